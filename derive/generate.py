@@ -1,0 +1,88 @@
+"""Derive every quantity of a layout and emit its numpy module text."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from volerr.layout import Layout
+
+from . import volumetric as vol
+from .codegen import Function, render_module
+from .kinematics import PROBE, Chain, parameter_symbol
+
+
+def module_name(layout_name: str) -> str:
+    """File/module name of a layout's generated module (``MB1`` -> ``mb1``)."""
+    return layout_name.lower()
+
+
+def _sigma(name: str) -> sp.Symbol:
+    return sp.Symbol(f"s_{name}", real=True)
+
+
+def derive_functions(layout: Layout) -> list[Function]:
+    """All generated functions of one layout."""
+    chain = Chain.from_layout(layout)
+    pos = [str(s) for s in chain.positions]
+    probe = [str(s) for s in PROBE]
+    params = [str(s) for s in chain.parameters]
+    error = vol.volumetric_error(chain)
+    sens = vol.sensitivity(chain, error)
+    sigmas = [_sigma(p) for p in params]
+    rules = vol.transfer_rules(chain, error)
+    transfer_args = sorted({str(s) for e in rules.shift.values() for s in e.free_symbols},
+                           key=lambda n: (n not in ("Xo", "Yo", "Zo"), n))
+    funcs = [
+        Function("volumetric_error", pos + probe + params, list(error),
+                 "First-order volumetric error (dX, dY, dZ), mm."),
+        Function("sensitivity", pos + probe, list(sens),
+                 "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",
+                 shape=(3, len(params))),
+        Function("exact_error", pos + probe + params, list(vol.exact_error(chain)),
+                 "Exact (non-linearised) error of the probe tip, mm: rotations not small."),
+        Function("random_error_termwise", pos + probe + [str(s) for s in sigmas],
+                 list(vol.random_error_termwise(sens, sigmas)),
+                 "Random error by Pahk's term-wise quadrature (eq. 5, 8), mm; arguments "
+                 "s_<name> are standard deviations of the parameters."),
+        Function("nominal_position", pos + probe, list(vol.nominal_point(chain)),
+                 "Nominal probe-tip / tool-tip position in the workpiece frame, mm."),
+        Function("tool_axis", pos, list(vol.nominal_tool_axis(chain)),
+                 "Nominal tool-axis direction (tool +z) in the workpiece frame, unit vector."),
+        Function("orientation_error", pos + params, list(vol.orientation_error(chain)),
+                 "First-order error of the tool-axis direction (i, j, k), rad."),
+    ]
+    if rules.shift:
+        funcs.append(Function(
+            "transfer_shift", transfer_args, [rules.shift[k] for k in sorted(rules.shift)],
+            "Transfer rules: measured value minus reference value of each parameter for a "
+            "measurement at offset (Xo, Yo, Zo) mm, given the angular errors there (rad).",
+            output_names=sorted(rules.shift)))
+    return funcs
+
+
+def generate_module(layout: Layout) -> str:
+    """The complete module text of one layout (deterministic)."""
+    chain_params = layout.parameter_names
+    constants = {
+        "LAYOUT": repr(layout.name),
+        "LAYOUT_SHA256": repr(layout.sha256),
+        "AXES": repr(tuple(layout.axis_names)),
+        "ROTARY_AXES": repr(tuple(a for a in layout.axis_names
+                                  if layout.axes[a].kind == "rotary")),
+        "PARAMETERS": repr(tuple(chain_params)),
+        "PARAMETER_AXIS": repr(layout.parameter_axis),
+    }
+    for k, v in sorted(layout.parameters.items()):
+        constants[k] = repr(float(v))
+    header = {
+        "title": f"Error model of layout {layout.name}.",
+        "layout": layout.name,
+        "layout_file": layout.path or f"{layout.name}.toml",
+        "sha256": layout.sha256,
+    }
+    return render_module(header, constants, derive_functions(layout))
+
+
+def parameter_symbols(layout: Layout) -> list[sp.Symbol]:
+    """Symbols of the layout's error parameters, in model order."""
+    return [parameter_symbol(p) for p in layout.parameter_names]

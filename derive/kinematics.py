@@ -1,0 +1,234 @@
+"""Kinematic chains of small-angle homogeneous transforms (sympy).
+
+Frames and direction of every matrix
+------------------------------------
+``tool2work`` is the 4x4 HTM that maps coordinates in the tool (probe) frame to the workpiece
+frame.  It is the product, left to right, of *factors*
+
+    tool2work = F_1 @ F_2 @ ... @ F_n
+
+where the list is the workpiece chain reversed (each table stage written as the tool's motion
+relative to the table, ISO 841) followed by the tool chain from the base to the probe.  A
+factor is either *nominal* (a known HTM of positions and layout parameters) or an *error
+factor* ``I + D`` whose 4x4 twist ``D`` is linear in error parameters::
+
+    D = [[ 0,  -ez,  ey, dx],
+         [ ez,  0,  -ex, dy],
+         [-ey,  ex,  0,  dz],
+         [ 0,   0,   0,  0 ]]
+
+(Pahk eq. 2: the small-angle rotation ``T`` and the translation ``L``).  The exact model uses
+``Trans(dx, dy, dz) @ Rz(ez) @ Ry(ey) @ Rx(ex)`` instead; the two differ at second order.
+
+Stage conventions
+-----------------
+* linear axis ``A`` with direction ``u``: ``Trans(q u) @ (I + D_squareness) @ (I + D_A(q))``
+  -- the angular error rotates what rides on the carriage, not its own travel.
+* rotary axis ``R`` through point ``c``: ``Trans(c) @ (I + D_location) @ (I + D_R(q)) @
+  Rot(u, q) @ Trans(-c)`` -- error motions in the non-rotating frame on the axis (ISO 230-7).
+* fixed frame: ``Trans(t) @ Rot(axis, angle)``.
+* a table (workpiece-side) stage is written as the tool's motion relative to the table, so its
+  error parameters are tool-relative (ISO 230-1) and its rotation pivots about the tool-side
+  reference point.  ``table_pivot="table_origin"`` instead pivots the table about its own moving
+  origin, which adds own-travel lever arms (Pahk's appendix reading; used by the audit).
+
+Angles of rotary axes are in radians inside the derivation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from volerr.layout import SQUARENESS, Layout
+
+PROBE = sp.symbols("Xp Yp Zp", real=True)
+
+
+def position_symbol(axis: str) -> sp.Symbol:
+    """The symbol of an axis position (mm for linear axes, rad for rotary axes)."""
+    return sp.Symbol(axis, real=True)
+
+
+def parameter_symbol(name: str) -> sp.Symbol:
+    """The symbol of an error parameter, named as in ISO 230-1 (``EXX``, ``EC0Y`` ...)."""
+    return sp.Symbol(name, real=True)
+
+
+def twist(ex=0, ey=0, ez=0, dx=0, dy=0, dz=0) -> sp.Matrix:
+    """The first-order error twist D (the HTM of a small motion is I + D)."""
+    return sp.Matrix([[0, -ez, ey, dx], [ez, 0, -ex, dy], [-ey, ex, 0, dz], [0, 0, 0, 0]])
+
+
+def translation(v) -> sp.Matrix:
+    """HTM of a pure translation by the 3-vector ``v``."""
+    m = sp.eye(4)
+    m[0:3, 3] = sp.Matrix(v)
+    return m
+
+
+def rotation(axis, angle) -> sp.Matrix:
+    """HTM of a right-hand rotation by ``angle`` (rad) about the unit vector ``axis``."""
+    k = sp.Matrix(axis)
+    kx = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    r = sp.eye(3) + sp.sin(angle) * kx + (1 - sp.cos(angle)) * kx * kx
+    m = sp.eye(4)
+    m[0:3, 0:3] = r
+    return m
+
+
+def exact_error_htm(ex=0, ey=0, ez=0, dx=0, dy=0, dz=0) -> sp.Matrix:
+    """The exact rigid motion that a twist approximates: Trans(d) Rz(ez) Ry(ey) Rx(ex)."""
+    return (translation((dx, dy, dz)) * rotation((0, 0, 1), ez) * rotation((0, 1, 0), ey)
+            * rotation((1, 0, 0), ex))
+
+
+@dataclass
+class Factor:
+    """One factor of the chain: ``nominal`` HTM, or an error twist ``twist_args``."""
+
+    nominal: sp.Matrix | None = None
+    twist_args: dict | None = None
+    owner: str = ""          # axis or frame the factor belongs to
+    role: str = ""           # "motion", "component", "squareness", "location", "fixed"
+
+    @property
+    def is_error(self) -> bool:
+        return self.twist_args is not None
+
+    def first_order(self) -> sp.Matrix:
+        return twist(**self.twist_args)
+
+    def exact(self) -> sp.Matrix:
+        return exact_error_htm(**self.twist_args) if self.is_error else self.nominal
+
+
+def _sympify_vec(v, params: dict) -> sp.Matrix:
+    loc = {k: sp.Symbol(k, real=True) for k in params}
+    return sp.Matrix([sp.nsimplify(c) if not isinstance(c, str) else sp.sympify(c, locals=loc)
+                      for c in v])
+
+
+def _rational_vec(v) -> sp.Matrix:
+    """Direction cosines as exact numbers where they are simple (1, 0, sqrt(2)/2 ...)."""
+    return sp.Matrix([sp.nsimplify(c, [sp.sqrt(2), sp.sqrt(3)], tolerance=1e-12) for c in v])
+
+
+def _component_twist(axis: str) -> dict:
+    return dict(dx=parameter_symbol(f"EX{axis}"), dy=parameter_symbol(f"EY{axis}"),
+                dz=parameter_symbol(f"EZ{axis}"), ex=parameter_symbol(f"EA{axis}"),
+                ey=parameter_symbol(f"EB{axis}"), ez=parameter_symbol(f"EC{axis}"))
+
+
+def _squareness_twist(layout: Layout, axis: str, direction: sp.Matrix, q) -> dict | None:
+    """Translation twist q * (omega x u) of the squareness rotations this axis carries."""
+    omega = sp.zeros(3, 1)
+    for name, carrier in layout.squareness.items():
+        if carrier != axis:
+            continue
+        about, moving, _ = SQUARENESS[name]
+        sign = 1 if carrier == moving else -1
+        omega[about] += sign * parameter_symbol(name)
+    if omega == sp.zeros(3, 1):
+        return None
+    shift = q * omega.cross(direction)
+    return dict(dx=shift[0], dy=shift[1], dz=shift[2])
+
+
+def _location_twist(axis) -> dict:
+    args = {}
+    for name in axis.location_errors:
+        key = {"X": "dx", "Y": "dy", "Z": "dz", "A": "ex", "B": "ey", "C": "ez"}[name[1]]
+        args[key] = parameter_symbol(name)
+    return args
+
+
+def stage_factors(layout: Layout, entry: str) -> list[Factor]:
+    """The factors of one chain entry (axis or frame), in tool-side form."""
+    params = layout.parameters
+    if entry in layout.frames:
+        f = layout.frames[entry]
+        angle = sp.sympify(f.angle_deg, locals={k: sp.Symbol(k, real=True) for k in params})
+        m = translation(_sympify_vec(f.translation, params)) * rotation(
+            _rational_vec(f.rotation_axis), sp.pi * sp.nsimplify(angle) / 180)
+        return [Factor(nominal=m, owner=entry, role="fixed")]
+    axis = layout.axes[entry]
+    q = position_symbol(entry)
+    u = _rational_vec(axis.direction)
+    if axis.kind == "linear":
+        out = [Factor(nominal=translation(q * u), owner=entry, role="motion")]
+        sq = _squareness_twist(layout, entry, u, q)
+        if sq:
+            out.append(Factor(twist_args=sq, owner=entry, role="squareness"))
+        out.append(Factor(twist_args=_component_twist(entry), owner=entry, role="component"))
+        return out
+    c = _sympify_vec(axis.point, params)
+    out = [Factor(nominal=translation(c), owner=entry, role="fixed")]
+    loc = _location_twist(axis)
+    if loc:
+        out.append(Factor(twist_args=loc, owner=entry, role="location"))
+    out.append(Factor(twist_args=_component_twist(entry), owner=entry, role="component"))
+    out.append(Factor(nominal=rotation(u, q), owner=entry, role="motion"))
+    out.append(Factor(nominal=translation(-c), owner=entry, role="fixed"))
+    return out
+
+
+def _move_to_table_origin(factors: list[Factor]) -> list[Factor]:
+    """Pahk's appendix reading: a table's error twist acts before its own travel."""
+    motion = [f for f in factors if f.role == "motion"]
+    errors = [f for f in factors if f.is_error]
+    if len(motion) == 1 and all(f.role in ("motion", "component", "squareness") for f in factors):
+        return errors + motion
+    return factors
+
+
+def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Factor]:
+    """All factors of ``tool2work``, workpiece side first (reversed), then the tool side."""
+    out: list[Factor] = []
+    for entry in reversed(layout.workpiece_chain):
+        fs = stage_factors(layout, entry)
+        if table_pivot == "table_origin" and entry in layout.axes:
+            fs = _move_to_table_origin(fs)
+        out.extend(fs)
+    for entry in layout.tool_chain:
+        out.extend(stage_factors(layout, entry))
+    return out
+
+
+@dataclass
+class Chain:
+    """A layout's chain with its symbols; all derived quantities are computed from it."""
+
+    layout: Layout
+    factors: list[Factor]
+    positions: tuple = field(default_factory=tuple)
+    parameters: tuple = field(default_factory=tuple)
+
+    @classmethod
+    def from_layout(cls, layout: Layout, table_pivot: str = "tool_point") -> "Chain":
+        return cls(layout, chain_factors(layout, table_pivot),
+                   tuple(position_symbol(a) for a in layout.axis_names),
+                   tuple(parameter_symbol(p) for p in layout.parameter_names))
+
+    def nominal_htm(self) -> sp.Matrix:
+        """Nominal ``tool2work`` (error factors are identity)."""
+        m = sp.eye(4)
+        for f in self.factors:
+            if not f.is_error:
+                m = m * f.nominal
+        return m
+
+    def exact_htm(self) -> sp.Matrix:
+        """Actual ``tool2work`` with exact rotations (not linearised)."""
+        m = sp.eye(4)
+        for f in self.factors:
+            m = m * f.exact()
+        return m
+
+    def small_angle_htm(self) -> sp.Matrix:
+        """Actual ``tool2work`` as the plain product of small-angle matrices (Pahk eq. 1)."""
+        m = sp.eye(4)
+        for f in self.factors:
+            m = m * (sp.eye(4) + f.first_order() if f.is_error else f.nominal)
+        return m

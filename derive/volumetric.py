@@ -1,0 +1,149 @@
+"""Volumetric error, sensitivities, random error and transfer rules derived from a chain.
+
+Everything here is computed from :class:`volerr.derive.kinematics.Chain`; nothing is
+transcribed from a paper.  Units: positions and offsets in mm, rotary positions in rad,
+translational errors in mm, angular errors in rad.  Sign: error = actual - nominal position of
+the probe tip / tool centre point in the workpiece frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from volerr.layout import SQUARENESS
+
+from .kinematics import PROBE, Chain, parameter_symbol, position_symbol, twist
+
+
+def nominal_point(chain: Chain) -> sp.Matrix:
+    """Nominal probe-tip position in the workpiece frame (3x1), mm."""
+    return (chain.nominal_htm() * sp.Matrix([*PROBE, 1]))[0:3, 0]
+
+
+def nominal_tool_axis(chain: Chain) -> sp.Matrix:
+    """Nominal direction of the tool axis (tool-frame +z) in the workpiece frame (3x1)."""
+    return chain.nominal_htm()[0:3, 2]
+
+
+def volumetric_error(chain: Chain) -> sp.Matrix:
+    """First-order volumetric error (dX, dY, dZ), linear in the error parameters."""
+    return _first_order_displacement(chain, sp.Matrix([*PROBE, 1]))
+
+
+def _first_order_displacement(chain: Chain, v: sp.Matrix) -> sp.Matrix:
+    """sum_k prefix_k @ D_k @ suffix_k @ v: the first-order change of the homogeneous vector v
+    (a point when v[3] = 1, a direction when v[3] = 0)."""
+    factors = chain.factors
+    suffix = [None] * len(factors)
+    for i in range(len(factors) - 1, -1, -1):
+        suffix[i] = v
+        if not factors[i].is_error:
+            v = factors[i].nominal * v
+    total = sp.zeros(4, 1)
+    prefix = sp.eye(4)
+    for i, f in enumerate(factors):
+        if f.is_error:
+            total += prefix * (f.first_order() * suffix[i])
+        else:
+            prefix = prefix * f.nominal
+    return sp.Matrix([sp.expand(total[i]) for i in range(3)])
+
+
+def orientation_error(chain: Chain) -> sp.Matrix:
+    """First-order error of the tool-axis direction (tool +z) in the workpiece frame."""
+    return _first_order_displacement(chain, sp.Matrix([0, 0, 1, 0]))
+
+
+def exact_error(chain: Chain) -> sp.Matrix:
+    """Exact (non-linearised) error: exact actual chain minus nominal chain, applied to the probe."""
+    p = sp.Matrix([*PROBE, 1])
+    return (chain.exact_htm() * p - chain.nominal_htm() * p)[0:3, 0]
+
+
+def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
+    """3 x n_parameters matrix d(dX, dY, dZ)/d(parameter) (unitless or mm/rad)."""
+    error = volumetric_error(chain) if error is None else error
+    return error.jacobian(sp.Matrix(chain.parameters))
+
+
+def random_error_exact(sens: sp.Matrix, sigmas) -> sp.Matrix:
+    """Standard uncertainty by first-order propagation: sqrt(sum((dD/dp)^2 sigma_p^2))."""
+    return sp.Matrix([
+        sp.sqrt(sum(sens[i, j] ** 2 * sigmas[j] ** 2 for j in range(sens.shape[1])))
+        for i in range(3)])
+
+
+def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
+    """Pahk's printed quadrature (eq. 5, 8): every monomial of a sensitivity squared alone,
+    so cross terms such as 2 Z Zp of (Z + Zp)^2 are dropped."""
+    rows = []
+    for i in range(3):
+        acc = 0
+        for j in range(sens.shape[1]):
+            for term in sp.Add.make_args(sp.expand(sens[i, j])):
+                if term != 0:
+                    acc += term ** 2 * sigmas[j] ** 2
+        rows.append(sp.sqrt(acc))
+    return sp.Matrix(rows)
+
+
+OFFSETS = sp.symbols("Xo Yo Zo", real=True)
+
+
+@dataclass
+class TransferRules:
+    """Transfer rules: measured value = reference value + ``shift``.
+
+    ``shift[name]`` is a sympy expression in the offsets (Xo, Yo, Zo) and the angular error
+    parameters.  For a translational error of an axis it is the Abbe term ``(eps x o)`` of the
+    axis' own angular errors at lever arm ``o`` from the axis' reference point; for a
+    squareness it is what the other axes' angular errors at position ``o`` add to the angle
+    between the straightness reference lines."""
+
+    shift: dict
+
+    def reference(self, name: str) -> sp.Expr:
+        """The reference value of ``name`` in terms of its measured value (symbol ``<name>_m``)."""
+        return sp.Symbol(f"{name}_m", real=True) - self.shift[name]
+
+
+def transfer_rules(chain: Chain, error: sp.Matrix | None = None) -> TransferRules:
+    """Derive the transfer rules of every linear axis' translational errors and squareness."""
+    layout = chain.layout
+    o = sp.Matrix([*OFFSETS, 1])
+    shift = {}
+    for f in chain.factors:
+        if f.role != "component" or layout.axes[f.owner].kind != "linear":
+            continue
+        angular_only = {k: v for k, v in f.twist_args.items() if k in ("ex", "ey", "ez")}
+        abbe = twist(**angular_only) * o
+        for i, t in enumerate("XYZ"):
+            shift[f"E{t}{f.owner}"] = sp.expand(abbe[i])
+    error = volumetric_error(chain) if error is None else error
+    frozen = _squareness_slopes(chain, error)
+    for name, expr in frozen.items():
+        shift[name] = sp.expand(expr - parameter_symbol(name))
+    return TransferRules(shift)
+
+
+def _squareness_slopes(chain: Chain, error: sp.Matrix) -> dict:
+    """Apparent squareness from the slopes of straightness reference lines, all component
+    errors frozen at their values at the measuring position (Xo, Yo, Zo)."""
+    layout = chain.layout
+    idx = {"X": 0, "Y": 1, "Z": 2}
+    pos = {t: position_symbol(t) for t in "XYZ"}
+    out = {}
+    for name in layout.squareness:
+        about, b, a = SQUARENESS[name]
+        ia, ib = idx[a], idx[b]
+        slope = sp.diff(error[ia], pos[b]) + sp.diff(error[ib], pos[a])
+        # the angle between lines a and b: 90 deg - slope; convert to the named rotation
+        sign = {"EC0Y": -1, "EB0Z": 1, "EA0Z": -1}[name]
+        apparent = sign * slope
+        apparent = apparent.subs({position_symbol(t): OFFSETS[i] for i, t in enumerate("XYZ")
+                                  if t in layout.axes})
+        apparent = apparent.subs({p: 0 for p in PROBE})
+        out[name] = sp.expand(apparent)
+    return out

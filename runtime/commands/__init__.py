@@ -1,0 +1,1 @@
+"""One module per ``volerr`` command; each has ``register(subparsers)``."""

@@ -1,0 +1,39 @@
+"""Safe output: never overwrite an input file, create parent folders, write atomically."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from .errors import require
+
+
+def check_output(path, inputs=()) -> Path:
+    """Refuse an output path that is one of the input files; return it as a Path."""
+    out = Path(path)
+    for p in inputs:
+        if p is None:
+            continue
+        p = Path(p)
+        if p.exists() and out.exists():
+            require(not os.path.samefile(out, p), f"refusing to overwrite input file {p}")
+        else:
+            require(out.resolve() != p.resolve(), f"refusing to overwrite input file {p}")
+    return out
+
+
+def write_text(path, text: str, inputs=()) -> Path:
+    """Write ``text`` to ``path`` atomically (temporary file + rename)."""
+    out = check_output(path, inputs)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+        os.replace(tmp, out)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return out

@@ -1,0 +1,250 @@
+"""The runtime model: a generated module behind a small, validated API.
+
+Units: positions mm (linear) and deg (rotary), translational errors and probe offsets mm,
+angular errors rad, results mm.  Error = actual minus nominal position of the probe tip / tool
+centre point in the workpiece frame.  Importing this module does not import sympy; a layout
+given as a file path is derived on the fly (that path imports sympy).
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import types
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError, require
+from .layout import Layout, read_layout
+
+
+def _module_for(layout: Layout, name_or_path) -> types.ModuleType:
+    """The generated module of a shipped layout, or a freshly derived one for a layout file."""
+    shipped = str(name_or_path) == layout.name and not str(name_or_path).endswith(".toml")
+    if shipped:
+        try:
+            mod = importlib.import_module(f"volerr.generated.{layout.name.lower()}")
+        except ModuleNotFoundError:
+            mod = None
+        if mod is not None and mod.LAYOUT_SHA256 == layout.sha256:
+            return mod
+    return derive_module(layout)
+
+
+def derive_module(layout: Layout) -> types.ModuleType:
+    """Derive and generate ``layout`` in memory (imports sympy) and load the module."""
+    from volerr.derive.generate import generate_module
+
+    source = generate_module(layout)
+    mod = types.ModuleType(f"volerr_generated_{layout.name.lower()}")
+    exec(compile(source, f"<generated {layout.name}>", "exec"), mod.__dict__)
+    return mod
+
+
+def _columns(components, n: int) -> np.ndarray:
+    """Generated outputs (tuple of broadcastable arrays) -> (n, len) float array."""
+    return np.stack([np.broadcast_to(c, (n,)) for c in components], axis=-1).astype(float)
+
+
+@dataclass
+class Model:
+    """A machine's error model. Create with :func:`load`."""
+
+    layout: Layout
+    module: types.ModuleType
+
+    # ---- description -------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.layout.name
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """Axis names in position-array column order."""
+        return tuple(self.module.AXES)
+
+    @property
+    def rotary_axes(self) -> tuple[str, ...]:
+        return tuple(self.module.ROTARY_AXES)
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """ISO 230-1 names of the error parameters, in model order."""
+        return tuple(self.module.PARAMETERS)
+
+    @property
+    def parameter_axis(self) -> dict:
+        """Parameter -> axis whose position it depends on (None for constants)."""
+        return dict(self.module.PARAMETER_AXIS)
+
+    @property
+    def paper_symbols(self) -> dict:
+        """ISO name -> symbol (with sign) used for it in the source document of the layout."""
+        return dict(self.layout.paper_symbols)
+
+    @property
+    def travel(self) -> dict:
+        """Axis -> (min, max) travel, mm or deg."""
+        return {a: self.layout.axes[a].travel for a in self.axes}
+
+    # ---- input handling ----------------------------------------------------------
+    def positions(self, positions) -> dict:
+        """Validate positions (dict or (N, n_axes) array, mm/deg) -> dict of float arrays,
+        rotary axes converted to rad."""
+        if isinstance(positions, dict):
+            unknown = set(positions) - set(self.axes)
+            if unknown:
+                raise InputError(f"{self.name}: unknown axis {sorted(unknown)[0]!r}; "
+                                 f"axes are {' '.join(self.axes)}")
+            missing = [a for a in self.axes if a not in positions]
+            if missing:
+                raise InputError(f"{self.name}: positions lack axis {missing[0]}")
+            cols = {a: np.asarray(positions[a], dtype=float) for a in self.axes}
+        else:
+            arr = np.asarray(positions, dtype=float)
+            if arr.ndim == 1:
+                arr = arr[None, :]
+            require(arr.ndim == 2 and arr.shape[1] == len(self.axes),
+                    f"{self.name}: positions must have {len(self.axes)} columns "
+                    f"({' '.join(self.axes)}), got shape {arr.shape}")
+            cols = {a: arr[:, i] for i, a in enumerate(self.axes)}
+        for a, v in cols.items():
+            require(np.all(np.isfinite(v)), f"{self.name}: position {a} has NaN or infinite values")
+        shape = np.broadcast_shapes(*(np.shape(v) for v in cols.values()))
+        out = {}
+        for a, v in cols.items():
+            v = np.broadcast_to(v, shape).ravel() if shape else np.atleast_1d(v)
+            out[a] = np.deg2rad(v) if a in self.rotary_axes else v
+        return out
+
+    def _probe(self, probe, n: int) -> dict:
+        p = np.asarray(probe, dtype=float)
+        require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
+        require(np.all(np.isfinite(p)), "probe offset has NaN values")
+        p = np.broadcast_to(p, (n, 3))
+        return {"Xp": p[:, 0], "Yp": p[:, 1], "Zp": p[:, 2]}
+
+    def _errors(self, errors, n: int) -> dict:
+        errors = dict(errors or {})
+        unknown = set(errors) - set(self.parameters)
+        if unknown:
+            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown)[0]!r}")
+        out = {}
+        for p in self.parameters:
+            v = np.asarray(errors.get(p, 0.0), dtype=float)
+            require(v.shape in ((), (n,), (1,)), f"error {p} must be a scalar or ({n},) array")
+            require(np.all(np.isfinite(v)), f"error {p} has NaN or infinite values")
+            out[p] = v
+        return out
+
+    # ---- evaluation --------------------------------------------------------------
+    def volumetric_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
+                         direction=None, probe_error=None) -> np.ndarray:
+        """First-order volumetric error, (N, 3) mm.
+
+        ``errors``: {name: scalar or (N,)} in mm / rad, missing names are zero.  ``probe``:
+        probe/tool offset (3,) or (N, 3) mm.  ``direction`` (N, 3) probing direction and
+        ``probe_error`` (a callable of directions giving mm, or an (N,) array) combine the
+        probe error as Pahk eq. (17): the error along the probing direction is subtracted."""
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        e = self.module.volumetric_error(**pos, **self._probe(probe, n), **self._errors(errors, n))
+        out = _columns(e, n)
+        if direction is not None or probe_error is not None:
+            out = out - self._probe_term(direction, probe_error, n)
+        return out
+
+    def _probe_term(self, direction, probe_error, n: int) -> np.ndarray:
+        require(direction is not None and probe_error is not None,
+                "combined model needs both a probing direction and a probe error")
+        m = np.broadcast_to(np.asarray(direction, dtype=float), (n, 3))
+        norm = np.linalg.norm(m, axis=1, keepdims=True)
+        require(np.all(norm > 0), "probing direction must not be the zero vector")
+        m = m / norm
+        value = probe_error(m) if callable(probe_error) else probe_error
+        value = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+        return value[:, None] * m
+
+    def exact_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        e = self.module.exact_error(**pos, **self._probe(probe, n), **self._errors(errors, n))
+        return _columns(e, n)
+
+    def sensitivity(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """d(error)/d(parameter), (N, 3, n_parameters): mm/mm or mm/rad."""
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        s = self.module.sensitivity(**pos, **self._probe(probe, n))
+        return np.moveaxis(np.broadcast_to(s, s.shape[:2] + (n,)), -1, 0)
+
+    def random_error(self, positions, sigmas, probe=(0.0, 0.0, 0.0),
+                     method: str = "exact") -> np.ndarray:
+        """Standard uncertainty of the volumetric error, (N, 3) mm.
+
+        ``sigmas``: {name: standard deviation (mm / rad), scalar or (N,)}.  ``method="exact"``
+        is first-order propagation sqrt(sum((dD/dp)^2 sigma_p^2)); ``"termwise"`` is Pahk's
+        printed quadrature (eq. 5, 8), which squares each term alone and drops cross terms."""
+        require(method in ("exact", "termwise"), f"unknown random-error method {method!r}")
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        sig = self._errors(sigmas, n)
+        if method == "termwise":
+            r = self.module.random_error_termwise(
+                **pos, **self._probe(probe, n), **{f"s_{k}": v for k, v in sig.items()})
+            return _columns(r, n)
+        s = self.sensitivity(positions, probe)
+        var = np.stack([np.broadcast_to(sig[p], (n,)) for p in self.parameters], axis=-1) ** 2
+        return np.sqrt(np.einsum("nij,nj->ni", s ** 2, var))
+
+    def transfer(self, measured: dict, offsets, angular: dict | None = None) -> dict:
+        """Re-reference errors measured at an offset (Pahk sec. 2.3).
+
+        ``measured``: {name: value (mm or rad), scalar or array} as measured with the
+        functional point at ``offsets`` = (Xo, Yo, Zo) mm from the axis' reference point (for
+        squareness: measured at that position).  ``angular``: the angular errors (rad) there,
+        defaulting to the values in ``measured``.  Returns the reference values; parameters
+        without a transfer rule pass through unchanged."""
+        require(hasattr(self.module, "transfer_shift"), f"{self.name} has no transfer rules")
+        unknown = set(measured) - set(self.parameters)
+        if unknown:
+            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown)[0]!r}")
+        o = np.asarray(offsets, dtype=float)
+        require(o.shape[-1:] == (3,), "offsets must be (Xo, Yo, Zo)")
+        values = {**{p: 0.0 for p in self.parameters}, **measured, **(angular or {})}
+        args = inspect.signature(self.module.transfer_shift).parameters
+        kw = {a: values[a] for a in args if a not in ("Xo", "Yo", "Zo")}
+        shift = self.module.transfer_shift(Xo=o[..., 0], Yo=o[..., 1], Zo=o[..., 2], **kw)
+        return {k: np.asarray(v) - (np.asarray(shift[k]) if k in shift else 0.0)
+                for k, v in measured.items()}
+
+    def nominal_position(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Nominal probe/tool tip in the workpiece frame, (N, 3) mm."""
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        p = self.module.nominal_position(**pos, **self._probe(probe, n))
+        return _columns(p, n)
+
+    def forward(self, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Nominal tool tip and tool axis in the workpiece frame, (N, 6) = x, y, z, i, j, k."""
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        k = self.module.tool_axis(**pos)
+        return np.concatenate([self.nominal_position(positions, tool), _columns(k, n)], axis=1)
+
+    def orientation_error(self, positions, errors=None) -> np.ndarray:
+        """First-order error of the tool-axis direction, (N, 3), rad."""
+        pos = self.positions(positions)
+        n = len(next(iter(pos.values())))
+        e = self.module.orientation_error(**pos, **self._errors(errors, n))
+        return _columns(e, n)
+
+
+def load(name_or_path) -> Model:
+    """Load a shipped layout's generated model by name, or derive one from a layout file."""
+    layout = read_layout(name_or_path)
+    if not isinstance(layout, Layout):  # pragma: no cover - defensive
+        raise InputError(f"not a layout: {name_or_path}")
+    return Model(layout, _module_for(layout, name_or_path))
