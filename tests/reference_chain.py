@@ -37,8 +37,11 @@ def _axis_errors(name: str, errors: dict) -> tuple[np.ndarray, np.ndarray]:
     return d, e
 
 
-def stage(layout: Layout, entry: str, q: dict, errors: dict) -> np.ndarray:
-    """Exact HTM of one chain entry in tool-relative form; positions q in mm / rad."""
+def stage(layout: Layout, entry: str, q: dict, errors: dict, table: bool = False) -> np.ndarray:
+    """Exact HTM of one chain entry in tool-relative form; positions q in mm / rad.
+
+    A rotary table turns the workpiece: in tool-relative form the rotation comes first and the
+    error motions act in the frame of the (non-turning) body that carries the table."""
     if entry in layout.frames:
         f = layout.frames[entry]
         t = [float(eval(str(c), {}, dict(layout.parameters))) for c in f.translation]
@@ -60,14 +63,18 @@ def stage(layout: Layout, entry: str, q: dict, errors: dict) -> np.ndarray:
     loc_e = np.zeros(3)
     for n in ax.location_errors:
         (loc_d if n[1] in "XYZ" else loc_e)[_LETTER[n[1]]] = errors.get(n, 0.0)
-    return (trans(c) @ error_htm(loc_d, loc_e) @ error_htm(d, e) @ rot(u * q[entry])
-            @ trans(-c))
+    errs = error_htm(loc_d, loc_e) @ error_htm(d, e)
+    if table:
+        return trans(c) @ rot(u * q[entry]) @ errs @ trans(-c)
+    return trans(c) @ errs @ rot(u * q[entry]) @ trans(-c)
 
 
 def tool_point(layout: Layout, q: dict, errors: dict, probe) -> np.ndarray:
     """Actual (exact) probe tip in the workpiece frame, mm; ``errors={}`` gives the nominal."""
     m = np.eye(4)
-    for entry in list(reversed(layout.workpiece_chain)) + list(layout.tool_chain):
+    for entry in reversed(layout.workpiece_chain):
+        m = m @ stage(layout, entry, q, errors, table=True)
+    for entry in layout.tool_chain:
         m = m @ stage(layout, entry, q, errors)
     return (m @ np.array([*probe, 1.0]))[:3]
 
