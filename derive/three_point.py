@@ -1,0 +1,169 @@
+"""Three-point (laser-tracker) identification of the six error motions of one axis.
+
+Source: Ellingsdalen (2021), NTNU thesis, Appendix B sec. 3.1 (linear axes, eq. 27-37) and
+ch. 3.2 (rotary axes, eq. 3.1-3.8), after Zhang & Hu (2011, 2013).
+
+Model
+-----
+Points ``P, Q, K, ...`` are fixed on the moving component (spindle head for a linear axis,
+table for a rotary axis).  At the reference position (the first commanded position of a round)
+a point sits at ``r`` (mm) in the measurement frame.  At a later position the component has
+moved nominally (translation along the axis, or rotation about the axis through the frame
+origin) and, in addition, by its six error motions: the translation ``t = (EX, EY, EZ)`` of
+the body point that coincided with the frame origin at the reference position, and the small
+rotation ``e = (EA, EB, EC)`` about the frame axes.  To first order (small angles, the error
+twist ``I + D`` of :func:`volerr.derive.kinematics.twist`) the deviation of a point from its
+nominal position is::
+
+    Delta = t + e x r_hat        r_hat = r (linear axis) or R_axis(theta) r (rotary axis)
+
+which is thesis eq. 30 (linear) and eq. 3.4 (rotary, the lever arm in rotated coordinates
+``x_hat = x cos C - y sin C``, ``y_hat = x sin C + y cos C``).  Every point gives three
+equations, linear in the six unknowns: ``n`` points give the ``3n x 6`` system of eq. 31 /
+eq. 3.5.  Zhang & Hu pick six of the nine rows (eq. 32, 36, 37, 3.6) and solve them in closed
+form (eq. 33-34, 3.7-3.8 and the Appendix Z-axis solution); :func:`closed_form` does the same
+symbolically, and :func:`generate_module` emits those solutions as numpy code
+(``generated/three_point.py``).  The runtime (``volerr.identify``) defaults to weighted least
+squares over all ``3n`` rows and uses the closed forms as a cross-check.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+
+import sympy as sp
+
+from .codegen import Function, render_module
+from .kinematics import rotation, twist
+
+#: the six error motions, in the order of the unknown vector (ISO 230-1 without the axis letter)
+MOTIONS = ("EX", "EY", "EZ", "EA", "EB", "EC")
+COORDS = ("x", "y", "z")
+
+#: Zhang & Hu row selections from the 9 x 6 system of points P, Q, K (thesis eq. 32 for the
+#: X axis and eq. 3.6 for the C axis, eq. 36 for Y, eq. 37 for Z): (point, coordinate) per row.
+SELECTIONS = {
+    "x": (("P", "x"), ("P", "y"), ("Q", "x"), ("Q", "z"), ("K", "y"), ("K", "z")),
+    "y": (("P", "y"), ("P", "z"), ("Q", "y"), ("K", "x"), ("K", "z"), ("P", "x")),
+    "z": (("P", "z"), ("Q", "x"), ("Q", "z"), ("K", "y"), ("P", "x"), ("P", "y")),
+}
+#: which selection the thesis uses for which axis
+AXIS_SELECTION = {"X": "x", "Y": "y", "Z": "z", "C": "x"}
+
+
+def motion_symbols() -> tuple[sp.Symbol, ...]:
+    """The six unknowns ``EX EY EZ EA EB EC`` (mm, mm, mm, rad, rad, rad)."""
+    return tuple(sp.Symbol(m, real=True) for m in MOTIONS)
+
+
+def point_symbols(label: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
+    """Lever arm of a point in the frame used by the equations: ``x_P, y_P, z_P`` (mm)."""
+    return tuple(sp.Symbol(f"{c}_{label}", real=True) for c in COORDS)
+
+
+def delta_symbols(label: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
+    """Measured deviation of a point from its nominal position: ``d_xP, d_yP, d_zP`` (mm)."""
+    return tuple(sp.Symbol(f"d_{c}{label}", real=True) for c in COORDS)
+
+
+def point_displacement(r) -> sp.Matrix:
+    """First-order deviation (3-vector) of a body point with lever arm ``r`` under the error
+    motions: ``(I + D) r - r`` with the error twist ``D`` of the six motions."""
+    ex, ey, ez, ea, eb, ec = motion_symbols()
+    D = twist(ea, eb, ec, ex, ey, ez)
+    rh = sp.Matrix([r[0], r[1], r[2], 1])
+    return sp.expand((D * rh)[0:3, 0])
+
+
+def rotated_lever_arm(r, axis=(0, 0, 1), angle=sp.Symbol("theta", real=True)) -> sp.Matrix:
+    """Lever arm of a table point after the nominal rotation by ``angle`` about ``axis``
+    through the frame origin (thesis eq. 3.2): ``R_axis(angle) r``."""
+    return (rotation(axis, angle) * sp.Matrix([r[0], r[1], r[2], 1]))[0:3, 0]
+
+
+def system(labels, rotary_axis=None, angle=sp.Symbol("theta", real=True)):
+    """The ``3n x 6`` coefficient matrix of the identification equations.
+
+    ``labels``: point labels; lever arms are :func:`point_symbols`.  With ``rotary_axis`` (a unit
+    3-vector) the lever arms are first turned by ``angle`` (rotary axis, eq. 3.5); otherwise they
+    are used as they are (linear axis, eq. 31).  Returns ``(A, rows)`` with ``rows`` the
+    (label, coordinate) of every row."""
+    unknowns = motion_symbols()
+    blocks, rows = [], []
+    for lab in labels:
+        r = sp.Matrix(point_symbols(lab))
+        if rotary_axis is not None:
+            r = rotated_lever_arm(r, rotary_axis, angle)
+        disp = point_displacement(r)
+        blocks.append(disp.jacobian(unknowns))
+        rows.extend((lab, c) for c in COORDS)
+    return sp.Matrix.vstack(*blocks), rows
+
+
+def selected_system(selection: str):
+    """The 6 x 6 system of one Zhang & Hu selection in the lever arms of P, Q, K:
+    ``(A, b)`` with ``b`` the corresponding :func:`delta_symbols`."""
+    A, rows = system(("P", "Q", "K"))
+    index = [rows.index(row) for row in SELECTIONS[selection]]
+    b = sp.Matrix([delta_symbols(lab)[COORDS.index(c)] for lab, c in SELECTIONS[selection]])
+    return sp.Matrix(A.extract(index, list(range(6)))), b
+
+
+def closed_form(selection: str) -> dict:
+    """Closed-form solution of a selected 6 x 6 system.
+
+    Returns ``{"EX": expr, ..., "EC": expr, "N": determinant}``: each motion as a function of
+    the lever arms and the six selected deviations (Cramer's rule, factored)."""
+    A, b = selected_system(selection)
+    det = sp.factor(A.det())
+    out = {}
+    for j, name in enumerate(MOTIONS):
+        Aj = sp.Matrix(A)
+        Aj[:, j] = b
+        out[name] = sp.factor(sp.expand(Aj.det())) / det
+    out["N"] = det
+    return out
+
+
+def _args(selection: str) -> list[str]:
+    pts = [str(s) for lab in ("P", "Q", "K") for s in point_symbols(lab)]
+    ds = [str(delta_symbols(lab)[COORDS.index(c)]) for lab, c in SELECTIONS[selection]]
+    return pts + ds
+
+
+def derive_functions() -> list[Function]:
+    """Generated functions: one closed-form solver and one determinant per selection."""
+    funcs = []
+    for sel in sorted(SELECTIONS):
+        sol = closed_form(sel)
+        rows = ", ".join(f"{c}{lab}" for lab, c in SELECTIONS[sel])
+        funcs.append(Function(
+            f"solve_{sel}", _args(sel), [sol[m] for m in MOTIONS],
+            f"Zhang & Hu closed form, selection {sel!r} (rows {rows}): the six error motions "
+            f"(EX, EY, EZ mm; EA, EB, EC rad) as array (6, *shape) from the lever arms of P, Q, K "
+            f"and the six selected deviations d (mm).", shape=(6,)))
+        funcs.append(Function(
+            f"det_{sel}", [str(s) for lab in ("P", "Q", "K") for s in point_symbols(lab)],
+            [sol["N"]],
+            f"Determinant of the selected 6 x 6 system {sel!r} (mm^3): zero means the "
+            f"selection is singular for these points even if the full system is not.",
+            output_names=["N"]))
+    return funcs
+
+
+def generate_module() -> str:
+    """Text of ``generated/three_point.py`` (deterministic)."""
+    src = inspect.getsource(inspect.getmodule(generate_module))
+    header = {
+        "title": "Three-point identification: Zhang & Hu closed-form solutions.",
+        "layout": "--all",
+        "layout_file": "derive/three_point.py",
+        "sha256": hashlib.sha256(src.encode()).hexdigest(),
+    }
+    constants = {
+        "MOTIONS": repr(MOTIONS),
+        "SELECTIONS": repr({k: SELECTIONS[k] for k in sorted(SELECTIONS)}),
+        "AXIS_SELECTION": repr(AXIS_SELECTION),
+    }
+    return render_module(header, constants, derive_functions())
