@@ -6,6 +6,7 @@ import sympy as sp
 
 from volerr.layout import Layout
 
+from . import inverse
 from . import volumetric as vol
 from .codegen import Function, render_module
 from .kinematics import PROBE, Chain, parameter_symbol
@@ -51,6 +52,8 @@ def derive_functions(layout: Layout) -> list[Function]:
         Function("orientation_error", pos + params, list(vol.orientation_error(chain)),
                  "First-order error of the tool-axis direction (i, j, k), rad."),
     ]
+    if inverse.applies(layout):
+        funcs.extend(inverse.inverse_functions(layout))
     if rules.shift:
         funcs.append(Function(
             "transfer_shift", transfer_args, [rules.shift[k] for k in sorted(rules.shift)],

@@ -31,6 +31,11 @@ Stage conventions
   error parameters are tool-relative (ISO 230-1) and its rotation pivots about the tool-side
   reference point.  ``table_pivot="table_origin"`` instead pivots the table about its own moving
   origin, which adds own-travel lever arms (Pahk's appendix reading; used by the audit).
+* a table rotary axis ``R``: ``Trans(c) @ Rot(u, q) @ (I + D_location) @ (I + D_R(q)) @
+  Trans(-c)`` -- in ``tool2work`` the frame left of ``Rot`` turns with the table, so the error
+  twists stand right of it, in the frame of the body that carries the table axis (which does
+  not turn with it; ISO 230-7).  A constant location error then moves the tool relative to
+  the workpiece by an amount that turns with the axis, as an offset axis line does.
 
 Angles of rotary axes are in radians inside the derivation.
 """
@@ -183,11 +188,22 @@ def _move_to_table_origin(factors: list[Factor]) -> list[Factor]:
     return factors
 
 
+def _table_rotary(factors: list[Factor]) -> list[Factor]:
+    """A table rotary stage: error twists right of the rotation (carrier frame, not turning)."""
+    fixed_in, *rest = factors
+    motion = [f for f in rest if f.role == "motion"]
+    errors = [f for f in rest if f.is_error]
+    fixed_out = [f for f in rest if f.role == "fixed"]
+    return [fixed_in, *motion, *errors, *fixed_out]
+
+
 def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Factor]:
     """All factors of ``tool2work``, workpiece side first (reversed), then the tool side."""
     out: list[Factor] = []
     for entry in reversed(layout.workpiece_chain):
         fs = stage_factors(layout, entry)
+        if entry in layout.axes and layout.axes[entry].kind == "rotary":
+            fs = _table_rotary(fs)
         if table_pivot == "table_origin" and entry in layout.axes:
             fs = _move_to_table_origin(fs)
         out.extend(fs)

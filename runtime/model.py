@@ -234,6 +234,14 @@ class Model:
         k = self.module.tool_axis(**pos)
         return np.concatenate([self.nominal_position(positions, tool), _columns(k, n)], axis=1)
 
+    def inverse(self, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
+        """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
+        axis ``target`` (N, 6) = x, y, z, i, j, k; ``near`` picks the branch, the turn and an
+        undetermined rotary axis (see :func:`volerr.fiveaxis.inverse`)."""
+        from .fiveaxis import inverse
+
+        return inverse(self, target, tool, near)
+
     def orientation_error(self, positions, errors=None) -> np.ndarray:
         """First-order error of the tool-axis direction, (N, 3), rad."""
         pos = self.positions(positions)

@@ -1,0 +1,126 @@
+"""Nominal inverse kinematics of a five-axis layout, derived from its chain (sympy).
+
+Scope: layouts with three linear axes and two rotary axes, in any arrangement (table-table,
+head-head, table-head, inclined axes as on the DMU 50).  Two facts make a closed form generic:
+
+* the tool orientation depends on the rotary axes only: the rotation part of ``tool2work`` is
+  ``A0 @ Rot(u1, q1) @ A1 @ Rot(u2, q2) @ A2`` with constant rotations ``A0 A1 A2`` (fixed frames)
+  and ``q1``, ``q2`` the rotary positions in chain order (left to right in ``tool2work``);
+* for fixed rotary positions the tool tip is affine in the linear positions:
+  ``p = M(q_rot) @ (X, Y, Z) + t(q_rot, tool)``.
+
+Tool axis ``k`` (unit, workpiece frame) -> rotary positions: with ``k' = A0^T k``,
+``w2 = A1 u2`` and ``p0 = A1 A2 e_z`` the equation ``Rot(u1, q1) Rot(w2, q2) p0 = k'`` is
+Paden-Kahan subproblem 2 (Murray, Li, Sastry 1994, sec. 3.3): the intermediate vector
+``c = alpha u1 + beta w2 + gamma (u1 x w2)`` with ``gamma = branch * sqrt(...)``, ``branch = +1 or
+-1`` choosing one of the two solutions, then two subproblems 1 (``atan2``) give ``q2`` and ``q1``.
+On a singular orientation (``k'`` along ``u1``) ``q1`` is undetermined and comes out as
+``atan2(0, 0) = 0``; the runtime keeps the previous value there.  Unreachable orientations give
+NaN (negative radicand).
+
+Tool tip ``p`` -> linear positions: ``(X, Y, Z) = M^-1 (p - t)``; ``M`` is the derivative of the
+nominal tip with respect to the linear positions (``M^T`` when orthogonal).
+
+Units: rad and mm.  This module does no file I/O.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from volerr.layout import Layout
+
+from .codegen import Function
+from .kinematics import PROBE, Chain, _rational_vec, position_symbol
+from .volumetric import nominal_point
+
+TOOL_AXIS = sp.symbols("i j k", real=True)
+TIP = sp.symbols("x y z", real=True)
+BRANCH = sp.Symbol("branch", real=True)
+
+
+def applies(layout: Layout) -> bool:
+    """True for layouts with exactly three linear axes X Y Z and two rotary axes."""
+    lin = [a for a in layout.axis_names if layout.axes[a].kind == "linear"]
+    rot = [a for a in layout.axis_names if layout.axes[a].kind == "rotary"]
+    return lin == ["X", "Y", "Z"] and len(rot) == 2
+
+
+def rotation_structure(chain: Chain):
+    """(A0, u1, axis1, A1, u2, axis2, A2): the rotation part of nominal ``tool2work`` split at
+    its two rotary motions (3x3 sympy matrices, unit 3-vectors, axis names)."""
+    layout = chain.layout
+    parts, axes, dirs = [sp.eye(3)], [], []
+    for f in chain.factors:
+        if f.is_error:
+            continue
+        if f.role == "motion" and layout.axes[f.owner].kind == "rotary":
+            axes.append(f.owner)
+            dirs.append(_rational_vec(layout.axes[f.owner].direction))
+            parts.append(sp.eye(3))
+        else:
+            parts[-1] = parts[-1] * f.nominal[0:3, 0:3]
+    if len(axes) != 2:
+        raise ValueError(f"layout {layout.name}: expected two rotary motions, found {len(axes)}")
+    return parts[0], dirs[0], axes[0], parts[1], dirs[1], axes[1], parts[2]
+
+
+def _subproblem1(axis: sp.Matrix, a: sp.Matrix, b: sp.Matrix):
+    """Angle of the right-hand rotation about unit ``axis`` that turns ``a`` onto ``b``."""
+    ap = a - axis * (axis.dot(a))
+    bp = b - axis * (axis.dot(b))
+    return sp.atan2(axis.dot(ap.cross(bp)), ap.dot(bp))
+
+
+def rotary_inverse(chain: Chain) -> dict:
+    """Axis name -> expression of its position (rad) in the tool axis (i, j, k) and ``branch``."""
+    a0, u1, n1, a1, u2, n2, a2 = rotation_structure(chain)
+    kp = a0.T * sp.Matrix(TOOL_AXIS)
+    w2 = sp.simplify(a1 * u2)
+    p0 = sp.simplify(a1 * a2 * sp.Matrix([0, 0, 1]))
+    c12 = sp.nsimplify(sp.simplify(u1.dot(w2)))
+    if sp.simplify(c12 ** 2 - 1) == 0:
+        raise ValueError(f"layout {chain.layout.name}: the two rotary axes are parallel")
+    alpha = (c12 * w2.dot(p0) - u1.dot(kp)) / (c12 ** 2 - 1)
+    beta = (c12 * u1.dot(kp) - w2.dot(p0)) / (c12 ** 2 - 1)
+    cross = u1.cross(w2)
+    radicand = sp.factor(sp.simplify(
+        (p0.dot(p0) - alpha ** 2 - beta ** 2 - 2 * alpha * beta * c12) / cross.dot(cross)))
+    alpha, beta = sp.simplify(alpha), sp.simplify(beta)
+    gamma = BRANCH * sp.sqrt(radicand)
+    c = alpha * u1 + beta * w2 + gamma * cross
+    q2 = _subproblem1(w2, p0, c)
+    q1 = _subproblem1(u1, c, kp)
+    return {n1: q1, n2: q2}
+
+
+def linear_inverse(chain: Chain) -> dict:
+    """Linear axis -> expression in the rotary positions, the tip (x, y, z) and the tool offset."""
+    lin = [position_symbol(a) for a in ("X", "Y", "Z")]
+    p = nominal_point(chain)
+    m = p.jacobian(sp.Matrix(lin))
+    t = p.subs({s: 0 for s in lin})
+    mtm = sp.simplify(m.T * m)
+    minv = m.T if mtm == sp.eye(3) else sp.simplify(m.inv())
+    sol = minv * (sp.Matrix(TIP) - t)
+    return {a: sp.expand(sp.simplify(sol[i])) for i, a in enumerate(("X", "Y", "Z"))}
+
+
+def inverse_functions(layout: Layout) -> list[Function]:
+    """Generated functions ``inverse_rotary`` and ``inverse_linear`` of a five-axis layout."""
+    chain = Chain.from_layout(layout)
+    rot = [a for a in layout.axis_names if layout.axes[a].kind == "rotary"]
+    rinv = rotary_inverse(chain)
+    linv = linear_inverse(chain)
+    return [
+        Function("inverse_rotary", [str(s) for s in TOOL_AXIS] + [str(BRANCH)],
+                 [rinv[a] for a in rot],
+                 f"Rotary positions ({', '.join(rot)}), rad, that give the unit tool axis (i, j, k) "
+                 "in the workpiece frame; branch = +1 or -1 picks one of the two solutions "
+                 "(Paden-Kahan subproblem 2). NaN where the orientation is unreachable."),
+        Function("inverse_linear", rot + [str(s) for s in TIP] + [str(s) for s in PROBE],
+                 [linv[a] for a in ("X", "Y", "Z")],
+                 "Linear positions (X, Y, Z), mm, that put the tool tip (offset Xp, Yp, Zp in the "
+                 "tool frame) at (x, y, z) in the workpiece frame for the given rotary "
+                 "positions (rad)."),
+    ]
