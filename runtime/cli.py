@@ -14,8 +14,8 @@ import sys
 from .errors import InputError
 
 #: command modules, in the order shown by ``volerr --help``
-COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "probe_cal",
-            "compensate", "controller", "loop", "simulate", "demo")
+COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
+            "probe_cal", "compensate", "controller", "loop", "simulate", "demo")
 
 
 def build_parser() -> argparse.ArgumentParser:

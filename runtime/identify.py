@@ -221,6 +221,7 @@ class Identification:
         if cf:
             out["closed_form"] = {
                 "selection": cf[0]["selection"], "roles": cf[0]["roles"],
+                "thesis_choice_everywhere": all(c["thesis_choice_everywhere"] for c in cf),
                 "consistency_max": max(c["consistency_max"] for c in cf),
                 "vs_lsq_max": {n: max(c["vs_lsq_max"][n] for c in cf) for n in self.names},
             }
@@ -297,54 +298,72 @@ def _solve(A, W, delta):
     return theta, Ninv
 
 
-def _closed_form(lever, delta, theta_lsq, axis, kind, roles=None):
-    """Zhang & Hu closed form on three points of every position; cross-check vs ``theta_lsq``.
+def _closed_form(lever, delta, theta_lsq, axis, kind):
+    """Zhang & Hu closed form on three points at every position; cross-check vs ``theta_lsq``.
 
-    lever, delta: (K, n, 3); returns dict with the values (K, 6), the selection, the roles
-    (indices of P, Q, K) and deviations."""
+    Candidates: the three row selections (eq. 32/3.6, 36, 37) x the 3! assignments of the first
+    three points to the roles P, Q, K.  At each position the thesis' choice (the axis'
+    selection, points in the given order) is used unless its determinant N is below 0.1 of the
+    best candidate's there (for a rotary axis N changes with the angle and can pass through
+    zero).  lever, delta: (K, n, 3)."""
     from volerr.generated import three_point as gen
 
     K, n, _ = lever.shape
     pref = gen.AXIS_SELECTION.get(axis if kind == "linear" else "C", "x")
     c0 = lever[0] - lever[0].mean(axis=0)
     spread = math.sqrt(float(np.mean(np.sum(c0 ** 2, axis=1))))
-    cand = []
-    trio = (0, 1, 2) if n == 3 else None
-    perms = itertools.permutations(range(n) if trio is None else trio, 3) if roles is None \
-        else [tuple(roles)]
-    for perm in perms:
-        for sel in (pref,) + tuple(s for s in sorted(gen.SELECTIONS) if s != pref):
-            L = lever[:, perm, :]
-            det = gen.det_x if sel == "x" else gen.det_y if sel == "y" else gen.det_z
-            N = det(*[L[:, i, c] for i in range(3) for c in range(3)])["N"]
-            score = float(np.min(np.abs(N))) / spread ** 3
-            rank = (sel == pref) + (perm == (0, 1, 2))  # the thesis' choice first
-            cand.append((score, rank, sel, perm))
-    best = max(cand, key=lambda c: c[0])
-    good = [c for c in cand if c[0] >= 0.1 * best[0]]
-    score, _, sel, perm = max(good, key=lambda c: (c[1], c[0]))
-    require(score > 1e-9, "closed form: every Zhang & Hu selection is singular for these points "
-                          "(denominator N = 0); use the least-squares method")
-    solve = getattr(gen, f"solve_{sel}")
-    rows = gen.SELECTIONS[sel]
     names = ("P", "Q", "K")
-    L = lever[:, perm, :]
+    cands, scores, ranks = [], [], []
+    for perm in itertools.permutations((0, 1, 2), 3):
+        L = lever[:, perm, :]
+        args = [L[:, i, c] for i in range(3) for c in range(3)]
+        for sel in sorted(gen.SELECTIONS):
+            N = np.broadcast_to(getattr(gen, f"det_{sel}")(*args)["N"], (K,))
+            cands.append((sel, perm))
+            scores.append(np.abs(N) / spread ** 3)
+            ranks.append((sel == pref) + (perm == (0, 1, 2)))
+    scores = np.array(scores)                      # (n_cand, K)
+    best = scores.max(axis=0)
+    require(np.all(best[1:] > 1e-9) if K > 1 else True,
+            "closed form: every Zhang & Hu selection is singular for these points (denominator "
+            "N = 0); use the least-squares method")
+    ok = scores >= 0.1 * best
+    key = np.where(ok, np.array(ranks)[:, None] * 10.0 + scores / np.maximum(best, 1e-300), -1)
+    choice = np.argmax(key, axis=0)                # (K,)
 
     def run(dl):
-        D = dl[:, perm, :]
-        ds = [D[:, names.index(lab), "xyz".index(c)] for lab, c in rows]
-        return np.asarray(solve(*[L[:, i, c] for i in range(3) for c in range(3)], *ds)).T
+        out = np.zeros((K, 6))
+        for c in np.unique(choice):
+            sel, perm = cands[c]
+            m = choice == c
+            L = lever[m][:, perm, :]
+            D = dl[m][:, perm, :]
+            ds = [D[:, names.index(lab), "xyz".index(co)] for lab, co in gen.SELECTIONS[sel]]
+            solve = getattr(gen, f"solve_{sel}")
+            out[m] = np.asarray(solve(*[L[:, i, co] for i in range(3) for co in range(3)],
+                                      *ds)).T
+        return out
 
     values = run(delta)
     A = design(lever)
     fitted = np.einsum("knij,kj->kni", A, theta_lsq)
     consistent = run(fitted)
     scale = np.array([1.0, 1.0, 1.0, spread, spread, spread])
+    used = [cands[c] for c in np.unique(choice[1:] if K > 1 else choice)]
+    rows = []
+    for k in range(K):
+        sel, perm = cands[choice[k]]
+        rows.append([(perm[names.index(lab)], "xyz".index(co)) for lab, co in
+                     gen.SELECTIONS[sel]])
     return {
-        "values": values, "selection": sel, "roles": {names[i]: int(perm[i]) for i in range(3)},
+        "values": values,
+        "selection": ",".join(sorted({sel for sel, _ in used})),
+        "roles": [{names[i]: int(perm[i]) for i in range(3)} for _, perm in used],
         "consistency_max": float(np.max(np.abs((consistent - theta_lsq) * scale))),
         "vs_lsq": values - theta_lsq,
-        "row_index": [(perm[names.index(lab)], "xyz".index(c)) for lab, c in rows],
+        "row_index": rows,
+        "thesis_choice_everywhere": bool(np.all([cands[c][0] == pref and cands[c][1] ==
+                                                 (0, 1, 2) for c in choice])),
     }
 
 
@@ -394,18 +413,19 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
         resid = delta - np.einsum("knij,kj->kni", A, theta)
         resid[0] = 0.0
         # propagate through the selected six equations
-        idx = closed["row_index"]
-        As = np.stack([A[:, i, c, :] for i, c in idx], axis=1)  # (K, 6, 6)
+        rows = closed["row_index"]
+        As = np.array([[A[k, i, c, :] for i, c in rows[k]] for k in range(K)])  # (K, 6, 6)
         Ainv = np.linalg.inv(As)
         if W is None:
             covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)
         else:
             cov_full = np.linalg.inv(W)
             S = np.zeros((K, 6, 6))
-            for a, (i, c) in enumerate(idx):
-                for b, (j, d) in enumerate(idx):
-                    if i == j:
-                        S[:, a, b] = cov_full[:, i, c, d]
+            for k in range(K):
+                for a, (i, c) in enumerate(rows[k]):
+                    for b, (j, d) in enumerate(rows[k]):
+                        if i == j:
+                            S[k, a, b] = cov_full[k, i, c, d]
             covs = np.einsum("kij,kjl,kml->kim", Ainv, S, Ainv)
         u = np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None))
         u[0] = 0.0
@@ -414,7 +434,9 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
         names = tuple(p + axis for p in MOTION_PREFIX)
         diff = np.abs(closed["vs_lsq"][1:]) if K > 1 else np.zeros((1, 6))
         summary_cf = {"selection": closed["selection"],
-                      "roles": {k: rnd.labels[v] for k, v in closed["roles"].items()},
+                      "roles": [{k: rnd.labels[v] for k, v in r.items()}
+                                for r in closed["roles"]],
+                      "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
                       "consistency_max": closed["consistency_max"],
                       "vs_lsq_max": {nm: float(diff[:, j].max()) * (1e3 if j < 3 else 1e6)
                                      for j, nm in enumerate(names)}}

@@ -49,6 +49,9 @@ def register(sub) -> None:
                    help="refuse point geometry with a larger condition number (default 1e4)")
     p.add_argument("--outlier-k", type=float, default=5.0,
                    help="flag points whose residual exceeds k times the noise (default 5)")
+    p.add_argument("--fit", choices=("poly", "smooth", "linear", "cubic"),
+                   help="fit error functions (poly: degree by cross-validation; smooth: "
+                        "smoothing spline by GCV) and report their residuals (JSON, plot)")
     p.add_argument("--residuals", help="write per-position, per-point residuals (CSV, um)")
     p.add_argument("--json", help="write a summary (JSON)")
     p.add_argument("--plot", help="write a plot of the error motions (PNG)")
@@ -123,9 +126,14 @@ def run(args) -> int:
     table = result.table()
     text = table_to_csv(table)
     summary = result.summary()
+    fits = None
+    if args.fit:
+        from volerr.errorfit import fit_table
+        fits = fit_table(table, args.fit, weighted=table.std != {})
+        summary["fit"] = [f.report() for f in fits.values()]
     if args.plot:
         from volerr.plots_identify import plot_identification
-        plot_identification(result, args.plot)
+        plot_identification(result, args.plot, fits)
     write_text(args.out, text, inputs=inputs)
     if args.residuals:
         write_text(args.residuals, residual_csv(result), inputs=inputs)
@@ -138,9 +146,15 @@ def run(args) -> int:
     if "closed_form" in s:
         cf = s["closed_form"]
         worst = max(cf["vs_lsq_max"].values())
-        print(f"closed form (selection {cf['selection']}, P={cf['roles']['P']} "
-              f"Q={cf['roles']['Q']} K={cf['roles']['K']}): consistent with least squares to "
-              f"{cf['consistency_max']:.2g}; differs on the data by up to {worst:.3g} um/urad")
+        roles = "; ".join(f"P={r['P']} Q={r['Q']} K={r['K']}" for r in cf["roles"])
+        print(f"closed form (selection {cf['selection']}, {roles}): consistent with least "
+              f"squares to {cf['consistency_max']:.2g}; differs on the data by up to "
+              f"{worst:.3g} um/urad")
+    for f in s.get("fit", []):
+        deg = f" degree {f['degree']}" if f["degree"] is not None else ""
+        loo = f", leave-one-out {f['loo_rms']:.3g}" if f["loo_rms"] is not None else ""
+        print(f"fit {f['name']}: {f['method']}{deg}, residual RMS {f['rms_residual']:.3g} "
+              f"max {f['max_residual']:.3g}{loo} {f['unit']}")
     for o in s["outliers"]:
         print(f"warning: round {o['round']} position {o['position']:g} point {o['point']}: "
               f"residual {o['residual_um']:.3g} um = {o['ratio']:.1f} x noise", file=sys.stderr)
