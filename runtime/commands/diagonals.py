@@ -21,7 +21,7 @@ from volerr.volmap import check_distinct, linear_axes
 def register(sub) -> None:
     p = sub.add_parser("diagonals", help="space diagonals, face diagonals and axis-parallel "
                                          "lines of the working volume (length deviations)",
-                       description=__doc__.split("\n\n")[1])
+                       description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
     p.add_argument("--lines", nargs="+", choices=diagonals.KINDS, default=list(diagonals.KINDS),
                    help="which lines (default: all)")

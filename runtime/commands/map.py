@@ -48,7 +48,7 @@ def inputs_of(args) -> list:
 
 def register(sub) -> None:
     p = sub.add_parser("map", help="volumetric error map over the working volume (CSV, plots)",
-                       description=__doc__.split("\n\n")[1])
+                       description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
     p.add_argument("--grid", nargs="+", type=int, default=None, metavar="N",
                    help="grid points per axis: N, or nx ny nz (default 5)")
