@@ -1,0 +1,114 @@
+"""Plots of a probe calibration: the 3-D lobing map (Pahk Fig. 3a) and the 2-D (phi, theta)
+map (Fig. 3b).  Errors in um; directions in the probe frame (x', y', z')."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _grid(cal, n_phi: int = 61, n_theta: int = 121):
+    lo, hi = cal.map.phi_range_deg
+    phi = np.linspace(lo, hi, n_phi)
+    theta = np.linspace(0.0, 360.0, n_theta)
+    pp, tt = np.meshgrid(phi, theta, indexing="ij")
+    return pp, tt, cal.map.at(pp, tt) * 1e3
+
+
+def _norm(values):
+    from matplotlib.colors import TwoSlopeNorm
+
+    lim = max(float(np.nanmax(np.abs(values))), 1e-6)
+    return TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim)
+
+
+def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
+    """Fig. 3a: the probed part of a unit sphere deformed radially by the smooth map
+    (1 + gain * Probe), coloured in um, with the measured Probe at each point as a radial
+    stem from the reference sphere."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    pp, tt, val = _grid(cal, 37, 73)
+    pts_um = cal.probe * 1e3
+    vmax = max(float(np.max(np.abs(val))), float(np.max(np.abs(pts_um))), 1e-6)
+    gain = gain if gain is not None else 0.2 / vmax
+    ph, th = np.radians(pp), np.radians(tt)
+    r = 1.0 + gain * val
+    x, y, z = r * np.sin(ph) * np.cos(th), r * np.sin(ph) * np.sin(th), r * np.cos(ph)
+    norm = _norm(np.concatenate([val.ravel(), pts_um]))
+    cmap = plt.get_cmap("RdBu_r")
+    fig = plt.figure(figsize=(8, 7))
+    ax = fig.add_subplot(projection="3d")
+    ax.plot_surface(x, y, z, facecolors=cmap(norm(val)), rstride=1, cstride=1,
+                    linewidth=0.2, edgecolor=(0, 0, 0, 0.15), antialiased=True, shade=False)
+    p, t = np.radians(cal.phi_deg), np.radians(cal.theta_deg)
+    u = np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=1)
+    tip = u * (1.0 + gain * pts_um)[:, None]
+    for a, b in zip(u, tip):
+        ax.plot(*zip(a, b), color="k", linewidth=0.8)
+    ax.scatter(*tip.T, c=pts_um, cmap=cmap, norm=norm, s=14, edgecolors="k", linewidths=0.4,
+               depthshade=False)
+    if cal.outlier.any():
+        ax.scatter(*tip[cal.outlier].T, marker="x", color="k", s=60, label="flagged outlier")
+        ax.legend(loc="upper left")
+    sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=ax, shrink=0.6, label="probe error Probe(phi, theta), um")
+    ax.set_xlabel("x'")
+    ax.set_ylabel("y'")
+    ax.set_zlabel("z' (probe axis)")
+    ax.set_box_aspect((1, 1, 0.6 if cal.map.phi_range_deg[1] <= 95 else 1))
+    stats = cal.stats_um()
+    ax.set_title(f"Probe error map (3-D): R_eff {cal.r_eff:.4f} mm, max {stats['max']:.1f} / "
+                 f"min {stats['min']:.1f} / rms {stats['rms']:.1f} um\n"
+                 f"unit sphere deformed radially by the map (1 um shown as {gain:.3f} of the "
+                 f"radius); stems: measured Probe", fontsize=10)
+    ax.view_init(elev=28, azim=-60)
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return out
+
+
+def plot_probe_map_2d(cal, path) -> Path:
+    """Fig. 3b: the smooth map on the (theta, phi) grid with contours, the measured Probe at
+    each point as coloured markers (flagged outliers crossed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    pp, tt, val = _grid(cal)
+    pts_um = cal.probe * 1e3
+    norm = _norm(np.concatenate([val.ravel(), pts_um]))
+    fig, ax = plt.subplots(figsize=(10, 4.8))
+    mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm, shading="gouraud")
+    cs = ax.contour(tt, pp, val, levels=11, colors="k", linewidths=0.5)
+    ax.clabel(cs, fmt="%.1f", fontsize=7)
+    ax.scatter(cal.theta_deg, cal.phi_deg, c=pts_um, cmap="RdBu_r", norm=norm, s=28,
+               edgecolors="k", linewidths=0.5, label="measured Probe (eq. 13)")
+    if cal.outlier.any():
+        ax.scatter(cal.theta_deg[cal.outlier], cal.phi_deg[cal.outlier], marker="x",
+                   color="k", s=80, label="flagged outlier")
+    fig.colorbar(mesh, ax=ax, label="probe error, um")
+    ax.set_xlim(0, 360)
+    ax.set_xticks(np.arange(0, 361, 45))
+    lo, hi = cal.map.phi_range_deg
+    ax.set_ylim(hi + 2, lo - 2)
+    ax.set_xlabel("theta (azimuth in the probe frame), deg")
+    ax.set_ylabel("phi (from the probe axis), deg")
+    stats = cal.stats_um()
+    ax.set_title(f"Probe error map: tilt A {cal.map.tilt_deg:g} deg, roll B "
+                 f"{cal.map.roll_deg:g} deg, spherical harmonics degree {cal.map.degree}; "
+                 f"max {stats['max']:.1f} / min {stats['min']:.1f} / rms {stats['rms']:.1f} um",
+                 fontsize=10)
+    ax.legend(loc="lower right", fontsize=8)
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return out
