@@ -204,9 +204,18 @@ def _equal_box(ax, pts):
     ax.set_zlim(lo[2] - pad[2], hi[2] + pad[2])
 
 
+def _face_grid(shape, axis: int, side: int):
+    """Flat indices of the nodes on one face of the grid (axis fixed at 0 or max), 2-D array."""
+    idx = np.arange(int(np.prod(shape))).reshape(shape)
+    sl = [slice(None)] * 3
+    sl[axis] = 0 if side == 0 else shape[axis] - 1
+    return idx[tuple(sl)]
+
+
 def plot_map(vmap: VolumetricMap, path, magnify: float | None = None, inputs=()) -> float:
-    """Nominal grid (dashed) vs actual grid magnified (solid), like Pahk Fig. 5 / 7(a).
-    Returns the magnification used."""
+    """Nominal grid (dashed) vs actual grid magnified (solid), like Pahk Fig. 5 / 7(a): the
+    outer faces in 3-D, and three faces in their own planes (top z = max, front y = min, side
+    x = max) with the in-plane error components.  Returns the magnification used."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -214,8 +223,12 @@ def plot_map(vmap: VolumetricMap, path, magnify: float | None = None, inputs=())
     k = float(magnify) if magnify else auto_magnification(vmap, vmap.error)
     require(k > 0, f"magnification must be positive, got {k:g}")
     nom, act = vmap.nominal, vmap.nominal + k * vmap.error
-    fig = plt.figure(figsize=(8.5, 7))
-    ax = _axes3d(fig)
+    fig = plt.figure(figsize=(14, 8))
+    gs = fig.add_gridspec(3, 2, width_ratios=[1.7, 1])
+    ax = fig.add_subplot(gs[:, 0], projection="3d")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_zlabel("z (mm)")
     for line in _face_lines(vmap.shape):
         ax.plot(*nom[line].T, ls="--", lw=0.7, color="0.55")
         ax.plot(*act[line].T, ls="-", lw=1.1, color="C3")
@@ -224,6 +237,20 @@ def plot_map(vmap: VolumetricMap, path, magnify: float | None = None, inputs=())
     ax.set_title(f"{vmap.layout} volumetric error map, errors magnified x{k:g}\n"
                  f"dashed: nominal grid, solid: actual; max |d| {s['max_length_um']:.1f} um, "
                  f"RMS {s['rms_length_um']:.1f} um", fontsize=10)
+    faces = [(2, 1, (0, 1), "top face z = max"), (1, 0, (0, 2), "front face y = min"),
+             (0, 1, (1, 2), "side face x = max")]
+    for row, (axis, side, (i, j), label) in enumerate(faces):
+        a2 = fig.add_subplot(gs[row, 1])
+        g = _face_grid(vmap.shape, axis, side)
+        for lines in (g, g.T):
+            for line in lines:
+                a2.plot(nom[line, i], nom[line, j], ls="--", lw=0.7, color="0.55")
+                a2.plot(act[line, i], act[line, j], ls="-", lw=1.1, color="C3")
+        a2.set_aspect("equal", adjustable="datalim")
+        a2.set_xlabel(f"{'xyz'[i]} (mm)", fontsize=8)
+        a2.set_ylabel(f"{'xyz'[j]} (mm)", fontsize=8)
+        a2.tick_params(labelsize=7)
+        a2.set_title(f"{label} (in-plane errors x{k:g})", fontsize=9)
     fig.tight_layout()
     save_figure(fig, path, inputs)
     return k

@@ -182,3 +182,32 @@ def test_write_refuses_input(tmp_path):
     with pytest.raises(InputError, match="refusing to overwrite"):
         write_error_table(p, ErrorTable("X", [0, 1], {"EXX": [0, 2e-3]}), inputs=[p])
     assert p.read_text() == before
+
+
+def test_rotary_table_in_degrees(tmp_path):
+    p = _write(tmp_path / "C.csv", "C_deg,EXC_um,EAC_urad,ECC_urad\n-180,0,0,0\n0,1.5,2,3\n180,3,4,6\n")
+    t = read_error_table(p, axis="C")
+    np.testing.assert_array_equal(t.positions, [-180, 0, 180])  # degrees stay degrees
+    assert t.values["EXC"][1] == pytest.approx(1.5e-3) and t.values["ECC"][2] == pytest.approx(6e-6)
+    write_error_table(tmp_path / "C2.csv", t)
+    assert (tmp_path / "C2.csv").read_text().splitlines()[0] == "C,EXC_um,EAC_urad,ECC_urad"
+    p = _write(tmp_path / "C3.csv", "C_mm,EXC_um\n0,0\n1,1\n")
+    with pytest.raises(InputError, match="deg"):
+        read_error_table(p)
+
+
+def test_poly_functions_from_tables():
+    x = np.linspace(0, 900, 19)
+    rng = np.random.default_rng(0)
+    y = 1e-3 * (0.5 * ((x - 450) / 450) ** 2 - 0.2 * (x - 450) / 450) + rng.normal(0, 2e-5, x.size)
+    t = ErrorTable("X", x, {"EXX": y})
+    f = ErrorFunctions({"X": t}, {}, MB1, method="poly")
+    assert f.degrees == {"EXX": choose_degree(x, y)}
+    q = {"X": x, "Y": 0 * x, "Z": 0 * x}
+    truth = 1e-3 * (0.5 * ((x - 450) / 450) ** 2 - 0.2 * (x - 450) / 450)
+    assert np.max(np.abs(f(q)["EXX"] - truth)) < 3 * 2e-5  # smooths the noise
+    g = ErrorFunctions({"X": t}, {}, MB1, method="poly", degree=1)
+    lin = np.polyval(np.polyfit(x, y, 1), x)  # independent least squares
+    np.testing.assert_allclose(g(q)["EXX"], lin, atol=1e-12)
+    with pytest.raises(InputError, match="degree"):
+        ErrorFunctions({"X": t}, {}, MB1, method="poly", degree=19)
