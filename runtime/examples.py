@@ -17,8 +17,9 @@ from them are therefore not expected to equal the paper's printed diagonals.
   ISO names through the layout's ``paper_symbols`` (MB1: EC0Y = alpha, EB0Z = -beta1,
   EA0Z = beta2);
 * repeatability: the paper states it as the largest 2 sigma over the positions: 10.75 um (EXX),
-  21.0 um (EYY), 12.30 urad (EBX); the example's sigma grows linearly from half that value at
-  the start of travel to the full value at the end (``_std_`` columns).
+  21.0 um (EYY), 12.30 urad (EBX); in the example sigma is zero at the reference position
+  (every run is zeroed there) and grows like sqrt(distance) to that value at the end of
+  travel (``_std_`` columns).
 
 ``MH2`` -- CMM B (moving horizontal arm, 1100 mm cube), 10 parameters:
 
@@ -29,7 +30,8 @@ from them are therefore not expected to equal the paper's printed diagonals.
   that the horizontal arm turns into Abbe errors;
 * squareness as printed, XY 43.2, YZ -48.9, ZX 108.9 urad (alpha, beta2, beta1).
 
-All tables start at zero error at the first position (the reference of a laser measurement).
+All tables start at zero error and zero standard deviation at the first position (the
+reference of a laser measurement); repeatability grows with sqrt(distance) as above.
 """
 
 from __future__ import annotations
@@ -105,7 +107,7 @@ def example_errors(layout: str = "MB1"):
             scale = 1e-3 if name[1] in "XYZ" else 1e-6  # um -> mm, urad -> rad
             values[name] = np.round(_smooth(rng, t, band), 4) * scale
             if rep is not None:
-                std[name] = np.round((rep / 2.0) * (0.5 + 0.5 * t), 4) * scale
+                std[name] = np.round((rep / 2.0) * np.sqrt(t), 4) * scale
         tables[ax] = ErrorTable(ax, x, values, std=std)
     constants = _paper_to_iso(lay.paper_symbols, spec["squareness"])
     return tables, constants

@@ -22,8 +22,8 @@ def add_common(p) -> None:
     tables.add_arguments(p)
     p.add_argument("--probe", nargs=3, type=float, metavar=("XP", "YP", "ZP"), default=(0.0, 0.0, 0.0),
                    help="probe / tool offset, mm (default 0 0 0)")
-    p.add_argument("--at", nargs="*", default=[], metavar="AXIS=DEG",
-                   help="positions of rotary axes (default 0 deg)")
+    p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
+                   help="position of a rotary axis during the test, repeatable (default 0 deg)")
 
 
 def parse_at(items) -> dict:
