@@ -23,13 +23,51 @@ def _norm(values):
     return TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim)
 
 
-def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
-    """Fig. 3a: the probed part of a unit sphere deformed radially by the smooth map
-    (1 + gain * Probe), coloured in um, with the measured Probe at each point as a radial
-    stem from the reference sphere."""
+def _save(fig, path) -> Path:
+    import matplotlib.pyplot as plt
+
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return out
+
+
+def _figure(size):
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.figure(figsize=size)
+
+
+def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
+    """Fig. 3a alone: see :func:`draw_3d`."""
+    fig = _figure((8, 7))
+    draw_3d(fig, fig.add_subplot(projection="3d"), cal, gain)
+    return _save(fig, path)
+
+
+def plot_probe_map_2d(cal, path) -> Path:
+    """Fig. 3b alone: see :func:`draw_2d`."""
+    fig = _figure((10, 4.8))
+    draw_2d(fig, fig.add_subplot(), cal)
+    return _save(fig, path)
+
+
+def plot_probe_calibration(cal, path) -> Path:
+    """Both maps in one PNG: 3-D lobing map (left) and the (theta, phi) map (right)."""
+    fig = _figure((17, 6.5))
+    draw_3d(fig, fig.add_subplot(1, 2, 1, projection="3d"), cal)
+    draw_2d(fig, fig.add_subplot(1, 2, 2), cal)
+    return _save(fig, path)
+
+
+def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
+    """Fig. 3a: the probed part of a unit sphere deformed radially by the smooth map
+    (1 + gain * Probe), coloured in um, with the measured Probe at each point as a radial
+    stem from the reference sphere."""
     import matplotlib.pyplot as plt
 
     pp, tt, val = _grid(cal, 37, 73)
@@ -41,8 +79,6 @@ def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
     x, y, z = r * np.sin(ph) * np.cos(th), r * np.sin(ph) * np.sin(th), r * np.cos(ph)
     norm = _norm(np.concatenate([val.ravel(), pts_um]))
     cmap = plt.get_cmap("RdBu_r")
-    fig = plt.figure(figsize=(8, 7))
-    ax = fig.add_subplot(projection="3d")
     ax.plot_surface(x, y, z, facecolors=cmap(norm(val)), rstride=1, cstride=1,
                     linewidth=0.2, edgecolor=(0, 0, 0, 0.15), antialiased=True, shade=False)
     p, t = np.radians(cal.phi_deg), np.radians(cal.theta_deg)
@@ -64,28 +100,17 @@ def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
     stats = cal.stats_um()
     ax.set_title(f"Probe error map (3-D): R_eff {cal.r_eff:.4f} mm, max {stats['max']:.1f} / "
                  f"min {stats['min']:.1f} / rms {stats['rms']:.1f} um\n"
-                 f"unit sphere deformed radially by the map (1 um shown as {gain:.3f} of the "
-                 f"radius); stems: measured Probe", fontsize=10)
+                 f"sphere deformed radially by the map (1 um = {gain:.3f} of the radius); "
+                 f"stems: measured", fontsize=10)
     ax.view_init(elev=28, azim=-60)
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return out
 
 
-def plot_probe_map_2d(cal, path) -> Path:
+def draw_2d(fig, ax, cal) -> None:
     """Fig. 3b: the smooth map on the (theta, phi) grid with contours, the measured Probe at
     each point as coloured markers (flagged outliers crossed)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     pp, tt, val = _grid(cal)
     pts_um = cal.probe * 1e3
     norm = _norm(np.concatenate([val.ravel(), pts_um]))
-    fig, ax = plt.subplots(figsize=(10, 4.8))
     mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm, shading="gouraud")
     cs = ax.contour(tt, pp, val, levels=11, colors="k", linewidths=0.5)
     ax.clabel(cs, fmt="%.1f", fontsize=7)
@@ -102,13 +127,8 @@ def plot_probe_map_2d(cal, path) -> Path:
     ax.set_xlabel("theta (azimuth in the probe frame), deg")
     ax.set_ylabel("phi (from the probe axis), deg")
     stats = cal.stats_um()
-    ax.set_title(f"Probe error map: tilt A {cal.map.tilt_deg:g} deg, roll B "
-                 f"{cal.map.roll_deg:g} deg, spherical harmonics degree {cal.map.degree}; "
+    ax.set_title(f"Probe error map on (theta, phi): tilt A {cal.map.tilt_deg:g} deg, roll B "
+                 f"{cal.map.roll_deg:g} deg\nspherical harmonics of degree {cal.map.degree}; "
                  f"max {stats['max']:.1f} / min {stats['min']:.1f} / rms {stats['rms']:.1f} um",
                  fontsize=10)
     ax.legend(loc="lower right", fontsize=8)
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return out

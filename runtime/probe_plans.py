@@ -101,3 +101,19 @@ def plan_csv_text(plan: Plan, points: np.ndarray) -> str:
     for (x, y, z), p, t in zip(points, plan.phi_deg, plan.theta_deg):
         lines.append(f"{x:.6f},{y:.6f},{z:.6f},{p:.6f},{t:.6f}")
     return "\n".join(lines) + "\n"
+
+
+def simulate_demo_sphere(path, seed: int = 1995, center=(250.0, 180.0, -120.0),
+                         noise_mm: float = 0.3e-3) -> dict:
+    """Write a simulated Pahk-like master-sphere run (``x,y,z`` ball centres, mm) to ``path``:
+    25.006 mm sphere, 1.006 mm ball, vertical probe, Pahk's 101-point plan, the
+    :func:`pahk_like_pretravel` kinematic probe and ``noise_mm`` Gaussian noise per axis.
+    Returns ``{"path", "sphere_radius_mm", "ball_radius_mm", "center_mm", "n_points"}``."""
+    from .fileio import write_text
+
+    plan = pahk_plan()
+    pts = simulate_probing(plan, center, 25.006, 1.006, noise_mm=noise_mm, rng=seed)
+    lines = ["x,y,z"] + [f"{x:.6f},{y:.6f},{z:.6f}" for x, y, z in pts]
+    out = write_text(path, "\n".join(lines) + "\n")
+    return {"path": str(out), "sphere_radius_mm": 25.006, "ball_radius_mm": 1.006,
+            "center_mm": [float(v) for v in center], "n_points": len(plan)}

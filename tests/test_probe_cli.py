@@ -100,9 +100,11 @@ def test_plan_round_trip(tmp_path, capsys):
 def test_plots(tmp_path, data):
     path, _ = data
     assert main(["probe-cal", str(path), "--sphere-radius", str(R_S), "--out",
-                 str(tmp_path / "m.csv"), "--plots", str(tmp_path / "fig")]) == 0
-    for name in ("probe_map_3d.png", "probe_map_2d.png"):
-        assert (tmp_path / "fig" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+                 str(tmp_path / "m.csv"), "--plots", str(tmp_path / "fig"),
+                 "--plot", str(tmp_path / "both.png")]) == 0
+    for f in (tmp_path / "fig" / "probe_map_3d.png", tmp_path / "fig" / "probe_map_2d.png",
+              tmp_path / "both.png"):
+        assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def bad_cases(tmp_path, pts):
@@ -181,3 +183,15 @@ def test_subprocess_entry_point(tmp_path, data):
                        capture_output=True, text=True)
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and "diameter" in r.stderr
+
+
+def test_demo_sphere_hook(tmp_path):
+    from volerr.probe_plans import simulate_demo_sphere
+
+    info = simulate_demo_sphere(tmp_path / "demo.csv")
+    out, js = tmp_path / "m.csv", tmp_path / "c.json"
+    assert main(["probe-cal", info["path"], "--sphere-radius", str(info["sphere_radius_mm"]),
+                 "--out", str(out), "--json", str(js)]) == 0
+    s = json.loads(js.read_text())
+    np.testing.assert_allclose(s["center_mm"], info["center_mm"], atol=0.02)
+    assert 0.99 < s["r_eff_mm"] < info["ball_radius_mm"]

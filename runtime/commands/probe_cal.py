@@ -48,6 +48,9 @@ def register(sub) -> None:
                         "(default 5)")
     p.add_argument("--exclude-outliers", action="store_true",
                    help="refit without the flagged points (they stay in MAP.csv, flagged)")
+    p.add_argument("--plot", metavar="F.png",
+                   help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map "
+                        "(Fig. 3b)")
     p.add_argument("--plots", metavar="DIR",
                    help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png (Fig. 3b)")
     g = p.add_argument_group("plan generation (--plan)")
@@ -117,6 +120,11 @@ def run(args) -> int:
     summary = cal.summary()
     if args.json:
         write_text(args.json, json.dumps(summary, indent=2) + "\n", inputs=inputs + [args.out])
+    if args.plot:
+        from volerr.fileio import check_output
+        from volerr.plots_probe import plot_probe_calibration
+
+        plot_probe_calibration(cal, check_output(args.plot, inputs + [args.out]))
     if args.plots:
         from pathlib import Path
 
