@@ -25,6 +25,7 @@ def derive_functions(layout: Layout) -> list[Function]:
     """All generated functions of one layout."""
     chain = Chain.from_layout(layout)
     pos = [str(s) for s in chain.positions]
+    cov = list(layout.covariates)  # effect covariates (augmented layouts only)
     probe = [str(s) for s in PROBE]
     params = [str(s) for s in chain.parameters]
     error = vol.volumetric_error(chain)
@@ -34,14 +35,14 @@ def derive_functions(layout: Layout) -> list[Function]:
     transfer_args = sorted({str(s) for e in rules.shift.values() for s in e.free_symbols},
                            key=lambda n: (n not in ("Xo", "Yo", "Zo"), n))
     funcs = [
-        Function("volumetric_error", pos + probe + params, list(error),
+        Function("volumetric_error", pos + cov + probe + params, list(error),
                  "First-order volumetric error (dX, dY, dZ), mm."),
-        Function("sensitivity", pos + probe, list(sens),
+        Function("sensitivity", pos + cov + probe, list(sens),
                  "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",
                  shape=(3, len(params))),
-        Function("exact_error", pos + probe + params, list(vol.exact_error(chain)),
+        Function("exact_error", pos + cov + probe + params, list(vol.exact_error(chain)),
                  "Exact (non-linearised) error of the probe tip, mm: rotations not small."),
-        Function("random_error_termwise", pos + probe + [str(s) for s in sigmas],
+        Function("random_error_termwise", pos + cov + probe + [str(s) for s in sigmas],
                  list(vol.random_error_termwise(sens, sigmas)),
                  "Random error by Pahk's term-wise quadrature (eq. 5, 8), mm; arguments "
                  "s_<name> are standard deviations of the parameters."),
@@ -49,7 +50,7 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "Nominal probe-tip / tool-tip position in the workpiece frame, mm."),
         Function("tool_axis", pos, list(vol.nominal_tool_axis(chain)),
                  "Nominal tool-axis direction (tool +z) in the workpiece frame, unit vector."),
-        Function("orientation_error", pos + params, list(vol.orientation_error(chain)),
+        Function("orientation_error", pos + cov + params, list(vol.orientation_error(chain)),
                  "First-order error of the tool-axis direction (i, j, k), rad."),
     ]
     if inverse.applies(layout):
@@ -75,6 +76,9 @@ def generate_module(layout: Layout) -> str:
         "PARAMETERS": repr(tuple(chain_params)),
         "PARAMETER_AXIS": repr(layout.parameter_axis),
     }
+    if layout.effects:
+        constants["COVARIATES"] = repr(tuple(layout.covariates))
+        constants["EFFECTS"] = repr({e.name: e.kind for e in layout.effects})
     for k, v in sorted(layout.parameters.items()):
         constants[k] = repr(float(v))
     header = {

@@ -209,6 +209,10 @@ def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Facto
         out.extend(fs)
     for entry in layout.tool_chain:
         out.extend(stage_factors(layout, entry))
+    if layout.effects:  # declared effects (augmented models): see volerr.derive.effects
+        from .effects import apply_effects
+
+        out = apply_effects(layout, out)
     return out
 
 

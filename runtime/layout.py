@@ -16,6 +16,16 @@ A layout is a TOML file (shipped ones live in ``volerr/layouts/``).  It declares
 * ``[parameters]``: named numbers (mm) usable in frame expressions, kept symbolic in the
   derivation (e.g. DMU 50 ``d``).
 * ``[paper_symbols]``: ISO name -> symbol, with sign, used in the source document.
+* ``[effects.NAME]`` (optional; written by ``volerr loop`` for an augmented model):
+  ``kind`` (``thermal``, ``drift``, ``reversal``, ``coupling``, ``periodic``, ``higher_order``,
+  ``probe_direction``, ``setup`` ...), free descriptive keys (``axis``, ``period`` ...), and
+  ``terms = [{parameter = "KT_X", target = "EXX", basis = "X*(T_C - 20)"}, ...]``: each term adds
+  ``parameter * basis`` to ``target``, a component or location error of an axis (``EXX``,
+  ``EX0C``) or one of the six twist coordinates ``dx dy dz ex ey ez`` of an extra error factor
+  at the workpiece end (``work.dx``: the measuring instrument's placement) or at the tool end
+  (``tool.dx``: the probe) of the chain.  The parameters become error parameters of the model
+  (after all others); names in a basis (:mod:`volerr.basis`) that are not axes are
+  *covariates*: extra arguments of the generated functions (``T_C``, ``t_s``, ``dir_X`` ...).
 
 Sign conventions (ISO 230-1 / ISO 841): every axis ``direction`` is the direction in which the
 tool (probe) moves *relative to the workpiece* for a positive command, whether the tool side
@@ -73,6 +83,33 @@ class Frame:
     angle_deg: object = 0.0
 
 
+#: twist coordinates of the extra error factors ``work.*`` / ``tool.*`` of effect terms
+TWIST_KEYS = ("dx", "dy", "dz", "ex", "ey", "ez")
+
+
+@dataclass(frozen=True)
+class EffectTerm:
+    """``parameter * basis`` added to ``target`` (see the module docstring)."""
+
+    parameter: str
+    target: str
+    basis: str
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A declared effect: its ``kind``, terms and free descriptive ``info``."""
+
+    name: str
+    kind: str
+    terms: tuple
+    info: dict = field(default_factory=dict)
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(t.parameter for t in self.terms))
+
+
 @dataclass(frozen=True)
 class Layout:
     """A parsed, validated machine layout (see the module docstring for the file format)."""
@@ -91,6 +128,7 @@ class Layout:
     sha256: str
     path: str = ""
     extra: dict = field(default_factory=dict)
+    effects: tuple = ()
 
     @property
     def axis_names(self) -> tuple[str, ...]:
@@ -108,7 +146,17 @@ class Layout:
         names.extend(sorted(self.squareness))
         for a in self.axis_names:
             names.extend(self.axes[a].location_errors)
+        for e in self.effects:
+            names.extend(p for p in e.parameters if p not in names)
         return tuple(names)
+
+    @property
+    def covariates(self) -> tuple[str, ...]:
+        """Names in effect bases that are not axes (data columns such as ``T_C``), sorted."""
+        from .basis import variables
+
+        names = {v for e in self.effects for t in e.terms for v in variables(t.basis)}
+        return tuple(sorted(names - set(self.axes) - set(self.parameters)))
 
     @property
     def parameter_axis(self) -> dict:
@@ -222,6 +270,7 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
                 f"{where}: squareness {sq} carrier {carrier} is not a linear axis")
 
     symbols = {str(k): str(v) for k, v in doc.get("paper_symbols", {}).items()}
+    effects = _parse_effects(doc.get("effects", {}), axes, squareness, params, where)
     return Layout(
         name=name,
         description=str(doc.get("description", "")),
@@ -238,8 +287,44 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
         path=origin,
         extra={k: v for k, v in doc.items() if k not in {
             "name", "description", "kind", "axes", "frames", "chain", "squareness",
-            "parameters", "paper_symbols", "source"}},
+            "parameters", "paper_symbols", "source", "effects"}},
+        effects=effects,
     )
+
+
+def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str) -> tuple:
+    """Validate ``[effects.NAME]`` tables -> tuple of :class:`Effect`."""
+    from .basis import variables
+
+    require(isinstance(raw, dict), f"{where}: [effects] must be tables [effects.NAME]")
+    targets = {n for a in axes.values() for n in a.component_errors + a.location_errors}
+    targets |= {f"{side}.{k}" for side in ("work", "tool") for k in TWIST_KEYS}
+    builtin = {n for a in axes.values() for n in a.component_errors + a.location_errors}
+    builtin |= set(squareness) | set(params) | set(axes) | {"Xp", "Yp", "Zp"}
+    seen: dict = {}
+    out = []
+    for en, spec in raw.items():
+        require(isinstance(spec, dict) and isinstance(spec.get("kind"), str),
+                f"{where}: effect {en} needs a 'kind'")
+        terms = spec.get("terms")
+        require(isinstance(terms, list) and terms, f"{where}: effect {en} needs 'terms'")
+        parsed = []
+        for t in terms:
+            require(isinstance(t, dict) and {"parameter", "target", "basis"} <= set(t),
+                    f"{where}: effect {en}: each term needs parameter, target and basis")
+            pn, target, basis = str(t["parameter"]), str(t["target"]), str(t["basis"])
+            require(_NAME.match(pn) is not None and pn not in builtin,
+                    f"{where}: effect {en}: bad or clashing parameter name {pn!r}")
+            require(seen.setdefault(pn, en) == en,
+                    f"{where}: parameter {pn} used by effects {seen[pn]} and {en}")
+            require(target in targets, f"{where}: effect {en}: unknown target {target!r}")
+            for v in variables(basis):
+                require(_NAME.match(v) is not None and v not in builtin - set(axes)
+                        and v not in seen, f"{where}: effect {en}: basis uses {v!r}")
+            parsed.append(EffectTerm(pn, target, basis))
+        info = {k: v for k, v in spec.items() if k not in ("kind", "terms")}
+        out.append(Effect(str(en), spec["kind"], tuple(parsed), info))
+    return tuple(out)
 
 
 def shipped_layout_dir():

@@ -1,0 +1,87 @@
+"""Effects: symbolic extensions of a layout's chain (sympy).
+
+A layout may declare ``[effects.NAME]`` tables (format: :mod:`volerr.layout`).  Each term adds
+``parameter * basis`` to a target of the chain:
+
+* a component error of an axis (``EXX`` ... ``ECZ``) or a location error of a rotary axis
+  (``EX0C`` ...): the term is added to that entry of the axis' error twist, so it propagates
+  through the chain exactly like the error it modifies (Abbe arms included).  Examples:
+  ``thermal`` -- scale expansion ``EXX += KT_X * X * (T_C - 20)``; ``reversal`` --
+  ``EXX += RV_X * dir_X``; ``coupling`` -- ``EZX += c * x * y`` (a straightness of X that
+  depends on Y: a cross term no sum of one-dimensional functions can absorb); ``periodic`` --
+  ``EXX += a sin(2 pi X / P) + b cos(2 pi X / P)``; ``higher_order`` -- Legendre terms of a
+  component beyond the fitted degree.
+* ``work.<k>``: an extra error twist ``I + D_work`` standing first in ``tool2work`` (the
+  workpiece / measuring-instrument end): ``setup`` (rigid placement of the instrument, six
+  coordinates, per set-up group through ``ind(setup, g)``) and ``drift`` (``work.dx += k t_s``).
+* ``tool.<k>``: an extra error twist standing last (the probe / tool end), in the tool frame:
+  ``probe_direction`` (``tool.dx += r nx`` ...: an effective probe-radius error along the
+  probing direction).
+
+Covariates (``T_C``, ``t_s``, ``dir_X``, ``nx`` ...) are plain real symbols; the code generator
+makes them arguments of the generated functions.  Rotary positions are in rad here, as
+everywhere in the derivation.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from volerr.layout import TWIST_KEYS, Layout
+
+_SYMPY_FUNCTIONS = {
+    "sin": sp.sin, "cos": sp.cos, "exp": sp.exp, "sqrt": sp.sqrt, "abs": sp.Abs, "pi": sp.pi,
+    "ind": lambda a, b: sp.Piecewise((1, sp.Eq(a, b)), (0, True)),
+    "legendre": lambda n, x: sp.expand(sp.legendre(int(n), x)),
+}
+
+
+def basis_expr(text: str) -> sp.Expr:
+    """A basis expression (validated by :mod:`volerr.basis`) as sympy, variables real."""
+    from volerr.basis import variables
+
+    loc = {v: sp.Symbol(v, real=True) for v in variables(text)}
+    loc.update(_SYMPY_FUNCTIONS)
+    return sp.sympify(text, locals=loc, rational=True)
+
+
+def additions(layout: Layout) -> dict:
+    """target -> sympy expression added to it (sum of parameter * basis of all terms)."""
+    out: dict = {}
+    for e in layout.effects:
+        for t in e.terms:
+            term = sp.Symbol(t.parameter, real=True) * basis_expr(t.basis)
+            out[t.target] = out.get(t.target, 0) + term
+    return out
+
+
+def covariate_symbols(layout: Layout) -> tuple:
+    """Symbols of the layout's covariates, sorted by name."""
+    return tuple(sp.Symbol(c, real=True) for c in layout.covariates)
+
+
+def apply_effects(layout: Layout, factors: list) -> list:
+    """The chain's factors with the layout's effects added (unchanged without effects).
+
+    ``factors`` is the list of :func:`volerr.derive.kinematics.chain_factors` (workpiece end
+    first); component and location twists are extended in place, ``work``/``tool`` twists are
+    new factors at the two ends."""
+    from .kinematics import Factor, parameter_symbol
+
+    add = additions(layout)
+    if not add:
+        return factors
+    out = list(factors)
+    for f in out:
+        if not f.is_error or f.role not in ("component", "location"):
+            continue
+        for key, value in list(f.twist_args.items()):
+            for target, extra in add.items():
+                if "." not in target and value == parameter_symbol(target):
+                    f.twist_args[key] = value + extra
+    for side in ("work", "tool"):
+        args = {k: add[f"{side}.{k}"] for k in TWIST_KEYS if f"{side}.{k}" in add}
+        if args:
+            factor = Factor(twist_args=args, owner=side, role="effect")
+            out = [factor, *out] if side == "work" else [*out, factor]
+    return out

@@ -1,0 +1,319 @@
+"""Fit a layout's model to measured volumetric deviations: linear least squares.
+
+Model of the measured deviation ``d`` (actual minus nominal, mm) at point ``i``::
+
+    d_i = sum_p S_p(q_i, probe_i) e_p(q_{axis(p), i})  +  S_setup(q_i, probe_i) s  +  noise
+
+``S = model.sensitivity`` (generated from the layout's chain).  Every component error ``e_p`` is
+a Legendre series of degree ``K`` in its own axis position (normalised to [-1, 1] over the
+measured range); squareness, rotary location errors and effect parameters are constants; ``s``
+is the rigid placement of the measuring instrument (three translations, three small rotations
+of the workpiece end).  ``K`` is chosen by k-fold cross-validation.
+
+Gauge.  Some combinations are not determined by *any* volumetric measurement: a constant of a
+translational error against the instrument's translation, a straightness slope against
+squareness and the instrument's rotation, and so on.  They are fixed by convention: columns
+are taken in the order set-up, constants, higher degrees, slopes, constant terms, and a column
+is dropped when it lies in the span of those before it on an *ideal* plan (the measured volume
+filled, probe offsets along every axis).  What the ideal plan determines but the actual data
+does not is a property of the measurement plan: it is reported (:func:`identifiability`),
+never silently absorbed.
+
+Columns are scaled to unit RMS before solving; solutions use the normal equations with an
+eigenvalue cut-off (minimum norm in the scaled parameters along undetermined directions).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import require
+from .model import Model
+
+SETUP = ("dx", "dy", "dz", "ex", "ey", "ez")
+#: relative singular value below which a direction counts as undetermined
+SV_TOL = 1e-6
+
+
+@dataclass
+class Data:
+    """Measured deviations: positions mm | deg, probe (N, 3) mm, deviation (N, 3) mm."""
+
+    positions: dict
+    probe: np.ndarray
+    deviation: np.ndarray
+    covariates: dict = field(default_factory=dict)
+
+    @property
+    def n(self) -> int:
+        return len(self.deviation)
+
+    def subset(self, idx) -> "Data":
+        return Data({a: v[idx] for a, v in self.positions.items()}, self.probe[idx],
+                    self.deviation[idx], {c: v[idx] for c, v in self.covariates.items()})
+
+
+def unit(q, lo, hi):
+    """Position normalised to [-1, 1] over [lo, hi]."""
+    return (2.0 * np.asarray(q, dtype=float) - (lo + hi)) / (hi - lo)
+
+
+def legendre(u, degree: int) -> np.ndarray:
+    """Legendre polynomials P_0 .. P_degree at u, shape (N, degree + 1)."""
+    out = np.empty((len(u), degree + 1))
+    out[:, 0] = 1.0
+    if degree >= 1:
+        out[:, 1] = u
+    for k in range(2, degree + 1):
+        out[:, k] = ((2 * k - 1) * u * out[:, k - 1] - (k - 1) * out[:, k - 2]) / k
+    return out
+
+
+def data_ranges(model: Model, data: Data) -> dict:
+    """Axis -> (lo, hi) of the measured positions (widened when an axis does not move)."""
+    out = {}
+    for a in model.axes:
+        lo, hi = float(np.min(data.positions[a])), float(np.max(data.positions[a]))
+        if hi - lo < 1e-9:
+            lo, hi = lo - 0.5, hi + 0.5
+        out[a] = (lo, hi)
+    return out
+
+
+def rotary_rad(model: Model, positions: dict) -> dict:
+    """Positions with rotary axes in rad (the unit of the chain and of effect bases)."""
+    return {a: (np.deg2rad(v) if a in model.rotary_axes else np.asarray(v, dtype=float))
+            for a, v in positions.items()}
+
+
+def nominal_frame(model: Model, data: Data):
+    """Nominal probe point (N, 3) and tool rotation (N, 3, 3) in the workpiece frame."""
+    p0 = model.nominal_position(data.positions, data.probe)
+    rot = np.empty((data.n, 3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = 1.0
+        rot[:, :, k] = model.nominal_position(data.positions, data.probe + e) - p0
+    return p0, rot
+
+
+def twist_columns(side: str, key: str, data: Data, frame) -> np.ndarray:
+    """(N, 3) effect of a unit twist coordinate of the workpiece-end or tool-end factor."""
+    p0, rot = frame
+    k = "xyz".index(key[1])
+    e = np.zeros((data.n, 3))
+    e[:, k] = 1.0
+    if side == "work":
+        return e if key[0] == "d" else np.cross(e, p0)
+    return np.einsum("nij,nj->ni", rot, e if key[0] == "d" else np.cross(e, data.probe))
+
+
+@dataclass
+class Design:
+    """Columns of the declared model at the data points: ``A`` (N, 3, P), labels."""
+
+    A: np.ndarray
+    labels: list            # (parameter, degree) ; degree None for constants; ("setup", key)
+    sens: np.ndarray        # model sensitivity (N, 3, n_parameters)
+    frame: tuple
+
+
+def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Design:
+    """All columns of the declared model with component errors of degree ``degree``."""
+    cov = {c: data.covariates[c] for c in model.covariates}
+    sens = model.sensitivity(data.positions, data.probe, covariates=cov)
+    frame = nominal_frame(model, data)
+    cols, labels = [], []
+    for key in SETUP:
+        cols.append(twist_columns("work", key, data, frame))
+        labels.append(("setup", key))
+    bases = {a: legendre(unit(data.positions[a], *ranges[a]), degree) for a in model.axes}
+    for j, p in enumerate(model.parameters):
+        axis = model.parameter_axis.get(p)
+        if axis is None:
+            cols.append(sens[:, :, j])
+            labels.append((p, None))
+            continue
+        for k in range(degree + 1):
+            cols.append(sens[:, :, j] * bases[axis][:, k:k + 1])
+            labels.append((p, k))
+    return Design(np.stack(cols, axis=-1), labels, sens, frame)
+
+
+def _priority(label) -> int:
+    p, k = label
+    if p == "setup":
+        return 0
+    if k is None:
+        return 1
+    angular = p[1] in "ABC"
+    if k >= 2:
+        return 2
+    if k == 1:
+        return 3 if angular else 4
+    return 5 if angular else 6
+
+
+def independent_columns(A2: np.ndarray, order, tol: float = 1e-7) -> np.ndarray:
+    """Boolean mask of columns kept by Gram-Schmidt in ``order`` (a column is dropped when it
+    lies within ``tol`` (relative) of the span of the kept ones)."""
+    norms = np.linalg.norm(A2, axis=0)
+    keep = np.zeros(A2.shape[1], bool)
+    q = np.zeros((A2.shape[0], 0))
+    for j in order:
+        if norms[j] == 0:
+            continue
+        v = A2[:, j] / norms[j]
+        for _ in range(2):  # re-orthogonalise once for stability
+            v = v - q @ (q.T @ v)
+        nv = np.linalg.norm(v)
+        if nv > tol:
+            keep[j] = True
+            q = np.column_stack([q, v / nv])
+    return keep
+
+
+def ideal_data(model: Model, data: Data, ranges: dict, n: int = 400, seed: int = 1) -> Data:
+    """An ideal plan over the measured volume: probe offsets along every axis (gauge test)."""
+    rng = np.random.default_rng(seed)
+    pos = {a: rng.uniform(*ranges[a], n) for a in model.axes}
+    lin = [ranges[a][1] - ranges[a][0] for a in model.axes if a not in model.rotary_axes]
+    arm = 0.25 * max(lin or [400.0])
+    base = np.mean(data.probe, axis=0)
+    offs = np.array([[0, 0, 0], [arm, 0, 0], [-arm, 0, 0], [0, arm, 0], [0, -arm, 0],
+                     [0, 0, arm], [0, 0, -arm]]) + base
+    probe = offs[np.arange(n) % len(offs)]
+    cov = {c: np.resize(np.asarray(data.covariates[c]), n) for c in model.covariates}
+    return Data(pos, probe, np.zeros((n, 3)), cov)
+
+
+def gauge_mask(model: Model, data: Data, degree: int, ranges: dict) -> tuple[np.ndarray, list]:
+    """Columns kept after gauge fixing (see the module docstring) and the dropped labels."""
+    ideal = ideal_data(model, data, ranges)
+    d = declared_design(model, ideal, degree, ranges)
+    A2 = d.A.reshape(-1, d.A.shape[-1])
+    order = sorted(range(len(d.labels)), key=lambda j: (_priority(d.labels[j]), j))
+    keep = independent_columns(A2, order)
+    return keep, [d.labels[j] for j in np.flatnonzero(~keep)]
+
+
+# ---- linear algebra -----------------------------------------------------------------
+def solve_normal(G: np.ndarray, b: np.ndarray, tol: float = SV_TOL ** 2) -> np.ndarray:
+    """Minimum-norm solution of G x = b (G symmetric PSD): eigenvalues below tol*max cut."""
+    w, V = np.linalg.eigh(G)
+    wmax = max(float(w[-1]), 1e-300)
+    ok = w > tol * wmax
+    return V[:, ok] @ ((V[:, ok].T @ b) / w[ok])
+
+
+def rows_of(points: np.ndarray) -> np.ndarray:
+    """Row indices (point-major, 3 rows per point) of the given points."""
+    return (3 * np.asarray(points)[:, None] + np.arange(3)).ravel()
+
+
+class Problem:
+    """A scaled linear least-squares problem on rows ``y`` (3 per point)."""
+
+    def __init__(self, A2: np.ndarray, y: np.ndarray):
+        self.scale = np.sqrt(np.mean(A2 ** 2, axis=0))
+        self.scale[self.scale == 0] = 1.0
+        self.A = A2 / self.scale
+        self.y = y
+
+    def fit(self, points=None) -> np.ndarray:
+        """Coefficients (in unscaled column units) fitted on ``points`` (all when None)."""
+        A, y = (self.A, self.y) if points is None else (self.A[rows_of(points)],
+                                                          self.y[rows_of(points)])
+        return solve_normal(A.T @ A, A.T @ y) / self.scale
+
+    def predict(self, coef, points=None) -> np.ndarray:
+        A = self.A if points is None else self.A[rows_of(points)]
+        return A @ (coef * self.scale)
+
+    def cv_residuals(self, folds, points) -> np.ndarray:
+        """Held-out residual rows of ``points`` (k-fold, ``folds`` = fold label per point)."""
+        r = np.empty(3 * len(points))
+        rows = rows_of(points)
+        A, y = self.A[rows], self.y[rows]
+        G, b = A.T @ A, A.T @ y
+        for f in np.unique(folds):
+            m = np.repeat(folds == f, 3)
+            Af, yf = A[m], y[m]
+            c = solve_normal(G - Af.T @ Af, b - Af.T @ yf)
+            r[m] = yf - Af @ c
+        return r
+
+
+def point_norm(rows: np.ndarray) -> np.ndarray:
+    """Length of each point's 3-D residual from point-major rows."""
+    return np.linalg.norm(rows.reshape(-1, 3), axis=1)
+
+
+def rms(rows: np.ndarray) -> float:
+    """RMS of the 3-D residual vector length."""
+    return float(np.sqrt(np.mean(point_norm(rows) ** 2))) if len(rows) else float("nan")
+
+
+# ---- identifiability ----------------------------------------------------------------
+def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> list:
+    """Parameter groups the data cannot separate: SVD of the column-scaled design.
+
+    Returns a list of ``{"parameters", "dimension", "combination", "singular_value"}``: each
+    group is a connected set of parameters sharing undetermined directions; ``combination`` is
+    the direction (weights per parameter, summed over basis terms) best describing it."""
+    scale = np.linalg.norm(A2, axis=0)
+    scale[scale == 0] = 1.0
+    As = A2 / scale
+    w, V = np.linalg.eigh(As.T @ As)       # Gram route: tall SVDs are slow with threaded BLAS
+    s = np.sqrt(np.clip(w[::-1], 0.0, None))
+    vt = V[:, ::-1].T
+    null = vt[s < tol * s[0]] if len(s) else vt[:0]
+    zero_cols = np.flatnonzero(np.linalg.norm(A2, axis=0) == 0)
+    if len(null) == 0 and len(zero_cols) == 0:
+        return []
+    params = [lab[0] if lab[0] != "setup" else f"setup.{lab[1]}" for lab in labels]
+    names = list(dict.fromkeys(params))
+    index = {n: i for i, n in enumerate(names)}
+    P = null.T @ null if len(null) else np.zeros((len(labels), len(labels)))
+    w = np.zeros((len(names), len(names)))
+    for i, pi in enumerate(params):
+        for j, pj in enumerate(params):
+            w[index[pi], index[pj]] = max(w[index[pi], index[pj]], abs(P[i, j]))
+    involved = [i for i in range(len(names)) if w[i, i] > 1e-3]
+    groups, seen = [], set()
+    for i in involved:
+        if i in seen:
+            continue
+        stack, comp = [i], set()
+        while stack:
+            k = stack.pop()
+            if k in comp:
+                continue
+            comp.add(k)
+            stack.extend(j for j in involved if w[k, j] > 1e-3 and j not in comp)
+        seen |= comp
+        groups.append(sorted(comp))
+    out = []
+    for g in groups:
+        gnames = [names[i] for i in g]
+        cols = [j for j, p in enumerate(params) if p in gnames]
+        sub = null[:, cols]
+        dim = int(np.linalg.matrix_rank(sub, tol=1e-6)) if len(sub) else 0
+        vec = np.zeros(len(gnames))
+        if len(sub):
+            v = sub[np.argmax(np.linalg.norm(sub, axis=1))]
+            for c, val in zip(cols, v):
+                vec[gnames.index(params[c])] += val ** 2
+        combo = {n: round(float(x), 4) for n, x in zip(gnames, vec / max(vec.sum(), 1e-300))}
+        out.append({"parameters": gnames, "dimension": dim, "combination": combo,
+                    "singular_value": float(s[-1] / s[0]) if len(s) else 0.0})
+    return out
+
+
+def require_points(n_points: int, n_columns: int, what: str) -> None:
+    """Refuse a fit with too few points for its basis."""
+    require(3 * n_points >= 2 * n_columns + 10,
+            f"too few points for the basis: {n_points} points give {3 * n_points} equations, "
+            f"the {what} needs at least {n_columns * 2 + 10} (reduce --degree or add points)")
