@@ -84,6 +84,11 @@ class Model:
         return dict(self.layout.paper_symbols)
 
     @property
+    def covariates(self) -> tuple[str, ...]:
+        """Covariates of declared effects (``T_C``, ``t_s`` ...): extra inputs, () usually."""
+        return tuple(getattr(self.module, "COVARIATES", ()))
+
+    @property
     def travel(self) -> dict:
         """Axis -> (min, max) travel, mm or deg."""
         return {a: self.layout.axes[a].travel for a in self.axes}
@@ -125,6 +130,18 @@ class Model:
         p = np.broadcast_to(p, (n, 3))
         return {"Xp": p[:, 0], "Yp": p[:, 1], "Zp": p[:, 2]}
 
+    def _covariates(self, covariates, n: int) -> dict:
+        """Covariate values for a model with declared effects ({} for the others)."""
+        covariates = dict(covariates or {})
+        out = {}
+        for c in self.covariates:
+            require(c in covariates, f"{self.name}: covariate {c} is needed (declared effects)")
+            v = np.asarray(covariates[c], dtype=float)
+            require(v.shape in ((), (n,), (1,)), f"covariate {c} must be a scalar or ({n},) array")
+            require(np.all(np.isfinite(v)), f"covariate {c} has NaN or infinite values")
+            out[c] = v
+        return out
+
     def _errors(self, errors, n: int) -> dict:
         errors = dict(errors or {})
         unknown = set(errors) - set(self.parameters)
@@ -140,7 +157,7 @@ class Model:
 
     # ---- evaluation --------------------------------------------------------------
     def volumetric_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
-                         direction=None, probe_error=None) -> np.ndarray:
+                         direction=None, probe_error=None, covariates=None) -> np.ndarray:
         """First-order volumetric error, (N, 3) mm.
 
         ``errors``: {name: scalar or (N,)} in mm / rad, missing names are zero.  ``probe``:
@@ -149,7 +166,8 @@ class Model:
         probe error as Pahk eq. (17): the error along the probing direction is subtracted."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
-        e = self.module.volumetric_error(**pos, **self._probe(probe, n), **self._errors(errors, n))
+        e = self.module.volumetric_error(**pos, **self._covariates(covariates, n),
+                                         **self._probe(probe, n), **self._errors(errors, n))
         out = _columns(e, n)
         if direction is not None or probe_error is not None:
             out = out - self._probe_term(direction, probe_error, n)
@@ -166,22 +184,25 @@ class Model:
         value = np.broadcast_to(np.asarray(value, dtype=float), (n,))
         return value[:, None] * m
 
-    def exact_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
+    def exact_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
+                    covariates=None) -> np.ndarray:
         """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
-        e = self.module.exact_error(**pos, **self._probe(probe, n), **self._errors(errors, n))
+        e = self.module.exact_error(**pos, **self._covariates(covariates, n),
+                                    **self._probe(probe, n), **self._errors(errors, n))
         return _columns(e, n)
 
-    def sensitivity(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
+    def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
         """d(error)/d(parameter), (N, 3, n_parameters): mm/mm or mm/rad."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
-        s = self.module.sensitivity(**pos, **self._probe(probe, n))
+        s = self.module.sensitivity(**pos, **self._covariates(covariates, n),
+                                    **self._probe(probe, n))
         return np.moveaxis(np.broadcast_to(s, s.shape[:2] + (n,)), -1, 0)
 
     def random_error(self, positions, sigmas, probe=(0.0, 0.0, 0.0),
-                     method: str = "exact") -> np.ndarray:
+                     method: str = "exact", covariates=None) -> np.ndarray:
         """Standard uncertainty of the volumetric error, (N, 3) mm.
 
         ``sigmas``: {name: standard deviation (mm / rad), scalar or (N,)}.  ``method="exact"``
@@ -193,9 +214,10 @@ class Model:
         sig = self._errors(sigmas, n)
         if method == "termwise":
             r = self.module.random_error_termwise(
-                **pos, **self._probe(probe, n), **{f"s_{k}": v for k, v in sig.items()})
+                **pos, **self._covariates(covariates, n), **self._probe(probe, n),
+                **{f"s_{k}": v for k, v in sig.items()})
             return _columns(r, n)
-        s = self.sensitivity(positions, probe)
+        s = self.sensitivity(positions, probe, covariates)
         var = np.stack([np.broadcast_to(sig[p], (n,)) for p in self.parameters], axis=-1) ** 2
         return np.sqrt(np.einsum("nij,nj->ni", s ** 2, var))
 
@@ -242,11 +264,12 @@ class Model:
 
         return inverse(self, target, tool, near)
 
-    def orientation_error(self, positions, errors=None) -> np.ndarray:
+    def orientation_error(self, positions, errors=None, covariates=None) -> np.ndarray:
         """First-order error of the tool-axis direction, (N, 3), rad."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
-        e = self.module.orientation_error(**pos, **self._errors(errors, n))
+        e = self.module.orientation_error(**pos, **self._covariates(covariates, n),
+                                          **self._errors(errors, n))
         return _columns(e, n)
 
 
