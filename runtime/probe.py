@@ -601,6 +601,30 @@ def map_csv_text(cal: ProbeCalibration) -> str:
     return "\n".join(lines) + "\n"
 
 
+def probe_map_from_json(source, tilt_deg: float | None = None, roll_deg: float | None = None,
+                        outside: str = "raise") -> ProbeMap:
+    """The exact :class:`ProbeMap` of a ``probe-cal --json`` report (a path or the parsed
+    dict); tilt/roll default to those of the calibration."""
+    import json
+
+    if not isinstance(source, dict):
+        path = Path(source)
+        require(path.is_file(), f"{path}: no such file")
+        try:
+            source = json.loads(path.read_text(encoding="utf-8"))
+        except ValueError as exc:
+            raise InputError(f"{path}: not JSON: {exc}") from None
+    try:
+        m = source["map"]
+        return ProbeMap(int(m["degree"]), np.asarray(m["coefficients_um"], dtype=float) * 1e-3,
+                        tuple(float(v) for v in source["phi_range_deg"]),
+                        float(source.get("tilt_deg", 0.0) if tilt_deg is None else tilt_deg),
+                        float(source.get("roll_deg", 0.0) if roll_deg is None else roll_deg),
+                        outside)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"not a probe-cal report: missing or bad {exc}") from None
+
+
 def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
                    degree: int | None = None, outside: str = "raise") -> ProbeMap:
     """A :class:`ProbeMap` from a MAP.csv (``phi_deg,theta_deg,probe_um``; rows flagged

@@ -184,6 +184,12 @@ def test_map_csv_round_trip(tmp_path):
     dirs = random_dirs_in_cap(np.random.default_rng(0), 100)
     assert m.degree == cal.map.degree
     np.testing.assert_allclose(m(dirs), cal.map(dirs), atol=2e-6)
+    import json
+
+    exact = probe.probe_map_from_json(json.loads(json.dumps(cal.summary())))
+    np.testing.assert_allclose(exact(dirs), cal.map(dirs), atol=1e-12)
+    with pytest.raises(InputError, match="not a probe-cal report"):
+        probe.probe_map_from_json({"r_eff_mm": 1.0})
 
 
 def test_spherical_harmonics_orthonormal():
