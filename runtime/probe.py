@@ -43,6 +43,8 @@ from .errors import InputError, require
 
 #: largest plausible effective stylus-ball radius, mm (a sphere radius that implies more is wrong)
 MAX_BALL_RADIUS_MM = 25.0
+#: smallest plausible effective stylus-ball radius, mm
+MIN_BALL_RADIUS_MM = 0.005
 #: fewest points the calibration accepts: 4 sphere unknowns plus redundancy for the error map
 MIN_POINTS = 6
 #: robust outlier threshold: studentised residual of a bisquare map fit > k robust sigmas
@@ -173,6 +175,7 @@ class SphereFit:
     residuals: np.ndarray
     condition: float
     iterations: int
+    cov_unit: np.ndarray  # inv(J'J) of (cx, cy, cz, r): covariance per unit residual variance
 
 
 def check_sphere_points(points) -> np.ndarray:
@@ -230,7 +233,8 @@ def fit_sphere(points, max_iter: int = 50) -> SphereFit:
     require(cond < MAX_CONDITION,
             f"the points cover too little of the sphere to fit it (condition number "
             f"{cond:.3g}); probe a wider range of latitudes")
-    return SphereFit(c, float(dist.mean()), dist - dist.mean(), cond, it)
+    return SphereFit(c, float(dist.mean()), dist - dist.mean(), cond, it,
+                     np.linalg.inv(jac.T @ jac))
 
 
 # ---- spherical-harmonic map -----------------------------------------------------------------
@@ -433,6 +437,9 @@ class ProbeCalibration:
     direction_source: str
     direction_mismatch_deg: np.ndarray | None = None
     condition: float = 0.0
+    noise: float = 0.0             # scatter about the smooth map (Type A), mm
+    u_center: np.ndarray | None = None  # standard uncertainty of the centre from it, mm
+    u_r_eff: float = 0.0           # standard uncertainty of R_eff from it (without u(R_s)), mm
     notes: list = field(default_factory=list)
 
     @property
@@ -471,6 +478,14 @@ class ProbeCalibration:
                 "robust_sigma_um": float(self.robust_sigma * 1e3),
                 "index": [int(i) for i in np.flatnonzero(self.outlier)],
                 "excluded": bool((~self.used).any()),
+            },
+            "uncertainty": {
+                "note": "standard uncertainties (Type A) from the scatter about the smooth map; "
+                        "u(R_eff) excludes the master-sphere radius uncertainty u(R_s)",
+                "noise_um": float(self.noise * 1e3),
+                "u_center_um": [float(v) * 1e3 for v in (self.u_center if self.u_center
+                                                         is not None else np.zeros(3))],
+                "u_r_eff_um": float(self.u_r_eff * 1e3),
             },
             "sphere_fit_condition": float(self.condition),
         }
@@ -530,6 +545,10 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
             f"fitted radius of the ball centres {fit.radius:.6g} mm minus the sphere radius "
             f"{sphere_radius:.6g} mm gives a stylus-ball radius {r_eff:.4g} mm <= 0: check "
             f"--sphere-radius (a radius in mm, not a diameter)")
+    require(r_eff >= MIN_BALL_RADIUS_MM,
+            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
+            f"{r_eff * 1e3:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
+            f"check --sphere-radius (mm)")
     require(r_eff <= MAX_BALL_RADIUS_MM,
             f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
             f"{r_eff:.4g} mm (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
@@ -565,6 +584,9 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
     fitted = sh(np.radians(phi), np.radians(theta))
     flag_used, sigma = robust_flags(sh.degree, np.radians(phi[used]), np.radians(theta[used]),
                                     probe[used], outlier_k)
+    res = probe[used] - sh.fitted
+    noise = math.sqrt(float(res @ res) / max(used.sum() - sh.dof, 1.0))
+    u_par = noise * np.sqrt(np.diag(fit.cov_unit))
     outlier = np.zeros(len(p), dtype=bool)
     outlier[used] = flag_used
     if flags is not None:
@@ -575,7 +597,7 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
         phi_deg=phi, theta_deg=theta, r_m=r_m, probe=probe, map=pmap, map_fitted=fitted,
         outlier=outlier, robust_sigma=sigma, used=used.copy(),
         direction_source=source, direction_mismatch_deg=mismatch, condition=fit.condition,
-        notes=notes)
+        noise=noise, u_center=u_par[:3], u_r_eff=float(u_par[3]), notes=notes)
 
 
 def calibrate_data(data: SphereData, sphere_radius: float, **kw) -> ProbeCalibration:

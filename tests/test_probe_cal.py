@@ -230,3 +230,20 @@ def test_sphere_radius_that_does_not_fit():
         probe.calibrate(pts, 0.5)
     with pytest.raises(InputError, match="positive"):
         probe.calibrate(pts, -1.0)
+    fit_radius = probe.fit_sphere(pts).radius
+    with pytest.raises(InputError, match="not a plausible stylus"):
+        probe.calibrate(pts, fit_radius - 0.001)  # a 1 um ball
+
+
+def test_type_a_uncertainty_matches_scatter():
+    """u(centre), u(R_eff) from the map residuals against the scatter of repeated runs."""
+    plan = pp.pahk_plan()
+    runs = [probe.calibrate(pp.simulate_probing(plan, C0, R_S, R_BALL, noise_mm=0.5e-3,
+                                                rng=1000 + k), R_S) for k in range(60)]
+    sd_c = np.std([r.center for r in runs], axis=0, ddof=1)
+    sd_r = np.std([r.r_eff for r in runs], ddof=1)
+    u_c = np.mean([r.u_center for r in runs], axis=0)
+    u_r = np.mean([r.u_r_eff for r in runs])
+    assert np.all((0.7 < u_c / sd_c) & (u_c / sd_c < 1.6)), (u_c, sd_c)
+    assert 0.7 < u_r / sd_r < 1.6
+    assert 0.4e-3 < np.mean([r.noise for r in runs]) < 0.65e-3   # radial noise 0.5 um

@@ -140,7 +140,10 @@ def run(args) -> int:
     n_out = len(summary["outliers"]["index"])
     print(f"{cal.n_points} points, sphere radius {cal.sphere_radius:.4f} mm, "
           f"directions from {cal.direction_source}")
-    print(f"centre {c[0]:.4f} {c[1]:.4f} {c[2]:.4f} mm, R_eff {cal.r_eff:.4f} mm")
+    u = summary["uncertainty"]
+    print(f"centre {c[0]:.4f} {c[1]:.4f} {c[2]:.4f} mm, R_eff {cal.r_eff:.4f} mm "
+          f"(u: centre {max(u['u_center_um']):.2f} um, R_eff {u['u_r_eff_um']:.2f} um; "
+          f"noise {u['noise_um']:.2f} um)")
     print(f"probe error max {e['max']:.1f} um, min {e['min']:.1f} um, rms {e['rms']:.1f} um; "
           f"map degree {cal.map.degree}, residual rms {summary['map']['residual_rms_um']:.2f} um;"
           f" {n_out} outlier{'s' if n_out != 1 else ''} flagged"
