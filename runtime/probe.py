@@ -17,6 +17,13 @@ Conventions (stated once, used everywhere in volerr)
   mean(R_m) (the normal equation of the radius), so ``R_eff = R_fit - R_s`` and
   ``Probe_i = R_eff - (R_m,i - R_s)``: positive where the probe triggers late (more
   pretravel, the ball centre recorded nearer the surface).
+* What the sphere fit absorbs: the part of the true pretravel pattern that is constant or
+  linear in the direction (1, Mx, My, Mz) over the probed points cannot be told from the
+  ball radius and the sphere centre; it goes into R_eff and the centre (on Pahk's hemisphere
+  plan a pattern growing with phi moves the centre along the probe axis by several um).  That
+  is the probe's effective centre and radius -- what a stylus qualification uses -- so the
+  along-normal error of a measured point is still -Probe(M); the reported u(centre), u(R_eff)
+  are Type A (scatter about the map) and do not include this definitional part.
 * Eq. (17): a point measured with probing direction ``M`` is in error by ``-Probe(M) M``, which
   :meth:`volerr.Model.volumetric_error` subtracts (``direction=M, probe_error=probe_map``).
 * Units: mm and deg at the API, um in files' ``_um`` columns and in reports.
