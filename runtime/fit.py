@@ -13,7 +13,8 @@ of the workpiece end).  ``K`` is chosen by k-fold cross-validation.
 Gauge.  Some combinations are not determined by *any* volumetric measurement: a constant of a
 translational error against the instrument's translation, a straightness slope against
 squareness and the instrument's rotation, and so on.  They are fixed by convention: columns
-are taken in the order set-up, constants, higher degrees, slopes, constant terms, and a column
+are taken in the order set-up, constants (squareness, location), degrees >= 2, angular slopes,
+angular constants, translational slopes, translational constants, and a column
 is dropped when it lies in the span of those before it on an *ideal* plan (the measured volume
 filled, probe offsets along every axis).  What the ideal plan determines but the actual data
 does not is a property of the measurement plan: it is reported (:func:`identifiability`),
@@ -151,28 +152,42 @@ def _priority(label) -> int:
     angular = p[1] in "ABC"
     if k >= 2:
         return 2
-    if k == 1:
-        return 3 if angular else 4
-    return 5 if angular else 6
+    if angular:
+        return 3 if k == 1 else 4
+    return 5 if k == 1 else 6
 
 
-def independent_columns(A2: np.ndarray, order, tol: float = 1e-7) -> np.ndarray:
-    """Boolean mask of columns kept by Gram-Schmidt in ``order`` (a column is dropped when it
-    lies within ``tol`` (relative) of the span of the kept ones)."""
-    norms = np.linalg.norm(A2, axis=0)
-    keep = np.zeros(A2.shape[1], bool)
-    q = np.zeros((A2.shape[0], 0))
+def independent_columns(G: np.ndarray, order, tol: float = 1e-7) -> np.ndarray:
+    """Boolean mask of columns kept in ``order``: a column is dropped when its distance to the
+    span of the kept ones is below ``tol`` times its norm.  ``G`` is the Gram matrix A^T A
+    (incremental Cholesky on it: no tall decompositions)."""
+    n = G.shape[0]
+    keep = np.zeros(n, bool)
+    L = np.zeros((n, n))
+    kept: list[int] = []
     for j in order:
-        if norms[j] == 0:
+        gjj = G[j, j]
+        if gjj <= 0:
             continue
-        v = A2[:, j] / norms[j]
-        for _ in range(2):  # re-orthogonalise once for stability
-            v = v - q @ (q.T @ v)
-        nv = np.linalg.norm(v)
-        if nv > tol:
+        if kept:
+            w = _forward(L[:len(kept), :len(kept)], G[kept, j])
+            r2 = gjj - float(w @ w)
+        else:
+            w, r2 = np.zeros(0), gjj
+        if r2 > tol * tol * gjj:
+            k = len(kept)
+            L[k, :k] = w
+            L[k, k] = np.sqrt(r2)
+            kept.append(j)
             keep[j] = True
-            q = np.column_stack([q, v / nv])
     return keep
+
+
+def _forward(L: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve L w = b for lower-triangular L."""
+    from scipy.linalg import solve_triangular
+
+    return solve_triangular(L, b, lower=True, check_finite=False)
 
 
 def ideal_data(model: Model, data: Data, ranges: dict, n: int = 400, seed: int = 1) -> Data:
@@ -194,9 +209,13 @@ def gauge_mask(model: Model, data: Data, degree: int, ranges: dict) -> tuple[np.
     ideal = ideal_data(model, data, ranges)
     d = declared_design(model, ideal, degree, ranges)
     A2 = d.A.reshape(-1, d.A.shape[-1])
-    order = sorted(range(len(d.labels)), key=lambda j: (_priority(d.labels[j]), j))
-    keep = independent_columns(A2, order)
+    keep = independent_columns(A2.T @ A2, priority_order(d.labels))
     return keep, [d.labels[j] for j in np.flatnonzero(~keep)]
+
+
+def priority_order(labels) -> list:
+    """Column order of gauge fixing (see the module docstring)."""
+    return sorted(range(len(labels)), key=lambda j: (_priority(labels[j]), j))
 
 
 # ---- linear algebra -----------------------------------------------------------------
@@ -257,59 +276,54 @@ def rms(rows: np.ndarray) -> float:
 
 
 # ---- identifiability ----------------------------------------------------------------
-def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> list:
-    """Parameter groups the data cannot separate: SVD of the column-scaled design.
+def _name(label) -> str:
+    return label[0] if label[0] != "setup" else f"setup.{label[1]}"
 
-    Returns a list of ``{"parameters", "dimension", "combination", "singular_value"}``: each
-    group is a connected set of parameters sharing undetermined directions; ``combination`` is
-    the direction (weights per parameter, summed over basis terms) best describing it."""
-    scale = np.linalg.norm(A2, axis=0)
-    scale[scale == 0] = 1.0
-    As = A2 / scale
-    w, V = np.linalg.eigh(As.T @ As)       # Gram route: tall SVDs are slow with threaded BLAS
-    s = np.sqrt(np.clip(w[::-1], 0.0, None))
-    vt = V[:, ::-1].T
-    null = vt[s < tol * s[0]] if len(s) else vt[:0]
-    zero_cols = np.flatnonzero(np.linalg.norm(A2, axis=0) == 0)
-    if len(null) == 0 and len(zero_cols) == 0:
-        return []
-    params = [lab[0] if lab[0] != "setup" else f"setup.{lab[1]}" for lab in labels]
-    names = list(dict.fromkeys(params))
-    index = {n: i for i, n in enumerate(names)}
-    P = null.T @ null if len(null) else np.zeros((len(labels), len(labels)))
-    w = np.zeros((len(names), len(names)))
-    for i, pi in enumerate(params):
-        for j, pj in enumerate(params):
-            w[index[pi], index[pj]] = max(w[index[pi], index[pj]], abs(P[i, j]))
-    involved = [i for i in range(len(names)) if w[i, i] > 1e-3]
-    groups, seen = [], set()
-    for i in involved:
-        if i in seen:
+
+def _term(label) -> str:
+    p, k = label
+    if p == "setup":
+        return f"setup.{k}"
+    return p if k is None else f"{p}[P{k}]"
+
+
+def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> tuple[np.ndarray, list]:
+    """Columns the data determine, and what they cannot separate.
+
+    ``A2`` (rows, P) holds the gauge-fixed columns.  Columns are taken in the gauge order; one
+    that lies (within ``tol``) in the span of those kept before it cannot be separated from
+    them by these data.  Returns the mask of kept columns and one entry per parameter with
+    dropped terms: ``{"parameters": [that parameter, then the partners it is confounded
+    with], "terms": [dropped basis terms], "confounded_with": {partner: weight}}``."""
+    G = A2.T @ A2
+    keep = independent_columns(G, priority_order(labels), tol)
+    dropped = np.flatnonzero(~keep)
+    if len(dropped) == 0:
+        return keep, []
+    kept = np.flatnonzero(keep)
+    Gk = G[np.ix_(kept, kept)]
+    groups: dict = {}
+    for j in dropped:
+        p = _name(labels[j])
+        g = groups.setdefault(p, {"parameters": [p], "terms": [], "confounded_with": {}})
+        g["terms"].append(_term(labels[j]))
+        if G[j, j] <= 0:
+            g["no_sensitivity"] = True
             continue
-        stack, comp = [i], set()
-        while stack:
-            k = stack.pop()
-            if k in comp:
-                continue
-            comp.add(k)
-            stack.extend(j for j in involved if w[k, j] > 1e-3 and j not in comp)
-        seen |= comp
-        groups.append(sorted(comp))
+        coef = np.linalg.lstsq(Gk, G[kept, j], rcond=1e-12)[0]
+        contrib = np.abs(coef) * np.sqrt(np.diag(Gk)) / np.sqrt(G[j, j])
+        for c, w in zip(kept, contrib):
+            if w > 0.05:
+                q = _name(labels[c])
+                if q != p:
+                    g["confounded_with"][q] = round(max(g["confounded_with"].get(q, 0.0),
+                                                        float(w)), 3)
     out = []
-    for g in groups:
-        gnames = [names[i] for i in g]
-        cols = [j for j, p in enumerate(params) if p in gnames]
-        sub = null[:, cols]
-        dim = int(np.linalg.matrix_rank(sub, tol=1e-6)) if len(sub) else 0
-        vec = np.zeros(len(gnames))
-        if len(sub):
-            v = sub[np.argmax(np.linalg.norm(sub, axis=1))]
-            for c, val in zip(cols, v):
-                vec[gnames.index(params[c])] += val ** 2
-        combo = {n: round(float(x), 4) for n, x in zip(gnames, vec / max(vec.sum(), 1e-300))}
-        out.append({"parameters": gnames, "dimension": dim, "combination": combo,
-                    "singular_value": float(s[-1] / s[0]) if len(s) else 0.0})
-    return out
+    for g in groups.values():
+        partners = sorted(g["confounded_with"], key=lambda q: -g["confounded_with"][q])
+        g["parameters"] = g["parameters"] + partners
+        out.append(g)
+    return keep, out
 
 
 def require_points(n_points: int, n_columns: int, what: str) -> None:

@@ -80,7 +80,8 @@ def read_deviations(path, model: Model) -> Data:
                 vals.append(math.nan)
         if bad is not None and all(_not_number(s) for s in raw):
             continue  # a label column (text): ignored
-        require(bad is None, f"{p.name}: column {h} row {bad + 2}: {raw[bad]!r} is not a number")
+        if bad is not None:
+            raise InputError(f"{p.name}: column {h} row {bad + 2}: {raw[bad]!r} is not a number")
         v = np.asarray(vals)
         k = int(np.flatnonzero(~np.isfinite(v))[0]) if not np.all(np.isfinite(v)) else -1
         require(k < 0, f"{p.name}: column {h} row {k + 2} is NaN or infinite")
@@ -335,6 +336,10 @@ class _Context:
         design = declared_design(model, dat, degree, self.ranges)
         keep, gauge = gauge_mask(model, dat, degree, self.ranges)
         require_points(len(train), int(keep.sum()), f"declared model of degree {degree}")
+        labels = [lab for lab, k in zip(design.labels, keep) if k]
+        keep_d, unident = identifiability(design.A[:, :, keep].reshape(-1, keep.sum()), labels)
+        keep = keep.copy()
+        keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
         A_all = design.A[:, :, keep].reshape(-1, keep.sum())
         candidates = [c for c in cands.build(model, dat, self.ranges, degree)
                       if c.kind in self.families]
@@ -394,12 +399,13 @@ class _Context:
             if not accepted:
                 break
         return {"design": design, "keep": keep, "gauge": gauge, "A_all": A_all,
+                "unidentifiable": unident,
                 "selected": selected, "candidates": candidates}
 
 
 def run_loop(layout, data, *, seed: int = 0, folds: int = 5, test_fraction: float = 0.25,
              degree: int | None = None, max_degree: int = 6, out_dir=None,
-             progress=None, families=cands.FAMILIES) -> Report:
+             progress=None, families=cands.FAMILIES, inputs=()) -> Report:
     """Run the loop on ``data`` (CSV path, :class:`volerr.simulate.Campaign` or
     :class:`volerr.fit.Data`) for ``layout`` (name or layout file). Returns a :class:`Report`.
 
@@ -452,7 +458,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int = 5, test_fraction: floa
     design, keep, gauge = state["design"], state["keep"], state["gauge"]
     labels = [lab for lab, k in zip(design.labels, keep) if k]
     A_all, selected, candidates = state["A_all"], state["selected"], state["candidates"]
-    unident = identifiability(design.A[:, :, keep].reshape(-1, keep.sum()), labels)
+    unident = state["unidentifiable"]
     _explain(unident, dat)
 
     # ---- augment: layout file, derivation, generated module ---------------------------
@@ -537,8 +543,8 @@ def run_loop(layout, data, *, seed: int = 0, folds: int = 5, test_fraction: floa
         from .fileio import write_text
 
         out = Path(out_dir)
-        inputs = [str(data)] if isinstance(data, (str, Path)) else []
-        paths["augmented_layout"] = str(write_text(out / f"{aug_model.name.lower()}.toml",
+        inputs = list(inputs) + ([str(data)] if isinstance(data, (str, Path)) else [])
+        paths["augmented_layout"] = str(write_text(out / f"{aug_model.name}.toml",
                                                    aug_text, inputs=inputs))
         paths["generated_module"] = str(write_text(out / f"{aug_model.name.lower()}.py",
                                                    gen_text, inputs=inputs))
@@ -606,8 +612,13 @@ def _explain(groups, data: Data) -> None:
     """Attach a plain-language reason to each unidentifiable group."""
     n_probes = len(np.unique(np.round(data.probe, 6), axis=0))
     for g in groups:
-        angular = [p for p in g["parameters"] if p[:1] == "E" and len(p) == 3 and p[1] in "ABC"]
-        if angular and n_probes <= 2:
+        angular = [p for p in g["parameters"][:1] if p[:1] == "E" and len(p) == 3
+                   and p[1] in "ABC"]
+        if g.get("no_sensitivity"):
+            g["reason"] = (f"{g['parameters'][0]} does not act on these data at all (zero "
+                           f"sensitivity: e.g. an angular error with no lever arm); measure "
+                           f"with probe/tool offsets that give it one")
+        elif angular and n_probes <= 2:
             g["reason"] = (f"angular errors {' '.join(angular)} act only through probe/tool "
                            f"offsets (Abbe arms); with {n_probes} distinct offset(s) they "
                            "cannot be separated from the translational errors: measure with "

@@ -36,8 +36,13 @@ import numpy as np
 from .errors import InputError, require
 from .model import Model, load
 
-KINDS = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
-         "probe_direction", "setup")
+#: effect kind -> the keys it accepts (besides "kind")
+EFFECT_KEYS = {"thermal": {"axis", "ppm_per_K"}, "drift": {"direction", "um_per_h"},
+               "reversal": {"axis", "um"}, "coupling": {"component", "axis", "um"},
+               "periodic": {"component", "period_mm", "um", "phase"},
+               "higher_order": {"component", "um", "degree"}, "probe_direction": {"um"},
+               "setup": {"um", "urad"}}
+KINDS = tuple(EFFECT_KEYS)
 
 
 def _rotation(ex, ey, ez) -> np.ndarray:
@@ -140,19 +145,27 @@ def make_plan(model: Model, n_points: int, rng: np.random.Generator, probes=None
 def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, rounds: int = 1,
              effects=(), noise_um: float = 0.3, magnitude_um: float = 5.0, degree: int = 4,
              setup_um: float = 20.0, setup_urad: float = 20.0, temperature_K: float = 4.0,
-             duration_h: float = 8.0) -> Campaign:
+             duration_h: float = 8.0, errors=None) -> Campaign:
     """Simulate a campaign on a virtual machine of ``layout`` (name or layout file).
 
     The covariate columns ``T_C`` (deg C), ``t_s`` (s), ``dir_<axis>`` (+1 / -1, linear axes),
     ``nx ny nz`` (probing direction) and ``setup`` (round number) are always written, so that
-    a loop has every candidate family to consider whether or not an effect is present."""
+    a loop has every candidate family to consider whether or not an effect is present.
+    ``errors``: {name: constant or callable(position)} replacing random error functions
+    (mm / rad; a callable of a component error gets its own axis' positions, mm | deg)."""
     model = load(layout)
     rng = np.random.default_rng(seed)
     effects = [dict(e) for e in effects]
     for e in effects:
         require(e.get("kind") in KINDS, f"unknown effect kind {e.get('kind')!r}; "
                 f"kinds are {' '.join(KINDS)}")
+        bad = sorted(set(e) - {"kind"} - EFFECT_KEYS[e["kind"]])
+        require(not bad, f"effect {e['kind']}: unknown key {bad[0] if bad else ''!r} "
+                f"(keys: {' '.join(sorted(EFFECT_KEYS[e['kind']]))})")
     funcs = random_errors(model, rng, magnitude_um, degree)
+    for p, f in dict(errors or {}).items():
+        require(p in model.parameters, f"{model.name}: unknown error parameter {p!r}")
+        funcs[p] = f
     positions, probe, rnd = make_plan(model, n_points, rng, probes, rounds)
     n = len(rnd)
     linear = [a for a in model.axes if a not in model.rotary_axes]
