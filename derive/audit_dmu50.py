@@ -1,0 +1,373 @@
+"""Audit of the DMU 50 kinematics printed in Ellingsdalen (2021) against the derivation.
+
+The printed material comes as the parsed ``volerr/data/printed_dmu50.toml`` (no file I/O here):
+Sorby's forward kinematics (eq. 3.19-3.24) and inverse (eq. 3.25-3.29), the chain of HTMs
+(eq. 3.30-3.36), their product (eq. 3.37), the chain "updated" with the errors, and Listing 3.3
+(``T_r``, ``rot_x/y/z``, ``T_er``).  The authority is the derivation from
+``volerr/layouts/DMU50.toml``: the nominal ``tool2work`` of
+:class:`volerr.derive.kinematics.Chain` and the generated inverse of
+:mod:`volerr.derive.inverse`.
+
+How each item is judged
+* forward formulas: ``simplify(derived - printed) == 0`` (symbolic), confirmed numerically;
+* inverse formulas: printed and derived inverse evaluated at the forward kinematics of 200
+  random poses with 0 < B < 180 deg (the branch of eq. 3.25); identical if they agree to 1e-9
+  (mm, rad) -- the printed inverse is a function of (x, y, z, i, j, k), so "identical" means
+  identical as a function on that branch;
+* matrices: the derived factors of the workpiece side of the chain, in the thesis' form
+  ``T_0^w = Trans(c_B) Rx(alpha) Rz(B) Rx(-alpha) Trans(-c_B) Rz(-C)`` with ``alpha`` the angle
+  that turns z onto the table's B axis (45 deg) -- its product is checked against the chain
+  first -- compared entry by entry, with missing or duplicated rows named;
+* products: the printed factor order against the derived one;
+* Listing 3.3 ``T_er``: the first-order effect of each error parameter of B and C on a table
+  point (machine frame), listing against derived model, at the listing's own pose
+  (B = C = 90 deg, point (179.009, 94.545, 143.533) mm).
+"""
+
+from __future__ import annotations
+
+import difflib
+
+import numpy as np
+import sympy as sp
+
+from volerr.layout import read_layout
+
+from .audit import Verdict, fmt
+from .inverse import BRANCH, TIP, TOOL_AXIS, linear_inverse, rotary_inverse
+from .kinematics import Chain, position_symbol, rotation, translation
+from .volumetric import nominal_point, nominal_tool_axis, volumetric_error
+
+DATA_FILE = "printed_dmu50.toml"
+LAYOUTS = ("DMU50",)
+SOURCE = "Ellingsdalen 2021"
+
+X, Y, Z, B, C = (position_symbol(a) for a in "XYZBC")
+D = sp.Symbol("d", real=True)
+A_SYM = sp.Symbol("a", real=True)
+_LOCALS = {"X": X, "Y": Y, "Z": Z, "B": B, "C": C, "d": D, "a": A_SYM,
+           "c45": sp.sqrt(2) / 2, "s45": sp.sqrt(2) / 2,
+           **{str(s): s for s in TIP + TOOL_AXIS}}
+
+
+def _parse(text: str):
+    return sp.sympify(text, locals=_LOCALS)
+
+
+def _verdict(eq, same, erratum, evidence, printed, derived, component="") -> Verdict:
+    return Verdict(SOURCE, eq, "DMU50", "identical" if same else "differs",
+                   "" if same else erratum, evidence, printed, derived, component)
+
+
+# ------------------------------------------------------------------------------ derived pieces
+def _chain():
+    layout = read_layout("DMU50")
+    return layout, Chain.from_layout(layout)
+
+
+def derived_forward(chain) -> dict:
+    p = nominal_point(chain).subs({s: 0 for s in sp.symbols("Xp Yp Zp", real=True)})
+    k = nominal_tool_axis(chain)
+    return {"x": p[0], "y": p[1], "z": p[2], "i": k[0], "j": k[1], "k": k[2]}
+
+
+def derived_factors(layout) -> dict:
+    """The thesis' factors of ``T_0^w`` (machine <- workpiece), derived from the layout."""
+    b, c = layout.axes["B"], layout.axes["C"]
+    cb = sp.Matrix([sp.sympify(v, locals={"d": D}) if isinstance(v, str) else sp.nsimplify(v)
+                    for v in b.point])
+    cc = sp.Matrix([sp.nsimplify(v) for v in c.point])
+    assert cc == sp.zeros(3, 1), "the factor form assumes the C axis through the workpiece origin"
+    # the table turns by +B about w = -u_B (u_B: tool-relative direction of B)
+    w = -sp.Matrix([sp.nsimplify(v, [sp.sqrt(2)]) for v in b.direction])
+    assert w[0] == 0, "the factor form assumes the B axis in the y-z plane"
+    alpha = sp.atan2(-w[1], w[2])
+    return {
+        "T_0^1": translation(cb), "T_1^2": rotation((1, 0, 0), alpha),
+        "T_2^3": rotation((0, 0, 1), B), "T_3^4": rotation((1, 0, 0), -alpha),
+        "T_4^5": translation(-cb), "T_5^w": rotation((0, 0, 1), -C),
+        "T_0^t": translation((X, Y, Z)),
+    }
+
+
+DERIVED_ORDER = ["T_w^5", "T_5^4", "T_4^3", "T_3^2", "T_2^1", "T_1^0", "T_0^t"]
+
+
+# ------------------------------------------------------------------------------ comparisons
+def _matrix_diff(printed_rows, derived: sp.Matrix) -> tuple[bool, str, str]:
+    """(same, erratum, evidence) of a printed matrix (list of rows) against ``derived``."""
+    rows = [[sp.simplify(_parse(c)) for c in r] for r in printed_rows]
+    drows = [[sp.simplify(derived[i, j]) for j in range(derived.cols)] for i in range(derived.rows)]
+
+    def eq(r1, r2):
+        return len(r1) == len(r2) and all(sp.simplify(a - b) == 0 for a, b in zip(r1, r2))
+
+    if len(rows) == len(drows) and all(len(r) == len(d) for r, d in zip(rows, drows)):
+        bad = [(i, j) for i in range(len(rows)) for j in range(len(rows[i]))
+               if sp.simplify(rows[i][j] - drows[i][j]) != 0]
+        if not bad:
+            return True, "", "all 16 entries agree with the derived factor"
+        desc = "; ".join(f"entry ({i + 1},{j + 1}): printed {fmt(rows[i][j])}, derived "
+                         f"{fmt(drows[i][j])}" for i, j in bad)
+        kind = "sign error" if all(sp.simplify(rows[i][j] + drows[i][j]) == 0 for i, j in bad) \
+            else "wrong entries"
+        m = sp.Matrix(rows)
+        extra = ""
+        r3 = m[0:3, 0:3]
+        if sp.simplify(r3.T * r3 - sp.eye(3)) != sp.zeros(3, 3):
+            extra = f"; the printed 3x3 block is not a rotation (det = {fmt(sp.simplify(r3.det()))})"
+        return False, f"{kind} in {len(bad)} entr{'y' if len(bad) == 1 else 'ies'}", desc + extra
+    if len(rows) == len(drows) - 1:
+        for k in range(len(drows)):
+            if all(eq(a, b) for a, b in zip(rows, drows[:k] + drows[k + 1:])):
+                return False, f"row {k + 1} missing", (
+                    f"printed with {len(rows)} rows; it is the derived factor without row "
+                    f"{k + 1} [{', '.join(fmt(v) for v in drows[k])}]")
+    if len(rows) == len(drows) + 1:
+        for k in range(len(rows)):
+            if all(eq(a, b) for a, b in zip(rows[:k] + rows[k + 1:], drows)):
+                dup = [j for j in (k - 1, k + 1) if 0 <= j < len(rows) and eq(rows[k], rows[j])]
+                erratum = f"row {min(k, dup[0]) + 1} printed twice" if dup else \
+                    f"extra row {k + 1}"
+                return False, erratum, (f"printed with {len(rows)} rows; removing row {k + 1} "
+                                        f"[{', '.join(fmt(v) for v in rows[k])}] gives the "
+                                        "derived factor")
+    return False, "wrong matrix", f"printed {rows}, derived {drows}"
+
+
+def _product_diff(printed: list, derived: list) -> tuple[bool, str, str]:
+    if printed == derived:
+        return True, "", "same factors in the same order"
+    ops = difflib.SequenceMatcher(a=derived, b=printed, autojunk=False).get_opcodes()
+    parts = []
+    for tag, i1, i2, j1, j2 in ops:
+        if tag == "replace":
+            parts.append(f"{', '.join(derived[i1:i2])} printed as {', '.join(printed[j1:j2])}")
+        elif tag == "delete":
+            parts.append(f"{', '.join(derived[i1:i2])} missing")
+        elif tag == "insert":
+            parts.append(f"extra {' '.join(printed[j1:j2])}")
+    return False, "; ".join(parts), (f"derived order {' '.join(derived)}; printed "
+                                     f"{' '.join(printed)}")
+
+
+# ------------------------------------------------------------------------------ the audit
+def audit(printed: dict, layouts=None) -> list[Verdict]:
+    if layouts is not None and "DMU50" not in layouts:
+        return []
+    layout, chain = _chain()
+    d_value = float(layout.parameters["d"])
+    out: list[Verdict] = []
+    fwd = derived_forward(chain)
+    rinv = rotary_inverse(chain)
+    linv = linear_inverse(chain)
+    rng = np.random.default_rng(20210)
+    n = 200
+    q = {"X": rng.uniform(-250, 250, n), "Y": rng.uniform(-225, 225, n),
+         "Z": rng.uniform(0, 400, n), "B": np.deg2rad(rng.uniform(1, 179, n)),
+         "C": np.deg2rad(rng.uniform(-179, 179, n))}
+    subs_num = {D: d_value}
+    fnum = {k: sp.lambdify((X, Y, Z, B, C), v.subs(subs_num), "numpy") for k, v in fwd.items()}
+    pose = {k: np.broadcast_to(f(q["X"], q["Y"], q["Z"], q["B"], q["C"]), (n,)) for k, f in
+            fnum.items()}
+
+    for item in printed.get("formula", []):
+        eq, qty = f"eq. {item['id']}", item["quantity"]
+        pr = _parse(item["expr"])
+        if qty in fwd:
+            diff = sp.simplify(sp.expand_trig(fwd[qty] - pr))
+            f = sp.lambdify((X, Y, Z, B, C), (fwd[qty] - pr).subs(subs_num), "numpy")
+            num = float(np.max(np.abs(f(q["X"], q["Y"], q["Z"], q["B"], q["C"]))))
+            same = diff == 0
+            ev = (f"simplify(derived - printed) = {fmt(diff)}; max |difference| at {n} random "
+                  f"poses = {num:.2g}")
+            out.append(_verdict(eq, same, "wrong forward formula", ev, item["expr"],
+                                fmt(fwd[qty]), qty))
+            continue
+        # inverse: printed and derived evaluated on the same poses
+        args = (*TIP, *TOOL_AXIS)
+        if qty in ("B", "C"):
+            der = rinv[qty].subs(BRANCH, -1)
+        else:
+            der = linv[qty].subs({s: 0 for s in sp.symbols("Xp Yp Zp", real=True)})
+        vals = [pose[str(s)] for s in args]
+        g_der = sp.lambdify(args + (B, C), der.subs(subs_num), "numpy")
+        g_pr = sp.lambdify(args + (B, C), pr.subs(subs_num), "numpy")
+        # eq. 3.27-3.29 use C (and B) from eq. 3.25-3.26: evaluate them at the true angles
+        a = np.asarray(g_der(*vals, q["B"], q["C"]), float)
+        b = np.asarray(g_pr(*vals, q["B"], q["C"]), float)
+        if qty in ("B", "C"):
+            dev = np.abs((a - b + np.pi) % (2 * np.pi) - np.pi)
+        else:
+            dev = np.abs(a - b)
+        truth = q[qty]
+        err_true = np.abs(((b - truth + np.pi) % (2 * np.pi) - np.pi) if qty in ("B", "C")
+                          else b - truth)
+        same = bool(np.nanmax(dev) < 1e-9)
+        ev = (f"printed and derived inverse (branch of eq. 3.25, 0 < B < 180 deg) agree at {n} "
+              f"random poses to {np.nanmax(dev):.2g} ({'rad' if qty in 'BC' else 'mm'}); the "
+              f"printed formula returns the commanded {qty} to {np.nanmax(err_true):.2g}")
+        out.append(_verdict(eq, same, "wrong inverse formula", ev, item["expr"], fmt(der), qty))
+
+    factors = derived_factors(layout)
+    # the factor form must reproduce the chain (workpiece side, machine <- workpiece)
+    t0w = sp.eye(4)
+    for name in ("T_0^1", "T_1^2", "T_2^3", "T_3^4", "T_4^5", "T_5^w"):
+        t0w = t0w * factors[name]
+    # T_0^w @ tool2work(X = Y = Z = 0) must be the identity (checked at random angles)
+    wp = chain.nominal_htm().subs({X: 0, Y: 0, Z: 0})
+    check = sp.lambdify((B, C, D), t0w * wp - sp.eye(4), "numpy")
+    for bb, cc in rng.uniform(-3, 3, (5, 2)):
+        assert np.abs(np.array(check(bb, cc, d_value), float)).max() < 1e-9, \
+            "factor form does not reproduce the chain"
+    for item in printed.get("matrix", []):
+        name = item["name"]
+        eq = f"eq. {item['id']}" if item["id"][0].isdigit() else item["id"]
+        same, erratum, ev = _matrix_diff(item["rows"], factors[name])
+        if item["id"].startswith("error chain") and not same:
+            for other, m in factors.items():
+                if other != name and _matrix_diff(item["rows"], m)[0]:
+                    erratum, ev = f"{name} printed as {other}", (
+                        f"the printed matrix is the derived {other}; {name} is the translation "
+                        f"by -c_B = (0, 0, -d)")
+        out.append(_verdict(eq, same, erratum, ev, str(item["rows"]), fmt(factors[name]), name))
+
+    prod = printed.get("product", {})
+    if "3.37" in prod:
+        same, erratum, ev = _product_diff(prod["3.37"], DERIVED_ORDER)
+        out.append(_verdict("eq. 3.37", same, erratum, ev + "; T_a^b maps frame b into frame a, "
+                            "T_w^t = (T_0^w)^-1 T_0^t", prod.get("3.37_text", ""),
+                            " ".join(DERIVED_ORDER)))
+    lst = printed.get("listing", {})
+    names = {"T_d": "T_0^1", "T_45": "T_1^2", "T_B": "T_2^3", "T_n45": "T_3^4", "T_nd": "T_4^5",
+             "T_C": "T_5^w"}
+    for lname, fname in names.items():
+        if lname in lst:
+            same, erratum, ev = _matrix_diff(lst[lname], factors[fname])
+            out.append(_verdict(f"Listing 3.3 {lname}", same, erratum,
+                                ev + f" (derived {fname})", str(lst[lname]),
+                                fmt(factors[fname]), lname))
+    key = "listing 3.3 line 46"
+    if key in prod:
+        pr = prod[key]
+        sign = -1 if pr and pr[0] == "-" else 1
+        fac = [p for p in pr if p != "-"]
+        m = sp.eye(4)
+        for p in fac:
+            m = m * sp.Matrix([[_parse(c) for c in r] for r in lst[p]])
+        same_body = sp.simplify(m - t0w) == sp.zeros(4, 4)
+        same = same_body and sign == 1
+        if same:
+            erratum, ev = "", "the product equals the derived T_0^w (machine <- workpiece)"
+        elif same_body:
+            erratum = "leading minus sign"
+            ev = ("taken literally, T = -(T_d T_45 T_B T_n45 T_nd T_C) negates the whole HTM "
+                  "(its homogeneous 1 becomes -1); without the minus the product equals the "
+                  "derived T_0^w exactly (the minus may be an OCR artefact of 'T_-d')")
+        else:
+            erratum, ev = "wrong product", "the product differs from the derived T_0^w"
+        out.append(_verdict("Listing 3.3 line 46 (T_r)", same, erratum, ev,
+                            prod.get(key + "_text", ""), "T_d @ T_45 @ T_B @ T_n45 @ T_nd @ T_C"))
+    std = {"rot_x": rotation((1, 0, 0), A_SYM), "rot_y": rotation((0, 1, 0), A_SYM),
+           "rot_z": rotation((0, 0, 1), A_SYM)}
+    for rname, m in std.items():
+        if rname in lst:
+            same, erratum, ev = _matrix_diff(lst[rname], m)
+            if not same and sp.simplify(sp.Matrix([[_parse(c) for c in r] for r in lst[rname]])
+                                        - m.subs(A_SYM, -A_SYM)) == sp.zeros(4, 4):
+                erratum = f"{rname} turns by -a"
+                ev = (f"{rname}(a) is the right-hand rotation by -a (signs of the sine terms "
+                      f"swapped; rot_x and rot_z are right-handed): E_BB and E_BC enter T_er with "
+                      f"the wrong sign; " + ev)
+            out.append(_verdict(f"Listing 3.3 {rname}", same, erratum, ev, str(lst[rname]),
+                                fmt(m), rname))
+    if "sources" in lst:
+        for pname, src in lst["sources"].items():
+            expected = f"{pname}_avg."
+            same = src == expected
+            out.append(_verdict(f"Listing 3.3 T_er {pname}", same,
+                                f"{pname} read from the data of {src[:-5]}",
+                                f"{pname} = cf_rot('{expected}', ...) reads its own data" if same
+                                else f"line reads cf_rot('{src}', ...) for {pname}; expected "
+                                f"'{expected}' (copy-paste: the {pname} curve is never used)",
+                                f"cf_rot('{src}')", f"cf_rot('{expected}')", pname))
+    if "T_er" in lst:
+        out.append(_audit_t_er(layout, chain, lst, factors, d_value))
+    return out
+
+
+def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
+    """First-order effect of each B/C error on a table point: Listing 3.3 T_er (with its rot_y
+    and data sources corrected) against the derived model, at the listing's pose
+    (B = C = 90 deg) and at a general one (B = 37, C = 23 deg)."""
+    t0w = sp.eye(4)
+    for name in ("T_0^1", "T_1^2", "T_2^3", "T_3^4", "T_4^5", "T_5^w"):
+        t0w = t0w * factors[name]
+    t0w_num = sp.lambdify((B, C, D), t0w, "numpy")
+    err_expr = volumetric_error(chain)
+    params = [sp.Symbol(p, real=True) for p in layout.parameter_names]
+    probe = sp.symbols("Xp Yp Zp", real=True)
+    err_num = sp.lambdify((X, Y, Z, B, C, D, *probe, *params), list(err_expr), "numpy")
+    p_table = np.array([179.009, 94.545, 143.533, 1.0])
+    rows = []
+    for bdeg, cdeg in ((90.0, 90.0), (37.0, 23.0)):
+        rows += [f"(B {bdeg:g}, C {cdeg:g}) {r}" for r in
+                 _t_er_pose(np.deg2rad(bdeg), np.deg2rad(cdeg), p_table, t0w_num, err_num,
+                            layout, d_value)]
+    same = not rows
+    ev = ("first-order effect per error parameter on the table point (179.009, 94.545, "
+          "143.533) mm, listing with rot_y and the data sources corrected: " +
+          ("; ".join(rows) if rows else "all effects agree") +
+          ". Reasons: T_er applies every error in the machine frame after the whole rotation "
+          "-- the tilts of B turn about the machine origin instead of about the B axis (lever "
+          "arm to the B/C intersection at (0, 0, d)), and the errors of C are not turned with "
+          "the B axis that carries C")
+    return _verdict("Listing 3.3 T_er (error model)", same, "errors applied in the wrong frame",
+                    ev, " @ ".join(lst["T_er"]), "derived first-order chain (DMU50 layout)",
+                    "T_er")
+
+
+def _t_er_pose(bq, cq, p_table, t0w_num, err_num, layout, d_value) -> list[str]:
+    t_r = np.array(t0w_num(bq, cq, d_value), dtype=float)
+    machine = t_r @ p_table
+    r = t_r[:3, :3]
+
+    def rx(a):
+        return np.array(rotation((1, 0, 0), a).evalf(), dtype=float)
+
+    def ry(a):
+        return np.array(rotation((0, 1, 0), a).evalf(), dtype=float)
+
+    def rz(a):
+        return np.array(rotation((0, 0, 1), a).evalf(), dtype=float)
+
+    def tr(v):
+        m = np.eye(4)
+        m[:3, 3] = v
+        return m
+
+    errs = ["E_XB", "E_YB", "E_ZB", "E_AB", "E_BB", "E_CB", "E_XC", "E_YC", "E_ZC", "E_AC",
+            "E_BC", "E_CC"]
+    # derived: the tool-relative model at the machine position of the point (EXB = -E_XB ...)
+    names = layout.parameter_names
+    rows = []
+    for e in errs:
+        unit = 1e-3 if e[2] in "XYZ" else 1e-6
+        v = dict.fromkeys(errs, 0.0)
+        v[e] = unit
+        t_er = (rx(v["E_AB"]) @ ry(v["E_BB"]) @ rz(v["E_CB"]) @ rx(v["E_AC"]) @ ry(v["E_BC"])
+                @ rz(v["E_CC"]) @ tr([v["E_XB"], 0, 0]) @ tr([0, v["E_YB"], 0])
+                @ tr([0, 0, v["E_ZB"]]) @ tr([v["E_XC"], 0, 0]) @ tr([0, v["E_YC"], 0])
+                @ tr([0, 0, v["E_ZC"]]) @ t_r)
+        d_machine = (t_er @ p_table - t_r @ p_table)[:3]
+        listing_tool = -(r.T @ d_machine)  # tool relative to the workpiece, workpiece frame
+        iso = "E" + e[2] + e[3]
+        pv = [(-unit if n == iso else 0.0) for n in names]
+        model = np.array([float(v) for v in err_num(machine[0], machine[1], machine[2], bq, cq,
+                                                    d_value, 0.0, 0.0, 0.0, *pv)])
+        diff = np.linalg.norm(model - listing_tool)
+        if diff > 1e-9:
+            rows.append(f"{e}: listing {np.round(listing_tool * 1e3, 4).tolist()} um, derived "
+                        f"{np.round(model * 1e3, 4).tolist()} um per "
+                        f"{'1 um' if e[2] in 'XYZ' else '1 urad'}")
+    return rows

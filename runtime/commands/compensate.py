@@ -1,0 +1,159 @@
+"""``volerr compensate LAYOUT --errors DIR PROGRAM --out F``: compensated NC program.
+
+Reads a G-code program in machine axis coordinates, predicts the tool-tip error of every
+motion block from the layout's model and the error tables, and writes a copy whose axis
+positions make the actual tool tip land on the nominal one (see :mod:`volerr.compensate` for
+the method and :mod:`volerr.gcode` for what is supported).  Only axis numbers change; the
+input is never overwritten.
+
+Outputs: ``--out`` (the program, same bytes except the compensated numbers), ``--report``
+(CSV, one row per motion block: ``line,status``, the programmed and written axis positions
+``<axis>_nominal_mm|deg``, ``<axis>_out_mm|deg``, the predicted tool-tip error before and after
+``dx_before_um, dy_before_um, dz_before_um, e_before_um, dx_after_um, ..., e_after_um``, the
+tool-axis error ``orientation_before_urad, orientation_after_urad`` and ``iterations``),
+``--json`` (summary) and ``--plot`` (PNG: error along the program before and after).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+from volerr.errors import InputError, require
+from volerr.fileio import check_output, write_text
+
+
+def register(sub) -> None:
+    from volerr import tables
+
+    p = sub.add_parser("compensate", help="rewrite an NC program with compensated coordinates",
+                       description=__doc__.split("\n\n")[1])
+    p.add_argument("layout", help="layout name (see 'volerr layouts') or layout file")
+    p.add_argument("program", help="G-code program in machine axis coordinates")
+    p.add_argument("--out", required=True, help="compensated program (never the input)")
+    tables.add_arguments(p)
+    p.add_argument("--strategy", choices=("full", "thesis"), default="full",
+                   help="full: iterate the inverse on the complete model (default); thesis: "
+                        "Ellingsdalen 2021 sec. 3.5 (rotary, then linear; angular errors of the "
+                        "linear axes neglected), for comparison")
+    p.add_argument("--orientation", action="store_true",
+                   help="also correct the tool orientation with the rotary axes")
+    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
+                   metavar=("XT", "YT", "ZT"),
+                   help="tool-tip offset in the tool frame, mm, beyond the point the axis "
+                        "positions refer to (default 0 0 0: the program positions the tip)")
+    p.add_argument("--tol-um", type=float, default=0.1,
+                   help="stop iterating when the correction changes by less than this (um)")
+    p.add_argument("--decimals", type=int, default=4,
+                   help="decimals of the written numbers (at least those of the input)")
+    p.add_argument("--initial", default="",
+                   help="axis positions at program start, e.g. 'B=0,C=0' (otherwise an axis "
+                        "is unknown until programmed)")
+    p.add_argument("--ignore-travel", action="store_true",
+                   help="accept positions outside the layout's travel")
+    p.add_argument("--report", help="per-block CSV report")
+    p.add_argument("--json", help="summary as JSON")
+    p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")
+    p.set_defaults(func=run)
+
+
+def _initial(text: str) -> dict:
+    out = {}
+    for part in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
+        require("=" in part, f"--initial: expected AXIS=VALUE, got {part!r}")
+        a, v = part.split("=", 1)
+        try:
+            val = float(v)
+        except ValueError:
+            raise InputError(f"--initial: {v!r} is not a number") from None
+        require(math.isfinite(val), f"--initial: {a} is not finite")
+        out[a.strip().upper()] = val
+    return out
+
+
+def write_bytes(path, data: bytes, inputs=()) -> Path:
+    """Atomic write of raw bytes (the program keeps its encoding), refusing inputs."""
+    out = check_output(path, inputs)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, out)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return out
+
+
+def report_csv(model, reports) -> str:
+    unit = {a: ("deg" if a in model.rotary_axes else "mm") for a in model.axes}
+    cols = ["line", "status"] + [f"{a}_nominal_{unit[a]}" for a in model.axes] + \
+        [f"{a}_out_{unit[a]}" for a in model.axes] + \
+        ["dx_before_um", "dy_before_um", "dz_before_um", "e_before_um",
+         "dx_after_um", "dy_after_um", "dz_after_um", "e_after_um",
+         "orientation_before_urad", "orientation_after_urad", "iterations"]
+    rows = [",".join(cols)]
+
+    def f(v):
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.10g}"
+
+    for r in reports:
+        eb = math.sqrt(sum(v * v for v in r.before_um))
+        ea = math.sqrt(sum(v * v for v in r.after_um))
+        vals = [str(r.line), r.status.replace(",", ";")]
+        vals += [f(r.nominal[a]) for a in model.axes] + [f(r.output[a]) for a in model.axes]
+        vals += [f(v) for v in r.before_um] + [f(eb)] + [f(v) for v in r.after_um] + [f(ea)]
+        vals += [f(r.orientation_before_urad), f(r.orientation_after_urad), str(r.iterations)]
+        rows.append(",".join(vals))
+    return "\n".join(rows) + "\n"
+
+
+def run(args) -> int:
+    import sys
+
+    from volerr import gcode, tables
+    from volerr.compensate import compensate_program
+    from volerr.model import load
+
+    model = load(args.layout)
+    require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
+    funcs = tables.from_args(args, model)
+    text = gcode.read_program(args.program)
+    inputs = [args.program, *Path(args.errors).glob("*.csv")]
+    for out in (args.out, args.report, args.json, args.plot):
+        if out:
+            check_output(out, inputs)
+    result = compensate_program(
+        model, funcs, text, tool=args.tool, orientation=args.orientation,
+        strategy=args.strategy, tol_um=args.tol_um, decimals=args.decimals,
+        initial=_initial(args.initial), check_travel=not args.ignore_travel)
+    write_bytes(args.out, result.text.encode("latin-1"), inputs)
+    s = result.summary()
+    if args.report:
+        write_text(args.report, report_csv(model, result.reports), inputs)
+    if args.json:
+        write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
+                                          "orientation": bool(args.orientation), **s},
+                                         indent=2) + "\n", inputs)
+    if args.plot:
+        from volerr.plots_fiveaxis import plot_program_errors
+
+        plot_program_errors(result.reports, args.plot, title=f"{model.name}: {args.program}")
+    print(f"{model.name}: {s['compensated']} of {s['motion_blocks']} motion blocks compensated "
+          f"({args.strategy}{', orientation' if args.orientation else ''}); predicted tool-tip "
+          f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
+          f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
+    if model.rotary_axes:
+        print(f"tool-axis error max {s['max_orientation_before_urad']:.2f} -> "
+              f"{s['max_orientation_after_urad']:.2f} urad")
+    for nc in s["not_compensated"][:5]:
+        print(f"warning: line {nc['line']}: {nc['reason']}", file=sys.stderr)
+    if len(s["not_compensated"]) > 5:
+        print(f"warning: {len(s['not_compensated']) - 5} more blocks not compensated",
+              file=sys.stderr)
+    return 0
