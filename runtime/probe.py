@@ -88,22 +88,23 @@ def probe2machine(tilt_deg: float = 0.0, roll_deg: float = 0.0) -> np.ndarray:
     return _gen().probe2machine(math.radians(tilt_deg), math.radians(roll_deg))
 
 
-def angles_of(directions_machine, tilt_deg: float = 0.0, roll_deg: float = 0.0):
+def angles_of(directions_machine, tilt_deg=0.0, roll_deg=0.0):
     """Machine-frame directions, shape (n, 3) (any length) -> (phi_deg, theta_deg) in the
-    probe frame (eq. 14-16)."""
+    probe frame (eq. 14-16); tilt/roll scalars or (n,) arrays (deg)."""
     d = np.atleast_2d(np.asarray(directions_machine, dtype=float))
     gen = _gen()
-    mp = gen.direction_to_probe(math.radians(tilt_deg), math.radians(roll_deg),
+    mp = gen.direction_to_probe(np.radians(tilt_deg), np.radians(roll_deg),
                                 d[:, 0], d[:, 1], d[:, 2])
     phi, theta = gen.direction_angles(*mp)
     theta = np.degrees(theta)
     return np.degrees(phi), np.where(theta >= 360.0, theta - 360.0, theta)
 
 
-def directions_of(phi_deg, theta_deg, tilt_deg: float = 0.0, roll_deg: float = 0.0):
-    """Probe-frame angles (deg) -> machine-frame unit vectors, shape (n, 3)."""
+def directions_of(phi_deg, theta_deg, tilt_deg=0.0, roll_deg=0.0):
+    """Probe-frame angles (deg) -> machine-frame unit vectors, shape (n, 3); tilt/roll
+    scalars or arrays broadcasting with the angles (deg)."""
     gen = _gen()
-    m = gen.direction_to_machine(math.radians(tilt_deg), math.radians(roll_deg),
+    m = gen.direction_to_machine(np.radians(tilt_deg), np.radians(roll_deg),
                                  np.radians(np.asarray(phi_deg, dtype=float)),
                                  np.radians(np.asarray(theta_deg, dtype=float)))
     return np.stack(m, axis=-1)
@@ -382,9 +383,14 @@ class ProbeMap:
         require(len(self.coefficients) == (self.degree + 1) ** 2,
                 "coefficient count does not match the degree")
 
-    def oriented(self, tilt_deg: float, roll_deg: float) -> "ProbeMap":
-        """The same probe used with the head at tilt/roll (deg)."""
-        return replace(self, tilt_deg=float(tilt_deg), roll_deg=float(roll_deg))
+    def oriented(self, tilt_deg, roll_deg) -> "ProbeMap":
+        """The same probe used with the head at tilt/roll (deg): scalars, or (n,) arrays of
+        per-point head angles (e.g. a probe on a five-axis head) matching the directions."""
+        t = np.asarray(tilt_deg, dtype=float)
+        r = np.asarray(roll_deg, dtype=float)
+        require(np.all(np.isfinite(t)) and np.all(np.isfinite(r)), "tilt/roll must be finite")
+        return replace(self, tilt_deg=float(t) if t.ndim == 0 else t,
+                       roll_deg=float(r) if r.ndim == 0 else r)
 
     def with_outside(self, outside: str) -> "ProbeMap":
         return replace(self, outside=outside)
@@ -419,6 +425,9 @@ class ProbeMap:
         require(np.all(np.isfinite(d)), "probing directions contain NaN")
         norm = np.linalg.norm(d, axis=1)
         require(np.all(norm > 0), "a probing direction is the zero vector")
+        for v in (self.tilt_deg, self.roll_deg):
+            require(np.ndim(v) == 0 or np.shape(v) == (len(d),),
+                    f"per-point tilt/roll need one value per direction ({len(d)})")
         phi, theta = angles_of(d / norm[:, None], self.tilt_deg, self.roll_deg)
         return self.at(phi, theta)
 

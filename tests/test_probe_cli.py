@@ -169,8 +169,16 @@ def test_usage_errors(tmp_path, data, capsys):
     assert main(["probe-cal", "--plan", str(tmp_path / "p.csv"),
                  "--sphere-radius", str(R_S)]) == 2                             # no ball
     assert main(["probe-cal", str(path), "--sphere-radius", "abc", "--out", "x"]) == 2
-    err = capsys.readouterr().err
-    assert "Traceback" not in err
+    capsys.readouterr()
+    for extra, msg in ((["--degree", "30"], "--degree"), (["--degree", "10"], "coefficients"),
+                       (["--outlier-k", "-1"], "outlier"),
+                       (["--json", str(tmp_path / "m.csv")], "overwrite")):
+        code = main(["probe-cal", str(path), "--sphere-radius", str(R_S), "--out",
+                     str(tmp_path / "m.csv"), *extra])
+        err = capsys.readouterr().err
+        assert code == 2 and msg in err and err.count("\n") == 1, (extra, err)
+    assert main(["probe-cal", "--help"]) == 0
+    assert "Master-sphere" in capsys.readouterr().out
 
 
 def test_subprocess_entry_point(tmp_path, data):

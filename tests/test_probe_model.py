@@ -128,3 +128,23 @@ def test_measurement_with_pretravel(calibration):
     # without the probe term the normal error would be off by the lobing (several um)
     plain = np.sum((err - geo) * m, axis=1)
     assert np.sqrt(np.mean(plain ** 2)) > 2e-3
+
+
+def test_per_point_head_angles(calibration):
+    """A head that changes tilt/roll from point to point: same as one orientation at a time."""
+    rng = np.random.default_rng(3)
+    a = rng.uniform(5, 90, 25)
+    b = rng.uniform(-180, 180, 25)
+    v = rng.normal(size=(25, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 0.2                      # probe-frame directions, phi < 90
+    v /= np.linalg.norm(v, axis=1)[:, None]
+    d = np.stack([frame(ai, bi) @ vi for ai, bi, vi in zip(a, b, v)])
+    many = calibration.map.oriented(a, b)(d)
+    one = [calibration.map.oriented(ai, bi)(di[None, :])[0] for ai, bi, di in zip(a, b, d)]
+    np.testing.assert_allclose(many, one, atol=1e-15)
+    model = volerr.load("MB1")
+    pos = np.zeros((25, 3))
+    out = model.volumetric_error(pos, {}, direction=d, probe_error=calibration.map.oriented(a, b))
+    np.testing.assert_allclose(out, -many[:, None] * d, atol=1e-15)
+    with pytest.raises(volerr.InputError, match="one value per direction"):
+        calibration.map.oriented(a[:3], b[:3])(d)

@@ -112,6 +112,13 @@ def run(args) -> int:
     require(math.isfinite(args.sphere_radius) and args.sphere_radius > 0,
             f"--sphere-radius must be a positive length in mm, got {args.sphere_radius}")
     inputs = [args.data]
+    from volerr.fileio import check_output
+
+    outputs = [o for o in (args.out, args.json, args.plot) if o]
+    for i, o in enumerate(outputs):
+        check_output(o, inputs + outputs[:i])
+    require(args.degree is None or 0 <= args.degree <= 20,
+            f"--degree must be between 0 and 20, got {args.degree}")
     data = probe.read_sphere_csv(args.data)
     cal = probe.calibrate_data(data, args.sphere_radius, tilt_deg=args.tilt_deg,
                                roll_deg=args.roll_deg, degree=args.degree,
@@ -121,7 +128,6 @@ def run(args) -> int:
     if args.json:
         write_text(args.json, json.dumps(summary, indent=2) + "\n", inputs=inputs + [args.out])
     if args.plot:
-        from volerr.fileio import check_output
         from volerr.plots_probe import plot_probe_calibration
 
         plot_probe_calibration(cal, check_output(args.plot, inputs + [args.out]))
