@@ -637,6 +637,10 @@ def _chain_L(eq: dict, by_id: dict) -> tuple[dict, str]:
     return L, "; ".join(notes) + where
 
 
+def _vec(exprs) -> str:
+    return "[" + ", ".join(f"{c} = {fmt(e)}" for c, e in zip(COMPONENTS, exprs)) + "]"
+
+
 def _key(exprs) -> tuple:
     return tuple(sp.expand(e) for e in exprs)
 
@@ -669,8 +673,16 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
         except (ValueError, TypeError, sp.SympifyError):
             continue
         found.append((rname, cost, res, index.get(res)))
-    literal = found[0][2]
     ev = [note + "."] if note else []
+    if not found or found[0][1] != 0:
+        try:
+            chain_error(eq["lhs"], eq["rhs"], L)
+            why = "no result"
+        except (ValueError, TypeError, sp.SympifyError) as exc:
+            why = str(exc)
+        return [Verdict(SOURCE, eq["id"], name, "differs", "printed chain cannot be evaluated",
+                        f"{why}. " + " ".join(ev), text, _vec(physical))]
+    literal = found[0][2]
     if printed_result is not None:
         k = sum(n_diff(a, b) for a, b in zip(literal, printed_result))
         ev.append(f"The printed chain {'reproduces' if k == 0 else 'does not reproduce'} the "
@@ -682,7 +694,7 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
     if all(is_identical(a, b) for a, b in zip(physical, literal)):
         return [Verdict(SOURCE, eq["id"], name, "identical", "", "The printed chain's "
                         "first-order error equals the derived model of the physical layout. "
-                        + " ".join(ev), text, fmt(sp.Matrix(physical).T))]
+                        + " ".join(ev), text, _vec(physical))]
     diffs = [f"{c}: {describe_diff(physical[i], literal[i])}" for i, c in enumerate(COMPONENTS)
              if not is_identical(physical[i], literal[i])]
     ev.insert(0, "The printed chain's first-order error differs from the physical layout's "
@@ -717,7 +729,7 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
             ev.append(f"The chain {f[0]} gives the layout's model read as: "
                       f"{f[3].describe(lay)}.")
     return [Verdict(SOURCE, eq["id"], name, "differs", erratum, " ".join(ev),
-                    f"{text}  =>  {fmt(sp.Matrix(literal).T)}", fmt(sp.Matrix(physical).T))]
+                    f"{text}  =>  {_vec(literal)}", _vec(physical))]
 
 
 # ------------------------------------------------------------------------------ entry

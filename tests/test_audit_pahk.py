@@ -225,3 +225,12 @@ def test_cli_bad_input(tmp_path):
     before = Path(str(data)).read_bytes()
     assert_clean_failure(run("MB1", "--json", str(data)), "refusing to overwrite")
     assert Path(str(data)).read_bytes() == before
+
+
+def test_literal_eq3_lz_without_ocr_reading_is_not_a_valid_chain():
+    data = copy.deepcopy(DATA)
+    eq1 = next(e for e in data["equation"] if e["id"] == "1")
+    eq1["ocr"].pop("L.z")                  # 'dx(Z) - Z' taken literally: a -Z nominal offset
+    v = find(audit_pahk.audit(data, ["MB1"]), "1")
+    assert v.verdict == "differs" and "cannot be evaluated" in v.erratum
+    assert "nominal point" in v.evidence
