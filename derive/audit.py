@@ -87,6 +87,11 @@ def n_diff(derived, printed) -> int:
     return len(terms(derived - printed))
 
 
+def n_issues(expected, printed) -> int:
+    """Number of distinct defects (an exchanged symbol counts once, not as two terms)."""
+    return sum(len(v) for v in term_diff(expected, printed).values())
+
+
 def fmt(expr) -> str:
     """A compact string of an expression (symbols print as the paper writes them)."""
     return sp.sstr(expr, order="lex")

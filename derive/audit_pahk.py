@@ -38,7 +38,7 @@ import sympy as sp
 from volerr.layout import SQUARENESS, read_layout
 
 from . import volumetric as vol
-from .audit import Verdict, describe_diff, fmt, is_identical, n_diff
+from .audit import Verdict, describe_diff, fmt, is_identical, n_diff, n_issues
 from .kinematics import PROBE, Chain, parameter_symbol, position_symbol
 
 SOURCE = "Pahk 1995"
@@ -240,7 +240,7 @@ def _search(name: str, printed: list) -> tuple[Reading, list, int]:
     best = None
     for r in readings(name):
         d = derived_error(name, r)
-        score = sum(n_diff(a, b) for a, b in zip(d, printed))
+        score = sum(n_issues(a, b) for a, b in zip(d, printed))
         if best is None or score < best[2]:
             best = (r, d, score)
         if score == 0:
@@ -391,10 +391,11 @@ class RuleReading:
     flips: tuple = ()
     rule1: bool = False
     line: str = "both"
+    zero: tuple = ()
 
     def cost(self) -> int:
         return (self.pivot != "tool_point") + len(self.flips) + self.rule1 + \
-            (self.line != "both")
+            (self.line != "both") + len(self.zero)
 
     def describe(self, layout, iso) -> str:
         parts = []
@@ -411,6 +412,9 @@ class RuleReading:
             other = a if self.line == b else b
             parts.append(f"squareness from the slope of the {self.line} line alone (the "
                          f"{other} line's tilt at the measuring position ignored)")
+        if self.zero:
+            parts.append("only if " + " = ".join(self.zero) + " = 0 (the rule ignores the Abbe "
+                         "terms of that offset, as if the measuring line had no such offset)")
         if self.pivot == "table_origin":
             parts.append("table errors about the moving table origin")
         for f in self.flips:
@@ -441,6 +445,8 @@ def derived_rule(name: str, key: str, r: RuleReading = RuleReading()):
             shift = sum((t for t in sp.Add.make_args(shift)
                          if all(keep(s) for s in t.free_symbols if s.name[:1] == "E")),
                         sp.Integer(0))
+        if r.zero:
+            shift = shift.subs({o: 0 for o in OFFSETS if o.name in r.zero})
     m = paper_map(lay, r.flips)
     iso_sym = parameter_symbol(iso)
     ref_iso = iso_sym - shift                      # reference = measured - shift (ISO)
@@ -454,9 +460,12 @@ def rule_readings(name: str, flips: tuple) -> list[RuleReading]:
     single = [(f,) for f in sorted(lay.squareness) + list(lay.workpiece_chain)]
     flipsets = [()] + ([flips] if flips else []) + [f for f in single if f != flips]
     lines = ["both", "X", "Y", "Z"]
-    out = [RuleReading(p, f, r1, ln) for p in pivots for f in flipsets for r1 in (False, True)
-           for ln in lines]
-    return sorted(out, key=lambda r: (r.cost(), repr(r)))
+    offs = [o.name for o in OFFSETS]
+    zeros = [z for k in range(4) for z in itertools.combinations(offs, k)]
+    out = [RuleReading(p, f, r1, ln, z) for p in pivots for f in flipsets
+           for r1 in (False, True) for ln in lines for z in zeros]
+    # Pahk's own rule (1) and the squareness readings before assumed zero offsets
+    return sorted(out, key=lambda r: (r.cost(), len(r.zero), repr(r)))
 
 
 def audit_transfer(eq: dict, flips: tuple) -> list[Verdict]:
@@ -470,7 +479,8 @@ def audit_transfer(eq: dict, flips: tuple) -> list[Verdict]:
         rr = [r for r in rule_readings(name, flips)
               if (iso in SQUARENESS or r.line == "both")
               and (iso not in SQUARENESS or not r.rule1)
-              and (r.line == "both" or r.line in _LINES.get(iso, ()))]
+              and (r.line == "both" or r.line in _LINES.get(iso, ()))
+              and (iso not in SQUARENESS or not r.zero)]
         d0 = derived_rule(name, key)
         label = f"{key}"
         if is_identical(d0, pr):
@@ -484,7 +494,7 @@ def audit_transfer(eq: dict, flips: tuple) -> list[Verdict]:
         best = None
         for r in rr:
             d = derived_rule(name, key, r)
-            k = n_diff(d, pr)
+            k = n_issues(d, pr)
             if best is None or k < best[1]:
                 best = (r, k, d)
             if k == 0:
