@@ -13,7 +13,8 @@ def _grid(cal, n_phi: int = 61, n_theta: int = 121):
     phi = np.linspace(lo, hi, n_phi)
     theta = np.linspace(0.0, 360.0, n_theta)
     pp, tt = np.meshgrid(phi, theta, indexing="ij")
-    return pp, tt, cal.map.at(pp, tt) * 1e3
+    val = cal.map.with_outside("extrapolate").at(pp, tt) * 1e3
+    return pp, tt, np.ma.masked_where(~cal.map.covered(pp, tt), val)
 
 
 def _norm(values):
@@ -70,7 +71,8 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
     stem from the reference sphere."""
     import matplotlib.pyplot as plt
 
-    pp, tt, val = _grid(cal, 37, 73)
+    pp, tt, masked = _grid(cal, 37, 73)
+    val = masked.filled(0.0)          # uncalibrated directions: reference sphere, grey
     pts_um = cal.probe * 1e3
     vmax = max(float(np.max(np.abs(val))), float(np.max(np.abs(pts_um))), 1e-6)
     gain = gain if gain is not None else 0.2 / vmax
@@ -79,7 +81,9 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
     x, y, z = r * np.sin(ph) * np.cos(th), r * np.sin(ph) * np.sin(th), r * np.cos(ph)
     norm = _norm(np.concatenate([val.ravel(), pts_um]))
     cmap = plt.get_cmap("RdBu_r")
-    ax.plot_surface(x, y, z, facecolors=cmap(norm(val)), rstride=1, cstride=1,
+    colors = cmap(norm(val))
+    colors[np.ma.getmaskarray(masked)] = (0.85, 0.85, 0.85, 0.4)
+    ax.plot_surface(x, y, z, facecolors=colors, rstride=1, cstride=1,
                     linewidth=0.2, edgecolor=(0, 0, 0, 0.15), antialiased=True, shade=False)
     p, t = np.radians(cal.phi_deg), np.radians(cal.theta_deg)
     u = np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=1)
@@ -110,8 +114,10 @@ def draw_2d(fig, ax, cal) -> None:
     each point as coloured markers (flagged outliers crossed)."""
     pp, tt, val = _grid(cal)
     pts_um = cal.probe * 1e3
-    norm = _norm(np.concatenate([val.ravel(), pts_um]))
-    mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm, shading="gouraud")
+    norm = _norm(np.concatenate([val.compressed(), pts_um]))
+    holes = bool(np.ma.getmaskarray(val).any())
+    mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm,
+                         shading="nearest" if holes else "gouraud")
     cs = ax.contour(tt, pp, val, levels=11, colors="k", linewidths=0.5)
     ax.clabel(cs, fmt="%.1f", fontsize=7)
     ax.scatter(cal.theta_deg, cal.phi_deg, c=pts_um, cmap="RdBu_r", norm=norm, s=28,

@@ -283,7 +283,16 @@ class SHFit:
     fitted: np.ndarray
     gcv: float
     dof: float
-    hat: np.ndarray
+    hat: np.ndarray      # w_i q_i: diagonal of the (weighted) hat matrix
+    q: np.ndarray        # x_i' A^-1 x_i
+    weights: np.ndarray
+
+    def loo_t(self, values, sigma: float = 1.0) -> np.ndarray:
+        """Leave-one-out prediction residuals over their standard deviation: residual
+        r / (1 - w q) over sigma sqrt(1 + q / (1 - w q)) (Sherman-Morrison), so that a point
+        already down-weighted to zero is judged like any other."""
+        one = np.clip(1.0 - self.weights * self.q, 1e-9, None)
+        return (values - self.fitted) / one / (sigma * np.sqrt(1.0 + self.q / one))
 
     def __call__(self, phi, theta) -> np.ndarray:
         return sh_design(self.degree, phi, theta) @ self.coefficients
@@ -301,34 +310,32 @@ def _ridge_fit(degree: int, phi, theta, values, weights=None, ridge: float = RID
     lam = ridge * np.trace(xtx) / p
     a = xtx + lam * np.diag(ll * (ll + 1))
     coef = np.linalg.solve(a, xw.T @ values)
-    hat_diag = np.einsum("ij,ji->i", xw, np.linalg.solve(a, x.T))
+    q = np.einsum("ij,ji->i", x, np.linalg.solve(a, x.T))  # x_i' A^-1 x_i
+    hat_diag = wts * q
     fitted = x @ coef
     res = values - fitted
     dof = float(hat_diag.sum())
     gcv = n * float(res @ (wts * res)) / max(n - dof, 1e-9) ** 2
-    return SHFit(degree, coef, fitted, gcv, dof, hat_diag)
+    return SHFit(degree, coef, fitted, gcv, dof, hat_diag, q, wts)
 
 
 def robust_flags(degree: int, phi, theta, values, k: float = OUTLIER_K, iterations: int = 50):
     """Outlier flags from a Tukey-bisquare (IRLS) fit of the map: a point is flagged when its
-    studentised residual r / sqrt(1 - h) exceeds ``k`` sigma.  Sigma is 1.4826 MAD of the
-    studentised residuals of the plain fit (floored at :data:`SCALE_FLOOR_MM`), held fixed
-    while the weights iterate.  Returns (flags, sigma_mm)."""
+    leave-one-out residual exceeds ``k`` of its standard deviations (:meth:`SHFit.loo_t`).
+    Sigma is 1.4826 MAD of the studentised residuals of the plain fit (floored at
+    :data:`SCALE_FLOOR_MM`), held fixed while the weights iterate.  Returns (flags, sigma)."""
+    f = _ridge_fit(degree, phi, theta, values)
+    t = f.loo_t(values)
+    sigma = max(1.4826 * float(np.median(np.abs(t - np.median(t)))), SCALE_FLOOR_MM)
     w = np.ones(len(values))
-    sigma = None
-    stud = np.zeros(len(values))
     for _ in range(iterations):
-        f = _ridge_fit(degree, phi, theta, values, w)
-        stud = (values - f.fitted) / np.sqrt(np.clip(1.0 - f.hat, 1e-6, None))
-        if sigma is None:
-            sigma = max(1.4826 * float(np.median(np.abs(stud - np.median(stud)))),
-                        SCALE_FLOOR_MM)
-        u = stud / (4.685 * sigma)
+        u = f.loo_t(values, sigma) / 4.685
         w_new = np.where(np.abs(u) < 1.0, (1.0 - u ** 2) ** 2, 0.0)
         if np.max(np.abs(w_new - w)) < 1e-6:
             break
         w = w_new
-    return np.abs(stud) > k * sigma, sigma
+        f = _ridge_fit(degree, phi, theta, values, w)
+    return np.abs(f.loo_t(values, sigma)) > k, sigma
 
 
 def max_degree_for(n_points: int) -> int:
@@ -356,6 +363,24 @@ def fit_sh(phi, theta, values, degree: int | None = None) -> SHFit:
 
 
 # ---- the probe error map ------------------------------------------------------------------
+def _unit_of(phi_deg, theta_deg) -> np.ndarray:
+    p, t = np.radians(phi_deg), np.radians(theta_deg)
+    return np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=-1)
+
+
+def coverage_of(phi_deg, theta_deg) -> float:
+    """Coverage radius of probed directions, deg: 1.5 x the largest nearest-neighbour angle
+    (at least 5 deg)."""
+    u = _unit_of(phi_deg, theta_deg)
+    if len(u) < 2:
+        return 5.0
+    dots = u @ u.T
+    np.fill_diagonal(dots, -2.0)
+    nn = np.degrees(np.arccos(np.clip(dots.max(axis=1), -1.0, 1.0)))
+    return float(max(1.5 * nn.max(), 5.0))
+
+
+
 @dataclass
 class ProbeMap:
     """Smooth probe error Probe(phi, theta) (mm) of a probe, in its own frame.
@@ -365,9 +390,12 @@ class ProbeMap:
     ``tilt_deg`` and roll ``roll_deg`` (eq. 14-16) and returns Probe in mm, shape (n,).  It is
     the ``probe_error`` argument of :meth:`volerr.Model.volumetric_error` (eq. 17).
 
-    ``outside``: what to do with directions whose phi lies beyond the probed range
-    ``phi_range_deg`` (+- 2 deg): ``"raise"`` (InputError), ``"clamp"`` (evaluate at the nearest
-    probed phi, same theta) or ``"extrapolate"`` (evaluate the harmonics as they are)."""
+    Coverage: a direction is *outside* when its phi lies beyond the probed range
+    ``phi_range_deg`` (+- 2 deg), or when it is farther than ``coverage_deg`` from every probed
+    direction ``support_deg`` (a hole in the plan, e.g. azimuths never probed).
+    ``outside``: ``"raise"`` (InputError), ``"clamp"`` (phi clamped into the probed range, then
+    a direction still in a hole takes the value of the nearest probed direction) or
+    ``"extrapolate"`` (evaluate the harmonics as they are)."""
 
     degree: int
     coefficients: np.ndarray  # mm
@@ -375,6 +403,8 @@ class ProbeMap:
     tilt_deg: float = 0.0
     roll_deg: float = 0.0
     outside: str = "raise"
+    support_deg: np.ndarray | None = None   # (n, 2) probed (phi, theta), deg
+    coverage_deg: float = 180.0
 
     def __post_init__(self):
         require(self.outside in ("raise", "clamp", "extrapolate"),
@@ -382,6 +412,33 @@ class ProbeMap:
         self.coefficients = np.asarray(self.coefficients, dtype=float)
         require(len(self.coefficients) == (self.degree + 1) ** 2,
                 "coefficient count does not match the degree")
+        if self.support_deg is not None:
+            self.support_deg = np.asarray(self.support_deg, dtype=float).reshape(-1, 2)
+            self._support_u = _unit_of(self.support_deg[:, 0], self.support_deg[:, 1])
+
+    def covered(self, phi_deg, theta_deg) -> np.ndarray:
+        """Boolean mask: probe-frame angles (deg) inside the calibrated coverage."""
+        phi = np.asarray(phi_deg, dtype=float)
+        theta = np.asarray(theta_deg, dtype=float)
+        shape = np.broadcast_shapes(phi.shape, theta.shape)
+        phi = np.broadcast_to(phi, shape).ravel()
+        theta = np.broadcast_to(theta, shape).ravel()
+        lo, hi = self.phi_range_deg
+        ok = (phi >= lo - COVERAGE_TOL_DEG) & (phi <= hi + COVERAGE_TOL_DEG)
+        if self.support_deg is not None and len(phi):
+            ok &= self._nearest(np.clip(phi, lo, hi), theta)[0] <= self.coverage_deg
+        return ok.reshape(shape)
+
+    def _nearest(self, phi, theta):
+        """(angle to the nearest probed direction in deg, its index) for each query."""
+        u = _unit_of(phi, theta)
+        best = np.empty(len(u))
+        idx = np.empty(len(u), dtype=int)
+        for s in range(0, len(u), 20000):
+            dots = u[s:s + 20000] @ self._support_u.T
+            idx[s:s + 20000] = np.argmax(dots, axis=1)
+            best[s:s + 20000] = np.max(dots, axis=1)
+        return np.degrees(np.arccos(np.clip(best, -1.0, 1.0))), idx
 
     def oriented(self, tilt_deg, roll_deg) -> "ProbeMap":
         """The same probe used with the head at tilt/roll (deg): scalars, or (n,) arrays of
@@ -405,16 +462,27 @@ class ProbeMap:
         require(np.all(np.isfinite(phi)) and np.all(np.isfinite(theta)),
                 "probe directions contain NaN")
         lo, hi = self.phi_range_deg
-        out = (phi < lo - COVERAGE_TOL_DEG) | (phi > hi + COVERAGE_TOL_DEG)
-        if out.any():
-            if self.outside == "raise":
+        if self.outside != "extrapolate":
+            out = (phi < lo - COVERAGE_TOL_DEG) | (phi > hi + COVERAGE_TOL_DEG)
+            if out.any() and self.outside == "raise":
                 k = int(np.argmax(out))
                 raise InputError(
                     f"probing direction phi = {phi[k]:.1f} deg (theta {theta[k]:.1f}) lies "
                     f"outside the calibrated range phi {lo:.0f}..{hi:.0f} deg; calibrate "
                     f"there or use outside='clamp'")
-            if self.outside == "clamp":
-                phi = np.clip(phi, lo, hi)
+            phi = np.clip(phi, lo, hi)
+            if self.support_deg is not None and len(phi):
+                gap, idx = self._nearest(phi, theta)
+                hole = gap > self.coverage_deg
+                if hole.any() and self.outside == "raise":
+                    k = int(np.argmax(hole))
+                    raise InputError(
+                        f"probing direction phi = {phi[k]:.1f} deg, theta {theta[k]:.1f} deg "
+                        f"is {gap[k]:.0f} deg from the nearest probed direction (coverage "
+                        f"{self.coverage_deg:.0f} deg): not calibrated there; use "
+                        f"outside='clamp'")
+                phi = np.where(hole, self.support_deg[idx, 0], phi)
+                theta = np.where(hole, self.support_deg[idx, 1], theta)
         return (sh_design(self.degree, np.radians(phi), np.radians(theta))
                 @ self.coefficients).reshape(shape)
 
@@ -486,6 +554,9 @@ class ProbeCalibration:
                 "kind": "real spherical harmonics, orthonormal, l <= degree, m = -l..l",
                 "degree": int(self.map.degree),
                 "coefficients_um": [float(v) * 1e3 for v in self.map.coefficients],
+                "coverage_deg": float(self.map.coverage_deg),
+                "support_deg": [[round(float(p), 6), round(float(t), 6)]
+                                for p, t in self.map.support_deg],
                 "residual_rms_um": float(math.sqrt(np.mean(
                     (self.probe[self.used] - self.map_fitted[self.used]) ** 2)) * 1e3),
             },
@@ -594,9 +665,11 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
         phi, theta = phi_m, theta_m
         source = "fitted centre"
     sh = fit_sh(np.radians(phi[used]), np.radians(theta[used]), probe[used], degree)
+    support = np.column_stack([phi[used], theta[used]])
     pmap = ProbeMap(sh.degree, sh.coefficients,
                     (float(phi[used].min()), float(phi[used].max())),
-                    float(tilt_deg), float(roll_deg))
+                    float(tilt_deg), float(roll_deg), support_deg=support,
+                    coverage_deg=coverage_of(phi[used], theta[used]))
     fitted = sh(np.radians(phi), np.radians(theta))
     flag_used, sigma = robust_flags(sh.degree, np.radians(phi[used]), np.radians(theta[used]),
                                     probe[used], outlier_k)
@@ -658,7 +731,7 @@ def probe_map_from_json(source, tilt_deg: float | None = None, roll_deg: float |
                         tuple(float(v) for v in source["phi_range_deg"]),
                         float(source.get("tilt_deg", 0.0) if tilt_deg is None else tilt_deg),
                         float(source.get("roll_deg", 0.0) if roll_deg is None else roll_deg),
-                        outside)
+                        outside, m.get("support_deg"), float(m.get("coverage_deg", 180.0)))
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"not a probe-cal report: missing or bad {exc}") from None
 
@@ -689,4 +762,5 @@ def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
     sh = fit_sh(np.radians(arr[:, 0]), np.radians(arr[:, 1]), arr[:, 2] * 1e-3, degree)
     return ProbeMap(sh.degree, sh.coefficients,
                     (float(arr[:, 0].min()), float(arr[:, 0].max())),
-                    float(tilt_deg), float(roll_deg), outside)
+                    float(tilt_deg), float(roll_deg), outside, arr[:, :2],
+                    coverage_of(arr[:, 0], arr[:, 1]))

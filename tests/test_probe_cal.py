@@ -247,3 +247,37 @@ def test_type_a_uncertainty_matches_scatter():
     assert np.all((0.7 < u_c / sd_c) & (u_c / sd_c < 1.6)), (u_c, sd_c)
     assert 0.7 < u_r / sd_r < 1.6
     assert 0.4e-3 < np.mean([r.noise for r in runs]) < 0.65e-3   # radial noise 0.5 um
+
+
+def test_map_hole_in_azimuth():
+    """Half of the azimuths never probed: directions there are refused, or clamped to the
+    nearest probed direction."""
+    plan = pp.pahk_plan()
+    keep = (plan.theta_deg < 180) | (plan.phi_deg == 0)
+    half = pp.Plan(plan.phi_deg[keep], plan.theta_deg[keep])
+    pts = pp.simulate_probing(half, C0, R_S, R_BALL, noise_mm=0.1e-3, rng=3)
+    cal = probe.calibrate(pts, R_S)
+    assert cal.map.coverage_deg == pytest.approx(27.0, abs=0.5)   # 1.5 x 18 deg spacing
+    inside = probe.directions_of([60.0], [90.0])
+    cal.map(inside)                                             # fine
+    hole = probe.directions_of([60.0], [270.0])
+    with pytest.raises(InputError, match="nearest probed direction"):
+        cal.map(hole)
+    clamped = cal.map.with_outside("clamp")(hole)
+    u = half.directions()
+    k = int(np.argmax(u @ hole[0]))
+    np.testing.assert_allclose(clamped, cal.map.at(cal.phi_deg[k], cal.theta_deg[k]))
+
+
+def test_plot_with_uncalibrated_hole(tmp_path):
+    from volerr.plots_probe import plot_probe_map_2d
+
+    plan = pp.pahk_plan()
+    keep = (plan.theta_deg < 180) | (plan.phi_deg == 0)
+    pts = pp.simulate_probing(pp.Plan(plan.phi_deg[keep], plan.theta_deg[keep]), C0, R_S,
+                              R_BALL, noise_mm=0.1e-3, rng=3)
+    cal = probe.calibrate(pts, R_S)
+    grid = cal.map.covered(*np.meshgrid([30.0, 60.0], [90.0, 270.0]))
+    assert grid[0].all() and not grid[1].any()
+    out = plot_probe_map_2d(cal, tmp_path / "half.png")
+    assert out.read_bytes()[:4] == b"\x89PNG"
