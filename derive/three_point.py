@@ -116,12 +116,14 @@ def closed_form(selection: str) -> dict:
     Returns ``{"EX": expr, ..., "EC": expr, "N": determinant}``: each motion as a function of
     the lever arms and the six selected deviations (Cramer's rule, factored)."""
     A, b = selected_system(selection)
-    det = sp.factor(A.det())
+    det = sp.factor(A.det(method="berkowitz"))
     out = {}
     for j, name in enumerate(MOTIONS):
         Aj = sp.Matrix(A)
         Aj[:, j] = b
-        out[name] = sp.factor(sp.expand(Aj.det())) / det
+        num = sp.expand(Aj.det(method="berkowitz"))
+        # cancel the common polynomial factors of numerator and determinant
+        out[name] = sp.cancel(num / sp.expand(det))
     out["N"] = det
     return out
 

@@ -1,0 +1,481 @@
+"""Audit of the three-point identification equations of Ellingsdalen (2021) (sympy, no I/O).
+
+The printed equations come as the parsed ``volerr/data/printed_tracker.toml`` (its header gives
+the symbol mapping).  The authority is :mod:`volerr.derive.three_point`: the small-angle
+displacement of a point fixed on the moving body (``(I + D) r - r`` with the error twist of
+:mod:`volerr.derive.kinematics`), the ``3n x 6`` system, and the Zhang & Hu closed forms solved
+by Cramer's rule.
+
+Checks per printed item
+
+* displacement (eq. 30, 3.4): each row, right-hand side (``expand`` / trigonometric
+  simplification of derived - printed) and left-hand side (measured - nominal position);
+* systems (eq. 31, 32, 35, 36, 37, 3.5, 3.6): the coefficient rows (each against the derived
+  row of the equation its right-hand side names), the number of rows (9 or 6, duplicates), the
+  unknown vector, the right-hand side entries, and for a selected system its determinant;
+* closed forms (eq. 33-34, 3.7-3.8, the appendix Z-axis solution): every motion with the
+  printed M and N substituted, ``cancel(derived - printed) == 0``; the appendix solution is in
+  raw coordinates (``d_xP = x'_Pt - x_zP - x_o`` ...);
+* denominators (appendix): equal to the derived ones up to a constant factor.
+
+For a closed form that differs, the audit searches the *readings* that reproduce the derived
+result exactly: one printed symbol replaced by another lever-arm symbol, or the sign between
+the two triple products of N restored (eq. 3.8 prints a product); the first that works names
+the erratum.  Identities of rational functions are decided by exact rational evaluation at random points
+(:func:`_equal`); polynomial rows and displacements by ``expand``.
+"""
+
+from __future__ import annotations
+
+import random
+from functools import lru_cache
+
+import sympy as sp
+
+from .audit import Verdict, describe_diff, fmt
+from .three_point import (COORDS, MOTIONS, SELECTIONS, closed_form, point_displacement,
+                          point_symbols, rotated_lever_arm, system)
+
+SOURCE = "Ellingsdalen 2021"
+DATA_FILE = "printed_tracker.toml"
+LAYOUTS = ("DMU50",)
+LAYOUT = "DMU50"
+LABELS = ("P", "Q", "K")
+C = sp.Symbol("C", real=True)
+
+
+def S(name: str) -> sp.Symbol:
+    return sp.Symbol(name, real=True)
+
+
+def _locals(axis: str) -> dict:
+    loc = {"C": C, "cos": sp.cos, "sin": sp.sin}
+    for lab in LABELS:
+        for c in COORDS:
+            for pre in ("", "h", "m"):
+                n = f"{c}{pre}_{lab}"
+                loc[n] = S(n)
+            loc[f"d_{c}{lab}"] = S(f"d_{c}{lab}")
+    for c in COORDS:
+        loc[f"{c}_o"] = S(f"{c}_o")
+        loc[c] = S(c)
+    for m in MOTIONS:
+        loc[m + axis] = S(m + axis)
+    for n in ("M", "N"):
+        loc[n] = S(n)
+    return loc
+
+
+def parse(text: str, axis: str) -> sp.Expr:
+    """A printed expression in the data file's notation -> sympy (ValueError if garbled)."""
+    loc = _locals(axis)
+    try:
+        expr = sp.parse_expr(text, local_dict=loc)
+    except Exception as exc:  # noqa: BLE001 - any parse failure means "garbled"
+        raise ValueError(f"unparsable {text!r}: {exc}") from None
+    unknown = [s for s in expr.free_symbols if s not in set(loc.values())]
+    if unknown:
+        raise ValueError(f"unknown symbol {unknown[0]} in {text!r}")
+    return expr
+
+
+def _hat(expr):
+    """Lever-arm symbols x_P, y_P -> the rotated ones xh_P, yh_P (z unchanged)."""
+    return expr.subs({S(f"{c}_{lab}"): S(f"{c}h_{lab}") for lab in LABELS for c in "xy"},
+                     simultaneous=True)
+
+
+def _motion_map(axis: str) -> dict:
+    return {S(m): S(m + axis) for m in MOTIONS}
+
+
+def _deviation(label: str, coord: str, axis: str, rotated: bool = False) -> sp.Expr:
+    """Derived deviation of point ``label`` along ``coord``: measured - nominal position."""
+    m = S(f"{coord}m_{label}")
+    o = S(f"{coord}_o")
+    if rotated:
+        r = rotated_lever_arm(point_symbols(label), (0, 0, 1), C)
+        return m - r[COORDS.index(coord)] - o
+    nominal = S(f"{coord}_{label}") + o
+    if coord == axis.lower():
+        nominal += S(coord)
+    return m - nominal
+
+
+# ----------------------------------------------------------------------- exact screening
+_RNG = random.Random(20210601)
+
+
+def _samples(symbols, n: int) -> list[dict]:
+    return [{s: sp.Rational(_RNG.randint(-99991, 99991), _RNG.randint(101, 997))
+             for s in sorted(symbols, key=str)} for _ in range(n)]
+
+
+def _equal(a, b, n: int = 8) -> bool:
+    """Identity of two rational functions by exact rational evaluation at ``n`` random points
+    (Schwartz-Zippel: for the low-degree polynomials here a false "identical" has probability
+    far below 1e-20); points where a denominator vanishes are skipped."""
+    d = a - b
+    hits = 0
+    for point in _samples(d.free_symbols, 3 * n):
+        v = d.xreplace(point)
+        if v.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+            continue
+        if v != 0:
+            return False
+        hits += 1
+        if hits == n:
+            return True
+    return False
+
+
+@lru_cache(maxsize=None)
+def _closed(selection: str) -> dict:
+    return closed_form(selection)
+
+
+def _verdict(eq, comp, ok, erratum, evidence, printed, derived) -> Verdict:
+    return Verdict(SOURCE, f"eq. {eq['id']}" if eq["id"][0].isdigit() else eq["id"], LAYOUT,
+                   "identical" if ok else "differs", "" if ok else erratum, evidence,
+                   printed if isinstance(printed, str) else fmt(printed),
+                   derived if isinstance(derived, str) else fmt(derived), comp)
+
+
+# ------------------------------------------------------------------------- displacement
+def audit_displacement(eq: dict) -> list[Verdict]:
+    axis = eq["axis"]
+    rotated = axis in "ABC"
+    r = point_symbols("P")
+    lever = rotated_lever_arm(r, (0, 0, 1), C) if rotated else sp.Matrix(r)
+    disp = point_displacement(lever).subs(_motion_map(axis))
+    out = []
+    for i, c in enumerate(COORDS):
+        pr = parse(eq["expr"][c], axis)
+        de = sp.expand(disp[i])
+        diff = sp.simplify(sp.expand_trig(de - pr))
+        if diff == 0:
+            out.append(_verdict(eq, f"Delta_{c} right-hand side", True, "",
+                                "expand(derived - printed) == 0: derived as (I + D) r - r with "
+                                "the error twist D of the six motions"
+                                + (", r = Rz(C) r_P (eq. 3.2)" if rotated else ""),
+                                eq["expr"][c], de))
+        else:
+            named = describe_diff(de, sp.expand(pr))
+            out.append(_verdict(
+                eq, f"Delta_{c} right-hand side", False,
+                f"row {c}: {named}",
+                f"the derived row is {fmt(sp.collect(de, list(r)))}; the printed row differs by "
+                f"{fmt(sp.collect(sp.expand(pr - de), list(r)))} (derived - printed = "
+                f"{fmt(diff)}). The printed coefficient of x_P, {fmt(sp.expand(pr).coeff(r[0]))}"
+                f", is not the z-row of e x r_hat = EAC*yh - EBC*xh with xh = x cos C - y sin "
+                f"C, yh = x sin C + y cos C." if rotated else
+                f"derived - printed = {fmt(diff)}", eq["expr"][c], de))
+        lhs = parse(eq["lhs"][c], axis)
+        dl = _deviation("P", c, axis, rotated)
+        ok = sp.simplify(sp.expand(dl - lhs)) == 0
+        out.append(_verdict(eq, f"Delta_{c} left-hand side", ok,
+                            f"row {c}: measured - nominal printed as {eq['lhs'][c]}",
+                            "measured minus nominal position of P"
+                            + (" (nominal: Rz(C) r_P + o)" if rotated else
+                               f" (nominal: r_P + o + displacement along {axis})"),
+                            eq["lhs"][c], dl))
+    return out
+
+
+# ------------------------------------------------------------------------------- systems
+def _derived_rows(axis: str, rotated: bool) -> dict:
+    A, rows = system(LABELS)
+    if rotated:
+        # the rotary system is the linear one at the rotated lever arms (eq. 3.5): check it
+        Ar, _ = system(LABELS, rotary_axis=(0, 0, 1), angle=C)
+        sub = {}
+        for lab in LABELS:
+            xr, yr, _ = rotated_lever_arm(point_symbols(lab), (0, 0, 1), C)
+            sub[S(f"x_{lab}")], sub[S(f"y_{lab}")] = xr, yr
+        assert sp.simplify(Ar - A.subs(sub, simultaneous=True)) == sp.zeros(*A.shape)
+        A = _hat(A)
+    return {f"{lab}{c}": list(A.row(i)) for i, (lab, c) in enumerate(rows)}
+
+
+def audit_system(eq: dict) -> list[Verdict]:
+    axis = eq["axis"]
+    rotated = axis in "ABC"
+    derived = _derived_rows(axis, rotated)
+    out = []
+    rows = eq["rows"]
+    full = "selection" not in eq
+    expect_n = 3 * len(LABELS) if full else 6
+    labels = [lab for lab, _ in rows]
+    dup = sorted({lab for lab in labels if labels.count(lab) > 1})
+    bad_rows = []
+    for k, (lab, coeffs) in enumerate(rows):
+        pr = [parse(c, axis) for c in coeffs]
+        if any(sp.expand(a - b) != 0 for a, b in zip(derived[lab], pr)):
+            bad_rows.append(f"row {k + 1} ({lab}): printed {pr}, derived {derived[lab]}")
+    problems = []
+    if len(rows) != expect_n:
+        problems.append(f"{len(rows)} rows printed for {expect_n} equations")
+    if dup:
+        problems.append(f"row(s) {', '.join(d[0] + ' ' + d[1] for d in dup)} printed twice")
+    if full and set(labels) != set(derived):
+        problems.append(f"row(s) {sorted(set(derived) - set(labels))} missing")
+    problems.extend(bad_rows)
+    sel_note = ""
+    if not full:
+        sel = eq["selection"]
+        want = ["".join(r) for r in SELECTIONS[sel]]
+        if labels != want:
+            problems.append(f"rows {labels} are not the Zhang & Hu selection {want}")
+        det = _closed(sel)["N"]
+        sel_note = (f" The selected 6 x 6 system has determinant N = {fmt(sp.factor(det))} "
+                    f"(rotated coordinates for a rotary axis): it is singular whenever N = 0, "
+                    f"even for non-collinear points (e.g. all points at one height z).")
+    out.append(_verdict(eq, "coefficient matrix", not problems,
+                        "; ".join(problems[:3]) if problems else "",
+                        ("every printed row equals the derived row of the equation its "
+                         "right-hand side names" if not problems else
+                         "compared row by row with the derived system: " + "; ".join(problems))
+                        + sel_note,
+                        f"{len(rows)} rows", f"{expect_n} rows"))
+    want_u = [m + axis for m in MOTIONS]
+    got_u = list(eq["unknowns"])
+    if got_u == want_u:
+        out.append(_verdict(eq, "unknown vector", True, "", "E_X, E_Y, E_Z, E_A, E_B, E_C of "
+                            f"axis {axis}", ", ".join(got_u), ", ".join(want_u)))
+    else:
+        missing = [u for u in want_u if u not in got_u]
+        twice = sorted({u for u in got_u if got_u.count(u) > 1})
+        parts = []
+        if missing:
+            parts.append(f"{', '.join(missing)} missing")
+        if twice:
+            parts.append(f"{', '.join(twice)} listed twice")
+        if len(got_u) != 6:
+            parts.append(f"{len(got_u)} unknowns for 6 columns")
+        out.append(_verdict(eq, "unknown vector", False, "unknown vector: " + "; ".join(parts),
+                            "the six columns multiply E_X ... E_C of the axis in this order; "
+                            "the printed vector mislabels them (possibly an extraction defect "
+                            "of repeated subscripts)", ", ".join(got_u), ", ".join(want_u)))
+    # right-hand side
+    rhs = eq.get("rhs", [])
+    problems = []
+    if len(rhs) != len(rows):
+        problems.append(f"{len(rhs)} entries for {len(rows)} rows")
+    row_labels = labels if eq.get("row_labels_from") != "matrix" else labels
+    for k, text in enumerate(rhs):
+        if k >= len(row_labels):
+            break
+        lab = row_labels[k]
+        pr = parse(text, axis)
+        if rotated:
+            want = S(f"d_{lab[1]}{lab[0]}")
+        else:
+            want = _deviation(lab[0], lab[1], axis)
+        if sp.expand(pr - want) != 0:
+            problems.append(f"entry {k + 1} is {text} for row {lab} ({fmt(want)})")
+    out.append(_verdict(eq, "right-hand side", not problems,
+                        "right-hand side: " + "; ".join(problems[:2]) if problems else "",
+                        ("each entry is the deviation (measured - nominal) of the point and "
+                         "coordinate of its row" if not problems else
+                         "entries compared with the rows in printed order: " + "; ".join(problems)),
+                        "; ".join(rhs), f"{len(rows)} deviations"))
+    return out
+
+
+# --------------------------------------------------------------------------- closed forms
+def _printed_solution(eq: dict, motion: str, use_ocr: bool = True) -> tuple[sp.Expr, str]:
+    axis = eq["axis"]
+    text = eq["expr"][motion]
+    note = ""
+    if use_ocr and motion in eq.get("ocr", {}):
+        note = f" OCR text {text!r} read as {eq['ocr'][motion]!r} (a subscript swallowed the " \
+               f"multiplied factor)."
+        text = eq["ocr"][motion]
+    expr = parse(text, axis)
+    define = {S(k): parse(v, axis) for k, v in eq.get("define", {}).items()}
+    return expr, note, define
+
+
+def _derived_solution(eq: dict, motion: str) -> sp.Expr:
+    sol = _closed(eq["selection"])[motion]
+    if eq.get("rotated"):
+        sol = _hat(sol)
+    if eq.get("variables") == "raw":
+        axis = eq["axis"]
+        sub = {S(f"d_{c}{lab}"): _deviation(lab, c, axis) for lab in LABELS for c in COORDS}
+        sol = sol.subs(sub, simultaneous=True)
+    return sol
+
+
+def _top_level_factors(text: str) -> list[str]:
+    """The parenthesised factors of a printed product, in printed order: ``(a)(b)*(c)``."""
+    out, depth, start = [], 0, None
+    for i, ch in enumerate(text):
+        if ch == "(":
+            if depth == 0:
+                start = i
+            depth += 1
+        elif ch == ")":
+            depth -= 1
+            if depth == 0:
+                out.append(text[start:i + 1])
+        elif depth == 0 and ch not in " *":
+            return []
+    return out
+
+
+def _product_readings(text, axis, det):
+    """Readings of a printed N that is one product of six factors: the minus sign between two
+    consecutive partial products restored.  Returns the repaired N or None."""
+    factors = [parse(f, axis) for f in _top_level_factors(text)]
+    if len(factors) != 6:
+        return None
+    for split in range(1, 6):
+        a, b = sp.Mul(*factors[:split]), sp.Mul(*factors[split:])
+        for cand in (a - b, b - a):
+            if _equal(cand, det) or _equal(cand, -det):
+                return cand
+    return None
+
+
+def _swap_search(printed, define, derived):
+    """One printed lever-arm symbol of the solution (not of M, N) replaced by another makes it
+    equal the derived one: ``(old, new)`` or None.  Screened numerically (the replacement is a
+    change of one argument value), confirmed exactly."""
+    import numpy as np
+
+    full = printed.subs(define)
+    syms = sorted(full.free_symbols | derived.free_symbols, key=str)
+    aux = sorted(define, key=str)
+    outer = printed.free_symbols
+    lever = [s for s in syms if s.name[0] in "xyz" and s.name[1:3] in ("_P", "_Q", "_K", "h_")]
+    f_pr = sp.lambdify(syms + aux, printed, "numpy")
+    f_aux = [sp.lambdify(syms, define[a], "numpy") for a in aux]
+    f_de = sp.lambdify(syms, derived, "numpy")
+    rng = np.random.default_rng(7)
+    points = [rng.uniform(-300, 300, len(syms)) for _ in range(2)]
+    with np.errstate(all="ignore"):
+        want = [f_de(*p) for p in points]
+        auxv = [[f(*p) for f in f_aux] for p in points]
+        for old in (s for s in lever if s in outer):
+            io = syms.index(old)
+            for new in lever:
+                if new == old:
+                    continue
+                ok = True
+                for p, w, av in zip(points, want, auxv):
+                    q = p.copy()
+                    q[io] = p[syms.index(new)]
+                    v = f_pr(*q, *av)
+                    if not np.isfinite(v) or abs(v - w) > 1e-9 * max(1.0, abs(w)):
+                        ok = False
+                        break
+                if ok and _equal(derived, printed.subs(old, new).subs(define)):
+                    return old, new
+    return None
+
+
+def audit_closed_form(eq: dict) -> list[Verdict]:
+    axis = eq["axis"]
+    out = []
+    define_fix = {}
+    n_verdict = None
+    if "N" in eq.get("define", {}):
+        N = parse(eq["define"]["N"], axis)
+        det = _closed(eq["selection"])["N"]
+        if eq.get("rotated"):
+            det = _hat(det)
+        ok = _equal(N, det) or _equal(N, -det)
+        ev = f"derived determinant of the selected system: {fmt(sp.factor(det))}"
+        erratum = ""
+        if not ok:
+            fixed = _product_readings(eq["define"]["N"], axis, det)
+            if fixed is not None:
+                erratum = ("N printed as one product of six factors: the minus sign between "
+                           "the two triple products is lost")
+                define_fix[S("N")] = fixed
+                ev += f"; the reading N = {fmt(fixed)} reproduces it (up to sign)"
+            else:
+                erratum = "N differs from the determinant"
+            ev += f"; printed N = {eq['define']['N']}"
+        n_verdict = _verdict(eq, "N", ok, erratum, ev, eq["define"]["N"], sp.factor(det))
+    for motion in MOTIONS:
+        if motion not in eq["expr"]:
+            continue
+        printed, note, define = _printed_solution(eq, motion)
+        derived = _derived_solution(eq, motion)
+        name = motion + axis
+        full = printed.subs(define)
+        where = " with the printed M and N substituted" if define else ""
+        if _equal(derived, full):
+            out.append(_verdict(eq, name, True, "",
+                                f"derived - printed == 0{where} (exact rational evaluation at "
+                                f"8 random points); derived by Cramer's "
+                                f"rule on the selected system (selection {eq['selection']!r})"
+                                + (" in rotated coordinates" if eq.get("rotated") else "")
+                                + (" in raw coordinates (d = measured - nominal)"
+                                   if eq.get("variables") == "raw" else "") + "." + note,
+                                eq["expr"][motion], sp.factor(derived)))
+            continue
+        errs, ev = [], (f"derived {fmt(sp.factor(derived))}; the printed form{where} is not "
+                        f"identical.")
+        fixed_define = {**define, **define_fix}
+        full_fixed = printed.subs(fixed_define)
+        if define_fix and _equal(derived, full_fixed):
+            errs.append("N printed as one product (minus sign lost); otherwise as derived")
+            ev += " With N read as the determinant (minus sign restored) it is identical."
+        else:
+            hit = _swap_search(printed, fixed_define, derived)
+            if hit:
+                old, new = hit
+                errs.append(f"{old} printed for {new}")
+                ev += (f" Reading {old} as {new}" + (" and N with its minus sign restored"
+                                                      if define_fix else "")
+                       + " reproduces the derived solution exactly.")
+                if define_fix:
+                    errs.append("and N printed as one product")
+            else:
+                errs.append("closed form differs (no single-symbol reading reproduces it)")
+        out.append(_verdict(eq, name, False, " ".join(errs), ev + note, eq["expr"][motion],
+                            sp.factor(derived)))
+    if n_verdict is not None:
+        out.append(n_verdict)
+    return out
+
+
+def audit_denominator(eq: dict) -> list[Verdict]:
+    axis = eq["axis"]
+    out = []
+    for motion in MOTIONS:
+        if motion not in eq["expr"]:
+            continue
+        pr = parse(eq["expr"][motion], axis)
+        de = sp.denom(sp.factor(_closed(eq["selection"])[motion]))
+        ratio = sp.cancel(pr / de)
+        ok = ratio.is_number and ratio != 0
+        out.append(_verdict(eq, motion + axis, bool(ok),
+                            "denominator differs",
+                            f"printed denominator / derived denominator = {fmt(ratio)}"
+                            + (" (a constant: the same up to the sign of the numerator)"
+                               if ok else ""), eq["expr"][motion], de))
+    return out
+
+
+def audit(printed: dict, layouts=None) -> list[Verdict]:
+    """Verdicts for every printed equation of the data file (see the module docstring)."""
+    if layouts is not None and not (set(layouts) & set(LAYOUTS)):
+        return []
+    out = []
+    for eq in printed.get("equation", []):
+        kind = eq["kind"]
+        if kind == "displacement":
+            out.extend(audit_displacement(eq))
+        elif kind == "system":
+            out.extend(audit_system(eq))
+        elif kind == "closed_form":
+            out.extend(audit_closed_form(eq))
+        elif kind == "denominator":
+            out.extend(audit_denominator(eq))
+        else:
+            raise ValueError(f"printed_tracker: unknown kind {kind!r} of eq. {eq['id']}")
+    return out
