@@ -265,6 +265,24 @@ class Problem:
         return r
 
 
+    def loo_residuals(self, points) -> np.ndarray:
+        """Leave-one-point-out residual rows of ``points`` (exact, one factorisation):
+        r_loo_i = (I - H_ii)^-1 r_i with the 3x3 diagonal blocks H_ii of the hat matrix."""
+        rows = rows_of(points)
+        A, y = self.A[rows], self.y[rows]
+        w, V = np.linalg.eigh(A.T @ A)
+        ok = w > SV_TOL ** 2 * max(float(w[-1]), 1e-300)
+        Gi = (V[:, ok] / w[ok]) @ V[:, ok].T
+        r = y - A @ (Gi @ (A.T @ y))
+        n, P = len(points), A.shape[1]
+        B = (A @ Gi).reshape(n, 3, P)                  # one gemm, then 3x3 blocks
+        A3 = A.reshape(n, 3, P)
+        h = np.stack([np.sum(B[:, i, None, :] * A3, axis=2) for i in range(3)], axis=1)
+        m = np.eye(3) - h
+        det = np.linalg.det(m)
+        m[np.abs(det) < 1e-9] = np.eye(3)      # a point that alone fixes a parameter
+        return np.linalg.solve(m, r.reshape(n, 3, 1)).ravel()
+
 def point_norm(rows: np.ndarray) -> np.ndarray:
     """Length of each point's 3-D residual from point-major rows."""
     return np.linalg.norm(rows.reshape(-1, 3), axis=1)

@@ -7,10 +7,10 @@ Steps (:func:`run_loop`):
 2. hold out a random ``test_fraction`` of the points; everything below is decided on the
    others (the training points) and judged on the held-out ones;
 3. fit the declared model (:mod:`volerr.fit`): component errors as Legendre series, degree by
-   k-fold cross-validation, squareness, location errors, the instrument's rigid placement;
+   cross-validation, squareness, location errors, the instrument's rigid placement;
    gauge fixed by convention, plan-specific unidentifiable combinations reported;
 4. candidate effects (:mod:`volerr.candidates`), forward stepwise: the candidate with the best
-   BIC gain is accepted when the gain is strong (dBIC < -10) *and* its k-fold held-out
+   BIC gain is accepted when the gain is strong (dBIC < -10) *and* its cross-validated
    residual is significantly smaller (paired t > 3 on the per-point squared errors);
    stop when no candidate passes;
 5. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
@@ -47,6 +47,7 @@ from .model import Model, load
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
 CV_T = 3.0           # minimum paired t of the held-out improvement
 MAX_EFFECTS = 8
+DEGREE_CV_POINTS = 2500  # training points used to choose the degree (a random subset)
 AXIS_NAMES = "XYZUVWABC"
 
 
@@ -239,11 +240,14 @@ def _progress(total: int, enabled):
 
 # ---- the loop -------------------------------------------------------------------------
 def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
-    """Degree of the component series by k-fold CV on the training points (``extra``: effect
+    """Degree of the component series by cross-validation on the training points (``extra``: effect
     columns (rows, m) included in every model compared)."""
     design = declared_design(model, data, max_degree, ranges)
     keep, _ = gauge_mask(model, data, max_degree, ranges)
     y = data.deviation.ravel()
+    if len(train) > DEGREE_CV_POINTS:  # the degree needs no more points than this
+        train = np.sort(np.random.default_rng(0).choice(train, DEGREE_CV_POINTS, replace=False))
+        folds = None
     scores = {}
     for k in range(1, max_degree + 1):
         m = keep & np.array([lab[1] is None or lab[0] == "setup" or lab[1] <= k
@@ -254,11 +258,19 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
         if extra is not None and extra.shape[1]:
             A = np.concatenate([A, extra], axis=1)
         prob = Problem(A, y)
-        scores[k] = rms(prob.cv_residuals(folds, train))
+        scores[k] = rms(_cv(prob, folds, train))
     require(scores, f"too few points for the basis: {len(train)} training points cannot fit "
             f"even a degree-1 model of layout {model.name}")
     best = min(scores.values())
     return min(k for k, v in scores.items() if v <= 1.01 * best), scores
+
+
+def _cv(prob: Problem, folds, points) -> np.ndarray:
+    """Cross-validated residual rows: leave-one-point-out when ``folds`` is None, else k-fold
+    with the given fold label per point."""
+    if folds is None:
+        return prob.loo_residuals(points)
+    return prob.cv_residuals(folds, points)
 
 
 def _periodic_best(cand, model, data, train, sens, resid, ranges):
@@ -347,7 +359,7 @@ class _Context:
         ytr = y[tr_rows]
         n3 = len(ytr)
         cache, selected, rejected = {}, [], set()
-        cv_old = point_norm(Problem(A_all, y).cv_residuals(fold_t, train)) ** 2
+        cv_old = point_norm(_cv(Problem(A_all, y), fold_t, train)) ** 2
         while len(selected) < MAX_EFFECTS:
             base = _Base(A_all[tr_rows], ytr)
             scored = []
@@ -377,7 +389,7 @@ class _Context:
                 if dbic > -BIC_GAIN:
                     break
                 A_try = np.concatenate([A_all, cols.reshape(-1, cols.shape[-1])], axis=1)
-                cv_new = point_norm(Problem(A_try, y).cv_residuals(fold_t, train)) ** 2
+                cv_new = point_norm(_cv(Problem(A_try, y), fold_t, train)) ** 2
                 d = cv_old - cv_new
                 t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
                 if t < CV_T:
@@ -403,7 +415,8 @@ class _Context:
                 "selected": selected, "candidates": candidates}
 
 
-def run_loop(layout, data, *, seed: int = 0, folds: int = 5, test_fraction: float = 0.25,
+def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
+             test_fraction: float = 0.25,
              degree: int | None = None, max_degree: int = 6, out_dir=None,
              progress=None, families=cands.FAMILIES, inputs=()) -> Report:
     """Run the loop on ``data`` (CSV path, :class:`volerr.simulate.Campaign` or
@@ -419,7 +432,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int = 5, test_fraction: floa
         dat = columns_to_data(data.columns(), model, "campaign")
     else:
         dat = read_deviations(data, model)
-    require(2 <= folds <= 20, "folds must be between 2 and 20")
+    require(folds is None or 2 <= folds <= 20, "folds must be between 2 and 20")
     require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
     bar = _progress(7, progress)
     rng = np.random.default_rng(seed)
@@ -427,9 +440,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int = 5, test_fraction: floa
     perm = rng.permutation(n)
     n_test = max(1, int(round(test_fraction * n)))
     test, train = np.sort(perm[:n_test]), np.sort(perm[n_test:])
-    fold = np.empty(n, int)
-    fold[train] = rng.permutation(len(train)) % folds
-    fold_t = fold[train]
+    fold_t = None if folds is None else rng.permutation(len(train)) % folds
     ranges = data_ranges(model, dat)
     y = dat.deviation.ravel()
 
@@ -663,16 +674,20 @@ def augmented_layout_text(model: Model, selected) -> str:
 
 
 # ---- demo --------------------------------------------------------------------------
-def demo_campaign(seed: int = 0, out=None, n_points: int = 900, kind: str = "thermal"):
+def demo_campaign(out=None, seed: int = 0, n_points: int = 900, kind: str = "thermal"):
     """A simulated MB1 campaign with one undeclared effect and five probe offsets.
 
-    ``kind``: ``"thermal"`` (scale of X grows 11.5 um/m/K with T_C - 20) or ``"periodic"``
-    (a 2 um cyclic error of EXX, period 40 mm).  Writes the CSV to ``out`` (a path; a
-    temporary file when None).  Returns ``("MB1", csv_path, campaign)``."""
+    ``out``: CSV path to write (a temporary file when None; an int is taken as ``seed``).
+    ``kind``: ``"thermal"`` (the scale of X grows 11.5 um/m/K with T_C - 20) or ``"periodic"``
+    (a 2 um cyclic error of EXX, period 40 mm).  Sized so that the loop on it takes a few
+    seconds.  Returns ``("MB1", csv_path)``."""
     import tempfile
 
     from .simulate import demo_probes, simulate
 
+    if isinstance(out, int) and not isinstance(out, bool):
+        seed, out = out, None
+    require(kind in ("thermal", "periodic"), f"demo effect must be thermal or periodic")
     model = load("MB1")
     effect = {"thermal": {"kind": "thermal", "axis": "X", "ppm_per_K": 11.5},
               "periodic": {"kind": "periodic", "component": "EXX", "period_mm": 40.0,
@@ -681,5 +696,4 @@ def demo_campaign(seed: int = 0, out=None, n_points: int = 900, kind: str = "the
                     effects=[effect], noise_um=0.3)
     if out is None:
         out = Path(tempfile.mkdtemp(prefix="volerr_demo_")) / "MB1_campaign.csv"
-    path = camp.write_csv(out)
-    return "MB1", str(path), camp
+    return "MB1", str(camp.write_csv(out))

@@ -20,7 +20,7 @@ def register(sub) -> None:
         description="Fit LAYOUT's model to measured volumetric deviations (CSV: axis columns, "
                     "optional Xp,Yp,Zp, dx_um,dy_um,dz_um, covariates such as T_C, t_s, "
                     "dir_X, nx,ny,nz, setup), search candidate effects by forward stepwise "
-                    "selection (BIC and k-fold held-out residual), augment the layout and "
+                    "selection (BIC and cross-validated residual), augment the layout and "
                     "report RMS/max before and after on held-out points.")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", help="measured-deviation CSV")
@@ -29,7 +29,8 @@ def register(sub) -> None:
     p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
                                      "(default: the folder of --json)")
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
-    p.add_argument("--folds", type=int, default=5, help="k of the k-fold cross-validation")
+    p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
+                                             "leave-one-point-out, exact via the hat matrix)")
     p.add_argument("--test-fraction", type=float, default=0.25,
                    help="fraction of points held out for before/after (default 0.25)")
     p.add_argument("--degree", type=int, help="degree of the component series (default: by "
