@@ -265,7 +265,7 @@ def audit_volumetric(eq: dict) -> list[Verdict]:
         if is_identical(physical[i], printed[i]):
             out.append(_verdict(eq, c, "identical", "",
                                 f"expand(derived - printed) == 0 for the physical layout "
-                                f"{name} ({' -> '.join(lay.workpiece_chain[::-1] + ('|',) + lay.tool_chain)})."
+                                f"{name} ({_stacking(lay)})."
                                 + ocr, printed[i], physical[i]))
             continue
         diff0 = describe_diff(physical[i], printed[i])
@@ -281,6 +281,13 @@ def audit_volumetric(eq: dict) -> list[Verdict]:
                         f"{resid}.")
         out.append(_verdict(eq, c, "differs", erratum, evidence + ocr, printed[i], physical[i]))
     return out
+
+
+def _stacking(lay) -> str:
+    tool = "tool side " + " -> ".join(("bed",) + lay.tool_chain)
+    if lay.workpiece_chain:
+        return tool + "; table " + " -> ".join(("bed",) + lay.workpiece_chain)
+    return tool
 
 
 def _verdict(eq, comp, verdict, erratum, evidence, printed, derived) -> Verdict:
