@@ -103,7 +103,7 @@ def linear_inverse(chain: Chain) -> dict:
     mtm = sp.simplify(m.T * m)
     minv = m.T if mtm == sp.eye(3) else sp.simplify(m.inv())
     sol = minv * (sp.Matrix(TIP) - t)
-    return {a: sp.expand(sp.simplify(sol[i])) for i, a in enumerate(("X", "Y", "Z"))}
+    return {a: sp.expand(sp.trigsimp(sp.expand(sol[i]))) for i, a in enumerate(("X", "Y", "Z"))}
 
 
 def inverse_functions(layout: Layout) -> list[Function]:
