@@ -383,6 +383,7 @@ def _resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
 def _write(lines, axes, initial, known, q_out, nd) -> str:
     """The output program: original bytes except the changed / added axis words."""
     interp = gcode.Interpreter(axes, initial)
+    spaced = gcode.spaced_style(lines)
     state = {a: (None if interp.position[a] is None else float(interp.position[a])) for a in axes}
     row = {id(b.line): r for r, b in enumerate(known)}
     out = []
@@ -437,6 +438,6 @@ def _write(lines, axes, initial, known, q_out, nd) -> str:
                     txt = gcode.format_number(want, int(nd[r, i]))
                     added[a] = txt
                     state[a] = float(txt)
-        out.append(gcode.rewrite_line(line, new_values, added) if (new_values or added)
+        out.append(gcode.rewrite_line(line, new_values, added, spaced) if (new_values or added)
                    else line.text)
     return "".join(out)

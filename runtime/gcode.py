@@ -25,6 +25,8 @@ Interpretation (modal state, one block per line)
   Arcs are refused rather than linearised, so that the output's geometry stays the program's.
 * ``G90``/``G91``: both handled; in ``G91`` an axis word is the increment from the position
   the controller holds.
+* ``G53`` moves and work offsets (``G54`` ...) are kept as written: the program's numbers are
+  taken to be the axis positions the error tables refer to.
 * ``G28``/``G30`` (reference return) and ``G4`` (dwell, its ``X``/``P`` is time) are passed
   through untouched; after ``G28``/``G30`` the axes they name are at an unknown position until
   programmed again.
@@ -259,9 +261,24 @@ def format_number(value: float, ndigits: int, template: str = "") -> str:
     return s
 
 
-def rewrite_line(line: Line, new_values: dict, added: dict) -> str:
+def spaced_style(lines: list[Line]) -> bool:
+    """True when the program separates words by blanks (``G1 X1 Y2``), False when it writes
+    them together (``G1X1Y2``): decides how an added word is separated."""
+    for line in lines:
+        toks = line.tokens
+        for a, b, c in zip(toks, toks[1:], toks[2:]):
+            if a.kind == "word" and c.kind == "word":
+                return b.kind == "space"
+        for a, b in zip(toks, toks[1:]):
+            if a.kind == "word" and b.kind == "word":
+                return False
+    return True
+
+
+def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None = None) -> str:
     """The line with the numbers of axis words in ``new_values`` (letter -> text) replaced and
-    the words of ``added`` (letter -> text) appended after the last word; every other byte kept."""
+    the words of ``added`` (letter -> text) appended after the last word; every other byte kept.
+    ``spaced``: separate added words by a blank (default: as the line does, else yes)."""
     body = line.body
     pieces = []
     pos = 0
@@ -279,8 +296,9 @@ def rewrite_line(line: Line, new_values: dict, added: dict) -> str:
         # the insertion point moves with the length change of the replaced numbers before it
         shift = len(out) - len(body)
         at = (last_word_end if last_word_end is not None else len(body)) + shift
-        spaced = any(t.kind == "space" for t in line.tokens) or len(line.words()) <= 1
-        sep = " " if spaced else ""
+        own = spaced_style([line]) if len(line.words()) > 1 else None
+        sep = " " if (own if own is not None else (spaced if spaced is not None else True)) \
+            else ""
         lower = all(t.text[0].islower() for t in line.words()) and line.words()
         ins = "".join(f"{sep}{(a.lower() if lower else a)}{v}" for a, v in added.items())
         out = out[:at] + ins + out[at:]

@@ -428,3 +428,37 @@ def test_controller_reads_the_documented_isg_example(tmp_path):
     assert c == {"EA0Z": 0.0001, "EB0Z": -0.0002}
     assert t["X"].values["EYX"].tolist() == [0.01, -0.1]
     assert math.isclose(t["X"].values["EBX"][0], 0.0042)
+
+
+def test_added_words_follow_the_program_style(tmp_path):
+    m = volerr.load("DMU50")
+    y = np.linspace(-225, 225, 11)
+    write_error_table(tmp_path / "Y.csv", ErrorTable("Y", y, {"EXY": 1e-5 * y}))
+    funcs = tables.ErrorFunctions.from_dir(tmp_path, m)
+    out = compensate_program(m, funcs, "G90G1X10Y0Z100B0C0\ny10\n").text
+    assert out == "G90G1X10Y0Z100B0C0\ny10x9.9999\n"
+
+
+def test_builtin_example_hemisphere(tmp_path):
+    """The demo example: thesis-size errors, a five-axis finishing program made with the
+    nominal inverse (tool axis normal to a hemisphere); compensated within 0.1 um."""
+    from volerr.fiveaxis_example import write_example
+
+    paths = write_example(tmp_path / "ex")
+    m = volerr.load("DMU50")
+    funcs = tables.ErrorFunctions.from_dir(paths["errors"], m)
+    text = paths["program"].read_bytes().decode("latin-1")
+    want = nominal(m, text)
+    blocks = gcode.blocks(gcode.parse(text), m.axes)
+    q = np.array([[b.target[a] for a in m.axes] for b in blocks])
+    # the program really is the hemisphere: tool axis along the normal at every block
+    nrm = (want[:, :3] - [30.0, 20.0, 20.0]) / 40.0
+    body = slice(0, -1)  # the last block is the retract
+    assert np.allclose(np.linalg.norm(nrm[body], axis=1), 1.0, atol=1e-5)
+    assert np.allclose(want[body, 3:], nrm[body], atol=1e-5)
+    assert np.ptp(q[:, 3]) > 40 and np.ptp(q[:, 4]) > 300
+    res = compensate_program(m, funcs, text)
+    _, _, after = execute(m, funcs, res.text)
+    _, _, before = execute(m, funcs, text)
+    assert np.linalg.norm(before[:, :3] - want[:, :3], axis=1).max() > 10e-3
+    assert np.linalg.norm(after[:, :3] - want[:, :3], axis=1).max() < 1e-4
