@@ -298,7 +298,7 @@ def _solve(A, W, delta):
     return theta, Ninv
 
 
-def _closed_form(lever, delta, theta_lsq, axis, kind):
+def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
     """Zhang & Hu closed form on three points at every position; cross-check vs ``theta_lsq``.
 
     Candidates: the three row selections (eq. 32/3.6, 36, 37) x the 3! assignments of the first
@@ -314,11 +314,14 @@ def _closed_form(lever, delta, theta_lsq, axis, kind):
     spread = math.sqrt(float(np.mean(np.sum(c0 ** 2, axis=1))))
     names = ("P", "Q", "K")
     cands, scores, ranks = [], [], []
+    # a linear axis has the same lever arms at every position: score them once
+    geo = lever[:1] if kind == "linear" else lever
     for perm in itertools.permutations((0, 1, 2), 3):
-        L = lever[:, perm, :]
+        L = geo[:, perm, :]
         args = [L[:, i, c] for i in range(3) for c in range(3)]
         for sel in sorted(gen.SELECTIONS):
-            N = np.broadcast_to(getattr(gen, f"det_{sel}")(*args)["N"], (K,))
+            N = np.broadcast_to(getattr(gen, f"det_{sel}")(*args)["N"], (geo.shape[0],))
+            N = np.broadcast_to(N, (K,))
             cands.append((sel, perm))
             scores.append(np.abs(N) / spread ** 3)
             ranks.append((sel == pref) + (perm == (0, 1, 2)))
@@ -336,7 +339,8 @@ def _closed_form(lever, delta, theta_lsq, axis, kind):
         for c in np.unique(choice):
             sel, perm = cands[c]
             m = choice == c
-            L = lever[m][:, perm, :]
+            # lever arms: constants for a linear axis, per position for a rotary one
+            L = lever[:1, perm, :] if kind == "linear" else lever[m][:, perm, :]
             D = dl[m][:, perm, :]
             ds = [D[:, names.index(lab), "xyz".index(co)] for lab, co in gen.SELECTIONS[sel]]
             solve = getattr(gen, f"solve_{sel}")
@@ -345,16 +349,16 @@ def _closed_form(lever, delta, theta_lsq, axis, kind):
         return out
 
     values = run(delta)
-    A = design(lever)
+    A = design(lever) if A is None else A
     fitted = np.einsum("knij,kj->kni", A, theta_lsq)
     consistent = run(fitted)
     scale = np.array([1.0, 1.0, 1.0, spread, spread, spread])
     used = [cands[c] for c in np.unique(choice[1:] if K > 1 else choice)]
-    rows = []
-    for k in range(K):
-        sel, perm = cands[choice[k]]
-        rows.append([(perm[names.index(lab)], "xyz".index(co)) for lab, co in
-                     gen.SELECTIONS[sel]])
+    rows = {}
+    for c in np.unique(choice):
+        sel, perm = cands[c]
+        rows[int(c)] = [(perm[names.index(lab)], "xyz".index(co)) for lab, co in
+                        gen.SELECTIONS[sel]]
     return {
         "values": values,
         "selection": ",".join(sorted({sel for sel, _ in used})),
@@ -362,6 +366,7 @@ def _closed_form(lever, delta, theta_lsq, axis, kind):
         "consistency_max": float(np.max(np.abs((consistent - theta_lsq) * scale))),
         "vs_lsq": values - theta_lsq,
         "row_index": rows,
+        "choice": choice,
         "thesis_choice_everywhere": bool(np.all([cands[c][0] == pref and cands[c][1] ==
                                                  (0, 1, 2) for c in choice])),
     }
@@ -406,26 +411,29 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
     u[0] = 0.0
     closed = {}
     if method == "closed" or (cross_check and n >= 3):
-        closed = _closed_form(lever, delta, theta, axis, kind)
+        closed = _closed_form(lever, delta, theta, axis, kind, A)
     if method == "closed":
         theta = closed["values"].copy()
         theta[0] = 0.0
         resid = delta - np.einsum("knij,kj->kni", A, theta)
         resid[0] = 0.0
         # propagate through the selected six equations
-        rows = closed["row_index"]
-        As = np.array([[A[k, i, c, :] for i, c in rows[k]] for k in range(K)])  # (K, 6, 6)
+        choice = closed["choice"]
+        As = np.empty((K, 6, 6))
+        S = np.zeros((K, 6, 6))
+        cov_full = np.linalg.inv(W) if W is not None else None
+        for c, rows in closed["row_index"].items():
+            m = choice == c
+            for a, (i, co) in enumerate(rows):
+                As[m, a, :] = A[m, i, co, :]
+                if cov_full is not None:
+                    for b, (j, d) in enumerate(rows):
+                        if i == j:
+                            S[m, a, b] = cov_full[m, i, co, d]
         Ainv = np.linalg.inv(As)
         if W is None:
             covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)
         else:
-            cov_full = np.linalg.inv(W)
-            S = np.zeros((K, 6, 6))
-            for k in range(K):
-                for a, (i, c) in enumerate(rows[k]):
-                    for b, (j, d) in enumerate(rows[k]):
-                        if i == j:
-                            S[k, a, b] = cov_full[k, i, c, d]
             covs = np.einsum("kij,kjl,kml->kim", Ainv, S, Ainv)
         u = np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None))
         u[0] = 0.0

@@ -103,7 +103,6 @@ def read_tracker_csv(path) -> list[Round]:
     idx = _header_index(path, header)
     require(body, f"{path}: header only, no measurements")
     data: dict = {}
-    order: list = []
     width = max(idx.values()) + 1
     for lineno, cells in body:
         require(len(cells) >= width, f"{path}:{lineno}: expected at least {width} columns, "
@@ -113,26 +112,22 @@ def read_tracker_csv(path) -> list[Round]:
         require(label != "", f"{path}:{lineno}: empty point label")
         pos = _num(path, lineno, "position", cells[idx["position"]])
         xyz = tuple(_num(path, lineno, c, cells[idx[c]]) for c in ("x", "y", "z"))
-        if rnd not in data:
-            data[rnd] = {"positions": [], "labels": [], "values": {}}
-            order.append(rnd)
-        d = data[rnd]
-        if pos not in d["positions"]:
-            d["positions"].append(pos)
-        if label not in d["labels"]:
-            d["labels"].append(label)
+        # dicts keep the file order: positions in measurement order, labels as first seen
+        d = data.setdefault(rnd, {"positions": {}, "labels": {}, "values": {}})
+        d["positions"].setdefault(pos, None)
+        d["labels"].setdefault(label, None)
         key = (pos, label)
         require(key not in d["values"], f"{path}:{lineno}: round {rnd}: point {label} measured "
                                          f"twice at position {pos:g}")
         d["values"][key] = xyz
     rounds = []
-    for rnd in order:
-        d = data[rnd]
-        pos, labels = d["positions"], d["labels"]
-        for p in pos:
-            for lab in labels:
-                require((p, lab) in d["values"], f"{path}: round {rnd}: point {lab} has no "
-                                                 f"measurement at position {p:g}")
+    for rnd, d in data.items():
+        pos, labels = list(d["positions"]), list(d["labels"])
+        if len(d["values"]) != len(pos) * len(labels):
+            for p in pos:
+                for lab in labels:
+                    require((p, lab) in d["values"], f"{path}: round {rnd}: point {lab} has no "
+                                                     f"measurement at position {p:g}")
         pts = np.array([[d["values"][(p, lab)] for lab in labels] for p in pos], dtype=float)
         rounds.append(Round(f"{path.name}:{rnd}", np.array(pos, dtype=float), tuple(labels), pts))
     return rounds
