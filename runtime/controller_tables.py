@@ -10,8 +10,8 @@ errors keep their names (``EXX`` ... ``ECC``); position errors (squareness and l
 of the rotary axes, volerr ``EC0Y``, ``EX0C`` ...) are written without the leading ``E``
 (``C0Y``, ``X0C``), as the ISG parameter list names them.  Values are the layout's errors as
 volerr defines them (tool relative to workpiece, ISO 230-1; for a table axis minus the
-table's own error motion); a controller that expects the opposite sign needs its ``negate``
-option.
+table's own error motion); ``--negate`` writes (reads) compensation values, the errors with
+reversed sign, for a controller that expects those.
 
 ISG CSV (columns separated by blanks or tabs)
     ``//`` starts a comment, a line ``#`` separates blocks, each block starts with a header::
@@ -255,6 +255,13 @@ def read_etalon(text: str, where: str = "Etalon file") -> tuple[dict, dict]:
         except InputError as exc:
             raise InputError(f"{where}: {exc}") from None
     return tables, constants
+
+
+def negated(tables: dict, constants: dict) -> tuple[dict, dict]:
+    """Errors -> compensation values (or back): every value with reversed sign (ISO/TR 16907:
+    reversing the sign of an error table gives the compensation table)."""
+    return ({a: ErrorTable(a, t.positions, {k: -v for k, v in t.values.items()})
+             for a, t in tables.items()}, {k: -v for k, v in constants.items()})
 
 
 def detect_format(text: str) -> str:

@@ -23,7 +23,27 @@ def tcp_error_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: i
 
     Returns ``(axis1, axis2, q1 (n1,), q2 (n2,), err (n2, n1, 3) mm, valid (n2, n1))``; ``valid``
     is False where the linear axes leave their travel or a position leaves an error table's
-    measured range (there ``err`` is NaN)."""
+    measured range (there ``err`` is NaN).  :func:`tool_axis_error_map` gives the matching
+    tool-axis error."""
+    a1, a2, q1, q2, q, valid, em = _grid(model, funcs, point, tool, n1, n2, range1, range2)
+    err = np.full((len(q), 3), np.nan)
+    if valid.any():
+        err[valid] = em.position_error(q[valid])
+    return a1, a2, q1, q2, err.reshape(len(q2), len(q1), 3), valid.reshape(len(q2), len(q1))
+
+
+def tool_axis_error_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: int = 73,
+                        range1=None, range2=None) -> np.ndarray:
+    """First-order tool-axis error (rad) on the grid of :func:`tcp_error_map`, (n2, n1, 3)."""
+    a1, a2, q1, q2, q, valid, em = _grid(model, funcs, point, tool, n1, n2, range1, range2)
+    err = np.full((len(q), 3), np.nan)
+    if valid.any():
+        err[valid] = em.orientation_error(q[valid])
+    return err.reshape(len(q2), len(q1), 3)
+
+
+def _grid(model, funcs, point, tool, n1, n2, range1, range2):
+    """Axis positions of the (rotary 1, rotary 2) grid that keep the tool tip on ``point``."""
     from .compensate import ErrorModel
     from .fiveaxis import is_five_axis
 
@@ -64,10 +84,7 @@ def tcp_error_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: i
         for a, (lo, hi) in em.ranges.items():
             i = model.axes.index(a)
             valid &= (ql[:, i] >= lo) & (ql[:, i] <= hi)
-    err = np.full((n, 3), np.nan)
-    if valid.any():
-        err[valid] = em.position_error(q[valid])
-    return a1, a2, q1, q2, err.reshape(n2, n1, 3), valid.reshape(n2, n1)
+    return a1, a2, q1, q2, q, valid, em
 
 
 def plot_tcp_error_map(model, funcs, point, path, tool=(0.0, 0.0, 0.0), title: str = "",
@@ -79,22 +96,25 @@ def plot_tcp_error_map(model, funcs, point, path, tool=(0.0, 0.0, 0.0), title: s
     import matplotlib.pyplot as plt
 
     a1, a2, q1, q2, err, valid = tcp_error_map(model, funcs, point, tool, **kw)
+    ori = tool_axis_error_map(model, funcs, point, tool, **kw)
     mag = np.linalg.norm(err, axis=2) * 1e3
-    fig, axs = plt.subplots(1, 4, figsize=(17, 4.2), constrained_layout=True)
-    panels = [(mag, "|e|"), (err[..., 0] * 1e3, "dx"), (err[..., 1] * 1e3, "dy"),
-              (err[..., 2] * 1e3, "dz")]
+    fig, axs = plt.subplots(1, 5, figsize=(21, 4.2), constrained_layout=True)
+    panels = [(mag, "|e| / um"), (err[..., 0] * 1e3, "dx / um"), (err[..., 1] * 1e3, "dy / um"),
+              (err[..., 2] * 1e3, "dz / um"),
+              (np.linalg.norm(ori, axis=2) * 1e6, "tool-axis error / urad")]
     for ax, (z, name) in zip(axs, panels):
         zm = np.ma.masked_invalid(z)
         lim = np.nanmax(np.abs(z)) if np.isfinite(z).any() else 1.0
-        cmap = "viridis" if name == "|e|" else "RdBu_r"
-        vmin = 0 if name == "|e|" else -lim
+        positive = name.startswith("|e|") or name.startswith("tool")
+        cmap = "viridis" if positive else "RdBu_r"
+        vmin = 0 if positive else -lim
         im = ax.pcolormesh(q1, q2, zm, shading="auto", cmap=cmap, vmin=vmin, vmax=lim)
         if np.isfinite(z).sum() > 4:
             ax.contour(q1, q2, zm, levels=6, colors="k", linewidths=0.4)
         ax.set_facecolor("0.85")
         ax.set_xlabel(f"{a1} / deg")
         ax.set_ylabel(f"{a2} / deg")
-        ax.set_title(f"{name} / um")
+        ax.set_title(name)
         fig.colorbar(im, ax=ax, shrink=0.85)
     p = np.asarray(point, dtype=float)
     fig.suptitle(title or f"{model.name}: tool-tip error at workpiece point "

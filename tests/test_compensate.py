@@ -462,3 +462,34 @@ def test_builtin_example_hemisphere(tmp_path):
     _, _, before = execute(m, funcs, text)
     assert np.linalg.norm(before[:, :3] - want[:, :3], axis=1).max() > 10e-3
     assert np.linalg.norm(after[:, :3] - want[:, :3], axis=1).max() < 1e-4
+
+
+@pytest.mark.parametrize("name", ["TT_AC", "HH_BC", "TH_BC"])
+def test_orientation_compensation_other_families(tmp_path, name):
+    m = volerr.load(name)
+    err = write_errors(tmp_path / "err", m, seed=8)
+    funcs = tables.ErrorFunctions.from_dir(err, m)
+    text = random_program(m, np.random.default_rng(5), 25)
+    res = compensate_program(m, funcs, text, orientation=True)
+    want = nominal(m, text)
+    _, _, after = execute(m, funcs, res.text)
+    assert np.linalg.norm(after[:, :3] - want[:, :3], axis=1).max() < 1e-4
+    ok = np.array([r.status == "compensated" for r in res.reports])
+    assert ok.sum() >= len(ok) - 2
+    assert np.linalg.norm(after[ok, 3:] - want[ok, 3:], axis=1).max() < 2e-6
+
+
+def test_controller_negate_round_trip(tmp_path):
+    m = volerr.load("TT_AC")
+    err = write_errors(tmp_path / "err", m)
+    f = tmp_path / "comp.isg"
+    assert cli("controller", "export", "TT_AC", "--errors", err, "--format", "isg", "--out", f,
+               "--negate")[0] == 0
+    t_err, _ = tables.read_error_dir(err, m.axes)
+    from volerr.controller_tables import read_controller_file
+
+    t_neg, _ = read_controller_file(f, m)
+    assert np.allclose(t_neg["X"].values["EXX"], -t_err["X"].values["EXX"])
+    assert cli("controller", "import", "TT_AC", f, "--negate", "--out", tmp_path / "b")[0] == 0
+    t_back, _ = tables.read_error_dir(tmp_path / "b", m.axes)
+    assert np.allclose(t_back["A"].values["EBA"], t_err["A"].values["EBA"], rtol=1e-10)

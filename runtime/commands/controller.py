@@ -25,12 +25,17 @@ def register(sub) -> None:
     e.add_argument("--errors", required=True, metavar="DIR", help="error directory")
     e.add_argument("--format", choices=("isg", "etalon"), required=True)
     e.add_argument("--out", required=True, help="controller file to write")
+    e.add_argument("--negate", action="store_true",
+                   help="write compensation values (the errors with reversed sign) for a "
+                        "controller that expects them")
     e.set_defaults(func=run)
     i = s.add_parser("import", help="controller file -> error directory")
     i.add_argument("layout", help="layout name or file")
     i.add_argument("file", help="ISG CSV or Etalon file")
     i.add_argument("--format", choices=("auto", "isg", "etalon"), default="auto")
     i.add_argument("--out", required=True, metavar="DIR", help="error directory to write")
+    i.add_argument("--negate", action="store_true",
+                   help="the file holds compensation values: reverse their sign")
     i.set_defaults(func=run)
 
 
@@ -46,14 +51,19 @@ def run(args) -> int:
         tables, (consts, _, _) = read_error_dir(args.errors, model.axes)
         ct.check_against_model(model, tables, consts, args.errors)
         require(tables or consts, f"{args.errors}: no error tables or constants to export")
+        if args.negate:
+            tables, consts = ct.negated(tables, consts)
         writer = ct.write_isg if args.format == "isg" else ct.write_etalon
         inputs = list(Path(args.errors).glob("*.csv"))
         write_text(args.out, writer(model.name, tables, consts), inputs)
         n = sum(len(t.values) for t in tables.values())
         print(f"{model.name}: wrote {n} component errors ({len(tables)} axes) and "
-              f"{len(consts)} position errors to {args.out} ({args.format})")
+              f"{len(consts)} position errors to {args.out} ({args.format}"
+              f"{', negated: compensation values' if args.negate else ''})")
         return 0
     tables, consts = ct.read_controller_file(args.file, model, args.format)
+    if args.negate:
+        tables, consts = ct.negated(tables, consts)
     out = Path(args.out)
     for ax in tables:
         require(not (out / f"{ax}.csv").exists() or not (out / f"{ax}.csv").samefile(args.file),
