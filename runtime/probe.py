@@ -5,7 +5,7 @@ Conventions (stated once, used everywhere in volerr)
 * Probe frame: tilt ``A`` and roll ``B`` of the probe head (deg at the API) define the probe
   frame (x', y', z') of Pahk eq. (11), z' along the stylus towards the head; the transforms
   are derived in :mod:`volerr.derive.probe` and generated into :mod:`volerr.generated.probe`.
-  A vertical probe (A = 0, B = 0) has the machine frame as its probe frame.
+  A vertical probe (A = 0) has the machine frame as its probe frame, whatever the roll B.
 * Probing direction ``M`` (unit vector): the outward normal of the probed surface at the
   contact, i.e. from the contact point towards the stylus-ball centre.  On the master sphere it
   is the direction from the sphere centre to the recorded ball centre, so the pole (phi = 0) is
@@ -78,14 +78,24 @@ def _gen():
 
 
 # ---- frames and directions ---------------------------------------------------------------
+def _head_angles_rad(tilt_deg, roll_deg):
+    """(tilt, roll) in rad.  A vertical probe (tilt 0) has the machine frame as its probe frame
+    whatever the roll: eq. (11)'s cross product vanishes there, and the roll of a vertical
+    stylus is not part of the probe frame (it is 0 here, where the closed form of eq. 11 gives
+    the machine frame)."""
+    t = np.radians(np.asarray(tilt_deg, dtype=float))
+    r = np.where(t == 0.0, 0.0, np.radians(np.asarray(roll_deg, dtype=float)))
+    return (float(t), float(r)) if t.ndim == 0 and r.ndim == 0 else (t, r)
+
+
 def machine2probe(tilt_deg: float = 0.0, roll_deg: float = 0.0) -> np.ndarray:
     """Tp of eq. (12) as stated (``v_probe = machine2probe @ v_machine``), (3, 3)."""
-    return _gen().machine2probe(math.radians(tilt_deg), math.radians(roll_deg))
+    return _gen().machine2probe(*_head_angles_rad(tilt_deg, roll_deg))
 
 
 def probe2machine(tilt_deg: float = 0.0, roll_deg: float = 0.0) -> np.ndarray:
     """Columns e'_x, e'_y, e'_z of eq. (11) (``v_machine = probe2machine @ v_probe``), (3, 3)."""
-    return _gen().probe2machine(math.radians(tilt_deg), math.radians(roll_deg))
+    return _gen().probe2machine(*_head_angles_rad(tilt_deg, roll_deg))
 
 
 def angles_of(directions_machine, tilt_deg=0.0, roll_deg=0.0):
@@ -93,7 +103,7 @@ def angles_of(directions_machine, tilt_deg=0.0, roll_deg=0.0):
     probe frame (eq. 14-16); tilt/roll scalars or (n,) arrays (deg)."""
     d = np.atleast_2d(np.asarray(directions_machine, dtype=float))
     gen = _gen()
-    mp = gen.direction_to_probe(np.radians(tilt_deg), np.radians(roll_deg),
+    mp = gen.direction_to_probe(*_head_angles_rad(tilt_deg, roll_deg),
                                 d[:, 0], d[:, 1], d[:, 2])
     phi, theta = gen.direction_angles(*mp)
     theta = np.degrees(theta)
@@ -104,7 +114,7 @@ def directions_of(phi_deg, theta_deg, tilt_deg=0.0, roll_deg=0.0):
     """Probe-frame angles (deg) -> machine-frame unit vectors, shape (n, 3); tilt/roll
     scalars or arrays broadcasting with the angles (deg)."""
     gen = _gen()
-    m = gen.direction_to_machine(np.radians(tilt_deg), np.radians(roll_deg),
+    m = gen.direction_to_machine(*_head_angles_rad(tilt_deg, roll_deg),
                                  np.radians(np.asarray(phi_deg, dtype=float)),
                                  np.radians(np.asarray(theta_deg, dtype=float)))
     return np.stack(m, axis=-1)

@@ -60,25 +60,26 @@ def test_tp_is_orthonormal_for_any_angles(a, b, m):
     # eq. (14) with the printed matrix (= probe2machine): M' = Tp^-1 M
     printed = probe.probe2machine(a, b)
     np.testing.assert_allclose(np.linalg.solve(printed, v), tp @ v, atol=1e-12)
-    mp = gen.direction_to_probe(math.radians(a), math.radians(b), *v)
+    mp = gen.direction_to_probe(*probe._head_angles_rad(a, b), *v)
     np.testing.assert_allclose(np.array(mp), tp @ v, atol=1e-12)
 
 
 @pytest.mark.parametrize("b", [0.0, 30.0, -135.0])
 def test_vertical_probe(b):
-    """A = 0: eq. (11) is undefined (the cross product vanishes); the frame is the limit
-    A -> 0+, the machine frame turned by the roll (the machine frame for B = 0)."""
+    """A = 0: eq. (11) is undefined (the cross product vanishes); as the issue states, the
+    probe frame is then the machine frame, whatever the roll.  Just off vertical the eq. (11)
+    construction is the machine frame turned by the roll (its limit A -> 0+)."""
     ez = np.array([0.0, 0.0, 1.0])
     assert np.linalg.norm(np.cross(ez, [0, 0, 1])) == 0.0
     rz = np.array([[math.cos(math.radians(b)), -math.sin(math.radians(b)), 0],
                    [math.sin(math.radians(b)), math.cos(math.radians(b)), 0], [0, 0, 1]])
-    np.testing.assert_allclose(probe.probe2machine(0.0, b), rz, atol=1e-15)
+    np.testing.assert_array_equal(probe.probe2machine(0.0, b), np.eye(3))
+    np.testing.assert_array_equal(probe.machine2probe(0.0, b), np.eye(3))
     np.testing.assert_allclose(construct_basis(1e-7, b), rz, atol=1e-8)
-    if b == 0.0:
-        np.testing.assert_array_equal(probe.probe2machine(0.0, 0.0), np.eye(3))
-        phi, theta = probe.angles_of([[0, 0, 1], [1, 0, 0], [0, -1, 0], [-1, 0, -1]])
-        np.testing.assert_allclose(phi, [0, 90, 90, 135], atol=1e-12)
-        np.testing.assert_allclose(theta[1:], [0, 270, 180], atol=1e-12)
+    np.testing.assert_allclose(probe.probe2machine(1e-7, b), rz, atol=1e-8)
+    phi, theta = probe.angles_of([[0, 0, 1], [1, 0, 0], [0, -1, 0], [-1, 0, -1]], 0.0, b)
+    np.testing.assert_allclose(phi, [0, 90, 90, 135], atol=1e-12)
+    np.testing.assert_allclose(theta[1:], [0, 270, 180], atol=1e-12)
 
 
 def test_sympy_derivation():
