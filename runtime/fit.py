@@ -314,7 +314,12 @@ def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> tuple[
     dropped terms: ``{"parameters": [that parameter, then the partners it is confounded
     with], "terms": [dropped basis terms], "confounded_with": {partner: weight}}``."""
     G = A2.T @ A2
-    keep = independent_columns(G, priority_order(labels), tol)
+    # translational terms before angular ones: an angular error is what a plan without the
+    # lever arms cannot see, not the scale or straightness it would be confused with
+    order = sorted(range(len(labels)), key=lambda j: (
+        0 if labels[j][0] == "setup" else 1 if labels[j][1] is None else
+        2 if labels[j][0][1] in "XYZ" else 3, j))
+    keep = independent_columns(G, order, tol)
     dropped = np.flatnonzero(~keep)
     if len(dropped) == 0:
         return keep, []
