@@ -27,6 +27,7 @@ How each item is judged
 from __future__ import annotations
 
 import difflib
+import functools
 
 import numpy as np
 import sympy as sp
@@ -63,6 +64,13 @@ def _verdict(eq, same, erratum, evidence, printed, derived, component="") -> Ver
 def _chain():
     layout = read_layout("DMU50")
     return layout, Chain.from_layout(layout)
+
+
+@functools.lru_cache(maxsize=1)
+def _derived():
+    """(layout, chain, forward, rotary inverse, linear inverse) of DMU50, derived once."""
+    layout, chain = _chain()
+    return layout, chain, derived_forward(chain), rotary_inverse(chain), linear_inverse(chain)
 
 
 def derived_forward(chain) -> dict:
@@ -155,12 +163,9 @@ def _product_diff(printed: list, derived: list) -> tuple[bool, str, str]:
 def audit(printed: dict, layouts=None) -> list[Verdict]:
     if layouts is not None and "DMU50" not in layouts:
         return []
-    layout, chain = _chain()
+    layout, chain, fwd, rinv, linv = _derived()
     d_value = float(layout.parameters["d"])
     out: list[Verdict] = []
-    fwd = derived_forward(chain)
-    rinv = rotary_inverse(chain)
-    linv = linear_inverse(chain)
     rng = np.random.default_rng(20210)
     n = 200
     q = {"X": rng.uniform(-250, 250, n), "Y": rng.uniform(-225, 225, n),
