@@ -536,6 +536,10 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
             units[pn] = u
             contrib += after_prob.A[:, j] * after_prob.scale[j] * c_all[j]
         info = {k: (round(v, 6) if isinstance(v, float) else v) for k, v in c.info.items()}
+        if c.kind == "periodic":
+            a_s, a_c = (pars[t[0]] for t in c.terms)
+            info["amplitude_um"] = round(math.hypot(a_s, a_c), 4)
+            info["phase_rad"] = round(math.atan2(a_c, a_s), 4)   # a sin(2 pi q / P + phase)
         ev = dict(s["evidence"])
         ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
         ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)

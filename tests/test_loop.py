@@ -167,3 +167,42 @@ def test_five_axis_clean_and_rotary_columns():
     assert rep["effects"] == []
     assert rep["rms_before_um"] < 2.2 * np.sqrt(3) * 0.3
     assert {"A", "C"} <= set(rep["residual_analysis"])
+
+
+def test_two_effects_at_once():
+    camp = simulate("MB1", n_points=600, seed=61, probes=demo_probes(volerr.load("MB1")),
+                    effects=[{"kind": "thermal", "axis": "Y", "ppm_per_K": 8.0},
+                             {"kind": "periodic", "component": "EXX", "period_mm": 22.0,
+                              "um": 1.2}])
+    rep = run_loop("MB1", camp, progress=False)
+    names = sorted(e["name"] for e in rep["effects"])
+    assert names == ["periodic_EXX", "thermal_Y"]
+    per = next(e for e in rep["effects"] if e["kind"] == "periodic")
+    assert abs(per["info"]["period"] - 22.0) < 0.3 and abs(per["info"]["amplitude_um"] - 1.2) < 0.15
+
+
+@pytest.mark.parametrize("layout", ["MB1", "FB1", "TT_AC"])
+def test_candidate_bases_agree_with_the_derivation(layout):
+    """Every candidate's basis text evaluates the same in the runtime (numpy, no eval) and in
+    the derivation (sympy, lambdified): the search and the augmented model use one formula."""
+    import sympy as sp
+
+    from volerr import candidates
+    from volerr.basis import evaluate, variables
+    from volerr.derive.effects import basis_expr
+    from volerr.fit import data_ranges, rotary_rad
+    from volerr.loop import columns_to_data
+
+    model = volerr.load(layout)
+    camp = simulate(layout, n_points=60, seed=1, rounds=2)
+    data = columns_to_data(camp.columns(), model)
+    values = {**rotary_rad(model, data.positions), **data.covariates}
+    cands = candidates.build(model, data, data_ranges(model, data), 4)
+    terms = [t for c in cands for t in c.terms]
+    terms += candidates.periodic_terms("EXX", "X", 37.5)
+    assert {c.kind for c in cands} == set(candidates.FAMILIES)
+    for _, _, text in terms:
+        names = variables(text)
+        f = sp.lambdify([sp.Symbol(v, real=True) for v in names], basis_expr(text), "numpy")
+        want = np.broadcast_to(f(*(values[v] for v in names)), (data.n,))
+        np.testing.assert_allclose(evaluate(text, values), want, rtol=1e-9, atol=1e-9)
