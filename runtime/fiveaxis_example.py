@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import InputError
 from .fileio import write_text
 from .tables import ErrorTable, write_error_dir
 
@@ -97,6 +98,30 @@ def hemisphere_program(model, radius: float = 40.0, center=(30.0, 20.0, 20.0), r
     return end.join(lines) + end
 
 
+def _inside(model, text: str) -> bool:
+    from . import gcode
+
+    for b in gcode.blocks(gcode.parse(text), model.axes):
+        for a, v in b.target.items():
+            lo, hi = model.travel[a]
+            if v is not None and not lo <= v <= hi:
+                return False
+    return True
+
+
+def example_program(model, radius: float = 40.0) -> str:
+    """:func:`hemisphere_program` at the first of a few centres where it stays in travel."""
+    (xl, xh), (yl, yh), (zl, zh) = (model.travel[a] for a in ("X", "Y", "Z"))
+    centres = [(30.0, 20.0, 20.0), (30.0, 20.0, 60.0), (0.0, 0.0, 120.0),
+               (0.5 * (xl + xh), 0.5 * (yl + yh), zl + 2 * radius),
+               (0.5 * (xl + xh), 0.5 * (yl + yh), 0.5 * (zl + zh))]
+    for c in centres:
+        text = hemisphere_program(model, radius, c)
+        if _inside(model, text):
+            return text
+    raise InputError(f"{model.name}: no example hemisphere fits the travel")
+
+
 def write_example(directory, layout: str = "DMU50") -> dict:
     """Write ``errors/`` and ``hemisphere.nc`` for ``layout`` into ``directory``; return paths."""
     from .model import load
@@ -106,5 +131,5 @@ def write_example(directory, layout: str = "DMU50") -> dict:
     tables, constants = example_errors(model)
     write_error_dir(d / "errors", tables, constants)
     prog = d / "hemisphere.nc"
-    write_text(prog, hemisphere_program(model))
+    write_text(prog, example_program(model))
     return {"errors": d / "errors", "program": prog}
