@@ -39,6 +39,11 @@ step is already the best grid point: at 4 decimals the written program leaves at
 sqrt(3)/2 x 0.1 um = 0.087 um of rounding error (use ``decimals=5`` where the controller takes
 it).
 
+Error tables: positions outside a table's measured range are refused unless extrapolation is
+asked for.  An endless rotary axis (travel >= 720 deg) whose table covers less than a turn is
+closed over the turn (:func:`close_periodic`): the gap, e.g. 340..360 deg, is interpolated
+towards the value at 0 deg; a position such as C = 400 deg is looked up at 40 deg.
+
 Bytes: only the numbers of axis words change.  A word is added to a block only where an axis
 that the block does not program needs a value different from the one the controller holds
 (in ``G91``, a non-zero increment).  With zero errors the output is byte-identical.
@@ -99,6 +104,51 @@ class Result:
             "max_orientation_before_urad": mx(ob), "max_orientation_after_urad": mx(oa),
             "max_iterations": max((r.iterations for r in done), default=0),
         }
+
+
+# ---------------------------------------------------------------------------------------
+# error functions with endless rotary axes closed over the full turn
+def endless_axes(model) -> tuple[str, ...]:
+    """Rotary axes that turn endlessly: travel of at least one turn each way (>= 720 deg)."""
+    return tuple(a for a in model.rotary_axes
+                 if model.travel[a][1] - model.travel[a][0] >= 720.0 - 1e-9)
+
+
+def close_periodic(tables_: dict, model) -> tuple[dict, list[str]]:
+    """For an endless rotary axis whose table covers less than a turn (e.g. 0..340 deg in 20 deg
+    steps), add the first row again one turn later (360 deg): the error at 360 deg is the error
+    at 0 deg, so positions in the gap are interpolated between measured values, not
+    extrapolated.  Returns the tables and a note per closed axis."""
+    from .tables import ErrorTable
+
+    out, notes = dict(tables_), []
+    for a in endless_axes(model):
+        t = tables_.get(a)
+        if t is None:
+            continue
+        lo, hi = float(t.positions[0]), float(t.positions[-1])
+        if hi - lo >= 360.0 - 1e-9:
+            continue
+        out[a] = ErrorTable(a, np.r_[t.positions, lo + 360.0],
+                            {k: np.r_[v, v[0]] for k, v in t.values.items()},
+                            {k: np.r_[v, v[0]] for k, v in t.std.items()},
+                            {k: np.r_[v, v[0]] for k, v in t.u95.items()})
+        notes.append(f"table {a} ({lo:g}..{hi:g} deg) closed over the full turn: "
+                     f"{hi:g}..{lo + 360:g} deg interpolated towards the value at {lo:g} deg")
+    return out, notes
+
+
+def error_functions(directory, model, method: str = "linear", degree=None,
+                    extrapolate: bool = False):
+    """:class:`volerr.tables.ErrorFunctions` of an error directory, endless rotary axes closed
+    over the full turn (:func:`close_periodic`).  Returns (functions, notes)."""
+    from .tables import ErrorFunctions, read_error_dir
+
+    tabs, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
+    tabs, notes = close_periodic(tabs, model)
+    cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}
+    return ErrorFunctions(tabs, consts, model, method, degree, extrapolate, constants_std=cstd,
+                          source=str(directory)), notes
 
 
 # ---------------------------------------------------------------------------------------

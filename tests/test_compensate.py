@@ -493,3 +493,26 @@ def test_controller_negate_round_trip(tmp_path):
     assert cli("controller", "import", "TT_AC", f, "--negate", "--out", tmp_path / "b")[0] == 0
     t_back, _ = tables.read_error_dir(tmp_path / "b", m.axes)
     assert np.allclose(t_back["A"].values["EBA"], t_err["A"].values["EBA"], rtol=1e-10)
+
+
+def test_endless_rotary_table_is_closed_over_the_turn(tmp_path):
+    """A C table measured 0..340 deg (thesis: 18 positions, 20 deg steps) serves C = 350 by
+    interpolating towards the value at 0 = 360 deg, never by extrapolating."""
+    m = volerr.load("DMU50")
+    c = np.arange(0, 360, 20.0)
+    exc = 1e-3 * np.sin(np.deg2rad(c)) + 2e-3
+    write_error_table(tmp_path / "C.csv", ErrorTable("C", c, {"EXC": exc}))
+    prog = tmp_path / "p.nc"
+    prog.write_text("G1 X10 Y10 Z100 B0 C350\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", tmp_path, prog, "--out", tmp_path / "o",
+                     "--report", tmp_path / "r.csv")
+    assert rc == 0, se
+    assert "closed over the full turn" in se
+    rep = np.genfromtxt(tmp_path / "r.csv", delimiter=",", names=True, dtype=None,
+                        encoding=None)
+    # at C = 350: halfway between EXC(340) and EXC(360) = EXC(0); the tool-relative error of
+    # the table's C axis turns with C (see test_fiveaxis)
+    want = 0.5 * (exc[-1] + exc[0])
+    cc = np.deg2rad(350.0)
+    assert rep["dx_before_um"] == pytest.approx(1e3 * want * np.cos(cc), abs=1e-6)
+    assert rep["dy_before_um"] == pytest.approx(1e3 * want * np.sin(cc), abs=1e-6)

@@ -116,13 +116,16 @@ def report_csv(model, reports) -> str:
 def run(args) -> int:
     import sys
 
-    from volerr import gcode, tables
-    from volerr.compensate import compensate_program
+    from volerr import gcode
+    from volerr.compensate import compensate_program, error_functions
     from volerr.model import load
 
     model = load(args.layout)
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
-    funcs = tables.from_args(args, model)
+    funcs, notes = error_functions(args.errors, model, args.method, args.degree,
+                                   args.extrapolate)
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
     text = gcode.read_program(args.program)
     inputs = [args.program, *Path(args.errors).glob("*.csv")]
     for out in (args.out, args.report, args.json, args.plot):

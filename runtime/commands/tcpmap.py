@@ -35,10 +35,11 @@ def register(sub) -> None:
 
 def run(args) -> int:
     import math
+    import sys
 
     import numpy as np
 
-    from volerr import tables
+    from volerr.compensate import error_functions
     from volerr.model import load
     from volerr.plots_fiveaxis import plot_tcp_error_map, tcp_error_map
 
@@ -47,7 +48,10 @@ def run(args) -> int:
     require(all(math.isfinite(v) for v in (*args.point, *args.tool)), "point/tool must be finite")
     require(3 <= args.steps <= 1000, "--steps must be 3..1000")
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
-    funcs = tables.from_args(args, model)
+    funcs, notes = error_functions(args.errors, model, args.method, args.degree,
+                                   args.extrapolate)
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
     inputs = list(Path(args.errors).glob("*.csv"))
     for out in (args.out, args.csv):
         if out:
