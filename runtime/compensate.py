@@ -76,6 +76,9 @@ class LineReport:
     orientation_after_urad: float
     iterations: int
     status: str
+    #: standard uncertainty (k = 1) of the remaining error, from the tables' Type A std,
+    #: per axis x y z (NaN when the tables carry none)
+    u_after_um: tuple = (math.nan,) * 3
 
 
 @dataclass
@@ -103,6 +106,8 @@ class Result:
             "rms_after_um": float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0,
             "max_orientation_before_urad": mx(ob), "max_orientation_after_urad": mx(oa),
             "max_iterations": max((r.iterations for r in done), default=0),
+            "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
+                                           if np.all(np.isfinite(r.u_after_um))])),
         }
 
 
@@ -399,6 +404,10 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
             oa = np.linalg.norm(k_after - k_nom, axis=1) * 1e6
         else:
             ob = oa = np.zeros(len(known))
+        u_after = np.full((len(known), 3), math.nan)
+        if funcs is not None and funcs.has_random:
+            ql = em.lookup(q_out)
+            u_after = model.random_error(q_out, funcs.sigmas(ql), probe=tool) * 1e3
     row = {id(b): r for r, b in enumerate(known)}
     for b in blocks:
         if id(b) in row:
@@ -408,7 +417,7 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
                 tuple(before[r]), tuple(after[r]), float(ob[r]), float(oa[r]), int(iters[r]),
                 "compensated (thesis strategy)" if strategy == "thesis" else
                 "compensated; orientation limited by rotary travel or error table" if limited[r]
-                else "compensated"))
+                else "compensated", tuple(u_after[r])))
         else:
             missing = [a for a in axes if b.target[a] is None]
             reports.append(LineReport(b.line.number, dict(b.target), dict(b.target),

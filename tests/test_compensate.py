@@ -516,3 +516,18 @@ def test_endless_rotary_table_is_closed_over_the_turn(tmp_path):
     cc = np.deg2rad(350.0)
     assert rep["dx_before_um"] == pytest.approx(1e3 * want * np.cos(cc), abs=1e-6)
     assert rep["dy_before_um"] == pytest.approx(1e3 * want * np.sin(cc), abs=1e-6)
+
+
+def test_report_carries_the_uncertainty_of_the_remaining_error(tmp_path):
+    """Only EXX has a standard deviation (0.7 um): the remaining error of every block is
+    uncertain by 0.7 um along the machine X direction, whatever the rotary positions."""
+    m = volerr.load("DMU50")
+    x = np.linspace(-250, 250, 6)
+    write_error_table(tmp_path / "X.csv", ErrorTable("X", x, {"EXX": 1e-5 * x},
+                                                     std={"EXX": np.full(6, 0.7e-3)}))
+    funcs = tables.ErrorFunctions.from_dir(tmp_path, m)
+    text = random_program(m, np.random.default_rng(4), 10)
+    res = compensate_program(m, funcs, text)
+    u = np.array([r.u_after_um for r in res.reports])
+    assert np.allclose(np.linalg.norm(u, axis=1), 0.7, rtol=1e-9)
+    assert res.summary()["max_u_after_um"] == pytest.approx(0.7)

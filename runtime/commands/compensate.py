@@ -10,7 +10,9 @@ Outputs: ``--out`` (the program, same bytes except the compensated numbers), ``-
 (CSV, one row per motion block: ``line,status``, the programmed and written axis positions
 ``<axis>_nominal_mm|deg``, ``<axis>_out_mm|deg``, the predicted tool-tip error before and after
 ``dx_before_um, dy_before_um, dz_before_um, e_before_um, dx_after_um, ..., e_after_um``, the
-tool-axis error ``orientation_before_urad, orientation_after_urad`` and ``iterations``),
+tool-axis error ``orientation_before_urad, orientation_after_urad``, ``iterations`` and the
+standard uncertainty of the remaining error ``ux_after_um, uy_after_um, uz_after_um`` from the
+tables' std columns, empty without them),
 ``--json`` (summary) and ``--plot`` (PNG: error along the program before and after).
 """
 
@@ -96,7 +98,8 @@ def report_csv(model, reports) -> str:
         [f"{a}_out_{unit[a]}" for a in model.axes] + \
         ["dx_before_um", "dy_before_um", "dz_before_um", "e_before_um",
          "dx_after_um", "dy_after_um", "dz_after_um", "e_after_um",
-         "orientation_before_urad", "orientation_after_urad", "iterations"]
+         "orientation_before_urad", "orientation_after_urad", "iterations",
+         "ux_after_um", "uy_after_um", "uz_after_um"]
     rows = [",".join(cols)]
 
     def f(v):
@@ -109,6 +112,7 @@ def report_csv(model, reports) -> str:
         vals += [f(r.nominal[a]) for a in model.axes] + [f(r.output[a]) for a in model.axes]
         vals += [f(v) for v in r.before_um] + [f(eb)] + [f(v) for v in r.after_um] + [f(ea)]
         vals += [f(r.orientation_before_urad), f(r.orientation_after_urad), str(r.iterations)]
+        vals += [f(v) for v in r.u_after_um]
         rows.append(",".join(vals))
     return "\n".join(rows) + "\n"
 
@@ -151,6 +155,9 @@ def run(args) -> int:
           f"({args.strategy}{', orientation' if args.orientation else ''}); predicted tool-tip "
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
+    if s["max_u_after_um"] > 0:
+        print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
+              f"{s['max_u_after_um']:.3f} um")
     if model.rotary_axes:
         print(f"tool-axis error max {s['max_orientation_before_urad']:.2f} -> "
               f"{s['max_orientation_after_urad']:.2f} urad")
