@@ -259,6 +259,9 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
             A = np.concatenate([A, extra], axis=1)
         prob = Problem(A, y)
         scores[k] = rms(_cv(prob, folds, train))
+        best_k = min(scores, key=scores.get)
+        if k - best_k >= 2:   # two degrees without a gain: stop
+            break
     require(scores, f"too few points for the basis: {len(train)} training points cannot fit "
             f"even a degree-1 model of layout {model.name}")
     best = min(scores.values())
@@ -417,7 +420,7 @@ class _Context:
 
 def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
              test_fraction: float = 0.25,
-             degree: int | None = None, max_degree: int = 6, out_dir=None,
+             degree: int | None = None, max_degree: int = 10, out_dir=None,
              progress=None, families=cands.FAMILIES, inputs=()) -> Report:
     """Run the loop on ``data`` (CSV path, :class:`volerr.simulate.Campaign` or
     :class:`volerr.fit.Data`) for ``layout`` (name or layout file). Returns a :class:`Report`.

@@ -103,12 +103,15 @@ def _fmt(v: float) -> str:
 
 
 def random_errors(model: Model, rng: np.random.Generator, magnitude_um: float = 5.0,
-                  degree: int = 4) -> dict:
+                  degree: int = 4, shape: str = "poly") -> dict:
     """Random smooth error functions: name -> callable(q) (mm or rad) or constant.
 
-    Component errors are Legendre series of degree ``degree`` in the axis position normalised
-    over the travel, coefficients decaying as 1/(k+1); translational ones of about
-    ``magnitude_um``, angular ones of ``magnitude_um`` over half the largest linear travel."""
+    ``shape="poly"``: component errors are Legendre series of degree ``degree`` in the axis
+    position normalised over the travel, coefficients decaying as 1/(k+1).  ``"smooth"``: sums
+    of four sinusoids with wavelengths between 4 and 1 times the travel (not polynomials:
+    what a fitted basis can only approximate).  Translational errors are of about
+    ``magnitude_um``, angular ones ``magnitude_um`` over half the largest linear travel."""
+    require(shape in ("poly", "smooth"), f"error shape must be poly or smooth, not {shape!r}")
     lin = [model.travel[a][1] - model.travel[a][0] for a in model.axes
            if a not in model.rotary_axes] or [500.0]
     arm = 0.5 * max(lin)
@@ -119,8 +122,15 @@ def random_errors(model: Model, rng: np.random.Generator, magnitude_um: float = 
         if axis is None:
             out[p] = float(rng.normal(0.0, 1.5 * scale))
             continue
-        coef = rng.normal(0.0, 1.0, degree + 1) * scale / (1.0 + np.arange(degree + 1))
         lo, hi = model.travel[axis]
+        if shape == "smooth":
+            amp = rng.normal(0.0, 1.0, 4) * scale / np.sqrt(2.0)
+            k = rng.uniform(0.25, 1.0, 4) * 2 * np.pi          # rad per normalised travel
+            ph = rng.uniform(0, 2 * np.pi, 4)
+            out[p] = (lambda q, a=amp, k=k, ph=ph, lo=lo, hi=hi:
+                      np.sin(np.multiply.outer(_unit(lo, hi, q), k) + ph) @ a)
+            continue
+        coef = rng.normal(0.0, 1.0, degree + 1) * scale / (1.0 + np.arange(degree + 1))
         out[p] = (lambda q, c=coef, lo=lo, hi=hi:
                   np.polynomial.legendre.legval(_unit(lo, hi, q), c))
     return out
@@ -145,12 +155,13 @@ def make_plan(model: Model, n_points: int, rng: np.random.Generator, probes=None
 def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, rounds: int = 1,
              effects=(), noise_um: float = 0.3, magnitude_um: float = 5.0, degree: int = 4,
              setup_um: float = 20.0, setup_urad: float = 20.0, temperature_K: float = 4.0,
-             duration_h: float = 8.0, errors=None) -> Campaign:
+             duration_h: float = 8.0, errors=None, shape: str = "poly") -> Campaign:
     """Simulate a campaign on a virtual machine of ``layout`` (name or layout file).
 
     The covariate columns ``T_C`` (deg C), ``t_s`` (s), ``dir_<axis>`` (+1 / -1, linear axes),
     ``nx ny nz`` (probing direction) and ``setup`` (round number) are always written, so that
     a loop has every candidate family to consider whether or not an effect is present.
+    ``shape``: ``"poly"`` or ``"smooth"`` error functions (:func:`random_errors`).
     ``errors``: {name: constant or callable(position)} replacing random error functions
     (mm / rad; a callable of a component error gets its own axis' positions, mm | deg)."""
     model = load(layout)
@@ -162,7 +173,7 @@ def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, roun
         bad = sorted(set(e) - {"kind"} - EFFECT_KEYS[e["kind"]])
         require(not bad, f"effect {e['kind']}: unknown key {bad[0] if bad else ''!r} "
                 f"(keys: {' '.join(sorted(EFFECT_KEYS[e['kind']]))})")
-    funcs = random_errors(model, rng, magnitude_um, degree)
+    funcs = random_errors(model, rng, magnitude_um, degree, shape)
     for p, f in dict(errors or {}).items():
         require(p in model.parameters, f"{model.name}: unknown error parameter {p!r}")
         funcs[p] = f

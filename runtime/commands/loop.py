@@ -34,7 +34,7 @@ def register(sub) -> None:
     p.add_argument("--test-fraction", type=float, default=0.25,
                    help="fraction of points held out for before/after (default 0.25)")
     p.add_argument("--degree", type=int, help="degree of the component series (default: by "
-                                              "cross-validation, 1..6)")
+                                              "cross-validation, 1..10)")
     p.add_argument("--families", help="comma list of candidate families to search (default: "
                                       "all)")
     p.set_defaults(func=run)
