@@ -104,3 +104,33 @@ def test_fit_table_weighted_and_smooth():
     assert fits["ECC"].rms_residual < 5e-7
     s = fit_table(t, "smooth")["ECC"]
     assert s.report()["unit"] == "urad" and s.rms_residual < 1e-6
+
+
+def test_shipped_example_identifies_and_gives_squareness(tmp_path):
+    """The shipped example tracker data (simulated, tests/tracker_sim.example_set) through
+    identify and squareness recovers the simulated truth within the stated uncertainty."""
+    import sys
+    from importlib import resources
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from tracker_sim import example_set
+
+    from volerr.identify import identify
+    from volerr.layout import read_layout
+    from volerr.tables import ErrorTable
+    from volerr.tracker_io import read_tracker_csv
+
+    data, sq = example_set()
+    tables = {}
+    for axis in "XYZ":
+        f = resources.files("volerr") / "data" / f"tracker_example_{axis}.csv"
+        res = identify(read_tracker_csv(f), "MB1", axis)
+        pos, rounds, e = data[axis]
+        assert np.allclose(res.positions, pos)
+        z = np.abs(res.values - e)[1:] / (res.u_tracker[1:] / 2.0)  # 4 rounds: u of mean
+        assert z.max() < 5.0
+        tables[axis] = res.table()
+    values, std, _, _ = squareness(tables, read_layout("MB1"))
+    for k, v in sq.items():
+        assert abs(values[k] - v) < 3 * std[k] + 2e-6, k

@@ -67,3 +67,30 @@ def to_csv(rounds_points, positions, labels):
                 x, y, z = pts[k, i]
                 lines.append(f"{r},{lab},{s:.10g},{x:.9f},{y:.9f},{z:.9f}")
     return "\n".join(lines) + "\n"
+
+
+def example_set(seed=2021):
+    """Thesis-like example: X, Y, Z axes of a machine whose spindle carries P, Q, K; 11 steps,
+    4 rounds, 2 um tracker noise, straightness lines inclined so that the squareness is
+    EC0Y = 20 urad, EB0Z = -15 urad, EA0Z = 10 urad (layout sign convention).
+    Returns {axis: (positions, rounds (4, 11, 3, 3), errors (11, 6))}, squareness dict."""
+    rng = np.random.default_rng(seed)
+    ref = np.array([[80.0, 0.0, -120.0], [-40.0, 69.3, -160.0], [-40.0, -69.3, -200.0]])
+    sq = {"EC0Y": 20e-6, "EB0Z": -15e-6, "EA0Z": 10e-6}
+    # lines of motion (tool side): X along x; Y rotated by EC0Y about z -> EXY slope -EC0Y;
+    # Z rotated by EB0Z about y -> EXZ slope +EB0Z, by EA0Z about x -> EYZ slope -EA0Z
+    slopes = {"X": {}, "Y": {0: -sq["EC0Y"]}, "Z": {0: sq["EB0Z"], 1: -sq["EA0Z"]}}
+    out = {}
+    for i, (axis, travel) in enumerate((("X", 500.0), ("Y", 450.0), ("Z", 400.0))):
+        pos = np.linspace(0.0, travel, 11)
+        e = smooth_errors(pos, scale_mm=0.01, scale_rad=40e-6, seed=seed + i)
+        for j in range(3):
+            if j != i:  # straightness: no inclination of its own (least-squares slope 0)
+                e[:, j] -= np.polyfit(pos, e[:, j], 1)[0] * (pos - pos[0])
+        for j, a in slopes[axis].items():
+            e[:, j] += a * (pos - pos[0])
+        d = np.eye(3)[i]
+        rounds = np.array([simulate("linear", ref, pos, e, direction=d, noise_mm=0.002,
+                                    rng=rng) for _ in range(4)])
+        out[axis] = (pos, rounds, e)
+    return out, sq
