@@ -38,7 +38,7 @@ import numpy as np
 from . import candidates as cands
 from .basis import evaluate
 from .errors import InputError, require
-from .fit import (SETUP, Data, Problem, data_ranges, declared_design, gauge_mask,
+from .fit import (Data, Problem, data_ranges, declared_design, gauge_mask,
                   identifiability, point_norm, require_points, rms, rotary_rad, rows_of,
                   twist_columns)
 from .layout import layout_text, parse_layout

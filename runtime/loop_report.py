@@ -15,7 +15,6 @@ import json
 
 import numpy as np
 
-from .basis import evaluate
 from .fit import rotary_rad
 
 

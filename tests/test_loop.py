@@ -71,6 +71,18 @@ def test_clean_data_nothing_found(layout, seed, magnitude, noise):
     assert abs(rep["noise_estimate_um"] - noise) < 0.2 * noise
 
 
+@pytest.mark.parametrize("layout,seed", [("MB1", 14), ("MH1", 15)])
+def test_clean_non_polynomial_errors_nothing_found(layout, seed):
+    """Error functions that are sums of sinusoids (1/4 to 1 cycle over the travel), not
+    polynomials: the degree rises by cross-validation and no effect is invented."""
+    model = volerr.load(layout)
+    camp = simulate(layout, n_points=600, seed=seed, probes=demo_probes(model), shape="smooth")
+    rep = run_loop(layout, camp, seed=seed, progress=False)
+    assert rep["effects"] == [], [e["name"] for e in rep["effects"]]
+    assert rep["degree"] >= 6
+    assert rep["rms_before_um"] < 2.5 * np.sqrt(3) * 0.3
+
+
 def test_identifiability_single_probe_offset():
     """One probe offset straight down: yaw of X and Z have no lever arm at all, roll/pitch of
     Z only the constant one of the probe: they cannot be separated from the straightness of Z."""
