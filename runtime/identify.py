@@ -224,6 +224,9 @@ class Identification:
                 "thesis_choice_everywhere": all(c["thesis_choice_everywhere"] for c in cf),
                 "consistency_max": max(c["consistency_max"] for c in cf),
                 "vs_lsq_max": {n: max(c["vs_lsq_max"][n] for c in cf) for n in self.names},
+                "noise_gain_vs_lsq": {n: float(np.mean([c.get("noise_gain_vs_lsq", {})
+                                                       .get(n, np.nan) for c in cf]))
+                                      for n in self.names},
             }
         return out
 
@@ -412,31 +415,18 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
     closed = {}
     if method == "closed" or (cross_check and n >= 3):
         closed = _closed_form(lever, delta, theta, axis, kind, A)
+    u_closed = _closed_uncertainty(A, closed, W, sigma) if closed else None
+    # outliers are judged on the least-squares residuals (the closed form fits six equations
+    # exactly and leaves all misfit in the other three)
+    outliers = _flag_outliers(rnd, resid, W, sigma, n, outlier_k)
     if method == "closed":
         theta = closed["values"].copy()
         theta[0] = 0.0
         resid = delta - np.einsum("knij,kj->kni", A, theta)
         resid[0] = 0.0
-        # propagate through the selected six equations
-        choice = closed["choice"]
-        As = np.empty((K, 6, 6))
-        S = np.zeros((K, 6, 6))
-        cov_full = np.linalg.inv(W) if W is not None else None
-        for c, rows in closed["row_index"].items():
-            m = choice == c
-            for a, (i, co) in enumerate(rows):
-                As[m, a, :] = A[m, i, co, :]
-                if cov_full is not None:
-                    for b, (j, d) in enumerate(rows):
-                        if i == j:
-                            S[m, a, b] = cov_full[m, i, co, d]
-        Ainv = np.linalg.inv(As)
-        if W is None:
-            covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)
-        else:
-            covs = np.einsum("kij,kjl,kml->kim", Ainv, S, Ainv)
-        u = np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None))
-        u[0] = 0.0
+        u_lsq, u = u, u_closed
+    else:
+        u_lsq = u
     summary_cf = {}
     if closed:
         names = tuple(p + axis for p in MOTION_PREFIX)
@@ -448,9 +438,38 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
                       "consistency_max": closed["consistency_max"],
                       "vs_lsq_max": {nm: float(diff[:, j].max()) * (1e3 if j < 3 else 1e6)
                                      for j, nm in enumerate(names)}}
-    outliers = _flag_outliers(rnd, resid, W, sigma, n, outlier_k)
+        if K > 1:
+            with np.errstate(all="ignore"):
+                gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
+            summary_cf["noise_gain_vs_lsq"] = {nm: float(gain[j]) for j, nm in enumerate(names)}
     return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, delta,
                        cond, s, sigma, outliers, summary_cf)
+
+
+def _closed_uncertainty(A, closed, W, sigma):
+    """Standard uncertainties (K, 6) of the closed form: propagated through the six selected
+    equations of every position (equal weights: per-coordinate noise ``sigma``)."""
+    K = A.shape[0]
+    choice = closed["choice"]
+    As = np.empty((K, 6, 6))
+    S = np.zeros((K, 6, 6))
+    cov_full = np.linalg.inv(W) if W is not None else None
+    for c, rows in closed["row_index"].items():
+        m = choice == c
+        for a, (i, co) in enumerate(rows):
+            As[m, a, :] = A[m, i, co, :]
+            if cov_full is not None:
+                for b, (j, d) in enumerate(rows):
+                    if i == j:
+                        S[m, a, b] = cov_full[m, i, co, d]
+    Ainv = np.linalg.inv(As)
+    if W is None:
+        covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)
+    else:
+        covs = np.einsum("kij,kjl,kml->kim", Ainv, S, Ainv)
+    u = np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None))
+    u[0] = 0.0
+    return u
 
 
 def _flag_outliers(rnd, resid, W, sigma, n, k):

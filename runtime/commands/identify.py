@@ -145,11 +145,13 @@ def run(args) -> int:
           f"residual RMS {s['residual_rms_um']:.3g} um -> {args.out}")
     if "closed_form" in s:
         cf = s["closed_form"]
-        worst = max(cf["vs_lsq_max"].values())
+        d = list(cf["vs_lsq_max"].values())
+        g = [v for v in cf["noise_gain_vs_lsq"].values() if v == v]
         roles = "; ".join(f"P={r['P']} Q={r['Q']} K={r['K']}" for r in cf["roles"])
-        print(f"closed form (selection {cf['selection']}, {roles}): consistent with least "
-              f"squares to {cf['consistency_max']:.2g}; differs on the data by up to "
-              f"{worst:.3g} um/urad")
+        print(f"closed form (Zhang & Hu selection {cf['selection']}, {roles}): equals least "
+              f"squares on consistent data to {cf['consistency_max']:.1g}; on these data it "
+              f"differs by up to {max(d[:3]):.3g} um / {max(d[3:]):.3g} urad"
+              + (f", noise gain {min(g):.2g}-{max(g):.2g} x least squares" if g else ""))
     for f in s.get("fit", []):
         deg = f" degree {f['degree']}" if f["degree"] is not None else ""
         loo = f", leave-one-out {f['loo_rms']:.3g}" if f["loo_rms"] is not None else ""
