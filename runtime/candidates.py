@@ -5,7 +5,9 @@ Each candidate is a list of effect terms (``parameter * basis`` added to a targe
 columns the data provide.  Families (``kind``):
 
 * ``thermal``: a temperature column (``T_C``, ``T_<axis>``, ``temp``...): the scale of each
-  linear axis grows with T - 20 degC (``E<d><A> += KT_A * A * (T - 20)``, KT in 1/K).
+  linear axis grows with T - 20 degC (``E<d><A> += KT_A * A * (T - 20)``, KT in 1/K).  Measured
+  against an artefact at the same temperature, KT is the *differential* expansion (scale
+  minus artefact); its mean over the campaign also sits in the fitted scale error.
 * ``drift``: a time column (``t_s``, ``t_min``, ``t_h``, ``time``): the instrument drifts
   linearly along x, y or z (``work.d<k> += DR_<k> * t``, DR in mm/h).
 * ``reversal``: ``dir_<A>`` (+1 / -1): positioning of A differs by RV_A between approach

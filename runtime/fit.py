@@ -349,6 +349,27 @@ def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> tuple[
     return keep, out
 
 
+def weakly_determined(A2: np.ndarray, labels: list, limit: float = 1e4) -> list:
+    """Parameters the data determine only poorly: variance inflation factor of each column
+    (1 / squared relative distance to the span of the others) above ``limit``, i.e. a
+    standard error inflated more than sqrt(limit) times by near-confounding.  Returns
+    ``[{"parameter", "vif", "terms"}]`` sorted by decreasing VIF."""
+    G = A2.T @ A2
+    d = np.sqrt(np.diag(G))
+    d[d == 0] = 1.0
+    C = G / np.outer(d, d)
+    w, V = np.linalg.eigh(C)
+    ok = w > 1e-14 * w[-1]
+    vif = np.einsum("ij,j,ij->i", V[:, ok], 1.0 / w[ok], V[:, ok])
+    out: dict = {}
+    for j in np.flatnonzero(vif > limit):
+        p = _name(labels[j])
+        e = out.setdefault(p, {"parameter": p, "vif": 0.0, "terms": []})
+        e["vif"] = max(e["vif"], round(float(vif[j]), 1))
+        e["terms"].append(_term(labels[j]))
+    return sorted(out.values(), key=lambda e: -e["vif"])
+
+
 def require_points(n_points: int, n_columns: int, what: str) -> None:
     """Refuse a fit with too few points for its basis."""
     require(3 * n_points >= 2 * n_columns + 10,

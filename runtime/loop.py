@@ -40,7 +40,7 @@ from .basis import evaluate
 from .errors import InputError, require
 from .fit import (Data, Problem, data_ranges, declared_design, gauge_mask,
                   identifiability, point_norm, require_points, rms, rotary_rad, rows_of,
-                  twist_columns)
+                  twist_columns, weakly_determined)
 from .layout import layout_text, parse_layout
 from .model import Model, load
 
@@ -57,7 +57,7 @@ def read_deviations(path, model: Model) -> Data:
     p = Path(path)
     require(p.is_file(), f"data file not found: {path}")
     try:
-        with open(p, newline="", encoding="utf-8") as fh:
+        with open(p, newline="", encoding="utf-8-sig") as fh:
             rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
     except (UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{p.name}: not a readable CSV ({exc})") from None
@@ -356,6 +356,7 @@ class _Context:
         keep = keep.copy()
         keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
         A_all = design.A[:, :, keep].reshape(-1, keep.sum())
+        weak = weakly_determined(A_all, [lab for lab, k in zip(design.labels, keep) if k])
         candidates = [c for c in cands.build(model, dat, self.ranges, degree)
                       if c.kind in self.families]
         tr_rows = rows_of(train)
@@ -414,7 +415,7 @@ class _Context:
             if not accepted:
                 break
         return {"design": design, "keep": keep, "gauge": gauge, "A_all": A_all,
-                "unidentifiable": unident,
+                "unidentifiable": unident, "weak": weak,
                 "selected": selected, "candidates": candidates}
 
 
@@ -578,6 +579,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
         "max_after_um": round(1e3 * float(na.max()), 4),
         "effects": effects,
         "unidentifiable": unident,
+        "weakly_determined": state["weak"],
         "n_train": int(len(train)),
         "n_test": int(len(test)),
         "degree": int(degree),

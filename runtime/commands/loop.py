@@ -64,4 +64,13 @@ def run(args) -> int:
     if args.html:
         report.write_html(args.html, inputs=inputs)
     print(report.summary())
+    for e in report.effects:
+        pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
+        print(f"  {e['kind']} {e['name']}: {pars}")
+    if report["augmented_layout"]:
+        print(f"  augmented layout: {report['augmented_layout']}; generated module: "
+              f"{report['generated_module']}")
+    if report["unidentifiable"]:
+        print(f"  not separable by these data: "
+              f"{', '.join(u['parameters'][0] for u in report['unidentifiable'])} (see the report)")
     return 0
