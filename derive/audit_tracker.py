@@ -163,7 +163,7 @@ def audit_displacement(eq: dict) -> list[Verdict]:
             named = describe_diff(de, sp.expand(pr))
             out.append(_verdict(
                 eq, f"Delta_{c} right-hand side", False,
-                f"row {c}: {named}",
+                named,
                 f"the derived row is {fmt(sp.collect(de, list(r)))}; the printed row differs by "
                 f"{fmt(sp.collect(sp.expand(pr - de), list(r)))} (derived - printed = "
                 f"{fmt(diff)}). The printed coefficient of x_P, {fmt(sp.expand(pr).coeff(r[0]))}"
@@ -252,33 +252,48 @@ def audit_system(eq: dict) -> list[Verdict]:
             parts.append(f"{', '.join(twice)} listed twice")
         if len(got_u) != 6:
             parts.append(f"{len(got_u)} unknowns for 6 columns")
-        out.append(_verdict(eq, "unknown vector", False, "unknown vector: " + "; ".join(parts),
+        out.append(_verdict(eq, "unknown vector", False, "; ".join(parts),
                             "the six columns multiply E_X ... E_C of the axis in this order; "
                             "the printed vector mislabels them (possibly an extraction defect "
                             "of repeated subscripts)", ", ".join(got_u), ", ".join(want_u)))
-    # right-hand side
+    # right-hand side: which equation does each printed entry belong to?
     rhs = eq.get("rhs", [])
-    problems = []
-    if len(rhs) != len(rows):
-        problems.append(f"{len(rhs)} entries for {len(rows)} rows")
-    row_labels = labels if eq.get("row_labels_from") != "matrix" else labels
-    for k, text in enumerate(rhs):
-        if k >= len(row_labels):
-            break
-        lab = row_labels[k]
+    distinct = list(dict.fromkeys(labels))
+    want = {lab: (S(f"d_{lab[1]}{lab[0]}") if rotated else _deviation(lab[0], lab[1], axis))
+            for lab in derived}
+    matched = []
+    for text in rhs:
         pr = parse(text, axis)
-        if rotated:
-            want = S(f"d_{lab[1]}{lab[0]}")
-        else:
-            want = _deviation(lab[0], lab[1], axis)
-        if sp.expand(pr - want) != 0:
-            problems.append(f"entry {k + 1} is {text} for row {lab} ({fmt(want)})")
+        matched.append(next((lab for lab, w in want.items() if sp.expand(pr - w) == 0), None))
+    problems = []
+    if matched == distinct:
+        pass
+    else:
+        if len(rhs) != len(distinct):
+            problems.append(f"{len(rhs)} entries for {len(distinct)} equations")
+        for k, (text, lab) in enumerate(zip(rhs, matched)):
+            if lab is None:
+                guess = distinct[k] if k < len(distinct) else None
+                hint = f" (row {guess} needs {fmt(want[guess])})" if guess else ""
+                problems.append(f"entry {k + 1} {text!r} is no deviation of any point{hint}")
+        twice = sorted({lab for lab in matched if lab and matched.count(lab) > 1})
+        if twice:
+            problems.append(f"entry for {', '.join(twice)} printed twice")
+        missing = [lab for lab in distinct if lab not in matched]
+        if missing:
+            problems.append(f"no entry for row(s) {', '.join(missing)}")
+        order = [lab for lab in dict.fromkeys(m for m in matched if m) if lab in distinct]
+        rows_order = [lab for lab in distinct if lab in order]
+        if order != rows_order:
+            problems.append(f"entries in the order {', '.join(order)}, rows in the order "
+                            f"{', '.join(rows_order)}")
     out.append(_verdict(eq, "right-hand side", not problems,
-                        "right-hand side: " + "; ".join(problems[:2]) if problems else "",
+                        "; ".join(problems[:3]) if problems else "",
                         ("each entry is the deviation (measured - nominal) of the point and "
                          "coordinate of its row" if not problems else
-                         "entries compared with the rows in printed order: " + "; ".join(problems)),
-                        "; ".join(rhs), f"{len(rows)} deviations"))
+                         "each entry matched against the derived deviations (measured - "
+                         "nominal) of every point and coordinate: " + "; ".join(problems)),
+                        "; ".join(rhs), f"{len(distinct)} deviations"))
     return out
 
 
