@@ -214,6 +214,48 @@ class Report:
 
         return write_text(path, render_html(self), inputs=list(inputs))
 
+    def error_tables(self, n_grid: int = 41) -> tuple[dict, dict]:
+        """The fitted error functions of the declared model (effects removed: the machine at
+        the reference state, T = 20 degC, t = 0 ...) as error tables over the measured range.
+
+        Returns ``({axis: volerr.tables.ErrorTable}, constants {name: value})`` in mm / rad,
+        with ``std`` columns (standard deviation of the fit).  Translational errors are zero at
+        the start of the measured range (their constants belong to the instrument placement);
+        straightness slopes are carried by squareness (gauge: see :mod:`volerr.fit`)."""
+        from .fit import legendre, unit
+        from .tables import ErrorTable
+
+        fg = self.figures
+        model, ranges, deg = fg["model"], fg["ranges"], fg["degree"]
+        prob, coef, labels, var = fg["after_prob"], fg["c_all"], fg["aug_labels"], fg["cov_diag"]
+        index = {lab: j for j, lab in enumerate(labels)}
+        tables, constants = {}, {}
+        for a in model.axes:
+            q = np.linspace(*ranges[a], n_grid)
+            P = legendre(unit(q, *ranges[a]), deg)
+            vals, std = {}, {}
+            for p in model.parameters:
+                if model.parameter_axis.get(p) != a:
+                    continue
+                js = [(k, index[(p, k)]) for k in range(deg + 1) if (p, k) in index]
+                v = sum((P[:, k] * coef[j] for k, j in js), np.zeros(n_grid))
+                sd = np.sqrt(sum((P[:, k] ** 2 * var[j] for k, j in js), np.zeros(n_grid)))
+                if p[1] in "XYZ":
+                    v = v - v[0]
+                vals[p], std[p] = v, sd
+            tables[a] = ErrorTable(a, q, vals, std=std)
+        for p in model.parameters:
+            if model.parameter_axis.get(p) is None and (p, None) in index:
+                constants[p] = float(coef[index[(p, None)]])
+        return tables, constants
+
+    def write_error_tables(self, directory, inputs=()) -> Path:
+        """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``)."""
+        from .tables import write_error_dir
+
+        tables, constants = self.error_tables()
+        return write_error_dir(directory, tables, constants or None, inputs=list(inputs))
+
     def summary(self) -> str:
         d = self.data
         found = ", ".join(f"{e['kind']} ({e['name']})" for e in d["effects"]) or "none"
@@ -599,7 +641,8 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
                    "fitting; before = declared model, after = augmented model, both fitted "
                    "on the other points").format(test_fraction),
     }
-    figs = {"model": model, "data": dat, "res_before": res_before_all,
+    figs = {"model": model, "data": dat, "res_before": res_before_all, "ranges": ranges,
+            "degree": degree, "cov_diag": cov_diag,
             "res_after": res_after_all, "test": test, "r_before": r_before, "r_after": r_after,
             "selected": selected, "after_prob": after_prob, "c_all": c_all,
             "aug_labels": aug_labels}

@@ -218,3 +218,45 @@ def test_candidate_bases_agree_with_the_derivation(layout):
         f = sp.lambdify([sp.Symbol(v, real=True) for v in names], basis_expr(text), "numpy")
         want = np.broadcast_to(f(*(values[v] for v in names)), (data.n,))
         np.testing.assert_allclose(evaluate(text, values), want, rtol=1e-9, atol=1e-9)
+
+
+def _rigid_residual(model, pos, probe, d):
+    """d (N, 3) minus its best first-order rigid motion t + w x p (the instrument's placement)."""
+    nom = model.nominal_position(pos, probe)
+    n = len(nom)
+    A = np.zeros((3 * n, 6))
+    for i in range(3):
+        A[i::3, i] = 1.0
+    for k in range(3):
+        A[:, 3 + k] = np.cross(np.eye(3)[k], nom).ravel()
+    c, *_ = np.linalg.lstsq(A, d.ravel(), rcond=None)
+    return (d.ravel() - A @ c).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("layout,seed,effect", [
+    ("MH2", 71, {"kind": "thermal", "axis": "Z", "ppm_per_K": 9.0}),
+    ("FB1", 72, {"kind": "periodic", "component": "EXX", "period_mm": 35.0, "um": 1.0})])
+def test_exported_error_map_is_the_machine(tmp_path, layout, seed, effect):
+    """The fitted error functions, written as error tables and read back through
+    volerr.tables, predict the simulated machine's true (exact-chain) error at new points to
+    a small fraction of its size, up to the instrument's rigid placement."""
+    from volerr.tables import ErrorFunctions, read_error_dir
+
+    model = volerr.load(layout)
+    camp = simulate(layout, n_points=700, seed=seed, probes=demo_probes(model),
+                    effects=[effect])
+    rep = run_loop(layout, camp, progress=False)
+    rep.write_error_tables(tmp_path / "errors")
+    tables, (consts, _, _) = read_error_dir(tmp_path / "errors", model.axes)
+    funcs = ErrorFunctions(tables, consts, model, method="cubic")
+    rng = np.random.default_rng(seed)
+    pos = {a: rng.uniform(camp.positions[a].min(), camp.positions[a].max(), 400)
+           for a in model.axes}
+    probe = np.array(demo_probes(model))[rng.integers(0, 5, 400)]
+    truth = {p: (f(pos[model.parameter_axis[p]]) if callable(f) else f)
+             for p, f in camp.truth["functions"].items()}
+    true = model.exact_error(pos, truth, probe)
+    err = _rigid_residual(model, pos, probe, model.volumetric_error(pos, funcs(pos), probe) - true)
+    size = np.sqrt(np.mean(np.sum(_rigid_residual(model, pos, probe, true) ** 2, axis=1)))
+    rms_err = np.sqrt(np.mean(np.sum(err ** 2, axis=1)))
+    assert rms_err < 0.05 * size and rms_err < 0.2e-3, (rms_err, size)

@@ -40,7 +40,7 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
                (np.asarray(v) * 1e-3 if k.endswith("_um") else v) for k, v in cols.items()}
     mm = _write(tmp_path / "mm.csv", mm_cols)
     r1 = _cli("loop", "MB1", um, "--json", tmp_path / "a.json", "--degree", "4",
-              "--out-dir", tmp_path / "aug")
+              "--out-dir", tmp_path / "aug", "--errors-out", tmp_path / "errors")
     r2 = _cli("loop", "MB1", mm, "--json", tmp_path / "b.json", "--degree", "4",
               "--out-dir", tmp_path / "aug2")
     assert r1.returncode == 0 and r2.returncode == 0, r1.stderr + r2.stderr
@@ -49,6 +49,8 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     assert a["rms_before_um"] == pytest.approx(b["rms_before_um"], rel=1e-6)
     assert [e["name"] for e in a["effects"]] == ["reversal_X"]
     assert (tmp_path / "aug" / "MB1_aug.toml").is_file()
+    assert sorted(p.name for p in (tmp_path / "errors").iterdir()) == [
+        "X.csv", "Y.csv", "Z.csv", "constants.csv"]
     assert "reversal" in r1.stdout
 
 

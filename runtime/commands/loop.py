@@ -28,6 +28,9 @@ def register(sub) -> None:
     p.add_argument("--html", help="write the report with figures (HTML)")
     p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
                                      "(default: the folder of --json)")
+    p.add_argument("--errors-out", metavar="DIR",
+                   help="write the fitted error functions (effects removed) as an error "
+                        "directory: X.csv, Y.csv, ... and constants.csv")
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
                                              "leave-one-point-out, exact via the hat matrix)")
@@ -63,6 +66,8 @@ def run(args) -> int:
     report.write_json(args.json, inputs=inputs)
     if args.html:
         report.write_html(args.html, inputs=inputs)
+    if args.errors_out:
+        report.write_error_tables(args.errors_out, inputs=inputs)
     print(report.summary())
     for e in report.effects:
         pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
