@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from tracker_sim import simulate, smooth_errors  # noqa: E402,F401
+from tracker_sim import smooth_errors  # noqa: E402
 
 from volerr.identify import design, identify  # noqa: E402
 from volerr.layout import parse_layout  # noqa: E402

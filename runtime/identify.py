@@ -231,6 +231,35 @@ class Identification:
         return out
 
 
+def _layout_number(value, params: dict) -> float:
+    """A layout coordinate: a number or an arithmetic expression in the layout parameters."""
+    import ast
+    import operator
+
+    if isinstance(value, (int, float)):
+        return float(value)
+    ops = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+           ast.Div: operator.truediv, ast.USub: operator.neg, ast.UAdd: operator.pos}
+
+    def ev(node):
+        if isinstance(node, ast.Expression):
+            return ev(node.body)
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return float(node.value)
+        if isinstance(node, ast.Name) and node.id in params:
+            return float(params[node.id])
+        if isinstance(node, ast.BinOp) and type(node.op) in ops:
+            return ops[type(node.op)](ev(node.left), ev(node.right))
+        if isinstance(node, ast.UnaryOp) and type(node.op) in ops:
+            return ops[type(node.op)](ev(node.operand))
+        raise InputError(f"cannot evaluate the layout coordinate {value!r}")
+
+    try:
+        return ev(ast.parse(str(value), mode="eval"))
+    except SyntaxError:
+        raise InputError(f"cannot evaluate the layout coordinate {value!r}") from None
+
+
 def _axis_geometry(layout, axis, direction, origin):
     require(axis in layout.axes, f"axis {axis!r} is not an axis of layout {layout.name} "
                                  f"(axes: {' '.join(layout.axis_names)})")
@@ -240,6 +269,9 @@ def _axis_geometry(layout, axis, direction, origin):
     d = np.asarray(direction, dtype=float)
     require(d.shape == (3,) and np.all(np.isfinite(d)) and np.linalg.norm(d) > 1e-12,
             "axis direction must be three finite numbers, not all zero")
+    if isinstance(origin, str) and origin == "layout":
+        require(ax.kind == "rotary", f"origin 'layout' applies to rotary axes; {axis} is linear")
+        origin = [_layout_number(v, layout.parameters) for v in ax.point]
     o = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
     require(o.shape == (3,) and np.all(np.isfinite(o)), "origin must be three finite numbers")
     return ax.kind, d / np.linalg.norm(d), o
@@ -515,7 +547,9 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         Tracker position in the measurement frame: weights and propagated uncertainty from the
         AT960 figures.
     direction, origin : (3,), optional
-        Axis direction (default: the layout's) and a point of a rotary axis (default 0, 0, 0).
+        Axis direction (default: the layout's) and a point of a rotary axis in the measurement
+        frame (default 0, 0, 0: the frame origin lies on the axis; ``"layout"``: the layout's
+        ``point`` of the axis, for a measurement frame that is the machine frame).
     sense : "auto", +1 or -1
         Sense of the nominal motion (default: detected from the data).
     """

@@ -260,3 +260,45 @@ def test_rounds_table_written_with_std(tmp_path):
 def test_layout_axis_direction_used():
     lay = read_layout("MB1")
     assert lay.axes["Y"].direction == (0.0, 1.0, 0.0)
+
+
+def test_dmu50_inclined_b_axis_with_layout_origin():
+    """DMU 50 B axis: inclined 45 deg, through (0, 0, d); table points turn about it."""
+    lay = read_layout("DMU50")
+    d = float(lay.parameters["d"])
+    origin = np.array([0.0, 0.0, d])
+    pos = np.arange(0.0, 181.0, 10.0)
+    e = smooth_errors(pos, seed=13)
+    table_pts = np.array([[150.0, 20.0, 30.0], [-90.0, 120.0, 60.0], [10.0, -140.0, 90.0]])
+    pts = simulate("rotary", table_pts, pos, e, direction=lay.axes["B"].direction,
+                   origin=origin, sense=-1)
+    res = identify([Round("r", pos, LABELS, pts)], lay, "B", origin="layout")
+    assert res.rounds[0].sense == -1
+    b = second_order_bound(e, table_pts, origin)
+    _check(res, e, b, b / 50.0)
+    with pytest.raises(InputError, match="deviate"):  # origin off the axis: refused or wrong
+        identify([Round("r", pos, LABELS, pts)], lay, "B")
+
+
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000), scale=st.floats(10.0, 400.0))
+def test_random_geometry_recovered(seed, scale):
+    """Random well-conditioned point sets of any size and random errors: exact recovery up to
+    the second-order term of the rigid-body motion."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 7))
+    ref = rng.uniform(-1, 1, size=(n, 3)) * scale + rng.uniform(-300, 300, size=3)
+    from volerr.identify import geometry_condition
+    if geometry_condition(ref) > 50:
+        return
+    pos = np.linspace(0, 300, 5)
+    e = smooth_errors(pos, seed=seed)
+    pts = simulate("linear", ref, pos, e, direction=(0, 1, 0))
+    res = identify([Round("r", pos, tuple(f"p{i}" for i in range(n)), pts)], "MB1", "Y",
+                   cross_check=n == 3)
+    b = second_order_bound(e, ref) * 50  # gain of an off-centre frame origin
+    assert np.abs(res.values - e)[:, :3].max() < b + 1e-7
+    assert np.abs(res.values - e)[:, 3:].max() < b / max(scale, 1) + 1e-9

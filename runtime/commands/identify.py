@@ -42,7 +42,8 @@ def register(sub) -> None:
     p.add_argument("--direction", metavar="X,Y,Z", help="axis direction in the measurement "
                                                         "frame (default: the layout's)")
     p.add_argument("--origin", metavar="X,Y,Z", help="a point on a rotary axis in the "
-                                                     "measurement frame, mm (default 0,0,0)")
+                                                     "measurement frame, mm (default 0,0,0), "
+                                                     "or 'layout': the axis point of the layout")
     p.add_argument("--sense", choices=("auto", "+", "-"), default="auto",
                    help="sense of the nominal motion of the points (default: from the data)")
     p.add_argument("--max-cond", type=float, default=1e4,
@@ -121,7 +122,8 @@ def run(args) -> int:
         rounds, layout, args.axis, method=args.method,
         tracker=_vec(args.tracker, "--tracker") if args.tracker else None,
         direction=_vec(args.direction, "--direction") if args.direction else None,
-        origin=_vec(args.origin, "--origin") if args.origin else None,
+        origin=("layout" if args.origin == "layout" else
+                _vec(args.origin, "--origin") if args.origin else None),
         sense=sense, max_cond=args.max_cond, outlier_k=args.outlier_k)
     table = result.table()
     text = table_to_csv(table)
