@@ -62,6 +62,52 @@ from .fiveaxis import is_five_axis, linear_axes, linear_jacobian
 
 STRATEGIES = ("full", "thesis")
 
+#: ISO/TR 16907 compensation types (thesis sec. 2.9.1) and the groups that combine them
+TYPES = ("L-POS", "L-STR", "L-SQU", "L-ANG", "R-POS", "R-RAX", "R-POR", "R-ANG")
+TYPE_GROUPS = {"L-VOL": ("L-POS", "L-STR", "L-SQU", "L-ANG"),
+               "R-VOL": ("R-POS", "R-RAX", "R-POR", "R-ANG")}
+
+
+def parameter_types(model) -> dict:
+    """ISO name -> the ISO/TR 16907 compensation types that address it.
+
+    Linear axis ``A``: ``EAA``-like positioning (``EXX``) L-POS, straightness L-STR, angular
+    L-ANG; squareness L-SQU.  Rotary axis ``R``: translational error motions R-RAX (radial and
+    axial), location and orientation errors R-POR, angular positioning R-POS, tilt R-ANG.  For
+    a rotary axis not aligned with x, y or z (the DMU 50's B) the angular error motions about
+    x, y, z each mix positioning and tilt: they belong to both R-POS and R-ANG."""
+    out = {}
+    paxis = model.parameter_axis
+    for p in model.parameters:
+        a = paxis[p]
+        if a is None:
+            out[p] = ("L-SQU",) if p[-1] in linear_axes(model) else ("R-POR",)
+        elif a not in model.rotary_axes:
+            out[p] = ("L-POS",) if p[1] == a else ("L-STR",) if p[1] in "XYZ" else ("L-ANG",)
+        elif p[1] in "XYZ":
+            out[p] = ("R-RAX",)
+        else:
+            u = np.abs(np.asarray(model.layout.axes[a].direction, dtype=float))
+            aligned = abs(u.max() - 1.0) < 1e-12
+            own = "ABC"[int(np.argmax(u))] if aligned else None
+            out[p] = ("R-POS", "R-ANG") if own is None else \
+                ("R-POS",) if p[1] == own else ("R-ANG",)
+    return out
+
+
+def parameters_for_types(model, types) -> set | None:
+    """The parameters compensated by the ISO/TR 16907 ``types`` (names or groups L-VOL,
+    R-VOL); None (all) when ``types`` is None."""
+    if types is None:
+        return None
+    wanted = set()
+    for t in types:
+        t = t.strip().upper()
+        require(t in TYPES or t in TYPE_GROUPS,
+                f"unknown compensation type {t!r} (use {' '.join(TYPES)} or L-VOL R-VOL)")
+        wanted.update(TYPE_GROUPS.get(t, (t,)))
+    return {p for p, ts in parameter_types(model).items() if wanted.intersection(ts)}
+
 
 @dataclass
 class LineReport:
@@ -161,8 +207,10 @@ def error_functions(directory, model, method: str = "linear", degree=None,
 class ErrorModel:
     """Actual tool tip and tool axis of a model with error functions (mm, deg at the API)."""
 
-    def __init__(self, model, funcs=None, tool=(0.0, 0.0, 0.0)):
+    def __init__(self, model, funcs=None, tool=(0.0, 0.0, 0.0), compensated=None):
         self.model, self.funcs = model, funcs
+        #: the parameters the compensation acts on (None: all); the report uses all
+        self.compensated = compensated
         self.tool = np.asarray(tool, dtype=float)
         self.rot = model.rotary_axes
         self.lin = linear_axes(model)
@@ -261,7 +309,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
         qa = q[active]
         change = np.zeros(len(qa))
         if orientation and em.rot:
-            k_act = em.tool_axis(qa) + em.orientation_error(qa)
+            k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated)
             j = _rotary_jacobian(em, qa)
             d = _truncated_solve(j, -(k_act - target_k[active]))
             trial = qa.copy()
@@ -271,7 +319,8 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
             d[~ok] = 0.0
             qa[ok] = trial[ok]
             change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa) - target_p[active]
+        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated) \
+            - target_p[active]
         mj = linear_jacobian(m, qa, em.tool)
         d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
         qa[:, lin_idx] += d
@@ -321,8 +370,12 @@ def _round(v: float, nd: int) -> float:
 def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
                        strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
                        initial: dict | None = None, check_travel: bool = True,
-                       max_iter: int = 50) -> Result:
-    """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`."""
+                       max_iter: int = 50, types=None) -> Result:
+    """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
+
+    ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
+    that compensates the linear axes only); the report still predicts the error of the full
+    model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL)."""
     require(strategy in STRATEGIES, f"unknown strategy {strategy!r} ({' '.join(STRATEGIES)})")
     require(tol_um > 0 and math.isfinite(tol_um), "tolerance must be a positive number")
     require(0 <= decimals <= 9, "decimals must be 0..9")
@@ -336,7 +389,10 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
         require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")
     lines = gcode.parse(text)
     blocks = gcode.blocks(lines, model.axes, initial)
-    em = ErrorModel(model, funcs, tool)
+    require(not (types is not None and strategy == "thesis"),
+            "the thesis strategy has its own set of errors (L-POS L-STR L-SQU and the "
+            "rotary-axis errors); --types applies to the full strategy")
+    em = ErrorModel(model, funcs, tool, parameters_for_types(model, types))
     axes = model.axes
 
     known = [b for b in blocks if all(b.target[a] is not None for a in axes)]
@@ -435,7 +491,7 @@ def _resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
     target_p = m.nominal_position(q_nom, em.tool)
     q = q_out.copy()
     for _ in range(max_iter):
-        e = m.nominal_position(q, em.tool) + em.position_error(q) - target_p
+        e = m.nominal_position(q, em.tool) + em.position_error(q, em.compensated) - target_p
         d = -np.linalg.solve(linear_jacobian(m, q, em.tool), e[:, :, None])[:, :, 0]
         q[:, lin_idx] += d
         if np.abs(d).max() < tol:

@@ -531,3 +531,29 @@ def test_report_carries_the_uncertainty_of_the_remaining_error(tmp_path):
     u = np.array([r.u_after_um for r in res.reports])
     assert np.allclose(np.linalg.norm(u, axis=1), 0.7, rtol=1e-9)
     assert res.summary()["max_u_after_um"] == pytest.approx(0.7)
+
+
+def test_iso_16907_types_select_what_is_compensated(tmp_path):
+    m = volerr.load("DMU50")
+    rotary_only = {p for p in m.parameters if m.parameter_axis[p] in ("B", "C") or "0B" in p
+                   or "0C" in p}
+    err = write_errors(tmp_path / "err", m, seed=9, only=rotary_only)
+    funcs = tables.ErrorFunctions.from_dir(err, m)
+    text = random_program(m, np.random.default_rng(3), 15)
+    lin = compensate_program(m, funcs, text, types=["L-VOL"])
+    assert lin.text == text                    # nothing of the linear axes to compensate
+    s = lin.summary()
+    assert s["max_after_um"] == pytest.approx(s["max_before_um"]) and s["max_before_um"] > 1
+    full = compensate_program(m, funcs, text)
+    assert compensate_program(m, funcs, text, types=["L-VOL", "R-VOL"]).text == full.text
+    assert compensate_program(m, funcs, text, types=["R-VOL"]).text == full.text
+    # every parameter has a type; the inclined B mixes positioning and tilt
+    from volerr.compensate import parameter_types
+
+    t = parameter_types(m)
+    assert set(t) == set(m.parameters)
+    assert t["EXX"] == ("L-POS",) and t["EYX"] == ("L-STR",) and t["EBX"] == ("L-ANG",)
+    assert t["EC0Y"] == ("L-SQU",) and t["EX0C"] == ("R-POR",) and t["ECC"] == ("R-POS",)
+    assert t["EAC"] == ("R-ANG",) and t["EBB"] == ("R-POS", "R-ANG")
+    with pytest.raises(volerr.errors.InputError, match="unknown compensation type"):
+        compensate_program(m, funcs, text, types=["L-FOO"])

@@ -42,7 +42,11 @@ def register(sub) -> None:
                         "Ellingsdalen 2021 sec. 3.5 (rotary, then linear; angular errors of the "
                         "linear axes neglected), for comparison")
     p.add_argument("--orientation", action="store_true",
-                   help="also correct the tool orientation with the rotary axes")
+                   help="also correct the tool orientation with the rotary axes (FOR)")
+    p.add_argument("--types", default=None,
+                   help="ISO/TR 16907 compensation types to apply, comma separated: L-POS "
+                        "L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG, or L-VOL R-VOL (default: "
+                        "all); the report still predicts the full model's error")
     p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
                    metavar=("XT", "YT", "ZT"),
                    help="tool-tip offset in the tool frame, mm, beyond the point the axis "
@@ -138,21 +142,24 @@ def run(args) -> int:
     result = compensate_program(
         model, funcs, text, tool=args.tool, orientation=args.orientation,
         strategy=args.strategy, tol_um=args.tol_um, decimals=args.decimals,
-        initial=_initial(args.initial), check_travel=not args.ignore_travel)
+        initial=_initial(args.initial), check_travel=not args.ignore_travel,
+        types=None if args.types is None else [t for t in args.types.split(",") if t.strip()])
     write_bytes(args.out, result.text.encode("latin-1"), inputs)
     s = result.summary()
     if args.report:
         write_text(args.report, report_csv(model, result.reports), inputs)
     if args.json:
         write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
-                                          "orientation": bool(args.orientation), **s},
+                                          "orientation": bool(args.orientation),
+                                          "types": args.types or "L-VOL,R-VOL", **s},
                                          indent=2) + "\n", inputs)
     if args.plot:
         from volerr.plots_fiveaxis import plot_program_errors
 
         plot_program_errors(result.reports, args.plot, title=f"{model.name}: {args.program}")
     print(f"{model.name}: {s['compensated']} of {s['motion_blocks']} motion blocks compensated "
-          f"({args.strategy}{', orientation' if args.orientation else ''}); predicted tool-tip "
+          f"({args.strategy}{', orientation' if args.orientation else ''}"
+          f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
     if s["max_u_after_um"] > 0:
