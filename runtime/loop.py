@@ -214,20 +214,24 @@ class Report:
 
         return write_text(path, render_html(self), inputs=list(inputs))
 
-    def error_tables(self, n_grid: int = 41) -> tuple[dict, dict]:
+    def error_tables(self, n_grid: int = 41, which: str = "after") -> tuple[dict, dict]:
         """The fitted error functions of the declared model (effects removed: the machine at
         the reference state, T = 20 degC, t = 0 ...) as error tables over the measured range.
 
         Returns ``({axis: volerr.tables.ErrorTable}, constants {name: value})`` in mm / rad,
         with ``std`` columns (standard deviation of the fit).  Translational errors are zero at
         the start of the measured range (their constants belong to the instrument placement);
-        straightness slopes are carried by squareness (gauge: see :mod:`volerr.fit`)."""
+        straightness slopes are carried by squareness (gauge: see :mod:`volerr.fit`).
+        ``which="before"``: the declared model's own fit (effects unmodelled, no std)."""
         from .fit import legendre, unit
         from .tables import ErrorTable
 
         fg = self.figures
         model, ranges, deg = fg["model"], fg["ranges"], fg["degree"]
-        prob, coef, labels, var = fg["after_prob"], fg["c_all"], fg["aug_labels"], fg["cov_diag"]
+        coef, labels, var = fg["c_all"], fg["aug_labels"], fg["cov_diag"]
+        if which == "before":
+            coef, labels = fg["c_before"], fg["before_labels"]
+            var = np.zeros(len(coef))
         index = {lab: j for j, lab in enumerate(labels)}
         tables, constants = {}, {}
         for a in model.axes:
@@ -561,7 +565,8 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
     bar.set_postfix_str("estimates and residual analysis")
     c_all = after_prob.fit()
     res_after_all = y - after_prob.predict(c_all)
-    res_before_all = y - before_prob.predict(before_prob.fit())
+    c_before = before_prob.fit()
+    res_before_all = y - before_prob.predict(c_before)
     G = after_prob.A.T @ after_prob.A
     wG = np.linalg.eigvalsh(G)
     dof = max(len(y) - int(np.sum(wG > 1e-12 * wG[-1])), 1)
@@ -645,7 +650,8 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
             "degree": degree, "cov_diag": cov_diag,
             "res_after": res_after_all, "test": test, "r_before": r_before, "r_after": r_after,
             "selected": selected, "after_prob": after_prob, "c_all": c_all,
-            "aug_labels": aug_labels}
+            "aug_labels": aug_labels, "c_before": c_before,
+            "before_labels": [lab for lab, k in zip(design.labels, keep) if k]}
     return Report(report, figs, aug_text, gen_text)
 
 

@@ -4,7 +4,8 @@ Figures (residuals of fits to all points, um): residual components against every
 covariate before (declared model) and after (augmented model); each effect's evidence (partial
 residual -- the after-residual plus the effect's own contribution -- against the effect's
 natural variable, with the fitted contribution); error maps (residual length over the first
-two axes) before and after.  The headline numbers are the held-out ones of the json report.
+two axes) before and after; the fitted component errors of every axis before and after (an
+unmodelled effect leaks into them).  The headline numbers are the held-out ones of the json report.
 """
 
 from __future__ import annotations
@@ -166,6 +167,40 @@ def fig_maps(fg) -> str:
     return _png(fig)
 
 
+def fig_functions(report) -> str:
+    """The fitted component errors of every axis, declared fit (before) and augmented
+    fit (after, +-2 standard deviations)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    after, _ = report.error_tables()
+    before, _ = report.error_tables(which="before")
+    axes_names = list(after)
+    fig, axes = plt.subplots(2, len(axes_names), figsize=(3.6 * len(axes_names), 5.4),
+                             squeeze=False)
+    for i, a in enumerate(axes_names):
+        for row, (kind, f, unit) in enumerate((("XYZ", 1e3, "um"), ("ABC", 1e6, "urad"))):
+            ax = axes[row, i]
+            for k, (name, v) in enumerate(after[a].values.items()):
+                if name[1] not in kind:
+                    continue
+                color = f"C{k}"
+                q = after[a].positions
+                sd = after[a].std.get(name, np.zeros_like(v))
+                ax.plot(q, v * f, color=color, label=name)
+                ax.fill_between(q, (v - 2 * sd) * f, (v + 2 * sd) * f, color=color, alpha=0.2)
+                ax.plot(before[a].positions, before[a].values[name] * f, "--", color=color,
+                        lw=0.8)
+            ax.set_xlabel(a)
+            ax.set_ylabel(unit)
+            ax.legend(fontsize=6)
+    axes[0, 0].set_title("solid: after, dashed: before", fontsize=8, loc="left")
+    fig.tight_layout()
+    return _png(fig)
+
+
 def render_html(report) -> str:
     """The complete HTML text of a :class:`volerr.loop.Report`."""
     import jinja2
@@ -173,7 +208,8 @@ def render_html(report) -> str:
     from importlib import resources
 
     fg = report.figures
-    figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg)}
+    figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg),
+               "functions": fig_functions(report)}
     effects = [{"e": e, "png": fig_effect(fg, e),
                 "params": [(p, v, e["std"][p], e["units"][p]) for p, v in e["parameters"].items()]}
                for e in report.data["effects"]]
