@@ -25,8 +25,9 @@ def main(n: int = 20000) -> None:
         for a in m.axes:
             lo, hi = (0.0, 360.0) if a == "C" else m.travel[a]
             x = np.linspace(lo, hi, 31)
-            vals = {p: rng.normal(0, 30e-6 if p[1] in "ABC" else 10e-3) * np.sin(
-                np.linspace(0, 3, 31) + rng.uniform(0, 3)) for p in m.layout.axes[a].component_errors}
+            vals = {p: rng.normal(0, 30e-6 if p[1] in "ABC" else 10e-3)
+                    * np.sin(np.linspace(0, 3, 31) + rng.uniform(0, 3))
+                    for p in m.layout.axes[a].component_errors}
             write_error_table(d / f"{a}.csv", ErrorTable(a, x, vals))
         write_constants(d / "constants.csv", {"EC0Y": 20e-6, "EX0C": 0.01, "EA0B": 15e-6})
         funcs = tables.ErrorFunctions.from_dir(d, m)

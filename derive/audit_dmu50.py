@@ -123,7 +123,8 @@ def _matrix_diff(printed_rows, derived: sp.Matrix) -> tuple[bool, str, str]:
         extra = ""
         r3 = m[0:3, 0:3]
         if sp.simplify(r3.T * r3 - sp.eye(3)) != sp.zeros(3, 3):
-            extra = f"; the printed 3x3 block is not a rotation (det = {fmt(sp.simplify(r3.det()))})"
+            det = fmt(sp.simplify(r3.det()))
+            extra = f"; the printed 3x3 block is not a rotation (det = {det})"
         return False, f"{kind} in {len(bad)} entr{'y' if len(bad) == 1 else 'ies'}", desc + extra
     if len(rows) == len(drows) - 1:
         for k in range(len(drows)):

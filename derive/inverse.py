@@ -115,7 +115,8 @@ def inverse_functions(layout: Layout) -> list[Function]:
     return [
         Function("inverse_rotary", [str(s) for s in TOOL_AXIS] + [str(BRANCH)],
                  [rinv[a] for a in rot],
-                 f"Rotary positions ({', '.join(rot)}), rad, that give the unit tool axis (i, j, k) "
+                 f"Rotary positions ({', '.join(rot)}), rad, that give the unit tool axis "
+                 "(i, j, k) "
                  "in the workpiece frame; branch = +1 or -1 picks one of the two solutions "
                  "(Paden-Kahan subproblem 2). NaN where the orientation is unreachable."),
         Function("inverse_linear", rot + [str(s) for s in TIP] + [str(s) for s in PROBE],

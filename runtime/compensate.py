@@ -39,6 +39,11 @@ step is already the best grid point: at 4 decimals the written program leaves at
 sqrt(3)/2 x 0.1 um = 0.087 um of rounding error (use ``decimals=5`` where the controller takes
 it).
 
+ISO/TR 16907 types: ``types`` restricts the compensation to some of the types of the thesis'
+sec. 2.9.1 (``L-POS L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG``, groups ``L-VOL R-VOL``; FOR is
+``orientation``), e.g. to predict what a controller that only does L-VOL leaves; the report
+always evaluates the full model (:func:`parameter_types` says which parameter is which).
+
 Error tables: positions outside a table's measured range are refused unless extrapolation is
 asked for.  An endless rotary axis (travel >= 720 deg) whose table covers less than a turn is
 closed over the turn (:func:`close_periodic`): the gap, e.g. 340..360 deg, is interpolated

@@ -380,7 +380,8 @@ def test_controller_export_import_round_trip(tmp_path, fmt):
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m)
     f = tmp_path / f"dmu.{fmt}"
-    assert cli("controller", "export", "DMU50", "--errors", err, "--format", fmt, "--out", f)[0] == 0
+    rc, so, se = cli("controller", "export", "DMU50", "--errors", err, "--format", fmt, "--out", f)
+    assert rc == 0, se
     rc, so, se = cli("controller", "import", "DMU50", f, "--out", tmp_path / "back")
     assert rc == 0, se
     t0, (c0, _, _) = tables.read_error_dir(err, m.axes)
