@@ -18,8 +18,9 @@ columns the data provide.  Families (``kind``):
 * ``periodic``: a cyclic translational error along an axis, ``a sin(2 pi q/P) + b cos(..)``,
   period P searched (periodogram of the residual, then refined).
 * ``higher_order``: Legendre terms of a component beyond the fitted degree.
-* ``probe_direction``: ``nx, ny, nz`` columns: an error along the probing direction (effective
-  probe radius), ``tool.d<k> += PR_R * n_k``.
+* ``probe_direction``: ``nx, ny, nz`` columns (unit probing direction in the probe frame,
+  which is the workpiece frame's orientation on a CMM): an error along the probing direction
+  (effective probe radius), ``tool.d<k> += PR_R * n_k``.
 * ``setup``: a grouping column (``setup``, ``round``, ``mount``, ``group``) with 2-50 levels:
   the instrument was re-placed, six rigid-placement coordinates per later group.
 """

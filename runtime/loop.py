@@ -598,6 +598,11 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
                         "std": std, "target": sorted({t[1] for t in c.terms}), "info": info,
                         "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}
                                   for t in c.terms], "evidence": ev})
+    # points far off the final fit: chi-square(3) of |r|^2 / sigma^2 above 30 (p ~ 1e-6)
+    thresh = math.sqrt(30.0 * sigma2)
+    far = np.flatnonzero(point_norm(res_after_all) > thresh)
+    outliers = {"threshold_um": round(1e3 * thresh, 4), "count": int(len(far)),
+                "data_rows": [int(i) + 1 for i in far[:100]]}
     variables = {**{a: dat.positions[a] for a in model.axes}, **dat.covariates}
     analysis = {v: {"before_trend_um": _trend(res_before_all, x),
                     "after_trend_um": _trend(res_after_all, x)}
@@ -633,6 +638,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
         "degree_cv_rms_um": {str(k): round(1e3 * v, 4) for k, v in degree_scores.items()},
         "gauge_fixed": _gauge_text(gauge),
         "noise_estimate_um": round(1e3 * math.sqrt(sigma2), 4),
+        "outliers": outliers,
         "candidates_tested": len(candidates),
         "candidate_families": sorted({c.kind for c in candidates}),
         "residual_analysis": analysis,

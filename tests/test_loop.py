@@ -260,3 +260,11 @@ def test_exported_error_map_is_the_machine(tmp_path, layout, seed, effect):
     size = np.sqrt(np.mean(np.sum(_rigid_residual(model, pos, probe, true) ** 2, axis=1)))
     rms_err = np.sqrt(np.mean(np.sum(err ** 2, axis=1)))
     assert rms_err < 0.05 * size and rms_err < 0.2e-3, (rms_err, size)
+
+
+def test_blunders_are_flagged_not_explained():
+    camp = simulate("MH1", n_points=400, seed=81, probes=demo_probes(volerr.load("MH1")))
+    camp.deviation[[7, 150, 333]] += np.array([0.012, -0.008, 0.0])   # 12-14 um blunders
+    rep = run_loop("MH1", camp, progress=False)
+    assert rep["outliers"]["data_rows"] == [8, 151, 334]
+    assert rep["effects"] == []
