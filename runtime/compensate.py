@@ -22,7 +22,8 @@ Strategies
     equals the nominal one (functional orientation, L-VOL+ / R-VOL+), then the linear axes
     restore the tool tip.  Two rotary axes can turn the tool axis about two directions; near a
     singular orientation (e.g. B = 0 on the DMU 50, where C does not tilt the tool) only the
-    component they can reach is corrected (truncated SVD) and the rest is reported.
+    component they can reach is corrected (truncated SVD, :data:`ORIENTATION_RCOND`) and the
+    rest is reported.
 ``thesis``
     The strategy of Ellingsdalen (2021) sec. 3.5 (Figure 3.9), for comparison: the deviation
     caused by the rotary-axis errors is computed at the programmed position and subtracted
@@ -283,19 +284,26 @@ def _rotary_jacobian(em: ErrorModel, q: np.ndarray) -> np.ndarray:
     return np.stack(cols, axis=2)
 
 
-def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = 1e-3) -> np.ndarray:
-    """Least-squares x of j x = r per row, singular directions (sigma < rcond) dropped."""
+#: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
+#: uncorrected: near a singular orientation (within about 3 deg of it on the DMU 50) the
+#: correction would need large rotary motions for a few urad
+ORIENTATION_RCOND = 0.05
+
+
+def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = ORIENTATION_RCOND):
+    """Least-squares x of j x = r per row, singular directions (sigma < rcond) dropped; also
+    returns per row whether a direction was dropped."""
     u, s, vt = np.linalg.svd(j, full_matrices=False)
     inv = np.where(s > rcond, 1.0 / np.where(s > rcond, s, 1.0), 0.0)
     y = inv * np.einsum("nji,nj->ni", u, r)   # diag(1/s) U^T r
-    return np.einsum("nji,nj->ni", vt, y)     # V y
+    return np.einsum("nji,nj->ni", vt, y), np.any(s <= rcond, axis=1)     # V y
 
 
 def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: float = 1e-4,
           max_iter: int = 50):
     """Corrected positions (N, n) for programmed ``q_nom``, the iteration count per row, and
-    per row whether the orientation correction was stopped because a rotary axis would have
-    left its travel or its error table.
+    per row whether the orientation correction was limited: stopped because a rotary axis would
+    have left its travel or its error table, or partial near a singular orientation.
 
     Iterates until the change of the correction is below ``tol`` (mm; rotary axes weighted by a
     1 m lever)."""
@@ -310,13 +318,15 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     iters = np.zeros(n, dtype=int)
     active = np.ones(n, dtype=bool)
     limited = np.zeros(n, dtype=bool)
+    partial = np.zeros(n, dtype=bool)
     for it in range(1, max_iter + 1):
         qa = q[active]
         change = np.zeros(len(qa))
         if orientation and em.rot:
             k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated)
             j = _rotary_jacobian(em, qa)
-            d = _truncated_solve(j, -(k_act - target_k[active]))
+            d, dropped = _truncated_solve(j, -(k_act - target_k[active]))
+            partial[np.flatnonzero(active)] = dropped
             trial = qa.copy()
             trial[:, rot_idx] += np.rad2deg(d)
             ok = em.admissible(trial)
@@ -340,7 +350,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     if active.any():
         raise InputError(f"compensation did not converge in {max_iter} iterations (the errors "
                          "are too large or the position is singular)")
-    return q, iters, limited
+    return q, iters, limited | partial
 
 
 def solve_thesis(em: ErrorModel, q_nom: np.ndarray) -> np.ndarray:
@@ -477,7 +487,8 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
                 b.line.number, dict(zip(axes, q_nom[r])), dict(zip(axes, q_out[r])),
                 tuple(before[r]), tuple(after[r]), float(ob[r]), float(oa[r]), int(iters[r]),
                 "compensated (thesis strategy)" if strategy == "thesis" else
-                "compensated; orientation limited by rotary travel or error table" if limited[r]
+                "compensated; orientation limited (rotary travel, error table or near a "
+                "singular orientation)" if limited[r]
                 else "compensated", tuple(u_after[r])))
         else:
             missing = [a for a in axes if b.target[a] is None]
