@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 import volerr
-from volerr import gcode, tables
+from volerr import tables
 from volerr.compensate import ErrorModel, compensate_program, solve
 from volerr.tables import ErrorTable, write_constants, write_error_table
 

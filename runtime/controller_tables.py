@@ -137,7 +137,6 @@ def read_isg(text: str, where: str = "ISG CSV") -> tuple[dict, dict]:
 def _isg_block(header, rows, tables, constants, where):
     require(rows, f"{where}: header without data rows")
     args = [h for h in header if re.fullmatch(r"[XYZABC]", h)]
-    params = [h for h in header if h not in args]
     if not args:
         require(len(rows) == 1, f"{where}: position errors need exactly one data row")
         for h, v in zip(header, rows[0][1]):

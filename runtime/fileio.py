@@ -24,13 +24,18 @@ def check_output(path, inputs=()) -> Path:
 
 
 def write_text(path, text: str, inputs=()) -> Path:
-    """Write ``text`` to ``path`` atomically (temporary file + rename)."""
+    """Write ``text`` (UTF-8, line endings kept) to ``path`` atomically."""
+    return write_bytes(path, text.encode("utf-8"), inputs)
+
+
+def write_bytes(path, data: bytes, inputs=()) -> Path:
+    """Write ``data`` to ``path`` atomically (temporary file + rename), refusing inputs."""
     out = check_output(path, inputs)
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
         os.replace(tmp, out)
     except BaseException:
         if os.path.exists(tmp):

@@ -596,3 +596,40 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
     return Identification(axis, kind, positions, values, std, u_tr, results, method,
                           tracker is not None, tuple(float(v) for v in d),
                           tuple(float(v) for v in o))
+
+
+def to_model_signs(table, layout):
+    """An identified table (error motions of the component carrying the points) in the
+    volerr model's convention (tool relative to workpiece, ``volerr.layout``).
+
+    Tool-side axes are unchanged: the model's carriage frame pivots, like the tracker's, about
+    the carriage point at the tool reference point.  For a table axis the model gives the tool's
+    error relative to the table with rotations pivoting about the tool reference point, which
+    stays put while the table travels, whereas the tracker's pivot is the table point that was
+    there at the reference position.  With ``t, e`` the table's own motions, ``u`` the axis
+    direction and ``q - q0`` the travel from the reference position:
+
+    * linear table axis: ``delta = -t - (q - q0) (e x u)``, ``eps = -e``;
+    * rotary table axis (frame origin on the axis): ``delta = -t``, ``eps = -e``.
+
+    Assumes the measurement frame origin at the tool reference point and its axes along the
+    machine axes; for other measuring points use :meth:`volerr.model.Model.transfer`."""
+    from .tables import ErrorTable
+
+    axis = table.axis
+    require(axis in layout.axes, f"axis {axis} is not an axis of layout {layout.name}")
+    if axis not in layout.workpiece_chain:
+        return table
+    t = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
+                  for p in MOTION_PREFIX[:3]], axis=1)
+    e = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
+                  for p in MOTION_PREFIX[3:]], axis=1)
+    delta = -t
+    if layout.axes[axis].kind == "linear":
+        u = np.asarray(layout.axes[axis].direction, dtype=float)
+        travel = table.positions - table.positions[0]
+        delta = delta - travel[:, None] * np.cross(e, u)
+    motions = np.concatenate([delta, -e], axis=1)
+    values = {p + axis: motions[:, j] for j, p in enumerate(MOTION_PREFIX)
+              if p + axis in table.values}
+    return ErrorTable(axis, table.positions, values, table.std, table.u95)

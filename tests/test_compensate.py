@@ -326,7 +326,6 @@ def test_cli_bad_input_exit_2_one_line(tmp_path):
 
 
 def test_cli_refuses_arcs_and_positions_outside_the_tables(tmp_path):
-    m = volerr.load("DMU50")
     err = tmp_path / "err"
     err.mkdir()
     write_error_table(err / "X.csv", ErrorTable("X", [0, 100], {"EXX": [0.0, 0.001]}))
@@ -499,7 +498,6 @@ def test_controller_negate_round_trip(tmp_path):
 def test_endless_rotary_table_is_closed_over_the_turn(tmp_path):
     """A C table measured 0..340 deg (thesis: 18 positions, 20 deg steps) serves C = 350 by
     interpolating towards the value at 0 = 360 deg, never by extrapolating."""
-    m = volerr.load("DMU50")
     c = np.arange(0, 360, 20.0)
     exc = 1e-3 * np.sin(np.deg2rad(c)) + 2e-3
     write_error_table(tmp_path / "C.csv", ErrorTable("C", c, {"EXC": exc}))

@@ -13,8 +13,8 @@ import pytest
 import volerr
 from volerr.cli import main
 from volerr.diagonals import box_lines, evaluate_lines
-from volerr.examples import EXAMPLES, example_errors, write_example_errors
-from volerr.tables import ErrorFunctions, ErrorTable, read_constants, read_error_table
+from volerr.examples import EXAMPLES, write_example_errors
+from volerr.tables import ErrorFunctions, read_constants, read_error_table
 
 CMMS = ["MB1", "MB2", "FB1", "FB2", "MH1", "MH2", "FH1", "FH2", "CX", "CY"]
 

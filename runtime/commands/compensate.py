@@ -20,12 +20,10 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 from volerr.errors import InputError, require
-from volerr.fileio import check_output, write_text
+from volerr.fileio import check_output, write_bytes, write_text
 
 
 def register(sub) -> None:
@@ -77,22 +75,6 @@ def _initial(text: str) -> dict:
             raise InputError(f"--initial: {v!r} is not a number") from None
         require(math.isfinite(val), f"--initial: {a} is not finite")
         out[a.strip().upper()] = val
-    return out
-
-
-def write_bytes(path, data: bytes, inputs=()) -> Path:
-    """Atomic write of raw bytes (the program keeps its encoding), refusing inputs."""
-    out = check_output(path, inputs)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return out
 
 

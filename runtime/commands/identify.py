@@ -54,6 +54,11 @@ def register(sub) -> None:
                    help="fit error functions (poly: degree by cross-validation; smooth: "
                         "smoothing spline by GCV) and report their residuals (JSON, plot)")
     p.add_argument("--residuals", help="write per-position, per-point residuals (CSV, um)")
+    p.add_argument("--signs", choices=("component", "model"), default="component",
+                   help="component (default, as the thesis and INTERFACE.md): the error motions "
+                        "of the moving component that carries the points; model: the volerr "
+                        "model's tool-relative convention (for a table axis of LAYOUT: negated "
+                        "and re-referenced to the tool point), ready for map / compensate")
     p.add_argument("--json", help="write a summary (JSON)")
     p.add_argument("--plot", help="write a plot of the error motions (PNG)")
     p.set_defaults(func=run)
@@ -106,7 +111,7 @@ def residual_csv(result) -> str:
 
 def run(args) -> int:
     from volerr.fileio import check_output, write_text
-    from volerr.identify import identify
+    from volerr.identify import identify, to_model_signs
     from volerr.layout import read_layout
     from volerr.tables import table_to_csv
 
@@ -126,6 +131,8 @@ def run(args) -> int:
                 _vec(args.origin, "--origin") if args.origin else None),
         sense=sense, max_cond=args.max_cond, outlier_k=args.outlier_k)
     table = result.table()
+    if args.signs == "model":
+        table = to_model_signs(table, layout)
     text = table_to_csv(table)
     summary = result.summary()
     fits = None
