@@ -36,7 +36,7 @@ from .fit import Data
 
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
             "probe_direction", "setup")
-_TEMP = re.compile(r"^(T(_.*)?|temp.*)$", re.IGNORECASE)
+_TEMP = re.compile(r"^(T(_\w+)?|[Tt]emp\w*)$")   # T, T_C, T_X, temp_C (not t_s: time)
 _TIME = {"t_s": "/3600", "time_s": "/3600", "t_min": "/60", "t_h": "", "time": ""}
 _GROUP = ("setup", "round", "mount", "group", "placement")
 
@@ -77,7 +77,7 @@ def along_component(layout, axis: str) -> str:
 
 
 def temperature_columns(covariates) -> list:
-    return [c for c in covariates if _TEMP.match(c) and c not in ("t_s",)]
+    return [c for c in covariates if _TEMP.match(c) and c not in _TIME]
 
 
 def build(model, data: Data, ranges: dict, degree: int) -> list:
