@@ -95,13 +95,29 @@ def fixed_positions(model, at: dict | None = None) -> dict:
     return out
 
 
-def volumetric_map(model, funcs, grid=None, probe=(0.0, 0.0, 0.0), at=None) -> VolumetricMap:
-    """Evaluate the volumetric error of ``model`` with error functions ``funcs`` on a grid."""
+def volume(model, funcs, choice: str = "travel") -> dict:
+    """Axis -> (min, max) of the box to test: the layout's travel, or (``"measured"``) the part
+    of it that the error tables of ``funcs`` cover."""
+    box = dict(model.travel)
+    if choice == "measured":
+        for a, (lo, hi) in funcs.ranges().items():
+            t_lo, t_hi = box[a]
+            require(max(lo, t_lo) < min(hi, t_hi),
+                    f"table {a} ({lo:g} .. {hi:g}) does not overlap the travel {t_lo:g} .. {t_hi:g}")
+            box[a] = (max(lo, t_lo), min(hi, t_hi))
+    return box
+
+
+def volumetric_map(model, funcs, grid=None, probe=(0.0, 0.0, 0.0), at=None,
+                   box=None) -> VolumetricMap:
+    """Evaluate the volumetric error of ``model`` with error functions ``funcs`` on a grid over
+    ``box`` (axis -> (min, max); default the layout's travel)."""
+    box = model.travel if box is None else box
     counts = grid_counts(grid)
     lin = linear_axes(model)
     probe = np.asarray(probe, dtype=float)
     require(probe.shape == (3,) and np.all(np.isfinite(probe)), "probe offset must be three numbers")
-    ticks = [np.linspace(*model.travel[a], n) for a, n in zip(lin, counts)]
+    ticks = [np.linspace(*box[a], n) for a, n in zip(lin, counts)]
     mesh = np.meshgrid(*ticks, indexing="ij")
     pos = {a: m.ravel() for a, m in zip(lin, mesh)}
     n = mesh[0].size

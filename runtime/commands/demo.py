@@ -103,16 +103,29 @@ def _probe(out: Path) -> dict:
 
 
 def _identify(out: Path) -> dict:
-    from volerr.identify import simulate_demo_campaign
+    from volerr.tracker_io import example_path
 
-    files = simulate_demo_campaign(out / "tracker")
-    _cli("identify", files["layout"], "--axis", files["axis"], *files["paths"],
-         "--out", out / f"identified_{files['axis']}.csv",
-         "--plot", out / f"identified_{files['axis']}.png")
-    return {"title": f"laser-tracker identification of axis {files['axis']} "
-                     f"({files['layout']}, simulated, {len(files['paths'])} rounds)",
-            "value": files.get("summary", "error motions recovered; see the table"),
-            "files": [f"identified_{files['axis']}.csv", f"identified_{files['axis']}.png"]}
+    measured = out / "tracker_identified"
+    for axis in ("X", "Y", "Z"):
+        _cli("identify", "MB1", "--axis", axis, example_path(axis), "--fit", "poly",
+             "--out", measured / f"{axis}.csv", "--plot", out / f"identified_{axis}.png")
+    _cli("squareness", "MB1", measured, "--out", out / "tracker_errors",
+         "--json", out / "squareness.json")
+    sq = json.loads((out / "squareness.json").read_text())
+    u = sq["u_urad"]
+    text = ", ".join(f"{k} {v:+.1f} +/- {u[k]:.1f}" for k, v in sq["squareness_urad"].items())
+    _cli("diagonals", "MB1", "--errors", out / "tracker_errors", "--method", "poly",
+         "--volume", "measured", "--json", out / "diagonals_tracker.json")
+    diag = json.loads((out / "diagonals_tracker.json").read_text())
+    space = [ln["deviation_um"] for ln in diag["lines"] if ln["kind"] == "space"]
+    return {"title": "laser-tracker identification of MB1 X, Y, Z (shipped example data: 3 "
+                     "points, 11 positions, 4 rounds) -> squareness -> space diagonals",
+            "value": f"squareness {text} urad (k = 1; simulated truth EC0Y +20, EB0Z -15, "
+                     "EA0Z +10); "
+                     "space diagonals " + ", ".join(f"{d:+.1f}" for d in space) + " um",
+            "files": ["tracker_identified/", "tracker_errors/", "squareness.json",
+                      "identified_X.png", "identified_Y.png", "identified_Z.png",
+                      "diagonals_tracker.json"]}
 
 
 def _loop(out: Path) -> dict:

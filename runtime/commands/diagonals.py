@@ -15,7 +15,7 @@ from volerr.commands.map import add_common, inputs_of, parse_at
 from volerr.errors import require
 from volerr.fileio import check_output, write_text
 from volerr.model import load
-from volerr.volmap import check_distinct, linear_axes
+from volerr.volmap import check_distinct, linear_axes, volume
 
 
 def register(sub) -> None:
@@ -42,7 +42,7 @@ def run(args) -> int:
         if out is not None:
             check_output(out, inputs)
     lin = linear_axes(model)
-    lines = diagonals.box_lines(model.travel, lin, tuple(args.lines))
+    lines = diagonals.box_lines(volume(model, funcs, args.volume), lin, tuple(args.lines))
     results = diagonals.evaluate_lines(model, funcs, lines, tuple(args.probe), parse_at(args.at),
                                        args.profile_points)
     print(f"{model.name}: length deviation dL = actual - nominal distance of the probe tip "

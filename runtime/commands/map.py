@@ -24,6 +24,9 @@ def add_common(p) -> None:
                    help="probe / tool offset, mm (default 0 0 0)")
     p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
                    help="position of a rotary axis during the test, repeatable (default 0 deg)")
+    p.add_argument("--volume", choices=("travel", "measured"), default="travel",
+                   help="box of the linear axes: the layout's travel (default) or the part of "
+                        "it the error tables cover (no extrapolation either way)")
 
 
 def parse_at(items) -> dict:
@@ -77,7 +80,8 @@ def run(args) -> int:
         if out is not None:
             from volerr.fileio import check_output
             check_output(out, inputs)
-    vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at))
+    vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at),
+                                 box=volmap.volume(model, funcs, args.volume))
     s = vmap.summary()
     if args.out:
         volmap.write_map_csv(args.out, vmap, inputs)
