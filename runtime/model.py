@@ -44,7 +44,8 @@ def derive_module(layout: Layout) -> types.ModuleType:
 
 def _columns(components, n: int) -> np.ndarray:
     """Generated outputs (tuple of broadcastable arrays) -> (n, len) float array."""
-    return np.stack([np.broadcast_to(c, (n,)) for c in components], axis=-1).astype(float)
+    return np.stack([np.broadcast_to(c, (n,)) for c in components], axis=-1).astype(
+        float, copy=False)
 
 
 @dataclass
@@ -115,7 +116,8 @@ class Model:
                     f"({' '.join(self.axes)}), got shape {arr.shape}")
             cols = {a: arr[:, i] for i, a in enumerate(self.axes)}
         for a, v in cols.items():
-            require(np.all(np.isfinite(v)), f"{self.name}: position {a} has NaN or infinite values")
+            if not np.isfinite(v).all():
+                raise InputError(f"{self.name}: position {a} has NaN or infinite values")
         shape = np.broadcast_shapes(*(np.shape(v) for v in cols.values()))
         out = {}
         for a, v in cols.items():
@@ -151,9 +153,18 @@ class Model:
         for p in self.parameters:
             v = np.asarray(errors.get(p, 0.0), dtype=float)
             require(v.shape in ((), (n,), (1,)), f"error {p} must be a scalar or ({n},) array")
-            require(np.all(np.isfinite(v)), f"error {p} has NaN or infinite values")
             out[p] = v
         return out
+
+    @staticmethod
+    def _check_finite(result: np.ndarray, inputs: dict) -> np.ndarray:
+        """NaN in any input propagates to the result: check once there, then name the input."""
+        if not np.isfinite(result).all():
+            for name, v in inputs.items():
+                if not np.all(np.isfinite(v)):
+                    raise InputError(f"error {name} has NaN or infinite values")
+            raise InputError("the model evaluated to NaN or infinity (values too large?)")
+        return result
 
     # ---- evaluation --------------------------------------------------------------
     def volumetric_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
@@ -166,9 +177,10 @@ class Model:
         probe error as Pahk eq. (17): the error along the probing direction is subtracted."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
+        errs = self._errors(errors, n)
         e = self.module.volumetric_error(**pos, **self._covariates(covariates, n),
-                                         **self._probe(probe, n), **self._errors(errors, n))
-        out = _columns(e, n)
+                                         **self._probe(probe, n), **errs)
+        out = self._check_finite(_columns(e, n), errs)
         if direction is not None or probe_error is not None:
             out = out - self._probe_term(direction, probe_error, n)
         return out
@@ -189,9 +201,10 @@ class Model:
         """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
+        errs = self._errors(errors, n)
         e = self.module.exact_error(**pos, **self._covariates(covariates, n),
-                                    **self._probe(probe, n), **self._errors(errors, n))
-        return _columns(e, n)
+                                    **self._probe(probe, n), **errs)
+        return self._check_finite(_columns(e, n), errs)
 
     def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
         """d(error)/d(parameter), (N, 3, n_parameters): mm/mm or mm/rad."""
@@ -212,6 +225,7 @@ class Model:
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
         sig = self._errors(sigmas, n)
+        self._check_finite(np.stack([np.broadcast_to(v, (n,)) for v in sig.values()]), sig)
         if method == "termwise":
             r = self.module.random_error_termwise(
                 **pos, **self._covariates(covariates, n), **self._probe(probe, n),
@@ -268,9 +282,9 @@ class Model:
         """First-order error of the tool-axis direction, (N, 3), rad."""
         pos = self.positions(positions)
         n = len(next(iter(pos.values())))
-        e = self.module.orientation_error(**pos, **self._covariates(covariates, n),
-                                          **self._errors(errors, n))
-        return _columns(e, n)
+        errs = self._errors(errors, n)
+        e = self.module.orientation_error(**pos, **self._covariates(covariates, n), **errs)
+        return self._check_finite(_columns(e, n), errs)
 
 
 def load(name_or_path) -> Model:
