@@ -35,7 +35,9 @@ def derive_functions(layout: Layout) -> list[Function]:
     transfer_args = sorted({str(s) for e in rules.shift.values() for s in e.free_symbols},
                            key=lambda n: (n not in ("Xo", "Yo", "Zo"), n))
     funcs = [
-        Function("volumetric_error", pos + cov + probe + params, list(error),
+        Function("volumetric_error", pos + cov + probe + params,
+                 # grouped by position and probe symbols: sums of errors share one product
+                 [sp.collect(e, list(chain.positions) + list(PROBE)) for e in error],
                  "First-order volumetric error (dX, dY, dZ), mm."),
         Function("sensitivity", pos + cov + probe, list(sens),
                  "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",

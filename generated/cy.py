@@ -21,9 +21,14 @@ PARAMETER_AXIS = {'EXX': 'X', 'EYX': 'X', 'EZX': 'X', 'EAX': 'X', 'EBX': 'X', 'E
 def volumetric_error(X, Y, Z, Xp, Yp, Zp, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY, ECY, EXZ, EYZ, EZZ, EAZ, EBZ, ECZ, EA0Z, EB0Z, EC0Y):
     """First-order volumetric error (dX, dY, dZ), mm."""
     _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp), numpy.shape(EXX), numpy.shape(EYX), numpy.shape(EZX), numpy.shape(EAX), numpy.shape(EBX), numpy.shape(ECX), numpy.shape(EXY), numpy.shape(EYY), numpy.shape(EZY), numpy.shape(EAY), numpy.shape(EBY), numpy.shape(ECY), numpy.shape(EXZ), numpy.shape(EYZ), numpy.shape(EZZ), numpy.shape(EAZ), numpy.shape(EBZ), numpy.shape(ECZ), numpy.shape(EA0Z), numpy.shape(EB0Z), numpy.shape(EC0Y), )
-    _o0 = numpy.broadcast_to(EB0Z*Z + EBX*Z + EBX*Zp + EBY*Z + EBY*Zp + EBZ*Zp - ECX*Y - ECX*Yp - ECY*Yp - ECZ*Yp + EXX + EXY + EXZ, _shape)
-    _o1 = numpy.broadcast_to(-EA0Z*Z - EAX*Z - EAX*Zp - EAY*Z - EAY*Zp - EAZ*Zp - EC0Y*X + ECX*Xp + ECY*Xp + ECZ*Xp + EYX + EYY + EYZ, _shape)
-    _o2 = numpy.broadcast_to(EAX*Y + EAX*Yp + EAY*Yp + EAZ*Yp - EBX*Xp - EBY*Xp - EBZ*Xp + EZX + EZY + EZZ, _shape)
+    _t0 = EBX + EBY
+    _t1 = EBZ + _t0
+    _t2 = ECX + ECY + ECZ
+    _t3 = EAX + EAY
+    _t4 = EAZ + _t3
+    _o0 = numpy.broadcast_to(-ECX*Y + EXX + EXY + EXZ - Yp*_t2 + Z*(EB0Z + _t0) + Zp*_t1, _shape)
+    _o1 = numpy.broadcast_to(-EC0Y*X + EYX + EYY + EYZ + Xp*_t2 + Z*(-EA0Z - _t3) - Zp*_t4, _shape)
+    _o2 = numpy.broadcast_to(EAX*Y + EZX + EZY + EZZ - Xp*_t1 + Yp*_t4, _shape)
     return _o0, _o1, _o2
 
 

@@ -21,9 +21,14 @@ PARAMETER_AXIS = {'EXX': 'X', 'EYX': 'X', 'EZX': 'X', 'EAX': 'X', 'EBX': 'X', 'E
 def volumetric_error(X, Y, Z, Xp, Yp, Zp, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY, ECY, EXZ, EYZ, EZZ, EAZ, EBZ, ECZ, EA0Z, EB0Z, EC0Y):
     """First-order volumetric error (dX, dY, dZ), mm."""
     _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp), numpy.shape(EXX), numpy.shape(EYX), numpy.shape(EZX), numpy.shape(EAX), numpy.shape(EBX), numpy.shape(ECX), numpy.shape(EXY), numpy.shape(EYY), numpy.shape(EZY), numpy.shape(EAY), numpy.shape(EBY), numpy.shape(ECY), numpy.shape(EXZ), numpy.shape(EYZ), numpy.shape(EZZ), numpy.shape(EAZ), numpy.shape(EBZ), numpy.shape(ECZ), numpy.shape(EA0Z), numpy.shape(EB0Z), numpy.shape(EC0Y), )
-    _o0 = numpy.broadcast_to(EB0Z*Z + EBX*Zp + EBY*Z + EBY*Zp + EBZ*Zp - ECX*Yp - ECY*Yp - ECZ*Yp + EXX + EXY + EXZ, _shape)
-    _o1 = numpy.broadcast_to(-EA0Z*Z - EAX*Zp - EAY*Z - EAY*Zp - EAZ*Zp - EC0Y*X + ECX*Xp + ECY*X + ECY*Xp + ECZ*X + ECZ*Xp + EYX + EYY + EYZ, _shape)
-    _o2 = numpy.broadcast_to(EAX*Yp + EAY*Yp + EAZ*Yp - EBX*Xp - EBY*X - EBY*Xp - EBZ*X - EBZ*Xp + EZX + EZY + EZZ, _shape)
+    _t0 = EBY + EBZ
+    _t1 = EBX + _t0
+    _t2 = ECY + ECZ
+    _t3 = ECX + _t2
+    _t4 = EAX + EAY + EAZ
+    _o0 = numpy.broadcast_to(EXX + EXY + EXZ - Yp*_t3 + Z*(EB0Z + EBY) + Zp*_t1, _shape)
+    _o1 = numpy.broadcast_to(EYX + EYY + EYZ + X*(-EC0Y + _t2) + Xp*_t3 + Z*(-EA0Z - EAY) - Zp*_t4, _shape)
+    _o2 = numpy.broadcast_to(EZX + EZY + EZZ - X*_t0 - Xp*_t1 + Yp*_t4, _shape)
     return _o0, _o1, _o2
 
 

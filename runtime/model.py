@@ -114,14 +114,15 @@ class Model:
             require(arr.ndim == 2 and arr.shape[1] == len(self.axes),
                     f"{self.name}: positions must have {len(self.axes)} columns "
                     f"({' '.join(self.axes)}), got shape {arr.shape}")
-            cols = {a: arr[:, i] for i, a in enumerate(self.axes)}
+            cols = dict(zip(self.axes, np.ascontiguousarray(arr.T)))
         for a, v in cols.items():
             if not np.isfinite(v).all():
                 raise InputError(f"{self.name}: position {a} has NaN or infinite values")
         shape = np.broadcast_shapes(*(np.shape(v) for v in cols.values()))
         out = {}
         for a, v in cols.items():
-            v = np.broadcast_to(v, shape).ravel() if shape else np.atleast_1d(v)
+            if v.shape != shape or v.ndim != 1:
+                v = np.broadcast_to(v, shape).ravel() if shape else np.atleast_1d(v)
             out[a] = np.deg2rad(v) if a in self.rotary_axes else v
         return out
 
@@ -129,7 +130,8 @@ class Model:
         p = np.asarray(probe, dtype=float)
         require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
         require(np.all(np.isfinite(p)), "probe offset has NaN values")
-        p = np.broadcast_to(p, (n, 3))
+        if p.shape == (3,):  # one offset for all points: scalars broadcast in the generated code
+            return {"Xp": float(p[0]), "Yp": float(p[1]), "Zp": float(p[2])}
         return {"Xp": p[:, 0], "Yp": p[:, 1], "Zp": p[:, 2]}
 
     def _covariates(self, covariates, n: int) -> dict:
