@@ -18,8 +18,15 @@ COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squar
             "probe_cal", "compensate", "tcpmap", "controller", "loop", "simulate", "demo")
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line on stderr (exit 2), like every other bad input."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="volerr",
         description="Derived, audited volumetric error models of CMMs and five-axis machines.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

@@ -93,3 +93,9 @@ def test_help_for_every_command():
     for name in sub.choices:
         proc = run(name, "--help")
         assert proc.returncode == 0 and "usage" in proc.stdout.lower()
+
+
+@pytest.mark.parametrize("argv", [["layouts", "--bogus"], [], ["map"],
+                                  ["identify", "MB1", "x.csv"], ["derive", "--nope"]])
+def test_usage_errors_are_one_line(argv):
+    assert_clean_failure(run(*argv), "error")
