@@ -561,11 +561,15 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
     kind, d, o = _axis_geometry(layout, axis, direction, origin)
     rounds = list(rounds)
     check_rounds(rounds)
+    # one reference for all rounds: the first position of the first round.  A round measured
+    # in another order (e.g. backwards) is referred to it too, so that the rounds average
+    # error motions of the same reference pose (their values at ``ref`` are zero).
     ref = rounds[0].positions[0]
-    for r in rounds:
-        require(abs(r.positions[0] - ref) < 1e-9,
-                f"round {r.name} starts at {r.positions[0]:g}, round {rounds[0].name} at "
-                f"{ref:g}: every round must start at the same reference position")
+    for i, r in enumerate(rounds):
+        k = int(np.argmin(np.abs(r.positions - ref)))
+        if k:
+            order = [k] + [j for j in range(r.positions.size) if j != k]
+            rounds[i] = Round(r.name, r.positions[order], r.labels, r.points[order])
     if tracker is not None:
         tracker = np.asarray(tracker, dtype=float)
         require(tracker.shape == (3,) and np.all(np.isfinite(tracker)),

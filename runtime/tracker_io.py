@@ -11,8 +11,10 @@ columns are ignored; ``x_mm`` etc. are accepted; blank lines and ``#`` comments 
 
 ``point`` is any label (at least three distinct points), ``position`` the commanded axis
 position (mm or deg).  Within a round every point is measured at every position exactly once.
-The *first* position of a round, in file order, is its reference (errors zero there).  Rows of
-one round may be in any order otherwise.  Several files are concatenated; rounds are keyed by
+The *first* position of a round, in file order, is its reference (errors zero there); a round
+that starts elsewhere (e.g. measured backwards) is referred to the first round's reference, so
+that all rounds average the same reference pose.  Rows of one round may be in any order
+otherwise.  Several files are concatenated; rounds are keyed by
 (file, round).
 
 *Thesis export* (``format="thesis"``): the measuring software's export used by the thesis

@@ -302,3 +302,17 @@ def test_random_geometry_recovered(seed, scale):
     b = second_order_bound(e, ref) * 50  # gain of an off-centre frame origin
     assert np.abs(res.values - e)[:, :3].max() < b + 1e-7
     assert np.abs(res.values - e)[:, 3:].max() < b / max(scale, 1) + 1e-9
+
+
+def test_round_measured_backwards_referred_to_the_first_rounds_reference():
+    """A round measured in the other direction (first position 500) is referred to the first
+    round's reference position (0), so the rounds average the same error motions."""
+    lay = read_layout("MB1")
+    pos = np.linspace(0, 500, 6)
+    e = smooth_errors(pos, seed=11)
+    fwd = simulate("linear", REF, pos, e)
+    # the same machine measured backwards: simulated with reference at 0, rows in reverse order
+    back = Round("2", pos[::-1].copy(), LABELS, fwd[::-1].copy())
+    res = identify([Round("1", pos, LABELS, fwd), back], lay, "X")
+    _check(res, e, second_order_bound(e, REF), 1e-8)
+    assert np.allclose(res.std, 0, atol=1e-12)
