@@ -6,12 +6,17 @@ import os
 import tempfile
 from pathlib import Path
 
-from .errors import require
+from .errors import InputError, require
 
 
 def check_output(path, inputs=()) -> Path:
     """Refuse an output path that is one of the input files; return it as a Path."""
     out = Path(path)
+    require(not out.is_dir(), f"{out} is a folder: give a file name for the output")
+    for parent in out.parents:
+        if parent.exists():
+            require(parent.is_dir(), f"cannot write {out}: {parent} is a file, not a folder")
+            break
     for p in inputs:
         if p is None:
             continue
@@ -31,14 +36,19 @@ def write_text(path, text: str, inputs=()) -> Path:
 def write_bytes(path, data: bytes, inputs=()) -> Path:
     """Write ``data`` to ``path`` atomically (temporary file + rename), refusing inputs."""
     out = check_output(path, inputs)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise InputError(f"cannot write {out}: {exc.strerror or exc}") from None
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
         os.replace(tmp, out)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise InputError(f"cannot write {out}: {exc.strerror or exc}") from None
         raise
     return out

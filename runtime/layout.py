@@ -247,6 +247,8 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
             rot.get("angle_deg", 0.0),
         )
 
+    _check_expressions(where, params, axes, frames)
+
     chain = doc.get("chain", {})
     require("tool" in chain, f"{where}: [chain] needs a 'tool' list (base to probe/tool)")
     tool = tuple(chain.get("tool", []))
@@ -290,6 +292,29 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
             "parameters", "paper_symbols", "source", "effects"}},
         effects=effects,
     )
+
+
+def _check_expressions(where: str, params: dict, axes: dict, frames: dict) -> None:
+    """Expressions in points, translations and angles: valid, and only declared [parameters]."""
+    from .basis import variables
+
+    items = [(f"axis {a.name} point", v) for a in axes.values() for v in a.point]
+    for f in frames.values():
+        items += [(f"frame {f.name} translation", v) for v in f.translation]
+        items.append((f"frame {f.name} rotation angle_deg", f.angle_deg))
+    for what, v in items:
+        if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+            raise InputError(f"{where}: {what} must be a number or an expression, got {v!r}")
+        if not isinstance(v, str):
+            continue
+        try:
+            names = variables(v)
+        except InputError:
+            raise InputError(f"{where}: {what}: {v!r} is not a valid expression") from None
+        unknown = [n for n in names if n not in params]
+        if unknown:
+            raise InputError(f"{where}: {what}: unknown name {unknown[0]!r} in {v!r} "
+                             f"(declare it under [parameters])")
 
 
 def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str) -> tuple:
@@ -349,7 +374,13 @@ def layout_text(name_or_path) -> tuple[str, str]:
     if s.endswith(".toml") or "/" in s or "\\" in s:
         p = Path(s)
         require(p.is_file(), f"layout file not found: {s}")
-        return p.read_text(encoding="utf-8"), p.name
+        try:
+            return p.read_text(encoding="utf-8-sig"), p.name
+        except UnicodeDecodeError:
+            raise InputError(f"layout file {s}: not a UTF-8 text file") from None
     names = layout_names()
+    folded = [n for n in names if n.upper() == s.upper()]
+    if s not in names and len(folded) == 1:  # layout names are case-insensitive: mb1 = MB1
+        s = folded[0]
     require(s in names, f"unknown layout {s!r}; known layouts: {' '.join(names)}")
     return (shipped_layout_dir() / f"{s}.toml").read_text(encoding="utf-8"), f"{s}.toml"

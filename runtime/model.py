@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import types
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +22,8 @@ from .layout import Layout, read_layout
 
 def _module_for(layout: Layout, name_or_path) -> types.ModuleType:
     """The generated module of a shipped layout, or a freshly derived one for a layout file."""
-    shipped = str(name_or_path) == layout.name and not str(name_or_path).endswith(".toml")
+    shipped = (str(name_or_path).upper() == layout.name.upper()
+               and not str(name_or_path).endswith(".toml"))
     if shipped:
         try:
             mod = importlib.import_module(f"volerr.generated.{layout.name.lower()}")
@@ -40,6 +42,29 @@ def derive_module(layout: Layout) -> types.ModuleType:
     mod = types.ModuleType(f"volerr_generated_{layout.name.lower()}")
     exec(compile(source, f"<generated {layout.name}>", "exec"), mod.__dict__)
     return mod
+
+
+def _floats(value, what: str) -> np.ndarray:
+    """``value`` as a float array; anything that is not numbers raises InputError."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be numbers, got {value!r:.60}") from None
+
+
+def _case_insensitive(given: dict, names) -> dict:
+    """Keys that match one of ``names`` only up to case (``x``, ``exx``) get its spelling."""
+    upper = {}
+    for n in names:
+        upper.setdefault(n.upper(), []).append(n)
+    out = {}
+    for k, v in given.items():
+        if k not in names and isinstance(k, str) and len(upper.get(k.upper(), ())) == 1:
+            k = upper[k.upper()][0]
+        if k in out:
+            raise InputError(f"{k} given twice (names are case-insensitive)")
+        out[k] = v
+    return out
 
 
 def _columns(components, n: int) -> np.ndarray:
@@ -98,7 +123,8 @@ class Model:
     def positions(self, positions) -> dict:
         """Validate positions (dict or (N, n_axes) array, mm/deg) -> dict of float arrays,
         rotary axes converted to rad."""
-        if isinstance(positions, dict):
+        if isinstance(positions, Mapping):
+            positions = _case_insensitive(dict(positions), self.axes)
             unknown = set(positions) - set(self.axes)
             if unknown:
                 raise InputError(f"{self.name}: unknown axis {sorted(unknown)[0]!r}; "
@@ -106,9 +132,9 @@ class Model:
             missing = [a for a in self.axes if a not in positions]
             if missing:
                 raise InputError(f"{self.name}: positions lack axis {missing[0]}")
-            cols = {a: np.asarray(positions[a], dtype=float) for a in self.axes}
+            cols = {a: _floats(positions[a], f"position {a}") for a in self.axes}
         else:
-            arr = np.asarray(positions, dtype=float)
+            arr = _floats(positions, "positions")
             if arr.ndim == 1:
                 arr = arr[None, :]
             require(arr.ndim == 2 and arr.shape[1] == len(self.axes),
@@ -118,7 +144,11 @@ class Model:
         for a, v in cols.items():
             if not np.isfinite(v).all():
                 raise InputError(f"{self.name}: position {a} has NaN or infinite values")
-        shape = np.broadcast_shapes(*(np.shape(v) for v in cols.values()))
+        try:
+            shape = np.broadcast_shapes(*(np.shape(v) for v in cols.values()))
+        except ValueError:
+            raise InputError(f"{self.name}: positions of the axes differ in length: " + ", ".join(
+                f"{a} {np.size(v)}" for a, v in cols.items())) from None
         out = {}
         for a, v in cols.items():
             if v.shape != shape or v.ndim != 1:
@@ -127,7 +157,7 @@ class Model:
         return out
 
     def _probe(self, probe, n: int) -> dict:
-        p = np.asarray(probe, dtype=float)
+        p = _floats(probe, "probe offset")
         require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
         require(np.all(np.isfinite(p)), "probe offset has NaN values")
         if p.shape == (3,):  # one offset for all points: scalars broadcast in the generated code
@@ -140,20 +170,22 @@ class Model:
         out = {}
         for c in self.covariates:
             require(c in covariates, f"{self.name}: covariate {c} is needed (declared effects)")
-            v = np.asarray(covariates[c], dtype=float)
+            v = _floats(covariates[c], f"covariate {c}")
             require(v.shape in ((), (n,), (1,)), f"covariate {c} must be a scalar or ({n},) array")
             require(np.all(np.isfinite(v)), f"covariate {c} has NaN or infinite values")
             out[c] = v
         return out
 
     def _errors(self, errors, n: int) -> dict:
-        errors = dict(errors or {})
+        require(errors is None or isinstance(errors, Mapping),
+                f"errors must be a dict {{name: value}}, got {type(errors).__name__}")
+        errors = _case_insensitive(dict(errors or {}), self.parameters)
         unknown = set(errors) - set(self.parameters)
         if unknown:
             raise InputError(f"{self.name}: unknown error parameter {sorted(unknown)[0]!r}")
         out = {}
         for p in self.parameters:
-            v = np.asarray(errors.get(p, 0.0), dtype=float)
+            v = _floats(errors.get(p, 0.0), f"error {p}")
             require(v.shape in ((), (n,), (1,)), f"error {p} must be a scalar or ({n},) array")
             out[p] = v
         return out
@@ -228,6 +260,8 @@ class Model:
         n = len(next(iter(pos.values())))
         sig = self._errors(sigmas, n)
         self._check_finite(np.stack([np.broadcast_to(v, (n,)) for v in sig.values()]), sig)
+        for k, v in sig.items():
+            require(np.all(v >= 0), f"standard deviation {k} must not be negative")
         if method == "termwise":
             r = self.module.random_error_termwise(
                 **pos, **self._covariates(covariates, n), **self._probe(probe, n),
@@ -246,11 +280,17 @@ class Model:
         defaulting to the values in ``measured``.  Returns the reference values; parameters
         without a transfer rule pass through unchanged."""
         require(hasattr(self.module, "transfer_shift"), f"{self.name} has no transfer rules")
+        measured = _case_insensitive(dict(measured), self.parameters)
+        angular = _case_insensitive(dict(angular), self.parameters) if angular else angular
         unknown = set(measured) - set(self.parameters)
         if unknown:
             raise InputError(f"{self.name}: unknown error parameter {sorted(unknown)[0]!r}")
-        o = np.asarray(offsets, dtype=float)
+        try:
+            o = np.asarray(offsets, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("offsets must be (Xo, Yo, Zo) numbers, mm") from None
         require(o.shape[-1:] == (3,), "offsets must be (Xo, Yo, Zo)")
+        require(np.all(np.isfinite(o)), "offsets have NaN or infinite values")
         values = {**{p: 0.0 for p in self.parameters}, **measured, **(angular or {})}
         args = inspect.signature(self.module.transfer_shift).parameters
         kw = {a: values[a] for a in args if a not in ("Xo", "Yo", "Zo")}

@@ -62,7 +62,24 @@ ROTARY_LETTERS = ("A", "B", "C")
 _TABLE_NAME = re.compile(r"^E([XYZABC])([A-Z])$")
 _CONST_NAME = re.compile(r"^E([XYZABC])0([A-Z])$")
 _COL = re.compile(r"^(?P<name>[A-Za-z0-9]+?)"
-                  r"(?:_(?P<kind1>std|u95))?_(?P<unit>[A-Za-z]+)(?:_(?P<kind2>std|u95))?$")
+                  r"(?:_(?P<kind1>std|u95))?_(?P<unit>[A-Za-z]+)(?:_(?P<kind2>std|u95))?$",
+                  re.IGNORECASE)
+#: a column that names an error parameter (any case): it must carry a unit suffix
+_PARAM_LIKE = re.compile(r"^E[XYZABC]0?[A-Z](?:_|$)", re.IGNORECASE)
+_AXIS_COL = re.compile(r"([A-Za-z])(?:_(mm|deg))?", re.IGNORECASE)
+
+
+def _unit_text(text: str) -> str:
+    """Column or unit spelling -> canonical: micro sign as ``u``, case-insensitive."""
+    return text.replace("\u00b5", "u").replace("\u03bc", "u")
+
+
+def _ignored_column(col: str) -> bool:
+    """An extra column (comment, temperature ...): neither a parameter name nor unit-suffixed."""
+    if _PARAM_LIKE.match(col):
+        return False
+    m = _COL.match(_unit_text(col))
+    return m is None or m.group("unit").lower() not in UNITS
 
 
 def parameter_kind(name: str) -> str:
@@ -169,12 +186,12 @@ def _number(path, lineno, column, text) -> float:
 
 def _parse_column(path, col: str, axis: str):
     """-> (name, unit, kind) with kind '', 'std' or 'u95'."""
-    m = _COL.match(col)
+    m = _COL.match(_unit_text(col))
     if m is None or (m.group("kind1") and m.group("kind2")):
         raise InputError(f"{path}: column {col!r} has no unit suffix (wrong units): "
                          f"write it as <name>_um, _mm, _urad or _rad")
-    name, unit = m.group("name"), m.group("unit")
-    kind = m.group("kind1") or m.group("kind2") or ""
+    name, unit = m.group("name").upper(), m.group("unit").lower()
+    kind = (m.group("kind1") or m.group("kind2") or "").lower()
     require(unit in UNITS, f"{path}: column {col!r}: unknown unit {unit!r} (wrong units); "
                            f"use um, mm, urad or rad")
     mt = _TABLE_NAME.match(name)
@@ -194,14 +211,27 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
     ``axis``: the expected axis (e.g. from the file name); the first column must name it."""
     path = Path(path)
     header, body = _read_rows(path)
+    # the axis column comes first (INTERFACE.md); one found elsewhere is moved there, and extra
+    # columns that are neither parameters nor unit-suffixed (comments, temperatures) are ignored
+    if _AXIS_COL.fullmatch(header[0]) is None:
+        at = [j for j, h in enumerate(header) if _AXIS_COL.fullmatch(h)
+              and (axis is None or h[0].upper() == axis)]
+        if len(at) == 1:
+            order = at + [j for j in range(len(header)) if j != at[0]]
+            header = [header[j] for j in order]
+            body = [(ln, [cells[j] for j in order]) for ln, cells in body]
+    keep = [0] + [j for j in range(1, len(header)) if not _ignored_column(header[j])]
+    if len(keep) < len(header):
+        header = [header[j] for j in keep]
+        body = [(ln, [cells[j] for j in keep]) for ln, cells in body]
     first = header[0]
-    m = re.fullmatch(r"([A-Z])(?:_(mm|deg))?", first)
+    m = _AXIS_COL.fullmatch(first)
     require(m is not None, f"{path}: first column must be the axis position named by the axis "
                            f"(e.g. X or C), got {first!r}")
-    tax = m.group(1)
+    tax = m.group(1).upper()
     if m.group(2):
-        require(m.group(2) == axis_unit(tax), f"{path}: axis {tax} positions are in "
-                                              f"{axis_unit(tax)}, not {m.group(2)}")
+        require(m.group(2).lower() == axis_unit(tax), f"{path}: axis {tax} positions are in "
+                                                      f"{axis_unit(tax)}, not {m.group(2)}")
     if axis is not None:
         require(tax == axis, f"{path}: header names axis {tax!r}, expected {axis!r} (header mismatch)")
     require(len(header) >= 2, f"{path}: no error columns")
@@ -262,14 +292,18 @@ def read_constants_full(path) -> tuple[dict, dict, dict]:
     """Read a constants CSV -> (values, std, u95), each name -> float in mm / rad."""
     path = Path(path)
     header, body = _read_rows(path)
-    require(header[:3] == ["name", "value", "unit"],
-            f"{path}: header must start with name,value,unit, got {','.join(header)}")
+    low = [h.lower() for h in header]
+    require(all(k in low for k in ("name", "value", "unit")),
+            f"{path}: header must have the columns name,value,unit, got {','.join(header)}")
+    # columns in any order, any case; columns other than std / u95 (comments ...) are ignored
+    order = [low.index(k) for k in ("name", "value", "unit")]
+    order += [j for j, h in enumerate(low) if h in ("std", "u95")]
+    header = [low[j] for j in order]
+    body = [(ln, [cells[j] for j in order]) for ln, cells in body]
     extra = header[3:]
-    for h in extra:
-        require(h in ("std", "u95"), f"{path}: unknown column {h!r} (allowed extra columns: std, u95)")
     values, std, u95 = {}, {}, {}
     for lineno, cells in body:
-        name, unit = cells[0], cells[2]
+        name, unit = cells[0].upper(), _unit_text(cells[2]).lower()
         require(_CONST_NAME.match(name) is not None,
                 f"{path}:{lineno}: {name!r} is not a constant error name "
                 f"(squareness EC0Y EB0Z EA0Z or location errors such as EX0C)")

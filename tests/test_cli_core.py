@@ -47,6 +47,12 @@ BAD_LAYOUTS = {
     "bad squareness": ('name = "T"\n[axes.X]\nkind = "linear"\ndirection = [1,0,0]\n'
                        'travel = [0, 1]\n[chain]\ntool = ["X"]\n[squareness]\nEC0Y = "Z"\n',
                        "squareness"),
+    "undeclared name in a frame": ('name = "T"\n[axes.X]\nkind = "linear"\ndirection = [1,0,0]\n'
+                                   'travel = [0, 1]\n[frames.ram]\ntranslation = [0, 0, "q"]\n'
+                                   '[chain]\ntool = ["X", "ram"]\n', "unknown name 'q'"),
+    "bad expression in a frame": ('name = "T"\n[axes.X]\nkind = "linear"\ndirection = [1,0,0]\n'
+                                  'travel = [0, 1]\n[frames.ram]\ntranslation = [0, 0, "2*("]\n'
+                                  '[chain]\ntool = ["X", "ram"]\n', "not a valid expression"),
 }
 
 
@@ -70,6 +76,34 @@ def test_derive_layout_file_on_the_fly(tmp_path):
     assert proc.returncode == 0 and (tmp_path / "gen" / "mine.py").exists()
 
 
+def test_layout_file_with_a_fixed_frame_offset(tmp_path):
+    """A fixed frame f between X and Z is a lever for the X and Y rotations only: the custom
+    machine with probe p equals MB1 with probe p + f for X/Y errors, and MB1 for Z errors."""
+    import numpy as np
+
+    src = (volerr.layout.shipped_layout_dir() / "MB1.toml").read_text()
+    src = src.replace('name = "MB1"', 'name = "RAM"').replace(
+        'tool = ["Y", "X", "Z"]', 'tool = ["Y", "X", "ram", "Z"]').replace(
+        "[chain]", '[parameters]\nh = 100\n\n[frames.ram]\ntranslation = [50, -30, "2*h"]\n\n[chain]')
+    path = tmp_path / "ram.toml"
+    path.write_text(src)
+    m, mb1 = volerr.load(str(path)), volerr.load("MB1")
+    rng = np.random.default_rng(4)
+    pos = rng.uniform(0, 400, (20, 3))
+    f, p = np.array([50.0, -30.0, 200.0]), np.array([10.0, -20.0, -150.0])
+    exy = {k: rng.normal(size=20) * (1e-3 if k[1] in "XYZ" else 1e-5)
+           for k in m.parameters if k[-1] in "XY" and "0" not in k}
+    exy["EC0Y"] = 1e-5
+    np.testing.assert_allclose(m.volumetric_error(pos, exy, probe=p),
+                               mb1.volumetric_error(pos, exy, probe=p + f), atol=1e-15)
+    ez = {k: rng.normal(size=20) * 1e-5 for k in m.parameters if k[-1] == "Z" and "0" not in k}
+    ez.update(EB0Z=2e-5, EA0Z=-3e-5)
+    np.testing.assert_allclose(m.volumetric_error(pos, ez, probe=p),
+                               mb1.volumetric_error(pos, ez, probe=p), atol=1e-15)
+    np.testing.assert_allclose(m.nominal_position(pos, p), mb1.nominal_position(pos, p) + f,
+                               atol=1e-9)
+
+
 def test_bad_positions_and_errors_raise_input_error():
     import numpy as np
 
@@ -82,6 +116,36 @@ def test_bad_positions_and_errors_raise_input_error():
         m.volumetric_error(np.zeros((1, 2)), {})
     with pytest.raises(volerr.InputError, match="unknown axis"):
         m.volumetric_error({"X": 0, "Y": 0, "Z": 0, "B": 0}, {})
+
+
+def test_api_input_forms_and_non_numbers():
+    """Positions as lists, one point, names in any case give the same numbers; anything that
+    is not numbers (or positions of different lengths, sigmas < 0) raises InputError."""
+    import numpy as np
+
+    m = volerr.load("MB1")
+    assert volerr.load("mb1").name == "MB1"
+    pos = np.array([[100.0, 200.0, 300.0], [800.0, 20.0, 10.0]])
+    errs = {"EXX": [1e-3, 2e-3], "EBX": 1e-5, "EC0Y": 2e-5}
+    want = m.volumetric_error(pos, errs, probe=(1.0, 2.0, -30.0))
+    got = m.volumetric_error({"x": pos[:, 0].tolist(), "y": pos[:, 1], "Z": pos[:, 2]},
+                             {k.lower(): v for k, v in errs.items()}, probe=[1, 2, -30])
+    np.testing.assert_array_equal(got, want)
+    one = m.volumetric_error(pos[1].tolist(), {"EXX": 2e-3, "EBX": 1e-5, "EC0Y": 2e-5},
+                             probe=[1, 2, -30])
+    np.testing.assert_allclose(one, want[1:], rtol=1e-15)
+    bad = [lambda: m.volumetric_error([["a", 1, 2]], {}),
+           lambda: m.volumetric_error({"X": "a", "Y": 1, "Z": 2}, {}),
+           lambda: m.volumetric_error(pos, {"EXX": "abc"}),
+           lambda: m.volumetric_error(pos, {}, probe=("a", 0, 0)),
+           lambda: m.volumetric_error(pos, [1, 2]),
+           lambda: m.volumetric_error({"X": [1, 2], "Y": [1, 2, 3], "Z": 0}, {}),
+           lambda: m.volumetric_error({"X": 1, "x": 2, "Y": 0, "Z": 0}, {}),
+           lambda: m.random_error(pos, {"EXX": -1e-3}),
+           lambda: m.transfer({"EXX": 1e-3}, (0, 0, "a"))]
+    for call in bad:
+        with pytest.raises(volerr.InputError):
+            call()
 
 
 def test_help_for_every_command():

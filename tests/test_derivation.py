@@ -114,6 +114,8 @@ def test_random_error_exact_and_termwise():
     sample = model.volumetric_error(np.repeat(pos, 20000, axis=0), draws, probe)
     want = model.random_error(pos, {p: 2e-6 for p in model.parameters}, probe)[0]
     np.testing.assert_allclose(sample.std(axis=0), want, rtol=0.03)
+    with pytest.raises(volerr.InputError, match="negative"):
+        model.random_error(pos, {"EBX": -1e-5}, probe)
 
 
 # ---- hypothesis over random layouts ----------------------------------------------------

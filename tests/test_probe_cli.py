@@ -163,6 +163,22 @@ def test_refuses_to_overwrite_input(data, capsys):
     assert path.read_bytes() == before
 
 
+def test_output_that_is_a_folder_or_under_a_file(tmp_path, data, capsys):
+    """--out naming an existing folder, or a path below a file: exit 2, one line, nothing written."""
+    path, _ = data
+    before = path.read_bytes()
+    cases = ((["--out", str(tmp_path)], "is a folder"),
+             (["--out", str(path / "m.csv")], "is a file"),
+             (["--out", str(tmp_path / "ok.csv"), "--json", str(tmp_path)], "is a folder"))
+    for extra, msg in cases:
+        code = main(["probe-cal", str(path), "--sphere-radius", str(R_S), *extra])
+        err = capsys.readouterr().err
+        assert code == 2 and msg in err and err.count("\n") == 1, (extra, err)
+        assert "Traceback" not in err
+    assert not (tmp_path / "ok.csv").exists()
+    assert path.read_bytes() == before
+
+
 def test_usage_errors(tmp_path, data, capsys):
     path, _ = data
     assert main(["probe-cal", str(path), "--sphere-radius", str(R_S)]) == 2      # no --out

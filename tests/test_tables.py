@@ -211,3 +211,30 @@ def test_poly_functions_from_tables():
     np.testing.assert_allclose(g(q)["EXX"], lin, atol=1e-12)
     with pytest.raises(InputError, match="degree"):
         ErrorFunctions({"X": t}, {}, MB1, method="poly", degree=19)
+
+
+def test_lenient_spelling_of_tables_and_constants(tmp_path):
+    """Case, the micro sign, the axis column elsewhere and comment columns read as the plain form;
+    a parameter column without a valid unit is still refused."""
+    for sub in ("0", "1", "2", "3", "bad"):
+        (tmp_path / sub).mkdir()
+    plain = read_error_table(_write(tmp_path / "X.csv", "X,EXX_um,EAX_urad\n0,1,2\n10,3,-4\n"),
+                             axis="X")
+    for i, text in enumerate([
+            "x,exx_UM,eax_URAD\n0,1,2\n10,3,-4\n",
+            "X,EXX_\u00b5m,EAX_\u03bcrad\n0,1,2\n10,3,-4\n",
+            "EXX_um,X,EAX_urad\n1,0,2\n3,10,-4\n",
+            "X,note,EXX_um,T_C,EAX_urad\n0,start,1,20.1,2\n10,,3,20.3,-4\n"]):
+        t = read_error_table(_write(tmp_path / f"{i}" / "X.csv", text), axis="X")
+        np.testing.assert_array_equal(t.positions, plain.positions)
+        assert t.values.keys() == plain.values.keys()
+        for k in plain.values:
+            np.testing.assert_allclose(t.values[k], plain.values[k], rtol=1e-15)
+    for text, match in (("X,dx_um\n0,1\n1,2\n", "not a component error"),
+                        ("X,note\n0,a\n1,b\n", "no error columns"),
+                        ("X,exx\n0,1\n1,2\n", "unit suffix")):
+        with pytest.raises(InputError, match=match):
+            read_error_table(_write(tmp_path / "bad" / "X.csv", text), axis="X")
+    c = _write(tmp_path / "c.csv", "Unit,Name,Value,comment\nURAD,ec0y,12,squareness\n"
+                                   "\u00b5m,EX0C,5,\n")
+    assert read_constants(c) == pytest.approx({"EC0Y": 12e-6, "EX0C": 5e-3})
