@@ -153,6 +153,8 @@ def run(args) -> int:
     print(f"probe error max {e['max']:.1f} um, min {e['min']:.1f} um, rms {e['rms']:.1f} um; "
           f"map degree {cal.map.degree}, residual rms {summary['map']['residual_rms_um']:.2f} um;"
           f" {n_out} outlier{'s' if n_out != 1 else ''} flagged"
-          + (" and excluded" if args.exclude_outliers and n_out else ""))
+          + (" and excluded" if args.exclude_outliers and n_out else "")
+          + (" (kept in the fit: --exclude-outliers refits without them)"
+             if n_out and not args.exclude_outliers else ""))
     print(f"map: {out}")
     return 0
