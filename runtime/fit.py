@@ -36,6 +36,8 @@ from .model import Model
 SETUP = ("dx", "dy", "dz", "ex", "ey", "ez")
 #: relative singular value below which a direction counts as undetermined
 SV_TOL = 1e-6
+#: relative distance below which a column counts as gauge on the ideal plan
+GAUGE_TOL = 1e-4
 
 
 @dataclass
@@ -209,8 +211,18 @@ def gauge_mask(model: Model, data: Data, degree: int, ranges: dict) -> tuple[np.
     ideal = ideal_data(model, data, ranges)
     d = declared_design(model, ideal, degree, ranges)
     A2 = d.A.reshape(-1, d.A.shape[-1])
-    keep = independent_columns(A2.T @ A2, priority_order(d.labels))
+    # correlation-scaled Gram (columns in mm and rad differ by orders of magnitude): on the
+    # ideal plan a kept column is >= ~0.1 of its norm away from the span of the others and
+    # a gauge column ~1e-7 (rounding), so 1e-4 separates them whatever the seed
+    keep = independent_columns(_correlation(A2.T @ A2), priority_order(d.labels), GAUGE_TOL)
     return keep, [d.labels[j] for j in np.flatnonzero(~keep)]
+
+
+def _correlation(G: np.ndarray) -> np.ndarray:
+    """Gram matrix of the columns scaled to unit norm (zero columns stay zero)."""
+    s = np.sqrt(np.diag(G))
+    s[s == 0] = 1.0
+    return G / np.outer(s, s)
 
 
 def priority_order(labels) -> list:
@@ -313,7 +325,7 @@ def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> tuple[
     them by these data.  Returns the mask of kept columns and one entry per parameter with
     dropped terms: ``{"parameters": [that parameter, then the partners it is confounded
     with], "terms": [dropped basis terms], "confounded_with": {partner: weight}}``."""
-    G = A2.T @ A2
+    G = _correlation(A2.T @ A2)   # scale-free: mm and rad columns alike
     # translational terms before angular ones: an angular error is what a plan without the
     # lever arms cannot see, not the scale or straightness it would be confused with
     order = sorted(range(len(labels)), key=lambda j: (
