@@ -434,6 +434,7 @@ class _Context:
                 dbic = n3 * math.log(new / base.rss) + m_eff * math.log(n3)
                 scored.append((dbic, gain, c, cols, params))
             scored.sort(key=lambda s: s[0])
+            _prefer_first_of_ties(scored, candidates)
             accepted = False
             for dbic, gain, c, cols, params in scored[:3]:
                 if dbic > -BIC_GAIN:
@@ -463,6 +464,20 @@ class _Context:
         return {"design": design, "keep": keep, "gauge": gauge, "A_all": A_all,
                 "unidentifiable": unident, "weak": weak,
                 "selected": selected, "candidates": candidates}
+
+
+def _prefer_first_of_ties(scored: list, candidates: list) -> None:
+    """Among candidates that fit the data identically (same columns up to rounding, e.g. on a
+    CMM ``EZX`` depending on ``Y`` and ``EZY`` depending on ``X``), put the one listed first
+    by :func:`volerr.candidates.build` in front, so that the choice does not depend on
+    rounding; the others are reported as ``indistinguishable_from``."""
+    if len(scored) < 2:
+        return
+    order = {c.name: i for i, c in enumerate(candidates)}
+    d0 = scored[0][0]
+    ties = [i for i, s in enumerate(scored) if abs(s[0] - d0) <= 1e-7 * abs(d0) + 1e-9]
+    first = min(ties, key=lambda i: order.get(scored[i][2].name, len(order)))
+    scored.insert(0, scored.pop(first))
 
 
 def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
