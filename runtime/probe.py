@@ -153,6 +153,8 @@ def read_sphere_csv(path) -> SphereData:
     header = [h.strip().lower() for h in rows[0]]
     alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
     header = [alias.get(h, h) for h in header]
+    dup = [c for c in ("x", "y", "z", "phi_deg", "theta_deg") if header.count(c) > 1]
+    require(not dup, f"{path}: column {dup[0]!r} appears twice" if dup else "")
     missing = [c for c in ("x", "y", "z") if c not in header]
     if missing:
         raise InputError(f"{path}: missing column {missing[0]!r} (need x,y,z in mm, "

@@ -131,13 +131,15 @@ def bad_cases(tmp_path, pts):
         "empty": (w("i.csv", ""), R_S, "empty"),
         "no rows": (w("j.csv", "x,y,z\n"), R_S, "no data"),
         "phi only": (w("k.csv", "x,y,z,phi_deg\n1,2,3,4\n"), R_S, "both"),
+        "duplicate column": (w("l.csv", "x,y,z,X\n" + "\n".join(r + ",0" for r in rows.split("\n"))),
+                             R_S, "twice"),
         "missing file": (tmp_path / "nope.csv", R_S, "no such file"),
     }
 
 
 @pytest.mark.parametrize("case", ["missing column", "nan", "text", "few points", "circle",
                                   "diameter", "absurd", "negative", "empty", "no rows",
-                                  "phi only", "missing file"])
+                                  "phi only", "missing file", "duplicate column"])
 def test_bad_input_exit_2(tmp_path, case, capsys):
     pts = pp.simulate_probing(pp.pahk_plan(), C0, R_S, R_BALL, noise_mm=0.2e-3, rng=0)
     path, radius, message = bad_cases(tmp_path, pts)[case]
