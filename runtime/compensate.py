@@ -249,10 +249,27 @@ class ErrorModel:
                 ok &= (ql[:, i] >= lo) & (ql[:, i] <= hi)
         return ok
 
+    #: how far (mm, deg) a compensated position may pass the end of its error table: the
+    #: nominal positions are checked against the tables' ranges, the correction (um) may then
+    #: push a block at the end of a table just past it; the end value is used there
+    EDGE_MARGIN = {"linear": 1.0, "rotary": 0.1}
+
+    def _clip_edges(self, q: np.ndarray) -> np.ndarray:
+        if self.funcs is None or self.funcs.extrapolate:
+            return q
+        q = q.copy()
+        for a, (lo, hi) in self.ranges.items():
+            i = self.model.axes.index(a)
+            m = self.EDGE_MARGIN["rotary" if a in self.rot else "linear"]
+            v = q[:, i]
+            near = ((v < lo) & (v >= lo - m)) | ((v > hi) & (v <= hi + m))
+            q[:, i] = np.where(near, np.clip(v, lo, hi), v)
+        return q
+
     def errors(self, q: np.ndarray, subset=None) -> dict:
         if self.funcs is None:
             return {}
-        e = self.funcs(self.lookup(q))
+        e = self.funcs(self._clip_edges(self.lookup(q)))
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e

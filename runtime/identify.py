@@ -445,8 +445,15 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
     u = np.sqrt(np.clip(np.einsum("kii->ki", cov_theta), 0, None))
     u[0] = 0.0
     closed = {}
-    if method == "closed" or (cross_check and n >= 3):
+    if method == "closed":
         closed = _closed_form(lever, delta, theta, axis, kind, A)
+    elif cross_check and n >= 3:
+        # only a cross-check: points at one height (a common set-up on a rotary table) make
+        # every Zhang & Hu selection singular, while least squares is well determined
+        try:
+            closed = _closed_form(lever, delta, theta, axis, kind, A)
+        except InputError:
+            closed = {}
     u_closed = _closed_uncertainty(A, closed, W, sigma) if closed else None
     # outliers are judged on the least-squares residuals (the closed form fits six equations
     # exactly and leaves all misfit in the other three)

@@ -556,3 +556,63 @@ def test_iso_16907_types_select_what_is_compensated(tmp_path):
     assert t["EAC"] == ("R-ANG",) and t["EBB"] == ("R-POS", "R-ANG")
     with pytest.raises(volerr.errors.InputError, match="unknown compensation type"):
         compensate_program(m, funcs, text, types=["L-FOO"])
+
+
+def test_program_at_the_end_of_the_tables_is_compensated(tmp_path):
+    """Tables measured over exactly the travel, a program that goes to both travel ends: the
+    correction pushes the axis a few um past the table's end; the end value is used there
+    (the nominal positions are inside), the executed tip lands within 0.1 um."""
+    m = volerr.load("DMU50")
+    err = tmp_path / "err"
+    err.mkdir()
+    lo, hi = m.travel["X"]
+    x = np.linspace(lo, hi, 5)
+    write_error_table(err / "X.csv", ErrorTable("X", x, {"EXX": -x * 1e-5, "EYX": x * 2e-5}))
+    prog = tmp_path / "p.nc"
+    prog.write_text(f"G0 X0 Y0 Z100 B0 C0\nG1 X{hi:g}\nG1 X{lo:g}\n")
+    out = tmp_path / "o.nc"
+    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", out)
+    assert rc == 0, se
+    blocks = gcode.blocks(gcode.parse(out.read_text()), m.axes)
+    q = np.array([[b.target[a] for a in m.axes] for b in blocks])
+    assert q[1, 0] > hi and q[2, 0] < lo            # the correction goes past the ends
+    # the executing machine: exact chain, table values held at the ends
+    xc = np.clip(q[:, 0], lo, hi)
+    tip = []
+    for r, row in enumerate(q):
+        e = {"EXX": -xc[r] * 1e-5, "EYX": xc[r] * 2e-5}
+        tip.append((tool2work("DMU50", dict(zip(m.axes, row)), e) @ [0, 0, 0, 1])[:3])
+    want = nominal(m, prog.read_text())[:, :3]
+    assert np.linalg.norm(np.array(tip) - want, axis=1).max() * 1e3 < 0.1
+    # beyond the margin it is still refused
+    prog.write_text(f"G0 X0 Y0 Z100 B0 C0\nG1 X{hi + 2:g}\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o2",
+                     "--ignore-travel")
+    assert rc == 2 and "outside the measured range" in se
+
+
+def test_bad_program_one_stderr_line_even_with_notes_about_the_tables(tmp_path):
+    """An endless C table that leaves a gap (0..330 deg) gives a note; a bad program must
+    still give exactly one line on stderr (the error), for compensate and tcpmap."""
+    err = tmp_path / "err"
+    err.mkdir()
+    c = np.arange(0.0, 331.0, 30.0)
+    write_error_table(err / "C.csv", ErrorTable("C", c, {"EXC": 1e-3 * np.sin(np.radians(c))}))
+    prog = tmp_path / "p.nc"
+    prog.write_text("G0 X0 Y0 Z100 B0 C0\nG2 X10 Y10 R5\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
+    assert rc == 2 and len(se.strip().splitlines()) == 1 and "G2" in se, se
+    rc, so, se = cli("tcpmap", "DMU50", "--errors", err, "--point", "0", "0", "0", "--out",
+                     prog)
+    assert rc == 2 and len(se.strip().splitlines()) == 1 and ".png" in se, se
+    assert prog.read_text().startswith("G0")
+    for args in (("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o",
+                  "--plot", tmp_path / "q.nc"),
+                 ("identify", "MB1", "--axis", "X", prog, "--out", tmp_path / "o",
+                  "--plot", tmp_path / "p.svg")):
+        rc, so, se = cli(*args)
+        assert rc == 2 and len(se.strip().splitlines()) == 1 and ".png" in se, se
+        assert not (tmp_path / "o").exists()
+    prog.write_text("G0 X0 Y0 Z100 B0 C0\nG1 C345\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
+    assert rc == 0 and "note:" in se, se

@@ -316,3 +316,19 @@ def test_round_measured_backwards_referred_to_the_first_rounds_reference():
     res = identify([Round("1", pos, LABELS, fwd), back], lay, "X")
     _check(res, e, second_order_bound(e, REF), 1e-8)
     assert np.allclose(res.std, 0, atol=1e-12)
+
+
+def test_rotary_points_at_one_height_least_squares_default():
+    """Three balls at one height on a rotary table: every Zhang & Hu selection is singular
+    (they divide by height differences) but least squares is well determined; the default
+    (lsq) identifies, only method="closed" is refused."""
+    lay = parse_layout(ROTARY_LAYOUT)
+    pos = np.arange(0.0, 360.0, 20.0)
+    e = smooth_errors(pos, seed=5)
+    flat = np.array([[150.0, 0.0, 50.0], [-75.0, 130.0, 50.0], [-75.0, -130.0, 50.0]])
+    pts = simulate("rotary", flat, pos, e, direction=(0, 0, 1))
+    res = identify([Round("r", pos, LABELS, pts)], lay, "C")
+    b = second_order_bound(e, flat)
+    _check(res, e, b, b / 50.0)
+    with pytest.raises(InputError, match="singular"):
+        identify([Round("r", pos, LABELS, pts)], lay, "C", method="closed")

@@ -114,13 +114,13 @@ def run(args) -> int:
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
-    for note in notes:
-        print(f"note: {note}", file=sys.stderr)
     text = gcode.read_program(args.program)
     inputs = [args.program, *Path(args.errors).glob("*.csv")]
     for out in (args.out, args.report, args.json, args.plot):
         if out:
             check_output(out, inputs)
+    require(not args.plot or str(args.plot).lower().endswith(".png"),
+            f"plot file must end in .png, got {args.plot}")
     result = compensate_program(
         model, funcs, text, tool=args.tool, orientation=args.orientation,
         strategy=args.strategy, tol_um=args.tol_um, decimals=args.decimals,
@@ -147,6 +147,9 @@ def run(args) -> int:
     if s["max_u_after_um"] > 0:
         print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
+    # notes only after success: bad input gets exactly one line on stderr
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
     if model.rotary_axes:
         print(f"tool-axis error max {s['max_orientation_before_urad']:.2f} -> "
               f"{s['max_orientation_after_urad']:.2f} urad")

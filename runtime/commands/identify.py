@@ -120,6 +120,8 @@ def run(args) -> int:
     for o in outs:
         check_output(o, inputs)
     require(len(set(outs)) == len(outs), "output files must differ from each other")
+    require(not args.plot or str(args.plot).lower().endswith(".png"),
+            f"plot file must end in .png, got {args.plot}")
     layout = read_layout(args.layout)
     rounds = read_rounds(args.files, args.format, args.positions, args.points)
     sense = {"auto": "auto", "+": 1, "-": -1}[args.sense]

@@ -50,12 +50,11 @@ def run(args) -> int:
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
-    for note in notes:
-        print(f"note: {note}", file=sys.stderr)
     inputs = list(Path(args.errors).glob("*.csv"))
     for out in (args.out, args.csv):
         if out:
             check_output(out, inputs)
+    require(str(args.out).lower().endswith(".png"), f"plot file must end in .png, got {args.out}")
     a1, a2, q1, q2, err, valid = tcp_error_map(model, funcs, args.point, args.tool,
                                                args.steps, args.steps)
     require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
@@ -84,4 +83,7 @@ def run(args) -> int:
           f"{a1} {q1[0]:g}..{q1[-1]:g} deg, {a2} {q2[0]:g}..{q2[-1]:g} deg: max "
           f"{np.nanmax(mag):.3f} um, min {np.nanmin(mag):.3f} um "
           f"({int(valid.sum())} of {valid.size} grid points valid); wrote {args.out}")
+    # notes only after success: bad input gets exactly one line on stderr
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
     return 0
