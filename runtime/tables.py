@@ -18,9 +18,14 @@ File formats (INTERFACE.md)
   ``EXX_std_um`` / ``EXX_u95_um`` (unit stays the last suffix, like every other column);
   ``EXX_um_std`` / ``EXX_um_u95`` are accepted on read.
 * blank lines and lines starting with ``#`` are ignored; every other cell must be a finite number.
+* lenient spelling: names and units in any case (``exx_UM`` = ``EXX_um``; ``µm``/``µrad`` =
+  ``um``/``urad``); the axis column may stand anywhere (it is moved first); columns that are
+  neither parameter names nor unit-suffixed (``comment``, ``T_C``) are ignored.  A column named
+  like a parameter without a valid unit is refused, and so is a table without error columns.
 
 *Constants* (squareness, rotary-axis location errors), CSV ``name,value,unit`` with unit one of
-``um mm urad rad``; optional columns ``std`` and ``u95`` in the same unit as ``value``.
+``um mm urad rad``; optional columns ``std`` and ``u95`` in the same unit as ``value``.  Columns
+in any order and case; other columns (comments) are ignored.
 
 *Error directory* (``--errors DIR``): ``<AXIS>.csv`` for each measured axis of the layout and
 optionally ``constants.csv``.  A missing table means zero errors for that axis; any other CSV
