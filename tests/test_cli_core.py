@@ -28,6 +28,12 @@ def test_layouts_lists_the_ten_cmms():
     assert names == volerr.layouts()
 
 
+def test_layouts_long_one_complete_line_each():
+    lines = run("layouts", "--long").stdout.splitlines()
+    assert [ln.split()[0] for ln in lines] == volerr.layouts()
+    assert all(ln.rstrip().endswith(".") for ln in lines)
+
+
 def test_unknown_layout():
     assert_clean_failure(run("derive", "MB9", "--out", "x"), "unknown layout")
     with pytest.raises(volerr.InputError):

@@ -13,7 +13,8 @@ def run(args) -> int:
     for name in layout_names():
         if args.long:
             lay = read_layout(name)
-            first = lay.description.strip().splitlines()[0] if lay.description else ""
+            text = " ".join(lay.description.split())  # the first sentence, on one line
+            first = text.split(". ")[0].rstrip(".") + "." if text else ""
             print(f"{name:8s} {' '.join(lay.axis_names):12s} {first}")
         else:
             print(name)
