@@ -222,12 +222,20 @@ class Model:
     def _probe_term(self, direction, probe_error, n: int) -> np.ndarray:
         require(direction is not None and probe_error is not None,
                 "combined model needs both a probing direction and a probe error")
-        m = np.broadcast_to(np.asarray(direction, dtype=float), (n, 3))
+        m = _floats(direction, "probing direction")
+        require(m.shape in ((3,), (n, 3)), f"probing direction must be (3,) or ({n}, 3), "
+                                           f"got {m.shape}")
+        require(np.all(np.isfinite(m)), "probing direction has NaN or infinite values")
+        m = np.broadcast_to(m, (n, 3))
         norm = np.linalg.norm(m, axis=1, keepdims=True)
         require(np.all(norm > 0), "probing direction must not be the zero vector")
         m = m / norm
         value = probe_error(m) if callable(probe_error) else probe_error
-        value = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+        value = _floats(value, "probe error")
+        require(value.shape in ((), (1,), (n,)), f"probe error must be a scalar or ({n},) "
+                                                 f"array, got {value.shape}")
+        require(np.all(np.isfinite(value)), "probe error has NaN or infinite values")
+        value = np.broadcast_to(value, (n,))
         return value[:, None] * m
 
     def exact_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),

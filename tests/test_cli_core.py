@@ -148,7 +148,10 @@ def test_api_input_forms_and_non_numbers():
            lambda: m.volumetric_error({"X": [1, 2], "Y": [1, 2, 3], "Z": 0}, {}),
            lambda: m.volumetric_error({"X": 1, "x": 2, "Y": 0, "Z": 0}, {}),
            lambda: m.random_error(pos, {"EXX": -1e-3}),
-           lambda: m.transfer({"EXX": 1e-3}, (0, 0, "a"))]
+           lambda: m.transfer({"EXX": 1e-3}, (0, 0, "a")),
+           lambda: m.volumetric_error(pos, {}, direction=("a", 0, 1), probe_error=1e-3),
+           lambda: m.volumetric_error(pos, {}, direction=(0, 0, 1), probe_error=[1, 2, 3]),
+           lambda: m.volumetric_error(pos, {}, direction=(0, 1), probe_error=1e-3)]
     for call in bad:
         with pytest.raises(volerr.InputError):
             call()
