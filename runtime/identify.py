@@ -609,12 +609,14 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
                           tuple(float(v) for v in o))
 
 
-def to_model_signs(table, layout):
+def to_model_signs(table, layout, reference=None):
     """An identified table (error motions of the component carrying the points) in the
     volerr model's convention (tool relative to workpiece, ``volerr.layout``).
 
-    Tool-side axes are unchanged: the model's carriage frame pivots, like the tracker's, about
-    the carriage point at the tool reference point.  For a table axis the model gives the tool's
+    Tool-side axes keep their signs; the model's carriage frame pivots about the carriage point
+    that is at the origin at ``q = 0``, the tracker's about the one there at the reference
+    position ``q0``, so a linear tool-side axis measured from ``q0 != 0`` gets
+    ``delta = t + q0 (e x u)`` (unchanged for ``q0 = 0``).  For a table axis the model gives the tool's
     error relative to the table with rotations pivoting about the tool reference point, which
     stays put while the table travels, whereas the tracker's pivot is the table point that was
     there at the reference position.  With ``t, e`` the table's own motions, ``u`` the axis
@@ -629,16 +631,29 @@ def to_model_signs(table, layout):
 
     axis = table.axis
     require(axis in layout.axes, f"axis {axis} is not an axis of layout {layout.name}")
-    if axis not in layout.workpiece_chain:
+    tool_side = axis not in layout.workpiece_chain
+    # the reference position q0 (errors zero there): the first position of the first round
+    q0 = float(table.positions[0] if reference is None else reference)
+    if tool_side and (layout.axes[axis].kind != "linear" or q0 == 0):
         return table
     t = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
                   for p in MOTION_PREFIX[:3]], axis=1)
     e = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
                   for p in MOTION_PREFIX[3:]], axis=1)
+    if tool_side:
+        # the model's carriage frame is the carriage point at the origin at q = 0; the
+        # tracker's pivot is the one there at the reference position q0: t + q0 (e x u)
+        u = np.asarray(layout.axes[axis].direction, dtype=float)
+        delta = t + q0 * np.cross(e, u)
+        values = dict(table.values)
+        for j, p in enumerate(MOTION_PREFIX[:3]):
+            if p + axis in values or np.any(delta[:, j]):
+                values[p + axis] = delta[:, j]
+        return ErrorTable(axis, table.positions, values, table.std, table.u95)
     delta = -t
     if layout.axes[axis].kind == "linear":
         u = np.asarray(layout.axes[axis].direction, dtype=float)
-        travel = table.positions - table.positions[0]
+        travel = table.positions - q0
         delta = delta - travel[:, None] * np.cross(e, u)
     motions = np.concatenate([delta, -e], axis=1)
     values = {p + axis: motions[:, j] for j, p in enumerate(MOTION_PREFIX)

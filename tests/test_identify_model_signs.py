@@ -65,3 +65,56 @@ def test_component_signs_are_the_default_and_differ_for_a_table(tmp_path):
     np.testing.assert_allclose(comp.values["EAX"], body[:, 3], atol=1e-8)
     mod = read_error_table(tmp_path / "model.csv")
     np.testing.assert_allclose(mod.values["EAX"], -body[:, 3], atol=1e-8)
+
+
+@pytest.mark.parametrize("q0,q1", [(-250.0, 250.0), (250.0, -250.0), (0.0, 250.0)])
+def test_tool_axis_measured_from_a_nonzero_reference(tmp_path, q0, q1):
+    """DMU50 X (tool side) measured from q0 (frame = machine frame): the tracker's pivot is the
+    carriage point at the origin at q0, the model's the one there at q = 0; --signs model
+    re-references (t + q0 e x u) and the model reproduces the exact error of the tool tip."""
+    model = volerr.load("DMU50")
+    u = np.array([1.0, 0.0, 0.0])
+    pos = np.linspace(q0, q1, 11)
+    body = smooth_errors(pos, scale_mm=0.02, scale_rad=80e-6, seed=9)
+    pts = simulate("linear", REF, pos, body, direction=u)
+    f = tmp_path / "tracker.csv"
+    f.write_text(to_csv([pts], pos, ("P", "Q", "K")))
+    assert main(["identify", "DMU50", "--axis", "X", str(f), "--signs", "model",
+                 "--out", str(tmp_path / "X.csv")]) == 0
+    table = read_error_table(tmp_path / "X.csv")
+    funcs = ErrorFunctions({"X": table}, {}, model, method="linear")
+    for y, z in ((0.0, 0.0), (50.0, 200.0)):
+        for k, q in enumerate(pos):
+            t, R = body[k, :3], error_rotation(*body[k, 3:])
+            tip = np.array([q, y, z])
+            carriage = (q - q0) * u            # the body point at the origin at q0
+            exact = carriage + t + R @ (tip - carriage) - tip
+            at = {"X": np.array([q]), "Y": np.array([y]), "Z": np.array([z]),
+                  "B": np.array([0.0]), "C": np.array([0.0])}
+            got = model.volumetric_error(at, funcs(at))[0]
+            np.testing.assert_allclose(got, exact, atol=1e-5)
+
+
+def test_table_axis_measured_backwards(tmp_path):
+    """FB2 X (table) measured from 400 down to 0: the reference is 400 (first position), the
+    re-referencing uses the travel from there, not from the smallest position."""
+    model = volerr.load("FB2")
+    u = np.asarray(model.layout.axes["X"].direction)
+    pos = np.linspace(400, 0, 9)
+    body = smooth_errors(pos, scale_mm=0.02, scale_rad=80e-6, seed=12)
+    pts = simulate("linear", REF, pos, body, direction=-u)
+    f = tmp_path / "tracker.csv"
+    f.write_text(to_csv([pts], pos, ("P", "Q", "K")))
+    assert main(["identify", "FB2", "--axis", "X", str(f), "--signs", "model",
+                 "--out", str(tmp_path / "X.csv")]) == 0
+    funcs = ErrorFunctions({"X": read_error_table(tmp_path / "X.csv")}, {}, model,
+                           method="linear")
+    P = np.array([35.0, -80.0, -120.0])
+    for k, q in enumerate(pos):
+        t, R = body[k, :3], error_rotation(*body[k, 3:])
+        moved = (q - pos[0]) * u
+        exact = R.T @ (P + moved - t) - (P + moved)
+        at = {a: np.array([0.0]) for a in model.axes}
+        at["X"] = np.array([q])
+        np.testing.assert_allclose(model.volumetric_error(at, funcs(at), probe=P)[0], exact,
+                                   atol=1e-5)

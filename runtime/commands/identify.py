@@ -134,7 +134,7 @@ def run(args) -> int:
         sense=sense, max_cond=args.max_cond, outlier_k=args.outlier_k)
     table = result.table()
     if args.signs == "model":
-        table = to_model_signs(table, layout)
+        table = to_model_signs(table, layout, reference=result.rounds[0].positions[0])
     text = table_to_csv(table)
     summary = result.summary()
     fits = None
