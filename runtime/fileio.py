@@ -28,6 +28,24 @@ def check_output(path, inputs=()) -> Path:
     return out
 
 
+def check_plot(path, inputs=()) -> Path:
+    """:func:`check_output` for a plot, which must be a ``.png`` file (checked before any write)."""
+    out = check_output(path, inputs)
+    require(out.suffix.lower() == ".png", f"plot file must end in .png, got {out.name}")
+    return out
+
+
+def check_folder(path) -> Path:
+    """An output folder: refuse a path that is an existing file (or lies below one)."""
+    d = Path(path)
+    require(not d.exists() or d.is_dir(), f"{d} is a file, not a folder")
+    for parent in d.parents:
+        if parent.exists():
+            require(parent.is_dir(), f"cannot write {d}: {parent} is a file, not a folder")
+            break
+    return d
+
+
 def write_text(path, text: str, inputs=()) -> Path:
     """Write ``text`` (UTF-8, line endings kept) to ``path`` atomically."""
     return write_bytes(path, text.encode("utf-8"), inputs)

@@ -258,6 +258,19 @@ def test_bad_cli_input(tmp_path, capsys, mb1_dir):
     _clean_failure(capsys, ["diagonals", "MB1", "--errors", str(d)], "wrong units")
 
 
+def test_bad_plot_name_writes_nothing(tmp_path, capsys, mb1_dir):
+    """The plot name is checked with the other outputs, before the CSV / JSON are written."""
+    out, js = tmp_path / "m.csv", tmp_path / "d.json"
+    _clean_failure(capsys, ["map", "MB1", "--errors", str(mb1_dir), "--out", str(out),
+                            "--plot", str(tmp_path / "m.txt")], ".png")
+    _clean_failure(capsys, ["map", "MB1", "--errors", str(mb1_dir), "--out", str(out),
+                            "--plot", str(tmp_path / "m.png"), "--plot-random",
+                            str(tmp_path / "r.jpg")], ".png")
+    _clean_failure(capsys, ["diagonals", "MB1", "--errors", str(mb1_dir), "--json", str(js),
+                            "--plot", str(tmp_path / "d.txt")], ".png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
 def test_cli_subprocess_exit_code(tmp_path):
     d = _bad_dir(tmp_path, "X,EXX_um\n0,1\n0,2\n")
     p = subprocess.run([sys.executable, "-m", "volerr", "diagonals", "MB1", "--errors", str(d)],

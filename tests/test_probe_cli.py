@@ -179,6 +179,14 @@ def test_output_that_is_a_folder_or_under_a_file(tmp_path, data, capsys):
         assert "Traceback" not in err
     assert not (tmp_path / "ok.csv").exists()
     assert path.read_bytes() == before
+    for extra, msg in ((["--plot", str(tmp_path / "p.txt")], ".png"),
+                       (["--plots", str(path)], "not a folder")):
+        code = main(["probe-cal", str(path), "--sphere-radius", str(R_S), "--out",
+                     str(tmp_path / "ok.csv"), "--json", str(tmp_path / "ok.json"), *extra])
+        err = capsys.readouterr().err
+        assert code == 2 and msg in err and err.count("\n") == 1, (extra, err)
+        assert not (tmp_path / "ok.csv").exists() and not (tmp_path / "ok.json").exists()
+    assert path.read_bytes() == before
 
 
 def test_usage_errors(tmp_path, data, capsys):

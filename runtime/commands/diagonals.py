@@ -41,6 +41,9 @@ def run(args) -> int:
     for out in (args.json, args.plot):
         if out is not None:
             check_output(out, inputs)
+    if args.plot is not None:
+        from volerr.fileio import check_plot
+        check_plot(args.plot, inputs)
     lin = linear_axes(model)
     lines = diagonals.box_lines(volume(model, funcs, args.volume), lin, tuple(args.lines))
     results = diagonals.evaluate_lines(model, funcs, lines, tuple(args.probe), parse_at(args.at),

@@ -78,8 +78,8 @@ def run(args) -> int:
                           ("--plot-random", rnd_plot), ("--json", args.json))
     for out in (args.out, args.plot, rnd_plot, args.json):
         if out is not None:
-            from volerr.fileio import check_output
-            check_output(out, inputs)
+            from volerr.fileio import check_output, check_plot
+            (check_plot if out in (args.plot, rnd_plot) else check_output)(out, inputs)
     vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at),
                                  box=volmap.volume(model, funcs, args.volume))
     s = vmap.summary()

@@ -117,6 +117,16 @@ def run(args) -> int:
     outputs = [o for o in (args.out, args.json, args.plot) if o]
     for i, o in enumerate(outputs):
         check_output(o, inputs + outputs[:i])
+    if args.plot:
+        from volerr.fileio import check_plot
+        check_plot(args.plot, inputs + [args.out])
+    if args.plots:  # checked before anything is written
+        from pathlib import Path
+
+        from volerr.fileio import check_folder
+        d = check_folder(args.plots)
+        for name in ("probe_map_3d.png", "probe_map_2d.png"):
+            check_output(d / name, inputs + outputs)
     require(args.degree is None or 0 <= args.degree <= 20,
             f"--degree must be between 0 and 20, got {args.degree}")
     data = probe.read_sphere_csv(args.data)
