@@ -224,11 +224,16 @@ class Identification:
                 "thesis_choice_everywhere": all(c["thesis_choice_everywhere"] for c in cf),
                 "consistency_max": max(c["consistency_max"] for c in cf),
                 "vs_lsq_max": {n: max(c["vs_lsq_max"][n] for c in cf) for n in self.names},
-                "noise_gain_vs_lsq": {n: float(np.mean([c.get("noise_gain_vs_lsq", {})
-                                                       .get(n, np.nan) for c in cf]))
-                                      for n in self.names},
+                "noise_gain_vs_lsq": {n: _mean_or_none([c.get("noise_gain_vs_lsq", {}).get(n)
+                                                        for c in cf]) for n in self.names},
             }
         return out
+
+
+def _mean_or_none(values):
+    """Mean of the finite values (None when there is none: JSON null, never NaN)."""
+    v = [float(x) for x in values if x is not None and math.isfinite(x)]
+    return float(np.mean(v)) if v else None
 
 
 def _layout_number(value, params: dict) -> float:
@@ -478,9 +483,13 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
                       "vs_lsq_max": {nm: float(diff[:, j].max()) * (1e3 if j < 3 else 1e6)
                                      for j, nm in enumerate(names)}}
         if K > 1:
-            with np.errstate(all="ignore"):
+            import warnings
+
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: noise-free data
                 gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
-            summary_cf["noise_gain_vs_lsq"] = {nm: float(gain[j]) for j, nm in enumerate(names)}
+            summary_cf["noise_gain_vs_lsq"] = {nm: float(gain[j]) if np.isfinite(gain[j])
+                                               else None for j, nm in enumerate(names)}
     return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, delta,
                        cond, s, sigma, outliers, summary_cf)
 

@@ -202,3 +202,21 @@ def test_squareness_bad_input(tmp_path, capsys):
     (d / "Y.csv").unlink()
     code, so, se = run_cli(["squareness", "MB1", d, "--out", tmp_path / "o"], capsys)
     assert code == 2 and "no pair" in se
+
+
+def test_json_summary_strict_on_noise_free_data(tmp_path, capsys):
+    """Noise-free data make ratios 0/0: the summary has null there, never NaN (not JSON), and
+    no warning reaches stderr."""
+    f = tmp_path / "in.csv"
+    pts = simulate("linear", REF, POS, np.zeros((POS.size, 6)))   # a perfect axis
+    f.write_text(to_csv([pts, pts], POS, ("P", "Q", "K")))
+    js = tmp_path / "s.json"
+    code, so, se = run_cli(["identify", "MB1", "--axis", "X", f, "--out", tmp_path / "X.csv",
+                            "--json", js], capsys)
+    assert code == 0 and se == "", se
+
+    def refuse(c):
+        raise ValueError(f"non-JSON constant {c}")
+
+    doc = json.loads(js.read_text(), parse_constant=refuse)
+    assert doc["n_rounds"] == 2

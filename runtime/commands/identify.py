@@ -157,7 +157,7 @@ def run(args) -> int:
     if "closed_form" in s:
         cf = s["closed_form"]
         d = list(cf["vs_lsq_max"].values())
-        g = [v for v in cf["noise_gain_vs_lsq"].values() if v == v]
+        g = [v for v in cf["noise_gain_vs_lsq"].values() if v is not None and v == v]
         roles = "; ".join(f"P={r['P']} Q={r['Q']} K={r['K']}" for r in cf["roles"])
         print(f"closed form (Zhang & Hu selection {cf['selection']}, {roles}): equals least "
               f"squares on consistent data to {cf['consistency_max']:.1g}; on these data it "
