@@ -51,6 +51,13 @@ def write_text(path, text: str, inputs=()) -> Path:
     return write_bytes(path, text.encode("utf-8"), inputs)
 
 
+def default_mode() -> int:
+    """Permissions of a new file under the current umask (mkstemp alone would give 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_bytes(path, data: bytes, inputs=()) -> Path:
     """Write ``data`` to ``path`` atomically (temporary file + rename), refusing inputs."""
     out = check_output(path, inputs)
@@ -62,6 +69,7 @@ def write_bytes(path, data: bytes, inputs=()) -> Path:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, default_mode())
         os.replace(tmp, out)
     except BaseException as exc:
         if os.path.exists(tmp):

@@ -166,6 +166,8 @@ def save_figure(fig, path, inputs=()) -> Path:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=120)
+        from .fileio import default_mode
+        os.chmod(tmp, default_mode())
         os.replace(tmp, out)
     finally:
         if os.path.exists(tmp):

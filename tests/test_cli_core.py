@@ -172,3 +172,18 @@ def test_help_for_every_command():
                                   ["identify", "MB1", "x.csv"], ["derive", "--nope"]])
 def test_usage_errors_are_one_line(argv):
     assert_clean_failure(run(*argv), "error")
+
+
+def test_outputs_have_the_umask_permissions(tmp_path):
+    """Atomic writes go through a private temporary file; the result must not stay 0600."""
+    import os
+    import stat
+
+    from volerr.fileio import write_text
+
+    mask = os.umask(0o022)
+    try:
+        p = write_text(tmp_path / "a.csv", "x\n")
+        assert stat.S_IMODE(p.stat().st_mode) == 0o644
+    finally:
+        os.umask(mask)
