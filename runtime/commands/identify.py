@@ -58,7 +58,9 @@ def register(sub) -> None:
                    help="component (default, as the thesis and INTERFACE.md): the error motions "
                         "of the moving component that carries the points; model: the volerr "
                         "model's tool-relative convention (for a table axis of LAYOUT: negated "
-                        "and re-referenced to the tool point), ready for map / compensate")
+                        "and re-referenced to the tool point; a linear axis measured from a "
+                        "reference position q0 != 0: re-referenced to q = 0; measurement frame = "
+                        "machine frame), ready for map / compensate")
     p.add_argument("--json", help="write a summary (JSON)")
     p.add_argument("--plot", help="write a plot of the error motions (PNG)")
     p.set_defaults(func=run)
