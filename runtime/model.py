@@ -127,7 +127,7 @@ class Model:
             positions = _case_insensitive(dict(positions), self.axes)
             unknown = set(positions) - set(self.axes)
             if unknown:
-                raise InputError(f"{self.name}: unknown axis {sorted(unknown)[0]!r}; "
+                raise InputError(f"{self.name}: unknown axis {sorted(unknown, key=str)[0]!r}; "
                                  f"axes are {' '.join(self.axes)}")
             missing = [a for a in self.axes if a not in positions]
             if missing:
@@ -182,7 +182,7 @@ class Model:
         errors = _case_insensitive(dict(errors or {}), self.parameters)
         unknown = set(errors) - set(self.parameters)
         if unknown:
-            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown)[0]!r}")
+            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown, key=str)[0]!r}")
         out = {}
         for p in self.parameters:
             v = _floats(errors.get(p, 0.0), f"error {p}")
@@ -292,7 +292,7 @@ class Model:
         angular = _case_insensitive(dict(angular), self.parameters) if angular else angular
         unknown = set(measured) - set(self.parameters)
         if unknown:
-            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown)[0]!r}")
+            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown, key=str)[0]!r}")
         try:
             o = np.asarray(offsets, dtype=float)
         except (TypeError, ValueError):
