@@ -311,7 +311,7 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
     require(scores, f"too few points for the basis: {len(train)} training points cannot fit "
             f"even a degree-1 model of layout {model.name}")
     best = min(scores.values())
-    return min(k for k, v in scores.items() if v <= 1.01 * best), scores
+    return min(k for k, v in scores.items() if v <= best), scores
 
 
 def _cv(prob: Problem, folds, points) -> np.ndarray:
@@ -535,7 +535,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
     labels = [lab for lab, k in zip(design.labels, keep) if k]
     A_all, selected, candidates = state["A_all"], state["selected"], state["candidates"]
     unident = state["unidentifiable"]
-    _explain(unident, dat)
+    _explain(unident, dat, model)
 
     # ---- augment: layout file, derivation, generated module ---------------------------
     bar.set_postfix_str("augment, derive, generate")
@@ -698,13 +698,19 @@ def _gauge_text(gauge) -> list:
     return [f"{p}: {', '.join(v) if isinstance(v, list) else v}" for p, v in out.items()]
 
 
-def _explain(groups, data: Data) -> None:
+def _explain(groups, data: Data, model: Model | None = None) -> None:
     """Attach a plain-language reason to each unidentifiable group."""
     n_probes = len(np.unique(np.round(data.probe, 6), axis=0))
+    still = {a for a, v in data.positions.items() if np.ptp(v) == 0}
     for g in groups:
         angular = [p for p in g["parameters"][:1] if p[:1] == "E" and len(p) == 3
                    and p[1] in "ABC"]
-        if g.get("no_sensitivity"):
+        axis = model.parameter_axis.get(g["parameters"][0]) if model is not None else None
+        if axis in still:
+            g["reason"] = (f"axis {axis} does not move in these data (all points at {axis} = "
+                           f"{float(data.positions[axis][0]):g}): {g['parameters'][0]} cannot be "
+                           f"determined as a function of {axis}; measure along {axis}")
+        elif g.get("no_sensitivity"):
             g["reason"] = (f"{g['parameters'][0]} does not act on these data at all (zero "
                            f"sensitivity: e.g. an angular error with no lever arm); measure "
                            f"with probe/tool offsets that give it one")

@@ -50,3 +50,19 @@ def test_gauge_columns_are_exact_dependencies_and_kept_ones_are_not():
     assert keep.sum() == rank
     svk = np.linalg.svd(A[:, keep], compute_uv=False)
     assert svk[-1] > 1e-6 * svk[0]
+
+
+def test_axis_that_does_not_move_is_named_as_the_reason():
+    """A plan where X stands still: the X component errors are unidentifiable, and the report
+    says why (the axis does not move), not 'zero sensitivity'."""
+    from volerr.loop import run_loop
+    from volerr.simulate import demo_probes, simulate
+
+    model = volerr.load("MB1")
+    camp = simulate("MB1", n_points=300, seed=3, probes=demo_probes(model), noise_um=0.3)
+    camp.positions["X"] = np.full(camp.n_points, 450.0)
+    rep = run_loop("MB1", camp, seed=3, progress=False, families=())
+    groups = {g["parameters"][0]: g for g in rep["unidentifiable"]}
+    assert {"EXX", "EYX", "EZX"} <= set(groups)
+    for p in ("EXX", "EYX", "EZX"):
+        assert "axis X does not move" in groups[p]["reason"], groups[p]
