@@ -31,6 +31,10 @@ Sign conventions (ISO 230-1 / ISO 841): every axis ``direction`` is the directio
 tool (probe) moves *relative to the workpiece* for a positive command, whether the tool side
 or the table moves.  Component errors of an axis are likewise those of the tool relative to the
 workpiece caused by that axis: for a table axis they are minus the table's own error motion.
+Error motions of an axis are expressed in the frame of the body the axis rides on, i.e. after
+the nominal rotations of the axes and frames below it in its chain (for a C table on a tilting
+B axis, ``EAC`` is about the x axis of the tilted B body; on the shipped CMMs, where no frame
+is rotated, that is the machine x axis).
 Squareness ``E{R}0{B}`` is the small right-hand rotation about axis ``R`` of the line of motion
 of ``B`` relative to the reference axis (X for EC0Y and EB0Z, Y for EA0Z); when the layout
 assigns it to the reference axis instead, that axis is rotated by the opposite angle, which
