@@ -137,6 +137,8 @@ class LineReport:
 class Result:
     text: str
     reports: list = field(default_factory=list)
+    #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
+    assumed_zero: tuple = ()
 
     def summary(self) -> dict:
         done = [r for r in self.reports if r.status.startswith("compensated")]
@@ -420,7 +422,14 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
     for a in initial or {}:
         require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")
     lines = gcode.parse(text)
+    initial = dict(initial or {})
     blocks = gcode.blocks(lines, model.axes, initial)
+    # a rotary axis the program never commands stays where it is: at its zero unless given
+    never = tuple(a for a in model.rotary_axes
+                  if a not in initial and all(b.target[a] is None for b in blocks))
+    if never:
+        initial.update({a: 0.0 for a in never})
+        blocks = gcode.blocks(lines, model.axes, initial)
     require(not (types is not None and strategy == "thesis"),
             "the thesis strategy has its own set of errors (L-POS L-STR L-SQU and the "
             "rotary-axis errors); --types applies to the full strategy")
@@ -514,7 +523,7 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
                                       f"not compensated: position of axis {missing[0]} unknown"))
 
     out_text = _write(lines, model.axes, initial, known, q_out, nd)
-    return Result(out_text, reports)
+    return Result(out_text, reports, never)
 
 
 def _resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:

@@ -420,6 +420,8 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
     K, n, _ = pts.shape
     steps = rnd.positions - rnd.positions[0]
     cond = geometry_condition(pts[0])
+    if not math.isfinite(cond):  # exactly singular: report the number a solver would give up at
+        cond = 1.0 / np.finfo(float).eps
     require(cond <= max_cond,
             f"round {rnd.name}: degenerate point geometry (condition number {cond:.3g} > "
             f"{max_cond:.3g}): points {','.join(rnd.labels)} are coincident or (nearly) "

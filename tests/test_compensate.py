@@ -295,6 +295,27 @@ def test_unknown_axes_are_reported_not_guessed(tmp_path):
     assert res2.reports[0].status == "compensated"
 
 
+def test_rotary_axes_never_programmed_are_taken_at_zero(tmp_path):
+    """A three-axis program on a five-axis machine: B and C stay at 0 and every block is
+    compensated; executed on the independent chain it lands within 0.1 um."""
+    m = volerr.load("DMU50")
+    err = write_errors(tmp_path / "err", m, seed=3)
+    funcs = tables.ErrorFunctions.from_dir(err, m)
+    text = "G90 G1 X10 Y-20 Z30\nX40\nY15 Z110\n"
+    res = compensate_program(m, funcs, text)
+    assert res.assumed_zero == ("B", "C")
+    assert [r.status for r in res.reports] == ["compensated"] * 3
+    full = lambda t: "".join(f"{ln} B0 C0\n" for ln in t.splitlines())  # noqa: E731
+    want = nominal(m, full(text))
+    _, _, before = execute(m, funcs, full(text))
+    _, _, after = execute(m, funcs, full(res.text))
+    assert np.linalg.norm(before[:, :3] - want[:, :3], axis=1).max() > 5e-3
+    assert np.linalg.norm(after[:, :3] - want[:, :3], axis=1).max() < 1e-4
+    # a B word anywhere means B is programmed: before it, its position stays unknown
+    res2 = compensate_program(m, funcs, "G1 X10 Y0 Z0\nB10 C0\n")
+    assert res2.assumed_zero == () and res2.reports[0].status.startswith("not compensated")
+
+
 # ------------------------------------------------------------------ command line
 def test_cli_bad_input_exit_2_one_line(tmp_path):
     m = volerr.load("DMU50")

@@ -55,7 +55,8 @@ def register(sub) -> None:
                    help="decimals of the written numbers (at least those of the input)")
     p.add_argument("--initial", default="",
                    help="axis positions at program start, e.g. 'B=0,C=0' (otherwise an axis "
-                        "is unknown until programmed)")
+                        "is unknown until programmed; a rotary axis the program never commands "
+                        "is taken at 0 deg)")
     p.add_argument("--ignore-travel", action="store_true",
                    help="accept positions outside the layout's travel")
     p.add_argument("--report", help="per-block CSV report")
@@ -148,6 +149,9 @@ def run(args) -> int:
         print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
     # notes only after success: bad input gets exactly one line on stderr
+    if result.assumed_zero:
+        notes.append(f"axes {' '.join(result.assumed_zero)} are never programmed: taken at 0 deg "
+                     f"(give --initial to state other positions)")
     for note in notes:
         print(f"note: {note}", file=sys.stderr)
     if model.rotary_axes:
