@@ -5,9 +5,11 @@ Each candidate is a list of effect terms (``parameter * basis`` added to a targe
 columns the data provide.  Families (``kind``):
 
 * ``thermal``: a temperature column (``T_C``, ``T_<axis>``, ``temp``...): the scale of each
-  linear axis grows with T - 20 degC (``E<d><A> += KT_A * A * (T - 20)``, KT in 1/K).  Measured
-  against an artefact at the same temperature, KT is the *differential* expansion (scale
-  minus artefact); its mean over the campaign also sits in the fitted scale error.
+  linear axis grows with T - 20 degC about a fixed point A0 of the scale, which need not be
+  the axis origin: ``E<d><A> += KT_A * A * (T - 20) + KT0_A * (T - 20)`` (KT in 1/K, KT0 in
+  mm/K, A0 = -KT0/KT).  Measured against an artefact at the same temperature, KT is the
+  *differential* expansion (scale minus artefact); its mean over the campaign also sits in
+  the fitted scale error.
 * ``drift``: a time column (``t_s``, ``t_min``, ``t_h``, ``time``): the instrument drifts
   linearly along x, y or z (``work.d<k> += DR_<k> * t``, DR in mm/h).
 * ``reversal``: ``dir_<A>`` (+1 / -1): positioning of A differs by RV_A between approach
@@ -93,7 +95,8 @@ def build(model, data: Data, ranges: dict, degree: int) -> list:
         for a in linear:
             comp = along_component(lay, a)
             out.append(Candidate("thermal", f"thermal_{a}{sfx}",
-                                 [(f"KT_{a}{sfx}", comp, f"{a}*({tcol} - 20)")],
+                                 [(f"KT_{a}{sfx}", comp, f"{a}*({tcol} - 20)"),
+                                  (f"KT0_{a}{sfx}", comp, f"({tcol} - 20)")],
                                  {"axis": a, "component": comp, "covariate": tcol,
                                   "reference_C": 20.0}))
     for tcol, div in _TIME.items():

@@ -179,7 +179,8 @@ def _unit_of(kind: str, target: str, basis: str) -> tuple[float, str]:
     """Report factor and unit of an effect parameter."""
     angular = (target[1] in "ABC" and "." not in target) or ".e" in target
     if kind == "thermal":
-        return 1e6, "um/m/K"
+        # KT * A * (T - 20): 1/K -> um/m/K; KT0 * (T - 20), the scale's fixed point: mm/K -> um/K
+        return (1e3, "um/K") if basis.startswith("(") else (1e6, "um/m/K")
     if kind == "drift":
         per = "h" if "/3600" in basis or "t_h" in basis or "/60" in basis else "unit"
         return 1e3, f"um/{per}"
@@ -602,6 +603,10 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
             units[pn] = u
             contrib += after_prob.A[:, j] * after_prob.scale[j] * c_all[j]
         info = {k: (round(v, 6) if isinstance(v, float) else v) for k, v in c.info.items()}
+        if c.kind == "thermal" and len(c.terms) == 2:
+            k1, k0 = (float(c_all[col_index[t[0]]]) for t in c.terms)
+            if k1 != 0.0:   # expansion about A0: KT (A - A0) (T - 20), A0 = -KT0 / KT
+                info["fixed_point_mm"] = round(-k0 / k1, 3)
         if c.kind == "periodic":
             a_s, a_c = (pars[t[0]] for t in c.terms)
             info["amplitude_um"] = round(math.hypot(a_s, a_c), 4)

@@ -75,7 +75,9 @@ def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str
     """The variable against which an effect is best seen."""
     if kind == "thermal":
         a, t = info["axis"], info["covariate"]
-        return dat.positions[a] * (dat.covariates[t] - 20.0), f"{a} * ({t} - 20), mm K"
+        a0 = float(info.get("fixed_point_mm", 0.0))
+        label = f"({a} - {a0:g}) * ({t} - 20), mm K" if a0 else f"{a} * ({t} - 20), mm K"
+        return (dat.positions[a] - a0) * (dat.covariates[t] - 20.0), label
     if kind in ("drift", "reversal") or kind == "setup":
         c = info["covariate"]
         return np.asarray(dat.covariates[c], dtype=float), c

@@ -132,7 +132,7 @@ def campaign(layout="MB1", n=1000, seed=0, effects=(), noise_um=0.5, probes=PROB
         if k == "thermal":   # positioning error along axis prop to q*(T-20)
             a = e.get("axis", "X")
             add["EX" + a if a == "X" else ("EY" + a if a == "Y" else "EZ" + a)] = \
-                e.get("alpha", 11.5e-6) * pos[a] * (T - 20.0)
+                e.get("alpha", 11.5e-6) * (pos[a] - e.get("x0", 0.0)) * (T - 20.0)
         elif k == "drift":
             v = np.zeros(3); v["xyz".index(e.get("dir", "x"))] = e.get("um_per_h", 1.5) * 1e-3
             extra_dev += (t_s / 3600)[:, None] * v
@@ -155,6 +155,9 @@ def campaign(layout="MB1", n=1000, seed=0, effects=(), noise_um=0.5, probes=PROB
                 sel = rnd == r
                 inst_t[sel] += rng.normal(0, e.get("um", 8.0) * 1e-3, 3)
                 inst_r[sel] += rng.normal(0, e.get("urad", 15.0) * 1e-6, 3)
+        elif k == "bump":
+            c = e.get("component", "EYZ"); a = c[2]
+            add[c] = add.get(c, 0) + e.get("um", 3.0) * 1e-3 * np.exp(-((pos[a] - e.get("at", mid[a] + 37)) / e.get("width", 20.0)) ** 2)
         elif k == "higher_order":
             c = e.get("component", "EYZ"); a = c[2]
             u = (pos[a] - mid[a]) / half[a]

@@ -111,7 +111,8 @@ def test_augmented_layout_is_a_real_layout(tmp_path):
     assert rep["augmented_layout"] == str(path) and (tmp_path / "mb1_aug.py").is_file()
     aug, base = volerr.load(str(path)), volerr.load("MB1")
     assert aug.parameters[:len(base.parameters)] == base.parameters
-    assert aug.parameters[len(base.parameters):] == ("KT_X",) and aug.covariates == ("T_C",)
+    assert aug.parameters[len(base.parameters):] == ("KT_X", "KT0_X")
+    assert aug.covariates == ("T_C",)
     rng = np.random.default_rng(0)
     pos = {a: rng.uniform(*base.travel[a], 20) for a in base.axes}
     T = rng.uniform(15, 25, 20)
@@ -119,6 +120,11 @@ def test_augmented_layout_is_a_real_layout(tmp_path):
     k = 1.2e-5
     got = aug.volumetric_error(pos, {"KT_X": k}, probe, covariates={"T_C": T})
     want = base.volumetric_error(pos, {"EXX": k * pos["X"] * (T - 20.0)}, probe)
+    np.testing.assert_allclose(got, want, atol=1e-15)
+    # KT0_X: the scale's fixed point X0 = -KT0_X / KT_X (expansion k (X - X0) (T - 20))
+    got = aug.volumetric_error(pos, {"KT_X": k, "KT0_X": -k * 300.0}, probe,
+                               covariates={"T_C": T})
+    want = base.volumetric_error(pos, {"EXX": k * (pos["X"] - 300.0) * (T - 20.0)}, probe)
     np.testing.assert_allclose(got, want, atol=1e-15)
     # and the generated module file is what `volerr derive` makes of that layout
     from volerr.derive.generate import generate_module

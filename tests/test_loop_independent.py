@@ -32,6 +32,10 @@ def test_clean_wavy_machine_nothing_found(tmp_path, n, seed):
 CASES = [
     ("MB1", {"kind": "thermal", "axis": "X"},
      lambda e: e["info"]["axis"] == "X" and abs(list(e["parameters"].values())[0] - 11.5) < 0.5),
+    # a scale fixed at the far end of the travel: expansion about X0 = 900 mm, not X = 0
+    ("MB1", {"kind": "thermal", "axis": "X", "x0": 900.0},
+     lambda e: e["info"]["axis"] == "X" and abs(e["parameters"]["KT_X"] - 11.5) < 0.5
+     and abs(e["info"]["fixed_point_mm"] - 900.0) < 30.0),
     ("FB1", {"kind": "reversal", "axis": "Z", "um": 3.0},
      lambda e: e["name"] == "reversal_Z" and abs(e["parameters"]["RV_Z"] - 3.0) < 0.3),
     ("MB1", {"kind": "periodic", "component": "EYY", "pitch": 20.0, "um": 2.0},
@@ -42,7 +46,7 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("layout,effect,check", CASES, ids=[c[1]["kind"] for c in CASES])
+@pytest.mark.parametrize("layout,effect,check", CASES, ids=[f"{c[1]['kind']}-{c[0]}-{i}" for i, c in enumerate(CASES)])
 def test_planted_effect_found(tmp_path, layout, effect, check):
     rep = _run(tmp_path, layout, 700, 3, [effect])
     assert [e["kind"] for e in rep["effects"]] == [effect["kind"]], rep["effects"]
