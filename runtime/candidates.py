@@ -13,17 +13,20 @@ columns the data provide.  Families (``kind``):
 * ``drift``: a time column (``t_s``, ``t_min``, ``t_h``, ``time``): the instrument drifts
   linearly along x, y or z (``work.d<k> += DR_<k> * t``, DR in mm/h).
 * ``reversal``: ``dir_<A>`` (+1 / -1): positioning of A differs by RV_A between approach
-  directions (``E<d><A> += RV_A * dir_A / 2``).
+  directions (``E<d><A> += RV_A * dir_A / 2``; two levels coded otherwise, e.g. 0 / 1, are
+  mapped to -1/2, +1/2, so RV_A is always the high-level minus the low-level position).
 * ``coupling``: a component error of axis A depends on the position of another axis B:
   Legendre cross terms P1(a)P1(b), P2(a)P1(b), P1(a)P2(b), which no sum of one-dimensional
   functions can represent.
 * ``periodic``: a cyclic translational error along an axis, ``a sin(2 pi q/P) + b cos(..)``,
   period P searched (periodogram of the residual, then refined).
 * ``higher_order``: Legendre terms of a component beyond the fitted degree.
-* ``probe_direction``: ``nx, ny, nz`` columns (unit probing direction in the probe frame,
+* ``probe_direction``: ``nx, ny, nz`` columns (or ``ni, nj, nk``, ``n_x ...``, ``i, j, k``:
+  unit probing direction in the probe frame,
   which is the workpiece frame's orientation on a CMM): an error along the probing direction
   (effective probe radius), ``tool.d<k> += PR_R * n_k``.
-* ``setup``: a grouping column (``setup``, ``round``, ``mount``, ``group``) with 2-50 levels:
+* ``setup``: a grouping column (``setup``, ``round``, ``mount``, ``group``, ``placement``,
+  ``run``, ``session``, ``batch``) with 2-50 levels:
   the instrument was re-placed, six rigid-placement coordinates per later group.
 """
 
@@ -39,8 +42,11 @@ from .fit import Data
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
             "probe_direction", "setup")
 _TEMP = re.compile(r"^(T(_\w+)?|[Tt]emp\w*)$")   # T, T_C, T_X, temp_C (not t_s: time)
-_TIME = {"t_s": "/3600", "time_s": "/3600", "t_min": "/60", "t_h": "", "time": ""}
-_GROUP = ("setup", "round", "mount", "group", "placement")
+_TIME = {"t_s": "/3600", "time_s": "/3600", "t_min": "/60", "time_min": "/60", "t_h": "",
+         "time_h": "", "time": ""}
+_GROUP = ("setup", "round", "mount", "group", "placement", "run", "session", "batch")
+#: column triples accepted as the probing direction (unit vector in the probe frame)
+_PROBE_DIRS = (("nx", "ny", "nz"), ("ni", "nj", "nk"), ("n_x", "n_y", "n_z"), ("i", "j", "k"))
 
 
 @dataclass
@@ -110,8 +116,14 @@ def build(model, data: Data, ranges: dict, degree: int) -> list:
         col = f"dir_{a}"
         if col in cov and len(np.unique(cov[col])) > 1:
             comp = along_component(lay, a)
+            levels = np.unique(cov[col])
+            basis = f"{col}/2"
+            if len(levels) == 2 and not np.array_equal(levels, [-1.0, 1.0]):
+                # two levels coded otherwise (0/1 ...): +-1/2 all the same, RV = high - low
+                lo, hi = float(levels[0]), float(levels[1])
+                basis = f"({col} - {_f((lo + hi) / 2)})/{_f(hi - lo)}"
             out.append(Candidate("reversal", f"reversal_{a}",
-                                 [(f"RV_{a}", comp, f"{col}/2")],
+                                 [(f"RV_{a}", comp, basis)],
                                  {"axis": a, "component": comp, "covariate": col}))
     comps = [p for p in model.parameters if model.parameter_axis.get(p)]
     for p in comps:
@@ -151,10 +163,12 @@ def build(model, data: Data, ranges: dict, degree: int) -> list:
         terms = [(f"HO_{p}_{k}", p, f"legendre({k}, {ua})") for k in range(degree + 1, top + 1)]
         out.append(Candidate("higher_order", f"higher_order_{p}", terms,
                              {"component": p, "axis": a, "degrees": [degree + 1, top]}))
-    if all(c in cov for c in ("nx", "ny", "nz")):
-        out.append(Candidate("probe_direction", "probe_direction",
-                             [("PR_R", f"tool.d{k}", f"n{k}") for k in "xyz"],
-                             {"covariates": ["nx", "ny", "nz"]}))
+    for names in _PROBE_DIRS:
+        if all(c in cov for c in names):
+            out.append(Candidate("probe_direction", "probe_direction",
+                                 [("PR_R", f"tool.d{k}", c) for k, c in zip("xyz", names)],
+                                 {"covariates": list(names)}))
+            break
     for g in _GROUP:
         if g not in cov:
             continue

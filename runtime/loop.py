@@ -182,7 +182,8 @@ def _unit_of(kind: str, target: str, basis: str) -> tuple[float, str]:
         # KT * A * (T - 20): 1/K -> um/m/K; KT0 * (T - 20), the scale's fixed point: mm/K -> um/K
         return (1e3, "um/K") if basis.startswith("(") else (1e6, "um/m/K")
     if kind == "drift":
-        per = "h" if "/3600" in basis or "t_h" in basis or "/60" in basis else "unit"
+        per = ("h" if "/3600" in basis or "/60" in basis or basis in ("t_h", "time_h")
+               else "unit")
         return 1e3, f"um/{per}"
     return (1e6, "urad") if angular else (1e3, "um")
 

@@ -118,7 +118,8 @@ def fig_effect(fg, eff: dict) -> str:
     x, xlabel = _natural(eff["kind"], eff["info"], model, dat, values)
     if eff["kind"] == "probe_direction":
         # along the probing direction: the component of the partial residual along n
-        n = np.column_stack([dat.covariates[c] for c in ("nx", "ny", "nz")])
+        names = eff["info"].get("covariates", ("nx", "ny", "nz"))
+        n = np.column_stack([dat.covariates[c] for c in names])
         n = n / np.linalg.norm(n, axis=1, keepdims=True)
         y, fit = np.sum(partial * n, axis=1), np.sum(c3 * n, axis=1)
         x = np.arange(dat.n, dtype=float)

@@ -53,3 +53,36 @@ def test_planted_effect_found(tmp_path, layout, effect, check):
     assert check(rep["effects"][0]), rep["effects"][0]
     assert rep["rms_after_um"] < 0.75 * rep["rms_before_um"]
     assert rep["rms_after_um"] < 1.1
+
+
+def _renamed(cols, renames):
+    out = dict(cols)
+    for old, new in renames.items():
+        out[new] = out.pop(old)
+    return out
+
+
+@pytest.mark.parametrize("effect,change,family,check", [
+    ({"kind": "probe_direction", "um": 1.5}, {"nx": "ni", "ny": "nj", "nz": "nk"},
+     "probe_direction", lambda e: abs(e["parameters"]["PR_R"] - 1.5) < 0.2),
+    ({"kind": "reversal", "axis": "X", "um": 4.0}, "dir01", "reversal",
+     lambda e: abs(e["parameters"]["RV_X"] - 4.0) < 0.3),
+    ({"kind": "drift", "dir": "z", "um_per_h": 2.0}, "time_h", "drift",
+     lambda e: abs(e["parameters"]["DR_Z"] - 2.0) < 0.2 and e["units"]["DR_Z"] == "um/h"),
+    ({"kind": "setup"}, {"round": "session"}, "setup",
+     lambda e: e["name"] == "setup_session"),
+], ids=["ni-nj-nk", "dir-0-1", "time_h", "session"])
+def test_other_column_conventions(tmp_path, effect, change, family, check):
+    """Probing direction as ni,nj,nk; approach direction coded 0/1 (RV is still the difference
+    between the directions); time in hours; set-ups in a 'session' column."""
+    cols = sim.campaign("MB1", 500, 12, [effect])
+    if change == "dir01":
+        cols["dir_X"] = (cols["dir_X"] + 1) / 2
+    elif change == "time_h":
+        cols["time_h"] = cols.pop("t_s") / 3600
+    else:
+        cols = _renamed(cols, change)
+    path = sim.write_csv(str(tmp_path / "data.csv"), cols)
+    rep = run_loop("MB1", path, seed=0, progress=False, families=(family,))
+    assert len(rep["effects"]) == 1 and check(rep["effects"][0]), rep["effects"]
+    assert rep["derived_vs_numeric_max_rel_diff"] < 1e-9
