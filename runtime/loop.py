@@ -12,7 +12,8 @@ Steps (:func:`run_loop`):
 4. candidate effects (:mod:`volerr.candidates`), forward stepwise: the candidate with the best
    BIC gain is accepted when the gain is strong (dBIC < -10) *and* its cross-validated
    residual is significantly smaller (paired t > 3 on the per-point squared errors);
-   stop when no candidate passes;
+   stop when no candidate passes; then a backward check drops any effect that, given all
+   the others, no longer gains dBIC < -10 (a later effect made it redundant);
 5. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
    it, and fit it: it gives the "after" figures, and its derived sensitivities are checked
    against the numeric columns used during the search;
@@ -463,9 +464,48 @@ class _Context:
                 break
             if not accepted:
                 break
+        selected, A_all = self._backward(A_all[:, :A_all.shape[1] - sum(
+            s_["cols"].shape[-1] for s_ in selected)], selected, tr_rows, ytr)
         return {"design": design, "keep": keep, "gauge": gauge, "A_all": A_all,
                 "unidentifiable": unident, "weak": weak,
                 "selected": selected, "candidates": candidates}
+
+
+    @staticmethod
+    def _backward(A0, selected, tr_rows, ytr):
+        """Backward check of the forward selection: an effect that a later one made redundant
+        (e.g. per-round set-ups taken first for what is a linear drift in x, y and z) is
+        dropped when, given all the others, it no longer gains dBIC < -BIC_GAIN.  Each kept
+        effect gets ``delta_bic_given_others``.  Returns (selected, design columns)."""
+        n3 = len(ytr)
+
+        def stack(sel):
+            return np.concatenate([A0] + [s_["cols"].reshape(-1, s_["cols"].shape[-1])
+                                          for s_ in sel], axis=1)
+
+        def dbic_without(sel, i):
+            others = [s_ for j, s_ in enumerate(sel) if j != i]
+            base = _Base(stack(others)[tr_rows], ytr)
+            cols = sel[i]["cols"]
+            gain, rank = base.score(cols.reshape(-1, cols.shape[-1])[tr_rows])
+            m_eff = rank + (1 if sel[i]["cand"].period_search is not None else 0)
+            new = max(base.rss - gain, 1e-300)
+            return n3 * math.log(new / base.rss) + m_eff * math.log(n3)
+
+        sel = list(selected)
+        while len(sel) > 1:
+            scores = [dbic_without(sel, i) for i in range(len(sel))]
+            worst = int(np.argmax(scores))
+            if scores[worst] <= -BIC_GAIN:
+                for s_, d in zip(sel, scores):
+                    s_["evidence"]["delta_bic_given_others"] = round(d, 2)
+                break
+            sel.pop(worst)
+        if len(sel) == 1:
+            sel[0]["evidence"]["delta_bic_given_others"] = sel[0]["evidence"]["delta_bic"]
+        for k, s_ in enumerate(sel):
+            s_["evidence"]["step"] = k + 1
+        return sel, stack(sel)
 
 
 def _prefer_first_of_ties(scored: list, candidates: list) -> None:

@@ -86,3 +86,18 @@ def test_other_column_conventions(tmp_path, effect, change, family, check):
     rep = run_loop("MB1", path, seed=0, progress=False, families=(family,))
     assert len(rep["effects"]) == 1 and check(rep["effects"][0]), rep["effects"]
     assert rep["derived_vs_numeric_max_rel_diff"] < 1e-9
+
+
+def test_redundant_effect_dropped_by_backward_check(tmp_path):
+    """Drift along x, y and z; the rounds are consecutive blocks of time, so per-round set-ups
+    (12 parameters) approximate the drift and win the first forward step.  Once the three
+    drifts are in, the set-ups are redundant and must go: only the three drifts remain."""
+    cols = sim.campaign("MB1", 1000, 55, [{"kind": "drift", "dir": d, "um_per_h": 1.5}
+                                          for d in "xyz"])
+    path = sim.write_csv(str(tmp_path / "data.csv"), cols)
+    rep = run_loop("MB1", path, seed=0, progress=False)
+    assert sorted(e["name"] for e in rep["effects"]) == ["drift_x", "drift_y", "drift_z"]
+    for e in rep["effects"]:
+        assert abs(list(e["parameters"].values())[0] - 1.5) < 0.15
+        assert e["evidence"]["delta_bic_given_others"] < -10
+    assert rep["rms_after_um"] < 1.0
