@@ -59,7 +59,14 @@ def read_deviations(path, model: Model) -> Data:
     require(p.is_file(), f"data file not found: {path}")
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
-            rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+            first = fh.readline()
+            fh.seek(0)
+            # comma-separated as INTERFACE.md says; a header without commas but with
+            # semicolons or tabs (spreadsheet exports) is read with that separator
+            delim = ","
+            if "," not in first:
+                delim = ";" if ";" in first else "\t" if "\t" in first else ","
+            rows = [r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)]
     except (UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{p.name}: not a readable CSV ({exc})") from None
     require(len(rows) >= 2, f"{p.name}: no data rows")
@@ -81,6 +88,10 @@ def read_deviations(path, model: Model) -> Data:
                 bad = bad if bad is not None else i
                 vals.append(math.nan)
         if bad is not None and all(_not_number(s) for s in raw):
+            comma = next((s for s in raw if re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", s)),
+                         None)
+            require(comma is None, f"{p.name}: column {h}: {comma!r} has a decimal comma; "
+                    f"write numbers with a decimal point")
             continue  # a label column (text): ignored
         if bad is not None:
             raise InputError(f"{p.name}: column {h} row {bad + 2}: {raw[bad]!r} is not a number")

@@ -101,3 +101,27 @@ def test_redundant_effect_dropped_by_backward_check(tmp_path):
         assert abs(list(e["parameters"].values())[0] - 1.5) < 0.15
         assert e["evidence"]["delta_bic_given_others"] < -10
     assert rep["rms_after_um"] < 1.0
+
+
+def test_semicolon_and_tab_separated_read_decimal_comma_refused(tmp_path):
+    """Spreadsheet exports: ';' or tab separators are read like commas; a decimal comma is
+    refused with one clear line (it used to read as a text column, then 'missing axis X')."""
+    import subprocess
+    import sys
+
+    cols = sim.campaign("MB1", 200, 5, [])
+    text = open(sim.write_csv(str(tmp_path / "c.csv"), cols)).read()
+    ref = run_loop("MB1", str(tmp_path / "c.csv"), seed=0, progress=False, families=())
+    for sep in (";", "\t"):
+        p = tmp_path / f"s{ord(sep)}.csv"
+        p.write_text(text.replace(",", sep))
+        rep = run_loop("MB1", str(p), seed=0, progress=False, families=())
+        assert rep["rms_before_um"] == ref["rms_before_um"]
+    p = tmp_path / "dc.csv"
+    p.write_text(text.replace(",", ";").replace(".", ","))
+    before = p.read_bytes()
+    r = subprocess.run([sys.executable, "-m", "volerr", "loop", "MB1", str(p), "--json",
+                        str(tmp_path / "o.json")], capture_output=True, text=True)
+    assert r.returncode == 2 and "decimal comma" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+    assert p.read_bytes() == before and not (tmp_path / "o.json").exists()
