@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import csv
+import io
 import os
 import tempfile
 from pathlib import Path
@@ -78,3 +80,23 @@ def write_bytes(path, data: bytes, inputs=()) -> Path:
             raise InputError(f"cannot write {out}: {exc.strerror or exc}") from None
         raise
     return out
+
+
+def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
+    """(line number, stripped cells) of every row of a UTF-8 CSV file (a BOM is allowed);
+    blank rows and rows whose first cell starts with '#' are skipped.  ``missing``/``empty``:
+    the error lines for a file that does not exist / has no rows."""
+    path = Path(path)
+    require(path.is_file(), missing or f"{path}: no such file")
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+    rows = []
+    for lineno, cells in enumerate(csv.reader(io.StringIO(text)), start=1):
+        cells = [c.strip() for c in cells]
+        if not cells or all(c == "" for c in cells) or cells[0].startswith("#"):
+            continue
+        rows.append((lineno, cells))
+    require(rows, empty or f"{path}: empty file")
+    return rows

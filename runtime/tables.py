@@ -48,8 +48,6 @@ ends); a ``u95`` column without ``std`` gives ``std = u95 / 2``.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -58,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError, require
-from .fileio import write_text
+from .fileio import read_csv_rows, write_text
 
 #: unit suffix -> (kind, factor to mm or rad)
 UNITS = {"um": ("length", 1e-3), "mm": ("length", 1.0), "urad": ("angle", 1e-6), "rad": ("angle", 1.0)}
@@ -157,17 +155,7 @@ class ErrorTable:
 # CSV reading
 def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header and (line number, cells) of a CSV file; blank and '#' lines skipped."""
-    require(path.is_file(), f"{path}: no such file")
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    rows = []
-    for lineno, cells in enumerate(csv.reader(io.StringIO(text)), start=1):
-        if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
-            continue
-        rows.append((lineno, [c.strip() for c in cells]))
-    require(rows, f"{path}: empty file (no header)")
+    rows = read_csv_rows(path, empty=f"{path}: empty file (no header)")
     (_, header), body = rows[0], rows[1:]
     require(all(header), f"{path}: empty column name in header")
     dup = sorted({h for h in header if header.count(h) > 1})

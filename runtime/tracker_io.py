@@ -26,8 +26,6 @@ then P, then Q.  The commanded positions are not in the file and are given separ
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError, require
+from .fileio import read_csv_rows
 
 REQUIRED = ("round", "point", "position", "x", "y", "z")
 
@@ -54,19 +53,7 @@ class Round:
 
 
 def _open_rows(path: Path):
-    require(path.is_file(), f"tracker file not found: {path}")
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a text (UTF-8) file") from None
-    rows = []
-    for lineno, cells in enumerate(csv.reader(io.StringIO(text)), start=1):
-        cells = [c.strip() for c in cells]
-        if not cells or all(c == "" for c in cells) or cells[0].startswith("#"):
-            continue
-        rows.append((lineno, cells))
-    require(rows, f"{path}: no data")
-    return rows
+    return read_csv_rows(path, missing=f"tracker file not found: {path}", empty=f"{path}: no data")
 
 
 def _num(path, lineno, what, text) -> float:
