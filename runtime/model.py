@@ -156,6 +156,11 @@ class Model:
             out[a] = np.deg2rad(v) if a in self.rotary_axes else v
         return out
 
+    def _points(self, positions) -> tuple[dict, int]:
+        """Validated positions (see :meth:`positions`) and their number of points."""
+        pos = self.positions(positions)
+        return pos, len(next(iter(pos.values())))
+
     def _probe(self, probe, n: int) -> dict:
         p = _floats(probe, "probe offset")
         require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
@@ -209,8 +214,7 @@ class Model:
         probe/tool offset (3,) or (N, 3) mm.  ``direction`` (N, 3) probing direction and
         ``probe_error`` (a callable of directions giving mm, or an (N,) array) combine the
         probe error as Pahk eq. (17): the error along the probing direction is subtracted."""
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
+        pos, n = self._points(positions)
         errs = self._errors(errors, n)
         e = self.module.volumetric_error(**pos, **self._covariates(covariates, n),
                                          **self._probe(probe, n), **errs)
@@ -241,8 +245,7 @@ class Model:
     def exact_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
                     covariates=None) -> np.ndarray:
         """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
+        pos, n = self._points(positions)
         errs = self._errors(errors, n)
         e = self.module.exact_error(**pos, **self._covariates(covariates, n),
                                     **self._probe(probe, n), **errs)
@@ -250,8 +253,10 @@ class Model:
 
     def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
         """d(error)/d(parameter), (N, 3, n_parameters): mm/mm or mm/rad."""
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
+        pos, n = self._points(positions)
+        return self._sensitivity(pos, n, probe, covariates)
+
+    def _sensitivity(self, pos: dict, n: int, probe, covariates) -> np.ndarray:
         s = self.module.sensitivity(**pos, **self._covariates(covariates, n),
                                     **self._probe(probe, n))
         return np.moveaxis(np.broadcast_to(s, s.shape[:2] + (n,)), -1, 0)
@@ -264,8 +269,7 @@ class Model:
         is first-order propagation sqrt(sum((dD/dp)^2 sigma_p^2)); ``"termwise"`` is Pahk's
         printed quadrature (eq. 5, 8), which squares each term alone and drops cross terms."""
         require(method in ("exact", "termwise"), f"unknown random-error method {method!r}")
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
+        pos, n = self._points(positions)
         sig = self._errors(sigmas, n)
         self._check_finite(np.stack([np.broadcast_to(v, (n,)) for v in sig.values()]), sig)
         for k, v in sig.items():
@@ -275,7 +279,7 @@ class Model:
                 **pos, **self._covariates(covariates, n), **self._probe(probe, n),
                 **{f"s_{k}": v for k, v in sig.items()})
             return _columns(r, n)
-        s = self.sensitivity(positions, probe, covariates)
+        s = self._sensitivity(pos, n, probe, covariates)
         var = np.stack([np.broadcast_to(sig[p], (n,)) for p in self.parameters], axis=-1) ** 2
         return np.sqrt(np.einsum("nij,nj->ni", s ** 2, var))
 
@@ -308,17 +312,15 @@ class Model:
 
     def nominal_position(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
         """Nominal probe/tool tip in the workpiece frame, (N, 3) mm."""
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
-        p = self.module.nominal_position(**pos, **self._probe(probe, n))
-        return _columns(p, n)
+        pos, n = self._points(positions)
+        return _columns(self.module.nominal_position(**pos, **self._probe(probe, n)), n)
 
     def forward(self, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
         """Nominal tool tip and tool axis in the workpiece frame, (N, 6) = x, y, z, i, j, k."""
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
-        k = self.module.tool_axis(**pos)
-        return np.concatenate([self.nominal_position(positions, tool), _columns(k, n)], axis=1)
+        pos, n = self._points(positions)
+        tip = self.module.nominal_position(**pos, **self._probe(tool, n))
+        return np.concatenate([_columns(tip, n), _columns(self.module.tool_axis(**pos), n)],
+                              axis=1)
 
     def inverse(self, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
         """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
@@ -330,8 +332,7 @@ class Model:
 
     def orientation_error(self, positions, errors=None, covariates=None) -> np.ndarray:
         """First-order error of the tool-axis direction, (N, 3), rad."""
-        pos = self.positions(positions)
-        n = len(next(iter(pos.values())))
+        pos, n = self._points(positions)
         errs = self._errors(errors, n)
         e = self.module.orientation_error(**pos, **self._covariates(covariates, n), **errs)
         return self._check_finite(_columns(e, n), errs)
