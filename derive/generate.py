@@ -9,7 +9,7 @@ from volerr.layout import Layout
 from . import inverse
 from . import volumetric as vol
 from .codegen import Function, render_module
-from .kinematics import PROBE, Chain, parameter_symbol
+from .kinematics import PROBE, Chain
 
 
 def module_name(layout_name: str) -> str:
@@ -90,8 +90,3 @@ def generate_module(layout: Layout) -> str:
         "sha256": layout.sha256,
     }
     return render_module(header, constants, derive_functions(layout))
-
-
-def parameter_symbols(layout: Layout) -> list[sp.Symbol]:
-    """Symbols of the layout's error parameters, in model order."""
-    return [parameter_symbol(p) for p in layout.parameter_names]

@@ -245,10 +245,3 @@ class Chain:
         for f in self.factors:
             m = m * f.exact()
         return m
-
-    def small_angle_htm(self) -> sp.Matrix:
-        """Actual ``tool2work`` as the plain product of small-angle matrices (Pahk eq. 1)."""
-        m = sp.eye(4)
-        for f in self.factors:
-            m = m * (sp.eye(4) + f.first_order() if f.is_error else f.nominal)
-        return m

@@ -68,13 +68,6 @@ def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
     return error.jacobian(sp.Matrix(chain.parameters))
 
 
-def random_error_exact(sens: sp.Matrix, sigmas) -> sp.Matrix:
-    """Standard uncertainty by first-order propagation: sqrt(sum((dD/dp)^2 sigma_p^2))."""
-    return sp.Matrix([
-        sp.sqrt(sum(sens[i, j] ** 2 * sigmas[j] ** 2 for j in range(sens.shape[1])))
-        for i in range(3)])
-
-
 def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
     """Pahk's printed quadrature (eq. 5, 8): every monomial of a sensitivity squared alone,
     so cross terms such as 2 Z Zp of (Z + Zp)^2 are dropped."""
@@ -103,10 +96,6 @@ class TransferRules:
     between the straightness reference lines."""
 
     shift: dict
-
-    def reference(self, name: str) -> sp.Expr:
-        """The reference value of ``name`` in terms of its measured value (symbol ``<name>_m``)."""
-        return sp.Symbol(f"{name}_m", real=True) - self.shift[name]
 
 
 def transfer_rules(chain: Chain, error: sp.Matrix | None = None) -> TransferRules:
