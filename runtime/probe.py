@@ -77,6 +77,14 @@ def _gen():
     return gen
 
 
+def _flat_angles(phi_deg, theta_deg):
+    """(phi, theta) broadcast together and flattened, and their common shape."""
+    phi = np.asarray(phi_deg, dtype=float)
+    theta = np.asarray(theta_deg, dtype=float)
+    shape = np.broadcast_shapes(phi.shape, theta.shape)
+    return np.broadcast_to(phi, shape).ravel(), np.broadcast_to(theta, shape).ravel(), shape
+
+
 # ---- frames and directions ---------------------------------------------------------------
 def _head_angles_rad(tilt_deg, roll_deg):
     """(tilt, roll) in rad.  A vertical probe (tilt 0) has the machine frame as its probe frame
@@ -430,11 +438,7 @@ class ProbeMap:
 
     def covered(self, phi_deg, theta_deg) -> np.ndarray:
         """Boolean mask: probe-frame angles (deg) inside the calibrated coverage."""
-        phi = np.asarray(phi_deg, dtype=float)
-        theta = np.asarray(theta_deg, dtype=float)
-        shape = np.broadcast_shapes(phi.shape, theta.shape)
-        phi = np.broadcast_to(phi, shape).ravel()
-        theta = np.broadcast_to(theta, shape).ravel()
+        phi, theta, shape = _flat_angles(phi_deg, theta_deg)
         lo, hi = self.phi_range_deg
         ok = (phi >= lo - COVERAGE_TOL_DEG) & (phi <= hi + COVERAGE_TOL_DEG)
         if self.support_deg is not None and len(phi):
@@ -466,11 +470,7 @@ class ProbeMap:
 
     def at(self, phi_deg, theta_deg) -> np.ndarray:
         """Probe (mm) at probe-frame angles (deg); same shape as the broadcast inputs."""
-        phi = np.asarray(phi_deg, dtype=float)
-        theta = np.asarray(theta_deg, dtype=float)
-        shape = np.broadcast_shapes(phi.shape, theta.shape)
-        phi = np.broadcast_to(phi, shape).ravel()
-        theta = np.broadcast_to(theta, shape).ravel()
+        phi, theta, shape = _flat_angles(phi_deg, theta_deg)
         require(np.all(np.isfinite(phi)) and np.all(np.isfinite(theta)),
                 "probe directions contain NaN")
         lo, hi = self.phi_range_deg
