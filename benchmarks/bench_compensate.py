@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 
 import volerr
-from volerr import tables
-from volerr.compensate import ErrorModel, compensate_program, solve
-from volerr.tables import ErrorTable, write_constants, write_error_table
+from volerr.tables import table as tables
+from volerr.fiveaxis.compensate import ErrorModel, compensate_program, solve
+from volerr.tables.table import ErrorTable, write_constants, write_error_table
 
 
 def main(n: int = 20000) -> None:

@@ -1,6 +1,6 @@
 """Benchmark: three-point identification of 10^5 axis positions x 3 points.
 
-Times ``volerr.identify.identify`` (vectorised weighted least squares over all points, with
+Times ``volerr.identify.solve.identify`` (vectorised weighted least squares over all points, with
 the closed-form cross-check, residuals and outlier flags) for a linear and a rotary axis, with
 and without the tracker uncertainty model, against a baseline in the same process: a Python
 loop calling ``numpy.linalg.lstsq`` per position (timed on a subset and scaled).
@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "helpers"))
 from tracker_sim import smooth_errors  # noqa: E402
 
-from volerr.identify import design, identify  # noqa: E402
-from volerr.layout import parse_layout  # noqa: E402
-from volerr.tracker_io import Round  # noqa: E402
+from volerr.identify.solve import design, identify  # noqa: E402
+from volerr.machine.layout import parse_layout  # noqa: E402
+from volerr.identify.tracker_io import Round  # noqa: E402
 
 REF = np.array([[60.0, 10.0, -150.0], [-40.0, 50.0, -100.0], [10.0, -60.0, -200.0]])
 ROTARY = parse_layout("""
@@ -49,7 +49,7 @@ def _rot_batch(axis, a):
 
 
 def _data(kind, n):
-    """Exact rigid-body data, vectorised (same model as tests/tracker_sim.py)."""
+    """Exact rigid-body data, vectorised (same model as tests/helpers/tracker_sim.py)."""
     pos = np.linspace(0.0, 1000.0, n) if kind == "linear" else \
         np.linspace(0.0, 360.0, n, endpoint=False)
     e = smooth_errors(pos, seed=2)

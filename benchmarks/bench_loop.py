@@ -15,9 +15,9 @@ import time
 import numpy as np
 
 import volerr
-from volerr.fit import data_ranges, declared_design
-from volerr.loop import columns_to_data, run_loop
-from volerr.simulate import demo_probes, simulate
+from volerr.loop.fit import data_ranges, declared_design
+from volerr.loop.run import columns_to_data, run_loop
+from volerr.loop.simulate import demo_probes, simulate
 
 
 def main(n: int = 10_000) -> None:

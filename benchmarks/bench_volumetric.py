@@ -117,7 +117,7 @@ def main(n=1_000_000):
     print(f"  lambdify exact chain     {t_lam:8.3f} s   lambdify/generated = {t_lam / t_gen:6.1f}x"
           f"  (+{t_lambdify_build:.2f} s to build)")
 
-    from volerr.commands.derive import all_generated
+    from volerr.derive.generate import all_generated
 
     t0 = time.perf_counter()
     files = all_generated()

@@ -32,7 +32,7 @@ import functools
 import numpy as np
 import sympy as sp
 
-from volerr.layout import read_layout
+from volerr.machine.layout import read_layout
 
 from .audit import Verdict, fmt
 from .inverse import BRANCH, TIP, TOOL_AXIS, linear_inverse, rotary_inverse

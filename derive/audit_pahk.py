@@ -35,7 +35,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from volerr.layout import SQUARENESS, read_layout
+from volerr.machine.layout import SQUARENESS, read_layout
 
 from . import volumetric as vol
 from .audit import Verdict, describe_diff, fmt, is_identical, n_diff, n_issues

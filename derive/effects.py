@@ -1,6 +1,6 @@
 """Effects: symbolic extensions of a layout's chain (sympy).
 
-A layout may declare ``[effects.NAME]`` tables (format: :mod:`volerr.layout`).  Each term adds
+A layout may declare ``[effects.NAME]`` tables (format: :mod:`volerr.machine.layout`).  Each term adds
 ``parameter * basis`` to a target of the chain:
 
 * a component error of an axis (``EXX`` ... ``ECZ``) or a location error of a rotary axis
@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from volerr.layout import TWIST_KEYS, Layout
+from volerr.machine.layout import TWIST_KEYS, Layout
 
 _SYMPY_FUNCTIONS = {
     "sin": sp.sin, "cos": sp.cos, "exp": sp.exp, "sqrt": sp.sqrt, "abs": sp.Abs, "pi": sp.pi,
@@ -37,8 +37,8 @@ _SYMPY_FUNCTIONS = {
 
 
 def basis_expr(text: str) -> sp.Expr:
-    """A basis expression (validated by :mod:`volerr.basis`) as sympy, variables real."""
-    from volerr.basis import variables
+    """A basis expression (validated by :mod:`volerr.machine.expressions`) as sympy, variables real."""
+    from volerr.machine.expressions import variables
 
     loc = {v: sp.Symbol(v, real=True) for v in variables(text)}
     loc.update(_SYMPY_FUNCTIONS)
@@ -66,7 +66,7 @@ def apply_effects(layout: Layout, factors: list) -> list:
     ``factors`` is the list of :func:`volerr.derive.kinematics.chain_factors` (workpiece end
     first); component and location twists are extended in place, ``work``/``tool`` twists are
     new factors at the two ends."""
-    from .kinematics import Factor, parameter_symbol
+    from .htm import Factor, parameter_symbol
 
     add = additions(layout)
     if not add:

@@ -2,14 +2,24 @@
 
 from __future__ import annotations
 
+import importlib
+
 import sympy as sp
 
-from volerr.layout import Layout
+from volerr.machine.layout import Layout, layout_names, read_layout
 
 from . import inverse
 from . import volumetric as vol
 from .codegen import Function, render_module
 from .kinematics import PROBE, Chain
+
+
+#: generated file name -> "module:function" returning that file's text (no arguments).
+#: Layout-independent derivations (identification solves, probe frame) register here.
+EXTRA_MODULES = {
+    "three_point.py": "volerr.derive.three_point:generate_module",
+    "probe.py": "volerr.derive.probe:generate_module",
+}
 
 
 def module_name(layout_name: str) -> str:
@@ -90,3 +100,13 @@ def generate_module(layout: Layout) -> str:
         "sha256": layout.sha256,
     }
     return render_module(header, constants, derive_functions(layout))
+
+
+def all_generated() -> dict:
+    """File name -> text of every file of ``generated/``: one module per shipped layout plus
+    the layout-independent modules of :data:`EXTRA_MODULES`."""
+    out = {f"{module_name(n)}.py": generate_module(read_layout(n)) for n in layout_names()}
+    for filename, target in EXTRA_MODULES.items():
+        mod_name, func = target.split(":")
+        out[filename] = getattr(importlib.import_module(mod_name), func)()
+    return out

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from volerr.layout import Layout
+from volerr.machine.layout import Layout
 
 from .codegen import Function
 from .kinematics import PROBE, Chain, _rational_vec, position_symbol

@@ -25,7 +25,7 @@ every A.  At A = 0 the cross product vanishes and eq. (11) is undefined: the clo
 limit A -> 0+ is the machine frame turned by the roll B about z (the machine frame itself for
 B = 0), which is also what a motorised head does -- the roll turns the stylus, and with it the
 lobing pattern, about its own axis.  :func:`construction_limit_at_vertical` checks that limit.
-At exactly A = 0 the runtime (``volerr.probe``) takes the machine frame itself, whatever B.
+At exactly A = 0 the runtime (``volerr.probe.calibration``) takes the machine frame itself, whatever B.
 
 Probing direction and angles (eq. 14-16)
 ----------------------------------------

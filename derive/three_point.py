@@ -23,7 +23,7 @@ equations, linear in the six unknowns: ``n`` points give the ``3n x 6`` system o
 eq. 3.5.  Zhang & Hu pick six of the nine rows (eq. 32, 36, 37, 3.6) and solve them in closed
 form (eq. 33-34, 3.7-3.8 and the Appendix Z-axis solution); :func:`closed_form` does the same
 symbolically, and :func:`generate_module` emits those solutions as numpy code
-(``generated/three_point.py``).  The runtime (``volerr.identify``) defaults to weighted least
+(``generated/three_point.py``).  The runtime (``volerr.identify.solve``) defaults to weighted least
 squares over all ``3n`` rows and uses the closed forms as a cross-check.
 """
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from volerr.layout import SQUARENESS
+from volerr.machine.layout import SQUARENESS
 
 from .kinematics import PROBE, Chain, parameter_symbol, position_symbol, twist
 

@@ -8,7 +8,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from .errors import InputError, require
+from volerr.errors import InputError, require
 
 
 def check_output(path, inputs=()) -> Path:

@@ -1,0 +1,165 @@
+"""``volerr compensate LAYOUT --errors DIR PROGRAM --out F``: compensated NC program.
+
+Reads a G-code program in machine axis coordinates, predicts the tool-tip error of every
+motion block from the layout's model and the error tables, and writes a copy whose axis
+positions make the actual tool tip land on the nominal one (see :mod:`volerr.fiveaxis.compensate` for
+the method and :mod:`volerr.fiveaxis.gcode` for what is supported).  Only axis numbers change; the
+input is never overwritten.
+
+Outputs: ``--out`` (the program, same bytes except the compensated numbers), ``--report``
+(CSV, one row per motion block: ``line,status``, the programmed and written axis positions
+``<axis>_nominal_mm|deg``, ``<axis>_out_mm|deg``, the predicted tool-tip error before and after
+``dx_before_um, dy_before_um, dz_before_um, e_before_um, dx_after_um, ..., e_after_um``, the
+tool-axis error ``orientation_before_urad, orientation_after_urad``, ``iterations`` and the
+standard uncertainty of the remaining error ``ux_after_um, uy_after_um, uz_after_um`` from the
+tables' std columns, empty without them),
+``--json`` (summary) and ``--plot`` (PNG: error along the program before and after).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from volerr.cli._common import add_error_arguments
+from volerr.errors import InputError, require
+from volerr.fileio import check_output, write_bytes, write_text
+
+
+def register(sub) -> None:
+
+    p = sub.add_parser("compensate", help="rewrite an NC program with compensated coordinates",
+                       description=__doc__.split("\n\n")[1])
+    p.add_argument("layout", help="layout name (see 'volerr layouts') or layout file")
+    p.add_argument("program", help="G-code program in machine axis coordinates")
+    p.add_argument("--out", required=True, help="compensated program (never the input)")
+    add_error_arguments(p)
+    p.add_argument("--strategy", choices=("full", "thesis"), default="full",
+                   help="full: iterate the inverse on the complete model (default); thesis: "
+                        "Ellingsdalen 2021 sec. 3.5 (rotary, then linear; angular errors of the "
+                        "linear axes neglected), for comparison")
+    p.add_argument("--orientation", action="store_true",
+                   help="also correct the tool orientation with the rotary axes (FOR)")
+    p.add_argument("--types", default=None,
+                   help="ISO/TR 16907 compensation types to apply, comma separated: L-POS "
+                        "L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG, or L-VOL R-VOL (default: "
+                        "all); the report still predicts the full model's error")
+    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
+                   metavar=("XT", "YT", "ZT"),
+                   help="tool-tip offset in the tool frame, mm, beyond the point the axis "
+                        "positions refer to (default 0 0 0: the program positions the tip)")
+    p.add_argument("--tol-um", type=float, default=0.1,
+                   help="stop iterating when the correction changes by less than this (um)")
+    p.add_argument("--decimals", type=int, default=4,
+                   help="decimals of the written numbers (at least those of the input)")
+    p.add_argument("--initial", default="",
+                   help="axis positions at program start, e.g. 'B=0,C=0' (otherwise an axis "
+                        "is unknown until programmed; a rotary axis the program never commands "
+                        "is taken at 0 deg)")
+    p.add_argument("--ignore-travel", action="store_true",
+                   help="accept positions outside the layout's travel")
+    p.add_argument("--report", help="per-block CSV report")
+    p.add_argument("--json", help="summary as JSON")
+    p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")
+    p.set_defaults(func=run)
+
+
+def _initial(text: str) -> dict:
+    out = {}
+    for part in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
+        require("=" in part, f"--initial: expected AXIS=VALUE, got {part!r}")
+        a, v = part.split("=", 1)
+        try:
+            val = float(v)
+        except ValueError:
+            raise InputError(f"--initial: {v!r} is not a number") from None
+        require(math.isfinite(val), f"--initial: {a} is not finite")
+        out[a.strip().upper()] = val
+    return out
+
+
+def report_csv(model, reports) -> str:
+    unit = {a: ("deg" if a in model.rotary_axes else "mm") for a in model.axes}
+    cols = ["line", "status"] + [f"{a}_nominal_{unit[a]}" for a in model.axes] + \
+        [f"{a}_out_{unit[a]}" for a in model.axes] + \
+        ["dx_before_um", "dy_before_um", "dz_before_um", "e_before_um",
+         "dx_after_um", "dy_after_um", "dz_after_um", "e_after_um",
+         "orientation_before_urad", "orientation_after_urad", "iterations",
+         "ux_after_um", "uy_after_um", "uz_after_um"]
+    rows = [",".join(cols)]
+
+    def f(v):
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.10g}"
+
+    for r in reports:
+        eb = math.sqrt(sum(v * v for v in r.before_um))
+        ea = math.sqrt(sum(v * v for v in r.after_um))
+        vals = [str(r.line), r.status.replace(",", ";")]
+        vals += [f(r.nominal[a]) for a in model.axes] + [f(r.output[a]) for a in model.axes]
+        vals += [f(v) for v in r.before_um] + [f(eb)] + [f(v) for v in r.after_um] + [f(ea)]
+        vals += [f(r.orientation_before_urad), f(r.orientation_after_urad), str(r.iterations)]
+        vals += [f(v) for v in r.u_after_um]
+        rows.append(",".join(vals))
+    return "\n".join(rows) + "\n"
+
+
+def run(args) -> int:
+    import sys
+
+    from volerr.fiveaxis import gcode
+    from volerr.fiveaxis.compensate import compensate_program, error_functions
+    from volerr.machine.model import load
+
+    model = load(args.layout)
+    require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
+    funcs, notes = error_functions(args.errors, model, args.method, args.degree,
+                                   args.extrapolate)
+    text = gcode.read_program(args.program)
+    inputs = [args.program, *Path(args.errors).glob("*.csv")]
+    for out in (args.out, args.report, args.json, args.plot):
+        if out:
+            check_output(out, inputs)
+    require(not args.plot or str(args.plot).lower().endswith(".png"),
+            f"plot file must end in .png, got {args.plot}")
+    result = compensate_program(
+        model, funcs, text, tool=args.tool, orientation=args.orientation,
+        strategy=args.strategy, tol_um=args.tol_um, decimals=args.decimals,
+        initial=_initial(args.initial), check_travel=not args.ignore_travel,
+        types=None if args.types is None else [t for t in args.types.split(",") if t.strip()])
+    write_bytes(args.out, result.text.encode("latin-1"), inputs)
+    s = result.summary()
+    if args.report:
+        write_text(args.report, report_csv(model, result.reports), inputs)
+    if args.json:
+        write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
+                                          "orientation": bool(args.orientation),
+                                          "types": args.types or "L-VOL,R-VOL", **s},
+                                         indent=2) + "\n", inputs)
+    if args.plot:
+        from volerr.fiveaxis.plots import plot_program_errors
+
+        plot_program_errors(result.reports, args.plot, title=f"{model.name}: {args.program}")
+    print(f"{model.name}: {s['compensated']} of {s['motion_blocks']} motion blocks compensated "
+          f"({args.strategy}{', orientation' if args.orientation else ''}"
+          f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
+          f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
+          f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
+    if s["max_u_after_um"] > 0:
+        print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
+              f"{s['max_u_after_um']:.3f} um")
+    # notes only after success: bad input gets exactly one line on stderr
+    if result.assumed_zero:
+        notes.append(f"axes {' '.join(result.assumed_zero)} are never programmed: taken at 0 deg "
+                     f"(give --initial to state other positions)")
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
+    if model.rotary_axes:
+        print(f"tool-axis error max {s['max_orientation_before_urad']:.2f} -> "
+              f"{s['max_orientation_after_urad']:.2f} urad")
+    for nc in s["not_compensated"][:5]:
+        print(f"warning: line {nc['line']}: {nc['reason']}", file=sys.stderr)
+    if len(s["not_compensated"]) > 5:
+        print(f"warning: {len(s['not_compensated']) - 5} more blocks not compensated",
+              file=sys.stderr)
+    return 0

@@ -1,0 +1,64 @@
+"""``volerr diagonals LAYOUT --errors DIR``: length deviations of the space diagonals (Pahk
+sec. 4), face diagonals and axis-parallel lines of the working volume.
+
+Prints a table in um (with standard deviations in the tables also the random component u(dL),
+k = 1), optionally writes ``--json`` (with the profiles along each line) and ``--plot``.
+Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
+"""
+
+from __future__ import annotations
+
+import json
+
+from volerr.cmm import diagonals
+from volerr.cli._common import add_common, error_functions_from_args, inputs_of, parse_at
+from volerr.errors import require
+from volerr.fileio import check_output, write_text
+from volerr.machine.model import load
+from volerr.cmm.volmap import check_distinct, linear_axes, volume
+
+
+def register(sub) -> None:
+    p = sub.add_parser("diagonals", help="space diagonals, face diagonals and axis-parallel "
+                                         "lines of the working volume (length deviations)",
+                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    add_common(p)
+    p.add_argument("--lines", nargs="+", choices=diagonals.KINDS, default=list(diagonals.KINDS),
+                   help="which lines (default: all)")
+    p.add_argument("--profile-points", type=int, default=21, metavar="N",
+                   help="points along each line for the profile (default 21)")
+    p.add_argument("--json", metavar="F", help="results with profiles as JSON")
+    p.add_argument("--plot", metavar="PNG", help="space-diagonal profiles and all deviations")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    require(2 <= args.profile_points <= 10000, "--profile-points must be between 2 and 10000")
+    model = load(args.layout)
+    funcs = error_functions_from_args(args, model)
+    inputs = inputs_of(args)
+    check_distinct(("--json", args.json), ("--plot", args.plot))
+    for out in (args.json, args.plot):
+        if out is not None:
+            check_output(out, inputs)
+    if args.plot is not None:
+        from volerr.fileio import check_plot
+        check_plot(args.plot, inputs)
+    lin = linear_axes(model)
+    lines = diagonals.box_lines(volume(model, funcs, args.volume), lin, tuple(args.lines))
+    results = diagonals.evaluate_lines(model, funcs, lines, tuple(args.probe), parse_at(args.at),
+                                       args.profile_points)
+    print(f"{model.name}: length deviation dL = actual - nominal distance of the probe tip "
+          f"(first order), probe {' '.join(f'{v:g}' for v in args.probe)} mm")
+    print(diagonals.format_table(results))
+    if args.json:
+        doc = {"layout": model.name, "probe_mm": [float(v) for v in args.probe],
+               "errors": str(args.errors), "method": args.method,
+               "lines": [r.as_dict() for r in results]}
+        write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs)
+        print(f"json: {args.json}")
+    if args.plot:
+        diagonals.plot_lines(results, args.plot, f"{model.name}: length deviations "
+                                                 f"({args.errors})", inputs)
+        print(f"plot: {args.plot}")
+    return 0

@@ -1,0 +1,81 @@
+"""``volerr loop LAYOUT DATA.csv --json F [--html F]``: close the loop on measured deviations.
+
+Fits the declared model, traces what is left to candidate effects (thermal, drift, reversal,
+coupling, periodic, higher_order, probe_direction, setup), writes the augmented layout and its
+generated module (``--out-dir``, default: the folder of the json report) and reports the error
+before and after on held-out points.  See :mod:`volerr.loop.run`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from volerr.errors import require
+from volerr.fileio import check_output
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "loop", help="fit measured deviations, find missing effects, augment the model",
+        description="Fit LAYOUT's model to measured volumetric deviations (CSV: axis columns, "
+                    "optional Xp,Yp,Zp, dx_um,dy_um,dz_um, covariates such as T_C, t_s, "
+                    "dir_X, nx,ny,nz, setup), search candidate effects by forward stepwise "
+                    "selection (BIC and cross-validated residual), augment the layout and "
+                    "report RMS/max before and after on held-out points.")
+    p.add_argument("layout", help="layout name or layout file")
+    p.add_argument("data", help="measured-deviation CSV")
+    p.add_argument("--json", required=True, help="write the report (JSON)")
+    p.add_argument("--html", help="write the report with figures (HTML)")
+    p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
+                                     "(default: the folder of --json)")
+    p.add_argument("--errors-out", metavar="DIR",
+                   help="write the fitted error functions (effects removed) as an error "
+                        "directory: X.csv, Y.csv, ... and constants.csv")
+    p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
+    p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
+                                             "leave-one-point-out, exact via the hat matrix)")
+    p.add_argument("--test-fraction", type=float, default=0.25,
+                   help="fraction of points held out for before/after (default 0.25)")
+    p.add_argument("--degree", type=int, help="degree of the component series (default: by "
+                                              "cross-validation, 1..10)")
+    p.add_argument("--families", help="comma list of candidate families to search (default: "
+                                      "all)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from volerr.loop import candidates
+    from volerr.loop.run import run_loop
+
+    inputs = [args.data, args.layout]
+    check_output(args.json, inputs)
+    if args.html:
+        check_output(args.html, inputs)
+        require(Path(args.html).resolve() != Path(args.json).resolve(),
+                "--json and --html must be different files")
+    families = candidates.FAMILIES
+    if args.families:
+        families = tuple(f.strip() for f in args.families.split(",") if f.strip())
+        bad = [f for f in families if f not in candidates.FAMILIES]
+        require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
+                f"{' '.join(candidates.FAMILIES)}")
+    out_dir = Path(args.out_dir) if args.out_dir else Path(args.json).resolve().parent
+    report = run_loop(args.layout, args.data, seed=args.seed, folds=args.folds,
+                      test_fraction=args.test_fraction, degree=args.degree,
+                      out_dir=out_dir, families=families, inputs=inputs)
+    report.write_json(args.json, inputs=inputs)
+    if args.html:
+        report.write_html(args.html, inputs=inputs)
+    if args.errors_out:
+        report.write_error_tables(args.errors_out, inputs=inputs)
+    print(report.summary())
+    for e in report.effects:
+        pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
+        print(f"  {e['kind']} {e['name']}: {pars}")
+    if report["augmented_layout"]:
+        print(f"  augmented layout: {report['augmented_layout']}; generated module: "
+              f"{report['generated_module']}")
+    if report["unidentifiable"]:
+        print(f"  not separable by these data: "
+              f"{', '.join(u['parameters'][0] for u in report['unidentifiable'])} (see the report)")
+    return 0

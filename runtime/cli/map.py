@@ -1,0 +1,73 @@
+"""``volerr map LAYOUT --errors DIR``: volumetric error map over the working volume.
+
+Writes the map as CSV (``--out``), plots it like Pahk Fig. 5 / 7 (``--plot``; with standard
+deviations in the tables also ``<plot>_random.png`` or ``--plot-random``) and prints a summary
+(um).  See :mod:`volerr.cmm.volmap` for the grid, the columns and the plots.
+"""
+
+from __future__ import annotations
+
+import json
+
+from volerr.cli._common import add_common, error_functions_from_args, inputs_of, parse_at
+from volerr.cmm import volmap
+from volerr.errors import require
+from volerr.fileio import write_text
+from volerr.machine.model import load
+
+
+def register(sub) -> None:
+    p = sub.add_parser("map", help="volumetric error map over the working volume (CSV, plots)",
+                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    add_common(p)
+    p.add_argument("--grid", nargs="+", type=int, default=None, metavar="N",
+                   help="grid points per axis: N, or nx ny nz (default 5)")
+    p.add_argument("--out", metavar="CSV", help="map CSV: axis positions, Xp Yp Zp, dx_um dy_um "
+                                                "dz_um (+ rx_um ry_um rz_um)")
+    p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")
+    p.add_argument("--plot-random", metavar="PNG",
+                   help="random component plot (default <plot>_random.png when the tables have std)")
+    p.add_argument("--magnify", type=float, default=None, metavar="K",
+                   help="error magnification in the plots (default: automatic)")
+    p.add_argument("--json", metavar="F", help="summary as JSON")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    require(args.magnify is None or args.magnify > 0, f"--magnify must be positive, got {args.magnify}")
+    model = load(args.layout)
+    funcs = error_functions_from_args(args, model)
+    inputs = inputs_of(args)
+    rnd_plot = args.plot_random
+    if rnd_plot is None and args.plot and funcs.has_random:
+        rnd_plot = volmap.random_plot_path(args.plot)
+    volmap.check_distinct(("--out", args.out), ("--plot", args.plot),
+                          ("--plot-random", rnd_plot), ("--json", args.json))
+    for out in (args.out, args.plot, rnd_plot, args.json):
+        if out is not None:
+            from volerr.fileio import check_output, check_plot
+            (check_plot if out in (args.plot, rnd_plot) else check_output)(out, inputs)
+    vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at),
+                                 box=volmap.volume(model, funcs, args.volume))
+    s = vmap.summary()
+    if args.out:
+        volmap.write_map_csv(args.out, vmap, inputs)
+    if args.plot:
+        s["magnification"] = volmap.plot_map(vmap, args.plot, args.magnify, inputs)
+    if rnd_plot:
+        s["random_magnification"] = volmap.plot_random(vmap, rnd_plot, args.magnify, inputs)
+    if args.json:
+        write_text(args.json, json.dumps(s, indent=2) + "\n", inputs)
+    print(f"{model.name}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
+          f"probe {' '.join(f'{v:g}' for v in vmap.probe)} mm")
+    m = s["max_abs_um"]
+    print(f"  max |dx| {m['x']:.2f} um, |dy| {m['y']:.2f} um, |dz| {m['z']:.2f} um; "
+          f"max |d| {s['max_length_um']:.2f} um, RMS |d| {s['rms_length_um']:.2f} um")
+    if vmap.random is not None:
+        r = s["random_max_um"]
+        print(f"  random (1 sigma) max rx {r['x']:.2f} um, ry {r['y']:.2f} um, rz {r['z']:.2f} um")
+    for label, path in (("map", args.out), ("plot", args.plot), ("random plot", rnd_plot),
+                        ("summary", args.json)):
+        if path:
+            print(f"  {label}: {path}")
+    return 0

@@ -1,0 +1,170 @@
+"""``volerr probe-cal``: probe (lobing) calibration on a master sphere (Pahk sec. 3.2, eq. 13).
+
+    volerr probe-cal DATA.csv --sphere-radius R --out MAP.csv [--json F] [--plots DIR]
+    volerr probe-cal --plan PLAN.csv --sphere-radius R --ball-radius r [--center X,Y,Z]
+
+The first form fits the sphere of the recorded ball centres, reports the effective ball radius
+R_eff and Probe(phi, theta) at every point (MAP.csv) and fits the smooth map.  The second writes
+a probing plan (Pahk's 101 points by default) as nominal ball centres in the same CSV format.
+Conventions: see :mod:`volerr.probe.calibration`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+from volerr.errors import InputError, require
+from volerr.fileio import write_text
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "probe-cal", help="probe lobing calibration on a master sphere (Pahk eq. 13)",
+        description="Master-sphere probe calibration (Pahk 1995 sec. 3): least-squares sphere "
+                    "of the recorded stylus-ball centres, effective ball radius R_eff and the "
+                    "probe error Probe(phi, theta) = R_eff - (R_m - R_s) at every point, plus a "
+                    "smooth spherical-harmonic map. Directions: outward normal at the contact "
+                    "(sphere centre -> ball centre), phi from the probe axis, theta azimuth, in "
+                    "the probe frame of tilt A / roll B. With --plan: write a probing plan.")
+    p.add_argument("data", nargs="?", metavar="DATA.csv",
+                   help="CSV x,y,z (ball centres, mm) [,phi_deg,theta_deg (probe frame)]")
+    p.add_argument("--sphere-radius", type=float, required=True, metavar="R",
+                   help="master-sphere radius, mm (calibrated value)")
+    p.add_argument("--out", metavar="MAP.csv",
+                   help="output map: phi_deg,theta_deg,probe_um (+ map_um, residual_um, "
+                        "r_m_mm, outlier)")
+    p.add_argument("--json", metavar="F", help="summary: r_eff_mm, center_mm, probe_error_um")
+    p.add_argument("--tilt-deg", type=float, default=0.0, metavar="A",
+                   help="probe-head tilt A, deg (default 0: vertical probe)")
+    p.add_argument("--roll-deg", type=float, default=0.0, metavar="B",
+                   help="probe-head roll B, deg (default 0)")
+    p.add_argument("--degree", type=int, metavar="L",
+                   help="spherical-harmonic degree of the smooth map (default: by "
+                        "cross-validation)")
+    p.add_argument("--outlier-k", type=float, default=5.0, metavar="K",
+                   help="flag points whose leave-one-out map residual exceeds K x 1.4826 MAD "
+                        "(default 5)")
+    p.add_argument("--exclude-outliers", action="store_true",
+                   help="refit without the flagged points (they stay in MAP.csv, flagged)")
+    p.add_argument("--plot", metavar="F.png",
+                   help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map "
+                        "(Fig. 3b)")
+    p.add_argument("--plots", metavar="DIR",
+                   help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png (Fig. 3b)")
+    g = p.add_argument_group("plan generation (--plan)")
+    g.add_argument("--plan", metavar="PLAN.csv",
+                   help="write a probing plan (nominal ball centres x,y,z,phi_deg,theta_deg) "
+                        "instead of calibrating")
+    g.add_argument("--ball-radius", type=float, metavar="r", help="stylus-ball radius, mm")
+    g.add_argument("--center", default="0,0,0", metavar="X,Y,Z",
+                   help="sphere centre, mm (default 0,0,0)")
+    g.add_argument("--step-deg", type=float, default=18.0,
+                   help="Pahk plan: latitude and azimuth step, deg (default 18)")
+    g.add_argument("--circles", type=int, default=5,
+                   help="Pahk plan: number of latitude circles (default 5)")
+    g.add_argument("--phis", metavar="P1,P2,...",
+                   help="custom plan: circle latitudes phi, deg (with --per-circle)")
+    g.add_argument("--per-circle", type=int, metavar="N", help="custom plan: points per circle")
+    g.add_argument("--no-pole", action="store_true", help="leave out the pole point")
+    p.set_defaults(func=run)
+
+
+def _floats(text: str, what: str, n: int | None = None) -> list[float]:
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"{what}: expected comma-separated numbers, got {text!r}") from None
+    require(all(math.isfinite(v) for v in vals), f"{what}: NaN or infinite value")
+    if n is not None:
+        require(len(vals) == n, f"{what}: expected {n} numbers, got {len(vals)}")
+    return vals
+
+
+def _run_plan(args) -> int:
+    from volerr.probe import plans as pp
+
+    require(args.data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
+    require(args.ball_radius is not None and args.ball_radius > 0,
+            "--plan needs --ball-radius (stylus-ball radius, mm, > 0)")
+    require(args.sphere_radius > 0, "--sphere-radius must be > 0 mm")
+    center = _floats(args.center, "--center", 3)
+    if args.phis or args.per_circle:
+        require(args.phis and args.per_circle, "a custom plan needs both --phis and --per-circle")
+        plan = pp.circles_plan(_floats(args.phis, "--phis"), args.per_circle, not args.no_pole)
+    else:
+        plan = pp.pahk_plan(args.step_deg, args.circles, not args.no_pole)
+    pts = pp.nominal_points(plan, center, args.sphere_radius, args.ball_radius,
+                            args.tilt_deg, args.roll_deg)
+    path = write_text(args.plan, pp.plan_csv_text(plan, pts))
+    print(f"plan: {len(plan)} points -> {path}")
+    return 0
+
+
+def run(args) -> int:
+    if args.plan:
+        return _run_plan(args)
+    from volerr.probe import calibration as probe
+
+    require(args.data, "name the probing data DATA.csv (or use --plan to write a plan)")
+    require(args.out, "--out MAP.csv is required")
+    require(math.isfinite(args.sphere_radius) and args.sphere_radius > 0,
+            f"--sphere-radius must be a positive length in mm, got {args.sphere_radius}")
+    inputs = [args.data]
+    from volerr.fileio import check_output
+
+    outputs = [o for o in (args.out, args.json, args.plot) if o]
+    for i, o in enumerate(outputs):
+        check_output(o, inputs + outputs[:i])
+    if args.plot:
+        from volerr.fileio import check_plot
+        check_plot(args.plot, inputs + [args.out])
+    if args.plots:  # checked before anything is written
+        from pathlib import Path
+
+        from volerr.fileio import check_folder
+        d = check_folder(args.plots)
+        for name in ("probe_map_3d.png", "probe_map_2d.png"):
+            check_output(d / name, inputs + outputs)
+    require(args.degree is None or 0 <= args.degree <= 20,
+            f"--degree must be between 0 and 20, got {args.degree}")
+    data = probe.read_sphere_csv(args.data)
+    cal = probe.calibrate_data(data, args.sphere_radius, tilt_deg=args.tilt_deg,
+                               roll_deg=args.roll_deg, degree=args.degree,
+                               outlier_k=args.outlier_k, exclude_outliers=args.exclude_outliers)
+    out = write_text(args.out, probe.map_csv_text(cal), inputs=inputs)
+    summary = cal.summary()
+    if args.json:
+        write_text(args.json, json.dumps(summary, indent=2) + "\n", inputs=inputs + [args.out])
+    if args.plot:
+        from volerr.probe.plots import plot_probe_calibration
+
+        plot_probe_calibration(cal, check_output(args.plot, inputs + [args.out]))
+    if args.plots:
+        from pathlib import Path
+
+        from volerr.probe.plots import plot_probe_map_2d, plot_probe_map_3d
+
+        d = Path(args.plots)
+        plot_probe_map_3d(cal, d / "probe_map_3d.png")
+        plot_probe_map_2d(cal, d / "probe_map_2d.png")
+    for note in cal.notes:
+        print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
+    e = summary["probe_error_um"]
+    c = summary["center_mm"]
+    n_out = len(summary["outliers"]["index"])
+    print(f"{cal.n_points} points, sphere radius {cal.sphere_radius:.4f} mm, "
+          f"directions from {cal.direction_source}")
+    u = summary["uncertainty"]
+    print(f"centre {c[0]:.4f} {c[1]:.4f} {c[2]:.4f} mm, R_eff {cal.r_eff:.4f} mm "
+          f"(u: centre {max(u['u_center_um']):.2f} um, R_eff {u['u_r_eff_um']:.2f} um; "
+          f"noise {u['noise_um']:.2f} um)")
+    print(f"probe error max {e['max']:.1f} um, min {e['min']:.1f} um, rms {e['rms']:.1f} um; "
+          f"map degree {cal.map.degree}, residual rms {summary['map']['residual_rms_um']:.2f} um;"
+          f" {n_out} outlier{'s' if n_out != 1 else ''} flagged"
+          + (" and excluded" if args.exclude_outliers and n_out else "")
+          + (" (kept in the fit: --exclude-outliers refits without them)"
+             if n_out and not args.exclude_outliers else ""))
+    print(f"map: {out}")
+    return 0

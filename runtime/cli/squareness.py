@@ -1,0 +1,66 @@
+"""``volerr squareness LAYOUT DIR --out DIR2``: squareness from straightness reference lines.
+
+Reads the error tables of DIR (``X.csv``, ``Y.csv``, ``Z.csv`` ..., e.g. written by ``volerr
+identify``), fits the least-squares reference straight line of every straightness, writes the
+squareness errors ``EC0Y EB0Z EA0Z`` (those whose two straightness tables exist) to
+``DIR2/constants.csv`` (with the other constants of DIR) and the tables with the slopes removed
+to DIR2.  Sign convention: ``volerr.cmm.squareness``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from volerr.errors import require
+
+
+def register(sub) -> None:
+    p = sub.add_parser("squareness", help="squareness of linear axes from straightness tables",
+                       description=__doc__.split("\n\n")[1])
+    p.add_argument("layout", help="layout name or layout file")
+    p.add_argument("directory", help="error directory with the straightness tables")
+    p.add_argument("--out", required=True, help="output error directory (must differ from DIR)")
+    p.add_argument("--tables-are", choices=("carrier", "component"), default="carrier",
+                   help="carrier: motions of the component carrying the points, as written by "
+                        "'volerr identify' (default); component: ISO component errors (tool "
+                        "relative to workpiece)")
+    p.add_argument("--json", help="write the squareness and the slopes (JSON, urad)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from volerr.fileio import write_text
+    from volerr.machine.layout import read_layout
+    from volerr.cmm.squareness import squareness
+    from volerr.tables.table import read_error_dir, table_to_csv, write_constants
+
+    layout = read_layout(args.layout)
+    src, out = Path(args.directory), Path(args.out)
+    require(src.is_dir(), f"error directory {src} does not exist")
+    require(not (out.exists() and out.resolve() == src.resolve()),
+            "--out must differ from the input directory (inputs are never overwritten)")
+    tables, (consts, cstd, _) = read_error_dir(src, axes=layout.axis_names)
+    require(tables, f"{src}: no error tables")
+    values, std, corrected, slopes = squareness(tables, layout, args.tables_are)
+    require(values, f"{src}: no pair of straightness tables for a squareness (EC0Y needs EYX "
+                    f"in X.csv and EXY in Y.csv, EB0Z EZX and EXZ, EA0Z EZY and EYZ)")
+    inputs = [p for p in src.iterdir() if p.is_file()]
+    texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
+    for name, text in texts.items():
+        write_text(out / name, text, inputs=inputs)
+    merged = {k: v for k, v in consts.items() if k not in values}
+    merged_std = {k: v for k, v in cstd.items() if k in merged}
+    merged.update(values)
+    merged_std.update(std)
+    write_constants(out / "constants.csv", merged, inputs=inputs, std=merged_std)
+    for sq, v in values.items():
+        print(f"{sq} = {v * 1e6:.3f} urad (u = {std[sq] * 1e6:.3f} urad)")
+    if args.json:
+        doc = {"squareness_urad": {k: v * 1e6 for k, v in values.items()},
+               "u_urad": {k: v * 1e6 for k, v in std.items()},
+               "slopes_urad": {k: v * 1e6 for k, v in slopes.items()},
+               "tables_are": args.tables_are}
+        write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs=inputs)
+    print(f"-> {out}")
+    return 0

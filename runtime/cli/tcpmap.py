@@ -1,0 +1,89 @@
+"""``volerr tcpmap LAYOUT --errors DIR --point X Y Z --out F.png``: tool-tip error over the
+range of the two rotary axes of a five-axis machine for one workpiece point.
+
+For every pair of rotary positions the linear axes follow the nominal inverse kinematics so
+that the tool tip stays on the point (x, y, z) of the workpiece frame (mm); the map shows the
+predicted error there (length and dx, dy, dz in um).  Grey: the linear axes leave their travel
+or a position leaves an error table's measured range.  ``--csv`` writes the grid:
+``<R1>_deg,<R2>_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um`` (empty error cells where invalid).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from volerr.cli._common import add_error_arguments
+from volerr.errors import require
+from volerr.fileio import check_output, write_text
+
+
+def register(sub) -> None:
+
+    p = sub.add_parser("tcpmap", help="five-axis tool-tip error over the rotary range (PNG)",
+                       description=__doc__.split("\n\n")[1])
+    p.add_argument("layout", help="five-axis layout name or file")
+    add_error_arguments(p)
+    p.add_argument("--point", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"),
+                   help="workpiece point, mm (workpiece frame)")
+    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
+                   metavar=("XT", "YT", "ZT"), help="tool-tip offset in the tool frame, mm")
+    p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
+    p.add_argument("--out", required=True, help="PNG file")
+    p.add_argument("--csv", help="grid as CSV")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    import math
+    import sys
+
+    import numpy as np
+
+    from volerr.fiveaxis.compensate import error_functions
+    from volerr.machine.model import load
+    from volerr.fiveaxis.plots import plot_tcp_error_map, tcp_error_map
+
+    model = load(args.layout)
+    require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")
+    require(all(math.isfinite(v) for v in (*args.point, *args.tool)), "point/tool must be finite")
+    require(3 <= args.steps <= 1000, "--steps must be 3..1000")
+    require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
+    funcs, notes = error_functions(args.errors, model, args.method, args.degree,
+                                   args.extrapolate)
+    inputs = list(Path(args.errors).glob("*.csv"))
+    for out in (args.out, args.csv):
+        if out:
+            check_output(out, inputs)
+    require(str(args.out).lower().endswith(".png"), f"plot file must end in .png, got {args.out}")
+    a1, a2, q1, q2, err, valid = tcp_error_map(model, funcs, args.point, args.tool,
+                                               args.steps, args.steps)
+    require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
+                         "for every rotary position")
+    plot_tcp_error_map(model, funcs, args.point, args.out, args.tool, n1=args.steps,
+                       n2=args.steps)
+    mag = np.linalg.norm(err, axis=2) * 1e3
+    if args.csv:
+        p = np.asarray(args.point, float)
+        t = np.asarray(args.tool, float)
+        g1, g2 = np.meshgrid(q1, q2)
+        lin = model.module.inverse_linear(
+            *(np.deg2rad(g1.ravel() if a == a1 else g2.ravel()) for a in model.rotary_axes),
+            p[0], p[1], p[2], t[0], t[1], t[2])
+        lin = [np.broadcast_to(v, g1.size) for v in lin]
+        rows = [f"{a1}_deg,{a2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
+        e = err.reshape(-1, 3) * 1e3
+        m = mag.ravel()
+        for i in range(g1.size):
+            cells = [f"{g1.ravel()[i]:.10g}", f"{g2.ravel()[i]:.10g}"] + \
+                [f"{lin[k][i]:.10g}" for k in range(3)]
+            cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
+            rows.append(",".join(cells))
+        write_text(args.csv, "\n".join(rows) + "\n", inputs)
+    print(f"{model.name}: tool-tip error at ({', '.join(f'{v:g}' for v in args.point)}) mm over "
+          f"{a1} {q1[0]:g}..{q1[-1]:g} deg, {a2} {q2[0]:g}..{q2[-1]:g} deg: max "
+          f"{np.nanmax(mag):.3f} um, min {np.nanmin(mag):.3f} um "
+          f"({int(valid.sum())} of {valid.size} grid points valid); wrote {args.out}")
+    # notes only after success: bad input gets exactly one line on stderr
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
+    return 0

@@ -1,1 +1,0 @@
-"""One module per ``volerr`` command; each has ``register(subparsers)``."""

@@ -1,0 +1,604 @@
+"""Compensation of NC programs: rewrite axis positions so the actual tool tip lands on the nominal.
+
+Problem
+-------
+A motion block commands axis positions ``q`` (mm / deg).  Without compensation the tool tip
+lands at ``p(q) + e(q)`` in the workpiece frame, with ``p`` the nominal forward kinematics and
+``e`` the volumetric error of the layout's model evaluated with the error functions of the
+error directory (component errors of every axis, linear and rotary, squareness, location
+errors).  Compensation finds ``q'`` with ``p(q') + e(q') = p(q)``: the tool tip lands where the
+program meant it to be.
+
+Strategies
+----------
+``full`` (default)
+    Solve the equation above on the complete model -- the angular errors of the linear axes
+    included, the exact (not linearised) chain, errors re-evaluated at the corrected position
+    -- by the iteration ``X' <- X' - M^-1 (p(q') + e(q') - p(q))`` on the linear axes, with
+    ``M = dp/d(X, Y, Z)`` (exact: ``p`` is affine in the linear axes), until the correction
+    changes by less than ``tol`` (default 0.1 um).  The rotary axes keep their programmed
+    values (the tool orientation is not changed), as in ISO/TR 16907 L-VOL + R-VOL.
+    With ``orientation=True`` the rotary axes are also corrected so that the actual tool axis
+    equals the nominal one (functional orientation, L-VOL+ / R-VOL+), then the linear axes
+    restore the tool tip.  Two rotary axes can turn the tool axis about two directions; near a
+    singular orientation (e.g. B = 0 on the DMU 50, where C does not tilt the tool) only the
+    component they can reach is corrected (truncated SVD, :data:`ORIENTATION_RCOND`) and the
+    rest is reported.
+``thesis``
+    The strategy of Ellingsdalen (2021) sec. 3.5 (Figure 3.9), for comparison: the deviation
+    caused by the rotary-axis errors is computed at the programmed position and subtracted
+    from X Y Z; then the deviation caused by the translational errors and squareness of the
+    linear axes (their angular errors neglected) is computed at these coordinates and
+    subtracted; no iteration.  The report shows what it leaves on the full model.
+
+Rounding: corrected positions are written with at least ``decimals`` decimals (default 4:
+0.1 um, 0.0001 deg) and never fewer than the programmed word had; rotary values are rounded
+first and the linear axes solved again for the rounded rotary values.  The "after" error in
+the report is that of the values actually written.  Since the tip moves with the linear axes
+through an orthogonal matrix (for orthogonal linear axes), rounding each axis to the nearest
+step is already the best grid point: at 4 decimals the written program leaves at most
+sqrt(3)/2 x 0.1 um = 0.087 um of rounding error (use ``decimals=5`` where the controller takes
+it).
+
+ISO/TR 16907 types: ``types`` restricts the compensation to some of the types of the thesis'
+sec. 2.9.1 (``L-POS L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG``, groups ``L-VOL R-VOL``; FOR is
+``orientation``), e.g. to predict what a controller that only does L-VOL leaves; the report
+always evaluates the full model (:func:`parameter_types` says which parameter is which).
+
+Error tables: positions outside a table's measured range are refused unless extrapolation is
+asked for.  An endless rotary axis (travel >= 720 deg) whose table covers less than a turn is
+closed over the turn (:func:`close_periodic`): the gap, e.g. 340..360 deg, is interpolated
+towards the value at 0 deg; a position such as C = 400 deg is looked up at 40 deg.
+
+Bytes: only the numbers of axis words change.  A word is added to a block only where an axis
+that the block does not program needs a value different from the one the controller holds
+(in ``G91``, a non-zero increment).  With zero errors the output is byte-identical.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volerr.fiveaxis import gcode
+from volerr.errors import InputError, require
+from volerr.fiveaxis.kinematics import is_five_axis, linear_axes, linear_jacobian
+
+STRATEGIES = ("full", "thesis")
+
+#: ISO/TR 16907 compensation types (thesis sec. 2.9.1) and the groups that combine them
+TYPES = ("L-POS", "L-STR", "L-SQU", "L-ANG", "R-POS", "R-RAX", "R-POR", "R-ANG")
+TYPE_GROUPS = {"L-VOL": ("L-POS", "L-STR", "L-SQU", "L-ANG"),
+               "R-VOL": ("R-POS", "R-RAX", "R-POR", "R-ANG")}
+
+
+def parameter_types(model) -> dict:
+    """ISO name -> the ISO/TR 16907 compensation types that address it.
+
+    Linear axis ``A``: ``EAA``-like positioning (``EXX``) L-POS, straightness L-STR, angular
+    L-ANG; squareness L-SQU.  Rotary axis ``R``: translational error motions R-RAX (radial and
+    axial), location and orientation errors R-POR, angular positioning R-POS, tilt R-ANG.  For
+    a rotary axis not aligned with x, y or z (the DMU 50's B) the angular error motions about
+    x, y, z each mix positioning and tilt: they belong to both R-POS and R-ANG."""
+    out = {}
+    paxis = model.parameter_axis
+    for p in model.parameters:
+        a = paxis[p]
+        if a is None:
+            out[p] = ("L-SQU",) if p[-1] in linear_axes(model) else ("R-POR",)
+        elif a not in model.rotary_axes:
+            out[p] = ("L-POS",) if p[1] == a else ("L-STR",) if p[1] in "XYZ" else ("L-ANG",)
+        elif p[1] in "XYZ":
+            out[p] = ("R-RAX",)
+        else:
+            u = np.abs(np.asarray(model.layout.axes[a].direction, dtype=float))
+            aligned = abs(u.max() - 1.0) < 1e-12
+            own = "ABC"[int(np.argmax(u))] if aligned else None
+            out[p] = ("R-POS", "R-ANG") if own is None else \
+                ("R-POS",) if p[1] == own else ("R-ANG",)
+    return out
+
+
+def parameters_for_types(model, types) -> set | None:
+    """The parameters compensated by the ISO/TR 16907 ``types`` (names or groups L-VOL,
+    R-VOL); None (all) when ``types`` is None."""
+    if types is None:
+        return None
+    wanted = set()
+    for t in types:
+        t = t.strip().upper()
+        require(t in TYPES or t in TYPE_GROUPS,
+                f"unknown compensation type {t!r} (use {' '.join(TYPES)} or L-VOL R-VOL)")
+        wanted.update(TYPE_GROUPS.get(t, (t,)))
+    return {p for p, ts in parameter_types(model).items() if wanted.intersection(ts)}
+
+
+@dataclass
+class LineReport:
+    """Predicted error of one motion block before and after compensation."""
+
+    line: int
+    nominal: dict
+    output: dict
+    before_um: tuple
+    after_um: tuple
+    orientation_before_urad: float
+    orientation_after_urad: float
+    iterations: int
+    status: str
+    #: standard uncertainty (k = 1) of the remaining error, from the tables' Type A std,
+    #: per axis x y z (NaN when the tables carry none)
+    u_after_um: tuple = (math.nan,) * 3
+
+
+@dataclass
+class Result:
+    text: str
+    reports: list = field(default_factory=list)
+    #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
+    assumed_zero: tuple = ()
+
+    def summary(self) -> dict:
+        done = [r for r in self.reports if r.status.startswith("compensated")]
+        b = np.array([np.linalg.norm(r.before_um) for r in done]) if done else np.zeros(0)
+        a = np.array([np.linalg.norm(r.after_um) for r in done]) if done else np.zeros(0)
+        ob = np.array([r.orientation_before_urad for r in done]) if done else np.zeros(0)
+        oa = np.array([r.orientation_after_urad for r in done]) if done else np.zeros(0)
+
+        def mx(v):
+            return float(v.max()) if v.size else 0.0
+
+        return {
+            "motion_blocks": len(self.reports),
+            "compensated": len(done),
+            "not_compensated": [{"line": r.line, "reason": r.status} for r in self.reports
+                                if not r.status.startswith("compensated")],
+            "max_before_um": mx(b), "max_after_um": mx(a),
+            "rms_before_um": float(np.sqrt(np.mean(b ** 2))) if b.size else 0.0,
+            "rms_after_um": float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0,
+            "max_orientation_before_urad": mx(ob), "max_orientation_after_urad": mx(oa),
+            "max_iterations": max((r.iterations for r in done), default=0),
+            "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
+                                           if np.all(np.isfinite(r.u_after_um))])),
+        }
+
+
+# ---------------------------------------------------------------------------------------
+# error functions with endless rotary axes closed over the full turn
+def endless_axes(model) -> tuple[str, ...]:
+    """Rotary axes that turn endlessly: travel of at least one turn each way (>= 720 deg)."""
+    return tuple(a for a in model.rotary_axes
+                 if model.travel[a][1] - model.travel[a][0] >= 720.0 - 1e-9)
+
+
+def close_periodic(tables_: dict, model) -> tuple[dict, list[str]]:
+    """For an endless rotary axis whose table covers less than a turn (e.g. 0..340 deg in 20 deg
+    steps), add the first row again one turn later (360 deg): the error at 360 deg is the error
+    at 0 deg, so positions in the gap are interpolated between measured values, not
+    extrapolated.  Returns the tables and a note per closed axis."""
+    from volerr.tables.table import ErrorTable
+
+    out, notes = dict(tables_), []
+    for a in endless_axes(model):
+        t = tables_.get(a)
+        if t is None:
+            continue
+        lo, hi = float(t.positions[0]), float(t.positions[-1])
+        if hi - lo >= 360.0 - 1e-9:
+            continue
+        out[a] = ErrorTable(a, np.r_[t.positions, lo + 360.0],
+                            {k: np.r_[v, v[0]] for k, v in t.values.items()},
+                            {k: np.r_[v, v[0]] for k, v in t.std.items()},
+                            {k: np.r_[v, v[0]] for k, v in t.u95.items()})
+        notes.append(f"table {a} ({lo:g}..{hi:g} deg) closed over the full turn: "
+                     f"{hi:g}..{lo + 360:g} deg interpolated towards the value at {lo:g} deg")
+    return out, notes
+
+
+def error_functions(directory, model, method: str = "linear", degree=None,
+                    extrapolate: bool = False):
+    """:class:`volerr.tables.table.ErrorFunctions` of an error directory, endless rotary axes closed
+    over the full turn (:func:`close_periodic`).  Returns (functions, notes)."""
+    from volerr.tables.table import ErrorFunctions, read_error_dir
+
+    tabs, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
+    tabs, notes = close_periodic(tabs, model)
+    cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}
+    return ErrorFunctions(tabs, consts, model, method, degree, extrapolate, constants_std=cstd,
+                          source=str(directory)), notes
+
+
+# ---------------------------------------------------------------------------------------
+# the error model on axis positions
+class ErrorModel:
+    """Actual tool tip and tool axis of a model with error functions (mm, deg at the API)."""
+
+    def __init__(self, model, funcs=None, tool=(0.0, 0.0, 0.0), compensated=None):
+        self.model, self.funcs = model, funcs
+        #: the parameters the compensation acts on (None: all); the report uses all
+        self.compensated = compensated
+        self.tool = np.asarray(tool, dtype=float)
+        self.rot = model.rotary_axes
+        self.lin = linear_axes(model)
+        self.ranges = funcs.ranges() if funcs is not None else {}
+
+    def lookup(self, q: np.ndarray) -> np.ndarray:
+        """Positions for the error tables: a rotary axis is taken modulo 360 deg where that
+        brings it into its table's range (a C table 0..340 serves C = 400)."""
+        q = np.array(q, dtype=float, copy=True)
+        for a in self.rot:
+            if a in self.ranges:
+                lo, hi = self.ranges[a]
+                i = self.model.axes.index(a)
+                w = lo + np.mod(q[:, i] - lo, 360.0)
+                inside = (q[:, i] >= lo) & (q[:, i] <= hi)
+                q[:, i] = np.where(~inside & (w <= hi), w, q[:, i])
+        return q
+
+    def admissible(self, q: np.ndarray) -> np.ndarray:
+        """Rows whose rotary positions lie inside the travel and (unless extrapolating) inside
+        the range of their error tables."""
+        ok = np.ones(len(q), dtype=bool)
+        ql = self.lookup(q)
+        for a in self.rot:
+            i = self.model.axes.index(a)
+            lo, hi = self.model.travel[a]
+            ok &= (q[:, i] >= lo) & (q[:, i] <= hi)
+            if a in self.ranges and not self.funcs.extrapolate:
+                lo, hi = self.ranges[a]
+                ok &= (ql[:, i] >= lo) & (ql[:, i] <= hi)
+        return ok
+
+    #: how far (mm, deg) a compensated position may pass the end of its error table: the
+    #: nominal positions are checked against the tables' ranges, the correction (um) may then
+    #: push a block at the end of a table just past it; the end value is used there
+    EDGE_MARGIN = {"linear": 1.0, "rotary": 0.1}
+
+    def _clip_edges(self, q: np.ndarray) -> np.ndarray:
+        if self.funcs is None or self.funcs.extrapolate:
+            return q
+        q = q.copy()
+        for a, (lo, hi) in self.ranges.items():
+            i = self.model.axes.index(a)
+            m = self.EDGE_MARGIN["rotary" if a in self.rot else "linear"]
+            v = q[:, i]
+            near = ((v < lo) & (v >= lo - m)) | ((v > hi) & (v <= hi + m))
+            q[:, i] = np.where(near, np.clip(v, lo, hi), v)
+        return q
+
+    def errors(self, q: np.ndarray, subset=None) -> dict:
+        if self.funcs is None:
+            return {}
+        e = self.funcs(self._clip_edges(self.lookup(q)))
+        if subset is not None:
+            e = {k: v for k, v in e.items() if k in subset}
+        return e
+
+    def position_error(self, q, subset=None) -> np.ndarray:
+        """Exact error of the tool tip, (N, 3) mm."""
+        return self.model.exact_error(q, self.errors(q, subset), probe=self.tool)
+
+    def orientation_error(self, q, subset=None) -> np.ndarray:
+        """First-order error of the tool axis, (N, 3) rad."""
+        if not self.rot:
+            return np.zeros((len(q), 3))
+        return self.model.orientation_error(q, self.errors(q, subset))
+
+    def tool_axis(self, q) -> np.ndarray:
+        return self.model.forward(q, self.tool)[:, 3:6]
+
+
+def _rotary_jacobian(em: ErrorModel, q: np.ndarray) -> np.ndarray:
+    """d(tool axis)/d(rotary axes) per rad, (N, 3, n_rot), central differences."""
+    cols = []
+    h = 1e-5  # deg
+    for a in em.rot:
+        i = em.model.axes.index(a)
+        qp, qm = q.copy(), q.copy()
+        qp[:, i] += h
+        qm[:, i] -= h
+        cols.append((em.tool_axis(qp) - em.tool_axis(qm)) / (2 * math.radians(h)))
+    return np.stack(cols, axis=2)
+
+
+#: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
+#: uncorrected: near a singular orientation (within about 3 deg of it on the DMU 50) the
+#: correction would need large rotary motions for a few urad
+ORIENTATION_RCOND = 0.05
+
+
+def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = ORIENTATION_RCOND):
+    """Least-squares x of j x = r per row, singular directions (sigma < rcond) dropped; also
+    returns per row whether a direction was dropped."""
+    u, s, vt = np.linalg.svd(j, full_matrices=False)
+    inv = np.where(s > rcond, 1.0 / np.where(s > rcond, s, 1.0), 0.0)
+    y = inv * np.einsum("nji,nj->ni", u, r)   # diag(1/s) U^T r
+    return np.einsum("nji,nj->ni", vt, y), np.any(s <= rcond, axis=1)     # V y
+
+
+def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: float = 1e-4,
+          max_iter: int = 50):
+    """Corrected positions (N, n) for programmed ``q_nom``, the iteration count per row, and
+    per row whether the orientation correction was limited: stopped because a rotary axis would
+    have left its travel or its error table, or partial near a singular orientation.
+
+    Iterates until the change of the correction is below ``tol`` (mm; rotary axes weighted by a
+    1 m lever)."""
+    m = em.model
+    q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
+    n = len(q_nom)
+    lin_idx = [m.axes.index(a) for a in em.lin]
+    rot_idx = [m.axes.index(a) for a in em.rot]
+    target_p = m.nominal_position(q_nom, em.tool)
+    target_k = em.tool_axis(q_nom) if em.rot else None
+    q = q_nom.copy()
+    iters = np.zeros(n, dtype=int)
+    active = np.ones(n, dtype=bool)
+    limited = np.zeros(n, dtype=bool)
+    partial = np.zeros(n, dtype=bool)
+    for it in range(1, max_iter + 1):
+        qa = q[active]
+        change = np.zeros(len(qa))
+        if orientation and em.rot:
+            k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated)
+            j = _rotary_jacobian(em, qa)
+            d, dropped = _truncated_solve(j, -(k_act - target_k[active]))
+            partial[np.flatnonzero(active)] = dropped
+            trial = qa.copy()
+            trial[:, rot_idx] += np.rad2deg(d)
+            ok = em.admissible(trial)
+            limited[np.flatnonzero(active)[~ok]] = True
+            d[~ok] = 0.0
+            qa[ok] = trial[ok]
+            change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
+        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated) \
+            - target_p[active]
+        mj = linear_jacobian(m, qa, em.tool)
+        d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
+        qa[:, lin_idx] += d
+        change = np.maximum(change, np.abs(d).max(axis=1))
+        q[active] = qa
+        idx = np.flatnonzero(active)
+        iters[idx] = it
+        done = change < tol
+        active[idx[done]] = False
+        if not active.any():
+            break
+    if active.any():
+        raise InputError(f"compensation did not converge in {max_iter} iterations (the errors "
+                         "are too large or the position is singular)")
+    return q, iters, limited | partial
+
+
+def solve_thesis(em: ErrorModel, q_nom: np.ndarray) -> np.ndarray:
+    """Ellingsdalen's strategy (rotary errors first, then linear translational errors and
+    squareness; angular errors of the linear axes neglected; no iteration)."""
+    m = em.model
+    q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
+    lin_idx = [m.axes.index(a) for a in em.lin]
+    paxis = m.parameter_axis
+    rotary_params = {p for p in m.parameters
+                     if paxis[p] in em.rot or (paxis[p] is None and p[-1] in em.rot
+                                               and p[2] == "0")}
+    linear_params = {p for p in m.parameters if paxis[p] in em.lin and p[1] in "XYZ"}
+    linear_params |= {p for p in m.parameters if paxis[p] is None and p not in rotary_params}
+    q1 = q_nom.copy()
+    mj = linear_jacobian(m, q_nom, em.tool)
+    if em.rot:
+        e_rot = em.position_error(q_nom, rotary_params)
+        q1[:, lin_idx] -= np.linalg.solve(mj, e_rot[:, :, None])[:, :, 0]
+    e_lin = em.position_error(q1, linear_params)
+    q2 = q1.copy()
+    q2[:, lin_idx] -= np.linalg.solve(linear_jacobian(m, q1, em.tool), e_lin[:, :, None])[:, :, 0]
+    return q2
+
+
+# ---------------------------------------------------------------------------------------
+# programs
+def _round(v: float, nd: int) -> float:
+    return float(gcode.format_number(v, nd))
+
+
+def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
+                       strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
+                       initial: dict | None = None, check_travel: bool = True,
+                       max_iter: int = 50, types=None) -> Result:
+    """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
+
+    ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
+    that compensates the linear axes only); the report still predicts the error of the full
+    model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL)."""
+    require(strategy in STRATEGIES, f"unknown strategy {strategy!r} ({' '.join(STRATEGIES)})")
+    require(tol_um > 0 and math.isfinite(tol_um), "tolerance must be a positive number")
+    require(0 <= decimals <= 9, "decimals must be 0..9")
+    require(not (orientation and not is_five_axis(model)),
+            f"{model.name}: orientation compensation needs two rotary axes")
+    require(not (orientation and strategy == "thesis"),
+            "the thesis strategy does not compensate the orientation")
+    tool = np.asarray(tool, dtype=float)
+    require(tool.shape == (3,) and np.all(np.isfinite(tool)), "tool offset must be 3 numbers")
+    for a in initial or {}:
+        require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")
+    lines = gcode.parse(text)
+    initial = dict(initial or {})
+    blocks = gcode.blocks(lines, model.axes, initial)
+    # a rotary axis the program never commands stays where it is: at its zero unless given
+    never = tuple(a for a in model.rotary_axes
+                  if a not in initial and all(b.target[a] is None for b in blocks))
+    if never:
+        initial.update({a: 0.0 for a in never})
+        blocks = gcode.blocks(lines, model.axes, initial)
+    require(not (types is not None and strategy == "thesis"),
+            "the thesis strategy has its own set of errors (L-POS L-STR L-SQU and the "
+            "rotary-axis errors); --types applies to the full strategy")
+    em = ErrorModel(model, funcs, tool, parameters_for_types(model, types))
+    axes = model.axes
+
+    known = [b for b in blocks if all(b.target[a] is not None for a in axes)]
+    q_nom = np.array([[b.target[a] for a in axes] for b in known]) if known else \
+        np.zeros((0, len(axes)))
+    if check_travel and len(known):
+        for i, a in enumerate(axes):
+            lo, hi = model.travel[a]
+            bad = (q_nom[:, i] < lo - 1e-9) | (q_nom[:, i] > hi + 1e-9)
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise InputError(f"line {known[k].line.number}: {a} = {q_nom[k, i]:g} is outside "
+                                 f"the travel {lo:g} .. {hi:g} of {model.name} "
+                                 "(--ignore-travel to go on)")
+    if funcs is not None and len(known) and not funcs.extrapolate:
+        ql = em.lookup(q_nom)
+        for a, (lo, hi) in em.ranges.items():
+            i = axes.index(a)
+            bad = (ql[:, i] < lo - 1e-9) | (ql[:, i] > hi + 1e-9)
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise InputError(f"line {known[k].line.number}: {a} = {q_nom[k, i]:g} is outside "
+                                 f"the measured range {lo:g} .. {hi:g} of error table {a} "
+                                 "(--extrapolate to evaluate beyond it)")
+
+    if len(known):
+        if strategy == "thesis":
+            q_c, iters = solve_thesis(em, q_nom), np.ones(len(known), dtype=int)
+            limited = np.zeros(len(known), dtype=bool)
+        else:
+            q_c, iters, limited = solve(em, q_nom, orientation, tol_um * 1e-3, max_iter)
+    else:
+        q_c, iters, limited = q_nom.copy(), np.zeros(0, dtype=int), np.zeros(0, dtype=bool)
+
+    # decimals per block and axis: never fewer than the programmed word had
+    nd = np.full(q_nom.shape, decimals, dtype=int)
+    for r, b in enumerate(known):
+        for w in b.line.words():
+            if w.letter in axes:
+                nd[r, axes.index(w.letter)] = max(decimals, gcode.decimals(
+                    b.line.body[w.num_start:w.num_end]))
+    q_out = q_c.copy()
+    rot_idx = [axes.index(a) for a in model.rotary_axes]
+    lin_idx = [axes.index(a) for a in linear_axes(model)]
+    if len(known):
+        for j in rot_idx:
+            q_out[:, j] = [q_nom[r, j] if q_c[r, j] == q_nom[r, j] else _round(q_c[r, j], nd[r, j])
+                           for r in range(len(known))]
+        if orientation and not np.array_equal(q_out[:, rot_idx], q_c[:, rot_idx]):
+            q_out = _resolve_linear(em, q_nom, q_out, tol_um * 1e-3, max_iter)
+        for j in lin_idx:
+            q_out[:, j] = [q_nom[r, j] if q_out[r, j] == q_nom[r, j] else
+                           _round(q_out[r, j], nd[r, j]) for r in range(len(known))]
+
+    # predicted errors before / after
+    reports = []
+    if len(known):
+        target = model.nominal_position(q_nom, tool)
+        before = em.position_error(q_nom) * 1e3
+        after = (model.nominal_position(q_out, tool) + em.position_error(q_out) - target) * 1e3
+        if model.rotary_axes:
+            k_nom = em.tool_axis(q_nom)
+            ob = np.linalg.norm(em.orientation_error(q_nom), axis=1) * 1e6
+            k_after = em.tool_axis(q_out) + em.orientation_error(q_out)
+            oa = np.linalg.norm(k_after - k_nom, axis=1) * 1e6
+        else:
+            ob = oa = np.zeros(len(known))
+        u_after = np.full((len(known), 3), math.nan)
+        if funcs is not None and funcs.has_random:
+            ql = em.lookup(q_out)
+            u_after = model.random_error(q_out, funcs.sigmas(ql), probe=tool) * 1e3
+    row = {id(b): r for r, b in enumerate(known)}
+    for b in blocks:
+        if id(b) in row:
+            r = row[id(b)]
+            reports.append(LineReport(
+                b.line.number, dict(zip(axes, q_nom[r])), dict(zip(axes, q_out[r])),
+                tuple(before[r]), tuple(after[r]), float(ob[r]), float(oa[r]), int(iters[r]),
+                "compensated (thesis strategy)" if strategy == "thesis" else
+                "compensated; orientation limited (rotary travel, error table or near a "
+                "singular orientation)" if limited[r]
+                else "compensated", tuple(u_after[r])))
+        else:
+            missing = [a for a in axes if b.target[a] is None]
+            reports.append(LineReport(b.line.number, dict(b.target), dict(b.target),
+                                      (math.nan,) * 3, (math.nan,) * 3, math.nan, math.nan, 0,
+                                      f"not compensated: position of axis {missing[0]} unknown"))
+
+    out_text = _write(lines, model.axes, initial, known, q_out, nd)
+    return Result(out_text, reports, never)
+
+
+def _resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
+    """Linear axes solved again for the (rounded) rotary values of ``q_out``."""
+    m = em.model
+    lin_idx = [m.axes.index(a) for a in em.lin]
+    target_p = m.nominal_position(q_nom, em.tool)
+    q = q_out.copy()
+    for _ in range(max_iter):
+        e = m.nominal_position(q, em.tool) + em.position_error(q, em.compensated) - target_p
+        d = -np.linalg.solve(linear_jacobian(m, q, em.tool), e[:, :, None])[:, :, 0]
+        q[:, lin_idx] += d
+        if np.abs(d).max() < tol:
+            break
+    return q
+
+
+def _write(lines, axes, initial, known, q_out, nd) -> str:
+    """The output program: original bytes except the changed / added axis words."""
+    interp = gcode.Interpreter(axes, initial)
+    spaced = gcode.spaced_style(lines)
+    state = {a: (None if interp.position[a] is None else float(interp.position[a])) for a in axes}
+    row = {id(b.line): r for r, b in enumerate(known)}
+    out = []
+    for line in lines:
+        b = interp.block(line)
+        if b is None or id(line) not in row:
+            out.append(line.text)
+            # follow what the controller holds (unchanged words, G28/G30 -> unknown)
+            if b is not None:
+                for w in line.words():
+                    if w.letter in axes:
+                        if b.incremental:
+                            state[w.letter] = None if state[w.letter] is None else \
+                                state[w.letter] + w.value
+                        else:
+                            state[w.letter] = w.value
+            for a in axes:
+                if interp.position[a] is None:
+                    state[a] = None
+            continue
+        r = row[id(line)]
+        words = {w.letter: w for w in line.words() if w.letter in axes}
+        new_values, added = {}, {}
+        for i, a in enumerate(axes):
+            want = float(q_out[r, i])
+            half = 0.5 * 10.0 ** (-int(nd[r, i]))
+            if b.incremental:
+                prev = state[a]
+                inc = want - prev
+                if a in words:
+                    if abs(inc - words[a].value) >= half:
+                        txt = gcode.format_number(inc, int(nd[r, i]), line.body[words[a].num_start:
+                                                                                 words[a].num_end])
+                        new_values[a] = txt
+                        state[a] = prev + float(txt)
+                    else:
+                        state[a] = prev + words[a].value
+                elif abs(inc) >= half:
+                    txt = gcode.format_number(inc, int(nd[r, i]))
+                    added[a] = txt
+                    state[a] = prev + float(txt)
+            else:
+                if a in words:
+                    orig = line.body[words[a].num_start:words[a].num_end]
+                    if abs(want - words[a].value) >= half:
+                        txt = gcode.format_number(want, int(nd[r, i]), orig)
+                        new_values[a] = txt
+                        state[a] = float(txt)
+                    else:
+                        state[a] = words[a].value
+                elif state[a] is None or abs(want - state[a]) >= half:
+                    txt = gcode.format_number(want, int(nd[r, i]))
+                    added[a] = txt
+                    state[a] = float(txt)
+        out.append(gcode.rewrite_line(line, new_values, added, spaced) if (new_values or added)
+                   else line.text)
+    return "".join(out)

@@ -1,0 +1,132 @@
+"""Five-axis kinematics at run time: nominal inverse, branch choice, Jacobians.
+
+The closed-form inverse is generated per layout (``inverse_rotary``, ``inverse_linear`` in the
+generated module, derived by :mod:`volerr.derive.inverse`).  This module picks among its
+solutions: the two branches of the rotary solution, the turn (multiples of 360 deg) of each
+rotary axis, and the value of an undetermined rotary axis on a singular orientation (tool axis
+along the first rotary axis, e.g. B = 0 on the DMU 50, where C does not change the tool axis).
+
+Units: mm and deg at this interface (rad only inside the generated code).  Frames: target tool
+tip (x, y, z) and unit tool axis (i, j, k) in the workpiece frame, as returned by
+:meth:`volerr.machine.model.Model.forward`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volerr.errors import InputError, require
+
+#: a rotary axis whose motion turns the tool axis by less than this (rad per rad) is singular
+SINGULAR = 1e-9
+
+
+def is_five_axis(model) -> bool:
+    """True when the model's generated module carries the five-axis inverse."""
+    return hasattr(model.module, "inverse_rotary") and hasattr(model.module, "inverse_linear")
+
+
+def linear_axes(model) -> tuple[str, ...]:
+    return tuple(a for a in model.axes if a not in model.rotary_axes)
+
+
+def _wrap_near(angle_deg: np.ndarray, ref_deg: np.ndarray) -> np.ndarray:
+    """The representative of ``angle`` (mod 360) nearest to ``ref``."""
+    return ref_deg + (angle_deg - ref_deg + 180.0) % 360.0 - 180.0
+
+
+def inverse(model, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
+    """Axis positions (N, n_axes) in ``model.axes`` order (mm / deg) that put the tool tip at
+    ``target[:, :3]`` (mm) with tool axis ``target[:, 3:6]`` (normalised here).
+
+    ``near``: (n_axes,) or (N, n_axes) positions to stay close to (e.g. the previous block);
+    it chooses the branch and the turn of every rotary axis, and fills a rotary axis that is
+    undetermined on a singular orientation.  Without it the solution inside the travel
+    closest to the middle of the rotary travel is taken, and an undetermined axis gets 0.
+    Raises :class:`InputError` for an unreachable orientation."""
+    require(is_five_axis(model), f"{model.name}: no five-axis inverse kinematics "
+                                 "(needs three linear and two rotary axes)")
+    t = np.atleast_2d(np.asarray(target, dtype=float))
+    require(t.ndim == 2 and t.shape[1] == 6, f"target must be (N, 6) x y z i j k, got {t.shape}")
+    require(np.all(np.isfinite(t)), "target has NaN or infinite values")
+    n = len(t)
+    k = t[:, 3:6]
+    norm = np.linalg.norm(k, axis=1, keepdims=True)
+    require(np.all(norm > 1e-12), "tool axis (i, j, k) must not be the zero vector")
+    k = k / norm
+    rot = model.rotary_axes
+    travel = model.travel
+    if near is not None:
+        near = np.broadcast_to(np.asarray(near, dtype=float), (n, len(model.axes)))
+        near_rot = {a: near[:, model.axes.index(a)] for a in rot}
+    else:
+        near_rot = {a: np.full(n, 0.5 * sum(travel[a])) for a in rot}
+
+    candidates = []
+    for branch in (1.0, -1.0):
+        sol = model.module.inverse_rotary(k[:, 0], k[:, 1], k[:, 2], branch)
+        cand = {}
+        for a, v in zip(rot, sol):
+            v = np.rad2deg(np.broadcast_to(np.asarray(v, dtype=float), (n,)))
+            cand[a] = _wrap_near(v, near_rot[a])
+        candidates.append(cand)
+    # an axis that does not turn the tool axis at the solution is undetermined: keep near
+    for cand in candidates:
+        for a in rot:
+            sens = _axis_sensitivity(model, cand, a)
+            undetermined = sens < SINGULAR
+            if undetermined.any():
+                cand[a] = np.where(undetermined, near_rot[a], cand[a])
+    ok = [np.all([np.isfinite(c[a]) for a in rot], axis=0) for c in candidates]
+    require(np.all(ok[0] | ok[1]),
+            f"{model.name}: tool orientation unreachable (row {int(np.argmin(ok[0] | ok[1]))})")
+
+    def score(c, good):
+        inside = np.all([(c[a] >= travel[a][0] - 1e-9) & (c[a] <= travel[a][1] + 1e-9)
+                         for a in rot], axis=0)
+        dist = sum(np.abs(np.nan_to_num(c[a], nan=1e9) - near_rot[a]) for a in rot)
+        return np.where(good, np.where(inside, 0.0, 1e6) + dist, np.inf)
+
+    s0, s1 = score(candidates[0], ok[0]), score(candidates[1], ok[1])
+    pick = s1 < s0
+    rot_deg = {a: np.where(pick, candidates[1][a], candidates[0][a]) for a in rot}
+    tool = np.broadcast_to(np.asarray(tool, dtype=float), (n, 3))
+    lin = model.module.inverse_linear(*(np.deg2rad(rot_deg[a]) for a in rot),
+                                      t[:, 0], t[:, 1], t[:, 2], tool[:, 0], tool[:, 1], tool[:, 2])
+    lin = {a: np.broadcast_to(np.asarray(v, dtype=float), (n,)) for a, v in
+           zip(("X", "Y", "Z"), lin)}
+    out = np.empty((n, len(model.axes)))
+    for i, a in enumerate(model.axes):
+        out[:, i] = rot_deg[a] if a in rot else lin[a]
+    return out
+
+
+def _axis_sensitivity(model, rot_deg: dict, axis: str) -> np.ndarray:
+    """|d(tool axis)/d(axis)| (per rad) at the rotary positions ``rot_deg``."""
+    n = len(next(iter(rot_deg.values())))
+    h = 1e-4
+    args = {a: np.deg2rad(np.nan_to_num(rot_deg.get(a, np.zeros(n)))) for a in model.rotary_axes}
+    full = {a: np.zeros(n) for a in model.axes if a not in model.rotary_axes}
+    k0 = np.stack(model.module.tool_axis(**full, **args), axis=1)
+    args[axis] = args[axis] + h
+    k1 = np.stack(model.module.tool_axis(**full, **args), axis=1)
+    return np.linalg.norm(k1 - k0, axis=1) / h
+
+
+def linear_jacobian(model, positions: np.ndarray, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """d(tool tip)/d(X, Y, Z), (N, 3, 3): exact, since the tip is affine in the linear axes."""
+    positions = np.atleast_2d(np.asarray(positions, dtype=float))
+    idx = [model.axes.index(a) for a in linear_axes(model)]
+    base = model.nominal_position(positions, tool)
+    cols = []
+    for i in idx:
+        p = positions.copy()
+        p[:, i] += 1.0
+        cols.append(model.nominal_position(p, tool) - base)
+    return np.stack(cols, axis=2)
+
+
+def check_axes(model, axes) -> None:
+    for a in axes:
+        if a not in model.axes:
+            raise InputError(f"{model.name}: unknown axis {a!r}; axes are {' '.join(model.axes)}")

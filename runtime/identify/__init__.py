@@ -1,0 +1,17 @@
+"""Laser-tracker identification: tracker point files, the three-point (or more) least-squares
+solve of the six error motions of an axis per position, rounds with Type A uncertainty, the
+conversion to the model's sign convention, and the identification plots.
+"""
+
+from volerr.identify.solve import Identification, identify, identify_round, to_model_signs
+
+__all__ = ["Identification", "identify", "identify_round", "to_model_signs"]
+
+
+def __getattr__(name):
+    # names of the former flat module volerr.identify, still importable from here
+    from volerr.identify import solve as _m
+    try:
+        return getattr(_m, name)
+    except AttributeError:
+        raise AttributeError(f"module 'volerr.identify' has no attribute {name!r}") from None

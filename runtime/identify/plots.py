@@ -1,0 +1,71 @@
+"""Plots of identified error motions (thesis Fig. 4.x style): value vs position with
++-2 sigma bars (Type A over rounds, else the propagated uncertainty), every round as faint
+markers, the fitted error function when given; rotary axes also as polar plots."""
+
+from __future__ import annotations
+
+import numpy as np
+
+SCALE = (1e3, 1e3, 1e3, 1e6, 1e6, 1e6)
+
+
+def _sigma(result):
+    if result.std is not None:
+        return result.std, "2 s (Type A, rounds)"
+    return result.u_tracker, "2 u (propagated)"
+
+
+def plot_identification(result, path, fits: dict | None = None) -> None:
+    """Write a PNG of the six error motions of ``result`` (:class:`volerr.identify.solve.
+    Identification`); ``fits``: name -> callable of position (mm or rad), optional."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rotary = result.kind == "rotary"
+    sig, sig_label = _sigma(result)
+    unit_pos = "deg" if rotary else "mm"
+    nrows = 4 if rotary else 3
+    fig = plt.figure(figsize=(11, 3.0 * nrows))
+    x = result.positions
+    for j, name in enumerate(result.names):
+        col, row = (0, j) if j < 3 else (1, j - 3)
+        ax = fig.add_subplot(nrows, 2, 2 * row + col + 1)
+        for r in result.rounds:
+            order = np.argsort(r.positions)
+            ax.plot(r.positions[order], r.values[order, j] * SCALE[j], ".", color="0.7", ms=3)
+        ax.errorbar(x, result.values[:, j] * SCALE[j], yerr=2 * sig[:, j] * SCALE[j],
+                    fmt="o", ms=4, color="C0", ecolor="k", capsize=3,
+                    label=f"mean, bars {sig_label}")
+        if fits and name in fits:
+            q = np.linspace(x[0], x[-1], 400)
+            ax.plot(q, np.asarray(fits[name](q)) * SCALE[j], "-", color="C3", lw=1,
+                    label="fitted function")
+        ax.axhline(0, color="0.5", lw=0.5)
+        ax.set_xlabel(f"{result.axis} [{unit_pos}]")
+        ax.set_ylabel(f"{name} [{'um' if j < 3 else 'urad'}]")
+        ax.grid(True, lw=0.3)
+        if j == 0:
+            ax.legend(fontsize=7, loc="best")
+    if rotary:
+        th = np.radians(x)
+        for k, (lo, hi, unit) in enumerate(((0, 3, "um"), (3, 6, "urad"))):
+            ax = fig.add_subplot(nrows, 2, 7 + k, projection="polar")
+            vals = result.values[:, lo:hi] * np.array(SCALE[lo:hi])
+            span = float(np.max(np.abs(vals))) or 1.0
+            base = 2.0 * span
+            for i in range(3):
+                ax.plot(th, base + vals[:, i], "-o", ms=3, label=result.names[lo + i])
+            ax.plot(np.linspace(0, 2 * np.pi, 200), np.full(200, base), color="0.6", lw=0.5)
+            ax.set_rmin(0)
+            ax.set_rmax(base + 1.2 * span)
+            ax.set_yticklabels([])
+            ax.set_title(f"polar, {unit}: radius = {base:.3g} + value (grey circle = 0)",
+                         fontsize=8)
+            ax.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.25, -0.1))
+    fig.suptitle(f"Error motions of axis {result.axis} ({len(result.rounds)} round(s), "
+                 f"{result.method}, {len(result.rounds[0].labels)} points)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

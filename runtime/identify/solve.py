@@ -1,0 +1,672 @@
+"""Three-point (or more) laser-tracker identification of the six error motions of one axis.
+
+What is identified
+------------------
+Points fixed on the moving component (spindle head for a linear axis, table for a rotary axis)
+are measured at every commanded position.  The first position of each round is the reference:
+the error motions are zero there by definition.  At a position ``s`` a point deviates from its
+nominal position by (thesis eq. 30 linear, eq. 3.4 rotary; ``volerr.derive.three_point``)::
+
+    Delta_i(s) = t(s) + e(s) x r_hat_i(s)
+
+* ``t = (EX, EY, EZ)`` (mm): translation of the body point that coincided with the origin of the
+  measurement frame at the reference position; for a rotary axis the frame origin lies on the
+  axis (``origin`` moves it there if the frame was set up elsewhere).
+* ``e = (EA, EB, EC)`` (rad): small right-hand rotations of the body about the frame axes x, y, z.
+* ``r_hat_i``: the point's lever arm from the frame origin at its nominal pose: the reference
+  coordinates for a linear axis, rotated by the nominal angle for a rotary axis.
+* nominal pose: translation ``sense * (s - s_ref) * direction`` (linear) or rotation by
+  ``sense * (s - s_ref)`` deg about ``direction`` through the origin (rotary).  ``direction`` is
+  the layout's axis direction unless given; ``sense`` (+1/-1) is detected from the data by
+  default, because it depends on whether the points ride on the tool or the table side and on
+  the controller's rotation convention (the thesis turns the table by +C, eq. 3.2).
+
+The results are the error motions of the component that carries the points, in the
+measurement frame (INTERFACE.md), named ``E{X,Y,Z,A,B,C}{axis}``.
+
+Estimation
+----------
+The default ``method="lsq"`` is (weighted) least squares over every point and all three
+coordinates (``3n`` equations, 6 unknowns) at each position.  ``method="closed"`` uses the
+Zhang & Hu closed forms of six selected equations (generated code, ``volerr.generated.
+three_point``); ``cross_check`` compares them with least squares at every position.
+
+Weights and uncertainty: without a tracker position the points are weighted equally and the
+noise is estimated from the residuals (pooled over the round, ``3n - 6`` degrees of freedom per
+position).  With ``tracker=(x, y, z)`` (mm, measurement frame) each point gets the covariance of
+the thesis' laser-tracker figures (Leica AT960, sec. 2.8 of Appendix B): interferometer
+MPE 0.4 um + 0.3 um/m along the beam, angle encoders MPE 15 um + 6 um/m across it, each MPE
+taken as a rectangular distribution (standard uncertainty MPE / sqrt(3)); the deviation of a
+point is a difference of two measurements (position and reference), so both covariances add.
+Standard uncertainties of the identified motions are propagated from these (``(A^T W A)^-1``).
+
+Degenerate geometry (coincident or collinear points) is refused: the condition number of the
+coefficient matrix, with lever arms taken from the points' centroid and the rotation columns
+scaled by the points' RMS spread, must stay below ``max_cond``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volerr.errors import InputError, require
+from volerr.identify.tracker_io import Round, check_rounds
+
+MOTION_PREFIX = ("EX", "EY", "EZ", "EA", "EB", "EC")
+#: Leica AT960 MPE figures quoted in the thesis (Appendix B, 2.8): (constant um, um per m)
+IFM_MPE = (0.4, 0.3)
+ANGLE_MPE = (15.0, 6.0)
+
+
+def tracker_covariance(points, tracker) -> np.ndarray:
+    """Covariance (mm^2) of tracker-measured points: shape (..., 3, 3) for points (..., 3).
+
+    Along the beam (tracker -> point) the interferometer, across it the angle encoders; MPE
+    figures of the thesis turned into standard uncertainties by MPE / sqrt(3)."""
+    p = np.asarray(points, dtype=float)
+    b = p - np.asarray(tracker, dtype=float)
+    L = np.linalg.norm(b, axis=-1)
+    require(np.all(L > 1.0), "tracker position coincides with a measured point")
+    u = b / L[..., None]
+    Lm = L / 1000.0
+    s_r = (IFM_MPE[0] + IFM_MPE[1] * Lm) * 1e-3 / math.sqrt(3.0)
+    s_t = (ANGLE_MPE[0] + ANGLE_MPE[1] * Lm) * 1e-3 / math.sqrt(3.0)
+    uu = u[..., :, None] * u[..., None, :]
+    eye = np.eye(3)
+    return s_r[..., None, None] ** 2 * uu + s_t[..., None, None] ** 2 * (eye - uu)
+
+
+def _skew(r) -> np.ndarray:
+    """[r]x for r of shape (..., 3) -> (..., 3, 3)."""
+    r = np.asarray(r)
+    z = np.zeros(r.shape[:-1])
+    return np.stack([np.stack([z, -r[..., 2], r[..., 1]], -1),
+                     np.stack([r[..., 2], z, -r[..., 0]], -1),
+                     np.stack([-r[..., 1], r[..., 0], z], -1)], -2)
+
+
+def design(lever) -> np.ndarray:
+    """Coefficient blocks ``[I, -[r]x]`` (Delta = A (t, e)): lever (..., 3) -> (..., 3, 6)."""
+    lever = np.asarray(lever, dtype=float)
+    eye = np.broadcast_to(np.eye(3), lever.shape[:-1] + (3, 3))
+    return np.concatenate([eye, -_skew(lever)], axis=-1)
+
+
+def rotation_matrix(axis, angle_rad) -> np.ndarray:
+    """Right-hand rotation about unit ``axis`` by ``angle_rad`` (array) -> (..., 3, 3)."""
+    k = np.asarray(axis, dtype=float)
+    k = k / np.linalg.norm(k)
+    a = np.asarray(angle_rad, dtype=float)[..., None, None]
+    K = _skew(k)
+    return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * (K @ K)
+
+
+def geometry_condition(lever) -> float:
+    """Scale-free condition number of the identification for points at ``lever`` (n, 3), mm:
+    lever arms from the centroid, rotation columns scaled by the RMS spread."""
+    lever = np.asarray(lever, dtype=float)
+    c = lever - lever.mean(axis=0)
+    spread = math.sqrt(float(np.mean(np.sum(c ** 2, axis=1))))
+    if spread < 1e-9:
+        return math.inf
+    A = design(c).reshape(-1, 6) / np.array([1, 1, 1, spread, spread, spread])
+    s = np.linalg.svd(A, compute_uv=False)
+    return math.inf if s[-1] <= s[0] * 1e-15 else float(s[0] / s[-1])
+
+
+@dataclass
+class RoundResult:
+    """Identification of one round (positions in measurement order, reference first).
+
+    ``values``/``u``: (n_positions, 6) error motions (mm, rad) and their standard uncertainties
+    (propagated); ``residuals``: (n_positions, n_points, 3) mm; ``deltas``: measured deviations
+    from the nominal pose, same shape."""
+
+    name: str
+    positions: np.ndarray
+    labels: tuple
+    values: np.ndarray
+    u: np.ndarray
+    residuals: np.ndarray
+    deltas: np.ndarray
+    condition: float
+    sense: int
+    sigma_mm: float
+    outliers: list = field(default_factory=list)
+    closed_form: dict = field(default_factory=dict)
+
+
+@dataclass
+class Identification:
+    """Result of :func:`identify`: positions sorted, values averaged over rounds.
+
+    ``values``, ``std`` (Type A, experimental standard deviation of one round, ``ddof=1``, the
+    thesis' C.2/D.2), ``u_tracker`` (propagated standard uncertainty, mean over rounds in
+    quadrature): (n_positions, 6) in mm / rad, motions ordered EX EY EZ EA EB EC."""
+
+    axis: str
+    kind: str
+    positions: np.ndarray
+    values: np.ndarray
+    std: np.ndarray | None
+    u_tracker: np.ndarray
+    rounds: list
+    method: str
+    weighted: bool
+    direction: tuple
+    origin: tuple
+
+    @property
+    def names(self) -> tuple:
+        """ISO names of the six motions, e.g. ``EXX ... ECX``."""
+        return tuple(p + self.axis for p in MOTION_PREFIX)
+
+    def table(self, with_u95: bool | None = None):
+        """The averaged result as a :class:`volerr.tables.table.ErrorTable`.
+
+        ``std`` columns when there are several rounds; ``u95`` (k = 2) columns combine the
+        propagated tracker uncertainty and the Type A standard deviation of the mean:
+        ``2 sqrt(u_tracker^2 + s^2 / n_rounds)``; written by default only when weighted by a
+        tracker position."""
+        from volerr.tables.table import ErrorTable
+
+        with_u95 = self.weighted if with_u95 is None else with_u95
+        values = {n: self.values[:, j] for j, n in enumerate(self.names)}
+        std = {n: self.std[:, j] for j, n in enumerate(self.names)} if self.std is not None \
+            else {}
+        u95 = {}
+        if with_u95:
+            var = self.u_tracker ** 2
+            if self.std is not None:
+                var = var + self.std ** 2 / len(self.rounds)
+            u95 = {n: 2.0 * np.sqrt(var[:, j]) for j, n in enumerate(self.names)}
+        return ErrorTable(self.axis, self.positions, values, std, u95)
+
+    def outliers(self) -> list:
+        """All flagged (round, position, point, residual_um, ratio) over rounds."""
+        return [o for r in self.rounds for o in r.outliers]
+
+    def summary(self) -> dict:
+        """JSON-friendly summary (um, urad)."""
+        res = np.concatenate([r.residuals[1:].reshape(-1, 3) for r in self.rounds])
+        norms = np.linalg.norm(res, axis=1) * 1e3
+        scale = np.array([1e3, 1e3, 1e3, 1e6, 1e6, 1e6])
+        out = {
+            "axis": self.axis, "kind": self.kind, "method": self.method,
+            "weighted_by_tracker": self.weighted,
+            "direction": list(self.direction), "origin_mm": list(self.origin),
+            "n_rounds": len(self.rounds), "n_positions": int(self.positions.size),
+            "points": list(self.rounds[0].labels),
+            "sense": [r.sense for r in self.rounds],
+            "condition": max(r.condition for r in self.rounds),
+            "residual_rms_um": float(np.sqrt(np.mean(norms ** 2))) if norms.size else 0.0,
+            "residual_max_um": float(norms.max()) if norms.size else 0.0,
+            "noise_sigma_um": [r.sigma_mm * 1e3 for r in self.rounds],
+            "max_abs": {n: float(np.max(np.abs(self.values[:, j])) * scale[j])
+                        for j, n in enumerate(self.names)},
+            "outliers": [{"round": o[0], "position": o[1], "point": o[2],
+                          "residual_um": o[3], "ratio": o[4]} for o in self.outliers()],
+        }
+        if self.std is not None:
+            out["max_std"] = {n: float(np.max(self.std[:, j]) * scale[j])
+                              for j, n in enumerate(self.names)}
+        if self.weighted:
+            out["max_u_tracker"] = {n: float(np.max(self.u_tracker[:, j]) * scale[j])
+                                    for j, n in enumerate(self.names)}
+        cf = [r.closed_form for r in self.rounds if r.closed_form]
+        if cf:
+            out["closed_form"] = {
+                "selection": cf[0]["selection"], "roles": cf[0]["roles"],
+                "thesis_choice_everywhere": all(c["thesis_choice_everywhere"] for c in cf),
+                "consistency_max": max(c["consistency_max"] for c in cf),
+                "vs_lsq_max": {n: max(c["vs_lsq_max"][n] for c in cf) for n in self.names},
+                "noise_gain_vs_lsq": {n: _mean_or_none([c.get("noise_gain_vs_lsq", {}).get(n)
+                                                        for c in cf]) for n in self.names},
+            }
+        return out
+
+
+def _mean_or_none(values):
+    """Mean of the finite values (None when there is none: JSON null, never NaN)."""
+    v = [float(x) for x in values if x is not None and math.isfinite(x)]
+    return float(np.mean(v)) if v else None
+
+
+def _layout_number(value, params: dict) -> float:
+    """A layout coordinate: a number or an arithmetic expression in the layout parameters."""
+    import ast
+    import operator
+
+    if isinstance(value, (int, float)):
+        return float(value)
+    ops = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+           ast.Div: operator.truediv, ast.USub: operator.neg, ast.UAdd: operator.pos}
+
+    def ev(node):
+        if isinstance(node, ast.Expression):
+            return ev(node.body)
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return float(node.value)
+        if isinstance(node, ast.Name) and node.id in params:
+            return float(params[node.id])
+        if isinstance(node, ast.BinOp) and type(node.op) in ops:
+            return ops[type(node.op)](ev(node.left), ev(node.right))
+        if isinstance(node, ast.UnaryOp) and type(node.op) in ops:
+            return ops[type(node.op)](ev(node.operand))
+        raise InputError(f"cannot evaluate the layout coordinate {value!r}")
+
+    try:
+        return ev(ast.parse(str(value), mode="eval"))
+    except SyntaxError:
+        raise InputError(f"cannot evaluate the layout coordinate {value!r}") from None
+
+
+def _axis_geometry(layout, axis, direction, origin):
+    require(axis in layout.axes, f"axis {axis!r} is not an axis of layout {layout.name} "
+                                 f"(axes: {' '.join(layout.axis_names)})")
+    ax = layout.axes[axis]
+    if direction is None:
+        direction = ax.direction
+    d = np.asarray(direction, dtype=float)
+    require(d.shape == (3,) and np.all(np.isfinite(d)) and np.linalg.norm(d) > 1e-12,
+            "axis direction must be three finite numbers, not all zero")
+    if isinstance(origin, str) and origin == "layout":
+        require(ax.kind == "rotary", f"origin 'layout' applies to rotary axes; {axis} is linear")
+        origin = [_layout_number(v, layout.parameters) for v in ax.point]
+    o = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
+    require(o.shape == (3,) and np.all(np.isfinite(o)), "origin must be three finite numbers")
+    return ax.kind, d / np.linalg.norm(d), o
+
+
+def _nominal(kind, ref, steps, d, o, sense):
+    """Nominal positions (K, n, 3) and lever arms (K, n, 3) for reference points ref (n, 3)."""
+    lever0 = ref - o
+    if kind == "linear":
+        nom = ref[None] + sense * steps[:, None, None] * d
+        lever = np.broadcast_to(lever0, nom.shape)
+    else:
+        R = rotation_matrix(d, sense * np.radians(steps))
+        lever = np.einsum("kab,nb->kna", R, lever0)
+        nom = lever + o
+    return nom, lever
+
+
+def _detect_sense(kind, pts, steps, d, o, name, sense):
+    """Choose the sense (+1/-1) of the nominal motion that fits the data; check plausibility."""
+    ref = pts[0]
+    senses = (1, -1) if sense in (None, 0, "auto") else (int(sense),)
+    best = None
+    for s in senses:
+        nom, _ = _nominal(kind, ref, steps, d, o, s)
+        dev = float(np.max(np.linalg.norm(pts - nom, axis=-1)))
+        if best is None or dev < best[1]:
+            best = (s, dev)
+    s, dev = best
+    # implausibly large deviations: wrong axis, direction, units or origin
+    span = float(np.max(np.abs(steps)))
+    if kind == "linear":
+        limit = max(0.05 * span, 0.5)
+        what = "mm"
+    else:
+        lever = np.linalg.norm(np.cross(ref - o, d), axis=-1).max()
+        limit = max(np.radians(0.5) * lever, 0.5)
+        what = "mm"
+    require(dev <= limit,
+            f"round {name}: measured points deviate up to {dev:.3g} {what} from the nominal "
+            f"{'translation' if kind == 'linear' else 'rotation'} (limit {limit:.3g} mm); check "
+            f"--axis, the axis direction, the units (mm, deg)"
+            f"{', the origin on the axis' if kind == 'rotary' else ''} and the point order")
+    return s
+
+
+def _solve(A, W, delta):
+    """Batched weighted least squares. A (K, n, 3, 6), W (K, n, 3, 3) or None, delta (K, n, 3).
+    Returns theta (K, 6), Ninv (K, 6, 6)."""
+    if W is None:
+        N = np.einsum("knai,knaj->kij", A, A)
+        rhs = np.einsum("knai,kna->ki", A, delta)
+    else:
+        WA = np.einsum("knab,knbj->knaj", W, A)
+        N = np.einsum("knai,knaj->kij", A, WA)
+        rhs = np.einsum("knai,knab,knb->ki", A, W, delta)
+    Ninv = np.linalg.inv(N)
+    theta = np.einsum("kij,kj->ki", Ninv, rhs)
+    return theta, Ninv
+
+
+def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
+    """Zhang & Hu closed form on three points at every position; cross-check vs ``theta_lsq``.
+
+    Candidates: the three row selections (eq. 32/3.6, 36, 37) x the 3! assignments of the first
+    three points to the roles P, Q, K.  At each position the thesis' choice (the axis'
+    selection, points in the given order) is used unless its determinant N is below 0.1 of the
+    best candidate's there (for a rotary axis N changes with the angle and can pass through
+    zero).  lever, delta: (K, n, 3)."""
+    from volerr.generated import three_point as gen
+
+    K, n, _ = lever.shape
+    pref = gen.AXIS_SELECTION.get(axis if kind == "linear" else "C", "x")
+    c0 = lever[0] - lever[0].mean(axis=0)
+    spread = math.sqrt(float(np.mean(np.sum(c0 ** 2, axis=1))))
+    names = ("P", "Q", "K")
+    cands, scores, ranks = [], [], []
+    # a linear axis has the same lever arms at every position: score them once
+    geo = lever[:1] if kind == "linear" else lever
+    for perm in itertools.permutations((0, 1, 2), 3):
+        L = geo[:, perm, :]
+        args = [L[:, i, c] for i in range(3) for c in range(3)]
+        for sel in sorted(gen.SELECTIONS):
+            N = np.broadcast_to(getattr(gen, f"det_{sel}")(*args)["N"], (geo.shape[0],))
+            N = np.broadcast_to(N, (K,))
+            cands.append((sel, perm))
+            scores.append(np.abs(N) / spread ** 3)
+            ranks.append((sel == pref) + (perm == (0, 1, 2)))
+    scores = np.array(scores)                      # (n_cand, K)
+    best = scores.max(axis=0)
+    require(np.all(best[1:] > 1e-9) if K > 1 else True,
+            "closed form: every Zhang & Hu selection is singular for these points (denominator "
+            "N = 0); use the least-squares method")
+    ok = scores >= 0.1 * best
+    key = np.where(ok, np.array(ranks)[:, None] * 10.0 + scores / np.maximum(best, 1e-300), -1)
+    choice = np.argmax(key, axis=0)                # (K,)
+
+    def run(dl):
+        out = np.zeros((K, 6))
+        for c in np.unique(choice):
+            sel, perm = cands[c]
+            m = choice == c
+            # lever arms: constants for a linear axis, per position for a rotary one
+            L = lever[:1, perm, :] if kind == "linear" else lever[m][:, perm, :]
+            D = dl[m][:, perm, :]
+            ds = [D[:, names.index(lab), "xyz".index(co)] for lab, co in gen.SELECTIONS[sel]]
+            solve = getattr(gen, f"solve_{sel}")
+            out[m] = np.asarray(solve(*[L[:, i, co] for i in range(3) for co in range(3)],
+                                      *ds)).T
+        return out
+
+    values = run(delta)
+    A = design(lever) if A is None else A
+    fitted = np.einsum("knij,kj->kni", A, theta_lsq)
+    consistent = run(fitted)
+    scale = np.array([1.0, 1.0, 1.0, spread, spread, spread])
+    used = [cands[c] for c in np.unique(choice[1:] if K > 1 else choice)]
+    rows = {}
+    for c in np.unique(choice):
+        sel, perm = cands[c]
+        rows[int(c)] = [(perm[names.index(lab)], "xyz".index(co)) for lab, co in
+                        gen.SELECTIONS[sel]]
+    return {
+        "values": values,
+        "selection": ",".join(sorted({sel for sel, _ in used})),
+        "roles": [{names[i]: int(perm[i]) for i in range(3)} for _, perm in used],
+        "consistency_max": float(np.max(np.abs((consistent - theta_lsq) * scale))),
+        "vs_lsq": values - theta_lsq,
+        "row_index": rows,
+        "choice": choice,
+        "thesis_choice_everywhere": bool(np.all([cands[c][0] == pref and cands[c][1] ==
+                                                 (0, 1, 2) for c in choice])),
+    }
+
+
+def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, method="lsq",
+                   tracker=None, sense="auto", max_cond=1e4, outlier_k=5.0,
+                   cross_check=True) -> RoundResult:
+    """Identify the six error motions of one round (see the module docstring)."""
+    pts = rnd.points
+    K, n, _ = pts.shape
+    steps = rnd.positions - rnd.positions[0]
+    cond = geometry_condition(pts[0])
+    if not math.isfinite(cond):  # exactly singular: report the number a solver would give up at
+        cond = 1.0 / np.finfo(float).eps
+    require(cond <= max_cond,
+            f"round {rnd.name}: degenerate point geometry (condition number {cond:.3g} > "
+            f"{max_cond:.3g}): points {','.join(rnd.labels)} are coincident or (nearly) "
+            f"collinear; use three well-spread, non-collinear points")
+    s = _detect_sense(kind, pts, steps, direction, origin, rnd.name, sense)
+    nom, lever = _nominal(kind, pts[0], steps, direction, origin, s)
+    delta = pts - nom
+    A = design(lever)
+    W = None
+    if tracker is not None:
+        cov = tracker_covariance(pts, tracker) + tracker_covariance(pts[0], tracker)[None]
+        W = np.linalg.inv(cov)
+    theta, Ninv = _solve(A, W, delta)
+    theta[0] = 0.0
+    fitted = np.einsum("knij,kj->kni", A, theta)
+    resid = delta - fitted
+    resid[0] = 0.0
+    dof = 3 * n - 6
+    m = K - 1
+    if W is None:
+        pooled = float(np.sum(resid[1:] ** 2)) / max(m * dof, 1)
+        sigma = math.sqrt(pooled)
+        cov_theta = pooled * Ninv
+    else:
+        cov_theta = Ninv
+        sigma = float(np.sqrt(np.mean([np.trace(c) / 3 for c in
+                                        tracker_covariance(pts[0], tracker)])))
+    u = np.sqrt(np.clip(np.einsum("kii->ki", cov_theta), 0, None))
+    u[0] = 0.0
+    closed = {}
+    if method == "closed":
+        closed = _closed_form(lever, delta, theta, axis, kind, A)
+    elif cross_check and n >= 3:
+        # only a cross-check: points at one height (a common set-up on a rotary table) make
+        # every Zhang & Hu selection singular, while least squares is well determined
+        try:
+            closed = _closed_form(lever, delta, theta, axis, kind, A)
+        except InputError:
+            closed = {}
+    u_closed = _closed_uncertainty(A, closed, W, sigma) if closed else None
+    # outliers are judged on the least-squares residuals (the closed form fits six equations
+    # exactly and leaves all misfit in the other three)
+    outliers = _flag_outliers(rnd, resid, W, sigma, n, outlier_k)
+    if method == "closed":
+        theta = closed["values"].copy()
+        theta[0] = 0.0
+        resid = delta - np.einsum("knij,kj->kni", A, theta)
+        resid[0] = 0.0
+        u_lsq, u = u, u_closed
+    else:
+        u_lsq = u
+    summary_cf = {}
+    if closed:
+        names = tuple(p + axis for p in MOTION_PREFIX)
+        diff = np.abs(closed["vs_lsq"][1:]) if K > 1 else np.zeros((1, 6))
+        summary_cf = {"selection": closed["selection"],
+                      "roles": [{k: rnd.labels[v] for k, v in r.items()}
+                                for r in closed["roles"]],
+                      "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
+                      "consistency_max": closed["consistency_max"],
+                      "vs_lsq_max": {nm: float(diff[:, j].max()) * (1e3 if j < 3 else 1e6)
+                                     for j, nm in enumerate(names)}}
+        if K > 1:
+            import warnings
+
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: noise-free data
+                gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
+            summary_cf["noise_gain_vs_lsq"] = {nm: float(gain[j]) if np.isfinite(gain[j])
+                                               else None for j, nm in enumerate(names)}
+    return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, delta,
+                       cond, s, sigma, outliers, summary_cf)
+
+
+def _closed_uncertainty(A, closed, W, sigma):
+    """Standard uncertainties (K, 6) of the closed form: propagated through the six selected
+    equations of every position (equal weights: per-coordinate noise ``sigma``)."""
+    K = A.shape[0]
+    choice = closed["choice"]
+    As = np.empty((K, 6, 6))
+    S = np.zeros((K, 6, 6))
+    cov_full = np.linalg.inv(W) if W is not None else None
+    for c, rows in closed["row_index"].items():
+        m = choice == c
+        for a, (i, co) in enumerate(rows):
+            As[m, a, :] = A[m, i, co, :]
+            if cov_full is not None:
+                for b, (j, d) in enumerate(rows):
+                    if i == j:
+                        S[m, a, b] = cov_full[m, i, co, d]
+    Ainv = np.linalg.inv(As)
+    if W is None:
+        covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)
+    else:
+        covs = np.einsum("kij,kjl,kml->kim", Ainv, S, Ainv)
+    u = np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None))
+    u[0] = 0.0
+    return u
+
+
+def _flag_outliers(rnd, resid, W, sigma, n, k):
+    """Points whose residual is far above the tracker noise: (round, position, point, um, ratio).
+
+    The expected squared (weighted) residual of one point is ``(3n - 6) / n`` times its noise
+    variance per coordinate; with equal weights the noise is estimated robustly (median)."""
+    K = resid.shape[0]
+    if K < 2:
+        return []
+    frac = (3 * n - 6) / n
+    if W is not None:
+        z2 = np.einsum("kna,knab,knb->kn", resid, W, resid)
+    else:
+        r2 = np.sum(resid[1:] ** 2, axis=-1)
+        # median of chi2(3)/3 is 0.7887: robust per-coordinate variance of the residuals
+        robust = float(np.median(r2)) / (3 * 0.7887 * frac) if r2.size else 0.0
+        var = max(robust, (1e-7) ** 2)
+        z2 = np.sum(resid ** 2, axis=-1) / var
+    ratio = np.sqrt(z2 / (3 * frac))
+    out = []
+    for kk, i in zip(*np.nonzero(ratio > k)):
+        if kk == 0:
+            continue
+        out.append((rnd.name, float(rnd.positions[kk]), rnd.labels[i],
+                    float(np.linalg.norm(resid[kk, i]) * 1e3), float(ratio[kk, i])))
+    return out
+
+
+def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, direction=None,
+             origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
+             cross_check: bool = True) -> Identification:
+    """Identify the six error motions of ``axis`` of ``layout`` from tracker rounds.
+
+    Parameters
+    ----------
+    rounds : list of :class:`volerr.identify.tracker_io.Round`
+        Measurements, mm in the measurement frame; every round the same points and positions.
+    layout : Layout or str
+        The machine layout (name or file) declaring ``axis``.
+    method : "lsq" (default, weighted least squares over all points) or "closed" (Zhang & Hu).
+    tracker : (3,) mm, optional
+        Tracker position in the measurement frame: weights and propagated uncertainty from the
+        AT960 figures.
+    direction, origin : (3,), optional
+        Axis direction (default: the layout's) and a point of a rotary axis in the measurement
+        frame (default 0, 0, 0: the frame origin lies on the axis; ``"layout"``: the layout's
+        ``point`` of the axis, for a measurement frame that is the machine frame).
+    sense : "auto", +1 or -1
+        Sense of the nominal motion (default: detected from the data).
+    """
+    from volerr.machine.layout import Layout, read_layout
+
+    if not isinstance(layout, Layout):
+        layout = read_layout(layout)
+    require(method in ("lsq", "closed"), f"unknown method {method!r} (lsq, closed)")
+    kind, d, o = _axis_geometry(layout, axis, direction, origin)
+    rounds = list(rounds)
+    check_rounds(rounds)
+    # one reference for all rounds: the first position of the first round.  A round measured
+    # in another order (e.g. backwards) is referred to it too, so that the rounds average
+    # error motions of the same reference pose (their values at ``ref`` are zero).
+    ref = rounds[0].positions[0]
+    for i, r in enumerate(rounds):
+        k = int(np.argmin(np.abs(r.positions - ref)))
+        if k:
+            order = [k] + [j for j in range(r.positions.size) if j != k]
+            rounds[i] = Round(r.name, r.positions[order], r.labels, r.points[order])
+    if tracker is not None:
+        tracker = np.asarray(tracker, dtype=float)
+        require(tracker.shape == (3,) and np.all(np.isfinite(tracker)),
+                "tracker position must be three finite numbers (mm)")
+    # the same point order in every round
+    labels = rounds[0].labels
+    aligned = []
+    for r in rounds:
+        order = [r.labels.index(lab) for lab in labels]
+        aligned.append(Round(r.name, r.positions, labels, r.points[:, order, :]))
+    results = [identify_round(r, kind, axis, d, o, method=method, tracker=tracker, sense=sense,
+                              max_cond=max_cond, outlier_k=outlier_k, cross_check=cross_check)
+               for r in aligned]
+    positions = np.sort(rounds[0].positions)
+    stack = np.empty((len(results), positions.size, 6))
+    ustack = np.empty_like(stack)
+    for i, res in enumerate(results):
+        order = np.searchsorted(positions, res.positions)
+        # positions of later rounds match within 1e-9; map by nearest
+        order = np.array([int(np.argmin(np.abs(positions - p))) for p in res.positions]) \
+            if not np.allclose(positions[order.clip(0, positions.size - 1)], res.positions) \
+            else order
+        stack[i, order] = res.values
+        ustack[i, order] = res.u
+    values = stack.mean(axis=0)
+    std = stack.std(axis=0, ddof=1) if len(results) > 1 else None
+    u_tr = np.sqrt(np.mean(ustack ** 2, axis=0))
+    return Identification(axis, kind, positions, values, std, u_tr, results, method,
+                          tracker is not None, tuple(float(v) for v in d),
+                          tuple(float(v) for v in o))
+
+
+def to_model_signs(table, layout, reference=None):
+    """An identified table (error motions of the component carrying the points) in the
+    volerr model's convention (tool relative to workpiece, ``volerr.machine.layout``).
+
+    Tool-side axes keep their signs; the model's carriage frame pivots about the carriage point
+    that is at the origin at ``q = 0``, the tracker's about the one there at the reference
+    position ``q0``, so a linear tool-side axis measured from ``q0 != 0`` gets
+    ``delta = t + q0 (e x u)`` (unchanged for ``q0 = 0``).  For a table axis the model gives the tool's
+    error relative to the table with rotations pivoting about the tool reference point, which
+    stays put while the table travels, whereas the tracker's pivot is the table point that was
+    there at the reference position.  With ``t, e`` the table's own motions, ``u`` the axis
+    direction and ``q - q0`` the travel from the reference position:
+
+    * linear table axis: ``delta = -t - (q - q0) (e x u)``, ``eps = -e``;
+    * rotary table axis (frame origin on the axis): ``delta = -t``, ``eps = -e``.
+
+    Assumes the measurement frame origin at the tool reference point and its axes along the
+    machine axes; for other measuring points use :meth:`volerr.machine.model.Model.transfer`."""
+    from volerr.tables.table import ErrorTable
+
+    axis = table.axis
+    require(axis in layout.axes, f"axis {axis} is not an axis of layout {layout.name}")
+    tool_side = axis not in layout.workpiece_chain
+    # the reference position q0 (errors zero there): the first position of the first round
+    q0 = float(table.positions[0] if reference is None else reference)
+    if tool_side and (layout.axes[axis].kind != "linear" or q0 == 0):
+        return table
+    t = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
+                  for p in MOTION_PREFIX[:3]], axis=1)
+    e = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
+                  for p in MOTION_PREFIX[3:]], axis=1)
+    if tool_side:
+        # the model's carriage frame is the carriage point at the origin at q = 0; the
+        # tracker's pivot is the one there at the reference position q0: t + q0 (e x u)
+        u = np.asarray(layout.axes[axis].direction, dtype=float)
+        delta = t + q0 * np.cross(e, u)
+        values = dict(table.values)
+        for j, p in enumerate(MOTION_PREFIX[:3]):
+            if p + axis in values or np.any(delta[:, j]):
+                values[p + axis] = delta[:, j]
+        return ErrorTable(axis, table.positions, values, table.std, table.u95)
+    delta = -t
+    if layout.axes[axis].kind == "linear":
+        u = np.asarray(layout.axes[axis].direction, dtype=float)
+        travel = table.positions - q0
+        delta = delta - travel[:, None] * np.cross(e, u)
+    motions = np.concatenate([delta, -e], axis=1)
+    values = {p + axis: motions[:, j] for j, p in enumerate(MOTION_PREFIX)
+              if p + axis in table.values}
+    return ErrorTable(axis, table.positions, values, table.std, table.u95)

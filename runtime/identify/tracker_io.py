@@ -1,0 +1,212 @@
+"""Laser-tracker point data for the three-point identification: reading and validation.
+
+Two input formats, both in mm in the measurement frame:
+
+*Tracker CSV* (INTERFACE.md), header ``round,point,position,x,y,z`` (any column order; extra
+columns are ignored; ``x_mm`` etc. are accepted; blank lines and ``#`` comments skipped)::
+
+    round,point,position,x,y,z
+    1,P,0,100.0012,50.0003,-20.0001
+    1,Q,0,...
+
+``point`` is any label (at least three distinct points), ``position`` the commanded axis
+position (mm or deg).  Within a round every point is measured at every position exactly once.
+The *first* position of a round, in file order, is its reference (errors zero there); a round
+that starts elsewhere (e.g. measured backwards) is referred to the first round's reference, so
+that all rounds average the same reference pose.  Rows of one round may be in any order
+otherwise.  Several files are concatenated; rounds are keyed by
+(file, round).
+
+*Thesis export* (``format="thesis"``): the measuring software's export used by the thesis
+scripts (Appendix C.1, D.1): one file per round, rows ``label,x,y,z`` without header, one block
+of N consecutive rows per point (N = number of commanded positions, in order), e.g. the K block,
+then P, then Q.  The commanded positions are not in the file and are given separately
+(``positions``, e.g. ``numpy.linspace(0, 500, 11)``); the first one is the reference.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from volerr.errors import InputError, require
+from volerr.fileio import read_csv_rows
+
+REQUIRED = ("round", "point", "position", "x", "y", "z")
+
+
+@dataclass
+class Round:
+    """One round of measurements.
+
+    ``positions``: shape (n_positions,), commanded positions in measurement order (the first is
+    the reference); ``labels``: the point labels, shape (n_points,); ``points``: shape
+    (n_positions, n_points, 3), measured coordinates, mm."""
+
+    name: str
+    positions: np.ndarray
+    labels: tuple
+    points: np.ndarray
+
+
+def _open_rows(path: Path):
+    return read_csv_rows(path, missing=f"tracker file not found: {path}", empty=f"{path}: no data")
+
+
+def _num(path, lineno, what, text) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {what} {text!r} is not a number") from None
+    require(math.isfinite(v), f"{path}:{lineno}: {what} is {text} (NaN or infinite)")
+    return v
+
+
+def _header_index(path, header):
+    norm = [h.strip().lower() for h in header]
+    alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
+    norm = [alias.get(h, h) for h in norm]
+    index = {}
+    for col in REQUIRED:
+        if col not in norm:
+            if col == "position":
+                cand = [h for h in norm if h.startswith("position")]
+                if len(cand) == 1:
+                    index[col] = norm.index(cand[0])
+                    continue
+            missing = [c for c in REQUIRED if c not in norm]
+            raise InputError(f"{path}: missing column(s) {', '.join(missing)}; the tracker CSV "
+                             f"needs the header {','.join(REQUIRED)}")
+        index[col] = norm.index(col)
+    return index
+
+
+def read_tracker_csv(path) -> list[Round]:
+    """Read one tracker CSV file -> its rounds (see the module docstring)."""
+    path = Path(path)
+    rows = _open_rows(path)
+    (_, header), body = rows[0], rows[1:]
+    idx = _header_index(path, header)
+    require(body, f"{path}: header only, no measurements")
+    data: dict = {}
+    width = max(idx.values()) + 1
+    for lineno, cells in body:
+        require(len(cells) >= width, f"{path}:{lineno}: expected at least {width} columns, "
+                                     f"got {len(cells)}")
+        rnd, label = cells[idx["round"]], cells[idx["point"]]
+        require(rnd != "", f"{path}:{lineno}: empty round")
+        require(label != "", f"{path}:{lineno}: empty point label")
+        pos = _num(path, lineno, "position", cells[idx["position"]])
+        xyz = tuple(_num(path, lineno, c, cells[idx[c]]) for c in ("x", "y", "z"))
+        # dicts keep the file order: positions in measurement order, labels as first seen
+        d = data.setdefault(rnd, {"positions": {}, "labels": {}, "values": {}})
+        d["positions"].setdefault(pos, None)
+        d["labels"].setdefault(label, None)
+        key = (pos, label)
+        require(key not in d["values"], f"{path}:{lineno}: round {rnd}: point {label} measured "
+                                         f"twice at position {pos:g}")
+        d["values"][key] = xyz
+    rounds = []
+    for rnd, d in data.items():
+        pos, labels = list(d["positions"]), list(d["labels"])
+        if len(d["values"]) != len(pos) * len(labels):
+            for p in pos:
+                for lab in labels:
+                    require((p, lab) in d["values"], f"{path}: round {rnd}: point {lab} has no "
+                                                     f"measurement at position {p:g}")
+        pts = np.array([[d["values"][(p, lab)] for lab in labels] for p in pos], dtype=float)
+        rounds.append(Round(f"{path.name}:{rnd}", np.array(pos, dtype=float), tuple(labels), pts))
+    return rounds
+
+
+def read_thesis_export(path, positions, labels=None) -> Round:
+    """Read one round in the thesis' raw export format (blocks of ``label,x,y,z`` rows)."""
+    path = Path(path)
+    positions = np.asarray(positions, dtype=float)
+    require(positions.ndim == 1 and positions.size >= 2,
+            "the thesis format needs the commanded positions (at least two), e.g. "
+            "--positions 0:500:11")
+    rows = _open_rows(path)
+    # a header line (non-numeric coordinates) is tolerated
+    first = rows[0][1]
+    if len(first) >= 4:
+        try:
+            [float(c) for c in first[1:4]]
+        except ValueError:
+            rows = rows[1:]
+    n = positions.size
+    require(len(rows) % n == 0,
+            f"{path}: {len(rows)} rows is not a whole number of blocks of {n} positions "
+            f"(one block of {n} rows per point)")
+    n_points = len(rows) // n
+    values = np.empty((n_points, n, 3))
+    file_labels = []
+    for k, (lineno, cells) in enumerate(rows):
+        require(len(cells) >= 4, f"{path}:{lineno}: expected label,x,y,z, got {len(cells)} "
+                                 f"column(s)")
+        values[k // n, k % n] = [_num(path, lineno, c, cells[i + 1])
+                                 for i, c in enumerate("xyz")]
+        if k % n == 0:
+            file_labels.append(cells[0] or f"point{k // n + 1}")
+    if labels is None:
+        labels = []
+        for i, lab in enumerate(file_labels):
+            labels.append(lab if lab not in labels else f"{lab}#{i + 1}")
+    labels = tuple(labels)
+    require(len(labels) == n_points, f"{path}: {n_points} blocks of {n} rows but "
+                                     f"{len(labels)} point labels given ({','.join(labels)})")
+    require(len(set(labels)) == len(labels), f"point labels must be distinct: {','.join(labels)}")
+    return Round(path.name, positions, labels, np.transpose(values, (1, 0, 2)).copy())
+
+
+def parse_positions(text: str) -> np.ndarray:
+    """``start:stop:count`` (inclusive, like ``numpy.linspace``) or a comma list of numbers."""
+    text = str(text).strip()
+    try:
+        if ":" in text:
+            a, b, c = text.split(":")
+            count = int(c)
+            require(count >= 2, f"--positions {text}: count must be at least 2")
+            return np.linspace(float(a), float(b), count)
+        vals = np.array([float(v) for v in text.split(",") if v.strip() != ""])
+    except ValueError:
+        raise InputError(f"--positions {text!r}: use start:stop:count or a comma list") from None
+    require(vals.size >= 2 and np.all(np.isfinite(vals)),
+            f"--positions {text!r}: needs at least two finite numbers")
+    return vals
+
+
+def check_rounds(rounds: list[Round]) -> None:
+    """Validate rounds for identification: three or more points, the same positions and the
+    same points in every round, finite values.  Raises :class:`InputError`."""
+    require(rounds, "no rounds of measurements")
+    first = rounds[0]
+    for r in rounds:
+        require(len(r.labels) >= 3, f"round {r.name}: {len(r.labels)} point(s) "
+                                    f"({','.join(r.labels)}); the method needs at least three "
+                                    f"non-collinear points")
+        require(r.positions.size >= 2, f"round {r.name}: needs at least two positions "
+                                       f"(the first is the reference)")
+        require(np.all(np.isfinite(r.points)), f"round {r.name}: NaN or infinite coordinates")
+        require(set(r.labels) == set(first.labels),
+                f"rounds {first.name} and {r.name} measure different points "
+                f"({','.join(first.labels)} vs {','.join(r.labels)})")
+        a, b = np.sort(first.positions), np.sort(r.positions)
+        if a.shape != b.shape or not np.allclose(a, b, rtol=0, atol=1e-9):
+            extra = sorted(set(b.tolist()) ^ set(a.tolist()))
+            raise InputError(f"rounds {first.name} and {r.name} have different positions "
+                             f"(e.g. {extra[0]:g} in one only); every round must visit the "
+                             f"same commanded positions")
+
+
+def example_path(axis: str):
+    """Path of the shipped example tracker data of axis X, Y or Z (simulated: three spindle
+    points, 11 positions, 4 rounds, 2 um noise, squareness EC0Y 20, EB0Z -15, EA0Z 10 urad;
+    generated by ``tests/helpers/tracker_sim.py:example_set``)."""
+    from importlib import resources
+
+    require(axis in ("X", "Y", "Z"), f"no example tracker data for axis {axis!r} (X, Y, Z)")
+    return resources.files("volerr") / "data" / f"tracker_example_{axis}.csv"

@@ -1,0 +1,18 @@
+"""Closing the loop: measured deviations in, declared model fitted, residual traced to candidate
+effects, the layout augmented, before/after reported on held-out points.  Steps: ``fit``
+(design and gauge), ``candidates``, ``run`` (selection and augmentation), ``report`` (HTML),
+``simulate`` (a virtual machine with undeclared effects).
+"""
+
+from volerr.loop.run import Report, read_deviations, run_loop
+
+__all__ = ["Report", "read_deviations", "run_loop"]
+
+
+def __getattr__(name):
+    # names of the former flat module volerr.loop, still importable from here
+    from volerr.loop import run as _m
+    try:
+        return getattr(_m, name)
+    except AttributeError:
+        raise AttributeError(f"module 'volerr.loop' has no attribute {name!r}") from None

@@ -1,0 +1,225 @@
+"""HTML report of ``volerr loop``: a jinja2 template with embedded matplotlib PNG figures.
+
+Figures (residuals of fits to all points, um): residual components against every axis and
+covariate before (declared model) and after (augmented model); each effect's evidence (partial
+residual -- the after-residual plus the effect's own contribution -- against the effect's
+natural variable, with the fitted contribution); error maps (residual length over the first
+two axes) before and after; the fitted component errors of every axis before and after (an
+unmodelled effect leaks into them).  The headline numbers are the held-out ones of the json report.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+
+import numpy as np
+
+from volerr.loop.fit import rotary_rad
+
+
+def _png(fig) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _thin(n: int, limit: int = 4000, seed: int = 0) -> np.ndarray:
+    """At most ``limit`` point indices (plots stay light)."""
+    if n <= limit:
+        return np.arange(n)
+    return np.sort(np.random.default_rng(seed).choice(n, limit, replace=False))
+
+
+def fig_residuals(fg) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    dat = fg["data"]
+    variables = {**dat.positions, **dat.covariates}
+    names = [v for v, x in variables.items() if np.ptp(x) > 0][:14]
+    idx = _thin(dat.n)
+    rb = fg["res_before"].reshape(-1, 3)[idx] * 1e3
+    ra = fg["res_after"].reshape(-1, 3)[idx] * 1e3
+    lim = max(np.percentile(np.abs(rb), 99.5), 1e-6) * 1.1
+    fig, axes = plt.subplots(len(names), 2, figsize=(10, 1.9 * len(names) + 0.6),
+                             squeeze=False, sharey=True)
+    colors = ("tab:red", "tab:green", "tab:blue")
+    for i, v in enumerate(names):
+        x = np.asarray(variables[v])[idx]
+        for j, (res, title) in enumerate(((rb, "before (declared model)"),
+                                          (ra, "after (augmented model)"))):
+            ax = axes[i, j]
+            for k in range(3):
+                ax.plot(x, res[:, k], ".", ms=2, alpha=0.5, color=colors[k],
+                        label="xyz"[k] if i == 0 and j == 0 else None)
+            ax.set_ylim(-lim, lim)
+            ax.axhline(0, color="k", lw=0.5)
+            ax.set_xlabel(v, labelpad=0)
+            if i == 0:
+                ax.set_title(title)
+            if j == 0:
+                ax.set_ylabel("residual, um")
+    axes[0, 0].legend(loc="upper right", fontsize=7, markerscale=4)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str]:
+    """The variable against which an effect is best seen."""
+    if kind == "thermal":
+        a, t = info["axis"], info["covariate"]
+        a0 = float(info.get("fixed_point_mm", 0.0))
+        label = f"({a} - {a0:g}) * ({t} - 20), mm K" if a0 else f"{a} * ({t} - 20), mm K"
+        return (dat.positions[a] - a0) * (dat.covariates[t] - 20.0), label
+    if kind in ("drift", "reversal") or kind == "setup":
+        c = info["covariate"]
+        return np.asarray(dat.covariates[c], dtype=float), c
+    if kind == "periodic":
+        a, p = info["axis"], info["period"]
+        return np.mod(dat.positions[a], p), f"{a} modulo {p:.3f}"
+    if kind == "coupling":
+        a, b = info["axis"], info["depends_on"]
+        ua = (2 * dat.positions[a] - np.ptp(dat.positions[a]) - 2 * dat.positions[a].min()) / \
+            max(np.ptp(dat.positions[a]), 1e-300)
+        ub = (2 * dat.positions[b] - np.ptp(dat.positions[b]) - 2 * dat.positions[b].min()) / \
+            max(np.ptp(dat.positions[b]), 1e-300)
+        return ua * ub, f"{a} * {b} (normalised)"
+    if kind == "higher_order":
+        a = info["axis"]
+        return dat.positions[a], a
+    if kind == "probe_direction":
+        return np.zeros(dat.n), "probing direction"
+    return np.arange(dat.n, dtype=float), "point"
+
+
+def fig_effect(fg, eff: dict) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    model, dat = fg["model"], fg["data"]
+    prob, coef, labels = fg["after_prob"], fg["c_all"], fg["aug_labels"]
+    col = {lab[0]: j for j, lab in enumerate(labels)}
+    contrib = np.zeros(3 * dat.n)
+    for p in eff["parameters"]:
+        j = col[p]
+        contrib += prob.A[:, j] * prob.scale[j] * coef[j]
+    c3 = contrib.reshape(-1, 3) * 1e3
+    partial = (fg["res_after"].reshape(-1, 3) * 1e3) + c3
+    values = {**rotary_rad(model, dat.positions), **dat.covariates}
+    x, xlabel = _natural(eff["kind"], eff["info"], model, dat, values)
+    if eff["kind"] == "probe_direction":
+        # along the probing direction: the component of the partial residual along n
+        names = eff["info"].get("covariates", ("nx", "ny", "nz"))
+        n = np.column_stack([dat.covariates[c] for c in names])
+        n = n / np.linalg.norm(n, axis=1, keepdims=True)
+        y, fit = np.sum(partial * n, axis=1), np.sum(c3 * n, axis=1)
+        x = np.arange(dat.n, dtype=float)
+        xlabel, ylabel = "point", "partial residual along probing direction, um"
+    else:
+        k = int(np.argmax(np.var(c3, axis=0)))
+        y, fit = partial[:, k], c3[:, k]
+        ylabel = f"partial residual d{'xyz'[k]}, um"
+    idx = _thin(dat.n)
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    jitter = 0.0
+    if eff["kind"] in ("reversal", "setup"):
+        jitter = np.random.default_rng(0).normal(0, 0.03 * max(np.ptp(x), 1.0), len(x))
+    ax.plot((x + jitter)[idx], y[idx], ".", ms=2, alpha=0.5, color="tab:gray",
+            label="partial residual")
+    order = np.argsort(x[idx])
+    ax.plot((x + jitter)[idx][order], fit[idx][order], ".", ms=2, color="tab:red",
+            label="fitted effect")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(f"{eff['kind']}: {eff['name']}")
+    ax.legend(fontsize=7, markerscale=4)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def fig_maps(fg) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    model, dat = fg["model"], fg["data"]
+    a, b = model.axes[0], model.axes[1]
+    idx = _thin(dat.n)
+    nb = np.linalg.norm(fg["res_before"].reshape(-1, 3), axis=1)[idx] * 1e3
+    na = np.linalg.norm(fg["res_after"].reshape(-1, 3), axis=1)[idx] * 1e3
+    vmax = max(np.percentile(nb, 99), 1e-6)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+    for ax, v, title in ((axes[0], nb, "before"), (axes[1], na, "after")):
+        sc = ax.scatter(dat.positions[a][idx], dat.positions[b][idx], c=v, s=8, cmap="viridis",
+                        vmin=0, vmax=vmax)
+        ax.set_title(f"residual length {title}, um")
+        ax.set_xlabel(a)
+        ax.set_aspect("equal", adjustable="datalim")
+    axes[0].set_ylabel(b)
+    fig.colorbar(sc, ax=axes, shrink=0.8, label="um")
+    return _png(fig)
+
+
+def fig_functions(report) -> str:
+    """The fitted component errors of every axis, declared fit (before) and augmented
+    fit (after, +-2 standard deviations)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    after, _ = report.error_tables()
+    before, _ = report.error_tables(which="before")
+    axes_names = list(after)
+    fig, axes = plt.subplots(2, len(axes_names), figsize=(3.6 * len(axes_names), 5.4),
+                             squeeze=False)
+    for i, a in enumerate(axes_names):
+        for row, (kind, f, unit) in enumerate((("XYZ", 1e3, "um"), ("ABC", 1e6, "urad"))):
+            ax = axes[row, i]
+            for k, (name, v) in enumerate(after[a].values.items()):
+                if name[1] not in kind:
+                    continue
+                color = f"C{k}"
+                q = after[a].positions
+                sd = after[a].std.get(name, np.zeros_like(v))
+                ax.plot(q, v * f, color=color, label=name)
+                ax.fill_between(q, (v - 2 * sd) * f, (v + 2 * sd) * f, color=color, alpha=0.2)
+                ax.plot(before[a].positions, before[a].values[name] * f, "--", color=color,
+                        lw=0.8)
+            ax.set_xlabel(a)
+            ax.set_ylabel(unit)
+            ax.legend(fontsize=6)
+    axes[0, 0].set_title("solid: after, dashed: before", fontsize=8, loc="left")
+    fig.tight_layout()
+    return _png(fig)
+
+
+def render_html(report) -> str:
+    """The complete HTML text of a :class:`volerr.loop.run.Report`."""
+    import jinja2
+
+    from importlib import resources
+
+    fg = report.figures
+    figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg),
+               "functions": fig_functions(report)}
+    effects = [{"e": e, "png": fig_effect(fg, e),
+                "params": [(p, v, e["std"][p], e["units"][p]) for p, v in e["parameters"].items()]}
+               for e in report.data["effects"]]
+    text = (resources.files("volerr.loop") / "templates" / "report.html.j2").read_text(
+        encoding="utf-8")
+    env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
+    return env.from_string(text).render(
+        r=report.data, figures=figures, effects=effects,
+        json_text=json.dumps({k: v for k, v in report.data.items()
+                              if k not in ("residual_analysis",)}, indent=1, default=str))

@@ -1,0 +1,81 @@
+"""Basis expressions of effect terms: parsed once, evaluated with numpy (no sympy, no eval).
+
+An effect term of a layout (``[effects.NAME]``, see :mod:`volerr.machine.layout`) multiplies a new
+parameter by a *basis expression* such as ``"X*(T_C - 20)"`` or ``"sin(2*pi*X/25.4)"``.  The
+same text is turned into sympy by the derivation (:mod:`volerr.derive.effects`) and evaluated
+here for the fitting loop, so both always agree.
+
+Grammar: numbers, names, ``+ - * / **``, unary minus, parentheses and the functions
+``sin cos exp sqrt abs``, ``ind(a, b)`` (1 where ``a == b``, else 0) and ``legendre(n, x)``
+(the Legendre polynomial of integer degree ``n``).  ``pi`` is the
+constant.  Every other name is a variable: an axis position (mm; rad for rotary axes, as in
+the derivation) or a covariate column of the measured data (``T_C``, ``t_s``, ``dir_X`` ...).
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+
+import numpy as np
+
+from volerr.errors import InputError
+
+FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "sqrt": np.sqrt, "abs": np.abs,
+             "ind": lambda a, b: (np.asarray(a) == np.asarray(b)).astype(float),
+             "legendre": lambda n, x: np.polynomial.legendre.legval(x, [0.0] * int(n) + [1.0])}
+CONSTANTS = {"pi": np.pi}
+_BINOPS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply,
+           ast.Div: np.divide, ast.Pow: np.power}
+
+
+@functools.lru_cache(maxsize=4096)
+def parse(text: str) -> ast.Expression:
+    """Parse and check a basis expression; raises :class:`InputError` when it is not allowed."""
+    try:
+        tree = ast.parse(str(text), mode="eval")
+    except SyntaxError:
+        raise InputError(f"basis expression {text!r} is not a valid expression") from None
+    for node in ast.walk(tree):
+        ok = isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.USub, ast.UAdd,
+                               ast.Name, ast.Load, ast.Call, *_BINOPS))
+        if isinstance(node, ast.Constant):
+            ok = isinstance(node.value, (int, float)) and not isinstance(node.value, bool)
+        if isinstance(node, ast.Call):
+            ok = (isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS
+                  and not node.keywords)
+        if not ok:
+            raise InputError(f"basis expression {text!r}: {type(node).__name__} not allowed")
+    return tree
+
+
+def variables(text: str) -> tuple[str, ...]:
+    """The variable names of a basis expression (positions and covariates), sorted."""
+    tree = parse(text)
+    names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+    return tuple(sorted(names - set(FUNCTIONS) - set(CONSTANTS)))
+
+
+def evaluate(text: str, values: dict) -> np.ndarray:
+    """Evaluate a basis expression with numpy; ``values`` maps every variable to an array."""
+    tree = parse(text)
+
+    def ev(node):
+        if isinstance(node, ast.Expression):
+            return ev(node.body)
+        if isinstance(node, ast.Constant):
+            return float(node.value)
+        if isinstance(node, ast.Name):
+            if node.id in CONSTANTS:
+                return CONSTANTS[node.id]
+            if node.id not in values:
+                raise InputError(f"basis expression {text!r} needs {node.id!r}")
+            return np.asarray(values[node.id], dtype=float)
+        if isinstance(node, ast.UnaryOp):
+            v = ev(node.operand)
+            return -v if isinstance(node.op, ast.USub) else v
+        if isinstance(node, ast.BinOp):
+            return _BINOPS[type(node.op)](ev(node.left), ev(node.right))
+        return FUNCTIONS[node.func.id](*(ev(a) for a in node.args))
+
+    return np.asarray(ev(tree), dtype=float)

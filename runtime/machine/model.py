@@ -1,0 +1,337 @@
+"""The runtime model: a generated module behind a small, validated API.
+
+Units: positions mm (linear) and deg (rotary), translational errors and probe offsets mm,
+angular errors rad, results mm.  Error = actual minus nominal position of the probe tip / tool
+centre point in the workpiece frame.  Importing this module does not import sympy; a layout
+given as a file path is derived on the fly (that path imports sympy).
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import types
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from volerr.errors import InputError, require
+from volerr.machine.derivation import derive_module
+from volerr.machine.layout import Layout, read_layout
+
+
+def _module_for(layout: Layout, name_or_path) -> types.ModuleType:
+    """The generated module of a shipped layout, or a freshly derived one for a layout file."""
+    shipped = (str(name_or_path).upper() == layout.name.upper()
+               and not str(name_or_path).endswith(".toml"))
+    if shipped:
+        try:
+            mod = importlib.import_module(f"volerr.generated.{layout.name.lower()}")
+        except ModuleNotFoundError:
+            mod = None
+        if mod is not None and mod.LAYOUT_SHA256 == layout.sha256:
+            return mod
+    return derive_module(layout)
+
+
+def _floats(value, what: str) -> np.ndarray:
+    """``value`` as a float array; anything that is not numbers raises InputError."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be numbers, got {value!r:.60}") from None
+
+
+def _case_insensitive(given: dict, names) -> dict:
+    """Keys that match one of ``names`` only up to case (``x``, ``exx``) get its spelling."""
+    upper = {}
+    for n in names:
+        upper.setdefault(n.upper(), []).append(n)
+    out = {}
+    for k, v in given.items():
+        if k not in names and isinstance(k, str) and len(upper.get(k.upper(), ())) == 1:
+            k = upper[k.upper()][0]
+        if k in out:
+            raise InputError(f"{k} given twice (names are case-insensitive)")
+        out[k] = v
+    return out
+
+
+def _columns(components, n: int) -> np.ndarray:
+    """Generated outputs (tuple of broadcastable arrays) -> (n, len) float array."""
+    return np.stack([np.broadcast_to(c, (n,)) for c in components], axis=-1).astype(
+        float, copy=False)
+
+
+@dataclass
+class Model:
+    """A machine's error model. Create with :func:`load`."""
+
+    layout: Layout
+    module: types.ModuleType
+
+    # ---- description -------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.layout.name
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """Axis names in position-array column order."""
+        return tuple(self.module.AXES)
+
+    @property
+    def rotary_axes(self) -> tuple[str, ...]:
+        return tuple(self.module.ROTARY_AXES)
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """ISO 230-1 names of the error parameters, in model order."""
+        return tuple(self.module.PARAMETERS)
+
+    @property
+    def parameter_axis(self) -> dict:
+        """Parameter -> axis whose position it depends on (None for constants)."""
+        return dict(self.module.PARAMETER_AXIS)
+
+    @property
+    def paper_symbols(self) -> dict:
+        """ISO name -> symbol (with sign) used for it in the source document of the layout."""
+        return dict(self.layout.paper_symbols)
+
+    @property
+    def covariates(self) -> tuple[str, ...]:
+        """Covariates of declared effects (``T_C``, ``t_s`` ...): extra inputs, () usually."""
+        return tuple(getattr(self.module, "COVARIATES", ()))
+
+    @property
+    def travel(self) -> dict:
+        """Axis -> (min, max) travel, mm or deg."""
+        return {a: self.layout.axes[a].travel for a in self.axes}
+
+    # ---- input handling ----------------------------------------------------------
+    def positions(self, positions) -> dict:
+        """Validate positions (dict or (N, n_axes) array, mm/deg) -> dict of float arrays,
+        rotary axes converted to rad."""
+        if isinstance(positions, Mapping):
+            positions = _case_insensitive(dict(positions), self.axes)
+            unknown = set(positions) - set(self.axes)
+            if unknown:
+                raise InputError(f"{self.name}: unknown axis {sorted(unknown, key=str)[0]!r}; "
+                                 f"axes are {' '.join(self.axes)}")
+            missing = [a for a in self.axes if a not in positions]
+            if missing:
+                raise InputError(f"{self.name}: positions lack axis {missing[0]}")
+            cols = {a: _floats(positions[a], f"position {a}") for a in self.axes}
+        else:
+            arr = _floats(positions, "positions")
+            if arr.ndim == 1:
+                arr = arr[None, :]
+            require(arr.ndim == 2 and arr.shape[1] == len(self.axes),
+                    f"{self.name}: positions must have {len(self.axes)} columns "
+                    f"({' '.join(self.axes)}), got shape {arr.shape}")
+            cols = dict(zip(self.axes, np.ascontiguousarray(arr.T)))
+        for a, v in cols.items():
+            if not np.isfinite(v).all():
+                raise InputError(f"{self.name}: position {a} has NaN or infinite values")
+        try:
+            shape = np.broadcast_shapes(*(np.shape(v) for v in cols.values()))
+        except ValueError:
+            raise InputError(f"{self.name}: positions of the axes differ in length: " + ", ".join(
+                f"{a} {np.size(v)}" for a, v in cols.items())) from None
+        out = {}
+        for a, v in cols.items():
+            if v.shape != shape or v.ndim != 1:
+                v = np.broadcast_to(v, shape).ravel() if shape else np.atleast_1d(v)
+            out[a] = np.deg2rad(v) if a in self.rotary_axes else v
+        return out
+
+    def _points(self, positions) -> tuple[dict, int]:
+        """Validated positions (see :meth:`positions`) and their number of points."""
+        pos = self.positions(positions)
+        return pos, len(next(iter(pos.values())))
+
+    def _probe(self, probe, n: int) -> dict:
+        p = _floats(probe, "probe offset")
+        require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
+        require(np.all(np.isfinite(p)), "probe offset has NaN values")
+        if p.shape == (3,):  # one offset for all points: scalars broadcast in the generated code
+            return {"Xp": float(p[0]), "Yp": float(p[1]), "Zp": float(p[2])}
+        return {"Xp": p[:, 0], "Yp": p[:, 1], "Zp": p[:, 2]}
+
+    def _covariates(self, covariates, n: int) -> dict:
+        """Covariate values for a model with declared effects ({} for the others)."""
+        covariates = dict(covariates or {})
+        out = {}
+        for c in self.covariates:
+            require(c in covariates, f"{self.name}: covariate {c} is needed (declared effects)")
+            v = _floats(covariates[c], f"covariate {c}")
+            require(v.shape in ((), (n,), (1,)), f"covariate {c} must be a scalar or ({n},) array")
+            require(np.all(np.isfinite(v)), f"covariate {c} has NaN or infinite values")
+            out[c] = v
+        return out
+
+    def _errors(self, errors, n: int) -> dict:
+        require(errors is None or isinstance(errors, Mapping),
+                f"errors must be a dict {{name: value}}, got {type(errors).__name__}")
+        errors = _case_insensitive(dict(errors or {}), self.parameters)
+        unknown = set(errors) - set(self.parameters)
+        if unknown:
+            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown, key=str)[0]!r}")
+        out = {}
+        for p in self.parameters:
+            v = _floats(errors.get(p, 0.0), f"error {p}")
+            require(v.shape in ((), (n,), (1,)), f"error {p} must be a scalar or ({n},) array")
+            out[p] = v
+        return out
+
+    @staticmethod
+    def _check_finite(result: np.ndarray, inputs: dict) -> np.ndarray:
+        """NaN in any input propagates to the result: check once there, then name the input."""
+        if not np.isfinite(result).all():
+            for name, v in inputs.items():
+                if not np.all(np.isfinite(v)):
+                    raise InputError(f"error {name} has NaN or infinite values")
+            raise InputError("the model evaluated to NaN or infinity (values too large?)")
+        return result
+
+    # ---- evaluation --------------------------------------------------------------
+    def volumetric_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
+                         direction=None, probe_error=None, covariates=None) -> np.ndarray:
+        """First-order volumetric error, (N, 3) mm.
+
+        ``errors``: {name: scalar or (N,)} in mm / rad, missing names are zero.  ``probe``:
+        probe/tool offset (3,) or (N, 3) mm.  ``direction`` (N, 3) probing direction and
+        ``probe_error`` (a callable of directions giving mm, or an (N,) array) combine the
+        probe error as Pahk eq. (17): the error along the probing direction is subtracted."""
+        pos, n = self._points(positions)
+        errs = self._errors(errors, n)
+        e = self.module.volumetric_error(**pos, **self._covariates(covariates, n),
+                                         **self._probe(probe, n), **errs)
+        out = self._check_finite(_columns(e, n), errs)
+        if direction is not None or probe_error is not None:
+            out = out - self._probe_term(direction, probe_error, n)
+        return out
+
+    def _probe_term(self, direction, probe_error, n: int) -> np.ndarray:
+        require(direction is not None and probe_error is not None,
+                "combined model needs both a probing direction and a probe error")
+        m = _floats(direction, "probing direction")
+        require(m.shape in ((3,), (n, 3)), f"probing direction must be (3,) or ({n}, 3), "
+                                           f"got {m.shape}")
+        require(np.all(np.isfinite(m)), "probing direction has NaN or infinite values")
+        m = np.broadcast_to(m, (n, 3))
+        norm = np.linalg.norm(m, axis=1, keepdims=True)
+        require(np.all(norm > 0), "probing direction must not be the zero vector")
+        m = m / norm
+        value = probe_error(m) if callable(probe_error) else probe_error
+        value = _floats(value, "probe error")
+        require(value.shape in ((), (1,), (n,)), f"probe error must be a scalar or ({n},) "
+                                                 f"array, got {value.shape}")
+        require(np.all(np.isfinite(value)), "probe error has NaN or infinite values")
+        value = np.broadcast_to(value, (n,))
+        return value[:, None] * m
+
+    def exact_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
+                    covariates=None) -> np.ndarray:
+        """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
+        pos, n = self._points(positions)
+        errs = self._errors(errors, n)
+        e = self.module.exact_error(**pos, **self._covariates(covariates, n),
+                                    **self._probe(probe, n), **errs)
+        return self._check_finite(_columns(e, n), errs)
+
+    def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
+        """d(error)/d(parameter), (N, 3, n_parameters): mm/mm or mm/rad."""
+        pos, n = self._points(positions)
+        return self._sensitivity(pos, n, probe, covariates)
+
+    def _sensitivity(self, pos: dict, n: int, probe, covariates) -> np.ndarray:
+        s = self.module.sensitivity(**pos, **self._covariates(covariates, n),
+                                    **self._probe(probe, n))
+        return np.moveaxis(np.broadcast_to(s, s.shape[:2] + (n,)), -1, 0)
+
+    def random_error(self, positions, sigmas, probe=(0.0, 0.0, 0.0),
+                     method: str = "exact", covariates=None) -> np.ndarray:
+        """Standard uncertainty of the volumetric error, (N, 3) mm.
+
+        ``sigmas``: {name: standard deviation (mm / rad), scalar or (N,)}.  ``method="exact"``
+        is first-order propagation sqrt(sum((dD/dp)^2 sigma_p^2)); ``"termwise"`` is Pahk's
+        printed quadrature (eq. 5, 8), which squares each term alone and drops cross terms."""
+        require(method in ("exact", "termwise"), f"unknown random-error method {method!r}")
+        pos, n = self._points(positions)
+        sig = self._errors(sigmas, n)
+        self._check_finite(np.stack([np.broadcast_to(v, (n,)) for v in sig.values()]), sig)
+        for k, v in sig.items():
+            require(np.all(v >= 0), f"standard deviation {k} must not be negative")
+        if method == "termwise":
+            r = self.module.random_error_termwise(
+                **pos, **self._covariates(covariates, n), **self._probe(probe, n),
+                **{f"s_{k}": v for k, v in sig.items()})
+            return _columns(r, n)
+        s = self._sensitivity(pos, n, probe, covariates)
+        var = np.stack([np.broadcast_to(sig[p], (n,)) for p in self.parameters], axis=-1) ** 2
+        return np.sqrt(np.einsum("nij,nj->ni", s ** 2, var))
+
+    def transfer(self, measured: dict, offsets, angular: dict | None = None) -> dict:
+        """Re-reference errors measured at an offset (Pahk sec. 2.3).
+
+        ``measured``: {name: value (mm or rad), scalar or array} as measured with the
+        functional point at ``offsets`` = (Xo, Yo, Zo) mm from the axis' reference point (for
+        squareness: measured at that position).  ``angular``: the angular errors (rad) there,
+        defaulting to the values in ``measured``.  Returns the reference values; parameters
+        without a transfer rule pass through unchanged."""
+        require(hasattr(self.module, "transfer_shift"), f"{self.name} has no transfer rules")
+        measured = _case_insensitive(dict(measured), self.parameters)
+        angular = _case_insensitive(dict(angular), self.parameters) if angular else angular
+        unknown = set(measured) - set(self.parameters)
+        if unknown:
+            raise InputError(f"{self.name}: unknown error parameter {sorted(unknown, key=str)[0]!r}")
+        try:
+            o = np.asarray(offsets, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("offsets must be (Xo, Yo, Zo) numbers, mm") from None
+        require(o.shape[-1:] == (3,), "offsets must be (Xo, Yo, Zo)")
+        require(np.all(np.isfinite(o)), "offsets have NaN or infinite values")
+        values = {**{p: 0.0 for p in self.parameters}, **measured, **(angular or {})}
+        args = inspect.signature(self.module.transfer_shift).parameters
+        kw = {a: values[a] for a in args if a not in ("Xo", "Yo", "Zo")}
+        shift = self.module.transfer_shift(Xo=o[..., 0], Yo=o[..., 1], Zo=o[..., 2], **kw)
+        return {k: np.asarray(v) - (np.asarray(shift[k]) if k in shift else 0.0)
+                for k, v in measured.items()}
+
+    def nominal_position(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Nominal probe/tool tip in the workpiece frame, (N, 3) mm."""
+        pos, n = self._points(positions)
+        return _columns(self.module.nominal_position(**pos, **self._probe(probe, n)), n)
+
+    def forward(self, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Nominal tool tip and tool axis in the workpiece frame, (N, 6) = x, y, z, i, j, k."""
+        pos, n = self._points(positions)
+        tip = self.module.nominal_position(**pos, **self._probe(tool, n))
+        return np.concatenate([_columns(tip, n), _columns(self.module.tool_axis(**pos), n)],
+                              axis=1)
+
+    def inverse(self, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
+        """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
+        axis ``target`` (N, 6) = x, y, z, i, j, k; ``near`` picks the branch, the turn and an
+        undetermined rotary axis (see :func:`volerr.fiveaxis.kinematics.inverse`)."""
+        from volerr.fiveaxis.kinematics import inverse
+
+        return inverse(self, target, tool, near)
+
+    def orientation_error(self, positions, errors=None, covariates=None) -> np.ndarray:
+        """First-order error of the tool-axis direction, (N, 3), rad."""
+        pos, n = self._points(positions)
+        errs = self._errors(errors, n)
+        e = self.module.orientation_error(**pos, **self._covariates(covariates, n), **errs)
+        return self._check_finite(_columns(e, n), errs)
+
+
+def load(name_or_path) -> Model:
+    """Load a shipped layout's generated model by name, or derive one from a layout file."""
+    layout = read_layout(name_or_path)
+    if not isinstance(layout, Layout):  # pragma: no cover - defensive
+        raise InputError(f"not a layout: {name_or_path}")
+    return Model(layout, _module_for(layout, name_or_path))

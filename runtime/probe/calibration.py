@@ -1,0 +1,778 @@
+"""Probe (lobing) error: master-sphere calibration and the probe error map (Pahk sec. 3).
+
+Conventions (stated once, used everywhere in volerr)
+----------------------------------------------------
+* Probe frame: tilt ``A`` and roll ``B`` of the probe head (deg at the API) define the probe
+  frame (x', y', z') of Pahk eq. (11), z' along the stylus towards the head; the transforms
+  are derived in :mod:`volerr.derive.probe` and generated into :mod:`volerr.generated.probe`.
+  A vertical probe (A = 0) has the machine frame as its probe frame, whatever the roll B.
+* Probing direction ``M`` (unit vector): the outward normal of the probed surface at the
+  contact, i.e. from the contact point towards the stylus-ball centre.  On the master sphere it
+  is the direction from the sphere centre to the recorded ball centre, so the pole (phi = 0) is
+  the point probed straight along the stylus.  ``phi`` = angle from the probe axis z' (eq. 15),
+  ``theta`` = azimuth from x' in [0, 360) deg (eq. 16).  The approach motion is ``-M``.
+* Eq. (13): ``R_eff - Probe(phi, theta) = R_m - R_s`` with ``R_m`` the distance of the
+  recorded ball centre from the fitted sphere centre and ``R_s`` the master-sphere radius.  The
+  least-squares sphere fit of the ball centres gives the centre and the radius ``R_fit`` =
+  mean(R_m) (the normal equation of the radius), so ``R_eff = R_fit - R_s`` and
+  ``Probe_i = R_eff - (R_m,i - R_s)``: positive where the probe triggers late (more
+  pretravel, the ball centre recorded nearer the surface).
+* What the sphere fit absorbs: the part of the true pretravel pattern that is constant or
+  linear in the direction (1, Mx, My, Mz) over the probed points cannot be told from the
+  ball radius and the sphere centre; it goes into R_eff and the centre (on Pahk's hemisphere
+  plan a pattern growing with phi moves the centre along the probe axis by several um).  That
+  is the probe's effective centre and radius -- what a stylus qualification uses -- so the
+  along-normal error of a measured point is still -Probe(M); the reported u(centre), u(R_eff)
+  are Type A (scatter about the map) and do not include this definitional part.
+* Eq. (17): a point measured with probing direction ``M`` is in error by ``-Probe(M) M``, which
+  :meth:`volerr.Model.volumetric_error` subtracts (``direction=M, probe_error=probe_map``).
+* Units: mm and deg at the API, um in files' ``_um`` columns and in reports.
+
+The smooth map is a least-squares fit of real spherical harmonics of degree <= L (L chosen by
+generalised cross-validation within what the number of points supports, or given), with a tiny
+smoothness (Laplace-Beltrami) ridge so that directions the data do not constrain stay quiet.
+It handles the pole and the theta wrap-around by construction and is evaluated in any
+direction; directions beyond the probed range of phi are refused (or clamped) rather than
+silently extrapolated.  Outliers are flagged by a robust (MAD) test on the leave-one-out
+residuals of the map and kept, unless the caller asks to exclude them.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from volerr.errors import InputError, require
+
+#: largest plausible effective stylus-ball radius, mm (a sphere radius that implies more is wrong)
+MAX_BALL_RADIUS_MM = 25.0
+#: smallest plausible effective stylus-ball radius, mm
+MIN_BALL_RADIUS_MM = 0.005
+#: fewest points the calibration accepts: 4 sphere unknowns plus redundancy for the error map
+MIN_POINTS = 6
+#: robust outlier threshold: studentised residual of a bisquare map fit > k robust sigmas
+OUTLIER_K = 5.0
+#: floor of the robust scale (mm): below it residuals are numerical, not noise
+SCALE_FLOOR_MM = 5e-5
+#: points whose out-of-plane RMS spread is below this fraction of their in-plane spread lie on
+#: "one plane": a sphere through them is fixed only by their noise or lobing
+PLANE_RATIO = 2e-3
+#: largest condition number of the sphere-fit Jacobian (a cap of ~6 deg half-angle reaches it)
+MAX_CONDITION = 1e3
+#: smoothness ridge of the map fit, relative to the mean diagonal of the normal matrix
+RIDGE = 1e-4
+#: largest map degree considered by the automatic choice
+MAX_DEGREE = 8
+#: tolerance on the probed phi range when evaluating the map, deg
+COVERAGE_TOL_DEG = 2.0
+
+
+def _gen():
+    from volerr.generated import probe as gen  # numpy only
+
+    return gen
+
+
+def _flat_angles(phi_deg, theta_deg):
+    """(phi, theta) broadcast together and flattened, and their common shape."""
+    phi = np.asarray(phi_deg, dtype=float)
+    theta = np.asarray(theta_deg, dtype=float)
+    shape = np.broadcast_shapes(phi.shape, theta.shape)
+    return np.broadcast_to(phi, shape).ravel(), np.broadcast_to(theta, shape).ravel(), shape
+
+
+# ---- frames and directions ---------------------------------------------------------------
+def _head_angles_rad(tilt_deg, roll_deg):
+    """(tilt, roll) in rad.  A vertical probe (tilt 0) has the machine frame as its probe frame
+    whatever the roll: eq. (11)'s cross product vanishes there, and the roll of a vertical
+    stylus is not part of the probe frame (it is 0 here, where the closed form of eq. 11 gives
+    the machine frame)."""
+    t = np.radians(np.asarray(tilt_deg, dtype=float))
+    r = np.where(t == 0.0, 0.0, np.radians(np.asarray(roll_deg, dtype=float)))
+    return (float(t), float(r)) if t.ndim == 0 and r.ndim == 0 else (t, r)
+
+
+def machine2probe(tilt_deg: float = 0.0, roll_deg: float = 0.0) -> np.ndarray:
+    """Tp of eq. (12) as stated (``v_probe = machine2probe @ v_machine``), (3, 3)."""
+    return _gen().machine2probe(*_head_angles_rad(tilt_deg, roll_deg))
+
+
+def probe2machine(tilt_deg: float = 0.0, roll_deg: float = 0.0) -> np.ndarray:
+    """Columns e'_x, e'_y, e'_z of eq. (11) (``v_machine = probe2machine @ v_probe``), (3, 3)."""
+    return _gen().probe2machine(*_head_angles_rad(tilt_deg, roll_deg))
+
+
+def angles_of(directions_machine, tilt_deg=0.0, roll_deg=0.0):
+    """Machine-frame directions, shape (n, 3) (any length) -> (phi_deg, theta_deg) in the
+    probe frame (eq. 14-16); tilt/roll scalars or (n,) arrays (deg)."""
+    d = np.atleast_2d(np.asarray(directions_machine, dtype=float))
+    gen = _gen()
+    mp = gen.direction_to_probe(*_head_angles_rad(tilt_deg, roll_deg),
+                                d[:, 0], d[:, 1], d[:, 2])
+    phi, theta = gen.direction_angles(*mp)
+    theta = np.degrees(theta)
+    return np.degrees(phi), np.where(theta >= 360.0, theta - 360.0, theta)
+
+
+def directions_of(phi_deg, theta_deg, tilt_deg=0.0, roll_deg=0.0):
+    """Probe-frame angles (deg) -> machine-frame unit vectors, shape (n, 3); tilt/roll
+    scalars or arrays broadcasting with the angles (deg)."""
+    gen = _gen()
+    m = gen.direction_to_machine(*_head_angles_rad(tilt_deg, roll_deg),
+                                 np.radians(np.asarray(phi_deg, dtype=float)),
+                                 np.radians(np.asarray(theta_deg, dtype=float)))
+    return np.stack(m, axis=-1)
+
+
+# ---- input ---------------------------------------------------------------------------------
+@dataclass
+class SphereData:
+    """Master-sphere probing data: ball centres (n, 3) mm and optional nominal directions."""
+
+    points: np.ndarray
+    phi_deg: np.ndarray | None = None
+    theta_deg: np.ndarray | None = None
+    source: str = ""
+
+
+def _float(text: str, where: str) -> float:
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: not a number: {text!r}") from None
+
+
+def read_sphere_csv(path) -> SphereData:
+    """Read ``x,y,z[,phi_deg,theta_deg]`` (mm, deg); other columns are ignored."""
+    path = Path(path)
+    require(path.is_file(), f"{path}: no such file")
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:
+            rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a text CSV file") from None
+    except csv.Error as exc:
+        raise InputError(f"{path}: malformed CSV: {exc}") from None
+    require(rows, f"{path}: empty file")
+    header = [h.strip().lower() for h in rows[0]]
+    alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
+    header = [alias.get(h, h) for h in header]
+    dup = [c for c in ("x", "y", "z", "phi_deg", "theta_deg") if header.count(c) > 1]
+    require(not dup, f"{path}: column {dup[0]!r} appears twice" if dup else "")
+    missing = [c for c in ("x", "y", "z") if c not in header]
+    if missing:
+        raise InputError(f"{path}: missing column {missing[0]!r} (need x,y,z in mm, "
+                         f"optional phi_deg,theta_deg)")
+    for bad, good in (("phi", "phi_deg"), ("theta", "theta_deg"), ("phi_rad", "phi_deg"),
+                      ("theta_rad", "theta_deg")):
+        require(bad not in header, f"{path}: column {bad!r}: give the angles as {good} (deg)")
+    has_phi, has_theta = "phi_deg" in header, "theta_deg" in header
+    require(has_phi == has_theta, f"{path}: give both phi_deg and theta_deg or neither")
+    cols = ["x", "y", "z"] + (["phi_deg", "theta_deg"] if has_phi else [])
+    idx = [header.index(c) for c in cols]
+    data = []
+    for k, r in enumerate(rows[1:], start=2):
+        require(len(r) >= len(header) or len(r) > max(idx),
+                f"{path}: line {k}: {len(r)} fields, header has {len(header)}")
+        data.append([_float(r[i].strip(), f"{path}: line {k}, column {c}")
+                     for i, c in zip(idx, cols)])
+    require(data, f"{path}: no data rows")
+    arr = np.asarray(data, dtype=float)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise InputError(f"{path}: line {i + 2}, column {cols[j]}: NaN or infinite value")
+    if has_phi:
+        require(np.all((arr[:, 3] >= 0) & (arr[:, 3] <= 180)),
+                f"{path}: phi_deg must lie in [0, 180] (angle from the probe axis)")
+        return SphereData(arr[:, :3], arr[:, 3], np.mod(arr[:, 4], 360.0), str(path))
+    return SphereData(arr[:, :3], source=str(path))
+
+
+# ---- sphere fit ------------------------------------------------------------------------------
+@dataclass
+class SphereFit:
+    """Least-squares sphere: centre (3,) mm, radius mm, residuals |p - c| - r (n,) mm."""
+
+    center: np.ndarray
+    radius: float
+    residuals: np.ndarray
+    condition: float
+    iterations: int
+    cov_unit: np.ndarray  # inv(J'J) of (cx, cy, cz, r): covariance per unit residual variance
+
+
+def check_sphere_points(points) -> np.ndarray:
+    """Validate ball centres for a sphere fit (count, finiteness, not all on one plane)."""
+    p = np.asarray(points, dtype=float)
+    require(p.ndim == 2 and p.shape[1] == 3, f"points must be (n, 3), got shape {p.shape}")
+    require(np.all(np.isfinite(p)), "points contain NaN or infinite values")
+    n = len(p)
+    require(n >= MIN_POINTS, f"{n} points: the calibration needs at least {MIN_POINTS} "
+                             "(4 sphere unknowns plus redundancy for the probe error map)")
+    s = np.linalg.svd(p - p.mean(axis=0), compute_uv=False) / math.sqrt(n)
+    require(s[0] > 1e-9, "all points coincide: no sphere can be fitted")
+    require(s[2] > PLANE_RATIO * s[0],
+            f"all {n} points lie on one plane (a single circle, out-of-plane spread "
+            f"{s[2] * 1e3:.2g} um): the sphere is undetermined; probe several latitudes")
+    return p
+
+
+def _algebraic_sphere(p: np.ndarray):
+    """Linear (Kasa) fit |p|^2 = 2 c.p + k: the starting point of the geometric fit."""
+    mu = p.mean(axis=0)
+    q = p - mu
+    a = np.column_stack([2 * q, np.ones(len(q))])
+    b = np.sum(q * q, axis=1)
+    sol, *_ = np.linalg.lstsq(a, b, rcond=None)
+    c = sol[:3]
+    r2 = sol[3] + c @ c
+    require(r2 > 0, "the points do not lie on a sphere (algebraic fit has no real radius)")
+    return c + mu, math.sqrt(r2)
+
+
+def fit_sphere(points, max_iter: int = 50) -> SphereFit:
+    """Geometric least-squares sphere (minimises sum(|p_i - c| - r)^2) by Gauss-Newton from
+    the algebraic fit.  At the optimum r = mean |p_i - c|."""
+    p = check_sphere_points(points)
+    c, r = _algebraic_sphere(p)
+    scale = r
+    it = 0
+    for it in range(1, max_iter + 1):
+        d = p - c
+        dist = np.linalg.norm(d, axis=1)
+        require(np.all(dist > 0), "a point coincides with the fitted sphere centre")
+        res = dist - r
+        jac = np.column_stack([-d / dist[:, None], -np.ones(len(p))])
+        step, *_ = np.linalg.lstsq(jac, -res, rcond=None)
+        c = c + step[:3]
+        r = r + step[3]
+        if np.max(np.abs(step)) < 1e-13 * max(scale, 1.0):
+            break
+    d = p - c
+    dist = np.linalg.norm(d, axis=1)
+    jac = np.column_stack([-d / dist[:, None], -np.ones(len(p))])
+    sv = np.linalg.svd(jac, compute_uv=False)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    require(cond < MAX_CONDITION,
+            f"the points cover too little of the sphere to fit it (condition number "
+            f"{cond:.3g}); probe a wider range of latitudes")
+    return SphereFit(c, float(dist.mean()), dist - dist.mean(), cond, it,
+                     np.linalg.inv(jac.T @ jac))
+
+
+# ---- spherical-harmonic map -----------------------------------------------------------------
+def sh_design(degree: int, phi, theta) -> np.ndarray:
+    """Real orthonormal spherical harmonics Y_lm, l <= degree, at (phi, theta) rad:
+    shape (n, (degree + 1)^2), column order l = 0..L, m = -l..l."""
+    from scipy.special import lpmv
+
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    theta = np.atleast_1d(np.asarray(theta, dtype=float))
+    x = np.cos(phi)
+    cols = []
+    for ll in range(degree + 1):
+        for m in range(-ll, ll + 1):
+            am = abs(m)
+            norm = math.sqrt((2 * ll + 1) / (4 * math.pi)
+                             * math.factorial(ll - am) / math.factorial(ll + am))
+            leg = lpmv(am, ll, x)
+            if m == 0:
+                cols.append(norm * leg)
+            elif m > 0:
+                cols.append(math.sqrt(2) * norm * leg * np.cos(am * theta))
+            else:
+                cols.append(math.sqrt(2) * norm * leg * np.sin(am * theta))
+    return np.column_stack(cols)
+
+
+def _degrees_of(degree: int) -> np.ndarray:
+    return np.concatenate([[ll] * (2 * ll + 1) for ll in range(degree + 1)]).astype(float)
+
+
+@dataclass
+class SHFit:
+    """A fitted spherical-harmonic expansion (values in mm)."""
+
+    degree: int
+    coefficients: np.ndarray
+    fitted: np.ndarray
+    gcv: float
+    dof: float
+    hat: np.ndarray      # w_i q_i: diagonal of the (weighted) hat matrix
+    q: np.ndarray        # x_i' A^-1 x_i
+    weights: np.ndarray
+
+    def loo_t(self, values, sigma: float = 1.0) -> np.ndarray:
+        """Leave-one-out prediction residuals over their standard deviation: residual
+        r / (1 - w q) over sigma sqrt(1 + q / (1 - w q)) (Sherman-Morrison), so that a point
+        already down-weighted to zero is judged like any other."""
+        one = np.clip(1.0 - self.weights * self.q, 1e-9, None)
+        return (values - self.fitted) / one / (sigma * np.sqrt(1.0 + self.q / one))
+
+    def __call__(self, phi, theta) -> np.ndarray:
+        return sh_design(self.degree, phi, theta) @ self.coefficients
+
+
+def _ridge_fit(degree: int, phi, theta, values, weights=None, ridge: float = RIDGE) -> SHFit:
+    """(Weighted) least squares with the smoothness ridge ``lam * l(l+1) c_lm^2``,
+    ``lam = ridge * trace(X'WX) / n_coefficients``."""
+    x = sh_design(degree, phi, theta)
+    n, p = x.shape
+    wts = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
+    ll = _degrees_of(degree)
+    xw = x * wts[:, None]
+    xtx = x.T @ xw
+    lam = ridge * np.trace(xtx) / p
+    a = xtx + lam * np.diag(ll * (ll + 1))
+    coef = np.linalg.solve(a, xw.T @ values)
+    q = np.einsum("ij,ji->i", x, np.linalg.solve(a, x.T))  # x_i' A^-1 x_i
+    hat_diag = wts * q
+    fitted = x @ coef
+    res = values - fitted
+    dof = float(hat_diag.sum())
+    gcv = n * float(res @ (wts * res)) / max(n - dof, 1e-9) ** 2
+    return SHFit(degree, coef, fitted, gcv, dof, hat_diag, q, wts)
+
+
+def robust_flags(degree: int, phi, theta, values, k: float = OUTLIER_K, iterations: int = 50):
+    """Outlier flags from a Tukey-bisquare (IRLS) fit of the map: a point is flagged when its
+    leave-one-out residual exceeds ``k`` of its standard deviations (:meth:`SHFit.loo_t`).
+    Sigma is 1.4826 MAD of the studentised residuals of the plain fit (floored at
+    :data:`SCALE_FLOOR_MM`), held fixed while the weights iterate.  Returns (flags, sigma)."""
+    f = _ridge_fit(degree, phi, theta, values)
+    t = f.loo_t(values)
+    sigma = max(1.4826 * float(np.median(np.abs(t - np.median(t)))), SCALE_FLOOR_MM)
+    w = np.ones(len(values))
+    for _ in range(iterations):
+        u = f.loo_t(values, sigma) / 4.685
+        w_new = np.where(np.abs(u) < 1.0, (1.0 - u ** 2) ** 2, 0.0)
+        if np.max(np.abs(w_new - w)) < 1e-6:
+            break
+        w = w_new
+        f = _ridge_fit(degree, phi, theta, values, w)
+    return np.abs(f.loo_t(values, sigma)) > k, sigma
+
+
+def max_degree_for(n_points: int) -> int:
+    """Largest degree the automatic choice considers: at most half the points as coefficients."""
+    return int(max(0, min(MAX_DEGREE, math.floor(math.sqrt(n_points / 2.0)) - 1)))
+
+
+def fit_sh(phi, theta, values, degree: int | None = None) -> SHFit:
+    """Fit a real spherical-harmonic map to values (mm) at (phi, theta) rad.  ``degree=None``
+    chooses it by generalised cross-validation over 0..:func:`max_degree_for`."""
+    n = len(values)
+    if degree is not None:
+        require(degree >= 0, f"map degree must be >= 0, got {degree}")
+        require((degree + 1) ** 2 <= n,
+                f"map degree {degree} has {(degree + 1) ** 2} coefficients, more than the "
+                f"{n} points")
+        return _ridge_fit(degree, phi, theta, values)
+    fits = [_ridge_fit(d, phi, theta, values) for d in range(max_degree_for(n) + 1)]
+    best = min(fits, key=lambda f: f.gcv)
+    # prefer the lowest degree whose GCV is within 2 % of the best (parsimony)
+    for f in fits:
+        if f.gcv <= 1.02 * best.gcv:
+            return f
+    return best  # pragma: no cover
+
+
+# ---- the probe error map ------------------------------------------------------------------
+def _unit_of(phi_deg, theta_deg) -> np.ndarray:
+    p, t = np.radians(phi_deg), np.radians(theta_deg)
+    return np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=-1)
+
+
+def coverage_of(phi_deg, theta_deg) -> float:
+    """Coverage radius of probed directions, deg: 1.5 x the largest nearest-neighbour angle
+    (at least 5 deg)."""
+    u = _unit_of(phi_deg, theta_deg)
+    if len(u) < 2:
+        return 5.0
+    dots = u @ u.T
+    np.fill_diagonal(dots, -2.0)
+    nn = np.degrees(np.arccos(np.clip(dots.max(axis=1), -1.0, 1.0)))
+    return float(max(1.5 * nn.max(), 5.0))
+
+
+
+@dataclass
+class ProbeMap:
+    """Smooth probe error Probe(phi, theta) (mm) of a probe, in its own frame.
+
+    ``probe_map(directions)`` takes machine-frame probing directions, shape (n, 3) (outward
+    surface normals, see the module docstring), converts them to the probe frame of tilt
+    ``tilt_deg`` and roll ``roll_deg`` (eq. 14-16) and returns Probe in mm, shape (n,).  It is
+    the ``probe_error`` argument of :meth:`volerr.Model.volumetric_error` (eq. 17).
+
+    Coverage: a direction is *outside* when its phi lies beyond the probed range
+    ``phi_range_deg`` (+- 2 deg), or when it is farther than ``coverage_deg`` from every probed
+    direction ``support_deg`` (a hole in the plan, e.g. azimuths never probed).
+    ``outside``: ``"raise"`` (InputError), ``"clamp"`` (phi clamped into the probed range, then
+    a direction still in a hole takes the value of the nearest probed direction) or
+    ``"extrapolate"`` (evaluate the harmonics as they are)."""
+
+    degree: int
+    coefficients: np.ndarray  # mm
+    phi_range_deg: tuple = (0.0, 180.0)
+    tilt_deg: float = 0.0
+    roll_deg: float = 0.0
+    outside: str = "raise"
+    support_deg: np.ndarray | None = None   # (n, 2) probed (phi, theta), deg
+    coverage_deg: float = 180.0
+
+    def __post_init__(self):
+        require(self.outside in ("raise", "clamp", "extrapolate"),
+                f"outside must be raise, clamp or extrapolate, not {self.outside!r}")
+        self.coefficients = np.asarray(self.coefficients, dtype=float)
+        require(len(self.coefficients) == (self.degree + 1) ** 2,
+                "coefficient count does not match the degree")
+        if self.support_deg is not None:
+            self.support_deg = np.asarray(self.support_deg, dtype=float).reshape(-1, 2)
+            self._support_u = _unit_of(self.support_deg[:, 0], self.support_deg[:, 1])
+
+    def covered(self, phi_deg, theta_deg) -> np.ndarray:
+        """Boolean mask: probe-frame angles (deg) inside the calibrated coverage."""
+        phi, theta, shape = _flat_angles(phi_deg, theta_deg)
+        lo, hi = self.phi_range_deg
+        ok = (phi >= lo - COVERAGE_TOL_DEG) & (phi <= hi + COVERAGE_TOL_DEG)
+        if self.support_deg is not None and len(phi):
+            ok &= self._nearest(np.clip(phi, lo, hi), theta)[0] <= self.coverage_deg
+        return ok.reshape(shape)
+
+    def _nearest(self, phi, theta):
+        """(angle to the nearest probed direction in deg, its index) for each query."""
+        u = _unit_of(phi, theta)
+        best = np.empty(len(u))
+        idx = np.empty(len(u), dtype=int)
+        for s in range(0, len(u), 20000):
+            dots = u[s:s + 20000] @ self._support_u.T
+            idx[s:s + 20000] = np.argmax(dots, axis=1)
+            best[s:s + 20000] = np.max(dots, axis=1)
+        return np.degrees(np.arccos(np.clip(best, -1.0, 1.0))), idx
+
+    def oriented(self, tilt_deg, roll_deg) -> "ProbeMap":
+        """The same probe used with the head at tilt/roll (deg): scalars, or (n,) arrays of
+        per-point head angles (e.g. a probe on a five-axis head) matching the directions."""
+        t = np.asarray(tilt_deg, dtype=float)
+        r = np.asarray(roll_deg, dtype=float)
+        require(np.all(np.isfinite(t)) and np.all(np.isfinite(r)), "tilt/roll must be finite")
+        return replace(self, tilt_deg=float(t) if t.ndim == 0 else t,
+                       roll_deg=float(r) if r.ndim == 0 else r)
+
+    def with_outside(self, outside: str) -> "ProbeMap":
+        return replace(self, outside=outside)
+
+    def at(self, phi_deg, theta_deg) -> np.ndarray:
+        """Probe (mm) at probe-frame angles (deg); same shape as the broadcast inputs."""
+        phi, theta, shape = _flat_angles(phi_deg, theta_deg)
+        require(np.all(np.isfinite(phi)) and np.all(np.isfinite(theta)),
+                "probe directions contain NaN")
+        lo, hi = self.phi_range_deg
+        if self.outside != "extrapolate":
+            out = (phi < lo - COVERAGE_TOL_DEG) | (phi > hi + COVERAGE_TOL_DEG)
+            if out.any() and self.outside == "raise":
+                k = int(np.argmax(out))
+                raise InputError(
+                    f"probing direction phi = {phi[k]:.1f} deg (theta {theta[k]:.1f}) lies "
+                    f"outside the calibrated range phi {lo:.0f}..{hi:.0f} deg; calibrate "
+                    f"there or use outside='clamp'")
+            phi = np.clip(phi, lo, hi)
+            if self.support_deg is not None and len(phi):
+                gap, idx = self._nearest(phi, theta)
+                hole = gap > self.coverage_deg
+                if hole.any() and self.outside == "raise":
+                    k = int(np.argmax(hole))
+                    raise InputError(
+                        f"probing direction phi = {phi[k]:.1f} deg, theta {theta[k]:.1f} deg "
+                        f"is {gap[k]:.0f} deg from the nearest probed direction (coverage "
+                        f"{self.coverage_deg:.0f} deg): not calibrated there; use "
+                        f"outside='clamp'")
+                phi = np.where(hole, self.support_deg[idx, 0], phi)
+                theta = np.where(hole, self.support_deg[idx, 1], theta)
+        return (sh_design(self.degree, np.radians(phi), np.radians(theta))
+                @ self.coefficients).reshape(shape)
+
+    def __call__(self, directions) -> np.ndarray:
+        d = np.asarray(directions, dtype=float)
+        d = np.atleast_2d(d)
+        require(d.ndim == 2 and d.shape[1] == 3, f"directions must be (n, 3), got {d.shape}")
+        require(np.all(np.isfinite(d)), "probing directions contain NaN")
+        norm = np.linalg.norm(d, axis=1)
+        require(np.all(norm > 0), "a probing direction is the zero vector")
+        for v in (self.tilt_deg, self.roll_deg):
+            require(np.ndim(v) == 0 or np.shape(v) == (len(d),),
+                    f"per-point tilt/roll need one value per direction ({len(d)})")
+        phi, theta = angles_of(d / norm[:, None], self.tilt_deg, self.roll_deg)
+        return self.at(phi, theta)
+
+
+# ---- calibration --------------------------------------------------------------------------
+@dataclass
+class ProbeCalibration:
+    """Result of a master-sphere calibration (eq. 13).  Lengths mm, angles deg."""
+
+    center: np.ndarray
+    fit_radius: float
+    sphere_radius: float
+    r_eff: float
+    phi_deg: np.ndarray
+    theta_deg: np.ndarray
+    r_m: np.ndarray
+    probe: np.ndarray              # Probe(phi_i, theta_j), mm, eq. (13)
+    map: ProbeMap
+    map_fitted: np.ndarray         # smooth map at the points, mm
+    outlier: np.ndarray            # bool flags
+    robust_sigma: float            # robust sigma of the map residuals (bisquare fit), mm
+    used: np.ndarray               # bool: point used in the fit
+    direction_source: str
+    direction_mismatch_deg: np.ndarray | None = None
+    condition: float = 0.0
+    noise: float = 0.0             # scatter about the smooth map (Type A), mm
+    u_center: np.ndarray | None = None  # standard uncertainty of the centre from it, mm
+    u_r_eff: float = 0.0           # standard uncertainty of R_eff from it (without u(R_s)), mm
+    notes: list = field(default_factory=list)
+
+    @property
+    def n_points(self) -> int:
+        return len(self.probe)
+
+    def stats_um(self, which: np.ndarray | None = None) -> dict:
+        """max / min / rms of Probe (um) over the used points (as Pahk reports them)."""
+        v = self.probe[self.used if which is None else which] * 1e3
+        return {"max": float(v.max()), "min": float(v.min()),
+                "rms": float(math.sqrt(np.mean(v ** 2)))}
+
+    def summary(self) -> dict:
+        """The ``--json`` report (INTERFACE.md keys first, then details)."""
+        out = {
+            "r_eff_mm": float(self.r_eff),
+            "center_mm": [float(v) for v in self.center],
+            "probe_error_um": self.stats_um(),
+            "n_points": int(self.n_points),
+            "n_used": int(self.used.sum()),
+            "sphere_radius_mm": float(self.sphere_radius),
+            "fit_radius_mm": float(self.fit_radius),
+            "tilt_deg": float(self.map.tilt_deg),
+            "roll_deg": float(self.map.roll_deg),
+            "direction_source": self.direction_source,
+            "phi_range_deg": [float(v) for v in self.map.phi_range_deg],
+            "map": {
+                "kind": "real spherical harmonics, orthonormal, l <= degree, m = -l..l",
+                "degree": int(self.map.degree),
+                "coefficients_um": [float(v) * 1e3 for v in self.map.coefficients],
+                "coverage_deg": float(self.map.coverage_deg),
+                "support_deg": [[round(float(p), 6), round(float(t), 6)]
+                                for p, t in self.map.support_deg],
+                "residual_rms_um": float(math.sqrt(np.mean(
+                    (self.probe[self.used] - self.map_fitted[self.used]) ** 2)) * 1e3),
+            },
+            "outliers": {
+                "threshold": "studentised residual of a bisquare map fit > k x robust sigma",
+                "robust_sigma_um": float(self.robust_sigma * 1e3),
+                "index": [int(i) for i in np.flatnonzero(self.outlier)],
+                "excluded": bool((~self.used).any()),
+            },
+            "uncertainty": {
+                "note": "standard uncertainties (Type A) from the scatter about the smooth map; "
+                        "u(R_eff) excludes the master-sphere radius uncertainty u(R_s)",
+                "noise_um": float(self.noise * 1e3),
+                "u_center_um": [float(v) * 1e3 for v in (self.u_center if self.u_center
+                                                         is not None else np.zeros(3))],
+                "u_r_eff_um": float(self.u_r_eff * 1e3),
+            },
+            "sphere_fit_condition": float(self.condition),
+        }
+        if self.direction_mismatch_deg is not None:
+            out["direction_mismatch_deg"] = {
+                "median": float(np.median(self.direction_mismatch_deg)),
+                "max": float(np.max(self.direction_mismatch_deg))}
+        if self.notes:
+            out["notes"] = list(self.notes)
+        return out
+
+
+def calibrate(points, sphere_radius: float, phi_deg=None, theta_deg=None,
+              tilt_deg: float = 0.0, roll_deg: float = 0.0, degree: int | None = None,
+              outlier_k: float = OUTLIER_K, exclude_outliers: bool = False) -> ProbeCalibration:
+    """Master-sphere calibration (Pahk eq. 13).
+
+    Parameters
+    ----------
+    points : array, shape (n, 3)
+        Recorded stylus-ball centres, mm, machine frame.
+    sphere_radius : float
+        Master-sphere radius R_s, mm (calibrated value).
+    phi_deg, theta_deg : array, shape (n,), optional
+        Nominal probing directions in the probe frame (deg); default: from the fitted centre.
+    tilt_deg, roll_deg : float
+        Probe-head tilt A and roll B during the calibration (deg).
+    degree : int, optional
+        Degree of the spherical-harmonic map; default chosen by cross-validation.
+    exclude_outliers : bool
+        Refit the sphere and the map without the flagged points (they stay in the result,
+        flagged, with their Probe relative to the refit).
+    """
+    p = check_sphere_points(points)
+    require(math.isfinite(sphere_radius) and sphere_radius > 0,
+            f"sphere radius must be a positive length in mm, got {sphere_radius}")
+    require(math.isfinite(tilt_deg) and math.isfinite(roll_deg), "tilt/roll must be finite")
+    require((phi_deg is None) == (theta_deg is None), "give both phi and theta or neither")
+    require(outlier_k > 0, "outlier threshold must be positive")
+    used = np.ones(len(p), dtype=bool)
+    result = _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_deg,
+                             degree, outlier_k)
+    if exclude_outliers and result.outlier.any():
+        used = ~result.outlier
+        require(used.sum() >= MIN_POINTS, "too few points left after excluding the outliers")
+        result = _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg,
+                                 roll_deg, degree, outlier_k, flags=result.outlier)
+    return result
+
+
+def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_deg, degree,
+                    outlier_k, flags=None) -> ProbeCalibration:
+    fit = fit_sphere(p[used])
+    c = fit.center
+    r_eff = fit.radius - sphere_radius
+    require(r_eff > 0,
+            f"fitted radius of the ball centres {fit.radius:.6g} mm minus the sphere radius "
+            f"{sphere_radius:.6g} mm gives a stylus-ball radius {r_eff:.4g} mm <= 0: check "
+            f"--sphere-radius (a radius in mm, not a diameter)")
+    require(r_eff >= MIN_BALL_RADIUS_MM,
+            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
+            f"{r_eff * 1e3:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
+            f"check --sphere-radius (mm)")
+    require(r_eff <= MAX_BALL_RADIUS_MM,
+            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
+            f"{r_eff:.4g} mm (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
+            f"check --sphere-radius (mm)")
+    d = p - c
+    r_m = np.linalg.norm(d, axis=1)
+    probe = r_eff - (r_m - sphere_radius)            # eq. (13)
+    u = d / r_m[:, None]
+    phi_m, theta_m = angles_of(u, tilt_deg, roll_deg)
+    mismatch = None
+    notes = []
+    if phi_deg is not None:
+        phi = np.asarray(phi_deg, dtype=float)
+        theta = np.mod(np.asarray(theta_deg, dtype=float), 360.0)
+        require(phi.shape == (len(p),) and theta.shape == (len(p),),
+                "phi/theta must have one value per point")
+        require(np.all(np.isfinite(phi)) and np.all(np.isfinite(theta)), "phi/theta have NaN")
+        nominal = directions_of(phi, theta, tilt_deg, roll_deg)
+        cosang = np.clip(np.sum(nominal * u, axis=1), -1.0, 1.0)
+        mismatch = np.degrees(np.arccos(cosang))
+        if np.median(mismatch) > 5.0:
+            notes.append(f"given directions differ from the measured ones by "
+                         f"{np.median(mismatch):.1f} deg (median): check phi/theta convention "
+                         f"(outward normal, phi from the probe axis) and the tilt/roll")
+        source = "columns"
+    else:
+        phi, theta = phi_m, theta_m
+        source = "fitted centre"
+    sh = fit_sh(np.radians(phi[used]), np.radians(theta[used]), probe[used], degree)
+    support = np.column_stack([phi[used], theta[used]])
+    pmap = ProbeMap(sh.degree, sh.coefficients,
+                    (float(phi[used].min()), float(phi[used].max())),
+                    float(tilt_deg), float(roll_deg), support_deg=support,
+                    coverage_deg=coverage_of(phi[used], theta[used]))
+    fitted = sh(np.radians(phi), np.radians(theta))
+    flag_used, sigma = robust_flags(sh.degree, np.radians(phi[used]), np.radians(theta[used]),
+                                    probe[used], outlier_k)
+    res = probe[used] - sh.fitted
+    noise = math.sqrt(float(res @ res) / max(used.sum() - sh.dof, 1.0))
+    u_par = noise * np.sqrt(np.diag(fit.cov_unit))
+    outlier = np.zeros(len(p), dtype=bool)
+    outlier[used] = flag_used
+    if flags is not None:
+        outlier |= flags
+        outlier[~used] = True
+    return ProbeCalibration(
+        center=c, fit_radius=fit.radius, sphere_radius=float(sphere_radius), r_eff=r_eff,
+        phi_deg=phi, theta_deg=theta, r_m=r_m, probe=probe, map=pmap, map_fitted=fitted,
+        outlier=outlier, robust_sigma=sigma, used=used.copy(),
+        direction_source=source, direction_mismatch_deg=mismatch, condition=fit.condition,
+        noise=noise, u_center=u_par[:3], u_r_eff=float(u_par[3]), notes=notes)
+
+
+def calibrate_data(data: SphereData, sphere_radius: float, **kw) -> ProbeCalibration:
+    """:func:`calibrate` on :class:`SphereData` (nominal directions taken when present)."""
+    return calibrate(data.points, sphere_radius, data.phi_deg, data.theta_deg, **kw)
+
+
+# ---- output -------------------------------------------------------------------------------
+MAP_COLUMNS = ("phi_deg", "theta_deg", "probe_um", "map_um", "residual_um", "r_m_mm",
+               "outlier")
+
+
+def map_csv_text(cal: ProbeCalibration) -> str:
+    """MAP.csv: one row per probed point, in input order.  ``probe_um`` = Probe of eq. (13);
+    ``map_um`` = the smooth map there; ``residual_um`` = probe_um - map_um; ``r_m_mm`` =
+    distance of the ball centre from the fitted sphere centre; ``outlier`` = 1 when flagged."""
+    lines = [",".join(MAP_COLUMNS)]
+    res = cal.probe - cal.map_fitted
+    for i in range(cal.n_points):
+        lines.append(f"{cal.phi_deg[i]:.6f},{cal.theta_deg[i]:.6f},{cal.probe[i] * 1e3:.4f},"
+                     f"{cal.map_fitted[i] * 1e3:.4f},{res[i] * 1e3:.4f},"
+                     f"{cal.r_m[i]:.7f},{int(cal.outlier[i])}")
+    return "\n".join(lines) + "\n"
+
+
+def probe_map_from_json(source, tilt_deg: float | None = None, roll_deg: float | None = None,
+                        outside: str = "raise") -> ProbeMap:
+    """The exact :class:`ProbeMap` of a ``probe-cal --json`` report (a path or the parsed
+    dict); tilt/roll default to those of the calibration."""
+    import json
+
+    if not isinstance(source, dict):
+        path = Path(source)
+        require(path.is_file(), f"{path}: no such file")
+        try:
+            source = json.loads(path.read_text(encoding="utf-8"))
+        except ValueError as exc:
+            raise InputError(f"{path}: not JSON: {exc}") from None
+    try:
+        m = source["map"]
+        return ProbeMap(int(m["degree"]), np.asarray(m["coefficients_um"], dtype=float) * 1e-3,
+                        tuple(float(v) for v in source["phi_range_deg"]),
+                        float(source.get("tilt_deg", 0.0) if tilt_deg is None else tilt_deg),
+                        float(source.get("roll_deg", 0.0) if roll_deg is None else roll_deg),
+                        outside, m.get("support_deg"), float(m.get("coverage_deg", 180.0)))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"not a probe-cal report: missing or bad {exc}") from None
+
+
+def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
+                   degree: int | None = None, outside: str = "raise") -> ProbeMap:
+    """A :class:`ProbeMap` from a MAP.csv (``phi_deg,theta_deg,probe_um``; rows flagged
+    ``outlier`` = 1 are left out), refitted as by the calibration."""
+    path = Path(path)
+    require(path.is_file(), f"{path}: no such file")
+    with path.open(newline="", encoding="utf-8-sig") as fh:
+        rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+    require(rows, f"{path}: empty file")
+    header = [h.strip().lower() for h in rows[0]]
+    for c in ("phi_deg", "theta_deg", "probe_um"):
+        require(c in header, f"{path}: missing column {c!r}")
+    idx = [header.index(c) for c in ("phi_deg", "theta_deg", "probe_um")]
+    io = header.index("outlier") if "outlier" in header else None
+    vals = []
+    for k, r in enumerate(rows[1:], start=2):
+        require(len(r) > max(idx), f"{path}: line {k}: too few fields")
+        if io is not None and len(r) > io and r[io].strip() not in ("", "0"):
+            continue
+        vals.append([_float(r[i].strip(), f"{path}: line {k}") for i in idx])
+    arr = np.asarray(vals, dtype=float)
+    require(len(arr) >= MIN_POINTS, f"{path}: needs at least {MIN_POINTS} map points")
+    require(np.all(np.isfinite(arr)), f"{path}: NaN values")
+    sh = fit_sh(np.radians(arr[:, 0]), np.radians(arr[:, 1]), arr[:, 2] * 1e-3, degree)
+    return ProbeMap(sh.degree, sh.coefficients,
+                    (float(arr[:, 0].min()), float(arr[:, 0].max())),
+                    float(tilt_deg), float(roll_deg), outside, arr[:, :2],
+                    coverage_of(arr[:, 0], arr[:, 1]))

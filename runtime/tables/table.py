@@ -1,0 +1,593 @@
+"""Error tables and error functions: measured component errors in, callables of position out.
+
+File formats (INTERFACE.md)
+---------------------------
+*Error table* (one per axis), CSV::
+
+    X,EXX_um,EYX_um,EZX_um,EAX_urad,EBX_urad,ECX_urad,EXX_std_um
+    0,0.0,0.0,0.0,0.0,0.0,0.0,0.4
+    100,1.2,...
+
+* first column: the axis position, named by the axis (``X`` in mm, ``C`` in deg; ``X_mm`` and
+  ``C_deg`` are accepted too).  Positions must be finite and strictly increasing.
+* parameter columns ``<ISO name>_<unit>``; translational errors (``EX? EY? EZ?``) in ``um`` or
+  ``mm``, angular errors (``EA? EB? EC?``) in ``urad`` or ``rad``.  A table holds only the
+  component errors of its own axis (``E??X`` in ``X.csv``).
+* optional uncertainty columns for a parameter present in the table: the standard deviation
+  (Type A, repeatability) and/or the expanded uncertainty (k = 2).  Written as
+  ``EXX_std_um`` / ``EXX_u95_um`` (unit stays the last suffix, like every other column);
+  ``EXX_um_std`` / ``EXX_um_u95`` are accepted on read.
+* blank lines and lines starting with ``#`` are ignored; every other cell must be a finite number.
+* lenient spelling: names and units in any case (``exx_UM`` = ``EXX_um``; ``µm``/``µrad`` =
+  ``um``/``urad``); the axis column may stand anywhere (it is moved first); columns that are
+  neither parameter names nor unit-suffixed (``comment``, ``T_C``) are ignored.  A column named
+  like a parameter without a valid unit is refused, and so is a table without error columns.
+
+*Constants* (squareness, rotary-axis location errors), CSV ``name,value,unit`` with unit one of
+``um mm urad rad``; optional columns ``std`` and ``u95`` in the same unit as ``value``.  Columns
+in any order and case; other columns (comments) are ignored.
+
+*Error directory* (``--errors DIR``): ``<AXIS>.csv`` for each measured axis of the layout and
+optionally ``constants.csv``.  A missing table means zero errors for that axis; any other CSV
+file in the directory is refused (it is almost always a misnamed table).
+
+In memory everything is mm / rad (translational / angular) and mm / deg (positions).
+
+Error functions
+---------------
+:class:`ErrorFunctions` turns the tables of a directory into functions of position:
+``method="linear"`` (piecewise linear interpolation), ``"cubic"`` (not-a-knot cubic spline,
+exact at the nodes) or ``"poly"`` (least-squares polynomial; the degree is given, or chosen per
+parameter by leave-one-out cross-validation with the one-standard-error rule: the lowest degree
+whose prediction error is within one standard error of the best).  Positions outside a table's
+measured range raise :class:`InputError`; with ``extrapolate=True`` the fitted function itself
+is evaluated there (linear: the end segment extended; cubic: the end polynomial of the spline;
+poly: the polynomial).  Standard deviations are always interpolated linearly (clamped at the
+ends); a ``u95`` column without ``std`` gives ``std = u95 / 2``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from volerr.errors import InputError, require
+from volerr.fileio import read_csv_rows, write_text
+
+#: unit suffix -> (kind, factor to mm or rad)
+UNITS = {"um": ("length", 1e-3), "mm": ("length", 1.0), "urad": ("angle", 1e-6), "rad": ("angle", 1.0)}
+_DIVISOR = {"um": 1000.0, "mm": 1.0, "urad": 1e6, "rad": 1.0}  # value_in_unit / divisor -> mm|rad
+ROTARY_LETTERS = ("A", "B", "C")
+_TABLE_NAME = re.compile(r"^E([XYZABC])([A-Z])$")
+_CONST_NAME = re.compile(r"^E([XYZABC])0([A-Z])$")
+_COL = re.compile(r"^(?P<name>[A-Za-z0-9]+?)"
+                  r"(?:_(?P<kind1>std|u95))?_(?P<unit>[A-Za-z]+)(?:_(?P<kind2>std|u95))?$",
+                  re.IGNORECASE)
+#: a column that names an error parameter (any case): it must carry a unit suffix
+_PARAM_LIKE = re.compile(r"^E[XYZABC]0?[A-Z](?:_|$)", re.IGNORECASE)
+_AXIS_COL = re.compile(r"([A-Za-z])(?:_(mm|deg))?", re.IGNORECASE)
+
+
+def _unit_text(text: str) -> str:
+    """Column or unit spelling -> canonical: micro sign as ``u``, case-insensitive."""
+    return text.replace("\u00b5", "u").replace("\u03bc", "u")
+
+
+def _ignored_column(col: str) -> bool:
+    """An extra column (comment, temperature ...): neither a parameter name nor unit-suffixed."""
+    if _PARAM_LIKE.match(col):
+        return False
+    m = _COL.match(_unit_text(col))
+    return m is None or m.group("unit").lower() not in UNITS
+
+
+def parameter_kind(name: str) -> str:
+    """``"length"`` for translational (EX?, EY?, EZ?, EX0?, ...), ``"angle"`` for angular."""
+    return "length" if name[1] in "XYZ" else "angle"
+
+
+def axis_unit(axis: str) -> str:
+    """Position unit of an axis: ``deg`` for rotary letters A B C, else ``mm``."""
+    return "deg" if axis in ROTARY_LETTERS else "mm"
+
+
+def _to_internal(values, unit: str):
+    return np.asarray(values, dtype=float) / _DIVISOR[unit]
+
+
+def _from_internal(values, unit: str):
+    return np.asarray(values, dtype=float) * _DIVISOR[unit]
+
+
+@dataclass
+class ErrorTable:
+    """Component errors of one axis at measured positions.
+
+    ``positions``: shape (n,), mm or deg, strictly increasing.  ``values``, ``std``, ``u95``:
+    ISO name -> shape (n,) arrays in mm (translational) or rad (angular); ``std`` is the standard
+    deviation (Type A), ``u95`` the expanded uncertainty (k = 2); both may be empty."""
+
+    axis: str
+    positions: np.ndarray
+    values: dict
+    std: dict = field(default_factory=dict)
+    u95: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.positions = np.asarray(self.positions, dtype=float)
+        self.values = {k: np.asarray(v, dtype=float) for k, v in self.values.items()}
+        self.std = {k: np.asarray(v, dtype=float) for k, v in (self.std or {}).items()}
+        self.u95 = {k: np.asarray(v, dtype=float) for k, v in (self.u95 or {}).items()}
+        self.validate()
+
+    def validate(self, where: str = "") -> None:
+        """Check shapes, names, finiteness and increasing positions; raise InputError."""
+        w = where or f"table {self.axis}"
+        require(re.fullmatch(r"[A-Z]", self.axis or "") is not None,
+                f"{w}: axis name must be one capital letter, got {self.axis!r}")
+        p = self.positions
+        require(p.ndim == 1 and p.size >= 2, f"{w}: needs at least two positions, got {p.size}")
+        require(np.all(np.isfinite(p)), f"{w}: positions contain NaN or infinite values")
+        d = np.diff(p)
+        if np.any(d <= 0):
+            i = int(np.argmax(d <= 0))
+            what = "duplicate" if d[i] == 0 else "decreasing"
+            raise InputError(f"{w}: positions must be strictly increasing ({what} position "
+                             f"{p[i + 1]:g} after {p[i]:g})")
+        for label, dct in (("", self.values), ("std ", self.std), ("u95 ", self.u95)):
+            for k, v in dct.items():
+                m = _TABLE_NAME.match(k)
+                require(m is not None and m.group(2) == self.axis,
+                        f"{w}: {k!r} is not a component error of axis {self.axis} "
+                        f"(expected EX{self.axis} ... EC{self.axis})")
+                require(v.shape == p.shape, f"{w}: {label}{k} has {v.size} values for {p.size} positions")
+                require(np.all(np.isfinite(v)), f"{w}: {label}{k} contains NaN or infinite values")
+                if label:
+                    require(k in self.values, f"{w}: {label.strip()} column for {k} without a {k} column")
+                    require(np.all(v >= 0), f"{w}: {label}{k} has negative values")
+
+
+# ---------------------------------------------------------------------------------------------
+# CSV reading
+def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """Header and (line number, cells) of a CSV file; blank and '#' lines skipped."""
+    rows = read_csv_rows(path, empty=f"{path}: empty file (no header)")
+    (_, header), body = rows[0], rows[1:]
+    require(all(header), f"{path}: empty column name in header")
+    dup = sorted({h for h in header if header.count(h) > 1})
+    if dup:
+        raise InputError(f"{path}: duplicate column {dup[0]!r}")
+    for lineno, cells in body:
+        require(len(cells) == len(header),
+                f"{path}:{lineno}: {len(cells)} fields, header has {len(header)}")
+    return header, body
+
+
+def _number(path, lineno, column, text) -> float:
+    require(text != "", f"{path}:{lineno}: empty value in column {column}")
+    try:
+        v = float(text)
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {column} = {text!r} is not a number") from None
+    require(math.isfinite(v), f"{path}:{lineno}: {column} = {text} (NaN or infinite)")
+    return v
+
+
+def _parse_column(path, col: str, axis: str):
+    """-> (name, unit, kind) with kind '', 'std' or 'u95'."""
+    m = _COL.match(_unit_text(col))
+    if m is None or (m.group("kind1") and m.group("kind2")):
+        raise InputError(f"{path}: column {col!r} has no unit suffix (wrong units): "
+                         f"write it as <name>_um, _mm, _urad or _rad")
+    name, unit = m.group("name").upper(), m.group("unit").lower()
+    kind = (m.group("kind1") or m.group("kind2") or "").lower()
+    require(unit in UNITS, f"{path}: column {col!r}: unknown unit {unit!r} (wrong units); "
+                           f"use um, mm, urad or rad")
+    mt = _TABLE_NAME.match(name)
+    require(mt is not None and mt.group(2) == axis,
+            f"{path}: column {col!r}: {name} is not a component error of axis {axis} "
+            f"(expected EX{axis} EY{axis} EZ{axis} EA{axis} EB{axis} EC{axis})")
+    need = parameter_kind(name)
+    require(UNITS[unit][0] == need,
+            f"{path}: column {col!r}: wrong units, {name} is {'an angle' if need == 'angle' else 'a length'}"
+            f" (use {'urad or rad' if need == 'angle' else 'um or mm'})")
+    return name, unit, kind
+
+
+def read_error_table(path, axis: str | None = None) -> ErrorTable:
+    """Read one error table (format in the module docstring) -> :class:`ErrorTable` in mm / rad.
+
+    ``axis``: the expected axis (e.g. from the file name); the first column must name it."""
+    path = Path(path)
+    header, body = _read_rows(path)
+    # the axis column comes first (INTERFACE.md); one found elsewhere is moved there, and extra
+    # columns that are neither parameters nor unit-suffixed (comments, temperatures) are ignored
+    if _AXIS_COL.fullmatch(header[0]) is None:
+        at = [j for j, h in enumerate(header) if _AXIS_COL.fullmatch(h)
+              and (axis is None or h[0].upper() == axis)]
+        if len(at) == 1:
+            order = at + [j for j in range(len(header)) if j != at[0]]
+            header = [header[j] for j in order]
+            body = [(ln, [cells[j] for j in order]) for ln, cells in body]
+    keep = [0] + [j for j in range(1, len(header)) if not _ignored_column(header[j])]
+    if len(keep) < len(header):
+        header = [header[j] for j in keep]
+        body = [(ln, [cells[j] for j in keep]) for ln, cells in body]
+    first = header[0]
+    m = _AXIS_COL.fullmatch(first)
+    require(m is not None, f"{path}: first column must be the axis position named by the axis "
+                           f"(e.g. X or C), got {first!r}")
+    tax = m.group(1).upper()
+    if m.group(2):
+        require(m.group(2).lower() == axis_unit(tax), f"{path}: axis {tax} positions are in "
+                                                      f"{axis_unit(tax)}, not {m.group(2)}")
+    if axis is not None:
+        require(tax == axis, f"{path}: header names axis {tax!r}, expected {axis!r} (header mismatch)")
+    require(len(header) >= 2, f"{path}: no error columns")
+    require(body, f"{path}: no data rows")
+    cols = [_parse_column(path, c, tax) for c in header[1:]]
+    seen = {}
+    for (name, unit, kind), col in zip(cols, header[1:]):
+        require((name, kind) not in seen, f"{path}: columns {seen.get((name, kind))!r} and "
+                                          f"{col!r} both give {name} {kind}".rstrip())
+        seen[(name, kind)] = col
+    data = np.array([[_number(path, ln, h, c) for h, c in zip(header, cells)] for ln, cells in body])
+    values, std, u95 = {}, {}, {}
+    for j, (name, unit, kind) in enumerate(cols, start=1):
+        {"": values, "std": std, "u95": u95}[kind][name] = _to_internal(data[:, j], unit)
+    for name in list(std) + list(u95):
+        require(name in values, f"{path}: uncertainty column for {name} without a {name} column")
+    try:
+        return ErrorTable(tax, data[:, 0], values, std, u95)
+    except InputError as exc:
+        msg = str(exc).split(": ", 1)[-1]
+        raise InputError(f"{path}: {msg}") from None
+
+
+def _fmt(v: float) -> str:
+    s = f"{float(v):.12g}"
+    return "0" if s == "-0" else s
+
+
+def table_to_csv(table: ErrorTable) -> str:
+    """CSV text of a table: lengths in um, angles in urad, uncertainty as ``_std_um`` etc."""
+    table.validate()
+    names = list(table.values)
+    header, columns = [table.axis], [table.positions]
+    for n in names:
+        unit = "um" if parameter_kind(n) == "length" else "urad"
+        header.append(f"{n}_{unit}")
+        columns.append(_from_internal(table.values[n], unit))
+    for kind, dct in (("std", table.std), ("u95", table.u95)):
+        for n in names:
+            if n in dct:
+                unit = "um" if parameter_kind(n) == "length" else "urad"
+                header.append(f"{n}_{kind}_{unit}")
+                columns.append(_from_internal(dct[n], unit))
+    lines = [",".join(header)]
+    for row in zip(*columns):
+        lines.append(",".join(_fmt(v) for v in row))
+    return "\n".join(lines) + "\n"
+
+
+def write_error_table(path, table: ErrorTable, inputs=()) -> Path:
+    """Write ``table`` as CSV (um / urad); refuses to overwrite any file in ``inputs``."""
+    return write_text(path, table_to_csv(table), inputs=inputs)
+
+
+# ---------------------------------------------------------------------------------------------
+# constants
+def read_constants_full(path) -> tuple[dict, dict, dict]:
+    """Read a constants CSV -> (values, std, u95), each name -> float in mm / rad."""
+    path = Path(path)
+    header, body = _read_rows(path)
+    low = [h.lower() for h in header]
+    require(all(k in low for k in ("name", "value", "unit")),
+            f"{path}: header must have the columns name,value,unit, got {','.join(header)}")
+    # columns in any order, any case; columns other than std / u95 (comments ...) are ignored
+    order = [low.index(k) for k in ("name", "value", "unit")]
+    order += [j for j, h in enumerate(low) if h in ("std", "u95")]
+    header = [low[j] for j in order]
+    body = [(ln, [cells[j] for j in order]) for ln, cells in body]
+    extra = header[3:]
+    values, std, u95 = {}, {}, {}
+    for lineno, cells in body:
+        name, unit = cells[0].upper(), _unit_text(cells[2]).lower()
+        require(_CONST_NAME.match(name) is not None,
+                f"{path}:{lineno}: {name!r} is not a constant error name "
+                f"(squareness EC0Y EB0Z EA0Z or location errors such as EX0C)")
+        require(name not in values, f"{path}:{lineno}: duplicate constant {name}")
+        require(unit in UNITS, f"{path}:{lineno}: unknown unit {unit!r} for {name} (wrong units); "
+                               f"use um, mm, urad or rad")
+        need = parameter_kind(name)
+        require(UNITS[unit][0] == need, f"{path}:{lineno}: wrong units {unit!r} for {name} "
+                                        f"({'urad or rad' if need == 'angle' else 'um or mm'})")
+        values[name] = float(_to_internal(_number(path, lineno, "value", cells[1]), unit))
+        for h in extra:
+            dct = std if h == "std" else u95
+            if cells[header.index(h)] == "":
+                continue
+            v = _number(path, lineno, h, cells[header.index(h)])
+            require(v >= 0, f"{path}:{lineno}: negative {h} for {name}")
+            dct[name] = float(_to_internal(v, unit))
+    return values, std, u95
+
+
+def read_constants(path) -> dict:
+    """Read a constants CSV ``name,value,unit`` -> name -> float in mm (translational) / rad."""
+    return read_constants_full(path)[0]
+
+
+def write_constants(path, values: dict, inputs=(), std: dict | None = None,
+                    u95: dict | None = None) -> Path:
+    """Write constants (mm / rad) as ``name,value,unit[,std][,u95]`` in um / urad."""
+    std, u95 = dict(std or {}), dict(u95 or {})
+    header = ["name", "value", "unit"] + (["std"] if std else []) + (["u95"] if u95 else [])
+    lines = [",".join(header)]
+    for name, v in values.items():
+        require(_CONST_NAME.match(name) is not None, f"{name!r} is not a constant error name")
+        require(math.isfinite(float(v)), f"constant {name} is NaN or infinite")
+        unit = "um" if parameter_kind(name) == "length" else "urad"
+        row = [name, _fmt(_from_internal(v, unit)), unit]
+        if std:
+            row.append(_fmt(_from_internal(std[name], unit)) if name in std else "")
+        if u95:
+            row.append(_fmt(_from_internal(u95[name], unit)) if name in u95 else "")
+        lines.append(",".join(row))
+    return write_text(path, "\n".join(lines) + "\n", inputs=inputs)
+
+
+# ---------------------------------------------------------------------------------------------
+# error directories
+def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]:
+    """Read an error directory -> (tables {axis: ErrorTable}, (constants, std, u95)).
+
+    ``axes``: the axes the machine has; a table for any other axis, or any other CSV file,
+    is refused."""
+    d = Path(directory)
+    require(d.is_dir(), f"error directory {d} does not exist")
+    tables, consts = {}, ({}, {}, {})
+    allowed = None if axes is None else set(axes)
+    for f in sorted(d.iterdir()):
+        if f.suffix.lower() != ".csv" or f.name.startswith("."):
+            continue
+        stem = f.stem
+        if stem.lower() == "constants":
+            consts = read_constants_full(f)
+            continue
+        if len(stem) == 1 and stem.isalpha():
+            ax = stem.upper()
+            require(allowed is None or ax in allowed,
+                    f"{f}: table for axis {ax}, but the machine's axes are {' '.join(sorted(allowed or ()))}")
+            require(ax not in tables, f"{d}: two tables for axis {ax}")
+            tables[ax] = read_error_table(f, axis=ax)
+            continue
+        raise InputError(f"{f}: unknown file in error directory (expected "
+                         f"{', '.join(a + '.csv' for a in (axes or ['X', 'Y', 'Z']))} or constants.csv)")
+    return tables, consts
+
+
+def write_error_dir(directory, tables: dict, constants: dict | None = None,
+                    constants_std: dict | None = None, inputs=()) -> Path:
+    """Write ``<AXIS>.csv`` for each table and ``constants.csv`` (when given) into ``directory``."""
+    d = Path(directory)
+    for ax, t in tables.items():
+        require(ax == t.axis, f"table for {t.axis} stored under {ax}")
+        write_error_table(d / f"{ax}.csv", t, inputs=inputs)
+    if constants:
+        write_constants(d / "constants.csv", constants, inputs=inputs, std=constants_std)
+    return d
+
+
+# ---------------------------------------------------------------------------------------------
+# fitting
+def loo_press(x, y, degree: int) -> np.ndarray:
+    """Leave-one-out prediction errors of a least-squares polynomial of ``degree`` (hat matrix)."""
+    t = _scale(x, x)
+    V = np.polynomial.legendre.legvander(t, degree)
+    Q, _ = np.linalg.qr(V)
+    h = np.sum(Q ** 2, axis=1)
+    resid = y - Q @ (Q.T @ y)
+    return resid / np.clip(1.0 - h, 1e-12, None)
+
+
+def _scale(x, ref):
+    lo, hi = float(np.min(ref)), float(np.max(ref))
+    return (np.asarray(x, dtype=float) - 0.5 * (lo + hi)) / (0.5 * (hi - lo))
+
+
+def choose_degree(x, y, max_degree: int | None = None) -> int:
+    """Polynomial degree by leave-one-out cross-validation with the one-standard-error rule."""
+    n = len(x)
+    top = n - 2 if max_degree is None else min(max_degree, n - 2)
+    top = max(0, min(top, 12))
+    scores, ses = [], []
+    for d in range(top + 1):
+        e2 = loo_press(x, y, d) ** 2
+        scores.append(e2.mean())
+        ses.append(e2.std(ddof=1) / math.sqrt(n) if n > 1 else 0.0)
+    best = int(np.argmin(scores))
+    limit = scores[best] + ses[best]
+    return next(d for d in range(best + 1) if scores[d] <= limit)
+
+
+class _Poly:
+    def __init__(self, x, y, degree):
+        self.lo, self.hi = float(x[0]), float(x[-1])
+        self.coef = np.polynomial.legendre.legfit(_scale(x, x), y, degree)
+        self.degree = degree
+
+    def __call__(self, q):
+        return np.polynomial.legendre.legval(_scale(q, [self.lo, self.hi]), self.coef)
+
+
+class _Linear:
+    def __init__(self, x, y):
+        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
+
+    def __call__(self, q):
+        q = np.asarray(q, float)
+        out = np.interp(q, self.x, self.y)
+        x, y = self.x, self.y
+        lo, hi = q < x[0], q > x[-1]
+        if lo.any():
+            out[lo] = y[0] + (q[lo] - x[0]) * (y[1] - y[0]) / (x[1] - x[0])
+        if hi.any():
+            out[hi] = y[-1] + (q[hi] - x[-1]) * (y[-1] - y[-2]) / (x[-1] - x[-2])
+        return out
+
+
+def make_function(x, y, method: str = "linear", degree: int | None = None):
+    """One error function of position from nodes ``x`` (increasing) and values ``y``.
+
+    Returns a callable; for ``method="poly"`` it has a ``degree`` attribute."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if method == "linear":
+        return _Linear(x, y)
+    if method == "cubic":
+        from scipy.interpolate import CubicSpline
+        return CubicSpline(x, y, bc_type="not-a-knot", extrapolate=True)
+    if method == "poly":
+        if degree is None:
+            degree = choose_degree(x, y)
+        require(0 <= degree < len(x), f"polynomial degree {degree} needs more than {degree} "
+                                      f"positions, the table has {len(x)}")
+        return _Poly(x, y, degree)
+    raise InputError(f"unknown interpolation method {method!r} (linear, cubic, poly)")
+
+
+METHODS = ("linear", "cubic", "poly")
+
+
+class ErrorFunctions:
+    """Error functions of a machine built from its error tables and constants.
+
+    Call with positions (``{axis: array}`` in mm / deg, or an (N, n_axes) array in
+    ``model.axes`` order) -> ``{name: (N,) array}`` in mm / rad for every parameter that has
+    data (table parameters and constants), ready for ``model.volumetric_error``.
+    :meth:`sigmas` gives the standard deviations the same way, for ``model.random_error``."""
+
+    def __init__(self, tables: dict, constants: dict | None, model, method: str = "linear",
+                 degree: int | None = None, extrapolate: bool = False,
+                 constants_std: dict | None = None, source: str = ""):
+        if isinstance(model, str):
+            from volerr.machine.model import load
+            model = load(model)
+        require(method in METHODS, f"unknown interpolation method {method!r} (linear, cubic, poly)")
+        require(degree is None or method == "poly", "a polynomial degree needs method 'poly'")
+        require(degree is None or degree >= 0, f"polynomial degree must be >= 0, got {degree}")
+        self.model, self.method, self.extrapolate = model, method, bool(extrapolate)
+        self.source = source
+        where = f"{source}: " if source else ""
+        params, paxis = set(model.parameters), model.parameter_axis
+        self.tables = dict(tables or {})
+        self.constants = {k: float(v) for k, v in (constants or {}).items()}
+        self.constants_std = {k: float(v) for k, v in (constants_std or {}).items()}
+        for ax, t in self.tables.items():
+            require(ax in model.axes, f"{where}table for axis {ax}, but {model.name} has axes "
+                                      f"{' '.join(model.axes)}")
+            for name in t.values:
+                require(name in params and paxis.get(name) == ax,
+                        f"{where}{ax}.csv: {model.name} has no parameter {name}")
+        for name in list(self.constants) + list(self.constants_std):
+            require(name in params and paxis.get(name) is None,
+                    f"{where}constants: {model.name} has no constant parameter {name} "
+                    f"(its constants are {' '.join(p for p in model.parameters if paxis[p] is None)})")
+        self.functions, self.std_functions, self.degrees = {}, {}, {}
+        for ax, t in self.tables.items():
+            for name, y in t.values.items():
+                try:
+                    f = make_function(t.positions, y, method, degree)
+                except InputError as exc:
+                    raise InputError(f"{where}{ax}.csv {name}: {exc}") from None
+                self.functions[name] = (ax, f)
+                if method == "poly":
+                    self.degrees[name] = f.degree
+                s = t.std.get(name)
+                if s is None and name in t.u95:
+                    s = t.u95[name] / 2.0
+                if s is not None:
+                    self.std_functions[name] = (ax, _clamped(t.positions, s))
+
+    @classmethod
+    def from_dir(cls, directory, model, method: str = "linear", degree: int | None = None,
+                 extrapolate: bool = False) -> "ErrorFunctions":
+        """Read an error directory (``X.csv`` ... ``constants.csv``) for ``model``."""
+        if isinstance(model, str):
+            from volerr.machine.model import load
+            model = load(model)
+        tables, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
+        cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}
+        return cls(tables, consts, model, method, degree, extrapolate, constants_std=cstd,
+                   source=str(directory))
+
+    # ---- evaluation ---------------------------------------------------------------------
+    @property
+    def has_random(self) -> bool:
+        """True when any table or constant carries a standard deviation (or u95)."""
+        return bool(self.std_functions or self.constants_std)
+
+    def ranges(self) -> dict:
+        """Axis -> (min, max) measured position of its table."""
+        return {ax: (float(t.positions[0]), float(t.positions[-1])) for ax, t in self.tables.items()}
+
+    def _positions(self, positions) -> tuple[dict, int]:
+        axes = self.model.axes
+        if isinstance(positions, dict):
+            unknown = set(positions) - set(axes)
+            if unknown:
+                raise InputError(f"unknown axis {sorted(unknown)[0]!r}; axes are {' '.join(axes)}")
+            missing = [a for a in self.tables if a not in positions]
+            require(not missing, f"positions lack axis {missing[0] if missing else ''}")
+            cols = {a: np.atleast_1d(np.asarray(v, dtype=float)) for a, v in positions.items()}
+        else:
+            arr = np.asarray(positions, dtype=float)
+            arr = arr[None, :] if arr.ndim == 1 else arr
+            require(arr.ndim == 2 and arr.shape[1] == len(axes),
+                    f"positions must have {len(axes)} columns ({' '.join(axes)}), got {arr.shape}")
+            cols = {a: arr[:, i] for i, a in enumerate(axes)}
+        shape = np.broadcast_shapes(*(v.shape for v in cols.values()))
+        cols = {a: np.broadcast_to(v, shape).ravel() for a, v in cols.items()}
+        n = int(np.prod(shape)) if shape else 1
+        for a, v in cols.items():
+            require(np.all(np.isfinite(v)), f"position {a} has NaN or infinite values")
+        if not self.extrapolate:
+            for ax, (lo, hi) in self.ranges().items():
+                v = cols[ax]
+                tol = 1e-9 * max(1.0, hi - lo)
+                bad = (v < lo - tol) | (v > hi + tol)
+                if bad.any():
+                    u = axis_unit(ax)
+                    x = v[bad][np.argmax(np.abs(v[bad] - 0.5 * (lo + hi)))]
+                    raise InputError(f"{ax} = {x:g} {u} is outside the measured range "
+                                     f"{lo:g} .. {hi:g} {u} of table {ax} (no extrapolation "
+                                     f"unless asked for)")
+        return cols, n
+
+    def __call__(self, positions) -> dict:
+        cols, n = self._positions(positions)
+        out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
+               for name, (ax, f) in self.functions.items()}
+        out.update({k: np.full(n, v) for k, v in self.constants.items()})
+        return out
+
+    def sigmas(self, positions) -> dict:
+        """Standard deviations (mm / rad) at ``positions``: name -> (N,) array."""
+        cols, n = self._positions(positions)
+        out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
+               for name, (ax, f) in self.std_functions.items()}
+        out.update({k: np.full(n, v) for k, v in self.constants_std.items()})
+        return out
+
+
+def _clamped(x, y):
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    return lambda q: np.interp(np.asarray(q, float), x, y)
+
+
+# ---------------------------------------------------------------------------------------------
+# command-line helpers shared by the commands that take --errors

@@ -1,0 +1,234 @@
+"""Audit of Pahk (1995): verdicts, named errata, readings, CLI and numeric spot check.
+
+Independent checks: the printed equations are also evaluated numerically (no sympy) against an
+independent exact numpy chain (tests/reference_chain.py, finite differences), and errata are
+injected into a copy of the printed data to show that the audit detects and names them.
+"""
+
+import copy
+import json
+import subprocess
+import sys
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import volerr
+from volerr.audit.numeric import _evaluate, _paper_values, spot_check
+from helpers import reference_chain
+
+audit_pahk = pytest.importorskip("volerr.derive.audit_pahk")
+
+DATA = tomllib.loads((resources.files("volerr") / "data" / "printed_pahk.toml")
+                     .read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def verdicts():
+    return audit_pahk.audit(DATA, None)
+
+
+def find(verdicts, eq, comp=""):
+    hits = [v for v in verdicts if v.equation == eq and v.component == comp]
+    assert len(hits) == 1, (eq, comp, [(v.equation, v.component) for v in verdicts])
+    return hits[0]
+
+
+# --------------------------------------------------------------------------- verdicts
+def test_every_printed_equation_and_component_gets_a_verdict(verdicts):
+    ids = {e["id"] for e in DATA["equation"]}
+    assert ids == {"1", "4", "5", "6", "7", "8", "9", "10", "A1", "A2", "A3", "A4", "A5",
+                   "A6", "A7", "A8", "A9"}
+    for e in DATA["equation"]:
+        comps = list(e.get("expr", {})) or [""]
+        for c in comps:
+            v = find(verdicts, e["id"], c)
+            assert v.verdict in ("identical", "differs")
+            assert (v.erratum == "") == (v.verdict == "identical")
+            assert v.layout == e["layout"] and v.evidence
+
+
+def test_eq4_is_identical_to_the_mb1_derivation(verdicts):
+    for c in ("dX", "dY", "dZ"):
+        assert find(verdicts, "4", c).verdict == "identical"
+
+
+def test_mh2_chain_and_eq7_identical(verdicts):
+    assert find(verdicts, "6").verdict == "identical"
+    for c in ("dX", "dY", "dZ"):
+        assert find(verdicts, "7", c).verdict == "identical"
+
+
+def test_transfer_rule_omissions_named(verdicts):
+    v = find(verdicts, "9", "dx(X)")
+    assert v.verdict == "differs"
+    assert "omitted Abbe term +Yo*Ez(X)" in v.erratum
+    # eq. 4 itself has the Abbe term -Yp*Ez(X) that the rule drops
+    assert "Yp*(Ez(X)" in find(verdicts, "4", "dX").printed
+    v = find(verdicts, "9", "dy(Y)")
+    assert "Ez(Z) for Ez(Y)" in v.erratum
+    v = find(verdicts, "9", "beta1")
+    assert "extra term +Ey(Y)" in v.erratum
+    assert "slope of the Z line alone" in v.evidence
+    # Pahk's rule (1) (straightness by roll only) reproduces the printed dy(X) rule
+    assert "roll Ex(X) only" in find(verdicts, "9", "dy(X)").evidence
+
+
+def test_mb1_chain_translation_vectors_misplaced(verdicts):
+    v = find(verdicts, "1")
+    assert v.verdict == "differs"
+    assert "Ty*(Tx*(Tz*P + Lz) + Lx) + Ly" in v.erratum
+    assert "beta1" in v.evidence  # the OCR-lost beta1 of eq. 3 is noted
+
+
+def test_appendix_fb1_xy_labels_and_table_convention(verdicts):
+    a1 = find(verdicts, "A1")
+    assert a1.verdict == "differs" and "X and Y exchanged" in a1.erratum
+    for c in ("dX", "dZ"):
+        v = find(verdicts, "A2", c)
+        assert v.verdict == "differs" and "moving table origin" in v.erratum
+    assert "+Y*Ez(Y)" in find(verdicts, "A2", "dX").evidence
+
+
+def test_garbled_a5_terms_and_fh1_stacking(verdicts):
+    dz = find(verdicts, "A5", "dZ")
+    assert "Ey(X) for Ex(X)" in dz.erratum
+    assert "extra +X*Ey(X)" in find(verdicts, "A5", "dY").erratum
+    dx = find(verdicts, "A5", "dX")
+    assert "Z riding on Y" in dx.erratum      # printed A4/A5: Z rides on Y, layout: Y on Z
+    assert "Z riding on Y" in find(verdicts, "A4").erratum
+    assert "OCR" in dx.evidence               # the unbalanced parenthesis is an OCR reading
+
+
+def test_random_error_readings(verdicts):
+    for c in ("RX2", "RY2", "RZ2"):
+        assert "term-wise" in find(verdicts, "5", c).erratum
+    assert "Z*Zp" in find(verdicts, "5", "RX2").evidence  # the dropped cross term
+    assert "MB1 (eq. 5) reprinted" in find(verdicts, "8", "RY2").erratum
+    assert "beta1 for Rbeta1" in find(verdicts, "8", "RX2").erratum
+
+
+# ------------------------------------------------------------ injected errata (can fail)
+def _with(eq_id, comp, text):
+    data = copy.deepcopy(DATA)
+    eq = next(e for e in data["equation"] if e["id"] == eq_id)
+    eq["expr"][comp] = text
+    eq.get("ocr", {}).pop(comp, None)
+    return data
+
+
+def test_injected_omission_sign_and_swap_are_named():
+    good = next(e for e in DATA["equation"] if e["id"] == "4")["expr"]["dZ"]
+    data = _with("4", "dZ", good.replace("- X*Ey(Y)", "+ X*Ey(Y)"))
+    v = find(audit_pahk.audit(data, ["MB1"]), "4", "dZ")
+    assert v.verdict == "differs" and "sign of -X*Ey(Y) flipped" in v.erratum
+    data = _with("4", "dZ", good.replace("- X*Ey(Y)", "- X*Ex(Y)"))
+    v = find(audit_pahk.audit(data, ["MB1"]), "4", "dZ")
+    assert "Ex(Y) for Ey(Y)" in v.erratum
+    data = _with("9", "dx(X)", "dx(X) - Zo*Ey(X) + Yo*Ez(X)")
+    assert find(audit_pahk.audit(data, ["MB1"]), "9", "dx(X)").verdict == "identical"
+
+
+def test_layout_filter(verdicts):
+    only = audit_pahk.audit(DATA, ["MH2"])
+    assert {v.layout for v in only} == {"MH2"}
+    assert len(only) == sum(1 for v in verdicts if v.layout == "MH2")
+
+
+# ------------------------------------------- numeric, independent of the derivation
+def _printed_numeric(name, eq_id, q, errors, probe):
+    model = volerr.load(name)
+    eq = next(e for e in DATA["equation"] if e["id"] == eq_id)
+    ns = {**{k: np.array([v]) for k, v in q.items()}, "Xp": probe[0], "Yp": probe[1],
+          "Zp": probe[2], **_paper_values(model, errors)}
+    return np.array([float(np.squeeze(_evaluate(eq.get("ocr", {}).get(c, eq["expr"][c]), ns)))
+                     for c in ("dX", "dY", "dZ")])
+
+
+@pytest.mark.parametrize("name,eq_id,agrees", [("MB1", "4", True), ("MH2", "7", True),
+                                               ("FB1", "A2", False)])
+def test_printed_volumetric_vs_independent_exact_chain(name, eq_id, agrees):
+    rng = np.random.default_rng(7)
+    model = volerr.load(name)
+    layout = model.layout
+    q = {a: rng.uniform(*layout.axes[a].travel) for a in layout.axis_names}
+    probe = rng.uniform(-80, 80, 3)
+    errors = {p: rng.normal(0, 20e-6 if p[1] in "ABC" else 5e-3) for p in model.parameters}
+    ref = reference_chain.first_order_by_differences(layout, q, errors, probe)
+    printed = _printed_numeric(name, eq_id, q, errors, probe)
+    if agrees:
+        np.testing.assert_allclose(printed, ref, atol=1e-9)
+    else:
+        # A2: own-travel terms of the table (Y*Ez(Y) in dX, -Y*Ex(Y) in dZ, paper signs)
+        ez_y, ex_y = -errors["ECY"], -errors["EAY"]
+        np.testing.assert_allclose(printed - ref, [q["Y"] * ez_y, 0, -q["Y"] * ex_y],
+                                   atol=1e-9)
+
+
+def test_spot_check_reports_rounding_level_and_real_differences():
+    rows = {(r["equation"], r["component"]): r for r in spot_check(volerr.load("MB1"), n=50)}
+    assert all(rows[("4", c)]["status"] == "agrees" for c in ("dX", "dY", "dZ"))
+    assert rows[("5", "RX2")]["status"] == "agrees"         # term-wise quadrature
+    assert rows[("5", "RX2")]["max_diff_exact_um"] > 1e-6    # ... not exact propagation
+    rows = {(r["equation"], r["component"]): r for r in spot_check(volerr.load("FB1"), n=50)}
+    assert rows[("A2", "dY")]["status"] == "agrees"
+    assert rows[("A2", "dX")]["status"] == "differs"
+    assert spot_check(volerr.load("MB2")) == []
+
+
+# ------------------------------------------------------------------------------- CLI
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "volerr", "audit", *args],
+                          capture_output=True, text=True)
+
+
+def assert_clean_failure(proc, fragment=""):
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert fragment.lower() in lines[0].lower()
+
+
+def test_cli_table_and_json(tmp_path):
+    out = tmp_path / "audit.json"
+    proc = run("MB1", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    rows = json.loads(out.read_text())
+    assert isinstance(rows, list) and rows
+    keys = {"source", "equation", "layout", "verdict", "erratum", "evidence", "printed",
+            "derived"}
+    for r in rows:
+        assert keys <= set(r) and r["layout"] == "MB1"
+        assert r["verdict"] in ("identical", "differs")
+    assert {r["equation"] for r in rows} == {"1", "4", "5", "9"}
+    lines = proc.stdout.splitlines()
+    row4 = next(ln for ln in lines if ln.split()[2:3] == ["4"])
+    assert "identical" in row4
+    assert any("omitted Abbe term +Yo*Ez(X)" in ln for ln in lines)
+
+
+def test_cli_numeric():
+    proc = run("MB1", "--numeric", "--points", "20")
+    assert proc.returncode == 0, proc.stderr
+    assert "numeric spot check" in proc.stdout and "agrees" in proc.stdout
+
+
+def test_cli_bad_input(tmp_path):
+    assert_clean_failure(run("NOPE"), "unknown layout")
+    assert_clean_failure(run("MB1", "--points", "0"), "points")
+    data = resources.files("volerr") / "data" / "printed_pahk.toml"
+    before = Path(str(data)).read_bytes()
+    assert_clean_failure(run("MB1", "--json", str(data)), "refusing to overwrite")
+    assert Path(str(data)).read_bytes() == before
+
+
+def test_literal_eq3_lz_without_ocr_reading_is_not_a_valid_chain():
+    data = copy.deepcopy(DATA)
+    eq1 = next(e for e in data["equation"] if e["id"] == "1")
+    eq1["ocr"].pop("L.z")                  # 'dx(Z) - Z' taken literally: a -Z nominal offset
+    v = find(audit_pahk.audit(data, ["MB1"]), "1")
+    assert v.verdict == "differs" and "cannot be evaluated" in v.erratum
+    assert "nominal point" in v.evidence

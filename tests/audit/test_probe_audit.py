@@ -1,0 +1,50 @@
+"""Audit of Pahk sec. 3 (eq. 11-17): printed forms against the probe-frame derivation."""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+
+import numpy as np
+import pytest
+
+from volerr.probe import calibration as probe
+
+
+@pytest.fixture(scope="module")
+def verdicts():
+    from volerr.derive import audit_probe
+
+    text = (resources.files("volerr") / "data" / audit_probe.DATA_FILE).read_text()
+    return {(v.equation, v.component): v for v in audit_probe.audit(tomllib.loads(text))}
+
+
+def test_verdicts(verdicts):
+    differs = {k for k, v in verdicts.items() if v.verdict == "differs"}
+    assert differs == {("12", "Tp"), ("16", "theta")}
+    assert "transposed" in verdicts[("12", "Tp")].erratum
+    assert "OCR" in verdicts[("12", "Tp")].evidence
+    assert "quadrant" in verdicts[("16", "theta")].erratum
+    for key in [("11", "e'_x"), ("11", "e'_y"), ("14", "M'"), ("15", "phi"), ("13", "Probe"),
+                ("17", "dXc")]:
+        assert verdicts[key].verdict == "identical" and verdicts[key].erratum == ""
+
+
+def test_erratum_evidence_numerically():
+    """The printed Tp maps probe to machine coordinates: its columns are the probe axes."""
+    a, b = np.radians(35.0), np.radians(-70.0)
+    printed = np.array([[np.cos(a) * np.cos(b), -np.sin(b), -np.sin(a) * np.cos(b)],
+                        [np.cos(a) * np.sin(b), np.cos(b), -np.sin(a) * np.sin(b)],
+                        [np.sin(a), 0.0, np.cos(a)]])
+    np.testing.assert_allclose(printed, probe.probe2machine(35.0, -70.0), atol=1e-15)
+    stylus = printed @ [0, 0, 1.0]          # the probe axis z' in machine coordinates
+    np.testing.assert_allclose(stylus, [-np.sin(a) * np.cos(b), -np.sin(a) * np.sin(b),
+                                        np.cos(a)], atol=1e-15)
+    # the stated [x'] = Tp [x] with the printed matrix would not give z' = (0, 0, 1)
+    assert not np.allclose(printed @ stylus, [0, 0, 1])
+
+
+def test_provider_registered():
+    from volerr.derive import audit
+
+    assert "volerr.derive.audit_probe" in audit.PROVIDERS
