@@ -41,8 +41,8 @@ correction to 20 degC (ISO 1), with --cte-ppm-per-K:
 outputs:
   --json: ISO 230-2:2014 clause 3 figures in um: A_um A_fwd_um A_bwd_um B_um B_avg_um R_um
   R_fwd_um R_bwd_um E_um E_fwd_um E_bwd_um M_um, per-target arrays (targets_mm, mean_fwd_um,
-  mean_bwd_um, mean_um, reversal_um, s_fwd_um, s_bwd_um, R_fwd_um, R_bwd_um, R_um), axis,
-  n_cycles, temperature_correction.  Several RUN files: {"runs": [...]}, same keys per run.
+  mean_bwd_um, mean_um, reversal_um, s_fwd_um, s_bwd_um, R_i_fwd_um, R_i_bwd_um, R_i_um),
+  axis, n_cycles, temperature_correction.  Several RUN files: {"runs": [...]}, same keys per run.
   E is bidirectional: max - min of the mean deviations of BOTH directions (not max(E_fwd,
   E_bwd)); B = max |B_i|, B_avg = mean of B_i = forward minus backward.
   --table-out DIR: DIR/<axis>.csv with <axis>,EXX_um,EXX_std_um,RV_X_um (for axis X):
