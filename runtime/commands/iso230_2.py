@@ -112,11 +112,12 @@ def run(args) -> int:
         require(not dup, f"--table-out writes one table per axis: {len(inputs)} runs of axis "
                          f"{dup[0] if dup else ''}; evaluate them one at a time")
         tables = [d / f"{a}.csv" for a in axes]
-    for i, o in enumerate(outputs + [str(t) for t in tables]):
-        check_output(o, inputs + (outputs + [str(t) for t in tables])[:i])
-        for prev in (outputs + [str(t) for t in tables])[:i]:
-            require(Path(o).resolve() != Path(prev).resolve(), f"two outputs are the same file "
-                                                               f"{o}")
+    every = outputs + [str(t) for t in tables]
+    for i, o in enumerate(every):
+        check_output(o, inputs)
+        require(all(Path(o).resolve() != Path(q).resolve() for q in every[:i]),
+                f"two outputs are the same file {o}: give distinct --json, --plot, --html and "
+                f"--table-out paths")
     if args.plot:
         check_plot(args.plot, inputs)
 
@@ -136,7 +137,9 @@ def run(args) -> int:
     html_text = None
     if args.html:
         from volerr import __version__ as ver
-        html_text = pos.report_html(report, png, inputs, f"Evaluated with volerr {ver}.")
+        import datetime
+        html_text = pos.report_html(report, png, inputs, f"Evaluated with volerr {ver} on "
+                                                         f"{datetime.date.today().isoformat()}.")
 
     # all outputs at the end
     write_text(args.json, json.dumps(report, indent=2) + "\n", inputs=inputs)

@@ -218,8 +218,11 @@ def _assemble(path, axis, entries, temps, fmt, conditions, ignored) -> Positioni
     targets = {}
     for (tk, _, _), (_, t, _) in entries.items():
         targets.setdefault(tk, t)
+    dirs = {}
+    for (k, d, _) in entries:
+        dirs.setdefault(k, set()).add(d)
     for tk in tkeys:
-        have = {d for (k, d, _) in entries if k == tk}
+        have = dirs[tk]
         if len(have) == 1:
             only = DIRECTION_NAMES[have.pop()]
             raise InputError(f"{path}: target {targets[tk]:g} mm is measured in the {only} "

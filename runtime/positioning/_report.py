@@ -10,7 +10,8 @@ R_i_bwd_um R_i_um`` (the repeatabilities at each position carry the standard's i
 that they do not collide with the axis figures ``R_um R_fwd_um R_bwd_um``),
 ``temperature_correction``
 (``{"applied": false}`` or what was done), ``conditions`` (other temperature columns: min,
-mean, max degC), ``notes`` and ``standard``.
+mean, max degC), ``ignored_columns`` (columns of the file not used), ``notes`` and
+``standard``.
 
 Error table (``DIR/<axis>.csv``, :mod:`volerr.tables` format): ``E<axis><axis>_um`` = mean
 bidirectional deviation x_i at each target, ``E<axis><axis>_std_um`` = pooled unidirectional
@@ -56,6 +57,7 @@ def run_dict(ev: Evaluation, thermal=None, notes=()) -> dict:
         t = run.temperature
         out["conditions"]["material_T_C"] = {"min": float(t.min()), "mean": float(t.mean()),
                                              "max": float(t.max())}
+    out["ignored_columns"] = list(run.ignored_columns)
     out["notes"] = list(notes)
     return out
 

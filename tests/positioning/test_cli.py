@@ -238,3 +238,10 @@ def test_help_documents_both_formats(capsys):
     out = capsys.readouterr().out
     assert "target_mm,cycle,direction,deviation_um" in out
     assert "target_mm,fwd_1_um,bwd_1_um" in out
+
+
+def test_two_outputs_the_same_file_refused(tmp_path, capsys):
+    f = write_long(tmp_path / "run.csv", simulated())
+    assert run_cli(f, "--json", tmp_path / "a.out", "--html", tmp_path / "a.out") == 2
+    assert "two outputs are the same file" in capsys.readouterr().err
+    assert not (tmp_path / "a.out").exists()
