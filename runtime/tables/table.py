@@ -17,6 +17,11 @@ File formats (INTERFACE.md)
   (Type A, repeatability) and/or the expanded uncertainty (k = 2).  Written as
   ``EXX_std_um`` / ``EXX_u95_um`` (unit stays the last suffix, like every other column);
   ``EXX_um_std`` / ``EXX_um_u95`` are accepted on read.
+* optional reversal column ``RV_<axis>_um`` (or ``_mm``; linear axes): the ISO 230-2 reversal
+  value B_i at each position = mean positional deviation approaching in the positive direction
+  minus approaching in the negative direction (the sign of the loop's ``RV_<axis>`` effect):
+  forward EXX + RV/2, backward EXX - RV/2 when EXX is the bidirectional mean.  Read into
+  :attr:`ErrorTable.reversal`; the volumetric model does not use it (``volerr iso230-2`` writes it).
 * blank lines and lines starting with ``#`` are ignored; every other cell must be a finite number.
 * lenient spelling: names and units in any case (``exx_UM`` = ``EXX_um``; ``µm``/``µrad`` =
   ``um``/``urad``); the axis column may stand anywhere (it is moved first); columns that are
@@ -70,6 +75,7 @@ _COL = re.compile(r"^(?P<name>[A-Za-z0-9]+?)"
 #: a column that names an error parameter (any case): it must carry a unit suffix
 _PARAM_LIKE = re.compile(r"^E[XYZABC]0?[A-Z](?:_|$)", re.IGNORECASE)
 _AXIS_COL = re.compile(r"([A-Za-z])(?:_(mm|deg))?", re.IGNORECASE)
+_REVERSAL_COL = re.compile(r"RV_([A-Z])_(um|mm)", re.IGNORECASE)
 
 
 def _unit_text(text: str) -> str:
@@ -109,19 +115,24 @@ class ErrorTable:
 
     ``positions``: shape (n,), mm or deg, strictly increasing.  ``values``, ``std``, ``u95``:
     ISO name -> shape (n,) arrays in mm (translational) or rad (angular); ``std`` is the standard
-    deviation (Type A), ``u95`` the expanded uncertainty (k = 2); both may be empty."""
+    deviation (Type A), ``u95`` the expanded uncertainty (k = 2); both may be empty.
+    ``reversal``: shape (n,) mm or None, the ISO 230-2 reversal B_i (positive-direction minus
+    negative-direction approach) at each position."""
 
     axis: str
     positions: np.ndarray
     values: dict
     std: dict = field(default_factory=dict)
     u95: dict = field(default_factory=dict)
+    reversal: np.ndarray | None = None
 
     def __post_init__(self):
         self.positions = np.asarray(self.positions, dtype=float)
         self.values = {k: np.asarray(v, dtype=float) for k, v in self.values.items()}
         self.std = {k: np.asarray(v, dtype=float) for k, v in (self.std or {}).items()}
         self.u95 = {k: np.asarray(v, dtype=float) for k, v in (self.u95 or {}).items()}
+        if self.reversal is not None:
+            self.reversal = np.asarray(self.reversal, dtype=float)
         self.validate()
 
     def validate(self, where: str = "") -> None:
@@ -149,6 +160,9 @@ class ErrorTable:
                 if label:
                     require(k in self.values, f"{w}: {label.strip()} column for {k} without a {k} column")
                     require(np.all(v >= 0), f"{w}: {label}{k} has negative values")
+        if self.reversal is not None:
+            require(self.reversal.shape == p.shape and np.all(np.isfinite(self.reversal)),
+                    f"{w}: reversal needs {p.size} finite values")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -213,6 +227,9 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
             order = at + [j for j in range(len(header)) if j != at[0]]
             header = [header[j] for j in order]
             body = [(ln, [cells[j] for j in order]) for ln, cells in body]
+    rv = [j for j, h in enumerate(header) if _REVERSAL_COL.fullmatch(_unit_text(h))]
+    require(len(rv) <= 1, f"{path}: more than one reversal column (RV_<axis>_um)")
+    rv_col = (header[rv[0]], [cells[rv[0]] for _, cells in body]) if rv else None
     keep = [0] + [j for j in range(1, len(header)) if not _ignored_column(header[j])]
     if len(keep) < len(header):
         header = [header[j] for j in keep]
@@ -241,8 +258,15 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
         {"": values, "std": std, "u95": u95}[kind][name] = _to_internal(data[:, j], unit)
     for name in list(std) + list(u95):
         require(name in values, f"{path}: uncertainty column for {name} without a {name} column")
+    reversal = None
+    if rv_col is not None:
+        rm = _REVERSAL_COL.fullmatch(_unit_text(rv_col[0]))
+        require(rm.group(1).upper() == tax, f"{path}: reversal column {rv_col[0]!r} names axis "
+                                            f"{rm.group(1).upper()}, the table is for {tax}")
+        reversal = _to_internal([_number(path, ln, rv_col[0], c)
+                                 for (ln, _), c in zip(body, rv_col[1])], rm.group(2).lower())
     try:
-        return ErrorTable(tax, data[:, 0], values, std, u95)
+        return ErrorTable(tax, data[:, 0], values, std, u95, reversal)
     except InputError as exc:
         msg = str(exc).split(": ", 1)[-1]
         raise InputError(f"{path}: {msg}") from None
@@ -268,6 +292,9 @@ def table_to_csv(table: ErrorTable) -> str:
                 unit = "um" if parameter_kind(n) == "length" else "urad"
                 header.append(f"{n}_{kind}_{unit}")
                 columns.append(_from_internal(dct[n], unit))
+    if table.reversal is not None:
+        header.append(f"RV_{table.axis}_um")
+        columns.append(_from_internal(table.reversal, "um"))
     lines = [",".join(header)]
     for row in zip(*columns):
         lines.append(",".join(_fmt(v) for v in row))
