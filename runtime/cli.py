@@ -15,7 +15,7 @@ from .errors import InputError
 
 #: command modules, in the order shown by ``volerr --help``
 COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
-            "probe_cal", "compensate", "tcpmap", "controller", "loop", "simulate", "demo")
+            "probe_cal", "compensate", "tcpmap", "controller", "loop", "simulate", "uncertainty", "iso10360", "demo")
 
 
 class _Parser(argparse.ArgumentParser):
