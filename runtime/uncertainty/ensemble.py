@@ -260,7 +260,14 @@ class SpecMachines(Source):
         out = {}
         for p, c in zip(self.params, coef):
             ax = self.paxis[p]
-            out[p] = c if ax is None else c @ vander[ax].T
+            if ax is None:
+                out[p] = c
+                continue
+            V = vander[ax]  # (P, D): a short sum of broadcast products beats a thin matmul
+            v = c[:, :1] * V[:, 0]
+            for k in range(1, V.shape[1]):
+                v += c[:, k:k + 1] * V[:, k]
+            out[p] = v
         return out
 
     def _length_errors(self, model, coef, noise):

@@ -224,7 +224,7 @@ class Runner:
             parts = [run_blocks(problem, g) for g in it]
         else:
             from dask.distributed import wait  # noqa: F401
-            fut = self._client.scatter(problem, broadcast=True)
+            fut = self._client.scatter(problem, broadcast=True, hash=False)
             futures = [self._client.submit(run_blocks, fut, g, pure=False) for g in groups]
             parts = self._client.gather(futures)
         info = {}

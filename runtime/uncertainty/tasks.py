@@ -136,6 +136,12 @@ def _solve(jtj, jtr):
     return np.linalg.solve(jtj, jtr[..., None])[..., 0]
 
 
+def _normal(J, r):
+    """J^T J (S, k, k) and J^T r (S, k) of a batch of Jacobians J (S, P, k), residuals (S, P)."""
+    Jt = np.swapaxes(J, 1, 2)
+    return Jt @ J, (Jt @ r[..., None])[..., 0]
+
+
 def _plane(points):
     """Centroid (S, 3), unit normal (S, 3) of the least-squares plane."""
     c = points.mean(axis=1)
@@ -149,12 +155,12 @@ def _plane(points):
     return c, n
 
 
-def _circle2d(u, v, iterations=4):
+def _circle2d(u, v, iterations=3):
     """Geometric least-squares circle of 2-D points (S, P) -> centre (S, 2), radius (S,)."""
     # algebraic (Kasa) start, then Gauss-Newton on the geometric residual |p - c| - r
     A = np.stack([u, v, np.ones_like(u)], axis=-1)
     b = u ** 2 + v ** 2
-    sol = _solve(np.einsum("spi,spj->sij", A, A), np.einsum("spi,sp->si", A, b))
+    sol = _solve(*_normal(A, b))
     cu, cv = sol[:, 0] / 2, sol[:, 1] / 2
     r = np.sqrt(sol[:, 2] + cu ** 2 + cv ** 2)
     for _ in range(iterations):
@@ -162,18 +168,18 @@ def _circle2d(u, v, iterations=4):
         rho = np.sqrt(du ** 2 + dv ** 2)
         res = rho - r[:, None]
         J = np.stack([-du / rho, -dv / rho, -np.ones_like(rho)], axis=-1)
-        step = _solve(np.einsum("spi,spj->sij", J, J), -np.einsum("spi,sp->si", J, res))
+        step = _solve(*_normal(J, -res))
         cu, cv, r = cu + step[:, 0], cv + step[:, 1], r + step[:, 2]
     return np.stack([cu, cv], axis=-1), r
 
 
-def fit_sphere(points, iterations=4):
+def fit_sphere(points, iterations=3):
     """Geometric least-squares sphere of (S, P, 3) points -> centre (S, 3), radius (S,)."""
     o = points.mean(axis=1, keepdims=True)
     q = points - o
     A = np.concatenate([q, np.ones(q.shape[:2] + (1,))], axis=-1)
     b = np.sum(q ** 2, axis=-1)
-    sol = _solve(np.einsum("spi,spj->sij", A, A), np.einsum("spi,sp->si", A, b))
+    sol = _solve(*_normal(A, b))
     c = sol[:, :3] / 2
     r = np.sqrt(sol[:, 3] + np.sum(c ** 2, axis=1))
     for _ in range(iterations):
@@ -181,7 +187,7 @@ def fit_sphere(points, iterations=4):
         rho = np.linalg.norm(d, axis=-1)
         res = rho - r[:, None]
         J = np.concatenate([-d / rho[..., None], -np.ones(rho.shape + (1,))], axis=-1)
-        step = _solve(np.einsum("spi,spj->sij", J, J), -np.einsum("spi,sp->si", J, res))
+        step = _solve(*_normal(J, -res))
         c, r = c + step[:, :3], r + step[:, 3]
     return c + o[:, 0, :], r
 
