@@ -17,7 +17,8 @@ __all__ = ["InputError"]
 
 #: command modules, in the order shown by ``volerr --help``
 COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
-            "probe_cal", "compensate", "tcpmap", "controller", "loop", "simulate", "iso230_2", "demo")
+            "probe_cal", "compensate", "tcpmap", "controller", "loop", "simulate", "iso230_2",
+            "uncertainty", "iso10360", "demo")
 
 
 class _Parser(argparse.ArgumentParser):

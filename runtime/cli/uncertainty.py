@@ -1,0 +1,171 @@
+"""``volerr uncertainty LAYOUT --task T.csv --evaluate E --json F``: task-specific measurement
+uncertainty by Monte Carlo (virtual CMM, ISO/TS 15530-4; JCGM 101).
+
+Machine knowledge: identified error tables with their std / u95 columns (--errors), or a
+specification only (--spec "E0=A+L/K", constrained Monte Carlo), plus probing noise
+(--noise-um), a probe error map (--probe-map) and temperature.  With only --noise-um the
+machine is perfect and the noise independent per point.  Reports estimate, bias of the known
+errors, u, U (k = 2) and the probabilistically symmetric 95 % interval.  Models and
+conventions: volerr.uncertainty.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from volerr.cli._common import add_error_arguments
+from volerr.errors import require
+from volerr.fileio import check_output, write_bytes, write_text
+from volerr.machine.model import load
+from volerr.uncertainty import ensemble, montecarlo as mc, tasks
+
+
+def register(sub) -> None:
+    p = sub.add_parser("uncertainty", help="task-specific uncertainty by Monte Carlo (virtual CMM)",
+                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    p.add_argument("layout", help="layout name (volerr layouts) or layout file")
+    p.add_argument("--task", required=True, metavar="CSV", help="probing points X,Y,Z[,i,j,k]"
+                                                                 "[,Xp,Yp,Zp] mm")
+    p.add_argument("--evaluate", required=True, metavar="E",
+                   help="distance, circle, sphere or plane")
+    add_error_arguments(p, required=False)
+    p.add_argument("--table-std", choices=("systematic", "repeatability"), default="systematic",
+                   help="table std columns: one perturbed error function per machine "
+                        "(default) or independent per probing point")
+    p.add_argument("--correlation-mm", type=float, default=0.0, metavar="L",
+                   help="correlation length of the node perturbations along an axis "
+                        "(default 0: independent nodes)")
+    p.add_argument("--spec", metavar="'E0=A+L/K'", help="ISO 10360-2 specification (A um, L mm, "
+                   "K), optionally ',PFTU=P' um: constrained Monte Carlo")
+    p.add_argument("--spec-acceptance", type=float, default=0.5, metavar="F",
+                   help="fraction of prior candidates passing the test (sets the prior scale)")
+    p.add_argument("--noise-um", type=float, default=0.0, metavar="S",
+                   help="probing noise, standard deviation per point, um")
+    p.add_argument("--probe-map", metavar="MAP.csv", help="probe error map of probe-cal "
+                                                          "(needs i,j,k in the task)")
+    for name, what in (("part-cte", "part expansion coefficient and its u, 1/K"),
+                       ("part-dt", "part temperature - 20 C and its u, K"),
+                       ("scale-cte", "scale expansion coefficient and its u, 1/K"),
+                       ("scale-dt", "scale temperature - 20 C and its u, K")):
+        p.add_argument(f"--{name}", nargs=2, type=float, metavar=("VALUE", "U"), help=what)
+    p.add_argument("--temperature-compensated", action="store_true",
+                   help="the CMM corrects the nominal expansion; only the uncertainties remain")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--samples", type=int, default=None, metavar="N",
+                   help="number of Monte Carlo samples (default 10000)")
+    g.add_argument("--adaptive", action="store_true",
+                   help="adaptive Monte Carlo, JCGM 101 7.9 (--digits significant digits)")
+    p.add_argument("--digits", type=int, default=2, help="significant digits of u for "
+                                                        "--adaptive (default 2)")
+    p.add_argument("--max-samples", type=int, default=1_000_000)
+    p.add_argument("--seed", type=int, default=0, metavar="K")
+    p.add_argument("--chunks", type=int, default=1, metavar="M",
+                   help="split the samples into M chunks (results identical for any M)")
+    p.add_argument("--scheduler", choices=("none", "dask"), default="none")
+    p.add_argument("--scheduler-address", metavar="ADDR", help="an existing dask scheduler")
+    p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (default 2)")
+    p.add_argument("--contributions", type=int, default=2000, metavar="N",
+                   help="samples per source for the one-at-a-time ranking (0: skip)")
+    p.add_argument("--json", required=True, metavar="F")
+    p.add_argument("--html", metavar="F", help="report with histogram and convergence plots")
+    p.add_argument("--plot", metavar="PNG", help="histogram plot")
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=run)
+
+
+def _temperature(args):
+    vals = {k: getattr(args, k) for k in ("part_cte", "part_dt", "scale_cte", "scale_dt")}
+    if all(v is None for v in vals.values()):
+        return None
+    kw = {}
+    for k, v in vals.items():
+        v = v or (0.0, 0.0)
+        require(all(abs(x) < 1e3 for x in v) and v[1] >= 0,
+                f"--{k.replace('_', '-')}: value and a non-negative u")
+        kw[k], kw[f"u_{k}"] = float(v[0]), float(v[1])
+    return ensemble.Temperature(**kw, compensated=args.temperature_compensated)
+
+
+def run(args) -> int:
+    from volerr.cli._common import error_functions_from_args, inputs_of
+
+    require(args.evaluate in tasks.EVALUATIONS, f"unknown evaluation {args.evaluate!r} "
+                                                f"(one of {', '.join(tasks.EVALUATIONS)})")
+    model = load(args.layout)
+    inputs = [Path(args.task)] + ([Path(args.probe_map)] if args.probe_map else [])
+    if args.errors:
+        inputs += inputs_of(args)
+    outs = [("--json", args.json), ("--html", args.html), ("--plot", args.plot)]
+    from volerr.cmm.volmap import check_distinct
+    check_distinct(*outs)
+    for _, o in outs:
+        if o is not None:
+            check_output(o, inputs)
+    if args.plot:
+        from volerr.fileio import check_plot
+        check_plot(args.plot, inputs)
+    task = tasks.read_task(args.task, model.axes)
+    funcs = error_functions_from_args(args, model) if args.errors else None
+    spec = ensemble.parse_spec(args.spec) if args.spec else None
+    require(funcs is not None or spec is not None or args.noise_um > 0 or args.probe_map
+            or _temperature(args) is not None,
+            "nothing is uncertain: give --errors, --spec, --noise-um or temperatures")
+    pmap = None
+    if args.probe_map:
+        from volerr.probe import read_probe_map
+        pmap = read_probe_map(args.probe_map)
+    ens = ensemble.Ensemble.build(funcs, spec, args.noise_um, args.table_std, args.correlation_mm,
+                                  _temperature(args), pmap, args.seed,
+                                  spec_acceptance=args.spec_acceptance)
+    prob = mc.prepare(model, str(args.layout), task, args.evaluate, ens, seed=args.seed)
+    require(prob.sources, "nothing is random: the tables have no std / u95 columns and no "
+                          "noise, spec or temperature uncertainty is given")
+    runner = mc.Runner(args.scheduler, args.chunks, args.workers, args.scheduler_address,
+                       progress=not args.quiet)
+    adaptive = None
+    with runner:
+        if args.adaptive:
+            values, info, adaptive = mc.run_adaptive(prob, runner, args.digits,
+                                                     max_samples=args.max_samples)
+        else:
+            n = 10_000 if args.samples is None else args.samples
+            require(2 <= n <= 10**8, "--samples must be between 2 and 1e8")
+            values, info = mc.run(prob, n, runner)
+    summary = mc.summarize(prob, values)
+    doc = {"layout": model.name, "task": str(args.task), "evaluation": args.evaluate,
+           "quantities": summary, "samples": int(values.shape[0]), "seed": args.seed,
+           "block_size": prob.block_size, "chunks": args.chunks, "scheduler": args.scheduler,
+           "machine": ("spec " + spec.text()) if spec else (f"tables {args.errors} "
+                                                          f"({args.table_std})" if funcs
+                                                          else "perfect"),
+           "noise_um": args.noise_um, "sources": [s.name for s in prob.sources]}
+    if "candidates" in info:
+        doc["spec_acceptance"] = {"candidates": info["candidates"], "kept": info["kept"],
+                                  "fraction": info["kept"] / info["candidates"]}
+    if adaptive is not None:
+        doc["adaptive"] = {"runs": adaptive.runs, "samples_per_run": adaptive.per_run,
+                           "converged": adaptive.converged, "digits": args.digits,
+                           "tolerance_um": [d * 1e3 for d in adaptive.delta_mm]}
+    if args.contributions:
+        doc["contributions"] = mc.contributions(prob, args.contributions)
+    title = f"{model.name} {args.evaluate} ({values.shape[0]} samples)"
+    hist = None
+    if args.plot or args.html:
+        from volerr.uncertainty import plots
+        hist = plots.histogram_png(values, prob.names, summary, title)
+    if not args.quiet:
+        print(f"{model.name} {args.evaluate}: {values.shape[0]} samples, seed {args.seed}")
+        for name, q in summary.items():
+            lo, hi = q["coverage_interval_mm"]
+            print(f"  {name:9s} {q['estimate_mm']:.6f} mm  bias {q['bias_um']:+.3f} um  "
+                  f"u {q['standard_uncertainty_um']:.3f} um  U {q['expanded_uncertainty_um']:.3f}"
+                  f" um  95% [{lo:.6f}, {hi:.6f}] mm")
+    write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs)
+    if args.plot:
+        write_bytes(args.plot, hist, inputs)
+    if args.html:
+        from volerr.uncertainty import plots, report
+        conv = plots.convergence_png(values, prob.names, title)
+        write_text(args.html, report.html_report(doc, [hist, conv]), inputs)
+    return 0

@@ -1,0 +1,255 @@
+"""Simulated ISO 10360-2 length measuring test (E0) on a virtual CMM.
+
+Geometry (``length_test``): the box of the three linear axes; 7 positions = the 4 space
+diagonals and 3 lines parallel to X, Y, Z, all through the box centre; on each line 5 test
+lengths ``fractions`` (default 0.1 0.25 0.4 0.55 0.7) of the line's length inside the box,
+centred on the box centre (the longest is >= 66 % of the line, as the standard asks for the
+space diagonals; on the axis lines the travel limits the length); each measured
+``repetitions`` (default 3) times.  Bidirectional (gauge block / step gauge faces): the near
+end is probed along -u, the far end along +u, u the unit vector of the line.
+
+Sign convention: the model's error e = actual - nominal probe tip.  The probe touches the
+gauge face at the actual position s; the CMM reads the nominal one, m = s - e(q) (+ noise
+along the probing direction).  The length error is E = (m_far - m_near) . u - L
+= -(e_far - e_near) . u (+ noise): a pure scale error EXX = s * X (s > 0: the machine moves
+further than it indicates) gives E = -s L on the X line (|E| = s L).
+MPE line: MPE_E0 = A + L / K, A in um, L in mm, K dimensionless (E0 in um).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volerr.errors import require
+
+FRACTIONS = (0.1, 0.25, 0.4, 0.55, 0.7)
+
+
+@dataclass(frozen=True)
+class Spec:
+    """ISO 10360-2 specification: MPE_E0 = A + L/K (um, L in mm); optional MPE_PFTU (um)."""
+
+    A_um: float
+    K: float
+    pftu_um: float | None = None
+
+    def mpe_um(self, length_mm):
+        return self.A_um + np.asarray(length_mm, dtype=float) / self.K
+
+    def text(self) -> str:
+        s = f"E0 = {self.A_um:g} + L/{self.K:g} um"
+        return s + (f", PFTU = {self.pftu_um:g} um" if self.pftu_um is not None else "")
+
+
+_NUM = r"([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)"
+
+
+def parse_spec(text: str) -> Spec:
+    """``"E0=A+L/K"`` (A um, K dimensionless), optionally ``",PFTU=P"`` (um)."""
+    t = str(text).replace(" ", "")
+    m = re.fullmatch(r"(?:MPE_?)?E0?=" + _NUM + r"\+L/" + _NUM + r"(?:[,;](?:MPE_?)?PFTU=" + _NUM
+                     + r")?", t, re.IGNORECASE)
+    require(m is not None, f"--spec {text!r}: expected \"E0=A+L/K\" (A in um, L in mm, K "
+                           f"dimensionless), optionally \",PFTU=P\" (um)")
+    a, k = float(m.group(1)), float(m.group(2))
+    require(a > 0 and k > 0, f"--spec {text!r}: A and K must be positive")
+    p = float(m.group(3)) if m.group(3) else None
+    require(p is None or p > 0, f"--spec {text!r}: PFTU must be positive")
+    return Spec(a, k, p)
+
+
+@dataclass
+class LengthTest:
+    """The test's measurements.  ``names``: line name per position (7,); ``lengths`` (7, 5)
+    mm; ``u`` (7, 3) unit vectors; ``targets`` (7, 5, 2, 3) nominal probe-tip points of the
+    near and far gauge face, mm; ``positions``: axis -> (7*5*2,) axis positions (mm, module
+    units) of those points in C order; ``probe`` (3,) mm; ``directions`` (7, 5, 2, 3)."""
+
+    names: tuple
+    lengths: np.ndarray
+    u: np.ndarray
+    targets: np.ndarray
+    positions: dict
+    probe: np.ndarray
+    directions: np.ndarray
+    repetitions: int = 3
+    box: dict = field(default_factory=dict)
+
+
+def linear_box(model, box=None) -> dict:
+    lin = tuple(a for a in model.axes if a not in model.rotary_axes)
+    require(len(lin) == 3 and set(lin) == {"X", "Y", "Z"},
+            f"{model.name}: the length test needs three linear axes X Y Z")
+    box = dict(model.travel if box is None else box)
+    return {a: tuple(map(float, box[a])) for a in ("X", "Y", "Z")}
+
+
+def axis_positions(model, targets, probe) -> dict:
+    """Axis positions (module units) that put the nominal probe tip at ``targets`` (N, 3) mm,
+    for the linear axes (nominal position affine in them); rotary axes at 0."""
+    targets = np.asarray(targets, dtype=float).reshape(-1, 3)
+    n = targets.shape[0]
+    zero = {a: np.zeros(1) for a in model.axes}
+    p = {"Xp": float(probe[0]), "Yp": float(probe[1]), "Zp": float(probe[2])}
+
+    def nominal(pos):
+        return np.array([np.broadcast_to(c, (1,))[0] for c in model.module.nominal_position(**pos, **p)])
+
+    n0 = nominal(zero)
+    J = np.empty((3, 3))
+    for j, a in enumerate(("X", "Y", "Z")):
+        J[:, j] = nominal({**zero, a: np.ones(1)}) - n0
+    q = np.linalg.solve(J, (targets - n0).T)
+    out = {a: np.zeros(n) for a in model.axes}
+    for j, a in enumerate(("X", "Y", "Z")):
+        out[a] = q[j]
+    return out
+
+
+def length_test(model, box=None, probe=(0.0, 0.0, 0.0), fractions=FRACTIONS,
+                repetitions: int = 3) -> LengthTest:
+    """The ISO 10360-2 test geometry inside ``box`` (default the travel); see module doc."""
+    box = linear_box(model, box)
+    probe = np.asarray(probe, dtype=float)
+    require(probe.shape == (3,) and np.all(np.isfinite(probe)), "probe offset: three numbers")
+    require(repetitions >= 1, "repetitions must be >= 1")
+    lo = np.array([box[a][0] for a in "XYZ"])
+    hi = np.array([box[a][1] for a in "XYZ"])
+    require(np.all(hi > lo), "the box is empty")
+    # the box of axis positions -> the box of nominal probe-tip points (CMM: shifted by probe)
+    p0 = axis_positions(model, np.zeros((1, 3)), probe)
+    shift = -np.array([p0[a][0] for a in "XYZ"])
+    centre = 0.5 * (lo + hi) + shift
+    half = 0.5 * (hi - lo)
+    names, dirs, extents = [], [], []
+    for sx, sy, sz in ((1, 1, 1), (-1, 1, 1), (1, -1, 1), (1, 1, -1)):
+        d = np.array([sx, sy, sz]) * half
+        names.append(f"diagonal {'+' if sx > 0 else '-'}X{'+' if sy > 0 else '-'}Y"
+                     f"{'+' if sz > 0 else '-'}Z")
+        extents.append(2 * np.linalg.norm(d))
+        dirs.append(d / np.linalg.norm(d))
+    for j, a in enumerate("XYZ"):
+        e = np.zeros(3)
+        e[j] = 1.0
+        names.append(f"axis {a}")
+        dirs.append(e)
+        extents.append(2 * half[j])
+    u = np.array(dirs)
+    fr = np.asarray(fractions, dtype=float)
+    require(fr.ndim == 1 and fr.size >= 1 and np.all((fr > 0) & (fr <= 1)),
+            "length fractions must lie in (0, 1]")
+    lengths = np.array(extents)[:, None] * fr[None, :]
+    near = centre - 0.5 * lengths[..., None] * u[:, None, :]
+    far = centre + 0.5 * lengths[..., None] * u[:, None, :]
+    targets = np.stack([near, far], axis=2)  # (7, 5, 2, 3)
+    directions = np.stack([np.broadcast_to(-u[:, None, :], near.shape),
+                           np.broadcast_to(u[:, None, :], far.shape)], axis=2)
+    pos = axis_positions(model, targets.reshape(-1, 3), probe)
+    return LengthTest(tuple(names), lengths, u, targets, pos, probe, directions, repetitions, box)
+
+
+def length_errors(test: LengthTest, e, noise=None) -> np.ndarray:
+    """E (S, 7, 5, R) mm from volumetric errors ``e`` (S, 7*5*2, 3) at the test points and
+    ``noise`` (S, 7, 5, R, 2) along the probing directions (None: no noise)."""
+    e = np.asarray(e).reshape((-1,) + test.targets.shape)
+    de = np.einsum("sflk,fk->sfl", e[:, :, :, 1] - e[:, :, :, 0], test.u)
+    E = -de[..., None] * np.ones(test.repetitions)
+    if noise is not None:
+        # m = s + n * direction: far end +u, near end -u -> length + n_far + n_near
+        E = E + noise[..., 1] + noise[..., 0]
+    return E
+
+
+def evaluate_errors(model, test: LengthTest, errors: dict) -> np.ndarray:
+    """Volumetric errors (S, 70, 3) mm at the test points for ``errors``: name -> array
+    broadcastable to (S, 70) (mm / rad)."""
+    n = len(next(iter(test.positions.values())))
+    full = {p: errors.get(p, 0.0) for p in model.parameters}
+    p = test.probe
+    comp = model.module.volumetric_error(**test.positions, Xp=float(p[0]), Yp=float(p[1]),
+                                         Zp=float(p[2]), **full)
+    shape = np.broadcast_shapes(*(np.shape(c) for c in comp), (n,))
+    return np.stack([np.broadcast_to(c, shape) for c in comp], axis=-1).reshape(-1, n, 3)
+
+
+@dataclass
+class TestResult:
+    """Simulated E0 values: ``E_um`` (7, 5, R), ``lengths`` (7, 5) mm, line names, MPE."""
+
+    names: tuple
+    lengths: np.ndarray
+    E_um: np.ndarray
+    spec: Spec | None
+
+    def as_dict(self) -> dict:
+        out = {"positions": []}
+        for i, name in enumerate(self.names):
+            out["positions"].append({
+                "line": name, "lengths_mm": [round(float(v), 6) for v in self.lengths[i]],
+                "E_um": [[round(float(v), 4) for v in row] for row in self.E_um[i]]})
+        out["max_abs_E_um"] = float(np.max(np.abs(self.E_um)))
+        if self.spec is not None:
+            mpe = self.spec.mpe_um(self.lengths)[..., None]
+            ratio = np.abs(self.E_um) / mpe
+            out["mpe"] = self.spec.text()
+            out["max_ratio_to_mpe"] = float(ratio.max())
+            out["passes"] = bool(np.all(ratio <= 1.0))
+        return out
+
+
+def simulate(model, funcs=None, probe=(0.0, 0.0, 0.0), box=None, repetitions: int = 3,
+             noise_um: float = 0.0, seed: int = 0, spec: Spec | None = None) -> TestResult:
+    """The length test on the machine of error functions ``funcs`` (None: perfect machine),
+    with probing noise ``noise_um`` (standard deviation along each probing direction)."""
+    require(noise_um >= 0 and np.isfinite(noise_um), "--noise-um must be >= 0")
+    test = length_test(model, box, probe, repetitions=repetitions)
+    errors = {}
+    if funcs is not None:
+        pos_deg = {a: (np.rad2deg(v) if a in model.rotary_axes else v)
+                   for a, v in test.positions.items()}
+        errors = funcs(pos_deg)
+    e = evaluate_errors(model, test, errors)
+    noise = None
+    if noise_um > 0:
+        rng = np.random.default_rng(seed)
+        noise = rng.standard_normal((1,) + test.lengths.shape + (repetitions, 2)) * noise_um * 1e-3
+    E = length_errors(test, e, noise)[0]
+    return TestResult(test.names, test.lengths, E * 1e3, spec)
+
+
+def plot(result: TestResult, path, title: str, inputs=()) -> None:
+    """E0 against L for every position and repetition, with the MPE lines (the certificate
+    picture)."""
+    import io
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from volerr.fileio import write_bytes
+
+    fig, ax = plt.subplots(figsize=(8, 5))
+    markers = "os^vD<>"
+    for i, name in enumerate(result.names):
+        L = np.repeat(result.lengths[i][:, None], result.E_um.shape[-1], axis=1)
+        ax.plot(L.ravel(), result.E_um[i].ravel(), markers[i % 7], ms=4, label=name, alpha=0.8)
+    lmax = float(result.lengths.max()) * 1.05
+    if result.spec is not None:
+        L = np.linspace(0, lmax, 50)
+        ax.plot(L, result.spec.mpe_um(L), "r-", lw=1.5, label=f"MPE {result.spec.text()}")
+        ax.plot(L, -result.spec.mpe_um(L), "r-", lw=1.5)
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xlim(0, lmax)
+    ax.set_xlabel("test length L / mm")
+    ax.set_ylabel("length error E0 / um")
+    ax.set_title(title)
+    ax.legend(fontsize=7, ncol=2)
+    ax.grid(alpha=0.3)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    write_bytes(path, buf.getvalue(), inputs)
+
