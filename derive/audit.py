@@ -41,7 +41,9 @@ import sympy as sp
 
 #: provider modules, imported when present
 PROVIDERS = ("volerr.derive.audit_pahk", "volerr.derive.audit_tracker",
-             "volerr.derive.audit_dmu50", "volerr.derive.audit_probe")
+             "volerr.derive.audit_dmu50", "volerr.derive.audit_rotary",
+             "volerr.derive.audit_listings", "volerr.derive.audit_probe",
+             "volerr.derive.audit_numbers")
 
 
 #: verdict categories, in report order
