@@ -81,8 +81,8 @@ def audit_lookup(item: dict) -> list[Verdict]:
           f"n = len(error_model) (no error raised). Run on an example (positions 0 .. -400 mm "
           f"in 40 mm steps, a cubic error zero at 0, degree 3 as printed): "
           + "; ".join(rows) + f"; largest difference from the intended model over -400 .. -1 "
-          f"mm: {worst:.2f} um. Only 0 and the mirror point of the middle of the travel read "
-          f"the right value. (The same axis with positive positions reads the intended curve "
+          f"mm: {worst:.2f} um. Only pos = 0 reads its own value; elsewhere the value is right "
+          f"only where the curve happens to be equal at the mirror point. (The same axis with positive positions reads the intended curve "
           f"up to the 1 mm quantisation of round(): {q_worst:.3f} um here.) Extraction repairs: "
           f"{repairs}. Category printing_error: a defect of the printed code, not a convention "
           f"(the fix: error_model[abs(round(pos))], or np.polyval(coefficients, pos))")
