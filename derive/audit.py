@@ -14,6 +14,20 @@ component of it: ``dX``, ``RY2``, the rule of ``dx(X)`` ...) gets a :class:`Verd
 ``identical`` when ``expand(derived - printed) == 0``, else ``differs`` with a named erratum
 and the evidence (which terms differ, and which alternative reading reproduces the print).
 
+Every verdict also carries a *category* (:data:`CATEGORIES`), what a reviewer needs to weigh it:
+
+* ``identical``: the printed form is the derived one;
+* ``printing_error``: a typo, wrong symbol, wrong sign or lost row that no consistent convention
+  explains;
+* ``extraction``: damage of the OCR / text extraction of the seed (garbled subscripts, lost
+  brackets), where the evidence allows telling it from the print;
+* ``convention``: reproduced exactly under a named alternative convention (``alternative``
+  holds the derivation under it, ``evidence`` names it and shows ``expand(alt - printed) == 0``);
+* ``simplification``: the author's stated approximation (``statement`` quotes it,
+  ``alternative`` is the approximate derivation that reproduces the print, ``dropped`` the terms
+  it drops and ``dropped_um`` their size on a typical machine, :data:`TYPICAL`);
+* ``undecidable``: the evidence does not decide; ``evidence`` says what is missing.
+
 This module holds the shared pieces: :class:`Verdict`, the provider registry and the
 term-by-term comparison of two polynomials (:func:`term_diff`, :func:`describe_diff`).
 """
@@ -27,7 +41,34 @@ import sympy as sp
 
 #: provider modules, imported when present
 PROVIDERS = ("volerr.derive.audit_pahk", "volerr.derive.audit_tracker",
-             "volerr.derive.audit_dmu50", "volerr.derive.audit_probe")
+             "volerr.derive.audit_dmu50", "volerr.derive.audit_rotary",
+             "volerr.derive.audit_listings", "volerr.derive.audit_probe",
+             "volerr.derive.audit_numbers")
+
+
+#: verdict categories, in report order
+CATEGORIES = ("identical", "printing_error", "extraction", "convention", "simplification",
+              "undecidable")
+
+#: a typical machine for the size of dropped terms: Pahk's CMM A (sec. 4: MB1, 900 x 575 x
+#: 400 mm; X pitch band 11.18 urad, repeatabilities 10.75 um and 12.30 urad as 2 sigma), measuring
+#: (Abbe) offsets and probe offsets as met in practice.  Units: mm and rad.
+TYPICAL = {
+    "travel_mm": {"X": 900.0, "Y": 575.0, "Z": 400.0},
+    "measuring_offset_mm": 200.0,     # |Xo|, |Yo|, |Zo| of a laser set-up
+    "probe_offset_mm": 100.0,         # |Xp|, |Yp|, |Zp| of a stylus
+    "angular_rad": 10e-6,             # an angular error motion
+    "translational_mm": 5e-3,         # a translational error motion
+    "sigma_angular_rad": 6e-6,        # random (1 sigma) angular error
+    "sigma_translational_mm": 5e-3,   # random (1 sigma) translational error
+}
+
+
+def typical_text() -> str:
+    t = TYPICAL
+    return (f"typical machine: Pahk's CMM A (900 x 575 x 400 mm), offsets up to "
+            f"{t['measuring_offset_mm']:g} mm, probe offsets up to {t['probe_offset_mm']:g} mm, "
+            f"angular errors {t['angular_rad'] * 1e6:g} urad")
 
 
 @dataclass
@@ -37,7 +78,10 @@ class Verdict:
     ``verdict`` is ``"identical"`` or ``"differs"``; ``erratum`` is "" when identical, else a
     short name of the printing error; ``evidence`` says which terms differ and which chain,
     sign convention or reading reproduces the printed form; ``printed`` and ``derived`` are the
-    two expressions (strings, in the paper's symbols)."""
+    two expressions (strings, in the paper's symbols).  ``category`` is one of
+    :data:`CATEGORIES` (``identical`` whenever ``verdict`` is); ``alternative``, ``statement``,
+    ``dropped`` and ``dropped_um`` document a ``convention`` or ``simplification`` (see the
+    module docstring)."""
 
     source: str
     equation: str
@@ -48,9 +92,46 @@ class Verdict:
     printed: str
     derived: str
     component: str = ""
+    category: str = ""
+    alternative: str = ""
+    statement: str = ""
+    dropped: str = ""
+    dropped_um: float | None = None
+
+    def __post_init__(self):
+        if self.verdict == "identical" and not self.category:
+            self.category = "identical"
+        if self.category and self.category not in CATEGORIES:
+            raise ValueError(f"unknown verdict category {self.category!r}")
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+def classify(v: Verdict, category: str, **fields) -> Verdict:
+    """Set the category (and the fields that document it) of a verdict; returns it."""
+    if category not in CATEGORIES:
+        raise ValueError(f"unknown verdict category {category!r}")
+    v.category = category
+    for k, val in fields.items():
+        setattr(v, k, val)
+    return v
+
+
+def worst_case_um(expr, bounds: dict) -> float:
+    """Worst-case |expr| in um for a polynomial whose every term is a product of bounded
+    symbols: sum over terms of |coefficient| * product of the bounds (``bounds``: symbol name
+    -> bound, mm or rad; symbols not named count 1)."""
+    total = 0.0
+    for t in sp.Add.make_args(sp.expand(expr)):
+        if t == 0:
+            continue
+        c, m = t.as_coeff_Mul()
+        val = abs(float(c))
+        for f, e in m.as_powers_dict().items():
+            val *= float(bounds.get(str(f), 1.0)) ** int(e)
+        total += val
+    return total * 1e3
 
 
 def providers() -> list:

@@ -34,7 +34,7 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from .audit import Verdict, fmt
+from .audit import TYPICAL, Verdict, fmt
 from .inverse import BRANCH, TIP, TOOL_AXIS, linear_inverse, rotary_inverse
 from .kinematics import Chain, position_symbol, rotation, translation
 from .volumetric import nominal_point, nominal_tool_axis, volumetric_error
@@ -55,9 +55,26 @@ def _parse(text: str):
     return sp.sympify(text, locals=_LOCALS)
 
 
-def _verdict(eq, same, erratum, evidence, printed, derived, component="") -> Verdict:
+def _verdict(eq, same, erratum, evidence, printed, derived, component="",
+             category: str = "printing_error", **fields) -> Verdict:
     return Verdict(SOURCE, eq, "DMU50", "identical" if same else "differs",
-                   "" if same else erratum, evidence, printed, derived, component)
+                   "" if same else erratum, evidence, printed, derived, component,
+                   category="identical" if same else category, **fields)
+
+
+def _matrix_category(erratum: str, evidence: str) -> tuple[str, str]:
+    """(category, evidence) of a printed matrix that differs from the derived one."""
+    if "missing" in erratum:
+        return "undecidable", evidence + (
+            ". Category undecidable: the row is present where the thesis prints the factor "
+            "again (the 'updated' chain after eq. 3.37), so either the print or the extraction "
+            "lost it here; missing to decide: the page of the original PDF")
+    if "printed twice" in erratum:
+        return "printing_error", evidence + (
+            ". Category printing_error: the same row is repeated identically where the thesis "
+            "prints the factor again (the 'updated' chain), so it is in the author's source, "
+            "not an accident of one extraction")
+    return "printing_error", evidence
 
 
 # ------------------------------------------------------------------------------ derived pieces
@@ -236,14 +253,19 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                     erratum, ev = f"{name} printed as {other}", (
                         f"the printed matrix is the derived {other}; {name} is the translation "
                         f"by -c_B = (0, 0, -d)")
-        out.append(_verdict(eq, same, erratum, ev, str(item["rows"]), fmt(factors[name]), name))
+        cat, ev = _matrix_category(erratum, ev) if not same else ("identical", ev)
+        out.append(_verdict(eq, same, erratum, ev, str(item["rows"]), fmt(factors[name]), name,
+                            category=cat))
 
     prod = printed.get("product", {})
     if "3.37" in prod:
         same, erratum, ev = _product_diff(prod["3.37"], DERIVED_ORDER)
         out.append(_verdict("eq. 3.37", same, erratum, ev + "; T_a^b maps frame b into frame a, "
-                            "T_w^t = (T_0^w)^-1 T_0^t", prod.get("3.37_text", ""),
-                            " ".join(DERIVED_ORDER)))
+                            "T_w^t = (T_0^w)^-1 T_0^t. Category extraction: 'T_1^d' and "
+                            "'T_2^2' are no frames of the chain (d is a length, not a frame "
+                            "index); garbled sub- and superscripts are the damage this "
+                            "extraction shows elsewhere", prod.get("3.37_text", ""),
+                            " ".join(DERIVED_ORDER), category="extraction"))
     lst = printed.get("listing", {})
     names = {"T_d": "T_0^1", "T_45": "T_1^2", "T_B": "T_2^3", "T_n45": "T_3^4", "T_nd": "T_4^5",
              "T_C": "T_5^w"}
@@ -262,18 +284,26 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         for p in fac:
             m = m * sp.Matrix([[_parse(c) for c in r] for r in lst[p]])
         same_body = sp.simplify(m - t0w) == sp.zeros(4, 4)
+        t_r_category = "printing_error"
         same = same_body and sign == 1
         if same:
             erratum, ev = "", "the product equals the derived T_0^w (machine <- workpiece)"
         elif same_body:
             erratum = "leading minus sign"
+            t_r_category = "undecidable"
             ev = ("taken literally, T = -(T_d T_45 T_B T_n45 T_nd T_C) negates the whole HTM "
                   "(its homogeneous 1 becomes -1); without the minus the product equals the "
                   "derived T_0^w exactly (the minus may be an OCR artefact of 'T_-d')")
         else:
             erratum, ev = "wrong product", "the product differs from the derived T_0^w"
+        if t_r_category == "undecidable":
+            ev += ("; category undecidable: the extraction renders the underscores of this "
+                   "line as '{-}' ('T = -T_{-}d @ T_{-}45 ...'), so the stray '-' may be the same "
+                   "damage; the printed output of the listing (Figure 3.10), which would tell, "
+                   "is not in the text; missing: the original listing")
         out.append(_verdict("Listing 3.3 line 46 (T_r)", same, erratum, ev,
-                            prod.get(key + "_text", ""), "T_d @ T_45 @ T_B @ T_n45 @ T_nd @ T_C"))
+                            prod.get(key + "_text", ""), "T_d @ T_45 @ T_B @ T_n45 @ T_nd @ T_C",
+                            category=t_r_category))
     std = {"rot_x": rotation((1, 0, 0), A_SYM), "rot_y": rotation((0, 1, 0), A_SYM),
            "rot_z": rotation((0, 0, 1), A_SYM)}
     for rname, m in std.items():
@@ -321,7 +351,10 @@ def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
                  _t_er_pose(np.deg2rad(bdeg), np.deg2rad(cdeg), p_table, t0w_num, err_num,
                             layout, d_value)]
     same = not rows
-    ev = ("first-order effect per error parameter on the table point (179.009, 94.545, "
+    size = _t_er_size_um(lst, factors, t0w_num, err_num, layout, d_value, p_table)
+    ev = (f"size of the difference with every angular error of B and C at "
+          f"{TYPICAL['angular_rad'] * 1e6:g} urad (signs worst case): up to {size:.2g} um at the "
+          f"listing's point; first-order effect per error parameter on the table point (179.009, 94.545, "
           "143.533) mm, listing with rot_y and the data sources corrected: " +
           ("; ".join(rows) if rows else "all effects agree") +
           ". Reasons: T_er applies every error in the machine frame after the whole rotation "
@@ -329,50 +362,86 @@ def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
           "arm to the B/C intersection at (0, 0, d)), and the errors of C are not turned with "
           "the B axis that carries C")
     return _verdict("Listing 3.3 T_er (error model)", same, "errors applied in the wrong frame",
-                    ev, " @ ".join(lst["T_er"]), "derived first-order chain (DMU50 layout)",
-                    "T_er")
+                    ev + ". Category simplification: the listing implements the method the "
+                    "thesis states (sec. 3.5)", " @ ".join(lst["T_er"]),
+                    "derived first-order chain (DMU50 layout)", "T_er",
+                    category="simplification", statement=T_ER_STATEMENT,
+                    alternative="every B and C error motion applied in the machine frame after "
+                                "the nominal rotation T_r (errors pivot about the machine "
+                                "origin)", dropped_um=size)
 
 
-def _t_er_pose(bq, cq, p_table, t0w_num, err_num, layout, d_value) -> list[str]:
+T_ER_STATEMENT = (
+    "Sec. 3.5: \"The coordinate system is rotated by the amount of each angular error. It is "
+    "then translated by the amount of the translational errors before it is rotated according "
+    "to the desired position of the B- and C-axis.\"")
+
+
+def _t_er_size_um(lst, factors, t0w_num, err_num, layout, d_value, p_table) -> float:
+    """Largest |listing - derived| (um) over poses B in 0..180, C in 0..360 (30 deg steps) with
+    the six angular errors of B and C at +-TYPICAL angular (worst sign per parameter)."""
+    worst = 0.0
+    for bdeg in range(0, 181, 30):
+        for cdeg in range(0, 360, 30):
+            per = _t_er_effects(np.deg2rad(bdeg), np.deg2rad(cdeg), p_table, t0w_num, err_num,
+                                layout, d_value)
+            tot = sum(np.abs(lt - mo) for e, (lt, mo) in per.items() if e[3] in "ABC"
+                      and e[2] in "ABC") * TYPICAL["angular_rad"] / 1e-6
+            worst = max(worst, float(np.max(tot)))
+    return worst * 1e3
+
+
+def _rot(axis: int, a: float) -> np.ndarray:
+    """Right-handed 4x4 rotation by ``a`` rad about machine axis 0/1/2 (x/y/z)."""
+    c, s_ = np.cos(a), np.sin(a)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m = np.eye(4)
+    m[i, i] = m[j, j] = c
+    m[i, j], m[j, i] = -s_, s_
+    return m
+
+
+def _tr(v) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = v
+    return m
+
+
+_T_ER_ERRS = ("E_XB", "E_YB", "E_ZB", "E_AB", "E_BB", "E_CB", "E_XC", "E_YC", "E_ZC", "E_AC",
+              "E_BC", "E_CC")
+
+
+def _t_er_effects(bq, cq, p_table, t0w_num, err_num, layout, d_value) -> dict:
+    """Per error parameter of Listing 3.3 (rot_y and sources corrected): (listing effect,
+    derived effect) on the table point, tool relative to the workpiece, mm per 1 um / 1 urad."""
     t_r = np.array(t0w_num(bq, cq, d_value), dtype=float)
     machine = t_r @ p_table
     r = t_r[:3, :3]
-
-    def rx(a):
-        return np.array(rotation((1, 0, 0), a).evalf(), dtype=float)
-
-    def ry(a):
-        return np.array(rotation((0, 1, 0), a).evalf(), dtype=float)
-
-    def rz(a):
-        return np.array(rotation((0, 0, 1), a).evalf(), dtype=float)
-
-    def tr(v):
-        m = np.eye(4)
-        m[:3, 3] = v
-        return m
-
-    errs = ["E_XB", "E_YB", "E_ZB", "E_AB", "E_BB", "E_CB", "E_XC", "E_YC", "E_ZC", "E_AC",
-            "E_BC", "E_CC"]
-    # derived: the tool-relative model at the machine position of the point (EXB = -E_XB ...)
     names = layout.parameter_names
-    rows = []
-    for e in errs:
+    out = {}
+    for e in _T_ER_ERRS:
         unit = 1e-3 if e[2] in "XYZ" else 1e-6
-        v = dict.fromkeys(errs, 0.0)
+        v = dict.fromkeys(_T_ER_ERRS, 0.0)
         v[e] = unit
-        t_er = (rx(v["E_AB"]) @ ry(v["E_BB"]) @ rz(v["E_CB"]) @ rx(v["E_AC"]) @ ry(v["E_BC"])
-                @ rz(v["E_CC"]) @ tr([v["E_XB"], 0, 0]) @ tr([0, v["E_YB"], 0])
-                @ tr([0, 0, v["E_ZB"]]) @ tr([v["E_XC"], 0, 0]) @ tr([0, v["E_YC"], 0])
-                @ tr([0, 0, v["E_ZC"]]) @ t_r)
+        t_er = (_rot(0, v["E_AB"]) @ _rot(1, v["E_BB"]) @ _rot(2, v["E_CB"])
+                @ _rot(0, v["E_AC"]) @ _rot(1, v["E_BC"]) @ _rot(2, v["E_CC"])
+                @ _tr([v["E_XB"], v["E_YB"], v["E_ZB"]])
+                @ _tr([v["E_XC"], v["E_YC"], v["E_ZC"]]) @ t_r)
         d_machine = (t_er @ p_table - t_r @ p_table)[:3]
         listing_tool = -(r.T @ d_machine)  # tool relative to the workpiece, workpiece frame
         iso = "E" + e[2] + e[3]
         pv = [(-unit if n == iso else 0.0) for n in names]
-        model = np.array([float(v) for v in err_num(machine[0], machine[1], machine[2], bq, cq,
+        model = np.array([float(x) for x in err_num(machine[0], machine[1], machine[2], bq, cq,
                                                     d_value, 0.0, 0.0, 0.0, *pv)])
-        diff = np.linalg.norm(model - listing_tool)
-        if diff > 1e-9:
+        out[e] = (listing_tool, model)
+    return out
+
+
+def _t_er_pose(bq, cq, p_table, t0w_num, err_num, layout, d_value) -> list[str]:
+    rows = []
+    for e, (listing_tool, model) in _t_er_effects(bq, cq, p_table, t0w_num, err_num, layout,
+                                                  d_value).items():
+        if np.linalg.norm(model - listing_tool) > 1e-9:
             rows.append(f"{e}: listing {np.round(listing_tool * 1e3, 4).tolist()} um, derived "
                         f"{np.round(model * 1e3, 4).tolist()} um per "
                         f"{'1 um' if e[2] in 'XYZ' else '1 urad'}")

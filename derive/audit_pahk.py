@@ -38,7 +38,8 @@ import sympy as sp
 from volerr.machine.layout import SQUARENESS, read_layout
 
 from . import volumetric as vol
-from .audit import Verdict, describe_diff, fmt, is_identical, n_diff, n_issues
+from .audit import (TYPICAL, Verdict, classify, describe_diff, fmt, is_identical, n_diff,
+                    n_issues, typical_text, worst_case_um)
 from .kinematics import PROBE, Chain, parameter_symbol, position_symbol
 
 SOURCE = "Pahk 1995"
@@ -263,24 +264,103 @@ def audit_volumetric(eq: dict) -> list[Verdict]:
     for i, c in enumerate(COMPONENTS):
         ocr = f" {notes[i]}." if notes[i] else ""
         if is_identical(physical[i], printed[i]):
-            out.append(_verdict(eq, c, "identical", "",
-                                f"expand(derived - printed) == 0 for the physical layout "
-                                f"{name} ({_stacking(lay)})."
-                                + ocr, printed[i], physical[i]))
+            v = _verdict(eq, c, "identical", "",
+                         f"expand(derived - printed) == 0 for the physical layout "
+                         f"{name} ({_stacking(lay)})." + ocr, printed[i], physical[i])
+            out.append(_ocr_category(v, notes[i]))
             continue
         diff0 = describe_diff(physical[i], printed[i])
         if is_identical(best_d[i], printed[i]):
             erratum = f"{best.short(lay)} reading"
             evidence = (f"differs from the physical layout: {diff0}. Reproduced exactly by the "
-                        f"reading: {best.describe(lay)}.")
-        else:
-            resid = describe_diff(best_d[i], printed[i])
-            erratum = resid if best.cost() == 0 else f"{resid} [under {best.short(lay)}]"
-            evidence = (f"differs from the physical layout: {diff0}. No reading reproduces it; "
-                        f"closest (for the whole equation): {best.describe(lay)}, which leaves: "
-                        f"{resid}.")
-        out.append(_verdict(eq, c, "differs", erratum, evidence + ocr, printed[i], physical[i]))
+                        f"reading: {best.describe(lay)} (expand(alternative - printed) == 0).")
+            v = _verdict(eq, c, "differs", erratum, evidence + ocr, printed[i], physical[i])
+            out.append(_reading_category(v, best, lay, best_d[i], physical[i]))
+            continue
+        resid = describe_diff(best_d[i], printed[i])
+        erratum = resid if best.cost() == 0 else f"{resid} [under {best.short(lay)}]"
+        evidence = (f"differs from the physical layout: {diff0}. No reading reproduces it; "
+                    f"closest (for the whole equation): {best.describe(lay)}, which leaves: "
+                    f"{resid}: a printing error (no consistent convention explains it).")
+        out.append(classify(_verdict(eq, c, "differs", erratum, evidence + ocr, printed[i],
+                                     physical[i]), "printing_error",
+                            alternative=fmt(best_d[i]) if best.cost() else ""))
     return out
+
+
+# ------------------------------------------------------------------ verdict categories
+#: the statements of Pahk (1995) that the categories quote (verbatim from the seed, translated)
+STATEMENTS = {
+    "quadrature": "Sec. 2.2: \"입체오차의 랜덤성분은 오차전파이론에 의한 구적공식(quadrature "
+                  "formula)을 이용하여 계산할 수 있다\" (the random component of the volumetric "
+                  "error can be computed with the quadrature formula of error propagation)",
+    "rule1": "Sec. 2.3, rule (1): \"한 축을 따라서의 오각도오차와 피치각도 오차는 그 축을 따라서의 "
+             "위치오차 값에 아베오프셋을 통해서 영향을 준다. 또한, 롤각도오차는 축을 따라서의 "
+             "진직도오차 값에 아베 오프셋을 통해서 영향을 준다.\" (the yaw and pitch errors of an "
+             "axis act on its positional error through the Abbe offset; the roll error acts on "
+             "its straightness errors through the Abbe offset); sec. 2.3.1: \"진직도오차들은 "
+             "롤오차와 이와 관련된 아베옵셋에 의해 영향받게 되며\" (straightness errors are "
+             "affected by the roll error and its Abbe offset)",
+}
+
+CONVENTION_TABLE = ("table rotations pivot about the moving table origin (Pahk's chain form "
+                    "Tx(Xa, Ya, Za)^T + Lx of eq. A1, A4, A7), not about the tool point")
+CONVENTION_SQUARENESS = ("squareness as the slope of ONE axis' straightness line in the machine "
+                         "frame (Pahk's definition), not ISO 230-1's angle between the two "
+                         "reference lines")
+
+
+def _bounds(expr) -> dict:
+    """Bounds of the symbols of a paper expression on the typical machine (mm, rad)."""
+    t = TYPICAL
+    out = {}
+    for s in expr.free_symbols:
+        n = s.name
+        if n in ("X", "Y", "Z"):
+            out[n] = t["travel_mm"][n]
+        elif n in ("Xo", "Yo", "Zo"):
+            out[n] = t["measuring_offset_mm"]
+        elif n in ("Xp", "Yp", "Zp"):
+            out[n] = t["probe_offset_mm"]
+        elif n[:1] == "d":
+            out[n] = t["translational_mm"]
+        else:
+            out[n] = t["angular_rad"]
+    return out
+
+
+def _ocr_category(v: Verdict, note: str) -> Verdict:
+    """An identical verdict that needed an OCR reading is an extraction defect."""
+    if note and v.verdict == "identical":
+        return classify(v, "extraction")
+    return v
+
+
+def _reading_category(v: Verdict, r: Reading, lay, alt, physical) -> Verdict:
+    """Category of a volumetric verdict reproduced exactly by reading ``r``."""
+    alt_text = fmt(alt)
+    if r.tool is not None or r.work is not None:
+        return classify(v, "printing_error", alternative=alt_text, evidence=v.evidence + (
+            " A different stacking of the axes is another machine, not a convention: the "
+            "printed chain stacks the axes wrongly."))
+    names = []
+    if r.pivot == "table_origin":
+        names.append(CONVENTION_TABLE)
+    for f in r.flips:
+        names.append(f"the six errors of table {f} signed as the table's own motion"
+                     if f in lay.axes else
+                     f"{_paper_name(lay, f)} signed the other way (its sign convention)")
+    if isinstance(alt, sp.MatrixBase):
+        diffs = [sp.expand(a - b) for a, b in zip(physical, alt)]
+        alt_text, dropped = _vec(alt), _vec(diffs)
+    else:
+        diffs = [sp.expand(physical - alt)]
+        dropped = fmt(diffs[0])
+    size = max(worst_case_um(d, _bounds(d)) for d in diffs)
+    return classify(v, "convention", alternative=alt_text, statement="; ".join(names),
+                    dropped=dropped, dropped_um=size,
+                    evidence=v.evidence + f" Convention: {'; '.join(names)}. The two conventions "
+                    f"differ by {dropped} (up to {size:.2g} um on the {typical_text()}).")
 
 
 def _stacking(lay) -> str:
@@ -325,6 +405,33 @@ def random_squared(name: str, method: str) -> list:
     return out
 
 
+def _random_size_um(name: str, i: int) -> float:
+    """Largest sqrt(exact) - sqrt(term-wise) of component ``i`` (um) over the corners of the
+    typical working volume and probe offsets of +-TYPICAL, every sigma at its typical value."""
+    import numpy as np
+
+    t = TYPICAL
+    ex, tw = random_squared(name, "exact")[i], random_squared(name, "termwise")[i]
+    syms = sorted(ex.free_symbols | tw.free_symbols, key=str)
+    vals = []
+    for s_ in syms:
+        n = s_.name
+        if n in ("X", "Y", "Z"):
+            vals.append(np.array([0.0, t["travel_mm"][n]]))
+        elif n in ("Xp", "Yp", "Zp"):
+            vals.append(np.array([-1.0, 1.0]) * t["probe_offset_mm"])
+        elif n.startswith("Rd"):
+            vals.append(np.array([t["sigma_translational_mm"]]))
+        else:
+            vals.append(np.array([t["sigma_angular_rad"]]))
+    grids = np.meshgrid(*vals, indexing="ij")
+    f_ex = sp.lambdify(syms, ex, "numpy")
+    f_tw = sp.lambdify(syms, tw, "numpy")
+    a = np.sqrt(np.maximum(np.broadcast_to(f_ex(*grids), grids[0].shape), 0))
+    b = np.sqrt(np.maximum(np.broadcast_to(f_tw(*grids), grids[0].shape), 0))
+    return float(np.max(np.abs(a - b))) * 1e3
+
+
 def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
     name = eq["layout"]
     cands = [("exact", name, "exact first-order propagation (the authority)"),
@@ -342,24 +449,38 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
         ocr = f" {note}." if note else ""
         exact, tw = derived[("exact", name)][i], derived[("termwise", name)][i]
         if is_identical(exact, pr):
-            out.append(_verdict(eq, c, "identical", "", "expand(derived - printed) == 0 for "
-                                "exact propagation." + ocr, pr, exact))
+            out.append(_ocr_category(_verdict(eq, c, "identical", "", "expand(derived - printed) "
+                                              "== 0 for exact propagation." + ocr, pr, exact),
+                                     note))
             continue
         diff0 = describe_diff(exact, pr)
         hit = next(((m, n, d) for m, n, d in cands if is_identical(derived[(m, n)][i], pr)), None)
         if hit and hit[1] == name:
             erratum = "term-wise quadrature drops cross terms"
-            evidence = (f"differs from exact propagation: {diff0}. Reproduced exactly by {hit[2]}.")
-        elif hit:
+            size = _random_size_um(name, i)
+            evidence = (f"differs from exact propagation: {diff0}. Reproduced exactly by {hit[2]} "
+                        f"(expand(term-wise - printed) == 0); the two agree when the probe offset "
+                        f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
+                        f"up to {size:.2g} um ({typical_text()}, random angular errors "
+                        f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, translational "
+                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma).")
+            out.append(classify(_verdict(eq, c, "differs", erratum, evidence + ocr, pr, exact),
+                                "simplification", alternative=fmt(tw),
+                                statement=STATEMENTS["quadrature"] + "; applied term by term",
+                                dropped=fmt(sp.expand(exact - tw)), dropped_um=size))
+            continue
+        if hit:
             erratum = f"{c[:2]}^2 of {hit[1]} (eq. {random_eqs[hit[1]]}) reprinted"
             evidence = (f"differs from exact propagation: {diff0}; from the term-wise quadrature "
-                        f"of {name}: {describe_diff(tw, pr)}. Reproduced exactly by {hit[2]}.")
+                        f"of {name}: {describe_diff(tw, pr)}. Reproduced exactly by {hit[2]}: "
+                        f"a copy of another layout's component, no convention of {name}.")
         else:
             resid = describe_diff(tw, pr)
             erratum = f"{resid} [term-wise]"
             evidence = (f"differs from exact propagation: {diff0}. No reading reproduces it; "
                         f"closest: the term-wise quadrature of {name}, which leaves: {resid}.")
-        out.append(_verdict(eq, c, "differs", erratum, evidence + ocr, pr, exact))
+        out.append(classify(_verdict(eq, c, "differs", erratum, evidence + ocr, pr, exact),
+                            "printing_error"))
     return out
 
 
@@ -491,9 +612,9 @@ def audit_transfer(eq: dict, flips: tuple) -> list[Verdict]:
         d0 = derived_rule(name, key)
         label = f"{key}"
         if is_identical(d0, pr):
-            out.append(_verdict(eq, label, "identical", "", "expand(derived - printed) == 0 for "
-                                "the full rigid-body transfer of the physical layout." + ocr,
-                                pr, d0))
+            out.append(_ocr_category(_verdict(
+                eq, label, "identical", "", "expand(derived - printed) == 0 for the full "
+                "rigid-body transfer of the physical layout." + ocr, pr, d0), note))
             continue
         diff0 = describe_diff(d0, pr)
         term = "Abbe term" if iso not in SQUARENESS else "term"
@@ -509,13 +630,55 @@ def audit_transfer(eq: dict, flips: tuple) -> list[Verdict]:
         r, k, d = best
         if k == 0:
             evidence = (f"derived {key} = {fmt(d0)}; printed differs by: {diff0}. Reproduced "
-                        f"exactly by the reading: {r.describe(lay, iso)}.")
+                        f"exactly by the reading: {r.describe(lay, iso)} (expand(alternative - "
+                        f"printed) == 0).")
+            v = _verdict(eq, label, "differs", erratum, evidence + ocr, pr, d0)
+            out.append(_rule_category(v, r, flips, lay, iso, d, d0))
         else:
             evidence = (f"derived {key} = {fmt(d0)}; printed differs by: {diff0}. No reading "
                         f"reproduces it; closest: {r.describe(lay, iso)}, which leaves: "
-                        f"{describe_diff(d, pr)}.")
-        out.append(_verdict(eq, label, "differs", erratum, evidence + ocr, pr, d0))
+                        f"{describe_diff(d, pr)}: a printing error.")
+            out.append(classify(_verdict(eq, label, "differs", erratum, evidence + ocr, pr, d0),
+                                "printing_error"))
     return out
+
+
+def _rule_category(v: Verdict, r: RuleReading, vol_flips: tuple, lay, iso: str, alt, d0):
+    """Category of a transfer-rule verdict reproduced exactly by reading ``r``."""
+    dropped = sp.expand(d0 - alt)
+    size = worst_case_um(dropped, _bounds(dropped)) if iso not in SQUARENESS else None
+    fields = {"alternative": fmt(alt), "dropped": fmt(dropped), "dropped_um": size}
+    extra_flips = [f for f in r.flips if f not in vol_flips]
+    if extra_flips:
+        sym = ", ".join(_paper_name(lay, f) for f in extra_flips)
+        return classify(v, "printing_error", evidence=v.evidence + (
+            f" The sign of {sym} needed here is the opposite of the one the same layout's "
+            f"volumetric equation uses: no consistent convention, a sign error."), **fields)
+    where = f" (worst case {size:.2g} um on the {typical_text()})" if size is not None else ""
+    if r.zero:
+        zero = " = ".join(r.zero) + " = 0"
+        return classify(v, "undecidable", evidence=v.evidence + (
+            f" Pahk states no zero-offset assumption: the rule is exact only for a measuring "
+            f"set-up with {zero}. Missing to decide between a deliberate set-up choice and a "
+            f"printing error: the offsets of the set-up the rule was written for. Terms "
+            f"omitted otherwise: {fmt(dropped)}{where}."), **fields)
+    if r.rule1:
+        return classify(v, "simplification", statement=STATEMENTS["rule1"],
+                        evidence=v.evidence + f" Terms dropped by the stated rule: "
+                                              f"{fmt(dropped)}{where}.", **fields)
+    names = []
+    if r.line != "both":
+        names.append(CONVENTION_SQUARENESS)
+        ang = sum(abs(float(c)) for c in sp.Poly(dropped, *dropped.free_symbols).coeffs()) \
+            if dropped != 0 else 0.0
+        v.evidence += (f" The two definitions differ by {fmt(dropped)} (up to "
+                       f"{ang * TYPICAL['angular_rad'] * 1e6:.3g} urad with angular errors of "
+                       f"{TYPICAL['angular_rad'] * 1e6:g} urad).")
+    if r.pivot == "table_origin":
+        names.append(CONVENTION_TABLE)
+    for f in r.flips:
+        names.append(f"{_paper_name(lay, f)} signed as in the volumetric equation")
+    return classify(v, "convention", statement="; ".join(names), **fields)
 
 
 # ------------------------------------------------------------------------------ chains
@@ -698,7 +861,8 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
         except (ValueError, TypeError, sp.SympifyError) as exc:
             why = str(exc)
         return [Verdict(SOURCE, eq["id"], name, "differs", "printed chain cannot be evaluated",
-                        f"{why}. " + " ".join(ev), text, _vec(physical))]
+                        f"{why}. " + " ".join(ev), text, _vec(physical),
+                        category="undecidable")]
     literal = found[0][2]
     if printed_result is not None:
         k = sum(n_diff(a, b) for a, b in zip(literal, printed_result))
@@ -711,7 +875,8 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
     if all(is_identical(a, b) for a, b in zip(physical, literal)):
         return [Verdict(SOURCE, eq["id"], name, "identical", "", "The printed chain's "
                         "first-order error equals the derived model of the physical layout. "
-                        + " ".join(ev), text, _vec(physical))]
+                        + " ".join(ev), text, _vec(physical),
+                        category="extraction" if note and "L_from" not in eq else "identical")]
     diffs = [f"{c}: {describe_diff(physical[i], literal[i])}" for i, c in enumerate(COMPONENTS)
              if not is_identical(physical[i], literal[i])]
     ev.insert(0, "The printed chain's first-order error differs from the physical layout's "
@@ -745,8 +910,16 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
         if f[1] == 1 and f[3] is not None and (best is None or f[0] != best[0]):
             ev.append(f"The chain {f[0]} gives the layout's model read as: "
                       f"{f[3].describe(lay)}.")
-    return [Verdict(SOURCE, eq["id"], name, "differs", erratum, " ".join(ev),
-                    f"{text}  =>  {_vec(literal)}", _vec(physical))]
+    v = Verdict(SOURCE, eq["id"], name, "differs", erratum, " ".join(ev),
+                f"{text}  =>  {_vec(literal)}", _vec(physical))
+    lit = found[0][3]
+    if lit is not None and lit.tool is None and lit.work is None:
+        # the printed chain, taken literally, is the layout under a convention
+        return [_reading_category(v, lit, lay, sp.Matrix(literal), sp.Matrix(physical))]
+    v.evidence += (" The printed chain is not the layout under any convention (a different "
+                   "stacking of the axes is another machine): a printing error.")
+    return [classify(v, "printing_error",
+                     alternative=_vec(best[2]) if best is not None else "")]
 
 
 # ------------------------------------------------------------------------------ entry

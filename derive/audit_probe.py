@@ -47,9 +47,11 @@ def _mat(rows) -> sp.Matrix:
     return sp.Matrix([[_parse(t) for t in r] for r in rows])
 
 
-def _v(eq, same, erratum, evidence, printed, derived, component="") -> Verdict:
+def _v(eq, same, erratum, evidence, printed, derived, component="",
+       category: str = "printing_error", **fields) -> Verdict:
     return Verdict(SOURCE, eq, LAYOUT, "identical" if same else "differs",
-                   "" if same else erratum, evidence, printed, derived, component)
+                   "" if same else erratum, evidence, printed, derived, component,
+                   category="identical" if same else category, **fields)
 
 
 def _zero(m) -> bool:
@@ -147,8 +149,20 @@ def audit_angles(eq15: dict, eq16: dict) -> list[Verdict]:
                   "tan^-1(My'/Mx') lies in (-90, 90) deg and cannot tell M' from -M' in the "
                   "xy-plane: for Mx' < 0 it is off by 180 deg (e.g. M' = (-1, 0, 0): 0 instead "
                   "of 180 deg); the azimuth is the two-argument atan2(My', Mx') in [0, 360); "
-                  + ev, fmt(p16), fmt(theta_d), "theta"))
+                  + ev + ". Category convention: read tan^-1(My'/Mx') as the quadrant-correct "
+                  "azimuth (the common convention for an angle written as tan^-1(y/x), the "
+                  "two-argument atan2(My', Mx') mod 360 deg), the printed eq. (16) is the "
+                  "derived azimuth exactly (" + _atan2_check(theta_d) + ")",
+                  fmt(p16), fmt(theta_d), "theta", category="convention",
+                  alternative="atan2(My', Mx') mod 2 pi",
+                  statement="tan^-1(y/x) written for the quadrant-correct atan2(y, x)"))
     return out
+
+
+def _atan2_check(theta_d) -> str:
+    g = sp.lambdify((d.MXP, d.MYP, d.MZP), theta_d, "math")
+    ok, ev = _angles_numeric(lambda x, y, z: math.atan2(y, x) % (2 * math.pi), g, True)
+    return ("atan2 reading " + ev) if ok else ("the atan2 reading also differs: " + ev)
 
 
 def audit_signs(eq13: dict, eq17: dict) -> list[Verdict]:

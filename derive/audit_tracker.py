@@ -134,11 +134,28 @@ def _closed(selection: str) -> dict:
     return closed_form(selection)
 
 
-def _verdict(eq, comp, ok, erratum, evidence, printed, derived) -> Verdict:
+#: why a wrong unknown vector is extraction damage, not a printing error
+EXTRACTION_SUBSCRIPTS = (
+    " Category extraction: the printed coefficient columns are right and only the subscripts of "
+    "the vector are wrong; this extraction garbles subscripts elsewhere in the same equations "
+    "(e.g. \\hat{x}_{xP} for \\hat{x}_{CP} inside the matrix of eq. 3.5, E_{DB} and E_{2B} "
+    "for E_BB and E_ZB in the 'updated' chain), which no printed thesis would carry.")
+UNDECIDABLE_ENTRIES = (
+    " Category undecidable: lost, repeated or garbled entries of a column vector look the same "
+    "whether the print or the OCR lost them; missing to decide: the page of the original PDF.")
+UNDECIDABLE_N = (
+    " Category undecidable: a '-' between two bracketed triple products is lost; the OCR "
+    "extraction of this text also loses operators, and the appendix prints the same determinant "
+    "with its minus (eq. 33-34); missing to decide: the page of the original PDF.")
+
+
+def _verdict(eq, comp, ok, erratum, evidence, printed, derived,
+             category: str = "printing_error") -> Verdict:
     return Verdict(SOURCE, f"eq. {eq['id']}" if eq["id"][0].isdigit() else eq["id"], LAYOUT,
                    "identical" if ok else "differs", "" if ok else erratum, evidence,
                    printed if isinstance(printed, str) else fmt(printed),
-                   derived if isinstance(derived, str) else fmt(derived), comp)
+                   derived if isinstance(derived, str) else fmt(derived), comp,
+                   category="identical" if ok else category)
 
 
 # ------------------------------------------------------------------------- displacement
@@ -254,8 +271,8 @@ def audit_system(eq: dict) -> list[Verdict]:
             parts.append(f"{len(got_u)} unknowns for 6 columns")
         out.append(_verdict(eq, "unknown vector", False, "; ".join(parts),
                             "the six columns multiply E_X ... E_C of the axis in this order; "
-                            "the printed vector mislabels them (possibly an extraction defect "
-                            "of repeated subscripts)", ", ".join(got_u), ", ".join(want_u)))
+                            "the printed vector mislabels them." + EXTRACTION_SUBSCRIPTS,
+                            ", ".join(got_u), ", ".join(want_u), category="extraction"))
     # right-hand side: which equation does each printed entry belong to?
     rhs = eq.get("rhs", [])
     distinct = list(dict.fromkeys(labels))
@@ -292,8 +309,9 @@ def audit_system(eq: dict) -> list[Verdict]:
                         ("each entry is the deviation (measured - nominal) of the point and "
                          "coordinate of its row" if not problems else
                          "each entry matched against the derived deviations (measured - "
-                         "nominal) of every point and coordinate: " + "; ".join(problems)),
-                        "; ".join(rhs), f"{len(distinct)} deviations"))
+                         "nominal) of every point and coordinate: " + "; ".join(problems)
+                         + UNDECIDABLE_ENTRIES),
+                        "; ".join(rhs), f"{len(distinct)} deviations", category="undecidable"))
     return out
 
 
@@ -413,7 +431,10 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
             else:
                 erratum = "N differs from the determinant"
             ev += f"; printed N = {eq['define']['N']}"
-        n_verdict = _verdict(eq, "N", ok, erratum, ev, eq["define"]["N"], sp.factor(det))
+        n_verdict = _verdict(eq, "N", ok, erratum, ev + (UNDECIDABLE_N if erratum.startswith(
+            "N printed as one product") else ""), eq["define"]["N"], sp.factor(det),
+            category="undecidable" if erratum.startswith("N printed as one product")
+            else "printing_error")
     for motion in MOTIONS:
         if motion not in eq["expr"]:
             continue
@@ -431,14 +452,19 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                 + (" in raw coordinates (d = measured - nominal)"
                                    if eq.get("variables") == "raw" else "") + "." + note,
                                 eq["expr"][motion], sp.factor(derived)))
+            if note:
+                out[-1].category = "extraction"
             continue
         errs, ev = [], (f"derived {fmt(sp.factor(derived))}; the printed form{where} is not "
                         f"identical.")
+        category = "printing_error"
         fixed_define = {**define, **define_fix}
         full_fixed = printed.subs(fixed_define)
         if define_fix and _equal(derived, full_fixed):
             errs.append("N printed as one product (minus sign lost); otherwise as derived")
-            ev += " With N read as the determinant (minus sign restored) it is identical."
+            ev += (" With N read as the determinant (minus sign restored) it is identical; it "
+                   "shares the verdict on N." + UNDECIDABLE_N)
+            category = "undecidable"
         else:
             hit = _swap_search(printed, fixed_define, derived)
             if hit:
@@ -452,7 +478,7 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
             else:
                 errs.append("closed form differs (no single-symbol reading reproduces it)")
         out.append(_verdict(eq, name, False, " ".join(errs), ev + note, eq["expr"][motion],
-                            sp.factor(derived)))
+                            sp.factor(derived), category=category))
     if n_verdict is not None:
         out.append(n_verdict)
     return out

@@ -1,10 +1,13 @@
-"""``volerr audit [LAYOUT...] [--json F] [--detail] [--numeric]``: printed vs derived equations.
+"""``volerr audit [LAYOUT...] [--json F] [--html F] [--detail] [--numeric]``: printed vs derived.
 
 Every provider of :data:`volerr.derive.audit.PROVIDERS` that exists audits its source document:
 the command reads the provider's data file (``volerr/data/<DATA_FILE>``, the printed equations
 kept as printed) and passes it on.  Output: a table with one row per printed equation (source,
 equation, layout, verdict, erratum) on stdout; ``--detail`` gives one row per component;
-``--json F`` writes the list of verdicts with their evidence.  Finding errata is the purpose,
+``--json F`` writes the list of verdicts with their evidence; ``--html F`` one page with a
+section per source document (rendered math, category, evidence).  Every verdict has a category
+(identical, printing_error, extraction, convention, simplification, undecidable); the summary
+line counts them.  Finding errata is the purpose,
 so the exit code is 0 when errata are found; 2 for bad input (unknown layout ...).
 ``--numeric`` also spot-checks the generated models numerically against the printed equations
 of their layouts (no derivation involved).
@@ -18,8 +21,11 @@ import textwrap
 import tomllib
 from importlib import resources
 
+from pathlib import Path
+
+from volerr.audit import summary_line
 from volerr.errors import InputError, require
-from volerr.fileio import write_text
+from volerr.fileio import check_output, write_text
 from volerr.machine.layout import layout_names
 
 
@@ -28,6 +34,9 @@ def register(sub) -> None:
     p.add_argument("layouts", nargs="*", metavar="LAYOUT",
                    help="restrict to these layouts (default: every audited equation)")
     p.add_argument("--json", metavar="F", help="write the verdicts with evidence as JSON")
+    p.add_argument("--html", metavar="F",
+                   help="write one HTML page: a section per source document, rendered math, "
+                        "category and evidence of every verdict (no network needed to view)")
     p.add_argument("--detail", action="store_true",
                    help="one row per component (dX, RY2, the rule of dx(X) ...)")
     p.add_argument("--numeric", action="store_true",
@@ -85,7 +94,8 @@ def group(verdicts) -> list[dict]:
         row["n"] += 1
         if v.verdict != "identical":
             row["differs"] += 1
-            row["errata"].append(f"{v.component}: {v.erratum}" if v.component else v.erratum)
+            tag = f"[{v.category}] {v.erratum}"
+            row["errata"].append(f"{v.component}: {tag}" if v.component else tag)
     out = []
     for row in rows.values():
         if row["differs"] == 0:
@@ -140,24 +150,46 @@ def numeric_table(layouts: list[str] | None, points: int) -> str:
     return "\n".join(lines)
 
 
+def _check_outputs(args) -> None:
+    """Output paths checked before any computing: never an input, never the same file twice."""
+    from volerr.derive.audit import providers
+
+    inputs = _data_paths(providers())
+    outs = [p for p in (args.json, args.html) if p]
+    for p in outs:
+        check_output(p, inputs)
+    if len(outs) == 2:
+        require(Path(outs[0]).resolve() != Path(outs[1]).resolve(),
+                "--json and --html name the same file")
+
+
 def run(args) -> int:
     require(args.points >= 1, "--points must be at least 1")
+    _check_outputs(args)
     mods, verdicts = collect(args.layouts)
+    entries = [v.as_dict() for v in verdicts]
+    files = {}
     if args.json:
-        text = json.dumps([v.as_dict() for v in verdicts], indent=1, ensure_ascii=False)
-        write_text(args.json, text + "\n", inputs=_data_paths(mods))
+        files[args.json] = json.dumps(entries, indent=1, ensure_ascii=False) + "\n"
+    if args.html:
+        from volerr.audit import render_html
+
+        files[args.html] = render_html(entries)
+    for path, text in files.items():
+        write_text(path, text, inputs=_data_paths(mods))
     if args.detail:
         rows = [{"source": v.source, "equation": v.equation, "layout": v.layout,
-                 "verdict": (v.verdict + (f" {v.component}" if v.component else "")),
+                 "verdict": (v.category + (f" {v.component}" if v.component else "")),
                  "erratum": v.erratum} for v in verdicts]
     else:
         rows = group(verdicts)
     print(table(rows))
     n_eq = len(group(verdicts))
     n_diff = sum(1 for r in group(verdicts) if r["verdict"] != "identical")
-    print(f"\n{n_eq} printed equations audited: {n_eq - n_diff} identical, {n_diff} differ "
-          f"({sum(v.verdict != 'identical' for v in verdicts)} of {len(verdicts)} components)."
-          + (f" Evidence: {args.json}" if args.json else " Evidence: --json F"))
+    print(f"\n{n_eq} printed items audited: {n_eq - n_diff} identical, {n_diff} differ "
+          f"({sum(v.verdict != 'identical' for v in verdicts)} of {len(verdicts)} components).")
+    print(summary_line(entries) + "."
+          + (f" Evidence: {', '.join(files)}" if files else " Evidence: --json F, --html F"))
     if args.numeric:
         print()
         print(numeric_table(args.layouts or None, args.points))

@@ -1,0 +1,215 @@
+"""Audit of the axis error models of Ellingsdalen (2021), sec. 2.5 and eq. 3.15 (sympy, no I/O).
+
+The printed material is the parsed ``volerr/data/printed_rotary.toml``.  The authority is
+written here from first principles, independently of the printed matrices:
+
+* a linear axis X: the moved point is ``Trans(x) E p`` with the small-angle error HTM
+  ``E = I + [e]x + t`` (e = (E_AX, E_BX, E_CX), t = (E_XX, E_YX, E_ZX)), so the deviation from
+  the nominal ``Trans(x) p`` is ``[e]x p + t``;
+* a rotary axis C (eq. 2.42 without squareness): ``T = T_ES T_CC`` with the nominal
+  ``T_CC = Rz(C)``, right-handed as in the thesis' own eq. 3.2, and the small-angle error HTM
+  ``T_ES``; the deviation of a table point p is ``(T_ES - I) Rz(C) p`` (first order), whose
+  matrix has a zero bottom row;
+* the squareness matrix ``T_SS`` is the small-angle rotation by S_XC about x and S_YC about y;
+* eq. 3.15: the first-order series (in the angles) of the exact squareness translations of
+  eq. 3.12 and 3.14.
+
+Every printed matrix is compared entry by entry, every printed equation by
+``expand(derived - printed) == 0``.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .audit import Verdict, fmt
+
+DATA_FILE = "printed_rotary.toml"
+LAYOUTS = ("DMU50",)
+SOURCE = "Ellingsdalen 2021"
+LAYOUT = "DMU50"
+
+C = sp.Symbol("C", real=True)
+_NAMES = ("EXX EYX EZX EAX EBX ECX EXC EYC EZC EAC EBC ECC SXC SYC xx yx zx xC yC zC x z "
+          "EC0XY EB0XZ EA0YZ").split()
+SYM = {n: sp.Symbol(n, real=True) for n in _NAMES}
+
+
+def _parse(text: str):
+    return sp.sympify(text, locals={**SYM, "C": C, "cos": sp.cos, "sin": sp.sin})
+
+
+def _mat(rows) -> sp.Matrix:
+    return sp.Matrix([[_parse(c) for c in r] for r in rows])
+
+
+def _skew(a, b, c) -> sp.Matrix:
+    return sp.Matrix([[0, -c, b], [c, 0, -a], [-b, a, 0]])
+
+
+def _small_htm(rot, trans) -> sp.Matrix:
+    """I + [e]x + t as a 4x4 HTM (first order in the six error motions)."""
+    m = sp.eye(4)
+    m[:3, :3] += _skew(*rot)
+    m[:3, 3] = sp.Matrix(trans)
+    return m
+
+
+def _rz(a) -> sp.Matrix:
+    m = sp.eye(4)
+    m[:2, :2] = sp.Matrix([[sp.cos(a), -sp.sin(a)], [sp.sin(a), sp.cos(a)]])
+    return m
+
+
+def _v(eq, comp, same, erratum, evidence, printed, derived, category="printing_error",
+       **fields) -> Verdict:
+    return Verdict(SOURCE, eq, LAYOUT, "identical" if same else "differs",
+                   "" if same else erratum, evidence, printed, derived, comp,
+                   category="identical" if same else category, **fields)
+
+
+def _entries(printed: sp.Matrix, derived: sp.Matrix) -> list[str]:
+    return [f"entry ({i + 1},{j + 1}): printed {fmt(printed[i, j])}, derived "
+            f"{fmt(derived[i, j])}"
+            for i in range(derived.rows) for j in range(derived.cols)
+            if sp.simplify(printed[i, j] - derived[i, j]) != 0]
+
+
+# ------------------------------------------------------------------------------ linear axis
+def audit_linear(item: dict) -> list[Verdict]:
+    e = [SYM[n] for n in ("EAX", "EBX", "ECX")]
+    t = [SYM[n] for n in ("EXX", "EYX", "EZX")]
+    p = sp.Matrix([SYM["xx"], SYM["yx"], SYM["zx"], 1])
+    dev = (_small_htm(e, t) - sp.eye(4)) * p               # deviation, bottom entry 0
+    out = []
+    literal = _mat(item["matrix"]) * sp.Matrix([_parse(c) for c in item["vector"]])
+    diffs = [f"row {i + 1}: {item['lhs'][i]} = {fmt(sp.expand(literal[i]))}"
+             for i in range(4) if sp.expand(literal[i] - dev[i]) != 0]
+    out.append(_v(item["id"], "matrix equation", not diffs,
+                  "the matrix equation gives the moved point, not its deviation",
+                  "taken literally, the printed product is the moved point: " + "; ".join(diffs)
+                  + " (the bottom row reads 0 = 1). The deviation is (T - T_nominal) p: the "
+                  "printed matrix without its identity part and without the nominal x, with a "
+                  "zero bottom row; the three equations printed under it are that deviation. "
+                  "Category printing_error: left- and right-hand side disagree within the "
+                  "equation, no convention reconciles them",
+                  "Delta = T p", "Delta = (T - T_nominal) p"))
+    for i, c in enumerate(("Delta_x", "Delta_y", "Delta_z")):
+        pr = _parse(item["expr"][c])
+        same = sp.expand(pr - dev[i]) == 0
+        out.append(_v(item["id"], c, same, "differs",
+                      "derived ([e]x p + t) with e = (E_AX, E_BX, E_CX), t = (E_XX, E_YX, E_ZX); "
+                      f"expand(derived - printed) = {fmt(sp.expand(dev[i] - pr))}",
+                      item["expr"][c], fmt(dev[i])))
+    return out
+
+
+# ------------------------------------------------------------------------------ rotary axis
+def audit_rotary(item: dict) -> list[Verdict]:
+    eq = f"eq. {item['id']}"
+    e = [SYM[n] for n in ("EAC", "EBC", "ECC")]
+    t = [SYM[n] for n in ("EXC", "EYC", "EZC")]
+    t_es = _small_htm(e, t)
+    t_ss = _small_htm((SYM["SXC"], SYM["SYC"], 0), (0, 0, 0))
+    t_cc = _rz(C)
+    out = []
+    for name, derived, what in (("T_ES", t_es, "the small-angle HTM of the six error motions"),
+                                ("T_SS", t_ss, "the small-angle rotation by S_XC about x and "
+                                               "S_YC about y")):
+        bad = _entries(_mat(item[name]), derived)
+        out.append(_v(eq, name, not bad, "; ".join(bad), f"derived as {what}: "
+                      + ("all 16 entries agree" if not bad else "; ".join(bad)),
+                      str(item[name]), fmt(derived)))
+    printed_cc = _mat(item["T_CC"])
+    bad = _entries(printed_cc, t_cc)
+    det = sp.simplify(printed_cc[:3, :3].det())
+    out.append(_v(eq, "T_CC", not bad, "-cos C printed for cos C (not a rotation)",
+                  "derived nominal rotation Rz(C), right-handed as the thesis' own eq. 3.2: "
+                  + "; ".join(bad) + f"; the printed 3x3 block has det = {fmt(det)}, not 1: not "
+                  "a rotation (at C = 0 it mirrors y). The matrix is also labelled "
+                  f"{item['T_CC_label']}, the name of the product of eq. 2.42, where the text "
+                  "announces T_CC. Category printing_error: no rotation convention (active, "
+                  "passive, left- or right-handed) has -cos C on the diagonal",
+                  str(item["T_CC"]), fmt(t_cc)))
+    # the deviation matrix "neglecting the squareness errors"
+    dev = (t_es - sp.eye(4)) * t_cc
+    printed_m = _mat(item["error_matrix"])
+    bad = _entries(printed_m[:3, :], dev[:3, :])
+    hint = ""
+    if sp.simplify(printed_m[1, 2] + SYM["EXC"]) == 0:
+        hint = (" The (2,3) entry is the rotation about x, -E_AC (the same row of T_ES printed "
+                "above it has -E_AC): -E_XC there puts a translational error into a rotation "
+                "entry.")
+    out.append(_v(eq, "error matrix", not bad, "-E_XC printed where -E_AC belongs" if hint else
+                  "; ".join(bad), "derived (T_ES - I) Rz(C), first order: "
+                  + ("all entries of the first three rows agree" if not bad else "; ".join(bad))
+                  + hint, str(item["error_matrix"]), fmt(dev)))
+    row4 = [fmt(v) for v in printed_m[3, :]]
+    ok4 = all(v == 0 for v in printed_m[3, :])
+    out.append(_v(eq, "error matrix row 4", ok4, "bottom row 0 0 0 1 under a left-hand side 0",
+                  f"the printed bottom row [{', '.join(row4)}] times [x_C, y_C, z_C, 1] gives 1, "
+                  "the left-hand side says 0; a deviation matrix has the bottom row 0 0 0 0 "
+                  "(the product T_ES T_CC minus T_CC). Category printing_error: the equation "
+                  "contradicts itself", str(row4), "[0, 0, 0, 0]"))
+    p = sp.Matrix([SYM["xC"], SYM["yC"], SYM["zC"], 1])
+    derived_eqs = dev * p
+    printed_rows = printed_m * p
+    for i, c in enumerate(("Delta_x", "Delta_y", "Delta_z")):
+        pr = _parse(item["expr"][c])
+        d = sp.expand(derived_eqs[i])
+        diff = sp.simplify(d - pr)
+        ev = f"derived row {i + 1} of (T_ES - I) Rz(C) [x_C, y_C, z_C, 1]^T = {fmt(d)}; " \
+             f"derived - printed = {fmt(diff)}"
+        erratum = "differs"
+        if diff != 0 and sp.simplify(sp.expand(d + pr - 2 * (d - d.coeff(SYM["ECC"])
+                                                             * SYM["ECC"]))) == 0:
+            erratum = "sign of the E_CC term"
+            ecc = SYM["ECC"]
+            same_as_matrix = sp.simplify(sp.expand(printed_rows[i]).coeff(ecc)
+                                         - d.coeff(ecc)) == 0
+            ev += ("; only the sign of the E_CC term differs"
+                   + ("; the printed matrix just above gives the derived sign (+E_CC cos C, "
+                      "-E_CC sin C in its row 2), so the equation contradicts its own matrix"
+                      if same_as_matrix else "")
+                   + "; eq. 3.4 (ch. 3) prints the same row with the derived sign")
+        out.append(_v(eq, c, diff == 0, erratum, ev, item["expr"][c], fmt(d)))
+    return out
+
+
+# ----------------------------------------------------------------------------- eq. 3.15
+def audit_squareness(item: dict) -> list[Verdict]:
+    eq = f"eq. {item['id']}"
+    out = []
+    angles = [SYM["EC0XY"], SYM["EB0XZ"], SYM["EA0YZ"]]
+    eps = sp.Symbol("eps")
+    for axis, key in (("X", "X"), ("Z", "Z")):
+        for i, (pr_t, ex_t) in enumerate(zip(item[key], item[key + "_exact"])):
+            exact = _parse(ex_t)
+            scaled = exact.subs({a: eps * a for a in angles}, simultaneous=True)
+            first = sp.expand(sp.series(scaled, eps, 0, 2).removeO().subs(eps, 1))
+            pr = _parse(pr_t)
+            diff = sp.expand(first - pr)
+            out.append(_v(eq, f"{axis} axis, row {i + 1}", diff == 0,
+                          f"{fmt(pr)} printed for {fmt(first)}",
+                          f"first-order series of the exact {fmt(exact)} (eq. 3.12 / 3.14) in the "
+                          f"squareness angles: {fmt(first)}"
+                          + ("" if diff == 0 else
+                             f"; the printed {fmt(pr)} is the angle times the displacement "
+                             f"where cos(angle) ~ 1 belongs: the nominal displacement itself is "
+                             f"lost (it is there in the Z-axis matrix, whose (3,4) entry is z)"),
+                          pr_t, fmt(first)))
+    return out
+
+
+def audit(printed: dict, layouts=None) -> list[Verdict]:
+    """Verdicts on the printed axis error models (sec. 2.5, eq. 3.15)."""
+    if layouts is not None and not set(layouts) & set(LAYOUTS):
+        return []
+    out = []
+    if "linear" in printed:
+        out += audit_linear(printed["linear"])
+    if "rotary" in printed:
+        out += audit_rotary(printed["rotary"])
+    if "squareness" in printed:
+        out += audit_squareness(printed["squareness"])
+    return out

@@ -1,0 +1,125 @@
+"""``volerr audit --html F``: one self-contained page, one section per source document.
+
+Every verdict shows the printed form, the derived form (and, for a convention or a
+simplification, the alternative derivation that reproduces the print), its category and the
+evidence.  Expressions are rendered as presentation MathML (sympy's MathML printer; browsers
+render it natively: no script, no network, no CDN); text that is no expression (matrices as
+lists, code, prose) is shown as preformatted text.  All links are relative (``#anchors``).
+sympy is imported inside :func:`math_html` only.
+"""
+
+from __future__ import annotations
+
+import html
+import re
+
+from ._summary import CATEGORIES, category_counts
+
+_COLOURS = {"identical": "#2e7d32", "printing_error": "#c62828", "extraction": "#6a1b9a",
+            "convention": "#1565c0", "simplification": "#00838f", "undecidable": "#ef6c00"}
+_MAX_MATH = 3000          # characters: longer expressions are shown as text
+_PLAIN = re.compile(r"^[\w\s\(\)\*\+\-/\.\^,]+$")
+
+
+def _anchor(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "-", text).strip("-").lower() or "x"
+
+
+def math_html(text: str) -> str:
+    """Presentation MathML of an expression string, or escaped preformatted text."""
+    if not text:
+        return ""
+    if len(text) <= _MAX_MATH and _PLAIN.match(text):
+        try:
+            import sympy as sp
+            from sympy.parsing.sympy_parser import parse_expr
+
+            src = re.sub(r"\b(R?(?:dx|dy|dz|Ex|Ey|Ez))\((\w+)\)", r"\1__\2", text)
+            names = {}
+            for n in set(re.findall(r"[A-Za-z_]\w*", src)):
+                if n in ("sin", "cos", "tan", "sqrt", "atan2", "acos", "atan", "pi"):
+                    continue
+                # paper notation dx(X), Ey(Yo): one symbol printed with its argument
+                names[n] = sp.Symbol(n.replace("__", "(") + ")" if "__" in n else n)
+            expr = parse_expr(src, local_dict=names, evaluate=False)
+            ml = sp.mathml(expr, printer="presentation", order="none")
+            return f'<math display="block">{ml}</math>'
+        except Exception:  # noqa: BLE001 - anything unparsable is shown as text
+            pass
+    return f"<pre>{html.escape(text)}</pre>"
+
+
+def _badge(cat: str) -> str:
+    return (f'<span class="cat" style="background:{_COLOURS.get(cat, "#555")}">'
+            f"{html.escape(cat)}</span>")
+
+
+def _row(e: dict) -> str:
+    cells = [f"<td>{html.escape(str(e.get('equation', '')))}<br><small>"
+             f"{html.escape(str(e.get('component', '')))}</small></td>",
+             f"<td>{_badge(e['category'])}<br><small>{html.escape(e.get('erratum', ''))}"
+             f"</small></td>",
+             f"<td>{math_html(e.get('printed', ''))}</td>",
+             f"<td>{math_html(e.get('derived', ''))}</td>"]
+    extra = []
+    if e.get("alternative"):
+        extra.append(f"<p><b>alternative that reproduces the print:</b></p>"
+                     f"{math_html(e['alternative'])}")
+    if e.get("statement"):
+        extra.append(f"<p><b>statement / convention:</b> {html.escape(e['statement'])}</p>")
+    if e.get("dropped"):
+        extra.append(f"<p><b>terms by which it differs:</b></p>{math_html(e['dropped'])}")
+    if e.get("dropped_um") is not None:
+        extra.append(f"<p><b>size on a typical machine:</b> {e['dropped_um']:.3g} um</p>")
+    extra.append(f"<p>{html.escape(e.get('evidence', ''))}</p>")
+    cells.append(f"<td>{''.join(extra)}</td>")
+    return "<tr>" + "".join(cells) + "</tr>"
+
+
+def _counts_table(entries, sources) -> str:
+    head = "".join(f"<th>{_badge(c)}</th>" for c in CATEGORIES)
+    rows = []
+    for s in sources:
+        counts = category_counts([e for e in entries if e["source"] == s])
+        rows.append(f'<tr><td><a href="#{_anchor(s)}">{html.escape(s)}</a></td>'
+                    + "".join(f"<td>{counts[c]}</td>" for c in CATEGORIES) + "</tr>")
+    total = category_counts(entries)
+    rows.append("<tr><td><b>all</b></td>" + "".join(f"<td><b>{total[c]}</b></td>"
+                                                     for c in CATEGORIES) + "</tr>")
+    return f"<table><tr><th>document</th>{head}</tr>{''.join(rows)}</table>"
+
+
+def render_html(entries: list[dict], title: str = "volerr audit") -> str:
+    """The audit page for ``entries`` (dicts as written by ``volerr audit --json``)."""
+    sources = list(dict.fromkeys(e["source"] for e in entries))
+    parts = [f"<h1>{html.escape(title)}</h1>",
+             "<p>Printed equations, numbers and code of the source documents against volerr's "
+             "own derivations. Categories: <b>identical</b>; <b>printing_error</b> (a typo, "
+             "wrong symbol, sign or lost row no consistent convention explains); "
+             "<b>extraction</b> (damage of the OCR text of the seed); <b>convention</b> "
+             "(reproduced exactly under the named convention); <b>simplification</b> (the "
+             "author's stated approximation, with the size of what it drops); "
+             "<b>undecidable</b> (the evidence says what is missing).</p>",
+             _counts_table(entries, sources)]
+    for s in sources:
+        mine = [e for e in entries if e["source"] == s]
+        counts = category_counts(mine)
+        parts.append(f'<h2 id="{_anchor(s)}">{html.escape(s)}</h2><p>'
+                     + ", ".join(f"{counts[c]} {c}" for c in CATEGORIES) + "</p>")
+        for c in CATEGORIES:
+            rows = [e for e in mine if e["category"] == c]
+            if not rows:
+                continue
+            parts.append(f'<h3 id="{_anchor(s + "-" + c)}">{_badge(c)} {len(rows)}</h3>'
+                         "<table><tr><th>equation</th><th>category</th><th>printed</th>"
+                         "<th>derived</th><th>evidence</th></tr>"
+                         + "".join(_row(e) for e in rows) + "</table>")
+    style = ("body{font-family:sans-serif;margin:2em;max-width:110em}"
+             "table{border-collapse:collapse;margin:1em 0}"
+             "td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%}"
+             "td:nth-child(3),td:nth-child(4){max-width:28em;overflow-x:auto}"
+             "pre{white-space:pre-wrap;margin:0}"
+             ".cat{color:#fff;border-radius:3px;padding:1px 5px;font-size:85%}")
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{html.escape(title)}</title><style>{style}</style></head><body>"
+            + "\n".join(parts) + "</body></html>\n")
