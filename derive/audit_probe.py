@@ -179,18 +179,23 @@ def audit_signs(eq13: dict, eq17: dict) -> list[Verdict]:
               "the probe triggers late (ball centre recorded nearer the sphere)",
               fmt(probe_printed), fmt(delta - mean), "Probe")]
     n = sp.Matrix(sp.symbols("n_x n_y n_z", real=True))
-    error = ((r - delta) - reff) * n                # reported minus true surface point
+    # actual minus reported contact point: the sign convention of dX of eq. (4) (actual minus
+    # nominal), so that the two terms of eq. (17) add up in one convention
+    error = -((r - delta) - reff) * n
     probe_sym = sp.Symbol("Probe")
     printed = [_parse(t) for t in eq17["expr"]]
     dxyz = sp.Matrix(sp.symbols("dX dY dZ"))     # as parsed (plain symbols)
-    printed_term = (sp.Matrix(printed) - dxyz).subs({d.MX: n[0], d.MY: n[1], d.MZ: n[2]})
+    # M of eq. (17) is the probe's contact (approach) direction, into the surface: M = -n
+    printed_term = (sp.Matrix(printed) - dxyz).subs({d.MX: -n[0], d.MY: -n[1], d.MZ: -n[2]})
     derived_term = error
     same = _zero(printed_term.subs(probe_sym, delta - mean) - derived_term)
     out.append(_v("17", same, "sign of the probe term",
-                  "a point probed with outward surface normal M (from the surface towards the "
-                  "ball centre; the (phi, theta) of the sphere point, pole = phi 0) is reported "
-                  "Probe(M) inside the surface: error -Probe M, as printed; if M were the "
-                  "approach direction (into the surface) the sign would flip",
+                  "dX of eq. (4) is actual minus nominal; a trigger probe reports a point "
+                  "Probe(n) inside the surface (n the outward normal, the (phi, theta) of eq. "
+                  "13), so the actual contact lies +Probe n from the reported one.  Eq. (17)'s "
+                  "-Probe M is that term with M the contact (approach) direction, into the "
+                  "surface, M = -n, as Pahk names it; volerr's `direction` is the outward "
+                  "normal n, so Model.volumetric_error adds +Probe(n) n",
                   fmt(list(printed_term)), fmt(list(derived_term.subs(delta - mean,
                                                                       probe_sym))),
                   "dXc"))

@@ -204,14 +204,16 @@ class Model:
         ``errors``: {name: scalar or (N,)} in mm / rad, missing names are zero.  ``probe``:
         probe/tool offset (3,) or (N, 3) mm.  ``direction`` (N, 3) probing direction and
         ``probe_error`` (a callable of directions giving mm, or an (N,) array) combine the
-        probe error as Pahk eq. (17): the error along the probing direction is subtracted."""
+        probe error as Pahk eq. (17): ``+ Probe(n) n`` is added, ``n`` the outward surface
+        normal (eq. 17's ``- Probe M`` with ``M = -n`` its contact direction), so that the whole
+        result stays "actual minus nominal": a CMM reports the point minus this error."""
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
         e = self.module.volumetric_error(**pos, **self._covariates(covariates, n),
                                          **self._probe(probe, n), **errs)
         out = self._check_finite(_columns(e, n), errs)
         if direction is not None or probe_error is not None:
-            out = out - self._probe_term(direction, probe_error, n)
+            out = out + self._probe_term(direction, probe_error, n)
         return out
 
     def _probe_term(self, direction, probe_error, n: int) -> np.ndarray:

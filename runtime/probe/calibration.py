@@ -24,8 +24,11 @@ Conventions (stated once, used everywhere in volerr)
   is the probe's effective centre and radius -- what a stylus qualification uses -- so the
   along-normal error of a measured point is still -Probe(M); the reported u(centre), u(R_eff)
   are Type A (scatter about the map) and do not include this definitional part.
-* Eq. (17): a point measured with probing direction ``M`` is in error by ``-Probe(M) M``, which
-  :meth:`volerr.Model.volumetric_error` subtracts (``direction=M, probe_error=probe_map``).
+* Eq. (17): a point measured with probing direction ``M`` is reported ``Probe(M)`` inside the
+  surface (reported minus true = ``-Probe(M) M``); in the "actual minus nominal" convention of
+  the volumetric error that is ``+Probe(M) M``, which :meth:`volerr.Model.volumetric_error`
+  adds (``direction=M, probe_error=probe_map``).  Pahk writes ``- Probe M`` with ``M`` the
+  contact (approach) direction, the opposite of ours.
 * Units: mm and deg at the API, um in files' ``_um`` columns and in reports.
 
 The smooth map is a least-squares fit of real spherical harmonics of degree <= L (L chosen by

@@ -53,7 +53,8 @@ def directions_in_cap(rng, n, a_deg, b_deg, phi_max=85.0):
 
 @pytest.mark.parametrize("layout", ["MB1", "MH2", "FB1", "CY"])
 def test_combined_model_eq17(calibration, layout):
-    """Model.volumetric_error(direction=M, probe_error=map) = geometric error - Probe(M) M."""
+    """Model.volumetric_error(direction=M, probe_error=map) = geometric error + Probe(M) M
+    (actual minus nominal; M the outward normal)."""
     model = volerr.load(layout)
     rng = np.random.default_rng(hash(layout) % 2**32)
     n = 50
@@ -68,7 +69,7 @@ def test_combined_model_eq17(calibration, layout):
         geo = model.volumetric_error(pos, errs, probe=off)
         combined = model.volumetric_error(pos, errs, probe=off, direction=d, probe_error=pmap)
         phi, theta = independent_angles(d, a, b)
-        expect = geo - calibration.map.at(phi, theta)[:, None] * d
+        expect = geo + calibration.map.at(phi, theta)[:, None] * d
         np.testing.assert_allclose(combined, expect, atol=1e-12)
         # a non-unit direction is normalised by the model
         again = model.volumetric_error(pos, errs, probe=off, direction=3.5 * d, probe_error=pmap)
@@ -114,19 +115,20 @@ def test_measurement_with_pretravel(calibration):
     phi, theta = independent_angles(m, a, b)
     delta = pp.pahk_like_pretravel(np.radians(phi), np.radians(theta))
     surface = rng.uniform(-100, 100, (n, 3))
-    # recorded ball centre: contact + (r - pretravel) M, shifted by the geometric error;
-    # the qualification subtracts the sphere-centre bias and the effective radius
+    # recorded ball centre: contact + (r - pretravel) M; the machine reads its nominal
+    # position, actual minus the geometric error (geo = actual - nominal); the qualification
+    # subtracts the sphere-centre bias and the effective radius
     centre_bias = calibration.center - C0
-    recorded = surface + geo + (R_BALL - delta)[:, None] * m
+    recorded = surface - geo + (R_BALL - delta)[:, None] * m
     measured = recorded - centre_bias - calibration.r_eff * m
-    err = measured - surface
+    err = measured - surface                             # reported minus true = -(combined)
     combined = model.volumetric_error(pos, errs, direction=m,
                                       probe_error=calibration.map.oriented(a, b))
-    normal = np.sum((err - combined) * m, axis=1)
+    normal = np.sum((err + combined) * m, axis=1)
     assert np.sqrt(np.mean(normal ** 2)) < 0.25e-3      # within the calibration noise
     assert np.max(np.abs(normal)) < 0.8e-3
     # without the probe term the normal error would be off by the lobing (several um)
-    plain = np.sum((err - geo) * m, axis=1)
+    plain = np.sum((err + geo) * m, axis=1)
     assert np.sqrt(np.mean(plain ** 2)) > 2e-3
 
 
@@ -145,6 +147,6 @@ def test_per_point_head_angles(calibration):
     model = volerr.load("MB1")
     pos = np.zeros((25, 3))
     out = model.volumetric_error(pos, {}, direction=d, probe_error=calibration.map.oriented(a, b))
-    np.testing.assert_allclose(out, -many[:, None] * d, atol=1e-15)
+    np.testing.assert_allclose(out, many[:, None] * d, atol=1e-15)
     with pytest.raises(volerr.InputError, match="one value per direction"):
         calibration.map.oriented(a[:3], b[:3])(d)
