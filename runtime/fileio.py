@@ -100,3 +100,42 @@ def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
         rows.append((lineno, cells))
     require(rows, empty or f"{path}: empty file")
     return rows
+
+
+class AtomicFile:
+    """An output written in pieces (streamed) and put in place at the end, all or nothing:
+    a temporary file next to ``path``; :meth:`commit` renames it over ``path``,
+    :meth:`discard` removes it.  Checked with :func:`check_output` first."""
+
+    def __init__(self, path, inputs=(), mode: str = "wb"):
+        self.path = check_output(path, inputs)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            fd, self.tmp = tempfile.mkstemp(dir=self.path.parent, prefix=f".{self.path.name}.",
+                                            suffix=".tmp")
+        except OSError as exc:
+            raise InputError(f"cannot write {self.path}: {exc.strerror or exc}") from None
+        self.fh = os.fdopen(fd, mode)
+
+    def write(self, data) -> None:
+        self.fh.write(data)
+
+    def truncate(self) -> None:
+        self.fh.seek(0)
+        self.fh.truncate()
+
+    def commit(self) -> Path:
+        try:
+            self.fh.close()
+            os.chmod(self.tmp, default_mode())
+            os.replace(self.tmp, self.path)
+        except OSError as exc:
+            self.discard()
+            raise InputError(f"cannot write {self.path}: {exc.strerror or exc}") from None
+        return self.path
+
+    def discard(self) -> None:
+        if not self.fh.closed:
+            self.fh.close()
+        if os.path.exists(self.tmp):
+            os.unlink(self.tmp)

@@ -24,7 +24,7 @@ from pathlib import Path
 
 from volerr.cli._common import add_error_arguments
 from volerr.errors import InputError, require
-from volerr.fileio import check_output, write_bytes, write_text
+from volerr.fileio import check_output, write_text
 
 
 def register(sub) -> None:
@@ -80,6 +80,8 @@ def _initial(text: str) -> dict:
 
 
 def report_csv(model, reports) -> str:
+    """The report CSV of a :class:`volerr.fiveaxis.compensate.Result`'s line reports (the
+    command streams the same rows with :func:`volerr.fiveaxis.program.report_rows`)."""
     unit = {a: ("deg" if a in model.rotary_axes else "mm") for a in model.axes}
     cols = ["line", "status"] + [f"{a}_nominal_{unit[a]}" for a in model.axes] + \
         [f"{a}_out_{unit[a]}" for a in model.axes] + \
@@ -107,39 +109,43 @@ def report_csv(model, reports) -> str:
 def run(args) -> int:
     import sys
 
-    from volerr.fiveaxis import gcode
-    from volerr.fiveaxis.compensate import compensate_program, error_functions
+    from volerr.fiveaxis import program
+    from volerr.fiveaxis.compensate import error_functions
     from volerr.machine.model import load
 
     model = load(args.layout)
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
-    text = gcode.read_program(args.program)
+    open_source = program.open_program(args.program)
     inputs = [args.program, *Path(args.errors).glob("*.csv")]
     for out in (args.out, args.report, args.json, args.plot):
         if out:
             check_output(out, inputs)
     require(not args.plot or str(args.plot).lower().endswith(".png"),
             f"plot file must end in .png, got {args.plot}")
-    result = compensate_program(
-        model, funcs, text, tool=args.tool, orientation=args.orientation,
-        strategy=args.strategy, tol_um=args.tol_um, decimals=args.decimals,
-        initial=_initial(args.initial), check_travel=not args.ignore_travel,
-        types=None if args.types is None else [t for t in args.types.split(",") if t.strip()])
-    write_bytes(args.out, result.text.encode("latin-1"), inputs)
-    s = result.summary()
-    if args.report:
-        write_text(args.report, report_csv(model, result.reports), inputs)
-    if args.json:
-        write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
-                                          "orientation": bool(args.orientation),
-                                          "types": args.types or "L-VOL,R-VOL", **s},
-                                         indent=2) + "\n", inputs)
-    if args.plot:
-        from volerr.fiveaxis.plots import plot_program_errors
+    opts = program.Options(
+        tuple(args.tool), args.orientation, args.strategy, args.tol_um, args.decimals,
+        _initial(args.initial), not args.ignore_travel, 50,
+        None if args.types is None else tuple(t for t in args.types.split(",") if t.strip()))
+    # streamed: the program and the report go to temporary files, put in place at the end
+    sink = program.FileSink(model, args.out, args.report, inputs, keep_errors=bool(args.plot))
+    try:
+        s, assumed_zero = program.run(open_source, model, funcs, opts, sink)
+        if args.json:
+            write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
+                                              "orientation": bool(args.orientation),
+                                              "types": args.types or "L-VOL,R-VOL", **s},
+                                             indent=2) + "\n", inputs)
+        if args.plot:
+            from volerr.fiveaxis.plots import plot_program_errors
 
-        plot_program_errors(result.reports, args.plot, title=f"{model.name}: {args.program}")
+            plot_program_errors(sink.program_errors(), args.plot,
+                                title=f"{model.name}: {args.program}")
+        sink.commit()
+    except BaseException:
+        sink.discard()
+        raise
     print(f"{model.name}: {s['compensated']} of {s['motion_blocks']} motion blocks compensated "
           f"({args.strategy}{', orientation' if args.orientation else ''}"
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
@@ -149,8 +155,8 @@ def run(args) -> int:
         print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
     # notes only after success: bad input gets exactly one line on stderr
-    if result.assumed_zero:
-        notes.append(f"axes {' '.join(result.assumed_zero)} are never programmed: taken at 0 deg "
+    if assumed_zero:
+        notes.append(f"axes {' '.join(assumed_zero)} are never programmed: taken at 0 deg "
                      f"(give --initial to state other positions)")
     for note in notes:
         print(f"note: {note}", file=sys.stderr)

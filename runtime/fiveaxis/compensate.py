@@ -397,208 +397,77 @@ def solve_thesis(em: ErrorModel, q_nom: np.ndarray) -> np.ndarray:
 
 # ---------------------------------------------------------------------------------------
 # programs
-def _round(v: float, nd: int) -> float:
-    return float(gcode.format_number(v, nd))
+class _Collect:
+    """Sink of :func:`volerr.fiveaxis.program.run` that keeps the text and a report per block."""
+
+    def __init__(self, model):
+        self.model = model
+
+    def start(self):
+        self.text, self.reports = [], []
+
+    def add(self, chunk) -> None:
+        axes = self.model.axes
+        b, p = chunk.blocks, chunk.prediction
+        self.text.append(chunk.text)
+        q_nom, q_out = b.q_nom.tolist(), chunk.q_out.tolist()
+        rows = [b.lines[i] for i, r in enumerate(b.row) if r >= 0]
+        for o in b.order:
+            if o >= 0:
+                self.reports.append(LineReport(
+                    rows[o].number, dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
+                    tuple(p.before_um[o]), tuple(p.after_um[o]),
+                    float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
+                    int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))
+            else:
+                line, target = b.pending[-1 - o]
+                missing = [a for a in axes if target[a] is None]
+                self.reports.append(LineReport(
+                    line.number, dict(target), dict(target), (math.nan,) * 3, (math.nan,) * 3,
+                    math.nan, math.nan, 0,
+                    f"not compensated: position of axis {missing[0]} unknown"))
 
 
 def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
                        strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
                        initial: dict | None = None, check_travel: bool = True,
-                       max_iter: int = 50, types=None) -> Result:
+                       max_iter: int = 50, types=None, chunk_lines: int | None = None) -> Result:
     """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
 
     ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
     that compensates the linear axes only); the report still predicts the error of the full
-    model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL)."""
-    require(strategy in STRATEGIES, f"unknown strategy {strategy!r} ({' '.join(STRATEGIES)})")
-    require(tol_um > 0 and math.isfinite(tol_um), "tolerance must be a positive number")
-    require(0 <= decimals <= 9, "decimals must be 0..9")
-    require(not (orientation and not is_five_axis(model)),
-            f"{model.name}: orientation compensation needs two rotary axes")
-    require(not (orientation and strategy == "thesis"),
-            "the thesis strategy does not compensate the orientation")
-    tool = np.asarray(tool, dtype=float)
-    require(tool.shape == (3,) and np.all(np.isfinite(tool)), "tool offset must be 3 numbers")
-    for a in initial or {}:
-        require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")
-    lines = gcode.parse(text)
-    initial = dict(initial or {})
-    blocks = gcode.blocks(lines, model.axes, initial)
-    # a rotary axis the program never commands stays where it is: at its zero unless given
-    never = tuple(a for a in model.rotary_axes
-                  if a not in initial and all(b.target[a] is None for b in blocks))
-    if never:
-        initial.update({a: 0.0 for a in never})
-        blocks = gcode.blocks(lines, model.axes, initial)
-    require(not (types is not None and strategy == "thesis"),
-            "the thesis strategy has its own set of errors (L-POS L-STR L-SQU and the "
-            "rotary-axis errors); --types applies to the full strategy")
-    em = ErrorModel(model, funcs, tool, parameters_for_types(model, types))
-    axes = model.axes
+    model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL).
+    ``chunk_lines``: lines per chunk (the output does not depend on it; see
+    :mod:`volerr.fiveaxis.program`, which also streams a program file of any length)."""
+    import io
 
-    known = [b for b in blocks if all(b.target[a] is not None for a in axes)]
-    q_nom = np.array([[b.target[a] for a in axes] for b in known]) if known else \
-        np.zeros((0, len(axes)))
-    if check_travel and len(known):
-        for i, a in enumerate(axes):
-            lo, hi = model.travel[a]
-            bad = (q_nom[:, i] < lo - 1e-9) | (q_nom[:, i] > hi + 1e-9)
-            if bad.any():
-                k = int(np.argmax(bad))
-                raise InputError(f"line {known[k].line.number}: {a} = {q_nom[k, i]:g} is outside "
-                                 f"the travel {lo:g} .. {hi:g} of {model.name} "
-                                 "(--ignore-travel to go on)")
-    if funcs is not None and len(known) and not funcs.extrapolate:
-        ql = em.lookup(q_nom)
-        for a, (lo, hi) in em.ranges.items():
-            i = axes.index(a)
-            bad = (ql[:, i] < lo - 1e-9) | (ql[:, i] > hi + 1e-9)
-            if bad.any():
-                k = int(np.argmax(bad))
-                raise InputError(f"line {known[k].line.number}: {a} = {q_nom[k, i]:g} is outside "
-                                 f"the measured range {lo:g} .. {hi:g} of error table {a} "
-                                 "(--extrapolate to evaluate beyond it)")
+    from volerr.fiveaxis import program
 
-    if len(known):
-        if strategy == "thesis":
-            q_c, iters = solve_thesis(em, q_nom), np.ones(len(known), dtype=int)
-            limited = np.zeros(len(known), dtype=bool)
-        else:
-            q_c, iters, limited = solve(em, q_nom, orientation, tol_um * 1e-3, max_iter)
-    else:
-        q_c, iters, limited = q_nom.copy(), np.zeros(0, dtype=int), np.zeros(0, dtype=bool)
-
-    # decimals per block and axis: never fewer than the programmed word had
-    nd = np.full(q_nom.shape, decimals, dtype=int)
-    for r, b in enumerate(known):
-        for w in b.line.words():
-            if w.letter in axes:
-                nd[r, axes.index(w.letter)] = max(decimals, gcode.decimals(
-                    b.line.body[w.num_start:w.num_end]))
-    q_out = q_c.copy()
-    rot_idx = [axes.index(a) for a in model.rotary_axes]
-    lin_idx = [axes.index(a) for a in linear_axes(model)]
-    if len(known):
-        for j in rot_idx:
-            q_out[:, j] = [q_nom[r, j] if q_c[r, j] == q_nom[r, j] else _round(q_c[r, j], nd[r, j])
-                           for r in range(len(known))]
-        if orientation and not np.array_equal(q_out[:, rot_idx], q_c[:, rot_idx]):
-            q_out = _resolve_linear(em, q_nom, q_out, tol_um * 1e-3, max_iter)
-        for j in lin_idx:
-            q_out[:, j] = [q_nom[r, j] if q_out[r, j] == q_nom[r, j] else
-                           _round(q_out[r, j], nd[r, j]) for r in range(len(known))]
-
-    # predicted errors before / after
-    reports = []
-    if len(known):
-        target = model.nominal_position(q_nom, tool)
-        before = em.position_error(q_nom) * 1e3
-        after = (model.nominal_position(q_out, tool) + em.position_error(q_out) - target) * 1e3
-        if model.rotary_axes:
-            k_nom = em.tool_axis(q_nom)
-            ob = np.linalg.norm(em.orientation_error(q_nom), axis=1) * 1e6
-            k_after = em.tool_axis(q_out) + em.orientation_error(q_out)
-            oa = np.linalg.norm(k_after - k_nom, axis=1) * 1e6
-        else:
-            ob = oa = np.zeros(len(known))
-        u_after = np.full((len(known), 3), math.nan)
-        if funcs is not None and funcs.has_random:
-            ql = em.lookup(q_out)
-            u_after = model.random_error(q_out, funcs.sigmas(ql), probe=tool) * 1e3
-    row = {id(b): r for r, b in enumerate(known)}
-    for b in blocks:
-        if id(b) in row:
-            r = row[id(b)]
-            reports.append(LineReport(
-                b.line.number, dict(zip(axes, q_nom[r])), dict(zip(axes, q_out[r])),
-                tuple(before[r]), tuple(after[r]), float(ob[r]), float(oa[r]), int(iters[r]),
-                "compensated (thesis strategy)" if strategy == "thesis" else
-                "compensated; orientation limited (rotary travel, error table or near a "
-                "singular orientation)" if limited[r]
-                else "compensated", tuple(u_after[r])))
-        else:
-            missing = [a for a in axes if b.target[a] is None]
-            reports.append(LineReport(b.line.number, dict(b.target), dict(b.target),
-                                      (math.nan,) * 3, (math.nan,) * 3, math.nan, math.nan, 0,
-                                      f"not compensated: position of axis {missing[0]} unknown"))
-
-    out_text = _write(lines, model.axes, initial, known, q_out, nd)
-    return Result(out_text, reports, never)
+    opts = program.Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
+                           check_travel, max_iter, None if types is None else tuple(types))
+    sink = _Collect(model)
+    _, never = program.run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
+                           chunk_lines or program.CHUNK_LINES)
+    return Result("".join(sink.text), sink.reports, never)
 
 
-def _resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
-    """Linear axes solved again for the (rounded) rotary values of ``q_out``."""
+def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
+    """Linear axes solved again for the (rounded) rotary values of ``q_out``; each row
+    iterates until its own correction changes by less than ``tol`` (mm)."""
     m = em.model
     lin_idx = [m.axes.index(a) for a in em.lin]
     target_p = m.nominal_position(q_nom, em.tool)
     q = q_out.copy()
+    active = np.ones(len(q), dtype=bool)
     for _ in range(max_iter):
-        e = m.nominal_position(q, em.tool) + em.position_error(q, em.compensated) - target_p
-        d = -np.linalg.solve(linear_jacobian(m, q, em.tool), e[:, :, None])[:, :, 0]
-        q[:, lin_idx] += d
-        if np.abs(d).max() < tol:
+        qa = q[active]
+        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated) \
+            - target_p[active]
+        d = -np.linalg.solve(linear_jacobian(m, qa, em.tool), e[:, :, None])[:, :, 0]
+        qa[:, lin_idx] += d
+        q[active] = qa
+        idx = np.flatnonzero(active)
+        active[idx[np.abs(d).max(axis=1) < tol]] = False
+        if not active.any():
             break
     return q
-
-
-def _write(lines, axes, initial, known, q_out, nd) -> str:
-    """The output program: original bytes except the changed / added axis words."""
-    interp = gcode.Interpreter(axes, initial)
-    spaced = gcode.spaced_style(lines)
-    state = {a: (None if interp.position[a] is None else float(interp.position[a])) for a in axes}
-    row = {id(b.line): r for r, b in enumerate(known)}
-    out = []
-    for line in lines:
-        b = interp.block(line)
-        if b is None or id(line) not in row:
-            out.append(line.text)
-            # follow what the controller holds (unchanged words, G28/G30 -> unknown)
-            if b is not None:
-                for w in line.words():
-                    if w.letter in axes:
-                        if b.incremental:
-                            state[w.letter] = None if state[w.letter] is None else \
-                                state[w.letter] + w.value
-                        else:
-                            state[w.letter] = w.value
-            for a in axes:
-                if interp.position[a] is None:
-                    state[a] = None
-            continue
-        r = row[id(line)]
-        words = {w.letter: w for w in line.words() if w.letter in axes}
-        new_values, added = {}, {}
-        for i, a in enumerate(axes):
-            want = float(q_out[r, i])
-            half = 0.5 * 10.0 ** (-int(nd[r, i]))
-            if b.incremental:
-                prev = state[a]
-                inc = want - prev
-                if a in words:
-                    if abs(inc - words[a].value) >= half:
-                        txt = gcode.format_number(inc, int(nd[r, i]), line.body[words[a].num_start:
-                                                                                 words[a].num_end])
-                        new_values[a] = txt
-                        state[a] = prev + float(txt)
-                    else:
-                        state[a] = prev + words[a].value
-                elif abs(inc) >= half:
-                    txt = gcode.format_number(inc, int(nd[r, i]))
-                    added[a] = txt
-                    state[a] = prev + float(txt)
-            else:
-                if a in words:
-                    orig = line.body[words[a].num_start:words[a].num_end]
-                    if abs(want - words[a].value) >= half:
-                        txt = gcode.format_number(want, int(nd[r, i]), orig)
-                        new_values[a] = txt
-                        state[a] = float(txt)
-                    else:
-                        state[a] = words[a].value
-                elif state[a] is None or abs(want - state[a]) >= half:
-                    txt = gcode.format_number(want, int(nd[r, i]))
-                    added[a] = txt
-                    state[a] = float(txt)
-        out.append(gcode.rewrite_line(line, new_values, added, spaced) if (new_values or added)
-                   else line.text)
-    return "".join(out)

@@ -49,6 +49,9 @@ _LINE = re.compile(r"[^\r\n]*(?:\r\n|\n|\r|$)")
 _WORD = re.compile(r"([A-Za-z])([ \t]*)([+-]?(?:\d+\.?\d*|\.\d+))")
 _SPACE = re.compile(r"[ \t]+")
 _COMMENT_PAREN = re.compile(r"\([^)]*\)")
+#: a line of address words and blanks only, and its words with the blanks before them
+_SIMPLE = re.compile(r"(?:[ \t]*[A-Za-z][ \t]*[+-]?(?:\d+\.?\d*|\.\d+))+[ \t]*")
+_PARTS = re.compile(r"([ \t]*)([A-Za-z])([ \t]*)([+-]?(?:\d+\.?\d*|\.\d+))")
 
 REFUSED_G = {
     2: "G2 circular arc", 3: "G3 circular arc", 10: "G10 offset setting",
@@ -74,21 +77,55 @@ class Token:
     num_end: int = 0
 
 
-@dataclass
 class Line:
-    """One line: its body (without the line ending), the ending, and its tokens."""
+    """One line: its body (without the line ending), the ending, and its tokens.
 
-    number: int          # 1-based line number in the file
-    body: str
-    ending: str
-    tokens: list = field(default_factory=list)
+    A line of address words and blanks only (``X1.5 Y-2 Z30``, the bulk of a program) keeps
+    its words as ``parts`` (leading blanks, letter, blanks, number text) and tokenizes only
+    when :attr:`tokens` is asked for; any other line is tokenized (and checked) at once."""
+
+    __slots__ = ("number", "body", "ending", "_tokens", "parts", "_items")
+
+    def __init__(self, number: int, body: str, ending: str, tokens=None, parts=None):
+        self.number = number      # 1-based line number in the file
+        self.body = body
+        self.ending = ending
+        self._tokens = tokens
+        self.parts = parts
+        self._items = None
+
+    @classmethod
+    def parse(cls, number: int, body: str, ending: str) -> "Line":
+        if _SIMPLE.fullmatch(body):
+            return cls(number, body, ending, parts=_PARTS.findall(body))
+        return cls(number, body, ending, tokens=tokenize(body, number))
+
+    @property
+    def tokens(self) -> list:
+        if self._tokens is None:
+            self._tokens = tokenize(self.body, self.number)
+        return self._tokens
 
     def words(self) -> list[Token]:
         return [t for t in self.tokens if t.kind == "word"]
 
+    def items(self) -> list[tuple[str, float, str]]:
+        """(upper-case letter, value, number text) of every word, in order."""
+        if self._items is None:
+            if self.parts is not None:
+                self._items = [(p[1].upper(), float(p[3]), p[3]) for p in self.parts]
+            else:
+                b = self.body
+                self._items = [(t.letter, t.value, b[t.num_start:t.num_end])
+                               for t in self.tokens if t.kind == "word"]
+        return self._items
+
     @property
     def text(self) -> str:
         return self.body + self.ending
+
+    def __repr__(self) -> str:
+        return f"Line({self.number}, {self.body!r}, {self.ending!r})"
 
 
 @dataclass
@@ -160,8 +197,56 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
 
 def parse(text: str) -> list[Line]:
     """All lines of a program with their tokens."""
-    return [Line(n, body, end, tokenize(body, n))
-            for n, (body, end) in enumerate(split_lines(text), start=1)]
+    return [Line.parse(n, body, end) for n, (body, end) in enumerate(split_lines(text), start=1)]
+
+
+def iter_lines(source, first: int = 1):
+    """Parsed lines of a program, one at a time: ``source`` is the program text or an open
+    text file (latin-1, ``newline=""`` so that every line keeps its own ending)."""
+    import io
+
+    fh = io.StringIO(source, newline="") if isinstance(source, str) else source
+    for n, seg in enumerate(fh, start=first):
+        body = seg.rstrip("\r\n")
+        yield Line.parse(n, body, seg[len(body):])
+
+
+@dataclass
+class Step:
+    """What one line does to the controller: ``kind`` "motion" (a motion block), "reference"
+    (G28 / G30: the named axes go to an unknown position) or "none" (dwell, or no axis
+    words); ``axis_words`` the (axis, value) pairs as written; ``incremental`` the distance
+    mode in force."""
+
+    kind: str
+    axis_words: list
+    incremental: bool
+
+
+class ControllerState:
+    """Axis positions a controller holds (mm / deg; None where unknown) and the one rule that
+    moves them: :meth:`apply`.  The interpreter follows the program as read with one; the
+    writer of a compensated program follows the program as written with another."""
+
+    __slots__ = ("position",)
+
+    def __init__(self, axes, initial: dict | None = None):
+        self.position = {a: None for a in axes}
+        self.position.update({a: float(v) for a, v in (initial or {}).items()})
+
+    def apply(self, step: Step) -> None:
+        pos = self.position
+        if step.kind == "motion":
+            if step.incremental:
+                for a, v in step.axis_words:
+                    prev = pos[a]
+                    pos[a] = None if prev is None else prev + v
+            else:
+                for a, v in step.axis_words:
+                    pos[a] = v
+        elif step.kind == "reference":
+            for a, _ in step.axis_words:
+                pos[a] = None   # via an intermediate point to a reference
 
 
 class Interpreter:
@@ -173,58 +258,67 @@ class Interpreter:
 
     def __init__(self, axes, initial: dict | None = None):
         self.axes = tuple(axes)
-        self.position = {a: None for a in self.axes}
-        self.position.update({a: float(v) for a, v in (initial or {}).items()})
+        self.state = ControllerState(self.axes, initial)
         self.incremental = False
+        #: the :class:`Step` of the last line read (None for a line without words)
+        self.last_step: Step | None = None
 
-    def block(self, line: Line) -> Block | None:
-        """Update the modal state with one line; return a :class:`Block` for a motion block."""
-        words = line.words()
-        if not words:
+    @property
+    def position(self) -> dict:
+        return self.state.position
+
+    def step(self, line: Line) -> Step | None:
+        """Check one line and update the distance mode; return what it does (None without
+        words).  Raises :class:`InputError` on unsupported constructs."""
+        items = line.items()
+        if not items:
             return None
-        gs = [w.value for w in words if w.letter == "G"]
-        ms = [w.value for w in words if w.letter == "M"]
         where = f"line {line.number}"
-        for g in gs:
-            g = round(g, 1)
-            if g in REFUSED_G:
-                raise InputError(f"{where}: {REFUSED_G[g]} is not supported")
-        for m in ms:
-            if round(m) in REFUSED_M:
-                raise InputError(f"{where}: {REFUSED_M[round(m)]} is not supported")
-        if "TRAORI" in line.body.upper():
+        foreign = self.FOREIGN_AXES
+        gs, axis_words = [], []
+        for letter, value, _ in items:
+            if letter in foreign:
+                axis_words.append((letter, value))
+            elif letter == "G":
+                g = round(value, 1)
+                if g in REFUSED_G:
+                    raise InputError(f"{where}: {REFUSED_G[g]} is not supported")
+                gs.append(g)
+            elif letter == "M" and round(value) in REFUSED_M:
+                raise InputError(f"{where}: {REFUSED_M[round(value)]} is not supported")
+        if line.parts is None and "TRAORI" in line.body.upper():
             raise InputError(f"{where}: TRAORI (TCPM) is not supported")
         for g in gs:
             if g == 90:
                 self.incremental = False
             elif g == 91:
                 self.incremental = True
-        axis_words = [w for w in words if w.letter in self.FOREIGN_AXES]
-        for w in axis_words:
-            if w.letter not in self.axes:
-                raise InputError(f"{where}: axis {w.letter} is not an axis of this machine "
-                                 f"(axes {' '.join(self.axes)})")
-        seen = set()
-        for w in axis_words:
-            if w.letter in seen:
-                raise InputError(f"{where}: axis {w.letter} programmed twice")
-            seen.add(w.letter)
-        if not axis_words:
+        if axis_words:
+            axes = self.axes
+            for a, _ in axis_words:
+                if a not in axes:
+                    raise InputError(f"{where}: axis {a} is not an axis of this machine "
+                                     f"(axes {' '.join(axes)})")
+            seen = set()
+            for a, _ in axis_words:
+                if a in seen:
+                    raise InputError(f"{where}: axis {a} programmed twice")
+                seen.add(a)
+        kind = "none"
+        if axis_words and 4 not in gs:      # dwell: X / P are times
+            kind = "reference" if (28 in gs or 30 in gs) else "motion"
+        return Step(kind, axis_words, self.incremental)
+
+    def block(self, line: Line) -> Block | None:
+        """Update the modal state with one line; return a :class:`Block` for a motion block."""
+        step = self.last_step = self.step(line)
+        if step is None:
             return None
-        if any(round(g, 1) == 4 for g in gs):
-            return None  # dwell: X / P are times
-        if any(round(g, 1) in (28, 30) for g in gs):
-            for w in axis_words:
-                self.position[w.letter] = None  # via an intermediate point to a reference
+        self.state.apply(step)
+        if step.kind != "motion":
             return None
-        for w in axis_words:
-            if self.incremental:
-                prev = self.position[w.letter]
-                self.position[w.letter] = None if prev is None else prev + w.value
-            else:
-                self.position[w.letter] = w.value
-        return Block(line, dict(self.position), tuple(w.letter for w in axis_words),
-                     self.incremental)
+        return Block(line, dict(self.state.position), tuple(a for a, _ in step.axis_words),
+                     step.incremental)
 
 
 def blocks(lines: list[Line], axes, initial: dict | None = None) -> list[Block]:
@@ -247,8 +341,11 @@ def format_number(value: float, ndigits: int, template: str = "") -> str:
     """``value`` with ``ndigits`` decimals, trailing zeros dropped but at least as many
     decimals as ``template`` had; a leading ``+`` kept if the template had one."""
     s = f"{value:.{ndigits}f}"
-    if "." in s:
-        keep = max(decimals(template), 1 if "." in template else 0)
+    if ndigits:
+        dot = template.find(".")
+        keep = len(template) - dot - 1 if dot >= 0 else 0
+        if keep == 0 and dot >= 0:
+            keep = 1
         intpart, frac = s.split(".")
         frac = frac.rstrip("0")
         if len(frac) < keep:
@@ -261,17 +358,34 @@ def format_number(value: float, ndigits: int, template: str = "") -> str:
     return s
 
 
-def spaced_style(lines: list[Line]) -> bool:
+def _kinds(line: Line) -> list[str]:
+    if line.parts is not None:
+        kinds = []
+        for p in line.parts:
+            if p[0]:
+                kinds.append("space")
+            kinds.append("word")
+        return kinds
+    return [t.kind for t in line.tokens]
+
+
+def _spaced(kinds: list[str]) -> bool | None:
+    for a, b, c in zip(kinds, kinds[1:], kinds[2:]):
+        if a == "word" and c == "word":
+            return b == "space"
+    for a, b in zip(kinds, kinds[1:]):
+        if a == "word" and b == "word":
+            return False
+    return None
+
+
+def spaced_style(lines) -> bool:
     """True when the program separates words by blanks (``G1 X1 Y2``), False when it writes
     them together (``G1X1Y2``): decides how an added word is separated."""
     for line in lines:
-        toks = line.tokens
-        for a, b, c in zip(toks, toks[1:], toks[2:]):
-            if a.kind == "word" and c.kind == "word":
-                return b.kind == "space"
-        for a, b in zip(toks, toks[1:]):
-            if a.kind == "word" and b.kind == "word":
-                return False
+        own = _spaced(_kinds(line))
+        if own is not None:
+            return own
     return True
 
 
@@ -280,26 +394,39 @@ def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None 
     the words of ``added`` (letter -> text) appended after the last word; every other byte kept.
     ``spaced``: separate added words by a blank (default: as the line does, else yes)."""
     body = line.body
-    pieces = []
-    pos = 0
-    last_word_end = None
-    for t in line.tokens:
-        if t.kind == "word":
-            last_word_end = t.start + len(t.text)
-    for t in line.tokens:
-        if t.kind == "word" and t.letter in new_values:
-            pieces.append(body[pos:t.num_start])
-            pieces.append(new_values[t.letter])
-            pos = t.num_end
-    out = "".join(pieces) + body[pos:]
-    if added:
+    if line.parts is not None:
+        parts = line.parts
+        get = new_values.get
+        head = "".join([f"{p[0]}{p[1]}{p[2]}{get(p[1].upper(), p[3])}" for p in parts])
+        tail = body[len(body.rstrip(" \t")):]   # a simple line ends in a number, then blanks
+        if not added:
+            return head + tail + line.ending
+        own = _spaced(_kinds(line)) if len(parts) > 1 else None
+        lower = all(p[1].islower() for p in parts)
+    else:
+        pieces = []
+        pos = 0
+        last_word_end = None
+        for t in line.tokens:
+            if t.kind == "word":
+                last_word_end = t.start + len(t.text)
+        for t in line.tokens:
+            if t.kind == "word" and t.letter in new_values:
+                pieces.append(body[pos:t.num_start])
+                pieces.append(new_values[t.letter])
+                pos = t.num_end
+        out = "".join(pieces) + body[pos:]
+        if not added:
+            return out + line.ending
         # the insertion point moves with the length change of the replaced numbers before it
         shift = len(out) - len(body)
         at = (last_word_end if last_word_end is not None else len(body)) + shift
-        own = spaced_style([line]) if len(line.words()) > 1 else None
-        sep = " " if (own if own is not None else (spaced if spaced is not None else True)) \
-            else ""
-        lower = all(t.text[0].islower() for t in line.words()) and line.words()
-        ins = "".join(f"{sep}{(a.lower() if lower else a)}{v}" for a, v in added.items())
-        out = out[:at] + ins + out[at:]
-    return out + line.ending
+        head, tail = out[:at], out[at:]
+        words = line.words()
+        own = _spaced(_kinds(line)) if len(words) > 1 else None
+        if len(words) > 1 and own is None:
+            own = True
+        lower = all(t.text[0].islower() for t in words) and words
+    sep = " " if (own if own is not None else (spaced if spaced is not None else True)) else ""
+    ins = "".join(f"{sep}{(a.lower() if lower else a)}{v}" for a, v in added.items())
+    return head + ins + tail + line.ending

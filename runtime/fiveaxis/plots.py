@@ -125,20 +125,23 @@ def plot_tcp_error_map(model, funcs, point, path, tool=(0.0, 0.0, 0.0), title: s
     return path
 
 
-def plot_program_errors(reports, path, title: str = ""):
+def plot_program_errors(errors, path, title: str = ""):
     """PNG: predicted tool-tip error (um, log scale) and tool-axis error (urad) per motion
-    block, before and after compensation."""
+    block, before and after compensation.  ``errors``: a
+    :class:`volerr.fiveaxis.program.ProgramErrors` (or the line reports of a
+    :class:`volerr.fiveaxis.compensate.Result`)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    done = [r for r in reports if r.status.startswith("compensated")]
-    lines = np.array([r.line for r in done])
-    before = np.array([np.linalg.norm(r.before_um) for r in done])
-    after = np.array([np.linalg.norm(r.after_um) for r in done])
-    ob = np.array([r.orientation_before_urad for r in done])
-    oa = np.array([r.orientation_after_urad for r in done])
+    from volerr.fiveaxis.program import ProgramErrors
+
+    if not isinstance(errors, ProgramErrors):
+        errors = ProgramErrors.from_reports(errors)
+    lines, before, after = errors.line, errors.before_um, errors.after_um
+    ob, oa = errors.orientation_before_urad, errors.orientation_after_urad
+    done = lines
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
     if len(done):
         floor = 1e-4

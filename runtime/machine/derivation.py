@@ -3,10 +3,21 @@
 Shipped layouts are loaded from their committed modules in ``volerr.generated`` and never reach
 this door; a layout file given by path, an augmented layout of ``volerr loop`` and the
 ``volerr derive`` command do.
+
+Cache: a module derived for a layout file is kept on disk, keyed by the layout text's sha256 and
+a fingerprint of the generator (the source of ``volerr.derive`` and the sympy version), in
+``$VOLERR_CACHE_DIR`` or else ``$XDG_CACHE_HOME/volerr`` (``~/.cache/volerr``), never inside the
+package.  The next load of the same layout text reads that file without importing sympy.  An
+entry carries the sha256 of its own text in its last line; an entry that does not match (cut
+short, edited, not Python) is ignored and rewritten atomically (temporary file + rename).  A
+cache folder that cannot be written only costs the derivation.
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
 import types
 from pathlib import Path
 
@@ -39,9 +50,99 @@ def module_from_source(source: str, layout_name: str) -> types.ModuleType:
     return mod
 
 
-def derive_module(layout: Layout) -> types.ModuleType:
-    """Derive and generate ``layout`` in memory and load the module."""
-    return module_from_source(generate_source(layout), layout.name)
+def derive_module(layout: Layout, cache: bool = True) -> types.ModuleType:
+    """The generated module of ``layout``: from the cache when an entry for this layout text
+    and generator exists, else derived (sympy) and stored in the cache."""
+    if not cache:
+        return module_from_source(generate_source(layout), layout.name)
+    path = cache_path(layout)
+    source = _read_entry(path)
+    if source is not None:
+        try:
+            mod = module_from_source(source, layout.name)
+            if getattr(mod, "LAYOUT_SHA256", None) == layout.sha256:
+                return mod
+        except Exception:  # noqa: BLE001 - a bad entry is rebuilt below
+            pass
+    source = generate_source(layout)
+    _write_entry(path, source)
+    return module_from_source(source, layout.name)
+
+
+_ENTRY_TAG = "# volerr-cache sha256 "
+
+
+def cache_dir() -> Path:
+    """Folder of derived modules: ``$VOLERR_CACHE_DIR``, else ``$XDG_CACHE_HOME/volerr``, else
+    ``~/.cache/volerr``."""
+    if os.environ.get("VOLERR_CACHE_DIR"):
+        return Path(os.environ["VOLERR_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "volerr"
+
+
+_FINGERPRINT = None
+
+
+def generator_fingerprint() -> str:
+    """sha256 of the generator's source files (``volerr.derive``: *.py and templates) and the
+    sympy version, without importing either."""
+    global _FINGERPRINT
+    if _FINGERPRINT is None:
+        import importlib.util
+        from importlib import metadata
+
+        spec = importlib.util.find_spec("volerr.derive")
+        h = hashlib.sha256()
+        for folder in spec.submodule_search_locations or ():
+            root = Path(folder)
+            for f in sorted(p for p in root.rglob("*") if p.is_file()
+                            and p.suffix not in (".pyc",) and "__pycache__" not in p.parts):
+                h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+        try:
+            h.update(metadata.version("sympy").encode())
+        except metadata.PackageNotFoundError:  # pragma: no cover
+            pass
+        _FINGERPRINT = h.hexdigest()
+    return _FINGERPRINT
+
+
+def cache_path(layout: Layout) -> Path:
+    """Cache entry of ``layout``: ``<cache_dir>/<name>-<key>.py``, key from the layout text's
+    sha256 and :func:`generator_fingerprint`."""
+    key = hashlib.sha256(f"{layout.sha256}:{generator_fingerprint()}".encode()).hexdigest()
+    safe = "".join(c if c.isalnum() or c in "_-" else "_" for c in layout.name.lower())
+    return cache_dir() / f"{safe}-{key[:32]}.py"
+
+
+def _read_entry(path: Path) -> str | None:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    body, _, tag = text.rstrip("\n").rpartition("\n")
+    if not tag.startswith(_ENTRY_TAG):
+        return None
+    if hashlib.sha256(body.encode("utf-8")).hexdigest() != tag[len(_ENTRY_TAG):]:
+        return None
+    return body
+
+
+def _write_entry(path: Path, source: str) -> None:
+    body = source.rstrip("\n")
+    text = f"{body}\n{_ENTRY_TAG}{hashlib.sha256(body.encode('utf-8')).hexdigest()}\n"
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    except OSError:
+        pass  # no cache: the next load derives again
 
 
 def package_generated_dir() -> Path:
