@@ -80,29 +80,28 @@ def tracker_covariance(points, tracker) -> np.ndarray:
     return s_r[..., None, None] ** 2 * uu + s_t[..., None, None] ** 2 * (eye - uu)
 
 
-def _skew(r) -> np.ndarray:
-    """[r]x for r of shape (..., 3) -> (..., 3, 3)."""
-    r = np.asarray(r)
-    z = np.zeros(r.shape[:-1])
-    return np.stack([np.stack([z, -r[..., 2], r[..., 1]], -1),
-                     np.stack([r[..., 2], z, -r[..., 0]], -1),
-                     np.stack([-r[..., 1], r[..., 0], z], -1)], -2)
+def _gen():
+    from volerr.generated import three_point as gen  # numpy only
+
+    return gen
 
 
 def design(lever) -> np.ndarray:
-    """Coefficient blocks ``[I, -[r]x]`` (Delta = A (t, e)): lever (..., 3) -> (..., 3, 6)."""
+    """Coefficient blocks ``[I, -[r]x]`` (Delta = A (t, e)): lever (..., 3) mm -> (..., 3, 6).
+
+    Generated from :func:`volerr.derive.three_point.design_block` (thesis eq. 31)."""
     lever = np.asarray(lever, dtype=float)
-    eye = np.broadcast_to(np.eye(3), lever.shape[:-1] + (3, 3))
-    return np.concatenate([eye, -_skew(lever)], axis=-1)
+    block = _gen().design_block(lever[..., 0], lever[..., 1], lever[..., 2])
+    return np.moveaxis(block, (0, 1), (-2, -1))
 
 
 def rotation_matrix(axis, angle_rad) -> np.ndarray:
-    """Right-hand rotation about unit ``axis`` by ``angle_rad`` (array) -> (..., 3, 3)."""
+    """Right-hand rotation about ``axis`` (normalised here) by ``angle_rad`` (array, rad) ->
+    (..., 3, 3); generated from :func:`volerr.derive.three_point.axis_rotation`."""
     k = np.asarray(axis, dtype=float)
     k = k / np.linalg.norm(k)
-    a = np.asarray(angle_rad, dtype=float)[..., None, None]
-    K = _skew(k)
-    return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * (K @ K)
+    a = np.asarray(angle_rad, dtype=float)
+    return np.moveaxis(_gen().axis_rotation(k[0], k[1], k[2], a), (0, 1), (-2, -1))
 
 
 def geometry_condition(lever) -> float:
@@ -647,26 +646,19 @@ def to_model_signs(table, layout, reference=None):
     q0 = float(table.positions[0] if reference is None else reference)
     if tool_side and (layout.axes[axis].kind != "linear" or q0 == 0):
         return table
-    t = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
-                  for p in MOTION_PREFIX[:3]], axis=1)
-    e = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
-                  for p in MOTION_PREFIX[3:]], axis=1)
+    zero = np.zeros_like(table.positions)
+    motions = [table.values.get(p + axis, zero) for p in MOTION_PREFIX]
+    u = np.asarray(layout.axes[axis].direction, dtype=float)
     if tool_side:
-        # the model's carriage frame is the carriage point at the origin at q = 0; the
-        # tracker's pivot is the one there at the reference position q0: t + q0 (e x u)
-        u = np.asarray(layout.axes[axis].direction, dtype=float)
-        delta = t + q0 * np.cross(e, u)
+        # generated: t + q0 (e x u), e (volerr.derive.three_point.tool_side_signs)
+        out = _gen().tool_side_signs(q0, *motions, *u)
         values = dict(table.values)
         for j, p in enumerate(MOTION_PREFIX[:3]):
-            if p + axis in values or np.any(delta[:, j]):
-                values[p + axis] = delta[:, j]
+            if p + axis in values or np.any(out[j]):
+                values[p + axis] = out[j]
         return ErrorTable(axis, table.positions, values, table.std, table.u95)
-    delta = -t
-    if layout.axes[axis].kind == "linear":
-        u = np.asarray(layout.axes[axis].direction, dtype=float)
-        travel = table.positions - q0
-        delta = delta - travel[:, None] * np.cross(e, u)
-    motions = np.concatenate([delta, -e], axis=1)
-    values = {p + axis: motions[:, j] for j, p in enumerate(MOTION_PREFIX)
-              if p + axis in table.values}
+    # generated: -t - travel (e x u), -e (volerr.derive.three_point.table_side_signs)
+    travel = table.positions - q0 if layout.axes[axis].kind == "linear" else zero
+    out = _gen().table_side_signs(travel, *motions, *u)
+    values = {p + axis: out[j] for j, p in enumerate(MOTION_PREFIX) if p + axis in table.values}
     return ErrorTable(axis, table.positions, values, table.std, table.u95)

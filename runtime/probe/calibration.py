@@ -383,15 +383,17 @@ def fit_sh(phi, theta, values, degree: int | None = None) -> SHFit:
 
 
 # ---- the probe error map ------------------------------------------------------------------
-def _unit_of(phi_deg, theta_deg) -> np.ndarray:
-    p, t = np.radians(phi_deg), np.radians(theta_deg)
-    return np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=-1)
+def unit_vectors(phi_deg, theta_deg) -> np.ndarray:
+    """Probe-frame unit vectors of the angles (phi, theta) in deg, shape (..., 3) of the
+    broadcast angles: generated :func:`volerr.generated.probe.unit_direction`."""
+    m = _gen().unit_direction(np.radians(phi_deg), np.radians(theta_deg))
+    return np.stack(m, axis=-1)
 
 
 def coverage_of(phi_deg, theta_deg) -> float:
     """Coverage radius of probed directions, deg: 1.5 x the largest nearest-neighbour angle
     (at least 5 deg)."""
-    u = _unit_of(phi_deg, theta_deg)
+    u = unit_vectors(phi_deg, theta_deg)
     if len(u) < 2:
         return 5.0
     dots = u @ u.T
@@ -434,7 +436,7 @@ class ProbeMap:
                 "coefficient count does not match the degree")
         if self.support_deg is not None:
             self.support_deg = np.asarray(self.support_deg, dtype=float).reshape(-1, 2)
-            self._support_u = _unit_of(self.support_deg[:, 0], self.support_deg[:, 1])
+            self._support_u = unit_vectors(self.support_deg[:, 0], self.support_deg[:, 1])
 
     def covered(self, phi_deg, theta_deg) -> np.ndarray:
         """Boolean mask: probe-frame angles (deg) inside the calibrated coverage."""
@@ -447,7 +449,7 @@ class ProbeMap:
 
     def _nearest(self, phi, theta):
         """(angle to the nearest probed direction in deg, its index) for each query."""
-        u = _unit_of(phi, theta)
+        u = unit_vectors(phi, theta)
         best = np.empty(len(u))
         idx = np.empty(len(u), dtype=int)
         for s in range(0, len(u), 20000):

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.probe.calibration import unit_vectors
+
 
 def _grid(cal, n_phi: int = 61, n_theta: int = 121):
     lo, hi = cal.map.phi_range_deg
@@ -76,17 +78,15 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
     pts_um = cal.probe * 1e3
     vmax = max(float(np.max(np.abs(val))), float(np.max(np.abs(pts_um))), 1e-6)
     gain = gain if gain is not None else 0.2 / vmax
-    ph, th = np.radians(pp), np.radians(tt)
     r = 1.0 + gain * val
-    x, y, z = r * np.sin(ph) * np.cos(th), r * np.sin(ph) * np.sin(th), r * np.cos(ph)
+    x, y, z = np.moveaxis(unit_vectors(pp, tt) * np.asarray(r)[..., None], -1, 0)
     norm = _norm(np.concatenate([val.ravel(), pts_um]))
     cmap = plt.get_cmap("RdBu_r")
     colors = cmap(norm(val))
     colors[np.ma.getmaskarray(masked)] = (0.85, 0.85, 0.85, 0.4)
     ax.plot_surface(x, y, z, facecolors=colors, rstride=1, cstride=1,
                     linewidth=0.2, edgecolor=(0, 0, 0, 0.15), antialiased=True, shade=False)
-    p, t = np.radians(cal.phi_deg), np.radians(cal.theta_deg)
-    u = np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=1)
+    u = unit_vectors(cal.phi_deg, cal.theta_deg)
     tip = u * (1.0 + gain * pts_um)[:, None]
     for a, b in zip(u, tip):
         ax.plot(*zip(a, b), color="k", linewidth=0.8)
