@@ -248,6 +248,11 @@ def generate_module() -> str:
         "layout": "--all",
         "layout_file": "derive/three_point.py",
         "sha256": hashlib.sha256(src.encode()).hexdigest(),
+        "sources": ("derive/htm.py", "derive/kinematics.py", "derive/three_point.py"),
+        "units": "Lever arms x, y, z and measured deviations d mm; error motions EX, EY, EZ "
+                 "mm and EA, EB, EC rad (small rotations about the frame axes); determinants "
+                 "N mm^3; angles rad; axis directions (ux, uy, uz) unit vectors; q0 and "
+                 "travel mm.  design_block maps (mm, rad) to mm.",
     }
     constants = {
         "MOTIONS": repr(MOTIONS),
