@@ -93,6 +93,7 @@ def generate_module(layout: Layout) -> str:
                                   if layout.axes[a].kind == "rotary")),
         "PARAMETERS": repr(tuple(chain_params)),
         "PARAMETER_AXIS": repr(layout.parameter_axis),
+        "PARAMETER_KIND": repr(layout.parameter_kind),
     }
     if layout.effects:
         constants["COVARIATES"] = repr(tuple(layout.covariates))

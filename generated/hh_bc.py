@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9e0b9225cac4964404bf2e854a5173268922f8f2cc7f38758d6dc04d440f1726
-derivation sha256  75fc28a82c33a4ec2b41698db0883f87fa8436ade2fe23aaa657f682fa028fee
+derivation sha256  892c72a7bf4cd915103c99ab1219c6cd66963d21d32d90d3669f8ecfcec10cc6
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -37,6 +37,17 @@ PARAMETER_AXIS = {'EXX': 'X', 'EYX': 'X', 'EZX': 'X', 'EAX': 'X', 'EBX': 'X', 'E
     'EAC': 'C', 'EBC': 'C', 'ECC': 'C', 'EA0Z': None, 'EB0Z': None, 'EC0Y': None, 'EX0B': None,
     'EZ0B': None, 'EA0B': None, 'EC0B': None, 'EX0C': None, 'EY0C': None, 'EA0C': None,
     'EB0C': None}
+PARAMETER_KIND = {'EXX': 'translational', 'EYX': 'translational', 'EZX': 'translational',
+    'EAX': 'angular', 'EBX': 'angular', 'ECX': 'angular', 'EXY': 'translational',
+    'EYY': 'translational', 'EZY': 'translational', 'EAY': 'angular', 'EBY': 'angular',
+    'ECY': 'angular', 'EXZ': 'translational', 'EYZ': 'translational', 'EZZ': 'translational',
+    'EAZ': 'angular', 'EBZ': 'angular', 'ECZ': 'angular', 'EXB': 'translational',
+    'EYB': 'translational', 'EZB': 'translational', 'EAB': 'angular', 'EBB': 'angular',
+    'ECB': 'angular', 'EXC': 'translational', 'EYC': 'translational', 'EZC': 'translational',
+    'EAC': 'angular', 'EBC': 'angular', 'ECC': 'angular', 'EA0Z': 'squareness',
+    'EB0Z': 'squareness', 'EC0Y': 'squareness', 'EX0B': 'location', 'EZ0B': 'location',
+    'EA0B': 'location', 'EC0B': 'location', 'EX0C': 'location', 'EY0C': 'location',
+    'EA0C': 'location', 'EB0C': 'location'}
 L = 250.0
 
 

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       c36a8ee13222ceb6375c8b54545b89e573334f275a5ba9e2b540af123de2e12a
-derivation sha256  75fc28a82c33a4ec2b41698db0883f87fa8436ade2fe23aaa657f682fa028fee
+derivation sha256  892c72a7bf4cd915103c99ab1219c6cd66963d21d32d90d3669f8ecfcec10cc6
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -32,6 +32,12 @@ PARAMETER_AXIS = {'EXX': 'X', 'EYX': 'X', 'EZX': 'X', 'EAX': 'X', 'EBX': 'X', 'E
     'EXY': 'Y', 'EYY': 'Y', 'EZY': 'Y', 'EAY': 'Y', 'EBY': 'Y', 'ECY': 'Y', 'EXZ': 'Z',
     'EYZ': 'Z', 'EZZ': 'Z', 'EAZ': 'Z', 'EBZ': 'Z', 'ECZ': 'Z', 'EA0Z': None, 'EB0Z': None,
     'EC0Y': None}
+PARAMETER_KIND = {'EXX': 'translational', 'EYX': 'translational', 'EZX': 'translational',
+    'EAX': 'angular', 'EBX': 'angular', 'ECX': 'angular', 'EXY': 'translational',
+    'EYY': 'translational', 'EZY': 'translational', 'EAY': 'angular', 'EBY': 'angular',
+    'ECY': 'angular', 'EXZ': 'translational', 'EYZ': 'translational', 'EZZ': 'translational',
+    'EAZ': 'angular', 'EBZ': 'angular', 'ECZ': 'angular', 'EA0Z': 'squareness',
+    'EB0Z': 'squareness', 'EC0Y': 'squareness'}
 
 
 def volumetric_error(X, Y, Z, Xp, Yp, Zp, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY,

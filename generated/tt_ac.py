@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9b5f923e440b8c75c3b5ca7308d4ba4371152109c2b1c6354b17becb2a4ed34a
-derivation sha256  75fc28a82c33a4ec2b41698db0883f87fa8436ade2fe23aaa657f682fa028fee
+derivation sha256  892c72a7bf4cd915103c99ab1219c6cd66963d21d32d90d3669f8ecfcec10cc6
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -37,6 +37,17 @@ PARAMETER_AXIS = {'EXX': 'X', 'EYX': 'X', 'EZX': 'X', 'EAX': 'X', 'EBX': 'X', 'E
     'EAC': 'C', 'EBC': 'C', 'ECC': 'C', 'EA0Z': None, 'EB0Z': None, 'EC0Y': None, 'EY0A': None,
     'EZ0A': None, 'EB0A': None, 'EC0A': None, 'EX0C': None, 'EY0C': None, 'EA0C': None,
     'EB0C': None}
+PARAMETER_KIND = {'EXX': 'translational', 'EYX': 'translational', 'EZX': 'translational',
+    'EAX': 'angular', 'EBX': 'angular', 'ECX': 'angular', 'EXY': 'translational',
+    'EYY': 'translational', 'EZY': 'translational', 'EAY': 'angular', 'EBY': 'angular',
+    'ECY': 'angular', 'EXZ': 'translational', 'EYZ': 'translational', 'EZZ': 'translational',
+    'EAZ': 'angular', 'EBZ': 'angular', 'ECZ': 'angular', 'EXA': 'translational',
+    'EYA': 'translational', 'EZA': 'translational', 'EAA': 'angular', 'EBA': 'angular',
+    'ECA': 'angular', 'EXC': 'translational', 'EYC': 'translational', 'EZC': 'translational',
+    'EAC': 'angular', 'EBC': 'angular', 'ECC': 'angular', 'EA0Z': 'squareness',
+    'EB0Z': 'squareness', 'EC0Y': 'squareness', 'EY0A': 'location', 'EZ0A': 'location',
+    'EB0A': 'location', 'EC0A': 'location', 'EX0C': 'location', 'EY0C': 'location',
+    'EA0C': 'location', 'EB0C': 'location'}
 h = 150.0
 
 

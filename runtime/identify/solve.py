@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volerr.units import MM_PER_M, MM_PER_UM, UM_PER_MM, URAD_PER_RAD
 from volerr.errors import InputError, require
 from volerr.identify.tracker_io import Round, check_rounds
 
@@ -72,9 +73,9 @@ def tracker_covariance(points, tracker) -> np.ndarray:
     L = np.linalg.norm(b, axis=-1)
     require(np.all(L > 1.0), "tracker position coincides with a measured point")
     u = b / L[..., None]
-    Lm = L / 1000.0
-    s_r = (IFM_MPE[0] + IFM_MPE[1] * Lm) * 1e-3 / math.sqrt(3.0)
-    s_t = (ANGLE_MPE[0] + ANGLE_MPE[1] * Lm) * 1e-3 / math.sqrt(3.0)
+    Lm = L / MM_PER_M
+    s_r = (IFM_MPE[0] + IFM_MPE[1] * Lm) * MM_PER_UM / math.sqrt(3.0)
+    s_t = (ANGLE_MPE[0] + ANGLE_MPE[1] * Lm) * MM_PER_UM / math.sqrt(3.0)
     uu = u[..., :, None] * u[..., None, :]
     eye = np.eye(3)
     return s_r[..., None, None] ** 2 * uu + s_t[..., None, None] ** 2 * (eye - uu)
@@ -192,8 +193,8 @@ class Identification:
     def summary(self) -> dict:
         """JSON-friendly summary (um, urad)."""
         res = np.concatenate([r.residuals[1:].reshape(-1, 3) for r in self.rounds])
-        norms = np.linalg.norm(res, axis=1) * 1e3
-        scale = np.array([1e3, 1e3, 1e3, 1e6, 1e6, 1e6])
+        norms = np.linalg.norm(res, axis=1) * UM_PER_MM
+        scale = np.array([UM_PER_MM] * 3 + [URAD_PER_RAD] * 3)
         out = {
             "axis": self.axis, "kind": self.kind, "method": self.method,
             "weighted_by_tracker": self.weighted,
@@ -204,7 +205,7 @@ class Identification:
             "condition": max(r.condition for r in self.rounds),
             "residual_rms_um": float(np.sqrt(np.mean(norms ** 2))) if norms.size else 0.0,
             "residual_max_um": float(norms.max()) if norms.size else 0.0,
-            "noise_sigma_um": [r.sigma_mm * 1e3 for r in self.rounds],
+            "noise_sigma_um": [r.sigma_mm * UM_PER_MM for r in self.rounds],
             "max_abs": {n: float(np.max(np.abs(self.values[:, j])) * scale[j])
                         for j, n in enumerate(self.names)},
             "outliers": [{"round": o[0], "position": o[1], "point": o[2],
@@ -237,31 +238,9 @@ def _mean_or_none(values):
 
 def _layout_number(value, params: dict) -> float:
     """A layout coordinate: a number or an arithmetic expression in the layout parameters."""
-    import ast
-    import operator
+    from volerr.machine.expressions import number
 
-    if isinstance(value, (int, float)):
-        return float(value)
-    ops = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
-           ast.Div: operator.truediv, ast.USub: operator.neg, ast.UAdd: operator.pos}
-
-    def ev(node):
-        if isinstance(node, ast.Expression):
-            return ev(node.body)
-        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
-            return float(node.value)
-        if isinstance(node, ast.Name) and node.id in params:
-            return float(params[node.id])
-        if isinstance(node, ast.BinOp) and type(node.op) in ops:
-            return ops[type(node.op)](ev(node.left), ev(node.right))
-        if isinstance(node, ast.UnaryOp) and type(node.op) in ops:
-            return ops[type(node.op)](ev(node.operand))
-        raise InputError(f"cannot evaluate the layout coordinate {value!r}")
-
-    try:
-        return ev(ast.parse(str(value), mode="eval"))
-    except SyntaxError:
-        raise InputError(f"cannot evaluate the layout coordinate {value!r}") from None
+    return number(value, params, "the layout coordinate")
 
 
 def _axis_geometry(layout, axis, direction, origin):
@@ -481,7 +460,7 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
                                 for r in closed["roles"]],
                       "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
                       "consistency_max": closed["consistency_max"],
-                      "vs_lsq_max": {nm: float(diff[:, j].max()) * (1e3 if j < 3 else 1e6)
+                      "vs_lsq_max": {nm: float(diff[:, j].max()) * (UM_PER_MM if j < 3 else URAD_PER_RAD)
                                      for j, nm in enumerate(names)}}
         if K > 1:
             import warnings
@@ -544,7 +523,7 @@ def _flag_outliers(rnd, resid, W, sigma, n, k):
         if kk == 0:
             continue
         out.append((rnd.name, float(rnd.positions[kk]), rnd.labels[i],
-                    float(np.linalg.norm(resid[kk, i]) * 1e3), float(ratio[kk, i])))
+                    float(np.linalg.norm(resid[kk, i]) * UM_PER_MM), float(ratio[kk, i])))
     return out
 
 

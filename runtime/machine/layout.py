@@ -163,6 +163,16 @@ class Layout:
         return tuple(sorted(names - set(self.axes) - set(self.parameters)))
 
     @property
+    def parameter_kind(self) -> dict:
+        """Parameter name -> kind: ``translational``, ``angular``, ``squareness``,
+        ``location`` or ``effect`` (:mod:`volerr.machine.iso_names`)."""
+        from volerr.machine.iso_names import kind_of
+
+        builtin = {n for a in self.axes.values() for n in a.component_errors
+                   + a.location_errors} | set(self.squareness)
+        return {n: kind_of(n) if n in builtin else "effect" for n in self.parameter_names}
+
+    @property
     def parameter_axis(self) -> dict:
         """Parameter name -> the axis whose position it depends on, or None for constants."""
         out = {}

@@ -46,6 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.units import MM_PER_UM, UM_PER_MM, URAD_PER_RAD, parse_number
 from volerr.errors import InputError, require
 
 #: largest plausible effective stylus-ball radius, mm (a sphere radius that implies more is wrong)
@@ -140,10 +141,7 @@ class SphereData:
 
 
 def _float(text: str, where: str) -> float:
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        raise InputError(f"{where}: not a number: {text!r}") from None
+    return parse_number(text, where)
 
 
 def read_sphere_csv(path) -> SphereData:
@@ -218,7 +216,7 @@ def check_sphere_points(points) -> np.ndarray:
     require(s[0] > 1e-9, "all points coincide: no sphere can be fitted")
     require(s[2] > PLANE_RATIO * s[0],
             f"all {n} points lie on one plane (a single circle, out-of-plane spread "
-            f"{s[2] * 1e3:.2g} um): the sphere is undetermined; probe several latitudes")
+            f"{s[2] * UM_PER_MM:.2g} um): the sphere is undetermined; probe several latitudes")
     return p
 
 
@@ -546,7 +544,7 @@ class ProbeCalibration:
 
     def stats_um(self, which: np.ndarray | None = None) -> dict:
         """max / min / rms of Probe (um) over the used points (as Pahk reports them)."""
-        v = self.probe[self.used if which is None else which] * 1e3
+        v = self.probe[self.used if which is None else which] * UM_PER_MM
         return {"max": float(v.max()), "min": float(v.min()),
                 "rms": float(math.sqrt(np.mean(v ** 2)))}
 
@@ -567,26 +565,26 @@ class ProbeCalibration:
             "map": {
                 "kind": "real spherical harmonics, orthonormal, l <= degree, m = -l..l",
                 "degree": int(self.map.degree),
-                "coefficients_um": [float(v) * 1e3 for v in self.map.coefficients],
+                "coefficients_um": [float(v) * UM_PER_MM for v in self.map.coefficients],
                 "coverage_deg": float(self.map.coverage_deg),
                 "support_deg": [[round(float(p), 6), round(float(t), 6)]
                                 for p, t in self.map.support_deg],
                 "residual_rms_um": float(math.sqrt(np.mean(
-                    (self.probe[self.used] - self.map_fitted[self.used]) ** 2)) * 1e3),
+                    (self.probe[self.used] - self.map_fitted[self.used]) ** 2)) * UM_PER_MM),
             },
             "outliers": {
                 "threshold": "studentised residual of a bisquare map fit > k x robust sigma",
-                "robust_sigma_um": float(self.robust_sigma * 1e3),
+                "robust_sigma_um": float(self.robust_sigma * UM_PER_MM),
                 "index": [int(i) for i in np.flatnonzero(self.outlier)],
                 "excluded": bool((~self.used).any()),
             },
             "uncertainty": {
                 "note": "standard uncertainties (Type A) from the scatter about the smooth map; "
                         "u(R_eff) excludes the master-sphere radius uncertainty u(R_s)",
-                "noise_um": float(self.noise * 1e3),
-                "u_center_um": [float(v) * 1e3 for v in (self.u_center if self.u_center
+                "noise_um": float(self.noise * UM_PER_MM),
+                "u_center_um": [float(v) * UM_PER_MM for v in (self.u_center if self.u_center
                                                          is not None else np.zeros(3))],
-                "u_r_eff_um": float(self.u_r_eff * 1e3),
+                "u_r_eff_um": float(self.u_r_eff * UM_PER_MM),
             },
             "sphere_fit_condition": float(self.condition),
         }
@@ -648,7 +646,7 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
             f"--sphere-radius (a radius in mm, not a diameter)")
     require(r_eff >= MIN_BALL_RADIUS_MM,
             f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
-            f"{r_eff * 1e3:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
+            f"{r_eff * UM_PER_MM:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
             f"check --sphere-radius (mm)")
     require(r_eff <= MAX_BALL_RADIUS_MM,
             f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
@@ -720,8 +718,8 @@ def map_csv_text(cal: ProbeCalibration) -> str:
     lines = [",".join(MAP_COLUMNS)]
     res = cal.probe - cal.map_fitted
     for i in range(cal.n_points):
-        lines.append(f"{cal.phi_deg[i]:.6f},{cal.theta_deg[i]:.6f},{cal.probe[i] * 1e3:.4f},"
-                     f"{cal.map_fitted[i] * 1e3:.4f},{res[i] * 1e3:.4f},"
+        lines.append(f"{cal.phi_deg[i]:.6f},{cal.theta_deg[i]:.6f},{cal.probe[i] * UM_PER_MM:.4f},"
+                     f"{cal.map_fitted[i] * UM_PER_MM:.4f},{res[i] * UM_PER_MM:.4f},"
                      f"{cal.r_m[i]:.7f},{int(cal.outlier[i])}")
     return "\n".join(lines) + "\n"
 
@@ -741,7 +739,7 @@ def probe_map_from_json(source, tilt_deg: float | None = None, roll_deg: float |
             raise InputError(f"{path}: not JSON: {exc}") from None
     try:
         m = source["map"]
-        return ProbeMap(int(m["degree"]), np.asarray(m["coefficients_um"], dtype=float) * 1e-3,
+        return ProbeMap(int(m["degree"]), np.asarray(m["coefficients_um"], dtype=float) * MM_PER_UM,
                         tuple(float(v) for v in source["phi_range_deg"]),
                         float(source.get("tilt_deg", 0.0) if tilt_deg is None else tilt_deg),
                         float(source.get("roll_deg", 0.0) if roll_deg is None else roll_deg),
@@ -773,7 +771,7 @@ def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
     arr = np.asarray(vals, dtype=float)
     require(len(arr) >= MIN_POINTS, f"{path}: needs at least {MIN_POINTS} map points")
     require(np.all(np.isfinite(arr)), f"{path}: NaN values")
-    sh = fit_sh(np.radians(arr[:, 0]), np.radians(arr[:, 1]), arr[:, 2] * 1e-3, degree)
+    sh = fit_sh(np.radians(arr[:, 0]), np.radians(arr[:, 1]), arr[:, 2] * MM_PER_UM, degree)
     return ProbeMap(sh.degree, sh.coefficients,
                     (float(arr[:, 0].min()), float(arr[:, 0].max())),
                     float(tilt_deg), float(roll_deg), outside, arr[:, :2],

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.units import UM_PER_MM
 from volerr.probe.calibration import unit_vectors
 
 
@@ -15,7 +16,7 @@ def _grid(cal, n_phi: int = 61, n_theta: int = 121):
     phi = np.linspace(lo, hi, n_phi)
     theta = np.linspace(0.0, 360.0, n_theta)
     pp, tt = np.meshgrid(phi, theta, indexing="ij")
-    val = cal.map.with_outside("extrapolate").at(pp, tt) * 1e3
+    val = cal.map.with_outside("extrapolate").at(pp, tt) * UM_PER_MM
     return pp, tt, np.ma.masked_where(~cal.map.covered(pp, tt), val)
 
 
@@ -75,7 +76,7 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
 
     pp, tt, masked = _grid(cal, 37, 73)
     val = masked.filled(0.0)          # uncalibrated directions: reference sphere, grey
-    pts_um = cal.probe * 1e3
+    pts_um = cal.probe * UM_PER_MM
     vmax = max(float(np.max(np.abs(val))), float(np.max(np.abs(pts_um))), 1e-6)
     gain = gain if gain is not None else 0.2 / vmax
     r = 1.0 + gain * val
@@ -113,7 +114,7 @@ def draw_2d(fig, ax, cal) -> None:
     """Fig. 3b: the smooth map on the (theta, phi) grid with contours, the measured Probe at
     each point as coloured markers (flagged outliers crossed)."""
     pp, tt, val = _grid(cal)
-    pts_um = cal.probe * 1e3
+    pts_um = cal.probe * UM_PER_MM
     norm = _norm(np.concatenate([val.compressed(), pts_um]))
     holes = bool(np.ma.getmaskarray(val).any())
     mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm,

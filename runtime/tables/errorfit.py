@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volerr.units import UM_PER_MM, URAD_PER_RAD
 from volerr.errors import InputError, require
 from volerr.tables.table import ErrorTable, choose_degree, loo_press, make_function, parameter_kind
 
@@ -56,11 +57,11 @@ class Fit:
 
     def report(self) -> dict:
         """Residuals in um or urad."""
-        k = 1e3 if parameter_kind(self.name) == "length" else 1e6
+        k = UM_PER_MM if parameter_kind(self.name) == "length" else URAD_PER_RAD
         return {"name": self.name, "method": self.method, "degree": self.degree,
                 "rms_residual": self.rms_residual * k, "max_residual": self.max_residual * k,
                 "loo_rms": None if self.loo_rms is None else self.loo_rms * k,
-                "unit": "um" if k == 1e3 else "urad"}
+                "unit": "um" if k == UM_PER_MM else "urad"}
 
 
 def _smooth(x, y, w):

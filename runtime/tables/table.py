@@ -60,12 +60,15 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.machine import iso_names
+from volerr.units import MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number, parse_number
 from volerr.errors import InputError, require
 from volerr.fileio import read_csv_rows, write_text
 
 #: unit suffix -> (kind, factor to mm or rad)
-UNITS = {"um": ("length", 1e-3), "mm": ("length", 1.0), "urad": ("angle", 1e-6), "rad": ("angle", 1.0)}
-_DIVISOR = {"um": 1000.0, "mm": 1.0, "urad": 1e6, "rad": 1.0}  # value_in_unit / divisor -> mm|rad
+UNITS = {"um": ("length", MM_PER_UM), "mm": ("length", 1.0), "urad": ("angle", RAD_PER_URAD),
+         "rad": ("angle", 1.0)}
+_DIVISOR = {"um": UM_PER_MM, "mm": 1.0, "urad": URAD_PER_RAD, "rad": 1.0}  # value_in_unit / divisor -> mm|rad
 ROTARY_LETTERS = ("A", "B", "C")
 _TABLE_NAME = re.compile(r"^E([XYZABC])([A-Z])$")
 _CONST_NAME = re.compile(r"^E([XYZABC])0([A-Z])$")
@@ -93,7 +96,7 @@ def _ignored_column(col: str) -> bool:
 
 def parameter_kind(name: str) -> str:
     """``"length"`` for translational (EX?, EY?, EZ?, EX0?, ...), ``"angle"`` for angular."""
-    return "length" if name[1] in "XYZ" else "angle"
+    return "length" if iso_names.is_length(name) else "angle"
 
 
 def axis_unit(axis: str) -> str:
@@ -182,13 +185,7 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
 
 
 def _number(path, lineno, column, text) -> float:
-    require(text != "", f"{path}:{lineno}: empty value in column {column}")
-    try:
-        v = float(text)
-    except ValueError:
-        raise InputError(f"{path}:{lineno}: {column} = {text!r} is not a number") from None
-    require(math.isfinite(v), f"{path}:{lineno}: {column} = {text} (NaN or infinite)")
-    return v
+    return parse_number(text, f"{path}:{lineno}", column)
 
 
 def _parse_column(path, col: str, axis: str):
@@ -273,8 +270,7 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
 
 
 def _fmt(v: float) -> str:
-    s = f"{float(v):.12g}"
-    return "0" if s == "-0" else s
+    return format_number(v, 12)
 
 
 def table_to_csv(table: ErrorTable) -> str:
