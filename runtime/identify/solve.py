@@ -390,12 +390,31 @@ def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
     }
 
 
-def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, method="lsq",
-                   tracker=None, sense="auto", max_cond=1e4, outlier_k=5.0,
-                   cross_check=True) -> RoundResult:
-    """Identify the six error motions of one round (see the module docstring)."""
+@dataclass
+class _Geometry:
+    """Step 1 of a round: nominal poses and measured deviations (K positions, n points)."""
+
+    condition: float
+    sense: int
+    lever: np.ndarray   # (K, n, 3) mm, lever arms at the nominal pose
+    delta: np.ndarray   # (K, n, 3) mm, measured minus nominal
+    A: np.ndarray       # (K, n, 3, 6) design blocks
+
+
+@dataclass
+class _LsqFit:
+    """Step 2 of a round: (weighted) least squares at every position."""
+
+    theta: np.ndarray   # (K, 6) mm / rad, zero at the reference
+    resid: np.ndarray   # (K, n, 3) mm
+    u: np.ndarray       # (K, 6) propagated standard uncertainties
+    sigma: float        # per-coordinate noise, mm
+    W: np.ndarray | None
+
+
+def _round_geometry(rnd: Round, kind, direction, origin, sense, max_cond) -> _Geometry:
+    """Check the point geometry, detect the sense and build the nominal pose."""
     pts = rnd.points
-    K, n, _ = pts.shape
     steps = rnd.positions - rnd.positions[0]
     cond = geometry_condition(pts[0])
     if not math.isfinite(cond):  # exactly singular: report the number a solver would give up at
@@ -406,21 +425,24 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
             f"collinear; use three well-spread, non-collinear points")
     s = _detect_sense(kind, pts, steps, direction, origin, rnd.name, sense)
     nom, lever = _nominal(kind, pts[0], steps, direction, origin, s)
-    delta = pts - nom
-    A = design(lever)
+    return _Geometry(cond, s, lever, pts - nom, design(lever))
+
+
+def _round_lsq(rnd: Round, geo: _Geometry, tracker) -> _LsqFit:
+    """Weighted (tracker covariance) or equal-weight least squares; noise pooled over the
+    round (``3n - 6`` degrees of freedom per position) without a tracker position."""
+    pts = rnd.points
+    K, n, _ = pts.shape
     W = None
     if tracker is not None:
         cov = tracker_covariance(pts, tracker) + tracker_covariance(pts[0], tracker)[None]
         W = np.linalg.inv(cov)
-    theta, Ninv = _solve(A, W, delta)
+    theta, Ninv = _solve(geo.A, W, geo.delta)
     theta[0] = 0.0
-    fitted = np.einsum("knij,kj->kni", A, theta)
-    resid = delta - fitted
+    resid = geo.delta - np.einsum("knij,kj->kni", geo.A, theta)
     resid[0] = 0.0
-    dof = 3 * n - 6
-    m = K - 1
     if W is None:
-        pooled = float(np.sum(resid[1:] ** 2)) / max(m * dof, 1)
+        pooled = float(np.sum(resid[1:] ** 2)) / max((K - 1) * (3 * n - 6), 1)
         sigma = math.sqrt(pooled)
         cov_theta = pooled * Ninv
     else:
@@ -429,49 +451,64 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
                                         tracker_covariance(pts[0], tracker)])))
     u = np.sqrt(np.clip(np.einsum("kii->ki", cov_theta), 0, None))
     u[0] = 0.0
+    return _LsqFit(theta, resid, u, sigma, W)
+
+
+def _closed_summary(closed: dict, rnd: Round, axis: str, u_closed, u_lsq) -> dict:
+    """JSON-friendly comparison of the closed form with least squares (um, urad)."""
+    K = u_lsq.shape[0]
+    names = tuple(p + axis for p in MOTION_PREFIX)
+    diff = np.abs(closed["vs_lsq"][1:]) if K > 1 else np.zeros((1, 6))
+    out = {"selection": closed["selection"],
+           "roles": [{k: rnd.labels[v] for k, v in r.items()} for r in closed["roles"]],
+           "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
+           "consistency_max": closed["consistency_max"],
+           "vs_lsq_max": {nm: float(diff[:, j].max()) * (UM_PER_MM if j < 3 else URAD_PER_RAD)
+                          for j, nm in enumerate(names)}}
+    if K > 1:
+        import warnings
+
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: noise-free data
+            gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
+        out["noise_gain_vs_lsq"] = {nm: float(gain[j]) if np.isfinite(gain[j]) else None
+                                    for j, nm in enumerate(names)}
+    return out
+
+
+def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, method="lsq",
+                   tracker=None, sense="auto", max_cond=1e4, outlier_k=5.0,
+                   cross_check=True) -> RoundResult:
+    """Identify the six error motions of one round (see the module docstring).
+
+    Steps: geometry and nominal pose, least squares, closed form (method or cross-check),
+    outliers (always judged on the least-squares residuals: the closed form fits six equations
+    exactly and leaves all misfit in the other three)."""
+    n = rnd.points.shape[1]
+    geo = _round_geometry(rnd, kind, direction, origin, sense, max_cond)
+    lsq = _round_lsq(rnd, geo, tracker)
     closed = {}
     if method == "closed":
-        closed = _closed_form(lever, delta, theta, axis, kind, A)
+        closed = _closed_form(geo.lever, geo.delta, lsq.theta, axis, kind, geo.A)
     elif cross_check and n >= 3:
         # only a cross-check: points at one height (a common set-up on a rotary table) make
         # every Zhang & Hu selection singular, while least squares is well determined
         try:
-            closed = _closed_form(lever, delta, theta, axis, kind, A)
+            closed = _closed_form(geo.lever, geo.delta, lsq.theta, axis, kind, geo.A)
         except InputError:
             closed = {}
-    u_closed = _closed_uncertainty(A, closed, W, sigma) if closed else None
-    # outliers are judged on the least-squares residuals (the closed form fits six equations
-    # exactly and leaves all misfit in the other three)
-    outliers = _flag_outliers(rnd, resid, W, sigma, n, outlier_k)
+    u_closed = _closed_uncertainty(geo.A, closed, lsq.W, lsq.sigma) if closed else None
+    outliers = _flag_outliers(rnd, lsq.resid, lsq.W, lsq.sigma, n, outlier_k)
+    theta, resid, u = lsq.theta, lsq.resid, lsq.u
     if method == "closed":
         theta = closed["values"].copy()
         theta[0] = 0.0
-        resid = delta - np.einsum("knij,kj->kni", A, theta)
+        resid = geo.delta - np.einsum("knij,kj->kni", geo.A, theta)
         resid[0] = 0.0
-        u_lsq, u = u, u_closed
-    else:
-        u_lsq = u
-    summary_cf = {}
-    if closed:
-        names = tuple(p + axis for p in MOTION_PREFIX)
-        diff = np.abs(closed["vs_lsq"][1:]) if K > 1 else np.zeros((1, 6))
-        summary_cf = {"selection": closed["selection"],
-                      "roles": [{k: rnd.labels[v] for k, v in r.items()}
-                                for r in closed["roles"]],
-                      "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
-                      "consistency_max": closed["consistency_max"],
-                      "vs_lsq_max": {nm: float(diff[:, j].max()) * (UM_PER_MM if j < 3 else URAD_PER_RAD)
-                                     for j, nm in enumerate(names)}}
-        if K > 1:
-            import warnings
-
-            with np.errstate(all="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: noise-free data
-                gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
-            summary_cf["noise_gain_vs_lsq"] = {nm: float(gain[j]) if np.isfinite(gain[j])
-                                               else None for j, nm in enumerate(names)}
-    return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, delta,
-                       cond, s, sigma, outliers, summary_cf)
+        u = u_closed
+    summary_cf = _closed_summary(closed, rnd, axis, u_closed, lsq.u) if closed else {}
+    return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, geo.delta,
+                       geo.condition, geo.sense, lsq.sigma, outliers, summary_cf)
 
 
 def _closed_uncertainty(A, closed, W, sigma):
