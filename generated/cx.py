@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       4e622ee7fcbf25114a88ce70a90bf837f7d7bb7c984c275446832d748a0e3760
-derivation sha256  892c72a7bf4cd915103c99ab1219c6cd66963d21d32d90d3669f8ecfcec10cc6
+derivation sha256  7be376daa0704ca00bac394989578bed2d48599ea90b4237d4492ddf3c9a4706
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       f33f383453fd86eb89aede0e8d896e5e1639520405e75ca24882d84376f1d8b8
-derivation sha256  892c72a7bf4cd915103c99ab1219c6cd66963d21d32d90d3669f8ecfcec10cc6
+derivation sha256  7be376daa0704ca00bac394989578bed2d48599ea90b4237d4492ddf3c9a4706
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

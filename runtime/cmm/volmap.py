@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.units import UM_PER_MM, URAD_PER_RAD, format_number
+from volerr.units import UM_PER_MM, format_number
 from volerr.errors import InputError, require
 from volerr.fileio import check_output, write_text
 

@@ -26,13 +26,12 @@ then P, then Q.  The commanded positions are not in the file and are given separ
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from volerr.units import format_number, parse_number, UM_PER_MM, URAD_PER_RAD
+from volerr.units import parse_number
 from volerr.errors import InputError, require
 from volerr.fileio import read_csv_rows
 

@@ -357,7 +357,24 @@ class Model:
 
 
 def load(name_or_path) -> Model:
-    """Load a shipped layout's generated model by name, or derive one from a layout file."""
+    """Load a machine's error model.
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        A shipped layout name (``"MB1"``, ``"DMU50"`` ...; its generated module is imported,
+        no sympy) or a layout ``.toml`` file (derived on the fly; imports sympy).
+
+    Returns
+    -------
+    Model
+        Positions in mm (linear) and deg (rotary); errors in mm / rad; results mm, shape
+        (N, 3) for N points.
+
+    Raises
+    ------
+    volerr.errors.InputError
+        Unknown layout or a defective layout file (one line)."""
     layout = read_layout(name_or_path)
     if not isinstance(layout, Layout):  # pragma: no cover - defensive
         raise InputError(f"not a layout: {name_or_path}")
