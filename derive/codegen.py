@@ -8,12 +8,25 @@ text gives the same bytes.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 from importlib import resources
+from pathlib import Path
 
 import jinja2
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
+
+from .linewrap import wrap_statement, wrap_text
+
+_DERIVE = Path(__file__).resolve().parent
+#: sources that shape every generated module: this printer, the wrapper and the template
+PRINTER_SOURCES = ("derive/codegen.py", "derive/linewrap.py", "derive/templates/model.py.j2")
+#: units paragraph of a layout's error-model module
+MODEL_UNITS = ("Linear positions and probe offsets mm, rotary positions rad (the runtime "
+               "converts from deg), translational errors mm, angular errors rad. Errors are "
+               "actual minus nominal position of the probe tip / tool centre point in the "
+               "workpiece frame, first order unless named exact.")
 
 
 class _Printer(NumPyPrinter):
@@ -51,6 +64,9 @@ class Function:
     output_names: list | None = None
     body: list = field(default_factory=list)
     result: str = ""
+    signature: list = field(default_factory=list)
+    doc_lines: list = field(default_factory=list)
+    result_lines: list = field(default_factory=list)
 
 
 def _prepare(f: Function) -> Function:
@@ -75,7 +91,12 @@ def _prepare(f: Function) -> Function:
                     for i, r in enumerate(reduced))
         f.result = ", ".join(f"_o{i}" for i in range(len(reduced))) + ("," if len(reduced) == 1
                                                                         else "")
-    f.body = body
+    f.signature = wrap_statement(f"def {f.name}({', '.join(f.args)}):", hang=8)
+    shapes = ", ".join(f"numpy.shape({a})" for a in f.args)
+    body.insert(0, f"_shape = numpy.broadcast_shapes({shapes})")
+    f.body = [line for stmt in body for line in wrap_statement(stmt, indent="    ")]
+    f.doc_lines = wrap_text(f.doc, indent="    ")
+    f.result_lines = wrap_statement(f"return {f.result}", indent="    ")
     return f
 
 
@@ -87,13 +108,43 @@ def _unravel(i: int, shape: tuple) -> tuple:
     return tuple(reversed(out))
 
 
+def source_path(name: str) -> Path:
+    """Path of a derivation source named relative to the repository (``derive/htm.py``,
+    ``runtime/machine/layout.py``), resolved in the installed packages."""
+    top, _, rest = name.partition("/")
+    if top == "derive":
+        return _DERIVE / rest
+    if top == "runtime":
+        return Path(str(resources.files("volerr"))) / rest
+    raise ValueError(f"unknown source {name!r}")
+
+
+def sources_sha256(names) -> str:
+    """sha256 over the named source files (name and bytes of each, in the given order)."""
+    h = hashlib.sha256()
+    for name in names:
+        h.update(name.encode() + b"\0" + source_path(name).read_bytes() + b"\0")
+    return h.hexdigest()
+
+
 def render_module(header: dict, constants: dict, functions: list[Function]) -> str:
-    """Module source text: ``header`` (layout, file, sha256, ...), module-level ``constants``
-    (name -> Python literal) and the generated ``functions``."""
+    """Module source text.
+
+    ``header``: ``title``, ``layout`` (the ``volerr derive`` argument), ``layout_file`` and its
+    ``sha256``, ``sources`` (derivation sources relative to the repository; the printer's are
+    added) and optionally ``units`` (the module's Units paragraph, default: error-model units).
+    ``constants``: name -> Python literal.  The header records the sympy version and the
+    sha256 over the derivation sources next to the input's sha256."""
+    sources = tuple(header.get("sources", ())) + PRINTER_SOURCES
+    header = {**header, "sympy_version": sp.__version__,
+              "sources_sha256": sources_sha256(sources),
+              "sources_lines": wrap_text(", ".join(sources), width=95),
+              "units_lines": wrap_text(header.get("units", MODEL_UNITS))}
+    consts = {k: wrap_statement(f"{k} = {v}") for k, v in constants.items()}
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(resources.files("volerr.derive") / "templates")),
         keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True,
         undefined=jinja2.StrictUndefined)
     template = env.get_template("model.py.j2")
-    return template.render(header=header, constants=constants,
+    return template.render(header=header, constants=consts,
                            functions=[_prepare(f) for f in functions])

@@ -22,6 +22,12 @@ EXTRA_MODULES = {
 }
 
 
+#: derivation sources of a layout's module (hashed into its header)
+LAYOUT_SOURCES = ("runtime/machine/layout.py", "derive/htm.py", "derive/effects.py",
+                  "derive/kinematics.py", "derive/volumetric.py", "derive/inverse.py",
+                  "derive/generate.py")
+
+
 def module_name(layout_name: str) -> str:
     """File/module name of a layout's generated module (``MB1`` -> ``mb1``)."""
     return layout_name.lower()
@@ -87,6 +93,7 @@ def generate_module(layout: Layout) -> str:
                                   if layout.axes[a].kind == "rotary")),
         "PARAMETERS": repr(tuple(chain_params)),
         "PARAMETER_AXIS": repr(layout.parameter_axis),
+        "PARAMETER_KIND": repr(layout.parameter_kind),
     }
     if layout.effects:
         constants["COVARIATES"] = repr(tuple(layout.covariates))
@@ -98,6 +105,7 @@ def generate_module(layout: Layout) -> str:
         "layout": layout.name,
         "layout_file": layout.path or f"{layout.name}.toml",
         "sha256": layout.sha256,
+        "sources": LAYOUT_SOURCES,
     }
     return render_module(header, constants, derive_functions(layout))
 

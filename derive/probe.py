@@ -183,6 +183,11 @@ def generate_module() -> str:
         "layout": "--all",
         "layout_file": "derive/probe.py",
         "sha256": source_sha256(),
+        "sources": ("derive/probe.py",),
+        "units": "Angles A (tilt), B (roll) of the probe head and the probing-direction "
+                 "angles phi (from the probe axis) and theta (azimuth) in rad; directions "
+                 "(Mx, My, Mz) and (Mx', My', Mz') unit vectors, frame matrices rotations "
+                 "(dimensionless).  No lengths.",
     }
     constants = {"DERIVATION": repr("volerr.derive.probe")}
     return render_module(header, constants, functions())

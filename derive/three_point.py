@@ -35,7 +35,7 @@ import inspect
 import sympy as sp
 
 from .codegen import Function, render_module
-from .kinematics import rotation, twist
+from .kinematics import rotation, translation, twist
 
 #: the six error motions, in the order of the unknown vector (ISO 230-1 without the axis letter)
 MOTIONS = ("EX", "EY", "EZ", "EA", "EB", "EC")
@@ -154,6 +154,92 @@ def derive_functions() -> list[Function]:
     return funcs
 
 
+# ---- numeric building blocks of the runtime identification ---------------------------------
+LEVER = sp.symbols("x y z", real=True)
+AXIS_DIR = sp.symbols("ux uy uz", real=True)
+ANGLE = sp.Symbol("angle", real=True)
+
+
+def design_block(r=LEVER) -> sp.Matrix:
+    """3 x 6 coefficient block of one point: ``d Delta / d(EX, EY, EZ, EA, EB, EC)`` at the
+    lever arm ``r`` (mm), i.e. ``[I, -[r]x]`` (thesis eq. 31; one block of :func:`system`)."""
+    return point_displacement(sp.Matrix(r)).jacobian(motion_symbols())
+
+
+def axis_rotation(axis=AXIS_DIR, angle=ANGLE) -> sp.Matrix:
+    """3 x 3 right-hand rotation by ``angle`` (rad) about the unit vector ``axis`` (Rodrigues,
+    the nominal motion of a rotary axis, thesis eq. 3.2)."""
+    return rotation(axis, angle)[0:3, 0:3]
+
+
+def moved_pivot(motions, p_from, p_to) -> sp.Matrix:
+    """The six motions of a body given about the pivot ``p_from`` re-expressed about the pivot
+    ``p_to`` (first order): the rotation stays, the translation becomes the displacement of the
+    body point at ``p_to`` under ``Trans(p_from) (I + D) Trans(-p_from)``."""
+    ex, ey, ez, ea, eb, ec = motions
+    D = twist(ea, eb, ec, ex, ey, ez)
+    T = translation(p_from) * (sp.eye(4) + D) * translation(-sp.Matrix(p_from))
+    x = sp.Matrix([*p_to, 1])
+    t_new = sp.expand((T * x - x)[0:3, 0])
+    return sp.Matrix([*t_new, ea, eb, ec])
+
+
+def relative_motion(motions) -> sp.Matrix:
+    """First-order motions of the tool relative to a table that moves by ``motions`` (about the
+    same pivot): ``(I + D)^-1 = I - D + O(D^2)``, i.e. all six negated."""
+    ex, ey, ez, ea, eb, ec = motions
+    D = twist(ea, eb, ec, ex, ey, ez)
+    first = sp.eye(4) - D
+    assert sp.expand((sp.eye(4) + D) * first - sp.eye(4) + D * D) == sp.zeros(4)
+    return sp.Matrix([first[0, 3], first[1, 3], first[2, 3],
+                      first[2, 1], first[0, 2], first[1, 0]])
+
+
+def tool_side_signs(q0=sp.Symbol("q0", real=True), u=AXIS_DIR) -> sp.Matrix:
+    """Tool-side linear axis measured from the reference position ``q0`` (mm): the tracker's
+    pivot is the carriage point at the frame origin at ``q0``, which travels to ``(q - q0) u``;
+    the model's is the one there at ``q = 0``, at ``q u``.  Result ``t + q0 (e x u)``, ``e``."""
+    q = sp.Symbol("q", real=True)
+    u = sp.Matrix(u)
+    out = moved_pivot(motion_symbols(), (q - q0) * u, q * u)
+    assert not out.has(q)
+    return out
+
+
+def table_side_signs(travel=sp.Symbol("travel", real=True), u=AXIS_DIR) -> sp.Matrix:
+    """Table (workpiece-side) axis, ``travel = q - q0`` (mm; 0 for a rotary axis with the frame
+    origin on it): the table's pivot, the table point at the origin at the reference position,
+    is at ``-travel u`` (the table moves opposite to the tool's relative motion); the model
+    gives the tool relative to the table about the tool point at the origin:
+    ``-t - travel (e x u)``, ``-e``."""
+    u = sp.Matrix(u)
+    return relative_motion(moved_pivot(motion_symbols(), -travel * u, (0, 0, 0)))
+
+
+def runtime_functions() -> list[Function]:
+    """Generated numeric blocks of ``volerr.identify.solve`` (design, rotation, model signs)."""
+    motions = [str(s) for s in motion_symbols()]
+    udir = [str(s) for s in AXIS_DIR]
+    return [
+        Function("design_block", [str(s) for s in LEVER], list(design_block()),
+                 "Coefficient block [I, -[r]x] of one point, array (3, 6, *shape): "
+                 "Delta (mm) = block @ (EX, EY, EZ mm, EA, EB, EC rad); lever arm x, y, z mm "
+                 "(thesis eq. 31).", shape=(3, 6)),
+        Function("axis_rotation", udir + [str(ANGLE)], list(axis_rotation()),
+                 "Right-hand rotation about the unit vector (ux, uy, uz) by angle (rad), "
+                 "array (3, 3, *shape) (thesis eq. 3.2, Rodrigues).", shape=(3, 3)),
+        Function("tool_side_signs", ["q0"] + motions + udir, list(tool_side_signs()),
+                 "Identified motions (EX, EY, EZ mm; EA, EB, EC rad) of a tool-side linear axis "
+                 "measured from the reference position q0 (mm) in the model's convention, "
+                 "array (6, *shape): t + q0 (e x u), e.", shape=(6,)),
+        Function("table_side_signs", ["travel"] + motions + udir, list(table_side_signs()),
+                 "Identified motions of a table axis (the table's own motions, EX, EY, EZ mm; "
+                 "EA, EB, EC rad) in the model's convention (tool relative to the table), "
+                 "array (6, *shape): -t - travel (e x u), -e; travel = q - q0 (mm), 0 for a "
+                 "rotary axis with the frame origin on it.", shape=(6,)),
+    ]
+
+
 def generate_module() -> str:
     """Text of ``generated/three_point.py`` (deterministic)."""
     src = inspect.getsource(inspect.getmodule(generate_module))
@@ -162,10 +248,15 @@ def generate_module() -> str:
         "layout": "--all",
         "layout_file": "derive/three_point.py",
         "sha256": hashlib.sha256(src.encode()).hexdigest(),
+        "sources": ("derive/htm.py", "derive/kinematics.py", "derive/three_point.py"),
+        "units": "Lever arms x, y, z and measured deviations d mm; error motions EX, EY, EZ "
+                 "mm and EA, EB, EC rad (small rotations about the frame axes); determinants "
+                 "N mm^3; angles rad; axis directions (ux, uy, uz) unit vectors; q0 and "
+                 "travel mm.  design_block maps (mm, rad) to mm.",
     }
     constants = {
         "MOTIONS": repr(MOTIONS),
         "SELECTIONS": repr({k: SELECTIONS[k] for k in sorted(SELECTIONS)}),
         "AXIS_SELECTION": repr(AXIS_SELECTION),
     }
-    return render_module(header, constants, derive_functions())
+    return render_module(header, constants, derive_functions() + runtime_functions())

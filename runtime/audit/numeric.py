@@ -20,6 +20,7 @@ from importlib import resources
 
 import numpy as np
 
+from volerr.machine import iso_names
 from volerr.errors import InputError
 
 DATA_FILE = "printed_pahk.toml"
@@ -87,7 +88,7 @@ def spot_check(model, n: int = 200, seed: int = 0, translational_mm: float = 0.0
     probe = rng.uniform(-probe_mm, probe_mm, (n, 3))
     errors = {}
     for p in model.parameters:
-        angular = p[1] in "ABC"
+        angular = iso_names.is_angle(p)
         errors[p] = rng.normal(0.0, angular_rad if angular else translational_mm, n)
     sigmas = {p: abs(v[0]) + 1e-9 for p, v in errors.items()}
     base = {**pos, "Xp": probe[:, 0], "Yp": probe[:, 1], "Zp": probe[:, 2]}

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volerr.units import UM_PER_MM
 from volerr.errors import require
 from volerr.cmm.volmap import fixed_positions, linear_axes
 
@@ -187,11 +188,11 @@ def evaluate_lines(model, funcs, lines, probe=(0.0, 0.0, 0.0), at=None,
         u = vec / length
         prof = (err[i] - err[i, 0]) @ u
         actual = (nom[i, -1] + ex[i, -1]) - (nom[i, 0] + ex[i, 0])
-        out.append(LineResult(ln, length, float(prof[-1] * 1e3),
-                              float((np.linalg.norm(actual) - length) * 1e3),
-                              None if rand is None else float(rand[i, -1] * 1e3),
-                              t * length, prof * 1e3,
-                              None if rand is None else rand[i] * 1e3))
+        out.append(LineResult(ln, length, float(prof[-1] * UM_PER_MM),
+                              float((np.linalg.norm(actual) - length) * UM_PER_MM),
+                              None if rand is None else float(rand[i, -1] * UM_PER_MM),
+                              t * length, prof * UM_PER_MM,
+                              None if rand is None else rand[i] * UM_PER_MM))
     return out
 
 

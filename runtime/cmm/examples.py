@@ -38,6 +38,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from volerr.machine import iso_names
+from volerr.units import MM_PER_UM, RAD_PER_URAD
 from volerr.errors import InputError
 from volerr.tables.table import ErrorTable, write_error_dir
 
@@ -85,7 +87,7 @@ def _paper_to_iso(paper_symbols: dict, squareness: dict) -> dict:
     for iso, sym in paper_symbols.items():
         sign, bare = (-1.0, sym[1:]) if sym.startswith("-") else (1.0, sym.lstrip("+"))
         if bare in squareness:
-            out[iso] = sign * squareness[bare] * 1e-6
+            out[iso] = sign * squareness[bare] * RAD_PER_URAD
     return out
 
 
@@ -104,7 +106,7 @@ def example_errors(layout: str = "MB1"):
         t = (x - lo) / (hi - lo)
         values, std = {}, {}
         for name, (band, rep) in params.items():
-            scale = 1e-3 if name[1] in "XYZ" else 1e-6  # um -> mm, urad -> rad
+            scale = MM_PER_UM if iso_names.is_length(name) else RAD_PER_URAD
             values[name] = np.round(_smooth(rng, t, band), 4) * scale
             if rep is not None:
                 std[name] = np.round((rep / 2.0) * np.sqrt(t), 4) * scale

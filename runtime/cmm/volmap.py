@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.units import UM_PER_MM, format_number
 from volerr.errors import InputError, require
 from volerr.fileio import check_output, write_text
 
@@ -47,7 +48,7 @@ class VolumetricMap:
 
     def summary(self) -> dict:
         """Max |component|, max and RMS length of the error vector, in um."""
-        e = self.error * 1e3
+        e = self.error * UM_PER_MM
         length = np.linalg.norm(e, axis=1)
         out = {"layout": self.layout, "grid": list(self.shape), "n_points": int(len(e)),
                "probe_mm": [float(v) for v in self.probe],
@@ -55,7 +56,7 @@ class VolumetricMap:
                "max_length_um": float(length.max()),
                "rms_length_um": float(np.sqrt(np.mean(length ** 2)))}
         if self.random is not None:
-            r = self.random * 1e3
+            r = self.random * UM_PER_MM
             out["random_max_um"] = {k: float(r[:, i].max()) for i, k in enumerate("xyz")}
             out["random_max_length_um"] = float(np.linalg.norm(r, axis=1).max())
         return out
@@ -133,8 +134,7 @@ def volumetric_map(model, funcs, grid=None, probe=(0.0, 0.0, 0.0), at=None,
 
 
 def _fmt(v) -> str:
-    s = f"{float(v):.10g}"
-    return "0" if s == "-0" else s
+    return format_number(v, 10)
 
 
 def map_csv(vmap: VolumetricMap) -> str:
@@ -143,10 +143,10 @@ def map_csv(vmap: VolumetricMap) -> str:
     cols = [vmap.positions[a] for a in vmap.axes]
     n = len(cols[0])
     cols += [np.full(n, vmap.probe[i]) for i in range(3)]
-    cols += [vmap.error[:, i] * 1e3 for i in range(3)]
+    cols += [vmap.error[:, i] * UM_PER_MM for i in range(3)]
     if vmap.random is not None:
         header += ["rx_um", "ry_um", "rz_um"]
-        cols += [vmap.random[:, i] * 1e3 for i in range(3)]
+        cols += [vmap.random[:, i] * UM_PER_MM for i in range(3)]
     lines = [",".join(header)] + [",".join(_fmt(v) for v in row) for row in zip(*cols)]
     return "\n".join(lines) + "\n"
 
@@ -291,7 +291,7 @@ def plot_random(vmap: VolumetricMap, path, magnify: float | None = None, inputs=
     ax = _axes3d(fig)
     for line in _face_lines(vmap.shape):
         ax.plot(*nom[line].T, ls="--", lw=0.6, color="0.6")
-    mag = np.linalg.norm(r, axis=1) * 1e3
+    mag = np.linalg.norm(r, axis=1) * UM_PER_MM
     norm = matplotlib.colors.Normalize(vmin=0.0, vmax=max(mag.max(), 1e-12))
     cmap = matplotlib.colormaps["viridis"]
     for p, rv, m in zip(nom, r, mag):

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.machine import iso_names
 from volerr.errors import InputError
 from volerr.fileio import write_text
 from volerr.tables.table import ErrorTable, write_error_dir
@@ -42,7 +43,7 @@ def example_errors(model, seed: int = 50, samples: int = 21) -> tuple[dict, dict
         vals = {}
         for p in model.layout.axes[a].component_errors:
             um, urad = _SCALE[kind]
-            amp = urad * 1e-6 if p[1] in "ABC" else um * 1e-3
+            amp = urad * 1e-6 if iso_names.is_angle(p) else um * 1e-3
             if p == f"E{a}{a}" and a in _POSITIONING_UM:
                 amp = _POSITIONING_UM[a] * 1e-3
             c = rng.uniform(-1, 1, 3)
@@ -57,7 +58,7 @@ def example_errors(model, seed: int = 50, samples: int = 21) -> tuple[dict, dict
     constants = {}
     for p in model.parameters:
         if model.parameter_axis[p] is None:
-            constants[p] = rng.uniform(-1, 1) * (15e-3 if p[1] in "XYZ" else 40e-6)
+            constants[p] = rng.uniform(-1, 1) * (15e-3 if iso_names.is_length(p) else 40e-6)
     return tables, constants
 
 

@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-SCALE = (1e3, 1e3, 1e3, 1e6, 1e6, 1e6)
+from volerr.units import UM_PER_MM, URAD_PER_RAD
+
+SCALE = (UM_PER_MM,) * 3 + (URAD_PER_RAD,) * 3
 
 
 def _sigma(result):

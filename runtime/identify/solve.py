@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volerr.units import MM_PER_M, MM_PER_UM, UM_PER_MM, URAD_PER_RAD
 from volerr.errors import InputError, require
 from volerr.identify.tracker_io import Round, check_rounds
 
@@ -72,37 +73,36 @@ def tracker_covariance(points, tracker) -> np.ndarray:
     L = np.linalg.norm(b, axis=-1)
     require(np.all(L > 1.0), "tracker position coincides with a measured point")
     u = b / L[..., None]
-    Lm = L / 1000.0
-    s_r = (IFM_MPE[0] + IFM_MPE[1] * Lm) * 1e-3 / math.sqrt(3.0)
-    s_t = (ANGLE_MPE[0] + ANGLE_MPE[1] * Lm) * 1e-3 / math.sqrt(3.0)
+    Lm = L / MM_PER_M
+    s_r = (IFM_MPE[0] + IFM_MPE[1] * Lm) * MM_PER_UM / math.sqrt(3.0)
+    s_t = (ANGLE_MPE[0] + ANGLE_MPE[1] * Lm) * MM_PER_UM / math.sqrt(3.0)
     uu = u[..., :, None] * u[..., None, :]
     eye = np.eye(3)
     return s_r[..., None, None] ** 2 * uu + s_t[..., None, None] ** 2 * (eye - uu)
 
 
-def _skew(r) -> np.ndarray:
-    """[r]x for r of shape (..., 3) -> (..., 3, 3)."""
-    r = np.asarray(r)
-    z = np.zeros(r.shape[:-1])
-    return np.stack([np.stack([z, -r[..., 2], r[..., 1]], -1),
-                     np.stack([r[..., 2], z, -r[..., 0]], -1),
-                     np.stack([-r[..., 1], r[..., 0], z], -1)], -2)
+def _gen():
+    from volerr.generated import three_point as gen  # numpy only
+
+    return gen
 
 
 def design(lever) -> np.ndarray:
-    """Coefficient blocks ``[I, -[r]x]`` (Delta = A (t, e)): lever (..., 3) -> (..., 3, 6)."""
+    """Coefficient blocks ``[I, -[r]x]`` (Delta = A (t, e)): lever (..., 3) mm -> (..., 3, 6).
+
+    Generated from :func:`volerr.derive.three_point.design_block` (thesis eq. 31)."""
     lever = np.asarray(lever, dtype=float)
-    eye = np.broadcast_to(np.eye(3), lever.shape[:-1] + (3, 3))
-    return np.concatenate([eye, -_skew(lever)], axis=-1)
+    block = _gen().design_block(lever[..., 0], lever[..., 1], lever[..., 2])
+    return np.moveaxis(block, (0, 1), (-2, -1))
 
 
 def rotation_matrix(axis, angle_rad) -> np.ndarray:
-    """Right-hand rotation about unit ``axis`` by ``angle_rad`` (array) -> (..., 3, 3)."""
+    """Right-hand rotation about ``axis`` (normalised here) by ``angle_rad`` (array, rad) ->
+    (..., 3, 3); generated from :func:`volerr.derive.three_point.axis_rotation`."""
     k = np.asarray(axis, dtype=float)
     k = k / np.linalg.norm(k)
-    a = np.asarray(angle_rad, dtype=float)[..., None, None]
-    K = _skew(k)
-    return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * (K @ K)
+    a = np.asarray(angle_rad, dtype=float)
+    return np.moveaxis(_gen().axis_rotation(k[0], k[1], k[2], a), (0, 1), (-2, -1))
 
 
 def geometry_condition(lever) -> float:
@@ -193,8 +193,8 @@ class Identification:
     def summary(self) -> dict:
         """JSON-friendly summary (um, urad)."""
         res = np.concatenate([r.residuals[1:].reshape(-1, 3) for r in self.rounds])
-        norms = np.linalg.norm(res, axis=1) * 1e3
-        scale = np.array([1e3, 1e3, 1e3, 1e6, 1e6, 1e6])
+        norms = np.linalg.norm(res, axis=1) * UM_PER_MM
+        scale = np.array([UM_PER_MM] * 3 + [URAD_PER_RAD] * 3)
         out = {
             "axis": self.axis, "kind": self.kind, "method": self.method,
             "weighted_by_tracker": self.weighted,
@@ -205,7 +205,7 @@ class Identification:
             "condition": max(r.condition for r in self.rounds),
             "residual_rms_um": float(np.sqrt(np.mean(norms ** 2))) if norms.size else 0.0,
             "residual_max_um": float(norms.max()) if norms.size else 0.0,
-            "noise_sigma_um": [r.sigma_mm * 1e3 for r in self.rounds],
+            "noise_sigma_um": [r.sigma_mm * UM_PER_MM for r in self.rounds],
             "max_abs": {n: float(np.max(np.abs(self.values[:, j])) * scale[j])
                         for j, n in enumerate(self.names)},
             "outliers": [{"round": o[0], "position": o[1], "point": o[2],
@@ -238,31 +238,9 @@ def _mean_or_none(values):
 
 def _layout_number(value, params: dict) -> float:
     """A layout coordinate: a number or an arithmetic expression in the layout parameters."""
-    import ast
-    import operator
+    from volerr.machine.expressions import number
 
-    if isinstance(value, (int, float)):
-        return float(value)
-    ops = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
-           ast.Div: operator.truediv, ast.USub: operator.neg, ast.UAdd: operator.pos}
-
-    def ev(node):
-        if isinstance(node, ast.Expression):
-            return ev(node.body)
-        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
-            return float(node.value)
-        if isinstance(node, ast.Name) and node.id in params:
-            return float(params[node.id])
-        if isinstance(node, ast.BinOp) and type(node.op) in ops:
-            return ops[type(node.op)](ev(node.left), ev(node.right))
-        if isinstance(node, ast.UnaryOp) and type(node.op) in ops:
-            return ops[type(node.op)](ev(node.operand))
-        raise InputError(f"cannot evaluate the layout coordinate {value!r}")
-
-    try:
-        return ev(ast.parse(str(value), mode="eval"))
-    except SyntaxError:
-        raise InputError(f"cannot evaluate the layout coordinate {value!r}") from None
+    return number(value, params, "the layout coordinate")
 
 
 def _axis_geometry(layout, axis, direction, origin):
@@ -412,12 +390,31 @@ def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
     }
 
 
-def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, method="lsq",
-                   tracker=None, sense="auto", max_cond=1e4, outlier_k=5.0,
-                   cross_check=True) -> RoundResult:
-    """Identify the six error motions of one round (see the module docstring)."""
+@dataclass
+class _Geometry:
+    """Step 1 of a round: nominal poses and measured deviations (K positions, n points)."""
+
+    condition: float
+    sense: int
+    lever: np.ndarray   # (K, n, 3) mm, lever arms at the nominal pose
+    delta: np.ndarray   # (K, n, 3) mm, measured minus nominal
+    A: np.ndarray       # (K, n, 3, 6) design blocks
+
+
+@dataclass
+class _LsqFit:
+    """Step 2 of a round: (weighted) least squares at every position."""
+
+    theta: np.ndarray   # (K, 6) mm / rad, zero at the reference
+    resid: np.ndarray   # (K, n, 3) mm
+    u: np.ndarray       # (K, 6) propagated standard uncertainties
+    sigma: float        # per-coordinate noise, mm
+    W: np.ndarray | None
+
+
+def _round_geometry(rnd: Round, kind, direction, origin, sense, max_cond) -> _Geometry:
+    """Check the point geometry, detect the sense and build the nominal pose."""
     pts = rnd.points
-    K, n, _ = pts.shape
     steps = rnd.positions - rnd.positions[0]
     cond = geometry_condition(pts[0])
     if not math.isfinite(cond):  # exactly singular: report the number a solver would give up at
@@ -428,21 +425,24 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
             f"collinear; use three well-spread, non-collinear points")
     s = _detect_sense(kind, pts, steps, direction, origin, rnd.name, sense)
     nom, lever = _nominal(kind, pts[0], steps, direction, origin, s)
-    delta = pts - nom
-    A = design(lever)
+    return _Geometry(cond, s, lever, pts - nom, design(lever))
+
+
+def _round_lsq(rnd: Round, geo: _Geometry, tracker) -> _LsqFit:
+    """Weighted (tracker covariance) or equal-weight least squares; noise pooled over the
+    round (``3n - 6`` degrees of freedom per position) without a tracker position."""
+    pts = rnd.points
+    K, n, _ = pts.shape
     W = None
     if tracker is not None:
         cov = tracker_covariance(pts, tracker) + tracker_covariance(pts[0], tracker)[None]
         W = np.linalg.inv(cov)
-    theta, Ninv = _solve(A, W, delta)
+    theta, Ninv = _solve(geo.A, W, geo.delta)
     theta[0] = 0.0
-    fitted = np.einsum("knij,kj->kni", A, theta)
-    resid = delta - fitted
+    resid = geo.delta - np.einsum("knij,kj->kni", geo.A, theta)
     resid[0] = 0.0
-    dof = 3 * n - 6
-    m = K - 1
     if W is None:
-        pooled = float(np.sum(resid[1:] ** 2)) / max(m * dof, 1)
+        pooled = float(np.sum(resid[1:] ** 2)) / max((K - 1) * (3 * n - 6), 1)
         sigma = math.sqrt(pooled)
         cov_theta = pooled * Ninv
     else:
@@ -451,49 +451,64 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
                                         tracker_covariance(pts[0], tracker)])))
     u = np.sqrt(np.clip(np.einsum("kii->ki", cov_theta), 0, None))
     u[0] = 0.0
+    return _LsqFit(theta, resid, u, sigma, W)
+
+
+def _closed_summary(closed: dict, rnd: Round, axis: str, u_closed, u_lsq) -> dict:
+    """JSON-friendly comparison of the closed form with least squares (um, urad)."""
+    K = u_lsq.shape[0]
+    names = tuple(p + axis for p in MOTION_PREFIX)
+    diff = np.abs(closed["vs_lsq"][1:]) if K > 1 else np.zeros((1, 6))
+    out = {"selection": closed["selection"],
+           "roles": [{k: rnd.labels[v] for k, v in r.items()} for r in closed["roles"]],
+           "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
+           "consistency_max": closed["consistency_max"],
+           "vs_lsq_max": {nm: float(diff[:, j].max()) * (UM_PER_MM if j < 3 else URAD_PER_RAD)
+                          for j, nm in enumerate(names)}}
+    if K > 1:
+        import warnings
+
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: noise-free data
+            gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
+        out["noise_gain_vs_lsq"] = {nm: float(gain[j]) if np.isfinite(gain[j]) else None
+                                    for j, nm in enumerate(names)}
+    return out
+
+
+def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, method="lsq",
+                   tracker=None, sense="auto", max_cond=1e4, outlier_k=5.0,
+                   cross_check=True) -> RoundResult:
+    """Identify the six error motions of one round (see the module docstring).
+
+    Steps: geometry and nominal pose, least squares, closed form (method or cross-check),
+    outliers (always judged on the least-squares residuals: the closed form fits six equations
+    exactly and leaves all misfit in the other three)."""
+    n = rnd.points.shape[1]
+    geo = _round_geometry(rnd, kind, direction, origin, sense, max_cond)
+    lsq = _round_lsq(rnd, geo, tracker)
     closed = {}
     if method == "closed":
-        closed = _closed_form(lever, delta, theta, axis, kind, A)
+        closed = _closed_form(geo.lever, geo.delta, lsq.theta, axis, kind, geo.A)
     elif cross_check and n >= 3:
         # only a cross-check: points at one height (a common set-up on a rotary table) make
         # every Zhang & Hu selection singular, while least squares is well determined
         try:
-            closed = _closed_form(lever, delta, theta, axis, kind, A)
+            closed = _closed_form(geo.lever, geo.delta, lsq.theta, axis, kind, geo.A)
         except InputError:
             closed = {}
-    u_closed = _closed_uncertainty(A, closed, W, sigma) if closed else None
-    # outliers are judged on the least-squares residuals (the closed form fits six equations
-    # exactly and leaves all misfit in the other three)
-    outliers = _flag_outliers(rnd, resid, W, sigma, n, outlier_k)
+    u_closed = _closed_uncertainty(geo.A, closed, lsq.W, lsq.sigma) if closed else None
+    outliers = _flag_outliers(rnd, lsq.resid, lsq.W, lsq.sigma, n, outlier_k)
+    theta, resid, u = lsq.theta, lsq.resid, lsq.u
     if method == "closed":
         theta = closed["values"].copy()
         theta[0] = 0.0
-        resid = delta - np.einsum("knij,kj->kni", A, theta)
+        resid = geo.delta - np.einsum("knij,kj->kni", geo.A, theta)
         resid[0] = 0.0
-        u_lsq, u = u, u_closed
-    else:
-        u_lsq = u
-    summary_cf = {}
-    if closed:
-        names = tuple(p + axis for p in MOTION_PREFIX)
-        diff = np.abs(closed["vs_lsq"][1:]) if K > 1 else np.zeros((1, 6))
-        summary_cf = {"selection": closed["selection"],
-                      "roles": [{k: rnd.labels[v] for k, v in r.items()}
-                                for r in closed["roles"]],
-                      "thesis_choice_everywhere": closed["thesis_choice_everywhere"],
-                      "consistency_max": closed["consistency_max"],
-                      "vs_lsq_max": {nm: float(diff[:, j].max()) * (1e3 if j < 3 else 1e6)
-                                     for j, nm in enumerate(names)}}
-        if K > 1:
-            import warnings
-
-            with np.errstate(all="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: noise-free data
-                gain = np.nanmedian(u_closed[1:] / u_lsq[1:], axis=0)
-            summary_cf["noise_gain_vs_lsq"] = {nm: float(gain[j]) if np.isfinite(gain[j])
-                                               else None for j, nm in enumerate(names)}
-    return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, delta,
-                       cond, s, sigma, outliers, summary_cf)
+        u = u_closed
+    summary_cf = _closed_summary(closed, rnd, axis, u_closed, lsq.u) if closed else {}
+    return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, geo.delta,
+                       geo.condition, geo.sense, lsq.sigma, outliers, summary_cf)
 
 
 def _closed_uncertainty(A, closed, W, sigma):
@@ -545,7 +560,7 @@ def _flag_outliers(rnd, resid, W, sigma, n, k):
         if kk == 0:
             continue
         out.append((rnd.name, float(rnd.positions[kk]), rnd.labels[i],
-                    float(np.linalg.norm(resid[kk, i]) * 1e3), float(ratio[kk, i])))
+                    float(np.linalg.norm(resid[kk, i]) * UM_PER_MM), float(ratio[kk, i])))
     return out
 
 
@@ -647,26 +662,19 @@ def to_model_signs(table, layout, reference=None):
     q0 = float(table.positions[0] if reference is None else reference)
     if tool_side and (layout.axes[axis].kind != "linear" or q0 == 0):
         return table
-    t = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
-                  for p in MOTION_PREFIX[:3]], axis=1)
-    e = np.stack([table.values.get(p + axis, np.zeros_like(table.positions))
-                  for p in MOTION_PREFIX[3:]], axis=1)
+    zero = np.zeros_like(table.positions)
+    motions = [table.values.get(p + axis, zero) for p in MOTION_PREFIX]
+    u = np.asarray(layout.axes[axis].direction, dtype=float)
     if tool_side:
-        # the model's carriage frame is the carriage point at the origin at q = 0; the
-        # tracker's pivot is the one there at the reference position q0: t + q0 (e x u)
-        u = np.asarray(layout.axes[axis].direction, dtype=float)
-        delta = t + q0 * np.cross(e, u)
+        # generated: t + q0 (e x u), e (volerr.derive.three_point.tool_side_signs)
+        out = _gen().tool_side_signs(q0, *motions, *u)
         values = dict(table.values)
         for j, p in enumerate(MOTION_PREFIX[:3]):
-            if p + axis in values or np.any(delta[:, j]):
-                values[p + axis] = delta[:, j]
+            if p + axis in values or np.any(out[j]):
+                values[p + axis] = out[j]
         return ErrorTable(axis, table.positions, values, table.std, table.u95)
-    delta = -t
-    if layout.axes[axis].kind == "linear":
-        u = np.asarray(layout.axes[axis].direction, dtype=float)
-        travel = table.positions - q0
-        delta = delta - travel[:, None] * np.cross(e, u)
-    motions = np.concatenate([delta, -e], axis=1)
-    values = {p + axis: motions[:, j] for j, p in enumerate(MOTION_PREFIX)
-              if p + axis in table.values}
+    # generated: -t - travel (e x u), -e (volerr.derive.three_point.table_side_signs)
+    travel = table.positions - q0 if layout.axes[axis].kind == "linear" else zero
+    out = _gen().table_side_signs(travel, *motions, *u)
+    values = {p + axis: out[j] for j, p in enumerate(MOTION_PREFIX) if p + axis in table.values}
     return ErrorTable(axis, table.positions, values, table.std, table.u95)

@@ -26,12 +26,12 @@ then P, then Q.  The commanded positions are not in the file and are given separ
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from volerr.units import parse_number
 from volerr.errors import InputError, require
 from volerr.fileio import read_csv_rows
 
@@ -57,12 +57,7 @@ def _open_rows(path: Path):
 
 
 def _num(path, lineno, what, text) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise InputError(f"{path}:{lineno}: {what} {text!r} is not a number") from None
-    require(math.isfinite(v), f"{path}:{lineno}: {what} is {text} (NaN or infinite)")
-    return v
+    return parse_number(text, f"{path}:{lineno}", what)
 
 
 def _header_index(path, header):

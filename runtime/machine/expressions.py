@@ -79,3 +79,18 @@ def evaluate(text: str, values: dict) -> np.ndarray:
         return FUNCTIONS[node.func.id](*(ev(a) for a in node.args))
 
     return np.asarray(ev(tree), dtype=float)
+
+
+def number(value, values: dict, what: str = "expression") -> float:
+    """A number given as a number or as an expression in ``values`` (e.g. a layout coordinate
+    ``"d + 12.5"`` in the layout parameters, mm); one float.  Raises :class:`InputError`
+    ``"cannot evaluate <what> '...'"`` when it is neither."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    try:
+        out = evaluate(str(value), values)
+    except InputError:
+        raise InputError(f"cannot evaluate {what} {value!r}") from None
+    if out.ndim != 0:
+        raise InputError(f"cannot evaluate {what} {value!r}")
+    return float(out)

@@ -163,6 +163,16 @@ class Layout:
         return tuple(sorted(names - set(self.axes) - set(self.parameters)))
 
     @property
+    def parameter_kind(self) -> dict:
+        """Parameter name -> kind: ``translational``, ``angular``, ``squareness``,
+        ``location`` or ``effect`` (:mod:`volerr.machine.iso_names`)."""
+        from volerr.machine.iso_names import kind_of
+
+        builtin = {n for a in self.axes.values() for n in a.component_errors
+                   + a.location_errors} | set(self.squareness)
+        return {n: kind_of(n) if n in builtin else "effect" for n in self.parameter_names}
+
+    @property
     def parameter_axis(self) -> dict:
         """Parameter name -> the axis whose position it depends on, or None for constants."""
         out = {}
@@ -203,8 +213,80 @@ def _default_location_errors(name: str, direction) -> tuple[str, ...]:
     return tuple(out)
 
 
-def parse_layout(text: str, origin: str = "<string>") -> Layout:
-    """Parse and validate layout TOML text. Raises :class:`InputError` on any defect."""
+def _parse_axis(an: str, spec: dict, where: str) -> Axis:
+    """One ``[axes.NAME]`` table."""
+    require(re.fullmatch(r"[XYZUVWABC]", an) is not None,
+            f"{where}: unknown axis name {an!r} (use X Y Z U V W A B C)")
+    k = spec.get("kind")
+    require(k in ("linear", "rotary"), f"{where}: axis {an} kind must be linear or rotary")
+    require("direction" in spec, f"{where}: axis {an} has no direction")
+    direction = _unit(spec["direction"], f"{where}: axis {an} direction")
+    travel = spec.get("travel")
+    require(isinstance(travel, list) and len(travel) == 2 and travel[0] < travel[1],
+            f"{where}: axis {an} travel must be [min, max] with min < max")
+    point = _vector(spec.get("point", [0, 0, 0]), f"{where}: axis {an} point", True)
+    loc = ()
+    if k == "rotary":
+        loc = tuple(spec.get("location_errors", _default_location_errors(an, direction)))
+        for ln in loc:
+            require(re.fullmatch(rf"E[XYZABC]0{an}", ln) is not None,
+                    f"{where}: bad location error name {ln!r} for axis {an}")
+    return Axis(an, k, direction, (float(travel[0]), float(travel[1])), point, loc)
+
+
+def _parse_axes(raw_axes, where: str) -> dict:
+    require(isinstance(raw_axes, dict) and raw_axes, f"{where}: no [axes] declared")
+    return {an: _parse_axis(an, spec, where) for an, spec in raw_axes.items()}
+
+
+def _parse_frames(raw: dict, axes: dict, where: str) -> dict:
+    frames = {}
+    for fn, spec in raw.items():
+        require(fn not in axes, f"{where}: frame {fn!r} has the name of an axis")
+        rot = spec.get("rotation", {})
+        frames[fn] = Frame(
+            fn,
+            _vector(spec.get("translation", [0, 0, 0]), f"{where}: frame {fn} translation", True),
+            _unit(rot.get("axis", [0, 0, 1]), f"{where}: frame {fn} rotation axis"),
+            rot.get("angle_deg", 0.0),
+        )
+    return frames
+
+
+def _parse_chain(chain: dict, axes: dict, frames: dict, where: str) -> tuple[tuple, tuple]:
+    """(tool chain, workpiece chain): every entry known, none twice, every axis used."""
+    require("tool" in chain, f"{where}: [chain] needs a 'tool' list (base to probe/tool)")
+    tool = tuple(chain.get("tool", []))
+    work = tuple(chain.get("workpiece", []))
+    seen = set()
+    for entry in tool + work:
+        require(entry in axes or entry in frames,
+                f"{where}: chain entry {entry!r} is neither an axis nor a frame (missing transform)")
+        require(entry not in seen, f"{where}: {entry!r} appears twice in the chain (cycle)")
+        seen.add(entry)
+    for an in axes:
+        require(an in seen, f"{where}: axis {an} is declared but not in any chain")
+    return tool, work
+
+
+def _parse_squareness(raw: dict, axes: dict, where: str) -> dict:
+    squareness = dict(raw)
+    for sq, carrier in squareness.items():
+        require(sq in SQUARENESS, f"{where}: unknown squareness {sq!r} (use EC0Y EB0Z EA0Z)")
+        _, moving, reference = SQUARENESS[sq]
+        require(carrier in (moving, reference),
+                f"{where}: squareness {sq} must be carried by axis {moving} or {reference}")
+        require(carrier in axes and axes[carrier].kind == "linear",
+                f"{where}: squareness {sq} carrier {carrier} is not a linear axis")
+    return squareness
+
+
+_KNOWN_KEYS = {"name", "description", "kind", "axes", "frames", "chain", "squareness",
+               "parameters", "paper_symbols", "source", "effects"}
+
+
+def _parse_header(text: str, origin: str) -> tuple[dict, str, str, dict]:
+    """(TOML document, layout name, kind, parameters)."""
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -217,84 +299,29 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
     params = doc.get("parameters", {})
     require(all(isinstance(v, (int, float)) for v in params.values()),
             f"{where}: [parameters] must be numbers")
+    return doc, name, kind, params
 
-    axes = {}
-    raw_axes = doc.get("axes")
-    require(isinstance(raw_axes, dict) and raw_axes, f"{where}: no [axes] declared")
-    for an, spec in raw_axes.items():
-        require(re.fullmatch(r"[XYZUVWABC]", an) is not None,
-                f"{where}: unknown axis name {an!r} (use X Y Z U V W A B C)")
-        k = spec.get("kind")
-        require(k in ("linear", "rotary"), f"{where}: axis {an} kind must be linear or rotary")
-        require("direction" in spec, f"{where}: axis {an} has no direction")
-        direction = _unit(spec["direction"], f"{where}: axis {an} direction")
-        travel = spec.get("travel")
-        require(isinstance(travel, list) and len(travel) == 2 and travel[0] < travel[1],
-                f"{where}: axis {an} travel must be [min, max] with min < max")
-        point = _vector(spec.get("point", [0, 0, 0]), f"{where}: axis {an} point", True)
-        loc = ()
-        if k == "rotary":
-            loc = tuple(spec.get("location_errors", _default_location_errors(an, direction)))
-            for ln in loc:
-                require(re.fullmatch(rf"E[XYZABC]0{an}", ln) is not None,
-                        f"{where}: bad location error name {ln!r} for axis {an}")
-        axes[an] = Axis(an, k, direction, (float(travel[0]), float(travel[1])), point, loc)
 
-    frames = {}
-    for fn, spec in doc.get("frames", {}).items():
-        require(fn not in axes, f"{where}: frame {fn!r} has the name of an axis")
-        rot = spec.get("rotation", {})
-        frames[fn] = Frame(
-            fn,
-            _vector(spec.get("translation", [0, 0, 0]), f"{where}: frame {fn} translation", True),
-            _unit(rot.get("axis", [0, 0, 1]), f"{where}: frame {fn} rotation axis"),
-            rot.get("angle_deg", 0.0),
-        )
+def parse_layout(text: str, origin: str = "<string>") -> Layout:
+    """Parse and validate layout TOML text. Raises :class:`InputError` on any defect.
 
+    Steps: header (name, kind, parameters), axes, frames, expressions, chains, squareness,
+    effects."""
+    doc, name, kind, params = _parse_header(text, origin)
+    where = f"layout {name}"
+    axes = _parse_axes(doc.get("axes"), where)
+    frames = _parse_frames(doc.get("frames", {}), axes, where)
     _check_expressions(where, params, axes, frames)
-
-    chain = doc.get("chain", {})
-    require("tool" in chain, f"{where}: [chain] needs a 'tool' list (base to probe/tool)")
-    tool = tuple(chain.get("tool", []))
-    work = tuple(chain.get("workpiece", []))
-    seen = set()
-    for entry in tool + work:
-        require(entry in axes or entry in frames,
-                f"{where}: chain entry {entry!r} is neither an axis nor a frame (missing transform)")
-        require(entry not in seen, f"{where}: {entry!r} appears twice in the chain (cycle)")
-        seen.add(entry)
-    for an in axes:
-        require(an in seen, f"{where}: axis {an} is declared but not in any chain")
-
-    squareness = dict(doc.get("squareness", {}))
-    for sq, carrier in squareness.items():
-        require(sq in SQUARENESS, f"{where}: unknown squareness {sq!r} (use EC0Y EB0Z EA0Z)")
-        _, moving, reference = SQUARENESS[sq]
-        require(carrier in (moving, reference),
-                f"{where}: squareness {sq} must be carried by axis {moving} or {reference}")
-        require(carrier in axes and axes[carrier].kind == "linear",
-                f"{where}: squareness {sq} carrier {carrier} is not a linear axis")
-
+    tool, work = _parse_chain(doc.get("chain", {}), axes, frames, where)
+    squareness = _parse_squareness(doc.get("squareness", {}), axes, where)
     symbols = {str(k): str(v) for k, v in doc.get("paper_symbols", {}).items()}
     effects = _parse_effects(doc.get("effects", {}), axes, squareness, params, where)
     return Layout(
-        name=name,
-        description=str(doc.get("description", "")),
-        kind=kind,
-        axes=axes,
-        frames=frames,
-        tool_chain=tool,
-        workpiece_chain=work,
-        squareness=squareness,
-        parameters=dict(params),
-        paper_symbols=symbols,
-        source=str(doc.get("source", "")),
-        sha256=hashlib.sha256(text.encode()).hexdigest(),
-        path=origin,
-        extra={k: v for k, v in doc.items() if k not in {
-            "name", "description", "kind", "axes", "frames", "chain", "squareness",
-            "parameters", "paper_symbols", "source", "effects"}},
-        effects=effects,
+        name=name, description=str(doc.get("description", "")), kind=kind, axes=axes,
+        frames=frames, tool_chain=tool, workpiece_chain=work, squareness=squareness,
+        parameters=dict(params), paper_symbols=symbols, source=str(doc.get("source", "")),
+        sha256=hashlib.sha256(text.encode()).hexdigest(), path=origin,
+        extra={k: v for k, v in doc.items() if k not in _KNOWN_KEYS}, effects=effects,
     )
 
 

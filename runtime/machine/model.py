@@ -64,6 +64,13 @@ def _columns(components, n: int) -> np.ndarray:
         float, copy=False)
 
 
+def _offset(probe, tool):
+    """The probe/tool offset given as ``probe=`` (the API name) or its alias ``tool=``."""
+    require(probe is None or tool is None, "give the offset as probe= or tool=, not both")
+    value = probe if probe is not None else tool
+    return (0.0, 0.0, 0.0) if value is None else value
+
+
 @dataclass
 class Model:
     """A machine's error model. Create with :func:`load`."""
@@ -94,6 +101,13 @@ class Model:
     def parameter_axis(self) -> dict:
         """Parameter -> axis whose position it depends on (None for constants)."""
         return dict(self.module.PARAMETER_AXIS)
+
+    @property
+    def parameter_kind(self) -> dict:
+        """Parameter -> ``translational`` (mm), ``angular`` (rad), ``squareness`` (rad),
+        ``location`` (mm or rad by its letter) or ``effect`` (:mod:`volerr.machine.iso_names`)."""
+        kinds = getattr(self.module, "PARAMETER_KIND", None)
+        return dict(kinds) if kinds is not None else dict(self.layout.parameter_kind)
 
     @property
     def paper_symbols(self) -> dict:
@@ -308,20 +322,33 @@ class Model:
         pos, n = self._points(positions)
         return _columns(self.module.nominal_position(**pos, **self._probe(probe, n)), n)
 
-    def forward(self, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
-        """Nominal tool tip and tool axis in the workpiece frame, (N, 6) = x, y, z, i, j, k."""
+    def forward(self, positions, probe=None, *, tool=None) -> np.ndarray:
+        """Nominal tool tip and tool axis in the workpiece frame.
+
+        Parameters
+        ----------
+        positions : dict or array, shape (N, n_axes)
+            Axis positions, mm (linear) and deg (rotary).
+        probe : array, shape (3,) or (N, 3), optional
+            Probe/tool offset in the tool frame, mm (default 0).  ``tool=`` is an alias.
+
+        Returns
+        -------
+        array, shape (N, 6)
+            Tool tip x, y, z (mm) and unit tool axis i, j, k."""
         pos, n = self._points(positions)
-        tip = self.module.nominal_position(**pos, **self._probe(tool, n))
+        tip = self.module.nominal_position(**pos, **self._probe(_offset(probe, tool), n))
         return np.concatenate([_columns(tip, n), _columns(self.module.tool_axis(**pos), n)],
                               axis=1)
 
-    def inverse(self, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
+    def inverse(self, target, probe=None, near=None, *, tool=None) -> np.ndarray:
         """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
         axis ``target`` (N, 6) = x, y, z, i, j, k; ``near`` picks the branch, the turn and an
-        undetermined rotary axis (see :func:`volerr.fiveaxis.kinematics.inverse`)."""
+        undetermined rotary axis (see :func:`volerr.fiveaxis.kinematics.inverse`).  ``probe``:
+        tool offset (3,) mm, ``tool=`` an alias."""
         from volerr.fiveaxis.kinematics import inverse
 
-        return inverse(self, target, tool, near)
+        return inverse(self, target, _offset(probe, tool), near)
 
     def orientation_error(self, positions, errors=None, covariates=None) -> np.ndarray:
         """First-order error of the tool-axis direction, (N, 3), rad."""
@@ -332,7 +359,24 @@ class Model:
 
 
 def load(name_or_path) -> Model:
-    """Load a shipped layout's generated model by name, or derive one from a layout file."""
+    """Load a machine's error model.
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        A shipped layout name (``"MB1"``, ``"DMU50"`` ...; its generated module is imported,
+        no sympy) or a layout ``.toml`` file (derived on the fly; imports sympy).
+
+    Returns
+    -------
+    Model
+        Positions in mm (linear) and deg (rotary); errors in mm / rad; results mm, shape
+        (N, 3) for N points.
+
+    Raises
+    ------
+    volerr.errors.InputError
+        Unknown layout or a defective layout file (one line)."""
     layout = read_layout(name_or_path)
     if not isinstance(layout, Layout):  # pragma: no cover - defensive
         raise InputError(f"not a layout: {name_or_path}")

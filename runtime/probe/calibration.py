@@ -49,27 +49,17 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.units import MM_PER_UM, UM_PER_MM, parse_number
 from volerr.errors import InputError, require
+from volerr.probe.fits import (MAX_CONDITION, MAX_DEGREE, MIN_POINTS, OUTLIER_K,  # noqa: F401
+                               PLANE_RATIO, RIDGE, SCALE_FLOOR_MM, SHFit, SphereFit,
+                               check_sphere_points, fit_sh, fit_sphere, max_degree_for,
+                               robust_flags, sh_design)
 
 #: largest plausible effective stylus-ball radius, mm (a sphere radius that implies more is wrong)
 MAX_BALL_RADIUS_MM = 25.0
 #: smallest plausible effective stylus-ball radius, mm
 MIN_BALL_RADIUS_MM = 0.005
-#: fewest points the calibration accepts: 4 sphere unknowns plus redundancy for the error map
-MIN_POINTS = 6
-#: robust outlier threshold: studentised residual of a bisquare map fit > k robust sigmas
-OUTLIER_K = 5.0
-#: floor of the robust scale (mm): below it residuals are numerical, not noise
-SCALE_FLOOR_MM = 5e-5
-#: points whose out-of-plane RMS spread is below this fraction of their in-plane spread lie on
-#: "one plane": a sphere through them is fixed only by their noise or lobing
-PLANE_RATIO = 2e-3
-#: largest condition number of the sphere-fit Jacobian (a cap of ~6 deg half-angle reaches it)
-MAX_CONDITION = 1e3
-#: smoothness ridge of the map fit, relative to the mean diagonal of the normal matrix
-RIDGE = 1e-4
-#: largest map degree considered by the automatic choice
-MAX_DEGREE = 8
 #: tolerance on the probed phi range when evaluating the map, deg
 COVERAGE_TOL_DEG = 2.0
 
@@ -143,10 +133,7 @@ class SphereData:
 
 
 def _float(text: str, where: str) -> float:
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        raise InputError(f"{where}: not a number: {text!r}") from None
+    return parse_number(text, where)
 
 
 def read_sphere_csv(path) -> SphereData:
@@ -196,205 +183,18 @@ def read_sphere_csv(path) -> SphereData:
     return SphereData(arr[:, :3], source=str(path))
 
 
-# ---- sphere fit ------------------------------------------------------------------------------
-@dataclass
-class SphereFit:
-    """Least-squares sphere: centre (3,) mm, radius mm, residuals |p - c| - r (n,) mm."""
-
-    center: np.ndarray
-    radius: float
-    residuals: np.ndarray
-    condition: float
-    iterations: int
-    cov_unit: np.ndarray  # inv(J'J) of (cx, cy, cz, r): covariance per unit residual variance
-
-
-def check_sphere_points(points) -> np.ndarray:
-    """Validate ball centres for a sphere fit (count, finiteness, not all on one plane)."""
-    p = np.asarray(points, dtype=float)
-    require(p.ndim == 2 and p.shape[1] == 3, f"points must be (n, 3), got shape {p.shape}")
-    require(np.all(np.isfinite(p)), "points contain NaN or infinite values")
-    n = len(p)
-    require(n >= MIN_POINTS, f"{n} points: the calibration needs at least {MIN_POINTS} "
-                             "(4 sphere unknowns plus redundancy for the probe error map)")
-    s = np.linalg.svd(p - p.mean(axis=0), compute_uv=False) / math.sqrt(n)
-    require(s[0] > 1e-9, "all points coincide: no sphere can be fitted")
-    require(s[2] > PLANE_RATIO * s[0],
-            f"all {n} points lie on one plane (a single circle, out-of-plane spread "
-            f"{s[2] * 1e3:.2g} um): the sphere is undetermined; probe several latitudes")
-    return p
-
-
-def _algebraic_sphere(p: np.ndarray):
-    """Linear (Kasa) fit |p|^2 = 2 c.p + k: the starting point of the geometric fit."""
-    mu = p.mean(axis=0)
-    q = p - mu
-    a = np.column_stack([2 * q, np.ones(len(q))])
-    b = np.sum(q * q, axis=1)
-    sol, *_ = np.linalg.lstsq(a, b, rcond=None)
-    c = sol[:3]
-    r2 = sol[3] + c @ c
-    require(r2 > 0, "the points do not lie on a sphere (algebraic fit has no real radius)")
-    return c + mu, math.sqrt(r2)
-
-
-def fit_sphere(points, max_iter: int = 50) -> SphereFit:
-    """Geometric least-squares sphere (minimises sum(|p_i - c| - r)^2) by Gauss-Newton from
-    the algebraic fit.  At the optimum r = mean |p_i - c|."""
-    p = check_sphere_points(points)
-    c, r = _algebraic_sphere(p)
-    scale = r
-    it = 0
-    for it in range(1, max_iter + 1):
-        d = p - c
-        dist = np.linalg.norm(d, axis=1)
-        require(np.all(dist > 0), "a point coincides with the fitted sphere centre")
-        res = dist - r
-        jac = np.column_stack([-d / dist[:, None], -np.ones(len(p))])
-        step, *_ = np.linalg.lstsq(jac, -res, rcond=None)
-        c = c + step[:3]
-        r = r + step[3]
-        if np.max(np.abs(step)) < 1e-13 * max(scale, 1.0):
-            break
-    d = p - c
-    dist = np.linalg.norm(d, axis=1)
-    jac = np.column_stack([-d / dist[:, None], -np.ones(len(p))])
-    sv = np.linalg.svd(jac, compute_uv=False)
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
-    require(cond < MAX_CONDITION,
-            f"the points cover too little of the sphere to fit it (condition number "
-            f"{cond:.3g}); probe a wider range of latitudes")
-    return SphereFit(c, float(dist.mean()), dist - dist.mean(), cond, it,
-                     np.linalg.inv(jac.T @ jac))
-
-
-# ---- spherical-harmonic map -----------------------------------------------------------------
-def sh_design(degree: int, phi, theta) -> np.ndarray:
-    """Real orthonormal spherical harmonics Y_lm, l <= degree, at (phi, theta) rad:
-    shape (n, (degree + 1)^2), column order l = 0..L, m = -l..l."""
-    from scipy.special import lpmv
-
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    theta = np.atleast_1d(np.asarray(theta, dtype=float))
-    x = np.cos(phi)
-    cols = []
-    for ll in range(degree + 1):
-        for m in range(-ll, ll + 1):
-            am = abs(m)
-            norm = math.sqrt((2 * ll + 1) / (4 * math.pi)
-                             * math.factorial(ll - am) / math.factorial(ll + am))
-            leg = lpmv(am, ll, x)
-            if m == 0:
-                cols.append(norm * leg)
-            elif m > 0:
-                cols.append(math.sqrt(2) * norm * leg * np.cos(am * theta))
-            else:
-                cols.append(math.sqrt(2) * norm * leg * np.sin(am * theta))
-    return np.column_stack(cols)
-
-
-def _degrees_of(degree: int) -> np.ndarray:
-    return np.concatenate([[ll] * (2 * ll + 1) for ll in range(degree + 1)]).astype(float)
-
-
-@dataclass
-class SHFit:
-    """A fitted spherical-harmonic expansion (values in mm)."""
-
-    degree: int
-    coefficients: np.ndarray
-    fitted: np.ndarray
-    gcv: float
-    dof: float
-    hat: np.ndarray      # w_i q_i: diagonal of the (weighted) hat matrix
-    q: np.ndarray        # x_i' A^-1 x_i
-    weights: np.ndarray
-
-    def loo_t(self, values, sigma: float = 1.0) -> np.ndarray:
-        """Leave-one-out prediction residuals over their standard deviation: residual
-        r / (1 - w q) over sigma sqrt(1 + q / (1 - w q)) (Sherman-Morrison), so that a point
-        already down-weighted to zero is judged like any other."""
-        one = np.clip(1.0 - self.weights * self.q, 1e-9, None)
-        return (values - self.fitted) / one / (sigma * np.sqrt(1.0 + self.q / one))
-
-    def __call__(self, phi, theta) -> np.ndarray:
-        return sh_design(self.degree, phi, theta) @ self.coefficients
-
-
-def _ridge_fit(degree: int, phi, theta, values, weights=None, ridge: float = RIDGE) -> SHFit:
-    """(Weighted) least squares with the smoothness ridge ``lam * l(l+1) c_lm^2``,
-    ``lam = ridge * trace(X'WX) / n_coefficients``."""
-    x = sh_design(degree, phi, theta)
-    n, p = x.shape
-    wts = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
-    ll = _degrees_of(degree)
-    xw = x * wts[:, None]
-    xtx = x.T @ xw
-    lam = ridge * np.trace(xtx) / p
-    a = xtx + lam * np.diag(ll * (ll + 1))
-    coef = np.linalg.solve(a, xw.T @ values)
-    q = np.einsum("ij,ji->i", x, np.linalg.solve(a, x.T))  # x_i' A^-1 x_i
-    hat_diag = wts * q
-    fitted = x @ coef
-    res = values - fitted
-    dof = float(hat_diag.sum())
-    gcv = n * float(res @ (wts * res)) / max(n - dof, 1e-9) ** 2
-    return SHFit(degree, coef, fitted, gcv, dof, hat_diag, q, wts)
-
-
-def robust_flags(degree: int, phi, theta, values, k: float = OUTLIER_K, iterations: int = 50):
-    """Outlier flags from a Tukey-bisquare (IRLS) fit of the map: a point is flagged when its
-    leave-one-out residual exceeds ``k`` of its standard deviations (:meth:`SHFit.loo_t`).
-    Sigma is 1.4826 MAD of the studentised residuals of the plain fit (floored at
-    :data:`SCALE_FLOOR_MM`), held fixed while the weights iterate.  Returns (flags, sigma)."""
-    f = _ridge_fit(degree, phi, theta, values)
-    t = f.loo_t(values)
-    sigma = max(1.4826 * float(np.median(np.abs(t - np.median(t)))), SCALE_FLOOR_MM)
-    w = np.ones(len(values))
-    for _ in range(iterations):
-        u = f.loo_t(values, sigma) / 4.685
-        w_new = np.where(np.abs(u) < 1.0, (1.0 - u ** 2) ** 2, 0.0)
-        if np.max(np.abs(w_new - w)) < 1e-6:
-            break
-        w = w_new
-        f = _ridge_fit(degree, phi, theta, values, w)
-    return np.abs(f.loo_t(values, sigma)) > k, sigma
-
-
-def max_degree_for(n_points: int) -> int:
-    """Largest degree the automatic choice considers: at most half the points as coefficients."""
-    return int(max(0, min(MAX_DEGREE, math.floor(math.sqrt(n_points / 2.0)) - 1)))
-
-
-def fit_sh(phi, theta, values, degree: int | None = None) -> SHFit:
-    """Fit a real spherical-harmonic map to values (mm) at (phi, theta) rad.  ``degree=None``
-    chooses it by generalised cross-validation over 0..:func:`max_degree_for`."""
-    n = len(values)
-    if degree is not None:
-        require(degree >= 0, f"map degree must be >= 0, got {degree}")
-        require((degree + 1) ** 2 <= n,
-                f"map degree {degree} has {(degree + 1) ** 2} coefficients, more than the "
-                f"{n} points")
-        return _ridge_fit(degree, phi, theta, values)
-    fits = [_ridge_fit(d, phi, theta, values) for d in range(max_degree_for(n) + 1)]
-    best = min(fits, key=lambda f: f.gcv)
-    # prefer the lowest degree whose GCV is within 2 % of the best (parsimony)
-    for f in fits:
-        if f.gcv <= 1.02 * best.gcv:
-            return f
-    return best  # pragma: no cover
-
-
 # ---- the probe error map ------------------------------------------------------------------
-def _unit_of(phi_deg, theta_deg) -> np.ndarray:
-    p, t = np.radians(phi_deg), np.radians(theta_deg)
-    return np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=-1)
+def unit_vectors(phi_deg, theta_deg) -> np.ndarray:
+    """Probe-frame unit vectors of the angles (phi, theta) in deg, shape (..., 3) of the
+    broadcast angles: generated :func:`volerr.generated.probe.unit_direction`."""
+    m = _gen().unit_direction(np.radians(phi_deg), np.radians(theta_deg))
+    return np.stack(m, axis=-1)
 
 
 def coverage_of(phi_deg, theta_deg) -> float:
     """Coverage radius of probed directions, deg: 1.5 x the largest nearest-neighbour angle
     (at least 5 deg)."""
-    u = _unit_of(phi_deg, theta_deg)
+    u = unit_vectors(phi_deg, theta_deg)
     if len(u) < 2:
         return 5.0
     dots = u @ u.T
@@ -437,7 +237,7 @@ class ProbeMap:
                 "coefficient count does not match the degree")
         if self.support_deg is not None:
             self.support_deg = np.asarray(self.support_deg, dtype=float).reshape(-1, 2)
-            self._support_u = _unit_of(self.support_deg[:, 0], self.support_deg[:, 1])
+            self._support_u = unit_vectors(self.support_deg[:, 0], self.support_deg[:, 1])
 
     def covered(self, phi_deg, theta_deg) -> np.ndarray:
         """Boolean mask: probe-frame angles (deg) inside the calibrated coverage."""
@@ -450,7 +250,7 @@ class ProbeMap:
 
     def _nearest(self, phi, theta):
         """(angle to the nearest probed direction in deg, its index) for each query."""
-        u = _unit_of(phi, theta)
+        u = unit_vectors(phi, theta)
         best = np.empty(len(u))
         idx = np.empty(len(u), dtype=int)
         for s in range(0, len(u), 20000):
@@ -547,7 +347,7 @@ class ProbeCalibration:
 
     def stats_um(self, which: np.ndarray | None = None) -> dict:
         """max / min / rms of Probe (um) over the used points (as Pahk reports them)."""
-        v = self.probe[self.used if which is None else which] * 1e3
+        v = self.probe[self.used if which is None else which] * UM_PER_MM
         return {"max": float(v.max()), "min": float(v.min()),
                 "rms": float(math.sqrt(np.mean(v ** 2)))}
 
@@ -568,26 +368,26 @@ class ProbeCalibration:
             "map": {
                 "kind": "real spherical harmonics, orthonormal, l <= degree, m = -l..l",
                 "degree": int(self.map.degree),
-                "coefficients_um": [float(v) * 1e3 for v in self.map.coefficients],
+                "coefficients_um": [float(v) * UM_PER_MM for v in self.map.coefficients],
                 "coverage_deg": float(self.map.coverage_deg),
                 "support_deg": [[round(float(p), 6), round(float(t), 6)]
                                 for p, t in self.map.support_deg],
                 "residual_rms_um": float(math.sqrt(np.mean(
-                    (self.probe[self.used] - self.map_fitted[self.used]) ** 2)) * 1e3),
+                    (self.probe[self.used] - self.map_fitted[self.used]) ** 2)) * UM_PER_MM),
             },
             "outliers": {
                 "threshold": "studentised residual of a bisquare map fit > k x robust sigma",
-                "robust_sigma_um": float(self.robust_sigma * 1e3),
+                "robust_sigma_um": float(self.robust_sigma * UM_PER_MM),
                 "index": [int(i) for i in np.flatnonzero(self.outlier)],
                 "excluded": bool((~self.used).any()),
             },
             "uncertainty": {
                 "note": "standard uncertainties (Type A) from the scatter about the smooth map; "
                         "u(R_eff) excludes the master-sphere radius uncertainty u(R_s)",
-                "noise_um": float(self.noise * 1e3),
-                "u_center_um": [float(v) * 1e3 for v in (self.u_center if self.u_center
+                "noise_um": float(self.noise * UM_PER_MM),
+                "u_center_um": [float(v) * UM_PER_MM for v in (self.u_center if self.u_center
                                                          is not None else np.zeros(3))],
-                "u_r_eff_um": float(self.u_r_eff * 1e3),
+                "u_r_eff_um": float(self.u_r_eff * UM_PER_MM),
             },
             "sphere_fit_condition": float(self.condition),
         }
@@ -649,7 +449,7 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
             f"--sphere-radius (a radius in mm, not a diameter)")
     require(r_eff >= MIN_BALL_RADIUS_MM,
             f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
-            f"{r_eff * 1e3:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
+            f"{r_eff * UM_PER_MM:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
             f"check --sphere-radius (mm)")
     require(r_eff <= MAX_BALL_RADIUS_MM,
             f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
@@ -721,8 +521,8 @@ def map_csv_text(cal: ProbeCalibration) -> str:
     lines = [",".join(MAP_COLUMNS)]
     res = cal.probe - cal.map_fitted
     for i in range(cal.n_points):
-        lines.append(f"{cal.phi_deg[i]:.6f},{cal.theta_deg[i]:.6f},{cal.probe[i] * 1e3:.4f},"
-                     f"{cal.map_fitted[i] * 1e3:.4f},{res[i] * 1e3:.4f},"
+        lines.append(f"{cal.phi_deg[i]:.6f},{cal.theta_deg[i]:.6f},{cal.probe[i] * UM_PER_MM:.4f},"
+                     f"{cal.map_fitted[i] * UM_PER_MM:.4f},{res[i] * UM_PER_MM:.4f},"
                      f"{cal.r_m[i]:.7f},{int(cal.outlier[i])}")
     return "\n".join(lines) + "\n"
 
@@ -742,7 +542,7 @@ def probe_map_from_json(source, tilt_deg: float | None = None, roll_deg: float |
             raise InputError(f"{path}: not JSON: {exc}") from None
     try:
         m = source["map"]
-        return ProbeMap(int(m["degree"]), np.asarray(m["coefficients_um"], dtype=float) * 1e-3,
+        return ProbeMap(int(m["degree"]), np.asarray(m["coefficients_um"], dtype=float) * MM_PER_UM,
                         tuple(float(v) for v in source["phi_range_deg"]),
                         float(source.get("tilt_deg", 0.0) if tilt_deg is None else tilt_deg),
                         float(source.get("roll_deg", 0.0) if roll_deg is None else roll_deg),
@@ -774,7 +574,7 @@ def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
     arr = np.asarray(vals, dtype=float)
     require(len(arr) >= MIN_POINTS, f"{path}: needs at least {MIN_POINTS} map points")
     require(np.all(np.isfinite(arr)), f"{path}: NaN values")
-    sh = fit_sh(np.radians(arr[:, 0]), np.radians(arr[:, 1]), arr[:, 2] * 1e-3, degree)
+    sh = fit_sh(np.radians(arr[:, 0]), np.radians(arr[:, 1]), arr[:, 2] * MM_PER_UM, degree)
     return ProbeMap(sh.degree, sh.coefficients,
                     (float(arr[:, 0].min()), float(arr[:, 0].max())),
                     float(tilt_deg), float(roll_deg), outside, arr[:, :2],

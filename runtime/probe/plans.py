@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volerr.units import MM_PER_UM
 from volerr.errors import require
 from volerr.probe.calibration import directions_of
 
@@ -76,7 +77,7 @@ def pahk_like_pretravel(phi, theta, scale: float = 1.0, mean_um: float = 18.0,
     s = np.sin(phi)
     t = theta - math.radians(orientation_deg)
     var = 7.9 * s ** 3 * np.cos(3 * t) - 2.15 * s ** 6 * np.cos(6 * t) - 8.2 * s ** 2
-    return (mean_um + scale * var) * 1e-3
+    return (mean_um + scale * var) * MM_PER_UM
 
 
 def simulate_probing(plan: Plan, center, sphere_radius: float, ball_radius: float,

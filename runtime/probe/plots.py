@@ -7,13 +7,16 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.units import UM_PER_MM
+from volerr.probe.calibration import unit_vectors
+
 
 def _grid(cal, n_phi: int = 61, n_theta: int = 121):
     lo, hi = cal.map.phi_range_deg
     phi = np.linspace(lo, hi, n_phi)
     theta = np.linspace(0.0, 360.0, n_theta)
     pp, tt = np.meshgrid(phi, theta, indexing="ij")
-    val = cal.map.with_outside("extrapolate").at(pp, tt) * 1e3
+    val = cal.map.with_outside("extrapolate").at(pp, tt) * UM_PER_MM
     return pp, tt, np.ma.masked_where(~cal.map.covered(pp, tt), val)
 
 
@@ -73,20 +76,18 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
 
     pp, tt, masked = _grid(cal, 37, 73)
     val = masked.filled(0.0)          # uncalibrated directions: reference sphere, grey
-    pts_um = cal.probe * 1e3
+    pts_um = cal.probe * UM_PER_MM
     vmax = max(float(np.max(np.abs(val))), float(np.max(np.abs(pts_um))), 1e-6)
     gain = gain if gain is not None else 0.2 / vmax
-    ph, th = np.radians(pp), np.radians(tt)
     r = 1.0 + gain * val
-    x, y, z = r * np.sin(ph) * np.cos(th), r * np.sin(ph) * np.sin(th), r * np.cos(ph)
+    x, y, z = np.moveaxis(unit_vectors(pp, tt) * np.asarray(r)[..., None], -1, 0)
     norm = _norm(np.concatenate([val.ravel(), pts_um]))
     cmap = plt.get_cmap("RdBu_r")
     colors = cmap(norm(val))
     colors[np.ma.getmaskarray(masked)] = (0.85, 0.85, 0.85, 0.4)
     ax.plot_surface(x, y, z, facecolors=colors, rstride=1, cstride=1,
                     linewidth=0.2, edgecolor=(0, 0, 0, 0.15), antialiased=True, shade=False)
-    p, t = np.radians(cal.phi_deg), np.radians(cal.theta_deg)
-    u = np.stack([np.sin(p) * np.cos(t), np.sin(p) * np.sin(t), np.cos(p)], axis=1)
+    u = unit_vectors(cal.phi_deg, cal.theta_deg)
     tip = u * (1.0 + gain * pts_um)[:, None]
     for a, b in zip(u, tip):
         ax.plot(*zip(a, b), color="k", linewidth=0.8)
@@ -113,7 +114,7 @@ def draw_2d(fig, ax, cal) -> None:
     """Fig. 3b: the smooth map on the (theta, phi) grid with contours, the measured Probe at
     each point as coloured markers (flagged outliers crossed)."""
     pp, tt, val = _grid(cal)
-    pts_um = cal.probe * 1e3
+    pts_um = cal.probe * UM_PER_MM
     norm = _norm(np.concatenate([val.compressed(), pts_um]))
     holes = bool(np.ma.getmaskarray(val).any())
     mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm,

@@ -16,13 +16,14 @@ finite weight of the table.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from volerr.units import UM_PER_MM, URAD_PER_RAD
 from volerr.errors import InputError, require
-from volerr.tables.table import ErrorTable, choose_degree, loo_press, make_function, parameter_kind
+from volerr.tables import legendre
+from volerr.tables.table import ErrorTable, make_function, parameter_kind
 
 METHODS = ("poly", "smooth", "linear", "cubic")
 
@@ -56,11 +57,11 @@ class Fit:
 
     def report(self) -> dict:
         """Residuals in um or urad."""
-        k = 1e3 if parameter_kind(self.name) == "length" else 1e6
+        k = UM_PER_MM if parameter_kind(self.name) == "length" else URAD_PER_RAD
         return {"name": self.name, "method": self.method, "degree": self.degree,
                 "rms_residual": self.rms_residual * k, "max_residual": self.max_residual * k,
                 "loo_rms": None if self.loo_rms is None else self.loo_rms * k,
-                "unit": "um" if k == 1e3 else "urad"}
+                "unit": "um" if k == UM_PER_MM else "urad"}
 
 
 def _smooth(x, y, w):
@@ -84,19 +85,12 @@ def fit(name: str, x, y, method: str = "poly", degree: int | None = None,
         w = w / np.mean(w)
     loo = None
     if method == "poly":
-        if w is None:
-            if degree is None:
-                degree = choose_degree(x, y, max_degree)
-            f = make_function(x, y, "poly", degree)
-            loo = float(np.sqrt(np.mean(loo_press(x, y, degree) ** 2)))
-        else:
-            if degree is None:
-                degree = _choose_weighted_degree(x, y, w, max_degree)
-            lo, hi = float(x[0]), float(x[-1])
-            t = (x - 0.5 * (lo + hi)) / (0.5 * (hi - lo))
-            coef = np.polynomial.legendre.legfit(t, y, degree, w=w)
-            f = _LegPoly(coef, lo, hi)
-            loo = float(np.sqrt(np.mean(_loo_weighted(x, y, w, degree) ** 2)))
+        require(degree is None or 0 <= degree < x.size,
+                f"polynomial degree {degree} needs more than {degree} positions, the table "
+                f"has {x.size}")
+        f = legendre.fit(x, y, degree, w, max_degree)
+        degree = f.degree
+        loo = float(np.sqrt(np.mean(legendre.loo_errors(x, y, degree, w) ** 2)))
     elif method == "smooth":
         f = _smooth(x, y, w)
         degree = None
@@ -106,38 +100,6 @@ def fit(name: str, x, y, method: str = "poly", degree: int | None = None,
     res = y - np.asarray(f(x))
     return Fit(name, method, float(x[0]), float(x[-1]), f, degree,
                float(np.sqrt(np.mean(res ** 2))), float(np.max(np.abs(res))), loo)
-
-
-class _LegPoly:
-    def __init__(self, coef, lo, hi):
-        self.coef, self.lo, self.hi = coef, lo, hi
-        self.degree = len(coef) - 1
-
-    def __call__(self, q):
-        t = (np.asarray(q, float) - 0.5 * (self.lo + self.hi)) / (0.5 * (self.hi - self.lo))
-        return np.polynomial.legendre.legval(t, self.coef)
-
-
-def _loo_weighted(x, y, w, degree):
-    t = (x - 0.5 * (x[0] + x[-1])) / (0.5 * (x[-1] - x[0]))
-    V = np.polynomial.legendre.legvander(t, degree) * w[:, None]
-    Q, _ = np.linalg.qr(V)
-    h = np.sum(Q ** 2, axis=1)
-    r = y * w - Q @ (Q.T @ (y * w))
-    return r / np.clip(1.0 - h, 1e-12, None) / w
-
-
-def _choose_weighted_degree(x, y, w, max_degree):
-    n = x.size
-    top = n - 2 if max_degree is None else min(max_degree, n - 2)
-    top = max(0, min(top, 12))
-    scores, ses = [], []
-    for d in range(top + 1):
-        e2 = (_loo_weighted(x, y, w, d) * w) ** 2
-        scores.append(e2.mean())
-        ses.append(e2.std(ddof=1) / math.sqrt(n) if n > 1 else 0.0)
-    best = int(np.argmin(scores))
-    return next(d for d in range(best + 1) if scores[d] <= scores[best] + ses[best])
 
 
 def fit_table(table: ErrorTable, method: str = "poly", degree: int | None = None,

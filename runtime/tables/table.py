@@ -60,12 +60,16 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.tables import legendre
+from volerr.machine import iso_names
+from volerr.units import MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number, parse_number
 from volerr.errors import InputError, require
 from volerr.fileio import read_csv_rows, write_text
 
 #: unit suffix -> (kind, factor to mm or rad)
-UNITS = {"um": ("length", 1e-3), "mm": ("length", 1.0), "urad": ("angle", 1e-6), "rad": ("angle", 1.0)}
-_DIVISOR = {"um": 1000.0, "mm": 1.0, "urad": 1e6, "rad": 1.0}  # value_in_unit / divisor -> mm|rad
+UNITS = {"um": ("length", MM_PER_UM), "mm": ("length", 1.0), "urad": ("angle", RAD_PER_URAD),
+         "rad": ("angle", 1.0)}
+_DIVISOR = {"um": UM_PER_MM, "mm": 1.0, "urad": URAD_PER_RAD, "rad": 1.0}  # value_in_unit / divisor -> mm|rad
 ROTARY_LETTERS = ("A", "B", "C")
 _TABLE_NAME = re.compile(r"^E([XYZABC])([A-Z])$")
 _CONST_NAME = re.compile(r"^E([XYZABC])0([A-Z])$")
@@ -93,7 +97,7 @@ def _ignored_column(col: str) -> bool:
 
 def parameter_kind(name: str) -> str:
     """``"length"`` for translational (EX?, EY?, EZ?, EX0?, ...), ``"angle"`` for angular."""
-    return "length" if name[1] in "XYZ" else "angle"
+    return "length" if iso_names.is_length(name) else "angle"
 
 
 def axis_unit(axis: str) -> str:
@@ -182,13 +186,7 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
 
 
 def _number(path, lineno, column, text) -> float:
-    require(text != "", f"{path}:{lineno}: empty value in column {column}")
-    try:
-        v = float(text)
-    except ValueError:
-        raise InputError(f"{path}:{lineno}: {column} = {text!r} is not a number") from None
-    require(math.isfinite(v), f"{path}:{lineno}: {column} = {text} (NaN or infinite)")
-    return v
+    return parse_number(text, f"{path}:{lineno}", column)
 
 
 def _parse_column(path, col: str, axis: str):
@@ -273,8 +271,7 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
 
 
 def _fmt(v: float) -> str:
-    s = f"{float(v):.12g}"
-    return "0" if s == "-0" else s
+    return format_number(v, 12)
 
 
 def table_to_csv(table: ErrorTable) -> str:
@@ -413,43 +410,15 @@ def write_error_dir(directory, tables: dict, constants: dict | None = None,
 # ---------------------------------------------------------------------------------------------
 # fitting
 def loo_press(x, y, degree: int) -> np.ndarray:
-    """Leave-one-out prediction errors of a least-squares polynomial of ``degree`` (hat matrix)."""
-    t = _scale(x, x)
-    V = np.polynomial.legendre.legvander(t, degree)
-    Q, _ = np.linalg.qr(V)
-    h = np.sum(Q ** 2, axis=1)
-    resid = y - Q @ (Q.T @ y)
-    return resid / np.clip(1.0 - h, 1e-12, None)
-
-
-def _scale(x, ref):
-    lo, hi = float(np.min(ref)), float(np.max(ref))
-    return (np.asarray(x, dtype=float) - 0.5 * (lo + hi)) / (0.5 * (hi - lo))
+    """Leave-one-out prediction errors of a least-squares polynomial of ``degree`` (hat matrix);
+    :func:`volerr.tables.legendre.loo_errors`."""
+    return legendre.loo_errors(x, y, degree)
 
 
 def choose_degree(x, y, max_degree: int | None = None) -> int:
-    """Polynomial degree by leave-one-out cross-validation with the one-standard-error rule."""
-    n = len(x)
-    top = n - 2 if max_degree is None else min(max_degree, n - 2)
-    top = max(0, min(top, 12))
-    scores, ses = [], []
-    for d in range(top + 1):
-        e2 = loo_press(x, y, d) ** 2
-        scores.append(e2.mean())
-        ses.append(e2.std(ddof=1) / math.sqrt(n) if n > 1 else 0.0)
-    best = int(np.argmin(scores))
-    limit = scores[best] + ses[best]
-    return next(d for d in range(best + 1) if scores[d] <= limit)
-
-
-class _Poly:
-    def __init__(self, x, y, degree):
-        self.lo, self.hi = float(x[0]), float(x[-1])
-        self.coef = np.polynomial.legendre.legfit(_scale(x, x), y, degree)
-        self.degree = degree
-
-    def __call__(self, q):
-        return np.polynomial.legendre.legval(_scale(q, [self.lo, self.hi]), self.coef)
+    """Polynomial degree by leave-one-out cross-validation with the one-standard-error rule;
+    :func:`volerr.tables.legendre.choose_degree`."""
+    return legendre.choose_degree(x, y, max_degree)
 
 
 class _Linear:
@@ -483,7 +452,7 @@ def make_function(x, y, method: str = "linear", degree: int | None = None):
             degree = choose_degree(x, y)
         require(0 <= degree < len(x), f"polynomial degree {degree} needs more than {degree} "
                                       f"positions, the table has {len(x)}")
-        return _Poly(x, y, degree)
+        return legendre.LegendreFit(x, y, degree)
     raise InputError(f"unknown interpolation method {method!r} (linear, cubic, poly)")
 
 

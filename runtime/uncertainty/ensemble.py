@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volerr.machine import iso_names
 from volerr.errors import InputError, require
 
 from . import iso10360
@@ -236,7 +237,7 @@ class SpecMachines(Source):
         k = np.arange(1, self.degree + 1)
         amp = []
         for p in self.params:
-            base = mpe_max if p[1] in "XYZ" else mpe_max / diag
+            base = mpe_max if iso_names.is_length(p) else mpe_max / diag
             amp.append(base / k if paxis[p] is not None else np.array([base]))
         self.amp = amp
         self.v_task = {a: self._vander(task.positions[a], *box[a]) for a in "XYZ"}
