@@ -873,10 +873,17 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None) -> list[Verdict]:
         if k and hit:
             ev.append(f"Eq. {result_eq['id']} is reproduced by the chain: {hit[0]}.")
     if all(is_identical(a, b) for a, b in zip(physical, literal)):
+        if note:
+            # the equality holds only for the repaired vectors, also when they are borrowed
+            # from another equation (eq. 6 uses the Lz of eq. 3): an extraction defect
+            ev.append("Category extraction: the derived form equals the print only once the "
+                      "extraction damage of the vectors" + (f" (eq. {eq['L_from']})"
+                                                            if "L_from" in eq else "")
+                      + " is repaired as read above.")
         return [Verdict(SOURCE, eq["id"], name, "identical", "", "The printed chain's "
                         "first-order error equals the derived model of the physical layout. "
                         + " ".join(ev), text, _vec(physical),
-                        category="extraction" if note and "L_from" not in eq else "identical")]
+                        category="extraction" if note else "identical")]
     diffs = [f"{c}: {describe_diff(physical[i], literal[i])}" for i, c in enumerate(COMPONENTS)
              if not is_identical(physical[i], literal[i])]
     ev.insert(0, "The printed chain's first-order error differs from the physical layout's "

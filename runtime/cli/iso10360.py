@@ -16,6 +16,7 @@ from volerr.cli._common import add_error_arguments, error_functions_from_args, i
 from volerr.fileio import check_output, check_plot, write_text
 from volerr.machine.model import load
 from volerr.uncertainty import iso10360
+from volerr.uncertainty.report import num
 from volerr.cmm.volmap import check_distinct, volume
 
 
@@ -44,18 +45,18 @@ def run(args) -> int:
         check_output(args.json, inputs)
     if args.plot:
         check_plot(args.plot, inputs)
-    spec = iso10360.parse_spec(args.mpe) if args.mpe else None
+    spec = iso10360.parse_spec(args.mpe, "--mpe") if args.mpe else None
     res = iso10360.simulate(model, funcs, args.probe, volume(model, funcs, args.volume),
                             noise_um=args.noise_um, seed=args.seed, spec=spec)
     print(f"{model.name}: simulated ISO 10360-2 length test, E0 = measured - true length, um")
     for i, name in enumerate(res.names):
-        cells = "  ".join(f"L={L:7.1f}: " + " ".join(f"{e:+7.3f}" for e in res.E_um[i, j])
+        cells = "  ".join(f"L={L:7.1f}: " + " ".join(num(e, "+7.3f") for e in res.E_um[i, j])
                           for j, L in enumerate(res.lengths[i]))
         print(f"  {name:16s} {cells}")
     d = res.as_dict()
-    print(f"  max |E0| = {d['max_abs_E_um']:.3f} um")
+    print(f"  max |E0| = {num(d['max_abs_E_um'], '.3f')} um")
     if spec is not None:
-        print(f"  MPE {spec.text()}: max |E0| / MPE = {d['max_ratio_to_mpe']:.3f} -> "
+        print(f"  MPE {spec.text()}: max |E0| / MPE = {num(d['max_ratio_to_mpe'], '.3f')} -> "
               f"{'PASS' if d['passes'] else 'FAIL'}")
     if args.json:
         doc = {"layout": model.name, "errors": str(args.errors), "probe_mm": list(args.probe),

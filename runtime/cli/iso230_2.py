@@ -29,7 +29,10 @@ input formats (CSV; ';' or tab separated exports are read too; names case-insens
   wide, one row per target (interferometer software export):
     target_mm,fwd_1_um,bwd_1_um,fwd_2_um,bwd_2_um,...[,T_C]
   variants: fwd1, Fwd 1, forward_1, run1_fwd, 1+, 1-, up_1, down_1, b_2 ...; unit suffix
-  _um, _mm, (um), (mm); no unit means um.
+  _um, _mm, (um), (mm), [um], [mm]; no unit means um.
+  target column (both formats): target_mm, target, target_position, position, with the same
+  unit spellings (Target (mm), Target [mm], position_mm); no unit means mm.  cycle: an integer
+  (or a text label); 1.5 is refused.
 
   T_C (or material_T_C): material temperature, degC, used by --cte-ppm-per-K; other *_C
   columns are reported as conditions; other columns are ignored.  Every target needs both
@@ -45,9 +48,14 @@ outputs:
   axis, n_cycles, temperature_correction.  Several RUN files: {"runs": [...]}, same keys per run.
   E is bidirectional: max - min of the mean deviations of BOTH directions (not max(E_fwd,
   E_bwd)); B = max |B_i|, B_avg = mean of B_i = forward minus backward.
-  --table-out DIR: DIR/<axis>.csv with <axis>,EXX_um,EXX_std_um,RV_X_um (for axis X):
-  mean bidirectional deviation, pooled unidirectional repeatability sqrt((S_fwd^2 +
-  S_bwd^2)/2), reversal B_i; readable by 'volerr map --errors DIR'.
+  --table-out DIR: DIR/<axis>.csv with <axis>,EXX_um,EXX_std_um,RV_X_um,S_X_um (axis X):
+  EXX = mean bidirectional deviation x_i; EXX_std = its standard uncertainty (Type A)
+  S_i / sqrt(2 n), n cycles per direction (2 n readings per target); RV_X = reversal B_i;
+  S_X = pooled single-reading repeatability S_i = sqrt((S_fwd^2 + S_bwd^2)/2) (ignored by
+  the table reader).  Readable by 'volerr map --errors DIR' and 'volerr uncertainty --errors
+  DIR' with its default --table-std systematic (EXX_std is the uncertainty of the error
+  function at each node).  Not with --table-std repeatability: that wants a single-reading
+  scatter per probing point, and EXX_std is sqrt(2 n) times smaller than S_X.
 """
 
 
@@ -69,8 +77,10 @@ def register(sub) -> None:
     p.add_argument("--plot", metavar="P.png", help="write the ISO 230-2 plot (PNG)")
     p.add_argument("--html", metavar="F", help="write a one-page report (HTML, plot embedded)")
     p.add_argument("--table-out", metavar="DIR",
-                   help="write DIR/<axis>.csv: mean bidirectional deviation, repeatability "
-                        "(_std) and reversal (RV_<axis>_um) for --errors DIR")
+                   help="write DIR/<axis>.csv for --errors DIR: mean bidirectional deviation, "
+                        "its standard uncertainty S/sqrt(2n) (_std; fits 'volerr uncertainty "
+                        "--table-std systematic', the default), reversal (RV_<axis>_um) and "
+                        "the single-reading repeatability S (S_<axis>_um)")
     g = p.add_argument_group("correction to 20 degC")
     g.add_argument("--cte-ppm-per-K", type=float, metavar="A",
                    help="coefficient of expansion of the scale / material, ppm/K (um/m/K); "
@@ -96,7 +106,6 @@ def run(args) -> int:
 
     from volerr import positioning as pos
     from volerr.fileio import check_folder, check_output, check_plot, write_bytes, write_text
-    from volerr.tables import table_to_csv
 
     inputs = list(args.runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs), "the same RUN file is given "
@@ -132,7 +141,7 @@ def run(args) -> int:
         thermals.append(th)
         notes.append(pos.standard_notes(r, th is not None))
     report = pos.report_dict(evaluations, thermals, notes)
-    table_texts = [table_to_csv(pos.error_table(ev)) for ev in evaluations] if tables else []
+    table_texts = [pos.error_table_csv(ev) for ev in evaluations] if tables else []
     png = pos.plot_runs(evaluations) if (args.plot or args.html) else None
     html_text = None
     if args.html:

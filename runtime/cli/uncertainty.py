@@ -19,6 +19,7 @@ from volerr.errors import require
 from volerr.fileio import check_output, write_bytes, write_text
 from volerr.machine.model import load
 from volerr.uncertainty import ensemble, montecarlo as mc, tasks
+from volerr.uncertainty.report import num
 
 
 def register(sub) -> None:
@@ -31,8 +32,12 @@ def register(sub) -> None:
                    help="distance, circle, sphere or plane")
     add_error_arguments(p, required=False)
     p.add_argument("--table-std", choices=("systematic", "repeatability"), default="systematic",
-                   help="table std columns: one perturbed error function per machine "
-                        "(default) or independent per probing point")
+                   help="meaning of the tables' std columns.  systematic (default): the "
+                        "standard uncertainty of the tabulated error function at each node; "
+                        "one perturbed function per machine (what 'iso230-2 --table-out' "
+                        "writes as _std: S/sqrt(2n), the uncertainty of the mean deviation).  "
+                        "repeatability: the scatter of one positioning, drawn independently "
+                        "per probing point (a single-reading S, not the _std of iso230-2)")
     p.add_argument("--correlation-mm", type=float, default=0.0, metavar="L",
                    help="correlation length of the node perturbations along an axis "
                         "(default 0: independent nodes)")
@@ -87,9 +92,33 @@ def _temperature(args):
     return ensemble.Temperature(**kw, compensated=args.temperature_compensated)
 
 
+def _check_options(args) -> None:
+    """Option values first, before any file is read or anything is decided."""
+    import math
+
+    def finite(v):
+        return v is not None and math.isfinite(v)
+
+    require(finite(args.noise_um) and args.noise_um >= 0, "--noise-um must be >= 0")
+    require(finite(args.correlation_mm) and args.correlation_mm >= 0,
+            "--correlation-mm must be >= 0")
+    require(finite(args.spec_acceptance) and 0 < args.spec_acceptance < 1,
+            "--spec-acceptance must lie in (0, 1)")
+    require(args.samples is None or 2 <= args.samples <= 10**8,
+            "--samples must be between 2 and 1e8")
+    require(1 <= args.digits <= 4, "--digits must be between 1 and 4")
+    require(args.max_samples >= 2, "--max-samples must be >= 2")
+    require(args.seed >= 0, "--seed must be a non-negative integer")
+    require(args.chunks >= 1, "--chunks must be >= 1")
+    require(args.workers >= 1, "--workers must be >= 1")
+    require(args.contributions >= 0, "--contributions must be >= 0")
+    _temperature(args)  # validates the temperature options
+
+
 def run(args) -> int:
     from volerr.cli._common import error_functions_from_args, inputs_of
 
+    _check_options(args)
     require(args.evaluate in tasks.EVALUATIONS, f"unknown evaluation {args.evaluate!r} "
                                                 f"(one of {', '.join(tasks.EVALUATIONS)})")
     model = load(args.layout)
@@ -158,9 +187,10 @@ def run(args) -> int:
         print(f"{model.name} {args.evaluate}: {values.shape[0]} samples, seed {args.seed}")
         for name, q in summary.items():
             lo, hi = q["coverage_interval_mm"]
-            print(f"  {name:9s} {q['estimate_mm']:.6f} mm  bias {q['bias_um']:+.3f} um  "
-                  f"u {q['standard_uncertainty_um']:.3f} um  U {q['expanded_uncertainty_um']:.3f}"
-                  f" um  95% [{lo:.6f}, {hi:.6f}] mm")
+            print(f"  {name:9s} {num(q['estimate_mm'], '.6f')} mm  bias "
+                  f"{num(q['bias_um'], '+.3f')} um  u {q['standard_uncertainty_um']:.3f} um  "
+                  f"U {q['expanded_uncertainty_um']:.3f} um  95% [{num(lo, '.6f')}, "
+                  f"{num(hi, '.6f')}] mm")
     write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs)
     if args.plot:
         write_bytes(args.plot, hist, inputs)

@@ -7,9 +7,10 @@ certificate-like HTML and an error table with reversal for ``--errors DIR`` (:mo
 
 from ._evaluate import Evaluation, evaluate
 from ._io import PositioningRun, read_run
-from ._report import error_table, plot_runs, report_dict, report_html, standard_notes
+from ._report import (error_table, error_table_csv, plot_runs, report_dict, report_html,
+                      standard_notes)
 from ._thermal import ThermalCorrection, correct_to_20C
 
 __all__ = ["PositioningRun", "read_run", "ThermalCorrection", "correct_to_20C", "Evaluation",
-           "evaluate", "report_dict", "plot_runs", "report_html", "error_table",
+           "evaluate", "report_dict", "plot_runs", "report_html", "error_table", "error_table_csv",
            "standard_notes"]

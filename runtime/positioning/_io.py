@@ -11,12 +11,16 @@ starting with ``#`` are ignored, names are case-insensitive.
     0,1,-1,1.8
     ...
 
-* ``target_mm`` (or ``target_position_mm``): target position P_i, mm.
-* ``cycle`` (or ``run``): the cycle j = 1..n (any label; ``1`` and ``1.0`` are the same cycle).
+* ``target_mm``: target position P_i, mm; also ``target``, ``target_position``, ``position``
+  with or without a unit ``_mm``, `` mm``, ``(mm)``, ``[mm]`` (or um: ``_um``, ``(µm)`` ...);
+  no unit means mm (``Target (mm)``, ``Target [mm]``, ``position_mm``).
+* ``cycle`` (or ``run``): the cycle j = 1..n, an integer (``1`` and ``1.0`` are the same
+  cycle; ``1.5`` is refused) or a text label.
 * ``direction`` (or ``dir``): ``+1`` forward (approach in the positive direction, the
   standard's up arrow) or ``-1`` backward (down arrow); ``+``/``-``, ``fwd``/``bwd``,
   ``forward``/``backward``, ``up``/``down`` are accepted too.
-* ``deviation_um`` (or ``deviation_mm``): positional deviation x_ij = actual minus target
+* ``deviation_um`` (or ``deviation_mm``; the unit spellings of the target, no unit: um):
+  positional deviation x_ij = actual minus target
   position, the interferometer reading after the usual environmental (air) compensation, in
   the axis' NC coordinate (ISO 841: tool relative to workpiece).
 * optional material temperature ``T_C`` (or ``material_T_C``, ``T_material_C``), degC, used by
@@ -32,7 +36,8 @@ software exports)::
   ``fwd forward fw f up pos plus + ↑`` / ``bwd backward bw b back down neg minus rev reverse
   - ↓`` before or after the cycle number, optionally with ``run``/``cycle``/``c``/``r``
   (``fwd1``, ``Fwd 1``, ``run1_fwd``, ``1+``, ``cycle_2_bwd``), and a unit suffix ``_um``,
-  ``_mm``, ``(um)``, ``(mm)``; a column without a unit is in um.
+  ``_mm``, ``(um)``, ``(mm)``, ``[um]``, ``[mm]``; a column without a unit is in um.
+* the target column as in the long format (``target_mm``, ``Target (mm)`` ...).
 * ``T_C``: the material temperature at that target (all its cycles).
 
 In both formats every target must be measured in both directions in every cycle, exactly once;
@@ -56,10 +61,8 @@ FWD, BWD = 0, 1
 DIRECTION_NAMES = ("forward", "backward")
 LINEAR_AXES = "XYZUVW"
 
-_TARGET = ("target_mm", "target_position_mm")
 _CYCLE = ("cycle", "run")
 _DIRECTION = ("direction", "dir")
-_DEVIATION = {"deviation_um": 1e-3, "deviation_mm": 1.0}
 _TEMP = ("t_c", "material_t_c", "t_material_c")
 _DIR_WORDS = {**{w: +1 for w in ("+1", "1", "+", "fwd", "forward", "up", "pos", "plus",
                                  "\u2191")},
@@ -67,7 +70,11 @@ _DIR_WORDS = {**{w: +1 for w in ("+1", "1", "+", "fwd", "forward", "up", "pos", 
                                  "rev", "reverse", "\u2193")}}
 _F = r"fwd|forward|fw|f|up|pos|plus|\+|\u2191"
 _B = r"bwd|backward|bw|back|b|down|neg|minus|reverse|rev|-|\u2193"
-_UNIT = r"(?:[ _]?\(?(?P<u>um|\u00b5m|\u03bcm|mm)\)?)?"
+_UNIT = r"(?:[ _]?[(\[]?(?P<u>um|\u00b5m|\u03bcm|mm)[)\]]?)?"
+#: target column: name (target, target_position, position) and an optional unit, default mm
+_TARGET_RX = re.compile(rf"^(?P<n>target(?:[ _]?position)?|position){_UNIT}$", re.IGNORECASE)
+#: deviation column of the long format, optional unit, default um
+_DEVIATION_RX = re.compile(rf"^deviation{_UNIT}$", re.IGNORECASE)
 _RUN = r"(?:run|cycle|cyc|c|r)?"
 _WIDE = (re.compile(rf"^(?P<d>{_F}|{_B})[ _.-]?{_RUN}[ _.-]?(?P<k>\d+){_UNIT}$", re.IGNORECASE),
          re.compile(rf"^{_RUN}[ _.-]?(?P<k>\d+)[ _.-]?(?P<d>{_F}|{_B}){_UNIT}$", re.IGNORECASE))
@@ -187,12 +194,37 @@ def _find(low: list[str], names) -> int | None:
     return hits[0] if hits else None
 
 
-def _cycle_label(text: str) -> str:
+def _unit_column(path, header, rx, what: str, default: str):
+    """-> (index, factor to mm) of the one column whose name matches ``rx`` (a name and an
+    optional unit um / mm in any spelling of ``_UNIT``; ``default`` unit when none), or
+    (None, None).  Two matching columns are refused."""
+    hits = []
+    for j, h in enumerate(header):
+        m = rx.match(h.strip())
+        if m:  # 'target...' is preferred to a bare 'position' when both are present
+            rank = 1 if (m.groupdict().get("n") or "").lower() == "position" else 0
+            hits.append((rank, j, m))
+    if not hits:
+        return None, None
+    hits.sort(key=lambda h: h[:2])
+    if len(hits) > 1 and hits[1][0] == hits[0][0]:
+        raise InputError(f"{path}: columns {header[hits[0][1]]!r} and {header[hits[1][1]]!r} "
+                         f"both give the {what}")
+    _, j, m = hits[0]
+    unit = (m.group("u") or default).lower()
+    return j, (1.0 if unit == "mm" else 1e-3)
+
+
+def _cycle_label(path, lineno, column, text: str) -> str:
+    """Cycle label: an integer (``1`` and ``1.0`` are the same cycle) or a text label; a
+    number that is not an integer (``1.5``) is refused."""
     try:
         v = float(text)
     except ValueError:
         return text
-    return str(int(v)) if math.isfinite(v) and v == int(v) else text
+    if not (math.isfinite(v) and v == int(v)):
+        raise InputError(f"{path}:{lineno}: {column} = {text!r}: cycle must be an integer")
+    return str(int(v))
 
 
 def _conditions(path, header, body, columns) -> dict:
@@ -246,26 +278,26 @@ def _assemble(path, axis, entries, temps, fmt, conditions, ignored) -> Positioni
 
 
 def _read_long(path, axis, header, body, low) -> PositioningRun:
-    jt, jc, jd = _find(low, _TARGET), _find(low, _CYCLE), _find(low, _DIRECTION)
-    jv = _find(low, _DEVIATION)
+    jt, tscale = _unit_column(path, header, _TARGET_RX, "target position", "mm")
+    jc, jd = _find(low, _CYCLE), _find(low, _DIRECTION)
+    jv, scale = _unit_column(path, header, _DEVIATION_RX, "deviation", "um")
     for j, what in ((jt, "target_mm"), (jc, "cycle"), (jd, "direction"),
                     (jv, "deviation_um")):
         require(j is not None, f"{path}: missing column {what} (long format: target_mm,cycle,"
                                f"direction,deviation_um; see volerr iso230-2 --help)")
-    scale = _DEVIATION[low[jv]]
     jT = _find(low, _TEMP)
     used = {jt, jc, jd, jv, jT}
     cond = [j for j in range(len(header)) if j not in used and low[j].endswith("_c")]
     ignored = [header[j] for j in range(len(header)) if j not in used and j not in cond]
     entries, temps = {}, {}
     for ln, cells in body:
-        t = _number(path, ln, header[jt], cells[jt])
+        t = _number(path, ln, header[jt], cells[jt]) * tscale
         dtext = cells[jd].lower()
         require(dtext in _DIR_WORDS, f"{path}:{ln}: direction = {cells[jd]!r}: use +1 (forward) "
                                      f"or -1 (backward)")
         d = FWD if _DIR_WORDS[dtext] > 0 else BWD
         require(cells[jc] != "", f"{path}:{ln}: empty value in column {header[jc]}")
-        c = _cycle_label(cells[jc])
+        c = _cycle_label(path, ln, header[jc], cells[jc])
         v = _number(path, ln, header[jv], cells[jv]) * scale
         key = (round(t / _TARGET_KEY_MM), d, c)
         if key in entries:
@@ -295,7 +327,7 @@ def _canon_dir(word: str) -> str:
 
 
 def _read_wide(path, axis, header, body, low) -> PositioningRun:
-    jt = _find(low, _TARGET)
+    jt, tscale = _unit_column(path, header, _TARGET_RX, "target position", "mm")
     require(jt is not None, f"{path}: missing column target_mm (wide format: target_mm,fwd_1_um,"
                             f"bwd_1_um,...; see volerr iso230-2 --help)")
     jT = _find(low, _TEMP)
@@ -319,7 +351,7 @@ def _read_wide(path, axis, header, body, low) -> PositioningRun:
     ignored = [header[j] for j in range(len(header)) if j not in used and j not in cond]
     entries, temps, rows_of = {}, {}, {}
     for ln, cells in body:
-        t = _number(path, ln, header[jt], cells[jt])
+        t = _number(path, ln, header[jt], cells[jt]) * tscale
         tk = round(t / _TARGET_KEY_MM)
         if tk in rows_of:
             raise InputError(f"{path}:{ln}: duplicate target {t:g} mm (already on line "

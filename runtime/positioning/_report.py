@@ -222,16 +222,46 @@ approach. E = max &minus; min of the mean unidirectional deviations of both dire
 
 
 def error_table(ev: Evaluation) -> ErrorTable:
-    """Error table of the run's axis: ``E<a><a>`` = mean bidirectional deviation, its ``std`` =
-    sqrt((S_up^2 + S_dn^2) / 2), and the reversal B_i (mm).  Linear axes X, Y, Z only."""
+    """Error table of the run's axis (X, Y, Z only), mm:
+
+    * ``E<a><a>`` = mean bidirectional deviation x_i = (mean_fwd + mean_bwd) / 2;
+    * its ``std`` = the standard uncertainty (Type A) of that mean, S_i / sqrt(2 n) with S_i =
+      sqrt((s_fwd^2 + s_bwd^2) / 2) the pooled single-reading repeatability and n the cycles
+      per direction (2 n readings per target; the reversal is a fixed effect of the mean, not
+      a scatter): what ``volerr uncertainty --table-std systematic`` (the default) needs, the
+      uncertainty of the error function at each node;
+    * the reversal B_i.
+
+    The repeatability S_i itself is not a table column of :class:`ErrorTable`; see
+    :func:`repeatability` and :func:`error_table_csv`."""
     from volerr.errors import require
 
     a = ev.run.axis
     require(a in "XYZ", f"--table-out: axis {a} has no ISO 230-1 positioning parameter in the "
                         f"error-table format (X, Y, Z only)")
     name = f"E{a}{a}"
-    pooled = np.sqrt(0.5 * (ev.s_fwd ** 2 + ev.s_bwd ** 2))
-    return ErrorTable(a, ev.run.targets, {name: ev.mean}, {name: pooled}, {}, ev.reversal)
+    u_mean = repeatability(ev) / np.sqrt(2 * ev.run.n_cycles)
+    return ErrorTable(a, ev.run.targets, {name: ev.mean}, {name: u_mean}, {}, ev.reversal)
+
+
+def repeatability(ev: Evaluation) -> np.ndarray:
+    """Pooled unidirectional single-reading repeatability S_i = sqrt((s_fwd^2 + s_bwd^2) / 2)
+    at each target, mm, shape (m,)."""
+    return np.sqrt(0.5 * (ev.s_fwd ** 2 + ev.s_bwd ** 2))
+
+
+def error_table_csv(ev: Evaluation) -> str:
+    """CSV text of :func:`error_table` plus the column ``S_<axis>_um``: the pooled
+    single-reading repeatability S_i (um), the scatter of one positioning.  The error-table
+    reader ignores that column (it is no error parameter); ``EXX_std_um`` is S_i / sqrt(2 n)."""
+    from volerr.tables import table_to_csv
+
+    t = error_table(ev)
+    lines = table_to_csv(t).splitlines()
+    S = repeatability(ev) * 1e3
+    out = [lines[0] + f",S_{t.axis}_um"]
+    out += [f"{ln},{float(f'{v:.12g}') + 0.0:.12g}" for ln, v in zip(lines[1:], S)]
+    return "\n".join(out) + "\n"
 
 
 def standard_notes(run, corrected: bool) -> list[str]:

@@ -25,6 +25,8 @@ import numpy as np
 
 from volerr.errors import require
 
+from .tasks import check_travel
+
 FRACTIONS = (0.1, 0.25, 0.4, 0.55, 0.7)
 
 
@@ -47,17 +49,18 @@ class Spec:
 _NUM = r"([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)"
 
 
-def parse_spec(text: str) -> Spec:
-    """``"E0=A+L/K"`` (A um, K dimensionless), optionally ``",PFTU=P"`` (um)."""
+def parse_spec(text: str, option: str = "--spec") -> Spec:
+    """``"E0=A+L/K"`` (A um, K dimensionless), optionally ``",PFTU=P"`` (um).  ``option``:
+    the command-line option the text came from, named in the messages."""
     t = str(text).replace(" ", "")
     m = re.fullmatch(r"(?:MPE_?)?E0?=" + _NUM + r"\+L/" + _NUM + r"(?:[,;](?:MPE_?)?PFTU=" + _NUM
                      + r")?", t, re.IGNORECASE)
-    require(m is not None, f"--spec {text!r}: expected \"E0=A+L/K\" (A in um, L in mm, K "
+    require(m is not None, f"{option} {text!r}: expected \"E0=A+L/K\" (A in um, L in mm, K "
                            f"dimensionless), optionally \",PFTU=P\" (um)")
     a, k = float(m.group(1)), float(m.group(2))
-    require(a > 0 and k > 0, f"--spec {text!r}: A and K must be positive")
+    require(a > 0 and k > 0, f"{option} {text!r}: A and K must be positive")
     p = float(m.group(3)) if m.group(3) else None
-    require(p is None or p > 0, f"--spec {text!r}: PFTU must be positive")
+    require(p is None or p > 0, f"{option} {text!r}: PFTU must be positive")
     return Spec(a, k, p)
 
 
@@ -148,6 +151,8 @@ def length_test(model, box=None, probe=(0.0, 0.0, 0.0), fractions=FRACTIONS,
     directions = np.stack([np.broadcast_to(-u[:, None, :], near.shape),
                            np.broadcast_to(u[:, None, :], far.shape)], axis=2)
     pos = axis_positions(model, targets.reshape(-1, 3), probe)
+    check_travel(model, {a: (np.rad2deg(v) if a in model.rotary_axes else v)
+                         for a, v in pos.items()}, "ISO 10360-2 test point")
     return LengthTest(tuple(names), lengths, u, targets, pos, probe, directions, repetitions, box)
 
 
@@ -189,7 +194,8 @@ class TestResult:
         for i, name in enumerate(self.names):
             out["positions"].append({
                 "line": name, "lengths_mm": [round(float(v), 6) for v in self.lengths[i]],
-                "E_um": [[round(float(v), 4) for v in row] for row in self.E_um[i]]})
+                # + 0.0: no negative zero in the JSON
+                "E_um": [[round(float(v), 4) + 0.0 for v in row] for row in self.E_um[i]]})
         out["max_abs_E_um"] = float(np.max(np.abs(self.E_um)))
         if self.spec is not None:
             mpe = self.spec.mpe_um(self.lengths)[..., None]

@@ -23,7 +23,7 @@ import numpy as np
 
 from volerr.errors import require
 
-from .tasks import EVALUATIONS, check_task, evaluate
+from .tasks import EVALUATIONS, check_task, check_travel, evaluate
 
 BLOCK_SIZE = 250
 _MODELS: dict = {}
@@ -117,6 +117,8 @@ def prepare(model, layout_ref: str, task, evaluation: str, ensemble, seed: int =
     require(block_size >= 1, "block size must be >= 1")
     require(not model.covariates, f"{model.name}: layouts with declared effects need "
                                   f"covariates, not supported here")
+    # one check for every kind of machine knowledge (tables, spec, perfect machine)
+    check_travel(model, task.positions)
     pos = model.positions(task.positions)
     n = task.n_points
     nominal = model.nominal_position(task.positions, task.probe)

@@ -8,37 +8,59 @@ import io
 import numpy as np
 
 
-def _fig_bytes(fig) -> bytes:
+def _fig_bytes(fig, tight: bool = True, dpi: int = 100) -> bytes:
     import matplotlib.pyplot as plt
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight" if tight else None)
     plt.close(fig)
     return buf.getvalue()
 
 
-def histogram_png(values, names, summary: dict, title: str) -> bytes:
-    """One panel per quantity: histogram (um about the estimate), interval, +-U lines."""
+#: histogram figure: inches per panel (width), height, dots per inch -> >= 1200 px wide
+HIST_PANEL_IN, HIST_HEIGHT_IN, HIST_DPI = 5.0, 4.6, 120
+HIST_MIN_WIDTH_IN = 10.0
+
+
+def histogram_figure(values, names, summary: dict, title: str):
+    """The histogram figure (matplotlib Figure, Agg): one panel per quantity, the samples as
+    deviations from the estimate in um (x label in one unit), the estimate in mm in the panel
+    title, the probabilistically symmetric 95 % interval (red) and +-U (blue, k = 2)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     k = len(names)
-    fig, axes = plt.subplots(1, k, figsize=(4.2 * k, 3.4), squeeze=False)
+    width = max(HIST_MIN_WIDTH_IN, HIST_PANEL_IN * k)
+    fig, axes = plt.subplots(1, k, figsize=(width, HIST_HEIGHT_IN), squeeze=False,
+                             layout="constrained")
     for ax, j, name in zip(axes[0], range(k), names):
         s = summary[name]
         est = s["estimate_mm"]
         d = (values[:, j] - est) * 1e3
-        ax.hist(d, bins=60, color="0.6", density=True)
+        ax.hist(d, bins=60, color="0.65", density=True)
         lo, hi = s["coverage_interval_mm"]
-        for x in ((lo - est) * 1e3, (hi - est) * 1e3):
-            ax.axvline(x, color="r", lw=1)
-        for x in (-s["expanded_uncertainty_um"], s["expanded_uncertainty_um"]):
-            ax.axvline(x, color="b", lw=1, ls="--")
-        ax.set_xlabel(f"{name} - {est:.6f} mm / um")
-        ax.set_title(f"u = {s['standard_uncertainty_um']:.3g} um", fontsize=9)
-    axes[0][0].set_ylabel("density")
-    fig.suptitle(title + "  (red: 95 % interval, blue: +-U, k = 2)", fontsize=9)
-    return _fig_bytes(fig)
+        for i, x in enumerate(((lo - est) * 1e3, (hi - est) * 1e3)):
+            ax.axvline(x, color="tab:red", lw=1.5, label="95 % interval" if i == 0 else None)
+        U = s["expanded_uncertainty_um"]
+        for i, x in enumerate((-U, U)):
+            ax.axvline(x, color="tab:blue", lw=1.5, ls="--",
+                       label="estimate \u00b1 U (k = 2)" if i == 0 else None)
+        ax.set_xlabel("deviation from estimate / um", fontsize=12)
+        ax.set_title(f"{name}: estimate {est:.6f} mm\n"
+                     f"u = {s['standard_uncertainty_um']:.3g} um, U = {U:.3g} um", fontsize=12)
+        ax.tick_params(labelsize=11)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("probability density / (1/um)", fontsize=12)
+    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="outside lower center", ncol=2,
+               fontsize=11, frameon=False)
+    fig.suptitle(title, fontsize=14)
+    return fig
+
+
+def histogram_png(values, names, summary: dict, title: str) -> bytes:
+    """PNG bytes of :func:`histogram_figure` (at least 1200 px wide)."""
+    fig = histogram_figure(values, names, summary, title)
+    return _fig_bytes(fig, tight=False, dpi=HIST_DPI)
 
 
 def convergence_png(values, names, title: str) -> bytes:

@@ -6,6 +6,17 @@ import base64
 import html
 
 
+def num(value, spec: str) -> str:
+    """``format(value, spec)`` without negative zero: a value that prints as zero (-0.0 or
+    a tiny negative rounded away) prints with the sign of +0, e.g. ``+0.000``, not ``-0.000``."""
+    s = format(float(value), spec)
+    try:
+        zero = float(s) == 0.0
+    except ValueError:
+        return s
+    return format(0.0, spec) if zero else s
+
+
 def _img(png: bytes) -> str:
     return f'<img src="data:image/png;base64,{base64.b64encode(png).decode()}">'
 
@@ -16,10 +27,10 @@ def html_report(doc: dict, pngs=()) -> str:
     rows = []
     for name, q in doc["quantities"].items():
         lo, hi = q["coverage_interval_mm"]
-        rows.append(f"<tr><td>{e(name)}</td><td>{q['estimate_mm']:.6f}</td>"
-                    f"<td>{q['bias_um']:.3f}</td><td>{q['standard_uncertainty_um']:.3f}</td>"
+        rows.append(f"<tr><td>{e(name)}</td><td>{num(q['estimate_mm'], '.6f')}</td>"
+                    f"<td>{num(q['bias_um'], '.3f')}</td><td>{q['standard_uncertainty_um']:.3f}</td>"
                     f"<td>{q['expanded_uncertainty_um']:.3f}</td>"
-                    f"<td>[{lo:.6f}, {hi:.6f}]</td></tr>")
+                    f"<td>[{num(lo, '.6f')}, {num(hi, '.6f')}]</td></tr>")
     contrib = []
     for c in doc.get("contributions", []):
         cells = "".join(f"<td>{v:.3f}</td>" for v in c["standard_uncertainty_um"].values())

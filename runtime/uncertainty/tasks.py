@@ -109,6 +109,39 @@ def read_task(path, axes=("X", "Y", "Z")) -> Task:
     return Task(positions, probe, dirs, str(path))
 
 
+def check_travel(model, positions: dict, what: str = "task point") -> None:
+    """Refuse axis positions outside the layout's travel (every axis of the layout, rotary
+    axes too where their travel is finite), whatever the machine knowledge is: error tables
+    would refuse positions outside their measured range, but a specification or a perfect
+    machine would otherwise be extrapolated silently beyond the machine.
+
+    ``positions``: axis -> (P,) mm (linear) or deg (rotary), the layout's units; an axis
+    missing from ``positions`` is not checked.  Raises InputError naming the first point
+    (1-based) and axis, e.g. ``task point 3: X = 1000 mm outside the travel 0..900 mm of
+    MB1``."""
+    bad = []  # (point index, axis order, axis, value, lo, hi)
+    for k, a in enumerate(model.axes):
+        if a not in positions:
+            continue
+        lo, hi = (float(v) for v in model.travel[a])
+        v = np.atleast_1d(np.asarray(positions[a], dtype=float))
+        tol = 1e-9 * max(1.0, hi - lo if np.isfinite(hi - lo) else 1.0)
+        out = np.zeros(v.shape, bool)
+        if np.isfinite(lo):
+            out |= v < lo - tol
+        if np.isfinite(hi):
+            out |= v > hi + tol
+        out |= ~np.isfinite(v)
+        if out.any():
+            i = int(np.flatnonzero(out)[0])
+            bad.append((i, k, a, float(v[i]), lo, hi))
+    if bad:
+        i, _, a, v, lo, hi = min(bad)
+        unit = "deg" if a in model.rotary_axes else "mm"
+        raise InputError(f"{what} {i + 1}: {a} = {v:g} {unit} outside the travel {lo:g}..{hi:g} "
+                         f"{unit} of {model.name}")
+
+
 def check_task(task: Task, evaluation: str, nominal: np.ndarray) -> None:
     """Refuse an unknown evaluation, too few points, or a degenerate nominal geometry."""
     require(evaluation in EVALUATIONS, f"unknown evaluation {evaluation!r} "

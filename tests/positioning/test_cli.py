@@ -114,7 +114,12 @@ def test_outputs_and_table_round_trip(tmp_path):
     xm, s = dev.mean(axis=2), dev.std(axis=2, ddof=1)
     assert np.allclose(t.positions, TARGETS)
     assert np.allclose(t.values["EXX"] * 1e3, xm.mean(axis=1), atol=1e-9)
-    assert np.allclose(t.std["EXX"] * 1e3, np.sqrt((s[:, 0] ** 2 + s[:, 1] ** 2) / 2), atol=1e-9)
+    S = np.sqrt((s[:, 0] ** 2 + s[:, 1] ** 2) / 2)          # pooled single-reading S_i
+    # _std = u of the bidirectional mean of 2 x 5 readings; S_i in its own column
+    assert np.allclose(t.std["EXX"] * 1e3, S / np.sqrt(2 * 5), atol=1e-9)
+    with open(tab / "X.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert np.allclose([float(r["S_X_um"]) for r in rows], S, atol=1e-9)
     assert np.allclose(t.reversal * 1e3, xm[:, 0] - xm[:, 1], atol=1e-9)
     assert np.allclose(t.values["EXX"] * 1e3, rep["mean_um"], atol=1e-9)
     funcs = ErrorFunctions.from_dir(tab, "MB1")
@@ -194,6 +199,8 @@ GOOD = [f"{t},{c},{d},{0.1 * c}" for t in (0, 100) for c in (1, 2) for d in ("+1
     ([r if r != "0,1,+1,0.1" else "0,1,+1,nan" for r in GOOD], "NaN"),
     ([r if r != "0,1,+1,0.1" else "0,1,+1,0,1" for r in GOOD], "fields"),
     ([r if r != "0,1,+1,0.1" else "0,1,0,0.1" for r in GOOD], "direction"),
+    ([r if r != "0,1,+1,0.1" else "0,1.5,+1,0.1" for r in GOOD],
+     "cycle = '1.5': cycle must be an integer"),
 ])
 def test_bad_long_input(tmp_path, capsys, rows, message):
     assert message in _bad(tmp_path, capsys, _long(rows))
@@ -238,6 +245,11 @@ def test_help_documents_both_formats(capsys):
     out = capsys.readouterr().out
     assert "target_mm,cycle,direction,deviation_um" in out
     assert "target_mm,fwd_1_um,bwd_1_um" in out
+    # which uncertainty setting the table fits
+    assert "S_i / sqrt(2 n)" in out and "--table-std systematic" in out
+    assert main(["uncertainty", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "iso230-2 --table-out" in out and "S/sqrt(2n)" in out
 
 
 def test_two_outputs_the_same_file_refused(tmp_path, capsys):
@@ -245,3 +257,69 @@ def test_two_outputs_the_same_file_refused(tmp_path, capsys):
     assert run_cli(f, "--json", tmp_path / "a.out", "--html", tmp_path / "a.out") == 2
     assert "two outputs are the same file" in capsys.readouterr().err
     assert not (tmp_path / "a.out").exists()
+
+
+@pytest.mark.parametrize("head, factor", [("Target (mm)", 1.0), ("target", 1.0),
+                                          ("Target [mm]", 1.0), ("position_mm", 1.0),
+                                          ("target position (mm)", 1.0), ("Target [um]", 1e3),
+                                          ("TARGET_MM", 1.0)])
+def test_target_column_unit_spellings(tmp_path, head, factor):
+    """The target column takes the unit spellings of the reading columns, in both formats."""
+    dev = simulated()
+    ref = read_run(write_wide(tmp_path / "ref.csv", dev))
+    wide = write_wide(tmp_path / "w.csv", dev)
+    lines = wide.read_text().splitlines()
+    body = [",".join([f"{float(r.split(',')[0]) * factor:g}"] + r.split(",")[1:])
+            for r in lines[1:]]
+    wide.write_text("\n".join([lines[0].replace("target_mm", head, 1)] + body) + "\n")
+    long = write_long(tmp_path / "l.csv", dev)
+    ll = long.read_text().splitlines()
+    lbody = [",".join([f"{float(r.split(',')[0]) * factor:g}"] + r.split(",")[1:])
+             for r in ll[1:]]
+    long.write_text("\n".join([ll[0].replace("target_mm", head, 1)] + lbody) + "\n")
+    for f in (wide, long):
+        r = read_run(f)
+        assert np.allclose(r.targets, TARGETS) and np.array_equal(r.deviation, ref.deviation)
+
+
+def test_deviation_column_unit_spellings(tmp_path):
+    dev = simulated()
+    ref = read_run(write_long(tmp_path / "a.csv", dev))
+    for head, scale in (("Deviation (um)", 1.0), ("deviation [mm]", 1e-3), ("deviation", 1.0)):
+        r = read_run(write_long(tmp_path / "b.csv", dev, dev_header=head, scale=scale))
+        assert np.allclose(r.deviation, ref.deviation, atol=1e-15), head
+
+
+def test_two_target_columns_refused_target_preferred_to_position(tmp_path, capsys):
+    assert "both give the target position" in _bad(
+        tmp_path, capsys, "target_mm,Target (mm),fwd_1,bwd_1,fwd_2,bwd_2\n"
+                          "0,0,1,2,3,4\n100,100,1,2,3,4\n")
+    f = tmp_path / "p.csv"      # an extra 'position' column (e.g. actual) loses to 'target'
+    f.write_text("position_mm,target_mm,fwd_1,bwd_1,fwd_2,bwd_2\n5,0,1,2,3,4\n"
+                 "105,100,1,2,3,4\n")
+    assert np.allclose(read_run(f).targets, [0.0, 100.0])
+
+
+def test_table_std_is_the_uncertainty_of_the_mean_deviation():
+    """Statistical check of the chain iso230-2 -> uncertainty (--table-std systematic): over
+    many simulated runs of one machine (fixed error function + N(0, sigma) per reading, fixed
+    reversal), the scatter of the tabulated mean deviation EXX is what _std states, sigma /
+    sqrt(2 n), not the single-reading sigma."""
+    from volerr.positioning import PositioningRun, error_table, evaluate
+
+    rng = np.random.default_rng(11)
+    n, sigma, runs = 4, 0.8e-3, 600
+    truth = 1e-3 * (5.0 * np.sin(TARGETS / 200.0))
+    base = truth[:, None, None] + np.array([1.5e-3, -1.5e-3])[None, :, None]
+    exx, std = [], []
+    for _ in range(runs):
+        dev = base + rng.normal(0.0, sigma, (TARGETS.size, 2, n))
+        t = error_table(evaluate(PositioningRun("X", TARGETS, tuple("1234"), dev)))
+        exx.append(t.values["EXX"])
+        std.append(t.std["EXX"])
+    scatter = np.std(np.array(exx) - truth, axis=0, ddof=1)      # per target, over runs
+    expected = sigma / np.sqrt(2 * n)
+    # the std of a std estimate from 600 runs: relative 1/sqrt(2*599) ~ 3 %; pooled targets
+    assert np.mean(scatter) == pytest.approx(expected, rel=0.05)
+    assert np.sqrt(np.mean(np.array(std) ** 2)) == pytest.approx(expected, rel=0.05)
+    assert np.mean(scatter) < 0.5 * sigma      # clearly not the single-reading repeatability
