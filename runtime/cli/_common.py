@@ -55,9 +55,28 @@ def parse_at(items) -> dict:
     return out
 
 
-def inputs_of(args) -> list:
-    """Files that must never be overwritten: the error tables and a layout file."""
+def inputs_of(args, model=None) -> list:
+    """Files that must never be overwritten: the error tables and a layout file (shipped
+    layouts are package files, protected by :class:`volerr.fileio.Outputs` anyway)."""
     files = volmap.error_dir_inputs(args.errors)
-    if str(args.layout).endswith(".toml"):
-        files.append(Path(args.layout))
+    files.extend(layout_inputs(args.layout))
     return files
+
+
+def layout_inputs(layout) -> list:
+    """``[path]`` when LAYOUT names an existing file, else ``[]`` (a shipped name)."""
+    p = Path(str(layout))
+    return [p] if p.is_file() else []
+
+
+def progress(iterable, total=None, **kw):
+    """``tqdm`` progress on stderr when stderr is a terminal; the plain iterable otherwise."""
+    import sys
+
+    if not sys.stderr.isatty():
+        return iterable
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover
+        return iterable
+    return tqdm(iterable, total=total, file=sys.stderr, leave=False, **kw)

@@ -26,7 +26,8 @@ from volerr.machine.layout import layout_names
 def register(sub) -> None:
     p = sub.add_parser("audit", help="derived equations against the printed ones (errata)")
     p.add_argument("layouts", nargs="*", metavar="LAYOUT",
-                   help="restrict to these layouts (default: every audited equation)")
+                   help="restrict to these layouts, by name or layout file (default: every "
+                        "audited equation)")
     p.add_argument("--json", metavar="F", help="write the verdicts with evidence as JSON")
     p.add_argument("--detail", action="store_true",
                    help="one row per component (dX, RY2, the rule of dx(X) ...)")
@@ -140,12 +141,42 @@ def numeric_table(layouts: list[str] | None, points: int) -> str:
     return "\n".join(lines)
 
 
+def _layout_names(items) -> list:
+    """Layout names; a layout file counts as the layout it names (``name = ...``)."""
+    import sys
+    from pathlib import Path
+
+    from volerr.machine.layout import read_layout
+
+    names = []
+    for item in items or []:
+        p = Path(item)
+        if p.suffix.lower() == ".toml" or p.is_file():
+            require(p.is_file(), f"layout file {p} does not exist")
+            lay = read_layout(str(p))
+            names.append(lay.name)
+            if lay.name in layout_names() and lay.sha256 != read_layout(lay.name).sha256:
+                print(f"volerr audit: note: {p} differs from the shipped layout {lay.name}: the "
+                      f"printed equations are audited against the derivation of the shipped "
+                      f"{lay.name}", file=sys.stderr)
+        else:
+            names.append(item)
+    return names
+
+
 def run(args) -> int:
+    from volerr.cli._common import layout_inputs
+    from volerr.fileio import Outputs
+
     require(args.points >= 1, "--points must be at least 1")
+    inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]
+    outs = Outputs(inputs).file("--json", args.json).check()
+    args.layouts = _layout_names(args.layouts)
     mods, verdicts = collect(args.layouts)
     if args.json:
         text = json.dumps([v.as_dict() for v in verdicts], indent=1, ensure_ascii=False)
-        write_text(args.json, text + "\n", inputs=_data_paths(mods))
+        with outs:
+            write_text(outs.path("--json"), text + "\n", inputs=_data_paths(mods))
     if args.detail:
         rows = [{"source": v.source, "equation": v.equation, "layout": v.layout,
                  "verdict": (v.verdict + (f" {v.component}" if v.component else "")),

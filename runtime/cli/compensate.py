@@ -24,7 +24,8 @@ from pathlib import Path
 
 from volerr.cli._common import add_error_arguments
 from volerr.errors import InputError, require
-from volerr.fileio import check_output, write_bytes, write_text
+from volerr.cli._common import layout_inputs
+from volerr.fileio import Outputs, write_bytes, write_text
 
 
 def register(sub) -> None:
@@ -116,30 +117,31 @@ def run(args) -> int:
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
     text = gcode.read_program(args.program)
-    inputs = [args.program, *Path(args.errors).glob("*.csv")]
-    for out in (args.out, args.report, args.json, args.plot):
-        if out:
-            check_output(out, inputs)
-    require(not args.plot or str(args.plot).lower().endswith(".png"),
-            f"plot file must end in .png, got {args.plot}")
+    inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
+    outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
+        .file("--json", args.json).plot("--plot", args.plot).check()
     result = compensate_program(
         model, funcs, text, tool=args.tool, orientation=args.orientation,
         strategy=args.strategy, tol_um=args.tol_um, decimals=args.decimals,
         initial=_initial(args.initial), check_travel=not args.ignore_travel,
         types=None if args.types is None else [t for t in args.types.split(",") if t.strip()])
-    write_bytes(args.out, result.text.encode("latin-1"), inputs)
     s = result.summary()
-    if args.report:
-        write_text(args.report, report_csv(model, result.reports), inputs)
-    if args.json:
-        write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
-                                          "orientation": bool(args.orientation),
-                                          "types": args.types or "L-VOL,R-VOL", **s},
-                                         indent=2) + "\n", inputs)
-    if args.plot:
-        from volerr.fiveaxis.plots import plot_program_errors
+    require(s["motion_blocks"] > 0, f"{args.program}: no motion block to compensate (an empty "
+                                    "program or one without axis words)")
+    with outs:
+        write_bytes(outs.path("--out"), result.text.encode("latin-1"), inputs)
+        if args.report:
+            write_text(outs.path("--report"), report_csv(model, result.reports), inputs)
+        if args.json:
+            write_text(outs.path("--json"), json.dumps(
+                {"layout": model.name, "strategy": args.strategy,
+                 "orientation": bool(args.orientation), "types": args.types or "L-VOL,R-VOL",
+                 **s}, indent=2) + "\n", inputs)
+        if args.plot:
+            from volerr.fiveaxis.plots import plot_program_errors
 
-        plot_program_errors(result.reports, args.plot, title=f"{model.name}: {args.program}")
+            plot_program_errors(result.reports, outs.path("--plot"),
+                                title=f"{model.name}: {args.program}")
     print(f"{model.name}: {s['compensated']} of {s['motion_blocks']} motion blocks compensated "
           f"({args.strategy}{', orientation' if args.orientation else ''}"
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "

@@ -75,6 +75,23 @@ def _vec(text, what):
     return v
 
 
+def _refuse_repeated_files(files) -> None:
+    """The same tracker file given twice would count its rounds twice (understated Type A
+    uncertainty)."""
+    import os
+    from pathlib import Path
+
+    seen = []
+    for f in files:
+        p = Path(f)
+        for q in seen:
+            same = p.resolve() == q.resolve() or (
+                p.exists() and q.exists() and os.path.samefile(p, q))
+            require(not same, f"tracker file {f} is given twice (its rounds would be counted "
+                              f"twice)")
+        seen.append(p)
+
+
 def read_rounds(files, fmt="csv", positions=None, points=None):
     """Rounds from the input files (both formats)."""
     from volerr.identify.tracker_io import parse_positions, read_thesis_export, read_tracker_csv
@@ -112,18 +129,17 @@ def residual_csv(result) -> str:
 
 
 def run(args) -> int:
-    from volerr.fileio import check_output, write_text
+    from volerr.fileio import Outputs, write_text
     from volerr.identify.solve import identify, to_model_signs
     from volerr.machine.layout import read_layout
     from volerr.tables.table import table_to_csv
 
-    inputs = list(args.files)
-    outs = [o for o in (args.out, args.residuals, args.json, args.plot) if o]
-    for o in outs:
-        check_output(o, inputs)
-    require(len(set(outs)) == len(outs), "output files must differ from each other")
-    require(not args.plot or str(args.plot).lower().endswith(".png"),
-            f"plot file must end in .png, got {args.plot}")
+    from volerr.cli._common import layout_inputs
+
+    inputs = list(args.files) + layout_inputs(args.layout)
+    _refuse_repeated_files(args.files)
+    outs = Outputs(inputs).file("--out", args.out).file("--residuals", args.residuals) \
+        .file("--json", args.json).plot("--plot", args.plot).check()
     layout = read_layout(args.layout)
     rounds = read_rounds(args.files, args.format, args.positions, args.points)
     sense = {"auto": "auto", "+": 1, "-": -1}[args.sense]
@@ -144,14 +160,15 @@ def run(args) -> int:
         from volerr.tables.errorfit import fit_table
         fits = fit_table(table, args.fit, weighted=table.std != {})
         summary["fit"] = [f.report() for f in fits.values()]
-    if args.plot:
-        from volerr.identify.plots import plot_identification
-        plot_identification(result, args.plot, fits)
-    write_text(args.out, text, inputs=inputs)
-    if args.residuals:
-        write_text(args.residuals, residual_csv(result), inputs=inputs)
-    if args.json:
-        write_text(args.json, json.dumps(summary, indent=2) + "\n", inputs=inputs)
+    with outs:
+        if args.plot:
+            from volerr.identify.plots import plot_identification
+            plot_identification(result, outs.path("--plot"), fits)
+        write_text(outs.path("--out"), text, inputs=inputs)
+        if args.residuals:
+            write_text(outs.path("--residuals"), residual_csv(result), inputs=inputs)
+        if args.json:
+            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
     s = summary
     print(f"{args.axis}: {s['n_positions']} positions x {len(s['points'])} points x "
           f"{s['n_rounds']} round(s), method {s['method']}, condition {s['condition']:.3g}, "

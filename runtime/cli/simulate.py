@@ -66,11 +66,17 @@ def run(args) -> int:
 
     require(10 <= args.points <= 10_000_000, "--points must be between 10 and 10^7")
     require(args.noise_um >= 0 and args.magnitude_um >= 0, "noise and magnitude must be >= 0")
+    from volerr.cli._common import layout_inputs
+    from volerr.fileio import Outputs
+
     model = load(args.layout)
+    inputs = layout_inputs(args.layout)
+    outs = Outputs(inputs).file("--out", args.out).check()
     probes = [_probe(t) for t in args.probe] if args.probe else demo_probes(model)
     camp = simulate(args.layout, n_points=args.points, seed=args.seed, probes=probes,
                     rounds=args.rounds, effects=[_effect(e) for e in args.effect],
                     noise_um=args.noise_um, magnitude_um=args.magnitude_um)
-    path = camp.write_csv(args.out, inputs=[args.layout])
-    print(f"{camp.n_points} points of {model.name} -> {path}")
+    with outs:
+        camp.write_csv(outs.path("--out"), inputs=inputs)
+    print(f"{camp.n_points} points of {model.name} -> {args.out}")
     return 0
