@@ -184,27 +184,39 @@ def _index(out: Path, results: list) -> None:
 
 
 def run(args) -> int:
-    out = Path(args.out)
-    require(not out.exists() or out.is_dir(), f"--out {out} exists and is not a folder")
-    steps = {
-        "cmm_a": lambda: _cmm(out, "MB1", "CMM A of Pahk"),
-        "cmm_b": lambda: _cmm(out, "MH2", "CMM B of Pahk"),
-        "audit": lambda: _audit(out),
-        "probe": lambda: _probe(out),
-        "identify": lambda: _identify(out),
-        "fiveaxis": lambda: _fiveaxis(out),
-        "loop": lambda: _loop(out),
-    }
-    out.mkdir(parents=True, exist_ok=True)
+    import os
+
+    from volerr.fileio import Outputs
+
+    final = Path(args.out)
+    outs = Outputs().folder("--out", final).check()
     results = []
     t0 = time.perf_counter()
-    for name in args.only or SECTIONS:
-        t = time.perf_counter()
-        r = steps[name]()
-        r["seconds"] = round(time.perf_counter() - t, 1)
-        results.append(r)
-        print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
-    _index(out, results)
-    write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
-    print(f"report: {out / 'index.html'}  ({time.perf_counter() - t0:.0f} s)")
+    here = os.getcwd()
+    with outs:
+        staged = outs.path("--out")
+        os.chdir(staged)  # relative paths: the reports name files as they will be found
+        try:
+            out = Path(".")
+            steps = {
+                "cmm_a": lambda: _cmm(out, "MB1", "CMM A of Pahk"),
+                "cmm_b": lambda: _cmm(out, "MH2", "CMM B of Pahk"),
+                "audit": lambda: _audit(out),
+                "probe": lambda: _probe(out),
+                "identify": lambda: _identify(out),
+                "fiveaxis": lambda: _fiveaxis(out),
+                "loop": lambda: _loop(out),
+            }
+            for name in args.only or SECTIONS:
+                t = time.perf_counter()
+                r = steps[name]()
+                r["section"] = name
+                r["seconds"] = round(time.perf_counter() - t, 1)
+                results.append(r)
+                print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
+            _index(out, results)
+            write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
+        finally:
+            os.chdir(here)
+    print(f"report: {final / 'index.html'}  ({time.perf_counter() - t0:.0f} s)")
     return 0
