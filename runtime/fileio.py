@@ -97,6 +97,29 @@ def write_bytes(path, data: bytes, inputs=()) -> Path:
     return out
 
 
+#: the largest magnitude accepted for a number read from a data file (mm, um, urad, deg ...):
+#: far beyond any machine, small enough that squares and sums stay finite
+MAX_ABS = 1e9
+
+
+def check_magnitude(value: float, where: str) -> float:
+    """Refuse NaN, infinity and magnitudes above :data:`MAX_ABS` (one line)."""
+    import math
+
+    require(math.isfinite(value), f"{where} is NaN or infinite")
+    require(abs(value) <= MAX_ABS, f"{where} = {value:g} is implausibly large (more than "
+                                   f"{MAX_ABS:g} in the file's unit)")
+    return value
+
+
+def check_header(cells, where: str) -> None:
+    """Refuse a header with an empty or a repeated column name (the second would be ignored)."""
+    names = [c.strip().lower() for c in cells]
+    require(all(names), f"{where}: empty column name in header")
+    dup = sorted({c for c in names if names.count(c) > 1})
+    require(not dup, f"{where}: column {dup[0] if dup else ''!r} appears twice in the header")
+
+
 def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
     """(line number, stripped cells) of every row of a UTF-8 CSV file (a BOM is allowed);
     blank rows and rows whose first cell starts with '#' are skipped.  ``missing``/``empty``:

@@ -22,7 +22,7 @@ import json
 import math
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments
+from volerr.cli._common import add_error_arguments, add_vector
 from volerr.errors import InputError, require
 from volerr.cli._common import layout_inputs
 from volerr.fileio import Outputs, write_bytes, write_text
@@ -46,10 +46,10 @@ def register(sub) -> None:
                    help="ISO/TR 16907 compensation types to apply, comma separated: L-POS "
                         "L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG, or L-VOL R-VOL (default: "
                         "all); the report still predicts the full model's error")
-    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
-                   metavar=("XT", "YT", "ZT"),
-                   help="tool-tip offset in the tool frame, mm, beyond the point the axis "
-                        "positions refer to (default 0 0 0: the program positions the tip)")
+    add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
+               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z), beyond "
+                    "the point the axis positions refer to (0 0 0: the program positions the "
+                    "tip)")
     p.add_argument("--tol-um", type=float, default=0.1,
                    help="stop iterating when the correction changes by less than this (um)")
     p.add_argument("--decimals", type=int, default=4,

@@ -12,7 +12,8 @@ from __future__ import annotations
 import json
 import sys
 
-from volerr.errors import InputError, require
+from volerr.cli._common import add_vector
+from volerr.errors import require
 
 
 def register(sub) -> None:
@@ -35,15 +36,15 @@ def register(sub) -> None:
     p.add_argument("--method", choices=("lsq", "closed"), default="lsq",
                    help="lsq: weighted least squares over all points (default); closed: Zhang "
                         "& Hu closed form of six selected equations")
-    p.add_argument("--tracker", metavar="X,Y,Z",
-                   help="tracker position in the measurement frame (mm): weights the points "
-                        "with the AT960 uncertainty model and writes _u95 columns (write --tracker=-1,2,3 "
-                        "when the first number is negative)")
-    p.add_argument("--direction", metavar="X,Y,Z", help="axis direction in the measurement "
-                                                        "frame (default: the layout's)")
-    p.add_argument("--origin", metavar="X,Y,Z", help="a point on a rotary axis in the "
-                                                     "measurement frame, mm (default 0,0,0), "
-                                                     "or 'layout': the axis point of the layout")
+    add_vector(p, "--tracker",
+               help="tracker position X Y Z in the measurement frame, mm (X Y Z or X,Y,Z): "
+                    "weights the points with the AT960 uncertainty model and writes _u95 "
+                    "columns (not given: unweighted, no _u95)")
+    add_vector(p, "--direction", help="axis direction X Y Z in the measurement frame (not "
+                                      "given: the layout's)")
+    p.add_argument("--origin", nargs="+", metavar="X",
+                   help="a point X Y Z on a rotary axis in the measurement frame, mm (X Y Z or "
+                        "X,Y,Z; not given: 0 0 0), or 'layout': the axis point of the layout")
     p.add_argument("--sense", choices=("auto", "+", "-"), default="auto",
                    help="sense of the nominal motion of the points (default: from the data)")
     p.add_argument("--max-cond", type=float, default=1e4,
@@ -67,12 +68,9 @@ def register(sub) -> None:
 
 
 def _vec(text, what):
-    try:
-        v = [float(c) for c in str(text).split(",")]
-    except ValueError:
-        raise InputError(f"{what} must be three comma-separated numbers, got {text!r}") from None
-    require(len(v) == 3, f"{what} must be three comma-separated numbers, got {text!r}")
-    return v
+    from volerr.cli._common import parse_vector
+
+    return list(parse_vector(text, what))
 
 
 def _refuse_repeated_files(files) -> None:
@@ -147,7 +145,7 @@ def run(args) -> int:
         rounds, layout, args.axis, method=args.method,
         tracker=_vec(args.tracker, "--tracker") if args.tracker else None,
         direction=_vec(args.direction, "--direction") if args.direction else None,
-        origin=("layout" if args.origin == "layout" else
+        origin=("layout" if args.origin == ["layout"] else
                 _vec(args.origin, "--origin") if args.origin else None),
         sense=sense, max_cond=args.max_cond, outlier_k=args.outlier_k)
     table = result.table()

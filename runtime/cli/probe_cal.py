@@ -15,6 +15,7 @@ import json
 import math
 import sys
 
+from volerr.cli._common import add_vector
 from volerr.errors import InputError, require
 from volerr.fileio import write_text
 
@@ -58,8 +59,8 @@ def register(sub) -> None:
                    help="write a probing plan (nominal ball centres x,y,z,phi_deg,theta_deg) "
                         "instead of calibrating")
     g.add_argument("--ball-radius", type=float, metavar="r", help="stylus-ball radius, mm")
-    g.add_argument("--center", default="0,0,0", metavar="X,Y,Z",
-                   help="sphere centre, mm (default 0,0,0)")
+    add_vector(g, "--center", default=(0.0, 0.0, 0.0),
+               help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
     g.add_argument("--step-deg", type=float, default=18.0,
                    help="Pahk plan: latitude and azimuth step, deg (default 18)")
     g.add_argument("--circles", type=int, default=5,
@@ -89,7 +90,7 @@ def _run_plan(args) -> int:
     require(args.ball_radius is not None and args.ball_radius > 0,
             "--plan needs --ball-radius (stylus-ball radius, mm, > 0)")
     require(args.sphere_radius > 0, "--sphere-radius must be > 0 mm")
-    center = _floats(args.center, "--center", 3)
+    center = list(args.center)
     if args.phis or args.per_circle:
         require(args.phis and args.per_circle, "a custom plan needs both --phis and --per-circle")
         plan = pp.circles_plan(_floats(args.phis, "--phis"), args.per_circle, not args.no_pole)

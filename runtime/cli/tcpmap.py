@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments
+from volerr.cli._common import add_error_arguments, add_vector
 from volerr.errors import require
 from volerr.cli._common import layout_inputs
 from volerr.fileio import Outputs, write_text
@@ -24,10 +24,10 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("layout", help="five-axis layout name or file")
     add_error_arguments(p)
-    p.add_argument("--point", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"),
-                   help="workpiece point, mm (workpiece frame)")
-    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
-                   metavar=("XT", "YT", "ZT"), help="tool-tip offset in the tool frame, mm")
+    add_vector(p, "--point", required=True,
+               help="workpiece point X Y Z, mm, workpiece frame (X Y Z or X,Y,Z)")
+    add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
+               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z)")
     p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
     p.add_argument("--out", required=True, help="PNG file")
     p.add_argument("--csv", help="grid as CSV")

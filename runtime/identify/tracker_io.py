@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.errors import InputError, require
-from volerr.fileio import read_csv_rows
+from volerr.fileio import check_header, check_magnitude, read_csv_rows
 
 REQUIRED = ("round", "point", "position", "x", "y", "z")
 
@@ -62,10 +62,12 @@ def _num(path, lineno, what, text) -> float:
     except ValueError:
         raise InputError(f"{path}:{lineno}: {what} {text!r} is not a number") from None
     require(math.isfinite(v), f"{path}:{lineno}: {what} is {text} (NaN or infinite)")
-    return v
+    return check_magnitude(v, f"{path}:{lineno}: {what}")
 
 
 def _header_index(path, header):
+    check_header([{"x_mm": "x", "y_mm": "y", "z_mm": "z"}.get(h.strip().lower(), h)
+                  for h in header], str(path))
     norm = [h.strip().lower() for h in header]
     alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
     norm = [alias.get(h, h) for h in norm]

@@ -61,7 +61,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.errors import InputError, require
-from volerr.fileio import read_csv_rows, write_text
+from volerr.fileio import check_magnitude, read_csv_rows, write_text
 
 #: unit suffix -> (kind, factor to mm or rad)
 UNITS = {"um": ("length", 1e-3), "mm": ("length", 1.0), "urad": ("angle", 1e-6), "rad": ("angle", 1.0)}
@@ -188,7 +188,7 @@ def _number(path, lineno, column, text) -> float:
     except ValueError:
         raise InputError(f"{path}:{lineno}: {column} = {text!r} is not a number") from None
     require(math.isfinite(v), f"{path}:{lineno}: {column} = {text} (NaN or infinite)")
-    return v
+    return check_magnitude(v, f"{path}:{lineno}: {column}")
 
 
 def _parse_column(path, col: str, axis: str):
