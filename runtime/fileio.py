@@ -293,8 +293,8 @@ class Outputs:
                     f = p / name
                     self._refuse_target(role, f)
                     key = f.resolve()
-                    require(key not in finals, f"{role} writes {f}, which is also "
-                                               f"{finals.get(key)}")
+                    require(key not in finals, f"{role} {p} and {finals.get(key)} name the "
+                                               f"same file {f}")
                     finals[key] = f"{role} {p}"
             else:
                 require(not p.is_dir(), f"{role} {p}: is a folder, give a file name")
