@@ -113,6 +113,8 @@ def add_vector(parser, flag: str, help: str, default=None, required: bool = Fals
     import argparse
 
     class _Vector(argparse.Action):
+        vector = True
+
         def __call__(self, p, namespace, values, option_string=None):
             try:
                 v = parse_vector(values, option_string)
@@ -124,6 +126,6 @@ def add_vector(parser, flag: str, help: str, default=None, required: bool = Fals
                 v = items
             setattr(namespace, self.dest, v)
 
-    parser.add_argument(flag, nargs="+", action=_Vector, default=default, required=required,
-                        metavar=metavar.split()[0] if " " in metavar else metavar,
-                        help=help)
+    act = parser.add_argument(flag, nargs="+", action=_Vector, default=default,
+                              required=required, metavar=metavar, help=help)
+    act.vector = True

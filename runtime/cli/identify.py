@@ -56,7 +56,7 @@ def register(sub) -> None:
                         "smoothing spline by GCV) and report their residuals (JSON, plot)")
     p.add_argument("--residuals", help="write per-position, per-point residuals (CSV, um)")
     p.add_argument("--signs", choices=("component", "model"), default="component",
-                   help="component (default, as the thesis and INTERFACE.md): the error motions "
+                   help="component (as the thesis; 'volerr formats tracker'): the error motions "
                         "of the moving component that carries the points; model: the volerr "
                         "model's tool-relative convention (for a table axis of LAYOUT: negated "
                         "and re-referenced to the tool point; a linear axis measured from a "

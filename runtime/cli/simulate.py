@@ -3,7 +3,7 @@
 The machine of LAYOUT (exact chain, random smooth error functions by seed) measured at
 random points with several probe/tool offsets, Gaussian noise, an unknown instrument
 placement, and optionally undeclared effects (``--effect``).  Writes the measured-deviation
-CSV of INTERFACE.md.  See :mod:`volerr.loop.simulate`.
+CSV ('volerr formats deviations').  See volerr.loop.simulate.
 """
 
 from __future__ import annotations
