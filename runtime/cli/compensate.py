@@ -113,6 +113,8 @@ def run(args) -> int:
     from volerr.machine.model import load
 
     model = load(args.layout)
+    require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
+                                              f"directory (the folder holding X.csv ...)")
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)

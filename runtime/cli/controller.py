@@ -48,6 +48,8 @@ def run(args) -> int:
 
     model = load(args.layout)
     if args.action == "export":
+        require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
+                                                  f"directory (the folder holding X.csv ...)")
         require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
         tables, (consts, _, _) = read_error_dir(args.errors, model.axes)
         ct.check_against_model(model, tables, consts, args.errors)

@@ -9,6 +9,7 @@ closed`` for the Zhang & Hu closed form), averages the rounds and writes the err
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 
@@ -25,14 +26,20 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="tracker data file(s)")
     p.add_argument("--axis", required=True, help="the measured axis (X, Y, Z, B, C ...)")
-    p.add_argument("--out", required=True, help="output error table (CSV)")
+    p.add_argument("--out", required=True, metavar="DIR/A.csv",
+                   help="output error table (CSV).  For 'volerr squareness' and 'volerr map' "
+                        "name it after the axis inside an error directory: DIR/X.csv, "
+                        "DIR/Y.csv ... (add constants.csv there for squareness / location "
+                        "errors)")
     p.add_argument("--format", choices=("csv", "thesis"), default="csv",
                    help="csv: round,point,position,x,y,z (default); thesis: the raw export of "
                         "the thesis, blocks of label,x,y,z rows, one file per round")
     p.add_argument("--positions", help="thesis format: commanded positions, start:stop:count "
                                        "or a comma list")
-    p.add_argument("--points", help="thesis format: labels of the point blocks in file order, "
-                                    "e.g. K,P,Q (default: the first label of each block)")
+    p.add_argument("--labels", dest="points",
+                   help="thesis format: labels of the point blocks in file order, e.g. K,P,Q "
+                        "(default: the first label of each block)")
+    p.add_argument("--points", dest="points", help=argparse.SUPPRESS)  # old name of --labels
     p.add_argument("--method", choices=("lsq", "closed"), default="lsq",
                    help="lsq: weighted least squares over all points (default); closed: Zhang "
                         "& Hu closed form of six selected equations")
@@ -105,7 +112,7 @@ def read_rounds(files, fmt="csv", positions=None, points=None):
             rounds.append(read_thesis_export(f, pos, labels))
     else:
         require(positions is None and points is None,
-                "--positions and --points apply to --format thesis only")
+                "--positions and --labels apply to --format thesis only")
         for f in files:
             rounds.extend(read_tracker_csv(f))
     return rounds

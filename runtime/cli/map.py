@@ -21,7 +21,8 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
     p.add_argument("--grid", nargs="+", type=int, default=None, metavar="N",
-                   help="grid points per axis: N, or nx ny nz (default 5)")
+                   help="grid points per axis: N, or nx ny nz (default 5; 2..200 per axis, at "
+                        "most 10^6 points in all: N <= 100)")
     p.add_argument("--out", metavar="CSV", help="map CSV: axis positions, Xp Yp Zp, dx_um dy_um "
                                                 "dz_um (+ rx_um ry_um rz_um)")
     p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")

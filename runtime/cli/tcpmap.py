@@ -48,6 +48,8 @@ def run(args) -> int:
     require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")
     require(all(math.isfinite(v) for v in (*args.point, *args.tool)), "point/tool must be finite")
     require(3 <= args.steps <= 1000, "--steps must be 3..1000")
+    require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
+                                              f"directory (the folder holding X.csv ...)")
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)

@@ -71,7 +71,7 @@ def grid_counts(grid) -> tuple:
         grid = grid * 3
     require(all(2 <= g <= 200 for g in grid), f"grid counts must be between 2 and 200, got {grid}")
     require(int(np.prod(grid)) <= 1_000_000, f"grid of {int(np.prod(grid))} points is too large "
-                                             f"(at most 1000000)")
+                                             f"(at most 1000000 points: N <= 100 for --grid N)")
     return tuple(grid)
 
 

@@ -171,6 +171,10 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header and (line number, cells) of a CSV file; blank and '#' lines skipped."""
     rows = read_csv_rows(path, empty=f"{path}: empty file (no header)")
     (_, header), body = rows[0], rows[1:]
+    for sep, word in ((";", "semicolons"), ("\t", "tabs")):
+        require(not (len(header) == 1 and sep in header[0]),
+                f"{path}: columns separated by {word}; volerr reads comma-separated CSV "
+                f"(export with ',' as separator and '.' as decimal point)")
     require(all(header), f"{path}: empty column name in header")
     dup = sorted({h for h in header if header.count(h) > 1})
     if dup:
@@ -376,6 +380,8 @@ def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]
     ``axes``: the axes the machine has; a table for any other axis, or any other CSV file,
     is refused."""
     d = Path(directory)
+    require(not d.is_file(), f"{d} is a file, not an error directory (give the folder that "
+                             f"holds X.csv, Y.csv ... and constants.csv)")
     require(d.is_dir(), f"error directory {d} does not exist")
     tables, consts = {}, ({}, {}, {})
     allowed = None if axes is None else set(axes)
