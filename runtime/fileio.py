@@ -182,6 +182,11 @@ def _staged(path) -> bool:
 
 # ---------------------------------------------------------------------------------------------
 # the output plan
+def _same(role, other, path) -> str:
+    return (f"two outputs are the same file {path}: {role} and {other} would overwrite each "
+            f"other")
+
+
 class Outputs:
     """Every output of one command run: declared and checked before computing, written at the
     end, all or nothing.
@@ -293,8 +298,7 @@ class Outputs:
                     f = p / name
                     self._refuse_target(role, f)
                     key = f.resolve()
-                    require(key not in finals, f"{role} {p} and {finals.get(key)} name the "
-                                               f"same file {f}")
+                    require(key not in finals, _same(f"{role} {p}", finals.get(key), f))
                     finals[key] = f"{role} {p}"
             else:
                 require(not p.is_dir(), f"{role} {p}: is a folder, give a file name")
@@ -303,8 +307,7 @@ class Outputs:
                             f"{role}: plot file must end in .png, got {p.name}")
                 self._refuse_target(role, p)
                 key = p.resolve()
-                require(key not in finals,
-                        f"{role} and {finals.get(key)} name the same file {p}")
+                require(key not in finals, _same(role, finals.get(key), p))
                 finals[key] = role
                 self._probe_writable(role, p.parent, p)
         # a file inside a folder whose file names are not known in advance
@@ -383,7 +386,7 @@ class Outputs:
             for _, final, role in moves:
                 self._refuse_target(role, final)
                 key = final.resolve()
-                require(key not in seen, f"{role} and {seen.get(key)} name the same file {final}")
+                require(key not in seen, _same(role, seen.get(key), final))
                 seen[key] = role
             done = []      # (final, backup or None)
             try:

@@ -47,13 +47,17 @@ class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
         text = self._plain(action.help or "")
         default = action.default
         if (default is None or default is False or default is argparse.SUPPRESS
-                or not action.option_strings or "default" in text.lower()
-                or "%(default)" in text):
+                or not action.option_strings or default == [] or "%(default)" in text):
             return text
         if isinstance(default, (list, tuple)):
             shown = " ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in default)
-            return f"{text} (default: {shown})" if shown else text
-        return f"{text} (default: %(default)s)"
+        elif isinstance(default, float):
+            shown = f"{default:g}"
+        else:
+            shown = str(default)
+        if "default" in text.lower() and shown in text:
+            return text  # the help states it already
+        return f"{text} (default: {shown.replace('%', '%%')})"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -62,7 +66,9 @@ class _Parser(argparse.ArgumentParser):
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", _HelpFormatter)
-        kwargs.setdefault("epilog", EPILOG)
+        epilog = kwargs.get("epilog")
+        kwargs["epilog"] = EPILOG if not epilog else (
+            epilog if "volerr formats" in epilog else f"{epilog}\n\n{EPILOG}")
         if kwargs.get("description"):
             kwargs["description"] = _HelpFormatter._plain(kwargs["description"])
         super().__init__(*args, **kwargs)

@@ -97,9 +97,11 @@ def parse_vector(tokens, what: str, n: int = 3) -> tuple:
     try:
         v = tuple(float(c) for c in parts)
     except ValueError:
-        raise InputError(f"{what}: expected {n} numbers (X Y Z or X,Y,Z), got "
+        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got "
                          f"{' '.join(map(str, tokens))!r}") from None
-    require(len(v) == n, f"{what}: expected {n} numbers (X Y Z or X,Y,Z), got {len(v)}")
+    require(len(v) == n, f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got {len(v)}")
     require(all(math.isfinite(c) and abs(c) <= MAX_COORD_MM for c in v),
             f"{what}: numbers must be finite and at most {MAX_COORD_MM:g} mm, got "
             f"{' '.join(map(str, tokens))}")
