@@ -66,8 +66,10 @@ def collect(layouts: list[str] | None):
     for name in layouts or []:
         require(name in known, f"unknown layout {name!r}; audited layouts and shipped layouts: "
                                f"{' '.join(sorted(known))}")
+    from volerr.cli._common import progress
+
     verdicts = []
-    for m in mods:
+    for m in progress(mods, desc="audit", unit="source"):
         covered = getattr(m, "LAYOUTS", None)
         if layouts and covered is not None and not set(layouts) & set(covered):
             continue

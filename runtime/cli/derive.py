@@ -59,7 +59,8 @@ def run(args) -> int:
     for layout in progress(layouts, desc="derive", unit="layout"):
         texts[derivation.module_filename(layout)] = derivation.generate_source(layout)
     if args.all:
-        texts.update(derivation.all_sources())
+        texts.update(derivation.all_sources(
+            lambda names: progress(names, desc="derive --all", unit="layout")))
     with outs:
         for filename, text in texts.items():
             write_text(outs.path("--out") / filename, text, inputs=inputs)
