@@ -110,10 +110,13 @@ def generate_module(layout: Layout) -> str:
     return render_module(header, constants, derive_functions(layout))
 
 
-def all_generated() -> dict:
+def all_generated(progress=None) -> dict:
     """File name -> text of every file of ``generated/``: one module per shipped layout plus
-    the layout-independent modules of :data:`EXTRA_MODULES`."""
-    out = {f"{module_name(n)}.py": generate_module(read_layout(n)) for n in layout_names()}
+    the layout-independent modules of :data:`EXTRA_MODULES`.  ``progress``: optional wrapper
+    of the layout-name iterable (e.g. a tqdm bar)."""
+    names = layout_names()
+    out = {f"{module_name(n)}.py": generate_module(read_layout(n))
+           for n in (progress(names) if progress else names)}
     for filename, target in EXTRA_MODULES.items():
         mod_name, func = target.split(":")
         out[filename] = getattr(importlib.import_module(mod_name), func)()

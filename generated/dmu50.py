@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       6becd7e820c09acbcc33c79ae7d7c211001b2243ca6dc9cd164ea1ac78f83c89
-derivation sha256  7be376daa0704ca00bac394989578bed2d48599ea90b4237d4492ddf3c9a4706
+input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
+derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -23,7 +23,7 @@ probe tip / tool centre point in the workpiece frame, first order unless named e
 import numpy
 
 LAYOUT = 'DMU50'
-LAYOUT_SHA256 = '6becd7e820c09acbcc33c79ae7d7c211001b2243ca6dc9cd164ea1ac78f83c89'
+LAYOUT_SHA256 = '71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac'
 AXES = ('X', 'Y', 'Z', 'B', 'C')
 ROTARY_AXES = ('B', 'C')
 PARAMETERS = ('EXX', 'EYX', 'EZX', 'EAX', 'EBX', 'ECX', 'EXY', 'EYY', 'EZY', 'EAY', 'EBY', 'ECY',

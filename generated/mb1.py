@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       c36a8ee13222ceb6375c8b54545b89e573334f275a5ba9e2b540af123de2e12a
-derivation sha256  7be376daa0704ca00bac394989578bed2d48599ea90b4237d4492ddf3c9a4706
+derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9f5664e7e76c63758343031e2e71c38e0cb7e6231fb10646e63c6605339e98de
-derivation sha256  7be376daa0704ca00bac394989578bed2d48599ea90b4237d4492ddf3c9a4706
+derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -1,10 +1,20 @@
-"""Safe output: never overwrite an input file, create parent folders, write atomically."""
+"""Safe output: never overwrite an input or a package file, check every output before
+computing, write all outputs of a run at the end, all or nothing.
+
+A command declares its outputs up front in an :class:`Outputs` plan (``file``, ``plot``,
+``folder``), calls :meth:`Outputs.check` before any work (writable, not an input, not a file of
+the installed package, distinct from each other, a folder's future files included), writes to
+the staged paths :meth:`Outputs.path` gives, and :meth:`Outputs.commit` (or leaving the
+``with`` block) renames everything into place; any failure removes every staged file and
+restores what was replaced.
+"""
 
 from __future__ import annotations
 
 import csv
 import io
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -14,7 +24,10 @@ from volerr.errors import InputError, require
 def check_output(path, inputs=()) -> Path:
     """Refuse an output path that is one of the input files; return it as a Path."""
     out = Path(path)
+    require(str(path).strip() != "", "empty output file name")
     require(not out.is_dir(), f"{out} is a folder: give a file name for the output")
+    require(not is_package_file(out) or _staged(out),
+            f"refusing to write {out}: it is a file of the installed volerr package")
     for parent in out.parents:
         if parent.exists():
             require(parent.is_dir(), f"cannot write {out}: {parent} is a file, not a folder")
@@ -40,6 +53,8 @@ def check_plot(path, inputs=()) -> Path:
 def check_folder(path) -> Path:
     """An output folder: refuse a path that is an existing file (or lies below one)."""
     d = Path(path)
+    require(not is_package_file(d) or _staged(d),
+            f"refusing to write into {d}: it is a folder of the installed volerr package")
     require(not d.exists() or d.is_dir(), f"{d} is a file, not a folder")
     for parent in d.parents:
         if parent.exists():
@@ -80,6 +95,29 @@ def write_bytes(path, data: bytes, inputs=()) -> Path:
             raise InputError(f"cannot write {out}: {exc.strerror or exc}") from None
         raise
     return out
+
+
+#: the largest magnitude accepted for a number read from a data file (mm, um, urad, deg ...):
+#: far beyond any machine, small enough that squares and sums stay finite
+MAX_ABS = 1e9
+
+
+def check_magnitude(value: float, where: str) -> float:
+    """Refuse NaN, infinity and magnitudes above :data:`MAX_ABS` (one line)."""
+    import math
+
+    require(math.isfinite(value), f"{where} is NaN or infinite")
+    require(abs(value) <= MAX_ABS, f"{where} = {value:g} is implausibly large (more than "
+                                   f"{MAX_ABS:g} in the file's unit)")
+    return value
+
+
+def check_header(cells, where: str) -> None:
+    """Refuse a header with an empty or a repeated column name (the second would be ignored)."""
+    names = [c.strip().lower() for c in cells]
+    require(all(names), f"{where}: empty column name in header")
+    dup = sorted({c for c in names if names.count(c) > 1})
+    require(not dup, f"{where}: column {dup[0] if dup else ''!r} appears twice in the header")
 
 
 def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
@@ -139,3 +177,313 @@ class AtomicFile:
             self.fh.close()
         if os.path.exists(self.tmp):
             os.unlink(self.tmp)
+# ---------------------------------------------------------------------------------------------
+# package protection
+_PACKAGE_ROOTS: list | None = None
+_STAGING: set = set()          # staging folders of open plans: writes there are allowed
+
+
+def package_roots() -> list:
+    """Resolved folders of the installed ``volerr`` package, ``volerr.generated`` and
+    ``volerr.derive``: no command writes there (``volerr derive --in-package`` excepted)."""
+    global _PACKAGE_ROOTS
+    if _PACKAGE_ROOTS is None:
+        import importlib.util
+
+        roots = []
+        for name in ("volerr", "volerr.generated", "volerr.derive"):
+            try:
+                spec = importlib.util.find_spec(name)
+            except (ImportError, ValueError):
+                spec = None
+            for loc in (spec.submodule_search_locations or []) if spec else []:
+                roots.append(Path(loc).resolve())
+        _PACKAGE_ROOTS = roots
+    return _PACKAGE_ROOTS
+
+
+def _within(path: Path, root: Path) -> bool:
+    return path == root or root in path.parents
+
+
+def is_package_file(path) -> bool:
+    """True when ``path`` is, or lies inside, a folder of the installed package."""
+    p = Path(path).resolve()
+    return any(_within(p, r) for r in package_roots())
+
+
+def _staged(path) -> bool:
+    p = Path(path).resolve()
+    return any(_within(p, s) for s in _STAGING)
+
+
+# ---------------------------------------------------------------------------------------------
+# the output plan
+def _same(role, other, path) -> str:
+    return (f"two outputs are the same file {path}: {role} and {other} would overwrite each "
+            f"other")
+
+
+class Outputs:
+    """Every output of one command run: declared and checked before computing, written at the
+    end, all or nothing.
+
+    Parameters
+    ----------
+    inputs : iterable of path-like
+        Files (or folders: every file inside) the run reads; never overwritten.  ``None``
+        entries are ignored.
+    allow_package : bool
+        Permit writing into the installed package (only ``volerr derive --in-package``).
+
+    Examples
+    --------
+    >>> outs = Outputs([table]).file("--out", "map.csv").plot("--plot", None)
+    >>> outs.check()                      # before any computation: exit 2 on a bad path
+    >>> with outs:                        # commit on success, nothing written on failure
+    ...     write_text(outs.path("--out"), text)
+    """
+
+    def __init__(self, inputs=(), *, allow_package: bool = False):
+        files = []
+        for p in inputs:
+            if p is None:
+                continue
+            p = Path(p)
+            if p.is_dir():
+                files.extend(q for q in p.iterdir() if q.is_file())
+            else:
+                files.append(p)
+        self.inputs = files
+        self.allow_package = allow_package
+        self._items: list = []          # (role, path, kind, files)
+        self._stage: dict = {}          # role -> staged path
+        self._roots: dict = {}          # target folder -> staging folder
+        self._created: list = []        # parent folders created for staging
+        self._checked = False
+        self._closed = False
+
+    # -- declaration ---------------------------------------------------------------------
+    def file(self, role: str, path, *, plot: bool = False) -> "Outputs":
+        """Declare an output file (``None``: option not given, ignored)."""
+        if path is not None:
+            require(not self._checked, "internal: output declared after check()")
+            self._items.append((role, Path(path), "plot" if plot else "file", None))
+        return self
+
+    def plot(self, role: str, path) -> "Outputs":
+        """Declare a PNG plot (must end in ``.png``)."""
+        return self.file(role, path, plot=True)
+
+    def folder(self, role: str, path, files=None) -> "Outputs":
+        """Declare an output folder and, when known, the names of the files it will get
+        (relative paths); unknown names are checked at commit, before anything moves."""
+        if path is not None:
+            require(not self._checked, "internal: output declared after check()")
+            self._items.append((role, Path(path), "folder",
+                                None if files is None else tuple(files)))
+        return self
+
+    @property
+    def declared(self) -> list:
+        """(role, final path) of every declared output."""
+        return [(r, p) for r, p, _, _ in self._items]
+
+    # -- checks --------------------------------------------------------------------------
+    def _refuse_target(self, role, p: Path) -> None:
+        require(str(p).strip() != "", f"{role}: empty file name")
+        if not self.allow_package:
+            require(not is_package_file(p),
+                    f"{role} {p}: refusing to write into the installed volerr package "
+                    f"(a shipped file such as a layout or generated module)")
+        rp = p.resolve()
+        for q in self.inputs:
+            same = (rp == q.resolve()) or (p.exists() and q.exists() and os.path.samefile(p, q))
+            require(not same, f"{role} {p}: refusing to overwrite the input file {q}")
+
+    @staticmethod
+    def _probe_writable(role, target_dir: Path, shown: Path) -> None:
+        d = target_dir
+        while not d.exists():
+            if d.parent == d:
+                break
+            d = d.parent
+        require(d.is_dir(), f"{role} {shown}: cannot write, {d} is a file, not a folder")
+        try:
+            fd, tmp = tempfile.mkstemp(dir=d, prefix=".volerr-probe-")
+            os.close(fd)
+            os.unlink(tmp)
+        except OSError as exc:
+            raise InputError(f"{role} {shown}: cannot write in {d} "
+                             f"({exc.strerror or exc})") from None
+
+    def check(self) -> "Outputs":
+        """All checks, before any computation; raises :class:`InputError` (one line)."""
+        finals: dict = {}
+        folders = []
+        for role, p, kind, files in self._items:
+            if kind == "folder":
+                require(not p.exists() or p.is_dir(),
+                        f"{role} {p}: is a file, not a folder")
+                self._refuse_target(role, p)
+                for other_role, other in folders:
+                    require(p.resolve() != other.resolve(),
+                            f"{role} and {other_role} name the same folder {p}")
+                folders.append((role, p))
+                self._probe_writable(role, p, p)
+                for name in files or ():
+                    f = p / name
+                    self._refuse_target(role, f)
+                    key = f.resolve()
+                    require(key not in finals, _same(f"{role} {p}", finals.get(key), f))
+                    finals[key] = f"{role} {p}"
+            else:
+                require(not p.is_dir(), f"{role} {p}: is a folder, give a file name")
+                if kind == "plot":
+                    require(p.suffix.lower() == ".png",
+                            f"{role}: plot file must end in .png, got {p.name}")
+                self._refuse_target(role, p)
+                key = p.resolve()
+                require(key not in finals, _same(role, finals.get(key), p))
+                finals[key] = role
+                self._probe_writable(role, p.parent, p)
+        # a file inside a folder whose file names are not known in advance
+        for role, p, kind, files in self._items:
+            if kind == "folder" and files is None:
+                for key, other in finals.items():
+                    require(not _within(key, p.resolve()) or str(other).endswith(f" {p}"),
+                            f"{other} writes inside the output folder {role} {p}: give "
+                            f"another location")
+        self._checked = True
+        return self
+
+    # -- staging -------------------------------------------------------------------------
+    def _staging_root(self, folder: Path) -> Path:
+        key = folder.resolve() if folder.exists() else folder.absolute()
+        if key not in self._roots:
+            missing = []
+            d = folder
+            while not d.exists():
+                missing.append(d)
+                d = d.parent
+            try:
+                for m in reversed(missing):
+                    m.mkdir()
+                    self._created.append(m)
+                root = Path(tempfile.mkdtemp(dir=folder, prefix=".volerr-staging-"))
+            except OSError as exc:
+                raise InputError(f"cannot write in {folder}: {exc.strerror or exc}") from None
+            self._roots[key] = root
+            _STAGING.add(root.resolve())
+        return self._roots[key]
+
+    def path(self, role: str):
+        """Where to write output ``role`` now (a staged path; a folder for folders); ``None``
+        when the option was not given."""
+        if not self._checked:
+            self.check()
+        require(not self._closed, "internal: outputs already committed")
+        for r, p, kind, _ in self._items:
+            if r == role:
+                if role not in self._stage:
+                    if kind == "folder":
+                        root = self._staging_root(p if p.exists() else p.parent)
+                        self._stage[role] = root / f".volerr-folder-{len(self._stage)}"
+                        self._stage[role].mkdir()
+                    else:
+                        self._stage[role] = self._staging_root(p.parent) / p.name
+                return self._stage[role]
+        return None
+
+    __getitem__ = path
+
+    def _moves(self) -> list:
+        """(staged file, final file, role) of everything written."""
+        moves = []
+        for role, p, kind, _ in self._items:
+            st = self._stage.get(role)
+            if st is None or not st.exists():
+                continue
+            if kind == "folder":
+                for f in sorted(st.rglob("*")):
+                    if f.is_file():
+                        moves.append((f, p / f.relative_to(st), role))
+            else:
+                moves.append((st, p, role))
+        return moves
+
+    def commit(self) -> list:
+        """Move every staged output into place (checked again first); on any failure
+        restore what was there and remove everything staged.  Returns the final paths."""
+        if self._closed:
+            return []
+        moves = self._moves()
+        try:
+            seen = {}
+            for _, final, role in moves:
+                self._refuse_target(role, final)
+                key = final.resolve()
+                require(key not in seen, _same(role, seen.get(key), final))
+                seen[key] = role
+            done = []      # (final, backup or None)
+            try:
+                for staged, final, _ in moves:
+                    final.parent.mkdir(parents=True, exist_ok=True)
+                    backup = None
+                    if final.exists():
+                        backup = final.with_name(f".volerr-backup-{os.getpid()}-{final.name}")
+                        os.replace(final, backup)
+                    done.append((final, backup))
+                    try:
+                        os.replace(staged, final)
+                    except OSError:
+                        shutil.move(str(staged), str(final))
+            except OSError as exc:
+                for final, backup in reversed(done):
+                    try:
+                        if backup is not None:
+                            os.replace(backup, final)
+                        elif final.exists():
+                            final.unlink()
+                    except OSError:
+                        pass
+                raise InputError(f"cannot write {final}: {exc.strerror or exc}") from None
+            for _, backup in done:
+                if backup is not None and backup.exists():
+                    backup.unlink()
+        except BaseException:
+            self.discard()
+            raise
+        self._cleanup(keep_created=True)
+        return [final for _, final, _ in moves]
+
+    def discard(self) -> None:
+        """Remove every staged file and the folders created for them."""
+        self._cleanup(keep_created=False)
+
+    def _cleanup(self, keep_created: bool) -> None:
+        for root in self._roots.values():
+            _STAGING.discard(root.resolve())
+            shutil.rmtree(root, ignore_errors=True)
+        self._roots.clear()
+        self._stage.clear()
+        if not keep_created:
+            for d in reversed(self._created):
+                try:
+                    d.rmdir()
+                except OSError:
+                    pass
+        self._created.clear()
+        self._closed = True
+
+    def __enter__(self) -> "Outputs":
+        if not self._checked:
+            self.check()
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.discard()
+        return False

@@ -34,8 +34,8 @@ def add_common(p) -> None:
     """Arguments shared with ``volerr diagonals``."""
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)
-    p.add_argument("--probe", nargs=3, type=float, metavar=("XP", "YP", "ZP"), default=(0.0, 0.0, 0.0),
-                   help="probe / tool offset, mm (default 0 0 0)")
+    add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
+               help="probe / tool offset XP YP ZP, mm (X Y Z or X,Y,Z)")
     p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
                    help="position of a rotary axis during the test, repeatable (default 0 deg)")
     p.add_argument("--volume", choices=("travel", "measured"), default="travel",
@@ -55,9 +55,79 @@ def parse_at(items) -> dict:
     return out
 
 
-def inputs_of(args) -> list:
-    """Files that must never be overwritten: the error tables and a layout file."""
+def inputs_of(args, model=None) -> list:
+    """Files that must never be overwritten: the error tables and a layout file (shipped
+    layouts are package files, protected by :class:`volerr.fileio.Outputs` anyway)."""
     files = volmap.error_dir_inputs(args.errors)
-    if str(args.layout).endswith(".toml"):
-        files.append(Path(args.layout))
+    files.extend(layout_inputs(args.layout))
     return files
+
+
+def layout_inputs(layout) -> list:
+    """``[path]`` when LAYOUT names an existing file, else ``[]`` (a shipped name)."""
+    p = Path(str(layout))
+    return [p] if p.is_file() else []
+
+
+def progress(iterable, total=None, **kw):
+    """``tqdm`` progress on stderr when stderr is a terminal; the plain iterable otherwise."""
+    import sys
+
+    if not sys.stderr.isatty():
+        return iterable
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover
+        return iterable
+    return tqdm(iterable, total=total, file=sys.stderr, leave=False, **kw)
+
+
+#: the largest coordinate accepted on the command line (mm)
+MAX_COORD_MM = 1e6
+
+
+def parse_vector(tokens, what: str, n: int = 3) -> tuple:
+    """``["1", "2", "3"]``, ``["1,2,3"]`` or ``["1, 2", "3"]`` -> (1.0, 2.0, 3.0): both vector
+    syntaxes, finite numbers of at most :data:`MAX_COORD_MM`."""
+    import math
+
+    if isinstance(tokens, str):
+        tokens = [tokens]
+    parts = [c for t in tokens for c in str(t).replace(",", " ").split()]
+    try:
+        v = tuple(float(c) for c in parts)
+    except ValueError:
+        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got "
+                         f"{' '.join(map(str, tokens))!r}") from None
+    require(len(v) == n, f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got {len(v)}")
+    require(all(math.isfinite(c) and abs(c) <= MAX_COORD_MM for c in v),
+            f"{what}: numbers must be finite and at most {MAX_COORD_MM:g} mm, got "
+            f"{' '.join(map(str, tokens))}")
+    return v
+
+
+def add_vector(parser, flag: str, help: str, default=None, required: bool = False,
+               append: bool = False, metavar: str = "X Y Z") -> None:
+    """A 3-vector option that accepts both ``X Y Z`` and ``X,Y,Z`` (checked at parse time:
+    exit 2 and one line for a bad value)."""
+    import argparse
+
+    class _Vector(argparse.Action):
+        vector = True
+
+        def __call__(self, p, namespace, values, option_string=None):
+            try:
+                v = parse_vector(values, option_string)
+            except InputError as exc:
+                p.error(str(exc))
+            if append:
+                items = list(getattr(namespace, self.dest) or [])
+                items.append(v)
+                v = items
+            setattr(namespace, self.dest, v)
+
+    act = parser.add_argument(flag, nargs="+", action=_Vector, default=default,
+                              required=required, metavar=metavar, help=help)
+    act.vector = True

@@ -25,14 +25,15 @@ from pathlib import Path
 
 from volerr.audit import summary_line
 from volerr.errors import InputError, require
-from volerr.fileio import check_output, write_text
+from volerr.fileio import write_text
 from volerr.machine.layout import layout_names
 
 
 def register(sub) -> None:
     p = sub.add_parser("audit", help="derived equations against the printed ones (errata)")
     p.add_argument("layouts", nargs="*", metavar="LAYOUT",
-                   help="restrict to these layouts (default: every audited equation)")
+                   help="restrict to these layouts, by name or layout file (default: every "
+                        "audited equation)")
     p.add_argument("--json", metavar="F", help="write the verdicts with evidence as JSON")
     p.add_argument("--html", metavar="F",
                    help="write one HTML page: a section per source document, rendered math, "
@@ -74,8 +75,10 @@ def collect(layouts: list[str] | None):
     for name in layouts or []:
         require(name in known, f"unknown layout {name!r}; audited layouts and shipped layouts: "
                                f"{' '.join(sorted(known))}")
+    from volerr.cli._common import progress
+
     verdicts = []
-    for m in mods:
+    for m in progress(mods, desc="audit", unit="source"):
         covered = getattr(m, "LAYOUTS", None)
         if layouts and covered is not None and not set(layouts) & set(covered):
             continue
@@ -150,33 +153,51 @@ def numeric_table(layouts: list[str] | None, points: int) -> str:
     return "\n".join(lines)
 
 
-def _check_outputs(args) -> None:
-    """Output paths checked before any computing: never an input, never the same file twice."""
-    from volerr.derive.audit import providers
+def _layout_names(items) -> list:
+    """Layout names; a layout file counts as the layout it names (``name = ...``)."""
+    import sys
 
-    inputs = _data_paths(providers())
-    outs = [p for p in (args.json, args.html) if p]
-    for p in outs:
-        check_output(p, inputs)
-    if len(outs) == 2:
-        require(Path(outs[0]).resolve() != Path(outs[1]).resolve(),
-                "--json and --html name the same file")
+    from volerr.machine.layout import read_layout
+
+    names = []
+    for item in items or []:
+        p = Path(item)
+        if p.suffix.lower() == ".toml" or p.is_file():
+            require(p.is_file(), f"layout file {p} does not exist")
+            lay = read_layout(str(p))
+            names.append(lay.name)
+            if lay.name in layout_names() and lay.sha256 != read_layout(lay.name).sha256:
+                print(f"volerr audit: note: {p} differs from the shipped layout {lay.name}: the "
+                      f"printed equations are audited against the derivation of the shipped "
+                      f"{lay.name}", file=sys.stderr)
+        else:
+            names.append(item)
+    return names
 
 
 def run(args) -> int:
+    from volerr.cli._common import layout_inputs
+    from volerr.fileio import Outputs
+
+    from volerr.derive.audit import providers
+
     require(args.points >= 1, "--points must be at least 1")
-    _check_outputs(args)
+    inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]
+    inputs += _data_paths(providers())
+    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html).check()
+    args.layouts = _layout_names(args.layouts)
     mods, verdicts = collect(args.layouts)
     entries = [v.as_dict() for v in verdicts]
     files = {}
     if args.json:
-        files[args.json] = json.dumps(entries, indent=1, ensure_ascii=False) + "\n"
+        files["--json"] = json.dumps(entries, indent=1, ensure_ascii=False) + "\n"
     if args.html:
         from volerr.audit import render_html
 
-        files[args.html] = render_html(entries)
-    for path, text in files.items():
-        write_text(path, text, inputs=_data_paths(mods))
+        files["--html"] = render_html(entries)
+    with outs:
+        for role, text in files.items():
+            write_text(outs.path(role), text, inputs=_data_paths(mods))
     if args.detail:
         rows = [{"source": v.source, "equation": v.equation, "layout": v.layout,
                  "verdict": (v.category + (f" {v.component}" if v.component else "")),
@@ -189,7 +210,8 @@ def run(args) -> int:
     print(f"\n{n_eq} printed items audited: {n_eq - n_diff} identical, {n_diff} differ "
           f"({sum(v.verdict != 'identical' for v in verdicts)} of {len(verdicts)} components).")
     print(summary_line(entries) + "."
-          + (f" Evidence: {', '.join(files)}" if files else " Evidence: --json F, --html F"))
+          + (f" Evidence: {', '.join(p for p in (args.json, args.html) if p)}" if files
+             else " Evidence: --json F, --html F"))
     if args.numeric:
         print()
         print(numeric_table(args.layouts or None, args.points))

@@ -22,9 +22,10 @@ import json
 import math
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments
+from volerr.cli._common import add_error_arguments, add_vector
 from volerr.errors import InputError, require
-from volerr.fileio import check_output, write_text
+from volerr.cli._common import layout_inputs
+from volerr.fileio import Outputs, write_text
 
 
 def register(sub) -> None:
@@ -45,10 +46,10 @@ def register(sub) -> None:
                    help="ISO/TR 16907 compensation types to apply, comma separated: L-POS "
                         "L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG, or L-VOL R-VOL (default: "
                         "all); the report still predicts the full model's error")
-    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
-                   metavar=("XT", "YT", "ZT"),
-                   help="tool-tip offset in the tool frame, mm, beyond the point the axis "
-                        "positions refer to (default 0 0 0: the program positions the tip)")
+    add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
+               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z), beyond "
+                    "the point the axis positions refer to (0 0 0: the program positions the "
+                    "tip)")
     p.add_argument("--tol-um", type=float, default=0.1,
                    help="stop iterating when the correction changes by less than this (um)")
     p.add_argument("--decimals", type=int, default=4,
@@ -114,38 +115,42 @@ def run(args) -> int:
     from volerr.machine.model import load
 
     model = load(args.layout)
+    require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
+                                              f"directory (the folder holding X.csv ...)")
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
     open_source = program.open_program(args.program)
-    inputs = [args.program, *Path(args.errors).glob("*.csv")]
-    for out in (args.out, args.report, args.json, args.plot):
-        if out:
-            check_output(out, inputs)
-    require(not args.plot or str(args.plot).lower().endswith(".png"),
-            f"plot file must end in .png, got {args.plot}")
+    inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
+    outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
+        .file("--json", args.json).plot("--plot", args.plot).check()
     opts = program.Options(
         tuple(args.tool), args.orientation, args.strategy, args.tol_um, args.decimals,
         _initial(args.initial), not args.ignore_travel, 50,
         None if args.types is None else tuple(t for t in args.types.split(",") if t.strip()))
-    # streamed: the program and the report go to temporary files, put in place at the end
-    sink = program.FileSink(model, args.out, args.report, inputs, keep_errors=bool(args.plot))
-    try:
-        s, assumed_zero = program.run(open_source, model, funcs, opts, sink)
-        if args.json:
-            write_text(args.json, json.dumps({"layout": model.name, "strategy": args.strategy,
-                                              "orientation": bool(args.orientation),
-                                              "types": args.types or "L-VOL,R-VOL", **s},
-                                             indent=2) + "\n", inputs)
-        if args.plot:
-            from volerr.fiveaxis.plots import plot_program_errors
+    with outs:  # all or nothing: staged outputs are put in place at the end
+        # streamed: the program and the report are written chunk by chunk
+        sink = program.FileSink(model, outs.path("--out"),
+                                outs.path("--report") if args.report else None, inputs,
+                                keep_errors=bool(args.plot))
+        try:
+            s, assumed_zero = program.run(open_source, model, funcs, opts, sink)
+            require(s["motion_blocks"] > 0, f"{args.program}: no motion block to compensate "
+                                            "(an empty program or one without axis words)")
+            if args.json:
+                write_text(outs.path("--json"), json.dumps(
+                    {"layout": model.name, "strategy": args.strategy,
+                     "orientation": bool(args.orientation), "types": args.types or "L-VOL,R-VOL",
+                     **s}, indent=2) + "\n", inputs)
+            if args.plot:
+                from volerr.fiveaxis.plots import plot_program_errors
 
-            plot_program_errors(sink.program_errors(), args.plot,
-                                title=f"{model.name}: {args.program}")
-        sink.commit()
-    except BaseException:
-        sink.discard()
-        raise
+                plot_program_errors(sink.program_errors(), outs.path("--plot"),
+                                    title=f"{model.name}: {args.program}")
+            sink.commit()
+        except BaseException:
+            sink.discard()
+            raise
     print(f"{model.name}: {s['compensated']} of {s['motion_blocks']} motion blocks compensated "
           f"({args.strategy}{', orientation' if args.orientation else ''}"
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "

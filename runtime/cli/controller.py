@@ -41,12 +41,15 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from volerr.tables import controller as ct
-    from volerr.fileio import write_text
+    from volerr.cli._common import layout_inputs
+    from volerr.fileio import Outputs, write_text
     from volerr.machine.model import load
     from volerr.tables.table import read_error_dir, write_error_dir
 
     model = load(args.layout)
     if args.action == "export":
+        require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
+                                                  f"directory (the folder holding X.csv ...)")
         require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
         tables, (consts, _, _) = read_error_dir(args.errors, model.axes)
         ct.check_against_model(model, tables, consts, args.errors)
@@ -54,21 +57,24 @@ def run(args) -> int:
         if args.negate:
             tables, consts = ct.negated(tables, consts)
         writer = ct.write_isg if args.format == "isg" else ct.write_etalon
-        inputs = list(Path(args.errors).glob("*.csv"))
-        write_text(args.out, writer(model.name, tables, consts), inputs)
+        inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
+        with Outputs(inputs).file("--out", args.out) as outs:
+            write_text(outs.path("--out"), writer(model.name, tables, consts), inputs)
         n = sum(len(t.values) for t in tables.values())
         print(f"{model.name}: wrote {n} component errors ({len(tables)} axes) and "
               f"{len(consts)} position errors to {args.out} ({args.format}"
               f"{', negated: compensation values' if args.negate else ''})")
         return 0
+    inputs = [args.file] + layout_inputs(args.layout)
+    outs = Outputs(inputs).folder("--out", args.out,
+                                  files=[f"{a}.csv" for a in model.axes] + ["constants.csv"])
+    outs.check()
     tables, consts = ct.read_controller_file(args.file, model, args.format)
     if args.negate:
         tables, consts = ct.negated(tables, consts)
     out = Path(args.out)
-    for ax in tables:
-        require(not (out / f"{ax}.csv").exists() or not (out / f"{ax}.csv").samefile(args.file),
-                f"refusing to overwrite input file {args.file}")
-    write_error_dir(out, tables, consts or None, inputs=[args.file])
+    with outs:
+        write_error_dir(outs.path("--out"), tables, consts or None, inputs=inputs)
     n = sum(len(t.values) for t in tables.values())
     print(f"{model.name}: read {n} component errors ({len(tables)} axes) and {len(consts)} "
           f"position errors from {args.file}; wrote {out}/")

@@ -10,7 +10,10 @@ Sections (each runs the real command or API on built-in data and writes into DIR
 6. five-axis DMU 50: a hemisphere finishing program compensated (full model and the thesis'
    strategy), tool-centre-point error over the (B, C) range;
 7. closing the loop: a virtual MB1 with an undeclared effect, fit, diagnosis, augmented model;
-8. ``index.html`` linking everything, and the headline figures printed.
+8. ISO 230-2 evaluation of a simulated positioning run;
+9. task-specific uncertainty of a distance (Monte Carlo);
+10. ``index.html`` with a section, figures and captions per step, and the headline figures
+    printed.  Everything is written at the end, all or nothing.
 """
 
 from __future__ import annotations
@@ -24,7 +27,59 @@ from pathlib import Path
 from volerr.errors import require
 from volerr.fileio import write_text
 
-SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "fiveaxis", "loop")
+SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "fiveaxis", "loop", "iso230_2",
+            "uncertainty")
+
+#: one sentence per section of index.html: what it shows and how to read it
+ABOUT = {
+    "cmm_a": "Pahk's CMM A (moving bridge MB1) with synthetic example error tables: the "
+             "volumetric error over the working volume (nominal grid dashed, actual solid, "
+             "magnified) and the length deviations of the space diagonals.",
+    "cmm_b": "Pahk's CMM B (MH2): the same with repeatability columns in the tables, so the "
+             "random component (1 sigma) is mapped and propagated to the diagonals separately.",
+    "audit": "Every derived CMM equation against the one printed in Pahk 1995; differences are "
+             "named errata with their evidence (audit.json).",
+    "probe": "A simulated 3-lobe kinematic probe measured on Pahk's 101-point plan: effective "
+             "ball radius R_eff and the probe error map Probe(phi, theta).",
+    "identify": "Shipped laser-tracker data (3 points, 11 positions, 4 rounds per axis): the six "
+                "error motions of X, Y and Z identified, squareness from the straightness "
+                "reference lines, then the space diagonals of the measured machine.",
+    "fiveaxis": "A hemisphere finishing program on the DMU 50 compensated with the full model "
+                "and with the thesis' strategy; the tool-tip error over the (B, C) range.",
+    "loop": "A virtual MB1 with an undeclared thermal growth: the loop fits the declared "
+            "model, finds the missing effect, augments the layout and compares before and "
+            "after on held-out points.",
+    "iso230_2": "A simulated laser-interferometer positioning run of X (9 targets, 5 cycles, "
+                "both directions) evaluated as ISO 230-2: accuracy A, repeatability R, "
+                "reversal B, systematic error E.",
+    "uncertainty": "Task-specific uncertainty of a 400 mm distance on MH2 by Monte Carlo "
+                   "(virtual CMM, JCGM 101) from the example tables' repeatability and 0.5 um "
+                   "probing noise.",
+}
+
+#: figure captions (file name -> sentence)
+CAPTIONS = {
+    "map_MB1.png": "MB1: volumetric error on the travel grid, nominal (dashed) and actual "
+                   "(solid) grid, errors magnified by the factor in the title.",
+    "map_MB1_random.png": "MB1: random component (1 sigma) of the volumetric error.",
+    "map_MH2.png": "MH2: volumetric error on the travel grid (magnified).",
+    "map_MH2_random.png": "MH2: random component (1 sigma) of the volumetric error.",
+    "diagonals_MB1.png": "MB1: length deviation along the space diagonals and of every line.",
+    "diagonals_MH2.png": "MH2: length deviation along the space diagonals, with the random "
+                         "part.",
+    "probe_map.png": "Probe error: 3-D lobing map (left) and over (phi, theta) (right), um.",
+    "identified_X.png": "X axis: identified error motions (mean of 4 rounds, +/- 1 s).",
+    "identified_Y.png": "Y axis: identified error motions.",
+    "identified_Z.png": "Z axis: identified error motions.",
+    "compensate_full.png": "DMU 50 program, full model: predicted tool-tip error per block "
+                           "before and after compensation.",
+    "compensate_thesis.png": "DMU 50 program, thesis strategy (rotary, then linear).",
+    "tcpmap_DMU50.png": "DMU 50: tool-tip error at one workpiece point over B and C (grey: "
+                        "outside the travel or the tables).",
+    "iso230_2.png": "ISO 230-2 plot: mean deviations per direction, +/- 2 s bands.",
+    "uncertainty.png": "Distribution of the Monte Carlo samples of the distance with the 95 % "
+                       "coverage interval.",
+}
 
 
 def register(sub) -> None:
@@ -64,9 +119,11 @@ def _cmm(out: Path, layout: str, label: str) -> dict:
         text += " um (random " + ", ".join(f"{r:.1f}" for r in rand) + " um)"
     else:
         text += " um"
+    files = [f"errors_{layout}/", f"map_{layout}.csv", f"map_{layout}.png"]
+    if (out / f"map_{layout}_random.png").exists():
+        files.append(f"map_{layout}_random.png")
     return {"title": f"{label} ({layout}): space diagonals", "value": text,
-            "files": [f"errors_{layout}/", f"map_{layout}.csv", f"map_{layout}.png",
-                      f"diagonals_{layout}.json", f"diagonals_{layout}.png"]}
+            "files": files + [f"diagonals_{layout}.json", f"diagonals_{layout}.png"]}
 
 
 #: the demo audits the CMM models (seconds); ``volerr audit`` alone audits everything
@@ -168,43 +225,122 @@ def _loop(out: Path) -> dict:
             "files": ["loop_measured.csv", "loop.json", "loop.html"]}
 
 
+def _iso230_2(out: Path) -> dict:
+    import numpy as np
+
+    rng = np.random.default_rng(2)
+    lines = ["target_mm,cycle,direction,deviation_um"]
+    for t in np.linspace(0.0, 800.0, 9):
+        base = 4.0 * np.sin(t / 200.0) + 0.005 * t
+        for c in range(1, 6):
+            for word, half in (("+1", 1.2), ("-1", -1.2)):
+                lines.append(f"{t:g},{c},{word},{base + half + rng.normal(0, 0.3):.4f}")
+    write_text(out / "iso230_2_run_X.csv", "\n".join(lines) + "\n")
+    _cli("iso230-2", out / "iso230_2_run_X.csv", "--axis", "X", "--json", out / "iso230_2.json",
+         "--plot", out / "iso230_2.png", "--html", out / "iso230_2.html")
+    r = json.loads((out / "iso230_2.json").read_text())
+    return {"title": "ISO 230-2 evaluation of a simulated positioning run of X",
+            "value": f"A {r['A_um']:.2f} um, R {r['R_um']:.2f} um, B {r['B_um']:.2f} um, "
+                     f"E {r['E_um']:.2f} um, M {r['M_um']:.2f} um",
+            "files": ["iso230_2_run_X.csv", "iso230_2.json", "iso230_2.html", "iso230_2.png"]}
+
+
+def _uncertainty(out: Path) -> dict:
+    from volerr.cmm.examples import write_example_errors
+
+    errors = out / "errors_MH2_u"
+    write_example_errors(errors, "MH2")
+    write_text(out / "task_distance.csv", "X,Y,Z\n100,200,150\n500,200,150\n")
+    _cli("uncertainty", "MH2", "--task", out / "task_distance.csv", "--evaluate", "distance",
+         "--errors", errors, "--noise-um", 0.5, "--samples", 2000, "--seed", 1, "--quiet",
+         "--json", out / "uncertainty.json", "--plot", out / "uncertainty.png")
+    q = json.loads((out / "uncertainty.json").read_text())["quantities"]["distance"]
+    lo, hi = q["coverage_interval_mm"]
+    return {"title": "task-specific uncertainty of a 400 mm distance on MH2 (Monte Carlo, "
+                     "2000 samples)",
+            "value": f"estimate {q['estimate_mm']:.4f} mm, bias {q['bias_um']:+.2f} um, "
+                     f"u {q['standard_uncertainty_um']:.2f} um, U(95 %) "
+                     f"{q['expanded_uncertainty_um']:.2f} um, interval [{lo:.4f}, {hi:.4f}] mm",
+            "files": ["task_distance.csv", "errors_MH2_u/", "uncertainty.json",
+                      "uncertainty.png"]}
+
+
 def _index(out: Path, results: list) -> None:
-    rows = "\n".join(
-        f"<tr><td>{r['title']}</td><td>{r['value']}</td><td>"
-        + " ".join(f'<a href="{f}">{f}</a>' for f in r["files"]) + "</td></tr>"
-        for r in results)
-    pngs = "\n".join(f'<figure><img src="{f}" width="640"><figcaption>{f}</figcaption></figure>'
-                     for r in results for f in r["files"] if f.endswith(".png"))
-    html = ("<!doctype html><html><head><meta charset='utf-8'><title>volerr demo</title>"
-            "<style>body{font-family:sans-serif;margin:2em}td{padding:4px 10px;"
-            "border-bottom:1px solid #ddd;vertical-align:top}</style></head><body>"
-            "<h1>volerr demo</h1><table><tr><th>step</th><th>result</th><th>files</th></tr>"
-            f"{rows}</table>{pngs}</body></html>\n")
+    from html import escape
+
+    parts = []
+    toc = []
+    for i, r in enumerate(results, start=1):
+        sid = f"s{i}"
+        toc.append(f'<li><a href="#{sid}">{escape(r["title"])}</a></li>')
+        files = " ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in r["files"])
+        figs = []
+        for f in r["files"]:
+            if f.endswith(".png"):
+                cap = CAPTIONS.get(f, f)
+                figs.append(f'<figure><a href="{escape(f)}"><img src="{escape(f)}" '
+                            f'alt="{escape(cap)}"></a><figcaption>{escape(cap)} '
+                            f'<span class="file">({escape(f)})</span></figcaption></figure>')
+        parts.append(
+            f'<section id="{sid}"><h2>{i}. {escape(r["title"])}</h2>'
+            f'<p>{escape(ABOUT.get(r.get("section", ""), ""))}</p>'
+            f'<p class="result"><strong>Result:</strong> {escape(r["value"])} '
+            f'<span class="file">[{r.get("seconds", 0)} s]</span></p>'
+            + "".join(figs) + f'<p class="files">Files: {files}</p></section>')
+    html = ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+            "<title>volerr demo</title><style>"
+            "body{font-family:system-ui,sans-serif;font-size:17px;line-height:1.5;"
+            "max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
+            "h1{font-size:1.9em}h2{font-size:1.35em;border-bottom:2px solid #ddd;"
+            "padding-bottom:.2em;margin-top:2em}"
+            "figure{margin:1.2em 0}img{width:100%;height:auto;border:1px solid #eee}"
+            "figcaption{font-size:.95em;color:#444}.file{color:#777;font-size:.9em}"
+            ".result{background:#f5f7fa;padding:.6em .9em;border-left:4px solid #4a7}"
+            ".files a{margin-right:.8em}</style></head><body>"
+            "<h1>volerr demo</h1><p>Every step below ran a real <code>volerr</code> command "
+            "on built-in data; units um and urad unless stated.  Click a figure for full "
+            "size; the files next to this page hold every number.</p>"
+            f"<ol>{''.join(toc)}</ol>{''.join(parts)}</body></html>\n")
     write_text(out / "index.html", html)
 
 
 def run(args) -> int:
-    out = Path(args.out)
-    require(not out.exists() or out.is_dir(), f"--out {out} exists and is not a folder")
-    steps = {
-        "cmm_a": lambda: _cmm(out, "MB1", "CMM A of Pahk"),
-        "cmm_b": lambda: _cmm(out, "MH2", "CMM B of Pahk"),
-        "audit": lambda: _audit(out),
-        "probe": lambda: _probe(out),
-        "identify": lambda: _identify(out),
-        "fiveaxis": lambda: _fiveaxis(out),
-        "loop": lambda: _loop(out),
-    }
-    out.mkdir(parents=True, exist_ok=True)
+    import os
+
+    from volerr.fileio import Outputs
+
+    final = Path(args.out)
+    outs = Outputs().folder("--out", final).check()
     results = []
     t0 = time.perf_counter()
-    for name in args.only or SECTIONS:
-        t = time.perf_counter()
-        r = steps[name]()
-        r["seconds"] = round(time.perf_counter() - t, 1)
-        results.append(r)
-        print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
-    _index(out, results)
-    write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
-    print(f"report: {out / 'index.html'}  ({time.perf_counter() - t0:.0f} s)")
+    here = os.getcwd()
+    with outs:
+        staged = outs.path("--out")
+        os.chdir(staged)  # relative paths: the reports name files as they will be found
+        try:
+            out = Path(".")
+            steps = {
+                "cmm_a": lambda: _cmm(out, "MB1", "CMM A of Pahk"),
+                "cmm_b": lambda: _cmm(out, "MH2", "CMM B of Pahk"),
+                "audit": lambda: _audit(out),
+                "probe": lambda: _probe(out),
+                "identify": lambda: _identify(out),
+                "fiveaxis": lambda: _fiveaxis(out),
+                "loop": lambda: _loop(out),
+                "iso230_2": lambda: _iso230_2(out),
+                "uncertainty": lambda: _uncertainty(out),
+            }
+            for name in args.only or SECTIONS:
+                t = time.perf_counter()
+                r = steps[name]()
+                r["section"] = name
+                r["seconds"] = round(time.perf_counter() - t, 1)
+                results.append(r)
+                print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
+            _index(out, results)
+            write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
+        finally:
+            os.chdir(here)
+    print(f"report: {final / 'index.html'}  ({time.perf_counter() - t0:.0f} s)")
     return 0

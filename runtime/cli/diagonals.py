@@ -13,9 +13,9 @@ import json
 from volerr.cmm import diagonals
 from volerr.cli._common import add_common, error_functions_from_args, inputs_of, parse_at
 from volerr.errors import require
-from volerr.fileio import check_output, write_text
+from volerr.fileio import Outputs, write_text
 from volerr.machine.model import load
-from volerr.cmm.volmap import check_distinct, linear_axes, volume
+from volerr.cmm.volmap import linear_axes, volume
 
 
 def register(sub) -> None:
@@ -37,13 +37,7 @@ def run(args) -> int:
     model = load(args.layout)
     funcs = error_functions_from_args(args, model)
     inputs = inputs_of(args)
-    check_distinct(("--json", args.json), ("--plot", args.plot))
-    for out in (args.json, args.plot):
-        if out is not None:
-            check_output(out, inputs)
-    if args.plot is not None:
-        from volerr.fileio import check_plot
-        check_plot(args.plot, inputs)
+    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot).check()
     lin = linear_axes(model)
     lines = diagonals.box_lines(volume(model, funcs, args.volume), lin, tuple(args.lines))
     results = diagonals.evaluate_lines(model, funcs, lines, tuple(args.probe), parse_at(args.at),
@@ -51,14 +45,17 @@ def run(args) -> int:
     print(f"{model.name}: length deviation dL = actual - nominal distance of the probe tip "
           f"(first order), probe {' '.join(f'{v:g}' for v in args.probe)} mm")
     print(diagonals.format_table(results))
+    with outs:
+        if args.json:
+            doc = {"layout": model.name, "probe_mm": [float(v) for v in args.probe],
+                   "errors": str(args.errors), "method": args.method,
+                   "lines": [r.as_dict() for r in results]}
+            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+        if args.plot:
+            diagonals.plot_lines(results, outs.path("--plot"),
+                                 f"{model.name}: length deviations ({args.errors})", inputs)
     if args.json:
-        doc = {"layout": model.name, "probe_mm": [float(v) for v in args.probe],
-               "errors": str(args.errors), "method": args.method,
-               "lines": [r.as_dict() for r in results]}
-        write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs)
         print(f"json: {args.json}")
     if args.plot:
-        diagonals.plot_lines(results, args.plot, f"{model.name}: length deviations "
-                                                 f"({args.errors})", inputs)
         print(f"plot: {args.plot}")
     return 0

@@ -9,10 +9,12 @@ closed`` for the Zhang & Hu closed form), averages the rounds and writes the err
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 
-from volerr.errors import InputError, require
+from volerr.cli._common import add_vector
+from volerr.errors import require
 
 
 def register(sub) -> None:
@@ -24,26 +26,32 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="tracker data file(s)")
     p.add_argument("--axis", required=True, help="the measured axis (X, Y, Z, B, C ...)")
-    p.add_argument("--out", required=True, help="output error table (CSV)")
+    p.add_argument("--out", required=True, metavar="DIR/A.csv",
+                   help="output error table (CSV).  For 'volerr squareness' and 'volerr map' "
+                        "name it after the axis inside an error directory: DIR/X.csv, "
+                        "DIR/Y.csv ... (add constants.csv there for squareness / location "
+                        "errors)")
     p.add_argument("--format", choices=("csv", "thesis"), default="csv",
                    help="csv: round,point,position,x,y,z (default); thesis: the raw export of "
                         "the thesis, blocks of label,x,y,z rows, one file per round")
     p.add_argument("--positions", help="thesis format: commanded positions, start:stop:count "
                                        "or a comma list")
-    p.add_argument("--points", help="thesis format: labels of the point blocks in file order, "
-                                    "e.g. K,P,Q (default: the first label of each block)")
+    p.add_argument("--labels", dest="points",
+                   help="thesis format: labels of the point blocks in file order, e.g. K,P,Q "
+                        "(default: the first label of each block)")
+    p.add_argument("--points", dest="points", help=argparse.SUPPRESS)  # old name of --labels
     p.add_argument("--method", choices=("lsq", "closed"), default="lsq",
                    help="lsq: weighted least squares over all points (default); closed: Zhang "
                         "& Hu closed form of six selected equations")
-    p.add_argument("--tracker", metavar="X,Y,Z",
-                   help="tracker position in the measurement frame (mm): weights the points "
-                        "with the AT960 uncertainty model and writes _u95 columns (write --tracker=-1,2,3 "
-                        "when the first number is negative)")
-    p.add_argument("--direction", metavar="X,Y,Z", help="axis direction in the measurement "
-                                                        "frame (default: the layout's)")
-    p.add_argument("--origin", metavar="X,Y,Z", help="a point on a rotary axis in the "
-                                                     "measurement frame, mm (default 0,0,0), "
-                                                     "or 'layout': the axis point of the layout")
+    add_vector(p, "--tracker",
+               help="tracker position X Y Z in the measurement frame, mm (X Y Z or X,Y,Z): "
+                    "weights the points with the AT960 uncertainty model and writes _u95 "
+                    "columns (not given: unweighted, no _u95)")
+    add_vector(p, "--direction", help="axis direction X Y Z in the measurement frame (not "
+                                      "given: the layout's)")
+    p.add_argument("--origin", nargs="+", metavar="X",
+                   help="a point X Y Z on a rotary axis in the measurement frame, mm (X Y Z or "
+                        "X,Y,Z; not given: 0 0 0), or 'layout': the axis point of the layout")
     p.add_argument("--sense", choices=("auto", "+", "-"), default="auto",
                    help="sense of the nominal motion of the points (default: from the data)")
     p.add_argument("--max-cond", type=float, default=1e4,
@@ -55,7 +63,7 @@ def register(sub) -> None:
                         "smoothing spline by GCV) and report their residuals (JSON, plot)")
     p.add_argument("--residuals", help="write per-position, per-point residuals (CSV, um)")
     p.add_argument("--signs", choices=("component", "model"), default="component",
-                   help="component (default, as the thesis and INTERFACE.md): the error motions "
+                   help="component (as the thesis; 'volerr formats tracker'): the error motions "
                         "of the moving component that carries the points; model: the volerr "
                         "model's tool-relative convention (for a table axis of LAYOUT: negated "
                         "and re-referenced to the tool point; a linear axis measured from a "
@@ -67,12 +75,26 @@ def register(sub) -> None:
 
 
 def _vec(text, what):
-    try:
-        v = [float(c) for c in str(text).split(",")]
-    except ValueError:
-        raise InputError(f"{what} must be three comma-separated numbers, got {text!r}") from None
-    require(len(v) == 3, f"{what} must be three comma-separated numbers, got {text!r}")
-    return v
+    from volerr.cli._common import parse_vector
+
+    return list(parse_vector(text, what))
+
+
+def _refuse_repeated_files(files) -> None:
+    """The same tracker file given twice would count its rounds twice (understated Type A
+    uncertainty)."""
+    import os
+    from pathlib import Path
+
+    seen = []
+    for f in files:
+        p = Path(f)
+        for q in seen:
+            same = p.resolve() == q.resolve() or (
+                p.exists() and q.exists() and os.path.samefile(p, q))
+            require(not same, f"tracker file {f} is given twice (its rounds would be counted "
+                              f"twice)")
+        seen.append(p)
 
 
 def read_rounds(files, fmt="csv", positions=None, points=None):
@@ -90,7 +112,7 @@ def read_rounds(files, fmt="csv", positions=None, points=None):
             rounds.append(read_thesis_export(f, pos, labels))
     else:
         require(positions is None and points is None,
-                "--positions and --points apply to --format thesis only")
+                "--positions and --labels apply to --format thesis only")
         for f in files:
             rounds.extend(read_tracker_csv(f))
     return rounds
@@ -112,18 +134,17 @@ def residual_csv(result) -> str:
 
 
 def run(args) -> int:
-    from volerr.fileio import check_output, write_text
+    from volerr.fileio import Outputs, write_text
     from volerr.identify.solve import identify, to_model_signs
     from volerr.machine.layout import read_layout
     from volerr.tables.table import table_to_csv
 
-    inputs = list(args.files)
-    outs = [o for o in (args.out, args.residuals, args.json, args.plot) if o]
-    for o in outs:
-        check_output(o, inputs)
-    require(len(set(outs)) == len(outs), "output files must differ from each other")
-    require(not args.plot or str(args.plot).lower().endswith(".png"),
-            f"plot file must end in .png, got {args.plot}")
+    from volerr.cli._common import layout_inputs
+
+    inputs = list(args.files) + layout_inputs(args.layout)
+    _refuse_repeated_files(args.files)
+    outs = Outputs(inputs).file("--out", args.out).file("--residuals", args.residuals) \
+        .file("--json", args.json).plot("--plot", args.plot).check()
     layout = read_layout(args.layout)
     rounds = read_rounds(args.files, args.format, args.positions, args.points)
     sense = {"auto": "auto", "+": 1, "-": -1}[args.sense]
@@ -131,7 +152,7 @@ def run(args) -> int:
         rounds, layout, args.axis, method=args.method,
         tracker=_vec(args.tracker, "--tracker") if args.tracker else None,
         direction=_vec(args.direction, "--direction") if args.direction else None,
-        origin=("layout" if args.origin == "layout" else
+        origin=("layout" if args.origin == ["layout"] else
                 _vec(args.origin, "--origin") if args.origin else None),
         sense=sense, max_cond=args.max_cond, outlier_k=args.outlier_k)
     table = result.table()
@@ -144,14 +165,15 @@ def run(args) -> int:
         from volerr.tables.errorfit import fit_table
         fits = fit_table(table, args.fit, weighted=table.std != {})
         summary["fit"] = [f.report() for f in fits.values()]
-    if args.plot:
-        from volerr.identify.plots import plot_identification
-        plot_identification(result, args.plot, fits)
-    write_text(args.out, text, inputs=inputs)
-    if args.residuals:
-        write_text(args.residuals, residual_csv(result), inputs=inputs)
-    if args.json:
-        write_text(args.json, json.dumps(summary, indent=2) + "\n", inputs=inputs)
+    with outs:
+        if args.plot:
+            from volerr.identify.plots import plot_identification
+            plot_identification(result, outs.path("--plot"), fits)
+        write_text(outs.path("--out"), text, inputs=inputs)
+        if args.residuals:
+            write_text(outs.path("--residuals"), residual_csv(result), inputs=inputs)
+        if args.json:
+            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
     s = summary
     print(f"{args.axis}: {s['n_positions']} positions x {len(s['points'])} points x "
           f"{s['n_rounds']} round(s), method {s['method']}, condition {s['condition']:.3g}, "

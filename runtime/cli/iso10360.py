@@ -13,11 +13,11 @@ import json
 import numpy as np
 
 from volerr.cli._common import add_error_arguments, error_functions_from_args, inputs_of
-from volerr.fileio import check_output, check_plot, write_text
+from volerr.fileio import Outputs, write_text
 from volerr.machine.model import load
 from volerr.uncertainty import iso10360
 from volerr.uncertainty.report import num
-from volerr.cmm.volmap import check_distinct, volume
+from volerr.cmm.volmap import volume
 
 
 def register(sub) -> None:
@@ -40,11 +40,7 @@ def run(args) -> int:
     model = load(args.layout)
     funcs = error_functions_from_args(args, model)
     inputs = inputs_of(args)
-    check_distinct(("--json", args.json), ("--plot", args.plot))
-    if args.json:
-        check_output(args.json, inputs)
-    if args.plot:
-        check_plot(args.plot, inputs)
+    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot).check()
     spec = iso10360.parse_spec(args.mpe, "--mpe") if args.mpe else None
     res = iso10360.simulate(model, funcs, args.probe, volume(model, funcs, args.volume),
                             noise_um=args.noise_um, seed=args.seed, spec=spec)
@@ -58,11 +54,12 @@ def run(args) -> int:
     if spec is not None:
         print(f"  MPE {spec.text()}: max |E0| / MPE = {num(d['max_ratio_to_mpe'], '.3f')} -> "
               f"{'PASS' if d['passes'] else 'FAIL'}")
-    if args.json:
-        doc = {"layout": model.name, "errors": str(args.errors), "probe_mm": list(args.probe),
-               "repetitions": int(res.E_um.shape[-1]), **d}
-        write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs)
-    if args.plot:
-        iso10360.plot(res, args.plot, f"{model.name}: simulated ISO 10360-2 ({args.errors})",
-                      inputs)
+    with outs:
+        if args.json:
+            doc = {"layout": model.name, "errors": str(args.errors),
+                   "probe_mm": list(args.probe), "repetitions": int(res.E_um.shape[-1]), **d}
+            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+        if args.plot:
+            iso10360.plot(res, outs.path("--plot"),
+                          f"{model.name}: simulated ISO 10360-2 ({args.errors})", inputs)
     return 0 if np.isfinite(d["max_abs_E_um"]) else 1

@@ -105,7 +105,7 @@ def run(args) -> int:
     import sys
 
     from volerr import positioning as pos
-    from volerr.fileio import check_folder, check_output, check_plot, write_bytes, write_text
+    from volerr.fileio import Outputs, write_bytes, write_text
 
     inputs = list(args.runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs), "the same RUN file is given "
@@ -113,22 +113,13 @@ def run(args) -> int:
     require(args.material_temp_C is None or args.cte_ppm_per_K is not None,
             "--material-temp-C is used only with --cte-ppm-per-K")
     axes = _axes(args.axis, len(inputs))
-    outputs = [o for o in (args.json, args.plot, args.html) if o]
-    tables = []
-    if args.table_out:
-        d = check_folder(args.table_out)
-        dup = sorted({a for a in axes if axes.count(a) > 1})
-        require(not dup, f"--table-out writes one table per axis: {len(inputs)} runs of axis "
-                         f"{dup[0] if dup else ''}; evaluate them one at a time")
-        tables = [d / f"{a}.csv" for a in axes]
-    every = outputs + [str(t) for t in tables]
-    for i, o in enumerate(every):
-        check_output(o, inputs)
-        require(all(Path(o).resolve() != Path(q).resolve() for q in every[:i]),
-                f"two outputs are the same file {o}: give distinct --json, --plot, --html and "
-                f"--table-out paths")
-    if args.plot:
-        check_plot(args.plot, inputs)
+    dup = sorted({a for a in axes if axes.count(a) > 1})
+    require(not args.table_out or not dup,
+            f"--table-out writes one table per axis: {len(inputs)} runs of axis "
+            f"{dup[0] if dup else ''}; evaluate them one at a time")
+    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
+        .file("--html", args.html) \
+        .folder("--table-out", args.table_out, files=[f"{a}.csv" for a in axes]).check()
 
     evaluations, thermals, notes = [], [], []
     for f, a in zip(inputs, axes):
@@ -141,7 +132,7 @@ def run(args) -> int:
         thermals.append(th)
         notes.append(pos.standard_notes(r, th is not None))
     report = pos.report_dict(evaluations, thermals, notes)
-    table_texts = [pos.error_table_csv(ev) for ev in evaluations] if tables else []
+    table_texts = [pos.error_table_csv(ev) for ev in evaluations] if args.table_out else []
     png = pos.plot_runs(evaluations) if (args.plot or args.html) else None
     html_text = None
     if args.html:
@@ -150,14 +141,15 @@ def run(args) -> int:
         html_text = pos.report_html(report, png, inputs, f"Evaluated with volerr {ver} on "
                                                          f"{datetime.date.today().isoformat()}.")
 
-    # all outputs at the end
-    write_text(args.json, json.dumps(report, indent=2) + "\n", inputs=inputs)
-    if args.plot:
-        write_bytes(args.plot, png, inputs=inputs)
-    if html_text is not None:
-        write_text(args.html, html_text, inputs=inputs)
-    for path, text in zip(tables, table_texts):
-        write_text(path, text, inputs=inputs)
+    # all outputs at the end, all or nothing
+    with outs:
+        write_text(outs.path("--json"), json.dumps(report, indent=2) + "\n", inputs=inputs)
+        if args.plot:
+            write_bytes(outs.path("--plot"), png, inputs=inputs)
+        if html_text is not None:
+            write_text(outs.path("--html"), html_text, inputs=inputs)
+        for a, text in zip(axes, table_texts):
+            write_text(outs.path("--table-out") / f"{a}.csv", text, inputs=inputs)
 
     runs = report["runs"] if "runs" in report else [report]
     for r in runs:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from volerr.errors import require
-from volerr.fileio import check_output
+from volerr.fileio import Outputs
 
 
 def register(sub) -> None:
@@ -47,27 +47,36 @@ def run(args) -> int:
     from volerr.loop import candidates
     from volerr.loop.run import run_loop
 
-    inputs = [args.data, args.layout]
-    check_output(args.json, inputs)
-    if args.html:
-        check_output(args.html, inputs)
-        require(Path(args.html).resolve() != Path(args.json).resolve(),
-                "--json and --html must be different files")
+    from volerr.cli._common import layout_inputs
+    from volerr.machine.model import load
+
+    inputs = [args.data, *layout_inputs(args.layout)]
+    model = load(args.layout)
+    aug = (f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py")
+    out_dir = Path(args.out_dir) if args.out_dir else Path(args.json).resolve().parent
+    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
+        .folder("--out-dir", out_dir, files=aug) \
+        .folder("--errors-out", args.errors_out,
+                files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     families = candidates.FAMILIES
     if args.families:
         families = tuple(f.strip() for f in args.families.split(",") if f.strip())
         bad = [f for f in families if f not in candidates.FAMILIES]
         require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
                 f"{' '.join(candidates.FAMILIES)}")
-    out_dir = Path(args.out_dir) if args.out_dir else Path(args.json).resolve().parent
-    report = run_loop(args.layout, args.data, seed=args.seed, folds=args.folds,
-                      test_fraction=args.test_fraction, degree=args.degree,
-                      out_dir=out_dir, families=families, inputs=inputs)
-    report.write_json(args.json, inputs=inputs)
-    if args.html:
-        report.write_html(args.html, inputs=inputs)
-    if args.errors_out:
-        report.write_error_tables(args.errors_out, inputs=inputs)
+    with outs:
+        staged = outs.path("--out-dir")
+        report = run_loop(args.layout, args.data, seed=args.seed, folds=args.folds,
+                          test_fraction=args.test_fraction, degree=args.degree,
+                          out_dir=staged, families=families, inputs=inputs)
+        for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
+            if report.data.get(key):
+                report.data[key] = str(out_dir / Path(report.data[key]).name)
+        report.write_json(outs.path("--json"), inputs=inputs)
+        if args.html:
+            report.write_html(outs.path("--html"), inputs=inputs)
+        if args.errors_out:
+            report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
     print(report.summary())
     for e in report.effects:
         pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())

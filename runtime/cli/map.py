@@ -12,7 +12,7 @@ import json
 from volerr.cli._common import add_common, error_functions_from_args, inputs_of, parse_at
 from volerr.cmm import volmap
 from volerr.errors import require
-from volerr.fileio import write_text
+from volerr.fileio import Outputs, write_text
 from volerr.machine.model import load
 
 
@@ -21,7 +21,8 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
     p.add_argument("--grid", nargs="+", type=int, default=None, metavar="N",
-                   help="grid points per axis: N, or nx ny nz (default 5)")
+                   help="grid points per axis: N, or nx ny nz (default 5; 2..200 per axis, at "
+                        "most 10^6 points in all: N <= 100)")
     p.add_argument("--out", metavar="CSV", help="map CSV: axis positions, Xp Yp Zp, dx_um dy_um "
                                                 "dz_um (+ rx_um ry_um rz_um)")
     p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")
@@ -34,30 +35,31 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    require(args.magnify is None or args.magnify > 0, f"--magnify must be positive, got {args.magnify}")
+    import math
+
+    require(args.magnify is None or (math.isfinite(args.magnify) and args.magnify > 0),
+            f"--magnify must be a positive finite number, got {args.magnify}")
     model = load(args.layout)
     funcs = error_functions_from_args(args, model)
-    inputs = inputs_of(args)
+    inputs = inputs_of(args, model)
     rnd_plot = args.plot_random
     if rnd_plot is None and args.plot and funcs.has_random:
         rnd_plot = volmap.random_plot_path(args.plot)
-    volmap.check_distinct(("--out", args.out), ("--plot", args.plot),
-                          ("--plot-random", rnd_plot), ("--json", args.json))
-    for out in (args.out, args.plot, rnd_plot, args.json):
-        if out is not None:
-            from volerr.fileio import check_output, check_plot
-            (check_plot if out in (args.plot, rnd_plot) else check_output)(out, inputs)
+    outs = Outputs(inputs).file("--out", args.out).plot("--plot", args.plot) \
+        .plot("--plot-random", rnd_plot).file("--json", args.json).check()
     vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at),
                                  box=volmap.volume(model, funcs, args.volume))
     s = vmap.summary()
-    if args.out:
-        volmap.write_map_csv(args.out, vmap, inputs)
-    if args.plot:
-        s["magnification"] = volmap.plot_map(vmap, args.plot, args.magnify, inputs)
-    if rnd_plot:
-        s["random_magnification"] = volmap.plot_random(vmap, rnd_plot, args.magnify, inputs)
-    if args.json:
-        write_text(args.json, json.dumps(s, indent=2) + "\n", inputs)
+    with outs:
+        if args.out:
+            volmap.write_map_csv(outs.path("--out"), vmap, inputs)
+        if args.plot:
+            s["magnification"] = volmap.plot_map(vmap, outs.path("--plot"), args.magnify, inputs)
+        if rnd_plot:
+            s["random_magnification"] = volmap.plot_random(vmap, outs.path("--plot-random"),
+                                                           args.magnify, inputs)
+        if args.json:
+            write_text(outs.path("--json"), json.dumps(s, indent=2) + "\n", inputs)
     print(f"{model.name}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
           f"probe {' '.join(f'{v:g}' for v in vmap.probe)} mm")
     m = s["max_abs_um"]

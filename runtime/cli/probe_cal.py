@@ -15,6 +15,7 @@ import json
 import math
 import sys
 
+from volerr.cli._common import add_vector
 from volerr.errors import InputError, require
 from volerr.fileio import write_text
 
@@ -58,8 +59,8 @@ def register(sub) -> None:
                    help="write a probing plan (nominal ball centres x,y,z,phi_deg,theta_deg) "
                         "instead of calibrating")
     g.add_argument("--ball-radius", type=float, metavar="r", help="stylus-ball radius, mm")
-    g.add_argument("--center", default="0,0,0", metavar="X,Y,Z",
-                   help="sphere centre, mm (default 0,0,0)")
+    add_vector(g, "--center", default=(0.0, 0.0, 0.0),
+               help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
     g.add_argument("--step-deg", type=float, default=18.0,
                    help="Pahk plan: latitude and azimuth step, deg (default 18)")
     g.add_argument("--circles", type=int, default=5,
@@ -89,7 +90,7 @@ def _run_plan(args) -> int:
     require(args.ball_radius is not None and args.ball_radius > 0,
             "--plan needs --ball-radius (stylus-ball radius, mm, > 0)")
     require(args.sphere_radius > 0, "--sphere-radius must be > 0 mm")
-    center = _floats(args.center, "--center", 3)
+    center = list(args.center)
     if args.phis or args.per_circle:
         require(args.phis and args.per_circle, "a custom plan needs both --phis and --per-circle")
         plan = pp.circles_plan(_floats(args.phis, "--phis"), args.per_circle, not args.no_pole)
@@ -97,8 +98,11 @@ def _run_plan(args) -> int:
         plan = pp.pahk_plan(args.step_deg, args.circles, not args.no_pole)
     pts = pp.nominal_points(plan, center, args.sphere_radius, args.ball_radius,
                             args.tilt_deg, args.roll_deg)
-    path = write_text(args.plan, pp.plan_csv_text(plan, pts))
-    print(f"plan: {len(plan)} points -> {path}")
+    from volerr.fileio import Outputs
+
+    with Outputs().file("--plan", args.plan) as outs:
+        write_text(outs.path("--plan"), pp.plan_csv_text(plan, pts))
+    print(f"plan: {len(plan)} points -> {args.plan}")
     return 0
 
 
@@ -111,44 +115,34 @@ def run(args) -> int:
     require(args.out, "--out MAP.csv is required")
     require(math.isfinite(args.sphere_radius) and args.sphere_radius > 0,
             f"--sphere-radius must be a positive length in mm, got {args.sphere_radius}")
+    from volerr.fileio import Outputs
+
     inputs = [args.data]
-    from volerr.fileio import check_output
-
-    outputs = [o for o in (args.out, args.json, args.plot) if o]
-    for i, o in enumerate(outputs):
-        check_output(o, inputs + outputs[:i])
-    if args.plot:
-        from volerr.fileio import check_plot
-        check_plot(args.plot, inputs + [args.out])
-    if args.plots:  # checked before anything is written
-        from pathlib import Path
-
-        from volerr.fileio import check_folder
-        d = check_folder(args.plots)
-        for name in ("probe_map_3d.png", "probe_map_2d.png"):
-            check_output(d / name, inputs + outputs)
+    outs = Outputs(inputs).file("--out", args.out).file("--json", args.json) \
+        .plot("--plot", args.plot) \
+        .folder("--plots", args.plots, files=("probe_map_3d.png", "probe_map_2d.png")).check()
     require(args.degree is None or 0 <= args.degree <= 20,
             f"--degree must be between 0 and 20, got {args.degree}")
     data = probe.read_sphere_csv(args.data)
     cal = probe.calibrate_data(data, args.sphere_radius, tilt_deg=args.tilt_deg,
                                roll_deg=args.roll_deg, degree=args.degree,
                                outlier_k=args.outlier_k, exclude_outliers=args.exclude_outliers)
-    out = write_text(args.out, probe.map_csv_text(cal), inputs=inputs)
     summary = cal.summary()
-    if args.json:
-        write_text(args.json, json.dumps(summary, indent=2) + "\n", inputs=inputs + [args.out])
-    if args.plot:
-        from volerr.probe.plots import plot_probe_calibration
+    with outs:
+        write_text(outs.path("--out"), probe.map_csv_text(cal), inputs=inputs)
+        if args.json:
+            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
+        if args.plot:
+            from volerr.probe.plots import plot_probe_calibration
 
-        plot_probe_calibration(cal, check_output(args.plot, inputs + [args.out]))
-    if args.plots:
-        from pathlib import Path
+            plot_probe_calibration(cal, outs.path("--plot"))
+        if args.plots:
+            from volerr.probe.plots import plot_probe_map_2d, plot_probe_map_3d
 
-        from volerr.probe.plots import plot_probe_map_2d, plot_probe_map_3d
-
-        d = Path(args.plots)
-        plot_probe_map_3d(cal, d / "probe_map_3d.png")
-        plot_probe_map_2d(cal, d / "probe_map_2d.png")
+            d = outs.path("--plots")
+            plot_probe_map_3d(cal, d / "probe_map_3d.png")
+            plot_probe_map_2d(cal, d / "probe_map_2d.png")
+    out = args.out
     for note in cal.notes:
         print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
     e = summary["probe_error_um"]

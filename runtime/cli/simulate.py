@@ -3,12 +3,13 @@
 The machine of LAYOUT (exact chain, random smooth error functions by seed) measured at
 random points with several probe/tool offsets, Gaussian noise, an unknown instrument
 placement, and optionally undeclared effects (``--effect``).  Writes the measured-deviation
-CSV of INTERFACE.md.  See :mod:`volerr.loop.simulate`.
+CSV ('volerr formats deviations').  See volerr.loop.simulate.
 """
 
 from __future__ import annotations
 
-from volerr.errors import InputError, require
+from volerr.cli._common import add_vector
+from volerr.errors import require
 
 
 def _effect(text: str) -> dict:
@@ -25,13 +26,35 @@ def _effect(text: str) -> dict:
     return out
 
 
-def _probe(text: str) -> tuple:
-    try:
-        v = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise InputError(f"--probe {text!r}: write x,y,z in mm") from None
-    require(len(v) == 3, f"--probe {text!r}: write x,y,z in mm")
-    return v
+#: keys of --effect that name something; every other key is a number
+_TEXT_KEYS = ("axis", "component", "direction")
+
+
+def _check_effect(e: dict, model, text: str) -> dict:
+    """Every value of an --effect checked against the layout: one line for a bad one."""
+    import math
+
+    for key, v in e.items():
+        if key == "kind":
+            continue
+        if key == "axis":
+            require(v in model.axes, f"--effect {text!r}: axis {v!r} is not an axis of "
+                                     f"{model.name} ({' '.join(model.axes)})")
+        elif key == "component":
+            require(v in model.parameters, f"--effect {text!r}: component {v!r} is not an "
+                                           f"error of {model.name}")
+        elif key == "direction":
+            require(v in ("x", "y", "z"), f"--effect {text!r}: direction must be x, y or z")
+        else:
+            require(isinstance(v, float), f"--effect {text!r}: {key} = {v!r} is not a number")
+            require(math.isfinite(v) and abs(v) <= 1e6,
+                    f"--effect {text!r}: {key} = {v:g} must be a finite number of at most 1e6")
+            if key == "degree":
+                require(v == int(v) and 1 <= v <= 30,
+                        f"--effect {text!r}: degree must be an integer 1..30")
+            if key == "period_mm":
+                require(v > 0, f"--effect {text!r}: period_mm must be positive")
+    return e
 
 
 def register(sub) -> None:
@@ -49,8 +72,9 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, help="measured-deviation CSV to write")
     p.add_argument("--points", type=int, default=600, help="number of points (default 600)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--probe", action="append", metavar="X,Y,Z",
-                   help="probe/tool offset in mm (repeat for several; default: a plan of five)")
+    add_vector(p, "--probe", append=True,
+               help="probe/tool offset X Y Z in mm (X Y Z or X,Y,Z; repeat for several; "
+                    "default: a plan of five)")
     p.add_argument("--rounds", type=int, default=1, help="measurement rounds (set-ups)")
     p.add_argument("--effect", action="append", default=[], metavar="KIND[:K=V,...]",
                    help="an undeclared effect (repeatable)")
@@ -65,12 +89,22 @@ def run(args) -> int:
     from volerr.loop.simulate import demo_probes, simulate
 
     require(10 <= args.points <= 10_000_000, "--points must be between 10 and 10^7")
-    require(args.noise_um >= 0 and args.magnitude_um >= 0, "noise and magnitude must be >= 0")
+    import math
+
+    require(all(math.isfinite(v) and 0 <= v <= 1e6 for v in (args.noise_um, args.magnitude_um)),
+            "--noise-um and --magnitude-um must be finite, between 0 and 1e6 um")
+    from volerr.cli._common import layout_inputs
+    from volerr.fileio import Outputs
+
     model = load(args.layout)
-    probes = [_probe(t) for t in args.probe] if args.probe else demo_probes(model)
+    inputs = layout_inputs(args.layout)
+    outs = Outputs(inputs).file("--out", args.out).check()
+    effects = [_check_effect(_effect(e), model, e) for e in args.effect]
+    probes = [tuple(v) for v in args.probe] if args.probe else demo_probes(model)
     camp = simulate(args.layout, n_points=args.points, seed=args.seed, probes=probes,
-                    rounds=args.rounds, effects=[_effect(e) for e in args.effect],
+                    rounds=args.rounds, effects=effects,
                     noise_um=args.noise_um, magnitude_um=args.magnitude_um)
-    path = camp.write_csv(args.out, inputs=[args.layout])
-    print(f"{camp.n_points} points of {model.name} -> {path}")
+    with outs:
+        camp.write_csv(outs.path("--out"), inputs=inputs)
+    print(f"{camp.n_points} points of {model.name} -> {args.out}")
     return 0

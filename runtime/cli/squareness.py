@@ -30,14 +30,16 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from volerr.fileio import write_text
+    from volerr.cli._common import layout_inputs
+    from volerr.fileio import Outputs, write_text
     from volerr.machine.layout import read_layout
     from volerr.cmm.squareness import squareness
     from volerr.tables.table import read_error_dir, table_to_csv, write_constants
 
     layout = read_layout(args.layout)
     src, out = Path(args.directory), Path(args.out)
-    require(src.is_dir(), f"error directory {src} does not exist")
+    require(src.exists(), f"error directory {src} does not exist")
+    require(src.is_dir(), f"{src} is a file: give the error directory (X.csv, Y.csv ...)")
     require(not (out.exists() and out.resolve() == src.resolve()),
             "--out must differ from the input directory (inputs are never overwritten)")
     tables, (consts, cstd, _) = read_error_dir(src, axes=layout.axis_names)
@@ -45,22 +47,26 @@ def run(args) -> int:
     values, std, corrected, slopes = squareness(tables, layout, args.tables_are)
     require(values, f"{src}: no pair of straightness tables for a squareness (EC0Y needs EYX "
                     f"in X.csv and EXY in Y.csv, EB0Z EZX and EXZ, EA0Z EZY and EYZ)")
-    inputs = [p for p in src.iterdir() if p.is_file()]
+    inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
     texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
-    for name, text in texts.items():
-        write_text(out / name, text, inputs=inputs)
+    outs = Outputs(inputs).folder("--out", out, files=[*texts, "constants.csv"]) \
+        .file("--json", args.json).check()
     merged = {k: v for k, v in consts.items() if k not in values}
     merged_std = {k: v for k, v in cstd.items() if k in merged}
     merged.update(values)
     merged_std.update(std)
-    write_constants(out / "constants.csv", merged, inputs=inputs, std=merged_std)
+    with outs:
+        staged = outs.path("--out")
+        for name, text in texts.items():
+            write_text(staged / name, text, inputs=inputs)
+        write_constants(staged / "constants.csv", merged, inputs=inputs, std=merged_std)
+        if args.json:
+            doc = {"squareness_urad": {k: v * 1e6 for k, v in values.items()},
+                   "u_urad": {k: v * 1e6 for k, v in std.items()},
+                   "slopes_urad": {k: v * 1e6 for k, v in slopes.items()},
+                   "tables_are": args.tables_are}
+            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs=inputs)
     for sq, v in values.items():
         print(f"{sq} = {v * 1e6:.3f} urad (u = {std[sq] * 1e6:.3f} urad)")
-    if args.json:
-        doc = {"squareness_urad": {k: v * 1e6 for k, v in values.items()},
-               "u_urad": {k: v * 1e6 for k, v in std.items()},
-               "slopes_urad": {k: v * 1e6 for k, v in slopes.items()},
-               "tables_are": args.tables_are}
-        write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs=inputs)
     print(f"-> {out}")
     return 0

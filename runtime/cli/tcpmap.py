@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments
+from volerr.cli._common import add_error_arguments, add_vector
 from volerr.errors import require
-from volerr.fileio import check_output, write_text
+from volerr.cli._common import layout_inputs
+from volerr.fileio import Outputs, write_text
 
 
 def register(sub) -> None:
@@ -23,10 +24,10 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("layout", help="five-axis layout name or file")
     add_error_arguments(p)
-    p.add_argument("--point", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"),
-                   help="workpiece point, mm (workpiece frame)")
-    p.add_argument("--tool", nargs=3, type=float, default=(0.0, 0.0, 0.0),
-                   metavar=("XT", "YT", "ZT"), help="tool-tip offset in the tool frame, mm")
+    add_vector(p, "--point", required=True,
+               help="workpiece point X Y Z, mm, workpiece frame (X Y Z or X,Y,Z)")
+    add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
+               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z)")
     p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
     p.add_argument("--out", required=True, help="PNG file")
     p.add_argument("--csv", help="grid as CSV")
@@ -47,38 +48,24 @@ def run(args) -> int:
     require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")
     require(all(math.isfinite(v) for v in (*args.point, *args.tool)), "point/tool must be finite")
     require(3 <= args.steps <= 1000, "--steps must be 3..1000")
+    require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
+                                              f"directory (the folder holding X.csv ...)")
     require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
-    inputs = list(Path(args.errors).glob("*.csv"))
-    for out in (args.out, args.csv):
-        if out:
-            check_output(out, inputs)
-    require(str(args.out).lower().endswith(".png"), f"plot file must end in .png, got {args.out}")
+    inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
+    outs = Outputs(inputs).plot("--out", args.out).file("--csv", args.csv).check()
     a1, a2, q1, q2, err, valid = tcp_error_map(model, funcs, args.point, args.tool,
                                                args.steps, args.steps)
     require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
                          "for every rotary position")
-    plot_tcp_error_map(model, funcs, args.point, args.out, args.tool, n1=args.steps,
-                       n2=args.steps)
+    with outs:
+        plot_tcp_error_map(model, funcs, args.point, outs.path("--out"), args.tool,
+                           n1=args.steps, n2=args.steps)
+        if args.csv:
+            write_text(outs.path("--csv"), _grid_csv(model, args, a1, a2, q1, q2, err),
+                       inputs)
     mag = np.linalg.norm(err, axis=2) * 1e3
-    if args.csv:
-        p = np.asarray(args.point, float)
-        t = np.asarray(args.tool, float)
-        g1, g2 = np.meshgrid(q1, q2)
-        lin = model.module.inverse_linear(
-            *(np.deg2rad(g1.ravel() if a == a1 else g2.ravel()) for a in model.rotary_axes),
-            p[0], p[1], p[2], t[0], t[1], t[2])
-        lin = [np.broadcast_to(v, g1.size) for v in lin]
-        rows = [f"{a1}_deg,{a2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
-        e = err.reshape(-1, 3) * 1e3
-        m = mag.ravel()
-        for i in range(g1.size):
-            cells = [f"{g1.ravel()[i]:.10g}", f"{g2.ravel()[i]:.10g}"] + \
-                [f"{lin[k][i]:.10g}" for k in range(3)]
-            cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
-            rows.append(",".join(cells))
-        write_text(args.csv, "\n".join(rows) + "\n", inputs)
     print(f"{model.name}: tool-tip error at ({', '.join(f'{v:g}' for v in args.point)}) mm over "
           f"{a1} {q1[0]:g}..{q1[-1]:g} deg, {a2} {q2[0]:g}..{q2[-1]:g} deg: max "
           f"{np.nanmax(mag):.3f} um, min {np.nanmin(mag):.3f} um "
@@ -87,3 +74,26 @@ def run(args) -> int:
     for note in notes:
         print(f"note: {note}", file=sys.stderr)
     return 0
+
+
+def _grid_csv(model, args, a1, a2, q1, q2, err) -> str:
+    """The ``--csv`` text: one row per grid point, empty error cells where invalid."""
+    import numpy as np
+
+    mag = np.linalg.norm(err, axis=2) * 1e3
+    p = np.asarray(args.point, float)
+    t = np.asarray(args.tool, float)
+    g1, g2 = np.meshgrid(q1, q2)
+    lin = model.module.inverse_linear(
+        *(np.deg2rad(g1.ravel() if a == a1 else g2.ravel()) for a in model.rotary_axes),
+        p[0], p[1], p[2], t[0], t[1], t[2])
+    lin = [np.broadcast_to(v, g1.size) for v in lin]
+    rows = [f"{a1}_deg,{a2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
+    e = err.reshape(-1, 3) * 1e3
+    m = mag.ravel()
+    for i in range(g1.size):
+        cells = [f"{g1.ravel()[i]:.10g}", f"{g2.ravel()[i]:.10g}"] + \
+            [f"{lin[k][i]:.10g}" for k in range(3)]
+        cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
+        rows.append(",".join(cells))
+    return "\n".join(rows) + "\n"

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from volerr.cli._common import add_error_arguments
 from volerr.errors import require
-from volerr.fileio import check_output, write_bytes, write_text
+from volerr.fileio import Outputs, write_bytes, write_text
 from volerr.machine.model import load
 from volerr.uncertainty import ensemble, montecarlo as mc, tasks
 from volerr.uncertainty.report import num
@@ -125,15 +125,11 @@ def run(args) -> int:
     inputs = [Path(args.task)] + ([Path(args.probe_map)] if args.probe_map else [])
     if args.errors:
         inputs += inputs_of(args)
-    outs = [("--json", args.json), ("--html", args.html), ("--plot", args.plot)]
-    from volerr.cmm.volmap import check_distinct
-    check_distinct(*outs)
-    for _, o in outs:
-        if o is not None:
-            check_output(o, inputs)
-    if args.plot:
-        from volerr.fileio import check_plot
-        check_plot(args.plot, inputs)
+    from volerr.cli._common import layout_inputs
+
+    inputs += layout_inputs(args.layout)
+    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
+        .plot("--plot", args.plot).check()
     task = tasks.read_task(args.task, model.axes)
     funcs = error_functions_from_args(args, model) if args.errors else None
     spec = ensemble.parse_spec(args.spec) if args.spec else None
@@ -191,11 +187,12 @@ def run(args) -> int:
                   f"{num(q['bias_um'], '+.3f')} um  u {q['standard_uncertainty_um']:.3f} um  "
                   f"U {q['expanded_uncertainty_um']:.3f} um  95% [{num(lo, '.6f')}, "
                   f"{num(hi, '.6f')}] mm")
-    write_text(args.json, json.dumps(doc, indent=2) + "\n", inputs)
-    if args.plot:
-        write_bytes(args.plot, hist, inputs)
-    if args.html:
-        from volerr.uncertainty import plots, report
-        conv = plots.convergence_png(values, prob.names, title)
-        write_text(args.html, report.html_report(doc, [hist, conv]), inputs)
+    with outs:
+        write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+        if args.plot:
+            write_bytes(outs.path("--plot"), hist, inputs)
+        if args.html:
+            from volerr.uncertainty import plots, report
+            conv = plots.convergence_png(values, prob.names, title)
+            write_text(outs.path("--html"), report.html_report(doc, [hist, conv]), inputs)
     return 0

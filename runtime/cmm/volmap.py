@@ -72,7 +72,7 @@ def grid_counts(grid) -> tuple:
         grid = grid * 3
     require(all(2 <= g <= 200 for g in grid), f"grid counts must be between 2 and 200, got {grid}")
     require(int(np.prod(grid)) <= 1_000_000, f"grid of {int(np.prod(grid))} points is too large "
-                                             f"(at most 1000000)")
+                                             f"(at most 1000000 points: N <= 100 for --grid N)")
     return tuple(grid)
 
 
@@ -302,7 +302,8 @@ def plot_random(vmap: VolumetricMap, path, magnify: float | None = None, inputs=
             ax.plot(*np.stack([p - d, p + d]).T, color=c, lw=1.4)
     _equal_box(ax, np.vstack([nom - k * r, nom + k * r]))
     sm = cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, shrink=0.6, label="|r| = sqrt(rx^2 + ry^2 + rz^2) (um)")
+    fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.14,  # clear of the z label
+                 label="|r| = sqrt(rx^2 + ry^2 + rz^2) (um)")
     ax.set_title(f"{vmap.layout} random component (1 sigma), bars +-{k:g} x (rx, ry, rz)\n"
                  f"max |r| {mag.max():.2f} um", fontsize=10)
     fig.tight_layout()

@@ -62,9 +62,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.fiveaxis import gcode
 from volerr.errors import InputError, require
-from volerr.fiveaxis.kinematics import is_five_axis, linear_axes, linear_jacobian
+from volerr.fiveaxis.kinematics import linear_axes, linear_jacobian
 
 STRATEGIES = ("full", "thesis")
 

@@ -40,7 +40,7 @@ Interpretation (modal state, one block per line)
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from volerr.errors import InputError

@@ -155,6 +155,9 @@ def plot_program_errors(errors, path, title: str = ""):
     ax1.grid(True, which="both", alpha=0.3)
     ax2.set_ylabel("tool-axis error / urad")
     ax2.set_xlabel("program line")
+    if len(done) and np.allclose(ob, oa, rtol=1e-6, atol=1e-9):
+        ax2.set_title("orientation not compensated (use --orientation): before and after "
+                      "coincide", fontsize=9, color="0.3")
     ax2.legend(loc="best", fontsize=8)
     ax2.grid(True, alpha=0.3)
     fig.suptitle(title or "predicted error along the program")

@@ -33,7 +33,7 @@ import numpy as np
 
 from volerr.units import parse_number
 from volerr.errors import InputError, require
-from volerr.fileio import read_csv_rows
+from volerr.fileio import check_header, check_magnitude, read_csv_rows
 
 REQUIRED = ("round", "point", "position", "x", "y", "z")
 
@@ -57,10 +57,13 @@ def _open_rows(path: Path):
 
 
 def _num(path, lineno, what, text) -> float:
-    return parse_number(text, f"{path}:{lineno}", what)
+    where = f"{path}:{lineno}"
+    return check_magnitude(parse_number(text, where, what), f"{where}: {what}")
 
 
 def _header_index(path, header):
+    check_header([{"x_mm": "x", "y_mm": "y", "z_mm": "z"}.get(h.strip().lower(), h)
+                  for h in header], str(path))
     norm = [h.strip().lower() for h in header]
     alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
     norm = [alias.get(h, h) for h in norm]

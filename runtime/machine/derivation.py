@@ -36,11 +36,12 @@ def module_filename(layout: Layout) -> str:
     return f"{layout.name.lower()}.py"
 
 
-def all_sources() -> dict:
-    """File name -> text of every file of ``generated/`` (imports sympy)."""
+def all_sources(progress=None) -> dict:
+    """File name -> text of every file of ``generated/`` (imports sympy); ``progress``: optional
+    wrapper of the iterable of shipped layout names."""
     from volerr.derive.generate import all_generated
 
-    return all_generated()
+    return all_generated(progress) if progress else all_generated()
 
 
 def module_from_source(source: str, layout_name: str) -> types.ModuleType:

@@ -8,7 +8,8 @@ here for the fitting loop, so both always agree.
 Grammar: numbers, names, ``+ - * / **``, unary minus, parentheses and the functions
 ``sin cos exp sqrt abs``, ``ind(a, b)`` (1 where ``a == b``, else 0) and ``legendre(n, x)``
 (the Legendre polynomial of integer degree ``n``).  ``pi`` is the
-constant.  Every other name is a variable: an axis position (mm; rad for rotary axes, as in
+constant.  Bounds: at most 400 characters and 200 terms, numbers finite and at most 1e9 in
+magnitude, an exponent a number between -64 and 64 (``9**9**9**9`` is refused).  Every other name is a variable: an axis position (mm; rad for rotary axes, as in
 the derivation) or a covariate column of the measured data (``T_C``, ``t_s``, ``dir_X`` ...).
 """
 
@@ -25,6 +26,8 @@ FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "sqrt": np.sqrt, "abs"
              "ind": lambda a, b: (np.asarray(a) == np.asarray(b)).astype(float),
              "legendre": lambda n, x: np.polynomial.legendre.legval(x, [0.0] * int(n) + [1.0])}
 CONSTANTS = {"pi": np.pi}
+#: bounds that keep parsing, the derivation and the evaluation finite and fast
+MAX_CHARS, MAX_NODES, MAX_EXPONENT, MAX_CONSTANT = 400, 200, 64, 1e9
 _BINOPS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply,
            ast.Div: np.divide, ast.Pow: np.power}
 
@@ -36,7 +39,25 @@ def parse(text: str) -> ast.Expression:
         tree = ast.parse(str(text), mode="eval")
     except SyntaxError:
         raise InputError(f"basis expression {text!r} is not a valid expression") from None
+    require_small = len(str(text)) <= MAX_CHARS and sum(1 for _ in ast.walk(tree)) <= MAX_NODES
+    if not require_small:
+        raise InputError(f"basis expression {str(text)[:40]!r}...: longer than {MAX_CHARS} "
+                         f"characters or {MAX_NODES} terms")
     for node in ast.walk(tree):
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+            e = node.right
+            if isinstance(e, ast.UnaryOp) and isinstance(e.op, (ast.USub, ast.UAdd)):
+                e = e.operand
+            if not (isinstance(e, ast.Constant) and isinstance(e.value, (int, float))
+                    and not isinstance(e.value, bool) and abs(e.value) <= MAX_EXPONENT):
+                raise InputError(f"basis expression {text!r}: an exponent must be a number "
+                                 f"between -{MAX_EXPONENT} and {MAX_EXPONENT}")
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) \
+                and not isinstance(node.value, bool):
+            v = float(node.value)
+            if not (v == v and abs(v) <= MAX_CONSTANT):
+                raise InputError(f"basis expression {text!r}: number {node.value!r} is not "
+                                 f"finite or larger than {MAX_CONSTANT:g}")
         ok = isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.USub, ast.UAdd,
                                ast.Name, ast.Load, ast.Call, *_BINOPS))
         if isinstance(node, ast.Constant):

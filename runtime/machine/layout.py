@@ -189,7 +189,15 @@ def _vector(value, what: str, allow_expr: bool = False) -> tuple:
     for v in value:
         ok = isinstance(v, (int, float)) or (allow_expr and isinstance(v, str))
         require(ok, f"{what} must hold numbers{' or expressions' if allow_expr else ''}, got {v!r}")
+    for v in value:
+        if isinstance(v, (int, float)):
+            require(math.isfinite(v) and abs(v) <= MAX_COORDINATE,
+                    f"{what}: {v!r} is not a finite number of at most {MAX_COORDINATE:g}")
     return tuple(float(v) if isinstance(v, (int, float)) else v for v in value)
+
+
+#: largest coordinate, travel limit or parameter accepted in a layout (mm or deg)
+MAX_COORDINATE = 1e6
 
 
 def _unit(value, what: str) -> tuple[float, float, float]:
@@ -224,6 +232,10 @@ def _parse_axis(an: str, spec: dict, where: str) -> Axis:
     travel = spec.get("travel")
     require(isinstance(travel, list) and len(travel) == 2 and travel[0] < travel[1],
             f"{where}: axis {an} travel must be [min, max] with min < max")
+    require(all(isinstance(t, (int, float)) and math.isfinite(t)
+                and abs(t) <= MAX_COORDINATE for t in travel),
+            f"{where}: axis {an} travel must be finite numbers of at most "
+            f"{MAX_COORDINATE:g}, got {travel}")
     point = _vector(spec.get("point", [0, 0, 0]), f"{where}: axis {an} point", True)
     loc = ()
     if k == "rotary":
@@ -299,6 +311,8 @@ def _parse_header(text: str, origin: str) -> tuple[dict, str, str, dict]:
     params = doc.get("parameters", {})
     require(all(isinstance(v, (int, float)) for v in params.values()),
             f"{where}: [parameters] must be numbers")
+    require(all(math.isfinite(v) and abs(v) <= MAX_COORDINATE for v in params.values()),
+            f"{where}: [parameters] must be finite numbers of at most {MAX_COORDINATE:g}")
     return doc, name, kind, params
 
 
@@ -340,8 +354,8 @@ def _check_expressions(where: str, params: dict, axes: dict, frames: dict) -> No
             continue
         try:
             names = variables(v)
-        except InputError:
-            raise InputError(f"{where}: {what}: {v!r} is not a valid expression") from None
+        except InputError as exc:
+            raise InputError(f"{where}: {what}: {exc}") from None
         unknown = [n for n in names if n not in params]
         if unknown:
             raise InputError(f"{where}: {what}: unknown name {unknown[0]!r} in {v!r} "

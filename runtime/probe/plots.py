@@ -95,12 +95,12 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
                depthshade=False)
     if cal.outlier.any():
         ax.scatter(*tip[cal.outlier].T, marker="x", color="k", s=60, label="flagged outlier")
-        ax.legend(loc="upper left")
+        fig.legend(loc="lower left", fontsize=8)  # outside the axes: covers no point
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, shrink=0.6, label="probe error Probe(phi, theta), um")
-    ax.set_xlabel("x'")
-    ax.set_ylabel("y'")
-    ax.set_zlabel("z' (probe axis)")
+    fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.12, label="probe error Probe(phi, theta), um")
+    ax.set_xlabel("x' (unit direction)")
+    ax.set_ylabel("y' (unit direction)")
+    ax.set_zlabel("z' along the probe axis (unit direction)")
     ax.set_box_aspect((1, 1, 0.6 if cal.map.phi_range_deg[1] <= 95 else 1))
     stats = cal.stats_um()
     ax.set_title(f"Probe error map (3-D): R_eff {cal.r_eff:.4f} mm, max {stats['max']:.1f} / "
@@ -138,4 +138,4 @@ def draw_2d(fig, ax, cal) -> None:
                  f"{cal.map.roll_deg:g} deg\nspherical harmonics of degree {cal.map.degree}; "
                  f"max {stats['max']:.1f} / min {stats['min']:.1f} / rms {stats['rms']:.1f} um",
                  fontsize=10)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=8)

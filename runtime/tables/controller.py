@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.errors import InputError, require
+from volerr.fileio import check_header, check_magnitude
 from volerr.tables.table import ErrorTable
 
 FORMATS = ("isg", "etalon")
@@ -119,6 +120,7 @@ def read_isg(text: str, where: str = "ISG CSV") -> tuple[dict, dict]:
             continue
         cells = line.replace(",", " ").replace(";", " ").split()
         if header is None:
+            check_header(cells, f"{where} line {lineno}")
             header, start = cells, lineno
             continue
         require(len(cells) == len(header), f"{where} line {lineno}: {len(cells)} values for "
@@ -127,7 +129,8 @@ def read_isg(text: str, where: str = "ISG CSV") -> tuple[dict, dict]:
             vals = [float(c) for c in cells]
         except ValueError:
             raise InputError(f"{where} line {lineno}: not a number in {line!r}") from None
-        require(all(np.isfinite(vals)), f"{where} line {lineno}: NaN or infinite value")
+        for v in vals:
+            check_magnitude(v, f"{where} line {lineno}: value")
         rows.append((lineno, vals))
     flush()
     require(tables or constants, f"{where}: no error parameters found")
@@ -203,7 +206,8 @@ def read_etalon(text: str, where: str = "Etalon file") -> tuple[dict, dict]:
                 a, v = float(cells[0]), float(cells[1])
             except ValueError:
                 raise InputError(f"{where} line {lineno}: not a number in {line!r}") from None
-            require(np.isfinite(a) and np.isfinite(v), f"{where} line {lineno}: NaN or infinite")
+            check_magnitude(a, f"{where} line {lineno}: argument")
+            check_magnitude(v, f"{where} line {lineno}: value")
             grid.append((a, v))
             continue
         m = re.fullmatch(r"\[\s*([A-Za-z0-9]+)\s*\]", line)
@@ -223,7 +227,7 @@ def read_etalon(text: str, where: str = "Etalon file") -> tuple[dict, dict]:
                 constants["E" + section] = float(val)
             except ValueError:
                 raise InputError(f"{where} line {lineno}: VALUE is not a number") from None
-            require(np.isfinite(constants["E" + section]), f"{where} line {lineno}: NaN VALUE")
+            check_magnitude(constants["E" + section], f"{where} line {lineno}: VALUE")
         elif key == "GRIDPOINTS":
             require(_COMPONENT.match(section) is not None,
                     f"{where} line {lineno}: [{section}] is a position error; expected VALUE")

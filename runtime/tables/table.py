@@ -64,7 +64,7 @@ from volerr.tables import legendre
 from volerr.machine import iso_names
 from volerr.units import MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number, parse_number
 from volerr.errors import InputError, require
-from volerr.fileio import read_csv_rows, write_text
+from volerr.fileio import check_magnitude, read_csv_rows, write_text
 
 #: unit suffix -> (kind, factor to mm or rad)
 UNITS = {"um": ("length", MM_PER_UM), "mm": ("length", 1.0), "urad": ("angle", RAD_PER_URAD),
@@ -175,6 +175,10 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header and (line number, cells) of a CSV file; blank and '#' lines skipped."""
     rows = read_csv_rows(path, empty=f"{path}: empty file (no header)")
     (_, header), body = rows[0], rows[1:]
+    for sep, word in ((";", "semicolons"), ("\t", "tabs")):
+        require(not (len(header) == 1 and sep in header[0]),
+                f"{path}: columns separated by {word}; volerr reads comma-separated CSV "
+                f"(export with ',' as separator and '.' as decimal point)")
     require(all(header), f"{path}: empty column name in header")
     dup = sorted({h for h in header if header.count(h) > 1})
     if dup:
@@ -186,7 +190,8 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
 
 
 def _number(path, lineno, column, text) -> float:
-    return parse_number(text, f"{path}:{lineno}", column)
+    where = f"{path}:{lineno}"
+    return check_magnitude(parse_number(text, where, column), f"{where}: {column}")
 
 
 def _parse_column(path, col: str, axis: str):
@@ -373,6 +378,8 @@ def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]
     ``axes``: the axes the machine has; a table for any other axis, or any other CSV file,
     is refused."""
     d = Path(directory)
+    require(not d.is_file(), f"{d} is a file, not an error directory (give the folder that "
+                             f"holds X.csv, Y.csv ... and constants.csv)")
     require(d.is_dir(), f"error directory {d} does not exist")
     tables, consts = {}, ({}, {}, {})
     allowed = None if axes is None else set(axes)

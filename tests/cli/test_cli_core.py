@@ -28,10 +28,14 @@ def test_layouts_lists_the_ten_cmms():
     assert names == volerr.layouts()
 
 
-def test_layouts_long_one_complete_line_each():
-    lines = run("layouts", "--long").stdout.splitlines()
-    assert [ln.split()[0] for ln in lines] == volerr.layouts()
-    assert all(ln.rstrip().endswith(".") for ln in lines)
+def test_layouts_long_one_complete_block_each():
+    blocks = run("layouts", "--long").stdout.strip().split("\n\n")
+    assert [b.split()[0] for b in blocks] == volerr.layouts()
+    for b, name in zip(blocks, volerr.layouts()):
+        lay = volerr.load(name).layout
+        for a in lay.axis_names:  # every axis with its travel
+            assert f"  {a}: " in b and " travel " in b.split(f"  {a}: ")[1].splitlines()[0]
+        assert b.rstrip().endswith(".")  # the whole description, not its first sentence
 
 
 def test_unknown_layout():

@@ -11,7 +11,7 @@ def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
                           capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     summary = json.loads((out / "summary.json").read_text())
-    assert len(summary) == 7
+    assert len(summary) == 9
     for section in summary:
         for f in section["files"]:
             assert (out / f).exists(), f
@@ -20,7 +20,9 @@ def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
     cal = json.loads((out / "probe_cal.json").read_text())
     assert 0.99 < cal["r_eff_mm"] < 1.01
     html = (out / "index.html").read_text()
-    assert html.count("<tr>") == 8 and "loop.html" in html
+    assert html.count("<section") == 9 and "loop.html" in html
+    assert html.count("<figcaption>") == html.count("<img ") > 10
+    assert "map_MB1_random.png" in html  # the random component is shown
 
 
 def test_demo_refuses_to_write_over_a_file(tmp_path):
