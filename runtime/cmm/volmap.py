@@ -9,7 +9,8 @@ first-order propagation, ``Model.random_error``).
 
 Map CSV columns: the axis positions (mm / deg), the probe offset ``Xp,Yp,Zp`` (mm),
 ``dx_um,dy_um,dz_um`` and, with standard deviations, ``rx_um,ry_um,rz_um``.  The first part is
-the input format of ``volerr loop`` (measured deviations).
+the input format of ``volerr loop`` (measured deviations).  Numbers have 6 decimals (1 nm,
+1e-6 um), trailing zeros dropped; the CSV is written in blocks of rows.
 
 Plots: the nominal grid of the volume's outer faces (dashed) against the actual grid, nominal +
 K x error (solid), K the magnification (automatic: the largest error drawn as 15 % of the
