@@ -64,6 +64,15 @@ def derive_functions(layout: Layout) -> list[Function]:
                  list(vol.random_error_termwise(sens, sigmas)),
                  "Random error by Pahk's term-wise quadrature (eq. 5, 8), mm; arguments "
                  "s_<name> are standard deviations of the parameters."),
+        Function("random_error_exact", pos + cov + probe + [str(s) for s in sigmas],
+                 list(vol.random_error_exact(sens, sigmas)),
+                 "Random error by first-order propagation for independent parameters, "
+                 "sqrt(sum_p (d dk/d p)^2 s_p^2), mm; arguments s_<name> are standard "
+                 "deviations of the parameters (fused: no sensitivity array)."),
+        Function("nominal_jacobian", pos + probe, list(vol.nominal_jacobian(chain)),
+                 "Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): "
+                 "array (6, n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad.",
+                 shape=(6, len(pos))),
         Function("nominal_position", pos + probe, list(vol.nominal_point(chain)),
                  "Nominal probe-tip / tool-tip position in the workpiece frame, mm."),
         Function("tool_axis", pos, list(vol.nominal_tool_axis(chain)),

@@ -82,6 +82,31 @@ def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
     return sp.Matrix(rows)
 
 
+def random_error_exact(sens: sp.Matrix, sigmas) -> sp.Matrix:
+    """First-order standard uncertainty of (dX, dY, dZ) for independent parameters:
+    ``u_k = sqrt(sum_p (d dk/d p)^2 s_p^2)`` (GUM eq. 10, no covariances), ``s_p`` the standard
+    deviation of parameter p.  One fused expression per component, so that the runtime never
+    builds the (3, n_parameters, N) sensitivity array."""
+    rows = []
+    for i in range(3):
+        acc = sp.Integer(0)
+        for j in range(sens.shape[1]):
+            if sens[i, j] != 0:
+                acc += sens[i, j] ** 2 * sigmas[j] ** 2
+        rows.append(sp.sqrt(acc))
+    return sp.Matrix(rows)
+
+
+def nominal_jacobian(chain: Chain) -> sp.Matrix:
+    """Exact derivatives of the nominal tool tip (rows 0-2, mm per mm or mm per rad) and of the
+    nominal tool axis (rows 3-5, per mm = 0 or per rad) with respect to the axis positions in
+    chain order: a 6 x n_axes matrix."""
+    q = sp.Matrix(chain.positions)
+    tip = nominal_point(chain).jacobian(q)
+    axis = nominal_tool_axis(chain).jacobian(q)
+    return tip.col_join(axis)
+
+
 OFFSETS = sp.symbols("Xo Yo Zo", real=True)
 
 

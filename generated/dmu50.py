@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
-derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
+derivation sha256  723ec86c9eb6776ea096e1f88b32a6f6c8d0e785feff5e4ab215b95024a508f5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -1076,6 +1076,304 @@ def random_error_termwise(X, Y, Z, B, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX,
         + _t80 + _t82 + _t84 + _t88 + _t89 + _t91 + _t92 + _t93 + _t94 + _t95 + _t99 + s_EZC**2),
         _shape)
     return _o0, _o1, _o2
+
+
+def random_error_exact(X, Y, Z, B, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX, s_EBX, s_ECX, s_EXY,
+        s_EYY, s_EZY, s_EAY, s_EBY, s_ECY, s_EXZ, s_EYZ, s_EZZ, s_EAZ, s_EBZ, s_ECZ, s_EXB, s_EYB,
+        s_EZB, s_EAB, s_EBB, s_ECB, s_EXC, s_EYC, s_EZC, s_EAC, s_EBC, s_ECC, s_EA0Z, s_EB0Z,
+        s_EC0Y, s_EX0B, s_EY0B, s_EA0B, s_EB0B, s_EX0C, s_EY0C, s_EA0C, s_EB0C):
+    """Random error by first-order propagation for independent parameters, sqrt(sum_p (d dk/d p)^2
+    s_p^2), mm; arguments s_<name> are standard deviations of the parameters (fused: no
+    sensitivity array)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp),
+        numpy.shape(s_EXX), numpy.shape(s_EYX), numpy.shape(s_EZX), numpy.shape(s_EAX),
+        numpy.shape(s_EBX), numpy.shape(s_ECX), numpy.shape(s_EXY), numpy.shape(s_EYY),
+        numpy.shape(s_EZY), numpy.shape(s_EAY), numpy.shape(s_EBY), numpy.shape(s_ECY),
+        numpy.shape(s_EXZ), numpy.shape(s_EYZ), numpy.shape(s_EZZ), numpy.shape(s_EAZ),
+        numpy.shape(s_EBZ), numpy.shape(s_ECZ), numpy.shape(s_EXB), numpy.shape(s_EYB),
+        numpy.shape(s_EZB), numpy.shape(s_EAB), numpy.shape(s_EBB), numpy.shape(s_ECB),
+        numpy.shape(s_EXC), numpy.shape(s_EYC), numpy.shape(s_EZC), numpy.shape(s_EAC),
+        numpy.shape(s_EBC), numpy.shape(s_ECC), numpy.shape(s_EA0Z), numpy.shape(s_EB0Z),
+        numpy.shape(s_EC0Y), numpy.shape(s_EX0B), numpy.shape(s_EY0B), numpy.shape(s_EA0B),
+        numpy.shape(s_EB0B), numpy.shape(s_EX0C), numpy.shape(s_EY0C), numpy.shape(s_EA0C),
+        numpy.shape(s_EB0C))
+    _t0 = s_EX0C**2
+    _t1 = numpy.cos(C)
+    _t2 = _t1**2
+    _t3 = s_EXC**2
+    _t4 = s_EY0C**2
+    _t5 = numpy.sin(C)
+    _t6 = _t5**2
+    _t7 = s_EYC**2
+    _t8 = s_EX0B**2
+    _t9 = numpy.cos(B)
+    _t10 = _t1*_t9
+    _t11 = (1/2)*_t5
+    _t12 = numpy.sqrt(2)
+    _t13 = numpy.sin(B)
+    _t14 = _t12*_t13
+    _t15 = _t11*_t14
+    _t16 = (_t10 + _t15)**2
+    _t17 = s_EXB**2
+    _t18 = s_EXX**2
+    _t19 = s_EXY**2
+    _t20 = s_EXZ**2
+    _t21 = s_EB0Z**2
+    _t22 = Z*_t11
+    _t23 = _t14*_t22
+    _t24 = Z*_t10 + _t23
+    _t25 = s_EC0Y**2
+    _t26 = Y*_t11
+    _t27 = _t14*_t26
+    _t28 = Y*_t10 + _t27
+    _t29 = s_EY0B**2
+    _t30 = _t11*_t9
+    _t31 = (1/2)*_t1
+    _t32 = _t14*_t31
+    _t33 = (-_t11 - _t30 + _t32)**2
+    _t34 = s_EYB**2
+    _t35 = s_EYX**2
+    _t36 = s_EYY**2
+    _t37 = s_EYZ**2
+    _t38 = s_EZB**2
+    _t39 = (_t11 - _t30 + _t32)**2
+    _t40 = s_EZX**2
+    _t41 = s_EZY**2
+    _t42 = s_EZZ**2
+    _t43 = s_EA0Z**2
+    _t44 = Z*_t31
+    _t45 = _t14*_t44
+    _t46 = _t22*_t9
+    _t47 = _t22 + _t46
+    _t48 = -_t45 + _t47
+    _t49 = s_EBZ**2
+    _t50 = Xp*_t11
+    _t51 = Zp*_t11
+    _t52 = _t14*_t51
+    _t53 = Xp*_t9
+    _t54 = _t11*_t53
+    _t55 = Xp*_t31
+    _t56 = _t14*_t55
+    _t57 = -_t56
+    _t58 = _t54 + _t57
+    _t59 = Zp*_t10 - _t50 + _t52 + _t58
+    _t60 = s_ECY**2
+    _t61 = Yp*_t11
+    _t62 = _t14*_t61
+    _t63 = Yp*_t10 + _t50 + _t58 + _t62
+    _t64 = _t63**2
+    _t65 = s_ECZ**2
+    _t66 = s_EAZ**2
+    _t67 = Zp*_t31
+    _t68 = _t14*_t67
+    _t69 = _t51*_t9
+    _t70 = _t51 + _t69
+    _t71 = Yp*_t31
+    _t72 = _t14*_t71
+    _t73 = _t61*_t9
+    _t74 = _t72 - _t73
+    _t75 = _t61 - _t68 + _t70 + _t74
+    _t76 = s_EBX**2
+    _t77 = (_t24 + _t59)**2
+    _t78 = s_EBY**2
+    _t79 = s_ECX**2
+    _t80 = _t28 + _t63
+    _t81 = s_EAY**2
+    _t82 = _t48 + _t75
+    _t83 = s_ECB**2
+    _t84 = X*_t11
+    _t85 = X*_t9
+    _t86 = _t11*_t85
+    _t87 = X*_t31
+    _t88 = _t14*_t87
+    _t89 = -_t88
+    _t90 = s_EA0C**2
+    _t91 = _t11*d
+    _t92 = _t26*_t9
+    _t93 = _t9*_t91
+    _t94 = -_t93
+    _t95 = _t14*_t84
+    _t96 = _t14*_t50
+    _t97 = -_t26 - _t61
+    _t98 = (_t47 + _t70 + _t73 + _t91 + _t92 + _t94 - _t95 - _t96 + _t97)**2
+    _t99 = s_EAC**2
+    _t100 = s_EB0C**2
+    _t101 = Y*_t31
+    _t102 = (1/2)*Z
+    _t103 = _t10*_t102
+    _t104 = _t103 + _t44
+    _t105 = (1/2)*Zp
+    _t106 = _t10*_t105
+    _t107 = _t106 + _t67
+    _t108 = _t31*d
+    _t109 = (1/2)*Y
+    _t110 = _t10*_t109
+    _t111 = (1/2)*Yp
+    _t112 = _t10*_t111
+    _t113 = (1/2)*d
+    _t114 = -_t10*_t113
+    _t115 = _t108 + _t110 + _t112 + _t114 + _t57 + _t89
+    _t116 = -_t101 + _t104 + _t107 + _t115 - _t71
+    _t117 = _t116**2
+    _t118 = s_EBC**2
+    _t119 = s_EAX**2
+    _t120 = _t101*_t14
+    _t121 = _t120 - _t92
+    _t122 = _t121 + _t26 + _t82
+    _t123 = s_EB0B**2
+    _t124 = _t14*_t91
+    _t125 = ((Z*_t1*_t9 + Zp*_t1*_t9 - _t10*d - _t124 + _t23 - _t50 + _t52 + _t54 - _t56 - _t84
+        + _t86 - _t88)**2)
+    _t126 = s_EBB**2
+    _t127 = s_EA0B**2
+    _t128 = -_t91
+    _t129 = _t108*_t14
+    _t130 = (_t122 + _t128 + _t129 + _t94)**2
+    _t131 = s_EAB**2
+    _t132 = s_ECC**2
+    _t133 = -_t124
+    _t134 = _t5*_t9
+    _t135 = _t52 + _t71
+    _t136 = (-_t32 + _t5*_t9)**2
+    _t137 = -Z*_t5*_t9 + _t45
+    _t138 = -Y*_t134 + _t120
+    _t139 = (1/2)*_t10 + _t15
+    _t140 = (_t139 + _t31)**2
+    _t141 = (_t139 - _t31)**2
+    _t142 = _t104 + _t23
+    _t143 = (1/2)*Xp
+    _t144 = _t10*_t143 + _t96
+    _t145 = -1/2*Xp*_t1 - Zp*_t5*_t9 + _t144 + _t68
+    _t146 = -Yp*_t134 + _t144 + _t55 + _t72
+    _t147 = _t146**2
+    _t148 = _t107 - _t112 + _t135 - _t62
+    _t149 = _t137 + _t145
+    _t150 = _t149**2
+    _t151 = _t138 + _t146
+    _t152 = _t142 + _t148
+    _t153 = (1/2)*X
+    _t154 = _t10*_t153 + _t95
+    _t155 = _t116**2
+    _t156 = _t101 - _t110 + _t152 - _t27
+    _t157 = -_t129
+    _t158 = ((1/2)*X*_t1 - _t134*d - _t149 - _t154 - _t157)**2
+    _t159 = (_t108 - _t114 - _t133 - _t156)**2
+    _t160 = (1/2)*_t13**2
+    _t161 = (1/2)*_t9
+    _t162 = (_t161 - 1/2)**2
+    _t163 = (_t161 + 1/2)**2
+    _t164 = _t102*_t9
+    _t165 = -_t102 + _t164
+    _t166 = _t105*_t9
+    _t167 = _t111*_t9 + _t111
+    _t168 = _t105 - _t166 + _t167
+    _t169 = _t143*_t9
+    _t170 = _t105*_t14
+    _t171 = _t143 + _t169 + _t170
+    _t172 = _t111*_t14
+    _t173 = -_t143 + _t169 + _t172
+    _t174 = _t173**2
+    _t175 = _t102 - _t164 + _t168
+    _t176 = _t102*_t14
+    _t177 = _t171 + _t176
+    _t178 = _t177**2
+    _t179 = _t109*_t14
+    _t180 = _t173 + _t179
+    _t181 = _t109*_t9 + _t109
+    _t182 = _t175 + _t181
+    _t183 = _t153*_t9
+    _t184 = _t113*_t9
+    _t185 = (-_t113 + _t182 + _t184)**2
+    _t186 = -1/2*_t12*_t13*d
+    _t187 = (-_t153 - _t177 - _t183 - _t186)**2
+    _t188 = (-_t170 - _t172 - _t176 - _t179 - _t186 - _t53 - _t85)**2
+    _t189 = (-_t105 + _t113 - _t14*_t143 - _t14*_t153 + _t165 + _t166 + _t167 + _t181 - _t184)**2
+    _o0 = numpy.broadcast_to(numpy.sqrt(_t0*_t2 + _t100*_t117 + _t117*_t118 + _t119*_t122**2
+        + _t123*_t125 + _t125*_t126 + _t127*_t130 + _t130*_t131 + _t132*(-X*_t134 - Xp*_t134
+        - _t101 - _t103 - _t106 - _t115 - _t133 - _t135 - _t23 - _t27 + _t44 - _t62 + _t67)**2
+        + _t16*_t17 + _t16*_t18 + _t16*_t19 + _t16*_t20 + _t16*_t8 + _t2*_t3 + _t21*_t24**2
+        + _t25*_t28**2 + _t29*_t33 + _t33*_t34 + _t33*_t35 + _t33*_t36 + _t33*_t37 + _t38*_t39
+        + _t39*_t40 + _t39*_t41 + _t39*_t42 + _t4*_t6 + _t43*_t48**2 + _t49*_t59**2 + _t6*_t7
+        + _t60*_t64 + _t64*_t65 + _t66*_t75**2 + _t76*_t77 + _t77*_t78 + _t79*_t80**2
+        + _t81*_t82**2 + _t83*(-_t80 - _t84 - _t86 - _t89)**2 + _t90*_t98 + _t98*_t99), _shape)
+    _o1 = numpy.broadcast_to(numpy.sqrt(_t0*_t6 + _t100*_t98 + _t118*_t98 + _t119*_t156**2
+        + _t123*_t158 + _t126*_t158 + _t127*_t159 + _t131*_t159 + _t132*(X*_t10 + Xp*_t10 + _t121
+        + _t128 + _t157 + _t22 + _t45 - _t46 + _t51 + _t68 - _t69 + _t74 + _t93 + _t95 + _t96
+        + _t97)**2 + _t136*_t17 + _t136*_t18 + _t136*_t19 + _t136*_t20 + _t136*_t8 + _t137**2*_t21
+        + _t138**2*_t25 + _t140*_t29 + _t140*_t34 + _t140*_t35 + _t140*_t36 + _t140*_t37
+        + _t141*_t38 + _t141*_t40 + _t141*_t41 + _t141*_t42 + _t142**2*_t43 + _t145**2*_t49
+        + _t147*_t60 + _t147*_t65 + _t148**2*_t66 + _t150*_t76 + _t150*_t78 + _t151**2*_t79
+        + _t152**2*_t81 + _t155*_t90 + _t155*_t99 + _t2*_t4 + _t2*_t7 + _t3*_t6 + _t83*(_t151
+        + _t154 + _t87)**2), _shape)
+    _o2 = numpy.broadcast_to(numpy.sqrt(Y**2*_t160*_t25 + Z**2*_t160*_t21 + _t100*_t188
+        + _t118*_t188 + _t119*_t182**2 + _t123*_t187 + _t126*_t187 + _t127*_t185 + _t131*_t185
+        + _t160*_t17 + _t160*_t18 + _t160*_t19 + _t160*_t20 + _t160*_t8 + _t162*_t29 + _t162*_t34
+        + _t162*_t35 + _t162*_t36 + _t162*_t37 + _t163*_t38 + _t163*_t40 + _t163*_t41 + _t163*_t42
+        + _t165**2*_t43 + _t168**2*_t66 + _t171**2*_t49 + _t174*_t60 + _t174*_t65 + _t175**2*_t81
+        + _t178*_t76 + _t178*_t78 + _t180**2*_t79 + _t189*_t90 + _t189*_t99 + _t83*(-_t153 + _t180
+        + _t183)**2 + s_EZC**2), _shape)
+    return _o0, _o1, _o2
+
+
+def nominal_jacobian(X, Y, Z, B, C, Xp, Yp, Zp):
+    """Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): array (6,
+    n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(B)
+    _t1 = numpy.cos(C)
+    _t2 = _t0*_t1
+    _t3 = numpy.sqrt(2)
+    _t4 = numpy.sin(B)
+    _t5 = numpy.sin(C)
+    _t6 = _t4*_t5
+    _t7 = (1/2)*_t6
+    _t8 = _t3*_t7
+    _t9 = _t2 + _t8
+    _t10 = (1/2)*_t0
+    _t11 = _t10 + 1/2
+    _t12 = _t1*_t4
+    _t13 = (1/2)*_t12
+    _t14 = _t13*_t3
+    _t15 = -_t14
+    _t16 = -_t11*_t5 - _t15
+    _t17 = _t10 - 1/2
+    _t18 = -_t15 - _t17*_t5
+    _t19 = -1/2*_t0*_t3*_t5
+    _t20 = -_t12 - _t19
+    _t21 = (1/2)*_t2*_t3
+    _t22 = _t21 + _t7
+    _t23 = -_t0*_t5 + _t14
+    _t24 = _t1*_t11 + _t8
+    _t25 = -_t24
+    _t26 = _t1*_t17 + _t8
+    _t27 = -_t26
+    _t28 = -_t21 - _t6
+    _t29 = -_t13 - _t19
+    _t30 = (1/2)*_t4
+    _t31 = _t10*_t3
+    _out = numpy.zeros((6, 5) + _shape)
+    _out[0, 0] = _t9
+    _out[0, 1] = _t16
+    _out[0, 2] = _t18
+    _out[0, 3] = X*_t20 + Xp*_t20 + Y*_t22 + Yp*_t22 + Z*_t22 + Zp*_t22 - _t22*d
+    _out[0, 4] = X*_t23 + Xp*_t23 + Y*_t25 + Yp*_t25 + Z*_t27 + Zp*_t27 - _t27*d
+    _out[1, 0] = -_t23
+    _out[1, 1] = _t24
+    _out[1, 2] = _t26
+    _out[1, 3] = X*_t28 + Xp*_t28 + Y*_t29 + Yp*_t29 + Z*_t29 + Zp*_t29 - _t29*d
+    _out[1, 4] = X*_t9 + Xp*_t9 + Y*_t16 + Yp*_t16 + Z*_t18 + Zp*_t18 - _t18*d
+    _out[2, 0] = -_t3*_t30
+    _out[2, 1] = _t17
+    _out[2, 2] = _t11
+    _out[2, 3] = -X*_t31 - Xp*_t31 - Y*_t30 - Yp*_t30 - Z*_t30 - Zp*_t30 + (1/2)*_t4*d
+    _out[3, 3] = _t22
+    _out[3, 4] = _t27
+    _out[4, 3] = _t29
+    _out[4, 4] = _t18
+    _out[5, 3] = -_t30
+    return _out
 
 
 def nominal_position(X, Y, Z, B, C, Xp, Yp, Zp):

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       cb3eaaef6ea43479f494f78b20313cf9234c86c1a4672bb40b6ddf3f14ec9daf
-derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
+derivation sha256  723ec86c9eb6776ea096e1f88b32a6f6c8d0e785feff5e4ab215b95024a508f5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -224,6 +224,58 @@ def random_error_termwise(X, Y, Z, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX, s_EBX
     _o2 = numpy.broadcast_to(numpy.sqrt(_t0*_t11 + _t10*_t6 + _t10*_t7 + _t10*_t9 + _t11*_t2
         + _t12*_t2 + _t13*_t2 + s_EZX**2 + s_EZY**2 + s_EZZ**2), _shape)
     return _o0, _o1, _o2
+
+
+def random_error_exact(X, Y, Z, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX, s_EBX, s_ECX, s_EXY,
+        s_EYY, s_EZY, s_EAY, s_EBY, s_ECY, s_EXZ, s_EYZ, s_EZZ, s_EAZ, s_EBZ, s_ECZ, s_EA0Z,
+        s_EB0Z, s_EC0Y):
+    """Random error by first-order propagation for independent parameters, sqrt(sum_p (d dk/d p)^2
+    s_p^2), mm; arguments s_<name> are standard deviations of the parameters (fused: no
+    sensitivity array)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp), numpy.shape(s_EXX), numpy.shape(s_EYX),
+        numpy.shape(s_EZX), numpy.shape(s_EAX), numpy.shape(s_EBX), numpy.shape(s_ECX),
+        numpy.shape(s_EXY), numpy.shape(s_EYY), numpy.shape(s_EZY), numpy.shape(s_EAY),
+        numpy.shape(s_EBY), numpy.shape(s_ECY), numpy.shape(s_EXZ), numpy.shape(s_EYZ),
+        numpy.shape(s_EZZ), numpy.shape(s_EAZ), numpy.shape(s_EBZ), numpy.shape(s_ECZ),
+        numpy.shape(s_EA0Z), numpy.shape(s_EB0Z), numpy.shape(s_EC0Y))
+    _t0 = Yp**2
+    _t1 = s_ECY**2
+    _t2 = s_ECZ**2
+    _t3 = Z**2
+    _t4 = Zp**2
+    _t5 = s_EBZ**2
+    _t6 = s_EBX**2
+    _t7 = Z + Zp
+    _t8 = _t7**2
+    _t9 = s_EBY**2
+    _t10 = s_ECX**2
+    _t11 = Y + Yp
+    _t12 = Xp**2
+    _t13 = s_EAZ**2
+    _t14 = s_EAX**2
+    _t15 = _t7**2
+    _t16 = s_EAY**2
+    _o0 = numpy.broadcast_to(numpy.sqrt(_t0*_t1 + _t0*_t2 + _t10*_t11**2 + _t3*s_EB0Z**2 + _t4*_t5
+        + _t6*_t8 + _t8*_t9 + s_EXX**2 + s_EXY**2 + s_EXZ**2), _shape)
+    _o1 = numpy.broadcast_to(numpy.sqrt(X**2*s_EC0Y**2 + _t1*_t12 + _t10*_t12 + _t12*_t2
+        + _t13*_t4 + _t14*_t15 + _t15*_t16 + _t3*s_EA0Z**2 + s_EYX**2 + s_EYY**2 + s_EYZ**2),
+        _shape)
+    _o2 = numpy.broadcast_to(numpy.sqrt(_t0*_t13 + _t0*_t16 + _t11**2*_t14 + _t12*_t5 + _t12*_t6
+        + _t12*_t9 + s_EZX**2 + s_EZY**2 + s_EZZ**2), _shape)
+    return _o0, _o1, _o2
+
+
+def nominal_jacobian(X, Y, Z, Xp, Yp, Zp):
+    """Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): array (6,
+    n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _out = numpy.zeros((6, 3) + _shape)
+    _out[0, 0] = 1
+    _out[1, 1] = 1
+    _out[2, 2] = 1
+    return _out
 
 
 def nominal_position(X, Y, Z, Xp, Yp, Zp):

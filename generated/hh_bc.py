@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9e0b9225cac4964404bf2e854a5173268922f8f2cc7f38758d6dc04d440f1726
-derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
+derivation sha256  723ec86c9eb6776ea096e1f88b32a6f6c8d0e785feff5e4ab215b95024a508f5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -573,6 +573,124 @@ def random_error_termwise(X, Y, Z, B, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX,
         + _t6*_t67 + _t62*_t7 + _t62*_t9 + _t64*_t7 + _t64*_t9 + _t67*_t8 + s_EZ0B**2 + s_EZB**2
         + s_EZC**2 + s_EZX**2 + s_EZY**2 + s_EZZ**2), _shape)
     return _o0, _o1, _o2
+
+
+def random_error_exact(X, Y, Z, B, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX, s_EBX, s_ECX, s_EXY,
+        s_EYY, s_EZY, s_EAY, s_EBY, s_ECY, s_EXZ, s_EYZ, s_EZZ, s_EAZ, s_EBZ, s_ECZ, s_EXB, s_EYB,
+        s_EZB, s_EAB, s_EBB, s_ECB, s_EXC, s_EYC, s_EZC, s_EAC, s_EBC, s_ECC, s_EA0Z, s_EB0Z,
+        s_EC0Y, s_EX0B, s_EZ0B, s_EA0B, s_EC0B, s_EX0C, s_EY0C, s_EA0C, s_EB0C):
+    """Random error by first-order propagation for independent parameters, sqrt(sum_p (d dk/d p)^2
+    s_p^2), mm; arguments s_<name> are standard deviations of the parameters (fused: no
+    sensitivity array)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp),
+        numpy.shape(s_EXX), numpy.shape(s_EYX), numpy.shape(s_EZX), numpy.shape(s_EAX),
+        numpy.shape(s_EBX), numpy.shape(s_ECX), numpy.shape(s_EXY), numpy.shape(s_EYY),
+        numpy.shape(s_EZY), numpy.shape(s_EAY), numpy.shape(s_EBY), numpy.shape(s_ECY),
+        numpy.shape(s_EXZ), numpy.shape(s_EYZ), numpy.shape(s_EZZ), numpy.shape(s_EAZ),
+        numpy.shape(s_EBZ), numpy.shape(s_ECZ), numpy.shape(s_EXB), numpy.shape(s_EYB),
+        numpy.shape(s_EZB), numpy.shape(s_EAB), numpy.shape(s_EBB), numpy.shape(s_ECB),
+        numpy.shape(s_EXC), numpy.shape(s_EYC), numpy.shape(s_EZC), numpy.shape(s_EAC),
+        numpy.shape(s_EBC), numpy.shape(s_ECC), numpy.shape(s_EA0Z), numpy.shape(s_EB0Z),
+        numpy.shape(s_EC0Y), numpy.shape(s_EX0B), numpy.shape(s_EZ0B), numpy.shape(s_EA0B),
+        numpy.shape(s_EC0B), numpy.shape(s_EX0C), numpy.shape(s_EY0C), numpy.shape(s_EA0C),
+        numpy.shape(s_EB0C))
+    _t0 = Z**2
+    _t1 = s_EX0B**2
+    _t2 = numpy.cos(C)
+    _t3 = _t2**2
+    _t4 = s_EXB**2
+    _t5 = s_EYB**2
+    _t6 = numpy.sin(C)
+    _t7 = _t6**2
+    _t8 = s_EB0C**2
+    _t9 = numpy.cos(B)
+    _t10 = L*_t9
+    _t11 = numpy.sin(B)
+    _t12 = Xp*_t11
+    _t13 = Zp*_t9
+    _t14 = -L + _t10 + _t12 - _t13
+    _t15 = _t14**2
+    _t16 = s_EBC**2
+    _t17 = s_EBZ**2
+    _t18 = s_EBX**2
+    _t19 = L + Z - _t10 - _t12 + _t13
+    _t20 = _t19**2
+    _t21 = s_EBY**2
+    _t22 = s_EA0B**2
+    _t23 = (Zp*_t6*_t9 - _t10*_t6 - _t12*_t6)**2
+    _t24 = s_EAB**2
+    _t25 = s_EBB**2
+    _t26 = -Zp*_t2*_t9 + _t10*_t2 + _t12*_t2
+    _t27 = s_EC0B**2
+    _t28 = Xp*_t9
+    _t29 = Zp*_t11
+    _t30 = -L*_t11*_t6 + Yp*_t2 + _t28*_t6 + _t29*_t6
+    _t31 = _t30**2
+    _t32 = s_ECB**2
+    _t33 = s_ECC**2
+    _t34 = s_ECY**2
+    _t35 = s_ECZ**2
+    _t36 = s_ECX**2
+    _t37 = Y + _t30
+    _t38 = s_EA0C**2
+    _t39 = _t14**2
+    _t40 = s_EAC**2
+    _t41 = s_EAZ**2
+    _t42 = _t26**2
+    _t43 = s_EAX**2
+    _t44 = _t19**2
+    _t45 = s_EAY**2
+    _t46 = L*_t11*_t2 - Xp*_t2*_t9 + Yp*_t6 - Zp*_t11*_t2
+    _t47 = _t46**2
+    _t48 = Yp**2
+    _t49 = _t30**2
+    _t50 = _t46**2
+    _o0 = numpy.broadcast_to(numpy.sqrt(Y**2*s_EC0Y**2 + _t0*s_EB0Z**2 + _t1*_t3 + _t15*_t16
+        + _t15*_t17 + _t15*_t8 + _t18*_t20 + _t20*_t21 + _t22*_t23 + _t23*_t24 + _t25*_t26**2
+        + _t27*_t31 + _t3*_t4 + _t31*_t32 + _t31*_t33 + _t31*_t34 + _t31*_t35 + _t36*_t37**2
+        + _t5*_t7 + s_EX0C**2 + s_EXC**2 + s_EXX**2 + s_EXY**2 + s_EXZ**2), _shape)
+    _o1 = numpy.broadcast_to(numpy.sqrt(_t0*s_EA0Z**2 + _t1*_t7 + _t22*_t42 + _t23*_t25
+        + _t24*_t42 + _t27*_t47 + _t3*_t5 + _t32*_t47 + _t33*_t47 + _t34*_t47 + _t35*_t47
+        + _t36*_t47 + _t38*_t39 + _t39*_t40 + _t39*_t41 + _t4*_t7 + _t43*_t44 + _t44*_t45
+        + s_EY0C**2 + s_EYC**2 + s_EYX**2 + s_EYY**2 + s_EYZ**2), _shape)
+    _o2 = numpy.broadcast_to(numpy.sqrt(_t16*_t50 + _t17*_t50 + _t18*_t50 + _t21*_t50 + _t22*_t48
+        + _t24*_t48 + _t25*(L*_t11 - _t28 - _t29)**2 + _t37**2*_t43 + _t38*_t49 + _t40*_t49
+        + _t41*_t49 + _t45*_t49 + _t50*_t8 + s_EZ0B**2 + s_EZB**2 + s_EZC**2 + s_EZX**2 + s_EZY**2
+        + s_EZZ**2), _shape)
+    return _o0, _o1, _o2
+
+
+def nominal_jacobian(X, Y, Z, B, C, Xp, Yp, Zp):
+    """Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): array (6,
+    n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(B)
+    _t1 = numpy.cos(C)
+    _t2 = _t0*_t1
+    _t3 = numpy.sin(B)
+    _t4 = _t1*_t3
+    _t5 = numpy.sin(C)
+    _t6 = Xp*_t0
+    _t7 = Zp*_t3
+    _t8 = _t0*_t5
+    _t9 = _t3*_t5
+    _out = numpy.zeros((6, 5) + _shape)
+    _out[0, 0] = 1
+    _out[0, 3] = -L*_t2 - Xp*_t4 + Zp*_t0*_t1
+    _out[0, 4] = L*_t3*_t5 - Yp*_t1 - _t5*_t6 - _t5*_t7
+    _out[1, 1] = 1
+    _out[1, 3] = -L*_t8 - Xp*_t9 + Zp*_t0*_t5
+    _out[1, 4] = -L*_t1*_t3 + Xp*_t0*_t1 - Yp*_t5 + Zp*_t1*_t3
+    _out[2, 2] = 1
+    _out[2, 3] = L*_t3 - _t6 - _t7
+    _out[3, 3] = _t2
+    _out[3, 4] = -_t9
+    _out[4, 3] = _t8
+    _out[4, 4] = _t4
+    _out[5, 3] = -_t3
+    return _out
 
 
 def nominal_position(X, Y, Z, B, C, Xp, Yp, Zp):

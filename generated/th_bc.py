@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       f33f383453fd86eb89aede0e8d896e5e1639520405e75ca24882d84376f1d8b8
-derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
+derivation sha256  723ec86c9eb6776ea096e1f88b32a6f6c8d0e785feff5e4ab215b95024a508f5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -679,6 +679,152 @@ def random_error_termwise(X, Y, Z, B, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX,
         + _t46*_t59 + _t60*_t69 + _t60*_t76 + _t60*_t94 + s_EZ0B**2 + s_EZB**2 + s_EZC**2
         + s_EZX**2 + s_EZY**2 + s_EZZ**2), _shape)
     return _o0, _o1, _o2
+
+
+def random_error_exact(X, Y, Z, B, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX, s_EBX, s_ECX, s_EXY,
+        s_EYY, s_EZY, s_EAY, s_EBY, s_ECY, s_EXZ, s_EYZ, s_EZZ, s_EAZ, s_EBZ, s_ECZ, s_EXB, s_EYB,
+        s_EZB, s_EAB, s_EBB, s_ECB, s_EXC, s_EYC, s_EZC, s_EAC, s_EBC, s_ECC, s_EA0Z, s_EB0Z,
+        s_EC0Y, s_EX0B, s_EZ0B, s_EA0B, s_EC0B, s_EX0C, s_EY0C, s_EA0C, s_EB0C):
+    """Random error by first-order propagation for independent parameters, sqrt(sum_p (d dk/d p)^2
+    s_p^2), mm; arguments s_<name> are standard deviations of the parameters (fused: no
+    sensitivity array)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp),
+        numpy.shape(s_EXX), numpy.shape(s_EYX), numpy.shape(s_EZX), numpy.shape(s_EAX),
+        numpy.shape(s_EBX), numpy.shape(s_ECX), numpy.shape(s_EXY), numpy.shape(s_EYY),
+        numpy.shape(s_EZY), numpy.shape(s_EAY), numpy.shape(s_EBY), numpy.shape(s_ECY),
+        numpy.shape(s_EXZ), numpy.shape(s_EYZ), numpy.shape(s_EZZ), numpy.shape(s_EAZ),
+        numpy.shape(s_EBZ), numpy.shape(s_ECZ), numpy.shape(s_EXB), numpy.shape(s_EYB),
+        numpy.shape(s_EZB), numpy.shape(s_EAB), numpy.shape(s_EBB), numpy.shape(s_ECB),
+        numpy.shape(s_EXC), numpy.shape(s_EYC), numpy.shape(s_EZC), numpy.shape(s_EAC),
+        numpy.shape(s_EBC), numpy.shape(s_ECC), numpy.shape(s_EA0Z), numpy.shape(s_EB0Z),
+        numpy.shape(s_EC0Y), numpy.shape(s_EX0B), numpy.shape(s_EZ0B), numpy.shape(s_EA0B),
+        numpy.shape(s_EC0B), numpy.shape(s_EX0C), numpy.shape(s_EY0C), numpy.shape(s_EA0C),
+        numpy.shape(s_EB0C))
+    _t0 = s_EX0B**2
+    _t1 = numpy.cos(C)
+    _t2 = _t1**2
+    _t3 = s_EX0C**2
+    _t4 = s_EXB**2
+    _t5 = s_EXC**2
+    _t6 = s_EXX**2
+    _t7 = s_EXY**2
+    _t8 = s_EXZ**2
+    _t9 = s_EY0C**2
+    _t10 = numpy.sin(C)
+    _t11 = _t10**2
+    _t12 = s_EYB**2
+    _t13 = s_EYC**2
+    _t14 = s_EYX**2
+    _t15 = s_EYY**2
+    _t16 = s_EYZ**2
+    _t17 = Y**2*s_EC0Y**2
+    _t18 = Z**2
+    _t19 = _t18*s_EA0Z**2
+    _t20 = _t18*s_EB0Z**2
+    _t21 = s_EA0B**2
+    _t22 = numpy.cos(B)
+    _t23 = L*_t10
+    _t24 = _t22*_t23
+    _t25 = numpy.sin(B)
+    _t26 = Xp*_t25
+    _t27 = _t10*_t26
+    _t28 = -Zp*_t10*_t22 + _t24 + _t27
+    _t29 = _t28**2
+    _t30 = s_EAB**2
+    _t31 = s_EBB**2
+    _t32 = L*_t1
+    _t33 = _t22*_t32
+    _t34 = _t1*_t26
+    _t35 = Zp*_t22
+    _t36 = _t1*_t35
+    _t37 = _t33 + _t34 - _t36
+    _t38 = s_EAZ**2
+    _t39 = (L*_t10 - _t28)**2
+    _t40 = s_EBZ**2
+    _t41 = -_t32 + _t37
+    _t42 = s_EC0B**2
+    _t43 = Xp*_t22
+    _t44 = Zp*_t25
+    _t45 = -L*_t10*_t25 + Yp*_t1 + _t10*_t43 + _t10*_t44
+    _t46 = _t45**2
+    _t47 = s_ECB**2
+    _t48 = s_ECY**2
+    _t49 = s_ECZ**2
+    _t50 = s_EA0C**2
+    _t51 = (Z*_t10 + _t10*_t35 + _t23 - _t24 - _t27)**2
+    _t52 = s_EAC**2
+    _t53 = s_EAX**2
+    _t54 = s_EAY**2
+    _t55 = s_EB0C**2
+    _t56 = Z*_t1 + _t32 - _t33 - _t34 + _t36
+    _t57 = _t56**2
+    _t58 = s_EBC**2
+    _t59 = s_EBX**2
+    _t60 = s_EBY**2
+    _t61 = s_ECX**2
+    _t62 = Y*_t1 + _t45
+    _t63 = s_ECC**2
+    _t64 = _t37**2
+    _t65 = -Xp*_t1*_t22 + Yp*_t10 - Zp*_t1*_t25 + _t25*_t32
+    _t66 = _t65**2
+    _t67 = _t56**2
+    _t68 = Y*_t10 + _t65
+    _t69 = Yp**2
+    _t70 = (Y + Yp)**2
+    _t71 = -L*_t25 + _t43 + _t44
+    _t72 = _t71**2
+    _t73 = (-X - _t71)**2
+    _o0 = numpy.broadcast_to(numpy.sqrt(_t0*_t2 + _t11*_t12 + _t11*_t13 + _t11*_t14 + _t11*_t15
+        + _t11*_t16 + _t11*_t19 + _t11*_t9 + _t17*_t2 + _t2*_t20 + _t2*_t3 + _t2*_t4 + _t2*_t5
+        + _t2*_t6 + _t2*_t7 + _t2*_t8 + _t21*_t29 + _t29*_t30 + _t31*_t37**2 + _t38*_t39
+        + _t40*_t41**2 + _t42*_t46 + _t46*_t47 + _t46*_t48 + _t46*_t49 + _t50*_t51 + _t51*_t52
+        + _t51*_t53 + _t51*_t54 + _t55*_t57 + _t57*_t58 + _t57*_t59 + _t57*_t60 + _t61*_t62**2
+        + _t63*(-X*_t10 - _t62)**2), _shape)
+    _o1 = numpy.broadcast_to(numpy.sqrt(_t0*_t11 + _t11*_t17 + _t11*_t20 + _t11*_t3 + _t11*_t4
+        + _t11*_t5 + _t11*_t6 + _t11*_t7 + _t11*_t8 + _t12*_t2 + _t13*_t2 + _t14*_t2 + _t15*_t2
+        + _t16*_t2 + _t19*_t2 + _t2*_t9 + _t21*_t64 + _t29*_t31 + _t30*_t64 + _t38*_t41**2
+        + _t39*_t40 + _t42*_t66 + _t47*_t66 + _t48*_t66 + _t49*_t66 + _t50*_t67 + _t51*_t55
+        + _t51*_t58 + _t51*_t59 + _t51*_t60 + _t52*_t67 + _t53*_t67 + _t54*_t67 + _t61*_t68**2
+        + _t63*(X*_t1 - _t68)**2), _shape)
+    _o2 = numpy.broadcast_to(numpy.sqrt(_t21*_t69 + _t30*_t69 + _t31*_t72 + _t38*_t69 + _t40*_t72
+        + _t50*_t70 + _t52*_t70 + _t53*_t70 + _t54*_t69 + _t55*_t73 + _t58*_t73 + _t59*_t72
+        + _t60*_t72 + s_EZ0B**2 + s_EZB**2 + s_EZC**2 + s_EZX**2 + s_EZY**2 + s_EZZ**2), _shape)
+    return _o0, _o1, _o2
+
+
+def nominal_jacobian(X, Y, Z, B, C, Xp, Yp, Zp):
+    """Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): array (6,
+    n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(C)
+    _t1 = numpy.sin(C)
+    _t2 = numpy.cos(B)
+    _t3 = _t0*_t2
+    _t4 = numpy.sin(B)
+    _t5 = _t0*_t4
+    _t6 = Xp*_t2
+    _t7 = Zp*_t4
+    _t8 = _t1*_t2
+    _t9 = _t1*_t4
+    _out = numpy.zeros((6, 5) + _shape)
+    _out[0, 0] = _t0
+    _out[0, 1] = -_t1
+    _out[0, 3] = -L*_t3 - Xp*_t5 + Zp*_t0*_t2
+    _out[0, 4] = L*_t1*_t4 - X*_t1 - Y*_t0 - Yp*_t0 - _t1*_t6 - _t1*_t7
+    _out[1, 0] = _t1
+    _out[1, 1] = _t0
+    _out[1, 3] = -L*_t8 - Xp*_t9 + Zp*_t1*_t2
+    _out[1, 4] = -L*_t0*_t4 + X*_t0 + Xp*_t0*_t2 - Y*_t1 - Yp*_t1 + Zp*_t0*_t4
+    _out[2, 2] = 1
+    _out[2, 3] = L*_t4 - _t6 - _t7
+    _out[3, 3] = _t3
+    _out[3, 4] = -_t9
+    _out[4, 3] = _t8
+    _out[4, 4] = _t5
+    _out[5, 3] = -_t4
+    return _out
 
 
 def nominal_position(X, Y, Z, B, C, Xp, Yp, Zp):

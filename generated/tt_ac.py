@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9b5f923e440b8c75c3b5ca7308d4ba4371152109c2b1c6354b17becb2a4ed34a
-derivation sha256  f2cf7f903792df6ad48100b19f4635b19c495beb6439a05f3e92c633ad8bdbae
+derivation sha256  723ec86c9eb6776ea096e1f88b32a6f6c8d0e785feff5e4ab215b95024a508f5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -703,6 +703,190 @@ def random_error_termwise(X, Y, Z, A, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX,
         + _t65*_t97 + _t69*_t95 + _t69*_t96 + _t69*_t97 + _t70*_t95 + _t70*_t97 + _t73*_t96
         + s_EZC**2), _shape)
     return _o0, _o1, _o2
+
+
+def random_error_exact(X, Y, Z, A, C, Xp, Yp, Zp, s_EXX, s_EYX, s_EZX, s_EAX, s_EBX, s_ECX, s_EXY,
+        s_EYY, s_EZY, s_EAY, s_EBY, s_ECY, s_EXZ, s_EYZ, s_EZZ, s_EAZ, s_EBZ, s_ECZ, s_EXA, s_EYA,
+        s_EZA, s_EAA, s_EBA, s_ECA, s_EXC, s_EYC, s_EZC, s_EAC, s_EBC, s_ECC, s_EA0Z, s_EB0Z,
+        s_EC0Y, s_EY0A, s_EZ0A, s_EB0A, s_EC0A, s_EX0C, s_EY0C, s_EA0C, s_EB0C):
+    """Random error by first-order propagation for independent parameters, sqrt(sum_p (d dk/d p)^2
+    s_p^2), mm; arguments s_<name> are standard deviations of the parameters (fused: no
+    sensitivity array)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(A), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp),
+        numpy.shape(s_EXX), numpy.shape(s_EYX), numpy.shape(s_EZX), numpy.shape(s_EAX),
+        numpy.shape(s_EBX), numpy.shape(s_ECX), numpy.shape(s_EXY), numpy.shape(s_EYY),
+        numpy.shape(s_EZY), numpy.shape(s_EAY), numpy.shape(s_EBY), numpy.shape(s_ECY),
+        numpy.shape(s_EXZ), numpy.shape(s_EYZ), numpy.shape(s_EZZ), numpy.shape(s_EAZ),
+        numpy.shape(s_EBZ), numpy.shape(s_ECZ), numpy.shape(s_EXA), numpy.shape(s_EYA),
+        numpy.shape(s_EZA), numpy.shape(s_EAA), numpy.shape(s_EBA), numpy.shape(s_ECA),
+        numpy.shape(s_EXC), numpy.shape(s_EYC), numpy.shape(s_EZC), numpy.shape(s_EAC),
+        numpy.shape(s_EBC), numpy.shape(s_ECC), numpy.shape(s_EA0Z), numpy.shape(s_EB0Z),
+        numpy.shape(s_EC0Y), numpy.shape(s_EY0A), numpy.shape(s_EZ0A), numpy.shape(s_EB0A),
+        numpy.shape(s_EC0A), numpy.shape(s_EX0C), numpy.shape(s_EY0C), numpy.shape(s_EA0C),
+        numpy.shape(s_EB0C))
+    _t0 = s_EX0C**2
+    _t1 = numpy.cos(C)
+    _t2 = _t1**2
+    _t3 = s_EXA**2
+    _t4 = s_EXC**2
+    _t5 = s_EXX**2
+    _t6 = s_EXY**2
+    _t7 = s_EXZ**2
+    _t8 = s_EY0C**2
+    _t9 = numpy.sin(C)
+    _t10 = _t9**2
+    _t11 = s_EYC**2
+    _t12 = Y**2*s_EC0Y**2
+    _t13 = Z**2
+    _t14 = _t13*s_EB0Z**2
+    _t15 = s_EY0A**2
+    _t16 = numpy.cos(A)
+    _t17 = _t16**2
+    _t18 = _t10*_t17
+    _t19 = s_EYA**2
+    _t20 = s_EYX**2
+    _t21 = s_EYY**2
+    _t22 = s_EYZ**2
+    _t23 = s_EZ0A**2
+    _t24 = numpy.sin(A)
+    _t25 = _t24**2
+    _t26 = _t10*_t25
+    _t27 = s_EZA**2
+    _t28 = s_EZX**2
+    _t29 = s_EZY**2
+    _t30 = s_EZZ**2
+    _t31 = _t13*s_EA0Z**2
+    _t32 = s_EBZ**2
+    _t33 = Xp*_t9
+    _t34 = _t24*_t33
+    _t35 = s_EAZ**2
+    _t36 = Yp*_t9
+    _t37 = Zp*_t9
+    _t38 = _t16*_t37 + _t24*_t36
+    _t39 = s_ECY**2
+    _t40 = Yp*_t1
+    _t41 = _t16*_t33 + _t40
+    _t42 = _t41**2
+    _t43 = s_ECZ**2
+    _t44 = s_EBX**2
+    _t45 = Z*_t1
+    _t46 = Zp*_t1
+    _t47 = -_t34 + _t45 + _t46
+    _t48 = _t47**2
+    _t49 = s_EBY**2
+    _t50 = s_ECX**2
+    _t51 = Y*_t1
+    _t52 = _t41 + _t51
+    _t53 = s_EAY**2
+    _t54 = Z*_t9
+    _t55 = _t16*_t54 + _t38
+    _t56 = s_EAX**2
+    _t57 = Y*_t9
+    _t58 = _t24*_t57 + _t55
+    _t59 = s_EC0A**2
+    _t60 = X*_t9
+    _t61 = (-_t16*_t60 - _t52)**2
+    _t62 = s_ECA**2
+    _t63 = s_EB0A**2
+    _t64 = _t1*h
+    _t65 = (-_t24*_t60 + _t47 + _t64)**2
+    _t66 = s_EBA**2
+    _t67 = s_EAA**2
+    _t68 = _t9*h
+    _t69 = _t16*_t68 + _t58
+    _t70 = s_EA0C**2
+    _t71 = (-_t68 + _t69)**2
+    _t72 = s_EAC**2
+    _t73 = s_EB0C**2
+    _t74 = _t16*_t46 + _t24*_t40
+    _t75 = _t16*_t45 + _t74
+    _t76 = _t24*_t51 + _t75
+    _t77 = _t16*_t64 + _t76
+    _t78 = -_t64 + _t77
+    _t79 = _t78**2
+    _t80 = s_EBC**2
+    _t81 = s_ECC**2
+    _t82 = _t17*_t2
+    _t83 = _t2*_t25
+    _t84 = Xp*_t1
+    _t85 = _t24*_t84 + _t37
+    _t86 = _t16*_t84 - _t36
+    _t87 = _t86**2
+    _t88 = _t54 + _t85
+    _t89 = _t88**2
+    _t90 = X*_t1
+    _t91 = (_t16*_t90 - _t57 + _t86)**2
+    _t92 = (_t24*_t90 + _t68 + _t88)**2
+    _t93 = _t78**2
+    _t94 = Xp**2
+    _t95 = _t17*_t94
+    _t96 = _t25*_t94
+    _t97 = (-X - Xp)**2
+    _t98 = (X*_t24 + Xp*_t24)**2
+    _t99 = Zp*_t24
+    _t100 = Yp*_t16 - _t99
+    _t101 = (-X*_t16 - Xp*_t16)**2
+    _t102 = Z*_t24
+    _t103 = -Yp*_t16 + _t102 + _t99
+    _t104 = (Y*_t16 - _t103 - _t24*h)**2
+    _o0 = numpy.broadcast_to(numpy.sqrt(_t0*_t2 + _t10*_t11 + _t10*_t8 + _t12*_t2 + _t14*_t2
+        + _t15*_t18 + _t18*_t19 + _t18*_t20 + _t18*_t21 + _t18*_t22 + _t18*_t31 + _t2*_t3
+        + _t2*_t4 + _t2*_t5 + _t2*_t6 + _t2*_t7 + _t23*_t26 + _t26*_t27 + _t26*_t28 + _t26*_t29
+        + _t26*_t30 + _t32*(Zp*_t1 - _t34)**2 + _t35*_t38**2 + _t39*_t42 + _t42*_t43 + _t44*_t48
+        + _t48*_t49 + _t50*_t52**2 + _t53*_t55**2 + _t56*_t58**2 + _t59*_t61 + _t61*_t62
+        + _t63*_t65 + _t65*_t66 + _t67*_t69**2 + _t70*_t71 + _t71*_t72 + _t73*_t79 + _t79*_t80
+        + _t81*(Z*_t1*_t24 + Zp*_t1*_t24 + _t1*_t24*h - _t16*_t40 - _t16*_t51 - _t33 - _t60)**2),
+        _shape)
+    _o1 = numpy.broadcast_to(numpy.sqrt(_t0*_t10 + _t10*_t12 + _t10*_t14 + _t10*_t3 + _t10*_t4
+        + _t10*_t5 + _t10*_t6 + _t10*_t7 + _t11*_t2 + _t15*_t82 + _t19*_t82 + _t2*_t8 + _t20*_t82
+        + _t21*_t82 + _t22*_t82 + _t23*_t83 + _t27*_t83 + _t28*_t83 + _t29*_t83 + _t30*_t83
+        + _t31*_t82 + _t32*_t85**2 + _t35*_t74**2 + _t39*_t87 + _t43*_t87 + _t44*_t89 + _t49*_t89
+        + _t50*(Xp*_t1*_t16 - _t36 - _t57)**2 + _t53*_t75**2 + _t56*_t76**2 + _t59*_t91
+        + _t62*_t91 + _t63*_t92 + _t66*_t92 + _t67*_t77**2 + _t70*_t93 + _t71*_t73 + _t71*_t80
+        + _t72*_t93 + _t81*(-_t16*_t36 - _t16*_t57 + _t24*_t37 + _t24*_t54 + _t24*_t68 + _t84
+        + _t90)**2), _shape)
+    _o2 = numpy.broadcast_to(numpy.sqrt(_t100**2*_t35 + _t101*_t63 + _t101*_t66 + _t103**2*_t53
+        + _t104*_t67 + _t104*_t70 + _t104*_t72 + _t15*_t25 + _t17*_t23 + _t17*_t27 + _t17*_t28
+        + _t17*_t29 + _t17*_t30 + _t19*_t25 + _t20*_t25 + _t21*_t25 + _t22*_t25 + _t25*_t31
+        + _t32*_t95 + _t39*_t96 + _t43*_t96 + _t44*_t95 + _t49*_t95 + _t50*_t96 + _t56*(Y*_t16
+        + _t100 - _t102)**2 + _t59*_t98 + _t62*_t98 + _t73*_t97 + _t80*_t97 + s_EZC**2), _shape)
+    return _o0, _o1, _o2
+
+
+def nominal_jacobian(X, Y, Z, A, C, Xp, Yp, Zp):
+    """Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): array (6,
+    n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(A), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(C)
+    _t1 = numpy.sin(C)
+    _t2 = numpy.cos(A)
+    _t3 = _t1*_t2
+    _t4 = numpy.sin(A)
+    _t5 = _t1*_t4
+    _t6 = _t0*_t2
+    _t7 = _t0*_t4
+    _out = numpy.zeros((6, 5) + _shape)
+    _out[0, 0] = _t0
+    _out[0, 1] = -_t3
+    _out[0, 2] = _t5
+    _out[0, 3] = Y*_t5 + Yp*_t5 + Z*_t3 + Zp*_t3 + _t3*h
+    _out[0, 4] = -X*_t1 - Xp*_t1 - Y*_t6 - Yp*_t6 + Z*_t0*_t4 + Zp*_t0*_t4 + _t0*_t4*h
+    _out[1, 0] = _t1
+    _out[1, 1] = _t6
+    _out[1, 2] = -_t7
+    _out[1, 3] = -Y*_t7 - Yp*_t7 - Z*_t6 - Zp*_t6 - _t6*h
+    _out[1, 4] = X*_t0 + Xp*_t0 - Y*_t3 - Yp*_t3 + Z*_t5 + Zp*_t5 + _t5*h
+    _out[2, 1] = _t4
+    _out[2, 2] = _t2
+    _out[2, 3] = Y*_t2 + Yp*_t2 - Z*_t4 - Zp*_t4 - _t4*h
+    _out[3, 3] = _t3
+    _out[3, 4] = _t7
+    _out[4, 3] = -_t6
+    _out[4, 4] = _t5
+    _out[5, 3] = -_t4
+    return _out
 
 
 def nominal_position(X, Y, Z, A, C, Xp, Yp, Zp):

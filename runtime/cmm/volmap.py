@@ -9,7 +9,8 @@ first-order propagation, ``Model.random_error``).
 
 Map CSV columns: the axis positions (mm / deg), the probe offset ``Xp,Yp,Zp`` (mm),
 ``dx_um,dy_um,dz_um`` and, with standard deviations, ``rx_um,ry_um,rz_um``.  The first part is
-the input format of ``volerr loop`` (measured deviations).
+the input format of ``volerr loop`` (measured deviations).  Numbers have 6 decimals (1 nm,
+1e-6 um), trailing zeros dropped; the CSV is written in blocks of rows.
 
 Plots: the nominal grid of the volume's outer faces (dashed) against the actual grid, nominal +
 K x error (solid), K the magnification (automatic: the largest error drawn as 15 % of the
@@ -25,16 +26,18 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.units import UM_PER_MM, format_number
+from volerr.units import UM_PER_MM
 from volerr.errors import InputError, require
-from volerr.fileio import check_output, write_text
+from volerr.cmm import csvformat
+from volerr.fileio import AtomicFile, check_output
 
 
 @dataclass
 class VolumetricMap:
     """A computed map.  ``positions``: axis -> (N,) mm/deg; ``nominal``, ``error``, ``random``:
     (N, 3) mm (``random`` None without standard deviations); ``shape`` = grid counts of the
-    linear axes in ``grid_axes`` order (C order, last axis fastest)."""
+    linear axes in ``grid_axes`` order (C order, last axis fastest); ``ticks``: grid axis ->
+    its positions (mm)."""
 
     layout: str
     axes: tuple
@@ -45,6 +48,7 @@ class VolumetricMap:
     nominal: np.ndarray
     error: np.ndarray
     random: np.ndarray | None
+    ticks: dict | None = None  # grid axis -> its (count,) positions (mm), C-order grid
 
     def summary(self) -> dict:
         """Max |component|, max and RMS length of the error vector, in um."""
@@ -125,34 +129,79 @@ def volumetric_map(model, funcs, grid=None, probe=(0.0, 0.0, 0.0), at=None,
     for a, v in fixed_positions(model, at).items():
         pos[a] = np.full(n, v)
     pos = {a: pos[a] for a in model.axes}
-    err = model.volumetric_error(pos, funcs(pos), probe=probe)
-    rnd = None
-    if getattr(funcs, "has_random", False):
-        rnd = model.random_error(pos, funcs.sigmas(pos), probe=probe)
-    nominal = model.nominal_position(pos, probe=probe)
-    return VolumetricMap(model.name, model.axes, lin, counts, pos, probe, nominal, err, rnd)
+    err, nominal = np.empty((n, 3)), np.empty((n, 3))
+    has_random = getattr(funcs, "has_random", False)
+    rnd = np.empty((n, 3)) if has_random else None
+    # in blocks: the error functions' values (one (N,) array per parameter, and as many for
+    # the standard deviations) never exist for the whole grid at once
+    for start in range(0, n, BLOCK):
+        sl = slice(start, min(start + BLOCK, n))
+        p = {a: v[sl] for a, v in pos.items()}
+        err[sl] = model.volumetric_error(p, funcs(p), probe=probe)
+        if has_random:
+            rnd[sl] = model.random_error(p, funcs.sigmas(p), probe=probe)
+        nominal[sl] = model.nominal_position(p, probe=probe)
+    return VolumetricMap(model.name, model.axes, lin, counts, pos, probe, nominal, err, rnd,
+                         dict(zip(lin, ticks)))
 
 
-def _fmt(v) -> str:
-    return format_number(v, 10)
+#: points per block of the map's evaluation and of its CSV text
+BLOCK = 65536
+
+#: decimals of the map CSV: positions and probe offsets (mm, deg) and errors (um)
+DECIMALS_MM, DECIMALS_UM = 6, 6
+
+
+def _header(vmap: VolumetricMap) -> str:
+    header = list(vmap.axes) + ["Xp", "Yp", "Zp", "dx_um", "dy_um", "dz_um"]
+    if vmap.random is not None:
+        header += ["rx_um", "ry_um", "rz_um"]
+    return ",".join(header) + "\n"
+
+
+def map_csv_blocks(vmap: VolumetricMap):
+    """The CSV text of a map (format in the module docstring) as bytes, in blocks of rows:
+    header first.  Numbers have fixed decimals (:data:`DECIMALS_MM` for mm / deg,
+    :data:`DECIMALS_UM` for um), trailing zeros dropped (:mod:`volerr.cmm.csvformat`)."""
+    yield _header(vmap).encode("ascii")
+    n = len(vmap.error)
+    ticks = vmap.ticks or {}
+    for start in range(0, n, BLOCK):
+        stop = min(start + BLOCK, n)
+        sl = slice(start, stop)
+        index = np.unravel_index(np.arange(start, stop), vmap.shape) if ticks else None
+        cols, dec = [], []
+        for a in vmap.axes:
+            if a in ticks:  # a grid axis: its ticks and each row's tick index
+                cols.append((ticks[a], index[vmap.grid_axes.index(a)]))
+            else:
+                cols.append(vmap.positions[a][sl])
+            dec.append(DECIMALS_MM)
+        cols += [float(v) for v in vmap.probe]
+        dec += [DECIMALS_MM] * 3
+        cols += [vmap.error[sl, i] * UM_PER_MM for i in range(3)]
+        if vmap.random is not None:
+            cols += [vmap.random[sl, i] * UM_PER_MM for i in range(3)]
+        dec += [DECIMALS_UM] * (len(cols) - len(dec))
+        yield csvformat.rows_text(cols, dec)
 
 
 def map_csv(vmap: VolumetricMap) -> str:
     """CSV text of a map (format in the module docstring)."""
-    header = list(vmap.axes) + ["Xp", "Yp", "Zp", "dx_um", "dy_um", "dz_um"]
-    cols = [vmap.positions[a] for a in vmap.axes]
-    n = len(cols[0])
-    cols += [np.full(n, vmap.probe[i]) for i in range(3)]
-    cols += [vmap.error[:, i] * UM_PER_MM for i in range(3)]
-    if vmap.random is not None:
-        header += ["rx_um", "ry_um", "rz_um"]
-        cols += [vmap.random[:, i] * UM_PER_MM for i in range(3)]
-    lines = [",".join(header)] + [",".join(_fmt(v) for v in row) for row in zip(*cols)]
-    return "\n".join(lines) + "\n"
+    return b"".join(map_csv_blocks(vmap)).decode("ascii")
 
 
 def write_map_csv(path, vmap: VolumetricMap, inputs=()) -> Path:
-    return write_text(path, map_csv(vmap), inputs=inputs)
+    """Write the map CSV to ``path`` streamed in blocks (memory does not grow with the text),
+    atomically: a temporary file renamed at the end."""
+    out = AtomicFile(path, inputs)
+    try:
+        for block in map_csv_blocks(vmap):
+            out.write(block)
+    except BaseException:
+        out.discard()
+        raise
+    return out.commit()
 
 
 # ---------------------------------------------------------------------------------------------

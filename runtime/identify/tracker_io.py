@@ -89,6 +89,14 @@ def read_tracker_csv(path) -> list[Round]:
     (_, header), body = rows[0], rows[1:]
     idx = _header_index(path, header)
     require(body, f"{path}: header only, no measurements")
+    fast = _read_regular(path, body, idx)
+    if fast is not None:
+        return fast
+    return _read_by_row(path, body, idx)  # a file with a problem: its line is named
+
+
+def _read_by_row(path: Path, body: list, idx: dict) -> list[Round]:
+    """Row-by-row reader with a check and an exact message per line (slow)."""
     data: dict = {}
     width = max(idx.values()) + 1
     for lineno, cells in body:
@@ -117,6 +125,47 @@ def read_tracker_csv(path) -> list[Round]:
                                                      f"measurement at position {p:g}")
         pts = np.array([[d["values"][(p, lab)] for lab in labels] for p in pos], dtype=float)
         rounds.append(Round(f"{path.name}:{rnd}", np.array(pos, dtype=float), tuple(labels), pts))
+    return rounds
+
+
+def _first_seen(values: np.ndarray):
+    """(distinct values in order of first appearance, index of each row's value in them)."""
+    uniq, first, inv = np.unique(values, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(len(order), dtype=np.intp)
+    rank[order] = np.arange(len(order))
+    return uniq[order], rank[np.ravel(inv)]
+
+
+def _read_regular(path: Path, body: list, idx: dict) -> list[Round] | None:
+    """The rounds of a well-formed file, parsed column-wise (numbers converted by numpy, no
+    per-row checks); None when anything is irregular, so that the row-by-row reader reports it
+    with its line number."""
+    width = max(idx.values()) + 1
+    cells = [c for _, c in body]
+    if min(map(len, cells)) < width or max(map(len, cells)) != min(map(len, cells)):
+        return None
+    table = np.array(cells)  # (n, columns) of text, one C-level conversion
+    rnd, label = table[:, idx["round"]], table[:, idx["point"]]
+    try:
+        num = table[:, [idx[c] for c in ("position", "x", "y", "z")]].astype(float).T
+    except ValueError:
+        return None
+    if not np.isfinite(num).all() or (rnd == "").any() or (label == "").any():
+        return None
+    rnd_names, rnd_of = _first_seen(rnd)
+    rounds = []
+    for r, name in enumerate(rnd_names):
+        rows = np.flatnonzero(rnd_of == r)
+        pos, pos_of = _first_seen(num[0, rows])
+        labels, lab_of = _first_seen(label[rows])
+        key = pos_of * len(labels) + lab_of
+        if len(rows) != len(pos) * len(labels) or len(np.unique(key)) != len(rows):
+            return None  # a duplicate or a missing measurement
+        pts = np.empty((len(pos), len(labels), 3))
+        pts[pos_of, lab_of] = num[1:, rows].T
+        rounds.append(Round(f"{path.name}:{name}", pos.astype(float),
+                            tuple(str(v) for v in labels), pts))
     return rounds
 
 

@@ -58,6 +58,27 @@ def _case_insensitive(given: dict, names) -> dict:
     return out
 
 
+#: points per block of :func:`_blocked`: the block's inputs, temporaries and outputs (some 30-60
+#: arrays of 8 kB x 8) stay in the L2 cache, so each input is read from memory once
+BLOCK = 8192
+
+
+def _blocked(fn, kwargs: dict, n: int, n_out: int = 3) -> np.ndarray:
+    """``fn(**kwargs)`` (a generated function returning ``n_out`` broadcastable outputs)
+    evaluated block by block into one (n, n_out) array.  Arguments that are (n,) arrays are
+    sliced (views, also of strided columns); scalars and (1,) arrays pass whole."""
+    out = np.empty((n, n_out))
+    sliced = [k for k, v in kwargs.items() if np.ndim(v) == 1 and np.shape(v)[0] == n and n > 1]
+    for start in range(0, n, BLOCK):
+        sl = slice(start, min(start + BLOCK, n))
+        kw = dict(kwargs)
+        for k in sliced:
+            kw[k] = kwargs[k][sl]
+        for i, c in enumerate(fn(**kw)):
+            out[sl, i] = c
+    return out
+
+
 def _columns(components, n: int) -> np.ndarray:
     """Generated outputs (tuple of broadcastable arrays) -> (n, len) float array."""
     return np.stack([np.broadcast_to(c, (n,)) for c in components], axis=-1).astype(
@@ -145,7 +166,7 @@ class Model:
             require(arr.ndim == 2 and arr.shape[1] == len(self.axes),
                     f"{self.name}: positions must have {len(self.axes)} columns "
                     f"({' '.join(self.axes)}), got shape {arr.shape}")
-            cols = dict(zip(self.axes, np.ascontiguousarray(arr.T)))
+            cols = {a: arr[:, i] for i, a in enumerate(self.axes)}  # strided views, no copy
         for a, v in cols.items():
             if not np.isfinite(v).all():
                 raise InputError(f"{self.name}: position {a} has NaN or infinite values")
@@ -223,9 +244,9 @@ class Model:
         result stays "actual minus nominal": a CMM reports the point minus this error."""
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
-        e = self.module.volumetric_error(**pos, **self._covariates(covariates, n),
-                                         **self._probe(probe, n), **errs)
-        out = self._check_finite(_columns(e, n), errs)
+        out = self._check_finite(_blocked(
+            self.module.volumetric_error,
+            {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n), errs)
         if direction is not None or probe_error is not None:
             out = out + self._probe_term(direction, probe_error, n)
         return out
@@ -278,17 +299,16 @@ class Model:
         require(method in ("exact", "termwise"), f"unknown random-error method {method!r}")
         pos, n = self._points(positions)
         sig = self._errors(sigmas, n)
-        self._check_finite(np.stack([np.broadcast_to(v, (n,)) for v in sig.values()]), sig)
         for k, v in sig.items():
+            require(np.all(np.isfinite(v)), f"error {k} has NaN or infinite values")
             require(np.all(v >= 0), f"standard deviation {k} must not be negative")
         if method == "termwise":
-            r = self.module.random_error_termwise(
-                **pos, **self._covariates(covariates, n), **self._probe(probe, n),
-                **{f"s_{k}": v for k, v in sig.items()})
-            return _columns(r, n)
-        s = self._sensitivity(pos, n, probe, covariates)
-        var = np.stack([np.broadcast_to(sig[p], (n,)) for p in self.parameters], axis=-1) ** 2
-        return np.sqrt(np.einsum("nij,nj->ni", s ** 2, var))
+            return _blocked(self.module.random_error_termwise,
+                            {**pos, **self._covariates(covariates, n), **self._probe(probe, n),
+                             **{f"s_{k}": v for k, v in sig.items()}}, n)
+        return _blocked(self.module.random_error_exact,
+                        {**pos, **self._covariates(covariates, n), **self._probe(probe, n),
+                         **{f"s_{k}": v for k, v in sig.items()}}, n)
 
     def transfer(self, measured: dict, offsets, angular: dict | None = None) -> dict:
         """Re-reference errors measured at an offset (Pahk sec. 2.3).
