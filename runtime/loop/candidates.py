@@ -295,7 +295,11 @@ def _linear(model, target: Target, cov: Covariate, special, gauge) -> list:
     slope = (ps, target.chain, f"{a}*{b}")
     offset = (p0, target.chain, b)
     u_slope, u_off = _unit(target, cov.unit, a, model), _unit(target, cov.unit, None, model)
-    if (target.name, cov.name) in special:         # the former families: scale + fixed point
+    if (target.name, cov.name) in special:
+        if kind == "reversal":                     # the former family: position offset
+            return [Candidate(kind, name, [(ps, target.chain, b)], dict(info),
+                              units={ps: u_off})]
+        # the former thermal family: scale + its fixed point
         return [Candidate(kind, name, [slope, offset], {**info, "basis": "linear, scale"},
                           units={ps: u_slope, p0: u_off})]
     out = []

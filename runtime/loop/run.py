@@ -311,7 +311,7 @@ def split_points(n: int, seed: int, test_fraction: float, folds: int | None) -> 
     return Split(train, test, fold_t)
 
 
-def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
+def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None, weights=None):
     """Degree of the component series by cross-validation on the training points (``extra``:
     effect columns (rows, m) included in every model compared).  At most
     ``DEGREE_CV_POINTS`` random training points are used (the design is built for those only)."""
@@ -326,7 +326,8 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
         extra = extra.reshape(-1, 3, extra.shape[1])[train].reshape(-1, extra.shape[1])
     sub_data = data.subset(train)
     design = declared_design(model, sub_data, max_degree, ranges)
-    y = sub_data.deviation.ravel()
+    sw = np.ones(3 * len(train)) if weights is None else np.repeat(np.sqrt(weights[train]), 3)
+    y = sub_data.deviation.ravel() * sw
     pts = np.arange(len(train))
     scores = {}
     for k in range(1, max_degree + 1):
@@ -337,7 +338,7 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
         A = design.A[:, :, m].reshape(-1, m.sum())
         if extra is not None and extra.shape[1]:
             A = np.concatenate([A, extra], axis=1)
-        prob = Problem(A, y)
+        prob = Problem(A * sw[:, None], y)
         scores[k] = rms(prob.loo_residuals(pts) if folds is None else
                         prob.cv_residuals(folds, pts))
         best_k = min(scores, key=scores.get)
@@ -619,10 +620,13 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
     """Declared fit, robust weights, selection; the degree chosen again with the effects."""
     degree_scores = {}
     if not fixed_degree:
+        # robust weights of a preliminary fit first: outliers must not choose the degree
+        pre = declared_step(model, dat, min(max_degree, 6), ranges, spl.train)
+        w0 = robust_weights(pre.A, y, np.arange(dat.n), dat.n).weights
         degree, degree_scores = _choose_degree(model, dat, spl.train, spl.folds, ranges,
-                                               max_degree)
+                                               max_degree, weights=w0)
     decl = declared_step(model, dat, degree, ranges, spl.train)
-    robust = robust_weights(decl.A, y, spl.train, dat.n)
+    robust = robust_weights(decl.A, y, np.arange(dat.n), dat.n)
     selection, warns = selection_step(model, dat, decl, spl, ranges, degree, families,
                                       robust, y)
     keepers = [s for s in selection.accepted if s.cand.kind != "higher_order"]
@@ -630,11 +634,11 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
         # the degree was chosen with the effects unmodelled: choose it again with them
         extra = np.concatenate([s.cols.reshape(-1, s.cols.shape[-1]) for s in keepers], axis=1)
         degree2, scores2 = _choose_degree(model, dat, spl.train, spl.folds, ranges,
-                                          max_degree, extra)
+                                          max_degree, extra, robust.weights)
         if degree2 != degree:
             degree, degree_scores = degree2, scores2
             decl = declared_step(model, dat, degree, ranges, spl.train)
-            robust = robust_weights(decl.A, y, spl.train, dat.n)
+            robust = robust_weights(decl.A, y, np.arange(dat.n), dat.n)
             selection, warns = selection_step(model, dat, decl, spl, ranges, degree,
                                               families, robust, y)
     return degree, degree_scores, decl, robust, selection, warns
