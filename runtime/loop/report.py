@@ -41,12 +41,12 @@ def fig_residuals(fg) -> str:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    dat = fg["data"]
+    dat = fg.data
     variables = {**dat.positions, **dat.covariates}
     names = [v for v, x in variables.items() if np.ptp(x) > 0][:14]
     idx = _thin(dat.n)
-    rb = fg["res_before"].reshape(-1, 3)[idx] * 1e3
-    ra = fg["res_after"].reshape(-1, 3)[idx] * 1e3
+    rb = fg.res_before.reshape(-1, 3)[idx] * 1e3
+    ra = fg.res_after.reshape(-1, 3)[idx] * 1e3
     lim = max(np.percentile(np.abs(rb), 99.5), 1e-6) * 1.1
     fig, axes = plt.subplots(len(names), 2, figsize=(10, 1.9 * len(names) + 0.6),
                              squeeze=False, sharey=True)
@@ -105,15 +105,15 @@ def fig_effect(fg, eff: dict) -> str:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    model, dat = fg["model"], fg["data"]
-    prob, coef, labels = fg["after_prob"], fg["c_all"], fg["aug_labels"]
+    model, dat = fg.model, fg.data
+    prob, coef, labels = fg.after_prob, fg.c_all, fg.aug_labels
     col = {lab[0]: j for j, lab in enumerate(labels)}
     contrib = np.zeros(3 * dat.n)
     for p in eff["parameters"]:
         j = col[p]
         contrib += prob.A[:, j] * prob.scale[j] * coef[j]
     c3 = contrib.reshape(-1, 3) * 1e3
-    partial = (fg["res_after"].reshape(-1, 3) * 1e3) + c3
+    partial = (fg.res_after.reshape(-1, 3) * 1e3) + c3
     values = {**rotary_rad(model, dat.positions), **dat.covariates}
     x, xlabel = _natural(eff["kind"], eff["info"], model, dat, values)
     if eff["kind"] == "probe_direction":
@@ -152,11 +152,11 @@ def fig_maps(fg) -> str:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    model, dat = fg["model"], fg["data"]
+    model, dat = fg.model, fg.data
     a, b = model.axes[0], model.axes[1]
     idx = _thin(dat.n)
-    nb = np.linalg.norm(fg["res_before"].reshape(-1, 3), axis=1)[idx] * 1e3
-    na = np.linalg.norm(fg["res_after"].reshape(-1, 3), axis=1)[idx] * 1e3
+    nb = np.linalg.norm(fg.res_before.reshape(-1, 3), axis=1)[idx] * 1e3
+    na = np.linalg.norm(fg.res_after.reshape(-1, 3), axis=1)[idx] * 1e3
     vmax = max(np.percentile(nb, 99), 1e-6)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
     for ax, v, title in ((axes[0], nb, "before"), (axes[1], na, "after")):

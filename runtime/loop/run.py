@@ -425,9 +425,9 @@ def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, famil
     candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
                   if c.kind in families]
     w_rows = robust.rows()
-    ctx = sel.Context(model, dat, decl.design.sens, decl.design.frame, rows_of(spl.train),
-                      w_rows[rows_of(spl.train)], ranges)
-    return sel.select(candidates, ctx, decl.A, y, spl.train, spl.folds, w_rows), warns
+    ctx = sel.Context(model, dat, decl.design.sens, decl.design.frame, spl.train,
+                      np.sqrt(robust.weights[spl.train]), ranges)
+    return sel.select(candidates, ctx, decl.A, y, spl.folds, w_rows, sel.SCREEN_POINTS), warns
 
 
 @dataclass

@@ -28,6 +28,7 @@ BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an 
 CV_T = 3.0           # minimum paired t of the held-out improvement
 MAX_EFFECTS = 8
 TOP_FIT = 3          # candidates fitted fully per forward step
+SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
 N_SOURCES = 10       # residual sources reported
 
 
@@ -83,80 +84,88 @@ class Base:
 
 @dataclass
 class Context:
-    """What the columns of a candidate need: model, data, sensitivities, frame, rows."""
+    """What the columns of a candidate need: model, data, sensitivities, frame, and the
+    points (``pts``, with their sqrt robust weights ``sw``) on which they are scored."""
 
     model: object
     data: object
     sens: np.ndarray
     frame: tuple
-    rows: np.ndarray          # weighted training rows
-    sqrt_w: np.ndarray        # sqrt of the robust weights on those rows
+    pts: np.ndarray
+    sw: np.ndarray
     ranges: dict
     cache: dict = field(default_factory=dict)
 
-    def values(self):
+    def on(self, pts, sw) -> "Context":
+        """The same context on other points (shares nothing that depends on the points)."""
+        return Context(self.model, self.data, self.sens, self.frame, pts, sw, self.ranges,
+                       {"fixed": self.cache.setdefault("fixed", {})})
+
+    def values(self, full: bool = False):
         from volerr.loop.fit import rotary_rad
 
-        if "_values" not in self.cache:
-            self.cache["_values"] = {**rotary_rad(self.model, self.data.positions),
-                                     **self.data.covariates}
-        return self.cache["_values"]
+        key = ("_values", full)
+        if key not in self.cache:
+            idx = slice(None) if full else self.pts
+            vals = {**rotary_rad(self.model, self.data.positions), **self.data.covariates}
+            self.cache[key] = {k: np.asarray(v)[idx] for k, v in vals.items()}
+        return self.cache[key]
 
-    def target_column(self, target: str) -> np.ndarray:
-        """(N, 3) sensitivity of a chain target (a parameter, ``work.*`` or ``tool.*``)."""
-        key = ("target", target)
+    def target_column(self, target: str, full: bool = False) -> np.ndarray:
+        """(n, 3) sensitivity of a chain target (a parameter, ``work.*`` or ``tool.*``) at the
+        context's points (all points when ``full``)."""
+        key = ("target", target, full)
         if key not in self.cache:
             if "." in target:
                 side, k = target.split(".")
-                self.cache[key] = twist_columns(side, k, self.data, self.frame)
+                col = twist_columns(side, k, self.data, self.frame)
             else:
-                self.cache[key] = self.sens[:, :, self.model.parameters.index(target)]
+                col = self.sens[:, :, self.model.parameters.index(target)]
+            self.cache[key] = col if full else col[self.pts]
         return self.cache[key]
 
-    def columns(self, terms) -> tuple[np.ndarray, list]:
-        """(N, 3, m) columns of the parameters of ``terms`` [(parameter, target, basis)]."""
-        key = tuple(terms)
-        if key not in self.cache:
-            params = list(dict.fromkeys(t[0] for t in terms))
-            out = np.zeros((self.data.n, 3, len(params)))
-            for pn, target, basis in terms:
-                b = np.broadcast_to(evaluate(basis, self.values()), (self.data.n,))
-                out[:, :, params.index(pn)] += self.target_column(target) * b[:, None]
+    def columns(self, terms, full: bool = False) -> tuple[np.ndarray, list]:
+        """(n, 3, m) columns of the parameters of ``terms`` [(parameter, target, basis)] at
+        the context's points (all points when ``full``: not cached, memory stays bounded)."""
+        key = ("cols", tuple(terms))
+        if not full and key in self.cache:
+            return self.cache[key]
+        params = list(dict.fromkeys(t[0] for t in terms))
+        vals = self.values(full)
+        n = self.data.n if full else len(self.pts)
+        out = np.zeros((n, 3, len(params)))
+        for pn, target, basis in terms:
+            b = np.broadcast_to(evaluate(basis, vals), (n,))
+            out[:, :, params.index(pn)] += self.target_column(target, full) * b[:, None]
+        if not full and len(self.pts) * len(params) <= 20000 * 3:
             self.cache[key] = (out, params)
-            if len(self.cache) > 3000:      # profiles make many; keep memory bounded
-                for k in list(self.cache)[:1000]:
-                    if k != "_values" and not (isinstance(k, tuple) and k[0] == "target"):
-                        del self.cache[k]
-        return self.cache[key]
+        return out, params
+
+    def rows(self, cols) -> np.ndarray:
+        """Weighted rows (3n, m) of columns (n, 3, m) at the context's points."""
+        return (cols * self.sw[:, None, None]).reshape(-1, cols.shape[-1])
 
     def profile_rows(self, c, values) -> np.ndarray:
-        """Weighted training rows (rows, G) of a one-term searched candidate at ``values``."""
+        """Weighted rows (3n, G) of a one-term searched candidate at ``values``."""
         key = ("profile", c.name, tuple(values))
         if key not in self.cache:
             (_, target, _), = c.search.make(values[0])[0]
-            pts = self.rows[::3] // 3
-            vals = self.values()
-            sub = {k: np.asarray(v)[pts] if np.ndim(v) else v for k, v in vals.items()}
-            basis = np.column_stack([np.broadcast_to(evaluate(c.search.make(v)[0][0][2], sub),
-                                                     (len(pts),)) for v in values])
-            t = self.target_column(target)[pts]                      # (n, 3)
-            B = (t[:, :, None] * basis[:, None, :]).reshape(-1, len(values))
-            self.cache[key] = B * self.sqrt_w[:, None]
+            basis = np.column_stack([np.broadcast_to(evaluate(c.search.make(v)[0][0][2],
+                                                              self.values()), (len(self.pts),))
+                                     for v in values])
+            t = self.target_column(target) * self.sw[:, None]          # (n, 3)
+            self.cache[key] = (t[:, :, None] * basis[:, None, :]).reshape(-1, len(values))
         return self.cache[key]
-
-    def train_rows(self, cols) -> np.ndarray:
-        return cols.reshape(-1, cols.shape[-1])[self.rows] * self.sqrt_w[:, None]
 
 
 @dataclass
 class Scored:
-    """A screened candidate: BIC change, RSS reduction, rank, its (fixed) candidate, columns."""
+    """A screened candidate: BIC change, RSS reduction, rank, its (fixed) candidate."""
 
     dbic: float
     gain: float
     rank: int
     cand: cands.Candidate
-    cols: np.ndarray
     params: list
 
 
@@ -189,12 +198,11 @@ def _profile(c: cands.Candidate, ctx: Context, base: Base) -> cands.Candidate:
 def _periodic_best(c, ctx: Context, base: Base) -> float:
     """Best period of a periodic candidate by the residual periodogram, refined."""
     comp, axis, periods = c.info["component"], c.info["axis"], np.asarray(c.search.grid)
-    n = len(ctx.rows) // 3
-    s = (ctx.target_column(comp).reshape(-1)[ctx.rows] * ctx.sqrt_w).reshape(n, 3)
-    r = base.r.reshape(n, 3)
+    s = ctx.target_column(comp) * ctx.sw[:, None]
+    r = base.r.reshape(-1, 3)
     w = np.sum(r * s, axis=1)
     s2 = np.sum(s * s, axis=1)
-    q = ctx.data.positions[axis][ctx.rows[::3] // 3]
+    q = ctx.data.positions[axis][ctx.pts]
 
     def gain(per):
         ph = 2 * np.pi * np.outer(q, 1.0 / np.atleast_1d(per))
@@ -213,16 +221,16 @@ def _periodic_best(c, ctx: Context, base: Base) -> float:
     return float(fine[int(np.argmax(gain(fine)))])
 
 
+def _scored(c, ctx: Context, base: Base) -> "Scored":
+    cols, params = ctx.columns(c.terms)
+    gain, rank = base.score(ctx.rows(cols))
+    m_eff = rank + (1 if c.search is not None else 0)
+    return Scored(base.dbic(gain, m_eff), gain, rank, c, params)
+
+
 def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
     """Score every candidate against the residual of ``base``; sorted by BIC change."""
     out = []
-
-    def scored(c):
-        cols, params = ctx.columns(c.terms)
-        gain, rank = base.score(ctx.train_rows(cols))
-        m_eff = rank + (1 if c.search is not None else 0)
-        return Scored(base.dbic(gain, m_eff), gain, rank, c, cols, params)
-
     fixed = ctx.cache.setdefault("fixed", {})
     for c in candidates:
         if c.name in skip:
@@ -231,22 +239,29 @@ def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
             # profiled once; later screenings reuse the value and re-profile the leaders
             c = fixed[c.name] if c.name in fixed else _profile(c, ctx, base)
             fixed[c.name] = c
-        s = scored(c)
-        if s.rank:
-            out.append(s)
-    out.sort(key=lambda s: s.dbic)
-    for i, s in enumerate(out[:2 * TOP_FIT]):
-        if s.cand.search is not None and not s.cand.info.get("_fresh_for") == id(base):
-            c = _profile(s.cand, ctx, base)
-            c.info["_fresh_for"] = id(base)
+        sc = _scored(c, ctx, base)
+        if sc.rank:
+            out.append(sc)
+    out.sort(key=lambda x: x.dbic)
+    for i, sc in enumerate(out[:2 * TOP_FIT]):
+        if sc.cand.search is not None:
+            c = _profile(sc.cand, ctx, base)
             fixed[c.name] = c
-            out[i] = scored(c)
-    for s in out:
-        s.cand.info.pop("_fresh_for", None)
-    out = [s for s in out if s.rank]
-    out.sort(key=lambda s: s.dbic)
+            out[i] = _scored(c, ctx, base)
+    out = [x for x in out if x.rank]
+    out.sort(key=lambda x: x.dbic)
     _prefer_first_of_ties(out, candidates)
     return out
+
+
+def rescore(scored: list, ctx: Context, base: Base, candidates, top: int) -> list:
+    """The ``top`` leaders of a screening (on a subset of points) scored exactly on all
+    training points, then the rest as they were."""
+    head = [_scored(x.cand, ctx, base) for x in scored[:top]]
+    head = [x for x in head if x.rank]
+    head.sort(key=lambda x: x.dbic)
+    _prefer_first_of_ties(head, candidates)
+    return head + scored[top:]
 
 
 def _prefer_first_of_ties(scored: list, candidates: list) -> None:
@@ -304,42 +319,56 @@ class Selection:
 
 def _cv_sq(A, y, folds, train, w_rows) -> np.ndarray:
     """Per-point squared cross-validated residual (weighted rows)."""
-    prob = Problem(A * w_rows[:, None], y * w_rows)
-    r = prob.loo_residuals(train) if folds is None else prob.cv_residuals(folds, train)
+    rows = rows_of(train)
+    prob = Problem(A[rows] * w_rows[rows, None], y[rows] * w_rows[rows])
+    pts = np.arange(len(train))
+    r = prob.loo_residuals(pts) if folds is None else prob.cv_residuals(folds, pts)
     return point_norm(r) ** 2
 
 
-def select(candidates, ctx: Context, A0, y, train, folds, w_rows) -> Selection:
-    """Forward selection with held-out evidence, then the backward check."""
-    tr = rows_of(train)
-    ytr = y[tr] * ctx.sqrt_w
+def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -> Selection:
+    """Forward selection with held-out evidence, then the backward check.  ``ctx`` is on the
+    training points; screening uses at most ``screen_points`` of them (a random subset), the
+    leaders are then scored exactly on all training points."""
+    train = ctx.pts
+    ctx_s = ctx
+    if len(train) > screen_points:
+        sub = np.sort(np.random.default_rng(1).choice(len(train), screen_points, replace=False))
+        ctx_s = ctx.on(train[sub], ctx.sw[sub])
+    tr, tr_s = rows_of(train), rows_of(ctx_s.pts)
+    ytr, ytr_s = y[tr] * w_rows[tr], y[tr_s] * w_rows[tr_s]
     A_all = A0
     cv_old = _cv_sq(A_all, y, folds, train, w_rows)
     accepted, rejected, first, last = [], set(), None, []
     while True:
-        base = Base(A_all[tr] * ctx.sqrt_w[:, None], ytr)
-        scored = screen(candidates, ctx, base, rejected | {a.cand.name for a in accepted})
+        base = Base(A_all[tr] * w_rows[tr, None], ytr)
+        scored = screen(candidates, ctx_s, Base(A_all[tr_s] * w_rows[tr_s, None], ytr_s)
+                        if ctx_s is not ctx else base,
+                        rejected | {a.cand.name for a in accepted})
+        if ctx_s is not ctx:
+            scored = rescore(scored, ctx, base, candidates, 2 * N_SOURCES)
         last = scored
         if first is None:
             first = scored
         if len(accepted) >= MAX_EFFECTS:
             break
         hit = None
-        for s in scored[:TOP_FIT]:
-            if s.dbic > -BIC_GAIN:
+        for x in scored[:TOP_FIT]:
+            if x.dbic > -BIC_GAIN:
                 break
-            A_try = np.concatenate([A_all, s.cols.reshape(-1, s.cols.shape[-1])], axis=1)
+            cols, _ = ctx.columns(x.cand.terms, full=True)
+            A_try = np.concatenate([A_all, cols.reshape(-1, cols.shape[-1])], axis=1)
             cv_new = _cv_sq(A_try, y, folds, train, w_rows)
             d = cv_old - cv_new
             t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
             if t < CV_T:
-                rejected.add(s.cand.name)
+                rejected.add(x.cand.name)
                 continue
-            alts = [o.cand.name for o in scored if o.cand.name != s.cand.name
-                    and o.gain >= 0.98 * s.gain]
-            hit = Accepted(s.cand, s.params, s.cols, {
-                "delta_bic": round(s.dbic, 2),
-                "rss_reduction_fraction": round(s.gain / base.rss, 5),
+            alts = [o.cand.name for o in scored[:2 * N_SOURCES] if o.cand.name != x.cand.name
+                    and o.gain >= 0.98 * x.gain]
+            hit = Accepted(x.cand, x.params, cols, {
+                "delta_bic": round(x.dbic, 2),
+                "rss_reduction_fraction": round(x.gain / base.rss, 5),
                 "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
                 "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
                 "cv_paired_t": round(t, 2), "step": len(accepted) + 1,
@@ -350,10 +379,16 @@ def select(candidates, ctx: Context, A0, y, train, folds, w_rows) -> Selection:
             break
         accepted.append(hit)
     if accepted:
-        accepted = _backward(A0, accepted, ctx, ytr)
+        accepted = _backward(A0, accepted, tr, w_rows, ytr)
         A_all = _stack(A0, accepted)
-        base = Base(A_all[tr] * ctx.sqrt_w[:, None], ytr)
-        last = screen(candidates, ctx, base, {a.cand.name for a in accepted})
+        base = Base(A_all[tr] * w_rows[tr, None], ytr)
+        names = {a.cand.name for a in accepted}
+        if ctx_s is not ctx:
+            last = rescore(screen(candidates, ctx_s, Base(A_all[tr_s] * w_rows[tr_s, None],
+                                                          ytr_s), names),
+                           ctx, base, candidates, 2 * N_SOURCES)
+        else:
+            last = screen(candidates, ctx, base, names)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
 
@@ -362,14 +397,13 @@ def _stack(A0, sel):
     return np.concatenate([A0] + [s.cols.reshape(-1, s.cols.shape[-1]) for s in sel], axis=1)
 
 
-def _backward(A0, selected, ctx: Context, ytr) -> list:
+def _backward(A0, selected, tr, w_rows, ytr) -> list:
     """Drop an effect that, given all the others, no longer gains dBIC < -BIC_GAIN (a later
     effect made it redundant); each kept effect gets ``delta_bic_given_others``."""
-    tr = ctx.rows
-
     def dbic_without(sel, i):
-        base = Base(_stack(A0, sel[:i] + sel[i + 1:])[tr] * ctx.sqrt_w[:, None], ytr)
-        gain, rank = base.score(ctx.train_rows(sel[i].cols))
+        base = Base(_stack(A0, sel[:i] + sel[i + 1:])[tr] * w_rows[tr, None], ytr)
+        B = sel[i].cols.reshape(-1, sel[i].cols.shape[-1])[tr] * w_rows[tr, None]
+        gain, rank = base.score(B)
         return base.dbic(gain, rank + (1 if sel[i].cand.search is not None else 0))
 
     sel = list(selected)

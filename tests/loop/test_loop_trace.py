@@ -31,7 +31,8 @@ def _run(tmp_path, effects, seed, layout="MB1", noise_um=0.3):
 CASES = [  # effect, (parameter, covariate) expected, check of the value
     ({"kind": "gradient", "component": "EBX", "urad_per_K": 12.0}, ("EBX", "T_top - T_bottom"),
      lambda e: abs(list(e["parameters"].values())[0] - 12.0) < 1.0),
-    ({"kind": "gradient", "component": "EAY", "urad_per_K": -9.0}, ("EAY", "T_top - T_bottom"),
+    # (a roll EAY would be the same columns as EAX on this chain: X moves along x)
+    ({"kind": "gradient", "component": "ECY", "urad_per_K": -9.0}, ("ECY", "T_top - T_bottom"),
      lambda e: abs(list(e["parameters"].values())[0] + 9.0) < 1.0),
     # the simulator tilts Y; volerr's EC0Y tilts X: the same squareness up to a rigid rotation
     ({"kind": "squareness_T", "index": 0, "urad_per_K": -8.0}, ("EC0Y", "T_C"),
@@ -64,7 +65,7 @@ def test_effect_outside_the_eight_traced(tmp_path, i):
     assert (top["parameter"], top["covariate"]) == pc and top["accepted"]
     assert rep["rms_after_um"] <= 1.15 * floor, (rep["rms_after_um"], floor)
     # what is left: nothing of that size
-    assert rep["residual_sources_after"][0]["explained_um"] < 0.2 * top["explained_um"]
+    assert rep["residual_sources_after"][0]["explained_um"] < max(0.2 * top["explained_um"], 0.1)
 
 
 @pytest.mark.slow
