@@ -1,7 +1,8 @@
 """``volerr loop LAYOUT DATA.csv --json F [--html F]``: close the loop on measured deviations.
 
-Fits the declared model, traces what is left to candidate effects (thermal, drift, reversal,
-coupling, periodic, higher_order, probe_direction, setup), writes the augmented layout and its
+Fits the declared model, traces what is left to candidate effects "parameter P of the chain
+varies with covariate C" (thermal, drift, reversal, coupling, periodic, higher_order, step,
+probe_direction, setup, group ...), writes the augmented layout and its
 generated module (``--out-dir``, default: the folder of the json report) and reports the error
 before and after on held-out points.  See :mod:`volerr.loop.run`.
 """
@@ -24,7 +25,7 @@ def register(sub) -> None:
                     "report RMS/max before and after on held-out points.")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", help="measured-deviation CSV")
-    p.add_argument("--json", required=True, help="write the report (JSON)")
+    p.add_argument("--json", help="write the report (JSON)")
     p.add_argument("--html", help="write the report with figures (HTML)")
     p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
                                      "(default: the folder of --json)")
@@ -48,10 +49,12 @@ def run(args) -> int:
     from volerr.loop.run import run_loop
 
     inputs = [args.data, args.layout]
-    check_output(args.json, inputs)
+    require(args.json or args.html, "give --json or --html (or both) for the report")
+    if args.json:
+        check_output(args.json, inputs)
     if args.html:
         check_output(args.html, inputs)
-        require(Path(args.html).resolve() != Path(args.json).resolve(),
+        require(not args.json or Path(args.html).resolve() != Path(args.json).resolve(),
                 "--json and --html must be different files")
     families = candidates.FAMILIES
     if args.families:
@@ -59,15 +62,18 @@ def run(args) -> int:
         bad = [f for f in families if f not in candidates.FAMILIES]
         require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
                 f"{' '.join(candidates.FAMILIES)}")
-    out_dir = Path(args.out_dir) if args.out_dir else Path(args.json).resolve().parent
+    out_dir = Path(args.out_dir) if args.out_dir else Path(args.json or args.html).resolve().parent
     report = run_loop(args.layout, args.data, seed=args.seed, folds=args.folds,
                       test_fraction=args.test_fraction, degree=args.degree,
                       out_dir=out_dir, families=families, inputs=inputs)
-    report.write_json(args.json, inputs=inputs)
+    if args.json:
+        report.write_json(args.json, inputs=inputs)
     if args.html:
         report.write_html(args.html, inputs=inputs)
     if args.errors_out:
         report.write_error_tables(args.errors_out, inputs=inputs)
+    for w in report["warnings"]:
+        print(f"  warning: {w}")
     print(report.summary())
     for e in report.effects:
         pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
@@ -75,6 +81,8 @@ def run(args) -> int:
     if report["augmented_layout"]:
         print(f"  augmented layout: {report['augmented_layout']}; generated module: "
               f"{report['generated_module']}")
+    if report["residual_note"]:
+        print(f"  {report['residual_note']}")
     if report["unidentifiable"]:
         print(f"  not separable by these data: "
               f"{', '.join(u['parameters'][0] for u in report['unidentifiable'])} (see the report)")

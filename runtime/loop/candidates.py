@@ -303,7 +303,10 @@ def _linear(model, target: Target, cov: Covariate, special, gauge) -> list:
         return [Candidate(kind, name, [slope, offset], {**info, "basis": "linear, scale"},
                           units={ps: u_slope, p0: u_off})]
     out = []
-    has0, has1 = (target.name, 0) not in gauge, (target.name, 1) not in gauge
+    # an angular error's offset stays a candidate even where the declared model fixes it by
+    # convention: varying with C it is one cause (a yaw of Y), not squareness + a yaw of X
+    has0 = target.angular or (target.name, 0) not in gauge
+    has1 = target.angular or (target.name, 1) not in gauge
     if has0:
         out.append(Candidate(kind, name, [(ps, target.chain, b)], dict(info),
                              units={ps: u_off}))

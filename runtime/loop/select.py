@@ -380,6 +380,7 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
         accepted.append(hit)
     if accepted:
         accepted = _backward(A0, accepted, tr, w_rows, ytr)
+        accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, tr, w_rows, ytr)
         A_all = _stack(A0, accepted)
         base = Base(A_all[tr] * w_rows[tr, None], ytr)
         names = {a.cand.name for a in accepted}
@@ -415,6 +416,46 @@ def _backward(A0, selected, tr, w_rows, ytr) -> list:
                 s_.evidence["delta_bic_given_others"] = round(d, 2)
             break
         sel.pop(worst)
+    for k, s_ in enumerate(sel):
+        s_.evidence["step"] = k + 1
+    return sel
+
+
+def _merge(A0, accepted, pool, ctx: Context, tr, w_rows, ytr) -> list:
+    """Parsimony across overlapping candidates: two accepted effects are replaced by ONE
+    candidate of the first screening when it explains the data at least as well by BIC (e.g.
+    a yaw of Y, taken first as squareness and then as a yaw of X).  Repeated while it helps."""
+    sel = list(accepted)
+    changed = True
+    while changed and len(sel) >= 2:
+        changed = False
+        best = (0.0, None)
+        for i in range(len(sel)):
+            for j in range(i + 1, len(sel)):
+                others = [s_ for k, s_ in enumerate(sel) if k not in (i, j)]
+                base = Base(_stack(A0, others)[tr] * w_rows[tr, None], ytr)
+                pair = np.concatenate([sel[i].cols, sel[j].cols], axis=2)
+                B = pair.reshape(-1, pair.shape[-1])[tr] * w_rows[tr, None]
+                g_ij, r_ij = base.score(B)
+                m_ij = r_ij + sum(1 for s_ in (sel[i], sel[j]) if s_.cand.search is not None)
+                for x in pool:
+                    if x.cand.name in (sel[i].cand.name, sel[j].cand.name):
+                        continue
+                    cols, _ = ctx.columns(x.cand.terms, full=True)
+                    g_c, r_c = base.score(cols.reshape(-1, cols.shape[-1])[tr] *
+                                          w_rows[tr, None])
+                    m_c = r_c + (1 if x.cand.search is not None else 0)
+                    d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
+                    if r_c and d < best[0]:
+                        best = (d, (i, j, x, cols))
+        if best[1] is not None:
+            i, j, x, cols = best[1]
+            ev = dict(sel[i].evidence)
+            ev["replaces"] = [sel[i].cand.name, sel[j].cand.name]
+            ev["delta_bic_vs_replaced"] = round(best[0], 2)
+            merged = Accepted(x.cand, x.params, cols, ev)
+            sel = [s_ for k, s_ in enumerate(sel) if k not in (i, j)] + [merged]
+            changed = True
     for k, s_ in enumerate(sel):
         s_.evidence["step"] = k + 1
     return sel

@@ -132,3 +132,21 @@ def test_bad_covariate_columns_left_out_with_a_warning(tmp_path):
         assert sum(c in w for w in rep["warnings"]) == 1, text
     assert [e["name"] for e in rep["effects"]] == [e["name"] for e in ref["effects"]]
     assert rep["rms_after_um"] == ref["rms_after_um"]
+
+
+def test_cli_html_without_json(tmp_path):
+    """`volerr loop LAYOUT DATA --html F` works without --json; the page holds the residual
+    sources as tables, no raw JSON dump and no absolute paths."""
+    import subprocess
+    import sys
+
+    cols = sim.campaign("MB1", 300, 71, [{"kind": "reversal", "axis": "Y", "um": 5.0}])
+    path = sim.write_csv(str(tmp_path / "d.csv"), cols)
+    html = tmp_path / "r.html"
+    r = subprocess.run([sys.executable, "-m", "volerr", "loop", "MB1", path, "--html",
+                        str(html)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    text = html.read_text()
+    assert "Where the residual lives" in text and "parameter P" in text
+    assert str(tmp_path) not in text and '"rms_before_um"' not in text
+    assert (tmp_path / "MB1_aug.toml").is_file()
