@@ -155,10 +155,12 @@ def temperature_columns(covs) -> list:
 # ---- P: the parameters of the chain ---------------------------------------------------
 def targets(model) -> list:
     """Every declared parameter of ``model`` a candidate can modulate."""
-    out = []
-    for p in model.parameters:
-        a = model.parameter_axis.get(p)
-        out.append(Target(p, "component" if a else "constant", p, a))
+    # constants (squareness, location errors) first: where a component's offset gives the
+    # same columns (a radial error of C and its location error EY0C), ties go to the constant,
+    # as in the declared model's gauge order
+    out = [Target(p, "constant", p) for p in model.parameters if not model.parameter_axis.get(p)]
+    out += [Target(p, "component", p, model.parameter_axis[p]) for p in model.parameters
+            if model.parameter_axis.get(p)]
     out += [Target(f"setup.{k}", "setup", f"work.{k}") for k in SETUP_KEYS]
     out += [Target(f"tool.{k}", "tool", f"tool.{k}") for k in ("dx", "dy", "dz")]
     return out

@@ -150,3 +150,72 @@ def test_cli_html_without_json(tmp_path):
     assert "Where the residual lives" in text and "parameter P" in text
     assert str(tmp_path) not in text and '"rms_before_um"' not in text
     assert (tmp_path / "MB1_aug.toml").is_file()
+
+
+def _five_axis_campaign(n, seed, planted):
+    """TT_AC measured with the independent exact chain (tests/helpers/reference_chain.py, scipy
+    rotations): smooth component errors, constant squareness / location errors, the rotary
+    location error ``planted`` = (name, um per K) growing with T_C, rigid instrument
+    placement, 0.3 um noise.  Returns CSV columns and the noise (n, 3) mm."""
+    import volerr
+    from helpers.reference_chain import tool_point
+
+    from helpers.indep_sim import rot
+
+    model = volerr.load("TT_AC")
+    lay = model.layout
+    rng = np.random.default_rng(seed)
+    pos = {a: rng.uniform(*model.travel[a], n) for a in model.axes}
+    probes = np.array([(0, 0, 100.0), (0, 0, 200.0), (30, 0, 150.0), (0, 30, 150.0)])
+    probe = probes[rng.integers(0, 4, n)]
+    t_s = np.sort(rng.uniform(0, 6 * 3600, n))[rng.permutation(n)]
+    T = 20.5 + 1.5 * np.sin(2 * np.pi * t_s / (4.5 * 3600)) + rng.normal(0, 0.03, n)
+    coef = {}
+    for p in model.parameters:
+        a = model.parameter_axis.get(p)
+        size = 3e-3 if p[1] in "XYZ" else 5e-6
+        coef[p] = rng.normal(0, size, 4 if a else 1) / np.array([1, 1, 2, 3][:4 if a else 1])
+    dev = np.zeros((n, 3))
+    for i in range(n):
+        q = {a: (np.deg2rad(pos[a][i]) if a in model.rotary_axes else pos[a][i])
+             for a in model.axes}
+        err = {}
+        for p in model.parameters:
+            a = model.parameter_axis.get(p)
+            if a is None:
+                err[p] = coef[p][0]
+            else:
+                lo, hi = model.travel[a]
+                u = (2 * pos[a][i] - lo - hi) / (hi - lo)
+                err[p] = coef[p] @ np.array([0.0, u, u * u - 1 / 3, u ** 3 - 0.6 * u])
+        name, per_k = planted
+        err[name] = err[name] + per_k * 1e-3 * (T[i] - 20.0)
+        dev[i] = tool_point(lay, q, err, probe[i]) - tool_point(lay, q, {}, probe[i])
+    nom = model.nominal_position(pos, probe)
+    R = rot(*rng.normal(0, 10e-6, 3))          # the instrument's placement, exact
+    meas = (nom + dev) @ R.T + rng.normal(0, 5e-3, 3)
+    noise = rng.normal(0, 0.3e-3, (n, 3))
+    d = meas - nom + noise
+    cols = {**pos, "Xp": probe[:, 0], "Yp": probe[:, 1], "Zp": probe[:, 2],
+            "dx_um": d[:, 0] * 1e3, "dy_um": d[:, 1] * 1e3, "dz_um": d[:, 2] * 1e3,
+            "T_C": T, "t_s": t_s}
+    return cols, noise
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("planted,seed", [(("EY0C", 1.5), 81), (("EX0C", -1.2), 82)])
+def test_five_axis_rotary_location_error_with_temperature(tmp_path, planted, seed):
+    """A rotary location error of the C table that moves with temperature (outside the eight
+    former families): named by parameter and covariate on a five-axis layout."""
+    cols, noise = _five_axis_campaign(700, seed, planted)
+    path = sim.write_csv(str(tmp_path / "f.csv"), cols)
+    rep = run_loop("TT_AC", path, seed=0, progress=False)
+    named = [(e["parameter"], e["covariate"]) for e in rep["effects"]]
+    assert named and named[0] == (planted[0], "T_C"), named
+    assert len(named) == 1 or all(e["evidence"].get("same_cause_as") for e in rep["effects"])
+    assert abs(list(rep["effects"][0]["parameters"].values())[0] - planted[1]) < 0.2
+    test = split_points(700, 0, 0.25, None).test
+    floor = 1e3 * np.sqrt(np.mean(np.sum(noise[test] ** 2, axis=1)))
+    assert rep["rms_after_um"] <= 1.15 * floor, (rep["rms_after_um"], floor)
+    top = rep["residual_sources"][0]
+    assert (top["parameter"], top["covariate"]) == (planted[0], "T_C")
