@@ -41,7 +41,7 @@ import numpy as np
 from volerr.loop import candidates as cands
 from volerr.loop import select as sel
 from volerr.errors import InputError, require
-from volerr.loop.fit import (Data, Problem, data_ranges, declared_design, gauge_mask,
+from volerr.loop.fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
                   identifiability, point_norm, require_points, rms, rotary_rad, rows_of,
                   twist_columns, weakly_determined)
 from volerr.machine.layout import layout_text, parse_layout
@@ -375,6 +375,7 @@ def declared_step(model, dat, degree, ranges, train) -> Declared:
     keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
     labels = [lab for lab, k in zip(design.labels, keep) if k]
     A = design.A[:, :, keep].reshape(-1, keep.sum())
+    design.A = None              # (N, 3, P) with the gauge columns: not needed any more
     weak = weakly_determined(A[rows_of(train)], labels)
     return Declared(design, keep, gauge, A, labels, unident, weak)
 
@@ -399,13 +400,15 @@ def robust_weights(A, y, points, n: int, iterations: int = 8) -> Robust:
     neither inflate the noise estimate nor hide smaller ones."""
     w = np.ones(len(points))
     rows = rows_of(points)
-    A_p, y_p = A[rows], y[rows]
+    scale = np.sqrt(np.einsum("ij,ij->j", A, A) / len(A))
+    scale[scale == 0] = 1.0
     sigma = 0.0
     for _ in range(iterations):
-        sw = np.repeat(np.sqrt(w), 3)
-        prob = Problem(A_p * sw[:, None], y_p * sw)
-        c = prob.fit()
-        r = point_norm(y_p - A_p @ c)
+        w_rows = np.zeros(len(y))
+        w_rows[rows] = np.repeat(np.sqrt(w), 3)
+        G, b = _gram(A, y, w_rows, rows)
+        c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
+        r = point_norm(y[rows] - A[rows] @ c)
         sigma = max(float(np.median(r[w > 0])) / 1.538, 1e-12)
         z = r / sigma
         w_new = np.where(z <= ROBUST_K, 1.0,
@@ -475,10 +478,24 @@ class Outcome:
     test_inliers: np.ndarray
 
 
+def _gram(A, y, w_rows, rows=None, chunk: int = 30000):
+    """Weighted normal equations (A^T W A, A^T W y) accumulated in chunks of rows (no
+    weighted copy of the whole design)."""
+    rows = np.arange(len(y)) if rows is None else rows
+    G = np.zeros((A.shape[1], A.shape[1]))
+    b = np.zeros(A.shape[1])
+    for i in range(0, len(rows), chunk):
+        r = rows[i:i + chunk]
+        Ar = A[r] * w_rows[r, None]
+        G += Ar.T @ Ar
+        b += Ar.T @ (y[r] * w_rows[r])
+    return G, b
+
+
 def _weighted_fit(prob: Problem, w_rows, points=None):
-    rows = np.arange(len(prob.y)) if points is None else rows_of(points)
-    P = Problem(prob.A[rows] * w_rows[rows, None], prob.y[rows] * w_rows[rows])
-    return P.fit() / prob.scale
+    """Coefficients (unscaled column units) of the weighted fit on ``points`` (all if None)."""
+    G, b = _gram(prob.A, prob.y, w_rows, None if points is None else rows_of(points))
+    return solve_normal(G, b) / prob.scale
 
 
 def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y) -> Outcome:
@@ -492,8 +509,7 @@ def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y) 
     c_before = _weighted_fit(before, w_rows)
     res_after = y - after.predict(c_all)
     res_before = y - before.predict(c_before)
-    Aw = after.A * w_rows[:, None]
-    G = Aw.T @ Aw
+    G, _ = _gram(after.A, y, w_rows)
     wG = np.linalg.eigvalsh(G)
     dof = max(3 * float(robust.weights.sum()) - int(np.sum(wG > 1e-12 * wG[-1])), 1.0)
     sigma2 = float(np.sum((res_after * w_rows) ** 2)) / dof

@@ -80,6 +80,7 @@ def test_clean_machines_at_most_one_spurious(tmp_path, layout, seed):
     assert rep["residual_note"] is None or len(rep["effects"]) == 0
 
 
+@pytest.mark.slow
 def test_residual_sources_json_contract(tmp_path):
     """Keys of the contract; sources ranked by BIC; every effect names P, C and the basis."""
     rep, _ = _run(tmp_path, [{"kind": "gradient", "component": "EBX", "urad_per_K": 12.0}], 41)
@@ -96,6 +97,7 @@ def test_residual_sources_json_contract(tmp_path):
                 "basis"} <= set(e)
 
 
+@pytest.mark.slow
 def test_outliers_do_not_inflate_the_noise(tmp_path):
     """Five gross outliers (20-50 um) and three of 2-4 um on 0.3 um noise: the robust noise
     estimate stays at the noise, all eight are flagged, held-out figures on the inliers."""
@@ -116,6 +118,7 @@ def test_outliers_do_not_inflate_the_noise(tmp_path):
     assert rep["inliers"]["rms_after_um"] < 0.7
 
 
+@pytest.mark.slow
 def test_bad_covariate_columns_left_out_with_a_warning(tmp_path):
     """A constant column, a text column and one with NaN: named once each, left out; the
     rest runs as without them."""
@@ -134,6 +137,7 @@ def test_bad_covariate_columns_left_out_with_a_warning(tmp_path):
     assert rep["rms_after_um"] == ref["rms_after_um"]
 
 
+@pytest.mark.slow
 def test_cli_html_without_json(tmp_path):
     """`volerr loop LAYOUT DATA --html F` works without --json; the page holds the residual
     sources as tables, no raw JSON dump and no absolute paths."""
