@@ -3,8 +3,9 @@
 A layout may declare ``[effects.NAME]`` tables (format: :mod:`volerr.machine.layout`).  Each term adds
 ``parameter * basis`` to a target of the chain:
 
-* a component error of an axis (``EXX`` ... ``ECZ``) or a location error of a rotary axis
-  (``EX0C`` ...): the term is added to that entry of the axis' error twist, so it propagates
+* a component error of an axis (``EXX`` ... ``ECZ``), a squareness (``EC0Y`` ...) or a location
+  error of a rotary axis (``EX0C`` ...): the term is added to that parameter wherever it enters
+  the axis' error twist, so it propagates
   through the chain exactly like the error it modifies (Abbe arms included).  Examples:
   ``thermal`` -- scale expansion ``EXX += KT_X * X * (T_C - 20)``; ``reversal`` --
   ``EXX += RV_X * dir_X``; ``coupling`` -- ``EZX += c * x * y`` (a straightness of X that
@@ -72,13 +73,14 @@ def apply_effects(layout: Layout, factors: list) -> list:
     if not add:
         return factors
     out = list(factors)
+    subs = {parameter_symbol(t): parameter_symbol(t) + extra for t, extra in add.items()
+            if "." not in t}
     for f in out:
-        if not f.is_error or f.role not in ("component", "location"):
+        if not f.is_error or f.role not in ("component", "location", "squareness"):
             continue
         for key, value in list(f.twist_args.items()):
-            for target, extra in add.items():
-                if "." not in target and value == parameter_symbol(target):
-                    f.twist_args[key] = value + extra
+            # the parameter as it enters the twist (alone, or q * squareness)
+            f.twist_args[key] = sp.sympify(value).xreplace(subs)
     for side in ("work", "tool"):
         args = {k: add[f"{side}.{k}"] for k in TWIST_KEYS if f"{side}.{k}" in add}
         if args:

@@ -1,7 +1,8 @@
 """``volerr loop LAYOUT DATA.csv --json F [--html F]``: close the loop on measured deviations.
 
-Fits the declared model, traces what is left to candidate effects (thermal, drift, reversal,
-coupling, periodic, higher_order, probe_direction, setup), writes the augmented layout and its
+Fits the declared model, traces what is left to candidate effects "parameter P of the chain
+varies with covariate C" (thermal, drift, reversal, coupling, periodic, higher_order, step,
+probe_direction, setup, group ...), writes the augmented layout and its
 generated module (``--out-dir``, default: the folder of the json report) and reports the error
 before and after on held-out points.  See :mod:`volerr.loop.run`.
 """
@@ -24,7 +25,7 @@ def register(sub) -> None:
                     "report RMS/max before and after on held-out points.")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", help="measured-deviation CSV")
-    p.add_argument("--json", required=True, help="write the report (JSON)")
+    p.add_argument("--json", help="write the report (JSON)")
     p.add_argument("--html", help="write the report with figures (HTML)")
     p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
                                      "(default: the folder of --json)")
@@ -50,10 +51,12 @@ def run(args) -> int:
     from volerr.cli._common import layout_inputs
     from volerr.machine.model import load
 
+    require(args.json or args.html, "give --json or --html (or both) for the report")
     inputs = [args.data, *layout_inputs(args.layout)]
     model = load(args.layout)
     aug = (f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py")
-    out_dir = Path(args.out_dir) if args.out_dir else Path(args.json).resolve().parent
+    out_dir = (Path(args.out_dir) if args.out_dir
+               else Path(args.json or args.html).resolve().parent)
     outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
         .folder("--out-dir", out_dir, files=aug) \
         .folder("--errors-out", args.errors_out,
@@ -72,11 +75,14 @@ def run(args) -> int:
         for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
             if report.data.get(key):
                 report.data[key] = str(out_dir / Path(report.data[key]).name)
-        report.write_json(outs.path("--json"), inputs=inputs)
+        if args.json:
+            report.write_json(outs.path("--json"), inputs=inputs)
         if args.html:
             report.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
             report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+    for w in report["warnings"]:
+        print(f"  warning: {w}")
     print(report.summary())
     for e in report.effects:
         pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
@@ -84,6 +90,8 @@ def run(args) -> int:
     if report["augmented_layout"]:
         print(f"  augmented layout: {report['augmented_layout']}; generated module: "
               f"{report['generated_module']}")
+    if report["residual_note"]:
+        print(f"  {report['residual_note']}")
     if report["unidentifiable"]:
         print(f"  not separable by these data: "
               f"{', '.join(u['parameters'][0] for u in report['unidentifiable'])} (see the report)")

@@ -1,7 +1,9 @@
 """Closing the loop: measured deviations in, declared model fitted, residual traced to candidate
-effects, the layout augmented, before/after reported on held-out points.  Steps: ``fit``
-(design and gauge), ``candidates``, ``run`` (selection and augmentation), ``report`` (HTML),
-``simulate`` (a virtual machine with undeclared effects).
+effects "parameter P of the chain varies with covariate C", the layout augmented, before/after
+reported on held-out points.  Modules: ``fit`` (design and gauge), ``candidates`` (P x C x basis
+generated from the chain), ``select`` (screening, selection, backward check, merge), ``run``
+(the named steps, robust weights, augmentation), ``report`` (HTML), ``simulate`` (a virtual
+machine with undeclared effects).
 """
 
 from volerr.loop.run import Report, read_deviations, run_loop

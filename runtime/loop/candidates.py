@@ -1,37 +1,40 @@
-"""Candidate effects of the closing loop: which extensions of the chain the data could need.
+"""Candidate effects of the closing loop, generated from the chain: "parameter P varies with C".
 
-Each candidate is a list of effect terms (``parameter * basis`` added to a target, as in
-``[effects.NAME]`` of a layout file, :mod:`volerr.machine.layout`), built from the layout and the
-columns the data provide.  Families (``kind``):
+A candidate is one declared parameter ``P`` of the layout modulated by one covariate ``C``
+through a basis; its columns are the generated sensitivity of ``P`` times the basis, so it
+propagates through the chain exactly like ``P`` (Abbe arms included).  Written as
+``[effects.NAME]`` terms (``parameter * basis`` added to a target,
+:mod:`volerr.machine.layout`), which ``derive`` turns into new parameters.
 
-* ``thermal``: a temperature column (``T_C``, ``T_<axis>``, ``temp``...): the scale of each
-  linear axis grows with T - 20 degC about a fixed point A0 of the scale, which need not be
-  the axis origin: ``E<d><A> += KT_A * A * (T - 20) + KT0_A * (T - 20)`` (KT in 1/K, KT0 in
-  mm/K, A0 = -KT0/KT).  Measured against an artefact at the same temperature, KT is the
-  *differential* expansion (scale minus artefact); its mean over the campaign also sits in
-  the fitted scale error.
-* ``drift``: a time column (``t_s``, ``t_min``, ``t_h``, ``time``): the instrument drifts
-  linearly along x, y or z (``work.d<k> += DR_<k> * t``, DR in mm/h).
-* ``reversal``: ``dir_<A>`` (+1 / -1): positioning of A differs by RV_A between approach
-  directions (``E<d><A> += RV_A * dir_A / 2``; two levels coded otherwise, e.g. 0 / 1, are
-  mapped to -1/2, +1/2, so RV_A is always the high-level minus the low-level position).
-* ``coupling``: a component error of axis A depends on the position of another axis B:
-  Legendre cross terms P1(a)P1(b), P2(a)P1(b), P1(a)P2(b), which no sum of one-dimensional
-  functions can represent.
-* ``periodic``: a cyclic translational error along an axis, ``a sin(2 pi q/P) + b cos(..)``,
-  period P searched (periodogram of the residual, then refined).
-* ``higher_order``: Legendre terms of a component beyond the fitted degree.
-* ``probe_direction``: ``nx, ny, nz`` columns (or ``ni, nj, nk``, ``n_x ...``, ``i, j, k``:
-  unit probing direction in the probe frame,
-  which is the workpiece frame's orientation on a CMM): an error along the probing direction
-  (effective probe radius), ``tool.d<k> += PR_R * n_k``.
-* ``setup``: a grouping column (``setup``, ``round``, ``mount``, ``group``, ``placement``,
-  ``run``, ``session``, ``batch``) with 2-50 levels:
-  the instrument was re-placed, six rigid-placement coordinates per later group.
+Parameters ``P`` (:func:`targets`): every component error of every axis (modulated as offset +
+slope along its own axis), every squareness and rotary location error, the instrument set-up
+(``work.dx ... work.ez``: the rigid placement of the measuring instrument, workpiece end) and the
+probe / tool offset (``tool.dx tool.dy tool.dz``, tool end), and the probe radius along the
+probing direction.
+
+Covariates ``C`` (:func:`covariates`): every numeric data column that is not an axis, probe
+offset or deviation: temperatures (``T``, ``T_C``, ``T_top``, ``temp_X`` ...: basis ``T - 20``)
+and the differences of every pair of temperature channels (gradients), time (``t_s``, ``t_min``,
+``t_h``, ``time``: linear in hours and a saturating warm-up ``1 - exp(-t / tau)``, tau
+searched), approach directions ``dir_<axis>``, set-up / run ids (``setup``, ``round``, ``run``
+...: one indicator per later level), the probing direction (``nx ny nz``), any other numeric
+column (linear about its mean), and the positions of the axes: another axis (coupling:
+Legendre cross terms), the parameter's own axis (Legendre terms beyond the fitted degree, a
+step at a searched location, a periodic term with a searched period).
+
+``kind`` names the familiar special cases of this one mechanism: ``thermal`` (any P x a
+temperature or gradient), ``drift`` (any P x time, linear or saturating), ``reversal`` (x an
+approach direction), ``setup`` (the set-up x a run id), ``group`` (another P x a run id),
+``coupling`` (x another axis), ``higher_order``, ``step``, ``periodic`` (x its own axis),
+``probe_direction`` (probe radius x probing direction) and ``covariate`` (x another column).
+
+Units inside: mm, rad, K, h.  Each candidate carries, per parameter, the factor and unit in
+which the report shows it.
 """
 
 from __future__ import annotations
 
+import itertools
 import re
 from dataclasses import dataclass, field
 
@@ -40,28 +43,85 @@ import numpy as np
 from volerr.loop.fit import Data
 
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
-            "probe_direction", "setup")
+            "probe_direction", "setup", "group", "step", "covariate")
 _TEMP = re.compile(r"^(T(_\w+)?|[Tt]emp\w*)$")   # T, T_C, T_X, temp_C (not t_s: time)
-_TIME = {"t_s": "/3600", "time_s": "/3600", "t_min": "/60", "time_min": "/60", "t_h": "",
-         "time_h": "", "time": ""}
+#: time columns -> divisor to hours
+_TIME = {"t_s": 3600.0, "time_s": 3600.0, "t_min": 60.0, "time_min": 60.0, "t_h": 1.0,
+         "time_h": 1.0, "time": 1.0}
 _GROUP = ("setup", "round", "mount", "group", "placement", "run", "session", "batch")
 #: column triples accepted as the probing direction (unit vector in the probe frame)
 _PROBE_DIRS = (("nx", "ny", "nz"), ("ni", "nj", "nk"), ("n_x", "n_y", "n_z"), ("i", "j", "k"))
+SETUP_KEYS = ("dx", "dy", "dz", "ex", "ey", "ez")
+#: warm-up time constants searched (h) and step locations (fractions of the range)
+TAU_GRID_H = (0.15, 0.25, 0.4, 0.6, 0.9, 1.3, 1.8, 2.5, 3.5, 5.0)
+STEP_GRID = tuple(np.linspace(0.06, 0.94, 45))
+
+
+@dataclass(frozen=True)
+class Covariate:
+    """A covariate C: ``name`` (as reported), ``kind`` (temperature, difference, time,
+    direction, group, probing_direction, numeric), ``expr`` (basis text of the centred
+    variable), ``unit`` (for the report), ``columns`` (data columns used)."""
+
+    name: str
+    kind: str
+    expr: str
+    unit: str
+    columns: tuple
+    levels: tuple = ()
+
+
+@dataclass(frozen=True)
+class Target:
+    """A declared parameter P: ``name`` (reported), ``kind`` (component, constant, setup,
+    tool), ``chain`` (target text of effect terms), ``axis`` (own axis of a component)."""
+
+    name: str
+    kind: str
+    chain: str
+    axis: str | None = None
+
+    @property
+    def angular(self) -> bool:
+        if self.kind in ("setup", "tool"):
+            return self.chain.split(".")[1][0] == "e"
+        return self.name[1] in "ABC"
+
+
+@dataclass
+class Search:
+    """A nonlinear basis parameter searched on a grid (warm-up tau, step location, period):
+    ``make(value) -> terms``."""
+
+    what: str
+    grid: tuple
+    make: object
 
 
 @dataclass
 class Candidate:
-    """A candidate effect: its terms and descriptive info (axis, component, period ...)."""
+    """A candidate effect: its terms [(parameter, target, basis)] and what it means."""
 
     kind: str
     name: str
-    terms: list                       # [(parameter, target, basis)]
+    terms: list
     info: dict = field(default_factory=dict)
-    period_search: tuple | None = None  # (component, axis, periods) for periodic
+    search: Search | None = None
+    units: dict = field(default_factory=dict)      # parameter -> (factor, unit)
 
     @property
     def parameters(self) -> list:
         return list(dict.fromkeys(t[0] for t in self.terms))
+
+    @property
+    def period_search(self):        # former name: candidates with a searched basis parameter
+        return self.search
+
+    def fixed(self, value: float) -> "Candidate":
+        """This candidate with its searched parameter fixed at ``value``."""
+        terms, extra = self.search.make(value)
+        return Candidate(self.kind, self.name, terms, {**self.info, **extra}, self.search,
+                         self.units)
 
 
 def _f(x: float) -> str:
@@ -77,6 +137,10 @@ def _u(axis: str, lo: float, hi: float, rotary: bool = False) -> str:
     return f"(({axis} - {_f((lo + hi) / 2)})/{_f((hi - lo) / 2)})"
 
 
+def _ident(text: str) -> str:
+    return re.sub(r"\W+", "_", text).strip("_")
+
+
 def along_component(layout, axis: str) -> str:
     """The component error along/about an axis' own direction (EXX, EYY, ECC ...)."""
     ax = layout.axes[axis]
@@ -84,104 +148,329 @@ def along_component(layout, axis: str) -> str:
     return "E" + ("XYZ" if ax.kind == "linear" else "ABC")[i] + axis
 
 
-def temperature_columns(covariates) -> list:
-    return [c for c in covariates if _TEMP.match(c) and c not in _TIME]
+def temperature_columns(covs) -> list:
+    return [c for c in covs if _TEMP.match(c) and c not in _TIME]
 
 
-def build(model, data: Data, ranges: dict, degree: int) -> list:
-    """All candidates for this layout and these data columns."""
-    lay = model.layout
-    cov = data.covariates
-    linear = [a for a in model.axes if a not in model.rotary_axes]
-    out: list[Candidate] = []
-    for tcol in temperature_columns(cov):
-        if np.ptp(cov[tcol]) < 0.05:
+# ---- P: the parameters of the chain ---------------------------------------------------
+def targets(model) -> list:
+    """Every declared parameter of ``model`` a candidate can modulate."""
+    # constants (squareness, location errors) first: where a component's offset gives the
+    # same columns (a radial error of C and its location error EY0C), ties go to the constant,
+    # as in the declared model's gauge order
+    out = [Target(p, "constant", p) for p in model.parameters if not model.parameter_axis.get(p)]
+    out += [Target(p, "component", p, model.parameter_axis[p]) for p in model.parameters
+            if model.parameter_axis.get(p)]
+    out += [Target(f"setup.{k}", "setup", f"work.{k}") for k in SETUP_KEYS]
+    out += [Target(f"tool.{k}", "tool", f"tool.{k}") for k in ("dx", "dy", "dz")]
+    return out
+
+
+# ---- C: the covariate columns ------------------------------------------------------------
+def covariates(cov: dict, model=None) -> tuple[list, list]:
+    """Covariates of the data columns ``cov`` (name -> (N,) floats): (list of
+    :class:`Covariate`, warnings).  A constant column or one with NaN is left out with a
+    one-line warning."""
+    out, warn = [], []
+    good = {}
+    for c, v in cov.items():
+        v = np.asarray(v, dtype=float)
+        if not np.all(np.isfinite(v)):
+            warn.append(f"covariate column {c} has NaN or infinite values: left out of the "
+                        f"candidates")
+        elif np.ptp(v) == 0:
+            warn.append(f"covariate column {c} is constant ({float(v[0]):g}): left out of the "
+                        f"candidates")
+        else:
+            good[c] = v
+    probe_dir = next((t for t in _PROBE_DIRS if all(c in good for c in t)), ())
+    if probe_dir:
+        out.append(Covariate("probing direction", "probing_direction", "", "1", probe_dir))
+    temps = []
+    for c, v in good.items():
+        if c in probe_dir:
             continue
-        sfx = "" if tcol == "T_C" else f"_{tcol}"
-        for a in linear:
-            comp = along_component(lay, a)
-            out.append(Candidate("thermal", f"thermal_{a}{sfx}",
-                                 [(f"KT_{a}{sfx}", comp, f"{a}*({tcol} - 20)"),
-                                  (f"KT0_{a}{sfx}", comp, f"({tcol} - 20)")],
-                                 {"axis": a, "component": comp, "covariate": tcol,
-                                  "reference_C": 20.0}))
-    for tcol, div in _TIME.items():
-        if tcol in cov and np.ptp(cov[tcol]) > 0:
-            for k in "xyz":
-                out.append(Candidate("drift", f"drift_{k}",
-                                     [(f"DR_{k.upper()}", f"work.d{k}", f"{tcol}{div}")],
-                                     {"direction": k, "covariate": tcol}))
-            break
-    for a in model.axes:
-        col = f"dir_{a}"
-        if col in cov and len(np.unique(cov[col])) > 1:
-            comp = along_component(lay, a)
-            levels = np.unique(cov[col])
-            basis = f"{col}/2"
-            if len(levels) == 2 and not np.array_equal(levels, [-1.0, 1.0]):
-                # two levels coded otherwise (0/1 ...): +-1/2 all the same, RV = high - low
-                lo, hi = float(levels[0]), float(levels[1])
-                basis = f"({col} - {_f((lo + hi) / 2)})/{_f(hi - lo)}"
-            out.append(Candidate("reversal", f"reversal_{a}",
-                                 [(f"RV_{a}", comp, basis)],
-                                 {"axis": a, "component": comp, "covariate": col}))
-    comps = [p for p in model.parameters if model.parameter_axis.get(p)]
-    for p in comps:
-        a = model.parameter_axis[p]
-        for b in model.axes:
-            if b == a:
+        if c in _TIME:
+            out.append(Covariate(c, "time", f"{c}/{_f(_TIME[c])}" if _TIME[c] != 1 else c,
+                                 "h", (c,)))
+        elif _TEMP.match(c):
+            temps.append(c)
+            out.append(Covariate(c, "temperature", f"({c} - 20)", "K", (c,)))
+        elif c.startswith("dir_"):
+            levels = np.unique(v)
+            if len(levels) != 2:
+                out.append(Covariate(c, "numeric", f"({c} - {_f(np.mean(v))})", "1", (c,)))
                 continue
-            ua = _u(a, *ranges[a], a in model.rotary_axes)
-            ub = _u(b, *ranges[b], b in model.rotary_axes)
-            terms = [(f"CP_{p}_{b}_11", p, f"{ua}*{ub}"),
-                     (f"CP_{p}_{b}_21", p, f"legendre(2, {ua})*{ub}"),
-                     (f"CP_{p}_{b}_12", p, f"{ua}*legendre(2, {ub})")]
-            out.append(Candidate("coupling", f"coupling_{p}_{b}", terms,
-                                 {"component": p, "axis": a, "depends_on": b}))
-    for p in comps:
-        a = model.parameter_axis[p]
-        if p[1] not in "XYZ" or a in model.rotary_axes:
+            lo, hi = float(levels[0]), float(levels[1])
+            expr = f"{c}/2" if (lo, hi) == (-1.0, 1.0) else f"({c} - {_f((lo + hi) / 2)})/{_f(hi - lo)}"
+            out.append(Covariate(c, "direction", expr, "1", (c,), (lo, hi)))
+        elif c in _GROUP or (len(np.unique(v)) <= 12 and np.all(v == np.round(v))
+                             and c.lower().startswith(_GROUP)):
+            levels = np.unique(v)
+            if 2 <= len(levels) <= 50:
+                out.append(Covariate(c, "group", "", "1", (c,), tuple(float(x) for x in levels)))
+        else:
+            out.append(Covariate(c, "numeric", f"({c} - {_f(np.mean(v))})", "unit", (c,)))
+    for a, b in itertools.combinations(temps, 2):
+        if np.ptp(good[a] - good[b]) > 0:
+            out.append(Covariate(f"{a} - {b}", "difference", f"({a} - {b})", "K", (a, b)))
+    return out, warn
+
+
+# ---- P x C x basis ------------------------------------------------------------------------
+_KIND = {"temperature": "thermal", "difference": "thermal", "time": "drift",
+         "direction": "reversal", "numeric": "covariate", "group": "group"}
+_PREFIX = {"thermal": "KT", "drift": "DR", "reversal": "RV", "covariate": "CV", "group": "GR"}
+
+
+def _unit(target: Target, per: str, slope_axis: str | None, model) -> tuple[float, str]:
+    """Report factor and unit of a parameter of P x C (per: unit of the covariate basis)."""
+    f, u = (1e6, "urad") if target.angular else (1e3, "um")
+    if slope_axis is not None:        # parameter * A (mm) * basis: per m of travel
+        f, u = f * 1e3, f"{u}/m"
+    if per in ("1", ""):
+        return f, u
+    return f, f"{u}/{per}"
+
+
+def _names(target: Target, cov: Covariate, kind: str, special: dict) -> tuple[str, str, str]:
+    """(effect name, slope parameter, offset parameter) -- the former names where they exist."""
+    tag = _ident(target.name.replace("setup.", "").replace("tool.", "T"))
+    ctag = _ident(cov.name)
+    key = (target.name, cov.name)
+    if key in special:
+        return special[key]
+    pre = _PREFIX[kind]
+    return f"{kind}_{tag}_{ctag}", f"{pre}_{tag}_{ctag}", f"{pre}0_{tag}_{ctag}"
+
+
+def _special_names(model, covs) -> dict:
+    """The names the eight former families used (reports and tests rely on them)."""
+    lay = model.layout
+    out = {}
+    temps = [c for c in covs if c.kind == "temperature"]
+    for c in temps:
+        sfx = "" if c.name == "T_C" else f"_{c.name}"
+        for a in model.axes:
+            if a in model.rotary_axes:
+                continue
+            comp = along_component(lay, a)
+            out[(comp, c.name)] = (f"thermal_{a}{sfx}", f"KT_{a}{sfx}", f"KT0_{a}{sfx}")
+    for c in covs:
+        if c.kind == "time":
+            for k in "xyz":
+                out[(f"setup.d{k}", c.name)] = (f"drift_{k}", f"DR_{k.upper()}", "")
+        if c.kind == "direction":
+            a = c.name[4:]
+            if a in model.axes:
+                comp = along_component(lay, a)
+                out[(comp, c.name)] = (f"reversal_{a}", f"RV_{a}", "")
+    return out
+
+
+def _linear(model, target: Target, cov: Covariate, special, gauge) -> list:
+    """P x C, linear in C.  A component error of a linear axis A is modulated as an offset, a
+    slope along A, or both -- each only where it is not a gauge term of the declared model
+    (a straightness slope is carried by squareness, a translational offset by the
+    instrument's placement: those are the candidates "squareness x C", "set-up x C").  The
+    position error along A always gets both (scale and fixed point, ``thermal_X``)."""
+    kind = _KIND[cov.kind]
+    name, ps, p0 = _names(target, cov, kind, special)
+    b = cov.expr
+    info = {"parameter": target.name, "covariate": cov.name, "basis": "linear"}
+    if target.axis:
+        info.update({"axis": target.axis, "component": target.name})
+    if kind == "thermal":
+        info["reference_C"] = 20.0
+    if target.kind != "component" or target.axis in model.rotary_axes:
+        out = [Candidate(kind, name, [(ps, target.chain, b)], dict(info),
+                         units={ps: _unit(target, cov.unit, None, model)})]
+        for comp, ax in _squareness_as_slopes(model, target):
+            # the same squareness seen as the tilt of the other axis (differs from the
+            # layout's convention by a rigid rotation, which a varying squareness need not share)
+            out.append(Candidate(kind, f"{name}_via_{comp}", [(ps, comp, f"{ax}*{b}")],
+                                 {**info, "basis": f"linear, as the tilt of {ax} ({comp})"},
+                                 units={ps: _unit(target, cov.unit, None, model)}))
+        return out
+    a = target.axis
+    p0 = p0 or f"{ps}_0"
+    slope = (ps, target.chain, f"{a}*{b}")
+    offset = (p0, target.chain, b)
+    u_slope, u_off = _unit(target, cov.unit, a, model), _unit(target, cov.unit, None, model)
+    if (target.name, cov.name) in special:
+        if kind == "reversal":                     # the former family: position offset
+            return [Candidate(kind, name, [(ps, target.chain, b)], dict(info),
+                              units={ps: u_off})]
+        # the former thermal family: scale + its fixed point
+        return [Candidate(kind, name, [slope, offset], {**info, "basis": "linear, scale"},
+                          units={ps: u_slope, p0: u_off})]
+    out = []
+    # an angular error's offset stays a candidate even where the declared model fixes it by
+    # convention: varying with C it is one cause (a yaw of Y), not squareness + a yaw of X
+    has0 = target.angular or (target.name, 0) not in gauge
+    has1 = target.angular or (target.name, 1) not in gauge
+    if has0:
+        out.append(Candidate(kind, name, [(ps, target.chain, b)], dict(info),
+                             units={ps: u_off}))
+    if has1:
+        out.append(Candidate(kind, f"{name}_slope", [slope], {**info, "basis": f"linear x {a}"},
+                             units={ps: u_slope}))
+    if has0 and has1:
+        out.append(Candidate(kind, f"{name}_both", [slope, offset],
+                             {**info, "basis": f"linear, offset + slope along {a}"},
+                             units={ps: u_slope, p0: u_off}))
+    return out
+
+
+def _squareness_as_slopes(model, target: Target) -> list:
+    """(straightness component, axis) pairs whose slope is the squareness ``target`` (the two
+    linear axes square to each other about its rotation axis)."""
+    if target.kind != "constant" or target.name not in model.layout.squareness:
+        return []
+    about = "ABC".index(target.name[1])
+    out = []
+    for a in model.axes:
+        if a in model.rotary_axes:
             continue
-        lo, hi = ranges[a]
-        span = hi - lo
-        uniq = np.unique(np.round(data.positions[a], 6))
-        step = float(np.median(np.diff(uniq))) if len(uniq) > 2 else span
-        pmin = max(2.2 * step, span / 60.0)
-        pmax = span / 2.5
-        if pmin >= pmax:
+        i = int(np.argmax(np.abs(model.layout.axes[a].direction)))
+        if i == about:
             continue
-        freqs = np.arange(1.0 / pmax, 1.0 / pmin, 1.0 / (4.0 * span))
-        out.append(Candidate("periodic", f"periodic_{p}", [], {"component": p, "axis": a},
-                             period_search=(p, a, 1.0 / freqs)))
-    for p in comps:
-        a = model.parameter_axis[p]
-        n_unique = len(np.unique(np.round(data.positions[a], 6)))
-        top = min(degree + 6, 14, n_unique - 1)
-        if top <= degree:
+        j = 3 - about - i
+        comp = "E" + "XYZ"[j] + a
+        if comp in model.parameters:
+            out.append((comp, a))
+    return out
+
+
+def _warmup(model, target: Target, cov: Covariate, special) -> Candidate:
+    name, ps, _ = _names(target, cov, "drift", special)
+    name, ps = name.replace("drift", "warmup", 1), ps.replace("DR", "WU", 1)
+    hours = cov.expr
+
+    def make(tau, ps=ps, chain=target.chain):
+        return [(ps, chain, f"(1 - exp(-{hours}/{_f(tau)}))")], {"tau_h": round(float(tau), 4)}
+
+    terms, extra = make(TAU_GRID_H[0])
+    f, u = (1e6, "urad") if target.angular else (1e3, "um")
+    info = {"parameter": target.name, "covariate": cov.name, "basis": "saturating",
+            **extra}
+    return Candidate("drift", name, terms, info, Search("tau_h", TAU_GRID_H, make),
+                     {ps: (f, u)})
+
+
+def _group(model, target: Target, cov: Covariate) -> Candidate:
+    g = cov.name
+    terms, units = [], {}
+    f, u = (1e6, "urad") if target.angular else (1e3, "um")
+    for lv in cov.levels[1:]:
+        tag = _f(lv).replace(".0", "").replace("-", "m").replace(".", "p")
+        if target.kind == "setup" and target.chain == "work.dx":
+            for k in SETUP_KEYS:
+                pn = f"SU{tag}_{g}_{k.upper()}"
+                terms.append((pn, f"work.{k}", f"ind({g}, {_f(lv)})"))
+                units[pn] = (1e6, "urad") if k[0] == "e" else (1e3, "um")
+        else:
+            pn = f"GR{tag}_{g}_{_ident(target.name)}"
+            terms.append((pn, target.chain, f"ind({g}, {_f(lv)})"))
+            units[pn] = (f, u)
+    if target.kind == "setup":
+        return Candidate("setup", f"setup_{g}", terms,
+                         {"parameter": "setup", "covariate": g, "basis": "indicator",
+                          "levels": list(cov.levels)}, units=units)
+    return Candidate("group", f"group_{_ident(target.name)}_{g}", terms,
+                     {"parameter": target.name, "covariate": g, "basis": "indicator",
+                      "levels": list(cov.levels)}, units=units)
+
+
+def _positions(model, target: Target, data: Data, ranges, degree) -> list:
+    """Position bases of a component error: other axes (coupling), own axis (higher order,
+    step, periodic)."""
+    a, p = target.axis, target.name
+    out = []
+    f, u = (1e6, "urad") if target.angular else (1e3, "um")
+    ua = _u(a, *ranges[a], a in model.rotary_axes)
+    for b in model.axes:
+        if b == a:
             continue
-        ua = _u(a, *ranges[a], a in model.rotary_axes)
+        ub = _u(b, *ranges[b], b in model.rotary_axes)
+        terms = [(f"CP_{p}_{b}_11", p, f"{ua}*{ub}"),
+                 (f"CP_{p}_{b}_21", p, f"legendre(2, {ua})*{ub}"),
+                 (f"CP_{p}_{b}_12", p, f"{ua}*legendre(2, {ub})")]
+        out.append(Candidate("coupling", f"coupling_{p}_{b}", terms,
+                             {"parameter": p, "covariate": b, "basis": "legendre",
+                              "component": p, "axis": a, "depends_on": b},
+                             units={t[0]: (f, u) for t in terms}))
+    q = data.positions[a]
+    uniq = np.unique(np.round(q, 6))
+    top = min(degree + 6, 14, len(uniq) - 1)
+    if top > degree:
         terms = [(f"HO_{p}_{k}", p, f"legendre({k}, {ua})") for k in range(degree + 1, top + 1)]
         out.append(Candidate("higher_order", f"higher_order_{p}", terms,
-                             {"component": p, "axis": a, "degrees": [degree + 1, top]}))
-    for names in _PROBE_DIRS:
-        if all(c in cov for c in names):
+                             {"parameter": p, "covariate": a, "basis": "legendre",
+                              "component": p, "axis": a, "degrees": [degree + 1, top]},
+                             units={t[0]: (f, u) for t in terms}))
+    if a in model.rotary_axes:
+        return out
+    lo, hi = ranges[a]
+    locs = tuple(sorted({float(x) for x in np.quantile(q, STEP_GRID)}))
+
+    def make_step(x0, p=p, a=a):
+        # a step of height ST at A = x0 (smooth over 1 nm: no division by zero anywhere)
+        d = f"({a} - {_f(x0)})"
+        return [(f"ST_{p}", p, f"(1 + {d}/sqrt({d}**2 + 1e-12))/2")], {"location_mm": round(x0, 3)}
+
+    terms, extra = make_step(locs[len(locs) // 2])
+    out.append(Candidate("step", f"step_{p}", terms,
+                         {"parameter": p, "covariate": a, "basis": "step", "component": p,
+                          "axis": a, **extra}, Search("location_mm", locs, make_step),
+                         {f"ST_{p}": (f, u)}))
+    if p[1] in "XYZ":
+        span = hi - lo
+        step = float(np.median(np.diff(uniq))) if len(uniq) > 2 else span
+        pmin, pmax = max(2.2 * step, span / 60.0), span / 2.5
+        if pmin < pmax:
+            freqs = np.arange(1.0 / pmax, 1.0 / pmin, 1.0 / (4.0 * span))
+            out.append(Candidate("periodic", f"periodic_{p}", [],
+                                 {"parameter": p, "covariate": a, "basis": "periodic",
+                                  "component": p, "axis": a},
+                                 Search("period", tuple(1.0 / freqs),
+                                        lambda per, p=p, a=a: (periodic_terms(p, a, per),
+                                                               {"period": round(per, 6)})),
+                                 {f"PS_{p}": (f, u), f"PC_{p}": (f, u)}))
+    return out
+
+
+def build(model, data: Data, ranges: dict, degree: int, covs=None, gauge=()) -> list:
+    """All candidates P x C x basis for this layout and these data columns (``gauge``: the
+    (parameter, degree) labels the declared model fixes by convention)."""
+    gauge = set(gauge)
+    if covs is None:
+        covs, _ = covariates(data.covariates, model)
+    special = _special_names(model, covs)
+    tgts = targets(model)
+    out: list[Candidate] = []
+    for cov in covs:
+        if cov.kind == "probing_direction":
             out.append(Candidate("probe_direction", "probe_direction",
-                                 [("PR_R", f"tool.d{k}", c) for k, c in zip("xyz", names)],
-                                 {"covariates": list(names)}))
-            break
-    for g in _GROUP:
-        if g not in cov:
+                                 [("PR_R", f"tool.d{k}", c) for k, c in zip("xyz", cov.columns)],
+                                 {"parameter": "probe radius", "covariate": cov.name,
+                                  "basis": "linear", "covariates": list(cov.columns)},
+                                 units={"PR_R": (1e3, "um")}))
             continue
-        levels = np.unique(cov[g])
-        if not 2 <= len(levels) <= 50:
-            continue
-        terms = []
-        for lv in levels[1:]:
-            tag = _f(lv).replace(".0", "").replace("-", "m").replace(".", "p")
-            for k in ("dx", "dy", "dz", "ex", "ey", "ez"):
-                terms.append((f"SU{tag}_{g}_{k.upper()}", f"work.{k}", f"ind({g}, {_f(lv)})"))
-        out.append(Candidate("setup", f"setup_{g}", terms,
-                             {"covariate": g, "levels": [float(v) for v in levels]}))
+        for t in tgts:
+            if cov.kind == "group":
+                if t.kind == "setup" and t.chain != "work.dx":
+                    continue            # the set-up is one candidate: all six coordinates
+                if len(cov.levels) > 20 and t.kind != "setup":
+                    continue
+                out.append(_group(model, t, cov))
+                continue
+            out += _linear(model, t, cov, special, gauge)
+            if cov.kind == "time" and not (t.kind == "component" and (t.name, 0) in gauge):
+                out.append(_warmup(model, t, cov, special))
+    for t in tgts:
+        if t.kind == "component":
+            out += _positions(model, t, data, ranges, degree)
     return out
 
 

@@ -48,6 +48,7 @@ class Data:
     probe: np.ndarray
     deviation: np.ndarray
     covariates: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)   # columns left out, one line each
 
     @property
     def n(self) -> int:
@@ -55,7 +56,8 @@ class Data:
 
     def subset(self, idx) -> "Data":
         return Data({a: v[idx] for a, v in self.positions.items()}, self.probe[idx],
-                    self.deviation[idx], {c: v[idx] for c, v in self.covariates.items()})
+                    self.deviation[idx], {c: v[idx] for c, v in self.covariates.items()},
+                    self.warnings)
 
 
 def unit(q, lo, hi):

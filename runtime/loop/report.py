@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import base64
 import io
-import json
+from pathlib import Path
 
 import numpy as np
 
@@ -35,19 +35,34 @@ def _thin(n: int, limit: int = 4000, seed: int = 0) -> np.ndarray:
     return np.sort(np.random.default_rng(seed).choice(n, limit, replace=False))
 
 
+def _unit_label(v: str, model) -> str:
+    """Unit of a plotted variable (axis or covariate column)."""
+    if v in model.axes:
+        return "deg" if v in model.rotary_axes else "mm"
+    if v.startswith(("T", "temp")):
+        return "degC"
+    if v in ("t_s", "time_s"):
+        return "s"
+    if v in ("t_min", "time_min"):
+        return "min"
+    if v in ("t_h", "time_h", "time"):
+        return "h"
+    return "1"
+
+
 def fig_residuals(fg) -> str:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    dat = fg["data"]
+    dat = fg.data
     variables = {**dat.positions, **dat.covariates}
     names = [v for v, x in variables.items() if np.ptp(x) > 0][:14]
     idx = _thin(dat.n)
-    rb = fg["res_before"].reshape(-1, 3)[idx] * 1e3
-    ra = fg["res_after"].reshape(-1, 3)[idx] * 1e3
-    lim = max(np.percentile(np.abs(rb), 99.5), 1e-6) * 1.1
+    rb = fg.res_before.reshape(-1, 3)[idx] * 1e3
+    ra = fg.res_after.reshape(-1, 3)[idx] * 1e3
+    lim = max(np.max(np.abs(rb)), np.max(np.abs(ra)), 1e-6) * 1.05   # nothing clipped
     fig, axes = plt.subplots(len(names), 2, figsize=(10, 1.9 * len(names) + 0.6),
                              squeeze=False, sharey=True)
     colors = ("tab:red", "tab:green", "tab:blue")
@@ -61,7 +76,7 @@ def fig_residuals(fg) -> str:
                         label="xyz"[k] if i == 0 and j == 0 else None)
             ax.set_ylim(-lim, lim)
             ax.axhline(0, color="k", lw=0.5)
-            ax.set_xlabel(v, labelpad=0)
+            ax.set_xlabel(f"{v}, {_unit_label(v, fg.model)}", labelpad=0)
             if i == 0:
                 ax.set_title(title)
             if j == 0:
@@ -72,30 +87,27 @@ def fig_residuals(fg) -> str:
 
 
 def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str]:
-    """The variable against which an effect is best seen."""
-    if kind == "thermal":
-        a, t = info["axis"], info["covariate"]
-        a0 = float(info.get("fixed_point_mm", 0.0))
-        label = f"({a} - {a0:g}) * ({t} - 20), mm K" if a0 else f"{a} * ({t} - 20), mm K"
-        return (dat.positions[a] - a0) * (dat.covariates[t] - 20.0), label
-    if kind in ("drift", "reversal") or kind == "setup":
-        c = info["covariate"]
-        return np.asarray(dat.covariates[c], dtype=float), c
+    """The variable against which an effect is best seen (its covariate C)."""
+    from volerr.machine.expressions import evaluate
+
+    c = info.get("covariate")
     if kind == "periodic":
         a, p = info["axis"], info["period"]
-        return np.mod(dat.positions[a], p), f"{a} modulo {p:.3f}"
+        return np.mod(dat.positions[a], p), f"{a} modulo {p:.3f}, mm"
     if kind == "coupling":
         a, b = info["axis"], info["depends_on"]
-        ua = (2 * dat.positions[a] - np.ptp(dat.positions[a]) - 2 * dat.positions[a].min()) / \
-            max(np.ptp(dat.positions[a]), 1e-300)
-        ub = (2 * dat.positions[b] - np.ptp(dat.positions[b]) - 2 * dat.positions[b].min()) / \
-            max(np.ptp(dat.positions[b]), 1e-300)
-        return ua * ub, f"{a} * {b} (normalised)"
-    if kind == "higher_order":
-        a = info["axis"]
-        return dat.positions[a], a
-    if kind == "probe_direction":
-        return np.zeros(dat.n), "probing direction"
+        u = {q: (2 * dat.positions[q] - dat.positions[q].min() - dat.positions[q].max())
+             / max(np.ptp(dat.positions[q]), 1e-300) for q in (a, b)}
+        return u[a] * u[b], f"{a} * {b} (normalised to [-1, 1]), 1"
+    if c in dat.positions:
+        return np.asarray(dat.positions[c], dtype=float), f"{c}, {_unit_label(c, model)}"
+    if c in dat.covariates:
+        return np.asarray(dat.covariates[c], dtype=float), f"{c}, {_unit_label(c, model)}"
+    if c and kind != "probe_direction":
+        try:
+            return np.asarray(evaluate(c, values), dtype=float), f"{c}, {_unit_label(c, model)}"
+        except Exception:   # noqa: BLE001  (a label that is not an expression)
+            pass
     return np.arange(dat.n, dtype=float), "point"
 
 
@@ -105,15 +117,15 @@ def fig_effect(fg, eff: dict) -> str:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    model, dat = fg["model"], fg["data"]
-    prob, coef, labels = fg["after_prob"], fg["c_all"], fg["aug_labels"]
+    model, dat = fg.model, fg.data
+    prob, coef, labels = fg.after_prob, fg.c_all, fg.aug_labels
     col = {lab[0]: j for j, lab in enumerate(labels)}
     contrib = np.zeros(3 * dat.n)
     for p in eff["parameters"]:
         j = col[p]
         contrib += prob.A[:, j] * prob.scale[j] * coef[j]
     c3 = contrib.reshape(-1, 3) * 1e3
-    partial = (fg["res_after"].reshape(-1, 3) * 1e3) + c3
+    partial = (fg.res_after.reshape(-1, 3) * 1e3) + c3
     values = {**rotary_rad(model, dat.positions), **dat.covariates}
     x, xlabel = _natural(eff["kind"], eff["info"], model, dat, values)
     if eff["kind"] == "probe_direction":
@@ -152,20 +164,20 @@ def fig_maps(fg) -> str:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    model, dat = fg["model"], fg["data"]
+    model, dat = fg.model, fg.data
     a, b = model.axes[0], model.axes[1]
     idx = _thin(dat.n)
-    nb = np.linalg.norm(fg["res_before"].reshape(-1, 3), axis=1)[idx] * 1e3
-    na = np.linalg.norm(fg["res_after"].reshape(-1, 3), axis=1)[idx] * 1e3
+    nb = np.linalg.norm(fg.res_before.reshape(-1, 3), axis=1)[idx] * 1e3
+    na = np.linalg.norm(fg.res_after.reshape(-1, 3), axis=1)[idx] * 1e3
     vmax = max(np.percentile(nb, 99), 1e-6)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
     for ax, v, title in ((axes[0], nb, "before"), (axes[1], na, "after")):
         sc = ax.scatter(dat.positions[a][idx], dat.positions[b][idx], c=v, s=8, cmap="viridis",
                         vmin=0, vmax=vmax)
         ax.set_title(f"residual length {title}, um")
-        ax.set_xlabel(a)
+        ax.set_xlabel(f"{a}, {_unit_label(a, model)}")
         ax.set_aspect("equal", adjustable="datalim")
-    axes[0].set_ylabel(b)
+    axes[0].set_ylabel(f"{b}, {_unit_label(b, model)}")
     fig.colorbar(sc, ax=axes, shrink=0.8, label="um")
     return _png(fig)
 
@@ -196,10 +208,50 @@ def fig_functions(report) -> str:
                 ax.fill_between(q, (v - 2 * sd) * f, (v + 2 * sd) * f, color=color, alpha=0.2)
                 ax.plot(before[a].positions, before[a].values[name] * f, "--", color=color,
                         lw=0.8)
-            ax.set_xlabel(a)
+            ax.set_xlabel(f"{a}, {'deg' if a in report.figures.model.rotary_axes else 'mm'}")
             ax.set_ylabel(unit)
             ax.legend(fontsize=6)
     axes[0, 0].set_title("solid: after, dashed: before", fontsize=8, loc="left")
+    fig.tight_layout()
+    return _png(fig)
+
+
+def fig_interactions(fg, sources) -> str | None:
+    """Residual (after) against the covariates of the top residual sources, coloured by each
+    axis position: an interaction shows as a colour gradient across the cloud."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    dat, model = fg.data, fg.model
+    values = {**rotary_rad(model, dat.positions), **dat.covariates}
+    covs = []
+    for src in sources:
+        x, label = _natural(src.get("kind", ""), {"covariate": src["covariate"]}, model, dat,
+                            values)
+        if label != "point" and label not in [c[1] for c in covs]:
+            covs.append((x, label))
+        if len(covs) == 3:
+            break
+    if not covs:
+        return None
+    idx = _thin(dat.n)
+    res = fg.res_after.reshape(-1, 3)[idx] * 1e3
+    k = int(np.argmax(np.var(res, axis=0)))
+    axes_names = list(model.axes)[:3]
+    fig, axes = plt.subplots(len(covs), len(axes_names), figsize=(3.6 * len(axes_names),
+                             2.6 * len(covs) + 0.4), squeeze=False, sharey=True)
+    lim = max(np.max(np.abs(res[:, k])), 1e-6) * 1.05
+    for i, (x, label) in enumerate(covs):
+        for j, a in enumerate(axes_names):
+            ax = axes[i, j]
+            sc = ax.scatter(x[idx], res[:, k], c=dat.positions[a][idx], s=3, cmap="viridis")
+            ax.set_ylim(-lim, lim)
+            ax.set_xlabel(label)
+            if j == 0:
+                ax.set_ylabel(f"residual d{'xyz'[k]} after, um")
+            fig.colorbar(sc, ax=ax, label=f"{a}, {_unit_label(a, model)}")
     fig.tight_layout()
     return _png(fig)
 
@@ -212,14 +264,16 @@ def render_html(report) -> str:
 
     fg = report.figures
     figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg),
-               "functions": fig_functions(report)}
+               "functions": fig_functions(report),
+               "interactions": fig_interactions(fg, report.data["residual_sources"])}
     effects = [{"e": e, "png": fig_effect(fg, e),
                 "params": [(p, v, e["std"][p], e["units"][p]) for p, v in e["parameters"].items()]}
                for e in report.data["effects"]]
     text = (resources.files("volerr.loop") / "templates" / "report.html.j2").read_text(
         encoding="utf-8")
     env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
-    return env.from_string(text).render(
-        r=report.data, figures=figures, effects=effects,
-        json_text=json.dumps({k: v for k, v in report.data.items()
-                              if k not in ("residual_analysis",)}, indent=1, default=str))
+    paths = {k: (Path(v).name if v else v) for k, v in (
+        ("augmented_layout", report.data.get("augmented_layout")),
+        ("generated_module", report.data.get("generated_module")))}
+    return env.from_string(text).render(r=report.data, figures=figures, effects=effects,
+                                        paths=paths)

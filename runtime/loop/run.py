@@ -9,15 +9,18 @@ Steps (:func:`run_loop`):
 3. fit the declared model (:mod:`volerr.loop.fit`): component errors as Legendre series, degree by
    cross-validation, squareness, location errors, the instrument's rigid placement;
    gauge fixed by convention, plan-specific unidentifiable combinations reported;
-4. candidate effects (:mod:`volerr.loop.candidates`), forward stepwise: the candidate with the best
-   BIC gain is accepted when the gain is strong (dBIC < -10) *and* its cross-validated
+4. robust weights of the points (IRLS on the declared fit): gross outliers are down-weighted
+   and flagged, not explained;
+5. candidate effects "parameter P varies with covariate C" generated from the chain
+   (:mod:`volerr.loop.candidates`), screened and selected (:mod:`volerr.loop.select`), forward
+   stepwise: the candidate with the best BIC gain is accepted when the gain is strong (dBIC < -10) *and* its cross-validated
    residual is significantly smaller (paired t > 3 on the per-point squared errors);
    stop when no candidate passes; then a backward check drops any effect that, given all
    the others, no longer gains dBIC < -10 (a later effect made it redundant);
-5. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
+6. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
    it, and fit it: it gives the "after" figures, and its derived sensitivities are checked
    against the numeric columns used during the search;
-6. report: :class:`Report` (``write_json``, ``write_html``).
+7. report: :class:`Report` (with the ranked residual sources before and after) (``write_json``, ``write_html``).
 
 Units: deviations in mm inside, um in reports; angular parameters urad; thermal um/m/K.
 """
@@ -30,24 +33,25 @@ import math
 import re
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from volerr.loop import candidates as cands
-from volerr.machine.expressions import evaluate
+from volerr.loop import select as sel
 from volerr.errors import InputError, require
-from volerr.loop.fit import (Data, Problem, data_ranges, declared_design, gauge_mask,
-                  identifiability, point_norm, require_points, rms, rotary_rad, rows_of,
-                  twist_columns, weakly_determined)
+from volerr.loop.fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
+                  identifiability, point_norm, require_points, rms, rows_of,
+                  weakly_determined)
 from volerr.machine.layout import layout_text, parse_layout
 from volerr.machine import derivation
 from volerr.machine.model import Model, load
 
-BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
-CV_T = 3.0           # minimum paired t of the held-out improvement
-MAX_EFFECTS = 8
+from volerr.loop.select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
+
+ROBUST_K = 4.0       # robust sigmas of the 3-D residual length kept at full weight
+OUTLIER_Z = 5.0      # robust sigmas beyond which a point is flagged as an outlier
 DEGREE_CV_POINTS = 2500  # training points used to choose the degree (a random subset)
 AXIS_NAMES = "XYZUVWABC"
 
@@ -76,7 +80,7 @@ def read_deviations(path, model: Model) -> Data:
     for i, r in enumerate(body):
         require(len(r) == len(header), f"{p.name}: row {i + 2} has {len(r)} fields, "
                 f"the header {len(header)}")
-    cols = {}
+    cols, text = {}, {}
     for j, h in enumerate(header):
         raw = [r[j].strip() for r in body]
         vals = []
@@ -92,14 +96,13 @@ def read_deviations(path, model: Model) -> Data:
                          None)
             require(comma is None, f"{p.name}: column {h}: {comma!r} has a decimal comma; "
                     f"write numbers with a decimal point")
-            continue  # a label column (text): ignored
+            text[h] = None  # a label column (text): ignored, named in a warning
+            continue
         if bad is not None:
-            raise InputError(f"{p.name}: column {h} row {bad + 2}: {raw[bad]!r} is not a number")
-        v = np.asarray(vals)
-        k = int(np.flatnonzero(~np.isfinite(v))[0]) if not np.all(np.isfinite(v)) else -1
-        require(k < 0, f"{p.name}: column {h} row {k + 2} is NaN or infinite")
-        cols[h] = v
-    return columns_to_data(cols, model, p.name)
+            text[h] = f"{p.name}: column {h} row {bad + 2}: {raw[bad]!r} is not a number"
+            continue
+        cols[h] = np.asarray(vals)
+    return columns_to_data(cols, model, p.name, text)
 
 
 def _not_number(s: str) -> bool:
@@ -110,8 +113,30 @@ def _not_number(s: str) -> bool:
         return True
 
 
-def columns_to_data(cols: dict, model: Model, where: str = "data") -> Data:
-    """Column dict (CSV names) -> :class:`Data`, checking axes, units and ranges."""
+def columns_to_data(cols: dict, model: Model, where: str = "data", text=None) -> Data:
+    """Column dict (CSV names) -> :class:`Data`, checking axes, units and ranges.
+
+    ``text``: columns that are not all numbers (name -> the first bad cell's message, None for a
+    label column): an error when the column is needed, else a warning and left out.  A
+    covariate with NaN is left out with a warning; positions, offsets and deviations must be
+    finite."""
+    text = dict(text or {})
+    for h in list(cols):
+        v = np.asarray(cols[h], dtype=float)
+        if not np.all(np.isfinite(v)):
+            k = int(np.flatnonzero(~np.isfinite(v))[0])
+            text[h] = f"{where}: column {h} row {k + 2} is NaN or infinite"
+            del cols[h]
+    needed = {a + u for a in model.axes for u in ("", "_mm", "_deg")}
+    needed |= {c + u for c in ("Xp", "Yp", "Zp") for u in ("", "_mm")}
+    needed |= {f"{d}_{u}" for d in ("dx", "dy", "dz") for u in ("um", "mm")}
+    needed |= set(model.covariates)
+    warnings = []
+    for h, msg in text.items():
+        require(h not in needed, msg or f"{where}: column {h} is not numeric")
+        warnings.append(f"column {h} is not numeric: left out of the candidates" if msg is None
+                        else f"column {h} has a value that is not a finite number: left out "
+                             f"of the candidates")
     used = set()
 
     def find(name, units, what):
@@ -165,47 +190,16 @@ def columns_to_data(cols: dict, model: Model, where: str = "data") -> Data:
                                                                                   "dz"))}
     missing = [c for c in model.covariates if c not in covs]
     require(not missing, f"{where}: layout {model.name} needs covariate column {missing[0] if missing else ''}")
-    return Data(positions, probe, dev, covs)
+    return Data(positions, probe, dev, covs, warnings)
 
 
-# ---- effect columns ---------------------------------------------------------------
-def term_columns(model: Model, data: Data, sens: np.ndarray, frame, terms) -> tuple:
-    """(N, 3, m) columns of the parameters of ``terms`` [(parameter, target, basis)]."""
-    params = list(dict.fromkeys(t[0] for t in terms))
-    out = np.zeros((data.n, 3, len(params)))
-    values = {**rotary_rad(model, data.positions), **data.covariates}
-    index = {p: j for j, p in enumerate(model.parameters)}
-    for pn, target, basis in terms:
-        b = np.broadcast_to(evaluate(basis, values), (data.n,))
-        if "." in target:
-            side, key = target.split(".")
-            col = twist_columns(side, key, data, frame)
-        else:
-            col = sens[:, :, index[target]]
-        out[:, :, params.index(pn)] += col * b[:, None]
-    return out, params
-
-
-# ---- reporting helpers ----------------------------------------------------------------
-def _unit_of(kind: str, target: str, basis: str) -> tuple[float, str]:
-    """Report factor and unit of an effect parameter."""
-    angular = (target[1] in "ABC" and "." not in target) or ".e" in target
-    if kind == "thermal":
-        # KT * A * (T - 20): 1/K -> um/m/K; KT0 * (T - 20), the scale's fixed point: mm/K -> um/K
-        return (1e3, "um/K") if basis.startswith("(") else (1e6, "um/m/K")
-    if kind == "drift":
-        per = ("h" if "/3600" in basis or "/60" in basis or basis in ("t_h", "time_h")
-               else "unit")
-        return 1e3, f"um/{per}"
-    return (1e6, "urad") if angular else (1e3, "um")
-
-
+# ---- report ---------------------------------------------------------------------
 @dataclass
 class Report:
     """Result of :func:`run_loop`; ``data`` is the json report (INTERFACE.md keys first)."""
 
     data: dict
-    figures: dict = field(default_factory=dict)   # name -> (plot function args) for html
+    figures: "Figures | None" = None       # what the html report and error tables need
     augmented_text: str = ""
     generated_text: str = ""
 
@@ -241,10 +235,10 @@ class Report:
         from volerr.tables.table import ErrorTable
 
         fg = self.figures
-        model, ranges, deg = fg["model"], fg["ranges"], fg["degree"]
-        coef, labels, var = fg["c_all"], fg["aug_labels"], fg["cov_diag"]
+        model, ranges, deg = fg.model, fg.ranges, fg.degree
+        coef, labels, var = fg.c_all, fg.aug_labels, fg.cov_diag
         if which == "before":
-            coef, labels = fg["c_before"], fg["before_labels"]
+            coef, labels = fg.c_before, fg.before_labels
             var = np.zeros(len(coef))
         index = {lab: j for j, lab in enumerate(labels)}
         tables, constants = {}, {}
@@ -298,16 +292,43 @@ def _progress(total: int, enabled):
                 bar_format="{desc}: {n}/{total} {postfix}")
 
 
-# ---- the loop -------------------------------------------------------------------------
-def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
-    """Degree of the component series by cross-validation on the training points (``extra``: effect
-    columns (rows, m) included in every model compared)."""
-    design = declared_design(model, data, max_degree, ranges)
+# ---- steps of the loop ----------------------------------------------------------------
+@dataclass
+class Split:
+    """Held-out split: ``test`` and ``train`` point indices, k-fold labels (None: LOO)."""
+
+    train: np.ndarray
+    test: np.ndarray
+    folds: np.ndarray | None
+
+
+def split_points(n: int, seed: int, test_fraction: float, folds: int | None) -> Split:
+    rng = np.random.default_rng(seed)
+    perm = rng.permutation(n)
+    n_test = max(1, int(round(test_fraction * n)))
+    test, train = np.sort(perm[:n_test]), np.sort(perm[n_test:])
+    fold_t = None if folds is None else rng.permutation(len(train)) % folds
+    return Split(train, test, fold_t)
+
+
+def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None, weights=None):
+    """Degree of the component series by cross-validation on the training points (``extra``:
+    effect columns (rows, m) included in every model compared).  At most
+    ``DEGREE_CV_POINTS`` random training points are used (the design is built for those only)."""
     keep, _ = gauge_mask(model, data, max_degree, ranges)
-    y = data.deviation.ravel()
     if len(train) > DEGREE_CV_POINTS:  # the degree needs no more points than this
-        train = np.sort(np.random.default_rng(0).choice(train, DEGREE_CV_POINTS, replace=False))
-        folds = None
+        sub = np.sort(np.random.default_rng(0).choice(len(train), DEGREE_CV_POINTS,
+                                                      replace=False))
+        if extra is not None:
+            extra = extra.reshape(-1, 3, extra.shape[1])[train[sub]].reshape(-1, extra.shape[1])
+        train, folds = train[sub], None
+    elif extra is not None:
+        extra = extra.reshape(-1, 3, extra.shape[1])[train].reshape(-1, extra.shape[1])
+    sub_data = data.subset(train)
+    design = declared_design(model, sub_data, max_degree, ranges)
+    sw = np.ones(3 * len(train)) if weights is None else np.repeat(np.sqrt(weights[train]), 3)
+    y = sub_data.deviation.ravel() * sw
+    pts = np.arange(len(train))
     scores = {}
     for k in range(1, max_degree + 1):
         m = keep & np.array([lab[1] is None or lab[0] == "setup" or lab[1] <= k
@@ -317,8 +338,9 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
         A = design.A[:, :, m].reshape(-1, m.sum())
         if extra is not None and extra.shape[1]:
             A = np.concatenate([A, extra], axis=1)
-        prob = Problem(A, y)
-        scores[k] = rms(_cv(prob, folds, train))
+        prob = Problem(A * sw[:, None], y)
+        scores[k] = rms(prob.loo_residuals(pts) if folds is None else
+                        prob.cv_residuals(folds, pts))
         best_k = min(scores, key=scores.get)
         if k - best_k >= 2:   # two degrees without a gain: stop
             break
@@ -328,209 +350,314 @@ def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None):
     return min(k for k, v in scores.items() if v <= best), scores
 
 
-def _cv(prob: Problem, folds, points) -> np.ndarray:
-    """Cross-validated residual rows: leave-one-point-out when ``folds`` is None, else k-fold
-    with the given fold label per point."""
-    if folds is None:
-        return prob.loo_residuals(points)
-    return prob.cv_residuals(folds, points)
+@dataclass
+class Declared:
+    """The declared model's design at the data: columns kept after gauge fixing and what the
+    plan cannot separate."""
+
+    design: object
+    keep: np.ndarray
+    gauge: list
+    A: np.ndarray                # (3N, k)
+    labels: list
+    unidentifiable: list
+    weak: list
 
 
-def _periodic_best(cand, model, data, train, sens, resid, ranges):
-    """Best period of a periodic candidate by the residual periodogram, refined."""
-    comp, axis, periods = cand.period_search
-    j = model.parameters.index(comp)
-    s = sens[train, :, j]                       # (n, 3)
-    r = resid.reshape(-1, 3)
-    w = np.sum(r * s, axis=1)
-    s2 = np.sum(s * s, axis=1)
-    q = data.positions[axis][train]
-
-    def gain(per):
-        ph = 2 * np.pi * np.outer(q, 1.0 / np.atleast_1d(per))
-        sn, cs = np.sin(ph), np.cos(ph)
-        a, c = w @ sn, w @ cs
-        ss, cc, sc = s2 @ (sn * sn), s2 @ (cs * cs), s2 @ (sn * cs)
-        det = np.maximum(ss * cc - sc * sc, 1e-300)
-        return (a * a * cc - 2 * a * c * sc + c * c * ss) / det
-
-    g = gain(periods)
-    i = int(np.argmax(g))
-    f0 = 1.0 / periods[i]
-    df = (1.0 / periods[min(i + 1, len(periods) - 1)] - 1.0 / periods[max(i - 1, 0)]) / 2 or f0 * 1e-3
-    fine = 1.0 / np.linspace(max(f0 - df, 1e-12), f0 + df, 41)
-    gf = gain(fine)
-    return float(fine[int(np.argmax(gf))])
+def declared_step(model, dat, degree, ranges, train) -> Declared:
+    design = declared_design(model, dat, degree, ranges)
+    keep, gauge = gauge_mask(model, dat, degree, ranges)
+    require_points(len(train), int(keep.sum()), f"declared model of degree {degree}")
+    labels = [lab for lab, k in zip(design.labels, keep) if k]
+    A_tr = design.A[train][:, :, keep].reshape(-1, keep.sum())
+    keep_d, unident = identifiability(A_tr, labels)
+    keep = keep.copy()
+    keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
+    labels = [lab for lab, k in zip(design.labels, keep) if k]
+    A = design.A[:, :, keep].reshape(-1, keep.sum())
+    design.A = None              # (N, 3, P) with the gauge columns: not needed any more
+    weak = weakly_determined(A[rows_of(train)], labels)
+    return Declared(design, keep, gauge, A, labels, unident, weak)
 
 
-def _pinv_sym(G, tol=1e-12):
-    """Pseudo-inverse of a symmetric PSD matrix by eigh (small matrices only)."""
-    w, V = np.linalg.eigh(G)
-    ok = w > tol * max(float(w[-1]), 1e-300)
-    return (V[:, ok] / w[ok]) @ V[:, ok].T
+@dataclass
+class Robust:
+    """Robust point weights (N,), 0..1, the robust noise scale (mm per coordinate) and the
+    points flagged as outliers."""
+
+    weights: np.ndarray
+    sigma: float
+    outliers: np.ndarray
+
+    def rows(self) -> np.ndarray:
+        return np.repeat(np.sqrt(self.weights), 3)
 
 
-class _Base:
-    """The current design on the training rows, column-scaled, with its Gram pseudo-inverse.
-
-    Everything is done through Gram matrices (tall SVD/QR are slow with threaded BLAS on a
-    busy machine)."""
-
-    def __init__(self, A, y):
-        self.scale = np.sqrt(np.mean(A ** 2, axis=0))
-        self.scale[self.scale == 0] = 1.0
-        self.A = A / self.scale
-        self.Gi = _pinv_sym(self.A.T @ self.A)
-        self.r = y - self.A @ (self.Gi @ (self.A.T @ y))
-        self.rss = float(self.r @ self.r)
-
-    def score(self, B) -> tuple[float, int]:
-        """(RSS reduction, effective rank) of adding the columns B."""
-        sc = np.sqrt(np.mean(B ** 2, axis=0))
-        sc[sc == 0] = 1.0
-        Bs = B / sc
-        C = self.A.T @ Bs
-        M = Bs.T @ Bs - C.T @ self.Gi @ C
-        w, V = np.linalg.eigh((M + M.T) / 2)
-        ok = w > 1e-9 * len(Bs)          # columns (unit RMS) not inside the base span
-        if not ok.any():
-            return 0.0, 0
-        g = V[:, ok].T @ (Bs.T @ self.r)
-        return float(np.sum(g * g / w[ok])), int(ok.sum())
-
-
-class _Context:
-    """Data, split and settings of one loop run; :meth:`search` is the stepwise selection."""
-
-    def __init__(self, model, dat, train, fold_t, ranges, y, families):
-        self.model, self.dat, self.train, self.fold_t = model, dat, train, fold_t
-        self.ranges, self.y, self.families = ranges, y, families
-
-    def search(self, degree: int) -> dict:
-        model, dat, train, fold_t, y = self.model, self.dat, self.train, self.fold_t, self.y
-        design = declared_design(model, dat, degree, self.ranges)
-        keep, gauge = gauge_mask(model, dat, degree, self.ranges)
-        require_points(len(train), int(keep.sum()), f"declared model of degree {degree}")
-        labels = [lab for lab, k in zip(design.labels, keep) if k]
-        keep_d, unident = identifiability(design.A[:, :, keep].reshape(-1, keep.sum()), labels)
-        keep = keep.copy()
-        keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
-        A_all = design.A[:, :, keep].reshape(-1, keep.sum())
-        weak = weakly_determined(A_all, [lab for lab, k in zip(design.labels, keep) if k])
-        candidates = [c for c in cands.build(model, dat, self.ranges, degree)
-                      if c.kind in self.families]
-        tr_rows = rows_of(train)
-        ytr = y[tr_rows]
-        n3 = len(ytr)
-        cache, selected, rejected = {}, [], set()
-        cv_old = point_norm(_cv(Problem(A_all, y), fold_t, train)) ** 2
-        while len(selected) < MAX_EFFECTS:
-            base = _Base(A_all[tr_rows], ytr)
-            scored = []
-            for c in candidates:
-                if c.name in rejected or any(c.name == s["cand"].name for s in selected):
-                    continue
-                if c.period_search is not None:
-                    per = _periodic_best(c, model, dat, train, design.sens, base.r, self.ranges)
-                    c = cands.Candidate(c.kind, c.name,
-                                        cands.periodic_terms(c.info["component"],
-                                                             c.info["axis"], per),
-                                        {**c.info, "period": per}, c.period_search)
-                key = (c.name, tuple(c.terms))
-                if key not in cache:
-                    cache[key] = term_columns(model, dat, design.sens, design.frame, c.terms)
-                cols, params = cache[key]
-                gain, rank = base.score(cols.reshape(-1, cols.shape[-1])[tr_rows])
-                if rank == 0:
-                    continue
-                m_eff = rank + (1 if c.period_search is not None else 0)
-                new = max(base.rss - gain, 1e-300)
-                dbic = n3 * math.log(new / base.rss) + m_eff * math.log(n3)
-                scored.append((dbic, gain, c, cols, params))
-            scored.sort(key=lambda s: s[0])
-            _prefer_first_of_ties(scored, candidates)
-            accepted = False
-            for dbic, gain, c, cols, params in scored[:3]:
-                if dbic > -BIC_GAIN:
-                    break
-                A_try = np.concatenate([A_all, cols.reshape(-1, cols.shape[-1])], axis=1)
-                cv_new = point_norm(_cv(Problem(A_try, y), fold_t, train)) ** 2
-                d = cv_old - cv_new
-                t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
-                if t < CV_T:
-                    rejected.add(c.name)
-                    continue
-                alts = [s[2].name for s in scored if s[2].name != c.name and s[1] >= 0.98 * gain]
-                selected.append({"cand": c, "params": params, "cols": cols, "evidence": {
-                    "delta_bic": round(dbic, 2),
-                    "rss_reduction_fraction": round(gain / base.rss, 5),
-                    "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
-                    "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
-                    "cv_paired_t": round(t, 2),
-                    "step": len(selected) + 1,
-                    "indistinguishable_from": alts[:5]}})
-                A_all = A_try
-                cv_old = cv_new
-                accepted = True
-                break
-            if not accepted:
-                break
-        selected, A_all = self._backward(A_all[:, :A_all.shape[1] - sum(
-            s_["cols"].shape[-1] for s_ in selected)], selected, tr_rows, ytr)
-        return {"design": design, "keep": keep, "gauge": gauge, "A_all": A_all,
-                "unidentifiable": unident, "weak": weak,
-                "selected": selected, "candidates": candidates}
+def robust_weights(A, y, points, n: int, iterations: int = 8) -> Robust:
+    """IRLS on the 3-D residual length of each point: weight 1 up to ``ROBUST_K`` robust
+    standard deviations, then a bisquare down to 0 at twice that; the scale from the median
+    residual length (the median of a chi(3) variable is 1.538 sigma), so gross outliers
+    neither inflate the noise estimate nor hide smaller ones."""
+    w = np.ones(len(points))
+    rows = rows_of(points)
+    scale = np.sqrt(np.einsum("ij,ij->j", A, A) / len(A))
+    scale[scale == 0] = 1.0
+    sigma = 0.0
+    for _ in range(iterations):
+        w_rows = np.zeros(len(y))
+        w_rows[rows] = np.repeat(np.sqrt(w), 3)
+        G, b = _gram(A, y, w_rows, rows)
+        c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
+        r = point_norm(y[rows] - A[rows] @ c)
+        sigma = max(float(np.median(r[w > 0])) / 1.538, 1e-12)
+        z = r / sigma
+        w_new = np.where(z <= ROBUST_K, 1.0,
+                         np.clip(1 - ((z - ROBUST_K) / ROBUST_K) ** 2, 0, 1) ** 2)
+        if np.allclose(w_new, w):
+            break
+        w = w_new
+    weights = np.ones(n)
+    weights[points] = w
+    flagged = points[z > OUTLIER_Z]
+    return Robust(weights, sigma, flagged)
 
 
-    @staticmethod
-    def _backward(A0, selected, tr_rows, ytr):
-        """Backward check of the forward selection: an effect that a later one made redundant
-        (e.g. per-round set-ups taken first for what is a linear drift in x, y and z) is
-        dropped when, given all the others, it no longer gains dBIC < -BIC_GAIN.  Each kept
-        effect gets ``delta_bic_given_others``.  Returns (selected, design columns)."""
-        n3 = len(ytr)
-
-        def stack(sel):
-            return np.concatenate([A0] + [s_["cols"].reshape(-1, s_["cols"].shape[-1])
-                                          for s_ in sel], axis=1)
-
-        def dbic_without(sel, i):
-            others = [s_ for j, s_ in enumerate(sel) if j != i]
-            base = _Base(stack(others)[tr_rows], ytr)
-            cols = sel[i]["cols"]
-            gain, rank = base.score(cols.reshape(-1, cols.shape[-1])[tr_rows])
-            m_eff = rank + (1 if sel[i]["cand"].period_search is not None else 0)
-            new = max(base.rss - gain, 1e-300)
-            return n3 * math.log(new / base.rss) + m_eff * math.log(n3)
-
-        sel = list(selected)
-        while len(sel) > 1:
-            scores = [dbic_without(sel, i) for i in range(len(sel))]
-            worst = int(np.argmax(scores))
-            if scores[worst] <= -BIC_GAIN:
-                for s_, d in zip(sel, scores):
-                    s_["evidence"]["delta_bic_given_others"] = round(d, 2)
-                break
-            sel.pop(worst)
-        if len(sel) == 1:
-            sel[0]["evidence"]["delta_bic_given_others"] = sel[0]["evidence"]["delta_bic"]
-        for k, s_ in enumerate(sel):
-            s_["evidence"]["step"] = k + 1
-        return sel, stack(sel)
+def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, families,
+                   robust: Robust, y) -> tuple[sel.Selection, list]:
+    covs, warns = cands.covariates(dat.covariates, model)
+    candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
+                  if c.kind in families]
+    w_rows = robust.rows()
+    ctx = sel.Context(model, dat, decl.design.sens, decl.design.frame, spl.train,
+                      np.sqrt(robust.weights[spl.train]), ranges)
+    return sel.select(candidates, ctx, decl.A, y, spl.folds, w_rows, sel.SCREEN_POINTS), warns
 
 
-def _prefer_first_of_ties(scored: list, candidates: list) -> None:
-    """Among candidates that fit the data identically (same columns up to rounding, e.g. on a
-    CMM ``EZX`` depending on ``Y`` and ``EZY`` depending on ``X``), put the one listed first
-    by :func:`volerr.loop.candidates.build` in front, so that the choice does not depend on
-    rounding; the others are reported as ``indistinguishable_from``."""
-    if len(scored) < 2:
-        return
-    order = {c.name: i for i, c in enumerate(candidates)}
-    d0 = scored[0][0]
-    ties = [i for i, s in enumerate(scored) if abs(s[0] - d0) <= 1e-7 * abs(d0) + 1e-9]
-    first = min(ties, key=lambda i: order.get(scored[i][2].name, len(order)))
-    scored.insert(0, scored.pop(first))
+@dataclass
+class Augmented:
+    """The augmented layout (text), its generated module (text), model and design."""
+
+    text: str
+    source: str
+    model: Model
+    A: np.ndarray
+    labels: list
+    derived_check: float | None
+
+
+def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augmented:
+    if not selection.accepted:
+        return Augmented("", "", model, decl.A, decl.labels, None)
+    text = augmented_layout_text(model, selection.accepted)
+    lay = parse_layout(text, f"{model.name}_aug.toml")
+    source = derivation.generate_source(lay)
+    aug = Model(lay, derivation.module_from_source(source, lay.name))
+    ad = declared_design(aug, dat, degree, ranges)
+    n_new = len(aug.parameters) - len(model.parameters)
+    keep = np.concatenate([decl.keep, np.ones(n_new, bool)])
+    A = ad.A[:, :, keep].reshape(-1, keep.sum())
+    k = decl.keep.sum()
+    numeric = selection.A[:, k:]
+    check = float(np.max(np.abs(numeric - A[:, k:])) / max(np.max(np.abs(numeric)), 1e-300))
+    return Augmented(text, source, aug, A, [lab for lab, m in zip(ad.labels, keep) if m], check)
+
+
+@dataclass
+class Outcome:
+    """Held-out residual rows before (declared) and after (augmented), fits on all points."""
+
+    r_before: np.ndarray
+    r_after: np.ndarray
+    after_prob: Problem
+    c_all: np.ndarray
+    c_before: np.ndarray
+    res_before: np.ndarray
+    res_after: np.ndarray
+    sigma2: float
+    cov_diag: np.ndarray
+    test_inliers: np.ndarray
+
+
+def _gram(A, y, w_rows, rows=None, chunk: int = 30000):
+    """Weighted normal equations (A^T W A, A^T W y) accumulated in chunks of rows (no
+    weighted copy of the whole design)."""
+    rows = np.arange(len(y)) if rows is None else rows
+    G = np.zeros((A.shape[1], A.shape[1]))
+    b = np.zeros(A.shape[1])
+    for i in range(0, len(rows), chunk):
+        r = rows[i:i + chunk]
+        Ar = A[r] * w_rows[r, None]
+        G += Ar.T @ Ar
+        b += Ar.T @ (y[r] * w_rows[r])
+    return G, b
+
+
+def _weighted_fit(prob: Problem, w_rows, points=None):
+    """Coefficients (unscaled column units) of the weighted fit on ``points`` (all if None)."""
+    G, b = _gram(prob.A, prob.y, w_rows, None if points is None else rows_of(points))
+    return solve_normal(G, b) / prob.scale
+
+
+def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y) -> Outcome:
+    w_rows = robust.rows()
+    before, after = Problem(decl.A, y), Problem(aug.A, y)
+    r_before = y[rows_of(spl.test)] - before.predict(_weighted_fit(before, w_rows, spl.train),
+                                                    spl.test)
+    r_after = y[rows_of(spl.test)] - after.predict(_weighted_fit(after, w_rows, spl.train),
+                                                  spl.test)
+    c_all = _weighted_fit(after, w_rows)
+    c_before = _weighted_fit(before, w_rows)
+    res_after = y - after.predict(c_all)
+    res_before = y - before.predict(c_before)
+    G, _ = _gram(after.A, y, w_rows)
+    wG = np.linalg.eigvalsh(G)
+    dof = max(3 * float(robust.weights.sum()) - int(np.sum(wG > 1e-12 * wG[-1])), 1.0)
+    sigma2 = float(np.sum((res_after * w_rows) ** 2)) / dof
+    cov_diag = np.diag(np.linalg.pinv(G, rcond=1e-12)) * sigma2 / after.scale ** 2
+    inl = point_norm(r_after) <= OUTLIER_Z * math.sqrt(sigma2)
+    return Outcome(r_before, r_after, after, c_all, c_before, res_before, res_after, sigma2,
+                   cov_diag, inl)
+
+
+def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
+    """The json entries of the accepted effects (values in report units, evidence)."""
+    col = {lab[0]: j for j, lab in enumerate(aug.labels)}
+    effects = []
+    for s in selection.accepted:
+        c = s.cand
+        pars, units, std = {}, {}, {}
+        contrib = np.zeros(3 * n)
+        for pn in s.params:
+            f, u = c.units.get(pn, (1e3, "um"))
+            j = col[pn]
+            pars[pn] = round(float(out.c_all[j]) * f, 6)
+            std[pn] = round(float(math.sqrt(max(out.cov_diag[j], 0.0))) * f, 6)
+            units[pn] = u
+            contrib += out.after_prob.A[:, j] * out.after_prob.scale[j] * out.c_all[j]
+        info = {k: (round(v, 6) if isinstance(v, float) else v) for k, v in c.info.items()}
+        if c.kind == "thermal" and len(c.terms) == 2 and c.terms[0][2].startswith(
+                info.get("axis", "?") + "*"):
+            k1, k0 = (float(out.c_all[col[t[0]]]) for t in c.terms)
+            sd1 = math.sqrt(max(out.cov_diag[col[c.terms[0][0]]], 0.0))
+            if k1 != 0.0 and abs(k1) > 3.0 * sd1:   # only for a significant scale term
+                info["fixed_point_mm"] = round(-k0 / k1, 3)
+        if c.kind == "periodic":
+            a_s, a_c = (pars[t[0]] for t in c.terms)
+            info["amplitude_um"] = round(math.hypot(a_s, a_c), 4)
+            info["phase_rad"] = round(math.atan2(a_c, a_s), 4)   # a sin(2 pi q / P + phase)
+        ev = dict(s.evidence)
+        ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
+        ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)
+        effects.append({"kind": c.kind, "name": c.name, "parameters": pars, "units": units,
+                        "std": std, "parameter": info.get("parameter"),
+                        "covariate": info.get("covariate"), "basis": info.get("basis"),
+                        "target": sorted({t[1] for t in c.terms}), "info": info,
+                        "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}
+                                  for t in c.terms], "evidence": ev})
+    return effects
+
+
+def _replicate_sigma(dat: Data, res_rows, weights) -> tuple[float, int] | None:
+    """Pure-error standard deviation (mm per coordinate) from replicated points (same
+    positions and probe offset), and its degrees of freedom; None without replicates."""
+    key = np.column_stack([dat.positions[a] for a in dat.positions] + [dat.probe])
+    _, inv, counts = np.unique(np.round(key, 6), axis=0, return_inverse=True,
+                               return_counts=True)
+    inv = inv.ravel()
+    rep = (counts[inv] > 1) & (weights > 0.5)
+    if rep.sum() < 10:
+        return None
+    r = res_rows.reshape(-1, 3)[rep]
+    g = inv[rep]
+    means = np.zeros((inv.max() + 1, 3))
+    np.add.at(means, g, r)
+    cnt = np.bincount(g, minlength=inv.max() + 1)[:, None]
+    means = means / np.maximum(cnt, 1)
+    ss = float(np.sum((r - means[g]) ** 2))
+    dof = 3 * (len(g) - len(np.unique(g)))
+    return (math.sqrt(ss / dof), dof) if dof > 0 else None
+
+
+def residual_note(dat, out: Outcome, sources_after, robust: Robust) -> str | None:
+    """One sentence when the augmented residual is still clearly above the noise: replicate
+    points (F test of lack of fit) where the plan has them, else the screening's BIC."""
+    if not sources_after:
+        return None
+    top = sources_after[0]
+    what = (f"the top remaining source is {top['parameter']} varying with {top['covariate']} "
+            f"({top['basis']}, {top['explained_um']:.3g} um)")
+    rep = _replicate_sigma(dat, out.res_after, robust.weights)
+    if rep is not None:
+        s_pe, dof = rep
+        ratio = out.sigma2 / max(s_pe ** 2, 1e-300)
+        if ratio > 1.0 + 4.0 * math.sqrt(2.0 / dof) and ratio > 1.2:
+            return (f"The augmented residual is still above the noise of the replicated points "
+                    f"({1e3 * math.sqrt(out.sigma2):.3g} vs {1e3 * s_pe:.3g} um): {what}.")
+        return None
+    if top["delta_bic"] < -2 * sel.BIC_GAIN:
+        return (f"The augmented residual still holds structure (lack of fit, dBIC "
+                f"{top['delta_bic']:.0f}, not confirmed on held-out points): {what}.")
+    return None
+
+
+@dataclass
+class Figures:
+    """What the HTML report and the error tables need (fits on all points)."""
+
+    model: Model
+    data: Data
+    ranges: dict
+    degree: int
+    res_before: np.ndarray
+    res_after: np.ndarray
+    test: np.ndarray
+    r_before: np.ndarray
+    r_after: np.ndarray
+    selected: list
+    after_prob: Problem
+    c_all: np.ndarray
+    aug_labels: list
+    c_before: np.ndarray
+    before_labels: list
+    cov_diag: np.ndarray
+    weights: np.ndarray
+
+
+def _load(layout, data) -> tuple[Model, Data]:
+    model = load(layout)
+    if isinstance(data, Data):
+        return model, data
+    if hasattr(data, "columns") and callable(data.columns):
+        return model, columns_to_data(data.columns(), model, "campaign")
+    return model, read_deviations(data, model)
+
+
+def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, families):
+    """Declared fit, robust weights, selection; the degree chosen again with the effects."""
+    degree_scores = {}
+    if not fixed_degree:
+        # robust weights of a preliminary fit first: outliers must not choose the degree
+        pre = declared_step(model, dat, min(max_degree, 6), ranges, spl.train)
+        w0 = robust_weights(pre.A, y, np.arange(dat.n), dat.n).weights
+        degree, degree_scores = _choose_degree(model, dat, spl.train, spl.folds, ranges,
+                                               max_degree, weights=w0)
+    decl = declared_step(model, dat, degree, ranges, spl.train)
+    robust = robust_weights(decl.A, y, np.arange(dat.n), dat.n)
+    selection, warns = selection_step(model, dat, decl, spl, ranges, degree, families,
+                                      robust, y)
+    keepers = [s for s in selection.accepted if s.cand.kind != "higher_order"]
+    if keepers and not fixed_degree:
+        # the degree was chosen with the effects unmodelled: choose it again with them
+        extra = np.concatenate([s.cols.reshape(-1, s.cols.shape[-1]) for s in keepers], axis=1)
+        degree2, scores2 = _choose_degree(model, dat, spl.train, spl.folds, ranges,
+                                          max_degree, extra, robust.weights)
+        if degree2 != degree:
+            degree, degree_scores = degree2, scores2
+            decl = declared_step(model, dat, degree, ranges, spl.train)
+            robust = robust_weights(decl.A, y, np.arange(dat.n), dat.n)
+            selection, warns = selection_step(model, dat, decl, spl, ranges, degree,
+                                              families, robust, y)
+    return degree, degree_scores, decl, robust, selection, warns
 
 
 def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
@@ -542,191 +669,118 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
 
     ``out_dir``: where the augmented layout and its generated module are written (nothing is
     written when None; the texts are in the report object either way)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir,
+                    progress, families, inputs)
+
+
+def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, progress,
+         families, inputs) -> Report:
     t_start = time.perf_counter()
-    model = load(layout)
-    if isinstance(data, Data):
-        dat = data
-    elif hasattr(data, "columns") and callable(data.columns):
-        dat = columns_to_data(data.columns(), model, "campaign")
-    else:
-        dat = read_deviations(data, model)
+    model, dat = _load(layout, data)
     require(folds is None or 2 <= folds <= 20, "folds must be between 2 and 20")
     require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
-    bar = _progress(7, progress)
-    rng = np.random.default_rng(seed)
-    n = dat.n
-    perm = rng.permutation(n)
-    n_test = max(1, int(round(test_fraction * n)))
-    test, train = np.sort(perm[:n_test]), np.sort(perm[n_test:])
-    fold_t = None if folds is None else rng.permutation(len(train)) % folds
+    if degree is not None:
+        require(1 <= degree <= 12, "degree must be between 1 and 12")
+    bar = _progress(4, progress)
+    spl = split_points(dat.n, seed, test_fraction, folds)
     ranges = data_ranges(model, dat)
     y = dat.deviation.ravel()
-
-    bar.set_postfix_str("degree by cross-validation")
-    fixed_degree = degree is not None
-    if fixed_degree:
-        require(1 <= degree <= 12, "degree must be between 1 and 12")
-        degree_scores = {}
-    else:
-        degree, degree_scores = _choose_degree(model, dat, train, fold_t, ranges, max_degree)
+    bar.set_postfix_str("degree, screening and selection")
+    degree, degree_scores, decl, robust, selection, warns = _search(
+        model, dat, spl, ranges, y, degree, max_degree, degree is not None, families)
+    _explain(decl.unidentifiable, dat, model)
     bar.update()
-    bar.set_postfix_str("candidate effects")
-    ctx = _Context(model, dat, train, fold_t, ranges, y, families)
-    state = ctx.search(degree)
-    if state["selected"] and not fixed_degree:
-        # the degree was chosen with the effects unmodelled: choose it again with them
-        # (higher_order terms excluded: they stand for degree) and search again if it moved
-        keepers = [s_ for s_ in state["selected"] if s_["cand"].kind != "higher_order"]
-        extra = np.concatenate([s_["cols"].reshape(-1, s_["cols"].shape[-1])
-                                for s_ in keepers], axis=1) if keepers else None
-        degree2, scores2 = _choose_degree(model, dat, train, fold_t, ranges, max_degree, extra)
-        if degree2 != degree:
-            degree, degree_scores = degree2, scores2
-            state = ctx.search(degree)
-    bar.update()
-    design, keep, gauge = state["design"], state["keep"], state["gauge"]
-    labels = [lab for lab, k in zip(design.labels, keep) if k]
-    A_all, selected, candidates = state["A_all"], state["selected"], state["candidates"]
-    unident = state["unidentifiable"]
-    _explain(unident, dat, model)
-
-    # ---- augment: layout file, derivation, generated module ---------------------------
     bar.set_postfix_str("augment, derive, generate")
-    aug_text = gen_text = ""
-    aug_model = model
-    derived_check = None
-    if selected:
-        aug_text = augmented_layout_text(model, selected)
-        aug_layout = parse_layout(aug_text, f"{model.name}_aug.toml")
-        gen_text = derivation.generate_source(aug_layout)
-        aug_model = Model(aug_layout, derivation.module_from_source(gen_text, aug_layout.name))
+    aug = augment_step(model, dat, decl, selection, degree, ranges)
     bar.update()
-
-    # ---- before / after on held-out points -------------------------------------------
     bar.set_postfix_str("held-out before/after")
-    before_prob = Problem(design.A[:, :, keep].reshape(-1, keep.sum()), y)
-    c_b = before_prob.fit(train)
-    r_before = y[rows_of(test)] - before_prob.predict(c_b, test)
-    if selected:
-        ad = declared_design(aug_model, dat, degree, ranges)
-        n_new = len(aug_model.parameters) - len(model.parameters)
-        keep_aug = np.concatenate([keep, np.ones(n_new, bool)])
-        A_aug = ad.A[:, :, keep_aug].reshape(-1, keep_aug.sum())
-        # the derived model's effect columns against the numeric ones used in the search
-        numeric = A_all[:, keep.sum():]
-        derived = A_aug[:, keep.sum():]
-        derived_check = float(np.max(np.abs(numeric - derived)) /
-                              max(np.max(np.abs(numeric)), 1e-300))
-        aug_labels = [lab for lab, k in zip(ad.labels, keep_aug) if k]
-    else:
-        A_aug, aug_labels = before_prob.A * before_prob.scale, labels
-    after_prob = Problem(A_aug, y)
-    c_a = after_prob.fit(train)
-    r_after = y[rows_of(test)] - after_prob.predict(c_a, test)
+    out = outcome_step(decl, aug, spl, robust, y)
+    effects = effects_step(selection, aug, out, dat.n)
     bar.update()
-
-    # ---- final estimates on all points ------------------------------------------------
-    bar.set_postfix_str("estimates and residual analysis")
-    c_all = after_prob.fit()
-    res_after_all = y - after_prob.predict(c_all)
-    c_before = before_prob.fit()
-    res_before_all = y - before_prob.predict(c_before)
-    G = after_prob.A.T @ after_prob.A
-    wG = np.linalg.eigvalsh(G)
-    dof = max(len(y) - int(np.sum(wG > 1e-12 * wG[-1])), 1)
-    sigma2 = float(res_after_all @ res_after_all) / dof
-    cov_diag = np.diag(np.linalg.pinv(G, rcond=1e-12)) * sigma2 / after_prob.scale ** 2
-    effects = []
-    col_index = {lab[0]: j for j, lab in enumerate(aug_labels)}
-    for s in selected:
-        c = s["cand"]
-        pars, units, std = {}, {}, {}
-        contrib = np.zeros(len(y))
-        for pn in s["params"]:
-            term = next(t for t in c.terms if t[0] == pn)
-            f, u = _unit_of(c.kind, term[1], term[2])
-            j = col_index[pn]
-            pars[pn] = round(float(c_all[j]) * f, 6)
-            std[pn] = round(float(math.sqrt(max(cov_diag[j], 0.0))) * f, 6)
-            units[pn] = u
-            contrib += after_prob.A[:, j] * after_prob.scale[j] * c_all[j]
-        info = {k: (round(v, 6) if isinstance(v, float) else v) for k, v in c.info.items()}
-        if c.kind == "thermal" and len(c.terms) == 2:
-            k1, k0 = (float(c_all[col_index[t[0]]]) for t in c.terms)
-            if k1 != 0.0:   # expansion about A0: KT (A - A0) (T - 20), A0 = -KT0 / KT
-                info["fixed_point_mm"] = round(-k0 / k1, 3)
-        if c.kind == "periodic":
-            a_s, a_c = (pars[t[0]] for t in c.terms)
-            info["amplitude_um"] = round(math.hypot(a_s, a_c), 4)
-            info["phase_rad"] = round(math.atan2(a_c, a_s), 4)   # a sin(2 pi q / P + phase)
-        ev = dict(s["evidence"])
-        ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
-        ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)
-        effects.append({"kind": c.kind, "name": c.name, "parameters": pars, "units": units,
-                        "std": std, "target": sorted({t[1] for t in c.terms}), "info": info,
-                        "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}
-                                  for t in c.terms], "evidence": ev})
-    # points far off the final fit: chi-square(3) of |r|^2 / sigma^2 above 30 (p ~ 1e-6)
-    thresh = math.sqrt(30.0 * sigma2)
-    far = np.flatnonzero(point_norm(res_after_all) > thresh)
-    outliers = {"threshold_um": round(1e3 * thresh, 4), "count": int(len(far)),
-                "data_rows": [int(i) + 1 for i in far[:100]]}
-    variables = {**{a: dat.positions[a] for a in model.axes}, **dat.covariates}
-    analysis = {v: {"before_trend_um": _trend(res_before_all, x),
-                    "after_trend_um": _trend(res_after_all, x)}
-                for v, x in variables.items() if np.ptp(x) > 0}
-    bar.update()
-
-    paths = {}
-    if out_dir is not None and selected:
-        from volerr.fileio import write_text
-
-        out = Path(out_dir)
-        inputs = list(inputs) + ([str(data)] if isinstance(data, (str, Path)) else [])
-        paths["augmented_layout"] = str(write_text(out / f"{aug_model.name}.toml",
-                                                   aug_text, inputs=inputs))
-        paths["generated_module"] = str(write_text(out / f"{aug_model.name.lower()}.py",
-                                                   gen_text, inputs=inputs))
+    paths = _write_augmented(out_dir, aug, selection, inputs, data)
     bar.update()
     bar.close()
-    nb, na = point_norm(r_before), point_norm(r_after)
-    report = {
+    n_tr = float(robust.weights[spl.train].sum())
+    src_before = sel.sources(selection.first, n_tr, selection.accepted)
+    src_after = sel.sources(selection.last, n_tr)
+    report = _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection,
+                          aug, out, effects, warns + list(dat.warnings), paths, test_fraction)
+    report["residual_sources"] = src_before
+    report["residual_sources_after"] = src_after
+    report["residual_note"] = residual_note(dat, out, src_after, robust)
+    report["seconds"] = round(time.perf_counter() - t_start, 2)
+    figs = Figures(model, dat, ranges, degree, out.res_before, out.res_after, spl.test,
+                   out.r_before, out.r_after, selection.accepted, out.after_prob, out.c_all,
+                   aug.labels, out.c_before, decl.labels, out.cov_diag, robust.weights)
+    return Report(report, figs, aug.text, aug.source)
+
+
+def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
+    if out_dir is None or not selection.accepted:
+        return {}
+    from volerr.fileio import write_text
+
+    out = Path(out_dir)
+    inputs = list(inputs) + ([str(data)] if isinstance(data, (str, Path)) else [])
+    return {"augmented_layout": str(write_text(out / f"{aug.model.name}.toml", aug.text,
+                                               inputs=inputs)),
+            "generated_module": str(write_text(out / f"{aug.model.name.lower()}.py",
+                                               aug.source, inputs=inputs))}
+
+
+def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection, aug, out,
+                 effects, warnings, paths, test_fraction) -> dict:
+    nb, na = point_norm(out.r_before), point_norm(out.r_after)
+    inl = out.test_inliers
+    thresh = OUTLIER_Z * math.sqrt(out.sigma2)
+    far = np.union1d(np.flatnonzero(point_norm(out.res_after) > thresh), robust.outliers)
+    variables = {**{a: dat.positions[a] for a in model.axes}, **dat.covariates}
+    analysis = {v: {"before_trend_um": _trend(out.res_before, x),
+                    "after_trend_um": _trend(out.res_after, x)}
+                for v, x in variables.items() if np.ptp(x) > 0 and np.all(np.isfinite(x))}
+    rows_in = rows_of(np.flatnonzero(inl))
+    return {
         "layout": model.name,
-        "n_points": int(n),
-        "rms_before_um": round(1e3 * rms(r_before), 4),
-        "rms_after_um": round(1e3 * rms(r_after), 4),
+        "n_points": int(dat.n),
+        "rms_before_um": round(1e3 * rms(out.r_before), 4),
+        "rms_after_um": round(1e3 * rms(out.r_after), 4),
         "max_before_um": round(1e3 * float(nb.max()), 4),
         "max_after_um": round(1e3 * float(na.max()), 4),
         "effects": effects,
-        "unidentifiable": unident,
-        "weakly_determined": state["weak"],
-        "n_train": int(len(train)),
-        "n_test": int(len(test)),
+        "unidentifiable": decl.unidentifiable,
+        "residual_sources": [],
+        "residual_sources_after": [],
+        "warnings": warnings,
+        "inliers": {"n_test": int(inl.sum()),
+                    "rms_before_um": round(1e3 * rms(out.r_before[rows_in]), 4),
+                    "rms_after_um": round(1e3 * rms(out.r_after[rows_in]), 4)},
+        "weakly_determined": decl.weak,
+        "n_train": int(len(spl.train)),
+        "n_test": int(len(spl.test)),
         "degree": int(degree),
         "degree_cv_rms_um": {str(k): round(1e3 * v, 4) for k, v in degree_scores.items()},
-        "gauge_fixed": _gauge_text(gauge),
-        "noise_estimate_um": round(1e3 * math.sqrt(sigma2), 4),
-        "outliers": outliers,
-        "candidates_tested": len(candidates),
-        "candidate_families": sorted({c.kind for c in candidates}),
+        "gauge_fixed": _gauge_text(decl.gauge),
+        "noise_estimate_um": round(1e3 * math.sqrt(out.sigma2), 4),
+        "outliers": {"threshold_um": round(1e3 * thresh, 4), "count": int(len(far)),
+                     "data_rows": [int(i) + 1 for i in far[:100]],
+                     "method": f"IRLS, weight 1 up to {ROBUST_K:g} robust sigma, bisquare to 0 "
+                               f"at {2 * ROBUST_K:g}; flagged beyond {OUTLIER_Z:g} sigma"},
+        "candidates_tested": selection.n_candidates,
+        "candidate_families": sorted({s.cand.kind for s in selection.first}),
         "residual_analysis": analysis,
         "augmented_layout": paths.get("augmented_layout"),
         "generated_module": paths.get("generated_module"),
-        "augmented_parameters": [p for p in aug_model.parameters if p not in model.parameters],
-        "augmented_covariates": list(aug_model.covariates),
-        "derived_vs_numeric_max_rel_diff": derived_check,
-        "seconds": round(time.perf_counter() - t_start, 2),
+        "augmented_parameters": [p for p in aug.model.parameters if p not in model.parameters],
+        "augmented_covariates": list(aug.model.covariates),
+        "derived_vs_numeric_max_rel_diff": aug.derived_check,
+        "seconds": 0.0,
         "method": ("held-out: random {:.0%} of the points, never used for selection or "
                    "fitting; before = declared model, after = augmented model, both fitted "
                    "on the other points").format(test_fraction),
     }
-    figs = {"model": model, "data": dat, "res_before": res_before_all, "ranges": ranges,
-            "degree": degree, "cov_diag": cov_diag,
-            "res_after": res_after_all, "test": test, "r_before": r_before, "r_after": r_after,
-            "selected": selected, "after_prob": after_prob, "c_all": c_all,
-            "aug_labels": aug_labels, "c_before": c_before,
-            "before_labels": [lab for lab, k in zip(design.labels, keep) if k]}
-    return Report(report, figs, aug_text, gen_text)
 
 
 def _trend(res_rows, x) -> float:
@@ -797,7 +851,7 @@ def augmented_layout_text(model: Model, selected) -> str:
     require(k == 1, f"layout {model.name}: no top-level name line to rename")
     parts = [text.rstrip("\n"), ""]
     for s in selected:
-        c = s["cand"]
+        c = s.cand
         parts.append(f"[effects.{c.name}]")
         parts.append(f"kind = {_toml_value(c.kind)}")
         for key, v in c.info.items():

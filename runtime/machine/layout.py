@@ -368,6 +368,7 @@ def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str) 
 
     require(isinstance(raw, dict), f"{where}: [effects] must be tables [effects.NAME]")
     targets = {n for a in axes.values() for n in a.component_errors + a.location_errors}
+    targets |= set(squareness)     # a squareness that varies (with temperature ...)
     targets |= {f"{side}.{k}" for side in ("work", "tool") for k in TWIST_KEYS}
     builtin = {n for a in axes.values() for n in a.component_errors + a.location_errors}
     builtin |= set(squareness) | set(params) | set(axes) | {"Xp", "Yp", "Zp"}

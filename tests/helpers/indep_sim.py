@@ -57,18 +57,22 @@ class Machine:
         self.sq = rng.normal(0, sq_urad * 1e-6, 3)
         self.extra = {}   # name -> callable(pos, cov) -> dict of component additions
 
-    def axis_dir(self, a):
+    def axis_dir(self, a, dsq=None):
+        """direction of axis a, (3,) or (n, 3) when the squareness varies per point (dsq)"""
+        sq = self.sq if dsq is None else self.sq[None, :] + dsq
+        one = np.ones_like(sq[..., 0])
         if a == "Y":
-            return np.array([-self.sq[0], 1, 0])
+            return np.stack([-sq[..., 0], one, 0 * one], -1)
         if a == "Z":
-            return np.array([self.sq[1], -self.sq[2], 1])
-        return U[a]
+            return np.stack([sq[..., 1], -sq[..., 2], one], -1)
+        return U[a] if dsq is None else np.broadcast_to(U[a], sq.shape)
 
     def stage(self, a, q, add):
         """(R, t) of one axis at positions q: nominal translation (with squareness) and errors."""
         e = {c: self.fn[c + a](q) + add.get(c + a, 0.0) for c in COMP}
         R = rot(e["EA"], e["EB"], e["EC"])
-        t = q[:, None] * self.axis_dir(a)[None, :] + np.stack([e["EX"], e["EY"], e["EZ"]], -1)
+        d = self.axis_dir(a, add.get("dsq"))
+        t = q[:, None] * (d if d.ndim == 2 else d[None, :]) + np.stack([e["EX"], e["EY"], e["EZ"]], -1)
         return R, t
 
     def tip(self, pos, probe, add, sign_work=-1):
@@ -108,9 +112,12 @@ PROBES5 = [(0, 0, -120), (90, 0, -120), (-90, 0, -120), (0, 90, -120), (0, -90, 
 
 
 def campaign(layout="MB1", n=1000, seed=0, effects=(), noise_um=0.5, probes=PROBES5, grid=None,
-             rounds=3, mseed=None):
-    """Return dict of columns (CSV names) and truth."""
-    m = Machine(layout, seed if mseed is None else mseed)
+             rounds=3, mseed=None, channels=False, truth=None, trans_um=5.0):
+    """Return dict of columns (CSV names); ``truth`` (a dict) receives the noise (n, 3) mm.
+
+    ``channels``: also two temperature channels ``T_top``, ``T_bottom`` (a vertical gradient
+    that changes over the day, not a function of T_C)."""
+    m = Machine(layout, seed if mseed is None else mseed, trans_um=trans_um)
     rng = np.random.default_rng(seed)
     pos, pr = plan(rng, m.travel, n, probes, grid)
     order = np.argsort(rng.uniform(size=n))  # measurement order
@@ -120,6 +127,11 @@ def campaign(layout="MB1", n=1000, seed=0, effects=(), noise_um=0.5, probes=PROB
     rnd = np.empty(n); rnd[order] = np.repeat(np.arange(1, rounds + 1), int(np.ceil(n / rounds)))[:n]
     nvec = rng.normal(size=(n, 3)); nvec /= np.linalg.norm(nvec, axis=1)[:, None]
     cov = {"T_C": T, "t_s": t_s, **dirs, "round": rnd, "nx": nvec[:, 0], "ny": nvec[:, 1], "nz": nvec[:, 2]}
+    if channels:   # own stream: the other columns stay as without channels
+        rc = np.random.default_rng(7000 + seed)
+        grad = 0.8 * np.sin(2 * np.pi * t_s / (2.3 * 3600) + 1.9) + 0.3 * (t_s / 14400)
+        cov["T_top"] = T + 0.5 * grad + rc.normal(0, .03, n)
+        cov["T_bottom"] = T - 0.5 * grad + rc.normal(0, .03, n)
     add = {}
     extra_dev = np.zeros((n, 3))
     inst_t = np.tile(rng.normal(0, 5e-3, 3), (n, 1))
@@ -162,13 +174,28 @@ def campaign(layout="MB1", n=1000, seed=0, effects=(), noise_um=0.5, probes=PROB
             c = e.get("component", "EYZ"); a = c[2]
             u = (pos[a] - mid[a]) / half[a]
             add[c] = add.get(c, 0) + e.get("um", 3.0) * 1e-3 * np.cos(7 * np.pi * u)
+        elif k == "gradient":   # an angular error grows with the vertical temperature gradient
+            c = e.get("component", "EBX")
+            add[c] = add.get(c, 0) + e.get("urad_per_K", 12.0) * 1e-6 * (cov["T_top"] - cov["T_bottom"])
+        elif k == "squareness_T":   # squareness i (0: Y about z) changes with temperature
+            dsq = np.zeros((n, 3)); dsq[:, e.get("index", 0)] = e.get("urad_per_K", -8.0) * 1e-6 * (T - 20.0)
+            add["dsq"] = dsq
+        elif k == "warmup":   # the instrument drifts and settles: um (1 - exp(-t / tau))
+            v = np.zeros(3); v["xyz".index(e.get("dir", "x"))] = e.get("um", 4.0) * 1e-3
+            extra_dev += (1 - np.exp(-t_s / 3600 / e.get("tau_h", 1.5)))[:, None] * v
+        elif k == "scale_step":   # a joint of the scale: the positioning error jumps at x0
+            a = e.get("axis", "X"); c = {"X": "EXX", "Y": "EYY", "Z": "EZZ"}[a]
+            add[c] = add.get(c, 0) + e.get("um", 3.0) * 1e-3 * (pos[a] > e.get("at", mid[a] + 0.23 * half[a]))
         else:
             raise ValueError(k)
     act = m.tip(pos, probe_eff, add)
     nom = np.column_stack([pos[a] for a in "XYZ"]) + pr
     Ri = rot(inst_r[:, 0], inst_r[:, 1], inst_r[:, 2])
     meas = np.einsum("nij,nj->ni", Ri, act) + inst_t
-    dev = meas - nom + extra_dev + rng.normal(0, noise_um * 1e-3, (n, 3))
+    noise = rng.normal(0, noise_um * 1e-3, (n, 3))
+    dev = meas - nom + extra_dev + noise
+    if truth is not None:
+        truth["noise"] = noise
     cols = {**pos, "Xp": pr[:, 0], "Yp": pr[:, 1], "Zp": pr[:, 2],
             "dx_um": dev[:, 0] * 1e3, "dy_um": dev[:, 1] * 1e3, "dz_um": dev[:, 2] * 1e3, **cov}
     return cols

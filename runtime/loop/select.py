@@ -1,0 +1,472 @@
+"""Screening and selection of candidate effects (steps 4-5 of :func:`volerr.loop.run.run_loop`).
+
+Screen: every candidate (P x C x basis, :mod:`volerr.loop.candidates`) is scored against the
+current residual by the exact RSS reduction of adding its columns to the current design (a
+score test through the Gram matrix: no refit), converted to a BIC change; searched basis
+parameters (warm-up tau, step location, period) are profiled on their grid, refined, and cost
+one extra parameter.  Select: the best three by BIC are fitted fully; the first with dBIC <
+-``BIC_GAIN`` and a significantly smaller cross-validated residual (paired t > ``CV_T`` on the
+per-point squared errors) is accepted; repeat.  After acceptance every effect is re-tested
+given the others (backward check) and dropped when it no longer earns its place.
+
+Rows are weighted (robust weights of the points, :func:`robust_weights`): gross outliers do
+not drive the choice.  Units: mm rows; BIC in natural-log units.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volerr.loop import candidates as cands
+from volerr.loop.fit import Problem, point_norm, rows_of, twist_columns
+from volerr.machine.expressions import evaluate
+
+BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
+CV_T = 3.0           # minimum paired t of the held-out improvement
+MAX_EFFECTS = 8
+TOP_FIT = 3          # candidates fitted fully per forward step
+SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
+N_SOURCES = 10       # residual sources reported
+
+
+def _pinv_sym(G, tol=1e-12):
+    """Pseudo-inverse of a symmetric PSD matrix by eigh (small matrices only)."""
+    w, V = np.linalg.eigh(G)
+    ok = w > tol * max(float(w[-1]), 1e-300)
+    return (V[:, ok] / w[ok]) @ V[:, ok].T
+
+
+class Base:
+    """The current design on the (weighted) training rows, column-scaled, with its Gram
+    pseudo-inverse; :meth:`score` is the RSS reduction of adding columns."""
+
+    def __init__(self, A, y):
+        self.scale = np.sqrt(np.mean(A ** 2, axis=0))
+        self.scale[self.scale == 0] = 1.0
+        self.A = A / self.scale
+        self.Gi = _pinv_sym(self.A.T @ self.A)
+        self.r = y - self.A @ (self.Gi @ (self.A.T @ y))
+        self.rss = float(self.r @ self.r)
+        self.n = len(y)
+
+    def score(self, B) -> tuple[float, int]:
+        """(RSS reduction, effective rank) of adding the columns B (rows, m)."""
+        sc = np.sqrt(np.mean(B ** 2, axis=0))
+        sc[sc == 0] = 1.0
+        Bs = B / sc
+        C = self.A.T @ Bs
+        M = Bs.T @ Bs - C.T @ self.Gi @ C
+        w, V = np.linalg.eigh((M + M.T) / 2)
+        ok = w > 1e-9 * len(Bs)          # columns (unit RMS) not inside the base span
+        if not ok.any():
+            return 0.0, 0
+        g = V[:, ok].T @ (Bs.T @ self.r)
+        return float(np.sum(g * g / w[ok])), int(ok.sum())
+
+    def score_single(self, B) -> np.ndarray:
+        """RSS reduction of each single column of B (rows, G) added alone (profiles)."""
+        sc = np.sqrt(np.mean(B ** 2, axis=0))
+        sc[sc == 0] = 1.0
+        Bs = B / sc
+        C = self.A.T @ Bs
+        m = np.einsum("ij,ij->j", Bs, Bs) - np.einsum("ij,ij->j", C, self.Gi @ C)
+        g = Bs.T @ self.r
+        ok = m > 1e-9 * len(Bs)
+        return np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
+
+    def dbic(self, gain: float, m_eff: int) -> float:
+        new = max(self.rss - gain, 1e-300)
+        return self.n * math.log(new / self.rss) + m_eff * math.log(self.n)
+
+
+@dataclass
+class Context:
+    """What the columns of a candidate need: model, data, sensitivities, frame, and the
+    points (``pts``, with their sqrt robust weights ``sw``) on which they are scored."""
+
+    model: object
+    data: object
+    sens: np.ndarray
+    frame: tuple
+    pts: np.ndarray
+    sw: np.ndarray
+    ranges: dict
+    cache: dict = field(default_factory=dict)
+
+    def on(self, pts, sw) -> "Context":
+        """The same context on other points (shares nothing that depends on the points)."""
+        return Context(self.model, self.data, self.sens, self.frame, pts, sw, self.ranges,
+                       {"fixed": self.cache.setdefault("fixed", {})})
+
+    def values(self, full: bool = False):
+        from volerr.loop.fit import rotary_rad
+
+        key = ("_values", full)
+        if key not in self.cache:
+            idx = slice(None) if full else self.pts
+            vals = {**rotary_rad(self.model, self.data.positions), **self.data.covariates}
+            self.cache[key] = {k: np.asarray(v)[idx] for k, v in vals.items()}
+        return self.cache[key]
+
+    def target_column(self, target: str, full: bool = False) -> np.ndarray:
+        """(n, 3) sensitivity of a chain target (a parameter, ``work.*`` or ``tool.*``) at the
+        context's points (all points when ``full``)."""
+        key = ("target", target, full)
+        if key not in self.cache:
+            if "." in target:
+                side, k = target.split(".")
+                col = twist_columns(side, k, self.data, self.frame)
+            else:
+                col = self.sens[:, :, self.model.parameters.index(target)]
+            self.cache[key] = col if full else col[self.pts]
+        return self.cache[key]
+
+    def columns(self, terms, full: bool = False) -> tuple[np.ndarray, list]:
+        """(n, 3, m) columns of the parameters of ``terms`` [(parameter, target, basis)] at
+        the context's points (all points when ``full``: not cached, memory stays bounded)."""
+        key = ("cols", tuple(terms))
+        if not full and key in self.cache:
+            return self.cache[key]
+        params = list(dict.fromkeys(t[0] for t in terms))
+        vals = self.values(full)
+        n = self.data.n if full else len(self.pts)
+        out = np.zeros((n, 3, len(params)))
+        for pn, target, basis in terms:
+            b = np.broadcast_to(evaluate(basis, vals), (n,))
+            out[:, :, params.index(pn)] += self.target_column(target, full) * b[:, None]
+        if not full and len(self.pts) * len(params) <= 20000 * 3:
+            self.cache[key] = (out, params)
+        return out, params
+
+    def rows(self, cols) -> np.ndarray:
+        """Weighted rows (3n, m) of columns (n, 3, m) at the context's points."""
+        return (cols * self.sw[:, None, None]).reshape(-1, cols.shape[-1])
+
+    def profile_rows(self, c, values) -> np.ndarray:
+        """Weighted rows (3n, G) of a one-term searched candidate at ``values``."""
+        key = ("profile", c.name, tuple(values))
+        if key not in self.cache:
+            (_, target, _), = c.search.make(values[0])[0]
+            basis = np.column_stack([np.broadcast_to(evaluate(c.search.make(v)[0][0][2],
+                                                              self.values()), (len(self.pts),))
+                                     for v in values])
+            t = self.target_column(target) * self.sw[:, None]          # (n, 3)
+            self.cache[key] = (t[:, :, None] * basis[:, None, :]).reshape(-1, len(values))
+        return self.cache[key]
+
+
+@dataclass
+class Scored:
+    """A screened candidate: BIC change, RSS reduction, rank, its (fixed) candidate."""
+
+    dbic: float
+    gain: float
+    rank: int
+    cand: cands.Candidate
+    params: list
+
+
+def _profile(c: cands.Candidate, ctx: Context, base: Base) -> cands.Candidate:
+    """Fix the searched basis parameter of ``c`` at its best value (grid, then refined)."""
+    if c.search.what == "period":
+        return c.fixed(_periodic_best(c, ctx, base))
+    grid = list(c.search.grid)
+
+    def best_of(values):
+        g = base.score_single(ctx.profile_rows(c, values))
+        return values[int(np.argmax(g))]
+
+    v0 = best_of(grid)
+    i = grid.index(v0)
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    if c.search.what == "location_mm":
+        q = np.unique(ctx.data.positions[c.info["axis"]])
+        mids = (q[1:] + q[:-1]) / 2
+        fine = mids[(mids > lo) & (mids < hi)]
+        if len(fine) > 40:
+            fine = fine[np.linspace(0, len(fine) - 1, 40).astype(int)]
+    else:
+        fine = np.geomspace(max(lo, 1e-3), hi, 15)
+    if len(fine):
+        v0 = best_of([v0] + [float(x) for x in fine])
+    return c.fixed(v0)
+
+
+def _periodic_best(c, ctx: Context, base: Base) -> float:
+    """Best period of a periodic candidate by the residual periodogram, refined."""
+    comp, axis, periods = c.info["component"], c.info["axis"], np.asarray(c.search.grid)
+    s = ctx.target_column(comp) * ctx.sw[:, None]
+    r = base.r.reshape(-1, 3)
+    w = np.sum(r * s, axis=1)
+    s2 = np.sum(s * s, axis=1)
+    q = ctx.data.positions[axis][ctx.pts]
+
+    def gain(per):
+        ph = 2 * np.pi * np.outer(q, 1.0 / np.atleast_1d(per))
+        sn, cs = np.sin(ph), np.cos(ph)
+        a, b = w @ sn, w @ cs
+        ss, cc, sc = s2 @ (sn * sn), s2 @ (cs * cs), s2 @ (sn * cs)
+        det = np.maximum(ss * cc - sc * sc, 1e-300)
+        return (a * a * cc - 2 * a * b * sc + b * b * ss) / det
+
+    g = np.concatenate([gain(periods[i:i + 64]) for i in range(0, len(periods), 64)])
+    i = int(np.argmax(g))
+    f0 = 1.0 / periods[i]
+    df = (1.0 / periods[min(i + 1, len(periods) - 1)] - 1.0 / periods[max(i - 1, 0)]) / 2 \
+        or f0 * 1e-3
+    fine = 1.0 / np.linspace(max(f0 - df, 1e-12), f0 + df, 41)
+    return float(fine[int(np.argmax(gain(fine)))])
+
+
+def _scored(c, ctx: Context, base: Base) -> "Scored":
+    cols, params = ctx.columns(c.terms)
+    gain, rank = base.score(ctx.rows(cols))
+    m_eff = rank + (1 if c.search is not None else 0)
+    return Scored(base.dbic(gain, m_eff), gain, rank, c, params)
+
+
+def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
+    """Score every candidate against the residual of ``base``; sorted by BIC change."""
+    out = []
+    fixed = ctx.cache.setdefault("fixed", {})
+    for c in candidates:
+        if c.name in skip:
+            continue
+        if c.search is not None:
+            # profiled once; later screenings reuse the value and re-profile the leaders
+            c = fixed[c.name] if c.name in fixed else _profile(c, ctx, base)
+            fixed[c.name] = c
+        sc = _scored(c, ctx, base)
+        if sc.rank:
+            out.append(sc)
+    out.sort(key=lambda x: x.dbic)
+    for i, sc in enumerate(out[:2 * TOP_FIT]):
+        if sc.cand.search is not None:
+            c = _profile(sc.cand, ctx, base)
+            fixed[c.name] = c
+            out[i] = _scored(c, ctx, base)
+    out = [x for x in out if x.rank]
+    out.sort(key=lambda x: x.dbic)
+    _prefer_first_of_ties(out, candidates)
+    return out
+
+
+def rescore(scored: list, ctx: Context, base: Base, candidates, top: int) -> list:
+    """The ``top`` leaders of a screening (on a subset of points) scored exactly on all
+    training points, then the rest as they were."""
+    head = [_scored(x.cand, ctx, base) for x in scored[:top]]
+    head = [x for x in head if x.rank]
+    head.sort(key=lambda x: x.dbic)
+    _prefer_first_of_ties(head, candidates)
+    return head + scored[top:]
+
+
+def _prefer_first_of_ties(scored: list, candidates: list) -> None:
+    """Among candidates that fit the data identically (e.g. on a CMM ``EZX`` depending on ``Y``
+    and ``EZY`` depending on ``X``), put the one listed first by
+    :func:`volerr.loop.candidates.build` in front: the choice does not depend on rounding."""
+    if len(scored) < 2:
+        return
+    order = {c.name: i for i, c in enumerate(candidates)}
+    d0 = scored[0].dbic
+    ties = [i for i, s in enumerate(scored) if abs(s.dbic - d0) <= 1e-7 * abs(d0) + 1e-9]
+    first = min(ties, key=lambda i: order.get(scored[i].cand.name, len(order)))
+    scored.insert(0, scored.pop(first))
+
+
+def sources(scored: list, n_points: int, accepted=()) -> list:
+    """The ranked residual sources: best basis per (parameter, covariate), top ``N_SOURCES``."""
+    seen, out = set(), []
+    acc = {(a.cand.info.get("parameter"), a.cand.info.get("covariate")) for a in accepted}
+    for s in scored:
+        key = (s.cand.info.get("parameter"), s.cand.info.get("covariate"))
+        if key in seen:
+            continue
+        seen.add(key)
+        out.append({"parameter": key[0], "covariate": key[1],
+                    "basis": s.cand.info.get("basis"), "kind": s.cand.kind,
+                    "name": s.cand.name,
+                    "explained_um": round(1e3 * math.sqrt(max(s.gain, 0.0) / n_points), 4),
+                    "delta_bic": round(s.dbic, 2), "accepted": key in acc})
+        if len(out) >= N_SOURCES:
+            break
+    return out
+
+
+@dataclass
+class Accepted:
+    """An accepted effect: its candidate, parameters, columns (N, 3, m) and evidence."""
+
+    cand: cands.Candidate
+    params: list
+    cols: np.ndarray
+    evidence: dict
+
+
+@dataclass
+class Selection:
+    """Result of :func:`select`: accepted effects, the final design, the screenings."""
+
+    accepted: list
+    A: np.ndarray               # (3N, k + m) declared + effect columns
+    first: list                 # screening on the declared model's residual
+    last: list                  # screening on the final residual
+    n_candidates: int
+
+
+def _cv_sq(A, y, folds, train, w_rows) -> np.ndarray:
+    """Per-point squared cross-validated residual (weighted rows)."""
+    rows = rows_of(train)
+    prob = Problem(A[rows] * w_rows[rows, None], y[rows] * w_rows[rows])
+    pts = np.arange(len(train))
+    r = prob.loo_residuals(pts) if folds is None else prob.cv_residuals(folds, pts)
+    return point_norm(r) ** 2
+
+
+def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -> Selection:
+    """Forward selection with held-out evidence, then the backward check.  ``ctx`` is on the
+    training points; screening uses at most ``screen_points`` of them (a random subset), the
+    leaders are then scored exactly on all training points."""
+    train = ctx.pts
+    ctx_s = ctx
+    if len(train) > screen_points:
+        sub = np.sort(np.random.default_rng(1).choice(len(train), screen_points, replace=False))
+        ctx_s = ctx.on(train[sub], ctx.sw[sub])
+    tr, tr_s = rows_of(train), rows_of(ctx_s.pts)
+    ytr, ytr_s = y[tr] * w_rows[tr], y[tr_s] * w_rows[tr_s]
+    A_all = A0
+    cv_old = _cv_sq(A_all, y, folds, train, w_rows)
+    accepted, rejected, first, last = [], set(), None, []
+    while True:
+        base = Base(A_all[tr] * w_rows[tr, None], ytr)
+        scored = screen(candidates, ctx_s, Base(A_all[tr_s] * w_rows[tr_s, None], ytr_s)
+                        if ctx_s is not ctx else base,
+                        rejected | {a.cand.name for a in accepted})
+        if ctx_s is not ctx:
+            scored = rescore(scored, ctx, base, candidates, 2 * N_SOURCES)
+        last = scored
+        if first is None:
+            first = scored
+        if len(accepted) >= MAX_EFFECTS:
+            break
+        hit = None
+        for x in scored[:TOP_FIT]:
+            if x.dbic > -BIC_GAIN:
+                break
+            cols, _ = ctx.columns(x.cand.terms, full=True)
+            A_try = np.concatenate([A_all, cols.reshape(-1, cols.shape[-1])], axis=1)
+            cv_new = _cv_sq(A_try, y, folds, train, w_rows)
+            d = cv_old - cv_new
+            t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
+            if t < CV_T:
+                rejected.add(x.cand.name)
+                continue
+            alts = [o.cand.name for o in scored[:2 * N_SOURCES] if o.cand.name != x.cand.name
+                    and o.gain >= 0.98 * x.gain]
+            hit = Accepted(x.cand, x.params, cols, {
+                "delta_bic": round(x.dbic, 2),
+                "rss_reduction_fraction": round(x.gain / base.rss, 5),
+                "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
+                "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
+                "cv_paired_t": round(t, 2), "step": len(accepted) + 1,
+                "indistinguishable_from": alts[:5]})
+            A_all, cv_old = A_try, cv_new
+            break
+        if hit is None:
+            break
+        accepted.append(hit)
+    if accepted:
+        accepted = _backward(A0, accepted, tr, w_rows, ytr)
+        accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, tr, w_rows, ytr)
+        A_all = _stack(A0, accepted)
+        base = Base(A_all[tr] * w_rows[tr, None], ytr)
+        names = {a.cand.name for a in accepted}
+        if ctx_s is not ctx:
+            last = rescore(screen(candidates, ctx_s, Base(A_all[tr_s] * w_rows[tr_s, None],
+                                                          ytr_s), names),
+                           ctx, base, candidates, 2 * N_SOURCES)
+        else:
+            last = screen(candidates, ctx, base, names)
+    _same_cause(accepted)
+    return Selection(accepted, A_all, first or [], last, len(candidates))
+
+
+def _stack(A0, sel):
+    return np.concatenate([A0] + [s.cols.reshape(-1, s.cols.shape[-1]) for s in sel], axis=1)
+
+
+def _backward(A0, selected, tr, w_rows, ytr) -> list:
+    """Drop an effect that, given all the others, no longer gains dBIC < -BIC_GAIN (a later
+    effect made it redundant); each kept effect gets ``delta_bic_given_others``."""
+    def dbic_without(sel, i):
+        base = Base(_stack(A0, sel[:i] + sel[i + 1:])[tr] * w_rows[tr, None], ytr)
+        B = sel[i].cols.reshape(-1, sel[i].cols.shape[-1])[tr] * w_rows[tr, None]
+        gain, rank = base.score(B)
+        return base.dbic(gain, rank + (1 if sel[i].cand.search is not None else 0))
+
+    sel = list(selected)
+    while sel:
+        scores = [dbic_without(sel, i) for i in range(len(sel))]
+        worst = int(np.argmax(scores))
+        if scores[worst] <= -BIC_GAIN or len(sel) == 1:
+            for s_, d in zip(sel, scores):
+                s_.evidence["delta_bic_given_others"] = round(d, 2)
+            break
+        sel.pop(worst)
+    for k, s_ in enumerate(sel):
+        s_.evidence["step"] = k + 1
+    return sel
+
+
+def _merge(A0, accepted, pool, ctx: Context, tr, w_rows, ytr) -> list:
+    """Parsimony across overlapping candidates: two accepted effects are replaced by ONE
+    candidate of the first screening when it explains the data at least as well by BIC (e.g.
+    a yaw of Y, taken first as squareness and then as a yaw of X).  Repeated while it helps."""
+    sel = list(accepted)
+    changed = True
+    while changed and len(sel) >= 2:
+        changed = False
+        best = (0.0, None)
+        for i in range(len(sel)):
+            for j in range(i + 1, len(sel)):
+                others = [s_ for k, s_ in enumerate(sel) if k not in (i, j)]
+                base = Base(_stack(A0, others)[tr] * w_rows[tr, None], ytr)
+                pair = np.concatenate([sel[i].cols, sel[j].cols], axis=2)
+                B = pair.reshape(-1, pair.shape[-1])[tr] * w_rows[tr, None]
+                g_ij, r_ij = base.score(B)
+                m_ij = r_ij + sum(1 for s_ in (sel[i], sel[j]) if s_.cand.search is not None)
+                for x in pool:
+                    if x.cand.name in (sel[i].cand.name, sel[j].cand.name):
+                        continue
+                    cols, _ = ctx.columns(x.cand.terms, full=True)
+                    g_c, r_c = base.score(cols.reshape(-1, cols.shape[-1])[tr] *
+                                          w_rows[tr, None])
+                    m_c = r_c + (1 if x.cand.search is not None else 0)
+                    d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
+                    if r_c and d < best[0]:
+                        best = (d, (i, j, x, cols))
+        if best[1] is not None:
+            i, j, x, cols = best[1]
+            ev = dict(sel[i].evidence)
+            ev["replaces"] = [sel[i].cand.name, sel[j].cand.name]
+            ev["delta_bic_vs_replaced"] = round(best[0], 2)
+            merged = Accepted(x.cand, x.params, cols, ev)
+            sel = [s_ for k, s_ in enumerate(sel) if k not in (i, j)] + [merged]
+            changed = True
+    for k, s_ in enumerate(sel):
+        s_.evidence["step"] = k + 1
+    return sel
+
+
+def _same_cause(accepted) -> None:
+    """Mark accepted effects that modulate the same parameter by the same covariate (e.g. a
+    linear and a saturating drift of the set-up): one cause, two bases."""
+    for a in accepted:
+        key = (a.cand.info.get("parameter"), a.cand.info.get("covariate"))
+        same = [b.cand.name for b in accepted if b is not a and
+                (b.cand.info.get("parameter"), b.cand.info.get("covariate")) == key]
+        if same:
+            a.evidence["same_cause_as"] = same
