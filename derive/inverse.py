@@ -94,16 +94,34 @@ def rotary_inverse(chain: Chain) -> dict:
     return {n1: q1, n2: q2}
 
 
+def _reduce_sin_cos(expr, angles) -> sp.Expr:
+    """``expr`` (polynomial in sin and cos of ``angles``) expanded and reduced modulo
+    ``sin^2 + cos^2 = 1`` of every angle: the remainder of the division by
+    ``cos^2 + sin^2 - 1`` in each cosine, a canonical form (at most linear in each cosine).
+    Polynomial arithmetic only: much cheaper than ``trigsimp`` on the same expression."""
+    pairs = [(sp.Dummy(f"s{i}"), sp.Dummy(f"c{i}")) for i in range(len(angles))]
+    fwd = {}
+    for q, (s_, c_) in zip(angles, pairs):
+        fwd[sp.sin(q)], fwd[sp.cos(q)] = s_, c_
+    e = sp.expand(sp.expand(expr).xreplace(fwd))
+    for s_, c_ in pairs:
+        if e.has(c_):
+            e = sp.expand(sp.rem(e, c_ ** 2 + s_ ** 2 - 1, c_))
+    return sp.expand(e.xreplace({v: k for k, v in fwd.items()}))
+
+
 def linear_inverse(chain: Chain) -> dict:
     """Linear axis -> expression in the rotary positions, the tip (x, y, z) and the tool offset."""
     lin = [position_symbol(a) for a in ("X", "Y", "Z")]
+    layout = chain.layout
+    angles = [position_symbol(a) for a in layout.axis_names if layout.axes[a].kind == "rotary"]
     p = nominal_point(chain)
     m = p.jacobian(sp.Matrix(lin))
     t = p.subs({s: 0 for s in lin})
-    mtm = sp.simplify(m.T * m)
+    mtm = (m.T * m).applyfunc(lambda e: _reduce_sin_cos(e, angles))
     minv = m.T if mtm == sp.eye(3) else sp.simplify(m.inv())
     sol = minv * (sp.Matrix(TIP) - t)
-    return {a: sp.expand(sp.trigsimp(sp.expand(sol[i]))) for i, a in enumerate(("X", "Y", "Z"))}
+    return {a: _reduce_sin_cos(sol[i], angles) for i, a in enumerate(("X", "Y", "Z"))}
 
 
 def inverse_functions(layout: Layout) -> list[Function]:

@@ -65,7 +65,21 @@ def exact_error(chain: Chain) -> sp.Matrix:
 def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
     """3 x n_parameters matrix d(dX, dY, dZ)/d(parameter) (unitless or mm/rad)."""
     error = volumetric_error(chain) if error is None else error
-    return error.jacobian(sp.Matrix(chain.parameters))
+    params = list(chain.parameters)
+    index = {q: j for j, q in enumerate(params)}
+    out = sp.zeros(3, len(params))
+    for i in range(3):
+        # the first-order error is linear in the parameters: each expanded term holds exactly
+        # one parameter to the first power, its coefficient is the derivative (as diff gives)
+        coeffs = [[] for _ in params]
+        for term in sp.Add.make_args(sp.expand(error[i])):
+            found = [q for q in term.free_symbols if q in index]
+            if len(found) != 1 or sp.degree(term, found[0]) != 1:
+                return error.jacobian(sp.Matrix(params))   # not linear term by term: general
+            coeffs[index[found[0]]].append(term.xreplace({found[0]: sp.Integer(1)}))
+        for j, c in enumerate(coeffs):
+            out[i, j] = sp.Add(*c)
+    return out
 
 
 def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       cb3eaaef6ea43479f494f78b20313cf9234c86c1a4672bb40b6ddf3f14ec9daf
-derivation sha256  723ec86c9eb6776ea096e1f88b32a6f6c8d0e785feff5e4ab215b95024a508f5
+derivation sha256  c27af211de914ebf935e9f6eeb20bb1c0aa821fc593f7f2707ffe637dcc6ee50
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

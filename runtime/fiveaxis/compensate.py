@@ -63,7 +63,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.errors import InputError, require
-from volerr.fiveaxis.kinematics import linear_axes, linear_jacobian
+from volerr.fiveaxis.kinematics import linear_axes, linear_jacobian, rotary_jacobian
+from volerr.machine import iso_names
 
 STRATEGIES = ("full", "thesis")
 
@@ -83,20 +84,24 @@ def parameter_types(model) -> dict:
     x, y, z each mix positioning and tilt: they belong to both R-POS and R-ANG."""
     out = {}
     paxis = model.parameter_axis
+    lin = linear_axes(model)
     for p in model.parameters:
-        a = paxis[p]
-        if a is None:
-            out[p] = ("L-SQU",) if p[-1] in linear_axes(model) else ("R-POR",)
+        a, iso = paxis[p], iso_names.parse(p)
+        if iso.kind == "effect":
+            out[p] = ()            # effect parameters of augmented layouts: no ISO/TR 16907 type
+        elif a is None:
+            out[p] = ("L-SQU",) if iso.axis in lin else ("R-POR",)
         elif a not in model.rotary_axes:
-            out[p] = ("L-POS",) if p[1] == a else ("L-STR",) if p[1] in "XYZ" else ("L-ANG",)
-        elif p[1] in "XYZ":
+            out[p] = ("L-POS",) if iso.direction == a else \
+                ("L-STR",) if iso.is_length else ("L-ANG",)
+        elif iso.is_length:
             out[p] = ("R-RAX",)
         else:
             u = np.abs(np.asarray(model.layout.axes[a].direction, dtype=float))
             aligned = abs(u.max() - 1.0) < 1e-12
             own = "ABC"[int(np.argmax(u))] if aligned else None
             out[p] = ("R-POS", "R-ANG") if own is None else \
-                ("R-POS",) if p[1] == own else ("R-ANG",)
+                ("R-POS",) if iso.direction == own else ("R-ANG",)
     return out
 
 
@@ -289,19 +294,6 @@ class ErrorModel:
         return self.model.forward(q, self.tool)[:, 3:6]
 
 
-def _rotary_jacobian(em: ErrorModel, q: np.ndarray) -> np.ndarray:
-    """d(tool axis)/d(rotary axes) per rad, (N, 3, n_rot), central differences."""
-    cols = []
-    h = 1e-5  # deg
-    for a in em.rot:
-        i = em.model.axes.index(a)
-        qp, qm = q.copy(), q.copy()
-        qp[:, i] += h
-        qm[:, i] -= h
-        cols.append((em.tool_axis(qp) - em.tool_axis(qm)) / (2 * math.radians(h)))
-    return np.stack(cols, axis=2)
-
-
 #: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
 #: uncorrected: near a singular orientation (within about 3 deg of it on the DMU 50) the
 #: correction would need large rotary motions for a few urad
@@ -342,7 +334,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
         change = np.zeros(len(qa))
         if orientation and em.rot:
             k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated)
-            j = _rotary_jacobian(em, qa)
+            j = rotary_jacobian(m, qa)
             d, dropped = _truncated_solve(j, -(k_act - target_k[active]))
             partial[np.flatnonzero(active)] = dropped
             trial = qa.copy()
@@ -378,10 +370,11 @@ def solve_thesis(em: ErrorModel, q_nom: np.ndarray) -> np.ndarray:
     q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
     lin_idx = [m.axes.index(a) for a in em.lin]
     paxis = m.parameter_axis
+    iso = {p: iso_names.parse(p) for p in m.parameters}
     rotary_params = {p for p in m.parameters
-                     if paxis[p] in em.rot or (paxis[p] is None and p[-1] in em.rot
-                                               and p[2] == "0")}
-    linear_params = {p for p in m.parameters if paxis[p] in em.lin and p[1] in "XYZ"}
+                     if paxis[p] in em.rot or (paxis[p] is None and iso[p].kind == "location"
+                                               and iso[p].axis in em.rot)}
+    linear_params = {p for p in m.parameters if paxis[p] in em.lin and iso[p].is_length}
     linear_params |= {p for p in m.parameters if paxis[p] is None and p not in rotary_params}
     q1 = q_nom.copy()
     mj = linear_jacobian(m, q_nom, em.tool)

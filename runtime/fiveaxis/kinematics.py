@@ -101,29 +101,39 @@ def inverse(model, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
     return out
 
 
+def nominal_jacobian(model, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Exact derivatives of the nominal tool tip (rows 0-2) and tool axis (rows 3-5) with
+    respect to the axis positions (columns in ``model.axes`` order), (N, 6, n_axes): mm/mm and
+    mm/rad for the tip, 0 and 1/rad for the axis.  ``positions`` (N, n_axes) mm / deg; from the
+    generated ``nominal_jacobian`` (derived by :func:`volerr.derive.volumetric.nominal_jacobian`).
+    """
+    pos, n = model._points(positions)
+    j = model.module.nominal_jacobian(**pos, **model._probe(tool, n))
+    return np.moveaxis(np.broadcast_to(j, (6, len(model.axes), n)), -1, 0)
+
+
 def _axis_sensitivity(model, rot_deg: dict, axis: str) -> np.ndarray:
-    """|d(tool axis)/d(axis)| (per rad) at the rotary positions ``rot_deg``."""
+    """|d(tool axis)/d(axis)| (per rad) at the rotary positions ``rot_deg`` (exact)."""
     n = len(next(iter(rot_deg.values())))
-    h = 1e-4
-    args = {a: np.deg2rad(np.nan_to_num(rot_deg.get(a, np.zeros(n)))) for a in model.rotary_axes}
-    full = {a: np.zeros(n) for a in model.axes if a not in model.rotary_axes}
-    k0 = np.stack(model.module.tool_axis(**full, **args), axis=1)
-    args[axis] = args[axis] + h
-    k1 = np.stack(model.module.tool_axis(**full, **args), axis=1)
-    return np.linalg.norm(k1 - k0, axis=1) / h
+    q = np.zeros((n, len(model.axes)))
+    for a in model.rotary_axes:
+        if a in rot_deg:
+            q[:, model.axes.index(a)] = np.nan_to_num(rot_deg[a])
+    j = nominal_jacobian(model, q)
+    return np.linalg.norm(j[:, 3:6, model.axes.index(axis)], axis=1)
 
 
 def linear_jacobian(model, positions: np.ndarray, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """d(tool tip)/d(X, Y, Z), (N, 3, 3): exact, since the tip is affine in the linear axes."""
-    positions = np.atleast_2d(np.asarray(positions, dtype=float))
+    """d(tool tip)/d(X, Y, Z), (N, 3, 3), exact (the generated Jacobian)."""
     idx = [model.axes.index(a) for a in linear_axes(model)]
-    base = model.nominal_position(positions, tool)
-    cols = []
-    for i in idx:
-        p = positions.copy()
-        p[:, i] += 1.0
-        cols.append(model.nominal_position(p, tool) - base)
-    return np.stack(cols, axis=2)
+    return nominal_jacobian(model, positions, tool)[:, 0:3, idx]
+
+
+def rotary_jacobian(model, positions: np.ndarray) -> np.ndarray:
+    """d(tool axis)/d(rotary axes in ``model.rotary_axes`` order), (N, 3, n_rot), per rad,
+    exact (the generated Jacobian)."""
+    idx = [model.axes.index(a) for a in model.rotary_axes]
+    return nominal_jacobian(model, positions)[:, 3:6, idx]
 
 
 def check_axes(model, axes) -> None:

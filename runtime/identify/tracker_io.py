@@ -85,6 +85,9 @@ def _header_index(path, header):
 def read_tracker_csv(path) -> list[Round]:
     """Read one tracker CSV file -> its rounds (see the module docstring)."""
     path = Path(path)
+    fast = _read_loadtxt(path)
+    if fast is not None:
+        return fast
     rows = _open_rows(path)
     (_, header), body = rows[0], rows[1:]
     idx = _header_index(path, header)
@@ -93,6 +96,39 @@ def read_tracker_csv(path) -> list[Round]:
     if fast is not None:
         return fast
     return _read_by_row(path, body, idx)  # a file with a problem: its line is named
+
+
+def _read_loadtxt(path: Path) -> list[Round] | None:
+    """A plain file (no quotes, comments or blank lines; one header line) tokenised by numpy's
+    C reader (``numpy.loadtxt``) and grouped by :func:`_group`; None for anything else, so that
+    the csv-module readers handle it (and name the faulty line)."""
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError):
+        return None
+    first, sep, rest = text.partition("\n")
+    if not sep or '"' in text or "#" in text or "\n\n" in text or "\r" in text \
+            or not rest.strip():
+        return None
+    header = [h.strip() for h in first.split(",")]
+    try:
+        idx = _header_index(path, header)
+    except InputError:
+        return None
+    width = len(header)
+    try:
+        lines = rest.splitlines()
+        num = np.loadtxt(lines, delimiter=",", dtype=float, ndmin=2,
+                         usecols=[idx[c] for c in ("position", "x", "y", "z")])
+        txt = np.loadtxt(lines, delimiter=",", dtype=str, ndmin=2,
+                         usecols=list(range(width)))
+    except (ValueError, IndexError):
+        return None
+    if txt.shape != (len(lines), width) or num.shape[0] != len(lines):
+        return None
+    rnd = np.char.strip(txt[:, idx["round"]])
+    label = np.char.strip(txt[:, idx["point"]])
+    return _group(path, rnd, label, num.T)
 
 
 def _read_by_row(path: Path, body: list, idx: dict) -> list[Round]:
@@ -151,6 +187,12 @@ def _read_regular(path: Path, body: list, idx: dict) -> list[Round] | None:
         num = table[:, [idx[c] for c in ("position", "x", "y", "z")]].astype(float).T
     except ValueError:
         return None
+    return _group(path, rnd, label, num)
+
+
+def _group(path: Path, rnd: np.ndarray, label: np.ndarray, num: np.ndarray) -> list[Round] | None:
+    """Rounds from the columns round, point (text, (n,)) and position, x, y, z ((4, n) float);
+    None when anything is irregular (the row-by-row reader then reports it)."""
     if not np.isfinite(num).all() or (rnd == "").any() or (label == "").any():
         return None
     rnd_names, rnd_of = _first_seen(rnd)
