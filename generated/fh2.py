@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       a47a1650cc12d3db47d92764978ee4bb013956fe536312cb0baad903987dbdb5
-derivation sha256  c27af211de914ebf935e9f6eeb20bb1c0aa821fc593f7f2707ffe637dcc6ee50
+derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -33,7 +33,7 @@ import numpy as np
 
 from volerr.units import parse_number
 from volerr.errors import InputError, require
-from volerr.fileio import check_header, check_magnitude, read_csv_rows
+from volerr.fileio import MAX_ABS, check_header, check_magnitude, read_csv_rows
 
 REQUIRED = ("round", "point", "position", "x", "y", "z")
 
@@ -193,8 +193,9 @@ def _read_regular(path: Path, body: list, idx: dict) -> list[Round] | None:
 def _group(path: Path, rnd: np.ndarray, label: np.ndarray, num: np.ndarray) -> list[Round] | None:
     """Rounds from the columns round, point (text, (n,)) and position, x, y, z ((4, n) float);
     None when anything is irregular (the row-by-row reader then reports it)."""
-    if not np.isfinite(num).all() or (rnd == "").any() or (label == "").any():
-        return None
+    if not np.isfinite(num).all() or np.abs(num).max(initial=0.0) > MAX_ABS \
+            or (rnd == "").any() or (label == "").any():
+        return None  # the row reader names the faulty line
     rnd_names, rnd_of = _first_seen(rnd)
     rounds = []
     for r, name in enumerate(rnd_names):
