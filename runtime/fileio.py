@@ -292,14 +292,14 @@ class Outputs:
     # -- checks --------------------------------------------------------------------------
     def _refuse_target(self, role, p: Path) -> None:
         require(str(p).strip() != "", f"{role}: empty file name")
+        rp = p.resolve()
+        for q in self.inputs:  # first: an input that is also a package file is named an input
+            same = (rp == q.resolve()) or (p.exists() and q.exists() and os.path.samefile(p, q))
+            require(not same, f"{role} {p}: refusing to overwrite the input file {q}")
         if not self.allow_package:
             require(not is_package_file(p),
                     f"{role} {p}: refusing to write into the installed volerr package "
                     f"(a shipped file such as a layout or generated module)")
-        rp = p.resolve()
-        for q in self.inputs:
-            same = (rp == q.resolve()) or (p.exists() and q.exists() and os.path.samefile(p, q))
-            require(not same, f"{role} {p}: refusing to overwrite the input file {q}")
 
     @staticmethod
     def _probe_writable(role, target_dir: Path, shown: Path) -> None:
