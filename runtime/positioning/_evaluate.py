@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volerr.units import UM_PER_MM
+
 from ._io import BWD, FWD, PositioningRun
 
 #: axis figures: JSON key (um) -> attribute name
@@ -75,12 +77,12 @@ class Evaluation:
 
     def figures_um(self) -> dict:
         """The axis figures, um, keyed as in the JSON report."""
-        return {k: float(getattr(self, a)) * 1e3 for k, a in FIGURES.items()}
+        return {k: float(getattr(self, a)) * UM_PER_MM for k, a in FIGURES.items()}
 
     def per_target_um(self) -> dict:
         """The per-target arrays as lists, um (targets in mm), keyed as in the JSON report."""
         out = {"targets_mm": [float(v) for v in self.run.targets]}
-        out.update({k: [float(v) * 1e3 for v in getattr(self, a)] for k, a in PER_TARGET.items()})
+        out.update({k: [float(v) * UM_PER_MM for v in getattr(self, a)] for k, a in PER_TARGET.items()})
         return out
 
 

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.tables import ErrorTable
+from volerr.units import MM_PER_M, UM_PER_MM
 
 from ._evaluate import Evaluation
 
@@ -87,7 +88,7 @@ def plot_runs(evaluations, path=None) -> bytes:
     fig, axes = plt.subplots(1, n, figsize=(9.5 * n, 5.2), squeeze=False, sharey=True)
     for k, (ev, ax) in enumerate(zip(evaluations, axes[0])):
         t = ev.run.targets
-        um = 1e3
+        um = UM_PER_MM
         for d, (mean, s, col, arrow, name) in enumerate(
                 ((ev.mean_fwd, ev.s_fwd, "tab:red", "\u2191", "forward"),
                  (ev.mean_bwd, ev.s_bwd, "tab:blue", "\u2193", "backward"))):
@@ -298,7 +299,7 @@ def error_table_csv(ev: Evaluation) -> str:
 
     t = error_table(ev)
     lines = table_to_csv(t).splitlines()
-    S = repeatability(ev) * 1e3
+    S = repeatability(ev) * UM_PER_MM
     out = [lines[0] + f",S_{t.axis}_um"]
     out += [f"{ln},{float(f'{v:.12g}') + 0.0:.12g}" for ln, v in zip(lines[1:], S)]
     return "\n".join(out) + "\n"
@@ -310,7 +311,7 @@ def standard_notes(run, corrected: bool) -> list[str]:
     if run.n_cycles < 5:
         notes.append(f"{run.n_cycles} cycles per direction; the standard test cycle has 5")
     travel = float(run.targets[-1] - run.targets[0])
-    need = max(5, int(np.ceil(5 * travel / 1000.0)))
+    need = max(5, int(np.ceil(5 * travel / MM_PER_M)))
     if run.n_targets < need:
         notes.append(f"{run.n_targets} targets over {travel:g} mm; the standard asks for at "
                      f"least 5 per metre and at least 5 ({need})")

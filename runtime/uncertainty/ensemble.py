@@ -41,6 +41,7 @@ import numpy as np
 
 from volerr.machine import iso_names
 from volerr.errors import InputError, require
+from volerr.units import MM_PER_UM
 
 from . import iso10360
 from .iso10360 import Spec, parse_spec  # noqa: F401  (re-exported)
@@ -230,8 +231,8 @@ class SpecMachines(Source):
         box = iso10360.linear_box(model)
         self.test = iso10360.length_test(model, box, self.probe)
         diag = float(np.linalg.norm([box[a][1] - box[a][0] for a in "XYZ"]))
-        mpe_max = float(self.spec.mpe_um(diag)) * 1e-3
-        self.mpe_mm = self.spec.mpe_um(self.test.lengths) * 1e-3
+        mpe_max = float(self.spec.mpe_um(diag)) * MM_PER_UM
+        self.mpe_mm = self.spec.mpe_um(self.test.lengths) * MM_PER_UM
         paxis = model.parameter_axis
         self.params = tuple(model.parameters)
         k = np.arange(1, self.degree + 1)
@@ -337,11 +338,11 @@ class Ensemble:
             for name, s in funcs.constants_std.items():
                 if s > 0:
                     sources.append(ConstantParameter(name, s))
-        noise_mm = noise_um * 1e-3
+        noise_mm = noise_um * MM_PER_UM
         if spec is not None:
             if noise_mm == 0 and spec.pftu_um is not None:
                 # PFTU is the range of 25 radial residuals; mean range of 25 N(0,1) = 3.931
-                noise_mm = spec.pftu_um * 1e-3 / 3.931
+                noise_mm = spec.pftu_um * MM_PER_UM / 3.931
             require(0 < spec_acceptance < 1, "--spec-acceptance must lie in (0, 1)")
             sources.append(SpecMachines(spec, noise_mm, probe=tuple(spec_probe), seed=seed,
                                         acceptance=spec_acceptance))

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.errors import require
+from volerr.units import UM_PER_MM
 
 from .tasks import EVALUATIONS, check_task, check_travel, evaluate
 
@@ -323,7 +324,7 @@ def summarize(problem: Problem, values, p: float = 0.95) -> dict:
         out[name] = {
             "estimate_mm": float(mean[j]),
             "nominal_mm": float(problem.nominal_values[j]),
-            "bias_um": float((problem.known_values[j] - problem.nominal_values[j]) * 1e3),
+            "bias_um": float((problem.known_values[j] - problem.nominal_values[j]) * UM_PER_MM),
             "standard_uncertainty_um": float(u[j] * 1e3),
             "expanded_uncertainty_um": float(2 * u[j] * 1e3),
             "coverage_interval_mm": [float(lo[j]), float(hi[j])],
@@ -339,7 +340,7 @@ def contributions(problem: Problem, samples: int = 2000) -> list:
     out = []
     for src in problem.sources:
         v, _ = run(with_sources(problem, [src]), samples)
-        u = v.std(axis=0, ddof=1) * 1e3
+        u = v.std(axis=0, ddof=1) * UM_PER_MM
         out.append({"source": src.name,
                     "standard_uncertainty_um": {n: float(x) for n, x in zip(problem.names, u)}})
     first = problem.names[0]
