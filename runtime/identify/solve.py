@@ -613,6 +613,21 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         ``point`` of the axis, for a measurement frame that is the machine frame).
     sense : "auto", +1 or -1
         Sense of the nominal motion (default: detected from the data).
+    max_cond : float
+        Largest accepted condition number of the point geometry (default 1e4).
+    outlier_k : float
+        Points whose residual exceeds ``outlier_k`` x the noise are flagged (default 5).
+    cross_check : bool
+        With ``method="closed"``: also report the closed form against least squares.
+
+    Returns
+    -------
+    Identification
+        Positions (n_positions,) sorted, mm or deg; ``values`` (n_positions, 6), the error
+        motions EX EY EZ (mm) EA EB EC (rad) of the component carrying the points, zero at each
+        round's reference position (the first position), averaged over the rounds; ``std``
+        (Type A) and ``u_tracker`` the same shape.  ``.table()`` gives the
+        :class:`volerr.tables.ErrorTable`.
     """
     from volerr.machine.layout import Layout, read_layout
 
@@ -680,7 +695,25 @@ def to_model_signs(table, layout, reference=None):
     * rotary table axis (frame origin on the axis): ``delta = -t``, ``eps = -e``.
 
     Assumes the measurement frame origin at the tool reference point and its axes along the
-    machine axes; for other measuring points use :meth:`volerr.machine.model.Model.transfer`."""
+    machine axes; for other measuring points use :meth:`volerr.machine.model.Model.transfer`.
+
+    Parameters
+    ----------
+    table : volerr.tables.ErrorTable
+        The identified table of one axis (:meth:`Identification.table`): positions (n,) mm or
+        deg, values mm (translational) / rad (angular).
+    layout : Layout
+        The machine layout declaring the axis (which chain carries it).
+    reference : float, optional
+        The reference position ``q0`` (errors zero there), mm or deg; default: the table's
+        first position.
+
+    Returns
+    -------
+    volerr.tables.ErrorTable
+        The same positions, values in the model's convention (mm / rad); the table itself when
+        nothing changes (a tool-side axis measured from ``q0 = 0`` or a tool-side rotary axis).
+    """
     from volerr.tables.table import ErrorTable
 
     axis = table.axis

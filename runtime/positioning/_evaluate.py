@@ -91,7 +91,21 @@ def _range(values) -> float:
 
 
 def evaluate(run: PositioningRun) -> Evaluation:
-    """All ISO 230-2:2014 clause 3 quantities of ``run`` (definitions in the module docstring)."""
+    """All ISO 230-2:2014 clause 3 quantities of ``run`` (definitions in the module docstring).
+
+    Parameters
+    ----------
+    run : PositioningRun
+        Deviations (actual minus target) at m targets x 2 directions x n cycles, mm
+        (:func:`volerr.positioning.read_run`, optionally :func:`correct_to_20C`).
+
+    Returns
+    -------
+    Evaluation
+        Per-target arrays, shape (m,), and the axis figures A, B, E, M, R (bidirectional and
+        per direction), mm; :meth:`Evaluation.figures_um` and :meth:`Evaluation.per_target_um`
+        give them in um.
+    """
     x = run.deviation                                   # (m, 2, n) mm
     xm = x.mean(axis=2)                                 # (m, 2)
     s = x.std(axis=2, ddof=1)                           # (m, 2): n - 1 in the denominator

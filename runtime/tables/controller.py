@@ -49,7 +49,7 @@ import numpy as np
 from volerr.errors import InputError, require
 from volerr.fileio import check_header, check_magnitude
 from volerr.machine import iso_names
-from volerr.tables.table import ErrorTable
+from volerr.tables.table import ErrorTable, axis_unit
 from volerr.units import format_number
 
 FORMATS = ("isg", "etalon")
@@ -90,7 +90,7 @@ def write_isg(model_name: str, tables: dict, constants: dict) -> str:
     for ax in sorted(tables):
         t = tables[ax]
         names = list(t.values)
-        unit = "deg" if ax in "ABC" else "mm"
+        unit = axis_unit(ax)
         rows = [f"// component errors of axis {ax} (argument {ax} in {unit}; values mm, rad)",
                 " ".join([ax] + names)]
         for i, p in enumerate(t.positions):

@@ -81,7 +81,27 @@ class ErrorFunctions:
     Call with positions (``{axis: array}`` in mm / deg, or an (N, n_axes) array in
     ``model.axes`` order) -> ``{name: (N,) array}`` in mm / rad for every parameter that has
     data (table parameters and constants), ready for ``model.volumetric_error``.
-    :meth:`sigmas` gives the standard deviations the same way, for ``model.random_error``."""
+    :meth:`sigmas` gives the standard deviations the same way, for ``model.random_error``.
+
+    Parameters
+    ----------
+    tables : dict
+        Axis -> :class:`volerr.tables.ErrorTable` (positions mm / deg, values mm / rad).
+    constants : dict or None
+        ISO name (``EC0Y`` ...) -> constant error, mm or rad.
+    model : volerr.Model or str
+        The model whose parameters the tables must name (a layout name or file is loaded).
+    method : {"linear", "cubic", "poly"}
+        Interpolation between the table positions (``poly``: Legendre least squares).
+    degree : int, optional
+        Polynomial degree for ``poly`` (default: by leave-one-out cross-validation).
+    extrapolate : bool
+        Evaluate beyond a table's measured range (default: refuse with InputError).
+    constants_std : dict, optional
+        Standard deviations of the constants, mm or rad.
+    source : str
+        Where the data came from (error messages).
+    """
 
     def __init__(self, tables: dict, constants: dict | None, model, method: str = "linear",
                  degree: int | None = None, extrapolate: bool = False,
@@ -181,6 +201,8 @@ class ErrorFunctions:
         return cols, n
 
     def __call__(self, positions) -> dict:
+        """Error values at ``positions`` ({axis: (N,)} or (N, n_axes), mm / deg): name -> (N,)
+        array, mm / rad, for every table parameter and constant."""
         cols, n = self._positions(positions)
         out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
                for name, (ax, f) in self.functions.items()}
@@ -188,7 +210,8 @@ class ErrorFunctions:
         return out
 
     def sigmas(self, positions) -> dict:
-        """Standard deviations (mm / rad) at ``positions``: name -> (N,) array."""
+        """Standard deviations (mm / rad) at ``positions`` (as :meth:`__call__`): name -> (N,)
+        array; a ``u95`` column without ``std`` counts as ``u95 / 2``."""
         cols, n = self._positions(positions)
         out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
                for name, (ax, f) in self.std_functions.items()}

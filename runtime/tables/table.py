@@ -105,9 +105,9 @@ def _from_internal(values, unit: str):
 
 @dataclass
 class ErrorTable:
-    """Component errors of one axis at measured positions.
+    """Component errors of one axis at measured positions (one ``<AXIS>.csv``).
 
-    ``positions``: shape (n,), mm or deg, strictly increasing.  ``values``, ``std``, ``u95``:
+    ``axis``: the axis letter.  ``positions``: shape (n,), mm or deg, strictly increasing.  ``values``, ``std``, ``u95``:
     ISO name -> shape (n,) arrays in mm (translational) or rad (angular); ``std`` is the standard
     deviation (Type A), ``u95`` the expanded uncertainty (k = 2); both may be empty.
     ``reversal``: shape (n,) mm or None, the ISO 230-2 reversal B_i (positive-direction minus
@@ -363,10 +363,24 @@ def write_constants(path, values: dict, inputs=(), std: dict | None = None,
 # ---------------------------------------------------------------------------------------------
 # error directories
 def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]:
-    """Read an error directory -> (tables {axis: ErrorTable}, (constants, std, u95)).
+    """Read an error directory (``<AXIS>.csv`` per measured axis, optional ``constants.csv``).
 
-    ``axes``: the axes the machine has; a table for any other axis, or any other CSV file,
-    is refused."""
+    Parameters
+    ----------
+    directory : path
+        The error directory; a missing table means zero errors for that axis.
+    axes : sequence of str, optional
+        The axes the machine has; a table for any other axis, or any other CSV file, is
+        refused (default: X Y Z tables).
+
+    Returns
+    -------
+    tables : dict
+        Axis -> :class:`ErrorTable` (positions mm / deg, values mm / rad).
+    (constants, std, u95) : tuple of dict
+        ISO name (``EC0Y`` ...) -> value, its standard deviation and its expanded uncertainty
+        (k = 2), mm or rad; ``std`` and ``u95`` hold only the names that carry them.
+    """
     d = Path(directory)
     require(not d.is_file(), f"{d} is a file, not an error directory (give the folder that "
                              f"holds X.csv, Y.csv ... and constants.csv)")

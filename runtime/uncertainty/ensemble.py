@@ -319,6 +319,33 @@ class Ensemble:
               mode: str = "systematic", correlation_mm: float = 0.0,
               temperature: Temperature | None = None, probe_map=None, seed: int = 0,
               spec_probe=(0.0, 0.0, 0.0), spec_acceptance: float = 0.5) -> "Ensemble":
+        """The uncertainty sources of a task-specific Monte Carlo.
+
+        Parameters
+        ----------
+        funcs : volerr.tables.ErrorFunctions, optional
+            Error tables with std / u95 columns (perturbed per ``mode``).
+        spec : Spec, optional
+            ISO 10360-2 specification: machines drawn and kept when they pass the simulated
+            test (constrained Monte Carlo).
+        noise_um : float
+            Probing noise, standard deviation per point, um.
+        mode : {"systematic", "repeatability"}
+            Meaning of the tables' std: uncertainty of the tabulated function (one perturbed
+            function per machine) or single-positioning scatter (drawn per point).
+        correlation_mm : float
+            Correlation length of the node perturbations along an axis, mm (0: independent).
+        temperature : Temperature, optional
+            Part and scale expansion and their uncertainties.
+        probe_map : volerr.probe.ProbeMap, optional
+            Probe error map added at each point's probing direction.
+        seed : int
+            Seed of the spec prior scale search.
+        spec_probe : (3,) mm
+            Probe offset of the simulated spec test.
+        spec_acceptance : float
+            Fraction of prior candidates that pass the test (sets the prior scale), in (0, 1).
+        """
         require(mode in ("systematic", "repeatability"),
                 f"unknown table std mode {mode!r} (systematic, repeatability)")
         require(np.isfinite(noise_um) and noise_um >= 0, "--noise-um must be >= 0")
