@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.errors import InputError, require
-from volerr.units import MM_PER_UM
+from volerr.units import MM_PER_UM, parse_number
 
 FWD, BWD = 0, 1
 DIRECTION_NAMES = ("forward", "backward")
@@ -178,16 +178,7 @@ def _rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
 
 
 def _number(path, lineno, column, text) -> float:
-    require(text != "", f"{path}:{lineno}: empty value in column {column}")
-    try:
-        v = float(text)
-    except ValueError:
-        if re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", text):
-            raise InputError(f"{path}:{lineno}: {column} = {text!r} has a decimal comma; write "
-                             f"numbers with a decimal point") from None
-        raise InputError(f"{path}:{lineno}: {column} = {text!r} is not a number") from None
-    require(math.isfinite(v), f"{path}:{lineno}: {column} = {text} (NaN or infinite)")
-    return v
+    return parse_number(text, f"{path}:{lineno}", column)
 
 
 def _find(low: list[str], names) -> int | None:
