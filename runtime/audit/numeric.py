@@ -22,6 +22,7 @@ import numpy as np
 
 from volerr.machine import iso_names
 from volerr.errors import InputError
+from volerr.units import UM_PER_MM
 
 DATA_FILE = "printed_pahk.toml"
 _FUNC = re.compile(r"\b(R?)(dx|dy|dz|Ex|Ey|Ez)\((X|Y|Z)o?\)")
@@ -117,12 +118,12 @@ def spot_check(model, n: int = 200, seed: int = 0, translational_mm: float = 0.0
             if eq["kind"] == "random":
                 val = np.sqrt(np.maximum(val, 0.0))
             ref = targets[c][1]
-            diff = float(np.max(np.abs(val - ref))) * 1e3
-            scale = float(np.max(np.abs(ref))) * 1e3
+            diff = float(np.max(np.abs(val - ref))) * UM_PER_MM
+            scale = float(np.max(np.abs(ref))) * UM_PER_MM
             row.update(max_diff_um=diff, max_value_um=scale,
                        status="agrees" if diff <= 1e-9 * max(scale, 1.0) + 1e-9 else "differs")
             if eq["kind"] == "random":
-                row["max_diff_exact_um"] = float(np.max(np.abs(val - targets[c][2]))) * 1e3
+                row["max_diff_exact_um"] = float(np.max(np.abs(val - targets[c][2]))) * UM_PER_MM
             out.append(row)
     return out
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from volerr.cmm import volmap
 from volerr.errors import InputError, require
-from volerr.tables.table import METHODS, ErrorFunctions
+from volerr.tables.functions import METHODS, ErrorFunctions
 
 
 def add_error_arguments(parser, required: bool = True) -> None:

@@ -14,7 +14,6 @@ import json
 import sys
 
 from volerr.cli._common import add_vector
-from volerr.errors import require
 
 
 def register(sub) -> None:
@@ -80,61 +79,10 @@ def _vec(text, what):
     return list(parse_vector(text, what))
 
 
-def _refuse_repeated_files(files) -> None:
-    """The same tracker file given twice would count its rounds twice (understated Type A
-    uncertainty)."""
-    import os
-    from pathlib import Path
-
-    seen = []
-    for f in files:
-        p = Path(f)
-        for q in seen:
-            same = p.resolve() == q.resolve() or (
-                p.exists() and q.exists() and os.path.samefile(p, q))
-            require(not same, f"tracker file {f} is given twice (its rounds would be counted "
-                              f"twice)")
-        seen.append(p)
-
-
-def read_rounds(files, fmt="csv", positions=None, points=None):
-    """Rounds from the input files (both formats)."""
-    from volerr.identify.tracker_io import parse_positions, read_thesis_export, read_tracker_csv
-
-    rounds = []
-    if fmt == "thesis":
-        require(positions is not None, "--format thesis needs --positions start:stop:count")
-        pos = parse_positions(positions)
-        labels = None
-        if points:
-            labels = [s.strip() for s in points.split(",") if s.strip()]
-        for f in files:
-            rounds.append(read_thesis_export(f, pos, labels))
-    else:
-        require(positions is None and points is None,
-                "--positions and --labels apply to --format thesis only")
-        for f in files:
-            rounds.extend(read_tracker_csv(f))
-    return rounds
-
-
-def residual_csv(result) -> str:
-    """Per-position, per-point residuals of every round (um) with the outlier flag."""
-    flagged = {(o[0], o[1], o[2]) for o in result.outliers()}
-    lines = ["round,point,position,rx_um,ry_um,rz_um,norm_um,outlier"]
-    for r in result.rounds:
-        for k, pos in enumerate(r.positions):
-            for i, lab in enumerate(r.labels):
-                v = r.residuals[k, i] * 1e3
-                n = float((v ** 2).sum()) ** 0.5
-                flag = int((r.name, float(pos), lab) in flagged)
-                lines.append(f"{r.name},{lab},{pos:.10g},{v[0]:.6g},{v[1]:.6g},{v[2]:.6g},"
-                             f"{n:.6g},{flag}")
-    return "\n".join(lines) + "\n"
-
-
 def run(args) -> int:
     from volerr.fileio import Outputs, write_text
+    from volerr.identify.inputs import read_rounds, refuse_repeated_files
+    from volerr.identify.report import outlier_warnings, residual_csv, summary_lines
     from volerr.identify.solve import identify, to_model_signs
     from volerr.machine.layout import read_layout
     from volerr.tables.table import table_to_csv
@@ -142,7 +90,7 @@ def run(args) -> int:
     from volerr.cli._common import layout_inputs
 
     inputs = list(args.files) + layout_inputs(args.layout)
-    _refuse_repeated_files(args.files)
+    refuse_repeated_files(args.files)
     outs = Outputs(inputs).file("--out", args.out).file("--residuals", args.residuals) \
         .file("--json", args.json).plot("--plot", args.plot).check()
     layout = read_layout(args.layout)
@@ -174,25 +122,7 @@ def run(args) -> int:
             write_text(outs.path("--residuals"), residual_csv(result), inputs=inputs)
         if args.json:
             write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
-    s = summary
-    print(f"{args.axis}: {s['n_positions']} positions x {len(s['points'])} points x "
-          f"{s['n_rounds']} round(s), method {s['method']}, condition {s['condition']:.3g}, "
-          f"residual RMS {s['residual_rms_um']:.3g} um -> {args.out}")
-    if "closed_form" in s:
-        cf = s["closed_form"]
-        d = list(cf["vs_lsq_max"].values())
-        g = [v for v in cf["noise_gain_vs_lsq"].values() if v is not None and v == v]
-        roles = "; ".join(f"P={r['P']} Q={r['Q']} K={r['K']}" for r in cf["roles"])
-        print(f"closed form (Zhang & Hu selection {cf['selection']}, {roles}): equals least "
-              f"squares on consistent data to {cf['consistency_max']:.1g}; on these data it "
-              f"differs by up to {max(d[:3]):.3g} um / {max(d[3:]):.3g} urad"
-              + (f", noise gain {min(g):.2g}-{max(g):.2g} x least squares" if g else ""))
-    for f in s.get("fit", []):
-        deg = f" degree {f['degree']}" if f["degree"] is not None else ""
-        loo = f", leave-one-out {f['loo_rms']:.3g}" if f["loo_rms"] is not None else ""
-        print(f"fit {f['name']}: {f['method']}{deg}, residual RMS {f['rms_residual']:.3g} "
-              f"max {f['max_residual']:.3g}{loo} {f['unit']}")
-    for o in s["outliers"]:
-        print(f"warning: round {o['round']} position {o['position']:g} point {o['point']}: "
-              f"residual {o['residual_um']:.3g} um = {o['ratio']:.1f} x noise", file=sys.stderr)
+    print("\n".join(summary_lines(args.axis, summary, args.out)))
+    for line in outlier_warnings(summary):
+        print(line, file=sys.stderr)
     return 0

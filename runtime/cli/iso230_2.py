@@ -121,17 +121,10 @@ def run(args) -> int:
         .file("--html", args.html) \
         .folder("--table-out", args.table_out, files=[f"{a}.csv" for a in axes]).check()
 
-    evaluations, thermals, notes = [], [], []
-    for f, a in zip(inputs, axes):
-        r = pos.read_run(f, a)
-        th = None
-        if args.cte_ppm_per_K is not None:
-            r, th = pos.correct_to_20C(r, args.cte_ppm_per_K, args.material_temp_C,
-                                       args.cte_reference_mm)
-        evaluations.append(pos.evaluate(r))
-        thermals.append(th)
-        notes.append(pos.standard_notes(r, th is not None))
-    report = pos.report_dict(evaluations, thermals, notes)
+    runs = pos.evaluate_files(inputs, axes, args.cte_ppm_per_K, args.material_temp_C,
+                              args.cte_reference_mm)
+    evaluations = runs.evaluations
+    report = runs.report()
     table_texts = [pos.error_table_csv(ev) for ev in evaluations] if args.table_out else []
     png = pos.plot_runs(evaluations) if (args.plot or args.html) else None
     html_text = None
@@ -151,11 +144,8 @@ def run(args) -> int:
         for a, text in zip(axes, table_texts):
             write_text(outs.path("--table-out") / f"{a}.csv", text, inputs=inputs)
 
-    runs = report["runs"] if "runs" in report else [report]
-    for r in runs:
-        print(f"{Path(r['file']).name}: axis {r['axis']}, {r['n_targets']} targets x "
-              f"{r['n_cycles']} cycles: A {r['A_um']:.2f}  E {r['E_um']:.2f}  M {r['M_um']:.2f}"
-              f"  R {r['R_um']:.2f}  B {r['B_um']:.2f}  (B_avg {r['B_avg_um']:+.2f}) um")
-        for n in r["notes"]:
-            print(f"volerr iso230-2: note: {Path(r['file']).name}: {n}", file=sys.stderr)
+    lines, notes = pos.summary_lines(report)
+    print("\n".join(lines))
+    for n in notes:
+        print(f"volerr iso230-2: note: {n}", file=sys.stderr)
     return 0

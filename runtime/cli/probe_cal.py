@@ -16,8 +16,9 @@ import math
 import sys
 
 from volerr.cli._common import add_vector
-from volerr.errors import InputError, require
+from volerr.errors import require
 from volerr.fileio import write_text
+from volerr.units import parse_number
 
 
 def register(sub) -> None:
@@ -72,15 +73,9 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _floats(text: str, what: str, n: int | None = None) -> list[float]:
-    try:
-        vals = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise InputError(f"{what}: expected comma-separated numbers, got {text!r}") from None
-    require(all(math.isfinite(v) for v in vals), f"{what}: NaN or infinite value")
-    if n is not None:
-        require(len(vals) == n, f"{what}: expected {n} numbers, got {len(vals)}")
-    return vals
+def _floats(text: str, what: str) -> list[float]:
+    """Comma-separated finite numbers (``30,60,90``)."""
+    return [parse_number(v, what=what) for v in text.split(",") if v.strip()]
 
 
 def _run_plan(args) -> int:
@@ -110,6 +105,7 @@ def run(args) -> int:
     if args.plan:
         return _run_plan(args)
     from volerr.probe import calibration as probe
+    from volerr.probe.report import summary_lines
 
     require(args.data, "name the probing data DATA.csv (or use --plan to write a plan)")
     require(args.out, "--out MAP.csv is required")
@@ -142,23 +138,8 @@ def run(args) -> int:
             d = outs.path("--plots")
             plot_probe_map_3d(cal, d / "probe_map_3d.png")
             plot_probe_map_2d(cal, d / "probe_map_2d.png")
-    out = args.out
     for note in cal.notes:
         print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
-    e = summary["probe_error_um"]
-    c = summary["center_mm"]
-    n_out = len(summary["outliers"]["index"])
-    print(f"{cal.n_points} points, sphere radius {cal.sphere_radius:.4f} mm, "
-          f"directions from {cal.direction_source}")
-    u = summary["uncertainty"]
-    print(f"centre {c[0]:.4f} {c[1]:.4f} {c[2]:.4f} mm, R_eff {cal.r_eff:.4f} mm "
-          f"(u: centre {max(u['u_center_um']):.2f} um, R_eff {u['u_r_eff_um']:.2f} um; "
-          f"noise {u['noise_um']:.2f} um)")
-    print(f"probe error max {e['max']:.1f} um, min {e['min']:.1f} um, rms {e['rms']:.1f} um; "
-          f"map degree {cal.map.degree}, residual rms {summary['map']['residual_rms_um']:.2f} um;"
-          f" {n_out} outlier{'s' if n_out != 1 else ''} flagged"
-          + (" and excluded" if args.exclude_outliers and n_out else "")
-          + (" (kept in the fit: --exclude-outliers refits without them)"
-             if n_out and not args.exclude_outliers else ""))
-    print(f"map: {out}")
+    print("\n".join(summary_lines(cal, args.exclude_outliers)))
+    print(f"map: {args.out}")
     return 0

@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 from volerr.errors import require
+from volerr.units import URAD_PER_RAD
 
 
 def register(sub) -> None:
@@ -61,12 +62,12 @@ def run(args) -> int:
             write_text(staged / name, text, inputs=inputs)
         write_constants(staged / "constants.csv", merged, inputs=inputs, std=merged_std)
         if args.json:
-            doc = {"squareness_urad": {k: v * 1e6 for k, v in values.items()},
-                   "u_urad": {k: v * 1e6 for k, v in std.items()},
-                   "slopes_urad": {k: v * 1e6 for k, v in slopes.items()},
+            doc = {"squareness_urad": {k: v * URAD_PER_RAD for k, v in values.items()},
+                   "u_urad": {k: v * URAD_PER_RAD for k, v in std.items()},
+                   "slopes_urad": {k: v * URAD_PER_RAD for k, v in slopes.items()},
                    "tables_are": args.tables_are}
             write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs=inputs)
     for sq, v in values.items():
-        print(f"{sq} = {v * 1e6:.3f} urad (u = {std[sq] * 1e6:.3f} urad)")
+        print(f"{sq} = {v * URAD_PER_RAD:.3f} urad (u = {std[sq] * URAD_PER_RAD:.3f} urad)")
     print(f"-> {out}")
     return 0

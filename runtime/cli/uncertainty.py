@@ -19,7 +19,7 @@ from volerr.errors import require
 from volerr.fileio import Outputs, write_bytes, write_text
 from volerr.machine.model import load
 from volerr.uncertainty import ensemble, montecarlo as mc, tasks
-from volerr.uncertainty.report import num
+from volerr.uncertainty import report
 
 
 def register(sub) -> None:
@@ -158,41 +158,26 @@ def run(args) -> int:
             require(2 <= n <= 10**8, "--samples must be between 2 and 1e8")
             values, info = mc.run(prob, n, runner)
     summary = mc.summarize(prob, values)
-    doc = {"layout": model.name, "task": str(args.task), "evaluation": args.evaluate,
-           "quantities": summary, "samples": int(values.shape[0]), "seed": args.seed,
-           "block_size": prob.block_size, "chunks": args.chunks, "scheduler": args.scheduler,
-           "machine": ("spec " + spec.text()) if spec else (f"tables {args.errors} "
-                                                          f"({args.table_std})" if funcs
-                                                          else "perfect"),
-           "noise_um": args.noise_um, "sources": [s.name for s in prob.sources]}
-    if "candidates" in info:
-        doc["spec_acceptance"] = {"candidates": info["candidates"], "kept": info["kept"],
-                                  "fraction": info["kept"] / info["candidates"]}
-    if adaptive is not None:
-        doc["adaptive"] = {"runs": adaptive.runs, "samples_per_run": adaptive.per_run,
-                           "converged": adaptive.converged, "digits": args.digits,
-                           "tolerance_um": [d * 1e3 for d in adaptive.delta_mm]}
-    if args.contributions:
-        doc["contributions"] = mc.contributions(prob, args.contributions)
+    doc = report.result_document(
+        prob, values, summary, info, layout=model.name, task=str(args.task),
+        evaluation=args.evaluate, seed=args.seed, chunks=args.chunks, scheduler=args.scheduler,
+        machine=report.machine_text(spec, args.errors if funcs else None, args.table_std),
+        noise_um=args.noise_um, adaptive=adaptive, digits=args.digits,
+        contributions=(mc.contributions(prob, args.contributions) if args.contributions
+                       else None))
     title = f"{model.name} {args.evaluate} ({values.shape[0]} samples)"
     hist = None
     if args.plot or args.html:
         from volerr.uncertainty import plots
         hist = plots.histogram_png(values, prob.names, summary, title)
     if not args.quiet:
-        print(f"{model.name} {args.evaluate}: {values.shape[0]} samples, seed {args.seed}")
-        for name, q in summary.items():
-            lo, hi = q["coverage_interval_mm"]
-            print(f"  {name:9s} {num(q['estimate_mm'], '.6f')} mm  bias "
-                  f"{num(q['bias_um'], '+.3f')} um  u {q['standard_uncertainty_um']:.3f} um  "
-                  f"U {q['expanded_uncertainty_um']:.3f} um  95% [{num(lo, '.6f')}, "
-                  f"{num(hi, '.6f')}] mm")
+        print("\n".join(report.summary_lines(doc)))
     with outs:
         write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), hist, inputs)
         if args.html:
-            from volerr.uncertainty import plots, report
+            from volerr.uncertainty import plots
             conv = plots.convergence_png(values, prob.names, title)
             write_text(outs.path("--html"), report.html_report(doc, [hist, conv]), inputs)
     return 0

@@ -316,21 +316,30 @@ def _solve(A, W, delta):
     return theta, Ninv
 
 
-def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
-    """Zhang & Hu closed form on three points at every position; cross-check vs ``theta_lsq``.
+@dataclass
+class _ClosedChoice:
+    """The Zhang & Hu candidate used at each position: ``cands`` lists (selection, point
+    permutation) pairs, ``choice`` (K,) indexes them; ``pref`` is the axis' printed selection and
+    ``spread`` the RMS distance of the points from their centroid, mm."""
 
-    Candidates: the three row selections (eq. 32/3.6, 36, 37) x the 3! assignments of the first
-    three points to the roles P, Q, K.  At each position the thesis' choice (the axis'
-    selection, points in the given order) is used unless its determinant N is below 0.1 of the
-    best candidate's there (for a rotary axis N changes with the angle and can pass through
-    zero).  lever, delta: (K, n, 3)."""
+    cands: list
+    choice: np.ndarray
+    pref: str
+    spread: float
+
+
+_ROLES = ("P", "Q", "K")
+
+
+def _closed_choice(lever, axis, kind) -> _ClosedChoice:
+    """Score every candidate by its normalised determinant N at every position and choose: the
+    thesis' candidate unless it is below 0.1 of the best one there.  lever: (K, n, 3) mm."""
     from volerr.generated import three_point as gen
 
-    K, n, _ = lever.shape
+    K = lever.shape[0]
     pref = gen.AXIS_SELECTION.get(axis if kind == "linear" else "C", "x")
     c0 = lever[0] - lever[0].mean(axis=0)
     spread = math.sqrt(float(np.mean(np.sum(c0 ** 2, axis=1))))
-    names = ("P", "Q", "K")
     cands, scores, ranks = [], [], []
     # a linear axis has the same lever arms at every position: score them once
     geo = lever[:1] if kind == "linear" else lever
@@ -350,42 +359,61 @@ def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
             "N = 0); use the least-squares method")
     ok = scores >= 0.1 * best
     key = np.where(ok, np.array(ranks)[:, None] * 10.0 + scores / np.maximum(best, 1e-300), -1)
-    choice = np.argmax(key, axis=0)                # (K,)
+    return _ClosedChoice(cands, np.argmax(key, axis=0), pref, spread)
 
-    def run(dl):
-        out = np.zeros((K, 6))
-        for c in np.unique(choice):
-            sel, perm = cands[c]
-            m = choice == c
-            # lever arms: constants for a linear axis, per position for a rotary one
-            L = lever[:1, perm, :] if kind == "linear" else lever[m][:, perm, :]
-            D = dl[m][:, perm, :]
-            ds = [D[:, names.index(lab), "xyz".index(co)] for lab, co in gen.SELECTIONS[sel]]
-            solve = getattr(gen, f"solve_{sel}")
-            out[m] = np.asarray(solve(*[L[:, i, co] for i in range(3) for co in range(3)],
-                                      *ds)).T
-        return out
 
-    values = run(delta)
+def _closed_solve(ch: _ClosedChoice, lever, dl, kind) -> np.ndarray:
+    """The six error motions (K, 6) from the deviations ``dl`` (K, n, 3) by the chosen
+    candidate at each position."""
+    from volerr.generated import three_point as gen
+
+    out = np.zeros((lever.shape[0], 6))
+    for c in np.unique(ch.choice):
+        sel, perm = ch.cands[c]
+        m = ch.choice == c
+        # lever arms: constants for a linear axis, per position for a rotary one
+        L = lever[:1, perm, :] if kind == "linear" else lever[m][:, perm, :]
+        D = dl[m][:, perm, :]
+        ds = [D[:, _ROLES.index(lab), "xyz".index(co)] for lab, co in gen.SELECTIONS[sel]]
+        solve = getattr(gen, f"solve_{sel}")
+        out[m] = np.asarray(solve(*[L[:, i, co] for i in range(3) for co in range(3)],
+                                  *ds)).T
+    return out
+
+
+def _closed_form(lever, delta, theta_lsq, axis, kind, A=None):
+    """Zhang & Hu closed form on three points at every position; cross-check vs ``theta_lsq``.
+
+    Candidates: the three row selections (eq. 32/3.6, 36, 37) x the 3! assignments of the first
+    three points to the roles P, Q, K.  At each position the thesis' choice (the axis'
+    selection, points in the given order) is used unless its determinant N is below 0.1 of the
+    best candidate's there (for a rotary axis N changes with the angle and can pass through
+    zero).  lever, delta: (K, n, 3)."""
+    from volerr.generated import three_point as gen
+
+    K = lever.shape[0]
+    ch = _closed_choice(lever, axis, kind)
+    cands, choice = ch.cands, ch.choice
+    values = _closed_solve(ch, lever, delta, kind)
     A = design(lever) if A is None else A
     fitted = np.einsum("knij,kj->kni", A, theta_lsq)
-    consistent = run(fitted)
-    scale = np.array([1.0, 1.0, 1.0, spread, spread, spread])
+    consistent = _closed_solve(ch, lever, fitted, kind)
+    scale = np.array([1.0, 1.0, 1.0, ch.spread, ch.spread, ch.spread])
     used = [cands[c] for c in np.unique(choice[1:] if K > 1 else choice)]
     rows = {}
     for c in np.unique(choice):
         sel, perm = cands[c]
-        rows[int(c)] = [(perm[names.index(lab)], "xyz".index(co)) for lab, co in
+        rows[int(c)] = [(perm[_ROLES.index(lab)], "xyz".index(co)) for lab, co in
                         gen.SELECTIONS[sel]]
     return {
         "values": values,
         "selection": ",".join(sorted({sel for sel, _ in used})),
-        "roles": [{names[i]: int(perm[i]) for i in range(3)} for _, perm in used],
+        "roles": [{_ROLES[i]: int(perm[i]) for i in range(3)} for _, perm in used],
         "consistency_max": float(np.max(np.abs((consistent - theta_lsq) * scale))),
         "vs_lsq": values - theta_lsq,
         "row_index": rows,
         "choice": choice,
-        "thesis_choice_everywhere": bool(np.all([cands[c][0] == pref and cands[c][1] ==
+        "thesis_choice_everywhere": bool(np.all([cands[c][0] == ch.pref and cands[c][1] ==
                                                  (0, 1, 2) for c in choice])),
     }
 
@@ -585,6 +613,21 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         ``point`` of the axis, for a measurement frame that is the machine frame).
     sense : "auto", +1 or -1
         Sense of the nominal motion (default: detected from the data).
+    max_cond : float
+        Largest accepted condition number of the point geometry (default 1e4).
+    outlier_k : float
+        Points whose residual exceeds ``outlier_k`` x the noise are flagged (default 5).
+    cross_check : bool
+        With ``method="closed"``: also report the closed form against least squares.
+
+    Returns
+    -------
+    Identification
+        Positions (n_positions,) sorted, mm or deg; ``values`` (n_positions, 6), the error
+        motions EX EY EZ (mm) EA EB EC (rad) of the component carrying the points, zero at each
+        round's reference position (the first position), averaged over the rounds; ``std``
+        (Type A) and ``u_tracker`` the same shape.  ``.table()`` gives the
+        :class:`volerr.tables.ErrorTable`.
     """
     from volerr.machine.layout import Layout, read_layout
 
@@ -652,7 +695,25 @@ def to_model_signs(table, layout, reference=None):
     * rotary table axis (frame origin on the axis): ``delta = -t``, ``eps = -e``.
 
     Assumes the measurement frame origin at the tool reference point and its axes along the
-    machine axes; for other measuring points use :meth:`volerr.machine.model.Model.transfer`."""
+    machine axes; for other measuring points use :meth:`volerr.machine.model.Model.transfer`.
+
+    Parameters
+    ----------
+    table : volerr.tables.ErrorTable
+        The identified table of one axis (:meth:`Identification.table`): positions (n,) mm or
+        deg, values mm (translational) / rad (angular).
+    layout : Layout
+        The machine layout declaring the axis (which chain carries it).
+    reference : float, optional
+        The reference position ``q0`` (errors zero there), mm or deg; default: the table's
+        first position.
+
+    Returns
+    -------
+    volerr.tables.ErrorTable
+        The same positions, values in the model's convention (mm / rad); the table itself when
+        nothing changes (a tool-side axis measured from ``q0 = 0`` or a tool-side rotary axis).
+    """
     from volerr.tables.table import ErrorTable
 
     axis = table.axis

@@ -430,3 +430,32 @@ def layout_text(name_or_path) -> tuple[str, str]:
         s = folded[0]
     require(s in names, f"unknown layout {s!r}; known layouts: {' '.join(names)}")
     return (shipped_layout_dir() / f"{s}.toml").read_text(encoding="utf-8"), f"{s}.toml"
+
+
+def _num(v) -> str:
+    return f"{v:g}" if isinstance(v, (int, float)) else str(v)
+
+
+def describe(lay: Layout, width: int = 94) -> str:
+    """Several lines on one layout (``volerr layouts --long``): axes with travel (mm / deg)
+    and direction, points on rotary axes (mm), parameters (mm), the description wrapped to
+    ``width`` columns."""
+    import textwrap
+
+    lines = [f"{lay.name}  ({lay.kind})"]
+    for a in lay.axis_names:
+        ax = lay.axes[a]
+        unit = "deg" if ax.kind == "rotary" else "mm"
+        text = (f"  {a}: {ax.kind:6s} travel {_num(ax.travel[0])} .. {_num(ax.travel[1])} "
+                f"{unit}, direction ({', '.join(_num(c) for c in ax.direction)})")
+        if ax.kind == "rotary":
+            text += f", through ({', '.join(_num(c) for c in ax.point)}) mm"
+        lines.append(text)
+    if lay.parameters:
+        lines.append("  parameters: " + ", ".join(f"{k} = {_num(v)} mm"
+                                                  for k, v in sorted(lay.parameters.items())))
+    desc = " ".join(lay.description.split())
+    if desc:
+        lines.extend(textwrap.wrap(desc, width=width, initial_indent="  ",
+                                   subsequent_indent="  "))
+    return "\n".join(lines)

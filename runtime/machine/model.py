@@ -240,14 +240,33 @@ class Model:
     # ---- evaluation --------------------------------------------------------------
     def volumetric_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
                          direction=None, probe_error=None, covariates=None) -> np.ndarray:
-        """First-order volumetric error, (N, 3) mm.
+        """First-order volumetric error: actual minus nominal tool point relative to the
+        workpiece.
 
-        ``errors``: {name: scalar or (N,)} in mm / rad, missing names are zero.  ``probe``:
-        probe/tool offset (3,) or (N, 3) mm.  ``direction`` (N, 3) probing direction and
-        ``probe_error`` (a callable of directions giving mm, or an (N,) array) combine the
-        probe error as Pahk eq. (17): ``+ Probe(n) n`` is added, ``n`` the outward surface
-        normal (eq. 17's ``- Probe M`` with ``M = -n`` its contact direction), so that the whole
-        result stays "actual minus nominal": a CMM reports the point minus this error."""
+        Parameters
+        ----------
+        positions : dict or array_like
+            ``{axis: scalar or (N,)}`` or shape (N, n_axes) in :attr:`axes` order; mm (linear),
+            deg (rotary).
+        errors : dict, optional
+            ``{name: scalar or (N,)}``, mm (translational) / rad (angular); missing names are 0.
+        probe : array_like, shape (3,) or (N, 3)
+            Probe / tool offset, mm.
+        direction : array_like, shape (3,) or (N, 3), optional
+            Probing direction ``n`` (outward surface normal), with ``probe_error``.
+        probe_error : callable or array_like, optional
+            Probe(n), mm: a callable of (N, 3) directions (:class:`volerr.probe.ProbeMap`) or
+            (N,) values.  Pahk eq. (17): ``+ Probe(n) n`` is added (eq. 17's ``- Probe M`` with
+            ``M = -n`` the contact direction), so the result stays "actual minus nominal": a
+            CMM reports the point minus this error.
+        covariates : dict, optional
+            Values of the layout's covariates (e.g. temperatures), scalar or (N,).
+
+        Returns
+        -------
+        ndarray, shape (N, 3)
+            dx, dy, dz, mm.
+        """
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
         out = self._check_finite(_blocked(
@@ -286,7 +305,22 @@ class Model:
         return self._check_finite(_columns(e, n), errs)
 
     def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
-        """d(error)/d(parameter), (N, 3, n_parameters): mm/mm or mm/rad."""
+        """Sensitivity of the volumetric error to every parameter.
+
+        Parameters
+        ----------
+        positions : dict or array_like
+            As :meth:`volumetric_error` (mm / deg).
+        probe : array_like, shape (3,) or (N, 3)
+            Probe / tool offset, mm.
+        covariates : dict, optional
+            As :meth:`volumetric_error`.
+
+        Returns
+        -------
+        ndarray, shape (N, 3, n_parameters)
+            d(dx, dy, dz)/d(parameter) in :attr:`parameters` order: mm/mm or mm/rad.
+        """
         pos, n = self._points(positions)
         return self._sensitivity(pos, n, probe, covariates)
 
@@ -297,11 +331,29 @@ class Model:
 
     def random_error(self, positions, sigmas, probe=(0.0, 0.0, 0.0),
                      method: str = "exact", covariates=None) -> np.ndarray:
-        """Standard uncertainty of the volumetric error, (N, 3) mm.
+        """Standard uncertainty of the volumetric error (independent parameters).
 
-        ``sigmas``: {name: standard deviation (mm / rad), scalar or (N,)}.  ``method="exact"``
-        is first-order propagation sqrt(sum((dD/dp)^2 sigma_p^2)); ``"termwise"`` is Pahk's
-        printed quadrature (eq. 5, 8), which squares each term alone and drops cross terms."""
+        Parameters
+        ----------
+        positions : dict or array_like
+            As :meth:`volumetric_error` (mm / deg).
+        sigmas : dict
+            ``{name: standard deviation, scalar or (N,)}``, mm / rad, non-negative; missing
+            names are 0.
+        probe : array_like, shape (3,) or (N, 3)
+            Probe / tool offset, mm.
+        method : {"exact", "termwise"}
+            ``"exact"``: first-order propagation sqrt(sum((dD/dp)^2 sigma_p^2));
+            ``"termwise"``: Pahk's printed quadrature (eq. 5, 8), which squares each term alone
+            and drops cross terms such as ``2 Z Zp``.
+        covariates : dict, optional
+            As :meth:`volumetric_error`.
+
+        Returns
+        -------
+        ndarray, shape (N, 3)
+            Standard uncertainties of dx, dy, dz, mm.
+        """
         require(method in ("exact", "termwise"), f"unknown random-error method {method!r}")
         pos, n = self._points(positions)
         sig = self._errors(sigmas, n)

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volerr.units import UM_PER_MM
+
 from ._io import BWD, FWD, PositioningRun
 
 #: axis figures: JSON key (um) -> attribute name
@@ -75,12 +77,12 @@ class Evaluation:
 
     def figures_um(self) -> dict:
         """The axis figures, um, keyed as in the JSON report."""
-        return {k: float(getattr(self, a)) * 1e3 for k, a in FIGURES.items()}
+        return {k: float(getattr(self, a)) * UM_PER_MM for k, a in FIGURES.items()}
 
     def per_target_um(self) -> dict:
         """The per-target arrays as lists, um (targets in mm), keyed as in the JSON report."""
         out = {"targets_mm": [float(v) for v in self.run.targets]}
-        out.update({k: [float(v) * 1e3 for v in getattr(self, a)] for k, a in PER_TARGET.items()})
+        out.update({k: [float(v) * UM_PER_MM for v in getattr(self, a)] for k, a in PER_TARGET.items()})
         return out
 
 
@@ -89,7 +91,21 @@ def _range(values) -> float:
 
 
 def evaluate(run: PositioningRun) -> Evaluation:
-    """All ISO 230-2:2014 clause 3 quantities of ``run`` (definitions in the module docstring)."""
+    """All ISO 230-2:2014 clause 3 quantities of ``run`` (definitions in the module docstring).
+
+    Parameters
+    ----------
+    run : PositioningRun
+        Deviations (actual minus target) at m targets x 2 directions x n cycles, mm
+        (:func:`volerr.positioning.read_run`, optionally :func:`correct_to_20C`).
+
+    Returns
+    -------
+    Evaluation
+        Per-target arrays, shape (m,), and the axis figures A, B, E, M, R (bidirectional and
+        per direction), mm; :meth:`Evaluation.figures_um` and :meth:`Evaluation.per_target_um`
+        give them in um.
+    """
     x = run.deviation                                   # (m, 2, n) mm
     xm = x.mean(axis=2)                                 # (m, 2)
     s = x.std(axis=2, ddof=1)                           # (m, 2): n - 1 in the denominator

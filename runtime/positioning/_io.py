@@ -56,6 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.errors import InputError, require
+from volerr.units import MM_PER_UM, parse_number
 
 FWD, BWD = 0, 1
 DIRECTION_NAMES = ("forward", "backward")
@@ -177,16 +178,7 @@ def _rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
 
 
 def _number(path, lineno, column, text) -> float:
-    require(text != "", f"{path}:{lineno}: empty value in column {column}")
-    try:
-        v = float(text)
-    except ValueError:
-        if re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", text):
-            raise InputError(f"{path}:{lineno}: {column} = {text!r} has a decimal comma; write "
-                             f"numbers with a decimal point") from None
-        raise InputError(f"{path}:{lineno}: {column} = {text!r} is not a number") from None
-    require(math.isfinite(v), f"{path}:{lineno}: {column} = {text} (NaN or infinite)")
-    return v
+    return parse_number(text, f"{path}:{lineno}", column)
 
 
 def _find(low: list[str], names) -> int | None:
@@ -212,7 +204,7 @@ def _unit_column(path, header, rx, what: str, default: str):
                          f"both give the {what}")
     _, j, m = hits[0]
     unit = (m.group("u") or default).lower()
-    return j, (1.0 if unit == "mm" else 1e-3)
+    return j, (1.0 if unit == "mm" else MM_PER_UM)
 
 
 def _cycle_label(path, lineno, column, text: str) -> str:
@@ -317,7 +309,7 @@ def wide_column(name: str):
         if m:
             d = FWD if _DIR_WORDS.get(_canon_dir(m.group("d"))) == 1 else BWD
             unit = (m.group("u") or "um").lower()
-            return d, str(int(m.group("k"))), (1.0 if unit == "mm" else 1e-3)
+            return d, str(int(m.group("k"))), (1.0 if unit == "mm" else MM_PER_UM)
     return None
 
 

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from volerr.tables import ErrorTable
+from volerr.units import MM_PER_M, UM_PER_MM
 
 from ._evaluate import Evaluation
 
@@ -87,7 +88,7 @@ def plot_runs(evaluations, path=None) -> bytes:
     fig, axes = plt.subplots(1, n, figsize=(9.5 * n, 5.2), squeeze=False, sharey=True)
     for k, (ev, ax) in enumerate(zip(evaluations, axes[0])):
         t = ev.run.targets
-        um = 1e3
+        um = UM_PER_MM
         for d, (mean, s, col, arrow, name) in enumerate(
                 ((ev.mean_fwd, ev.s_fwd, "tab:red", "\u2191", "forward"),
                  (ev.mean_bwd, ev.s_bwd, "tab:blue", "\u2193", "backward"))):
@@ -129,57 +130,73 @@ def _f(v: float) -> str:
     return f"{v:.2f}"
 
 
-def report_html(report: dict, png: bytes, inputs, generated: str = "") -> str:
-    """A one-page certificate-like report: conditions, results (runs side by side), the plot
-    (embedded PNG) and the per-target table of every run.  Plain HTML, no network."""
-    runs = report["runs"] if "runs" in report else [report]
+def _row(runs, label, key) -> str:
     e = html.escape
-    head = "".join(f"<th>{e(Path(r['file']).name)} ({e(r['axis'])})</th>" for r in runs)
+    return f"<tr><th class='l'>{e(label)}</th>" + "".join(
+        f"<td>{e(str(r[key])) if not isinstance(r[key], float) else _f(r[key])}</td>"
+        for r in runs) + "</tr>"
 
-    def row(label, key):
-        return f"<tr><th class='l'>{e(label)}</th>" + "".join(
-            f"<td>{e(str(r[key])) if not isinstance(r[key], float) else _f(r[key])}</td>"
-            for r in runs) + "</tr>"
 
-    def trow(label, fn):
-        return f"<tr><th class='l'>{e(label)}</th>" + "".join(
-            f"<td>{e(fn(r))}</td>" for r in runs) + "</tr>"
+def _trow(runs, label, fn) -> str:
+    e = html.escape
+    return f"<tr><th class='l'>{e(label)}</th>" + "".join(
+        f"<td>{e(fn(r))}</td>" for r in runs) + "</tr>"
 
-    def tcorr(r):
-        tc = r["temperature_correction"]
-        if not tc["applied"]:
-            return "none"
-        return (f"to 20 \u00b0C, \u03b1 = {tc['cte_ppm_per_K']:g} ppm/K, P_ref = "
-                f"{tc['reference_mm']:g} mm, T = {tc['temperature_C']['min']:.2f} .. "
-                f"{tc['temperature_C']['max']:.2f} \u00b0C ({tc['temperature_source']}), "
-                f"correction {tc['correction_um']['min']:.2f} .. "
-                f"{tc['correction_um']['max']:.2f} \u00b5m")
 
-    def conds(r):
-        c = r["conditions"]
-        return "; ".join(f"{k}: {v['min']:.2f} .. {v['max']:.2f} (mean {v['mean']:.2f})"
-                         for k, v in c.items()) or "not recorded"
+def _temperature_correction_text(r: dict) -> str:
+    tc = r["temperature_correction"]
+    if not tc["applied"]:
+        return "none"
+    return (f"to 20 \u00b0C, \u03b1 = {tc['cte_ppm_per_K']:g} ppm/K, P_ref = "
+            f"{tc['reference_mm']:g} mm, T = {tc['temperature_C']['min']:.2f} .. "
+            f"{tc['temperature_C']['max']:.2f} \u00b0C ({tc['temperature_source']}), "
+            f"correction {tc['correction_um']['min']:.2f} .. "
+            f"{tc['correction_um']['max']:.2f} \u00b5m")
 
-    conditions = "".join([
-        trow("axis", lambda r: r["axis"]),
-        trow("targets", lambda r: f"{r['n_targets']} from {r['targets_mm'][0]:g} to "
-                                  f"{r['targets_mm'][-1]:g} mm"),
-        row("cycles per direction", "n_cycles"),
-        trow("input format", lambda r: r["format"]),
-        trow("temperatures (\u00b0C)", conds),
-        trow("temperature correction", tcorr),
+
+def _conditions_text(r: dict) -> str:
+    c = r["conditions"]
+    return "; ".join(f"{k}: {v['min']:.2f} .. {v['max']:.2f} (mean {v['mean']:.2f})"
+                     for k, v in c.items()) or "not recorded"
+
+
+def _conditions_rows(runs) -> str:
+    """Rows of the conditions table: axis, targets, cycles, format, temperatures, correction."""
+    return "".join([
+        _trow(runs, "axis", lambda r: r["axis"]),
+        _trow(runs, "targets", lambda r: f"{r['n_targets']} from {r['targets_mm'][0]:g} to "
+                                         f"{r['targets_mm'][-1]:g} mm"),
+        _row(runs, "cycles per direction", "n_cycles"),
+        _trow(runs, "input format", lambda r: r["format"]),
+        _trow(runs, "temperatures (\u00b0C)", _conditions_text),
+        _trow(runs, "temperature correction", _temperature_correction_text),
     ])
+
+
+def _results_rows(runs) -> str:
+    """Rows of the results table: A, E, M, R, B, B_avg (um), directions in small print."""
+    e = html.escape
     results = []
     for key, up, dn, name in _ROWS:
         results.append(f"<tr><th class='l'>{e(key)} \u2014 {e(name)}</th>" + "".join(
             f"<td>{_f(r[key + '_um'])}" + (f" <span class='s'>(\u2191 {_f(r[up + '_um'])}, "
                                           f"\u2193 {_f(r[dn + '_um'])})</span>" if up else "")
             + "</td>" for r in runs) + "</tr>")
+    return "".join(results)
+
+
+_TARGET_COLUMNS = (("targets_mm", "P_i (mm)"), ("mean_fwd_um", "x\u0304\u2191"),
+                   ("mean_bwd_um", "x\u0304\u2193"), ("mean_um", "x\u0304"),
+                   ("reversal_um", "B_i"), ("s_fwd_um", "S\u2191"), ("s_bwd_um", "S\u2193"),
+                   ("R_i_fwd_um", "R_i\u2191"), ("R_i_bwd_um", "R_i\u2193"),
+                   ("R_i_um", "R_i"))
+
+
+def _target_tables(runs) -> str:
+    """One per-target table (um) per run."""
+    e = html.escape
+    cols = _TARGET_COLUMNS
     tables = []
-    cols = (("targets_mm", "P_i (mm)"), ("mean_fwd_um", "x\u0304\u2191"),
-            ("mean_bwd_um", "x\u0304\u2193"), ("mean_um", "x\u0304"), ("reversal_um", "B_i"),
-            ("s_fwd_um", "S\u2191"), ("s_bwd_um", "S\u2193"), ("R_i_fwd_um", "R_i\u2191"),
-            ("R_i_bwd_um", "R_i\u2193"), ("R_i_um", "R_i"))
     for r in runs:
         body = "".join("<tr>" + "".join(f"<td>{r[k][i]:g}</td>" if k == "targets_mm" else
                                         f"<td>{_f(r[k][i])}</td>" for k, _ in cols) + "</tr>"
@@ -187,6 +204,30 @@ def report_html(report: dict, png: bytes, inputs, generated: str = "") -> str:
         tables.append(f"<h3>{e(Path(r['file']).name)} \u2014 per target (\u00b5m)</h3>"
                       f"<table><tr>{''.join(f'<th>{e(h)}</th>' for _, h in cols)}</tr>{body}"
                       f"</table>")
+    return "".join(tables)
+
+
+def report_html(report: dict, png: bytes, inputs, generated: str = "") -> str:
+    """A one-page certificate-like report: conditions, results (runs side by side), the plot
+    (embedded PNG) and the per-target table of every run.  Plain HTML, no network.
+
+    Parameters
+    ----------
+    report : dict
+        :func:`report_dict` of the evaluated runs (deviations um, targets mm).
+    png : bytes
+        The ISO 230-2 plot (:func:`plot_runs`).
+    inputs : sequence of path
+        The run files, listed in the report.
+    generated : str
+        A sentence on how and when the report was made.
+    """
+    runs = report["runs"] if "runs" in report else [report]
+    e = html.escape
+    head = "".join(f"<th>{e(Path(r['file']).name)} ({e(r['axis'])})</th>" for r in runs)
+    conditions = _conditions_rows(runs)
+    results = [_results_rows(runs)]
+    tables = [_target_tables(runs)]
     notes = [f"{Path(r['file']).name}: {n}" for r in runs for n in r["notes"]]
     files = "".join(f"<li><code>{e(str(p))}</code></li>" for p in inputs)
     img = base64.b64encode(png).decode("ascii")
@@ -258,7 +299,7 @@ def error_table_csv(ev: Evaluation) -> str:
 
     t = error_table(ev)
     lines = table_to_csv(t).splitlines()
-    S = repeatability(ev) * 1e3
+    S = repeatability(ev) * UM_PER_MM
     out = [lines[0] + f",S_{t.axis}_um"]
     out += [f"{ln},{float(f'{v:.12g}') + 0.0:.12g}" for ln, v in zip(lines[1:], S)]
     return "\n".join(out) + "\n"
@@ -270,7 +311,7 @@ def standard_notes(run, corrected: bool) -> list[str]:
     if run.n_cycles < 5:
         notes.append(f"{run.n_cycles} cycles per direction; the standard test cycle has 5")
     travel = float(run.targets[-1] - run.targets[0])
-    need = max(5, int(np.ceil(5 * travel / 1000.0)))
+    need = max(5, int(np.ceil(5 * travel / MM_PER_M)))
     if run.n_targets < need:
         notes.append(f"{run.n_targets} targets over {travel:g} mm; the standard asks for at "
                      f"least 5 per metre and at least 5 ({need})")

@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from volerr.errors import require
+from volerr.units import UM_PER_MM
 
 from ._io import PositioningRun
 
@@ -83,5 +84,5 @@ def correct_to_20C(run: PositioningRun, cte_ppm_per_K: float, temperature_C: flo
     out = replace(run, deviation=run.deviation + corr, temperature=T.copy())
     info = ThermalCorrection(float(cte_ppm_per_K), float(reference_mm),
                              (float(T.min()), float(T.mean()), float(T.max())),
-                             (float(corr.min() * 1e3), float(corr.max() * 1e3)), source)
+                             (float(corr.min() * UM_PER_MM), float(corr.max() * UM_PER_MM)), source)
     return out, info

@@ -420,6 +420,15 @@ def calibrate(points, sphere_radius: float, phi_deg=None, theta_deg=None,
     exclude_outliers : bool
         Refit the sphere and the map without the flagged points (they stay in the result,
         flagged, with their Probe relative to the refit).
+    outlier_k : float
+        Flag points whose studentised map residual exceeds ``outlier_k`` x the robust sigma.
+
+    Returns
+    -------
+    ProbeCalibration
+        Fitted centre (3,) mm, effective ball radius ``r_eff`` mm, ``probe`` (n,) mm
+        (Probe = R_eff - (R_m - R_s) at every point), the smooth :class:`ProbeMap` ``map``,
+        outlier flags (n,) and standard uncertainties of centre and R_eff (mm).
     """
     p = check_sphere_points(points)
     require(math.isfinite(sphere_radius) and sphere_radius > 0,

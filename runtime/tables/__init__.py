@@ -1,11 +1,13 @@
-"""Error tables: reading and writing per-axis tables and constants (unit-suffixed CSV), error
-functions of position (linear, cubic, Legendre least squares), fitting identified tables, and the
-controller exchange formats (ISG, Etalon).
+"""Error tables: reading and writing per-axis tables and constants (unit-suffixed CSV,
+:mod:`.table`), error functions of position (linear, cubic, Legendre least squares,
+:mod:`.functions`, :mod:`.legendre`), fitting identified tables (:mod:`.errorfit`), and the
+controller exchange formats (ISG, Etalon, :mod:`.controller`).
 """
 
-from volerr.tables.table import (ErrorFunctions, ErrorTable, read_constants, read_error_dir,
-                                  read_error_table, table_to_csv, write_constants,
-                                  write_error_dir, write_error_table)
+from volerr.tables.table import (ErrorTable, read_constants, read_error_dir, read_error_table,
+                                 table_to_csv, write_constants, write_error_dir,
+                                 write_error_table)
+from volerr.tables.functions import ErrorFunctions  # noqa: E402 (after .table: it imports it)
 
 __all__ = ["ErrorFunctions", "ErrorTable", "read_constants", "read_error_dir", "read_error_table", "table_to_csv", "write_constants", "write_error_dir", "write_error_table"]
 

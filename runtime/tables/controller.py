@@ -41,13 +41,16 @@ them).
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from volerr.errors import InputError, require
 from volerr.fileio import check_header, check_magnitude
-from volerr.tables.table import ErrorTable
+from volerr.machine import iso_names
+from volerr.tables.table import ErrorTable, axis_unit
+from volerr.units import format_number
 
 FORMATS = ("isg", "etalon")
 _COMPONENT = re.compile(r"^E([XYZABC])([XYZABC])$")
@@ -69,7 +72,7 @@ def controller_to_iso(name: str) -> str:
 
 
 def _num(v: float) -> str:
-    return f"{float(v):.12g}"
+    return format_number(v, 12)
 
 
 # ------------------------------------------------------------------------------------------
@@ -87,7 +90,7 @@ def write_isg(model_name: str, tables: dict, constants: dict) -> str:
     for ax in sorted(tables):
         t = tables[ax]
         names = list(t.values)
-        unit = "deg" if ax in "ABC" else "mm"
+        unit = axis_unit(ax)
         rows = [f"// component errors of axis {ax} (argument {ax} in {unit}; values mm, rad)",
                 " ".join([ax] + names)]
         for i, p in enumerate(t.positions):
@@ -125,10 +128,7 @@ def read_isg(text: str, where: str = "ISG CSV") -> tuple[dict, dict]:
             continue
         require(len(cells) == len(header), f"{where} line {lineno}: {len(cells)} values for "
                                             f"{len(header)} columns")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{where} line {lineno}: not a number in {line!r}") from None
+        vals = _numbers(cells, f"{where} line {lineno}", line)
         for v in vals:
             check_magnitude(v, f"{where} line {lineno}: value")
         rows.append((lineno, vals))
@@ -186,60 +186,84 @@ def write_etalon(model_name: str, tables: dict, constants: dict) -> str:
     return "\n".join(out) + "\n"
 
 
-def read_etalon(text: str, where: str = "Etalon file") -> tuple[dict, dict]:
-    """Parse Etalon exchange text -> (tables, constants), ISO names, mm | rad."""
-    constants, columns = {}, {}
-    section, grid, seen = None, None, set()
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = _strip_comment(raw)
-        if not line:
-            continue
-        if grid is not None:
-            if line.startswith("}"):
-                require(grid, f"{where} line {lineno}: empty Gridpoints of {section}")
-                columns[section] = grid
-                grid = None
-                continue
-            cells = line.split()
-            require(len(cells) == 2, f"{where} line {lineno}: expected 'argument value'")
-            try:
-                a, v = float(cells[0]), float(cells[1])
-            except ValueError:
-                raise InputError(f"{where} line {lineno}: not a number in {line!r}") from None
-            check_magnitude(a, f"{where} line {lineno}: argument")
-            check_magnitude(v, f"{where} line {lineno}: value")
-            grid.append((a, v))
-            continue
+@dataclass
+class _EtalonReader:
+    """The state of reading an Etalon file line by line: the current ``[section]``, the open
+    ``Gridpoints`` list (None outside one) and what has been read so far."""
+
+    where: str
+    constants: dict = field(default_factory=dict)
+    columns: dict = field(default_factory=dict)
+    section: str | None = None
+    grid: list | None = None
+    seen: set = field(default_factory=set)
+
+    def line(self, lineno: int, line: str) -> None:
+        """Read one non-blank line (comments stripped)."""
+        if self.grid is not None:
+            self._grid_line(lineno, line)
+            return
         m = re.fullmatch(r"\[\s*([A-Za-z0-9]+)\s*\]", line)
         if m:
-            section = m.group(1).upper()
-            require(section not in seen, f"{where} line {lineno}: [{section}] given twice")
-            seen.add(section)
-            controller_to_iso(section)
-            continue
-        require(section is not None, f"{where} line {lineno}: data before the first [section]")
+            self._section(lineno, m.group(1).upper())
+            return
+        require(self.section is not None,
+                f"{self.where} line {lineno}: data before the first [section]")
         key, _, val = line.partition("=")
-        key, val = key.strip().upper(), val.strip()
+        self._key(lineno, key.strip().upper(), val.strip())
+
+    def _section(self, lineno: int, section: str) -> None:
+        require(section not in self.seen, f"{self.where} line {lineno}: [{section}] given twice")
+        self.seen.add(section)
+        controller_to_iso(section)
+        self.section = section
+
+    def _grid_line(self, lineno: int, line: str) -> None:
+        at = f"{self.where} line {lineno}"
+        if line.startswith("}"):
+            require(self.grid, f"{at}: empty Gridpoints of {self.section}")
+            self.columns[self.section] = self.grid
+            self.grid = None
+            return
+        cells = line.split()
+        require(len(cells) == 2, f"{at}: expected 'argument value'")
+        a, v = _numbers(cells, at, line)
+        check_magnitude(a, f"{at}: argument")
+        check_magnitude(v, f"{at}: value")
+        self.grid.append((a, v))
+
+    def _key(self, lineno: int, key: str, val: str) -> None:
+        at, section = f"{self.where} line {lineno}", self.section
         if key == "VALUE":
             require(_POSITION.match(section) is not None,
-                    f"{where} line {lineno}: [{section}] is a component error; expected Gridpoints")
+                    f"{at}: [{section}] is a component error; expected Gridpoints")
             try:
-                constants["E" + section] = float(val)
+                self.constants["E" + section] = float(val)
             except ValueError:
-                raise InputError(f"{where} line {lineno}: VALUE is not a number") from None
-            check_magnitude(constants["E" + section], f"{where} line {lineno}: VALUE")
+                raise InputError(f"{at}: VALUE is not a number") from None
+            check_magnitude(self.constants["E" + section], f"{at}: VALUE")
         elif key == "GRIDPOINTS":
             require(_COMPONENT.match(section) is not None,
-                    f"{where} line {lineno}: [{section}] is a position error; expected VALUE")
-            require(val.startswith("{"), f"{where} line {lineno}: Gridpoints must open with '{{'")
-            grid = []
+                    f"{at}: [{section}] is a position error; expected VALUE")
+            require(val.startswith("{"), f"{at}: Gridpoints must open with '{{'")
+            self.grid = []
         else:
-            raise InputError(f"{where} line {lineno}: unknown key {key!r} (VALUE or Gridpoints)")
-    require(grid is None, f"{where}: Gridpoints of [{section}] not closed with '}}'")
-    require(constants or columns, f"{where}: no error parameters found")
+            raise InputError(f"{at}: unknown key {key!r} (VALUE or Gridpoints)")
+
+
+def _numbers(cells, at: str, line: str) -> list[float]:
+    try:
+        return [float(c) for c in cells]
+    except ValueError:
+        raise InputError(f"{at}: not a number in {line!r}") from None
+
+
+def _grid_tables(columns: dict, where: str) -> dict:
+    """{axis: ErrorTable} from {component name: [(argument, value), ...]}: the columns of one
+    axis must share their grid points (in any order)."""
     by_axis: dict = {}
     for name, pts in columns.items():
-        by_axis.setdefault(name[2], {})[name] = np.array(pts)
+        by_axis.setdefault(iso_names.parse(name).axis, {})[name] = np.array(pts)
     tables = {}
     for ax, cols in by_axis.items():
         ref = None
@@ -257,7 +281,28 @@ def read_etalon(text: str, where: str = "Etalon file") -> tuple[dict, dict]:
             tables[ax] = ErrorTable(ax, ref, values)
         except InputError as exc:
             raise InputError(f"{where}: {exc}") from None
-    return tables, constants
+    return tables
+
+
+def read_etalon(text: str, where: str = "Etalon file") -> tuple[dict, dict]:
+    """Parse Etalon exchange text.
+
+    Returns
+    -------
+    tables : dict
+        Axis letter -> :class:`volerr.tables.ErrorTable` (ISO names, values mm or rad,
+        positions mm or deg).
+    constants : dict
+        ISO name (``EC0Y`` ...) -> position error, mm or rad.
+    """
+    reader = _EtalonReader(where)
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = _strip_comment(raw)
+        if line:
+            reader.line(lineno, line)
+    require(reader.grid is None, f"{where}: Gridpoints of [{reader.section}] not closed with '}}'")
+    require(reader.constants or reader.columns, f"{where}: no error parameters found")
+    return _grid_tables(reader.columns, where), reader.constants
 
 
 def negated(tables: dict, constants: dict) -> tuple[dict, dict]:

@@ -23,7 +23,8 @@ import numpy as np
 from volerr.units import UM_PER_MM, URAD_PER_RAD
 from volerr.errors import InputError, require
 from volerr.tables import legendre
-from volerr.tables.table import ErrorTable, make_function, parameter_kind
+from volerr.tables.functions import make_function
+from volerr.tables.table import ErrorTable, parameter_kind
 
 METHODS = ("poly", "smooth", "linear", "cubic")
 

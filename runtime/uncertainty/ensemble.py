@@ -41,6 +41,7 @@ import numpy as np
 
 from volerr.machine import iso_names
 from volerr.errors import InputError, require
+from volerr.units import MM_PER_UM
 
 from . import iso10360
 from .iso10360 import Spec, parse_spec  # noqa: F401  (re-exported)
@@ -230,8 +231,8 @@ class SpecMachines(Source):
         box = iso10360.linear_box(model)
         self.test = iso10360.length_test(model, box, self.probe)
         diag = float(np.linalg.norm([box[a][1] - box[a][0] for a in "XYZ"]))
-        mpe_max = float(self.spec.mpe_um(diag)) * 1e-3
-        self.mpe_mm = self.spec.mpe_um(self.test.lengths) * 1e-3
+        mpe_max = float(self.spec.mpe_um(diag)) * MM_PER_UM
+        self.mpe_mm = self.spec.mpe_um(self.test.lengths) * MM_PER_UM
         paxis = model.parameter_axis
         self.params = tuple(model.parameters)
         k = np.arange(1, self.degree + 1)
@@ -318,6 +319,33 @@ class Ensemble:
               mode: str = "systematic", correlation_mm: float = 0.0,
               temperature: Temperature | None = None, probe_map=None, seed: int = 0,
               spec_probe=(0.0, 0.0, 0.0), spec_acceptance: float = 0.5) -> "Ensemble":
+        """The uncertainty sources of a task-specific Monte Carlo.
+
+        Parameters
+        ----------
+        funcs : volerr.tables.ErrorFunctions, optional
+            Error tables with std / u95 columns (perturbed per ``mode``).
+        spec : Spec, optional
+            ISO 10360-2 specification: machines drawn and kept when they pass the simulated
+            test (constrained Monte Carlo).
+        noise_um : float
+            Probing noise, standard deviation per point, um.
+        mode : {"systematic", "repeatability"}
+            Meaning of the tables' std: uncertainty of the tabulated function (one perturbed
+            function per machine) or single-positioning scatter (drawn per point).
+        correlation_mm : float
+            Correlation length of the node perturbations along an axis, mm (0: independent).
+        temperature : Temperature, optional
+            Part and scale expansion and their uncertainties.
+        probe_map : volerr.probe.ProbeMap, optional
+            Probe error map added at each point's probing direction.
+        seed : int
+            Seed of the spec prior scale search.
+        spec_probe : (3,) mm
+            Probe offset of the simulated spec test.
+        spec_acceptance : float
+            Fraction of prior candidates that pass the test (sets the prior scale), in (0, 1).
+        """
         require(mode in ("systematic", "repeatability"),
                 f"unknown table std mode {mode!r} (systematic, repeatability)")
         require(np.isfinite(noise_um) and noise_um >= 0, "--noise-um must be >= 0")
@@ -337,11 +365,11 @@ class Ensemble:
             for name, s in funcs.constants_std.items():
                 if s > 0:
                     sources.append(ConstantParameter(name, s))
-        noise_mm = noise_um * 1e-3
+        noise_mm = noise_um * MM_PER_UM
         if spec is not None:
             if noise_mm == 0 and spec.pftu_um is not None:
                 # PFTU is the range of 25 radial residuals; mean range of 25 N(0,1) = 3.931
-                noise_mm = spec.pftu_um * 1e-3 / 3.931
+                noise_mm = spec.pftu_um * MM_PER_UM / 3.931
             require(0 < spec_acceptance < 1, "--spec-acceptance must lie in (0, 1)")
             sources.append(SpecMachines(spec, noise_mm, probe=tuple(spec_probe), seed=seed,
                                         acceptance=spec_acceptance))

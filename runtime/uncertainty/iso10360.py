@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.errors import require
+from volerr.units import MM_PER_UM, UM_PER_MM
 
 from .tasks import check_travel
 
@@ -221,9 +222,9 @@ def simulate(model, funcs=None, probe=(0.0, 0.0, 0.0), box=None, repetitions: in
     noise = None
     if noise_um > 0:
         rng = np.random.default_rng(seed)
-        noise = rng.standard_normal((1,) + test.lengths.shape + (repetitions, 2)) * noise_um * 1e-3
+        noise = rng.standard_normal((1,) + test.lengths.shape + (repetitions, 2)) * noise_um * MM_PER_UM
     E = length_errors(test, e, noise)[0]
-    return TestResult(test.names, test.lengths, E * 1e3, spec)
+    return TestResult(test.names, test.lengths, E * UM_PER_MM, spec)
 
 
 def plot(result: TestResult, path, title: str, inputs=()) -> None:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.errors import require
+from volerr.units import UM_PER_MM
 
 from .tasks import EVALUATIONS, check_task, check_travel, evaluate
 
@@ -110,7 +111,30 @@ class Problem:
 
 def prepare(model, layout_ref: str, task, evaluation: str, ensemble, seed: int = 0,
             block_size: int = BLOCK_SIZE) -> Problem:
-    """Bind ``ensemble`` (:class:`~.ensemble.Ensemble`) to ``task`` on ``model``."""
+    """Bind ``ensemble`` (:class:`~.ensemble.Ensemble`) to ``task`` on ``model``.
+
+    Parameters
+    ----------
+    model : volerr.Model
+        The machine's error model.
+    layout_ref : str
+        Layout name or file (what a dask worker loads the model from).
+    task : volerr.uncertainty.tasks.Task
+        Probing points (P,) per axis, mm / deg, with probe offsets and directions.
+    evaluation : str
+        One of :data:`volerr.uncertainty.tasks.EVALUATIONS` (distance, circle, sphere, plane).
+    ensemble : volerr.uncertainty.ensemble.Ensemble
+        The plausible machines and the other uncertainty sources.
+    seed : int
+        Seed of every random stream (results independent of chunking).
+    block_size : int
+        Samples per block (the unit of seeding and of work).
+
+    Returns
+    -------
+    Problem
+        Everything a worker needs to draw blocks of samples.
+    """
     require(evaluation in EVALUATIONS, f"unknown evaluation {evaluation!r} "
                                        f"(one of {', '.join(EVALUATIONS)})")
     require(isinstance(seed, int) and seed >= 0, "--seed must be a non-negative integer")
@@ -238,7 +262,26 @@ class Runner:
 
 def run(problem: Problem, samples: int, runner: Runner | None = None,
         first_block: int = 0) -> tuple[np.ndarray, dict]:
-    """``samples`` Monte Carlo values (samples, n_quantities) mm and source counters."""
+    """Draw ``samples`` Monte Carlo values of the task's quantities.
+
+    Parameters
+    ----------
+    problem : Problem
+        From :func:`prepare`.
+    samples : int
+        Number of samples M.
+    runner : Runner, optional
+        Where the blocks run (in process by default, or dask); values are identical.
+    first_block : int
+        Index of the first block (continuing a run draws new, independent blocks).
+
+    Returns
+    -------
+    values : ndarray, shape (samples, n_quantities)
+        The measured quantities of every sampled machine, mm.
+    info : dict
+        Counters of the sources (e.g. ``candidates`` and ``kept`` of a spec ensemble).
+    """
     require(samples >= 2, "--samples must be >= 2")
     runner = runner or Runner()
     if runner._client is None and runner.scheduler == "dask":
@@ -273,7 +316,21 @@ class Adaptive:
 
 def run_adaptive(problem: Problem, runner: Runner | None = None, n_dig: int = 2,
                  p: float = 0.95, max_samples: int = 1_000_000):
-    """Adaptive Monte Carlo (JCGM 101 7.9, see module docstring) -> (values, info, Adaptive)."""
+    """Adaptive Monte Carlo (JCGM 101 7.9, see module docstring).
+
+    Runs of M samples until the standard deviations of the run values of the estimate, u and
+    both interval ends, divided by sqrt(h), are all <= delta / 2, delta the numerical tolerance
+    of u written with ``n_dig`` significant digits; at most ``max_samples`` samples.
+
+    Returns
+    -------
+    values : ndarray, shape (n_samples, n_quantities)
+        All samples of all runs, mm.
+    info : dict
+        Source counters, as :func:`run`.
+    adaptive : Adaptive
+        Runs, samples per run, convergence and the tolerances (mm).
+    """
     require(1 <= n_dig <= 4, "significant digits must be 1..4")
     B = problem.block_size
     M = max(math.ceil(100 / (1 - p)), 10_000)
@@ -323,7 +380,7 @@ def summarize(problem: Problem, values, p: float = 0.95) -> dict:
         out[name] = {
             "estimate_mm": float(mean[j]),
             "nominal_mm": float(problem.nominal_values[j]),
-            "bias_um": float((problem.known_values[j] - problem.nominal_values[j]) * 1e3),
+            "bias_um": float((problem.known_values[j] - problem.nominal_values[j]) * UM_PER_MM),
             "standard_uncertainty_um": float(u[j] * 1e3),
             "expanded_uncertainty_um": float(2 * u[j] * 1e3),
             "coverage_interval_mm": [float(lo[j]), float(hi[j])],
@@ -339,7 +396,7 @@ def contributions(problem: Problem, samples: int = 2000) -> list:
     out = []
     for src in problem.sources:
         v, _ = run(with_sources(problem, [src]), samples)
-        u = v.std(axis=0, ddof=1) * 1e3
+        u = v.std(axis=0, ddof=1) * UM_PER_MM
         out.append({"source": src.name,
                     "standard_uncertainty_um": {n: float(x) for n, x in zip(problem.names, u)}})
     first = problem.names[0]

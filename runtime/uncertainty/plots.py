@@ -7,6 +7,8 @@ import io
 
 import numpy as np
 
+from volerr.units import UM_PER_MM
+
 
 def _fig_bytes(fig, tight: bool = True, dpi: int = 100) -> bytes:
     import matplotlib.pyplot as plt
@@ -36,10 +38,10 @@ def histogram_figure(values, names, summary: dict, title: str):
     for ax, j, name in zip(axes[0], range(k), names):
         s = summary[name]
         est = s["estimate_mm"]
-        d = (values[:, j] - est) * 1e3
+        d = (values[:, j] - est) * UM_PER_MM
         ax.hist(d, bins=60, color="0.65", density=True)
         lo, hi = s["coverage_interval_mm"]
-        for i, x in enumerate(((lo - est) * 1e3, (hi - est) * 1e3)):
+        for i, x in enumerate(((lo - est) * UM_PER_MM, (hi - est) * UM_PER_MM)):
             ax.axvline(x, color="tab:red", lw=1.5, label="95 % interval" if i == 0 else None)
         U = s["expanded_uncertainty_um"]
         for i, x in enumerate((-U, U)):
@@ -79,7 +81,7 @@ def convergence_png(values, names, title: str) -> bytes:
         mean = c1[idx - 1] / idx
         var = (c2[idx - 1] - idx * mean ** 2) / (idx - 1)
         a1.plot(idx, mean * 1e3, label=name)
-        a2.plot(idx, np.sqrt(np.clip(var, 0, None)) * 1e3, label=name)
+        a2.plot(idx, np.sqrt(np.clip(var, 0, None)) * UM_PER_MM, label=name)
     for a, lab in ((a1, "running mean - final / um"), (a2, "running u / um")):
         a.set_xscale("log")
         a.set_xlabel("samples")

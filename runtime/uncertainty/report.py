@@ -1,9 +1,14 @@
-"""HTML report of a task-specific uncertainty: result table, contributions, plots inline."""
+"""Reports of a task-specific uncertainty: the JSON document of ``volerr uncertainty``
+(:func:`result_document`), its printed lines (:func:`summary_lines`) and the HTML report (result
+table, contributions, plots inline).  Estimates and intervals in mm, bias and uncertainties in
+um."""
 
 from __future__ import annotations
 
 import base64
 import html
+
+from volerr.units import UM_PER_MM
 
 
 def num(value, spec: str) -> str:
@@ -15,6 +20,75 @@ def num(value, spec: str) -> str:
     except ValueError:
         return s
     return format(0.0, spec) if zero else s
+
+
+def machine_text(spec=None, errors=None, table_std: str = "") -> str:
+    """What the simulated machines are: ``"spec E0=..."``, ``"tables DIR (meaning of std)"`` or
+    ``"perfect"``."""
+    if spec is not None:
+        return "spec " + spec.text()
+    if errors is not None:
+        return f"tables {errors} ({table_std})"
+    return "perfect"
+
+
+def result_document(problem, values, summary: dict, info: dict, *, layout: str, task: str,
+                    evaluation: str, seed: int, chunks: int, scheduler: str, machine: str,
+                    noise_um: float, adaptive=None, digits: int | None = None,
+                    contributions=None) -> dict:
+    """The JSON document of one Monte Carlo run.
+
+    Parameters
+    ----------
+    problem : volerr.uncertainty.montecarlo.Problem
+        The prepared problem (block size, sources).
+    values : ndarray, shape (n_samples, n_quantities)
+        The Monte Carlo values, mm.
+    summary : dict
+        :func:`volerr.uncertainty.montecarlo.summarize` of ``values``.
+    info : dict
+        Run information; with ``candidates`` and ``kept`` for a constrained (spec) ensemble.
+    adaptive : volerr.uncertainty.montecarlo.Adaptive, optional
+        The adaptive run's record (JCGM 101 7.9); ``digits`` its significant digits.
+    contributions : list, optional
+        :func:`volerr.uncertainty.montecarlo.contributions`.
+    layout, task, evaluation, seed, chunks, scheduler, machine, noise_um
+        Recorded as given (``noise_um`` in um).
+
+    Returns
+    -------
+    dict
+        Keys ``layout task evaluation quantities samples seed block_size chunks scheduler
+        machine noise_um sources`` and, when present, ``spec_acceptance adaptive
+        contributions``.
+    """
+    doc = {"layout": layout, "task": task, "evaluation": evaluation, "quantities": summary,
+           "samples": int(values.shape[0]), "seed": seed, "block_size": problem.block_size,
+           "chunks": chunks, "scheduler": scheduler, "machine": machine, "noise_um": noise_um,
+           "sources": [s.name for s in problem.sources]}
+    if "candidates" in info:
+        doc["spec_acceptance"] = {"candidates": info["candidates"], "kept": info["kept"],
+                                  "fraction": info["kept"] / info["candidates"]}
+    if adaptive is not None:
+        doc["adaptive"] = {"runs": adaptive.runs, "samples_per_run": adaptive.per_run,
+                           "converged": adaptive.converged, "digits": digits,
+                           "tolerance_um": [d * UM_PER_MM for d in adaptive.delta_mm]}
+    if contributions is not None:
+        doc["contributions"] = contributions
+    return doc
+
+
+def summary_lines(doc: dict) -> list[str]:
+    """The lines printed after a run: per quantity estimate (mm), bias, u, U (um) and the 95 %
+    coverage interval (mm)."""
+    lines = [f"{doc['layout']} {doc['evaluation']}: {doc['samples']} samples, seed {doc['seed']}"]
+    for name, q in doc["quantities"].items():
+        lo, hi = q["coverage_interval_mm"]
+        lines.append(f"  {name:9s} {num(q['estimate_mm'], '.6f')} mm  bias "
+                     f"{num(q['bias_um'], '+.3f')} um  u {q['standard_uncertainty_um']:.3f} um  "
+                     f"U {q['expanded_uncertainty_um']:.3f} um  95% [{num(lo, '.6f')}, "
+                     f"{num(hi, '.6f')}] mm")
+    return lines
 
 
 def _img(png: bytes) -> str:

@@ -29,6 +29,7 @@ import numpy as np
 
 from volerr.errors import InputError, require
 from volerr.fileio import read_csv_rows
+from volerr.units import parse_number
 
 EVALUATIONS = {
     "distance": ("distance",),
@@ -75,15 +76,7 @@ def read_task(path, axes=("X", "Y", "Z")) -> Task:
     for lineno, cells in body:
         require(len(cells) == len(header), f"{path}:{lineno}: {len(cells)} fields, header has "
                                            f"{len(header)}")
-        row = []
-        for h, c in zip(low, cells):
-            try:
-                v = float(c)
-            except ValueError:
-                raise InputError(f"{path}:{lineno}: {h} = {c!r} is not a number") from None
-            require(np.isfinite(v), f"{path}:{lineno}: {h} = {c} (NaN or infinite)")
-            row.append(v)
-        data.append(row)
+        data.append([parse_number(c, f"{path}:{lineno}", h) for h, c in zip(low, cells)])
     arr = np.asarray(data, dtype=float)
 
     def col(name):

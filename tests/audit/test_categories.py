@@ -350,7 +350,7 @@ EXPECTED = {"identical": 113, "printing_error": 37, "extraction": 11, "conventio
 @pytest.mark.slow
 def test_counts_per_category():
     """Every verdict has a category; the counts are pinned so that a moved verdict fails."""
-    from volerr.cli.audit import collect
+    from volerr.audit.run import collect
 
     _, verdicts = collect(None)
     counts = Counter(v.category for v in verdicts)

@@ -1,0 +1,224 @@
+"""Error functions of position from the error tables of a directory.
+
+:class:`ErrorFunctions` turns the tables of a directory into functions of position:
+``method="linear"`` (piecewise linear interpolation), ``"cubic"`` (not-a-knot cubic spline,
+exact at the nodes) or ``"poly"`` (least-squares polynomial; the degree is given, or chosen per
+parameter by leave-one-out cross-validation with the one-standard-error rule: the lowest degree
+whose prediction error is within one standard error of the best).  Positions outside a table's
+measured range raise :class:`InputError`; with ``extrapolate=True`` the fitted function itself
+is evaluated there (linear: the end segment extended; cubic: the end polynomial of the spline;
+poly: the polynomial).  Standard deviations are always interpolated linearly (clamped at the
+ends); a ``u95`` column without ``std`` gives ``std = u95 / 2``.
+
+Units: positions mm (linear axes) / deg (rotary axes); errors and standard deviations mm
+(translational) / rad (angular).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volerr.errors import InputError, require
+from volerr.tables import legendre
+from volerr.tables.table import axis_unit, read_error_dir
+
+
+# ---------------------------------------------------------------------------------------------
+# fitting
+def loo_press(x, y, degree: int) -> np.ndarray:
+    """Leave-one-out prediction errors of a least-squares polynomial of ``degree`` (hat matrix);
+    :func:`volerr.tables.legendre.loo_errors`."""
+    return legendre.loo_errors(x, y, degree)
+
+
+def choose_degree(x, y, max_degree: int | None = None) -> int:
+    """Polynomial degree by leave-one-out cross-validation with the one-standard-error rule;
+    :func:`volerr.tables.legendre.choose_degree`."""
+    return legendre.choose_degree(x, y, max_degree)
+
+
+class _Linear:
+    def __init__(self, x, y):
+        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
+
+    def __call__(self, q):
+        q = np.asarray(q, float)
+        out = np.interp(q, self.x, self.y)
+        x, y = self.x, self.y
+        lo, hi = q < x[0], q > x[-1]
+        if lo.any():
+            out[lo] = y[0] + (q[lo] - x[0]) * (y[1] - y[0]) / (x[1] - x[0])
+        if hi.any():
+            out[hi] = y[-1] + (q[hi] - x[-1]) * (y[-1] - y[-2]) / (x[-1] - x[-2])
+        return out
+
+
+def make_function(x, y, method: str = "linear", degree: int | None = None):
+    """One error function of position from nodes ``x`` (increasing) and values ``y``.
+
+    Returns a callable; for ``method="poly"`` it has a ``degree`` attribute."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if method == "linear":
+        return _Linear(x, y)
+    if method == "cubic":
+        from scipy.interpolate import CubicSpline
+        return CubicSpline(x, y, bc_type="not-a-knot", extrapolate=True)
+    if method == "poly":
+        if degree is None:
+            degree = choose_degree(x, y)
+        require(0 <= degree < len(x), f"polynomial degree {degree} needs more than {degree} "
+                                      f"positions, the table has {len(x)}")
+        return legendre.LegendreFit(x, y, degree)
+    raise InputError(f"unknown interpolation method {method!r} (linear, cubic, poly)")
+
+
+METHODS = ("linear", "cubic", "poly")
+
+
+class ErrorFunctions:
+    """Error functions of a machine built from its error tables and constants.
+
+    Call with positions (``{axis: array}`` in mm / deg, or an (N, n_axes) array in
+    ``model.axes`` order) -> ``{name: (N,) array}`` in mm / rad for every parameter that has
+    data (table parameters and constants), ready for ``model.volumetric_error``.
+    :meth:`sigmas` gives the standard deviations the same way, for ``model.random_error``.
+
+    Parameters
+    ----------
+    tables : dict
+        Axis -> :class:`volerr.tables.ErrorTable` (positions mm / deg, values mm / rad).
+    constants : dict or None
+        ISO name (``EC0Y`` ...) -> constant error, mm or rad.
+    model : volerr.Model or str
+        The model whose parameters the tables must name (a layout name or file is loaded).
+    method : {"linear", "cubic", "poly"}
+        Interpolation between the table positions (``poly``: Legendre least squares).
+    degree : int, optional
+        Polynomial degree for ``poly`` (default: by leave-one-out cross-validation).
+    extrapolate : bool
+        Evaluate beyond a table's measured range (default: refuse with InputError).
+    constants_std : dict, optional
+        Standard deviations of the constants, mm or rad.
+    source : str
+        Where the data came from (error messages).
+    """
+
+    def __init__(self, tables: dict, constants: dict | None, model, method: str = "linear",
+                 degree: int | None = None, extrapolate: bool = False,
+                 constants_std: dict | None = None, source: str = ""):
+        if isinstance(model, str):
+            from volerr.machine.model import load
+            model = load(model)
+        require(method in METHODS, f"unknown interpolation method {method!r} (linear, cubic, poly)")
+        require(degree is None or method == "poly", "a polynomial degree needs method 'poly'")
+        require(degree is None or degree >= 0, f"polynomial degree must be >= 0, got {degree}")
+        self.model, self.method, self.extrapolate = model, method, bool(extrapolate)
+        self.source = source
+        where = f"{source}: " if source else ""
+        params, paxis = set(model.parameters), model.parameter_axis
+        self.tables = dict(tables or {})
+        self.constants = {k: float(v) for k, v in (constants or {}).items()}
+        self.constants_std = {k: float(v) for k, v in (constants_std or {}).items()}
+        for ax, t in self.tables.items():
+            require(ax in model.axes, f"{where}table for axis {ax}, but {model.name} has axes "
+                                      f"{' '.join(model.axes)}")
+            for name in t.values:
+                require(name in params and paxis.get(name) == ax,
+                        f"{where}{ax}.csv: {model.name} has no parameter {name}")
+        for name in list(self.constants) + list(self.constants_std):
+            require(name in params and paxis.get(name) is None,
+                    f"{where}constants: {model.name} has no constant parameter {name} "
+                    f"(its constants are {' '.join(p for p in model.parameters if paxis[p] is None)})")
+        self.functions, self.std_functions, self.degrees = {}, {}, {}
+        for ax, t in self.tables.items():
+            for name, y in t.values.items():
+                try:
+                    f = make_function(t.positions, y, method, degree)
+                except InputError as exc:
+                    raise InputError(f"{where}{ax}.csv {name}: {exc}") from None
+                self.functions[name] = (ax, f)
+                if method == "poly":
+                    self.degrees[name] = f.degree
+                s = t.std.get(name)
+                if s is None and name in t.u95:
+                    s = t.u95[name] / 2.0
+                if s is not None:
+                    self.std_functions[name] = (ax, _clamped(t.positions, s))
+
+    @classmethod
+    def from_dir(cls, directory, model, method: str = "linear", degree: int | None = None,
+                 extrapolate: bool = False) -> "ErrorFunctions":
+        """Read an error directory (``X.csv`` ... ``constants.csv``) for ``model``."""
+        if isinstance(model, str):
+            from volerr.machine.model import load
+            model = load(model)
+        tables, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
+        cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}
+        return cls(tables, consts, model, method, degree, extrapolate, constants_std=cstd,
+                   source=str(directory))
+
+    # ---- evaluation ---------------------------------------------------------------------
+    @property
+    def has_random(self) -> bool:
+        """True when any table or constant carries a standard deviation (or u95)."""
+        return bool(self.std_functions or self.constants_std)
+
+    def ranges(self) -> dict:
+        """Axis -> (min, max) measured position of its table."""
+        return {ax: (float(t.positions[0]), float(t.positions[-1])) for ax, t in self.tables.items()}
+
+    def _positions(self, positions) -> tuple[dict, int]:
+        axes = self.model.axes
+        if isinstance(positions, dict):
+            unknown = set(positions) - set(axes)
+            if unknown:
+                raise InputError(f"unknown axis {sorted(unknown)[0]!r}; axes are {' '.join(axes)}")
+            missing = [a for a in self.tables if a not in positions]
+            require(not missing, f"positions lack axis {missing[0] if missing else ''}")
+            cols = {a: np.atleast_1d(np.asarray(v, dtype=float)) for a, v in positions.items()}
+        else:
+            arr = np.asarray(positions, dtype=float)
+            arr = arr[None, :] if arr.ndim == 1 else arr
+            require(arr.ndim == 2 and arr.shape[1] == len(axes),
+                    f"positions must have {len(axes)} columns ({' '.join(axes)}), got {arr.shape}")
+            cols = {a: arr[:, i] for i, a in enumerate(axes)}
+        shape = np.broadcast_shapes(*(v.shape for v in cols.values()))
+        cols = {a: np.broadcast_to(v, shape).ravel() for a, v in cols.items()}
+        n = int(np.prod(shape)) if shape else 1
+        for a, v in cols.items():
+            require(np.all(np.isfinite(v)), f"position {a} has NaN or infinite values")
+        if not self.extrapolate:
+            for ax, (lo, hi) in self.ranges().items():
+                v = cols[ax]
+                tol = 1e-9 * max(1.0, hi - lo)
+                bad = (v < lo - tol) | (v > hi + tol)
+                if bad.any():
+                    u = axis_unit(ax)
+                    x = v[bad][np.argmax(np.abs(v[bad] - 0.5 * (lo + hi)))]
+                    raise InputError(f"{ax} = {x:g} {u} is outside the measured range "
+                                     f"{lo:g} .. {hi:g} {u} of table {ax} (no extrapolation "
+                                     f"unless asked for)")
+        return cols, n
+
+    def __call__(self, positions) -> dict:
+        """Error values at ``positions`` ({axis: (N,)} or (N, n_axes), mm / deg): name -> (N,)
+        array, mm / rad, for every table parameter and constant."""
+        cols, n = self._positions(positions)
+        out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
+               for name, (ax, f) in self.functions.items()}
+        out.update({k: np.full(n, v) for k, v in self.constants.items()})
+        return out
+
+    def sigmas(self, positions) -> dict:
+        """Standard deviations (mm / rad) at ``positions`` (as :meth:`__call__`): name -> (N,)
+        array; a ``u95`` column without ``std`` counts as ``u95 / 2``."""
+        cols, n = self._positions(positions)
+        out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
+               for name, (ax, f) in self.std_functions.items()}
+        out.update({k: np.full(n, v) for k, v in self.constants_std.items()})
+        return out
+
+
+def _clamped(x, y):
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    return lambda q: np.interp(np.asarray(q, float), x, y)
