@@ -5,7 +5,6 @@ from importlib import resources
 
 import numpy as np
 import pytest
-import sympy as sp
 
 from volerr.derive import audit_tracker, three_point
 

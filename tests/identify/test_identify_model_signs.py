@@ -2,8 +2,6 @@
 (exact rigid-body simulation of the table's own motion) -> ``identify --signs model`` -> the
 model's volumetric error equals the exact error of the tool point relative to the table."""
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest

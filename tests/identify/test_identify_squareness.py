@@ -109,14 +109,11 @@ def test_fit_table_weighted_and_smooth():
 def test_shipped_example_identifies_and_gives_squareness(tmp_path):
     """The shipped example tracker data (simulated, tests/tracker_sim.example_set) through
     identify and squareness recovers the simulated truth within the stated uncertainty."""
-    import sys
     from importlib import resources
-    from pathlib import Path
     from helpers.tracker_sim import example_set
 
     from volerr.identify.solve import identify
     from volerr.machine.layout import read_layout
-    from volerr.tables.table import ErrorTable
     from volerr.identify.tracker_io import read_tracker_csv
 
     data, sq = example_set()

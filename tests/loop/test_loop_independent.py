@@ -6,7 +6,6 @@ seeds once gave a spurious periodic / higher-order effect, when the degree was t
 the cross-validation minimum, and a gauge column reported as unidentifiable).  Planted effects:
 the right kind, attributed to the right axis/component, held-out error down to the noise."""
 
-import numpy as np
 import pytest
 
 from volerr.loop.run import run_loop
