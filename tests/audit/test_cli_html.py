@@ -53,9 +53,7 @@ def test_html_page_mb1(tmp_path):
 
 
 @pytest.mark.slow
-def test_html_every_document(tmp_path):
-    out = tmp_path / "all.html"
-    r = run("--html", str(out))
-    assert r.returncode == 0, r.stderr
-    page = out.read_text("utf-8")
+@pytest.mark.xdist_group("full_audit")
+def test_html_every_document(full_audit):
+    r, _, page = full_audit
     assert '<h2 id="pahk-1995">' in page and '<h2 id="ellingsdalen-2021">' in page
