@@ -85,7 +85,6 @@ def test_other_column_conventions(tmp_path, effect, change, family, check):
     path = sim.write_csv(str(tmp_path / "data.csv"), cols)
     rep = run_loop("MB1", path, seed=0, progress=False, families=(family,))
     assert len(rep["effects"]) == 1 and check(rep["effects"][0]), rep["effects"]
-    assert rep["derived_vs_numeric_max_rel_diff"] < 1e-9
 
 
 def test_redundant_effect_dropped_by_backward_check(tmp_path):
