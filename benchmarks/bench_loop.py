@@ -9,6 +9,11 @@ solve of the declared design of the same points (what a single fit costs).  BLAS
 to one thread inside the loop (threadpoolctl).
 
     python benchmarks/bench_loop.py [n_points ...]      (default: 10000 100000)
+    python benchmarks/bench_loop.py --threads N         default BLAS threads vs one thread
+
+``--threads``: the loop on N points twice, with the loop's one-thread BLAS limit lifted
+(default threads) and as shipped (one thread); wall and CPU time of each.  Start a busy
+process first to see the effect of a shared core (OpenBLAS threads spin-wait).
 """
 
 import resource
@@ -49,6 +54,30 @@ def one(n: int) -> None:
     print("  " + rep.summary())
 
 
+def threads(n: int) -> None:
+    import contextlib
+
+    import threadpoolctl
+
+    model = volerr.load("MB1")
+    camp = simulate("MB1", n_points=n, seed=7, probes=demo_probes(model), rounds=2,
+                    effects=[{"kind": "thermal", "axis": "Y", "ppm_per_K": 6.0}])
+    camp.covariates = {c: v for c, v in camp.covariates.items() if c in KEEP}
+    data = columns_to_data(camp.columns(), model)
+    shipped = threadpoolctl.threadpool_limits
+    for mode in ("default threads", "one thread"):
+        threadpoolctl.threadpool_limits = (shipped if mode == "one thread" else
+                                           lambda **k: contextlib.nullcontext())
+        t0, c0 = time.perf_counter(), time.process_time()
+        run_loop("MB1", data, progress=False)
+        print(f"{mode}: wall {time.perf_counter() - t0:.2f} s, "
+              f"CPU {time.process_time() - c0:.2f} s")
+    threadpoolctl.threadpool_limits = shipped
+
+
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["--threads"]:
+        threads(int(sys.argv[2]) if len(sys.argv) > 2 else 30000)
+        sys.exit()
     for arg in (sys.argv[1:] or ["10000", "100000"]):
         one(int(arg))

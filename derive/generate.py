@@ -73,6 +73,11 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "Exact d(tool tip x, y, z; tool axis i, j, k)/d(axis positions in AXES order): "
                  "array (6, n_axes, *shape), mm/mm, mm/rad, 1/mm (= 0) and 1/rad.",
                  shape=(6, len(pos))),
+        Function("setup_sensitivity", pos + probe, list(vol.setup_sensitivity(chain)),
+                 "d(dX, dY, dZ)/d(rigid twist dx, dy, dz, ex, ey, ez) of the workpiece frame "
+                 "(columns 0-5, first in the chain: the instrument's placement) and of the tool "
+                 "end (columns 6-11, tool frame): array (3, 12, *shape), mm/mm and mm/rad.",
+                 shape=(3, 12)),
         Function("nominal_position", pos + probe, list(vol.nominal_point(chain)),
                  "Nominal probe-tip / tool-tip position in the workpiece frame, mm."),
         Function("tool_axis", pos, list(vol.nominal_tool_axis(chain)),

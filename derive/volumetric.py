@@ -82,6 +82,24 @@ def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
     return out
 
 
+#: twist coordinates of :func:`setup_sensitivity` (work end, then tool end)
+SETUP_TWIST = ("dx", "dy", "dz", "ex", "ey", "ez")
+
+
+def setup_sensitivity(chain: Chain) -> sp.Matrix:
+    """3 x 12 matrix d(dX, dY, dZ)/d(twist): columns 0-5 a small rigid twist
+    (dx, dy, dz mm; ex, ey, ez rad) of the workpiece frame standing first in the chain (the
+    measuring instrument's placement: ``(I + D) T p``), columns 6-11 the same twist at the
+    tool end, in the tool frame, standing last (``T (I + D) p``: a probe / tool offset error).
+    Exact in the nominal chain (first order in the twist)."""
+    syms = sp.symbols("_tw_dx _tw_dy _tw_dz _tw_ex _tw_ey _tw_ez", real=True)
+    d = twist(**dict(zip(SETUP_TWIST, syms)))
+    T, p = chain.nominal_htm(), sp.Matrix([*PROBE, 1])
+    work = (d * (T * p))[0:3, 0].jacobian(sp.Matrix(syms))
+    tool = (T * (d * p))[0:3, 0].jacobian(sp.Matrix(syms))
+    return work.row_join(tool).applyfunc(sp.expand)
+
+
 def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
     """Pahk's printed quadrature (eq. 5, 8): every monomial of a sensitivity squared alone,
     so cross terms such as 2 Z Zp of (Z + Zp)^2 are dropped."""

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
-derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
+derivation sha256  0632ad81df0ab9a3233a6142ddcb8ab78f3b692d4d13db5b3177007d1cc5eb64
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -1373,6 +1373,96 @@ def nominal_jacobian(X, Y, Z, B, C, Xp, Yp, Zp):
     _out[4, 3] = _t29
     _out[4, 4] = _t18
     _out[5, 3] = -_t30
+    return _out
+
+
+def setup_sensitivity(X, Y, Z, B, C, Xp, Yp, Zp):
+    """d(dX, dY, dZ)/d(rigid twist dx, dy, dz, ex, ey, ez) of the workpiece frame (columns 0-5,
+    first in the chain: the instrument's placement) and of the tool end (columns 6-11, tool
+    frame): array (3, 12, *shape), mm/mm and mm/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = (1/2)*Z
+    _t1 = (1/2)*d
+    _t2 = (1/2)*Y
+    _t3 = (1/2)*Yp
+    _t4 = numpy.cos(B)
+    _t5 = (1/2)*Zp
+    _t6 = _t4*_t5
+    _t7 = numpy.sqrt(2)
+    _t8 = numpy.sin(B)
+    _t9 = _t7*_t8
+    _t10 = (1/2)*_t9
+    _t11 = (1/2)*Xp
+    _t12 = _t3*_t4 + _t5
+    _t13 = -X*_t10 + _t0*_t4 + _t0 - _t1*_t4 + _t1 - _t11*_t9 + _t12 + _t2*_t4 - _t2 - _t3 + _t6
+    _t14 = numpy.cos(C)
+    _t15 = (1/2)*_t14
+    _t16 = Xp*_t15
+    _t17 = -_t16*_t9
+    _t18 = numpy.sin(C)
+    _t19 = _t18*_t3
+    _t20 = _t19*_t9
+    _t21 = _t14*_t2
+    _t22 = _t1*_t14
+    _t23 = _t14*_t5
+    _t24 = _t18*_t4
+    _t25 = _t14*_t4
+    _t26 = _t25*_t3
+    _t27 = _t18*_t2
+    _t28 = _t0*_t18
+    _t29 = _t18*_t5
+    _t30 = _t29*_t9
+    _t31 = _t14*_t3
+    _t32 = _t25*_t5 + _t30 + _t31
+    _t33 = (-1/2*X*_t14*_t7*_t8 + X*_t24 + Xp*_t24 - 1/2*Z*_t14 + _t0*_t25 - 1/2*_t14*_t4*d + _t17
+        - 1/2*_t18*_t7*_t8*d + _t2*_t25 + _t20 + _t21 + _t22 - _t23 + _t26 + _t27*_t9 + _t28*_t9
+        + _t32)
+    _t34 = (1/2)*_t18
+    _t35 = _t34*_t9
+    _t36 = _t34*_t4
+    _t37 = _t15*_t9
+    _t38 = _t24*_t5
+    _t39 = _t23*_t9
+    _t40 = _t31*_t9
+    _t41 = -_t24*_t3 + _t29 + _t40
+    _t42 = Xp*_t34
+    _t43 = Xp*_t36 + _t17
+    _t44 = _t42*_t9
+    _t45 = (X*_t25 + X*_t35 + Xp*_t25 + _t0*_t14*_t9 - _t0*_t24 - _t1*_t18 + _t1*_t24 - _t19
+        - _t2*_t24 + _t21*_t9 - _t22*_t9 - _t27 + _t28 - _t38 + _t39 + _t41 + _t44)
+    _t46 = (1/2)*_t25 + _t35
+    _t47 = _t11*_t25 + _t44
+    _t48 = (1/2)*_t4
+    _t49 = Xp*_t48
+    _out = numpy.zeros((3, 12) + _shape)
+    _out[0, 0] = 1
+    _out[0, 4] = _t13
+    _out[0, 5] = -_t33
+    _out[0, 6] = _t25 + _t35
+    _out[0, 7] = -_t34 - _t36 + _t37
+    _out[0, 8] = _t34 - _t36 + _t37
+    _out[0, 9] = _t19 + _t38 - _t39 + _t41
+    _out[0, 10] = Zp*_t25 + _t30 - _t42 + _t43
+    _out[0, 11] = -Yp*_t25 - _t20 - _t42 - _t43
+    _out[1, 1] = 1
+    _out[1, 3] = -_t13
+    _out[1, 5] = _t45
+    _out[1, 6] = _t18*_t4 - _t37
+    _out[1, 7] = _t15 + _t46
+    _out[1, 8] = -_t15 + _t46
+    _out[1, 9] = _t20 - _t23 + _t26 - _t32
+    _out[1, 10] = (1/2)*Xp*_t14 + Zp*_t18*_t4 - _t39 - _t47
+    _out[1, 11] = -Yp*_t24 + _t16 + _t40 + _t47
+    _out[2, 2] = 1
+    _out[2, 3] = _t33
+    _out[2, 4] = -_t45
+    _out[2, 6] = -_t10
+    _out[2, 7] = _t48 - 1/2
+    _out[2, 8] = _t48 + 1/2
+    _out[2, 9] = _t12 + _t3 - _t6
+    _out[2, 10] = -_t11 - _t49 - _t5*_t9
+    _out[2, 11] = -_t11 + _t3*_t9 + _t49
     return _out
 
 

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       a47a1650cc12d3db47d92764978ee4bb013956fe536312cb0baad903987dbdb5
-derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
+derivation sha256  0632ad81df0ab9a3233a6142ddcb8ab78f3b692d4d13db5b3177007d1cc5eb64
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -277,6 +277,37 @@ def nominal_jacobian(X, Y, Z, Xp, Yp, Zp):
     _out[0, 0] = 1
     _out[1, 1] = 1
     _out[2, 2] = 1
+    return _out
+
+
+def setup_sensitivity(X, Y, Z, Xp, Yp, Zp):
+    """d(dX, dY, dZ)/d(rigid twist dx, dy, dz, ex, ey, ez) of the workpiece frame (columns 0-5,
+    first in the chain: the instrument's placement) and of the tool end (columns 6-11, tool
+    frame): array (3, 12, *shape), mm/mm and mm/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = Z + Zp
+    _t1 = Y + Yp
+    _t2 = X + Xp
+    _out = numpy.zeros((3, 12) + _shape)
+    _out[0, 0] = 1
+    _out[0, 4] = _t0
+    _out[0, 5] = -_t1
+    _out[0, 6] = 1
+    _out[0, 10] = Zp
+    _out[0, 11] = -Yp
+    _out[1, 1] = 1
+    _out[1, 3] = -_t0
+    _out[1, 5] = _t2
+    _out[1, 7] = 1
+    _out[1, 9] = -Zp
+    _out[1, 11] = Xp
+    _out[2, 2] = 1
+    _out[2, 3] = _t1
+    _out[2, 4] = -_t2
+    _out[2, 8] = 1
+    _out[2, 9] = Yp
+    _out[2, 10] = -Xp
     return _out
 
 

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9e0b9225cac4964404bf2e854a5173268922f8f2cc7f38758d6dc04d440f1726
-derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
+derivation sha256  0632ad81df0ab9a3233a6142ddcb8ab78f3b692d4d13db5b3177007d1cc5eb64
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -690,6 +690,56 @@ def nominal_jacobian(X, Y, Z, B, C, Xp, Yp, Zp):
     _out[4, 3] = _t8
     _out[4, 4] = _t4
     _out[5, 3] = -_t3
+    return _out
+
+
+def setup_sensitivity(X, Y, Z, B, C, Xp, Yp, Zp):
+    """d(dX, dY, dZ)/d(rigid twist dx, dy, dz, ex, ey, ez) of the workpiece frame (columns 0-5,
+    first in the chain: the instrument's placement) and of the tool end (columns 6-11, tool
+    frame): array (3, 12, *shape), mm/mm and mm/rad."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(B)
+    _t1 = numpy.sin(B)
+    _t2 = Xp*_t1
+    _t3 = -L*_t0 + L + Z + Zp*_t0 - _t2
+    _t4 = numpy.cos(C)
+    _t5 = Yp*_t4
+    _t6 = numpy.sin(C)
+    _t7 = Xp*_t6
+    _t8 = Zp*_t6
+    _t9 = -L*_t1*_t6 + Y + _t0*_t7 + _t1*_t8 + _t5
+    _t10 = _t0*_t4
+    _t11 = _t1*_t4
+    _t12 = Yp*_t6
+    _t13 = -L*_t11 + X + Xp*_t10 + Zp*_t11 - _t12
+    _out = numpy.zeros((3, 12) + _shape)
+    _out[0, 0] = 1
+    _out[0, 4] = _t3
+    _out[0, 5] = -_t9
+    _out[0, 6] = _t10
+    _out[0, 7] = -_t6
+    _out[0, 8] = _t11
+    _out[0, 9] = _t1*_t5 + _t8
+    _out[0, 10] = Zp*_t0*_t4 - _t2*_t4
+    _out[0, 11] = -_t0*_t5 - _t7
+    _out[1, 1] = 1
+    _out[1, 3] = -_t3
+    _out[1, 5] = _t13
+    _out[1, 6] = _t0*_t6
+    _out[1, 7] = _t4
+    _out[1, 8] = _t1*_t6
+    _out[1, 9] = -Zp*_t4 + _t1*_t12
+    _out[1, 10] = Zp*_t0*_t6 - _t2*_t6
+    _out[1, 11] = Xp*_t4 - _t0*_t12
+    _out[2, 2] = 1
+    _out[2, 3] = _t9
+    _out[2, 4] = -_t13
+    _out[2, 6] = -_t1
+    _out[2, 8] = _t0
+    _out[2, 9] = Yp*_t0
+    _out[2, 10] = -Xp*_t0 - Zp*_t1
+    _out[2, 11] = Yp*_t1
     return _out
 
 

@@ -93,26 +93,19 @@ def rotary_rad(model: Model, positions: dict) -> dict:
             for a, v in positions.items()}
 
 
-def nominal_frame(model: Model, data: Data):
-    """Nominal probe point (N, 3) and tool rotation (N, 3, 3) in the workpiece frame."""
-    p0 = model.nominal_position(data.positions, data.probe)
-    rot = np.empty((data.n, 3, 3))
-    for k in range(3):
-        e = np.zeros(3)
-        e[k] = 1.0
-        rot[:, :, k] = model.nominal_position(data.positions, data.probe + e) - p0
-    return p0, rot
+#: target name -> column of the generated ``setup_sensitivity`` (work end, then tool end)
+TWIST = {f"{side}.{k}": 6 * i + j for i, side in enumerate(("work", "tool"))
+         for j, k in enumerate(SETUP)}
 
 
-def twist_columns(side: str, key: str, data: Data, frame) -> np.ndarray:
-    """(N, 3) effect of a unit twist coordinate of the workpiece-end or tool-end factor."""
-    p0, rot = frame
-    k = "xyz".index(key[1])
-    e = np.zeros((data.n, 3))
-    e[:, k] = 1.0
-    if side == "work":
-        return e if key[0] == "d" else np.cross(e, p0)
-    return np.einsum("nij,nj->ni", rot, e if key[0] == "d" else np.cross(e, data.probe))
+def twist_sensitivity(model: Model, data: Data) -> np.ndarray:
+    """(N, 3, 12) d(error)/d(rigid twist) of the workpiece frame (columns 0-5: dx, dy, dz mm,
+    ex, ey, ez rad; the instrument's placement) and of the tool end (6-11, tool frame): the
+    generated ``setup_sensitivity`` of the layout's chain."""
+    pos = model.positions(data.positions)
+    p = data.probe
+    s = model.module.setup_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
+    return np.moveaxis(np.broadcast_to(s, (3, 12, data.n)), -1, 0)
 
 
 @dataclass
@@ -122,17 +115,17 @@ class Design:
     A: np.ndarray
     labels: list            # (parameter, degree) ; degree None for constants; ("setup", key)
     sens: np.ndarray        # model sensitivity (N, 3, n_parameters)
-    frame: tuple
+    twist: np.ndarray       # rigid-twist sensitivity (N, 3, 12), see twist_sensitivity
 
 
 def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Design:
     """All columns of the declared model with component errors of degree ``degree``."""
     cov = {c: data.covariates[c] for c in model.covariates}
     sens = model.sensitivity(data.positions, data.probe, covariates=cov)
-    frame = nominal_frame(model, data)
+    tw = twist_sensitivity(model, data)
     cols, labels = [], []
     for key in SETUP:
-        cols.append(twist_columns("work", key, data, frame))
+        cols.append(tw[:, :, TWIST[f"work.{key}"]])
         labels.append(("setup", key))
     bases = {a: legendre(unit(data.positions[a], *ranges[a]), degree) for a in model.axes}
     for j, p in enumerate(model.parameters):
@@ -144,7 +137,7 @@ def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Desi
         for k in range(degree + 1):
             cols.append(sens[:, :, j] * bases[axis][:, k:k + 1])
             labels.append((p, k))
-    return Design(np.stack(cols, axis=-1), labels, sens, frame)
+    return Design(np.stack(cols, axis=-1), labels, sens, tw)
 
 
 def _priority(label) -> int:

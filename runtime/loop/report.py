@@ -91,10 +91,10 @@ def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str
     from volerr.machine.expressions import evaluate
 
     c = info.get("covariate")
-    if kind == "periodic":
+    if kind == "periodic" and {"axis", "period"} <= set(info):
         a, p = info["axis"], info["period"]
         return np.mod(dat.positions[a], p), f"{a} modulo {p:.3f}, mm"
-    if kind == "coupling":
+    if kind == "coupling" and {"axis", "depends_on"} <= set(info):
         a, b = info["axis"], info["depends_on"]
         u = {q: (2 * dat.positions[q] - dat.positions[q].min() - dat.positions[q].max())
              / max(np.ptp(dat.positions[q]), 1e-300) for q in (a, b)}

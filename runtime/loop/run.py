@@ -18,8 +18,7 @@ Steps (:func:`run_loop`):
    stop when no candidate passes; then a backward check drops any effect that, given all
    the others, no longer gains dBIC < -10 (a later effect made it redundant);
 6. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
-   it, and fit it: it gives the "after" figures, and its derived sensitivities are checked
-   against the numeric columns used during the search;
+   it, and fit it with the columns of its generated module: it gives the "after" figures;
 7. report: :class:`Report` (with the ranked residual sources before and after) (``write_json``, ``write_html``).
 
 Units: deviations in mm inside, um in reports; angular parameters urad; thermal um/m/K.
@@ -120,13 +119,29 @@ def columns_to_data(cols: dict, model: Model, where: str = "data", text=None) ->
     label column): an error when the column is needed, else a warning and left out.  A
     covariate with NaN is left out with a warning; positions, offsets and deviations must be
     finite."""
-    text = dict(text or {})
+    cols, text = dict(cols), dict(text or {})
     for h in list(cols):
         v = np.asarray(cols[h], dtype=float)
         if not np.all(np.isfinite(v)):
             k = int(np.flatnonzero(~np.isfinite(v))[0])
             text[h] = f"{where}: column {h} row {k + 2} is NaN or infinite"
             del cols[h]
+    warnings = _text_columns(text, model, where)
+    find = _Finder(cols, where)
+    positions = _positions(find, model, where)
+    n = len(next(iter(positions.values())))
+    probe = _probe(find, n, where)
+    dev = _deviations(find, cols, n, where)
+    covs = {c: v for c, v in cols.items() if c not in find.used
+            and not c.startswith(("dx", "dy", "dz"))}
+    missing = [c for c in model.covariates if c not in covs]
+    require(not missing, f"{where}: layout {model.name} needs covariate column "
+            f"{missing[0] if missing else ''}")
+    return Data(positions, probe, dev, covs, warnings)
+
+
+def _text_columns(text: dict, model: Model, where: str) -> list:
+    """Refuse a needed column that is not numeric; one warning for each other such column."""
     needed = {a + u for a in model.axes for u in ("", "_mm", "_deg")}
     needed |= {c + u for c in ("Xp", "Yp", "Zp") for u in ("", "_mm")}
     needed |= {f"{d}_{u}" for d in ("dx", "dy", "dz") for u in ("um", "mm")}
@@ -137,17 +152,27 @@ def columns_to_data(cols: dict, model: Model, where: str = "data", text=None) ->
         warnings.append(f"column {h} is not numeric: left out of the candidates" if msg is None
                         else f"column {h} has a value that is not a finite number: left out "
                              f"of the candidates")
-    used = set()
+    return warnings
 
-    def find(name, units, what):
-        hits = [f"{name}{u}" for u in units if f"{name}{u}" in cols]
-        require(len(hits) <= 1, f"{where}: both {' and '.join(hits)} given for {what}")
+
+class _Finder:
+    """Finds a column under one of its unit spellings; remembers the columns used."""
+
+    def __init__(self, cols: dict, where: str):
+        self.cols, self.where, self.used = cols, where, set()
+
+    def __call__(self, name, units, what):
+        hits = [f"{name}{u}" for u in units if f"{name}{u}" in self.cols]
+        require(len(hits) <= 1, f"{self.where}: both {' and '.join(hits)} given for {what}")
         if hits:
-            used.add(hits[0])
+            self.used.add(hits[0])
             return hits[0]
         return None
 
-    positions = {}
+
+def _positions(find: _Finder, model: Model, where: str) -> dict:
+    """Axis columns (mm | deg): every axis of the layout, no other, inside the travel."""
+    cols, positions = find.cols, {}
     for a in model.axes:
         unit = ("", "_deg") if a in model.rotary_axes else ("", "_mm")
         c = find(a, unit, f"axis {a}")
@@ -166,12 +191,21 @@ def columns_to_data(cols: dict, model: Model, where: str = "data", text=None) ->
         out = np.flatnonzero((v < lo - margin) | (v > hi + margin))
         require(len(out) == 0, f"{where}: {a} = {v[out[0]] if len(out) else 0:g} lies outside "
                 f"the travel [{lo:g}, {hi:g}] of layout {model.name}: layout mismatch")
-    probe = np.zeros((n, 3))
+    return positions
+
+
+def _probe(find: _Finder, n: int, where: str) -> np.ndarray:
+    """Probe / tool offsets (n, 3) mm: all of Xp, Yp, Zp or none (zero)."""
     pc = [find(c, ("", "_mm"), f"probe offset {c}") for c in ("Xp", "Yp", "Zp")]
     require(all(c is None for c in pc) or all(c is not None for c in pc),
             f"{where}: give all of Xp, Yp, Zp or none")
-    if pc[0] is not None:
-        probe = np.column_stack([cols[c] for c in pc])
+    if pc[0] is None:
+        return np.zeros((n, 3))
+    return np.column_stack([find.cols[c] for c in pc])
+
+
+def _deviations(find: _Finder, cols: dict, n: int, where: str) -> np.ndarray:
+    """Deviations (n, 3) mm from dx/dy/dz columns in um or mm, plausibility-checked."""
     dev = np.zeros((n, 3))
     for i, d in enumerate(("dx", "dy", "dz")):
         require(d not in cols, f"{where}: deviation column {d} has no unit suffix "
@@ -186,11 +220,7 @@ def columns_to_data(cols: dict, model: Model, where: str = "data", text=None) ->
     big = float(np.max(np.abs(dev)))
     require(big < 5.0, f"{where}: deviations up to {big:g} mm are implausible for an error "
             f"map: wrong unit (um given as mm?) or nominal instead of deviation values")
-    covs = {c: v for c, v in cols.items() if c not in used and not c.startswith(("dx", "dy",
-                                                                                  "dz"))}
-    missing = [c for c in model.covariates if c not in covs]
-    require(not missing, f"{where}: layout {model.name} needs covariate column {missing[0] if missing else ''}")
-    return Data(positions, probe, dev, covs, warnings)
+    return dev
 
 
 # ---- report ---------------------------------------------------------------------
@@ -428,7 +458,7 @@ def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, famil
     candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
                   if c.kind in families]
     w_rows = robust.rows()
-    ctx = sel.Context(model, dat, decl.design.sens, decl.design.frame, spl.train,
+    ctx = sel.Context(model, dat, decl.design.sens, decl.design.twist, spl.train,
                       np.sqrt(robust.weights[spl.train]), ranges)
     return sel.select(candidates, ctx, decl.A, y, spl.folds, w_rows, sel.SCREEN_POINTS), warns
 
@@ -442,12 +472,11 @@ class Augmented:
     model: Model
     A: np.ndarray
     labels: list
-    derived_check: float | None
 
 
 def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augmented:
     if not selection.accepted:
-        return Augmented("", "", model, decl.A, decl.labels, None)
+        return Augmented("", "", model, decl.A, decl.labels)
     text = augmented_layout_text(model, selection.accepted)
     lay = parse_layout(text, f"{model.name}_aug.toml")
     source = derivation.generate_source(lay)
@@ -456,10 +485,7 @@ def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augme
     n_new = len(aug.parameters) - len(model.parameters)
     keep = np.concatenate([decl.keep, np.ones(n_new, bool)])
     A = ad.A[:, :, keep].reshape(-1, keep.sum())
-    k = decl.keep.sum()
-    numeric = selection.A[:, k:]
-    check = float(np.max(np.abs(numeric - A[:, k:])) / max(np.max(np.abs(numeric)), 1e-300))
-    return Augmented(text, source, aug, A, [lab for lab, m in zip(ad.labels, keep) if m], check)
+    return Augmented(text, source, aug, A, [lab for lab, m in zip(ad.labels, keep) if m])
 
 
 @dataclass
@@ -775,7 +801,6 @@ def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection
         "generated_module": paths.get("generated_module"),
         "augmented_parameters": [p for p in aug.model.parameters if p not in model.parameters],
         "augmented_covariates": list(aug.model.covariates),
-        "derived_vs_numeric_max_rel_diff": aug.derived_check,
         "seconds": 0.0,
         "method": ("held-out: random {:.0%} of the points, never used for selection or "
                    "fitting; before = declared model, after = augmented model, both fitted "

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.loop import candidates as cands
-from volerr.loop.fit import Problem, point_norm, rows_of, twist_columns
+from volerr.loop.fit import TWIST, Problem, point_norm, rows_of
 from volerr.machine.expressions import evaluate
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
@@ -84,13 +84,13 @@ class Base:
 
 @dataclass
 class Context:
-    """What the columns of a candidate need: model, data, sensitivities, frame, and the
+    """What the columns of a candidate need: model, data, sensitivities, twist sensitivities, and the
     points (``pts``, with their sqrt robust weights ``sw``) on which they are scored."""
 
     model: object
     data: object
     sens: np.ndarray
-    frame: tuple
+    twist: np.ndarray       # (N, 3, 12) rigid-twist sensitivity (fit.twist_sensitivity)
     pts: np.ndarray
     sw: np.ndarray
     ranges: dict
@@ -98,7 +98,7 @@ class Context:
 
     def on(self, pts, sw) -> "Context":
         """The same context on other points (shares nothing that depends on the points)."""
-        return Context(self.model, self.data, self.sens, self.frame, pts, sw, self.ranges,
+        return Context(self.model, self.data, self.sens, self.twist, pts, sw, self.ranges,
                        {"fixed": self.cache.setdefault("fixed", {})})
 
     def values(self, full: bool = False):
@@ -117,8 +117,7 @@ class Context:
         key = ("target", target, full)
         if key not in self.cache:
             if "." in target:
-                side, k = target.split(".")
-                col = twist_columns(side, k, self.data, self.frame)
+                col = self.twist[:, :, TWIST[target]]
             else:
                 col = self.sens[:, :, self.model.parameters.index(target)]
             self.cache[key] = col if full else col[self.pts]

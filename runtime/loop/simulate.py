@@ -46,12 +46,10 @@ KINDS = tuple(EFFECT_KEYS)
 
 
 def _rotation(ex, ey, ez) -> np.ndarray:
-    """Exact rotation Rz(ez) Ry(ey) Rx(ex), shape (3, 3)."""
-    cx, sx, cy, sy, cz, sz = np.cos(ex), np.sin(ex), np.cos(ey), np.sin(ey), np.cos(ez), np.sin(ez)
-    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    return rz @ ry @ rx
+    """Exact rotation Rz(ez) Ry(ey) Rx(ex) (rad), shape (3, 3): scipy's extrinsic x-y-z."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_euler("xyz", [ex, ey, ez]).as_matrix()
 
 
 def _unit(lo, hi, q):

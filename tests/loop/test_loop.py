@@ -51,8 +51,6 @@ def test_effect_found_attributed_removed(layout, effect, seed, rounds, check):
     # held-out error clearly reduced, down to about the noise (3-D: sqrt(3) * 0.3 um)
     assert rep["rms_after_um"] < 0.7 * rep["rms_before_um"]
     assert rep["rms_after_um"] < 0.75
-    # the derived augmented model reproduces the numeric columns used in the search
-    assert rep["derived_vs_numeric_max_rel_diff"] < 1e-9
     assert set(rep["augmented_parameters"]) == set(rep["effects"][0]["parameters"])
 
 

@@ -41,12 +41,18 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     mm = _write(tmp_path / "mm.csv", mm_cols)
     r1 = _cli("loop", "MB1", um, "--json", tmp_path / "a.json", "--degree", "4",
               "--out-dir", tmp_path / "aug", "--errors-out", tmp_path / "errors")
-    r2 = _cli("loop", "MB1", mm, "--json", tmp_path / "b.json", "--degree", "4",
-              "--out-dir", tmp_path / "aug2")
+    # the same data in mm, with --html and no --json: the augmented layout goes next to the
+    # page; the page holds the residual sources as tables, no raw JSON dump, no absolute paths
+    html = tmp_path / "page" / "r.html"
+    html.parent.mkdir()
+    r2 = _cli("loop", "MB1", mm, "--html", html, "--degree", "4")
     assert r1.returncode == 0 and r2.returncode == 0, r1.stderr + r2.stderr
     a = json.loads((tmp_path / "a.json").read_text())
-    b = json.loads((tmp_path / "b.json").read_text())
-    assert a["rms_before_um"] == pytest.approx(b["rms_before_um"], rel=1e-6)
+    assert f"held-out RMS {a['rms_before_um']:.3f} -> {a['rms_after_um']:.3f} um" in r2.stdout
+    text = html.read_text()
+    assert "Where the residual lives" in text and "parameter P" in text
+    assert str(tmp_path) not in text and '"rms_before_um"' not in text
+    assert (html.parent / "MB1_aug.toml").is_file()
     assert [e["name"] for e in a["effects"]] == ["reversal_X"]
     assert (tmp_path / "aug" / "MB1_aug.toml").is_file()
     assert sorted(p.name for p in (tmp_path / "errors").iterdir()) == [
