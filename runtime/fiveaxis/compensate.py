@@ -403,11 +403,11 @@ class _Collect:
         b, p = chunk.blocks, chunk.prediction
         self.text.append(chunk.text)
         q_nom, q_out = b.q_nom.tolist(), chunk.q_out.tolist()
-        rows = [b.lines[i] for i, r in enumerate(b.row) if r >= 0]
+        rows = b.numbers.tolist()
         for o in b.order:
             if o >= 0:
                 self.reports.append(LineReport(
-                    rows[o].number, dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
+                    rows[o], dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
                     tuple(p.before_um[o]), tuple(p.after_um[o]),
                     float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
                     int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))
