@@ -71,10 +71,10 @@ def scan(segs: list, axes) -> Scan:
     np.cumsum(lens[:-1], out=start[1:])
     b = np.frombuffer(text.encode("latin-1", "replace"), dtype=np.uint8)
     cls = _CLS[b]
-    lid = np.repeat(np.arange(n), lens)
+    lid = np.repeat(np.arange(n, dtype=np.int32), lens)
     bad = np.zeros(n, dtype=bool)
     bad[lid[cls == _OTHER]] = True
-    sig = np.flatnonzero((cls >= _LETTER) & (cls <= _DOT))
+    sig = np.flatnonzero((cls >= _LETTER) & (cls <= _DOT)).astype(np.int32)
     c, ln = cls[sig], lid[sig]
     isnum = c >= _DIGIT
     isl = c == _LETTER
@@ -94,7 +94,7 @@ def scan(segs: list, axes) -> Scan:
     nxt_num[:-1] = isnum[1:] & same_prev[1:]
     bad[ln[isl & ~nxt_num]] = True
     # numbers: [+-]?(\d+\.?\d*|\.\d+)
-    rid = np.cumsum(run0) - 1
+    rid = np.cumsum(run0, dtype=np.int32) - 1
     nr = int(run0.sum())
     rn = rid[isnum]
     cn = c[isnum]
@@ -139,15 +139,16 @@ def scan(segs: list, axes) -> Scan:
     after = np.bincount(drun[dpos > dot_at[drun]], minlength=nr)
     frac = np.where(dot_at >= 0, after, -1)
     # k-th digit from the end of the run
-    dcount = np.zeros(nr + 1, dtype=np.int64)
+    dcount = np.zeros(nr + 1, dtype=np.int32)
     np.cumsum(ndig, out=dcount[1:])
-    k_from_end = dcount[drun + 1] - 1 - np.arange(len(drun))
-    dval = (b[pos_num[dpos]] - 48).astype(np.int64)
+    k_from_end = dcount[drun + 1] - np.arange(1, len(drun) + 1, dtype=np.int32)
+    dval = b[pos_num[dpos]] - 48
     exact = ndig <= 15
-    kk = np.minimum(k_from_end, 18)
-    mant = _sum_by_run(drun, dval * _IPOW10[kk], nr)
+    np.minimum(k_from_end, 18, out=k_from_end)
+    # float sums of integers below 2**53 are exact (longer mantissas: Python below)
+    mant = np.bincount(drun, weights=_POW10[k_from_end] * dval, minlength=nr)
     fr = np.maximum(frac, 0)
-    val = mant.astype(np.float64) / _POW10[np.minimum(fr, 22)]
+    val = mant / _POW10[np.minimum(fr, 22)]
     neg = b[ns] == ord("-")
     val = np.where(neg, -val, val)
     exact &= fr <= 22
@@ -156,15 +157,6 @@ def scan(segs: list, axes) -> Scan:
     plus = b[ns] == ord("+")
     sel = keep_run
     return Scan(text, start, fast, wl, wa, val[sel], frac[sel], plus[sel], ns[sel], ne[sel])
-
-
-def _sum_by_run(run: np.ndarray, v: np.ndarray, nr: int) -> np.ndarray:
-    """Integer sums of ``v`` per run (``run`` sorted), exact in int64."""
-    out = np.zeros(nr, dtype=np.int64)
-    if len(run):
-        starts = np.flatnonzero(np.r_[True, run[1:] != run[:-1]])
-        out[run[starts]] = np.add.reduceat(v, starts)
-    return out
 
 
 def format_numbers(values, nd, keep, plus, template=None) -> list:
@@ -198,7 +190,7 @@ def format_numbers(values, nd, keep, plus, template=None) -> list:
     dg = np.where(shift >= 0, fp // _IPOW10[np.maximum(shift, 0)],
                   fp * _IPOW10[np.maximum(-shift, 0)])
     sg = np.where(neg, "-", np.where(plus, "+", "")).tolist()
-    out = [f"{s}{i}.{g:0{k}d}" if k else f"{s}{i}"
+    out = ["%s%d.%0*d" % (s, i, k, g) if k else "%s%d" % (s, i)
            for s, i, g, k in zip(sg, ip.tolist(), dg.tolist(), d.tolist())]
     for i in np.flatnonzero(risky):
         t = template(i) if template is not None else ""

@@ -273,9 +273,18 @@ class ErrorModel:
         return q
 
     def errors(self, q: np.ndarray, subset=None) -> dict:
+        """Error functions at ``q`` (the last two evaluations are remembered: the position and
+        the orientation error of the same positions share one table look-up)."""
         if self.funcs is None:
             return {}
-        e = self.funcs(self._clip_edges(self.lookup(q)))
+        memo = self.__dict__.setdefault("_memo", [])
+        for qm, e in memo:
+            if qm.shape == q.shape and np.array_equal(qm, q):
+                break
+        else:
+            e = self.funcs(self._clip_edges(self.lookup(q)))
+            memo.insert(0, (np.array(q, dtype=float, copy=True), e))
+            del memo[2:]
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e

@@ -516,15 +516,20 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
         for k, li in enumerate(line_of.tolist()):
             if li in added:
                 by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
-    for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(), texts)):
-        if not added or int(line_of[k]) not in added:
-            edits.append((s0, e0, t))
+    if not added:
+        edits.extend(zip(span_s.tolist(), span_e.tolist(), texts))
+        return
+    own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
+                                                          texts))
+           if int(line_of[k]) not in added]
     for li, add in added.items():
         i = i0 + li
         line = _parse_seg(b.segs, b.first, i)
         s0 = int(sc.start[i])
-        edits.append((s0, s0 + len(b.segs[i]),
-                      gcode.rewrite_line(line, by_line.get(li, {}), add, spaced)))
+        own.append((s0, s0 + len(b.segs[i]),
+                    gcode.rewrite_line(line, by_line.get(li, {}), add, spaced)))
+    own.sort()
+    edits.extend(own)
 
 
 def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axes,
@@ -554,7 +559,6 @@ def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axe
         i += 1
     if not edits:
         return b.scan.text
-    edits.sort()
     text = b.scan.text
     out, p = [], 0
     for s0, e0, t in edits:
