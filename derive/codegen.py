@@ -9,6 +9,7 @@ text gives the same bytes.
 from __future__ import annotations
 
 import hashlib
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -69,11 +70,36 @@ class Function:
     result_lines: list = field(default_factory=list)
 
 
+@contextmanager
+def _counted_nodes():
+    """sympy's canonical ordering (``ordered``, used by ``cse(order="canonical")`` for every
+    Add and Mul it rebuilds) sorts by node counts that it recounts from scratch at every level
+    of the tree; here each sub-expression's count is remembered for the duration.  Same counts,
+    so the same order and the same generated text."""
+    from sympy.core import sorting
+
+    plain = sorting._node_count
+    memo = {}
+
+    def counted(e):
+        n = memo.get(e)
+        if n is None:
+            n = memo[e] = 0.5 if e.is_Float else 1 + sum(map(counted, e.args))
+        return n
+
+    sorting._node_count = counted
+    try:
+        yield
+    finally:
+        sorting._node_count = plain
+
+
 def _prepare(f: Function) -> Function:
     nonzero = [(i, e) for i, e in enumerate(f.outputs) if e != 0] if f.shape else \
         list(enumerate(f.outputs))
     exprs = [e for _, e in nonzero]
-    temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"), order="canonical")
+    with _counted_nodes():
+        temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"), order="canonical")
     body = [f"{print_expr(s)} = {print_expr(e)}" for s, e in temps]
     if f.shape:
         body.append(f"_out = numpy.zeros({tuple(f.shape)!r} + _shape)")
