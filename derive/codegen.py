@@ -73,25 +73,47 @@ class Function:
 @contextmanager
 def _counted_nodes():
     """sympy's canonical ordering (``ordered``, used by ``cse(order="canonical")`` for every
-    Add and Mul it rebuilds) sorts by node counts that it recounts from scratch at every level
-    of the tree; here each sub-expression's count is remembered for the duration.  Same counts,
-    so the same order and the same generated text."""
+    Add and Mul it rebuilds) sorts by node count, then by ``default_sort_key`` within ties, and
+    recounts the nodes from scratch at every level of the tree.  Here the same stable sort is
+    done with each sub-expression's count remembered for the duration: the same order, so the
+    same generated text (a test compares the orders)."""
     from sympy.core import sorting
+    from sympy.simplify import cse_main
 
-    plain = sorting._node_count
+    plain_count, plain_ordered = sorting._node_count, cse_main.ordered
     memo = {}
 
     def counted(e):
+        if not e.args:
+            return 0.5 if e.is_Float else 1
         n = memo.get(e)
         if n is None:
-            n = memo[e] = 0.5 if e.is_Float else 1 + sum(map(counted, e.args))
+            n = memo[e] = 1 + sum(map(counted, e.args))
         return n
 
     sorting._node_count = counted
+    cse_main.ordered = canonical_order
     try:
         yield
     finally:
-        sorting._node_count = plain
+        sorting._node_count, cse_main.ordered = plain_count, plain_ordered
+
+
+def canonical_order(seq, keys=None, default=True, warn=False):
+    """``sympy.ordered`` with its default keys, as one stable sort (other calls: sympy's)."""
+    from sympy.core import sorting
+
+    if keys is not None or not default:
+        return sorting.ordered(seq, keys, default, warn)
+    seq = list(seq)
+    if len(seq) < 2:
+        return iter(seq)
+    nodes = [sorting._nodes(a) for a in seq]
+    idx = range(len(seq))
+    if len(set(nodes)) == len(nodes):
+        return iter([seq[i] for i in sorted(idx, key=nodes.__getitem__)])
+    dsk = sorting.default_sort_key
+    return iter([seq[i] for i in sorted(idx, key=lambda i: (nodes[i], dsk(seq[i])))])
 
 
 def _prepare(f: Function) -> Function:

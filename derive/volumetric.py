@@ -58,8 +58,10 @@ def orientation_error(chain: Chain) -> sp.Matrix:
 
 def exact_error(chain: Chain) -> sp.Matrix:
     """Exact (non-linearised) error: exact actual chain minus nominal chain, applied to the probe."""
+    from .kinematics import _matmul
+
     p = sp.Matrix([*PROBE, 1])
-    return (chain.exact_htm() * p - chain.nominal_htm() * p)[0:3, 0]
+    return (_matmul(chain.exact_htm(), p) - _matmul(chain.nominal_htm(), p))[0:3, 0]
 
 
 def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
