@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       a47a1650cc12d3db47d92764978ee4bb013956fe536312cb0baad903987dbdb5
-derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
+derivation sha256  dca7638ca87748bbfedd9e3f60dee18ed12e96d8b78b8e601d6c05a2c58d4304
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

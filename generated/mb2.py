@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9f5664e7e76c63758343031e2e71c38e0cb7e6231fb10646e63c6605339e98de
-derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
+derivation sha256  dca7638ca87748bbfedd9e3f60dee18ed12e96d8b78b8e601d6c05a2c58d4304
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

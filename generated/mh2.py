@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       14c00cbdd4320c30c61d6c8934b7e649bc3fee4d78e7c7cc3d4d29e6aee0c398
-derivation sha256  b415b3ed71a71869116d949faa4a9fe986329eaa2e50996af859d74a495f49b9
+derivation sha256  dca7638ca87748bbfedd9e3f60dee18ed12e96d8b78b8e601d6c05a2c58d4304
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
