@@ -560,12 +560,11 @@ def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axe
     if not edits:
         return b.scan.text
     text = b.scan.text
-    out, p = [], 0
-    for s0, e0, t in edits:
-        out.append(text[p:s0])
-        out.append(t)
-        p = e0
-    out.append(text[p:])
+    s0, e0, t = zip(*edits)
+    out = [""] * (2 * len(edits) + 1)
+    out[0:-1:2] = [text[p:q] for p, q in zip((0,) + e0[:-1], s0)]
+    out[1::2] = t
+    out[-1] = text[e0[-1]:]
     return "".join(out)
 
 
