@@ -1,12 +1,15 @@
 """Benchmark: `volerr compensate DMU50` on a long five-axis program, streamed in chunks.
 
-Reports, for N blocks: the whole command (parse, interpret, solve, round, predict, write) in a
-subprocess with its peak RSS (resource.getrusage), the vectorised solve alone on the same
-positions (ratio whole / solve: what the text handling costs on top of the numerics) and the
-solve block by block (the baseline a per-line script would be).  Peak RSS is also measured for
-N/10 blocks: streaming keeps it independent of the program length.
+Reports, for N blocks and N/10 blocks: the whole command (parse, interpret, solve, round,
+predict, write) in a subprocess, wall and CPU time and peak RSS (resource.getrusage), with the
+whole-chunk text path (default) and with every line interpreted and written one by one
+(``program.WHOLE_CHUNK = False``, the previous implementation's text handling; same output,
+checked), interleaved, min of the runs.  The line-by-line path runs at N/10 only unless
+``--baseline-full`` (it takes ~100 s per 10^6 blocks).  Also: the vectorised solve alone on
+the same positions and the solve block by block (a per-line script).
 
-Run: python benchmarks/bench_compensate.py [N_BLOCKS]   (default 200000)
+Run: python benchmarks/bench_compensate.py [N_BLOCKS] [--runs R] [--baseline-full]
+     (default 1000000 blocks, 2 runs)
 """
 
 import subprocess
@@ -25,6 +28,8 @@ from volerr.tables.table import ErrorTable, write_constants, write_error_table
 RUN = """
 import resource, sys, time
 from volerr.cli import main
+from volerr.fiveaxis import program
+program.WHOLE_CHUNK = sys.argv[4] == "1"
 t0 = time.perf_counter(); c0 = time.process_time()
 rc = main(["compensate", "DMU50", sys.argv[1], "--errors", sys.argv[2], "--out", sys.argv[3]])
 print(time.perf_counter() - t0, time.process_time() - c0,
@@ -42,14 +47,14 @@ def write_program(path: Path, n: int, rng) -> np.ndarray:
     return np.round(q, 3)
 
 
-def command(prog, errors, out):
-    r = subprocess.run([sys.executable, "-c", RUN, str(prog), str(errors), str(out)],
-                       capture_output=True, text=True, check=True)
+def command(prog, errors, out, whole=True):
+    r = subprocess.run([sys.executable, "-c", RUN, str(prog), str(errors), str(out),
+                        "1" if whole else "0"], capture_output=True, text=True, check=True)
     wall, cpu, rss = map(float, r.stdout.split()[-3:])
     return wall, cpu, rss
 
 
-def main(n: int = 200000) -> None:
+def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False) -> None:
     m = volerr.load("DMU50")
     rng = np.random.default_rng(0)
     with tempfile.TemporaryDirectory() as tmp:
@@ -68,30 +73,48 @@ def main(n: int = 200000) -> None:
         write_program(small, max(n // 10, 1), rng)
         em = ErrorModel(m, funcs)
         k = min(300, n)
-        runs = []
-        for _ in range(2):   # interleaved, min of the runs
-            runs.append((command(big, d, d / "out.nc"), command(small, d, d / "out_s.nc")))
+        res = {key: [] for key in ("big", "small", "big_line", "small_line", "solve")}
+        for _ in range(runs):   # interleaved, min of the runs
+            res["big"].append(command(big, d, d / "out.nc"))
+            res["small"].append(command(small, d, d / "out_s.nc"))
+            res["small_line"].append(command(small, d, d / "ref_s.nc", whole=False))
+            assert (d / "out_s.nc").read_bytes() == (d / "ref_s.nc").read_bytes()
+            if baseline_full:
+                res["big_line"].append(command(big, d, d / "ref.nc", whole=False))
+                assert (d / "out.nc").read_bytes() == (d / "ref.nc").read_bytes()
             t0 = time.perf_counter()
             for i in range(0, n, 20000):
                 solve(em, q[i:i + 20000])
-            t_vec = time.perf_counter() - t0
-            runs[-1] += (t_vec,)
-        wall = min(r[0][0] for r in runs)
-        cpu = min(r[0][1] for r in runs)
-        rss, rss_s = min(r[0][2] for r in runs), min(r[1][2] for r in runs)
-        t_vec = min(r[2] for r in runs)
+            res["solve"].append(time.perf_counter() - t0)
         t0 = time.perf_counter()
         for row in q[:k]:
             solve(em, row[None, :])
         t_loop = (time.perf_counter() - t0) * n / k
-        print(f"DMU50, {n} motion blocks, full strategy (min of {len(runs)} interleaved runs)")
-        print(f"  volerr compensate: {wall:.1f} s wall, {cpu:.1f} s CPU "
-              f"({n / wall:.0f} blocks/s); peak RSS {rss:.0f} MB ({rss_s:.0f} MB at {n // 10} "
-              "blocks)")
+        t_vec = min(res["solve"])
+        best = {key: tuple(min(r[i] for r in v) for i in range(3))
+                for key, v in res.items() if v and key != "solve"}
+        print(f"DMU50, full strategy, min of {runs} interleaved runs "
+              f"(wall s, CPU s, peak RSS MB)")
+        for key, nb in (("big", n), ("small", n // 10)):
+            w, c, r = best[key]
+            line = f"  {nb:>8} blocks: whole-chunk {w:.1f} s wall, {c:.1f} s CPU, {r:.0f} MB"
+            if key + "_line" in best:
+                lw, lc, lr = best[key + "_line"]
+                line += (f"; line by line {lw:.1f} s wall, {lc:.1f} s CPU, {lr:.0f} MB; "
+                         f"ratio {lw / w:.1f}x wall, {lc / c:.1f}x CPU")
+            print(line)
+        w = best["big"][0]
         print(f"  solve alone (chunks of 20000): {t_vec:.2f} s; whole command / solve "
-              f"{wall / t_vec:.1f}x; block by block (extrapolated from {k}): {t_loop:.0f} s, "
-              f"{t_loop / wall:.0f}x the whole command")
+              f"{w / t_vec:.1f}x; block by block (extrapolated from {k}): {t_loop:.0f} s, "
+              f"{t_loop / w:.0f}x the whole command")
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 200000)
+    import argparse
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("n", nargs="?", type=int, default=1000000)
+    ap.add_argument("--runs", type=int, default=2)
+    ap.add_argument("--baseline-full", action="store_true")
+    a = ap.parse_args()
+    main(a.n, a.runs, a.baseline_full)

@@ -9,6 +9,7 @@ text gives the same bytes.
 from __future__ import annotations
 
 import hashlib
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -69,11 +70,58 @@ class Function:
     result_lines: list = field(default_factory=list)
 
 
+@contextmanager
+def _counted_nodes():
+    """sympy's canonical ordering (``ordered``, used by ``cse(order="canonical")`` for every
+    Add and Mul it rebuilds) sorts by node count, then by ``default_sort_key`` within ties, and
+    recounts the nodes from scratch at every level of the tree.  Here the same stable sort is
+    done with each sub-expression's count remembered for the duration: the same order, so the
+    same generated text (a test compares the orders)."""
+    from sympy.core import sorting
+    from sympy.simplify import cse_main
+
+    plain_count, plain_ordered = sorting._node_count, cse_main.ordered
+    memo = {}
+
+    def counted(e):
+        if not e.args:
+            return 0.5 if e.is_Float else 1
+        n = memo.get(e)
+        if n is None:
+            n = memo[e] = 1 + sum(map(counted, e.args))
+        return n
+
+    sorting._node_count = counted
+    cse_main.ordered = canonical_order
+    try:
+        yield
+    finally:
+        sorting._node_count, cse_main.ordered = plain_count, plain_ordered
+
+
+def canonical_order(seq, keys=None, default=True, warn=False):
+    """``sympy.ordered`` with its default keys, as one stable sort (other calls: sympy's)."""
+    from sympy.core import sorting
+
+    if keys is not None or not default:
+        return sorting.ordered(seq, keys, default, warn)
+    seq = list(seq)
+    if len(seq) < 2:
+        return iter(seq)
+    nodes = [sorting._nodes(a) for a in seq]
+    idx = range(len(seq))
+    if len(set(nodes)) == len(nodes):
+        return iter([seq[i] for i in sorted(idx, key=nodes.__getitem__)])
+    dsk = sorting.default_sort_key
+    return iter([seq[i] for i in sorted(idx, key=lambda i: (nodes[i], dsk(seq[i])))])
+
+
 def _prepare(f: Function) -> Function:
     nonzero = [(i, e) for i, e in enumerate(f.outputs) if e != 0] if f.shape else \
         list(enumerate(f.outputs))
     exprs = [e for _, e in nonzero]
-    temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"), order="canonical")
+    with _counted_nodes():
+        temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"), order="canonical")
     body = [f"{print_expr(s)} = {print_expr(e)}" for s, e in temps]
     if f.shape:
         body.append(f"_out = numpy.zeros({tuple(f.shape)!r} + _shape)")

@@ -159,6 +159,20 @@ def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Facto
     return out
 
 
+def _matmul(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
+    """``a * b`` built entry by entry as one Add of the non-zero products: the same
+    expressions as sympy's product (tested), without its general-domain machinery."""
+    n, m, p = a.rows, a.cols, b.cols
+    zero = sp.S.Zero
+    out = []
+    for i in range(n):
+        row = [a[i, k] for k in range(m)]
+        for j in range(p):
+            terms = [x * b[k, j] for k, x in enumerate(row) if x != 0 and b[k, j] != 0]
+            out.append(sp.Add(*terms) if terms else zero)
+    return sp.Matrix(n, p, out)
+
+
 @dataclass
 class Chain:
     """A layout's chain with its symbols; all derived quantities are computed from it."""
@@ -186,5 +200,5 @@ class Chain:
         """Actual ``tool2work`` with exact rotations (not linearised)."""
         m = sp.eye(4)
         for f in self.factors:
-            m = m * f.exact()
+            m = _matmul(m, f.exact())
         return m

@@ -58,8 +58,10 @@ def orientation_error(chain: Chain) -> sp.Matrix:
 
 def exact_error(chain: Chain) -> sp.Matrix:
     """Exact (non-linearised) error: exact actual chain minus nominal chain, applied to the probe."""
+    from .kinematics import _matmul
+
     p = sp.Matrix([*PROBE, 1])
-    return (chain.exact_htm() * p - chain.nominal_htm() * p)[0:3, 0]
+    return (_matmul(chain.exact_htm(), p) - _matmul(chain.nominal_htm(), p))[0:3, 0]
 
 
 def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
@@ -74,7 +76,7 @@ def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
         coeffs = [[] for _ in params]
         for term in sp.Add.make_args(sp.expand(error[i])):
             found = [q for q in term.free_symbols if q in index]
-            if len(found) != 1 or sp.degree(term, found[0]) != 1:
+            if len(found) != 1 or not _linear_factor(term, found[0]):
                 return error.jacobian(sp.Matrix(params))   # not linear term by term: general
             coeffs[index[found[0]]].append(term.xreplace({found[0]: sp.Integer(1)}))
         for j, c in enumerate(coeffs):
@@ -98,6 +100,14 @@ def setup_sensitivity(chain: Chain) -> sp.Matrix:
     work = (d * (T * p))[0:3, 0].jacobian(sp.Matrix(syms))
     tool = (T * (d * p))[0:3, 0].jacobian(sp.Matrix(syms))
     return work.row_join(tool).applyfunc(sp.expand)
+def _linear_factor(term, q) -> bool:
+    """``sp.degree(term, q) == 1`` for a term of an expanded sum: a product with the factor
+    ``q`` to the first power and ``q`` nowhere else (checked without building a polynomial;
+    anything else is left to ``sp.degree``)."""
+    factors = sp.Mul.make_args(term)
+    if factors.count(q) == 1 and not any(f != q and f.has(q) for f in factors):
+        return True
+    return sp.degree(term, q) == 1
 
 
 def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
@@ -105,12 +115,13 @@ def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
     so cross terms such as 2 Z Zp of (Z + Zp)^2 are dropped."""
     rows = []
     for i in range(3):
-        acc = 0
+        # one Add of all squares (the same canonical sum as adding them one by one)
+        acc = []
         for j in range(sens.shape[1]):
             for term in sp.Add.make_args(sp.expand(sens[i, j])):
                 if term != 0:
-                    acc += term ** 2 * sigmas[j] ** 2
-        rows.append(sp.sqrt(acc))
+                    acc.append(term ** 2 * sigmas[j] ** 2)
+        rows.append(sp.sqrt(sp.Add(*acc)))
     return sp.Matrix(rows)
 
 

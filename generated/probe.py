@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       936d6b81b28e27cd2c685d2970ba1a9819c19b8969d97c12a7c54c91c993e5b7
-derivation sha256  146ad1c194ed5933e444fb0ba5167d0646ca979bcca9e161057fa5e075cfae2c
+derivation sha256  707cce1c6578403bc8c334da6ab3159db6f8c202e6e7da4723fa876dbe427ff3
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/probe.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

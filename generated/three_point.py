@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       89f2a27009f0d9a9f996bcfc608579797fab9193a3b97f7bcf6c5cfed0db4643
-derivation sha256  aeb0468c367e5654268019846a185baa86f0bd29de3cfc754a5970251cb84aa3
+input sha256       4775acad0bedd6fe9e1efc5ca1893b3b117b363fb55916daaacd5b645d56ae56
+derivation sha256  1d88f059b9645a64d6750392bf4afeb91084c2c51e51f72c220a7da9e1143169
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9b5f923e440b8c75c3b5ca7308d4ba4371152109c2b1c6354b17becb2a4ed34a
-derivation sha256  0632ad81df0ab9a3233a6142ddcb8ab78f3b692d4d13db5b3177007d1cc5eb64
+derivation sha256  f74ac1349920e463edf4bbcf1a6473df79b0733728798c494bcbc08bcea5abbb
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -42,7 +42,8 @@ def run(args) -> int:
 
     from volerr.fiveaxis.compensate import error_functions
     from volerr.machine.model import load
-    from volerr.fiveaxis.plots import plot_tcp_error_map, tcp_error_map
+    from volerr.fiveaxis.plots import plot_tcp_error_map
+    from volerr.fiveaxis.tcpmap import tcp_map
 
     model = load(args.layout)
     require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")
@@ -55,16 +56,14 @@ def run(args) -> int:
                                    args.extrapolate)
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
     outs = Outputs(inputs).plot("--out", args.out).file("--csv", args.csv).check()
-    a1, a2, q1, q2, err, valid = tcp_error_map(model, funcs, args.point, args.tool,
-                                               args.steps, args.steps)
+    tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps)
+    a1, a2, q1, q2, err, valid = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err, tmap.valid
     require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
                          "for every rotary position")
     with outs:
-        plot_tcp_error_map(model, funcs, args.point, outs.path("--out"), args.tool,
-                           n1=args.steps, n2=args.steps)
+        plot_tcp_error_map(tmap, outs.path("--out"))
         if args.csv:
-            write_text(outs.path("--csv"), _grid_csv(model, args, a1, a2, q1, q2, err),
-                       inputs)
+            write_text(outs.path("--csv"), _grid_csv(tmap), inputs)
     mag = np.linalg.norm(err, axis=2) * 1e3
     print(f"{model.name}: tool-tip error at ({', '.join(f'{v:g}' for v in args.point)}) mm over "
           f"{a1} {q1[0]:g}..{q1[-1]:g} deg, {a2} {q2[0]:g}..{q2[-1]:g} deg: max "
@@ -76,24 +75,18 @@ def run(args) -> int:
     return 0
 
 
-def _grid_csv(model, args, a1, a2, q1, q2, err) -> str:
+def _grid_csv(tmap) -> str:
     """The ``--csv`` text: one row per grid point, empty error cells where invalid."""
     import numpy as np
 
-    mag = np.linalg.norm(err, axis=2) * 1e3
-    p = np.asarray(args.point, float)
-    t = np.asarray(args.tool, float)
-    g1, g2 = np.meshgrid(q1, q2)
-    lin = model.module.inverse_linear(
-        *(np.deg2rad(g1.ravel() if a == a1 else g2.ravel()) for a in model.rotary_axes),
-        p[0], p[1], p[2], t[0], t[1], t[2])
-    lin = [np.broadcast_to(v, g1.size) for v in lin]
-    rows = [f"{a1}_deg,{a2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
-    e = err.reshape(-1, 3) * 1e3
-    m = mag.ravel()
+    g1, g2 = np.meshgrid(tmap.q1, tmap.q2)
+    lin = tmap.linear.reshape(-1, 3)
+    e = tmap.err.reshape(-1, 3) * 1e3
+    m = np.linalg.norm(tmap.err, axis=2).ravel() * 1e3
+    rows = [f"{tmap.axis1}_deg,{tmap.axis2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
     for i in range(g1.size):
         cells = [f"{g1.ravel()[i]:.10g}", f"{g2.ravel()[i]:.10g}"] + \
-            [f"{lin[k][i]:.10g}" for k in range(3)]
+            [f"{lin[i, k]:.10g}" for k in range(3)]
         cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
         rows.append(",".join(cells))
     return "\n".join(rows) + "\n"

@@ -273,9 +273,18 @@ class ErrorModel:
         return q
 
     def errors(self, q: np.ndarray, subset=None) -> dict:
+        """Error functions at ``q`` (the last two evaluations are remembered: the position and
+        the orientation error of the same positions share one table look-up)."""
         if self.funcs is None:
             return {}
-        e = self.funcs(self._clip_edges(self.lookup(q)))
+        memo = self.__dict__.setdefault("_memo", [])
+        for qm, e in memo:
+            if qm.shape == q.shape and np.array_equal(qm, q):
+                break
+        else:
+            e = self.funcs(self._clip_edges(self.lookup(q)))
+            memo.insert(0, (np.array(q, dtype=float, copy=True), e))
+            del memo[2:]
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e
@@ -403,11 +412,11 @@ class _Collect:
         b, p = chunk.blocks, chunk.prediction
         self.text.append(chunk.text)
         q_nom, q_out = b.q_nom.tolist(), chunk.q_out.tolist()
-        rows = [b.lines[i] for i, r in enumerate(b.row) if r >= 0]
+        rows = b.numbers.tolist()
         for o in b.order:
             if o >= 0:
                 self.reports.append(LineReport(
-                    rows[o].number, dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
+                    rows[o], dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
                     tuple(p.before_um[o]), tuple(p.after_um[o]),
                     float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
                     int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))

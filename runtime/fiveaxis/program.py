@@ -34,6 +34,10 @@ from volerr.fiveaxis.kinematics import is_five_axis, linear_axes
 #: lines per chunk: large enough for the vectorised solve, small enough for the memory
 CHUNK_LINES = 20000
 
+#: False: every line is interpreted and written one by one (the reference the whole-chunk
+#: path is tested and benchmarked against; the output is the same)
+WHOLE_CHUNK = True
+
 _COMMENTS = re.compile(r"\([^)\r\n]*\)|;[^\r\n]*")
 
 
@@ -125,60 +129,125 @@ def _letters(segs, pats, seen) -> set:
 class Blocks:
     """The lines of one chunk and its motion blocks.
 
-    ``steps``: what each line does (None without words); ``row``: per line, the row of a
-    motion block whose axes are all known in ``q_nom`` / ``nd``, else -1; ``pending``: per
-    motion block with an unknown axis, (line, target); ``q_nom`` (n, n_axes) mm / deg;
-    ``nd`` (n, n_axes) decimals to write (never fewer than the programmed word had)."""
+    ``segs``: the lines as read (with their endings), ``first`` the number of the first;
+    ``scan``: the plain lines found by :func:`volerr.fiveaxis.chunkscan.scan` and their words;
+    ``runs``: (first, end) line indices of the plain lines interpreted together in absolute
+    mode; ``slow``: line index -> (:class:`~volerr.fiveaxis.gcode.Line`, step) of the lines
+    interpreted one by one (step None without words); ``row``: per line, the row of a motion
+    block whose axes are all known in ``q_nom`` / ``nd``, else -1; ``numbers``: the line number
+    of every row; ``pending``: per motion block with an unknown axis, (line, target);
+    ``q_nom`` (n, n_axes) mm / deg; ``nd`` (n, n_axes) decimals to write (never fewer than the
+    programmed word had)."""
 
-    lines: list
-    steps: list
-    row: list
+    segs: list
+    first: int
+    scan: object
+    runs: list
+    slow: dict
+    row: np.ndarray
+    numbers: np.ndarray
     q_nom: np.ndarray
     nd: np.ndarray
     order: list          # per motion block in order: row (>= 0) or -(1 + index into pending)
     pending: list
     known_rotary: set
+    motion: np.ndarray   # per line: a motion block
+
+    def line(self, i: int) -> gcode.Line:
+        """Line ``i`` of the chunk, parsed."""
+        return self.slow[i][0] if i in self.slow else _parse_seg(self.segs, self.first, i)
 
 
-def interpret(lines, interp: gcode.Interpreter, model, decimals: int) -> Blocks:
+def _parse_seg(segs, first: int, i: int) -> gcode.Line:
+    seg = segs[i]
+    body = seg.rstrip("\r\n")
+    return gcode.Line.parse(first + i, body, seg[len(body):])
+
+
+def _words(sc, i0: int, i1: int) -> slice:
+    lo, hi = np.searchsorted(sc.line, [i0, i1])
+    return slice(int(lo), int(hi))
+
+
+def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int) -> Blocks:
+    """Interpret the lines ``segs`` (numbered from ``first``); ``interp`` carries the modal
+    state from chunk to chunk.  Runs of plain lines in absolute mode are done together (the
+    position of an axis is its last programmed value: a forward fill); every other line goes
+    through ``interp`` one by one."""
+    from volerr.fiveaxis import chunkscan
+
     axes = model.axes
+    nax = len(axes)
+    n = len(segs)
+    sc = chunkscan.scan(segs, axes)
+    if not WHOLE_CHUNK:
+        sc.fast[:] = False
+    q = np.full((n, nax), np.nan)
+    nd = np.full((n, nax), decimals, dtype=np.int64)
+    motion = np.zeros(n, dtype=bool)
+    slow, runs = {}, []
+    pos = interp.state.position
     index = {a: i for i, a in enumerate(axes)}
-    state = interp.state.position
-    steps, row, order, pending = [], [], [], []
-    q_rows, nd_rows = [], []
-    known_rotary = set()
-    rot = model.rotary_axes
-    for line in lines:
+    slow_idx = np.flatnonzero(~sc.fast)
+    i = 0
+    while i < n:
+        if sc.fast[i] and not interp.incremental:
+            k = np.searchsorted(slow_idx, i)
+            j = int(slow_idx[k]) if k < len(slow_idx) else n
+            w = _words(sc, i, j)
+            wl, wa = sc.line[w] - i, sc.axis[w]
+            ax = wa >= 0
+            wl, wa = wl[ax], wa[ax]
+            m = j - i
+            v = np.full((m, nax), np.nan)
+            v[wl, wa] = sc.value[w][ax]
+            has = np.zeros((m, nax), dtype=bool)
+            has[wl, wa] = True
+            fr = sc.frac[w][ax]
+            nd[i + wl, wa] = np.maximum(decimals, fr)
+            last = np.where(has, np.arange(m)[:, None], -1)
+            np.maximum.accumulate(last, axis=0, out=last)
+            startv = np.array([np.nan if pos[a] is None else pos[a] for a in axes])
+            cols = np.arange(nax)
+            q[i:j] = np.where(last >= 0, v[np.maximum(last, 0), cols], startv)
+            motion[i:j] = has.any(axis=1)
+            for c, a in enumerate(axes):
+                val = q[j - 1, c]
+                pos[a] = None if val != val else float(val)
+            runs.append((i, j))
+            i = j
+            continue
+        seg = segs[i]
+        body = seg.rstrip("\r\n")
+        line = gcode.Line.parse(first + i, body, seg[len(body):])
         step = interp.step(line)
-        steps.append(step)
-        if step is None:
-            row.append(-1)
-            continue
-        interp.state.apply(step)
-        if step.kind != "motion":
-            row.append(-1)
-            continue
-        target = [state[a] for a in axes]
-        for a in rot:
-            if state[a] is not None:
-                known_rotary.add(a)
-        if None in target:
-            row.append(-1)
-            order.append(-1 - len(pending))
-            pending.append((line, dict(state)))
-            continue
-        nd = [decimals] * len(axes)
-        for a, _, txt in line.items():
-            i = index.get(a)
-            if i is not None and "." in txt:
-                nd[i] = max(decimals, len(txt) - txt.index(".") - 1)
-        row.append(len(q_rows))
-        order.append(len(q_rows))
-        q_rows.append(target)
-        nd_rows.append(nd)
-    q = np.array(q_rows, dtype=float).reshape(len(q_rows), len(axes))
-    nd = np.array(nd_rows, dtype=int).reshape(len(q_rows), len(axes))
-    return Blocks(list(lines), steps, row, q, nd, order, pending, known_rotary)
+        slow[i] = (line, step)
+        if step is not None:
+            interp.state.apply(step)
+            if step.kind == "motion":
+                motion[i] = True
+                q[i] = [np.nan if pos[a] is None else pos[a] for a in axes]
+                for a, _, txt in line.items():
+                    c = index.get(a)
+                    if c is not None and "." in txt:
+                        nd[i, c] = max(decimals, len(txt) - txt.index(".") - 1)
+        i += 1
+    known = motion & ~np.isnan(q).any(axis=1)
+    row = np.where(known, np.cumsum(known) - 1, -1)
+    known_rotary = {a for a in model.rotary_axes
+                    if (motion & ~np.isnan(q[:, index[a]])).any()}
+    unk = motion & ~known
+    pend = np.cumsum(unk) - 1
+    ml = np.flatnonzero(motion)
+    order = np.where(known[ml], row[ml], -1 - pend[ml]).tolist()
+    pending = []
+    for li in np.flatnonzero(unk).tolist():
+        line = slow[li][0] if li in slow else _parse_seg(segs, first, li)
+        pending.append((line, {a: (None if q[li, c] != q[li, c] else float(q[li, c]))
+                               for c, a in enumerate(axes)}))
+    rows = np.flatnonzero(known)
+    return Blocks(list(segs), first, sc, runs, slow, row, first + rows, q[rows], nd[rows], order,
+                  pending, known_rotary, motion)
 
 
 # ---------------------------------------------------------------------------------------
@@ -190,14 +259,14 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
     if not len(q_nom):
         return
     axes = model.axes
-    lines = [blocks.lines[i] for i, r in enumerate(blocks.row) if r >= 0]
+    numbers = blocks.numbers
     if opts.check_travel:
         for i, a in enumerate(axes):
             lo, hi = model.travel[a]
             bad = (q_nom[:, i] < lo - 1e-9) | (q_nom[:, i] > hi + 1e-9)
             if bad.any():
                 k = int(np.argmax(bad))
-                raise InputError(f"line {lines[k].number}: {a} = {q_nom[k, i]:g} is outside "
+                raise InputError(f"line {numbers[k]}: {a} = {q_nom[k, i]:g} is outside "
                                  f"the travel {lo:g} .. {hi:g} of {model.name} "
                                  "(--ignore-travel to go on)")
     if em.funcs is not None and not em.funcs.extrapolate:
@@ -207,7 +276,7 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
             bad = (ql[:, i] < lo - 1e-9) | (ql[:, i] > hi + 1e-9)
             if bad.any():
                 k = int(np.argmax(bad))
-                raise InputError(f"line {lines[k].number}: {a} = {q_nom[k, i]:g} is outside "
+                raise InputError(f"line {numbers[k]}: {a} = {q_nom[k, i]:g} is outside "
                                  f"the measured range {lo:g} .. {hi:g} of error table {a} "
                                  "(--extrapolate to evaluate beyond it)")
 
@@ -313,63 +382,189 @@ def predict(em, q_nom: np.ndarray, q_out: np.ndarray) -> Prediction:
 
 # ---------------------------------------------------------------------------------------
 # step 6: write
-def _format(value: float, nd: int, template: str) -> str:
-    return gcode.format_number(value, nd, template)
+def _write_line(line, step, r, q_list, nd_list, written, axes, spaced) -> str:
+    """One line written block by block (the exact rule; :func:`_write_run` does the same for
+    a run of plain lines in absolute mode at once)."""
+    fmt = gcode.format_number
+    pos = written.position
+    if r < 0:
+        if step is not None:
+            written.apply(step)
+        return line.body + line.ending
+    words = {a: (v, txt) for a, v, txt in line.items() if a in pos}
+    new_values, added, values = {}, {}, []
+    want_row, nd_row = q_list[r], nd_list[r]
+    if step.incremental:
+        for a, want, nd in zip(axes, want_row, nd_row):
+            half = 0.5 * 10.0 ** (-nd)
+            prev = pos[a]
+            inc = want - prev
+            w = words.get(a)
+            if w is not None:
+                if abs(inc - w[0]) >= half:
+                    txt = fmt(inc, nd, w[1])
+                    new_values[a] = txt
+                    values.append((a, float(txt)))
+                else:
+                    values.append((a, w[0]))
+            elif abs(inc) >= half:
+                txt = fmt(inc, nd)
+                added[a] = txt
+                values.append((a, float(txt)))
+    else:
+        for a, want, nd in zip(axes, want_row, nd_row):
+            half = 0.5 * 10.0 ** (-nd)
+            w = words.get(a)
+            if w is not None:
+                if abs(want - w[0]) >= half:
+                    txt = fmt(want, nd, w[1])
+                    new_values[a] = txt
+                    values.append((a, float(txt)))
+                else:
+                    values.append((a, w[0]))
+            elif pos[a] is None or abs(want - pos[a]) >= half:
+                txt = fmt(want, nd)
+                added[a] = txt
+                values.append((a, float(txt)))
+    written.apply(gcode.Step("motion", values, step.incremental))
+    return (gcode.rewrite_line(line, new_values, added, spaced) if (new_values or added)
+            else line.body + line.ending)
+
+
+def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, spaced,
+               edits: list) -> None:
+    """The plain lines ``i0 .. i1 - 1`` (absolute mode) written together: ``edits`` gets
+    (start, end, text) replacements of the chunk text; ``written`` is updated.
+
+    A programmed word is rewritten where the value to write differs from it by half a step or
+    more; an axis the line does not program gets a word where the controller (as written so
+    far) holds another value -- a chain along the lines, followed one entry at a time for the
+    (line, axis) pairs without a word only."""
+    from volerr.fiveaxis import chunkscan
+
+    sc = b.scan
+    pos = written.position
+    nax = len(axes)
+    m = i1 - i0
+    w = _words(sc, i0, i1)
+    ax = sc.axis[w] >= 0
+    wl = sc.line[w][ax] - i0
+    wa = sc.axis[w][ax]
+    wv = sc.value[w][ax]
+    row = b.row[i0:i1]
+    wr = row[wl]
+    known = wr >= 0
+    # programmed words of known blocks: rewritten where the value moves by half a step
+    kr, ka = wr[known], wa[known]
+    want = q_out[kr, ka]
+    nd = b.nd[kr, ka]
+    change = np.abs(want - wv[known]) >= 0.5 * 10.0 ** (-nd.astype(float))
+    ci = np.flatnonzero(known)[change]
+    span_s, span_e = sc.num_start[w][ax][ci], sc.num_end[w][ax][ci]
+    fr, pl = sc.frac[w][ax][ci], sc.plus[w][ax][ci]
+    text = sc.text
+    texts = chunkscan.format_numbers(want[change], nd[change], fr, pl,
+                                     lambda k: text[span_s[k]:span_e[k]])
+    wvals = wv.copy()
+    if len(ci):
+        wvals[ci] = np.array([float(t) for t in texts])
+    # positions held after every line from the programmed words (as written)
+    val = np.full((m, nax), np.nan)
+    val[wl, wa] = wvals
+    has = np.zeros((m, nax), dtype=bool)
+    has[wl, wa] = True
+    last = np.where(has, np.arange(m)[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)
+    # axes without a word in a known block: the chain
+    absent = np.argwhere((row >= 0)[:, None] & ~has)
+    added = {}
+    if len(absent):
+        cand_w = q_out[row[absent[:, 0]], absent[:, 1]]
+        cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
+        li_prev = last[absent[:, 0], absent[:, 1]]
+        held = val[np.maximum(li_prev, 0), absent[:, 1]]
+        start = [pos[a] for a in axes]
+        last_add = {}
+        fmt = gcode.format_number
+        for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
+                                                cand_nd.tolist(), li_prev.tolist(),
+                                                held.tolist()):
+            la = last_add.get(c)
+            if la is not None and la[0] > pi:
+                prev = la[1]
+            elif pi >= 0:
+                prev = h
+            else:
+                prev = start[c] if la is None else la[1]
+            if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
+                txt = fmt(want_a, nd_a)
+                added.setdefault(li, {})[axes[c]] = txt
+                last_add[c] = (li, float(txt))
+    else:
+        last_add = {}
+    for c, a in enumerate(axes):
+        li = int(last[m - 1, c]) if m else -1
+        la = last_add.get(c)
+        if la is not None and la[0] > li:
+            pos[a] = la[1]
+        elif li >= 0:
+            pos[a] = float(val[li, c])
+    # the edits: a line that gets a word is rewritten whole, else its numbers are replaced
+    line_of = wl[ci]
+    by_line = {}
+    if added:
+        for k, li in enumerate(line_of.tolist()):
+            if li in added:
+                by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
+    if not added:
+        edits.extend(zip(span_s.tolist(), span_e.tolist(), texts))
+        return
+    own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
+                                                          texts))
+           if int(line_of[k]) not in added]
+    for li, add in added.items():
+        i = i0 + li
+        line = _parse_seg(b.segs, b.first, i)
+        s0 = int(sc.start[i])
+        own.append((s0, s0 + len(b.segs[i]),
+                    gcode.rewrite_line(line, by_line.get(li, {}), add, spaced)))
+    own.sort()
+    edits.extend(own)
 
 
 def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axes,
           spaced: bool) -> str:
     """The chunk's output text: original bytes except the changed / added axis words.
     ``written`` (the positions the output program leaves the controller at) is updated."""
-    out = []
-    pos = written.position
-    q_list = q_out.tolist()
-    nd_list = blocks.nd.tolist()
-    fmt = gcode.format_number
-    for line, step, r in zip(blocks.lines, blocks.steps, blocks.row):
-        if r < 0:
-            out.append(line.body + line.ending)
-            if step is not None:
-                written.apply(step)
+    b = blocks
+    edits = []
+    q_list = nd_list = None
+    starts = b.scan.start
+    runs = iter(b.runs)
+    nxt = next(runs, None)
+    i, n = 0, len(b.segs)
+    while i < n:
+        if nxt is not None and nxt[0] == i:
+            _write_run(b, nxt[0], nxt[1], q_out, written, axes, spaced, edits)
+            i = nxt[1]
+            nxt = next(runs, None)
             continue
-        words = {a: (v, txt) for a, v, txt in line.items() if a in pos}
-        new_values, added, values = {}, {}, []
-        want_row, nd_row = q_list[r], nd_list[r]
-        if step.incremental:
-            for a, want, nd in zip(axes, want_row, nd_row):
-                half = 0.5 * 10.0 ** (-nd)
-                prev = pos[a]
-                inc = want - prev
-                w = words.get(a)
-                if w is not None:
-                    if abs(inc - w[0]) >= half:
-                        txt = fmt(inc, nd, w[1])
-                        new_values[a] = txt
-                        values.append((a, float(txt)))
-                    else:
-                        values.append((a, w[0]))
-                elif abs(inc) >= half:
-                    txt = fmt(inc, nd)
-                    added[a] = txt
-                    values.append((a, float(txt)))
-        else:
-            for a, want, nd in zip(axes, want_row, nd_row):
-                half = 0.5 * 10.0 ** (-nd)
-                w = words.get(a)
-                if w is not None:
-                    if abs(want - w[0]) >= half:
-                        txt = fmt(want, nd, w[1])
-                        new_values[a] = txt
-                        values.append((a, float(txt)))
-                    else:
-                        values.append((a, w[0]))
-                elif pos[a] is None or abs(want - pos[a]) >= half:
-                    txt = fmt(want, nd)
-                    added[a] = txt
-                    values.append((a, float(txt)))
-        written.apply(gcode.Step("motion", values, step.incremental))
-        out.append(gcode.rewrite_line(line, new_values, added, spaced) if (new_values or added)
-                   else line.body + line.ending)
+        line, step = b.slow[i]
+        r = int(b.row[i])
+        if r >= 0 and q_list is None:
+            q_list, nd_list = q_out.tolist(), b.nd.tolist()
+        t = _write_line(line, step, r, q_list, nd_list, written, axes, spaced)
+        if r >= 0 and t != b.segs[i]:
+            edits.append((int(starts[i]), int(starts[i]) + len(b.segs[i]), t))
+        i += 1
+    if not edits:
+        return b.scan.text
+    text = b.scan.text
+    s0, e0, t = zip(*edits)
+    out = [""] * (2 * len(edits) + 1)
+    out[0:-1:2] = [text[p:q] for p, q in zip((0,) + e0[:-1], s0)]
+    out[1::2] = t
+    out[-1] = text[e0[-1]:]
     return "".join(out)
 
 
@@ -468,16 +663,18 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         fh = open_source()
         try:
             buf = []
-            for line in gcode.iter_lines(fh):
-                buf.append(line)
+            first = 1
+            for seg in fh:
+                buf.append(seg)
                 if len(buf) >= chunk_lines:
-                    chunk = _run_chunk(buf, interp, written, em, opts, pre.spaced, known)
+                    chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
                     summary.add(chunk)
                     sink.add(chunk)
                     if progress is not None:
                         progress(len(buf))
+                    first += len(buf)
                     buf = []
-            chunk = _run_chunk(buf, interp, written, em, opts, pre.spaced, known)
+            chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
             summary.add(chunk)
             sink.add(chunk)
             if progress is not None:
@@ -491,9 +688,9 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         never = tuple(a for a in model.rotary_axes if a in never or a in late)
 
 
-def _run_chunk(lines, interp, written, em, opts, spaced, known) -> Chunk:
+def _run_chunk(segs, first, interp, written, em, opts, spaced, known) -> Chunk:
     model = em.model
-    b = interpret(lines, interp, model, opts.decimals)
+    b = interpret(segs, first, interp, model, opts.decimals)
     known |= b.known_rotary
     check_positions(b, em, opts)
     sol = solve_blocks(em, b.q_nom, opts)
@@ -534,12 +731,12 @@ def report_rows(model, chunk: Chunk) -> str:
         fmt = ",".join(["%.10g"] * (2 * n_ax + 10))
         its = chunk.solution.iterations.tolist()
         u = p.u_after_um.tolist()
-    row_line = [b.lines[i] for i, r in enumerate(b.row) if r >= 0]
+    row_line = b.numbers.tolist()
     for o in b.order:
         if o >= 0:
             uu = u[o]
             tail = ",".join(_g(v) for v in uu)
-            rows.append(f"{row_line[o].number},{chunk.status(o).replace(',', ';')},"
+            rows.append(f"{row_line[o]},{chunk.status(o).replace(',', ';')},"
                         f"{fmt % tuple(num[o])},{its[o]},{tail}")
         else:
             line, target = b.pending[-1 - o]
@@ -608,7 +805,7 @@ class FileSink:
         if self.keep_errors and len(chunk.blocks.q_nom):
             b, p = chunk.blocks, chunk.prediction
             self.errors.append((
-                np.array([b.lines[i].number for i, r in enumerate(b.row) if r >= 0]),
+                b.numbers,
                 np.linalg.norm(p.before_um, axis=1), np.linalg.norm(p.after_um, axis=1),
                 p.orientation_before_urad, p.orientation_after_urad))
 

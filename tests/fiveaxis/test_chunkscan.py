@@ -1,0 +1,143 @@
+"""The whole-chunk path of the compensation against the line-by-line rule: the scanner finds
+exactly the lines the word regex accepts and parses their numbers as Python's float does; the
+array formatter writes what gcode.format_number writes; random programs mixing plain lines,
+G90/G91, G28, comments, lower case, unknown axes and missing words compensate to the same
+bytes with the whole-chunk path on and off, at several chunk sizes."""
+
+import re
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_compensate import write_errors
+
+import volerr
+from volerr.fiveaxis import chunkscan, gcode, program
+from volerr.fiveaxis.compensate import compensate_program
+from volerr.tables import table as tables
+
+AXES = ("X", "Y", "Z", "B", "C")
+NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+
+number = st.one_of(
+    st.decimals(min_value=-1000, max_value=1000, allow_nan=False, places=4).map(str),
+    st.sampled_from(["1.", ".5", "+2", "-0", "+.25", "007", "12.3456789012345678", "1.2.3",
+                     "--1", "+", "."]))
+word = st.tuples(st.sampled_from("XYZBCxyzbNFGMAUS"), st.sampled_from(["", " ", "\t"]), number)
+plain = st.lists(st.tuples(st.sampled_from(["", " ", "  "]), word), min_size=0, max_size=6).map(
+    lambda ws: "".join(sp + a + b + c for sp, (a, b, c) in ws))
+line = st.one_of(plain, plain.map(lambda s: s + " "), st.sampled_from(
+    ["(comment X1)", "X1 (c)", "%", "G90", "G91", "X1 ; c", "X1 #1", "  "]))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(line, st.sampled_from(["\n", "\r\n", "\r"])), max_size=8))
+def test_scan_finds_the_plain_lines_and_their_numbers(lines):
+    segs = [a + b for a, b in lines]
+    sc = chunkscan.scan(segs, AXES)
+    for i, (body, _) in enumerate(lines):
+        simple = gcode._SIMPLE.fullmatch(body) is not None
+        parts = gcode._PARTS.findall(body) if simple else []
+        letters = [p[1].upper() for p in parts]
+        axes_ = [x for x in letters if x in AXES]
+        want_fast = simple and not any(x in "GMAU" for x in letters) and \
+            len(set(axes_)) == len(axes_)
+        assert bool(sc.fast[i]) == want_fast, body
+        if want_fast:
+            k = sc.line == i
+            assert [AXES[a] if a >= 0 else "?" for a in sc.axis[k]] == \
+                [x if x in AXES else "?" for x in letters]
+            texts = [p[3] for p in parts]
+            assert [sc.text[s:e] for s, e in zip(sc.num_start[k], sc.num_end[k])] == texts
+            vals = sc.value[k]
+            for t, v in zip(texts, vals):
+                assert v == float(t) and np.signbit(v) == np.signbit(float(t)), t
+            assert list(sc.frac[k]) == [len(t.split(".")[1]) if "." in t else -1 for t in texts]
+            assert list(sc.plus[k]) == [t.startswith("+") for t in texts]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(
+    st.one_of(st.floats(-1e4, 1e4), st.integers(-10 ** 6, 10 ** 6).map(lambda i: i / 2000),
+              st.sampled_from([0.5, 2.5, -0.0, 1e-9, -4.9999e-5, 0.00015, 1e16])),
+    st.integers(0, 9), st.sampled_from(["", "1.", "+1.25", "10", "-3.1234", "+7", ".5"])),
+    min_size=1, max_size=20))
+def test_format_numbers_is_format_number(items):
+    v = [a for a, _, _ in items]
+    nd = [d for _, d, _ in items]
+    t = [s for _, _, s in items]
+    keep = [len(s) - s.index(".") - 1 if "." in s else -1 for s in t]
+    got = chunkscan.format_numbers(v, nd, keep, [s.startswith("+") for s in t], lambda i: t[i])
+    assert got == [gcode.format_number(a, d, s) for a, d, s in items]
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    m = volerr.load("DMU50")
+    d = write_errors(tmp_path_factory.mktemp("err"), m, seed=5)
+    return m, tables.ErrorFunctions.from_dir(d, m)
+
+
+def _range(a):
+    return {"X": (-200, 200), "Y": (-200, 200), "Z": (20, 380), "B": (1, 100),
+            "C": (0, 359)}[a]
+
+
+def _value(rng, a):
+    return rng.uniform(*_range(a))
+
+
+def random_program(seed: int) -> str:
+    rng = np.random.default_rng(seed)
+    out = ["%", "G90 G1 X0 Y0 Z100 F500" if seed % 2 else "G90 G1 X0 Y0 Z100 B10 C5"]
+    incr = False
+    cur = {"X": 0.0, "Y": 0.0, "Z": 100.0, "B": 10.0, "C": 5.0}
+    for i in range(120):
+        r = rng.uniform()
+        if r < 0.04:
+            out.append("G91" if not incr else "G90")
+            incr = not incr
+            continue
+        if r < 0.06 and not incr:
+            out.append("G28 Z0")
+            continue
+        if r < 0.08:
+            out.append("(plain comment)")
+            continue
+        axes = [a for a in AXES if rng.uniform() < 0.55] or ["X"]
+        words = []
+        for a in axes:
+            target = float(np.clip(cur[a] + rng.uniform(-2, 2), *_range(a))) if incr \
+                else _value(rng, a)
+            nd = int(rng.integers(0, 5))
+            v = round(target - cur[a], nd) if incr else target
+            cur[a] = cur[a] + v if incr else round(target, nd)
+            txt = f"{v:.{nd}f}" + ("." if nd == 0 and rng.uniform() < 0.2 else "")
+            words.append((a.lower() if seed % 3 == 0 else a) + txt)
+        if rng.uniform() < 0.2:
+            words.insert(0, f"N{i}")
+        sep = "" if seed % 4 == 1 else " "
+        out.append(sep.join(words) + ("  " if rng.uniform() < 0.1 else ""))
+    if incr:
+        out.append("G90")
+    end = ["\n", "\r\n", "\r"][seed % 3]
+    return end.join(out) + end
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("orientation", [False, True])
+def test_whole_chunk_path_writes_the_line_by_line_bytes(setup, seed, orientation, monkeypatch):
+    m, funcs = setup
+    text = random_program(seed)
+    init = {"B": 10.0, "C": 5.0} if seed % 2 else {}
+    monkeypatch.setattr(program, "WHOLE_CHUNK", False)
+    ref = compensate_program(m, funcs, text, orientation=orientation, initial=init)
+    monkeypatch.setattr(program, "WHOLE_CHUNK", True)
+    assert ref.text != text
+    for k in (None, 1, 7, 50):
+        got = compensate_program(m, funcs, text, orientation=orientation, initial=init,
+                                 chunk_lines=k)
+        assert got.text == ref.text, k
+        assert [(r.line, r.status, r.output) for r in got.reports] == \
+            [(r.line, r.status, r.output) for r in ref.reports]
