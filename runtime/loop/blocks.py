@@ -14,7 +14,8 @@ import math
 
 import numpy as np
 
-from volerr.loop.fit import SV_TOL, declared_design, point_norm, rows_of
+from volerr.loop.fit import (SV_TOL, TWIST, declared_design, legendre, point_norm, rows_of,
+                             twist_sensitivity, unit)
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
 BLOCK = 8192
@@ -31,30 +32,83 @@ class Design:
     """Columns of a linear model at the data points, generated per block.
 
     ``keep``: mask of the columns of :func:`volerr.loop.fit.declared_design` kept (gauge and
-    identifiability); ``extra``: dense (N, 3, m) column groups appended in order."""
+    identifiability); ``extra``: dense (N, 3, m) column groups appended in order.
+
+    :meth:`block` returns the columns transposed, (p, 3n), with the rows of a block in
+    component-major order (all dx rows, then dy, then dz): each column is then one contiguous
+    product of a generated sensitivity (3, n) and a Legendre basis (n,).  :func:`yrows` and
+    :func:`wrows` give the deviations and weights of a block in that order."""
 
     def __init__(self, model, data, degree: int, ranges: dict, keep, extra=()):
         self.model, self.data, self.degree, self.ranges = model, data, degree, ranges
         self.keep = np.asarray(keep, bool)
         self.extra = [np.asarray(e) for e in extra]
-        self.p = int(self.keep.sum()) + sum(e.shape[-1] for e in self.extra)
+        labels = declared_design(model, data.subset(np.arange(1)), degree, ranges).labels
+        self.labels = [lab for lab, k in zip(labels, self.keep) if k]
+        pidx = {p: j for j, p in enumerate(model.parameters)}
+        self._ops = []
+        for p, k in self.labels:
+            if p == "setup":
+                self._ops.append((0, TWIST[f"work.{k}"], None, None))
+            elif k is None:
+                self._ops.append((1, pidx[p], None, None))
+            else:
+                self._ops.append((1, pidx[p], model.parameter_axis[p], k))
+        self.p = len(self.labels) + sum(e.shape[-1] for e in self.extra)
 
     def plus(self, extra) -> "Design":
         """This design with more dense column groups appended."""
         return Design(self.model, self.data, self.degree, self.ranges, self.keep,
                       self.extra + [np.asarray(e) for e in extra])
 
-    def cols(self, idx) -> np.ndarray:
-        """(n, 3, p) columns at the points ``idx``."""
-        d = declared_design(self.model, self.data.subset(idx), self.degree, self.ranges)
-        A = d.A[:, :, self.keep]
-        if self.extra:
-            A = np.concatenate([A] + [e[idx] for e in self.extra], axis=2)
-        return A
+    def block(self, idx) -> np.ndarray:
+        """(p, 3n) columns at the points ``idx``, rows component-major."""
+        sub = self.data.subset(idx)
+        n = len(idx)
+        cov = {c: sub.covariates[c] for c in self.model.covariates}
+        sens = np.moveaxis(self.model.sensitivity(sub.positions, sub.probe, covariates=cov),
+                           0, -1)                                      # (3, P, n)
+        tw = np.moveaxis(twist_sensitivity(self.model, sub), 0, -1)    # (3, 12, n)
+        bases = {a: legendre(unit(sub.positions[a], *self.ranges[a]), self.degree).T
+                 for a in self.model.axes}
+        At = np.empty((self.p, 3, n))
+        for i, (src, j, axis, k) in enumerate(self._ops):
+            col = (tw if src == 0 else sens)[:, j, :]
+            if axis is None:
+                At[i] = col
+            else:
+                np.multiply(col, bases[axis][k], out=At[i])
+        i = len(self._ops)
+        for e in self.extra:
+            m = e.shape[-1]
+            At[i:i + m] = np.transpose(e[idx], (2, 1, 0))
+            i += m
+        return At.reshape(self.p, 3 * n)
 
     def rows(self, idx) -> np.ndarray:
-        """(3n, p) rows at the points ``idx``."""
-        return self.cols(idx).reshape(-1, self.p)
+        """(3n, p) rows at the points ``idx``, point-major (3 per point)."""
+        At = self.block(idx).reshape(self.p, 3, len(idx))
+        return np.ascontiguousarray(np.transpose(At, (2, 1, 0))).reshape(-1, self.p)
+
+
+def yrows(y, idx) -> np.ndarray:
+    """Rows of ``y`` (3N,) at the points ``idx`` in a block's component-major order."""
+    return np.ascontiguousarray(y.reshape(-1, 3)[idx].T).ravel()
+
+
+def wrows(sw) -> np.ndarray:
+    """Row weights of a block (component-major) from the points' weights."""
+    return np.tile(sw, 3)
+
+
+def group_block(cols) -> np.ndarray:
+    """(n, 3, m) columns of a block -> (m, 3n), rows component-major."""
+    return np.transpose(cols, (2, 1, 0)).reshape(cols.shape[-1], -1)
+
+
+def to_point_major(r, n: int) -> np.ndarray:
+    """Block rows component-major (3n,) -> point-major."""
+    return np.ascontiguousarray(r.reshape(3, n).T).ravel()
 
 
 def normal(design, points, sw, y):
@@ -64,10 +118,11 @@ def normal(design, points, sw, y):
     G = np.zeros((design.p, design.p))
     b = np.zeros(design.p)
     for s, idx in blocks(points):
-        w = np.repeat(sw[s], 3)
-        A = design.rows(idx) * w[:, None]
-        G += A.T @ A
-        b += A.T @ (y[rows_of(idx)] * w)
+        w = wrows(sw[s])
+        At = design.block(idx)
+        At *= w
+        G += At @ At.T
+        b += At @ (yrows(y, idx) * w)
     return G, b, np.diag(G).copy()
 
 
@@ -86,10 +141,11 @@ def eig_inverse(G, tol: float):
 
 
 def predict(design, points, coef) -> np.ndarray:
-    """Rows A c at ``points`` (3 per point)."""
+    """Rows A c at ``points`` (point-major, 3 per point)."""
     out = np.empty(3 * len(points))
     for s, idx in blocks(points):
-        out[3 * s.start:3 * s.start + 3 * len(idx)] = design.rows(idx) @ coef
+        out[3 * s.start:3 * s.start + 3 * len(idx)] = to_point_major(
+            coef @ design.block(idx), len(idx))
     return out
 
 
@@ -106,31 +162,33 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
         c = Gi @ (b / sc)
         out = np.empty(len(points))
         for s, idx in blocks(points):
-            w = np.repeat(sw[s], 3)
-            A = design.rows(idx) * (w[:, None] / sc)
-            r = y[rows_of(idx)] * w - A @ c
+            w = wrows(sw[s])
+            At = design.block(idx)
+            At *= w / sc[:, None]
             n = len(idx)
-            B = (A @ Gi).reshape(n, 3, -1)
-            A3 = A.reshape(n, 3, -1)
-            h = np.einsum("nik,njk->nij", B, A3)
+            r = (yrows(y, idx) * w - c @ At).reshape(3, n).T          # (n, 3)
+            A3 = At.reshape(-1, 3, n)
+            B3 = (Gi @ At).reshape(-1, 3, n)
+            h = np.einsum("kin,kjn->nij", B3, A3)
             m = np.eye(3) - h
             det = np.linalg.det(m)
             m[np.abs(det) < 1e-9] = np.eye(3)      # a point that alone fixes a parameter
-            out[s] = point_norm(np.linalg.solve(m, r.reshape(n, 3, 1)).ravel()) ** 2
+            out[s] = np.sum(np.linalg.solve(m, r[:, :, None])[:, :, 0] ** 2, axis=1)
         return out
     labels = np.unique(folds)
     p = design.p
     Gf = np.zeros((len(labels), p, p))
     bf = np.zeros((len(labels), p))
     for s, idx in blocks(points):
-        w = np.repeat(sw[s], 3)
-        A = design.rows(idx) * w[:, None]
-        yw = y[rows_of(idx)] * w
-        f = np.repeat(folds[s], 3)
+        w = wrows(sw[s])
+        At = design.block(idx)
+        At *= w
+        yw = yrows(y, idx) * w
+        f = np.tile(folds[s], 3)
         for k, lab in enumerate(labels):
             m = f == lab
-            Gf[k] += A[m].T @ A[m]
-            bf[k] += A[m].T @ yw[m]
+            Gf[k] += At[:, m] @ At[:, m].T
+            bf[k] += At[:, m] @ yw[m]
     G, b = Gf.sum(axis=0), bf.sum(axis=0)
     sc = unit_scale(np.diag(G), n_rows)
     S = np.outer(sc, sc)
@@ -138,11 +196,13 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
                      for k in range(len(labels))])
     out = np.empty(len(points))
     for s, idx in blocks(points):
-        w = np.repeat(sw[s], 3)
-        A = design.rows(idx) * w[:, None]
+        w = wrows(sw[s])
+        n = len(idx)
+        At = design.block(idx).reshape(p, 3, n)
         k = np.searchsorted(labels, folds[s])
-        pred = np.einsum("nip,np->ni", A.reshape(len(idx), 3, -1), coef[k])
-        out[s] = np.sum((y[rows_of(idx)].reshape(-1, 3) * w.reshape(-1, 3) - pred) ** 2, axis=1)
+        pred = np.einsum("pin,np->ni", At, coef[k])
+        yw = (yrows(y, idx) * w).reshape(3, n).T
+        out[s] = np.sum((yw - pred * w.reshape(3, n).T) ** 2, axis=1)
     return out
 
 
@@ -167,11 +227,11 @@ class BlockBase:
         self.scale = unit_scale(colsq, self.n)
         self.Gi = eig_inverse(G / np.outer(self.scale, self.scale), 1e-12)
         c = self.Gi @ (b / self.scale) / self.scale
-        self.r = np.empty(self.n)
+        self.r = np.empty(self.n)         # weighted residual rows, component-major per block
         for s, idx in blocks(self.points):
-            w = np.repeat(self.sw[s], 3)
+            w = wrows(self.sw[s])
             self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (
-                (y[rows_of(idx)] - design.rows(idx) @ c) * w)
+                (yrows(y, idx) - c @ design.block(idx)) * w)
         self.rss = float(self.r @ self.r)
 
     def score_many(self, groups) -> list:
@@ -179,13 +239,13 @@ class BlockBase:
         ``idx -> (n, 3, m)`` columns at the points ``idx``."""
         acc = [None] * len(groups)
         for s, idx in blocks(self.points):
-            w = np.repeat(self.sw[s], 3)
-            A = self.design.rows(idx) * (w[:, None] / self.scale)
+            w = wrows(self.sw[s])
+            At = self.design.block(idx)
+            At *= w / self.scale[:, None]
             r = self.r[3 * s.start:3 * s.start + 3 * len(idx)]
             for k, g in enumerate(groups):
-                B = g(idx)
-                B = B.reshape(-1, B.shape[-1]) * w[:, None]
-                parts = (A.T @ B, B.T @ B, B.T @ r)
+                Bt = group_block(g(idx)) * w
+                parts = (At @ Bt.T, Bt @ Bt.T, Bt @ r)
                 acc[k] = parts if acc[k] is None else tuple(x + y for x, y in zip(acc[k], parts))
         return [self._score(*a) for a in acc]
 

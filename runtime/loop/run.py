@@ -530,12 +530,12 @@ def _fits(design, spl: Split, sw, y):
     ss = np.zeros(p)
     for k, pts in enumerate((spl.train, spl.test)):
         for _, idx in blocks.blocks(pts):
-            A = design.rows(idx)
-            ss += np.einsum("ij,ij->j", A, A)
-            w = np.repeat(sw[idx], 3)
-            A *= w[:, None]
-            G[k] += A.T @ A
-            b[k] += A.T @ (y[rows_of(idx)] * w)
+            At = design.block(idx)
+            ss += np.einsum("ij,ij->i", At, At)
+            w = blocks.wrows(sw[idx])
+            At *= w
+            G[k] += At @ At.T
+            b[k] += At @ (blocks.yrows(y, idx) * w)
     scale = blocks.unit_scale(ss, len(y))
     S = np.outer(scale, scale)
     c_tr = solve_normal(G[0] / S, b[0] / scale) / scale
@@ -552,12 +552,13 @@ def _residuals(design, n, test, y, c_tr, c_all, groups=None):
     r_test = np.empty(3 * n)
     contrib = {g: np.empty(3 * n) for g in groups}
     for _, idx in blocks.blocks(np.arange(n)):
-        A = design.rows(idx)
+        At = design.block(idx)
         rr = rows_of(idx)
-        res[rr] = y[rr] - A @ c_all
-        r_test[rr] = y[rr] - A @ c_tr
+        pm = len(idx)
+        res[rr] = y[rr] - blocks.to_point_major(c_all @ At, pm)
+        r_test[rr] = y[rr] - blocks.to_point_major(c_tr @ At, pm)
         for g, js in groups.items():
-            contrib[g][rr] = A[:, js] @ c_all[js]
+            contrib[g][rr] = blocks.to_point_major(c_all[js] @ At[js], pm)
     return res, r_test[rows_of(test)], contrib
 
 
