@@ -439,16 +439,17 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     sigma = 0.0
     for _ in range(iterations):
         low = np.flatnonzero(w < 1.0)
-        if len(low) > len(points) // 4:
+        if len(low) > len(points) // 2:
             G, b, _ = blocks.normal(design, points, np.sqrt(w), y)
-        else:
+        else:       # G1 minus the down-weighted points' share (1 - w) A_i^T A_i
             G, b = G1.copy(), b1.copy()
-            for s, part in blocks.blocks(low):
+            for _, part in blocks.blocks(low):
                 idx = points[part]
-                d = np.repeat(1.0 - w[part], 3)
-                A = design.rows(idx)
-                G -= A.T @ (A * d[:, None])
-                b -= A.T @ (y[rows_of(idx)] * d)
+                d = blocks.wrows(np.sqrt(1.0 - w[part]))
+                At = design.block(idx)
+                At *= d
+                G -= At @ At.T
+                b -= At @ (blocks.yrows(y, idx) * d)
         c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
         r = point_norm(y[rows] - blocks.predict(design, points, c))
         sigma = max(float(np.median(r[w > 0])) / 1.538, 1e-12)
