@@ -21,9 +21,9 @@ from volerr.loop.fit import (SV_TOL, TWIST, declared_design, legendre, point_nor
 BLOCK = 8192
 
 
-def blocks(points, size: int = BLOCK):
+def blocks(points, size: int | None = None):
     """Consecutive slices of ``points`` (index arrays) of at most ``size`` points."""
-    points = np.asarray(points)
+    points, size = np.asarray(points), size or BLOCK
     for i in range(0, len(points), size):
         yield slice(i, i + size), points[i:i + size]
 
