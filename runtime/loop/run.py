@@ -232,7 +232,14 @@ class Report:
     data: dict
     figures: "Figures | None" = None       # what the html report and error tables need
     augmented_text: str = ""
-    generated_text: str = ""
+    generated: object = ""      # module text, or a function deriving it when first asked
+
+    @property
+    def generated_text(self) -> str:
+        """The augmented layout's generated module (derived on first access)."""
+        if callable(self.generated):
+            self.generated = self.generated()
+        return self.generated
 
     def __getitem__(self, key):
         return self.data[key]
@@ -481,26 +488,32 @@ def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, famil
 
 @dataclass
 class Augmented:
-    """The augmented layout (text), its generated module (text), model and design."""
+    """The augmented layout (text), model (from a reduced module: the fitting functions) and
+    design; :meth:`source` derives its full generated module (text)."""
 
     text: str
-    source: str
+    layout: object
     model: Model
     design: blocks.Design
     labels: list
+    _source: str | None = None
+
+    def source(self) -> str:
+        if self._source is None:
+            self._source = "" if self.layout is None else derivation.generate_source(self.layout)
+        return self._source
 
 
 def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augmented:
     if not selection.accepted:
-        return Augmented("", "", model, decl.design, decl.labels)
+        return Augmented("", None, model, decl.design, decl.labels)
     text = augmented_layout_text(model, selection.accepted)
     lay = parse_layout(text, f"{model.name}_aug.toml")
-    source = derivation.generate_source(lay)
-    aug = Model(lay, derivation.module_from_source(source, lay.name))
+    aug = Model(lay, derivation.module_from_source(derivation.fit_source(lay), lay.name))
     labels = declared_design(aug, dat.subset(np.arange(1)), degree, ranges).labels
     n_new = len(aug.parameters) - len(model.parameters)
     keep = np.concatenate([decl.keep, np.ones(n_new, bool)])
-    return Augmented(text, source, aug, blocks.Design(aug, dat, degree, ranges, keep),
+    return Augmented(text, lay, aug, blocks.Design(aug, dat, degree, ranges, keep),
                      [lab for lab, m in zip(labels, keep) if m])
 
 
@@ -785,7 +798,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     figs = Figures(model, dat, ranges, degree, out.res_before, out.res_after, spl.test,
                    out.r_before, out.r_after, selection.accepted, out.contrib, out.c_all,
                    aug.labels, out.c_before, decl.labels, out.cov_diag, robust.weights)
-    return Report(report, figs, aug.text, aug.source)
+    return Report(report, figs, aug.text, aug.source)  # the full module: derived when asked
 
 
 def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
@@ -798,7 +811,7 @@ def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
     return {"augmented_layout": str(write_text(out / f"{aug.model.name}.toml", aug.text,
                                                inputs=inputs)),
             "generated_module": str(write_text(out / f"{aug.model.name.lower()}.py",
-                                               aug.source, inputs=inputs))}
+                                               aug.source(), inputs=inputs))}
 
 
 def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection, aug, out,

@@ -116,3 +116,33 @@ def test_screening_score_is_the_rss_reduction_of_a_refit(problem):
     # a candidate inside the span of the design adds nothing
     inside = dense.reshape(n, 3, -1)[:, :, 3:4] * 2.0
     assert base.score(lambda idx: inside[idx])[1] == 0
+
+
+def test_reduced_fitting_module_equals_the_full_module():
+    """The loop derives only the fitting functions of its augmented layout during the run
+    (derivation.fit_source); they must equal those of the full generated module."""
+    from volerr.loop.run import augmented_layout_text
+    from volerr.machine import derivation
+    from volerr.machine.layout import parse_layout
+
+    model = volerr.load("MB1")
+
+    class S:                                       # an accepted effect: thermal growth of X
+        cand = type("C", (), {"name": "thermal_X", "kind": "thermal", "info": {},
+                              "terms": [("KT_X", "EXX", "X*(T_C - 20)"),
+                                        ("KT0_X", "EXX", "(T_C - 20)")]})()
+
+    lay = parse_layout(augmented_layout_text(model, [S]), "MB1_aug.toml")
+    full = derivation.module_from_source(derivation.generate_source(lay), lay.name)
+    red = derivation.module_from_source(derivation.fit_source(lay), lay.name)
+    for k in ("AXES", "ROTARY_AXES", "PARAMETERS", "PARAMETER_AXIS", "COVARIATES"):
+        assert getattr(red, k) == getattr(full, k)
+    rng = np.random.default_rng(5)
+    pos = {a: rng.uniform(0, 500, 50) for a in full.AXES}
+    probe = {k: rng.uniform(-80, 80, 50) for k in ("Xp", "Yp", "Zp")}
+    cov = {"T_C": rng.uniform(18, 24, 50)}
+    assert np.array_equal(red.sensitivity(**pos, **cov, **probe),
+                          full.sensitivity(**pos, **cov, **probe))
+    assert np.array_equal(red.setup_sensitivity(**pos, **probe),
+                          full.setup_sensitivity(**pos, **probe))
+    assert "exact_error" not in red.__dict__
