@@ -14,8 +14,7 @@ import math
 
 import numpy as np
 
-from volerr.loop.fit import (SV_TOL, TWIST, declared_design, legendre, point_norm, rows_of,
-                             twist_sensitivity, unit)
+from volerr.loop.fit import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
 BLOCK = 8192

@@ -43,7 +43,7 @@ from volerr.loop import select as sel
 from volerr.errors import InputError, require
 from volerr.loop.fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
                   identifiability_gram, point_norm, require_points, rms, rows_of,
-                  twist_sensitivity, weakly_determined_gram)
+                  weakly_determined_gram)
 from volerr.machine.layout import layout_text, parse_layout
 from volerr.machine import derivation
 from volerr.machine.model import Model, load
@@ -478,9 +478,7 @@ def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, famil
     candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
                   if c.kind in families]
     w_rows = robust.rows()
-    sens = model.sensitivity(dat.positions, dat.probe,
-                             covariates={c: dat.covariates[c] for c in model.covariates})
-    ctx = sel.Context(model, dat, sens, twist_sensitivity(model, dat), spl.train,
+    ctx = sel.Context(model, dat, None, None, spl.train,    # sensitivities per block
                       np.sqrt(robust.weights[spl.train]), ranges)
     return sel.select(candidates, ctx, decl.design, y, spl.folds, w_rows,
                       sel.SCREEN_POINTS), warns

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.loop import candidates as cands
-from volerr.loop.blocks import BlockBase, cv_sq
+from volerr.loop.blocks import BlockBase, blocks, cv_sq
 from volerr.loop.fit import TWIST, rows_of
 from volerr.machine.expressions import evaluate
 
@@ -90,8 +90,8 @@ class Context:
 
     model: object
     data: object
-    sens: np.ndarray
-    twist: np.ndarray       # (N, 3, 12) rigid-twist sensitivity (fit.twist_sensitivity)
+    sens: np.ndarray | None     # (N, 3, P) model sensitivity; None: generated per block
+    twist: np.ndarray | None    # (N, 3, 12) rigid-twist sensitivity (fit.twist_sensitivity)
     pts: np.ndarray
     sw: np.ndarray
     ranges: dict
@@ -112,16 +112,37 @@ class Context:
             self.cache[key] = {k: np.asarray(v)[idx] for k, v in vals.items()}
         return self.cache[key]
 
+    def sensitivities(self, idx, slot: str = "_block") -> tuple:
+        """(sensitivity (n, 3, P), twist sensitivity (n, 3, 12)) at the points ``idx``: slices
+        of the full arrays when the context holds them, else generated (kept for the last
+        ``idx`` of each ``slot``)."""
+        if self.sens is not None:
+            return self.sens[idx], self.twist[idx]
+        from volerr.loop.fit import twist_sensitivity
+
+        last = self.cache.get(slot)
+        if last is not None and np.array_equal(last[0], idx):
+            return last[1]
+        sub = self.data.subset(idx)
+        cov = {c: sub.covariates[c] for c in self.model.covariates}
+        out = (self.model.sensitivity(sub.positions, sub.probe, covariates=cov),
+               twist_sensitivity(self.model, sub))
+        self.cache[slot] = (np.array(idx), out)
+        return out
+
+    def _column(self, target: str, sens, tw) -> np.ndarray:
+        if "." in target:
+            return tw[:, :, TWIST[target]]
+        return sens[:, :, self.model.parameters.index(target)]
+
     def target_column(self, target: str, full: bool = False) -> np.ndarray:
         """(n, 3) sensitivity of a chain target (a parameter, ``work.*`` or ``tool.*``) at the
         context's points (all points when ``full``)."""
+        if full:
+            return self._column(target, *self.sensitivities(np.arange(self.data.n), "_full"))
         key = ("target", target, full)
         if key not in self.cache:
-            if "." in target:
-                col = self.twist[:, :, TWIST[target]]
-            else:
-                col = self.sens[:, :, self.model.parameters.index(target)]
-            self.cache[key] = col if full else col[self.pts]
+            self.cache[key] = self._column(target, *self.sensitivities(self.pts, "_pts"))
         return self.cache[key]
 
     def columns(self, terms, full: bool = False) -> tuple[np.ndarray, list]:
@@ -131,6 +152,11 @@ class Context:
         if not full and key in self.cache:
             return self.cache[key]
         params = list(dict.fromkeys(t[0] for t in terms))
+        if full:          # by blocks of points: no full sensitivity arrays
+            out = np.empty((self.data.n, 3, len(params)))
+            for s, idx in blocks(np.arange(self.data.n)):
+                out[s] = self.columns_at(terms, idx)
+            return out, params
         vals = self.values(full)
         n = self.data.n if full else len(self.pts)
         out = np.zeros((n, 3, len(params)))
@@ -145,10 +171,11 @@ class Context:
         """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
         params = list(dict.fromkeys(t[0] for t in terms))
         vals = {k: v[idx] for k, v in self.values(True).items()}
+        sens, tw = self.sensitivities(idx)
         out = np.zeros((len(idx), 3, len(params)))
         for pn, target, basis in terms:
             b = np.broadcast_to(evaluate(basis, vals), (len(idx),))
-            out[:, :, params.index(pn)] += self.target_column(target, True)[idx] * b[:, None]
+            out[:, :, params.index(pn)] += self._column(target, sens, tw) * b[:, None]
         return out
 
     def group(self, terms):
