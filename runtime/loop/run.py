@@ -17,8 +17,12 @@ Steps (:func:`run_loop`):
    residual is significantly smaller (paired t > 3 on the per-point squared errors);
    stop when no candidate passes; then a backward check drops any effect that, given all
    the others, no longer gains dBIC < -10 (a later effect made it redundant);
-6. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
-   it, and fit it with the columns of its generated module: it gives the "after" figures;
+6. write the augmented layout (the original with ``[effects.*]`` tables), derive its fitting
+   functions (sensitivities; the full module only when written or asked for) and fit it with
+   their columns: it gives the "after" figures;
+
+All fits run on columns generated per block of points (:mod:`volerr.loop.blocks`): normal
+equations, cross-products and residuals are accumulated blockwise, never the (3N, p) design.
 7. report: :class:`Report` (with the ranked residual sources before and after) (``write_json``, ``write_html``).
 
 Units: deviations in mm inside, um in reports; angular parameters urad; thermal um/m/K.
