@@ -63,6 +63,8 @@ def fit_source(layout: Layout) -> str:
     if layout.effects:
         constants["COVARIATES"] = repr(tuple(layout.covariates))
         constants["EFFECTS"] = repr({e.name: e.kind for e in layout.effects})
+    for k, v in sorted(layout.parameters.items()):     # numeric layout parameters (h, ...)
+        constants[k] = repr(float(v))
     header = {"title": f"Fitting functions of layout {layout.name} (reduced module).",
               "layout": layout.name, "layout_file": layout.path or f"{layout.name}.toml",
               "sha256": layout.sha256, "sources": LAYOUT_SOURCES}

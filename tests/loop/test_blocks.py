@@ -118,21 +118,22 @@ def test_screening_score_is_the_rss_reduction_of_a_refit(problem):
     assert base.score(lambda idx: inside[idx])[1] == 0
 
 
-def test_reduced_fitting_module_equals_the_full_module():
+@pytest.mark.parametrize("layout", ["MB1", "TT_AC"])     # TT_AC: numeric layout parameters
+def test_reduced_fitting_module_equals_the_full_module(layout):
     """The loop derives only the fitting functions of its augmented layout during the run
     (derivation.fit_source); they must equal those of the full generated module."""
     from volerr.loop.run import augmented_layout_text
     from volerr.machine import derivation
     from volerr.machine.layout import parse_layout
 
-    model = volerr.load("MB1")
+    model = volerr.load(layout)
 
     class S:                                       # an accepted effect: thermal growth of X
         cand = type("C", (), {"name": "thermal_X", "kind": "thermal", "info": {},
                               "terms": [("KT_X", "EXX", "X*(T_C - 20)"),
                                         ("KT0_X", "EXX", "(T_C - 20)")]})()
 
-    lay = parse_layout(augmented_layout_text(model, [S]), "MB1_aug.toml")
+    lay = parse_layout(augmented_layout_text(model, [S]), f"{layout}_aug.toml")
     full = derivation.module_from_source(derivation.generate_source(lay), lay.name)
     red = derivation.module_from_source(derivation.fit_source(lay), lay.name)
     for k in ("AXES", "ROTARY_AXES", "PARAMETERS", "PARAMETER_AXIS", "COVARIATES"):
