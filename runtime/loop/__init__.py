@@ -2,8 +2,9 @@
 effects "parameter P of the chain varies with covariate C", the layout augmented, before/after
 reported on held-out points.  Modules: ``fit`` (design and gauge), ``candidates`` (P x C x basis
 generated from the chain), ``select`` (screening, selection, backward check, merge), ``run``
-(the named steps, robust weights, augmentation), ``report`` (HTML), ``simulate`` (a virtual
-machine with undeclared effects).
+(the named steps, robust weights, augmentation), ``blocks`` (least squares with the columns
+generated per block of points), ``report`` (HTML), ``simulate`` (a virtual machine with
+undeclared effects).
 """
 
 from volerr.loop.run import Report, read_deviations, run_loop

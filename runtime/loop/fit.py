@@ -123,21 +123,24 @@ def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Desi
     cov = {c: data.covariates[c] for c in model.covariates}
     sens = model.sensitivity(data.positions, data.probe, covariates=cov)
     tw = twist_sensitivity(model, data)
-    cols, labels = [], []
-    for key in SETUP:
-        cols.append(tw[:, :, TWIST[f"work.{key}"]])
-        labels.append(("setup", key))
+    labels = [("setup", key) for key in SETUP]
+    for p in model.parameters:
+        labels += ([(p, None)] if model.parameter_axis.get(p) is None
+                   else [(p, k) for k in range(degree + 1)])
+    A = np.empty((data.n, 3, len(labels)))
+    for i, key in enumerate(SETUP):
+        A[:, :, i] = tw[:, :, TWIST[f"work.{key}"]]
     bases = {a: legendre(unit(data.positions[a], *ranges[a]), degree) for a in model.axes}
+    i = len(SETUP)
     for j, p in enumerate(model.parameters):
         axis = model.parameter_axis.get(p)
         if axis is None:
-            cols.append(sens[:, :, j])
-            labels.append((p, None))
+            A[:, :, i] = sens[:, :, j]
+            i += 1
             continue
-        for k in range(degree + 1):
-            cols.append(sens[:, :, j] * bases[axis][:, k:k + 1])
-            labels.append((p, k))
-    return Design(np.stack(cols, axis=-1), labels, sens, tw)
+        A[:, :, i:i + degree + 1] = sens[:, :, j, None] * bases[axis][:, None, :]
+        i += degree + 1
+    return Design(A, labels, sens, tw)
 
 
 def _priority(label) -> int:
@@ -320,7 +323,12 @@ def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> tuple[
     them by these data.  Returns the mask of kept columns and one entry per parameter with
     dropped terms: ``{"parameters": [that parameter, then the partners it is confounded
     with], "terms": [dropped basis terms], "confounded_with": {partner: weight}}``."""
-    G = _correlation(A2.T @ A2)   # scale-free: mm and rad columns alike
+    return identifiability_gram(A2.T @ A2, labels, tol)
+
+
+def identifiability_gram(G: np.ndarray, labels: list, tol: float = SV_TOL):
+    """:func:`identifiability` from the Gram matrix A2^T A2 of the columns."""
+    G = _correlation(G)   # scale-free: mm and rad columns alike
     # translational terms before angular ones: an angular error is what a plan without the
     # lever arms cannot see, not the scale or straightness it would be confused with
     order = sorted(range(len(labels)), key=lambda j: (
@@ -361,7 +369,11 @@ def weakly_determined(A2: np.ndarray, labels: list, limit: float = 1e4) -> list:
     (1 / squared relative distance to the span of the others) above ``limit``, i.e. a
     standard error inflated more than sqrt(limit) times by near-confounding.  Returns
     ``[{"parameter", "vif", "terms"}]`` sorted by decreasing VIF."""
-    G = A2.T @ A2
+    return weakly_determined_gram(A2.T @ A2, labels, limit)
+
+
+def weakly_determined_gram(G: np.ndarray, labels: list, limit: float = 1e4) -> list:
+    """:func:`weakly_determined` from the Gram matrix A2^T A2 of the columns."""
     d = np.sqrt(np.diag(G))
     d[d == 0] = 1.0
     C = G / np.outer(d, d)

@@ -118,13 +118,7 @@ def fig_effect(fg, eff: dict) -> str:
     import matplotlib.pyplot as plt
 
     model, dat = fg.model, fg.data
-    prob, coef, labels = fg.after_prob, fg.c_all, fg.aug_labels
-    col = {lab[0]: j for j, lab in enumerate(labels)}
-    contrib = np.zeros(3 * dat.n)
-    for p in eff["parameters"]:
-        j = col[p]
-        contrib += prob.A[:, j] * prob.scale[j] * coef[j]
-    c3 = contrib.reshape(-1, 3) * 1e3
+    c3 = fg.contrib[eff["name"]].reshape(-1, 3) * 1e3
     partial = (fg.res_after.reshape(-1, 3) * 1e3) + c3
     values = {**rotary_rad(model, dat.positions), **dat.covariates}
     x, xlabel = _natural(eff["kind"], eff["info"], model, dat, values)

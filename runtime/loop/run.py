@@ -17,8 +17,12 @@ Steps (:func:`run_loop`):
    residual is significantly smaller (paired t > 3 on the per-point squared errors);
    stop when no candidate passes; then a backward check drops any effect that, given all
    the others, no longer gains dBIC < -10 (a later effect made it redundant);
-6. write the augmented layout (the original with ``[effects.*]`` tables), derive and generate
-   it, and fit it with the columns of its generated module: it gives the "after" figures;
+6. write the augmented layout (the original with ``[effects.*]`` tables), derive its fitting
+   functions (sensitivities; the full module only when written or asked for) and fit it with
+   their columns: it gives the "after" figures;
+
+All fits run on columns generated per block of points (:mod:`volerr.loop.blocks`): normal
+equations, cross-products and residuals are accumulated blockwise, never the (3N, p) design.
 7. report: :class:`Report` (with the ranked residual sources before and after) (``write_json``, ``write_html``).
 
 Units: deviations in mm inside, um in reports; angular parameters urad; thermal um/m/K.
@@ -37,12 +41,13 @@ from pathlib import Path
 
 import numpy as np
 
+from volerr.loop import blocks
 from volerr.loop import candidates as cands
 from volerr.loop import select as sel
 from volerr.errors import InputError, require
 from volerr.loop.fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
-                  identifiability, point_norm, require_points, rms, rows_of,
-                  weakly_determined)
+                  identifiability_gram, point_norm, require_points, rms, rows_of,
+                  weakly_determined_gram)
 from volerr.machine.layout import layout_text, parse_layout
 from volerr.machine import derivation
 from volerr.machine.model import Model, load
@@ -231,7 +236,14 @@ class Report:
     data: dict
     figures: "Figures | None" = None       # what the html report and error tables need
     augmented_text: str = ""
-    generated_text: str = ""
+    generated: object = ""      # module text, or a function deriving it when first asked
+
+    @property
+    def generated_text(self) -> str:
+        """The augmented layout's generated module (derived on first access)."""
+        if callable(self.generated):
+            self.generated = self.generated()
+        return self.generated
 
     def __getitem__(self, key):
         return self.data[key]
@@ -385,29 +397,28 @@ class Declared:
     """The declared model's design at the data: columns kept after gauge fixing and what the
     plan cannot separate."""
 
-    design: object
+    design: blocks.Design        # the kept columns, generated per block of points
     keep: np.ndarray
     gauge: list
-    A: np.ndarray                # (3N, k)
     labels: list
     unidentifiable: list
     weak: list
 
 
 def declared_step(model, dat, degree, ranges, train) -> Declared:
-    design = declared_design(model, dat, degree, ranges)
+    all_labels = declared_design(model, dat.subset(np.arange(1)), degree, ranges).labels
     keep, gauge = gauge_mask(model, dat, degree, ranges)
     require_points(len(train), int(keep.sum()), f"declared model of degree {degree}")
-    labels = [lab for lab, k in zip(design.labels, keep) if k]
-    A_tr = design.A[train][:, :, keep].reshape(-1, keep.sum())
-    keep_d, unident = identifiability(A_tr, labels)
+    labels = [lab for lab, k in zip(all_labels, keep) if k]
+    G_tr, _, _ = blocks.normal(blocks.Design(model, dat, degree, ranges, keep), train,
+                               np.ones(len(train)), dat.deviation.ravel())
+    keep_d, unident = identifiability_gram(G_tr, labels)
     keep = keep.copy()
     keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
-    labels = [lab for lab, k in zip(design.labels, keep) if k]
-    A = design.A[:, :, keep].reshape(-1, keep.sum())
-    design.A = None              # (N, 3, P) with the gauge columns: not needed any more
-    weak = weakly_determined(A[rows_of(train)], labels)
-    return Declared(design, keep, gauge, A, labels, unident, weak)
+    labels = [lab for lab, k in zip(all_labels, keep) if k]
+    weak = weakly_determined_gram(G_tr[np.ix_(keep_d, keep_d)], labels)
+    design = blocks.Design(model, dat, degree, ranges, keep)
+    return Declared(design, keep, gauge, labels, unident, weak)
 
 
 @dataclass
@@ -423,22 +434,35 @@ class Robust:
         return np.repeat(np.sqrt(self.weights), 3)
 
 
-def robust_weights(A, y, points, n: int, iterations: int = 8) -> Robust:
+def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     """IRLS on the 3-D residual length of each point: weight 1 up to ``ROBUST_K`` robust
     standard deviations, then a bisquare down to 0 at twice that; the scale from the median
     residual length (the median of a chi(3) variable is 1.538 sigma), so gross outliers
-    neither inflate the noise estimate nor hide smaller ones."""
+    neither inflate the noise estimate nor hide smaller ones.
+
+    ``design``: :class:`volerr.loop.blocks.Design`; ``points``: the points fitted (their rows
+    of ``y``).  The normal equations of all points at weight 1 are accumulated once; each
+    iteration subtracts those of the down-weighted points (few) and predicts blockwise."""
     w = np.ones(len(points))
     rows = rows_of(points)
-    scale = np.sqrt(np.einsum("ij,ij->j", A, A) / len(A))
-    scale[scale == 0] = 1.0
+    G1, b1, colsq = blocks.normal(design, points, np.ones(len(points)), y)
+    scale = blocks.unit_scale(colsq, len(rows))
     sigma = 0.0
     for _ in range(iterations):
-        w_rows = np.zeros(len(y))
-        w_rows[rows] = np.repeat(np.sqrt(w), 3)
-        G, b = _gram(A, y, w_rows, rows)
+        low = np.flatnonzero(w < 1.0)
+        if len(low) > len(points) // 2:
+            G, b, _ = blocks.normal(design, points, np.sqrt(w), y)
+        else:       # G1 minus the down-weighted points' share (1 - w) A_i^T A_i
+            G, b = G1.copy(), b1.copy()
+            for _, part in blocks.blocks(low):
+                idx = points[part]
+                d = blocks.wrows(np.sqrt(1.0 - w[part]))
+                At = design.block(idx)
+                At *= d
+                G -= At @ At.T
+                b -= At @ (blocks.yrows(y, idx) * d)
         c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
-        r = point_norm(y[rows] - A[rows] @ c)
+        r = point_norm(y[rows] - blocks.predict(design, points, c))
         sigma = max(float(np.median(r[w > 0])) / 1.538, 1e-12)
         z = r / sigma
         w_new = np.where(z <= ROBUST_K, 1.0,
@@ -458,43 +482,51 @@ def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, famil
     candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
                   if c.kind in families]
     w_rows = robust.rows()
-    ctx = sel.Context(model, dat, decl.design.sens, decl.design.twist, spl.train,
+    ctx = sel.Context(model, dat, None, None, spl.train,    # sensitivities per block
                       np.sqrt(robust.weights[spl.train]), ranges)
-    return sel.select(candidates, ctx, decl.A, y, spl.folds, w_rows, sel.SCREEN_POINTS), warns
+    return sel.select(candidates, ctx, decl.design, y, spl.folds, w_rows,
+                      sel.SCREEN_POINTS), warns
 
 
 @dataclass
 class Augmented:
-    """The augmented layout (text), its generated module (text), model and design."""
+    """The augmented layout (text), model (from a reduced module: the fitting functions) and
+    design; :meth:`source` derives its full generated module (text)."""
 
     text: str
-    source: str
+    layout: object
     model: Model
-    A: np.ndarray
+    design: blocks.Design
     labels: list
+    _source: str | None = None
+
+    def source(self) -> str:
+        if self._source is None:
+            self._source = "" if self.layout is None else derivation.generate_source(self.layout)
+        return self._source
 
 
 def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augmented:
     if not selection.accepted:
-        return Augmented("", "", model, decl.A, decl.labels)
+        return Augmented("", None, model, decl.design, decl.labels)
     text = augmented_layout_text(model, selection.accepted)
     lay = parse_layout(text, f"{model.name}_aug.toml")
-    source = derivation.generate_source(lay)
-    aug = Model(lay, derivation.module_from_source(source, lay.name))
-    ad = declared_design(aug, dat, degree, ranges)
+    aug = Model(lay, derivation.module_from_source(derivation.fit_source(lay), lay.name))
+    labels = declared_design(aug, dat.subset(np.arange(1)), degree, ranges).labels
     n_new = len(aug.parameters) - len(model.parameters)
     keep = np.concatenate([decl.keep, np.ones(n_new, bool)])
-    A = ad.A[:, :, keep].reshape(-1, keep.sum())
-    return Augmented(text, source, aug, A, [lab for lab, m in zip(ad.labels, keep) if m])
+    return Augmented(text, lay, aug, blocks.Design(aug, dat, degree, ranges, keep),
+                     [lab for lab, m in zip(labels, keep) if m])
 
 
 @dataclass
 class Outcome:
-    """Held-out residual rows before (declared) and after (augmented), fits on all points."""
+    """Held-out residual rows before (declared) and after (augmented), fits on all points;
+    ``contrib``: effect name -> its contribution rows (3N,) at all points (fit on all)."""
 
     r_before: np.ndarray
     r_after: np.ndarray
-    after_prob: Problem
+    contrib: dict
     c_all: np.ndarray
     c_before: np.ndarray
     res_before: np.ndarray
@@ -504,45 +536,73 @@ class Outcome:
     test_inliers: np.ndarray
 
 
-def _gram(A, y, w_rows, rows=None, chunk: int = 30000):
-    """Weighted normal equations (A^T W A, A^T W y) accumulated in chunks of rows (no
-    weighted copy of the whole design)."""
-    rows = np.arange(len(y)) if rows is None else rows
-    G = np.zeros((A.shape[1], A.shape[1]))
-    b = np.zeros(A.shape[1])
-    for i in range(0, len(rows), chunk):
-        r = rows[i:i + chunk]
-        Ar = A[r] * w_rows[r, None]
-        G += Ar.T @ Ar
-        b += Ar.T @ (y[r] * w_rows[r])
-    return G, b
+def _fits(design, spl: Split, sw, y):
+    """Weighted fits on the training points and on all points (one pass over the rows):
+    (column scale, coefficients train, coefficients all, scaled Gram of all points).  The
+    columns are scaled to unit RMS over all rows, unweighted (as :class:`Problem`)."""
+    p = design.p
+    G = np.zeros((2, p, p))
+    b = np.zeros((2, p))
+    ss = np.zeros(p)
+    for k, pts in enumerate((spl.train, spl.test)):
+        for _, idx in blocks.blocks(pts):
+            At = design.block(idx)
+            ss += np.einsum("ij,ij->i", At, At)
+            w = blocks.wrows(sw[idx])
+            At *= w
+            G[k] += At @ At.T
+            b[k] += At @ (blocks.yrows(y, idx) * w)
+    scale = blocks.unit_scale(ss, len(y))
+    S = np.outer(scale, scale)
+    c_tr = solve_normal(G[0] / S, b[0] / scale) / scale
+    G_all = (G[0] + G[1]) / S
+    c_all = solve_normal(G_all, (b[0] + b[1]) / scale) / scale
+    return c_tr, c_all, G_all, scale
 
 
-def _weighted_fit(prob: Problem, w_rows, points=None):
-    """Coefficients (unscaled column units) of the weighted fit on ``points`` (all if None)."""
-    G, b = _gram(prob.A, prob.y, w_rows, None if points is None else rows_of(points))
-    return solve_normal(G, b) / prob.scale
+def _residuals(design, n, test, y, c_tr, c_all, groups=None):
+    """Blockwise: residual rows at all points (fit ``c_all``), held-out residual rows at
+    ``test`` (fit ``c_tr``), and the contribution rows of each column group."""
+    groups = groups or {}
+    res = np.empty(3 * n)
+    r_test = np.empty(3 * n)
+    contrib = {g: np.empty(3 * n) for g in groups}
+    for _, idx in blocks.blocks(np.arange(n)):
+        At = design.block(idx)
+        rr = rows_of(idx)
+        pm = len(idx)
+        res[rr] = y[rr] - blocks.to_point_major(c_all @ At, pm)
+        r_test[rr] = y[rr] - blocks.to_point_major(c_tr @ At, pm)
+        for g, js in groups.items():
+            contrib[g][rr] = blocks.to_point_major(c_all[js] @ At[js], pm)
+    return res, r_test[rows_of(test)], contrib
 
 
-def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y) -> Outcome:
+def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y,
+                 groups=None) -> Outcome:
+    """Fits of the declared and the augmented model (weighted; on the training points and on
+    all points), blockwise.  ``groups``: effect name -> column indices of the augmented design
+    whose contribution is wanted."""
     w_rows = robust.rows()
-    before, after = Problem(decl.A, y), Problem(aug.A, y)
-    r_before = y[rows_of(spl.test)] - before.predict(_weighted_fit(before, w_rows, spl.train),
-                                                    spl.test)
-    r_after = y[rows_of(spl.test)] - after.predict(_weighted_fit(after, w_rows, spl.train),
-                                                  spl.test)
-    c_all = _weighted_fit(after, w_rows)
-    c_before = _weighted_fit(before, w_rows)
-    res_after = y - after.predict(c_all)
-    res_before = y - before.predict(c_before)
-    G, _ = _gram(after.A, y, w_rows)
+    sw = np.sqrt(robust.weights)
+    n = len(robust.weights)
+    cb_tr, c_before, _, _ = _fits(decl.design, spl, sw, y)
+    res_before, r_before, _ = _residuals(decl.design, n, spl.test, y, cb_tr, c_before)
+    ca_tr, c_all, G, scale = _fits(aug.design, spl, sw, y)
+    res_after, r_after, contrib = _residuals(aug.design, n, spl.test, y, ca_tr, c_all, groups)
     wG = np.linalg.eigvalsh(G)
     dof = max(3 * float(robust.weights.sum()) - int(np.sum(wG > 1e-12 * wG[-1])), 1.0)
     sigma2 = float(np.sum((res_after * w_rows) ** 2)) / dof
-    cov_diag = np.diag(np.linalg.pinv(G, rcond=1e-12)) * sigma2 / after.scale ** 2
+    cov_diag = np.diag(np.linalg.pinv(G, rcond=1e-12)) * sigma2 / scale ** 2
     inl = point_norm(r_after) <= OUTLIER_Z * math.sqrt(sigma2)
-    return Outcome(r_before, r_after, after, c_all, c_before, res_before, res_after, sigma2,
+    return Outcome(r_before, r_after, contrib, c_all, c_before, res_before, res_after, sigma2,
                    cov_diag, inl)
+
+
+def effect_columns(selection, aug: Augmented) -> dict:
+    """Effect name -> column indices of its parameters in the augmented design."""
+    col = {lab[0]: j for j, lab in enumerate(aug.labels)}
+    return {s.cand.name: [col[pn] for pn in s.params] for s in selection.accepted}
 
 
 def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
@@ -552,14 +612,13 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
     for s in selection.accepted:
         c = s.cand
         pars, units, std = {}, {}, {}
-        contrib = np.zeros(3 * n)
+        contrib = out.contrib[c.name]
         for pn in s.params:
             f, u = c.units.get(pn, (1e3, "um"))
             j = col[pn]
             pars[pn] = round(float(out.c_all[j]) * f, 6)
             std[pn] = round(float(math.sqrt(max(out.cov_diag[j], 0.0))) * f, 6)
             units[pn] = u
-            contrib += out.after_prob.A[:, j] * out.after_prob.scale[j] * out.c_all[j]
         info = {k: (round(v, 6) if isinstance(v, float) else v) for k, v in c.info.items()}
         if c.kind == "thermal" and len(c.terms) == 2 and c.terms[0][2].startswith(
                 info.get("axis", "?") + "*"):
@@ -640,7 +699,7 @@ class Figures:
     r_before: np.ndarray
     r_after: np.ndarray
     selected: list
-    after_prob: Problem
+    contrib: dict               # effect name -> contribution rows (3N,), mm
     c_all: np.ndarray
     aug_labels: list
     c_before: np.ndarray
@@ -664,11 +723,11 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
     if not fixed_degree:
         # robust weights of a preliminary fit first: outliers must not choose the degree
         pre = declared_step(model, dat, min(max_degree, 6), ranges, spl.train)
-        w0 = robust_weights(pre.A, y, np.arange(dat.n), dat.n).weights
+        w0 = robust_weights(pre.design, y, np.arange(dat.n), dat.n).weights
         degree, degree_scores = _choose_degree(model, dat, spl.train, spl.folds, ranges,
                                                max_degree, weights=w0)
     decl = declared_step(model, dat, degree, ranges, spl.train)
-    robust = robust_weights(decl.A, y, np.arange(dat.n), dat.n)
+    robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
     selection, warns = selection_step(model, dat, decl, spl, ranges, degree, families,
                                       robust, y)
     keepers = [s for s in selection.accepted if s.cand.kind != "higher_order"]
@@ -680,7 +739,7 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
         if degree2 != degree:
             degree, degree_scores = degree2, scores2
             decl = declared_step(model, dat, degree, ranges, spl.train)
-            robust = robust_weights(decl.A, y, np.arange(dat.n), dat.n)
+            robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
             selection, warns = selection_step(model, dat, decl, spl, ranges, degree,
                                               families, robust, y)
     return degree, degree_scores, decl, robust, selection, warns
@@ -723,7 +782,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     aug = augment_step(model, dat, decl, selection, degree, ranges)
     bar.update()
     bar.set_postfix_str("held-out before/after")
-    out = outcome_step(decl, aug, spl, robust, y)
+    out = outcome_step(decl, aug, spl, robust, y, effect_columns(selection, aug))
     effects = effects_step(selection, aug, out, dat.n)
     bar.update()
     paths = _write_augmented(out_dir, aug, selection, inputs, data)
@@ -739,9 +798,9 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     report["residual_note"] = residual_note(dat, out, src_after, robust)
     report["seconds"] = round(time.perf_counter() - t_start, 2)
     figs = Figures(model, dat, ranges, degree, out.res_before, out.res_after, spl.test,
-                   out.r_before, out.r_after, selection.accepted, out.after_prob, out.c_all,
+                   out.r_before, out.r_after, selection.accepted, out.contrib, out.c_all,
                    aug.labels, out.c_before, decl.labels, out.cov_diag, robust.weights)
-    return Report(report, figs, aug.text, aug.source)
+    return Report(report, figs, aug.text, aug.source)  # the full module: derived when asked
 
 
 def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
@@ -754,7 +813,7 @@ def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
     return {"augmented_layout": str(write_text(out / f"{aug.model.name}.toml", aug.text,
                                                inputs=inputs)),
             "generated_module": str(write_text(out / f"{aug.model.name.lower()}.py",
-                                               aug.source, inputs=inputs))}
+                                               aug.source(), inputs=inputs))}
 
 
 def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection, aug, out,

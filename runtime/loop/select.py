@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volerr.loop import candidates as cands
-from volerr.loop.fit import TWIST, Problem, point_norm, rows_of
+from volerr.loop.blocks import BlockBase, blocks, cv_sq
+from volerr.loop.fit import TWIST, rows_of
 from volerr.machine.expressions import evaluate
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
@@ -89,8 +90,8 @@ class Context:
 
     model: object
     data: object
-    sens: np.ndarray
-    twist: np.ndarray       # (N, 3, 12) rigid-twist sensitivity (fit.twist_sensitivity)
+    sens: np.ndarray | None     # (N, 3, P) model sensitivity; None: generated per block
+    twist: np.ndarray | None    # (N, 3, 12) rigid-twist sensitivity (fit.twist_sensitivity)
     pts: np.ndarray
     sw: np.ndarray
     ranges: dict
@@ -111,16 +112,37 @@ class Context:
             self.cache[key] = {k: np.asarray(v)[idx] for k, v in vals.items()}
         return self.cache[key]
 
+    def sensitivities(self, idx, slot: str = "_block") -> tuple:
+        """(sensitivity (n, 3, P), twist sensitivity (n, 3, 12)) at the points ``idx``: slices
+        of the full arrays when the context holds them, else generated (kept for the last
+        ``idx`` of each ``slot``)."""
+        if self.sens is not None:
+            return self.sens[idx], self.twist[idx]
+        from volerr.loop.fit import twist_sensitivity
+
+        last = self.cache.get(slot)
+        if last is not None and np.array_equal(last[0], idx):
+            return last[1]
+        sub = self.data.subset(idx)
+        cov = {c: sub.covariates[c] for c in self.model.covariates}
+        out = (self.model.sensitivity(sub.positions, sub.probe, covariates=cov),
+               twist_sensitivity(self.model, sub))
+        self.cache[slot] = (np.array(idx), out)
+        return out
+
+    def _column(self, target: str, sens, tw) -> np.ndarray:
+        if "." in target:
+            return tw[:, :, TWIST[target]]
+        return sens[:, :, self.model.parameters.index(target)]
+
     def target_column(self, target: str, full: bool = False) -> np.ndarray:
         """(n, 3) sensitivity of a chain target (a parameter, ``work.*`` or ``tool.*``) at the
         context's points (all points when ``full``)."""
+        if full:
+            return self._column(target, *self.sensitivities(np.arange(self.data.n), "_full"))
         key = ("target", target, full)
         if key not in self.cache:
-            if "." in target:
-                col = self.twist[:, :, TWIST[target]]
-            else:
-                col = self.sens[:, :, self.model.parameters.index(target)]
-            self.cache[key] = col if full else col[self.pts]
+            self.cache[key] = self._column(target, *self.sensitivities(self.pts, "_pts"))
         return self.cache[key]
 
     def columns(self, terms, full: bool = False) -> tuple[np.ndarray, list]:
@@ -130,6 +152,11 @@ class Context:
         if not full and key in self.cache:
             return self.cache[key]
         params = list(dict.fromkeys(t[0] for t in terms))
+        if full:          # by blocks of points: no full sensitivity arrays
+            out = np.empty((self.data.n, 3, len(params)))
+            for s, idx in blocks(np.arange(self.data.n)):
+                out[s] = self.columns_at(terms, idx)
+            return out, params
         vals = self.values(full)
         n = self.data.n if full else len(self.pts)
         out = np.zeros((n, 3, len(params)))
@@ -139,6 +166,21 @@ class Context:
         if not full and len(self.pts) * len(params) <= 20000 * 3:
             self.cache[key] = (out, params)
         return out, params
+
+    def columns_at(self, terms, idx) -> np.ndarray:
+        """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
+        params = list(dict.fromkeys(t[0] for t in terms))
+        vals = {k: v[idx] for k, v in self.values(True).items()}
+        sens, tw = self.sensitivities(idx)
+        out = np.zeros((len(idx), 3, len(params)))
+        for pn, target, basis in terms:
+            b = np.broadcast_to(evaluate(basis, vals), (len(idx),))
+            out[:, :, params.index(pn)] += self._column(target, sens, tw) * b[:, None]
+        return out
+
+    def group(self, terms):
+        """The columns of ``terms`` as a function of the points (for :class:`BlockBase`)."""
+        return lambda idx: self.columns_at(terms, idx)
 
     def rows(self, cols) -> np.ndarray:
         """Weighted rows (3n, m) of columns (n, 3, m) at the context's points."""
@@ -227,6 +269,15 @@ def _scored(c, ctx: Context, base: Base) -> "Scored":
     return Scored(base.dbic(gain, m_eff), gain, rank, c, params)
 
 
+def _scored_many(cs, ctx: Context, base) -> list:
+    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`."""
+    if not isinstance(base, BlockBase):
+        return [_scored(c, ctx, base) for c in cs]
+    res = base.score_many([ctx.group(c.terms) for c in cs])
+    return [Scored(base.dbic(g, r + (1 if c.search is not None else 0)), g, r, c,
+                   c.parameters) for c, (g, r) in zip(cs, res)]
+
+
 def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
     """Score every candidate against the residual of ``base``; sorted by BIC change."""
     out = []
@@ -256,7 +307,7 @@ def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
 def rescore(scored: list, ctx: Context, base: Base, candidates, top: int) -> list:
     """The ``top`` leaders of a screening (on a subset of points) scored exactly on all
     training points, then the rest as they were."""
-    head = [_scored(x.cand, ctx, base) for x in scored[:top]]
+    head = _scored_many([x.cand for x in scored[:top]], ctx, base)
     head = [x for x in head if x.rank]
     head.sort(key=lambda x: x.dbic)
     _prefer_first_of_ties(head, candidates)
@@ -301,7 +352,7 @@ class Accepted:
 
     cand: cands.Candidate
     params: list
-    cols: np.ndarray
+    cols: np.ndarray            # (N, 3, m) at all points
     evidence: dict
 
 
@@ -310,19 +361,20 @@ class Selection:
     """Result of :func:`select`: accepted effects, the final design, the screenings."""
 
     accepted: list
-    A: np.ndarray               # (3N, k + m) declared + effect columns
+    design: object              # blocks.Design: declared + effect columns
     first: list                 # screening on the declared model's residual
     last: list                  # screening on the final residual
     n_candidates: int
 
 
-def _cv_sq(A, y, folds, train, w_rows) -> np.ndarray:
-    """Per-point squared cross-validated residual (weighted rows)."""
-    rows = rows_of(train)
-    prob = Problem(A[rows] * w_rows[rows, None], y[rows] * w_rows[rows])
-    pts = np.arange(len(train))
-    r = prob.loo_residuals(pts) if folds is None else prob.cv_residuals(folds, pts)
-    return point_norm(r) ** 2
+def _cv_sq(design, y, folds, train, w_rows) -> np.ndarray:
+    """Per-point squared cross-validated residual (weighted rows; blockwise)."""
+    return cv_sq(design, y, folds, train, w_rows[3 * np.asarray(train)])
+
+
+def _full_base(design, train, w_rows, y) -> BlockBase:
+    """The base on all training points (blockwise: no copy of the rows)."""
+    return BlockBase(design, train, w_rows[3 * np.asarray(train)], y)
 
 
 def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -> Selection:
@@ -334,15 +386,21 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     if len(train) > screen_points:
         sub = np.sort(np.random.default_rng(1).choice(len(train), screen_points, replace=False))
         ctx_s = ctx.on(train[sub], ctx.sw[sub])
-    tr, tr_s = rows_of(train), rows_of(ctx_s.pts)
-    ytr, ytr_s = y[tr] * w_rows[tr], y[tr_s] * w_rows[tr_s]
+    tr_s = rows_of(ctx_s.pts)
+    ytr_s = y[tr_s] * w_rows[tr_s]
+
+    def dense(design):       # the base on the screening points (a few thousand: dense)
+        return Base(design.rows(ctx_s.pts) * w_rows[tr_s, None], ytr_s)
+
+    def full(design):
+        return dense(design) if ctx_s is ctx else _full_base(design, train, w_rows, y)
+
     A_all = A0
     cv_old = _cv_sq(A_all, y, folds, train, w_rows)
     accepted, rejected, first, last = [], set(), None, []
     while True:
-        base = Base(A_all[tr] * w_rows[tr, None], ytr)
-        scored = screen(candidates, ctx_s, Base(A_all[tr_s] * w_rows[tr_s, None], ytr_s)
-                        if ctx_s is not ctx else base,
+        base = full(A_all)
+        scored = screen(candidates, ctx_s, dense(A_all) if ctx_s is not ctx else base,
                         rejected | {a.cand.name for a in accepted})
         if ctx_s is not ctx:
             scored = rescore(scored, ctx, base, candidates, 2 * N_SOURCES)
@@ -356,7 +414,7 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             if x.dbic > -BIC_GAIN:
                 break
             cols, _ = ctx.columns(x.cand.terms, full=True)
-            A_try = np.concatenate([A_all, cols.reshape(-1, cols.shape[-1])], axis=1)
+            A_try = A_all.plus([cols])
             cv_new = _cv_sq(A_try, y, folds, train, w_rows)
             d = cv_old - cv_new
             t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
@@ -378,14 +436,13 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             break
         accepted.append(hit)
     if accepted:
-        accepted = _backward(A0, accepted, tr, w_rows, ytr)
-        accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, tr, w_rows, ytr)
+        accepted = _backward(A0, accepted, train, w_rows, y)
+        accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, train, w_rows, y)
         A_all = _stack(A0, accepted)
-        base = Base(A_all[tr] * w_rows[tr, None], ytr)
+        base = full(A_all)
         names = {a.cand.name for a in accepted}
         if ctx_s is not ctx:
-            last = rescore(screen(candidates, ctx_s, Base(A_all[tr_s] * w_rows[tr_s, None],
-                                                          ytr_s), names),
+            last = rescore(screen(candidates, ctx_s, dense(A_all), names),
                            ctx, base, candidates, 2 * N_SOURCES)
         else:
             last = screen(candidates, ctx, base, names)
@@ -394,16 +451,19 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
 
 
 def _stack(A0, sel):
-    return np.concatenate([A0] + [s.cols.reshape(-1, s.cols.shape[-1]) for s in sel], axis=1)
+    return A0.plus([s.cols for s in sel])
 
 
-def _backward(A0, selected, tr, w_rows, ytr) -> list:
+def _dense_group(cols):
+    return lambda idx: cols[idx]
+
+
+def _backward(A0, selected, train, w_rows, y) -> list:
     """Drop an effect that, given all the others, no longer gains dBIC < -BIC_GAIN (a later
     effect made it redundant); each kept effect gets ``delta_bic_given_others``."""
     def dbic_without(sel, i):
-        base = Base(_stack(A0, sel[:i] + sel[i + 1:])[tr] * w_rows[tr, None], ytr)
-        B = sel[i].cols.reshape(-1, sel[i].cols.shape[-1])[tr] * w_rows[tr, None]
-        gain, rank = base.score(B)
+        base = _full_base(_stack(A0, sel[:i] + sel[i + 1:]), train, w_rows, y)
+        gain, rank = base.score(_dense_group(sel[i].cols))
         return base.dbic(gain, rank + (1 if sel[i].cand.search is not None else 0))
 
     sel = list(selected)
@@ -420,7 +480,7 @@ def _backward(A0, selected, tr, w_rows, ytr) -> list:
     return sel
 
 
-def _merge(A0, accepted, pool, ctx: Context, tr, w_rows, ytr) -> list:
+def _merge(A0, accepted, pool, ctx: Context, train, w_rows, y) -> list:
     """Parsimony across overlapping candidates: two accepted effects are replaced by ONE
     candidate of the first screening when it explains the data at least as well by BIC (e.g.
     a yaw of Y, taken first as squareness and then as a yaw of X).  Repeated while it helps."""
@@ -432,23 +492,22 @@ def _merge(A0, accepted, pool, ctx: Context, tr, w_rows, ytr) -> list:
         for i in range(len(sel)):
             for j in range(i + 1, len(sel)):
                 others = [s_ for k, s_ in enumerate(sel) if k not in (i, j)]
-                base = Base(_stack(A0, others)[tr] * w_rows[tr, None], ytr)
+                base = _full_base(_stack(A0, others), train, w_rows, y)
                 pair = np.concatenate([sel[i].cols, sel[j].cols], axis=2)
-                B = pair.reshape(-1, pair.shape[-1])[tr] * w_rows[tr, None]
-                g_ij, r_ij = base.score(B)
+                xs = [x for x in pool
+                      if x.cand.name not in (sel[i].cand.name, sel[j].cand.name)]
+                scores = base.score_many([_dense_group(pair)] +
+                                         [ctx.group(x.cand.terms) for x in xs])
+                g_ij, r_ij = scores[0]
                 m_ij = r_ij + sum(1 for s_ in (sel[i], sel[j]) if s_.cand.search is not None)
-                for x in pool:
-                    if x.cand.name in (sel[i].cand.name, sel[j].cand.name):
-                        continue
-                    cols, _ = ctx.columns(x.cand.terms, full=True)
-                    g_c, r_c = base.score(cols.reshape(-1, cols.shape[-1])[tr] *
-                                          w_rows[tr, None])
+                for x, (g_c, r_c) in zip(xs, scores[1:]):
                     m_c = r_c + (1 if x.cand.search is not None else 0)
                     d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
                     if r_c and d < best[0]:
-                        best = (d, (i, j, x, cols))
+                        best = (d, (i, j, x))
         if best[1] is not None:
-            i, j, x, cols = best[1]
+            i, j, x = best[1]
+            cols, _ = ctx.columns(x.cand.terms, full=True)
             ev = dict(sel[i].evidence)
             ev["replaces"] = [sel[i].cand.name, sel[j].cand.name]
             ev["delta_bic_vs_replaced"] = round(best[0], 2)

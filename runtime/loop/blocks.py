@@ -1,0 +1,269 @@
+"""Least squares on the loop's designs without the (3N, p) matrix: columns generated per block of
+points, weighted normal equations (A^T W A, A^T W y) and cross-products accumulated blockwise,
+held-out residuals per block.  Memory: p x p matrices, p-vectors and one block of rows.
+
+A :class:`Design` is the declared model's kept columns (generated from the model's sensitivity
+per block, :func:`volerr.loop.fit.declared_design`) followed by dense extra columns (accepted
+effects, (N, 3, m)).  Rows are point-major (3 per point), deviations in mm; weights are the
+square roots of the robust point weights (one per point).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from volerr.loop.fit import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
+
+#: points per block (a block of rows is 3 * BLOCK x p floats)
+BLOCK = 8192
+
+
+def blocks(points, size: int | None = None):
+    """Consecutive slices of ``points`` (index arrays) of at most ``size`` points."""
+    points, size = np.asarray(points), size or BLOCK
+    for i in range(0, len(points), size):
+        yield slice(i, i + size), points[i:i + size]
+
+
+class Design:
+    """Columns of a linear model at the data points, generated per block.
+
+    ``keep``: mask of the columns of :func:`volerr.loop.fit.declared_design` kept (gauge and
+    identifiability); ``extra``: dense (N, 3, m) column groups appended in order.
+
+    :meth:`block` returns the columns transposed, (p, 3n), with the rows of a block in
+    component-major order (all dx rows, then dy, then dz): each column is then one contiguous
+    product of a generated sensitivity (3, n) and a Legendre basis (n,).  :func:`yrows` and
+    :func:`wrows` give the deviations and weights of a block in that order."""
+
+    def __init__(self, model, data, degree: int, ranges: dict, keep, extra=()):
+        self.model, self.data, self.degree, self.ranges = model, data, degree, ranges
+        self.keep = np.asarray(keep, bool)
+        self.extra = [np.asarray(e) for e in extra]
+        labels = declared_design(model, data.subset(np.arange(1)), degree, ranges).labels
+        self.labels = [lab for lab, k in zip(labels, self.keep) if k]
+        pidx = {p: j for j, p in enumerate(model.parameters)}
+        self._ops = []
+        for p, k in self.labels:
+            if p == "setup":
+                self._ops.append((0, TWIST[f"work.{k}"], None, None))
+            elif k is None:
+                self._ops.append((1, pidx[p], None, None))
+            else:
+                self._ops.append((1, pidx[p], model.parameter_axis[p], k))
+        self.p = len(self.labels) + sum(e.shape[-1] for e in self.extra)
+
+    def plus(self, extra) -> "Design":
+        """This design with more dense column groups appended."""
+        return Design(self.model, self.data, self.degree, self.ranges, self.keep,
+                      self.extra + [np.asarray(e) for e in extra])
+
+    def block(self, idx) -> np.ndarray:
+        """(p, 3n) columns at the points ``idx``, rows component-major."""
+        sub = self.data.subset(idx)
+        n = len(idx)
+        cov = {c: sub.covariates[c] for c in self.model.covariates}
+        sens = np.moveaxis(self.model.sensitivity(sub.positions, sub.probe, covariates=cov),
+                           0, -1)                                      # (3, P, n)
+        tw = np.moveaxis(twist_sensitivity(self.model, sub), 0, -1)    # (3, 12, n)
+        bases = {a: legendre(unit(sub.positions[a], *self.ranges[a]), self.degree).T
+                 for a in self.model.axes}
+        At = np.empty((self.p, 3, n))
+        for i, (src, j, axis, k) in enumerate(self._ops):
+            col = (tw if src == 0 else sens)[:, j, :]
+            if axis is None:
+                At[i] = col
+            else:
+                np.multiply(col, bases[axis][k], out=At[i])
+        i = len(self._ops)
+        for e in self.extra:
+            m = e.shape[-1]
+            At[i:i + m] = np.transpose(e[idx], (2, 1, 0))
+            i += m
+        return At.reshape(self.p, 3 * n)
+
+    def rows(self, idx) -> np.ndarray:
+        """(3n, p) rows at the points ``idx``, point-major (3 per point)."""
+        At = self.block(idx).reshape(self.p, 3, len(idx))
+        return np.ascontiguousarray(np.transpose(At, (2, 1, 0))).reshape(-1, self.p)
+
+
+def yrows(y, idx) -> np.ndarray:
+    """Rows of ``y`` (3N,) at the points ``idx`` in a block's component-major order."""
+    return np.ascontiguousarray(y.reshape(-1, 3)[idx].T).ravel()
+
+
+def wrows(sw) -> np.ndarray:
+    """Row weights of a block (component-major) from the points' weights."""
+    return np.tile(sw, 3)
+
+
+def group_block(cols) -> np.ndarray:
+    """(n, 3, m) columns of a block -> (m, 3n), rows component-major."""
+    return np.transpose(cols, (2, 1, 0)).reshape(cols.shape[-1], -1)
+
+
+def to_point_major(r, n: int) -> np.ndarray:
+    """Block rows component-major (3n,) -> point-major."""
+    return np.ascontiguousarray(r.reshape(3, n).T).ravel()
+
+
+def normal(design, points, sw, y):
+    """Weighted normal equations on ``points``: (G, b, colsq) with G = A^T W A, b = A^T W y
+    and colsq the weighted column sums of squares (= diag G).  ``sw`` (len(points),) square
+    roots of the point weights; ``y`` all rows (3N,)."""
+    G = np.zeros((design.p, design.p))
+    b = np.zeros(design.p)
+    for s, idx in blocks(points):
+        w = wrows(sw[s])
+        At = design.block(idx)
+        At *= w
+        G += At @ At.T
+        b += At @ (yrows(y, idx) * w)
+    return G, b, np.diag(G).copy()
+
+
+def unit_scale(colsq, n_rows: int) -> np.ndarray:
+    """Column scale to unit RMS (as :class:`volerr.loop.fit.Problem`): sqrt(mean square)."""
+    s = np.sqrt(np.maximum(colsq, 0.0) / max(n_rows, 1))
+    s[s == 0] = 1.0
+    return s
+
+
+def eig_inverse(G, tol: float):
+    """Pseudo-inverse of a symmetric PSD matrix by eigh: eigenvalues below tol*max cut."""
+    w, V = np.linalg.eigh(G)
+    ok = w > tol * max(float(w[-1]), 1e-300)
+    return (V[:, ok] / w[ok]) @ V[:, ok].T
+
+
+def predict(design, points, coef) -> np.ndarray:
+    """Rows A c at ``points`` (point-major, 3 per point)."""
+    out = np.empty(3 * len(points))
+    for s, idx in blocks(points):
+        out[3 * s.start:3 * s.start + 3 * len(idx)] = to_point_major(
+            coef @ design.block(idx), len(idx))
+    return out
+
+
+def cv_sq(design, y, folds, points, sw) -> np.ndarray:
+    """Per-point squared length of the cross-validated (weighted) residual on ``points``:
+    leave-one-point-out when ``folds`` is None (exact, through the 3x3 diagonal blocks of the
+    hat matrix), else k-fold (``folds``: fold label per point).  Equals
+    :meth:`volerr.loop.fit.Problem.loo_residuals` / ``cv_residuals`` on the weighted rows."""
+    n_rows = 3 * len(points)
+    if folds is None:
+        G, b, colsq = normal(design, points, sw, y)
+        sc = unit_scale(colsq, n_rows)
+        Gi = eig_inverse(G / np.outer(sc, sc), SV_TOL ** 2)
+        c = Gi @ (b / sc)
+        out = np.empty(len(points))
+        for s, idx in blocks(points):
+            w = wrows(sw[s])
+            At = design.block(idx)
+            At *= w / sc[:, None]
+            n = len(idx)
+            r = (yrows(y, idx) * w - c @ At).reshape(3, n).T          # (n, 3)
+            A3 = At.reshape(-1, 3, n)
+            B3 = (Gi @ At).reshape(-1, 3, n)
+            h = np.einsum("kin,kjn->nij", B3, A3)
+            m = np.eye(3) - h
+            det = np.linalg.det(m)
+            m[np.abs(det) < 1e-9] = np.eye(3)      # a point that alone fixes a parameter
+            out[s] = np.sum(np.linalg.solve(m, r[:, :, None])[:, :, 0] ** 2, axis=1)
+        return out
+    labels = np.unique(folds)
+    p = design.p
+    Gf = np.zeros((len(labels), p, p))
+    bf = np.zeros((len(labels), p))
+    for s, idx in blocks(points):
+        w = wrows(sw[s])
+        At = design.block(idx)
+        At *= w
+        yw = yrows(y, idx) * w
+        f = np.tile(folds[s], 3)
+        for k, lab in enumerate(labels):
+            m = f == lab
+            Gf[k] += At[:, m] @ At[:, m].T
+            bf[k] += At[:, m] @ yw[m]
+    G, b = Gf.sum(axis=0), bf.sum(axis=0)
+    sc = unit_scale(np.diag(G), n_rows)
+    S = np.outer(sc, sc)
+    coef = np.array([solve_sym((G - Gf[k]) / S, (b - bf[k]) / sc) / sc
+                     for k in range(len(labels))])
+    out = np.empty(len(points))
+    for s, idx in blocks(points):
+        w = wrows(sw[s])
+        n = len(idx)
+        At = design.block(idx).reshape(p, 3, n)
+        k = np.searchsorted(labels, folds[s])
+        pred = np.einsum("pin,np->ni", At, coef[k])
+        yw = (yrows(y, idx) * w).reshape(3, n).T
+        out[s] = np.sum((yw - pred * w.reshape(3, n).T) ** 2, axis=1)
+    return out
+
+
+def solve_sym(G, b, tol: float = SV_TOL ** 2):
+    """Minimum-norm solution of G x = b (as :func:`volerr.loop.fit.solve_normal`)."""
+    from volerr.loop.fit import solve_normal
+
+    return solve_normal(G, b, tol)
+
+
+class BlockBase:
+    """The current design on the weighted training rows, column-scaled, with its Gram
+    pseudo-inverse and residual: :class:`volerr.loop.select.Base` without the rows.
+
+    ``score_many`` gives the RSS reduction of adding column groups, from the blockwise
+    cross-products A_c^T r, A_c^T A_c and A_c^T A (one pass for all groups)."""
+
+    def __init__(self, design, points, sw, y):
+        self.design, self.points, self.sw = design, np.asarray(points), np.asarray(sw)
+        G, b, colsq = normal(design, self.points, self.sw, y)
+        self.n = 3 * len(self.points)
+        self.scale = unit_scale(colsq, self.n)
+        self.Gi = eig_inverse(G / np.outer(self.scale, self.scale), 1e-12)
+        c = self.Gi @ (b / self.scale) / self.scale
+        self.r = np.empty(self.n)         # weighted residual rows, component-major per block
+        for s, idx in blocks(self.points):
+            w = wrows(self.sw[s])
+            self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (
+                (yrows(y, idx) - c @ design.block(idx)) * w)
+        self.rss = float(self.r @ self.r)
+
+    def score_many(self, groups) -> list:
+        """[(RSS reduction, effective rank)] of adding each column group; a group is a function
+        ``idx -> (n, 3, m)`` columns at the points ``idx``."""
+        acc = [None] * len(groups)
+        for s, idx in blocks(self.points):
+            w = wrows(self.sw[s])
+            At = self.design.block(idx)
+            At *= w / self.scale[:, None]
+            r = self.r[3 * s.start:3 * s.start + 3 * len(idx)]
+            for k, g in enumerate(groups):
+                Bt = group_block(g(idx)) * w
+                parts = (At @ Bt.T, Bt @ Bt.T, Bt @ r)
+                acc[k] = parts if acc[k] is None else tuple(x + y for x, y in zip(acc[k], parts))
+        return [self._score(*a) for a in acc]
+
+    def _score(self, AB, BB, Br) -> tuple[float, int]:
+        """As :meth:`volerr.loop.select.Base.score`, from the cross-products."""
+        sc = np.sqrt(np.maximum(np.diag(BB), 0.0) / self.n)
+        sc[sc == 0] = 1.0
+        C = AB / sc
+        M = BB / np.outer(sc, sc) - C.T @ self.Gi @ C
+        w, V = np.linalg.eigh((M + M.T) / 2)
+        ok = w > 1e-9 * self.n
+        if not ok.any():
+            return 0.0, 0
+        g = V[:, ok].T @ (Br / sc)
+        return float(np.sum(g * g / w[ok])), int(ok.sum())
+
+    def score(self, group) -> tuple[float, int]:
+        return self.score_many([group])[0]
+
+    def dbic(self, gain: float, m_eff: int) -> float:
+        new = max(self.rss - gain, 1e-300)
+        return self.n * math.log(new / self.rss) + m_eff * math.log(self.n)
