@@ -96,16 +96,15 @@ def derive_functions(layout: Layout) -> list[Function]:
     return funcs
 
 
-def generate_module(layout: Layout) -> str:
-    """The complete module text of one layout (deterministic)."""
-    chain_params = layout.parameter_names
+def _constants(layout: Layout) -> dict:
+    """The module constants of a layout (names -> Python literal text)."""
     constants = {
         "LAYOUT": repr(layout.name),
         "LAYOUT_SHA256": repr(layout.sha256),
         "AXES": repr(tuple(layout.axis_names)),
         "ROTARY_AXES": repr(tuple(a for a in layout.axis_names
                                   if layout.axes[a].kind == "rotary")),
-        "PARAMETERS": repr(tuple(chain_params)),
+        "PARAMETERS": repr(tuple(layout.parameter_names)),
         "PARAMETER_AXIS": repr(layout.parameter_axis),
         "PARAMETER_KIND": repr(layout.parameter_kind),
     }
@@ -114,14 +113,38 @@ def generate_module(layout: Layout) -> str:
         constants["EFFECTS"] = repr({e.name: e.kind for e in layout.effects})
     for k, v in sorted(layout.parameters.items()):
         constants[k] = repr(float(v))
-    header = {
-        "title": f"Error model of layout {layout.name}.",
-        "layout": layout.name,
-        "layout_file": layout.path or f"{layout.name}.toml",
-        "sha256": layout.sha256,
-        "sources": LAYOUT_SOURCES,
-    }
-    return render_module(header, constants, derive_functions(layout))
+    return constants
+
+
+def _header(layout: Layout, title: str) -> dict:
+    return {"title": title, "layout": layout.name,
+            "layout_file": layout.path or f"{layout.name}.toml", "sha256": layout.sha256,
+            "sources": LAYOUT_SOURCES}
+
+
+def generate_module(layout: Layout) -> str:
+    """The complete module text of one layout (deterministic)."""
+    return render_module(_header(layout, f"Error model of layout {layout.name}."),
+                         _constants(layout), derive_functions(layout))
+
+
+def generate_fit_module(layout: Layout) -> str:
+    """A reduced module of one layout for fitting: the constants of :func:`generate_module`
+    and only ``sensitivity`` and ``setup_sensitivity`` (no exact or random error, inverse,
+    Jacobian or transfer rules: a fraction of the derivation; used by ``volerr loop`` for its
+    augmented model during the run)."""
+    chain = Chain.from_layout(layout)
+    pos = [str(q) for q in chain.positions]
+    probe = [str(q) for q in PROBE]
+    sens = vol.sensitivity(chain, vol.volumetric_error(chain))
+    funcs = [Function("sensitivity", pos + list(layout.covariates) + probe, list(sens),
+                      "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",
+                      shape=(3, len(chain.parameters))),
+             Function("setup_sensitivity", pos + probe, list(vol.setup_sensitivity(chain)),
+                      "d(dX, dY, dZ)/d(rigid twist of the workpiece frame, then of the tool "
+                      "end): array (3, 12, *shape), mm/mm and mm/rad.", shape=(3, 12))]
+    return render_module(_header(layout, f"Fitting functions of layout {layout.name} "
+                                         f"(reduced module)."), _constants(layout), funcs)
 
 
 def all_generated(progress=None) -> dict:

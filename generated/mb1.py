@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       c36a8ee13222ceb6375c8b54545b89e573334f275a5ba9e2b540af123de2e12a
-derivation sha256  f74ac1349920e463edf4bbcf1a6473df79b0733728798c494bcbc08bcea5abbb
+derivation sha256  d9cd0ea362e6a50ced052f3588389e3e6716c55f6ab3b2866c802b13f4502b75
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

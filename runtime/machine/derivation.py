@@ -33,42 +33,12 @@ def generate_source(layout: Layout) -> str:
 
 def fit_source(layout: Layout) -> str:
     """A reduced module text of ``layout`` for fitting (imports sympy): the constants of
-    :func:`generate_source` and only ``sensitivity`` and ``setup_sensitivity`` (no exact or
-    random error, inverse, Jacobian or transfer rules: a fraction of the derivation).  Used by
+    :func:`generate_source` and only ``sensitivity`` and ``setup_sensitivity``.  Used by
     ``volerr loop`` for its augmented model during the run; the full text is derived only
     when it is written or asked for."""
-    from volerr.derive import volumetric as vol
-    from volerr.derive.codegen import Function, render_module
-    from volerr.derive.generate import LAYOUT_SOURCES
-    from volerr.derive.kinematics import PROBE, Chain
+    from volerr.derive.generate import generate_fit_module
 
-    chain = Chain.from_layout(layout)
-    pos = [str(q) for q in chain.positions]
-    probe = [str(q) for q in PROBE]
-    sens = vol.sensitivity(chain, vol.volumetric_error(chain))
-    funcs = [Function("sensitivity", pos + list(layout.covariates) + probe, list(sens),
-                      "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",
-                      shape=(3, len(chain.parameters))),
-             Function("setup_sensitivity", pos + probe, list(vol.setup_sensitivity(chain)),
-                      "d(dX, dY, dZ)/d(rigid twist of the workpiece frame, then of the tool "
-                      "end): array (3, 12, *shape), mm/mm and mm/rad.", shape=(3, 12))]
-    constants = {   # as volerr.derive.generate.generate_module
-        "LAYOUT": repr(layout.name), "LAYOUT_SHA256": repr(layout.sha256),
-        "AXES": repr(tuple(layout.axis_names)),
-        "ROTARY_AXES": repr(tuple(a for a in layout.axis_names
-                                  if layout.axes[a].kind == "rotary")),
-        "PARAMETERS": repr(tuple(layout.parameter_names)),
-        "PARAMETER_AXIS": repr(layout.parameter_axis),
-        "PARAMETER_KIND": repr(layout.parameter_kind)}
-    if layout.effects:
-        constants["COVARIATES"] = repr(tuple(layout.covariates))
-        constants["EFFECTS"] = repr({e.name: e.kind for e in layout.effects})
-    for k, v in sorted(layout.parameters.items()):     # numeric layout parameters (h, ...)
-        constants[k] = repr(float(v))
-    header = {"title": f"Fitting functions of layout {layout.name} (reduced module).",
-              "layout": layout.name, "layout_file": layout.path or f"{layout.name}.toml",
-              "sha256": layout.sha256, "sources": LAYOUT_SOURCES}
-    return render_module(header, constants, funcs)
+    return generate_fit_module(layout)
 
 
 def module_filename(layout: Layout) -> str:
