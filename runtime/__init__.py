@@ -4,13 +4,13 @@ Units of the Python API: positions in mm (linear axes) and degrees (rotary axes)
 errors in mm, angular errors in rad; results in mm.
 """
 
-from volerr.errors import InputError
-from volerr.machine.layout import layout_names as layouts
-from volerr.machine.model import Model, load  # noqa: F401
+from .errors import InputError
+from .machine.layout import layout_names as layouts
+from .machine.model import Model, load  # noqa: F401
 
 __all__ = ["InputError", "Model", "layouts", "load"]
 __version__ = "0.1.0"
 
-from volerr import _legacy
+from . import _legacy
 
 _legacy.install()

@@ -18,7 +18,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from volerr.errors import InputError, require
+from .errors import InputError, require
 
 
 def check_output(path, inputs=()) -> Path:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import re
 
-from volerr.errors import InputError
+from .errors import InputError
 
 #: micrometres per millimetre
 UM_PER_MM = 1e3

@@ -20,9 +20,9 @@ from importlib import resources
 
 import numpy as np
 
-from volerr.machine import iso_names
-from volerr.errors import InputError
-from volerr.units import UM_PER_MM
+from ..machine import iso_names
+from ..errors import InputError
+from ..units import UM_PER_MM
 
 DATA_FILE = "printed_pahk.toml"
 _FUNC = re.compile(r"\b(R?)(dx|dy|dz|Ex|Ey|Ez)\((X|Y|Z)o?\)")

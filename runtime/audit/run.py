@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from volerr.errors import InputError, require
-from volerr.machine.layout import layout_names, read_layout
+from ..errors import InputError, require
+from ..machine.layout import layout_names, read_layout
 
 
 @dataclass
@@ -171,8 +171,8 @@ def totals_line(verdicts) -> str:
 def numeric_table(layouts: list[str] | None, points: int) -> str:
     """Text table of :func:`volerr.audit.numeric.spot_check` for ``layouts`` (default: every
     layout with a printed equation) at ``points`` random points; differences in um."""
-    from volerr.audit.numeric import printed_equations, spot_check
-    from volerr.machine.model import load
+    from .numeric import printed_equations, spot_check
+    from ..machine.model import load
 
     names = layouts or [n for n in layout_names() if printed_equations(n)]
     lines = ["numeric spot check: generated model vs printed equation, "

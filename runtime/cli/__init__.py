@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-from volerr.errors import InputError
+from ..errors import InputError
 
 __all__ = ["InputError"]
 

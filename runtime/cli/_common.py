@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volerr.cmm import volmap
-from volerr.errors import InputError, require
-from volerr.tables.functions import METHODS, ErrorFunctions
+from ..cmm import volmap
+from ..errors import InputError, require
+from ..tables.functions import METHODS, ErrorFunctions
 
 
 def add_error_arguments(parser, required: bool = True) -> None:

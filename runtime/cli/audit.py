@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import json
 
-from volerr.audit import run as audit_run
-from volerr.audit import summary_line
-from volerr.errors import require
-from volerr.fileio import write_text
+from ..audit import run as audit_run
+from ..audit import summary_line
+from ..errors import require
+from ..fileio import write_text
 
 
 def register(sub) -> None:
@@ -41,9 +41,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from volerr.cli._common import layout_inputs, progress
+    from ._common import layout_inputs, progress
     from volerr.derive.audit import providers
-    from volerr.fileio import Outputs
+    from ..fileio import Outputs
 
     require(args.points >= 1, "--points must be at least 1")
     inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]
@@ -56,7 +56,7 @@ def run(args) -> int:
     if args.json:
         files["--json"] = json.dumps(entries, indent=1, ensure_ascii=False) + "\n"
     if args.html:
-        from volerr.audit import render_html
+        from ..audit import render_html
 
         files["--html"] = render_html(entries)
     with outs:

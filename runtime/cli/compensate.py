@@ -22,10 +22,10 @@ import json
 import math
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments, add_vector
-from volerr.errors import InputError, require
-from volerr.cli._common import layout_inputs
-from volerr.fileio import Outputs, write_text
+from ._common import add_error_arguments, add_vector
+from ..errors import InputError, require
+from ._common import layout_inputs
+from ..fileio import Outputs, write_text
 
 
 def register(sub) -> None:
@@ -110,9 +110,9 @@ def report_csv(model, reports) -> str:
 def run(args) -> int:
     import sys
 
-    from volerr.fiveaxis import program
-    from volerr.fiveaxis.compensate import error_functions
-    from volerr.machine.model import load
+    from ..fiveaxis import program
+    from ..fiveaxis.compensate import error_functions
+    from ..machine.model import load
 
     model = load(args.layout)
     require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
@@ -143,7 +143,7 @@ def run(args) -> int:
                      "orientation": bool(args.orientation), "types": args.types or "L-VOL,R-VOL",
                      **s}, indent=2) + "\n", inputs)
             if args.plot:
-                from volerr.fiveaxis.plots import plot_program_errors
+                from ..fiveaxis.plots import plot_program_errors
 
                 plot_program_errors(sink.program_errors(), outs.path("--plot"),
                                     title=f"{model.name}: {args.program}")

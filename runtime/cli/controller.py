@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volerr.errors import require
+from ..errors import require
 
 
 def register(sub) -> None:
@@ -40,11 +40,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from volerr.tables import controller as ct
-    from volerr.cli._common import layout_inputs
-    from volerr.fileio import Outputs, write_text
-    from volerr.machine.model import load
-    from volerr.tables.table import read_error_dir, write_error_dir
+    from ..tables import controller as ct
+    from ._common import layout_inputs
+    from ..fileio import Outputs, write_text
+    from ..machine.model import load
+    from ..tables.table import read_error_dir, write_error_dir
 
     model = load(args.layout)
     if args.action == "export":

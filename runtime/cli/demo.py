@@ -24,8 +24,8 @@ import json
 import time
 from pathlib import Path
 
-from volerr.errors import require
-from volerr.fileio import write_text
+from ..errors import require
+from ..fileio import write_text
 
 SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "fiveaxis", "loop", "iso230_2",
             "uncertainty")
@@ -92,7 +92,7 @@ def register(sub) -> None:
 
 def _cli(*argv) -> str:
     """Run a volerr command in-process; return what it printed. Non-zero exit is an error."""
-    from volerr.cli import main
+    from . import main
 
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
@@ -102,7 +102,7 @@ def _cli(*argv) -> str:
 
 
 def _cmm(out: Path, layout: str, label: str) -> dict:
-    from volerr.cmm.examples import write_example_errors
+    from ..cmm.examples import write_example_errors
 
     errors = out / f"errors_{layout}"
     write_example_errors(errors, layout)
@@ -147,7 +147,7 @@ def _audit(out: Path) -> dict:
 
 
 def _probe(out: Path) -> dict:
-    from volerr.probe.plans import simulate_demo_sphere
+    from ..probe.plans import simulate_demo_sphere
 
     data = simulate_demo_sphere(out / "sphere_probing.csv")
     _cli("probe-cal", data["path"], "--sphere-radius", data["sphere_radius_mm"],
@@ -162,7 +162,7 @@ def _probe(out: Path) -> dict:
 
 
 def _identify(out: Path) -> dict:
-    from volerr.identify.tracker_io import example_path
+    from ..identify.tracker_io import example_path
 
     measured = out / "tracker_identified"
     for axis in ("X", "Y", "Z"):
@@ -188,7 +188,7 @@ def _identify(out: Path) -> dict:
 
 
 def _fiveaxis(out: Path) -> dict:
-    from volerr.fiveaxis.example import write_example
+    from ..fiveaxis.example import write_example
 
     ex = write_example(out / "dmu50", "DMU50")
     results = {}
@@ -212,7 +212,7 @@ def _fiveaxis(out: Path) -> dict:
 
 
 def _loop(out: Path) -> dict:
-    from volerr.loop.run import demo_campaign
+    from ..loop.run import demo_campaign
 
     layout, data = demo_campaign(out / "loop_measured.csv")
     _cli("loop", layout, data, "--json", out / "loop.json", "--html", out / "loop.html")
@@ -246,7 +246,7 @@ def _iso230_2(out: Path) -> dict:
 
 
 def _uncertainty(out: Path) -> dict:
-    from volerr.cmm.examples import write_example_errors
+    from ..cmm.examples import write_example_errors
 
     errors = out / "errors_MH2_u"
     write_example_errors(errors, "MH2")
@@ -308,7 +308,7 @@ def _index(out: Path, results: list) -> None:
 def run(args) -> int:
     import os
 
-    from volerr.fileio import Outputs
+    from ..fileio import Outputs
 
     final = Path(args.out)
     outs = Outputs().folder("--out", final).check()

@@ -9,10 +9,10 @@ it writes the committed ``generated/`` folder (that is ``./generated/`` there), 
 
 from pathlib import Path
 
-from volerr.errors import require
-from volerr.fileio import Outputs, is_package_file, write_text
-from volerr.machine import derivation
-from volerr.machine.layout import read_layout
+from ..errors import require
+from ..fileio import Outputs, is_package_file, write_text
+from ..machine import derivation
+from ..machine.layout import read_layout
 
 
 def register(sub) -> None:
@@ -46,7 +46,7 @@ def run(args) -> int:
     layouts = [read_layout(name) for name in args.layout]
     names = [derivation.module_filename(lay) for lay in layouts]
     if args.all:
-        from volerr.machine.layout import layout_names
+        from ..machine.layout import layout_names
         names += [derivation.module_filename(read_layout(n)) for n in layout_names()]
     dup = sorted({n for n in names if names.count(n) > 1})
     require(not dup, f"two layouts generate the same module {dup[0] if dup else ''}: give them "
@@ -54,7 +54,7 @@ def run(args) -> int:
     inputs = [p for p in (Path(n) for n in args.layout) if p.is_file()]
     outs = Outputs(inputs, allow_package=in_package).folder("--out", out).check()
     texts = {}
-    from volerr.cli._common import progress
+    from ._common import progress
 
     for layout in progress(layouts, desc="derive", unit="layout"):
         texts[derivation.module_filename(layout)] = derivation.generate_source(layout)

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import json
 
-from volerr.cmm import diagonals
-from volerr.cli._common import add_common, error_functions_from_args, inputs_of, parse_at
-from volerr.errors import require
-from volerr.fileio import Outputs, write_text
-from volerr.machine.model import load
-from volerr.cmm.volmap import linear_axes, volume
+from ..cmm import diagonals
+from ._common import add_common, error_functions_from_args, inputs_of, parse_at
+from ..errors import require
+from ..fileio import Outputs, write_text
+from ..machine.model import load
+from ..cmm.volmap import linear_axes, volume
 
 
 def register(sub) -> None:

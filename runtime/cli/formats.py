@@ -9,7 +9,7 @@ from __future__ import annotations
 import re
 from importlib import resources
 
-from volerr.errors import require
+from ..errors import require
 
 
 def register(sub) -> None:

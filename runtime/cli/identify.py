@@ -13,7 +13,7 @@ import argparse
 import json
 import sys
 
-from volerr.cli._common import add_vector
+from ._common import add_vector
 
 
 def register(sub) -> None:
@@ -74,20 +74,20 @@ def register(sub) -> None:
 
 
 def _vec(text, what):
-    from volerr.cli._common import parse_vector
+    from ._common import parse_vector
 
     return list(parse_vector(text, what))
 
 
 def run(args) -> int:
-    from volerr.fileio import Outputs, write_text
-    from volerr.identify.inputs import read_rounds, refuse_repeated_files
-    from volerr.identify.report import outlier_warnings, residual_csv, summary_lines
-    from volerr.identify.solve import identify, to_model_signs
-    from volerr.machine.layout import read_layout
-    from volerr.tables.table import table_to_csv
+    from ..fileio import Outputs, write_text
+    from ..identify.inputs import read_rounds, refuse_repeated_files
+    from ..identify.report import outlier_warnings, residual_csv, summary_lines
+    from ..identify.solve import identify, to_model_signs
+    from ..machine.layout import read_layout
+    from ..tables.table import table_to_csv
 
-    from volerr.cli._common import layout_inputs
+    from ._common import layout_inputs
 
     inputs = list(args.files) + layout_inputs(args.layout)
     refuse_repeated_files(args.files)
@@ -110,12 +110,12 @@ def run(args) -> int:
     summary = result.summary()
     fits = None
     if args.fit:
-        from volerr.tables.errorfit import fit_table
+        from ..tables.errorfit import fit_table
         fits = fit_table(table, args.fit, weighted=table.std != {})
         summary["fit"] = [f.report() for f in fits.values()]
     with outs:
         if args.plot:
-            from volerr.identify.plots import plot_identification
+            from ..identify.plots import plot_identification
             plot_identification(result, outs.path("--plot"), fits)
         write_text(outs.path("--out"), text, inputs=inputs)
         if args.residuals:

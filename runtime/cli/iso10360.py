@@ -12,12 +12,12 @@ import json
 
 import numpy as np
 
-from volerr.cli._common import add_error_arguments, error_functions_from_args, inputs_of
-from volerr.fileio import Outputs, write_text
-from volerr.machine.model import load
-from volerr.uncertainty import iso10360
-from volerr.uncertainty.report import num
-from volerr.cmm.volmap import volume
+from ._common import add_error_arguments, error_functions_from_args, inputs_of
+from ..fileio import Outputs, write_text
+from ..machine.model import load
+from ..uncertainty import iso10360
+from ..uncertainty.report import num
+from ..cmm.volmap import volume
 
 
 def register(sub) -> None:

@@ -13,7 +13,7 @@ import argparse
 import json
 from pathlib import Path
 
-from volerr.errors import require
+from ..errors import require
 
 EPILOG = """\
 input formats (CSV; ';' or tab separated exports are read too; names case-insensitive):
@@ -104,8 +104,8 @@ def _axes(text: str, n: int) -> list[str]:
 def run(args) -> int:
     import sys
 
-    from volerr import positioning as pos
-    from volerr.fileio import Outputs, write_bytes, write_text
+    from .. import positioning as pos
+    from ..fileio import Outputs, write_bytes, write_text
 
     inputs = list(args.runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs), "the same RUN file is given "
@@ -129,7 +129,7 @@ def run(args) -> int:
     png = pos.plot_runs(evaluations) if (args.plot or args.html) else None
     html_text = None
     if args.html:
-        from volerr import __version__ as ver
+        from .. import __version__ as ver
         import datetime
         html_text = pos.report_html(report, png, inputs, f"Evaluated with volerr {ver} on "
                                                          f"{datetime.date.today().isoformat()}.")

@@ -1,7 +1,7 @@
 """``volerr layouts [--long]``: list the shipped layouts (with --long: axes, travel, rotary axis
 points, parameters and the description)."""
 
-from volerr.machine.layout import describe, layout_names, read_layout
+from ..machine.layout import describe, layout_names, read_layout
 
 
 def register(sub) -> None:

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volerr.errors import require
-from volerr.fileio import Outputs
+from ..errors import require
+from ..fileio import Outputs
 
 
 def register(sub) -> None:
@@ -45,11 +45,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from volerr.loop import candidates
-    from volerr.loop.run import run_loop
+    from ..loop import candidates
+    from ..loop.run import run_loop
 
-    from volerr.cli._common import layout_inputs
-    from volerr.machine.model import load
+    from ._common import layout_inputs
+    from ..machine.model import load
 
     require(args.json or args.html, "give --json or --html (or both) for the report")
     inputs = [args.data, *layout_inputs(args.layout)]

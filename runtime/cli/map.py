@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import json
 
-from volerr.cli._common import add_common, error_functions_from_args, inputs_of, parse_at
-from volerr.cmm import volmap
-from volerr.errors import require
-from volerr.fileio import Outputs, write_text
-from volerr.machine.model import load
+from ._common import add_common, error_functions_from_args, inputs_of, parse_at
+from ..cmm import volmap
+from ..errors import require
+from ..fileio import Outputs, write_text
+from ..machine.model import load
 
 
 def register(sub) -> None:

@@ -15,10 +15,10 @@ import json
 import math
 import sys
 
-from volerr.cli._common import add_vector
-from volerr.errors import require
-from volerr.fileio import write_text
-from volerr.units import parse_number
+from ._common import add_vector
+from ..errors import require
+from ..fileio import write_text
+from ..units import parse_number
 
 
 def register(sub) -> None:
@@ -79,7 +79,7 @@ def _floats(text: str, what: str) -> list[float]:
 
 
 def _run_plan(args) -> int:
-    from volerr.probe import plans as pp
+    from ..probe import plans as pp
 
     require(args.data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
     require(args.ball_radius is not None and args.ball_radius > 0,
@@ -93,7 +93,7 @@ def _run_plan(args) -> int:
         plan = pp.pahk_plan(args.step_deg, args.circles, not args.no_pole)
     pts = pp.nominal_points(plan, center, args.sphere_radius, args.ball_radius,
                             args.tilt_deg, args.roll_deg)
-    from volerr.fileio import Outputs
+    from ..fileio import Outputs
 
     with Outputs().file("--plan", args.plan) as outs:
         write_text(outs.path("--plan"), pp.plan_csv_text(plan, pts))
@@ -104,14 +104,14 @@ def _run_plan(args) -> int:
 def run(args) -> int:
     if args.plan:
         return _run_plan(args)
-    from volerr.probe import calibration as probe
-    from volerr.probe.report import summary_lines
+    from ..probe import calibration as probe
+    from ..probe.report import summary_lines
 
     require(args.data, "name the probing data DATA.csv (or use --plan to write a plan)")
     require(args.out, "--out MAP.csv is required")
     require(math.isfinite(args.sphere_radius) and args.sphere_radius > 0,
             f"--sphere-radius must be a positive length in mm, got {args.sphere_radius}")
-    from volerr.fileio import Outputs
+    from ..fileio import Outputs
 
     inputs = [args.data]
     outs = Outputs(inputs).file("--out", args.out).file("--json", args.json) \
@@ -129,11 +129,11 @@ def run(args) -> int:
         if args.json:
             write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
         if args.plot:
-            from volerr.probe.plots import plot_probe_calibration
+            from ..probe.plots import plot_probe_calibration
 
             plot_probe_calibration(cal, outs.path("--plot"))
         if args.plots:
-            from volerr.probe.plots import plot_probe_map_2d, plot_probe_map_3d
+            from ..probe.plots import plot_probe_map_2d, plot_probe_map_3d
 
             d = outs.path("--plots")
             plot_probe_map_3d(cal, d / "probe_map_3d.png")

@@ -8,8 +8,8 @@ CSV ('volerr formats deviations').  See volerr.loop.simulate.
 
 from __future__ import annotations
 
-from volerr.cli._common import add_vector
-from volerr.errors import require
+from ._common import add_vector
+from ..errors import require
 
 
 def _effect(text: str) -> dict:
@@ -85,16 +85,16 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from volerr.machine.model import load
-    from volerr.loop.simulate import demo_probes, simulate
+    from ..machine.model import load
+    from ..loop.simulate import demo_probes, simulate
 
     require(10 <= args.points <= 10_000_000, "--points must be between 10 and 10^7")
     import math
 
     require(all(math.isfinite(v) and 0 <= v <= 1e6 for v in (args.noise_um, args.magnitude_um)),
             "--noise-um and --magnitude-um must be finite, between 0 and 1e6 um")
-    from volerr.cli._common import layout_inputs
-    from volerr.fileio import Outputs
+    from ._common import layout_inputs
+    from ..fileio import Outputs
 
     model = load(args.layout)
     inputs = layout_inputs(args.layout)

@@ -12,8 +12,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from volerr.errors import require
-from volerr.units import URAD_PER_RAD
+from ..errors import require
+from ..units import URAD_PER_RAD
 
 
 def register(sub) -> None:
@@ -31,11 +31,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from volerr.cli._common import layout_inputs
-    from volerr.fileio import Outputs, write_text
-    from volerr.machine.layout import read_layout
-    from volerr.cmm.squareness import squareness
-    from volerr.tables.table import read_error_dir, table_to_csv, write_constants
+    from ._common import layout_inputs
+    from ..fileio import Outputs, write_text
+    from ..machine.layout import read_layout
+    from ..cmm.squareness import squareness
+    from ..tables.table import read_error_dir, table_to_csv, write_constants
 
     layout = read_layout(args.layout)
     src, out = Path(args.directory), Path(args.out)

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments, add_vector
-from volerr.errors import require
-from volerr.cli._common import layout_inputs
-from volerr.fileio import Outputs, write_text
+from ._common import add_error_arguments, add_vector
+from ..errors import require
+from ._common import layout_inputs
+from ..fileio import Outputs, write_text
 
 
 def register(sub) -> None:
@@ -40,10 +40,10 @@ def run(args) -> int:
 
     import numpy as np
 
-    from volerr.fiveaxis.compensate import error_functions
-    from volerr.machine.model import load
-    from volerr.fiveaxis.plots import plot_tcp_error_map
-    from volerr.fiveaxis.tcpmap import tcp_map
+    from ..fiveaxis.compensate import error_functions
+    from ..machine.model import load
+    from ..fiveaxis.plots import plot_tcp_error_map
+    from ..fiveaxis.tcpmap import tcp_map
 
     model = load(args.layout)
     require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")

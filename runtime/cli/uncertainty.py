@@ -14,12 +14,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from volerr.cli._common import add_error_arguments
-from volerr.errors import require
-from volerr.fileio import Outputs, write_bytes, write_text
-from volerr.machine.model import load
-from volerr.uncertainty import ensemble, montecarlo as mc, tasks
-from volerr.uncertainty import report
+from ._common import add_error_arguments
+from ..errors import require
+from ..fileio import Outputs, write_bytes, write_text
+from ..machine.model import load
+from ..uncertainty import ensemble, montecarlo as mc, tasks
+from ..uncertainty import report
 
 
 def register(sub) -> None:
@@ -116,7 +116,7 @@ def _check_options(args) -> None:
 
 
 def run(args) -> int:
-    from volerr.cli._common import error_functions_from_args, inputs_of
+    from ._common import error_functions_from_args, inputs_of
 
     _check_options(args)
     require(args.evaluate in tasks.EVALUATIONS, f"unknown evaluation {args.evaluate!r} "
@@ -125,7 +125,7 @@ def run(args) -> int:
     inputs = [Path(args.task)] + ([Path(args.probe_map)] if args.probe_map else [])
     if args.errors:
         inputs += inputs_of(args)
-    from volerr.cli._common import layout_inputs
+    from ._common import layout_inputs
 
     inputs += layout_inputs(args.layout)
     outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
@@ -138,7 +138,7 @@ def run(args) -> int:
             "nothing is uncertain: give --errors, --spec, --noise-um or temperatures")
     pmap = None
     if args.probe_map:
-        from volerr.probe import read_probe_map
+        from ..probe import read_probe_map
         pmap = read_probe_map(args.probe_map)
     ens = ensemble.Ensemble.build(funcs, spec, args.noise_um, args.table_std, args.correlation_mm,
                                   _temperature(args), pmap, args.seed,
@@ -168,7 +168,7 @@ def run(args) -> int:
     title = f"{model.name} {args.evaluate} ({values.shape[0]} samples)"
     hist = None
     if args.plot or args.html:
-        from volerr.uncertainty import plots
+        from ..uncertainty import plots
         hist = plots.histogram_png(values, prob.names, summary, title)
     if not args.quiet:
         print("\n".join(report.summary_lines(doc)))
@@ -177,7 +177,7 @@ def run(args) -> int:
         if args.plot:
             write_bytes(outs.path("--plot"), hist, inputs)
         if args.html:
-            from volerr.uncertainty import plots
+            from ..uncertainty import plots
             conv = plots.convergence_png(values, prob.names, title)
             write_text(outs.path("--html"), report.html_report(doc, [hist, conv]), inputs)
     return 0

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from volerr.errors import require
+from ..errors import require
 
 #: |value| * 10^decimals must stay below this: then floor(x / 10) of the rounded integer x is
 #: exact in float64 (x / 10 = m + r/10, r >= 1 is at least 0.1 away from m + 1)

@@ -40,9 +40,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.units import UM_PER_MM
-from volerr.errors import require
-from volerr.cmm.volmap import fixed_positions, linear_axes
+from ..units import UM_PER_MM
+from ..errors import require
+from .volmap import fixed_positions, linear_axes
 
 KINDS = ("space", "face", "axis")
 
@@ -219,7 +219,7 @@ def plot_lines(results, path, title: str = "", inputs=()) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from volerr.cmm.volmap import save_figure
+    from .volmap import save_figure
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1, 1.4]})
     space = [r for r in results if r.line.kind == "space"] or results[:4]

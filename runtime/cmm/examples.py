@@ -38,10 +38,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from volerr.machine import iso_names
-from volerr.units import MM_PER_UM, RAD_PER_URAD
-from volerr.errors import InputError
-from volerr.tables.table import ErrorTable, write_error_dir
+from ..machine import iso_names
+from ..units import MM_PER_UM, RAD_PER_URAD
+from ..errors import InputError
+from ..tables.table import ErrorTable, write_error_dir
 
 #: per layout: axis -> (step mm, {name: (band, repeatability_2sigma or None)}) in um / urad;
 #: constants: paper symbol -> value (urad)
@@ -95,7 +95,7 @@ def example_errors(layout: str = "MB1"):
     """-> (tables {axis: ErrorTable}, constants {name: rad}) of a built-in example set."""
     if layout not in SPECS:
         raise InputError(f"no built-in example error set for {layout!r} (have {', '.join(EXAMPLES)})")
-    from volerr.machine.layout import read_layout
+    from ..machine.layout import read_layout
     lay = read_layout(layout)
     spec = SPECS[layout]
     rng = np.random.default_rng(spec["seed"])

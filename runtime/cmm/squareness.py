@@ -30,8 +30,8 @@ import math
 
 import numpy as np
 
-from volerr.errors import require
-from volerr.tables.table import ErrorTable
+from ..errors import require
+from ..tables.table import ErrorTable
 
 #: squareness -> ((straightness, axis, sign), (straightness, axis, sign)): value = sum sign*slope
 PAIRS = {

@@ -26,10 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.units import UM_PER_MM
-from volerr.errors import InputError, require
-from volerr.cmm import csvformat
-from volerr.fileio import AtomicFile, check_output
+from ..units import UM_PER_MM
+from ..errors import InputError, require
+from . import csvformat
+from ..fileio import AtomicFile, check_output
 
 
 @dataclass
@@ -215,7 +215,7 @@ def save_figure(fig, path, inputs=()) -> Path:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=120)
-        from volerr.fileio import default_mode
+        from ..fileio import default_mode
         os.chmod(tmp, default_mode())
         os.replace(tmp, out)
     finally:

@@ -2,14 +2,14 @@
 compensation of NC programs on the full error model, the DMU 50 example, and the plots.
 """
 
-from volerr.fiveaxis.kinematics import inverse, is_five_axis, linear_axes
+from .kinematics import inverse, is_five_axis, linear_axes
 
 __all__ = ["inverse", "is_five_axis", "linear_axes"]
 
 
 def __getattr__(name):
     # names of the former flat module volerr.fiveaxis, still importable from here
-    from volerr.fiveaxis import kinematics as _m
+    from . import kinematics as _m
     try:
         return getattr(_m, name)
     except AttributeError:

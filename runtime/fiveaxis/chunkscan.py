@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.fiveaxis import gcode
+from . import gcode
 
 _OTHER, _LETTER, _DIGIT, _SIGN, _DOT, _BLANK, _EOL = range(7)
 _CLS = np.full(256, _OTHER, dtype=np.int8)

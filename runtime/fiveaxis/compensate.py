@@ -62,9 +62,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.fiveaxis.kinematics import linear_axes, linear_jacobian, rotary_jacobian
-from volerr.machine import iso_names
+from ..errors import InputError, require
+from .kinematics import linear_axes, linear_jacobian, rotary_jacobian
+from ..machine import iso_names
 
 STRATEGIES = ("full", "thesis")
 
@@ -182,7 +182,7 @@ def close_periodic(tables_: dict, model) -> tuple[dict, list[str]]:
     steps), add the first row again one turn later (360 deg): the error at 360 deg is the error
     at 0 deg, so positions in the gap are interpolated between measured values, not
     extrapolated.  Returns the tables and a note per closed axis."""
-    from volerr.tables.table import ErrorTable
+    from ..tables.table import ErrorTable
 
     out, notes = dict(tables_), []
     for a in endless_axes(model):
@@ -205,7 +205,7 @@ def error_functions(directory, model, method: str = "linear", degree=None,
                     extrapolate: bool = False):
     """:class:`volerr.tables.table.ErrorFunctions` of an error directory, endless rotary axes closed
     over the full turn (:func:`close_periodic`).  Returns (functions, notes)."""
-    from volerr.tables.table import ErrorFunctions, read_error_dir
+    from ..tables.table import ErrorFunctions, read_error_dir
 
     tabs, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
     tabs, notes = close_periodic(tabs, model)
@@ -442,7 +442,7 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
     :mod:`volerr.fiveaxis.program`, which also streams a program file of any length)."""
     import io
 
-    from volerr.fiveaxis import program
+    from . import program
 
     opts = program.Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
                            check_travel, max_iter, None if types is None else tuple(types))

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.machine import iso_names
-from volerr.errors import InputError
-from volerr.fileio import write_text
-from volerr.tables.table import ErrorTable, write_error_dir
+from ..machine import iso_names
+from ..errors import InputError
+from ..fileio import write_text
+from ..tables.table import ErrorTable, write_error_dir
 
 #: (translational um, angular urad) amplitude per axis kind, thesis-like
 _SCALE = {"linear": (8.0, 80.0), "rotary": (5.0, 30.0)}
@@ -100,7 +100,7 @@ def hemisphere_program(model, radius: float = 40.0, center=(30.0, 20.0, 20.0), r
 
 
 def _inside(model, text: str) -> bool:
-    from volerr.fiveaxis import gcode
+    from . import gcode
 
     for b in gcode.blocks(gcode.parse(text), model.axes):
         for a, v in b.target.items():
@@ -125,7 +125,7 @@ def example_program(model, radius: float = 40.0) -> str:
 
 def write_example(directory, layout: str = "DMU50") -> dict:
     """Write ``errors/`` and ``hemisphere.nc`` for ``layout`` into ``directory``; return paths."""
-    from volerr.machine.model import load
+    from ..machine.model import load
 
     model = load(layout)
     d = Path(directory)

@@ -43,7 +43,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from volerr.errors import InputError
+from ..errors import InputError
 
 _LINE = re.compile(r"[^\r\n]*(?:\r\n|\n|\r|$)")
 _WORD = re.compile(r"([A-Za-z])([ \t]*)([+-]?(?:\d+\.?\d*|\.\d+))")

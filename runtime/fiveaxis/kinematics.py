@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from volerr.errors import InputError, require
+from ..errors import InputError, require
 
 #: a rotary axis whose motion turns the tool axis by less than this (rad per rad) is singular
 SINGULAR = 1e-9

@@ -60,7 +60,7 @@ def plot_program_errors(errors, path, title: str = ""):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from volerr.fiveaxis.program import ProgramErrors
+    from .program import ProgramErrors
 
     if not isinstance(errors, ProgramErrors):
         errors = ProgramErrors.from_reports(errors)

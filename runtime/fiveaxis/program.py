@@ -27,9 +27,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.fiveaxis import gcode
-from volerr.fiveaxis.kinematics import is_five_axis, linear_axes
+from ..errors import InputError, require
+from . import gcode
+from .kinematics import is_five_axis, linear_axes
 
 #: lines per chunk: large enough for the vectorised solve, small enough for the memory
 CHUNK_LINES = 20000
@@ -56,7 +56,7 @@ class Options:
     types: tuple | None = None
 
     def validated(self, model) -> "Options":
-        from volerr.fiveaxis.compensate import STRATEGIES
+        from .compensate import STRATEGIES
 
         require(self.strategy in STRATEGIES,
                 f"unknown strategy {self.strategy!r} ({' '.join(STRATEGIES)})")
@@ -174,7 +174,7 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int)
     state from chunk to chunk.  Runs of plain lines in absolute mode are done together (the
     position of an axis is its last programmed value: a forward fill); every other line goes
     through ``interp`` one by one."""
-    from volerr.fiveaxis import chunkscan
+    from . import chunkscan
 
     axes = model.axes
     nax = len(axes)
@@ -293,7 +293,7 @@ class Solution:
 
 
 def solve_blocks(em, q_nom: np.ndarray, opts: Options) -> Solution:
-    from volerr.fiveaxis.compensate import solve, solve_thesis
+    from .compensate import solve, solve_thesis
 
     n = len(q_nom)
     if not n:
@@ -324,7 +324,7 @@ def round_positions(em, q_nom: np.ndarray, sol: Solution, nd: np.ndarray,
                     opts: Options) -> np.ndarray:
     """The positions written: rotary values rounded first, the linear axes solved again for
     them (orientation), then rounded; a value equal to the programmed one is kept as is."""
-    from volerr.fiveaxis.compensate import resolve_linear
+    from .compensate import resolve_linear
 
     model = em.model
     q_c = sol.q
@@ -440,7 +440,7 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
     more; an axis the line does not program gets a word where the controller (as written so
     far) holds another value -- a chain along the lines, followed one entry at a time for the
     (line, axis) pairs without a word only."""
-    from volerr.fiveaxis import chunkscan
+    from . import chunkscan
 
     sc = b.scan
     pos = written.position
@@ -647,7 +647,7 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     read a second time (``start`` called again) only when a rotary axis turns out never to be
     known although its letter appears (e.g. only in a G28 block), which the prescan cannot
     tell.  ``progress(n_lines)`` is called after every chunk."""
-    from volerr.fiveaxis.compensate import ErrorModel, parameters_for_types
+    from .compensate import ErrorModel, parameters_for_types
 
     opts = opts.validated(model)
     pre = prescan(open_source, model, chunk_lines)
@@ -776,7 +776,7 @@ class FileSink:
     place by :meth:`commit`) and keeping the plot data only when asked for."""
 
     def __init__(self, model, out, report=None, inputs=(), keep_errors: bool = False):
-        from volerr.fileio import AtomicFile
+        from ..fileio import AtomicFile
 
         self.model = model
         self.files = []

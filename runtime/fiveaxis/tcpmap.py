@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.errors import require
+from ..errors import require
 
 
 @dataclass(frozen=True)
@@ -50,8 +50,8 @@ def tcp_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: int = 7
     workpiece point ``point`` (mm).  ``range1`` / ``range2``: (lo, hi) deg of the rotary axes
     (default: the travel inside the measured range, at most -180..180 for an endless axis).
     ``orientation=False`` skips the tool-axis error (NaN)."""
-    from volerr.fiveaxis.compensate import ErrorModel
-    from volerr.fiveaxis.kinematics import is_five_axis
+    from .compensate import ErrorModel
+    from .kinematics import is_five_axis
 
     require(is_five_axis(model), f"{model.name}: not a five-axis layout")
     a1, a2 = model.rotary_axes

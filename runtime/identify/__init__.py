@@ -3,14 +3,14 @@ solve of the six error motions of an axis per position, rounds with Type A uncer
 conversion to the model's sign convention, and the identification plots.
 """
 
-from volerr.identify.solve import Identification, identify, identify_round, to_model_signs
+from .solve import Identification, identify, identify_round, to_model_signs
 
 __all__ = ["Identification", "identify", "identify_round", "to_model_signs"]
 
 
 def __getattr__(name):
     # names of the former flat module volerr.identify, still importable from here
-    from volerr.identify import solve as _m
+    from . import solve as _m
     try:
         return getattr(_m, name)
     except AttributeError:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from volerr.errors import require
+from ..errors import require
 
 
 def refuse_repeated_files(files) -> None:
@@ -45,7 +45,7 @@ def read_rounds(files, fmt: str = "csv", positions: str | None = None,
     list of Round
         The rounds (:class:`volerr.identify.tracker_io.Round`), in file order.
     """
-    from volerr.identify.tracker_io import parse_positions, read_thesis_export, read_tracker_csv
+    from .tracker_io import parse_positions, read_thesis_export, read_tracker_csv
 
     rounds = []
     if fmt == "thesis":

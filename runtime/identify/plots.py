@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from volerr.units import UM_PER_MM, URAD_PER_RAD
+from ..units import UM_PER_MM, URAD_PER_RAD
 
 SCALE = (UM_PER_MM,) * 3 + (URAD_PER_RAD,) * 3
 

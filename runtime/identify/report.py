@@ -3,7 +3,7 @@ prints (summary on stdout, outlier warnings on stderr).  Residuals in um."""
 
 from __future__ import annotations
 
-from volerr.units import UM_PER_MM
+from ..units import UM_PER_MM
 
 
 def residual_csv(result) -> str:

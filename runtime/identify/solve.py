@@ -53,9 +53,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.units import MM_PER_M, MM_PER_UM, UM_PER_MM, URAD_PER_RAD
-from volerr.errors import InputError, require
-from volerr.identify.tracker_io import Round, check_rounds
+from ..units import MM_PER_M, MM_PER_UM, UM_PER_MM, URAD_PER_RAD
+from ..errors import InputError, require
+from .tracker_io import Round, check_rounds
 
 MOTION_PREFIX = ("EX", "EY", "EZ", "EA", "EB", "EC")
 #: Leica AT960 MPE figures quoted in the thesis (Appendix B, 2.8): (constant um, um per m)
@@ -172,7 +172,7 @@ class Identification:
         propagated tracker uncertainty and the Type A standard deviation of the mean:
         ``2 sqrt(u_tracker^2 + s^2 / n_rounds)``; written by default only when weighted by a
         tracker position."""
-        from volerr.tables.table import ErrorTable
+        from ..tables.table import ErrorTable
 
         with_u95 = self.weighted if with_u95 is None else with_u95
         values = {n: self.values[:, j] for j, n in enumerate(self.names)}
@@ -238,7 +238,7 @@ def _mean_or_none(values):
 
 def _layout_number(value, params: dict) -> float:
     """A layout coordinate: a number or an arithmetic expression in the layout parameters."""
-    from volerr.machine.expressions import number
+    from ..machine.expressions import number
 
     return number(value, params, "the layout coordinate")
 
@@ -629,7 +629,7 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         (Type A) and ``u_tracker`` the same shape.  ``.table()`` gives the
         :class:`volerr.tables.ErrorTable`.
     """
-    from volerr.machine.layout import Layout, read_layout
+    from ..machine.layout import Layout, read_layout
 
     if not isinstance(layout, Layout):
         layout = read_layout(layout)
@@ -714,7 +714,7 @@ def to_model_signs(table, layout, reference=None):
         The same positions, values in the model's convention (mm / rad); the table itself when
         nothing changes (a tool-side axis measured from ``q0 = 0`` or a tool-side rotary axis).
     """
-    from volerr.tables.table import ErrorTable
+    from ..tables.table import ErrorTable
 
     axis = table.axis
     require(axis in layout.axes, f"axis {axis} is not an axis of layout {layout.name}")

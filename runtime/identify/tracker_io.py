@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.units import parse_number
-from volerr.errors import InputError, require
-from volerr.fileio import MAX_ABS, check_header, check_magnitude, read_csv_rows
+from ..units import parse_number
+from ..errors import InputError, require
+from ..fileio import MAX_ABS, check_header, check_magnitude, read_csv_rows
 
 REQUIRED = ("round", "point", "position", "x", "y", "z")
 

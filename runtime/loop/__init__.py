@@ -7,14 +7,14 @@ generated per block of points), ``report`` (HTML), ``simulate`` (a virtual machi
 undeclared effects).
 """
 
-from volerr.loop.run import Report, read_deviations, run_loop
+from .run import Report, read_deviations, run_loop
 
 __all__ = ["Report", "read_deviations", "run_loop"]
 
 
 def __getattr__(name):
     # names of the former flat module volerr.loop, still importable from here
-    from volerr.loop import run as _m
+    from . import run as _m
     try:
         return getattr(_m, name)
     except AttributeError:

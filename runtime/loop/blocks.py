@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from volerr.loop.fit import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
+from .fit import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
 BLOCK = 8192
@@ -207,7 +207,7 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
 
 def solve_sym(G, b, tol: float = SV_TOL ** 2):
     """Minimum-norm solution of G x = b (as :func:`volerr.loop.fit.solve_normal`)."""
-    from volerr.loop.fit import solve_normal
+    from .fit import solve_normal
 
     return solve_normal(G, b, tol)
 

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.loop.fit import Data
+from .fit import Data
 
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
             "probe_direction", "setup", "group", "step", "covariate")

@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.errors import require
-from volerr.machine.model import Model
+from ..errors import require
+from ..machine.model import Model
 
 SETUP = ("dx", "dy", "dz", "ex", "ey", "ez")
 #: relative singular value below which a direction counts as undetermined

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.loop.fit import rotary_rad
+from .fit import rotary_rad
 
 
 def _png(fig) -> str:
@@ -88,7 +88,7 @@ def fig_residuals(fg) -> str:
 
 def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str]:
     """The variable against which an effect is best seen (its covariate C)."""
-    from volerr.machine.expressions import evaluate
+    from ..machine.expressions import evaluate
 
     c = info.get("covariate")
     if kind == "periodic" and {"axis", "period"} <= set(info):

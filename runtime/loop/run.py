@@ -41,18 +41,18 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.loop import blocks
-from volerr.loop import candidates as cands
-from volerr.loop import select as sel
-from volerr.errors import InputError, require
-from volerr.loop.fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
+from . import blocks
+from . import candidates as cands
+from . import select as sel
+from ..errors import InputError, require
+from .fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
                   identifiability_gram, point_norm, require_points, rms, rows_of,
                   weakly_determined_gram)
-from volerr.machine.layout import layout_text, parse_layout
-from volerr.machine import derivation
-from volerr.machine.model import Model, load
+from ..machine.layout import layout_text, parse_layout
+from ..machine import derivation
+from ..machine.model import Model, load
 
-from volerr.loop.select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
+from .select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
 
 ROBUST_K = 4.0       # robust sigmas of the 3-D residual length kept at full weight
 OUTLIER_Z = 5.0      # robust sigmas beyond which a point is flagged as an outlier
@@ -253,14 +253,14 @@ class Report:
         return self.data["effects"]
 
     def write_json(self, path, inputs=()) -> Path:
-        from volerr.fileio import write_text
+        from ..fileio import write_text
 
         return write_text(path, json.dumps(self.data, indent=2, default=_json) + "\n",
                           inputs=list(inputs))
 
     def write_html(self, path, inputs=()) -> Path:
-        from volerr.fileio import write_text
-        from volerr.loop.report import render_html
+        from ..fileio import write_text
+        from .report import render_html
 
         return write_text(path, render_html(self), inputs=list(inputs))
 
@@ -273,8 +273,8 @@ class Report:
         the start of the measured range (their constants belong to the instrument placement);
         straightness slopes are carried by squareness (gauge: see :mod:`volerr.loop.fit`).
         ``which="before"``: the declared model's own fit (effects unmodelled, no std)."""
-        from volerr.loop.fit import legendre, unit
-        from volerr.tables.table import ErrorTable
+        from .fit import legendre, unit
+        from ..tables.table import ErrorTable
 
         fg = self.figures
         model, ranges, deg = fg.model, fg.ranges, fg.degree
@@ -305,7 +305,7 @@ class Report:
 
     def write_error_tables(self, directory, inputs=()) -> Path:
         """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``)."""
-        from volerr.tables.table import write_error_dir
+        from ..tables.table import write_error_dir
 
         tables, constants = self.error_tables()
         return write_error_dir(directory, tables, constants or None, inputs=list(inputs))
@@ -806,7 +806,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
 def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
     if out_dir is None or not selection.accepted:
         return {}
-    from volerr.fileio import write_text
+    from ..fileio import write_text
 
     out = Path(out_dir)
     inputs = list(inputs) + ([str(data)] if isinstance(data, (str, Path)) else [])
@@ -959,7 +959,7 @@ def demo_campaign(out=None, seed: int = 0, n_points: int = 900, kind: str = "the
     seconds.  Returns ``("MB1", csv_path)``."""
     import tempfile
 
-    from volerr.loop.simulate import demo_probes, simulate
+    from .simulate import demo_probes, simulate
 
     if isinstance(out, int) and not isinstance(out, bool):
         seed, out = out, None

@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.loop import candidates as cands
-from volerr.loop.blocks import BlockBase, blocks, cv_sq
-from volerr.loop.fit import TWIST, rows_of
-from volerr.machine.expressions import evaluate
+from . import candidates as cands
+from .blocks import BlockBase, blocks, cv_sq
+from .fit import TWIST, rows_of
+from ..machine.expressions import evaluate
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
 CV_T = 3.0           # minimum paired t of the held-out improvement
@@ -103,7 +103,7 @@ class Context:
                        {"fixed": self.cache.setdefault("fixed", {})})
 
     def values(self, full: bool = False):
-        from volerr.loop.fit import rotary_rad
+        from .fit import rotary_rad
 
         key = ("_values", full)
         if key not in self.cache:
@@ -118,7 +118,7 @@ class Context:
         ``idx`` of each ``slot``)."""
         if self.sens is not None:
             return self.sens[idx], self.twist[idx]
-        from volerr.loop.fit import twist_sensitivity
+        from .fit import twist_sensitivity
 
         last = self.cache.get(slot)
         if last is not None and np.array_equal(last[0], idx):

@@ -33,8 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.machine.model import Model, load
+from ..errors import InputError, require
+from ..machine.model import Model, load
 
 #: effect kind -> the keys it accepts (besides "kind")
 EFFECT_KEYS = {"thermal": {"axis", "ppm_per_K"}, "drift": {"direction", "um_per_h"},
@@ -83,7 +83,7 @@ class Campaign:
 
     def write_csv(self, path, inputs=()) -> Path:
         """Write the measured-deviation CSV (INTERFACE.md) atomically; returns the path."""
-        from volerr.fileio import write_text
+        from ..fileio import write_text
 
         cols = self.columns()
         names = list(cols)

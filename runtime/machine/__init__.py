@@ -4,7 +4,7 @@ hold, and the generated error model loaded from it (:class:`Model`, :func:`load`
 The derivation is reached through one door, :func:`volerr.machine.derivation.generate_source`.
 """
 
-from volerr.machine.layout import Layout, layout_names, read_layout
-from volerr.machine.model import Model, load
+from .layout import Layout, layout_names, read_layout
+from .model import Model, load
 
 __all__ = ["Layout", "Model", "layout_names", "load", "read_layout"]

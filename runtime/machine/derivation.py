@@ -21,7 +21,7 @@ import tempfile
 import types
 from pathlib import Path
 
-from volerr.machine.layout import Layout
+from .layout import Layout
 
 
 def generate_source(layout: Layout) -> str:

@@ -20,7 +20,7 @@ import functools
 
 import numpy as np
 
-from volerr.errors import InputError
+from ..errors import InputError
 
 FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "sqrt": np.sqrt, "abs": np.abs,
              "ind": lambda a, b: (np.asarray(a) == np.asarray(b)).astype(float),

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from volerr.errors import InputError, require
+from ..errors import InputError, require
 
 LINEAR_COMPONENTS = ("EX", "EY", "EZ", "EA", "EB", "EC")
 #: squareness name -> (rotation axis index, carrier axis, reference axis)
@@ -157,7 +157,7 @@ class Layout:
     @property
     def covariates(self) -> tuple[str, ...]:
         """Names in effect bases that are not axes (data columns such as ``T_C``), sorted."""
-        from volerr.machine.expressions import variables
+        from .expressions import variables
 
         names = {v for e in self.effects for t in e.terms for v in variables(t.basis)}
         return tuple(sorted(names - set(self.axes) - set(self.parameters)))
@@ -166,7 +166,7 @@ class Layout:
     def parameter_kind(self) -> dict:
         """Parameter name -> kind: ``translational``, ``angular``, ``squareness``,
         ``location`` or ``effect`` (:mod:`volerr.machine.iso_names`)."""
-        from volerr.machine.iso_names import kind_of
+        from .iso_names import kind_of
 
         builtin = {n for a in self.axes.values() for n in a.component_errors
                    + a.location_errors} | set(self.squareness)
@@ -341,7 +341,7 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
 
 def _check_expressions(where: str, params: dict, axes: dict, frames: dict) -> None:
     """Expressions in points, translations and angles: valid, and only declared [parameters]."""
-    from volerr.machine.expressions import variables
+    from .expressions import variables
 
     items = [(f"axis {a.name} point", v) for a in axes.values() for v in a.point]
     for f in frames.values():
@@ -364,7 +364,7 @@ def _check_expressions(where: str, params: dict, axes: dict, frames: dict) -> No
 
 def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str) -> tuple:
     """Validate ``[effects.NAME]`` tables -> tuple of :class:`Effect`."""
-    from volerr.machine.expressions import variables
+    from .expressions import variables
 
     require(isinstance(raw, dict), f"{where}: [effects] must be tables [effects.NAME]")
     targets = {n for a in axes.values() for n in a.component_errors + a.location_errors}

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.machine.derivation import derive_module
-from volerr.machine.layout import Layout, read_layout
+from ..errors import InputError, require
+from .derivation import derive_module
+from .layout import Layout, read_layout
 
 
 def _module_for(layout: Layout, name_or_path) -> types.ModuleType:
@@ -424,7 +424,7 @@ class Model:
         axis ``target`` (N, 6) = x, y, z, i, j, k; ``near`` picks the branch, the turn and an
         undetermined rotary axis (see :func:`volerr.fiveaxis.kinematics.inverse`).  ``probe``:
         tool offset (3,) mm, ``tool=`` an alias."""
-        from volerr.fiveaxis.kinematics import inverse
+        from ..fiveaxis.kinematics import inverse
 
         return inverse(self, target, _offset(probe, tool), near)
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.units import UM_PER_MM
+from ..units import UM_PER_MM
 
 from ._io import BWD, FWD, PositioningRun
 

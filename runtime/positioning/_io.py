@@ -55,8 +55,8 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.units import MM_PER_UM, parse_number
+from ..errors import InputError, require
+from ..units import MM_PER_UM, parse_number
 
 FWD, BWD = 0, 1
 DIRECTION_NAMES = ("forward", "backward")

@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.tables import ErrorTable
-from volerr.units import MM_PER_M, UM_PER_MM
+from ..tables import ErrorTable
+from ..units import MM_PER_M, UM_PER_MM
 
 from ._evaluate import Evaluation
 
@@ -121,7 +121,7 @@ def plot_runs(evaluations, path=None) -> bytes:
     plt.close(fig)
     data = buf.getvalue()
     if path is not None:
-        from volerr.fileio import write_bytes
+        from ..fileio import write_bytes
         write_bytes(path, data)
     return data
 
@@ -275,7 +275,7 @@ def error_table(ev: Evaluation) -> ErrorTable:
 
     The repeatability S_i itself is not a table column of :class:`ErrorTable`; see
     :func:`repeatability` and :func:`error_table_csv`."""
-    from volerr.errors import require
+    from ..errors import require
 
     a = ev.run.axis
     require(a in "XYZ", f"--table-out: axis {a} has no ISO 230-1 positioning parameter in the "
@@ -295,7 +295,7 @@ def error_table_csv(ev: Evaluation) -> str:
     """CSV text of :func:`error_table` plus the column ``S_<axis>_um``: the pooled
     single-reading repeatability S_i (um), the scatter of one positioning.  The error-table
     reader ignores that column (it is no error parameter); ``EXX_std_um`` is S_i / sqrt(2 n)."""
-    from volerr.tables import table_to_csv
+    from ..tables import table_to_csv
 
     t = error_table(ev)
     lines = table_to_csv(t).splitlines()

@@ -28,8 +28,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from volerr.errors import require
-from volerr.units import UM_PER_MM
+from ..errors import require
+from ..units import UM_PER_MM
 
 from ._io import PositioningRun
 

@@ -2,14 +2,14 @@
 error map, outliers), probing plans (Pahk's 101 points), and the probe plots.
 """
 
-from volerr.probe.calibration import ProbeCalibration, ProbeMap, calibrate, fit_sphere
+from .calibration import ProbeCalibration, ProbeMap, calibrate, fit_sphere
 
 __all__ = ["ProbeCalibration", "ProbeMap", "calibrate", "fit_sphere"]
 
 
 def __getattr__(name):
     # names of the former flat module volerr.probe, still importable from here
-    from volerr.probe import calibration as _m
+    from . import calibration as _m
     try:
         return getattr(_m, name)
     except AttributeError:

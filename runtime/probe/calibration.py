@@ -49,9 +49,9 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.units import MM_PER_UM, UM_PER_MM, parse_number
-from volerr.errors import InputError, require
-from volerr.probe.fits import (MAX_CONDITION, MAX_DEGREE, MIN_POINTS, OUTLIER_K,  # noqa: F401
+from ..units import MM_PER_UM, UM_PER_MM, parse_number
+from ..errors import InputError, require
+from .fits import (MAX_CONDITION, MAX_DEGREE, MIN_POINTS, OUTLIER_K,  # noqa: F401
                                PLANE_RATIO, RIDGE, SCALE_FLOOR_MM, SHFit, SphereFit,
                                check_sphere_points, fit_sh, fit_sphere, max_degree_for,
                                robust_flags, sh_design)

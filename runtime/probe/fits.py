@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.errors import require
-from volerr.units import UM_PER_MM
+from ..errors import require
+from ..units import UM_PER_MM
 
 #: fewest points the calibration accepts: 4 sphere unknowns plus redundancy for the error map
 MIN_POINTS = 6

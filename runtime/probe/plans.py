@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.units import MM_PER_UM
-from volerr.errors import require
-from volerr.probe.calibration import directions_of
+from ..units import MM_PER_UM
+from ..errors import require
+from .calibration import directions_of
 
 
 @dataclass
@@ -110,7 +110,7 @@ def simulate_demo_sphere(path, seed: int = 1995, center=(250.0, 180.0, -120.0),
     25.006 mm sphere, 1.006 mm ball, vertical probe, Pahk's 101-point plan, the
     :func:`pahk_like_pretravel` kinematic probe and ``noise_mm`` Gaussian noise per axis.
     Returns ``{"path", "sphere_radius_mm", "ball_radius_mm", "center_mm", "n_points"}``."""
-    from volerr.fileio import write_text
+    from ..fileio import write_text
 
     plan = pahk_plan()
     pts = simulate_probing(plan, center, 25.006, 1.006, noise_mm=noise_mm, rng=seed)

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.units import UM_PER_MM
-from volerr.probe.calibration import unit_vectors
+from ..units import UM_PER_MM
+from .calibration import unit_vectors
 
 
 def _grid(cal, n_phi: int = 61, n_theta: int = 121):

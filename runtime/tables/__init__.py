@@ -4,17 +4,17 @@
 controller exchange formats (ISG, Etalon, :mod:`.controller`).
 """
 
-from volerr.tables.table import (ErrorTable, read_constants, read_error_dir, read_error_table,
+from .table import (ErrorTable, read_constants, read_error_dir, read_error_table,
                                  table_to_csv, write_constants, write_error_dir,
                                  write_error_table)
-from volerr.tables.functions import ErrorFunctions  # noqa: E402 (after .table: it imports it)
+from .functions import ErrorFunctions  # noqa: E402 (after .table: it imports it)
 
 __all__ = ["ErrorFunctions", "ErrorTable", "read_constants", "read_error_dir", "read_error_table", "table_to_csv", "write_constants", "write_error_dir", "write_error_table"]
 
 
 def __getattr__(name):
     # names of the former flat module volerr.tables, still importable from here
-    from volerr.tables import table as _m
+    from . import table as _m
     try:
         return getattr(_m, name)
     except AttributeError:

@@ -46,11 +46,11 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.fileio import check_header, check_magnitude
-from volerr.machine import iso_names
-from volerr.tables.table import ErrorTable, axis_unit
-from volerr.units import format_number
+from ..errors import InputError, require
+from ..fileio import check_header, check_magnitude
+from ..machine import iso_names
+from .table import ErrorTable, axis_unit
+from ..units import format_number
 
 FORMATS = ("isg", "etalon")
 _COMPONENT = re.compile(r"^E([XYZABC])([XYZABC])$")

@@ -20,11 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volerr.units import UM_PER_MM, URAD_PER_RAD
-from volerr.errors import InputError, require
-from volerr.tables import legendre
-from volerr.tables.functions import make_function
-from volerr.tables.table import ErrorTable, parameter_kind
+from ..units import UM_PER_MM, URAD_PER_RAD
+from ..errors import InputError, require
+from . import legendre
+from .functions import make_function
+from .table import ErrorTable, parameter_kind
 
 METHODS = ("poly", "smooth", "linear", "cubic")
 

@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.tables import legendre
-from volerr.tables.table import axis_unit, read_error_dir
+from ..errors import InputError, require
+from . import legendre
+from .table import axis_unit, read_error_dir
 
 
 # ---------------------------------------------------------------------------------------------
@@ -107,7 +107,7 @@ class ErrorFunctions:
                  degree: int | None = None, extrapolate: bool = False,
                  constants_std: dict | None = None, source: str = ""):
         if isinstance(model, str):
-            from volerr.machine.model import load
+            from ..machine.model import load
             model = load(model)
         require(method in METHODS, f"unknown interpolation method {method!r} (linear, cubic, poly)")
         require(degree is None or method == "poly", "a polynomial degree needs method 'poly'")
@@ -150,7 +150,7 @@ class ErrorFunctions:
                  extrapolate: bool = False) -> "ErrorFunctions":
         """Read an error directory (``X.csv`` ... ``constants.csv``) for ``model``."""
         if isinstance(model, str):
-            from volerr.machine.model import load
+            from ..machine.model import load
             model = load(model)
         tables, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
         cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}

@@ -51,10 +51,10 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.machine import iso_names
-from volerr.units import MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number, parse_number
-from volerr.errors import InputError, require
-from volerr.fileio import check_magnitude, read_csv_rows, write_text
+from ..machine import iso_names
+from ..units import MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number, parse_number
+from ..errors import InputError, require
+from ..fileio import check_magnitude, read_csv_rows, write_text
 
 #: unit suffix -> (kind, factor to mm or rad)
 UNITS = {"um": ("length", MM_PER_UM), "mm": ("length", 1.0), "urad": ("angle", RAD_PER_URAD),
@@ -419,5 +419,5 @@ def write_error_dir(directory, tables: dict, constants: dict | None = None,
 
 
 # error functions live in volerr.tables.functions; their names stay importable from here
-from volerr.tables.functions import (METHODS, ErrorFunctions, choose_degree,  # noqa: E402,F401
+from .functions import (METHODS, ErrorFunctions, choose_degree,  # noqa: E402,F401
                                      loo_press, make_function)

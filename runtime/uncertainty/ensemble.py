@@ -39,9 +39,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.machine import iso_names
-from volerr.errors import InputError, require
-from volerr.units import MM_PER_UM
+from ..machine import iso_names
+from ..errors import InputError, require
+from ..units import MM_PER_UM
 
 from . import iso10360
 from .iso10360 import Spec, parse_spec  # noqa: F401  (re-exported)
@@ -93,7 +93,7 @@ class TableParameter(Source):
         return self.parameter
 
     def prepare(self, model, task, ctx):
-        from volerr.tables import make_function
+        from ..tables import make_function
 
         q = np.asarray(task.positions[self.axis], dtype=float)
         if self.mode == "repeatability":

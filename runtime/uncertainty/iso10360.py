@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.errors import require
-from volerr.units import MM_PER_UM, UM_PER_MM
+from ..errors import require
+from ..units import MM_PER_UM, UM_PER_MM
 
 from .tasks import check_travel
 
@@ -236,7 +236,7 @@ def plot(result: TestResult, path, title: str, inputs=()) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from volerr.fileio import write_bytes
+    from ..fileio import write_bytes
 
     fig, ax = plt.subplots(figsize=(8, 5))
     markers = "os^vD<>"

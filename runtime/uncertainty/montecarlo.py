@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from volerr.errors import require
-from volerr.units import UM_PER_MM
+from ..errors import require
+from ..units import UM_PER_MM
 
 from .tasks import EVALUATIONS, check_task, check_travel, evaluate
 
@@ -33,7 +33,7 @@ _MODELS: dict = {}
 def _model(layout: str):
     """Model by layout name or path, cached per process (workers reload it by name)."""
     if layout not in _MODELS:
-        from volerr.machine.model import load
+        from ..machine.model import load
         _MODELS[layout] = load(layout)
     return _MODELS[layout]
 
@@ -215,13 +215,13 @@ class Runner:
             try:
                 from dask.distributed import Client, LocalCluster
             except ImportError:
-                from volerr.errors import InputError
+                from ..errors import InputError
                 raise InputError("--scheduler dask needs dask: pip install 'volerr[dask]'") from None
             if self.address:
                 try:
                     self._client = Client(self.address, timeout="10s")
                 except OSError as exc:
-                    from volerr.errors import InputError
+                    from ..errors import InputError
                     raise InputError(f"cannot reach the dask scheduler at {self.address}: "
                                      f"{exc}") from None
             else:

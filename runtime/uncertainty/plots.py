@@ -7,7 +7,7 @@ import io
 
 import numpy as np
 
-from volerr.units import UM_PER_MM
+from ..units import UM_PER_MM
 
 
 def _fig_bytes(fig, tight: bool = True, dpi: int = 100) -> bytes:

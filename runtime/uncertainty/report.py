@@ -8,7 +8,7 @@ from __future__ import annotations
 import base64
 import html
 
-from volerr.units import UM_PER_MM
+from ..units import UM_PER_MM
 
 
 def num(value, spec: str) -> str:

@@ -27,9 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from volerr.errors import InputError, require
-from volerr.fileio import read_csv_rows
-from volerr.units import parse_number
+from ..errors import InputError, require
+from ..fileio import read_csv_rows
+from ..units import parse_number
 
 EVALUATIONS = {
     "distance": ("distance",),
