@@ -80,33 +80,6 @@ def _initial(text: str) -> dict:
     return out
 
 
-def report_csv(model, reports) -> str:
-    """The report CSV of a :class:`volerr.fiveaxis.compensate.Result`'s line reports (the
-    command streams the same rows with :func:`volerr.fiveaxis.program.report_rows`)."""
-    unit = {a: ("deg" if a in model.rotary_axes else "mm") for a in model.axes}
-    cols = ["line", "status"] + [f"{a}_nominal_{unit[a]}" for a in model.axes] + \
-        [f"{a}_out_{unit[a]}" for a in model.axes] + \
-        ["dx_before_um", "dy_before_um", "dz_before_um", "e_before_um",
-         "dx_after_um", "dy_after_um", "dz_after_um", "e_after_um",
-         "orientation_before_urad", "orientation_after_urad", "iterations",
-         "ux_after_um", "uy_after_um", "uz_after_um"]
-    rows = [",".join(cols)]
-
-    def f(v):
-        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.10g}"
-
-    for r in reports:
-        eb = math.sqrt(sum(v * v for v in r.before_um))
-        ea = math.sqrt(sum(v * v for v in r.after_um))
-        vals = [str(r.line), r.status.replace(",", ";")]
-        vals += [f(r.nominal[a]) for a in model.axes] + [f(r.output[a]) for a in model.axes]
-        vals += [f(v) for v in r.before_um] + [f(eb)] + [f(v) for v in r.after_um] + [f(ea)]
-        vals += [f(r.orientation_before_urad), f(r.orientation_after_urad), str(r.iterations)]
-        vals += [f(v) for v in r.u_after_um]
-        rows.append(",".join(vals))
-    return "\n".join(rows) + "\n"
-
-
 def run(args) -> int:
     import sys
 
