@@ -77,24 +77,15 @@ def default_mode() -> int:
 
 def write_bytes(path, data: bytes, inputs=()) -> Path:
     """Write ``data`` to ``path`` atomically (temporary file + rename), refusing inputs."""
-    out = check_output(path, inputs)
+    out = AtomicFile(path, inputs)
     try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise InputError(f"cannot write {out}: {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, default_mode())
-        os.replace(tmp, out)
+        out.write(data)
     except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        out.discard()
         if isinstance(exc, OSError):
-            raise InputError(f"cannot write {out}: {exc.strerror or exc}") from None
+            raise InputError(f"cannot write {out.path}: {exc.strerror or exc}") from None
         raise
-    return out
+    return out.commit()
 
 
 #: the largest magnitude accepted for a number read from a data file (mm, um, urad, deg ...):

@@ -19,8 +19,6 @@ smallest box edge); the random component as its own figure (nominal grid with +-
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,7 +27,7 @@ import numpy as np
 from ..units import UM_PER_MM
 from ..errors import InputError, require
 from . import csvformat
-from ..fileio import AtomicFile, check_output
+from ..fileio import AtomicFile, check_plot
 
 
 @dataclass
@@ -208,22 +206,16 @@ def write_map_csv(path, vmap: VolumetricMap, inputs=()) -> Path:
 # plots
 def save_figure(fig, path, inputs=()) -> Path:
     """Save a matplotlib figure as PNG atomically, never over an input file."""
-    out = check_output(path, inputs)
-    require(out.suffix.lower() == ".png", f"plot file must end in .png, got {out.name}")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".png")
-    os.close(fd)
+    out = AtomicFile(check_plot(path, inputs), inputs)
     try:
-        fig.savefig(tmp, dpi=120)
-        from ..fileio import default_mode
-        os.chmod(tmp, default_mode())
-        os.replace(tmp, out)
+        fig.savefig(out.fh, format="png", dpi=120)
+    except BaseException:
+        out.discard()
+        raise
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
         import matplotlib.pyplot as plt
         plt.close(fig)
-    return out
+    return out.commit()
 
 
 def auto_magnification(vmap: VolumetricMap, values: np.ndarray) -> float:

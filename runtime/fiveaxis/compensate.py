@@ -203,9 +203,10 @@ def close_periodic(tables_: dict, model) -> tuple[dict, list[str]]:
 
 def error_functions(directory, model, method: str = "linear", degree=None,
                     extrapolate: bool = False):
-    """:class:`volerr.tables.table.ErrorFunctions` of an error directory, endless rotary axes closed
+    """:class:`volerr.tables.functions.ErrorFunctions` of an error directory, endless rotary axes closed
     over the full turn (:func:`close_periodic`).  Returns (functions, notes)."""
-    from ..tables.table import ErrorFunctions, read_error_dir
+    from ..tables.functions import ErrorFunctions
+    from ..tables.table import read_error_dir
 
     tabs, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
     tabs, notes = close_periodic(tabs, model)

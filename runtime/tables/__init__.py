@@ -7,7 +7,7 @@ controller exchange formats (ISG, Etalon, :mod:`.controller`).
 from .table import (ErrorTable, read_constants, read_error_dir, read_error_table,
                                  table_to_csv, write_constants, write_error_dir,
                                  write_error_table)
-from .functions import ErrorFunctions  # noqa: E402 (after .table: it imports it)
+from .functions import ErrorFunctions
 
 __all__ = ["ErrorFunctions", "ErrorTable", "read_constants", "read_error_dir", "read_error_table", "table_to_csv", "write_constants", "write_error_dir", "write_error_table"]
 

@@ -418,6 +418,12 @@ def write_error_dir(directory, tables: dict, constants: dict | None = None,
     return d
 
 
-# error functions live in volerr.tables.functions; their names stay importable from here
-from .functions import (METHODS, ErrorFunctions, choose_degree,  # noqa: E402,F401
-                                     loo_press, make_function)
+#: names that moved to :mod:`volerr.tables.functions`, still importable from here
+_MOVED = ("METHODS", "ErrorFunctions", "choose_degree", "loo_press", "make_function")
+
+
+def __getattr__(name):
+    if name in _MOVED:
+        from . import functions
+        return getattr(functions, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
