@@ -164,12 +164,22 @@ def format_numbers(values, nd, keep, plus, template=None) -> list:
     the template (-1 without a dot in it), ``plus`` the template starts with ``+``.
     ``template(i)`` gives the template text of value ``i`` for the few values within rounding
     noise of a decimal tie, which are formatted by Python (None: an empty template)."""
+    flat, lens, _ = format_bytes(values, nd, keep, plus, template)
+    text = flat.tobytes().decode("ascii")
+    ends = np.cumsum(lens).tolist()
+    return [text[a:b] for a, b in zip([0] + ends[:-1], ends)]
+
+
+def format_bytes(values, nd, keep, plus, template=None):
+    """:func:`format_numbers` as ASCII bytes, built digit column by digit column without a
+    Python string per number: returns (all texts one after the other as a uint8 array, the
+    length of each text (n,), the value of each text (n,) -- what ``float(text)`` gives)."""
     v = np.asarray(values, dtype=float)
     nd = np.asarray(nd, dtype=np.int64)
     keep = np.asarray(keep, dtype=np.int64)
     plus = np.asarray(plus, dtype=bool)
     if not len(v):
-        return []
+        return np.zeros(0, np.uint8), np.zeros(0, np.int64), np.zeros(0)
     x = v * _POW10[nd]
     ax = np.abs(x)
     ok = ax < 2.0 ** 52
@@ -189,10 +199,39 @@ def format_numbers(values, nd, keep, plus, template=None) -> list:
     shift = nd - d
     dg = np.where(shift >= 0, fp // _IPOW10[np.maximum(shift, 0)],
                   fp * _IPOW10[np.maximum(-shift, 0)])
-    sg = np.where(neg, "-", np.where(plus, "+", "")).tolist()
-    out = ["%s%d.%0*d" % (s, i, k, g) if k else "%s%d" % (s, i)
-           for s, i, g, k in zip(sg, ip.tolist(), dg.tolist(), d.tolist())]
-    for i in np.flatnonzero(risky):
-        t = template(i) if template is not None else ""
-        out[i] = gcode.format_number(float(v[i]), int(nd[i]), t)
-    return out
+    # the value of the text: integer / power of ten, one correctly rounded division as in
+    # float(text); + 0.0 makes -0.0 (a negative number rounded to zero) plain 0.0
+    val = np.where(neg, -a, a) / _POW10[np.minimum(nd, 22)] + 0.0
+    # lengths: sign, integer digits, dot and decimals
+    signed = neg | plus
+    n_int = np.ones(len(v), dtype=np.int64)
+    for k in range(1, 19):
+        n_int += ip >= _IPOW10[k]
+    lens = signed + n_int + np.where(d > 0, d + 1, 0)
+    slow = np.flatnonzero(risky)
+    slow_text = []
+    for i in slow:
+        t = gcode.format_number(float(v[i]), int(nd[i]),
+                                template(i) if template is not None else "")
+        slow_text.append(t.encode("ascii"))
+        lens[i] = len(t)
+        val[i] = float(t)
+    start = np.zeros(len(v), dtype=np.int64)
+    np.cumsum(lens[:-1], out=start[1:])
+    flat = np.empty(int(lens.sum()), dtype=np.uint8)
+    fast = ~risky
+    at = start + signed
+    m = fast & signed
+    flat[start[m]] = np.where(neg[m], ord("-"), ord("+"))
+    for k in range(int(n_int[fast].max()) if fast.any() else 0):
+        m = fast & (k < n_int)
+        flat[at[m] + k] = 48 + (ip[m] // _IPOW10[n_int[m] - 1 - k]) % 10
+    at = at + n_int
+    m = fast & (d > 0)
+    flat[at[m]] = ord(".")
+    for k in range(int(d[fast].max()) if fast.any() else 0):
+        m = fast & (k < d)
+        flat[at[m] + 1 + k] = 48 + (dg[m] // _IPOW10[d[m] - 1 - k]) % 10
+    for i, t in zip(slow, slow_text):
+        flat[start[i]:start[i] + len(t)] = np.frombuffer(t, dtype=np.uint8)
+    return flat, lens, val

@@ -284,6 +284,8 @@ class ErrorModel:
                 break
         else:
             e = self.funcs(self._clip_edges(self.lookup(q)))
+            # constants as scalars: the generated code then takes their sin/cos once
+            e.update({k: float(v) for k, v in self.funcs.constants.items()})
             memo.insert(0, (np.array(q, dtype=float, copy=True), e))
             del memo[2:]
         if subset is not None:

@@ -463,11 +463,10 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
     span_s, span_e = sc.num_start[w][ax][ci], sc.num_end[w][ax][ci]
     fr, pl = sc.frac[w][ax][ci], sc.plus[w][ax][ci]
     text = sc.text
-    texts = chunkscan.format_numbers(want[change], nd[change], fr, pl,
-                                     lambda k: text[span_s[k]:span_e[k]])
+    flat, lens, new_vals = chunkscan.format_bytes(want[change], nd[change], fr, pl,
+                                                  lambda k: text[span_s[k]:span_e[k]])
     wvals = wv.copy()
-    if len(ci):
-        wvals[ci] = np.array([float(t) for t in texts])
+    wvals[ci] = new_vals
     # positions held after every line from the programmed words (as written)
     val = np.full((m, nax), np.nan)
     val[wl, wa] = wvals
@@ -510,15 +509,16 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
         elif li >= 0:
             pos[a] = float(val[li, c])
     # the edits: a line that gets a word is rewritten whole, else its numbers are replaced
+    if not added:
+        edits.add_bytes(span_s, span_e, flat, lens)
+        return
+    ends = np.cumsum(lens).tolist()
+    texts = [flat[a:b].tobytes().decode("ascii") for a, b in zip([0] + ends[:-1], ends)]
     line_of = wl[ci]
     by_line = {}
-    if added:
-        for k, li in enumerate(line_of.tolist()):
-            if li in added:
-                by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
-    if not added:
-        edits.extend(zip(span_s.tolist(), span_e.tolist(), texts))
-        return
+    for k, li in enumerate(line_of.tolist()):
+        if li in added:
+            by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
     own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
                                                           texts))
            if int(line_of[k]) not in added]
@@ -529,7 +529,74 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
         own.append((s0, s0 + len(b.segs[i]),
                     gcode.rewrite_line(line, by_line.get(li, {}), add, spaced)))
     own.sort()
-    edits.extend(own)
+    for s0, e0, t in own:
+        edits.add(s0, e0, t)
+
+
+class _Edits:
+    """Replacements (start, end, new text) of a chunk's text, in text order; most come as
+    arrays of spans with their new texts as ASCII bytes (:func:`_write_run`), the others one
+    by one as strings (lines written by the rule, lines that get a word)."""
+
+    def __init__(self):
+        self.batches = []   # (starts, ends, new texts: (flat uint8, lengths) or list of str)
+        self.one = []       # pending single edits (start, end, str)
+
+    def add(self, start: int, end: int, text: str) -> None:
+        self.one.append((start, end, text))
+
+    def add_bytes(self, starts, ends, flat, lens) -> None:
+        self._flush()
+        self.batches.append((np.asarray(starts, np.int64), np.asarray(ends, np.int64),
+                             (flat, np.asarray(lens, np.int64))))
+
+    def _flush(self) -> None:
+        if self.one:
+            s0, e0, t = zip(*self.one)
+            self.batches.append((np.array(s0, np.int64), np.array(e0, np.int64), list(t)))
+            self.one = []
+
+    def apply(self, text: str) -> str:
+        """``text`` with the replacements made (spans in text order, not overlapping)."""
+        self._flush()
+        if not self.batches:
+            return text
+        starts = np.concatenate([s0 for s0, _, _ in self.batches])
+        ends = np.concatenate([e0 for _, e0, _ in self.batches])
+        try:
+            b = np.frombuffer(text.encode("latin-1"), np.uint8)
+            new = [t if isinstance(t, tuple) else
+                   (np.frombuffer("".join(t).encode("latin-1"), np.uint8),
+                    np.array([len(x) for x in t], np.int64))
+                   for _, _, t in self.batches]
+        except UnicodeEncodeError:      # a str program with characters beyond latin-1
+            return self._apply_str(text, starts, ends)
+        flat = np.concatenate([f for f, _ in new])
+        lens = np.concatenate([n for _, n in new])
+        n = len(b)
+        cover = np.cumsum(np.bincount(starts, minlength=n + 1)
+                          - np.bincount(ends, minlength=n + 1))[:n] > 0
+        removed = np.zeros(len(starts), dtype=np.int64)
+        np.cumsum((ends - starts)[:-1], out=removed[1:])
+        out = np.insert(b[~cover], np.repeat(starts - removed, lens), flat)
+        return out.tobytes().decode("latin-1")
+
+    def _apply_str(self, text: str, starts, ends) -> str:
+        new = []
+        for _, _, t in self.batches:
+            if isinstance(t, tuple):
+                flat, lens = t
+                s = flat.tobytes().decode("ascii")
+                cut = np.r_[0, np.cumsum(lens)].tolist()
+                new += [s[a:b] for a, b in zip(cut[:-1], cut[1:])]
+            else:
+                new += t
+        out, prev = [], 0
+        for s0, e0, t in zip(starts.tolist(), ends.tolist(), new):
+            out += [text[prev:s0], t]
+            prev = e0
+        out.append(text[prev:])
+        return "".join(out)
 
 
 def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axes,
@@ -537,7 +604,7 @@ def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axe
     """The chunk's output text: original bytes except the changed / added axis words.
     ``written`` (the positions the output program leaves the controller at) is updated."""
     b = blocks
-    edits = []
+    edits = _Edits()
     q_list = nd_list = None
     starts = b.scan.start
     runs = iter(b.runs)
@@ -555,17 +622,9 @@ def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axe
             q_list, nd_list = q_out.tolist(), b.nd.tolist()
         t = _write_line(line, step, r, q_list, nd_list, written, axes, spaced)
         if r >= 0 and t != b.segs[i]:
-            edits.append((int(starts[i]), int(starts[i]) + len(b.segs[i]), t))
+            edits.add(int(starts[i]), int(starts[i]) + len(b.segs[i]), t)
         i += 1
-    if not edits:
-        return b.scan.text
-    text = b.scan.text
-    s0, e0, t = zip(*edits)
-    out = [""] * (2 * len(edits) + 1)
-    out[0:-1:2] = [text[p:q] for p, q in zip((0,) + e0[:-1], s0)]
-    out[1::2] = t
-    out[-1] = text[e0[-1]:]
-    return "".join(out)
+    return edits.apply(b.scan.text)
 
 
 # ---------------------------------------------------------------------------------------

@@ -53,6 +53,47 @@ class _Linear:
         return out
 
 
+class _LinearGroup:
+    """Piecewise-linear functions of one axis sharing its table positions, evaluated together:
+    one bracket search for all of them, then one gather per value row.  Values equal
+    ``numpy.interp`` inside the range (same slope formula, same operation order) and
+    :class:`_Linear`'s end segments outside it."""
+
+    def __init__(self, x, ys: dict):
+        self.x = np.asarray(x, float)
+        self.names = list(ys)
+        self.y = np.array([np.asarray(ys[k], float) for k in self.names]).reshape(len(ys), -1)
+        self.slope = np.diff(self.y, axis=1) / np.diff(self.x)
+        step = np.diff(self.x)
+        #: evenly spaced positions: the bracket comes from arithmetic, then is checked
+        self.inv_step = 1.0 / step.mean() if np.allclose(step, step.mean(), rtol=1e-9) else None
+
+    def bracket(self, q: np.ndarray) -> np.ndarray:
+        """Segment index j per position: x[j] <= q < x[j+1], clipped to the end segments
+        (the same j as a binary search)."""
+        x, last = self.x, len(self.x) - 2
+        if self.inv_step is None:
+            return np.clip(np.searchsorted(x, q, side="right") - 1, 0, last)
+        j = np.clip((q - x[0]) * self.inv_step, 0, last).astype(np.intp)
+        j -= (x.take(j) > q) & (j > 0)          # rounding may put q one segment off
+        j += (x.take(j + 1) <= q) & (j < last)
+        return j
+
+    def __call__(self, q) -> dict:
+        x, y, slope = self.x, self.y, self.slope
+        q = np.asarray(q, float)
+        j = self.bracket(q)
+        out = np.take(slope, j, axis=1) * (q - x.take(j)) + np.take(y, j, axis=1)
+        last = q >= x[-1]
+        if last.any():
+            out[:, last] = y[:, -1:] + (q[last] - x[-1]) * (y[:, -1:] - y[:, -2:-1]) \
+                / (x[-1] - x[-2])
+        first = q < x[0]
+        if first.any():
+            out[:, first] = y[:, :1] + (q[first] - x[0]) * (y[:, 1:2] - y[:, :1]) / (x[1] - x[0])
+        return dict(zip(self.names, out))
+
+
 def make_function(x, y, method: str = "linear", degree: int | None = None):
     """One error function of position from nodes ``x`` (increasing) and values ``y``.
 
@@ -204,10 +245,25 @@ class ErrorFunctions:
         """Error values at ``positions`` ({axis: (N,)} or (N, n_axes), mm / deg): name -> (N,)
         array, mm / rad, for every table parameter and constant."""
         cols, n = self._positions(positions)
-        out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
-               for name, (ax, f) in self.functions.items()}
+        if self.method == "linear":
+            out = {}
+            for ax, group in self._groups().items():
+                out.update(group(cols[ax].reshape(n)))
+            out = {name: out[name] for name in self.functions}
+        else:
+            out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
+                   for name, (ax, f) in self.functions.items()}
         out.update({k: np.full(n, v) for k, v in self.constants.items()})
         return out
+
+    def _groups(self) -> dict:
+        """Axis -> :class:`_LinearGroup` of its table's parameters (built once)."""
+        groups = self.__dict__.get("_linear_groups")
+        if groups is None:
+            groups = {ax: _LinearGroup(t.positions, {k: t.values[k] for k in t.values})
+                      for ax, t in self.tables.items() if t.values}
+            self._linear_groups = groups
+        return groups
 
     def sigmas(self, positions) -> dict:
         """Standard deviations (mm / rad) at ``positions`` (as :meth:`__call__`): name -> (N,)

@@ -68,8 +68,15 @@ def test_format_numbers_is_format_number(items):
     nd = [d for _, d, _ in items]
     t = [s for _, _, s in items]
     keep = [len(s) - s.index(".") - 1 if "." in s else -1 for s in t]
-    got = chunkscan.format_numbers(v, nd, keep, [s.startswith("+") for s in t], lambda i: t[i])
-    assert got == [gcode.format_number(a, d, s) for a, d, s in items]
+    plus = [s.startswith("+") for s in t]
+    got = chunkscan.format_numbers(v, nd, keep, plus, lambda i: t[i])
+    want = [gcode.format_number(a, d, s) for a, d, s in items]
+    assert got == want
+    # the values of the texts come without parsing them: what float() of the text gives
+    _, lens, vals = chunkscan.format_bytes(v, nd, keep, plus, lambda i: t[i])
+    assert list(lens) == [len(w) for w in want]
+    for w, x in zip(want, vals):
+        assert x == float(w) and np.signbit(x) == np.signbit(float(w)), w
 
 
 @pytest.fixture(scope="module")

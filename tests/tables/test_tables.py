@@ -111,6 +111,36 @@ def test_interpolation_exact_at_nodes(tmp_path, method):
         assert f(mid)["EXX"][0] == pytest.approx(1e-6 * (50 - 300) ** 2 / 100, rel=1e-9)
 
 
+@settings(max_examples=60, deadline=None)
+@given(data=st.data(), even=st.booleans())
+def test_linear_functions_equal_numpy_interp_and_the_end_lines(data, even):
+    """All parameters of an axis are interpolated together (one bracket search): inside the
+    range the values are numpy.interp's bit for bit, outside (extrapolate) the end segments
+    extended, for evenly and unevenly spaced tables."""
+    n = data.draw(st.integers(2, 15))
+    x0 = data.draw(st.floats(-500, 500))
+    if even:
+        x = x0 + data.draw(st.floats(0.1, 100)) * np.arange(n)
+    else:
+        x = x0 + np.concatenate([[0.0], np.cumsum(data.draw(
+            st.lists(st.floats(0.01, 100), min_size=n - 1, max_size=n - 1)))])
+    vals = {k: np.array(data.draw(st.lists(finite, min_size=n, max_size=n))) * 1e-6
+            for k in ("EXX", "EYX", "ECX")}
+    f = ErrorFunctions({"X": ErrorTable("X", x, vals)}, None, MB1, extrapolate=True)
+    span = x[-1] - x[0]
+    q = np.concatenate([x, data.draw(st.lists(st.floats(x[0] - span, x[-1] + span),
+                                              min_size=1, max_size=30))])
+    out = f({"X": q, "Y": 0.0 * q, "Z": 0.0 * q})
+    inside = (q >= x[0]) & (q <= x[-1])
+    for k, y in vals.items():
+        assert np.array_equal(out[k][inside], np.interp(q[inside], x, y))
+        lo, hi = q < x[0], q > x[-1]
+        np.testing.assert_allclose(out[k][lo], y[0] + (q[lo] - x[0]) * (y[1] - y[0]) / (x[1] - x[0]),
+                                   rtol=1e-12, atol=1e-18)
+        np.testing.assert_allclose(out[k][hi], y[-1] + (q[hi] - x[-1]) * (y[-1] - y[-2])
+                                   / (x[-1] - x[-2]), rtol=1e-12, atol=1e-18)
+
+
 def test_extrapolation_refused_unless_asked(tmp_path):
     f, _ = _funcs(tmp_path)
     with pytest.raises(InputError, match=r"X = 950 mm is outside the measured range 0 \.\. 900"):
