@@ -93,15 +93,26 @@ def scan(segs: list, axes) -> Scan:
     nxt_num = np.zeros(len(sig), dtype=bool)
     nxt_num[:-1] = isnum[1:] & same_prev[1:]
     bad[ln[isl & ~nxt_num]] = True
-    # numbers: [+-]?(\d+\.?\d*|\.\d+)
+    # numbers: [+-]?(\d+\.?\d*|\.\d+); per run, counts from running sums at its ends
     rid = np.cumsum(run0, dtype=np.int32) - 1
     nr = int(run0.sum())
     rn = rid[isnum]
     cn = c[isnum]
     first = run0[isnum]
-    bad_run = np.bincount(rn[(cn == _SIGN) & ~first], minlength=nr) > 0
-    ndot = np.bincount(rn[cn == _DOT], minlength=nr)
-    ndig = np.bincount(rn[cn == _DIGIT], minlength=nr)
+    run_first = np.flatnonzero(first)
+    run_last = np.empty(nr, dtype=np.int64)
+    run_last[:-1] = run_first[1:] - 1
+    if nr:
+        run_last[-1] = len(rn) - 1
+
+    def per_run(mask):
+        total = np.cumsum(mask, dtype=np.int32)
+        return total[run_last] - total[run_first] + mask[run_first]
+
+    ndot = per_run(cn == _DOT)
+    dig = cn == _DIGIT
+    ndig = per_run(dig)
+    bad_run = per_run(cn == _SIGN) > (cn[run_first] == _SIGN)     # a sign inside the number
     bad_run |= (ndot > 1) | (ndig == 0)
     rline = ln[run0]
     bad[rline[bad_run]] = True
@@ -126,27 +137,27 @@ def scan(segs: list, axes) -> Scan:
     wa = code[fast[ax_line]]
     # digits: mantissa and digits after the dot per run
     pos_num = sig[isnum]
-    run_first = np.flatnonzero(first)
-    run_last = np.r_[run_first[1:], len(rn)][:nr] - 1
     ns, ne = pos_num[run_first], pos_num[run_last] + 1
-    dig = cn == _DIGIT
     dpos = np.flatnonzero(dig)
-    drun = rn[dig]
-    # digits after the dot: digits of the run past its dot
+    # digits after the dot: the characters of the run past its dot (more than one dot or a
+    # sign there makes the line slow anyway)
     dot_at = np.full(nr, -1, dtype=np.int64)
     dots = np.flatnonzero(cn == _DOT)
     dot_at[rn[dots]] = dots
-    after = np.bincount(drun[dpos > dot_at[drun]], minlength=nr)
-    frac = np.where(dot_at >= 0, after, -1)
-    # k-th digit from the end of the run
-    dcount = np.zeros(nr + 1, dtype=np.int32)
+    frac = np.where(dot_at >= 0, run_last - dot_at, -1)
+    # k-th digit from the end of the run (the digits of a run are contiguous in dpos)
+    dcount = np.zeros(nr + 1, dtype=np.int64)
     np.cumsum(ndig, out=dcount[1:])
-    k_from_end = dcount[drun + 1] - np.arange(1, len(drun) + 1, dtype=np.int32)
+    drun_end = np.repeat(dcount[1:], ndig)
+    k_from_end = drun_end - np.arange(1, len(dpos) + 1, dtype=np.int64)
     dval = b[pos_num[dpos]] - 48
     exact = ndig <= 15
     np.minimum(k_from_end, 18, out=k_from_end)
     # float sums of integers below 2**53 are exact (longer mantissas: Python below)
-    mant = np.bincount(drun, weights=_POW10[k_from_end] * dval, minlength=nr)
+    mant = np.zeros(nr)
+    has_dig = ndig > 0
+    if len(dpos):
+        mant[has_dig] = np.add.reduceat(_POW10[k_from_end] * dval, dcount[:-1][has_dig])
     fr = np.maximum(frac, 0)
     val = mant / _POW10[np.minimum(fr, 22)]
     neg = b[ns] == ord("-")

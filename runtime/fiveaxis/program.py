@@ -111,6 +111,8 @@ def prescan(open_source, model, chunk_lines: int = CHUNK_LINES) -> Prescan:
             if len(buf) >= chunk_lines:
                 seen |= _letters(buf, pats, seen)
                 buf = []
+                if len(seen) == len(rot) and spaced is not None:
+                    break       # nothing left to learn from the rest of the program
         seen |= _letters(buf, pats, seen)
     finally:
         if hasattr(fh, "close"):
