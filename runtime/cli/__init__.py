@@ -95,6 +95,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    from ._memory import keep_freed_blocks
+
+    keep_freed_blocks()
     parser = build_parser()
     try:
         args = parser.parse_args(argv)

@@ -59,7 +59,8 @@ class _LinearGroup:
     ``numpy.interp`` inside the range (same slope formula, same operation order) and
     :class:`_Linear`'s end segments outside it."""
 
-    def __init__(self, x, ys: dict):
+    def __init__(self, x, ys: dict, clamp: bool = False):
+        self.clamp = clamp          # outside the range: the end values (numpy.interp's rule)
         self.x = np.asarray(x, float)
         self.names = list(ys)
         self.y = np.array([np.asarray(ys[k], float) for k in self.names]).reshape(len(ys), -1)
@@ -86,11 +87,12 @@ class _LinearGroup:
         out = np.take(slope, j, axis=1) * (q - x.take(j)) + np.take(y, j, axis=1)
         last = q >= x[-1]
         if last.any():
-            out[:, last] = y[:, -1:] + (q[last] - x[-1]) * (y[:, -1:] - y[:, -2:-1]) \
-                / (x[-1] - x[-2])
+            out[:, last] = y[:, -1:] if self.clamp else \
+                y[:, -1:] + (q[last] - x[-1]) * (y[:, -1:] - y[:, -2:-1]) / (x[-1] - x[-2])
         first = q < x[0]
         if first.any():
-            out[:, first] = y[:, :1] + (q[first] - x[0]) * (y[:, 1:2] - y[:, :1]) / (x[1] - x[0])
+            out[:, first] = y[:, :1] if self.clamp else \
+                y[:, :1] + (q[first] - x[0]) * (y[:, 1:2] - y[:, :1]) / (x[1] - x[0])
         return dict(zip(self.names, out))
 
 
@@ -171,6 +173,7 @@ class ErrorFunctions:
                     f"{where}constants: {model.name} has no constant parameter {name} "
                     f"(its constants are {' '.join(p for p in model.parameters if paxis[p] is None)})")
         self.functions, self.std_functions, self.degrees = {}, {}, {}
+        self._std_nodes = {}
         for ax, t in self.tables.items():
             for name, y in t.values.items():
                 try:
@@ -185,6 +188,7 @@ class ErrorFunctions:
                     s = t.u95[name] / 2.0
                 if s is not None:
                     self.std_functions[name] = (ax, _clamped(t.positions, s))
+                    self._std_nodes[name] = np.asarray(s, float)
 
     @classmethod
     def from_dir(cls, directory, model, method: str = "linear", degree: int | None = None,
@@ -256,21 +260,31 @@ class ErrorFunctions:
         out.update({k: np.full(n, v) for k, v in self.constants.items()})
         return out
 
-    def _groups(self) -> dict:
-        """Axis -> :class:`_LinearGroup` of its table's parameters (built once)."""
-        groups = self.__dict__.get("_linear_groups")
+    def _groups(self, std: bool = False) -> dict:
+        """Axis -> :class:`_LinearGroup` of its table's parameters (``std``: of their standard
+        deviations, clamped at the ends); built once."""
+        key = "_std_groups" if std else "_linear_groups"
+        groups = self.__dict__.get(key)
         if groups is None:
-            groups = {ax: _LinearGroup(t.positions, {k: t.values[k] for k in t.values})
-                      for ax, t in self.tables.items() if t.values}
-            self._linear_groups = groups
+            groups = {}
+            for ax, t in self.tables.items():
+                ys = {name: t.values[name] for name in t.values if name in self.functions}
+                if std:
+                    ys = {name: self._std_nodes[name] for name, (a, _) in
+                          self.std_functions.items() if a == ax}
+                if ys:
+                    groups[ax] = _LinearGroup(t.positions, ys, clamp=std)
+            self.__dict__[key] = groups
         return groups
 
     def sigmas(self, positions) -> dict:
         """Standard deviations (mm / rad) at ``positions`` (as :meth:`__call__`): name -> (N,)
         array; a ``u95`` column without ``std`` counts as ``u95 / 2``."""
         cols, n = self._positions(positions)
-        out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
-               for name, (ax, f) in self.std_functions.items()}
+        out = {}
+        for ax, group in self._groups(std=True).items():
+            out.update(group(cols[ax].reshape(n)))
+        out = {name: out[name] for name in self.std_functions}
         out.update({k: np.full(n, v) for k, v in self.constants_std.items()})
         return out
 

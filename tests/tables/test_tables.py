@@ -126,11 +126,16 @@ def test_linear_functions_equal_numpy_interp_and_the_end_lines(data, even):
             st.lists(st.floats(0.01, 100), min_size=n - 1, max_size=n - 1)))])
     vals = {k: np.array(data.draw(st.lists(finite, min_size=n, max_size=n))) * 1e-6
             for k in ("EXX", "EYX", "ECX")}
-    f = ErrorFunctions({"X": ErrorTable("X", x, vals)}, None, MB1, extrapolate=True)
+    sd = {"EXX": np.abs(vals["EXX"]) + 1e-7, "ECX": np.abs(vals["ECX"])}
+    f = ErrorFunctions({"X": ErrorTable("X", x, vals, std=sd)}, None, MB1, extrapolate=True)
     span = x[-1] - x[0]
     q = np.concatenate([x, data.draw(st.lists(st.floats(x[0] - span, x[-1] + span),
                                               min_size=1, max_size=30))])
     out = f({"X": q, "Y": 0.0 * q, "Z": 0.0 * q})
+    sig = f.sigmas({"X": q, "Y": 0.0 * q, "Z": 0.0 * q})
+    assert set(sig) == set(sd)
+    for k, y in sd.items():     # standard deviations: clamped at the ends, as numpy.interp
+        assert np.array_equal(sig[k], np.interp(q, x, y))
     inside = (q >= x[0]) & (q <= x[-1])
     for k, y in vals.items():
         assert np.array_equal(out[k][inside], np.interp(q[inside], x, y))
