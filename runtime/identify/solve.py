@@ -301,9 +301,23 @@ def _detect_sense(kind, pts, steps, d, o, name, sense):
     return s
 
 
+def _same_everywhere(M: np.ndarray) -> bool:
+    """True when every position has the same matrix (a linear axis: the lever arms do not
+    change along the travel), so that one inverse serves all."""
+    return bool(len(M)) and bool(np.all(M == M[:1]))
+
+
 def _solve(A, W, delta):
     """Batched weighted least squares. A (K, n, 3, 6), W (K, n, 3, 3) or None, delta (K, n, 3).
     Returns theta (K, 6), Ninv (K, 6, 6)."""
+    K, n = A.shape[:2]
+    A2 = A.reshape(K, 3 * n, 6)
+    if W is None and _same_everywhere(A2):
+        # one design for all positions (a linear axis): one normal matrix, one inverse, and
+        # the right-hand sides of all positions in one matrix product
+        Ninv1 = np.linalg.inv(A2[0].T @ A2[0])
+        theta = (delta.reshape(K, 3 * n) @ A2[0]) @ Ninv1.T
+        return theta, np.broadcast_to(Ninv1, (K, 6, 6))
     if W is None:
         N = np.einsum("knai,knaj->kij", A, A)
         rhs = np.einsum("knai,kna->ki", A, delta)
@@ -555,6 +569,11 @@ def _closed_uncertainty(A, closed, W, sigma):
                 for b, (j, d) in enumerate(rows):
                     if i == j:
                         S[m, a, b] = cov_full[m, i, co, d]
+    if W is None and _same_everywhere(As):
+        Ainv1 = np.linalg.inv(As[0])
+        u = np.broadcast_to(sigma * np.sqrt(np.sum(Ainv1 ** 2, axis=1)), (K, 6)).copy()
+        u[0] = 0.0
+        return u
     Ainv = np.linalg.inv(As)
     if W is None:
         covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)

@@ -116,18 +116,28 @@ def _read_loadtxt(path: Path) -> list[Round] | None:
     except InputError:
         return None
     width = len(header)
+    # every line has the header's number of cells (counted here: numpy reads only the
+    # columns it is asked for and would not notice a short or long line)
+    raw = np.frombuffer(rest.encode("utf-8"), dtype=np.uint8)
+    ends = np.flatnonzero(raw == ord("\n"))
+    if len(raw) and raw[-1] != ord("\n"):
+        ends = np.append(ends, len(raw))
+    commas = np.searchsorted(np.flatnonzero(raw == ord(",")), ends)   # commas before each end
+    per_line = np.diff(commas, prepend=0)
+    if len(ends) == 0 or np.any(per_line != width - 1):
+        return None
     try:
         lines = rest.splitlines()
         num = np.loadtxt(lines, delimiter=",", dtype=float, ndmin=2,
                          usecols=[idx[c] for c in ("position", "x", "y", "z")])
         txt = np.loadtxt(lines, delimiter=",", dtype=str, ndmin=2,
-                         usecols=list(range(width)))
+                         usecols=[idx["round"], idx["point"]])
     except (ValueError, IndexError):
         return None
-    if txt.shape != (len(lines), width) or num.shape[0] != len(lines):
+    if len(lines) != len(ends) or txt.shape != (len(lines), 2) or num.shape[0] != len(lines):
         return None
-    rnd = np.char.strip(txt[:, idx["round"]])
-    label = np.char.strip(txt[:, idx["point"]])
+    rnd = np.char.strip(txt[:, 0])
+    label = np.char.strip(txt[:, 1])
     return _group(path, rnd, label, num.T)
 
 
@@ -203,7 +213,8 @@ def _group(path: Path, rnd: np.ndarray, label: np.ndarray, num: np.ndarray) -> l
         pos, pos_of = _first_seen(num[0, rows])
         labels, lab_of = _first_seen(label[rows])
         key = pos_of * len(labels) + lab_of
-        if len(rows) != len(pos) * len(labels) or len(np.unique(key)) != len(rows):
+        if len(rows) != len(pos) * len(labels) or \
+                np.bincount(key, minlength=len(rows)).max(initial=0) > 1:
             return None  # a duplicate or a missing measurement
         pts = np.empty((len(pos), len(labels), 3))
         pts[pos_of, lab_of] = num[1:, rows].T

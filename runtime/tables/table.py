@@ -287,10 +287,14 @@ def table_to_csv(table: ErrorTable) -> str:
     if table.reversal is not None:
         header.append(f"RV_{table.axis}_um")
         columns.append(_from_internal(table.reversal, "um"))
-    lines = [",".join(header)]
-    for row in zip(*columns):
-        lines.append(",".join(_fmt(v) for v in row))
-    return "\n".join(lines) + "\n"
+    # one %-format per block of rows (the format_number rule: "%.12g"; + 0.0 turns -0 into 0)
+    data = np.column_stack([np.asarray(c, dtype=float) for c in columns]) + 0.0
+    row = ",".join(["%.12g"] * data.shape[1]) + "\n"
+    parts = [",".join(header) + "\n"]
+    for i in range(0, len(data), 20000):
+        block = data[i:i + 20000]
+        parts.append((row * len(block)) % tuple(block.ravel().tolist()))
+    return "".join(parts)
 
 
 def write_error_table(path, table: ErrorTable, inputs=()) -> Path:

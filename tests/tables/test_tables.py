@@ -273,3 +273,25 @@ def test_lenient_spelling_of_tables_and_constants(tmp_path):
     c = _write(tmp_path / "c.csv", "Unit,Name,Value,comment\nURAD,ec0y,12,squareness\n"
                                    "\u00b5m,EX0C,5,\n")
     assert read_constants(c) == pytest.approx({"EC0Y": 12e-6, "EX0C": 5e-3})
+
+
+@settings(max_examples=40, deadline=None)
+@given(data=st.data())
+def test_table_csv_cells_are_format_number_of_the_values(data):
+    """The table writer formats whole blocks at once; every cell must still be the documented
+    rule (units.format_number: 12 significant digits, never -0) of its value in um / urad."""
+    from volerr.tables.table import table_to_csv
+    from volerr.units import format_number
+
+    n = data.draw(st.integers(2, 8))
+    pos = np.cumsum(data.draw(st.lists(st.floats(0.01, 100), min_size=n, max_size=n)))
+    vals = {name: np.array(data.draw(st.lists(st.one_of(finite, st.just(-0.0),
+                                                         st.floats(-1e-12, 1e-12)),
+                                               min_size=n, max_size=n))) * 1e-3
+            for name in ("EXX", "EBX")}
+    text = table_to_csv(ErrorTable("X", pos, vals, std={"EXX": np.abs(vals["EXX"])}))
+    lines = text.splitlines()
+    assert lines[0] == "X,EXX_um,EBX_urad,EXX_std_um"
+    for i, line in enumerate(lines[1:]):
+        want = [pos[i], vals["EXX"][i] * 1e3, vals["EBX"][i] * 1e6, abs(vals["EXX"][i]) * 1e3]
+        assert line.split(",") == [format_number(v) for v in want]
