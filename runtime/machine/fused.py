@@ -98,6 +98,9 @@ def parse(fn) -> Parsed | None:
     if a.vararg or a.kwarg or a.kwonlyargs or a.posonlyargs or a.defaults:
         return None
     args = tuple(x.arg for x in a.args)
+    # numeric module constants (a layout's fixed lengths such as ``h = 150.0``) are inlined
+    consts = {k: float(v) for k, v in getattr(fn, "__globals__", {}).items()
+              if isinstance(v, (int, float)) and not isinstance(v, bool) and k not in args}
     known, temps, returned = set(args), [], None
     for i, st in enumerate(f.body):
         if i == 0 and isinstance(st, ast.Expr) and isinstance(st.value, ast.Constant):
@@ -121,6 +124,7 @@ def parse(fn) -> Parsed | None:
                                             and value.args[1].id == "_shape"):
                 return None
             value = value.args[0]
+        value = _Inline(consts, known).visit(value)
         if name in args or not _valid(value, known):
             return None
         known.add(name)
@@ -138,6 +142,18 @@ def parse(fn) -> Parsed | None:
             isinstance(n, ast.Name) and n.id in out_names for v in outputs for n in ast.walk(v)):
         return None  # an output used as an input of another expression: keep it simple
     return Parsed(f.name, args, temps, outputs)
+
+
+class _Inline(ast.NodeTransformer):
+    """Module constants -> their values (names bound locally or as arguments stay names)."""
+
+    def __init__(self, consts: dict, local: set):
+        self.consts, self.local = consts, local
+
+    def visit_Name(self, node):
+        if node.id not in self.local and node.id in self.consts:
+            return ast.copy_location(ast.Constant(self.consts[node.id]), node)
+        return node
 
 
 # ---- zero folding ---------------------------------------------------------------------------

@@ -96,7 +96,8 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
             for i, c in enumerate(fn(**kw)):
                 out[sl, i] = c
         if finite is not None and ok:
-            ok = bool(np.isfinite(out[sl].sum()))  # NaN/inf anywhere -> sum not finite
+            with np.errstate(over="ignore"):  # NaN/inf anywhere -> sum not finite
+                ok = bool(np.isfinite(out[sl].sum()))
     if finite is not None:
         finite.append(ok or bool(np.isfinite(out).all()))  # ok False: sum overflow or NaN
     return out
@@ -192,7 +193,9 @@ class Model:
             cols = {a: arr[:, i] for i, a in enumerate(self.axes)}  # strided views, no copy
             # one contiguous pass (a sum: NaN/inf anywhere makes it non-finite; only then, or on
             # an overflow of the sum, the exact check), naming the axis only on failure
-            if not np.isfinite(arr.sum()) and not np.isfinite(arr).all():
+            with np.errstate(over="ignore"):
+                finite = bool(np.isfinite(arr.sum())) or bool(np.isfinite(arr).all())
+            if not finite:
                 bad = next(a for a, v in cols.items() if not np.isfinite(v).all())
                 raise InputError(f"{self.name}: position {bad} has NaN or infinite values")
         for a, v in cols.items():
