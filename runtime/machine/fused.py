@@ -162,6 +162,22 @@ def _is_const(node, value=None) -> bool:
             and (value is None or node.value == value))
 
 
+def _is_neg(node) -> bool:
+    return isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub)
+
+
+def _negated(node):
+    """``x`` if ``node`` is ``-x``, ``(-a)*b`` or ``a*(-b)`` (x = a*b), else None."""
+    if _is_neg(node):
+        return node.operand
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mult):
+        if _is_neg(node.left):
+            return ast.BinOp(node.left.operand, ast.Mult(), node.right)
+        if _is_neg(node.right):
+            return ast.BinOp(node.left, ast.Mult(), node.right.operand)
+    return None
+
+
 class _Fold(ast.NodeTransformer):
     """Replace names known to be 0 by 0 and fold ``x*0``, ``x+0``, ``0-x``, ``-0``, ``0**k``."""
 
@@ -188,6 +204,14 @@ class _Fold(ast.NodeTransformer):
                 return right
             if zr:
                 return left
+            # exact rewrites that save a negation pass (IEEE: -(a*b) == (-a)*b, a+b == b+a):
+            # -a + b -> b - a, (-a)*c + b -> b - a*c, a + -b -> a - b
+            if _negated(left) is not None:
+                return ast.BinOp(right, ast.Sub(), _negated(left))
+            if _negated(right) is not None:
+                return ast.BinOp(left, ast.Sub(), _negated(right))
+        if isinstance(op, ast.Sub) and _negated(right) is not None:
+            return ast.BinOp(left, ast.Add(), _negated(right))  # a - -b -> a + b
         if isinstance(op, ast.Sub):
             if zr:
                 return left
@@ -275,7 +299,8 @@ class _Emitter:
         if target is None:
             buf = self.buffer()
             target = f"_b{buf}"
-        self.lines.append(f"numpy.{ufunc}({', '.join(texts)}, out={target})")
+        # out as the last positional argument: cheaper to parse than the keyword
+        self.lines.append(f"numpy.{ufunc}({', '.join(texts)}, {target})")
         return target, buf
 
 
