@@ -7,15 +7,21 @@ bookkeeping and one temporary (N,) array per operation, and the caller stacks th
 an (N, 3) array.  This module rewrites such a function, from its own source (no kinematics is
 written here), into
 
-* a **numpy block kernel** ``kernel(_out, **inputs)`` that writes the outputs straight into the
-  columns of a preallocated block ``_out`` (m, n_out) (no ``_shape``, no ``broadcast_to``, no
-  stacking), with parameters known to be scalar zero folded away (``x * 0`` -> 0, ``x + 0`` ->
-  x) so that unused error parameters cost nothing;
+* a **numpy block kernel** ``kernel(_out, _s, **inputs)`` in three-address form: every
+  operation on arrays is one ufunc call whose result goes into a row of the preallocated
+  scratch ``_s`` (reused once a value is dead) or straight into a column of the block
+  ``_out`` (m, n_out) of the result -- no ``_shape``, no ``broadcast_to``, no allocation, no
+  stacking.  Arguments known to be scalar 0 are folded away (``x * 0`` -> 0, ``x + 0`` -> x),
+  so unused error parameters cost nothing, and negations are absorbed where that is exact
+  (``(-a)*c + b`` -> ``b - a*c``): the values are bitwise those of the generated function;
 * a **numba kernel** (optional, ``pip install 'volerr[fast]'``): one compiled per-point loop
   over 2-D broadcast inputs writing an (S, P, n_out) array, the whole expression fused in
   registers.  Compilation costs 1-4 s per function the first time, so it is opt-in
-  (``backend="numba"``), never on a default path; the compiled code is cached on disk next to
-  the kernel source in ``<volerr cache dir>/fused`` (outside the package).
+  (``backend="numba"`` of the Monte Carlo), never on a default path; the compiled code is cached
+  on disk next to the kernel source in ``<volerr cache dir>/fused`` (outside the package).  It
+  pays on Monte Carlo blocks (S machines x P points, inputs broadcast from (S, P), (S, 1) and
+  (P,)); on 10^7 points held in 27 separate arrays its 27 simultaneous memory streams make it
+  slower than the blocked numpy kernel (``benchmarks/bench_volumetric.py``).
 
 A function whose source does not have the straight-line form is not fused (:func:`parse`
 returns None) and the callers evaluate the generated function as it is.
