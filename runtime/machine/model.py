@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, require
+from . import fused
 from .derivation import derive_module
 from .layout import Layout, read_layout
 
@@ -59,26 +60,46 @@ def _case_insensitive(given: dict, names) -> dict:
 
 
 #: points per block of :func:`_blocked`: large enough that the per-block Python cost (argument
-#: slicing, one ufunc call per operation: ~80 us) is small against the arithmetic, small enough
-#: that the block's inputs and temporaries (256 kB each) stay in the last-level cache, so each
-#: input is read from memory once (measured on MB1, 10^6 points: 2048 -> 74 ms, 8192 -> 44 ms,
-#: 32768 -> 38 ms, 65536 -> 38 ms)
-BLOCK = 32768
+#: slicing, one ufunc call per operation) is small against the arithmetic, small enough that the
+#: block's inputs and temporaries stay in the cache, so each input is read from memory once
+#: (``python benchmarks/bench_volumetric.py --blocks`` measures 2048 ... 65536)
+BLOCK = 16384
 
 
-def _blocked(fn, kwargs: dict, n: int, n_out: int = 3) -> np.ndarray:
+def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = None) -> np.ndarray:
     """``fn(**kwargs)`` (a generated function returning ``n_out`` broadcastable outputs)
     evaluated block by block into one (n, n_out) array.  Arguments that are (n,) arrays are
-    sliced (views, also of strided columns); scalars and (1,) arrays pass whole."""
+    sliced (views, also of strided columns); scalars and (1,) arrays pass whole.
+
+    The generated function is run as its fused block kernel (:mod:`.fused`): outputs written
+    straight into the rows of the result, arguments that are scalar 0 folded away; a function
+    that cannot be fused is called as it is.  ``finite``: a list that receives one bool, whether
+    every result is finite (checked block by block while the block is in the cache)."""
+    scalars = {k for k, v in kwargs.items() if np.ndim(v) == 0}
+    zeros = frozenset(k for k in scalars if kwargs[k] == 0)
+    kernel = (fused.numpy_kernel(fn, zeros, frozenset(scalars) - zeros)
+              if fused.n_outputs(fn) == n_out else None)
+    if kernel is not None:
+        kernel, n_scratch = kernel
+        scratch = np.empty((n_scratch, min(BLOCK, n)))
     out = np.empty((n, n_out))
+    ok = True
     sliced = [k for k, v in kwargs.items() if np.ndim(v) == 1 and np.shape(v)[0] == n and n > 1]
     for start in range(0, n, BLOCK):
         sl = slice(start, min(start + BLOCK, n))
         kw = dict(kwargs)
         for k in sliced:
             kw[k] = kwargs[k][sl]
-        for i, c in enumerate(fn(**kw)):
-            out[sl, i] = c
+        if kernel is not None:
+            kernel(out[sl], scratch[:, :sl.stop - sl.start], **kw)
+        else:
+            for i, c in enumerate(fn(**kw)):
+                out[sl, i] = c
+        if finite is not None and ok:
+            with np.errstate(over="ignore"):  # NaN/inf anywhere -> sum not finite
+                ok = bool(np.isfinite(out[sl].sum()))
+    if finite is not None:
+        finite.append(ok or bool(np.isfinite(out).all()))  # ok False: sum overflow or NaN
     return out
 
 
@@ -170,7 +191,11 @@ class Model:
                     f"{self.name}: positions must have {len(self.axes)} columns "
                     f"({' '.join(self.axes)}), got shape {arr.shape}")
             cols = {a: arr[:, i] for i, a in enumerate(self.axes)}  # strided views, no copy
-            if not np.isfinite(arr).all():    # one contiguous pass; name the axis only then
+            # one contiguous pass (a sum: NaN/inf anywhere makes it non-finite; only then, or on
+            # an overflow of the sum, the exact check), naming the axis only on failure
+            with np.errstate(over="ignore"):
+                finite = bool(np.isfinite(arr.sum())) or bool(np.isfinite(arr).all())
+            if not finite:
                 bad = next(a for a, v in cols.items() if not np.isfinite(v).all())
                 raise InputError(f"{self.name}: position {bad} has NaN or infinite values")
         for a, v in cols.items():
@@ -228,9 +253,11 @@ class Model:
         return out
 
     @staticmethod
-    def _check_finite(result: np.ndarray, inputs: dict) -> np.ndarray:
-        """NaN in any input propagates to the result: check once there, then name the input."""
-        if not np.isfinite(result).all():
+    def _check_finite(result: np.ndarray, inputs: dict, finite: bool | None = None
+                      ) -> np.ndarray:
+        """NaN in any input propagates to the result: check once there (or take ``finite``,
+        the check :func:`_blocked` made), then name the input."""
+        if not (np.isfinite(result).all() if finite is None else finite):
             for name, v in inputs.items():
                 if not np.all(np.isfinite(v)):
                     raise InputError(f"error {name} has NaN or infinite values")
@@ -269,9 +296,11 @@ class Model:
         """
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
-        out = self._check_finite(_blocked(
-            self.module.volumetric_error,
-            {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n), errs)
+        finite: list = []
+        out = _blocked(self.module.volumetric_error,
+                       {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs},
+                       n, finite=finite)
+        out = self._check_finite(out, errs, finite[0])
         if direction is not None or probe_error is not None:
             out = out + self._probe_term(direction, probe_error, n)
         return out
