@@ -329,9 +329,11 @@ class Model:
         """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
-        e = self.module.exact_error(**pos, **self._covariates(covariates, n),
-                                    **self._probe(probe, n), **errs)
-        return self._check_finite(_columns(e, n), errs)
+        finite: list = []
+        out = _blocked(self.module.exact_error,
+                       {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs},
+                       n, finite=finite)
+        return self._check_finite(out, errs, finite[0])
 
     def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
         """Sensitivity of the volumetric error to every parameter.
@@ -427,7 +429,7 @@ class Model:
     def nominal_position(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
         """Nominal probe/tool tip in the workpiece frame, (N, 3) mm."""
         pos, n = self._points(positions)
-        return _columns(self.module.nominal_position(**pos, **self._probe(probe, n)), n)
+        return _blocked(self.module.nominal_position, {**pos, **self._probe(probe, n)}, n)
 
     def forward(self, positions, probe=None, *, tool=None) -> np.ndarray:
         """Nominal tool tip and tool axis in the workpiece frame.
@@ -461,8 +463,10 @@ class Model:
         """First-order error of the tool-axis direction, (N, 3), rad."""
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
-        e = self.module.orientation_error(**pos, **self._covariates(covariates, n), **errs)
-        return self._check_finite(_columns(e, n), errs)
+        finite: list = []
+        out = _blocked(self.module.orientation_error,
+                       {**pos, **self._covariates(covariates, n), **errs}, n, finite=finite)
+        return self._check_finite(out, errs, finite[0])
 
 
 def load(name_or_path) -> Model:
