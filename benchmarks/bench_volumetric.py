@@ -20,12 +20,16 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
-import volerr
-from volerr.machine import fused
-from volerr.machine import model as model_mod
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from helpers.pahk_eq4 import hand_eq4  # noqa: E402
+
+import volerr  # noqa: E402
+from volerr.machine import fused  # noqa: E402
+from volerr.machine import model as model_mod  # noqa: E402
 
 
 def timed(fn, repeat=3):
@@ -69,22 +73,6 @@ def loop_3x3(pos, e, probe):
         actual = ly + ty @ (lx + tx @ (lz + tz @ p))
         out[i] = actual - (np.array([x, y, z]) + p)
     return out
-
-
-def hand_eq4(pos, g, probe):
-    """Pahk eq. (4) written by hand in numpy (EC0Y = alpha, EB0Z = -beta1, EA0Z = beta2)."""
-    x, y, z = pos.T
-    xp, yp, zp = probe
-    ez = g["ECX"] + g["ECY"] + g["ECZ"]
-    ey = g["EBX"] + g["EBY"] + g["EBZ"]
-    ex = g["EAX"] + g["EAY"] + g["EAZ"]
-    dx = (g["EXX"] + g["EXY"] + g["EXZ"] + z * (g["EB0Z"] + g["EBX"] + g["EBY"])
-          - yp * ez + zp * ey)
-    dy = (g["EYX"] + g["EYY"] + g["EYZ"] + x * (-g["EC0Y"] + g["ECY"])
-          - z * (g["EA0Z"] + g["EAY"] + g["EAX"]) + xp * ez - zp * ex)
-    dz = g["EZX"] + g["EZY"] + g["EZZ"] - x * g["EBY"] - xp * ey + yp * ex
-    return np.stack([dx, dy, dz], axis=-1)
-
 
 
 def problem(n, seed=0):

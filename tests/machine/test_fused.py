@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import volerr
+from helpers.pahk_eq4 import hand_eq4
 from volerr.cli import main
 from volerr.errors import InputError
 from volerr.machine import fused, model as model_mod
@@ -19,22 +20,6 @@ from volerr.uncertainty import ensemble, montecarlo as mc, tasks
 
 MB1 = volerr.load("MB1")
 DMU50 = volerr.load("DMU50")
-
-
-def hand_eq4(pos, g, probe):
-    """Pahk eq. (4) by hand (EC0Y = alpha, EB0Z = -beta1, EA0Z = beta2); missing names are 0."""
-    g = {k: g.get(k, 0.0) for k in MB1.parameters}
-    x, y, z = pos.T
-    xp, yp, zp = np.broadcast_to(np.asarray(probe, float), pos.shape).T
-    ez = g["ECX"] + g["ECY"] + g["ECZ"]
-    ey = g["EBX"] + g["EBY"] + g["EBZ"]
-    ex = g["EAX"] + g["EAY"] + g["EAZ"]
-    dx = (g["EXX"] + g["EXY"] + g["EXZ"] + z * (g["EB0Z"] + g["EBX"] + g["EBY"])
-          - yp * ez + zp * ey)
-    dy = (g["EYX"] + g["EYY"] + g["EYZ"] + x * (-g["EC0Y"] + g["ECY"])
-          - z * (g["EA0Z"] + g["EAY"] + g["EAX"]) + xp * ez - zp * ex)
-    dz = g["EZX"] + g["EZY"] + g["EZZ"] - x * g["EBY"] - xp * ey + yp * ex
-    return np.stack(np.broadcast_arrays(dx, dy, dz), axis=-1)
 
 
 def _random_case(model, rng, n, subset: bool):
