@@ -53,7 +53,7 @@ def derive_functions(layout: Layout) -> list[Function]:
     funcs = [
         Function("volumetric_error", pos + cov + probe + params,
                  # grouped by position and probe symbols: sums of errors share one product
-                 [sp.collect(e, list(chain.positions) + list(PROBE)) for e in error],
+                 [vol.collect_symbols(e, list(chain.positions) + list(PROBE)) for e in error],
                  "First-order volumetric error (dX, dY, dZ), mm."),
         Function("sensitivity", pos + cov + probe, list(sens),
                  "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",

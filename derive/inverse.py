@@ -98,7 +98,52 @@ def _reduce_sin_cos(expr, angles) -> sp.Expr:
     """``expr`` (polynomial in sin and cos of ``angles``) expanded and reduced modulo
     ``sin^2 + cos^2 = 1`` of every angle: the remainder of the division by
     ``cos^2 + sin^2 - 1`` in each cosine, a canonical form (at most linear in each cosine).
-    Polynomial arithmetic only: much cheaper than ``trigsimp`` on the same expression."""
+
+    Done in a sparse polynomial ring over QQ whose generators are the free symbols, the
+    sines and cosines and any radicals of the coefficients (``sqrt(2)``): the divisor is
+    monic in the cosine ``c``, so the remainder replaces ``c^k`` by
+    ``c^(k mod 2) (1 - s^2)^(k // 2)`` term by term.  The result is mathematically the
+    remainder that ``sympy.rem`` gives, expanded: the same canonical expression (the
+    generated code is compared byte for byte)."""
+    from sympy.polys.domains import QQ
+    from sympy.polys.rings import ring
+
+    pairs = [(sp.Dummy(f"s{i}"), sp.Dummy(f"c{i}")) for i in range(len(angles))]
+    fwd = {}
+    for q, (s_, c_) in zip(angles, pairs):
+        fwd[sp.sin(q)], fwd[sp.cos(q)] = s_, c_
+    e = sp.sympify(expr).xreplace(fwd)
+    radicals = sorted((a for a in e.atoms(sp.Pow) if a.is_number), key=sp.default_sort_key)
+    gens = [*sorted(e.free_symbols, key=sp.default_sort_key), *radicals]
+    if not gens:
+        return sp.expand(expr)
+    try:
+        R, *xs = ring(gens, QQ)
+        p = R.from_expr(e)
+    except (ValueError, TypeError, sp.polys.polyerrors.CoercionFailed):
+        return _reduce_sin_cos_sympy(expr, angles)   # not a polynomial of that shape
+    index = {g: i for i, g in enumerate(gens)}
+    for s_, c_ in pairs:
+        if c_ not in index:
+            continue
+        ic, s = index[c_], xs[index[s_]] if s_ in index else R.zero
+        if all(m[ic] < 2 for m in p.keys()):
+            continue
+        powers = [R.one]
+        out = R.zero
+        for m, coeff in p.terms():
+            k = m[ic]
+            while len(powers) <= k // 2:
+                powers.append(powers[-1] * (1 - s ** 2))
+            low = m[:ic] + (k % 2,) + m[ic + 1:]
+            out += R({low: coeff}) * powers[k // 2]
+        p = out
+    back = {v: k for k, v in fwd.items()}
+    return sp.expand(p.as_expr().xreplace(back))
+
+
+def _reduce_sin_cos_sympy(expr, angles) -> sp.Expr:
+    """:func:`_reduce_sin_cos` by ``sympy.rem`` on expressions (the general path)."""
     pairs = [(sp.Dummy(f"s{i}"), sp.Dummy(f"c{i}")) for i in range(len(angles))]
     fwd = {}
     for q, (s_, c_) in zip(angles, pairs):

@@ -51,6 +51,30 @@ def _first_order_displacement(chain: Chain, v: sp.Matrix) -> sp.Matrix:
     return sp.Matrix([sp.expand(total[i]) for i in range(3)])
 
 
+def collect_symbols(expr, syms) -> sp.Expr:
+    """``sympy.collect(expr, syms)`` for an expanded sum (the same expression, tested): each
+    term goes to the group of the first of ``syms`` (in that order) that is one of its
+    factors, alone or to a positive integer power; the group is ``key * (sum of the rest)``.
+    Terms without such a factor stay as they are.  One pass over the terms, where ``collect``
+    re-parses every term for every symbol."""
+    order = {q: i for i, q in enumerate(syms)}
+    groups, rest = {}, []
+    for term in sp.Add.make_args(expr):
+        factors = sp.Mul.make_args(term)
+        best = None
+        for j, f in enumerate(factors):
+            base = f.base if f.is_Pow and f.exp.is_Integer and f.exp > 0 else f
+            i = order.get(base)
+            if i is not None and (best is None or i < best[0]):
+                best = (i, j)
+        if best is None:
+            rest.append(term)
+            continue
+        j = best[1]
+        groups.setdefault(factors[j], []).append(sp.Mul(*factors[:j], *factors[j + 1:]))
+    return sp.Add(*rest, *[sp.Mul(k, sp.Add(*c)) for k, c in groups.items()])
+
+
 def orientation_error(chain: Chain) -> sp.Matrix:
     """First-order error of the tool-axis direction (tool +z) in the workpiece frame."""
     return _first_order_displacement(chain, sp.Matrix([0, 0, 1, 0]))
