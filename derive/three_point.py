@@ -110,13 +110,16 @@ def selected_system(selection: str):
     return sp.Matrix(A.extract(index, list(range(6)))), b
 
 
-def _det(m: sp.Matrix):
-    """Determinant of a polynomial matrix, expanded: computed in the polynomial ring
-    (fraction-free elimination on ring elements, ~20x faster than Berkowitz on expressions);
-    the expanded polynomial is the same whatever the method."""
+def _det(m: sp.Matrix, domain=None):
+    """Determinant of a polynomial matrix: computed in the polynomial ring (fraction-free
+    elimination on ring elements, ~20x faster than Berkowitz on expressions).  Returns the
+    ring element when ``domain`` (a polynomial ring domain holding the entries) is given,
+    else the expanded expression (the same polynomial whatever the method)."""
     from sympy.polys.matrices import DomainMatrix
 
     dm = DomainMatrix.from_Matrix(m)
+    if domain is not None:
+        return dm.convert_to(domain).det()
     return sp.expand(dm.domain.to_sympy(dm.det()))
 
 
@@ -124,17 +127,28 @@ def closed_form(selection: str) -> dict:
     """Closed-form solution of a selected 6 x 6 system.
 
     Returns ``{"EX": expr, ..., "EC": expr, "N": determinant}``: each motion as a function of
-    the lever arms and the six selected deviations (Cramer's rule, factored)."""
+    the lever arms and the six selected deviations (Cramer's rule, factored).
+
+    The determinants and the cancellation of their common factors are done on elements of
+    one polynomial ring over ZZ, its generators in the order ``sympy.cancel`` gives them, so
+    each quotient is ``sympy.cancel(numerator / determinant)`` without converting the
+    polynomials to expressions and back."""
+    from sympy.polys.domains import ZZ
+    from sympy.polys.polyutils import _sort_gens
+    from sympy.polys.rings import ring
+
     A, b = selected_system(selection)
-    det = sp.factor(_det(A))
+    R, *_ = ring(_sort_gens(sorted(A.free_symbols | b.free_symbols, key=str)), ZZ)
+    K = R.to_domain()
+    det = _det(A, K)
     out = {}
     for j, name in enumerate(MOTIONS):
         Aj = sp.Matrix(A)
         Aj[:, j] = b
-        num = _det(Aj)
         # cancel the common polynomial factors of numerator and determinant
-        out[name] = sp.cancel(num / sp.expand(det))
-    out["N"] = det
+        num, den = _det(Aj, K).cancel(det)
+        out[name] = num.as_expr() / den.as_expr()
+    out["N"] = sp.factor(det.as_expr())
     return out
 
 
