@@ -219,12 +219,35 @@ def _squareness_slopes(chain: Chain, error: sp.Matrix) -> dict:
     for name in layout.squareness:
         about, b, a = SQUARENESS[name]
         ia, ib = idx[a], idx[b]
-        slope = sp.diff(error[ia], pos[b]) + sp.diff(error[ib], pos[a])
+        slope = _diff_sum(error[ia], pos[b]) + _diff_sum(error[ib], pos[a])
         # the angle between lines a and b: 90 deg - slope; convert to the named rotation
         sign = {"EC0Y": -1, "EB0Z": 1, "EA0Z": -1}[name]
         apparent = sign * slope
-        apparent = apparent.subs({position_symbol(t): OFFSETS[i] for i, t in enumerate("XYZ")
-                                  if t in layout.axes})
-        apparent = apparent.subs({p: 0 for p in PROBE})
+        apparent = apparent.xreplace({position_symbol(t): OFFSETS[i]
+                                      for i, t in enumerate("XYZ") if t in layout.axes})
+        apparent = apparent.xreplace({p: sp.S.Zero for p in PROBE})
         out[name] = sp.expand(apparent)
     return out
+
+
+def _diff_sum(expr, x) -> sp.Expr:
+    """``diff(expr, x)`` of a sum, term by term: a term that holds ``x`` only as a factor
+    ``x**n`` (n a positive integer) gives ``n x**(n-1)`` times the other factors, a term
+    without ``x`` nothing, any other term its sympy derivative.  The same sum as ``diff``
+    (mathematically; the callers expand it), without sympy's general derivative machinery on
+    every term."""
+    out = []
+    for term in sp.Add.make_args(expr):
+        if x not in term.free_symbols:
+            continue
+        factors = sp.Mul.make_args(term)
+        hits = [j for j, f in enumerate(factors) if f.has(x)]
+        f = factors[hits[0]]
+        n = 1 if f == x else (f.exp if f.is_Pow and f.base == x and f.exp.is_Integer
+                              and f.exp > 0 else None)
+        if len(hits) != 1 or n is None:
+            out.append(sp.diff(term, x))
+            continue
+        j = hits[0]
+        out.append(sp.Mul(n, x ** (n - 1), *factors[:j], *factors[j + 1:]))
+    return sp.Add(*out)
