@@ -86,7 +86,7 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "First-order error of the tool-axis direction (i, j, k), rad."),
     ]
     if inverse.applies(layout):
-        funcs.extend(inverse.inverse_functions(layout))
+        funcs.extend(inverse.inverse_functions(layout, chain))
     if rules.shift:
         funcs.append(Function(
             "transfer_shift", transfer_args, [rules.shift[k] for k in sorted(rules.shift)],

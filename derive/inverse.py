@@ -169,9 +169,10 @@ def linear_inverse(chain: Chain) -> dict:
     return {a: _reduce_sin_cos(sol[i], angles) for i, a in enumerate(("X", "Y", "Z"))}
 
 
-def inverse_functions(layout: Layout) -> list[Function]:
-    """Generated functions ``inverse_rotary`` and ``inverse_linear`` of a five-axis layout."""
-    chain = Chain.from_layout(layout)
+def inverse_functions(layout: Layout, chain: Chain | None = None) -> list[Function]:
+    """Generated functions ``inverse_rotary`` and ``inverse_linear`` of a five-axis layout
+    (``chain``: the layout's chain if already built, default tool-point pivot)."""
+    chain = Chain.from_layout(layout) if chain is None else chain
     rot = [a for a in layout.axis_names if layout.axes[a].kind == "rotary"]
     rinv = rotary_inverse(chain)
     linv = linear_inverse(chain)

@@ -14,7 +14,8 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS
 
-from .kinematics import PROBE, Chain, parameter_symbol, position_symbol, twist
+from .kinematics import (NOT_POLYNOMIAL, PROBE, Chain, RingMatrices, parameter_symbol,
+                         position_symbol, twist)
 
 
 def nominal_point(chain: Chain) -> sp.Matrix:
@@ -34,7 +35,44 @@ def volumetric_error(chain: Chain) -> sp.Matrix:
 
 def _first_order_displacement(chain: Chain, v: sp.Matrix) -> sp.Matrix:
     """sum_k prefix_k @ D_k @ suffix_k @ v: the first-order change of the homogeneous vector v
-    (a point when v[3] = 1, a direction when v[3] = 0)."""
+    (a point when v[3] = 1, a direction when v[3] = 0), expanded.
+
+    Computed on polynomial-ring elements (:class:`volerr.derive.kinematics.RingMatrices`):
+    the expanded result is the same expression as ``expand`` of the product of the
+    matrices; chains with other functions than sines and cosines take the expression path."""
+    factors = chain.factors
+    mats = [f.first_order() if f.is_error else f.nominal for f in factors]
+    ring = RingMatrices.build([*mats, v])
+    if ring is not None:
+        try:
+            mats = [ring.convert(m) for m in mats]
+            v = ring.convert(v)
+        except NOT_POLYNOMIAL:
+            ring = None
+    if ring is None:
+        return _first_order_displacement_sympy(chain, v)
+    suffix = [None] * len(factors)
+    for i in range(len(factors) - 1, -1, -1):
+        suffix[i] = v
+        if not factors[i].is_error:
+            v = ring.mul(mats[i], v)
+    total = None
+    prefix = None
+    for i, f in enumerate(factors):
+        if f.is_error:
+            term = ring.mul(mats[i], suffix[i])
+            if prefix is not None:
+                term = ring.mul(prefix, term)
+            total = term if total is None else ring.add(total, term)
+        else:
+            prefix = mats[i] if prefix is None else ring.mul(prefix, mats[i])
+    if total is None:
+        return sp.zeros(3, 1)
+    return sp.Matrix([total[i][0].as_expr() for i in range(3)])
+
+
+def _first_order_displacement_sympy(chain: Chain, v: sp.Matrix) -> sp.Matrix:
+    """:func:`_first_order_displacement` on sympy expressions (any chain)."""
     factors = chain.factors
     suffix = [None] * len(factors)
     for i in range(len(factors) - 1, -1, -1):
@@ -118,9 +156,23 @@ def setup_sensitivity(chain: Chain) -> sp.Matrix:
     measuring instrument's placement: ``(I + D) T p``), columns 6-11 the same twist at the
     tool end, in the tool frame, standing last (``T (I + D) p``: a probe / tool offset error).
     Exact in the nominal chain (first order in the twist)."""
+    T, p = chain.nominal_htm(), sp.Matrix([*PROBE, 1])
+    # the twist is linear in its six coordinates: column k is the product with the twist of
+    # the k-th unit coordinate, computed on polynomial-ring elements (expanded, as below)
+    ring = RingMatrices.build([T, p])
+    if ring is not None:
+        try:
+            Tr, pr = ring.convert(T), ring.convert(p)
+        except NOT_POLYNOMIAL:
+            ring = None
+    if ring is not None:
+        units = [ring.convert(twist(**{k: 1})) for k in SETUP_TWIST]
+        Tp = ring.mul(Tr, pr)
+        work = [ring.mul(g, Tp) for g in units]
+        tool = [ring.mul(Tr, ring.mul(g, pr)) for g in units]
+        return sp.Matrix(3, 12, lambda i, j: (work[j] if j < 6 else tool[j - 6])[i][0].as_expr())
     syms = sp.symbols("_tw_dx _tw_dy _tw_dz _tw_ex _tw_ey _tw_ez", real=True)
     d = twist(**dict(zip(SETUP_TWIST, syms)))
-    T, p = chain.nominal_htm(), sp.Matrix([*PROBE, 1])
     work = (d * (T * p))[0:3, 0].jacobian(sp.Matrix(syms))
     tool = (T * (d * p))[0:3, 0].jacobian(sp.Matrix(syms))
     return work.row_join(tool).applyfunc(sp.expand)
