@@ -136,7 +136,7 @@ def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
         # the first-order error is linear in the parameters: each expanded term holds exactly
         # one parameter to the first power, its coefficient is the derivative (as diff gives)
         coeffs = [[] for _ in params]
-        for term in sp.Add.make_args(sp.expand(error[i])):
+        for term in sp.Add.make_args(expand(error[i])):
             found = [q for q in term.free_symbols if q in index]
             if len(found) != 1 or not _linear_factor(term, found[0]):
                 return error.jacobian(sp.Matrix(params))   # not linear term by term: general
@@ -176,6 +176,32 @@ def setup_sensitivity(chain: Chain) -> sp.Matrix:
     work = (d * (T * p))[0:3, 0].jacobian(sp.Matrix(syms))
     tool = (T * (d * p))[0:3, 0].jacobian(sp.Matrix(syms))
     return work.row_join(tool).applyfunc(sp.expand)
+def _is_expanded_factor(f) -> bool:
+    if f.is_Atom:
+        return True
+    if f.is_Pow and f.base.is_Integer and f.base > 0 and f.exp.is_Rational:
+        return True   # a numeric radical such as sqrt(2)
+    if f.is_Pow:
+        return f.exp.is_Integer and (f.base.is_Atom or _is_expanded_factor(f.base)) and \
+            not f.base.is_Add and not f.base.is_Mul and not f.base.is_Pow
+    if f.func in (sp.sin, sp.cos):
+        return is_expanded(f.args[0])
+    return False
+
+
+def is_expanded(expr) -> bool:
+    """True when ``sympy.expand(expr)`` is ``expr`` itself, recognised for the shapes the
+    derivation produces: sums of products of symbols, numbers, integer powers of those and
+    sines and cosines of such sums (anything else answers False, and the caller expands)."""
+    return all(_is_expanded_factor(f) for t in sp.Add.make_args(expr)
+               for f in sp.Mul.make_args(t))
+
+
+def expand(expr):
+    """``sympy.expand(expr)``, skipped when ``expr`` is already expanded (:func:`is_expanded`)."""
+    return expr if is_expanded(expr) else sp.expand(expr)
+
+
 def _linear_factor(term, q) -> bool:
     """``sp.degree(term, q) == 1`` for a term of an expanded sum: a product with the factor
     ``q`` to the first power and ``q`` nowhere else (checked without building a polynomial;
@@ -194,7 +220,7 @@ def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
         # one Add of all squares (the same canonical sum as adding them one by one)
         acc = []
         for j in range(sens.shape[1]):
-            for term in sp.Add.make_args(sp.expand(sens[i, j])):
+            for term in sp.Add.make_args(expand(sens[i, j])):
                 if term != 0:
                     acc.append(term ** 2 * sigmas[j] ** 2)
         rows.append(sp.sqrt(sp.Add(*acc)))
