@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       936d6b81b28e27cd2c685d2970ba1a9819c19b8969d97c12a7c54c91c993e5b7
-derivation sha256  707cce1c6578403bc8c334da6ab3159db6f8c202e6e7da4723fa876dbe427ff3
+input sha256       26ff981565755ae2f06cdbc614479e95b74eb63685bed151847c32178de4a711
+derivation sha256  5148c44520b68207f161f17d8ad6e31fe59a1ba5e2fb5965dec1e7a54667e8b4
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/probe.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       4775acad0bedd6fe9e1efc5ca1893b3b117b363fb55916daaacd5b645d56ae56
-derivation sha256  1d88f059b9645a64d6750392bf4afeb91084c2c51e51f72c220a7da9e1143169
+input sha256       4e958542d41ee41a3562c905ac982126f62b3b6e8551411cc5320f9343648625
+derivation sha256  33cd1857cf6ac80e89ab08914b6e0a918521aab6d12c4f4bbb0b3a80297d8166
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
