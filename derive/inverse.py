@@ -31,7 +31,7 @@ import sympy as sp
 from volerr.machine.layout import Layout
 
 from .codegen import Function
-from .kinematics import PROBE, Chain, _rational_vec, position_symbol
+from .kinematics import PROBE, Chain, _radical, _rational_vec, position_symbol
 from .volumetric import nominal_point
 
 TOOL_AXIS = sp.symbols("i j k", real=True)
@@ -113,10 +113,10 @@ def _reduce_sin_cos(expr, angles) -> sp.Expr:
     for q, (s_, c_) in zip(angles, pairs):
         fwd[sp.sin(q)], fwd[sp.cos(q)] = s_, c_
     e = sp.sympify(expr).xreplace(fwd)
-    radicals = sorted((a for a in e.atoms(sp.Pow) if a.is_number), key=sp.default_sort_key)
-    gens = [*sorted(e.free_symbols, key=sp.default_sort_key), *radicals]
-    if not gens:
-        return sp.expand(expr)
+    radicals = sorted((a for a in e.atoms(sp.Pow) if _radical(a)), key=sp.default_sort_key)
+    # every sine is a generator: the remainder brings in sin(q) where only cos(q)^2 was
+    gens = [*sorted(e.free_symbols | {s_ for s_, _ in pairs}, key=sp.default_sort_key),
+            *radicals]
     try:
         R, *xs = ring(gens, QQ)
         p = R.from_expr(e)
@@ -126,7 +126,7 @@ def _reduce_sin_cos(expr, angles) -> sp.Expr:
     for s_, c_ in pairs:
         if c_ not in index:
             continue
-        ic, s = index[c_], xs[index[s_]] if s_ in index else R.zero
+        ic, s = index[c_], xs[index[s_]]
         if all(m[ic] < 2 for m in p.keys()):
             continue
         powers = [R.one]

@@ -173,6 +173,12 @@ def _matmul(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
     return sp.Matrix(n, p, out)
 
 
+def _radical(a) -> bool:
+    """A numeric radical such as ``sqrt(2)`` or ``3**(1/3)`` (a generator of the rings below;
+    other numeric powers are polynomial arithmetic on numbers)."""
+    return a.is_Pow and a.base.is_Rational and a.exp.is_Rational and not a.exp.is_Integer
+
+
 def _ring_atoms(expr) -> set | None:
     """Generators a polynomial ring needs for ``expr``: its free symbols, its sines and
     cosines (of expanded arguments) and its numeric radicals (``sqrt(2)``); ``None`` when it
@@ -181,7 +187,7 @@ def _ring_atoms(expr) -> set | None:
     if any(f.func not in (sp.sin, sp.cos) or f.args[0] != sp.expand(f.args[0]) for f in funcs):
         return None
     return (set(expr.free_symbols) | funcs | expr.atoms(sp.NumberSymbol)
-            | {a for a in expr.atoms(sp.Pow) if a.is_number})
+            | {a for a in expr.atoms(sp.Pow) if _radical(a)})
 
 
 def _not_polynomial():

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       ac867c25cf9abfb12b4b0addd6df643f3e916907f010deb3173922ddc725570b
-derivation sha256  90ba0d62e559d6165a49563e14f598705c46c056148f2877c203a856d608d3fc
+derivation sha256  7681705b8be79e10dc76746539c87d2ff98293d9a66d3250709f06c2faed2cd0
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

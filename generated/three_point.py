@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       4e958542d41ee41a3562c905ac982126f62b3b6e8551411cc5320f9343648625
-derivation sha256  33cd1857cf6ac80e89ab08914b6e0a918521aab6d12c4f4bbb0b3a80297d8166
+derivation sha256  ab700d5a301174417316898b904f17074d6efca202b854400f1666aadbd6481c
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
