@@ -185,7 +185,39 @@ def canonical_order(seq, keys=None, default=True, warn=False):
     return iter([seq[i] for i in sorted(idx, key=lambda i: (nodes[i], dsk(seq[i])))])
 
 
+#: prepared functions of the current :func:`shared_preparation` block (None outside one)
+_PREPARED: dict | None = None
+
+
+@contextmanager
+def shared_preparation():
+    """Within this block a function equal to one already prepared (same name, arguments,
+    output expressions, shape, names and docstring: several layouts share a tool axis or a
+    nominal position) reuses that preparation instead of running ``cse`` and the printer
+    again: the same input gives the same text.  Used by ``derive --all``; the memo lives only
+    as long as the block."""
+    global _PREPARED
+    outer, _PREPARED = _PREPARED, ({} if _PREPARED is None else _PREPARED)
+    try:
+        yield
+    finally:
+        _PREPARED = outer
+
+
 def _prepare(f: Function) -> Function:
+    if _PREPARED is None:
+        return _prepare_new(f)
+    key = (f.name, tuple(f.args), tuple(f.outputs), f.shape, tuple(f.output_names or ()), f.doc)
+    done = _PREPARED.get(key)
+    if done is None:
+        done = _PREPARED[key] = _prepare_new(f)
+    elif done is not f:
+        for name in ("body", "result", "signature", "doc_lines", "result_lines"):
+            setattr(f, name, list(getattr(done, name)) if name != "result" else done.result)
+    return f
+
+
+def _prepare_new(f: Function) -> Function:
     nonzero = [(i, e) for i, e in enumerate(f.outputs) if e != 0] if f.shape else \
         list(enumerate(f.outputs))
     exprs = [e for _, e in nonzero]

@@ -10,7 +10,7 @@ from volerr.machine.layout import Layout, layout_names, read_layout
 
 from . import inverse
 from . import volumetric as vol
-from .codegen import Function, render_module
+from .codegen import Function, render_module, shared_preparation
 from .kinematics import PROBE, Chain
 
 
@@ -152,9 +152,10 @@ def all_generated(progress=None) -> dict:
     the layout-independent modules of :data:`EXTRA_MODULES`.  ``progress``: optional wrapper
     of the layout-name iterable (e.g. a tqdm bar)."""
     names = layout_names()
-    out = {f"{module_name(n)}.py": generate_module(read_layout(n))
-           for n in (progress(names) if progress else names)}
-    for filename, target in EXTRA_MODULES.items():
-        mod_name, func = target.split(":")
-        out[filename] = getattr(importlib.import_module(mod_name), func)()
+    with shared_preparation():     # layouts share some functions: prepared once
+        out = {f"{module_name(n)}.py": generate_module(read_layout(n))
+               for n in (progress(names) if progress else names)}
+        for filename, target in EXTRA_MODULES.items():
+            mod_name, func = target.split(":")
+            out[filename] = getattr(importlib.import_module(mod_name), func)()
     return out
