@@ -48,8 +48,8 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS, Layout
 
-from .htm import (PROBE, Factor, exact_error_htm, parameter_symbol, position_symbol,  # noqa: F401
-                  rotation, translation, twist)
+from .htm import (PROBE, Factor, _matmul, exact_error_htm, parameter_symbol,  # noqa: F401
+                  position_symbol, rotation, translation, twist)
 
 
 def _sympify_vec(v, params: dict) -> sp.Matrix:
@@ -157,20 +157,6 @@ def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Facto
 
         out = apply_effects(layout, out)
     return out
-
-
-def _matmul(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
-    """``a * b`` built entry by entry as one Add of the non-zero products: the same
-    expressions as sympy's product (tested), without its general-domain machinery."""
-    n, m, p = a.rows, a.cols, b.cols
-    zero = sp.S.Zero
-    out = []
-    for i in range(n):
-        row = [a[i, k] for k in range(m)]
-        for j in range(p):
-            terms = [x * b[k, j] for k, x in enumerate(row) if x != 0 and b[k, j] != 0]
-            out.append(sp.Add(*terms) if terms else zero)
-    return sp.Matrix(n, p, out)
 
 
 def _radical(a) -> bool:

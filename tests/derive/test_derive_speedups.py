@@ -219,3 +219,14 @@ def test_probe_basis_equals_the_simplified_construction():
         assert all(_same(p, q) for p, q in zip(u, w))
     m = sp.Matrix.hstack(*got)
     assert (m.T * m).applyfunc(lambda e: probe_derivation._pythagoras(e, (A_, B_))) == sp.eye(3)
+
+
+def test_exact_error_htm_is_the_sympy_product():
+    from volerr.derive.htm import exact_error_htm, rotation, translation
+
+    e = sp.symbols("ea eb ec", real=True)
+    d = sp.symbols("dx dy dz", real=True)
+    want = (translation(d) * rotation((0, 0, 1), e[2]) * rotation((0, 1, 0), e[1])
+            * rotation((1, 0, 0), e[0]))
+    got = exact_error_htm(*e, *d)
+    assert all(_same(u, w) for u, w in zip(got, want))
