@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9f5664e7e76c63758343031e2e71c38e0cb7e6231fb10646e63c6605339e98de
-derivation sha256  7681705b8be79e10dc76746539c87d2ff98293d9a66d3250709f06c2faed2cd0
+derivation sha256  a31d88b34c97b6c3158a5ebab94ff8800c3d466e9fb427245e3701754ec50b07
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

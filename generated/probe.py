@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       26ff981565755ae2f06cdbc614479e95b74eb63685bed151847c32178de4a711
-derivation sha256  5148c44520b68207f161f17d8ad6e31fe59a1ba5e2fb5965dec1e7a54667e8b4
+derivation sha256  019842496b6047a27afbd46c6d3326bd48e208d9f67445bc034fa916032f686f
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/probe.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

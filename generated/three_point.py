@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       4e958542d41ee41a3562c905ac982126f62b3b6e8551411cc5320f9343648625
-derivation sha256  ab700d5a301174417316898b904f17074d6efca202b854400f1666aadbd6481c
+derivation sha256  d89311bdfbeea0f7356f0da6d9d43fd9b0df49b94eb7026cff2acb60f917164b
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,

@@ -230,3 +230,33 @@ def test_exact_error_htm_is_the_sympy_product():
             * rotation((1, 0, 0), e[0]))
     got = exact_error_htm(*e, *d)
     assert all(_same(u, w) for u, w in zip(got, want))
+
+
+print_atoms = st.sampled_from([x, y, z, a, sp.sin(a), sp.cos(x), sp.sqrt(2), sp.Integer(2),
+                               sp.Integer(-3), sp.Rational(1, 2), sp.Rational(-5, 3),
+                               sp.Float(0.25), sp.Float(-1.5), sp.Symbol("_t3"), sp.pi,
+                               sp.atan2(x, y)])
+
+
+@st.composite
+def print_exprs(draw, depth=3):
+    if depth == 0 or draw(st.booleans()):
+        return draw(print_atoms)
+    op = draw(st.sampled_from([sp.Add, sp.Mul, lambda u, v: u / v, lambda u, v: u - v,
+                               lambda u, v: u ** 2, lambda u, v: sp.sqrt(u * u + v * v),
+                               lambda u, v: 1 / sp.sqrt(u), lambda u, v: u ** -3,
+                               lambda u, v: sp.sin(u + v), lambda u, v: -u * v]))
+    return op(draw(print_exprs(depth - 1)), draw(print_exprs(depth - 1)))
+
+
+@settings(max_examples=300, deadline=None)
+@given(print_exprs())
+def test_fast_printer_prints_what_sympys_printer_prints(e):
+    from volerr.derive.codegen import _PRINTER, _fast_print, _Unsupported, print_expr
+
+    want = _PRINTER.doprint(e)
+    try:
+        assert _fast_print(e) == want
+    except _Unsupported:
+        pass
+    assert print_expr(e) == want
