@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
-derivation sha256  a31d88b34c97b6c3158a5ebab94ff8800c3d466e9fb427245e3701754ec50b07
+derivation sha256  d967870b48121baae3e9c05c0392e172c0a87227cb83b6e62c8a4f39aa02cad4
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

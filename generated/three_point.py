@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       4e958542d41ee41a3562c905ac982126f62b3b6e8551411cc5320f9343648625
-derivation sha256  d89311bdfbeea0f7356f0da6d9d43fd9b0df49b94eb7026cff2acb60f917164b
+derivation sha256  9e1796aa9ce1a86fe84ecc62ad98df80562366a7523e175eb2145ec1ec38941f
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,

@@ -260,3 +260,22 @@ def test_fast_printer_prints_what_sympys_printer_prints(e):
     except _Unsupported:
         pass
     assert print_expr(e) == want
+
+
+code_tokens = st.sampled_from(["_t12", "numpy.sin", "x", "(", ")", "[", "]", ",", " ", "+",
+                               "-", "*", "**", "/", "=", "1", "0.5", "1e-05", "2.5e+20",
+                               "'EXX'", ":", "{", "}", "_out[0, 1]", ".", "3.", "05", "f",
+                               "j", "_", "0x1f", "1_0", "e", "'a\\'b'", "\"q\"", "  "])
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(code_tokens, min_size=1, max_size=30))
+def test_statement_tokens_are_pythons_tokens(parts):
+    from volerr.derive import linewrap as lw
+
+    code = "".join(parts).strip()
+    try:
+        want = lw._tokenize(code)
+    except Exception:      # not a tokenizable line (unbalanced brackets ...): nothing to compare
+        return
+    assert lw._tokens(code) == want
