@@ -65,6 +65,17 @@ def rotation_structure(chain: Chain):
     return parts[0], dirs[0], axes[0], parts[1], dirs[1], axes[1], parts[2]
 
 
+def _simplify(e):
+    """``sympy.simplify(e)``, except for numbers already in simplest form (a rational, a
+    radical ``sqrt(n)`` or a rational times one), which it returns unchanged: the fixed
+    rotations of most layouts have only such entries (a test compares with simplify)."""
+    e = sp.sympify(e)
+    if e.is_Rational or _radical(e) or (e.is_Mul and len(e.args) == 2 and e.args[0].is_Rational
+                                        and _radical(e.args[1])):
+        return e
+    return sp.simplify(e)
+
+
 def _subproblem1(axis: sp.Matrix, a: sp.Matrix, b: sp.Matrix):
     """Angle of the right-hand rotation about unit ``axis`` that turns ``a`` onto ``b``."""
     ap = a - axis * (axis.dot(a))
@@ -76,17 +87,17 @@ def rotary_inverse(chain: Chain) -> dict:
     """Axis name -> expression of its position (rad) in the tool axis (i, j, k) and ``branch``."""
     a0, u1, n1, a1, u2, n2, a2 = rotation_structure(chain)
     kp = a0.T * sp.Matrix(TOOL_AXIS)
-    w2 = sp.simplify(a1 * u2)
-    p0 = sp.simplify(a1 * a2 * sp.Matrix([0, 0, 1]))
-    c12 = sp.nsimplify(sp.simplify(u1.dot(w2)))
-    if sp.simplify(c12 ** 2 - 1) == 0:
+    w2 = (a1 * u2).applyfunc(_simplify)
+    p0 = (a1 * a2 * sp.Matrix([0, 0, 1])).applyfunc(_simplify)
+    c12 = sp.nsimplify(_simplify(u1.dot(w2)))
+    if _simplify(c12 ** 2 - 1) == 0:
         raise ValueError(f"layout {chain.layout.name}: the two rotary axes are parallel")
     alpha = (c12 * w2.dot(p0) - u1.dot(kp)) / (c12 ** 2 - 1)
     beta = (c12 * u1.dot(kp) - w2.dot(p0)) / (c12 ** 2 - 1)
     cross = u1.cross(w2)
     radicand = sp.factor(sp.simplify(
         (p0.dot(p0) - alpha ** 2 - beta ** 2 - 2 * alpha * beta * c12) / cross.dot(cross)))
-    alpha, beta = sp.simplify(alpha), sp.simplify(beta)
+    alpha, beta = _simplify(alpha), _simplify(beta)
     gamma = BRANCH * sp.sqrt(radicand)
     c = alpha * u1 + beta * w2 + gamma * cross
     q2 = _subproblem1(w2, p0, c)

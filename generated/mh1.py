@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       3a3a534a68c538a1437d4e5e1ddd5db71b1af141d519570f0656ef89cb7a4597
-derivation sha256  d967870b48121baae3e9c05c0392e172c0a87227cb83b6e62c8a4f39aa02cad4
+derivation sha256  fb02b76f04825c28b044984e3d28869e0a67534d9b596a6be86adaf790d72633
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -279,3 +279,11 @@ def test_statement_tokens_are_pythons_tokens(parts):
     except Exception:      # not a tokenizable line (unbalanced brackets ...): nothing to compare
         return
     assert lw._tokens(code) == want
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(-12, 12), st.integers(1, 12), st.sampled_from([1, 2, 3, 5, 6, 7, 8, 12]),
+       st.sampled_from([sp.S.Half, sp.Rational(1, 3), sp.Rational(-1, 2)]))
+def test_inverse_simplify_keeps_what_simplify_keeps(p, q, n, ex):
+    e = sp.Rational(p, q) * sp.Integer(n) ** ex
+    assert _same(inv._simplify(e), sp.simplify(e))
