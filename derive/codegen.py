@@ -1,9 +1,10 @@
 """Code generation: sympy expressions -> a plain, vectorised numpy module.
 
-Expressions are printed by sympy's :class:`NumPyPrinter` after common-subexpression
-elimination (``sympy.cse``); jinja2 only lays out the module around them (header with the
-layout hash, constants, signatures, docstrings).  Output is deterministic: the same layout
-text gives the same bytes.
+Expressions are printed with the rules of sympy's :class:`NumPyPrinter` after
+common-subexpression elimination (``sympy.cse``): a direct str printer for the shapes cse
+leaves (numbers, symbols, sums, products, powers, sin, cos), sympy's printer for anything
+else; jinja2 only lays out the module around them (header with the layout hash, constants,
+signatures, docstrings).  Output is deterministic: the same layout text gives the same bytes.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       cb3eaaef6ea43479f494f78b20313cf9234c86c1a4672bb40b6ddf3f14ec9daf
-derivation sha256  fb02b76f04825c28b044984e3d28869e0a67534d9b596a6be86adaf790d72633
+derivation sha256  4842b4f50bbbbf1aa3324c5f8a98894a8f631da857442cdc95b47cf9b2c3d684
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       4e958542d41ee41a3562c905ac982126f62b3b6e8551411cc5320f9343648625
-derivation sha256  9e1796aa9ce1a86fe84ecc62ad98df80562366a7523e175eb2145ec1ec38941f
+derivation sha256  1c176cb16b7ae119d9638c94c80bf827034d2f6a9ed8f7714ddc0fabfb5e4bd1
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
