@@ -29,6 +29,7 @@ squares over all ``3n`` rows and uses the closed forms as a cross-check.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import inspect
 
@@ -101,10 +102,17 @@ def system(labels, rotary_axis=None, angle=sp.Symbol("theta", real=True)):
     return sp.Matrix.vstack(*blocks), rows
 
 
+@functools.lru_cache(maxsize=1)
+def _system_pqk():
+    """:func:`system` of the points P, Q, K (shared by the three selections; immutable)."""
+    A, rows = system(("P", "Q", "K"))
+    return sp.ImmutableMatrix(A), tuple(rows)
+
+
 def selected_system(selection: str):
     """The 6 x 6 system of one Zhang & Hu selection in the lever arms of P, Q, K:
     ``(A, b)`` with ``b`` the corresponding :func:`delta_symbols`."""
-    A, rows = system(("P", "Q", "K"))
+    A, rows = _system_pqk()
     index = [rows.index(row) for row in SELECTIONS[selection]]
     b = sp.Matrix([delta_symbols(lab)[COORDS.index(c)] for lab, c in SELECTIONS[selection]])
     return sp.Matrix(A.extract(index, list(range(6)))), b
@@ -117,9 +125,10 @@ def _det(m: sp.Matrix, domain=None):
     else the expanded expression (the same polynomial whatever the method)."""
     from sympy.polys.matrices import DomainMatrix
 
-    dm = DomainMatrix.from_Matrix(m)
     if domain is not None:
-        return dm.convert_to(domain).det()
+        rows = [[domain.from_sympy(m[i, j]) for j in range(m.cols)] for i in range(m.rows)]
+        return DomainMatrix(rows, m.shape, domain).det()
+    dm = DomainMatrix.from_Matrix(m)
     return sp.expand(dm.domain.to_sympy(dm.det()))
 
 

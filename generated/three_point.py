@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       4e958542d41ee41a3562c905ac982126f62b3b6e8551411cc5320f9343648625
-derivation sha256  1c176cb16b7ae119d9638c94c80bf827034d2f6a9ed8f7714ddc0fabfb5e4bd1
+input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
+derivation sha256  2d11228338eb91526b757e61e6536b909b20361c503a79c3632c07be5f4fb532
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
