@@ -1,10 +1,9 @@
 """Code generation: sympy expressions -> a plain, vectorised numpy module.
 
-Expressions are printed with the rules of sympy's :class:`NumPyPrinter` after
-common-subexpression elimination (``sympy.cse``): a direct str printer for the shapes cse
-leaves (numbers, symbols, sums, products, powers, sin, cos), sympy's printer for anything
-else; jinja2 only lays out the module around them (header with the layout hash, constants,
-signatures, docstrings).  Output is deterministic: the same layout text gives the same bytes.
+Expressions are printed by a subclass of sympy's :class:`NumPyPrinter` after
+common-subexpression elimination (``sympy.cse``); jinja2 only lays out the module around them
+(header with the layout hash, constants, signatures, docstrings).  Output is deterministic: the
+same layout text gives the same bytes.
 """
 
 from __future__ import annotations
@@ -52,6 +51,87 @@ class _Printer(NumPyPrinter):
         if (order or self.order) is None and expr.is_Add:
             return ordered_terms(expr)
         return super()._as_ordered_terms(expr, order)
+
+    # sympy's rules for sums and products (StrPrinter._print_Add, CodePrinter._print_Mul,
+    # StrPrinter.parenthesize) with the precedence of the common nodes looked up directly:
+    # sympy's precedence() walks the class hierarchy and, for a product, builds its negative
+    # (Mul.could_extract_minus_sign) each time.  A test compares with sympy's printer.
+
+    def parenthesize(self, item, level, strict=False):
+        p = _precedence(item)
+        if p < level or (not strict and p <= level):
+            return "(%s)" % self._print(item)
+        return self._print(item)
+
+    def _print_Add(self, expr, order=None):
+        prec = _precedence(expr)
+        out = []
+        for term in self._as_ordered_terms(expr, order=order):
+            t = self._print(term)
+            if t.startswith("-") and not term.is_Add:
+                sign, t = "-", t[1:]
+            else:
+                sign = "+"
+            out.extend([sign, f"({t})" if _precedence(term) < prec or term.is_Add else t])
+        sign = out.pop(0)
+        return ("" if sign == "+" else sign) + " ".join(out)
+
+    def _print_Mul(self, expr):
+        if not expr.is_commutative or self.order in ("old", "none"):
+            return super()._print_Mul(expr)
+        prec = _precedence(expr)
+        c, rest = expr.as_coeff_Mul()
+        if c < 0:
+            expr, sign = _keep_coeff(-c, rest), "-"
+        else:
+            sign = ""
+        num, den, pow_paren = [], [], []
+        for item in expr.as_ordered_factors():
+            if item.is_Pow and item.exp.is_Rational and item.exp.is_negative:
+                if item.exp != -1:
+                    den.append(sp.Pow(item.base, -item.exp, evaluate=False))
+                else:
+                    if len(item.args[0].args) != 1 and isinstance(item.base, sp.Mul):
+                        pow_paren.append(item)
+                    den.append(sp.Pow(item.base, -item.exp))
+            else:
+                num.append(item)
+        num = num or [sp.S.One]
+        if len(num) == 1 and sign == "-":
+            num_str = [self.parenthesize(num[0], _UNARY)]
+        else:
+            num_str = [self.parenthesize(x, prec) for x in num]
+        den_str = [self.parenthesize(x, prec) for x in den]
+        for item in pow_paren:
+            if item.base in den:
+                k = den.index(item.base)
+                den_str[k] = f"({den_str[k]})"
+        if not den:
+            return sign + "*".join(num_str)
+        if len(den) == 1:
+            return sign + "*".join(num_str) + "/" + den_str[0]
+        return sign + "*".join(num_str) + "/(%s)" % "*".join(den_str)
+
+
+_ATOM, _ADD, _MUL, _POW = (PRECEDENCE[k] for k in ("Atom", "Add", "Mul", "Pow"))
+_UNARY = 0.5 * (PRECEDENCE["Pow"] + PRECEDENCE["Mul"])
+
+
+def _precedence(e):
+    """sympy's ``precedence(e)``: looked up directly for symbols, sums, powers and products of
+    numbers, symbols, powers and sines / cosines (a product led by a negative rational or
+    float prints as ``-...``); sympy's function for everything else."""
+    if e.is_Symbol:
+        return _ATOM
+    if e.is_Add:
+        return _ADD
+    if e.is_Pow:
+        return _POW
+    if e.is_Mul and all(not a.is_Function or type(a) in (sp.sin, sp.cos) for a in e.args):
+        c = e.args[0]
+        if c.is_Rational or (c.is_Float and c.is_finite):
+            return _ADD if c.is_extended_negative else _MUL
+    return sympy_precedence(e)
 
 
 #: complex values of the numeric factors seen by :func:`ordered_terms` (sympy number -> complex)
@@ -119,122 +199,8 @@ _PRINTER = _Printer()
 
 
 def print_expr(expr) -> str:
-    """One expression as numpy source text (:func:`_fast_print`, else sympy's printer)."""
-    try:
-        return _fast_print(expr)
-    except _Unsupported:
-        return _PRINTER.doprint(expr)
-
-
-_ATOM, _ADD, _MUL, _POW = (PRECEDENCE[k] for k in ("Atom", "Add", "Mul", "Pow"))
-
-
-class _Unsupported(Exception):
-    """An expression shape :func:`_fast_print` leaves to sympy's printer."""
-
-
-def _fast_print(expr) -> str:
-    """The text ``_PRINTER.doprint(expr)`` gives, for the shapes cse leaves in the generated
-    code: numbers, symbols, Add, Mul, Pow with a positive integer or +-1/2 exponent (or a
-    negative one inside a Mul), sin and cos.  The same rules as sympy's printers (StrPrinter
-    Add, CodePrinter Mul, NumPyPrinter Pow, known functions) without their per-node dispatch;
-    anything else raises :class:`_Unsupported` and the whole expression goes to sympy.  A test
-    compares the two printers; ``volerr derive --all`` output is compared byte for byte."""
-    P = _PRINTER
-    unary = 0.5 * (PRECEDENCE["Pow"] + PRECEDENCE["Mul"])
-
-    def precedence(e):
-        # sympy's precedence() for the common nodes; Mul without building -e (its
-        # could_extract_minus_sign): a Mul led by a negative rational or float prints as "-..."
-        if e.is_Symbol:
-            return _ATOM
-        if e.is_Add:
-            return _ADD
-        if e.is_Pow:
-            return _POW
-        if e.is_Mul and all(not a.is_Function or type(a) in (sp.sin, sp.cos) for a in e.args):
-            c = e.args[0]
-            if c.is_Rational or (c.is_Float and c.is_finite):
-                return _ADD if c.is_extended_negative else _MUL
-        return sympy_precedence(e)
-
-    def paren(item, level):
-        text = pr(item)
-        return f"({text})" if precedence(item) <= level else text
-
-    def pr(e):
-        if e.is_Number:
-            if e.is_Float or e.is_Rational:
-                return P._print(e)
-            raise _Unsupported
-        if e.is_Symbol:
-            name = e.name
-            if name in P.reserved_words or "{" in name or type(e) is not sp.Symbol:
-                raise _Unsupported
-            return name
-        if e.is_Add:
-            terms = ordered_terms(e)
-            prec = precedence(e)
-            out = []
-            for term in terms:
-                t = pr(term)
-                if t.startswith("-") and not term.is_Add:
-                    sign, t = "-", t[1:]
-                else:
-                    sign = "+"
-                out.extend([sign, f"({t})" if precedence(term) < prec or term.is_Add else t])
-            sign = out.pop(0)
-            return ("" if sign == "+" else sign) + " ".join(out)
-        if e.is_Mul:
-            if not e.is_commutative:
-                raise _Unsupported
-            prec = precedence(e)
-            c, rest = e.as_coeff_Mul()
-            if c < 0:
-                e, sign = _keep_coeff(-c, rest), "-"
-            else:
-                sign = ""
-            num, den, pow_paren = [], [], []
-            for item in e.as_ordered_factors():
-                if item.is_Pow and item.exp.is_Rational and item.exp.is_negative:
-                    if item.exp != -1:
-                        den.append(sp.Pow(item.base, -item.exp, evaluate=False))
-                    else:
-                        if len(item.args[0].args) != 1 and isinstance(item.base, sp.Mul):
-                            pow_paren.append(item)
-                        den.append(sp.Pow(item.base, -item.exp))
-                else:
-                    num.append(item)
-            num = num or [sp.S.One]
-            if len(num) == 1 and sign == "-":
-                num_str = [paren(num[0], unary)]
-            else:
-                num_str = [paren(x, prec) for x in num]
-            den_str = [paren(x, prec) for x in den]
-            for item in pow_paren:
-                if item.base in den:
-                    k = den.index(item.base)
-                    den_str[k] = f"({den_str[k]})"
-            if not den:
-                return sign + "*".join(num_str)
-            if len(den) == 1:
-                return sign + "*".join(num_str) + "/" + den_str[0]
-            return sign + "*".join(num_str) + "/(%s)" % "*".join(den_str)
-        if e.is_Pow:
-            base, exp = e.base, e.exp
-            if exp is sp.S.Half:
-                return f"numpy.sqrt({pr(base)})"
-            if exp == -sp.S.Half and e.is_commutative:
-                return f"1/numpy.sqrt({pr(base)})"
-            if not (exp.is_Integer and exp > 0):
-                raise _Unsupported
-            prec = precedence(e)
-            return f"{paren(base, prec)}**{paren(exp, prec)}"
-        if type(e) in (sp.sin, sp.cos):
-            return f"numpy.{type(e).__name__}({pr(e.args[0])})"
-        raise _Unsupported
-
-    return pr(sp.sympify(expr))
+    """One expression as numpy source text."""
+    return _PRINTER.doprint(expr)
 
 
 @dataclass

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       26ff981565755ae2f06cdbc614479e95b74eb63685bed151847c32178de4a711
-derivation sha256  b739402aa377a382384e993614064d6f579a48c3d0394814e39208c7e36f969f
+derivation sha256  aea622529006314811c53e89ef1183d70c498697df02fc111a94c21ea8a7772a
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/probe.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
-derivation sha256  2d11228338eb91526b757e61e6536b909b20361c503a79c3632c07be5f4fb532
+derivation sha256  ff2733587579ff348819bfa1914eb868cf512ee9d00763a1c794c78bd163073f
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
