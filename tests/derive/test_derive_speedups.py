@@ -1,7 +1,10 @@
 """The faster paths of the derivation give sympy's own results: the canonical order used by
-cse (sympy.ordered with its default keys) and the entry-by-entry matrix product (sympy's
-Matrix product), on the expressions of a real layout and on random expressions."""
+cse (sympy.ordered with its default keys), the entry-by-entry matrix product (sympy's Matrix
+product), polynomial-ring products and reductions (expand, rem, cancel), one-pass collect,
+term-wise derivatives, the printer (sympy's NumPyPrinter) and the line tokeniser (tokenize),
+on the expressions of real layouts and on random expressions."""
 
+import pytest
 import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -266,7 +269,13 @@ class _SympyPrinter(NumPyPrinter):
 def test_printer_prints_what_sympys_printer_prints(e):
     from volerr.derive.codegen import print_expr
 
-    assert print_expr(e) == _SympyPrinter().doprint(e)
+    try:
+        want = _SympyPrinter().doprint(e)
+    except Exception as exc:    # e.g. zoo from a division by zero: sympy cannot print it either
+        with pytest.raises(type(exc)):
+            print_expr(e)
+        return
+    assert print_expr(e) == want
 
 
 code_tokens = st.sampled_from(["_t12", "numpy.sin", "x", "(", ")", "[", "]", ",", " ", "+",
