@@ -10,7 +10,7 @@ from volerr.machine.layout import Layout, layout_names, read_layout
 
 from . import inverse
 from . import volumetric as vol
-from .codegen import Function, render_module
+from .codegen import Function, render_module, shared_preparation
 from .kinematics import PROBE, Chain
 
 
@@ -53,7 +53,7 @@ def derive_functions(layout: Layout) -> list[Function]:
     funcs = [
         Function("volumetric_error", pos + cov + probe + params,
                  # grouped by position and probe symbols: sums of errors share one product
-                 [sp.collect(e, list(chain.positions) + list(PROBE)) for e in error],
+                 [vol.collect_symbols(e, list(chain.positions) + list(PROBE)) for e in error],
                  "First-order volumetric error (dX, dY, dZ), mm."),
         Function("sensitivity", pos + cov + probe, list(sens),
                  "d(dX, dY, dZ)/d(parameter): array (3, n_parameters, *shape).",
@@ -86,7 +86,7 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "First-order error of the tool-axis direction (i, j, k), rad."),
     ]
     if inverse.applies(layout):
-        funcs.extend(inverse.inverse_functions(layout))
+        funcs.extend(inverse.inverse_functions(layout, chain))
     if rules.shift:
         funcs.append(Function(
             "transfer_shift", transfer_args, [rules.shift[k] for k in sorted(rules.shift)],
@@ -152,9 +152,10 @@ def all_generated(progress=None) -> dict:
     the layout-independent modules of :data:`EXTRA_MODULES`.  ``progress``: optional wrapper
     of the layout-name iterable (e.g. a tqdm bar)."""
     names = layout_names()
-    out = {f"{module_name(n)}.py": generate_module(read_layout(n))
-           for n in (progress(names) if progress else names)}
-    for filename, target in EXTRA_MODULES.items():
-        mod_name, func = target.split(":")
-        out[filename] = getattr(importlib.import_module(mod_name), func)()
+    with shared_preparation():     # layouts share some functions: prepared once
+        out = {f"{module_name(n)}.py": generate_module(read_layout(n))
+               for n in (progress(names) if progress else names)}
+        for filename, target in EXTRA_MODULES.items():
+            mod_name, func = target.split(":")
+            out[filename] = getattr(importlib.import_module(mod_name), func)()
     return out

@@ -47,9 +47,24 @@ def rotation(axis, angle) -> sp.Matrix:
 
 
 def exact_error_htm(ex=0, ey=0, ez=0, dx=0, dy=0, dz=0) -> sp.Matrix:
-    """The exact rigid motion that a twist approximates: Trans(d) Rz(ez) Ry(ey) Rx(ex)."""
-    return (translation((dx, dy, dz)) * rotation((0, 0, 1), ez) * rotation((0, 1, 0), ey)
-            * rotation((1, 0, 0), ex))
+    """The exact rigid motion that a twist approximates: Trans(d) Rz(ez) Ry(ey) Rx(ex)
+    (sympy's matrix product, entry by entry: :func:`_matmul`)."""
+    m = _matmul(translation((dx, dy, dz)), rotation((0, 0, 1), ez))
+    return _matmul(_matmul(m, rotation((0, 1, 0), ey)), rotation((1, 0, 0), ex))
+
+
+def _matmul(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
+    """``a * b`` built entry by entry as one Add of the non-zero products: the same
+    expressions as sympy's product (tested), without its general-domain machinery."""
+    n, m, p = a.rows, a.cols, b.cols
+    zero = sp.S.Zero
+    out = []
+    for i in range(n):
+        row = [a[i, k] for k in range(m)]
+        for j in range(p):
+            terms = [x * b[k, j] for k, x in enumerate(row) if x != 0 and b[k, j] != 0]
+            out.append(sp.Add(*terms) if terms else zero)
+    return sp.Matrix(n, p, out)
 
 
 @dataclass

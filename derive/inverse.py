@@ -31,7 +31,7 @@ import sympy as sp
 from volerr.machine.layout import Layout
 
 from .codegen import Function
-from .kinematics import PROBE, Chain, _rational_vec, position_symbol
+from .kinematics import PROBE, Chain, _radical, _rational_vec, position_symbol
 from .volumetric import nominal_point
 
 TOOL_AXIS = sp.symbols("i j k", real=True)
@@ -65,6 +65,17 @@ def rotation_structure(chain: Chain):
     return parts[0], dirs[0], axes[0], parts[1], dirs[1], axes[1], parts[2]
 
 
+def _simplify(e):
+    """``sympy.simplify(e)``, except for numbers already in simplest form (a rational, a
+    radical ``sqrt(n)`` or a rational times one), which it returns unchanged: the fixed
+    rotations of most layouts have only such entries (a test compares with simplify)."""
+    e = sp.sympify(e)
+    if e.is_Rational or _radical(e) or (e.is_Mul and len(e.args) == 2 and e.args[0].is_Rational
+                                        and _radical(e.args[1])):
+        return e
+    return sp.simplify(e)
+
+
 def _subproblem1(axis: sp.Matrix, a: sp.Matrix, b: sp.Matrix):
     """Angle of the right-hand rotation about unit ``axis`` that turns ``a`` onto ``b``."""
     ap = a - axis * (axis.dot(a))
@@ -76,17 +87,17 @@ def rotary_inverse(chain: Chain) -> dict:
     """Axis name -> expression of its position (rad) in the tool axis (i, j, k) and ``branch``."""
     a0, u1, n1, a1, u2, n2, a2 = rotation_structure(chain)
     kp = a0.T * sp.Matrix(TOOL_AXIS)
-    w2 = sp.simplify(a1 * u2)
-    p0 = sp.simplify(a1 * a2 * sp.Matrix([0, 0, 1]))
-    c12 = sp.nsimplify(sp.simplify(u1.dot(w2)))
-    if sp.simplify(c12 ** 2 - 1) == 0:
+    w2 = (a1 * u2).applyfunc(_simplify)
+    p0 = (a1 * a2 * sp.Matrix([0, 0, 1])).applyfunc(_simplify)
+    c12 = sp.nsimplify(_simplify(u1.dot(w2)))
+    if _simplify(c12 ** 2 - 1) == 0:
         raise ValueError(f"layout {chain.layout.name}: the two rotary axes are parallel")
     alpha = (c12 * w2.dot(p0) - u1.dot(kp)) / (c12 ** 2 - 1)
     beta = (c12 * u1.dot(kp) - w2.dot(p0)) / (c12 ** 2 - 1)
     cross = u1.cross(w2)
     radicand = sp.factor(sp.simplify(
         (p0.dot(p0) - alpha ** 2 - beta ** 2 - 2 * alpha * beta * c12) / cross.dot(cross)))
-    alpha, beta = sp.simplify(alpha), sp.simplify(beta)
+    alpha, beta = _simplify(alpha), _simplify(beta)
     gamma = BRANCH * sp.sqrt(radicand)
     c = alpha * u1 + beta * w2 + gamma * cross
     q2 = _subproblem1(w2, p0, c)
@@ -98,7 +109,52 @@ def _reduce_sin_cos(expr, angles) -> sp.Expr:
     """``expr`` (polynomial in sin and cos of ``angles``) expanded and reduced modulo
     ``sin^2 + cos^2 = 1`` of every angle: the remainder of the division by
     ``cos^2 + sin^2 - 1`` in each cosine, a canonical form (at most linear in each cosine).
-    Polynomial arithmetic only: much cheaper than ``trigsimp`` on the same expression."""
+
+    Done in a sparse polynomial ring over QQ whose generators are the free symbols, the
+    sines and cosines and any radicals of the coefficients (``sqrt(2)``): the divisor is
+    monic in the cosine ``c``, so the remainder replaces ``c^k`` by
+    ``c^(k mod 2) (1 - s^2)^(k // 2)`` term by term.  The result is mathematically the
+    remainder that ``sympy.rem`` gives, expanded: the same canonical expression (the
+    generated code is compared byte for byte)."""
+    from sympy.polys.domains import QQ
+    from sympy.polys.rings import ring
+
+    pairs = [(sp.Dummy(f"s{i}"), sp.Dummy(f"c{i}")) for i in range(len(angles))]
+    fwd = {}
+    for q, (s_, c_) in zip(angles, pairs):
+        fwd[sp.sin(q)], fwd[sp.cos(q)] = s_, c_
+    e = sp.sympify(expr).xreplace(fwd)
+    radicals = sorted((a for a in e.atoms(sp.Pow) if _radical(a)), key=sp.default_sort_key)
+    # every sine is a generator: the remainder brings in sin(q) where only cos(q)^2 was
+    gens = [*sorted(e.free_symbols | {s_ for s_, _ in pairs}, key=sp.default_sort_key),
+            *radicals]
+    try:
+        R, *xs = ring(gens, QQ)
+        p = R.from_expr(e)
+    except (ValueError, TypeError, sp.polys.polyerrors.CoercionFailed):
+        return _reduce_sin_cos_sympy(expr, angles)   # not a polynomial of that shape
+    index = {g: i for i, g in enumerate(gens)}
+    for s_, c_ in pairs:
+        if c_ not in index:
+            continue
+        ic, s = index[c_], xs[index[s_]]
+        if all(m[ic] < 2 for m in p.keys()):
+            continue
+        powers = [R.one]
+        out = R.zero
+        for m, coeff in p.terms():
+            k = m[ic]
+            while len(powers) <= k // 2:
+                powers.append(powers[-1] * (1 - s ** 2))
+            low = m[:ic] + (k % 2,) + m[ic + 1:]
+            out += R({low: coeff}) * powers[k // 2]
+        p = out
+    back = {v: k for k, v in fwd.items()}
+    return sp.expand(p.as_expr().xreplace(back))
+
+
+def _reduce_sin_cos_sympy(expr, angles) -> sp.Expr:
+    """:func:`_reduce_sin_cos` by ``sympy.rem`` on expressions (the general path)."""
     pairs = [(sp.Dummy(f"s{i}"), sp.Dummy(f"c{i}")) for i in range(len(angles))]
     fwd = {}
     for q, (s_, c_) in zip(angles, pairs):
@@ -124,9 +180,10 @@ def linear_inverse(chain: Chain) -> dict:
     return {a: _reduce_sin_cos(sol[i], angles) for i, a in enumerate(("X", "Y", "Z"))}
 
 
-def inverse_functions(layout: Layout) -> list[Function]:
-    """Generated functions ``inverse_rotary`` and ``inverse_linear`` of a five-axis layout."""
-    chain = Chain.from_layout(layout)
+def inverse_functions(layout: Layout, chain: Chain | None = None) -> list[Function]:
+    """Generated functions ``inverse_rotary`` and ``inverse_linear`` of a five-axis layout
+    (``chain``: the layout's chain if already built, default tool-point pivot)."""
+    chain = Chain.from_layout(layout) if chain is None else chain
     rot = [a for a in layout.axis_names if layout.axes[a].kind == "rotary"]
     rinv = rotary_inverse(chain)
     linv = linear_inverse(chain)

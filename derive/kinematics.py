@@ -48,8 +48,8 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS, Layout
 
-from .htm import (PROBE, Factor, exact_error_htm, parameter_symbol, position_symbol,  # noqa: F401
-                  rotation, translation, twist)
+from .htm import (PROBE, Factor, _matmul, exact_error_htm, parameter_symbol,  # noqa: F401
+                  position_symbol, rotation, translation, twist)
 
 
 def _sympify_vec(v, params: dict) -> sp.Matrix:
@@ -159,18 +159,84 @@ def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Facto
     return out
 
 
-def _matmul(a: sp.Matrix, b: sp.Matrix) -> sp.Matrix:
-    """``a * b`` built entry by entry as one Add of the non-zero products: the same
-    expressions as sympy's product (tested), without its general-domain machinery."""
-    n, m, p = a.rows, a.cols, b.cols
-    zero = sp.S.Zero
-    out = []
-    for i in range(n):
-        row = [a[i, k] for k in range(m)]
-        for j in range(p):
-            terms = [x * b[k, j] for k, x in enumerate(row) if x != 0 and b[k, j] != 0]
-            out.append(sp.Add(*terms) if terms else zero)
-    return sp.Matrix(n, p, out)
+def _radical(a) -> bool:
+    """A numeric radical such as ``sqrt(2)`` or ``3**(1/3)`` (a generator of the rings below;
+    other numeric powers are polynomial arithmetic on numbers)."""
+    return a.is_Pow and a.base.is_Rational and a.exp.is_Rational and not a.exp.is_Integer
+
+
+def _ring_atoms(expr) -> set | None:
+    """Generators a polynomial ring needs for ``expr``: its free symbols, its sines and
+    cosines (of expanded arguments) and its numeric radicals (``sqrt(2)``); ``None`` when it
+    holds any other function (``expand`` could rewrite inside it)."""
+    funcs = expr.atoms(sp.Function)
+    if any(f.func not in (sp.sin, sp.cos) or f.args[0] != sp.expand(f.args[0]) for f in funcs):
+        return None
+    return (set(expr.free_symbols) | funcs | expr.atoms(sp.NumberSymbol)
+            | {a for a in expr.atoms(sp.Pow) if _radical(a)})
+
+
+def _not_polynomial():
+    from sympy.polys.polyerrors import CoercionFailed
+
+    return (ValueError, TypeError, CoercionFailed)
+
+
+#: exceptions of :meth:`RingMatrices.convert` for an entry that is not a polynomial
+NOT_POLYNOMIAL = _not_polynomial()
+
+
+class RingMatrices:
+    """Matrices of expressions as matrices of elements of one sparse polynomial ring over
+    QQ (``sympy.polys.rings``): products are polynomial arithmetic, and ``as_expr`` of a
+    ring element is the expanded expression (``sympy.expand`` of the same product: the
+    expanded form of a polynomial in its generators is unique).  Generators: the symbols,
+    function applications and numeric radicals of the given matrices; sines and cosines are
+    generators, so no trigonometric identity is applied (as with ``expand``).  ``None`` from
+    :meth:`build` when an entry is not a polynomial in such generators."""
+
+    def __init__(self, ring):
+        self.ring = ring
+
+    @classmethod
+    def build(cls, matrices):
+        from sympy.polys.domains import QQ
+        from sympy.polys.rings import PolyRing
+
+        atoms = set()
+        for m in matrices:
+            for e in m:
+                more = _ring_atoms(sp.sympify(e))
+                if more is None:
+                    return None
+                atoms |= more
+        gens = sorted(atoms, key=sp.default_sort_key)
+        return cls(PolyRing(gens or [sp.Dummy("one")], QQ))
+
+    def convert(self, m: sp.Matrix) -> list:
+        """``m`` as a list of rows of ring elements (:data:`NOT_POLYNOMIAL` if an entry is
+        not a polynomial in the generators)."""
+        R = self.ring
+        return [[R.from_expr(m[i, j]) if m[i, j] != 0 else R.zero for j in range(m.cols)]
+                for i in range(m.rows)]
+
+    def mul(self, a: list, b: list) -> list:
+        R = self.ring
+        n, k, p = len(a), len(b), len(b[0])
+        out = []
+        for i in range(n):
+            row = a[i]
+            out.append([sum((row[t] * b[t][j] for t in range(k) if row[t] and b[t][j]),
+                            R.zero) for j in range(p)])
+        return out
+
+    @staticmethod
+    def add(a: list, b: list) -> list:
+        return [[x + y for x, y in zip(ra, rb)] for ra, rb in zip(a, b)]
+
+    @staticmethod
+    def as_expr(a: list) -> sp.Matrix:
+        return sp.Matrix([[x.as_expr() for x in row] for row in a])
 
 
 @dataclass
@@ -181,6 +247,7 @@ class Chain:
     factors: list[Factor]
     positions: tuple = field(default_factory=tuple)
     parameters: tuple = field(default_factory=tuple)
+    _nominal: tuple | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_layout(cls, layout: Layout, table_pivot: str = "tool_point") -> "Chain":
@@ -189,12 +256,16 @@ class Chain:
                    tuple(parameter_symbol(p) for p in layout.parameter_names))
 
     def nominal_htm(self) -> sp.Matrix:
-        """Nominal ``tool2work`` (error factors are identity)."""
-        m = sp.eye(4)
-        for f in self.factors:
-            if not f.is_error:
-                m = m * f.nominal
-        return m
+        """Nominal ``tool2work`` (error factors are identity); computed once per chain (the
+        product of sympy's matrix product, entry by entry: :func:`_matmul`), a copy returned."""
+        key = tuple(id(f.nominal) for f in self.factors if not f.is_error)
+        if self._nominal is None or self._nominal[0] != key:
+            m = sp.eye(4)
+            for f in self.factors:
+                if not f.is_error:
+                    m = _matmul(m, f.nominal)
+            self._nominal = (key, m)
+        return self._nominal[1].copy()
 
     def exact_htm(self) -> sp.Matrix:
         """Actual ``tool2work`` with exact rotations (not linearised)."""

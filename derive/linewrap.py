@@ -12,6 +12,7 @@ same text gives the same lines.
 from __future__ import annotations
 
 import io
+import re
 import textwrap
 import tokenize
 
@@ -23,8 +24,35 @@ _SKIP = (tokenize.NEWLINE, tokenize.NL, tokenize.ENDMARKER, tokenize.INDENT, tok
          tokenize.COMMENT)
 
 
+# Python's own token patterns, in the tokenizer's order (number, operator, string, name);
+# strings without escapes or line breaks only (others fall back to tokenize)
+_TOKEN = re.compile(r"[ ]*(?:(?P<number>%s)|(?P<op>%s)|(?P<string>(?:%s)(?:'[^'\\\n]*'|"
+                    r'"[^"\\\n]*"))|(?P<name>\w+))'
+                    % (tokenize.Number, tokenize.Special, tokenize.StringPrefix))
+_TYPES = {"number": tokenize.NUMBER, "name": tokenize.NAME, "string": tokenize.STRING,
+          "op": tokenize.OP}
+
+
 def _tokens(code: str) -> list[tuple[str, int, int, int]]:
-    """(text, start column, end column, type) of the tokens of a one-line statement."""
+    """(text, start column, end column, type) of the tokens of a one-line statement.
+
+    The statements the printer emits (names, decimal numbers, plain quoted strings,
+    operators, single spaces) are split by one regular expression; anything it does not
+    consume entirely goes to :mod:`tokenize` (a test compares the two on such statements)."""
+    out, pos, n = [], 0, len(code.rstrip(" "))
+    match = _TOKEN.match
+    while pos < n:
+        m = match(code, pos)
+        if m is None or m.end() == pos:
+            return _tokenize(code)
+        kind = m.lastgroup
+        start = m.start(kind)
+        out.append((m.group(kind), start, m.end(), _TYPES[kind]))
+        pos = m.end()
+    return out
+
+
+def _tokenize(code: str) -> list[tuple[str, int, int, int]]:
     toks = tokenize.generate_tokens(io.StringIO(code).readline)
     return [(t.string, t.start[1], t.end[1], t.type) for t in toks if t.type not in _SKIP]
 

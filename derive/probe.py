@@ -62,10 +62,22 @@ def probe_axis(a=A, b=B) -> sp.Matrix:
     return sp.Matrix([-sp.sin(a) * sp.cos(b), -sp.sin(a) * sp.sin(b), sp.cos(a)])
 
 
-def _unit(v: sp.Matrix, norm_sq, norm) -> sp.Matrix:
+def _pythagoras(expr, angles=(A, B)) -> sp.Expr:
+    """``expr`` (a polynomial in sines and cosines) expanded with every ``cos(q)**k``, k >= 2,
+    written as ``cos(q)**(k mod 2) (1 - sin(q)**2)**(k // 2)`` for q in ``angles``: a
+    canonical form, at most linear in each cosine, so two such polynomials are equal as
+    functions iff the forms are equal.  Polynomial arithmetic only (no ``simplify``)."""
+    e = sp.expand(expr)
+    cosines = {sp.cos(q) for q in angles}
+    rep = {p: p.base ** (p.exp % 2) * (1 - sp.sin(p.base.args[0]) ** 2) ** (p.exp // 2)
+           for p in e.atoms(sp.Pow) if p.base in cosines and p.exp.is_Integer and p.exp >= 2}
+    return sp.expand(e.xreplace(rep)) if rep else e
+
+
+def _unit(v: sp.Matrix, norm_sq, norm, angles) -> sp.Matrix:
     """``v / |v|`` with ``|v|^2`` proven equal to ``norm**2`` (so the norm is replaced)."""
-    assert sp.simplify(v.dot(v) - norm_sq) == 0
-    return sp.simplify(v / norm)
+    assert _pythagoras(v.dot(v) - norm_sq, angles) == 0
+    return v.applyfunc(lambda c: _pythagoras(sp.cancel(c / norm), angles))
 
 
 def basis(a=A, b=B) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
@@ -74,9 +86,9 @@ def basis(a=A, b=B) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
     The normalisation ``|e'_z x e_z| = |sin a|`` is taken as ``sin a`` (0 < a < pi)."""
     ez = probe_axis(a, b)
     cross_y = ez.cross(E_Z)
-    ey = _unit(cross_y, sp.sin(a) ** 2, sp.sin(a))
+    ey = _unit(cross_y, sp.sin(a) ** 2, sp.sin(a), (a, b))
     cross_x = ey.cross(ez)
-    ex = _unit(cross_x, 1, 1)
+    ex = _unit(cross_x, 1, 1, (a, b))
     return ex, ey, ez
 
 
@@ -112,7 +124,7 @@ def construction_limit_at_vertical(b=B) -> sp.Matrix:
 def direction_in_probe_frame(a=A, b=B, m=(MX, MY, MZ)) -> sp.Matrix:
     """Eq. (14): the probing direction in probe coordinates, ``M' = machine2probe M``
     (= Tp^-1 M with the printed Tp, whose inverse is its transpose)."""
-    return sp.simplify(machine2probe(a, b) * sp.Matrix(m))
+    return (machine2probe(a, b) * sp.Matrix(m)).applyfunc(sp.expand)
 
 
 def direction_angles(m=(MXP, MYP, MZP)) -> tuple:
@@ -140,7 +152,7 @@ def unit_direction(phi=PHI, theta=THETA) -> sp.Matrix:
 
 def direction_in_machine_frame(a=A, b=B, phi=PHI, theta=THETA) -> sp.Matrix:
     """Machine-frame probing direction of probe-frame angles (phi, theta)."""
-    return sp.simplify(probe2machine(a, b) * unit_direction(phi, theta))
+    return (probe2machine(a, b) * unit_direction(phi, theta)).applyfunc(sp.expand)
 
 
 def functions() -> list[Function]:

@@ -29,6 +29,7 @@ squares over all ``3n`` rows and uses the closed forms as a cross-check.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import inspect
 
@@ -101,21 +102,32 @@ def system(labels, rotary_axis=None, angle=sp.Symbol("theta", real=True)):
     return sp.Matrix.vstack(*blocks), rows
 
 
+@functools.lru_cache(maxsize=1)
+def _system_pqk():
+    """:func:`system` of the points P, Q, K (shared by the three selections; immutable)."""
+    A, rows = system(("P", "Q", "K"))
+    return sp.ImmutableMatrix(A), tuple(rows)
+
+
 def selected_system(selection: str):
     """The 6 x 6 system of one Zhang & Hu selection in the lever arms of P, Q, K:
     ``(A, b)`` with ``b`` the corresponding :func:`delta_symbols`."""
-    A, rows = system(("P", "Q", "K"))
+    A, rows = _system_pqk()
     index = [rows.index(row) for row in SELECTIONS[selection]]
     b = sp.Matrix([delta_symbols(lab)[COORDS.index(c)] for lab, c in SELECTIONS[selection]])
     return sp.Matrix(A.extract(index, list(range(6)))), b
 
 
-def _det(m: sp.Matrix):
-    """Determinant of a polynomial matrix, expanded: computed in the polynomial ring
-    (fraction-free elimination on ring elements, ~20x faster than Berkowitz on expressions);
-    the expanded polynomial is the same whatever the method."""
+def _det(m: sp.Matrix, domain=None):
+    """Determinant of a polynomial matrix: computed in the polynomial ring (fraction-free
+    elimination on ring elements, ~20x faster than Berkowitz on expressions).  Returns the
+    ring element when ``domain`` (a polynomial ring domain holding the entries) is given,
+    else the expanded expression (the same polynomial whatever the method)."""
     from sympy.polys.matrices import DomainMatrix
 
+    if domain is not None:
+        rows = [[domain.from_sympy(m[i, j]) for j in range(m.cols)] for i in range(m.rows)]
+        return DomainMatrix(rows, m.shape, domain).det()
     dm = DomainMatrix.from_Matrix(m)
     return sp.expand(dm.domain.to_sympy(dm.det()))
 
@@ -124,17 +136,28 @@ def closed_form(selection: str) -> dict:
     """Closed-form solution of a selected 6 x 6 system.
 
     Returns ``{"EX": expr, ..., "EC": expr, "N": determinant}``: each motion as a function of
-    the lever arms and the six selected deviations (Cramer's rule, factored)."""
+    the lever arms and the six selected deviations (Cramer's rule, factored).
+
+    The determinants and the cancellation of their common factors are done on elements of
+    one polynomial ring over ZZ, its generators in the order ``sympy.cancel`` gives them, so
+    each quotient is ``sympy.cancel(numerator / determinant)`` without converting the
+    polynomials to expressions and back."""
+    from sympy.polys.domains import ZZ
+    from sympy.polys.polyutils import _sort_gens
+    from sympy.polys.rings import ring
+
     A, b = selected_system(selection)
-    det = sp.factor(_det(A))
+    R, *_ = ring(_sort_gens(sorted(A.free_symbols | b.free_symbols, key=str)), ZZ)
+    K = R.to_domain()
+    det = _det(A, K)
     out = {}
     for j, name in enumerate(MOTIONS):
         Aj = sp.Matrix(A)
         Aj[:, j] = b
-        num = _det(Aj)
         # cancel the common polynomial factors of numerator and determinant
-        out[name] = sp.cancel(num / sp.expand(det))
-    out["N"] = det
+        num, den = _det(Aj, K).cancel(det)
+        out[name] = num.as_expr() / den.as_expr()
+    out["N"] = sp.factor(det.as_expr())
     return out
 
 

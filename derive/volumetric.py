@@ -14,7 +14,8 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS
 
-from .kinematics import PROBE, Chain, parameter_symbol, position_symbol, twist
+from .kinematics import (NOT_POLYNOMIAL, PROBE, Chain, RingMatrices, parameter_symbol,
+                         position_symbol, twist)
 
 
 def nominal_point(chain: Chain) -> sp.Matrix:
@@ -34,7 +35,44 @@ def volumetric_error(chain: Chain) -> sp.Matrix:
 
 def _first_order_displacement(chain: Chain, v: sp.Matrix) -> sp.Matrix:
     """sum_k prefix_k @ D_k @ suffix_k @ v: the first-order change of the homogeneous vector v
-    (a point when v[3] = 1, a direction when v[3] = 0)."""
+    (a point when v[3] = 1, a direction when v[3] = 0), expanded.
+
+    Computed on polynomial-ring elements (:class:`volerr.derive.kinematics.RingMatrices`):
+    the expanded result is the same expression as ``expand`` of the product of the
+    matrices; chains with other functions than sines and cosines take the expression path."""
+    factors = chain.factors
+    mats = [f.first_order() if f.is_error else f.nominal for f in factors]
+    ring = RingMatrices.build([*mats, v])
+    if ring is not None:
+        try:
+            mats = [ring.convert(m) for m in mats]
+            v = ring.convert(v)
+        except NOT_POLYNOMIAL:
+            ring = None
+    if ring is None:
+        return _first_order_displacement_sympy(chain, v)
+    suffix = [None] * len(factors)
+    for i in range(len(factors) - 1, -1, -1):
+        suffix[i] = v
+        if not factors[i].is_error:
+            v = ring.mul(mats[i], v)
+    total = None
+    prefix = None
+    for i, f in enumerate(factors):
+        if f.is_error:
+            term = ring.mul(mats[i], suffix[i])
+            if prefix is not None:
+                term = ring.mul(prefix, term)
+            total = term if total is None else ring.add(total, term)
+        else:
+            prefix = mats[i] if prefix is None else ring.mul(prefix, mats[i])
+    if total is None:
+        return sp.zeros(3, 1)
+    return sp.Matrix([total[i][0].as_expr() for i in range(3)])
+
+
+def _first_order_displacement_sympy(chain: Chain, v: sp.Matrix) -> sp.Matrix:
+    """:func:`_first_order_displacement` on sympy expressions (any chain)."""
     factors = chain.factors
     suffix = [None] * len(factors)
     for i in range(len(factors) - 1, -1, -1):
@@ -49,6 +87,30 @@ def _first_order_displacement(chain: Chain, v: sp.Matrix) -> sp.Matrix:
         else:
             prefix = prefix * f.nominal
     return sp.Matrix([sp.expand(total[i]) for i in range(3)])
+
+
+def collect_symbols(expr, syms) -> sp.Expr:
+    """``sympy.collect(expr, syms)`` for an expanded sum (the same expression, tested): each
+    term goes to the group of the first of ``syms`` (in that order) that is one of its
+    factors, alone or to a positive integer power; the group is ``key * (sum of the rest)``.
+    Terms without such a factor stay as they are.  One pass over the terms, where ``collect``
+    re-parses every term for every symbol."""
+    order = {q: i for i, q in enumerate(syms)}
+    groups, rest = {}, []
+    for term in sp.Add.make_args(expr):
+        factors = sp.Mul.make_args(term)
+        best = None
+        for j, f in enumerate(factors):
+            base = f.base if f.is_Pow and f.exp.is_Integer and f.exp > 0 else f
+            i = order.get(base)
+            if i is not None and (best is None or i < best[0]):
+                best = (i, j)
+        if best is None:
+            rest.append(term)
+            continue
+        j = best[1]
+        groups.setdefault(factors[j], []).append(sp.Mul(*factors[:j], *factors[j + 1:]))
+    return sp.Add(*rest, *[sp.Mul(k, sp.Add(*c)) for k, c in groups.items()])
 
 
 def orientation_error(chain: Chain) -> sp.Matrix:
@@ -74,7 +136,7 @@ def sensitivity(chain: Chain, error: sp.Matrix | None = None) -> sp.Matrix:
         # the first-order error is linear in the parameters: each expanded term holds exactly
         # one parameter to the first power, its coefficient is the derivative (as diff gives)
         coeffs = [[] for _ in params]
-        for term in sp.Add.make_args(sp.expand(error[i])):
+        for term in sp.Add.make_args(expand(error[i])):
             found = [q for q in term.free_symbols if q in index]
             if len(found) != 1 or not _linear_factor(term, found[0]):
                 return error.jacobian(sp.Matrix(params))   # not linear term by term: general
@@ -94,12 +156,52 @@ def setup_sensitivity(chain: Chain) -> sp.Matrix:
     measuring instrument's placement: ``(I + D) T p``), columns 6-11 the same twist at the
     tool end, in the tool frame, standing last (``T (I + D) p``: a probe / tool offset error).
     Exact in the nominal chain (first order in the twist)."""
+    T, p = chain.nominal_htm(), sp.Matrix([*PROBE, 1])
+    # the twist is linear in its six coordinates: column k is the product with the twist of
+    # the k-th unit coordinate, computed on polynomial-ring elements (expanded, as below)
+    ring = RingMatrices.build([T, p])
+    if ring is not None:
+        try:
+            Tr, pr = ring.convert(T), ring.convert(p)
+        except NOT_POLYNOMIAL:
+            ring = None
+    if ring is not None:
+        units = [ring.convert(twist(**{k: 1})) for k in SETUP_TWIST]
+        Tp = ring.mul(Tr, pr)
+        work = [ring.mul(g, Tp) for g in units]
+        tool = [ring.mul(Tr, ring.mul(g, pr)) for g in units]
+        return sp.Matrix(3, 12, lambda i, j: (work[j] if j < 6 else tool[j - 6])[i][0].as_expr())
     syms = sp.symbols("_tw_dx _tw_dy _tw_dz _tw_ex _tw_ey _tw_ez", real=True)
     d = twist(**dict(zip(SETUP_TWIST, syms)))
-    T, p = chain.nominal_htm(), sp.Matrix([*PROBE, 1])
     work = (d * (T * p))[0:3, 0].jacobian(sp.Matrix(syms))
     tool = (T * (d * p))[0:3, 0].jacobian(sp.Matrix(syms))
     return work.row_join(tool).applyfunc(sp.expand)
+def _is_expanded_factor(f) -> bool:
+    if f.is_Atom:
+        return True
+    if f.is_Pow and f.base.is_Integer and f.base > 0 and f.exp.is_Rational:
+        return True   # a numeric radical such as sqrt(2)
+    if f.is_Pow:
+        return f.exp.is_Integer and (f.base.is_Atom or _is_expanded_factor(f.base)) and \
+            not f.base.is_Add and not f.base.is_Mul and not f.base.is_Pow
+    if f.func in (sp.sin, sp.cos):
+        return is_expanded(f.args[0])
+    return False
+
+
+def is_expanded(expr) -> bool:
+    """True when ``sympy.expand(expr)`` is ``expr`` itself, recognised for the shapes the
+    derivation produces: sums of products of symbols, numbers, integer powers of those and
+    sines and cosines of such sums (anything else answers False, and the caller expands)."""
+    return all(_is_expanded_factor(f) for t in sp.Add.make_args(expr)
+               for f in sp.Mul.make_args(t))
+
+
+def expand(expr):
+    """``sympy.expand(expr)``, skipped when ``expr`` is already expanded (:func:`is_expanded`)."""
+    return expr if is_expanded(expr) else sp.expand(expr)
+
+
 def _linear_factor(term, q) -> bool:
     """``sp.degree(term, q) == 1`` for a term of an expanded sum: a product with the factor
     ``q`` to the first power and ``q`` nowhere else (checked without building a polynomial;
@@ -118,7 +220,7 @@ def random_error_termwise(sens: sp.Matrix, sigmas) -> sp.Matrix:
         # one Add of all squares (the same canonical sum as adding them one by one)
         acc = []
         for j in range(sens.shape[1]):
-            for term in sp.Add.make_args(sp.expand(sens[i, j])):
+            for term in sp.Add.make_args(expand(sens[i, j])):
                 if term != 0:
                     acc.append(term ** 2 * sigmas[j] ** 2)
         rows.append(sp.sqrt(sp.Add(*acc)))
@@ -195,12 +297,35 @@ def _squareness_slopes(chain: Chain, error: sp.Matrix) -> dict:
     for name in layout.squareness:
         about, b, a = SQUARENESS[name]
         ia, ib = idx[a], idx[b]
-        slope = sp.diff(error[ia], pos[b]) + sp.diff(error[ib], pos[a])
+        slope = _diff_sum(error[ia], pos[b]) + _diff_sum(error[ib], pos[a])
         # the angle between lines a and b: 90 deg - slope; convert to the named rotation
         sign = {"EC0Y": -1, "EB0Z": 1, "EA0Z": -1}[name]
         apparent = sign * slope
-        apparent = apparent.subs({position_symbol(t): OFFSETS[i] for i, t in enumerate("XYZ")
-                                  if t in layout.axes})
-        apparent = apparent.subs({p: 0 for p in PROBE})
+        apparent = apparent.xreplace({position_symbol(t): OFFSETS[i]
+                                      for i, t in enumerate("XYZ") if t in layout.axes})
+        apparent = apparent.xreplace({p: sp.S.Zero for p in PROBE})
         out[name] = sp.expand(apparent)
     return out
+
+
+def _diff_sum(expr, x) -> sp.Expr:
+    """``diff(expr, x)`` of a sum, term by term: a term that holds ``x`` only as a factor
+    ``x**n`` (n a positive integer) gives ``n x**(n-1)`` times the other factors, a term
+    without ``x`` nothing, any other term its sympy derivative.  The same sum as ``diff``
+    (mathematically; the callers expand it), without sympy's general derivative machinery on
+    every term."""
+    out = []
+    for term in sp.Add.make_args(expr):
+        if x not in term.free_symbols:
+            continue
+        factors = sp.Mul.make_args(term)
+        hits = [j for j, f in enumerate(factors) if f.has(x)]
+        f = factors[hits[0]]
+        n = 1 if f == x else (f.exp if f.is_Pow and f.base == x and f.exp.is_Integer
+                              and f.exp > 0 else None)
+        if len(hits) != 1 or n is None:
+            out.append(sp.diff(term, x))
+            continue
+        j = hits[0]
+        out.append(sp.Mul(n, x ** (n - 1), *factors[:j], *factors[j + 1:]))
+    return sp.Add(*out)

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       6ed720420a66bda53faa0aff37c360150d15409390162774f959284006fa7a68
-derivation sha256  a1d3232e56d659710c4f68f3ab9c8783722e3b1e8c17a977a6b9caa5266f2f71
+derivation sha256  e695f071db9a8b79bb44012d4d77729cda5ef7e8584e206ea242d049a640d78c
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       14c00cbdd4320c30c61d6c8934b7e649bc3fee4d78e7c7cc3d4d29e6aee0c398
-derivation sha256  a1d3232e56d659710c4f68f3ab9c8783722e3b1e8c17a977a6b9caa5266f2f71
+derivation sha256  e695f071db9a8b79bb44012d4d77729cda5ef7e8584e206ea242d049a640d78c
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       936d6b81b28e27cd2c685d2970ba1a9819c19b8969d97c12a7c54c91c993e5b7
-derivation sha256  707cce1c6578403bc8c334da6ab3159db6f8c202e6e7da4723fa876dbe427ff3
+input sha256       26ff981565755ae2f06cdbc614479e95b74eb63685bed151847c32178de4a711
+derivation sha256  aea622529006314811c53e89ef1183d70c498697df02fc111a94c21ea8a7772a
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/probe.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       4775acad0bedd6fe9e1efc5ca1893b3b117b363fb55916daaacd5b645d56ae56
-derivation sha256  1d88f059b9645a64d6750392bf4afeb91084c2c51e51f72c220a7da9e1143169
+input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
+derivation sha256  ff2733587579ff348819bfa1914eb868cf512ee9d00763a1c794c78bd163073f
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
