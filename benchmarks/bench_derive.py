@@ -13,48 +13,21 @@ Run: python benchmarks/bench_derive.py [--base REV] [--runs R]   (default b32e5c
 """
 
 import argparse
-import os
 import re
 import resource
-import shutil
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from _baseline import BASE, ROOT, env_for, export, which_volerr
+
 HASH = re.compile(r"^(derivation|input) sha256 .*$", re.M)
 
 
-def export(rev: str, dest: Path) -> Path:
-    src = dest / "src"
-    src.mkdir(parents=True)
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], check=True,
-                             capture_output=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(src)], input=archive, check=True)
-    pkg = dest / "pkg"
-    shutil.copytree(src / "runtime", pkg / "volerr")
-    shutil.copytree(src / "derive", pkg / "volerr" / "derive")
-    shutil.copytree(src / "generated", pkg / "volerr" / "generated")
-    return pkg
-
-
-def which_volerr(pythonpath=None) -> str:
-    """Folder of the ``volerr`` package a child process imports (checks the baseline's
-    PYTHONPATH wins over this tree's editable install)."""
-    env = dict(os.environ)
-    if pythonpath:
-        env["PYTHONPATH"] = str(pythonpath)
-    return subprocess.run([sys.executable, "-c", "import volerr; print(volerr.__file__)"],
-                          check=True, capture_output=True, text=True, env=env,
-                          cwd=tempfile.gettempdir()).stdout.strip()
-
-
 def run(out: Path, pythonpath=None):
-    env = dict(os.environ)
-    if pythonpath:
-        env["PYTHONPATH"] = str(pythonpath)
+    env = env_for(pythonpath)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "volerr", "derive", "--all", "--out", str(out)],
@@ -69,7 +42,7 @@ def texts(d: Path) -> dict:
     return {p.name: HASH.sub("", p.read_text()) for p in sorted(d.glob("*.py"))}
 
 
-def main(base: str = "b32e5c7", runs: int = 3) -> None:
+def main(base: str = BASE, runs: int = 3) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         pkg = export(base, tmp / "base")
@@ -93,7 +66,7 @@ def main(base: str = "b32e5c7", runs: int = 3) -> None:
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("--base", default="b32e5c7")
+    ap.add_argument("--base", default=BASE)
     ap.add_argument("--runs", type=int, default=3)
     a = ap.parse_args()
     main(a.base, a.runs)
