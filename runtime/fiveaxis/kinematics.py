@@ -89,7 +89,8 @@ def inverse(model, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
 
     s0, s1 = score(candidates[0], ok[0]), score(candidates[1], ok[1])
     pick = s1 < s0
-    rot_deg = {a: np.where(pick, candidates[1][a], candidates[0][a]) for a in rot}
+    rot_deg = _polish_rotary(model, {a: np.where(pick, candidates[1][a], candidates[0][a])
+                                     for a in rot}, k)
     tool = np.broadcast_to(np.asarray(tool, dtype=float), (n, 3))
     lin = model.module.inverse_linear(*(np.deg2rad(rot_deg[a]) for a in rot),
                                       t[:, 0], t[:, 1], t[:, 2], tool[:, 0], tool[:, 1], tool[:, 2])
@@ -99,6 +100,27 @@ def inverse(model, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
     for i, a in enumerate(model.axes):
         out[:, i] = rot_deg[a] if a in rot else lin[a]
     return out
+
+
+def _polish_rotary(model, rot_deg: dict, k: np.ndarray, steps: int = 2) -> dict:
+    """Newton steps on the rotary positions towards the unit tool axis ``k`` (N, 3).
+
+    The closed form goes through a square root whose argument vanishes at the singular
+    orientation: there it keeps only half the digits (an orientation 1e-6 deg from the
+    singular one comes back 1.2e-8 rad off).  A step ``pinv(J) (k - k(q))`` with the exact
+    Jacobian restores full precision; a direction the rotary axes hardly turn (singular
+    values below 1e-6 per rad: the undetermined axis) is left alone."""
+    rot = model.rotary_axes
+    idx = [model.axes.index(a) for a in rot]
+    q = np.zeros((len(k), len(model.axes)))
+    for a, i in zip(rot, idx):
+        q[:, i] = rot_deg[a]
+    for _ in range(steps):
+        k_now = model.forward(q)[:, 3:6]
+        j = nominal_jacobian(model, q)[:, 3:6, idx]
+        d = np.einsum("nij,nj->ni", np.linalg.pinv(j, rcond=1e-6), k - k_now)
+        q[:, idx] += np.rad2deg(np.nan_to_num(d))
+    return {a: q[:, i] for a, i in zip(rot, idx)}
 
 
 def nominal_jacobian(model, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
