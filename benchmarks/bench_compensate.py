@@ -8,7 +8,10 @@ checked), interleaved, min of the runs.  The line-by-line path runs at N/10 only
 ``--baseline-full`` (it takes ~100 s per 10^6 blocks).  Also: the vectorised solve alone on
 the same positions and the solve block by block (a per-line script).
 
-Run: python benchmarks/bench_compensate.py [N_BLOCKS] [--runs R] [--baseline-full]
+With ``--base REV`` the whole command of commit REV (exported with ``git archive``, run
+through ``PYTHONPATH``) runs on the N-block program too, interleaved, output compared.
+
+Run: python benchmarks/bench_compensate.py [N_BLOCKS] [--runs R] [--baseline-full] [--base REV]
      (default 1000000 blocks, 2 runs)
 """
 
@@ -21,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import volerr
+from _baseline import env_for, export, which_volerr
 from volerr.fiveaxis.compensate import ErrorModel, solve
 from volerr.tables import table as tables
 from volerr.tables.table import ErrorTable, write_constants, write_error_table
@@ -47,14 +51,15 @@ def write_program(path: Path, n: int, rng) -> np.ndarray:
     return np.round(q, 3)
 
 
-def command(prog, errors, out, whole=True):
+def command(prog, errors, out, whole=True, pythonpath=None):
     r = subprocess.run([sys.executable, "-c", RUN, str(prog), str(errors), str(out),
-                        "1" if whole else "0"], capture_output=True, text=True, check=True)
+                        "1" if whole else "0"], capture_output=True, text=True, check=True,
+                       env=env_for(pythonpath))
     wall, cpu, rss = map(float, r.stdout.split()[-3:])
     return wall, cpu, rss
 
 
-def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False) -> None:
+def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None) -> None:
     m = volerr.load("DMU50")
     rng = np.random.default_rng(0)
     with tempfile.TemporaryDirectory() as tmp:
@@ -73,9 +78,15 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False) -> None:
         write_program(small, max(n // 10, 1), rng)
         em = ErrorModel(m, funcs)
         k = min(300, n)
-        res = {key: [] for key in ("big", "small", "big_line", "small_line", "solve")}
+        res = {key: [] for key in ("big", "small", "big_line", "small_line", "solve", "base")}
+        pkg = export(base, d / "base") if base else None
+        if pkg is not None:
+            assert which_volerr(pkg).startswith(str(pkg)), "baseline import not taken"
         for _ in range(runs):   # interleaved, min of the runs
             res["big"].append(command(big, d, d / "out.nc"))
+            if pkg is not None:
+                res["base"].append(command(big, d, d / "out_base.nc", pythonpath=pkg))
+                assert (d / "out.nc").read_bytes() == (d / "out_base.nc").read_bytes()
             res["small"].append(command(small, d, d / "out_s.nc"))
             res["small_line"].append(command(small, d, d / "ref_s.nc", whole=False))
             assert (d / "out_s.nc").read_bytes() == (d / "ref_s.nc").read_bytes()
@@ -92,7 +103,7 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False) -> None:
         t_loop = (time.perf_counter() - t0) * n / k
         t_vec = min(res["solve"])
         best = {key: tuple(min(r[i] for r in v) for i in range(3))
-                for key, v in res.items() if v and key != "solve"}
+                for key, v in res.items() if v and key not in ("solve", "base")}
         print(f"DMU50, full strategy, min of {runs} interleaved runs "
               f"(wall s, CPU s, peak RSS MB)")
         for key, nb in (("big", n), ("small", n // 10)):
@@ -104,6 +115,10 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False) -> None:
                          f"ratio {lw / w:.1f}x wall, {lc / c:.1f}x CPU")
             print(line)
         w = best["big"][0]
+        if res["base"]:
+            bw, bc, br = (min(r[i] for r in res["base"]) for i in range(3))
+            print(f"  {n:>8} blocks, commit {base}: {bw:.1f} s wall, {bc:.1f} s CPU, {br:.0f} MB; "
+                  f"ratio {bw / w:.2f}x wall, {bc / best['big'][1]:.2f}x CPU; output identical")
         print(f"  solve alone (chunks of 20000): {t_vec:.2f} s; whole command / solve "
               f"{w / t_vec:.1f}x; block by block (extrapolated from {k}): {t_loop:.0f} s, "
               f"{t_loop / w:.0f}x the whole command")
@@ -116,5 +131,6 @@ if __name__ == "__main__":
     ap.add_argument("n", nargs="?", type=int, default=1000000)
     ap.add_argument("--runs", type=int, default=2)
     ap.add_argument("--baseline-full", action="store_true")
+    ap.add_argument("--base", default=None, help="also run this commit's command (e.g. b32e5c7)")
     a = ap.parse_args()
-    main(a.n, a.runs, a.baseline_full)
+    main(a.n, a.runs, a.baseline_full, a.base)
