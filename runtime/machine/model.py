@@ -66,7 +66,8 @@ def _case_insensitive(given: dict, names) -> dict:
 BLOCK = 16384
 
 
-def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = None) -> np.ndarray:
+def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = None,
+             check_rows=None) -> np.ndarray:
     """``fn(**kwargs)`` (a generated function returning ``n_out`` broadcastable outputs)
     evaluated block by block into one (n, n_out) array.  Arguments that are (n,) arrays are
     sliced (views, also of strided columns); scalars and (1,) arrays pass whole.
@@ -74,7 +75,9 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
     The generated function is run as its fused block kernel (:mod:`.fused`): outputs written
     straight into the rows of the result, arguments that are scalar 0 folded away; a function
     that cannot be fused is called as it is.  ``finite``: a list that receives one bool, whether
-    every result is finite (checked block by block while the block is in the cache)."""
+    every result is finite (checked block by block while the block is in the cache).
+    ``check_rows``: (rows (n, k), check) -- ``check(rows[block])`` is called before each block
+    is evaluated (the inputs' validation, done while the block is read anyway)."""
     scalars = {k for k, v in kwargs.items() if np.ndim(v) == 0}
     zeros = frozenset(k for k in scalars if kwargs[k] == 0)
     kernel = (fused.numpy_kernel(fn, zeros, frozenset(scalars) - zeros)
@@ -90,6 +93,8 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
         kw = dict(kwargs)
         for k in sliced:
             kw[k] = kwargs[k][sl]
+        if check_rows is not None:
+            check_rows[1](check_rows[0][sl])
         if kernel is not None:
             kernel(out[sl], scratch[:, :sl.stop - sl.start], **kw)
         else:
@@ -173,6 +178,13 @@ class Model:
     def positions(self, positions) -> dict:
         """Validate positions (dict or (N, n_axes) array, mm/deg) -> dict of float arrays,
         rotary axes converted to rad."""
+        return self._validated(positions)[0]
+
+    def _validated(self, positions, defer: bool = False) -> tuple[dict, np.ndarray | None]:
+        """:meth:`positions`, and with ``defer`` an (N, n_axes) array's finiteness check left
+        to the caller, who gets the array back (:func:`_blocked` checks it block by block while
+        the block is in the cache: one pass less over memory); None when checked here."""
+        deferred = None
         if isinstance(positions, Mapping):
             positions = _case_insensitive(dict(positions), self.axes)
             unknown = set(positions) - set(self.axes)
@@ -191,13 +203,10 @@ class Model:
                     f"{self.name}: positions must have {len(self.axes)} columns "
                     f"({' '.join(self.axes)}), got shape {arr.shape}")
             cols = {a: arr[:, i] for i, a in enumerate(self.axes)}  # strided views, no copy
-            # one contiguous pass (a sum: NaN/inf anywhere makes it non-finite; only then, or on
-            # an overflow of the sum, the exact check), naming the axis only on failure
-            with np.errstate(over="ignore"):
-                finite = bool(np.isfinite(arr.sum())) or bool(np.isfinite(arr).all())
-            if not finite:
-                bad = next(a for a, v in cols.items() if not np.isfinite(v).all())
-                raise InputError(f"{self.name}: position {bad} has NaN or infinite values")
+            if defer and arr.flags.c_contiguous and len(arr) > 1:
+                deferred = arr
+            else:
+                self._check_rows(arr)
         for a, v in cols.items():
             if isinstance(positions, Mapping) and not np.isfinite(v).all():
                 raise InputError(f"{self.name}: position {a} has NaN or infinite values")
@@ -211,7 +220,17 @@ class Model:
             if v.shape != shape or v.ndim != 1:
                 v = np.broadcast_to(v, shape).ravel() if shape else np.atleast_1d(v)
             out[a] = np.deg2rad(v) if a in self.rotary_axes else v
-        return out
+        return out, deferred
+
+    def _check_rows(self, arr: np.ndarray) -> None:
+        """(m, n_axes) positions finite, else InputError naming the axis.  One contiguous pass
+        (a sum: NaN/inf anywhere makes it non-finite; only then, or on an overflow of the sum,
+        the exact check)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            finite = bool(np.isfinite(arr.sum())) or bool(np.isfinite(arr).all())
+        if not finite:
+            bad = next(a for i, a in enumerate(self.axes) if not np.isfinite(arr[:, i]).all())
+            raise InputError(f"{self.name}: position {bad} has NaN or infinite values")
 
     def _points(self, positions) -> tuple[dict, int]:
         """Validated positions (see :meth:`positions`) and their number of points."""
@@ -294,12 +313,14 @@ class Model:
         ndarray, shape (N, 3)
             dx, dy, dz, mm.
         """
-        pos, n = self._points(positions)
+        pos, rows = self._validated(positions, defer=True)
+        n = len(next(iter(pos.values())))
         errs = self._errors(errors, n)
         finite: list = []
         out = _blocked(self.module.volumetric_error,
                        {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs},
-                       n, finite=finite)
+                       n, finite=finite,
+                       check_rows=None if rows is None else (rows, self._check_rows))
         out = self._check_finite(out, errs, finite[0])
         if direction is not None or probe_error is not None:
             out = out + self._probe_term(direction, probe_error, n)
