@@ -37,35 +37,19 @@ def choose_degree(x, y, max_degree: int | None = None) -> int:
     return legendre.choose_degree(x, y, max_degree)
 
 
-class _Linear:
-    def __init__(self, x, y):
-        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
-
-    def __call__(self, q):
-        q = np.asarray(q, float)
-        out = np.interp(q, self.x, self.y)
-        x, y = self.x, self.y
-        lo, hi = q < x[0], q > x[-1]
-        if lo.any():
-            out[lo] = y[0] + (q[lo] - x[0]) * (y[1] - y[0]) / (x[1] - x[0])
-        if hi.any():
-            out[hi] = y[-1] + (q[hi] - x[-1]) * (y[-1] - y[-2]) / (x[-1] - x[-2])
-        return out
-
-
 class _LinearGroup:
-    """Piecewise-linear functions of one axis sharing its table positions, evaluated together:
-    one bracket search for all of them, then one gather per value row.  Values equal
-    ``numpy.interp`` inside the range (same slope formula, same operation order) and
-    :class:`_Linear`'s end segments outside it."""
+    """Piecewise-linear functions sharing their nodes ``x`` (the parameters of one axis' table),
+    evaluated together: one bracket search for all of them, then one gather per value row.
+    Inside the range the values are ``numpy.interp``'s (same slope formula, same operation
+    order); outside it the end segments are extended, or with ``clamp`` the end values are kept
+    (numpy.interp's rule).  ``__call__(q)`` with q (N,) -> (n_functions, N)."""
 
-    def __init__(self, x, ys: dict, clamp: bool = False):
-        self.clamp = clamp          # outside the range: the end values (numpy.interp's rule)
+    def __init__(self, x, ys, clamp: bool = False):
+        self.clamp = clamp
         self.x = np.asarray(x, float)
-        self.names = list(ys)
-        self.y = np.array([np.asarray(ys[k], float) for k in self.names]).reshape(len(ys), -1)
-        self.slope = np.diff(self.y, axis=1) / np.diff(self.x)
+        self.y = np.array([np.asarray(y, float) for y in ys]).reshape(len(ys), -1)
         step = np.diff(self.x)
+        self.slope = np.diff(self.y, axis=1) / step
         #: evenly spaced positions: the bracket comes from arithmetic, then is checked
         self.inv_step = 1.0 / step.mean() if np.allclose(step, step.mean(), rtol=1e-9) else None
 
@@ -80,7 +64,7 @@ class _LinearGroup:
         j += (x.take(j + 1) <= q) & (j < last)
         return j
 
-    def __call__(self, q) -> dict:
+    def __call__(self, q) -> np.ndarray:
         x, y, slope = self.x, self.y, self.slope
         q = np.asarray(q, float)
         j = self.bracket(q)
@@ -93,7 +77,20 @@ class _LinearGroup:
         if first.any():
             out[:, first] = y[:, :1] if self.clamp else \
                 y[:, :1] + (q[first] - x[0]) * (y[:, 1:2] - y[:, :1]) / (x[1] - x[0])
-        return dict(zip(self.names, out))
+        return out
+
+
+class _Linear:
+    """One piecewise-linear function of position (a :class:`_LinearGroup` of one), for any
+    shape of ``q``; ``clamp``: the end values outside the range instead of the end lines."""
+
+    def __init__(self, x, y, clamp: bool = False):
+        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
+        self._group = _LinearGroup(self.x, [self.y], clamp)
+
+    def __call__(self, q):
+        q = np.asarray(q, float)
+        return self._group(q.ravel())[0].reshape(q.shape)
 
 
 def make_function(x, y, method: str = "linear", degree: int | None = None):
@@ -173,7 +170,6 @@ class ErrorFunctions:
                     f"{where}constants: {model.name} has no constant parameter {name} "
                     f"(its constants are {' '.join(p for p in model.parameters if paxis[p] is None)})")
         self.functions, self.std_functions, self.degrees = {}, {}, {}
-        self._std_nodes = {}
         for ax, t in self.tables.items():
             for name, y in t.values.items():
                 try:
@@ -187,8 +183,7 @@ class ErrorFunctions:
                 if s is None and name in t.u95:
                     s = t.u95[name] / 2.0
                 if s is not None:
-                    self.std_functions[name] = (ax, _clamped(t.positions, s))
-                    self._std_nodes[name] = np.asarray(s, float)
+                    self.std_functions[name] = (ax, _Linear(t.positions, s, clamp=True))
 
     @classmethod
     def from_dir(cls, directory, model, method: str = "linear", degree: int | None = None,
@@ -250,45 +245,37 @@ class ErrorFunctions:
         array, mm / rad, for every table parameter and constant."""
         cols, n = self._positions(positions)
         if self.method == "linear":
-            out = {}
-            for ax, group in self._groups().items():
-                out.update(group(cols[ax].reshape(n)))
-            out = {name: out[name] for name in self.functions}
+            out = self._grouped(cols, n)
         else:
             out = {name: np.asarray(f(cols[ax]), dtype=float).reshape(n)
                    for name, (ax, f) in self.functions.items()}
         out.update({k: np.full(n, v) for k, v in self.constants.items()})
         return out
 
-    def _groups(self, std: bool = False) -> dict:
-        """Axis -> :class:`_LinearGroup` of its table's parameters (``std``: of their standard
-        deviations, clamped at the ends); built once."""
-        key = "_std_groups" if std else "_linear_groups"
-        groups = self.__dict__.get(key)
+    def _grouped(self, cols: dict, n: int, std: bool = False) -> dict:
+        """The linear functions (``std``: the standard deviations, clamped at the ends) at the
+        positions ``cols``, those of an axis evaluated together (:class:`_LinearGroup`, built
+        once): name -> (n,)."""
+        functions, clamp = (self.std_functions, True) if std else (self.functions, False)
+        cache = self.__dict__.setdefault("_linear_groups", {})
+        groups = cache.get(std)
         if groups is None:
-            groups = {}
-            for ax, t in self.tables.items():
-                ys = {name: t.values[name] for name in t.values if name in self.functions}
-                if std:
-                    ys = {name: self._std_nodes[name] for name, (a, _) in
-                          self.std_functions.items() if a == ax}
-                if ys:
-                    groups[ax] = _LinearGroup(t.positions, ys, clamp=std)
-            self.__dict__[key] = groups
-        return groups
+            by_axis = {}
+            for name, (ax, f) in functions.items():
+                by_axis.setdefault(ax, []).append((name, f.y))
+            groups = cache[std] = {
+                ax: ([name for name, _ in items],
+                     _LinearGroup(self.tables[ax].positions, [y for _, y in items], clamp))
+                for ax, items in by_axis.items()}
+        out = {}
+        for ax, (names, group) in groups.items():
+            out.update(zip(names, group(cols[ax].reshape(n))))
+        return {name: out[name] for name in functions}
 
     def sigmas(self, positions) -> dict:
         """Standard deviations (mm / rad) at ``positions`` (as :meth:`__call__`): name -> (N,)
         array; a ``u95`` column without ``std`` counts as ``u95 / 2``."""
         cols, n = self._positions(positions)
-        out = {}
-        for ax, group in self._groups(std=True).items():
-            out.update(group(cols[ax].reshape(n)))
-        out = {name: out[name] for name in self.std_functions}
+        out = self._grouped(cols, n, std=True)
         out.update({k: np.full(n, v) for k, v in self.constants_std.items()})
         return out
-
-
-def _clamped(x, y):
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    return lambda q: np.interp(np.asarray(q, float), x, y)
