@@ -176,9 +176,15 @@ def format_numbers(values, nd, keep, plus, template=None) -> list:
     ``template(i)`` gives the template text of value ``i`` for the few values within rounding
     noise of a decimal tie, which are formatted by Python (None: an empty template)."""
     flat, lens, _ = format_bytes(values, nd, keep, plus, template)
+    return split_texts(flat, lens)
+
+
+def split_texts(flat: np.ndarray, lens) -> list:
+    """The texts of :func:`format_bytes` (ASCII bytes one after the other, their lengths) as
+    strings."""
     text = flat.tobytes().decode("ascii")
-    ends = np.cumsum(lens).tolist()
-    return [text[a:b] for a, b in zip([0] + ends[:-1], ends)]
+    cut = np.concatenate([[0], np.cumsum(lens)]).tolist()
+    return [text[a:b] for a, b in zip(cut[:-1], cut[1:])]
 
 
 def format_bytes(values, nd, keep, plus, template=None):

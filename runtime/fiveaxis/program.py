@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require
-from . import gcode
+from . import chunkscan, gcode
 from .kinematics import is_five_axis, linear_axes
 
 #: lines per chunk: large enough for the vectorised solve, small enough for the memory
@@ -176,8 +176,6 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int)
     state from chunk to chunk.  Runs of plain lines in absolute mode are done together (the
     position of an axis is its last programmed value: a forward fill); every other line goes
     through ``interp`` one by one."""
-    from . import chunkscan
-
     axes = model.axes
     nax = len(axes)
     n = len(segs)
@@ -442,8 +440,6 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
     more; an axis the line does not program gets a word where the controller (as written so
     far) holds another value -- a chain along the lines, followed one entry at a time for the
     (line, axis) pairs without a word only."""
-    from . import chunkscan
-
     sc = b.scan
     pos = written.position
     nax = len(axes)
@@ -514,8 +510,7 @@ def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, sp
     if not added:
         edits.add_bytes(span_s, span_e, flat, lens)
         return
-    ends = np.cumsum(lens).tolist()
-    texts = [flat[a:b].tobytes().decode("ascii") for a, b in zip([0] + ends[:-1], ends)]
+    texts = chunkscan.split_texts(flat, lens)
     line_of = wl[ci]
     by_line = {}
     for k, li in enumerate(line_of.tolist()):
@@ -587,10 +582,7 @@ class _Edits:
         new = []
         for _, _, t in self.batches:
             if isinstance(t, tuple):
-                flat, lens = t
-                s = flat.tobytes().decode("ascii")
-                cut = np.r_[0, np.cumsum(lens)].tolist()
-                new += [s[a:b] for a, b in zip(cut[:-1], cut[1:])]
+                new += chunkscan.split_texts(*t)
             else:
                 new += t
         out, prev = [], 0

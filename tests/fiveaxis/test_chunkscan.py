@@ -148,3 +148,18 @@ def test_whole_chunk_path_writes_the_line_by_line_bytes(setup, seed, orientation
         assert got.text == ref.text, k
         assert [(r.line, r.status, r.output) for r in got.reports] == \
             [(r.line, r.status, r.output) for r in ref.reports]
+
+
+def test_text_beyond_latin1_keeps_its_characters(setup, monkeypatch):
+    """A program given as a str may hold characters a latin-1 file cannot (an em dash, a
+    Greek letter in a comment): the edits are then made on the string, with the same result
+    as the line-by-line path, and the characters stay."""
+    m, funcs = setup
+    text = random_program(3).replace("(plain comment)", "(Ø10 — Ω roughing)")
+    assert "Ω" in text
+    monkeypatch.setattr(program, "WHOLE_CHUNK", False)
+    ref = compensate_program(m, funcs, text)
+    monkeypatch.setattr(program, "WHOLE_CHUNK", True)
+    got = compensate_program(m, funcs, text)
+    assert got.text == ref.text and got.text != text
+    assert got.text.count("(Ø10 — Ω roughing)") == text.count("(Ø10 — Ω roughing)")
