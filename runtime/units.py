@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 import re
 
+import numpy as np
+
 from .errors import InputError
 
 #: micrometres per millimetre
@@ -60,3 +62,12 @@ def format_number(value: float, digits: int = 12) -> str:
     """A number for a text file: ``digits`` significant digits (``%g``), ``-0`` written ``0``."""
     text = f"{float(value):.{digits}g}"
     return "0" if text == "-0" else text
+
+
+def format_rows(data, digits: int = 12, block: int = 20000) -> str:
+    """CSV rows (``\n``-terminated) of the (n, k) numbers ``data``, each cell as
+    :func:`format_number`; one %-format per block of rows instead of a call per number."""
+    data = np.asarray(data, dtype=float) + 0.0      # + 0.0: -0 becomes 0
+    row = ",".join([f"%.{digits}g"] * data.shape[1]) + "\n"
+    return "".join((row * len(b)) % tuple(b.ravel().tolist())
+                   for b in (data[i:i + block] for i in range(0, len(data), block)))

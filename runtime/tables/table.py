@@ -52,7 +52,8 @@ from pathlib import Path
 import numpy as np
 
 from ..machine import iso_names
-from ..units import MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number, parse_number
+from ..units import (MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number,
+                     format_rows, parse_number)
 from ..errors import InputError, require
 from ..fileio import check_magnitude, read_csv_rows, write_text
 
@@ -287,14 +288,8 @@ def table_to_csv(table: ErrorTable) -> str:
     if table.reversal is not None:
         header.append(f"RV_{table.axis}_um")
         columns.append(_from_internal(table.reversal, "um"))
-    # one %-format per block of rows (the format_number rule: "%.12g"; + 0.0 turns -0 into 0)
-    data = np.column_stack([np.asarray(c, dtype=float) for c in columns]) + 0.0
-    row = ",".join(["%.12g"] * data.shape[1]) + "\n"
-    parts = [",".join(header) + "\n"]
-    for i in range(0, len(data), 20000):
-        block = data[i:i + 20000]
-        parts.append((row * len(block)) % tuple(block.ravel().tolist()))
-    return "".join(parts)
+    return ",".join(header) + "\n" + format_rows(
+        np.column_stack([np.asarray(c, dtype=float) for c in columns]), 12)
 
 
 def write_error_table(path, table: ErrorTable, inputs=()) -> Path:
