@@ -570,16 +570,13 @@ def _closed_uncertainty(A, closed, W, sigma):
                     if i == j:
                         S[m, a, b] = cov_full[m, i, co, d]
     if W is None and _same_everywhere(As):
-        Ainv1 = np.linalg.inv(As[0])
-        u = np.broadcast_to(sigma * np.sqrt(np.sum(Ainv1 ** 2, axis=1)), (K, 6)).copy()
-        u[0] = 0.0
-        return u
+        As = As[:1]     # one design for all positions: one inverse, one covariance
     Ainv = np.linalg.inv(As)
     if W is None:
         covs = sigma ** 2 * np.einsum("kij,klj->kil", Ainv, Ainv)
     else:
         covs = np.einsum("kij,kjl,kml->kim", Ainv, S, Ainv)
-    u = np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None))
+    u = np.broadcast_to(np.sqrt(np.clip(np.einsum("kii->ki", covs), 0, None)), (K, 6)).copy()
     u[0] = 0.0
     return u
 

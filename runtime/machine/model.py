@@ -180,10 +180,10 @@ class Model:
         rotary axes converted to rad."""
         return self._validated(positions)[0]
 
-    def _validated(self, positions, defer: bool = False) -> tuple[dict, np.ndarray | None]:
-        """:meth:`positions`, and with ``defer`` an (N, n_axes) array's finiteness check left
-        to the caller, who gets the array back (:func:`_blocked` checks it block by block while
-        the block is in the cache: one pass less over memory); None when checked here."""
+    def _validated(self, positions, defer: bool = False) -> tuple[dict, int, np.ndarray | None]:
+        """:meth:`positions`, their number of points, and with ``defer`` an (N, n_axes) array
+        whose finiteness check is left to the caller (:func:`_blocked` checks it block by block
+        while the block is in the cache: one pass less over memory); None when checked here."""
         deferred = None
         if isinstance(positions, Mapping):
             positions = _case_insensitive(dict(positions), self.axes)
@@ -220,7 +220,7 @@ class Model:
             if v.shape != shape or v.ndim != 1:
                 v = np.broadcast_to(v, shape).ravel() if shape else np.atleast_1d(v)
             out[a] = np.deg2rad(v) if a in self.rotary_axes else v
-        return out, deferred
+        return out, len(next(iter(out.values()))), deferred
 
     def _check_rows(self, arr: np.ndarray) -> None:
         """(m, n_axes) positions finite, else InputError naming the axis.  One contiguous pass
@@ -234,8 +234,8 @@ class Model:
 
     def _points(self, positions) -> tuple[dict, int]:
         """Validated positions (see :meth:`positions`) and their number of points."""
-        pos = self.positions(positions)
-        return pos, len(next(iter(pos.values())))
+        pos, n, _ = self._validated(positions)
+        return pos, n
 
     def _probe(self, probe, n: int) -> dict:
         p = _floats(probe, "probe offset")
@@ -272,16 +272,18 @@ class Model:
         return out
 
     @staticmethod
-    def _check_finite(result: np.ndarray, inputs: dict, finite: bool | None = None
-                      ) -> np.ndarray:
-        """NaN in any input propagates to the result: check once there (or take ``finite``,
-        the check :func:`_blocked` made), then name the input."""
-        if not (np.isfinite(result).all() if finite is None else finite):
-            for name, v in inputs.items():
+    def _evaluate(fn, kwargs: dict, n: int, errs: dict, check_rows=None) -> np.ndarray:
+        """``fn`` block by block (:func:`_blocked`), the result checked for NaN there.  NaN in
+        any input propagates to the result, so the inputs are looked at only then, to name the
+        error parameter that caused it."""
+        finite: list = []
+        out = _blocked(fn, kwargs, n, finite=finite, check_rows=check_rows)
+        if not finite[0]:
+            for name, v in errs.items():
                 if not np.all(np.isfinite(v)):
                     raise InputError(f"error {name} has NaN or infinite values")
             raise InputError("the model evaluated to NaN or infinity (values too large?)")
-        return result
+        return out
 
     # ---- evaluation --------------------------------------------------------------
     def volumetric_error(self, positions, errors=None, probe=(0.0, 0.0, 0.0),
@@ -313,15 +315,12 @@ class Model:
         ndarray, shape (N, 3)
             dx, dy, dz, mm.
         """
-        pos, rows = self._validated(positions, defer=True)
-        n = len(next(iter(pos.values())))
+        pos, n, rows = self._validated(positions, defer=True)
         errs = self._errors(errors, n)
-        finite: list = []
-        out = _blocked(self.module.volumetric_error,
-                       {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs},
-                       n, finite=finite,
-                       check_rows=None if rows is None else (rows, self._check_rows))
-        out = self._check_finite(out, errs, finite[0])
+        out = self._evaluate(
+            self.module.volumetric_error,
+            {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n, errs,
+            check_rows=None if rows is None else (rows, self._check_rows))
         if direction is not None or probe_error is not None:
             out = out + self._probe_term(direction, probe_error, n)
         return out
@@ -350,11 +349,9 @@ class Model:
         """Error from the exact (not small-angle) chain, (N, 3) mm: for checks and simulation."""
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
-        finite: list = []
-        out = _blocked(self.module.exact_error,
-                       {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs},
-                       n, finite=finite)
-        return self._check_finite(out, errs, finite[0])
+        return self._evaluate(
+            self.module.exact_error,
+            {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n, errs)
 
     def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
         """Sensitivity of the volumetric error to every parameter.
@@ -484,10 +481,8 @@ class Model:
         """First-order error of the tool-axis direction, (N, 3), rad."""
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
-        finite: list = []
-        out = _blocked(self.module.orientation_error,
-                       {**pos, **self._covariates(covariates, n), **errs}, n, finite=finite)
-        return self._check_finite(out, errs, finite[0])
+        return self._evaluate(self.module.orientation_error,
+                              {**pos, **self._covariates(covariates, n), **errs}, n, errs)
 
 
 def load(name_or_path) -> Model:
