@@ -74,12 +74,12 @@ def audit_lookup(item: dict) -> list[Verdict]:
     for pos in np.arange(0.0, 400.0, 0.25):          # the mirror axis 0 .. 400 mm
         got, coef = run_printed(code, -axis, err, deg, pos)
         q_worst = max(q_worst, abs(got - float(np.polyval(coef, pos))))
-    ev = (f"What the printed code computes: for an axis whose positions are negative "
-          f"(Axis[-1] < 0, the branch Listing 3.1 provides), error_model[k] is the curve at "
-          f"-k mm; Listing 3.4's error_model[round(pos)] with pos < 0 is a negative index and "
-          f"Python counts it from the end: it reads the curve at -(n - |round(pos)|) mm, "
-          f"n = len(error_model) (no error raised). Run on an example (positions 0 .. -400 mm "
-          f"in 40 mm steps, a cubic error zero at 0, degree 3 as printed): "
+    ev = ("What the printed code computes: for an axis whose positions are negative "
+          "(Axis[-1] < 0, the branch Listing 3.1 provides), error_model[k] is the curve at "
+          "-k mm; Listing 3.4's error_model[round(pos)] with pos < 0 is a negative index and "
+          "Python counts it from the end: it reads the curve at -(n - |round(pos)|) mm, "
+          "n = len(error_model) (no error raised). Run on an example (positions 0 .. -400 mm "
+          "in 40 mm steps, a cubic error zero at 0, degree 3 as printed): "
           + "; ".join(rows) + f"; largest difference from the intended model over -400 .. -1 "
           f"mm: {worst:.2f} um. Only pos = 0 reads its own value; elsewhere the value is right "
           f"only where the curve happens to be equal at the mirror point. (The same axis with positive positions reads the intended curve "

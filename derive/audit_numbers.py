@@ -203,7 +203,7 @@ def check_definition(c) -> list[Verdict]:
                           + ", ".join(f"{n} multiplies the {norm[n][0]}-{norm[n][1]} coupling"
                                       for n in syms), pl["text"], str(norm)))
             continue
-        ev = (f"eq. 4 couples " + ", ".join(f"{n} to the {norm[n][0]}-{norm[n][1]} axes"
+        ev = ("eq. 4 couples " + ", ".join(f"{n} to the {norm[n][0]}-{norm[n][1]} axes"
                                              for n in syms)
               + f" (the position multiplying it and the component it enters); the {comp} "
               f"assigns " + ", ".join(f"{n} to {pl['pairs'][syms.index(n)]}" for n in bad))

@@ -1,6 +1,6 @@
 """Code generation: sympy expressions -> a plain, vectorised numpy module.
 
-Expressions are printed by a subclass of sympy's :class:`NumPyPrinter` after
+Expressions are printed by sympy's :class:`NumPyPrinter` (plain float literals) after
 common-subexpression elimination (``sympy.cse``); jinja2 only lays out the module around them
 (header with the layout hash, constants, signatures, docstrings).  Output is deterministic: the
 same layout text gives the same bytes.
@@ -16,10 +16,7 @@ from pathlib import Path
 
 import jinja2
 import sympy as sp
-from sympy.core.exprtools import _keep_coeff
 from sympy.printing.numpy import NumPyPrinter
-from sympy.printing.precedence import PRECEDENCE
-from sympy.printing.precedence import precedence as sympy_precedence
 
 from .linewrap import wrap_statement, wrap_text
 
@@ -46,153 +43,6 @@ class _Printer(NumPyPrinter):
     def _handle_UnevaluatedExpr(self, expr):
         # sympy rewrites re(UnevaluatedExpr(x)); without any re(...) that is the identity
         return super()._handle_UnevaluatedExpr(expr) if expr.has(sp.re) else expr
-
-    def _as_ordered_terms(self, expr, order=None):
-        if (order or self.order) is None and expr.is_Add:
-            return ordered_terms(expr)
-        return super()._as_ordered_terms(expr, order)
-
-    # sympy's rules for sums and products (StrPrinter._print_Add, CodePrinter._print_Mul,
-    # StrPrinter.parenthesize) with the precedence of the common nodes looked up directly:
-    # sympy's precedence() walks the class hierarchy and, for a product, builds its negative
-    # (Mul.could_extract_minus_sign) each time.  A test compares with sympy's printer.
-
-    def parenthesize(self, item, level, strict=False):
-        p = _precedence(item)
-        if p < level or (not strict and p <= level):
-            return "(%s)" % self._print(item)
-        return self._print(item)
-
-    def _print_Add(self, expr, order=None):
-        prec = _precedence(expr)
-        out = []
-        for term in self._as_ordered_terms(expr, order=order):
-            t = self._print(term)
-            if t.startswith("-") and not term.is_Add:
-                sign, t = "-", t[1:]
-            else:
-                sign = "+"
-            out.extend([sign, f"({t})" if _precedence(term) < prec or term.is_Add else t])
-        sign = out.pop(0)
-        return ("" if sign == "+" else sign) + " ".join(out)
-
-    def _print_Mul(self, expr):
-        if not expr.is_commutative or self.order in ("old", "none"):
-            return super()._print_Mul(expr)
-        prec = _precedence(expr)
-        c, rest = expr.as_coeff_Mul()
-        if c < 0:
-            expr, sign = _keep_coeff(-c, rest), "-"
-        else:
-            sign = ""
-        num, den, pow_paren = [], [], []
-        for item in expr.as_ordered_factors():
-            if item.is_Pow and item.exp.is_Rational and item.exp.is_negative:
-                if item.exp != -1:
-                    den.append(sp.Pow(item.base, -item.exp, evaluate=False))
-                else:
-                    if len(item.args[0].args) != 1 and isinstance(item.base, sp.Mul):
-                        pow_paren.append(item)
-                    den.append(sp.Pow(item.base, -item.exp))
-            else:
-                num.append(item)
-        num = num or [sp.S.One]
-        if len(num) == 1 and sign == "-":
-            num_str = [self.parenthesize(num[0], _UNARY)]
-        else:
-            num_str = [self.parenthesize(x, prec) for x in num]
-        den_str = [self.parenthesize(x, prec) for x in den]
-        for item in pow_paren:
-            if item.base in den:
-                k = den.index(item.base)
-                den_str[k] = f"({den_str[k]})"
-        if not den:
-            return sign + "*".join(num_str)
-        if len(den) == 1:
-            return sign + "*".join(num_str) + "/" + den_str[0]
-        return sign + "*".join(num_str) + "/(%s)" % "*".join(den_str)
-
-
-_ATOM, _ADD, _MUL, _POW = (PRECEDENCE[k] for k in ("Atom", "Add", "Mul", "Pow"))
-_UNARY = 0.5 * (PRECEDENCE["Pow"] + PRECEDENCE["Mul"])
-
-
-def _precedence(e):
-    """sympy's ``precedence(e)``: looked up directly for symbols, sums, powers and products of
-    numbers, symbols, powers and sines / cosines (a product led by a negative rational or
-    float prints as ``-...``); sympy's function for everything else."""
-    if e.is_Symbol:
-        return _ATOM
-    if e.is_Add:
-        return _ADD
-    if e.is_Pow:
-        return _POW
-    if e.is_Mul and all(not a.is_Function or type(a) in (sp.sin, sp.cos) for a in e.args):
-        c = e.args[0]
-        if c.is_Rational or (c.is_Float and c.is_finite):
-            return _ADD if c.is_extended_negative else _MUL
-    return sympy_precedence(e)
-
-
-#: complex values of the numeric factors seen by :func:`ordered_terms` (sympy number -> complex)
-_COMPLEX: dict = {}
-
-
-def _complex(x) -> complex:
-    c = _COMPLEX.get(x)
-    if c is None:
-        c = _COMPLEX[x] = complex(x)
-    return c
-
-
-def ordered_terms(expr) -> list:
-    """``expr.as_ordered_terms()`` (the printer's order of an Add's terms) for an Add
-    without noncommutative factors or ``Order`` terms: sympy's ``Expr.as_terms`` and lex
-    key, with the complex value of each numeric factor computed once per distinct number
-    (sympy evaluates ``complex(coeff)`` through ``evalf`` for every term: a third of the
-    printing time).  Other expressions go to sympy; a test compares the two orders."""
-    from sympy.core.exprtools import decompose_power
-    from sympy.core.numbers import Number, NumberSymbol
-
-    args = expr.args
-    # sympy's special case: Add(positive number, Mul(negative number, x)) keeps its order
-    if len(args) == 2 and isinstance(args[0], (Number, NumberSymbol)) and \
-            isinstance(args[1], sp.Mul):
-        mul_args = args[1].args
-        if len(mul_args) == 2 and isinstance(mul_args[0], Number) and \
-                args[0].is_positive and mul_args[0].is_negative:
-            return list(args)
-    gens, terms = set(), []
-    for term in args:
-        if not term.is_commutative or term.is_Order:
-            return expr.as_ordered_terms()
-        coeff, rest = term.as_coeff_Mul()
-        coeff = _complex(coeff)
-        cpart = {}
-        if rest is not sp.S.One:
-            for factor in sp.Mul.make_args(rest):
-                if factor.is_number:
-                    try:
-                        coeff *= _complex(factor)
-                    except (TypeError, ValueError):
-                        pass
-                    else:
-                        continue
-                base, exp = decompose_power(factor)
-                cpart[base] = exp
-                gens.add(base)
-        terms.append((term, coeff, cpart))
-    index = {g: i for i, g in enumerate(sorted(gens, key=sp.default_sort_key))}
-    keyed = []
-    for term, coeff, cpart in terms:
-        monom = [0] * len(index)
-        for base, exp in cpart.items():
-            monom[index[base]] = exp
-        im = coeff.imag
-        keyed.append(((tuple([-m for m in monom]), (), ((bool(im), im), (coeff.real, im))),
-                      term))
-    keyed.sort(key=lambda kt: kt[0])
-    return [t for _, t in keyed]
 
 
 _PRINTER = _Printer()

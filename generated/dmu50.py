@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
-derivation sha256  e695f071db9a8b79bb44012d4d77729cda5ef7e8584e206ea242d049a640d78c
+derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9e0b9225cac4964404bf2e854a5173268922f8f2cc7f38758d6dc04d440f1726
-derivation sha256  e695f071db9a8b79bb44012d4d77729cda5ef7e8584e206ea242d049a640d78c
+derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

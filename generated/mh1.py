@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       3a3a534a68c538a1437d4e5e1ddd5db71b1af141d519570f0656ef89cb7a4597
-derivation sha256  e695f071db9a8b79bb44012d4d77729cda5ef7e8584e206ea242d049a640d78c
+derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       14c00cbdd4320c30c61d6c8934b7e649bc3fee4d78e7c7cc3d4d29e6aee0c398
-derivation sha256  e695f071db9a8b79bb44012d4d77729cda5ef7e8584e206ea242d049a640d78c
+derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
-derivation sha256  ff2733587579ff348819bfa1914eb868cf512ee9d00763a1c794c78bd163073f
+derivation sha256  8cf5646c5668a5a8286978cb3dac789c2ac40ed68de44db7c7334a75e5985497
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,

@@ -79,7 +79,6 @@ def test_exact_htm_is_the_sympy_product_of_the_factors():
 from volerr.derive import inverse as inv  # noqa: E402
 from volerr.derive import probe as probe_derivation  # noqa: E402
 from volerr.derive import three_point as tp  # noqa: E402
-from volerr.derive.codegen import ordered_terms  # noqa: E402
 from volerr.derive.kinematics import RingMatrices  # noqa: E402
 
 s2 = sp.sqrt(2)
@@ -106,14 +105,6 @@ def test_collect_symbols_is_sympy_collect(terms):
     e = sp.expand(sp.Add(*terms))
     syms = [z, x, y]
     assert _same(vol.collect_symbols(e, syms), sp.collect(e, syms))
-
-
-@settings(max_examples=150, deadline=None)
-@given(st.lists(polys(2), min_size=2, max_size=7))
-def test_ordered_terms_is_sympys_order(terms):
-    e = sp.Add(*terms)
-    if e.is_Add:
-        assert ordered_terms(e) == e.as_ordered_terms()
 
 
 @settings(max_examples=60, deadline=None)
