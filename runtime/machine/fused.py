@@ -249,6 +249,8 @@ def _fold(parsed: Parsed, zeros: frozenset):
 
 
 def _copy(node):
+    # through the source text: copy.deepcopy recurses once per nesting level and exceeds
+    # Python's recursion limit on the deep expressions of five-axis exact_error
     return ast.parse(ast.unparse(node), mode="eval").body
 
 
