@@ -22,26 +22,32 @@ MOVED = {
     "plots_identify": "identify.plots", "probe_plans": "probe.plans", "plots_probe": "probe.plots",
     "gcode": "fiveaxis.gcode", "compensate": "fiveaxis.compensate",
     "fiveaxis_example": "fiveaxis.example", "plots_fiveaxis": "fiveaxis.plots",
-    "candidates": "loop.candidates", "fit": "loop.fit", "simulate": "loop.simulate",
+    "candidates": "loop.candidates", "fit": "estimate.design", "simulate": "loop.simulate",
+    "loop.fit": "estimate.design", "loop.blocks": "estimate.blocks",
     "loop_report": "loop.report", "audit_numeric": "audit.numeric", "commands": "cli",
 }
+
+
+def _moved(old: str):
+    """(moved name, rest) for the longest moved name that ``old`` starts with, else None."""
+    parts = old.split(".")
+    for k in range(len(parts), 0, -1):
+        head = ".".join(parts[:k])
+        if head in MOVED:
+            return head, ".".join(parts[k:])
+    return None
 
 
 class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     def find_spec(self, fullname, path=None, target=None):
         if not fullname.startswith("volerr."):
             return None
-        old = fullname[len("volerr."):]
-        head, _, tail = old.partition(".")
-        if head not in MOVED:
-            return None
-        return importlib.util.spec_from_loader(fullname, self)
+        return (importlib.util.spec_from_loader(fullname, self)
+                if _moved(fullname[len("volerr."):]) else None)
 
     def create_module(self, spec):
-        old = spec.name[len("volerr."):]
-        head, _, tail = old.partition(".")
-        target = "volerr." + MOVED[head] + ("." + tail if tail else "")
-        return importlib.import_module(target)
+        head, tail = _moved(spec.name[len("volerr."):])
+        return importlib.import_module("volerr." + MOVED[head] + ("." + tail if tail else ""))
 
     def exec_module(self, module):
         pass

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .fit import Data
+from ..estimate.design import Data
 
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
             "probe_direction", "setup", "group", "step", "covariate")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .fit import rotary_rad
+from ..estimate.design import rotary_rad
 
 
 def _png(fig) -> str:

@@ -6,7 +6,7 @@ Steps (:func:`run_loop`):
 1. read the measured-deviation CSV (INTERFACE.md) and check it against the layout;
 2. hold out a random ``test_fraction`` of the points; everything below is decided on the
    others (the training points) and judged on the held-out ones;
-3. fit the declared model (:mod:`volerr.loop.fit`): component errors as Legendre series, degree by
+3. fit the declared model (:mod:`volerr.estimate.design`): component errors as Legendre series, degree by
    cross-validation, squareness, location errors, the instrument's rigid placement;
    gauge fixed by convention, plan-specific unidentifiable combinations reported;
 4. robust weights of the points (IRLS on the declared fit): gross outliers are down-weighted
@@ -21,7 +21,7 @@ Steps (:func:`run_loop`):
    functions (sensitivities; the full module only when written or asked for) and fit it with
    their columns: it gives the "after" figures;
 
-All fits run on columns generated per block of points (:mod:`volerr.loop.blocks`): normal
+All fits run on columns generated per block of points (:mod:`volerr.estimate.blocks`): normal
 equations, cross-products and residuals are accumulated blockwise, never the (3N, p) design.
 7. report: :class:`Report` (with the ranked residual sources before and after) (``write_json``, ``write_html``).
 
@@ -41,11 +41,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import blocks
+from ..estimate import blocks
 from . import candidates as cands
 from . import select as sel
 from ..errors import InputError, require
-from .fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
+from ..estimate.design import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
                   identifiability_gram, point_norm, require_points, rms, rows_of,
                   weakly_determined_gram)
 from ..machine.layout import layout_text, parse_layout
@@ -271,9 +271,9 @@ class Report:
         Returns ``({axis: volerr.tables.table.ErrorTable}, constants {name: value})`` in mm / rad,
         with ``std`` columns (standard deviation of the fit).  Translational errors are zero at
         the start of the measured range (their constants belong to the instrument placement);
-        straightness slopes are carried by squareness (gauge: see :mod:`volerr.loop.fit`).
+        straightness slopes are carried by squareness (gauge: see :mod:`volerr.estimate.design`).
         ``which="before"``: the declared model's own fit (effects unmodelled, no std)."""
-        from .fit import legendre, unit
+        from ..estimate.design import legendre, unit
         from ..tables.table import ErrorTable
 
         fg = self.figures
@@ -440,7 +440,7 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     residual length (the median of a chi(3) variable is 1.538 sigma), so gross outliers
     neither inflate the noise estimate nor hide smaller ones.
 
-    ``design``: :class:`volerr.loop.blocks.Design`; ``points``: the points fitted (their rows
+    ``design``: :class:`volerr.estimate.blocks.Design`; ``points``: the points fitted (their rows
     of ``y``).  The normal equations of all points at weight 1 are accumulated once; each
     iteration subtracts those of the down-weighted points (few) and predicts blockwise."""
     w = np.ones(len(points))
@@ -750,7 +750,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
              degree: int | None = None, max_degree: int = 10, out_dir=None,
              progress=None, families=cands.FAMILIES, inputs=()) -> Report:
     """Run the loop on ``data`` (CSV path, :class:`volerr.loop.simulate.Campaign` or
-    :class:`volerr.loop.fit.Data`) for ``layout`` (name or layout file). Returns a :class:`Report`.
+    :class:`volerr.estimate.design.Data`) for ``layout`` (name or layout file). Returns a :class:`Report`.
 
     ``out_dir``: where the augmented layout and its generated module are written (nothing is
     written when None; the texts are in the report object either way)."""

@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import candidates as cands
-from .blocks import BlockBase, blocks, cv_sq
-from .fit import TWIST, rows_of
+from ..estimate.blocks import BlockBase, blocks, cv_sq
+from ..estimate.design import TWIST, rows_of
 from ..machine.expressions import evaluate
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
@@ -103,7 +103,7 @@ class Context:
                        {"fixed": self.cache.setdefault("fixed", {})})
 
     def values(self, full: bool = False):
-        from .fit import rotary_rad
+        from ..estimate.design import rotary_rad
 
         key = ("_values", full)
         if key not in self.cache:
@@ -118,7 +118,7 @@ class Context:
         ``idx`` of each ``slot``)."""
         if self.sens is not None:
             return self.sens[idx], self.twist[idx]
-        from .fit import twist_sensitivity
+        from ..estimate.design import twist_sensitivity
 
         last = self.cache.get(slot)
         if last is not None and np.array_equal(last[0], idx):

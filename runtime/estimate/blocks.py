@@ -3,7 +3,7 @@ points, weighted normal equations (A^T W A, A^T W y) and cross-products accumula
 held-out residuals per block.  Memory: p x p matrices, p-vectors and one block of rows.
 
 A :class:`Design` is the declared model's kept columns (generated from the model's sensitivity
-per block, :func:`volerr.loop.fit.declared_design`) followed by dense extra columns (accepted
+per block, :func:`volerr.estimate.design.declared_design`) followed by dense extra columns (accepted
 effects, (N, 3, m)).  Rows are point-major (3 per point), deviations in mm; weights are the
 square roots of the robust point weights (one per point).
 """
@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .fit import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
+from .design import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
 BLOCK = 8192
@@ -30,7 +30,7 @@ def blocks(points, size: int | None = None):
 class Design:
     """Columns of a linear model at the data points, generated per block.
 
-    ``keep``: mask of the columns of :func:`volerr.loop.fit.declared_design` kept (gauge and
+    ``keep``: mask of the columns of :func:`volerr.estimate.design.declared_design` kept (gauge and
     identifiability); ``extra``: dense (N, 3, m) column groups appended in order.
 
     :meth:`block` returns the columns transposed, (p, 3n), with the rows of a block in
@@ -126,7 +126,7 @@ def normal(design, points, sw, y):
 
 
 def unit_scale(colsq, n_rows: int) -> np.ndarray:
-    """Column scale to unit RMS (as :class:`volerr.loop.fit.Problem`): sqrt(mean square)."""
+    """Column scale to unit RMS (as :class:`volerr.estimate.design.Problem`): sqrt(mean square)."""
     s = np.sqrt(np.maximum(colsq, 0.0) / max(n_rows, 1))
     s[s == 0] = 1.0
     return s
@@ -152,7 +152,7 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     """Per-point squared length of the cross-validated (weighted) residual on ``points``:
     leave-one-point-out when ``folds`` is None (exact, through the 3x3 diagonal blocks of the
     hat matrix), else k-fold (``folds``: fold label per point).  Equals
-    :meth:`volerr.loop.fit.Problem.loo_residuals` / ``cv_residuals`` on the weighted rows."""
+    :meth:`volerr.estimate.design.Problem.loo_residuals` / ``cv_residuals`` on the weighted rows."""
     n_rows = 3 * len(points)
     if folds is None:
         G, b, colsq = normal(design, points, sw, y)
@@ -206,8 +206,8 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
 
 
 def solve_sym(G, b, tol: float = SV_TOL ** 2):
-    """Minimum-norm solution of G x = b (as :func:`volerr.loop.fit.solve_normal`)."""
-    from .fit import solve_normal
+    """Minimum-norm solution of G x = b (as :func:`volerr.estimate.design.solve_normal`)."""
+    from .design import solve_normal
 
     return solve_normal(G, b, tol)
 
