@@ -19,6 +19,7 @@ from .kinematics import PROBE, Chain
 EXTRA_MODULES = {
     "three_point.py": "volerr.derive.three_point:generate_module",
     "probe.py": "volerr.derive.probe:generate_module",
+    "instruments.py": "volerr.derive.observations:generate_module",
 }
 
 
@@ -82,6 +83,10 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "Nominal probe-tip / tool-tip position in the workpiece frame, mm."),
         Function("tool_axis", pos, list(vol.nominal_tool_axis(chain)),
                  "Nominal tool-axis direction (tool +z) in the workpiece frame, unit vector."),
+        Function("work_rotation", pos, list(vol.work_rotation(chain)),
+                 "Orientation of the workpiece frame in the base (linear-axis) frame: array "
+                 "(3, 3, *shape), v_base = R @ v_work (identity without table axes).",
+                 shape=(3, 3)),
         Function("orientation_error", pos + cov + params, list(vol.orientation_error(chain)),
                  "First-order error of the tool-axis direction (i, j, k), rad."),
     ]

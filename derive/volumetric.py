@@ -28,6 +28,24 @@ def nominal_tool_axis(chain: Chain) -> sp.Matrix:
     return chain.nominal_htm()[0:3, 2]
 
 
+def work_rotation(chain: Chain) -> sp.Matrix:
+    """Orientation of the workpiece frame in the base frame (the frame of the machine's linear
+    axes), 3x3: columns are the workpiece axes in base coordinates.  The workpiece side of
+    ``tool2work`` is ``base2work``; this is the transpose of its rotation."""
+    from .kinematics import _table_rotary, stage_factors
+
+    layout = chain.layout
+    m = sp.eye(4)
+    for entry in reversed(layout.workpiece_chain):
+        fs = stage_factors(layout, entry)
+        if entry in layout.axes and layout.axes[entry].kind == "rotary":
+            fs = _table_rotary(fs)
+        for f in fs:
+            if not f.is_error:
+                m = m * f.nominal
+    return m[0:3, 0:3].T.applyfunc(sp.expand)
+
+
 def volumetric_error(chain: Chain) -> sp.Matrix:
     """First-order volumetric error (dX, dY, dZ), linear in the error parameters."""
     return _first_order_displacement(chain, sp.Matrix([*PROBE, 1]))

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
-derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
+derivation sha256  71bd61924bc206d48a0d4baa0a657d290bdb0292966118cf6b6823449d8d4217
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -1508,6 +1508,36 @@ def tool_axis(X, Y, Z, B, C):
     _o1 = numpy.broadcast_to((1/2)*_t0*_t3*_t5 + _t2*_t4, _shape)
     _o2 = numpy.broadcast_to(_t1 + 1/2, _shape)
     return _o0, _o1, _o2
+
+
+def work_rotation(X, Y, Z, B, C):
+    """Orientation of the workpiece frame in the base (linear-axis) frame: array (3, 3, *shape),
+    v_base = R @ v_work (identity without table axes)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C))
+    _t0 = numpy.cos(B)
+    _t1 = numpy.cos(C)
+    _t2 = _t0*_t1
+    _t3 = numpy.sin(C)
+    _t4 = (1/2)*_t3
+    _t5 = numpy.sqrt(2)*numpy.sin(B)
+    _t6 = _t4*_t5
+    _t7 = (1/2)*_t1
+    _t8 = _t5*_t7
+    _t9 = (1/2)*_t0*_t3
+    _t10 = (1/2)*_t2 + _t6
+    _t11 = (1/2)*_t0
+    _out = numpy.zeros((3, 3) + _shape)
+    _out[0, 0] = _t2 + _t6
+    _out[0, 1] = _t0*_t3 - _t8
+    _out[0, 2] = -1/2*_t5
+    _out[1, 0] = -_t4 + _t8 - _t9
+    _out[1, 1] = _t10 + _t7
+    _out[1, 2] = _t11 - 1/2
+    _out[2, 0] = _t4 + _t8 - _t9
+    _out[2, 1] = _t10 - _t7
+    _out[2, 2] = _t11 + 1/2
+    return _out
 
 
 def orientation_error(X, Y, Z, B, C, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY, ECY,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       a47a1650cc12d3db47d92764978ee4bb013956fe536312cb0baad903987dbdb5
-derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
+derivation sha256  71bd61924bc206d48a0d4baa0a657d290bdb0292966118cf6b6823449d8d4217
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -328,6 +328,17 @@ def tool_axis(X, Y, Z):
     _o1 = numpy.broadcast_to(0, _shape)
     _o2 = numpy.broadcast_to(1, _shape)
     return _o0, _o1, _o2
+
+
+def work_rotation(X, Y, Z):
+    """Orientation of the workpiece frame in the base (linear-axis) frame: array (3, 3, *shape),
+    v_base = R @ v_work (identity without table axes)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z))
+    _out = numpy.zeros((3, 3) + _shape)
+    _out[0, 0] = 1
+    _out[1, 1] = 1
+    _out[2, 2] = 1
+    return _out
 
 
 def orientation_error(X, Y, Z, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY, ECY, EXZ,

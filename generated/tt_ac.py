@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9b5f923e440b8c75c3b5ca7308d4ba4371152109c2b1c6354b17becb2a4ed34a
-derivation sha256  61b206bb79671d0fbcf03045ce4f543b9251b482b9952d05bd7ea60c7b6dbe72
+derivation sha256  71bd61924bc206d48a0d4baa0a657d290bdb0292966118cf6b6823449d8d4217
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
@@ -967,6 +967,27 @@ def tool_axis(X, Y, Z, A, C):
     _o1 = numpy.broadcast_to(-_t0*numpy.cos(C), _shape)
     _o2 = numpy.broadcast_to(numpy.cos(A), _shape)
     return _o0, _o1, _o2
+
+
+def work_rotation(X, Y, Z, A, C):
+    """Orientation of the workpiece frame in the base (linear-axis) frame: array (3, 3, *shape),
+    v_base = R @ v_work (identity without table axes)."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(A), numpy.shape(C))
+    _t0 = numpy.cos(C)
+    _t1 = numpy.sin(C)
+    _t2 = numpy.cos(A)
+    _t3 = numpy.sin(A)
+    _out = numpy.zeros((3, 3) + _shape)
+    _out[0, 0] = _t0
+    _out[0, 1] = _t1
+    _out[1, 0] = -_t1*_t2
+    _out[1, 1] = _t0*_t2
+    _out[1, 2] = _t3
+    _out[2, 0] = _t1*_t3
+    _out[2, 1] = -_t0*_t3
+    _out[2, 2] = _t2
+    return _out
 
 
 def orientation_error(X, Y, Z, A, C, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY, ECY,
