@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .design import SV_TOL, TWIST, declared_design, legendre, twist_sensitivity, unit
+from .design import SV_TOL, declared_design, legendre, twist_sensitivity, unit
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
 BLOCK = 8192
@@ -45,10 +45,11 @@ class Design:
         labels = declared_design(model, data.subset(np.arange(1)), degree, ranges).labels
         self.labels = [lab for lab, k in zip(labels, self.keep) if k]
         pidx = {p: j for j, p in enumerate(model.parameters)}
+        sidx = {k: j for j, k in enumerate(data.setup_labels)}
         self._ops = []
         for p, k in self.labels:
             if p == "setup":
-                self._ops.append((0, TWIST[f"work.{k}"], None, None))
+                self._ops.append((0, sidx[k], None, None))
             elif k is None:
                 self._ops.append((1, pidx[p], None, None))
             else:
@@ -64,15 +65,14 @@ class Design:
         """(p, 3n) columns at the points ``idx``, rows component-major."""
         sub = self.data.subset(idx)
         n = len(idx)
-        cov = {c: sub.covariates[c] for c in self.model.covariates}
-        sens = np.moveaxis(self.model.sensitivity(sub.positions, sub.probe, covariates=cov),
-                           0, -1)                                      # (3, P, n)
-        tw = np.moveaxis(twist_sensitivity(self.model, sub), 0, -1)    # (3, 12, n)
+        sens = np.moveaxis(sub.sensitivity(self.model), 0, -1)         # (3, P, n)
+        tw = twist_sensitivity(self.model, sub)
+        setup = np.moveaxis(sub.setup_columns(tw), 0, -1)              # (3, m, n)
         bases = {a: legendre(unit(sub.positions[a], *self.ranges[a]), self.degree).T
                  for a in self.model.axes}
         At = np.empty((self.p, 3, n))
         for i, (src, j, axis, k) in enumerate(self._ops):
-            col = (tw if src == 0 else sens)[:, j, :]
+            col = (setup if src == 0 else sens)[:, j, :]
             if axis is None:
                 At[i] = col
             else:

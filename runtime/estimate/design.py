@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import require
+from ..instruments.observations import Observations
 from ..machine.model import Model
 
 SETUP = ("dx", "dy", "dz", "ex", "ey", "ez")
@@ -40,24 +41,8 @@ SV_TOL = 1e-6
 GAUGE_TOL = 1e-4
 
 
-@dataclass
-class Data:
-    """Measured deviations: positions mm | deg, probe (N, 3) mm, deviation (N, 3) mm."""
-
-    positions: dict
-    probe: np.ndarray
-    deviation: np.ndarray
-    covariates: dict = field(default_factory=dict)
-    warnings: list = field(default_factory=list)   # columns left out, one line each
-
-    @property
-    def n(self) -> int:
-        return len(self.deviation)
-
-    def subset(self, idx) -> "Data":
-        return Data({a: v[idx] for a, v in self.positions.items()}, self.probe[idx],
-                    self.deviation[idx], {c: v[idx] for c, v in self.covariates.items()},
-                    self.warnings)
+#: the readings of any instrument (3-D deviations, ballbar lengths, sphere centres ...)
+Data = Observations
 
 
 def unit(q, lo, hi):
@@ -99,13 +84,10 @@ TWIST = {f"{side}.{k}": 6 * i + j for i, side in enumerate(("work", "tool"))
 
 
 def twist_sensitivity(model: Model, data: Data) -> np.ndarray:
-    """(N, 3, 12) d(error)/d(rigid twist) of the workpiece frame (columns 0-5: dx, dy, dz mm,
-    ex, ey, ez rad; the instrument's placement) and of the tool end (6-11, tool frame): the
-    generated ``setup_sensitivity`` of the layout's chain."""
-    pos = model.positions(data.positions)
-    p = data.probe
-    s = model.module.setup_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
-    return np.moveaxis(np.broadcast_to(s, (3, 12, data.n)), -1, 0)
+    """(N, 3, 12) d(readings)/d(rigid twist) of the workpiece frame (columns 0-5: dx, dy, dz
+    mm, ex, ey, ez rad; the instrument's placement) and of the tool end (6-11, tool frame): the
+    generated ``setup_sensitivity`` of the layout's chain, seen by the instrument."""
+    return data.twist(model)
 
 
 @dataclass
@@ -118,20 +100,27 @@ class Design:
     twist: np.ndarray       # rigid-twist sensitivity (N, 3, 12), see twist_sensitivity
 
 
-def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Design:
-    """All columns of the declared model with component errors of degree ``degree``."""
-    cov = {c: data.covariates[c] for c in model.covariates}
-    sens = model.sensitivity(data.positions, data.probe, covariates=cov)
-    tw = twist_sensitivity(model, data)
-    labels = [("setup", key) for key in SETUP]
+def parameter_labels(model: Model, degree: int) -> list:
+    """Labels of the parameter columns: ``(name, None)`` for a constant, ``(name, k)`` for the
+    Legendre term P_k of a component error."""
+    labels = []
     for p in model.parameters:
         labels += ([(p, None)] if model.parameter_axis.get(p) is None
                    else [(p, k) for k in range(degree + 1)])
+    return labels
+
+
+def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Design:
+    """All columns of the declared model with component errors of degree ``degree``: the
+    instruments' set-up columns (labels ``("setup", key)``), then the parameters."""
+    sens = data.sensitivity(model)
+    tw = twist_sensitivity(model, data)
+    setup = data.setup_columns(tw)
+    labels = [("setup", key) for key in data.setup_labels] + parameter_labels(model, degree)
     A = np.empty((data.n, 3, len(labels)))
-    for i, key in enumerate(SETUP):
-        A[:, :, i] = tw[:, :, TWIST[f"work.{key}"]]
+    A[:, :, :setup.shape[2]] = setup
     bases = {a: legendre(unit(data.positions[a], *ranges[a]), degree) for a in model.axes}
-    i = len(SETUP)
+    i = setup.shape[2]
     for j, p in enumerate(model.parameters):
         axis = model.parameter_axis.get(p)
         if axis is None:
@@ -204,16 +193,27 @@ def ideal_data(model: Model, data: Data, ranges: dict, n: int = 400, seed: int =
     return Data(pos, probe, np.zeros((n, 3)), cov)
 
 
-def gauge_mask(model: Model, data: Data, degree: int, ranges: dict) -> tuple[np.ndarray, list]:
-    """Columns kept after gauge fixing (see the module docstring) and the dropped labels."""
+def gauge_mask(model: Model, data: Data, degree: int, ranges: dict,
+               parameters=None) -> tuple[np.ndarray, list]:
+    """Columns of :func:`declared_design` on ``data`` kept after gauge fixing (see the module
+    docstring) and the dropped labels.  The gauge is a property of the chain: it is found on
+    an ideal 3-D plan with the instrument's rigid placement, whatever instruments ``data``
+    holds; every set-up column of ``data`` is kept.  ``parameters``: the names fitted (None:
+    all); the others are left out (held at zero) before the gauge is fixed."""
     ideal = ideal_data(model, data, ranges)
     d = declared_design(model, ideal, degree, ranges)
     A2 = d.A.reshape(-1, d.A.shape[-1])
+    chosen = np.array([p == "setup" or parameters is None or p in parameters
+                       for p, _ in d.labels])
     # correlation-scaled Gram (columns in mm and rad differ by orders of magnitude): on the
     # ideal plan a kept column is >= ~0.1 of its norm away from the span of the others and
     # a gauge column ~1e-7 (rounding), so 1e-4 separates them whatever the seed
-    keep = independent_columns(_correlation(A2.T @ A2), priority_order(d.labels), GAUGE_TOL)
-    return keep, [d.labels[j] for j in np.flatnonzero(~keep)]
+    order = [j for j in priority_order(d.labels) if chosen[j]]
+    keep = independent_columns(_correlation(A2.T @ A2), order, GAUGE_TOL)
+    gauge = [d.labels[j] for j in np.flatnonzero(~keep & chosen)]
+    n_setup = len(data.setup_labels)
+    keep = np.concatenate([np.ones(n_setup, bool), keep[len(SETUP):]])
+    return keep, gauge
 
 
 def _correlation(G: np.ndarray) -> np.ndarray:

@@ -124,9 +124,7 @@ class Context:
         if last is not None and np.array_equal(last[0], idx):
             return last[1]
         sub = self.data.subset(idx)
-        cov = {c: sub.covariates[c] for c in self.model.covariates}
-        out = (self.model.sensitivity(sub.positions, sub.probe, covariates=cov),
-               twist_sensitivity(self.model, sub))
+        out = (sub.sensitivity(self.model), twist_sensitivity(self.model, sub))
         self.cache[slot] = (np.array(idx), out)
         return out
 

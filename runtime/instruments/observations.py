@@ -1,0 +1,233 @@
+"""Observations: the readings of any instrument as rows of the layout's linear model.
+
+A reading of any instrument is, to first order, a linear functional of the volumetric error at
+its commanded positions plus a few set-up unknowns of the instrument
+(:mod:`volerr.derive.observations`)::
+
+    reading - nominal reading = P (S(q, probe) theta) + C s + noise
+
+``S`` is the layout's generated sensitivity (3 x parameters, mm/mm or mm/rad), ``theta`` the
+error parameters, ``P`` the instrument's projection of the 3-D error on its readings (identity
+for a 3-D deviation, the bar direction for a ballbar, a rotation for a reading in the machine
+frame), ``C`` its set-up columns and ``s`` the set-up unknowns (a pivot offset, a bar-length
+offset, a sphere centre, an instrument placement ...).
+
+Storage: a *point* is one commanded pose with up to three readings (rows).  Arrays are (N, 3)
+with unused rows zero (a ballbar point has one reading: rows 2 and 3 are zero in the reading,
+the projection and the set-up columns, so they add nothing to any least-squares sum).  The
+estimator (:mod:`volerr.estimate`) and the loop work on these rows whatever the instrument.
+
+Units: positions mm / deg, probe offsets mm, readings mm (files carry um), set-up columns
+mm/mm or mm/rad.  Sign: every reading is "actual minus nominal" as the instrument defines it
+(stated once in each instrument's module).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: keys of the default set-up: the rigid placement of the measuring instrument (workpiece end)
+PLACEMENT = ("dx", "dy", "dz", "ex", "ey", "ez")
+
+
+@dataclass(frozen=True)
+class FileInfo:
+    """One measurement file of a campaign: its ``name`` (as reported), instrument ``kind``,
+    reading unit (``um``) and the number of readings per point (1 or 3)."""
+
+    name: str
+    kind: str
+    unit: str = "um"
+    rows: int = 3
+
+
+@dataclass
+class Setup:
+    """Set-up unknowns of the instruments, grouped (a group: one placement of one instrument).
+
+    ``group`` (N,) the group of each point; ``local`` (N, 3, k) the columns of the point's own
+    group (zero-padded to the widest group); ``names[g]`` and ``keys[g]`` name group g and its
+    unknowns; ``model_columns[g]``: None, or the twist columns of the layout's generated
+    ``setup_sensitivity`` that give group g's columns (a placement acting through the chain),
+    then ``local`` is unused for it.  Global column order: group by group, key by key."""
+
+    group: np.ndarray
+    local: np.ndarray
+    names: list
+    keys: list
+    model_columns: list
+
+    @property
+    def offsets(self) -> np.ndarray:
+        return np.concatenate([[0], np.cumsum([len(k) for k in self.keys])]).astype(int)
+
+    @property
+    def n_columns(self) -> int:
+        return int(sum(len(k) for k in self.keys))
+
+    @property
+    def labels(self) -> list:
+        return [f"{n}.{k}" for n, ks in zip(self.names, self.keys) for k in ks]
+
+    def subset(self, idx) -> "Setup":
+        return Setup(self.group[idx], self.local[idx], self.names, self.keys, self.model_columns)
+
+    def block(self, twist: np.ndarray | None) -> np.ndarray:
+        """(n, 3, m) set-up columns of these points (``twist``: their projected twist
+        sensitivity (n, 3, 12), needed by groups with ``model_columns``)."""
+        n = len(self.group)
+        out = np.zeros((n, 3, self.n_columns))
+        off = self.offsets
+        for g in np.unique(self.group):
+            m = self.group == g
+            k = len(self.keys[g])
+            cols = self.model_columns[g]
+            src = twist[m][:, :, list(cols)] if cols is not None else self.local[m][:, :, :k]
+            out[m, :, off[g]:off[g] + k] = src
+        return out
+
+
+def stack_setups(parts: list, ns: list) -> Setup:
+    """One :class:`Setup` of consecutive blocks of points (``ns`` points each)."""
+    width = max(p.local.shape[2] for p in parts)
+    local = np.zeros((sum(ns), 3, width))
+    group, names, keys, model_cols = [], [], [], []
+    start = 0
+    for p, n in zip(parts, ns):
+        local[start:start + n, :, :p.local.shape[2]] = p.local
+        group.append(p.group + len(names))
+        names += p.names
+        keys += p.keys
+        model_cols += p.model_columns
+        start += n
+    return Setup(np.concatenate(group), local, names, keys, model_cols)
+
+
+@dataclass
+class Observations:
+    """Readings of one or several instruments at commanded poses (see the module docstring).
+
+    ``positions`` axis -> (N,) mm | deg; ``probe`` (N, 3) mm: probe / tool (or tool-side ball)
+    offset; ``deviation`` (N, 3) mm: reading minus nominal reading, unused rows zero;
+    ``covariates`` name -> (N,); ``proj`` (N, 3, 3) or None (identity: 3-D deviations);
+    ``rows`` (N,) readings per point or None (all 3); ``weight`` (N,) relative weight of each
+    point's readings (1 / u^2, normalised) or None (equal); ``setup`` or None (one rigid
+    placement of the instrument, :data:`PLACEMENT`); ``file`` (N,) index into ``files`` and
+    ``row`` (N,) the point's data row in its file (0-based), or None (one file)."""
+
+    positions: dict
+    probe: np.ndarray
+    deviation: np.ndarray
+    covariates: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)   # columns left out, one line each
+    proj: np.ndarray | None = None
+    rows: np.ndarray | None = None
+    weight: np.ndarray | None = None
+    setup: Setup | None = None
+    file: np.ndarray | None = None
+    row: np.ndarray | None = None
+    files: tuple = ()
+    sigma: np.ndarray | None = None      # (N,) standard uncertainty of a reading, mm
+
+    @property
+    def n(self) -> int:
+        return len(self.deviation)
+
+    @property
+    def n_readings(self) -> int:
+        """Number of readings (rows that carry a reading)."""
+        return 3 * self.n if self.rows is None else int(np.sum(self.rows))
+
+    def readings_per_point(self) -> np.ndarray:
+        return np.full(self.n, 3) if self.rows is None else self.rows
+
+    def subset(self, idx) -> "Observations":
+        def take(a):
+            return None if a is None else a[idx]
+
+        return Observations({a: v[idx] for a, v in self.positions.items()}, self.probe[idx],
+                            self.deviation[idx], {c: v[idx] for c, v in self.covariates.items()},
+                            self.warnings, take(self.proj), take(self.rows), take(self.weight),
+                            None if self.setup is None else self.setup.subset(idx),
+                            take(self.file), take(self.row), self.files, take(self.sigma))
+
+    # ---- the rows of the linear model ------------------------------------------------
+    def project(self, cols: np.ndarray) -> np.ndarray:
+        """(n, 3, m) columns of the 3-D error -> the same columns as readings (``proj @``)."""
+        if self.proj is None:
+            return cols
+        return np.einsum("nij,njm->nim", self.proj, cols)
+
+    def sensitivity(self, model) -> np.ndarray:
+        """(N, 3, n_parameters) d(readings)/d(parameter), mm/mm or mm/rad."""
+        cov = {c: self.covariates[c] for c in model.covariates}
+        return self.project(model.sensitivity(self.positions, self.probe, covariates=cov))
+
+    def twist(self, model) -> np.ndarray:
+        """(N, 3, 12) d(readings)/d(rigid twist) of the workpiece end (0-5) and the tool end
+        (6-11) of the chain (the generated ``setup_sensitivity``, projected)."""
+        pos = model.positions(self.positions)
+        p = self.probe
+        s = model.module.setup_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
+        return self.project(np.moveaxis(np.broadcast_to(s, (3, 12, self.n)), -1, 0))
+
+    @property
+    def setup_labels(self) -> list:
+        """Keys of the set-up columns (``dx`` ... for the default placement)."""
+        return list(PLACEMENT) if self.setup is None else self.setup.labels
+
+    def setup_columns(self, twist: np.ndarray) -> np.ndarray:
+        """(N, 3, m) set-up columns, given this block's projected twist sensitivity."""
+        if self.setup is None:
+            return twist[:, :, :6]
+        return self.setup.block(twist)
+
+    def point_weights(self) -> np.ndarray:
+        return np.ones(self.n) if self.weight is None else self.weight
+
+
+def stack(parts: list) -> Observations:
+    """One :class:`Observations` of several files' (each with its own ``files`` entry); the
+    default placement of a part becomes that file's own set-up group."""
+    if len(parts) == 1:
+        return parts[0]
+    ns = [p.n for p in parts]
+    axes = list(parts[0].positions)
+    covs = set(parts[0].covariates)
+    for p in parts[1:]:
+        covs &= set(p.covariates)
+    setups = []
+    for i, p in enumerate(parts):
+        if p.setup is None:
+            name = p.files[0].name if p.files else f"file{i + 1}"
+            setups.append(Setup(np.zeros(p.n, int), np.zeros((p.n, 3, 0)), [name],
+                                [PLACEMENT], [tuple(range(6))]))
+        else:
+            setups.append(p.setup)
+
+    def cat(get, default):
+        return np.concatenate([get(p) if get(p) is not None else default(p) for p in parts])
+
+    files, file_idx = [], []
+    for p in parts:
+        fi = p.files or (FileInfo(f"file{len(files) + 1}", "deviations"),)
+        idx = np.zeros(p.n, int) if p.file is None else p.file
+        file_idx.append(idx + len(files))
+        files += list(fi)
+    eye = np.eye(3)
+    return Observations(
+        {a: np.concatenate([p.positions[a] for p in parts]) for a in axes},
+        np.concatenate([p.probe for p in parts]),
+        np.concatenate([p.deviation for p in parts]),
+        {c: np.concatenate([p.covariates[c] for p in parts]) for c in sorted(covs)},
+        [w for p in parts for w in p.warnings],
+        cat(lambda p: p.proj, lambda p: np.broadcast_to(eye, (p.n, 3, 3))),
+        cat(lambda p: p.rows, lambda p: np.full(p.n, 3)),
+        cat(lambda p: p.weight, lambda p: np.ones(p.n)),
+        stack_setups(setups, ns),
+        np.concatenate(file_idx),
+        cat(lambda p: p.row, lambda p: np.arange(p.n)),
+        tuple(files),
+        cat(lambda p: p.sigma, lambda p: np.full(p.n, np.nan)))
