@@ -26,7 +26,7 @@ eigenvalue cut-off (minimum norm in the scaled parameters along undetermined dir
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 

@@ -1,0 +1,95 @@
+"""The CSV reader shared by the instruments' files: UTF-8 (a BOM allowed), comma-separated (a
+header without commas but with semicolons or tabs is read with that separator: spreadsheet
+exports), blank rows skipped; numeric columns become float arrays, columns of labels are kept
+as text, a column with a bad number in an otherwise numeric column is named with its row."""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, require
+
+
+@dataclass
+class Columns:
+    """The columns of one file: ``numbers`` name -> float array, ``text`` name -> None (a
+    label column) or the one-line message of its first bad cell, ``labels`` name -> the
+    stripped cells of every non-numeric column, ``name`` the file name for messages."""
+
+    numbers: dict
+    text: dict
+    labels: dict = field(default_factory=dict)
+    name: str = "data"
+
+    @property
+    def n(self) -> int:
+        for v in self.numbers.values():
+            return len(v)
+        for v in self.labels.values():
+            return len(v)
+        return 0
+
+
+def read_columns(path) -> Columns:
+    """Read a CSV file into :class:`Columns` (InputError, one line, on a defect)."""
+    p = Path(path)
+    require(p.is_file(), f"data file not found: {path}")
+    try:
+        with open(p, newline="", encoding="utf-8-sig") as fh:
+            first = fh.readline()
+            fh.seek(0)
+            delim = ","
+            if "," not in first:
+                delim = ";" if ";" in first else "\t" if "\t" in first else ","
+            rows = [r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)
+                    and not r[0].lstrip().startswith("#")]
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{p.name}: not a readable CSV ({exc})") from None
+    require(len(rows) >= 2, f"{p.name}: no data rows")
+    header = [h.strip() for h in rows[0]]
+    require(len(set(header)) == len(header), f"{p.name}: duplicate column names")
+    body = rows[1:]
+    for i, r in enumerate(body):
+        require(len(r) == len(header), f"{p.name}: row {i + 2} has {len(r)} fields, "
+                f"the header {len(header)}")
+    cols, text, labels = {}, {}, {}
+    for j, h in enumerate(header):
+        raw = [r[j].strip() for r in body]
+        vals = []
+        bad = None
+        for i, s in enumerate(raw):
+            try:
+                vals.append(float(s))
+            except ValueError:
+                bad = bad if bad is not None else i
+                vals.append(math.nan)
+        if bad is not None and all(_not_number(s) for s in raw):
+            comma = next((s for s in raw if re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", s)),
+                         None)
+            require(comma is None, f"{p.name}: column {h}: {comma!r} has a decimal comma; "
+                    f"write numbers with a decimal point")
+            text[h] = None  # a label column (text)
+            labels[h] = raw
+            continue
+        if bad is not None:
+            text[h] = f"{p.name}: column {h} row {bad + 2}: {raw[bad]!r} is not a number"
+            labels[h] = raw
+            continue
+        cols[h] = np.asarray(vals)
+    return Columns(cols, text, labels, p.name)
+
+
+def _not_number(s: str) -> bool:
+    try:
+        float(s)
+        return False
+    except ValueError:
+        return True
+
+
