@@ -1,0 +1,169 @@
+"""Column rules shared by the instruments' readers: axis positions inside the layout's travel,
+probe / tool offsets, readings with a unit suffix, per-reading uncertainties, placement labels
+and covariates (every other numeric column).  Each check fails with one line naming the file,
+the column and, where it helps, the row."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from ..errors import require
+
+AXIS_NAMES = "XYZUVWABC"
+
+
+def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
+    """Numeric columns holding NaN or infinity become text columns with a message naming the
+    first bad row (an error if the column is needed, else left out with a warning)."""
+    cols, text = dict(cols), dict(text or {})
+    for h in list(cols):
+        v = np.asarray(cols[h], dtype=float)
+        if not np.all(np.isfinite(v)):
+            k = int(np.flatnonzero(~np.isfinite(v))[0])
+            text[h] = f"{where}: column {h} row {k + 2} is NaN or infinite"
+            del cols[h]
+    return cols, text
+
+
+def text_columns(text: dict, needed, where: str, labels=()) -> list:
+    """Refuse a needed column that is not numeric; one warning for each other such column
+    (``labels``: text columns the instrument reads itself, e.g. ``placement``)."""
+    needed = {h.lower() for h in needed}
+    labels = {h.lower() for h in labels}
+    warnings = []
+    for h, msg in text.items():
+        if h.lower() in labels and msg is None:
+            continue
+        require(h.lower() not in needed, msg or f"{where}: column {h} is not numeric")
+        warnings.append(f"column {h} is not numeric: left out of the candidates" if msg is None
+                        else f"column {h} has a value that is not a finite number: left out "
+                             f"of the candidates")
+    return warnings
+
+
+class Finder:
+    """Finds a column under one of its unit spellings (names case-insensitive); remembers the
+    columns used."""
+
+    def __init__(self, cols: dict, where: str):
+        self.cols, self.where, self.used = cols, where, set()
+        self._lower = {}
+        for h in cols:
+            self._lower.setdefault(h.lower(), h)
+
+    def name(self, text: str) -> str | None:
+        return self._lower.get(text.lower())
+
+    def __call__(self, name, units, what):
+        hits = [h for h in (self.name(f"{name}{u}") for u in units) if h is not None]
+        require(len(hits) <= 1, f"{self.where}: both {' and '.join(hits)} given for {what}")
+        if hits:
+            self.used.add(hits[0])
+            return hits[0]
+        return None
+
+
+def positions(find: Finder, model, where: str, min_points: int = 1,
+              needs: str = "the fit") -> dict:
+    """Axis columns (mm | deg): every axis of the layout, no other, inside the travel."""
+    cols, out = find.cols, {}
+    for a in model.axes:
+        unit = ("", "_deg") if a in model.rotary_axes else ("", "_mm")
+        c = find(a, unit, f"axis {a}")
+        require(c is not None, f"{where}: missing axis column {a} (layout {model.name} has "
+                f"axes {' '.join(model.axes)})")
+        out[a] = cols[c]
+    extra_axes = [h for h in cols if re.fullmatch(rf"[{AXIS_NAMES}](_mm|_deg)?", h)
+                  and h[0] not in model.axes]
+    require(not extra_axes, f"{where}: axis column {extra_axes[0] if extra_axes else ''} is "
+            f"not an axis of layout {model.name} ({' '.join(model.axes)}): layout mismatch")
+    n = len(next(iter(out.values())))
+    require(n >= min_points, f"{where}: too few points ({n}); {needs} needs at least "
+                             f"{min_points}")
+    for a, v in out.items():
+        lo, hi = model.travel[a]
+        margin = 0.05 * (hi - lo)
+        bad = np.flatnonzero((v < lo - margin) | (v > hi + margin))
+        require(len(bad) == 0, f"{where}: {a} = {v[bad[0]] if len(bad) else 0:g} lies outside "
+                f"the travel [{lo:g}, {hi:g}] of layout {model.name}: layout mismatch")
+    return out
+
+
+def probe(find: Finder, n: int, where: str) -> np.ndarray:
+    """Probe / tool offsets (n, 3) mm: all of Xp, Yp, Zp or none (zero)."""
+    pc = [find(c, ("", "_mm"), f"probe offset {c}") for c in ("Xp", "Yp", "Zp")]
+    require(all(c is None for c in pc) or all(c is not None for c in pc),
+            f"{where}: give all of Xp, Yp, Zp or none")
+    if pc[0] is None:
+        return np.zeros((n, 3))
+    return np.column_stack([find.cols[c] for c in pc])
+
+
+def vector(find: Finder, names, what: str, where: str, units=("", "_mm")) -> np.ndarray:
+    """(n, len(names)) mm of required columns such as ``pivot_x, pivot_y, pivot_z``."""
+    out = []
+    for c in names:
+        h = find(c, units, what)
+        require(h is not None, f"{where}: missing column {c} ({what}, mm)")
+        out.append(find.cols[h])
+    return np.column_stack(out)
+
+
+def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
+             what: str = "an error map") -> np.ndarray:
+    """Readings (n, len(names)) mm from columns ``<name>_um`` or ``<name>_mm``,
+    plausibility-checked."""
+    out = np.zeros((n, len(names)))
+    for i, d in enumerate(names):
+        require(find.name(d) is None, f"{where}: deviation column {d} has no unit suffix "
+                f"(use {d}_um or {d}_mm)")
+        c_um, c_mm = find(d, ("_um",), d), find(d, ("_mm",), d)
+        require(not (c_um and c_mm), f"{where}: both {d}_um and {d}_mm given")
+        for bad in (f"{d}_nm", f"{d}_m", f"{d}_in", f"{d}_urad", f"{d}_rad"):
+            require(find.name(bad) is None, f"{where}: deviation column {bad}: unit not "
+                    f"supported (use {d}_um or {d}_mm)")
+        require(c_um or c_mm, f"{where}: missing deviation column {d}_um (or {d}_mm)")
+        out[:, i] = find.cols[c_um] * 1e-3 if c_um else find.cols[c_mm]
+    big = float(np.max(np.abs(out))) if out.size else 0.0
+    require(big < limit_mm, f"{where}: deviations up to {big:g} mm are implausible for "
+            f"{what}: wrong unit (um given as mm?) or nominal instead of deviation values")
+    return out
+
+
+def uncertainty(find: Finder, n: int, default_um: float, where: str) -> np.ndarray:
+    """Standard uncertainty of each reading (n,) mm: column ``u_um`` (or ``u_mm``), else the
+    instrument's default."""
+    h_um, h_mm = find("u", ("_um",), "u_um"), find("u", ("_mm",), "u_mm")
+    require(not (h_um and h_mm), f"{where}: both u_um and u_mm given")
+    if not (h_um or h_mm):
+        return np.full(n, default_um * 1e-3)
+    u = find.cols[h_um] * 1e-3 if h_um else find.cols[h_mm]
+    require(np.all(u > 0), f"{where}: column {h_um or h_mm}: uncertainties must be positive")
+    return u
+
+
+def labels(find: Finder, name: str, raw: dict, n: int) -> np.ndarray | None:
+    """A label column (numbers or text, e.g. ``placement``) as strings, or None when absent."""
+    h = find.name(name)
+    if h is None:
+        for k in raw:
+            if k.lower() == name.lower():
+                h = k
+        if h is None:
+            return None
+        return np.asarray(raw[h], dtype=object)
+    find.used.add(h)
+    v = find.cols[h]
+    return np.asarray([f"{x:g}" for x in v], dtype=object)
+
+
+def covariates(find: Finder, model, where: str, skip=()) -> dict:
+    """Every numeric column not used by the reader (temperatures, times, directions ...)."""
+    skip = {s.lower() for s in skip}
+    covs = {c: v for c, v in find.cols.items() if c not in find.used and c.lower() not in skip}
+    missing = [c for c in model.covariates if c not in covs]
+    require(not missing, f"{where}: layout {model.name} needs covariate column "
+            f"{missing[0] if missing else ''}")
+    return covs
