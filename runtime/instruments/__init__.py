@@ -1,7 +1,74 @@
 """Instruments: each reads its measurement file into :class:`Observations` (rows of the
 layout's linear model plus its set-up columns), the one type the estimator
-(:mod:`volerr.estimate`), ``volerr calibrate`` and ``volerr loop`` work on."""
+(:mod:`volerr.estimate`), ``volerr calibrate`` and ``volerr loop`` work on.
 
+One module per instrument kind (``deviations``, ``ballbar``, ``sphere`` ...), each with ``KIND``,
+``detect(column names) -> bool`` and ``read(path, model) -> Observations``; they are found
+here by their module, so a new instrument is a new module and a section of the formats.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from pathlib import Path
+
+from ..errors import require
 from .observations import FileInfo, Observations, Setup, stack
 
-__all__ = ["FileInfo", "Observations", "Setup", "stack"]
+__all__ = ["FileInfo", "Observations", "Setup", "kinds", "read", "read_files", "stack"]
+
+#: the fallback kind: a file of 3-D deviations
+FALLBACK = "deviations"
+
+
+def kinds() -> dict:
+    """Instrument kind -> its module."""
+    out = {}
+    for info in pkgutil.iter_modules(__path__):
+        if info.name.startswith("_") or info.name == "observations":
+            continue
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        if hasattr(mod, "KIND") and hasattr(mod, "read"):
+            out[mod.KIND] = mod
+    return out
+
+
+def split_spec(spec: str) -> tuple[str | None, str]:
+    """``KIND:FILE`` -> (KIND, FILE); a plain path -> (None, path)."""
+    text = str(spec)
+    head, sep, rest = text.partition(":")
+    if sep and head in kinds() and not Path(text).exists():
+        return head, rest
+    return None, text
+
+
+def detect(path) -> str:
+    """The instrument kind of a file, from its header (InputError when it cannot tell)."""
+    from ._csv import read_columns
+
+    c = read_columns(path)
+    names = list(c.numbers) + list(c.text)
+    hits = [k for k, m in kinds().items() if k != FALLBACK and hasattr(m, "detect")
+            and m.detect(names)]
+    require(len(hits) <= 1, f"{Path(path).name}: columns of several instruments "
+            f"({', '.join(hits)}); name the kind as KIND:FILE")
+    return hits[0] if hits else FALLBACK
+
+
+def read(spec, model) -> Observations:
+    """One file (``KIND:FILE`` or a path, its kind detected) -> :class:`Observations`."""
+    kind, path = split_spec(spec)
+    kind = kind or detect(path)
+    obs = kinds()[kind].read(path, model)
+    if not obs.files:
+        obs.files = (FileInfo(Path(path).name, kind),)
+    return obs
+
+
+def read_files(specs, model) -> Observations:
+    """Several files, one campaign (each file its own set-up)."""
+    names = [Path(split_spec(s)[1]).resolve() for s in specs]
+    dup = [str(n) for n in names if names.count(n) > 1]
+    require(not dup, f"{Path(dup[0]).name if dup else ''}: the same file given twice")
+    return stack([read(s, model) for s in specs])

@@ -26,6 +26,15 @@ def read_deviations(path, model: Model) -> Observations:
     return obs
 
 
+def detect(names) -> bool:
+    """A deviations file has the three deviation columns."""
+    low = {n.lower() for n in names}
+    return all(any(f"{d}_{u}" in low for u in ("um", "mm")) for d in ("dx", "dy", "dz"))
+
+
+read = read_deviations
+
+
 def columns_to_data(cols: dict, model: Model, where: str = "data", text=None) -> Observations:
     """Column dict (CSV names) -> :class:`Observations`, checking axes, units and ranges.
 

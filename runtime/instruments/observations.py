@@ -45,19 +45,24 @@ class FileInfo:
 
 @dataclass
 class Setup:
-    """Set-up unknowns of the instruments, grouped (a group: one placement of one instrument).
+    """Set-up unknowns of the instruments, in groups (a group: the unknowns of one placement of
+    one instrument, or of one file, such as its tool-length error).
 
-    ``group`` (N,) the group of each point; ``local`` (N, 3, k) the columns of the point's own
-    group (zero-padded to the widest group); ``names[g]`` and ``keys[g]`` name group g and its
-    unknowns; ``model_columns[g]``: None, or the twist columns of the layout's generated
-    ``setup_sensitivity`` that give group g's columns (a placement acting through the chain),
-    then ``local`` is unused for it.  Global column order: group by group, key by key."""
+    ``group`` (N, L): the groups each point belongs to, one per layer (-1: none; a sphere
+    reading belongs to its placement's group and to its file's tool group).  Group ``g`` has
+    the name ``names[g]``, the unknowns ``keys[g]`` and its columns from ``source[g]``:
+    ``("local", j)`` -- columns ``local[:, :, j:j + len(keys[g])]`` given by the reader
+    (N, 3, K), or ``("twist", (c, ...))`` -- those columns of the projected twist sensitivity
+    (the layout's generated ``setup_sensitivity``: a placement or a tool offset acting through
+    the chain).  Global column order: group by group, key by key.  ``units[g]``: per key the
+    report unit, ``um`` (mm columns) or ``urad`` (rad columns)."""
 
     group: np.ndarray
     local: np.ndarray
     names: list
     keys: list
-    model_columns: list
+    source: list
+    units: list
 
     @property
     def offsets(self) -> np.ndarray:
@@ -72,37 +77,56 @@ class Setup:
         return [f"{n}.{k}" for n, ks in zip(self.names, self.keys) for k in ks]
 
     def subset(self, idx) -> "Setup":
-        return Setup(self.group[idx], self.local[idx], self.names, self.keys, self.model_columns)
+        return Setup(self.group[idx], self.local[idx], self.names, self.keys, self.source,
+                     self.units)
 
     def block(self, twist: np.ndarray | None) -> np.ndarray:
         """(n, 3, m) set-up columns of these points (``twist``: their projected twist
-        sensitivity (n, 3, 12), needed by groups with ``model_columns``)."""
+        sensitivity (n, 3, 12), for groups whose source is the twist)."""
         n = len(self.group)
         out = np.zeros((n, 3, self.n_columns))
         off = self.offsets
-        for g in np.unique(self.group):
-            m = self.group == g
-            k = len(self.keys[g])
-            cols = self.model_columns[g]
-            src = twist[m][:, :, list(cols)] if cols is not None else self.local[m][:, :, :k]
-            out[m, :, off[g]:off[g] + k] = src
+        for layer in range(self.group.shape[1]):
+            g_of = self.group[:, layer]
+            for g in np.unique(g_of[g_of >= 0]):
+                m = g_of == g
+                k = len(self.keys[g])
+                kind, where = self.source[g]
+                src = (twist[m][:, :, list(where)] if kind == "twist"
+                       else self.local[m][:, :, where:where + k])
+                out[m, :, off[g]:off[g] + k] = src
         return out
 
 
-def stack_setups(parts: list, ns: list) -> Setup:
-    """One :class:`Setup` of consecutive blocks of points (``ns`` points each)."""
-    width = max(p.local.shape[2] for p in parts)
+def placement_setup(n: int, name: str) -> Setup:
+    """The default set-up of a file of 3-D deviations: the instrument's rigid placement
+    (:data:`PLACEMENT`), one group for all its points."""
+    return Setup(np.zeros((n, 1), int), np.zeros((n, 3, 0)), [name], [PLACEMENT],
+                 [("twist", tuple(range(6)))], [("um",) * 3 + ("urad",) * 3])
+
+
+def stack_setups(parts: list) -> Setup:
+    """One :class:`Setup` of consecutive blocks of points."""
+    width = sum(p.local.shape[2] for p in parts)
+    layers = max(p.group.shape[1] for p in parts)
+    ns = [len(p.group) for p in parts]
     local = np.zeros((sum(ns), 3, width))
-    group, names, keys, model_cols = [], [], [], []
-    start = 0
+    group = np.full((sum(ns), layers), -1)
+    names, keys, source, units = [], [], [], []
+    start = col = 0
     for p, n in zip(parts, ns):
-        local[start:start + n, :, :p.local.shape[2]] = p.local
-        group.append(p.group + len(names))
+        k = p.local.shape[2]
+        local[start:start + n, :, col:col + k] = p.local
+        g = p.group.copy()
+        g[g >= 0] += len(names)
+        group[start:start + n, :g.shape[1]] = g
         names += p.names
         keys += p.keys
-        model_cols += p.model_columns
+        units += p.units
+        source += [(kind, w + col) if kind == "local" else (kind, w) for kind, w in p.source]
         start += n
-    return Setup(np.concatenate(group), local, names, keys, model_cols)
+        col += k
+    return Setup(group, local, names, keys, source, units)
 
 
 @dataclass
@@ -178,6 +202,13 @@ class Observations:
         """Keys of the set-up columns (``dx`` ... for the default placement)."""
         return list(PLACEMENT) if self.setup is None else self.setup.labels
 
+    @property
+    def setup_units(self) -> list:
+        """Report unit (``um`` or ``urad``) of each set-up column."""
+        if self.setup is None:
+            return ["um"] * 3 + ["urad"] * 3
+        return [u for us in self.setup.units for u in us]
+
     def setup_columns(self, twist: np.ndarray) -> np.ndarray:
         """(N, 3, m) set-up columns, given this block's projected twist sensitivity."""
         if self.setup is None:
@@ -193,19 +224,13 @@ def stack(parts: list) -> Observations:
     default placement of a part becomes that file's own set-up group."""
     if len(parts) == 1:
         return parts[0]
-    ns = [p.n for p in parts]
     axes = list(parts[0].positions)
     covs = set(parts[0].covariates)
     for p in parts[1:]:
         covs &= set(p.covariates)
-    setups = []
-    for i, p in enumerate(parts):
-        if p.setup is None:
-            name = p.files[0].name if p.files else f"file{i + 1}"
-            setups.append(Setup(np.zeros(p.n, int), np.zeros((p.n, 3, 0)), [name],
-                                [PLACEMENT], [tuple(range(6))]))
-        else:
-            setups.append(p.setup)
+    setups = [p.setup if p.setup is not None else
+              placement_setup(p.n, p.files[0].name if p.files else f"file{i + 1}")
+              for i, p in enumerate(parts)]
 
     def cat(get, default):
         return np.concatenate([get(p) if get(p) is not None else default(p) for p in parts])
@@ -226,7 +251,7 @@ def stack(parts: list) -> Observations:
         cat(lambda p: p.proj, lambda p: np.broadcast_to(eye, (p.n, 3, 3))),
         cat(lambda p: p.rows, lambda p: np.full(p.n, 3)),
         cat(lambda p: p.weight, lambda p: np.ones(p.n)),
-        stack_setups(setups, ns),
+        stack_setups(setups),
         np.concatenate(file_idx),
         cat(lambda p: p.row, lambda p: np.arange(p.n)),
         tuple(files),

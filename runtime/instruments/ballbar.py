@@ -1,0 +1,142 @@
+"""The ``ballbar`` instrument: a telescoping ballbar between a ball at the tool (tool-side ball,
+at the probe / tool offset ``Xp, Yp, Zp`` from the tool point) and a pivot ball fixed to the
+workpiece side (ISO 230-4 circular tests; ISO 10791-6 tests with rotary axes moving).
+
+Reading (one per pose): ``dr`` = measured bar length minus the nominal length ``length_mm``,
+positive when the balls are farther apart.  Model (:func:`volerr.derive.observations.ballbar`)::
+
+    dr = |t + e - (p + dp)| - length_mm + dL
+
+``t`` the nominal tool-ball centre in the workpiece frame (layout's nominal chain), ``e`` the
+volumetric error there, ``p`` the nominal pivot centre (``pivot_x, pivot_y, pivot_z``,
+workpiece frame), ``dp`` the pivot's unknown offset and ``dL`` the bar's unknown length offset:
+four set-up unknowns per placement (``pivot_dx pivot_dy pivot_dz`` um, ``length`` um).  To first
+order the reading sees the error along the bar, ``u . e`` with ``u = (t - p) / |t - p|``.
+
+The direction of motion of every axis (``dir_X`` ... +1 / -1) is derived from the order of the
+readings within each trace (one placement and one ``direction``) unless the file gives it: the
+loop reads it as a covariate (reversal).  File format: ``volerr formats ballbar``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import require
+from ..generated import instruments as generated
+from ..machine.model import Model
+from . import _fields as f
+from ._csv import read_columns
+from .observations import FileInfo, Observations, Setup
+
+KIND = "ballbar"
+#: default standard uncertainty of one reading, um (a ballbar with its calibrator)
+DEFAULT_U_UM = 0.5
+#: largest difference between |t - p| and length_mm (mm): beyond it the file's radius and its
+#: positions disagree
+RADIUS_TOLERANCE_MM = 0.5
+SETUP_KEYS = tuple(generated.SETUP[KIND])
+
+
+def detect(names) -> bool:
+    """A ballbar file names the pivot ball's centre."""
+    return {"pivot_x", "pivot_y", "pivot_z"} <= {n.lower() for n in names}
+
+
+def read(path, model: Model) -> Observations:
+    """Read a ballbar CSV into :class:`Observations` (InputError, one line, on a defect)."""
+    c = read_columns(path)
+    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
+
+
+def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
+                            where: str) -> Observations:
+    cols, text = f.drop_nonfinite(cols, text, where)
+    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
+              | {"pivot_x", "pivot_y", "pivot_z", "length_mm", "dr_um", "dr_mm", "Xp", "Yp",
+                 "Zp", "direction", "u_um"} | set(model.covariates))
+    warnings = f.text_columns(text, needed, where, labels=("placement",))
+    find = f.Finder(cols, where)
+    pos = f.positions(find, model, where, min_points=4, needs="a ballbar trace")
+    n = len(next(iter(pos.values())))
+    probe = f.probe(find, n, where)
+    pivot = f.vector(find, ("pivot_x", "pivot_y", "pivot_z"), "pivot ball centre", where)
+    length = f.vector(find, ("length",), "nominal bar length", where, units=("_mm",))[:, 0]
+    require(np.all(length > 0), f"{where}: length_mm must be positive")
+    dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading")[:, 0]
+    u = f.uncertainty(find, n, DEFAULT_U_UM, where)
+    direction = _direction(find, n, where)
+    placement = f.labels(find, "placement", raw, n)
+    t = model.nominal_position(pos, probe)
+    lin = generated.ballbar(t[:, 0], t[:, 1], t[:, 2], pivot[:, 0], pivot[:, 1], pivot[:, 2],
+                            length)[0]                       # (8, n)
+    off = lin[0]
+    bad = np.flatnonzero(np.abs(off) > RADIUS_TOLERANCE_MM)
+    require(len(bad) == 0, f"{where}: row {bad[0] + 2 if len(bad) else 0}: the tool ball is "
+            f"{float(np.linalg.norm(t[bad[0]] - pivot[bad[0]])) if len(bad) else 0:.4f} mm "
+            f"from the pivot, length_mm is {float(length[bad[0]]) if len(bad) else 0:g}: "
+            f"the bar length and the positions disagree")
+    groups, names = _placements(placement, pivot, length, where)
+    proj = np.zeros((n, 3, 3))
+    proj[:, 0, :] = lin[1:4].T
+    local = np.zeros((n, 3, len(SETUP_KEYS)))
+    local[:, 0, :] = lin[4:8].T
+    dev = np.zeros((n, 3))
+    dev[:, 0] = dr - off
+    setup = Setup(groups[:, None], local, [f"{where}#{m}" if len(names) > 1 else where
+                                           for m in names],
+                  [SETUP_KEYS] * len(names), [("local", 0)] * len(names),
+                  [("um",) * len(SETUP_KEYS)] * len(names))
+    covs = f.covariates(find, model, where, skip=())
+    covs = {**motion_directions(model, pos, groups, direction), **covs}
+    return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
+                        setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u)
+
+
+def _direction(find, n: int, where: str) -> np.ndarray:
+    h = find("direction", ("",), "direction")
+    if h is None:
+        return np.ones(n)
+    d = find.cols[h]
+    require(np.all(np.isin(d, (-1.0, 1.0))), f"{where}: direction must be +1 (counter-"
+                                              f"clockwise) or -1 (clockwise)")
+    return d
+
+
+def _placements(placement, pivot, length, where) -> tuple[np.ndarray, list]:
+    """Group index of each reading and the group labels: the ``placement`` column, else one
+    group per distinct (pivot, length)."""
+    if placement is not None:
+        names, idx = np.unique(placement.astype(str), return_inverse=True)
+        return idx, [str(x) for x in names]
+    key = np.round(np.column_stack([pivot, length]), 6)
+    uniq, idx = np.unique(key, axis=0, return_inverse=True)
+    return idx.ravel(), [str(i + 1) for i in range(len(uniq))]
+
+
+def motion_directions(model: Model, pos: dict, groups, direction) -> dict:
+    """``dir_<axis>`` (+1 / -1) of every moving axis: the sign of its motion between
+    consecutive readings of the same trace (placement and direction), in file order; a reading
+    where an axis turns takes the sign of the motion that brought it there."""
+    n = len(groups)
+    out = {}
+    trace = np.asarray(groups) * 2 + (np.asarray(direction) > 0)
+    for a in model.axes:
+        q = np.asarray(pos[a], dtype=float)
+        if np.ptp(q) == 0:
+            continue
+        d = np.zeros(n)
+        for t in np.unique(trace):
+            idx = np.flatnonzero(trace == t)
+            if len(idx) < 2:
+                continue
+            step = np.sign(np.diff(q[idx]))
+            s = np.concatenate([[step[0]], step])       # a reading: the motion that came to it
+            for i in range(1, len(s)):                   # standing still: keep the last sign
+                if s[i] == 0:
+                    s[i] = s[i - 1]
+            d[idx] = s
+        if np.any(d != 0):
+            d[d == 0] = 1.0
+            out[f"dir_{a}"] = d
+    return out

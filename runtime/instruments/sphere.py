@@ -1,0 +1,108 @@
+"""The ``sphere`` instrument: a calibration sphere probed at the tool point (a touch probe's
+kinematics cycle) or an R-test (three displacement sensors on the table around a ball in the
+spindle), at many positions of the rotary axes.
+
+Reading (three per pose): ``dx, dy, dz`` = measured position of the tool point minus the
+sphere's centre, in the workpiece frame (an R-test on the table measures there), um or mm.
+A touch probe reports in the machine's linear-axis frame: a column ``frame`` = ``machine``
+declares it, and the reading is then the same vector in that frame, ``R (t + e - c - dc)``
+with ``R`` the orientation of the workpiece frame (the layout's generated ``work_rotation``).
+Model (:func:`volerr.derive.observations.sphere`)::
+
+    d = t + e - (c + dc)
+
+``t`` the nominal tool point (the layout's nominal chain at the commanded positions and the
+tool offset ``Xp, Yp, Zp``), ``e`` the volumetric error, ``c`` the nominal sphere centre
+(``sphere_x, sphere_y, sphere_z``, approximate) and ``dc`` the unknown offset of its
+``placement`` (three set-up unknowns per placement, ``centre_dx centre_dy centre_dz`` um).
+Each file has one more set-up unknown, ``tool_dz``: an error of the tool length (the tool point
+displaced along the tool's own z axis), which a single sphere height cannot tell from a location
+error along the axis.  File format: ``volerr formats sphere``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import require
+from ..generated import instruments as generated
+from ..machine.model import Model
+from . import _fields as f
+from ._csv import read_columns
+from .observations import FileInfo, Observations, Setup
+
+KIND = "sphere"
+#: default standard uncertainty of one reading (per coordinate), um
+DEFAULT_U_UM = 1.0
+SETUP_KEYS = tuple(generated.SETUP[KIND])
+#: twist column of the tool end along the tool's z axis (tool length)
+TOOL_DZ = 8
+FRAMES = ("work", "machine")
+
+
+def detect(names) -> bool:
+    """A sphere file names the sphere's nominal centre."""
+    return {"sphere_x", "sphere_y", "sphere_z"} <= {n.lower() for n in names}
+
+
+def read(path, model: Model) -> Observations:
+    """Read a sphere / R-test CSV into :class:`Observations` (InputError, one line)."""
+    c = read_columns(path)
+    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
+
+
+def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
+                            where: str) -> Observations:
+    cols, text = f.drop_nonfinite(cols, text, where)
+    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
+              | {"sphere_x", "sphere_y", "sphere_z", "Xp", "Yp", "Zp", "u_um"}
+              | {f"{d}_{u}" for d in ("dx", "dy", "dz") for u in ("um", "mm")}
+              | set(model.covariates))
+    warnings = f.text_columns(text, needed, where, labels=("placement", "frame"))
+    find = f.Finder(cols, where)
+    pos = f.positions(find, model, where, min_points=3, needs="a sphere file")
+    n = len(next(iter(pos.values())))
+    probe = f.probe(find, n, where)
+    centre = f.vector(find, ("sphere_x", "sphere_y", "sphere_z"), "nominal sphere centre",
+                      where)
+    reading = f.readings(find, ("dx", "dy", "dz"), n, where, limit_mm=5.0,
+                         what="a sphere reading")
+    u = f.uncertainty(find, n, DEFAULT_U_UM, where)
+    placement = f.labels(find, "placement", raw, n)
+    require(placement is not None, f"{where}: no placement column: give each reading the "
+                                   f"label of its sphere placement (column placement)")
+    frame = _frames(find, raw, n, where)
+    t = model.nominal_position(pos, probe)
+    lin = generated.sphere(t[:, 0], t[:, 1], t[:, 2], centre[:, 0], centre[:, 1],
+                           centre[:, 2])                   # (3, 7, n)
+    lin = np.moveaxis(lin, -1, 0)                          # (n, 3, 7)
+    R = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+    machine = frame == "machine"
+    if machine.any():
+        rot = model.module.work_rotation(**model.positions({a: v[machine]
+                                                            for a, v in pos.items()}))
+        R[machine] = np.moveaxis(np.broadcast_to(rot, (3, 3, int(machine.sum()))), -1, 0)
+    proj = np.einsum("nij,njk->nik", R, lin[:, :, 1:4])
+    local = np.einsum("nij,njk->nik", R, lin[:, :, 4:7])
+    nominal = np.einsum("nij,nj->ni", R, lin[:, :, 0])
+    names, idx = np.unique(placement.astype(str), return_inverse=True)
+    groups = np.column_stack([idx.ravel(), np.full(n, len(names))])
+    setup = Setup(groups, local, [f"{where}#{m}" for m in names] + [where],
+                  [SETUP_KEYS] * len(names) + [("tool_dz",)],
+                  [("local", 0)] * len(names) + [("twist", (TOOL_DZ,))],
+                  [("um",) * 3] * len(names) + [("um",)])
+    covs = f.covariates(find, model, where)
+    return Observations(pos, probe, reading - nominal, covs, warnings, proj=proj,
+                        setup=setup, files=(FileInfo(where, KIND, "um", 3),), sigma=u)
+
+
+def _frames(find, raw: dict, n: int, where: str) -> np.ndarray:
+    """``frame`` of each reading: ``work`` (default) or ``machine``."""
+    col = next((raw[h] for h in raw if h.lower() == "frame"), None)
+    if col is None:
+        require(find.name("frame") is None, f"{where}: column frame must be work or machine")
+        return np.full(n, "work", dtype=object)
+    vals = np.asarray([str(v).strip().lower() for v in col], dtype=object)
+    bad = [v for v in vals if v not in FRAMES]
+    require(not bad, f"{where}: frame {bad[0] if bad else ''!r} is not work or machine")
+    return vals
