@@ -44,9 +44,10 @@ from ..estimate import blocks
 from . import candidates as cands
 from . import select as sel
 from ..errors import require
-from ..estimate.design import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
-                  identifiability_gram, point_norm, require_points, rms, rows_of,
-                  weakly_determined_gram)
+from ..estimate.design import (Data, solve_normal, data_ranges, declared_design, point_norm,
+                               rms, rows_of)
+from ..estimate.steps import (DEGREE_CV_POINTS, Declared, Split, choose_degree,  # noqa: F401
+                              declared_step, split_points)
 from ..instruments.deviations import columns_to_data, read_deviations  # noqa: F401
 from ..machine.layout import layout_text, parse_layout
 from ..machine import derivation
@@ -56,7 +57,6 @@ from .select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
 
 ROBUST_K = 4.0       # robust sigmas of the 3-D residual length kept at full weight
 OUTLIER_Z = 5.0      # robust sigmas beyond which a point is flagged as an outlier
-DEGREE_CV_POINTS = 2500  # training points used to choose the degree (a random subset)
 
 
 # ---- report ---------------------------------------------------------------------
@@ -166,92 +166,6 @@ def _progress(total: int, enabled):
 
 
 # ---- steps of the loop ----------------------------------------------------------------
-@dataclass
-class Split:
-    """Held-out split: ``test`` and ``train`` point indices, k-fold labels (None: LOO)."""
-
-    train: np.ndarray
-    test: np.ndarray
-    folds: np.ndarray | None
-
-
-def split_points(n: int, seed: int, test_fraction: float, folds: int | None) -> Split:
-    rng = np.random.default_rng(seed)
-    perm = rng.permutation(n)
-    n_test = max(1, int(round(test_fraction * n)))
-    test, train = np.sort(perm[:n_test]), np.sort(perm[n_test:])
-    fold_t = None if folds is None else rng.permutation(len(train)) % folds
-    return Split(train, test, fold_t)
-
-
-def _choose_degree(model, data, train, folds, ranges, max_degree, extra=None, weights=None):
-    """Degree of the component series by cross-validation on the training points (``extra``:
-    effect columns (rows, m) included in every model compared).  At most
-    ``DEGREE_CV_POINTS`` random training points are used (the design is built for those only)."""
-    keep, _ = gauge_mask(model, data, max_degree, ranges)
-    if len(train) > DEGREE_CV_POINTS:  # the degree needs no more points than this
-        sub = np.sort(np.random.default_rng(0).choice(len(train), DEGREE_CV_POINTS,
-                                                      replace=False))
-        if extra is not None:
-            extra = extra.reshape(-1, 3, extra.shape[1])[train[sub]].reshape(-1, extra.shape[1])
-        train, folds = train[sub], None
-    elif extra is not None:
-        extra = extra.reshape(-1, 3, extra.shape[1])[train].reshape(-1, extra.shape[1])
-    sub_data = data.subset(train)
-    design = declared_design(model, sub_data, max_degree, ranges)
-    sw = np.ones(3 * len(train)) if weights is None else np.repeat(np.sqrt(weights[train]), 3)
-    y = sub_data.deviation.ravel() * sw
-    pts = np.arange(len(train))
-    scores = {}
-    for k in range(1, max_degree + 1):
-        m = keep & np.array([lab[1] is None or lab[0] == "setup" or lab[1] <= k
-                             for lab in design.labels])
-        if 3 * len(train) < 2 * m.sum() + 10:
-            break
-        A = design.A[:, :, m].reshape(-1, m.sum())
-        if extra is not None and extra.shape[1]:
-            A = np.concatenate([A, extra], axis=1)
-        prob = Problem(A * sw[:, None], y)
-        scores[k] = rms(prob.loo_residuals(pts) if folds is None else
-                        prob.cv_residuals(folds, pts))
-        best_k = min(scores, key=scores.get)
-        if k - best_k >= 2:   # two degrees without a gain: stop
-            break
-    require(scores, f"too few points for the basis: {len(train)} training points cannot fit "
-            f"even a degree-1 model of layout {model.name}")
-    best = min(scores.values())
-    return min(k for k, v in scores.items() if v <= best), scores
-
-
-@dataclass
-class Declared:
-    """The declared model's design at the data: columns kept after gauge fixing and what the
-    plan cannot separate."""
-
-    design: blocks.Design        # the kept columns, generated per block of points
-    keep: np.ndarray
-    gauge: list
-    labels: list
-    unidentifiable: list
-    weak: list
-
-
-def declared_step(model, dat, degree, ranges, train) -> Declared:
-    all_labels = declared_design(model, dat.subset(np.arange(1)), degree, ranges).labels
-    keep, gauge = gauge_mask(model, dat, degree, ranges)
-    require_points(len(train), int(keep.sum()), f"declared model of degree {degree}")
-    labels = [lab for lab, k in zip(all_labels, keep) if k]
-    G_tr, _, _ = blocks.normal(blocks.Design(model, dat, degree, ranges, keep), train,
-                               np.ones(len(train)), dat.deviation.ravel())
-    keep_d, unident = identifiability_gram(G_tr, labels)
-    keep = keep.copy()
-    keep[np.flatnonzero(keep)[~keep_d]] = False     # what these data cannot separate
-    labels = [lab for lab, k in zip(all_labels, keep) if k]
-    weak = weakly_determined_gram(G_tr[np.ix_(keep_d, keep_d)], labels)
-    design = blocks.Design(model, dat, degree, ranges, keep)
-    return Declared(design, keep, gauge, labels, unident, weak)
-
-
 @dataclass
 class Robust:
     """Robust point weights (N,), 0..1, the robust noise scale (mm per coordinate) and the
@@ -555,7 +469,7 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
         # robust weights of a preliminary fit first: outliers must not choose the degree
         pre = declared_step(model, dat, min(max_degree, 6), ranges, spl.train)
         w0 = robust_weights(pre.design, y, np.arange(dat.n), dat.n).weights
-        degree, degree_scores = _choose_degree(model, dat, spl.train, spl.folds, ranges,
+        degree, degree_scores = choose_degree(model, dat, spl.train, spl.folds, ranges,
                                                max_degree, weights=w0)
     decl = declared_step(model, dat, degree, ranges, spl.train)
     robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
@@ -565,7 +479,7 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
     if keepers and not fixed_degree:
         # the degree was chosen with the effects unmodelled: choose it again with them
         extra = np.concatenate([s.cols.reshape(-1, s.cols.shape[-1]) for s in keepers], axis=1)
-        degree2, scores2 = _choose_degree(model, dat, spl.train, spl.folds, ranges,
+        degree2, scores2 = choose_degree(model, dat, spl.train, spl.folds, ranges,
                                           max_degree, extra, robust.weights)
         if degree2 != degree:
             degree, degree_scores = degree2, scores2
