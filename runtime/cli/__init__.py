@@ -17,7 +17,8 @@ __all__ = ["InputError"]
 
 #: command modules, in the order shown by ``volerr --help``
 COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
-            "probe_cal", "compensate", "tcpmap", "controller", "loop", "simulate", "iso230_2",
+            "probe_cal", "compensate", "tcpmap", "controller", "calibrate", "ballbar", "loop",
+            "simulate", "iso230_2",
             "uncertainty", "iso10360", "demo", "formats")
 
 #: closes every ``--help``

@@ -54,7 +54,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     cols, text = f.drop_nonfinite(cols, text, where)
     needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
               | {"pivot_x", "pivot_y", "pivot_z", "length_mm", "dr_um", "dr_mm", "Xp", "Yp",
-                 "Zp", "direction", "u_um"} | set(model.covariates))
+                 "Zp", "direction", "u_um", "length_u_um"} | set(model.covariates))
     warnings = f.text_columns(text, needed, where, labels=("placement",))
     find = f.Finder(cols, where)
     pos = f.positions(find, model, where, min_points=4, needs="a ballbar trace")
@@ -65,6 +65,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     require(np.all(length > 0), f"{where}: length_mm must be positive")
     dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading")[:, 0]
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
+    length_u = _length_uncertainty(find, where)
     direction = _direction(find, n, where)
     placement = f.labels(find, "placement", raw, n)
     t = model.nominal_position(pos, probe)
@@ -86,11 +87,24 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     setup = Setup(groups[:, None], local, [f"{where}#{m}" if len(names) > 1 else where
                                            for m in names],
                   [SETUP_KEYS] * len(names), [("local", 0)] * len(names),
-                  [("um",) * len(SETUP_KEYS)] * len(names))
+                  [("um",) * len(SETUP_KEYS)] * len(names),
+                  [(None, None, None, length_u)] * len(names))
     covs = f.covariates(find, model, where, skip=())
     covs = {**motion_directions(model, pos, groups, direction), **covs}
     return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
                         setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u)
+
+
+def _length_uncertainty(find, where: str) -> float | None:
+    """Standard uncertainty (mm) of the bar length from column ``length_u_um`` (a bar
+    calibrated with its calibrator: its length offset is then known to within it), else None
+    (the length offset is a set-up unknown of every placement)."""
+    h = find("length_u", ("_um",), "length_u_um")
+    if h is None:
+        return None
+    v = np.unique(find.cols[h])
+    require(len(v) == 1 and v[0] > 0, f"{where}: length_u_um must be one positive value")
+    return float(v[0]) * 1e-3
 
 
 def _direction(find, n: int, where: str) -> np.ndarray:

@@ -55,7 +55,9 @@ class Setup:
     (N, 3, K), or ``("twist", (c, ...))`` -- those columns of the projected twist sensitivity
     (the layout's generated ``setup_sensitivity``: a placement or a tool offset acting through
     the chain).  Global column order: group by group, key by key.  ``units[g]``: per key the
-    report unit, ``um`` (mm columns) or ``urad`` (rad columns)."""
+    report unit, ``um`` (mm columns) or ``urad`` (rad columns).  ``priors[g]``: per key None
+    (unknown) or the standard uncertainty (mm / rad) of a known value zero, e.g. the length of a
+    calibrated ballbar."""
 
     group: np.ndarray
     local: np.ndarray
@@ -63,6 +65,11 @@ class Setup:
     keys: list
     source: list
     units: list
+    priors: list = None
+
+    def __post_init__(self):
+        if self.priors is None:
+            self.priors = [(None,) * len(k) for k in self.keys]
 
     @property
     def offsets(self) -> np.ndarray:
@@ -78,7 +85,7 @@ class Setup:
 
     def subset(self, idx) -> "Setup":
         return Setup(self.group[idx], self.local[idx], self.names, self.keys, self.source,
-                     self.units)
+                     self.units, self.priors)
 
     def block(self, twist: np.ndarray | None) -> np.ndarray:
         """(n, 3, m) set-up columns of these points (``twist``: their projected twist
@@ -112,7 +119,7 @@ def stack_setups(parts: list) -> Setup:
     ns = [len(p.group) for p in parts]
     local = np.zeros((sum(ns), 3, width))
     group = np.full((sum(ns), layers), -1)
-    names, keys, source, units = [], [], [], []
+    names, keys, source, units, priors = [], [], [], [], []
     start = col = 0
     for p, n in zip(parts, ns):
         k = p.local.shape[2]
@@ -123,10 +130,11 @@ def stack_setups(parts: list) -> Setup:
         names += p.names
         keys += p.keys
         units += p.units
+        priors += p.priors
         source += [(kind, w + col) if kind == "local" else (kind, w) for kind, w in p.source]
         start += n
         col += k
-    return Setup(group, local, names, keys, source, units)
+    return Setup(group, local, names, keys, source, units, priors)
 
 
 @dataclass
@@ -208,6 +216,14 @@ class Observations:
         if self.setup is None:
             return ["um"] * 3 + ["urad"] * 3
         return [u for us in self.setup.units for u in us]
+
+    @property
+    def setup_priors(self) -> list:
+        """Per set-up column: None (unknown) or the standard uncertainty (mm / rad) of its
+        known value 0."""
+        if self.setup is None:
+            return [None] * 6
+        return [u for us in self.setup.priors for u in us]
 
     def setup_columns(self, twist: np.ndarray) -> np.ndarray:
         """(N, 3, m) set-up columns, given this block's projected twist sensitivity."""

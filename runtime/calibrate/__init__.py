@@ -1,0 +1,9 @@
+"""Calibration from instruments: weighted least squares of a layout's parameters over the files
+of any instruments mixed in one campaign, with the uncertainty of every identified value, what
+the campaign cannot determine and which file sees what (``volerr calibrate``).  Modules:
+``run`` (the named steps), ``terms`` (parameter selection and report names), ``estimability``
+(null space, per-file visibility), ``report`` (HTML)."""
+
+from .run import Calibration, calibrate
+
+__all__ = ["Calibration", "calibrate"]

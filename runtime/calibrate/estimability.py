@@ -1,0 +1,67 @@
+"""Which parameters a campaign determines, and which file sees which.
+
+Estimable: a parameter (one column of the design) can be determined on its own from the
+stacked readings of all files, whatever values the others and the set-up unknowns take, iff
+its column is not in the span of all the other columns; equivalently its row of every
+null-space vector of the Gram matrix is zero.  Columns are scaled to unit length first (mm and
+rad columns differ by orders of magnitude).
+
+Seen by a file: the file's readings depend on the parameter after that file's own set-up
+unknowns are removed (a ballbar circle in XY does not see EZZ at all; a pure offset of a
+translational error is absorbed by the pivot's position).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: null-space eigenvalues of the unit-scaled Gram matrix, relative to the largest
+NULL_TOL = 1e-10
+#: a column belongs to a null direction when its component there exceeds this
+MEMBER_TOL = 1e-4
+#: a file sees a column when what its set-up leaves of the column's squared norm exceeds
+#: this fraction of the largest squared norm the column has in any file
+SEEN_TOL = 1e-9
+
+
+def _unit(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    d = np.sqrt(np.maximum(np.diag(G), 0.0))
+    s = np.where(d > 0, d, 1.0)
+    return G / np.outer(s, s), d > 0
+
+
+def null_space(G: np.ndarray) -> np.ndarray:
+    """Orthonormal basis (p, k) of the directions the readings do not determine."""
+    C, nonzero = _unit(G)
+    w, V = np.linalg.eigh(C)
+    return V[:, w < NULL_TOL * max(float(w[-1]), 1e-300)]
+
+
+def estimable(G: np.ndarray) -> tuple[np.ndarray, dict]:
+    """(mask of individually estimable columns, column -> the columns it is confounded with)."""
+    N = null_space(G)
+    member = np.sqrt(np.sum(N * N, axis=1)) > MEMBER_TOL
+    _, nonzero = _unit(G)
+    P = N @ N.T
+    partners = {}
+    for j in np.flatnonzero(member):
+        w = np.abs(P[j]) / max(P[j, j], 1e-300)
+        partners[int(j)] = [int(k) for k in np.argsort(-w) if k != j and w[k] > 0.05]
+    return ~member & nonzero, partners
+
+
+def seen_by(G_files: list, setup_cols: list) -> np.ndarray:
+    """(files, p) bool: file f's readings depend on column j after f's own set-up columns
+    (``setup_cols[f]``, indices) are removed.  ``G_files[f]``: the Gram matrix of f's rows."""
+    p = G_files[0].shape[0]
+    left = np.zeros((len(G_files), p))
+    for f, (G, S) in enumerate(zip(G_files, setup_cols)):
+        diag = np.diag(G).copy()
+        if len(S):
+            GS = G[np.ix_(S, S)]
+            Gi = np.linalg.pinv(GS, rcond=1e-12, hermitian=True)
+            B = G[S, :]
+            diag = diag - np.einsum("ij,ik,kj->j", B, Gi, B)
+        left[f] = np.maximum(diag, 0.0)
+    top = np.max(np.stack([np.diag(G) for G in G_files]), axis=0)
+    return left > SEEN_TOL * np.where(top > 0, top, np.inf)

@@ -1,0 +1,401 @@
+"""``volerr calibrate``: identify a layout's parameters from the files of any instruments, mixed
+in one campaign, by weighted least squares on the layout's derived observation model.
+
+Steps (:func:`calibrate`):
+
+1. read every file as :class:`volerr.instruments.Observations` (its kind from its columns or
+   ``KIND:FILE``) and stack them: one design, each file with its own set-up unknowns;
+2. choose the parameters fitted (``--parameters``; the others are held at zero) and, for
+   component errors, the degree of their Legendre series by cross-validation;
+3. fix the gauge by convention (:func:`volerr.estimate.design.gauge_mask`: what no
+   measurement of the chain can determine, e.g. the offsets of translational errors against
+   the instruments' positions);
+4. accumulate the weighted normal equations (weights ``1 / u^2`` of each reading) per file, on
+   all readings and on the training readings (a random ``test_fraction`` of the points is
+   held out);
+5. estimability of every parameter from the stacked Gram matrix and which file sees it
+   (:mod:`volerr.calibrate.estimability`); the solution takes the columns in the gauge order
+   and leaves out those in the span of the ones before (their value 0);
+6. the covariance ``s0^2 (A^T W A)^-1`` with the a-posteriori variance factor ``s0^2`` (weighted
+   residual sum of squares per degree of freedom), set-up estimates per file / placement,
+   residual RMS per file on all readings and on the held-out ones.
+
+Units: readings mm inside; reports um, urad, um/mm ... (:mod:`volerr.calibrate.terms`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import instruments
+from ..errors import require
+from ..estimate import blocks
+from ..estimate.design import data_ranges, gauge_mask, identifiability_gram, parameter_labels
+from ..estimate.steps import choose_degree, split_points
+from ..machine.model import Model, load
+from . import estimability, terms
+
+#: relative eigenvalue below which the solution leaves a direction out (unit-scaled columns)
+SOLVE_TOL = 1e-12
+
+
+@dataclass
+class Calibration:
+    """Result of :func:`calibrate`: ``data`` the JSON report (INTERFACE.md keys first) and what
+    the error tables and the HTML page need."""
+
+    data: dict
+    model: Model
+    ranges: dict
+    degree: int
+    labels: list                 # design columns (set-up first)
+    coef: np.ndarray             # mm / rad per column (0 where left out)
+    std: np.ndarray              # standard uncertainty per column (0 where left out)
+    residuals: dict = field(default_factory=dict)   # file -> (positions, residual um, rows)
+
+    def __getitem__(self, key):
+        return self.data[key]
+
+    def error_tables(self, n_grid: int = 41):
+        """The identified error functions as error tables over the measured range and the
+        constants: ``({axis: ErrorTable}, {name: value}, {name: std})``, mm / rad.  Columns left
+        out (not fitted, not determined) are zero."""
+        from ..estimate.design import legendre, unit
+        from ..tables.table import ErrorTable
+
+        model, ranges, deg = self.model, self.ranges, self.degree
+        index = {lab: j for j, lab in enumerate(self.labels)}
+        tables, constants, cstd = {}, {}, {}
+        for a in model.axes:
+            q = np.linspace(*ranges[a], n_grid)
+            P = legendre(unit(q, *ranges[a]), deg)
+            vals, std = {}, {}
+            for p in model.parameters:
+                if model.parameter_axis.get(p) != a:
+                    continue
+                js = [(k, index[(p, k)]) for k in range(deg + 1) if (p, k) in index]
+                vals[p] = sum((P[:, k] * self.coef[j] for k, j in js), np.zeros(n_grid))
+                std[p] = np.sqrt(sum((P[:, k] ** 2 * self.std[j] ** 2 for k, j in js),
+                                     np.zeros(n_grid)))
+            if vals:
+                tables[a] = ErrorTable(a, q, vals, std=std)
+        for p in model.parameters:
+            j = index.get((p, None))
+            if j is not None:
+                constants[p] = float(self.coef[j])
+                cstd[p] = float(self.std[j])
+        return tables, constants, cstd
+
+    def write_error_tables(self, directory, inputs=()) -> Path:
+        from ..tables.table import write_error_dir
+
+        tables, constants, _ = self.error_tables()
+        return write_error_dir(directory, tables, constants or None, inputs=list(inputs))
+
+    def write_json(self, path, inputs=()) -> Path:
+        import json
+
+        from ..fileio import write_text
+
+        return write_text(path, json.dumps(self.data, indent=2) + "\n", inputs=list(inputs))
+
+    def write_html(self, path, inputs=()) -> Path:
+        from ..fileio import write_text
+        from .report import render_html
+
+        return write_text(path, render_html(self), inputs=list(inputs))
+
+    def summary(self) -> str:
+        d = self.data
+        files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} readings): RMS "
+                          f"{i['rms_residual']:.3f} um, held-out {i['heldout_rms']:.3f} um"
+                          for i in d["instruments"])
+        return (f"{d['layout']}: {len(d['parameters'])} parameters identified, "
+                f"{len(d['unidentifiable'])} not determined by these data; {files}")
+
+
+def default_parameters(obs) -> str:
+    """``location`` when every file is a sphere / R-test (a kinematics cycle identifies the
+    rotary axes' location errors), else ``all``."""
+    kinds = {f.kind for f in obs.files}
+    return "location" if kinds == {"sphere"} else "all"
+
+
+def reading_weights(obs) -> tuple[np.ndarray, float]:
+    """Relative weights (N,) of the points' readings, ``(u_ref / u)^2``, and ``u_ref`` (mm)."""
+    u = np.asarray(obs.sigma, dtype=float) if obs.sigma is not None else np.full(obs.n, np.nan)
+    u = np.where(np.isfinite(u), u, 1e-3)
+    ref = float(np.median(u))
+    return (ref / u) ** 2, ref
+
+
+def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,
+              max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
+              progress=None) -> Calibration:
+    """Identify ``layout``'s parameters from measurement ``files`` (paths or ``KIND:FILE``;
+    or an :class:`volerr.instruments.Observations`).  Returns a :class:`Calibration`."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _run(layout, files, parameters, degree, max_degree, seed, test_fraction,
+                    progress)
+
+
+def _progress(total: int, enabled):
+    import sys
+
+    from tqdm import tqdm
+
+    disable = (not sys.stderr.isatty()) if enabled is None else not enabled
+    return tqdm(total=total, file=sys.stderr, disable=disable, desc="volerr calibrate",
+                bar_format="{desc}: {n}/{total} {postfix}")
+
+
+def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, progress):
+    t0 = time.perf_counter()
+    require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
+    if degree is not None:
+        require(1 <= degree <= 12, "degree must be between 1 and 12")
+    model = load(layout)
+    bar = _progress(4, progress)
+    bar.set_postfix_str("read")
+    obs = files if isinstance(files, instruments.Observations) else \
+        instruments.read_files(list(files), model)
+    chosen = terms.resolve(parameters, model, default_parameters(obs))
+    ranges = data_ranges(model, obs)
+    spl = split_points(obs.n, seed, test_fraction, None)
+    w, u_ref = reading_weights(obs)
+    series = any(model.parameter_axis.get(p) for p in chosen)
+    degree_scores = {}
+    bar.update()
+    bar.set_postfix_str("degree")
+    if degree is None:
+        degree = 1
+        if series:
+            degree, degree_scores = choose_degree(model, obs, spl.train, None, ranges,
+                                                  max_degree, weights=w, parameters=chosen)
+    keep, gauge = gauge_mask(model, obs, degree, ranges, chosen)
+    design = blocks.Design(model, obs, degree, ranges, keep)
+    bar.update()
+    bar.set_postfix_str("normal equations")
+    fit = _normal_equations(design, obs, spl, np.sqrt(w))
+    bar.update()
+    bar.set_postfix_str("solve, residuals")
+    out = _solve(design, obs, spl, fit, np.sqrt(w), u_ref)
+    bar.update()
+    bar.close()
+    report = _report(model, obs, design, ranges, degree, degree_scores, chosen, gauge, fit,
+                     out, spl, u_ref)
+    report["seconds"] = round(time.perf_counter() - t0, 2)
+    std = np.zeros(design.p)
+    std[out.kept] = out.std
+    return Calibration(report, model, ranges, degree, design.labels, out.coef, std,
+                       out.residuals)
+
+
+@dataclass
+class Normal:
+    """Weighted normal equations of the design: all readings (``G``, ``b``), training readings
+    (``G_tr``, ``b_tr``), and per file (``G_files``)."""
+
+    G: np.ndarray
+    b: np.ndarray
+    G_tr: np.ndarray
+    b_tr: np.ndarray
+    G_files: list
+    scale: np.ndarray
+
+
+def _normal_equations(design, obs, spl, sw) -> Normal:
+    p = design.p
+    n_files = max(len(obs.files), 1)
+    file_of = obs.file if obs.file is not None else np.zeros(obs.n, int)
+    is_test = np.zeros(obs.n, bool)
+    is_test[spl.test] = True
+    G_files = [np.zeros((p, p)) for _ in range(n_files)]
+    b_files = [np.zeros(p) for _ in range(n_files)]
+    G_te, b_te = np.zeros((p, p)), np.zeros(p)
+    y = obs.deviation.ravel()
+    ss = np.zeros(p)
+    for f in range(n_files):
+        pts = np.flatnonzero(file_of == f)
+        for s, idx in blocks.blocks(pts):
+            At = design.block(idx)
+            ss += np.einsum("ij,ij->i", At, At)
+            wr = blocks.wrows(sw[idx])
+            At *= wr
+            yw = blocks.yrows(y, idx) * wr
+            G_files[f] += At @ At.T
+            b_files[f] += At @ yw
+            te = np.tile(is_test[idx], 3)
+            if te.any():
+                G_te += At[:, te] @ At[:, te].T
+                b_te += At[:, te] @ yw[te]
+    # known set-up values (a calibrated bar length): a prior 0 +- u on the column
+    u_ref = _u_ref(sw, obs)
+    priors = dict(zip(obs.setup_labels, obs.setup_priors))
+    for j, lab in enumerate(design.labels):
+        u = priors.get(lab[1]) if lab[0] == "setup" else None
+        if u:
+            for Gf in G_files:
+                if Gf[j, j] > 0:
+                    Gf[j, j] += (u_ref / u) ** 2
+    G, b = sum(G_files), sum(b_files)
+    scale = blocks.unit_scale(ss, obs.n_readings)
+    return Normal(G, b, G - G_te, b - b_te, G_files, scale)
+
+
+def _u_ref(sw, obs) -> float:
+    return reading_weights(obs)[1]
+
+
+@dataclass
+class Solution:
+    kept: np.ndarray            # column indices in the solution
+    coef: np.ndarray            # (p,) mm / rad, 0 where left out
+    coef_train: np.ndarray
+    std: np.ndarray             # of the kept columns
+    estimable: np.ndarray       # (p,) bool
+    partners: dict
+    seen: np.ndarray            # (files, p) bool
+    s0: float                   # a-posteriori standard deviation of unit weight (u_ref = 1)
+    dof: float
+    rms_all: dict               # file index -> RMS um of all readings
+    rms_test: dict              # file index -> RMS um of held-out readings
+    n_test: dict
+    residuals: dict
+
+
+def _solve(design, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
+    labels = design.labels
+    est, partners = estimability.estimable(fit.G)
+    setup_idx = [j for j, lab in enumerate(labels) if lab[0] == "setup"]
+    setup_of_file = [[j for j in setup_idx if Gf[j, j] > 0] for Gf in fit.G_files]
+    seen = estimability.seen_by(fit.G_files, setup_of_file)
+    keep_d, _ = identifiability_gram(fit.G, labels)
+    kept = np.flatnonzero(keep_d)
+    sc = fit.scale[kept]
+    S = np.outer(sc, sc)
+    Gk = fit.G[np.ix_(kept, kept)] / S
+    Gi = blocks.eig_inverse(Gk, SOLVE_TOL)
+    coef = np.zeros(design.p)
+    coef[kept] = Gi @ (fit.b[kept] / sc) / sc
+    Gti = blocks.eig_inverse(fit.G_tr[np.ix_(kept, kept)] / S, SOLVE_TOL)
+    coef_tr = np.zeros(design.p)
+    coef_tr[kept] = Gti @ (fit.b_tr[kept] / sc) / sc
+    # residuals, blockwise: all readings (fit on all) and held-out ones (fit on training)
+    y = obs.deviation.ravel()
+    file_of = obs.file if obs.file is not None else np.zeros(obs.n, int)
+    is_test = np.zeros(obs.n, bool)
+    is_test[spl.test] = True
+    rows = obs.readings_per_point()
+    rss_w = 0.0
+    rms_all, rms_test, n_test, residuals = {}, {}, {}, {}
+    for f in range(len(fit.G_files)):
+        pts = np.flatnonzero(file_of == f)
+        r_all = np.empty((len(pts), 3))
+        r_tr = np.empty((len(pts), 3))
+        for s, idx in blocks.blocks(pts):
+            At = design.block(idx)
+            yy = blocks.yrows(y, idx)
+            n = len(idx)
+            r_all[s] = (yy - coef @ At).reshape(3, n).T
+            r_tr[s] = (yy - coef_tr @ At).reshape(3, n).T
+        rss_w += float(np.sum((r_all * sw[pts, None]) ** 2))
+        k = rows[pts]
+        n_read = max(int(k.sum()), 1)
+        rms_all[f] = 1e3 * math.sqrt(float(np.sum(r_all ** 2)) / n_read)
+        te = is_test[pts]
+        n_te = int(k[te].sum())
+        n_test[f] = n_te
+        rms_test[f] = (1e3 * math.sqrt(float(np.sum(r_tr[te] ** 2)) / n_te)
+                       if n_te else float("nan"))
+        residuals[f] = (pts, 1e3 * r_all, k)
+    rank = int(np.sum(np.linalg.eigvalsh(Gk) > SOLVE_TOL * np.linalg.eigvalsh(Gk)[-1]))
+    dof = max(float(obs.n_readings - rank), 1.0)
+    s0 = math.sqrt(rss_w / dof)                 # mm: the weights are relative to u_ref
+    std = np.sqrt(np.maximum(np.diag(Gi), 0.0)) / sc * s0
+    s0 /= u_ref                                  # the a-posteriori factor, dimensionless
+    return Solution(kept, coef, coef_tr, std, est, partners, seen, s0, dof, rms_all, rms_test,
+                    n_test, residuals)
+
+
+def _report(model, obs, design, ranges, degree, degree_scores, chosen, gauge, fit, out,
+            spl, u_ref) -> dict:
+    labels = design.labels
+    names = [terms.term_name(lab) for lab in labels]
+    std_of = dict(zip(out.kept.tolist(), out.std.tolist()))
+    files = obs.files or (instruments.FileInfo("data", "deviations"),)
+    params, unident, ident = {}, [], {}
+    for j, lab in enumerate(labels):
+        if lab[0] == "setup":
+            continue
+        name = names[j]
+        seen = [files[f].name for f in range(len(files)) if out.seen[f, j]]
+        ident[name] = {
+            "identifiable": bool(out.estimable[j]),
+            "seen_by": seen,
+            "not_seen_by": [fi.name for fi in files if fi.name not in seen],
+            "confounded_with": [names[k] for k in out.partners.get(j, [])][:6]}
+        if out.estimable[j] and j in std_of:
+            params[name] = terms.report(lab, out.coef[j], std_of[j], model, ranges)
+        else:
+            unident.append(name)
+    setup = {}
+    units = obs.setup_units
+    setup_labels = obs.setup_labels
+    for j, lab in enumerate(labels):
+        if lab[0] != "setup":
+            continue
+        key = lab[1]
+        i = setup_labels.index(key)
+        group, _, k = key.rpartition(".") if "." in key else (files[0].name, "", key)
+        factor = 1e6 if units[i] == "urad" else 1e3
+        entry = {"value": float(out.coef[j]) * factor, "unit": units[i],
+                 "std": float(std_of.get(j, 0.0)) * factor,
+                 "determined": bool(out.estimable[j])}
+        setup.setdefault(group, {})[k] = entry
+    inst = []
+    file_of = obs.file if obs.file is not None else np.zeros(obs.n, int)
+    rows_in_file = obs.row if obs.row is not None else np.arange(obs.n)
+    test_set = set(spl.test.tolist())
+    for f, fi in enumerate(files):
+        pts = np.flatnonzero(file_of == f)
+        inst.append({
+            "file": fi.name, "kind": fi.kind, "n": int(obs.readings_per_point()[pts].sum()),
+            "n_points": int(len(pts)), "unit": fi.unit,
+            "rms_residual": round(out.rms_all[f], 5),
+            "heldout_rms": round(out.rms_test[f], 5), "n_heldout": out.n_test[f],
+            "test_rows": sorted(int(rows_in_file[i]) for i in pts if int(i) in test_set),
+            "normalised_rms": round(out.rms_all[f] / (1e3 * _file_u(obs, pts, u_ref)), 4)})
+    return {
+        "layout": model.name,
+        "parameters": params,
+        "unidentifiable": unident,
+        "setup": setup,
+        "instruments": inst,
+        "identifiability": ident,
+        "fitted": list(chosen),
+        "degree": int(degree),
+        "degree_cv_rms_um": {str(k): round(1e3 * v, 4) for k, v in degree_scores.items()},
+        "gauge_fixed": [terms.term_name(g) for g in gauge],
+        "variance_factor": round(out.s0 ** 2, 4),
+        "dof": out.dof,
+        "method": ("weighted least squares (weights 1/u^2 per reading) over all files; "
+                   "standard uncertainties from the covariance scaled by the a-posteriori "
+                   "variance factor; held-out: a random {:.0%} of the points, fitted on the "
+                   "others").format(len(spl.test) / max(obs.n, 1)),
+    }
+
+
+def _file_u(obs, pts, u_ref) -> float:
+    if obs.sigma is None:
+        return u_ref
+    u = np.asarray(obs.sigma)[pts]
+    u = u[np.isfinite(u)]
+    return float(np.sqrt(np.mean(u ** 2))) if len(u) else u_ref

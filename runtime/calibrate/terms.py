@@ -1,0 +1,81 @@
+"""The parameters of a calibration: which are fitted (``--parameters``), and how each column of
+the design is named and reported.
+
+A constant (squareness, location error of a rotary axis) is one column, reported in um or urad.
+A component error of an axis is a Legendre series in its own axis position over the measured
+range ``[lo, hi]``: ``e(q) = sum_k c_k P_k(u)``, ``u = (2 q - lo - hi) / (hi - lo)``.  Its terms
+are reported as
+
+* ``NAME@offset`` = ``c_0``, the mean value over the range (um / urad);
+* ``NAME@slope`` = ``2 c_1 / (hi - lo)``, the slope of the least-squares straight line of the
+  function over the range (the Legendre terms are orthogonal on it), per mm of a linear axis
+  or per deg of a rotary axis (``um/mm``, ``urad/mm``, ``um/deg``, ``urad/deg``);
+* ``NAME@P2`` ... ``NAME@Pk`` = ``c_k`` (um / urad).
+"""
+
+from __future__ import annotations
+
+from ..errors import require
+
+GROUPS = ("all", "constants", "squareness", "location", "linear", "rotary")
+
+
+def resolve(spec: str | None, model, default: str = "all") -> list:
+    """Parameter names of ``spec`` (comma list of names, axis names and groups; None: the
+    ``default`` group), in the model's order."""
+    text = spec if spec else default
+    axis_of = model.parameter_axis
+    squareness = set(model.layout.squareness)
+    chosen = set()
+    for word in [w.strip() for w in text.split(",") if w.strip()]:
+        w = word.upper() if word.lower() not in GROUPS else word.lower()
+        if w == "all":
+            chosen |= set(model.parameters)
+        elif w == "constants":
+            chosen |= {p for p in model.parameters if axis_of.get(p) is None}
+        elif w == "squareness":
+            chosen |= {p for p in model.parameters if p in squareness}
+        elif w == "location":
+            chosen |= {p for p in model.parameters if axis_of.get(p) is None
+                       and p not in squareness}
+        elif w == "linear":
+            chosen |= {p for p in model.parameters if axis_of.get(p) is not None
+                       and axis_of[p] not in model.rotary_axes}
+        elif w == "rotary":
+            chosen |= {p for p in model.parameters if axis_of.get(p) in model.rotary_axes}
+        elif w in model.axes:
+            chosen |= {p for p in model.parameters if axis_of.get(p) == w}
+        else:
+            require(w in model.parameters, f"--parameters: {word!r} is neither a parameter of "
+                    f"layout {model.name} nor an axis or a group ({', '.join(GROUPS)})")
+            chosen.add(w)
+    require(chosen, f"--parameters {text!r} selects no parameter of layout {model.name}")
+    return [p for p in model.parameters if p in chosen]
+
+
+def term_name(label) -> str:
+    """Report name of a design column label ``(parameter, degree or None)``."""
+    p, k = label
+    if p == "setup":
+        return f"setup:{k}"
+    if k is None:
+        return p
+    return f"{p}@offset" if k == 0 else f"{p}@slope" if k == 1 else f"{p}@P{k}"
+
+
+def is_angular(name: str) -> bool:
+    """An angular parameter (rad inside): E[ABC]* components and E[ABC]0* constants."""
+    return len(name) >= 3 and name[0] == "E" and name[1] in "ABC"
+
+
+def report(label, value: float, std: float, model, ranges: dict) -> dict:
+    """``{"value", "unit", "std"}`` of a column's coefficient (mm or rad inside)."""
+    p, k = label
+    angular = is_angular(p)
+    factor, unit = (1e6, "urad") if angular else (1e3, "um")
+    if k == 1:
+        axis = model.parameter_axis[p]
+        lo, hi = ranges[axis]
+        factor *= 2.0 / (hi - lo)
+        unit += "/deg" if axis in model.rotary_axes else "/mm"
+    return {"value": float(value) * factor, "unit": unit, "std": float(std) * abs(factor)}

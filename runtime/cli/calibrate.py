@@ -1,0 +1,72 @@
+"""``volerr calibrate LAYOUT FILE... --json F``: identify a layout's parameters from the files of
+any instruments (deviations, ballbar, sphere ...), mixed in one campaign.  See
+:mod:`volerr.calibrate.run`."""
+
+from __future__ import annotations
+
+from ..errors import require
+from ..fileio import Outputs
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "calibrate", help="identify the layout's parameters from instrument files (any mix)",
+        description="Identify LAYOUT's parameters by weighted least squares from measurement "
+                    "files of any instrument kind, in one campaign: 3-D deviations, ballbar "
+                    "traces, sphere probing / R-test ('volerr formats deviations|ballbar|"
+                    "sphere').  A file's kind is detected from its columns or given as "
+                    "KIND:FILE.  Reports the identified values with standard uncertainties, "
+                    "what the campaign cannot determine (and which file sees what), set-up "
+                    "estimates per file and placement, residuals per file on all and on "
+                    "held-out readings.")
+    p.add_argument("layout", help="layout name (volerr layouts) or layout file")
+    p.add_argument("files", nargs="+", metavar="FILE", help="measurement files (KIND:FILE to "
+                   "name the kind: deviations, ballbar, sphere)")
+    p.add_argument("--json", metavar="F", help="write the report (JSON)")
+    p.add_argument("--html", metavar="H", help="write the report with figures (HTML)")
+    p.add_argument("--errors-out", metavar="DIR", help="write the identified model as an error "
+                   "directory (X.csv ... constants.csv) for map, compensate, uncertainty")
+    p.add_argument("--parameters", metavar="SPEC",
+                   help="parameters fitted, the others held at zero: comma list of names "
+                        "(EC0Y, EX0C), axes (X: its six component errors) and groups (all, "
+                        "constants, squareness, location, linear, rotary); default: location "
+                        "when every file is a sphere file, else all")
+    p.add_argument("--degree", type=int, help="degree of the component errors' Legendre series "
+                                              "(default: by cross-validation, 1..8)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the held-out split")
+    p.add_argument("--test-fraction", type=float, default=0.25,
+                   help="fraction of the points held out for the held-out residual")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..calibrate.run import calibrate
+    from ..instruments import split_spec
+    from ..machine.model import load
+    from ._common import layout_inputs
+
+    require(args.json or args.html or args.errors_out,
+            "give --json, --html or --errors-out (or several) for the result")
+    model = load(args.layout)
+    inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout)
+    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
+        .folder("--errors-out", args.errors_out,
+                files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
+    with outs:
+        result = calibrate(args.layout, args.files, parameters=args.parameters,
+                           degree=args.degree, seed=args.seed,
+                           test_fraction=args.test_fraction)
+        if args.json:
+            result.write_json(outs.path("--json"), inputs=inputs)
+        if args.html:
+            result.write_html(outs.path("--html"), inputs=inputs)
+        if args.errors_out:
+            result.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+    print(result.summary())
+    for name, v in result["parameters"].items():
+        if "@" not in name or name.endswith("@slope"):
+            print(f"  {name} = {v['value']:.4g} +- {v['std']:.2g} {v['unit']}")
+    if result["unidentifiable"]:
+        print(f"  not determined by these data: {', '.join(result['unidentifiable'][:12])}"
+              f"{' ...' if len(result['unidentifiable']) > 12 else ''} (see the report)")
+    return 0
