@@ -57,6 +57,22 @@ class Calibration:
     coef: np.ndarray             # mm / rad per column (0 where left out)
     std: np.ndarray              # standard uncertainty per column (0 where left out)
     residuals: dict = field(default_factory=dict)   # file -> (positions, residual um, rows)
+    solution: "Solution | None" = None
+
+    def combination(self, weights: dict) -> tuple[float, float] | None:
+        """(value, standard uncertainty) of ``sum w_label * coefficient`` (mm / rad), or None
+        when the campaign does not determine that combination."""
+        sol = self.solution
+        c = np.zeros(len(self.labels))
+        for lab, w in weights.items():
+            if lab not in self.labels:
+                return None
+            c[self.labels.index(lab)] = w
+        d = np.where(sol.norms > 0, sol.norms, 1.0)
+        if np.linalg.norm(sol.null.T @ (c / d)) > 1e-6 * np.linalg.norm(c / d):
+            return None
+        ck = c[sol.kept]
+        return float(c @ self.coef), float(np.sqrt(max(ck @ sol.cov @ ck, 0.0)))
 
     def __getitem__(self, key):
         return self.data[key]
@@ -136,14 +152,19 @@ def reading_weights(obs) -> tuple[np.ndarray, float]:
 
 def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,
               max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
-              progress=None) -> Calibration:
+              extra_terms=(), progress=None) -> Calibration:
     """Identify ``layout``'s parameters from measurement ``files`` (paths or ``KIND:FILE``;
-    or an :class:`volerr.instruments.Observations`).  Returns a :class:`Calibration`."""
+    or an :class:`volerr.instruments.Observations`).  Returns a :class:`Calibration`.
+
+    ``extra_terms``: more columns ``(name, target, basis, (factor, unit))``: a parameter
+    ``name`` that adds ``name * basis`` to the declared parameter ``target`` (e.g. a reversal
+    ``("RV_X", "EXX", "dir_X/2", (1e3, "um"))``); the basis is an expression in the axis
+    positions (rad for rotary axes) and the covariates of the files."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
         return _run(layout, files, parameters, degree, max_degree, seed, test_fraction,
-                    progress)
+                    list(extra_terms), progress)
 
 
 def _progress(total: int, enabled):
@@ -156,12 +177,13 @@ def _progress(total: int, enabled):
                 bar_format="{desc}: {n}/{total} {postfix}")
 
 
-def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, progress):
+def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, extra_terms,
+         progress):
     t0 = time.perf_counter()
     require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
     if degree is not None:
         require(1 <= degree <= 12, "degree must be between 1 and 12")
-    model = load(layout)
+    model = layout if isinstance(layout, Model) else load(layout)
     bar = _progress(4, progress)
     bar.set_postfix_str("read")
     obs = files if isinstance(files, instruments.Observations) else \
@@ -181,21 +203,42 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, pro
                                                   max_degree, weights=w, parameters=chosen)
     keep, gauge = gauge_mask(model, obs, degree, ranges, chosen)
     design = blocks.Design(model, obs, degree, ranges, keep)
+    labels = list(design.labels)
+    if extra_terms:
+        design = design.plus([extra_columns(model, obs, extra_terms)])
+        labels += [(name, "extra") for name, *_ in extra_terms]
     bar.update()
     bar.set_postfix_str("normal equations")
     fit = _normal_equations(design, obs, spl, np.sqrt(w))
     bar.update()
     bar.set_postfix_str("solve, residuals")
-    out = _solve(design, obs, spl, fit, np.sqrt(w), u_ref)
+    out = _solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref)
     bar.update()
     bar.close()
-    report = _report(model, obs, design, ranges, degree, degree_scores, chosen, gauge, fit,
-                     out, spl, u_ref)
+    units = {name: unit for name, _, _, unit in extra_terms}
+    report = _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl,
+                     u_ref, units)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     std = np.zeros(design.p)
     std[out.kept] = out.std
-    return Calibration(report, model, ranges, degree, design.labels, out.coef, std,
-                       out.residuals)
+    return Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out)
+
+
+def extra_columns(model, obs, extra_terms) -> np.ndarray:
+    """(N, 3, m) columns of ``extra_terms`` (see :func:`calibrate`): the readings'
+    sensitivity to the target parameter times the basis."""
+    from ..estimate.design import rotary_rad
+    from ..machine.expressions import evaluate
+
+    sens = obs.sensitivity(model)
+    values = {**rotary_rad(model, obs.positions), **obs.covariates}
+    out = np.zeros((obs.n, 3, len(extra_terms)))
+    for k, (name, target, basis, _) in enumerate(extra_terms):
+        require(target in model.parameters, f"{name}: {target} is not a parameter of "
+                                            f"{model.name}")
+        b = np.broadcast_to(evaluate(basis, values), (obs.n,))
+        out[:, :, k] = sens[:, :, model.parameters.index(target)] * b[:, None]
+    return out
 
 
 @dataclass
@@ -257,6 +300,9 @@ def _u_ref(sw, obs) -> float:
 @dataclass
 class Solution:
     kept: np.ndarray            # column indices in the solution
+    cov: np.ndarray             # covariance of the kept columns (mm, rad)
+    null: np.ndarray            # null space (p, k) of the unit-scaled columns
+    norms: np.ndarray           # (p,) column norms (weighted)
     coef: np.ndarray            # (p,) mm / rad, 0 where left out
     coef_train: np.ndarray
     std: np.ndarray             # of the kept columns
@@ -271,8 +317,7 @@ class Solution:
     residuals: dict
 
 
-def _solve(design, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
-    labels = design.labels
+def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
     est, partners = estimability.estimable(fit.G)
     setup_idx = [j for j, lab in enumerate(labels) if lab[0] == "setup"]
     setup_of_file = [[j for j in setup_idx if Gf[j, j] > 0] for Gf in fit.G_files]
@@ -319,15 +364,16 @@ def _solve(design, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
     rank = int(np.sum(np.linalg.eigvalsh(Gk) > SOLVE_TOL * np.linalg.eigvalsh(Gk)[-1]))
     dof = max(float(obs.n_readings - rank), 1.0)
     s0 = math.sqrt(rss_w / dof)                 # mm: the weights are relative to u_ref
-    std = np.sqrt(np.maximum(np.diag(Gi), 0.0)) / sc * s0
+    cov = Gi / np.outer(sc, sc) * s0 ** 2
+    std = np.sqrt(np.maximum(np.diag(cov), 0.0))
     s0 /= u_ref                                  # the a-posteriori factor, dimensionless
-    return Solution(kept, coef, coef_tr, std, est, partners, seen, s0, dof, rms_all, rms_test,
-                    n_test, residuals)
+    return Solution(kept, cov, estimability.null_space(fit.G),
+                    np.sqrt(np.maximum(np.diag(fit.G), 0.0)), coef, coef_tr, std, est, partners,
+                    seen, s0, dof, rms_all, rms_test, n_test, residuals)
 
 
-def _report(model, obs, design, ranges, degree, degree_scores, chosen, gauge, fit, out,
-            spl, u_ref) -> dict:
-    labels = design.labels
+def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl, u_ref,
+            units) -> dict:
     names = [terms.term_name(lab) for lab in labels]
     std_of = dict(zip(out.kept.tolist(), out.std.tolist()))
     files = obs.files or (instruments.FileInfo("data", "deviations"),)
@@ -343,7 +389,8 @@ def _report(model, obs, design, ranges, degree, degree_scores, chosen, gauge, fi
             "not_seen_by": [fi.name for fi in files if fi.name not in seen],
             "confounded_with": [names[k] for k in out.partners.get(j, [])][:6]}
         if out.estimable[j] and j in std_of:
-            params[name] = terms.report(lab, out.coef[j], std_of[j], model, ranges)
+            params[name] = terms.report(lab, out.coef[j], std_of[j], model, ranges,
+                                        units.get(lab[0]))
         else:
             unident.append(name)
     setup = {}

@@ -58,7 +58,7 @@ def term_name(label) -> str:
     p, k = label
     if p == "setup":
         return f"setup:{k}"
-    if k is None:
+    if k is None or k == "extra":
         return p
     return f"{p}@offset" if k == 0 else f"{p}@slope" if k == 1 else f"{p}@P{k}"
 
@@ -68,11 +68,12 @@ def is_angular(name: str) -> bool:
     return len(name) >= 3 and name[0] == "E" and name[1] in "ABC"
 
 
-def report(label, value: float, std: float, model, ranges: dict) -> dict:
-    """``{"value", "unit", "std"}`` of a column's coefficient (mm or rad inside)."""
+def report(label, value: float, std: float, model, ranges: dict, unit=None) -> dict:
+    """``{"value", "unit", "std"}`` of a column's coefficient (mm or rad inside; ``unit``:
+    (factor, unit) of an extra term)."""
     p, k = label
     angular = is_angular(p)
-    factor, unit = (1e6, "urad") if angular else (1e3, "um")
+    factor, unit = unit or ((1e6, "urad") if angular else (1e3, "um"))
     if k == 1:
         axis = model.parameter_axis[p]
         lo, hi = ranges[axis]

@@ -196,21 +196,23 @@ def ideal_data(model: Model, data: Data, ranges: dict, n: int = 400, seed: int =
 def gauge_mask(model: Model, data: Data, degree: int, ranges: dict,
                parameters=None) -> tuple[np.ndarray, list]:
     """Columns of :func:`declared_design` on ``data`` kept after gauge fixing (see the module
-    docstring) and the dropped labels.  The gauge is a property of the chain: it is found on
-    an ideal 3-D plan with the instrument's rigid placement, whatever instruments ``data``
-    holds; every set-up column of ``data`` is kept.  ``parameters``: the names fitted (None:
-    all); the others are left out (held at zero) before the gauge is fixed."""
+    docstring) and the dropped labels.  The gauge is a property of the chain, found with all
+    its parameters on an ideal 3-D plan with the instrument's rigid placement, whatever
+    instruments ``data`` holds (so that the straightness slopes are carried by squareness on
+    every instrument, as ISO 230-1's reference lines define them); every set-up column of
+    ``data`` is kept.  ``parameters``: the names fitted (None: all); the others are left out
+    (held at zero)."""
     ideal = ideal_data(model, data, ranges)
     d = declared_design(model, ideal, degree, ranges)
     A2 = d.A.reshape(-1, d.A.shape[-1])
-    chosen = np.array([p == "setup" or parameters is None or p in parameters
-                       for p, _ in d.labels])
     # correlation-scaled Gram (columns in mm and rad differ by orders of magnitude): on the
     # ideal plan a kept column is >= ~0.1 of its norm away from the span of the others and
     # a gauge column ~1e-7 (rounding), so 1e-4 separates them whatever the seed
-    order = [j for j in priority_order(d.labels) if chosen[j]]
-    keep = independent_columns(_correlation(A2.T @ A2), order, GAUGE_TOL)
+    keep = independent_columns(_correlation(A2.T @ A2), priority_order(d.labels), GAUGE_TOL)
+    chosen = np.array([p == "setup" or parameters is None or p in parameters
+                       for p, _ in d.labels])
     gauge = [d.labels[j] for j in np.flatnonzero(~keep & chosen)]
+    keep &= chosen
     n_setup = len(data.setup_labels)
     keep = np.concatenate([np.ones(n_setup, bool), keep[len(SETUP):]])
     return keep, gauge

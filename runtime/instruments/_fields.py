@@ -66,8 +66,9 @@ class Finder:
 
 
 def positions(find: Finder, model, where: str, min_points: int = 1,
-              needs: str = "the fit") -> dict:
-    """Axis columns (mm | deg): every axis of the layout, no other, inside the travel."""
+              needs: str = "the fit", check_travel: bool = True) -> dict:
+    """Axis columns (mm | deg): every axis of the layout, no other, inside the travel (unless
+    ``check_travel`` is False: a generic layout standing in for an unknown machine)."""
     cols, out = find.cols, {}
     for a in model.axes:
         unit = ("", "_deg") if a in model.rotary_axes else ("", "_mm")
@@ -82,7 +83,7 @@ def positions(find: Finder, model, where: str, min_points: int = 1,
     n = len(next(iter(out.values())))
     require(n >= min_points, f"{where}: too few points ({n}); {needs} needs at least "
                              f"{min_points}")
-    for a, v in out.items():
+    for a, v in out.items() if check_travel else ():
         lo, hi = model.travel[a]
         margin = 0.05 * (hi - lo)
         bad = np.flatnonzero((v < lo - margin) | (v > hi + margin))

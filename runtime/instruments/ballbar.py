@@ -43,21 +43,24 @@ def detect(names) -> bool:
     return {"pivot_x", "pivot_y", "pivot_z"} <= {n.lower() for n in names}
 
 
-def read(path, model: Model) -> Observations:
-    """Read a ballbar CSV into :class:`Observations` (InputError, one line, on a defect)."""
+def read(path, model: Model, check_travel: bool = True) -> Observations:
+    """Read a ballbar CSV into :class:`Observations` (InputError, one line, on a defect);
+    ``check_travel`` False: positions outside the layout's travel accepted (a generic layout
+    standing in for the machine)."""
     c = read_columns(path)
-    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
+    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name, check_travel)
 
 
 def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
-                            where: str) -> Observations:
+                            where: str, check_travel: bool = True) -> Observations:
     cols, text = f.drop_nonfinite(cols, text, where)
     needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
               | {"pivot_x", "pivot_y", "pivot_z", "length_mm", "dr_um", "dr_mm", "Xp", "Yp",
                  "Zp", "direction", "u_um", "length_u_um"} | set(model.covariates))
     warnings = f.text_columns(text, needed, where, labels=("placement",))
     find = f.Finder(cols, where)
-    pos = f.positions(find, model, where, min_points=4, needs="a ballbar trace")
+    pos = f.positions(find, model, where, min_points=4, needs="a ballbar trace",
+                      check_travel=check_travel)
     n = len(next(iter(pos.values())))
     probe = f.probe(find, n, where)
     pivot = f.vector(find, ("pivot_x", "pivot_y", "pivot_z"), "pivot ball centre", where)
@@ -91,8 +94,11 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                   [(None, None, None, length_u)] * len(names))
     covs = f.covariates(find, model, where, skip=())
     covs = {**motion_directions(model, pos, groups, direction), **covs}
+    info = {"pivot": pivot, "length": length, "dr": dr, "direction": direction,
+            "placement": np.asarray(names, dtype=object)[groups]}
     return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
-                        setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u)
+                        setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u,
+                        info=info)
 
 
 def _length_uncertainty(find, where: str) -> float | None:

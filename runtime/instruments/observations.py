@@ -162,6 +162,9 @@ class Observations:
     row: np.ndarray | None = None
     files: tuple = ()
     sigma: np.ndarray | None = None      # (N,) standard uncertainty of a reading, mm
+    #: the instrument's own per-point columns (e.g. a ballbar's pivot, length, raw reading and
+    #: placement): name -> (N, ...) array, for evaluations beyond the model's rows
+    info: dict = field(default_factory=dict)
 
     @property
     def n(self) -> int:
@@ -183,7 +186,8 @@ class Observations:
                             self.deviation[idx], {c: v[idx] for c, v in self.covariates.items()},
                             self.warnings, take(self.proj), take(self.rows), take(self.weight),
                             None if self.setup is None else self.setup.subset(idx),
-                            take(self.file), take(self.row), self.files, take(self.sigma))
+                            take(self.file), take(self.row), self.files, take(self.sigma),
+                            {k: v[idx] for k, v in self.info.items()})
 
     # ---- the rows of the linear model ------------------------------------------------
     def project(self, cols: np.ndarray) -> np.ndarray:

@@ -1,0 +1,109 @@
+"""A diagnosis of ballbar traces in ISO 230-1 parameters, from the layout's observation model.
+
+Not a table of hand rules: the traces are fitted (:func:`volerr.calibrate.calibrate`) with the
+parameters a circle in a plane of two linear axes ``a``, ``b`` can show, and each is reported
+with its standard uncertainty only where the traces determine it:
+
+* the squareness of the plane (``EC0Y`` for XY, ``EB0Z`` for ZX, ``EA0Z`` for YZ);
+* the scale errors (slope of the positioning errors ``Eaa``, ``Ebb``); with the bar length
+  unknown (no ``length_u_um``) only their difference (scale mismatch) is determined;
+* the curvature of the straightness errors ``Eba``, ``Eab`` (Legendre P2 coefficient, um);
+* the reversal value of each axis (``RV_a`` = mean error approaching in the positive direction
+  minus in the negative direction, ISO 230-2's B), from the axes' directions of motion, when
+  both directions were run;
+* for a rotary sweep: the location errors of the swept axis.
+
+Angular errors of the axes act on a trace through the tool-ball offset (Abbe arm); they are
+not separable from the positioning and straightness errors in one plane and are not reported.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..calibrate import calibrate
+from ..errors import require
+from ..loop.candidates import along_component
+
+SQUARENESS_OF_PLANE = {"XY": "EC0Y", "ZX": "EB0Z", "YZ": "EA0Z"}
+
+
+def _axis_along(model, k: int) -> str | None:
+    for a in model.axes:
+        if a in model.rotary_axes:
+            continue
+        if int(np.argmax(np.abs(model.layout.axes[a].direction))) == k:
+            return a
+    return None
+
+
+def diagnose(model, obs, planes: list, swept: list = ()) -> list:
+    """``[{"parameter", "value", "unit", "std"}]`` of the traces ``obs`` (stacked ballbar
+    files) in ``planes`` (XY, YZ, ZX) with rotary axes ``swept``."""
+    params, extra, report = [], [], []
+    for plane in planes:
+        i, j = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}[plane]
+        a, b = _axis_along(model, i), _axis_along(model, j)
+        require(a and b, f"{model.name}: no linear axes along the plane {plane}")
+        sq = SQUARENESS_OF_PLANE[plane]
+        if sq in model.parameters:
+            params.append(sq)
+        ea, eb = along_component(model.layout, a), along_component(model.layout, b)
+        sab = "E" + "XYZ"[j] + a
+        sba = "E" + "XYZ"[i] + b
+        params += [p for p in (ea, eb, sab, sba) if p in model.parameters]
+        for ax, comp in ((a, ea), (b, eb)):
+            d = obs.covariates.get(f"dir_{ax}")
+            if d is not None and len(np.unique(d)) == 2 and comp in model.parameters \
+                    and not any(e[0] == f"RV_{ax}" for e in extra):
+                extra.append((f"RV_{ax}", comp, f"dir_{ax}/2", (1e3, "um")))
+        report.append((plane, a, b, sq, ea, eb, sab, sba))
+    for r in swept:
+        params += [p for p in model.parameters if model.parameter_axis.get(p) is None
+                   and p[-1] == r and p[2] == "0"]
+    require(params, "nothing to diagnose in these traces")
+    cal = calibrate(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
+                    extra_terms=extra)
+    return _entries(cal, report, swept, extra)
+
+
+def _entry(name, value_std, factor, unit) -> dict:
+    v, s = value_std
+    return {"parameter": name, "value": v * factor, "unit": unit, "std": s * abs(factor)}
+
+
+def _entries(cal, report, swept, extra) -> list:
+    out = []
+    ranges = cal.ranges
+    for plane, a, b, sq, ea, eb, sab, sba in report:
+        if sq in cal.model.parameters:
+            r = cal.combination({(sq, None): 1.0})
+            if r:
+                out.append(_entry(sq, r, 1e6, "urad"))
+        slopes = {}
+        for ax, comp in ((a, ea), (b, eb)):
+            lo, hi = ranges[ax]
+            slopes[comp] = 2.0 / (hi - lo)
+            r = cal.combination({(comp, 1): slopes[comp]})
+            if r:
+                out.append(_entry(f"{comp}@slope", r, 1e3, "um/mm"))
+        if not any(e["parameter"] in (f"{ea}@slope", f"{eb}@slope") for e in out):
+            r = cal.combination({(ea, 1): slopes[ea], (eb, 1): -slopes[eb]})
+            if r:
+                out.append(_entry(f"{ea}@slope-{eb}@slope", r, 1e3, "um/mm"))
+        for comp in (sab, sba):
+            r = cal.combination({(comp, 2): 1.0})
+            if r:
+                out.append(_entry(f"{comp}@P2", r, 1e3, "um"))
+    for name, *_ in extra:
+        r = cal.combination({(name, "extra"): 1.0})
+        if r and not any(e["parameter"] == name for e in out):
+            out.append(_entry(name, r, 1e3, "um"))
+    for r_axis in swept:
+        for p in cal.model.parameters:
+            if cal.model.parameter_axis.get(p) is None and p[-1] == r_axis and p[2] == "0":
+                r = cal.combination({(p, None): 1.0})
+                if r:
+                    f, u = (1e6, "urad") if p[1] in "ABC" else (1e3, "um")
+                    out.append(_entry(p, r, f, u))
+    return out

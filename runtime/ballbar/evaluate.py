@@ -1,0 +1,68 @@
+"""``volerr ballbar evaluate``: the ISO 230-4 evaluation of ballbar files and the diagnosis in
+ISO 230-1 parameters (:mod:`volerr.ballbar.iso230_4`, :mod:`volerr.ballbar.diagnosis`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import instruments
+from ..errors import require
+from ..instruments import ballbar as reader
+from ..machine.model import load
+from . import diagnosis, iso230_4
+
+#: the layout standing in for a Cartesian machine when none is given (its travel not enforced)
+DEFAULT_LAYOUT = "MB1"
+
+
+@dataclass
+class Evaluation:
+    """``data`` the JSON report; ``traces`` the ISO 230-4 traces (for the polar plot)."""
+
+    data: dict
+    traces: list
+    results: list
+
+    def write_json(self, path, inputs=()) -> Path:
+        import json
+
+        from ..fileio import write_text
+
+        return write_text(path, json.dumps(self.data, indent=2) + "\n", inputs=list(inputs))
+
+
+def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
+    """Evaluate ballbar ``files`` (paths); ``layout`` None: :data:`DEFAULT_LAYOUT` for
+    X, Y, Z traces (the travel of the generic layout is not enforced)."""
+    model = load(layout or DEFAULT_LAYOUT)
+    parts, trs = [], []
+    for path in files:
+        obs = reader.read(path, model, check_travel=layout is not None)
+        obs.files = (instruments.FileInfo(Path(path).name, reader.KIND, "um", 1),)
+        parts.append(obs)
+        trs += iso230_4.traces(obs, model)
+    results = iso230_4.evaluate_all(trs)
+    data = {"layout": model.name, "traces": results, "diagnosis": []}
+    if diagnose:
+        stacked = instruments.stack(parts)
+        planes = list(dict.fromkeys(t.plane for t in trs))
+        swept = [a for a in model.rotary_axes if np.ptp(stacked.positions[a]) > 1.0]
+        data["diagnosis"] = diagnosis.diagnose(model, stacked, [] if swept else planes, swept)
+    return Evaluation(data, trs, results)
+
+
+def check_layout_for(files, layout) -> None:
+    """A trace with rotary-axis columns needs its layout (the default is Cartesian)."""
+    if layout:
+        return
+    from ..instruments._csv import read_columns
+
+    for f in files:
+        cols = read_columns(f)
+        names = {n.upper() for n in list(cols.numbers) + list(cols.text)}
+        rot = sorted(names & {"A", "B", "C", "A_DEG", "B_DEG", "C_DEG"})
+        require(not rot, f"{Path(f).name}: rotary axis column {rot[0] if rot else ''}: give "
+                         f"the machine's layout (--layout)")
