@@ -32,27 +32,6 @@ def plane_axes(plane: str) -> tuple[np.ndarray, np.ndarray]:
     return e[i], e[j]
 
 
-def linear_positions(model, targets: np.ndarray, rotary: dict, tool) -> dict:
-    """Commanded positions {axis: (N,)} that put the tool point (offset ``tool``) at
-    ``targets`` (N, 3), workpiece frame, with the rotary axes at ``rotary`` {axis: (N,) deg}."""
-    n = len(targets)
-    lin = [a for a in model.axes if a not in model.rotary_axes]
-    require(len(lin) == 3, f"{model.name}: a ballbar test needs three linear axes")
-    missing = [a for a in model.rotary_axes if a not in rotary]
-    require(not missing, f"give the position of rotary axis {missing[0] if missing else ''} "
-                         f"(--rotary {missing[0] if missing else ''}=DEG)")
-    base = {**{a: np.zeros(n) for a in lin}, **{a: np.broadcast_to(
-        np.asarray(rotary[a], float), (n,)) for a in model.rotary_axes}}
-    t0 = model.nominal_position(base, tool)
-    J = np.empty((n, 3, 3))
-    for k, a in enumerate(lin):      # the chain is affine in the linear axes: exact columns
-        step = dict(base)
-        step[a] = np.ones(n)
-        J[:, :, k] = model.nominal_position(step, tool) - t0
-    q = np.linalg.solve(J, (targets - t0)[:, :, None])[:, :, 0]
-    return {**{a: q[:, k] for k, a in enumerate(lin)}, **{a: base[a] for a in model.rotary_axes}}
-
-
 def trace(model, plane: str, radius: float, centre, tool=(0.0, 0.0, 0.0), rotary=None,
           points: int = 360, direction: int = 1) -> dict:
     """Commanded positions and geometry of one trace: ``{"positions", "pivot", "angle_deg",
@@ -81,7 +60,7 @@ def trace(model, plane: str, radius: float, centre, tool=(0.0, 0.0, 0.0), rotary
         targets = centre + radius * (np.cos(theta)[:, None] * e1 + np.sin(theta)[:, None] * e2)
         rot = rotary
         angle = np.rad2deg(np.mod(theta, 2 * np.pi))
-    pos = linear_positions(model, targets, rot, tool)
+    pos = model.linear_positions(targets, rot, tool)
     return {"positions": pos, "pivot": centre, "angle_deg": angle, "direction": direction}
 
 

@@ -144,10 +144,7 @@ def default_parameters(obs) -> str:
 
 def reading_weights(obs) -> tuple[np.ndarray, float]:
     """Relative weights (N,) of the points' readings, ``(u_ref / u)^2``, and ``u_ref`` (mm)."""
-    u = np.asarray(obs.sigma, dtype=float) if obs.sigma is not None else np.full(obs.n, np.nan)
-    u = np.where(np.isfinite(u), u, 1e-3)
-    ref = float(np.median(u))
-    return (ref / u) ** 2, ref
+    return obs.point_weights(), obs.reference_sigma()
 
 
 def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,

@@ -24,7 +24,9 @@ def register(sub) -> None:
                     "selection (BIC and cross-validated residual), augment the layout and "
                     "report RMS/max before and after on held-out points.")
     p.add_argument("layout", help="layout name or layout file")
-    p.add_argument("data", help="measured-deviation CSV")
+    p.add_argument("data", nargs="+", metavar="FILE",
+                   help="measurement files of any instruments (deviations, ballbar, sphere; "
+                        "KIND:FILE to name the kind), one campaign")
     p.add_argument("--json", help="write the report (JSON)")
     p.add_argument("--html", help="write the report with figures (HTML)")
     p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
@@ -52,7 +54,9 @@ def run(args) -> int:
     from ..machine.model import load
 
     require(args.json or args.html, "give --json or --html (or both) for the report")
-    inputs = [args.data, *layout_inputs(args.layout)]
+    from ..instruments import split_spec
+
+    inputs = [split_spec(d)[1] for d in args.data] + layout_inputs(args.layout)
     model = load(args.layout)
     aug = (f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py")
     out_dir = (Path(args.out_dir) if args.out_dir
@@ -69,7 +73,8 @@ def run(args) -> int:
                 f"{' '.join(candidates.FAMILIES)}")
     with outs:
         staged = outs.path("--out-dir")
-        report = run_loop(args.layout, args.data, seed=args.seed, folds=args.folds,
+        data = args.data[0] if len(args.data) == 1 else args.data
+        report = run_loop(args.layout, data, seed=args.seed, folds=args.folds,
                           test_fraction=args.test_fraction, degree=args.degree,
                           out_dir=staged, families=families, inputs=inputs)
         for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
@@ -92,7 +97,8 @@ def run(args) -> int:
               f"{report['generated_module']}")
     if report["residual_note"]:
         print(f"  {report['residual_note']}")
-    if report["unidentifiable"]:
-        print(f"  not separable by these data: "
-              f"{', '.join(u['parameters'][0] for u in report['unidentifiable'])} (see the report)")
+    hidden = [u["parameters"][0] for u in report["unidentifiable"]
+              if not (u["parameters"][0].startswith("setup.") and u.get("no_sensitivity"))]
+    if hidden:
+        print(f"  not separable by these data: {', '.join(hidden)} (see the report)")
     return 0

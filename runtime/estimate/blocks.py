@@ -222,11 +222,13 @@ class BlockBase:
     def __init__(self, design, points, sw, y):
         self.design, self.points, self.sw = design, np.asarray(points), np.asarray(sw)
         G, b, colsq = normal(design, self.points, self.sw, y)
-        self.n = 3 * len(self.points)
-        self.scale = unit_scale(colsq, self.n)
+        n_rows = 3 * len(self.points)
+        #: readings (rows that carry one: a ballbar point has one), the n of the BIC
+        self.n = int(design.data.readings_per_point()[self.points].sum())
+        self.scale = unit_scale(colsq, n_rows)
         self.Gi = eig_inverse(G / np.outer(self.scale, self.scale), 1e-12)
         c = self.Gi @ (b / self.scale) / self.scale
-        self.r = np.empty(self.n)         # weighted residual rows, component-major per block
+        self.r = np.empty(n_rows)         # weighted residual rows, component-major per block
         for s, idx in blocks(self.points):
             w = wrows(self.sw[s])
             self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (
@@ -250,12 +252,12 @@ class BlockBase:
 
     def _score(self, AB, BB, Br) -> tuple[float, int]:
         """As :meth:`volerr.loop.select.Base.score`, from the cross-products."""
-        sc = np.sqrt(np.maximum(np.diag(BB), 0.0) / self.n)
+        sc = np.sqrt(np.maximum(np.diag(BB), 0.0) / len(self.r))
         sc[sc == 0] = 1.0
         C = AB / sc
         M = BB / np.outer(sc, sc) - C.T @ self.Gi @ C
         w, V = np.linalg.eigh((M + M.T) / 2)
-        ok = w > 1e-9 * self.n
+        ok = w > 1e-9 * len(self.r)
         if not ok.any():
             return 0.0, 0
         g = V[:, ok].T @ (Br / sc)

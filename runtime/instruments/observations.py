@@ -235,8 +235,24 @@ class Observations:
             return twist[:, :, :6]
         return self.setup.block(twist)
 
+    def reference_sigma(self) -> float:
+        """The median standard uncertainty of the readings (mm; 1 um when none is given)."""
+        u = self._sigmas()
+        return float(np.median(u))
+
+    def _sigmas(self) -> np.ndarray:
+        u = (np.full(self.n, np.nan) if self.sigma is None
+             else np.asarray(self.sigma, dtype=float))
+        fallback = float(np.median(u[np.isfinite(u)])) if np.isfinite(u).any() else 1e-3
+        return np.where(np.isfinite(u), u, fallback)
+
     def point_weights(self) -> np.ndarray:
-        return np.ones(self.n) if self.weight is None else self.weight
+        """Relative weight of each point's readings: ``(u_ref / u)^2`` (1 for equal
+        uncertainties), ``u_ref`` = :meth:`reference_sigma`."""
+        if self.weight is not None:
+            return self.weight
+        u = self._sigmas()
+        return (float(np.median(u)) / u) ** 2
 
 
 def stack(parts: list) -> Observations:

@@ -106,3 +106,70 @@ def _frames(find, raw: dict, n: int, where: str) -> np.ndarray:
     bad = [v for v in vals if v not in FRAMES]
     require(not bad, f"{where}: frame {bad[0] if bad else ''!r} is not work or machine")
     return vals
+
+
+# ---- plans and simulated readings ---------------------------------------------------------
+def plan(model, centres, rotary: dict, tool=(0.0, 0.0, 0.0)) -> dict:
+    """Commanded poses of a sphere test: for each nominal sphere centre (workpiece frame, mm)
+    and each combination of the rotary positions ``rotary`` {axis: [deg, ...]}, the linear
+    positions that put the tool point on the centre (poses outside the travel left out).
+    Returns ``{"positions": {axis: (N,)}, "centre": (N, 3), "placement": (N,) labels}``."""
+    import itertools
+
+    tool = np.asarray(tool, float)
+    axes = [a for a in model.rotary_axes]
+    grid = list(itertools.product(*[np.atleast_1d(rotary[a]) for a in axes])) or [()]
+    pos_parts, cen, place = [], [], []
+    for k, c in enumerate(np.atleast_2d(centres)):
+        rot = {a: np.array([g[i] for g in grid], float) for i, a in enumerate(axes)}
+        pos = model.linear_positions(np.tile(c, (len(grid), 1)), rot, tool)
+        inside = np.ones(len(grid), bool)
+        for a in model.axes:
+            lo, hi = model.travel[a]
+            inside &= (pos[a] >= lo) & (pos[a] <= hi)
+        pos_parts.append({a: v[inside] for a, v in pos.items()})
+        cen.append(np.tile(c, (int(inside.sum()), 1)))
+        place += [str(k + 1)] * int(inside.sum())
+    positions = {a: np.concatenate([p[a] for p in pos_parts]) for a in model.axes}
+    require(len(place) > 0, "no pose of the sphere plan lies inside the travel")
+    return {"positions": positions, "centre": np.concatenate(cen),
+            "placement": np.asarray(place, dtype=object)}
+
+
+def simulate(model, errors: dict, poses: dict, tool=(0.0, 0.0, 0.0), centre_offsets=None,
+             noise_um: float = 0.0, seed: int = 0) -> dict:
+    """Columns of a sphere file (frame work) for ``poses`` (:func:`plan`) of the layout's
+    first-order model with ``errors`` {name: value or callable(positions) -> (N,)} (mm / rad);
+    ``centre_offsets`` {placement: (3,) mm}: the spheres' true offsets from their nominal
+    centres."""
+    pos = poses["positions"]
+    n = len(poses["placement"])
+    vals = {k: (v(pos) if callable(v) else v) for k, v in (errors or {}).items()}
+    e = model.volumetric_error(pos, vals, probe=tool)
+    t = model.nominal_position(pos, tool)
+    dc = np.zeros((n, 3))
+    for k, v in (centre_offsets or {}).items():
+        dc[poses["placement"] == str(k)] = v
+    d = t + e - poses["centre"] - dc
+    if noise_um:
+        d = d + np.random.default_rng(seed).normal(0.0, noise_um * 1e-3, d.shape)
+    tool = np.asarray(tool, float)
+    return {**pos, "Xp": np.full(n, tool[0]), "Yp": np.full(n, tool[1]),
+            "Zp": np.full(n, tool[2]), "sphere_x": poses["centre"][:, 0],
+            "sphere_y": poses["centre"][:, 1], "sphere_z": poses["centre"][:, 2],
+            "dx_um": 1e3 * d[:, 0], "dy_um": 1e3 * d[:, 1], "dz_um": 1e3 * d[:, 2],
+            "placement": poses["placement"]}
+
+
+def write_csv(path, cols: dict, inputs=()):
+    """Write sphere columns (6 decimals mm/deg, 5 um; placement as text)."""
+    from ..fileio import write_text
+
+    names = list(cols)
+    n = len(cols[names[0]])
+    lines = [",".join(names)]
+    for i in range(n):
+        lines.append(",".join(str(cols[k][i]) if k == "placement" else
+                              (f"{cols[k][i]:.5f}" if k.endswith("_um") else
+                               f"{cols[k][i]:.6f}") for k in names))
+    return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))

@@ -179,36 +179,47 @@ class Robust:
         return np.repeat(np.sqrt(self.weights), 3)
 
 
+#: median of the length of a d-dimensional standard normal vector (chi(d)), d = 1, 2, 3
+CHI_MEDIAN = np.array([np.nan, 0.6745, 1.1774, 1.5382])
+
+
 def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
-    """IRLS on the 3-D residual length of each point: weight 1 up to ``ROBUST_K`` robust
-    standard deviations, then a bisquare down to 0 at twice that; the scale from the median
-    residual length (the median of a chi(3) variable is 1.538 sigma), so gross outliers
-    neither inflate the noise estimate nor hide smaller ones.
+    """IRLS on the residual length of each point (its readings: 3 for a 3-D deviation, 1 for a
+    ballbar length), standardised by the instrument's uncertainty: weight 1 up to
+    ``ROBUST_K`` robust standard deviations, then a bisquare down to 0 at twice that; the
+    scale from the median of the lengths, each divided by the median of a chi variable of its
+    dimension (1.538 sigma for three readings), so gross outliers neither inflate the noise
+    estimate nor hide smaller ones.  The weights returned are the instruments' relative weights
+    (1 / u^2) times the robust ones.
 
     ``design``: :class:`volerr.estimate.blocks.Design`; ``points``: the points fitted (their rows
-    of ``y``).  The normal equations of all points at weight 1 are accumulated once; each
-    iteration subtracts those of the down-weighted points (few) and predicts blockwise."""
+    of ``y``).  The normal equations of all points at their instrument weight are accumulated
+    once; each iteration subtracts those of the down-weighted points (few) and predicts
+    blockwise."""
+    data = design.data
+    base = data.point_weights()[points]
+    dims = data.readings_per_point()[points]
     w = np.ones(len(points))
     rows = rows_of(points)
-    G1, b1, colsq = blocks.normal(design, points, np.ones(len(points)), y)
+    G1, b1, colsq = blocks.normal(design, points, np.sqrt(base), y)
     scale = blocks.unit_scale(colsq, len(rows))
     sigma = 0.0
     for _ in range(iterations):
         low = np.flatnonzero(w < 1.0)
         if len(low) > len(points) // 2:
-            G, b, _ = blocks.normal(design, points, np.sqrt(w), y)
+            G, b, _ = blocks.normal(design, points, np.sqrt(base * w), y)
         else:       # G1 minus the down-weighted points' share (1 - w) A_i^T A_i
             G, b = G1.copy(), b1.copy()
             for _, part in blocks.blocks(low):
                 idx = points[part]
-                d = blocks.wrows(np.sqrt(1.0 - w[part]))
+                d = blocks.wrows(np.sqrt(base[part] * (1.0 - w[part])))
                 At = design.block(idx)
                 At *= d
                 G -= At @ At.T
                 b -= At @ (blocks.yrows(y, idx) * d)
         c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
-        r = point_norm(y[rows] - blocks.predict(design, points, c))
-        sigma = max(float(np.median(r[w > 0])) / 1.538, 1e-12)
+        r = point_norm(y[rows] - blocks.predict(design, points, c)) * np.sqrt(base)
+        sigma = max(float(np.median((r / CHI_MEDIAN[dims])[w > 0])), 1e-12)
         z = r / sigma
         w_new = np.where(z <= ROBUST_K, 1.0,
                          np.clip(1 - ((z - ROBUST_K) / ROBUST_K) ** 2, 0, 1) ** 2)
@@ -216,7 +227,7 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
             break
         w = w_new
     weights = np.ones(n)
-    weights[points] = w
+    weights[points] = w * base
     flagged = points[z > OUTLIER_Z]
     return Robust(weights, sigma, flagged)
 
@@ -336,7 +347,8 @@ def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y,
     ca_tr, c_all, G, scale = _fits(aug.design, spl, sw, y)
     res_after, r_after, contrib = _residuals(aug.design, n, spl.test, y, ca_tr, c_all, groups)
     wG = np.linalg.eigvalsh(G)
-    dof = max(3 * float(robust.weights.sum()) - int(np.sum(wG > 1e-12 * wG[-1])), 1.0)
+    n_readings = float(np.sum(robust.weights * decl.design.data.readings_per_point()))
+    dof = max(n_readings - int(np.sum(wG > 1e-12 * wG[-1])), 1.0)
     sigma2 = float(np.sum((res_after * w_rows) ** 2)) / dof
     cov_diag = np.diag(np.linalg.pinv(G, rcond=1e-12)) * sigma2 / scale ** 2
     inl = point_norm(r_after) <= OUTLIER_Z * math.sqrt(sigma2)
@@ -388,13 +400,18 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
 
 
 def _replicate_sigma(dat: Data, res_rows, weights) -> tuple[float, int] | None:
-    """Pure-error standard deviation (mm per coordinate) from replicated points (same
-    positions and probe offset), and its degrees of freedom; None without replicates."""
-    key = np.column_stack([dat.positions[a] for a in dat.positions] + [dat.probe])
+    """Pure-error standard deviation (mm per reading) from replicated points (same positions,
+    probe offset and instrument projection), and its degrees of freedom; None without
+    replicates."""
+    parts = [dat.positions[a] for a in dat.positions] + [dat.probe]
+    if dat.proj is not None:
+        parts.append(dat.proj.reshape(dat.n, 9))
+    key = np.column_stack(parts)
     _, inv, counts = np.unique(np.round(key, 6), axis=0, return_inverse=True,
                                return_counts=True)
     inv = inv.ravel()
-    rep = (counts[inv] > 1) & (weights > 0.5)
+    rows = dat.readings_per_point()
+    rep = (counts[inv] > 1) & (weights > 0.5 * dat.point_weights())
     if rep.sum() < 10:
         return None
     r = res_rows.reshape(-1, 3)[rep]
@@ -404,7 +421,8 @@ def _replicate_sigma(dat: Data, res_rows, weights) -> tuple[float, int] | None:
     cnt = np.bincount(g, minlength=inv.max() + 1)[:, None]
     means = means / np.maximum(cnt, 1)
     ss = float(np.sum((r - means[g]) ** 2))
-    dof = 3 * (len(g) - len(np.unique(g)))
+    groups, first = np.unique(g, return_index=True)
+    dof = int(rows[rep].sum() - rows[rep][first].sum())
     return (math.sqrt(ss / dof), dof) if dof > 0 else None
 
 
@@ -454,12 +472,16 @@ class Figures:
 
 
 def _load(layout, data) -> tuple[Model, Data]:
+    from .. import instruments
+
     model = load(layout)
     if isinstance(data, Data):
         return model, data
     if hasattr(data, "columns") and callable(data.columns):
         return model, columns_to_data(data.columns(), model, "campaign")
-    return model, read_deviations(data, model)
+    if isinstance(data, (list, tuple)):          # files of any instruments, one campaign
+        return model, instruments.read_files(list(data), model)
+    return model, instruments.read(data, model)
 
 
 def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, families):
@@ -541,11 +563,36 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     report["residual_sources"] = src_before
     report["residual_sources_after"] = src_after
     report["residual_note"] = residual_note(dat, out, src_after, robust)
+    report["instruments"] = instrument_residuals(dat, spl, out)
     report["seconds"] = round(time.perf_counter() - t_start, 2)
     figs = Figures(model, dat, ranges, degree, out.res_before, out.res_after, spl.test,
                    out.r_before, out.r_after, selection.accepted, out.contrib, out.c_all,
                    aug.labels, out.c_before, decl.labels, out.cov_diag, robust.weights)
     return Report(report, figs, aug.text, aug.source)  # the full module: derived when asked
+
+
+def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
+    """Held-out RMS before / after per file, in the file's own unit (um), per reading."""
+    files = dat.files or ()
+    if not files:
+        return []
+    file_of = dat.file if dat.file is not None else np.zeros(dat.n, int)
+    rows = dat.readings_per_point()
+    ft = file_of[spl.test]
+    out_list = []
+    for f, fi in enumerate(files):
+        m = ft == f
+        n_read = int(rows[spl.test][m].sum())
+        rb = out.r_before.reshape(-1, 3)[m]
+        ra = out.r_after.reshape(-1, 3)[m]
+
+        def per_reading(r):
+            return round(1e3 * math.sqrt(float(np.sum(r ** 2)) / n_read), 4) if n_read else None
+
+        out_list.append({"file": fi.name, "kind": fi.kind, "unit": fi.unit,
+                         "n": int(rows[file_of == f].sum()), "n_heldout": n_read,
+                         "rms_before_um": per_reading(rb), "rms_after_um": per_reading(ra)})
+    return out_list
 
 
 def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
@@ -554,7 +601,8 @@ def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
     from ..fileio import write_text
 
     out = Path(out_dir)
-    inputs = list(inputs) + ([str(data)] if isinstance(data, (str, Path)) else [])
+    inputs = list(inputs) + ([str(data)] if isinstance(data, (str, Path)) else
+                             [str(d) for d in data] if isinstance(data, (list, tuple)) else [])
     return {"augmented_layout": str(write_text(out / f"{aug.model.name}.toml", aug.text,
                                                inputs=inputs)),
             "generated_module": str(write_text(out / f"{aug.model.name.lower()}.py",

@@ -44,14 +44,15 @@ class Base:
     """The current design on the (weighted) training rows, column-scaled, with its Gram
     pseudo-inverse; :meth:`score` is the RSS reduction of adding columns."""
 
-    def __init__(self, A, y):
+    def __init__(self, A, y, n_readings: int | None = None):
         self.scale = np.sqrt(np.mean(A ** 2, axis=0))
         self.scale[self.scale == 0] = 1.0
         self.A = A / self.scale
         self.Gi = _pinv_sym(self.A.T @ self.A)
         self.r = y - self.A @ (self.Gi @ (self.A.T @ y))
         self.rss = float(self.r @ self.r)
-        self.n = len(y)
+        #: readings (rows that carry one), the n of the BIC
+        self.n = len(y) if n_readings is None else int(n_readings)
 
     def score(self, B) -> tuple[float, int]:
         """(RSS reduction, effective rank) of adding the columns B (rows, m)."""
@@ -388,7 +389,8 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     ytr_s = y[tr_s] * w_rows[tr_s]
 
     def dense(design):       # the base on the screening points (a few thousand: dense)
-        return Base(design.rows(ctx_s.pts) * w_rows[tr_s, None], ytr_s)
+        return Base(design.rows(ctx_s.pts) * w_rows[tr_s, None], ytr_s,
+                    ctx.data.readings_per_point()[ctx_s.pts].sum())
 
     def full(design):
         return dense(design) if ctx_s is ctx else _full_base(design, train, w_rows, y)

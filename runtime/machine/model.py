@@ -477,6 +477,33 @@ class Model:
 
         return inverse(self, target, _offset(probe, tool), near)
 
+    def linear_positions(self, targets, rotary: dict | None = None, probe=(0.0, 0.0, 0.0)
+                         ) -> dict:
+        """Positions of the linear axes that put the nominal tool point (offset ``probe``) at
+        ``targets`` (N, 3) in the workpiece frame, the rotary axes held at ``rotary`` {axis:
+        scalar or (N,) deg}: ``{axis: (N,)}`` for every axis, mm / deg.  Exact: at fixed rotary
+        positions the nominal chain is affine in the linear axes."""
+        targets = np.atleast_2d(_floats(targets, "targets"))
+        n = len(targets)
+        rotary = dict(rotary or {})
+        lin = [a for a in self.axes if a not in self.rotary_axes]
+        require(len(lin) == 3, f"{self.name}: placing the tool point needs three linear axes")
+        missing = [a for a in self.rotary_axes if a not in rotary]
+        require(not missing, f"give the position of rotary axis "
+                             f"{missing[0] if missing else ''}")
+        base = {**{a: np.zeros(n) for a in lin},
+                **{a: np.broadcast_to(_floats(rotary[a], f"position {a}"), (n,))
+                   for a in self.rotary_axes}}
+        t0 = self.nominal_position(base, probe)
+        J = np.empty((n, 3, 3))
+        for k, a in enumerate(lin):
+            step = dict(base)
+            step[a] = np.ones(n)
+            J[:, :, k] = self.nominal_position(step, probe) - t0
+        q = np.linalg.solve(J, (targets - t0)[:, :, None])[:, :, 0]
+        return {a: (q[:, lin.index(a)] if a in lin else np.asarray(base[a], float))
+                for a in self.axes}
+
     def orientation_error(self, positions, errors=None, covariates=None) -> np.ndarray:
         """First-order error of the tool-axis direction, (N, 3), rad."""
         pos, n = self._points(positions)
