@@ -183,8 +183,11 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     model = layout if isinstance(layout, Model) else load(layout)
     bar = _progress(4, progress)
     bar.set_postfix_str("read")
-    obs = files if isinstance(files, instruments.Observations) else \
-        instruments.read_files(list(files), model)
+    if isinstance(files, instruments.Observations):
+        parts, obs = [files], files
+    else:
+        parts = instruments.read_parts(list(files), model)
+        obs = instruments.stack(parts)
     chosen = terms.resolve(parameters, model, default_parameters(obs))
     ranges = data_ranges(model, obs)
     spl = split_points(obs.n, seed, test_fraction, None)
@@ -215,6 +218,11 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     units = {name: unit for name, _, _, unit in extra_terms}
     report = _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl,
                      u_ref, units)
+    if not extra_terms:
+        from .plan import suggest
+
+        report["plan"] = suggest(model, parts, design, labels, fit.G, report["unidentifiable"],
+                                 u_ref)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     std = np.zeros(design.p)
     std[out.kept] = out.std

@@ -18,7 +18,8 @@ def register(sub) -> None:
                        description="Print the file formats volerr reads and writes: all "
                                    "section names, or one section.")
     p.add_argument("name", nargs="?", metavar="NAME",
-                   help="section: tables, tracker, sphere, deviations, loop-json, layout, "
+                   help="section: tables, tracker, probe-sphere, deviations, ballbar, sphere, "
+                        "calibrate-json, loop-json, layout, "
                         "gcode, controller, uncertainty, iso230-2, outputs, or 'all'")
     p.set_defaults(func=run)
 
@@ -48,7 +49,7 @@ def run(args) -> int:
         print("File formats (volerr formats NAME; docs/formats.md):")
         for name, (title, _) in secs.items():
             short = re.sub(r"\s*\([a-z0-9-]+\)$", "", title)
-            print(f"  {name:12s} {short}")
+            print(f"  {name:15s} {short}")
         return 0
     if args.name == "all":
         print(text(), end="")

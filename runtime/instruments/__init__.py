@@ -16,7 +16,8 @@ from pathlib import Path
 from ..errors import require
 from .observations import FileInfo, Observations, Setup, stack
 
-__all__ = ["FileInfo", "Observations", "Setup", "kinds", "read", "read_files", "stack"]
+__all__ = ["FileInfo", "Observations", "Setup", "kinds", "read", "read_files", "read_parts",
+           "stack"]
 
 #: the fallback kind: a file of 3-D deviations
 FALLBACK = "deviations"
@@ -66,9 +67,14 @@ def read(spec, model) -> Observations:
     return obs
 
 
-def read_files(specs, model) -> Observations:
-    """Several files, one campaign (each file its own set-up)."""
+def read_parts(specs, model) -> list:
+    """Several files, each as its own :class:`Observations` (the same file twice refused)."""
     names = [Path(split_spec(s)[1]).resolve() for s in specs]
     dup = [str(n) for n in names if names.count(n) > 1]
     require(not dup, f"{Path(dup[0]).name if dup else ''}: the same file given twice")
-    return stack([read(s, model) for s in specs])
+    return [read(s, model) for s in specs]
+
+
+def read_files(specs, model) -> Observations:
+    """Several files, one campaign (each file its own set-up)."""
+    return stack(read_parts(specs, model))

@@ -160,3 +160,36 @@ def motion_directions(model: Model, pos: dict, groups, direction) -> dict:
             d[d == 0] = 1.0
             out[f"dir_{a}"] = d
     return out
+
+
+def extensions(model, obs) -> list:
+    """Plan extensions a calibration can try when the file leaves parameters undetermined:
+    ``[(text, hypothetical Observations)]`` -- circles in the planes the file lacks, a second
+    radius, and the bar length calibrated (``length_u_um``)."""
+    from ..ballbar.iso230_4 import PLANE_NAMES, plane_of
+    from ..ballbar.simulate import simulate
+
+    where = obs.files[0].name if obs.files else "ballbar"
+    pivot = obs.info["pivot"][0]
+    radius = float(obs.info["length"][0])
+    tool = obs.probe[0]
+    t = model.nominal_position(obs.positions, obs.probe)
+    have = {PLANE_NAMES[plane_of(t - obs.info["pivot"])]}
+    rotary = {a: float(np.median(obs.positions[a])) for a in model.rotary_axes}
+    trials = [(f"a circle in the {p} plane", p, radius) for p in ("XY", "YZ", "ZX")
+              if p not in have]
+    trials.append((f"a second radius ({1.5 * radius:g} mm)", next(iter(have)), 1.5 * radius))
+    out = []
+    for text, plane, r in trials:
+        try:
+            cols = simulate(model, None, plane, r, pivot, tool, rotary, points=72)
+        except Exception:      # the trial leaves the travel or the chain: not a suggestion
+            continue
+        ext = columns_to_observations({k: np.asarray(v, float) for k, v in cols.items()}, {},
+                                      {}, model, f"{where} + {text}")
+        out.append((text, ext))
+    if obs.setup is not None and obs.setup.priors[0][-1] is None:
+        calibrated = obs.subset(np.arange(obs.n))
+        calibrated.setup.priors = [(None, None, None, 1e-3)] * len(calibrated.setup.keys)
+        out.append(("the bar length calibrated to 1 um (length_u_um)", calibrated))
+    return out

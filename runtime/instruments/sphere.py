@@ -55,7 +55,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                             where: str) -> Observations:
     cols, text = f.drop_nonfinite(cols, text, where)
     needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
-              | {"sphere_x", "sphere_y", "sphere_z", "Xp", "Yp", "Zp", "u_um"}
+              | {"sphere_x", "sphere_y", "sphere_z", "Xp", "Yp", "Zp", "u_um", "tool_u_um"}
               | {f"{d}_{u}" for d in ("dx", "dy", "dz") for u in ("um", "mm")}
               | set(model.covariates))
     warnings = f.text_columns(text, needed, where, labels=("placement", "frame"))
@@ -72,6 +72,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     require(placement is not None, f"{where}: no placement column: give each reading the "
                                    f"label of its sphere placement (column placement)")
     frame = _frames(find, raw, n, where)
+    tool_u = _tool_uncertainty(find, where)
     t = model.nominal_position(pos, probe)
     lin = generated.sphere(t[:, 0], t[:, 1], t[:, 2], centre[:, 0], centre[:, 1],
                            centre[:, 2])                   # (3, 7, n)
@@ -90,10 +91,23 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     setup = Setup(groups, local, [f"{where}#{m}" for m in names] + [where],
                   [SETUP_KEYS] * len(names) + [("tool_dz",)],
                   [("local", 0)] * len(names) + [("twist", (TOOL_DZ,))],
-                  [("um",) * 3] * len(names) + [("um",)])
+                  [("um",) * 3] * len(names) + [("um",)],
+                  [(None,) * 3] * len(names) + [(tool_u,)])
     covs = f.covariates(find, model, where)
     return Observations(pos, probe, reading - nominal, covs, warnings, proj=proj,
-                        setup=setup, files=(FileInfo(where, KIND, "um", 3),), sigma=u)
+                        setup=setup, files=(FileInfo(where, KIND, "um", 3),), sigma=u,
+                        info={"centre": centre, "placement": placement, "frame": frame})
+
+
+def _tool_uncertainty(find, where: str) -> float | None:
+    """Standard uncertainty (mm) of the tool length from column ``tool_u_um`` (a tool measured
+    on a presetter or a tool setter: its length error is then known), else None (unknown)."""
+    h = find("tool_u", ("_um",), "tool_u_um")
+    if h is None:
+        return None
+    v = np.unique(find.cols[h])
+    require(len(v) == 1 and v[0] > 0, f"{where}: tool_u_um must be one positive value")
+    return float(v[0]) * 1e-3
 
 
 def _frames(find, raw: dict, n: int, where: str) -> np.ndarray:
@@ -173,3 +187,42 @@ def write_csv(path, cols: dict, inputs=()):
                               (f"{cols[k][i]:.5f}" if k.endswith("_um") else
                                f"{cols[k][i]:.6f}") for k in names))
     return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
+
+
+def _sweep(travel) -> tuple[float, float]:
+    """The range of a rotary axis a plan sweeps: its travel, at most one turn."""
+    lo, hi = travel
+    return (lo, min(hi, lo + 330.0))
+
+
+def extensions(model, obs) -> list:
+    """Plan extensions a calibration can try when the file leaves parameters undetermined:
+    ``[(text, hypothetical Observations)]`` -- the same rotary positions with a second tool
+    length, and with the sphere placed 100 mm higher or 100 mm further out."""
+    where = obs.files[0].name if obs.files else "sphere"
+    rotary = {a: np.unique(np.round(obs.positions[a], 6)) for a in model.rotary_axes}
+    centres = np.unique(np.round(obs.info["centre"], 6), axis=0)
+    tool = obs.probe[0]
+    wide = {a: np.linspace(*_sweep(model.travel[a]), 13) for a in model.rotary_axes}
+    trials = [("rotary positions over the whole travel", centres, tool, wide),
+              ("a second tool length (+100 mm)", centres, tool + (0.0, 0.0, 100.0)),
+              ("a sphere placement 100 mm higher", centres[:1] + (0.0, 0.0, 100.0), tool),
+              ("a sphere placement 100 mm further out in X", centres[:1] + (100.0, 0.0, 0.0),
+               tool)]
+    out = []
+    for text, c, t, *grid in trials:
+        try:
+            poses = plan(model, c, grid[0] if grid else rotary, t)
+        except Exception:      # the trial plan leaves the travel: not a suggestion
+            continue
+        cols = simulate(model, {}, poses, t)
+        labels = {"placement": list(cols.pop("placement"))}
+        numbers = {k: np.asarray(v, float) for k, v in cols.items()}
+        out.append((text, columns_to_observations(numbers, {"placement": None}, labels, model,
+                                                  f"{where} + {text}")))
+    if obs.setup is not None:
+        known = obs.subset(np.arange(obs.n))
+        known.setup.priors = [p if k != ("tool_dz",) else (1e-3,)
+                              for p, k in zip(known.setup.priors, known.setup.keys)]
+        out.append(("the tool length calibrated to 1 um (the same plan)", known))
+    return out

@@ -1,0 +1,59 @@
+"""Plans that separate what a campaign leaves undetermined.
+
+Identifiability is a property of the plan, not of the readings: a hypothetical extension of a
+file's plan (another tool length, another sphere placement, a circle in another plane, a
+calibrated bar ...; each instrument module's ``extensions``) adds design rows without any
+measurement.  Stacking them on the campaign's normal equations shows which undetermined
+parameters the extension would determine (:func:`volerr.calibrate.estimability.estimable`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import instruments
+from ..estimate import blocks
+from . import estimability, terms
+
+
+def suggest(model, parts: list, design, labels: list, G: np.ndarray, undetermined: list,
+            u_ref: float) -> list:
+    """``[{"adds", "makes_identifiable"}]``: the extensions of the files ``parts`` (their
+    Observations) that determine some of ``undetermined`` (report names), best first."""
+    if not undetermined:
+        return []
+    names = [terms.term_name(lab) for lab in labels]
+    setup_c = [j for j, lab in enumerate(labels) if lab[0] == "setup"]
+    params = [j for j, lab in enumerate(labels) if lab[0] != "setup"]
+    m_c = len(setup_c)
+    param_keep = design.keep[len(design.data.setup_labels):]
+    kinds = instruments.kinds()
+    out = []
+    for part in parts:
+        kind = part.files[0].kind if part.files else "deviations"
+        maker = getattr(kinds.get(kind), "extensions", None)
+        if maker is None:
+            continue
+        for text, ext in maker(model, part):
+            keep_e = np.concatenate([np.ones(len(ext.setup_labels), bool), param_keep])
+            d_e = blocks.Design(model, ext, design.degree, design.ranges, keep_e)
+            w = ext.point_weights() * (u_ref / ext.reference_sigma()) ** 2
+            G_e, _, _ = blocks.normal(d_e, np.arange(ext.n), np.sqrt(w), np.zeros(3 * ext.n))
+            m_e = len(ext.setup_labels)
+            for j, u in enumerate(ext.setup_priors):
+                if u and G_e[j, j] > 0:
+                    G_e[j, j] += (u_ref / u) ** 2
+            size = m_c + m_e + len(params)
+            comb = np.zeros((size, size))
+            idx_c = np.r_[np.arange(m_c), m_c + m_e + np.arange(len(params))]
+            comb[np.ix_(idx_c, idx_c)] += G[np.ix_(setup_c + params, setup_c + params)]
+            idx_e = np.r_[m_c + np.arange(m_e), m_c + m_e + np.arange(len(params))]
+            comb[np.ix_(idx_e, idx_e)] += G_e
+            est, _ = estimability.estimable(comb)
+            now = [names[params[k]] for k in range(len(params))
+                   if est[m_c + m_e + k] and names[params[k]] in undetermined]
+            if now:
+                out.append({"adds": f"{part.files[0].name}: {text}" if part.files else text,
+                            "makes_identifiable": now})
+    out.sort(key=lambda e: -len(e["makes_identifiable"]))
+    return out
