@@ -17,9 +17,11 @@ from . import estimability, terms
 
 
 def suggest(model, parts: list, design, labels: list, G: np.ndarray, undetermined: list,
-            u_ref: float) -> list:
+            u_ref: float, identifiability: dict | None = None) -> list:
     """``[{"adds", "makes_identifiable"}]``: the extensions of the files ``parts`` (their
-    Observations) that determine some of ``undetermined`` (report names), best first."""
+    Observations) that determine some of ``undetermined`` (report names), best first; a last
+    entry ``{"adds": "no extension ...", "makes_identifiable": [], "still_undetermined",
+    "why"}`` names what none of them determines and why."""
     if not undetermined:
         return []
     names = [terms.term_name(lab) for lab in labels]
@@ -56,4 +58,29 @@ def suggest(model, parts: list, design, labels: list, G: np.ndarray, undetermine
                 out.append({"adds": f"{part.files[0].name}: {text}" if part.files else text,
                             "makes_identifiable": now})
     out.sort(key=lambda e: -len(e["makes_identifiable"]))
+    helped = {n for e in out for n in e["makes_identifiable"]}
+    left = [n for n in undetermined if n not in helped]
+    if left:
+        out.append({"adds": "no extension of these instruments' plans that was tried",
+                    "makes_identifiable": [], "still_undetermined": left,
+                    "why": _why(left, identifiability or {})})
     return out
+
+
+def _why(names: list, identifiability: dict) -> str:
+    """Plain words for parameters no extension determined."""
+    datum = [n for n in names if identifiability.get(n, {}).get("confounded_with")
+             and all(p.startswith("setup:") for p in identifiability[n]["confounded_with"])]
+    unseen = [n for n in names if not identifiability.get(n, {}).get("seen_by")]
+    parts = []
+    if datum:
+        parts.append(f"{', '.join(datum)} act on the readings exactly as the instruments' own "
+                     f"set-up unknowns do (a datum of the set-up: a sphere centre, a pivot, a "
+                     f"tool length), so no plan of these instruments determines them")
+    if unseen:
+        parts.append(f"{', '.join(unseen)} do not act on any reading of these instruments")
+    rest = [n for n in names if n not in datum and n not in unseen]
+    if rest:
+        parts.append(f"{', '.join(rest)} stay confounded with other parameters (see "
+                     f"identifiability); another instrument is needed")
+    return "; ".join(parts) + "."

@@ -128,7 +128,7 @@ class Calibration:
 
     def summary(self) -> str:
         d = self.data
-        files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} readings): RMS "
+        files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} rows): RMS "
                           f"{i['rms_residual']:.3f} um, held-out {i['heldout_rms']:.3f} um"
                           for i in d["instruments"])
         return (f"{d['layout']}: {len(d['parameters'])} parameters identified, "
@@ -201,7 +201,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
         if series:
             degree, degree_scores = choose_degree(model, obs, spl.train, None, ranges,
                                                   max_degree, weights=w, parameters=chosen)
-    keep, gauge = gauge_mask(model, obs, degree, ranges, chosen)
+    keep, gauge = gauge_mask(model, obs, degree, ranges, chosen, constants=False)
     design = blocks.Design(model, obs, degree, ranges, keep)
     labels = list(design.labels)
     if extra_terms:
@@ -222,7 +222,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
         from .plan import suggest
 
         report["plan"] = suggest(model, parts, design, labels, fit.G, report["unidentifiable"],
-                                 u_ref)
+                                 u_ref, report["identifiability"])
     report["seconds"] = round(time.perf_counter() - t0, 2)
     std = np.zeros(design.p)
     std[out.kept] = out.std
@@ -419,8 +419,8 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
     for f, fi in enumerate(files):
         pts = np.flatnonzero(file_of == f)
         inst.append({
-            "file": fi.name, "kind": fi.kind, "n": int(obs.readings_per_point()[pts].sum()),
-            "n_points": int(len(pts)), "unit": fi.unit,
+            "file": fi.name, "kind": fi.kind, "n": int(len(pts)),
+            "n_readings": int(obs.readings_per_point()[pts].sum()), "unit": fi.unit,
             "rms_residual": round(out.rms_all[f], 5),
             "heldout_rms": round(out.rms_test[f], 5), "n_heldout": out.n_test[f],
             "test_rows": sorted(int(rows_in_file[i]) for i in pts if int(i) in test_set),

@@ -194,14 +194,17 @@ def ideal_data(model: Model, data: Data, ranges: dict, n: int = 400, seed: int =
 
 
 def gauge_mask(model: Model, data: Data, degree: int, ranges: dict,
-               parameters=None) -> tuple[np.ndarray, list]:
+               parameters=None, constants: bool = True) -> tuple[np.ndarray, list]:
     """Columns of :func:`declared_design` on ``data`` kept after gauge fixing (see the module
     docstring) and the dropped labels.  The gauge is a property of the chain, found with all
     its parameters on an ideal 3-D plan with the instrument's rigid placement, whatever
     instruments ``data`` holds (so that the straightness slopes are carried by squareness on
     every instrument, as ISO 230-1's reference lines define them); every set-up column of
     ``data`` is kept.  ``parameters``: the names fitted (None: all); the others are left out
-    (held at zero)."""
+    (held at zero).  ``constants`` False: only terms of the component series are fixed by the
+    gauge (offsets, straightness slopes), every constant fitted is kept and left to the
+    identifiability analysis of the actual readings (what a sphere or a ballbar determines of
+    a location error is not what a 3-D instrument with a rigid placement determines)."""
     ideal = ideal_data(model, data, ranges)
     d = declared_design(model, ideal, degree, ranges)
     A2 = d.A.reshape(-1, d.A.shape[-1])
@@ -211,6 +214,8 @@ def gauge_mask(model: Model, data: Data, degree: int, ranges: dict,
     keep = independent_columns(_correlation(A2.T @ A2), priority_order(d.labels), GAUGE_TOL)
     chosen = np.array([p == "setup" or parameters is None or p in parameters
                        for p, _ in d.labels])
+    if not constants:
+        keep |= np.array([k is None and p != "setup" for p, k in d.labels])
     gauge = [d.labels[j] for j in np.flatnonzero(~keep & chosen)]
     keep &= chosen
     n_setup = len(data.setup_labels)

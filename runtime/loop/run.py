@@ -572,7 +572,9 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
 
 
 def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
-    """Held-out RMS before / after per file, in the file's own unit (um), per reading."""
+    """Held-out RMS before / after per file, in the file's own unit (um): the length of each
+    held-out point's residual vector (its readings: three for a sphere, one for a ballbar), as
+    the loop's RMS everywhere."""
     files = dat.files or ()
     if not files:
         return []
@@ -586,11 +588,14 @@ def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
         rb = out.r_before.reshape(-1, 3)[m]
         ra = out.r_after.reshape(-1, 3)[m]
 
+        n_pts = int(m.sum())
+
         def per_reading(r):
-            return round(1e3 * math.sqrt(float(np.sum(r ** 2)) / n_read), 4) if n_read else None
+            return round(1e3 * math.sqrt(float(np.sum(r ** 2)) / n_pts), 4) if n_pts else None
 
         out_list.append({"file": fi.name, "kind": fi.kind, "unit": fi.unit,
-                         "n": int(rows[file_of == f].sum()), "n_heldout": n_read,
+                         "n": int(np.sum(file_of == f)),
+                         "n_readings": int(rows[file_of == f].sum()), "n_heldout": n_read,
                          "rms_before_um": per_reading(rb), "rms_after_um": per_reading(ra)})
     return out_list
 
