@@ -79,8 +79,9 @@ class Calibration:
 
     def error_tables(self, n_grid: int = 41):
         """The identified error functions as error tables over the measured range and the
-        constants: ``({axis: ErrorTable}, {name: value}, {name: std})``, mm / rad.  Columns left
-        out (not fitted, not determined) are zero."""
+        constants: ``({axis: ErrorTable}, {name: value}, {name: std})``, mm / rad.  An axis
+        none of whose component errors was fitted gets no table (zero errors everywhere, no
+        range); columns left out (not determined) are zero."""
         from ..estimate.design import legendre, unit
         from ..tables.table import ErrorTable
 
@@ -91,6 +92,9 @@ class Calibration:
             q = np.linspace(*ranges[a], n_grid)
             P = legendre(unit(q, *ranges[a]), deg)
             vals, std = {}, {}
+            if not any((p, k) in index for p in model.parameters
+                       if model.parameter_axis.get(p) == a for k in range(deg + 1)):
+                continue
             for p in model.parameters:
                 if model.parameter_axis.get(p) != a:
                     continue
@@ -110,8 +114,9 @@ class Calibration:
     def write_error_tables(self, directory, inputs=()) -> Path:
         from ..tables.table import write_error_dir
 
-        tables, constants, _ = self.error_tables()
-        return write_error_dir(directory, tables, constants or None, inputs=list(inputs))
+        tables, constants, cstd = self.error_tables()
+        return write_error_dir(directory, tables, constants or None, cstd or None,
+                               inputs=list(inputs))
 
     def write_json(self, path, inputs=()) -> Path:
         import json
