@@ -63,7 +63,7 @@ def diagnose(model, obs, planes: list, swept: list = ()) -> list:
                    and p[-1] == r and p[2] == "0"]
     require(params, "nothing to diagnose in these traces")
     cal = calibrate(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
-                    extra_terms=extra)
+                    extra_terms=extra, plan=False)
     return _entries(cal, report, swept, extra)
 
 

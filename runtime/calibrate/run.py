@@ -154,19 +154,20 @@ def reading_weights(obs) -> tuple[np.ndarray, float]:
 
 def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,
               max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
-              extra_terms=(), progress=None) -> Calibration:
+              extra_terms=(), plan: bool = True, progress=None) -> Calibration:
     """Identify ``layout``'s parameters from measurement ``files`` (paths or ``KIND:FILE``;
     or an :class:`volerr.instruments.Observations`).  Returns a :class:`Calibration`.
 
     ``extra_terms``: more columns ``(name, target, basis, (factor, unit))``: a parameter
     ``name`` that adds ``name * basis`` to the declared parameter ``target`` (e.g. a reversal
     ``("RV_X", "EXX", "dir_X/2", (1e3, "um"))``); the basis is an expression in the axis
-    positions (rad for rotary axes) and the covariates of the files."""
+    positions (rad for rotary axes) and the covariates of the files.  ``plan``: suggest the
+    plan extensions that would determine what the campaign does not."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
         return _run(layout, files, parameters, degree, max_degree, seed, test_fraction,
-                    list(extra_terms), progress)
+                    list(extra_terms), plan, progress)
 
 
 def _progress(total: int, enabled):
@@ -180,7 +181,7 @@ def _progress(total: int, enabled):
 
 
 def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, extra_terms,
-         progress):
+         plan, progress):
     t0 = time.perf_counter()
     require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
     if degree is not None:
@@ -223,7 +224,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     units = {name: unit for name, _, _, unit in extra_terms}
     report = _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl,
                      u_ref, units)
-    if not extra_terms:
+    if plan and not extra_terms:
         from .plan import suggest
 
         report["plan"] = suggest(model, parts, design, labels, fit.G, report["unidentifiable"],

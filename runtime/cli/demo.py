@@ -7,6 +7,8 @@ Sections (each runs the real command or API on built-in data and writes into DIR
 3. audit of the derived models against the printed equations;
 4. probe calibration on a simulated master-sphere run (Pahk's 101-point plan);
 5. laser-tracker identification of a simulated three-point campaign, squareness, diagonals;
+   ballbar circles (ISO 230-4 G, H, diagnosis) and the rotary axes of the DMU 50 from a
+   simulated sphere probing cycle (``volerr calibrate``);
 6. five-axis DMU 50: a hemisphere finishing program compensated (full model and the thesis'
    strategy), tool-centre-point error over the (B, C) range;
 7. closing the loop: a virtual MB1 with an undeclared effect, fit, diagnosis, augmented model;
@@ -27,8 +29,8 @@ from pathlib import Path
 from ..errors import require
 from ..fileio import write_text
 
-SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "fiveaxis", "loop", "iso230_2",
-            "uncertainty")
+SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "fiveaxis",
+            "loop", "iso230_2", "uncertainty")
 
 #: one sentence per section of index.html: what it shows and how to read it
 ABOUT = {
@@ -44,6 +46,15 @@ ABOUT = {
     "identify": "Shipped laser-tracker data (3 points, 11 positions, 4 rounds per axis): the six "
                 "error motions of X, Y and Z identified, squareness from the straightness "
                 "reference lines, then the space diagonals of the measured machine.",
+    "ballbar": "Ballbar circles (ISO 230-4) in the three planes of MB1 with planted squareness "
+               "and scale errors: circular deviation G and hysteresis H per trace, the polar "
+               "plot, and the diagnosis in ISO 230-1 parameters computed from the layout's "
+               "observation model (with an uncalibrated bar only the scale mismatch of two "
+               "axes is determined).",
+    "rotary": "A touch-probe kinematics cycle on the DMU 50 (two sphere placements, B and C "
+              "over their travel) with planted location errors of both rotary axes: volerr "
+              "calibrate identifies them with their uncertainties, names what this plan cannot "
+              "separate from the sphere and tool unknowns, and the plan that would.",
     "fiveaxis": "A hemisphere finishing program on the DMU 50 compensated with the full model "
                 "and with the thesis' strategy; the tool-tip error over the (B, C) range.",
     "loop": "A virtual MB1 with an undeclared thermal growth: the loop fits the declared "
@@ -71,6 +82,10 @@ CAPTIONS = {
     "identified_X.png": "X axis: identified error motions (mean of 4 rounds, +/- 1 s).",
     "identified_Y.png": "Y axis: identified error motions.",
     "identified_Z.png": "Z axis: identified error motions.",
+    "ballbar_polar.png": "Ballbar polar plot: radial deviation about the least-squares circle "
+                         "(magnified; CCW blue, CW red), G and H per trace.",
+    "calibrate_rotary.png": "Identified location errors of B and C with expanded uncertainty "
+                            "bars (k = 2).",
     "compensate_full.png": "DMU 50 program, full model: predicted tool-tip error per block "
                            "before and after compensation.",
     "compensate_thesis.png": "DMU 50 program, thesis strategy (rotary, then linear).",
@@ -185,6 +200,85 @@ def _identify(out: Path) -> dict:
             "files": ["tracker_identified/", "tracker_errors/", "squareness.json",
                       "identified_X.png", "identified_Y.png", "identified_Z.png",
                       "diagonals_tracker.json"]}
+
+
+def _ballbar(out: Path) -> dict:
+    from ..calibrate.examples import write_ballbar_example
+
+    ex = write_ballbar_example(out / "ballbar")
+    _cli("ballbar", "evaluate", *ex["files"], "--json", out / "ballbar.json",
+         "--plot", out / "ballbar_polar.png", "--html", out / "ballbar.html")
+    rep = json.loads((out / "ballbar.json").read_text())
+    g = ", ".join(f"{t['plane']} {t['direction']} {t['G_um']:.2f}" for t in rep["traces"]
+                  if t["direction"] == "ccw")
+    truth = ex["truth"]
+    diag = []
+    for d in rep["diagnosis"]:
+        name = d["parameter"]
+        if name in truth:
+            diag.append(f"{name} {d['value']:+.1f} +/- {d['std']:.1f} urad (planted "
+                        f"{truth[name]:+.1f})")
+        elif "-" in name:
+            a, b = (n.split("@")[0] for n in name.split("-"))
+            planted = 1e-3 * (truth[a] - truth[b])
+            diag.append(f"{a}-{b} scale {d['value']:+.4f} +/- {d['std']:.4f} um/mm (planted "
+                        f"{planted:+.4f})")
+    return {"title": "ballbar circles in XY, YZ, ZX of MB1 (ISO 230-4) -> G, H, diagnosis",
+            "value": f"G (CCW) {g} um; diagnosis: " + "; ".join(diag),
+            "files": ["ballbar/", "ballbar.json", "ballbar.html", "ballbar_polar.png"]}
+
+
+def _rotary(out: Path) -> dict:
+    from ..calibrate.examples import write_sphere_example
+
+    ex = write_sphere_example(out / "sphere_DMU50.csv", "DMU50")
+    _cli("calibrate", "DMU50", ex["path"], "--json", out / "calibrate_rotary.json",
+         "--html", out / "calibrate_rotary.html", "--errors-out", out / "errors_rotary")
+    rep = json.loads((out / "calibrate_rotary.json").read_text())
+    rows = []
+    for name, v in rep["parameters"].items():
+        rows.append(f"{name} {v['value']:+.1f} +/- {v['std']:.1f} (planted "
+                    f"{ex['truth'].get(name, 0.0):+.1f}) {v['unit']}")
+    plan = "; ".join(f"{p['adds']} -> {', '.join(p['makes_identifiable'])}"
+                     for p in rep["plan"] if p["makes_identifiable"])
+    _parameter_figure(out / "calibrate_rotary.png", rep, ex["truth"])
+    return {"title": f"rotary axes of the DMU50 from a sphere probing cycle ({ex['n']} poses, "
+                     f"2 placements)",
+            "value": "; ".join(rows) + f"; not determined by this plan: "
+                     f"{', '.join(rep['unidentifiable']) or 'none'}"
+                     + (f" (would be by: {plan})" if plan else ""),
+            "files": ["sphere_DMU50.csv", "calibrate_rotary.json", "calibrate_rotary.html",
+                      "calibrate_rotary.png", "errors_rotary/"]}
+
+
+def _parameter_figure(path: Path, rep: dict, truth: dict) -> None:
+    """Identified values (k = 2 bars) beside the planted truth."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    params = rep["parameters"]
+    units = list(dict.fromkeys(v["unit"] for v in params.values()))
+    fig, axes = plt.subplots(1, len(units), figsize=(5.0 * len(units), 3.2), squeeze=False)
+    for ax, u in zip(axes[0], units):
+        names = [n for n, v in params.items() if v["unit"] == u]
+        y = np.arange(len(names))
+        ax.errorbar([params[n]["value"] for n in names], y,
+                    xerr=[2 * params[n]["std"] for n in names], fmt="o", capsize=3,
+                    label="identified (k = 2)")
+        ax.plot([truth.get(n, 0.0) for n in names], y, "x", color="C3", ms=9,
+                label="planted")
+        ax.set_yticks(y)
+        ax.set_yticklabels(names)
+        ax.invert_yaxis()
+        ax.set_xlabel(f"value / {u.replace('um', 'µm').replace('urad', 'µrad')}")
+        ax.grid(axis="x", alpha=0.3)
+        ax.legend(fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
 
 
 def _fiveaxis(out: Path) -> dict:
@@ -326,6 +420,8 @@ def run(args) -> int:
                 "audit": lambda: _audit(out),
                 "probe": lambda: _probe(out),
                 "identify": lambda: _identify(out),
+                "ballbar": lambda: _ballbar(out),
+                "rotary": lambda: _rotary(out),
                 "fiveaxis": lambda: _fiveaxis(out),
                 "loop": lambda: _loop(out),
                 "iso230_2": lambda: _iso230_2(out),

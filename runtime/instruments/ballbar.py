@@ -169,6 +169,8 @@ def extensions(model, obs) -> list:
     from ..ballbar.iso230_4 import PLANE_NAMES, plane_of
     from ..ballbar.simulate import simulate
 
+    if "pivot" not in obs.info:
+        return []
     where = obs.files[0].name if obs.files else "ballbar"
     pivot = obs.info["pivot"][0]
     radius = float(obs.info["length"][0])

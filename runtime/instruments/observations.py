@@ -291,4 +291,7 @@ def stack(parts: list) -> Observations:
         np.concatenate(file_idx),
         cat(lambda p: p.row, lambda p: np.arange(p.n)),
         tuple(files),
-        cat(lambda p: p.sigma, lambda p: np.full(p.n, np.nan)))
+        cat(lambda p: p.sigma, lambda p: np.full(p.n, np.nan)),
+        {k: np.concatenate([p.info[k] for p in parts]) for k in parts[0].info
+         if all(k in p.info and np.ndim(p.info[k]) == np.ndim(parts[0].info[k])
+                for p in parts)})

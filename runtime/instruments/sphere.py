@@ -199,6 +199,8 @@ def extensions(model, obs) -> list:
     """Plan extensions a calibration can try when the file leaves parameters undetermined:
     ``[(text, hypothetical Observations)]`` -- the same rotary positions with a second tool
     length, and with the sphere placed 100 mm higher or 100 mm further out."""
+    if "centre" not in obs.info:
+        return []
     where = obs.files[0].name if obs.files else "sphere"
     rotary = {a: np.unique(np.round(obs.positions[a], 6)) for a in model.rotary_axes}
     centres = np.unique(np.round(obs.info["centre"], 6), axis=0)
