@@ -5,7 +5,8 @@ Circle test (ISO 230-4): the pivot ball at ``centre`` (workpiece frame, mm), the
 circle of ``radius`` about it in the plane XY, YZ or ZX of the workpiece frame, the rotary axes
 held at ``rotary`` (deg); angles counted from the plane's first axis towards its second (XY: from
 +X to +Y; YZ: +Y to +Z; ZX: +Z to +X), counter-clockwise seen from the plane's positive normal.
-Rotary test (ISO 10791-6 style): one rotary axis sweeps its range (``rotary={"C": (0, 360)}``)
+Rotary test (ISO 10791-6:2014, kinematic tests with rotary and linear axes moving
+together): one rotary axis sweeps its range (``rotary={"C": (0, 360)}``)
 while the linear axes keep the tool ball at ``centre + radius * first axis of the plane`` in
 the workpiece frame, i.e. on the table; counter-clockwise = the rotary position increasing.
 
