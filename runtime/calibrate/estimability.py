@@ -2,9 +2,10 @@
 
 Estimable: a parameter (one column of the design) can be determined on its own from the
 stacked readings of all files, whatever values the others and the set-up unknowns take, iff
-its column is not in the span of all the other columns; equivalently its row of every
-null-space vector of the Gram matrix is zero.  Columns are scaled to unit length first (mm and
-rad columns differ by orders of magnitude).
+its column is not in the span of all the other columns: its relative distance to that span
+(columns scaled to unit length first: mm and rad columns differ by orders of magnitude) is
+above :data:`DISTANCE_TOL`.  Whom it is confounded with: the columns sharing its null-space
+directions.
 
 Seen by a file: the file's readings depend on the parameter after that file's own set-up
 unknowns are removed (a ballbar circle in XY does not see EZZ at all; a pure offset of a
@@ -17,8 +18,8 @@ import numpy as np
 
 #: null-space eigenvalues of the unit-scaled Gram matrix, relative to the largest
 NULL_TOL = 1e-10
-#: a column belongs to a null direction when its component there exceeds this
-MEMBER_TOL = 1e-4
+#: relative distance of a unit column to the span of the others below which it is not estimable
+DISTANCE_TOL = 1e-5
 #: a file sees a column when what its set-up leaves of the column's squared norm exceeds
 #: this fraction of the largest squared norm the column has in any file
 SEEN_TOL = 1e-9
@@ -37,17 +38,33 @@ def null_space(G: np.ndarray) -> np.ndarray:
     return V[:, w < NULL_TOL * max(float(w[-1]), 1e-300)]
 
 
+def distances(G: np.ndarray) -> np.ndarray:
+    """Relative distance (p,) of each unit-scaled column to the span of all the others (0 for
+    a zero column): ``sqrt(C_jj - C_j,o C_o,o^+ C_o,j)`` from the Gram matrix."""
+    C, nonzero = _unit(G)
+    p = len(C)
+    out = np.zeros(p)
+    for j in np.flatnonzero(nonzero):
+        o = np.r_[0:j, j + 1:p]
+        Co = C[np.ix_(o, o)]
+        w, V = np.linalg.eigh(Co)
+        keep = w > 1e-13 * max(float(w[-1]), 1e-300)
+        c = V[:, keep].T @ C[o, j]
+        out[j] = np.sqrt(max(1.0 - float(np.sum(c * c / w[keep])), 0.0))
+    return out
+
+
 def estimable(G: np.ndarray) -> tuple[np.ndarray, dict]:
     """(mask of individually estimable columns, column -> the columns it is confounded with)."""
+    est = distances(G) > DISTANCE_TOL
     N = null_space(G)
-    member = np.sqrt(np.sum(N * N, axis=1)) > MEMBER_TOL
-    _, nonzero = _unit(G)
     P = N @ N.T
     partners = {}
-    for j in np.flatnonzero(member):
+    _, nonzero = _unit(G)
+    for j in np.flatnonzero(~est & nonzero):
         w = np.abs(P[j]) / max(P[j, j], 1e-300)
         partners[int(j)] = [int(k) for k in np.argsort(-w) if k != j and w[k] > 0.05]
-    return ~member & nonzero, partners
+    return est, partners
 
 
 def seen_by(G_files: list, setup_cols: list) -> np.ndarray:

@@ -39,8 +39,10 @@ SETUP_KEYS = tuple(generated.SETUP[KIND])
 
 
 def detect(names) -> bool:
-    """A ballbar file names the pivot ball's centre."""
-    return {"pivot_x", "pivot_y", "pivot_z"} <= {n.lower() for n in names}
+    """A ballbar file has a bar reading ``dr_um`` / ``dr_mm`` or names a pivot or a bar length
+    (a file with some but not all of them is a ballbar file with a missing column)."""
+    low = {n.lower() for n in names}
+    return bool(low & {"dr_um", "dr_mm", "length_mm", "pivot_x", "pivot_y", "pivot_z"})
 
 
 def read(path, model: Model, check_travel: bool = True) -> Observations:

@@ -41,8 +41,8 @@ FRAMES = ("work", "machine")
 
 
 def detect(names) -> bool:
-    """A sphere file names the sphere's nominal centre."""
-    return {"sphere_x", "sphere_y", "sphere_z"} <= {n.lower() for n in names}
+    """A sphere file names the sphere's nominal centre (any of its columns)."""
+    return bool({n.lower() for n in names} & {"sphere_x", "sphere_y", "sphere_z"})
 
 
 def read(path, model: Model) -> Observations:
