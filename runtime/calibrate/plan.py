@@ -24,7 +24,8 @@ def suggest(model, parts: list, design, labels: list, G: np.ndarray, undetermine
     "why"}`` names what none of them determines and why."""
     if not undetermined:
         return []
-    names = [terms.term_name(lab) for lab in labels]
+    name_of = terms.namer(model, design.ranges)
+    names = [name_of(lab) for lab in labels]
     setup_c = [j for j, lab in enumerate(labels) if lab[0] == "setup"]
     params = [j for j, lab in enumerate(labels) if lab[0] != "setup"]
     m_c = len(setup_c)
@@ -71,7 +72,8 @@ def _why(names: list, identifiability: dict) -> str:
     """Plain words for parameters no extension determined."""
     datum = [n for n in names if identifiability.get(n, {}).get("confounded_with")
              and all(p.startswith("setup:") for p in identifiability[n]["confounded_with"])]
-    unseen = [n for n in names if not identifiability.get(n, {}).get("seen_by")]
+    unseen = [n for n in names if not identifiability.get(n, {}).get("seen_by")
+              and n not in datum]
     parts = []
     if datum:
         parts.append(f"{', '.join(datum)} act on the readings exactly as the instruments' own "

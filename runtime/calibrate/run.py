@@ -35,7 +35,7 @@ import numpy as np
 from .. import instruments
 from ..errors import require
 from ..estimate import blocks
-from ..estimate.design import data_ranges, gauge_mask, identifiability_gram, parameter_labels
+from ..estimate.design import data_ranges, gauge_mask, identifiability_gram
 from ..estimate.steps import choose_degree, split_points
 from ..machine.model import Model, load
 from . import estimability, terms
@@ -82,7 +82,7 @@ class Calibration:
         constants: ``({axis: ErrorTable}, {name: value}, {name: std})``, mm / rad.  An axis
         none of whose component errors was fitted gets no table (zero errors everywhere, no
         range); columns left out (not determined) are zero."""
-        from ..estimate.design import legendre, unit
+        from ..estimate.design import series_basis
         from ..tables.table import ErrorTable
 
         model, ranges, deg = self.model, self.ranges, self.degree
@@ -90,7 +90,7 @@ class Calibration:
         tables, constants, cstd = {}, {}, {}
         for a in model.axes:
             q = np.linspace(*ranges[a], n_grid)
-            P = legendre(unit(q, *ranges[a]), deg)
+            P = series_basis(model, a, q, ranges, deg)
             vals, std = {}, {}
             if not any((p, k) in index for p in model.parameters
                        if model.parameter_axis.get(p) == a for k in range(deg + 1)):
@@ -385,7 +385,8 @@ def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
 
 def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl, u_ref,
             units) -> dict:
-    names = [terms.term_name(lab) for lab in labels]
+    name_of = terms.namer(model, ranges)
+    names = [name_of(lab) for lab in labels]
     std_of = dict(zip(out.kept.tolist(), out.std.tolist()))
     files = obs.files or (instruments.FileInfo("data", "deviations"),)
     params, unident, ident = {}, [], {}
@@ -441,7 +442,7 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
         "fitted": list(chosen),
         "degree": int(degree),
         "degree_cv_rms_um": {str(k): round(1e3 * v, 4) for k, v in degree_scores.items()},
-        "gauge_fixed": [terms.term_name(g) for g in gauge],
+        "gauge_fixed": [name_of(g) for g in gauge],
         "variance_factor": round(out.s0 ** 2, 4),
         "dof": out.dof,
         "method": ("weighted least squares (weights 1/u^2 per reading) over all files; "

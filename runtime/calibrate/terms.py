@@ -11,6 +11,11 @@ are reported as
   function over the range (the Legendre terms are orthogonal on it), per mm of a linear axis
   or per deg of a rotary axis (``um/mm``, ``urad/mm``, ``um/deg``, ``urad/deg``);
 * ``NAME@P2`` ... ``NAME@Pk`` = ``c_k`` (um / urad).
+
+A rotary axis measured over (nearly) a full turn has Fourier series instead
+(:func:`volerr.estimate.design.series_basis`): ``NAME@offset``, ``NAME@cos1``, ``NAME@sin1``,
+``NAME@cos2`` ... (um / urad); the first harmonic of its radial and tilt errors is its
+location error (ISO 230-7), fixed there by the gauge.
 """
 
 from __future__ import annotations
@@ -53,14 +58,32 @@ def resolve(spec: str | None, model, default: str = "all") -> list:
     return [p for p in model.parameters if p in chosen]
 
 
-def term_name(label) -> str:
-    """Report name of a design column label ``(parameter, degree or None)``."""
+def term_name(label, fourier: bool = False) -> str:
+    """Report name of a design column label ``(parameter, degree or None)``; ``fourier``: the
+    parameter's series is a Fourier series (a periodic rotary axis: ``@cos1``, ``@sin1``,
+    ``@cos2`` ...)."""
     p, k = label
     if p == "setup":
         return f"setup:{k}"
     if k is None or k == "extra":
         return p
-    return f"{p}@offset" if k == 0 else f"{p}@slope" if k == 1 else f"{p}@P{k}"
+    if k == 0:
+        return f"{p}@offset"
+    if fourier:
+        return f"{p}@{'cos' if k % 2 else 'sin'}{(k + 1) // 2}"
+    return f"{p}@slope" if k == 1 else f"{p}@P{k}"
+
+
+def namer(model, ranges: dict):
+    """``label -> report name`` of this model and measured range (Fourier series of the
+    periodic rotary axes: :func:`volerr.estimate.design.periodic`)."""
+    from ..estimate.design import periodic
+
+    def name(label) -> str:
+        axis = model.parameter_axis.get(label[0]) if label[0] != "setup" else None
+        return term_name(label, bool(axis) and periodic(model, axis, ranges))
+
+    return name
 
 
 def is_angular(name: str) -> bool:
@@ -71,10 +94,12 @@ def is_angular(name: str) -> bool:
 def report(label, value: float, std: float, model, ranges: dict, unit=None) -> dict:
     """``{"value", "unit", "std"}`` of a column's coefficient (mm or rad inside; ``unit``:
     (factor, unit) of an extra term)."""
+    from ..estimate.design import periodic
+
     p, k = label
     angular = is_angular(p)
     factor, unit = unit or ((1e6, "urad") if angular else (1e3, "um"))
-    if k == 1:
+    if k == 1 and not periodic(model, model.parameter_axis[p], ranges):
         axis = model.parameter_axis[p]
         lo, hi = ranges[axis]
         factor *= 2.0 / (hi - lo)

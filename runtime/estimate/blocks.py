@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .design import SV_TOL, declared_design, legendre, twist_sensitivity, unit
+from .design import SV_TOL, declared_design, series_basis, twist_sensitivity
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
 BLOCK = 8192
@@ -68,7 +68,7 @@ class Design:
         sens = np.moveaxis(sub.sensitivity(self.model), 0, -1)         # (3, P, n)
         tw = twist_sensitivity(self.model, sub)
         setup = np.moveaxis(sub.setup_columns(tw), 0, -1)              # (3, m, n)
-        bases = {a: legendre(unit(sub.positions[a], *self.ranges[a]), self.degree).T
+        bases = {a: series_basis(self.model, a, sub.positions[a], self.ranges, self.degree).T
                  for a in self.model.axes}
         At = np.empty((self.p, 3, n))
         for i, (src, j, axis, k) in enumerate(self._ops):

@@ -61,6 +61,37 @@ def legendre(u, degree: int) -> np.ndarray:
     return out
 
 
+#: measured ranges (deg) over which a rotary axis' component errors are Fourier series: the
+#: axis turns (nearly) once round, its errors repeat every revolution.  Over several turns the
+#: data tell positions a turn apart from each other and the series stays a polynomial.
+FULL_TURN_DEG = (300.0, 370.0)
+
+
+def periodic(model: Model, axis: str, ranges: dict) -> bool:
+    """A rotary axis measured over about one full turn: its component errors are Fourier
+    series in the angle (ISO 230-7: error motions repeat every revolution)."""
+    lo, hi = ranges[axis]
+    return (axis in model.rotary_axes
+            and FULL_TURN_DEG[0] <= hi - lo <= FULL_TURN_DEG[1])
+
+
+def series_basis(model: Model, axis: str, q, ranges: dict, degree: int) -> np.ndarray:
+    """(N, degree + 1) basis of a component error of ``axis`` at positions ``q`` (mm | deg):
+    Legendre polynomials P_0 .. P_degree over the measured range, or for a periodic rotary
+    axis (:func:`periodic`) the Fourier terms 1, cos q, sin q, cos 2q, sin 2q, ... (the first
+    harmonic of a radial or tilt error is the axis' location error, ISO 230-7: the gauge puts
+    it there)."""
+    if not periodic(model, axis, ranges):
+        return legendre(unit(q, *ranges[axis]), degree)
+    th = np.deg2rad(np.asarray(q, dtype=float))
+    out = np.empty((len(th), degree + 1))
+    out[:, 0] = 1.0
+    for k in range(1, degree + 1):
+        h = (k + 1) // 2
+        out[:, k] = np.cos(h * th) if k % 2 else np.sin(h * th)
+    return out
+
+
 def data_ranges(model: Model, data: Data) -> dict:
     """Axis -> (lo, hi) of the measured positions (widened when an axis does not move)."""
     out = {}
@@ -102,7 +133,7 @@ class Design:
 
 def parameter_labels(model: Model, degree: int) -> list:
     """Labels of the parameter columns: ``(name, None)`` for a constant, ``(name, k)`` for the
-    Legendre term P_k of a component error."""
+    term k of a component error's series (:func:`series_basis`)."""
     labels = []
     for p in model.parameters:
         labels += ([(p, None)] if model.parameter_axis.get(p) is None
@@ -119,7 +150,7 @@ def declared_design(model: Model, data: Data, degree: int, ranges: dict) -> Desi
     labels = [("setup", key) for key in data.setup_labels] + parameter_labels(model, degree)
     A = np.empty((data.n, 3, len(labels)))
     A[:, :, :setup.shape[2]] = setup
-    bases = {a: legendre(unit(data.positions[a], *ranges[a]), degree) for a in model.axes}
+    bases = {a: series_basis(model, a, data.positions[a], ranges, degree) for a in model.axes}
     i = setup.shape[2]
     for j, p in enumerate(model.parameters):
         axis = model.parameter_axis.get(p)

@@ -104,7 +104,7 @@ class Report:
         the start of the measured range (their constants belong to the instrument placement);
         straightness slopes are carried by squareness (gauge: see :mod:`volerr.estimate.design`).
         ``which="before"``: the declared model's own fit (effects unmodelled, no std)."""
-        from ..estimate.design import legendre, unit
+        from ..estimate.design import series_basis
         from ..tables.table import ErrorTable
 
         fg = self.figures
@@ -117,7 +117,7 @@ class Report:
         tables, constants = {}, {}
         for a in model.axes:
             q = np.linspace(*ranges[a], n_grid)
-            P = legendre(unit(q, *ranges[a]), deg)
+            P = series_basis(model, a, q, ranges, deg)
             vals, std = {}, {}
             for p in model.parameters:
                 if model.parameter_axis.get(p) != a:
@@ -579,6 +579,7 @@ def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
     if not files:
         return []
     file_of = dat.file if dat.file is not None else np.zeros(dat.n, int)
+    row_of = dat.row if dat.row is not None else np.arange(dat.n)
     rows = dat.readings_per_point()
     ft = file_of[spl.test]
     out_list = []
@@ -596,7 +597,8 @@ def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
         out_list.append({"file": fi.name, "kind": fi.kind, "unit": fi.unit,
                          "n": int(np.sum(file_of == f)),
                          "n_readings": int(rows[file_of == f].sum()), "n_heldout": n_read,
-                         "rms_before_um": per_reading(rb), "rms_after_um": per_reading(ra)})
+                         "rms_before_um": per_reading(rb), "rms_after_um": per_reading(ra),
+                         "test_rows": sorted(int(r) for r in row_of[spl.test][m])})
     return out_list
 
 

@@ -10,8 +10,10 @@ def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "volerr", "demo", "--out", str(out)],
                           capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
+    from volerr.cli.demo import SECTIONS
+
     summary = json.loads((out / "summary.json").read_text())
-    assert len(summary) == 9
+    assert len(summary) == len(SECTIONS)
     for section in summary:
         for f in section["files"]:
             assert (out / f).exists(), f
@@ -20,7 +22,17 @@ def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
     cal = json.loads((out / "probe_cal.json").read_text())
     assert 0.99 < cal["r_eff_mm"] < 1.01
     html = (out / "index.html").read_text()
-    assert html.count("<section") == 9 and "loop.html" in html
+    assert html.count("<section") == len(SECTIONS) and "loop.html" in html
+    # the instrument sections recover the planted truth within 3 standard uncertainties
+    from volerr.calibrate.examples import BALLBAR_TRUTH, SPHERE_TRUTH
+
+    diag = {d["parameter"]: d for d in json.loads((out / "ballbar.json").read_text())["diagnosis"]}
+    for name in ("EC0Y", "EB0Z", "EA0Z"):
+        assert abs(diag[name]["value"] - BALLBAR_TRUTH[name]) < 3 * diag[name]["std"], diag[name]
+    rot = json.loads((out / "calibrate_rotary.json").read_text())
+    assert len(rot["parameters"]) >= 4
+    for name, v in rot["parameters"].items():
+        assert abs(v["value"] - SPHERE_TRUTH[name]) < 3 * v["std"], (name, v)
     assert html.count("<figcaption>") == html.count("<img ") > 10
     assert "map_MB1_random.png" in html  # the random component is shown
 
