@@ -6,7 +6,8 @@ A trace is one circle run in one direction: the readings of one file with the sa
 
 * ``theta_i``: the angle of the nominal tool-ball centre about the pivot in the trace's plane
   (from the plane's first axis towards its second: XY from +X to +Y, YZ from +Y to +Z, ZX from
-  +Z to +X; the plane is the one whose normal the nominal positions do not move along);
+  +Z to +X; the plane is the one whose normal the nominal positions do not move along); for a
+  trace in which a rotary axis sweeps (ISO 10791-6), the position of that axis;
 * ``r_i = length_mm + dr_i``: the actual bar length, so the actual path point is
   ``P_i = r_i (cos theta_i, sin theta_i)`` about the pivot.
 
@@ -18,6 +19,8 @@ Quantities (um):
 * radial deviation ``F``: the deviation of the actual path from the nominal circle about the
   pivot, ``F_max = max dr``, ``F_min = min dr``;
 * ``centre_offset``: the least-squares centre minus the pivot, in the plane (um);
+* ``range``: ``F_max - F_min``, the deviation range of the reading (for a rotary sweep the
+  quantity ISO 10791-6 reports);
 * circular hysteresis ``H`` (a clockwise and a counter-clockwise trace of the same placement):
   the largest radial difference of the two paths at the same angle,
   ``max_i |dr_ccw(theta_i) - dr_cw(theta_i)|`` over the counter-clockwise readings, the clockwise
@@ -79,12 +82,18 @@ def traces(obs, model) -> list:
                 continue
             idx = np.flatnonzero(m)
             rel = t[idx] - pivot[idx]
-            k = plane_of(rel)
-            i, j = PLANE_AXES[k]
-            theta = np.arctan2(rel[:, j], rel[:, i])
+            swept = [a for a in model.rotary_axes if np.ptp(obs.positions[a][idx]) > 1.0]
+            if swept:       # ISO 10791-6: the deviation against the swept axis' angle
+                theta = np.deg2rad(obs.positions[swept[0]][idx])
+                plane = f"{swept[0]} sweep"
+            else:
+                k = plane_of(rel)
+                i, j = PLANE_AXES[k]
+                theta = np.arctan2(rel[:, j], rel[:, i])
+                plane = PLANE_NAMES[k]
             require(len(idx) >= 8, f"{where}: trace {pl} ({'ccw' if d > 0 else 'cw'}) has "
                                    f"{len(idx)} readings; ISO 230-4 needs a full circle")
-            out.append(Trace(where, str(pl), int(d), PLANE_NAMES[k], float(length[idx[0]]),
+            out.append(Trace(where, str(pl), int(d), plane, float(length[idx[0]]),
                              theta, obs.info["dr"][idx], idx, pivot[idx[0]]))
     return out
 
@@ -117,6 +126,7 @@ def evaluate(tr: Trace) -> dict:
             "radius_mm": tr.radius_mm, "direction": "ccw" if tr.direction > 0 else "cw",
             "n": int(len(tr.dr)), "G_um": float(1e3 * (d.max() - d.min())),
             "F_max_um": float(1e3 * tr.dr.max()), "F_min_um": float(1e3 * tr.dr.min()),
+            "range_um": float(1e3 * np.ptp(tr.dr)),
             "centre_offset_um": [float(1e3 * a), float(1e3 * b)]}
 
 

@@ -1,6 +1,8 @@
 """The ballbar polar plot (ISO 230-4 style): the radial deviation of each trace about its
 least-squares circle (centring removed, as G is evaluated), magnified, counter-clockwise and
-clockwise overlaid, with G and H in the legend.  Angles as in :mod:`volerr.ballbar.iso230_4`."""
+clockwise overlaid, with G and H in the legend; a rotary sweep (ISO 10791-6) is drawn as its
+reading against the swept axis' angle (its first harmonic is the axis' location error: not
+removed).  Angles as in :mod:`volerr.ballbar.iso230_4`."""
 
 from __future__ import annotations
 
@@ -19,6 +21,8 @@ def polar_plot(traces: list, results: list, path, title: str = "") -> None:
     from .iso230_4 import least_squares_circle
 
     def about_lsc(t):
+        if t.plane.endswith("sweep"):       # ISO 10791-6: the reading itself against the angle
+            return t.theta, 1e3 * t.dr
         r = t.radius_mm + t.dr
         x, y = r * np.cos(t.theta), r * np.sin(t.theta)
         a, b, rho = least_squares_circle(x, y)
@@ -50,11 +54,15 @@ def polar_plot(traces: list, results: list, path, title: str = "") -> None:
         ax.set_ylim(0, ring + 4 * div)
         ax.set_yticks([ring - 2 * div, ring, ring + 2 * div])
         ax.set_yticklabels([f"{-2 * div:g}", "0", f"+{2 * div:g} µm"], fontsize=9)
-        a, b = plane[0], plane[1]
         ax.set_xticks(np.deg2rad([0, 90, 180, 270]))
-        ax.set_xticklabels([f"+{a}", f"+{b}", f"-{a}", f"-{b}"])
+        if plane.endswith("sweep"):
+            ax.set_xticklabels([f"{plane[0]} = {v}°" for v in (0, 90, 180, 270)])
+        else:
+            a, b = plane[0], plane[1]
+            ax.set_xticklabels([f"+{a}", f"+{b}", f"-{a}", f"-{b}"])
         radius = next(t.radius_mm for t in traces if t.plane == plane)
-        ax.set_title(f"{plane} plane, radius {radius:g} mm\n{div:g} µm / division", fontsize=10)
+        what = plane if plane.endswith("sweep") else f"{plane} plane"
+        ax.set_title(f"{what}, radius {radius:g} mm\n{div:g} µm / division", fontsize=10)
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), fontsize=9, frameon=False)
     if title:
         fig.suptitle(title, fontsize=11)

@@ -62,6 +62,12 @@ def trace(model, plane: str, radius: float, centre, tool=(0.0, 0.0, 0.0), rotary
         rot = rotary
         angle = np.rad2deg(np.mod(theta, 2 * np.pi))
     pos = model.linear_positions(targets, rot, tool)
+    for a in model.axes:
+        lo, hi = model.travel[a]
+        bad = np.flatnonzero((pos[a] < lo - 1e-9) | (pos[a] > hi + 1e-9))
+        require(len(bad) == 0, f"the trace needs {a} = {pos[a][bad[0]] if len(bad) else 0:g}, "
+                               f"outside the travel [{lo:g}, {hi:g}] of {model.name}: move "
+                               f"the centre or shorten the radius")
     return {"positions": pos, "pivot": centre, "angle_deg": angle, "direction": direction}
 
 
