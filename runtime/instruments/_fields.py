@@ -145,6 +145,18 @@ def uncertainty(find: Finder, n: int, default_um: float, where: str) -> np.ndarr
     return u
 
 
+def known_uncertainty(find: Finder, name: str, where: str) -> float | None:
+    """Standard uncertainty (mm) of a set-up value the user knows (a calibrated bar length, a
+    tool length from a presetter) from the one-valued column ``<name>_um``, else None (the
+    set-up value is an unknown)."""
+    h = find(name, ("_um",), f"{name}_um")
+    if h is None:
+        return None
+    v = np.unique(find.cols[h])
+    require(len(v) == 1 and v[0] > 0, f"{where}: {name}_um must be one positive value")
+    return float(v[0]) * 1e-3
+
+
 def labels(find: Finder, name: str, raw: dict, n: int) -> np.ndarray | None:
     """A label column (numbers or text, e.g. ``placement``) as strings, or None when absent."""
     h = find.name(name)

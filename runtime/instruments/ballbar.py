@@ -70,7 +70,8 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     require(np.all(length > 0), f"{where}: length_mm must be positive")
     dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading")[:, 0]
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
-    length_u = _length_uncertainty(find, where)
+    # a bar calibrated with its calibrator: its length offset known to within length_u_um
+    length_u = f.known_uncertainty(find, "length_u", where)
     direction = _direction(find, n, where)
     placement = f.labels(find, "placement", raw, n)
     t = model.nominal_position(pos, probe)
@@ -101,18 +102,6 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
                         setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u,
                         info=info)
-
-
-def _length_uncertainty(find, where: str) -> float | None:
-    """Standard uncertainty (mm) of the bar length from column ``length_u_um`` (a bar
-    calibrated with its calibrator: its length offset is then known to within it), else None
-    (the length offset is a set-up unknown of every placement)."""
-    h = find("length_u", ("_um",), "length_u_um")
-    if h is None:
-        return None
-    v = np.unique(find.cols[h])
-    require(len(v) == 1 and v[0] > 0, f"{where}: length_u_um must be one positive value")
-    return float(v[0]) * 1e-3
 
 
 def _direction(find, n: int, where: str) -> np.ndarray:

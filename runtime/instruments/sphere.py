@@ -72,7 +72,8 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     require(placement is not None, f"{where}: no placement column: give each reading the "
                                    f"label of its sphere placement (column placement)")
     frame = _frames(find, raw, n, where)
-    tool_u = _tool_uncertainty(find, where)
+    # a tool measured on a presetter or a tool setter: its length error known to within it
+    tool_u = f.known_uncertainty(find, "tool_u", where)
     t = model.nominal_position(pos, probe)
     lin = generated.sphere(t[:, 0], t[:, 1], t[:, 2], centre[:, 0], centre[:, 1],
                            centre[:, 2])                   # (3, 7, n)
@@ -97,17 +98,6 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, reading - nominal, covs, warnings, proj=proj,
                         setup=setup, files=(FileInfo(where, KIND, "um", 3),), sigma=u,
                         info={"centre": centre, "placement": placement, "frame": frame})
-
-
-def _tool_uncertainty(find, where: str) -> float | None:
-    """Standard uncertainty (mm) of the tool length from column ``tool_u_um`` (a tool measured
-    on a presetter or a tool setter: its length error is then known), else None (unknown)."""
-    h = find("tool_u", ("_um",), "tool_u_um")
-    if h is None:
-        return None
-    v = np.unique(find.cols[h])
-    require(len(v) == 1 and v[0] > 0, f"{where}: tool_u_um must be one positive value")
-    return float(v[0]) * 1e-3
 
 
 def _frames(find, raw: dict, n: int, where: str) -> np.ndarray:
