@@ -131,3 +131,39 @@ def add_vector(parser, flag: str, help: str, default=None, required: bool = Fals
     act = parser.add_argument(flag, nargs="+", action=_Vector, default=default,
                               required=required, metavar=metavar, help=help)
     act.vector = True
+
+
+# ---------------------------------------------------------------------------------------------
+# the same option for the same thing in every command
+def add_json(parser, what: str = "the results") -> None:
+    """``--json F``: optional everywhere."""
+    parser.add_argument("--json", metavar="F", help=f"write {what} (JSON)")
+
+
+def add_plot(parser, what: str = "the plot", *aliases: str, required: bool = False) -> None:
+    """``--plot F.png`` (old spellings in ``aliases`` keep working)."""
+    parser.add_argument("--plot", *aliases, dest="plot", metavar="F.png", required=required,
+                        help=f"write {what} (PNG)")
+
+
+def add_html(parser, what: str = "a one-page report with the figures") -> None:
+    """``--html F.html``: optional everywhere."""
+    parser.add_argument("--html", metavar="F.html", help=f"write {what} (HTML, figures "
+                                                         f"embedded, no network needed)")
+
+
+def add_errors_out(parser, what: str, *aliases: str, required: bool = False) -> None:
+    """``--errors-out DIR`` for every error directory a command writes (``map --errors DIR``
+    reads it); ``aliases``: the command's former spelling, still accepted."""
+    parser.add_argument("--errors-out", *aliases, dest="errors_out", metavar="DIR",
+                        required=required,
+                        help=f"write {what} as an error directory (X.csv ... constants.csv; "
+                             f"'volerr formats tables'); created when missing, its parent "
+                             f"must exist")
+
+
+def add_force(parser) -> None:
+    """``--force``: a folder output may replace files that were there before the run."""
+    parser.add_argument("--force", action="store_true",
+                        help="let an output folder replace files that exist there already "
+                             "(without it such a file is named and nothing is written)")

@@ -87,6 +87,9 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="volerr-demo", help="output folder (default volerr-demo)")
     p.add_argument("--only", nargs="+", choices=SECTIONS, help="run only these sections")
+    from ._common import add_force
+
+    add_force(p)
     p.set_defaults(func=run)
 
 
@@ -311,7 +314,7 @@ def run(args) -> int:
     from ..fileio import Outputs
 
     final = Path(args.out)
-    outs = Outputs().folder("--out", final).check()
+    outs = Outputs(force=args.force).folder("--out", final).check()
     results = []
     t0 = time.perf_counter()
     here = os.getcwd()

@@ -24,7 +24,8 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
     p.add_argument("--lines", nargs="+", choices=diagonals.KINDS, default=list(diagonals.KINDS),
-                   help="which lines (default: all)")
+                   help="which lines: space diagonals, face diagonals, axis-parallel "
+                        "lines")
     p.add_argument("--profile-points", type=int, default=21, metavar="N",
                    help="points along each line for the profile (default 21)")
     p.add_argument("--json", metavar="F", help="results with profiles as JSON")

@@ -1,4 +1,4 @@
-"""``volerr squareness LAYOUT DIR --out DIR2``: squareness from straightness reference lines.
+"""``volerr squareness LAYOUT DIR --errors-out DIR2``: squareness from straightness reference lines.
 
 Reads the error tables of DIR (``X.csv``, ``Y.csv``, ``Z.csv`` ..., e.g. written by ``volerr
 identify``), fits the least-squares reference straight line of every straightness, writes the
@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..errors import require
 from ..units import URAD_PER_RAD
+from ._common import add_errors_out, add_force, add_json
 
 
 def register(sub) -> None:
@@ -21,12 +22,14 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("directory", help="error directory with the straightness tables")
-    p.add_argument("--out", required=True, help="output error directory (must differ from DIR)")
+    add_errors_out(p, "the squareness with the slope-free tables (must differ from DIR)",
+                   "--out", required=True)
+    add_force(p)
     p.add_argument("--tables-are", choices=("carrier", "component"), default="carrier",
                    help="carrier: motions of the component carrying the points, as written by "
                         "'volerr identify' (default); component: ISO component errors (tool "
                         "relative to workpiece)")
-    p.add_argument("--json", help="write the squareness and the slopes (JSON, urad)")
+    add_json(p, "the squareness and the slopes (urad)")
     p.set_defaults(func=run)
 
 
@@ -38,11 +41,11 @@ def run(args) -> int:
     from ..tables.table import read_error_dir, table_to_csv, write_constants
 
     layout = read_layout(args.layout)
-    src, out = Path(args.directory), Path(args.out)
+    src, out = Path(args.directory), Path(args.errors_out)
     require(src.exists(), f"error directory {src} does not exist")
     require(src.is_dir(), f"{src} is a file: give the error directory (X.csv, Y.csv ...)")
     require(not (out.exists() and out.resolve() == src.resolve()),
-            "--out must differ from the input directory (inputs are never overwritten)")
+            "--errors-out must differ from the input directory (inputs are never overwritten)")
     tables, (consts, cstd, _) = read_error_dir(src, axes=layout.axis_names)
     require(tables, f"{src}: no error tables")
     values, std, corrected, slopes = squareness(tables, layout, args.tables_are)
@@ -50,14 +53,15 @@ def run(args) -> int:
                     f"in X.csv and EXY in Y.csv, EB0Z EZX and EXZ, EA0Z EZY and EYZ)")
     inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
     texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
-    outs = Outputs(inputs).folder("--out", out, files=[*texts, "constants.csv"]) \
+    outs = Outputs(inputs, force=args.force) \
+        .folder("--errors-out", out, files=[*texts, "constants.csv"]) \
         .file("--json", args.json).check()
     merged = {k: v for k, v in consts.items() if k not in values}
     merged_std = {k: v for k, v in cstd.items() if k in merged}
     merged.update(values)
     merged_std.update(std)
     with outs:
-        staged = outs.path("--out")
+        staged = outs.path("--errors-out")
         for name, text in texts.items():
             write_text(staged / name, text, inputs=inputs)
         write_constants(staged / "constants.csv", merged, inputs=inputs, std=merged_std)
