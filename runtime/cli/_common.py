@@ -167,3 +167,43 @@ def add_force(parser) -> None:
     parser.add_argument("--force", action="store_true",
                         help="let an output folder replace files that exist there already "
                              "(without it such a file is named and nothing is written)")
+
+
+def add_identification(parser, instrument: str = "the measuring instrument") -> None:
+    """``--machine --instrument --operator --date``: the identification of a certificate."""
+    g = parser.add_argument_group("certificate identification (printed on the page and in "
+                                  "the JSON)")
+    g.add_argument("--machine", metavar="TEXT",
+                   help="the machine tested: make, model, serial number")
+    g.add_argument("--instrument", metavar="TEXT",
+                   help=f"{instrument}: make, model, serial number, calibration")
+    g.add_argument("--operator", metavar="TEXT", help="who made the test")
+    g.add_argument("--date", metavar="YYYY-MM-DD",
+                   help="date of the test (not given: the date of the evaluation)")
+
+
+def identification_from_args(args, conditions: dict | None = None):
+    """:class:`volerr.certificate.Identification` of the options of :func:`add_identification`
+    (the date checked)."""
+    import datetime
+
+    from ..certificate import Identification
+
+    kw = {}
+    if args.date:
+        try:
+            kw["date"] = datetime.date.fromisoformat(args.date).isoformat()
+        except ValueError:
+            raise InputError(f"--date {args.date!r}: expected YYYY-MM-DD") from None
+    return Identification(args.machine, args.instrument, args.operator,
+                          conditions=dict(conditions or {}), **kw)
+
+
+def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
+    """A number option checked to be finite and within [low, high] (None passes)."""
+    import math
+
+    if value is not None:
+        require(math.isfinite(value) and low <= value <= high,
+                f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
+    return value

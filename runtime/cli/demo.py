@@ -170,7 +170,7 @@ def _identify(out: Path) -> dict:
     measured = out / "tracker_identified"
     for axis in ("X", "Y", "Z"):
         _cli("identify", "MB1", "--axis", axis, example_path(axis), "--fit", "poly",
-             "--out", measured / f"{axis}.csv", "--plot", out / f"identified_{axis}.png")
+             "--errors-out", measured, "--plot", out / f"identified_{axis}.png")
     _cli("squareness", "MB1", measured, "--out", out / "tracker_errors",
          "--json", out / "squareness.json")
     sq = json.loads((out / "squareness.json").read_text())

@@ -45,6 +45,7 @@ from . import blocks
 from . import candidates as cands
 from . import select as sel
 from ..errors import InputError, require
+from ..fileio import sniff_delimiter
 from .fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
                   identifiability_gram, point_norm, require_points, rms, rows_of,
                   weakly_determined_gram)
@@ -71,9 +72,7 @@ def read_deviations(path, model: Model) -> Data:
             fh.seek(0)
             # comma-separated as INTERFACE.md says; a header without commas but with
             # semicolons or tabs (spreadsheet exports) is read with that separator
-            delim = ","
-            if "," not in first:
-                delim = ";" if ";" in first else "\t" if "\t" in first else ","
+            delim = sniff_delimiter(first)
             rows = [r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)]
     except (UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{p.name}: not a readable CSV ({exc})") from None
@@ -819,9 +818,13 @@ def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
 def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection, aug, out,
                  effects, warnings, paths, test_fraction) -> dict:
     nb, na = point_norm(out.r_before), point_norm(out.r_after)
-    inl = out.test_inliers
-    thresh = OUTLIER_Z * math.sqrt(out.sigma2)
-    far = np.union1d(np.flatnonzero(point_norm(out.res_after) > thresh), robust.outliers)
+    # outliers: off the FINAL fit by more than OUTLIER_Z of its own robust scale (median of
+    # the 3-D residual length = 1.538 sigma per coordinate), not the declared fit's flags
+    res_len = point_norm(out.res_after)
+    scale = max(float(np.median(res_len)) / 1.538, 1e-12)
+    thresh = OUTLIER_Z * scale
+    far = np.flatnonzero(res_len > thresh)
+    inl = na <= thresh
     variables = {**{a: dat.positions[a] for a in model.axes}, **dat.covariates}
     analysis = {v: {"before_trend_um": _trend(out.res_before, x),
                     "after_trend_um": _trend(out.res_after, x)}
@@ -850,9 +853,13 @@ def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection
         "gauge_fixed": _gauge_text(decl.gauge),
         "noise_estimate_um": round(1e3 * math.sqrt(out.sigma2), 4),
         "outliers": {"threshold_um": round(1e3 * thresh, 4), "count": int(len(far)),
+                     "z": OUTLIER_Z, "robust_sigma_um": round(1e3 * scale, 4),
                      "data_rows": [int(i) + 1 for i in far[:100]],
-                     "method": f"IRLS, weight 1 up to {ROBUST_K:g} robust sigma, bisquare to 0 "
-                               f"at {2 * ROBUST_K:g}; flagged beyond {OUTLIER_Z:g} sigma"},
+                     "method": f"counted on the final (augmented) fit: 3-D residual length "
+                               f"beyond {OUTLIER_Z:g} robust sigma (sigma per coordinate = "
+                               f"median length / 1.538); the fits weight points by IRLS on "
+                               f"the declared fit (weight 1 up to {ROBUST_K:g} robust sigma, "
+                               f"bisquare to 0 at {2 * ROBUST_K:g})"},
         "candidates_tested": selection.n_candidates,
         "candidate_families": sorted({s.cand.kind for s in selection.first}),
         "residual_analysis": analysis,

@@ -11,15 +11,7 @@ import html
 from ..units import UM_PER_MM
 
 
-def num(value, spec: str) -> str:
-    """``format(value, spec)`` without negative zero: a value that prints as zero (-0.0 or
-    a tiny negative rounded away) prints with the sign of +0, e.g. ``+0.000``, not ``-0.000``."""
-    s = format(float(value), spec)
-    try:
-        zero = float(s) == 0.0
-    except ValueError:
-        return s
-    return format(0.0, spec) if zero else s
+from ..units import num  # noqa: F401  (no negative zero; re-exported)
 
 
 def machine_text(spec=None, errors=None, table_std: str = "") -> str:
