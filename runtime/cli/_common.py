@@ -69,17 +69,7 @@ def layout_inputs(layout) -> list:
     return [p] if p.is_file() else []
 
 
-def progress(iterable, total=None, **kw):
-    """``tqdm`` progress on stderr when stderr is a terminal; the plain iterable otherwise."""
-    import sys
-
-    if not sys.stderr.isatty():
-        return iterable
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover
-        return iterable
-    return tqdm(iterable, total=total, file=sys.stderr, leave=False, **kw)
+from ..progress import bar, progress  # noqa: E402,F401  (one rule: volerr.progress)
 
 
 #: the largest coordinate accepted on the command line (mm)

@@ -209,10 +209,10 @@ def fig_interactions(fg, sources) -> str | None:
     values = {**rotary_rad(model, dat.positions), **dat.covariates}
     covs = []
     for src in sources:
-        x, label = _natural(src.get("kind", ""), {"covariate": src["covariate"]}, model, dat,
-                            values)
-        if label != "point" and label not in [c[1] for c in covs]:
-            covs.append((x, label))
+        x, xlab = _natural(src.get("kind", ""), {"covariate": src["covariate"]}, model, dat,
+                           values)
+        if xlab != "point" and xlab not in [c[1] for c in covs]:
+            covs.append((x, xlab))
         if len(covs) == 3:
             break
     if not covs:
@@ -224,12 +224,12 @@ def fig_interactions(fg, sources) -> str | None:
     fig, axes = figure(len(covs), len(axes_names), height=2.8 * len(covs) + 0.6,
                        squeeze=False, sharey=True)
     lim = max(np.max(np.abs(res[:, k])), 1e-6) * 1.05
-    for i, (x, label) in enumerate(covs):
+    for i, (x, xlab) in enumerate(covs):
         for j, a in enumerate(axes_names):
             ax = axes[i, j]
             sc = ax.scatter(x[idx], res[:, k], c=dat.positions[a][idx], s=3, cmap="viridis")
             ax.set_ylim(-lim, lim)
-            ax.set_xlabel(label)
+            ax.set_xlabel(xlab)
             if j == 0:
                 ax.set_ylabel(label(f"residual d{'xyz'[k]} after", "um"))
             fig.colorbar(sc, ax=ax, label=label(a, _unit_label(a, model)))

@@ -582,11 +582,11 @@ def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
     for c in ("phi_deg", "theta_deg", "probe_um"):
         require(c in header, f"{path}: missing column {c!r}")
     idx = [header.index(c) for c in ("phi_deg", "theta_deg", "probe_um")]
-    io = header.index("outlier") if "outlier" in header else None
+    i_out = header.index("outlier") if "outlier" in header else None
     vals = []
     for k, r in enumerate(rows[1:], start=2):
         require(len(r) > max(idx), f"{path}: line {k}: too few fields")
-        if io is not None and len(r) > io and r[io].strip() not in ("", "0"):
+        if i_out is not None and len(r) > i_out and r[i_out].strip() not in ("", "0"):
             continue
         vals.append([_float(r[i].strip(), f"{path}: line {k}") for i in idx])
     arr = np.asarray(vals, dtype=float)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..plotstyle import figure, label, png, styled
-from ..units import UM_PER_MM
+from ..units import UM_PER_MM, num
 
 
 #: histogram figure: height, inches (the width is the page width)
@@ -40,8 +40,11 @@ def histogram_figure(values, names, summary: dict, title: str):
             ax.axvline(x, color="tab:blue", lw=1.5, ls="--",
                        label="estimate \u00b1 U (k = 2)" if i == 0 else None)
         ax.set_xlabel(label("deviation from the estimate", "um"))
-        ax.set_title(f"{name}: estimate {est:.6f} mm\n"
-                     f"u = {s['standard_uncertainty_um']:.3g} \u00b5m, U = {U:.3g} \u00b5m")
+        nominal = (f", nominal {s['nominal_mm']:.6f} mm" if "nominal_mm" in s else "")
+        bias = (f"bias {num(s['bias_um'], '+.3g')} \u00b5m, " if "bias_um" in s else "")
+        ax.set_title(f"{name}: estimate {est:.6f} mm{nominal}\n"
+                     f"{bias}u = {s['standard_uncertainty_um']:.3g} \u00b5m, U = {U:.3g} \u00b5m "
+                     f"(k = 2)")
     for row in axes:
         row[0].set_ylabel(label("probability density", "1/\u00b5m"))
     fig.legend(*flat[0].get_legend_handles_labels(), loc="outside lower center", ncol=2,
