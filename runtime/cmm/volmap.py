@@ -258,10 +258,10 @@ def _axes3d(fig, pos=111):
     return ax
 
 
-def _equal_box(ax, pts):
+def _equal_box(ax, pts, zoom: float = 0.85):
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     span = np.where(hi - lo > 0, hi - lo, 1.0)
-    ax.set_box_aspect(tuple(span))
+    ax.set_box_aspect(tuple(span), zoom=zoom)  # < 1: the axis labels stay inside the panel
     pad = 0.08 * span
     ax.set_xlim(lo[0] - pad[0], hi[0] + pad[0])
     ax.set_ylim(lo[1] - pad[1], hi[1] + pad[1])
@@ -287,7 +287,7 @@ def plot_map(vmap: VolumetricMap, path, magnify: float | None = None, inputs=())
     require(k > 0, f"magnification must be positive, got {k:g}")
     nom, act = vmap.nominal, vmap.nominal + k * vmap.error
     fig = pyplot().figure(figsize=(PAGE_WIDTH_IN, 7.5), layout="constrained")
-    gs = fig.add_gridspec(3, 2, width_ratios=[1.5, 1])
+    gs = fig.add_gridspec(3, 3, width_ratios=[1.5, 0.12, 1])  # a gap for the 3-D z label
     ax = _axes3d(fig, gs[:, 0])
     for line in _face_lines(vmap.shape):
         ax.plot(*nom[line].T, ls="--", lw=0.7, color="0.55")
@@ -300,7 +300,7 @@ def plot_map(vmap: VolumetricMap, path, magnify: float | None = None, inputs=())
     faces = [(2, 1, (0, 1), "top face z = max"), (1, 0, (0, 2), "front face y = min"),
              (0, 1, (1, 2), "side face x = max")]
     for row, (axis, side, (i, j), face) in enumerate(faces):
-        a2 = fig.add_subplot(gs[row, 1])
+        a2 = fig.add_subplot(gs[row, 2])
         g = _face_grid(vmap.shape, axis, side)
         for lines in (g, g.T):
             for line in lines:

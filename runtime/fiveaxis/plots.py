@@ -37,6 +37,7 @@ def plot_tcp_error_map(tmap, path, title: str = ""):
         if np.isfinite(z).sum() > 4:
             ax.contour(q1, q2, zm, levels=6, colors="k", linewidths=0.4)
         ax.set_facecolor("0.85")
+        ax.grid(False)
         ax.set_xlabel(label(a1, "deg"))
         ax.set_ylabel(label(a2, "deg"))
         ax.set_title(name)

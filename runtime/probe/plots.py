@@ -125,6 +125,7 @@ def draw_2d(fig, ax, cal) -> None:
                    color="k", s=80, label="flagged outlier")
     fig.colorbar(mesh, ax=ax, label=label("probe error", "um"))
     ax.set_xlim(0, 360)
+    ax.grid(False)
     ax.set_xticks(np.arange(0, 361, 45))
     lo, hi = cal.map.phi_range_deg
     ax.set_ylim(hi + 2, lo - 2)
