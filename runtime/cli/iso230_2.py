@@ -82,7 +82,7 @@ def register(sub) -> None:
                     "deviations, reversal B, repeatability R, systematic error E, M and "
                     "accuracy A; the standard's plot, an HTML certificate and an error table "
                     "with reversal for --errors DIR.",
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=EPILOG)
     p.add_argument("runs", nargs="+", metavar="RUN.csv", help="positioning run(s), long or "
                                                                "wide format (below)")
     p.add_argument("--axis", default="X",
