@@ -258,6 +258,7 @@ def _iso230_2(out: Path) -> dict:
     _cli("iso230-2", out / "iso230_2_run_X.csv", "--axis", "X", "--json", out / "iso230_2.json",
          "--plot", out / "iso230_2.png", "--html", out / "iso230_2.html",
          "--tolerance", DEMO_TOLERANCE, "--machine", "virtual machine, axis X (demo)",
+         "--cte-ppm-per-K", 11.5, "--material-temp-C", 20.0, "--eve-um", 0.3,
          "--instrument", "simulated laser interferometer", "--operator", "volerr demo")
     r = json.loads((out / "iso230_2.json").read_text())
     U = r["uncertainty_um"]
@@ -372,13 +373,20 @@ def run(args) -> int:
                 "iso230_2": lambda: _iso230_2(out),
                 "uncertainty": lambda: _uncertainty(out),
             }
-            for name in args.only or SECTIONS:
+            from ..progress import bar
+
+            todo = args.only or SECTIONS
+            progress = bar(len(todo), "volerr demo", unit="section")
+            for name in todo:
+                progress.set_postfix_str(name)
                 t = time.perf_counter()
                 r = steps[name]()
+                progress.update()
                 r["section"] = name
                 r["seconds"] = round(time.perf_counter() - t, 1)
                 results.append(r)
                 print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
+            progress.close()
             _index(out, results)
             write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
         finally:
