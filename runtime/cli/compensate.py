@@ -130,7 +130,7 @@ def run(args) -> int:
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
     if s["max_u_after_um"] > 0:
-        print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
+        print(f"standard uncertainty of the remaining error (tables' _std and _s, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
     # notes only after success: bad input gets exactly one line on stderr
     if assumed_zero:

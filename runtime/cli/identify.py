@@ -4,7 +4,8 @@ Reads tracker point data (``round,point,position,x,y,z`` CSV, or the thesis' raw
 ``--format thesis --positions start:stop:count``), identifies the six error motions of axis A
 at every commanded position of every round (weighted least squares by default, ``--method
 closed`` for the Zhang & Hu closed form), averages the rounds and writes the error table
-(``_std`` columns with several rounds, ``_u95`` with ``--tracker``).  See ``volerr.identify.solve``.
+(with n rounds: ``_s`` = the standard deviation s of one round and ``_std`` = s / sqrt(n), the
+uncertainty of the mean; ``_u95`` with ``--tracker``).  See ``volerr.identify.solve``.
 """
 
 from __future__ import annotations

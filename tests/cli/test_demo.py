@@ -18,6 +18,9 @@ from pathlib import Path
 
 import pytest
 
+#: the demo runs once per session: every test of this module on one xdist worker
+pytestmark = pytest.mark.xdist_group("demo")
+
 #: text must be at least this high on the page, px
 MIN_PX = 9.0
 #: units on axis labels and table headers: 'quantity / unit', never '(mm)', '[mm]', ', mm'
