@@ -68,6 +68,23 @@ def write_text(path, text: str, inputs=()) -> Path:
     return write_bytes(path, text.encode("utf-8"), inputs)
 
 
+def json_text(doc, indent: int = 2, **kwargs) -> str:
+    """JSON text of ``doc`` (one trailing newline) without negative zero: every float ``-0.0``
+    (a negative value rounded to zero, a product with zero) is written ``0.0``."""
+    import json
+
+    def clean(v):
+        if isinstance(v, float):
+            return v + 0.0
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        return v
+
+    return json.dumps(clean(doc), indent=indent, **kwargs) + "\n"
+
+
 def default_mode() -> int:
     """Permissions of a new file under the current umask (mkstemp alone would give 0600)."""
     mask = os.umask(0)

@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 from ..errors import require
-from ..fileio import write_text
+from ..fileio import json_text, write_text
 from ..units import num
 
 SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "fiveaxis", "loop", "iso230_2",
@@ -388,7 +388,7 @@ def run(args) -> int:
                 print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
             progress.close()
             _index(out, results)
-            write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
+            write_text(out / "summary.json", json_text(results))
         finally:
             os.chdir(here)
     print(f"report: {final / 'index.html'}  ({time.perf_counter() - t0:.0f} s)")

@@ -11,7 +11,6 @@ uncertainty of the mean; ``_u95`` with ``--tracker``).  See ``volerr.identify.so
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -86,7 +85,7 @@ def _vec(text, what):
 
 
 def run(args) -> int:
-    from ..fileio import Outputs, write_text
+    from ..fileio import Outputs, json_text, write_text
     from ..identify.inputs import read_rounds, refuse_repeated_files
     from ..identify.report import outlier_warnings, residual_csv, summary_lines
     from ..identify.solve import identify, to_model_signs
@@ -132,7 +131,7 @@ def run(args) -> int:
         if args.residuals:
             write_text(outs.path("--residuals"), residual_csv(result), inputs=inputs)
         if args.json:
-            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
+            write_text(outs.path("--json"), json_text(summary), inputs=inputs)
     written = args.out or str(Path(args.errors_out) / f"{axis}.csv")
     print("\n".join(summary_lines(args.axis, summary, written)))
     for line in outlier_warnings(summary):

@@ -9,14 +9,13 @@ volerr.uncertainty.iso10360.
 
 from __future__ import annotations
 
-import json
 
 import numpy as np
 
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
                       add_vector, error_functions_from_args, finite_option,
                       identification_from_args, inputs_of)
-from ..fileio import Outputs, write_text
+from ..fileio import Outputs, json_text, write_text
 from ..machine.model import load
 from ..uncertainty import iso10360
 from ..units import num
@@ -101,7 +100,7 @@ def run(args) -> int:
     title = f"{model.name}: simulated ISO 10360-2" + (f", {d['verdict']}" if spec else "")
     with outs:
         if args.json:
-            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+            write_text(outs.path("--json"), json_text(doc), inputs)
         png = None
         if args.plot or args.html:
             png = iso10360.plot_png(res, title)

@@ -11,8 +11,6 @@ Parses arguments and calls :mod:`volerr.positioning`; formats are described ther
 
 from __future__ import annotations
 
-import argparse
-import json
 from pathlib import Path
 
 from ..errors import require
@@ -137,7 +135,7 @@ def run(args) -> int:
     import sys
 
     from .. import positioning as pos
-    from ..fileio import Outputs, write_bytes, write_text
+    from ..fileio import Outputs, json_text, write_bytes, write_text
 
     inputs = list(args.runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs), "the same RUN file is given "
@@ -187,7 +185,7 @@ def run(args) -> int:
 
     # all outputs at the end, all or nothing
     with outs:
-        write_text(outs.path("--json"), json.dumps(report, indent=2) + "\n", inputs=inputs)
+        write_text(outs.path("--json"), json_text(report), inputs=inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), png, inputs=inputs)
         if html_text is not None:

@@ -11,13 +11,12 @@ Conventions: see :mod:`volerr.probe.calibration`.
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
 from ._common import add_force, add_vector
 from ..errors import require
-from ..fileio import write_text
+from ..fileio import json_text, write_text
 from ..units import parse_number
 
 
@@ -130,7 +129,7 @@ def run(args) -> int:
     with outs:
         write_text(outs.path("--out"), probe.map_csv_text(cal), inputs=inputs)
         if args.json:
-            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
+            write_text(outs.path("--json"), json_text(summary), inputs=inputs)
         if args.plot:
             from ..probe.plots import plot_probe_calibration
 

@@ -9,7 +9,6 @@ to DIR2.  Sign convention: ``volerr.cmm.squareness``.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from ..errors import require
@@ -35,7 +34,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ._common import layout_inputs
-    from ..fileio import Outputs, write_text
+    from ..fileio import Outputs, json_text, write_text
     from ..machine.layout import read_layout
     from ..cmm.squareness import squareness
     from ..tables.table import read_error_dir, table_to_csv, write_constants
@@ -70,7 +69,7 @@ def run(args) -> int:
                    "u_urad": {k: v * URAD_PER_RAD for k, v in std.items()},
                    "slopes_urad": {k: v * URAD_PER_RAD for k, v in slopes.items()},
                    "tables_are": args.tables_are}
-            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs=inputs)
+            write_text(outs.path("--json"), json_text(doc), inputs=inputs)
     for sq, v in values.items():
         print(f"{sq} = {v * URAD_PER_RAD:.3f} urad (u = {std[sq] * URAD_PER_RAD:.3f} urad)")
     print(f"-> {out}")

@@ -12,12 +12,11 @@ volerr.uncertainty.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from ._common import add_error_arguments, add_html, add_json, add_plot
 from ..errors import require
-from ..fileio import Outputs, write_bytes, write_text
+from ..fileio import Outputs, json_text, write_bytes, write_text
 from ..machine.model import load
 from ..uncertainty import ensemble, montecarlo as mc, tasks
 from ..uncertainty import report
@@ -222,7 +221,7 @@ def run(args) -> int:
         print("\n".join(report.summary_lines(doc)))
     with outs:
         if args.json:
-            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+            write_text(outs.path("--json"), json_text(doc), inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), hist, inputs)
         if args.html:

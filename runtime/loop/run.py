@@ -45,7 +45,7 @@ from . import blocks
 from . import candidates as cands
 from . import select as sel
 from ..errors import InputError, require
-from ..fileio import sniff_delimiter
+from ..fileio import json_text, sniff_delimiter
 from .fit import (Data, Problem, solve_normal, data_ranges, declared_design, gauge_mask,
                   identifiability_gram, point_norm, require_points, rms, rows_of,
                   weakly_determined_gram)
@@ -254,7 +254,7 @@ class Report:
     def write_json(self, path, inputs=()) -> Path:
         from ..fileio import write_text
 
-        return write_text(path, json.dumps(self.data, indent=2, default=_json) + "\n",
+        return write_text(path, json_text(self.data, default=_json),
                           inputs=list(inputs))
 
     def write_html(self, path, inputs=()) -> Path:

@@ -123,6 +123,12 @@ def test_demo_runs_every_section_and_reports_honest_figures(demo):
     iso = json.loads((out / "iso230_2.json").read_text())
     assert set(iso["uncertainty_um"]) == set("AEMRB") and iso["verdict"] in (
         "pass", "fail", "undecided")
+    # no negative zero in any file the demo wrote (reports, pages, tables)
+    negative_zero = re.compile(r"(?<![\w.])[-\u2212]0(?:\.0+)?(?![\d.eE])")
+    for f in out.rglob("*"):
+        if f.suffix in (".json", ".html", ".csv"):
+            text = re.sub(r"data:image/png;base64,[^\"]+", "", f.read_text(encoding="utf-8"))
+            assert not negative_zero.search(text), (f.name, negative_zero.search(text))
 
 
 def _displayed(out: Path):

@@ -5,7 +5,6 @@ finds; the error-map panels span the data."""
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
