@@ -58,8 +58,10 @@ def run(args) -> int:
     # as the user named it (no resolve): the report names the files where they end up
     out_dir = (Path(args.out_dir) if args.out_dir else
                Path(args.json or args.html).parent if (args.json or args.html) else None)
+    # named in messages: the option, or where its default put the folder
+    OUT_DIR = "--out-dir" if args.out_dir else "--out-dir (not given: the report's folder)"
     outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
-        .folder("--out-dir", out_dir, files=aug) \
+        .folder(OUT_DIR, out_dir, files=aug) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     families = candidates.FAMILIES
@@ -69,7 +71,7 @@ def run(args) -> int:
         require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
                 f"{' '.join(candidates.FAMILIES)}")
     with outs:
-        staged = outs.path("--out-dir")
+        staged = outs.path(OUT_DIR)
         report = run_loop(args.layout, args.data, seed=args.seed, folds=args.folds,
                           test_fraction=args.test_fraction, degree=args.degree,
                           out_dir=staged, families=families, inputs=inputs)
