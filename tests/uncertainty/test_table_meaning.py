@@ -119,3 +119,32 @@ def test_old_tables_keep_their_reading(tables, tmp_path, capsys):
     assert doc["quantities"]["distance"]["standard_uncertainty_um"] == pytest.approx(
         np.hypot(s1, s2), rel=0.03)
     assert "repeatability" in doc["table_uncertainty"][0]["meaning"]
+
+
+def test_result_statement_corrected_and_uncorrected():
+    """--bias: the corrected result is the reading minus the bias with the reading's interval
+    shifted by -bias; the uncorrected one is the reading with the smallest interval that holds
+    both the reading's interval and the corrected one (so the bias is inside it)."""
+    from hypothesis import given, settings, strategies as st
+
+    from volerr.uncertainty.report import statement
+
+    @settings(max_examples=60, deadline=None)
+    @given(st.floats(-50, 50), st.floats(0.01, 5), st.floats(-1, 1))
+    def check(bias_um, half_um, skew):
+        est = 400.0
+        lo = est - half_um * 1e-3 * (1 + 0.2 * skew)
+        hi = est + half_um * 1e-3
+        q = {"estimate_mm": est, "bias_um": bias_um, "coverage_interval_mm": [lo, hi]}
+        c, u = statement(q, "corrected"), statement(q, "uncorrected")
+        b = bias_um * 1e-3
+        assert c["result_mm"] == pytest.approx(est - b)
+        assert c["result_interval_mm"] == pytest.approx([lo - b, hi - b])
+        assert u["result_mm"] == est
+        ulo, uhi = u["result_interval_mm"]
+        assert ulo <= min(lo, lo - b) + 1e-12 and uhi >= max(hi, hi - b) - 1e-12
+        assert ulo == pytest.approx(min(lo, lo - b)) and uhi == pytest.approx(max(hi, hi - b))
+        assert u["result_U_minus_um"] == pytest.approx((est - ulo) * 1e3)
+        assert u["result_U_plus_um"] == pytest.approx((uhi - est) * 1e3)
+
+    check()
