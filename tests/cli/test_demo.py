@@ -18,9 +18,6 @@ from pathlib import Path
 
 import pytest
 
-#: the demo runs once per session: every test of this module on one xdist worker
-pytestmark = pytest.mark.xdist_group("demo")
-
 #: text must be at least this high on the page, px
 MIN_PX = 9.0
 #: units on axis labels and table headers: 'quantity / unit', never '(mm)', '[mm]', ', mm'
@@ -47,8 +44,7 @@ def _png_chunks(data: bytes) -> dict:
     return out
 
 
-@pytest.fixture(scope="module")
-def demo(tmp_path_factory):
+def _run_demo(tmp_path_factory):
     """Run ``volerr demo`` once; return (folder, {tag: record of the saved figure})."""
     import matplotlib
     import matplotlib.figure
@@ -90,8 +86,16 @@ def demo(tmp_path_factory):
     return out, records
 
 
-def test_demo_runs_every_section_and_reports_honest_figures(demo):
-    out, _ = demo
+def test_demo(tmp_path_factory):
+    """One run of the demo (30 s) for every check: xdist would run a shared fixture once per
+    worker."""
+    out, records = _run_demo(tmp_path_factory)
+    _every_section_and_honest_figures(out)
+    _every_figure_has_text_of_at_least_9_px_where_it_is_shown(out, records)
+    _one_unit_notation_on_every_axis_and_table_header(out, records)
+
+
+def _every_section_and_honest_figures(out):
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary) == 9
     for section in summary:
@@ -143,8 +147,7 @@ def _displayed(out: Path):
             yield page.name, src[:40], data, int(w.group(1)) if w else None
 
 
-def test_every_demo_figure_has_text_of_at_least_9_px_where_it_is_shown(demo):
-    out, records = demo
+def _every_figure_has_text_of_at_least_9_px_where_it_is_shown(out, records):
     shown = set()
     n = 0
     for page, src, data, width in _displayed(out):
@@ -152,6 +155,7 @@ def test_every_demo_figure_has_text_of_at_least_9_px_where_it_is_shown(demo):
         assert width is not None, f"{page}: {src} has no width attribute"
         assert width <= 1100, f"{page}: {src} shown wider than the page"
         rec = records[chunks["volerr-test"]]
+        assert rec["min_pt"] >= 9.0, f"{page}: {src}: {rec['smallest']!r} below the style's 9 pt"
         px = rec["min_pt"] * rec["dpi"] / 72.0 * width / chunks["width"]
         assert px >= MIN_PX, (f"{page}: {src}: '{rec['smallest']}' is {px:.1f} px high on "
                               f"the page")
@@ -163,8 +167,7 @@ def test_every_demo_figure_has_text_of_at_least_9_px_where_it_is_shown(demo):
     assert {p.name for p in out.glob("*.png")} <= shown
 
 
-def test_one_unit_notation_on_every_axis_and_table_header(demo):
-    out, records = demo
+def _one_unit_notation_on_every_axis_and_table_header(out, records):
     labels = [lab for r in records.values() for lab in r["labels"]]
     assert len(labels) > 60
     for lab in labels:

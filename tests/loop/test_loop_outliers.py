@@ -13,8 +13,6 @@ import volerr
 from volerr.loop.run import run_loop
 from volerr.loop.simulate import demo_probes, simulate
 
-pytestmark = pytest.mark.xdist_group("loop_outliers")
-
 THERMAL = {"kind": "thermal", "axis": "X", "ppm_per_K": 11.5}
 
 

@@ -14,8 +14,6 @@ import pytest
 from volerr.cli import main
 from volerr.identify.tracker_io import example_path
 
-pytestmark = pytest.mark.xdist_group("table_meaning")
-
 #: the two probing points of the task, on a line along X through nodes of the table (mm)
 X1, X2 = 100.0, 400.0
 
