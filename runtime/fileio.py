@@ -68,6 +68,23 @@ def write_text(path, text: str, inputs=()) -> Path:
     return write_bytes(path, text.encode("utf-8"), inputs)
 
 
+def json_text(doc, indent: int = 2, **kwargs) -> str:
+    """JSON text of ``doc`` (one trailing newline) without negative zero: every float ``-0.0``
+    (a negative value rounded to zero, a product with zero) is written ``0.0``."""
+    import json
+
+    def clean(v):
+        if isinstance(v, float):
+            return v + 0.0
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        return v
+
+    return json.dumps(clean(doc), indent=indent, **kwargs) + "\n"
+
+
 def default_mode() -> int:
     """Permissions of a new file under the current umask (mkstemp alone would give 0600)."""
     mask = os.umask(0)
@@ -111,10 +128,23 @@ def check_header(cells, where: str) -> None:
     require(not dup, f"{where}: column {dup[0] if dup else ''!r} appears twice in the header")
 
 
+def sniff_delimiter(text: str) -> str:
+    """The column separator of a CSV text: ``,`` unless the first line that is neither blank
+    nor a ``#`` comment has no comma but a semicolon (``;``, spreadsheet exports with a
+    decimal point) or a tab.  Every CSV reader of volerr uses this one rule."""
+    for line in text.splitlines():
+        if line.strip() and not line.lstrip().startswith("#"):
+            if "," in line:
+                return ","
+            return ";" if ";" in line else "\t" if "\t" in line else ","
+    return ","
+
+
 def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
     """(line number, stripped cells) of every row of a UTF-8 CSV file (a BOM is allowed);
-    blank rows and rows whose first cell starts with '#' are skipped.  ``missing``/``empty``:
-    the error lines for a file that does not exist / has no rows."""
+    columns separated by ``,`` (or ``;`` / tab, :func:`sniff_delimiter`); blank rows and rows
+    whose first cell starts with '#' are skipped.  ``missing``/``empty``: the error lines for
+    a file that does not exist / has no rows."""
     path = Path(path)
     require(path.is_file(), missing or f"{path}: no such file")
     try:
@@ -122,11 +152,15 @@ def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a UTF-8 text file") from None
     rows = []
-    for lineno, cells in enumerate(csv.reader(io.StringIO(text)), start=1):
-        cells = [c.strip() for c in cells]
-        if not cells or all(c == "" for c in cells) or cells[0].startswith("#"):
-            continue
-        rows.append((lineno, cells))
+    try:
+        for lineno, cells in enumerate(csv.reader(io.StringIO(text),
+                                                  delimiter=sniff_delimiter(text)), start=1):
+            cells = [c.strip() for c in cells]
+            if not cells or all(c == "" for c in cells) or cells[0].startswith("#"):
+                continue
+            rows.append((lineno, cells))
+    except csv.Error as exc:
+        raise InputError(f"{path}: not a readable CSV ({exc})") from None
     require(rows, empty or f"{path}: empty file")
     return rows
 
@@ -209,6 +243,60 @@ def _staged(path) -> bool:
 
 
 # ---------------------------------------------------------------------------------------------
+# staging folders: named after the process that owns them, removed when it is gone
+_STAGING_RX = None
+
+
+def _host() -> str:
+    import re
+    import socket
+
+    return re.sub(r"[^A-Za-z0-9.]", "_", socket.gethostname() or "host")[:40]
+
+
+def staging_prefix() -> str:
+    """``.volerr-staging-<pid>@<host>-``: the name says which process owns the folder."""
+    return f".volerr-staging-{os.getpid()}@{_host()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:        # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_staging(folder) -> list:
+    """Remove the staging folders in ``folder`` left by runs that were killed (SIGKILL, power
+    loss): only those named by :func:`staging_prefix` on this host whose process is gone.
+    Returns the removed paths."""
+    import re
+
+    global _STAGING_RX
+    if _STAGING_RX is None:
+        _STAGING_RX = re.compile(r"\.volerr-staging-(\d+)@(.+)-[^-]+$")
+    removed = []
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError:
+        return removed
+    host = _host()
+    for d in entries:
+        m = _STAGING_RX.match(d.name)
+        if not m or m.group(2) != host or not d.is_dir() or d.is_symlink():
+            continue
+        pid = int(m.group(1))
+        if pid == os.getpid() or _alive(pid):
+            continue
+        shutil.rmtree(d, ignore_errors=True)
+        removed.append(d)
+    return removed
+
+
+# ---------------------------------------------------------------------------------------------
 # the output plan
 def _same(role, other, path) -> str:
     return (f"two outputs are the same file {path}: {role} and {other} would overwrite each "
@@ -226,6 +314,14 @@ class Outputs:
         entries are ignored.
     allow_package : bool
         Permit writing into the installed package (only ``volerr derive --in-package``).
+    force : bool
+        Let a folder output replace files that were there before the run (``--force``).
+        Without it a folder output never replaces an existing file: the refusal names it.
+        An output named as a file (``--json F``) is the user's explicit choice and replaces
+        an existing F either way.
+
+    Every output's folder must exist, except an output folder itself, which is created
+    when its parent exists: a mistyped folder name is refused, never created silently.
 
     Examples
     --------
@@ -235,7 +331,7 @@ class Outputs:
     ...     write_text(outs.path("--out"), text)
     """
 
-    def __init__(self, inputs=(), *, allow_package: bool = False):
+    def __init__(self, inputs=(), *, allow_package: bool = False, force: bool = False):
         files = []
         for p in inputs:
             if p is None:
@@ -247,6 +343,8 @@ class Outputs:
                 files.append(p)
         self.inputs = files
         self.allow_package = allow_package
+        self.force = force
+        self._replace: set = set()      # folder roles whose files may be replaced
         self._items: list = []          # (role, path, kind, files)
         self._stage: dict = {}          # role -> staged path
         self._roots: dict = {}          # target folder -> staging folder
@@ -266,14 +364,26 @@ class Outputs:
         """Declare a PNG plot (must end in ``.png``)."""
         return self.file(role, path, plot=True)
 
-    def folder(self, role: str, path, files=None) -> "Outputs":
+    def folder(self, role: str, path, files=None, *, replace: bool = False) -> "Outputs":
         """Declare an output folder and, when known, the names of the files it will get
-        (relative paths); unknown names are checked at commit, before anything moves."""
+        (relative paths); unknown names are checked at commit, before anything moves.
+        ``replace``: files of this folder may be replaced without ``force`` (only for a
+        folder whose files are by definition rewritten, such as ``volerr derive``'s)."""
         if path is not None:
             require(not self._checked, "internal: output declared after check()")
             self._items.append((role, Path(path), "folder",
                                 None if files is None else tuple(files)))
+            if replace:
+                self._replace.add(role)
         return self
+
+    def _refuse_existing(self, role, folder: Path, f: Path) -> None:
+        """A folder output must not replace a file that was there before the run."""
+        if self.force or role in self._replace:
+            return
+        require(not (f.exists() or f.is_symlink()),
+                f"{role} {folder}: {f} exists already (not written by this run); give "
+                f"--force to replace it, or another folder")
 
     @property
     def declared(self) -> list:
@@ -293,12 +403,21 @@ class Outputs:
                     f"(a shipped file such as a layout or generated module)")
 
     @staticmethod
-    def _probe_writable(role, target_dir: Path, shown: Path) -> None:
+    def _probe_writable(role, target_dir: Path, shown: Path, create: bool = False) -> None:
+        """``target_dir`` must be a writable folder; with ``create`` (an output folder) it
+        may be missing when its parent folder exists."""
         d = target_dir
-        while not d.exists():
-            if d.parent == d:
-                break
+        if create and not d.exists():
             d = d.parent
+        if not d.exists():
+            bad = d
+            while not bad.parent.exists() and bad.parent != bad:
+                bad = bad.parent
+            if bad.parent.exists() and not bad.parent.is_dir():
+                raise InputError(f"{role} {shown}: cannot write, {bad.parent} is a file, not "
+                                 f"a folder")
+            raise InputError(f"{role} {shown}: folder {d} does not exist (create it first; "
+                             f"a mistyped folder is never created)")
         require(d.is_dir(), f"{role} {shown}: cannot write, {d} is a file, not a folder")
         try:
             fd, tmp = tempfile.mkstemp(dir=d, prefix=".volerr-probe-")
@@ -312,6 +431,8 @@ class Outputs:
         """All checks, before any computation; raises :class:`InputError` (one line)."""
         finals: dict = {}
         folders = []
+        existing = []                   # (role, folder, file): checked after the rest
+        declared = [p.resolve() for _, p, kind, _ in self._items if kind == "folder"]
         for role, p, kind, files in self._items:
             if kind == "folder":
                 require(not p.exists() or p.is_dir(),
@@ -321,10 +442,11 @@ class Outputs:
                     require(p.resolve() != other.resolve(),
                             f"{role} and {other_role} name the same folder {p}")
                 folders.append((role, p))
-                self._probe_writable(role, p, p)
+                self._probe_writable(role, p, p, create=True)
                 for name in files or ():
                     f = p / name
                     self._refuse_target(role, f)
+                    existing.append((role, p, f))
                     key = f.resolve()
                     require(key not in finals, _same(f"{role} {p}", finals.get(key), f))
                     finals[key] = f"{role} {p}"
@@ -337,7 +459,12 @@ class Outputs:
                 key = p.resolve()
                 require(key not in finals, _same(role, finals.get(key), p))
                 finals[key] = role
-                self._probe_writable(role, p.parent, p)
+                # inside an output folder of this run: that folder is created
+                inside = next((d for d in declared if _within(p.parent.resolve(), d)), None)
+                if inside is None:
+                    self._probe_writable(role, p.parent, p)
+        for role, p, f in existing:
+            self._refuse_existing(role, p, f)
         # a file inside a folder whose file names are not known in advance
         for role, p, kind, files in self._items:
             if kind == "folder" and files is None:
@@ -361,7 +488,8 @@ class Outputs:
                 for m in reversed(missing):
                     m.mkdir()
                     self._created.append(m)
-                root = Path(tempfile.mkdtemp(dir=folder, prefix=".volerr-staging-"))
+                remove_stale_staging(folder)
+                root = Path(tempfile.mkdtemp(dir=folder, prefix=staging_prefix()))
             except OSError as exc:
                 raise InputError(f"cannot write in {folder}: {exc.strerror or exc}") from None
             self._roots[key] = root
@@ -411,8 +539,11 @@ class Outputs:
         moves = self._moves()
         try:
             seen = {}
+            folders = {r: p for r, p, kind, _ in self._items if kind == "folder"}
             for _, final, role in moves:
                 self._refuse_target(role, final)
+                if role in folders:
+                    self._refuse_existing(role, folders[role], final)
                 key = final.resolve()
                 require(key not in seen, _same(role, seen.get(key), final))
                 seen[key] = role

@@ -58,6 +58,18 @@ def parse_number(text, where: str = "", what: str = "") -> float:
     return value
 
 
+def num(value, spec: str) -> str:
+    """``format(value, spec)`` without negative zero: a value that prints as zero (-0.0 or a
+    tiny negative rounded away) prints with the sign of +0, e.g. ``+0.000`` or ``0.00``, never
+    ``-0.00`` (every report, page and printed line of volerr formats numbers with it)."""
+    s = format(float(value), spec)
+    try:
+        zero = float(s) == 0.0
+    except ValueError:
+        return s
+    return format(0.0, spec) if zero else s
+
+
 def format_number(value: float, digits: int = 12) -> str:
     """A number for a text file: ``digits`` significant digits (``%g``), ``-0`` written ``0``."""
     text = f"{float(value):.{digits}g}"

@@ -8,7 +8,9 @@ which becomes one line on stderr and exit code 2.
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
+import re
 import sys
 
 from ..errors import InputError
@@ -75,13 +77,74 @@ class _Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
     def error(self, message):
+        message = _did_you_mean(message)
+        if message.startswith("the following arguments are required"):
+            # a mistyped option is the likelier cause of a missing one: name it first
+            known = set(self._option_string_actions)
+            for token in _ARGV:
+                name = token.split("=", 1)[0]
+                if name.startswith("--") and name not in known and not any(
+                        k.startswith(name) for k in known):
+                    close = difflib.get_close_matches(name, _visible_options(self), n=1,
+                                                      cutoff=0.6)
+                    if close:
+                        message = f"unrecognized option {token} (did you mean {close[0]}?)"
+                        break
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+    def parse_args(self, args=None, namespace=None):
+        """As argparse, but an unknown option is named by the (sub)command it was given to,
+        with the closest option of that command ("did you mean --json?")."""
+        _ARGV[:] = [str(a) for a in (sys.argv[1:] if args is None else args)]
+        ns, extras = self.parse_known_args(args, namespace)
+        if extras:
+            leaf = getattr(ns, "_parser", None) or self
+            bad = next((e for e in extras if e.startswith("-")), extras[0])
+            if bad.startswith("-"):
+                close = difflib.get_close_matches(bad.split("=", 1)[0],
+                                                  _visible_options(leaf), n=1, cutoff=0.6)
+                hint = f" (did you mean {close[0]}?)" if close else ""
+                leaf.error(f"unrecognized option {bad}{hint}")
+            leaf.error(f"unrecognized arguments: {' '.join(extras)}")
+        return ns
+
+
+_ARGV: list = []   # the arguments being parsed (for the messages of a subcommand's parser)
+
+
+def _visible_options(parser) -> list:
+    return [s for a in parser._actions if a.help is not argparse.SUPPRESS
+            for s in a.option_strings]
+
+
+def _did_you_mean(message: str) -> str:
+    """argparse's "invalid choice: 'mapp' (choose from ...)" with the closest choice."""
+    m = re.search(r"invalid choice: '?([^' ]+)'? \(choose from (.*)\)", message)
+    if not m or "did you mean" in message:
+        return message
+    choices = re.findall(r"'([^']+)'", m.group(2)) or [c.strip() for c in
+                                                        m.group(2).split(",")]
+    close = difflib.get_close_matches(m.group(1), choices, n=1, cutoff=0.5)
+    return message + (f" (did you mean '{close[0]}'?)" if close else "")
+
+
+def _mark_leaves(parser) -> None:
+    """Every (sub)parser records itself in the namespace, for the messages above."""
+    parser.set_defaults(_parser=parser)
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in action.choices.values():
+                _mark_leaves(child)
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .. import __version__
+
     parser = _Parser(
         prog="volerr",
         description="Derived, audited volumetric error models of CMMs and five-axis machines.")
+    parser.add_argument("--version", action="version", version=f"volerr {__version__}",
+                        help="print the version of volerr and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMANDS:
@@ -92,6 +155,7 @@ def build_parser() -> argparse.ArgumentParser:
                 continue  # command not built yet
             raise
         module.register(sub)
+    _mark_leaves(parser)
     return parser
 
 

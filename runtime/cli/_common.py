@@ -69,17 +69,7 @@ def layout_inputs(layout) -> list:
     return [p] if p.is_file() else []
 
 
-def progress(iterable, total=None, **kw):
-    """``tqdm`` progress on stderr when stderr is a terminal; the plain iterable otherwise."""
-    import sys
-
-    if not sys.stderr.isatty():
-        return iterable
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover
-        return iterable
-    return tqdm(iterable, total=total, file=sys.stderr, leave=False, **kw)
+from ..progress import bar, progress  # noqa: E402,F401  (one rule: volerr.progress)
 
 
 #: the largest coordinate accepted on the command line (mm)
@@ -131,3 +121,79 @@ def add_vector(parser, flag: str, help: str, default=None, required: bool = Fals
     act = parser.add_argument(flag, nargs="+", action=_Vector, default=default,
                               required=required, metavar=metavar, help=help)
     act.vector = True
+
+
+# ---------------------------------------------------------------------------------------------
+# the same option for the same thing in every command
+def add_json(parser, what: str = "the results") -> None:
+    """``--json F``: optional everywhere."""
+    parser.add_argument("--json", metavar="F", help=f"write {what} (JSON)")
+
+
+def add_plot(parser, what: str = "the plot", *aliases: str, required: bool = False) -> None:
+    """``--plot F.png`` (old spellings in ``aliases`` keep working)."""
+    parser.add_argument("--plot", *aliases, dest="plot", metavar="F.png", required=required,
+                        help=f"write {what} (PNG)")
+
+
+def add_html(parser, what: str = "a one-page report with the figures") -> None:
+    """``--html F.html``: optional everywhere."""
+    parser.add_argument("--html", metavar="F.html", help=f"write {what} (HTML, figures "
+                                                         f"embedded, no network needed)")
+
+
+def add_errors_out(parser, what: str, *aliases: str, required: bool = False) -> None:
+    """``--errors-out DIR`` for every error directory a command writes (``map --errors DIR``
+    reads it); ``aliases``: the command's former spelling, still accepted."""
+    parser.add_argument("--errors-out", *aliases, dest="errors_out", metavar="DIR",
+                        required=required,
+                        help=f"write {what} as an error directory (X.csv ... constants.csv; "
+                             f"'volerr formats tables'); created when missing, its parent "
+                             f"must exist")
+
+
+def add_force(parser) -> None:
+    """``--force``: a folder output may replace files that were there before the run."""
+    parser.add_argument("--force", action="store_true",
+                        help="let an output folder replace files that exist there already "
+                             "(without it such a file is named and nothing is written)")
+
+
+def add_identification(parser, instrument: str = "the measuring instrument") -> None:
+    """``--machine --instrument --operator --date``: the identification of a certificate."""
+    g = parser.add_argument_group("certificate identification (printed on the page and in "
+                                  "the JSON)")
+    g.add_argument("--machine", metavar="TEXT",
+                   help="the machine tested: make, model, serial number")
+    g.add_argument("--instrument", metavar="TEXT",
+                   help=f"{instrument}: make, model, serial number, calibration")
+    g.add_argument("--operator", metavar="TEXT", help="who made the test")
+    g.add_argument("--date", metavar="YYYY-MM-DD",
+                   help="date of the test (not given: the date of the evaluation)")
+
+
+def identification_from_args(args, conditions: dict | None = None):
+    """:class:`volerr.certificate.Identification` of the options of :func:`add_identification`
+    (the date checked)."""
+    import datetime
+
+    from ..certificate import Identification
+
+    kw = {}
+    if args.date:
+        try:
+            kw["date"] = datetime.date.fromisoformat(args.date).isoformat()
+        except ValueError:
+            raise InputError(f"--date {args.date!r}: expected YYYY-MM-DD") from None
+    return Identification(args.machine, args.instrument, args.operator,
+                          conditions=dict(conditions or {}), **kw)
+
+
+def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
+    """A number option checked to be finite and within [low, high] (None passes)."""
+    import math
+
+    if value is not None:
+        require(math.isfinite(value) and low <= value <= high,
+                f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
+    return value

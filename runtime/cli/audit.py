@@ -15,12 +15,11 @@ of their layouts (no derivation involved).
 
 from __future__ import annotations
 
-import json
 
 from ..audit import run as audit_run
 from ..audit import summary_line
 from ..errors import require
-from ..fileio import write_text
+from ..fileio import json_text, write_text
 
 
 def register(sub) -> None:
@@ -54,7 +53,7 @@ def run(args) -> int:
     entries = [v.as_dict() for v in verdicts]
     files = {}
     if args.json:
-        files["--json"] = json.dumps(entries, indent=1, ensure_ascii=False) + "\n"
+        files["--json"] = json_text(entries, indent=1, ensure_ascii=False)
     if args.html:
         from ..audit import render_html
 

@@ -54,7 +54,7 @@ def register(sub) -> None:
                    help="stop iterating when the correction changes by less than this (um)")
     p.add_argument("--decimals", type=int, default=4,
                    help="decimals of the written numbers (at least those of the input)")
-    p.add_argument("--initial", default="",
+    p.add_argument("--initial", default=None,
                    help="axis positions at program start, e.g. 'B=0,C=0' (otherwise an axis "
                         "is unknown until programmed; a rotary axis the program never commands "
                         "is taken at 0 deg)")
@@ -99,7 +99,7 @@ def run(args) -> int:
         .file("--json", args.json).plot("--plot", args.plot).check()
     opts = program.Options(
         tuple(args.tool), args.orientation, args.strategy, args.tol_um, args.decimals,
-        _initial(args.initial), not args.ignore_travel, 50,
+        _initial(args.initial or ""), not args.ignore_travel, 50,
         None if args.types is None else tuple(t for t in args.types.split(",") if t.strip()))
     with outs:  # all or nothing: staged outputs are put in place at the end
         # streamed: the program and the report are written chunk by chunk
@@ -130,7 +130,7 @@ def run(args) -> int:
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
     if s["max_u_after_um"] > 0:
-        print(f"standard uncertainty of the remaining error (tables' Type A std, k = 1): max "
+        print(f"standard uncertainty of the remaining error (tables' _std and _s, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
     # notes only after success: bad input gets exactly one line on stderr
     if assumed_zero:

@@ -23,7 +23,8 @@ def register(sub) -> None:
     e = s.add_parser("export", help="error directory -> controller file")
     e.add_argument("layout", help="layout name or file")
     e.add_argument("--errors", required=True, metavar="DIR", help="error directory")
-    e.add_argument("--format", choices=("isg", "etalon"), required=True)
+    e.add_argument("--format", choices=("isg", "etalon"), required=True,
+                   help="isg: ISG CSV; etalon: Etalon exchange format")
     e.add_argument("--out", required=True, help="controller file to write")
     e.add_argument("--negate", action="store_true",
                    help="write compensation values (the errors with reversed sign) for a "
@@ -32,8 +33,12 @@ def register(sub) -> None:
     i = s.add_parser("import", help="controller file -> error directory")
     i.add_argument("layout", help="layout name or file")
     i.add_argument("file", help="ISG CSV or Etalon file")
-    i.add_argument("--format", choices=("auto", "isg", "etalon"), default="auto")
-    i.add_argument("--out", required=True, metavar="DIR", help="error directory to write")
+    i.add_argument("--format", choices=("auto", "isg", "etalon"), default="auto",
+                   help="format of FILE: auto (from its content), isg or etalon")
+    from ._common import add_errors_out, add_force
+
+    add_errors_out(i, "the imported tables", "--out", required=True)
+    add_force(i)
     i.add_argument("--negate", action="store_true",
                    help="the file holds compensation values: reverse their sign")
     i.set_defaults(func=run)
@@ -66,15 +71,15 @@ def run(args) -> int:
               f"{', negated: compensation values' if args.negate else ''})")
         return 0
     inputs = [args.file] + layout_inputs(args.layout)
-    outs = Outputs(inputs).folder("--out", args.out,
+    outs = Outputs(inputs, force=args.force).folder("--errors-out", args.errors_out,
                                   files=[f"{a}.csv" for a in model.axes] + ["constants.csv"])
     outs.check()
     tables, consts = ct.read_controller_file(args.file, model, args.format)
     if args.negate:
         tables, consts = ct.negated(tables, consts)
-    out = Path(args.out)
+    out = Path(args.errors_out)
     with outs:
-        write_error_dir(outs.path("--out"), tables, consts or None, inputs=inputs)
+        write_error_dir(outs.path("--errors-out"), tables, consts or None, inputs=inputs)
     n = sum(len(t.values) for t in tables.values())
     print(f"{model.name}: read {n} component errors ({len(tables)} axes) and {len(consts)} "
           f"position errors from {args.file}; wrote {out}/")

@@ -27,7 +27,8 @@ import time
 from pathlib import Path
 
 from ..errors import require
-from ..fileio import write_text
+from ..fileio import json_text, write_text
+from ..units import num
 
 SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "fiveaxis",
             "loop", "iso230_2", "uncertainty")
@@ -40,7 +41,7 @@ ABOUT = {
     "cmm_b": "Pahk's CMM B (MH2): the same with repeatability columns in the tables, so the "
              "random component (1 sigma) is mapped and propagated to the diagonals separately.",
     "audit": "Every derived CMM equation against the one printed in Pahk 1995; differences are "
-             "named errata with their evidence (audit.json).",
+             "named errata with their evidence (audit.html, audit.json).",
     "probe": "A simulated 3-lobe kinematic probe measured on Pahk's 101-point plan: effective "
              "ball radius R_eff and the probe error map Probe(phi, theta).",
     "identify": "Shipped laser-tracker data (3 points, 11 positions, 4 rounds per axis): the six "
@@ -62,38 +63,50 @@ ABOUT = {
             "after on held-out points.",
     "iso230_2": "A simulated laser-interferometer positioning run of X (9 targets, 5 cycles, "
                 "both directions) evaluated as ISO 230-2: accuracy A, repeatability R, "
-                "reversal B, systematic error E.",
+                "reversal B, systematic error E, each with its measurement uncertainty U "
+                "(k = 2, ISO/TR 230-9) and a verdict against example tolerances (ISO 14253-1); "
+                "the certificate is iso230_2.html.",
     "uncertainty": "Task-specific uncertainty of a 400 mm distance on MH2 by Monte Carlo "
-                   "(virtual CMM, JCGM 101) from the example tables' repeatability and 0.5 um "
-                   "probing noise.",
+                   "(virtual CMM, JCGM 101): the example tables' repeatability columns (_s, "
+                   "drawn independently at every probing point, --repeatability) and 0.5 µm "
+                   "probing noise; the result is corrected for the bias of the machine's known "
+                   "errors (uncertainty.html).",
 }
 
 #: figure captions (file name -> sentence)
 CAPTIONS = {
     "map_MB1.png": "MB1: volumetric error on the travel grid, nominal (dashed) and actual "
                    "(solid) grid, errors magnified by the factor in the title.",
-    "map_MB1_random.png": "MB1: random component (1 sigma) of the volumetric error.",
+    "map_MB1_random.png": "MB1: random component of the volumetric error, the standard "
+                          "uncertainty (k = 1) for one reading from the tables' repeatability "
+                          "columns; bars \u00b1 the magnified rx, ry, rz.",
     "map_MH2.png": "MH2: volumetric error on the travel grid (magnified).",
-    "map_MH2_random.png": "MH2: random component (1 sigma) of the volumetric error.",
-    "diagonals_MB1.png": "MB1: length deviation along the space diagonals and of every line.",
-    "diagonals_MH2.png": "MH2: length deviation along the space diagonals, with the random "
-                         "part.",
-    "probe_map.png": "Probe error: 3-D lobing map (left) and over (phi, theta) (right), um.",
-    "identified_X.png": "X axis: identified error motions (mean of 4 rounds, +/- 1 s).",
-    "identified_Y.png": "Y axis: identified error motions.",
-    "identified_Z.png": "Z axis: identified error motions.",
+    "map_MH2_random.png": "MH2: random component (k = 1) of the volumetric error; bars \u00b1 "
+                          "the magnified rx, ry, rz.",
+    "diagonals_MB1.png": "MB1: length deviation along the space diagonals (top) and of every "
+                         "line (below); bands and bars \u00b1 2 u (k = 2).",
+    "diagonals_MH2.png": "MH2: length deviation along the space diagonals, bands \u00b1 2 u "
+                         "(k = 2) of the random part, and of every line (bars \u00b1 2 u).",
+    "probe_map.png": "Probe error: 3-D lobing map (top) and over (theta, phi) (below), µm.",
+    "identified_X.png": "X axis: identified error motions, mean of 4 rounds; bars \u00b1 2 s, "
+                        "s the standard deviation of one round (the table's _s; its _std is "
+                        "s / \u221a4).",
+    "identified_Y.png": "Y axis: identified error motions (bars \u00b1 2 s of one round).",
+    "identified_Z.png": "Z axis: identified error motions (bars \u00b1 2 s of one round).",
     "ballbar_polar.png": "Ballbar polar plot: radial deviation about the least-squares circle "
                          "(magnified; CCW blue, CW red), G and H per trace.",
-    "calibrate_rotary.png": "Identified location errors of B and C with expanded uncertainty "
-                            "bars (k = 2).",
+    "calibrate_rotary.png": "Identified location errors of B and C, bars \u00b1 2 u (k = 2), "
+                            "beside the planted values (crosses).",
     "compensate_full.png": "DMU 50 program, full model: predicted tool-tip error per block "
                            "before and after compensation.",
     "compensate_thesis.png": "DMU 50 program, thesis strategy (rotary, then linear).",
     "tcpmap_DMU50.png": "DMU 50: tool-tip error at one workpiece point over B and C (grey: "
                         "outside the travel or the tables).",
-    "iso230_2.png": "ISO 230-2 plot: mean deviations per direction, +/- 2 s bands.",
-    "uncertainty.png": "Distribution of the Monte Carlo samples of the distance with the 95 % "
-                       "coverage interval.",
+    "iso230_2.png": "ISO 230-2 plot: mean deviations per direction with bands \u00b1 2 S "
+                    "(k = 2) of one reading; ringed: readings that decide a quantity that "
+                    "fails or is undecided.",
+    "uncertainty.png": "Distribution of the Monte Carlo readings of the distance about their "
+                       "mean: 95 % coverage interval (red) and \u00b1 U (k = 2, blue).",
 }
 
 
@@ -102,6 +115,9 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="volerr-demo", help="output folder (default volerr-demo)")
     p.add_argument("--only", nargs="+", choices=SECTIONS, help="run only these sections")
+    from ._common import add_force
+
+    add_force(p)
     p.set_defaults(func=run)
 
 
@@ -141,12 +157,15 @@ def _cmm(out: Path, layout: str, label: str) -> dict:
             "files": files + [f"diagonals_{layout}.json", f"diagonals_{layout}.png"]}
 
 
+#: the example tolerances of the ISO 230-2 certificate, um
+DEMO_TOLERANCE = "A=12,E=10,M=8,R=4,B=3"
+
 #: the demo audits the CMM models (seconds); ``volerr audit`` alone audits everything
 DEMO_AUDIT = ("MB1", "MB2", "FB1", "FB2", "MH1", "MH2", "FH1", "FH2", "CX", "CY")
 
 
 def _audit(out: Path) -> dict:
-    _cli("audit", *DEMO_AUDIT, "--json", out / "audit.json")
+    _cli("audit", *DEMO_AUDIT, "--json", out / "audit.json", "--html", out / "audit.html")
     verdicts = json.loads((out / "audit.json").read_text())
     verdicts = verdicts["verdicts"] if isinstance(verdicts, dict) else verdicts
     equations = {}
@@ -158,7 +177,7 @@ def _audit(out: Path) -> dict:
     return {"title": "audit of Pahk's printed CMM equations (all sources: volerr audit)",
             "value": f"{len(equations)} printed equations: {len(equations) - bad} identical, "
                      f"{bad} with named errata ({wrong} of {len(verdicts)} components)",
-            "files": ["audit.json"]}
+            "files": ["audit.html", "audit.json"]}
 
 
 def _probe(out: Path) -> dict:
@@ -182,7 +201,7 @@ def _identify(out: Path) -> dict:
     measured = out / "tracker_identified"
     for axis in ("X", "Y", "Z"):
         _cli("identify", "MB1", "--axis", axis, example_path(axis), "--fit", "poly",
-             "--out", measured / f"{axis}.csv", "--plot", out / f"identified_{axis}.png")
+             "--errors-out", measured, "--plot", out / f"identified_{axis}.png")
     _cli("squareness", "MB1", measured, "--out", out / "tracker_errors",
          "--json", out / "squareness.json")
     sq = json.loads((out / "squareness.json").read_text())
@@ -331,11 +350,16 @@ def _iso230_2(out: Path) -> dict:
                 lines.append(f"{t:g},{c},{word},{base + half + rng.normal(0, 0.3):.4f}")
     write_text(out / "iso230_2_run_X.csv", "\n".join(lines) + "\n")
     _cli("iso230-2", out / "iso230_2_run_X.csv", "--axis", "X", "--json", out / "iso230_2.json",
-         "--plot", out / "iso230_2.png", "--html", out / "iso230_2.html")
+         "--plot", out / "iso230_2.png", "--html", out / "iso230_2.html",
+         "--tolerance", DEMO_TOLERANCE, "--machine", "virtual machine, axis X (demo)",
+         "--cte-ppm-per-K", 11.5, "--material-temp-C", 20.0, "--eve-um", 0.3,
+         "--instrument", "simulated laser interferometer", "--operator", "volerr demo")
     r = json.loads((out / "iso230_2.json").read_text())
+    U = r["uncertainty_um"]
     return {"title": "ISO 230-2 evaluation of a simulated positioning run of X",
-            "value": f"A {r['A_um']:.2f} um, R {r['R_um']:.2f} um, B {r['B_um']:.2f} um, "
-                     f"E {r['E_um']:.2f} um, M {r['M_um']:.2f} um",
+            "value": ", ".join(f"{q} {num(r[q + '_um'], '.2f')} \u00b1 {num(U[q], '.2f')}"
+                               for q in "AERBM") + " \u00b5m (U, k = 2); verdict against "
+                     f"{DEMO_TOLERANCE} \u00b5m: {r['verdict']}",
             "files": ["iso230_2_run_X.csv", "iso230_2.json", "iso230_2.html", "iso230_2.png"]}
 
 
@@ -346,41 +370,58 @@ def _uncertainty(out: Path) -> dict:
     write_example_errors(errors, "MH2")
     write_text(out / "task_distance.csv", "X,Y,Z\n100,200,150\n500,200,150\n")
     _cli("uncertainty", "MH2", "--task", out / "task_distance.csv", "--evaluate", "distance",
-         "--errors", errors, "--noise-um", 0.5, "--samples", 2000, "--seed", 1, "--quiet",
-         "--json", out / "uncertainty.json", "--plot", out / "uncertainty.png")
+         "--errors", errors, "--repeatability", "--noise-um", 0.5, "--samples", 2000,
+         "--seed", 1, "--quiet", "--json", out / "uncertainty.json",
+         "--plot", out / "uncertainty.png", "--html", out / "uncertainty.html")
     q = json.loads((out / "uncertainty.json").read_text())["quantities"]["distance"]
-    lo, hi = q["coverage_interval_mm"]
+    lo, hi = q["result_interval_mm"]
     return {"title": "task-specific uncertainty of a 400 mm distance on MH2 (Monte Carlo, "
                      "2000 samples)",
-            "value": f"estimate {q['estimate_mm']:.4f} mm, bias {q['bias_um']:+.2f} um, "
-                     f"u {q['standard_uncertainty_um']:.2f} um, U(95 %) "
-                     f"{q['expanded_uncertainty_um']:.2f} um, interval [{lo:.4f}, {hi:.4f}] mm",
-            "files": ["task_distance.csv", "errors_MH2_u/", "uncertainty.json",
-                      "uncertainty.png"]}
+            "value": f"corrected result {num(q['result_mm'], '.4f')} mm, U "
+                     f"{num(q['expanded_uncertainty_um'], '.2f')} \u00b5m (k = 2), 95 % "
+                     f"interval [{num(lo, '.4f')}, {num(hi, '.4f')}] mm (nominal "
+                     f"{num(q['nominal_mm'], '.4f')} mm; the machine reads "
+                     f"{num(q['estimate_mm'], '.4f')} mm, bias {num(q['bias_um'], '+.2f')} "
+                     f"\u00b5m)",
+            "files": ["uncertainty.html", "task_distance.csv", "errors_MH2_u/",
+                      "uncertainty.json", "uncertainty.png"]}
 
 
 def _index(out: Path, results: list) -> None:
+    """index.html: a section per step with its figures (each shown at its own pixel width,
+    :func:`volerr.plotstyle.img_tag`), captions, the result line, a link to every report page
+    (HTML) the step wrote and to every file."""
     from html import escape
+
+    from ..plotstyle import img_tag, png_size
 
     parts = []
     toc = []
+    pages = []
     for i, r in enumerate(results, start=1):
         sid = f"s{i}"
         toc.append(f'<li><a href="#{sid}">{escape(r["title"])}</a></li>')
         files = " ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in r["files"])
+        reports = [f for f in r["files"] if f.endswith(".html")]
+        pages += reports
         figs = []
         for f in r["files"]:
             if f.endswith(".png"):
                 cap = CAPTIONS.get(f, f)
-                figs.append(f'<figure><a href="{escape(f)}"><img src="{escape(f)}" '
-                            f'alt="{escape(cap)}"></a><figcaption>{escape(cap)} '
-                            f'<span class="file">({escape(f)})</span></figcaption></figure>')
+                width = png_size((out / f).read_bytes()[:32])[0]
+                figs.append(f'<figure>{img_tag(f, cap, width=width, link=f)}'
+                            f'<figcaption>{escape(cap)} <span class="file">({escape(f)})'
+                            f'</span></figcaption></figure>')
+        report_links = (f'<p class="pages">Report page{"s" if len(reports) > 1 else ""}: '
+                        + " ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in reports)
+                        + "</p>") if reports else ""
         parts.append(
             f'<section id="{sid}"><h2>{i}. {escape(r["title"])}</h2>'
             f'<p>{escape(ABOUT.get(r.get("section", ""), ""))}</p>'
             f'<p class="result"><strong>Result:</strong> {escape(r["value"])} '
             f'<span class="file">[{r.get("seconds", 0)} s]</span></p>'
-            + "".join(figs) + f'<p class="files">Files: {files}</p></section>')
+            + report_links + "".join(figs) + f'<p class="files">Files: {files}</p></section>')
+    page_list = ", ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in pages)
     html = ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
             "<title>volerr demo</title><style>"
@@ -388,13 +429,14 @@ def _index(out: Path, results: list) -> None:
             "max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
             "h1{font-size:1.9em}h2{font-size:1.35em;border-bottom:2px solid #ddd;"
             "padding-bottom:.2em;margin-top:2em}"
-            "figure{margin:1.2em 0}img{width:100%;height:auto;border:1px solid #eee}"
+            "figure{margin:1.2em 0}img{max-width:100%;height:auto;border:1px solid #eee}"
             "figcaption{font-size:.95em;color:#444}.file{color:#777;font-size:.9em}"
             ".result{background:#f5f7fa;padding:.6em .9em;border-left:4px solid #4a7}"
             ".files a{margin-right:.8em}</style></head><body>"
             "<h1>volerr demo</h1><p>Every step below ran a real <code>volerr</code> command "
-            "on built-in data; units um and urad unless stated.  Click a figure for full "
-            "size; the files next to this page hold every number.</p>"
+            "on built-in data; units µm and µrad unless stated.  Click a figure for full "
+            "size; the files next to this page hold every number.  Report pages: "
+            f"{page_list}.</p>"
             f"<ol>{''.join(toc)}</ol>{''.join(parts)}</body></html>\n")
     write_text(out / "index.html", html)
 
@@ -405,7 +447,7 @@ def run(args) -> int:
     from ..fileio import Outputs
 
     final = Path(args.out)
-    outs = Outputs().folder("--out", final).check()
+    outs = Outputs(force=args.force).folder("--out", final).check()
     results = []
     t0 = time.perf_counter()
     here = os.getcwd()
@@ -427,15 +469,22 @@ def run(args) -> int:
                 "iso230_2": lambda: _iso230_2(out),
                 "uncertainty": lambda: _uncertainty(out),
             }
-            for name in args.only or SECTIONS:
+            from ..progress import bar
+
+            todo = args.only or SECTIONS
+            progress = bar(len(todo), "volerr demo", unit="section")
+            for name in todo:
+                progress.set_postfix_str(name)
                 t = time.perf_counter()
                 r = steps[name]()
+                progress.update()
                 r["section"] = name
                 r["seconds"] = round(time.perf_counter() - t, 1)
                 results.append(r)
                 print(f"{r['title']}: {r['value']}  [{r['seconds']} s]")
+            progress.close()
             _index(out, results)
-            write_text(out / "summary.json", json.dumps(results, indent=2) + "\n")
+            write_text(out / "summary.json", json_text(results))
         finally:
             os.chdir(here)
     print(f"report: {final / 'index.html'}  ({time.perf_counter() - t0:.0f} s)")

@@ -52,7 +52,8 @@ def run(args) -> int:
     require(not dup, f"two layouts generate the same module {dup[0] if dup else ''}: give them "
                      f"different names or derive them one at a time")
     inputs = [p for p in (Path(n) for n in args.layout) if p.is_file()]
-    outs = Outputs(inputs, allow_package=in_package).folder("--out", out).check()
+    # rewriting generated modules is what derive is for: its files may be replaced
+    outs = Outputs(inputs, allow_package=in_package).folder("--out", out, replace=True).check()
     texts = {}
     from ._common import progress
 

@@ -8,12 +8,11 @@ Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
 
 from __future__ import annotations
 
-import json
 
 from ..cmm import diagonals
 from ._common import add_common, error_functions_from_args, inputs_of, parse_at
 from ..errors import require
-from ..fileio import Outputs, write_text
+from ..fileio import Outputs, json_text, write_text
 from ..machine.model import load
 from ..cmm.volmap import linear_axes, volume
 
@@ -24,7 +23,8 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
     p.add_argument("--lines", nargs="+", choices=diagonals.KINDS, default=list(diagonals.KINDS),
-                   help="which lines (default: all)")
+                   help="which lines: space diagonals, face diagonals, axis-parallel "
+                        "lines")
     p.add_argument("--profile-points", type=int, default=21, metavar="N",
                    help="points along each line for the profile (default 21)")
     p.add_argument("--json", metavar="F", help="results with profiles as JSON")
@@ -50,7 +50,7 @@ def run(args) -> int:
             doc = {"layout": model.name, "probe_mm": [float(v) for v in args.probe],
                    "errors": str(args.errors), "method": args.method,
                    "lines": [r.as_dict() for r in results]}
-            write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+            write_text(outs.path("--json"), json_text(doc), inputs)
         if args.plot:
             diagonals.plot_lines(results, outs.path("--plot"),
                                  f"{model.name}: length deviations ({args.errors})", inputs)

@@ -4,16 +4,17 @@ Reads tracker point data (``round,point,position,x,y,z`` CSV, or the thesis' raw
 ``--format thesis --positions start:stop:count``), identifies the six error motions of axis A
 at every commanded position of every round (weighted least squares by default, ``--method
 closed`` for the Zhang & Hu closed form), averages the rounds and writes the error table
-(``_std`` columns with several rounds, ``_u95`` with ``--tracker``).  See ``volerr.identify.solve``.
+(with n rounds: ``_s`` = the standard deviation s of one round and ``_std`` = s / sqrt(n), the
+uncertainty of the mean; ``_u95`` with ``--tracker``).  See ``volerr.identify.solve``.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
+from pathlib import Path
 
-from ._common import add_vector
+from ._common import add_force, add_json, add_plot, add_vector
 
 
 def register(sub) -> None:
@@ -25,11 +26,14 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="tracker data file(s)")
     p.add_argument("--axis", required=True, help="the measured axis (X, Y, Z, B, C ...)")
-    p.add_argument("--out", required=True, metavar="DIR/A.csv",
-                   help="output error table (CSV).  For 'volerr squareness' and 'volerr map' "
-                        "name it after the axis inside an error directory: DIR/X.csv, "
-                        "DIR/Y.csv ... (add constants.csv there for squareness / location "
-                        "errors)")
+    out = p.add_mutually_exclusive_group(required=True)
+    out.add_argument("--errors-out", metavar="DIR",
+                     help="write the error table as DIR/<axis>.csv of an error directory (for "
+                          "'volerr squareness', 'map', 'uncertainty'); DIR is created when "
+                          "missing, its parent must exist")
+    out.add_argument("--out", metavar="F.csv",
+                     help="write the error table to this file instead (name it after the axis "
+                          "inside an error directory: DIR/X.csv ...)")
     p.add_argument("--format", choices=("csv", "thesis"), default="csv",
                    help="csv: round,point,position,x,y,z (default); thesis: the raw export of "
                         "the thesis, blocks of label,x,y,z rows, one file per round")
@@ -52,9 +56,9 @@ def register(sub) -> None:
                    help="a point X Y Z on a rotary axis in the measurement frame, mm (X Y Z or "
                         "X,Y,Z; not given: 0 0 0), or 'layout': the axis point of the layout")
     p.add_argument("--sense", choices=("auto", "+", "-"), default="auto",
-                   help="sense of the nominal motion of the points (default: from the data)")
+                   help="sense of the nominal motion of the points; auto: from the data")
     p.add_argument("--max-cond", type=float, default=1e4,
-                   help="refuse point geometry with a larger condition number (default 1e4)")
+                   help="refuse point geometry with a larger condition number")
     p.add_argument("--outlier-k", type=float, default=5.0,
                    help="flag points whose residual exceeds k times the noise (default 5)")
     p.add_argument("--fit", choices=("poly", "smooth", "linear", "cubic"),
@@ -68,8 +72,9 @@ def register(sub) -> None:
                         "and re-referenced to the tool point; a linear axis measured from a "
                         "reference position q0 != 0: re-referenced to q = 0; measurement frame = "
                         "machine frame), ready for map / compensate")
-    p.add_argument("--json", help="write a summary (JSON)")
-    p.add_argument("--plot", help="write a plot of the error motions (PNG)")
+    add_json(p, "a summary")
+    add_plot(p, "a plot of the error motions")
+    add_force(p)
     p.set_defaults(func=run)
 
 
@@ -80,7 +85,7 @@ def _vec(text, what):
 
 
 def run(args) -> int:
-    from ..fileio import Outputs, write_text
+    from ..fileio import Outputs, json_text, write_text
     from ..identify.inputs import read_rounds, refuse_repeated_files
     from ..identify.report import outlier_warnings, residual_csv, summary_lines
     from ..identify.solve import identify, to_model_signs
@@ -91,7 +96,10 @@ def run(args) -> int:
 
     inputs = list(args.files) + layout_inputs(args.layout)
     refuse_repeated_files(args.files)
-    outs = Outputs(inputs).file("--out", args.out).file("--residuals", args.residuals) \
+    axis = args.axis.strip().upper()
+    outs = Outputs(inputs, force=args.force).file("--out", args.out) \
+        .folder("--errors-out", args.errors_out, files=[f"{axis}.csv"]) \
+        .file("--residuals", args.residuals) \
         .file("--json", args.json).plot("--plot", args.plot).check()
     layout = read_layout(args.layout)
     rounds = read_rounds(args.files, args.format, args.positions, args.points)
@@ -117,12 +125,15 @@ def run(args) -> int:
         if args.plot:
             from ..identify.plots import plot_identification
             plot_identification(result, outs.path("--plot"), fits)
-        write_text(outs.path("--out"), text, inputs=inputs)
+        table_path = (outs.path("--out") if args.out else
+                      outs.path("--errors-out") / f"{axis}.csv")
+        write_text(table_path, text, inputs=inputs)
         if args.residuals:
             write_text(outs.path("--residuals"), residual_csv(result), inputs=inputs)
         if args.json:
-            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
-    print("\n".join(summary_lines(args.axis, summary, args.out)))
+            write_text(outs.path("--json"), json_text(summary), inputs=inputs)
+    written = args.out or str(Path(args.errors_out) / f"{axis}.csv")
+    print("\n".join(summary_lines(args.axis, summary, written)))
     for line in outlier_warnings(summary):
         print(line, file=sys.stderr)
     return 0

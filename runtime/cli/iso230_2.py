@@ -1,7 +1,9 @@
 """``volerr iso230-2``: ISO 230-2 evaluation of laser-interferometer positioning runs.
 
-    volerr iso230-2 RUN.csv [RUN2.csv ...] [--axis X] --json F [--plot P] [--table-out DIR]
-                    [--html F] [--cte-ppm-per-K A [--material-temp-C T] [--cte-reference-mm P]]
+    volerr iso230-2 RUN.csv [RUN2.csv ...] [--axis X] [--json F] [--plot P] [--html F]
+                    [--errors-out DIR] [--tolerance "A=..,E=..,M=..,R=..,B=.."]
+                    [--machine T --instrument T --operator T --date D]
+                    [--cte-ppm-per-K A [--material-temp-C T] [--cte-reference-mm P]]
 
 Parses arguments and calls :mod:`volerr.positioning`; formats are described there and in
 ``--help``.
@@ -9,11 +11,11 @@ Parses arguments and calls :mod:`volerr.positioning`; formats are described ther
 
 from __future__ import annotations
 
-import argparse
-import json
 from pathlib import Path
 
 from ..errors import require
+from ._common import (add_errors_out, add_force, add_html, add_identification, add_json,
+                      add_plot, finite_option, identification_from_args)
 
 EPILOG = """\
 input formats (CSV; ';' or tab separated exports are read too; names case-insensitive):
@@ -45,17 +47,28 @@ outputs:
   --json: ISO 230-2:2014 clause 3 figures in um: A_um A_fwd_um A_bwd_um B_um B_avg_um R_um
   R_fwd_um R_bwd_um E_um E_fwd_um E_bwd_um M_um, per-target arrays (targets_mm, mean_fwd_um,
   mean_bwd_um, mean_um, reversal_um, s_fwd_um, s_bwd_um, R_i_fwd_um, R_i_bwd_um, R_i_um),
-  axis, n_cycles, temperature_correction.  Several RUN files: {"runs": [...]}, same keys per run.
+  axis, n_cycles, temperature_correction; uncertainty_um {A, E, M, R, B: U (k = 2)} and
+  uncertainty_budget (ISO/TR 230-9); with --tolerance: tolerance_um, verdicts {Q: pass |
+  fail | undecided}, verdict, decision_rule (ISO 14253-1); identification.  Several RUN
+  files: {"runs": [...]}, same keys per run, and the overall verdict.
   E is bidirectional: max - min of the mean deviations of BOTH directions (not max(E_fwd,
   E_bwd)); B = max |B_i|, B_avg = mean of B_i = forward minus backward.
-  --table-out DIR: DIR/<axis>.csv with <axis>,EXX_um,EXX_std_um,RV_X_um,S_X_um (axis X):
+  --errors-out DIR: DIR/<axis>.csv with <axis>,EXX_um,EXX_std_um,EXX_s_um,RV_X_um (axis X):
   EXX = mean bidirectional deviation x_i; EXX_std = its standard uncertainty (Type A)
-  S_i / sqrt(2 n), n cycles per direction (2 n readings per target); RV_X = reversal B_i;
-  S_X = pooled single-reading repeatability S_i = sqrt((S_fwd^2 + S_bwd^2)/2) (ignored by
-  the table reader).  Readable by 'volerr map --errors DIR' and 'volerr uncertainty --errors
-  DIR' with its default --table-std systematic (EXX_std is the uncertainty of the error
-  function at each node).  Not with --table-std repeatability: that wants a single-reading
-  scatter per probing point, and EXX_std is sqrt(2 n) times smaller than S_X.
+  S_i / sqrt(2 n), n cycles per direction (2 n readings per target); EXX_s = the pooled
+  single-reading repeatability S_i = sqrt((S_fwd^2 + S_bwd^2)/2); RV_X = reversal B_i.
+  Readable by 'volerr map --errors DIR' and 'volerr uncertainty --errors DIR' (_std: the
+  uncertainty of the error function at each node; _s with --repeatability).
+
+measurement uncertainty (ISO/TR 230-9; contributors of ISO 230-2 Annex A), k = 2:
+  instrument u = ppm L / sqrt 3; alignment e = D^2 / (2 L), u = e / sqrt 12; temperature
+  (with --cte-ppm-per-K) u = L cte u(T) and L |T - 20| u(cte); environment u = EVE /
+  (2 sqrt 3); repeatability from the run: E S sqrt(2/n), M S/sqrt(n), B S sqrt(2/n),
+  R 4 S/sqrt(2(n-1)), A sqrt(2 S^2/n + 8 S^2/(2(n-1))).  R and B: environment and
+  repeatability only (the rest cancels at one target).
+verdict (ISO 14253-1, --tolerance): pass when value <= tolerance - U, fail when value >
+  tolerance + U, undecided in between; the plot rings the readings that decide a quantity
+  that fails or is undecided.
 """
 
 
@@ -67,20 +80,37 @@ def register(sub) -> None:
                     "deviations, reversal B, repeatability R, systematic error E, M and "
                     "accuracy A; the standard's plot, an HTML certificate and an error table "
                     "with reversal for --errors DIR.",
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=EPILOG)
     p.add_argument("runs", nargs="+", metavar="RUN.csv", help="positioning run(s), long or "
                                                                "wide format (below)")
     p.add_argument("--axis", default="X",
                    help="axis letter of the runs (X Y Z U V W; default X), or a comma list with "
                         "one letter per RUN file")
-    p.add_argument("--json", required=True, metavar="F", help="write the results (JSON)")
-    p.add_argument("--plot", metavar="P.png", help="write the ISO 230-2 plot (PNG)")
-    p.add_argument("--html", metavar="F", help="write a one-page report (HTML, plot embedded)")
-    p.add_argument("--table-out", metavar="DIR",
-                   help="write DIR/<axis>.csv for --errors DIR: mean bidirectional deviation, "
-                        "its standard uncertainty S/sqrt(2n) (_std; fits 'volerr uncertainty "
-                        "--table-std systematic', the default), reversal (RV_<axis>_um) and "
-                        "the single-reading repeatability S (S_<axis>_um)")
+    add_json(p, "the results")
+    add_plot(p, "the ISO 230-2 plot")
+    add_html(p, "the certificate (identification, results with U, verdicts, plot, budget)")
+    add_errors_out(p, "DIR/<axis>.csv: mean bidirectional deviation, its standard "
+                      "uncertainty S/sqrt(2n) (_std), the single-reading repeatability S (_s) "
+                      "and the reversal (RV_<axis>_um),", "--table-out")
+    add_force(p)
+    p.add_argument("--tolerance", metavar="'A=..,E=..'",
+                   help="tolerances in um of any of A E M R B: verdicts per ISO 14253-1 "
+                        "(tolerance reduced / widened by U)")
+    u = p.add_argument_group("measurement uncertainty (ISO/TR 230-9)")
+    u.add_argument("--instrument-ppm", type=float, default=0.5, metavar="P",
+                   help="accuracy of the interferometer with its environmental compensation, "
+                        "ppm of the length (a maximum error, rectangular)")
+    u.add_argument("--alignment-mm", type=float, default=0.1, metavar="D",
+                   help="lateral offset of the beam over the travel after alignment, mm "
+                        "(cosine error D^2 / 2L)")
+    u.add_argument("--temperature-u-K", type=float, default=0.2, metavar="U",
+                   help="standard uncertainty of the material temperature, K")
+    u.add_argument("--cte-u-ppm-per-K", type=float, default=1.0, metavar="U",
+                   help="standard uncertainty of the expansion coefficient, ppm/K")
+    u.add_argument("--eve-um", type=float, metavar="V",
+                   help="environmental variation error of a drift test, um (not given: not "
+                        "included, noted)")
+    add_identification(p, "the laser interferometer")
     g = p.add_argument_group("correction to 20 degC")
     g.add_argument("--cte-ppm-per-K", type=float, metavar="A",
                    help="coefficient of expansion of the scale / material, ppm/K (um/m/K); "
@@ -105,7 +135,7 @@ def run(args) -> int:
     import sys
 
     from .. import positioning as pos
-    from ..fileio import Outputs, write_bytes, write_text
+    from ..fileio import Outputs, json_text, write_bytes, write_text
 
     inputs = list(args.runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs), "the same RUN file is given "
@@ -114,38 +144,58 @@ def run(args) -> int:
             "--material-temp-C is used only with --cte-ppm-per-K")
     axes = _axes(args.axis, len(inputs))
     dup = sorted({a for a in axes if axes.count(a) > 1})
-    require(not args.table_out or not dup,
-            f"--table-out writes one table per axis: {len(inputs)} runs of axis "
+    require(not args.errors_out or not dup,
+            f"--errors-out writes one table per axis: {len(inputs)} runs of axis "
             f"{dup[0] if dup else ''}; evaluate them one at a time")
-    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
-        .file("--html", args.html) \
-        .folder("--table-out", args.table_out, files=[f"{a}.csv" for a in axes]).check()
+    for opt in ("instrument_ppm", "alignment_mm", "temperature_u_K", "cte_u_ppm_per_K",
+                "eve_um"):
+        finite_option(getattr(args, opt), "--" + opt.replace("_", "-"), 0.0, 1e3)
+    from .. import conformance
+    tolerance = (conformance.parse_tolerances(args.tolerance, ("A", "E", "M", "R", "B"))
+                 if args.tolerance else None)
+    outs = Outputs(inputs, force=args.force).file("--json", args.json) \
+        .plot("--plot", args.plot).file("--html", args.html) \
+        .folder("--errors-out", args.errors_out, files=[f"{a}.csv" for a in axes]).check()
 
     runs = pos.evaluate_files(inputs, axes, args.cte_ppm_per_K, args.material_temp_C,
                               args.cte_reference_mm)
     evaluations = runs.evaluations
-    report = runs.report()
-    table_texts = [pos.error_table_csv(ev) for ev in evaluations] if args.table_out else []
-    png = pos.plot_runs(evaluations) if (args.plot or args.html) else None
+    conditions = {}
+    if args.cte_ppm_per_K is not None:
+        conditions["expansion coefficient"] = f"{args.cte_ppm_per_K:g} ppm/K (corrected to " \
+                                              f"20 \u00b0C)"
+    if args.material_temp_C is not None:
+        conditions["material temperature"] = f"{args.material_temp_C:g} \u00b0C"
+    ident = identification_from_args(args, conditions)
+    report = runs.report(inputs=pos.BudgetInputs(args.instrument_ppm, args.alignment_mm,
+                                                 args.temperature_u_K, args.cte_u_ppm_per_K,
+                                                 args.eve_um),
+                         tolerance=tolerance, identification=ident)
+    table_texts = [pos.error_table_csv(ev) for ev in evaluations] if args.errors_out else []
+    per_run = report["runs"] if "runs" in report else [report]
+    png = (pos.plot_runs(evaluations, verdicts_per_run=[r.get("verdicts") for r in per_run])
+           if (args.plot or args.html) else None)
     html_text = None
     if args.html:
         from .. import __version__ as ver
         import datetime
         html_text = pos.report_html(report, png, inputs, f"Evaluated with volerr {ver} on "
-                                                         f"{datetime.date.today().isoformat()}.")
+                                                         f"{datetime.date.today().isoformat()}.",
+                                    identification=ident)
 
     # all outputs at the end, all or nothing
     with outs:
-        write_text(outs.path("--json"), json.dumps(report, indent=2) + "\n", inputs=inputs)
+        write_text(outs.path("--json"), json_text(report), inputs=inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), png, inputs=inputs)
         if html_text is not None:
             write_text(outs.path("--html"), html_text, inputs=inputs)
         for a, text in zip(axes, table_texts):
-            write_text(outs.path("--table-out") / f"{a}.csv", text, inputs=inputs)
+            write_text(outs.path("--errors-out") / f"{a}.csv", text, inputs=inputs)
 
     lines, notes = pos.summary_lines(report)
     print("\n".join(lines))
+    notes += [f"{r['file']}: {n}" for r in per_run for n in r["uncertainty_budget"]["notes"]]
     for n in notes:
         print(f"volerr iso230-2: note: {n}", file=sys.stderr)
     return 0

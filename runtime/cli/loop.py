@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ..errors import require
 from ..fileio import Outputs
+from ._common import add_errors_out, add_force, add_html, add_json
 
 
 def register(sub) -> None:
@@ -27,13 +28,13 @@ def register(sub) -> None:
     p.add_argument("data", nargs="+", metavar="FILE",
                    help="measurement files of any instruments (deviations, ballbar, sphere; "
                         "KIND:FILE to name the kind), one campaign")
-    p.add_argument("--json", help="write the report (JSON)")
-    p.add_argument("--html", help="write the report with figures (HTML)")
-    p.add_argument("--out-dir", help="folder for the augmented layout and generated module "
-                                     "(default: the folder of --json)")
-    p.add_argument("--errors-out", metavar="DIR",
-                   help="write the fitted error functions (effects removed) as an error "
-                        "directory: X.csv, Y.csv, ... and constants.csv")
+    add_json(p, "the report")
+    add_html(p, "the report with figures")
+    p.add_argument("--out-dir", metavar="DIR",
+                   help="folder for the augmented layout and its generated module (not given: "
+                        "the folder of --json or --html; neither: not written)")
+    add_errors_out(p, "the fitted error functions (effects removed)")
+    add_force(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
                                              "leave-one-point-out, exact via the hat matrix)")
@@ -53,16 +54,18 @@ def run(args) -> int:
     from ._common import layout_inputs
     from ..machine.model import load
 
-    require(args.json or args.html, "give --json or --html (or both) for the report")
     from ..instruments import split_spec
 
     inputs = [split_spec(d)[1] for d in args.data] + layout_inputs(args.layout)
     model = load(args.layout)
     aug = (f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py")
-    out_dir = (Path(args.out_dir) if args.out_dir
-               else Path(args.json or args.html).resolve().parent)
-    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
-        .folder("--out-dir", out_dir, files=aug) \
+    # as the user named it (no resolve): the report names the files where they end up
+    out_dir = (Path(args.out_dir) if args.out_dir else
+               Path(args.json or args.html).parent if (args.json or args.html) else None)
+    # named in messages: the option, or where its default put the folder
+    OUT_DIR = "--out-dir" if args.out_dir else "--out-dir (not given: the report's folder)"
+    outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
+        .folder(OUT_DIR, out_dir, files=aug) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     families = candidates.FAMILIES
@@ -72,7 +75,7 @@ def run(args) -> int:
         require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
                 f"{' '.join(candidates.FAMILIES)}")
     with outs:
-        staged = outs.path("--out-dir")
+        staged = outs.path(OUT_DIR)
         data = args.data[0] if len(args.data) == 1 else args.data
         report = run_loop(args.layout, data, seed=args.seed, folds=args.folds,
                           test_fraction=args.test_fraction, degree=args.degree,

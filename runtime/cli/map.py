@@ -7,12 +7,11 @@ deviations in the tables also ``<plot>_random.png`` or ``--plot-random``) and pr
 
 from __future__ import annotations
 
-import json
 
 from ._common import add_common, error_functions_from_args, inputs_of, parse_at
 from ..cmm import volmap
 from ..errors import require
-from ..fileio import Outputs, write_text
+from ..fileio import Outputs, json_text, write_text
 from ..machine.model import load
 
 
@@ -59,7 +58,7 @@ def run(args) -> int:
             s["random_magnification"] = volmap.plot_random(vmap, outs.path("--plot-random"),
                                                            args.magnify, inputs)
         if args.json:
-            write_text(outs.path("--json"), json.dumps(s, indent=2) + "\n", inputs)
+            write_text(outs.path("--json"), json_text(s), inputs)
     print(f"{model.name}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
           f"probe {' '.join(f'{v:g}' for v in vmap.probe)} mm")
     m = s["max_abs_um"]

@@ -11,13 +11,12 @@ Conventions: see :mod:`volerr.probe.calibration`.
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
-from ._common import add_vector
+from ._common import add_force, add_vector
 from ..errors import require
-from ..fileio import write_text
+from ..fileio import json_text, write_text
 from ..units import parse_number
 
 
@@ -54,7 +53,9 @@ def register(sub) -> None:
                    help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map "
                         "(Fig. 3b)")
     p.add_argument("--plots", metavar="DIR",
-                   help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png (Fig. 3b)")
+                   help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png (Fig. 3b) into "
+                        "DIR (created when missing, its parent must exist)")
+    add_force(p)
     g = p.add_argument_group("plan generation (--plan)")
     g.add_argument("--plan", metavar="PLAN.csv",
                    help="write a probing plan (nominal ball centres x,y,z,phi_deg,theta_deg) "
@@ -114,7 +115,8 @@ def run(args) -> int:
     from ..fileio import Outputs
 
     inputs = [args.data]
-    outs = Outputs(inputs).file("--out", args.out).file("--json", args.json) \
+    outs = Outputs(inputs, force=args.force).file("--out", args.out) \
+        .file("--json", args.json) \
         .plot("--plot", args.plot) \
         .folder("--plots", args.plots, files=("probe_map_3d.png", "probe_map_2d.png")).check()
     require(args.degree is None or 0 <= args.degree <= 20,
@@ -127,7 +129,7 @@ def run(args) -> int:
     with outs:
         write_text(outs.path("--out"), probe.map_csv_text(cal), inputs=inputs)
         if args.json:
-            write_text(outs.path("--json"), json.dumps(summary, indent=2) + "\n", inputs=inputs)
+            write_text(outs.path("--json"), json_text(summary), inputs=inputs)
         if args.plot:
             from ..probe.plots import plot_probe_calibration
 

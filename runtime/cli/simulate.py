@@ -71,7 +71,8 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("--out", required=True, help="measured-deviation CSV to write")
     p.add_argument("--points", type=int, default=600, help="number of points (default 600)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the machine's error functions, points and noise")
     add_vector(p, "--probe", append=True,
                help="probe/tool offset X Y Z in mm (X Y Z or X,Y,Z; repeat for several; "
                     "default: a plan of five)")

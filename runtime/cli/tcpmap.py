@@ -1,4 +1,4 @@
-"""``volerr tcpmap LAYOUT --errors DIR --point X Y Z --out F.png``: tool-tip error over the
+"""``volerr tcpmap LAYOUT --errors DIR --point X Y Z --plot F.png``: tool-tip error over the
 range of the two rotary axes of a five-axis machine for one workpiece point.
 
 For every pair of rotary positions the linear axes follow the nominal inverse kinematics so
@@ -29,8 +29,10 @@ def register(sub) -> None:
     add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
                help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z)")
     p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
-    p.add_argument("--out", required=True, help="PNG file")
-    p.add_argument("--csv", help="grid as CSV")
+    from ._common import add_plot
+
+    add_plot(p, "the map", "--out", required=True)
+    p.add_argument("--csv", metavar="F.csv", help="write the grid (CSV)")
     p.set_defaults(func=run)
 
 
@@ -55,20 +57,20 @@ def run(args) -> int:
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
-    outs = Outputs(inputs).plot("--out", args.out).file("--csv", args.csv).check()
+    outs = Outputs(inputs).plot("--plot", args.plot).file("--csv", args.csv).check()
     tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps)
     a1, a2, q1, q2, err, valid = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err, tmap.valid
     require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
                          "for every rotary position")
     with outs:
-        plot_tcp_error_map(tmap, outs.path("--out"))
+        plot_tcp_error_map(tmap, outs.path("--plot"))
         if args.csv:
             write_text(outs.path("--csv"), _grid_csv(tmap), inputs)
     mag = np.linalg.norm(err, axis=2) * 1e3
     print(f"{model.name}: tool-tip error at ({', '.join(f'{v:g}' for v in args.point)}) mm over "
           f"{a1} {q1[0]:g}..{q1[-1]:g} deg, {a2} {q2[0]:g}..{q2[-1]:g} deg: max "
           f"{np.nanmax(mag):.3f} um, min {np.nanmin(mag):.3f} um "
-          f"({int(valid.sum())} of {valid.size} grid points valid); wrote {args.out}")
+          f"({int(valid.sum())} of {valid.size} grid points valid); wrote {args.plot}")
     # notes only after success: bad input gets exactly one line on stderr
     for note in notes:
         print(f"note: {note}", file=sys.stderr)

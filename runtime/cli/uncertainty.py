@@ -4,22 +4,23 @@ uncertainty by Monte Carlo (virtual CMM, ISO/TS 15530-4; JCGM 101).
 Machine knowledge: identified error tables with their std / u95 columns (--errors), or a
 specification only (--spec "E0=A+L/K", constrained Monte Carlo), plus probing noise
 (--noise-um), a probe error map (--probe-map) and temperature.  With only --noise-um the
-machine is perfect and the noise independent per point.  Reports estimate, bias of the known
-errors, u, U (k = 2) and the probabilistically symmetric 95 % interval.  Models and
-conventions: volerr.uncertainty.
+machine is perfect and the noise independent per point.  Reports the result corrected for the
+bias of the known errors (or, with --bias uncorrected, the reading with an interval that
+contains the bias), u, U (k = 2) and the 95 % coverage interval.  Models and conventions:
+volerr.uncertainty.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from ._common import add_error_arguments
+from ._common import add_error_arguments, add_html, add_json, add_plot
 from ..errors import require
-from ..fileio import Outputs, write_bytes, write_text
+from ..fileio import Outputs, json_text, write_bytes, write_text
 from ..machine.model import load
 from ..uncertainty import ensemble, montecarlo as mc, tasks
 from ..uncertainty import report
+from ..uncertainty.report import BIAS_MODES
 
 
 def register(sub) -> None:
@@ -32,12 +33,19 @@ def register(sub) -> None:
                    help="distance, circle, sphere or plane")
     add_error_arguments(p, required=False)
     p.add_argument("--table-std", choices=("systematic", "repeatability"), default="systematic",
-                   help="meaning of the tables' std columns.  systematic (default): the "
-                        "standard uncertainty of the tabulated error function at each node; "
-                        "one perturbed function per machine (what 'iso230-2 --table-out' "
-                        "writes as _std: S/sqrt(2n), the uncertainty of the mean deviation).  "
-                        "repeatability: the scatter of one positioning, drawn independently "
-                        "per probing point (a single-reading S, not the _std of iso230-2)")
+                   help="how the tables' _std columns are drawn.  systematic: as what _std is "
+                        "('volerr formats tables'), the standard uncertainty of the tabulated "
+                        "value, one perturbed error function per machine.  repeatability: for "
+                        "old tables whose _std held a single-reading scatter, drawn "
+                        "independently per probing point")
+    p.add_argument("--repeatability", action="store_true",
+                   help="also draw the tables' _s columns (repeatability of one reading) "
+                        "independently at every probing point (the machine's scatter during "
+                        "the task; an identify table's _s holds the tracker's scatter too)")
+    p.add_argument("--bias", choices=BIAS_MODES, default="corrected",
+                   help="corrected: state the estimate minus the bias of the known errors, "
+                        "with U; uncorrected: the reading, with an interval widened to "
+                        "contain the bias")
     p.add_argument("--correlation-mm", type=float, default=0.0, metavar="L",
                    help="correlation length of the node perturbations along an axis "
                         "(default 0: independent nodes)")
@@ -45,6 +53,7 @@ def register(sub) -> None:
                    "K), optionally ',PFTU=P' um: constrained Monte Carlo")
     p.add_argument("--spec-acceptance", type=float, default=0.5, metavar="F",
                    help="fraction of prior candidates passing the test (sets the prior scale)")
+
     p.add_argument("--noise-um", type=float, default=0.0, metavar="S",
                    help="probing noise, standard deviation per point, um")
     p.add_argument("--probe-map", metavar="MAP.csv", help="probe error map of probe-cal "
@@ -63,24 +72,38 @@ def register(sub) -> None:
                    help="adaptive Monte Carlo, JCGM 101 7.9 (--digits significant digits)")
     p.add_argument("--digits", type=int, default=2, help="significant digits of u for "
                                                         "--adaptive (default 2)")
-    p.add_argument("--max-samples", type=int, default=1_000_000)
-    p.add_argument("--seed", type=int, default=0, metavar="K")
+    p.add_argument("--max-samples", type=int, default=1_000_000, metavar="N",
+                   help="--adaptive: stop after this many samples even when not converged")
+    p.add_argument("--seed", type=int, default=0, metavar="K",
+                   help="seed of the random draws (same seed, same numbers)")
     p.add_argument("--chunks", type=int, default=1, metavar="M",
                    help="split the samples into M chunks (results identical for any M)")
-    p.add_argument("--scheduler", choices=("none", "dask"), default="none")
+    p.add_argument("--scheduler", choices=("none", "dask"), default="none",
+                   help="none: chunks in this process; dask: on a dask cluster (pip install "
+                        "'volerr[dask]')")
     p.add_argument("--scheduler-address", metavar="ADDR", help="an existing dask scheduler")
     p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (default 2)")
     p.add_argument("--contributions", type=int, default=2000, metavar="N",
                    help="samples per source for the one-at-a-time ranking (0: skip)")
-    p.add_argument("--json", required=True, metavar="F")
-    p.add_argument("--html", metavar="F", help="report with histogram and convergence plots")
-    p.add_argument("--plot", metavar="PNG", help="histogram plot")
+    add_json(p, "the results")
+    add_html(p, "the report (header, result statement, contributions, histogram and "
+                "convergence plots)")
+    add_plot(p, "the histogram with the coverage interval")
     p.add_argument("--backend", choices=("numpy", "numba"), default="numpy",
                    help="evaluation of the samples: numpy (default) or the fused numba kernel "
                         "(pip install 'volerr[fast]'; 1-4 s to compile once, pays from ~1e8 "
                         "point evaluations; same values)")
-    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--quiet", action="store_true",
+                   help="print nothing (no progress, no result lines)")
     p.set_defaults(func=run)
+
+
+#: captions of the report's figures
+CAPTIONS = ("Distribution of the Monte Carlo readings about their mean (the estimate): red, the "
+            "probabilistically symmetric 95 % coverage interval; blue dashed, estimate \u00b1 U "
+            "(k = 2).",
+            "Convergence: running mean (about the final mean) and running standard "
+            "uncertainty u (k = 1) against the number of samples.")
 
 
 def _temperature(args):
@@ -160,12 +183,14 @@ def run(args) -> int:
         pmap = read_probe_map(args.probe_map)
     ens = ensemble.Ensemble.build(funcs, spec, args.noise_um, args.table_std, args.correlation_mm,
                                   _temperature(args), pmap, args.seed,
-                                  spec_acceptance=args.spec_acceptance)
+                                  spec_acceptance=args.spec_acceptance,
+                                  repeatability=args.repeatability)
     backend = _backend(args.backend)
     prob = mc.prepare(model, str(args.layout), task, args.evaluate, ens, seed=args.seed,
                       backend=backend)
-    require(prob.sources, "nothing is random: the tables have no std / u95 columns and no "
-                          "noise, spec or temperature uncertainty is given")
+    require(prob.sources, "nothing is random: the tables have no _std / _u95 columns (their _s "
+                          "columns need --repeatability) and no noise, spec or temperature "
+                          "uncertainty is given")
     runner = mc.Runner(args.scheduler, args.chunks, args.workers, args.scheduler_address,
                        progress=not args.quiet)
     adaptive = None
@@ -181,10 +206,12 @@ def run(args) -> int:
     doc = report.result_document(
         prob, values, summary, info, layout=model.name, task=str(args.task),
         evaluation=args.evaluate, seed=args.seed, chunks=args.chunks, scheduler=args.scheduler,
-        machine=report.machine_text(spec, args.errors if funcs else None, args.table_std),
+        machine=report.machine_text(spec, args.errors if funcs else None, args.table_std,
+                                    args.repeatability),
         noise_um=args.noise_um, adaptive=adaptive, digits=args.digits,
         contributions=(mc.contributions(prob, args.contributions) if args.contributions
-                       else None))
+                       else None), bias=args.bias, table_uncertainty=ens.table_columns,
+        task_points=task.n_points)
     title = f"{model.name} {args.evaluate} ({values.shape[0]} samples)"
     hist = None
     if args.plot or args.html:
@@ -193,11 +220,13 @@ def run(args) -> int:
     if not args.quiet:
         print("\n".join(report.summary_lines(doc)))
     with outs:
-        write_text(outs.path("--json"), json.dumps(doc, indent=2) + "\n", inputs)
+        if args.json:
+            write_text(outs.path("--json"), json_text(doc), inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), hist, inputs)
         if args.html:
             from ..uncertainty import plots
             conv = plots.convergence_png(values, prob.names, title)
-            write_text(outs.path("--html"), report.html_report(doc, [hist, conv]), inputs)
+            write_text(outs.path("--html"), report.html_report(doc, [hist, conv], CAPTIONS),
+                       inputs)
     return 0

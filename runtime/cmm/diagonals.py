@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..plotstyle import label, styled
 from ..units import UM_PER_MM
 from ..errors import require
 from .volmap import fixed_positions, linear_axes
@@ -213,42 +214,43 @@ def format_table(results) -> str:
     return "\n".join(rows)
 
 
+@styled
 def plot_lines(results, path, title: str = "", inputs=()) -> None:
-    """Profiles of the space diagonals (left; +-2 u band with std) and all deviations (right)."""
+    """Profiles of the space diagonals (top; +-2 u band, k = 2, with uncertainty columns) and
+    all deviations (below, bars +-2 u)."""
     import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
+    from ..plotstyle import figure
     from .volmap import save_figure
 
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1, 1.4]})
+    fig, (a1, a2) = figure(2, 1, height=8.5, height_ratios=[1, 1.15])
     space = [r for r in results if r.line.kind == "space"] or results[:4]
     for i, r in enumerate(space):
         c = f"C{i}"
-        a1.plot(r.profile_s_mm, r.profile_um, color=c, label=f"{r.line.name}: {r.deviation_um:+.1f} um")
+        a1.plot(r.profile_s_mm, r.profile_um, color=c,
+                label=f"{r.line.name}: {r.deviation_um:+.1f} \u00b5m")
         if r.profile_random_um is not None:
             a1.fill_between(r.profile_s_mm, r.profile_um - 2 * r.profile_random_um,
                             r.profile_um + 2 * r.profile_random_um, color=c, alpha=0.15)
     a1.axhline(0, color="0.5", lw=0.6)
-    a1.set_xlabel("distance along the diagonal (mm)")
-    a1.set_ylabel("length deviation (um)")
-    a1.set_title("space diagonals" + (" (band: +-2 u)" if space and space[0].profile_random_um
-                                      is not None else ""), fontsize=10)
-    a1.legend(fontsize=8)
+    a1.set_xlabel(label("distance along the diagonal", "mm"))
+    a1.set_ylabel(label("length deviation", "um"))
+    a1.set_title("space diagonals" + (" (band: \u00b12 u, k = 2)" if space and
+                                      space[0].profile_random_um is not None else ""))
+    a1.legend()
     colors = {"space": "C3", "face": "C0", "axis": "C2"}
     x = np.arange(len(results))
     a2.bar(x, [r.deviation_um for r in results], color=[colors[r.line.kind] for r in results],
            yerr=[2 * r.random_um for r in results] if all(r.random_um is not None for r in results)
            else None, capsize=2)
-    a2.set_xticks(x, [r.line.name for r in results], rotation=90, fontsize=7)
-    a2.set_ylabel("length deviation (um)")
+    a2.set_xticks(x, [r.line.name for r in results], rotation=90)
+    a2.set_ylabel(label("length deviation", "um"))
     a2.axhline(0, color="0.5", lw=0.6)
     handles = [matplotlib.patches.Patch(color=c, label=k) for k, c in colors.items()
                if any(r.line.kind == k for r in results)]
-    a2.legend(handles=handles, fontsize=8)
-    a2.set_title("all lines" + (" (error bars: +-2 u)" if results and results[0].random_um
-                                is not None else ""), fontsize=10)
+    a2.legend(handles=handles)
+    a2.set_title("all lines" + (" (error bars: \u00b12 u, k = 2)" if results and
+                                results[0].random_um is not None else ""))
     if title:
-        fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
+        fig.suptitle(title)
     save_figure(fig, path, inputs)

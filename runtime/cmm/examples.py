@@ -19,7 +19,7 @@ from them are therefore not expected to equal the paper's printed diagonals.
 * repeatability: the paper states it as the largest 2 sigma over the positions: 10.75 um (EXX),
   21.0 um (EYY), 12.30 urad (EBX); in the example sigma is zero at the reference position
   (every run is zeroed there) and grows like sqrt(distance) to that value at the end of
-  travel (``_std_`` columns).
+  travel (``_s_`` columns: repeatability of one reading).
 
 ``MH2`` -- CMM B (moving horizontal arm, 1100 mm cube), 10 parameters:
 
@@ -110,7 +110,7 @@ def example_errors(layout: str = "MB1"):
             values[name] = np.round(_smooth(rng, t, band), 4) * scale
             if rep is not None:
                 std[name] = np.round((rep / 2.0) * np.sqrt(t), 4) * scale
-        tables[ax] = ErrorTable(ax, x, values, std=std)
+        tables[ax] = ErrorTable(ax, x, values, s=std)  # repeatability of one reading
     constants = _paper_to_iso(lay.paper_symbols, spec["squareness"])
     return tables, constants
 

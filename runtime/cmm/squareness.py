@@ -108,7 +108,7 @@ def squareness(tables: dict, layout=None, tables_are: str = "carrier"):
                 # keep the value at the reference (first) position: remove slope * (s - s_ref)
                 s_ref = _reference_position(t)
                 vals[name] = vals[name] - slopes[name] * (t.positions - s_ref)
-        corrected[ax] = ErrorTable(t.axis, t.positions, vals, t.std, t.u95)
+        corrected[ax] = ErrorTable(t.axis, t.positions, vals, t.std, t.u95, t.reversal, t.s)
     return values, std, corrected, slopes
 
 

@@ -28,6 +28,7 @@ from ..units import UM_PER_MM
 from ..errors import InputError, require
 from . import csvformat
 from ..fileio import AtomicFile, check_plot
+from ..plotstyle import styled
 
 
 @dataclass
@@ -205,16 +206,16 @@ def write_map_csv(path, vmap: VolumetricMap, inputs=()) -> Path:
 # ---------------------------------------------------------------------------------------------
 # plots
 def save_figure(fig, path, inputs=()) -> Path:
-    """Save a matplotlib figure as PNG atomically, never over an input file."""
+    """Save a matplotlib figure as PNG (:func:`volerr.plotstyle.png`) atomically, never over
+    an input file."""
+    from ..plotstyle import png
+
     out = AtomicFile(check_plot(path, inputs), inputs)
     try:
-        fig.savefig(out.fh, format="png", dpi=120)
+        out.write(png(fig))
     except BaseException:
         out.discard()
         raise
-    finally:
-        import matplotlib.pyplot as plt
-        plt.close(fig)
     return out.commit()
 
 
@@ -248,17 +249,19 @@ def _face_lines(shape):
 
 
 def _axes3d(fig, pos=111):
+    from ..plotstyle import label
+
     ax = fig.add_subplot(pos, projection="3d")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.set_zlabel("z (mm)")
+    ax.set_xlabel(label("x", "mm"))
+    ax.set_ylabel(label("y", "mm"))
+    ax.set_zlabel(label("z", "mm"))
     return ax
 
 
-def _equal_box(ax, pts):
+def _equal_box(ax, pts, zoom: float = 0.85):
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     span = np.where(hi - lo > 0, hi - lo, 1.0)
-    ax.set_box_aspect(tuple(span))
+    ax.set_box_aspect(tuple(span), zoom=zoom)  # < 1: the axis labels stay inside the panel
     pad = 0.08 * span
     ax.set_xlim(lo[0] - pad[0], hi[0] + pad[0])
     ax.set_ylim(lo[1] - pad[1], hi[1] + pad[1])
@@ -273,62 +276,60 @@ def _face_grid(shape, axis: int, side: int):
     return idx[tuple(sl)]
 
 
+@styled
 def plot_map(vmap: VolumetricMap, path, magnify: float | None = None, inputs=()) -> float:
     """Nominal grid (dashed) vs actual grid magnified (solid), like Pahk Fig. 5 / 7(a): the
     outer faces in 3-D, and three faces in their own planes (top z = max, front y = min, side
     x = max) with the in-plane error components.  Returns the magnification used."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from ..plotstyle import PAGE_WIDTH_IN, label, pyplot
 
     k = float(magnify) if magnify else auto_magnification(vmap, vmap.error)
     require(k > 0, f"magnification must be positive, got {k:g}")
     nom, act = vmap.nominal, vmap.nominal + k * vmap.error
-    fig = plt.figure(figsize=(14, 8))
-    gs = fig.add_gridspec(3, 2, width_ratios=[1.7, 1])
-    ax = fig.add_subplot(gs[:, 0], projection="3d")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.set_zlabel("z (mm)")
+    fig = pyplot().figure(figsize=(PAGE_WIDTH_IN, 7.5), layout="constrained")
+    gs = fig.add_gridspec(3, 3, width_ratios=[1.5, 0.12, 1])  # a gap for the 3-D z label
+    ax = _axes3d(fig, gs[:, 0])
     for line in _face_lines(vmap.shape):
         ax.plot(*nom[line].T, ls="--", lw=0.7, color="0.55")
         ax.plot(*act[line].T, ls="-", lw=1.1, color="C3")
     _equal_box(ax, np.vstack([nom, act]))
     s = vmap.summary()
-    ax.set_title(f"{vmap.layout} volumetric error map, errors magnified x{k:g}\n"
-                 f"dashed: nominal grid, solid: actual; max |d| {s['max_length_um']:.1f} um, "
-                 f"RMS {s['rms_length_um']:.1f} um", fontsize=10)
+    ax.set_title(f"{vmap.layout} volumetric error map, errors magnified \u00d7{k:g}\n"
+                 f"dashed: nominal grid, solid: actual\nmax |d| {s['max_length_um']:.1f} "
+                 f"\u00b5m, RMS {s['rms_length_um']:.1f} \u00b5m")
     faces = [(2, 1, (0, 1), "top face z = max"), (1, 0, (0, 2), "front face y = min"),
              (0, 1, (1, 2), "side face x = max")]
-    for row, (axis, side, (i, j), label) in enumerate(faces):
-        a2 = fig.add_subplot(gs[row, 1])
+    for row, (axis, side, (i, j), face) in enumerate(faces):
+        a2 = fig.add_subplot(gs[row, 2])
         g = _face_grid(vmap.shape, axis, side)
         for lines in (g, g.T):
             for line in lines:
                 a2.plot(nom[line, i], nom[line, j], ls="--", lw=0.7, color="0.55")
                 a2.plot(act[line, i], act[line, j], ls="-", lw=1.1, color="C3")
         a2.set_aspect("equal", adjustable="datalim")
-        a2.set_xlabel(f"{'xyz'[i]} (mm)", fontsize=8)
-        a2.set_ylabel(f"{'xyz'[j]} (mm)", fontsize=8)
-        a2.tick_params(labelsize=7)
-        a2.set_title(f"{label} (in-plane errors x{k:g})", fontsize=9)
-    fig.tight_layout()
+        a2.set_xlabel(label("xyz"[i], "mm"))
+        a2.set_ylabel(label("xyz"[j], "mm"))
+        a2.set_title(f"{face} (in-plane errors \u00d7{k:g})")
     save_figure(fig, path, inputs)
     return k
 
 
+@styled
 def plot_random(vmap: VolumetricMap, path, magnify: float | None = None, inputs=()) -> float:
-    """Random component: nominal grid with +-K x (rx, ry, rz) bars at every node (Fig. 7(b))."""
-    require(vmap.random is not None, "no random component: the error tables have no std columns")
+    """Random component: nominal grid with +-K x (rx, ry, rz) bars at every node (Fig. 7(b)):
+    the standard uncertainty (k = 1) of the volumetric error for one reading, from the
+    tables' ``_std`` and ``_s`` columns (:meth:`volerr.tables.ErrorFunctions.sigmas`)."""
+    require(vmap.random is not None, "no random component: the error tables have no _std, "
+                                     "_s or _u95 columns")
     import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib import cm
+
+    from ..plotstyle import label, pyplot
 
     r = vmap.random
     k = float(magnify) if magnify else auto_magnification(vmap, r)
     nom = vmap.nominal
-    fig = plt.figure(figsize=(8.5, 7))
+    fig = pyplot().figure(figsize=(8.0, 6.5), layout="constrained")
     ax = _axes3d(fig)
     for line in _face_lines(vmap.shape):
         ax.plot(*nom[line].T, ls="--", lw=0.6, color="0.6")
@@ -344,10 +345,9 @@ def plot_random(vmap: VolumetricMap, path, magnify: float | None = None, inputs=
     _equal_box(ax, np.vstack([nom - k * r, nom + k * r]))
     sm = cm.ScalarMappable(norm=norm, cmap=cmap)
     fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.14,  # clear of the z label
-                 label="|r| = sqrt(rx^2 + ry^2 + rz^2) (um)")
-    ax.set_title(f"{vmap.layout} random component (1 sigma), bars +-{k:g} x (rx, ry, rz)\n"
-                 f"max |r| {mag.max():.2f} um", fontsize=10)
-    fig.tight_layout()
+                 label=label("|r| = \u221a(rx\u00b2 + ry\u00b2 + rz\u00b2)", "um"))
+    ax.set_title(f"{vmap.layout} random component (k = 1), bars \u00b1{k:g} \u00d7 "
+                 f"(rx, ry, rz)\nmax |r| {mag.max():.2f} \u00b5m")
     save_figure(fig, path, inputs)
     return k
 

@@ -53,6 +53,21 @@ _COMMENT_PAREN = re.compile(r"\([^)]*\)")
 _SIMPLE = re.compile(r"(?:[ \t]*[A-Za-z][ \t]*[+-]?(?:\d+\.?\d*|\.\d+))+[ \t]*")
 _PARTS = re.compile(r"([ \t]*)([A-Za-z])([ \t]*)([+-]?(?:\d+\.?\d*|\.\d+))")
 
+#: a number run straight into an E: exponent notation, which G-code does not have
+_EXPONENT = re.compile(r"([A-Za-z])[ \t]*([+-]?(?:\d+\.?\d*|\.\d+)[eE][+-]?\d+)")
+
+
+def refuse_exponent(text: str, number: int) -> None:
+    """``X1e300`` is no number of G-code: read as written it is ``X1`` followed by a word
+    ``E300``; refused (one line) instead of silently moving to X1."""
+    m = _EXPONENT.search(text)
+    if m:
+        raise InputError(f"line {number}: {m.group(1)}{m.group(2)}: exponent notation is not "
+                         f"G-code (it would read as {m.group(1)}{m.group(2).lower().split('e')[0]}"
+                         f" followed by an E word); write the number in full, or a blank "
+                         f"before an E word")
+
+
 REFUSED_G = {
     2: "G2 circular arc", 3: "G3 circular arc", 10: "G10 offset setting",
     20: "G20 inch units", 41: "G41 cutter radius compensation",
@@ -97,6 +112,7 @@ class Line:
     @classmethod
     def parse(cls, number: int, body: str, ending: str) -> "Line":
         if _SIMPLE.fullmatch(body):
+            refuse_exponent(body, number)
             return cls(number, body, ending, parts=_PARTS.findall(body))
         return cls(number, body, ending, tokens=tokenize(body, number))
 
@@ -189,6 +205,7 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
             if not m:
                 raise InputError(f"line {number}: cannot interpret {body[i:i + 12]!r} (only "
                                  "address words, comments and blanks are supported)")
+            refuse_exponent(body[i:m.end() + 3], number)
             tokens.append(Token("word", m.group(0), i, m.group(1).upper(), float(m.group(3)),
                                 m.start(3), m.end(3)))
             i = m.end()

@@ -5,28 +5,28 @@
 * :func:`plot_program_errors`: predicted tool-tip and tool-axis error along an NC program,
   before and after compensation.
 
-Units: um and urad in the plots; mm / deg / rad in the arguments.
+Units: µm and µrad in the plots; mm / deg / rad in the arguments.  Style: volerr.plotstyle.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..plotstyle import figure, label, save, styled
 
+
+@styled
 def plot_tcp_error_map(tmap, path, title: str = ""):
     """PNG of a :class:`volerr.fiveaxis.tcpmap.TcpMap`: length of the tool-tip error (colour,
-    um), its components and the tool-axis error (urad)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    µm), its components and the tool-axis error (µrad)."""
     a1, a2, q1, q2, err = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err
     mag = np.linalg.norm(err, axis=2) * 1e3
-    fig, axs = plt.subplots(1, 5, figsize=(21, 4.2), constrained_layout=True)
-    panels = [(mag, "|e| / um"), (err[..., 0] * 1e3, "dx / um"), (err[..., 1] * 1e3, "dy / um"),
-              (err[..., 2] * 1e3, "dz / um"),
-              (np.linalg.norm(tmap.orientation, axis=2) * 1e6, "tool-axis error / urad")]
+    fig, grid = figure(2, 3, height=6.6)
+    axs = grid.ravel()
+    axs[5].remove()
+    panels = [(mag, label("|e|", "um")), (err[..., 0] * 1e3, label("dx", "um")),
+              (err[..., 1] * 1e3, label("dy", "um")), (err[..., 2] * 1e3, label("dz", "um")),
+              (np.linalg.norm(tmap.orientation, axis=2) * 1e6, label("tool-axis error", "urad"))]
     for ax, (z, name) in zip(axs, panels):
         zm = np.ma.masked_invalid(z)
         lim = np.nanmax(np.abs(z)) if np.isfinite(z).any() else 1.0
@@ -37,29 +37,25 @@ def plot_tcp_error_map(tmap, path, title: str = ""):
         if np.isfinite(z).sum() > 4:
             ax.contour(q1, q2, zm, levels=6, colors="k", linewidths=0.4)
         ax.set_facecolor("0.85")
-        ax.set_xlabel(f"{a1} / deg")
-        ax.set_ylabel(f"{a2} / deg")
+        ax.grid(False)
+        ax.set_xlabel(label(a1, "deg"))
+        ax.set_ylabel(label(a2, "deg"))
         ax.set_title(name)
         fig.colorbar(im, ax=ax, shrink=0.85)
     p = tmap.point
     fig.suptitle(title or f"{tmap.model_name}: tool-tip error at workpiece point "
-                          f"({p[0]:g}, {p[1]:g}, {p[2]:g}) mm over {a1}, {a2} "
+                          f"({p[0]:g}, {p[1]:g}, {p[2]:g}) mm over {a1}, {a2}\n"
                           f"(grey: outside travel or error tables)")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return path
 
 
+@styled
 def plot_program_errors(errors, path, title: str = ""):
-    """PNG: predicted tool-tip error (um, log scale) and tool-axis error (urad) per motion
+    """PNG: predicted tool-tip error (µm, log scale) and tool-axis error (µrad) per motion
     block, before and after compensation.  ``errors``: a
     :class:`volerr.fiveaxis.program.ProgramErrors` (or the line reports of a
     :class:`volerr.fiveaxis.compensate.Result`)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from .program import ProgramErrors
 
     if not isinstance(errors, ProgramErrors):
@@ -67,25 +63,23 @@ def plot_program_errors(errors, path, title: str = ""):
     lines, before, after = errors.line, errors.before_um, errors.after_um
     ob, oa = errors.orientation_before_urad, errors.orientation_after_urad
     done = lines
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
+    fig, (ax1, ax2) = figure(2, 1, height=6.5, sharex=True)
     if len(done):
         floor = 1e-4
         ax1.semilogy(lines, np.maximum(before, floor), "o-", ms=3, label="before (predicted)")
         ax1.semilogy(lines, np.maximum(after, floor), "s-", ms=3, label="after (predicted)")
-        ax1.axhline(0.1, color="0.5", ls=":", lw=1, label="0.1 um")
+        ax1.axhline(0.1, color="0.5", ls=":", lw=1, label="0.1 \u00b5m")
         ax2.plot(lines, ob, "o-", ms=3, label="before")
         ax2.plot(lines, oa, "s-", ms=3, label="after")
-    ax1.set_ylabel("tool-tip error |e| / um")
-    ax1.legend(loc="best", fontsize=8)
+    ax1.set_ylabel(label("tool-tip error |e|", "um"))
+    ax1.legend(loc="best")
     ax1.grid(True, which="both", alpha=0.3)
-    ax2.set_ylabel("tool-axis error / urad")
+    ax2.set_ylabel(label("tool-axis error", "urad"))
     ax2.set_xlabel("program line")
     if len(done) and np.allclose(ob, oa, rtol=1e-6, atol=1e-9):
         ax2.set_title("orientation not compensated (use --orientation): before and after "
-                      "coincide", fontsize=9, color="0.3")
-    ax2.legend(loc="best", fontsize=8)
-    ax2.grid(True, alpha=0.3)
+                      "coincide", color="0.3")
+    ax2.legend(loc="best")
     fig.suptitle(title or "predicted error along the program")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return path

@@ -260,6 +260,11 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
         return
     axes = model.axes
     numbers = blocks.numbers
+    big = ~(np.abs(q_nom) <= 1e6)   # beyond any machine (mm / deg), travel checked or not
+    if big.any():
+        k, i = np.argwhere(big)[0]
+        raise InputError(f"line {numbers[k]}: {axes[i]} = {q_nom[k, i]:g} is implausibly large "
+                         f"(more than 1e6 mm or deg)")
     if opts.check_travel:
         for i, a in enumerate(axes):
             lo, hi = model.travel[a]

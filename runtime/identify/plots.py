@@ -6,34 +6,36 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..plotstyle import figure, label, save, styled
 from ..units import UM_PER_MM, URAD_PER_RAD
 
 SCALE = (UM_PER_MM,) * 3 + (URAD_PER_RAD,) * 3
 
 
 def _sigma(result):
+    """(standard deviation of ONE round, label of the +-2 sigma bars): the scatter over the
+    rounds (Type A, the table's ``_s``), else the propagated tracker uncertainty."""
     if result.std is not None:
-        return result.std, "2 s (Type A, rounds)"
-    return result.u_tracker, "2 u (propagated)"
+        return result.std, "\u00b1 2 s (s of one round)"
+    return result.u_tracker, "\u00b1 2 u (propagated, k = 2)"
 
 
+@styled
 def plot_identification(result, path, fits: dict | None = None) -> None:
     """Write a PNG of the six error motions of ``result`` (:class:`volerr.identify.solve.
-    Identification`); ``fits``: name -> callable of position (mm or rad), optional."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    Identification`); ``fits``: name -> callable of position (mm or rad), optional.  Bars:
+    +-2 s, s the standard deviation of one round (the scatter the table's ``_s`` holds)."""
     rotary = result.kind == "rotary"
     sig, sig_label = _sigma(result)
     unit_pos = "deg" if rotary else "mm"
     nrows = 4 if rotary else 3
-    fig = plt.figure(figsize=(11, 3.0 * nrows))
+    fig, grid = figure(nrows, 2, height=2.6 * nrows)
+    for ax in grid[3:].ravel() if rotary else ():
+        ax.remove()
     x = result.positions
     for j, name in enumerate(result.names):
         col, row = (0, j) if j < 3 else (1, j - 3)
-        ax = fig.add_subplot(nrows, 2, 2 * row + col + 1)
+        ax = grid[row, col]
         for r in result.rounds:
             order = np.argsort(r.positions)
             ax.plot(r.positions[order], r.values[order, j] * SCALE[j], ".", color="0.7", ms=3)
@@ -45,14 +47,13 @@ def plot_identification(result, path, fits: dict | None = None) -> None:
             ax.plot(q, np.asarray(fits[name](q)) * SCALE[j], "-", color="C3", lw=1,
                     label="fitted function")
         ax.axhline(0, color="0.5", lw=0.5)
-        ax.set_xlabel(f"{result.axis} [{unit_pos}]")
-        ax.set_ylabel(f"{name} [{'um' if j < 3 else 'urad'}]")
-        ax.grid(True, lw=0.3)
+        ax.set_xlabel(label(result.axis, unit_pos))
+        ax.set_ylabel(label(name, "um" if j < 3 else "urad"))
         if j == 0:
-            ax.legend(fontsize=7, loc="best")
+            ax.legend(loc="best")
     if rotary:
         th = np.radians(x)
-        for k, (lo, hi, unit) in enumerate(((0, 3, "um"), (3, 6, "urad"))):
+        for k, (lo, hi, unit) in enumerate(((0, 3, "µm"), (3, 6, "µrad"))):
             ax = fig.add_subplot(nrows, 2, 7 + k, projection="polar")
             vals = result.values[:, lo:hi] * np.array(SCALE[lo:hi])
             span = float(np.max(np.abs(vals))) or 1.0
@@ -63,11 +64,8 @@ def plot_identification(result, path, fits: dict | None = None) -> None:
             ax.set_rmin(0)
             ax.set_rmax(base + 1.2 * span)
             ax.set_yticklabels([])
-            ax.set_title(f"polar, {unit}: radius = {base:.3g} + value (grey circle = 0)",
-                         fontsize=8)
-            ax.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.25, -0.1))
+            ax.set_title(f"polar, {unit}: radius = {base:.3g} + value (grey circle = 0)")
+            ax.legend(loc="lower right", bbox_to_anchor=(1.3, -0.1))
     fig.suptitle(f"Error motions of axis {result.axis} ({len(result.rounds)} round(s), "
                  f"{result.method}, {len(result.rounds[0].labels)} points)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)

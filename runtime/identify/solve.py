@@ -168,23 +168,27 @@ class Identification:
     def table(self, with_u95: bool | None = None):
         """The averaged result as a :class:`volerr.tables.table.ErrorTable`.
 
-        ``std`` columns when there are several rounds; ``u95`` (k = 2) columns combine the
-        propagated tracker uncertainty and the Type A standard deviation of the mean:
-        ``2 sqrt(u_tracker^2 + s^2 / n_rounds)``; written by default only when weighted by a
-        tracker position."""
+        With several (n) rounds: ``s`` = the experimental standard deviation of one round
+        (ddof = 1, the repeatability of one reading, column ``_s``) and ``std`` = s / sqrt(n),
+        the standard uncertainty (Type A) of the tabulated mean (column ``_std``); ``u95``
+        (k = 2) columns combine the propagated tracker uncertainty and that Type A
+        uncertainty: ``2 sqrt(u_tracker^2 + s^2 / n)``; written by default only when weighted
+        by a tracker position."""
         from ..tables.table import ErrorTable
 
         with_u95 = self.weighted if with_u95 is None else with_u95
         values = {n: self.values[:, j] for j, n in enumerate(self.names)}
-        std = {n: self.std[:, j] for j, n in enumerate(self.names)} if self.std is not None \
+        n_rounds = len(self.rounds)
+        rep = {n: self.std[:, j] for j, n in enumerate(self.names)} if self.std is not None \
             else {}
+        std = {n: v / np.sqrt(n_rounds) for n, v in rep.items()}
         u95 = {}
         if with_u95:
             var = self.u_tracker ** 2
             if self.std is not None:
                 var = var + self.std ** 2 / len(self.rounds)
             u95 = {n: 2.0 * np.sqrt(var[:, j]) for j, n in enumerate(self.names)}
-        return ErrorTable(self.axis, self.positions, values, std, u95)
+        return ErrorTable(self.axis, self.positions, values, std, u95, s=rep)
 
     def outliers(self) -> list:
         """All flagged (round, position, point, residual_um, ratio) over rounds."""
@@ -749,9 +753,9 @@ def to_model_signs(table, layout, reference=None):
         for j, p in enumerate(MOTION_PREFIX[:3]):
             if p + axis in values or np.any(out[j]):
                 values[p + axis] = out[j]
-        return ErrorTable(axis, table.positions, values, table.std, table.u95)
+        return ErrorTable(axis, table.positions, values, table.std, table.u95, s=table.s)
     # generated: -t - travel (e x u), -e (volerr.derive.three_point.table_side_signs)
     travel = table.positions - q0 if layout.axes[axis].kind == "linear" else zero
     out = _gen().table_side_signs(travel, *motions, *u)
     values = {p + axis: out[j] for j, p in enumerate(MOTION_PREFIX) if p + axis in table.values}
-    return ErrorTable(axis, table.positions, values, table.std, table.u95)
+    return ErrorTable(axis, table.positions, values, table.std, table.u95, s=table.s)

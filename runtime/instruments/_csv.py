@@ -1,6 +1,6 @@
-"""The CSV reader shared by the instruments' files: UTF-8 (a BOM allowed), comma-separated (a
-header without commas but with semicolons or tabs is read with that separator: spreadsheet
-exports), blank rows skipped; numeric columns become float arrays, columns of labels are kept
+"""The CSV reader shared by the instruments' files: UTF-8 (a BOM allowed), comma-separated (or
+``;`` / tab by volerr's one delimiter rule, :func:`volerr.fileio.sniff_delimiter`), blank rows
+and ``#`` comment rows skipped; numeric columns become float arrays, columns of labels are kept
 as text, a column with a bad number in an otherwise numeric column is named with its row."""
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require
+from ..fileio import sniff_delimiter
 
 
 @dataclass
@@ -42,11 +43,8 @@ def read_columns(path) -> Columns:
     require(p.is_file(), f"data file not found: {path}")
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
-            first = fh.readline()
+            delim = sniff_delimiter(fh.read(65536))
             fh.seek(0)
-            delim = ","
-            if "," not in first:
-                delim = ";" if ";" in first else "\t" if "\t" in first else ","
             rows = [r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)
                     and not r[0].lstrip().startswith("#")]
     except (UnicodeDecodeError, csv.Error) as exc:

@@ -6,26 +6,22 @@ residual -- the after-residual plus the effect's own contribution -- against the
 natural variable, with the fitted contribution); error maps (residual length over the first
 two axes) before and after; the fitted component errors of every axis before and after (an
 unmodelled effect leaks into them).  The headline numbers are the held-out ones of the json report.
+Every figure is an ``<img>`` tag with its PNG embedded (style and widths: volerr.plotstyle).
 """
 
 from __future__ import annotations
 
-import base64
-import io
 from pathlib import Path
 
 import numpy as np
 
 from ..estimate.design import rotary_rad
+from ..plotstyle import embedded_img, figure, label, png, styled
 
 
-def _png(fig) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
+def _png(fig, alt: str = "figure") -> str:
+    """The ``<img>`` tag of ``fig`` (PNG embedded, shown at its own pixel width)."""
+    return embedded_img(png(fig), alt)
 
 
 def _thin(n: int, limit: int = 4000, seed: int = 0) -> np.ndarray:
@@ -40,7 +36,7 @@ def _unit_label(v: str, model) -> str:
     if v in model.axes:
         return "deg" if v in model.rotary_axes else "mm"
     if v.startswith(("T", "temp")):
-        return "degC"
+        return "°C"
     if v in ("t_s", "time_s"):
         return "s"
     if v in ("t_min", "time_min"):
@@ -50,12 +46,8 @@ def _unit_label(v: str, model) -> str:
     return "1"
 
 
+@styled
 def fig_residuals(fg) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     dat = fg.data
     variables = {**dat.positions, **dat.covariates}
     names = [v for v, x in variables.items() if np.ptp(x) > 0][:14]
@@ -63,8 +55,8 @@ def fig_residuals(fg) -> str:
     rb = fg.res_before.reshape(-1, 3)[idx] * 1e3
     ra = fg.res_after.reshape(-1, 3)[idx] * 1e3
     lim = max(np.max(np.abs(rb)), np.max(np.abs(ra)), 1e-6) * 1.05   # nothing clipped
-    fig, axes = plt.subplots(len(names), 2, figsize=(10, 1.9 * len(names) + 0.6),
-                             squeeze=False, sharey=True)
+    fig, axes = figure(len(names), 2, height=2.1 * len(names) + 0.8, squeeze=False,
+                       sharey=True)
     colors = ("tab:red", "tab:green", "tab:blue")
     for i, v in enumerate(names):
         x = np.asarray(variables[v])[idx]
@@ -76,14 +68,13 @@ def fig_residuals(fg) -> str:
                         label="xyz"[k] if i == 0 and j == 0 else None)
             ax.set_ylim(-lim, lim)
             ax.axhline(0, color="k", lw=0.5)
-            ax.set_xlabel(f"{v}, {_unit_label(v, fg.model)}", labelpad=0)
+            ax.set_xlabel(label(v, _unit_label(v, fg.model)), labelpad=0)
             if i == 0:
                 ax.set_title(title)
             if j == 0:
-                ax.set_ylabel("residual, um")
-    axes[0, 0].legend(loc="upper right", fontsize=7, markerscale=4)
-    fig.tight_layout()
-    return _png(fig)
+                ax.set_ylabel(label("residual", "um"))
+    axes[0, 0].legend(loc="upper right", markerscale=4)
+    return _png(fig, "residuals against every axis and covariate")
 
 
 def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str]:
@@ -93,30 +84,27 @@ def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str
     c = info.get("covariate")
     if kind == "periodic" and {"axis", "period"} <= set(info):
         a, p = info["axis"], info["period"]
-        return np.mod(dat.positions[a], p), f"{a} modulo {p:.3f}, mm"
+        return np.mod(dat.positions[a], p), label(f"{a} modulo {p:.3f}", "mm")
     if kind == "coupling" and {"axis", "depends_on"} <= set(info):
         a, b = info["axis"], info["depends_on"]
         u = {q: (2 * dat.positions[q] - dat.positions[q].min() - dat.positions[q].max())
              / max(np.ptp(dat.positions[q]), 1e-300) for q in (a, b)}
-        return u[a] * u[b], f"{a} * {b} (normalised to [-1, 1]), 1"
+        return u[a] * u[b], f"{a} \u00b7 {b} (normalised to [\u22121, 1])"
     if c in dat.positions:
-        return np.asarray(dat.positions[c], dtype=float), f"{c}, {_unit_label(c, model)}"
+        return np.asarray(dat.positions[c], dtype=float), label(c, _unit_label(c, model))
     if c in dat.covariates:
-        return np.asarray(dat.covariates[c], dtype=float), f"{c}, {_unit_label(c, model)}"
+        return np.asarray(dat.covariates[c], dtype=float), label(c, _unit_label(c, model))
     if c and kind != "probe_direction":
         try:
-            return np.asarray(evaluate(c, values), dtype=float), f"{c}, {_unit_label(c, model)}"
+            return (np.asarray(evaluate(c, values), dtype=float),
+                    label(c, _unit_label(c, model)))
         except Exception:   # noqa: BLE001  (a label that is not an expression)
             pass
     return np.arange(dat.n, dtype=float), "point"
 
 
+@styled
 def fig_effect(fg, eff: dict) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     model, dat = fg.model, fg.data
     c3 = fg.contrib[eff["name"]].reshape(-1, 3) * 1e3
     partial = (fg.res_after.reshape(-1, 3) * 1e3) + c3
@@ -129,13 +117,13 @@ def fig_effect(fg, eff: dict) -> str:
         n = n / np.linalg.norm(n, axis=1, keepdims=True)
         y, fit = np.sum(partial * n, axis=1), np.sum(c3 * n, axis=1)
         x = np.arange(dat.n, dtype=float)
-        xlabel, ylabel = "point", "partial residual along probing direction, um"
+        xlabel, ylabel = "point", label("partial residual along the probing direction", "um")
     else:
         k = int(np.argmax(np.var(c3, axis=0)))
         y, fit = partial[:, k], c3[:, k]
-        ylabel = f"partial residual d{'xyz'[k]}, um"
+        ylabel = label(f"partial residual d{'xyz'[k]}", "um")
     idx = _thin(dat.n)
-    fig, ax = plt.subplots(figsize=(7, 3.2))
+    fig, ax = figure(width=8.0, height=3.8)
     jitter = 0.0
     if eff["kind"] in ("reversal", "setup"):
         jitter = np.random.default_rng(0).normal(0, 0.03 * max(np.ptp(x), 1.0), len(x))
@@ -147,50 +135,53 @@ def fig_effect(fg, eff: dict) -> str:
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(f"{eff['kind']}: {eff['name']}")
-    ax.legend(fontsize=7, markerscale=4)
-    fig.tight_layout()
-    return _png(fig)
+    ax.legend(markerscale=4)
+    return _png(fig, f"evidence of {eff['name']}")
 
 
+def _span(x) -> tuple:
+    """Axis limits that show every value of ``x`` with a 3 % margin."""
+    lo, hi = float(np.min(x)), float(np.max(x))
+    pad = 0.03 * (hi - lo) if hi > lo else 1.0
+    return lo - pad, hi + pad
+
+
+@styled
 def fig_maps(fg) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Residual length before and after over the first two axes: every panel spans the data
+    of both axes (equal scales when both are lengths; the panel's box adapts, never the
+    limits)."""
     model, dat = fg.model, fg.data
     a, b = model.axes[0], model.axes[1]
     idx = _thin(dat.n)
     nb = np.linalg.norm(fg.res_before.reshape(-1, 3), axis=1)[idx] * 1e3
     na = np.linalg.norm(fg.res_after.reshape(-1, 3), axis=1)[idx] * 1e3
     vmax = max(np.percentile(nb, 99), 1e-6)
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+    xa, xb = np.asarray(dat.positions[a], float), np.asarray(dat.positions[b], float)
+    fig, axes = figure(1, 2, height=4.6)
     for ax, v, title in ((axes[0], nb, "before"), (axes[1], na, "after")):
-        sc = ax.scatter(dat.positions[a][idx], dat.positions[b][idx], c=v, s=8, cmap="viridis",
-                        vmin=0, vmax=vmax)
-        ax.set_title(f"residual length {title}, um")
-        ax.set_xlabel(f"{a}, {_unit_label(a, model)}")
-        ax.set_aspect("equal", adjustable="datalim")
-    axes[0].set_ylabel(f"{b}, {_unit_label(b, model)}")
-    fig.colorbar(sc, ax=axes, shrink=0.8, label="um")
-    return _png(fig)
+        sc = ax.scatter(xa[idx], xb[idx], c=v, s=8, cmap="viridis", vmin=0, vmax=vmax)
+        ax.set_title(f"residual length {title}")
+        ax.set_xlabel(label(a, _unit_label(a, model)))
+        ax.set_ylabel(label(b, _unit_label(b, model)))
+        ax.set_xlim(*_span(xa))
+        ax.set_ylim(*_span(xb))
+        if _unit_label(a, model) == _unit_label(b, model):
+            ax.set_aspect("equal", adjustable="box")
+    fig.colorbar(sc, ax=axes, shrink=0.8, label=label("residual length", "um"))
+    return _png(fig, "error maps before and after")
 
 
+@styled
 def fig_functions(report) -> str:
     """The fitted component errors of every axis, declared fit (before) and augmented
     fit (after, +-2 standard deviations)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     after, _ = report.error_tables()
     before, _ = report.error_tables(which="before")
     axes_names = list(after)
-    fig, axes = plt.subplots(2, len(axes_names), figsize=(3.6 * len(axes_names), 5.4),
-                             squeeze=False)
+    fig, axes = figure(2, len(axes_names), height=6.0, squeeze=False)
     for i, a in enumerate(axes_names):
-        for row, (kind, f, unit) in enumerate((("XYZ", 1e3, "um"), ("ABC", 1e6, "urad"))):
+        for row, (kind, f, unit) in enumerate((("XYZ", 1e3, "µm"), ("ABC", 1e6, "µrad"))):
             ax = axes[row, i]
             for k, (name, v) in enumerate(after[a].values.items()):
                 if name[1] not in kind:
@@ -202,30 +193,26 @@ def fig_functions(report) -> str:
                 ax.fill_between(q, (v - 2 * sd) * f, (v + 2 * sd) * f, color=color, alpha=0.2)
                 ax.plot(before[a].positions, before[a].values[name] * f, "--", color=color,
                         lw=0.8)
-            ax.set_xlabel(f"{a}, {'deg' if a in report.figures.model.rotary_axes else 'mm'}")
-            ax.set_ylabel(unit)
-            ax.legend(fontsize=6)
-    axes[0, 0].set_title("solid: after, dashed: before", fontsize=8, loc="left")
-    fig.tight_layout()
-    return _png(fig)
+            ax.set_xlabel(label(a, "deg" if a in report.figures.model.rotary_axes else "mm"))
+            ax.set_ylabel(label("error", unit))
+            ax.legend(fontsize=9, ncol=2)
+    fig.suptitle("solid: augmented model (band \u00b12 standard deviations, k = 2), dashed: "
+                 "declared model")
+    return _png(fig, "fitted component errors")
 
 
+@styled
 def fig_interactions(fg, sources) -> str | None:
     """Residual (after) against the covariates of the top residual sources, coloured by each
     axis position: an interaction shows as a colour gradient across the cloud."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     dat, model = fg.data, fg.model
     values = {**rotary_rad(model, dat.positions), **dat.covariates}
     covs = []
     for src in sources:
-        x, label = _natural(src.get("kind", ""), {"covariate": src["covariate"]}, model, dat,
-                            values)
-        if label != "point" and label not in [c[1] for c in covs]:
-            covs.append((x, label))
+        x, xlab = _natural(src.get("kind", ""), {"covariate": src["covariate"]}, model, dat,
+                           values)
+        if xlab != "point" and xlab not in [c[1] for c in covs]:
+            covs.append((x, xlab))
         if len(covs) == 3:
             break
     if not covs:
@@ -234,20 +221,19 @@ def fig_interactions(fg, sources) -> str | None:
     res = fg.res_after.reshape(-1, 3)[idx] * 1e3
     k = int(np.argmax(np.var(res, axis=0)))
     axes_names = list(model.axes)[:3]
-    fig, axes = plt.subplots(len(covs), len(axes_names), figsize=(3.6 * len(axes_names),
-                             2.6 * len(covs) + 0.4), squeeze=False, sharey=True)
+    fig, axes = figure(len(covs), len(axes_names), height=2.8 * len(covs) + 0.6,
+                       squeeze=False, sharey=True)
     lim = max(np.max(np.abs(res[:, k])), 1e-6) * 1.05
-    for i, (x, label) in enumerate(covs):
+    for i, (x, xlab) in enumerate(covs):
         for j, a in enumerate(axes_names):
             ax = axes[i, j]
             sc = ax.scatter(x[idx], res[:, k], c=dat.positions[a][idx], s=3, cmap="viridis")
             ax.set_ylim(-lim, lim)
-            ax.set_xlabel(label)
+            ax.set_xlabel(xlab)
             if j == 0:
-                ax.set_ylabel(f"residual d{'xyz'[k]} after, um")
-            fig.colorbar(sc, ax=ax, label=f"{a}, {_unit_label(a, model)}")
-    fig.tight_layout()
-    return _png(fig)
+                ax.set_ylabel(label(f"residual d{'xyz'[k]} after", "um"))
+            fig.colorbar(sc, ax=ax, label=label(a, _unit_label(a, model)))
+    return _png(fig, "residual against covariates")
 
 
 def render_html(report) -> str:

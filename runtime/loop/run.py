@@ -48,6 +48,7 @@ from ..estimate.design import (Data, solve_normal, data_ranges, declared_design,
                                rms, rows_of)
 from ..estimate.steps import (DEGREE_CV_POINTS, Declared, Split, choose_degree,  # noqa: F401
                               declared_step, split_points)
+from ..fileio import json_text
 from ..instruments.deviations import columns_to_data, read_deviations  # noqa: F401
 from ..machine.layout import layout_text, parse_layout
 from ..machine import derivation
@@ -86,7 +87,7 @@ class Report:
     def write_json(self, path, inputs=()) -> Path:
         from ..fileio import write_text
 
-        return write_text(path, json.dumps(self.data, indent=2, default=_json) + "\n",
+        return write_text(path, json_text(self.data, default=_json),
                           inputs=list(inputs))
 
     def write_html(self, path, inputs=()) -> Path:
@@ -619,9 +620,13 @@ def _write_augmented(out_dir, aug: Augmented, selection, inputs, data) -> dict:
 def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection, aug, out,
                  effects, warnings, paths, test_fraction) -> dict:
     nb, na = point_norm(out.r_before), point_norm(out.r_after)
-    inl = out.test_inliers
-    thresh = OUTLIER_Z * math.sqrt(out.sigma2)
-    far = np.union1d(np.flatnonzero(point_norm(out.res_after) > thresh), robust.outliers)
+    # outliers: off the FINAL fit by more than OUTLIER_Z of its own robust scale (median of
+    # the 3-D residual length = 1.538 sigma per coordinate), not the declared fit's flags
+    res_len = point_norm(out.res_after)
+    scale = max(float(np.median(res_len)) / 1.538, 1e-12)
+    thresh = OUTLIER_Z * scale
+    far = np.flatnonzero(res_len > thresh)
+    inl = na <= thresh
     variables = {**{a: dat.positions[a] for a in model.axes}, **dat.covariates}
     analysis = {v: {"before_trend_um": _trend(out.res_before, x),
                     "after_trend_um": _trend(out.res_after, x)}
@@ -650,9 +655,13 @@ def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection
         "gauge_fixed": _gauge_text(decl.gauge),
         "noise_estimate_um": round(1e3 * math.sqrt(out.sigma2), 4),
         "outliers": {"threshold_um": round(1e3 * thresh, 4), "count": int(len(far)),
+                     "z": OUTLIER_Z, "robust_sigma_um": round(1e3 * scale, 4),
                      "data_rows": [int(i) + 1 for i in far[:100]],
-                     "method": f"IRLS, weight 1 up to {ROBUST_K:g} robust sigma, bisquare to 0 "
-                               f"at {2 * ROBUST_K:g}; flagged beyond {OUTLIER_Z:g} sigma"},
+                     "method": f"counted on the final (augmented) fit: 3-D residual length "
+                               f"beyond {OUTLIER_Z:g} robust sigma (sigma per coordinate = "
+                               f"median length / 1.538); the fits weight points by IRLS on "
+                               f"the declared fit (weight 1 up to {ROBUST_K:g} robust sigma, "
+                               f"bisquare to 0 at {2 * ROBUST_K:g})"},
         "candidates_tested": selection.n_candidates,
         "candidate_families": sorted({s.cand.kind for s in selection.first}),
         "residual_analysis": analysis,

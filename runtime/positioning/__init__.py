@@ -12,7 +12,9 @@ from ._io import PositioningRun, read_run
 from ._report import (error_table, error_table_csv, plot_runs, report_dict, report_html,
                       standard_notes)
 from ._thermal import ThermalCorrection, correct_to_20C
+from ._uncertainty import BudgetInputs, budget
 
 __all__ = ["PositioningRun", "read_run", "ThermalCorrection", "correct_to_20C", "Evaluation",
            "evaluate", "report_dict", "plot_runs", "report_html", "error_table", "error_table_csv",
-           "standard_notes", "RunSet", "evaluate_files", "summary_lines"]
+           "standard_notes", "RunSet", "evaluate_files", "summary_lines", "BudgetInputs",
+           "budget"]

@@ -21,9 +21,10 @@ class RunSet:
     thermals: list[ThermalCorrection | None] = field(default_factory=list)
     notes: list[list[str]] = field(default_factory=list)
 
-    def report(self) -> dict:
-        """:func:`volerr.positioning.report_dict` of the runs."""
-        return report_dict(self.evaluations, self.thermals, self.notes)
+    def report(self, **kwargs) -> dict:
+        """:func:`volerr.positioning.report_dict` of the runs (``inputs``, ``tolerance``,
+        ``identification`` passed on)."""
+        return report_dict(self.evaluations, self.thermals, self.notes, **kwargs)
 
 
 def evaluate_files(files, axes, cte_ppm_per_K: float | None = None,
@@ -64,13 +65,26 @@ def evaluate_files(files, axes, cte_ppm_per_K: float | None = None,
 def summary_lines(report: dict) -> tuple[list[str], list[str]]:
     """The printed lines of ``report`` (:func:`report_dict`): one result line per run (um) and
     the notes, prefixed with the file name."""
+    from ..units import num
+
     runs = report["runs"] if "runs" in report else [report]
     lines, notes = [], []
     for r in runs:
         name = Path(r["file"]).name
+        U = r.get("uncertainty_um", {})
+
+        def q(key):
+            text = f"{key} {num(r[key + '_um'], '.2f')}"
+            if key in U:
+                text += f" (U {num(U[key], '.2f')})"
+            if key in r.get("verdicts", {}):
+                text += f" {r['verdicts'][key].upper()}"
+            return text
         lines.append(f"{name}: axis {r['axis']}, {r['n_targets']} targets x "
-                     f"{r['n_cycles']} cycles: A {r['A_um']:.2f}  E {r['E_um']:.2f}  "
-                     f"M {r['M_um']:.2f}  R {r['R_um']:.2f}  B {r['B_um']:.2f}  "
-                     f"(B_avg {r['B_avg_um']:+.2f}) um")
+                     f"{r['n_cycles']} cycles: {'  '.join(q(k) for k in 'AEMRB')}  "
+                     f"(B_avg {num(r['B_avg_um'], '+.2f')}) um")
+        if r.get("verdict"):
+            lines.append(f"  verdict {r['verdict'].upper()} (ISO 14253-1, tolerance reduced / "
+                         f"widened by U, k = 2)")
         notes.extend(f"{name}: {n}" for n in r["notes"])
     return lines, notes

@@ -56,6 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require
+from ..fileio import sniff_delimiter
 from ..units import MM_PER_UM, parse_number
 
 FWD, BWD = 0, 1
@@ -150,11 +151,7 @@ def _rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a UTF-8 text file") from None
-    lines = text.splitlines()
-    first = next((ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")), "")
-    delim = ","
-    if "," not in first:
-        delim = ";" if ";" in first else "\t" if "\t" in first else ","
+    delim = sniff_delimiter(text)
     rows = []
     try:
         for lineno, cells in enumerate(csv.reader(io.StringIO(text), delimiter=delim), 1):

@@ -43,6 +43,7 @@ residuals of the map and kept, unless the caller asks to exclude them.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -51,6 +52,7 @@ import numpy as np
 
 from ..units import MM_PER_UM, UM_PER_MM, parse_number
 from ..errors import InputError, require
+from ..fileio import sniff_delimiter
 from .fits import (MAX_CONDITION, MAX_DEGREE, MIN_POINTS, OUTLIER_K,  # noqa: F401
                                PLANE_RATIO, RIDGE, SCALE_FLOOR_MM, SHFit, SphereFit,
                                check_sphere_points, fit_sh, fit_sphere, max_degree_for,
@@ -141,8 +143,9 @@ def read_sphere_csv(path) -> SphereData:
     path = Path(path)
     require(path.is_file(), f"{path}: no such file")
     try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+        text = path.read_text(encoding="utf-8-sig")
+        rows = [r for r in csv.reader(io.StringIO(text), delimiter=sniff_delimiter(text))
+                if any(c.strip() for c in r)]
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a text CSV file") from None
     except csv.Error as exc:
@@ -566,18 +569,24 @@ def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
     ``outlier`` = 1 are left out), refitted as by the calibration."""
     path = Path(path)
     require(path.is_file(), f"{path}: no such file")
-    with path.open(newline="", encoding="utf-8-sig") as fh:
-        rows = [r for r in csv.reader(fh) if any(c.strip() for c in r)]
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+        rows = [r for r in csv.reader(io.StringIO(text), delimiter=sniff_delimiter(text))
+                if any(c.strip() for c in r)]
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a text CSV file") from None
+    except csv.Error as exc:
+        raise InputError(f"{path}: malformed CSV: {exc}") from None
     require(rows, f"{path}: empty file")
     header = [h.strip().lower() for h in rows[0]]
     for c in ("phi_deg", "theta_deg", "probe_um"):
         require(c in header, f"{path}: missing column {c!r}")
     idx = [header.index(c) for c in ("phi_deg", "theta_deg", "probe_um")]
-    io = header.index("outlier") if "outlier" in header else None
+    i_out = header.index("outlier") if "outlier" in header else None
     vals = []
     for k, r in enumerate(rows[1:], start=2):
         require(len(r) > max(idx), f"{path}: line {k}: too few fields")
-        if io is not None and len(r) > io and r[io].strip() not in ("", "0"):
+        if i_out is not None and len(r) > i_out and r[i_out].strip() not in ("", "0"):
             continue
         vals.append([_float(r[i].strip(), f"{path}: line {k}") for i in idx])
     arr = np.asarray(vals, dtype=float)

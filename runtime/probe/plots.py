@@ -1,5 +1,6 @@
 """Plots of a probe calibration: the 3-D lobing map (Pahk Fig. 3a) and the 2-D (phi, theta)
-map (Fig. 3b).  Errors in um; directions in the probe frame (x', y', z')."""
+map (Fig. 3b).  Errors in µm; directions in the probe frame (x', y', z').  Style:
+volerr.plotstyle."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..plotstyle import PAGE_WIDTH_IN, label, pyplot, save, styled
 from ..units import UM_PER_MM
 from .calibration import unit_vectors
 
@@ -28,24 +30,15 @@ def _norm(values):
 
 
 def _save(fig, path) -> Path:
-    import matplotlib.pyplot as plt
-
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return out
+    save(fig, path)
+    return Path(path)
 
 
 def _figure(size):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.figure(figsize=size)
+    return pyplot().figure(figsize=size, layout="constrained")
 
 
+@styled
 def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
     """Fig. 3a alone: see :func:`draw_3d`."""
     fig = _figure((8, 7))
@@ -53,18 +46,21 @@ def plot_probe_map_3d(cal, path, gain: float | None = None) -> Path:
     return _save(fig, path)
 
 
+@styled
 def plot_probe_map_2d(cal, path) -> Path:
     """Fig. 3b alone: see :func:`draw_2d`."""
-    fig = _figure((10, 4.8))
+    fig = _figure((PAGE_WIDTH_IN, 5.0))
     draw_2d(fig, fig.add_subplot(), cal)
     return _save(fig, path)
 
 
+@styled
 def plot_probe_calibration(cal, path) -> Path:
-    """Both maps in one PNG: 3-D lobing map (left) and the (theta, phi) map (right)."""
-    fig = _figure((17, 6.5))
-    draw_3d(fig, fig.add_subplot(1, 2, 1, projection="3d"), cal)
-    draw_2d(fig, fig.add_subplot(1, 2, 2), cal)
+    """Both maps in one PNG: 3-D lobing map (top) and the (theta, phi) map (below)."""
+    fig = _figure((PAGE_WIDTH_IN, 12.0))
+    sub = fig.subfigures(2, 1, height_ratios=(1.25, 1))
+    draw_3d(sub[0], sub[0].add_subplot(projection="3d"), cal)
+    draw_2d(sub[1], sub[1].add_subplot(), cal)
     return _save(fig, path)
 
 
@@ -95,18 +91,19 @@ def draw_3d(fig, ax, cal, gain: float | None = None) -> None:
                depthshade=False)
     if cal.outlier.any():
         ax.scatter(*tip[cal.outlier].T, marker="x", color="k", s=60, label="flagged outlier")
-        fig.legend(loc="lower left", fontsize=8)  # outside the axes: covers no point
+        fig.legend(loc="lower left")  # outside the axes: covers no point
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.12, label="probe error Probe(phi, theta), um")
+    fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.12,
+                 label=label("probe error Probe(phi, theta)", "um"))
     ax.set_xlabel("x' (unit direction)")
     ax.set_ylabel("y' (unit direction)")
-    ax.set_zlabel("z' along the probe axis (unit direction)")
+    ax.set_zlabel("z' (probe axis)")
     ax.set_box_aspect((1, 1, 0.6 if cal.map.phi_range_deg[1] <= 95 else 1))
     stats = cal.stats_um()
     ax.set_title(f"Probe error map (3-D): R_eff {cal.r_eff:.4f} mm, max {stats['max']:.1f} / "
-                 f"min {stats['min']:.1f} / rms {stats['rms']:.1f} um\n"
-                 f"sphere deformed radially by the map (1 um = {gain:.3f} of the radius); "
-                 f"stems: measured", fontsize=10)
+                 f"min {stats['min']:.1f} / rms {stats['rms']:.1f} \u00b5m\n"
+                 f"sphere deformed radially by the map (1 \u00b5m = {gain:.3f} of the "
+                 f"radius); stems: measured")
     ax.view_init(elev=28, azim=-60)
 
 
@@ -120,22 +117,23 @@ def draw_2d(fig, ax, cal) -> None:
     mesh = ax.pcolormesh(tt, pp, val, cmap="RdBu_r", norm=norm,
                          shading="nearest" if holes else "gouraud")
     cs = ax.contour(tt, pp, val, levels=11, colors="k", linewidths=0.5)
-    ax.clabel(cs, fmt="%.1f", fontsize=7)
+    ax.clabel(cs, fmt="%.1f", fontsize=9)
     ax.scatter(cal.theta_deg, cal.phi_deg, c=pts_um, cmap="RdBu_r", norm=norm, s=28,
                edgecolors="k", linewidths=0.5, label="measured Probe (eq. 13)")
     if cal.outlier.any():
         ax.scatter(cal.theta_deg[cal.outlier], cal.phi_deg[cal.outlier], marker="x",
                    color="k", s=80, label="flagged outlier")
-    fig.colorbar(mesh, ax=ax, label="probe error, um")
+    fig.colorbar(mesh, ax=ax, label=label("probe error", "um"))
     ax.set_xlim(0, 360)
+    ax.grid(False)
     ax.set_xticks(np.arange(0, 361, 45))
     lo, hi = cal.map.phi_range_deg
     ax.set_ylim(hi + 2, lo - 2)
-    ax.set_xlabel("theta (azimuth in the probe frame), deg")
-    ax.set_ylabel("phi (from the probe axis), deg")
+    ax.set_xlabel(label("theta (azimuth in the probe frame)", "deg"))
+    ax.set_ylabel(label("phi (from the probe axis)", "deg"))
     stats = cal.stats_um()
     ax.set_title(f"Probe error map on (theta, phi): tilt A {cal.map.tilt_deg:g} deg, roll B "
                  f"{cal.map.roll_deg:g} deg\nspherical harmonics of degree {cal.map.degree}; "
-                 f"max {stats['max']:.1f} / min {stats['min']:.1f} / rms {stats['rms']:.1f} um",
-                 fontsize=10)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=8)
+                 f"max {stats['max']:.1f} / min {stats['min']:.1f} / rms {stats['rms']:.1f} "
+                 f"\u00b5m")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3)

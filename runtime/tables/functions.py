@@ -7,8 +7,11 @@ parameter by leave-one-out cross-validation with the one-standard-error rule: th
 whose prediction error is within one standard error of the best).  Positions outside a table's
 measured range raise :class:`InputError`; with ``extrapolate=True`` the fitted function itself
 is evaluated there (linear: the end segment extended; cubic: the end polynomial of the spline;
-poly: the polynomial).  Standard deviations are always interpolated linearly (clamped at the
-ends); a ``u95`` column without ``std`` gives ``std = u95 / 2``.
+poly: the polynomial).  Standard uncertainties are always interpolated linearly (clamped at the
+ends); a ``u95`` column without ``std`` gives ``std = u95 / 2``; :meth:`ErrorFunctions.sigmas`
+combines a table's ``_std`` (uncertainty of the tabulated value) and ``_s`` (repeatability of
+one reading) in quadrature: the standard uncertainty of the error at a position for one
+reading.
 
 Units: positions mm (linear axes) / deg (rotary axes); errors and standard deviations mm
 (translational) / rad (angular).
@@ -182,6 +185,8 @@ class ErrorFunctions:
                 s = t.std.get(name)
                 if s is None and name in t.u95:
                     s = t.u95[name] / 2.0
+                if name in t.s:  # repeatability of one reading, in quadrature
+                    s = np.hypot(s if s is not None else 0.0, t.s[name])
                 if s is not None:
                     self.std_functions[name] = (ax, _Linear(t.positions, s, clamp=True))
 
@@ -200,7 +205,7 @@ class ErrorFunctions:
     # ---- evaluation ---------------------------------------------------------------------
     @property
     def has_random(self) -> bool:
-        """True when any table or constant carries a standard deviation (or u95)."""
+        """True when any table or constant carries an uncertainty (_std, _s or u95)."""
         return bool(self.std_functions or self.constants_std)
 
     def ranges(self) -> dict:
@@ -273,8 +278,9 @@ class ErrorFunctions:
         return {name: out[name] for name in functions}
 
     def sigmas(self, positions) -> dict:
-        """Standard deviations (mm / rad) at ``positions`` (as :meth:`__call__`): name -> (N,)
-        array; a ``u95`` column without ``std`` counts as ``u95 / 2``."""
+        """Standard uncertainties (mm / rad, k = 1) of the errors at ``positions`` for one
+        reading (as :meth:`__call__`): name -> (N,) array; a table's ``_std`` (or ``u95 / 2``)
+        and ``_s`` combined in quadrature, a constant's ``std``."""
         cols, n = self._positions(positions)
         out = self._grouped(cols, n, std=True)
         out.update({k: np.full(n, v) for k, v in self.constants_std.items()})

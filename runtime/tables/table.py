@@ -14,16 +14,29 @@ File formats (INTERFACE.md)
 * parameter columns ``<ISO name>_<unit>``; translational errors (``EX? EY? EZ?``) in ``um`` or
   ``mm``, angular errors (``EA? EB? EC?``) in ``urad`` or ``rad``.  A table holds only the
   component errors of its own axis (``E??X`` in ``X.csv``).
-* optional uncertainty columns for a parameter present in the table: the standard deviation
-  (Type A, repeatability) and/or the expanded uncertainty (k = 2).  Written as
-  ``EXX_std_um`` / ``EXX_u95_um`` (unit stays the last suffix, like every other column);
-  ``EXX_um_std`` / ``EXX_um_u95`` are accepted on read.
+* optional uncertainty columns for a parameter present in the table, one meaning each:
+
+  - ``EXX_std_um``: the *standard uncertainty of the tabulated value* (k = 1), e.g. of a mean
+    of n rounds: s / sqrt(n).  A Monte Carlo perturbs the error function by it once per
+    simulated machine (it is systematic for every later measurement).
+  - ``EXX_s_um``: the *repeatability of one reading* (experimental standard deviation s of a
+    single reading, ddof = 1): the scatter of the machine (and instrument) from one reading
+    to the next.
+  - ``EXX_u95_um``: an expanded uncertainty (k = 2) of the tabulated value; without a
+    ``_std`` column it counts as ``_std = u95 / 2``.
+
+  ``volerr identify`` with n rounds writes ``_s`` = s and ``_std`` = s / sqrt(n); ``volerr
+  iso230-2 --errors-out`` writes ``_s`` = S_i and ``_std`` = S_i / sqrt(2 n).  The unit stays
+  the last suffix, like every other column; ``EXX_um_std`` / ``EXX_um_s`` / ``EXX_um_u95`` are
+  accepted on read.
 * optional reversal column ``RV_<axis>_um`` (or ``_mm``; linear axes): the ISO 230-2 reversal
   value B_i at each position = mean positional deviation approaching in the positive direction
   minus approaching in the negative direction (the sign of the loop's ``RV_<axis>`` effect):
   forward EXX + RV/2, backward EXX - RV/2 when EXX is the bidirectional mean.  Read into
   :attr:`ErrorTable.reversal`; the volumetric model does not use it (``volerr iso230-2`` writes it).
 * blank lines and lines starting with ``#`` are ignored; every other cell must be a finite number.
+* columns separated by ``,`` or, as spreadsheets export them, by ``;`` or tabs (with a decimal
+  point; the rule of every CSV reader of volerr: :func:`volerr.fileio.sniff_delimiter`).
 * lenient spelling: names and units in any case (``exx_UM`` = ``EXX_um``; ``µm``/``µrad`` =
   ``um``/``urad``); the axis column may stand anywhere (it is moved first); columns that are
   neither parameter names nor unit-suffixed (``comment``, ``T_C``) are ignored.  A column named
@@ -65,8 +78,13 @@ ROTARY_LETTERS = ("A", "B", "C")
 _TABLE_NAME = re.compile(r"^E([XYZABC])([A-Z])$")
 _CONST_NAME = re.compile(r"^E([XYZABC])0([A-Z])$")
 _COL = re.compile(r"^(?P<name>[A-Za-z0-9]+?)"
-                  r"(?:_(?P<kind1>std|u95))?_(?P<unit>[A-Za-z]+)(?:_(?P<kind2>std|u95))?$",
+                  r"(?:_(?P<kind1>std|u95|s))?_(?P<unit>[A-Za-z]+)(?:_(?P<kind2>std|u95|s))?$",
                   re.IGNORECASE)
+#: uncertainty column kinds: suffix -> meaning (docs, reports)
+UNCERTAINTY_COLUMNS = {
+    "std": "standard uncertainty of the tabulated value (k = 1)",
+    "s": "repeatability of one reading (experimental standard deviation, k = 1)",
+    "u95": "expanded uncertainty of the tabulated value (k = 2)"}
 #: a column that names an error parameter (any case): it must carry a unit suffix
 _PARAM_LIKE = re.compile(r"^E[XYZABC]0?[A-Z](?:_|$)", re.IGNORECASE)
 _AXIS_COL = re.compile(r"([A-Za-z])(?:_(mm|deg))?", re.IGNORECASE)
@@ -108,11 +126,12 @@ def _from_internal(values, unit: str):
 class ErrorTable:
     """Component errors of one axis at measured positions (one ``<AXIS>.csv``).
 
-    ``axis``: the axis letter.  ``positions``: shape (n,), mm or deg, strictly increasing.  ``values``, ``std``, ``u95``:
-    ISO name -> shape (n,) arrays in mm (translational) or rad (angular); ``std`` is the standard
-    deviation (Type A), ``u95`` the expanded uncertainty (k = 2); both may be empty.
-    ``reversal``: shape (n,) mm or None, the ISO 230-2 reversal B_i (positive-direction minus
-    negative-direction approach) at each position."""
+    ``axis``: the axis letter.  ``positions``: shape (n,), mm or deg, strictly increasing.
+    ``values``, ``std``, ``u95``, ``s``: ISO name -> shape (n,) arrays in mm (translational) or
+    rad (angular); ``std`` is the standard uncertainty of the tabulated value (k = 1), ``u95``
+    its expanded uncertainty (k = 2), ``s`` the repeatability of one reading (module
+    docstring); each may be empty.  ``reversal``: shape (n,) mm or None, the ISO 230-2 reversal
+    B_i (positive-direction minus negative-direction approach) at each position."""
 
     axis: str
     positions: np.ndarray
@@ -120,12 +139,14 @@ class ErrorTable:
     std: dict = field(default_factory=dict)
     u95: dict = field(default_factory=dict)
     reversal: np.ndarray | None = None
+    s: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.positions = np.asarray(self.positions, dtype=float)
         self.values = {k: np.asarray(v, dtype=float) for k, v in self.values.items()}
         self.std = {k: np.asarray(v, dtype=float) for k, v in (self.std or {}).items()}
         self.u95 = {k: np.asarray(v, dtype=float) for k, v in (self.u95 or {}).items()}
+        self.s = {k: np.asarray(v, dtype=float) for k, v in (self.s or {}).items()}
         if self.reversal is not None:
             self.reversal = np.asarray(self.reversal, dtype=float)
         self.validate()
@@ -144,7 +165,8 @@ class ErrorTable:
             what = "duplicate" if d[i] == 0 else "decreasing"
             raise InputError(f"{w}: positions must be strictly increasing ({what} position "
                              f"{p[i + 1]:g} after {p[i]:g})")
-        for label, dct in (("", self.values), ("std ", self.std), ("u95 ", self.u95)):
+        for label, dct in (("", self.values), ("std ", self.std), ("u95 ", self.u95),
+                           ("s ", self.s)):
             for k, v in dct.items():
                 m = _TABLE_NAME.match(k)
                 require(m is not None and m.group(2) == self.axis,
@@ -166,10 +188,6 @@ def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header and (line number, cells) of a CSV file; blank and '#' lines skipped."""
     rows = read_csv_rows(path, empty=f"{path}: empty file (no header)")
     (_, header), body = rows[0], rows[1:]
-    for sep, word in ((";", "semicolons"), ("\t", "tabs")):
-        require(not (len(header) == 1 and sep in header[0]),
-                f"{path}: columns separated by {word}; volerr reads comma-separated CSV "
-                f"(export with ',' as separator and '.' as decimal point)")
     require(all(header), f"{path}: empty column name in header")
     dup = sorted({h for h in header if header.count(h) > 1})
     if dup:
@@ -186,7 +204,7 @@ def _number(path, lineno, column, text) -> float:
 
 
 def _parse_column(path, col: str, axis: str):
-    """-> (name, unit, kind) with kind '', 'std' or 'u95'."""
+    """-> (name, unit, kind) with kind '', 'std', 's' or 'u95'."""
     m = _COL.match(_unit_text(col))
     if m is None or (m.group("kind1") and m.group("kind2")):
         raise InputError(f"{path}: column {col!r} has no unit suffix (wrong units): "
@@ -247,10 +265,11 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
                                           f"{col!r} both give {name} {kind}".rstrip())
         seen[(name, kind)] = col
     data = np.array([[_number(path, ln, h, c) for h, c in zip(header, cells)] for ln, cells in body])
-    values, std, u95 = {}, {}, {}
+    values, std, u95, rep = {}, {}, {}, {}
     for j, (name, unit, kind) in enumerate(cols, start=1):
-        {"": values, "std": std, "u95": u95}[kind][name] = _to_internal(data[:, j], unit)
-    for name in list(std) + list(u95):
+        {"": values, "std": std, "u95": u95, "s": rep}[kind][name] = _to_internal(data[:, j],
+                                                                                 unit)
+    for name in list(std) + list(u95) + list(rep):
         require(name in values, f"{path}: uncertainty column for {name} without a {name} column")
     reversal = None
     if rv_col is not None:
@@ -260,7 +279,7 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
         reversal = _to_internal([_number(path, ln, rv_col[0], c)
                                  for (ln, _), c in zip(body, rv_col[1])], rm.group(2).lower())
     try:
-        return ErrorTable(tax, data[:, 0], values, std, u95, reversal)
+        return ErrorTable(tax, data[:, 0], values, std, u95, reversal, rep)
     except InputError as exc:
         msg = str(exc).split(": ", 1)[-1]
         raise InputError(f"{path}: {msg}") from None
@@ -271,7 +290,8 @@ def _fmt(v: float) -> str:
 
 
 def table_to_csv(table: ErrorTable) -> str:
-    """CSV text of a table: lengths in um, angles in urad, uncertainty as ``_std_um`` etc."""
+    """CSV text of a table: lengths in um, angles in urad, uncertainty as ``_std_um``,
+    ``_s_um``, ``_u95_um`` (module docstring)."""
     table.validate()
     names = list(table.values)
     header, columns = [table.axis], [table.positions]
@@ -279,7 +299,7 @@ def table_to_csv(table: ErrorTable) -> str:
         unit = "um" if parameter_kind(n) == "length" else "urad"
         header.append(f"{n}_{unit}")
         columns.append(_from_internal(table.values[n], unit))
-    for kind, dct in (("std", table.std), ("u95", table.u95)):
+    for kind, dct in (("std", table.std), ("s", table.s), ("u95", table.u95)):
         for n in names:
             if n in dct:
                 unit = "um" if parameter_kind(n) == "length" else "urad"

@@ -4,14 +4,17 @@ An :class:`Ensemble` is the known (systematic) part plus independent *sources*; 
 draws, from a numpy Generator, its contribution for ``n`` sampled machines/measurements at the
 task's P points:
 
-* :class:`TableParameter` -- one error function of a table with a standard deviation column
-  (``_std``, or ``_u95`` / 2).  ``mode="systematic"`` (default): the values at the table nodes
-  are perturbed (independent N(0, std_i) per node, or correlated along the axis with a
+* :class:`TableParameter` -- one error function of a table with an uncertainty column, read
+  with its one meaning (``volerr formats tables``).  ``_std`` (or ``_u95`` / 2), the standard
+  uncertainty of the tabulated value, is drawn ``mode="systematic"``: the values at the table
+  nodes are perturbed (independent N(0, std_i) per node, or correlated along the axis with a
   Gaussian correlation of length ``correlation_mm``) and the error function is rebuilt with
   the same method (linear / cubic / poly of the chosen degree) -- one function per machine,
-  so the errors at all task points are correlated as the function makes them.  ``mode=
-  "repeatability"``: independent per probing point with the interpolated std (Pahk's random
-  component; what ``Model.random_error`` propagates).
+  so the errors at all task points are correlated as the function makes them.  ``_s``, the
+  repeatability of one reading, is drawn ``mode="repeatability"`` when asked for
+  (``repeatability=True``): independent per probing point with the interpolated s (Pahk's
+  random component).  Old tables whose ``_std`` held a single-reading scatter are read with
+  ``table_std="repeatability"``: their ``_std`` is drawn that way.
 * :class:`ConstantParameter` -- squareness / location constant with its std, one per machine.
 * :class:`Noise` -- probing noise, independent per point: along the probing direction when the
   task gives one, else isotropic (each coordinate).
@@ -87,10 +90,11 @@ class TableParameter(Source):
     B: np.ndarray | None = None        # (P, n_nodes) node values -> values at the task points
     L: np.ndarray | None = None        # (n_nodes, n_nodes) factor of the node covariance
     sigma_points: np.ndarray | None = None
+    column: str = "std"                # the table column drawn: std (or u95) or s
 
     @property
     def name(self):
-        return self.parameter
+        return self.parameter if self.column != "s" else f"{self.parameter} repeatability"
 
     def prepare(self, model, task, ctx):
         from ..tables import make_function
@@ -313,12 +317,14 @@ class Ensemble:
     sources: list = field(default_factory=list)
     temperature: Temperature | None = None
     probe_map: object = None
+    table_columns: list = field(default_factory=list)
 
     @classmethod
     def build(cls, funcs=None, spec: Spec | None = None, noise_um: float = 0.0,
               mode: str = "systematic", correlation_mm: float = 0.0,
               temperature: Temperature | None = None, probe_map=None, seed: int = 0,
-              spec_probe=(0.0, 0.0, 0.0), spec_acceptance: float = 0.5) -> "Ensemble":
+              spec_probe=(0.0, 0.0, 0.0), spec_acceptance: float = 0.5,
+              repeatability: bool = False) -> "Ensemble":
         """The uncertainty sources of a task-specific Monte Carlo.
 
         Parameters
@@ -331,8 +337,12 @@ class Ensemble:
         noise_um : float
             Probing noise, standard deviation per point, um.
         mode : {"systematic", "repeatability"}
-            Meaning of the tables' std: uncertainty of the tabulated function (one perturbed
-            function per machine) or single-positioning scatter (drawn per point).
+            How the tables' ``_std`` columns are drawn: as what they are, the uncertainty of
+            the tabulated function (one perturbed function per machine), or, for old tables
+            whose ``_std`` held a single-reading scatter, per point.
+        repeatability : bool
+            Also draw the tables' ``_s`` columns (repeatability of one reading), independently
+            at every probing point.
         correlation_mm : float
             Correlation length of the node perturbations along an axis, mm (0: independent).
         temperature : Temperature, optional
@@ -351,17 +361,26 @@ class Ensemble:
         require(np.isfinite(noise_um) and noise_um >= 0, "--noise-um must be >= 0")
         require(correlation_mm >= 0, "--correlation-mm must be >= 0")
         require(funcs is None or spec is None, "give --errors or --spec, not both")
-        sources = []
+        sources, columns = [], []
         if funcs is not None:
             for ax, t in funcs.tables.items():
                 for name in t.values:
-                    s = t.std.get(name)
+                    s, col = t.std.get(name), "std"
                     if s is None and name in t.u95:
-                        s = t.u95[name] / 2.0
-                    if s is None or not np.any(s > 0):
-                        continue
-                    sources.append(TableParameter(name, ax, t.positions, s, funcs.method,
-                                                  funcs.degrees.get(name), mode, correlation_mm))
+                        s, col = t.u95[name] / 2.0, "u95"
+                    if s is not None and np.any(s > 0):
+                        sources.append(TableParameter(name, ax, t.positions, s, funcs.method,
+                                                      funcs.degrees.get(name), mode,
+                                                      correlation_mm))
+                        columns.append(_column_use(name, ax, col, mode))
+                    r = t.s.get(name)
+                    if r is not None and np.any(r > 0):
+                        if repeatability:
+                            sources.append(TableParameter(name, ax, t.positions, r,
+                                                          funcs.method, None, "repeatability",
+                                                          column="s"))
+                        columns.append(_column_use(name, ax, "s", "repeatability"
+                                                   if repeatability else "not used"))
             for name, s in funcs.constants_std.items():
                 if s > 0:
                     sources.append(ConstantParameter(name, s))
@@ -377,4 +396,22 @@ class Ensemble:
             sources.append(Noise(noise_mm))
         if temperature is not None and temperature.is_random:
             sources.append(TemperatureSource(temperature))
-        return cls(funcs, sources, temperature, probe_map)
+        return cls(funcs, sources, temperature, probe_map, columns)
+
+
+#: how a table column is drawn, in words (reports)
+DRAWN = {"systematic": "one perturbed error function per simulated machine (systematic for "
+                       "every point of the task)",
+         "repeatability": "independently at every probing point",
+         "not used": "not used (give --repeatability to draw it at every probing point)"}
+
+
+def _column_use(name: str, axis: str, column: str, mode: str) -> dict:
+    """What the Monte Carlo did with one uncertainty column of a table (JSON / HTML)."""
+    from ..tables.table import UNCERTAINTY_COLUMNS
+
+    meaning = UNCERTAINTY_COLUMNS[column]
+    if column != "s" and mode == "repeatability":
+        meaning = "read as the repeatability of one reading (--table-std repeatability)"
+    return {"parameter": name, "axis": axis, "column": f"{name}_{column}", "meaning": meaning,
+            "drawn": DRAWN[mode]}

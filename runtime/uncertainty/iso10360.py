@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import require
+from ..plotstyle import figure, label, png, styled
 from ..units import MM_PER_UM, UM_PER_MM
 
 from .tasks import check_travel
@@ -43,8 +44,8 @@ class Spec:
         return self.A_um + np.asarray(length_mm, dtype=float) / self.K
 
     def text(self) -> str:
-        s = f"E0 = {self.A_um:g} + L/{self.K:g} um"
-        return s + (f", PFTU = {self.pftu_um:g} um" if self.pftu_um is not None else "")
+        s = f"E0 = {self.A_um:g} + L/{self.K:g} \u00b5m"
+        return s + (f", PFTU = {self.pftu_um:g} \u00b5m" if self.pftu_um is not None else "")
 
 
 _NUM = r"([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)"
@@ -181,6 +182,56 @@ def evaluate_errors(model, test: LengthTest, errors: dict) -> np.ndarray:
     return np.stack([np.broadcast_to(c, shape) for c in comp], axis=-1).reshape(-1, n, 3)
 
 
+@dataclass(frozen=True)
+class TestUncertainty:
+    """Expanded uncertainty U(L) (k = 2) of the length test, the *test uncertainty* ISO
+    10360-2 (clause 6, with ISO/TS 23165 / ISO 14253-5) tells the verdict to account for: the
+    calibration of the reference lengths (a step gauge or gauge blocks, U_cal = A + L/K, k = 2,
+    um with L in mm), their expansion coefficient (u(alpha), ppm/K) at a temperature T away
+    from 20 degC and the reading of that temperature (u(T), K)::
+
+        U(L) = 2 sqrt((U_cal / 2)^2 + (L |T - 20| u(alpha))^2 + (L alpha u(T))^2)
+
+    (L mm, alpha ppm/K: products in nm, shown in um)."""
+
+    cal_A_um: float = 0.1
+    cal_K: float = 2000.0
+    cte_ppm_per_K: float = 11.5
+    cte_u_ppm_per_K: float = 1.0
+    temperature_C: float = 20.0
+    temperature_u_K: float = 0.2
+
+    def U_um(self, length_mm):
+        L = np.asarray(length_mm, dtype=float)
+        u_cal = 0.5 * (self.cal_A_um + L / self.cal_K)
+        u_cte = L * abs(self.temperature_C - 20.0) * self.cte_u_ppm_per_K * 1e-3
+        u_T = L * self.cte_ppm_per_K * self.temperature_u_K * 1e-3
+        return 2.0 * np.sqrt(u_cal ** 2 + u_cte ** 2 + u_T ** 2)
+
+    def text(self) -> str:
+        return (f"U(L) = 2 \u221a((U_cal/2)\u00b2 + (L |T \u2212 20| u(\u03b1))\u00b2 + (L \u03b1 "
+                f"u(T))\u00b2), U_cal = {self.cal_A_um:g} + L/{self.cal_K:g} \u00b5m, \u03b1 = "
+                f"{self.cte_ppm_per_K:g} ppm/K, u(\u03b1) = {self.cte_u_ppm_per_K:g} ppm/K, "
+                f"T = {self.temperature_C:g} \u00b0C, u(T) = {self.temperature_u_K:g} K")
+
+    def as_dict(self) -> dict:
+        return {"calibration_um": f"{self.cal_A_um:g}+L/{self.cal_K:g}",
+                "cte_ppm_per_K": self.cte_ppm_per_K, "cte_u_ppm_per_K": self.cte_u_ppm_per_K,
+                "temperature_C": self.temperature_C, "temperature_u_K": self.temperature_u_K,
+                "coverage_factor": 2, "formula": self.text()}
+
+
+def parse_calibration(text: str, option: str = "--artefact-u") -> tuple[float, float]:
+    """``"A+L/K"`` (um, L in mm) -> (A, K)."""
+    t = str(text).replace(" ", "")
+    m = re.fullmatch(r"(?:U=)?" + _NUM + r"\+L/" + _NUM, t, re.IGNORECASE)
+    require(m is not None, f"{option} {text!r}: expected \"A+L/K\" (A in um, L in mm)")
+    a, k = float(m.group(1)), float(m.group(2))
+    require(0 <= a <= 1e3 and 0 < k <= 1e9, f"{option} {text!r}: A must lie in 0..1000 um and "
+                                             f"K be positive")
+    return a, k
+
+
 @dataclass
 class TestResult:
     """Simulated E0 values: ``E_um`` (7, 5, R), ``lengths`` (7, 5) mm, line names, MPE."""
@@ -189,28 +240,65 @@ class TestResult:
     lengths: np.ndarray
     E_um: np.ndarray
     spec: Spec | None
+    uncertainty: TestUncertainty = field(default_factory=TestUncertainty)
+
+    def U_um(self) -> np.ndarray:
+        """Test uncertainty U (k = 2) at every test length, (7, 5) um."""
+        return self.uncertainty.U_um(self.lengths)
+
+    def verdicts(self) -> np.ndarray | None:
+        """ISO 14253-1 verdict of every E value against the MPE with U, (7, 5, R) strings
+        (None without a specification)."""
+        if self.spec is None:
+            return None
+        from ..conformance import verdict
+
+        mpe, U = self.spec.mpe_um(self.lengths), self.U_um()
+        out = np.empty(self.E_um.shape, dtype=object)
+        for idx in np.ndindex(self.E_um.shape):
+            out[idx] = verdict(abs(float(self.E_um[idx])), float(mpe[idx[:2]]),
+                               float(U[idx[:2]]))
+        return out
 
     def as_dict(self) -> dict:
+        """JSON: E values per position (um), ``uncertainty_um`` {"E0": largest U}, the test
+        uncertainty, and with a specification the ``verdict`` per ISO 14253-1 (with the
+        verdict of every value and the counts)."""
+        from ..conformance import RULE, overall
+
+        U = self.U_um()
+        v = self.verdicts()
         out = {"positions": []}
         for i, name in enumerate(self.names):
-            out["positions"].append({
-                "line": name, "lengths_mm": [round(float(v), 6) for v in self.lengths[i]],
-                # + 0.0: no negative zero in the JSON
-                "E_um": [[round(float(v), 4) + 0.0 for v in row] for row in self.E_um[i]]})
+            pos = {"line": name, "lengths_mm": [round(float(x), 6) for x in self.lengths[i]],
+                   # + 0.0: no negative zero in the JSON
+                   "E_um": [[round(float(x), 4) + 0.0 for x in row] for row in self.E_um[i]],
+                   "U_um": [round(float(x), 4) for x in U[i]]}
+            if v is not None:
+                pos["verdicts"] = [list(row) for row in v[i]]
+            out["positions"].append(pos)
         out["max_abs_E_um"] = float(np.max(np.abs(self.E_um)))
+        out["uncertainty_um"] = {"E0": float(U.max())}
+        out["test_uncertainty"] = self.uncertainty.as_dict()
         if self.spec is not None:
             mpe = self.spec.mpe_um(self.lengths)[..., None]
             ratio = np.abs(self.E_um) / mpe
             out["mpe"] = self.spec.text()
             out["max_ratio_to_mpe"] = float(ratio.max())
             out["passes"] = bool(np.all(ratio <= 1.0))
+            flat = list(v.ravel())
+            out["verdict"] = overall(flat)
+            out["verdict_counts"] = {k: flat.count(k) for k in ("pass", "undecided", "fail")}
+            out["decision_rule"] = RULE
         return out
 
 
 def simulate(model, funcs=None, probe=(0.0, 0.0, 0.0), box=None, repetitions: int = 3,
-             noise_um: float = 0.0, seed: int = 0, spec: Spec | None = None) -> TestResult:
+             noise_um: float = 0.0, seed: int = 0, spec: Spec | None = None,
+             uncertainty: TestUncertainty | None = None) -> TestResult:
     """The length test on the machine of error functions ``funcs`` (None: perfect machine),
-    with probing noise ``noise_um`` (standard deviation along each probing direction)."""
+    with probing noise ``noise_um`` (standard deviation along each probing direction) and the
+    test uncertainty ``uncertainty`` (default :class:`TestUncertainty`)."""
     require(noise_um >= 0 and np.isfinite(noise_um), "--noise-um must be >= 0")
     test = length_test(model, box, probe, repetitions=repetitions)
     errors = {}
@@ -224,39 +312,51 @@ def simulate(model, funcs=None, probe=(0.0, 0.0, 0.0), box=None, repetitions: in
         rng = np.random.default_rng(seed)
         noise = rng.standard_normal((1,) + test.lengths.shape + (repetitions, 2)) * noise_um * MM_PER_UM
     E = length_errors(test, e, noise)[0]
-    return TestResult(test.names, test.lengths, E * UM_PER_MM, spec)
+    return TestResult(test.names, test.lengths, E * UM_PER_MM, spec,
+                      uncertainty or TestUncertainty())
+
+
+#: colours of the verdict marks
+_MARK = {"fail": "#c62828", "undecided": "#e08a00"}
 
 
 def plot(result: TestResult, path, title: str, inputs=()) -> None:
-    """E0 against L for every position and repetition, with the MPE lines (the certificate
-    picture)."""
-    import io
-
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Write :func:`plot_png` to ``path`` (never over an input)."""
     from ..fileio import write_bytes
 
-    fig, ax = plt.subplots(figsize=(8, 5))
+    write_bytes(path, plot_png(result, title), inputs)
+
+
+@styled
+def plot_png(result: TestResult, title: str) -> bytes:
+    """E0 against L for every position and repetition, with the MPE lines and the
+    conformance zone (MPE reduced by the test uncertainty U, k = 2); values whose verdict is
+    fail (red) or undecided (amber) are marked (the certificate picture).  PNG bytes."""
+    fig, ax = figure(height=5.6)
     markers = "os^vD<>"
     for i, name in enumerate(result.names):
         L = np.repeat(result.lengths[i][:, None], result.E_um.shape[-1], axis=1)
-        ax.plot(L.ravel(), result.E_um[i].ravel(), markers[i % 7], ms=4, label=name, alpha=0.8)
+        ax.plot(L.ravel(), result.E_um[i].ravel(), markers[i % 7], ms=5, label=name, alpha=0.8)
     lmax = float(result.lengths.max()) * 1.05
     if result.spec is not None:
         L = np.linspace(0, lmax, 50)
-        ax.plot(L, result.spec.mpe_um(L), "r-", lw=1.5, label=f"MPE {result.spec.text()}")
-        ax.plot(L, -result.spec.mpe_um(L), "r-", lw=1.5)
+        mpe, U = result.spec.mpe_um(L), result.uncertainty.U_um(L)
+        ax.plot(L, mpe, "r-", lw=1.5, label=f"MPE {result.spec.text()}")
+        ax.plot(L, -mpe, "r-", lw=1.5)
+        ax.fill_between(L, mpe - U, mpe + U, color="tab:red", alpha=0.12, lw=0,
+                        label="MPE \u00b1 U (k = 2): undecided zone")
+        ax.fill_between(L, -mpe - U, -mpe + U, color="tab:red", alpha=0.12, lw=0)
+        v = result.verdicts()
+        for kind in ("undecided", "fail"):
+            idx = np.argwhere(v == kind)
+            if len(idx):
+                ax.plot(result.lengths[idx[:, 0], idx[:, 1]], result.E_um[tuple(idx.T)], "o",
+                        ms=13, mfc="none", mec=_MARK[kind], mew=2.2,
+                        label=f"{kind} ({len(idx)} value{'s' if len(idx) > 1 else ''})")
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xlim(0, lmax)
-    ax.set_xlabel("test length L / mm")
-    ax.set_ylabel("length error E0 / um")
+    ax.set_xlabel(label("test length L", "mm"))
+    ax.set_ylabel(label("length error E0", "um"))
     ax.set_title(title)
-    ax.legend(fontsize=7, ncol=2)
-    ax.grid(alpha=0.3)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    write_bytes(path, buf.getvalue(), inputs)
-
+    ax.legend(ncol=2, fontsize=9)
+    return png(fig)

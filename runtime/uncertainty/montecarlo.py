@@ -261,10 +261,14 @@ class Runner:
         groups = [list(g) for g in np.array_split(np.arange(len(blocks)), n_chunks) if len(g)]
         groups = [[blocks[i] for i in g] for g in groups]
         if self._client is None:
-            it = groups
-            if self.progress:
-                from tqdm import tqdm
-                it = tqdm(groups, desc="Monte Carlo chunks", unit="chunk", leave=False)
+            from ..progress import on_terminal, progress
+
+            if self.progress and on_terminal() and len(groups) < min(len(blocks), 50):
+                # finer groups only to show progress: the values do not depend on grouping
+                groups = [[blocks[i] for i in g] for g in
+                          np.array_split(np.arange(len(blocks)), min(len(blocks), 50))]
+            it = (progress(groups, desc="Monte Carlo", unit="group") if self.progress
+                  else groups)
             parts = [run_blocks(problem, g) for g in it]
         else:
             from dask.distributed import wait  # noqa: F401

@@ -1,15 +1,101 @@
-"""``volerr demo``: the README's first command runs the whole pipeline and its figures hold."""
+"""``volerr demo``: the README's first command runs the whole pipeline and its figures hold.
 
+The demo runs once, in-process, with matplotlib's ``Figure.savefig`` wrapped: every figure
+saved is tagged (a PNG text chunk written by the wrapper) and its texts, dpi and axis labels
+recorded, so that each PNG found afterwards -- a file next to ``index.html`` or a data URI
+inside a report page -- is traced to the figure it came from.  The pages' ``<img width>``
+gives the width each figure is displayed at."""
+
+import base64
+import html as htmllib
 import json
+import re
+import struct
 import subprocess
 import sys
+import zlib
+from pathlib import Path
+
+import pytest
+
+#: text must be at least this high on the page, px
+MIN_PX = 9.0
+#: units on axis labels and table headers: 'quantity / unit', never '(mm)', '[mm]', ', mm'
+UNIT = r"(?:mm|um|µm|urad|µrad|deg|degC|°C|rad|s|min|h)"
+BAD_UNIT = [re.compile(p) for p in (
+    rf"\(\s*{UNIT}\s*\)", rf"\[\s*{UNIT}\s*\]", rf",\s*{UNIT}\s*$", r"\bum\b", r"\burad\b",
+    r"\bdegC\b")]
 
 
-def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
-    out = tmp_path / "demo"
-    proc = subprocess.run([sys.executable, "-m", "volerr", "demo", "--out", str(out)],
-                          capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
+def _png_chunks(data: bytes) -> dict:
+    """tEXt chunks of a PNG (an independent reader: struct and zlib only)."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    out, i = {}, 8
+    while i < len(data):
+        n, kind = struct.unpack(">I4s", data[i:i + 8])
+        body = data[i + 8:i + 8 + n]
+        assert zlib.crc32(kind + body) == struct.unpack(">I", data[i + 8 + n:i + 12 + n])[0]
+        if kind == b"tEXt":
+            k, _, v = body.partition(b"\0")
+            out[k.decode("latin-1")] = v.decode("latin-1")
+        elif kind == b"IHDR":
+            out["width"], out["height"] = struct.unpack(">II", body[:8])
+        i += 12 + n
+    return out
+
+
+def _run_demo(tmp_path_factory):
+    """Run ``volerr demo`` once; return (folder, {tag: record of the saved figure})."""
+    import matplotlib
+    import matplotlib.figure
+    import matplotlib.text
+    from mpl_toolkits.mplot3d import Axes3D
+
+    from volerr.cli import main
+
+    records = {}
+    original = matplotlib.figure.Figure.savefig
+
+    def savefig(fig, fname, *args, **kwargs):
+        tag = f"fig{len(records)}"
+        fmt = kwargs.get("format") or (Path(str(fname)).suffix[1:] if isinstance(
+            fname, (str, Path)) else "png")
+        if fmt == "png":
+            kwargs["metadata"] = {**(kwargs.get("metadata") or {}), "volerr-test": tag}
+        result = original(fig, fname, *args, **kwargs)
+        dpi = kwargs.get("dpi")
+        dpi = fig.dpi if dpi in (None, "figure") else float(dpi)
+        texts = [t for t in fig.findobj(matplotlib.text.Text)
+                 if t.get_visible() and t.get_text().strip() and t.figure is not None]
+        labels = []
+        for ax in fig.axes:
+            labels += [ax.get_xlabel(), ax.get_ylabel()]
+            if isinstance(ax, Axes3D):
+                labels.append(ax.get_zlabel())
+        records[tag] = {"dpi": dpi, "labels": [s for s in labels if s.strip()],
+                        "min_pt": min(t.get_fontsize() for t in texts),
+                        "smallest": min(texts, key=lambda t: t.get_fontsize()).get_text()}
+        return result
+
+    out = tmp_path_factory.mktemp("demo") / "demo"
+    matplotlib.figure.Figure.savefig = savefig
+    try:
+        assert main(["demo", "--out", str(out)]) == 0
+    finally:
+        matplotlib.figure.Figure.savefig = original
+    return out, records
+
+
+def test_demo(tmp_path_factory):
+    """One run of the demo (30 s) for every check: xdist would run a shared fixture once per
+    worker."""
+    out, records = _run_demo(tmp_path_factory)
+    _every_section_and_honest_figures(out)
+    _every_figure_has_text_of_at_least_9_px_where_it_is_shown(out, records)
+    _one_unit_notation_on_every_axis_and_table_header(out, records)
+
+
+def _every_section_and_honest_figures(out):
     from volerr.cli.demo import SECTIONS
 
     summary = json.loads((out / "summary.json").read_text())
@@ -19,6 +105,10 @@ def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
             assert (out / f).exists(), f
     loop = json.loads((out / "loop.json").read_text())
     assert loop["effects"] and loop["rms_after_um"] < 0.5 * loop["rms_before_um"]
+    assert loop["outliers"]["count"] < 0.005 * loop["n_points"]
+    # paths in the report: where the files are, relative to the demo folder; no staging
+    assert ".volerr-staging" not in (out / "loop.json").read_text()
+    assert (out / loop["augmented_layout"]).is_file()
     cal = json.loads((out / "probe_cal.json").read_text())
     assert 0.99 < cal["r_eff_mm"] < 1.01
     html = (out / "index.html").read_text()
@@ -35,6 +125,75 @@ def test_demo_runs_every_section_and_reports_honest_figures(tmp_path):
         assert abs(v["value"] - SPHERE_TRUTH[name]) < 3 * v["std"], (name, v)
     assert html.count("<figcaption>") == html.count("<img ") > 10
     assert "map_MB1_random.png" in html  # the random component is shown
+    # every page the demo wrote is linked from the index
+    for page in out.glob("*.html"):
+        if page.name != "index.html":
+            assert f'href="{page.name}"' in html, page.name
+    assert {"audit.html", "uncertainty.html", "iso230_2.html", "loop.html"} <= {
+        p.name for p in out.glob("*.html")}
+    # the uncertainty is stated for the corrected result: the interval holds the nominal
+    q = json.loads((out / "uncertainty.json").read_text())["quantities"]["distance"]
+    lo, hi = q["result_interval_mm"]
+    assert lo <= q["nominal_mm"] <= hi
+    assert q["corrected_estimate_mm"] == pytest.approx(q["estimate_mm"] - q["bias_um"] * 1e-3)
+    iso = json.loads((out / "iso230_2.json").read_text())
+    assert set(iso["uncertainty_um"]) == set("AEMRB") and iso["verdict"] in (
+        "pass", "fail", "undecided")
+    # no negative zero in any file the demo wrote (reports, pages, tables)
+    negative_zero = re.compile(r"(?<![\w.])[-\u2212]0(?:\.0+)?(?![\d.eE])")
+    for f in out.rglob("*"):
+        if f.suffix in (".json", ".html", ".csv"):
+            text = re.sub(r"data:image/png;base64,[^\"]+", "", f.read_text(encoding="utf-8"))
+            assert not negative_zero.search(text), (f.name, negative_zero.search(text))
+
+
+def _displayed(out: Path):
+    """(page, png bytes, displayed width attribute) of every <img> of every page."""
+    for page in sorted(out.glob("*.html")):
+        text = page.read_text(encoding="utf-8")
+        for tag in re.findall(r"<img\b[^>]*>", text):
+            src = htmllib.unescape(re.search(r'src="([^"]+)"', tag).group(1))
+            w = re.search(r'\bwidth="(\d+)"', tag)
+            data = (base64.b64decode(src.split(",", 1)[1]) if src.startswith("data:")
+                    else (out / src).read_bytes())
+            yield page.name, src[:40], data, int(w.group(1)) if w else None
+
+
+def _every_figure_has_text_of_at_least_9_px_where_it_is_shown(out, records):
+    shown = set()
+    n = 0
+    for page, src, data, width in _displayed(out):
+        chunks = _png_chunks(data)
+        assert width is not None, f"{page}: {src} has no width attribute"
+        assert width <= 1100, f"{page}: {src} shown wider than the page"
+        rec = records[chunks["volerr-test"]]
+        assert rec["min_pt"] >= 9.0, f"{page}: {src}: {rec['smallest']!r} below the style's 9 pt"
+        px = rec["min_pt"] * rec["dpi"] / 72.0 * width / chunks["width"]
+        assert px >= MIN_PX, (f"{page}: {src}: '{rec['smallest']}' is {px:.1f} px high on "
+                              f"the page")
+        if not src.startswith("data:"):
+            shown.add(src)
+        n += 1
+    assert n >= 20
+    # every PNG file of the demo is shown on the index
+    assert {p.name for p in out.glob("*.png")} <= shown
+
+
+def _one_unit_notation_on_every_axis_and_table_header(out, records):
+    labels = [lab for r in records.values() for lab in r["labels"]]
+    assert len(labels) > 60
+    for lab in labels:
+        for rx in BAD_UNIT:
+            assert not rx.search(lab), f"axis label {lab!r}"
+        if re.search(rf"\b{UNIT}$", lab) and " / " not in lab:
+            pytest.fail(f"axis label {lab!r}: unit without ' / '")
+    assert any(lab.endswith(" / µm") for lab in labels)
+    assert any(lab.endswith(" / mm") for lab in labels)
+    for page in out.glob("*.html"):
+        for th in re.findall(r"<th\b[^>]*>(.*?)</th>", page.read_text(encoding="utf-8"), re.S):
+            text = htmllib.unescape(re.sub(r"<[^>]+>", "", th)).strip()
+            for rx in BAD_UNIT:
+                assert not rx.search(text), f"{page.name}: table header {text!r}"
 
 
 def test_demo_refuses_to_write_over_a_file(tmp_path):

@@ -41,7 +41,7 @@ def test_example_mb1_printed_figures(mb1_dir):
     assert np.ptp(x.values["EXX"]) * 1e3 == pytest.approx(6.15, abs=1e-3)
     assert np.ptp(y.values["EYY"]) * 1e3 == pytest.approx(23.0, abs=1e-3)
     assert np.ptp(x.values["EBX"]) * 1e6 == pytest.approx(11.18, abs=1e-3)
-    assert 2 * x.std["EXX"].max() * 1e3 == pytest.approx(10.75, abs=1e-3)
+    assert 2 * x.s["EXX"].max() * 1e3 == pytest.approx(10.75, abs=1e-3)  # repeatability of one reading (_s)
     model = volerr.load("MB1")
     funcs = ErrorFunctions.from_dir(mb1_dir, model)
     n_params = len(funcs.functions) + len(funcs.constants)

@@ -39,8 +39,9 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     mm_cols = {(k.replace("_um", "_mm") if k.startswith("d") and k.endswith("_um") else k):
                (np.asarray(v) * 1e-3 if k.endswith("_um") else v) for k, v in cols.items()}
     mm = _write(tmp_path / "mm.csv", mm_cols)
-    r1 = _cli("loop", "MB1", um, "--json", tmp_path / "a.json", "--degree", "4",
-              "--out-dir", tmp_path / "aug", "--errors-out", tmp_path / "errors")
+    # relative paths, as a user types them: the report names the files where they end up
+    r1 = _cli("loop", "MB1", um, "--json", "a.json", "--degree", "4",
+              "--out-dir", "aug", "--errors-out", "errors", cwd=tmp_path)
     # the same data in mm, with --html and no --json: the augmented layout goes next to the
     # page; the page holds the residual sources as tables, no raw JSON dump, no absolute paths
     html = tmp_path / "page" / "r.html"
@@ -55,6 +56,8 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     assert (html.parent / "MB1_aug.toml").is_file()
     assert [e["name"] for e in a["effects"]] == ["reversal_X"]
     assert (tmp_path / "aug" / "MB1_aug.toml").is_file()
+    assert a["augmented_layout"] == "aug/MB1_aug.toml" and a["generated_module"] == \
+        "aug/mb1_aug.py" and (tmp_path / a["generated_module"]).is_file()
     assert sorted(p.name for p in (tmp_path / "errors").iterdir()) == [
         "X.csv", "Y.csv", "Z.csv", "constants.csv"]
     assert "reversal" in r1.stdout

@@ -149,7 +149,7 @@ def test_histogram_wide_with_one_unit_on_x(tmp_path):
     fig = plots.histogram_figure(values, ("distance", "other"), summary, "t")
     try:
         for ax, n in zip(fig.axes, ("distance", "other")):
-            assert ax.get_xlabel() == "deviation from estimate / um"
+            assert ax.get_xlabel() == "deviation from the estimate / \u00b5m"
             assert f"estimate {summary[n]['estimate_mm']:.6f} mm" in ax.get_title()
             assert ax.xaxis.label.get_fontsize() >= 10
     finally:

@@ -1,0 +1,77 @@
+"""Decisions on conformance with a tolerance, ISO 14253-1 (default rule: guard bands of U).
+
+ISO 14253-1:2017 ("Decision rules for verifying conformity or nonconformity with
+specifications"), the rule for a supplier proving conformance and a customer proving
+nonconformance with the same measurement: the *conformance zone* is the specification zone
+reduced on each specified side by the expanded uncertainty U (k = 2); the *nonconformance
+zone* lies outside the specification zone widened by U.
+
+* ``pass``: the measured value lies in the conformance zone (value <= T - U for an upper
+  limit T), conformance is proven;
+* ``fail``: it lies in the nonconformance zone (value > T + U), nonconformance is proven;
+* ``undecided``: in between (the uncertainty range straddles the limit): neither is proven.
+
+Every volerr verdict comes from :func:`verdict`; a set of verdicts from :func:`overall` (any
+fail -> fail, else any undecided -> undecided, else pass).  Values and U in one unit.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from .errors import InputError, require
+
+PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
+#: the decision rule as stated on every certificate
+RULE = ("ISO 14253-1: pass when the measured value lies inside the tolerance reduced by the "
+        "expanded uncertainty U (k = 2); fail when it lies outside the tolerance widened by U; "
+        "undecided in between")
+
+
+def verdict(value: float, upper: float, U: float, lower: float | None = None) -> str:
+    """ISO 14253-1 verdict of ``value`` against the limits ``upper`` (and ``lower``) with the
+    expanded uncertainty ``U`` >= 0 (module docstring)."""
+    require(U >= 0 and math.isfinite(U), f"expanded uncertainty must be >= 0, got {U}")
+    if value > upper + U or (lower is not None and value < lower - U):
+        return FAIL
+    if value <= upper - U and (lower is None or value >= lower + U):
+        return PASS
+    return UNDECIDED
+
+
+def overall(verdicts) -> str | None:
+    """One verdict from several: any fail -> fail, else any undecided -> undecided, else pass
+    (None when there is none)."""
+    v = list(verdicts)
+    if not v:
+        return None
+    if FAIL in v:
+        return FAIL
+    return UNDECIDED if UNDECIDED in v else PASS
+
+
+def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
+    """``"A=10,E=8,R=4"`` -> ``{"A": 10.0, "E": 8.0, "R": 4.0}`` (um); names from ``names``
+    (any case), each at most once, values positive finite numbers."""
+    allowed = {n.upper(): n for n in names}
+    out = {}
+    for part in filter(None, (p.strip() for p in re.split(r"[,;]", str(text)))):
+        key, eq, value = part.partition("=")
+        key = key.strip().upper().removesuffix("_UM")
+        require(eq == "=" and key, f"{option} {text!r}: write NAME=VALUE pairs in um, e.g. "
+                                   f"\"{','.join(f'{n}=10' for n in list(names)[:3])}\"")
+        require(key in allowed, f"{option}: unknown quantity {key!r}; one of "
+                                f"{' '.join(names)}")
+        require(allowed[key] not in out, f"{option}: {allowed[key]} given twice")
+        try:
+            v = float(value)
+        except ValueError:
+            raise InputError(f"{option}: {allowed[key]} = {value.strip()!r} is not a "
+                             f"number") from None
+        require(math.isfinite(v) and 0 < v <= 1e6,
+                f"{option}: {allowed[key]} = {value.strip()} must be a positive number of um "
+                f"(at most 1e6)")
+        out[allowed[key]] = v
+    require(out, f"{option}: no tolerance given")
+    return out
