@@ -27,11 +27,9 @@ class Evaluation:
     results: list
 
     def write_json(self, path, inputs=()) -> Path:
-        import json
+        from ..fileio import json_text, write_text
 
-        from ..fileio import write_text
-
-        return write_text(path, json.dumps(self.data, indent=2) + "\n", inputs=list(inputs))
+        return write_text(path, json_text(self.data), inputs=list(inputs))
 
 
 def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:

@@ -2,34 +2,34 @@
 
 from __future__ import annotations
 
-import base64
 import html
-import io
+
+from ..plotstyle import embedded_img
+from ..units import num
 
 
 def render(ev) -> str:
-    from .plots import polar_plot
+    from .plots import polar_png
 
-    buf = io.BytesIO()
-    polar_plot(ev.traces, ev.results, buf)
-    img = base64.b64encode(buf.getvalue()).decode()
+    img = embedded_img(polar_png(ev.traces, ev.results), "ballbar polar plot")
     rows = "".join(
         f"<tr><td>{html.escape(r['file'])}</td><td>{html.escape(r['placement'])}</td>"
-        f"<td>{r['plane']}</td><td>{r['radius_mm']:g}</td><td>{r['direction']}</td>"
-        f"<td>{r['G_um']:.3f}</td><td>{r.get('H_um', float('nan')):.3f}</td>"
-        f"<td>{r['F_min_um']:.3f}</td><td>{r['F_max_um']:.3f}</td>"
-        f"<td>{r['centre_offset_um'][0]:.2f}, {r['centre_offset_um'][1]:.2f}</td></tr>"
+        f"<td>{r['plane']}</td><td>{num(r['radius_mm'], 'g')}</td><td>{r['direction']}</td>"
+        f"<td>{num(r['G_um'], '.3f')}</td><td>{_num(r.get('H_um'))}</td>"
+        f"<td>{num(r['F_min_um'], '.3f')}</td><td>{num(r['F_max_um'], '.3f')}</td>"
+        f"<td>{num(r['centre_offset_um'][0], '.2f')}, {num(r['centre_offset_um'][1], '.2f')}</td></tr>"
         for r in ev.data["traces"])
-    diag = "".join(f"<tr><td>{html.escape(d['parameter'])}</td><td>{d['value']:.4g}</td>"
-                   f"<td>{d['std']:.2g}</td><td>{html.escape(d['unit'])}</td></tr>"
+    diag = "".join(f"<tr><td>{html.escape(d['parameter'])}</td><td>{num(d['value'], '.4g')}</td>"
+                   f"<td>{num(d['std'], '.2g')}</td><td>{html.escape(d['unit'])}</td></tr>"
                    for d in ev.data["diagnosis"]) or "<tr><td colspan=4>none</td></tr>"
     return f"""<!DOCTYPE html><html><head><meta charset="utf-8"><title>Ballbar evaluation</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:1em auto}}table{{border-collapse:
 collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}</style></head><body>
 <h1>Ballbar evaluation (ISO 230-4), layout {html.escape(ev.data['layout'])}</h1>
-<img src="data:image/png;base64,{img}" style="width:100%" alt="polar plot">
-<p>Radial deviation of each trace about the nominal circle (the grey ring), magnified; angles
-from the plane's first axis towards its second.</p>
+{img}
+<p>Radial deviation of each trace about its least-squares circle (the grey ring), magnified;
+angles from the plane's first axis towards its second (a rotary sweep: the reading against the
+swept axis' angle).</p>
 <table><tr><th>file</th><th>placement</th><th>plane</th><th>radius / mm</th><th>direction</th>
 <th>G / µm</th><th>H / µm</th><th>F min / µm</th><th>F max / µm</th><th>centre offset / µm</th>
 </tr>{rows}</table>
@@ -42,6 +42,10 @@ deviation about the pivot.</p>
 is listed (with the bar length unknown, only the scale mismatch of the two axes).</p>
 </body></html>
 """
+
+
+def _num(v) -> str:
+    return "-" if v is None else num(v, ".3f")
 
 
 def write_html(path, ev, inputs=()):

@@ -108,14 +108,15 @@ def simulate(model, functions, plane: str, radius: float, centre, tool=(0.0, 0.0
 
 
 def write_csv(path, cols: dict, inputs=()):
-    """Write ballbar columns (6 decimals for mm/deg, 5 for um)."""
+    """Write ballbar columns (6 decimals for mm/deg, 5 for um; no negative zero)."""
     from ..fileio import write_text
+
+    from ..units import num
 
     names = list(cols)
     n = len(cols[names[0]])
-    fmt = ["%.5f" if k.endswith("_um") else "%.0f" if k == "direction" else "%.6f"
-           for k in names]
+    fmt = [".5f" if k.endswith("_um") else ".0f" if k == "direction" else ".6f" for k in names]
     lines = [",".join(names)]
     for i in range(n):
-        lines.append(",".join(f % cols[k][i] for f, k in zip(fmt, names)))
+        lines.append(",".join(num(cols[k][i], f) for f, k in zip(fmt, names)))
     return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))

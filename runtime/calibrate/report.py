@@ -1,79 +1,63 @@
 """HTML page of ``volerr calibrate``: the identified parameters with their standard
 uncertainties and coverage bars, what the campaign does not determine (and which file sees
-what), the plans that would determine it, the residuals of every file, the set-up estimates."""
+what), the plans that would determine it, the residuals of every file, the set-up estimates.
+Figures in volerr's style (:mod:`volerr.plotstyle`); numbers without negative zero."""
 
 from __future__ import annotations
 
-import base64
 import html
-import io
 
 import numpy as np
 
-
-def _png(fig) -> str:
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
+from ..plotstyle import embedded_img, figure, label, png, styled, unit
+from ..units import num
 
 
-def fig_parameters(cal) -> str | None:
-    """Identified values with +-2 u bars (k = 2), one panel per unit."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    params = cal.data["parameters"]
-    if not params:
-        return None
+@styled
+def parameter_figure(params: dict, truth: dict | None = None):
+    """Identified values with +-2 u bars (k = 2), one panel per unit; ``truth``: planted
+    values drawn beside them (simulated campaigns)."""
     units = list(dict.fromkeys(v["unit"] for v in params.values()))
-    fig, axes = plt.subplots(1, len(units), figsize=(4.8 * len(units), 0.45 * max(
-        sum(v["unit"] == u for v in params.values()) for u in units) + 1.6), squeeze=False)
+    rows = max(sum(v["unit"] == u for v in params.values()) for u in units)
+    fig, axes = figure(1, len(units), width=4.6 * len(units) + 0.4,
+                       height=0.42 * rows + 1.9, squeeze=False)
     for ax, u in zip(axes[0], units):
         names = [n for n, v in params.items() if v["unit"] == u]
-        vals = np.array([params[n]["value"] for n in names])
-        err = 2 * np.array([params[n]["std"] for n in names])
         y = np.arange(len(names))
-        ax.errorbar(vals, y, xerr=err, fmt="o", color="C0", capsize=3)
+        ax.errorbar([params[n]["value"] for n in names], y,
+                    xerr=[2 * params[n]["std"] for n in names], fmt="o", capsize=3,
+                    label="identified, ± 2 u (k = 2)")
+        if truth is not None:
+            ax.plot([truth.get(n, 0.0) for n in names], y, "x", color="C3", ms=9,
+                    label="planted")
         ax.axvline(0, color="0.6", lw=0.8)
         ax.set_yticks(y)
         ax.set_yticklabels(names)
         ax.invert_yaxis()
-        ax.set_xlabel(f"value / {u.replace('um', 'µm').replace('urad', 'µrad')}")
+        ax.set_xlabel(label("value", u))
         ax.grid(axis="x", alpha=0.3)
-    fig.suptitle("identified parameters, bars: expanded uncertainty (k = 2)", fontsize=11)
-    return _png(fig)
+        ax.legend(loc="best")
+    return fig
 
 
-def fig_residuals(cal) -> str | None:
+@styled
+def residual_figure(cal):
     """Residual of every reading after the fit on all readings, per file, against its row."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     res = cal.residuals
-    if not res:
-        return None
     files = cal.data["instruments"]
-    fig, axes = plt.subplots(len(res), 1, figsize=(9, 2.2 * len(res) + 0.6), squeeze=False)
+    fig, axes = figure(len(res), 1, height=2.1 * len(res) + 0.6, squeeze=False)
     for ax, (f, (pts, r, k)) in zip(axes[:, 0], sorted(res.items())):
-        labels = ("reading",) if int(np.max(k)) == 1 else ("x", "y", "z")
-        for i, lab in enumerate(labels):
-            ax.plot(np.arange(len(pts)), r[:, i], ".", ms=2.5, label=lab)
+        names = ("reading",) if int(np.max(k)) == 1 else ("x", "y", "z")
+        for i, name in enumerate(names):
+            ax.plot(np.arange(len(pts)), r[:, i], ".", ms=2.5, label=name)
         ax.axhline(0, color="0.6", lw=0.8)
-        ax.set_ylabel("residual / µm")
+        ax.set_ylabel(label("residual", "um"))
         ax.set_title(f"{files[f]['file']} ({files[f]['kind']}): RMS "
-                     f"{files[f]['rms_residual']:.3g} µm", fontsize=10)
-        if len(labels) > 1:
-            ax.legend(fontsize=8, markerscale=3, loc="upper right")
+                     f"{num(files[f]['rms_residual'], '.3g')} µm")
+        if len(names) > 1:
+            ax.legend(markerscale=3, loc="upper right")
     axes[-1, 0].set_xlabel("data row of the file")
-    fig.tight_layout()
-    return _png(fig)
+    return fig
 
 
 def _row(cells) -> str:
@@ -82,35 +66,39 @@ def _row(cells) -> str:
 
 def render_html(cal) -> str:
     d = cal.data
-    params = "".join(_row([n, f"{v['value']:.4g}", f"{v['std']:.2g}", v["unit"]])
+    params = "".join(_row([n, num(v["value"], ".4g"), num(v["std"], ".2g"), unit(v["unit"])])
                      for n, v in d["parameters"].items()) or _row(["none", "", "", ""])
     ident = "".join(_row([n, "yes" if v["identifiable"] else "NO", ", ".join(v["seen_by"]),
                           ", ".join(v["not_seen_by"]), ", ".join(v["confounded_with"])])
                     for n, v in d["identifiability"].items())
     plan = "".join(_row([e["adds"], ", ".join(e["makes_identifiable"]) or
-                         ("; ".join([", ".join(e.get("still_undetermined", [])),
-                                     e.get("why", "")]))]) for e in d.get("plan", [])) \
+                         "; ".join([", ".join(e.get("still_undetermined", [])),
+                                    e.get("why", "")])]) for e in d.get("plan", [])) \
         or _row(["nothing to add: every fitted parameter is determined", ""])
     inst = "".join(_row([i["file"], i["kind"], i["n"], i["n_readings"],
-                         f"{i['rms_residual']:.3g}", f"{i['heldout_rms']:.3g}",
-                         f"{i['normalised_rms']:.3g}"]) for i in d["instruments"])
-    setup = "".join(_row([g, k, f"{v['value']:.4g}", f"{v['std']:.2g}", v["unit"],
+                         num(i["rms_residual"], ".3g"), num(i["heldout_rms"], ".3g"),
+                         num(i["normalised_rms"], ".3g")]) for i in d["instruments"])
+    setup = "".join(_row([g, k, num(v["value"], ".4g"), num(v["std"], ".2g"), unit(v["unit"]),
                           "yes" if v["determined"] else "no"])
                     for g, keys in d["setup"].items() for k, v in keys.items())
-    figs = "".join(f'<img src="data:image/png;base64,{p}" style="max-width:100%" alt="">'
-                   for p in (fig_parameters(cal), fig_residuals(cal)) if p)
+    figs = []
+    if d["parameters"]:
+        figs.append(embedded_img(png(parameter_figure(d["parameters"])),
+                                 "identified parameters with expanded uncertainty bars"))
+    if cal.residuals:
+        figs.append(embedded_img(png(residual_figure(cal)), "residuals per file"))
     return f"""<!DOCTYPE html><html><head><meta charset="utf-8">
 <title>Calibration of {html.escape(d['layout'])}</title>
 <style>body{{font-family:sans-serif;max-width:1200px;margin:1em auto}}table{{border-collapse:
 collapse;margin:0.5em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;
-vertical-align:top}}</style></head><body>
+vertical-align:top;overflow-wrap:anywhere}}</style></head><body>
 <h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
 <p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
-variance factor {d['variance_factor']:.3g} (1 when the residuals match the stated reading
-uncertainties).  Standard uncertainties k = 1.</p>
+variance factor {num(d['variance_factor'], '.3g')} (1 when the residuals match the stated
+reading uncertainties).  Standard uncertainties u (k = 1); the figure's bars ± 2 u (k = 2).</p>
 <h2>Identified parameters</h2>
 <table><tr><th>parameter</th><th>value</th><th>u</th><th>unit</th></tr>{params}</table>
-{figs}
+{''.join(figs)}
 <h2>What the campaign determines</h2>
 <p>A parameter is identifiable when its column is not in the span of all other columns (the
 instruments' set-up unknowns included); a file sees it when its readings depend on it once its

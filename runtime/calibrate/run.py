@@ -119,11 +119,9 @@ class Calibration:
                                inputs=list(inputs))
 
     def write_json(self, path, inputs=()) -> Path:
-        import json
+        from ..fileio import json_text, write_text
 
-        from ..fileio import write_text
-
-        return write_text(path, json.dumps(self.data, indent=2) + "\n", inputs=list(inputs))
+        return write_text(path, json_text(self.data), inputs=list(inputs))
 
     def write_html(self, path, inputs=()) -> Path:
         from ..fileio import write_text

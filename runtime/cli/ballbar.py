@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from ..errors import InputError, require
 from ..fileio import Outputs
-from ._common import add_error_arguments, add_vector, error_functions_from_args, layout_inputs
+from ._common import (add_error_arguments, add_force, add_html, add_json, add_plot, add_vector,
+                      error_functions_from_args, layout_inputs)
 
 
 def register(sub) -> None:
@@ -33,7 +34,7 @@ def register(sub) -> None:
                                                     "mm (X Y Z or X,Y,Z)")
     add_vector(sim, "--tool", default=(0.0, 0.0, 0.0),
                help="offset of the tool-side ball centre from the tool point, mm")
-    sim.add_argument("--rotary", default="", metavar="A=DEG,...",
+    sim.add_argument("--rotary", default=None, metavar="A=DEG,...",
                      help="rotary axes: AXIS=DEG fixed, AXIS=START:STOP swept (comma list)")
     sim.add_argument("--points", type=int, default=360, help="readings per direction")
     sim.add_argument("--noise-um", type=float, default=0.0,
@@ -42,6 +43,7 @@ def register(sub) -> None:
                      help="counter-clockwise, clockwise or both (CCW first)")
     sim.add_argument("--seed", type=int, default=0, help="seed of the noise")
     sim.add_argument("--out", required=True, metavar="TRACE.csv", help="the trace to write")
+    add_force(sim)
     sim.set_defaults(func=run_simulate)
     ev = s.add_parser("evaluate", help="ISO 230-4 G, H, F of traces and a diagnosis",
                       description="Evaluate ballbar traces (one trace per file, placement and "
@@ -51,9 +53,10 @@ def register(sub) -> None:
     ev.add_argument("files", nargs="+", metavar="TRACE.csv", help="ballbar files")
     ev.add_argument("--layout", help="the machine's layout (needed for traces with rotary "
                                      "axes; default: a generic Cartesian layout, MB1)")
-    ev.add_argument("--json", metavar="F", help="write the evaluation (JSON)")
-    ev.add_argument("--plot", metavar="P.png", help="write the polar plot (PNG)")
-    ev.add_argument("--html", metavar="H.html", help="write a report page (HTML)")
+    add_json(ev, "the evaluation (G, H, F per trace; diagnosis)")
+    add_plot(ev, "the polar plot")
+    add_html(ev, "the report page (polar plot, ISO 230-4 table, diagnosis)")
+    add_force(ev)
     ev.set_defaults(func=run_evaluate)
 
 
@@ -79,11 +82,11 @@ def run_simulate(args) -> int:
 
     model = load(args.layout)
     inputs = error_dir_inputs(args.errors) + layout_inputs(args.layout)
-    outs = Outputs(inputs).file("--out", args.out).check()
+    outs = Outputs(inputs, force=args.force).file("--out", args.out).check()
     require(args.noise_um >= 0, "--noise-um must not be negative")
     funcs = error_functions_from_args(args, model)
     cols = simulate(model, funcs, args.plane, args.radius, args.centre, args.tool,
-                    _rotary(args.rotary), args.points, args.noise_um, args.direction, args.seed)
+                    _rotary(args.rotary or ""), args.points, args.noise_um, args.direction, args.seed)
     with outs:
         write_csv(outs.path("--out"), cols, inputs=inputs)
     n = len(cols["dr_um"])
@@ -95,9 +98,8 @@ def run_simulate(args) -> int:
 def run_evaluate(args) -> int:
     from ..ballbar.evaluate import check_layout_for, evaluate
 
-    require(args.json or args.plot or args.html, "give --json, --plot or --html (or several)")
     inputs = list(args.files) + layout_inputs(args.layout)
-    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
+    outs = Outputs(inputs, force=args.force).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).check()
     check_layout_for(args.files, args.layout)
     ev = evaluate(args.files, args.layout)
@@ -107,7 +109,7 @@ def run_evaluate(args) -> int:
         if args.plot:
             from ..ballbar.plots import polar_plot
 
-            polar_plot(ev.traces, ev.results, outs.path("--plot"))
+            polar_plot(ev.traces, ev.results, outs.path("--plot"), inputs=inputs)
         if args.html:
             from ..ballbar.report import write_html
 

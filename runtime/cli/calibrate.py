@@ -4,8 +4,8 @@ any instruments (deviations, ballbar, sphere ...), mixed in one campaign.  See
 
 from __future__ import annotations
 
-from ..errors import require
 from ..fileio import Outputs
+from ._common import add_errors_out, add_force, add_html, add_json
 
 
 def register(sub) -> None:
@@ -22,10 +22,10 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="measurement files (KIND:FILE to "
                    "name the kind: deviations, ballbar, sphere)")
-    p.add_argument("--json", metavar="F", help="write the report (JSON)")
-    p.add_argument("--html", metavar="H", help="write the report with figures (HTML)")
-    p.add_argument("--errors-out", metavar="DIR", help="write the identified model as an error "
-                   "directory (X.csv ... constants.csv) for map, compensate, uncertainty")
+    add_json(p, "the report (parameters, identifiability, set-ups, residuals per file)")
+    add_html(p, "the report with figures")
+    add_errors_out(p, "the identified model (for map, compensate, uncertainty)")
+    add_force(p)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters fitted, the others held at zero: comma list of names "
                         "(EC0Y, EX0C), axes (X: its six component errors) and groups (all, "
@@ -45,11 +45,9 @@ def run(args) -> int:
     from ..machine.model import load
     from ._common import layout_inputs
 
-    require(args.json or args.html or args.errors_out,
-            "give --json, --html or --errors-out (or several) for the result")
     model = load(args.layout)
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout)
-    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
+    outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     with outs:

@@ -223,25 +223,26 @@ def _identify(out: Path) -> dict:
 
 def _ballbar(out: Path) -> dict:
     from ..calibrate.examples import write_ballbar_example
+    from ..units import num
 
     ex = write_ballbar_example(out / "ballbar")
     _cli("ballbar", "evaluate", *ex["files"], "--json", out / "ballbar.json",
          "--plot", out / "ballbar_polar.png", "--html", out / "ballbar.html")
     rep = json.loads((out / "ballbar.json").read_text())
-    g = ", ".join(f"{t['plane']} {t['direction']} {t['G_um']:.2f}" for t in rep["traces"]
+    g = ", ".join(f"{t['plane']} {num(t['G_um'], '.2f')}" for t in rep["traces"]
                   if t["direction"] == "ccw")
     truth = ex["truth"]
     diag = []
     for d in rep["diagnosis"]:
         name = d["parameter"]
         if name in truth:
-            diag.append(f"{name} {d['value']:+.1f} +/- {d['std']:.1f} urad (planted "
-                        f"{truth[name]:+.1f})")
+            diag.append(f"{name} {num(d['value'], '+.1f')} +/- {num(d['std'], '.1f')} urad "
+                        f"(planted {num(truth[name], '+.1f')})")
         elif "-" in name:
             a, b = (n.split("@")[0] for n in name.split("-"))
             planted = 1e-3 * (truth[a] - truth[b])
-            diag.append(f"{a}-{b} scale {d['value']:+.4f} +/- {d['std']:.4f} um/mm (planted "
-                        f"{planted:+.4f})")
+            diag.append(f"{a}-{b} scale {num(d['value'], '+.4f')} +/- "
+                        f"{num(d['std'], '.4f')} um/mm (planted {num(planted, '+.4f')})")
     return {"title": "ballbar circles in XY, YZ, ZX of MB1 (ISO 230-4) -> G, H, diagnosis",
             "value": f"G (CCW) {g} um; diagnosis: " + "; ".join(diag),
             "files": ["ballbar/", "ballbar.json", "ballbar.html", "ballbar_polar.png"]}
@@ -249,6 +250,7 @@ def _ballbar(out: Path) -> dict:
 
 def _rotary(out: Path) -> dict:
     from ..calibrate.examples import write_sphere_example
+    from ..units import num
 
     ex = write_sphere_example(out / "sphere_DMU50.csv", "DMU50")
     _cli("calibrate", "DMU50", ex["path"], "--json", out / "calibrate_rotary.json",
@@ -256,8 +258,8 @@ def _rotary(out: Path) -> dict:
     rep = json.loads((out / "calibrate_rotary.json").read_text())
     rows = []
     for name, v in rep["parameters"].items():
-        rows.append(f"{name} {v['value']:+.1f} +/- {v['std']:.1f} (planted "
-                    f"{ex['truth'].get(name, 0.0):+.1f}) {v['unit']}")
+        rows.append(f"{name} {num(v['value'], '+.1f')} +/- {num(v['std'], '.1f')} (planted "
+                    f"{num(ex['truth'].get(name, 0.0), '+.1f')}) {v['unit']}")
     plan = "; ".join(f"{p['adds']} -> {', '.join(p['makes_identifiable'])}"
                      for p in rep["plan"] if p["makes_identifiable"])
     _parameter_figure(out / "calibrate_rotary.png", rep, ex["truth"])
@@ -272,32 +274,10 @@ def _rotary(out: Path) -> dict:
 
 def _parameter_figure(path: Path, rep: dict, truth: dict) -> None:
     """Identified values (k = 2 bars) beside the planted truth."""
-    import matplotlib
+    from ..calibrate.report import parameter_figure
+    from ..plotstyle import save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    params = rep["parameters"]
-    units = list(dict.fromkeys(v["unit"] for v in params.values()))
-    fig, axes = plt.subplots(1, len(units), figsize=(5.0 * len(units), 3.2), squeeze=False)
-    for ax, u in zip(axes[0], units):
-        names = [n for n, v in params.items() if v["unit"] == u]
-        y = np.arange(len(names))
-        ax.errorbar([params[n]["value"] for n in names], y,
-                    xerr=[2 * params[n]["std"] for n in names], fmt="o", capsize=3,
-                    label="identified (k = 2)")
-        ax.plot([truth.get(n, 0.0) for n in names], y, "x", color="C3", ms=9,
-                label="planted")
-        ax.set_yticks(y)
-        ax.set_yticklabels(names)
-        ax.invert_yaxis()
-        ax.set_xlabel(f"value / {u.replace('um', 'µm').replace('urad', 'µrad')}")
-        ax.grid(axis="x", alpha=0.3)
-        ax.legend(fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save(parameter_figure(rep["parameters"], truth), path)
 
 
 def _fiveaxis(out: Path) -> dict:

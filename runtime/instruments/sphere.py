@@ -166,16 +166,17 @@ def simulate(model, errors: dict, poses: dict, tool=(0.0, 0.0, 0.0), centre_offs
 
 
 def write_csv(path, cols: dict, inputs=()):
-    """Write sphere columns (6 decimals mm/deg, 5 um; placement as text)."""
+    """Write sphere columns (6 decimals mm/deg, 5 um; placement as text; no negative zero)."""
     from ..fileio import write_text
+    from ..units import num
 
     names = list(cols)
     n = len(cols[names[0]])
     lines = [",".join(names)]
     for i in range(n):
         lines.append(",".join(str(cols[k][i]) if k == "placement" else
-                              (f"{cols[k][i]:.5f}" if k.endswith("_um") else
-                               f"{cols[k][i]:.6f}") for k in names))
+                              num(cols[k][i], ".5f" if k.endswith("_um") else ".6f")
+                              for k in names))
     return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
 
 
