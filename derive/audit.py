@@ -95,6 +95,7 @@ READING_KINDS = {
     "ocr": "extraction",               # repair of extraction damage told from the print
     "zero": "assumption",              # an unstated zero offset
     "glyph": "assumption",             # glyph-level defect: print or extraction
+    "missing": "assumption",           # a value the text does not print
     "stacking": "other_machine",       # an axis stacking the text excludes
     "copy": "other_machine",           # a component copied from another equation
     "inconsistent": "other_machine",   # a sign the same document uses the other way
@@ -201,7 +202,11 @@ class Verdict:
             raise ValueError(f"unknown verdict category {self.category!r}")
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        out = asdict(self)
+        if not out["readings_tried"] and self.category == "identical":
+            out["readings_tried"] = ["the derivation itself reproduces the print (no reading "
+                                     "needed)"]
+        return out
 
 
 def classify(v: Verdict, category: str, **fields) -> Verdict:
