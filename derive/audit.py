@@ -54,8 +54,11 @@ import sympy as sp
 #: provider modules, imported when present
 PROVIDERS = ("volerr.derive.audit_pahk", "volerr.derive.audit_tracker",
              "volerr.derive.audit_dmu50", "volerr.derive.audit_rotary",
-             "volerr.derive.audit_listings", "volerr.derive.audit_probe",
-             "volerr.derive.audit_numbers")
+             "volerr.derive.audit_htm", "volerr.derive.audit_ch2",
+             "volerr.derive.audit_metrology", "volerr.derive.audit_listings",
+             "volerr.derive.audit_squareness", "volerr.derive.audit_scripts",
+             "volerr.derive.audit_probe", "volerr.derive.audit_numbers",
+             "volerr.derive.audit_results")
 
 
 #: the rule that picks a verdict's category from the readings tried (quoted by the HTML page
