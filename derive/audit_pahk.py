@@ -29,7 +29,7 @@ from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, class
                     typical_text, worst_case_um)
 from .audit_pahk_chain import audit_chain, audit_vectors, chain_error  # noqa: F401
 from .audit_pahk_model import (COMPONENTS, P, Reading, derived_error, geometries,  # noqa: F401
-                               iso_error, layout, paper_map, paper_name, parse,
+                               geometry_text, iso_error, layout, paper_map, paper_name, parse,
                                printed_component, readings, stacking_text)
 from .audit_pahk_rules import CONVENTION_TABLE, RULE1, _bounds, audit_transfer
 
@@ -143,7 +143,7 @@ def audit_volumetric(eq: dict, geoms: tuple) -> tuple[list[Verdict], Reading]:
                         f"reading: {r.describe(lay)} (expand(alternative - printed) == 0).")
             v = _verdict(eq, c, "differs", erratum, evidence + ocr, printed[i], physical[i])
             v.readings_tried, v.readings_used = tried, list(keys)
-            out.append(_reading_category(v, r, keys, lay, d[i], physical[i]))
+            out.append(_reading_category(v, r, keys, lay, d[i], physical[i], geoms))
             continue
         resid = describe_diff(best_d[i], printed[i])
         erratum = resid if best.cost() == 0 else f"{resid} [under {best.short(lay)}]"
@@ -185,7 +185,7 @@ def _tried(rows, i, printed, lay) -> list[str]:
     return out
 
 
-def _reading_category(v: Verdict, r: Reading, keys, lay, alt, physical) -> Verdict:
+def _reading_category(v: Verdict, r: Reading, keys, lay, alt, physical, geoms=()) -> Verdict:
     """Category of a volumetric verdict reproduced exactly by reading ``r`` (keys ``keys``)."""
     cat = category_of(keys)
     if cat == "printing_error":
@@ -196,8 +196,10 @@ def _reading_category(v: Verdict, r: Reading, keys, lay, alt, physical) -> Verdi
     if r.pivot == "table_origin":
         names.append(CONVENTION_TABLE)
     if r.tool is not None or r.work is not None:
+        passage = geometry_text(geoms, r.stacking(lay))
         names.append(f"axes stacked {stacking_text(*r.stacking(lay))}: a geometry the text "
-                     f"allows (the layout file has {_stacking(lay)}); the verdict rests on it")
+                     f"allows (the layout file has {_stacking(lay)}; Pahk: {passage}); the "
+                     f"verdict rests on it")
     for f in r.flips:
         names.append(f"the errors of table {f} signed as the table's own motion"
                      if f in lay.axes else
@@ -369,7 +371,7 @@ def audit(printed: dict, layouts: list[str] | None = None) -> list[Verdict]:
         elif kind == "random":
             out.extend(audit_random(e, random_eqs))
         elif kind == "transfer":
-            out.extend(audit_transfer(e, vol_reading.get(name), _verdict))
+            out.extend(audit_transfer(e, vol_reading.get(name), _verdict, geoms[name]))
         elif kind == "chain":
             out.extend(audit_vectors(e, _verdict))
             out.extend(audit_chain(e, by_id, result_of.get(name), geoms[name],

@@ -161,7 +161,7 @@ def chain_vectors(eq: dict, by_id: dict) -> tuple[dict, str, dict]:
             notes.append(f"L{k} printed {src['L'][k]} read as {ocr[f'L.{k}']}")
             L[k] = ocr[f"L.{k}"]
     if notes and ocr.get("note"):
-        notes.append(f"({ocr['note']}; verdict '{vector_label(src)}')")
+        notes.append(f"({ocr['note']}; see the verdict on eq. {vector_label(src)} L{k})")
     where = f" (vectors of eq. {eq['L_from']})" if "L_from" in eq else ""
     return L, "; ".join(notes) + where, src
 
@@ -325,7 +325,7 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
                              if best is not None else "")]
         v.readings_used = list(keys)
         if cat in ("convention", "simplification"):
-            return [_convention(v, r, lay, literal, physical, keys)]
+            return [_convention(v, r, lay, literal, physical, keys, geoms)]
         if cat == "printing_error":
             v.evidence += (" The printed chain is the layout only with an axis stacking the "
                            "text excludes (another machine): a printing error.")
@@ -337,14 +337,14 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
                      alternative=_vec(best[0][2]) if best is not None else "")]
 
 
-def _convention(v: Verdict, r, lay, literal, physical, keys) -> Verdict:
+def _convention(v: Verdict, r, lay, literal, physical, keys, geoms=()) -> Verdict:
     names = []
     if r.pivot == "table_origin":
         names.append(CONVENTION_TABLE)
     if r.tool is not None or r.work is not None:
-        from .audit_pahk_model import stacking_text
+        from .audit_pahk_model import geometry_text, stacking_text
         names.append(f"axes stacked {stacking_text(*r.stacking(lay))} (a geometry the text "
-                     f"allows)")
+                     f"allows; Pahk: {geometry_text(geoms, r.stacking(lay))})")
     for f in r.flips:
         names.append(f"the errors of table {f} signed as the table's own motion"
                      if f in lay.axes else f"{f} signed the other way")

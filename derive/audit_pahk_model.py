@@ -156,6 +156,14 @@ def geometries(printed: dict, name: str) -> list[Geometry]:
     return out
 
 
+def geometry_text(geoms, stacking) -> str:
+    """The passage that allows ``stacking`` ((tool, work)) among ``geoms``, or ""."""
+    for g in geoms:
+        if (g.tool, g.work) == tuple(map(tuple, stacking)):
+            return g.text
+    return ""
+
+
 # ------------------------------------------------------------------------------ readings
 @dataclass(frozen=True)
 class Reading:
@@ -195,7 +203,7 @@ class Reading:
         if self.tool is not None or self.work is not None:
             tool, work = self.stacking(lay)
             what = "a geometry the text allows" if self.allowed else \
-                "another machine: the text fixes the layout's stacking"
+                "another machine: a stacking the text does not allow"
             parts.append(f"axes stacked {stacking_text(tool, work)} ({what}; the layout file "
                          f"has {stacking_text(lay.tool_chain, lay.workpiece_chain)})")
         for f in self.flips:

@@ -208,9 +208,9 @@ def _n_terms_off(name, key, r, printed_terms) -> int:
 
 def rule_readings(name: str, iso: str, stacking) -> list[RuleReading]:
     """Every combination for the rule of ISO parameter ``iso`` of a layout whose volumetric
-    equation was read with stacking ``stacking`` ((tool, work) or None: the layout's).  Only
-    the signs that can enter the rule are varied: the squareness symbol itself and the errors
-    of the table axes."""
+    equation was read with stacking ``stacking`` ((tool, work) or None: the layout's; a rule
+    is read on the same machine).  Only the signs that can enter the rule are varied: the
+    squareness symbol itself and the errors of the table axes."""
     lay = layout(name)
     squ = iso in SQUARENESS
     table = list(stacking[1]) if stacking is not None else list(lay.workpiece_chain)
@@ -218,7 +218,8 @@ def rule_readings(name: str, iso: str, stacking) -> list[RuleReading]:
     flipsets = [c for k in range(len(flippable) + 1) for c in itertools.combinations(flippable, k)]
     if squ:
         pivots = ["tool_point"] + (["table_origin"] if table else [])
-        stacks = [(None, None)] + ([stacking] if stacking is not None else [])
+        # one machine: the stacking the layout's volumetric equation is read with
+        stacks = [stacking] if stacking is not None else [(None, None)]
         return [RuleReading(p, t, w, f, False, ln, ()) for p in pivots for (t, w) in stacks
                 for f in flipsets for ln in ("both", *_LINES[iso])]
     present = _translational_shifts(name)[iso].free_symbols
@@ -247,7 +248,7 @@ def _bounds(expr) -> dict:
     return out
 
 
-def audit_transfer(eq: dict, vol_reading, verdict) -> list[Verdict]:
+def audit_transfer(eq: dict, vol_reading, verdict, geoms=()) -> list[Verdict]:
     """Verdicts on every rule of a transfer equation.  ``vol_reading``: the reading of the same
     layout's volumetric equation (its flips and stacking are the consistent ones);
     ``verdict``: the Verdict factory of the provider."""
@@ -290,7 +291,7 @@ def audit_transfer(eq: dict, vol_reading, verdict) -> list[Verdict]:
                         f"exactly by the reading: {r.describe(lay, iso, vf)} "
                         f"(expand(alternative - printed) == 0).")
             v = verdict(eq, key, "differs", erratum, evidence + ocr, pr, d0)
-            out.append(_rule_category(v, keys, r, lay, iso, d, d0, tried))
+            out.append(_rule_category(v, keys, r, lay, iso, d, d0, tried, geoms))
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
         r = min(near, key=lambda x: (n_issues(derived_rule(name, key, x), pr),
@@ -310,15 +311,20 @@ def audit_transfer(eq: dict, vol_reading, verdict) -> list[Verdict]:
 
 def _tried(name, key, rr, pr, lay, iso, vol_flips, geometry_key, hits) -> list[str]:
     """The readings tried, for the verdict: each single reading and the exact combinations."""
-    out = []
+    d0 = derived_rule(name, key)
+    k0 = n_issues(d0, pr)
+    out = [f"the full rigid-body transfer of the physical layout: "
+           + ("exact" if k0 == 0 else f"{k0} term(s) differ ({describe_diff(d0, pr, 2)})")]
     singles = {}
+    base = RuleReading(tool=rr[0].tool, work=rr[0].work).keys(lay, vol_flips, geometry_key)
     for r in rr:
         keys = r.keys(lay, vol_flips, geometry_key)
-        base = RuleReading().keys(lay, vol_flips, geometry_key)
         extra = tuple(k for k in keys if k not in base)
         if len(extra) <= 1 and extra not in singles:
             singles[extra] = r
     for extra, r in sorted(singles.items(), key=lambda kv: (len(kv[0]), kv[0])):
+        if r == RuleReading():
+            continue                                     # the physical layout: listed first
         d = derived_rule(name, key, r)
         k = n_issues(d, pr)
         out.append(f"{r.describe(lay, iso, vol_flips)}: "
@@ -331,7 +337,7 @@ def _tried(name, key, rr, pr, lay, iso, vol_flips, geometry_key, hits) -> list[s
     return out
 
 
-def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tried):
+def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tried, geoms=()):
     """Category of a transfer-rule verdict reproduced exactly by reading ``r`` (keys ``keys``)."""
     dropped = sp.expand(d0 - alt)
     size = worst_case_um(dropped, _bounds(dropped)) if iso not in SQUARENESS else None
@@ -369,8 +375,10 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
     if r.pivot == "table_origin":
         names.append(CONVENTION_TABLE)
     if r.tool is not None or r.work is not None:
+        from .audit_pahk_model import geometry_text
         names.append(f"axes stacked {stacking_text(r.tool, r.work)}, the geometry of the "
-                     f"layout's volumetric equation")
+                     f"layout's volumetric equation, which the text allows (Pahk: "
+                     f"{geometry_text(geoms, (r.tool, r.work))})")
     for f in r.flips:
         names.append(f"{paper_name(lay, f) if f not in lay.axes else 'table ' + f} signed as in "
                      f"the volumetric equation")

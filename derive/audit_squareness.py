@@ -173,7 +173,7 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
             out.append(_v(u["id"], u["entry"], "undecidable", f"{u['term']} equals {u['eq']} "
                           "only for one travel direction of Z", base + " Among these the "
                           "entry is right for " + "; ".join(_label(sg) for sg in right)
-                          + " and wrong for the other," + extra + " The other Z entry of "
+                          + " and wrong for the other." + extra + " The other Z entry of "
                           "Listing 3.4 is wrong exactly "
                           "where this one is right: one of the two Z entries is a printing "
                           "error whatever the direction. Category undecidable; missing: the "
