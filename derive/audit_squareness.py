@@ -160,7 +160,9 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                           + "; ".join(_label(sg) for sg in right), base + " Under every one "
                           f"of them the entry equals {u['eq']}." + extra + " The travel "
                           "direction is a reading: the text does not give it.", u["text"],
-                          u["eq"], tried, keys))
+                          u["eq"], tried, keys,
+                          statement="the travel direction(s) " + "; ".join(
+                              _label(sg) for sg in right) + " (not printed)"))
         elif not right:
             out.append(_v(u["id"], u["entry"], "printing_error", f"{u['term']} != {u['eq']}",
                           base + f" Under none of them does the entry equal {u['eq']}. "
