@@ -20,7 +20,6 @@ import sympy as sp
 from .audit import Verdict, category_of
 
 DATA_FILE = "printed_ch2.toml"
-LAYOUTS = ("DMU50",)
 SOURCE = "Ellingsdalen 2021"
 LAYOUT = "-"
 

@@ -24,7 +24,6 @@ import sympy as sp
 from .audit import Verdict, category_of
 
 DATA_FILE = "printed_metrology.toml"
-LAYOUTS = ("DMU50",)
 SOURCE = "Ellingsdalen 2021"
 LAYOUT = "-"
 DOCS = {"paper": "conference paper (appendix A)", "project": "project report (appendix B)"}

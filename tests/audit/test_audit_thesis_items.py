@@ -382,3 +382,59 @@ def test_appendix_d1_solves_with_the_arms_of_theta_zero():
     assert np.ptp([np.linalg.det(A(th, False)) for th in (0.2, 1.0)]) == 0
     v = find(vs, "appendix D.1")
     assert v.category == "printing_error" and "theta = 0" in v.erratum
+
+
+def test_rotary_axis_model_of_the_paper_1_12_to_1_16(htm):
+    """1.13-1.16 as ISO 230-7's location, orientation, error motions and rotation of an axis
+    B about its own z (numpy, random small errors); 1.12 their product in that order."""
+    rng = np.random.default_rng(12)
+    vals = dict(zip(("EX0B", "EY0B", "EA0B", "EB0B", "EAB", "EBB", "ECB", "EXB", "EYB", "EZB"),
+                    rng.normal(0, 1e-4, 10)))
+    b = 1.3
+    want = {"1.13": np.block([[np.eye(3), np.array([[vals["EX0B"]], [vals["EY0B"]], [0]])],
+                              [np.zeros((1, 3)), np.ones((1, 1))]]),
+            "1.14": np.block([[np.eye(3) + skew([vals["EA0B"], vals["EB0B"], 0]),
+                               np.zeros((3, 1))], [np.zeros((1, 3)), np.ones((1, 1))]]),
+            "1.15": np.block([[np.eye(3) + skew([vals["EAB"], vals["EBB"], vals["ECB"]]),
+                               np.array([[vals["EXB"]], [vals["EYB"]], [vals["EZB"]]])],
+                              [np.zeros((1, 3)), np.ones((1, 1))]]),
+            "1.16": np.block([[rz(b), np.zeros((3, 1))], [np.zeros((1, 3)), np.ones((1, 1))]])}
+    items = {a["id"]: a for a in data("printed_htm.toml")["axis"]}
+    env = {"cos": math.cos, "sin": math.sin, "B": b, **vals}
+    for eq, m in want.items():
+        printed = np.array([[eval(x, {}, env) for x in r]  # noqa: S307
+                            for r in items[eq]["rows"]])
+        assert np.allclose(printed, m), eq
+        assert find(htm, f"paper eq. {eq}").category == "identical"
+    assert items["1.12"]["rows"][0] == ["T_OB", "T_SB", "T_EB", "T_BB"]
+    assert find(htm, "paper eq. 1.12").category == "identical"
+    assert find(htm, "paper eq. 1.7", "label").category == "undecidable"
+
+
+def test_project_report_x_axis_error_model_23_24(htm):
+    rng = np.random.default_rng(23)
+    e, t, p = rng.normal(0, 1e-4, 3), rng.normal(0, 1e-3, 3), rng.uniform(-100, 100, 3)
+    dev = skew(e) @ p + t                          # (T - T_nominal) p, first order
+    items = {a["id"]: a for a in data("printed_htm.toml")["axis"]}
+    env = dict(zip(("EAX", "EBX", "ECX", "EXX", "EYX", "EZX", "xx", "yx", "zx"),
+                   (*e, *t, *p)))
+    m = np.array([[eval(x, {}, env) for x in r] for r in items["(23)"]["rows"]])  # noqa: S307
+    assert np.allclose(m @ [*p, 1], [*dev, 0])
+    rows = [eval(r[0], {}, env) for r in items["(24)"]["rows"]]  # noqa: S307
+    assert np.allclose(rows, dev)
+    for eq in ("project eq. (23)", "project eq. (24)"):
+        assert find(htm, eq).category == "identical"
+
+
+def test_rodrigues_inputs_and_figure_3_11_table_cells(ch2):
+    ex = data("printed_ch2.toml")["example"]
+    assert rounds_to(ex["theta_rad"], math.pi / 6) and rounds_to(ex["one_minus_cos"],
+                                                                  1 - math.cos(math.pi / 6))
+    assert np.allclose(np.array(ex["skew"], float), skew([float(x) for x in ex["axis"]]))
+    assert find(ch2, "eq. 2.35-2.38 (2.35-2.37)").category == "identical"
+    vs = audit_results.audit(data("printed_results.toml"))
+    # Listing 3.4 sets every row's 4th entry to 1; the printed right array has none
+    comp = data("printed_results.toml")["nc_data"]["comp"]
+    assert all(len(r) == 3 for r in comp)
+    assert find(vs, "Figure 3.11", "homogeneous column").category == "undecidable"
+    assert find(vs, "sec. 4.2.1: E_YX 6.6 -> 1.3 um", "values").category == "undecidable"
