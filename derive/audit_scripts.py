@@ -72,6 +72,16 @@ def _deviations() -> dict:
     return out
 
 
+def _paren(expr: str) -> str:
+    """The cofactor in parentheses when it is a sum, so a leading sign applies to all of it."""
+    depth = 0
+    for i, ch in enumerate(expr):
+        depth += (ch == "(") - (ch == ")")
+        if depth == 0 and i > 0 and ch in "+-" and expr[i - 1] == " ":
+            return f"({expr})"
+    return expr
+
+
 def audit_c1(c1: dict) -> list[Verdict]:
     loc = _c1_locals("x")
     cf = closed_form("x")
@@ -94,7 +104,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
                 ok = dv is not None and sp.expand(pc - cof[dv]) == 0
                 used_d.add(dv)
                 (checked if ok else bad).append(
-                    f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}{t['cofactor']} * "
+                    f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}{_paren(t['cofactor'])} * "
                     f"({t['d']}) " + ("= the derived term of " + str(dv) if ok else
                                       f"!= the derived {fmt(cof.get(dv, 'none'))} of {dv}"))
         for t in terms:
@@ -105,7 +115,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
             if hit:
                 used_d.add(hit[0])
                 checked.append(f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}"
-                               f"{t['cofactor']} (deviation lost) = the derived cofactor of "
+                               f"{_paren(t['cofactor'])} (deviation lost) = the derived cofactor of "
                                f"{hit[0]}, the one deviation left")
             else:
                 bad.append(f"line {t['line']}: {t['cofactor']} matches no remaining cofactor")
