@@ -28,6 +28,18 @@ Every verdict also carries a *category* (:data:`CATEGORIES`), what a reviewer ne
   it drops and ``dropped_um`` their size on a typical machine, :data:`TYPICAL`);
 * ``undecidable``: the evidence does not decide; ``evidence`` says what is missing.
 
+How a category is chosen (:data:`PRIORITY_RULE`): every combination of the named *readings*
+a provider knows is tried -- conventions and simplifications, each with its own evidence, and
+every geometry the text allows -- and the verdict follows from the readings that reproduce the
+print exactly, by the rule ``identical`` > ``convention`` / ``simplification`` (fewest
+readings) > ``extraction`` > ``printing_error`` (no reading reproduces it and the text itself
+decides that it is not extraction damage) > ``undecidable`` (otherwise: only an unstated
+assumption reproduces it, or a glyph-level defect the print and the extraction explain
+equally).  Every
+verdict lists the readings tried (``readings_tried``) and the keys of the readings it rests on
+(``readings_used``); a reading key has one kind (:data:`READING_KINDS`), hence one category,
+on every layout and in every document (:func:`category_of`).
+
 This module holds the shared pieces: :class:`Verdict`, the provider registry and the
 term-by-term comparison of two polynomials (:func:`term_diff`, :func:`describe_diff`).
 """
@@ -35,15 +47,100 @@ term-by-term comparison of two polynomials (:func:`term_diff`, :func:`describe_d
 from __future__ import annotations
 
 import importlib
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import sympy as sp
 
 #: provider modules, imported when present
 PROVIDERS = ("volerr.derive.audit_pahk", "volerr.derive.audit_tracker",
              "volerr.derive.audit_dmu50", "volerr.derive.audit_rotary",
-             "volerr.derive.audit_listings", "volerr.derive.audit_probe",
-             "volerr.derive.audit_numbers")
+             "volerr.derive.audit_htm", "volerr.derive.audit_ch2",
+             "volerr.derive.audit_metrology", "volerr.derive.audit_listings",
+             "volerr.derive.audit_squareness", "volerr.derive.audit_scripts",
+             "volerr.derive.audit_probe", "volerr.derive.audit_numbers",
+             "volerr.derive.audit_results")
+
+
+#: the rule that picks a verdict's category from the readings tried (quoted by the HTML page
+#: and docs/formats.md)
+PRIORITY_RULE = (
+    "Every combination of the named readings is tried (conventions and simplifications, each "
+    "with its own evidence; every geometry the text allows; repairs of text-extraction "
+    "damage; unstated assumptions) and the category follows, in this order of preference: "
+    "(1) identical -- the derivation itself reproduces the print, no reading needed; "
+    "(2) convention / simplification -- a combination of stated conventions and the author's "
+    "stated approximations reproduces it exactly; the combination with the fewest readings "
+    "is reported (simplification when it contains an approximation); "
+    "(3) extraction -- only a repair of text-extraction damage reproduces it, and the "
+    "evidence tells that damage from the print (a symbol no print carries, a line number "
+    "without its line); "
+    "(4) printing_error -- no reading reproduces it, and the text itself decides that it is "
+    "not extraction damage (a well-formed wrong symbol, term or sign; the same defect in a "
+    "separately typeset copy; a consequence printed elsewhere; a sign or axis stacking that "
+    "contradicts the one the same document uses); "
+    "(5) undecidable -- otherwise: only an unstated assumption reproduces it, or the defect "
+    "is glyph-level (a lost letter, sign, row or column, a duplicated row, a confusable glyph "
+    "such as mm for um) and the print and the extraction explain it equally; both "
+    "explanations are named, and what would decide.")
+
+#: kind of every reading key prefix -> the category it implies (see :func:`category_of`)
+READING_KINDS = {
+    "table_origin": "convention",      # Pahk's chain form: table rotations about its origin
+    "geometry": "convention",          # an axis stacking the text allows
+    "flip": "convention",              # a sign convention of a symbol (used consistently)
+    "line": "convention",              # squareness as the slope of one line
+    "notation": "convention",          # a notational convention (atan for atan2 ...)
+    "rounding": "convention",          # a printed number from rounded printed intermediates
+    "travel": "convention",            # an axis travel direction the text leaves open
+    "rule1": "simplification",         # Pahk's rule (1) of sec. 2.3
+    "termwise": "simplification",      # Pahk's term-wise quadrature
+    "stated": "simplification",        # another approximation the author states
+    "ocr": "extraction",               # repair of extraction damage told from the print
+    "zero": "assumption",              # an unstated zero offset
+    "glyph": "assumption",             # glyph-level defect: print or extraction
+    "missing": "assumption",           # a value the text does not print
+    "stacking": "other_machine",       # an axis stacking the text excludes
+    "copy": "other_machine",           # a component copied from another equation
+    "inconsistent": "other_machine",   # a sign the same document uses the other way
+}
+
+_KIND_ORDER = {"other_machine": "printing_error", "assumption": "undecidable",
+               "simplification": "simplification", "convention": "convention",
+               "extraction": "extraction"}
+
+#: rank of a category among the combinations that reproduce the print (lower wins): an
+#: unstated assumption still beats a reading that contradicts the document (which only
+#: diagnoses the printing error)
+RANK = {"identical": 0, "convention": 1, "simplification": 1, "extraction": 2,
+        "undecidable": 3, "printing_error": 4}
+
+
+def reading_kind(key: str) -> str:
+    """Kind of a reading key (``"flip:alpha"`` -> ``"convention"``)."""
+    return READING_KINDS[key.split(":", 1)[0]]
+
+
+def category_of(keys) -> str:
+    """The category a combination of reading keys implies, by :data:`PRIORITY_RULE`."""
+    kinds = {reading_kind(k) for k in keys}
+    for kind, cat in _KIND_ORDER.items():
+        if kind in kinds:
+            if kind == "extraction" and kinds - {"extraction"}:
+                continue
+            return cat
+    return "identical"
+
+
+def best_combination(hits):
+    """Among ``hits`` = [(keys, payload)] of combinations that reproduce the print exactly,
+    the one the rule prefers: lowest category rank, then fewest unstated assumptions, then
+    fewest readings, then stable order.
+    Returns ``(keys, payload)`` or None."""
+    if not hits:
+        return None
+    return min(hits, key=lambda h: (RANK[category_of(h[0])],
+                                    sum(reading_kind(k) == "assumption" for k in h[0]),
+                                    len(h[0]), repr(h[0])))
 
 
 #: verdict categories, in report order
@@ -81,7 +178,8 @@ class Verdict:
     two expressions (strings, in the paper's symbols).  ``category`` is one of
     :data:`CATEGORIES` (``identical`` whenever ``verdict`` is); ``alternative``, ``statement``,
     ``dropped`` and ``dropped_um`` document a ``convention`` or ``simplification`` (see the
-    module docstring)."""
+    module docstring); ``readings_tried`` lists the readings (and combinations) tried with
+    their outcome, ``readings_used`` the keys of the readings the category rests on."""
 
     source: str
     equation: str
@@ -97,6 +195,8 @@ class Verdict:
     statement: str = ""
     dropped: str = ""
     dropped_um: float | None = None
+    readings_tried: list = field(default_factory=list)
+    readings_used: list = field(default_factory=list)
 
     def __post_init__(self):
         if self.verdict == "identical" and not self.category:
@@ -105,7 +205,11 @@ class Verdict:
             raise ValueError(f"unknown verdict category {self.category!r}")
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        out = asdict(self)
+        if not out["readings_tried"] and self.category == "identical":
+            out["readings_tried"] = ["the derivation itself reproduces the print (no reading "
+                                     "needed)"]
+        return out
 
 
 def classify(v: Verdict, category: str, **fields) -> Verdict:
@@ -255,3 +359,21 @@ def describe_diff(expected, printed, limit: int = 4) -> str:
     for p, e in d["coefficient"]:
         parts.append(f"{_signed(*p.as_coeff_Mul())} printed for {_signed(*e.as_coeff_Mul())}")
     return "; ".join(parts)
+
+
+def lost_glyphs(expected, printed) -> list[str]:
+    """If ``printed`` differs from ``expected`` only by symbols printed with one character
+    lost (``beta1`` for ``Rbeta1``), the list of those defects; else [] (a glyph-level defect
+    that the print and a text extraction explain equally)."""
+    d = term_diff(expected, printed)
+    if d["omitted"] or d["extra"] or d["sign"] or d["coefficient"] or not d["swapped"]:
+        return []
+    out = []
+    for p, e in d["swapped"]:
+        ps, es = _swap(e.as_coeff_Mul()[1], p.as_coeff_Mul()[1])
+        a, b = str(ps), str(es)
+        if len(b) != len(a) + 1 or not any(b[:i] + b[i + 1:] == a for i in range(len(b))):
+            return []
+        lost = next(b[i] for i in range(len(b)) if b[:i] + b[i + 1:] == a)
+        out.append(f"{a} for {b} (the letter {lost} lost)")
+    return out

@@ -62,19 +62,60 @@ def _verdict(eq, same, erratum, evidence, printed, derived, component="",
                    category="identical" if same else category, **fields)
 
 
-def _matrix_category(erratum: str, evidence: str) -> tuple[str, str]:
-    """(category, evidence) of a printed matrix that differs from the derived one."""
+#: matrices of the chain printed again in the other documents of the thesis: (equation,
+#: what it prints) -- separately typeset copies decide whether a defect is in the author's
+#: source (the same defect there) or not
+COPIES = {
+    "T_0^1": ("paper eq. 1.1, project eq. (1)", "the same matrix"),
+    "T_1^2": ("paper eq. 1.2, project eq. (2)", "all four rows"),
+    "T_2^3": ("paper eq. 1.3 ([[c_B, -s_B], [s_B, c_B]]: the rotation), project eq. (3) "
+              "([[c_B, s_B], [s_B, c_B]]: the same sign defect), Listing 3.3 T_B ([[c_B, -s_B], "
+              "[s_B, c_B]])", ""),
+    "T_3^4": ("paper eq. 1.4, project eq. (4)", "four rows, none repeated"),
+    "T_4^5": ("paper eq. 1.5, project eq. (5)", "the translation by -d"),
+    "T_5^w": ("project eq. (6), Listing 3.3 T_C", "the same matrix"),
+}
+
+
+def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, list, list]:
+    """(category, evidence, readings tried, readings used) of a printed matrix that differs
+    from the derived one."""
+    where = COPIES.get(name, ("", ""))[0]
     if "missing" in erratum:
         return "undecidable", evidence + (
-            ". Category undecidable: the row is present where the thesis prints the factor "
-            "again (the 'updated' chain after eq. 3.37), so either the print or the extraction "
-            "lost it here; missing to decide: the page of the original PDF")
+            f". Category undecidable: a lost row, which the print and the text extraction "
+            f"explain equally; the thesis prints the factor again in the 'updated' chain after "
+            f"eq. 3.37 with the row, and the separately typeset copies ({where}) have it, which "
+            f"shows the intended matrix but not whether this print lost the row; what would "
+            f"decide: the page of the original PDF"), [
+                "the matrix as printed: 3 rows, not a 4x4 HTM",
+                "a row lost by the print or by the extraction: the derived factor without "
+                "that row (exact)"], [f"glyph:{name} lost row"]
     if "printed twice" in erratum:
+        return "undecidable", evidence + (
+            f". Category undecidable: a duplicated row, which the print (a repeated line of "
+            f"the source) and the text extraction (a repeated span) explain equally; the "
+            f"'updated' chain after eq. 3.37 repeats the same row, but it renders the same "
+            f"matrix again, so a deterministic extraction would repeat it too; the separately "
+            f"typeset copies ({where}) print four rows, which shows the intended matrix but not "
+            f"whether this print repeated one; what would decide: the page of the original "
+            f"PDF"), [
+                "the matrix as printed: 5 rows, not a 4x4 HTM",
+                "a row repeated by the print or by the extraction: the derived factor with the "
+                "repeated row removed (exact)"], [f"glyph:{name} repeated row"]
+    if name == "T_2^3" and "sign error" in erratum:
         return "printing_error", evidence + (
-            ". Category printing_error: the same row is repeated identically where the thesis "
-            "prints the factor again (the 'updated' chain), so it is in the author's source, "
-            "not an accident of one extraction")
-    return "printing_error", evidence
+            ". Category printing_error: a single minus sign (glyph-level) lost, but the same "
+            "defect stands in the specialization project's eq. (3), a separately typeset "
+            "document (appendix B), so it is in the author's source, not an accident of this "
+            "extraction; the conference paper's eq. 1.3 and Listing 3.3's T_B have -s_B: the "
+            "author's intended rotation"), [
+                "right-handed rotation Rz(B) (derived; paper eq. 1.3, Listing 3.3 T_B): entry "
+                "(1,2) differs",
+                "left-handed Rz(-B) (the other rotation sense): entry (2,1) differs",
+                "a minus lost by the extraction: contradicted by the same defect in project eq. "
+                "(3)"], ["inconsistent:T_2^3 sign of s_B (1,2)"]
+    return "printing_error", evidence, [], []
 
 
 # ------------------------------------------------------------------------------ derived pieces
@@ -253,19 +294,45 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                     erratum, ev = f"{name} printed as {other}", (
                         f"the printed matrix is the derived {other}; {name} is the translation "
                         f"by -c_B = (0, 0, -d)")
-        cat, ev = _matrix_category(erratum, ev) if not same else ("identical", ev)
-        out.append(_verdict(eq, same, erratum, ev, str(item["rows"]), fmt(factors[name]), name,
-                            category=cat))
+        tried, used = [], []
+        if not same:
+            cat, ev, tried, used = _matrix_category(name, erratum, ev)
+            if item["id"].startswith("error chain"):
+                tried = ["the printed matrix against every derived factor: it is the derived "
+                         "T_3^4 (a rotation), not T_4^5 (the translation by -d)"]
+                ev += (". Category printing_error: a whole well-formed matrix of the chain in the "
+                       "place of another (the preceding factor repeated): not extraction "
+                       "damage, which does not produce another valid factor")
+        else:
+            cat = "identical"
+        v = _verdict(eq, same, erratum, ev, str(item["rows"]), fmt(factors[name]), name,
+                     category=cat)
+        if item["id"].startswith("error chain") and not same:
+            used = ["copy:updated chain T_4^5 <- T_3^4"]
+        v.readings_tried, v.readings_used = tried, used
+        out.append(v)
 
     prod = printed.get("product", {})
     if "3.37" in prod:
         same, erratum, ev = _product_diff(prod["3.37"], DERIVED_ORDER)
-        out.append(_verdict("eq. 3.37", same, erratum, ev + "; T_a^b maps frame b into frame a, "
-                            "T_w^t = (T_0^w)^-1 T_0^t. Category extraction: 'T_1^d' and "
-                            "'T_2^2' are no frames of the chain (d is a length, not a frame "
-                            "index); garbled sub- and superscripts are the damage this "
-                            "extraction shows elsewhere", prod.get("3.37_text", ""),
-                            " ".join(DERIVED_ORDER), category="extraction"))
+        v = _verdict("eq. 3.37", same, erratum, ev + "; T_a^b maps frame b into frame a, "
+                     "T_w^t = (T_0^w)^-1 T_0^t. 'T_2^2' (no frame maps into itself) stands at "
+                     "the same place in the specialization project's eq. (8), a separately "
+                     "typeset document ('T_w^5 T_5^4 T_4^3 T_2^2 T_1^1 T_1^0 T_0^t'), so the "
+                     "author's source has it: the factors T_3^2 T_2^1 are misprinted. "
+                     "'T_1^d' for T_0^t (d is a length, not a frame) is only in this copy "
+                     "(project eq. (8) ends with T_0^t): print or extraction. Category "
+                     "printing_error: at least the T_2^2 defect is decided to be printed",
+                     prod.get("3.37_text", ""), " ".join(DERIVED_ORDER),
+                     category="printing_error")
+        v.readings_tried = ["the derived order T_w^5 T_5^4 T_4^3 T_3^2 T_2^1 T_1^0 T_0^t: "
+                            "differs in factors 4-7",
+                            "extraction damage of the sub- and superscripts: excluded for "
+                            "T_2^2 by project eq. (8); possible for T_1^d",
+                            "the paper's eq. 1.8 form (T_5^w)^-1 ... (T_0^1)^-1 T_0^t: equals "
+                            "the derived order (see eq. 1.8)"]
+        v.readings_used = ["inconsistent:eq. 3.37 factor T_2^2"]
+        out.append(v)
     lst = printed.get("listing", {})
     names = {"T_d": "T_0^1", "T_45": "T_1^2", "T_B": "T_2^3", "T_n45": "T_3^4", "T_nd": "T_4^5",
              "T_C": "T_5^w"}
@@ -301,32 +368,55 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                    "line as '{-}' ('T = -T_{-}d @ T_{-}45 ...'), so the stray '-' may be the same "
                    "damage; the printed output of the listing (Figure 3.10), which would tell, "
                    "is not in the text; missing: the original listing")
-        out.append(_verdict("Listing 3.3 line 46 (T_r)", same, erratum, ev,
-                            prod.get(key + "_text", ""), "T_d @ T_45 @ T_B @ T_n45 @ T_nd @ T_C",
-                            category=t_r_category))
+        v = _verdict("Listing 3.3 line 46 (T_r)", same, erratum, ev,
+                     prod.get(key + "_text", ""), "T_d @ T_45 @ T_B @ T_n45 @ T_nd @ T_C",
+                     category=t_r_category)
+        if not same:
+            v.readings_tried = ["the line as printed: -(product), the homogeneous 1 becomes -1",
+                                "a stray '-' of the print or of the extraction: the product "
+                                "alone equals the derived T_0^w (exact)"]
+            v.readings_used = ["glyph:Listing 3.3 line 46 leading minus"]
+        out.append(v)
     std = {"rot_x": rotation((1, 0, 0), A_SYM), "rot_y": rotation((0, 1, 0), A_SYM),
            "rot_z": rotation((0, 0, 1), A_SYM)}
     for rname, m in std.items():
         if rname in lst:
             same, erratum, ev = _matrix_diff(lst[rname], m)
+            tried, used = [], []
             if not same and sp.simplify(sp.Matrix([[_parse(c) for c in r] for r in lst[rname]])
                                         - m.subs(A_SYM, -A_SYM)) == sp.zeros(4, 4):
                 erratum = f"{rname} turns by -a"
                 ev = (f"{rname}(a) is the right-hand rotation by -a (signs of the sine terms "
                       f"swapped; rot_x and rot_z are right-handed): E_BB and E_BC enter T_er with "
-                      f"the wrong sign; " + ev)
-            out.append(_verdict(f"Listing 3.3 {rname}", same, erratum, ev, str(lst[rname]),
-                                fmt(m), rname))
+                      f"the wrong sign; " + ev + ". Category printing_error: the left-handed "
+                      f"sense would be a convention only if the listing used it for every "
+                      f"axis; rot_x and rot_z of the same listing turn right-handed (code: "
+                      f"not extraction damage, both sine signs are consistently swapped)")
+                tried = ["right-handed rotation about y (derived): entries (1,3), (3,1) differ",
+                         "left-handed rotation (rotation by -a): exact, but rot_x and rot_z of "
+                         "the same listing are right-handed"]
+                used = [f"inconsistent:Listing 3.3 {rname} rotation sense"]
+            v = _verdict(f"Listing 3.3 {rname}", same, erratum, ev, str(lst[rname]), fmt(m), rname)
+            v.readings_tried, v.readings_used = tried, used
+            out.append(v)
     if "sources" in lst:
         for pname, src in lst["sources"].items():
             expected = f"{pname}_avg."
             same = src == expected
-            out.append(_verdict(f"Listing 3.3 T_er {pname}", same,
-                                f"{pname} read from the data of {src[:-5]}",
-                                f"{pname} = cf_rot('{expected}', ...) reads its own data" if same
-                                else f"line reads cf_rot('{src}', ...) for {pname}; expected "
-                                f"'{expected}' (copy-paste: the {pname} curve is never used)",
-                                f"cf_rot('{src}')", f"cf_rot('{expected}')", pname))
+            v = _verdict(f"Listing 3.3 T_er {pname}", same,
+                         f"{pname} read from the data of {src[:-5]}",
+                         f"{pname} = cf_rot('{expected}', ...) reads its own data" if same
+                         else f"line reads cf_rot('{src}', ...) for {pname}; expected "
+                         f"'{expected}' (copy-paste: the {pname} curve is never used). "
+                         f"Category printing_error: another valid file name of the same "
+                         f"listing (the one on the line above), not extraction damage",
+                         f"cf_rot('{src}')", f"cf_rot('{expected}')", pname)
+            if not same:
+                v.readings_tried = [f"the listing's own pattern (each parameter reads "
+                                    f"'<name>_avg.'): differs", f"a copy of the line above "
+                                    f"with the name left unchanged: exact"]
+                v.readings_used = [f"copy:Listing 3.3 line for {pname}"]
+            out.append(v)
     if "T_er" in lst:
         out.append(_audit_t_er(layout, chain, lst, factors, d_value))
     return out
@@ -361,7 +451,7 @@ def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
           "-- the tilts of B turn about the machine origin instead of about the B axis (lever "
           "arm to the B/C intersection at (0, 0, d)), and the errors of C are not turned with "
           "the B axis that carries C")
-    return _verdict("Listing 3.3 T_er (error model)", same, "errors applied in the wrong frame",
+    v = _verdict("Listing 3.3 T_er (error model)", same, "errors applied in the wrong frame",
                     ev + ". Category simplification: the listing implements the method the "
                     "thesis states (sec. 3.5)", " @ ".join(lst["T_er"]),
                     "derived first-order chain (DMU50 layout)", "T_er",
@@ -369,6 +459,12 @@ def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
                     alternative="every B and C error motion applied in the machine frame after "
                                 "the nominal rotation T_r (errors pivot about the machine "
                                 "origin)", dropped_um=size)
+    v.readings_tried = ["the derived first-order chain (errors of B about the B axis, errors of "
+                        "C turned with B): differs (table above)",
+                        "every error applied in the machine frame after T_r, the method sec. "
+                        "3.5 states: the listing, exactly"]
+    v.readings_used = ["stated:sec. 3.5 errors applied in the machine frame"]
+    return v
 
 
 T_ER_STATEMENT = (

@@ -89,7 +89,12 @@ def audit_lookup(item: dict) -> list[Verdict]:
     out.append(Verdict(SOURCE, item["id"], LAYOUT, "differs",
                        "negative positions read a mirrored value (negative index wraps around)",
                        ev, item["printed"], item["intended"], "negative positions",
-                       category="printing_error", dropped_um=worst))
+                       category="printing_error", dropped_um=worst,
+                       readings_tried=["the printed code run on an axis with negative "
+                                       f"positions: off by up to {worst:.2f} um",
+                                       "the same code on positive positions: the intended "
+                                       f"curve to {q_worst:.3f} um"],
+                       readings_used=["inconsistent:Listing 3.4 negative index"]))
     # 2. the constant term
     axis, err, deg = _example_constant()
     diffs = []
@@ -112,7 +117,11 @@ def audit_lookup(item: dict) -> list[Verdict]:
     out.append(Verdict(SOURCE, item["id"], LAYOUT, "differs",
                        "constant term of the polynomial dropped for degree > 1", ev,
                        item["printed"], item["intended"], "constant term",
-                       category="printing_error", dropped_um=float(np.max(np.abs(diffs)))))
+                       category="printing_error", dropped_um=float(np.max(np.abs(diffs))),
+                       readings_tried=["the printed loop range(1, degree) run: differs from "
+                                       "np.polyval by -c[degree]",
+                                       "degree 1 (the other branch): right"],
+                       readings_used=["inconsistent:Listing 3.1 loop range"]))
     return out
 
 

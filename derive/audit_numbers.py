@@ -62,8 +62,14 @@ def check_reduction(c) -> list[Verdict]:
                f"would be {100 * (1 - a / ob):.1f} %")
     ev += (". Category undecidable: 'approximately' does not bound the after-value; missing: "
            "the post-compensation peak itself (the plotted data are not in the text)")
-    return [_v(c, "percent", "undecidable", f"{c['percent']} % against {exact:.1f} % from the "
-               "printed values", ev, quote, f"{exact:.1f} % (after = {c['after']} um)")]
+    v = _v(c, "percent", "undecidable", f"{c['percent']} % against {exact:.1f} % from the "
+           "printed values", ev, quote, f"{exact:.1f} % (after = {c['after']} um)")
+    v.readings_tried = [f"before {c['before']} um, after 'approximately {c['after']}' um taken "
+                        f"as {c['after']}: {exact:.1f} %",
+                        f"the after-value the printed percentage needs: {need_after:.2f} um "
+                        f"(within 'approximately {c['after']}')"]
+    v.readings_used = [f"missing:{c['id']} post-compensation peak"]
+    return [v]
 
 
 def check_same(c) -> list[Verdict]:
@@ -99,12 +105,37 @@ def check_same(c) -> list[Verdict]:
                    f"({float(ref) / float(ratio['of']):.2f} x) fits as 'almost' double and "
                    f"{q['value']} ({float(q['value']) / float(ratio['of']):.2f} x, more than "
                    f"double) does not")
-        ev += (". Category printing_error: the sentence's own comparison and the two other "
-               "quotes agree on " + ref if ratio is not None else
-               ". Category printing_error")
-        out.append(_v(c, comp, "printing_error", f"{q['value']} printed for {ref}", ev,
-                      q["text"], ref))
+        lost = _lost_glyphs(ref, q["value"])
+        if lost:
+            ev += (f". The sentence's own comparison and the two other quotes agree on {ref}; "
+                   f"'{q['value']}' is '{ref}' with the glyphs '{lost}' lost, which the print "
+                   f"(a typo) and the text extraction explain equally. Category undecidable; "
+                   f"what would decide: the page of the original PDF")
+            cat = "undecidable"
+            used = [f"glyph:{c['id']} {q['where']}"]
+        else:
+            ev += (". Category printing_error: the sentence's own comparison and the two "
+                   "other quotes agree on " + ref if ratio is not None else
+                   ". Category printing_error")
+            cat = "printing_error"
+            used = [f"inconsistent:{c['id']} {q['where']}"]
+        v = _v(c, comp, cat, f"{q['value']} printed for {ref}", ev, q["text"], ref)
+        v.readings_tried = [f"the quote as printed, {q['value']}: its rounding interval does not "
+                            f"meet {ref}'s"] + ([f"'{ref}' with '{lost}' lost by the print or "
+                                                 f"the extraction: {ref} exactly"] if lost else [])
+        v.readings_used = used
+        out.append(v)
     return out
+
+
+def _lost_glyphs(full: str, short: str) -> str:
+    """The characters of ``full`` that ``short`` lacks when ``short`` is ``full`` with a run of
+    adjacent characters removed ("48" from "40.8" lacks "0."), else ""."""
+    for i in range(len(full)):
+        for j in range(i + 1, len(full) + 1):
+            if full[:i] + full[j:] == short:
+                return full[i:j]
+    return ""
 
 
 def check_count(c) -> list[Verdict]:
@@ -144,11 +175,23 @@ def check_units(c) -> list[Verdict]:
           f"{ball:g} mm radius: a deviation of {worst:g} mm from the mean pretravel is larger "
           f"than the ball itself; R_eff = {reff} mm means a mean pretravel of "
           f"{ball:g} - {reff} = {mean_pretravel_um:.0f} um, the scale on which deviations from "
-          f"that mean lie. Read in um ({', '.join(c['values'])} um) the numbers fit; the unit "
-          f"mm is a printing error (um, as for every other error in sec. 4)")
-    return [_v(c, "unit", "identical" if ok else "printing_error",
-               f"{c['unit']} printed for um", ev, c["quote"],
-               f"{', '.join(c['values'])} um")]
+          f"that mean lie. Read in um ({', '.join(c['values'])} um) the numbers fit, the unit of "
+          f"every other error in sec. 4: the printed unit mm is wrong")
+    v = _v(c, "unit", "identical" if ok else "undecidable",
+           f"{c['unit']} printed for um", ev + (
+               ". Category undecidable: 'mm' for 'um' is the confusion of one glyph (mu read "
+               "or printed as m), which the print and the text extraction explain equally; "
+               "no um of this section is extracted (sec. 3.2 spells the sphere's roundness "
+               "'1 마이크로미터' in words), so the page shows neither reading; what would "
+               "decide: the page of the original PDF" if not ok else ""),
+           c["quote"], f"{', '.join(c['values'])} um")
+    if not ok:
+        v.readings_tried = [f"the unit as printed, mm: a deviation of {worst:g} mm from the "
+                            f"mean pretravel, larger than the ball",
+                            "um (the glyph mu lost or misread): fits R_eff and every error of "
+                            "sec. 4"]
+        v.readings_used = [f"glyph:{c['id']} unit"]
+    return [v]
 
 
 def check_rms(c) -> list[Verdict]:
@@ -213,8 +256,16 @@ def check_definition(c) -> list[Verdict]:
                    "volumetric equation (4, 7, A2, A5, A8) use the eq. 4 assignment. CMM B's "
                    "squareness values (sec. 4) are quoted in the list's order XY, YZ, ZX, so "
                    "which of them is beta1 depends on the reading")
-        out.append(_v(c, comp, "printing_error", "squareness planes of "
-                      + ", ".join(bad) + " exchanged", ev, pl["text"], str(norm)))
+        v = _v(c, comp, "printing_error", "squareness planes of "
+               + ", ".join(bad) + " exchanged", ev + ". Category printing_error: a "
+               "well-formed list of other axis pairs, not extraction damage", pl["text"],
+               str(norm))
+        v.readings_tried = ["the list read 'respectively' against eq. 4: " + ", ".join(
+            f"{n}: {pl['pairs'][syms.index(n)]}" for n in bad),
+            "the order XY, YZ, ZX as a plain enumeration (not respectively): leaves the "
+            "assignment of the symbols open; the text after eq. 3 assigns them as eq. 4 does"]
+        v.readings_used = [f"inconsistent:{c['id']} {comp}"]
+        out.append(v)
     return out
 
 

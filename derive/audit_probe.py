@@ -94,9 +94,18 @@ def audit_transform(eq: dict) -> list[Verdict]:
                   "consistent with the printed matrix, so the statement of eq. (12) is the "
                   "slip; volerr names the two matrices probe2machine (the print) and "
                   "machine2probe (the statement)")
-    return [_v("12", same, "transposed matrix (statement and matrix disagree)" if is_transpose
-               else "matrix differs", "; ".join(ev), fmt(printed.tolist()),
-               fmt(derived.tolist()), "Tp")]
+    v = _v("12", same, "transposed matrix (statement and matrix disagree)" if is_transpose
+           else "matrix differs", "; ".join(ev) + (
+               ". Category printing_error: a whole well-formed matrix and a well-formed "
+               "statement that contradict each other, not extraction damage" if is_transpose
+               else ""), fmt(printed.tolist()), fmt(derived.tolist()), "Tp")
+    if is_transpose:
+        v.readings_tried = ["Tp as eq. (12) states it ([x', y', z'] = Tp [x, y, z]: the basis "
+                            "vectors of eq. (11) as rows): the printed matrix differs",
+                            "the transpose (basis vectors as columns, probe to machine): the "
+                            "printed matrix exactly; eq. (14) M' = Tp^-1 M needs this one"]
+        v.readings_used = ["inconsistent:eq. 12 statement vs matrix"]
+    return [v]
 
 
 def audit_direction(eq: dict, tp_printed: sp.Matrix) -> list[Verdict]:
@@ -156,6 +165,11 @@ def audit_angles(eq15: dict, eq16: dict) -> list[Verdict]:
                   fmt(p16), fmt(theta_d), "theta", category="convention",
                   alternative="atan2(My', Mx') mod 2 pi",
                   statement="tan^-1(y/x) written for the quadrant-correct atan2(y, x)"))
+    out[-1].readings_tried = ["tan^-1(My'/Mx') literally (one-argument, -90 .. 90 deg): differs "
+                              "by 180 deg for Mx' < 0",
+                              "tan^-1(y/x) read as the two-argument atan2(y, x) mod 360 deg: "
+                              "exact at 400 directions"]
+    out[-1].readings_used = ["notation:tan^-1(y/x) for atan2(y, x)"]
     return out
 
 

@@ -92,8 +92,16 @@ def audit_linear(item: dict) -> list[Verdict]:
                   "printed matrix without its identity part and without the nominal x, with a "
                   "zero bottom row; the three equations printed under it are that deviation. "
                   "Category printing_error: left- and right-hand side disagree within the "
-                  "equation, no convention reconciles them",
+                  "equation, no convention reconciles them; the specialization project's eq. "
+                  "(23) (appendix B, typeset separately) prints the same model as the deviation "
+                  "matrix (zero diagonal, no nominal x, zero bottom row), so the thesis' "
+                  "version is the author's edit, not extraction damage",
                   "Delta = T p", "Delta = (T - T_nominal) p"))
+    out[-1].readings_tried = ["the printed matrix times p, literally: the moved point (row 1 "
+                              "holds x + xx, row 4 reads 0 = 1)",
+                              "the matrix read as T - T_nominal (the deviation): gives the three "
+                              "printed equations; the project's eq. (23) prints it so"]
+    out[-1].readings_used = ["inconsistent:sec. 2.5 matrix equation lhs vs rhs"]
     for i, c in enumerate(("Delta_x", "Delta_y", "Delta_z")):
         pr = _parse(item["expr"][c])
         same = sp.expand(pr - dev[i]) == 0
@@ -128,9 +136,18 @@ def audit_rotary(item: dict) -> list[Verdict]:
                   + "; ".join(bad) + f"; the printed 3x3 block has det = {fmt(det)}, not 1: not "
                   "a rotation (at C = 0 it mirrors y). The matrix is also labelled "
                   f"{item['T_CC_label']}, the name of the product of eq. 2.42, where the text "
-                  "announces T_CC. Category printing_error: no rotation convention (active, "
-                  "passive, left- or right-handed) has -cos C on the diagonal",
-                  str(item["T_CC"]), fmt(t_cc)))
+                  "announces T_CC. No rotation convention (active, passive, left- or "
+                  "right-handed) has -cos C on the diagonal. Category undecidable: the defect "
+                  "is one extra minus (and one subscript letter of the label), glyph-level "
+                  "damage that the print and the text extraction explain equally; the "
+                  "conference paper's eq. 1.16 (typeset separately) prints the nominal rotation "
+                  "of B with +cos B, which shows the intended matrix but not this print; what "
+                  "would decide: the page of the original PDF",
+                  str(item["T_CC"]), fmt(t_cc), category="undecidable"))
+    out[-1].readings_tried = ["right-handed Rz(C) (eq. 3.2): entry (2,2) differs",
+                              "left-handed Rz(-C), transpose (passive): entry (2,2) differs",
+                              "a minus inserted by the print or by the extraction: Rz(C) exactly"]
+    out[-1].readings_used = ["glyph:eq. 2.42 T_CC extra minus"]
     # the deviation matrix "neglecting the squareness errors"
     dev = (t_es - sp.eye(4)) * t_cc
     printed_m = _mat(item["error_matrix"])
@@ -143,14 +160,29 @@ def audit_rotary(item: dict) -> list[Verdict]:
     out.append(_v(eq, "error matrix", not bad, "-E_XC printed where -E_AC belongs" if hint else
                   "; ".join(bad), "derived (T_ES - I) Rz(C), first order: "
                   + ("all entries of the first three rows agree" if not bad else "; ".join(bad))
-                  + hint, str(item["error_matrix"]), fmt(dev)))
+                  + hint + (" Category printing_error: the conference paper's B-axis matrix "
+                            "eq. 1.17, typeset separately, has -E_XB at the same entry (2,3): "
+                            "the author's source, not extraction damage" if hint else ""),
+                  str(item["error_matrix"]), fmt(dev)))
+    if hint:
+        out[-1].readings_tried = ["(T_ES - I) Rz(C), derived: entry (2,3) is -E_AC",
+                                  "a subscript letter confused by the extraction: excluded, the "
+                                  "separately typeset paper eq. 1.17 repeats -E_X at (2,3)"]
+        out[-1].readings_used = ["copy:eq. 2.42 (2,3) entry, also paper eq. 1.17"]
     row4 = [fmt(v) for v in printed_m[3, :]]
     ok4 = all(v == 0 for v in printed_m[3, :])
     out.append(_v(eq, "error matrix row 4", ok4, "bottom row 0 0 0 1 under a left-hand side 0",
                   f"the printed bottom row [{', '.join(row4)}] times [x_C, y_C, z_C, 1] gives 1, "
                   "the left-hand side says 0; a deviation matrix has the bottom row 0 0 0 0 "
                   "(the product T_ES T_CC minus T_CC). Category printing_error: the equation "
-                  "contradicts itself", str(row4), "[0, 0, 0, 0]"))
+                  "contradicts itself, and the conference paper's eq. 1.17 (typeset separately) "
+                  "has the same bottom row 0 0 0 1: the author's source, not extraction damage",
+                  str(row4), "[0, 0, 0, 0]"))
+    if not ok4:
+        out[-1].readings_tried = ["deviation matrix (T_ES - I) Rz(C): bottom row 0 0 0 0",
+                                  "the HTM T_ES Rz(C) (bottom row 0 0 0 1): its other entries "
+                                  "would need the identity part, which the printed matrix lacks"]
+        out[-1].readings_used = ["inconsistent:eq. 2.42 bottom row vs lhs"]
     p = sp.Matrix([SYM["xC"], SYM["yC"], SYM["zC"], 1])
     derived_eqs = dev * p
     printed_rows = printed_m * p
@@ -161,6 +193,7 @@ def audit_rotary(item: dict) -> list[Verdict]:
         ev = f"derived row {i + 1} of (T_ES - I) Rz(C) [x_C, y_C, z_C, 1]^T = {fmt(d)}; " \
              f"derived - printed = {fmt(diff)}"
         erratum = "differs"
+        cat, tried, used = "printing_error", [], []
         if diff != 0 and sp.simplify(sp.expand(d + pr - 2 * (d - d.coeff(SYM["ECC"])
                                                              * SYM["ECC"]))) == 0:
             erratum = "sign of the E_CC term"
@@ -171,8 +204,18 @@ def audit_rotary(item: dict) -> list[Verdict]:
                    + ("; the printed matrix just above gives the derived sign (+E_CC cos C, "
                       "-E_CC sin C in its row 2), so the equation contradicts its own matrix"
                       if same_as_matrix else "")
-                   + "; eq. 3.4 (ch. 3) prints the same row with the derived sign")
-        out.append(_v(eq, c, diff == 0, erratum, ev, item["expr"][c], fmt(d)))
+                   + "; eq. 3.4 (ch. 3) prints the same row with the derived sign. Category "
+                   "undecidable: one extra minus sign, glyph-level damage that the print and "
+                   "the text extraction explain equally (the matrix above and eq. 3.4 show the "
+                   "intended sign, not whether this print has the minus); what would decide: "
+                   "the page of the original PDF")
+            cat = "undecidable"
+            tried = ["row 2 of (T_ES - I) Rz(C) p (derived; the printed matrix above; eq. 3.4): "
+                     "the sign of the E_CC term differs",
+                     "a minus inserted by the print or by the extraction: exact"]
+            used = ["glyph:eq. 2.42 Delta_y extra minus"]
+        out.append(_v(eq, c, diff == 0, erratum, ev, item["expr"][c], fmt(d), category=cat))
+        out[-1].readings_tried, out[-1].readings_used = tried, used
     return out
 
 
@@ -196,8 +239,17 @@ def audit_squareness(item: dict) -> list[Verdict]:
                           + ("" if diff == 0 else
                              f"; the printed {fmt(pr)} is the angle times the displacement "
                              f"where cos(angle) ~ 1 belongs: the nominal displacement itself is "
-                             f"lost (it is there in the Z-axis matrix, whose (3,4) entry is z)"),
-                          pr_t, fmt(first)))
+                             f"lost (it is there in the Z-axis matrix, whose (3,4) entry is z). "
+                             f"The printed entry repeats the entry below it (x E_C(0X)Y): a "
+                             f"repeated entry, which the print (a copied line) and the text "
+                             f"extraction (a repeated span) explain equally. Category "
+                             f"undecidable; what would decide: the page of the original PDF"),
+                          pr_t, fmt(first), category="undecidable"))
+            if diff != 0:
+                out[-1].readings_tried = [f"first-order series of eq. 3.12: {fmt(first)}",
+                                          "the entry below repeated by the print or by the "
+                                          "extraction: the printed entry exactly"]
+                out[-1].readings_used = [f"glyph:eq. 3.15 {axis} row {i + 1} repeated entry"]
     return out
 
 

@@ -136,10 +136,14 @@ def _closed(selection: str) -> dict:
 
 #: why a wrong unknown vector is extraction damage, not a printing error
 EXTRACTION_SUBSCRIPTS = (
-    " Category extraction: the printed coefficient columns are right and only the subscripts of "
-    "the vector are wrong; this extraction garbles subscripts elsewhere in the same equations "
-    "(e.g. \\hat{x}_{xP} for \\hat{x}_{CP} inside the matrix of eq. 3.5, E_{DB} and E_{2B} "
-    "for E_BB and E_ZB in the 'updated' chain), which no printed thesis would carry.")
+    " Category extraction: the printed coefficient columns are right and only the vector's "
+    "entries are wrong; every unknown vector of the thesis is damaged at its middle entries, "
+    "each differently (E_BX twice and E_XX for E_ZX in eq. 31; E_BX twice in eq. 32; E_AY lost "
+    "in eq. 35 and 36; E_YZ lost in eq. 37; E_BC twice in eq. 3.5; E_ZC lost and E_BC twice "
+    "in eq. 3.6), so the defects are not one typo copied from vector to vector, while the "
+    "matrix rows beside them are extracted correctly; and this extraction demonstrably "
+    "repeats a token where the print has another: appendix B sec. 2.4 reads '(E_AX, E_BX, "
+    "E_BX) E_CX' where the parallel list before it reads '(E_XX, E_YX, and E_ZX)'.")
 UNDECIDABLE_ENTRIES = (
     " Category undecidable: lost, repeated or garbled entries of a column vector look the same "
     "whether the print or the OCR lost them; missing to decide: the page of the original PDF.")
@@ -187,6 +191,19 @@ def audit_displacement(eq: dict) -> list[Verdict]:
                 f", is not the z-row of e x r_hat = EAC*yh - EBC*xh with xh = x cos C - y sin "
                 f"C, yh = x sin C + y cos C." if rotated else
                 f"derived - printed = {fmt(diff)}", eq["expr"][c], de))
+            if rotated:
+                out[-1].evidence += (
+                    " Read as [-E_BC cos C + E_AC sin C] x_P the row is the derived one: the "
+                    "printed coefficient lost a minus sign and the factor 'sin C' (the thesis' "
+                    "eq. 2.42 prints the same row with both). Category undecidable: lost "
+                    "glyphs, which the print and the text extraction explain equally; what "
+                    "would decide: the page of the original PDF.")
+                out[-1].category = "undecidable"
+                out[-1].readings_tried = ["the z-row of (I + D) Rz(C) r - Rz(C) r (derived): "
+                                          "the x_P coefficient differs",
+                                          "a minus and 'sin C' lost by the print or by the "
+                                          "extraction: exact"]
+                out[-1].readings_used = [f"glyph:eq. {eq['id']} Delta_{c} lost glyphs"]
         lhs = parse(eq["lhs"][c], axis)
         dl = _deviation("P", c, axis, rotated)
         ok = sp.simplify(sp.expand(dl - lhs)) == 0
@@ -247,13 +264,27 @@ def audit_system(eq: dict) -> list[Verdict]:
         sel_note = (f" The selected 6 x 6 system has determinant N = {fmt(sp.factor(det))} "
                     f"(rotated coordinates for a rotary axis): it is singular whenever N = 0, "
                     f"even for non-collinear points (e.g. all points at one height z).")
+    dup_note = ""
+    if dup and not bad_rows:
+        dup_note = (" Category printing_error: the row K y is repeated at the same place in "
+                    "eq. 31 and eq. 35, two matrices with different symbols (different "
+                    "images), while the thesis' own 9-row matrix of eq. 3.5, of the same shape, "
+                    "is extracted without a repeated row: the repetition follows the project "
+                    "report's source (a copied matrix), not the extraction.")
     out.append(_verdict(eq, "coefficient matrix", not problems,
                         "; ".join(problems[:3]) if problems else "",
                         ("every printed row equals the derived row of the equation its "
                          "right-hand side names" if not problems else
                          "compared row by row with the derived system: " + "; ".join(problems))
-                        + sel_note,
+                        + sel_note + dup_note,
                         f"{len(rows)} rows", f"{expect_n} rows"))
+    if problems:
+        out[-1].readings_tried = ["every printed row against the derived row its right-hand "
+                                  "side names", "a row repeated by the extraction: not seen "
+                                  "in the 9-row matrix of eq. 3.5, and repeated at the same "
+                                  "place in eq. 31 and 35"] if dup else \
+            ["every printed row against the derived row its right-hand side names"]
+        out[-1].readings_used = ["copy:project report matrix row K y"] if dup else []
     want_u = [m + axis for m in MOTIONS]
     got_u = list(eq["unknowns"])
     if got_u == want_u:
@@ -273,6 +304,10 @@ def audit_system(eq: dict) -> list[Verdict]:
                             "the six columns multiply E_X ... E_C of the axis in this order; "
                             "the printed vector mislabels them." + EXTRACTION_SUBSCRIPTS,
                             ", ".join(got_u), ", ".join(want_u), category="extraction"))
+        out[-1].readings_tried = ["the vector as printed: " + "; ".join(parts),
+                                  "the vector the six columns multiply (E_X ... E_C of the "
+                                  "axis): exact once the damaged entries are read so"]
+        out[-1].readings_used = [f"ocr:eq. {eq['id']} unknown vector"]
     # right-hand side: which equation does each printed entry belong to?
     rhs = eq.get("rhs", [])
     distinct = list(dict.fromkeys(labels))
@@ -312,6 +347,12 @@ def audit_system(eq: dict) -> list[Verdict]:
                          "nominal) of every point and coordinate: " + "; ".join(problems)
                          + UNDECIDABLE_ENTRIES),
                         "; ".join(rhs), f"{len(distinct)} deviations", category="undecidable"))
+    if problems:
+        out[-1].readings_tried = ["each printed entry matched against the derived deviation of "
+                                  "every point and coordinate",
+                                  "entries lost, repeated or garbled by the print or by the "
+                                  "extraction: both explain the column"]
+        out[-1].readings_used = [f"glyph:eq. {eq['id']} right-hand side entries"]
     return out
 
 
@@ -435,6 +476,11 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
             "N printed as one product") else ""), eq["define"]["N"], sp.factor(det),
             category="undecidable" if erratum.startswith("N printed as one product")
             else "printing_error")
+        if erratum.startswith("N printed as one product"):
+            n_verdict.readings_tried = ["the printed product of six factors: not the determinant",
+                                        "a '-' between the two triple products lost by the print "
+                                        "or by the extraction: the determinant (up to sign)"]
+            n_verdict.readings_used = ["glyph:eq. 3.8 N lost minus"]
     for motion in MOTIONS:
         if motion not in eq["expr"]:
             continue
@@ -453,7 +499,21 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                    if eq.get("variables") == "raw" else "") + "." + note,
                                 eq["expr"][motion], sp.factor(derived)))
             if note:
-                out[-1].category = "extraction"
+                out[-1].category = "undecidable"
+                out[-1].verdict = "differs"
+                out[-1].erratum = "factor typeset as part of a subscript"
+                out[-1].evidence += (
+                    " Category undecidable: the formula equals the derivation once the factor "
+                    "written inside the subscript of z is read as multiplying it; a subscript "
+                    "that swallowed its neighbour is explained equally by the print (a brace "
+                    "misplaced in the source) and by the extraction (a misread scope); the "
+                    "thesis' eq. 3.7, written for the C axis, has the factor outside the "
+                    "subscript, which shows the intended formula, not this print; what would "
+                    "decide: the page of the original PDF.")
+                out[-1].readings_tried = ["the subscript as printed: z indexed by an expression, "
+                                          "not a formula of the document's notation",
+                                          "the factor read as multiplying z: exact"]
+                out[-1].readings_used = [f"glyph:eq. {eq['id']} {name} subscript scope"]
             continue
         errs, ev = [], (f"derived {fmt(sp.factor(derived))}; the printed form{where} is not "
                         f"identical.")
@@ -477,8 +537,22 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                     errs.append("and N printed as one product")
             else:
                 errs.append("closed form differs (no single-symbol reading reproduces it)")
-        out.append(_verdict(eq, name, False, " ".join(errs), ev + note, eq["expr"][motion],
-                            sp.factor(derived), category=category))
+        v = _verdict(eq, name, False, " ".join(errs), ev + note, eq["expr"][motion],
+                     sp.factor(derived), category=category)
+        if category == "undecidable":
+            v.readings_tried = ["the printed solution with the printed N: differs",
+                                "N read with its minus sign restored: exact"]
+            v.readings_used = ["glyph:eq. 3.8 N lost minus"]
+        elif errs and " printed for " in errs[0]:
+            v.evidence += (" Category printing_error: another valid symbol of the formula (two "
+                           "of its letters differ) in place of the right one, which a text "
+                           "extraction does not produce; the project report's eq. 33 prints the "
+                           "same solution for the X axis with the right symbol.")
+            v.readings_tried = ["the printed solution with N read as the determinant: differs",
+                                f"one lever-arm symbol read as another: {errs[0]} reproduces "
+                                f"it exactly"]
+            v.readings_used = [f"inconsistent:eq. {eq['id']} {name} symbol"]
+        out.append(v)
     if n_verdict is not None:
         out.append(n_verdict)
     return out

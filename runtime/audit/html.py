@@ -1,11 +1,15 @@
 """``volerr audit --html F``: one self-contained page, one section per source document.
 
 Every verdict shows the printed form, the derived form (and, for a convention or a
-simplification, the alternative derivation that reproduces the print), its category and the
-evidence.  Expressions are rendered as presentation MathML (sympy's MathML printer; browsers
-render it natively: no script, no network, no CDN); text that is no expression (matrices as
-lists, code, prose) is shown as preformatted text.  All links are relative (``#anchors``).
-sympy is imported inside :func:`math_html` only.
+simplification, the alternative derivation that reproduces the print), its category, the
+evidence and the readings tried.  The top of the page summarises the verdicts per document and
+per category and states the rule that picks a category.  Expressions are rendered as
+presentation MathML (sympy's MathML printer; browsers render it natively: no script, no
+network, no CDN); a long sum is rendered term by term as inline math that wraps like text, so
+the table fits a 1400 px page without horizontal scrolling (fixed table layout, long words
+broken); text that is no expression (matrices as lists, code, prose) is shown as wrapped
+preformatted text.  All links are relative (``#anchors``).  sympy is imported inside
+:func:`math_html` only.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from ._summary import CATEGORIES, category_counts
 _COLOURS = {"identical": "#2e7d32", "printing_error": "#c62828", "extraction": "#6a1b9a",
             "convention": "#1565c0", "simplification": "#00838f", "undecidable": "#ef6c00"}
 _MAX_MATH = 3000          # characters: longer expressions are shown as text
+_ONE_LINE = 90            # characters: longer sums are rendered term by term (they wrap)
 _PLAIN = re.compile(r"^[\w\s\(\)\*\+\-/\.\^,]+$")
 
 
@@ -42,6 +47,16 @@ def math_html(text: str) -> str:
                 # paper notation dx(X), Ey(Yo): one symbol printed with its argument
                 names[n] = sp.Symbol(n.replace("__", "(") + ")" if "__" in n else n)
             expr = parse_expr(src, local_dict=names, evaluate=False)
+            if len(text) > _ONE_LINE and isinstance(expr, sp.Add):
+                parts = []
+                for i, term in enumerate(sp.Add.make_args(expr)):
+                    c, rest = term.as_coeff_Mul()
+                    neg = c.is_number and c < 0
+                    body = -term if neg else term
+                    ml = sp.mathml(body, printer="presentation", order="none")
+                    sign = "<mo>-</mo>" if neg else ("<mo>+</mo>" if i else "")
+                    parts.append(f'<math display="inline"><mrow>{sign}{ml}</mrow></math>')
+                return '<div class="mwrap">' + " ".join(parts) + "</div>"
             ml = sp.mathml(expr, printer="presentation", order="none")
             return f'<math display="block">{ml}</math>'
         except Exception:  # noqa: BLE001 - anything unparsable is shown as text
@@ -72,6 +87,12 @@ def _row(e: dict) -> str:
     if e.get("dropped_um") is not None:
         extra.append(f"<p><b>size on a typical machine:</b> {e['dropped_um']:.3g} um</p>")
     extra.append(f"<p>{html.escape(e.get('evidence', ''))}</p>")
+    if e.get("readings_tried"):
+        items = "".join(f"<li>{html.escape(str(r))}</li>" for r in e["readings_tried"])
+        extra.append(f"<p><b>readings tried:</b></p><ul class=\"tried\">{items}</ul>")
+    if e.get("readings_used"):
+        extra.append("<p><b>rests on:</b> " + ", ".join(
+            f"<code>{html.escape(str(k))}</code>" for k in e["readings_used"]) + "</p>")
     cells.append(f"<td>{''.join(extra)}</td>")
     return "<tr>" + "".join(cells) + "</tr>"
 
@@ -89,6 +110,27 @@ def _counts_table(entries, sources) -> str:
     return f"<table><tr><th>document</th>{head}</tr>{''.join(rows)}</table>"
 
 
+_RULE = (
+    "Every combination of the named readings is tried (conventions and simplifications, each "
+    "with its own evidence; every axis stacking the text allows; repairs of text-extraction "
+    "damage; unstated assumptions). The category is, in this order of preference: "
+    "<b>identical</b> (the derivation reproduces the print); <b>convention</b> / "
+    "<b>simplification</b> (a combination of stated conventions and approximations reproduces "
+    "it exactly; the fewest readings are reported); <b>extraction</b> (only a repair of "
+    "extraction damage reproduces it, and the evidence tells that damage from the print); "
+    "<b>printing_error</b> (no reading reproduces it, and the text itself decides it is not "
+    "extraction damage); <b>undecidable</b> (otherwise: only an unstated assumption reproduces "
+    "it, or a glyph-level defect that the print and the extraction explain equally; both "
+    "are named).")
+
+
+def _category_summary(entries) -> str:
+    total = category_counts(entries)
+    items = "".join(f'<li>{_badge(c)} {total[c]}</li>' for c in CATEGORIES)
+    return (f"<p><b>{len(entries)} verdicts</b> in {len({e['source'] for e in entries})} "
+            f"documents:</p><ul class=\"cats\">{items}</ul>")
+
+
 def render_html(entries: list[dict], title: str = "volerr audit") -> str:
     """The audit page for ``entries`` (dicts as written by ``volerr audit --json``)."""
     sources = list(dict.fromkeys(e["source"] for e in entries))
@@ -100,26 +142,38 @@ def render_html(entries: list[dict], title: str = "volerr audit") -> str:
              "(reproduced exactly under the named convention); <b>simplification</b> (the "
              "author's stated approximation, with the size of what it drops); "
              "<b>undecidable</b> (the evidence says what is missing).</p>",
-             _counts_table(entries, sources)]
+             '<h2 id="summary">Summary</h2>', _category_summary(entries),
+             _counts_table(entries, sources),
+             f"<p><b>How a category is chosen.</b> {_RULE}</p>"]
     for s in sources:
         mine = [e for e in entries if e["source"] == s]
         counts = category_counts(mine)
         parts.append(f'<h2 id="{_anchor(s)}">{html.escape(s)}</h2><p>'
-                     + ", ".join(f"{counts[c]} {c}" for c in CATEGORIES) + "</p>")
+                     + ", ".join(f'<a href="#{_anchor(s + "-" + c)}">{counts[c]} {c}</a>'
+                                 if counts[c] else f"0 {c}" for c in CATEGORIES) + "</p>")
         for c in CATEGORIES:
             rows = [e for e in mine if e["category"] == c]
             if not rows:
                 continue
             parts.append(f'<h3 id="{_anchor(s + "-" + c)}">{_badge(c)} {len(rows)}</h3>'
-                         "<table><tr><th>equation</th><th>category</th><th>printed</th>"
-                         "<th>derived</th><th>evidence</th></tr>"
+                         "<table><colgroup><col class=\"c1\"><col class=\"c2\">"
+                         "<col class=\"c3\"><col class=\"c4\"><col class=\"c5\"></colgroup>"
+                         "<tr><th>equation</th><th>category</th><th>printed</th>"
+                         "<th>derived</th><th>evidence and readings</th></tr>"
                          + "".join(_row(e) for e in rows) + "</table>")
-    style = ("body{font-family:sans-serif;margin:2em;max-width:110em}"
-             "table{border-collapse:collapse;margin:1em 0}"
-             "td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%}"
-             "td:nth-child(3),td:nth-child(4){max-width:28em;overflow-x:auto}"
-             "pre{white-space:pre-wrap;margin:0}"
+    style = ("body{font-family:sans-serif;margin:1em auto;max-width:1360px;padding:0 10px}"
+             "table{border-collapse:collapse;margin:1em 0;width:100%;table-layout:fixed}"
+             "col.c1{width:9%}col.c2{width:10%}col.c3{width:20%}col.c4{width:20%}"
+             "col.c5{width:41%}"
+             "td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%;"
+             "overflow-wrap:anywhere;word-break:break-word}"
+             "math{max-width:100%}math[display=block]{overflow-wrap:anywhere}"
+             ".mwrap{white-space:normal;line-height:1.9}.mwrap math{display:inline}"
+             "pre{white-space:pre-wrap;overflow-wrap:anywhere;word-break:break-all;margin:0}"
+             "ul.tried{margin:0 0 0 1.2em;padding:0;font-size:92%}ul.cats{list-style:none;"
+             "padding:0}ul.cats li{display:inline;margin-right:1.5em}"
              ".cat{color:#fff;border-radius:3px;padding:1px 5px;font-size:85%}")
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width\">"
             f"<title>{html.escape(title)}</title><style>{style}</style></head><body>"
             + "\n".join(parts) + "</body></html>\n")

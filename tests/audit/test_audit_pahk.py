@@ -7,6 +7,7 @@ injected into a copy of the printed data to show that the audit detects and name
 
 import copy
 import json
+from collections import defaultdict
 import subprocess
 import sys
 import tomllib
@@ -19,6 +20,7 @@ import pytest
 import volerr
 from volerr.audit.numeric import _evaluate, _paper_values, spot_check
 from helpers import reference_chain
+from helpers.audit_rule import KIND, expected
 
 audit_pahk = pytest.importorskip("volerr.derive.audit_pahk")
 
@@ -98,9 +100,13 @@ def test_garbled_a5_terms_and_fh1_stacking(verdicts):
     assert "Ey(X) for Ex(X)" in dz.erratum
     assert "extra +X*Ey(X)" in find(verdicts, "A5", "dY").erratum
     dx = find(verdicts, "A5", "dX")
-    assert "Z riding on Y" in dx.erratum      # printed A4/A5: Z rides on Y, layout: Y on Z
-    assert "Z riding on Y" in find(verdicts, "A4").erratum
+    # printed A4/A5: Z rides on Y (tool Y -> Z), the layout file: Y on Z; the text allows both
+    geo = "geometry:FH1 tool Y -> Z, table X"
+    assert dx.category == "convention" and dx.readings_used == [geo]
+    a4 = find(verdicts, "A4")
+    assert a4.category == "convention" and geo in a4.readings_used
     assert "OCR" in dx.evidence               # the unbalanced parenthesis is an OCR reading
+    assert "glyph" in dx.evidence or "print or extraction" in dx.evidence
 
 
 def test_random_error_readings(verdicts):
@@ -108,7 +114,38 @@ def test_random_error_readings(verdicts):
         assert "term-wise" in find(verdicts, "5", c).erratum
     assert "Z*Zp" in find(verdicts, "5", "RX2").evidence  # the dropped cross term
     assert "MB1 (eq. 5) reprinted" in find(verdicts, "8", "RY2").erratum
-    assert "beta1 for Rbeta1" in find(verdicts, "8", "RX2").erratum
+    rx = find(verdicts, "8", "RX2")
+    assert "beta1 for Rbeta1" in rx.erratum
+    assert rx.category == "undecidable" and "letter R lost" in rx.evidence   # a lost glyph
+
+
+# ------------------------------------------------------ the same reading, every layout
+def test_pahk_reading_kinds_one_category_across_layouts(verdicts):
+    """Per reading kind, the layouts that use it and the categories: one category each."""
+    table = defaultdict(lambda: defaultdict(set))
+    for v in verdicts:
+        for k in v.readings_used:
+            table[k.split(":")[0]][v.layout].add(v.category)
+        if v.readings_used:
+            assert v.category == expected(v.readings_used), (v.equation, v.component)
+    for kind, per_layout in table.items():
+        single = {c for v in verdicts for c in [v.category]
+                  if [k.split(":")[0] for k in v.readings_used] == [kind]}
+        assert len(single) <= 1, (kind, single)
+        if single:
+            assert single == {KIND[kind]}
+    # the table origin pivot: convention on every layout with a table that needs it
+    assert set(table["table_origin"]) >= {"FB1", "FH1", "CY"}
+    assert table["rule1"].keys() >= {"MB1", "MH2", "FB1", "FH1", "CY"}
+    for layout, cats in table["rule1"].items():
+        assert cats <= {"simplification", "undecidable"}     # + a zero offset: undecidable
+
+
+def test_every_non_identical_pahk_verdict_lists_its_readings(verdicts):
+    for v in verdicts:
+        if v.category != "identical":
+            assert v.readings_tried, (v.equation, v.component)
+            assert v.readings_used or v.category == "printing_error", (v.equation, v.component)
 
 
 # ------------------------------------------------------------ injected errata (can fail)
@@ -203,7 +240,7 @@ def test_cli_table_and_json(tmp_path):
     for r in rows:
         assert keys <= set(r) and r["layout"] == "MB1"
         assert r["verdict"] in ("identical", "differs")
-    assert {r["equation"] for r in rows} == {"1", "4", "5", "9"}
+    assert {r["equation"] for r in rows} == {"1", "3", "4", "5", "9"}   # 3: the Lz vector
     lines = proc.stdout.splitlines()
     row4 = next(ln for ln in lines if ln.split()[2:3] == ["4"])
     assert "identical" in row4

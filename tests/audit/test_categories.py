@@ -199,15 +199,17 @@ def test_printing_error_rotary_axis_model_sec_2_5():
         pytest.approx(dev[1], abs=1e-15)
     assert find(vs, "eq. 2.42", "Delta_x").category == "identical"
     dy = find(vs, "eq. 2.42", "Delta_y")
-    assert dy.category == "printing_error" and "E_CC" in dy.erratum
+    # one extra minus: glyph-level, the print and the extraction explain it equally
+    assert dy.category == "undecidable" and "E_CC" in dy.erratum
     assert "contradicts its own matrix" in dy.evidence
     m = find(vs, "eq. 2.42", "error matrix")
-    assert m.category == "printing_error" and "-E_AC" in m.erratum
+    # decided: the separately typeset paper eq. 1.17 has -E_XB at the same entry
+    assert m.category == "printing_error" and "-E_AC" in m.erratum and "1.17" in m.evidence
     tcc = find(vs, "eq. 2.42", "T_CC")
     printed_tcc = np.array([[math.cos(c), -math.sin(c)], [math.sin(c), -math.cos(c)]])
     assert np.linalg.det(printed_tcc) == pytest.approx(-math.cos(2 * c))
-    assert tcc.category == "printing_error"
-    assert find(vs, "eq. 3.15", "X axis, row 1").category == "printing_error"
+    assert tcc.category == "undecidable" and "extra minus" in tcc.evidence
+    assert find(vs, "eq. 3.15", "X axis, row 1").category == "undecidable"
     assert find(vs, "eq. 3.15", "Z axis, row 3").category == "identical"
 
 
@@ -227,7 +229,7 @@ def test_extraction_unknown_vector_of_eq31():
     assert len(set(eq31["unknowns"])) < 6
     v = find(audit_tracker.audit_system(eq31), "eq. 31", "unknown vector")
     assert v.category == "extraction"
-    assert "subscripts" in v.evidence
+    assert "every unknown vector" in v.evidence and "(E_AX, E_BX, E_BX) E_CX" in v.evidence
 
 
 def _mh2_chain(Lz):
@@ -261,8 +263,11 @@ def test_extraction_eq6_uses_the_repaired_lz_of_eq3():
     assert sp.expand(literal[0] - printed7[0]) == sp.expand(-Z + beta1 * Z)
     vs = audit_pahk.audit(data("printed_pahk.toml"), ["MH2"])
     v = find(vs, "6")
-    assert v.verdict == "identical" and v.category == "extraction"
-    assert "beta1" in v.evidence and "repaired" in v.evidence
+    assert v.verdict == "identical" and v.category == "identical"
+    assert "beta1" in v.evidence and "vector" in v.evidence
+    # the damaged vector of eq. 3 is judged on its own (MB1's eq. 1 prints it): a lost glyph
+    lz = find(audit_pahk.audit(data("printed_pahk.toml"), ["MB1"]), "3", "Lz")
+    assert lz.category == "undecidable" and "beta1" in lz.erratum
 
 
 # --------------------------------------------------------------------------- numbers
@@ -283,7 +288,8 @@ def test_numbers_reduction_49_identical_78_undecidable(numbers):
 
 def test_numbers_same_peak_quoted_differently(numbers):
     v = find(numbers, "sec. 4.1 / 4.1.2 / 4.2.2: peak of E_YY", "sec. 4.1.2: 48")
-    assert v.category == "printing_error"
+    assert "40.8"[:1] + "40.8"[3:] == "48"          # '40.8' with '0.' lost
+    assert v.category == "undecidable" and "'0.' lost" in v.evidence
     assert abs(40.8 / 20.5 - 2) < 0.05 and 48 / 20.5 > 2.3      # 'almost double' of 20.5
     v = find(numbers, "sec. 4.1 / 4.2.1: peak of E_XX", "sec. 4.1: 20.5")
     assert v.category == "identical"
@@ -302,7 +308,7 @@ def test_numbers_symbol_list_squareness_planes(numbers):
 
 def test_numbers_probe_units_and_rms(numbers):
     v = find(numbers, "sec. 3.2: probe error units", "unit")
-    assert v.category == "printing_error"
+    assert v.category == "undecidable" and "one glyph" in v.evidence
     # zero-mean values in [-9, 6.6]: variance <= 9 * 6.6 (Bhatia-Davis); RMS 4.0 fits
     assert 4.0 ** 2 <= 9.0 * 6.6
     assert find(numbers, "sec. 3.2: probe error RMS", "rms").category == "identical"
@@ -343,8 +349,15 @@ def test_listing_constant_term_dropped():
 
 
 # --------------------------------------------------------------------------- all verdicts
-EXPECTED = {"identical": 113, "printing_error": 37, "extraction": 11, "convention": 12,
-            "simplification": 17, "undecidable": 37}
+EXPECTED = {"identical": 171, "printing_error": 35, "extraction": 14, "convention": 25,
+            "simplification": 19, "undecidable": 64}
+#: per document (a verdict that moves between documents or categories fails)
+EXPECTED_BY_SOURCE = {
+    "Pahk 1995": {"identical": 36, "printing_error": 11, "extraction": 0, "convention": 17,
+                  "simplification": 16, "undecidable": 32},
+    "Ellingsdalen 2021": {"identical": 135, "printing_error": 24, "extraction": 14,
+                          "convention": 8, "simplification": 3, "undecidable": 32},
+}
 
 
 @pytest.mark.slow
@@ -354,6 +367,9 @@ def test_counts_per_category(full_audit):
     _, entries, _ = full_audit
     counts = Counter(e["category"] for e in entries)
     assert dict(counts) == EXPECTED
+    for src, want in EXPECTED_BY_SOURCE.items():
+        got = Counter(e["category"] for e in entries if e["source"] == src)
+        assert {c: got.get(c, 0) for c in want} == want, src
     for e in entries:
         assert (e["category"] == "identical") == (e["verdict"] == "identical") or \
             e["category"] == "extraction"

@@ -7,9 +7,14 @@ import json
 import re
 import subprocess
 import sys
+from collections import Counter
 from importlib import resources
 
 import pytest
+
+
+CATS = ("identical", "printing_error", "extraction", "convention", "simplification",
+        "undecidable")
 
 
 def run(*args):
@@ -55,5 +60,40 @@ def test_html_page_mb1(tmp_path):
 @pytest.mark.slow
 @pytest.mark.xdist_group("full_audit")
 def test_html_every_document(full_audit):
-    r, _, page = full_audit
+    r, entries, page = full_audit
     assert '<h2 id="pahk-1995">' in page and '<h2 id="ellingsdalen-2021">' in page
+    # summary at the top: per document and per category, before the first document section
+    top = page[:page.index('<h2 id="pahk-1995">')]
+    assert '<h2 id="summary">' in top and "How a category is chosen" in top
+    for src in ("Pahk 1995", "Ellingsdalen 2021"):
+        counts = Counter(e["category"] for e in entries if e["source"] == src)
+        row = top[top.index(f">{src}</a></td>"):]
+        row = row[:row.index("</tr>")]
+        assert re.findall(r"<td>(\d+)</td>", row) == [str(counts.get(c, 0)) for c in CATS]
+    # every non-identical verdict shows its readings
+    assert page.count("<b>readings tried:</b>") >= sum(e["category"] != "identical"
+                                                        for e in entries)
+
+
+def test_html_fits_1400px_and_wraps(tmp_path):
+    """The page's layout cannot scroll sideways at 1400 px: a fixed table layout of 100 %
+    width inside a body of at most 1360 px + padding, every cell breaking long words, no
+    overflow-x anywhere, and long sums rendered as inline math pieces that wrap."""
+    from volerr.audit import render_html
+
+    long_sum = " + ".join(f"a{i}*Ez(X)*Yo" for i in range(60))
+    entries = [{"source": "S", "equation": "1", "layout": "L", "component": "c",
+                "category": "convention", "verdict": "differs", "erratum": "e",
+                "printed": long_sum, "derived": long_sum, "evidence": "x" * 3000,
+                "readings_tried": ["r1: exact", "r2: 2 term(s) differ"],
+                "readings_used": ["table_origin"], "alternative": long_sum}]
+    page = render_html(entries)
+    style = page[page.index("<style>"):page.index("</style>")]
+    assert "table-layout:fixed" in style and "width:100%" in style
+    assert "overflow-x" not in style and "overflow:auto" not in style
+    assert re.search(r"max-width:(\d+)px", style)
+    assert int(re.search(r"max-width:(\d+)px", style).group(1)) <= 1380
+    assert "overflow-wrap:anywhere" in style and "white-space:pre-wrap" in style
+    assert page.count('class="mwrap"') == 3                  # printed, derived, alternative
+    assert page.count('<math display="inline">') == 3 * 60
+    assert "<li>r1: exact</li>" in page and "<code>table_origin</code>" in page
