@@ -28,7 +28,12 @@ def inputs(tmp_path_factory):
     task.write_text("X,Y,Z\n100,100,100\n300,100,100\n")
     gcode = d / "prog.nc"
     gcode.write_text("G90\nG1 X10 Y10 Z50 B0 C0\nG1 X20 Y10 Z50 B10 C20\n")
+    from importlib import resources
+
+    data = resources.files("volerr") / "data"
     return {"dir": d, "errors": d / "errors_MB1", "dmu_errors": ex["errors"],
+            "ballbar": data / "ballbar_example_XY.csv",
+            "sphere_probing": data / "sphere_example_DMU50.csv",
             "program": ex["program"], "small_program": gcode, "tracker": example_path("X"),
             "sphere": sphere["path"], "sphere_r": sphere["sphere_radius_mm"], "run": run,
             "task": task}

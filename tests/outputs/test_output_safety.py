@@ -75,11 +75,22 @@ def _cases(i, bad, tmp):
         "audit --json": ["audit", "MB1", "--json", bad],
         "derive --out": ["derive", "MB1", "--out", bad],
         "demo --out": ["demo", "--out", bad],
+        "calibrate --json": ["calibrate", "DMU50", i["sphere_probing"], "--json", bad],
+        "calibrate --html": ["calibrate", "DMU50", i["sphere_probing"], "--html", bad],
+        "calibrate --errors-out": ["calibrate", "DMU50", i["sphere_probing"], "--json",
+                                   tmp / "c.json", "--errors-out", bad],
+        "ballbar simulate --out": ["ballbar", "simulate", "MB1", "--errors", e, "--plane", "XY",
+                                   "--radius", 100, "--centre", "450,287,200", "--out", bad],
+        "ballbar evaluate --json": ["ballbar", "evaluate", i["ballbar"], "--json", bad],
+        "ballbar evaluate --plot": ["ballbar", "evaluate", i["ballbar"], "--json",
+                                    tmp / "b.json", "--plot", png],
+        "ballbar evaluate --html": ["ballbar", "evaluate", i["ballbar"], "--html", bad],
     }
 
 
 CASES = sorted(_cases({k: Path("x") for k in ("errors", "dmu_errors", "program", "tracker",
-                                               "sphere", "run", "task")} | {"sphere_r": 1},
+                                               "sphere", "run", "task", "ballbar",
+                                               "sphere_probing")} | {"sphere_r": 1},
                       "b", Path("t")))
 
 
