@@ -500,8 +500,7 @@ def build(model, data: Data, ranges: dict, degree: int, covs=None, gauge=()) -> 
     special = _special_names(model, covs)
     tgts = targets(model)
     sym_const, sym_var = syms.targets(model, data)
-    ordered = (sym_const + [t for t in tgts if t.kind != "tool"] + sym_var
-               + [t for t in tgts if t.kind == "tool"])
+    ordered = sym_const + sym_var + tgts
     out: list[Candidate] = []
     for cov in covs:
         if cov.kind == "probing_direction":

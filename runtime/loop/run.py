@@ -54,6 +54,7 @@ from ..machine import derivation
 from ..machine.model import Model, load
 
 from .select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
+from .symbols import describe
 
 ROBUST_K = 4.0       # robust sigmas of the 3-D residual length kept at full weight
 OUTLIER_Z = 5.0      # robust sigmas beyond which a point is flagged as an outlier
@@ -391,7 +392,8 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
         ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
         ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)
         effects.append({"kind": c.kind, "name": c.name, "parameters": pars, "units": units,
-                        "std": std, "parameter": info.get("parameter"),
+                        "std": std, "description": describe(aug.model, info, pars, units),
+                        "parameter": info.get("parameter"),
                         "covariate": info.get("covariate"), "basis": info.get("basis"),
                         "target": sorted({t[1] for t in c.terms}), "info": info,
                         "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}

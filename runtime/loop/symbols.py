@@ -160,3 +160,39 @@ def words(model, name: str) -> str:
               if any(isinstance(c, str) and rest in variables(c)
                      for c in (*f.translation, f.angle_deg))]
     return f"{rest} ({', '.join(where)})" if where else rest
+
+
+def _num(v: float) -> str:
+    return f"{v:.3g}"
+
+
+def describe(model, info: dict, values: dict, units: dict) -> str:
+    """One line naming an accepted effect in the layout's vocabulary: ``stylus length grows
+    23 ppm/K with T_probe``, ``d (point of axis B) grows 2.1 um/K (13.5 ppm/K of 154.996 mm)
+    with T_spindle``; for an effect on a declared parameter ``EXX varies with T_C (linear,
+    scale): KT_X = 11.5 um/m/K``.  ``values`` / ``units``: parameter -> value and unit as
+    reported."""
+    cov, basis = info.get("covariate"), str(info.get("basis", ""))
+    symbol = info.get("symbol")
+    if symbol is None:
+        vals = ", ".join(f"{p} = {_num(v)} {units.get(p, '')}".rstrip()
+                         for p, v in values.items())
+        return f"{info.get('parameter')} varies with {cov} ({basis}): {vals}"
+    subject = words(model, symbol)
+    if "indicator" in basis or len(values) != 1:
+        vals = ", ".join(f"{_num(v)} {units.get(p, '')}".rstrip() for p, v in values.items())
+        return f"{subject} differs per {cov} level (after the first): {vals}"
+    (p, v), = values.items()
+    verb = "grows" if v >= 0 else "shrinks"
+    text = f"{subject} {verb} {_num(abs(v))} {units.get(p, '')}".rstrip()
+    if "saturating" in basis:
+        text += f" (saturating, time constant {_num(info.get('tau_h', float('nan')))} h)"
+    value = info.get("nominal_value")
+    if value and not str(units.get(p, "")).startswith("ppm"):
+        unit = str(units.get(p, ""))
+        per = unit.split("/", 1)[1] if "/" in unit else ""
+        factor = 1e-3 if unit.startswith("um") else 1e-6
+        rel = 1e6 * abs(v) * factor / abs(value)
+        nominal = f"{value:g} mm" if unit.startswith("um") else f"{value:g} rad"
+        text += f" ({_num(rel)} ppm{'/' + per if per else ''} of {nominal})"
+    return f"{text} with {cov}"
