@@ -42,6 +42,7 @@ import numpy as np
 
 from ..estimate import blocks
 from . import candidates as cands
+from . import checks
 from . import select as sel
 from ..errors import require
 from ..estimate.design import (Data, solve_normal, data_ranges, declared_design, point_norm,
@@ -488,6 +489,7 @@ def _load(layout, data) -> tuple[Model, Data]:
 
 def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, families):
     """Declared fit, robust weights, selection; the degree chosen again with the effects."""
+    checks.determined(model, dat, ranges)
     degree_scores = {}
     if not fixed_degree:
         # robust weights of a preliminary fit first: outliers must not choose the degree
@@ -534,6 +536,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
          families, inputs) -> Report:
     t_start = time.perf_counter()
     model, dat = _load(layout, data)
+    checks.one_position(dat)
     require(folds is None or 2 <= folds <= 20, "folds must be between 2 and 20")
     require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
     if degree is not None:
