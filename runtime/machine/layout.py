@@ -21,11 +21,17 @@ A layout is a TOML file (shipped ones live in ``volerr/layouts/``).  It declares
   ``probe_direction``, ``setup`` ...), free descriptive keys (``axis``, ``period`` ...), and
   ``terms = [{parameter = "KT_X", target = "EXX", basis = "X*(T_C - 20)"}, ...]``: each term adds
   ``parameter * basis`` to ``target``, a component or location error of an axis (``EXX``,
-  ``EX0C``) or one of the six twist coordinates ``dx dy dz ex ey ez`` of an extra error factor
-  at the workpiece end (``work.dx``: the measuring instrument's placement) or at the tool end
-  (``tool.dx``: the probe) of the chain.  The parameters become error parameters of the model
-  (after all others); names in a basis (:mod:`volerr.machine.expressions`) that are not axes are
-  *covariates*: extra arguments of the generated functions (``T_C``, ``t_s``, ``dir_X`` ...).
+  ``EX0C``), a squareness, one of the six twist coordinates ``dx dy dz ex ey ez`` of an extra
+  error factor at the workpiece end (``work.dx``: the measuring instrument's placement) or at
+  the tool end (``tool.dx``: the probe) of the chain, or a *nominal symbol* of the chain
+  (:attr:`Layout.symbols`: ``probe.Xp probe.Yp probe.Zp`` the probe / tool offset, ``axis.C``
+  an axis position, ``param.d`` a layout parameter, ``frame.F.x|y|z|angle`` a fixed frame's
+  translation or angle; mm or rad), whose value the actual machine has changed by the term
+  (:mod:`volerr.derive.symbols`).  A parameter may appear in several terms of one effect.
+  The parameters become error parameters of the model (after all others); names in a basis
+  (:mod:`volerr.machine.expressions`) that are not axes or the probe offset ``Xp Yp Zp`` (a
+  term proportional to each point's offset, ``Zp*(T - 20)``) are *covariates*: extra arguments
+  of the generated functions (``T_C``, ``t_s``, ``dir_X`` ...).
 
 Sign conventions (ISO 230-1 / ISO 841): every axis ``direction`` is the direction in which the
 tool (probe) moves *relative to the workpiece* for a positive command, whether the tool side
