@@ -185,6 +185,7 @@ def _loop(camp, layout, folder):
 
     files = camp.write(folder)
     rep = run_loop(layout, files, seed=0, progress=False)
+    rep.data["augmented_text"] = rep.augmented_text
     (inst,) = rep["instruments"]
     floor = camp.floor({camp.blocks[0].name: inst["test_rows"]})[camp.blocks[0].name]
     return rep, inst, floor
@@ -213,6 +214,17 @@ def check_named(case):
     assert (e["parameter"], e["covariate"]) == case["expect"], e
     assert e["kind"] == case["kind"], e
     assert case["words"] in e["description"] and case["expect"][1] in e["description"], e
+    # the augmented layout carries it as an effect on that parameter or symbol
+    from volerr.machine.layout import parse_layout
+
+    (effect,) = parse_layout(rep["augmented_text"]).effects
+    want = case["expect"][0]
+    targets = {t.target for t in effect.terms}
+    if want == "probe.length":     # the offset components the data hold, one parameter
+        assert targets and targets <= {"probe.Xp", "probe.Yp", "probe.Zp"}, targets
+        assert len(effect.parameters) == 1, effect
+    else:
+        assert targets == {want}, targets
 
 
 def check_value(case):
