@@ -9,8 +9,10 @@ propagates through the chain exactly like ``P`` (Abbe arms included).  Written a
 Parameters ``P`` (:func:`targets`): every component error of every axis (modulated as offset +
 slope along its own axis), every squareness and rotary location error, the instrument set-up
 (``work.dx ... work.ez``: the rigid placement of the measuring instrument, workpiece end) and the
-probe / tool offset (``tool.dx tool.dy tool.dz``, tool end), and the probe radius along the
-probing direction.
+probe / tool offset (``tool.dx tool.dy tool.dz``, tool end), the probe radius along the
+probing direction, and the nominal symbols of the chain (:mod:`volerr.loop.symbols`: the probe
+/ tool offset growing along itself, ``param.d``, ``frame.F.x``, the scale of a rotary axis;
+linear or *proportional* to the symbol's own value).
 
 Covariates ``C`` (:func:`covariates`): every numeric data column that is not an axis, probe
 offset or deviation: temperatures (``T``, ``T_C``, ``T_top``, ``temp_X`` ...: basis ``T - 20``)
@@ -479,7 +481,8 @@ def _symbol(model, t: syms.SymbolTarget, cov: Covariate) -> list:
         pw = f"WU_{st}_{ctag}"
 
         def make(tau, pw=pw, t=t, hours=cov.expr):
-            return t.make_terms(pw, f"(1 - exp(-{hours}/{_f(tau)}))"), {"tau_h": round(float(tau), 4)}
+            terms = t.make_terms(pw, f"(1 - exp(-{hours}/{_f(tau)}))")
+            return terms, {"tau_h": round(float(tau), 4)}
 
         terms, extra = make(TAU_GRID_H[0])
         out.append(Candidate("drift", f"warmup_{st}_{ctag}", terms,

@@ -3,7 +3,9 @@ layout, report the error before and after on held-out points.
 
 Steps (:func:`run_loop`):
 
-1. read the measured-deviation CSV (INTERFACE.md) and check it against the layout;
+1. read the measured-deviation CSV (INTERFACE.md) and check it against the layout; refuse a
+   file whose points all stand at one position and readings that determine none of the
+   declared model's parameters (:mod:`volerr.loop.checks`);
 2. hold out a random ``test_fraction`` of the points; everything below is decided on the
    others (the training points) and judged on the held-out ones;
 3. fit the declared model (:mod:`volerr.estimate.design`): component errors as Legendre series, degree by
