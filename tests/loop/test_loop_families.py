@@ -13,7 +13,8 @@ deviations of a CMM against a reference, R-test / sphere probing on a five-axis 
   table-side against tool-side thermal (FB1: the table Y with T_table, T_bridge also logged;
   FH2: the arm X with T_arm, T_table also logged; TH_BC: the C table's location with T_table,
   T_head also logged), rotary axis locations that drift (TT_AC: the trunnion height h of the
-  layout, HH_BC: the head's pivot distance L, both layout parameters);
+  layout, HH_BC: the head's pivot distance L, DMU50: the height d of the swivelling table's
+  axes, all layout parameters: "d grows 2 um/K with T_spindle");
 
 and the same campaign without the effect (clean control).  Every campaign also logs the room
 temperature or a second channel and the time, has static squareness / location / component
@@ -137,6 +138,14 @@ def tool_growth(value):
                   {"KL": value}, tool=(0, 0, -100.0))
 
 
+def swivel_height(value):
+    return sphere("DMU50", 25, "B", [0, 45, 90],
+                  {"P1": (80, 0, 30), "P2": (-60, 60, 90), "P3": (0, -70, 130)},
+                  ["T_C", "T_spindle"],
+                  lambda m: [F.Growth("KD", "param.d", lambda b: b.cov["T_spindle"] - 20.0)],
+                  {"KD": value}, tool=(0, 0, -100.0))
+
+
 def trunnion_height(value):
     return sphere("TT_AC", 22, "A", [-30, 0, 30, 45],
                   {"P1": (80, 0, 30), "P2": (-60, 60, 90), "P3": (0, -70, 130)},
@@ -171,6 +180,8 @@ CASES = {
     "ram_growth-CY": (ram_growth, 11.0, "CY", ("EZZ", "T_ram"), "thermal", "EZZ"),
     "tool_growth-DMU50": (tool_growth, 11.5, "DMU50", ("probe.length", "T_spindle"),
                           "thermal", "tool length grows"),
+    "swivel_height-DMU50": (swivel_height, 2.0, "DMU50", ("param.d", "T_spindle"), "thermal",
+                            "d (point of axis B) grows"),
     "trunnion_height-TT_AC": (trunnion_height, 2.0, "TT_AC", ("param.h", "T_table"),
                               "thermal", "h (point of axis A) grows"),
     "head_pivot-HH_BC": (head_pivot, 1.5, "HH_BC", ("param.L", "T_head"), "thermal",
