@@ -18,6 +18,15 @@ A layout may declare ``[effects.NAME]`` tables (format: :mod:`volerr.machine.lay
 * ``tool.<k>``: an extra error twist standing last (the probe / tool end), in the tool frame:
   ``probe_direction`` (``tool.dx += r nx`` ...: an effective probe-radius error along the
   probing direction).
+* a nominal symbol of the chain (:attr:`volerr.machine.layout.Layout.symbols`): ``probe.Xp``
+  ``probe.Yp`` ``probe.Zp`` (the probe / tool offset: a translation at the tool end, in the
+  tool frame), ``axis.<A>`` (the axis position, mm or rad), ``param.<p>`` (a layout parameter
+  such as the DMU 50's ``d``, wherever it enters the chain), ``frame.<F>.x|y|z|angle`` (a
+  fixed frame's translation, mm, or angle, rad): the term is the change of the symbol's
+  value; an error factor ``I + F^-1 dF/ds * change`` follows every nominal factor ``F`` that
+  holds the symbol (:mod:`volerr.derive.symbols`).  ``Xp Yp Zp`` may appear in a basis: a
+  *proportional* term such as ``probe.Zp += k * Zp * (T - 20)`` (a stylus or tool that grows
+  with temperature by ``k`` per K of its own length).
 
 Covariates (``T_C``, ``t_s``, ``dir_X``, ``nx`` ...) are plain real symbols; the code generator
 makes them arguments of the generated functions.  Rotary positions are in rad here, as
@@ -69,10 +78,16 @@ def apply_effects(layout: Layout, factors: list) -> list:
     new factors at the two ends."""
     from .htm import Factor, parameter_symbol
 
+    from .symbols import PROBE_TWIST, insert_variations
+
     add = additions(layout)
     if not add:
         return factors
-    out = list(factors)
+    for s, k in PROBE_TWIST.items():       # the probe offset: a translation at the tool end
+        if s in add:
+            add[f"tool.{k}"] = add.get(f"tool.{k}", 0) + add.pop(s)
+    nominal = {t: v for t, v in add.items() if t.split(".")[0] in ("param", "axis", "frame")}
+    out = insert_variations(list(factors), nominal) if nominal else list(factors)
     subs = {parameter_symbol(t): parameter_symbol(t) + extra for t, extra in add.items()
             if "." not in t}
     for f in out:

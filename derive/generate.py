@@ -8,7 +8,7 @@ import sympy as sp
 
 from volerr.machine.layout import Layout, layout_names, read_layout
 
-from . import inverse
+from . import inverse, symbols
 from . import volumetric as vol
 from .codegen import Function, render_module, shared_preparation
 from .kinematics import PROBE, Chain
@@ -26,7 +26,7 @@ EXTRA_MODULES = {
 #: derivation sources of a layout's module (hashed into its header)
 LAYOUT_SOURCES = ("runtime/machine/layout.py", "derive/htm.py", "derive/effects.py",
                   "derive/kinematics.py", "derive/volumetric.py", "derive/inverse.py",
-                  "derive/generate.py")
+                  "derive/symbols.py", "derive/generate.py")
 
 
 def module_name(layout_name: str) -> str:
@@ -79,6 +79,12 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "(columns 0-5, first in the chain: the instrument's placement) and of the tool "
                  "end (columns 6-11, tool frame): array (3, 12, *shape), mm/mm and mm/rad.",
                  shape=(3, 12)),
+        Function("symbol_sensitivity", pos + probe, list(symbols.symbol_sensitivity(chain)),
+                 "d(nominal tool point x, y, z)/d(nominal symbol) in SYMBOLS order (probe "
+                 "offset components, axis positions, layout parameters, frame offsets and "
+                 "angles): array (3, n_symbols, *shape), mm/mm or mm/rad; the first-order "
+                 "error of a change of the symbol's value.",
+                 shape=(3, len(layout.symbols))),
         Function("nominal_position", pos + probe, list(vol.nominal_point(chain)),
                  "Nominal probe-tip / tool-tip position in the workpiece frame, mm."),
         Function("tool_axis", pos, list(vol.nominal_tool_axis(chain)),
@@ -112,6 +118,7 @@ def _constants(layout: Layout) -> dict:
         "PARAMETERS": repr(tuple(layout.parameter_names)),
         "PARAMETER_AXIS": repr(layout.parameter_axis),
         "PARAMETER_KIND": repr(layout.parameter_kind),
+        "SYMBOLS": repr(tuple(layout.symbols)),
     }
     if layout.effects:
         constants["COVARIATES"] = repr(tuple(layout.covariates))

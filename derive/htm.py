@@ -75,6 +75,10 @@ class Factor:
     twist_args: dict | None = None
     owner: str = ""          # axis or frame the factor belongs to
     role: str = ""           # "motion", "component", "squareness", "location", "fixed"
+    #: nominal factors: nominal symbol (``axis.X``, ``param.d``, ``frame.F.x`` ...) -> the
+    #: twist ``F^-1 dF/ds`` of a unit change of that symbol (mm or rad), as twist arguments
+    #: (:mod:`volerr.derive.symbols`); error factors: None
+    variation: dict | None = None
 
     @property
     def is_error(self) -> bool:

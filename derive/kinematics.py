@@ -92,33 +92,81 @@ def _location_twist(axis) -> dict:
     return args
 
 
+def _twist_args(d=None, e=None) -> dict:
+    """Twist arguments of a translation ``d`` and a rotation ``e`` (3-vectors), zeros left out."""
+    out = {}
+    for keys, v in (("dx dy dz", d), ("ex ey ez", e)):
+        if v is None:
+            continue
+        for k, c in zip(keys.split(), v):
+            c = sp.expand(c)
+            if c != 0:
+                out[k] = c
+    return out
+
+
+def _parameter_variations(vec: sp.Matrix, params: dict, sign: int = 1) -> dict:
+    """``param.<p>`` -> translation twist ``sign * d(vec)/dp`` for each layout parameter the
+    vector holds (an axis point, a frame translation)."""
+    out = {}
+    for p in sorted(params):
+        d = vec.diff(sp.Symbol(p, real=True))
+        if any(c != 0 for c in d):
+            out[f"param.{p}"] = _twist_args(d=sign * d)
+    return out
+
+
+def _frame_variations(entry: str, t: sp.Matrix, u: sp.Matrix, theta, params: dict) -> dict:
+    """Variations of a fixed frame ``Trans(t) Rot(u, theta)``: ``F^-1 dF = [[R^T dR, R^T dt]]``
+    with ``R^T dR = dtheta [u]x`` (the axis is fixed): a unit change of a translation
+    component ``frame.F.x`` (mm, base side of the rotation) or of the angle ``frame.F.angle``
+    (rad), and of each layout parameter in ``t`` or ``theta``."""
+    Rt = rotation(u, theta)[0:3, 0:3].T
+    out = {f"frame.{entry}.{k}": _twist_args(d=Rt[:, i]) for i, k in enumerate("xyz")}
+    out[f"frame.{entry}.angle"] = _twist_args(e=u)
+    for p in sorted(params):
+        s = sp.Symbol(p, real=True)
+        dt, dth = t.diff(s), sp.diff(theta, s)
+        if any(c != 0 for c in dt) or dth != 0:
+            out[f"param.{p}"] = _twist_args(d=Rt * dt, e=u * dth)
+    return out
+
+
 def stage_factors(layout: Layout, entry: str) -> list[Factor]:
-    """The factors of one chain entry (axis or frame), in tool-side form."""
+    """The factors of one chain entry (axis or frame), in tool-side form.  Every nominal
+    factor carries its ``variation``: the twist of a unit change of each nominal symbol it
+    depends on (an axis position, a layout parameter, a frame's offset or angle)."""
     params = layout.parameters
     if entry in layout.frames:
         f = layout.frames[entry]
         angle = sp.sympify(f.angle_deg, locals={k: sp.Symbol(k, real=True) for k in params})
-        m = translation(_sympify_vec(f.translation, params)) * rotation(
-            _rational_vec(f.rotation_axis), sp.pi * sp.nsimplify(angle) / 180)
-        return [Factor(nominal=m, owner=entry, role="fixed")]
+        t, u = _sympify_vec(f.translation, params), _rational_vec(f.rotation_axis)
+        theta = sp.pi * sp.nsimplify(angle) / 180
+        m = translation(t) * rotation(u, theta)
+        return [Factor(nominal=m, owner=entry, role="fixed",
+                       variation=_frame_variations(entry, t, u, theta, params))]
     axis = layout.axes[entry]
     q = position_symbol(entry)
     u = _rational_vec(axis.direction)
     if axis.kind == "linear":
-        out = [Factor(nominal=translation(q * u), owner=entry, role="motion")]
+        out = [Factor(nominal=translation(q * u), owner=entry, role="motion",
+                      variation={f"axis.{entry}": _twist_args(d=u)})]
         sq = _squareness_twist(layout, entry, u, q)
         if sq:
             out.append(Factor(twist_args=sq, owner=entry, role="squareness"))
         out.append(Factor(twist_args=_component_twist(entry), owner=entry, role="component"))
         return out
     c = _sympify_vec(axis.point, params)
-    out = [Factor(nominal=translation(c), owner=entry, role="fixed")]
+    out = [Factor(nominal=translation(c), owner=entry, role="fixed",
+                  variation=_parameter_variations(c, params))]
     loc = _location_twist(axis)
     if loc:
         out.append(Factor(twist_args=loc, owner=entry, role="location"))
     out.append(Factor(twist_args=_component_twist(entry), owner=entry, role="component"))
-    out.append(Factor(nominal=rotation(u, q), owner=entry, role="motion"))
-    out.append(Factor(nominal=translation(-c), owner=entry, role="fixed"))
+    out.append(Factor(nominal=rotation(u, q), owner=entry, role="motion",
+                      variation={f"axis.{entry}": _twist_args(e=u)}))
+    out.append(Factor(nominal=translation(-c), owner=entry, role="fixed",
+                      variation=_parameter_variations(c, params, -1)))
     return out
 
 

@@ -6,12 +6,12 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       71588b1ebbefc8e45fea873daa24a7c200a58161555e20bfdadf7112bd3843ac
-derivation sha256  71bd61924bc206d48a0d4baa0a657d290bdb0292966118cf6b6823449d8d4217
+derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
-    derive/volumetric.py, derive/inverse.py, derive/generate.py, derive/codegen.py,
-    derive/linewrap.py, derive/templates/model.py.j2
+    derive/volumetric.py, derive/inverse.py, derive/symbols.py, derive/generate.py,
+    derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2
 
 Units
 -----
@@ -48,6 +48,8 @@ PARAMETER_KIND = {'EXX': 'translational', 'EYX': 'translational', 'EZX': 'transl
     'EB0Z': 'squareness', 'EC0Y': 'squareness', 'EX0B': 'location', 'EY0B': 'location',
     'EA0B': 'location', 'EB0B': 'location', 'EX0C': 'location', 'EY0C': 'location',
     'EA0C': 'location', 'EB0C': 'location'}
+SYMBOLS = ('probe.Xp', 'probe.Yp', 'probe.Zp', 'axis.X', 'axis.Y', 'axis.Z', 'axis.B', 'axis.C',
+    'param.d')
 d = 154.996
 
 
@@ -1463,6 +1465,94 @@ def setup_sensitivity(X, Y, Z, B, C, Xp, Yp, Zp):
     _out[2, 9] = _t12 + _t3 - _t6
     _out[2, 10] = -_t11 - _t49 - _t5*_t9
     _out[2, 11] = -_t11 + _t3*_t9 + _t49
+    return _out
+
+
+def symbol_sensitivity(X, Y, Z, B, C, Xp, Yp, Zp):
+    """d(nominal tool point x, y, z)/d(nominal symbol) in SYMBOLS order (probe offset components,
+    axis positions, layout parameters, frame offsets and angles): array (3, n_symbols, *shape),
+    mm/mm or mm/rad; the first-order error of a change of the symbol's value."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(B)
+    _t1 = numpy.cos(C)
+    _t2 = _t0*_t1
+    _t3 = numpy.sin(C)
+    _t4 = (1/2)*_t3
+    _t5 = numpy.sin(B)
+    _t6 = numpy.sqrt(2)
+    _t7 = _t5*_t6
+    _t8 = _t4*_t7
+    _t9 = _t2 + _t8
+    _t10 = _t0*_t4
+    _t11 = (1/2)*_t1
+    _t12 = _t11*_t7
+    _t13 = -_t10 + _t12 - _t4
+    _t14 = -_t10 + _t12 + _t4
+    _t15 = _t1*_t5
+    _t16 = Y*_t4
+    _t17 = Yp*_t4
+    _t18 = Z*_t4
+    _t19 = Zp*_t4
+    _t20 = _t4*d
+    _t21 = _t10*_t6
+    _t22 = (1/2)*_t2
+    _t23 = Y*_t22
+    _t24 = Yp*_t22
+    _t25 = Z*_t22
+    _t26 = Zp*_t22
+    _t27 = Y*_t11
+    _t28 = Yp*_t11
+    _t29 = _t11*d
+    _t30 = _t0*_t3
+    _t31 = _t0*_t3 - _t12
+    _t32 = _t22 + _t8
+    _t33 = _t11 + _t32
+    _t34 = -_t11 + _t32
+    _t35 = _t3*_t5
+    _t36 = Z*_t11
+    _t37 = Zp*_t11
+    _t38 = _t22*_t6
+    _t39 = _t10*d
+    _t40 = (1/2)*_t5
+    _t41 = -_t40*_t6
+    _t42 = (1/2)*_t0
+    _t43 = _t42 - 1/2
+    _t44 = _t42 + 1/2
+    _t45 = _t42*_t6
+    _out = numpy.zeros((3, 9) + _shape)
+    _out[0, 0] = _t9
+    _out[0, 1] = _t13
+    _out[0, 2] = _t14
+    _out[0, 3] = _t9
+    _out[0, 4] = _t13
+    _out[0, 5] = _t14
+    _out[0, 6] = (-X*_t15 + X*_t21 - Xp*_t15 + Xp*_t21 + _t16*_t5 + _t17*_t5 + _t18*_t5 + _t19*_t5
+        - _t20*_t5 - _t22*_t6*d + _t23*_t6 + _t24*_t6 + _t25*_t6 + _t26*_t6)
+    _out[0, 7] = ((1/2)*X*_t1*_t5*_t6 - X*_t30 + (1/2)*Xp*_t1*_t5*_t6 - Xp*_t30 + (1/2)*Z*_t1
+        + (1/2)*Zp*_t1 + (1/2)*_t0*_t1*d - _t16*_t7 - _t17*_t7 - _t18*_t7 - _t19*_t7 - _t23 - _t24
+        - _t25 - _t26 - _t27 - _t28 - _t29 + (1/2)*_t3*_t5*_t6*d)
+    _out[0, 8] = -_t14
+    _out[1, 0] = _t31
+    _out[1, 1] = _t33
+    _out[1, 2] = _t34
+    _out[1, 3] = _t31
+    _out[1, 4] = _t33
+    _out[1, 5] = _t34
+    _out[1, 6] = (-X*_t35 - X*_t38 - Xp*_t35 - Xp*_t38 + (1/2)*Y*_t0*_t3*_t6
+        + (1/2)*Yp*_t0*_t3*_t6 + (1/2)*Z*_t0*_t3*_t6 + (1/2)*Zp*_t0*_t3*_t6 + (1/2)*_t1*_t5*d
+        - _t27*_t5 - _t28*_t5 - _t36*_t5 - _t37*_t5 - _t39*_t6)
+    _out[1, 7] = (X*_t2 + X*_t8 + Xp*_t2 + Xp*_t8 - Y*_t10 - Yp*_t10 - Z*_t10 - Zp*_t10 - _t16
+        - _t17 + _t18 + _t19 - _t20 + _t27*_t7 + _t28*_t7 - _t29*_t7 + _t36*_t7 + _t37*_t7 + _t39)
+    _out[1, 8] = -_t34
+    _out[2, 0] = _t41
+    _out[2, 1] = _t43
+    _out[2, 2] = _t44
+    _out[2, 3] = _t41
+    _out[2, 4] = _t43
+    _out[2, 5] = _t44
+    _out[2, 6] = -X*_t45 - Xp*_t45 - Y*_t40 - Yp*_t40 - Z*_t40 - Zp*_t40 + (1/2)*_t5*d
+    _out[2, 8] = -_t43
     return _out
 
 

@@ -6,12 +6,12 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9f5664e7e76c63758343031e2e71c38e0cb7e6231fb10646e63c6605339e98de
-derivation sha256  71bd61924bc206d48a0d4baa0a657d290bdb0292966118cf6b6823449d8d4217
+derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
-    derive/volumetric.py, derive/inverse.py, derive/generate.py, derive/codegen.py,
-    derive/linewrap.py, derive/templates/model.py.j2
+    derive/volumetric.py, derive/inverse.py, derive/symbols.py, derive/generate.py,
+    derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2
 
 Units
 -----
@@ -38,6 +38,7 @@ PARAMETER_KIND = {'EXX': 'translational', 'EYX': 'translational', 'EZX': 'transl
     'ECY': 'angular', 'EXZ': 'translational', 'EYZ': 'translational', 'EZZ': 'translational',
     'EAZ': 'angular', 'EBZ': 'angular', 'ECZ': 'angular', 'EA0Z': 'squareness',
     'EB0Z': 'squareness', 'EC0Y': 'squareness'}
+SYMBOLS = ('probe.Xp', 'probe.Yp', 'probe.Zp', 'axis.X', 'axis.Y', 'axis.Z')
 
 
 def volumetric_error(X, Y, Z, Xp, Yp, Zp, EXX, EYX, EZX, EAX, EBX, ECX, EXY, EYY, EZY, EAY, EBY,
@@ -306,6 +307,22 @@ def setup_sensitivity(X, Y, Z, Xp, Yp, Zp):
     _out[2, 8] = 1
     _out[2, 9] = Yp
     _out[2, 10] = -Xp
+    return _out
+
+
+def symbol_sensitivity(X, Y, Z, Xp, Yp, Zp):
+    """d(nominal tool point x, y, z)/d(nominal symbol) in SYMBOLS order (probe offset components,
+    axis positions, layout parameters, frame offsets and angles): array (3, n_symbols, *shape),
+    mm/mm or mm/rad; the first-order error of a change of the symbol's value."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _out = numpy.zeros((3, 6) + _shape)
+    _out[0, 0] = 1
+    _out[0, 3] = 1
+    _out[1, 1] = 1
+    _out[1, 4] = 1
+    _out[2, 2] = 1
+    _out[2, 5] = 1
     return _out
 
 

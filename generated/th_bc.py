@@ -6,12 +6,12 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       f33f383453fd86eb89aede0e8d896e5e1639520405e75ca24882d84376f1d8b8
-derivation sha256  71bd61924bc206d48a0d4baa0a657d290bdb0292966118cf6b6823449d8d4217
+derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
-    derive/volumetric.py, derive/inverse.py, derive/generate.py, derive/codegen.py,
-    derive/linewrap.py, derive/templates/model.py.j2
+    derive/volumetric.py, derive/inverse.py, derive/symbols.py, derive/generate.py,
+    derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2
 
 Units
 -----
@@ -48,6 +48,8 @@ PARAMETER_KIND = {'EXX': 'translational', 'EYX': 'translational', 'EZX': 'transl
     'EB0Z': 'squareness', 'EC0Y': 'squareness', 'EX0B': 'location', 'EZ0B': 'location',
     'EA0B': 'location', 'EC0B': 'location', 'EX0C': 'location', 'EY0C': 'location',
     'EA0C': 'location', 'EB0C': 'location'}
+SYMBOLS = ('probe.Xp', 'probe.Yp', 'probe.Zp', 'axis.X', 'axis.Y', 'axis.Z', 'axis.B', 'axis.C',
+    'param.L')
 L = 200.0
 
 
@@ -873,6 +875,46 @@ def setup_sensitivity(X, Y, Z, B, C, Xp, Yp, Zp):
     _out[2, 9] = Yp*_t0
     _out[2, 10] = -Xp*_t0 - Zp*_t1
     _out[2, 11] = Yp*_t1
+    return _out
+
+
+def symbol_sensitivity(X, Y, Z, B, C, Xp, Yp, Zp):
+    """d(nominal tool point x, y, z)/d(nominal symbol) in SYMBOLS order (probe offset components,
+    axis positions, layout parameters, frame offsets and angles): array (3, n_symbols, *shape),
+    mm/mm or mm/rad; the first-order error of a change of the symbol's value."""
+    _shape = numpy.broadcast_shapes(numpy.shape(X), numpy.shape(Y), numpy.shape(Z),
+        numpy.shape(B), numpy.shape(C), numpy.shape(Xp), numpy.shape(Yp), numpy.shape(Zp))
+    _t0 = numpy.cos(B)
+    _t1 = numpy.cos(C)
+    _t2 = _t0*_t1
+    _t3 = numpy.sin(C)
+    _t4 = -_t3
+    _t5 = numpy.sin(B)
+    _t6 = _t1*_t5
+    _t7 = _t0*_t3
+    _t8 = _t3*_t5
+    _out = numpy.zeros((3, 9) + _shape)
+    _out[0, 0] = _t2
+    _out[0, 1] = _t4
+    _out[0, 2] = _t6
+    _out[0, 3] = _t1
+    _out[0, 4] = _t4
+    _out[0, 6] = -L*_t2 - Xp*_t6 + Zp*_t0*_t1
+    _out[0, 7] = L*_t3*_t5 - X*_t3 - Xp*_t7 - Y*_t1 - Yp*_t1 - Zp*_t8
+    _out[0, 8] = -_t6
+    _out[1, 0] = _t7
+    _out[1, 1] = _t1
+    _out[1, 2] = _t8
+    _out[1, 3] = _t3
+    _out[1, 4] = _t1
+    _out[1, 6] = -L*_t7 - Xp*_t8 + Zp*_t0*_t3
+    _out[1, 7] = -L*_t6 + X*_t1 + Xp*_t0*_t1 - Y*_t3 - Yp*_t3 + Zp*_t1*_t5
+    _out[1, 8] = -_t8
+    _out[2, 0] = -_t5
+    _out[2, 2] = _t0
+    _out[2, 5] = 1
+    _out[2, 6] = L*_t5 - Xp*_t0 - Zp*_t5
+    _out[2, 8] = 1 - _t0
     return _out
 
 

@@ -209,6 +209,18 @@ class Observations:
         s = model.module.setup_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
         return self.project(np.moveaxis(np.broadcast_to(s, (3, 12, self.n)), -1, 0))
 
+    def symbol_sensitivity(self, model) -> np.ndarray:
+        """(N, 3, n_symbols) d(readings)/d(nominal symbol) in ``model.symbols`` order (probe
+        offset components, axis positions, layout parameters, frame offsets and angles; the
+        generated ``symbol_sensitivity``, projected), mm/mm or mm/rad."""
+        names = model.symbols
+        if not names:
+            return np.zeros((self.n, 3, 0))
+        pos = model.positions(self.positions)
+        p = self.probe
+        s = model.module.symbol_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
+        return self.project(np.moveaxis(np.broadcast_to(s, (3, len(names), self.n)), -1, 0))
+
     @property
     def setup_labels(self) -> list:
         """Keys of the set-up columns (``dx`` ... for the default placement)."""

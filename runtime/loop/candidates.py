@@ -9,8 +9,10 @@ propagates through the chain exactly like ``P`` (Abbe arms included).  Written a
 Parameters ``P`` (:func:`targets`): every component error of every axis (modulated as offset +
 slope along its own axis), every squareness and rotary location error, the instrument set-up
 (``work.dx ... work.ez``: the rigid placement of the measuring instrument, workpiece end) and the
-probe / tool offset (``tool.dx tool.dy tool.dz``, tool end), and the probe radius along the
-probing direction.
+probe / tool offset (``tool.dx tool.dy tool.dz``, tool end), the probe radius along the
+probing direction, and the nominal symbols of the chain (:mod:`volerr.loop.symbols`: the probe
+/ tool offset growing along itself, ``param.d``, ``frame.F.x``, the scale of a rotary axis;
+linear or *proportional* to the symbol's own value).
 
 Covariates ``C`` (:func:`covariates`): every numeric data column that is not an axis, probe
 offset or deviation: temperatures (``T``, ``T_C``, ``T_top``, ``temp_X`` ...: basis ``T - 20``)
@@ -40,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import symbols as syms
 from ..estimate.design import Data
 
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
@@ -363,7 +366,7 @@ def _group(model, target: Target, cov: Covariate) -> Candidate:
     terms, units = [], {}
     f, u = (1e6, "urad") if target.angular else (1e3, "um")
     for lv in cov.levels[1:]:
-        tag = _f(lv).replace(".0", "").replace("-", "m").replace(".", "p")
+        tag = _level_tag(lv)
         if target.kind == "setup" and target.chain == "work.dx":
             for k in SETUP_KEYS:
                 pn = f"SU{tag}_{g}_{k.upper()}"
@@ -440,14 +443,67 @@ def _positions(model, target: Target, data: Data, ranges, degree) -> list:
     return out
 
 
+def _level_tag(level: float) -> str:
+    return _f(level).replace(".0", "").replace("-", "m").replace(".", "p")
+
+
+def _symbol(model, t: syms.SymbolTarget, cov: Covariate) -> list:
+    """Candidates of a nominal symbol x a covariate (:mod:`volerr.loop.symbols`): linear (a
+    constant of the chain) or proportional (the probe offset, a rotary axis position) in the
+    covariate, a saturating warm-up in time, one value per level of a run / set-up column;
+    none for an approach direction (a symbol does not reverse)."""
+    if cov.kind not in _KIND or cov.kind == "direction":
+        return []
+    st, ctag = syms.tag(t), _ident(cov.name)
+    info = {"parameter": t.name, "covariate": cov.name, "symbol": t.name,
+            "basis": "proportional" if t.proportional else "linear"}
+    if t.value is not None:
+        info["nominal_value"] = t.value
+    if cov.kind == "group":
+        if len(cov.levels) > 20:
+            return []
+        terms, units = [], {}
+        for lv in cov.levels[1:]:
+            pn = f"GR{_level_tag(lv)}_{ctag}_{st}"
+            terms += t.make_terms(pn, f"ind({cov.name}, {_f(lv)})")
+            units[pn] = syms.unit(t, "1")
+        return [Candidate("group", f"group_{st}_{ctag}", terms,
+                          {**info, "basis": "indicator" if not t.proportional
+                           else "proportional, indicator", "levels": list(cov.levels)},
+                          units=units)]
+    kind = _KIND[cov.kind]
+    pn = f"{_PREFIX[kind]}_{st}_{ctag}"
+    if kind == "thermal":
+        info["reference_C"] = 20.0
+    out = [Candidate(kind, f"{kind}_{st}_{ctag}", t.make_terms(pn, cov.expr), dict(info),
+                     units={pn: syms.unit(t, cov.unit)})]
+    if cov.kind == "time":
+        pw = f"WU_{st}_{ctag}"
+
+        def make(tau, pw=pw, t=t, hours=cov.expr):
+            terms = t.make_terms(pw, f"(1 - exp(-{hours}/{_f(tau)}))")
+            return terms, {"tau_h": round(float(tau), 4)}
+
+        terms, extra = make(TAU_GRID_H[0])
+        out.append(Candidate("drift", f"warmup_{st}_{ctag}", terms,
+                             {**info, "basis": "saturating" if not t.proportional
+                              else "proportional, saturating", **extra},
+                             Search("tau_h", TAU_GRID_H, make), {pw: syms.unit(t, "1")}))
+    return out
+
+
 def build(model, data: Data, ranges: dict, degree: int, covs=None, gauge=()) -> list:
     """All candidates P x C x basis for this layout and these data columns (``gauge``: the
-    (parameter, degree) labels the declared model fixes by convention)."""
+    (parameter, degree) labels the declared model fixes by convention).  P: the declared
+    parameters, the instrument's set-up, the tool end and the chain's nominal symbols
+    (:mod:`volerr.loop.symbols`, whose docstring gives the order and why)."""
     gauge = set(gauge)
     if covs is None:
         covs, _ = covariates(data.covariates, model)
     special = _special_names(model, covs)
     tgts = targets(model)
+    sym_const, sym_var = syms.targets(model, data)
+    ordered = sym_const + sym_var + tgts
     out: list[Candidate] = []
     for cov in covs:
         if cov.kind == "probing_direction":
@@ -457,7 +513,10 @@ def build(model, data: Data, ranges: dict, degree: int, covs=None, gauge=()) -> 
                                   "basis": "linear", "covariates": list(cov.columns)},
                                  units={"PR_R": (1e3, "um")}))
             continue
-        for t in tgts:
+        for t in ordered:
+            if isinstance(t, syms.SymbolTarget):
+                out += _symbol(model, t, cov)
+                continue
             if cov.kind == "group":
                 if t.kind == "setup" and t.chain != "work.dx":
                     continue            # the set-up is one candidate: all six coordinates

@@ -3,7 +3,9 @@ layout, report the error before and after on held-out points.
 
 Steps (:func:`run_loop`):
 
-1. read the measured-deviation CSV (INTERFACE.md) and check it against the layout;
+1. read the measured-deviation CSV (INTERFACE.md) and check it against the layout; refuse a
+   file whose points all stand at one position and readings that determine none of the
+   declared model's parameters (:mod:`volerr.loop.checks`);
 2. hold out a random ``test_fraction`` of the points; everything below is decided on the
    others (the training points) and judged on the held-out ones;
 3. fit the declared model (:mod:`volerr.estimate.design`): component errors as Legendre series, degree by
@@ -42,6 +44,7 @@ import numpy as np
 
 from ..estimate import blocks
 from . import candidates as cands
+from . import checks
 from . import select as sel
 from ..errors import require
 from ..estimate.design import (Data, solve_normal, data_ranges, declared_design, point_norm,
@@ -55,6 +58,7 @@ from ..machine import derivation
 from ..machine.model import Model, load
 
 from .select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
+from .symbols import describe
 
 ROBUST_K = 4.0       # robust sigmas of the 3-D residual length kept at full weight
 OUTLIER_Z = 5.0      # robust sigmas beyond which a point is flagged as an outlier
@@ -392,7 +396,8 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
         ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
         ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)
         effects.append({"kind": c.kind, "name": c.name, "parameters": pars, "units": units,
-                        "std": std, "parameter": info.get("parameter"),
+                        "std": std, "description": describe(aug.model, info, pars, units),
+                        "parameter": info.get("parameter"),
                         "covariate": info.get("covariate"), "basis": info.get("basis"),
                         "target": sorted({t[1] for t in c.terms}), "info": info,
                         "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}
@@ -487,6 +492,7 @@ def _load(layout, data) -> tuple[Model, Data]:
 
 def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, families):
     """Declared fit, robust weights, selection; the degree chosen again with the effects."""
+    checks.determined(model, dat, ranges)
     degree_scores = {}
     if not fixed_degree:
         # robust weights of a preliminary fit first: outliers must not choose the degree
@@ -533,6 +539,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
          families, inputs) -> Report:
     t_start = time.perf_counter()
     model, dat = _load(layout, data)
+    checks.one_position(dat)
     require(folds is None or 2 <= folds <= 20, "folds must be between 2 and 20")
     require(0.05 <= test_fraction <= 0.5, "test fraction must be between 0.05 and 0.5")
     if degree is not None:

@@ -86,8 +86,9 @@ class Base:
 
 @dataclass
 class Context:
-    """What the columns of a candidate need: model, data, sensitivities, twist sensitivities, and the
-    points (``pts``, with their sqrt robust weights ``sw``) on which they are scored."""
+    """What the columns of a candidate need: model, data, sensitivities (of the parameters, of
+    the rigid twists at the two ends, of the nominal symbols), and the points (``pts``, with
+    their sqrt robust weights ``sw``) on which they are scored."""
 
     model: object
     data: object
@@ -97,41 +98,51 @@ class Context:
     sw: np.ndarray
     ranges: dict
     cache: dict = field(default_factory=dict)
+    sym: np.ndarray | None = None   # (N, 3, S) nominal-symbol sensitivity, or None
 
     def on(self, pts, sw) -> "Context":
         """The same context on other points (shares nothing that depends on the points)."""
         return Context(self.model, self.data, self.sens, self.twist, pts, sw, self.ranges,
-                       {"fixed": self.cache.setdefault("fixed", {})})
+                       {"fixed": self.cache.setdefault("fixed", {})}, self.sym)
 
     def values(self, full: bool = False):
+        """Basis variables at the context's points (all when ``full``): axis positions
+        (rotary in rad), covariates and the probe offset components ``Xp Yp Zp`` (mm)."""
         from ..estimate.design import rotary_rad
 
         key = ("_values", full)
         if key not in self.cache:
             idx = slice(None) if full else self.pts
-            vals = {**rotary_rad(self.model, self.data.positions), **self.data.covariates}
+            probe = np.asarray(self.data.probe)
+            vals = {**rotary_rad(self.model, self.data.positions), **self.data.covariates,
+                    "Xp": probe[:, 0], "Yp": probe[:, 1], "Zp": probe[:, 2]}
             self.cache[key] = {k: np.asarray(v)[idx] for k, v in vals.items()}
         return self.cache[key]
 
     def sensitivities(self, idx, slot: str = "_block") -> tuple:
-        """(sensitivity (n, 3, P), twist sensitivity (n, 3, 12)) at the points ``idx``: slices
-        of the full arrays when the context holds them, else generated (kept for the last
-        ``idx`` of each ``slot``)."""
+        """(sensitivity (n, 3, P), twist sensitivity (n, 3, 12), nominal-symbol sensitivity
+        (n, 3, S)) at the points ``idx``: slices of the full arrays when the context holds
+        them, else generated (kept for the last ``idx`` of each ``slot``)."""
         if self.sens is not None:
-            return self.sens[idx], self.twist[idx]
+            sym = (self.sym[idx] if self.sym is not None
+                   else self.data.subset(idx).symbol_sensitivity(self.model))
+            return self.sens[idx], self.twist[idx], sym
         from ..estimate.design import twist_sensitivity
 
         last = self.cache.get(slot)
         if last is not None and np.array_equal(last[0], idx):
             return last[1]
         sub = self.data.subset(idx)
-        out = (sub.sensitivity(self.model), twist_sensitivity(self.model, sub))
+        out = (sub.sensitivity(self.model), twist_sensitivity(self.model, sub),
+               sub.symbol_sensitivity(self.model))
         self.cache[slot] = (np.array(idx), out)
         return out
 
-    def _column(self, target: str, sens, tw) -> np.ndarray:
-        if "." in target:
+    def _column(self, target: str, sens, tw, sym) -> np.ndarray:
+        if target in TWIST:
             return tw[:, :, TWIST[target]]
+        if "." in target:           # a nominal symbol of the chain (probe.Zp, param.d ...)
+            return sym[:, :, self.model.symbols.index(target)]
         return sens[:, :, self.model.parameters.index(target)]
 
     def target_column(self, target: str, full: bool = False) -> np.ndarray:
@@ -170,11 +181,11 @@ class Context:
         """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
         params = list(dict.fromkeys(t[0] for t in terms))
         vals = {k: v[idx] for k, v in self.values(True).items()}
-        sens, tw = self.sensitivities(idx)
+        arrays = self.sensitivities(idx)
         out = np.zeros((len(idx), 3, len(params)))
         for pn, target, basis in terms:
             b = np.broadcast_to(evaluate(basis, vals), (len(idx),))
-            out[:, :, params.index(pn)] += self._column(target, sens, tw) * b[:, None]
+            out[:, :, params.index(pn)] += self._column(target, *arrays) * b[:, None]
         return out
 
     def group(self, terms):
@@ -186,15 +197,18 @@ class Context:
         return (cols * self.sw[:, None, None]).reshape(-1, cols.shape[-1])
 
     def profile_rows(self, c, values) -> np.ndarray:
-        """Weighted rows (3n, G) of a one-term searched candidate at ``values``."""
+        """Weighted rows (3n, G) of a one-parameter searched candidate at ``values`` (its
+        terms summed: a proportional warm-up of the probe offset has three)."""
         key = ("profile", c.name, tuple(values))
         if key not in self.cache:
-            (_, target, _), = c.search.make(values[0])[0]
-            basis = np.column_stack([np.broadcast_to(evaluate(c.search.make(v)[0][0][2],
-                                                              self.values()), (len(self.pts),))
-                                     for v in values])
-            t = self.target_column(target) * self.sw[:, None]          # (n, 3)
-            self.cache[key] = (t[:, :, None] * basis[:, None, :]).reshape(-1, len(values))
+            made = [c.search.make(v)[0] for v in values]
+            n = len(self.pts)
+            cols = np.zeros((n, 3, len(values)))
+            for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
+                basis = np.column_stack([np.broadcast_to(evaluate(m[i][2], self.values()), (n,))
+                                         for m in made])
+                cols += self.target_column(target)[:, :, None] * basis[:, None, :]
+            self.cache[key] = (cols * self.sw[:, None, None]).reshape(-1, len(values))
         return self.cache[key]
 
 

@@ -21,11 +21,17 @@ A layout is a TOML file (shipped ones live in ``volerr/layouts/``).  It declares
   ``probe_direction``, ``setup`` ...), free descriptive keys (``axis``, ``period`` ...), and
   ``terms = [{parameter = "KT_X", target = "EXX", basis = "X*(T_C - 20)"}, ...]``: each term adds
   ``parameter * basis`` to ``target``, a component or location error of an axis (``EXX``,
-  ``EX0C``) or one of the six twist coordinates ``dx dy dz ex ey ez`` of an extra error factor
-  at the workpiece end (``work.dx``: the measuring instrument's placement) or at the tool end
-  (``tool.dx``: the probe) of the chain.  The parameters become error parameters of the model
-  (after all others); names in a basis (:mod:`volerr.machine.expressions`) that are not axes are
-  *covariates*: extra arguments of the generated functions (``T_C``, ``t_s``, ``dir_X`` ...).
+  ``EX0C``), a squareness, one of the six twist coordinates ``dx dy dz ex ey ez`` of an extra
+  error factor at the workpiece end (``work.dx``: the measuring instrument's placement) or at
+  the tool end (``tool.dx``: the probe) of the chain, or a *nominal symbol* of the chain
+  (:attr:`Layout.symbols`: ``probe.Xp probe.Yp probe.Zp`` the probe / tool offset, ``axis.C``
+  an axis position, ``param.d`` a layout parameter, ``frame.F.x|y|z|angle`` a fixed frame's
+  translation or angle; mm or rad), whose value the actual machine has changed by the term
+  (:mod:`volerr.derive.symbols`).  A parameter may appear in several terms of one effect.
+  The parameters become error parameters of the model (after all others); names in a basis
+  (:mod:`volerr.machine.expressions`) that are not axes or the probe offset ``Xp Yp Zp`` (a
+  term proportional to each point's offset, ``Zp*(T - 20)``) are *covariates*: extra arguments
+  of the generated functions (``T_C``, ``t_s``, ``dir_X`` ...).
 
 Sign conventions (ISO 230-1 / ISO 841): every axis ``direction`` is the direction in which the
 tool (probe) moves *relative to the workpiece* for a positive command, whether the tool side
@@ -89,6 +95,12 @@ class Frame:
 
 #: twist coordinates of the extra error factors ``work.*`` / ``tool.*`` of effect terms
 TWIST_KEYS = ("dx", "dy", "dz", "ex", "ey", "ez")
+#: the probe / tool offset components as nominal symbols (effect targets)
+PROBE_SYMBOLS = ("probe.Xp", "probe.Yp", "probe.Zp")
+#: the probe / tool offset components, names usable in an effect basis (a proportional term)
+PROBE_NAMES = ("Xp", "Yp", "Zp")
+#: keys of a fixed frame's nominal symbols: translation components (mm) and angle (rad)
+FRAME_KEYS = ("x", "y", "z", "angle")
 
 
 @dataclass(frozen=True)
@@ -156,11 +168,24 @@ class Layout:
 
     @property
     def covariates(self) -> tuple[str, ...]:
-        """Names in effect bases that are not axes (data columns such as ``T_C``), sorted."""
+        """Names in effect bases that are not axes or probe offsets (data columns such as
+        ``T_C``), sorted."""
         from .expressions import variables
 
         names = {v for e in self.effects for t in e.terms for v in variables(t.basis)}
-        return tuple(sorted(names - set(self.axes) - set(self.parameters)))
+        return tuple(sorted(names - set(self.axes) - set(self.parameters) - set(PROBE_NAMES)))
+
+    @property
+    def symbols(self) -> tuple[str, ...]:
+        """The nominal symbols of the chain, names as effect targets: the probe / tool offset
+        components (``probe.Xp probe.Yp probe.Zp``, mm), the axis positions (``axis.X`` ...,
+        mm or rad), the layout parameters (``param.d`` ..., mm) and the translation components
+        and angle of every fixed frame in the chain (``frame.F.x`` ... mm, ``frame.F.angle``
+        rad), in this order."""
+        frames = [e for e in self.workpiece_chain + self.tool_chain if e in self.frames]
+        return (PROBE_SYMBOLS + tuple(f"axis.{a}" for a in self.axis_names)
+                + tuple(f"param.{p}" for p in sorted(self.parameters))
+                + tuple(f"frame.{f}.{k}" for f in frames for k in FRAME_KEYS))
 
     @property
     def parameter_kind(self) -> dict:
@@ -329,7 +354,8 @@ def parse_layout(text: str, origin: str = "<string>") -> Layout:
     tool, work = _parse_chain(doc.get("chain", {}), axes, frames, where)
     squareness = _parse_squareness(doc.get("squareness", {}), axes, where)
     symbols = {str(k): str(v) for k, v in doc.get("paper_symbols", {}).items()}
-    effects = _parse_effects(doc.get("effects", {}), axes, squareness, params, where)
+    effects = _parse_effects(doc.get("effects", {}), axes, squareness, params, where,
+                             _symbol_targets(axes, frames, tool + work, params))
     return Layout(
         name=name, description=str(doc.get("description", "")), kind=kind, axes=axes,
         frames=frames, tool_chain=tool, workpiece_chain=work, squareness=squareness,
@@ -362,14 +388,23 @@ def _check_expressions(where: str, params: dict, axes: dict, frames: dict) -> No
                              f"(declare it under [parameters])")
 
 
-def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str) -> tuple:
-    """Validate ``[effects.NAME]`` tables -> tuple of :class:`Effect`."""
+def _symbol_targets(axes: dict, frames: dict, chain: tuple, params: dict) -> set:
+    """Nominal symbols an effect term may target (see :attr:`Layout.symbols`)."""
+    out = set(PROBE_SYMBOLS) | {f"axis.{a}" for a in axes} | {f"param.{p}" for p in params}
+    return out | {f"frame.{f}.{k}" for f in chain if f in frames for k in FRAME_KEYS}
+
+
+def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str,
+                   symbols: set = frozenset()) -> tuple:
+    """Validate ``[effects.NAME]`` tables -> tuple of :class:`Effect` (``symbols``: the
+    nominal symbols that may be targets)."""
     from .expressions import variables
 
     require(isinstance(raw, dict), f"{where}: [effects] must be tables [effects.NAME]")
     targets = {n for a in axes.values() for n in a.component_errors + a.location_errors}
     targets |= set(squareness)     # a squareness that varies (with temperature ...)
     targets |= {f"{side}.{k}" for side in ("work", "tool") for k in TWIST_KEYS}
+    targets |= set(symbols)        # a nominal symbol of the chain (param.d, probe.Zp ...)
     builtin = {n for a in axes.values() for n in a.component_errors + a.location_errors}
     builtin |= set(squareness) | set(params) | set(axes) | {"Xp", "Yp", "Zp"}
     seen: dict = {}
@@ -391,7 +426,8 @@ def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str) 
             require(target in targets, f"{where}: effect {en}: unknown target {target!r}")
             for v in variables(basis):
                 require(_NAME.match(v) is not None and v not in builtin - set(axes)
-                        and v not in seen, f"{where}: effect {en}: basis uses {v!r}")
+                        - set(PROBE_NAMES) and v not in seen,
+                        f"{where}: effect {en}: basis uses {v!r}")
             parsed.append(EffectTerm(pn, target, basis))
         info = {k: v for k, v in spec.items() if k not in ("kind", "terms")}
         out.append(Effect(str(en), spec["kind"], tuple(parsed), info))

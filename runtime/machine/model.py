@@ -170,6 +170,15 @@ class Model:
         return tuple(getattr(self.module, "COVARIATES", ()))
 
     @property
+    def symbols(self) -> tuple[str, ...]:
+        """Nominal symbols of the chain (``probe.Zp``, ``axis.C``, ``param.d``, ``frame.F.x``
+        ...; :attr:`volerr.machine.layout.Layout.symbols`) in the order of the generated
+        ``symbol_sensitivity``; () for a module generated before it existed."""
+        if not hasattr(self.module, "symbol_sensitivity"):
+            return ()
+        return tuple(getattr(self.module, "SYMBOLS", ()))
+
+    @property
     def travel(self) -> dict:
         """Axis -> (min, max) travel, mm or deg."""
         return {a: self.layout.axes[a].travel for a in self.axes}

@@ -61,7 +61,7 @@ def _header_field(text: str, key: str) -> str:
     ("three_point.py", ["derive/htm.py", "derive/kinematics.py", "derive/three_point.py"]),
     ("mb1.py", ["runtime/machine/layout.py", "derive/htm.py", "derive/effects.py",
                 "derive/kinematics.py", "derive/volumetric.py", "derive/inverse.py",
-                "derive/generate.py"]),
+                "derive/symbols.py", "derive/generate.py"]),
 ])
 def test_header_records_sympy_version_and_source_hash(module, sources):
     text = (GENERATED / module).read_text(encoding="utf-8")
