@@ -64,6 +64,8 @@ REFUSED_G = {
 }
 REFUSED_G.update({g: f"G{g} canned cycle" for g in range(81, 90)})
 REFUSED_M = {98: "M98 subprogram call", 128: "M128 TCPM (tool centre point control)"}
+#: M functions the interpreter acts on (a line with one of them is interpreted line by line)
+SPECIAL_M = frozenset({98, 128, 129})
 
 
 @dataclass

@@ -21,6 +21,7 @@ which rotary axes it never commands (taken at 0 deg) and how it separates words.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -96,24 +97,23 @@ def prescan(open_source, model, chunk_lines: int = CHUNK_LINES) -> Prescan:
     pats = {a: re.compile(rf"[{a}{a.lower()}][ \t]*[+-]?\.?\d") for a in rot}
     seen = set()
     spaced = None
-    buf = []
     fh = open_source()
     try:
-        for n, seg in enumerate(fh, start=1):
-            if spaced is None:
-                body = seg.rstrip("\r\n")
+        first = 1
+        while True:
+            buf = list(itertools.islice(fh, chunk_lines))
+            for n, seg in enumerate(buf if spaced is None else (), start=first):
                 try:
-                    own = gcode._spaced(gcode._kinds(gcode.Line.parse(n, body, "")))
+                    spaced = gcode._spaced(gcode._kinds(gcode.Line.parse(n, seg.rstrip("\r\n"),
+                                                                         "")))
                 except InputError:
-                    own = None      # reported with its line number by the interpreter
-                spaced = own
-            buf.append(seg)
-            if len(buf) >= chunk_lines:
-                seen |= _letters(buf, pats, seen)
-                buf = []
-                if len(seen) == len(rot) and spaced is not None:
-                    break       # nothing left to learn from the rest of the program
-        seen |= _letters(buf, pats, seen)
+                    pass        # reported with its line number by the interpreter
+                if spaced is not None:
+                    break
+            seen |= _letters(buf, pats, seen)
+            first += len(buf)
+            if len(buf) < chunk_lines or (len(seen) == len(rot) and spaced is not None):
+                break           # the end, or nothing left to learn from the rest
     finally:
         if hasattr(fh, "close"):
             fh.close()
@@ -570,12 +570,11 @@ class _Edits:
             return self._apply_str(text, starts, ends)
         flat = np.concatenate([f for f, _ in new])
         lens = np.concatenate([n for _, n in new])
-        n = len(b)
-        cover = np.cumsum(np.bincount(starts, minlength=n + 1)
-                          - np.bincount(ends, minlength=n + 1))[:n] > 0
+        keep = np.ones(len(b), dtype=bool)
+        keep[chunkscan._spans(starts, ends)] = False
         removed = np.zeros(len(starts), dtype=np.int64)
         np.cumsum((ends - starts)[:-1], out=removed[1:])
-        out = np.insert(b[~cover], np.repeat(starts - removed, lens), flat)
+        out = np.insert(b[keep], np.repeat(starts - removed, lens), flat)
         return out.tobytes().decode("latin-1")
 
     def _apply_str(self, text: str, starts, ends) -> str:
@@ -715,23 +714,17 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         sink.start()
         fh = open_source()
         try:
-            buf = []
             first = 1
-            for seg in fh:
-                buf.append(seg)
-                if len(buf) >= chunk_lines:
-                    chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
-                    summary.add(chunk)
-                    sink.add(chunk)
-                    if progress is not None:
-                        progress(len(buf))
-                    first += len(buf)
-                    buf = []
-            chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
-            summary.add(chunk)
-            sink.add(chunk)
-            if progress is not None:
-                progress(len(buf))
+            while True:
+                buf = list(itertools.islice(fh, chunk_lines))
+                chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
+                summary.add(chunk)
+                sink.add(chunk)
+                if progress is not None:
+                    progress(len(buf))
+                first += len(buf)
+                if len(buf) < chunk_lines:
+                    break
         finally:
             if hasattr(fh, "close"):
                 fh.close()

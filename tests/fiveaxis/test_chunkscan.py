@@ -14,6 +14,7 @@ from test_compensate import write_errors
 
 import volerr
 from volerr.fiveaxis import chunkscan, gcode, program
+from volerr.errors import InputError
 from volerr.fiveaxis.compensate import compensate_program
 from volerr.tables import table as tables
 
@@ -23,32 +24,58 @@ NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 number = st.one_of(
     st.decimals(min_value=-1000, max_value=1000, allow_nan=False, places=4).map(str),
     st.sampled_from(["1.", ".5", "+2", "-0", "+.25", "007", "12.3456789012345678", "1.2.3",
-                     "--1", "+", "."]))
-word = st.tuples(st.sampled_from("XYZBCxyzbNFGMAUS"), st.sampled_from(["", " ", "\t"]), number)
-plain = st.lists(st.tuples(st.sampled_from(["", " ", "  "]), word), min_size=0, max_size=6).map(
-    lambda ws: "".join(sp + a + b + c for sp, (a, b, c) in ws))
+                     "--1", "+", ".", "0", "1", "00", "01", "2", "3", "98", "128", "129.",
+                     "6"]))
+word = st.tuples(st.sampled_from("XYZBCxyzbNFGgMmAUSTHDI"), st.sampled_from(["", " ", "\t"]),
+                 number)
+comment = st.sampled_from(["(cut X1)", "(a;b)", "; fin (x", ";", "()", "(", ")", "(G2 M98)",
+                           "(\u00d810 \u2014)"])
+piece = st.one_of(word.map(lambda w: "".join(w)), comment)
+plain = st.lists(st.tuples(st.sampled_from(["", " ", "  "]), piece), min_size=0,
+                 max_size=6).map(lambda ws: "".join(sp + w for sp, w in ws))
 line = st.one_of(plain, plain.map(lambda s: s + " "), st.sampled_from(
-    ["(comment X1)", "X1 (c)", "%", "G90", "G91", "X1 ; c", "X1 #1", "  "]))
+    ["(comment X1)", "X1 (c)", "%", "G90", "G91", "X1 ; c", "X1 #1", "  ", "/X1", "X(c)1",
+     "G1 X1 (a) Y2 ; b", "N10 G01 X1. F500 S1200 M8 T3"]))
 
 
-@settings(max_examples=200, deadline=None)
+def reference_fast(body: str) -> list | None:
+    """The words of a line the interpreter would read as a plain line (a motion block in the
+    mode in force, or nothing): tokens of the line-by-line tokenizer, G only 0 / 1, M not one
+    the interpreter acts on, no foreign axis, no axis twice; None for any other line."""
+    try:
+        toks = gcode.tokenize(body)
+    except InputError:
+        return None
+    if any(t.kind == "other" for t in toks) and body.strip():
+        return None
+    words = [t for t in toks if t.kind == "word"]
+    axes_ = [t.letter for t in words if t.letter in AXES]
+    if len(set(axes_)) != len(axes_) or any(t.letter in "AU" for t in words):
+        return None
+    for t in words:
+        if t.letter == "G" and t.value not in (0.0, 1.0):
+            return None
+        if t.letter == "M" and round(t.value) in gcode.SPECIAL_M:
+            return None
+    return words
+
+
+@settings(max_examples=300, deadline=None)
 @given(st.lists(st.tuples(line, st.sampled_from(["\n", "\r\n", "\r"])), max_size=8))
 def test_scan_finds_the_plain_lines_and_their_numbers(lines):
     segs = [a + b for a, b in lines]
     sc = chunkscan.scan(segs, AXES)
+    codes = {"T": chunkscan.TRACKED["T"], "H": chunkscan.TRACKED["H"],
+             "D": chunkscan.TRACKED["D"], "G": chunkscan.G_WORD, "M": chunkscan.M_WORD}
     for i, (body, _) in enumerate(lines):
-        simple = gcode._SIMPLE.fullmatch(body) is not None
-        parts = gcode._PARTS.findall(body) if simple else []
-        letters = [p[1].upper() for p in parts]
-        axes_ = [x for x in letters if x in AXES]
-        want_fast = simple and not any(x in "GMAU" for x in letters) and \
-            len(set(axes_)) == len(axes_)
-        assert bool(sc.fast[i]) == want_fast, body
-        if want_fast:
+        words = reference_fast(body)
+        assert bool(sc.fast[i]) == (words is not None), body
+        if words is not None:
             k = sc.line == i
-            assert [AXES[a] if a >= 0 else "?" for a in sc.axis[k]] == \
-                [x if x in AXES else "?" for x in letters]
-            texts = [p[3] for p in parts]
+            words = [t for t in words if t.letter in AXES or t.letter in codes]
+            assert list(sc.axis[k]) == [AXES.index(t.letter) if t.letter in AXES else
+                                        codes[t.letter] for t in words]
+            texts = [body[t.num_start:t.num_end] for t in words]
             assert [sc.text[s:e] for s, e in zip(sc.num_start[k], sc.num_end[k])] == texts
             vals = sc.value[k]
             for t, v in zip(texts, vals):
