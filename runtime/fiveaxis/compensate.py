@@ -229,6 +229,15 @@ class ErrorModel:
         self.lin = linear_axes(model)
         self.ranges = funcs.ranges() if funcs is not None else {}
 
+    def with_tool(self, tool) -> "ErrorModel":
+        """The same model with another tool offset (3,) mm (error values shared)."""
+        import copy
+
+        other = copy.copy(self)
+        other.tool = np.asarray(tool, dtype=float)
+        other.__dict__["_memo"] = self.__dict__.setdefault("_memo", [])
+        return other
+
     def lookup(self, q: np.ndarray) -> np.ndarray:
         """Positions for the error tables: a rotary axis is taken modulo 360 deg where that
         brings it into its table's range (a C table 0..340 serves C = 400)."""
@@ -424,12 +433,10 @@ class _Collect:
                     float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
                     int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))
             else:
-                line, target = b.pending[-1 - o]
-                missing = [a for a in axes if target[a] is None]
+                line, target, missing = b.pending[-1 - o]
                 self.reports.append(LineReport(
                     line.number, dict(target), dict(target), (math.nan,) * 3, (math.nan,) * 3,
-                    math.nan, math.nan, 0,
-                    f"not compensated: position of axis {missing[0]} unknown"))
+                    math.nan, math.nan, 0, f"not compensated: position of {missing} unknown"))
 
 
 def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
