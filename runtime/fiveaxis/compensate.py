@@ -143,6 +143,9 @@ class Result:
     reports: list = field(default_factory=list)
     #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
     assumed_zero: tuple = ()
+    #: what the program held besides straight moves: ``tcpm_blocks`` and ``arcs`` (kept,
+    #: linearised, segments, max_path_deviation_um), as in the streamed summary
+    shapes: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         done = [r for r in self.reports if r.status.startswith("compensated")]
@@ -166,6 +169,7 @@ class Result:
             "max_iterations": max((r.iterations for r in done), default=0),
             "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
                                            if np.all(np.isfinite(r.u_after_um))])),
+            **self.shapes,
         }
 
 
@@ -442,24 +446,31 @@ class _Collect:
 def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
                        strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
                        initial: dict | None = None, check_travel: bool = True,
-                       max_iter: int = 50, types=None, chunk_lines: int | None = None) -> Result:
+                       max_iter: int = 50, types=None, chunk_lines: int | None = None,
+                       arc_tol_um: float = 1.0, tool_length: float | None = None,
+                       tool_table: dict | None = None, dialect: str = "auto") -> Result:
     """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
 
     ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
     that compensates the linear axes only); the report still predicts the error of the full
     model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL).
     ``chunk_lines``: lines per chunk (the output does not depend on it; see
-    :mod:`volerr.fiveaxis.program`, which also streams a program file of any length)."""
+    :mod:`volerr.fiveaxis.program`, which also streams a program file of any length).
+    ``arc_tol_um``: path tolerance of arcs (:mod:`volerr.fiveaxis.arcs`); ``tool_length``
+    (mm) or ``tool_table`` (tool number -> mm): the tool length of TCPM blocks
+    (:mod:`volerr.fiveaxis.tcpm`); ``dialect``: "auto", "iso" or "heidenhain"."""
     import io
 
     from . import program
 
     opts = program.Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
-                           check_travel, max_iter, None if types is None else tuple(types))
+                           check_travel, max_iter, None if types is None else tuple(types),
+                           arc_tol_um, tool_length, tool_table, dialect)
     sink = _Collect(model)
-    _, never = program.run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
+    s, never = program.run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
                            chunk_lines or program.CHUNK_LINES)
-    return Result("".join(sink.text), sink.reports, never)
+    return Result("".join(sink.text), sink.reports, never,
+                  {k: s[k] for k in ("tcpm_blocks", "arcs")})
 
 
 def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
