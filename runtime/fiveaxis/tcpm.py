@@ -57,10 +57,11 @@ def linear_from_tip(model, tip: np.ndarray, rot_deg: np.ndarray, length) -> np.n
 
 def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray) -> np.ndarray:
     """Rotary positions (N, 2) deg for the tool vectors ``vector`` (N, 3), continuing from the
-    rotary positions ``previous`` (2,) deg held before the first row: the branch of the two
-    solutions nearest the previous row's, each axis turned to the representative nearest its
-    previous value; an axis undetermined on a singular orientation keeps its previous value.
-    Raises :class:`InputError` (row index in the message) for an unreachable orientation."""
+    rotary positions ``previous`` (2,) deg held before the first row, block by block as a
+    controller does: of the two solutions, each turned (multiples of 360 deg) to the value
+    nearest the previous block's, the one inside the travel and nearest the previous block;
+    an axis undetermined on a singular orientation keeps its previous value.  Raises
+    :class:`InputError` (row index in the message) for an unreachable orientation."""
     n = len(vector)
     if not n:
         return np.zeros((0, 2))
@@ -73,38 +74,38 @@ def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray) -> np.nd
     bad = ~np.all(np.isfinite(cand), axis=(0, 2))
     if bad.any():
         raise InputError(f"row {int(np.argmax(bad))}: tool orientation unreachable")
-    # undetermined axis (singular orientation): NaN here, filled with the previous value
     rot = model.rotary_axes
     for b in range(2):
         for j, a in enumerate(rot):
             sens = _axis_sensitivity(model, {rot[0]: cand[b, :, 0], rot[1]: cand[b, :, 1]}, a)
             cand[b, sens < 1e-9, j] = np.nan
-
-    def dist(x, y):
-        d = np.abs((x - y + 180.0) % 360.0 - 180.0)
-        return np.nansum(d, axis=-1)
-
-    # the branch continues the previous row's: swap where crossing is nearer
-    prev0 = np.where(np.isnan(cand[0, :1]), previous, cand[0, :1])
-    prev1 = np.where(np.isnan(cand[1, :1]), previous, cand[1, :1])
-    first = 0 if dist(prev0, previous[None])[0] <= dist(prev1, previous[None])[0] else 1
-    same = dist(cand[0, 1:], cand[0, :-1]) + dist(cand[1, 1:], cand[1, :-1])
-    cross = dist(cand[0, 1:], cand[1, :-1]) + dist(cand[1, 1:], cand[0, :-1])
-    parity = np.concatenate([[0], np.cumsum(cross < same)]) % 2
-    pick = (first + parity) % 2
-    chosen = np.where(pick[:, None] == 0, cand[0], cand[1])
-    # undetermined: the previous value (forward fill); then the turns, step by step
-    out = np.empty_like(chosen)
-    for j in range(2):
-        v = chosen[:, j]
-        known = ~np.isnan(v)
-        idx = np.where(known, np.arange(n), -1)
-        np.maximum.accumulate(idx, out=idx)
-        filled = np.where(idx >= 0, v[np.maximum(idx, 0)], np.nan)
-        steps = np.diff(np.concatenate([[previous[j]], np.where(np.isnan(filled),
-                                                                 previous[j], filled)]))
-        steps = (steps + 180.0) % 360.0 - 180.0
-        out[:, j] = previous[j] + np.cumsum(steps)
+    lo = [model.travel[a][0] - 1e-9 for a in rot]
+    hi = [model.travel[a][1] + 1e-9 for a in rot]
+    out = np.empty((n, 2))
+    prev = [float(previous[0]), float(previous[1])]
+    c = cand.tolist()
+    for i in range(n):
+        best, best_score = None, None
+        for b in (0, 1):
+            v, inside, dist = [], True, 0.0
+            for j in (0, 1):
+                x = c[b][i][j]
+                if x != x:
+                    x = prev[j]                                 # undetermined: stays
+                x = prev[j] + (x - prev[j] + 180.0) % 360.0 - 180.0
+                for turn in (0.0, 360.0, -360.0):
+                    if lo[j] <= x + turn <= hi[j]:
+                        x += turn
+                        break
+                else:
+                    inside = False
+                v.append(x)
+                dist += abs(x - prev[j])
+            score = dist + (0.0 if inside else 1e6)
+            if best_score is None or score < best_score:
+                best, best_score = v, score
+        out[i] = best
+        prev = best
     return out
 
 
@@ -179,4 +180,31 @@ def length_rule(tool_length: float | None = None, table: dict | None = None):
         raise InputError(f"{where}: TCPM with no T / H / D word before it: the tool length "
                          "is unknown (give --tool-length)")
     return rule
+
+
+def read_tool_table(path) -> dict:
+    """A tool table CSV ``tool,length_mm`` (tool number, tool length in mm; other columns
+    ignored) -> {tool number: mm}."""
+    from ..fileio import read_csv_rows
+    from ..units import parse_number
+
+    rows = read_csv_rows(path, missing=f"tool table not found: {path}",
+                         empty=f"{path}: empty tool table")
+    header = [h.lower() for h in rows[0][1]]
+    require("tool" in header and "length_mm" in header,
+            f"{path}: a tool table needs the columns tool,length_mm (got {','.join(header)})")
+    it, il = header.index("tool"), header.index("length_mm")
+    out = {}
+    for lineno, cells in rows[1:]:
+        require(len(cells) == len(header), f"{path}:{lineno}: {len(cells)} fields, header "
+                                           f"has {len(header)}")
+        t = parse_number(cells[it], f"{path}:{lineno}", "tool")
+        key = int(t) if float(t).is_integer() else t
+        require(key not in out, f"{path}:{lineno}: tool {key:g} given twice")
+        length = parse_number(cells[il], f"{path}:{lineno}", "length_mm")
+        require(0 <= length <= 2000, f"{path}:{lineno}: tool length {length:g} mm is not "
+                                     "plausible (0 .. 2000 mm)")
+        out[key] = length
+    require(out, f"{path}: no tools in the tool table")
+    return out
 
