@@ -213,11 +213,16 @@ class ArcResult:
                 f"{self.deviation_um:.3g} um)")
 
 
-def compensate(em, paths: list, solve, tol_mm: float, keep: bool = True) -> list:
-    """:class:`ArcResult` of every :class:`ArcPath` in ``paths``.  ``solve(q)`` -> the
-    compensated positions (k, n_axes) of nominal positions ``q`` (the same rule as for every
-    block); ``em`` the :class:`volerr.fiveaxis.compensate.ErrorModel` (predicted actual tool
-    tip); ``tol_mm`` the tolerance; ``keep=False``: always linearise."""
+def compensate(em, paths: list, solve, tol_mm: float, keep: bool = True,
+               start_dirs=None) -> list:
+    """:class:`ArcResult` of every :class:`ArcPath` in ``paths``.  ``solve(q, direction)`` ->
+    the compensated positions (k, n_axes) of nominal positions ``q`` approached in
+    ``direction`` (None without reversal; the same rule as for every block); ``em`` the
+    :class:`volerr.fiveaxis.compensate.ErrorModel` (predicted actual tool tip); ``tol_mm``
+    the tolerance; ``keep=False``: always linearise; ``start_dirs``: per arc the approach
+    directions (n_axes,) before it (None: no reversal), the points along the arc approached
+    as the arc moves through them (:mod:`volerr.fiveaxis.reversal`)."""
+    from .reversal import along
     out = [None] * len(paths)
     if not paths:
         return out
@@ -227,24 +232,32 @@ def compensate(em, paths: list, solve, tol_mm: float, keep: bool = True) -> list
     for rnd in range(MAX_REFINE + 1):
         # the compensated points of every arc still to decide, in one solve
         ts = [np.linspace(0.0, 1.0, n_seg[i] + 1) for i in todo]
-        q_nom = np.concatenate([paths[i].points(t) for i, t in zip(todo, ts)])
-        q_c = solve(q_nom)
+        pts = [paths[i].points(t) for i, t in zip(todo, ts)]
+        q_nom = np.concatenate(pts)
+        dirs = None
+        if start_dirs is not None:
+            dirs = np.concatenate([
+                along(np.vstack([np.zeros((1, p.shape[1]), np.int8),
+                                 np.sign(np.diff(p, axis=0)).astype(np.int8)]),
+                      np.asarray(start_dirs[i], np.int8)) for i, p in zip(todo, pts)])
+        q_c = solve(q_nom, dirs)
         corr = q_c - q_nom
         # the predicted tool tip between the points: straight moves in axis space
-        mids, owner = [], []
+        mids, mid_dirs, owner = [], [], []
         at = 0
-        spans = []
         for i, t in zip(todo, ts):
             k = len(t)
             a, b = q_c[at:at + k - 1], q_c[at + 1:at + k]
             for f in CHECK_AT:
                 mids.append(a + f * (b - a))
+                if dirs is not None:
+                    mid_dirs.append(dirs[at + 1:at + k])   # a segment moves as its end
             owner.append((i, at, k))
-            spans.append(len(t) - 1)
             at += k
         # mids: for each arc, len(CHECK_AT) blocks of (k - 1) rows
         mid = np.concatenate(mids)
-        tip_dev = _path_deviation(em, mid, paths, owner, lin)
+        tip_dev = _path_deviation(em, mid, paths, owner, lin,
+                                  np.concatenate(mid_dirs) if dirs is not None else None)
         again = []
         pos = 0
         for (i, at0, k) in owner:
@@ -270,14 +283,14 @@ def compensate(em, paths: list, solve, tol_mm: float, keep: bool = True) -> list
     return out
 
 
-def _path_deviation(em, q_mid: np.ndarray, paths, owner, lin) -> np.ndarray:
+def _path_deviation(em, q_mid: np.ndarray, paths, owner, lin, direction=None) -> np.ndarray:
     """Distance (mm) of the predicted actual tool tip at the axis positions ``q_mid`` from
     the nominal arc of their owner: the actual tip mapped back into axis space through the
     nominal kinematics (affine in the linear axes for fixed rotary positions)."""
     from .kinematics import linear_jacobian
 
     m = em.model
-    actual = m.nominal_position(q_mid, em.tool) + em.position_error(q_mid)
+    actual = m.nominal_position(q_mid, em.tool) + em.position_error(q_mid, None, direction)
     # axis positions whose nominal tip is the actual tip: one Newton step is exact (affine)
     jac = linear_jacobian(m, q_mid, em.tool)
     q_back = q_mid.copy()

@@ -174,7 +174,9 @@ class Blocks:
     ``nd`` (n, n_axes + 3) decimals to write (never fewer than the programmed word had);
     ``frame`` (n,) :data:`volerr.fiveaxis.tcpm.AXES` / ``ANGLES`` / ``VECTOR``; ``length``
     (n,) the tool length of TCPM rows (NaN elsewhere), mm; ``arcs`` row -> the
-    :class:`~volerr.fiveaxis.arcs.ArcPath` of an arc block."""
+    :class:`~volerr.fiveaxis.arcs.ArcPath` of an arc block; ``direction`` (n, n_axes) the
+    approach directions (:mod:`volerr.fiveaxis.reversal`) when the tables carry a reversal,
+    else None."""
 
     segs: list
     first: int
@@ -193,6 +195,14 @@ class Blocks:
     frame: np.ndarray = None
     length: np.ndarray = None
     arcs: dict = field(default_factory=dict)
+    direction: np.ndarray | None = None
+    dir_before: np.ndarray | None = None
+    #: the approach directions of the program as read (its own moves), for "before"
+    dir_program: np.ndarray | None = None
+
+    def dir(self, rows):
+        """The directions of ``rows`` (None without reversal)."""
+        return None if self.direction is None else self.direction[rows]
 
     def line(self, i: int) -> gcode.Line:
         """Line ``i`` of the chunk, parsed."""
@@ -410,16 +420,19 @@ def tool_groups(em, blocks: Blocks, opts: Options) -> list:
     return out
 
 
-def solve_positions(em, q_nom: np.ndarray, opts: Options) -> Solution:
-    """The compensation of the positions ``q_nom`` (one tool offset: ``em``'s)."""
+def solve_positions(em, q_nom: np.ndarray, opts: Options, direction=None) -> Solution:
+    """The compensation of the positions ``q_nom`` (one tool offset: ``em``'s; ``direction``
+    the approach directions of the rows, or None)."""
     from .compensate import solve, solve_thesis
 
     n = len(q_nom)
     if not n:
         return Solution(q_nom.copy(), np.zeros(0, dtype=int), np.zeros(0, dtype=bool))
     if opts.strategy == "thesis":
-        return Solution(solve_thesis(em, q_nom), np.ones(n, dtype=int), np.zeros(n, dtype=bool))
-    q, it, lim = solve(em, q_nom, opts.orientation, opts.tol_um * 1e-3, opts.max_iter)
+        return Solution(solve_thesis(em, q_nom, direction), np.ones(n, dtype=int),
+                        np.zeros(n, dtype=bool))
+    q, it, lim = solve(em, q_nom, opts.orientation, opts.tol_um * 1e-3, opts.max_iter,
+                       direction)
     return Solution(q, it, lim)
 
 
@@ -429,7 +442,7 @@ def solve_blocks(em, blocks: Blocks, opts: Options) -> Solution:
     n = len(q_nom)
     sol = Solution(q_nom.copy(), np.zeros(n, dtype=int), np.zeros(n, dtype=bool))
     for g_em, rows in tool_groups(em, blocks, opts):
-        part = solve_positions(g_em, q_nom[rows], opts)
+        part = solve_positions(g_em, q_nom[rows], opts, blocks.dir(rows))
         sol.q[rows], sol.iterations[rows], sol.limited[rows] = part.q, part.iterations, \
             part.limited
     return sol
@@ -457,7 +470,7 @@ def _keep_or_round(v: np.ndarray, programmed: np.ndarray, nd: np.ndarray) -> np.
 
 
 def round_axes(em, q_nom: np.ndarray, q_c: np.ndarray, nd: np.ndarray,
-               opts: Options) -> np.ndarray:
+               opts: Options, direction=None) -> np.ndarray:
     """Axis positions as written: rotary values rounded first, the linear axes solved again
     for them (orientation), then rounded; a value equal to the programmed one is kept."""
     from .compensate import resolve_linear
@@ -471,14 +484,14 @@ def round_axes(em, q_nom: np.ndarray, q_c: np.ndarray, nd: np.ndarray,
     for j in rot_idx:
         q_out[:, j] = _keep_or_round(q_c[:, j], q_nom[:, j], nd[:, j])
     if opts.orientation and not np.array_equal(q_out[:, rot_idx], q_c[:, rot_idx]):
-        q_out = resolve_linear(em, q_nom, q_out, opts.tol_um * 1e-3, opts.max_iter)
+        q_out = resolve_linear(em, q_nom, q_out, opts.tol_um * 1e-3, opts.max_iter, direction)
     for j in lin_idx:
         q_out[:, j] = _keep_or_round(q_out[:, j], q_nom[:, j], nd[:, j])
     return q_out
 
 
 def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np.ndarray,
-               frame: np.ndarray, length: np.ndarray, opts: Options):
+               frame: np.ndarray, length: np.ndarray, opts: Options, direction=None):
     """TCPM rows as written -> (words (n, n_axes + 3), axis positions the controller's inverse
     gives for them).  The orientation words (angles, or the tool vector) are the programmed
     ones unless the orientation is compensated, then those of the corrected axes, rounded;
@@ -515,7 +528,8 @@ def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np
     moved = ~np.all(q_rot[:, rot_idx] == q_c[:, rot_idx], axis=1)
     if moved.any():
         q_rot[moved] = resolve_linear(em, q_nom[moved], q_rot[moved], opts.tol_um * 1e-3,
-                                      opts.max_iter)
+                                      opts.max_iter,
+                                      None if direction is None else direction[moved])
     tip = tcpm.words_from_axes(model, q_rot, length)[:, lin_idx]
     for k, j in enumerate(lin_idx):
         w_out[:, j] = _keep_or_round(tip[:, k], w_nom[:, j], nd[:, j])
@@ -537,12 +551,13 @@ def round_positions(em, blocks: Blocks, sol: Solution, opts: Options):
     for g_em, rows in tool_groups(em, b, opts):
         fr = b.frame[rows]
         if isinstance(rows, slice) or (fr == AXES).all():
-            q_out[rows] = round_axes(g_em, b.q_nom[rows], sol.q[rows], b.nd[rows, :nax], opts)
+            q_out[rows] = round_axes(g_em, b.q_nom[rows], sol.q[rows], b.nd[rows, :nax], opts,
+                                     b.dir(rows))
             w_out[rows, :nax] = q_out[rows]
         else:
             w_out[rows], q_out[rows] = round_tcpm(g_em, b.q_nom[rows], b.w_nom[rows],
                                                   sol.q[rows], b.nd[rows], fr, b.length[rows],
-                                                  opts)
+                                                  opts, b.dir(rows))
     return w_out, q_out
 
 
@@ -560,8 +575,12 @@ def compensate_arcs(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> dic
     rows = sorted(b.arcs)
     paths = [b.arcs[r] for r in rows]
     nax = len(em.model.axes)
-    results = arcs.compensate(em, paths, lambda q: solve_positions(em, q, opts).q,
-                              opts.arc_tol_um * 1e-3, keep=not opts.orientation)
+    starts = None
+    if b.direction is not None:
+        starts = [b.direction[r - 1] if r > 0 else b.dir_before for r in rows]
+    results = arcs.compensate(em, paths, lambda q, d: solve_positions(em, q, opts, d).q,
+                              opts.arc_tol_um * 1e-3, keep=not opts.orientation,
+                              start_dirs=starts)
     out = {}
     for r, path, res in zip(rows, paths, results):
         if not res.kept:
@@ -586,21 +605,25 @@ class Prediction:
     u_after_um: np.ndarray
 
 
-def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray) -> Prediction:
-    """Predicted errors of the positions ``q_nom`` (programmed) and ``q_out`` (written), with
-    ``em``'s tool offset."""
+def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray, direction=None,
+                      direction_before=None) -> Prediction:
+    """Predicted errors of the positions ``q_nom`` (programmed, approached in
+    ``direction_before``) and ``q_out`` (written, approached in ``direction``), with ``em``'s
+    tool offset (directions None: no reversal)."""
     model, tool, funcs = em.model, em.tool, em.funcs
     n = len(q_nom)
     if not n:
         z = np.zeros((0, 3))
         return Prediction(z, z, np.zeros(0), np.zeros(0), z)
     target = model.nominal_position(q_nom, tool)
-    before = em.position_error(q_nom) * 1e3
-    after = (model.nominal_position(q_out, tool) + em.position_error(q_out) - target) * 1e3
+    d, d0 = direction, direction_before
+    before = em.position_error(q_nom, None, d0) * 1e3
+    after = (model.nominal_position(q_out, tool) + em.position_error(q_out, None, d)
+             - target) * 1e3
     if model.rotary_axes:
         k_nom = em.tool_axis(q_nom)
-        ob = np.linalg.norm(em.orientation_error(q_nom), axis=1) * 1e6
-        k_after = em.tool_axis(q_out) + em.orientation_error(q_out)
+        ob = np.linalg.norm(em.orientation_error(q_nom, None, d0), axis=1) * 1e6
+        k_after = em.tool_axis(q_out) + em.orientation_error(q_out, None, d)
         oa = np.linalg.norm(k_after - k_nom, axis=1) * 1e6
     else:
         ob = oa = np.zeros(n)
@@ -614,12 +637,15 @@ def predict(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> Prediction:
     """:func:`predict_positions` of every row, with the tool offset of its group."""
     groups = tool_groups(em, blocks, opts)
     if len(groups) == 1 and isinstance(groups[0][1], slice):
-        return predict_positions(em, blocks.q_nom, q_out)
+        return predict_positions(em, blocks.q_nom, q_out, blocks.direction,
+                                 blocks.dir_program)
     n = len(q_out)
     p = Prediction(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
                    np.full((n, 3), math.nan))
     for g_em, rows in groups:
-        part = predict_positions(g_em, blocks.q_nom[rows], q_out[rows])
+        part = predict_positions(g_em, blocks.q_nom[rows], q_out[rows], blocks.dir(rows),
+                                 None if blocks.dir_program is None else
+                                 blocks.dir_program[rows])
         for f in ("before_um", "after_um", "orientation_before_urad",
                   "orientation_after_urad", "u_after_um"):
             getattr(p, f)[rows] = getattr(part, f)
@@ -733,6 +759,7 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     known although its letter appears (e.g. only in a G28 block), which the prescan cannot
     tell.  ``progress(n_lines)`` is called after every chunk."""
     from .compensate import ErrorModel, parameters_for_types
+    from .reversal import Directions
     from .tcpm import length_rule
     from .writer import Writer
 
@@ -747,6 +774,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         written = gcode.ControllerState(model.axes, initial, interp.state.linear)
         writer = Writer(written, model.axes, pre.spaced,
                         plus="+" if getattr(pre.dialect, "signed", False) else "")
+        directions = Directions(len(model.axes)) if funcs is not None and \
+            funcs.has_reversal else None
         known = set(initial)
         summary = Summary()
         sink.start()
@@ -755,7 +784,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
             first = 1
             while True:
                 buf = list(itertools.islice(fh, chunk_lines))
-                chunk = _run_chunk(buf, first, interp, writer, em, opts, known, pre.dialect)
+                chunk = _run_chunk(buf, first, interp, writer, em, opts, known, pre.dialect,
+                                   directions)
                 summary.add(chunk)
                 sink.add(chunk)
                 if progress is not None:
@@ -772,19 +802,51 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         never = tuple(a for a in model.rotary_axes if a in never or a in late)
 
 
-def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None) -> Chunk:
+def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None,
+               directions=None) -> Chunk:
     model = em.model
     b = interpret(segs, first, interp, model, opts.decimals, dialect)
     known |= b.known_rotary
+    if directions is not None:
+        b.dir_before = directions.last_dir.copy()
+        b.direction = b.dir_program = directions.rows(b.q_nom)
     check_positions(b, em, opts)
     sol = solve_blocks(em, b, opts)
     w_out, q_out = round_positions(em, b, sol, opts)
+    if directions is not None:
+        b.direction, q_out, w_out = _settle(em, b, sol, w_out, q_out, opts, directions)
     arc_res = compensate_arcs(em, b, q_out, opts)
     pred = predict(em, b, q_out, opts)
     if interp.vector_words is not None:
         writer.vector_words = interp.vector_words
     text = writer.chunk(b, w_out, arc_res)
     return Chunk(b, sol, q_out, pred, text, opts.strategy, w_out, arc_res)
+
+
+def _settle(em, b: Blocks, sol: Solution, w_out, q_out, opts, directions):
+    """The approach directions settled with the moves as written
+    (:func:`volerr.fiveaxis.reversal.settle`): rows compensated again where a written move
+    goes the other way than assumed."""
+    import dataclasses
+
+    from .reversal import settle
+
+    mask = np.array([a in em.funcs.reversal_functions for a in em.model.axes])
+
+    def redo(rows, d):
+        sub = dataclasses.replace(b, q_nom=b.q_nom[rows], w_nom=b.w_nom[rows], nd=b.nd[rows],
+                                  frame=b.frame[rows], length=b.length[rows], direction=d,
+                                  arcs={})
+        s = solve_blocks(em, sub, opts)
+        w, q = round_positions(em, sub, s, opts)
+        sol.q[rows], sol.iterations[rows], sol.limited[rows] = s.q, s.iterations, s.limited
+        w_out[rows] = w
+        return q
+
+    d, q, held = settle(directions, b.direction, q_out, redo, mask)
+    for r, j in held:
+        w_out[r, j] = q[r, j] if b.frame[r] == 0 else w_out[r, j]
+    return d, q, w_out
 
 
 # ---------------------------------------------------------------------------------------
