@@ -31,6 +31,12 @@ def register(sub) -> None:
     p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
     p.add_argument("--out", required=True, help="PNG file")
     p.add_argument("--csv", help="grid as CSV")
+    p.add_argument("--approach", default=None, metavar="DIRS",
+                   help="approach direction of linear axes whose tables carry a reversal "
+                        "column RV_<axis>_um: X+,Y- per axis, + / - for all, or sweep (the "
+                        "grid run row by row with the first rotary axis rising, each axis "
+                        "approaching in the direction it moves; default: the bidirectional "
+                        "mean)")
     p.set_defaults(func=run)
 
 
@@ -56,7 +62,14 @@ def run(args) -> int:
                                    args.extrapolate)
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
     outs = Outputs(inputs).plot("--out", args.out).file("--csv", args.csv).check()
-    tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps)
+    from ..tables.functions import parse_approach
+    from ._common import progress_bar
+
+    approach = "sweep" if args.approach == "sweep" else \
+        parse_approach(args.approach, model, funcs)
+    with progress_bar(None, "tcpmap", total=args.steps * args.steps, unit="points") as tick:
+        tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps,
+                       approach=approach, progress=tick)
     a1, a2, q1, q2, err, valid = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err, tmap.valid
     require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
                          "for every rotary position")

@@ -310,3 +310,35 @@ class ErrorFunctions:
         out = self._grouped(cols, n, std=True)
         out.update({k: np.full(n, v) for k, v in self.constants_std.items()})
         return out
+
+
+def parse_approach(spec, model, funcs=None) -> dict:
+    """Approach directions given on a command line -> {axis: +1 | -1}: ``"X+,Y-"`` per axis,
+    or ``"+"`` / ``"-"`` for every axis whose table has a reversal (``funcs``); None or ""
+    -> {} (the bidirectional mean).  Only linear axes of ``model``."""
+    if not spec:
+        return {}
+    spec = spec.replace(" ", "")
+    if spec in ("+", "-"):
+        require(funcs is not None and funcs.has_reversal,
+                "--approach: no error table has a reversal column (RV_<axis>_um)")
+        return {a: (1 if spec == "+" else -1) for a in funcs.reversal_functions}
+    out = {}
+    lin = [a for a in model.axes if a not in model.rotary_axes]
+    for part in filter(None, spec.split(",")):
+        require(len(part) == 2 and part[1] in "+-",
+                f"--approach: expected AXIS+ or AXIS- (e.g. X+,Y-), got {part!r}")
+        a = part[0].upper()
+        require(a in lin, f"--approach: {a} is not a linear axis of {model.name} "
+                          f"({' '.join(lin)})")
+        out[a] = 1 if part[1] == "+" else -1
+    return out
+
+
+def approach_array(approach: dict, axes, n: int) -> np.ndarray:
+    """(n, len(axes)) directions from {axis: +1 | -1} (0 elsewhere)."""
+    d = np.zeros((n, len(axes)))
+    for a, v in approach.items():
+        d[:, list(axes).index(a)] = v
+    return d
+

@@ -103,3 +103,42 @@ def test_reversal_needs_a_linear_axis_with_its_positioning_error(tmp_path):
     t = ErrorTable("C", [0.0, 90.0], {"EXC": [0.0, 1e-3]}, reversal=[1e-3, 1e-3])
     with pytest.raises(volerr.errors.InputError, match="RV_C needs a linear axis"):
         ErrorFunctions({"C": t}, {}, m)
+
+
+def test_map_and_tcpmap_use_the_approach_direction(tmp_path):
+    """A positioning error EXX is a translation along X: approaching in + instead of - moves
+    the tip by B_i(x) along X (map of a CMM: in dx; tcp map of a five-axis machine: by
+    |B_i| whatever the rotary axes do to the direction)."""
+    from volerr.cmm.volmap import volumetric_map
+    from volerr.fiveaxis.tcpmap import tcp_map
+    from volerr.tables.functions import parse_approach
+
+    cmm = volerr.load("MB1")
+    lo, hi = cmm.travel["X"]
+    x = np.linspace(lo, hi, 7)
+    rv = -5e-3 + 2e-3 * np.cos(x / 100.0)
+    t = ErrorTable("X", x, {"EXX": 1e-3 * np.sin(x / 50.0)}, reversal=rv)
+    funcs = ErrorFunctions({"X": t}, {}, cmm)
+    plus = volumetric_map(cmm, funcs, 4, approach=parse_approach("X+", cmm, funcs))
+    minus = volumetric_map(cmm, funcs, 4, approach=parse_approach("-", cmm, funcs))
+    mean = volumetric_map(cmm, funcs, 4)
+    xs = plus.positions["X"]
+    assert np.allclose(plus.error[:, 0] - minus.error[:, 0], np.interp(xs, x, rv), atol=1e-12)
+    assert np.allclose(plus.error + minus.error, 2 * mean.error, atol=1e-12)
+    m = volerr.load("DMU50")
+    lo, hi = m.travel["X"]
+    x = np.linspace(lo, hi, 9)
+    rv = -6e-3 + 0 * x
+    funcs = ErrorFunctions({"X": ErrorTable("X", x, {"EXX": 0 * x}, reversal=rv)}, {}, m)
+    a = tcp_map(m, funcs, (10, 20, 30), (0, 0, -100), 9, 9, approach={"X": 1})
+    b = tcp_map(m, funcs, (10, 20, 30), (0, 0, -100), 9, 9, approach={"X": -1})
+    s = tcp_map(m, funcs, (10, 20, 30), (0, 0, -100), 9, 9, approach="sweep")
+    ok = a.valid
+    assert ok.sum() > 20
+    assert np.allclose(np.linalg.norm(a.err - b.err, axis=2)[ok], 6e-3, atol=1e-9)
+    # the sweep: every point is one of the two, by the sign of X's move along its row
+    X = a.linear[..., 0]
+    step = np.diff(X, axis=1)
+    sign = np.sign(np.concatenate([step[:, :1], step], axis=1))
+    want = np.where(sign[..., None] > 0, a.err, b.err)
+    assert np.allclose(s.err[ok], want[ok], atol=1e-12)
