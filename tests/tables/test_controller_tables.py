@@ -173,7 +173,7 @@ def test_cli_export_json_plot_and_import(setup, tmp_path):
                         "--errors", str(d), "--format", "fanuc", "--out",
                         str(tmp_path / "f.txt"), "--points", "500"],
                        capture_output=True, text=True)
-    assert r.returncode == 2 and "at most" in r.stderr.split(": ", 1)[-1] and \
+    assert r.returncode == 2 and "2 .. 128 for fanuc" in r.stderr and \
         len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert not (tmp_path / "f.txt").exists()
 
