@@ -106,7 +106,7 @@ def _spans(s: np.ndarray, e: np.ndarray) -> np.ndarray:
     return np.arange(total, dtype=np.int64) + off
 
 
-def _comments(b: np.ndarray, cls: np.ndarray, start: np.ndarray, body_end: np.ndarray, lid: np.ndarray,
+def _comments(b: np.ndarray, cls: np.ndarray, start: np.ndarray, body_end: np.ndarray, lid,
               bad: np.ndarray) -> None:
     """Comments ``( ... )`` and ``;`` to the end of the line, as the tokenizer reads them: the
     first byte of each becomes a separator (a word cannot run through it), the others blanks;
@@ -117,7 +117,7 @@ def _comments(b: np.ndarray, cls: np.ndarray, start: np.ndarray, body_end: np.nd
     if not len(opens):
         return
     closes = np.flatnonzero(cls == _CLOSE)
-    lines = lid[opens]                       # sorted: keep the first of each line
+    lines = lid(opens)                       # sorted: keep the first of each line
     lines = lines[np.r_[True, lines[1:] != lines[:-1]]]
     pos = start[lines]
     s_all, e_all = [], []
@@ -158,7 +158,11 @@ def scan(segs: list, axes) -> Scan:
     raw = text.encode("latin-1", "replace")
     b = np.frombuffer(raw, dtype=np.uint8)
     cls = np.frombuffer(bytearray(raw.translate(_TRANSLATE)), dtype=np.int8)
-    lid = np.repeat(np.arange(n, dtype=np.int32), lens)
+
+    def lid(pos):
+        """The line of byte positions ``pos``."""
+        return np.searchsorted(start, pos, side="right") - 1
+
     bad = np.zeros(n, dtype=bool)
     # the body of a line ends where its ending (CRLF, LF or CR: the only CR / LF bytes of the
     # line) begins
@@ -169,51 +173,44 @@ def scan(segs: list, axes) -> Scan:
                        & (b[np.maximum(end - 2, 0)] == 13))
     body_end = end - ending
     _comments(b, cls, start, body_end, lid, bad)
-    bad[lid[cls >= _OTHER]] = True
-    # significant bytes: letters, number bytes, comment starts and line endings (so that
-    # neighbours in ``sig`` are in the same line unless an ending lies between them)
-    sig = np.flatnonzero(cls <= _EOL)
-    c = cls[sig]
-    isnum = (c >= _DIGIT) & (c <= _DOT)
-    isl = c == _LETTER
-    run0 = isnum.copy()
-    run0[1:] &= ~(isnum[:-1] & (np.diff(sig) == 1))
+    bad[lid(np.flatnonzero(cls >= _OTHER))] = True
+    # numbers: [+-]?(\d+\.?\d*|\.\d+), runs of adjacent number bytes [ns, ne)
+    nm = (cls >= _DIGIT) & (cls <= _DOT)
+    start_m = nm.copy()
+    start_m[1:] &= ~nm[:-1]
+    end_m = nm.copy()
+    end_m[:-1] &= ~nm[1:]
+    ns = np.flatnonzero(start_m)
+    ne = np.flatnonzero(end_m) + 1
+    nr = len(ns)
+    rline = lid(ns)
+    # tokens: letters, number runs (by their first byte), comment starts and line endings
+    # (so that neighbouring tokens are in the same line unless an ending lies between them)
+    tok = np.flatnonzero((cls == _LETTER) | start_m | (cls == _SEP) | (cls == _EOL))
+    is_run = start_m[tok]
+    isl = cls[tok] == _LETTER
     # a number starts right after its letter (blanks between allowed) ...
-    no_letter = run0.copy()
+    no_letter = is_run.copy()
     no_letter[1:] &= ~isl[:-1]
     # ... and a letter is followed by its number
     no_number = isl.copy()
-    no_number[:-1] &= ~isnum[1:]
-    bad[lid[sig[np.flatnonzero(no_letter | no_number)]]] = True
-    # numbers: [+-]?(\d+\.?\d*|\.\d+), runs of adjacent number bytes; in the positions of
-    # the number bytes (``num``) a run is [run_first, run_last]
-    num = np.flatnonzero((cls >= _DIGIT) & (cls <= _DOT))
-    cn = cls[num]
-    first = np.ones(len(num), dtype=bool)
-    first[1:] = np.diff(num) != 1
-    run_first = np.flatnonzero(first)
-    nr = len(run_first)
-    run_last = np.empty(nr, dtype=np.int64)
-    run_last[:-1] = run_first[1:] - 1
-    if nr:
-        run_last[-1] = len(cn) - 1
-    ns, ne = num[run_first], num[run_last] + 1
-    rline = lid[ns]
+    no_number[:-1] &= ~is_run[1:]
+    bad[lid(tok[np.flatnonzero(no_letter | no_number)])] = True
     # a sign only in front, at most one dot, at least one digit
-    run_of = np.cumsum(first, dtype=np.int32) - 1
-    signs = np.flatnonzero(cn == _SIGN)
-    bad[lid[num[signs[~first[signs]]]]] = True
-    dots = np.flatnonzero(cn == _DOT)
-    dot_run = run_of[dots]
+    signs = np.flatnonzero(cls == _SIGN)
+    bad[lid(signs[~start_m[signs]])] = True
+    dots = np.flatnonzero(cls == _DOT)
+    dot_run = np.searchsorted(ns, dots, side="right") - 1
     ndot = np.bincount(dot_run, minlength=nr)
     bad[rline[ndot > 1]] = True
     frac = np.full(nr, -1, dtype=np.int64)
-    frac[dot_run] = run_last[dot_run] - dots
-    ndig = (run_last - run_first + 1) - ndot - np.bincount(run_of[signs], minlength=nr)
+    frac[dot_run] = ne[dot_run] - 1 - dots
+    nsign = np.bincount(np.searchsorted(ns, signs, side="right") - 1, minlength=nr)
+    ndig = (ne - ns) - ndot - nsign
     bad[rline[ndig == 0]] = True
-    # the letter of each run: the significant byte before it (in a line that is not bad)
-    rs = np.flatnonzero(run0)
-    code = _letter_table(axes)[b[sig[np.maximum(rs - 1, 0)]]]
+    # the letter of each run: the token before it (in a line that is not bad)
+    rs = np.flatnonzero(is_run)
+    code = _letter_table(axes)[b[tok[np.maximum(rs - 1, 0)]]]
     bad[rline[code == NEEDS_INTERPRETER]] = True
     # an axis programmed twice
     m = code >= 0

@@ -148,11 +148,21 @@ def random_program(seed: int) -> str:
             v = round(target - cur[a], nd) if incr else target
             cur[a] = cur[a] + v if incr else round(target, nd)
             txt = f"{v:.{nd}f}" + ("." if nd == 0 and rng.uniform() < 0.2 else "")
-            words.append((a.lower() if seed % 3 == 0 else a) + txt)
+            gap = " " if seed % 4 == 2 and rng.uniform() < 0.3 else ""
+            words.append((a.lower() if seed % 3 == 0 else a) + gap + txt)
+        # what post-processors write: a motion word on every line, N F S T M words,
+        # comments in ( ) and after ;
+        if rng.uniform() < 0.6:
+            words.insert(0, str(rng.choice(["G1", "G01", "G0", "g00", "G1.0"])))
+        if rng.uniform() < 0.3:
+            words.append(str(rng.choice(["F1500.", "S12000", "M8", "T3", "F800 M3", "H2"])))
+        if rng.uniform() < 0.2:
+            words.insert(int(rng.integers(0, len(words) + 1)), "(cut X1)")
         if rng.uniform() < 0.2:
             words.insert(0, f"N{i}")
         sep = "" if seed % 4 == 1 else " "
-        out.append(sep.join(words) + ("  " if rng.uniform() < 0.1 else ""))
+        tail = "  " if rng.uniform() < 0.1 else (" ; fin (x" if rng.uniform() < 0.15 else "")
+        out.append(sep.join(words) + tail)
     if incr:
         out.append("G90")
     end = ["\n", "\r\n", "\r"][seed % 3]
