@@ -1,10 +1,13 @@
 """``volerr compensate LAYOUT --errors DIR PROGRAM --out F``: compensated NC program.
 
-Reads a G-code program in machine axis coordinates, predicts the tool-tip error of every
-motion block from the layout's model and the error tables, and writes a copy whose axis
-positions make the actual tool tip land on the nominal one (see :mod:`volerr.fiveaxis.compensate` for
-the method and :mod:`volerr.fiveaxis.gcode` for what is supported).  Only axis numbers change; the
-input is never overwritten.
+Reads an NC program (ISO G-code or Heidenhain plain language; axis positions, arcs G2/G3,
+TCPM), predicts the tool-tip error of every motion block from the layout's model and the error
+tables (by each block's approach direction where they carry a reversal), and writes a copy
+whose positions make the actual tool tip land on the nominal one (see
+:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.fiveaxis.gcode`,
+:mod:`volerr.fiveaxis.arcs`, :mod:`volerr.fiveaxis.tcpm` and :mod:`volerr.fiveaxis.heidenhain`
+for what is supported; ``volerr formats gcode``).  Only position numbers change; the input is
+never overwritten.
 
 Outputs: ``--out`` (the program, same bytes except the compensated numbers), ``--report``
 (CSV, one row per motion block: ``line,status``, the programmed and written axis positions

@@ -19,7 +19,8 @@ def register(sub) -> None:
                                    "section names, or one section.")
     p.add_argument("name", nargs="?", metavar="NAME",
                    help="section: tables, tracker, sphere, deviations, loop-json, layout, "
-                        "gcode, controller, uncertainty, iso230-2, outputs, or 'all'")
+                        "gcode, tools, controller, axis-tables, uncertainty, iso230-2, "
+                        "outputs, or 'all'")
     p.set_defaults(func=run)
 
 

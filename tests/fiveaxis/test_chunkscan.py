@@ -60,7 +60,7 @@ def reference_fast(body: str) -> list | None:
     return words
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(st.lists(st.tuples(line, st.sampled_from(["\n", "\r\n", "\r"])), max_size=8))
 def test_scan_finds_the_plain_lines_and_their_numbers(lines):
     segs = [a + b for a, b in lines]

@@ -198,24 +198,33 @@ def test_heidenhain_plain_language_gives_the_numbers_of_the_iso_program(setup):
     assert res.summary()["tcpm_blocks"] == 0 and res.summary()["compensated"] == 8
 
 
-@pytest.mark.parametrize("text,args,msg", [
-    ("G90 G1 X0 Y0 Z200 B0 C0\nN20 G43.4 H1\nG1 X1 Y2 Z3 B10 C10\n", [],
-     "line 2: a TCPM program needs the tool length"),
-    ("G90\nG43.4 H7\nG1 X1 Y2 Z3 B10 C10\n", ["--tool-table", "TT"],
+@pytest.mark.parametrize("text,kw,msg", [
+    ("G90\nG43.4 H7\nG1 X1 Y2 Z3 B10 C10\n", {"tool_table": {1: 120.0}},
      "line 2: tool H7 is not in the tool table"),
-    ("; a program\nGOTO/10,20,30\n", [], "line 2: unknown program dialect"),
-    ("0 BEGIN PGM X MM\n1 CC X+0 Y+0\n", [], "line 2: CC"),
-    ("0 BEGIN PGM X MM\n1 L X+1 Y+2 Z+3 B+0 C+0 RL F100\n", [], "line 2: radius compensation"),
+    ("; a program\nGOTO/10,20,30\n", {}, "line 2: unknown program dialect"),
+    ("0 BEGIN PGM X MM\n1 CC X+0 Y+0\n", {}, "line 2: CC"),
+    ("0 BEGIN PGM X MM\n1 L X+1 Y+2 Z+3 B+0 C+0 RL F100\n", {}, "line 2: radius compensation"),
+    ("G90 G1 X0 Y0 Z200 B0 C0\nTRAORI\nG1 X1 Y2 Z3 A3=0 B3=0 C3=1 B5\n", {"tool_length": 99.0},
+     "line 3: rotary axis B and a tool vector"),
 ])
-def test_bad_programs_exit_2_naming_the_line(setup, tmp_path, text, args, msg):
+def test_bad_programs_are_refused_naming_the_line(setup, text, kw, msg):
+    m, funcs, _ = setup
+    with pytest.raises(InputError, match=msg):
+        compensate_program(m, funcs, text, **kw)
+
+
+def test_cli_tcpm_without_tool_length_exit_2_one_line(setup, tmp_path):
     _, _, d = setup
     prog = tmp_path / "p.nc"
-    prog.write_text(text)
-    (tmp_path / "tools.csv").write_text("tool,length_mm\n1,120\n")
-    args = [str(tmp_path / "tools.csv") if a == "TT" else a for a in args]
-    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o", *args)
-    assert rc == 2 and msg in se and len(se.strip().splitlines()) == 1, se
+    prog.write_text("G90 G1 X0 Y0 Z200 B0 C0\nN20 G43.4 H1\nG1 X1 Y2 Z3 B10 C10\n")
+    (tmp_path / "tools.csv").write_text("tool,length_mm\n2,120\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o")
+    assert rc == 2 and "line 2: a TCPM program needs the tool length" in se and \
+        len(se.strip().splitlines()) == 1, se
     assert not (tmp_path / "o").exists()
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+                     "--tool-table", tmp_path / "tools.csv")
+    assert rc == 2 and "line 2: tool H1 is not in the tool table" in se, se
 
 
 def test_tool_length_rule():
