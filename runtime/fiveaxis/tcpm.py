@@ -111,9 +111,10 @@ def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray) -> np.nd
 
 def axes_from_words(model, w: np.ndarray, frame: np.ndarray, length: np.ndarray,
                     previous_rot: np.ndarray) -> np.ndarray:
-    """Axis positions (N, n_axes) the controller goes to for TCPM rows: ``w`` (N, n_axes + 3)
-    the words (linear columns the tip, rotary columns the angles of :data:`ANGLES` rows, the
-    last three the tool vector of :data:`VECTOR` rows), ``frame`` (N,), ``length`` (N,) mm;
+    """Axis positions (N, n_axes) the controller goes to: ``w`` (N, n_axes + 3) the words
+    (for TCPM rows the linear columns the tip, rotary columns the angles of :data:`ANGLES`
+    rows, the last three the tool vector of :data:`VECTOR` rows; :data:`AXES` rows the axis
+    positions themselves), ``frame`` (N,), ``length`` (N,) mm (TCPM rows);
     ``previous_rot`` (2,) deg the rotary positions before the first row (vector rows continue
     from the row before them)."""
     require(is_five_axis(model), f"{model.name}: TCPM needs a five-axis layout with its "
@@ -125,7 +126,7 @@ def axes_from_words(model, w: np.ndarray, frame: np.ndarray, length: np.ndarray,
     n = len(w)
     q = np.full((n, nax), np.nan)
     rot = np.full((n, 2), np.nan)
-    ang = frame == ANGLES
+    ang = frame != VECTOR               # rotary words: TCPM angles, or axis positions
     rot[ang] = w[ang][:, rot_idx]
     vec = np.flatnonzero(frame == VECTOR)
     if len(vec):
@@ -137,7 +138,9 @@ def axes_from_words(model, w: np.ndarray, frame: np.ndarray, length: np.ndarray,
             p = rot[before] if before >= 0 and np.all(np.isfinite(rot[before])) else prev
             rot[part] = rotary_from_vector(model, w[part, nax:nax + 3], p)
     q[:, rot_idx] = rot
-    q[:, lin_idx] = linear_from_tip(model, w[:, lin_idx], rot, length)
+    tc = frame != AXES
+    q[np.ix_(tc, lin_idx)] = linear_from_tip(model, w[tc][:, lin_idx], rot[tc], length[tc])
+    q[~tc] = w[~tc, :nax]               # axis positions as they are
     return q
 
 
