@@ -305,7 +305,7 @@ class ControllerState:
         if step.kind in ("motion", "arc"):
             inc = step.incremental_words
             for a, v in step.axis_words:
-                if step.incremental or a in inc:
+                if (step.incremental and a not in VECTOR) or a in inc:   # a vector: absolute
                     prev = pos[a]
                     pos[a] = None if prev is None else prev + v
                 else:

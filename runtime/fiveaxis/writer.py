@@ -39,7 +39,7 @@ def _letter_words(letters, want_row, nd_row, words: dict, pos: dict, incremental
             continue
         half = 0.5 * 10.0 ** (-nd)
         w = words.get(a)
-        if incremental or a in extra_inc:
+        if (incremental and a not in gcode.VECTOR) or a in extra_inc:
             prev = pos[a]
             if prev is None:
                 if w is not None:
