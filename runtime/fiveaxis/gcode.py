@@ -360,8 +360,17 @@ class Interpreter:
     @property
     def plain(self) -> bool:
         """True when a line of axis words (and G0 / G1, T H D and ignored words) is a straight
-        move of the axes: absolute, straight motion mode, no TCPM (the whole-chunk path)."""
-        return not self.incremental and self.motion in (0, 1) and self.frame == "axes"
+        move with nothing but its words to read: absolute, straight motion mode, axis
+        positions or TCPM with rotary angles (the whole-chunk path)."""
+        if self.incremental or self.motion not in (0, 1):
+            return False
+        return self.frame == "axes" or self.orientation == "angles" or \
+            (self.orientation == "any" and self._last_orientation != "vector")
+
+    @property
+    def length(self) -> float | None:
+        """The tool length of TCPM blocks now (mm), None outside TCPM."""
+        return self._length if self.frame == "tcpm" else None
 
     def _switch(self, frame: str, orientation, where: str) -> tuple:
         """Switch into or out of TCPM; returns the letters whose positions become unknown:

@@ -228,7 +228,7 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
               dialect=None) -> Blocks:
     """Interpret the lines ``segs`` (numbered from ``first``); ``interp`` carries the modal
     state from chunk to chunk.  Runs of plain lines in a plain mode (absolute, straight, axis
-    positions) are done together (the position of an axis is its last programmed value: a
+    positions or TCPM with rotary angles) are done together (the position of an axis is its last programmed value: a
     forward fill); every other line goes through ``interp`` one by one.  ``dialect``: the
     line parser of another dialect (:mod:`volerr.fiveaxis.heidenhain`; its lines are all
     interpreted one by one)."""
@@ -278,6 +278,12 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
             cols = np.arange(nax)
             w[i:j, :nax] = np.where(last >= 0, v[np.maximum(last, 0), cols], startv)
             motion[i:j] = has.any(axis=1)
+            if interp.frame == "tcpm":          # TCPM with rotary angles: tip and angles
+                mrows = i + np.flatnonzero(has.any(axis=1))
+                frame[mrows] = tcpm.ANGLES
+                length[mrows] = interp.length
+                if len(mrows):
+                    interp._last_orientation = "angles"
             for c, a in enumerate(axes):
                 val = w[j - 1, c]
                 pos[a] = None if val != val else float(val)

@@ -17,6 +17,7 @@ from volerr.fiveaxis import chunkscan, gcode, program
 from volerr.errors import InputError
 from volerr.fiveaxis.compensate import compensate_program
 from volerr.tables import table as tables
+from volerr.tables.functions import ErrorFunctions
 
 AXES = ("X", "Y", "Z", "B", "C")
 NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
@@ -165,23 +166,31 @@ def random_program(seed: int) -> str:
         out.append(sep.join(words) + tail)
     if incr:
         out.append("G90")
+    if seed >= 8:       # a TCPM program (rotary angles): the words are tool tip and angles
+        out = out[:2] + ["G43.4 H1 (TCPM)"] + out[2:] + ["G49"]
     end = ["\n", "\r\n", "\r"][seed % 3]
     return end.join(out) + end
 
 
-@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("seed", range(10))
 @pytest.mark.parametrize("orientation", [False, True])
 def test_whole_chunk_path_writes_the_line_by_line_bytes(setup, seed, orientation, monkeypatch):
     m, funcs = setup
     text = random_program(seed)
     init = {"B": 10.0, "C": 5.0} if seed % 2 else {}
+    kw = {}
+    if seed >= 8:       # TCPM: the axis positions may leave the travel and the tables
+        funcs = ErrorFunctions(funcs.tables, funcs.constants, m, extrapolate=True)
+        kw = {"tool_length": 100.0, "check_travel": False}
     monkeypatch.setattr(program, "WHOLE_CHUNK", False)
-    ref = compensate_program(m, funcs, text, orientation=orientation, initial=init)
+    ref = compensate_program(m, funcs, text, orientation=orientation, initial=init, **kw)
     monkeypatch.setattr(program, "WHOLE_CHUNK", True)
     assert ref.text != text
-    for k in (None, 1, 7, 50):
+    if seed >= 8:
+        assert ref.summary()["tcpm_blocks"] > 50
+    for k in (None, 1, 7, 50) if seed < 8 else (None, 13):
         got = compensate_program(m, funcs, text, orientation=orientation, initial=init,
-                                 chunk_lines=k)
+                                 chunk_lines=k, **kw)
         assert got.text == ref.text, k
         assert [(r.line, r.status, r.output) for r in got.reports] == \
             [(r.line, r.status, r.output) for r in ref.reports]
