@@ -346,7 +346,7 @@ def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = ORIENTATION_RC
 
 
 def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: float = 1e-4,
-          max_iter: int = 50, direction=None):
+          max_iter: int = 50, direction=None, out: dict | None = None):
     """Corrected positions (N, n) for programmed ``q_nom``, the iteration count per row, and
     per row whether the orientation correction was limited: stopped because a rotary axis would
     have left its travel or its error table, or partial near a singular orientation.
@@ -354,13 +354,17 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     Iterates until the change of the correction is below ``tol`` (mm; rotary axes weighted by a
     1 m lever).  ``direction`` (N, n) -1 / 0 / +1: the approach direction of each axis in each
     row (tables with reversal; the corrected positions are approached as the programmed
-    ones)."""
+    ones).  ``out``: a dict that gets ``target`` (N, 3), the nominal tool tip, and -- when the
+    first iteration evaluates the whole model at the programmed positions (no orientation,
+    no restriction to some types) -- ``before`` (N, 3), the error there (mm)."""
     m = em.model
     q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
     n = len(q_nom)
     lin_idx = [m.axes.index(a) for a in em.lin]
     rot_idx = [m.axes.index(a) for a in em.rot]
     target_p = m.nominal_position(q_nom, em.tool)
+    if out is not None:
+        out["target"] = target_p
     target_k = em.tool_axis(q_nom) if em.rot else None
     q = q_nom.copy()
     iters = np.zeros(n, dtype=int)
@@ -385,6 +389,8 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
             change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
         e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
             - target_p[active]
+        if it == 1 and out is not None and not orientation and em.compensated is None:
+            out["before"] = e.copy()        # nominal(q_nom) - target is exactly 0
         mj = linear_jacobian(m, qa, em.tool)
         d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
         qa[:, lin_idx] += d

@@ -399,11 +399,15 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
 # step 3: solve
 @dataclass
 class Solution:
-    """Corrected positions (n, n_axes), iterations (n,), orientation limited (n,)."""
+    """Corrected positions (n, n_axes), iterations (n,), orientation limited (n,); the
+    nominal tool tip ``target`` (n, 3) and the error at the programmed positions ``before``
+    (n, 3) mm when the solve has them (else None: the prediction computes them)."""
 
     q: np.ndarray
     iterations: np.ndarray
     limited: np.ndarray
+    target: np.ndarray | None = None
+    before: np.ndarray | None = None
 
 
 def tool_groups(em, blocks: Blocks, opts: Options) -> list:
@@ -437,9 +441,10 @@ def solve_positions(em, q_nom: np.ndarray, opts: Options, direction=None) -> Sol
     if opts.strategy == "thesis":
         return Solution(solve_thesis(em, q_nom, direction), np.ones(n, dtype=int),
                         np.zeros(n, dtype=bool))
+    out = {}
     q, it, lim = solve(em, q_nom, opts.orientation, opts.tol_um * 1e-3, opts.max_iter,
-                       direction)
-    return Solution(q, it, lim)
+                       direction, out)
+    return Solution(q, it, lim, out.get("target"), out.get("before"))
 
 
 def solve_blocks(em, blocks: Blocks, opts: Options) -> Solution:
@@ -447,7 +452,10 @@ def solve_blocks(em, blocks: Blocks, opts: Options) -> Solution:
     q_nom = blocks.q_nom
     n = len(q_nom)
     sol = Solution(q_nom.copy(), np.zeros(n, dtype=int), np.zeros(n, dtype=bool))
-    for g_em, rows in tool_groups(em, blocks, opts):
+    groups = tool_groups(em, blocks, opts)
+    if len(groups) == 1 and isinstance(groups[0][1], slice):
+        return solve_positions(em, q_nom, opts, blocks.direction)
+    for g_em, rows in groups:
         part = solve_positions(g_em, q_nom[rows], opts, blocks.dir(rows))
         sol.q[rows], sol.iterations[rows], sol.limited[rows] = part.q, part.iterations, \
             part.limited
@@ -612,18 +620,20 @@ class Prediction:
 
 
 def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray, direction=None,
-                      direction_before=None) -> Prediction:
+                      direction_before=None, target=None, before=None) -> Prediction:
     """Predicted errors of the positions ``q_nom`` (programmed, approached in
     ``direction_before``) and ``q_out`` (written, approached in ``direction``), with ``em``'s
-    tool offset (directions None: no reversal)."""
+    tool offset (directions None: no reversal).  ``target`` / ``before``: the nominal tip and
+    the error at ``q_nom`` when the solve has them (mm)."""
     model, tool, funcs = em.model, em.tool, em.funcs
     n = len(q_nom)
     if not n:
         z = np.zeros((0, 3))
         return Prediction(z, z, np.zeros(0), np.zeros(0), z)
-    target = model.nominal_position(q_nom, tool)
+    if target is None:
+        target = model.nominal_position(q_nom, tool)
     d, d0 = direction, direction_before
-    before = em.position_error(q_nom, None, d0) * 1e3
+    before = (em.position_error(q_nom, None, d0) if before is None else before) * 1e3
     after = (model.nominal_position(q_out, tool) + em.position_error(q_out, None, d)
              - target) * 1e3
     if model.rotary_axes:
@@ -639,12 +649,17 @@ def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray, direction=None,
     return Prediction(before, after, ob, oa, u_after)
 
 
-def predict(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> Prediction:
-    """:func:`predict_positions` of every row, with the tool offset of its group."""
+def predict(em, blocks: Blocks, q_out: np.ndarray, opts: Options,
+            sol: Solution | None = None) -> Prediction:
+    """:func:`predict_positions` of every row, with the tool offset of its group (``sol``:
+    the solution of a single group, whose target and error at the programmed positions are
+    reused)."""
     groups = tool_groups(em, blocks, opts)
     if len(groups) == 1 and isinstance(groups[0][1], slice):
+        reuse = sol is not None and blocks.direction is None
         return predict_positions(em, blocks.q_nom, q_out, blocks.direction,
-                                 blocks.dir_program)
+                                 blocks.dir_program, sol.target if reuse else None,
+                                 sol.before if reuse else None)
     n = len(q_out)
     p = Prediction(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
                    np.full((n, 3), math.nan))
@@ -822,7 +837,7 @@ def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None,
     if directions is not None:
         b.direction, q_out, w_out = _settle(em, b, sol, w_out, q_out, opts, directions)
     arc_res = compensate_arcs(em, b, q_out, opts)
-    pred = predict(em, b, q_out, opts)
+    pred = predict(em, b, q_out, opts, sol)
     if interp.vector_words is not None:
         writer.vector_words = interp.vector_words
     text = writer.chunk(b, w_out, arc_res)
