@@ -1,18 +1,24 @@
-"""Benchmark: `volerr compensate DMU50` on a long five-axis program, streamed in chunks.
+"""Benchmark: `volerr compensate DMU50` on a long five-axis program, streamed in chunks, for
+each shape of program post-processors write.
 
-Reports, for N blocks and N/10 blocks: the whole command (parse, interpret, solve, round,
-predict, write) in a subprocess, wall and CPU time and peak RSS (resource.getrusage), with the
-whole-chunk text path (default) and with every line interpreted and written one by one
-(``program.WHOLE_CHUNK = False``, the previous implementation's text handling; same output,
-checked), interleaved, min of the runs.  The line-by-line path runs at N/10 only unless
-``--baseline-full`` (it takes ~100 s per 10^6 blocks).  Also: the vectorised solve alone on
-the same positions and the solve block by block (a per-line script).
+Shapes (the same positions in every one): ``bare`` (``X.. Y.. Z.. B.. C..``), ``g1`` (``G1`` on
+every line), ``post`` (``N.. G01 X.. Y.. Z.. B.. C.. F1500. S12000 M8 (cut) ; fin`` with CRLF),
+``lower`` (``g1 x 1.0 y 2.0 ...``: lower case, blanks between letter and number), ``tools``
+(``G0``/``G1`` alternating, ``T`` and ``M`` words, comments between the words).
+
+Reports, for N blocks of each shape: the whole command (parse, interpret, solve, round,
+predict, write) in a subprocess, wall and CPU time and peak RSS (resource.getrusage), and the
+ratio to the bare shape; interleaved, min of the runs.  At N/10 blocks the whole-chunk text
+path is checked byte for byte against every line interpreted and written one by one
+(``program.WHOLE_CHUNK = False``, the reference) and timed against it (``--baseline-full``: also
+at N; it takes ~100 s per 10^6 blocks).  Also: the vectorised solve alone on the same
+positions and the solve block by block (a per-line script).
 
 With ``--base REV`` the whole command of commit REV (exported with ``git archive``, run
-through ``PYTHONPATH``) runs on the N-block program too, interleaved, output compared.
+through ``PYTHONPATH``) runs on the N-block bare program too, interleaved, output compared.
 
-Run: python benchmarks/bench_compensate.py [N_BLOCKS] [--runs R] [--baseline-full] [--base REV]
-     (default 1000000 blocks, 2 runs)
+Run: python benchmarks/bench_compensate.py [N_BLOCKS] [--runs R] [--shapes bare,post,...]
+     [--baseline-full] [--base REV]     (default 1000000 blocks, 2 runs, every shape)
 """
 
 import subprocess
@@ -41,13 +47,25 @@ print(time.perf_counter() - t0, time.process_time() - c0,
 """
 
 
-def write_program(path: Path, n: int, rng) -> np.ndarray:
+SHAPES = {
+    "bare": lambda k, r: "X%.3f Y%.3f Z%.3f B%.3f C%.3f\n" % r,
+    "g1": lambda k, r: "G1 X%.3f Y%.3f Z%.3f B%.3f C%.3f\n" % r,
+    "post": lambda k, r: ("N%d G01 X%.3f Y%.3f Z%.3f B%.3f C%.3f F1500. S12000 M8 (cut) ; fin"
+                          "\r\n" % ((k,) + r)),
+    "lower": lambda k, r: "g1 x %.3f y %.3f z %.3f b %.3f c %.3f\n" % r,
+    "tools": lambda k, r: ("G%d X%.3f (a) Y%.3f Z%.3f B%.3f C%.3f T%d M%d ;x\n"
+                           % ((k % 2,) + r + (k % 7, 8 + k % 2))),
+}
+
+
+def write_program(path: Path, n: int, rng, shape: str = "bare") -> np.ndarray:
     q = np.column_stack([rng.uniform(-240, 240, n), rng.uniform(-220, 220, n),
                          rng.uniform(10, 390, n), rng.uniform(1, 179, n), rng.uniform(0, 359, n)])
+    line = SHAPES[shape]
     with open(path, "w", encoding="latin-1", newline="") as fh:
         fh.write("G90 G1 X0 Y0 Z100 B10 C0\n")
         for i in range(0, n, 100000):
-            fh.write("".join("X%.3f Y%.3f Z%.3f B%.3f C%.3f\n" % tuple(r) for r in q[i:i + 100000]))
+            fh.write("".join(line(i + k, tuple(r)) for k, r in enumerate(q[i:i + 100000])))
     return np.round(q, 3)
 
 
@@ -59,7 +77,8 @@ def command(prog, errors, out, whole=True, pythonpath=None):
     return wall, cpu, rss
 
 
-def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None) -> None:
+def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None,
+         shapes=tuple(SHAPES)) -> None:
     m = volerr.load("DMU50")
     rng = np.random.default_rng(0)
     with tempfile.TemporaryDirectory() as tmp:
@@ -73,26 +92,34 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
             write_error_table(d / f"{a}.csv", ErrorTable(a, x, vals))
         write_constants(d / "constants.csv", {"EC0Y": 20e-6, "EX0C": 0.01, "EA0B": 15e-6})
         funcs = tables.ErrorFunctions.from_dir(d, m)
-        big, small = d / "big.nc", d / "small.nc"
-        q = write_program(big, n, rng)
-        write_program(small, max(n // 10, 1), rng)
+        q = None
+        for sh in shapes:
+            q = write_program(d / f"big_{sh}.nc", n, np.random.default_rng(1), sh)
+            write_program(d / f"small_{sh}.nc", max(n // 10, 1), np.random.default_rng(2), sh)
         em = ErrorModel(m, funcs)
         k = min(300, n)
-        res = {key: [] for key in ("big", "small", "big_line", "small_line", "solve", "base")}
+        res = {key: [] for key in ["solve", "base"] + [f"{sh}{x}" for sh in shapes
+                                                       for x in ("", "_small", "_line",
+                                                                 "_big_line")]}
         pkg = export(base, d / "base") if base else None
         if pkg is not None:
             assert which_volerr(pkg).startswith(str(pkg)), "baseline import not taken"
         for _ in range(runs):   # interleaved, min of the runs
-            res["big"].append(command(big, d, d / "out.nc"))
-            if pkg is not None:
-                res["base"].append(command(big, d, d / "out_base.nc", pythonpath=pkg))
+            for sh in shapes:
+                res[sh].append(command(d / f"big_{sh}.nc", d, d / "out.nc"))
+                res[f"{sh}_small"].append(command(d / f"small_{sh}.nc", d, d / "out_s.nc"))
+                res[f"{sh}_line"].append(command(d / f"small_{sh}.nc", d, d / "ref_s.nc",
+                                                 whole=False))
+                assert (d / "out_s.nc").read_bytes() == (d / "ref_s.nc").read_bytes(), sh
+                if baseline_full:
+                    res[f"{sh}_big_line"].append(command(d / f"big_{sh}.nc", d, d / "ref.nc",
+                                                         whole=False))
+                    assert (d / "out.nc").read_bytes() == (d / "ref.nc").read_bytes(), sh
+            if pkg is not None and "bare" in shapes:
+                command(d / "big_bare.nc", d, d / "out.nc")
+                res["base"].append(command(d / "big_bare.nc", d, d / "out_base.nc",
+                                           pythonpath=pkg))
                 assert (d / "out.nc").read_bytes() == (d / "out_base.nc").read_bytes()
-            res["small"].append(command(small, d, d / "out_s.nc"))
-            res["small_line"].append(command(small, d, d / "ref_s.nc", whole=False))
-            assert (d / "out_s.nc").read_bytes() == (d / "ref_s.nc").read_bytes()
-            if baseline_full:
-                res["big_line"].append(command(big, d, d / "ref.nc", whole=False))
-                assert (d / "out.nc").read_bytes() == (d / "ref.nc").read_bytes()
             t0 = time.perf_counter()
             for i in range(0, n, 20000):
                 solve(em, q[i:i + 20000])
@@ -105,23 +132,29 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
         best = {key: tuple(min(r[i] for r in v) for i in range(3))
                 for key, v in res.items() if v and key not in ("solve", "base")}
         print(f"DMU50, full strategy, min of {runs} interleaved runs "
-              f"(wall s, CPU s, peak RSS MB)")
-        for key, nb in (("big", n), ("small", n // 10)):
-            w, c, r = best[key]
-            line = f"  {nb:>8} blocks: whole-chunk {w:.1f} s wall, {c:.1f} s CPU, {r:.0f} MB"
-            if key + "_line" in best:
-                lw, lc, lr = best[key + "_line"]
-                line += (f"; line by line {lw:.1f} s wall, {lc:.1f} s CPU, {lr:.0f} MB; "
-                         f"ratio {lw / w:.1f}x wall, {lc / c:.1f}x CPU")
+              f"(wall s, CPU s, peak RSS MB; ratio to the bare shape)")
+        ref = best.get("bare")
+        for sh in shapes:
+            w, c, r = best[sh]
+            ratio = f", {w / ref[0]:.2f}x / {c / ref[1]:.2f}x bare" if ref else ""
+            print(f"  {sh:>6} {n:>8} blocks: {w:.1f} s wall, {c:.1f} s CPU, {r:.0f} MB{ratio}")
+            sw, sc, _ = best[f"{sh}_small"]
+            lw, lc, lr = best[f"{sh}_line"]
+            line = (f"  {sh:>6} {n // 10:>8} blocks: whole-chunk {sw:.1f} s wall; line by line "
+                    f"{lw:.1f} s wall, {lc:.1f} s CPU, {lr:.0f} MB; ratio {lw / sw:.1f}x wall; "
+                    "output identical")
+            if f"{sh}_big_line" in best:
+                bw = best[f"{sh}_big_line"][0]
+                line += f"; at {n}: line by line {bw:.1f} s ({bw / w:.1f}x)"
             print(line)
-        w = best["big"][0]
         if res["base"]:
+            w = best["bare"][0]
             bw, bc, br = (min(r[i] for r in res["base"]) for i in range(3))
-            print(f"  {n:>8} blocks, commit {base}: {bw:.1f} s wall, {bc:.1f} s CPU, {br:.0f} MB; "
-                  f"ratio {bw / w:.2f}x wall, {bc / best['big'][1]:.2f}x CPU; output identical")
-        print(f"  solve alone (chunks of 20000): {t_vec:.2f} s; whole command / solve "
-              f"{w / t_vec:.1f}x; block by block (extrapolated from {k}): {t_loop:.0f} s, "
-              f"{t_loop / w:.0f}x the whole command")
+            print(f"  bare {n:>8} blocks, commit {base}: {bw:.1f} s wall, {bc:.1f} s CPU, "
+                  f"{br:.0f} MB; ratio {bw / w:.2f}x wall, {bc / best['bare'][1]:.2f}x CPU; "
+                  "output identical")
+        print(f"  solve alone (chunks of 20000): {t_vec:.2f} s; block by block (extrapolated "
+              f"from {k}): {t_loop:.0f} s")
 
 
 if __name__ == "__main__":
@@ -132,5 +165,7 @@ if __name__ == "__main__":
     ap.add_argument("--runs", type=int, default=2)
     ap.add_argument("--baseline-full", action="store_true")
     ap.add_argument("--base", default=None, help="also run this commit's command (e.g. b32e5c7)")
+    ap.add_argument("--shapes", default=",".join(SHAPES),
+                    help=f"program shapes, comma separated ({', '.join(SHAPES)})")
     a = ap.parse_args()
-    main(a.n, a.runs, a.baseline_full, a.base)
+    main(a.n, a.runs, a.baseline_full, a.base, tuple(a.shapes.split(",")))

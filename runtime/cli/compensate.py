@@ -1,10 +1,13 @@
 """``volerr compensate LAYOUT --errors DIR PROGRAM --out F``: compensated NC program.
 
-Reads a G-code program in machine axis coordinates, predicts the tool-tip error of every
-motion block from the layout's model and the error tables, and writes a copy whose axis
-positions make the actual tool tip land on the nominal one (see :mod:`volerr.fiveaxis.compensate` for
-the method and :mod:`volerr.fiveaxis.gcode` for what is supported).  Only axis numbers change; the
-input is never overwritten.
+Reads an NC program (ISO G-code or Heidenhain plain language; axis positions, arcs G2/G3,
+TCPM), predicts the tool-tip error of every motion block from the layout's model and the error
+tables (by each block's approach direction where they carry a reversal), and writes a copy
+whose positions make the actual tool tip land on the nominal one (see
+:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.fiveaxis.gcode`,
+:mod:`volerr.fiveaxis.arcs`, :mod:`volerr.fiveaxis.tcpm` and :mod:`volerr.fiveaxis.heidenhain`
+for what is supported; ``volerr formats gcode``).  Only position numbers change; the input is
+never overwritten.
 
 Outputs: ``--out`` (the program, same bytes except the compensated numbers), ``--report``
 (CSV, one row per motion block: ``line,status``, the programmed and written axis positions
@@ -22,7 +25,7 @@ import json
 import math
 from pathlib import Path
 
-from ._common import add_error_arguments, add_vector
+from ._common import add_error_arguments, add_vector, progress_bar
 from ..errors import InputError, require
 from ._common import layout_inputs
 from ..fileio import Outputs, write_text
@@ -60,6 +63,22 @@ def register(sub) -> None:
                         "is taken at 0 deg)")
     p.add_argument("--ignore-travel", action="store_true",
                    help="accept positions outside the layout's travel")
+    p.add_argument("--arc-tolerance-um", type=float, default=1.0, metavar="T",
+                   help="arcs G2/G3: the actual tool path stays within T um of the nominal "
+                        "arc: an arc is kept (end point and centre corrected) where the "
+                        "correction varies less than T along it, else linearised into G1 "
+                        "moves (default 1)")
+    p.add_argument("--tool-length", type=float, default=None, metavar="MM",
+                   help="TCPM programs (G43.4/G43.5, M128, FUNCTION TCPM, TRAORI): the tool "
+                        "length the controller uses, mm (the tip lies this far from the point "
+                        "the axes refer to, against the tool axis)")
+    p.add_argument("--tool-table", default=None, metavar="CSV",
+                   help="TCPM programs: tool lengths by tool number, CSV tool,length_mm, "
+                        "looked up at the program's H word (Fanuc), else T (Siemens, "
+                        "Heidenhain TOOL CALL), else D")
+    p.add_argument("--dialect", choices=("auto", "iso", "heidenhain"), default="auto",
+                   help="program language: ISO G-code (Fanuc, Siemens, Heidenhain ISO) or "
+                        "Heidenhain plain language (default: detected from the first lines)")
     p.add_argument("--report", help="per-block CSV report")
     p.add_argument("--json", help="summary as JSON")
     p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")
@@ -94,20 +113,28 @@ def run(args) -> int:
     funcs, notes = error_functions(args.errors, model, args.method, args.degree,
                                    args.extrapolate)
     open_source = program.open_program(args.program)
-    inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
+    table = None
+    if args.tool_table:
+        from ..fiveaxis.tcpm import read_tool_table
+        table = read_tool_table(args.tool_table)
+    inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
+              *([args.tool_table] if args.tool_table else [])]
     outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
         .file("--json", args.json).plot("--plot", args.plot).check()
     opts = program.Options(
         tuple(args.tool), args.orientation, args.strategy, args.tol_um, args.decimals,
         _initial(args.initial or ""), not args.ignore_travel, 50,
-        None if args.types is None else tuple(t for t in args.types.split(",") if t.strip()))
+        None if args.types is None else tuple(t for t in args.types.split(",") if t.strip()),
+        args.arc_tolerance_um, args.tool_length, table, args.dialect)
     with outs:  # all or nothing: staged outputs are put in place at the end
         # streamed: the program and the report are written chunk by chunk
         sink = program.FileSink(model, outs.path("--out"),
                                 outs.path("--report") if args.report else None, inputs,
                                 keep_errors=bool(args.plot))
         try:
-            s, assumed_zero = program.run(open_source, model, funcs, opts, sink)
+            with progress_bar(Path(args.program), "compensate") as tick:
+                s, assumed_zero = program.run(open_source, model, funcs, opts, sink,
+                                              progress=tick)
             require(s["motion_blocks"] > 0, f"{args.program}: no motion block to compensate "
                                             "(an empty program or one without axis words)")
             if args.json:

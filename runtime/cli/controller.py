@@ -1,75 +1,167 @@
-"""``volerr controller export|import``: error parameters for controllers with built-in
-volumetric compensation (ISG CSV, Etalon exchange format; see :mod:`volerr.tables.controller`).
+"""``volerr controller export|import``: error parameters for controllers -- ISG CSV and Etalon
+(volumetric compensation, :mod:`volerr.tables.controller`) and the axis compensation tables of
+SINUMERIK (LEC, CEC), Heidenhain (``.CMA`` / ``.COM``) and Fanuc (pitch error compensation)
+(:mod:`volerr.tables.controller_tables`).
 
-``volerr controller export LAYOUT --errors DIR --format isg|etalon --out F``
-    writes the tables and constants of an error directory (component errors as grid points,
-    position errors as values; mm and rad, arguments mm and deg).
-``volerr controller import LAYOUT FILE --out DIR [--format auto|isg|etalon]``
-    reads such a file back into an error directory (``X.csv`` ... ``constants.csv``, um and urad).
+``volerr controller export LAYOUT --errors DIR --format FORMAT --out F [--json F] [--plot P]``
+    writes the tables and constants of an error directory; for the axis compensation formats
+    ``--json`` / ``--plot`` give what compensating with the tables leaves (the model's
+    volumetric error over the working volume after their correction).
+``volerr controller import LAYOUT FILE --out DIR [--format ...]``
+    reads such a file back into an error directory (``X.csv`` ... ``constants.csv``).
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from ..errors import require
 
+AXIS_FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc")
+
 
 def register(sub) -> None:
-    p = sub.add_parser("controller", help="export/import ISG CSV and Etalon controller tables",
+    p = sub.add_parser("controller", help="export/import controller compensation tables",
                        description=__doc__.split("\n\n")[0])
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
     e = s.add_parser("export", help="error directory -> controller file")
     e.add_argument("layout", help="layout name or file")
     e.add_argument("--errors", required=True, metavar="DIR", help="error directory")
-    e.add_argument("--format", choices=("isg", "etalon"), required=True,
-                   help="isg: ISG CSV; etalon: Etalon exchange format")
-    e.add_argument("--out", required=True, help="controller file to write")
+    e.add_argument("--format", choices=("isg", "etalon") + AXIS_FORMATS, required=True,
+                   help="isg / etalon: volumetric compensation parameters; sinumerik-lec "
+                        "(positioning), sinumerik-cec (straightness), heidenhain (.CMA with "
+                        ".COM tables next to it), fanuc (pitch error compensation tape): axis "
+                        "compensation tables, within each controller's documented limits "
+                        "(volerr formats controller)")
+    e.add_argument("--out", required=True,
+                   help="controller file to write (heidenhain: the .cma; its .com tables "
+                        "are written next to it)")
     e.add_argument("--negate", action="store_true",
-                   help="write compensation values (the errors with reversed sign) for a "
-                        "controller that expects them")
+                   help="isg / etalon: write compensation values (the errors with reversed "
+                        "sign) for a controller that expects them")
+    e.add_argument("--points", type=int, default=None, metavar="N",
+                   help="axis tables: at most N equally spaced points per table (default: "
+                        "the finest spacing of the error table, up to the format's limit)")
+    e.add_argument("--json", metavar="F",
+                   help="axis tables: JSON {format, left_um: {max, rms}, before_um, tables}: "
+                        "what compensating with the tables leaves of the model's volumetric "
+                        "error over the working volume")
+    e.add_argument("--plot", metavar="PNG",
+                   help="axis tables: map of the volumetric error before and after the "
+                        "tables' correction (three levels of the last linear axis)")
+    e.add_argument("--grid", type=int, default=9, metavar="N",
+                   help="axis tables: grid points per linear axis for --json / --plot over "
+                        "the part of the travel the error tables cover (default 9)")
+    e.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
+                   help="axis tables: position of a rotary axis for --json / --plot, "
+                        "repeatable (default 0 deg)")
     e.set_defaults(func=run)
     i = s.add_parser("import", help="controller file -> error directory")
     i.add_argument("layout", help="layout name or file")
-    i.add_argument("file", help="ISG CSV or Etalon file")
-    i.add_argument("--format", choices=("auto", "isg", "etalon"), default="auto",
-                   help="format of FILE: auto (from its content), isg or etalon")
+    i.add_argument("file", help="controller file (heidenhain: the .cma, its .com tables next "
+                                "to it)")
+    i.add_argument("--format", choices=("auto", "isg", "etalon") + AXIS_FORMATS,
+                   default="auto", help="the file's format (auto: isg or etalon)")
     from ._common import add_errors_out, add_force
 
     add_errors_out(i, "the imported tables", "--out", required=True)
     add_force(i)
     i.add_argument("--negate", action="store_true",
-                   help="the file holds compensation values: reverse their sign")
+                   help="isg / etalon: the file holds compensation values: reverse their sign")
     i.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..tables import controller as ct
-    from ._common import layout_inputs
-    from ..fileio import Outputs, write_text
     from ..machine.model import load
-    from ..tables.table import read_error_dir, write_error_dir
 
     model = load(args.layout)
     if args.action == "export":
         require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
                                                   f"directory (the folder holding X.csv ...)")
         require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
-        tables, (consts, _, _) = read_error_dir(args.errors, model.axes)
-        ct.check_against_model(model, tables, consts, args.errors)
-        require(tables or consts, f"{args.errors}: no error tables or constants to export")
-        if args.negate:
-            tables, consts = ct.negated(tables, consts)
-        writer = ct.write_isg if args.format == "isg" else ct.write_etalon
-        inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
-        with Outputs(inputs).file("--out", args.out) as outs:
-            write_text(outs.path("--out"), writer(model.name, tables, consts), inputs)
-        n = sum(len(t.values) for t in tables.values())
-        print(f"{model.name}: wrote {n} component errors ({len(tables)} axes) and "
-              f"{len(consts)} position errors to {args.out} ({args.format}"
-              f"{', negated: compensation values' if args.negate else ''})")
-        return 0
+        if args.format in AXIS_FORMATS:
+            return _export_axis_tables(args, model)
+        return _export_volumetric(args, model)
+    if args.format in AXIS_FORMATS:
+        return _import_axis_tables(args, model)
+    return _import_volumetric(args, model)
+
+
+def _export_volumetric(args, model) -> int:
+    from ..tables import controller as ct
+    from ..tables.table import read_error_dir
+    from ._common import layout_inputs
+    from ..fileio import Outputs, write_text
+
+    for flag in ("json", "plot", "points"):
+        require(getattr(args, flag) is None, f"--{flag} is for the axis compensation formats "
+                                             f"({' '.join(AXIS_FORMATS)})")
+    tables, (consts, _, _) = read_error_dir(args.errors, model.axes)
+    ct.check_against_model(model, tables, consts, args.errors)
+    require(tables or consts, f"{args.errors}: no error tables or constants to export")
+    if args.negate:
+        tables, consts = ct.negated(tables, consts)
+    writer = ct.write_isg if args.format == "isg" else ct.write_etalon
+    inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
+    with Outputs(inputs).file("--out", args.out) as outs:
+        write_text(outs.path("--out"), writer(model.name, tables, consts), inputs)
+    n = sum(len(t.values) for t in tables.values())
+    print(f"{model.name}: wrote {n} component errors ({len(tables)} axes) and "
+          f"{len(consts)} position errors to {args.out} ({args.format}"
+          f"{', negated: compensation values' if args.negate else ''})")
+    return 0
+
+
+def _export_axis_tables(args, model) -> int:
+    from ..fileio import Outputs, json_text, write_text
+    from ..tables import comp_tables, controller_tables as ctl
+    from ..tables.functions import ErrorFunctions
+    from ._common import layout_inputs, parse_at
+
+    require(not args.negate, "--negate is for isg / etalon (the axis formats have their own "
+                             "sign conventions, volerr formats controller)")
+    funcs = ErrorFunctions.from_dir(args.errors, model)
+    tables = ctl.build(funcs, args.format, args.points)
+    inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
+    outs = Outputs(inputs)
+    files = ctl.write(model, tables, args.format, Path(args.out))
+    roles = {}
+    for k, path in enumerate(files):
+        roles[path] = "--out" if k == 0 else f"--out ({Path(path).name})"
+        outs.file(roles[path], path)
+    outs.file("--json", args.json).plot("--plot", args.plot).check()
+    result = comp_tables.left(model, funcs, tables, args.grid, parse_at(args.at))
+    s = result.summary()
+    with outs:
+        for path, text in files.items():
+            write_text(outs.path(roles[path]), text, inputs)
+        if args.json:
+            write_text(outs.path("--json"), json_text(
+                {"layout": model.name, "format": args.format, **s,
+                 "tables": [{"parameter": t.parameter, "input": t.input, "output": t.output,
+                             "points": len(t.values), "start": t.start, "step": t.step,
+                             "modulo": t.modulo, "direction": t.direction}
+                            for t in tables]}), inputs)
+        if args.plot:
+            ctl.plot_left(result, outs.path("--plot"),
+                          f"{model.name}: what {args.format} tables leave")
+    print(f"{model.name}: wrote {len(tables)} {args.format} tables "
+          f"({', '.join(sorted({t.parameter for t in tables}))}) to {args.out}")
+    print(f"  volumetric error over the working volume ({s['points']} points): max "
+          f"{s['before_um']['max']:.2f} -> {s['left_um']['max']:.2f} um, rms "
+          f"{s['before_um']['rms']:.2f} -> {s['left_um']['rms']:.2f} um left after the "
+          "tables' correction")
+    return 0
+
+
+def _import_volumetric(args, model) -> int:
+    from ..tables import controller as ct
+    from ._common import layout_inputs
+    from ..fileio import Outputs
+    from ..tables.table import write_error_dir
+
     inputs = [args.file] + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force).folder("--errors-out", args.errors_out,
                                   files=[f"{a}.csv" for a in model.axes] + ["constants.csv"])
@@ -77,10 +169,30 @@ def run(args) -> int:
     tables, consts = ct.read_controller_file(args.file, model, args.format)
     if args.negate:
         tables, consts = ct.negated(tables, consts)
-    out = Path(args.errors_out)
     with outs:
         write_error_dir(outs.path("--errors-out"), tables, consts or None, inputs=inputs)
     n = sum(len(t.values) for t in tables.values())
     print(f"{model.name}: read {n} component errors ({len(tables)} axes) and {len(consts)} "
-          f"position errors from {args.file}; wrote {out}/")
+          f"position errors from {args.file}; wrote {Path(args.errors_out)}/")
+    return 0
+
+
+def _import_axis_tables(args, model) -> int:
+    from ..fileio import Outputs
+    from ..tables import controller_tables as ctl
+    from ..tables.table import write_error_dir
+    from ._common import layout_inputs
+
+    require(not args.negate, "--negate is for isg / etalon")
+    inputs = [args.file] + layout_inputs(args.layout)
+    outs = Outputs(inputs, force=args.force).folder(
+        "--errors-out", args.errors_out,
+        files=[f"{a}.csv" for a in model.axes] + ["constants.csv"])
+    outs.check()
+    tables = ctl.import_tables(model, args.file, args.format)
+    with outs:
+        write_error_dir(outs.path("--errors-out"), tables, None, inputs=inputs)
+    n = sum(len(t.values) for t in tables.values())
+    print(f"{model.name}: read {n} component errors ({len(tables)} axes) from {args.file} "
+          f"({args.format}); wrote {Path(args.errors_out)}/")
     return 0

@@ -30,6 +30,10 @@ def register(sub) -> None:
     p.add_argument("--magnify", type=float, default=None, metavar="K",
                    help="error magnification in the plots (default: automatic)")
     p.add_argument("--json", metavar="F", help="summary as JSON")
+    p.add_argument("--approach", default=None, metavar="DIRS",
+                   help="approach direction of axes whose tables carry a reversal column "
+                        "RV_<axis>_um (ISO 230-2 B_i): X+,Y- per axis, or + / - for all "
+                        "(default: the bidirectional mean, the tabulated value)")
     p.set_defaults(func=run)
 
 
@@ -46,9 +50,15 @@ def run(args) -> int:
         rnd_plot = volmap.random_plot_path(args.plot)
     outs = Outputs(inputs).file("--out", args.out).plot("--plot", args.plot) \
         .plot("--plot-random", rnd_plot).file("--json", args.json).check()
+    from ..tables.functions import parse_approach
+
+    approach = parse_approach(args.approach, model, funcs)
     vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at),
-                                 box=volmap.volume(model, funcs, args.volume))
+                                 box=volmap.volume(model, funcs, args.volume),
+                                 approach=approach)
     s = vmap.summary()
+    if approach:
+        s["approach"] = {a: ("+" if v > 0 else "-") for a, v in approach.items()}
     with outs:
         if args.out:
             volmap.write_map_csv(outs.path("--out"), vmap, inputs)

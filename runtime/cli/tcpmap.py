@@ -33,6 +33,12 @@ def register(sub) -> None:
 
     add_plot(p, "the map", "--out", required=True)
     p.add_argument("--csv", metavar="F.csv", help="write the grid (CSV)")
+    p.add_argument("--approach", default=None, metavar="DIRS",
+                   help="approach direction of linear axes whose tables carry a reversal "
+                        "column RV_<axis>_um: X+,Y- per axis, + / - for all, or sweep (the "
+                        "grid run row by row with the first rotary axis rising, each axis "
+                        "approaching in the direction it moves; not given: the bidirectional "
+                        "mean)")
     p.set_defaults(func=run)
 
 
@@ -58,7 +64,14 @@ def run(args) -> int:
                                    args.extrapolate)
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
     outs = Outputs(inputs).plot("--plot", args.plot).file("--csv", args.csv).check()
-    tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps)
+    from ..tables.functions import parse_approach
+    from ._common import progress_bar
+
+    approach = "sweep" if args.approach == "sweep" else \
+        parse_approach(args.approach, model, funcs)
+    with progress_bar(None, "tcpmap", total=args.steps * args.steps, unit="points") as tick:
+        tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps,
+                       approach=approach, progress=tick)
     a1, a2, q1, q2, err, valid = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err, tmap.valid
     require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
                          "for every rotary position")

@@ -113,9 +113,11 @@ def volume(model, funcs, choice: str = "travel") -> dict:
 
 
 def volumetric_map(model, funcs, grid=None, probe=(0.0, 0.0, 0.0), at=None,
-                   box=None) -> VolumetricMap:
+                   box=None, approach=None) -> VolumetricMap:
     """Evaluate the volumetric error of ``model`` with error functions ``funcs`` on a grid over
-    ``box`` (axis -> (min, max); default the layout's travel)."""
+    ``box`` (axis -> (min, max); default the layout's travel).  ``approach``: {axis: +1 | -1}
+    the approach direction of axes whose tables carry a reversal (ISO 230-2 B_i; default the
+    bidirectional mean)."""
     box = model.travel if box is None else box
     counts = grid_counts(grid)
     lin = linear_axes(model)
@@ -136,7 +138,15 @@ def volumetric_map(model, funcs, grid=None, probe=(0.0, 0.0, 0.0), at=None,
     for start in range(0, n, BLOCK):
         sl = slice(start, min(start + BLOCK, n))
         p = {a: v[sl] for a, v in pos.items()}
-        err[sl] = model.volumetric_error(p, funcs(p), probe=probe)
+        e = funcs(p)
+        if approach and getattr(funcs, "has_reversal", False):
+            from ..tables.functions import approach_array
+
+            q = np.column_stack([p[a] for a in model.axes])
+            for k, v in funcs.reversal(q, approach_array(approach, model.axes,
+                                                           len(q))).items():
+                e[k] = e[k] + v if k in e else v
+        err[sl] = model.volumetric_error(p, e, probe=probe)
         if has_random:
             rnd[sl] = model.random_error(p, funcs.sigmas(p), probe=probe)
         nominal[sl] = model.nominal_position(p, probe=probe)

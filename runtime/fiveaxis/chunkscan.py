@@ -1,12 +1,21 @@
 """Whole-chunk tokenising and number formatting for the streamed compensation (numpy).
 
-:func:`scan` finds, in one pass over the bytes of a chunk of lines, the lines that are plain
-address words (exactly the lines :data:`volerr.fiveaxis.gcode._SIMPLE` matches) without
-``G``/``M`` words, without an axis of another machine and without an axis written twice: the
-interpretation of such a line is known without the interpreter (a motion block in the distance
-mode in force, or nothing).  Their words come back as arrays (line, axis, value, decimals,
-``+`` sign, span in the chunk text); numbers are parsed exactly (integer mantissa / power of
-ten, correctly rounded; Python's ``float`` for the few with more than 15 digits).
+:func:`scan` finds, in one pass over the bytes of a chunk of lines, the lines whose
+interpretation is known without the interpreter, and their words.  Such a *plain* line holds
+address words (``X-12.5``, ``n0010``, blanks between letter and number allowed), blanks and
+comments (``( ... )`` and ``;`` to the end of the line) only, as post-processors write them:
+
+* ``G`` words only ``G0``/``G1`` (``G00``, ``G01``): straight moves in the mode in force;
+* ``M`` words other than those the interpreter acts on (:data:`volerr.fiveaxis.gcode.SPECIAL_M`);
+* ``T``, ``H``, ``D`` words (tool and offset numbers; the run keeps the last of each);
+* ``N F S`` and every other letter that is not an axis of another machine;
+* no axis written twice.
+
+Such a line is a motion block in the distance mode in force, or nothing; the caller lets the
+interpreter do every other line (and plain lines in a mode where axis words mean more than a
+straight move: incremental, arc, TCPM).  Its words come back as arrays (line, axis, value,
+decimals, ``+`` sign, span in the chunk text); numbers are parsed exactly (integer mantissa /
+power of ten, correctly rounded; Python's ``float`` for the few with more than 15 digits).
 :func:`format_numbers` is :func:`volerr.fiveaxis.gcode.format_number` for arrays.
 """
 
@@ -18,7 +27,9 @@ import numpy as np
 
 from . import gcode
 
-_OTHER, _LETTER, _DIGIT, _SIGN, _DOT, _BLANK, _EOL = range(7)
+#: byte classes; those up to _EOL are the significant bytes of the scan, from _OTHER on a
+#: byte a plain line cannot hold (outside comments)
+_LETTER, _DIGIT, _SIGN, _DOT, _SEP, _EOL, _BLANK, _OTHER, _OPEN, _CLOSE = range(1, 11)
 _CLS = np.full(256, _OTHER, dtype=np.int8)
 for _c in range(ord("A"), ord("Z") + 1):
     _CLS[_c] = _CLS[_c + 32] = _LETTER
@@ -27,17 +38,27 @@ _CLS[ord("+")] = _CLS[ord("-")] = _SIGN
 _CLS[ord(".")] = _DOT
 _CLS[ord(" ")] = _CLS[ord("\t")] = _BLANK
 _CLS[ord("\r")] = _CLS[ord("\n")] = _EOL
+_CLS[ord("(")] = _CLS[ord(";")] = _OPEN
+_CLS[ord(")")] = _CLOSE
+#: the class of every byte value, for ``bytes.translate``
+_TRANSLATE = _CLS.tobytes()
 _POW10 = 10.0 ** np.arange(23)
 _IPOW10 = 10 ** np.arange(19, dtype=np.int64)
 
+#: letter codes of :func:`_letter_table` below the axis indices
+IGNORED, NEEDS_INTERPRETER, G_WORD, M_WORD = -1, -2, -3, -4
+#: tool and offset numbers: the last of each in a run of plain lines is kept
+TRACKED = {"T": -5, "H": -6, "D": -7}
 
 @dataclass
 class Scan:
     """``text``: the chunk; ``start`` (n,) offset of every line; ``fast`` (n,) bool: a plain
-    line of the kind above; words of the fast lines, in text order: ``line`` (line index),
-    ``axis`` (index into the axes, -1 for an ignored letter such as ``N`` or ``F``), ``value``,
-    ``frac`` (digits after the dot, -1 without a dot), ``plus`` (written with ``+``),
-    ``num_start`` / ``num_end`` (span of the number in ``text``)."""
+    line of the kind above; the words of the fast lines that matter (not those the
+    interpreter ignores, such as ``N`` or ``F``), in text order: ``line`` (line index),
+    ``axis`` (index into the axes, or a negative letter code: :data:`G_WORD`,
+    :data:`M_WORD`, a :data:`TRACKED` code), ``value``, ``frac`` (digits after the dot, -1
+    without a dot), ``plus`` (written with ``+``), ``num_start`` / ``num_end`` (span of the
+    number in ``text``)."""
 
     text: str
     start: np.ndarray
@@ -50,16 +71,81 @@ class Scan:
     num_start: np.ndarray
     num_end: np.ndarray
 
+    def last_tracked(self, w: slice) -> dict:
+        """Letter -> value of the last ``T``/``H``/``D`` word among the words ``w``."""
+        out = {}
+        ax = self.axis[w]
+        for letter, code in TRACKED.items():
+            k = np.flatnonzero(ax == code)
+            if len(k):
+                out[letter] = float(self.value[w][k[-1]])
+        return out
+
 
 def _letter_table(axes) -> np.ndarray:
-    """Per byte: axis index, -1 for a letter the interpreter ignores, -2 for a letter that
-    needs it (G, M, an axis of another machine)."""
-    t = np.full(256, -1, dtype=np.int64)
-    for c in "GM" + "".join(sorted(gcode.Interpreter.FOREIGN_AXES)):
-        t[ord(c)] = t[ord(c.lower())] = -2
+    """Per byte: the axis index of an axis letter, else a negative code: G and M words (their
+    values decide), tracked tool numbers, letters that need the interpreter (an axis of
+    another machine), letters it ignores."""
+    t = np.full(256, IGNORED, dtype=np.int64)
+    for c in sorted(gcode.Interpreter.FOREIGN_AXES):
+        t[ord(c)] = t[ord(c.lower())] = NEEDS_INTERPRETER
+    for c, code in (("G", G_WORD), ("M", M_WORD), *TRACKED.items()):
+        t[ord(c)] = t[ord(c.lower())] = code
     for i, a in enumerate(axes):
         t[ord(a)] = t[ord(a.lower())] = i
     return t
+
+
+def _spans(s: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """Every index of the half-open spans [s, e) (s, e arrays, e >= s), in order."""
+    ln = e - s
+    total = int(ln.sum())
+    if not total:
+        return np.zeros(0, np.int64)
+    off = np.repeat(s - (np.cumsum(ln) - ln), ln)
+    return np.arange(total, dtype=np.int64) + off
+
+
+def _comments(b: np.ndarray, cls: np.ndarray, start: np.ndarray, body_end: np.ndarray, lid,
+              bad: np.ndarray) -> None:
+    """Comments ``( ... )`` and ``;`` to the end of the line, as the tokenizer reads them: the
+    first byte of each becomes a separator (a word cannot run through it), the others blanks;
+    a line with a ``(`` not closed on it is marked ``bad``.  ``cls`` and ``bad`` are changed in
+    place.  Lines are resolved opener by opener, all lines at once per round (a round per
+    comment of the line with the most)."""
+    opens = np.flatnonzero(cls == _OPEN)
+    if not len(opens):
+        return
+    closes = np.flatnonzero(cls == _CLOSE)
+    lines = lid(opens)                       # sorted: keep the first of each line
+    lines = lines[np.r_[True, lines[1:] != lines[:-1]]]
+    pos = start[lines]
+    s_all, e_all = [], []
+    last_open = len(opens) - 1
+    while len(lines):
+        k = np.searchsorted(opens, pos)
+        o = opens[np.minimum(k, last_open)]
+        has = (k <= last_open) & (o < body_end[lines])
+        lines, o = lines[has], o[has]
+        if not len(lines):
+            break
+        semi = b[o] == 59
+        end = body_end[lines].copy()
+        paren = np.flatnonzero(~semi)
+        if len(paren):
+            kc = np.searchsorted(closes, o[paren])
+            c = closes[np.minimum(kc, len(closes) - 1)] if len(closes) else np.zeros(len(kc),
+                                                                                   np.int64)
+            closed = (kc < len(closes)) & (c < end[paren])
+            bad[lines[paren[~closed]]] = True
+            end[paren[closed]] = c[closed] + 1
+        s_all.append(o)
+        e_all.append(end)
+        more = ~semi & (end < body_end[lines])
+        lines, pos = lines[more], end[more]
+    s_all, e_all = np.concatenate(s_all), np.concatenate(e_all)
+    cls[_spans(s_all + 1, e_all)] = _BLANK
+    cls[s_all] = _SEP
 
 
 def scan(segs: list, axes) -> Scan:
@@ -69,105 +155,105 @@ def scan(segs: list, axes) -> Scan:
     lens = np.fromiter(map(len, segs), dtype=np.int64, count=n)
     start = np.zeros(n, dtype=np.int64)
     np.cumsum(lens[:-1], out=start[1:])
-    b = np.frombuffer(text.encode("latin-1", "replace"), dtype=np.uint8)
-    cls = _CLS[b]
-    lid = np.repeat(np.arange(n, dtype=np.int32), lens)
+    raw = text.encode("latin-1", "replace")
+    b = np.frombuffer(raw, dtype=np.uint8)
+    cls = np.frombuffer(bytearray(raw.translate(_TRANSLATE)), dtype=np.int8)
+
+    def lid(pos):
+        """The line of byte positions ``pos``."""
+        return np.searchsorted(start, pos, side="right") - 1
+
     bad = np.zeros(n, dtype=bool)
-    bad[lid[cls == _OTHER]] = True
-    sig = np.flatnonzero((cls >= _LETTER) & (cls <= _DOT)).astype(np.int32)
-    c, ln = cls[sig], lid[sig]
-    isnum = c >= _DIGIT
-    isl = c == _LETTER
-    same_prev = np.zeros(len(sig), dtype=bool)
-    same_prev[1:] = ln[1:] == ln[:-1]
-    adj_prev = np.zeros(len(sig), dtype=bool)
-    adj_prev[1:] = (sig[1:] == sig[:-1] + 1) & same_prev[1:]
-    prev_num = np.zeros(len(sig), dtype=bool)
-    prev_num[1:] = isnum[:-1]
-    prev_l = np.zeros(len(sig), dtype=bool)
-    prev_l[1:] = isl[:-1]
-    run0 = isnum & ~(prev_num & adj_prev)
-    # a number starts right after its letter (blanks between allowed)
-    bad[ln[run0 & ~(prev_l & same_prev)]] = True
-    # a letter is followed by its number
-    nxt_num = np.zeros(len(sig), dtype=bool)
-    nxt_num[:-1] = isnum[1:] & same_prev[1:]
-    bad[ln[isl & ~nxt_num]] = True
-    # numbers: [+-]?(\d+\.?\d*|\.\d+); per run, counts from running sums at its ends
-    rid = np.cumsum(run0, dtype=np.int32) - 1
-    nr = int(run0.sum())
-    rn = rid[isnum]
-    cn = c[isnum]
-    first = run0[isnum]
-    run_first = np.flatnonzero(first)
-    run_last = np.empty(nr, dtype=np.int64)
-    run_last[:-1] = run_first[1:] - 1
-    if nr:
-        run_last[-1] = len(rn) - 1
-
-    def per_run(mask):
-        total = np.cumsum(mask, dtype=np.int32)
-        return total[run_last] - total[run_first] + mask[run_first]
-
-    ndot = per_run(cn == _DOT)
-    dig = cn == _DIGIT
-    ndig = per_run(dig)
-    bad_run = per_run(cn == _SIGN) > (cn[run_first] == _SIGN)     # a sign inside the number
-    bad_run |= (ndot > 1) | (ndig == 0)
-    rline = ln[run0]
-    bad[rline[bad_run]] = True
-    # letters that need the interpreter; no words at all -> the interpreter too
-    lt = _letter_table(axes)
-    code = lt[b[sig[isl]]]
-    bad[ln[isl][code == -2]] = True
-    has_word = np.zeros(n, dtype=bool)
-    has_word[ln[isl]] = True
-    bad |= ~has_word
+    # the body of a line ends where its ending (CRLF, LF or CR: the only CR / LF bytes of the
+    # line) begins
+    end = start + lens
+    last = np.where(lens > 0, b[np.maximum(end - 1, 0)], 0)
+    ending = (last == 10) | (last == 13)
+    ending = ending + (ending & (last == 10) & (lens > 1)
+                       & (b[np.maximum(end - 2, 0)] == 13))
+    body_end = end - ending
+    _comments(b, cls, start, body_end, lid, bad)
+    bad[lid(np.flatnonzero(cls >= _OTHER))] = True
+    # numbers: [+-]?(\d+\.?\d*|\.\d+), runs of adjacent number bytes [ns, ne)
+    nm = (cls >= _DIGIT) & (cls <= _DOT)
+    start_m = nm.copy()
+    start_m[1:] &= ~nm[:-1]
+    end_m = nm.copy()
+    end_m[:-1] &= ~nm[1:]
+    ns = np.flatnonzero(start_m)
+    ne = np.flatnonzero(end_m) + 1
+    nr = len(ns)
+    rline = lid(ns)
+    # tokens: letters, number runs (by their first byte), comment starts and line endings
+    # (so that neighbouring tokens are in the same line unless an ending lies between them)
+    tok = np.flatnonzero((cls == _LETTER) | start_m | (cls == _SEP) | (cls == _EOL))
+    is_run = start_m[tok]
+    isl = cls[tok] == _LETTER
+    # a number starts right after its letter (blanks between allowed) ...
+    no_letter = is_run.copy()
+    no_letter[1:] &= ~isl[:-1]
+    # ... and a letter is followed by its number
+    no_number = isl.copy()
+    no_number[:-1] &= ~is_run[1:]
+    bad[lid(tok[np.flatnonzero(no_letter | no_number)])] = True
+    # a sign only in front, at most one dot, at least one digit
+    signs = np.flatnonzero(cls == _SIGN)
+    bad[lid(signs[~start_m[signs]])] = True
+    dots = np.flatnonzero(cls == _DOT)
+    dot_run = np.searchsorted(ns, dots, side="right") - 1
+    ndot = np.bincount(dot_run, minlength=nr)
+    bad[rline[ndot > 1]] = True
+    frac = np.full(nr, -1, dtype=np.int64)
+    frac[dot_run] = ne[dot_run] - 1 - dots
+    nsign = np.bincount(np.searchsorted(ns, signs, side="right") - 1, minlength=nr)
+    ndig = (ne - ns) - ndot - nsign
+    bad[rline[ndig == 0]] = True
+    # the letter of each run: the token before it (in a line that is not bad)
+    rs = np.flatnonzero(is_run)
+    code = _letter_table(axes)[b[tok[np.maximum(rs - 1, 0)]]]
+    bad[rline[code == NEEDS_INTERPRETER]] = True
     # an axis programmed twice
-    ax_line = ln[isl]
     m = code >= 0
-    key = ax_line[m] * (len(axes) + 1) + code[m]
+    key = rline[m] * (len(axes) + 1) + code[m]
     if len(key):
         ks = np.sort(key)
         bad[ks[1:][ks[1:] == ks[:-1]] // (len(axes) + 1)] = True
-    fast = ~bad
-    # words of the fast lines (one number run per letter, in order)
-    keep_run = fast[rline]
-    wl = ax_line[fast[ax_line]]
-    wa = code[fast[ax_line]]
-    # digits: mantissa and digits after the dot per run
-    pos_num = sig[isnum]
-    ns, ne = pos_num[run_first], pos_num[run_last] + 1
-    dpos = np.flatnonzero(dig)
-    # digits after the dot: the characters of the run past its dot (more than one dot or a
-    # sign there makes the line slow anyway)
-    dot_at = np.full(nr, -1, dtype=np.int64)
-    dots = np.flatnonzero(cn == _DOT)
-    dot_at[rn[dots]] = dots
-    frac = np.where(dot_at >= 0, run_last - dot_at, -1)
-    # k-th digit from the end of the run (the digits of a run are contiguous in dpos)
+    # values of the words that matter (not N F S ...)
+    sel = np.flatnonzero(code != IGNORED)
+    ns, ne, rline, code, frac, ndig = ns[sel], ne[sel], rline[sel], code[sel], frac[sel], \
+        ndig[sel]
+    # mantissa: the k-th digit from the end of its run times 10**k, summed per run (float
+    # sums of integers below 2**53 are exact; longer mantissas: Python below)
+    at = _spans(ns, ne)
+    digits = at[cls[at] == _DIGIT]
+    nr = len(sel)
     dcount = np.zeros(nr + 1, dtype=np.int64)
     np.cumsum(ndig, out=dcount[1:])
-    drun_end = np.repeat(dcount[1:], ndig)
-    k_from_end = drun_end - np.arange(1, len(dpos) + 1, dtype=np.int64)
-    dval = b[pos_num[dpos]] - 48
-    exact = ndig <= 15
+    k_from_end = np.repeat(dcount[1:] - 1, ndig) - np.arange(len(digits), dtype=np.int64)
     np.minimum(k_from_end, 18, out=k_from_end)
-    # float sums of integers below 2**53 are exact (longer mantissas: Python below)
+    dval = b[digits] - 48
     mant = np.zeros(nr)
     has_dig = ndig > 0
-    if len(dpos):
+    if len(digits):
         mant[has_dig] = np.add.reduceat(_POW10[k_from_end] * dval, dcount[:-1][has_dig])
     fr = np.maximum(frac, 0)
     val = mant / _POW10[np.minimum(fr, 22)]
-    neg = b[ns] == ord("-")
+    neg = b[ns] == 45
     val = np.where(neg, -val, val)
-    exact &= fr <= 22
-    for i in np.flatnonzero(~exact & keep_run):
+    exact = (ndig <= 15) & (fr <= 22)
+    for i in np.flatnonzero(~exact & ~bad[rline]):
         val[i] = float(text[ns[i]:ne[i]])
-    plus = b[ns] == ord("+")
-    sel = keep_run
-    return Scan(text, start, fast, wl, wa, val[sel], frac[sel], plus[sel], ns[sel], ne[sel])
+    # G words: only G0 / G1; M words: not those the interpreter acts on
+    gm = np.flatnonzero((code == G_WORD) | (code == M_WORD))
+    if len(gm):
+        v = val[gm]
+        refused = np.where(code[gm] == G_WORD, (v != 0.0) & (v != 1.0),
+                           np.isin(np.round(v), list(gcode.SPECIAL_M)))
+        bad[rline[gm[refused]]] = True
+    fast = ~bad
+    keep = fast[rline]
+    return Scan(text, start, fast, rline[keep], code[keep], val[keep], frac[keep],
+                b[ns[keep]] == 43, ns[keep], ne[keep])
 
 
 def format_numbers(values, nd, keep, plus, template=None) -> list:

@@ -143,6 +143,9 @@ class Result:
     reports: list = field(default_factory=list)
     #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
     assumed_zero: tuple = ()
+    #: what the program held besides straight moves: ``tcpm_blocks`` and ``arcs`` (kept,
+    #: linearised, segments, max_path_deviation_um), as in the streamed summary
+    shapes: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         done = [r for r in self.reports if r.status.startswith("compensated")]
@@ -166,6 +169,7 @@ class Result:
             "max_iterations": max((r.iterations for r in done), default=0),
             "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
                                            if np.all(np.isfinite(r.u_after_um))])),
+            **self.shapes,
         }
 
 
@@ -229,6 +233,15 @@ class ErrorModel:
         self.lin = linear_axes(model)
         self.ranges = funcs.ranges() if funcs is not None else {}
 
+    def with_tool(self, tool) -> "ErrorModel":
+        """The same model with another tool offset (3,) mm (error values shared)."""
+        import copy
+
+        other = copy.copy(self)
+        other.tool = np.asarray(tool, dtype=float)
+        other.__dict__["_memo"] = self.__dict__.setdefault("_memo", [])
+        return other
+
     def lookup(self, q: np.ndarray) -> np.ndarray:
         """Positions for the error tables: a rotary axis is taken modulo 360 deg where that
         brings it into its table's range (a C table 0..340 serves C = 400)."""
@@ -273,34 +286,45 @@ class ErrorModel:
             q[:, i] = np.where(near, np.clip(v, lo, hi), v)
         return q
 
-    def errors(self, q: np.ndarray, subset=None) -> dict:
+    def errors(self, q: np.ndarray, subset=None, direction=None) -> dict:
         """Error functions at ``q`` (the last two evaluations are remembered: the position and
-        the orientation error of the same positions share one table look-up)."""
+        the orientation error of the same positions share one table look-up).  ``direction``
+        (N, n_axes) -1 / 0 / +1: the approach direction of every axis, for tables with a
+        reversal column (:meth:`volerr.tables.functions.ErrorFunctions.reversal`)."""
         if self.funcs is None:
             return {}
+        if direction is not None and not self.funcs.has_reversal:
+            direction = None
         memo = self.__dict__.setdefault("_memo", [])
-        for qm, e in memo:
-            if qm.shape == q.shape and np.array_equal(qm, q):
+        for qm, dm, e in memo:
+            if qm.shape == q.shape and np.array_equal(qm, q) and \
+                    (dm is None) == (direction is None) and \
+                    (dm is None or np.array_equal(dm, direction)):
                 break
         else:
-            e = self.funcs(self._clip_edges(self.lookup(q)))
+            ql = self._clip_edges(self.lookup(q))
+            e = self.funcs(ql)
             # constants as scalars: the generated code then takes their sin/cos once
             e.update({k: float(v) for k, v in self.funcs.constants.items()})
-            memo.insert(0, (np.array(q, dtype=float, copy=True), e))
+            if direction is not None:
+                for k, v in self.funcs.reversal(ql, direction).items():
+                    e[k] = e[k] + v if k in e else v
+            memo.insert(0, (np.array(q, dtype=float, copy=True),
+                            None if direction is None else np.array(direction), e))
             del memo[2:]
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e
 
-    def position_error(self, q, subset=None) -> np.ndarray:
-        """Exact error of the tool tip, (N, 3) mm."""
-        return self.model.exact_error(q, self.errors(q, subset), probe=self.tool)
+    def position_error(self, q, subset=None, direction=None) -> np.ndarray:
+        """Exact error of the tool tip, (N, 3) mm (``direction``: see :meth:`errors`)."""
+        return self.model.exact_error(q, self.errors(q, subset, direction), probe=self.tool)
 
-    def orientation_error(self, q, subset=None) -> np.ndarray:
+    def orientation_error(self, q, subset=None, direction=None) -> np.ndarray:
         """First-order error of the tool axis, (N, 3) rad."""
         if not self.rot:
             return np.zeros((len(q), 3))
-        return self.model.orientation_error(q, self.errors(q, subset))
+        return self.model.orientation_error(q, self.errors(q, subset, direction))
 
     def tool_axis(self, q) -> np.ndarray:
         return self.model.forward(q, self.tool)[:, 3:6]
@@ -322,19 +346,25 @@ def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = ORIENTATION_RC
 
 
 def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: float = 1e-4,
-          max_iter: int = 50):
+          max_iter: int = 50, direction=None, out: dict | None = None):
     """Corrected positions (N, n) for programmed ``q_nom``, the iteration count per row, and
     per row whether the orientation correction was limited: stopped because a rotary axis would
     have left its travel or its error table, or partial near a singular orientation.
 
     Iterates until the change of the correction is below ``tol`` (mm; rotary axes weighted by a
-    1 m lever)."""
+    1 m lever).  ``direction`` (N, n) -1 / 0 / +1: the approach direction of each axis in each
+    row (tables with reversal; the corrected positions are approached as the programmed
+    ones).  ``out``: a dict that gets ``target`` (N, 3), the nominal tool tip, and -- when the
+    first iteration evaluates the whole model at the programmed positions (no orientation,
+    no restriction to some types) -- ``before`` (N, 3), the error there (mm)."""
     m = em.model
     q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
     n = len(q_nom)
     lin_idx = [m.axes.index(a) for a in em.lin]
     rot_idx = [m.axes.index(a) for a in em.rot]
     target_p = m.nominal_position(q_nom, em.tool)
+    if out is not None:
+        out["target"] = target_p
     target_k = em.tool_axis(q_nom) if em.rot else None
     q = q_nom.copy()
     iters = np.zeros(n, dtype=int)
@@ -343,9 +373,10 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     partial = np.zeros(n, dtype=bool)
     for it in range(1, max_iter + 1):
         qa = q[active]
+        da = None if direction is None else direction[active]
         change = np.zeros(len(qa))
         if orientation and em.rot:
-            k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated)
+            k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated, da)
             j = rotary_jacobian(m, qa)
             d, dropped = _truncated_solve(j, -(k_act - target_k[active]))
             partial[np.flatnonzero(active)] = dropped
@@ -356,8 +387,10 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
             d[~ok] = 0.0
             qa[ok] = trial[ok]
             change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated) \
+        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
             - target_p[active]
+        if it == 1 and out is not None and not orientation and em.compensated is None:
+            out["before"] = e.copy()        # nominal(q_nom) - target is exactly 0
         mj = linear_jacobian(m, qa, em.tool)
         d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
         qa[:, lin_idx] += d
@@ -375,7 +408,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     return q, iters, limited | partial
 
 
-def solve_thesis(em: ErrorModel, q_nom: np.ndarray) -> np.ndarray:
+def solve_thesis(em: ErrorModel, q_nom: np.ndarray, direction=None) -> np.ndarray:
     """Ellingsdalen's strategy (rotary errors first, then linear translational errors and
     squareness; angular errors of the linear axes neglected; no iteration)."""
     m = em.model
@@ -391,9 +424,9 @@ def solve_thesis(em: ErrorModel, q_nom: np.ndarray) -> np.ndarray:
     q1 = q_nom.copy()
     mj = linear_jacobian(m, q_nom, em.tool)
     if em.rot:
-        e_rot = em.position_error(q_nom, rotary_params)
+        e_rot = em.position_error(q_nom, rotary_params, direction)
         q1[:, lin_idx] -= np.linalg.solve(mj, e_rot[:, :, None])[:, :, 0]
-    e_lin = em.position_error(q1, linear_params)
+    e_lin = em.position_error(q1, linear_params, direction)
     q2 = q1.copy()
     q2[:, lin_idx] -= np.linalg.solve(linear_jacobian(m, q1, em.tool), e_lin[:, :, None])[:, :, 0]
     return q2
@@ -424,38 +457,43 @@ class _Collect:
                     float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
                     int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))
             else:
-                line, target = b.pending[-1 - o]
-                missing = [a for a in axes if target[a] is None]
+                line, target, missing = b.pending[-1 - o]
                 self.reports.append(LineReport(
                     line.number, dict(target), dict(target), (math.nan,) * 3, (math.nan,) * 3,
-                    math.nan, math.nan, 0,
-                    f"not compensated: position of axis {missing[0]} unknown"))
+                    math.nan, math.nan, 0, f"not compensated: position of {missing} unknown"))
 
 
 def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
                        strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
                        initial: dict | None = None, check_travel: bool = True,
-                       max_iter: int = 50, types=None, chunk_lines: int | None = None) -> Result:
+                       max_iter: int = 50, types=None, chunk_lines: int | None = None,
+                       arc_tol_um: float = 1.0, tool_length: float | None = None,
+                       tool_table: dict | None = None, dialect: str = "auto") -> Result:
     """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
 
     ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
     that compensates the linear axes only); the report still predicts the error of the full
     model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL).
     ``chunk_lines``: lines per chunk (the output does not depend on it; see
-    :mod:`volerr.fiveaxis.program`, which also streams a program file of any length)."""
+    :mod:`volerr.fiveaxis.program`, which also streams a program file of any length).
+    ``arc_tol_um``: path tolerance of arcs (:mod:`volerr.fiveaxis.arcs`); ``tool_length``
+    (mm) or ``tool_table`` (tool number -> mm): the tool length of TCPM blocks
+    (:mod:`volerr.fiveaxis.tcpm`); ``dialect``: "auto", "iso" or "heidenhain"."""
     import io
 
     from . import program
 
     opts = program.Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
-                           check_travel, max_iter, None if types is None else tuple(types))
+                           check_travel, max_iter, None if types is None else tuple(types),
+                           arc_tol_um, tool_length, tool_table, dialect)
     sink = _Collect(model)
-    _, never = program.run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
+    s, never = program.run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
                            chunk_lines or program.CHUNK_LINES)
-    return Result("".join(sink.text), sink.reports, never)
+    return Result("".join(sink.text), sink.reports, never,
+                  {k: s[k] for k in ("tcpm_blocks", "arcs")})
 
 
-def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
+def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter, direction=None) -> np.ndarray:
     """Linear axes solved again for the (rounded) rotary values of ``q_out``; each row
     iterates until its own correction changes by less than ``tol`` (mm)."""
     m = em.model
@@ -465,7 +503,8 @@ def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter) -> np.ndarray:
     active = np.ones(len(q), dtype=bool)
     for _ in range(max_iter):
         qa = q[active]
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated) \
+        da = None if direction is None else direction[active]
+        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
             - target_p[active]
         d = -np.linalg.solve(linear_jacobian(m, qa, em.tool), e[:, :, None])[:, :, 0]
         qa[:, lin_idx] += d

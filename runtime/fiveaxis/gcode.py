@@ -1,4 +1,5 @@
-"""G-code programs in machine axis coordinates: a byte-keeping tokenizer and a modal interpreter.
+"""G-code programs (ISO dialect: Fanuc, Siemens, Heidenhain ISO): a byte-keeping tokenizer and a
+modal interpreter.
 
 What is read
 ------------
@@ -14,15 +15,24 @@ ending.  A line is split into tokens that together are the line exactly:
 Anything else (variables ``#1``, expressions ``[..]``, ``=``, conversational syntax) is refused
 with the line number: the program cannot be interpreted safely.
 
+Siemens extended addresses ``A3=``, ``B3=``, ``C3=`` (the tool vector under ``TRAORI``) are
+words (read as the vector components ``I J K``), and ``TRAORI`` / ``TRAFOOF`` are keywords.
+
 Interpretation (modal state, one block per line)
 ------------------------------------------------
-* Motion: ``G0`` and ``G1`` (straight moves in axis space).  A block with axis words and no
-  other non-modal function is a *motion block*.  ``G2``/``G3`` (arcs), canned cycles
-  ``G73 G74 G76 G81``-``G89``, ``G92 G52 G10`` (offset changes), ``G68 G51`` (rotation,
-  scaling), ``G41 G42`` (cutter radius compensation), ``G43.4 G43.5 M128 TRAORI`` (TCPM: the
-  program would be in workpiece, not axis, coordinates), ``G20`` (inch), ``/`` (block delete)
-  and ``M98`` (subprogram call) are refused: a compensated copy could not be guaranteed.
-  Arcs are refused rather than linearised, so that the output's geometry stays the program's.
+* Motion: ``G0`` and ``G1`` (straight moves in axis space) and ``G2``/``G3`` (arcs in the
+  plane of ``G17``/``G18``/``G19``, centre ``I J K`` relative to the start or radius ``R``;
+  see :mod:`volerr.fiveaxis.arcs`), modal.  A block with axis words and no other non-modal
+  function is a *motion block*.  Canned cycles ``G73 G74 G76 G81``-``G89``, ``G92 G52 G10``
+  (offset changes), ``G68 G51`` (rotation, scaling), ``G41 G42`` (cutter radius
+  compensation), ``G20`` (inch), ``/`` (block delete) and ``M98`` (subprogram call) are
+  refused: a compensated copy could not be guaranteed.
+* TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
+  ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
+  angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
+  workpiece frame (see :mod:`volerr.fiveaxis.tcpm`); the tool length comes from the
+  interpreter's ``tool_length`` rule (an ``H``, ``D`` or ``T`` word, or a given length).
+  At a switch into or out of TCPM the linear positions become unknown until programmed.
 * ``G90``/``G91``: both handled; in ``G91`` an axis word is the increment from the position
   the controller holds.
 * ``G53`` moves and work offsets (``G54`` ...) are kept as written: the program's numbers are
@@ -31,8 +41,8 @@ Interpretation (modal state, one block per line)
   through untouched; after ``G28``/``G30`` the axes they name are at an unknown position until
   programmed again.
 * Axis words are the model's axes (e.g. ``X Y Z B C``); a letter that is an axis of another
-  machine (``A`` ``U`` ... on a DMU 50) is refused.  All other words (``N F S T M H D``, ...)
-  are kept and ignored.
+  machine (``A`` ``U`` ... on a DMU 50) is refused.  ``T H D`` words are remembered (tool
+  length of TCPM); all other words (``N F S M``, ...) are kept and ignored.
 * An axis that has never been programmed is unknown; a motion block that needs it is reported
   as not compensated (its bytes are kept), unless an initial position is given.
 """
@@ -69,24 +79,30 @@ def refuse_exponent(text: str, number: int) -> None:
 
 
 REFUSED_G = {
-    2: "G2 circular arc", 3: "G3 circular arc", 10: "G10 offset setting",
+    10: "G10 offset setting",
     20: "G20 inch units", 41: "G41 cutter radius compensation",
     42: "G42 cutter radius compensation", 51: "G51 scaling", 52: "G52 local coordinate shift",
     68: "G68 coordinate rotation", 73: "G73 canned cycle", 74: "G74 canned cycle",
-    76: "G76 canned cycle", 92: "G92 coordinate shift", 43.4: "G43.4 TCPM (tool centre point "
-    "control: program not in axis coordinates)", 43.5: "G43.5 TCPM (tool centre point control)",
+    76: "G76 canned cycle", 92: "G92 coordinate shift",
     12.1: "G12.1 polar interpolation", 7.1: "G7.1 cylindrical interpolation",
 }
 REFUSED_G.update({g: f"G{g} canned cycle" for g in range(81, 90)})
-REFUSED_M = {98: "M98 subprogram call", 128: "M128 TCPM (tool centre point control)"}
+REFUSED_M = {98: "M98 subprogram call"}
+#: the components of a tool vector (``I J K`` of G43.5, ``A3 B3 C3`` of TRAORI)
+VECTOR = ("I", "J", "K")
+#: Siemens extended address of a tool-vector component: ``A3=0.5``
+_SIEMENS_VECTOR = re.compile(r"([ABCabc])3[ \t]*=[ \t]*([+-]?(?:\d+\.?\d*|\.\d+))")
+_KEYWORD = re.compile(r"(TRAORI|TRAFOOF)(?:[ \t]*\([ \t]*\d*[ \t]*\))?", re.IGNORECASE)
+#: M functions the interpreter acts on (a line with one of them is interpreted line by line)
+SPECIAL_M = frozenset({98, 128, 129})
 
 
 @dataclass
 class Token:
-    kind: str            # "word", "comment", "space", "other"
+    kind: str            # "word", "comment", "space", "keyword", "other"
     text: str
     start: int
-    letter: str = ""     # upper case, words only
+    letter: str = ""     # upper case: words (I J K for A3 B3 C3) and keywords
     value: float = 0.0
     num_start: int = 0   # span of the number inside the line
     num_end: int = 0
@@ -99,7 +115,8 @@ class Line:
     its words as ``parts`` (leading blanks, letter, blanks, number text) and tokenizes only
     when :attr:`tokens` is asked for; any other line is tokenized (and checked) at once."""
 
-    __slots__ = ("number", "body", "ending", "_tokens", "parts", "_items")
+    __slots__ = ("number", "body", "ending", "_tokens", "parts", "_items", "incremental",
+                 "anchor")
 
     def __init__(self, number: int, body: str, ending: str, tokens=None, parts=None):
         self.number = number      # 1-based line number in the file
@@ -108,6 +125,10 @@ class Line:
         self._tokens = tokens
         self.parts = parts
         self._items = None
+        #: letters written incrementally in an absolute block (Heidenhain ``IX``)
+        self.incremental = frozenset()
+        #: index of the token after which added words go (None: after the last word)
+        self.anchor = None
 
     @classmethod
     def parse(cls, number: int, body: str, ending: str) -> "Line":
@@ -135,6 +156,12 @@ class Line:
                 self._items = [(t.letter, t.value, b[t.num_start:t.num_end])
                                for t in self.tokens if t.kind == "word"]
         return self._items
+
+    def keywords(self) -> list[str]:
+        """The keywords of the line (``TRAORI`` ...), upper case."""
+        if self.parts is not None:
+            return []
+        return [t.letter for t in self.tokens if t.kind == "keyword"]
 
     @property
     def text(self) -> str:
@@ -200,6 +227,15 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
         elif c == "/" and not any(t.kind == "word" for t in tokens):
             raise InputError(f"line {number}: block delete '/' is not supported (the block may "
                              "or may not run)")
+        elif c in "ABCabc" and _SIEMENS_VECTOR.match(body, i):
+            m = _SIEMENS_VECTOR.match(body, i)
+            tokens.append(Token("word", m.group(0), i, VECTOR["ABC".index(c.upper())],
+                                float(m.group(2)), m.start(2), m.end(2)))
+            i = m.end()
+        elif c in "Tt" and _KEYWORD.match(body, i):
+            m = _KEYWORD.match(body, i)
+            tokens.append(Token("keyword", m.group(0), i, m.group(1).upper()))
+            i = m.end()
         else:
             m = _WORD.match(body, i)
             if not m:
@@ -229,54 +265,108 @@ def iter_lines(source, first: int = 1):
 
 
 @dataclass
+class Arc:
+    """The arc words of a ``G2``/``G3`` block: ``plane`` 17, 18 or 19, ``ccw`` (G3), the
+    centre words as written (``I J K`` -> value, mm, relative to the start) or the radius
+    ``R`` (mm; negative: more than half a turn)."""
+
+    plane: int
+    ccw: bool
+    centre: dict
+    radius: float | None
+
+
+@dataclass
 class Step:
-    """What one line does to the controller: ``kind`` "motion" (a motion block), "reference"
-    (G28 / G30: the named axes go to an unknown position) or "none" (dwell, or no axis
-    words); ``axis_words`` the (axis, value) pairs as written; ``incremental`` the distance
-    mode in force."""
+    """What one line does to the controller: ``kind`` "motion" (a straight motion block),
+    "arc" (a ``G2``/``G3`` block), "reference" (G28 / G30: the named axes go to an unknown
+    position) or "none" (dwell, a switch, or no axis words); ``axis_words`` the (letter,
+    value) pairs as written (axes, and ``I J K`` of a tool vector under TCPM);
+    ``incremental`` the distance mode in force (``incremental_words``: letters written
+    incrementally in an absolute block, Heidenhain ``IX``); ``arc`` the :class:`Arc`;
+    ``frame`` "axes" or "tcpm" for the block; ``forget`` the letters whose positions become
+    unknown before it (a switch into or out of TCPM); ``tool_length`` the tool length (mm) of
+    a TCPM block; ``orientation`` "angles" or "vector" for a TCPM motion block."""
 
     kind: str
     axis_words: list
     incremental: bool
+    arc: Arc | None = None
+    frame: str = "axes"
+    forget: tuple = ()
+    tool_length: float | None = None
+    incremental_words: frozenset = frozenset()
+    orientation: str | None = None
+    #: modal motion after the line (0 1 straight, 2 3 arcs) and whether the line writes it
+    motion: int = 0
+    motion_word: bool = False
 
 
 class ControllerState:
-    """Axis positions a controller holds (mm / deg; None where unknown) and the one rule that
-    moves them: :meth:`apply`.  The interpreter follows the program as read with one; the
-    writer of a compensated program follows the program as written with another."""
+    """Positions a controller holds (axes mm / deg, the tool vector ``I J K`` under TCPM;
+    None where unknown) and the one rule that moves them: :meth:`apply`.  The interpreter
+    follows the program as read with one; the writer of a compensated program follows the
+    program as written with another."""
 
-    __slots__ = ("position",)
+    __slots__ = ("position", "linear")
 
-    def __init__(self, axes, initial: dict | None = None):
-        self.position = {a: None for a in axes}
+    def __init__(self, axes, initial: dict | None = None, linear=("X", "Y", "Z")):
+        self.position = {a: None for a in (*axes, *VECTOR)}
         self.position.update({a: float(v) for a, v in (initial or {}).items()})
+        self.linear = tuple(linear)
 
     def apply(self, step: Step) -> None:
         pos = self.position
-        if step.kind == "motion":
-            if step.incremental:
-                for a, v in step.axis_words:
+        for a in step.forget:
+            pos[a] = None
+        if step.kind in ("motion", "arc"):
+            inc = step.incremental_words
+            for a, v in step.axis_words:
+                if (step.incremental and a not in VECTOR) or a in inc:   # a vector: absolute
                     prev = pos[a]
                     pos[a] = None if prev is None else prev + v
-            else:
-                for a, v in step.axis_words:
+                else:
                     pos[a] = v
         elif step.kind == "reference":
             for a, _ in step.axis_words:
                 pos[a] = None   # via an intermediate point to a reference
 
 
+#: G codes that switch TCPM on (with the orientation they read) and off
+TCPM_ON = {43.4: "angles", 43.5: "vector"}
+TCPM_OFF = (49,)
+
+
 class Interpreter:
     """Modal interpretation of a tokenized program for a machine with axes ``axes``.
 
-    ``initial``: axis -> known position at program start (mm / deg)."""
+    ``initial``: axis -> known position at program start (mm / deg).  ``tool_length``: a
+    callable ``(tools, where) -> mm`` giving the tool length a TCPM block uses from the last
+    ``T``/``H``/``D`` words (``tools``: letter -> value); it raises :class:`InputError`
+    naming ``where`` when it cannot.  Without it a TCPM program is refused."""
 
     FOREIGN_AXES = set("XYZABCUVW")
 
-    def __init__(self, axes, initial: dict | None = None):
+    def __init__(self, axes, initial: dict | None = None, tool_length=None):
         self.axes = tuple(axes)
-        self.state = ControllerState(self.axes, initial)
+        linear = tuple(a for a in self.axes if a in "XYZUVW")
+        self.state = ControllerState(self.axes, initial, linear)
         self.incremental = False
+        #: modal motion: 0, 1 (straight), 2, 3 (arcs); plane 17, 18, 19
+        self.motion = 0
+        self.plane = 17
+        #: "axes", or "tcpm" with ``orientation`` "angles" / "vector" / "any" (TRAORI)
+        self.frame = "axes"
+        self.orientation = None
+        self.tools: dict = {}
+        self.tool_length = tool_length
+        self._length = None
+        self._last_orientation = None
+        #: spelling of the tool-vector words once the program writes one (Siemens A3=)
+        self.vector_words: dict | None = None
+        #: rotary positions (deg) the machine holds after the last known block (TCPM vector
+        #: blocks continue from them); None before one
+        self.rotary_actual = None
         #: the :class:`Step` of the last line read (None for a line without words)
         self.last_step: Step | None = None
 
@@ -284,15 +374,52 @@ class Interpreter:
     def position(self) -> dict:
         return self.state.position
 
+    @property
+    def plain(self) -> bool:
+        """True when a line of axis words (and G0 / G1, T H D and ignored words) is a straight
+        move with nothing but its words to read: absolute, straight motion mode, axis
+        positions or TCPM with rotary angles (the whole-chunk path)."""
+        if self.incremental or self.motion not in (0, 1):
+            return False
+        return self.frame == "axes" or self.orientation == "angles" or \
+            (self.orientation == "any" and self._last_orientation != "vector")
+
+    @property
+    def length(self) -> float | None:
+        """The tool length of TCPM blocks now (mm), None outside TCPM."""
+        return self._length if self.frame == "tcpm" else None
+
+    def _switch(self, frame: str, orientation, where: str) -> tuple:
+        """Switch into or out of TCPM; returns the letters whose positions become unknown:
+        the linear words change their meaning (axis positions / tool tip in the workpiece
+        frame), the tool vector is forgotten, and after a tool-vector section the rotary
+        axes are where the controller's inverse put them (not a programmed word)."""
+        if frame == "tcpm":
+            if self.tool_length is None:
+                raise InputError(f"{where}: a TCPM program needs the tool length "
+                                 "(--tool-length, or a tool table for its T / H / D word)")
+            self._length = float(self.tool_length(dict(self.tools), where))
+        if frame == self.frame and orientation == self.orientation:
+            return ()
+        forget = ()
+        if frame != self.frame:
+            forget = (*self.state.linear, *VECTOR)
+            if self.orientation in ("vector", "any"):
+                forget += tuple(a for a in self.axes if a not in self.state.linear)
+        self.frame, self.orientation = frame, orientation
+        return forget
+
     def step(self, line: Line) -> Step | None:
-        """Check one line and update the distance mode; return what it does (None without
+        """Check one line and update the modal state; return what it does (None without
         words).  Raises :class:`InputError` on unsupported constructs."""
         items = line.items()
-        if not items:
+        keywords = line.keywords()
+        if not items and not keywords:
             return None
         where = f"line {line.number}"
         foreign = self.FOREIGN_AXES
-        gs, axis_words = [], []
+        gs, ms, axis_words, centre, vector = [], [], [], {}, []
+        radius = None
         for letter, value, _ in items:
             if letter in foreign:
                 axis_words.append((letter, value))
@@ -301,15 +428,51 @@ class Interpreter:
                 if g in REFUSED_G:
                     raise InputError(f"{where}: {REFUSED_G[g]} is not supported")
                 gs.append(g)
-            elif letter == "M" and round(value) in REFUSED_M:
-                raise InputError(f"{where}: {REFUSED_M[round(value)]} is not supported")
-        if line.parts is None and "TRAORI" in line.body.upper():
-            raise InputError(f"{where}: TRAORI (TCPM) is not supported")
+            elif letter == "M":
+                m = round(value)
+                if m in REFUSED_M:
+                    raise InputError(f"{where}: {REFUSED_M[m]} is not supported")
+                ms.append(m)
+            elif letter in VECTOR:
+                centre[letter] = value
+                vector.append((letter, value))
+            elif letter == "R":
+                radius = value
+            elif letter in ("T", "H", "D", "DL"):
+                self.tools[letter] = value
+        if any(a == "T" for a, _, _ in items) and not any(a == "DL" for a, _, _ in items):
+            self.tools.pop("DL", None)      # a new tool: no delta length unless given
+        if "L" in keywords:                 # Heidenhain straight move
+            gs.append(1.0)
         for g in gs:
             if g == 90:
                 self.incremental = False
             elif g == 91:
                 self.incremental = True
+            elif g in (0, 1, 2, 3):
+                self.motion = int(g)
+            elif g in (17, 18, 19):
+                self.plane = int(g)
+        # TCPM on / off (the tool numbers of this line count)
+        forget = ()
+        want = None
+        for g in gs:
+            if g in TCPM_ON:
+                want = ("tcpm", TCPM_ON[g])
+            elif g in TCPM_OFF:
+                want = ("axes", None)
+        for m in ms:
+            if m == 128:
+                want = ("tcpm", "angles")
+            elif m == 129:
+                want = ("axes", None)
+        for k in keywords:
+            if k in ("TRAORI", "TCPM"):
+                want = ("tcpm", "any" if k == "TRAORI" else "angles")
+            elif k in ("TRAFOOF", "TCPM_OFF"):
+                want = ("axes", None)
+        if want is not None:
+            forget = self._switch(*want, where)
         if axis_words:
             axes = self.axes
             for a, _ in axis_words:
@@ -321,21 +484,63 @@ class Interpreter:
                 if a in seen:
                     raise InputError(f"{where}: axis {a} programmed twice")
                 seen.add(a)
+        if vector and self.vector_words is None and line.parts is None:
+            siemens = any(t.kind == "word" and t.letter in VECTOR and t.text[:1].upper() in "ABC"
+                          for t in line.tokens)
+            self.vector_words = ({"I": "A3=", "J": "B3=", "K": "C3="} if siemens else
+                                 {v: v for v in VECTOR})
+        tcpm = self.frame == "tcpm"
+        orientation = None
+        if tcpm:
+            orientation = "vector" if self.orientation == "vector" else "angles"
+        if tcpm and vector:
+            orientation = "vector"
+            if self.orientation == "angles":
+                raise InputError(f"{where}: a tool vector ({' '.join(a for a, _ in vector)}) "
+                                 "under TCPM with rotary angles (G43.4 / M128)")
+            rot = [a for a, _ in axis_words if a not in self.state.linear]
+            if rot:
+                raise InputError(f"{where}: rotary axis {rot[0]} and a tool vector in one "
+                                 "block")
+            axis_words = axis_words + vector
         kind = "none"
         if axis_words and 4 not in gs:      # dwell: X / P are times
-            kind = "reference" if (28 in gs or 30 in gs) else "motion"
-        return Step(kind, axis_words, self.incremental)
+            kind = "reference" if (28 in gs or 30 in gs) else \
+                "arc" if self.motion in (2, 3) else "motion"
+        arc = None
+        if kind == "arc":
+            if tcpm:
+                raise InputError(f"{where}: an arc (G{self.motion}) under TCPM is not "
+                                 "supported")
+            rot = [a for a, _ in axis_words if a not in self.state.linear]
+            if rot:
+                raise InputError(f"{where}: rotary axis {rot[0]} in an arc block (G"
+                                 f"{self.motion}) is not supported")
+            arc = Arc(self.plane, self.motion == 3, centre, radius)
+        if tcpm and self.orientation == "any" and kind == "motion":
+            # TRAORI: rotary words give angles, A3 B3 C3 a vector; a block with neither
+            # keeps the orientation of the block before
+            rot = any(a not in self.state.linear for a, _ in axis_words)
+            orientation = "vector" if vector else "angles" if rot else \
+                (self._last_orientation or "angles")
+        if tcpm and kind == "motion":
+            self._last_orientation = orientation
+        return Step(kind, axis_words, self.incremental, arc, self.frame, forget,
+                    self._length if tcpm else None, line.incremental, orientation,
+                    self.motion, any(g in (0, 1, 2, 3) for g in gs))
 
     def block(self, line: Line) -> Block | None:
-        """Update the modal state with one line; return a :class:`Block` for a motion block."""
+        """Update the modal state with one line; return a :class:`Block` for a motion block
+        (straight or arc)."""
         step = self.last_step = self.step(line)
         if step is None:
             return None
         self.state.apply(step)
-        if step.kind != "motion":
+        if step.kind not in ("motion", "arc"):
             return None
-        return Block(line, dict(self.state.position), tuple(a for a, _ in step.axis_words),
-                     step.incremental)
+        pos = self.state.position
+        return Block(line, {a: pos[a] for a in self.axes},
+                     tuple(a for a, _ in step.axis_words), step.incremental)
 
 
 def blocks(lines: list[Line], axes, initial: dict | None = None) -> list[Block]:
@@ -435,9 +640,15 @@ def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None 
         out = "".join(pieces) + body[pos:]
         if not added:
             return out + line.ending
-        # the insertion point moves with the length change of the replaced numbers before it
-        shift = len(out) - len(body)
-        at = (last_word_end if last_word_end is not None else len(body)) + shift
+        if line.anchor is not None:
+            t = line.tokens[line.anchor]
+            last_word_end = t.start + len(t.text)
+        # the insertion point moves with the length change of the numbers replaced before it
+        anchor = last_word_end if last_word_end is not None else len(body)
+        shift = sum(len(new_values[t.letter]) - (t.num_end - t.num_start)
+                    for t in line.tokens if t.kind == "word" and t.letter in new_values
+                    and t.num_end <= anchor)
+        at = anchor + shift
         head, tail = out[:at], out[at:]
         words = line.words()
         own = _spaced(_kinds(line)) if len(words) > 1 else None
@@ -447,3 +658,54 @@ def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None 
     sep = " " if (own if own is not None else (spaced if spaced is not None else True)) else ""
     ins = "".join(f"{sep}{(a.lower() if lower else a)}{v}" for a, v in added.items())
     return head + ins + tail + line.ending
+
+
+#: :func:`rewrite_tokens`: drop the word (and the blanks before it)
+REMOVE = object()
+
+
+def rewrite_tokens(line: Line, edit, added: dict, spaced: bool | None = None) -> str:
+    """The line with every word token passed through ``edit(token)`` -> new number text, None
+    (keep) or :data:`REMOVE` (drop the word and the blanks before it), and the words of
+    ``added`` (word address -> number text, e.g. ``"G"`` or ``"A3="``) appended after the last
+    word; every other byte kept.  ``spaced`` as in :func:`rewrite_line`."""
+    body = line.body
+    toks = line.tokens
+    pieces, pos = [], 0
+    last_word_end = None
+    kept_words = []
+    for k, t in enumerate(toks):
+        if t.kind != "word":
+            continue
+        new = edit(t)
+        if new is REMOVE:
+            cut = t.start
+            if k and toks[k - 1].kind == "space" and toks[k - 1].start >= pos:
+                cut = toks[k - 1].start
+            pieces.append(body[pos:cut])
+            pos = t.start + len(t.text)
+            continue
+        if new is not None:
+            pieces.append(body[pos:t.num_start])
+            pieces.append(new)
+            pos = t.num_end
+        kept_words.append(t)
+        last_word_end = sum(len(x) for x in pieces) + (t.start + len(t.text) - pos)
+    out = "".join(pieces) + body[pos:]
+    if not added:
+        return out + line.ending
+    at = last_word_end if last_word_end is not None else len(out)
+    head, tail = out[:at], out[at:]
+    own = _spaced(_kinds(line)) if len(kept_words) > 1 else None
+    if len(kept_words) > 1 and own is None:
+        own = True
+    lower = bool(kept_words) and all(t.text[0].islower() for t in kept_words)
+    sep = " " if (own if own is not None else (spaced if spaced is not None else True)) else ""
+    if not kept_words and head and not head[-1].isspace():
+        head += sep
+        sep_first = ""
+    else:
+        sep_first = sep
+    words = [f"{(a.lower() if lower else a)}{v}" for a, v in added.items()]
+    return head + sep_first + sep.join(words) + tail + line.ending
+

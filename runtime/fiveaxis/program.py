@@ -21,6 +21,7 @@ which rotary axes it never commands (taken at 0 deg) and how it separates words.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -54,6 +55,13 @@ class Options:
     check_travel: bool = True
     max_iter: int = 50
     types: tuple | None = None
+    #: arcs: the path tolerance (:mod:`volerr.fiveaxis.arcs`), um
+    arc_tol_um: float = 1.0
+    #: TCPM: the tool length (mm), or a tool table (tool number -> mm) for T / H / D words
+    tool_length: float | None = None
+    tool_table: dict | None = None
+    #: "auto", "iso" or "heidenhain" (:mod:`volerr.fiveaxis.dialect`)
+    dialect: str = "auto"
 
     def validated(self, model) -> "Options":
         from .compensate import STRATEGIES
@@ -74,50 +82,71 @@ class Options:
         require(not (self.types is not None and self.strategy == "thesis"),
                 "the thesis strategy has its own set of errors (L-POS L-STR L-SQU and the "
                 "rotary-axis errors); --types applies to the full strategy")
+        require(self.arc_tol_um > 0 and math.isfinite(self.arc_tol_um),
+                "the arc tolerance must be a positive number (um)")
+        require(self.tool_length is None or (math.isfinite(self.tool_length)
+                                             and self.tool_length >= 0),
+                "the tool length must be a finite number >= 0 (mm)")
+        from .dialect import DIALECTS
+        require(self.dialect in DIALECTS, f"unknown dialect {self.dialect!r} "
+                                          f"({' '.join(DIALECTS)})")
         return Options(tuple(float(v) for v in tool), bool(self.orientation), self.strategy,
                        float(self.tol_um), int(self.decimals), dict(self.initial or {}),
                        bool(self.check_travel), int(self.max_iter),
-                       None if self.types is None else tuple(self.types))
+                       None if self.types is None else tuple(self.types),
+                       float(self.arc_tol_um),
+                       None if self.tool_length is None else float(self.tool_length),
+                       None if self.tool_table is None else dict(self.tool_table),
+                       self.dialect)
 
 
 # ---------------------------------------------------------------------------------------
 # step 0: what needs the whole program
 @dataclass
 class Prescan:
-    """Rotary axes whose letter never appears as a word (outside comments), and the word
-    separation of the program (:func:`volerr.fiveaxis.gcode.spaced_style`)."""
+    """Rotary axes whose letter never appears as a word (outside comments), the word
+    separation of the program (:func:`volerr.fiveaxis.gcode.spaced_style`) and its dialect's
+    line parser (None: ISO; :func:`volerr.fiveaxis.dialect.parser`)."""
 
     absent_rotary: tuple
     spaced: bool
+    dialect: object = None
 
 
-def prescan(open_source, model, chunk_lines: int = CHUNK_LINES) -> Prescan:
+def prescan(open_source, model, chunk_lines: int = CHUNK_LINES,
+            dialect: str = "auto") -> Prescan:
+    from . import dialect as dialects
+
     rot = [a for a in model.rotary_axes]
     pats = {a: re.compile(rf"[{a}{a.lower()}][ \t]*[+-]?\.?\d") for a in rot}
     seen = set()
     spaced = None
-    buf = []
     fh = open_source()
     try:
-        for n, seg in enumerate(fh, start=1):
-            if spaced is None:
-                body = seg.rstrip("\r\n")
+        first = 1
+        while True:
+            buf = list(itertools.islice(fh, chunk_lines))
+            if dialect == "auto":
+                dialect = dialects.detect(buf, first)
+            if dialect == "heidenhain":
+                spaced = True
+            for n, seg in enumerate(buf if spaced is None else (), start=first):
                 try:
-                    own = gcode._spaced(gcode._kinds(gcode.Line.parse(n, body, "")))
+                    spaced = gcode._spaced(gcode._kinds(gcode.Line.parse(n, seg.rstrip("\r\n"),
+                                                                         "")))
                 except InputError:
-                    own = None      # reported with its line number by the interpreter
-                spaced = own
-            buf.append(seg)
-            if len(buf) >= chunk_lines:
-                seen |= _letters(buf, pats, seen)
-                buf = []
-                if len(seen) == len(rot) and spaced is not None:
-                    break       # nothing left to learn from the rest of the program
-        seen |= _letters(buf, pats, seen)
+                    pass        # reported with its line number by the interpreter
+                if spaced is not None:
+                    break
+            seen |= _letters(buf, pats, seen)
+            first += len(buf)
+            if len(buf) < chunk_lines or (len(seen) == len(rot) and spaced is not None):
+                break           # the end, or nothing left to learn from the rest
     finally:
         if hasattr(fh, "close"):
             fh.close()
-    return Prescan(tuple(a for a in rot if a not in seen), True if spaced is None else spaced)
+    return Prescan(tuple(a for a in rot if a not in seen), True if spaced is None else spaced,
+                   dialects.parser(dialect))
 
 
 def _letters(segs, pats, seen) -> set:
@@ -136,10 +165,18 @@ class Blocks:
     ``runs``: (first, end) line indices of the plain lines interpreted together in absolute
     mode; ``slow``: line index -> (:class:`~volerr.fiveaxis.gcode.Line`, step) of the lines
     interpreted one by one (step None without words); ``row``: per line, the row of a motion
-    block whose axes are all known in ``q_nom`` / ``nd``, else -1; ``numbers``: the line number
-    of every row; ``pending``: per motion block with an unknown axis, (line, target);
-    ``q_nom`` (n, n_axes) mm / deg; ``nd`` (n, n_axes) decimals to write (never fewer than the
-    programmed word had)."""
+    block whose positions are all known, else -1; ``numbers``: the line number of every row;
+    ``pending``: per motion block with an unknown position, (line, target, the first
+    unknown letter); ``q_nom`` (n, n_axes)
+    the axis positions, mm / deg (under TCPM those the controller's inverse gives); ``w_nom``
+    (n, n_axes + 3) the words as programmed (axes, then the tool vector ``I J K``; NaN where
+    a row has none; under TCPM the linear columns are the tool tip in the workpiece frame);
+    ``nd`` (n, n_axes + 3) decimals to write (never fewer than the programmed word had);
+    ``frame`` (n,) :data:`volerr.fiveaxis.tcpm.AXES` / ``ANGLES`` / ``VECTOR``; ``length``
+    (n,) the tool length of TCPM rows (NaN elsewhere), mm; ``arcs`` row -> the
+    :class:`~volerr.fiveaxis.arcs.ArcPath` of an arc block; ``direction`` (n, n_axes) the
+    approach directions (:mod:`volerr.fiveaxis.reversal`) when the tables carry a reversal,
+    else None."""
 
     segs: list
     first: int
@@ -154,6 +191,18 @@ class Blocks:
     pending: list
     known_rotary: set
     motion: np.ndarray   # per line: a motion block
+    w_nom: np.ndarray = None
+    frame: np.ndarray = None
+    length: np.ndarray = None
+    arcs: dict = field(default_factory=dict)
+    direction: np.ndarray | None = None
+    dir_before: np.ndarray | None = None
+    #: the approach directions of the program as read (its own moves), for "before"
+    dir_program: np.ndarray | None = None
+
+    def dir(self, rows):
+        """The directions of ``rows`` (None without reversal)."""
+        return None if self.direction is None else self.direction[rows]
 
     def line(self, i: int) -> gcode.Line:
         """Line ``i`` of the chunk, parsed."""
@@ -171,71 +220,133 @@ def _words(sc, i0: int, i1: int) -> slice:
     return slice(int(lo), int(hi))
 
 
-def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int) -> Blocks:
+#: decimals of a tool-vector component at least (1e-7: 0.1 urad)
+VECTOR_DECIMALS = 7
+
+
+def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
+              dialect=None) -> Blocks:
     """Interpret the lines ``segs`` (numbered from ``first``); ``interp`` carries the modal
-    state from chunk to chunk.  Runs of plain lines in absolute mode are done together (the
-    position of an axis is its last programmed value: a forward fill); every other line goes
-    through ``interp`` one by one."""
+    state from chunk to chunk.  Runs of plain lines in a plain mode (absolute, straight, axis
+    positions or TCPM with rotary angles) are done together (the position of an axis is its last programmed value: a
+    forward fill); every other line goes through ``interp`` one by one.  ``dialect``: the
+    line parser of another dialect (:mod:`volerr.fiveaxis.heidenhain`; its lines are all
+    interpreted one by one)."""
+    from . import arcs, tcpm
+
     axes = model.axes
     nax = len(axes)
+    letters = (*axes, *gcode.VECTOR)
+    ncol = len(letters)
     n = len(segs)
     sc = chunkscan.scan(segs, axes)
-    if not WHOLE_CHUNK:
+    if not WHOLE_CHUNK or dialect is not None:
         sc.fast[:] = False
-    q = np.full((n, nax), np.nan)
-    nd = np.full((n, nax), decimals, dtype=np.int64)
+    w = np.full((n, ncol), np.nan)
+    nd = np.full((n, ncol), decimals, dtype=np.int64)
+    nd[:, nax:] = max(decimals, VECTOR_DECIMALS)
     motion = np.zeros(n, dtype=bool)
+    frame = np.zeros(n, dtype=np.int8)
+    length = np.full(n, np.nan)
+    paths = {}
     slow, runs = {}, []
     pos = interp.state.position
-    index = {a: i for i, a in enumerate(axes)}
+    index = {a: i for i, a in enumerate(letters)}
+    rot_idx = [axes.index(a) for a in model.rotary_axes]
+    parse = dialect.parse_line if dialect is not None else gcode.Line.parse
     slow_idx = np.flatnonzero(~sc.fast)
     i = 0
     while i < n:
-        if sc.fast[i] and not interp.incremental:
+        if sc.fast[i] and interp.plain:
             k = np.searchsorted(slow_idx, i)
             j = int(slow_idx[k]) if k < len(slow_idx) else n
-            w = _words(sc, i, j)
-            wl, wa = sc.line[w] - i, sc.axis[w]
+            ws = _words(sc, i, j)
+            interp.tools.update(sc.last_tracked(ws))
+            wl, wa = sc.line[ws] - i, sc.axis[ws]
             ax = wa >= 0
             wl, wa = wl[ax], wa[ax]
             m = j - i
             v = np.full((m, nax), np.nan)
-            v[wl, wa] = sc.value[w][ax]
+            v[wl, wa] = sc.value[ws][ax]
             has = np.zeros((m, nax), dtype=bool)
             has[wl, wa] = True
-            fr = sc.frac[w][ax]
+            fr = sc.frac[ws][ax]
             nd[i + wl, wa] = np.maximum(decimals, fr)
             last = np.where(has, np.arange(m)[:, None], -1)
             np.maximum.accumulate(last, axis=0, out=last)
             startv = np.array([np.nan if pos[a] is None else pos[a] for a in axes])
             cols = np.arange(nax)
-            q[i:j] = np.where(last >= 0, v[np.maximum(last, 0), cols], startv)
+            w[i:j, :nax] = np.where(last >= 0, v[np.maximum(last, 0), cols], startv)
             motion[i:j] = has.any(axis=1)
+            if interp.frame == "tcpm":          # TCPM with rotary angles: tip and angles
+                mrows = i + np.flatnonzero(has.any(axis=1))
+                frame[mrows] = tcpm.ANGLES
+                length[mrows] = interp.length
+                if len(mrows):
+                    interp._last_orientation = "angles"
             for c, a in enumerate(axes):
-                val = q[j - 1, c]
+                val = w[j - 1, c]
                 pos[a] = None if val != val else float(val)
             runs.append((i, j))
             i = j
             continue
         seg = segs[i]
         body = seg.rstrip("\r\n")
-        line = gcode.Line.parse(first + i, body, seg[len(body):])
+        line = parse(first + i, body, seg[len(body):])
         step = interp.step(line)
         slow[i] = (line, step)
         if step is not None:
+            start = None
+            if step.kind == "arc":
+                start = dict(pos)
+                start.update({a: None for a in step.forget})
             interp.state.apply(step)
-            if step.kind == "motion":
+            if step.kind in ("motion", "arc"):
                 motion[i] = True
-                q[i] = [np.nan if pos[a] is None else pos[a] for a in axes]
+                w[i] = [np.nan if pos[a] is None else pos[a] for a in letters]
+                if step.frame == "tcpm":
+                    vec = step.orientation == "vector"
+                    frame[i] = tcpm.VECTOR if vec else tcpm.ANGLES
+                    length[i] = step.tool_length
+                    if vec:
+                        w[i, rot_idx] = np.nan
+                    else:
+                        w[i, nax:] = np.nan
+                else:
+                    w[i, nax:] = np.nan
                 for a, _, txt in line.items():
                     c = index.get(a)
-                    if c is not None and "." in txt:
-                        nd[i, c] = max(decimals, len(txt) - txt.index(".") - 1)
+                    if c is not None and "." in txt and not (step.kind == "arc" and c >= nax):
+                        nd[i, c] = max(nd[i, c], len(txt) - txt.index(".") - 1)
+                if start is not None and all(start[a] is not None for a in axes) and \
+                        all(pos[a] is not None for a in axes):
+                    paths[i] = arcs.arc_path(axes, start, pos, step.arc,
+                                             f"line {line.number}")
         i += 1
-    known = motion & ~np.isnan(q).any(axis=1)
+    # a row is known when the words its frame needs are: axes; under TCPM the tip and the
+    # angles or the vector
+    need = np.ones((n, ncol), dtype=bool)
+    need[:, nax:] = False
+    vec_rows = frame == tcpm.VECTOR
+    need[np.ix_(vec_rows, rot_idx)] = False
+    need[vec_rows, nax:] = True
+    known = motion & ~(np.isnan(w) & need).any(axis=1)
     row = np.where(known, np.cumsum(known) - 1, -1)
+    rows = np.flatnonzero(known)
+    q = w[rows, :nax].copy()
+    fr_rows = frame[rows]
+    if (fr_rows != tcpm.AXES).any():
+        before = interp.rotary_actual
+        if before is None:
+            before = np.array([pos[a] if pos[a] is not None else 0.0
+                               for a in model.rotary_axes])
+        q = tcpm.axes_from_words(model, w[rows], fr_rows, length[rows], before)
+    if len(rows):
+        interp.rotary_actual = q[-1, rot_idx].copy()
     known_rotary = {a for a in model.rotary_axes
-                    if (motion & ~np.isnan(q[:, index[a]])).any()}
+                    if (motion & ~np.isnan(w[:, index[a]])).any()}
+    if vec_rows.any():
+        known_rotary |= set(model.rotary_axes)
     unk = motion & ~known
     pend = np.cumsum(unk) - 1
     ml = np.flatnonzero(motion)
@@ -243,11 +354,14 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int)
     pending = []
     for li in np.flatnonzero(unk).tolist():
         line = slow[li][0] if li in slow else _parse_seg(segs, first, li)
-        pending.append((line, {a: (None if q[li, c] != q[li, c] else float(q[li, c]))
-                               for c, a in enumerate(axes)}))
-    rows = np.flatnonzero(known)
-    return Blocks(list(segs), first, sc, runs, slow, row, first + rows, q[rows], nd[rows], order,
-                  pending, known_rotary, motion)
+        miss = [letters[c] for c in range(ncol) if need[li, c] and w[li, c] != w[li, c]]
+        pending.append((line, {a: (None if w[li, c] != w[li, c] else float(w[li, c]))
+                               for c, a in enumerate(axes)},
+                        f"axis {miss[0]}" if miss[0] in axes else
+                        f"tool-vector component {miss[0]}"))
+    return Blocks(list(segs), first, sc, runs, slow, row, first + rows, q, nd[rows], order,
+                  pending, known_rotary, motion, w[rows], fr_rows, length[rows],
+                  {int(row[i]): p for i, p in paths.items() if row[i] >= 0})
 
 
 # ---------------------------------------------------------------------------------------
@@ -290,23 +404,67 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
 # step 3: solve
 @dataclass
 class Solution:
-    """Corrected positions (n, n_axes), iterations (n,), orientation limited (n,)."""
+    """Corrected positions (n, n_axes), iterations (n,), orientation limited (n,); the
+    nominal tool tip ``target`` (n, 3) and the error at the programmed positions ``before``
+    (n, 3) mm when the solve has them (else None: the prediction computes them)."""
 
     q: np.ndarray
     iterations: np.ndarray
     limited: np.ndarray
+    target: np.ndarray | None = None
+    before: np.ndarray | None = None
 
 
-def solve_blocks(em, q_nom: np.ndarray, opts: Options) -> Solution:
+def tool_groups(em, blocks: Blocks, opts: Options) -> list:
+    """The rows of a chunk by the tool offset they use: (error model with that offset, row
+    index or ``slice(None)``).  Axis-position rows use the ``--tool`` offset; TCPM rows the
+    offset of their tool length (:func:`volerr.fiveaxis.tcpm.tool_offset`)."""
+    from .tcpm import AXES, tool_offset
+
+    fr = blocks.frame
+    if fr is None or not (fr != AXES).any():
+        return [(em, slice(None))]
+    key = np.where(fr == AXES, np.nan, blocks.length)
+    out = []
+    axis_rows = np.flatnonzero(fr == AXES)
+    if len(axis_rows):
+        out.append((em, axis_rows))
+    for length in np.unique(key[fr != AXES]):
+        rows = np.flatnonzero((fr != AXES) & (key == length))
+        out.append((em.with_tool(tool_offset([length])[0]), rows))
+    return out
+
+
+def solve_positions(em, q_nom: np.ndarray, opts: Options, direction=None) -> Solution:
+    """The compensation of the positions ``q_nom`` (one tool offset: ``em``'s; ``direction``
+    the approach directions of the rows, or None)."""
     from .compensate import solve, solve_thesis
 
     n = len(q_nom)
     if not n:
         return Solution(q_nom.copy(), np.zeros(0, dtype=int), np.zeros(0, dtype=bool))
     if opts.strategy == "thesis":
-        return Solution(solve_thesis(em, q_nom), np.ones(n, dtype=int), np.zeros(n, dtype=bool))
-    q, it, lim = solve(em, q_nom, opts.orientation, opts.tol_um * 1e-3, opts.max_iter)
-    return Solution(q, it, lim)
+        return Solution(solve_thesis(em, q_nom, direction), np.ones(n, dtype=int),
+                        np.zeros(n, dtype=bool))
+    out = {}
+    q, it, lim = solve(em, q_nom, opts.orientation, opts.tol_um * 1e-3, opts.max_iter,
+                       direction, out)
+    return Solution(q, it, lim, out.get("target"), out.get("before"))
+
+
+def solve_blocks(em, blocks: Blocks, opts: Options) -> Solution:
+    """:func:`solve_positions` of every row, group by group (:func:`tool_groups`)."""
+    q_nom = blocks.q_nom
+    n = len(q_nom)
+    sol = Solution(q_nom.copy(), np.zeros(n, dtype=int), np.zeros(n, dtype=bool))
+    groups = tool_groups(em, blocks, opts)
+    if len(groups) == 1 and isinstance(groups[0][1], slice):
+        return solve_positions(em, q_nom, opts, blocks.direction)
+    for g_em, rows in groups:
+        part = solve_positions(g_em, q_nom[rows], opts, blocks.dir(rows))
+        sol.q[rows], sol.iterations[rows], sol.limited[rows] = part.q, part.iterations, \
+            part.limited
+    return sol
 
 
 # ---------------------------------------------------------------------------------------
@@ -325,28 +483,131 @@ def round_decimals(v: np.ndarray, nd: np.ndarray) -> np.ndarray:
     return out
 
 
-def round_positions(em, q_nom: np.ndarray, sol: Solution, nd: np.ndarray,
-                    opts: Options) -> np.ndarray:
-    """The positions written: rotary values rounded first, the linear axes solved again for
-    them (orientation), then rounded; a value equal to the programmed one is kept as is."""
+def _keep_or_round(v: np.ndarray, programmed: np.ndarray, nd: np.ndarray) -> np.ndarray:
+    """``v`` rounded to ``nd`` decimals; where it equals the programmed value, that value."""
+    return np.where(v == programmed, programmed, round_decimals(v, nd))
+
+
+def round_axes(em, q_nom: np.ndarray, q_c: np.ndarray, nd: np.ndarray,
+               opts: Options, direction=None) -> np.ndarray:
+    """Axis positions as written: rotary values rounded first, the linear axes solved again
+    for them (orientation), then rounded; a value equal to the programmed one is kept."""
     from .compensate import resolve_linear
 
     model = em.model
-    q_c = sol.q
     q_out = q_c.copy()
     if not len(q_nom):
         return q_out
     rot_idx = [model.axes.index(a) for a in model.rotary_axes]
     lin_idx = [model.axes.index(a) for a in linear_axes(model)]
     for j in rot_idx:
-        q_out[:, j] = np.where(q_c[:, j] == q_nom[:, j], q_nom[:, j],
-                               round_decimals(q_c[:, j], nd[:, j]))
+        q_out[:, j] = _keep_or_round(q_c[:, j], q_nom[:, j], nd[:, j])
     if opts.orientation and not np.array_equal(q_out[:, rot_idx], q_c[:, rot_idx]):
-        q_out = resolve_linear(em, q_nom, q_out, opts.tol_um * 1e-3, opts.max_iter)
+        q_out = resolve_linear(em, q_nom, q_out, opts.tol_um * 1e-3, opts.max_iter, direction)
     for j in lin_idx:
-        q_out[:, j] = np.where(q_out[:, j] == q_nom[:, j], q_nom[:, j],
-                               round_decimals(q_out[:, j], nd[:, j]))
+        q_out[:, j] = _keep_or_round(q_out[:, j], q_nom[:, j], nd[:, j])
     return q_out
+
+
+def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np.ndarray,
+               frame: np.ndarray, length: np.ndarray, opts: Options, direction=None):
+    """TCPM rows as written -> (words (n, n_axes + 3), axis positions the controller's inverse
+    gives for them).  The orientation words (angles, or the tool vector) are the programmed
+    ones unless the orientation is compensated, then those of the corrected axes, rounded;
+    the linear axes are solved again for the rotary positions the controller takes from
+    them; the tool tip is the forward kinematics of the result, rounded."""
+    from . import tcpm
+    from .compensate import resolve_linear
+    from .kinematics import inverse
+
+    model = em.model
+    axes = model.axes
+    nax = len(axes)
+    rot_idx = [axes.index(a) for a in model.rotary_axes]
+    lin_idx = [axes.index(a) for a in linear_axes(model)]
+    w_c = tcpm.words_from_axes(model, q_c, length)
+    w_out = w_nom.copy()
+    q_rot = q_c.copy()
+    ang = frame == tcpm.ANGLES
+    vec = frame == tcpm.VECTOR
+    if opts.orientation:
+        for j in rot_idx:
+            w_out[ang, j] = _keep_or_round(w_c[ang, j], w_nom[ang, j], nd[ang, j])
+        if vec.any():
+            k = w_c[vec, nax:]
+            w_out[vec, nax:] = np.where(
+                np.abs(k - w_nom[vec, nax:]) < 1e-15, w_nom[vec, nax:],
+                round_decimals(k, nd[vec, nax:]))
+    # the rotary positions the controller takes from the written orientation
+    q_rot[ang] = q_c[ang]
+    q_rot[np.ix_(ang, rot_idx)] = w_out[np.ix_(ang, rot_idx)]
+    if vec.any():
+        target = np.column_stack([w_c[vec][:, lin_idx], w_out[vec, nax:]])
+        q_rot[vec] = inverse(model, target, tcpm.tool_offset(length[vec]), near=q_c[vec])
+    moved = ~np.all(q_rot[:, rot_idx] == q_c[:, rot_idx], axis=1)
+    if moved.any():
+        q_rot[moved] = resolve_linear(em, q_nom[moved], q_rot[moved], opts.tol_um * 1e-3,
+                                      opts.max_iter,
+                                      None if direction is None else direction[moved])
+    tip = tcpm.words_from_axes(model, q_rot, length)[:, lin_idx]
+    for k, j in enumerate(lin_idx):
+        w_out[:, j] = _keep_or_round(tip[:, k], w_nom[:, j], nd[:, j])
+    q_out = tcpm.axes_from_words(model, w_out, frame, length, q_rot[0, rot_idx]
+                                 if len(q_rot) else np.zeros(2))
+    return w_out, q_out
+
+
+def round_positions(em, blocks: Blocks, sol: Solution, opts: Options):
+    """The values written -> (words (n, n_axes + 3), axis positions the controller goes to):
+    :func:`round_axes` for axis rows, :func:`round_tcpm` for TCPM rows (each with the error
+    model of its tool, :func:`tool_groups`)."""
+    from .tcpm import AXES
+
+    b = blocks
+    q_out = sol.q.copy()
+    w_out = b.w_nom.copy()
+    nax = len(em.model.axes)
+    for g_em, rows in tool_groups(em, b, opts):
+        fr = b.frame[rows]
+        if isinstance(rows, slice) or (fr == AXES).all():
+            q_out[rows] = round_axes(g_em, b.q_nom[rows], sol.q[rows], b.nd[rows, :nax], opts,
+                                     b.dir(rows))
+            w_out[rows, :nax] = q_out[rows]
+        else:
+            w_out[rows], q_out[rows] = round_tcpm(g_em, b.q_nom[rows], b.w_nom[rows],
+                                                  sol.q[rows], b.nd[rows], fr, b.length[rows],
+                                                  opts, b.dir(rows))
+    return w_out, q_out
+
+
+def compensate_arcs(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> dict:
+    """Row -> (:class:`~volerr.fiveaxis.arcs.ArcPath`, :class:`~volerr.fiveaxis.arcs.ArcResult`)
+    of the arc blocks (:func:`volerr.fiveaxis.arcs.compensate`); the points of a linearised
+    arc are rounded as every written position, its last point is the block's end as
+    written.  With the orientation compensated an arc is always linearised (a corrected
+    rotary position cannot move in an arc block)."""
+    from . import arcs
+
+    b = blocks
+    if not b.arcs:
+        return {}
+    rows = sorted(b.arcs)
+    paths = [b.arcs[r] for r in rows]
+    nax = len(em.model.axes)
+    starts = None
+    if b.direction is not None:
+        starts = [b.direction[r - 1] if r > 0 else b.dir_before for r in rows]
+    results = arcs.compensate(em, paths, lambda q, d: solve_positions(em, q, opts, d).q,
+                              opts.arc_tol_um * 1e-3, keep=not opts.orientation,
+                              start_dirs=starts)
+    out = {}
+    for r, path, res in zip(rows, paths, results):
+        if not res.kept:
+            pts = round_decimals(res.points, np.broadcast_to(b.nd[r, :nax], res.points.shape))
+            pts[-1] = q_out[r]
+            res.points = pts
+        out[r] = (path, res)
+    return out
 
 
 # ---------------------------------------------------------------------------------------
@@ -363,19 +624,27 @@ class Prediction:
     u_after_um: np.ndarray
 
 
-def predict(em, q_nom: np.ndarray, q_out: np.ndarray) -> Prediction:
+def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray, direction=None,
+                      direction_before=None, target=None, before=None) -> Prediction:
+    """Predicted errors of the positions ``q_nom`` (programmed, approached in
+    ``direction_before``) and ``q_out`` (written, approached in ``direction``), with ``em``'s
+    tool offset (directions None: no reversal).  ``target`` / ``before``: the nominal tip and
+    the error at ``q_nom`` when the solve has them (mm)."""
     model, tool, funcs = em.model, em.tool, em.funcs
     n = len(q_nom)
     if not n:
         z = np.zeros((0, 3))
         return Prediction(z, z, np.zeros(0), np.zeros(0), z)
-    target = model.nominal_position(q_nom, tool)
-    before = em.position_error(q_nom) * 1e3
-    after = (model.nominal_position(q_out, tool) + em.position_error(q_out) - target) * 1e3
+    if target is None:
+        target = model.nominal_position(q_nom, tool)
+    d, d0 = direction, direction_before
+    before = (em.position_error(q_nom, None, d0) if before is None else before) * 1e3
+    after = (model.nominal_position(q_out, tool) + em.position_error(q_out, None, d)
+             - target) * 1e3
     if model.rotary_axes:
         k_nom = em.tool_axis(q_nom)
-        ob = np.linalg.norm(em.orientation_error(q_nom), axis=1) * 1e6
-        k_after = em.tool_axis(q_out) + em.orientation_error(q_out)
+        ob = np.linalg.norm(em.orientation_error(q_nom, None, d0), axis=1) * 1e6
+        k_after = em.tool_axis(q_out) + em.orientation_error(q_out, None, d)
         oa = np.linalg.norm(k_after - k_nom, axis=1) * 1e6
     else:
         ob = oa = np.zeros(n)
@@ -385,252 +654,37 @@ def predict(em, q_nom: np.ndarray, q_out: np.ndarray) -> Prediction:
     return Prediction(before, after, ob, oa, u_after)
 
 
-# ---------------------------------------------------------------------------------------
-# step 6: write
-def _write_line(line, step, r, q_list, nd_list, written, axes, spaced) -> str:
-    """One line written block by block (the exact rule; :func:`_write_run` does the same for
-    a run of plain lines in absolute mode at once)."""
-    fmt = gcode.format_number
-    pos = written.position
-    if r < 0:
-        if step is not None:
-            written.apply(step)
-        return line.body + line.ending
-    words = {a: (v, txt) for a, v, txt in line.items() if a in pos}
-    new_values, added, values = {}, {}, []
-    want_row, nd_row = q_list[r], nd_list[r]
-    if step.incremental:
-        for a, want, nd in zip(axes, want_row, nd_row):
-            half = 0.5 * 10.0 ** (-nd)
-            prev = pos[a]
-            inc = want - prev
-            w = words.get(a)
-            if w is not None:
-                if abs(inc - w[0]) >= half:
-                    txt = fmt(inc, nd, w[1])
-                    new_values[a] = txt
-                    values.append((a, float(txt)))
-                else:
-                    values.append((a, w[0]))
-            elif abs(inc) >= half:
-                txt = fmt(inc, nd)
-                added[a] = txt
-                values.append((a, float(txt)))
-    else:
-        for a, want, nd in zip(axes, want_row, nd_row):
-            half = 0.5 * 10.0 ** (-nd)
-            w = words.get(a)
-            if w is not None:
-                if abs(want - w[0]) >= half:
-                    txt = fmt(want, nd, w[1])
-                    new_values[a] = txt
-                    values.append((a, float(txt)))
-                else:
-                    values.append((a, w[0]))
-            elif pos[a] is None or abs(want - pos[a]) >= half:
-                txt = fmt(want, nd)
-                added[a] = txt
-                values.append((a, float(txt)))
-    written.apply(gcode.Step("motion", values, step.incremental))
-    return (gcode.rewrite_line(line, new_values, added, spaced) if (new_values or added)
-            else line.body + line.ending)
-
-
-def _write_run(b: Blocks, i0: int, i1: int, q_out: np.ndarray, written, axes, spaced,
-               edits: list) -> None:
-    """The plain lines ``i0 .. i1 - 1`` (absolute mode) written together: ``edits`` gets
-    (start, end, text) replacements of the chunk text; ``written`` is updated.
-
-    A programmed word is rewritten where the value to write differs from it by half a step or
-    more; an axis the line does not program gets a word where the controller (as written so
-    far) holds another value -- a chain along the lines, followed one entry at a time for the
-    (line, axis) pairs without a word only."""
-    sc = b.scan
-    pos = written.position
-    nax = len(axes)
-    m = i1 - i0
-    w = _words(sc, i0, i1)
-    ax = sc.axis[w] >= 0
-    wl = sc.line[w][ax] - i0
-    wa = sc.axis[w][ax]
-    wv = sc.value[w][ax]
-    row = b.row[i0:i1]
-    wr = row[wl]
-    known = wr >= 0
-    # programmed words of known blocks: rewritten where the value moves by half a step
-    kr, ka = wr[known], wa[known]
-    want = q_out[kr, ka]
-    nd = b.nd[kr, ka]
-    change = np.abs(want - wv[known]) >= 0.5 * 10.0 ** (-nd.astype(float))
-    ci = np.flatnonzero(known)[change]
-    span_s, span_e = sc.num_start[w][ax][ci], sc.num_end[w][ax][ci]
-    fr, pl = sc.frac[w][ax][ci], sc.plus[w][ax][ci]
-    text = sc.text
-    flat, lens, new_vals = chunkscan.format_bytes(want[change], nd[change], fr, pl,
-                                                  lambda k: text[span_s[k]:span_e[k]])
-    wvals = wv.copy()
-    wvals[ci] = new_vals
-    # positions held after every line from the programmed words (as written)
-    val = np.full((m, nax), np.nan)
-    val[wl, wa] = wvals
-    has = np.zeros((m, nax), dtype=bool)
-    has[wl, wa] = True
-    last = np.where(has, np.arange(m)[:, None], -1)
-    np.maximum.accumulate(last, axis=0, out=last)
-    # axes without a word in a known block: the chain
-    absent = np.argwhere((row >= 0)[:, None] & ~has)
-    added = {}
-    if len(absent):
-        cand_w = q_out[row[absent[:, 0]], absent[:, 1]]
-        cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
-        li_prev = last[absent[:, 0], absent[:, 1]]
-        held = val[np.maximum(li_prev, 0), absent[:, 1]]
-        start = [pos[a] for a in axes]
-        last_add = {}
-        fmt = gcode.format_number
-        for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
-                                                cand_nd.tolist(), li_prev.tolist(),
-                                                held.tolist()):
-            la = last_add.get(c)
-            if la is not None and la[0] > pi:
-                prev = la[1]
-            elif pi >= 0:
-                prev = h
-            else:
-                prev = start[c] if la is None else la[1]
-            if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
-                txt = fmt(want_a, nd_a)
-                added.setdefault(li, {})[axes[c]] = txt
-                last_add[c] = (li, float(txt))
-    else:
-        last_add = {}
-    for c, a in enumerate(axes):
-        li = int(last[m - 1, c]) if m else -1
-        la = last_add.get(c)
-        if la is not None and la[0] > li:
-            pos[a] = la[1]
-        elif li >= 0:
-            pos[a] = float(val[li, c])
-    # the edits: a line that gets a word is rewritten whole, else its numbers are replaced
-    if not added:
-        edits.add_bytes(span_s, span_e, flat, lens)
-        return
-    texts = chunkscan.split_texts(flat, lens)
-    line_of = wl[ci]
-    by_line = {}
-    for k, li in enumerate(line_of.tolist()):
-        if li in added:
-            by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
-    own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
-                                                          texts))
-           if int(line_of[k]) not in added]
-    for li, add in added.items():
-        i = i0 + li
-        line = _parse_seg(b.segs, b.first, i)
-        s0 = int(sc.start[i])
-        own.append((s0, s0 + len(b.segs[i]),
-                    gcode.rewrite_line(line, by_line.get(li, {}), add, spaced)))
-    own.sort()
-    for s0, e0, t in own:
-        edits.add(s0, e0, t)
-
-
-class _Edits:
-    """Replacements (start, end, new text) of a chunk's text, in text order; most come as
-    arrays of spans with their new texts as ASCII bytes (:func:`_write_run`), the others one
-    by one as strings (lines written by the rule, lines that get a word)."""
-
-    def __init__(self):
-        self.batches = []   # (starts, ends, new texts: (flat uint8, lengths) or list of str)
-        self.one = []       # pending single edits (start, end, str)
-
-    def add(self, start: int, end: int, text: str) -> None:
-        self.one.append((start, end, text))
-
-    def add_bytes(self, starts, ends, flat, lens) -> None:
-        self._flush()
-        self.batches.append((np.asarray(starts, np.int64), np.asarray(ends, np.int64),
-                             (flat, np.asarray(lens, np.int64))))
-
-    def _flush(self) -> None:
-        if self.one:
-            s0, e0, t = zip(*self.one)
-            self.batches.append((np.array(s0, np.int64), np.array(e0, np.int64), list(t)))
-            self.one = []
-
-    def apply(self, text: str) -> str:
-        """``text`` with the replacements made (spans in text order, not overlapping)."""
-        self._flush()
-        if not self.batches:
-            return text
-        starts = np.concatenate([s0 for s0, _, _ in self.batches])
-        ends = np.concatenate([e0 for _, e0, _ in self.batches])
-        try:
-            b = np.frombuffer(text.encode("latin-1"), np.uint8)
-            new = [t if isinstance(t, tuple) else
-                   (np.frombuffer("".join(t).encode("latin-1"), np.uint8),
-                    np.array([len(x) for x in t], np.int64))
-                   for _, _, t in self.batches]
-        except UnicodeEncodeError:      # a str program with characters beyond latin-1
-            return self._apply_str(text, starts, ends)
-        flat = np.concatenate([f for f, _ in new])
-        lens = np.concatenate([n for _, n in new])
-        n = len(b)
-        cover = np.cumsum(np.bincount(starts, minlength=n + 1)
-                          - np.bincount(ends, minlength=n + 1))[:n] > 0
-        removed = np.zeros(len(starts), dtype=np.int64)
-        np.cumsum((ends - starts)[:-1], out=removed[1:])
-        out = np.insert(b[~cover], np.repeat(starts - removed, lens), flat)
-        return out.tobytes().decode("latin-1")
-
-    def _apply_str(self, text: str, starts, ends) -> str:
-        new = []
-        for _, _, t in self.batches:
-            if isinstance(t, tuple):
-                new += chunkscan.split_texts(*t)
-            else:
-                new += t
-        out, prev = [], 0
-        for s0, e0, t in zip(starts.tolist(), ends.tolist(), new):
-            out += [text[prev:s0], t]
-            prev = e0
-        out.append(text[prev:])
-        return "".join(out)
-
-
-def write(blocks: Blocks, q_out: np.ndarray, written: gcode.ControllerState, axes,
-          spaced: bool) -> str:
-    """The chunk's output text: original bytes except the changed / added axis words.
-    ``written`` (the positions the output program leaves the controller at) is updated."""
-    b = blocks
-    edits = _Edits()
-    q_list = nd_list = None
-    starts = b.scan.start
-    runs = iter(b.runs)
-    nxt = next(runs, None)
-    i, n = 0, len(b.segs)
-    while i < n:
-        if nxt is not None and nxt[0] == i:
-            _write_run(b, nxt[0], nxt[1], q_out, written, axes, spaced, edits)
-            i = nxt[1]
-            nxt = next(runs, None)
-            continue
-        line, step = b.slow[i]
-        r = int(b.row[i])
-        if r >= 0 and q_list is None:
-            q_list, nd_list = q_out.tolist(), b.nd.tolist()
-        t = _write_line(line, step, r, q_list, nd_list, written, axes, spaced)
-        if r >= 0 and t != b.segs[i]:
-            edits.add(int(starts[i]), int(starts[i]) + len(b.segs[i]), t)
-        i += 1
-    return edits.apply(b.scan.text)
+def predict(em, blocks: Blocks, q_out: np.ndarray, opts: Options,
+            sol: Solution | None = None) -> Prediction:
+    """:func:`predict_positions` of every row, with the tool offset of its group (``sol``:
+    the solution of a single group, whose target and error at the programmed positions are
+    reused)."""
+    groups = tool_groups(em, blocks, opts)
+    if len(groups) == 1 and isinstance(groups[0][1], slice):
+        reuse = sol is not None and blocks.direction is None
+        return predict_positions(em, blocks.q_nom, q_out, blocks.direction,
+                                 blocks.dir_program, sol.target if reuse else None,
+                                 sol.before if reuse else None)
+    n = len(q_out)
+    p = Prediction(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
+                   np.full((n, 3), math.nan))
+    for g_em, rows in groups:
+        part = predict_positions(g_em, blocks.q_nom[rows], q_out[rows], blocks.dir(rows),
+                                 None if blocks.dir_program is None else
+                                 blocks.dir_program[rows])
+        for f in ("before_um", "after_um", "orientation_before_urad",
+                  "orientation_after_urad", "u_after_um"):
+            getattr(p, f)[rows] = getattr(part, f)
+    return p
 
 
 # ---------------------------------------------------------------------------------------
 # the chunks together
 @dataclass
 class Chunk:
-    """One chunk through all steps."""
+    """One chunk through all steps: ``q_out`` the axis positions the written program commands
+    (for TCPM rows those of the controller's inverse), ``w_out`` the words written, ``arcs``
+    row -> (ArcPath, ArcResult)."""
 
     blocks: Blocks
     solution: Solution
@@ -638,14 +692,25 @@ class Chunk:
     prediction: Prediction
     text: str
     strategy: str
+    w_out: np.ndarray = None
+    arcs: dict = field(default_factory=dict)
 
     def status(self, r: int) -> str:
+        from .tcpm import AXES
+
         if self.strategy == "thesis":
-            return "compensated (thesis strategy)"
-        if self.solution.limited[r]:
-            return ("compensated; orientation limited (rotary travel, error table or near a "
-                    "singular orientation)")
-        return "compensated"
+            s = "compensated (thesis strategy)"
+        elif self.solution.limited[r]:
+            s = ("compensated; orientation limited (rotary travel, error table or near a "
+                 "singular orientation)")
+        else:
+            s = "compensated"
+        fr = self.blocks.frame
+        if fr is not None and fr[r] != AXES:
+            s += "; TCPM (tool tip in the workpiece frame)"
+        if r in self.arcs:
+            s += "; " + self.arcs[r][1].status
+        return s
 
 
 class Summary:
@@ -657,16 +722,26 @@ class Summary:
         self.max_b = self.max_a = self.max_ob = self.max_oa = self.max_u = 0.0
         self.sum_b2 = self.sum_a2 = 0.0
         self.max_iter = 0
+        self.arcs_kept = self.arcs_linearised = self.segments = self.tcpm = 0
+        self.max_arc_dev = 0.0
 
     def add(self, chunk: Chunk) -> None:
         b, p = chunk.blocks, chunk.prediction
         self.n_blocks += len(b.order)
         n = len(b.q_nom)
         self.n_done += n
-        for line, target in b.pending:
-            missing = [a for a, v in target.items() if v is None]
+        for line, _, missing in b.pending:
             self.not_compensated.append({"line": line.number, "reason":
-                                         f"not compensated: position of axis {missing[0]} unknown"})
+                                         f"not compensated: position of {missing} unknown"})
+        for _, res in chunk.arcs.values():
+            if res.kept:
+                self.arcs_kept += 1
+            else:
+                self.arcs_linearised += 1
+                self.segments += len(res.points)
+            self.max_arc_dev = max(self.max_arc_dev, res.deviation_um)
+        if b.frame is not None:
+            self.tcpm += int(np.count_nonzero(b.frame))
         if n:
             eb = np.linalg.norm(p.before_um, axis=1)
             ea = np.linalg.norm(p.after_um, axis=1)
@@ -691,6 +766,10 @@ class Summary:
             "max_orientation_before_urad": float(self.max_ob),
             "max_orientation_after_urad": float(self.max_oa),
             "max_iterations": self.max_iter, "max_u_after_um": float(self.max_u),
+            "tcpm_blocks": self.tcpm,
+            "arcs": {"kept": self.arcs_kept, "linearised": self.arcs_linearised,
+                     "segments": self.segments,
+                     "max_path_deviation_um": float(self.max_arc_dev)},
         }
 
 
@@ -706,37 +785,40 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     known although its letter appears (e.g. only in a G28 block), which the prescan cannot
     tell.  ``progress(n_lines)`` is called after every chunk."""
     from .compensate import ErrorModel, parameters_for_types
+    from .reversal import Directions
+    from .tcpm import length_rule
+    from .writer import Writer
 
     opts = opts.validated(model)
-    pre = prescan(open_source, model, chunk_lines)
+    pre = prescan(open_source, model, chunk_lines, opts.dialect)
     never = tuple(a for a in pre.absent_rotary if a not in opts.initial)
     em = ErrorModel(model, funcs, opts.tool, parameters_for_types(model, opts.types))
+    rule = length_rule(opts.tool_length, opts.tool_table)
     while True:
         initial = {**opts.initial, **{a: 0.0 for a in never}}
-        interp = gcode.Interpreter(model.axes, initial)
-        written = gcode.ControllerState(model.axes, initial)
+        interp = gcode.Interpreter(model.axes, initial, rule)
+        written = gcode.ControllerState(model.axes, initial, interp.state.linear)
+        writer = Writer(written, model.axes, pre.spaced,
+                        plus="+" if getattr(pre.dialect, "signed", False) else "")
+        directions = Directions(len(model.axes)) if funcs is not None and \
+            funcs.has_reversal else None
         known = set(initial)
         summary = Summary()
         sink.start()
         fh = open_source()
         try:
-            buf = []
             first = 1
-            for seg in fh:
-                buf.append(seg)
-                if len(buf) >= chunk_lines:
-                    chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
-                    summary.add(chunk)
-                    sink.add(chunk)
-                    if progress is not None:
-                        progress(len(buf))
-                    first += len(buf)
-                    buf = []
-            chunk = _run_chunk(buf, first, interp, written, em, opts, pre.spaced, known)
-            summary.add(chunk)
-            sink.add(chunk)
-            if progress is not None:
-                progress(len(buf))
+            while True:
+                buf = list(itertools.islice(fh, chunk_lines))
+                chunk = _run_chunk(buf, first, interp, writer, em, opts, known, pre.dialect,
+                                   directions)
+                summary.add(chunk)
+                sink.add(chunk)
+                if progress is not None:
+                    progress(len(buf))
+                first += len(buf)
+                if len(buf) < chunk_lines:
+                    break
         finally:
             if hasattr(fh, "close"):
                 fh.close()
@@ -746,16 +828,51 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         never = tuple(a for a in model.rotary_axes if a in never or a in late)
 
 
-def _run_chunk(segs, first, interp, written, em, opts, spaced, known) -> Chunk:
+def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None,
+               directions=None) -> Chunk:
     model = em.model
-    b = interpret(segs, first, interp, model, opts.decimals)
+    b = interpret(segs, first, interp, model, opts.decimals, dialect)
     known |= b.known_rotary
+    if directions is not None:
+        b.dir_before = directions.last_dir.copy()
+        b.direction = b.dir_program = directions.rows(b.q_nom)
     check_positions(b, em, opts)
-    sol = solve_blocks(em, b.q_nom, opts)
-    q_out = round_positions(em, b.q_nom, sol, b.nd, opts)
-    pred = predict(em, b.q_nom, q_out)
-    text = write(b, q_out, written, model.axes, spaced)
-    return Chunk(b, sol, q_out, pred, text, opts.strategy)
+    sol = solve_blocks(em, b, opts)
+    w_out, q_out = round_positions(em, b, sol, opts)
+    if directions is not None:
+        b.direction, q_out, w_out = _settle(em, b, sol, w_out, q_out, opts, directions)
+    arc_res = compensate_arcs(em, b, q_out, opts)
+    pred = predict(em, b, q_out, opts, sol)
+    if interp.vector_words is not None:
+        writer.vector_words = interp.vector_words
+    text = writer.chunk(b, w_out, arc_res)
+    return Chunk(b, sol, q_out, pred, text, opts.strategy, w_out, arc_res)
+
+
+def _settle(em, b: Blocks, sol: Solution, w_out, q_out, opts, directions):
+    """The approach directions settled with the moves as written
+    (:func:`volerr.fiveaxis.reversal.settle`): rows compensated again where a written move
+    goes the other way than assumed."""
+    import dataclasses
+
+    from .reversal import settle
+
+    mask = np.array([a in em.funcs.reversal_functions for a in em.model.axes])
+
+    def redo(rows, d):
+        sub = dataclasses.replace(b, q_nom=b.q_nom[rows], w_nom=b.w_nom[rows], nd=b.nd[rows],
+                                  frame=b.frame[rows], length=b.length[rows], direction=d,
+                                  arcs={})
+        s = solve_blocks(em, sub, opts)
+        w, q = round_positions(em, sub, s, opts)
+        sol.q[rows], sol.iterations[rows], sol.limited[rows] = s.q, s.iterations, s.limited
+        w_out[rows] = w
+        return q
+
+    d, q, held = settle(directions, b.direction, q_out, redo, mask)
+    for r, j in held:
+        w_out[r, j] = q[r, j] if b.frame[r] == 0 else w_out[r, j]
+    return d, q, w_out
 
 
 # ---------------------------------------------------------------------------------------
@@ -797,9 +914,8 @@ def report_rows(model, chunk: Chunk) -> str:
             rows.append(f"{row_line[o]},{chunk.status(o).replace(',', ';')},"
                         f"{fmt % tuple(num[o])},{its[o]},{tail}")
         else:
-            line, target = b.pending[-1 - o]
-            missing = [a for a in model.axes if target[a] is None]
-            vals = [str(line.number), f"not compensated: position of axis {missing[0]} unknown"]
+            line, target, missing = b.pending[-1 - o]
+            vals = [str(line.number), f"not compensated: position of {missing} unknown"]
             vals += [_g(target[a]) for a in model.axes] * 2 + [""] * 10 + ["0", "", "", ""]
             rows.append(",".join(vals))
     return "".join(r + "\n" for r in rows)

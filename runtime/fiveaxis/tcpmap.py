@@ -45,11 +45,16 @@ class TcpMap:
 
 
 def tcp_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: int = 73,
-            range1=None, range2=None, orientation: bool = True) -> TcpMap:
+            range1=None, range2=None, orientation: bool = True, approach=None,
+            progress=None) -> TcpMap:
     """:class:`TcpMap` of ``model`` with error functions ``funcs`` (None: no errors) at the
     workpiece point ``point`` (mm).  ``range1`` / ``range2``: (lo, hi) deg of the rotary axes
     (default: the travel inside the measured range, at most -180..180 for an endless axis).
-    ``orientation=False`` skips the tool-axis error (NaN)."""
+    ``orientation=False`` skips the tool-axis error (NaN).  ``approach``: the approach
+    directions of axes whose tables carry a reversal: {axis: +1 | -1}, or ``"sweep"`` -- the
+    grid run as a program sweeping ``axis1`` upwards row by row, each linear axis approaching
+    every point in the direction it moves there (default: the bidirectional mean).
+    ``progress(n)``: called with the number of grid points done, block by block."""
     from .compensate import ErrorModel
     from .kinematics import is_five_axis
 
@@ -90,14 +95,42 @@ def tcp_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: int = 7
             valid &= (ql[:, i] >= lo) & (ql[:, i] <= hi)
     err = np.full((n, 3), np.nan)
     ori = np.full((n, 3), np.nan)
-    if valid.any():
-        err[valid] = em.position_error(q[valid])
-        if orientation:
-            ori[valid] = em.orientation_error(q[valid])
+    d = _directions(model, q, approach, len(q1)) if approach else None
+    for start in range(0, n, BLOCK):
+        sl = slice(start, min(start + BLOCK, n))
+        ok = np.flatnonzero(valid[sl]) + start
+        if len(ok):
+            dd = None if d is None else d[ok]
+            err[ok] = em.position_error(q[ok], None, dd)
+            if orientation:
+                ori[ok] = em.orientation_error(q[ok], None, dd)
+        if progress is not None:
+            progress(sl.stop - sl.start)
     shape = (len(q2), len(q1))
     return TcpMap(model.name, tuple(model.axes), a1, a2, q1, q2, p, t,
                   q.reshape(*shape, len(model.axes)), err.reshape(*shape, 3),
                   ori.reshape(*shape, 3), valid.reshape(shape))
+
+
+#: grid points per block of the evaluation
+BLOCK = 16384
+
+
+def _directions(model, q: np.ndarray, approach, n1: int) -> np.ndarray:
+    """Approach directions (n, n_axes) of the grid: given per axis, or ``"sweep"`` (rows of
+    ``n1`` points run with ``axis1`` rising; the first point of a row approached as the
+    second)."""
+    from ..tables.functions import approach_array
+    from .reversal import along
+
+    n = len(q)
+    if approach != "sweep":
+        return approach_array(approach, model.axes, n)
+    rows = q.reshape(-1, n1, q.shape[1])
+    step = np.diff(rows, axis=1)
+    d = np.sign(np.concatenate([step[:, :1], step], axis=1)).astype(np.int8)
+    out = np.stack([along(r, np.zeros(q.shape[1], np.int8)) for r in d])
+    return out.reshape(n, q.shape[1]).astype(float)
 
 
 def tcp_error_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: int = 73,

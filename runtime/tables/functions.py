@@ -189,6 +189,37 @@ class ErrorFunctions:
                     s = np.hypot(s if s is not None else 0.0, t.s[name])
                 if s is not None:
                     self.std_functions[name] = (ax, _Linear(t.positions, s, clamp=True))
+        #: reversal (ISO 230-2 B_i) of the axes whose table has an ``RV_<axis>`` column:
+        #: axis -> (its positioning error E<A><A>, B_i as a function of position, mm)
+        self.reversal_functions = {}
+        for ax, t in self.tables.items():
+            if t.reversal is None:
+                continue
+            name = f"E{ax}{ax}"
+            require(ax not in model.rotary_axes and name in params and paxis.get(name) == ax,
+                    f"{where}{ax}.csv: a reversal column RV_{ax} needs a linear axis with a "
+                    f"positioning error {name} in {model.name}")
+            self.reversal_functions[ax] = (name, _Linear(t.positions, t.reversal, clamp=True))
+
+    @property
+    def has_reversal(self) -> bool:
+        """True when a table carries a reversal column (``RV_<axis>_um``)."""
+        return bool(self.reversal_functions)
+
+    def reversal(self, positions, direction) -> dict:
+        """The direction-dependent part of the positioning errors: ``+B_i / 2`` approaching
+        in the positive direction, ``-B_i / 2`` in the negative one, 0 where the direction is
+        0 (unknown: the tabulated error is the bidirectional mean).  ``positions`` (N, n_axes)
+        mm / deg and ``direction`` (N, n_axes) -1 / 0 / +1, both in ``model.axes`` order ->
+        {E<A><A>: (N,) mm}."""
+        q = np.atleast_2d(np.asarray(positions, dtype=float))
+        d = np.atleast_2d(np.asarray(direction, dtype=float))
+        axes = self.model.axes
+        out = {}
+        for ax, (name, f) in self.reversal_functions.items():
+            i = axes.index(ax)
+            out[name] = 0.5 * d[:, i] * f(q[:, i])
+        return out
 
     @classmethod
     def from_dir(cls, directory, model, method: str = "linear", degree: int | None = None,
@@ -285,3 +316,35 @@ class ErrorFunctions:
         out = self._grouped(cols, n, std=True)
         out.update({k: np.full(n, v) for k, v in self.constants_std.items()})
         return out
+
+
+def parse_approach(spec, model, funcs=None) -> dict:
+    """Approach directions given on a command line -> {axis: +1 | -1}: ``"X+,Y-"`` per axis,
+    or ``"+"`` / ``"-"`` for every axis whose table has a reversal (``funcs``); None or ""
+    -> {} (the bidirectional mean).  Only linear axes of ``model``."""
+    if not spec:
+        return {}
+    spec = spec.replace(" ", "")
+    if spec in ("+", "-"):
+        require(funcs is not None and funcs.has_reversal,
+                "--approach: no error table has a reversal column (RV_<axis>_um)")
+        return {a: (1 if spec == "+" else -1) for a in funcs.reversal_functions}
+    out = {}
+    lin = [a for a in model.axes if a not in model.rotary_axes]
+    for part in filter(None, spec.split(",")):
+        require(len(part) == 2 and part[1] in "+-",
+                f"--approach: expected AXIS+ or AXIS- (e.g. X+,Y-), got {part!r}")
+        a = part[0].upper()
+        require(a in lin, f"--approach: {a} is not a linear axis of {model.name} "
+                          f"({' '.join(lin)})")
+        out[a] = 1 if part[1] == "+" else -1
+    return out
+
+
+def approach_array(approach: dict, axes, n: int) -> np.ndarray:
+    """(n, len(axes)) directions from {axis: +1 | -1} (0 elsewhere)."""
+    d = np.zeros((n, len(axes)))
+    for a, v in approach.items():
+        d[:, list(axes).index(a)] = v
+    return d
+

@@ -14,8 +14,10 @@ from test_compensate import write_errors
 
 import volerr
 from volerr.fiveaxis import chunkscan, gcode, program
+from volerr.errors import InputError
 from volerr.fiveaxis.compensate import compensate_program
 from volerr.tables import table as tables
+from volerr.tables.functions import ErrorFunctions
 
 AXES = ("X", "Y", "Z", "B", "C")
 NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
@@ -23,12 +25,40 @@ NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 number = st.one_of(
     st.decimals(min_value=-1000, max_value=1000, allow_nan=False, places=4).map(str),
     st.sampled_from(["1.", ".5", "+2", "-0", "+.25", "007", "12.3456789012345678", "1.2.3",
-                     "--1", "+", "."]))
-word = st.tuples(st.sampled_from("XYZBCxyzbNFGMAUS"), st.sampled_from(["", " ", "\t"]), number)
-plain = st.lists(st.tuples(st.sampled_from(["", " ", "  "]), word), min_size=0, max_size=6).map(
-    lambda ws: "".join(sp + a + b + c for sp, (a, b, c) in ws))
+                     "--1", "+", ".", "0", "1", "00", "01", "2", "3", "98", "128", "129.",
+                     "6"]))
+word = st.tuples(st.sampled_from("XYZBCxyzbNFGgMmAUSTHDI"), st.sampled_from(["", " ", "\t"]),
+                 number)
+comment = st.sampled_from(["(cut X1)", "(a;b)", "; fin (x", ";", "()", "(", ")", "(G2 M98)",
+                           "(\u00d810 \u2014)"])
+piece = st.one_of(word.map(lambda w: "".join(w)), comment)
+plain = st.lists(st.tuples(st.sampled_from(["", " ", "  "]), piece), min_size=0,
+                 max_size=6).map(lambda ws: "".join(sp + w for sp, w in ws))
 line = st.one_of(plain, plain.map(lambda s: s + " "), st.sampled_from(
-    ["(comment X1)", "X1 (c)", "%", "G90", "G91", "X1 ; c", "X1 #1", "  "]))
+    ["(comment X1)", "X1 (c)", "%", "G90", "G91", "X1 ; c", "X1 #1", "  ", "/X1", "X(c)1",
+     "G1 X1 (a) Y2 ; b", "N10 G01 X1. F500 S1200 M8 T3"]))
+
+
+def reference_fast(body: str) -> list | None:
+    """The words of a line the interpreter would read as a plain line (a motion block in the
+    mode in force, or nothing): tokens of the line-by-line tokenizer, G only 0 / 1, M not one
+    the interpreter acts on, no foreign axis, no axis twice; None for any other line."""
+    try:
+        toks = gcode.tokenize(body)
+    except InputError:
+        return None
+    if any(t.kind == "other" for t in toks) and body.strip():
+        return None
+    words = [t for t in toks if t.kind == "word"]
+    axes_ = [t.letter for t in words if t.letter in AXES]
+    if len(set(axes_)) != len(axes_) or any(t.letter in "AU" for t in words):
+        return None
+    for t in words:
+        if t.letter == "G" and t.value not in (0.0, 1.0):
+            return None
+        if t.letter == "M" and round(t.value) in gcode.SPECIAL_M:
+            return None
+    return words
 
 
 @settings(max_examples=200, deadline=None)
@@ -36,19 +66,17 @@ line = st.one_of(plain, plain.map(lambda s: s + " "), st.sampled_from(
 def test_scan_finds_the_plain_lines_and_their_numbers(lines):
     segs = [a + b for a, b in lines]
     sc = chunkscan.scan(segs, AXES)
+    codes = {"T": chunkscan.TRACKED["T"], "H": chunkscan.TRACKED["H"],
+             "D": chunkscan.TRACKED["D"], "G": chunkscan.G_WORD, "M": chunkscan.M_WORD}
     for i, (body, _) in enumerate(lines):
-        simple = gcode._SIMPLE.fullmatch(body) is not None
-        parts = gcode._PARTS.findall(body) if simple else []
-        letters = [p[1].upper() for p in parts]
-        axes_ = [x for x in letters if x in AXES]
-        want_fast = simple and not any(x in "GMAU" for x in letters) and \
-            len(set(axes_)) == len(axes_)
-        assert bool(sc.fast[i]) == want_fast, body
-        if want_fast:
+        words = reference_fast(body)
+        assert bool(sc.fast[i]) == (words is not None), body
+        if words is not None:
             k = sc.line == i
-            assert [AXES[a] if a >= 0 else "?" for a in sc.axis[k]] == \
-                [x if x in AXES else "?" for x in letters]
-            texts = [p[3] for p in parts]
+            words = [t for t in words if t.letter in AXES or t.letter in codes]
+            assert list(sc.axis[k]) == [AXES.index(t.letter) if t.letter in AXES else
+                                        codes[t.letter] for t in words]
+            texts = [body[t.num_start:t.num_end] for t in words]
             assert [sc.text[s:e] for s, e in zip(sc.num_start[k], sc.num_end[k])] == texts
             vals = sc.value[k]
             for t, v in zip(texts, vals):
@@ -121,30 +149,48 @@ def random_program(seed: int) -> str:
             v = round(target - cur[a], nd) if incr else target
             cur[a] = cur[a] + v if incr else round(target, nd)
             txt = f"{v:.{nd}f}" + ("." if nd == 0 and rng.uniform() < 0.2 else "")
-            words.append((a.lower() if seed % 3 == 0 else a) + txt)
+            gap = " " if seed % 4 == 2 and rng.uniform() < 0.3 else ""
+            words.append((a.lower() if seed % 3 == 0 else a) + gap + txt)
+        # what post-processors write: a motion word on every line, N F S T M words,
+        # comments in ( ) and after ;
+        if rng.uniform() < 0.6:
+            words.insert(0, str(rng.choice(["G1", "G01", "G0", "g00", "G1.0"])))
+        if rng.uniform() < 0.3:
+            words.append(str(rng.choice(["F1500.", "S12000", "M8", "T3", "F800 M3", "H2"])))
+        if rng.uniform() < 0.2:
+            words.insert(int(rng.integers(0, len(words) + 1)), "(cut X1)")
         if rng.uniform() < 0.2:
             words.insert(0, f"N{i}")
         sep = "" if seed % 4 == 1 else " "
-        out.append(sep.join(words) + ("  " if rng.uniform() < 0.1 else ""))
+        tail = "  " if rng.uniform() < 0.1 else (" ; fin (x" if rng.uniform() < 0.15 else "")
+        out.append(sep.join(words) + tail)
     if incr:
         out.append("G90")
+    if seed >= 8:       # a TCPM program (rotary angles): the words are tool tip and angles
+        out = out[:2] + ["G43.4 H1 (TCPM)"] + out[2:] + ["G49"]
     end = ["\n", "\r\n", "\r"][seed % 3]
     return end.join(out) + end
 
 
-@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("seed", range(10))
 @pytest.mark.parametrize("orientation", [False, True])
 def test_whole_chunk_path_writes_the_line_by_line_bytes(setup, seed, orientation, monkeypatch):
     m, funcs = setup
     text = random_program(seed)
     init = {"B": 10.0, "C": 5.0} if seed % 2 else {}
+    kw = {}
+    if seed >= 8:       # TCPM: the axis positions may leave the travel and the tables
+        funcs = ErrorFunctions(funcs.tables, funcs.constants, m, extrapolate=True)
+        kw = {"tool_length": 100.0, "check_travel": False}
     monkeypatch.setattr(program, "WHOLE_CHUNK", False)
-    ref = compensate_program(m, funcs, text, orientation=orientation, initial=init)
+    ref = compensate_program(m, funcs, text, orientation=orientation, initial=init, **kw)
     monkeypatch.setattr(program, "WHOLE_CHUNK", True)
     assert ref.text != text
-    for k in (None, 1, 7, 50):
+    if seed >= 8:
+        assert ref.summary()["tcpm_blocks"] > 50
+    for k in (None, 1, 7, 50) if seed < 8 else (None, 13):
         got = compensate_program(m, funcs, text, orientation=orientation, initial=init,
-                                 chunk_lines=k)
+                                 chunk_lines=k, **kw)
         assert got.text == ref.text, k
         assert [(r.line, r.status, r.output) for r in got.reports] == \
             [(r.line, r.status, r.output) for r in ref.reports]

@@ -262,8 +262,8 @@ def test_tokenizer_keeps_every_byte(lines, end, trailing):
 
 
 @pytest.mark.parametrize("text,msg", [
-    ("G2 X10 Y10 I5 J0\n", "G2 circular arc"),
-    ("G1 X1\nG03 X2 Y2 R1\n", "G3 circular arc"),
+    ("G2 X10 Y10 B10 I5 J0\n", "rotary axis B in an arc"),
+    ("G43.5 H1 X1 Y1 Z1 I0 J0 K1\n", "TCPM program needs the tool length"),
     ("G20\nG1 X1\n", "inch"),
     ("G1 A10\n", "axis A is not an axis"),
     ("G1 X#1\n", "cannot interpret"),
@@ -347,12 +347,13 @@ def test_cli_bad_input_exit_2_one_line(tmp_path):
     assert prog.read_bytes() == before
 
 
-def test_cli_refuses_arcs_and_positions_outside_the_tables(tmp_path):
+def test_cli_refuses_bad_arcs_and_positions_outside_the_tables(tmp_path):
     err = tmp_path / "err"
     err.mkdir()
     write_error_table(err / "X.csv", ErrorTable("X", [0, 100], {"EXX": [0.0, 0.001]}))
     prog = tmp_path / "p.nc"
-    for text, msg in [("G1 X10 Y0 Z10 B0 C0\nG2 X20 Y10 R5\n", "G2"),
+    for text, msg in [("G1 X10 Y0 Z10 B0 C0\nG2 X20 Y10 R5\n", "line 2: the end point is "
+                                                                  "not on the arc's circle"),
                       ("G1 X150 Y0 Z10 B0 C0\n", "outside the measured range"),
                       ("G1 X10 Y0 Z900 B0 C0\n", "outside the travel"),
                       ("G1 X10 Y0 Z10 B0 C0 A5\n", "axis A")]:
@@ -623,7 +624,7 @@ def test_bad_program_one_stderr_line_even_with_notes_about_the_tables(tmp_path):
     prog = tmp_path / "p.nc"
     prog.write_text("G0 X0 Y0 Z100 B0 C0\nG2 X10 Y10 R5\n")
     rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
-    assert rc == 2 and len(se.strip().splitlines()) == 1 and "G2" in se, se
+    assert rc == 2 and len(se.strip().splitlines()) == 1 and "line 2" in se, se
     rc, so, se = cli("tcpmap", "DMU50", "--errors", err, "--point", "0", "0", "0", "--out",
                      prog)
     assert rc == 2 and len(se.strip().splitlines()) == 1 and ".png" in se, se

@@ -1,0 +1,124 @@
+"""Axis compensation tables of SINUMERIK, Heidenhain and Fanuc controllers: export from an
+error directory, import back into one, and what compensating with them leaves.
+
+The formats (each module documents its file, limits and sources):
+
+=================  ===========================================  ==============================
+``sinumerik-lec``  :mod:`volerr.tables.sinumerik` (LEC)          positioning ``E<A><A>``
+``sinumerik-cec``  :mod:`volerr.tables.sinumerik` (CEC)          straightness ``E<B><A>``
+                                                                 (+ positioning by direction
+                                                                 with a reversal)
+``heidenhain``     :mod:`volerr.tables.heidenhain_tables`        positioning and straightness
+                                                                 (BACKLASH: reversal)
+``fanuc``          :mod:`volerr.tables.fanuc`                    positioning, relative to the
+                                                                 reference position
+=================  ===========================================  ==============================
+
+What compensating leaves: :func:`volerr.tables.comp_tables.left`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import require
+from . import comp_tables as ct
+
+FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc")
+
+
+def build(funcs, fmt: str, points: int | None = None) -> list:
+    """The :class:`~volerr.tables.comp_tables.CompTable` list of format ``fmt`` from error
+    functions (``points``: at most this many per table, within the format's limit)."""
+    from . import fanuc, heidenhain_tables, sinumerik
+
+    builders = {"sinumerik-lec": (sinumerik.build_lec, sinumerik.MAX_POINTS),
+                "sinumerik-cec": (sinumerik.build_cec, sinumerik.MAX_POINTS),
+                "heidenhain": (heidenhain_tables.build, heidenhain_tables.MAX_POINTS),
+                "fanuc": (fanuc.build, fanuc.MAX_POINTS)}
+    require(fmt in builders, f"unknown format {fmt!r} ({' '.join(FORMATS)})")
+    fn, limit = builders[fmt]
+    require(points is None or 2 <= points <= limit,
+            f"--points must be 2 .. {limit} for {fmt}")
+    tables = fn(funcs, points or limit)
+    require(tables, f"{fmt}: the error tables hold nothing this format carries "
+                    f"({'positioning' if fmt in ('sinumerik-lec', 'fanuc') else 'straightness'}"
+                    " errors of the axes)")
+    return tables
+
+
+def write(model, tables: list, fmt: str, out: Path) -> dict:
+    """{path: text} of the files of ``tables`` in format ``fmt``, the main file (at ``out``)
+    first (Heidenhain: the ``.CMA`` there and its ``.COM`` tables next to it)."""
+    from . import fanuc, heidenhain_tables, sinumerik
+
+    out = Path(out)
+    if fmt == "sinumerik-lec":
+        return {out: sinumerik.write_lec(model.name, tables)}
+    if fmt == "sinumerik-cec":
+        return {out: sinumerik.write_cec(model.name, tables, model.axes)}
+    if fmt == "fanuc":
+        return {out: fanuc.write(model.name, tables, model.axes)}
+    files = heidenhain_tables.write(out.stem, model.name, tables)
+    cma = next(name for name in files if name.endswith(".cma"))
+    return {out: files[cma], **{out.parent / name: text for name, text in files.items()
+                                if name != cma}}
+
+
+def read(model, path, fmt: str) -> list:
+    """The tables of a controller file (Heidenhain: the ``.CMA``)."""
+    from . import fanuc, heidenhain_tables, sinumerik
+
+    p = Path(path)
+    require(p.is_file(), f"controller file not found: {path}")
+    if fmt == "heidenhain":
+        return heidenhain_tables.read(p, model.axes)
+    text = p.read_text(encoding="latin-1")
+    reader = {"sinumerik-lec": sinumerik.read_lec, "sinumerik-cec": sinumerik.read_cec,
+              "fanuc": fanuc.read}[fmt]
+    return reader(text, model.axes, str(p))
+
+
+def import_tables(model, path, fmt: str) -> dict:
+    """{axis: ErrorTable} of a controller file (values back in volerr's units and signs)."""
+    from .controller import check_against_model
+
+    tables = ct.to_error_tables(read(model, path, fmt), model)
+    check_against_model(model, tables, {}, str(path))
+    return tables
+
+
+def plot_left(result, path, title: str = "") -> None:
+    """The volumetric error |e| before and after the tables' correction on three levels of
+    the last linear axis (lowest, middle, highest), um."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    shape = result.shape
+    lin = result.linear
+    q = result.positions
+    b = (np.linalg.norm(result.before, axis=1) * 1e3).reshape(shape)
+    a = (np.linalg.norm(result.after, axis=1) * 1e3).reshape(shape)
+    levels = sorted({0, shape[2] // 2, shape[2] - 1})
+    fig, ax = plt.subplots(2, len(levels), figsize=(4 * len(levels), 7), squeeze=False)
+    vmax_b, vmax_a = float(b.max()), float(max(a.max(), 1e-9))
+    i0, i1, i2 = (result.axes.index(x) for x in lin)
+    xs = np.unique(q[:, i0])
+    ys = np.unique(q[:, i1])
+    zs = np.unique(q[:, i2])
+    for col, k in enumerate(levels):
+        for row, (v, vmax, label) in enumerate(((b, vmax_b, "before"),
+                                                (a, vmax_a, "left after the tables"))):
+            im = ax[row][col].imshow(v[:, :, k].T, origin="lower", cmap="viridis",
+                                     vmin=0, vmax=vmax, aspect="auto",
+                                     extent=(xs[0], xs[-1], ys[0], ys[-1]))
+            ax[row][col].set_title(f"{label}, {lin[2]} = {zs[k]:g} mm", fontsize=9)
+            ax[row][col].set_xlabel(f"{lin[0]} (mm)")
+            ax[row][col].set_ylabel(f"{lin[1]} (mm)")
+            fig.colorbar(im, ax=ax[row][col], label="|e| (um)")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -1,0 +1,245 @@
+"""TCPM programs (tool tip in the workpiece frame): a TCPM program and its machine-axis
+equivalent give the same actual tool tips after compensation, on an independent controller
+(tests/helpers/nc_sim with an inverse from the independent exact chain) and chain
+(test_fiveaxis.tool2work); with --orientation the tool-axis error shrinks (tool-vector
+programs); Heidenhain plain language gives the same numbers as ISO; bad programs get exit 2
+naming the line."""
+
+import re
+
+import numpy as np
+import pytest
+from helpers import nc_sim
+from test_compensate import cli, write_errors
+from test_fiveaxis import tool2work
+
+import volerr
+from volerr.errors import InputError
+from volerr.fiveaxis.compensate import ErrorModel, compensate_program
+from volerr.tables.functions import ErrorFunctions
+
+L = 120.0                       # tool length, mm
+TOOL = np.array([0.0, 0.0, -L])  # the tip against the tool axis
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    m = volerr.load("DMU50")
+    d = write_errors(tmp_path_factory.mktemp("err"), m, seed=21)
+    return m, ErrorFunctions.from_dir(d, m), d
+
+
+def _htm(m, q, errors=None):
+    return tool2work(m.name, dict(zip(m.axes, q)), errors or {})
+
+
+def _tip(m, q, errors=None):
+    return (_htm(m, q, errors) @ np.r_[TOOL, 1.0])[:3]
+
+
+def _inverse_linear(m, tip, rot):
+    """Independent nominal inverse for fixed rotary positions: the chain is affine in X Y Z."""
+    base = np.r_[0.0, 0.0, 0.0, rot]
+    t0 = _tip(m, base)
+    a = np.column_stack([_tip(m, base + np.r_[np.eye(3)[k], 0, 0]) - t0 for k in range(3)])
+    return np.linalg.solve(a, tip - t0)
+
+
+def _positions(rng, n):
+    return np.column_stack([rng.uniform(-150, 150, n), rng.uniform(-150, 150, n),
+                            rng.uniform(150, 300, n), rng.uniform(5, 80, n),
+                            rng.uniform(0, 300, n)])
+
+
+def _errors_at(m, funcs, q):
+    e = funcs(ErrorModel(m, funcs).lookup(np.atleast_2d(q)))
+    return [{k: float(v[r]) for k, v in e.items()} for r in range(len(np.atleast_2d(q)))]
+
+
+def _programs(m, rng, n=25):
+    q = _positions(rng, n)
+    tips = np.array([_tip(m, row) for row in q])
+    tcpm = ["%", "N10 G90 G17 T1 M6", "G0 X0 Y0 Z250 B0 C0 (axis positions)",
+            "N20 G43.4 H1 (TCPM on)"]
+    iso_axes = ["%", "N10 G90 G17"]
+    for k, (t, row) in enumerate(zip(tips, q)):
+        tcpm.append(f"N{30 + 10 * k} G1 X{t[0]:.4f} Y{t[1]:.4f} Z{t[2]:.4f} B{row[3]:.3f} "
+                    f"C{row[4]:.3f} F1000")
+        # the axis positions the controller takes from these words (independent inverse)
+        tr = np.round(t, 4)
+        rot = np.round(row[3:], 3)
+        lin = _inverse_linear(m, tr, rot)
+        iso_axes.append(f"G1 X{lin[0]:.6f} Y{lin[1]:.6f} Z{lin[2]:.6f} B{rot[0]:.3f} "
+                        f"C{rot[1]:.3f}")
+    tcpm += ["G49", "G0 X0 Y0 Z250 B0 C0", "M30", "%"]
+    iso_axes += ["M30", "%"]
+    return "\n".join(tcpm) + "\n", "\n".join(iso_axes) + "\n", tips
+
+
+def _run_tcpm(m, text):
+    inv = lambda tip, rot: _inverse_linear(m, tip, rot)  # noqa: E731
+    return [mv for mv in nc_sim.moves(text, m.axes, tcpm_inverse=inv)]
+
+
+def _actual(m, funcs, q):
+    errs = _errors_at(m, funcs, q)
+    return np.array([_tip(m, row, e) for row, e in zip(q, errs)])
+
+
+def test_tcpm_program_and_its_axis_equivalent_land_on_the_same_tips(setup):
+    m, funcs, _ = setup
+    tcpm_text, axis_text, tips = _programs(m, np.random.default_rng(3))
+    out_t = compensate_program(m, funcs, tcpm_text, tool_table={1: L})
+    out_a = compensate_program(m, funcs, axis_text, tool=tuple(TOOL), decimals=6)
+    assert out_t.summary()["tcpm_blocks"] == len(tips)
+    # the controller: TCPM words through its nominal inverse; axis words as they are
+    tc = lambda text: [mv for mv in _run_tcpm(m, text) if mv.tcpm][1:]  # noqa: E731
+    q_t = np.array([[mv.end[a] for a in m.axes] for mv in tc(out_t.text)])
+    q_a = np.array([[mv.end[a] for a in m.axes] for mv in nc_sim.moves(out_a.text, m.axes)])
+    q_before = np.array([[mv.end[a] for a in m.axes] for mv in tc(tcpm_text)])
+    assert len(q_t) == len(tips) - 1 and len(q_a) == len(tips) - 1   # moves: from block 2 on
+    # the axis-position blocks around the TCPM section are compensated as in an axis program
+    axes_rep = [r for r in out_t.reports if "TCPM" not in r.status]
+    assert len(axes_rep) == 2 and all(r.status == "compensated" for r in axes_rep)
+    want = np.round(tips[1:], 4)
+    act_t, act_a = _actual(m, funcs, q_t), _actual(m, funcs, q_a)
+    before = _actual(m, funcs, q_before)
+    assert np.linalg.norm(before - want, axis=1).max() > 5e-3
+    assert np.linalg.norm(act_t - act_a, axis=1).max() < 0.2e-3
+    assert np.linalg.norm(act_t - want, axis=1).max() < 0.15e-3
+    # the rotary words are the programmed ones (orientation not compensated)
+    assert re.findall(r"B[\d.]+ C[\d.]+", out_t.text) == re.findall(r"B[\d.]+ C[\d.]+",
+                                                                    tcpm_text)
+
+
+def _axis(m, q, errors=None):
+    return _htm(m, q, errors)[:3, 2]
+
+
+def test_tool_vector_program_with_orientation_corrects_the_tool_axis(setup):
+    """G43.5 with I J K: the controller's inverse gives the rotary axes from the vector;
+    --orientation writes a corrected vector so that the actual tool axis is the programmed
+    one, and the tip still lands."""
+    m, funcs, _ = setup
+    rng = np.random.default_rng(5)
+    q = _positions(rng, 12)
+    lines = ["G90", "G43.5 H1"]
+    for row in q:
+        t, k = _tip(m, row), _axis(m, row)
+        lines.append(f"G1 X{t[0]:.4f} Y{t[1]:.4f} Z{t[2]:.4f} I{k[0]:.7f} J{k[1]:.7f} "
+                     f"K{k[2]:.7f}")
+    text = "\n".join(lines + ["G49"]) + "\n"
+    plain = compensate_program(m, funcs, text, tool_length=L)
+    ori = compensate_program(m, funcs, text, tool_length=L, orientation=True)
+    s0, s1 = plain.summary(), ori.summary()
+    assert s0["max_orientation_after_urad"] > 20
+    assert s1["max_orientation_after_urad"] < 0.25 * s0["max_orientation_after_urad"]
+    # independently: words -> axis positions by Newton on the exact chain, then actual axis
+    words = re.findall(r"X(\S+) Y(\S+) Z(\S+) I(\S+) J(\S+) K(\S+)", ori.text)
+    words0 = re.findall(r"X(\S+) Y(\S+) Z(\S+) I(\S+) J(\S+) K(\S+)", text)
+    for (w, w0, row) in zip(words, words0, q):
+        w = np.array(w, float)
+        w0 = np.array(w0, float)
+        rot = _rotary_from_vector(m, w[3:], row[3:])
+        lin = _inverse_linear(m, w[:3], rot)
+        qq = np.r_[lin, rot]
+        e = _errors_at(m, funcs, qq)[0]
+        k_act = _axis(m, qq, e)
+        assert np.linalg.norm(k_act - w0[3:] / np.linalg.norm(w0[3:])) < 5e-6
+        assert np.linalg.norm(_tip(m, qq, e) - w0[:3]) < 0.2e-3
+
+
+def _rotary_from_vector(m, k, near):
+    """Nominal rotary positions for the tool vector ``k``, by Gauss-Newton from ``near``."""
+    k = k / np.linalg.norm(k)
+    r = np.array(near, float)
+    for _ in range(20):
+        f = _axis(m, np.r_[0, 0, 0, r])
+        jac = np.column_stack([(_axis(m, np.r_[0, 0, 0, r + 1e-6 * np.eye(2)[j]]) - f) / 1e-6
+                               for j in range(2)])
+        step = np.linalg.lstsq(jac, k - f, rcond=None)[0]
+        r = r + step
+        if np.abs(step).max() < 1e-12:
+            break
+    return r
+
+
+def _heidenhain(tcpm_text):
+    out = ["0 BEGIN PGM TCPMTEST MM", "1 BLK FORM 0.1 Z X-200 Y-200 Z-50",
+           "2 BLK FORM 0.2 X+200 Y+200 Z+50", "3 TOOL CALL 1 Z S12000", "4 M128 ; TCPM on"]
+    n = 5
+    for line in tcpm_text.splitlines():
+        mm = re.search(r"X(\S+) Y(\S+) Z(\S+) B(\S+) C(\S+)", line)
+        if mm and line.startswith("N"):         # the TCPM blocks
+            vals = [float(v) for v in mm.groups()]
+            words = " ".join(f"{a}{v:+.4f}" if a in "XYZ" else f"{a}{v:+.3f}"
+                             for a, v in zip("XYZBC", vals))
+            out.append(f"{n} L {words} R0 F1000")
+            n += 1
+    out += [f"{n} M129", f"{n + 1} END PGM TCPMTEST MM"]
+    return "\r\n".join(out) + "\r\n"
+
+
+def test_heidenhain_plain_language_gives_the_numbers_of_the_iso_program(setup):
+    m, funcs, _ = setup
+    tcpm_text, _, _ = _programs(m, np.random.default_rng(3), n=8)
+    hh = _heidenhain(tcpm_text)
+    iso = compensate_program(m, funcs, tcpm_text, tool_table={1: L})
+    out = compensate_program(m, funcs, hh, tool_table={1: L})
+    assert out.summary()["tcpm_blocks"] == 8
+    num = r"([+-]?[\d.]+)"
+    got = [[float(v) for v in g] for g in re.findall(
+        rf"X{num} Y{num} Z{num} B{num} C{num}", out.text)]
+    want = [[float(v) for v in g] for g in re.findall(
+        rf"(?m)^N.*X{num} Y{num} Z{num} B{num} C{num}", iso.text)]
+    assert got == want and got != [[float(v) for v in g] for g in re.findall(
+        rf"X{num} Y{num} Z{num} B{num} C{num}", hh)]
+    # every other byte kept; the signs written as the TNC does
+    strip = lambda s: re.sub(r"[XYZBC][+-][\d.]+", "W", s)  # noqa: E731
+    assert strip(out.text) == strip(hh)
+    # a machine-axis plain-language program (no M128) works too
+    axes_prog = hh.replace("4 M128 ; TCPM on", "4 ; no TCPM").replace("M129", "M5")
+    res = compensate_program(m, funcs, axes_prog)
+    assert res.summary()["tcpm_blocks"] == 0 and res.summary()["compensated"] == 8
+
+
+@pytest.mark.parametrize("text,kw,msg", [
+    ("G90\nG43.4 H7\nG1 X1 Y2 Z3 B10 C10\n", {"tool_table": {1: 120.0}},
+     "line 2: tool H7 is not in the tool table"),
+    ("; a program\nGOTO/10,20,30\n", {}, "line 2: unknown program dialect"),
+    ("0 BEGIN PGM X MM\n1 CC X+0 Y+0\n", {}, "line 2: CC"),
+    ("0 BEGIN PGM X MM\n1 L X+1 Y+2 Z+3 B+0 C+0 RL F100\n", {}, "line 2: radius compensation"),
+    ("G90 G1 X0 Y0 Z200 B0 C0\nTRAORI\nG1 X1 Y2 Z3 A3=0 B3=0 C3=1 B5\n", {"tool_length": 99.0},
+     "line 3: rotary axis B and a tool vector"),
+])
+def test_bad_programs_are_refused_naming_the_line(setup, text, kw, msg):
+    m, funcs, _ = setup
+    with pytest.raises(InputError, match=msg):
+        compensate_program(m, funcs, text, **kw)
+
+
+def test_cli_tcpm_without_tool_length_exit_2_one_line(setup, tmp_path):
+    _, _, d = setup
+    prog = tmp_path / "p.nc"
+    prog.write_text("G90 G1 X0 Y0 Z200 B0 C0\nN20 G43.4 H1\nG1 X1 Y2 Z3 B10 C10\n")
+    (tmp_path / "tools.csv").write_text("tool,length_mm\n2,120\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o")
+    assert rc == 2 and "line 2: a TCPM program needs the tool length" in se and \
+        len(se.strip().splitlines()) == 1, se
+    assert not (tmp_path / "o").exists()
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+                     "--tool-table", tmp_path / "tools.csv")
+    assert rc == 2 and "line 2: tool H1 is not in the tool table" in se, se
+
+
+def test_tool_length_rule():
+    from volerr.fiveaxis.tcpm import length_rule
+
+    assert length_rule(None, None) is None
+    rule = length_rule(None, {1: 100.0, 2: 80.5})
+    assert rule({"T": 2.0}, "line 1") == 80.5
+    assert rule({"T": 2.0, "H": 1.0}, "line 1") == 100.0        # Fanuc: H wins
+    assert rule({"T": 1.0, "DL": 0.25}, "line 1") == 100.25     # Heidenhain delta length
+    assert length_rule(55.0, {1: 100.0})({"T": 1.0}, "x") == 55.0
+    with pytest.raises(InputError, match="line 9: TCPM with no T"):
+        rule({}, "line 9")
