@@ -78,7 +78,7 @@ def register(sub) -> None:
                         "Heidenhain TOOL CALL), else D")
     p.add_argument("--dialect", choices=("auto", "iso", "heidenhain"), default="auto",
                    help="program language: ISO G-code (Fanuc, Siemens, Heidenhain ISO) or "
-                        "Heidenhain plain language (default: detected from the first lines)")
+                        "Heidenhain plain language (auto: detected from the first lines)")
     p.add_argument("--report", help="per-block CSV report")
     p.add_argument("--json", help="summary as JSON")
     p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")

@@ -146,6 +146,7 @@ def test_what_the_tables_leave_equals_an_independent_computation(setup, tmp_path
 def test_cli_export_json_plot_and_import(setup, tmp_path):
     m, funcs, d = setup
     out = tmp_path / "ctl" / "comp.cma"
+    out.parent.mkdir()            # an output's folder must exist (a typo is never created)
     r = subprocess.run([sys.executable, "-m", "volerr", "controller", "export", "DMU50",
                         "--errors", str(d), "--format", "heidenhain", "--out", str(out),
                         "--json", str(tmp_path / "s.json"), "--plot", str(tmp_path / "m.png"),
