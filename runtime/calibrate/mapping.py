@@ -134,7 +134,11 @@ def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), input
     from ..cmm import csvformat
     from ..fileio import AtomicFile
 
+    from ..errors import require
+
     model = cal.model
+    require(len(model.axes) - len(model.rotary_axes) == 3,
+            f"--map-out: {model.name} has not three linear axes")
     pos, _, _ = grid_positions(cal, counts)
     e, u, _, _ = predict(cal, pos, np.asarray(probe, float))
     header = list(model.axes) + ["Xp", "Yp", "Zp", "dx_um", "dy_um", "dz_um", "u_dx_um",

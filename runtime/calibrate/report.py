@@ -1,6 +1,9 @@
 """HTML page of ``volerr calibrate``: the identified parameters with their standard
 uncertainties and coverage bars, what the campaign does not determine (and which file sees
-what), the plans that would determine it, the residuals of every file, the set-up estimates."""
+what), the plans that would determine it, the residuals of every file, the consistency of the
+files, artifact poses and station positions, the volumetric map's size and uncertainty, the
+ISO 10360-2 length errors of the identified model beside the step gauges, the set-up
+estimates.  Every figure is drawn here."""
 
 from __future__ import annotations
 
@@ -76,6 +79,112 @@ def fig_residuals(cal) -> str | None:
     return _png(fig)
 
 
+def fig_lengths(cal) -> str | None:
+    """ISO 10360-2 length errors of the identified model (k = 2 bands) and the measured
+    step-gauge length errors beside the prediction."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    iso = cal.data.get("iso10360")
+    if not iso:
+        return None
+    panels = [k for k in ("predicted", "step_gauges") if iso.get(k)]
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.6 * len(panels), 3.8), squeeze=False)
+    for ax, key in zip(axes[0], panels):
+        if key == "predicted":
+            for k, line in enumerate(iso["predicted"]):
+                L, E, u = (np.asarray(line[c]) for c in ("lengths_mm", "E_um", "u_um"))
+                ax.errorbar(L, E, yerr=2 * u, fmt="o-", ms=3, capsize=2, color=f"C{k}",
+                            label=line["line"])
+            ax.set_title("ISO 10360-2 E of the identified model (bars k = 2)", fontsize=10)
+        else:
+            for k, g in enumerate(iso["step_gauges"]):
+                L = np.asarray(g["lengths_mm"])
+                ax.errorbar(L, g["measured_um"], yerr=2 * np.asarray(g["u_measured_um"]),
+                            fmt="o", ms=4, capsize=2, color=f"C{k}",
+                            label=f"{g['file']} {g['placement']} measured")
+                ax.errorbar(L, g["predicted_um"], yerr=2 * np.asarray(g["u_predicted_um"]),
+                            fmt="-", color=f"C{k}", alpha=0.7, label="identified model")
+            ax.set_title("step gauges: measured and predicted (bars k = 2)", fontsize=10)
+        ax.axhline(0, color="0.6", lw=0.8)
+        ax.set_xlabel("L / mm")
+        ax.set_ylabel("E / µm")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def _lab_sections(d) -> str:
+    """Consistency of the files, instrument results (poses, stations), the volumetric map and
+    the ISO 10360-2 length errors."""
+    out = []
+    c = d.get("consistency")
+    if c:
+        rows = "".join(_row([e["file"], e["kind"], f"{e['chi2']:.4g}", f"{e['redundancy']:.4g}",
+                             _f(e["birge_ratio"]), _f(e["birge_spread"]),
+                             _f(e["loo_birge_ratio"]), _f(e["p_value"]),
+                             "yes" if e["consistent"] else "NO"]) for e in c["files"])
+        named = (f"<p><strong>Inconsistent with the rest:</strong> "
+                 f"{html.escape(', '.join(c['inconsistent']))}</p>" if c["inconsistent"]
+                 else "<p>Every file is consistent with its stated uncertainties and with the "
+                      "others.</p>")
+        out.append(f"""<h2>Consistency of the files</h2>
+<p>{html.escape(c['method'])} (alpha = {c['alpha']}).  A Birge ratio of 1 means the residuals
+match the stated uncertainties.</p>{named}
+<table><tr><th>file</th><th>kind</th><th>chi2</th><th>redundancy</th><th>Birge ratio</th>
+<th>its spread</th><th>Birge ratio against the rest</th><th>p</th><th>consistent</th></tr>
+{rows}</table>""")
+    poses = d.get("poses")
+    if poses:
+        rows = "".join(_row([g, ", ".join(f"{v:.4f}" for v in e["origin_mm"]),
+                             ", ".join(f"{v:.2g}" for v in e["origin_std_um"]),
+                             ", ".join(f"{v:.5f}" for v in e["rotation_vector_deg"]),
+                             ", ".join(f"{v:.2g}" for v in e["rotation_std_urad"])])
+                       for g, e in poses.items())
+        out.append(f"""<h2>Artifact poses</h2><p>Origin of the artifact frame in the workpiece
+frame and its rotation (rotation vector) as identified with the machine.</p>
+<table><tr><th>placement</th><th>origin / mm</th><th>u / µm</th><th>rotation vector / deg</th>
+<th>u / µrad</th></tr>{rows}</table>""")
+    stations = d.get("stations")
+    if stations:
+        rows = "".join(_row([g, ", ".join(f"{v:.4f}" for v in e["position_mm"]),
+                             ", ".join(f"{v:.2g}" for v in e["position_std_um"]),
+                             f"{e['dead_path_mm']:.4f}", f"{e['dead_path_std_um']:.2g}"])
+                       for g, e in stations.items())
+        out.append(f"""<h2>Stations of the tracking interferometer</h2>
+<table><tr><th>station</th><th>position / mm</th><th>u / µm</th><th>dead path / mm</th>
+<th>u / µm</th></tr>{rows}</table>""")
+    m = d.get("volumetric_map")
+    if m:
+        out.append(f"""<h2>Volumetric error map</h2><p>{html.escape(m['note'])}.  Grid
+{' x '.join(map(str, m['grid']))} over {html.escape(str(m['box_mm']))}: largest error
+{m['max_length_um']:.3g} µm (RMS {m['rms_length_um']:.3g} µm); standard uncertainty up to
+{m['u_max_um']:.2g} µm (RMS {m['u_rms_um']:.2g} µm).  Not determined (not in the map):
+{html.escape(', '.join(m['undetermined']) or 'none')}.</p>""")
+    iso = d.get("iso10360")
+    if iso:
+        rows = "".join(_row([e["line"], ", ".join(f"{v:.0f}" for v in e["lengths_mm"]),
+                             ", ".join(f"{v:.3g}" for v in e["E_um"]),
+                             ", ".join(f"{v:.2g}" for v in e["u_um"])])
+                       for e in iso.get("predicted", []))
+        gauges = "".join(_row([f"{g['file']} {g['placement']}", f"{g['lengths_mm'][-1]:.0f}",
+                               f"{g['measured_um'][-1]:.3g}", f"{g['predicted_um'][-1]:.3g}",
+                               f"{g['max_abs_En']:.3g}"]) for g in iso.get("step_gauges", []))
+        out.append(f"""<h2>ISO 10360-2 length errors</h2><p>{html.escape(iso['note'])}.
+Largest |E| predicted: {iso.get('max_abs_E_um', float('nan')):.3g} µm.</p>
+<table><tr><th>line</th><th>L / mm</th><th>E / µm</th><th>u / µm</th></tr>{rows}</table>
+""" + (f"""<table><tr><th>step gauge</th><th>longest L / mm</th><th>measured E / µm</th>
+<th>predicted E / µm</th><th>max |En|</th></tr>{gauges}</table>""" if gauges else ""))
+    return "\n".join(out)
+
+
+def _f(v) -> str:
+    return "" if v is None else f"{v:.3g}"
+
+
 def _row(cells) -> str:
     return "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>"
 
@@ -99,6 +208,9 @@ def render_html(cal) -> str:
                     for g, keys in d["setup"].items() for k, v in keys.items())
     figs = "".join(f'<img src="data:image/png;base64,{p}" style="max-width:100%" alt="">'
                    for p in (fig_parameters(cal), fig_residuals(cal)) if p)
+    lengths = fig_lengths(cal)
+    lab = _lab_sections(d) + (f'<img src="data:image/png;base64,{lengths}" '
+                              f'style="max-width:100%" alt="">' if lengths else "")
     return f"""<!DOCTYPE html><html><head><meta charset="utf-8">
 <title>Calibration of {html.escape(d['layout'])}</title>
 <style>body{{font-family:sans-serif;max-width:1200px;margin:1em auto}}table{{border-collapse:
@@ -123,6 +235,7 @@ own set-up unknowns are removed.  Fixed by convention (not parameters):
 <h2>Files</h2>
 <table><tr><th>file</th><th>kind</th><th>rows</th><th>readings</th><th>RMS / µm</th>
 <th>held-out RMS / µm</th><th>RMS / stated u</th></tr>{inst}</table>
+{lab}
 <h2>Set-up estimates</h2>
 <table><tr><th>set-up</th><th>unknown</th><th>value</th><th>u</th><th>unit</th>
 <th>determined</th></tr>{setup}</table>

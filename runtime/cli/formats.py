@@ -19,7 +19,7 @@ def register(sub) -> None:
                                    "section names, or one section.")
     p.add_argument("name", nargs="?", metavar="NAME",
                    help="section: tables, tracker, probe-sphere, deviations, ballbar, sphere, "
-                        "calibrate-json, loop-json, layout, "
+                        "artifact, interferometer, distances, calibrate-json, loop-json, layout, "
                         "gcode, controller, uncertainty, iso230-2, outputs, or 'all'")
     p.set_defaults(func=run)
 
