@@ -481,11 +481,11 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
     for f, fi in enumerate(files):
         pts = np.flatnonzero(file_of == f)
         inst.append({
-            "file": fi.name, "kind": fi.kind, "n": int(len(pts)),
+            "file": fi.name, "kind": fi.kind, "n": int(len(np.unique(rows_in_file[pts]))),
             "n_readings": int(obs.readings_per_point()[pts].sum()), "unit": fi.unit,
             "rms_residual": round(out.rms_all[f], 5),
             "heldout_rms": round(out.rms_test[f], 5), "n_heldout": out.n_test[f],
-            "test_rows": sorted(int(rows_in_file[i]) for i in pts if int(i) in test_set),
+            "test_rows": sorted({int(rows_in_file[i]) for i in pts if int(i) in test_set}),
             "normalised_rms": round(out.rms_all[f] / (unit_factor(obs, f)
                                                       * _file_u(obs, pts, u_ref)), 4)})
     return {

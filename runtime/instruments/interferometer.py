@@ -60,7 +60,6 @@ META_KEYS = ("axis", "mode", "at", "optics", "beam", "sense", "separation", "u_u
              "scale_u_ppm")
 _TARGET = re.compile(r"^(target(?:[ _]?position)?|position)(?:[ _]?[(\[]?(um|mm)[)\]]?)?$",
                      re.IGNORECASE)
-_WIDE = re.compile(r"^(fwd|bwd|forward|backward|run|cycle|\d)", re.IGNORECASE)
 
 
 def detect(names) -> bool:
@@ -140,18 +139,7 @@ def read(path, model: Model) -> Observations:
                          f"{model.name} ({' '.join(lin)})")
     mode = meta.get("mode", "positioning").strip().lower()
     require(mode in MODES, f"{where}: header mode: {mode!r} is not {', '.join(MODES)}")
-    if mode == "angular":
-        targets, dev, direction, cycle, temp = _read_angular(path, where)
-    else:
-        from ..positioning import read_run
-
-        run = read_run(path, axis)
-        m, _, n = run.deviation.shape
-        targets = np.repeat(run.targets, 2 * n)
-        dev = run.deviation.reshape(-1)
-        direction = np.tile(np.repeat([1.0, -1.0], n), m)
-        cycle = np.tile(np.asarray(run.cycles, dtype=object), 2 * m)
-        temp = None if run.temperature is None else run.temperature.reshape(-1)
+    targets, dev, direction, cycle, temp, rows = _readings(path, axis, mode, where)
     sense = _vector(meta["sense"], "sense", where) if "sense" in meta else None
     require(mode == "positioning" or sense is not None,
             f"{where}: a {mode} run needs the header line '# sense: x, y, z' (the "
@@ -166,44 +154,81 @@ def read(path, model: Model) -> Observations:
                 _number(meta["separation"], "separation", where) if "separation" in meta
                 else DEFAULT_SEPARATION_MM, u, scale_u)
     covs = {} if temp is None else {"T_C": temp}
-    return observations(model, line, targets, dev, direction, where, cycle=cycle,
-                        covariates=covs)
+    obs = observations(model, line, targets, dev, direction, where, cycle=cycle,
+                       covariates=covs)
+    obs.row = rows
+    return obs
 
 
-def _read_angular(path, where):
-    """Long format of an angular run: target (mm), deviation_urad, optional cycle and
-    direction."""
+def _readings(path, axis, mode, where):
+    """(targets mm, readings mm or rad, direction +1 / -1, cycle labels, material temperature
+    or None, data row of each reading in the file) of a run.  Long format (a direction
+    column): in file order, one reading a row (cycles and directions as given: a run need not
+    be a complete ISO 230-2 cycle for a calibration); wide format: read as ``volerr
+    iso230-2`` reads it, each reading's row the row of its target."""
+    from ..positioning._io import _DIRECTION
     from ._csv import read_columns
 
     c = read_columns(path)
     names = list(c.numbers) + list(c.text)
-    tcol = [h for h in names if _TARGET.match(h.strip())]
-    require(len(tcol) == 1, f"{where}: an angular run needs one target column (target_mm)")
-    m = _TARGET.match(tcol[0].strip())
-    require(tcol[0] in c.numbers, f"{where}: column {tcol[0]} is not numeric")
-    targets = c.numbers[tcol[0]] * (1e-3 if (m.group(2) or "mm").lower() == "um" else 1.0)
-    dcol = next((h for h in c.numbers if h.lower() == "deviation_urad"), None)
-    require(dcol is not None, f"{where}: an angular run needs the column deviation_urad "
-                              f"(long format: target_mm,cycle,direction,deviation_urad)")
-    dev = c.numbers[dcol] * 1e-6
-    require(np.all(np.isfinite(dev)) and np.all(np.isfinite(targets)),
-            f"{where}: NaN in the target or deviation column")
-    n = len(dev)
-    direction = np.ones(n)
-    hd = next((h for h in names if h.lower() in ("direction", "dir")), None)
-    if hd is not None:
-        words = {"+1": 1, "1": 1, "+": 1, "fwd": 1, "forward": 1, "up": 1,
-                 "-1": -1, "-": -1, "bwd": -1, "backward": -1, "down": -1}
-        raw = (c.labels[hd] if hd in c.labels
-               else [f"{v:+g}" if v < 0 else f"{v:g}" for v in c.numbers[hd]])
-        bad = [r for r in raw if str(r).strip().lower() not in words]
-        require(not bad, f"{where}: direction {bad[0] if bad else ''!r}: use +1 or -1")
-        direction = np.array([words[str(r).strip().lower()] for r in raw], float)
+    low = [h.lower() for h in names]
+    long = any(d in low for d in _DIRECTION)
+    if not long:
+        require(mode != "angular", f"{where}: an angular run is read in the long format "
+                                   f"(target_mm,cycle,direction,deviation_urad)")
+        from ..positioning import read_run
+
+        run = read_run(path, axis)
+        m, _, n = run.deviation.shape
+        tcol = _target_column(c, names, where)[0]
+        order = {round(float(t) * 1e6): i for i, t in enumerate(tcol)}
+        rows = np.array([order[round(float(t) * 1e6)] for t in run.targets])
+        temp = None if run.temperature is None else run.temperature.reshape(-1)
+        return (np.repeat(run.targets, 2 * n), run.deviation.reshape(-1),
+                np.tile(np.repeat([1.0, -1.0], n), m),
+                np.tile(np.asarray(run.cycles, dtype=object), 2 * m), temp,
+                np.repeat(rows, 2 * n))
+    targets, _ = _target_column(c, names, where)
+    n = len(targets)
+    unit = {"deviation_urad": 1e-6} if mode == "angular" else {
+        "deviation_um": 1e-3, "deviation_mm": 1.0, "deviation": 1e-3, "deviation_µm": 1e-3}
+    hits = [h for h in c.numbers if h.lower().replace(" ", "_") in unit]
+    require(len(hits) == 1, f"{where}: a {mode} run needs one reading column "
+            f"({' or '.join(unit)}; long format target_mm,cycle,direction,"
+            f"{next(iter(unit))})")
+    dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
+    hd = next(h for h in names if h.lower() in _DIRECTION)
+    direction = _directions(c, hd, where)
     hc = next((h for h in names if h.lower() in ("cycle", "run")), None)
-    cycle = (np.asarray(c.labels.get(hc) or [f"{v:g}" for v in c.numbers[hc]], dtype=object)
-             if hc is not None else np.full(n, "1", dtype=object))
-    temp = next((c.numbers[h] for h in c.numbers if h.lower() == "t_c"), None)
-    return targets, dev, direction, cycle, temp
+    cycle = (np.full(n, "1", dtype=object) if hc is None else
+             np.asarray(c.labels.get(hc) or [f"{v:g}" for v in c.numbers[hc]], dtype=object))
+    temp = next((c.numbers[h] for h in c.numbers
+                 if h.lower() in ("t_c", "material_t_c", "t_material_c")), None)
+    return targets, dev, direction, cycle, temp, np.arange(n)
+
+
+def _target_column(c, names, where):
+    """(targets mm in file order, column name) of the target column."""
+    hits = [h for h in names if _TARGET.match(h.strip())]
+    if len(hits) > 1:      # a target... column wins over a bare position column
+        hits = [h for h in hits if h.lower().startswith("target")] or hits
+    require(len(hits) == 1, f"{where}: {'no' if not hits else 'more than one'} target "
+                            f"column (target_mm)")
+    h = hits[0]
+    require(h in c.numbers, c.text.get(h) or f"{where}: column {h} is not numeric")
+    m = _TARGET.match(h.strip())
+    return c.numbers[h] * (1e-3 if (m.group(2) or "mm").lower() == "um" else 1.0), h
+
+
+def _directions(c, h, where) -> np.ndarray:
+    from ..positioning._io import _DIR_WORDS
+
+    raw = (c.labels[h] if h in c.labels
+           else [f"{v:+g}" if v < 0 else f"{v:g}" for v in c.numbers[h]])
+    bad = [r for r in raw if str(r).strip().lower() not in _DIR_WORDS]
+    require(not bad, f"{where}: direction = {bad[0] if bad else ''!r}: use +1 (forward) or "
+                     f"-1 (backward)")
+    return np.array([float(_DIR_WORDS[str(r).strip().lower()]) for r in raw])
 
 
 class Line:

@@ -350,7 +350,7 @@ def write_run(path, blk: Line, values_read):
         head.append(f"# separation: {blk.separation!r}")
     lines = head + [f"target_mm,cycle,direction,deviation_{unit}"]
     for t, c, d, v in zip(blk.targets, blk.cycle, blk.direction, values_read):
-        lines.append(f"{t!r},{c},{int(d):+d},{float(v)!r}")
+        lines.append(f"{float(t)!r},{c},{int(d):+d},{float(v)!r}")
     with open(path, "w") as fh:
         fh.write("\n".join(lines) + "\n")
     return str(path)
