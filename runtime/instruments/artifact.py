@@ -261,8 +261,8 @@ def columns(model, points, pose, placement="1", ball=None, feature="ball", probe
             rotary=None, errors=None, noise_um=0.0, seed=0) -> dict:
     """Columns of an artifact file for ``points`` (n, 3) calibrated coordinates placed by
     ``pose`` = (R (3, 3), origin (3,)) in the workpiece frame: the points the machine of the
-    layout's first-order model with ``errors`` {name: value} (mm / rad; None: a perfect
-    machine) reports, found by fixed-point iteration of ``t + e(t) = a``; ``noise_um``:
+    layout's first-order model with ``errors`` {name: value or callable(positions) -> (n,)}
+    (mm / rad; None: a perfect machine) reports, found by fixed-point iteration of ``t + e(t) = a``; ``noise_um``:
     Gaussian noise on the reported coordinates."""
     R, o = (np.asarray(v, float) for v in pose)
     p = np.atleast_2d(np.asarray(points, float))
@@ -272,7 +272,8 @@ def columns(model, points, pose, placement="1", ball=None, feature="ball", probe
     t = a.copy()
     for _ in range(4 if errors else 0):
         pos = model.linear_positions(t, rot, probe)
-        t = a - model.volumetric_error(pos, errors, probe=probe)
+        vals = {k: (v(pos) if callable(v) else v) for k, v in errors.items()}
+        t = a - model.volumetric_error(pos, vals, probe=probe)
     if noise_um:
         t = t + np.random.default_rng(seed).normal(0.0, noise_um * 1e-3, t.shape)
     labels = ball if ball is not None else [f"B{i + 1:02d}" for i in range(n)]

@@ -305,7 +305,9 @@ def stack(parts: list) -> Observations:
         [w for p in parts for w in p.warnings],
         cat(lambda p: p.proj, lambda p: np.broadcast_to(eye, (p.n, 3, 3))),
         cat(lambda p: p.rows, lambda p: np.full(p.n, 3)),
-        cat(lambda p: p.weight, lambda p: np.ones(p.n)),
+        # weights: from each reading's stated uncertainty (sigma) unless a part sets them
+        None if all(p.weight is None for p in parts) else
+        cat(lambda p: p.weight, lambda p: p.point_weights()),
         stack_setups(setups),
         np.concatenate(file_idx),
         cat(lambda p: p.row, lambda p: np.arange(p.n)),
