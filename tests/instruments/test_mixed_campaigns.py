@@ -3,7 +3,8 @@ the same values as the separate fits of each file pooled (inverse-variance weigh
 the estimates of every file that determines the parameter), within the pooled uncertainty;
 the joint values contain the planted ones within 3 standard uncertainties; the consistency
 check names nothing on clean data and names a deliberately biased file (a step gauge whose
-lengths are all 2 um long).  Simulated with the independent exact chains
+lengths are all 2 um long); ``volerr loop`` reads the same mixed files and finds no effect in
+clean data.  Simulated with the independent exact chains
 (tests/helpers/metrology_sim.py, tests/helpers/instrument_sim.py).
 
 * MB1: a ball plate (4 placements), a step gauge (along X and along Y), an ISO 230-2
@@ -99,6 +100,11 @@ def test_plate_gauge_interferometer_on_mb1(tmp_path):
     # the step gauge's measured lengths compared with the identified model's
     g = {e["placement"]: e for e in doc["iso10360"]["step_gauges"]}
     assert set(g) == {"GX", "GY"} and max(e["max_abs_En"] for e in g.values()) < 3.5
+    # the loop on the same files: every kind read, nothing found on clean data
+    r, loop = run_json(["loop", "MB1", *files], tmp_path / "loop.json")
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert {i["file"]: i["kind"] for i in loop["instruments"]} == kinds
+    assert loop["effects"] == [], loop["effects"]
 
     # the same step gauge with every length 2 um long: named inconsistent, the others not
     biased = out["gauge.csv"].copy()
