@@ -332,6 +332,18 @@ def _normal_equations(design, obs, spl, sw) -> Normal:
             if te.any():
                 G_te += At[:, te] @ At[:, te].T
                 b_te += At[:, te] @ yw[te]
+    # columns the readings do not see at all (numerically): zeroed before any test
+    off = np.zeros(p, bool)
+    off[:len(design.labels)] = estimability.negligible(
+        design.model, obs, design.labels, design.degree, design.ranges,
+        ss[:len(design.labels)], obs.n_readings)
+    if off.any():
+        for M in G_files + [G_te]:
+            M[off, :] = 0.0
+            M[:, off] = 0.0
+        for v in b_files + [b_te]:
+            v[off] = 0.0
+        ss[off] = 0.0
     # known set-up values (a calibrated bar length): a prior 0 +- u on the column
     u_ref = _u_ref(sw, obs)
     priors = dict(zip(obs.setup_labels, obs.setup_priors))

@@ -44,6 +44,8 @@ POSE_KEYS = {"ball": ("du", "dv", "dw", "eu", "ev", "ew"), "hole": ("du", "dv", 
              "face": ("du",)}
 ALL_POSE = ("du", "dv", "dw", "eu", "ev", "ew")
 CAL_KEYS = ("cu", "cv", "cw")
+#: an axis whose positions spread less than this (mm) within a placement did not move
+STILL_MM = 0.05
 #: largest distance between a reported point and its calibrated point placed by the fitted
 #: pose, mm: beyond it the calibrated coordinates and the measured points disagree
 FIT_TOLERANCE_MM = 0.5
@@ -112,6 +114,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(placement.astype(str), return_inverse=True)
     gidx = gidx.ravel()
+    pos = _hold_still_axes(pos, gidx, lin_axes)
     R0 = np.zeros((n, 3, 3))
     origin = np.zeros((n, 3))
     for g, name in enumerate(names):
@@ -139,6 +142,21 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, -lin[:, :, 0], covs, warnings, proj=lin[:, :, 1:4],
                         rows=rows, setup=setup, files=(FileInfo(where, KIND, "um", 3),),
                         sigma=u, info=info)
+
+
+def _hold_still_axes(pos: dict, gidx, axes) -> dict:
+    """Axis positions for the model's columns: within a placement, an axis whose positions
+    (derived from the reported points) spread less than :data:`STILL_MM` did not move -- the
+    spread is the machine's error and the probing noise -- and is held at its mean (else a
+    series term of that axis would be fitted to the noise of a plate lying in a plane).  The
+    change of the levers is below ``STILL_MM`` times the angular errors: negligible."""
+    out = {a: np.array(v, dtype=float) for a, v in pos.items()}
+    for g in np.unique(gidx):
+        m = gidx == g
+        for a in axes:
+            if np.ptp(out[a][m]) < STILL_MM:
+                out[a][m] = np.mean(out[a][m])
+    return out
 
 
 def rigid_fit(p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
