@@ -1,8 +1,8 @@
 """Built-in instrument campaigns of known truth for ``volerr demo``: ballbar circles of Pahk's
 CMM A example tables, a sphere / R-test plan on a five-axis layout with planted location
 errors of its rotary axes, a ball plate in four placements on a CMM, and multilateration from
-four stations of a tracking interferometer on a five-axis layout.  Simulated with the layout's first-order model (what the demo shows
-is the calibration, not the simulator)."""
+four stations of a tracking interferometer on a five-axis layout.  Simulated with the
+layout's first-order model (what the demo shows is the calibration, not the simulator)."""
 
 from __future__ import annotations
 

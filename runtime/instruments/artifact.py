@@ -280,8 +280,8 @@ def columns(model, points, pose, placement="1", ball=None, feature="ball", probe
     """Columns of an artifact file for ``points`` (n, 3) calibrated coordinates placed by
     ``pose`` = (R (3, 3), origin (3,)) in the workpiece frame: the points the machine of the
     layout's first-order model with ``errors`` {name: value or callable(positions) -> (n,)}
-    (mm / rad; None: a perfect machine) reports, found by fixed-point iteration of ``t + e(t) = a``; ``noise_um``:
-    Gaussian noise on the reported coordinates."""
+    (mm / rad; None: a perfect machine) reports, found by fixed-point iteration of
+    ``t + e(t) = a``; ``noise_um``: Gaussian noise on the reported coordinates."""
     R, o = (np.asarray(v, float) for v in pose)
     p = np.atleast_2d(np.asarray(points, float))
     n = len(p)
