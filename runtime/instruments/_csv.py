@@ -42,7 +42,11 @@ def read_columns(path) -> Columns:
     require(p.is_file(), f"data file not found: {path}")
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
-            first = fh.readline()
+            first = ""
+            for line in fh:     # the header: the first line that is not blank or a comment
+                if line.strip() and not line.lstrip().startswith("#"):
+                    first = line
+                    break
             fh.seek(0)
             delim = ","
             if "," not in first:

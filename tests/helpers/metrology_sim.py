@@ -12,8 +12,9 @@ Definitions (docs/formats.md sections artifact, interferometer, distances), all 
   nominal chain is affine in the linear axes: ``inverse`` exact); ``a = o + R (d +
   Rot(r) p + c)`` -- placement pose ``(R, o)``, its set-up perturbation ``d`` (um, artifact
   frame) and ``r`` (urad, rotation vector about the artifact's origin), the feature's
-  calibration error ``c`` (um, artifact frame).  Readings: the components of ``R^T x`` in the
-  artifact frame (a ball three, a face the first);
+  calibration error ``c`` (um, artifact frame).  Readings: the components of ``R^T (x - a0)``
+  in the artifact frame, ``a0`` the true feature point (a ball three, a hole the first two, a
+  face the first);
 * distances: ``|tool_point(q, errors, reflector) - (s + ds)| + dd``;
 * interferometer, the moving optic at ``optics`` (tool frame), ``t`` its actual position,
   ``r`` the nominal position at the first target, ``b`` the unit direction of nominal motion:
@@ -36,8 +37,9 @@ from scipy.spatial.transform import Rotation
 
 from helpers import instrument_sim as S
 
-POSE_KEYS = {"ball": ("du", "dv", "dw", "eu", "ev", "ew"), "face": ("du",)}
-ROWS = {"ball": 3, "face": 1}
+POSE_KEYS = {"ball": ("du", "dv", "dw", "eu", "ev", "ew"), "hole": ("du", "dv", "ew"),
+             "face": ("du",)}
+ROWS = {"ball": 3, "hole": 2, "face": 1}
 
 
 @dataclass
