@@ -5,30 +5,35 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       756bda5b3c591bab0205c49783763ff6519f3d05f7ec692f40e8a7fa82b9b20b
-derivation sha256  4e38c5ebaa64d827a1a9c65a78ea37046e994973b27a9eb5df4d872e36e87174
+input sha256       8d1fff502794c1f3a2c99e1c2555b47aa7abd14cf69caec93c9cc91d4bdab3a6
+derivation sha256  ac0d54ec1a2d80e9523c8f4d5c4a8f3a97fc55c10b64c4a221af97765e271ef6
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/observations.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2
 
 Units
 -----
-Tool point (tx, ty, tz), instrument geometry and readings in mm, in the workpiece frame;
-projections and set-up columns mm/mm.  Reading = nominal + projection @ (volumetric error) +
-set-up columns @ (set-up unknowns).
+Tool point (tx, ty, tz), instrument geometry and readings in mm, in the workpiece frame (angular
+readings rad); projections and set-up columns per unit of the unknown (mm/mm, mm/rad, rad/mm).
+Reading = nominal + projection @ (volumetric error) + set-up columns @ (set-up unknowns).
 """
 
 import numpy
 
-KINDS = ('ballbar', 'sphere')
+KINDS = ('ballbar', 'sphere', 'artifact', 'distances', 'interferometer_positioning',
+    'interferometer_straightness', 'interferometer_angular')
 SETUP = {'ballbar': ('pivot_dx', 'pivot_dy', 'pivot_dz', 'length'), 'sphere': ('centre_dx',
-    'centre_dy', 'centre_dz')}
+    'centre_dy', 'centre_dz'), 'artifact': ('du', 'dv', 'dw', 'eu', 'ev', 'ew', 'cu', 'cv', 'cw'),
+    'distances': ('station_dx', 'station_dy', 'station_dz', 'dead_path'),
+    'interferometer_positioning': ('zero', 'scale'), 'interferometer_straightness': ('zero',
+    'slope'), 'interferometer_angular': ('zero',)}
+POINTS = {'ballbar': 1, 'sphere': 1, 'artifact': 1, 'distances': 1,
+    'interferometer_positioning': 1, 'interferometer_straightness': 1, 'interferometer_angular': 2}
 
 
 def ballbar(tx, ty, tz, px, py, pz, L):
-    """ballbar: array (1, 8, *shape) -- per reading: nominal reading (mm), projection of the
-    volumetric error (3 columns, mm/mm), set-up columns pivot_dx, pivot_dy, pivot_dz, length
-    (mm/mm)."""
+    """ballbar: array (1, 8, *shape) -- per reading: nominal reading, projection of the volumetric
+    error (3 columns, mm/mm), set-up columns pivot_dx, pivot_dy, pivot_dz, length."""
     _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
         numpy.shape(px), numpy.shape(py), numpy.shape(pz), numpy.shape(L))
     _t0 = px - tx
@@ -49,8 +54,8 @@ def ballbar(tx, ty, tz, px, py, pz, L):
 
 
 def sphere(tx, ty, tz, cx, cy, cz):
-    """sphere: array (3, 7, *shape) -- per reading: nominal reading (mm), projection of the
-    volumetric error (3 columns, mm/mm), set-up columns centre_dx, centre_dy, centre_dz (mm/mm)."""
+    """sphere: array (3, 7, *shape) -- per reading: nominal reading, projection of the volumetric
+    error (3 columns, mm/mm), set-up columns centre_dx, centre_dy, centre_dz."""
     _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
         numpy.shape(cx), numpy.shape(cy), numpy.shape(cz))
     _out = numpy.zeros((3, 7) + _shape)
@@ -63,4 +68,124 @@ def sphere(tx, ty, tz, cx, cy, cz):
     _out[2, 0] = -cz + tz
     _out[2, 3] = 1
     _out[2, 6] = -1
+    return _out
+
+
+def artifact(tx, ty, tz, ox, oy, oz, r11, r12, r13, r21, r22, r23, r31, r32, r33, pu, pv, pw):
+    """artifact: array (3, 13, *shape) -- per reading: nominal reading, projection of the
+    volumetric error (3 columns, mm/mm), set-up columns du, dv, dw, eu, ev, ew, cu, cv, cw."""
+    _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
+        numpy.shape(ox), numpy.shape(oy), numpy.shape(oz), numpy.shape(r11), numpy.shape(r12),
+        numpy.shape(r13), numpy.shape(r21), numpy.shape(r22), numpy.shape(r23), numpy.shape(r31),
+        numpy.shape(r32), numpy.shape(r33), numpy.shape(pu), numpy.shape(pv), numpy.shape(pw))
+    _t0 = ox - tx
+    _t1 = oy - ty
+    _t2 = oz - tz
+    _out = numpy.zeros((3, 13) + _shape)
+    _out[0, 0] = -_t0*r11 - _t1*r21 - _t2*r31 - pu
+    _out[0, 1] = r11
+    _out[0, 2] = r21
+    _out[0, 3] = r31
+    _out[0, 4] = -1
+    _out[0, 8] = -pw
+    _out[0, 9] = pv
+    _out[0, 10] = -1
+    _out[1, 0] = -_t0*r12 - _t1*r22 - _t2*r32 - pv
+    _out[1, 1] = r12
+    _out[1, 2] = r22
+    _out[1, 3] = r32
+    _out[1, 5] = -1
+    _out[1, 7] = pw
+    _out[1, 9] = -pu
+    _out[1, 11] = -1
+    _out[2, 0] = -_t0*r13 - _t1*r23 - _t2*r33 - pw
+    _out[2, 1] = r13
+    _out[2, 2] = r23
+    _out[2, 3] = r33
+    _out[2, 6] = -1
+    _out[2, 7] = -pv
+    _out[2, 8] = pu
+    _out[2, 12] = -1
+    return _out
+
+
+def distances(tx, ty, tz, sx, sy, sz):
+    """distances: array (1, 8, *shape) -- per reading: nominal reading, projection of the
+    volumetric error (3 columns, mm/mm), set-up columns station_dx, station_dy, station_dz,
+    dead_path."""
+    _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
+        numpy.shape(sx), numpy.shape(sy), numpy.shape(sz))
+    _t0 = sx - tx
+    _t1 = sy - ty
+    _t2 = sz - tz
+    _t3 = numpy.sqrt(_t0**2 + _t1**2 + _t2**2)
+    _t4 = _t3**(-1.0)
+    _out = numpy.zeros((1, 8) + _shape)
+    _out[0, 0] = _t3
+    _out[0, 1] = -_t0*_t4
+    _out[0, 2] = -_t1*_t4
+    _out[0, 3] = -_t2*_t4
+    _out[0, 4] = _t0*_t4
+    _out[0, 5] = _t1*_t4
+    _out[0, 6] = _t2*_t4
+    _out[0, 7] = 1
+    return _out
+
+
+def interferometer_positioning(tx, ty, tz, bx, by, bz, rx, ry, rz):
+    """interferometer_positioning: array (1, 6, *shape) -- per reading: nominal reading, projection
+    of the volumetric error (3 columns, mm/mm), set-up columns zero, scale."""
+    _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
+        numpy.shape(bx), numpy.shape(by), numpy.shape(bz), numpy.shape(rx), numpy.shape(ry),
+        numpy.shape(rz))
+    _t0 = -bx*(rx - tx) - by*(ry - ty) - bz*(rz - tz)
+    _out = numpy.zeros((1, 6) + _shape)
+    _out[0, 0] = _t0
+    _out[0, 1] = bx
+    _out[0, 2] = by
+    _out[0, 3] = bz
+    _out[0, 4] = 1
+    _out[0, 5] = _t0
+    return _out
+
+
+def interferometer_straightness(tx, ty, tz, sx, sy, sz, bx, by, bz, rx, ry, rz):
+    """interferometer_straightness: array (1, 6, *shape) -- per reading: nominal reading,
+    projection of the volumetric error (3 columns, mm/mm), set-up columns zero, slope."""
+    _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
+        numpy.shape(sx), numpy.shape(sy), numpy.shape(sz), numpy.shape(bx), numpy.shape(by),
+        numpy.shape(bz), numpy.shape(rx), numpy.shape(ry), numpy.shape(rz))
+    _t0 = rx - tx
+    _t1 = ry - ty
+    _t2 = rz - tz
+    _out = numpy.zeros((1, 6) + _shape)
+    _out[0, 0] = -_t0*sx - _t1*sy - _t2*sz
+    _out[0, 1] = sx
+    _out[0, 2] = sy
+    _out[0, 3] = sz
+    _out[0, 4] = 1
+    _out[0, 5] = -_t0*bx - _t1*by - _t2*bz
+    return _out
+
+
+def interferometer_angular(tx, ty, tz, t2x, t2y, t2z, bx, by, bz, L):
+    """interferometer_angular: array (1, 8, *shape) -- per reading: nominal reading, projections of
+    the volumetric errors at the first and the second point (3 + 3 columns), set-up columns
+    zero."""
+    _shape = numpy.broadcast_shapes(numpy.shape(tx), numpy.shape(ty), numpy.shape(tz),
+        numpy.shape(t2x), numpy.shape(t2y), numpy.shape(t2z), numpy.shape(bx), numpy.shape(by),
+        numpy.shape(bz), numpy.shape(L))
+    _t0 = L**(-1.0)
+    _t1 = _t0*bx
+    _t2 = _t0*by
+    _t3 = _t0*bz
+    _out = numpy.zeros((1, 8) + _shape)
+    _out[0, 0] = _t0*(bx*(t2x - tx) + by*(t2y - ty) + bz*(t2z - tz))
+    _out[0, 1] = -_t1
+    _out[0, 2] = -_t2
+    _out[0, 3] = -_t3
+    _out[0, 4] = _t1
+    _out[0, 5] = _t2
+    _out[0, 6] = _t3
+    _out[0, 7] = 1
     return _out

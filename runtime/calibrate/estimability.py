@@ -10,6 +10,13 @@ directions.
 Seen by a file: the file's readings depend on the parameter after that file's own set-up
 unknowns are removed (a ballbar circle in XY does not see EZZ at all; a pure offset of a
 translational error is absorbed by the pivot's position).
+
+Not seen at all (:func:`negligible`): a parameter column whose RMS over the readings is below
+:data:`NEGLIGIBLE` times its RMS over an ideal 3-D plan of the measured volume -- a step gauge
+along X reads a Z error through the gauge's micro-radian misalignment only, a series term of
+an axis that moved by micrometres (the positions of an artifact come from the points the
+machine reports) spans nothing.  Scale-free tests would take such columns for information;
+they are zeroed before any test.
 """
 
 from __future__ import annotations
@@ -23,6 +30,8 @@ NULL_TOL = 1e-10
 #: designs of five-axis chains); a column closer than 1e-4 would have a standard uncertainty
 #: 10^4 times that of an orthogonal design anyway
 DISTANCE_TOL = 1e-4
+#: a parameter column below this fraction of its RMS on an ideal plan is not seen at all
+NEGLIGIBLE = 1e-6
 #: a file sees a column when what its set-up leaves of the column's squared norm exceeds
 #: this fraction of the largest squared norm the column has in any file
 SEEN_TOL = 1e-9
@@ -85,3 +94,23 @@ def seen_by(G_files: list, setup_cols: list) -> np.ndarray:
         left[f] = np.maximum(diag, 0.0)
     top = np.max(np.stack([np.diag(G) for G in G_files]), axis=0)
     return left > SEEN_TOL * np.where(top > 0, top, np.inf)
+
+
+def negligible(model, obs, labels, degree: int, ranges: dict, colsq: np.ndarray,
+               n_readings: int) -> np.ndarray:
+    """(p,) bool: the parameter columns of ``labels`` (a design's) whose RMS over the readings
+    (``colsq`` their sums of squares over ``n_readings`` readings) is below
+    :data:`NEGLIGIBLE` times their RMS on the ideal plan of the measured volume
+    (:func:`volerr.estimate.design.ideal_data`); set-up columns never."""
+    from ..estimate.design import declared_design, ideal_data
+
+    ideal = declared_design(model, ideal_data(model, obs, ranges), degree, ranges)
+    A = ideal.A.reshape(-1, ideal.A.shape[-1])
+    rms_ideal = dict(zip(ideal.labels, np.sqrt(np.mean(A ** 2, axis=0))))
+    rms = np.sqrt(np.maximum(colsq, 0.0) / max(n_readings, 1))
+    out = np.zeros(len(labels), bool)
+    for j, lab in enumerate(labels):
+        if lab[0] == "setup" or lab not in rms_ideal:
+            continue
+        out[j] = rms[j] < NEGLIGIBLE * rms_ideal[lab]
+    return out

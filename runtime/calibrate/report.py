@@ -1,7 +1,10 @@
 """HTML page of ``volerr calibrate``: the identified parameters with their standard
 uncertainties and coverage bars, what the campaign does not determine (and which file sees
-what), the plans that would determine it, the residuals of every file, the set-up estimates.
-Figures in volerr's style (:mod:`volerr.plotstyle`); numbers without negative zero."""
+what), the plans that would determine it, the residuals of every file, the consistency of the
+files, artifact poses and station positions, the volumetric map's size and uncertainty, the
+ISO 10360-2 length errors of the identified model beside the step gauges, the set-up
+estimates.  Figures in volerr's style (:mod:`volerr.plotstyle`); numbers without negative
+zero."""
 
 from __future__ import annotations
 
@@ -60,6 +63,106 @@ def residual_figure(cal):
     return fig
 
 
+@styled
+def length_figure(iso: dict):
+    """ISO 10360-2 length errors of the identified model (k = 2 bars) and the measured
+    step-gauge length errors beside the prediction."""
+    panels = [k for k in ("predicted", "step_gauges") if iso.get(k)]
+    fig, axes = figure(1, len(panels), width=5.0 * len(panels) + 0.4, height=4.0,
+                       squeeze=False)
+    for ax, key in zip(axes[0], panels):
+        if key == "predicted":
+            for k, line in enumerate(iso["predicted"]):
+                L, E, u = (np.asarray(line[c]) for c in ("lengths_mm", "E_um", "u_um"))
+                ax.errorbar(L, E, yerr=2 * u, fmt="o-", ms=3, capsize=2, color=f"C{k}",
+                            label=line["line"])
+            ax.set_title("ISO 10360-2 E of the identified model (bars k = 2)")
+        else:
+            for k, g in enumerate(iso["step_gauges"]):
+                L = np.asarray(g["lengths_mm"])
+                ax.errorbar(L, g["measured_um"], yerr=2 * np.asarray(g["u_measured_um"]),
+                            fmt="o", ms=4, capsize=2, color=f"C{k}",
+                            label=f"{g['file']} {g['placement']} measured")
+                ax.errorbar(L, g["predicted_um"], yerr=2 * np.asarray(g["u_predicted_um"]),
+                            fmt="-", color=f"C{k}", alpha=0.7, label="identified model")
+            ax.set_title("step gauges: measured and predicted (bars k = 2)")
+        ax.axhline(0, color="0.6", lw=0.8)
+        ax.set_xlabel(label("L", "mm"))
+        ax.set_ylabel(label("E", "um"))
+        ax.grid(alpha=0.3)
+        ax.legend()
+    return fig
+
+
+def _f(v, spec: str = ".3g") -> str:
+    return "" if v is None else num(v, spec)
+
+
+def _list(values, spec: str) -> str:
+    return ", ".join(num(v, spec) for v in values)
+
+
+def _lab_sections(d) -> str:
+    """Consistency of the files, instrument results (poses, stations), the volumetric map and
+    the ISO 10360-2 length errors."""
+    out = []
+    c = d.get("consistency")
+    if c:
+        rows = "".join(_row([e["file"], e["kind"], _f(e["chi2"], ".4g"),
+                             _f(e["redundancy"], ".4g"), _f(e["birge_ratio"]),
+                             _f(e["birge_spread"]), _f(e["loo_birge_ratio"]), _f(e["p_value"]),
+                             "yes" if e["consistent"] else "NO"]) for e in c["files"])
+        named = (f"<p><strong>Inconsistent with the rest:</strong> "
+                 f"{html.escape(', '.join(c['inconsistent']))}</p>" if c["inconsistent"]
+                 else "<p>Every file is consistent with its stated uncertainties and with the "
+                      "others.</p>")
+        out.append(f"""<h2>Consistency of the files</h2>
+<p>{html.escape(c['method'])} (alpha = {c['alpha']}).  A Birge ratio of 1 means the residuals
+match the stated uncertainties.</p>{named}
+<table><tr><th>file</th><th>kind</th><th>chi2</th><th>redundancy</th><th>Birge ratio</th>
+<th>its spread</th><th>Birge ratio against the rest</th><th>p</th><th>consistent</th></tr>
+{rows}</table>""")
+    poses = d.get("poses")
+    if poses:
+        rows = "".join(_row([g, _list(e["origin_mm"], ".4f"), _list(e["origin_std_um"], ".2g"),
+                             _list(e["rotation_vector_deg"], ".5f"),
+                             _list(e["rotation_std_urad"], ".2g")])
+                       for g, e in poses.items())
+        out.append(f"""<h2>Artifact poses</h2><p>Origin of the artifact frame in the workpiece
+frame and its rotation (rotation vector) as identified with the machine.</p>
+<table><tr><th>placement</th><th>origin / mm</th><th>u / µm</th><th>rotation vector / deg</th>
+<th>u / µrad</th></tr>{rows}</table>""")
+    stations = d.get("stations")
+    if stations:
+        rows = "".join(_row([g, _list(e["position_mm"], ".4f"), _list(e["position_std_um"], ".2g"),
+                             _f(e["dead_path_mm"], ".4f"), _f(e["dead_path_std_um"], ".2g")])
+                       for g, e in stations.items())
+        out.append(f"""<h2>Stations of the tracking interferometer</h2>
+<table><tr><th>station</th><th>position / mm</th><th>u / µm</th><th>dead path / mm</th>
+<th>u / µm</th></tr>{rows}</table>""")
+    m = d.get("volumetric_map")
+    if m:
+        out.append(f"""<h2>Volumetric error map</h2><p>{html.escape(m['note'])}.  Grid
+{' x '.join(map(str, m['grid']))} over {html.escape(str(m['box_mm']))}: largest error
+{_f(m['max_length_um'])} µm (RMS {_f(m['rms_length_um'])} µm); standard uncertainty up to
+{_f(m['u_max_um'], '.2g')} µm (RMS {_f(m['u_rms_um'], '.2g')} µm).  Not determined (not in the
+map): {html.escape(', '.join(m['undetermined']) or 'none')}.</p>""")
+    iso = d.get("iso10360")
+    if iso:
+        rows = "".join(_row([e["line"], _list(e["lengths_mm"], ".0f"), _list(e["E_um"], ".3g"),
+                             _list(e["u_um"], ".2g")]) for e in iso.get("predicted", []))
+        gauges = "".join(_row([f"{g['file']} {g['placement']}", _f(g["lengths_mm"][-1], ".0f"),
+                               _f(g["measured_um"][-1]), _f(g["predicted_um"][-1]),
+                               _f(g["max_abs_En"])]) for g in iso.get("step_gauges", []))
+        fig = embedded_img(png(length_figure(iso)), "ISO 10360-2 length errors")
+        out.append(f"""<h2>ISO 10360-2 length errors</h2><p>{html.escape(iso['note'])}.
+Largest |E| predicted: {_f(iso.get('max_abs_E_um'))} µm.</p>
+<table><tr><th>line</th><th>L / mm</th><th>E / µm</th><th>u / µm</th></tr>{rows}</table>
+""" + (f"""<table><tr><th>step gauge</th><th>longest L / mm</th><th>measured E / µm</th>
+<th>predicted E / µm</th><th>max |En|</th></tr>{gauges}</table>""" if gauges else "") + fig)
+    return "\n".join(out)
+
+
 def _row(cells) -> str:
     return "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>"
 
@@ -111,6 +214,7 @@ own set-up unknowns are removed.  Fixed by convention (not parameters):
 <h2>Files</h2>
 <table><tr><th>file</th><th>kind</th><th>rows</th><th>readings</th><th>RMS / µm</th>
 <th>held-out RMS / µm</th><th>RMS / stated u</th></tr>{inst}</table>
+{_lab_sections(d)}
 <h2>Set-up estimates</h2>
 <table><tr><th>set-up</th><th>unknown</th><th>value</th><th>u</th><th>unit</th>
 <th>determined</th></tr>{setup}</table>

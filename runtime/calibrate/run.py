@@ -58,6 +58,7 @@ class Calibration:
     std: np.ndarray              # standard uncertainty per column (0 where left out)
     residuals: dict = field(default_factory=dict)   # file -> (positions, residual um, rows)
     solution: "Solution | None" = None
+    parts: list = field(default_factory=list)       # the files' Observations
 
     def combination(self, weights: dict) -> tuple[float, float] | None:
         """(value, standard uncertainty) of ``sum w_label * coefficient`` (mm / rad), or None
@@ -85,6 +86,8 @@ class Calibration:
         from ..estimate.design import series_basis
         from ..tables.table import ErrorTable
 
+        from .mapping import function_std
+
         model, ranges, deg = self.model, self.ranges, self.degree
         index = {lab: j for j, lab in enumerate(self.labels)}
         tables, constants, cstd = {}, {}, {}
@@ -100,8 +103,7 @@ class Calibration:
                     continue
                 js = [(k, index[(p, k)]) for k in range(deg + 1) if (p, k) in index]
                 vals[p] = sum((P[:, k] * self.coef[j] for k, j in js), np.zeros(n_grid))
-                std[p] = np.sqrt(sum((P[:, k] ** 2 * self.std[j] ** 2 for k, j in js),
-                                     np.zeros(n_grid)))
+                std[p] = function_std(self, P, js)
             if vals:
                 tables[a] = ErrorTable(a, q, vals, std=std)
         for p in model.parameters:
@@ -227,10 +229,43 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
 
         report["plan"] = suggest(model, parts, design, labels, fit.G, report["unidentifiable"],
                                  u_ref, report["identifiability"])
-    report["seconds"] = round(time.perf_counter() - t0, 2)
     std = np.zeros(design.p)
     std[out.kept] = out.std
-    return Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out)
+    cal = Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out,
+                      parts)
+    _lab_report(cal, fit, obs, u_ref)
+    report["seconds"] = round(time.perf_counter() - t0, 2)
+    return cal
+
+
+def _lab_report(cal, fit, obs, u_ref) -> None:
+    """What a calibration laboratory reports beside the parameters: the consistency of the
+    files with each other (:mod:`volerr.calibrate.consistency`), the instruments' own results
+    (artifact poses, station positions), the volumetric error map with its uncertainty
+    (:mod:`volerr.calibrate.mapping`) and the ISO 10360-2 length errors of the identified model
+    beside the measured step-gauge lengths (:mod:`volerr.calibrate.lengths`)."""
+    from . import consistency, lengths, mapping
+
+    report = cal.data
+    report["consistency"] = consistency.check(fit, cal.solution, obs, u_ref)
+    flags = {e["file"]: e for e in report["consistency"]["files"]}
+    for entry in report["instruments"]:
+        c = flags.get(entry["file"], {})
+        entry["birge_ratio"] = c.get("birge_ratio")
+        entry["consistent"] = c.get("consistent", True)
+    kinds = instruments.kinds()
+    for part in cal.parts:
+        kind = part.files[0].kind if part.files else "deviations"
+        maker = getattr(kinds.get(kind), "results", None)
+        if maker is not None:
+            for key, value in maker(part, report["setup"]).items():
+                report.setdefault(key, {}).update(value)
+    summary = mapping.summary(cal)
+    if summary is not None:
+        report["volumetric_map"] = summary
+    iso = lengths.report(cal)
+    if iso is not None:
+        report["iso10360"] = iso
 
 
 def extra_columns(model, obs, extra_terms) -> np.ndarray:
@@ -253,7 +288,9 @@ def extra_columns(model, obs, extra_terms) -> np.ndarray:
 @dataclass
 class Normal:
     """Weighted normal equations of the design: all readings (``G``, ``b``), training readings
-    (``G_tr``, ``b_tr``), and per file (``G_files``)."""
+    (``G_tr``, ``b_tr``), and per file (``G_files`` with the priors of its set-up columns,
+    ``b_files``, ``yy_files`` the weighted sum of squares of its readings, ``priors_files``
+    the number of its priors)."""
 
     G: np.ndarray
     b: np.ndarray
@@ -261,6 +298,9 @@ class Normal:
     b_tr: np.ndarray
     G_files: list
     scale: np.ndarray
+    b_files: list = field(default_factory=list)
+    yy_files: list = field(default_factory=list)
+    priors_files: list = field(default_factory=list)
 
 
 def _normal_equations(design, obs, spl, sw) -> Normal:
@@ -272,6 +312,7 @@ def _normal_equations(design, obs, spl, sw) -> Normal:
     G_files = [np.zeros((p, p)) for _ in range(n_files)]
     b_files = [np.zeros(p) for _ in range(n_files)]
     G_te, b_te = np.zeros((p, p)), np.zeros(p)
+    yy_files = [0.0] * n_files
     y = obs.deviation.ravel()
     ss = np.zeros(p)
     for f in range(n_files):
@@ -284,22 +325,37 @@ def _normal_equations(design, obs, spl, sw) -> Normal:
             yw = blocks.yrows(y, idx) * wr
             G_files[f] += At @ At.T
             b_files[f] += At @ yw
+            yy_files[f] += float(yw @ yw)
             te = np.tile(is_test[idx], 3)
             if te.any():
                 G_te += At[:, te] @ At[:, te].T
                 b_te += At[:, te] @ yw[te]
+    # columns the readings do not see at all (numerically): zeroed before any test
+    off = np.zeros(p, bool)
+    off[:len(design.labels)] = estimability.negligible(
+        design.model, obs, design.labels, design.degree, design.ranges,
+        ss[:len(design.labels)], obs.n_readings)
+    if off.any():
+        for M in G_files + [G_te]:
+            M[off, :] = 0.0
+            M[:, off] = 0.0
+        for v in b_files + [b_te]:
+            v[off] = 0.0
+        ss[off] = 0.0
     # known set-up values (a calibrated bar length): a prior 0 +- u on the column
     u_ref = _u_ref(sw, obs)
     priors = dict(zip(obs.setup_labels, obs.setup_priors))
+    priors_files = [0] * n_files
     for j, lab in enumerate(design.labels):
         u = priors.get(lab[1]) if lab[0] == "setup" else None
         if u:
-            for Gf in G_files:
+            for f, Gf in enumerate(G_files):
                 if Gf[j, j] > 0:
                     Gf[j, j] += (u_ref / u) ** 2
+                    priors_files[f] += 1
     G, b = sum(G_files), sum(b_files)
     scale = blocks.unit_scale(ss, obs.n_readings)
-    return Normal(G, b, G - G_te, b - b_te, G_files, scale)
+    return Normal(G, b, G - G_te, b - b_te, G_files, scale, b_files, yy_files, priors_files)
 
 
 def _u_ref(sw, obs) -> float:
@@ -324,6 +380,8 @@ class Solution:
     rms_test: dict              # file index -> RMS um of held-out readings
     n_test: dict
     residuals: dict
+    rss_files: dict = field(default_factory=dict)   # file -> weighted residual SS (mm^2)
+    Gi: np.ndarray | None = None                     # inverse of the unit-scaled kept Gram
 
 
 def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
@@ -349,7 +407,7 @@ def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
     is_test[spl.test] = True
     rows = obs.readings_per_point()
     rss_w = 0.0
-    rms_all, rms_test, n_test, residuals = {}, {}, {}, {}
+    rms_all, rms_test, n_test, residuals, rss_files = {}, {}, {}, {}, {}
     for f in range(len(fit.G_files)):
         pts = np.flatnonzero(file_of == f)
         r_all = np.empty((len(pts), 3))
@@ -360,16 +418,18 @@ def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
             n = len(idx)
             r_all[s] = (yy - coef @ At).reshape(3, n).T
             r_tr[s] = (yy - coef_tr @ At).reshape(3, n).T
-        rss_w += float(np.sum((r_all * sw[pts, None]) ** 2))
+        rss_files[f] = float(np.sum((r_all * sw[pts, None]) ** 2))
+        rss_w += rss_files[f]
         k = rows[pts]
         n_read = max(int(k.sum()), 1)
-        rms_all[f] = 1e3 * math.sqrt(float(np.sum(r_all ** 2)) / n_read)
+        factor = unit_factor(obs, f)
+        rms_all[f] = factor * math.sqrt(float(np.sum(r_all ** 2)) / n_read)
         te = is_test[pts]
         n_te = int(k[te].sum())
         n_test[f] = n_te
-        rms_test[f] = (1e3 * math.sqrt(float(np.sum(r_tr[te] ** 2)) / n_te)
+        rms_test[f] = (factor * math.sqrt(float(np.sum(r_tr[te] ** 2)) / n_te)
                        if n_te else float("nan"))
-        residuals[f] = (pts, 1e3 * r_all, k)
+        residuals[f] = (pts, factor * r_all, k)
     rank = int(np.sum(np.linalg.eigvalsh(Gk) > SOLVE_TOL * np.linalg.eigvalsh(Gk)[-1]))
     dof = max(float(obs.n_readings - rank), 1.0)
     s0 = math.sqrt(rss_w / dof)                 # mm: the weights are relative to u_ref
@@ -378,7 +438,14 @@ def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
     s0 /= u_ref                                  # the a-posteriori factor, dimensionless
     return Solution(kept, cov, estimability.null_space(fit.G),
                     np.sqrt(np.maximum(np.diag(fit.G), 0.0)), coef, coef_tr, std, est, partners,
-                    seen, s0, dof, rms_all, rms_test, n_test, residuals)
+                    seen, s0, dof, rms_all, rms_test, n_test, residuals, rss_files, Gi)
+
+
+def unit_factor(obs, f: int) -> float:
+    """Report factor of file ``f``'s readings: 1e6 (rad -> urad) for angular readings, else
+    1e3 (mm -> um)."""
+    files = obs.files
+    return 1e6 if files and f < len(files) and files[f].unit == "urad" else 1e3
 
 
 def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl, u_ref,
@@ -412,7 +479,7 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
         key = lab[1]
         i = setup_labels.index(key)
         group, _, k = key.rpartition(".") if "." in key else (files[0].name, "", key)
-        factor = 1e6 if units[i] == "urad" else 1e3
+        factor = 1e6 if units[i] in ("urad", "ppm") else 1e3
         entry = {"value": float(out.coef[j]) * factor, "unit": units[i],
                  "std": float(std_of.get(j, 0.0)) * factor,
                  "determined": bool(out.estimable[j])}
@@ -424,12 +491,13 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
     for f, fi in enumerate(files):
         pts = np.flatnonzero(file_of == f)
         inst.append({
-            "file": fi.name, "kind": fi.kind, "n": int(len(pts)),
+            "file": fi.name, "kind": fi.kind, "n": int(len(np.unique(rows_in_file[pts]))),
             "n_readings": int(obs.readings_per_point()[pts].sum()), "unit": fi.unit,
             "rms_residual": round(out.rms_all[f], 5),
             "heldout_rms": round(out.rms_test[f], 5), "n_heldout": out.n_test[f],
-            "test_rows": sorted(int(rows_in_file[i]) for i in pts if int(i) in test_set),
-            "normalised_rms": round(out.rms_all[f] / (1e3 * _file_u(obs, pts, u_ref)), 4)})
+            "test_rows": sorted({int(rows_in_file[i]) for i in pts if int(i) in test_set}),
+            "normalised_rms": round(out.rms_all[f] / (unit_factor(obs, f)
+                                                      * _file_u(obs, pts, u_ref)), 4)})
     return {
         "layout": model.name,
         "parameters": params,

@@ -4,6 +4,7 @@ any instruments (deviations, ballbar, sphere ...), mixed in one campaign.  See
 
 from __future__ import annotations
 
+from ..errors import require
 from ..fileio import Outputs
 from ._common import add_errors_out, add_force, add_html, add_json
 
@@ -13,18 +14,29 @@ def register(sub) -> None:
         "calibrate", help="identify the layout's parameters from instrument files (any mix)",
         description="Identify LAYOUT's parameters by weighted least squares from measurement "
                     "files of any instrument kind, in one campaign: 3-D deviations, ballbar "
-                    "traces, sphere probing / R-test ('volerr formats deviations|ballbar|"
-                    "sphere').  A file's kind is detected from its columns or given as "
+                    "traces, sphere probing / R-test, artifacts (ball / hole plate, step "
+                    "gauge), laser-interferometer runs, tracking-interferometer distances "
+                    "('volerr formats deviations|ballbar|sphere|artifact|interferometer|"
+                    "distances').  A file's kind is detected from its columns or given as "
                     "KIND:FILE.  Reports the identified values with standard uncertainties, "
                     "what the campaign cannot determine (and which file sees what), set-up "
-                    "estimates per file and placement, residuals per file on all and on "
-                    "held-out readings.")
+                    "estimates per file and placement (artifact poses, station positions), "
+                    "residuals per file on all and on held-out readings, the consistency of "
+                    "every file with its stated uncertainty and with the others, the "
+                    "volumetric error map with its uncertainty and the ISO 10360-2 length "
+                    "errors of the identified model.")
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="measurement files (KIND:FILE to "
-                   "name the kind: deviations, ballbar, sphere)")
+                   "name the kind: deviations, ballbar, sphere, artifact, interferometer, "
+                   "distances)")
     add_json(p, "the report (parameters, identifiability, set-ups, residuals per file)")
     add_html(p, "the report with figures")
     add_errors_out(p, "the identified model (for map, compensate, uncertainty)")
+    p.add_argument("--map-out", metavar="MAP.csv", help="write the identified volumetric "
+                   "error map over the measured range with its standard uncertainty "
+                   "(dx_um ... u_dx_um ...)")
+    p.add_argument("--map-grid", type=int, default=9, metavar="N",
+                   help="points per linear axis of --map-out")
     add_force(p)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters fitted, the others held at zero: comma list of names "
@@ -45,9 +57,11 @@ def run(args) -> int:
     from ..machine.model import load
     from ._common import layout_inputs
 
+    require(2 <= args.map_grid <= 60, "--map-grid must be between 2 and 60")
     model = load(args.layout)
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout)
-    outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
+    outs = Outputs(inputs, force=args.force).file("--json", args.json) \
+        .file("--html", args.html).file("--map-out", args.map_out) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     with outs:
@@ -60,10 +74,20 @@ def run(args) -> int:
             result.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
             result.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+        if args.map_out:
+            from ..calibrate.mapping import write_csv
+
+            write_csv(outs.path("--map-out"), result, (args.map_grid,) * 3, inputs=inputs)
     print(result.summary())
     for name, v in result["parameters"].items():
         if "@" not in name or name.endswith("@slope"):
             print(f"  {name} = {v['value']:.4g} +- {v['std']:.2g} {v['unit']}")
+    bad = result["consistency"]["inconsistent"]
+    if bad:
+        worst = {e["file"]: e for e in result["consistency"]["files"]}
+        print("  inconsistent with the rest (leave-one-file-out test): " + ", ".join(
+            f"{f} (p = {worst[f]['p_value']:.2g}, Birge ratio {worst[f]['birge_ratio']})"
+            for f in bad))
     if result["unidentifiable"]:
         print(f"  not determined by these data: {', '.join(result['unidentifiable'][:12])}"
               f"{' ...' if len(result['unidentifiable']) > 12 else ''} (see the report)")

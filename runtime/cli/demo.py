@@ -8,7 +8,9 @@ Sections (each runs the real command or API on built-in data and writes into DIR
 4. probe calibration on a simulated master-sphere run (Pahk's 101-point plan);
 5. laser-tracker identification of a simulated three-point campaign, squareness, diagonals;
    ballbar circles (ISO 230-4 G, H, diagnosis) and the rotary axes of the DMU 50 from a
-   simulated sphere probing cycle (``volerr calibrate``);
+   simulated sphere probing cycle (``volerr calibrate``); a ball plate in four placements on
+   MB1 and multilateration from four stations of a tracking interferometer on the DMU 50
+   (``volerr calibrate``: parameters, poses, stations, consistency, map with its uncertainty);
 6. five-axis DMU 50: a hemisphere finishing program compensated (full model and the thesis'
    strategy), tool-centre-point error over the (B, C) range;
 7. closing the loop: a virtual MB1 with an undeclared effect, fit, diagnosis, augmented model;
@@ -30,8 +32,8 @@ from ..errors import require
 from ..fileio import json_text, write_text
 from ..units import num
 
-SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "fiveaxis",
-            "loop", "iso230_2", "uncertainty")
+SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "ballplate",
+            "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty")
 
 #: one sentence per section of index.html: what it shows and how to read it
 ABOUT = {
@@ -56,6 +58,17 @@ ABOUT = {
               "over their travel) with planted location errors of both rotary axes: volerr "
               "calibrate identifies them with their uncertainties, names what this plan cannot "
               "separate from the sphere and tool unknowns, and the plan that would.",
+    "ballplate": "A 5 x 5 ball plate measured by MB1 in four placements (XY at two heights, "
+                 "XZ, YZ; the plate's pose in each unknown) with planted scale and squareness "
+                 "errors: volerr calibrate identifies them with the poses, checks the file's "
+                 "consistency with its stated 0.5 um, and maps the identified volumetric "
+                 "error with its propagated uncertainty and the ISO 10360-2 length errors.",
+    "multilateration": "A tracking interferometer at four stations on the table of the DMU 50 "
+                       "measures the tool point at 200 poses of the five axes (relative "
+                       "distances, 0.3 um + 0.3 um/m): volerr calibrate identifies the linear "
+                       "axes' scales, the squareness and the location errors of B and C "
+                       "together with the stations' positions and dead paths "
+                       "(self-calibrating multilateration).",
     "fiveaxis": "A hemisphere finishing program on the DMU 50 compensated with the full model "
                 "and with the thesis' strategy; the tool-tip error over the (B, C) range.",
     "loop": "A virtual MB1 with an undeclared thermal growth: the loop fits the declared "
@@ -97,6 +110,12 @@ CAPTIONS = {
                          "(magnified; CCW blue, CW red), G and H per trace.",
     "calibrate_rotary.png": "Identified location errors of B and C, bars \u00b1 2 u (k = 2), "
                             "beside the planted values (crosses).",
+    "calibrate_ballplate.png": "Ball plate on MB1: identified scale (\u00b5m/mm) and squareness "
+                               "(\u00b5rad), bars \u00b1 2 u (k = 2), beside the planted "
+                               "values (crosses).",
+    "calibrate_multilateration.png": "Multilateration on the DMU 50: identified parameters, "
+                                     "bars \u00b1 2 u (k = 2), beside the planted values "
+                                     "(crosses).",
     "compensate_full.png": "DMU 50 program, full model: predicted tool-tip error per block "
                            "before and after compensation.",
     "compensate_thesis.png": "DMU 50 program, thesis strategy (rotary, then linear).",
@@ -272,6 +291,60 @@ def _rotary(out: Path) -> dict:
                       "calibrate_rotary.png", "errors_rotary/"]}
 
 
+def _ballplate(out: Path) -> dict:
+    from ..calibrate.examples import write_ballplate_example
+    from ..units import num
+
+    ex = write_ballplate_example(out / "ballplate_MB1.csv", "MB1")
+    _cli("calibrate", "MB1", ex["path"], "--parameters", "EXX,EYY,EZZ,EC0Y,EB0Z,EA0Z",
+         "--degree", "1", "--json", out / "calibrate_ballplate.json",
+         "--html", out / "calibrate_ballplate.html", "--map-out", out / "map_ballplate.csv")
+    rep = json.loads((out / "calibrate_ballplate.json").read_text())
+    rows = [f"{n} {num(v['value'], '+.4g')} +/- {num(v['std'], '.2g')} (planted {num(ex['truth'][n], '+.4g')}) "
+            f"{v['unit']}" for n, v in rep["parameters"].items()]
+    worst = max(abs(_largest_difference_um(rep["poses"][f"ballplate_MB1.csv#{k}"]["origin_mm"], o))
+                for k, (_, o) in ex["poses"].items())
+    m, c = rep["volumetric_map"], rep["consistency"]["files"][0]
+    _parameter_figure(out / "calibrate_ballplate.png", rep, ex["truth"])
+    return {"title": "ball plate (5 x 5) in four placements on MB1 -> volerr calibrate",
+            "value": "; ".join(rows) + f"; poses within {num(worst, '.2f')} um of the planted ones; "
+                     f"Birge ratio {num(c['birge_ratio'], '.2f')} (consistent: {c['consistent']}); "
+                     f"map up to {num(m['max_length_um'], '.1f')} um, its standard uncertainty up to "
+                     f"{num(m['u_max_um'], '.2f')} um; ISO 10360-2 max |E| of the identified model "
+                     f"{num(rep['iso10360']['max_abs_E_um'], '.2f')} um",
+            "files": ["ballplate_MB1.csv", "calibrate_ballplate.json",
+                      "calibrate_ballplate.html", "map_ballplate.csv",
+                      "calibrate_ballplate.png"]}
+
+
+def _largest_difference_um(a, b) -> float:
+    """Largest coordinate difference of two points, um."""
+    return 1e3 * max(abs(float(x) - float(y)) for x, y in zip(a, b))
+
+
+def _multilateration(out: Path) -> dict:
+    from ..calibrate.examples import write_multilateration_example
+    from ..units import num
+
+    ex = write_multilateration_example(out / "multilateration_DMU50.csv", "DMU50")
+    _cli("calibrate", "DMU50", ex["path"], "--parameters", ex["parameters"], "--degree", "1",
+         "--json", out / "calibrate_multilateration.json",
+         "--html", out / "calibrate_multilateration.html")
+    rep = json.loads((out / "calibrate_multilateration.json").read_text())
+    rows = [f"{n} {num(v['value'], '+.4g')} +/- {num(v['std'], '.2g')} (planted {num(ex['truth'].get(n, 0), '+.4g')})"
+            f" {v['unit']}" for n, v in rep["parameters"].items()]
+    found = {k.split("#")[1]: v["position_mm"] for k, v in rep["stations"].items()}
+    st = "; ".join(f"{k} {num(_largest_difference_um(found[k], s), '.2f')} um"
+                   for k, s in ex["stations"].items())
+    _parameter_figure(out / "calibrate_multilateration.png", rep, ex["truth"])
+    return {"title": "multilateration on the DMU50: 4 stations x 200 poses -> volerr calibrate",
+            "value": "; ".join(rows) + f"; stations found within (largest coordinate "
+                     f"difference): {st}; not determined: "
+                     f"{', '.join(rep['unidentifiable']) or 'none'}",
+            "files": ["multilateration_DMU50.csv", "calibrate_multilateration.json",
+                      "calibrate_multilateration.html", "calibrate_multilateration.png"]}
+
+
 def _parameter_figure(path: Path, rep: dict, truth: dict) -> None:
     """Identified values (k = 2 bars) beside the planted truth."""
     from ..calibrate.report import parameter_figure
@@ -444,6 +517,8 @@ def run(args) -> int:
                 "identify": lambda: _identify(out),
                 "ballbar": lambda: _ballbar(out),
                 "rotary": lambda: _rotary(out),
+                "ballplate": lambda: _ballplate(out),
+                "multilateration": lambda: _multilateration(out),
                 "fiveaxis": lambda: _fiveaxis(out),
                 "loop": lambda: _loop(out),
                 "iso230_2": lambda: _iso230_2(out),

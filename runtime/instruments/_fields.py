@@ -136,8 +136,16 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
 def uncertainty(find: Finder, n: int, default_um: float, where: str) -> np.ndarray:
     """Standard uncertainty of each reading (n,) mm: column ``u_um`` (or ``u_mm``), else the
     instrument's default."""
-    h_um, h_mm = find("u", ("_um",), "u_um"), find("u", ("_mm",), "u_mm")
-    require(not (h_um and h_mm), f"{where}: both u_um and u_mm given")
+    return uncertainty_named(find, "u", n, default_um, where)
+
+
+def uncertainty_named(find: Finder, name: str, n: int, default_um: float,
+                      where: str) -> np.ndarray:
+    """Standard uncertainty of each reading (n,) mm from the column ``<name>_um`` (or
+    ``<name>_mm``), else the instrument's default."""
+    h_um = find(name, ("_um",), f"{name}_um")
+    h_mm = find(name, ("_mm",), f"{name}_mm")
+    require(not (h_um and h_mm), f"{where}: both {name}_um and {name}_mm given")
     if not (h_um or h_mm):
         return np.full(n, default_um * 1e-3)
     u = find.cols[h_um] * 1e-3 if h_um else find.cols[h_mm]

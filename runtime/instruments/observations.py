@@ -12,6 +12,10 @@ for a 3-D deviation, the bar direction for a ballbar, a rotation for a reading i
 frame), ``C`` its set-up columns and ``s`` the set-up unknowns (a pivot offset, a bar-length
 offset, a sphere centre, an instrument placement ...).
 
+A differential reading (angular interferometer optics: the optical path difference of two
+reflectors) combines two points of the same pose: ``P S(q, probe) + P2 S(q, probe2)``, the
+second point's tool offset ``probe2`` and projection ``P2``.
+
 Storage: a *point* is one commanded pose with up to three readings (rows).  Arrays are (N, 3)
 with unused rows zero (a ballbar point has one reading: rows 2 and 3 are zero in the reading,
 the projection and the set-up columns, so they add nothing to any least-squares sum).  The
@@ -165,6 +169,10 @@ class Observations:
     #: the instrument's own per-point columns (e.g. a ballbar's pivot, length, raw reading and
     #: placement): name -> (N, ...) array, for evaluations beyond the model's rows
     info: dict = field(default_factory=dict)
+    #: a second point of the chain in the same reading (differential readings): its tool
+    #: offset (N, 3) mm and projection (N, 3, 3), or None
+    probe2: np.ndarray | None = None
+    proj2: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -187,7 +195,8 @@ class Observations:
                             self.warnings, take(self.proj), take(self.rows), take(self.weight),
                             None if self.setup is None else self.setup.subset(idx),
                             take(self.file), take(self.row), self.files, take(self.sigma),
-                            {k: v[idx] for k, v in self.info.items()})
+                            {k: v[idx] for k, v in self.info.items()}, take(self.probe2),
+                            take(self.proj2))
 
     # ---- the rows of the linear model ------------------------------------------------
     def project(self, cols: np.ndarray) -> np.ndarray:
@@ -199,15 +208,25 @@ class Observations:
     def sensitivity(self, model) -> np.ndarray:
         """(N, 3, n_parameters) d(readings)/d(parameter), mm/mm or mm/rad."""
         cov = {c: self.covariates[c] for c in model.covariates}
-        return self.project(model.sensitivity(self.positions, self.probe, covariates=cov))
+        out = self.project(model.sensitivity(self.positions, self.probe, covariates=cov))
+        if self.proj2 is not None:
+            out = out + np.einsum("nij,njm->nim", self.proj2, model.sensitivity(
+                self.positions, self.probe2, covariates=cov))
+        return out
 
     def twist(self, model) -> np.ndarray:
         """(N, 3, 12) d(readings)/d(rigid twist) of the workpiece end (0-5) and the tool end
         (6-11) of the chain (the generated ``setup_sensitivity``, projected)."""
         pos = model.positions(self.positions)
-        p = self.probe
-        s = model.module.setup_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
-        return self.project(np.moveaxis(np.broadcast_to(s, (3, 12, self.n)), -1, 0))
+
+        def at(p):
+            s = model.module.setup_sensitivity(**pos, Xp=p[:, 0], Yp=p[:, 1], Zp=p[:, 2])
+            return np.moveaxis(np.broadcast_to(s, (3, 12, self.n)), -1, 0)
+
+        out = self.project(at(self.probe))
+        if self.proj2 is not None:
+            out = out + np.einsum("nij,njm->nim", self.proj2, at(self.probe2))
+        return out
 
     def symbol_sensitivity(self, model) -> np.ndarray:
         """(N, 3, n_symbols) d(readings)/d(nominal symbol) in ``model.symbols`` order (probe
@@ -298,7 +317,9 @@ def stack(parts: list) -> Observations:
         [w for p in parts for w in p.warnings],
         cat(lambda p: p.proj, lambda p: np.broadcast_to(eye, (p.n, 3, 3))),
         cat(lambda p: p.rows, lambda p: np.full(p.n, 3)),
-        cat(lambda p: p.weight, lambda p: np.ones(p.n)),
+        # weights: from each reading's stated uncertainty (sigma) unless a part sets them
+        None if all(p.weight is None for p in parts) else
+        cat(lambda p: p.weight, lambda p: p.point_weights()),
         stack_setups(setups),
         np.concatenate(file_idx),
         cat(lambda p: p.row, lambda p: np.arange(p.n)),
@@ -306,4 +327,15 @@ def stack(parts: list) -> Observations:
         cat(lambda p: p.sigma, lambda p: np.full(p.n, np.nan)),
         {k: np.concatenate([p.info[k] for p in parts]) for k in parts[0].info
          if all(k in p.info and np.ndim(p.info[k]) == np.ndim(parts[0].info[k])
-                for p in parts)})
+                for p in parts)},
+        *_pairs(parts))
+
+
+def _pairs(parts) -> tuple:
+    """(probe2, proj2) of stacked parts: None when no part has a second point, else the parts
+    without one get a zero projection."""
+    if all(p.proj2 is None for p in parts):
+        return None, None
+    return (np.concatenate([p.probe if p.probe2 is None else p.probe2 for p in parts]),
+            np.concatenate([np.zeros((p.n, 3, 3)) if p.proj2 is None else p.proj2
+                            for p in parts]))

@@ -598,9 +598,10 @@ def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
         ra = out.r_after.reshape(-1, 3)[m]
 
         n_pts = int(m.sum())
+        factor = 1e6 if fi.unit == "urad" else 1e3     # angular readings are rad inside
 
         def per_reading(r):
-            return round(1e3 * math.sqrt(float(np.sum(r ** 2)) / n_pts), 4) if n_pts else None
+            return round(factor * math.sqrt(float(np.sum(r ** 2)) / n_pts), 4) if n_pts else None
 
         out_list.append({"file": fi.name, "kind": fi.kind, "unit": fi.unit,
                          "n": int(np.sum(file_of == f)),

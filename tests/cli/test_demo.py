@@ -123,6 +123,19 @@ def _every_section_and_honest_figures(out):
     assert len(rot["parameters"]) >= 4
     for name, v in rot["parameters"].items():
         assert abs(v["value"] - SPHERE_TRUTH[name]) < 3 * v["std"], (name, v)
+    # issue 20: ball plate and multilateration beside their planted truth
+    from volerr.calibrate.examples import PLATE_TRUTH, TRACER_STATIONS, TRACER_TRUTH
+
+    for name, truth in (("ballplate", PLATE_TRUTH), ("multilateration", TRACER_TRUTH)):
+        rep = json.loads((out / f"calibrate_{name}.json").read_text())
+        assert set(rep["parameters"]) == set(truth), (name, rep["unidentifiable"])
+        for p, v in rep["parameters"].items():
+            assert abs(v["value"] - truth[p]) < 3 * v["std"], (name, p, v)
+        assert rep["consistency"]["inconsistent"] == []
+    for k, s in TRACER_STATIONS.items():
+        e = rep["stations"][f"multilateration_DMU50.csv#{k}"]
+        for got, want, u in zip(e["position_mm"], s, e["position_std_um"]):
+            assert abs(got - want) * 1e3 < 3 * u, (k, e)
     assert html.count("<figcaption>") == html.count("<img ") > 10
     assert "map_MB1_random.png" in html  # the random component is shown
     # every page the demo wrote is linked from the index
