@@ -35,7 +35,10 @@ _UNITS = {"um": "µm", "µm": "µm", "urad": "µrad", "µrad": "µrad", "mm": "m
 
 
 def unit(text: str) -> str:
-    """``"um"`` -> ``"µm"``, ``"urad"`` -> ``"µrad"``, ``"degC"`` -> ``"°C"`` (others kept)."""
+    """``"um"`` -> ``"µm"``, ``"urad"`` -> ``"µrad"``, ``"degC"`` -> ``"°C"`` (others kept); a
+    compound unit part by part (``"um/mm"`` -> ``"µm/mm"``)."""
+    if "/" in text:
+        return "/".join(_UNITS.get(part, part) for part in text.split("/"))
     return _UNITS.get(text, text)
 
 
