@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 import volerr
-from volerr.ballbar.simulate import simulate as ballbar_trace
-from volerr.ballbar.simulate import write_csv as write_ballbar
+from volerr.instruments.ballbar import simulate as ballbar_trace
+from volerr.instruments.ballbar import write_csv as write_ballbar
 from volerr.calibrate.examples import SPHERE_TRUTH
 from volerr.instruments import sphere
 from volerr.tables.functions import ErrorFunctions

@@ -24,6 +24,7 @@ MOVED = {
     "fiveaxis_example": "fiveaxis.example", "plots_fiveaxis": "fiveaxis.plots",
     "candidates": "loop.candidates", "fit": "estimate.design", "simulate": "loop.simulate",
     "loop.fit": "estimate.design", "loop.blocks": "estimate.blocks",
+    "ballbar.simulate": "instruments.ballbar",
     "loop_report": "loop.report", "audit_numeric": "audit.numeric", "commands": "cli",
 }
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..calibrate import calibrate
 from ..errors import require
-from ..loop.candidates import along_component
+from ..machine.iso_names import along_component
 
 SQUARENESS_OF_PLANE = {"XY": "EC0Y", "ZX": "EB0Z", "YZ": "EA0Z"}
 

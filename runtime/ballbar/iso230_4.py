@@ -38,10 +38,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import require
+from ..instruments.ballbar import PLANE_AXES, PLANE_NAMES, plane_of  # noqa: F401
 
-PLANE_NAMES = {2: "XY", 0: "YZ", 1: "ZX"}
-#: in-plane axes (first, second) of the plane with normal index k
-PLANE_AXES = {2: (0, 1), 0: (1, 2), 1: (2, 0)}
 
 
 @dataclass
@@ -59,12 +57,6 @@ class Trace:
     dr: np.ndarray
     rows: np.ndarray
     pivot: np.ndarray
-
-
-def plane_of(offsets: np.ndarray) -> int:
-    """Index of the plane normal: the coordinate along which the nominal tool ball does not
-    move about the pivot (the smallest spread)."""
-    return int(np.argmin(np.ptp(offsets, axis=0)))
 
 
 def traces(obs, model) -> list:

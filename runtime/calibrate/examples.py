@@ -25,7 +25,7 @@ def write_ballbar_example(folder, layout: str = "MB1", noise_um: float = 0.3) ->
     the squareness and scale errors :data:`BALLBAR_TRUTH`, written as ballbar files in
     ``folder`` (and the error directory they come from).  Returns ``{"errors": DIR, "files":
     [...], "truth": {...}}``."""
-    from ..ballbar.simulate import simulate, write_csv
+    from ..instruments.ballbar import simulate, write_csv
     from ..machine.model import load
     from ..tables.functions import ErrorFunctions
     from ..tables.table import ErrorTable, write_error_dir

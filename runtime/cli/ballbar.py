@@ -76,7 +76,7 @@ def _rotary(text: str) -> dict:
 
 
 def run_simulate(args) -> int:
-    from ..ballbar.simulate import simulate, write_csv
+    from ..instruments.ballbar import simulate, write_csv
     from ..cmm.volmap import error_dir_inputs
     from ..machine.model import load
 

@@ -13,7 +13,6 @@ SINUMERIK (LEC, CEC), Heidenhain (``.CMA`` / ``.COM``) and Fanuc (pitch error co
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from ..errors import require
@@ -116,7 +115,8 @@ def _export_volumetric(args, model) -> int:
 
 def _export_axis_tables(args, model) -> int:
     from ..fileio import Outputs, json_text, write_text
-    from ..tables import comp_tables, controller_tables as ctl
+    from ..fiveaxis.tables_left import left
+    from ..tables import controller_tables as ctl
     from ..tables.functions import ErrorFunctions
     from ._common import layout_inputs, parse_at
 
@@ -132,7 +132,7 @@ def _export_axis_tables(args, model) -> int:
         roles[path] = "--out" if k == 0 else f"--out ({Path(path).name})"
         outs.file(roles[path], path)
     outs.file("--json", args.json).plot("--plot", args.plot).check()
-    result = comp_tables.left(model, funcs, tables, args.grid, parse_at(args.at))
+    result = left(model, funcs, tables, args.grid, parse_at(args.at))
     s = result.summary()
     with outs:
         for path, text in files.items():

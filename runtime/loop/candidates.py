@@ -44,6 +44,7 @@ import numpy as np
 
 from . import symbols as syms
 from ..estimate.design import Data
+from ..machine.iso_names import along_component  # noqa: F401  (also the loop's public name)
 
 FAMILIES = ("thermal", "drift", "reversal", "coupling", "periodic", "higher_order",
             "probe_direction", "setup", "group", "step", "covariate")
@@ -142,13 +143,6 @@ def _u(axis: str, lo: float, hi: float, rotary: bool = False) -> str:
 
 def _ident(text: str) -> str:
     return re.sub(r"\W+", "_", text).strip("_")
-
-
-def along_component(layout, axis: str) -> str:
-    """The component error along/about an axis' own direction (EXX, EYY, ECC ...)."""
-    ax = layout.axes[axis]
-    i = int(np.argmax(np.abs(ax.direction)))
-    return "E" + ("XYZ" if ax.kind == "linear" else "ABC")[i] + axis
 
 
 def temperature_columns(covs) -> list:

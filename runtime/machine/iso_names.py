@@ -72,3 +72,11 @@ def is_angle(name: str) -> bool:
 def component(prefix: str, axis: str) -> str:
     """ISO name of a component error: ``component("EX", "Y") == "EXY"``."""
     return prefix + axis
+
+
+def along_component(layout, axis: str) -> str:
+    """The component error along / about an axis' own direction (``EXX``, ``EYY``, ``ECC``
+    ...): its positioning error, from the axis' direction in the layout."""
+    ax = layout.axes[axis]
+    i = max(range(3), key=lambda k: abs(ax.direction[k]))
+    return "E" + ("XYZ" if ax.kind == "linear" else "ABC")[i] + axis

@@ -1,5 +1,5 @@
-"""Axis compensation tables of a controller, built from error functions, and what compensating
-with them leaves.
+"""Axis compensation tables of a controller, built from error functions, and the correction
+they command (what compensating with them leaves: :mod:`volerr.fiveaxis.tables_left`).
 
 A controller's axis compensation table (SINUMERIK LEC / CEC, Heidenhain ``.COM``, Fanuc pitch
 error compensation; the formats in :mod:`volerr.tables.sinumerik`,
@@ -13,7 +13,7 @@ or ``E<B><A>`` (straightness of linear axis A in the direction of linear axis B:
 output B).  Values are errors (mm; deg for a rotary axis' positioning); a format that stores
 compensation amounts writes them negated.
 
-What compensating leaves (:func:`left`): at every node of a grid over the working volume (the
+What compensating leaves (:func:`volerr.fiveaxis.tables_left.left`): at every node of a grid over the working volume (the
 linear axes over the part of their travel the error tables cover, rotary axes at fixed
 positions), the model's volumetric error ``e(q)`` (first order, all error functions) minus the
 tool-tip motion of the corrections, ``J(q) v(q)`` (``J`` the nominal Jacobian of the tool tip
@@ -247,30 +247,6 @@ def to_error_tables(tables: list, model) -> dict:
     return out
 
 
-# ---------------------------------------------------------------------------------------
-# what compensating leaves
-@dataclass
-class Left:
-    """The model's volumetric error on a grid over the working volume before and after the
-    tables' correction: ``positions`` (N, n_axes) mm / deg in the order of ``axes``,
-    ``before`` / ``after`` (N, 3) mm, ``shape`` the grid counts of the linear axes (C
-    order), ``linear`` their names."""
-
-    positions: np.ndarray
-    before: np.ndarray
-    after: np.ndarray
-    shape: tuple
-    linear: tuple
-    axes: tuple = ()
-
-    def summary(self) -> dict:
-        b = np.linalg.norm(self.before, axis=1) * 1e3
-        a = np.linalg.norm(self.after, axis=1) * 1e3
-        return {"before_um": {"max": float(b.max()), "rms": float(np.sqrt(np.mean(b ** 2)))},
-                "left_um": {"max": float(a.max()), "rms": float(np.sqrt(np.mean(a ** 2)))},
-                "points": int(len(a))}
-
-
 def correction(model, tables: list, q: np.ndarray, direction=None) -> np.ndarray:
     """The per-axis values (N, n_axes) the controller subtracts at axis positions ``q``
     (mm; deg for rotary outputs): the sum of the tables of each output axis; a direction
@@ -285,31 +261,3 @@ def correction(model, tables: list, q: np.ndarray, direction=None) -> np.ndarray
             val = w * val
         v[:, o] += val
     return v
-
-
-def left(model, funcs, tables: list, grid: int = 9, at=None, probe=(0.0, 0.0, 0.0)) -> Left:
-    """What compensating with ``tables`` leaves (module docstring) on a grid of ``grid``
-    points per linear axis over the part of the travel the error tables cover; rotary axes at
-    ``at`` (axis -> deg, default 0 or the nearest travel limit)."""
-    from ..cmm.volmap import fixed_positions, volume
-    from ..fiveaxis.kinematics import nominal_jacobian
-
-    require(2 <= grid <= 60, "--grid must be 2..60 points per axis")
-    box = volume(model, funcs, "measured")
-    lin = tuple(a for a in model.axes if a not in model.rotary_axes)
-    ticks = [np.linspace(*box[a], grid) for a in lin]
-    mesh = np.meshgrid(*ticks, indexing="ij")
-    n = mesh[0].size
-    q = np.zeros((n, len(model.axes)))
-    for a, m in zip(lin, mesh):
-        q[:, model.axes.index(a)] = m.ravel()
-    for a, v in fixed_positions(model, at).items():
-        q[:, model.axes.index(a)] = v
-    probe = np.asarray(probe, dtype=float)
-    e = model.volumetric_error(q, funcs(q), probe=probe)
-    v = correction(model, tables, q)
-    rot = [model.axes.index(a) for a in model.rotary_axes]
-    v[:, rot] = np.deg2rad(v[:, rot])           # deg -> rad: the Jacobian is per rad
-    jac = nominal_jacobian(model, q, probe)[:, 0:3, :]
-    after = e - np.einsum("nij,nj->ni", jac, v)
-    return Left(q, e, after, tuple(len(t) for t in ticks), lin, tuple(model.axes))

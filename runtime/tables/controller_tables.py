@@ -14,7 +14,7 @@ The formats (each module documents its file, limits and sources):
                                                                  reference position
 =================  ===========================================  ==============================
 
-What compensating leaves: :func:`volerr.tables.comp_tables.left`.
+What compensating leaves: :func:`volerr.fiveaxis.tables_left.left`.
 """
 
 from __future__ import annotations
