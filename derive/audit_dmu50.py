@@ -96,7 +96,11 @@ def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, 
             f". Category undecidable: a duplicated row, which the print (a repeated line of "
             f"the source) and the text extraction (a repeated span) explain equally; the "
             f"'updated' chain after eq. 3.37 repeats the same row, but it renders the same "
-            f"matrix again, so a deterministic extraction would repeat it too; the separately "
+            f"matrix again, so a deterministic extraction would repeat it too (by the "
+            f"cross-copy rule a repetition at the same place does not decide: this extraction "
+            f"demonstrably repeats rows within an image -- in that same chain the error matrix "
+            f"of T_0^{{t,c}} has five rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'); "
+            f"the separately "
             f"typeset copies ({where}) print four rows, which shows the intended matrix but not "
             f"whether this print repeated one; what would decide: the page of the original "
             f"PDF"), [

@@ -216,7 +216,7 @@ def _reading_category(v: Verdict, r: Reading, keys, lay, alt, physical, geoms=()
     if r.tool is not None or r.work is not None:
         passage = geometry_text(geoms, r.stacking(lay))
         names.append(f"axes stacked {stacking_text(*r.stacking(lay))}: a geometry the text "
-                     f"allows (the layout file has {_stacking(lay)}; Pahk: {passage}); the "
+                     f"allows (the layout file has {_stacking(lay)}; the text: {passage}); the "
                      f"verdict rests on it")
     for f in r.flips:
         names.append(f"the errors of table {f} signed as the table's own motion"
@@ -324,7 +324,14 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
                         f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
                         f"up to {size:.2g} um ({typical_text()}, random angular errors "
                         f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, translational "
-                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma).")
+                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma). "
+                        f"Category simplification: Pahk states the quadrature formula (quoted "
+                        f"in 'statement'), not that it is applied term by term; the term-wise "
+                        f"form is how he applies it -- every printed random component of both "
+                        f"layouts that is not a copy (eq. 5 RX^2, RY^2, RZ^2 and eq. 8 RX^2, the "
+                        f"latter up to a lost glyph) is built so -- and it drops the correlation "
+                        f"of one parameter's two lever arms (Z and Zp above): an approximation "
+                        f"of the stated method, small at the typical machine.")
             v = classify(_verdict(eq, c, "differs", "term-wise quadrature drops cross terms",
                                   evidence + ocr, pr, exact),
                          "simplification", alternative=fmt(tw),

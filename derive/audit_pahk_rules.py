@@ -46,7 +46,8 @@ RULE1 = ("Sec. 2.3, rule (1): \"한 축을 따라서의 오각도오차와 피�
          "진직도오차 값에 아베 오프셋을 통해서 영향을 준다.\" (the yaw and pitch errors of an "
          "axis act on its positional error through the Abbe offset; the roll error acts on "
          "its straightness errors through the Abbe offset); sec. 2.3.1: \"진직도오차들은 "
-         "롤오차와 이와 관련된 아베옵셋에 의해 영향받게 되며\" (straightness errors are "
+         "롤오차와 이와 관련된 아베옴셋에 의해 영향받게 되며\" (sic, '옴셋' for '옵셋', offset; "
+         "straightness errors are "
          "affected by the roll error and its Abbe offset)")
 
 CONVENTION_SQUARENESS = ("squareness as the slope of ONE axis' straightness line in the machine "
@@ -450,7 +451,7 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
     if r.tool is not None or r.work is not None:
         from .audit_pahk_model import geometry_text
         names.append(f"axes stacked {stacking_text(r.tool, r.work)}, the geometry of the "
-                     f"layout's volumetric equation, which the text allows (Pahk: "
+                     f"layout's volumetric equation, which the text allows (the text: "
                      f"{geometry_text(geoms, (r.tool, r.work))})")
     for f in r.flips:
         names.append(f"{paper_name(lay, f) if f not in lay.axes else 'table ' + f} signed as in "

@@ -135,22 +135,75 @@ def _closed(selection: str) -> dict:
     return closed_form(selection)
 
 
-#: why a wrong unknown vector is undecidable (print or extraction), by the cross-copy rule
-UNDECIDABLE_VECTOR = (
-    " Category undecidable: print or extraction, and the text decides neither. For the print "
-    "(a vector copied in the author's source): the 4th entry E_A is printed as E_B in all four "
-    "six-entry vectors -- the specialization project's eq. 31 [E_XX, E_YX, E_XX, E_BX, E_BX, "
-    "E_CX] and eq. 32 [E_XX, E_YX, E_ZX, E_BX, E_BX, E_CX], the thesis' eq. 3.5 [E_XC, E_YC, "
-    "E_ZC, E_BC, E_BC, E_CC] and eq. 3.6 [E_XC, E_YC, E_AC, E_BC, E_BC, E_CC] -- the same "
-    "defect at the same place in separately typeset documents. For the extraction: that defect "
-    "is a repeated token (E_B twice, the E_A it displaces lost), the damage this extraction "
-    "demonstrably does within one image (appendix B sec. 2.4 lists the three rotational errors "
-    "as '(E_AX, E_BX, E_BX) E_CX'), and which recurs at the same place in vector images of the "
-    "same layout; by the cross-copy rule (docs/formats.md, audit) a repetition at the same "
-    "place does not decide. The other defects differ from vector to vector (E_XX for E_ZX in "
-    "eq. 31, E_ZC missing in eq. 3.6, one entry lost in eq. 35 and 36 (E_AY) and in eq. 37 "
-    "(E_YZ)): lost or repeated entries, again explained by both. What would decide: the pages "
-    "of the original PDF.")
+#: the extraction's demonstrated repetitions and losses within one image (quoted by verdicts)
+EXTRACTION_REPEATS = (
+    "appendix B sec. 2.4 lists the three rotational errors as '(E_AX, E_BX, E_BX) E_CX'; "
+    "the error matrix of T_0^{t,c} after thesis eq. 3.37 has five rows, three of them "
+    "'-E_{DX} & ... & 1 & E_{ZX}' (D names no axis)")
+EXTRACTION_LOSSES = (
+    "in the chain after thesis eq. 3.37 T_2^{3,c} has three rows (its row '0 & 0 & 1 & 0' "
+    "lost) and the bottom row of the Y axis' error matrix reads '0 & 0 & 0'")
+
+
+def _letters(unknowns) -> list[str]:
+    return [u[1] for u in unknowns]
+
+
+def _vector_defects(got: list, want: list) -> str:
+    """'E_BX (the 5th entry's) for E_AX in the 4th entry' ... or 'E_AY lost' (in words)."""
+    name = lambda u: f"E_{u[1:]}"  # noqa: E731
+    if len(got) == len(want):
+        parts = []
+        for k, (g, w) in enumerate(zip(got, want)):
+            if g != w:
+                again = [j + 1 for j, x in enumerate(got) if x == g and j != k]
+                parts.append(f"{name(g)} for {name(w)} in the {_ordinal(k + 1)} entry"
+                             + (f" (a repeat of the {_ordinal(again[0])} entry)"
+                                if again else ""))
+        return "; ".join(parts) + ": a repeated token and the entry it displaces lost"
+    lost = [w for w in want if w not in got]
+    return (f"{', '.join(name(w) for w in lost)} lost ({len(got)} entries for {len(want)} "
+            f"columns, the others in order): a lost entry")
+
+
+def _ordinal(k: int) -> str:
+    return {1: "1st", 2: "2nd", 3: "3rd"}.get(k, f"{k}th")
+
+
+def _vector_evidence(eq: dict, others: dict) -> str:
+    """Why a wrong unknown vector is undecidable: its own defect, the same defect elsewhere
+    (cross-copy rule) and the extraction's record, and what would decide."""
+    axis = eq["axis"]
+    got, want = list(eq["unknowns"]), [m + axis for m in MOTIONS]
+    mine = _letters(got)
+    same = [o for o, info in others.items() if o != eq["id"] and info.get("unknowns")
+            and _letters(info["unknowns"]) == mine]
+    fourth_b = [o for o, info in others.items() if info.get("unknowns")
+                and len(info["unknowns"]) == 6 and _letters(info["unknowns"])[3] == "B"]
+    repeat = len(got) == len(want)
+    out = (f" Its defect: {_vector_defects(got, want)}."
+           + (f" The same entries are printed in eq. {', '.join(same)}." if same else ""))
+    out += " Category undecidable: print or extraction, and the text decides neither. For the "
+    out += "print (a vector copied in the author's source): "
+    if repeat and mine[3] == "B":
+        out += (f"E_B stands in the 4th entry, where E_A belongs, in all {len(fourth_b)} "
+                f"six-entry vectors (eq. {', '.join(fourth_b)}: the specialization project and "
+                f"the thesis, separately typeset) -- the same defect at the same place. ")
+    elif same:
+        out += f"the same defect at the same place in eq. {', '.join(same)}. "
+    else:
+        out += "a slip while typing the vector. "
+    out += ("For the extraction: " + ("a repeated token is damage it demonstrably does within "
+                                       "one image (" + EXTRACTION_REPEATS + ")" if repeat else
+                                       "it demonstrably loses entries and rows within one "
+                                       "image (" + EXTRACTION_LOSSES + ")")
+            + ", and a failure driven by the image recurs at the same place in vector images "
+              "of the same layout; by the cross-copy rule (docs/formats.md, audit) a "
+              "repetition or a loss at the same place does not decide. What would decide: the "
+              "pages of the original PDF.")
+    return out
+
+
 #: why a repeated coefficient row is undecidable (print or extraction), by the cross-copy rule
 UNDECIDABLE_ROW = (
     " Category undecidable: a row repeated within one image, which the print and the "
@@ -165,8 +218,11 @@ UNDECIDABLE_ROW = (
     "same nine rows for the C axis, other symbols) has no repeated row, which decides "
     "neither. What would decide: the page of the original PDF.")
 UNDECIDABLE_ENTRIES = (
-    " Category undecidable: lost, repeated or garbled entries of a column vector look the same "
-    "whether the print or the OCR lost them; missing to decide: the page of the original PDF.")
+    ". Category undecidable: lost, repeated or merged entries of a column vector, which the "
+    "print (a line of the column typed wrong, left out or typed twice) and the extraction "
+    "explain equally -- this extraction demonstrably repeats and loses entries within one "
+    "image (" + EXTRACTION_REPEATS + "; " + EXTRACTION_LOSSES + "); what would decide: the "
+    "page of the original PDF.")
 UNDECIDABLE_N = (
     " Category undecidable: a '-' between two bracketed triple products is lost; the OCR "
     "extraction of this text also loses operators, and the appendix prints the same determinant "
@@ -311,9 +367,9 @@ def _derived_rows(axis: str, rotated: bool) -> dict:
 
 
 def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
-    """Verdicts on a printed system; ``others``: equation id -> (row labels, lever arms with
-    the X axis' subscript (:func:`wrong_subscripts`)) of every rotary system, for the
-    cross-copy rule."""
+    """Verdicts on a printed system; ``others``: equation id -> {"labels": row labels,
+    "wrong": lever arms with the X axis' subscript (:func:`wrong_subscripts`), "unknowns":
+    the printed unknown vector} of every printed system, for the cross-copy rule."""
     axis = eq["axis"]
     rotated = axis in "ABC"
     derived = _derived_rows(axis, rotated)
@@ -365,8 +421,9 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
         problems.append(f"{len(wrong)} lever arms printed with the X axis' subscript x where "
                         f"the C axis' C belongs: " + ", ".join(
                             f"row {lab} column {j}: '{text}'" for lab, j, text in wrong))
-        same_in = [other for other, (olabels, owrong) in (others or {}).items()
-                   if other != eq["id"] and _same_places(wrong, olabels, owrong, labels)]
+        same_in = [other for other, info in (others or {}).items()
+                   if other != eq["id"] and _same_places(wrong, info["labels"], info["wrong"],
+                                                         labels)]
         note = (
             f" Read with C, every coefficient is the derived one (the rotated lever arms "
             f"x^_Ci = x_Ci cos C - y_Ci sin C, y^_Ci = y_Ci cos C + x_Ci sin C the thesis "
@@ -424,7 +481,7 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
                             "subscripts of the axis: see the verdict on the coefficient "
                             "matrix); the printed vector"
                             + (f" [{vec}]" if vec else "") + " mislabels them: "
-                            + "; ".join(parts) + "." + UNDECIDABLE_VECTOR,
+                            + "; ".join(parts) + "." + _vector_evidence(eq, others or {}),
                             ", ".join(got_u), ", ".join(want_u), category="undecidable"))
         out[-1].readings_tried = ["the vector as printed: " + "; ".join(parts),
                                   "entries repeated or lost by the print (a copied vector) or "
@@ -729,7 +786,8 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
     if layouts is not None and not (set(layouts) & set(LAYOUTS)):
         return []
     out = []
-    systems = {eq["id"]: ([lab for lab, _ in eq["rows"]], wrong_subscripts(eq))
+    systems = {eq["id"]: {"labels": [lab for lab, _ in eq["rows"]],
+                          "wrong": wrong_subscripts(eq), "unknowns": eq["unknowns"]}
                for eq in printed.get("equation", []) if eq["kind"] == "system"}
     for eq in printed.get("equation", []):
         kind = eq["kind"]
