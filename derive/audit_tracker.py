@@ -224,9 +224,14 @@ UNDECIDABLE_ENTRIES = (
     "image (" + EXTRACTION_REPEATS + "; " + EXTRACTION_LOSSES + "); what would decide: the "
     "page of the original PDF.")
 UNDECIDABLE_N = (
-    " Category undecidable: a '-' between two bracketed triple products is lost; the OCR "
-    "extraction of this text also loses operators, and the appendix prints the same determinant "
-    "with its minus (eq. 33-34); missing to decide: the page of the original PDF.")
+    " Category undecidable: a '-' between two bracketed triple products is lost (the printed "
+    "N is one product of six factors). For the print: a sign left out while typing. For the "
+    "extraction: it damages operators in this document (Listing 3.1 reads 'if degree = 1:', "
+    "a Python syntax error, where the copy of the same code in the appendix reads 'if degree "
+    "== 1:'). The specialization project prints the same determinant with its minus (eq. 34, "
+    "'N = (x_{xK} - x_{xQ})(y_{xP} - y_{xQ})(z_{xP} - z_{xK}) - (x_{xK} - x_{xP})...'): the "
+    "defect stands in one copy only, so the cross-copy rule does not decide it; missing to "
+    "decide: the page of the original PDF.")
 
 
 def _verdict(eq, comp, ok, erratum, evidence, printed, derived,
