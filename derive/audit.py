@@ -75,13 +75,33 @@ PRIORITY_RULE = (
     "evidence tells that damage from the print (a symbol no print carries, a line number "
     "without its line); "
     "(4) printing_error -- no reading reproduces it, and the text itself decides that it is "
-    "not extraction damage (a well-formed wrong symbol, term or sign; the same defect in a "
-    "separately typeset copy; a consequence printed elsewhere; a sign or axis stacking that "
+    "not extraction damage (a well-formed wrong symbol, term or sign; the same substitution "
+    "at the same place in a separately typeset copy, by the cross-copy rule below; a "
+    "consequence printed elsewhere; a sign or axis stacking that "
     "contradicts the one the same document uses); "
     "(5) undecidable -- otherwise: only an unstated assumption reproduces it, or the defect "
     "is glyph-level (a lost letter, sign, row or column, a duplicated row, a confusable glyph "
     "such as mm for um) and the print and the extraction explain it equally; both "
-    "explanations are named, and what would decide.")
+    "explanations are named, and what would decide. "
+    "Readings of the kinds inconsistent, copy and stacking do not explain a print, they name "
+    "a printing error: a combination that contains one is taken only when no combination "
+    "without one reproduces the print (an unstated assumption that reproduces it leaves the "
+    "verdict undecidable); only minimal combinations are counted (one that adds a reading "
+    "to an exact combination without changing the result is not). "
+    "Cross-copy rule: the same defect at the same place in two separately typeset images -- "
+    "the thesis, its appendix A (the conference paper) and its appendix B (the "
+    "specialization project), or two equations of one document -- decides for the author's "
+    "source (printing_error) when it is a substitution: another well-formed symbol, index, "
+    "sign, number, label or component, which an extraction would have to invent identically "
+    "in both images while it reads the same notation right elsewhere (a misreading driven by "
+    "the rendering would recur wherever that rendering does); a whole component or label of "
+    "another equation is such a substitution (this extraction is not seen to carry text from "
+    "one image into another). It does not decide a repetition within an image (a row, entry, "
+    "token or matrix repeated, with what it displaces lost) nor a lost entry: this extraction "
+    "demonstrably repeats within an image (the error matrix of T_0^{t,c} after thesis eq. "
+    "3.37 has five rows, three of them '-E_{DX} & ... & 1 & E_{ZX}' and two of these "
+    "identical, with the letter D that names no axis), and a failure driven by the image "
+    "repeats at the same place in images of the same layout: such defects are undecidable.")
 
 #: kind of every reading key prefix -> the category it implies (see :func:`category_of`)
 READING_KINDS = {
@@ -97,7 +117,8 @@ READING_KINDS = {
     "stated": "simplification",        # another approximation the author states
     "ocr": "extraction",               # repair of extraction damage told from the print
     "zero": "assumption",              # an unstated zero offset
-    "glyph": "assumption",             # glyph-level defect: print or extraction
+    "glyph": "assumption",             # glyph-level defect or a repetition within an image:
+                                       # print or extraction
     "missing": "assumption",           # a value the text does not print
     "stacking": "other_machine",       # an axis stacking the text excludes
     "copy": "other_machine",           # a component copied from another equation
@@ -141,6 +162,56 @@ def best_combination(hits):
     return min(hits, key=lambda h: (RANK[category_of(h[0])],
                                     sum(reading_kind(k) == "assumption" for k in h[0]),
                                     len(h[0]), repr(h[0])))
+
+
+def minimal_hits(hits):
+    """The combinations of ``hits`` = [(keys, payload)] that no other hit's key set is a
+    proper subset of: a reading added to an exact combination without changing the result is
+    not counted (:data:`PRIORITY_RULE`)."""
+    sets = [frozenset(k) for k, _ in hits]
+    return [h for h, s in zip(hits, sets) if not any(o < s for o in sets)]
+
+
+def _not_taken(keys, chosen, why=None) -> str:
+    """Why the combination ``keys`` is not the one the rule takes (``chosen``), "" if it is;
+    ``why(keys)``: a reason the caller knows first (or None)."""
+    if chosen is None or tuple(keys) == tuple(chosen):
+        return ""
+    first = why(keys) if why is not None else None
+    if first:
+        return f" (not taken: {first})"
+    cat, cc = category_of(keys), category_of(chosen)
+    if RANK[cat] > RANK[cc]:
+        if cat == "printing_error":
+            return (" (not taken: it names a printing error -- a reading the document "
+                    "contradicts -- and counts only when no combination without one "
+                    "reproduces the print; one does)")
+        if cat == "undecidable":
+            return (" (not taken: it rests on an unstated assumption, and a combination of "
+                    "stated readings reproduces the print)")
+        return f" (not taken: {cat} comes after {cc} in the rule's order)"
+    n_ass = sum(reading_kind(k) == "assumption" for k in keys)
+    c_ass = sum(reading_kind(k) == "assumption" for k in chosen)
+    if n_ass > c_ass:
+        return " (not taken: more unstated assumptions)"
+    if len(keys) > len(chosen):
+        return " (not taken: more readings)"
+    return " (as good by the rule; the one reported comes first in a fixed order)"
+
+
+def hits_text(hits, chosen=None, limit: int = 4, why=None) -> str:
+    """The minimal combinations of ``hits`` ([(keys, payload)]) for ``readings_tried``, in the
+    rule's order, each with its category and, if it is not ``chosen``, why not."""
+    mins = sorted((tuple(k) for k, _ in minimal_hits(hits)),
+                  key=lambda k: (RANK[category_of(k)],
+                                 sum(reading_kind(x) == "assumption" for x in k), len(k),
+                                 repr(k)))
+    shown = "; ".join(f"[{', '.join(k)}] -> {category_of(k)}{_not_taken(k, chosen, why)}"
+                      for k in mins[:limit])
+    more = " ..." if len(mins) > limit else ""
+    return (f"{len(mins)} minimal combination(s) reproduce it exactly (a reading added to one "
+            f"of them without changing the result is not counted)"
+            + (f": {shown}{more}" if mins else ""))
 
 
 #: verdict categories, in report order
@@ -359,6 +430,54 @@ def describe_diff(expected, printed, limit: int = 4) -> str:
     for p, e in d["coefficient"]:
         parts.append(f"{_signed(*p.as_coeff_Mul())} printed for {_signed(*e.as_coeff_Mul())}")
     return "; ".join(parts)
+
+
+def wrong_printed_terms(expected, printed) -> list:
+    """The printed terms (coefficient * monomial) that ``expected`` does not have: extra terms
+    and the printed side of exchanged symbols or signs."""
+    d = term_diff(expected, printed)
+    return d["extra"] + [p for p, _ in d["swapped"]] + [p for p, _ in d["sign"]] + \
+        [p for p, _ in d["coefficient"]]
+
+
+def term_elsewhere(wrong, before: dict, after: dict) -> tuple[list, list]:
+    """Where the wrong printed terms stand in the other components of the same printed image:
+    ``before`` / ``after``: {component name: printed expression} read before / after this one.
+    Returns ([(term, component)] read before, [(term, component)] read after)."""
+    def where(comps):
+        out = []
+        for t in wrong:
+            c, m = t.as_coeff_Mul()
+            for name, expr in comps.items():
+                if terms(expr).get(m) == c:
+                    out.append((t, name))
+                    break
+        return out
+    return where(before), where(after)
+
+
+def repetition_note(wrong, before: dict, after: dict) -> tuple[str, bool]:
+    """(evidence sentence, repeated) on whether a wrong printed term repeats a term of the same
+    image: ``repeated`` when every wrong term stands in a component read before it (a
+    repetition within an image, which the cross-copy rule leaves undecided)."""
+    if not wrong:
+        return "", False
+    b, a = term_elsewhere(wrong, before, after)
+    if b and len(b) == len(wrong):
+        return (" The wrong term" + ("s " if len(wrong) > 1 else " ")
+                + ", ".join(f"{fmt(t)} (as in {n})" for t, n in b)
+                + " repeat" + ("" if len(wrong) > 1 else "s")
+                + " a term printed before it in the same image: a repetition within an image, "
+                  "which the print (a line copied) and the extraction (a repeated span) explain "
+                  "equally (cross-copy rule); what would decide: the page of the original PDF.",
+                True)
+    if a:
+        return (" The wrong term " + ", ".join(f"{fmt(t)} also stands in {n}, printed after it"
+                                                for t, n in a)
+                + ": in reading order it comes first here, so it is no repetition of text "
+                  "already read; the author's line written from the later one explains it.",
+                False)
+    return "", False
 
 
 def lost_glyphs(expected, printed) -> list[str]:

@@ -96,7 +96,11 @@ def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, 
             f". Category undecidable: a duplicated row, which the print (a repeated line of "
             f"the source) and the text extraction (a repeated span) explain equally; the "
             f"'updated' chain after eq. 3.37 repeats the same row, but it renders the same "
-            f"matrix again, so a deterministic extraction would repeat it too; the separately "
+            f"matrix again, so a deterministic extraction would repeat it too (by the "
+            f"cross-copy rule a repetition at the same place does not decide: this extraction "
+            f"demonstrably repeats rows within an image -- in that same chain the error matrix "
+            f"of T_0^{{t,c}} has five rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'); "
+            f"the separately "
             f"typeset copies ({where}) print four rows, which shows the intended matrix but not "
             f"whether this print repeated one; what would decide: the page of the original "
             f"PDF"), [
@@ -105,17 +109,50 @@ def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, 
                 "repeated row removed (exact)"], [f"glyph:{name} repeated row"]
     if name == "T_2^3" and "sign error" in erratum:
         return "printing_error", evidence + (
-            ". Category printing_error: a single minus sign (glyph-level) lost, but the same "
-            "defect stands in the specialization project's eq. (3), a separately typeset "
-            "document (appendix B), so it is in the author's source, not an accident of this "
-            "extraction; the conference paper's eq. 1.3 and Listing 3.3's T_B have -s_B: the "
-            "author's intended rotation"), [
+            ". Category printing_error by the cross-copy rule: a single sign, but the same "
+            "sign stands at the same entry in the specialization project's eq. (3), a "
+            "separately typeset document (appendix B), while the extraction reads the minus of "
+            "'-s_B' in the paper's eq. 1.3 and of '-s_C' in eq. 3.35 right: a substitution it "
+            "would have to make identically in two images, so the author's source; the "
+            "conference paper's eq. 1.3 and Listing 3.3's T_B have -s_B: the author's intended "
+            "rotation"), [
                 "right-handed rotation Rz(B) (derived; paper eq. 1.3, Listing 3.3 T_B): entry "
                 "(1,2) differs",
                 "left-handed Rz(-B) (the other rotation sense): entry (2,1) differs",
                 "a minus lost by the extraction: contradicted by the same defect in project eq. "
                 "(3)"], ["inconsistent:T_2^3 sign of s_B (1,2)"]
     return "printing_error", evidence, [], []
+
+
+#: why a data source of Listing 3.3 repeated from the line above is undecidable
+LISTING_SOURCE_UNDECIDABLE = (
+    "Category undecidable: the quoted file name {src} is the one of the line above, a token "
+    "repeated within one image, which the print and the extraction explain equally. For the "
+    "print: a line of code copied and its file name left unchanged, the usual copy-paste "
+    "defect, and the same pattern stands in the B block (E_CB reads E_BB's data) and the C "
+    "block (E_CC reads E_BC's), as a C block copied from the B block would carry it; the "
+    "line of {name} keeps its own variable name. For the extraction: it demonstrably repeats tokens "
+    "and rows within an image (the error matrix of T_0^{{t,c}} after thesis eq. 3.37 has five "
+    "rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'; appendix B sec. 2.4 lists '(E_AX, "
+    "E_BX, E_BX) E_CX'), and the two blocks of the listing have the same layout, so a "
+    "repetition driven by the image recurs at the same place; by the cross-copy rule a "
+    "repetition within an image does not decide. What would decide: the original listing "
+    "(or a figure of the compensation that shows whether {name} was used)")
+
+
+#: why the T_4^5 of the chain "updated" with the errors (after eq. 3.37) is undecidable
+UPDATED_CHAIN_REPEAT = (
+    "Category undecidable: a whole matrix repeated, which the print and the extraction explain "
+    "equally. For the print: the author may have copied the preceding factor in the source "
+    "and not changed it. For the extraction: the updated chain is one image in which this "
+    "extraction demonstrably repeats and merges rows -- T_1^2 has a first row of five "
+    "entries ('1 & 0 & 0 & 0 & 0'), T_3^4 has the row '0 & -s_{45^\\circ} & c_{45^\\circ} & "
+    "0' twice, the error matrix of T_0^{t,c} has five rows, three of them '-E_{DX} & ... & 1 & "
+    "E_{ZX}', the tokens E_{DB}, E_{2B} and T_A name no error, T_6^{t,c} stands where the C "
+    "axis' factor belongs, and the translation of T_0^{t,c} reads '1 & 0 & 0 & X \\\\ 0 & 1 "
+    "& 0 & 0 \\\\ 0 & 0 & 1 & 1' -- so emitting the factor just read once more is within "
+    "its failures here; no separately typeset copy of the updated chain exists (the cross-copy "
+    "rule cannot decide). What would decide: the page of the original PDF")
 
 
 # ------------------------------------------------------------------------------ derived pieces
@@ -298,17 +335,20 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         if not same:
             cat, ev, tried, used = _matrix_category(name, erratum, ev)
             if item["id"].startswith("error chain"):
+                cat = "undecidable"
                 tried = ["the printed matrix against every derived factor: it is the derived "
-                         "T_3^4 (a rotation), not T_4^5 (the translation by -d)"]
-                ev += (". Category printing_error: a whole well-formed matrix of the chain in the "
-                       "place of another (the preceding factor repeated): not extraction "
-                       "damage, which does not produce another valid factor")
+                         "T_3^4 (a rotation), not T_4^5 (the translation by -d)",
+                         "the preceding factor T_3^4 repeated by the print (a copied source) "
+                         "or by the extraction (a repeated span, in a block it demonstrably "
+                         "damages): the printed matrix exactly"]
+                ev += (f" (thesis eq. 3.34 prints T_4^5 as that translation). The extraction "
+                       f"text: '{item.get('text', '')}'. " + UPDATED_CHAIN_REPEAT)
         else:
             cat = "identical"
         v = _verdict(eq, same, erratum, ev, str(item["rows"]), fmt(factors[name]), name,
                      category=cat)
         if item["id"].startswith("error chain") and not same:
-            used = ["copy:updated chain T_4^5 <- T_3^4"]
+            used = [f"glyph:updated chain {name} repeats T_3^4"]
         v.readings_tried, v.readings_used = tried, used
         out.append(v)
 
@@ -400,22 +440,29 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
             v.readings_tried, v.readings_used = tried, used
             out.append(v)
     if "sources" in lst:
+        texts = lst.get("sources_text", {})
         for pname, src in lst["sources"].items():
             expected = f"{pname}_avg."
             same = src == expected
+            lines = texts.get(pname, [])
+            quoted = (" The extraction reads the line above and this one as '"
+                      + "' and '".join(lines) + "'." if lines else "")
             v = _verdict(f"Listing 3.3 T_er {pname}", same,
                          f"{pname} read from the data of {src[:-5]}",
                          f"{pname} = cf_rot('{expected}', ...) reads its own data" if same
                          else f"line reads cf_rot('{src}', ...) for {pname}; expected "
-                         f"'{expected}' (copy-paste: the {pname} curve is never used). "
-                         f"Category printing_error: another valid file name of the same "
-                         f"listing (the one on the line above), not extraction damage",
-                         f"cf_rot('{src}')", f"cf_rot('{expected}')", pname)
+                         f"'{expected}' (each other parameter of T_er reads '<its name>_avg.'; "
+                         f"as printed the {pname} curve is never used).{quoted} "
+                         + LISTING_SOURCE_UNDECIDABLE.format(name=pname, src=src[:-5]),
+                         lines[-1] if lines else f"cf_rot('{src}')", f"cf_rot('{expected}')",
+                         pname, category="undecidable")
             if not same:
                 v.readings_tried = [f"the listing's own pattern (each parameter reads "
-                                    f"'<name>_avg.'): differs", f"a copy of the line above "
-                                    f"with the name left unchanged: exact"]
-                v.readings_used = [f"copy:Listing 3.3 line for {pname}"]
+                                    f"'<name>_avg.'): differs",
+                                    f"the file name of the line above repeated, by the print "
+                                    f"(a line copied, the name left unchanged) or by the "
+                                    f"extraction (a token repeated within the image): exact"]
+                v.readings_used = [f"glyph:Listing 3.3 line for {pname} repeats the name above"]
             out.append(v)
     if "T_er" in lst:
         out.append(_audit_t_er(layout, chain, lst, factors, d_value))
@@ -444,16 +491,25 @@ def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
     size = _t_er_size_um(lst, factors, t0w_num, err_num, layout, d_value, p_table)
     ev = (f"size of the difference with every angular error of B and C at "
           f"{TYPICAL['angular_rad'] * 1e6:g} urad (signs worst case): up to {size:.2g} um at the "
-          f"listing's point; first-order effect per error parameter on the table point (179.009, 94.545, "
-          "143.533) mm, listing with rot_y and the data sources corrected: " +
+          f"listing's point; first-order effect per error parameter on the table point (179.009, "
+          "94.545, 143.533) mm (workpiece frame), listing with rot_y and the data sources "
+          "corrected -- each effect is the displacement of the tool relative to the workpiece, "
+          "expressed in the workpiece (table) frame, per 1 um or 1 urad of the parameter: " +
           ("; ".join(rows) if rows else "all effects agree") +
           ". Reasons: T_er applies every error in the machine frame after the whole rotation "
           "-- the tilts of B turn about the machine origin instead of about the B axis (lever "
           "arm to the B/C intersection at (0, 0, d)), and the errors of C are not turned with "
           "the B axis that carries C")
     v = _verdict("Listing 3.3 T_er (error model)", same, "errors applied in the wrong frame",
-                    ev + ". Category simplification: the listing implements the method the "
-                    "thesis states (sec. 3.5)", " @ ".join(lst["T_er"]),
+                    ev + ". Category simplification, the audit's category for a model the "
+                    "author states (here sec. 3.5 states it as the method, not as an "
+                    "approximation): the listing implements exactly that statement, so it is "
+                    "no printing error, but the model is not the machine's -- its effect, up to "
+                    f"{size:.2g} um at the listing's point with {TYPICAL['angular_rad'] * 1e6:g} "
+                    "urad angular errors of B and C, is as large as the residual errors the "
+                    "thesis reports after compensation (E_YY about 10 um, sec. 4.2.2), so the "
+                    "compensation of the rotary axes is off by up to that much",
+                    " @ ".join(lst["T_er"]),
                     "derived first-order chain (DMU50 layout)", "T_er",
                     category="simplification", statement=T_ER_STATEMENT,
                     alternative="every B and C error motion applied in the machine frame after "

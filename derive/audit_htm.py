@@ -134,10 +134,12 @@ def audit_matrix(item: dict) -> list[Verdict]:
                           ["inconsistent:paper eq. 1.6 sense of C"]))
         elif name == "T_2^3":
             ev = ("; ".join(bad) + f"; the printed 3x3 block has det = {fmt(det)}: not a "
-                  "rotation in either sense. Category printing_error: a single sign "
-                  "(glyph-level), but thesis eq. 3.32, typeset separately, prints the same "
-                  "[[c_B, s_B], [s_B, c_B]]: the author's source; the paper's eq. 1.3 and "
-                  "Listing 3.3 T_B print the rotation [[c_B, -s_B], [s_B, c_B]]")
+                  "rotation in either sense. Category printing_error by the cross-copy rule: "
+                  "a single sign, but thesis eq. 3.32, typeset separately, prints the same "
+                  "[[c_B, s_B], [s_B, c_B]], while the extraction reads the minus of '-s_B' in "
+                  "the paper's eq. 1.3 and of '-s_C' in thesis eq. 3.35 right: the author's "
+                  "source; the paper's eq. 1.3 and Listing 3.3 T_B print the rotation "
+                  "[[c_B, -s_B], [s_B, c_B]]")
             out.append(_v(item, "matrix", "printing_error", "sign error in 1 entry (as thesis "
                           "eq. 3.32)", ev, str(item["rows"]), fmt(derived), tried,
                           ["inconsistent:T_2^3 sign of s_B (1,2)"]))
@@ -146,13 +148,18 @@ def audit_matrix(item: dict) -> list[Verdict]:
                           str(item["rows"]), fmt(derived), tried, []))
     if item["label"] != name:
         kind = item.get("label_kind", "glyph")
-        cat = {"glyph": "undecidable", "copy": "printing_error", "extraction": "extraction"}[kind]
+        cat = {"glyph": "undecidable", "copy": "printing_error", "cross": "printing_error",
+               "extraction": "extraction"}[kind]
         why = {"glyph": "Category undecidable: glyph-level, explained equally by the print and "
                         "by the text extraction; what would decide: the page of the original PDF",
-               "copy": "Category printing_error: the label of another equation, which an "
-                       "extraction does not produce",
+               "copy": "Category printing_error by the cross-copy rule: the label of another "
+                       "equation, which an extraction would have to carry from that image "
+                       "into this one",
+               "cross": "Category printing_error by the cross-copy rule: the same "
+                        "substitution at the same place in two images",
                "extraction": "Category extraction"}[kind]
-        key = {"glyph": "glyph", "copy": "copy", "extraction": "ocr"}[kind]
+        key = {"glyph": "glyph", "copy": "copy", "cross": "copy",
+               "extraction": "ocr"}[kind]
         out.append(_v(item, "label", cat, f"labelled {item['label']} for {name}",
                       f"the factor at this place of the chain is {name}; printed label "
                       f"{item['label']}: {item.get('label_note', '')}. {why}", item["label"],
@@ -222,13 +229,18 @@ def audit_product(item: dict) -> Verdict:
     tried.append(f"the printed factors as frame pairs: {', '.join(bad)} map no frame of the "
                  f"chain")
     tried.append("extraction damage of the sub- and superscripts: excluded for T_2^2, which "
-                 "thesis eq. 3.37 (typeset separately) prints at the same place")
+                 "thesis eq. 3.37 (typeset separately) prints at the same place; possible "
+                 "for T_1^1, which only this copy has")
     return _v(item, "", "printing_error", f"{', '.join(bad)} printed for T_3^2, T_2^1",
               f"derived order {' '.join(order)}; printed {' '.join(item['factors'])}: "
               f"{', '.join(bad)} are no frame pairs of the chain (a frame does not map into "
               f"itself). Thesis eq. 3.37, typeset separately, has T_2^2 at the same place "
-              f"('T_w^5 T_5^4 T_4^3 T_2^2 T_1^0 T_1^d'), so the defect is in the author's "
-              f"source. Category printing_error", item["text"], " ".join(order), tried,
+              f"('T_w^5 T_5^4 T_4^3 T_2^2 T_1^0 T_1^d'): by the cross-copy rule (a "
+              f"well-formed index substituted at the same place in two separately typeset "
+              f"copies) the T_2^2 for T_3^2 is in the author's source. T_1^1 for T_2^1 is only "
+              f"in this copy (thesis eq. 3.37 has no factor between T_2^2 and T_1^0): print or "
+              f"extraction (one digit), undecided. Category printing_error: at least the T_2^2 "
+              f"defect is decided to be printed", item["text"], " ".join(order), tried,
               ["inconsistent:product factor T_2^2"])
 
 
@@ -373,9 +385,12 @@ def audit_rotary(item: dict) -> Verdict:
               "the HTM instead of the deviation) reproduces it. Entry (2,3) -E_XB (a "
               "translational error where the rotation -E_AB belongs) and the bottom row "
               "0 0 0 1 under a deviation are the defects of the thesis' eq. 2.42 for C, a "
-              "separately typeset document: the author's source, not extraction damage; the "
-              "other three are sign differences the thesis' matrix does not have. Category "
-              "printing_error", str(item["rows"]), fmt(dev), tried,
+              "separately typeset document, at the same places: by the cross-copy rule "
+              "substitutions the extraction would have to make identically in two images "
+              "(it reads E_AB right in row 3 of this matrix), so the author's source; the "
+              "other three are single signs only this copy has (the thesis' matrix does not): "
+              "print or extraction, undecided. Category printing_error: at least the two "
+              "shared defects are decided to be printed", str(item["rows"]), fmt(dev), tried,
               ["copy:paper eq. 1.17 entries of thesis eq. 2.42"])
 
 

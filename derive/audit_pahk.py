@@ -25,8 +25,9 @@ from __future__ import annotations
 import sympy as sp
 
 from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
-                    describe_diff, fmt, is_identical, lost_glyphs, n_diff, n_issues, terms,
-                    typical_text, worst_case_um)
+                    describe_diff, fmt, hits_text, is_identical, lost_glyphs, n_diff,
+                    n_issues, repetition_note, terms, typical_text, worst_case_um,
+                    wrong_printed_terms)
 from .audit_pahk_chain import audit_chain, audit_vectors, chain_error  # noqa: F401
 from .audit_pahk_model import (COMPONENTS, P, Reading, derived_error, geometries,  # noqa: F401
                                geometry_text, iso_error, layout, paper_map, paper_name, parse,
@@ -125,6 +126,7 @@ def audit_volumetric(eq: dict, geoms: tuple) -> tuple[list[Verdict], Reading]:
         ocr = f" {notes[i]}." if notes[i] else ""
         tried = _tried(rows, i, printed[i], lay) + [whole]
         if is_identical(physical[i], printed[i]):
+            tried = _tried(rows, i, printed[i], lay, ()) + [whole]
             v = _verdict(eq, c, "identical", "",
                          f"expand(derived - printed) == 0 for the physical layout "
                          f"{name} ({_stacking(lay)})." + ocr, printed[i], physical[i])
@@ -138,6 +140,7 @@ def audit_volumetric(eq: dict, geoms: tuple) -> tuple[list[Verdict], Reading]:
                    if ex[i] and set(r.keys(lay)) <= best_keys and (r.tool, r.work) ==
                    (best.tool, best.work)]
             keys, (r, d) = best_combination(sub)
+            tried = _tried(rows, i, printed[i], lay, keys, best_keys) + [whole]
             erratum = f"{r.short(lay)} reading"
             evidence = (f"differs from the physical layout: {diff0}. Reproduced exactly by the "
                         f"reading: {r.describe(lay)} (expand(alternative - printed) == 0).")
@@ -160,28 +163,43 @@ def audit_volumetric(eq: dict, geoms: tuple) -> tuple[list[Verdict], Reading]:
                 f"text extraction explain equally; what would decide: the page of the "
                 f"original PDF.")))
             continue
-        out.append(classify(v, "printing_error", evidence=v.evidence + (
-            " The residual is a well-formed wrong term, symbol or sign (no convention, "
-            "geometry or extraction damage explains it): a printing error."),
+        wrong = wrong_printed_terms(best_d[i], printed[i])
+        rep, repeated = repetition_note(
+            wrong, {COMPONENTS[j]: printed[j] for j in range(i)},
+            {COMPONENTS[j]: printed[j] for j in range(i + 1, len(COMPONENTS))})
+        if repeated:
+            v.readings_used = [f"glyph:{eq['id']} {c} repeats an earlier term"]
+            out.append(classify(v, "undecidable", evidence=v.evidence + rep + (
+                " Category undecidable."), alternative=fmt(best_d[i]) if best.cost() else ""))
+            continue
+        out.append(classify(v, "printing_error", evidence=v.evidence + rep + (
+            " The residual is no lost, repeated or confusable glyph but a well-formed term, "
+            "symbol or sign of the paper's notation (the axis letters X, Y, Z do not resemble "
+            "one another), which an extraction would have to invent; no convention or "
+            "geometry explains it: a printing error."),
             alternative=fmt(best_d[i]) if best.cost() else ""))
     return out, best
 
 
-def _tried(rows, i, printed, lay) -> list[str]:
+def _tried(rows, i, printed, lay, chosen=None, whole_keys=None) -> list[str]:
     """Readings tried for component ``i``: the physical layout, every single reading, and the
-    count of the combinations that reproduce it."""
+    minimal combinations that reproduce it (``chosen``: the keys the verdict rests on)."""
     out = []
     for r, d, ex, off in rows:
         if r.cost() > 1:
             continue
         what = r.describe(lay) if r.cost() else f"the physical layout ({_stacking(lay)})"
         out.append(f"{what}: " + ("exact" if ex[i] else f"{off[i]} term(s) differ"))
-    hits = sorted(((r.keys(lay)) for r, d, ex, _ in rows if ex[i]),
-                  key=lambda k: (RANK[category_of(k)], len(k), repr(k)))
-    shown = "; ".join(f"[{', '.join(k)}] -> {category_of(k)}" for k in hits[:4])
-    out.append(f"all {len(rows)} combinations of pivot x stacking x signs tried; {len(hits)} "
-               f"reproduce this component exactly" + (f": {shown}" + (" ..." if len(hits) > 4
-                                                                      else "") if hits else ""))
+    hits = [(r.keys(lay), None) for r, d, ex, _ in rows if ex[i]]
+    why = None
+    if whole_keys is not None:
+        def why(keys):
+            if set(keys) <= set(whole_keys):
+                return None
+            return ("the whole equation is read as one machine, and this combination is not "
+                    "part of the reading that reproduces the equation")
+    out.append(f"all {len(rows)} combinations of pivot x stacking x signs tried for this "
+               f"component; " + hits_text(hits, chosen, why=why))
     return out
 
 
@@ -198,7 +216,7 @@ def _reading_category(v: Verdict, r: Reading, keys, lay, alt, physical, geoms=()
     if r.tool is not None or r.work is not None:
         passage = geometry_text(geoms, r.stacking(lay))
         names.append(f"axes stacked {stacking_text(*r.stacking(lay))}: a geometry the text "
-                     f"allows (the layout file has {_stacking(lay)}; Pahk: {passage}); the "
+                     f"allows (the layout file has {_stacking(lay)}; the text: {passage}); the "
                      f"verdict rests on it")
     for f in r.flips:
         names.append(f"the errors of table {f} signed as the table's own motion"
@@ -306,7 +324,14 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
                         f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
                         f"up to {size:.2g} um ({typical_text()}, random angular errors "
                         f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, translational "
-                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma).")
+                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma). "
+                        f"Category simplification: Pahk states the quadrature formula (quoted "
+                        f"in 'statement'), not that it is applied term by term; the term-wise "
+                        f"form is how he applies it -- every printed random component of both "
+                        f"layouts that is not a copy (eq. 5 RX^2, RY^2, RZ^2 and eq. 8 RX^2, the "
+                        f"latter up to a lost glyph) is built so -- and it drops the correlation "
+                        f"of one parameter's two lever arms (Z and Zp above): an approximation "
+                        f"of the stated method, small at the typical machine.")
             v = classify(_verdict(eq, c, "differs", "term-wise quadrature drops cross terms",
                                   evidence + ocr, pr, exact),
                          "simplification", alternative=fmt(tw),
@@ -320,8 +345,10 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
             erratum = f"{c[:2]}^2 of {n} (eq. {random_eqs[n]}) reprinted"
             evidence = (f"differs from exact propagation: {diff0}; from the term-wise quadrature "
                         f"of {name}: {describe_diff(tw, pr)}. Reproduced exactly by {d}: a "
-                        f"copy of another layout's component (a whole well-formed component, "
-                        f"not extraction damage), no convention of {name}: a printing error.")
+                        f"whole component of another equation in place of this one's -- by "
+                        f"the cross-copy rule a substitution, which an extraction would have to "
+                        f"carry from one image into another; no convention of {name}: a "
+                        f"printing error.")
             v = classify(_verdict(eq, c, "differs", erratum, evidence + ocr, pr, exact),
                          "printing_error")
             v.readings_tried, v.readings_used = tried, list(hit[0])
@@ -371,7 +398,7 @@ def audit(printed: dict, layouts: list[str] | None = None) -> list[Verdict]:
         elif kind == "random":
             out.extend(audit_random(e, random_eqs))
         elif kind == "transfer":
-            out.extend(audit_transfer(e, vol_reading.get(name), _verdict, geoms[name]))
+            out.extend(audit_transfer(e, vol_reading.get(name), _verdict, geoms[name], eqs))
         elif kind == "chain":
             out.extend(audit_vectors(e, _verdict))
             out.extend(audit_chain(e, by_id, result_of.get(name), geoms[name],

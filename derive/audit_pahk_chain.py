@@ -344,7 +344,7 @@ def _convention(v: Verdict, r, lay, literal, physical, keys, geoms=()) -> Verdic
     if r.tool is not None or r.work is not None:
         from .audit_pahk_model import geometry_text, stacking_text
         names.append(f"axes stacked {stacking_text(*r.stacking(lay))} (a geometry the text "
-                     f"allows; Pahk: {geometry_text(geoms, r.stacking(lay))})")
+                     f"allows; the text: {geometry_text(geoms, r.stacking(lay))})")
     for f in r.flips:
         names.append(f"the errors of table {f} signed as the table's own motion"
                      if f in lay.axes else f"{f} signed the other way")

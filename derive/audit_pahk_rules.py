@@ -31,8 +31,8 @@ from volerr.machine.layout import SQUARENESS
 
 from . import volumetric as vol
 from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
-                    describe_diff, fmt, is_identical, n_issues, terms, typical_text,
-                    worst_case_um)
+                    describe_diff, fmt, hits_text, is_identical, n_issues, repetition_note,
+                    terms, typical_text, worst_case_um, wrong_printed_terms)
 from .audit_pahk_model import (OFFSETS, POS, P, flip_key, iso_error, layout, paper_map,
                                paper_name, parse, printed_component, stacking_text)
 from .kinematics import PROBE, parameter_symbol
@@ -46,12 +46,20 @@ RULE1 = ("Sec. 2.3, rule (1): \"한 축을 따라서의 오각도오차와 피�
          "진직도오차 값에 아베 오프셋을 통해서 영향을 준다.\" (the yaw and pitch errors of an "
          "axis act on its positional error through the Abbe offset; the roll error acts on "
          "its straightness errors through the Abbe offset); sec. 2.3.1: \"진직도오차들은 "
-         "롤오차와 이와 관련된 아베옵셋에 의해 영향받게 되며\" (straightness errors are "
+         "롤오차와 이와 관련된 아베옴셋에 의해 영향받게 되며\" (sic, '옴셋' for '옵셋', offset; "
+         "straightness errors are "
          "affected by the roll error and its Abbe offset)")
 
 CONVENTION_SQUARENESS = ("squareness as the slope of ONE axis' straightness line in the machine "
                          "frame (Pahk's definition), not ISO 230-1's angle between the two "
                          "reference lines")
+#: where Pahk defines the squareness symbols (the seed's text, quoted by the verdicts)
+SQUARENESS_DEFINITION = (
+    "Pahk defines the squareness symbols in the translation vectors of eq. (3) (used again by "
+    "eq. (6) and the appendix chains A1, A4, A7): 'Lx = [X + δx(X), δy(X) - αX, δz(X)]^T' -- "
+    "alpha is the slope, in y, of the X axis' line -- and 'Lz = [δx(Z) - β1 Z, δy(Z) - β2 Z, "
+    "Z + δz(Z)]^T' -- beta1 and beta2 are the slopes, in x and y, of the Z axis' line (eq. "
+    "(3) as extracted reads 'δx(Z) - Z', the appendix vectors print β1 Z)")
 CONVENTION_TABLE = ("table rotations pivot about the moving table origin (Pahk's chain form "
                     "Tx(Xa, Ya, Za)^T + Lx of eq. A1, A4, A7), not about the tool point")
 
@@ -248,10 +256,44 @@ def _bounds(expr) -> dict:
     return out
 
 
-def audit_transfer(eq: dict, vol_reading, verdict, geoms=()) -> list[Verdict]:
+def _same_symbol_elsewhere(all_eqs, eq, key, want) -> list[str]:
+    """Transfer equations of the other layouts that print the rule of ``key`` and satisfy
+    ``want(layout name, printed expression)``: ["MB1 eq. 9: alpha = alpha + Ez(Yo)", ...]."""
+    out = []
+    for e in all_eqs:
+        if e.get("kind") != "transfer" or e["layout"] == eq["layout"] or key not in e["expr"]:
+            continue
+        pr, _ = printed_component(e, key)
+        note = want(e["layout"], pr)
+        if note is not None:
+            out.append(f"{e['layout']} eq. {e['id']}: {key} = {e['expr'][key]}{note}")
+    return out
+
+
+def _line_support(all_eqs, eq, key, line) -> list[str]:
+    """Non-trivial prints of the same squareness symbol on other layouts that the same line
+    reading reproduces (with the tool-point or the table pivot)."""
+    def want(name, pr):
+        if pr == P(key):
+            return None
+        for pivot in ("tool_point", "table_origin"):
+            try:
+                d = derived_rule(name, key, RuleReading(pivot=pivot, line=line))
+            except (KeyError, ValueError):
+                return None
+            if is_identical(d, pr):
+                iso_too = is_identical(derived_rule(name, key), pr)
+                return (" (with the table pivot)" if pivot == "table_origin" else "") + \
+                    (" -- the two-line transfer gives it too" if iso_too else "")
+        return None
+    return _same_symbol_elsewhere(all_eqs, eq, key, want)
+
+
+def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list[Verdict]:
     """Verdicts on every rule of a transfer equation.  ``vol_reading``: the reading of the same
     layout's volumetric equation (its flips and stacking are the consistent ones);
-    ``verdict``: the Verdict factory of the provider."""
+    ``verdict``: the Verdict factory of the provider; ``all_eqs``: every printed equation
+    (for the prints of the same rule on the other layouts)."""
     name = eq["layout"]
     lay = layout(name)
     vol_flips = tuple(vol_reading.flips) if vol_reading is not None else ()
@@ -291,19 +333,50 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=()) -> list[Verdict]:
                         f"exactly by the reading: {r.describe(lay, iso, vf)} "
                         f"(expand(alternative - printed) == 0).")
             v = verdict(eq, key, "differs", erratum, evidence + ocr, pr, d0)
-            out.append(_rule_category(v, keys, r, lay, iso, d, d0, tried, geoms))
+            v = _rule_category(v, keys, r, lay, iso, d, d0, tried, geoms)
+            if pr == P(key) and r.line != "both" and v.category == "convention":
+                support = _line_support(all_eqs, eq, key, r.line)
+                v.evidence += (
+                    f" The print leaves {key} unchanged, which alone cannot tell this "
+                    f"convention from an omitted transfer; the same reading (the slope of the "
+                    f"{r.line} line) reproduces Pahk's non-trivial rules for {key} on the other "
+                    f"layouts: " + ("; ".join(support) if support else "none") + ".")
+            elif pr == P(key) and v.category == "undecidable":
+                same = _same_symbol_elsewhere(all_eqs, eq, key,
+                                              lambda n, p: "" if p == P(key) else None)
+                if same:
+                    v.evidence += (f" The same unchanged rule '{key} = {key}' is printed for "
+                                   f"{', '.join(x.split(':')[0] for x in same)} too: a "
+                                   f"pattern rather than a one-off misprint, which fits a "
+                                   f"set-up without these offsets or a rule applied without "
+                                   f"being stated; it does not decide between them.")
+            out.append(v)
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
         r = min(near, key=lambda x: (n_issues(derived_rule(name, key, x), pr),
                                      RANK[category_of(x.keys(lay, vf, geometry_key))],
                                      len(x.keys(lay, vf, geometry_key)), repr(x)))
         d = derived_rule(name, key, r)
+        keys_order = list(eq["expr"])
+        k = keys_order.index(key)
+        comps = {c: printed_component(eq, c)[0] for c in keys_order}
+        rep, repeated = repetition_note(
+            wrong_printed_terms(d, pr), {c: comps[c] for c in keys_order[:k]},
+            {c: comps[c] for c in keys_order[k + 1:]})
         evidence = (f"derived {key} = {fmt(d0)}; printed differs by: {diff0}. No reading "
                     f"reproduces it (all {len(rr)} combinations tried); closest: "
-                    f"{r.describe(lay, iso, vf)}, which leaves: {describe_diff(d, pr)}: "
-                    f"a well-formed wrong term or symbol, a printing error.")
-        v = classify(verdict(eq, key, "differs", erratum, evidence + ocr, pr, d0),
-                     "printing_error")
+                    f"{r.describe(lay, iso, vf)}, which leaves: {describe_diff(d, pr)}."
+                    + rep)
+        if repeated:
+            v = classify(verdict(eq, key, "differs", erratum, evidence + ocr
+                                 + " Category undecidable.", pr, d0), "undecidable")
+            v.readings_used = [f"glyph:{eq['id']} {key} repeats an earlier rule's term"]
+        else:
+            v = classify(verdict(eq, key, "differs", erratum, evidence + (
+                " The residual is no lost, repeated or confusable glyph but a well-formed "
+                "term or symbol of the paper's notation (the letters X, Y, Z do not resemble "
+                "one another), which an extraction would have to invent: a printing error.")
+                + ocr, pr, d0), "printing_error")
         v.readings_tried = tried
         out.append(v)
     return out
@@ -329,11 +402,10 @@ def _tried(name, key, rr, pr, lay, iso, vol_flips, geometry_key, hits) -> list[s
         k = n_issues(d, pr)
         out.append(f"{r.describe(lay, iso, vol_flips)}: "
                    + ("exact" if k == 0 else f"{k} term(s) differ ({describe_diff(d, pr, 2)})"))
-    ranked = sorted(hits, key=lambda h: (RANK[category_of(h[0])], len(h[0]), repr(h[0])))
-    shown = "; ".join(f"[{', '.join(h[0])}] -> {category_of(h[0])}" for h in ranked[:4])
+    best = best_combination(hits)
     out.append(f"all {len(rr)} combinations of pivot, stacking, signs, rule (1), squareness line "
-               f"and zero offsets tried; {len(hits)} reproduce the print exactly"
-               + (f": {shown}" + (" ..." if len(hits) > 4 else "") if hits else ""))
+               f"and zero offsets tried; "
+               + hits_text(hits, best[0] if best is not None else None))
     return out
 
 
@@ -360,6 +432,7 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
             f"omitted otherwise: {fmt(dropped)}{where}."), **fields)
     if cat == "simplification":
         extra = [k for k in keys if k != "rule1"]
+        fields["erratum"] = f"Abbe term(s) {fmt(dropped)} dropped by Pahk's rule (1)"
         return classify(v, "simplification", statement=RULE1 + (
             ("; with " + "; ".join(extra)) if extra else ""),
             evidence=v.evidence + f" Terms dropped by the stated rule: {fmt(dropped)}{where}.",
@@ -367,6 +440,7 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
     names = []
     if r.line != "both":
         names.append(CONVENTION_SQUARENESS)
+        v.evidence += " " + SQUARENESS_DEFINITION + "."
         ang = sum(abs(float(c)) for c in sp.Poly(dropped, *dropped.free_symbols).coeffs()) \
             if dropped != 0 else 0.0
         v.evidence += (f" The two definitions differ by {fmt(dropped)} (up to "
@@ -377,9 +451,17 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
     if r.tool is not None or r.work is not None:
         from .audit_pahk_model import geometry_text
         names.append(f"axes stacked {stacking_text(r.tool, r.work)}, the geometry of the "
-                     f"layout's volumetric equation, which the text allows (Pahk: "
+                     f"layout's volumetric equation, which the text allows (the text: "
                      f"{geometry_text(geoms, (r.tool, r.work))})")
     for f in r.flips:
         names.append(f"{paper_name(lay, f) if f not in lay.axes else 'table ' + f} signed as in "
                      f"the volumetric equation")
-    return classify(v, "convention", statement="; ".join(names), **fields)
+    short = {"both": ""}.get(r.line, f"squareness as the slope of the {r.line} line")
+    parts = [x for x in (short, "table errors about the moving table origin"
+                         if r.pivot == "table_origin" else "",
+                         "the axis stacking of the volumetric equation"
+                         if (r.tool is not None or r.work is not None) else "") if x]
+    return classify(v, "convention", statement="; ".join(names),
+                    erratum=f"reads as {'; '.join(parts) or 'a sign convention'} (the "
+                            f"two-line ISO 230-1 transfer minus the print: {fmt(dropped)})",
+                    **fields)

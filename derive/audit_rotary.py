@@ -94,8 +94,10 @@ def audit_linear(item: dict) -> list[Verdict]:
                   "Category printing_error: left- and right-hand side disagree within the "
                   "equation, no convention reconciles them; the specialization project's eq. "
                   "(23) (appendix B, typeset separately) prints the same model as the deviation "
-                  "matrix (zero diagonal, no nominal x, zero bottom row), so the thesis' "
-                  "version is the author's edit, not extraction damage",
+                  "matrix (zero diagonal, no nominal x, zero bottom row); the thesis' matrix "
+                  "differs from it in five entries at once (the three 1s of the diagonal, the "
+                  "'+ x' and the bottom 1), all consistently those of the X axis' HTM, which ch. 3.3.2 prints with exactly these entries: "
+                  "another well-formed matrix, not glyph damage, so the author's edit",
                   "Delta = T p", "Delta = (T - T_nominal) p"))
     out[-1].readings_tried = ["the printed matrix times p, literally: the moved point (row 1 "
                               "holds x + xx, row 4 reads 0 = 1)",
@@ -160,9 +162,12 @@ def audit_rotary(item: dict) -> list[Verdict]:
     out.append(_v(eq, "error matrix", not bad, "-E_XC printed where -E_AC belongs" if hint else
                   "; ".join(bad), "derived (T_ES - I) Rz(C), first order: "
                   + ("all entries of the first three rows agree" if not bad else "; ".join(bad))
-                  + hint + (" Category printing_error: the conference paper's B-axis matrix "
-                            "eq. 1.17, typeset separately, has -E_XB at the same entry (2,3): "
-                            "the author's source, not extraction damage" if hint else ""),
+                  + hint + (" Category printing_error by the cross-copy rule: the "
+                            "conference paper's B-axis matrix eq. 1.17, typeset separately, has "
+                            "-E_XB at the same entry (2,3), while both matrices read the "
+                            "rotation E_A right in their row 3 (E_AC here, E_AB there): a "
+                            "substitution the extraction would have to make identically in two "
+                            "images; the author's source" if hint else ""),
                   str(item["error_matrix"]), fmt(dev)))
     if hint:
         out[-1].readings_tried = ["(T_ES - I) Rz(C), derived: entry (2,3) is -E_AC",
@@ -174,9 +179,12 @@ def audit_rotary(item: dict) -> list[Verdict]:
     out.append(_v(eq, "error matrix row 4", ok4, "bottom row 0 0 0 1 under a left-hand side 0",
                   f"the printed bottom row [{', '.join(row4)}] times [x_C, y_C, z_C, 1] gives 1, "
                   "the left-hand side says 0; a deviation matrix has the bottom row 0 0 0 0 "
-                  "(the product T_ES T_CC minus T_CC). Category printing_error: the equation "
-                  "contradicts itself, and the conference paper's eq. 1.17 (typeset separately) "
-                  "has the same bottom row 0 0 0 1: the author's source, not extraction damage",
+                  "(the product T_ES T_CC minus T_CC). Category printing_error by the "
+                  "cross-copy rule: the equation contradicts itself, and the conference paper's "
+                  "eq. 1.17 (typeset separately) has the same bottom row 0 0 0 1 -- a '1' for a "
+                  "'0' at the same place in two images, while the extraction reads the zero "
+                  "bottom row '0 & 0 & 0 & 0' of the deviation matrix of the specialization "
+                  "project's eq. (23) right: the author's source",
                   str(row4), "[0, 0, 0, 0]"))
     if not ok4:
         out[-1].readings_tried = ["deviation matrix (T_ES - I) Rz(C): bottom row 0 0 0 0",

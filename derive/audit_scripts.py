@@ -82,6 +82,12 @@ def _paren(expr: str) -> str:
     return expr
 
 
+def _line_span(terms) -> str:
+    """'lines 197-220': the listing lines of a formula's legible terms."""
+    nums = [int(x) for t in terms for x in str(t["line"]).split("-") if x.strip().isdigit()]
+    return f"lines {min(nums)}-{max(nums)}" if nums else "its lines"
+
+
 def audit_c1(c1: dict) -> list[Verdict]:
     loc = _c1_locals("x")
     cf = closed_form("x")
@@ -121,13 +127,20 @@ def audit_c1(c1: dict) -> list[Verdict]:
                 bad.append(f"line {t['line']}: {t['cofactor']} matches no remaining cofactor")
         factor = c1["factors"][name]
         unit = "* 1e3" if motion in ("EX", "EY", "EZ") else "* 1e6"
+        n_is = ("the derived determinant" if n_sign == 1 else "minus the derived determinant"
+                if n_sign == -1 else "not the determinant")
+        span = _line_span(terms)
+        n_where = (f"every term of the six formulas has its own '/(...)' denominator; the one "
+                   f"legible in full is that of E_XX's last term (lines 86-89), which, read "
+                   f"with its repairs, is {n_is} (15 monomials); the other denominators"
+                   + (f" of {name} ({span})" if name != "E_XX" else " of E_XX") +
+                   " are damaged by the extraction (debris, repeated spans) and were not "
+                   "compared one by one -- their legible starts read as N's first monomials")
         tried = [f"Cramer's rule on eq. 32 (the derived cofactor of each deviation over N): "
                  f"{len(checked)} legible terms compared, {len(bad)} differ",
-                 f"the denominator N (lines 86-89, read with its repairs): "
-                 f"{'the derived determinant' if n_sign == 1 else 'minus the derived determinant' if n_sign == -1 else 'not the determinant'}"]
+                 f"the denominator: {n_where}"]
         ev = (f"{name} = sum of cofactor * deviation / N, the solution of the selected system of "
-              f"eq. 32 by Cramer's rule (derive.three_point.closed_form); the printed N is the "
-              f"derived determinant (15 monomials) once the extraction debris is removed. "
+              f"eq. 32 by Cramer's rule (derive.three_point.closed_form); {n_where}. "
               f"Legible terms: " + "; ".join(checked + bad) + ". "
               + (f"Not comparable: {'; '.join(damaged)}. " if damaged else "")
               + f"Unit factor {factor} ({'mm to um' if unit == '* 1e3' else 'rad to urad'}"

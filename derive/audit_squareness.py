@@ -140,7 +140,10 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         tried = [f"{_label(sign)}: {u['term']} " + ("= " if r[u['id']] else "!= ") + u["eq"]
                  for sign, r in results]
         right = [sign for sign, r in best if r[u["id"]]]
-        base = (f"the entry {u['entry']} of Listing 3.4, '{u['term']}', run with the angles of "
+        raw = u.get("raw", u["term"])
+        shown = (f"'{u['term']}'" + (f" (extraction text of the line: '{raw}')"
+                                     if raw != u["term"] else ""))
+        base = (f"the entry {u['entry']} of Listing 3.4, {shown}, run with the angles of "
                 f"Listing 3.1 and the sum of Listing 3.2 on lines of known slopes, against "
                 f"{u['eq']} with the X axis as datum (the entry must put back q (k_ab + k_ba), "
                 f"the slope-signed squareness eq. 3.11/3.13 define). Travel directions that "

@@ -28,6 +28,7 @@ the erratum.  Identities of rational functions are decided by exact rational eva
 from __future__ import annotations
 
 import random
+import re
 from functools import lru_cache
 
 import sympy as sp
@@ -134,23 +135,103 @@ def _closed(selection: str) -> dict:
     return closed_form(selection)
 
 
-#: why a wrong unknown vector is extraction damage, not a printing error
-EXTRACTION_SUBSCRIPTS = (
-    " Category extraction: the printed coefficient columns are right and only the vector's "
-    "entries are wrong; every unknown vector of the thesis is damaged at its middle entries, "
-    "each differently (E_BX twice and E_XX for E_ZX in eq. 31; E_BX twice in eq. 32; E_AY lost "
-    "in eq. 35 and 36; E_YZ lost in eq. 37; E_BC twice in eq. 3.5; E_ZC lost and E_BC twice "
-    "in eq. 3.6), so the defects are not one typo copied from vector to vector, while the "
-    "matrix rows beside them are extracted correctly; and this extraction demonstrably "
-    "repeats a token where the print has another: appendix B sec. 2.4 reads '(E_AX, E_BX, "
-    "E_BX) E_CX' where the parallel list before it reads '(E_XX, E_YX, and E_ZX)'.")
+#: the extraction's demonstrated repetitions and losses within one image (quoted by verdicts)
+EXTRACTION_REPEATS = (
+    "appendix B sec. 2.4 lists the three rotational errors as '(E_AX, E_BX, E_BX) E_CX'; "
+    "the error matrix of T_0^{t,c} after thesis eq. 3.37 has five rows, three of them "
+    "'-E_{DX} & ... & 1 & E_{ZX}' (D names no axis)")
+EXTRACTION_LOSSES = (
+    "in the chain after thesis eq. 3.37 T_2^{3,c} has three rows (its row '0 & 0 & 1 & 0' "
+    "lost) and the bottom row of the Y axis' error matrix reads '0 & 0 & 0'")
+
+
+def _letters(unknowns) -> list[str]:
+    return [u[1] for u in unknowns]
+
+
+def _vector_defects(got: list, want: list) -> str:
+    """'E_BX (the 5th entry's) for E_AX in the 4th entry' ... or 'E_AY lost' (in words)."""
+    name = lambda u: f"E_{u[1:]}"  # noqa: E731
+    if len(got) == len(want):
+        parts = []
+        for k, (g, w) in enumerate(zip(got, want)):
+            if g != w:
+                again = [j + 1 for j, x in enumerate(got) if x == g and j != k]
+                parts.append(f"{name(g)} for {name(w)} in the {_ordinal(k + 1)} entry"
+                             + (f" (a repeat of the {_ordinal(again[0])} entry)"
+                                if again else ""))
+        return "; ".join(parts) + ": a repeated token and the entry it displaces lost"
+    lost = [w for w in want if w not in got]
+    return (f"{', '.join(name(w) for w in lost)} lost ({len(got)} entries for {len(want)} "
+            f"columns, the others in order): a lost entry")
+
+
+def _ordinal(k: int) -> str:
+    return {1: "1st", 2: "2nd", 3: "3rd"}.get(k, f"{k}th")
+
+
+def _vector_evidence(eq: dict, others: dict) -> str:
+    """Why a wrong unknown vector is undecidable: its own defect, the same defect elsewhere
+    (cross-copy rule) and the extraction's record, and what would decide."""
+    axis = eq["axis"]
+    got, want = list(eq["unknowns"]), [m + axis for m in MOTIONS]
+    mine = _letters(got)
+    same = [o for o, info in others.items() if o != eq["id"] and info.get("unknowns")
+            and _letters(info["unknowns"]) == mine]
+    fourth_b = [o for o, info in others.items() if info.get("unknowns")
+                and len(info["unknowns"]) == 6 and _letters(info["unknowns"])[3] == "B"]
+    repeat = len(got) == len(want)
+    out = (f" Its defect: {_vector_defects(got, want)}."
+           + (f" The same entries are printed in eq. {', '.join(same)}." if same else ""))
+    out += " Category undecidable: print or extraction, and the text decides neither. For the "
+    out += "print (a vector copied in the author's source): "
+    if repeat and mine[3] == "B":
+        out += (f"E_B stands in the 4th entry, where E_A belongs, in all {len(fourth_b)} "
+                f"six-entry vectors (eq. {', '.join(fourth_b)}: the specialization project and "
+                f"the thesis, separately typeset) -- the same defect at the same place. ")
+    elif same:
+        out += f"the same defect at the same place in eq. {', '.join(same)}. "
+    else:
+        out += "a slip while typing the vector. "
+    out += ("For the extraction: " + ("a repeated token is damage it demonstrably does within "
+                                       "one image (" + EXTRACTION_REPEATS + ")" if repeat else
+                                       "it demonstrably loses entries and rows within one "
+                                       "image (" + EXTRACTION_LOSSES + ")")
+            + ", and a failure driven by the image recurs at the same place in vector images "
+              "of the same layout; by the cross-copy rule (docs/formats.md, audit) a "
+              "repetition or a loss at the same place does not decide. What would decide: the "
+              "pages of the original PDF.")
+    return out
+
+
+#: why a repeated coefficient row is undecidable (print or extraction), by the cross-copy rule
+UNDECIDABLE_ROW = (
+    " Category undecidable: a row repeated within one image, which the print and the "
+    "extraction explain equally. For the print (a matrix copied in the author's source): the "
+    "specialization project repeats the same row K y at the same place in eq. 31 (X axis) and "
+    "eq. 35 (Y axis). For the extraction: it demonstrably repeats matrix rows within an image "
+    "(the error matrix of T_0^{t,c} after thesis eq. 3.37 has five rows, three of them "
+    "'-E_{DX} & ... & 1 & E_{ZX}' and two of these identical, with the letter D that names no "
+    "axis), and eq. 31 and 35 are images of the same layout (they differ only in the "
+    "subscripts x and y), so a repetition driven by the image recurs at the same place; by the "
+    "cross-copy rule a repetition at the same place does not decide. The thesis' eq. 3.5 (the "
+    "same nine rows for the C axis, other symbols) has no repeated row, which decides "
+    "neither. What would decide: the page of the original PDF.")
 UNDECIDABLE_ENTRIES = (
-    " Category undecidable: lost, repeated or garbled entries of a column vector look the same "
-    "whether the print or the OCR lost them; missing to decide: the page of the original PDF.")
+    ". Category undecidable: lost, repeated or merged entries of a column vector, which the "
+    "print (a line of the column typed wrong, left out or typed twice) and the extraction "
+    "explain equally -- this extraction demonstrably repeats and loses entries within one "
+    "image (" + EXTRACTION_REPEATS + "; " + EXTRACTION_LOSSES + "); what would decide: the "
+    "page of the original PDF.")
 UNDECIDABLE_N = (
-    " Category undecidable: a '-' between two bracketed triple products is lost; the OCR "
-    "extraction of this text also loses operators, and the appendix prints the same determinant "
-    "with its minus (eq. 33-34); missing to decide: the page of the original PDF.")
+    " Category undecidable: a '-' between two bracketed triple products is lost (the printed "
+    "N is one product of six factors). For the print: a sign left out while typing. For the "
+    "extraction: it damages operators in this document (Listing 3.1 reads 'if degree = 1:', "
+    "a Python syntax error, where the copy of the same code in the appendix reads 'if degree "
+    "== 1:'). The specialization project prints the same determinant with its minus (eq. 34, "
+    "'N = (x_{xK} - x_{xQ})(y_{xP} - y_{xQ})(z_{xP} - z_{xK}) - (x_{xK} - x_{xP})...'): the "
+    "defect stands in one copy only, so the cross-copy rule does not decide it; missing to "
+    "decide: the page of the original PDF.")
 
 
 def _verdict(eq, comp, ok, erratum, evidence, printed, derived,
@@ -216,6 +297,65 @@ def audit_displacement(eq: dict) -> list[Verdict]:
     return out
 
 
+# ------------------------------------------------------------------ the raw extraction text
+_BMATRIX = re.compile(r"\\begin\{bmatrix\}(.*?)\\end\{bmatrix\}", re.S)
+_X_SUBSCRIPT = re.compile(r"\\hat\{[xy]\}_\{x[PQK]\}")
+
+
+def _raw_blocks(eq: dict) -> list[list[str]]:
+    """The rows (raw LaTeX, stripped) of every bmatrix of the equation's extraction text."""
+    return [[r.strip() for r in body.split("\\\\")]
+            for body in _BMATRIX.findall(eq.get("text", ""))]
+
+
+def _raw_matrix(eq: dict) -> list[str]:
+    blocks = _raw_blocks(eq)
+    return blocks[0] if blocks else []
+
+
+def _raw_vector(eq: dict) -> str:
+    blocks = _raw_blocks(eq)
+    return ", ".join(blocks[1]) if len(blocks) > 1 else ""
+
+
+def wrong_subscripts(eq: dict) -> list[tuple[str, int, str]]:
+    """Lever arms of a rotary system printed with the X axis' subscript (``\\hat{x}_{xP}``
+    where the C axis' ``\\hat{x}_{CP}`` belongs): (row label, column 1..6, raw entry).  The
+    data file's rows read them with C (its symbol mapping); this reads the raw text."""
+    if eq.get("axis") not in ("A", "B", "C"):
+        return []
+    out = []
+    for (lab, _), raw in zip(eq["rows"], _raw_matrix(eq)):
+        for j, cell in enumerate(raw.split("&"), start=1):
+            if _X_SUBSCRIPT.search(cell):
+                out.append((lab, j, cell.strip()))
+    return out
+
+
+def _pair_note(eq: dict, wrong) -> str:
+    """' ('\\hat{x}_{CK}' (row Ky) and '\\hat{x}_{xK}' (row Kz) stand in one matrix)' for the
+    first wrong lever arm whose C-subscripted form is printed in the same matrix."""
+    cells = [(lab, c.strip()) for (lab, _), raw in zip(eq["rows"], _raw_matrix(eq))
+             for c in raw.split("&")]
+    for lab, _, text in wrong:
+        m = re.search(r"\\hat\{([xy])\}_\{x([PQK])\}", text)
+        right = f"\\hat{{{m.group(1)}}}_{{C{m.group(2)}}}"
+        hit = next((lb for lb, c in cells if right in c), None)
+        if hit:
+            return (f" ('{right}' in row {hit} and '{m.group(0)}' in row {lab} stand in one "
+                    f"matrix)")
+    return ""
+
+
+def _same_places(wrong, other_labels, other_wrong, labels) -> bool:
+    """Whether another system's wrong subscripts stand at exactly the same entries as
+    ``wrong`` in every row the two systems share (and there is at least one)."""
+    shared = set(labels) & set(other_labels)
+    mine = {(lab, j) for lab, j, _ in wrong if lab in shared}
+    theirs = {(lab, j) for lab, j, _ in other_wrong if lab in shared}
+    return bool(mine) and mine == theirs
+
+
 # ------------------------------------------------------------------------------- systems
 def _derived_rows(axis: str, rotated: bool) -> dict:
     A, rows = system(LABELS)
@@ -231,7 +371,10 @@ def _derived_rows(axis: str, rotated: bool) -> dict:
     return {f"{lab}{c}": list(A.row(i)) for i, (lab, c) in enumerate(rows)}
 
 
-def audit_system(eq: dict) -> list[Verdict]:
+def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
+    """Verdicts on a printed system; ``others``: equation id -> {"labels": row labels,
+    "wrong": lever arms with the X axis' subscript (:func:`wrong_subscripts`), "unknowns":
+    the printed unknown vector} of every printed system, for the cross-copy rule."""
     axis = eq["axis"]
     rotated = axis in "ABC"
     derived = _derived_rows(axis, rotated)
@@ -264,27 +407,63 @@ def audit_system(eq: dict) -> list[Verdict]:
         sel_note = (f" The selected 6 x 6 system has determinant N = {fmt(sp.factor(det))} "
                     f"(rotated coordinates for a rotary axis): it is singular whenever N = 0, "
                     f"even for non-collinear points (e.g. all points at one height z).")
-    dup_note = ""
+    raw = _raw_matrix(eq)
+    wrong = wrong_subscripts(eq)
+    note, tried, used, category = "", [], [], "printing_error"
     if dup and not bad_rows:
-        dup_note = (" Category printing_error: the row K y is repeated at the same place in "
-                    "eq. 31 and eq. 35, two matrices with different symbols (different "
-                    "images), while the thesis' own 9-row matrix of eq. 3.5, of the same shape, "
-                    "is extracted without a repeated row: the repetition follows the project "
-                    "report's source (a copied matrix), not the extraction.")
+        rep = [r for k, r in enumerate(raw) if k and r == raw[k - 1]]
+        note = (f" The repeated row reads '{rep[0]}' twice in a row; the right-hand side "
+                f"has the {len(set(labels))} entries of the {len(set(labels))} equations, once "
+                f"each." if rep else "") + UNDECIDABLE_ROW
+        category = "undecidable"
+        tried = ["every printed row against the derived row its right-hand side names: "
+                 "row(s) " + ", ".join(d[0] + " " + d[1] for d in dup) + " printed twice",
+                 "a row repeated by the print (a copied matrix) or by the extraction (a "
+                 "repeated span): the derived system once the repeated row is read once"]
+        used = [f"glyph:eq. {eq['id']} repeated row " + ", ".join(d[0] + " " + d[1]
+                                                                  for d in dup)]
+    elif wrong and not problems:
+        problems.append(f"{len(wrong)} lever arms printed with the X axis' subscript x where "
+                        f"the C axis' C belongs: " + ", ".join(
+                            f"row {lab} column {j}: '{text}'" for lab, j, text in wrong))
+        same_in = [other for other, info in (others or {}).items()
+                   if other != eq["id"] and _same_places(wrong, info["labels"], info["wrong"],
+                                                         labels)]
+        note = (
+            f" Read with C, every coefficient is the derived one (the rotated lever arms "
+            f"x^_Ci = x_Ci cos C - y_Ci sin C, y^_Ci = y_Ci cos C + x_Ci sin C the thesis "
+            f"defines under eq. 3.5); the other hatted lever arms of this matrix carry C."
+            + (f" Category printing_error by the cross-copy rule: eq. "
+               f"{', '.join(same_in)} prints the x at exactly the same entries of the rows it "
+               f"shares (two images), a substitution an extraction would have to invent "
+               f"identically in both while reading C in the other entries of the same form"
+               f"{_pair_note(eq, wrong)}; the "
+               f"author's source explains it: the C-axis system adapted from the X-axis "
+               f"system of the specialization project (eq. 31 and 32 print x_{{xP}}, "
+               f"y_{{xQ}} ... at these places) with some subscripts left unchanged."
+               if same_in else
+               " Category printing_error: a well-formed lever arm of another axis' "
+               "system (the X axis' subscript of eq. 31-32)."))
+        tried = ["every printed row against the derived row its right-hand side names, the "
+                 "lever arms read as printed: " + f"{len(wrong)} entries name the X axis' "
+                 f"lever arms", "the entries read with the C axis' subscript: every row the "
+                 "derived one"]
+        used = [f"copy:eq. {eq['id']} lever arms of the X-axis system"]
     out.append(_verdict(eq, "coefficient matrix", not problems,
                         "; ".join(problems[:3]) if problems else "",
                         ("every printed row equals the derived row of the equation its "
                          "right-hand side names" if not problems else
-                         "compared row by row with the derived system: " + "; ".join(problems))
-                        + sel_note + dup_note,
-                        f"{len(rows)} rows", f"{expect_n} rows"))
+                         "compared row by row with the derived system: " + "; ".join(problems)
+                         + ".")
+                        + sel_note + note,
+                        f"{len(rows)} rows" if not wrong else
+                        f"{len(rows)} rows; " + "; ".join(f"{lab} column {j}: {text}"
+                                                         for lab, j, text in wrong),
+                        f"{expect_n} rows", category=category))
     if problems:
-        out[-1].readings_tried = ["every printed row against the derived row its right-hand "
-                                  "side names", "a row repeated by the extraction: not seen "
-                                  "in the 9-row matrix of eq. 3.5, and repeated at the same "
-                                  "place in eq. 31 and 35"] if dup else \
-            ["every printed row against the derived row its right-hand side names"]
-        out[-1].readings_used = ["copy:project report matrix row K y"] if dup else []
+        out[-1].readings_tried = tried or ["every printed row against the derived row its "
+                                           "right-hand side names"]
+        out[-1].readings_used = used
     want_u = [m + axis for m in MOTIONS]
     got_u = list(eq["unknowns"])
     if got_u == want_u:
@@ -300,14 +479,20 @@ def audit_system(eq: dict) -> list[Verdict]:
             parts.append(f"{', '.join(twice)} listed twice")
         if len(got_u) != 6:
             parts.append(f"{len(got_u)} unknowns for 6 columns")
+        vec = _raw_vector(eq)
         out.append(_verdict(eq, "unknown vector", False, "; ".join(parts),
-                            "the six columns multiply E_X ... E_C of the axis in this order; "
-                            "the printed vector mislabels them." + EXTRACTION_SUBSCRIPTS,
-                            ", ".join(got_u), ", ".join(want_u), category="extraction"))
+                            "the six columns multiply E_X ... E_C of the axis in this order "
+                            "(every coefficient column is the derived one, read with the "
+                            "subscripts of the axis: see the verdict on the coefficient "
+                            "matrix); the printed vector"
+                            + (f" [{vec}]" if vec else "") + " mislabels them: "
+                            + "; ".join(parts) + "." + _vector_evidence(eq, others or {}),
+                            ", ".join(got_u), ", ".join(want_u), category="undecidable"))
         out[-1].readings_tried = ["the vector as printed: " + "; ".join(parts),
-                                  "the vector the six columns multiply (E_X ... E_C of the "
-                                  "axis): exact once the damaged entries are read so"]
-        out[-1].readings_used = [f"ocr:eq. {eq['id']} unknown vector"]
+                                  "entries repeated or lost by the print (a copied vector) or "
+                                  "by the extraction (a repeated token): the vector the six "
+                                  "columns multiply (E_X ... E_C of the axis)"]
+        out[-1].readings_used = [f"glyph:eq. {eq['id']} unknown vector"]
     # right-hand side: which equation does each printed entry belong to?
     rhs = eq.get("rhs", [])
     distinct = list(dict.fromkeys(labels))
@@ -357,13 +542,34 @@ def audit_system(eq: dict) -> list[Verdict]:
 
 
 # --------------------------------------------------------------------------- closed forms
+def raw_line(eq: dict, motion: str) -> str:
+    """The extraction's line of ``motion`` (``EY`` -> the line 'E_{YX}(x) = ...') in the
+    equation's text, "" if not found."""
+    head = f"E_{{{motion[1]}{eq['axis']}}}("
+    for line in eq.get("text", "").splitlines():
+        if line.strip().startswith(head):
+            return line.strip()
+    return ""
+
+
 def _printed_solution(eq: dict, motion: str, use_ocr: bool = True) -> tuple[sp.Expr, str]:
     axis = eq["axis"]
     text = eq["expr"][motion]
     note = ""
     if use_ocr and motion in eq.get("ocr", {}):
-        note = f" OCR text {text!r} read as {eq['ocr'][motion]!r} (a subscript swallowed the " \
-               f"multiplied factor)."
+        raw = raw_line(eq, motion)
+        scoped = re.findall(r"z_\{x[PQK]\([^{}]*(?:\{[^{}]*\}[^{}]*)*\)\}", raw)
+        others = [f"{m}{axis}: '{f}'" for m in eq.get("ocr", {}) if m != motion
+                  for f in re.findall(r"z_\{x[PQK]\([^{}]*(?:\{[^{}]*\}[^{}]*)*\)\}",
+                                      raw_line(eq, m))]
+        note = (f" The extraction text of the line is '{raw}': "
+                + (f"the subscript {scoped[0][2:]!s} of z holds the factor that multiplies "
+                   f"z, i.e. the printed formula reads z indexed by an expression, which no "
+                   f"formula of the document's notation does" if scoped else
+                   "a subscript swallowed the multiplied factor")
+                + f"; transcribed {text!r} and read as {eq['ocr'][motion]!r}"
+                + (f"; the same scope defect stands in the line of {', '.join(others)}"
+                   if others else "") + ".")
         text = eq["ocr"][motion]
     expr = parse(text, axis)
     define = {S(k): parse(v, axis) for k, v in eq.get("define", {}).items()}
@@ -499,6 +705,8 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                    if eq.get("variables") == "raw" else "") + "." + note,
                                 eq["expr"][motion], sp.factor(derived)))
             if note:
+                out[-1].evidence = "With the reading below: " + out[-1].evidence
+                out[-1].printed = raw_line(eq, motion) or out[-1].printed
                 out[-1].category = "undecidable"
                 out[-1].verdict = "differs"
                 out[-1].erratum = "factor typeset as part of a subscript"
@@ -544,10 +752,12 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                 "N read with its minus sign restored: exact"]
             v.readings_used = ["glyph:eq. 3.8 N lost minus"]
         elif errs and " printed for " in errs[0]:
-            v.evidence += (" Category printing_error: another valid symbol of the formula (two "
-                           "of its letters differ) in place of the right one, which a text "
-                           "extraction does not produce; the project report's eq. 33 prints the "
-                           "same solution for the X axis with the right symbol.")
+            v.evidence += (" Category printing_error: another well-formed symbol of the "
+                           "formula in place of the right one -- two letters differ, not a "
+                           "lost, repeated or confusable glyph -- which an extraction would have "
+                           "to invent, while it reads the same symbols right elsewhere in this "
+                           "formula; the project report's eq. 33 prints the same solution for "
+                           "the X axis with the right symbol.")
             v.readings_tried = ["the printed solution with N read as the determinant: differs",
                                 f"one lever-arm symbol read as another: {errs[0]} reproduces "
                                 f"it exactly"]
@@ -581,12 +791,15 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
     if layouts is not None and not (set(layouts) & set(LAYOUTS)):
         return []
     out = []
+    systems = {eq["id"]: {"labels": [lab for lab, _ in eq["rows"]],
+                          "wrong": wrong_subscripts(eq), "unknowns": eq["unknowns"]}
+               for eq in printed.get("equation", []) if eq["kind"] == "system"}
     for eq in printed.get("equation", []):
         kind = eq["kind"]
         if kind == "displacement":
             out.extend(audit_displacement(eq))
         elif kind == "system":
-            out.extend(audit_system(eq))
+            out.extend(audit_system(eq, systems))
         elif kind == "closed_form":
             out.extend(audit_closed_form(eq))
         elif kind == "denominator":

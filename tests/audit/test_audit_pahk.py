@@ -73,7 +73,9 @@ def test_transfer_rule_omissions_named(verdicts):
     v = find(verdicts, "9", "dy(Y)")
     assert "Ez(Z) for Ez(Y)" in v.erratum
     v = find(verdicts, "9", "beta1")
-    assert "extra term +Ey(Y)" in v.erratum
+    # a convention: the erratum names the reading, the evidence the extra term it explains
+    assert "slope of the Z line" in v.erratum and "-Ey(Y)" in v.erratum
+    assert "extra +Ey(Y)" in v.evidence
     assert "slope of the Z line alone" in v.evidence
     # Pahk's rule (1) (straightness by roll only) reproduces the printed dy(X) rule
     assert "roll Ex(X) only" in find(verdicts, "9", "dy(X)").evidence
@@ -269,3 +271,64 @@ def test_literal_eq3_lz_without_ocr_reading_is_not_a_valid_chain():
     v = find(audit_pahk.audit(data, ["MB1"]), "1")
     assert v.verdict == "differs" and "cannot be evaluated" in v.erratum
     assert "nominal point" in v.evidence
+
+
+# ------------------------------------------------- squareness as one line's slope (Pahk eq. 3)
+def _first_order(expr, errs):
+    import sympy as sp
+    eps = sp.Symbol("eps")
+    e = sp.expand(expr.subs({s: eps * s for s in errs}, simultaneous=True))
+    return sp.expand(e.coeff(eps, 0) + e.coeff(eps, 1))
+
+
+def test_trivial_alpha_rule_is_the_x_line_slope_on_mh2_and_mb1(verdicts):
+    """Pahk eq. 3: Lx = [X + dx(X), dy(X) - alpha X, dz(X)], so alpha is minus the slope of the
+    X line in y.  Written here from the chains of eq. 1 (MB1) and eq. 6 (MH2): the apparent
+    alpha measured on the X line (-d dY/dX, the angular errors constants at the measuring
+    position) minus the true one is the shift the rule removes.  MH2: no shift (the printed
+    'alpha = alpha'); MB1: -Ez(Y) (the printed 'alpha = alpha + Ez(Yo)').  The MH2 verdict is a
+    convention and must say that the same reading reproduces MB1's non-trivial rule."""
+    import sympy as sp
+    S = lambda n: sp.Symbol(n, real=True)  # noqa: E731
+    X, Y, Z, alpha = S("X"), S("Y"), S("Z"), S("alpha")
+
+    def T(a):
+        ex, ey, ez = (S(f"E{c}({a})") for c in "xyz")
+        return sp.Matrix([[1, -ez, ey], [ez, 1, -ex], [-ey, ex, 1]])
+    d = {f"d{c}({a})": S(f"d{c}({a})") for c in "xyz" for a in "XYZ"}
+    Lx = sp.Matrix([X + d["dx(X)"], d["dy(X)"] - alpha * X, d["dz(X)"]])
+    Ly = sp.Matrix([d["dx(Y)"], Y + d["dy(Y)"], d["dz(Y)"]])
+    Lz = sp.Matrix([d["dx(Z)"] - S("beta1") * Z, d["dy(Z)"] - S("beta2") * Z, Z + d["dz(Z)"]])
+    P = sp.zeros(3, 1)
+    chains = {"MB1": T("Y") * (T("X") * (T("Z") * P + Lz) + Lx) + Ly,
+              "MH2": T("X") * (T("Z") * (T("Y") * P + Ly) + Lz) + Lx}
+    errs = [s for s in chains["MB1"].free_symbols if "(" in s.name] + [alpha, S("beta1"),
+                                                                         S("beta2")]
+    shift = {}
+    for name, A in chains.items():
+        dY = _first_order(A[1] - Y, errs)
+        shift[name] = sp.expand(-sp.diff(dY, X) - alpha)
+    assert shift["MH2"] == 0 and shift["MB1"] == -S("Ez(Y)")
+    rules = {e["layout"]: e["expr"]["alpha"] for e in DATA["equation"]
+             if e["kind"] == "transfer" and "alpha" in e["expr"]}
+    assert rules["MH2"] == "alpha" and rules["MB1"].replace(" ", "") == "alpha+Ez(Yo)"
+    v = find(verdicts, "10", "alpha")
+    assert v.category == "convention" and v.readings_used == ["line:X"]
+    assert "Lx = [X + δx(X), δy(X) - αX, δz(X)]^T" in v.evidence
+    assert "MB1 eq. 9: alpha = alpha + Ez(Yo)" in v.evidence
+    assert not v.erratum.startswith("omitted")
+
+
+def test_only_minimal_combinations_are_listed_and_pattern_noted(verdicts):
+    """A3 dz(Z) = dz(Z): a sign reading that does not change this component is not counted,
+    so no printing-error combination is listed beside the zero offsets; the same unchanged
+    rule stands for four layouts in the data file."""
+    v = find(verdicts, "A3", "dz(Z)")
+    assert v.category == "undecidable"
+    assert not any("inconsistent" in t for t in v.readings_tried)
+    bare = sorted(e["layout"] for e in DATA["equation"]
+                  if e["kind"] == "transfer" and e["expr"].get("dz(Z)") == "dz(Z)")
+    assert bare == ["CY", "FB1", "FH1", "MB1"]
+    for lay in bare:
+        if lay != "FB1":
+            assert lay in v.evidence

@@ -90,7 +90,13 @@ def test_chain_factors_against_the_frame_definitions(htm):
     assert items["1.5"]["label"] == items["1.1"]["label"]
     assert items["1.6"]["label"] == items["1.3"]["label"]
     assert find(htm, "paper eq. 1.5", "label").category == "printing_error"
-    assert find(htm, "paper eq. 1.1", "label").category == "undecidable"
+    # eq. 1.5 is eq. 1.1 with -d for d (a copy of the source): the same '-1' label in two
+    # images, which the cross-copy rule decides as printed
+    m11, m15 = _printed_matrix(items["1.1"]), _printed_matrix(items["1.5"])
+    assert np.allclose(m11[:3, :3], m15[:3, :3]) and np.allclose(m11[:3, 3], -m15[:3, 3])
+    assert items["1.1"]["label"] != items["1.1"]["name"]
+    v11 = find(htm, "paper eq. 1.1", "label")
+    assert v11.category == "printing_error" and "1.5" in v11.evidence
 
 
 def test_products_eq_1_8_and_16_close_the_chain(htm):
@@ -117,6 +123,10 @@ def test_products_eq_1_8_and_16_close_the_chain(htm):
     assert find(htm, "project eq. (16)").category == "identical"
     v8 = find(htm, "project eq. (8)")          # T_2^2, T_1^1: no frame pairs
     assert v8.category == "printing_error" and "T_2^2" in v8.erratum
+    # only T_2^2 is shared with thesis eq. 3.37 (cross-copy rule); T_1^1 stays undecided
+    prods = {p["id"]: p for p in data("printed_htm.toml")["product"]}
+    assert "T_1^1" in prods["(8)"]["factors"]
+    assert "undecided" in v8.evidence.split("T_1^1 for T_2^1")[1]
 
 
 def test_axis_htms_squareness_sign_is_the_thesis_convention(htm):

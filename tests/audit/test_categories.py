@@ -213,10 +213,13 @@ def test_printing_error_rotary_axis_model_sec_2_5():
     assert find(vs, "eq. 3.15", "Z axis, row 3").category == "identical"
 
 
-# --------------------------------------------------------------------------- extraction
-def test_extraction_unknown_vector_of_eq31():
+# --------------------------------------------------------------- repetition: undecidable
+def test_undecidable_unknown_vector_of_eq31():
     """The coefficient columns of eq. 31 are those of (E_XX .. E_CX) (d = t + e x r, written
-    here); only the vector's subscripts are wrong (E_BX twice, E_AX missing)."""
+    here); only the vector's entries are wrong (E_BX twice, E_AX missing).  The 4th entry is
+    E_B in all four six-entry vectors (eq. 31, 32, 3.5, 3.6; two documents), but a repeated
+    token is what this extraction does within an image: the cross-copy rule leaves it
+    undecided."""
     eq31 = next(e for e in data("printed_tracker.toml")["equation"] if e["id"] == "31")
     xs, ys, zs = sp.symbols("x_P y_P z_P", real=True)
     e = sp.symbols("EA EB EC", real=True)
@@ -227,9 +230,12 @@ def test_extraction_unknown_vector_of_eq31():
                      for c in eq31["rows"][0][1]]
     assert [sp.expand(a - b) for a, b in zip(first, printed_first)] == [0] * 6
     assert len(set(eq31["unknowns"])) < 6
+    six = [e for e in data("printed_tracker.toml")["equation"] if e["kind"] == "system"
+           and len(e["unknowns"]) == 6]
+    assert len(six) == 4 and all(e["unknowns"][3][:2] == "EB" for e in six)
     v = find(audit_tracker.audit_system(eq31), "eq. 31", "unknown vector")
-    assert v.category == "extraction"
-    assert "every unknown vector" in v.evidence and "(E_AX, E_BX, E_BX) E_CX" in v.evidence
+    assert v.category == "undecidable" and v.readings_used[0].startswith("glyph:")
+    assert "(E_AX, E_BX, E_BX) E_CX" in v.evidence and "What would decide" in v.evidence
 
 
 def _mh2_chain(Lz):
@@ -349,14 +355,14 @@ def test_listing_constant_term_dropped():
 
 
 # --------------------------------------------------------------------------- all verdicts
-EXPECTED = {"identical": 171, "printing_error": 35, "extraction": 14, "convention": 25,
-            "simplification": 19, "undecidable": 64}
+EXPECTED = {"identical": 169, "printing_error": 33, "extraction": 7, "convention": 25,
+            "simplification": 19, "undecidable": 75}
 #: per document (a verdict that moves between documents or categories fails)
 EXPECTED_BY_SOURCE = {
     "Pahk 1995": {"identical": 36, "printing_error": 11, "extraction": 0, "convention": 17,
                   "simplification": 16, "undecidable": 32},
-    "Ellingsdalen 2021": {"identical": 135, "printing_error": 24, "extraction": 14,
-                          "convention": 8, "simplification": 3, "undecidable": 32},
+    "Ellingsdalen 2021": {"identical": 133, "printing_error": 22, "extraction": 7,
+                          "convention": 8, "simplification": 3, "undecidable": 43},
 }
 
 

@@ -4,6 +4,7 @@ import copy
 import tomllib
 from importlib import resources
 
+import numpy as np
 import pytest
 
 from volerr.derive import audit_dmu50
@@ -70,3 +71,38 @@ def test_a_changed_print_is_detected(printed):
     assert vs["eq. 3.22"].verdict == "differs"
     assert vs["eq. 3.30"].verdict == "differs" and "sign error" in vs["eq. 3.30"].erratum
     assert audit_dmu50.audit(bad, ["MB1"]) == []
+
+
+def _rx(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
+
+
+def test_repetitions_within_an_image_are_undecidable(verdicts, printed):
+    """The T_4^5 of the chain 'updated' with the errors is T_3^4 = Rx(-45 deg) (computed here),
+    the factor printed just before it in the same image; the data sources of E_CB and E_CC
+    repeat the file name of the line above.  Repetitions within an image: print or extraction
+    (the cross-copy rule does not decide them), so undecidable with both explanations."""
+    item = next(m for m in printed["matrix"] if m["id"] == "error chain after 3.37")
+    env = {"c45": np.sqrt(0.5), "s45": np.sqrt(0.5)}
+    m = np.array([[eval(e, {}, env) for e in r] for r in item["rows"]])  # noqa: S307
+    assert np.allclose(m, _rx(-np.pi / 4))
+    v = verdicts["error chain after 3.37"]
+    assert v.category == "undecidable" and v.readings_used[0].startswith("glyph:")
+    assert "For the print" in v.evidence and "For the extraction" in v.evidence
+    assert "What would decide" in v.evidence
+    texts = printed["listing"]["sources_text"]
+    for name, (above, line) in texts.items():
+        src = printed["listing"]["sources"][name]
+        # the quoted file name of this line is the one of the line above (braces of the
+        # LaTeX rendering dropped), and not the parameter's own
+        quoted = [t.split("'")[1].replace("{", "").replace("}", "") for t in (above, line)]
+        assert quoted[0][:4] == quoted[1][:4] == src[:4] != name
+        v = verdicts[f"Listing 3.3 T_er {name}"]
+        assert v.category == "undecidable" and "For the extraction" in v.evidence
+
+
+def test_t_er_effects_state_their_frame(verdicts):
+    v = verdicts["Listing 3.3 T_er (error model)"]
+    assert v.category == "simplification"
+    assert "workpiece (table) frame" in v.evidence and "not as an approximation" in v.evidence

@@ -43,9 +43,14 @@ def test_eq_33_34_identical(verdicts):
         assert verdicts[("eq. 33-34", m)].verdict == "identical"
     # E_XX, E_YX: identical once the factor printed inside the subscript of z multiplies it;
     # a subscript's scope is glyph-level damage (print or extraction): undecidable
-    for m in ("EXX", "EYX"):
+    for m, inner in (("EXX", "z_{xP(y_{xQ} - y_{xP})}"), ("EYX", "z_{xP(x_{xP} - x_{xK})}")):
         v = verdicts[("eq. 33-34", m)]
         assert v.category == "undecidable" and "subscript" in v.erratum
+        # the printed field and the evidence carry the raw text, where the scope shows
+        eq = next(e for e in _printed()["equation"] if e["id"] == "33-34")
+        assert inner in eq["text"] and inner in v.printed and inner in v.evidence
+    # each names the same defect in the other line
+    assert "z_{xP(x_{xP} - x_{xK})}" in verdicts[("eq. 33-34", "EXX")].evidence
 
 
 def test_appendix_z_identical(verdicts):
@@ -68,11 +73,33 @@ def test_rotary_errata_named(verdicts):
         assert verdicts[("eq. 3.4", f"Delta_{c} right-hand side")].verdict == "identical"
 
 
+def _x_subscripts(eq):
+    """(row label, column) of the lever arms printed with the X axis' subscript in the raw
+    LaTeX of a rotary system (own parse of the extraction text)."""
+    body = eq["text"].split("\\begin{bmatrix}")[1].split("\\end{bmatrix}")[0]
+    rows = [r for r in body.split("\\\\")]
+    assert len(rows) == len(eq["rows"])
+    return {(lab, j + 1) for (lab, _), raw in zip(eq["rows"], rows)
+            for j, cell in enumerate(raw.split("&")) if "}_{x" in cell and "hat" in cell}
+
+
 def test_systems(verdicts):
-    assert verdicts[("eq. 31", "coefficient matrix")].verdict == "differs"
-    assert "twice" in verdicts[("eq. 31", "coefficient matrix")].erratum
-    for eq in ("eq. 32", "eq. 36", "eq. 37", "eq. 3.5", "eq. 3.6"):
+    v31 = verdicts[("eq. 31", "coefficient matrix")]
+    assert v31.verdict == "differs" and "twice" in v31.erratum
+    # a row repeated within one image: print (copied matrix) or extraction -> undecidable
+    assert v31.category == "undecidable" and "T_0^{t,c}" in v31.evidence
+    for eq in ("eq. 32", "eq. 36", "eq. 37"):
         assert verdicts[(eq, "coefficient matrix")].verdict == "identical", eq
+    # eq. 3.5 / 3.6: lever arms with the X axis' subscript x, at the same entries of the rows
+    # the two systems share -> the cross-copy rule decides: printing error
+    eqs = {e["id"]: e for e in _printed()["equation"]}
+    x35, x36 = _x_subscripts(eqs["3.5"]), _x_subscripts(eqs["3.6"])
+    shared = {lab for lab, _ in eqs["3.5"]["rows"]} & {lab for lab, _ in eqs["3.6"]["rows"]}
+    assert x35 and {p for p in x35 if p[0] in shared} == {p for p in x36 if p[0] in shared}
+    for eq, xs in (("eq. 3.5", x35), ("eq. 3.6", x36)):
+        v = verdicts[(eq, "coefficient matrix")]
+        assert v.category == "printing_error" and f"{len(xs)} lever arms" in v.erratum, eq
+        assert "cross-copy rule" in v.evidence
     assert verdicts[("eq. 32", "right-hand side")].verdict == "identical"
     assert "EAX missing" in verdicts[("eq. 32", "unknown vector")].erratum
     assert verdicts[("eq. 37", "right-hand side")].verdict == "differs"
