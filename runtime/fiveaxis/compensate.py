@@ -287,8 +287,10 @@ class ErrorModel:
         return q
 
     def errors(self, q: np.ndarray, subset=None, direction=None) -> dict:
-        """Error functions at ``q`` (the last two evaluations are remembered: the position and
-        the orientation error of the same positions share one table look-up).  ``direction``
+        """Error functions at ``q`` (the last three evaluations are remembered: the position and
+        the orientation error of the same positions share one table look-up, and the
+        prediction after a solve of two iterations finds the programmed positions still
+        there).  ``direction``
         (N, n_axes) -1 / 0 / +1: the approach direction of every axis, for tables with a
         reversal column (:meth:`volerr.tables.functions.ErrorFunctions.reversal`)."""
         if self.funcs is None:
@@ -311,7 +313,7 @@ class ErrorModel:
                     e[k] = e[k] + v if k in e else v
             memo.insert(0, (np.array(q, dtype=float, copy=True),
                             None if direction is None else np.array(direction), e))
-            del memo[2:]
+            del memo[3:]
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e
@@ -327,7 +329,8 @@ class ErrorModel:
         return self.model.orientation_error(q, self.errors(q, subset, direction))
 
     def tool_axis(self, q) -> np.ndarray:
-        return self.model.forward(q, self.tool)[:, 3:6]
+        """Nominal unit tool axis, (N, 3) (it does not depend on the tool offset)."""
+        return self.model.tool_axis(q)
 
 
 #: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
@@ -354,9 +357,10 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     Iterates until the change of the correction is below ``tol`` (mm; rotary axes weighted by a
     1 m lever).  ``direction`` (N, n) -1 / 0 / +1: the approach direction of each axis in each
     row (tables with reversal; the corrected positions are approached as the programmed
-    ones).  ``out``: a dict that gets ``target`` (N, 3), the nominal tool tip, and -- when the
-    first iteration evaluates the whole model at the programmed positions (no orientation,
-    no restriction to some types) -- ``before`` (N, 3), the error there (mm)."""
+    ones).  ``out``: a dict that gets ``target`` (N, 3), the nominal tool tip, with the
+    orientation also ``tool_axis`` (N, 3), the nominal tool axis, and -- when the first
+    iteration evaluates the whole model at the programmed positions (no orientation, no
+    restriction to some types) -- ``before`` (N, 3), the error there (mm)."""
     m = em.model
     q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
     n = len(q_nom)
@@ -365,7 +369,9 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     target_p = m.nominal_position(q_nom, em.tool)
     if out is not None:
         out["target"] = target_p
-    target_k = em.tool_axis(q_nom) if em.rot else None
+    target_k = em.tool_axis(q_nom) if orientation and em.rot else None
+    if out is not None and target_k is not None:
+        out["tool_axis"] = target_k
     q = q_nom.copy()
     iters = np.zeros(n, dtype=int)
     active = np.ones(n, dtype=bool)

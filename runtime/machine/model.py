@@ -477,6 +477,12 @@ class Model:
         return np.concatenate([_columns(tip, n), _columns(self.module.tool_axis(**pos), n)],
                               axis=1)
 
+    def tool_axis(self, positions) -> np.ndarray:
+        """Nominal unit tool axis i, j, k in the workpiece frame, (N, 3): the last three
+        columns of :meth:`forward` (the same values), without computing the tool tip."""
+        pos, n = self._points(positions)
+        return _blocked(self.module.tool_axis, pos, n)
+
     def inverse(self, target, probe=None, near=None, *, tool=None) -> np.ndarray:
         """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
         axis ``target`` (N, 6) = x, y, z, i, j, k; ``near`` picks the branch, the turn and an

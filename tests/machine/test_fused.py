@@ -68,7 +68,8 @@ def test_mb1_blocked_kernel_equals_hand_written_eq4(seed, n, subset):
 @pytest.mark.parametrize("name", ["MB1", "FH2", "DMU50", "TT_AC"])
 def test_fused_kernels_identical_to_generated_functions(name, small_blocks):
     """Same expression tree, same order of operations: bitwise the same values (zero folding
-    only drops exact ``+ 0`` and ``* 0``), for volumetric and both random-error functions."""
+    only drops exact ``+ 0`` and ``* 0``), for volumetric and both random-error functions, and
+    the tool axis."""
     model = volerr.load(name)
     for f in ("volumetric_error", "random_error_exact", "random_error_termwise"):
         assert fused.parse(getattr(model.module, f)) is not None, f   # really fused
@@ -84,6 +85,8 @@ def test_fused_kernels_identical_to_generated_functions(name, small_blocks):
             ref = _unfused(model, fn, pos, probe,
                            {f"s_{p}": sig.get(p, 0.0) for p in model.parameters})
             assert np.array_equal(model.random_error(pos, sig, probe, method=method), ref)
+        if hasattr(model.module, "tool_axis"):   # fused tool axis = forward's (unfused) one
+            assert np.array_equal(model.tool_axis(pos), model.forward(pos)[:, 3:6])
 
 
 # ---- a synthetic straight-line function, in the form of the generated code ------------------
