@@ -377,11 +377,13 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     active = np.ones(n, dtype=bool)
     limited = np.zeros(n, dtype=bool)
     partial = np.zeros(n, dtype=bool)
+    turns = orientation and bool(em.rot)       # the rotary positions move
+    mj = None
     for it in range(1, max_iter + 1):
         qa = q[active]
         da = None if direction is None else direction[active]
         change = np.zeros(len(qa))
-        if orientation and em.rot:
+        if turns:
             k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated, da)
             j = rotary_jacobian(m, qa)
             d, dropped = _truncated_solve(j, -(k_act - target_k[active]))
@@ -393,11 +395,17 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
             d[~ok] = 0.0
             qa[ok] = trial[ok]
             change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
-            - target_p[active]
+        # the first iteration without turning starts at the programmed positions, whose
+        # nominal tip is the target
+        tip = target_p if it == 1 and not turns else m.nominal_position(qa, em.tool)
+        e = tip + em.position_error(qa, em.compensated, da) - target_p[active]
         if it == 1 and out is not None and not orientation and em.compensated is None:
             out["before"] = e.copy()        # nominal(q_nom) - target is exactly 0
-        mj = linear_jacobian(m, qa, em.tool)
+        # d(tip)/d(linear axes) depends on the rotary positions only (the nominal chain is
+        # affine in the linear axes; tests/fiveaxis/test_compensate.py checks the generated
+        # Jacobians): without turning, the first iteration's serves them all
+        if mj is None or turns:
+            mj = linear_jacobian(m, qa, em.tool)
         d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
         qa[:, lin_idx] += d
         change = np.maximum(change, np.abs(d).max(axis=1))
@@ -408,6 +416,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
         active[idx[done]] = False
         if not active.any():
             break
+        mj = mj[~done]
     if active.any():
         raise InputError(f"compensation did not converge in {max_iter} iterations (the errors "
                          "are too large or the position is singular)")
@@ -507,16 +516,21 @@ def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter, direction=None) 
     target_p = m.nominal_position(q_nom, em.tool)
     q = q_out.copy()
     active = np.ones(len(q), dtype=bool)
+    mj = None
     for _ in range(max_iter):
         qa = q[active]
         da = None if direction is None else direction[active]
         e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
             - target_p[active]
-        d = -np.linalg.solve(linear_jacobian(m, qa, em.tool), e[:, :, None])[:, :, 0]
+        if mj is None:      # the rotary positions stay: one Jacobian (see solve)
+            mj = linear_jacobian(m, qa, em.tool)
+        d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
         qa[:, lin_idx] += d
         q[active] = qa
         idx = np.flatnonzero(active)
-        active[idx[np.abs(d).max(axis=1) < tol]] = False
+        done = np.abs(d).max(axis=1) < tol
+        active[idx[done]] = False
         if not active.any():
             break
+        mj = mj[~done]
     return q
