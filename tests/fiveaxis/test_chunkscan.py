@@ -26,7 +26,8 @@ number = st.one_of(
     st.decimals(min_value=-1000, max_value=1000, allow_nan=False, places=4).map(str),
     st.sampled_from(["1.", ".5", "+2", "-0", "+.25", "007", "12.3456789012345678", "1.2.3",
                      "--1", "+", ".", "0", "1", "00", "01", "2", "3", "98", "128", "129.",
-                     "6"]))
+                     "6", "-0000000000000000012.5", "123456789012345678.5",
+                     "1234567890123456789.1.2", "12345678901234567-8", "+1234567890123456"]))
 word = st.tuples(st.sampled_from("XYZBCxyzbNFGgMmAUSTHDI"), st.sampled_from(["", " ", "\t"]),
                  number)
 comment = st.sampled_from(["(cut X1)", "(a;b)", "; fin (x", ";", "()", "(", ")", "(G2 M98)",
