@@ -214,7 +214,7 @@ def scan(segs: list, axes) -> Scan:
     misplaced = np.zeros(nr, dtype=bool)
     mant = np.zeros(nr)
     for c in range(width):
-        byte = padded[ns + c]
+        byte = padded[c:][ns]                   # (no array ns + c)
         inside = c < length
         digit = (byte - 48 < 10) & inside       # (uint8: the bytes below "0" wrap round)
         dot = (byte == 46) & inside
