@@ -318,19 +318,38 @@ class ErrorModel:
             e = {k: v for k, v in e.items() if k in subset}
         return e
 
+    def prepared(self, q: np.ndarray):
+        """``q`` validated with the sines and cosines of its rotary axes
+        (:meth:`volerr.machine.model.Model.prepared`), shared by the evaluations at the same
+        positions (the last three are remembered, as in :meth:`errors`)."""
+        memo = self.__dict__.setdefault("_prepared", [])
+        for qm, p in memo:
+            if qm.shape == q.shape and np.array_equal(qm, q):
+                return p
+        p = self.model.prepared(q)
+        memo.insert(0, (np.array(q, dtype=float, copy=True), p))
+        del memo[3:]
+        return p
+
+    def nominal_position(self, q) -> np.ndarray:
+        """Nominal tool tip with the tool offset, (N, 3) mm."""
+        return self.model.nominal_position(self.prepared(q), self.tool)
+
     def position_error(self, q, subset=None, direction=None) -> np.ndarray:
         """Exact error of the tool tip, (N, 3) mm (``direction``: see :meth:`errors`)."""
-        return self.model.exact_error(q, self.errors(q, subset, direction), probe=self.tool)
+        return self.model.exact_error(self.prepared(q), self.errors(q, subset, direction),
+                                      probe=self.tool)
 
     def orientation_error(self, q, subset=None, direction=None) -> np.ndarray:
         """First-order error of the tool axis, (N, 3) rad."""
         if not self.rot:
             return np.zeros((len(q), 3))
-        return self.model.orientation_error(q, self.errors(q, subset, direction))
+        return self.model.orientation_error(self.prepared(q),
+                                            self.errors(q, subset, direction))
 
     def tool_axis(self, q) -> np.ndarray:
         """Nominal unit tool axis, (N, 3) (it does not depend on the tool offset)."""
-        return self.model.tool_axis(q)
+        return self.model.tool_axis(self.prepared(q))
 
 
 #: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
@@ -366,7 +385,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     n = len(q_nom)
     lin_idx = [m.axes.index(a) for a in em.lin]
     rot_idx = [m.axes.index(a) for a in em.rot]
-    target_p = m.nominal_position(q_nom, em.tool)
+    target_p = em.nominal_position(q_nom)
     if out is not None:
         out["target"] = target_p
     target_k = em.tool_axis(q_nom) if orientation and em.rot else None
@@ -397,7 +416,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
             change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
         # the first iteration without turning starts at the programmed positions, whose
         # nominal tip is the target
-        tip = target_p if it == 1 and not turns else m.nominal_position(qa, em.tool)
+        tip = target_p if it == 1 and not turns else em.nominal_position(qa)
         e = tip + em.position_error(qa, em.compensated, da) - target_p[active]
         if it == 1 and out is not None and not orientation and em.compensated is None:
             out["before"] = e.copy()        # nominal(q_nom) - target is exactly 0
@@ -513,14 +532,14 @@ def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter, direction=None) 
     iterates until its own correction changes by less than ``tol`` (mm)."""
     m = em.model
     lin_idx = [m.axes.index(a) for a in em.lin]
-    target_p = m.nominal_position(q_nom, em.tool)
+    target_p = em.nominal_position(q_nom)
     q = q_out.copy()
     active = np.ones(len(q), dtype=bool)
     mj = None
     for _ in range(max_iter):
         qa = q[active]
         da = None if direction is None else direction[active]
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
+        e = em.nominal_position(qa) + em.position_error(qa, em.compensated, da) \
             - target_p[active]
         if mj is None:      # the rotary positions stay: one Jacobian (see solve)
             mj = linear_jacobian(m, qa, em.tool)

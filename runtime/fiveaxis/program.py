@@ -640,10 +640,10 @@ def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray, direction=None,
         z = np.zeros((0, 3))
         return Prediction(z, z, np.zeros(0), np.zeros(0), z)
     if target is None:
-        target = model.nominal_position(q_nom, tool)
+        target = em.nominal_position(q_nom)
     d, d0 = direction, direction_before
     before = (em.position_error(q_nom, None, d0) if before is None else before) * 1e3
-    after = (model.nominal_position(q_out, tool) + em.position_error(q_out, None, d)
+    after = (em.nominal_position(q_out) + em.position_error(q_out, None, d)
              - target) * 1e3
     if model.rotary_axes:
         k_nom = em.tool_axis(q_nom) if tool_axis is None else tool_axis
