@@ -250,8 +250,10 @@ class ErrorModel:
             if a in self.ranges:
                 lo, hi = self.ranges[a]
                 i = self.model.axes.index(a)
-                w = lo + np.mod(q[:, i] - lo, 360.0)
                 inside = (q[:, i] >= lo) & (q[:, i] <= hi)
+                if inside.all():
+                    continue        # (the usual case: nothing to take modulo 360)
+                w = lo + np.mod(q[:, i] - lo, 360.0)
                 q[:, i] = np.where(~inside & (w <= hi), w, q[:, i])
         return q
 
@@ -282,6 +284,8 @@ class ErrorModel:
             i = self.model.axes.index(a)
             m = self.EDGE_MARGIN["rotary" if a in self.rot else "linear"]
             v = q[:, i]
+            if not len(v) or (v.min() >= lo and v.max() <= hi):
+                continue            # (the usual case: no position beyond the table)
             near = ((v < lo) & (v >= lo - m)) | ((v > hi) & (v <= hi + m))
             q[:, i] = np.where(near, np.clip(v, lo, hi), v)
         return q
