@@ -239,12 +239,13 @@ TYPICAL = {
 }
 
 
-def typical_text() -> str:
+def typical_text(extra: str = "") -> str:
+    """The typical machine's assumptions (``extra``: more assumed values, appended)."""
     t = TYPICAL
     return (f"typical machine: Pahk's CMM A (900 x 575 x 400 mm), offsets up to "
             f"{t['measuring_offset_mm']:g} mm, probe offsets up to {t['probe_offset_mm']:g} mm, "
-            f"angular errors {t['angular_rad'] * 1e6:g} urad -- assumed values, not printed; "
-            f"the size scales in proportion to the lengths and angles assumed")
+            f"angular errors {t['angular_rad'] * 1e6:g} urad{extra} -- assumed values, not "
+            f"printed; the size scales in proportion to the lengths and angles assumed")
 
 
 @dataclass

@@ -313,6 +313,11 @@ def audit_linear(item: dict) -> Verdict:
                                                  if ocr else ""),
                   str(item["rows"]), fmt(stage), tried, used)
     used = [f"flip:thesis {SQUARENESS[s][1]} (slope convention, eq. 3.11/3.13)" for s in flips]
+    if ocr:
+        # the repair of the extraction's symbols is part of what reproduces the print
+        used.append(f"ocr:{item['doc']} eq. {item['id']} symbols")
+        tried.append(f"the extraction's reading ({ocr}) with the thesis' squareness signs: "
+                     "exact (the printed symbols are read before any comparison)")
     names = "; ".join(f"{SQUARENESS[s][1]} positive when the moving axis leans toward the "
                       f"positive other axis ({SQUARENESS[s][2]})" for s in flips)
     iso = "; ".join(f"volerr/ISO 230-1 {SQUARENESS[s][0]}: right-handed rotation about "

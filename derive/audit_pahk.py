@@ -322,9 +322,12 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
             evidence = (f"differs from exact propagation: {diff0}. Reproduced exactly by {d} "
                         f"(expand(term-wise - printed) == 0); the two agree when the probe offset "
                         f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
-                        f"up to {size:.2g} um ({typical_text()}, random angular errors "
-                        f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, translational "
-                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma). "
+                        f"up to {size:.2g} um ("
+                        + typical_text(f", random angular errors "
+                                       f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, "
+                                       f"translational "
+                                       f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, "
+                                       f"1 sigma") + "). "
                         f"Category simplification: Pahk states the quadrature formula (quoted "
                         f"in 'statement'), not that it is applied term by term; the term-wise "
                         f"form is how he applies it -- every printed random component of both "
@@ -347,8 +350,9 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
                         f"of {name}: {describe_diff(tw, pr)}. Reproduced exactly by {d}: a "
                         f"whole component of another equation in place of this one's -- by "
                         f"the cross-copy rule a substitution, which an extraction would have to "
-                        f"carry from one image into another; no convention of {name}: a "
-                        f"printing error.")
+                        f"carry from one image into another"
+                        + (f" ({eq['quote'][c]})" if c in eq.get("quote", {}) else "")
+                        + f"; no convention of {name}: a printing error.")
             v = classify(_verdict(eq, c, "differs", erratum, evidence + ocr, pr, exact),
                          "printing_error")
             v.readings_tried, v.readings_used = tried, list(hit[0])

@@ -392,6 +392,10 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
                 + ocr, pr, d0), "printing_error")
         v.readings_tried = tried
         out.append(v)
+    if eq.get("table_note"):
+        for v in out:
+            if v.category != "identical" and any("table" in t for t in v.readings_tried):
+                v.evidence += f" Table axis: {eq['table_note']}."
     return out
 
 
@@ -461,7 +465,8 @@ def _pattern_note(all_eqs, eq, key, d0) -> str:
         out += (" Several unchanged prints are a pattern rather than a one-off misprint, which "
                 "fits a set-up without these offsets or a rule applied without being stated")
     if with_terms:
-        out += ((";" if out.endswith("stated") else "") + f" the print with terms on "
+        out += ((";" if out.endswith("stated") else "") + (" t" if out.endswith("stated") else
+                                                           " T") + f"he print with terms on "
                 f"{', '.join(with_terms)}"
                 + (" (the same derived rule as here)" if same_rule == with_terms else
                    f" (the same derived rule as here on {', '.join(same_rule)})"

@@ -285,8 +285,11 @@ def audit_displacement(eq: dict) -> list[Verdict]:
                 f"C, yh = x sin C + y cos C." if rotated else
                 f"derived - printed = {fmt(diff)}", eq["expr"][c], de))
             if rotated:
+                raw_z = next((ln.strip() for ln in eq.get("text", "").splitlines()
+                              if ln.strip().startswith(f"{c}'_{{Pt}}")), "")
                 out[-1].evidence += (
-                    " Read as [-E_BC cos C + E_AC sin C] x_P the row is the derived one: the "
+                    (f" The extraction text of the row: '{raw_z}'." if raw_z else "")
+                    + " Read as [-E_BC cos C + E_AC sin C] x_P the row is the derived one: the "
                     "printed coefficient lost a minus sign and the factor 'sin C' (the thesis' "
                     "eq. 2.42 prints the same row with both). Category undecidable: lost "
                     "glyphs, which the print and the text extraction explain equally; what "
@@ -538,7 +541,11 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
             if lab is None:
                 guess = distinct[k] if k < len(distinct) else None
                 hint = f" (row {guess} needs {fmt(want[guess])})" if guess else ""
-                problems.append(f"entry {k + 1} {text!r} is no deviation of any point{hint}")
+                blocks = _raw_blocks(eq)
+                rawe = blocks[2][k] if len(blocks) > 2 and k < len(blocks[2]) else ""
+                problems.append(f"entry {k + 1} {text!r}"
+                                + (f" (raw '{rawe}')" if rawe else "")
+                                + f" is no deviation of any point{hint}")
         twice = sorted({lab for lab in matched if lab and matched.count(lab) > 1})
         if twice:
             problems.append(f"entry for {', '.join(twice)} printed twice")

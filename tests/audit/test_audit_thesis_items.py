@@ -155,16 +155,21 @@ def test_axis_htms_squareness_sign_is_the_thesis_convention(htm):
     e = 1e-4
     u_iso = rz(e) @ np.array([0, 1.0, 0])
     assert u_iso[0] < 0
-    for eq in ("paper eq. 1.10", "thesis eq. 3.17"):
+    items = {m["id"]: m for m in data("printed_htm.toml")["axis"]}
+    for eq, mid in (("paper eq. 1.10", "1.10"), ("thesis eq. 3.17", "3.17")):
         v = find(htm, eq)
         assert v.category == "convention"
-        assert v.readings_used == ["flip:thesis E_C(0X)Y (slope convention, eq. 3.11/3.13)"]
+        # the paper's print needs the extraction's chi read as X too (\chi in its text)
+        ocr = ["ocr:paper eq. 1.10 symbols"] if "chi" in items[mid].get("text", "") else []
+        assert v.readings_used == ["flip:thesis E_C(0X)Y (slope convention, eq. 3.11/3.13)"] \
+            + ocr
     # Z leaning toward +Y by E_A: the ISO rotation about +x turns z toward -y: flipped;
     # toward +X by E_B: the ISO rotation about +y turns z toward +x: the same sign
     assert (rx(e) @ np.array([0, 0, 1.0]))[1] < 0
-    for eq in ("paper eq. 1.11", "thesis eq. 3.18"):
+    for eq, mid in (("paper eq. 1.11", "1.11"), ("thesis eq. 3.18", "3.18")):
+        ocr = [f"ocr:paper eq. {mid} symbols"] if "chi" in items[mid].get("text", "") else []
         assert find(htm, eq).readings_used == [
-            "flip:thesis E_A(0Y)Z (slope convention, eq. 3.11/3.13)"]
+            "flip:thesis E_A(0Y)Z (slope convention, eq. 3.11/3.13)"] + ocr
     assert find(htm, "thesis eq. 3.16").category == "identical"
     assert find(htm, "paper eq. 1.9").category == "extraction"     # E_sx, E_rx, E_gx
 
