@@ -116,7 +116,9 @@ def audit_eyx(item: dict, nc: dict | None) -> list[Verdict]:
               f"{item['before']} um (before) and {item['after']} um (after) of E_YX are read "
               "from the plots of Figures 4.1 and 4.11, which the text does not carry; nothing "
               "printed gives either value or contradicts it (no discrepancy is shown: the "
-              "verdict 'unchecked' says only that the values could not be compared). Category "
+              "verdict 'unchecked' says only that the values could not be compared): the values "
+              "as read from the plots, or ones misread from them or misprinted -- nothing "
+              "printed tells them apart. Category "
               "undecidable; missing: the E_YX data before and after compensation",
               item["text"], f"{item['before']} -> {item['after']} um",
               ["no printed input reproduces or contradicts the values"], [f"missing:{eq} data"],
@@ -153,7 +155,9 @@ def audit_unreproducible(item: dict) -> Verdict:
               f"inconsistency found",
               f"{item['quantity']}: no printed input reproduces it. Consistency with the rest "
               f"of the text: " + "; ".join(item["consistent"]) + f". No discrepancy is shown "
-              f"(the verdict 'unchecked' says only that the value could not be compared). "
+              f"(the verdict 'unchecked' says only that the value could not be compared): the "
+              f"value as read from the plot, or one misread from it or misprinted -- nothing "
+              f"printed tells them apart. "
               f"Category undecidable; missing: {item['missing']}", item["text"],
               f"{item['value']} {item['unit']}",
               [f"checked: {c}" for c in item["consistent"]],
