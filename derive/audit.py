@@ -101,7 +101,14 @@ PRIORITY_RULE = (
     "demonstrably repeats within an image (the error matrix of T_0^{t,c} after thesis eq. "
     "3.37 has five rows, three of them '-E_{DX} & ... & 1 & E_{ZX}' and two of these "
     "identical, with the letter D that names no axis), and a failure driven by the image "
-    "repeats at the same place in images of the same layout: such defects are undecidable.")
+    "repeats at the same place in images of the same layout: such defects are undecidable. "
+    "A candidate repetition: the wrong whole symbol or term stands elsewhere in the same "
+    "printed equation, before or after it (an extraction reads the whole image; an author "
+    "writes from the neighbouring line), or a wrong index repeats the index written next to "
+    "it in the same symbol (T_2^2 for T_3^2); a bare sign or a 0/1 entry of a matrix is no "
+    "candidate (they stand everywhere). A printed text that is cut off (a line ending early) "
+    "is read with every restoration the text allows; when they lead to different categories "
+    "the verdict is undecidable.")
 
 #: kind of every reading key prefix -> the category it implies (see :func:`category_of`)
 READING_KINDS = {
@@ -232,18 +239,22 @@ TYPICAL = {
 }
 
 
-def typical_text() -> str:
+def typical_text(extra: str = "") -> str:
+    """The typical machine's assumptions (``extra``: more assumed values, appended)."""
     t = TYPICAL
     return (f"typical machine: Pahk's CMM A (900 x 575 x 400 mm), offsets up to "
             f"{t['measuring_offset_mm']:g} mm, probe offsets up to {t['probe_offset_mm']:g} mm, "
-            f"angular errors {t['angular_rad'] * 1e6:g} urad")
+            f"angular errors {t['angular_rad'] * 1e6:g} urad{extra} -- assumed values, not "
+            f"printed; the size scales in proportion to the lengths and angles assumed")
 
 
 @dataclass
 class Verdict:
     """The verdict on one printed equation (or one component of it).
 
-    ``verdict`` is ``"identical"`` or ``"differs"``; ``erratum`` is "" when identical, else a
+    ``verdict`` is ``"identical"``, ``"differs"`` or ``"unchecked"`` (a printed number whose
+    inputs the text does not print: nothing to compare, no discrepancy claimed); ``erratum``
+    is "" when identical, else a
     short name of the printing error; ``evidence`` says which terms differ and which chain,
     sign convention or reading reproduces the printed form; ``printed`` and ``derived`` are the
     two expressions (strings, in the paper's symbols).  ``category`` is one of
@@ -440,44 +451,63 @@ def wrong_printed_terms(expected, printed) -> list:
         [p for p, _ in d["coefficient"]]
 
 
-def term_elsewhere(wrong, before: dict, after: dict) -> tuple[list, list]:
-    """Where the wrong printed terms stand in the other components of the same printed image:
-    ``before`` / ``after``: {component name: printed expression} read before / after this one.
-    Returns ([(term, component)] read before, [(term, component)] read after)."""
-    def where(comps):
-        out = []
-        for t in wrong:
-            c, m = t.as_coeff_Mul()
-            for name, expr in comps.items():
-                if terms(expr).get(m) == c:
-                    out.append((t, name))
-                    break
-        return out
-    return where(before), where(after)
+def _occurrences(sym, image: dict, own: str, skip) -> list[str]:
+    """Where symbol ``sym`` stands in ``image`` ({component: printed expression}) outside the
+    term ``skip`` of component ``own``: ["+X*Ey(X) of this component", "dX", ...]."""
+    out = []
+    for name, expr in sorted(image.items(), key=lambda kv: kv[0] != own):
+        for t in sp.Add.make_args(sp.expand(expr)):
+            if t == 0 or (name == own and skip is not None and sp.expand(t - skip) == 0):
+                continue
+            if sym in t.free_symbols:
+                c, m = t.as_coeff_Mul()
+                out.append(f"{_signed(c, m)} of this component" if name == own else
+                           f"{_signed(c, m)} of {name}")
+    return out
 
 
-def repetition_note(wrong, before: dict, after: dict) -> tuple[str, bool]:
-    """(evidence sentence, repeated) on whether a wrong printed term repeats a term of the same
-    image: ``repeated`` when every wrong term stands in a component read before it (a
-    repetition within an image, which the cross-copy rule leaves undecided)."""
-    if not wrong:
+def repetition_check(expected, printed, image: dict, own: str) -> tuple[str, bool]:
+    """Whether the defect of ``printed`` against ``expected`` (the closest reading) is a
+    candidate repetition within one printed image: every wrong element -- the symbol printed
+    in place of another, or an extra term -- stands elsewhere in the same image (``image``:
+    {component name: printed expression}, ``own`` this component's name), before or after it
+    (an extraction reads the whole image; an author writes from the neighbouring line).
+    Returns (evidence sentence, repeated).  A sign or coefficient defect is no repetition.
+    When no wrong element stands elsewhere the sentence says so (for a printing error)."""
+    d = term_diff(expected, printed)
+    if d["sign"] or d["coefficient"] or not (d["swapped"] or d["extra"]):
         return "", False
-    b, a = term_elsewhere(wrong, before, after)
-    if b and len(b) == len(wrong):
-        return (" The wrong term" + ("s " if len(wrong) > 1 else " ")
-                + ", ".join(f"{fmt(t)} (as in {n})" for t, n in b)
-                + " repeat" + ("" if len(wrong) > 1 else "s")
-                + " a term printed before it in the same image: a repetition within an image, "
-                  "which the print (a line copied) and the extraction (a repeated span) explain "
-                  "equally (cross-copy rule); what would decide: the page of the original PDF.",
+    found, missing = [], []
+    for p, e in d["swapped"]:
+        sym = _swap(e.as_coeff_Mul()[1], p.as_coeff_Mul()[1])[0]
+        where = _occurrences(sym, image, own, p)
+        (found if where else missing).append((f"symbol {fmt(sym)}", where))
+    for t in d["extra"]:
+        c, m = t.as_coeff_Mul()
+        where = [f"{_signed(*u.as_coeff_Mul())} of {name}" for name, expr in image.items()
+                 if name != own for u in sp.Add.make_args(sp.expand(expr))
+                 if u != 0 and u.as_coeff_Mul()[1] == m]
+        (found if where else missing).append((f"term {fmt(t)}", where))
+    if found and not missing:
+        parts = "; ".join(f"the wrong {what} also stands in {', '.join(where[:3])}"
+                          for what, where in found)
+        return (f" Candidate repetition within one image: {parts} (the same printed "
+                f"equation). The print (the author writing it from the neighbouring term or "
+                f"line) and the extraction (a token of the neighbouring text emitted again in "
+                f"place of the right one -- in either reading order, since an extraction reads "
+                f"the whole image) explain it equally; by the cross-copy rule a repetition within "
+                f"an image is not decided. What would decide: the page of the original PDF.",
                 True)
-    if a:
-        return (" The wrong term " + ", ".join(f"{fmt(t)} also stands in {n}, printed after it"
-                                                for t, n in a)
-                + ": in reading order it comes first here, so it is no repetition of text "
-                  "already read; the author's line written from the later one explains it.",
-                False)
-    return "", False
+    if missing and not found:
+        return (" The wrong " + "; the wrong ".join(what for what, _ in missing)
+                + " stand" + ("s" if len(missing) == 1 else "")
+                + " nowhere else in this printed equation: no repetition of a neighbouring "
+                  "token.", False)
+    head = "; ".join(f"the wrong {what} also stands in {', '.join(where[:3])}"
+                     for what, where in found)
+    return (" " + head[0].upper() + head[1:] + "; " + "; ".join(f"the wrong {what} stands nowhere else" for what, _ in missing)
+            + " in this printed equation: not every wrong element can be a repetition.",
+            False)
 
 
 def lost_glyphs(expected, printed) -> list[str]:

@@ -77,6 +77,31 @@ COPIES = {
 }
 
 
+#: why the missing minus of T_2^3 (thesis eq. 3.32, project eq. (3)) is decided as printed
+T23_CROSS_COPY = (
+    "Category printing_error by the cross-copy rule: a single sign, but {other} -- the same "
+    "defect at the same entry in two separately typeset documents. Read as a loss or as a "
+    "repetition (the entry s_B of row 2, without its minus, in row 1), a failure driven by "
+    "the image would recur in images of the same layout, and the extraction reads the same "
+    "matrix with its minus there: the paper's eq. 1.3 ('c_{{B}} & -s_{{B}} & 0 & 0 \\\\ "
+    "s_{{B}} & c_{{B}}') and eq. 1.16 (T_BB, the same entries), and '-s_C' in thesis eq. "
+    "3.35; so the author's source has it. The paper's eq. 1.3 and Listing 3.3's T_B "
+    "(np.array([[c_B, -s_B, 0, 0]], ...)) show the intended rotation")
+
+
+#: why T_2^2 of the printed chains (thesis eq. 3.37, project eq. (8)) is undecided
+T22_UNDECIDED = (
+    "{here}: its subscript 2 repeats the superscript 2 written next to it, a candidate "
+    "repetition within the image; {there}. By the cross-copy rule that does not decide a "
+    "repetition: the two chains are images of the same layout (one line of factors T_a^b in "
+    "the same order), where a failure driven by the image recurs at the same place. For the "
+    "print: the author's chain written with these indices (the thesis' chain taken from the "
+    "project's). For the extraction: the superscript digit read again as the subscript, a "
+    "repetition of the kind it demonstrably makes within an image (the error matrix of "
+    "T_0^{{t,c}} after eq. 3.37 has three rows '-E_{{DX}} & ... & 1 & E_{{ZX}}', two of them "
+    "identical).")
+
+
 def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, list, list]:
     """(category, evidence, readings tried, readings used) of a printed matrix that differs
     from the derived one."""
@@ -108,19 +133,17 @@ def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, 
                 "a row repeated by the print or by the extraction: the derived factor with the "
                 "repeated row removed (exact)"], [f"glyph:{name} repeated row"]
     if name == "T_2^3" and "sign error" in erratum:
-        return "printing_error", evidence + (
-            ". Category printing_error by the cross-copy rule: a single sign, but the same "
-            "sign stands at the same entry in the specialization project's eq. (3), a "
-            "separately typeset document (appendix B), while the extraction reads the minus of "
-            "'-s_B' in the paper's eq. 1.3 and of '-s_C' in eq. 3.35 right: a substitution it "
-            "would have to make identically in two images, so the author's source; the "
-            "conference paper's eq. 1.3 and Listing 3.3's T_B have -s_B: the author's intended "
-            "rotation"), [
+        return "printing_error", evidence + ". " + T23_CROSS_COPY.format(
+            other="the specialization project's eq. (3) (appendix B) prints the same "
+                  "'T_2^3 = [[c_B, s_B], [s_B, c_B]]' and the 'updated' chain after eq. 3.37 "
+                  "repeats it (T_2^{3,c})"), [
                 "right-handed rotation Rz(B) (derived; paper eq. 1.3, Listing 3.3 T_B): entry "
                 "(1,2) differs",
                 "left-handed Rz(-B) (the other rotation sense): entry (2,1) differs",
-                "a minus lost by the extraction: contradicted by the same defect in project eq. "
-                "(3)"], ["inconsistent:T_2^3 sign of s_B (1,2)"]
+                "a minus lost by the print or by the extraction: the derived factor exactly; "
+                "the extraction's part contradicted by the same defect in project eq. (3) and "
+                "the minus read in the same matrix of paper eq. 1.3 and 1.16"], [
+                "inconsistent:T_2^3 sign of s_B (1,2)"]
     return "printing_error", evidence, [], []
 
 
@@ -356,22 +379,26 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
     if "3.37" in prod:
         same, erratum, ev = _product_diff(prod["3.37"], DERIVED_ORDER)
         v = _verdict("eq. 3.37", same, erratum, ev + "; T_a^b maps frame b into frame a, "
-                     "T_w^t = (T_0^w)^-1 T_0^t. 'T_2^2' (no frame maps into itself) stands at "
-                     "the same place in the specialization project's eq. (8), a separately "
-                     "typeset document ('T_w^5 T_5^4 T_4^3 T_2^2 T_1^1 T_1^0 T_0^t'), so the "
-                     "author's source has it: the factors T_3^2 T_2^1 are misprinted. "
-                     "'T_1^d' for T_0^t (d is a length, not a frame) is only in this copy "
-                     "(project eq. (8) ends with T_0^t): print or extraction. Category "
-                     "printing_error: at least the T_2^2 defect is decided to be printed",
+                     "T_w^t = (T_0^w)^-1 T_0^t. " + T22_UNDECIDED.format(
+                         here="'T_2^2' (no frame maps into itself) stands where T_3^2 T_2^1 "
+                              "belong", there="the specialization project's eq. (8), a "
+                              "separately typeset document, has it at the same place ('T_w^5 "
+                              "T_5^4 T_4^3 T_2^2 T_1^1 T_1^0 T_0^t', where T_1^1 repeats its "
+                              "superscript as well)")
+                     + " 'T_1^d' for T_0^t (d is a length, not a frame) stands in this copy only "
+                       "(project eq. (8) ends with T_0^t): glyph-level, print or extraction, "
+                       "undecided too. Category undecidable; what would decide: the page of "
+                       "the original PDF",
                      prod.get("3.37_text", ""), " ".join(DERIVED_ORDER),
-                     category="printing_error")
+                     category="undecidable")
         v.readings_tried = ["the derived order T_w^5 T_5^4 T_4^3 T_3^2 T_2^1 T_1^0 T_0^t: "
                             "differs in factors 4-7",
-                            "extraction damage of the sub- and superscripts: excluded for "
-                            "T_2^2 by project eq. (8); possible for T_1^d",
+                            "the subscript of T_2^2 a repetition of its superscript (print or "
+                            "extraction): not decided by project eq. (8), an image of the same "
+                            "layout with the same defect; T_1^d: print or extraction",
                             "the paper's eq. 1.8 form (T_5^w)^-1 ... (T_0^1)^-1 T_0^t: equals "
                             "the derived order (see eq. 1.8)"]
-        v.readings_used = ["inconsistent:eq. 3.37 factor T_2^2"]
+        v.readings_used = ["glyph:eq. 3.37 factor T_2^2 repeats its superscript"]
         out.append(v)
     lst = printed.get("listing", {})
     names = {"T_d": "T_0^1", "T_45": "T_1^2", "T_B": "T_2^3", "T_n45": "T_3^4", "T_nd": "T_4^5",
@@ -490,8 +517,9 @@ def _audit_t_er(layout, chain, lst, factors, d_value) -> Verdict:
     same = not rows
     size = _t_er_size_um(lst, factors, t0w_num, err_num, layout, d_value, p_table)
     ev = (f"size of the difference with every angular error of B and C at "
-          f"{TYPICAL['angular_rad'] * 1e6:g} urad (signs worst case): up to {size:.2g} um at the "
-          f"listing's point; first-order effect per error parameter on the table point (179.009, "
+          f"{TYPICAL['angular_rad'] * 1e6:g} urad (signs worst case; an assumed size, the "
+          f"errors are not printed as numbers -- the difference scales in proportion to them): "
+          f"up to {size:.2g} um at the listing's point; first-order effect per error parameter on the table point (179.009, "
           "94.545, 143.533) mm (workpiece frame), listing with rot_y and the data sources "
           "corrected -- each effect is the displacement of the tool relative to the workpiece, "
           "expressed in the workpiece (table) frame, per 1 um or 1 urad of the parameter: " +

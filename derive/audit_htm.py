@@ -33,7 +33,7 @@ import sympy as sp
 from volerr.machine.layout import read_layout
 
 from .audit import Verdict, category_of, fmt
-from .audit_dmu50 import derived_factors, derived_forward
+from .audit_dmu50 import T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward
 from .kinematics import Chain, position_symbol, rotation, stage_factors, translation
 
 DATA_FILE = "printed_htm.toml"
@@ -122,24 +122,41 @@ def audit_matrix(item: dict) -> list[Verdict]:
                   f"inverse (transposed rotation block): {'exact' if sinv else 'differs'}"]
         det = sp.simplify(printed[:3, :3].det())
         if name == "T_5^w" and srev:
-            ev = ("printed Rz(+C); the derived T_5^w turns by -C: " + "; ".join(bad) + ". The "
-                  "reversed sense of C reproduces it exactly, but the documents fix the sense: "
-                  "the project report's frame 7 'x_w y_w z_w rotates x_5 y_5 z_5 an angle -C "
-                  "about z_5', thesis eq. 3.35, project eq. (6) and Listing 3.3 T_C print "
-                  "Rz(-C), and Sorby's forward kinematics (eq. 3.19-3.24) need it. The matrix is "
-                  "the paper's eq. 1.3 with B replaced by C, sign pattern and label included: a "
-                  "copied equation not adapted. Category printing_error")
+            tried[1] = ("rotation sense reversed: exact, but the documents fix the sense of C "
+                        "(see the evidence): a reading the document contradicts")
+            tried[2] = (f"inverse (transposed rotation block): {'exact' if sinv else 'differs'}"
+                        ", but eq. 1.8 writes the inverse explicitly, (T_5^w)^{-1}: the factor "
+                        "printed here is T_5^w itself")
+            tried.append("extraction damage: a minus moved from (2,1) to (1,2), two glyph "
+                         "defects at once; the block's eq. 1.4 is read with its minus at (3,2)")
+            ev = ("printed Rz(+C), extraction text '" + item.get("text", "") + "'; the derived "
+                  "T_5^w turns by -C: " + "; ".join(bad) + ". Readings: (1) the reversed sense "
+                  "of C reproduces it exactly, but the documents fix the sense: the project "
+                  "report's frame 7 'x_w y_w z_w rotates x_5 y_5 z_5 an angle -C about z_5', "
+                  "thesis eq. 3.35, project eq. (6) and Listing 3.3 T_C print Rz(-C), and "
+                  "Sorby's forward kinematics (eq. 3.19-3.24) need it. (2) The inverse (the "
+                  "transposed rotation block) reproduces it too, but eq. 1.8 writes the inverse "
+                  "explicitly, (T_5^w)^{-1}: the factor printed here is T_5^w itself, and read "
+                  "as its inverse the chain would invert it twice. (3) Extraction damage would "
+                  "have to move a minus from (2,1) to (1,2) -- lose one and insert one, two "
+                  "glyph defects that turn one rotation into the other -- while the same block "
+                  "is read with the minus of a rotation's other sign pattern (eq. 1.4, "
+                  "'0 & -s_{45^\\circ} & c_{45^\\circ}' in its row 3): it does not normalise "
+                  "rotations to one sign pattern; the vertical bars and lower-case c_c, s_c of "
+                  "the extraction change no entry. The print is the well-formed Rz(+C), eq. "
+                  "1.3's sign pattern with B replaced by C (the label T_2^3 is eq. 1.3's too, "
+                  "see the label's verdict; the category does not rest on the label, as labels "
+                  "of this block are damaged elsewhere). Category printing_error: a rotation "
+                  "sense that contradicts the one the same documents fix")
             out.append(_v(item, "matrix", "printing_error", "rotation sense of C reversed (eq. "
-                          "1.3 copied with B -> C)", ev, str(item["rows"]), fmt(derived), tried,
-                          ["inconsistent:paper eq. 1.6 sense of C"]))
+                          "1.3's sign pattern with B -> C)", ev, str(item["rows"]),
+                          fmt(derived), tried, ["inconsistent:paper eq. 1.6 sense of C"]))
         elif name == "T_2^3":
             ev = ("; ".join(bad) + f"; the printed 3x3 block has det = {fmt(det)}: not a "
-                  "rotation in either sense. Category printing_error by the cross-copy rule: "
-                  "a single sign, but thesis eq. 3.32, typeset separately, prints the same "
-                  "[[c_B, s_B], [s_B, c_B]], while the extraction reads the minus of '-s_B' in "
-                  "the paper's eq. 1.3 and of '-s_C' in thesis eq. 3.35 right: the author's "
-                  "source; the paper's eq. 1.3 and Listing 3.3 T_B print the rotation "
-                  "[[c_B, -s_B], [s_B, c_B]]")
+                  "rotation in either sense. " + T23_CROSS_COPY.format(
+                      other="thesis eq. 3.32, typeset separately, prints the same [[c_B, s_B], "
+                            "[s_B, c_B]], and so does the thesis' 'updated' chain after eq. "
+                            "3.37 (T_2^{3,c})"))
             out.append(_v(item, "matrix", "printing_error", "sign error in 1 entry (as thesis "
                           "eq. 3.32)", ev, str(item["rows"]), fmt(derived), tried,
                           ["inconsistent:T_2^3 sign of s_B (1,2)"]))
@@ -162,7 +179,8 @@ def audit_matrix(item: dict) -> list[Verdict]:
                "extraction": "ocr"}[kind]
         out.append(_v(item, "label", cat, f"labelled {item['label']} for {name}",
                       f"the factor at this place of the chain is {name}; printed label "
-                      f"{item['label']}: {item.get('label_note', '')}. {why}", item["label"],
+                      f"{item['label']}: {item.get('label_note', '')}. "
+                      f"{item.get('label_why', why)}", item["label"],
                       name, [f"the label as printed, {item['label']}: not {name}",
                              f"read as {name}: the factor's place in eq. 1.8"],
                       [f"{key}:{item['doc']} eq. {item['id']} label"]))
@@ -228,20 +246,20 @@ def audit_product(item: dict) -> Verdict:
     bad = [n for n, m in zip(item["factors"], mats) if m is None]
     tried.append(f"the printed factors as frame pairs: {', '.join(bad)} map no frame of the "
                  f"chain")
-    tried.append("extraction damage of the sub- and superscripts: excluded for T_2^2, which "
-                 "thesis eq. 3.37 (typeset separately) prints at the same place; possible "
-                 "for T_1^1, which only this copy has")
-    return _v(item, "", "printing_error", f"{', '.join(bad)} printed for T_3^2, T_2^1",
+    tried.append("the subscripts of T_2^2 and T_1^1 repetitions of their superscripts (print "
+                 "or extraction): T_2^2 not decided by thesis eq. 3.37, an image of the same "
+                 "layout with the same defect; T_1^1 in this copy only")
+    return _v(item, "", "undecidable", f"{', '.join(bad)} printed for T_3^2, T_2^1",
               f"derived order {' '.join(order)}; printed {' '.join(item['factors'])}: "
               f"{', '.join(bad)} are no frame pairs of the chain (a frame does not map into "
-              f"itself). Thesis eq. 3.37, typeset separately, has T_2^2 at the same place "
-              f"('T_w^5 T_5^4 T_4^3 T_2^2 T_1^0 T_1^d'): by the cross-copy rule (a "
-              f"well-formed index substituted at the same place in two separately typeset "
-              f"copies) the T_2^2 for T_3^2 is in the author's source. T_1^1 for T_2^1 is only "
-              f"in this copy (thesis eq. 3.37 has no factor between T_2^2 and T_1^0): print or "
-              f"extraction (one digit), undecided. Category printing_error: at least the T_2^2 "
-              f"defect is decided to be printed", item["text"], " ".join(order), tried,
-              ["inconsistent:product factor T_2^2"])
+              f"itself). " + T22_UNDECIDED.format(
+                  here="T_2^2 stands where T_3^2 belongs and T_1^1 where T_2^1 belongs",
+                  there="thesis eq. 3.37, typeset separately, has T_2^2 at the same place "
+                        "('T_w^5 T_5^4 T_4^3 T_2^2 T_1^0 T_1^d'); T_1^1 stands in this copy "
+                        "only (the thesis has no factor between T_2^2 and T_1^0)")
+              + " Category undecidable; what would decide: the page of the original PDF",
+              item["text"], " ".join(order), tried,
+              ["glyph:product factors T_2^2, T_1^1 repeat their superscripts"])
 
 
 # ----------------------------------------------------------------------- linear axes
@@ -295,6 +313,11 @@ def audit_linear(item: dict) -> Verdict:
                                                  if ocr else ""),
                   str(item["rows"]), fmt(stage), tried, used)
     used = [f"flip:thesis {SQUARENESS[s][1]} (slope convention, eq. 3.11/3.13)" for s in flips]
+    if ocr:
+        # the repair of the extraction's symbols is part of what reproduces the print
+        used.append(f"ocr:{item['doc']} eq. {item['id']} symbols")
+        tried.append(f"the extraction's reading ({ocr}) with the thesis' squareness signs: "
+                     "exact (the printed symbols are read before any comparison)")
     names = "; ".join(f"{SQUARENESS[s][1]} positive when the moving axis leans toward the "
                       f"positive other axis ({SQUARENESS[s][2]})" for s in flips)
     iso = "; ".join(f"volerr/ISO 230-1 {SQUARENESS[s][0]}: right-handed rotation about "
@@ -382,16 +405,21 @@ def audit_rotary(item: dict) -> Verdict:
     return _v(item, "", "printing_error", f"{len(bad)} entries differ from (T_EB - I) Rz(B)",
               "derived (T_EB - I) Rz(B), first order (the squareness neglected as stated): "
               + "; ".join(bad) + ". No reading (rotation sense, transposed error rotation, "
-              "the HTM instead of the deviation) reproduces it. Entry (2,3) -E_XB (a "
-              "translational error where the rotation -E_AB belongs) and the bottom row "
-              "0 0 0 1 under a deviation are the defects of the thesis' eq. 2.42 for C, a "
-              "separately typeset document, at the same places: by the cross-copy rule "
-              "substitutions the extraction would have to make identically in two images "
-              "(it reads E_AB right in row 3 of this matrix), so the author's source; the "
-              "other three are single signs only this copy has (the thesis' matrix does not): "
-              "print or extraction, undecided. Category printing_error: at least the two "
-              "shared defects are decided to be printed", str(item["rows"]), fmt(dev), tried,
-              ["copy:paper eq. 1.17 entries of thesis eq. 2.42"])
+              "the HTM instead of the deviation) reproduces it. The bottom row 0 0 0 1 under "
+              "a deviation (the left-hand side of the equation ends in 0) is the defect of the "
+              "thesis' eq. 2.42 for C, a separately typeset document, at the same place: a "
+              "digit of a matrix row, not a symbol repeated from its neighbourhood, which the "
+              "extraction reads right in the same place of the specialization project's eq. "
+              "(23) ('0 & 0 & 0 & 0'), an image of the same layout there: by the cross-copy "
+              "rule the author's source. Entry (2,3) -E_XB (a translational error where the "
+              "rotation -E_AB belongs) is eq. 2.42's defect too, but E_XB also stands at "
+              "(1,4) of this matrix, three entries before: a candidate repetition, and the "
+              "two product matrices are images of the same layout, so it stays undecided (see "
+              "the verdict on eq. 2.42's error matrix). The other three are single signs only "
+              "this copy has (the thesis' matrix does not): print or extraction, undecided. "
+              "Category printing_error: the bottom row is decided to be printed",
+              str(item["rows"]), fmt(dev), tried,
+              ["copy:paper eq. 1.17 bottom row of thesis eq. 2.42"])
 
 
 # ------------------------------------------------------------------------------- items
@@ -529,7 +557,9 @@ def _actual_linear(item: dict, by_id: dict) -> Verdict:
               f"thesis does (eq. 3.11/3.13, the convention of eq. 1.10-1.11 / 3.17-3.18) they "
               f"differ only by the Abbe terms of the angular errors: {fmt(dropped)}; up to "
               f"{size:.3g} um with every angular error at 10 urad, X 500, Y 450, Z 400 mm and a "
-              f"tool point up to (100, 100, 200) mm. The simplification is stated: "
+              f"tool point up to (100, 100, 200) mm (assumed values: the text prints no "
+              f"error sizes; the dropped terms scale in proportion to the angular errors and "
+              f"the lever arms). The simplification is stated: "
               f"{item['statement']}", item["text"], fmt(der),
               ["the product of the derived stages, first order: differs by the Abbe terms",
                "angular errors set to zero (stated) with the thesis' squareness signs: exact"],

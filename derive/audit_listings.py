@@ -81,8 +81,11 @@ def audit_lookup(item: dict) -> list[Verdict]:
           "n = len(error_model) (no error raised). Run on an example (positions 0 .. -400 mm "
           "in 40 mm steps, a cubic error zero at 0, degree 3 as printed): "
           + "; ".join(rows) + f"; largest difference from the intended model over -400 .. -1 "
-          f"mm: {worst:.2f} um. Only pos = 0 reads its own value; elsewhere the value is right "
-          f"only where the curve happens to be equal at the mirror point. (The same axis with positive positions reads the intended curve "
+          f"mm: {worst:.2f} um -- a number of this assumed example (curve and travel are not "
+          f"printed): the error at a position is |f(pos) - f(pos - n)| for the fitted curve f "
+          f"(n = len(error_model)), zero for a constant curve and up to the whole range of f "
+          f"over the travel otherwise. Only pos = 0 reads its own value; elsewhere the value is "
+          f"right only where the curve happens to be equal at the mirror point. (The same axis with positive positions reads the intended curve "
           f"up to the 1 mm quantisation of round(): {q_worst:.3f} um here.) Extraction repairs: "
           f"{repairs}. Category printing_error: a defect of the printed code, not a convention "
           f"(the fix: error_model[abs(round(pos))], or np.polyval(coefficients, pos))")
@@ -111,8 +114,11 @@ def audit_lookup(item: dict) -> list[Verdict]:
           f"at 0 plus 1 um scatter, degree 4 as Listing 3.4 uses for E_XX): the fitted "
           f"constant is {const:.3f} um and the printed model differs from np.polyval by "
           f"{'exactly -c[degree] at every position' if same_everywhere else 'varying amounts'}"
-          f" ({float(np.max(np.abs(diffs))):.3f} um). The dropped constant is the fit's value "
-          f"at the reference position; it is zero only for an exact fit through 0. Category "
+          f" ({float(np.max(np.abs(diffs))):.3f} um, a number of this assumed example: the "
+          f"data are not printed). The dropped constant is the fit's value at the reference "
+          f"position: zero for an exact fit through 0, otherwise of the order of the scatter "
+          f"of the data at the reference (about the fit's residual), here 1 um of assumed "
+          f"scatter giving {abs(const):.3f} um. Category "
           f"printing_error: a defect of the printed code (range(1, degree + 1) adds it)")
     out.append(Verdict(SOURCE, item["id"], LAYOUT, "differs",
                        "constant term of the polynomial dropped for degree > 1", ev,

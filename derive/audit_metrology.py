@@ -81,10 +81,19 @@ def audit_spherical(item: dict) -> list[Verdict]:
                   f"(theta = azimuth, phi = elevation) the formulas do not give the tracker's "
                   f"coordinates; in the formulas phi is the azimuth and theta the angle from "
                   f"+z, which is 90 deg minus the elevation, not the elevation either way. "
+                  f"The one reading under which the formulas give the tracker's coordinates "
+                  f"(theta the polar angle, phi the azimuth; see the verdict on the formulas) "
+                  f"makes theta neither of the two angles the sentence names; read as an "
+                  f"unordered description ('the two angles are the azimuth and the "
+                  f"elevation'), phi is the azimuth but theta is still not the elevation. "
                   f"Category printing_error: a well-formed statement that contradicts the "
-                  f"equation it explains (no extraction damage)", item["names"],
+                  f"equation it explains under every reading (prose, no extraction damage: "
+                  f"each word is spelled right)", item["names"],
                   "phi the azimuth, theta the polar angle (90 deg - elevation)",
-                  tried, ["inconsistent:project eq. (25) angle names"]))
+                  [t.replace(": exact", ": exact for the formulas, but then theta is the polar "
+                                        "angle, which the sentence names neither azimuth nor "
+                                        "elevation") for t in tried],
+                  ["inconsistent:project eq. (25) angle names"]))
     return out
 
 

@@ -60,8 +60,12 @@ def check_reduction(c) -> list[Verdict]:
         ob = float(c["other_before"])
         ev += (f"; with the peak {c['other_before']} um quoted elsewhere for the same error it "
                f"would be {100 * (1 - a / ob):.1f} %")
-    ev += (". Category undecidable: 'approximately' does not bound the after-value; missing: "
-           "the post-compensation peak itself (the plotted data are not in the text)")
+    ev += (f". Explanations: (1) no defect -- the peak after compensation was about "
+           f"{need_after:.1f} um and the text rounds it to 'approximately {c['after']}'; (2) the "
+           f"percentage computed from other values than the quoted ones (e.g. another peak "
+           f"before compensation) or misprinted. Category undecidable: 'approximately' does "
+           f"not bound the after-value; missing: the post-compensation peak itself (the "
+           f"plotted data are not in the text)")
     v = _v(c, "percent", "undecidable", f"{c['percent']} % against {exact:.1f} % from the "
            "printed values", ev, quote, f"{exact:.1f} % (after = {c['after']} um)")
     v.readings_tried = [f"before {c['before']} um, after 'approximately {c['after']}' um taken "
@@ -253,17 +257,25 @@ def check_definition(c) -> list[Verdict]:
         if same_set:
             ev += (". The same three axis pairs, in another order: read 'respectively', the list "
                    "exchanges the planes of beta1 and beta2; the text after eq. 3 and every "
-                   "volumetric equation (4, 7, A2, A5, A8) use the eq. 4 assignment. CMM B's "
-                   "squareness values (sec. 4) are quoted in the list's order XY, YZ, ZX, so "
-                   "which of them is beta1 depends on the reading")
+                   "volumetric equation (4, 7, A2, A5, A8) use the eq. 4 assignment. Read as a "
+                   "plain enumeration (the three pairs, in no particular correspondence) the "
+                   "list would say nothing wrong, but every other entry of the same symbol "
+                   "list with several symbols pairs them respectively ('(Tx, Ty, Tz) : X, Y, Z "
+                   "축을 따라서 정의되는 회전변환행렬', 'Lx, Ly, Lz : X, Y, Z 축을 따라서 ...', "
+                   "'RX, RY, RZ : X, Y, Z 방향으로의 ...', 'A, B : ... 틸트각도 및 롤 각도'), "
+                   "so the list's own convention is 'respectively'. The wrong pairs are no "
+                   "glyph damage: 'YZ' and 'ZX' are well-formed pairs, and the extraction reads "
+                   "'X축 - Z축' and 'Y축 - Z축' right after eq. 3. Sec. 4 quotes CMM A's "
+                   "squareness for XY, XZ, YZ (the eq. 4 order) but CMM B's for XY, YZ, ZX (the "
+                   "list's order), so which of CMM B's values is beta1 depends on the reading")
         v = _v(c, comp, "printing_error", "squareness planes of "
                + ", ".join(bad) + " exchanged", ev + ". Category printing_error: a "
                "well-formed list of other axis pairs, not extraction damage", pl["text"],
                str(norm))
         v.readings_tried = ["the list read 'respectively' against eq. 4: " + ", ".join(
             f"{n}: {pl['pairs'][syms.index(n)]}" for n in bad),
-            "the order XY, YZ, ZX as a plain enumeration (not respectively): leaves the "
-            "assignment of the symbols open; the text after eq. 3 assigns them as eq. 4 does"]
+            "the order XY, YZ, ZX as a plain enumeration (not respectively): no contradiction, "
+            "but not the list's convention (its other multi-symbol entries pair respectively)"]
         v.readings_used = [f"inconsistent:{c['id']} {comp}"]
         out.append(v)
     return out

@@ -26,8 +26,7 @@ import sympy as sp
 
 from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
                     describe_diff, fmt, hits_text, is_identical, lost_glyphs, n_diff,
-                    n_issues, repetition_note, terms, typical_text, worst_case_um,
-                    wrong_printed_terms)
+                    n_issues, repetition_check, terms, typical_text, worst_case_um)
 from .audit_pahk_chain import audit_chain, audit_vectors, chain_error  # noqa: F401
 from .audit_pahk_model import (COMPONENTS, P, Reading, derived_error, geometries,  # noqa: F401
                                geometry_text, iso_error, layout, paper_map, paper_name, parse,
@@ -118,9 +117,12 @@ def audit_volumetric(eq: dict, geoms: tuple) -> tuple[list[Verdict], Reading]:
     physical = derived_error(name)
     best, best_d, rows = equation_reading(name, geoms, printed)
     best_keys = set(best.keys(lay))
+    left = {c: n_issues(a, b) for c, a, b in zip(COMPONENTS, best_d, printed)}
     whole = (f"whole equation (one machine) read as: {best.describe(lay)} "
              f"[{', '.join(sorted(best_keys)) or 'no reading'}]; "
-             f"{sum(n_issues(a, b) for a, b in zip(best_d, printed))} differing term(s) left")
+             f"{sum(left.values())} differing term(s) left"
+             + (" (" + ", ".join(f"{n} in {c}" for c, n in left.items() if n) + ")"
+                if sum(left.values()) else ""))
     out = []
     for i, c in enumerate(COMPONENTS):
         ocr = f" {notes[i]}." if notes[i] else ""
@@ -163,20 +165,18 @@ def audit_volumetric(eq: dict, geoms: tuple) -> tuple[list[Verdict], Reading]:
                 f"text extraction explain equally; what would decide: the page of the "
                 f"original PDF.")))
             continue
-        wrong = wrong_printed_terms(best_d[i], printed[i])
-        rep, repeated = repetition_note(
-            wrong, {COMPONENTS[j]: printed[j] for j in range(i)},
-            {COMPONENTS[j]: printed[j] for j in range(i + 1, len(COMPONENTS))})
+        rep, repeated = repetition_check(best_d[i], printed[i],
+                                         dict(zip(COMPONENTS, printed)), c)
         if repeated:
-            v.readings_used = [f"glyph:{eq['id']} {c} repeats an earlier term"]
+            v.readings_used = [f"glyph:{eq['id']} {c} repeats a token of the same image"]
             out.append(classify(v, "undecidable", evidence=v.evidence + rep + (
                 " Category undecidable."), alternative=fmt(best_d[i]) if best.cost() else ""))
             continue
         out.append(classify(v, "printing_error", evidence=v.evidence + rep + (
-            " The residual is no lost, repeated or confusable glyph but a well-formed term, "
-            "symbol or sign of the paper's notation (the axis letters X, Y, Z do not resemble "
-            "one another), which an extraction would have to invent; no convention or "
-            "geometry explains it: a printing error."),
+            " The residual is no lost or confusable glyph but a well-formed term, symbol or "
+            "sign of the paper's notation (the axis letters X, Y, Z do not resemble one "
+            "another), which an extraction would have to invent; no convention or geometry "
+            "explains it: a printing error."),
             alternative=fmt(best_d[i]) if best.cost() else ""))
     return out, best
 
@@ -322,9 +322,12 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
             evidence = (f"differs from exact propagation: {diff0}. Reproduced exactly by {d} "
                         f"(expand(term-wise - printed) == 0); the two agree when the probe offset "
                         f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
-                        f"up to {size:.2g} um ({typical_text()}, random angular errors "
-                        f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, translational "
-                        f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, 1 sigma). "
+                        f"up to {size:.2g} um ("
+                        + typical_text(f", random angular errors "
+                                       f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, "
+                                       f"translational "
+                                       f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, "
+                                       f"1 sigma") + "). "
                         f"Category simplification: Pahk states the quadrature formula (quoted "
                         f"in 'statement'), not that it is applied term by term; the term-wise "
                         f"form is how he applies it -- every printed random component of both "
@@ -347,8 +350,9 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
                         f"of {name}: {describe_diff(tw, pr)}. Reproduced exactly by {d}: a "
                         f"whole component of another equation in place of this one's -- by "
                         f"the cross-copy rule a substitution, which an extraction would have to "
-                        f"carry from one image into another; no convention of {name}: a "
-                        f"printing error.")
+                        f"carry from one image into another"
+                        + (f" ({eq['quote'][c]})" if c in eq.get("quote", {}) else "")
+                        + f"; no convention of {name}: a printing error.")
             v = classify(_verdict(eq, c, "differs", erratum, evidence + ocr, pr, exact),
                          "printing_error")
             v.readings_tried, v.readings_used = tried, list(hit[0])
@@ -364,7 +368,9 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
             v.readings_used = ["termwise", f"glyph:{eq['id']} {c}"]
             out.append(classify(v, "undecidable", evidence=v.evidence + (
                 f" Under the term-wise quadrature the only difference is a lost glyph "
-                f"({'; '.join(glyphs)}); a lost letter is explained equally by the print and "
+                f"({'; '.join(glyphs)}"
+                + (f"; raw '{eq['quote'][c]}'" if c in eq.get("quote", {}) else "")
+                + f"); a lost letter is explained equally by the print and "
                 f"by the text extraction (the same extraction reads R before beta_2 in RY^2 of "
                 f"this equation, which shows it can read the glyph, not that it did here); "
                 f"what would decide: the page of the original PDF.")))

@@ -284,7 +284,10 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
     for f in found[1:]:
         if f[3]:
             r = min(f[3], key=lambda r: (r.cost(), repr(r)))
-            tried.append(f"the chain {f[0]}: gives the layout read as {r.short(lay)}")
+            other = category_of(r.keys(lay)) == "printing_error"
+            tried.append(f"the chain {f[0]}: gives the layout read as {r.short(lay)}"
+                         + (" -- an axis stacking the text excludes for this layout (another "
+                            "machine), so it repairs nothing" if other else ""))
     if best is not None and best[0][0] != found[0][0]:
         fix = best[0][0].split(" (labels exchanged")[0]
         how = "" if best[1].cost() == 0 else f" read as: {best[1].describe(lay)}"
@@ -319,7 +322,13 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
                            f"geometry the text allows, but the same layout's result equation "
                            f"{result_eq['id'] if result_eq else ''} needs "
                            f"{stacking_text(*want)}: the document contradicts itself, a "
-                           f"printing error of the chain.")
+                           f"printing error of the chain. The other way round (the chain "
+                           f"right, eq. {result_eq['id'] if result_eq else ''} misprinted) "
+                           f"would need every component of the result equation misprinted in "
+                           f"the same way, while the layout's own stacking reproduces it "
+                           f"(see its verdicts); an extraction would have to exchange the "
+                           f"well-formed axis labels of the chain consistently, which no "
+                           f"glyph resemblance explains.")
             v.readings_used = list(keys) + [f"inconsistent:{name} stacking of the chain"]
             return [classify(v, "printing_error", alternative=_vec(best[0][2])
                              if best is not None else "")]
@@ -332,6 +341,11 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
         return [classify(v, cat, alternative=_vec(best[0][2]) if best is not None else "")]
     v.evidence += (" The printed chain is not the layout under any reading (conventions, "
                    "geometries the text allows, or other stackings): a printing error.")
+    if best is not None and "labels exchanged" in best[0][0]:
+        v.evidence += (" The printed labels are a permutation of the right ones (each stands "
+                       "once, none is lost or repeated): no repetition within the image; an "
+                       "extraction would have to exchange well-formed labels consistently, "
+                       "which no glyph resemblance explains (x, y, z).")
     v.readings_used = []
     return [classify(v, "printing_error",
                      alternative=_vec(best[0][2]) if best is not None else "")]

@@ -101,7 +101,8 @@ def printed_component(eq: dict, comp: str) -> tuple[sp.Expr, str]:
     raw = eq["expr"][comp]
     ocr = eq.get("ocr", {})
     if comp in ocr:
-        return parse(ocr[comp]), f"OCR text {raw!r} read as {ocr[comp]!r} ({ocr.get('note', '')})"
+        note = ocr.get("notes", {}).get(comp, ocr.get("note", ""))
+        return parse(ocr[comp]), f"Transcribed {raw!r} and read as {ocr[comp]!r} ({note})"
     return parse(raw), ""
 
 

@@ -31,8 +31,8 @@ from volerr.machine.layout import SQUARENESS
 
 from . import volumetric as vol
 from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
-                    describe_diff, fmt, hits_text, is_identical, n_issues, repetition_note,
-                    terms, typical_text, worst_case_um, wrong_printed_terms)
+                    describe_diff, fmt, hits_text, is_identical, n_issues, repetition_check,
+                    terms, typical_text, worst_case_um)
 from .audit_pahk_model import (OFFSETS, POS, P, flip_key, iso_error, layout, paper_map,
                                paper_name, parse, printed_component, stacking_text)
 from .kinematics import PROBE, parameter_symbol
@@ -289,6 +289,22 @@ def _line_support(all_eqs, eq, key, line) -> list[str]:
     return _same_symbol_elsewhere(all_eqs, eq, key, want)
 
 
+def _read_right_elsewhere(expected, printed, comps: dict, own: str, raw: dict) -> str:
+    """' The extraction reads the right symbol elsewhere in this equation: Ez(Y) (alpha =
+    alpha + Ez(Yo)).' for the symbols a printed rule has in place of the right ones, "" if
+    none is printed elsewhere (``raw``: the printed texts of the components)."""
+    from .audit import _swap, term_diff
+    out = []
+    for p, e in term_diff(expected, printed)["swapped"]:
+        want = _swap(e.as_coeff_Mul()[1], p.as_coeff_Mul()[1])[1]
+        hits = [f"{name} = {raw[name]}" for name, expr in comps.items()
+                if name != own and want in sp.expand(expr).free_symbols]
+        if hits:
+            out.append(f"{fmt(want)} ({'; '.join(hits[:2])})")
+    return (" The extraction reads the right symbol elsewhere in this equation: "
+            + "; ".join(out) + "." if out else "")
+
+
 def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list[Verdict]:
     """Verdicts on every rule of a transfer equation.  ``vol_reading``: the reading of the same
     layout's volumetric equation (its flips and stacking are the consistent ones);
@@ -307,6 +323,13 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
     for key in eq["expr"]:
         pr, note = printed_component(eq, key)
         ocr = f" {note}." if note else ""
+        if key in eq.get("cut", {}):
+            rr = rule_readings(name, iso_of(lay, key), stacking)
+            table = stacking[1] if stacking is not None else lay.workpiece_chain
+            vf = tuple(f for f in vol_flips if f == iso_of(lay, key) or f in table)
+            out.append(_cut_verdict(eq, key, name, lay, rr, vf, geometry_key, verdict, note,
+                                    all_eqs))
+            continue
         iso = iso_of(lay, key)
         squ = iso in SQUARENESS
         rr = rule_readings(name, iso, stacking)
@@ -341,15 +364,8 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
                     f"convention from an omitted transfer; the same reading (the slope of the "
                     f"{r.line} line) reproduces Pahk's non-trivial rules for {key} on the other "
                     f"layouts: " + ("; ".join(support) if support else "none") + ".")
-            elif pr == P(key) and v.category == "undecidable":
-                same = _same_symbol_elsewhere(all_eqs, eq, key,
-                                              lambda n, p: "" if p == P(key) else None)
-                if same:
-                    v.evidence += (f" The same unchanged rule '{key} = {key}' is printed for "
-                                   f"{', '.join(x.split(':')[0] for x in same)} too: a "
-                                   f"pattern rather than a one-off misprint, which fits a "
-                                   f"set-up without these offsets or a rule applied without "
-                                   f"being stated; it does not decide between them.")
+            elif eq["expr"][key] == key and v.category == "undecidable":
+                v.evidence += _pattern_note(all_eqs, eq, key, d0)
             out.append(v)
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
@@ -357,12 +373,8 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
                                      RANK[category_of(x.keys(lay, vf, geometry_key))],
                                      len(x.keys(lay, vf, geometry_key)), repr(x)))
         d = derived_rule(name, key, r)
-        keys_order = list(eq["expr"])
-        k = keys_order.index(key)
-        comps = {c: printed_component(eq, c)[0] for c in keys_order}
-        rep, repeated = repetition_note(
-            wrong_printed_terms(d, pr), {c: comps[c] for c in keys_order[:k]},
-            {c: comps[c] for c in keys_order[k + 1:]})
+        comps = {c: printed_component(eq, c)[0] for c in eq["expr"]}
+        rep, repeated = repetition_check(d, pr, comps, key)
         evidence = (f"derived {key} = {fmt(d0)}; printed differs by: {diff0}. No reading "
                     f"reproduces it (all {len(rr)} combinations tried); closest: "
                     f"{r.describe(lay, iso, vf)}, which leaves: {describe_diff(d, pr)}."
@@ -370,16 +382,120 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
         if repeated:
             v = classify(verdict(eq, key, "differs", erratum, evidence + ocr
                                  + " Category undecidable.", pr, d0), "undecidable")
-            v.readings_used = [f"glyph:{eq['id']} {key} repeats an earlier rule's term"]
+            v.readings_used = [f"glyph:{eq['id']} {key} repeats a token of the same image"]
         else:
-            v = classify(verdict(eq, key, "differs", erratum, evidence + (
-                " The residual is no lost, repeated or confusable glyph but a well-formed "
-                "term or symbol of the paper's notation (the letters X, Y, Z do not resemble "
-                "one another), which an extraction would have to invent: a printing error.")
+            right = _read_right_elsewhere(d, pr, comps, key, eq["expr"])
+            v = classify(verdict(eq, key, "differs", erratum, evidence + right + (
+                " The residual is no lost or confusable glyph but a well-formed term or symbol "
+                "of the paper's notation (the letters X, Y, Z do not resemble one another), "
+                "which an extraction would have to invent: a printing error.")
                 + ocr, pr, d0), "printing_error")
         v.readings_tried = tried
         out.append(v)
+    if eq.get("table_note"):
+        for v in out:
+            if v.category != "identical" and any("table" in t for t in v.readings_tried):
+                v.evidence += f" Table axis: {eq['table_note']}."
     return out
+
+
+def _cut_verdict(eq, key, name, lay, rr, vf, geometry_key, verdict, note, all_eqs):
+    """The verdict on a rule whose printed text is cut off (``[equation.cut]``): every
+    restoration is audited with every reading; the text does not tell which holds, so the
+    verdict is undecidable unless all restorations lead to one category."""
+    iso = iso_of(lay, key)
+    d0 = derived_rule(name, key)
+    raw = eq["expr"][key]
+    results = []
+    for text, lost in eq["cut"][key]:
+        pr = parse(text)
+        if is_identical(d0, pr):
+            results.append((text, lost, "identical", (), "the full transfer itself"))
+            continue
+        pt = terms(pr)
+        hits = [(r.keys(lay, vf, geometry_key), r) for r in rr if _matches(name, key, r, pt)]
+        best = best_combination(hits)
+        if best is None:
+            results.append((text, lost, "printing_error", (), "no reading"))
+        else:
+            results.append((text, lost, category_of(best[0]), best[0],
+                            best[1].describe(lay, iso, vf)))
+    cats = sorted({c for _, _, c, _, _ in results})
+    listing = "; ".join(f"if {lost} was lost, the rule reads {key} = {text}: "
+                        + (f"{how} -> {cat}" if cat != "identical" else "the full transfer "
+                           "-> identical")
+                        + (f" [{', '.join(keys)}]" if keys else "")
+                        for text, lost, cat, keys, how in results)
+    others = _elsewhere_note(all_eqs, eq, key)
+    category = cats[0] if len(cats) == 1 else "undecidable"
+    v = verdict(eq, key, "differs", f"rule cut off after {raw!r}: what was lost decides the "
+                f"category", f"derived {key} = {fmt(d0)}; printed {raw!r}: "
+                f"{eq.get('ocr', {}).get('notes', {}).get(key, 'the text is cut off')}. Restorations "
+                f"tried, each with all {len(rr)} combinations of readings: {listing}." + others
+                + (" The restorations lead to different categories and the text does not tell "
+                   "what was lost: the print (a line of the source cut short) and the "
+                   "extraction (the end of a line dropped) explain the cut equally. Category "
+                   "undecidable; what would decide: the page of the original PDF."
+                   if category == "undecidable" else ""), raw, d0)
+    v.readings_tried = [f"restoration {text!r} ({lost} lost): "
+                        + (f"{how} -> {cat}" if cat != "identical" else "identical")
+                        for text, lost, cat, keys, how in results]
+    v.readings_used = [f"glyph:{eq['id']} {key} cut off"]
+    return classify(v, category)
+
+
+def _pattern_note(all_eqs, eq, key, d0) -> str:
+    """For a rule printed unchanged: how the other layouts print it, and what that shows."""
+    note = _elsewhere_note(all_eqs, eq, key)
+    if not note:
+        return ""
+    same_rule, with_terms = [], []
+    for e in all_eqs:
+        if e.get("kind") != "transfer" or e["layout"] == eq["layout"] or key not in e["expr"]:
+            continue
+        raw = e["expr"][key]
+        if raw == key or key in e.get("cut", {}):
+            continue
+        with_terms.append(f"{e['layout']} eq. {e['id']}")
+        if is_identical(derived_rule(e["layout"], key), d0):
+            same_rule.append(with_terms[-1])
+    out = note
+    if any(e.get("kind") == "transfer" and e["layout"] != eq["layout"]
+           and e["expr"].get(key) == key for e in all_eqs):
+        out += (" Several unchanged prints are a pattern rather than a one-off misprint, which "
+                "fits a set-up without these offsets or a rule applied without being stated")
+    if with_terms:
+        out += ((";" if out.endswith("stated") else "") + (" t" if out.endswith("stated") else
+                                                           " T") + f"he print with terms on "
+                f"{', '.join(with_terms)}"
+                + (" (the same derived rule as here)" if same_rule == with_terms else
+                   f" (the same derived rule as here on {', '.join(same_rule)})"
+                   if same_rule else " (another derived rule)")
+                + " shows the author writing Abbe terms for this rule elsewhere, which points "
+                  "towards an omission here")
+    return out + "; the prints do not decide between these."
+
+
+def _elsewhere_note(all_eqs, eq, key) -> str:
+    """How the other layouts print the rule of ``key`` (raw text): the unchanged prints, the
+    prints with terms, the damaged ones."""
+    same, other = [], []
+    for e in all_eqs:
+        if e.get("kind") != "transfer" or e["layout"] == eq["layout"] or key not in e["expr"]:
+            continue
+        raw = e["expr"][key]
+        where = f"{e['layout']} eq. {e['id']}"
+        if raw == key:
+            same.append(where)
+        else:
+            cut = key in e.get("cut", {})
+            other.append(f"{where} prints '{key} = {raw}'" + (" (cut off)" if cut else ""))
+    parts = []
+    if same:
+        parts.append(f"the unchanged rule '{key} = {key}' is printed for {', '.join(same)}")
+    if other:
+        parts.append("; ".join(other))
+    return (" On the other layouts " + "; ".join(parts) + "." if parts else "")
 
 
 def _tried(name, key, rr, pr, lay, iso, vol_flips, geometry_key, hits) -> list[str]:

@@ -14,9 +14,11 @@ k decimals (or k significant digits, as numpy prints) stands for its rounding in
   consistency checks against the other printed material and what is missing.
 * Pahk's band (range of the averaged curve over the positions) and repeatability R (largest
   2 sigma of single readings): averaging n runs leaves noise of sigma / sqrt(n) in the curve,
-  whose range over m = 10 positions exceeds 1.86 sigma / sqrt(n) in 95 % of cases (5 %
-  quantile of the range of 10 normal values, simulated here); a band below that needs at
-  least n runs -- the number of runs is not printed.
+  whose range over m positions exceeds q05(m) sigma / sqrt(n) in 95 % of cases (q05: the 5 %
+  quantile of the range of m normal values, simulated here; 1.86 for m = 10); a band below
+  that needs at least n runs.  Neither the number of runs nor that of the positions is
+  printed: m is taken from a 100 mm and a 50 mm pitch over the travel, and a pair consistent
+  with the two runs the text implies ("repeated measurements") is identical.
 """
 
 from __future__ import annotations
@@ -39,9 +41,9 @@ def interval(text: str) -> tuple[float, float]:
 
 
 def _v(source, eq, comp, category, erratum, evidence, printed, derived, tried=(), used=(),
-       **f) -> Verdict:
+       verdict="differs", **f) -> Verdict:
     same = category == "identical"
-    return Verdict(source, eq, LAYOUT, "identical" if same else "differs",
+    return Verdict(source, eq, LAYOUT, "identical" if same else verdict,
                    "" if same else erratum, evidence, printed, derived, comp,
                    category=category, readings_tried=list(tried), readings_used=list(used), **f)
 
@@ -109,13 +111,18 @@ def audit_nc(item: dict) -> list[Verdict]:
 
 def audit_eyx(item: dict, nc: dict | None) -> list[Verdict]:
     src, eq = item["source"], item["id"]
-    out = [_v(src, eq, "values", "undecidable", f"{item['before']} -> {item['after']} um "
-              "not reproducible", f"the peaks {item['before']} um (before) and {item['after']} "
-              "um (after) of E_YX are read from the plots of Figures 4.1 and 4.11, which the "
-              "text does not carry; nothing printed gives either value. Category undecidable; "
-              "missing: the E_YX data before and after compensation", item["text"],
-              f"{item['before']} -> {item['after']} um",
-              ["no printed input reproduces the values"], [f"missing:{eq} data"])]
+    out = [_v(src, eq, "values", "undecidable", f"{item['before']} -> {item['after']} um: "
+              "not checkable (the plotted data are not printed)", f"the peaks "
+              f"{item['before']} um (before) and {item['after']} um (after) of E_YX are read "
+              "from the plots of Figures 4.1 and 4.11, which the text does not carry; nothing "
+              "printed gives either value or contradicts it (no discrepancy is shown: the "
+              "verdict 'unchecked' says only that the values could not be compared): the values "
+              "as read from the plots, or ones misread from them or misprinted -- nothing "
+              "printed tells them apart. Category "
+              "undecidable; missing: the E_YX data before and after compensation",
+              item["text"], f"{item['before']} -> {item['after']} um",
+              ["no printed input reproduces or contradicts the values"], [f"missing:{eq} data"],
+              verdict="unchecked")]
     if nc is not None:
         ys = [abs(float(r[1])) * 1e3 for r in nc["comp"] if r[1]]
         out.append(_v(src, eq, "attribution", "printing_error",
@@ -144,12 +151,17 @@ def audit_eyx(item: dict, nc: dict | None) -> list[Verdict]:
 
 def audit_unreproducible(item: dict) -> Verdict:
     return _v(item["source"], item["id"], "", "undecidable",
-              f"{item['value']} {item['unit']} not reproducible",
+              f"{item['value']} {item['unit']}: not checkable (its data are not printed); no "
+              f"inconsistency found",
               f"{item['quantity']}: no printed input reproduces it. Consistency with the rest "
-              f"of the text: " + "; ".join(item["consistent"]) + f". Category undecidable; "
-              f"missing: {item['missing']}", item["text"], f"{item['value']} {item['unit']}",
+              f"of the text: " + "; ".join(item["consistent"]) + f". No discrepancy is shown "
+              f"(the verdict 'unchecked' says only that the value could not be compared): the "
+              f"value as read from the plot, or one misread from it or misprinted -- nothing "
+              f"printed tells them apart. "
+              f"Category undecidable; missing: {item['missing']}", item["text"],
+              f"{item['value']} {item['unit']}",
               [f"checked: {c}" for c in item["consistent"]],
-              [f"missing:{item['id']} data"])
+              [f"missing:{item['id']} data"], verdict="unchecked")
 
 
 def audit_count(item: dict) -> Verdict:
@@ -161,44 +173,90 @@ def audit_count(item: dict) -> Verdict:
               + f" = {total} (printed {item['total']})", item["text"], str(total))
 
 
-_Q05 = None
+_Q05: dict = {}
+
+#: the number of measuring positions along the travel is not printed: from a 100 mm to a 50 mm
+#: pitch of a laser calibration (10 to 19 positions over CMM A's 900 mm X travel)
+PITCHES_MM = (100, 50)
+
+
+def positions(travel_mm: float) -> tuple[int, int]:
+    return tuple(int(travel_mm // p) + 1 for p in PITCHES_MM)
 
 
 def _range_q05(m: int = 10) -> float:
     """5 % quantile of the range of m standard normal values (simulated, seeded)."""
-    global _Q05
-    if _Q05 is None:
-        rng = np.random.default_rng(1995)
+    if m not in _Q05:
+        rng = np.random.default_rng(1995 + m)
         x = rng.standard_normal((40000, m))
-        _Q05 = float(np.quantile(x.max(axis=1) - x.min(axis=1), 0.05))
-    return _Q05
+        _Q05[m] = float(np.quantile(x.max(axis=1) - x.min(axis=1), 0.05))
+    return _Q05[m]
 
 
-def audit_band(item: dict) -> Verdict:
+def _n_min(band: float, sigma: float, m: int) -> int:
+    return max(1, math.ceil((_range_q05(m) * sigma / band) ** 2))
+
+
+def audit_band(item: dict, others: list | None = None) -> Verdict:
+    """Band (range of the averaged curve) against repeatability (largest 2 sigma of single
+    readings): averaging n runs leaves noise sigma / sqrt(n) in the curve; its range over m
+    positions exceeds q05(m) sigma / sqrt(n) in 95 % of cases.  ``others``: the other band
+    items of the same document (for the pattern)."""
     band, rep = float(item["band"]), float(item["repeatability"])
     sigma = rep / 2
-    q05 = _range_q05()
-    n_min = max(1, math.ceil((q05 * sigma / band) ** 2))
     u = item["unit"]
+    pos = positions(float(item["travel_mm"]))
+    ns = {m: _n_min(band, sigma, m) for m in pos}
+    lo, hi = ns[pos[0]], ns[pos[-1]]
     ev = (f"band {band:g} {u} (range of the averaged curve), repeatability {rep:g} {u} (the "
           f"largest 2 sigma of single readings over the positions, sec. 4); if every position "
           f"scattered as much as the worst one (sigma = {sigma:g} {u}), averaging n runs would "
-          f"leave noise sigma / sqrt(n) in the curve, whose range over 10 positions (the "
-          f"number is not printed) exceeds {q05:.2f} sigma / sqrt(n) in 95 % of cases: the "
-          f"band is then consistent with "
-          f"{'any number of runs' if n_min == 1 else f'at least {n_min} averaged runs'}")
-    if n_min == 1:
-        return _v(item["source"], item["id"], "", "identical", "", ev, item["text"],
-                  f"band >= {q05 * sigma:.3g} {u} for n = 1")
+          f"leave noise sigma / sqrt(n) in the curve, whose range over m positions exceeds "
+          + ", ".join(f"{_range_q05(m):.2f} sigma / sqrt(n) for m = {m}" for m in pos)
+          + f" in 95 % of cases (the number of positions is not printed: {pos[0]} to "
+          f"{pos[-1]} at the 100 or 50 mm pitch of a laser calibration over the "
+          f"{item['travel_mm']:g} mm travel)")
+    need = f"{lo}" if lo == hi else f"{lo} to {hi}"
+    if hi == 1:
+        return _v(item["source"], item["id"], "", "identical", "", ev + ": the band is "
+                  "consistent with any number of runs", item["text"],
+                  f"band >= {_range_q05(pos[-1]) * sigma:.3g} {u} for n = 1")
+    if hi <= 2:
+        return _v(item["source"], item["id"], "", "identical", "", ev + f": the band is "
+                  f"consistent with {need} averaged runs, and the text says the repeatability "
+                  f"comes from repeated measurements ('반복측정을 수행하여', n >= 2); assumed: "
+                  f"the plotted curve is the mean of those runs (the text does not say; a "
+                  f"single plotted run would need the band above "
+                  f"{_range_q05(pos[0]) * sigma:.3g} .. "
+                  f"{_range_q05(pos[-1]) * sigma:.3g} {u})", item["text"],
+                  f"n >= {need} runs")
+    pattern = [o for o in (others or []) if o["id"] != item["id"]
+               and o["source"] == item["source"] and o["id"].split(":")[0][:-3] ==
+               item["id"].split(":")[0][:-3]]
+    pat = ("; ".join(f"{o['id'].split(': ')[0].split(' ', 2)[-1]} band {o['band']}, "
+                     f"repeatability {o['repeatability']} {o['unit']}" for o in pattern))
+    ev += (f": the band is consistent with at least {lo} averaged runs for {pos[0]} "
+           f"positions and {hi} for {pos[-1]} (assumed: the plotted curve is the mean of the runs; fewer runs would leave the averaged curve's own noise above the "
+           f"printed band in 95 % of cases; a smaller scatter at the other positions would "
+           f"allow fewer). The text says the repeatability comes from repeated measurements "
+           f"('반복측정을 수행하여', n >= 2) but gives neither the number of runs (ISO 230-2's "
+           f"standard test has 5 per direction) nor the number of positions. Explanations: "
+           f"(1) no defect -- a band below the single-reading 2 sigma is what averaging "
+           f"{need} or more runs gives"
+           + (f", and the same figure group shows repeatabilities of the size of the band ("
+              f"{pat}), a pattern of these measurements rather than a one-off misprint"
+              if pattern else "")
+           + "; (2) a misprinted band or repeatability (a digit lost or exchanged), which "
+             "nothing printed supports or excludes. Category undecidable; missing: the number "
+             "of runs and of positions (the plots of Figure 4 are not in the text)")
     return _v(item["source"], item["id"], "", "undecidable",
-              f"repeatability {rep:g} {u} above the band {band:g} {u}",
-              ev + f" (with fewer runs the averaged curve's own noise would exceed the printed "
-              f"band in 95 % of cases; a smaller scatter at the other positions would allow "
-              f"fewer). The text gives neither the number of runs (ISO 230-2's standard test "
-              f"has 5 per direction) nor the scatter at each position. Category undecidable; "
-              f"missing: the number of runs", item["text"],
-              f"n >= {n_min} runs", [f"n runs averaged: consistent for n >= {n_min}",
-                                     "a single run: the band would be below the noise range"],
+              f"repeatability {rep:g} {u} above the band {band:g} {u}: consistent only with "
+              f"{need} or more averaged runs (not printed)", ev, item["text"],
+              f"n >= {need} runs",
+              [f"n runs averaged over {pos[0]} positions: consistent for n >= {lo}",
+               f"n runs averaged over {pos[-1]} positions: consistent for n >= {hi}",
+               "a single run: the band would be below the noise range",
+               "a misprinted band or repeatability: not decidable from the text"],
               [f"missing:{item['id']} number of runs"])
 
 
@@ -214,5 +272,6 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         out.extend(audit_eyx(printed["eyx"], nc))
     out.extend(audit_unreproducible(u) for u in printed.get("unreproducible", []))
     out.extend(audit_count(c) for c in printed.get("count", []))
-    out.extend(audit_band(b) for b in printed.get("band", []))
+    bands = printed.get("band", [])
+    out.extend(audit_band(b, bands) for b in bands)
     return out

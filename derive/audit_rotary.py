@@ -162,18 +162,34 @@ def audit_rotary(item: dict) -> list[Verdict]:
     out.append(_v(eq, "error matrix", not bad, "-E_XC printed where -E_AC belongs" if hint else
                   "; ".join(bad), "derived (T_ES - I) Rz(C), first order: "
                   + ("all entries of the first three rows agree" if not bad else "; ".join(bad))
-                  + hint + (" Category printing_error by the cross-copy rule: the "
-                            "conference paper's B-axis matrix eq. 1.17, typeset separately, has "
-                            "-E_XB at the same entry (2,3), while both matrices read the "
-                            "rotation E_A right in their row 3 (E_AC here, E_AB there): a "
-                            "substitution the extraction would have to make identically in two "
-                            "images; the author's source" if hint else ""),
-                  str(item["error_matrix"]), fmt(dev)))
+                  + hint + (" Candidate repetition within one image: E_XC also stands at "
+                            "(1,4) of this matrix, the entry read three entries before (2,3) "
+                            "('... & E_{\\rm BC}(C) & E_{\\rm XC}(C) \\\\ E_{\\rm CC}(C)"
+                            "cos\\theta & -E_{\\rm CC}(C)sin\\theta & -E_{\\rm XC}(C)'). "
+                            "The conference paper's B-axis matrix eq. 1.17, typeset separately, "
+                            "has -E_XB at the same entry below E_XB at (1,4), but the two "
+                            "product matrices are images of the same layout (the same entries "
+                            "with B for C), where a repetition driven by the image recurs at the "
+                            "same place: by the cross-copy rule that does not decide. The "
+                            "extraction reads -E_A right at (2,3) of the error matrices T_ES "
+                            "just above and T_EB (paper eq. 1.15), whose other entries differ "
+                            "(1 on the diagonal, no cos/sin), which decides neither. For the "
+                            "print: the author writing E_X of the entry above-right (and the "
+                            "paper's matrix made from the thesis' one). For the extraction: the "
+                            "token E_X of (1,4) emitted again, a repetition of the kind it "
+                            "demonstrably makes within an image (the error matrix of T_0^{t,c} "
+                            "after eq. 3.37 has three rows '-E_{DX} & ... & 1 & E_{ZX}', two of "
+                            "them identical). Category undecidable; what would decide: the page "
+                            "of the original PDF" if hint else ""),
+                  str(item["error_matrix"]), fmt(dev),
+                  category="undecidable" if hint else "printing_error"))
     if hint:
         out[-1].readings_tried = ["(T_ES - I) Rz(C), derived: entry (2,3) is -E_AC",
-                                  "a subscript letter confused by the extraction: excluded, the "
-                                  "separately typeset paper eq. 1.17 repeats -E_X at (2,3)"]
-        out[-1].readings_used = ["copy:eq. 2.42 (2,3) entry, also paper eq. 1.17"]
+                                  "E_XC of (1,4) repeated at (2,3), by the print or by the "
+                                  "extraction: the printed entry; the separately typeset paper "
+                                  "eq. 1.17 (an image of the same layout) repeats -E_X at (2,3)"]
+        out[-1].readings_used = ["glyph:eq. 2.42 (2,3) repeats E_XC of (1,4), also paper eq. "
+                                 "1.17"]
     row4 = [fmt(v) for v in printed_m[3, :]]
     ok4 = all(v == 0 for v in printed_m[3, :])
     out.append(_v(eq, "error matrix row 4", ok4, "bottom row 0 0 0 1 under a left-hand side 0",
@@ -182,9 +198,11 @@ def audit_rotary(item: dict) -> list[Verdict]:
                   "(the product T_ES T_CC minus T_CC). Category printing_error by the "
                   "cross-copy rule: the equation contradicts itself, and the conference paper's "
                   "eq. 1.17 (typeset separately) has the same bottom row 0 0 0 1 -- a '1' for a "
-                  "'0' at the same place in two images, while the extraction reads the zero "
-                  "bottom row '0 & 0 & 0 & 0' of the deviation matrix of the specialization "
-                  "project's eq. (23) right: the author's source",
+                  "'0' at the same place in two images (a digit of a matrix row, not a symbol "
+                  "repeated from its neighbourhood), while the extraction reads the zero bottom "
+                  "row '0 & 0 & 0 & 0' of the deviation matrix of the specialization project's "
+                  "eq. (23) right, an image of the same layout at this place (a deviation "
+                  "matrix between [Delta; 0] and [x; y; z; 1]): the author's source",
                   str(row4), "[0, 0, 0, 0]"))
     if not ok4:
         out[-1].readings_tried = ["deviation matrix (T_ES - I) Rz(C): bottom row 0 0 0 0",

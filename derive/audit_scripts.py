@@ -268,8 +268,11 @@ def audit_d1(d1: dict) -> Verdict:
           f"printed formulas solve with the arms of theta = 0 while the point has turned, a "
           f"mixture of the fixed-frame model (which turns the arms) and the body-frame model "
           f"(which turns the deviations back). It is right only at theta = 0: at theta = 90 deg "
-          f"(points within 150 mm), a pure tilt E_AB of 10 urad makes the printed model return "
-          f"{demo}. Category printing_error: the printed code solves another model than the "
+          f"(points drawn at random within 150 mm of the axis -- assumed, the text prints no "
+          f"positions), a pure tilt E_AB of 10 urad makes the printed model return {demo}; "
+          f"other point positions change these numbers (they scale with the error, and the "
+          f"mixing with the placement of the points) but not that the result is wrong at "
+          f"theta != 0. Category printing_error: the printed code solves another model than the "
           f"one the thesis states (legible structure, not extraction damage)")
     return _v(d1["id"], "B-axis model", "printing_error" if fits and ok_den else "undecidable",
               "lever arms not turned with the axis (the coefficients of theta = 0)", ev,

@@ -149,21 +149,45 @@ def _letters(unknowns) -> list[str]:
     return [u[1] for u in unknowns]
 
 
-def _vector_defects(got: list, want: list) -> str:
-    """'E_BX (the 5th entry's) for E_AX in the 4th entry' ... or 'E_AY lost' (in words)."""
+def _vector_defects(got: list, want: list, others: dict, me: str) -> list[tuple[str, str]]:
+    """The defects of a printed unknown vector, each with its cross-copy check against the
+    other printed vectors (``others``: equation id -> {"unknowns": ...}): [(defect, copies)]."""
     name = lambda u: f"E_{u[1:]}"  # noqa: E731
+    vecs = {o: info["unknowns"] for o, info in others.items() if o != me
+            and info.get("unknowns")}
+    out = []
     if len(got) == len(want):
-        parts = []
         for k, (g, w) in enumerate(zip(got, want)):
-            if g != w:
-                again = [j + 1 for j, x in enumerate(got) if x == g and j != k]
-                parts.append(f"{name(g)} for {name(w)} in the {_ordinal(k + 1)} entry"
-                             + (f" (a repeat of the {_ordinal(again[0])} entry)"
-                                if again else ""))
-        return "; ".join(parts) + ": a repeated token and the entry it displaces lost"
+            if g == w:
+                continue
+            again = [j + 1 for j, x in enumerate(got) if x == g and j != k]
+            moved = [j + 1 for j, x in enumerate(want) if x == g and j != k]
+            what = (f"{name(g)} in the {_ordinal(k + 1)} entry, where {name(w)} belongs"
+                    + (f" (a repeat of the {_ordinal(again[0])} entry)" if again else
+                       f" (the token of the {_ordinal(moved[0])} entry, which is not printed "
+                       f"there)" if moved else ""))
+            same = [o for o, v in vecs.items() if len(v) == len(got) and v[k][:2] == g[:2]]
+            diff = [f"eq. {o} has {name(v[k])}" for o, v in vecs.items()
+                    if len(v) == len(got) and v[k][:2] != g[:2]]
+            copies = (f"the same letter stands at the same place in eq. {', '.join(same)} "
+                      f"(separately typeset images of the same layout)" if same else
+                      f"one image only ({'; '.join(diff)} at this place)")
+            out.append((what, copies))
+        lost = [w for w in want if w not in got]
+        if lost:
+            out.append((f"{', '.join(name(w) for w in lost)} printed in no entry (lost)",
+                        "follows from the entries above"))
+        return out
     lost = [w for w in want if w not in got]
-    return (f"{', '.join(name(w) for w in lost)} lost ({len(got)} entries for {len(want)} "
-            f"columns, the others in order): a lost entry")
+    same = [o for o, v in vecs.items() if len(v) == len(got)
+            and [w for w in [m + v[0][2:] for m in MOTIONS] if w not in v] != []
+            and [m for m in MOTIONS if m + v[0][2:] not in v] ==
+            [m for m in MOTIONS if m + got[0][2:] not in got]]
+    out.append((f"{', '.join(name(w) for w in lost)} lost ({len(got)} entries for "
+                f"{len(want)} columns, the others in order)",
+                f"the same entry is lost in eq. {', '.join(same)} (images of the same layout)"
+                if same else "one image only"))
+    return out
 
 
 def _ordinal(k: int) -> str:
@@ -171,36 +195,24 @@ def _ordinal(k: int) -> str:
 
 
 def _vector_evidence(eq: dict, others: dict) -> str:
-    """Why a wrong unknown vector is undecidable: its own defect, the same defect elsewhere
-    (cross-copy rule) and the extraction's record, and what would decide."""
+    """Why a wrong unknown vector is undecidable: each defect with its own cross-copy check
+    (the same at the same place elsewhere, or one image only), the extraction's record, and
+    what would decide."""
     axis = eq["axis"]
     got, want = list(eq["unknowns"]), [m + axis for m in MOTIONS]
-    mine = _letters(got)
-    same = [o for o, info in others.items() if o != eq["id"] and info.get("unknowns")
-            and _letters(info["unknowns"]) == mine]
-    fourth_b = [o for o, info in others.items() if info.get("unknowns")
-                and len(info["unknowns"]) == 6 and _letters(info["unknowns"])[3] == "B"]
+    defects = _vector_defects(got, want, others, eq["id"])
     repeat = len(got) == len(want)
-    out = (f" Its defect: {_vector_defects(got, want)}."
-           + (f" The same entries are printed in eq. {', '.join(same)}." if same else ""))
-    out += " Category undecidable: print or extraction, and the text decides neither. For the "
-    out += "print (a vector copied in the author's source): "
-    if repeat and mine[3] == "B":
-        out += (f"E_B stands in the 4th entry, where E_A belongs, in all {len(fourth_b)} "
-                f"six-entry vectors (eq. {', '.join(fourth_b)}: the specialization project and "
-                f"the thesis, separately typeset) -- the same defect at the same place. ")
-    elif same:
-        out += f"the same defect at the same place in eq. {', '.join(same)}. "
-    else:
-        out += "a slip while typing the vector. "
-    out += ("For the extraction: " + ("a repeated token is damage it demonstrably does within "
-                                       "one image (" + EXTRACTION_REPEATS + ")" if repeat else
-                                       "it demonstrably loses entries and rows within one "
-                                       "image (" + EXTRACTION_LOSSES + ")")
-            + ", and a failure driven by the image recurs at the same place in vector images "
-              "of the same layout; by the cross-copy rule (docs/formats.md, audit) a "
-              "repetition or a loss at the same place does not decide. What would decide: the "
-              "pages of the original PDF.")
+    out = " Its defects: " + "; ".join(f"{what} -- {copies}" for what, copies in defects) + "."
+    out += (" Category undecidable: print or extraction, and the text decides none of them. "
+            "For the print: a vector typed or copied wrong in the author's source. For the "
+            "extraction: " + ("a repeated token, with the entry it displaces lost, is damage "
+                              "it demonstrably does within one image (" + EXTRACTION_REPEATS
+                              + ")" if repeat else "it demonstrably loses entries and rows "
+                              "within one image (" + EXTRACTION_LOSSES + ")")
+            + ". By the cross-copy rule (docs/formats.md, audit) neither a defect in one "
+              "image only nor a repetition or loss at the same place in images of the same "
+              "layout (where a failure driven by the image recurs) decides. What would "
+              "decide: the pages of the original PDF.")
     return out
 
 
@@ -273,8 +285,11 @@ def audit_displacement(eq: dict) -> list[Verdict]:
                 f"C, yh = x sin C + y cos C." if rotated else
                 f"derived - printed = {fmt(diff)}", eq["expr"][c], de))
             if rotated:
+                raw_z = next((ln.strip() for ln in eq.get("text", "").splitlines()
+                              if ln.strip().startswith(f"{c}'_{{Pt}}")), "")
                 out[-1].evidence += (
-                    " Read as [-E_BC cos C + E_AC sin C] x_P the row is the derived one: the "
+                    (f" The extraction text of the row: '{raw_z}'." if raw_z else "")
+                    + " Read as [-E_BC cos C + E_AC sin C] x_P the row is the derived one: the "
                     "printed coefficient lost a minus sign and the factor 'sin C' (the thesis' "
                     "eq. 2.42 prints the same row with both). Category undecidable: lost "
                     "glyphs, which the print and the text extraction explain equally; what "
@@ -437,10 +452,24 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
                f"{', '.join(same_in)} prints the x at exactly the same entries of the rows it "
                f"shares (two images), a substitution an extraction would have to invent "
                f"identically in both while reading C in the other entries of the same form"
-               f"{_pair_note(eq, wrong)}; the "
-               f"author's source explains it: the C-axis system adapted from the X-axis "
-               f"system of the specialization project (eq. 31 and 32 print x_{{xP}}, "
-               f"y_{{xQ}} ... at these places) with some subscripts left unchanged."
+               f"{_pair_note(eq, wrong)}. It is no repetition within an image: "
+               + ("none of the x-subscripted lever arms stands elsewhere in its matrix"
+                  if all(" & ".join(raw).count(re.search(r"\\hat\{[xy]\}_\{x[PQK]\}",
+                                                           t).group(0)) == 1
+                         for _, _, t in wrong) else
+                  "(an x-subscripted lever arm stands twice in its matrix)")
+               + f", and the rows that "
+               f"carry them stand at other places in the two images ("
+               + "; ".join(f"eq. {o}: rows " + ", ".join(
+                   str(k + 1) for k, lab in enumerate((others or {})[o]["labels"])
+                   if lab in {w[0] for w in wrong}) for o in [eq["id"], *same_in])
+               + f"), so the x follows the rows' content, not a place in the image, as a "
+               f"failure driven by the image would. The competing explanation, the "
+               f"extraction writing x for C, would need the same five misreadings in two "
+               f"images of another row order; the author's source explains it: the C-axis "
+               f"system adapted from the X-axis system of the specialization project (eq. 31 "
+               f"and 32 print x_{{xP}}, y_{{xQ}} ... at these places) with some subscripts "
+               f"left unchanged."
                if same_in else
                " Category printing_error: a well-formed lever arm of another axis' "
                "system (the X axis' subscript of eq. 31-32)."))
@@ -512,7 +541,11 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
             if lab is None:
                 guess = distinct[k] if k < len(distinct) else None
                 hint = f" (row {guess} needs {fmt(want[guess])})" if guess else ""
-                problems.append(f"entry {k + 1} {text!r} is no deviation of any point{hint}")
+                blocks = _raw_blocks(eq)
+                rawe = blocks[2][k] if len(blocks) > 2 and k < len(blocks[2]) else ""
+                problems.append(f"entry {k + 1} {text!r}"
+                                + (f" (raw '{rawe}')" if rawe else "")
+                                + f" is no deviation of any point{hint}")
         twice = sorted({lab for lab in matched if lab and matched.count(lab) > 1})
         if twice:
             problems.append(f"entry for {', '.join(twice)} printed twice")
@@ -655,6 +688,47 @@ def _swap_search(printed, define, derived):
     return None
 
 
+#: how a rotated lever-arm symbol of the data file is written in the extraction text
+def _tex(sym) -> str:
+    n = str(sym)
+    if "h_" in n:
+        return f"\\hat{{{n[0]}}}_{{C{n[-1]}}}"
+    return f"{n[0]}_{{x{n[-1]}}}" if n[1] == "_" else n
+
+
+def _swap_evidence(eq: dict, motion: str, old, new, n_fixed: bool) -> str:
+    """Why one lever-arm symbol printed for another is undecidable when the printed symbol
+    stands in the neighbouring lines of the same equation block (a candidate repetition),
+    and why the other copy of the solution does not decide it."""
+    axis = eq["axis"]
+    others = [m for m in eq["expr"] if m != motion
+              and old in parse(eq["expr"][m], axis).free_symbols]
+    pattern = f"+ ({old} - "
+    same_place = [m for m in others if pattern in eq["expr"][m] and pattern in eq["expr"][motion]]
+    names = {m: f"E_{m[1]}{axis}" for m in eq["expr"]}
+    where = ", ".join(names[m] for m in others)
+    out = (f" The printed symbol {_tex(old)} (read {old}) stands where {_tex(new)} belongs. It "
+           f"also stands in the lines of {where} of the same equation block"
+           + (f" -- in the line of {', '.join(names[m] for m in same_place)} at the same place "
+              f"(the first symbol of the numerator of the second fraction, '{pattern[2:]}...')"
+              if same_place else "")
+           + ": a candidate repetition within one image. For the print: the author writing "
+             "the numerator from the neighbouring line. For the extraction: a token of the "
+             "neighbouring line emitted again in place of the right one, damage it "
+             "demonstrably does within one image (" + EXTRACTION_REPEATS + "); it also "
+             "invents well-formed symbols in this document (T_6^{t,c} where the C axis' factor "
+             "belongs in the chain after eq. 3.37), so a well-formed wrong symbol alone does not "
+             "decide. The cross-copy rule does not decide it: the specialization project's eq. "
+             "33 is the X-axis solution and prints the right symbol at this place ('\\frac{x_{xP} "
+             "- x_{xK}}{z_{xP} - z_{xK}} \\cdot \\frac{M}{N}'), which shows the intended "
+             "formula, not the same defect in a second image: the defect stands in one image "
+             "only.")
+    if n_fixed:
+        out += (" The second defect, N printed as one product of six factors (its minus lost), "
+                "is undecided too (see the verdict on N).")
+    return out + " Category undecidable; what would decide: the page of the original PDF."
+
+
 def audit_closed_form(eq: dict) -> list[Verdict]:
     axis = eq["axis"]
     out = []
@@ -752,16 +826,16 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                 "N read with its minus sign restored: exact"]
             v.readings_used = ["glyph:eq. 3.8 N lost minus"]
         elif errs and " printed for " in errs[0]:
-            v.evidence += (" Category printing_error: another well-formed symbol of the "
-                           "formula in place of the right one -- two letters differ, not a "
-                           "lost, repeated or confusable glyph -- which an extraction would have "
-                           "to invent, while it reads the same symbols right elsewhere in this "
-                           "formula; the project report's eq. 33 prints the same solution for "
-                           "the X axis with the right symbol.")
+            old, new = hit
+            v.evidence += _swap_evidence(eq, motion, old, new, bool(define_fix))
+            v.category = "undecidable"
             v.readings_tried = ["the printed solution with N read as the determinant: differs",
                                 f"one lever-arm symbol read as another: {errs[0]} reproduces "
-                                f"it exactly"]
-            v.readings_used = [f"inconsistent:eq. {eq['id']} {name} symbol"]
+                                f"it exactly (with N's minus restored)",
+                                f"{old} repeated from the neighbouring line (print or "
+                                f"extraction): the same reading"]
+            v.readings_used = [f"glyph:eq. {eq['id']} {name} {old} repeats a token of the "
+                               f"same image"]
         out.append(v)
     if n_verdict is not None:
         out.append(n_verdict)

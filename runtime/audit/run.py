@@ -111,23 +111,27 @@ def collect(layouts: list[str] | None, progress=None):
 
 def group(verdicts) -> list[Row]:
     """One row per (source, equation, layout), in first-seen order; ``verdict`` is
-    ``identical``, ``differs`` (one component) or ``differs k/n``."""
+    ``identical``, ``differs`` (one component) or ``differs k/n`` -- ``unchecked`` instead of
+    ``differs`` when every component that is not identical could not be compared."""
     rows: dict = {}
+    unchecked: dict = {}
     for v in verdicts:
-        row = rows.setdefault((v.source, v.equation, v.layout),
-                              Row(v.source, v.equation, v.layout))
+        key = (v.source, v.equation, v.layout)
+        row = rows.setdefault(key, Row(v.source, v.equation, v.layout))
         row.n += 1
         if v.verdict != "identical":
             row.differs += 1
+            unchecked[key] = unchecked.get(key, 0) + (v.verdict == "unchecked")
             tag = f"[{v.category}] {v.erratum}"
             row.errata.append(f"{v.component}: {tag}" if v.component else tag)
-    for row in rows.values():
+    for key, row in rows.items():
+        word = "unchecked" if row.differs and unchecked.get(key) == row.differs else "differs"
         if row.differs == 0:
             row.verdict = "identical"
         elif row.n == 1:
-            row.verdict = "differs"
+            row.verdict = word
         else:
-            row.verdict = f"differs {row.differs}/{row.n}"
+            row.verdict = f"{word} {row.differs}/{row.n}"
         row.erratum = "; ".join(row.errata)
     return list(rows.values())
 
@@ -162,10 +166,12 @@ def table(rows: list[Row], width: int = 110) -> str:
 def totals_line(verdicts) -> str:
     """``"N printed items audited: a identical, b differ (c of d components)."``"""
     rows = group(verdicts)
-    n_diff = sum(1 for r in rows if r.verdict != "identical")
-    return (f"{len(rows)} printed items audited: {len(rows) - n_diff} identical, {n_diff} "
-            f"differ ({sum(v.verdict != 'identical' for v in verdicts)} of {len(verdicts)} "
-            f"components).")
+    n_diff = sum(1 for r in rows if r.verdict.startswith("differs"))
+    n_unch = sum(1 for r in rows if r.verdict.startswith("unchecked"))
+    return (f"{len(rows)} printed items audited: {len(rows) - n_diff - n_unch} identical, "
+            f"{n_diff} differ ({sum(v.verdict == 'differs' for v in verdicts)} of "
+            f"{len(verdicts)} components)" + (f", {n_unch} unchecked (inputs not printed)"
+                                              if n_unch else "") + ".")
 
 
 def numeric_table(layouts: list[str] | None, points: int) -> str:

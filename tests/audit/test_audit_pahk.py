@@ -107,8 +107,105 @@ def test_garbled_a5_terms_and_fh1_stacking(verdicts):
     assert dx.category == "convention" and dx.readings_used == [geo]
     a4 = find(verdicts, "A4")
     assert a4.category == "convention" and geo in a4.readings_used
-    assert "OCR" in dx.evidence               # the unbalanced parenthesis is an OCR reading
-    assert "glyph" in dx.evidence or "print or extraction" in dx.evidence
+    # the unbalanced parenthesis is read where it closes; the raw text is quoted
+    raw = next(e for e in DATA["equation"] if e["id"] == "A5")["text"].splitlines()[0]
+    assert raw.count("(") == raw.count(")") + 1
+    assert "raw 'Z(-\\beta_1 + (Ey(Y) - Ey(X))" in dx.evidence
+    assert "print or extraction" in dx.evidence
+    # the whole-equation line says where the terms it leaves are: not in dX
+    whole = next(t for t in dx.readings_tried if t.startswith("whole equation"))
+    assert "in dY" in whole and "in dX" not in whole
+
+
+def _raw_components(eq_id):
+    return next(e for e in DATA["equation"] if e["id"] == eq_id)["expr"]
+
+
+@pytest.mark.parametrize("eq_id, comp, token, elsewhere", [
+    ("A5", "dY", "X*Ey(X)", "dZ"),          # the extra term of dY is a term of dZ
+    ("A5", "dZ", "Ey(X)", "dZ"),            # Ey(X) for Ex(X): Ey(X) stands again in dZ
+    ("A6", "dy(X)", "Yo*Ex(X)", "dz(X)"),   # the extra term of dy(X) is the term of dz(X)
+    ("A8", "dY", "Ex(Z)", "dY"),            # Ex(Z) for Ex(X): Ex(Z) stands in the Zp bracket
+])
+def test_candidate_repetitions_within_one_image_are_undecidable(verdicts, eq_id, comp, token,
+                                                                elsewhere):
+    """The wrong token of these prints stands elsewhere in the same printed equation (read
+    here from the raw transcription): the print and the extraction explain a repetition
+    equally, so the verdict is undecidable and says so."""
+    raw = _raw_components(eq_id)
+    count = sum(raw[c].replace(" ", "").count(token) for c in raw)
+    assert count >= 2 and token in raw[elsewhere].replace(" ", "")
+    v = find(verdicts, eq_id, comp)
+    assert v.category == "undecidable" and "Candidate repetition" in v.evidence
+    assert "what would decide" in v.evidence.lower()
+
+
+def test_a_wrong_symbol_that_stands_nowhere_else_stays_a_printing_error(verdicts):
+    """MB1 eq. 9 dy(Y) prints Ez(Z) for Ez(Y); Ez(Z) stands in no other rule of eq. 9 (read
+    here), and the right symbol Ez(Y) is read in 'alpha = alpha + Ez(Yo)': a printing error.
+    Put Ez(Z) into another rule of eq. 9 and the same print becomes a candidate repetition."""
+    raw = _raw_components("9")
+    assert [c for c in raw if "Ez(Z)" in raw[c]] == ["dy(Y)"]
+    assert "Ez(Yo)" in raw["alpha"]
+    v = find(verdicts, "9", "dy(Y)")
+    assert v.category == "printing_error" and "nowhere else" in v.evidence
+    data = copy.deepcopy(DATA)
+    eq9 = next(e for e in data["equation"] if e["id"] == "9")
+    eq9["expr"]["dx(Z)"] = "dx(Z) + Yo*Ez(Z)"
+    w = find(audit_pahk.audit(data, ["MB1"]), "9", "dy(Y)")
+    assert w.category == "undecidable" and "Candidate repetition" in w.evidence
+
+
+def test_cut_off_rules_are_undecidable_with_every_restoration_named(verdicts):
+    """MH2 eq. 10 prints 'dz(Y) = dz' and 'dz(X) = dz(X) - Yo*Ex': cut off.  Written here from
+    the MH2 chain of eq. 6 (A = Tx(Tz(Ty P + Ly) + Lz) + Lx): a point of the Y arm offset by
+    (Xo, Yo, Zo) measures dz(Y) plus an Abbe shift, and the reference value is the measured one
+    minus that shift: dz(Y) - Yo Ex(Y) + Xo Ey(Y), dz(X) - Yo Ex(X) + Xo Ey(X) -- the full
+    transfers, so the restorations that print those terms are identical, the ones that keep the
+    roll term only (Ey(Y) is the roll of Y, Ex(X) that of X) are Pahk's rule (1)."""
+    import sympy as sp
+    S = lambda n: sp.Symbol(n, real=True)  # noqa: E731
+
+    def T(a):
+        ex, ey, ez = (S(f"E{c}({a})") for c in "xyz")
+        return sp.Matrix([[1, -ez, ey], [ez, 1, -ex], [-ey, ex, 1]])
+    X, Y, Z = S("X"), S("Y"), S("Z")
+    d = {f"d{c}({a})": S(f"d{c}({a})") for c in "xyz" for a in "XYZ"}
+    Lx = sp.Matrix([X + d["dx(X)"], d["dy(X)"], d["dz(X)"]])
+    Ly = sp.Matrix([d["dx(Y)"], Y + d["dy(Y)"], d["dz(Y)"]])
+    Lz = sp.Matrix([d["dx(Z)"], d["dy(Z)"], Z + d["dz(Z)"]])
+    Po = sp.Matrix([S("Xo"), S("Yo"), S("Zo")])
+    A = T("X") * (T("Z") * (T("Y") * Po + Ly) + Lz) + Lx
+    errs = [s for s in A.free_symbols if "(" in s.name]
+    # the offsets are measured from the reference point with the other axes at zero
+    dZ = _first_order((A[2] - Z - Po[2]).subs({X: 0, Y: 0, Z: 0}), errs)
+    for axis, roll in (("Y", "Ey(Y)"), ("X", "Ex(X)")):
+        shift = sum(t for t in sp.Add.make_args(dZ) if t.has(S(f"Ex({axis})"))
+                    or t.has(S(f"Ey({axis})")))
+        full = d[f"dz({axis})"] - shift           # reference = measured - Abbe shift
+        v = find(verdicts, "10", f"dz({axis})")
+        assert v.category == "undecidable" and "cut off" in v.erratum
+        rest = {t.split("'")[1]: t.rsplit(": ", 1)[-1] for t in v.readings_tried}
+        by_expr = {sp.expand(audit_pahk.parse(k)): out for k, out in rest.items()}
+        assert by_expr[sp.expand(full)] == "identical"
+        rule1 = d[f"dz({axis})"] - sum(t for t in sp.Add.make_args(shift) if t.has(S(roll)))
+        assert "simplification" in by_expr[sp.expand(rule1)]
+    assert _raw_components("10")["dz(Y)"] == "dz"
+    v = find(verdicts, "10", "dz(Y)")
+    assert "MB1 eq. 9 prints 'dz(Y) = dz(Y) + Xo*Ey(Y)'" in v.evidence
+
+
+def test_unchanged_rule_pattern_names_the_prints_that_differ(verdicts):
+    """A3 dz(Y) = dz(Y): the other layouts print it unchanged (FH1, CY), with the roll term
+    (MB1 eq. 9) and cut off (MH2 eq. 10): the evidence names all of them."""
+    raw = {e["layout"]: e["expr"].get("dz(Y)") for e in DATA["equation"]
+           if e["kind"] == "transfer"}
+    assert raw["MB1"].replace(" ", "") == "dz(Y)+Xo*Ey(Y)" and raw["MH2"] == "dz"
+    v = find(verdicts, "A3", "dz(Y)")
+    assert v.category == "undecidable"
+    assert "MB1 eq. 9 prints 'dz(Y) = dz(Y) + Xo*Ey(Y)'" in v.evidence
+    assert "MH2 eq. 10 prints 'dz(Y) = dz' (cut off)" in v.evidence
+    assert "FH1 eq. A6" in v.evidence and "CY eq. A9" in v.evidence
 
 
 def test_random_error_readings(verdicts):

@@ -23,7 +23,7 @@ def test_verdicts(verdicts):
     differs = {k for k, v in verdicts.items() if v.verdict == "differs"}
     assert differs == {("12", "Tp"), ("16", "theta")}
     assert "transposed" in verdicts[("12", "Tp")].erratum
-    assert "OCR" in verdicts[("12", "Tp")].evidence
+    assert "cos B = 0" in verdicts[("12", "Tp")].evidence      # the stray text is quoted
     assert "quadrant" in verdicts[("16", "theta")].erratum
     for key in [("11", "e'_x"), ("11", "e'_y"), ("14", "M'"), ("15", "phi"), ("13", "Probe"),
                 ("17", "dXc")]:
