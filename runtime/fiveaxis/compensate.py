@@ -371,6 +371,25 @@ def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = ORIENTATION_RC
     return np.einsum("nji,nj->ni", vt, y), np.any(s <= rcond, axis=1)     # V y
 
 
+def solve_linear(j: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """x of j x = r per row, j (N, k, k), r (N, k).  For k = 3 (the linear axes of every
+    shipped layout) by the adjugate, column arrays at a time: the batched LAPACK solve spends
+    most of its time per 3x3 matrix, not per flop (the linear Jacobians are rotations and
+    shears of the axes: well conditioned, so the explicit inverse loses nothing)."""
+    if j.shape[1:] != (3, 3):
+        return np.linalg.solve(j, r[:, :, None])[:, :, 0]
+    a, b, c, d, e, f, g, h, i = np.ascontiguousarray(j.reshape(-1, 9).T)
+    A, B, C = e * i - f * h, f * g - d * i, d * h - e * g       # cofactors of the first row
+    det = a * A + b * B + c * C
+    if not np.all(det != 0.0):
+        raise np.linalg.LinAlgError("Singular matrix")
+    r0, r1, r2 = np.ascontiguousarray(r.T)
+    return np.column_stack([(A * r0 + (c * h - b * i) * r1 + (b * f - c * e) * r2),
+                            (B * r0 + (a * i - c * g) * r1 + (c * d - a * f) * r2),
+                            (C * r0 + (b * g - a * h) * r1 + (a * e - b * d) * r2)]) \
+        / det[:, None]
+
+
 def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: float = 1e-4,
           max_iter: int = 50, direction=None, out: dict | None = None):
     """Corrected positions (N, n) for programmed ``q_nom``, the iteration count per row, and
@@ -429,7 +448,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
         # Jacobians): without turning, the first iteration's serves them all
         if mj is None or turns:
             mj = linear_jacobian(m, qa, em.tool)
-        d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
+        d = -solve_linear(mj, e)
         qa[:, lin_idx] += d
         change = np.maximum(change, np.abs(d).max(axis=1))
         q[active] = qa
@@ -463,10 +482,10 @@ def solve_thesis(em: ErrorModel, q_nom: np.ndarray, direction=None) -> np.ndarra
     mj = linear_jacobian(m, q_nom, em.tool)
     if em.rot:
         e_rot = em.position_error(q_nom, rotary_params, direction)
-        q1[:, lin_idx] -= np.linalg.solve(mj, e_rot[:, :, None])[:, :, 0]
+        q1[:, lin_idx] -= solve_linear(mj, e_rot)
     e_lin = em.position_error(q1, linear_params, direction)
     q2 = q1.copy()
-    q2[:, lin_idx] -= np.linalg.solve(linear_jacobian(m, q1, em.tool), e_lin[:, :, None])[:, :, 0]
+    q2[:, lin_idx] -= solve_linear(linear_jacobian(m, q1, em.tool), e_lin)
     return q2
 
 
@@ -547,7 +566,7 @@ def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter, direction=None) 
             - target_p[active]
         if mj is None:      # the rotary positions stay: one Jacobian (see solve)
             mj = linear_jacobian(m, qa, em.tool)
-        d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
+        d = -solve_linear(mj, e)
         qa[:, lin_idx] += d
         q[active] = qa
         idx = np.flatnonzero(active)

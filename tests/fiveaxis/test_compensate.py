@@ -661,3 +661,20 @@ def test_bad_program_one_stderr_line_even_with_notes_about_the_tables(tmp_path):
     prog.write_text("G0 X0 Y0 Z100 B0 C0\nG1 C345\n")
     rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
     assert rc == 0 and "note:" in se, se
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1, 2, 3, 4]))
+def test_linear_solve_by_adjugate_equals_lapack(seed, k):
+    """The per-row solve of the linear-axis correction (adjugate for 3x3, LAPACK otherwise)
+    against numpy.linalg.solve, on random well- and moderately-conditioned matrices; a singular
+    matrix is refused like LAPACK refuses it."""
+    from volerr.fiveaxis.compensate import solve_linear
+    rng = np.random.default_rng(seed)
+    j = rng.normal(size=(50, k, k)) + 3.0 * np.eye(k) * rng.uniform(0, 1, (50, 1, 1))
+    r = rng.normal(size=(50, k))
+    np.testing.assert_allclose(solve_linear(j, r), np.linalg.solve(j, r[:, :, None])[:, :, 0],
+                               rtol=1e-9, atol=1e-9 * np.linalg.cond(j).max())
+    j[7] = 0.0
+    with pytest.raises(np.linalg.LinAlgError):
+        solve_linear(j, r)
