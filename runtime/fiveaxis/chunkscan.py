@@ -27,9 +27,10 @@ import numpy as np
 
 from . import gcode
 
-#: byte classes; those up to _EOL are the significant bytes of the scan, from _OTHER on a
-#: byte a plain line cannot hold (outside comments)
-_LETTER, _DIGIT, _SIGN, _DOT, _SEP, _EOL, _BLANK, _OTHER, _OPEN, _CLOSE = range(1, 11)
+#: byte classes; those up to _DOT make numbers, those up to _EOL are the significant bytes of
+#: the scan (from _LETTER to _EOL those that are tokens by themselves), from _OTHER on a byte a
+#: plain line cannot hold (outside comments)
+_DIGIT, _SIGN, _DOT, _LETTER, _SEP, _EOL, _BLANK, _OTHER, _OPEN, _CLOSE = range(1, 11)
 _CLS = np.full(256, _OTHER, dtype=np.int8)
 for _c in range(ord("A"), ord("Z") + 1):
     _CLS[_c] = _CLS[_c + 32] = _LETTER
@@ -43,6 +44,8 @@ _CLS[ord(")")] = _CLOSE
 #: the class of every byte value, for ``bytes.translate``
 _TRANSLATE = _CLS.tobytes()
 _POW10 = 10.0 ** np.arange(23)
+#: the longest number run read by the scan: a sign, 15 digits and a dot
+_LONGEST = 17
 _IPOW10 = 10 ** np.arange(19, dtype=np.int64)
 
 #: letter codes of :func:`_letter_table` below the axis indices
@@ -159,9 +162,11 @@ def scan(segs: list, axes) -> Scan:
     b = np.frombuffer(raw, dtype=np.uint8)
     cls = np.frombuffer(bytearray(raw.translate(_TRANSLATE)), dtype=np.int8)
 
+    line_of = np.repeat(np.arange(n, dtype=np.int32), lens)     # the line of every byte
+
     def lid(pos):
         """The line of byte positions ``pos``."""
-        return np.searchsorted(start, pos, side="right") - 1
+        return line_of[pos].astype(np.int64)
 
     bad = np.zeros(n, dtype=bool)
     # the body of a line ends where its ending (CRLF, LF or CR: the only CR / LF bytes of the
@@ -175,7 +180,7 @@ def scan(segs: list, axes) -> Scan:
     _comments(b, cls, start, body_end, lid, bad)
     bad[lid(np.flatnonzero(cls >= _OTHER))] = True
     # numbers: [+-]?(\d+\.?\d*|\.\d+), runs of adjacent number bytes [ns, ne)
-    nm = (cls >= _DIGIT) & (cls <= _DOT)
+    nm = cls <= _DOT
     start_m = nm.copy()
     start_m[1:] &= ~nm[:-1]
     end_m = nm.copy()
@@ -186,7 +191,7 @@ def scan(segs: list, axes) -> Scan:
     rline = lid(ns)
     # tokens: letters, number runs (by their first byte), comment starts and line endings
     # (so that neighbouring tokens are in the same line unless an ending lies between them)
-    tok = np.flatnonzero((cls == _LETTER) | start_m | (cls == _SEP) | (cls == _EOL))
+    tok = np.flatnonzero(((cls >= _LETTER) & (cls <= _EOL)) | start_m)
     is_run = start_m[tok]
     isl = cls[tok] == _LETTER
     # a number starts right after its letter (blanks between allowed) ...
@@ -196,18 +201,38 @@ def scan(segs: list, axes) -> Scan:
     no_number = isl.copy()
     no_number[:-1] &= ~is_run[1:]
     bad[lid(tok[np.flatnonzero(no_letter | no_number)])] = True
+    # the runs read column by column (their first, second ... bytes at once): digits, dots,
+    # signs behind the first byte, and the mantissa (mant * 10 + digit: exact for integers
+    # below 2**53).  Only the first _LONGEST bytes (a sign, 15 digits and a dot): a longer run
+    # has more digits than a double holds and is checked here and read by Python below
+    length = ne - ns
+    width = min(int(length.max()), _LONGEST) if nr else 0
+    padded = np.frombuffer(raw + bytes(width), np.uint8)
+    ndig = np.zeros(nr, dtype=np.int8)
+    ndot = np.zeros(nr, dtype=np.int8)
+    dot_at = np.full(nr, -1, dtype=np.int64)
+    misplaced = np.zeros(nr, dtype=bool)
+    mant = np.zeros(nr)
+    for c in range(width):
+        byte = padded[c:][ns]                   # (no array ns + c)
+        inside = c < length
+        digit = (byte - 48 < 10) & inside       # (uint8: the bytes below "0" wrap round)
+        dot = (byte == 46) & inside
+        ndig += digit
+        ndot += dot
+        dot_at[dot] = c
+        if c:
+            misplaced |= ((byte == 43) | (byte == 45)) & inside
+        mant = np.where(digit, mant * 10 + (byte - 48), mant)
+    ndig, ndot = ndig.astype(np.int64), ndot.astype(np.int64)
+    frac = np.where(dot_at >= 0, length - 1 - dot_at, -1)
+    for i in np.flatnonzero(length > width):
+        t = text[ns[i]:ne[i]]
+        ndot[i], misplaced[i] = t.count("."), "+" in t[1:] or "-" in t[1:]
+        frac[i] = len(t) - 1 - t.rindex(".") if "." in t else -1
+        ndig[i] = sum(ch.isdigit() for ch in t)
     # a sign only in front, at most one dot, at least one digit
-    signs = np.flatnonzero(cls == _SIGN)
-    bad[lid(signs[~start_m[signs]])] = True
-    dots = np.flatnonzero(cls == _DOT)
-    dot_run = np.searchsorted(ns, dots, side="right") - 1
-    ndot = np.bincount(dot_run, minlength=nr)
-    bad[rline[ndot > 1]] = True
-    frac = np.full(nr, -1, dtype=np.int64)
-    frac[dot_run] = ne[dot_run] - 1 - dots
-    nsign = np.bincount(np.searchsorted(ns, signs, side="right") - 1, minlength=nr)
-    ndig = (ne - ns) - ndot - nsign
-    bad[rline[ndig == 0]] = True
+    bad[rline[misplaced | (ndot > 1) | (ndig == 0)]] = True
     # the letter of each run: the token before it (in a line that is not bad)
     rs = np.flatnonzero(is_run)
     code = _letter_table(axes)[b[tok[np.maximum(rs - 1, 0)]]]
@@ -222,20 +247,7 @@ def scan(segs: list, axes) -> Scan:
     sel = np.flatnonzero(code != IGNORED)
     ns, ne, rline, code, frac, ndig = ns[sel], ne[sel], rline[sel], code[sel], frac[sel], \
         ndig[sel]
-    # mantissa: the k-th digit from the end of its run times 10**k, summed per run (float
-    # sums of integers below 2**53 are exact; longer mantissas: Python below)
-    at = _spans(ns, ne)
-    digits = at[cls[at] == _DIGIT]
-    nr = len(sel)
-    dcount = np.zeros(nr + 1, dtype=np.int64)
-    np.cumsum(ndig, out=dcount[1:])
-    k_from_end = np.repeat(dcount[1:] - 1, ndig) - np.arange(len(digits), dtype=np.int64)
-    np.minimum(k_from_end, 18, out=k_from_end)
-    dval = b[digits] - 48
-    mant = np.zeros(nr)
-    has_dig = ndig > 0
-    if len(digits):
-        mant[has_dig] = np.add.reduceat(_POW10[k_from_end] * dval, dcount[:-1][has_dig])
+    mant = mant[sel]
     fr = np.maximum(frac, 0)
     val = mant / _POW10[np.minimum(fr, 22)]
     neg = b[ns] == 45
@@ -294,9 +306,12 @@ def format_bytes(values, nd, keep, plus, template=None):
     neg = (big < 0) & (a != 0)
     p10 = _IPOW10[nd]
     ip, fp = a // p10, a % p10
+    # trailing zeros of the decimals (``x // p * p == x``: numpy divides by a scalar with
+    # vectorised code, not so ``%`` and ``divmod``, which take 4-5 times longer)
     tz = np.zeros(len(v), dtype=np.int64)
     for k in range(1, int(nd.max()) + 1):
-        tz += (k <= nd) & (fp % _IPOW10[k] == 0)
+        p = int(_IPOW10[k])
+        tz += (k <= nd) & (fp // p * p == fp)
     keep_eff = np.where(keep < 0, 0, np.maximum(keep, 1))
     d = np.where(nd > 0, np.maximum(nd - tz, keep_eff), 0)
     shift = nd - d
@@ -305,11 +320,10 @@ def format_bytes(values, nd, keep, plus, template=None):
     # the value of the text: integer / power of ten, one correctly rounded division as in
     # float(text); + 0.0 makes -0.0 (a negative number rounded to zero) plain 0.0
     val = np.where(neg, -a, a) / _POW10[np.minimum(nd, 22)] + 0.0
-    # lengths: sign, integer digits, dot and decimals
+    # lengths: sign, integer digits (1 + the number of powers 10 .. 10**18 not above the
+    # integer part), dot and decimals
     signed = neg | plus
-    n_int = np.ones(len(v), dtype=np.int64)
-    for k in range(1, 19):
-        n_int += ip >= _IPOW10[k]
+    n_int = np.searchsorted(_IPOW10[1:], ip, side="right") + 1
     lens = signed + n_int + np.where(d > 0, d + 1, 0)
     slow = np.flatnonzero(risky)
     slow_text = []
@@ -319,22 +333,34 @@ def format_bytes(values, nd, keep, plus, template=None):
         slow_text.append(t.encode("ascii"))
         lens[i] = len(t)
         val[i] = float(t)
-    start = np.zeros(len(v), dtype=np.int64)
-    np.cumsum(lens[:-1], out=start[1:])
-    flat = np.empty(int(lens.sum()), dtype=np.uint8)
+    # every text as a row of a byte table [sign | integer digits, right-aligned | dot |
+    # decimals, right-aligned]; a mask keeps the bytes each text has, and the table read row
+    # by row through the mask is the texts one after the other (the texts of the risky values,
+    # formatted above, stand left-aligned in their rows)
     fast = ~risky
-    at = start + signed
-    m = fast & signed
-    flat[start[m]] = np.where(neg[m], ord("-"), ord("+"))
-    for k in range(int(n_int[fast].max()) if fast.any() else 0):
-        m = fast & (k < n_int)
-        flat[at[m] + k] = 48 + (ip[m] // _IPOW10[n_int[m] - 1 - k]) % 10
-    at = at + n_int
-    m = fast & (d > 0)
-    flat[at[m]] = ord(".")
-    for k in range(int(d[fast].max()) if fast.any() else 0):
-        m = fast & (k < d)
-        flat[at[m] + 1 + k] = 48 + (dg[m] // _IPOW10[d[m] - 1 - k]) % 10
+    n_i = int(n_int[fast].max()) if fast.any() else 0
+    n_d = int(d[fast].max()) if fast.any() else 0
+    width = max(2 + n_i + n_d, max(map(len, slow_text), default=0))
+    table = np.empty((len(v), width), dtype=np.uint8)
+    mask = np.zeros((len(v), width), dtype=bool)
+    table[:, 0] = np.where(neg, ord("-"), ord("+"))
+    mask[:, 0] = signed
+    rest = ip
+    for k in range(n_i):        # integer digits from the right
+        higher = rest // 10
+        table[:, n_i - k] = 48 + (rest - 10 * higher)
+        rest = higher
+        mask[:, n_i - k] = k < n_int
+    table[:, 1 + n_i] = ord(".")
+    mask[:, 1 + n_i] = d > 0
+    rest = dg
+    for k in range(n_d):        # decimals from the right
+        higher = rest // 10
+        table[:, 1 + n_i + n_d - k] = 48 + (rest - 10 * higher)
+        rest = higher
+        mask[:, 1 + n_i + n_d - k] = k < d
     for i, t in zip(slow, slow_text):
-        flat[start[i]:start[i] + len(t)] = np.frombuffer(t, dtype=np.uint8)
-    return flat, lens, val
+        mask[i] = False
+        mask[i, :len(t)] = True
+        table[i, :len(t)] = np.frombuffer(t, dtype=np.uint8)
+    return table[mask], lens, val

@@ -250,8 +250,10 @@ class ErrorModel:
             if a in self.ranges:
                 lo, hi = self.ranges[a]
                 i = self.model.axes.index(a)
-                w = lo + np.mod(q[:, i] - lo, 360.0)
                 inside = (q[:, i] >= lo) & (q[:, i] <= hi)
+                if inside.all():
+                    continue        # (the usual case: nothing to take modulo 360)
+                w = lo + np.mod(q[:, i] - lo, 360.0)
                 q[:, i] = np.where(~inside & (w <= hi), w, q[:, i])
         return q
 
@@ -282,13 +284,17 @@ class ErrorModel:
             i = self.model.axes.index(a)
             m = self.EDGE_MARGIN["rotary" if a in self.rot else "linear"]
             v = q[:, i]
+            if not len(v) or (v.min() >= lo and v.max() <= hi):
+                continue            # (the usual case: no position beyond the table)
             near = ((v < lo) & (v >= lo - m)) | ((v > hi) & (v <= hi + m))
             q[:, i] = np.where(near, np.clip(v, lo, hi), v)
         return q
 
     def errors(self, q: np.ndarray, subset=None, direction=None) -> dict:
-        """Error functions at ``q`` (the last two evaluations are remembered: the position and
-        the orientation error of the same positions share one table look-up).  ``direction``
+        """Error functions at ``q`` (the last three evaluations are remembered: the position and
+        the orientation error of the same positions share one table look-up, and the
+        prediction after a solve of two iterations finds the programmed positions still
+        there).  ``direction``
         (N, n_axes) -1 / 0 / +1: the approach direction of every axis, for tables with a
         reversal column (:meth:`volerr.tables.functions.ErrorFunctions.reversal`)."""
         if self.funcs is None:
@@ -311,23 +317,43 @@ class ErrorModel:
                     e[k] = e[k] + v if k in e else v
             memo.insert(0, (np.array(q, dtype=float, copy=True),
                             None if direction is None else np.array(direction), e))
-            del memo[2:]
+            del memo[3:]
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e
 
+    def prepared(self, q: np.ndarray):
+        """``q`` validated with the sines and cosines of its rotary axes
+        (:meth:`volerr.machine.model.Model.prepared`), shared by the evaluations at the same
+        positions (the last three are remembered, as in :meth:`errors`)."""
+        memo = self.__dict__.setdefault("_prepared", [])
+        for qm, p in memo:
+            if qm.shape == q.shape and np.array_equal(qm, q):
+                return p
+        p = self.model.prepared(q)
+        memo.insert(0, (np.array(q, dtype=float, copy=True), p))
+        del memo[3:]
+        return p
+
+    def nominal_position(self, q) -> np.ndarray:
+        """Nominal tool tip with the tool offset, (N, 3) mm."""
+        return self.model.nominal_position(self.prepared(q), self.tool)
+
     def position_error(self, q, subset=None, direction=None) -> np.ndarray:
         """Exact error of the tool tip, (N, 3) mm (``direction``: see :meth:`errors`)."""
-        return self.model.exact_error(q, self.errors(q, subset, direction), probe=self.tool)
+        return self.model.exact_error(self.prepared(q), self.errors(q, subset, direction),
+                                      probe=self.tool)
 
     def orientation_error(self, q, subset=None, direction=None) -> np.ndarray:
         """First-order error of the tool axis, (N, 3) rad."""
         if not self.rot:
             return np.zeros((len(q), 3))
-        return self.model.orientation_error(q, self.errors(q, subset, direction))
+        return self.model.orientation_error(self.prepared(q),
+                                            self.errors(q, subset, direction))
 
     def tool_axis(self, q) -> np.ndarray:
-        return self.model.forward(q, self.tool)[:, 3:6]
+        """Nominal unit tool axis, (N, 3) (it does not depend on the tool offset)."""
+        return self.model.tool_axis(self.prepared(q))
 
 
 #: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
@@ -345,6 +371,25 @@ def _truncated_solve(j: np.ndarray, r: np.ndarray, rcond: float = ORIENTATION_RC
     return np.einsum("nji,nj->ni", vt, y), np.any(s <= rcond, axis=1)     # V y
 
 
+def solve_linear(j: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """x of j x = r per row, j (N, k, k), r (N, k).  For k = 3 (the linear axes of every
+    shipped layout) by the adjugate, column arrays at a time: the batched LAPACK solve spends
+    most of its time per 3x3 matrix, not per flop (the linear Jacobians are rotations and
+    shears of the axes: well conditioned, so the explicit inverse loses nothing)."""
+    if j.shape[1:] != (3, 3):
+        return np.linalg.solve(j, r[:, :, None])[:, :, 0]
+    a, b, c, d, e, f, g, h, i = np.ascontiguousarray(j.reshape(-1, 9).T)
+    A, B, C = e * i - f * h, f * g - d * i, d * h - e * g       # cofactors of the first row
+    det = a * A + b * B + c * C
+    if not np.all(det != 0.0):
+        raise np.linalg.LinAlgError("Singular matrix")
+    r0, r1, r2 = np.ascontiguousarray(r.T)
+    return np.column_stack([(A * r0 + (c * h - b * i) * r1 + (b * f - c * e) * r2),
+                            (B * r0 + (a * i - c * g) * r1 + (c * d - a * f) * r2),
+                            (C * r0 + (b * g - a * h) * r1 + (a * e - b * d) * r2)]) \
+        / det[:, None]
+
+
 def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: float = 1e-4,
           max_iter: int = 50, direction=None, out: dict | None = None):
     """Corrected positions (N, n) for programmed ``q_nom``, the iteration count per row, and
@@ -354,28 +399,33 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
     Iterates until the change of the correction is below ``tol`` (mm; rotary axes weighted by a
     1 m lever).  ``direction`` (N, n) -1 / 0 / +1: the approach direction of each axis in each
     row (tables with reversal; the corrected positions are approached as the programmed
-    ones).  ``out``: a dict that gets ``target`` (N, 3), the nominal tool tip, and -- when the
-    first iteration evaluates the whole model at the programmed positions (no orientation,
-    no restriction to some types) -- ``before`` (N, 3), the error there (mm)."""
+    ones).  ``out``: a dict that gets ``target`` (N, 3), the nominal tool tip, with the
+    orientation also ``tool_axis`` (N, 3), the nominal tool axis, and -- when the first
+    iteration evaluates the whole model at the programmed positions (no orientation, no
+    restriction to some types) -- ``before`` (N, 3), the error there (mm)."""
     m = em.model
     q_nom = np.atleast_2d(np.asarray(q_nom, dtype=float))
     n = len(q_nom)
     lin_idx = [m.axes.index(a) for a in em.lin]
     rot_idx = [m.axes.index(a) for a in em.rot]
-    target_p = m.nominal_position(q_nom, em.tool)
+    target_p = em.nominal_position(q_nom)
     if out is not None:
         out["target"] = target_p
-    target_k = em.tool_axis(q_nom) if em.rot else None
+    target_k = em.tool_axis(q_nom) if orientation and em.rot else None
+    if out is not None and target_k is not None:
+        out["tool_axis"] = target_k
     q = q_nom.copy()
     iters = np.zeros(n, dtype=int)
     active = np.ones(n, dtype=bool)
     limited = np.zeros(n, dtype=bool)
     partial = np.zeros(n, dtype=bool)
+    turns = orientation and bool(em.rot)       # the rotary positions move
+    mj = None
     for it in range(1, max_iter + 1):
         qa = q[active]
         da = None if direction is None else direction[active]
         change = np.zeros(len(qa))
-        if orientation and em.rot:
+        if turns:
             k_act = em.tool_axis(qa) + em.orientation_error(qa, em.compensated, da)
             j = rotary_jacobian(m, qa)
             d, dropped = _truncated_solve(j, -(k_act - target_k[active]))
@@ -387,12 +437,18 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
             d[~ok] = 0.0
             qa[ok] = trial[ok]
             change = np.maximum(change, np.abs(d).max(axis=1) * 1000.0)
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
-            - target_p[active]
+        # the first iteration without turning starts at the programmed positions, whose
+        # nominal tip is the target
+        tip = target_p if it == 1 and not turns else em.nominal_position(qa)
+        e = tip + em.position_error(qa, em.compensated, da) - target_p[active]
         if it == 1 and out is not None and not orientation and em.compensated is None:
             out["before"] = e.copy()        # nominal(q_nom) - target is exactly 0
-        mj = linear_jacobian(m, qa, em.tool)
-        d = -np.linalg.solve(mj, e[:, :, None])[:, :, 0]
+        # d(tip)/d(linear axes) depends on the rotary positions only (the nominal chain is
+        # affine in the linear axes; tests/fiveaxis/test_compensate.py checks the generated
+        # Jacobians): without turning, the first iteration's serves them all
+        if mj is None or turns:
+            mj = linear_jacobian(m, qa, em.tool)
+        d = -solve_linear(mj, e)
         qa[:, lin_idx] += d
         change = np.maximum(change, np.abs(d).max(axis=1))
         q[active] = qa
@@ -402,6 +458,7 @@ def solve(em: ErrorModel, q_nom: np.ndarray, orientation: bool = False, tol: flo
         active[idx[done]] = False
         if not active.any():
             break
+        mj = mj[~done]
     if active.any():
         raise InputError(f"compensation did not converge in {max_iter} iterations (the errors "
                          "are too large or the position is singular)")
@@ -425,10 +482,10 @@ def solve_thesis(em: ErrorModel, q_nom: np.ndarray, direction=None) -> np.ndarra
     mj = linear_jacobian(m, q_nom, em.tool)
     if em.rot:
         e_rot = em.position_error(q_nom, rotary_params, direction)
-        q1[:, lin_idx] -= np.linalg.solve(mj, e_rot[:, :, None])[:, :, 0]
+        q1[:, lin_idx] -= solve_linear(mj, e_rot)
     e_lin = em.position_error(q1, linear_params, direction)
     q2 = q1.copy()
-    q2[:, lin_idx] -= np.linalg.solve(linear_jacobian(m, q1, em.tool), e_lin[:, :, None])[:, :, 0]
+    q2[:, lin_idx] -= solve_linear(linear_jacobian(m, q1, em.tool), e_lin)
     return q2
 
 
@@ -498,19 +555,24 @@ def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter, direction=None) 
     iterates until its own correction changes by less than ``tol`` (mm)."""
     m = em.model
     lin_idx = [m.axes.index(a) for a in em.lin]
-    target_p = m.nominal_position(q_nom, em.tool)
+    target_p = em.nominal_position(q_nom)
     q = q_out.copy()
     active = np.ones(len(q), dtype=bool)
+    mj = None
     for _ in range(max_iter):
         qa = q[active]
         da = None if direction is None else direction[active]
-        e = m.nominal_position(qa, em.tool) + em.position_error(qa, em.compensated, da) \
+        e = em.nominal_position(qa) + em.position_error(qa, em.compensated, da) \
             - target_p[active]
-        d = -np.linalg.solve(linear_jacobian(m, qa, em.tool), e[:, :, None])[:, :, 0]
+        if mj is None:      # the rotary positions stay: one Jacobian (see solve)
+            mj = linear_jacobian(m, qa, em.tool)
+        d = -solve_linear(mj, e)
         qa[:, lin_idx] += d
         q[active] = qa
         idx = np.flatnonzero(active)
-        active[idx[np.abs(d).max(axis=1) < tol]] = False
+        done = np.abs(d).max(axis=1) < tol
+        active[idx[done]] = False
         if not active.any():
             break
+        mj = mj[~done]
     return q

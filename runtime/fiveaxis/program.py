@@ -405,14 +405,16 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
 @dataclass
 class Solution:
     """Corrected positions (n, n_axes), iterations (n,), orientation limited (n,); the
-    nominal tool tip ``target`` (n, 3) and the error at the programmed positions ``before``
-    (n, 3) mm when the solve has them (else None: the prediction computes them)."""
+    nominal tool tip ``target`` (n, 3), the error at the programmed positions ``before``
+    (n, 3) mm and the nominal tool axis ``tool_axis`` (n, 3) when the solve has them (else
+    None: the prediction computes them)."""
 
     q: np.ndarray
     iterations: np.ndarray
     limited: np.ndarray
     target: np.ndarray | None = None
     before: np.ndarray | None = None
+    tool_axis: np.ndarray | None = None
 
 
 def tool_groups(em, blocks: Blocks, opts: Options) -> list:
@@ -449,7 +451,7 @@ def solve_positions(em, q_nom: np.ndarray, opts: Options, direction=None) -> Sol
     out = {}
     q, it, lim = solve(em, q_nom, opts.orientation, opts.tol_um * 1e-3, opts.max_iter,
                        direction, out)
-    return Solution(q, it, lim, out.get("target"), out.get("before"))
+    return Solution(q, it, lim, out.get("target"), out.get("before"), out.get("tool_axis"))
 
 
 def solve_blocks(em, blocks: Blocks, opts: Options) -> Solution:
@@ -625,24 +627,26 @@ class Prediction:
 
 
 def predict_positions(em, q_nom: np.ndarray, q_out: np.ndarray, direction=None,
-                      direction_before=None, target=None, before=None) -> Prediction:
+                      direction_before=None, target=None, before=None,
+                      tool_axis=None) -> Prediction:
     """Predicted errors of the positions ``q_nom`` (programmed, approached in
     ``direction_before``) and ``q_out`` (written, approached in ``direction``), with ``em``'s
-    tool offset (directions None: no reversal).  ``target`` / ``before``: the nominal tip and
-    the error at ``q_nom`` when the solve has them (mm)."""
+    tool offset (directions None: no reversal).  ``target`` / ``before`` / ``tool_axis``: the
+    nominal tip, the error (mm) and the nominal tool axis at ``q_nom`` when the solve has
+    them."""
     model, tool, funcs = em.model, em.tool, em.funcs
     n = len(q_nom)
     if not n:
         z = np.zeros((0, 3))
         return Prediction(z, z, np.zeros(0), np.zeros(0), z)
     if target is None:
-        target = model.nominal_position(q_nom, tool)
+        target = em.nominal_position(q_nom)
     d, d0 = direction, direction_before
     before = (em.position_error(q_nom, None, d0) if before is None else before) * 1e3
-    after = (model.nominal_position(q_out, tool) + em.position_error(q_out, None, d)
+    after = (em.nominal_position(q_out) + em.position_error(q_out, None, d)
              - target) * 1e3
     if model.rotary_axes:
-        k_nom = em.tool_axis(q_nom)
+        k_nom = em.tool_axis(q_nom) if tool_axis is None else tool_axis
         ob = np.linalg.norm(em.orientation_error(q_nom, None, d0), axis=1) * 1e6
         k_after = em.tool_axis(q_out) + em.orientation_error(q_out, None, d)
         oa = np.linalg.norm(k_after - k_nom, axis=1) * 1e6
@@ -664,7 +668,8 @@ def predict(em, blocks: Blocks, q_out: np.ndarray, opts: Options,
         reuse = sol is not None and blocks.direction is None
         return predict_positions(em, blocks.q_nom, q_out, blocks.direction,
                                  blocks.dir_program, sol.target if reuse else None,
-                                 sol.before if reuse else None)
+                                 sol.before if reuse else None,
+                                 sol.tool_axis if reuse else None)
     n = len(q_out)
     p = Prediction(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
                    np.full((n, 3), math.nan))

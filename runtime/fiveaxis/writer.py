@@ -387,11 +387,18 @@ class Edits:
             return self._apply_str(text, starts, ends)
         flat = np.concatenate([f for f, _ in new])
         lens = np.concatenate([n for _, n in new])
+        # where each new text begins in the output: its start in the text plus the bytes the
+        # edits before it added (numpy.insert would do the same, but sorts its positions)
+        grow = lens - (ends - starts)
+        first = starts + np.cumsum(grow) - grow
+        at = np.repeat(first - (np.cumsum(lens) - lens), lens) + np.arange(len(flat))
+        out = np.empty(len(b) + int(grow.sum()), dtype=np.uint8)
+        is_new = np.zeros(len(out), dtype=bool)
+        is_new[at] = True
+        out[at] = flat
         keep = np.ones(len(b), dtype=bool)
         keep[chunkscan._spans(starts, ends)] = False
-        removed = np.zeros(len(starts), dtype=np.int64)
-        np.cumsum((ends - starts)[:-1], out=removed[1:])
-        out = np.insert(b[keep], np.repeat(starts - removed, lens), flat)
+        out[~is_new] = b[keep]
         return out.tobytes().decode("latin-1")
 
     def _apply_str(self, text: str, starts, ends) -> str:

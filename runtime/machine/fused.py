@@ -13,7 +13,10 @@ written here), into
   ``_out`` (m, n_out) of the result -- no ``_shape``, no ``broadcast_to``, no allocation, no
   stacking.  Arguments known to be scalar 0 are folded away (``x * 0`` -> 0, ``x + 0`` -> x),
   so unused error parameters cost nothing, and negations are absorbed where that is exact
-  (``(-a)*c + b`` -> ``b - a*c``): the values are bitwise those of the generated function;
+  (``(-a)*c + b`` -> ``b - a*c``); the sines and cosines of arguments (the rotary axes) can be
+  given as inputs, computed once for several functions at the same positions
+  (:meth:`volerr.machine.model.Model.prepared`): the values are bitwise those of the
+  generated function;
 * a **numba kernel** (optional, ``pip install 'volerr[fast]'``): one compiled per-point loop
   over 2-D broadcast inputs writing an (S, P, n_out) array, the whole expression fused in
   registers.  Compilation costs 1-4 s per function the first time, so it is opt-in
@@ -228,17 +231,41 @@ class _Fold(ast.NodeTransformer):
         return node
 
 
-def _fold(parsed: Parsed, zeros: frozenset):
-    """Temporaries and outputs with ``zeros`` folded away; dead temporaries dropped."""
+class _Given(ast.NodeTransformer):
+    """``numpy.sin(a)`` / ``numpy.cos(a)`` of an argument ``a`` in ``names`` -> the input
+    ``_sin_a`` / ``_cos_a`` (:func:`trig_name`): computed once by the caller for several
+    functions at the same positions."""
+
+    def __init__(self, names):
+        self.names = names
+
+    def visit_Call(self, node):
+        self.generic_visit(node)
+        if (_is_numpy_call(node, {"sin", "cos"}) and len(node.args) == 1 and not node.keywords
+                and isinstance(node.args[0], ast.Name) and node.args[0].id in self.names):
+            return ast.copy_location(ast.Name(trig_name(node.func.attr, node.args[0].id),
+                                              ast.Load()), node)
+        return node
+
+
+def trig_name(func: str, arg: str) -> str:
+    """The kernel input that holds ``numpy.<func>(<arg>)`` (``func`` "sin" or "cos")."""
+    return f"_{func}_{arg}"
+
+
+def _fold(parsed: Parsed, zeros: frozenset, trig=frozenset()):
+    """Temporaries and outputs with ``zeros`` folded away and the sines and cosines of the
+    arguments ``trig`` taken as inputs; dead temporaries dropped."""
     zeros = set(zeros)
+    given = _Given(trig)
     temps = []
     for name, value in parsed.temps:
-        value = _Fold(zeros).visit(_copy(value))
+        value = _Fold(zeros).visit(given.visit(_copy(value)))
         if _is_const(value, 0):
             zeros.add(name)
         else:
             temps.append((name, value))
-    outputs = [_Fold(zeros).visit(_copy(v)) for v in parsed.outputs]
+    outputs = [_Fold(zeros).visit(given.visit(_copy(v))) for v in parsed.outputs]
     used = {n.id for v in outputs for n in ast.walk(v) if isinstance(n, ast.Name)}
     live = []
     for name, value in reversed(temps):
@@ -312,13 +339,16 @@ class _Emitter:
         return target, buf
 
 
-def numpy_source(parsed: Parsed, zeros=frozenset(), scalars=frozenset()) -> tuple[str, int]:
+def numpy_source(parsed: Parsed, zeros=frozenset(), scalars=frozenset(),
+                 trig=frozenset()) -> tuple[str, int]:
     """Source of the numpy block kernel ``kernel(_out, _s, <args>)`` and its number of scratch
     rows: ``_out`` (m, n_out) the block of the result, ``_s`` (n_scratch, m) scratch space;
     ``zeros`` arguments known to be scalar 0 (folded away), ``scalars`` other scalar arguments
-    (all others are (m,) or (1,) arrays)."""
-    temps, outputs = _fold(parsed, frozenset(zeros))
-    em = _Emitter(set(parsed.args) - set(zeros) - set(scalars))
+    (all others are (m,) or (1,) arrays); ``trig`` array arguments whose sine and cosine are
+    given as the further arguments ``_sin_<a>``, ``_cos_<a>`` (in sorted order of ``a``)."""
+    temps, outputs = _fold(parsed, frozenset(zeros), frozenset(trig))
+    given = [trig_name(f, a) for a in sorted(trig) for f in ("sin", "cos")]
+    em = _Emitter(set(parsed.args) - set(zeros) - set(scalars) | set(given))
     last_use = {}
     for i, (_, value) in enumerate(temps + [(None, v) for v in outputs]):
         for node in ast.walk(value):
@@ -345,7 +375,7 @@ def numpy_source(parsed: Parsed, zeros=frozenset(), scalars=frozenset()) -> tupl
         else:
             em.lines.append(f"{col} = {ast.unparse(value)}")
         _release(em, last_use, len(temps) + k)
-    head = [f"def kernel(_out, _s, {', '.join(parsed.args)}):"]
+    head = [f"def kernel(_out, _s, {', '.join(parsed.args + tuple(given))}):"]
     if em.n_buf:
         head.append(f"    {''.join(f'_b{j}, ' for j in range(em.n_buf))}= _s")
     return "\n".join(head + ["    " + ln for ln in em.lines]) + "\n", em.n_buf
@@ -360,13 +390,13 @@ def _release(em: _Emitter, last_use: dict, i: int) -> None:
 
 
 @functools.lru_cache(maxsize=256)
-def numpy_kernel(fn, zeros=frozenset(), scalars=frozenset()):
+def numpy_kernel(fn, zeros=frozenset(), scalars=frozenset(), trig=frozenset()):
     """``(kernel, n_scratch)``: the numpy block kernel of generated function ``fn`` (see
     :func:`numpy_source`), or None if ``fn`` is not in straight-line form."""
     parsed = parse(fn)
     if parsed is None:
         return None
-    src, n_scratch = numpy_source(parsed, zeros, scalars)
+    src, n_scratch = numpy_source(parsed, zeros, scalars, trig)
     ns = {"numpy": np}
     exec(compile(src, f"<fused {parsed.name}>", "exec"), ns)
     return ns["kernel"], n_scratch

@@ -67,7 +67,7 @@ BLOCK = 16384
 
 
 def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = None,
-             check_rows=None) -> np.ndarray:
+             check_rows=None, trig: dict | None = None) -> np.ndarray:
     """``fn(**kwargs)`` (a generated function returning ``n_out`` broadcastable outputs)
     evaluated block by block into one (n, n_out) array.  Arguments that are (n,) arrays are
     sliced (views, also of strided columns); scalars and (1,) arrays pass whole.
@@ -77,13 +77,18 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
     that cannot be fused is called as it is.  ``finite``: a list that receives one bool, whether
     every result is finite (checked block by block while the block is in the cache).
     ``check_rows``: (rows (n, k), check) -- ``check(rows[block])`` is called before each block
-    is evaluated (the inputs' validation, done while the block is read anyway)."""
+    is evaluated (the inputs' validation, done while the block is read anyway).  ``trig``:
+    argument -> (its sine, its cosine) (n,), computed once for several functions
+    (:meth:`Model.prepared`), which the fused kernel reads instead of computing them."""
     scalars = {k for k, v in kwargs.items() if np.ndim(v) == 0}
     zeros = frozenset(k for k in scalars if kwargs[k] == 0)
-    kernel = (fused.numpy_kernel(fn, zeros, frozenset(scalars) - zeros)
+    trig = trig or {}
+    kernel = (fused.numpy_kernel(fn, zeros, frozenset(scalars) - zeros, frozenset(trig))
               if fused.n_outputs(fn) == n_out else None)
     if kernel is not None:
         kernel, n_scratch = kernel
+        kwargs = {**kwargs, **{fused.trig_name(f, a): v for a, sc in trig.items()
+                               for f, v in zip(("sin", "cos"), sc)}}
         scratch = np.empty((n_scratch, min(BLOCK, n)))
     out = np.empty((n, n_out))
     ok = True
@@ -112,6 +117,24 @@ def _columns(components, n: int) -> np.ndarray:
     """Generated outputs (tuple of broadcastable arrays) -> (n, len) float array."""
     return np.stack([np.broadcast_to(c, (n,)) for c in components], axis=-1).astype(
         float, copy=False)
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """Axis positions validated once (:meth:`Model.prepared`): ``values`` axis -> (n,) array
+    (rotary axes in rad, the model's own copies), ``n`` the number of points, ``trig`` rotary
+    axis -> (its sine, its cosine) (n,).  The evaluation methods take it in place of
+    positions; their fused kernels read these sines and cosines instead of computing them
+    again (the same values)."""
+
+    values: dict
+    n: int
+    trig: dict
+
+
+def _trig(positions) -> dict | None:
+    """The sines and cosines of prepared positions (None for others)."""
+    return positions.trig if isinstance(positions, Prepared) else None
 
 
 def _offset(probe, tool):
@@ -194,6 +217,8 @@ class Model:
         whose finiteness check is left to the caller (:func:`_blocked` checks it block by block
         while the block is in the cache: one pass less over memory); None when checked here."""
         deferred = None
+        if isinstance(positions, Prepared):
+            return dict(positions.values), positions.n, None
         if isinstance(positions, Mapping):
             positions = _case_insensitive(dict(positions), self.axes)
             unknown = set(positions) - set(self.axes)
@@ -246,6 +271,16 @@ class Model:
         pos, n, _ = self._validated(positions)
         return pos, n
 
+    def prepared(self, positions) -> Prepared:
+        """Positions (as :meth:`positions` takes them, mm / deg) validated once, with the sine
+        and cosine of every rotary axis: for several evaluations at the same positions
+        (:meth:`nominal_position`, :meth:`exact_error`, :meth:`orientation_error`,
+        :meth:`tool_axis` ... take it in place of positions and give the same values)."""
+        pos, n = self._points(positions)
+        values = {a: np.array(v, dtype=float) for a, v in pos.items()}  # not the caller's
+        return Prepared(values, n, {a: (np.sin(values[a]), np.cos(values[a]))
+                                    for a in self.rotary_axes})
+
     def _probe(self, probe, n: int) -> dict:
         p = _floats(probe, "probe offset")
         require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
@@ -281,12 +316,13 @@ class Model:
         return out
 
     @staticmethod
-    def _evaluate(fn, kwargs: dict, n: int, errs: dict, check_rows=None) -> np.ndarray:
+    def _evaluate(fn, kwargs: dict, n: int, errs: dict, check_rows=None,
+                  trig=None) -> np.ndarray:
         """``fn`` block by block (:func:`_blocked`), the result checked for NaN there.  NaN in
         any input propagates to the result, so the inputs are looked at only then, to name the
         error parameter that caused it."""
         finite: list = []
-        out = _blocked(fn, kwargs, n, finite=finite, check_rows=check_rows)
+        out = _blocked(fn, kwargs, n, finite=finite, check_rows=check_rows, trig=trig)
         if not finite[0]:
             for name, v in errs.items():
                 if not np.all(np.isfinite(v)):
@@ -329,7 +365,8 @@ class Model:
         out = self._evaluate(
             self.module.volumetric_error,
             {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n, errs,
-            check_rows=None if rows is None else (rows, self._check_rows))
+            check_rows=None if rows is None else (rows, self._check_rows),
+            trig=_trig(positions))
         if direction is not None or probe_error is not None:
             out = out + self._probe_term(direction, probe_error, n)
         return out
@@ -360,7 +397,8 @@ class Model:
         errs = self._errors(errors, n)
         return self._evaluate(
             self.module.exact_error,
-            {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n, errs)
+            {**pos, **self._covariates(covariates, n), **self._probe(probe, n), **errs}, n, errs,
+            trig=_trig(positions))
 
     def sensitivity(self, positions, probe=(0.0, 0.0, 0.0), covariates=None) -> np.ndarray:
         """Sensitivity of the volumetric error to every parameter.
@@ -456,7 +494,8 @@ class Model:
     def nominal_position(self, positions, probe=(0.0, 0.0, 0.0)) -> np.ndarray:
         """Nominal probe/tool tip in the workpiece frame, (N, 3) mm."""
         pos, n = self._points(positions)
-        return _blocked(self.module.nominal_position, {**pos, **self._probe(probe, n)}, n)
+        return _blocked(self.module.nominal_position, {**pos, **self._probe(probe, n)}, n,
+                        trig=_trig(positions))
 
     def forward(self, positions, probe=None, *, tool=None) -> np.ndarray:
         """Nominal tool tip and tool axis in the workpiece frame.
@@ -476,6 +515,12 @@ class Model:
         tip = self.module.nominal_position(**pos, **self._probe(_offset(probe, tool), n))
         return np.concatenate([_columns(tip, n), _columns(self.module.tool_axis(**pos), n)],
                               axis=1)
+
+    def tool_axis(self, positions) -> np.ndarray:
+        """Nominal unit tool axis i, j, k in the workpiece frame, (N, 3): the last three
+        columns of :meth:`forward` (the same values), without computing the tool tip."""
+        pos, n = self._points(positions)
+        return _blocked(self.module.tool_axis, pos, n, trig=_trig(positions))
 
     def inverse(self, target, probe=None, near=None, *, tool=None) -> np.ndarray:
         """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
@@ -518,7 +563,8 @@ class Model:
         pos, n = self._points(positions)
         errs = self._errors(errors, n)
         return self._evaluate(self.module.orientation_error,
-                              {**pos, **self._covariates(covariates, n), **errs}, n, errs)
+                              {**pos, **self._covariates(covariates, n), **errs}, n, errs,
+                              trig=_trig(positions))
 
 
 def load(name_or_path) -> Model:

@@ -267,6 +267,8 @@ class ErrorFunctions:
             for ax, (lo, hi) in self.ranges().items():
                 v = cols[ax]
                 tol = 1e-9 * max(1.0, hi - lo)
+                if not len(v) or (v.min() >= lo - tol and v.max() <= hi + tol):
+                    continue        # (finite values, all inside: the usual case)
                 bad = (v < lo - tol) | (v > hi + tol)
                 if bad.any():
                     u = axis_unit(ax)

@@ -26,7 +26,8 @@ number = st.one_of(
     st.decimals(min_value=-1000, max_value=1000, allow_nan=False, places=4).map(str),
     st.sampled_from(["1.", ".5", "+2", "-0", "+.25", "007", "12.3456789012345678", "1.2.3",
                      "--1", "+", ".", "0", "1", "00", "01", "2", "3", "98", "128", "129.",
-                     "6"]))
+                     "6", "-0000000000000000012.5", "123456789012345678.5",
+                     "1234567890123456789.1.2", "12345678901234567-8", "+1234567890123456"]))
 word = st.tuples(st.sampled_from("XYZBCxyzbNFGgMmAUSTHDI"), st.sampled_from(["", " ", "\t"]),
                  number)
 comment = st.sampled_from(["(cut X1)", "(a;b)", "; fin (x", ";", "()", "(", ")", "(G2 M98)",
@@ -105,6 +106,39 @@ def test_format_numbers_is_format_number(items):
     assert list(lens) == [len(w) for w in want]
     for w, x in zip(want, vals):
         assert x == float(w) and np.signbit(x) == np.signbit(float(w)), w
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text("ab \n\r;(", max_size=40), st.data())
+def test_edits_replace_their_spans(text, data):
+    """writer.Edits (spans replaced in the chunk's bytes, some as byte arrays, some as
+    strings) against slicing the text piece by piece."""
+    from volerr.fiveaxis.writer import Edits
+
+    cuts = sorted(data.draw(st.lists(st.integers(0, len(text)), max_size=12)))
+    spans = list(zip(cuts[0::2], cuts[1::2]))
+    new = [data.draw(st.text("0123456789.-+XYZ\n", max_size=6)) for _ in spans]
+    as_bytes = [data.draw(st.booleans()) for _ in spans]
+    edits = Edits()
+    k = 0
+    while k < len(spans):
+        if as_bytes[k]:             # a run of byte edits, as Writer.run adds them
+            j = k
+            while j < len(spans) and as_bytes[j]:
+                j += 1
+            texts = new[k:j]
+            edits.add_bytes([s0 for s0, _ in spans[k:j]], [e0 for _, e0 in spans[k:j]],
+                            np.frombuffer("".join(texts).encode("ascii"), np.uint8),
+                            [len(t) for t in texts])
+            k = j
+        else:
+            edits.add(*spans[k], new[k])
+            k += 1
+    want, prev = [], 0
+    for (s0, e0), t in zip(spans, new):
+        want += [text[prev:s0], t]
+        prev = e0
+    assert edits.apply(text) == "".join(want) + text[prev:]
 
 
 @pytest.fixture(scope="module")

@@ -145,6 +145,28 @@ def test_compensated_program_lands_within_0p1_um(tmp_path, name):
     assert len(strip(text_out)) == len(strip(text_in))
 
 
+@pytest.mark.parametrize("name", ["DMU50", "TT_AC", "HH_BC", "TH_BC", "MB1", "MB2", "FH1",
+                                  "FH2", "FB1", "FB2", "MH1", "MH2", "CX", "CY"])
+def test_linear_jacobian_depends_on_the_rotary_positions_only(name):
+    """The solve evaluates d(tip)/d(linear axes) once and keeps it while only the linear axes
+    move (the nominal chain is affine in them): the generated Jacobian of every shipped layout
+    gives bitwise the same values at other linear positions."""
+    from volerr.fiveaxis.kinematics import linear_axes, linear_jacobian
+
+    m = volerr.load(name)
+    rng = np.random.default_rng(4)
+    lo = np.array([m.travel[a][0] for a in m.axes])
+    hi = np.array([m.travel[a][1] for a in m.axes])
+    q = lo + rng.random((50, len(m.axes))) * (hi - lo)
+    moved = q.copy()
+    for a in linear_axes(m):
+        i = m.axes.index(a)
+        moved[:, i] = lo[i] + rng.random(50) * (hi[i] - lo[i])
+    assert not np.array_equal(moved, q)
+    for tool in ((0.0, 0.0, 0.0), (12.0, -7.0, 95.0)):
+        assert np.array_equal(linear_jacobian(m, moved, tool), linear_jacobian(m, q, tool))
+
+
 def test_orientation_compensation_corrects_the_tool_axis(tmp_path):
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m, seed=3)
@@ -639,3 +661,20 @@ def test_bad_program_one_stderr_line_even_with_notes_about_the_tables(tmp_path):
     prog.write_text("G0 X0 Y0 Z100 B0 C0\nG1 C345\n")
     rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
     assert rc == 0 and "note:" in se, se
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1, 2, 3, 4]))
+def test_linear_solve_by_adjugate_equals_lapack(seed, k):
+    """The per-row solve of the linear-axis correction (adjugate for 3x3, LAPACK otherwise)
+    against numpy.linalg.solve, on random well- and moderately-conditioned matrices; a singular
+    matrix is refused like LAPACK refuses it."""
+    from volerr.fiveaxis.compensate import solve_linear
+    rng = np.random.default_rng(seed)
+    j = rng.normal(size=(50, k, k)) + 3.0 * np.eye(k) * rng.uniform(0, 1, (50, 1, 1))
+    r = rng.normal(size=(50, k))
+    np.testing.assert_allclose(solve_linear(j, r), np.linalg.solve(j, r[:, :, None])[:, :, 0],
+                               rtol=1e-9, atol=1e-9 * np.linalg.cond(j).max())
+    j[7] = 0.0
+    with pytest.raises(np.linalg.LinAlgError):
+        solve_linear(j, r)

@@ -68,7 +68,8 @@ def test_mb1_blocked_kernel_equals_hand_written_eq4(seed, n, subset):
 @pytest.mark.parametrize("name", ["MB1", "FH2", "DMU50", "TT_AC"])
 def test_fused_kernels_identical_to_generated_functions(name, small_blocks):
     """Same expression tree, same order of operations: bitwise the same values (zero folding
-    only drops exact ``+ 0`` and ``* 0``), for volumetric and both random-error functions."""
+    only drops exact ``+ 0`` and ``* 0``), for volumetric and both random-error functions, and
+    the tool axis."""
     model = volerr.load(name)
     for f in ("volumetric_error", "random_error_exact", "random_error_termwise"):
         assert fused.parse(getattr(model.module, f)) is not None, f   # really fused
@@ -84,6 +85,39 @@ def test_fused_kernels_identical_to_generated_functions(name, small_blocks):
             ref = _unfused(model, fn, pos, probe,
                            {f"s_{p}": sig.get(p, 0.0) for p in model.parameters})
             assert np.array_equal(model.random_error(pos, sig, probe, method=method), ref)
+        if hasattr(model.module, "tool_axis"):   # fused tool axis = forward's (unfused) one
+            assert np.array_equal(model.tool_axis(pos), model.forward(pos)[:, 3:6])
+
+
+@pytest.mark.parametrize("name", ["DMU50", "TT_AC", "HH_BC", "MB1"])
+def test_prepared_positions_give_the_same_values(name, small_blocks):
+    """Model.prepared: the positions validated once with the sines and cosines of the rotary
+    axes, which the kernels read instead of computing them: bitwise the values of the plain
+    calls, and not changed when the caller changes its array afterwards."""
+    model = volerr.load(name)
+    rng = np.random.default_rng(8)
+    pos, errs, probe = _random_case(model, rng, 120, False)
+    prep = model.prepared(pos)
+    want = {"exact": model.exact_error(pos, errs, probe),
+            "volumetric": model.volumetric_error(pos, errs, probe),
+            "nominal": model.nominal_position(pos, probe)}
+    if model.rotary_axes:
+        want["orientation"] = model.orientation_error(pos, errs)
+        want["axis"] = model.tool_axis(pos)
+    pos += 1.0       # the prepared positions are the model's own copies
+    got = {"exact": model.exact_error(prep, errs, probe),
+           "volumetric": model.volumetric_error(prep, errs, probe),
+           "nominal": model.nominal_position(prep, probe)}
+    if model.rotary_axes:
+        got["orientation"] = model.orientation_error(prep, errs)
+        got["axis"] = model.tool_axis(prep)
+    for k in want:
+        assert np.array_equal(got[k], want[k]), k
+    assert set(prep.trig) == set(model.rotary_axes)
+    if model.rotary_axes:   # the kernels really take the given sines and cosines
+        src, _ = fused.numpy_source(fused.parse(model.module.exact_error), trig=prep.trig)
+        a = model.rotary_axes[0]
+        assert f"numpy.sin({a}" not in src and fused.trig_name("sin", a) in src
 
 
 # ---- a synthetic straight-line function, in the form of the generated code ------------------
