@@ -46,8 +46,6 @@ at least 2 targets and 2 cycles (the standard test asks for 5 of each; fewer giv
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -56,7 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require
-from ..fileio import sniff_delimiter
+from ..fileio import read_csv_rows
 from ..units import MM_PER_UM, parse_number
 
 FWD, BWD = 0, 1
@@ -146,22 +144,7 @@ class PositioningRun:
 
 # ---------------------------------------------------------------------------------------------
 def _rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
-    require(path.is_file(), f"{path}: no such file")
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    delim = sniff_delimiter(text)
-    rows = []
-    try:
-        for lineno, cells in enumerate(csv.reader(io.StringIO(text), delimiter=delim), 1):
-            cells = [c.strip() for c in cells]
-            if not cells or all(c == "" for c in cells) or cells[0].startswith("#"):
-                continue
-            rows.append((lineno, cells))
-    except csv.Error as exc:
-        raise InputError(f"{path}: not a readable CSV ({exc})") from None
-    require(rows, f"{path}: empty file (no header)")
+    rows = read_csv_rows(path, empty=f"{path}: empty file (no header)")
     (_, header), body = rows[0], rows[1:]
     require(all(header), f"{path}: empty column name in header")
     low = [h.lower() for h in header]

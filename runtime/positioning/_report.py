@@ -33,7 +33,7 @@ from ..units import MM_PER_M, UM_PER_MM
 
 from .. import conformance
 from ..certificate import html_table, verdict_html
-from ..plotstyle import embedded_img, figure, label, png, styled
+from ..plotstyle import TEST_REPORT_CSS, embedded_img, figure, label, png, styled
 from ..units import num
 from ._evaluate import Evaluation
 from ._uncertainty import BudgetInputs, QUANTITIES, budget, decisive_targets, verdicts
@@ -321,15 +321,7 @@ def report_html(report: dict, png: bytes, inputs, generated: str = "", identific
 <html lang="en"><head><meta charset="utf-8">
 <title>ISO 230-2 positioning test</title>
 <style>
-body {{ font-family: sans-serif; max-width: 1100px; margin: 1.5em auto; color: #111; }}
-h1 {{ font-size: 1.4em; border-bottom: 2px solid #333; padding-bottom: .3em; }}
-table {{ border-collapse: collapse; margin: .5em 0 1em 0; font-size: .9em; }}
-th, td {{ border: 1px solid #999; padding: .2em .6em; text-align: right; }}
-th.l, td.l {{ text-align: left; }}
-th.l {{ background: #f2f2f2; }}
-.s {{ color: #555; font-size: .85em; }}
-.verdict {{ font-size: 1.15em; }}
-img {{ max-width: 100%; height: auto; border: 1px solid #ccc; }}
+{TEST_REPORT_CSS}
 </style></head><body>
 <h1>Positioning accuracy and repeatability &mdash; ISO 230-2</h1>
 <p>Evaluation of laser-interferometer positioning runs by direct measurement of a single axis

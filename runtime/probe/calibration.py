@@ -138,9 +138,9 @@ def _float(text: str, where: str) -> float:
     return parse_number(text, where)
 
 
-def read_sphere_csv(path) -> SphereData:
-    """Read ``x,y,z[,phi_deg,theta_deg]`` (mm, deg); other columns are ignored."""
-    path = Path(path)
+def _csv_rows(path: Path) -> list:
+    """The non-blank rows of a CSV file (cells as written), InputError (one line) for a file
+    that is missing, not text, malformed or empty."""
     require(path.is_file(), f"{path}: no such file")
     try:
         text = path.read_text(encoding="utf-8-sig")
@@ -151,6 +151,13 @@ def read_sphere_csv(path) -> SphereData:
     except csv.Error as exc:
         raise InputError(f"{path}: malformed CSV: {exc}") from None
     require(rows, f"{path}: empty file")
+    return rows
+
+
+def read_sphere_csv(path) -> SphereData:
+    """Read ``x,y,z[,phi_deg,theta_deg]`` (mm, deg); other columns are ignored."""
+    path = Path(path)
+    rows = _csv_rows(path)
     header = [h.strip().lower() for h in rows[0]]
     alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
     header = [alias.get(h, h) for h in header]
@@ -568,16 +575,7 @@ def read_probe_map(path, tilt_deg: float = 0.0, roll_deg: float = 0.0,
     """A :class:`ProbeMap` from a MAP.csv (``phi_deg,theta_deg,probe_um``; rows flagged
     ``outlier`` = 1 are left out), refitted as by the calibration."""
     path = Path(path)
-    require(path.is_file(), f"{path}: no such file")
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-        rows = [r for r in csv.reader(io.StringIO(text), delimiter=sniff_delimiter(text))
-                if any(c.strip() for c in r)]
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a text CSV file") from None
-    except csv.Error as exc:
-        raise InputError(f"{path}: malformed CSV: {exc}") from None
-    require(rows, f"{path}: empty file")
+    rows = _csv_rows(path)
     header = [h.strip().lower() for h in rows[0]]
     for c in ("phi_deg", "theta_deg", "probe_um"):
         require(c in header, f"{path}: missing column {c!r}")

@@ -9,7 +9,7 @@ import html
 
 from ..certificate import Identification, html_table, verdict_html
 from ..conformance import RULE
-from ..plotstyle import embedded_img
+from ..plotstyle import TEST_REPORT_CSS, embedded_img
 from ..units import num
 
 
@@ -43,14 +43,7 @@ def report_html(doc: dict, png: bytes | None, identification: Identification | N
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>ISO 10360-2 length test: {e(doc['layout'])}</title>
 <style>
-body {{ font-family: sans-serif; max-width: 1100px; margin: 1.5em auto; color: #111; }}
-h1 {{ font-size: 1.4em; border-bottom: 2px solid #333; padding-bottom: .3em; }}
-table {{ border-collapse: collapse; margin: .5em 0 1em 0; font-size: .9em; }}
-th, td {{ border: 1px solid #999; padding: .2em .6em; text-align: right; }}
-th.l, td.l {{ text-align: left; }}
-th.l {{ background: #f2f2f2; }}
-.verdict {{ font-size: 1.15em; }}
-.s {{ color: #555; font-size: .9em; }}
+{TEST_REPORT_CSS}
 </style></head><body>
 <h1>Length measuring test &mdash; ISO 10360-2 (simulated on the model of {e(doc['layout'])})</h1>
 <p>E0 = indicated minus calibrated length, bidirectional, 7 positions &times; 5 lengths &times;
