@@ -33,7 +33,8 @@ import sympy as sp
 from volerr.machine.layout import read_layout
 
 from .audit import Verdict, category_of, fmt
-from .audit_dmu50 import T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward
+from .audit_dmu50 import (T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward,
+                          forward_note, forward_tried, t23_forward)
 from .kinematics import Chain, position_symbol, rotation, stage_factors, translation
 
 DATA_FILE = "printed_htm.toml"
@@ -152,11 +153,13 @@ def audit_matrix(item: dict) -> list[Verdict]:
                           "1.3's sign pattern with B -> C)", ev, str(item["rows"]),
                           fmt(derived), tried, ["inconsistent:paper eq. 1.6 sense of C"]))
         elif name == "T_2^3":
+            fwd = t23_forward(item["rows"])
+            tried += forward_tried(fwd)
             ev = ("; ".join(bad) + f"; the printed 3x3 block has det = {fmt(det)}: not a "
                   "rotation in either sense. " + T23_CROSS_COPY.format(
                       other="thesis eq. 3.32, typeset separately, prints the same [[c_B, s_B], "
                             "[s_B, c_B]], and so does the thesis' 'updated' chain after eq. "
-                            "3.37 (T_2^{3,c})"))
+                            "3.37 (T_2^{3,c})", fwd=forward_note(fwd)))
             out.append(_v(item, "matrix", "printing_error", "sign error in 1 entry (as thesis "
                           "eq. 3.32)", ev, str(item["rows"]), fmt(derived), tried,
                           ["inconsistent:T_2^3 sign of s_B (1,2)"]))
