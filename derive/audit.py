@@ -255,10 +255,34 @@ TYPICAL = {
 }
 
 
-def typical_text(extra: str = "") -> str:
-    """The typical machine's assumptions (``extra``: more assumed values, appended)."""
+def typical_text(extra: str = "", layout: str | None = None, term=None) -> str:
+    """The typical machine's assumptions (``extra``: more assumed values, appended).  With
+    ``layout``, it names the machine whose travels scale the worst case against the layout's
+    own machine in Pahk (its layout file's ``source``); with ``term`` (the dropped
+    expression), whether the travels enter the size at all."""
     t = TYPICAL
-    return (f"typical machine: Pahk's CMM A (900 x 575 x 400 mm), offsets up to "
+    machine = "Pahk's CMM A (900 x 575 x 400 mm)"
+    if layout is not None:
+        import re
+
+        from volerr.machine.layout import read_layout
+        m = re.search(r"(CMM [A-Z]) of sec\. 4 \(([^)]*)\)", read_layout(layout).source or "")
+        if m and m.group(1) == "CMM A":
+            machine += f", this {layout} layout's own machine in Pahk's sec. 4"
+        else:
+            machine = (f"the travels of Pahk's CMM A (an MB1, 900 x 575 x 400 mm) taken for "
+                       f"this {layout} layout -- "
+                       + (f"Pahk's own {layout} machine is {m.group(1)} ({m.group(2)})" if m
+                          else f"Pahk describes no {layout} machine"))
+    if term is not None:
+        axes = sorted({str(s_) for s_ in sp.sympify(term).free_symbols}
+                      & {"X", "Y", "Z"})
+        machine += ("; the term depends on the offsets only, so its size does not depend on "
+                    "the machine's travels" if not axes else
+                    f"; the travel{'s' if len(axes) > 1 else ''} of {', '.join(axes)} "
+                    f"({', '.join('%g mm' % t['travel_mm'][a] for a in axes)}) "
+                    f"enter{'' if len(axes) > 1 else 's'} the size")
+    return (f"typical machine: {machine}, offsets up to "
             f"{t['measuring_offset_mm']:g} mm, probe offsets up to {t['probe_offset_mm']:g} mm, "
             f"angular errors {t['angular_rad'] * 1e6:g} urad{extra} -- assumed values, not "
             f"printed; the size scales in proportion to the lengths and angles assumed")

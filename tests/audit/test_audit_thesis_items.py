@@ -191,8 +191,22 @@ def test_b_axis_error_matrix_1_17(htm):
     off = {(i + 1, j + 1) for i in range(4) for j in range(4)
            if abs(printed[i, j] - dev[i, j]) > 1e-12}
     assert off == {(1, 3), (2, 1), (2, 3), (3, 2), (4, 4)}
+    # read as the HTM its label names (T_EB Rz(B), like eq. 1.12): the bottom row is right,
+    # 8 entries differ, and with every error zero the printed block lacks the rotation in 5
+    htm_m = te @ rot
+    off_htm = {(i + 1, j + 1) for i in range(4) for j in range(4)
+               if abs(printed[i, j] - htm_m[i, j]) > 1e-12}
+    assert len(off_htm) == 8 and (4, 4) not in off_htm
+    zero = {k: (0.0 if k.startswith("E") else v) for k, v in env.items()}
+    p0 = np.array([[eval(x, {}, zero) for x in r] for r in item["rows"]])  # noqa: S307
+    lacking = {(i + 1, j + 1) for i in range(3) for j in range(3)
+               if abs(p0[i, j] - rot[i, j]) > 1e-12}
+    assert lacking == {(1, 1), (1, 2), (2, 1), (2, 2), (3, 3)}
     v = find(htm, "paper eq. 1.17")
     assert v.category == "printing_error" and "2.42" in v.evidence
+    assert "Read as that HTM" in v.evidence and f"{len(off_htm)} entries differ" in v.evidence
+    assert f"missing from {len(lacking)} of them" in v.evidence
+    assert "Read as the deviation" in v.evidence and "under either reading" in v.evidence
 
 
 def test_linear_chain_with_angular_errors_dropped_1_19(htm):
