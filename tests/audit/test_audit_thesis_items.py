@@ -424,6 +424,19 @@ def test_appendix_c1_terms_are_cramers_rule():
     for f in motion:
         assert find(vs, f"appendix C.1 {f}", "formula").category == "extraction"
     assert find(vs, "appendix C.1 E_YX", "unit factor").category == "undecidable"
+    # review 3 (#14): the d_zQ term of E_YX prints (x_xK*z_xP - x_xP*z_xK) three times;
+    # valid Python, but cubed the cofactor has degree 7 in the lengths where the adjugate's
+    # entries of the translational rows have degree 3 (checked here on A): the repair says so
+    t = next(t for t in d["term"] if t["formula"] == "E_YX" and t["d"] == "z_actQt - z_xQ - z_o")
+    f = sp.sympify("(x_xK*z_xP - x_xP*z_xK)", locals=sym)
+    cubed = sp.sympify(t["cofactor"], locals=sym) * f ** 2
+    arms = list(sym.values())
+    assert sp.Poly(cubed, *arms).total_degree() == 7
+    assert {sp.Poly(e, *arms).total_degree() for e in A.adjugate()[:3, :] if e != 0} == {3}
+    assert "degree 7" in " ".join(t["repairs"])
+    ev = find(vs, "appendix C.1 E_YX", "formula").evidence
+    assert "degree 7" in ev and "has degree 3 in the lengths" in ev
+    assert "line 97-99" in ev and "the debris 'N' dropped" in ev
 
 
 def test_appendix_d1_solves_with_the_arms_of_theta_zero():
