@@ -61,6 +61,18 @@ PROVIDERS = ("volerr.derive.audit_pahk", "volerr.derive.audit_tracker",
              "volerr.derive.audit_results")
 
 
+#: the assumption behind "a repetition or loss at the same place in two images does not
+#: decide" (quoted by the rule and by the verdicts that apply it): the documents show neither
+#: that a failure of the extraction recurs at the same place of another image nor that it
+#: cannot
+RECURRENCE_UNSHOWN = (
+    "that a failure driven by the image recurs at the same place in another image of the "
+    "same layout is an assumption the documents neither show nor exclude (the thesis renders "
+    "the chain's factors twice, eq. 3.31-3.33 and the chain after eq. 3.37, and the "
+    "extraction damages them differently there -- T_1^2 loses a row in eq. 3.31 only, T_2^3 "
+    "in the chain only -- while T_3^4 has the same repeated row in both)")
+
+
 #: the rule that picks a verdict's category from the readings tried (quoted by the HTML page
 #: and docs/formats.md)
 PRIORITY_RULE = (
@@ -78,7 +90,10 @@ PRIORITY_RULE = (
     "not extraction damage (a well-formed wrong symbol, term or sign; the same substitution "
     "at the same place in a separately typeset copy, by the cross-copy rule below; a "
     "consequence printed elsewhere; a sign or axis stacking that "
-    "contradicts the one the same document uses); "
+    "contradicts the one the same document uses; a whole block of entries in another order, "
+    "which the extraction is not seen to produce); an item with several defects is "
+    "printing_error when one of them is decided so, and its evidence names the defects that "
+    "stay undecided; "
     "(5) undecidable -- otherwise: only an unstated assumption reproduces it, or the defect "
     "is glyph-level (a lost letter, sign, row or column, a duplicated row, a confusable glyph "
     "such as mm for um) and the print and the extraction explain it equally; both "
@@ -93,15 +108,16 @@ PRIORITY_RULE = (
     "specialization project), or two equations of one document -- decides for the author's "
     "source (printing_error) when it is a substitution: another well-formed symbol, index, "
     "sign, number, label or component, which an extraction would have to invent identically "
-    "in both images while it reads the same notation right elsewhere (a misreading driven by "
-    "the rendering would recur wherever that rendering does); a whole component or label of "
-    "another equation is such a substitution (this extraction is not seen to carry text from "
-    "one image into another). It does not decide a repetition within an image (a row, entry, "
-    "token or matrix repeated, with what it displaces lost) nor a lost entry: this extraction "
-    "demonstrably repeats within an image (the error matrix of T_0^{t,c} after thesis eq. "
-    "3.37 has five rows, three of them '-E_{DX} & ... & 1 & E_{ZX}' and two of these "
-    "identical, with the letter D that names no axis), and a failure driven by the image "
-    "repeats at the same place in images of the same layout: such defects are undecidable. "
+    "in both images while it reads the same notation right elsewhere; a whole component or "
+    "label of another equation is such a substitution (this extraction is not seen to carry "
+    "text from one image into another). It does not decide a repetition within an image (a "
+    "row, entry, token or matrix repeated, with what it displaces lost) nor a lost entry: "
+    "this extraction demonstrably repeats within an image (the error matrix of T_0^{t,c} "
+    "after thesis eq. 3.37 has five rows, three of them '-E_{DX} & ... & 1 & E_{ZX}' and two "
+    "of these identical, with the letter D that names no axis), and " + RECURRENCE_UNSHOWN
+    + "; so the same repetition or loss at the same place in two images weighs towards the "
+    "author's source but does not decide: such defects are undecidable, and the evidence "
+    "says which way the copies weigh. "
     "A candidate repetition: the wrong whole symbol or term stands elsewhere in the same "
     "printed equation, before or after it (an extraction reads the whole image; an author "
     "writes from the neighbouring line), or a wrong index repeats the index written next to "
@@ -239,10 +255,34 @@ TYPICAL = {
 }
 
 
-def typical_text(extra: str = "") -> str:
-    """The typical machine's assumptions (``extra``: more assumed values, appended)."""
+def typical_text(extra: str = "", layout: str | None = None, term=None) -> str:
+    """The typical machine's assumptions (``extra``: more assumed values, appended).  With
+    ``layout``, it names the machine whose travels scale the worst case against the layout's
+    own machine in Pahk (its layout file's ``source``); with ``term`` (the dropped
+    expression), whether the travels enter the size at all."""
     t = TYPICAL
-    return (f"typical machine: Pahk's CMM A (900 x 575 x 400 mm), offsets up to "
+    machine = "Pahk's CMM A (900 x 575 x 400 mm)"
+    if layout is not None:
+        import re
+
+        from volerr.machine.layout import read_layout
+        m = re.search(r"(CMM [A-Z]) of sec\. 4 \(([^)]*)\)", read_layout(layout).source or "")
+        if m and m.group(1) == "CMM A":
+            machine += f", this {layout} layout's own machine in Pahk's sec. 4"
+        else:
+            machine = (f"the travels of Pahk's CMM A (an MB1, 900 x 575 x 400 mm) taken for "
+                       f"this {layout} layout -- "
+                       + (f"Pahk's own {layout} machine is {m.group(1)} ({m.group(2)})" if m
+                          else f"Pahk describes no {layout} machine"))
+    if term is not None:
+        axes = sorted({str(s_) for s_ in sp.sympify(term).free_symbols}
+                      & {"X", "Y", "Z"})
+        machine += ("; the term depends on the offsets only, so its size does not depend on "
+                    "the machine's travels" if not axes else
+                    f"; the travel{'s' if len(axes) > 1 else ''} of {', '.join(axes)} "
+                    f"({', '.join('%g mm' % t['travel_mm'][a] for a in axes)}) "
+                    f"enter{'' if len(axes) > 1 else 's'} the size")
+    return (f"typical machine: {machine}, offsets up to "
             f"{t['measuring_offset_mm']:g} mm, probe offsets up to {t['probe_offset_mm']:g} mm, "
             f"angular errors {t['angular_rad'] * 1e6:g} urad{extra} -- assumed values, not "
             f"printed; the size scales in proportion to the lengths and angles assumed")

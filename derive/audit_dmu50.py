@@ -34,7 +34,7 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from .audit import TYPICAL, Verdict, fmt
+from .audit import RECURRENCE_UNSHOWN, TYPICAL, Verdict, fmt
 from .inverse import BRANCH, TIP, TOOL_AXIS, linear_inverse, rotary_inverse
 from .kinematics import Chain, position_symbol, rotation, translation
 from .volumetric import nominal_point, nominal_tool_axis, volumetric_error
@@ -79,14 +79,21 @@ COPIES = {
 
 #: why the missing minus of T_2^3 (thesis eq. 3.32, project eq. (3)) is decided as printed
 T23_CROSS_COPY = (
-    "Category printing_error by the cross-copy rule: a single sign, but {other} -- the same "
-    "defect at the same entry in two separately typeset documents. Read as a loss or as a "
-    "repetition (the entry s_B of row 2, without its minus, in row 1), a failure driven by "
-    "the image would recur in images of the same layout, and the extraction reads the same "
-    "matrix with its minus there: the paper's eq. 1.3 ('c_{{B}} & -s_{{B}} & 0 & 0 \\\\ "
-    "s_{{B}} & c_{{B}}') and eq. 1.16 (T_BB, the same entries), and '-s_C' in thesis eq. "
-    "3.35; so the author's source has it. The paper's eq. 1.3 and Listing 3.3's T_B "
-    "(np.array([[c_B, -s_B, 0, 0]], ...)) show the intended rotation")
+    "Category printing_error by the cross-copy rule and a consequence printed elsewhere. A "
+    "single sign, but {other} -- the same defect at the same entry in two separately typeset "
+    "documents -- while the extraction reads the same matrix with its minus in the paper's "
+    "eq. 1.3 ('c_{{B}} & -s_{{B}} & 0 & 0 \\\\ s_{{B}} & c_{{B}}') and eq. 1.16 (T_BB, the "
+    "same entries), and '-s_C' in thesis eq. 3.35: an extraction that lost the minus (or "
+    "repeated the entry s_B of row 2 in row 1) would have to do so at the same entry in three "
+    "renderings while reading it in the others, and it is not deterministic between "
+    "renderings (the thesis' two renderings of T_1^2 and T_2^3 are damaged differently, see "
+    "eq. 3.31 and 3.33). The consequence: the project's forward kinematics eq. (10)-(15), "
+    "'found' from its chain by eq. (9), print the same six formulas as thesis eq. 3.19-3.24, "
+    "which equal the derivation (their verdicts); computed here at 5 random poses, the chain "
+    "T_w^t = (T_0^w)^-1 T_0^t reproduces {fwd}. So the author computed with the rotation "
+    "Rz(B): the other rotation sense (the transposed matrix) is no convention of the author, "
+    "and the print, not the computation, has the sign wrong. The paper's eq. 1.3 and Listing "
+    "3.3's T_B (np.array([[c_B, -s_B, 0, 0]], ...)) show the intended rotation")
 
 
 #: why T_2^2 of the printed chains (thesis eq. 3.37, project eq. (8)) is undecided
@@ -94,17 +101,19 @@ T22_UNDECIDED = (
     "{here}: its subscript 2 repeats the superscript 2 written next to it, a candidate "
     "repetition within the image; {there}. By the cross-copy rule that does not decide a "
     "repetition: the two chains are images of the same layout (one line of factors T_a^b in "
-    "the same order), where a failure driven by the image recurs at the same place. For the "
-    "print: the author's chain written with these indices (the thesis' chain taken from the "
+    "the same order); the same defect at the same place weighs towards the print, but "
+    + RECURRENCE_UNSHOWN.replace("{", "{{").replace("}", "}}") + ". For the print: the author's chain written with these indices (the thesis' chain taken from the "
     "project's). For the extraction: the superscript digit read again as the subscript, a "
     "repetition of the kind it demonstrably makes within an image (the error matrix of "
     "T_0^{{t,c}} after eq. 3.37 has three rows '-E_{{DX}} & ... & 1 & E_{{ZX}}', two of them "
     "identical).")
 
 
-def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, list, list]:
+def _matrix_category(name: str, erratum: str, evidence: str,
+                     context: dict | None = None) -> tuple[str, str, list, list]:
     """(category, evidence, readings tried, readings used) of a printed matrix that differs
-    from the derived one."""
+    from the derived one; ``context``: "renderings" (:func:`_renderings`), "chain_T_4^5" (how
+    the chain after eq. 3.37 prints T_4^5) and "t23_forward" (:func:`_t23_forward`)."""
     where = COPIES.get(name, ("", ""))[0]
     if "missing" in erratum:
         return "undecidable", evidence + (
@@ -117,29 +126,51 @@ def _matrix_category(name: str, erratum: str, evidence: str) -> tuple[str, str, 
                 "a row lost by the print or by the extraction: the derived factor without "
                 "that row (exact)"], [f"glyph:{name} lost row"]
     if "printed twice" in erratum:
+        two = (context or {}).get("renderings", {})
+        mine = two.get(name, {})
+        same_dup = bool(mine) and mine["eq"] == mine["chain"] and bool(mine["eq"][1])
+        others = "; ".join(f"{n} has {_said(r['eq'], 'in eq. ' + r['id'])} and "
+                           f"{_said(r['chain'], 'in the chain')}"
+                           for n, r in two.items() if n != name and r["eq"] != r["chain"])
+        t45 = (context or {}).get("chain_T_4^5", "")
         return "undecidable", evidence + (
             f". Category undecidable: a duplicated row, which the print (a repeated line of "
-            f"the source) and the text extraction (a repeated span) explain equally; the "
-            f"'updated' chain after eq. 3.37 repeats the same row, but it renders the same "
-            f"matrix again, so a deterministic extraction would repeat it too (by the "
-            f"cross-copy rule a repetition at the same place does not decide: this extraction "
-            f"demonstrably repeats rows within an image -- in that same chain the error matrix "
-            f"of T_0^{{t,c}} has five rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'); "
-            f"the separately "
-            f"typeset copies ({where}) print four rows, which shows the intended matrix but not "
-            f"whether this print repeated one; what would decide: the page of the original "
-            f"PDF"), [
+            f"the source) and the text extraction (a repeated span) explain equally. "
+            + (f"The 'updated' chain after eq. 3.37 renders {name} again with the same "
+               f"defect ({'; '.join(mine['chain'][1]) if mine else ''}). That is no proof of either explanation. It weighs towards "
+               f"the author's source (the chain's factor copied from this equation): the "
+               f"extraction is not deterministic between these two renderings, it damages the "
+               f"neighbouring factors differently there ({others}), yet it would have to "
+               f"repeat this row identically in both. It does not decide: this extraction "
+               f"demonstrably repeats rows within that same chain (the error matrix of "
+               f"T_0^{{t,c}} has five rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'), "
+               f"so a repetition in each rendering is possible; and the chain's next factor "
+               f"T_4^5 prints {name}'s rotation with {t45} -- a {name} copied with the duplicate in "
+               f"the author's source would carry it there too, and an extraction that "
+               f"repeated the factor just read would have read it without the duplicate this "
+               f"time, so that block fits neither explanation cleanly. "
+               if same_dup else "")
+            + f"The separately typeset copies ({where}) print four rows, which shows the "
+            f"intended matrix but not whether this print repeated one; what would decide: the "
+            f"page of the original PDF"), [
                 "the matrix as printed: 5 rows, not a 4x4 HTM",
                 "a row repeated by the print or by the extraction: the derived factor with the "
-                "repeated row removed (exact)"], [f"glyph:{name} repeated row"]
+                "repeated row removed (exact)"] + ([
+                "the chain after eq. 3.37 as a second rendering: the same duplicate, while "
+                "the extraction damages the neighbouring factors differently in the two "
+                "renderings (weighs towards the print) and repeats rows within that chain; "
+                f"its T_4^5 has {name}'s rotation without the duplicate: decides neither"]
+                if same_dup else []), [f"glyph:{name} repeated row"]
     if name == "T_2^3" and "sign error" in erratum:
+        fwd = (context or {}).get("t23_forward", {})
         return "printing_error", evidence + ". " + T23_CROSS_COPY.format(
             other="the specialization project's eq. (3) (appendix B) prints the same "
                   "'T_2^3 = [[c_B, s_B], [s_B, c_B]]' and the 'updated' chain after eq. 3.37 "
-                  "repeats it (T_2^{3,c})"), [
+                  "repeats it (T_2^{3,c})", fwd=forward_note(fwd)), [
                 "right-handed rotation Rz(B) (derived; paper eq. 1.3, Listing 3.3 T_B): entry "
                 "(1,2) differs",
-                "left-handed Rz(-B) (the other rotation sense): entry (2,1) differs",
+                "left-handed Rz(-B) (the other rotation sense, the transposed matrix): entry "
+                "(2,1) differs"] + forward_tried(fwd) + [
                 "a minus lost by the print or by the extraction: the derived factor exactly; "
                 "the extraction's part contradicted by the same defect in project eq. (3) and "
                 "the minus read in the same matrix of paper eq. 1.3 and 1.16"], [
@@ -154,13 +185,15 @@ LISTING_SOURCE_UNDECIDABLE = (
     "print: a line of code copied and its file name left unchanged, the usual copy-paste "
     "defect, and the same pattern stands in the B block (E_CB reads E_BB's data) and the C "
     "block (E_CC reads E_BC's), as a C block copied from the B block would carry it; the "
-    "line of {name} keeps its own variable name. For the extraction: it demonstrably repeats tokens "
-    "and rows within an image (the error matrix of T_0^{{t,c}} after thesis eq. 3.37 has five "
-    "rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'; appendix B sec. 2.4 lists '(E_AX, "
-    "E_BX, E_BX) E_CX'), and the two blocks of the listing have the same layout, so a "
-    "repetition driven by the image recurs at the same place; by the cross-copy rule a "
-    "repetition within an image does not decide. What would decide: the original listing "
-    "(or a figure of the compensation that shows whether {name} was used)")
+    "line of {name} keeps its own variable name. For the extraction: it demonstrably repeats "
+    "tokens and rows within an image (the error matrix of T_0^{{t,c}} after thesis eq. 3.37 "
+    "has five rows, three of them '-E_{{DX}} & ... & 1 & E_{{ZX}}'; appendix B sec. 2.4 lists "
+    "'(E_AX, E_BX, E_BX) E_CX'). The same repetition in both blocks weighs towards the print, "
+    "the more so as the extraction renders the two defective lines differently ({modes}), so "
+    "they are no one rendering failing twice alike; by the cross-copy rule a repetition "
+    "within an image still does not decide: "
+    + RECURRENCE_UNSHOWN.replace("{", "{{").replace("}", "}}") + ". What would decide: the "
+    "original listing (or a figure of the compensation that shows whether {name} was used)")
 
 
 #: why the T_4^5 of the chain "updated" with the errors (after eq. 3.37) is undecidable
@@ -214,6 +247,106 @@ def derived_factors(layout) -> dict:
         "T_4^5": translation(-cb), "T_5^w": rotation((0, 0, 1), -C),
         "T_0^t": translation((X, Y, Z)),
     }
+
+
+def _rows_note(rows, derived: sp.Matrix) -> tuple[int, list[str]]:
+    """How a printed rendering of a factor differs in its rows from the derived factor:
+    (number of rows, ['row [...] lost', 'the row [...] twice', 'its row 1 with 5 entries']).
+    A printed row stands for a derived row when its first entries equal it, up to the signs
+    (a sign defect is no row defect); exact matches are paired first."""
+    parsed = [[sp.simplify(_parse(c)) for c in r] for r in rows]
+    drows = [[sp.simplify(derived[i, j]) for j in range(derived.cols)]
+             for i in range(derived.rows)]
+    free, left = list(range(len(drows))), list(range(len(parsed)))
+    for test in (lambda u, v: sp.simplify(u - v) == 0,
+                 lambda u, v: sp.simplify(u ** 2 - v ** 2) == 0):
+        for k in list(left):
+            hit = next((i for i in free if len(parsed[k]) >= len(drows[i])
+                        and all(test(u, v) for u, v in zip(parsed[k], drows[i]))), None)
+            if hit is not None:
+                free.remove(hit)
+                left.remove(k)
+    notes = [f"row [{', '.join(fmt(v) for v in drows[i])}] lost" for i in free]
+    notes += [f"the row [{', '.join(fmt(v) for v in r)}] twice" for k, r in enumerate(parsed)
+              if r in parsed[:k]]
+    notes += [f"its row {k + 1} with {len(r)} entries" for k, r in enumerate(parsed)
+              if len(r) != derived.cols]
+    return len(rows), notes
+
+
+def _renderings(printed: dict, factors: dict) -> dict:
+    """Factors printed twice in the thesis -- eq. 3.31-3.33 and the chain after eq. 3.37 --
+    each rendering's rows described: {name: {"id", "eq", "chain"}}."""
+    out = {}
+    for name, rows in printed.get("chain_rendering", {}).items():
+        item = next((m for m in printed.get("matrix", []) if m["name"] == name
+                     and m["id"][0].isdigit()), None)
+        if item is not None:
+            out[name] = {"id": item["id"], "eq": _rows_note(item["rows"], factors[name]),
+                         "chain": _rows_note(rows, factors[name])}
+    return out
+
+
+def _said(note: tuple[int, list[str]], where: str) -> str:
+    """'3 rows in eq. 3.31 (row [...] lost)'."""
+    n, notes = note
+    return f"{n} rows {where}" + (f" ({'; '.join(notes)})" if notes else "")
+
+
+def _t23_forward(fwd: dict, factors: dict, printed_rows) -> dict:
+    """Which of the forward formulas (tool axis i, j, k and tool tip x, y, z; the derivation,
+    which eq. 3.19-3.24 print and the project's eq. (10)-(15) print again) the chain
+    ``T_w^t = (T_0^w)^-1 T_0^t`` reproduces with T_2^3 taken as each candidate matrix:
+    {candidate: [formula names]}, checked at 5 random poses."""
+    rz = factors["T_2^3"]
+    cands = {"Rz(B)": rz, "the printed matrix": sp.Matrix([[_parse(c) for c in r]
+                                                          for r in printed_rows]),
+             "Rz(-B)": rz.subs(B, -B)}
+    rng = np.random.default_rng(2303)
+    args = (X, Y, Z, B, C, D)
+    poses = rng.uniform((-250, -225, 0, 0.1, -3, 100), (250, 225, 400, 3, 3, 200), (5, 6))
+    t0t = sp.lambdify(args, factors["T_0^t"], "numpy")
+    want = {q: sp.lambdify(args, fwd[q], "numpy") for q in "ijkxyz"}
+    out = {}
+    for label, t23 in cands.items():
+        t0w = sp.lambdify(args, factors["T_0^1"] * factors["T_1^2"] * t23 * factors["T_3^4"]
+                          * factors["T_4^5"] * factors["T_5^w"], "numpy")
+        twt = [np.linalg.solve(np.array(t0w(*p), float), np.array(t0t(*p), float))
+               for p in poses]
+        ok = [q for q, (row, col) in zip("ijkxyz", ((0, 2), (1, 2), (2, 2), (0, 3), (1, 3),
+                                                   (2, 3)))
+              if all(abs(t[row, col] - float(want[q](*p))) < 1e-9 * (1 + abs(t[row, col]))
+                     for t, p in zip(twt, poses))]
+        out[label] = ok
+    return out
+
+
+def _formulas(found: list) -> str:
+    return ("all six (i, j, k, x, y, z)" if len(found) == 6 else "none" if not found
+            else "only " + ", ".join(found))
+
+
+def forward_note(res: dict) -> str:
+    """The result of :func:`_t23_forward` in words (quoted by the T_2^3 verdicts)."""
+    return "; ".join(f"{_formulas(f)} with T_2^3 = {c}" + (" (-s_B at (1,2))" if c == "Rz(B)"
+                                                          else "")
+                     for c, f in res.items()) or "(not computed)"
+
+
+def forward_tried(res: dict) -> list[str]:
+    """The readings of T_2^3 checked against the printed forward kinematics."""
+    if not res:
+        return []
+    return [f"the chain with T_2^3 = {c}: {_formulas(f)} of the project's forward formulas eq. "
+            f"(10)-(15) (= thesis eq. 3.19-3.24)"
+            + (" -- the other rotation sense ruled out as the author's convention"
+               if c == "Rz(-B)" else "") for c, f in res.items()]
+
+
+def t23_forward(printed_rows) -> dict:
+    """:func:`_t23_forward` for the DMU50 layout's derived chain (cached derivation)."""
+    layout, _, fwd, _, _ = _derived()
+    return _t23_forward(fwd, derived_factors(layout), printed_rows)
 
 
 DERIVED_ORDER = ["T_w^5", "T_5^4", "T_4^3", "T_3^2", "T_2^1", "T_1^0", "T_0^t"]
@@ -344,6 +477,16 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
     for bb, cc in rng.uniform(-3, 3, (5, 2)):
         assert np.abs(np.array(check(bb, cc, d_value), float)).max() < 1e-9, \
             "factor form does not reproduce the chain"
+    chain45 = next((m for m in printed.get("matrix", [])
+                    if m["id"].startswith("error chain") and m["name"] == "T_4^5"), None)
+    t32 = next((m for m in printed.get("matrix", []) if m["name"] == "T_2^3"
+                and m["id"][0].isdigit()), None)
+    context = {"renderings": _renderings(printed, factors),
+               "chain_T_4^5": "" if chain45 is None else
+               f"{len(chain45['rows'])} rows, none repeated"
+               + " (the derived T_3^4)" * bool(_matrix_diff(chain45["rows"],
+                                                            factors["T_3^4"])[0]),
+               "t23_forward": {} if t32 is None else _t23_forward(fwd, factors, t32["rows"])}
     for item in printed.get("matrix", []):
         name = item["name"]
         eq = f"eq. {item['id']}" if item["id"][0].isdigit() else item["id"]
@@ -356,7 +499,7 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                         f"by -c_B = (0, 0, -d)")
         tried, used = [], []
         if not same:
-            cat, ev, tried, used = _matrix_category(name, erratum, ev)
+            cat, ev, tried, used = _matrix_category(name, erratum, ev, context)
             if item["id"].startswith("error chain"):
                 cat = "undecidable"
                 tried = ["the printed matrix against every derived factor: it is the derived "
@@ -468,6 +611,8 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
             out.append(v)
     if "sources" in lst:
         texts = lst.get("sources_text", {})
+        modes = "; ".join(f"the line of {n} {'as LaTeX' if '_{' in ls[-1] else 'as plain code'}"
+                          f" ('{ls[-1]}')" for n, ls in texts.items())
         for pname, src in lst["sources"].items():
             expected = f"{pname}_avg."
             same = src == expected
@@ -480,7 +625,8 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                          else f"line reads cf_rot('{src}', ...) for {pname}; expected "
                          f"'{expected}' (each other parameter of T_er reads '<its name>_avg.'; "
                          f"as printed the {pname} curve is never used).{quoted} "
-                         + LISTING_SOURCE_UNDECIDABLE.format(name=pname, src=src[:-5]),
+                         + LISTING_SOURCE_UNDECIDABLE.format(name=pname, src=src[:-5],
+                                                             modes=modes),
                          lines[-1] if lines else f"cf_rot('{src}')", f"cf_rot('{expected}')",
                          pname, category="undecidable")
             if not same:

@@ -33,7 +33,8 @@ import sympy as sp
 from volerr.machine.layout import read_layout
 
 from .audit import Verdict, category_of, fmt
-from .audit_dmu50 import T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward
+from .audit_dmu50 import (T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward,
+                          forward_note, forward_tried, t23_forward)
 from .kinematics import Chain, position_symbol, rotation, stage_factors, translation
 
 DATA_FILE = "printed_htm.toml"
@@ -152,11 +153,13 @@ def audit_matrix(item: dict) -> list[Verdict]:
                           "1.3's sign pattern with B -> C)", ev, str(item["rows"]),
                           fmt(derived), tried, ["inconsistent:paper eq. 1.6 sense of C"]))
         elif name == "T_2^3":
+            fwd = t23_forward(item["rows"])
+            tried += forward_tried(fwd)
             ev = ("; ".join(bad) + f"; the printed 3x3 block has det = {fmt(det)}: not a "
                   "rotation in either sense. " + T23_CROSS_COPY.format(
                       other="thesis eq. 3.32, typeset separately, prints the same [[c_B, s_B], "
                             "[s_B, c_B]], and so does the thesis' 'updated' chain after eq. "
-                            "3.37 (T_2^{3,c})"))
+                            "3.37 (T_2^{3,c})", fwd=forward_note(fwd)))
             out.append(_v(item, "matrix", "printing_error", "sign error in 1 entry (as thesis "
                           "eq. 3.32)", ev, str(item["rows"]), fmt(derived), tried,
                           ["inconsistent:T_2^3 sign of s_B (1,2)"]))
@@ -402,24 +405,42 @@ def audit_rotary(item: dict) -> Verdict:
     for name, m in alts.items():
         n = len(_entries(printed, m))
         tried.append(f"{name}: {'exact' if n == 0 else f'{n} entries differ'}")
+    htm = _small(e, t) * rz
+    no_error = {s_: 0 for s_ in (*e, *t)}
+    missing = [(i + 1, j + 1) for i in range(3) for j in range(3)
+               if sp.simplify(printed[i, j].subs(no_error) - rz[i, j]) != 0]
+    n_htm = len(_entries(printed, htm))
     return _v(item, "", "printing_error", f"{len(bad)} entries differ from (T_EB - I) Rz(B)",
               "derived (T_EB - I) Rz(B), first order (the squareness neglected as stated): "
               + "; ".join(bad) + ". No reading (rotation sense, transposed error rotation, "
-              "the HTM instead of the deviation) reproduces it. The bottom row 0 0 0 1 under "
-              "a deviation (the left-hand side of the equation ends in 0) is the defect of the "
-              "thesis' eq. 2.42 for C, a separately typeset document, at the same place: a "
-              "digit of a matrix row, not a symbol repeated from its neighbourhood, which the "
-              "extraction reads right in the same place of the specialization project's eq. "
-              "(23) ('0 & 0 & 0 & 0'), an image of the same layout there: by the cross-copy "
-              "rule the author's source. Entry (2,3) -E_XB (a translational error where the "
-              "rotation -E_AB belongs) is eq. 2.42's defect too, but E_XB also stands at "
-              "(1,4) of this matrix, three entries before: a candidate repetition, and the "
-              "two product matrices are images of the same layout, so it stays undecided (see "
-              "the verdict on eq. 2.42's error matrix). The other three are single signs only "
-              "this copy has (the thesis' matrix does not): print or extraction, undecided. "
-              "Category printing_error: the bottom row is decided to be printed",
+              "the HTM instead of the deviation) reproduces it. The paper prints no left-hand "
+              "side: the matrix is introduced as 'the error model for the B-axis' and labelled "
+              "'^{T}T_{0}^{B}', like eq. 1.12's HTM '^{e}T_{0}^{B} = T_OB T_SB T_EB T_BB'. "
+              f"Read as that HTM, T_EB Rz(B) to first order, its bottom row 0 0 0 1 is right and "
+              f"{n_htm} entries differ: the nominal rotation is missing from "
+              f"{len(missing)} of them ({', '.join(f'({i},{j})' for i, j in missing)}: the "
+              "c_B, s_B of the rotation block and the 1 at (3,3)), which print only error "
+              "terms, the deviation's form -- a whole, well-formed pattern (the error terms "
+              "without the rotation they multiply), not damage to a few glyphs, which no "
+              "extraction produces: the author's source. Read as the deviation, as the thesis "
+              "prints it for C (eq. 2.42, with the deviation vector on its left), the bottom "
+              "row 0 0 0 1 is eq. 2.42's defect at the same place in a separately typeset "
+              "document: a digit of a matrix row, not a symbol repeated from its "
+              "neighbourhood, which the extraction reads right in the same place of the "
+              "specialization project's eq. (23) ('0 & 0 & 0 & 0'), an image of the same "
+              "layout there: by the cross-copy rule the author's source. Entry (2,3) -E_XB (a "
+              "translational error where the rotation -E_AB belongs) is eq. 2.42's defect too, "
+              "but E_XB also stands at (1,4) of this matrix, three entries before: a candidate "
+              "repetition, and the two product matrices are images of the same layout, so it "
+              "stays undecided (see the verdict on eq. 2.42's error matrix). The other three "
+              "are single signs only this copy has (the thesis' matrix does not): print or "
+              "extraction, undecided. Category printing_error under either reading: read as "
+              "the HTM its label names, the missing nominal rotation; read as the deviation, "
+              "the bottom row is decided to be printed",
               str(item["rows"]), fmt(dev), tried,
-              ["copy:paper eq. 1.17 bottom row of thesis eq. 2.42"])
+              ["copy:paper eq. 1.17 bottom row of thesis eq. 2.42",
+               "inconsistent:paper eq. 1.17 labelled as eq. 1.12's HTM without its nominal "
+               "rotation"])
 
 
 # ------------------------------------------------------------------------------- items

@@ -227,7 +227,8 @@ def _reading_category(v: Verdict, r: Reading, keys, lay, alt, physical, geoms=()
     return classify(v, "convention", alternative=fmt(alt), statement="; ".join(names),
                     dropped=fmt(diff), dropped_um=size,
                     evidence=v.evidence + f" Convention: {'; '.join(names)}. The two readings "
-                    f"differ by {fmt(diff)} (up to {size:.2g} um on the {typical_text()}).")
+                    f"differ by {fmt(diff)} (up to {size:.2g} um on the "
+                    f"{typical_text(layout=lay.name, term=diff)}).")
 
 
 # ----------------------------------------------------------------------------- random
@@ -380,6 +381,29 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
 
 
 # ------------------------------------------------------------------------------ entry
+def _chain_is_the_print(chain_eq: dict, by_id: dict, result_eq: dict, verdicts) -> None:
+    """A convention verdict on a component of a result equation whose print is exactly what the
+    layout's printed chain gives to first order says so: the convention is then Pahk's own
+    chain, not only a reading that reproduces the print."""
+    from .audit_pahk_chain import chain_vectors
+    L, note, _ = chain_vectors(chain_eq, by_id)
+    try:
+        literal = chain_error(chain_eq["lhs"], chain_eq["rhs"], L)
+    except (ValueError, TypeError, sp.SympifyError):
+        return
+    for i, c in enumerate(COMPONENTS):
+        v = next((x for x in verdicts if x.component == c), None)
+        if v is None or v.category != "convention":
+            continue
+        if is_identical(literal[i], printed_component(result_eq, c)[0]):
+            v.evidence += (f" The printed chain eq. {chain_eq['id']} ('{chain_eq['lhs']} = "
+                           f"{chain_eq['rhs']}', with "
+                           + (f"its vectors as read: {note}" if note else "its printed vectors")
+                           + f"), expanded to first "
+                           f"order, gives exactly this {c}: the convention is Pahk's own "
+                           f"equation, not only a reading that reproduces the print.")
+
+
 def audit(printed: dict, layouts: list[str] | None = None) -> list[Verdict]:
     """Verdicts on every printed equation of the data file (restricted to ``layouts``)."""
     eqs = printed.get("equation", [])
@@ -393,6 +417,13 @@ def audit(printed: dict, layouts: list[str] | None = None) -> list[Verdict]:
         if e["kind"] == "volumetric" and (wanted is None or e["layout"] in wanted):
             vol_verdicts[e["id"]], vol_reading[e["layout"]] = \
                 audit_volumetric(e, geoms[e["layout"]])
+    for e in eqs:
+        if e["kind"] == "chain" and e["layout"] in vol_reading \
+                and result_of.get(e["layout"]) is not None:
+            _chain_is_the_print(e, by_id, result_of[e["layout"]],
+                                vol_verdicts[result_of[e["layout"]]["id"]])
+    stackings = {n: r.stacking(layout(n)) for n, r in vol_reading.items()
+                 if r is not None and (r.tool is not None or r.work is not None)}
     out: list[Verdict] = []
     for e in eqs:
         name = e["layout"]
@@ -404,7 +435,8 @@ def audit(printed: dict, layouts: list[str] | None = None) -> list[Verdict]:
         elif kind == "random":
             out.extend(audit_random(e, random_eqs))
         elif kind == "transfer":
-            out.extend(audit_transfer(e, vol_reading.get(name), _verdict, geoms[name], eqs))
+            out.extend(audit_transfer(e, vol_reading.get(name), _verdict, geoms[name], eqs,
+                                      stackings))
         elif kind == "chain":
             out.extend(audit_vectors(e, _verdict))
             out.extend(audit_chain(e, by_id, result_of.get(name), geoms[name],

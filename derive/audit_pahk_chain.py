@@ -367,7 +367,8 @@ def _convention(v: Verdict, r, lay, literal, physical, keys, geoms=()) -> Verdic
     return classify(v, "convention", alternative=_vec(literal), statement="; ".join(names),
                     dropped=_vec(diffs), dropped_um=size,
                     evidence=v.evidence + f" Convention: {'; '.join(names)}. The two readings "
-                    f"differ by {_vec(diffs)} (up to {size:.2g} um on the {typical_text()}).")
+                    f"differ by {_vec(diffs)} (up to {size:.2g} um on the "
+                    f"{typical_text(layout=lay.name, term=sum(diffs))}).")
 
 
 __all__ = ["audit_chain", "audit_vectors", "chain_error", "chain_readings", "chain_vectors",

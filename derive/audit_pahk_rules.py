@@ -22,6 +22,7 @@ the rule of :data:`volerr.derive.audit.PRIORITY_RULE`:
 from __future__ import annotations
 
 import itertools
+import re
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -270,20 +271,28 @@ def _same_symbol_elsewhere(all_eqs, eq, key, want) -> list[str]:
     return out
 
 
-def _line_support(all_eqs, eq, key, line) -> list[str]:
+def _line_support(all_eqs, eq, key, line, stackings=None) -> list[str]:
     """Non-trivial prints of the same squareness symbol on other layouts that the same line
-    reading reproduces (with the tool-point or the table pivot)."""
+    reading reproduces (with the tool-point or the table pivot), each layout read with the
+    axis stacking of its own volumetric equation (``stackings``: layout -> (tool, work)), as
+    its own verdict reads it."""
     def want(name, pr):
         if pr == P(key):
             return None
+        tool, work = (stackings or {}).get(name, (None, None))
         for pivot in ("tool_point", "table_origin"):
             try:
-                d = derived_rule(name, key, RuleReading(pivot=pivot, line=line))
+                d = derived_rule(name, key, RuleReading(pivot=pivot, line=line, tool=tool,
+                                                        work=work))
             except (KeyError, ValueError):
                 return None
             if is_identical(d, pr):
                 iso_too = is_identical(derived_rule(name, key), pr)
-                return (" (with the table pivot)" if pivot == "table_origin" else "") + \
+                how = [x for x in ("the table pivot" if pivot == "table_origin" else "",
+                                   f"the axis stacking of its volumetric equation, "
+                                   f"{stacking_text(tool, work)}" if tool is not None else "")
+                       if x]
+                return (f" (with {' and '.join(how)})" if how else "") + \
                     (" -- the two-line transfer gives it too" if iso_too else "")
         return None
     return _same_symbol_elsewhere(all_eqs, eq, key, want)
@@ -305,11 +314,13 @@ def _read_right_elsewhere(expected, printed, comps: dict, own: str, raw: dict) -
             + "; ".join(out) + "." if out else "")
 
 
-def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list[Verdict]:
+def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
+                   stackings=None) -> list[Verdict]:
     """Verdicts on every rule of a transfer equation.  ``vol_reading``: the reading of the same
     layout's volumetric equation (its flips and stacking are the consistent ones);
     ``verdict``: the Verdict factory of the provider; ``all_eqs``: every printed equation
-    (for the prints of the same rule on the other layouts)."""
+    (for the prints of the same rule on the other layouts); ``stackings``: layout -> (tool,
+    work) of the volumetric equations that read another axis stacking."""
     name = eq["layout"]
     lay = layout(name)
     vol_flips = tuple(vol_reading.flips) if vol_reading is not None else ()
@@ -358,7 +369,7 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
             v = verdict(eq, key, "differs", erratum, evidence + ocr, pr, d0)
             v = _rule_category(v, keys, r, lay, iso, d, d0, tried, geoms)
             if pr == P(key) and r.line != "both" and v.category == "convention":
-                support = _line_support(all_eqs, eq, key, r.line)
+                support = _line_support(all_eqs, eq, key, r.line, stackings)
                 v.evidence += (
                     f" The print leaves {key} unchanged, which alone cannot tell this "
                     f"convention from an omitted transfer; the same reading (the slope of the "
@@ -366,6 +377,8 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
                     f"layouts: " + ("; ".join(support) if support else "none") + ".")
             elif eq["expr"][key] == key and v.category == "undecidable":
                 v.evidence += _pattern_note(all_eqs, eq, key, d0)
+            elif v.category == "undecidable" and r.zero:
+                v.evidence += _omission_pattern(all_eqs, eq, key, sp.expand(d0 - d), r.zero)
             out.append(v)
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
@@ -396,7 +409,43 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=()) -> list
         for v in out:
             if v.category != "identical" and any("table" in t for t in v.readings_tried):
                 v.evidence += f" Table axis: {eq['table_note']}."
+    raws = {r for e in all_eqs if e.get("kind") == "transfer" for r in e["expr"].values()}
+    for v in out:
+        if iso_of(lay, v.component) in SQUARENESS and v.category != "identical":
+            _offset_notation(v, raws)
     return out
+
+
+#: an error symbol of a squareness transfer rule, in the notation without the offset
+_AT_AXIS = re.compile(r"\b([Ed][xyz])\(([XYZ])\)")
+
+
+def _offset_notation(v: Verdict, raws=()) -> None:
+    """Write the error motions of a squareness rule as Pahk does, at the measuring offset
+    (Ez(Yo): the yaw of Y where the line is measured; the derivation evaluates each error
+    motion there, :func:`_squareness_shift`), in every field but the print; quoted prints
+    (``raws``, the printed rules) keep their own text."""
+    keep = sorted((r for r in raws if _AT_AXIS.search(r)), key=len, reverse=True)
+
+    def fix(t):
+        if not isinstance(t, str):
+            return t
+        held = {}
+        for k, r in enumerate(keep):
+            if r in t:
+                held[f"\0{k}\0"] = r
+                t = t.replace(r, f"\0{k}\0")
+        t = _AT_AXIS.sub(r"\1(\2o)", t)
+        for mark, r in held.items():
+            t = t.replace(mark, r)
+        return t
+
+    for f in ("derived", "alternative", "dropped", "erratum", "evidence"):
+        setattr(v, f, fix(getattr(v, f)))
+    v.readings_tried = [fix(t) for t in v.readings_tried]
+    v.evidence += (" Notation: as Pahk writes the squareness rules, each error motion is "
+                   "taken at the measuring offset (Ez(Yo): the yaw of the Y axis at Yo), in "
+                   "'derived' and 'alternative' too.")
 
 
 def _cut_verdict(eq, key, name, lay, rr, vf, geometry_key, verdict, note, all_eqs):
@@ -476,6 +525,52 @@ def _pattern_note(all_eqs, eq, key, d0) -> str:
     return out + "; the prints do not decide between these."
 
 
+def _layout_type(name: str) -> str:
+    """'moving bridge' for MB1: the machine type its layout file describes."""
+    return layout(name).description.split(" CMM")[0].strip().lower()
+
+
+def _omission_pattern(all_eqs, eq, key, dropped, zero) -> str:
+    """For a rule exact only with a zero offset: on the other layouts whose derived rule has
+    the same omitted term (up to its sign), which print it and which omit it too (identical
+    prints named) -- the pattern of the omission over the layouts.  It does not change the
+    category: the offsets of the set-ups stay unprinted."""
+    monos = {t.as_coeff_Mul()[1] for t in sp.Add.make_args(sp.expand(dropped))}
+    if not monos or dropped == 0:
+        return ""
+    has = lambda expr: monos <= {t.as_coeff_Mul()[1]  # noqa: E731
+                                 for t in sp.Add.make_args(sp.expand(expr))}
+    raw = eq["expr"][key]
+    omit, keep, same = [eq["layout"]], [], []
+    for e in all_eqs:
+        if e.get("kind") != "transfer" or e["layout"] == eq["layout"] or key not in e["expr"] \
+                or key in e.get("cut", {}) or not has(derived_rule(e["layout"], key)):
+            continue
+        where = f"{e['layout']} eq. {e['id']}"
+        if has(printed_component(e, key)[0]):
+            keep.append(f"{where} ('{key} = {e['expr'][key]}')")
+        else:
+            omit.append(e["layout"])
+            if e["expr"][key] == raw:
+                same.append(where)
+    if not keep and len(omit) == 1:
+        return ""
+    kinds = {_layout_type(n).split()[-1] for n in omit}
+    term = " + ".join(sorted(fmt(m) for m in monos))
+    return (f" Across the layouts whose derived rule has the term {term} (up to its sign): "
+            + (f"the identical '{key} = {raw}' is printed for {', '.join(same)}; " if same
+               else "")
+            + (f"the term stands in {'; '.join(keep)}; " if keep else "")
+            + ("it is omitted by " + ", ".join(f"{n} ({_layout_type(n)})" for n in omit)
+               + (f" -- one machine type ({kinds.pop()})" if len(kinds) == 1 else "")
+               + f". This fits a set-up common to them ({' = '.join(zero)} = 0, the measuring "
+                 f"line through that reference) or a rule copied from one to the other"
+               if len(omit) > 1 else f"only {eq['layout']} omits it: a one-off omission or a "
+                                     f"set-up of this layout alone with {' = '.join(zero)} = 0")
+            + "; it does not change the category (the offsets of the set-ups are not "
+              "printed).")
+
+
 def _elsewhere_note(all_eqs, eq, key) -> str:
     """How the other layouts print the rule of ``key`` (raw text): the unchanged prints, the
     prints with terms, the damaged ones."""
@@ -532,7 +627,8 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
     fields = {"alternative": fmt(alt), "dropped": fmt(dropped), "dropped_um": size,
               "readings_tried": tried, "readings_used": list(keys)}
     cat = category_of(keys)
-    where = f" (worst case {size:.2g} um on the {typical_text()})" if size is not None else ""
+    where = (f" (worst case {size:.2g} um on the {typical_text(layout=lay.name, term=dropped)})"
+             if size is not None else "")
     if cat == "printing_error":
         bad = [k.split(":", 1)[1] for k in keys if k.startswith("inconsistent:")]
         return classify(v, "printing_error", evidence=v.evidence + (

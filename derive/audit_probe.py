@@ -137,6 +137,19 @@ def _angles_numeric(fn_printed, fn_derived, periodic: bool) -> tuple[bool, str]:
                    f"({where[0]:.2f}, {where[1]:.2f}, {where[2]:.2f})")
 
 
+#: Pahk's probe calibration (sec. 3.2, after eq. (13)): 100 points on 5 latitude
+#: circles, 18 deg apart along each angle -- so 20 azimuths per circle
+_CAL_POINTS, _CAL_CIRCLES, _CAL_STEP_DEG = 100, 5, 18
+_CALIBRATION_AZIMUTH = (
+    f"The text supports that reading: the calibration measures '{_CAL_POINTS + 1} points (100 "
+    f"on {_CAL_CIRCLES} latitude circles and one at the top)' at {_CAL_STEP_DEG} deg steps "
+    f"('전체적으로 101 점을 측정하였으며(5개의 위도원을 따른 100개의 점과 꼭대기의 한 점)'), i.e. "
+    f"{_CAL_POINTS // _CAL_CIRCLES} azimuths per circle, {_CAL_POINTS // _CAL_CIRCLES} x "
+    f"{_CAL_STEP_DEG} = {_CAL_POINTS // _CAL_CIRCLES * _CAL_STEP_DEG} deg: the probe error map "
+    f"(Fig. 3(b), a (phi, theta) grid) spans the full azimuth, which a one-argument arctangent "
+    f"(a 180 deg range) cannot index and atan2 can")
+
+
 def audit_angles(eq15: dict, eq16: dict) -> list[Verdict]:
     out = []
     phi_d, theta_d = d.direction_angles()
@@ -161,7 +174,7 @@ def audit_angles(eq15: dict, eq16: dict) -> list[Verdict]:
                   + ev + ". Category convention: read tan^-1(My'/Mx') as the quadrant-correct "
                   "azimuth (the common convention for an angle written as tan^-1(y/x), the "
                   "two-argument atan2(My', Mx') mod 360 deg), the printed eq. (16) is the "
-                  "derived azimuth exactly (" + _atan2_check(theta_d) + ")",
+                  "derived azimuth exactly (" + _atan2_check(theta_d) + "). " + _CALIBRATION_AZIMUTH,
                   fmt(p16), fmt(theta_d), "theta", category="convention",
                   alternative="atan2(My', Mx') mod 2 pi",
                   statement="tan^-1(y/x) written for the quadrant-correct atan2(y, x)"))

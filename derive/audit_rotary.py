@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .audit import Verdict, fmt
+from .audit import RECURRENCE_UNSHOWN, Verdict, fmt
 
 DATA_FILE = "printed_rotary.toml"
 LAYOUTS = ("DMU50",)
@@ -169,8 +169,9 @@ def audit_rotary(item: dict) -> list[Verdict]:
                             "The conference paper's B-axis matrix eq. 1.17, typeset separately, "
                             "has -E_XB at the same entry below E_XB at (1,4), but the two "
                             "product matrices are images of the same layout (the same entries "
-                            "with B for C), where a repetition driven by the image recurs at the "
-                            "same place: by the cross-copy rule that does not decide. The "
+                            "with B for C): the same entry at the same place weighs towards "
+                            "the print, but by the cross-copy rule a repetition there does not "
+                            "decide (" + RECURRENCE_UNSHOWN + "). The "
                             "extraction reads -E_A right at (2,3) of the error matrices T_ES "
                             "just above and T_EB (paper eq. 1.15), whose other entries differ "
                             "(1 on the diagonal, no cos/sin), which decides neither. For the "

@@ -82,6 +82,11 @@ def _paren(expr: str) -> str:
     return expr
 
 
+def _repairs(term: dict) -> str:
+    """' (read with: ...)' -- the repairs a legible term's reading needs, '' if none."""
+    return f" (read with: {'; '.join(term['repairs'])})" if term["repairs"] else ""
+
+
 def _line_span(terms) -> str:
     """'lines 197-220': the listing lines of a formula's legible terms."""
     nums = [int(x) for t in terms for x in str(t["line"]).split("-") if x.strip().isdigit()]
@@ -96,6 +101,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
     n_sign = 1 if sp.expand(printed_N - N) == 0 else (-1 if sp.expand(printed_N + N) == 0 else 0)
     devs = _deviations()
     by_dev = {sp.expand(v): k for k, v in devs.items()}
+    arms = [sp.Symbol(f"{c}_{lab}", real=True) for lab in "PQK" for c in "xyz"]
     out = []
     for name, motion in MOTIONS.items():
         sol = cf[motion]
@@ -112,7 +118,8 @@ def audit_c1(c1: dict) -> list[Verdict]:
                 (checked if ok else bad).append(
                     f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}{_paren(t['cofactor'])} * "
                     f"({t['d']}) " + ("= the derived term of " + str(dv) if ok else
-                                      f"!= the derived {fmt(cof.get(dv, 'none'))} of {dv}"))
+                                      f"!= the derived {fmt(cof.get(dv, 'none'))} of {dv}")
+                    + _repairs(t))
         for t in terms:
             if t["status"] != "cofactor":
                 continue
@@ -122,7 +129,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
                 used_d.add(hit[0])
                 checked.append(f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}"
                                f"{_paren(t['cofactor'])} (deviation lost) = the derived cofactor of "
-                               f"{hit[0]}, the one deviation left")
+                               f"{hit[0]}, the one deviation left" + _repairs(t))
             else:
                 bad.append(f"line {t['line']}: {t['cofactor']} matches no remaining cofactor")
         factor = c1["factors"][name]
@@ -139,9 +146,17 @@ def audit_c1(c1: dict) -> list[Verdict]:
         tried = [f"Cramer's rule on eq. 32 (the derived cofactor of each deviation over N): "
                  f"{len(checked)} legible terms compared, {len(bad)} differ",
                  f"the denominator: {n_where}"]
+        degrees = sorted({sp.Poly(sp.sympify(t["cofactor"], locals=loc), *arms).total_degree()
+                          for t in terms})
+        want_deg = sorted({sp.Poly(c, *arms).total_degree() for c in cof.values() if c != 0})
         ev = (f"{name} = sum of cofactor * deviation / N, the solution of the selected system of "
               f"eq. 32 by Cramer's rule (derive.three_point.closed_form); {n_where}. "
-              f"Legible terms: " + "; ".join(checked + bad) + ". "
+              f"Legible terms (with the repairs each reading needs): "
+              + "; ".join(checked + bad) + ". "
+              + (f"Every legible cofactor, so read, has degree {degrees[0]} in the lengths, as "
+                 f"every derived one ({name} = cofactor * deviation / N with N of degree 3"
+                 f"{' is a length' if motion in ('EX', 'EY', 'EZ') else ' is an angle'}). "
+                 if terms and degrees == want_deg and len(degrees) == 1 else "")
               + (f"Not comparable: {'; '.join(damaged)}. " if damaged else "")
               + f"Unit factor {factor} ({'mm to um' if unit == '* 1e3' else 'rad to urad'}"
               + ("" if factor == unit else f"; printed '{factor}', see its own verdict") + ").")
@@ -156,7 +171,11 @@ def audit_c1(c1: dict) -> list[Verdict]:
                           "derived one; the damage -- lines whose numbers remain without text, "
                           "LaTeX debris such as '\\sum_{i=1}^{n} (x_i - x_i)^{i}' inside Python "
                           "code, products rendered as subscripts -- is the extraction's (a "
-                          "Python listing cannot carry it)", f"{name} (appendix C.1)",
+                          "Python listing cannot carry it)"
+                          + ("; a repair whose printed form is valid Python (a repeated factor) "
+                             "rests on the degree of the term as printed instead (see that "
+                             "repair)" if any("degree" in r for t in terms for r in t["repairs"])
+                             else ""), f"{name} (appendix C.1)",
                           "Cramer's rule, selection of eq. 32", tried,
                           [f"ocr:appendix C.1 {name} damaged lines"]))
         else:

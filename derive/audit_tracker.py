@@ -27,13 +27,14 @@ the erratum.  Identities of rational functions are decided by exact rational eva
 
 from __future__ import annotations
 
+import difflib
 import random
 import re
 from functools import lru_cache
 
 import sympy as sp
 
-from .audit import Verdict, describe_diff, fmt
+from .audit import RECURRENCE_UNSHOWN, Verdict, describe_diff, fmt
 from .three_point import (COORDS, MOTIONS, SELECTIONS, closed_form, point_displacement,
                           point_symbols, rotated_lever_arm, system)
 
@@ -211,8 +212,9 @@ def _vector_evidence(eq: dict, others: dict) -> str:
                               "within one image (" + EXTRACTION_LOSSES + ")")
             + ". By the cross-copy rule (docs/formats.md, audit) neither a defect in one "
               "image only nor a repetition or loss at the same place in images of the same "
-              "layout (where a failure driven by the image recurs) decides. What would "
-              "decide: the pages of the original PDF.")
+              "layout decides: the same defect at the same place weighs towards the print, "
+              "but " + RECURRENCE_UNSHOWN + ". What would decide: the pages of the original "
+              "PDF.")
     return out
 
 
@@ -221,14 +223,16 @@ UNDECIDABLE_ROW = (
     " Category undecidable: a row repeated within one image, which the print and the "
     "extraction explain equally. For the print (a matrix copied in the author's source): the "
     "specialization project repeats the same row K y at the same place in eq. 31 (X axis) and "
-    "eq. 35 (Y axis). For the extraction: it demonstrably repeats matrix rows within an image "
-    "(the error matrix of T_0^{t,c} after thesis eq. 3.37 has five rows, three of them "
-    "'-E_{DX} & ... & 1 & E_{ZX}' and two of these identical, with the letter D that names no "
-    "axis), and eq. 31 and 35 are images of the same layout (they differ only in the "
-    "subscripts x and y), so a repetition driven by the image recurs at the same place; by the "
-    "cross-copy rule a repetition at the same place does not decide. The thesis' eq. 3.5 (the "
-    "same nine rows for the C axis, other symbols) has no repeated row, which decides "
-    "neither. What would decide: the page of the original PDF.")
+    "eq. 35 (Y axis), and eq. 35 is eq. 31 with the subscript x changed to y, so a matrix "
+    "copied in the source carries the row into both. For the extraction: it demonstrably "
+    "repeats matrix rows within an image (the error matrix of T_0^{t,c} after thesis eq. 3.37 "
+    "has five rows, three of them '-E_{DX} & ... & 1 & E_{ZX}' and two of these identical, "
+    "with the letter D that names no axis), and eq. 31 and 35 are images of the same layout "
+    "(they differ only in the subscripts x and y). The same row at the same place in the two "
+    "images weighs towards the print, but by the cross-copy rule a repetition at the same "
+    "place does not decide: " + RECURRENCE_UNSHOWN + ". The thesis' eq. 3.5 (the same nine "
+    "rows for the C axis, other symbols) has no repeated row, which decides neither. What "
+    "would decide: the page of the original PDF.")
 UNDECIDABLE_ENTRIES = (
     ". Category undecidable: lost, repeated or merged entries of a column vector, which the "
     "print (a line of the column typed wrong, left out or typed twice) and the extraction "
@@ -463,8 +467,8 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
                + "; ".join(f"eq. {o}: rows " + ", ".join(
                    str(k + 1) for k, lab in enumerate((others or {})[o]["labels"])
                    if lab in {w[0] for w in wrong}) for o in [eq["id"], *same_in])
-               + f"), so the x follows the rows' content, not a place in the image, as a "
-               f"failure driven by the image would. The competing explanation, the "
+               + f"), so the x follows the rows' content, not their places in the "
+               f"images. The competing explanation, the "
                f"extraction writing x for C, would need the same five misreadings in two "
                f"images of another row order; the author's source explains it: the C-axis "
                f"system adapted from the X-axis system of the specialization project (eq. 31 "
@@ -523,18 +527,105 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
                                   "columns multiply (E_X ... E_C of the axis)"]
         out[-1].readings_used = [f"glyph:eq. {eq['id']} unknown vector"]
     # right-hand side: which equation does each printed entry belong to?
-    rhs = eq.get("rhs", [])
+    out.append(_audit_rhs(eq, labels, others or {}))
+    return out
+
+
+def rhs_matched(eq: dict) -> list:
+    """The row label (point + coordinate, ``"Kx"``) whose derived deviation each printed
+    right-hand side entry is, or None for an entry that is no deviation of any point."""
+    axis = eq["axis"]
+    rotated = axis in "ABC"
+    want = _rhs_wanted(axis, rotated)
+    return [next((lab for lab, w in want.items() if sp.expand(parse(t, axis) - w) == 0), None)
+            for t in eq.get("rhs", [])]
+
+
+def _rhs_wanted(axis: str, rotated: bool) -> dict:
+    labels = [f"{lab}{c}" for lab in LABELS for c in COORDS]
+    return {lab: (S(f"d_{lab[1]}{lab[0]}") if rotated else _deviation(lab[0], lab[1], axis))
+            for lab in labels}
+
+
+def _order_kept(matched: list, labels: list) -> bool:
+    """Whether the entries that name a row stand in the order of the rows."""
     distinct = list(dict.fromkeys(labels))
-    want = {lab: (S(f"d_{lab[1]}{lab[0]}") if rotated else _deviation(lab[0], lab[1], axis))
-            for lab in derived}
-    matched = []
-    for text in rhs:
-        pr = parse(text, axis)
-        matched.append(next((lab for lab, w in want.items() if sp.expand(pr - w) == 0), None))
+    order = [lab for lab in dict.fromkeys(m for m in matched if m) if lab in distinct]
+    return order == [lab for lab in distinct if lab in order]
+
+
+def _point_blocks(matched: list, distinct: list):
+    """The printed column as blocks of one point each, ``[(point, [labels])]``, when every
+    point's entries stand together and in the rows' order within the block (a column whose
+    points are merely in another order); None otherwise."""
+    runs = []
+    for lab in (m for m in matched if m):
+        if runs and runs[-1][0] == lab[0]:
+            runs[-1][1].append(lab)
+        else:
+            runs.append((lab[0], [lab]))
+    points = [p for p, _ in runs]
+    if len(points) != len(set(points)):
+        return None
+    for p, labs in runs:
+        seen = list(dict.fromkeys(labs))
+        if seen != [lab for lab in distinct if lab in seen]:
+            return None
+    return runs
+
+
+def _align(expected: list, printed: list) -> list[str]:
+    """What the printed column lost, repeated or replaced against ``expected`` (labels;
+    None for an entry that names no row), in words."""
+    got = [m or "?" for m in printed]
+    parts = []
+    for tag, i1, i2, j1, j2 in difflib.SequenceMatcher(a=expected, b=got,
+                                                       autojunk=False).get_opcodes():
+        if tag == "delete":
+            parts.append(f"lost {', '.join(expected[i1:i2])}")
+        elif tag == "insert":
+            parts.append(f"has {', '.join(got[j1:j2])} in addition")
+        elif tag == "replace":
+            for k, (e, g) in enumerate(zip(expected[i1:i2], got[j1:j2])):
+                near = [got[j] for j in (j1 + k - 1, j1 + k + 1) if 0 <= j < len(got)]
+                parts.append(f"has {g} where {e} belongs" + (" (a repeat of the entry "
+                                                              "beside it)" if g in near else ""))
+            if i2 - i1 > j2 - j1:
+                parts.append(f"lost {', '.join(expected[i1 + j2 - j1:i2])}")
+            elif j2 - j1 > i2 - i1:
+                parts.append(f"has {', '.join(got[j1 + i2 - i1:j2])} in addition")
+    return parts
+
+
+def _points_named(eq: dict, order: list) -> str:
+    """The text's own listings of the points (``points_named`` of the data file) that name
+    them in ``order``, quoted."""
+    hits = []
+    for quote, where in eq.get("points_named", []):
+        named = list(dict.fromkeys(re.findall(r"\b([PQK])\b", quote)))
+        if named == order:
+            hits.append(f"'{quote}' ({where})")
+    return "; ".join(hits)
+
+
+def _audit_rhs(eq: dict, labels: list, others: dict) -> Verdict:
+    """The verdict on a printed system's right-hand side: each entry matched against the
+    derived deviation of every point and coordinate.  Lost, repeated or merged entries are
+    glyph-level (print or extraction: undecidable); a column whose points' blocks stand in
+    another order than the rows is a well-formed misordering the extraction is not seen to
+    produce, decided as printed (the entry is then printing_error, its other defects named
+    as undecided)."""
+    rhs = eq.get("rhs", [])
+    axis = eq["axis"]
+    distinct = list(dict.fromkeys(labels))
+    want = _rhs_wanted(axis, axis in "ABC")
+    matched = rhs_matched(eq)
     problems = []
-    if matched == distinct:
-        pass
-    else:
+    order_note, order_decided, runs, row_points = "", False, None, []
+    tried = ["each printed entry matched against the derived deviation of every point and "
+             "coordinate"]
+    used = [f"glyph:eq. {eq['id']} right-hand side entries"]
+    if matched != distinct:
         if len(rhs) != len(distinct):
             problems.append(f"{len(rhs)} entries for {len(distinct)} equations")
         for k, (text, lab) in enumerate(zip(rhs, matched)):
@@ -557,21 +648,120 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
         if order != rows_order:
             problems.append(f"entries in the order {', '.join(order)}, rows in the order "
                             f"{', '.join(rows_order)}")
-    out.append(_verdict(eq, "right-hand side", not problems,
-                        "; ".join(problems[:3]) if problems else "",
-                        ("each entry is the deviation (measured - nominal) of the point and "
-                         "coordinate of its row" if not problems else
-                         "each entry matched against the derived deviations (measured - "
-                         "nominal) of every point and coordinate: " + "; ".join(problems)
-                         + UNDECIDABLE_ENTRIES),
-                        "; ".join(rhs), f"{len(distinct)} deviations", category="undecidable"))
+            runs = _point_blocks(matched, distinct)
+            row_points = list(dict.fromkeys(lab[0] for lab in distinct))
+            col_points = [p for p, _ in runs] if runs else []
+            if runs and col_points != [p for p in row_points if p in col_points]:
+                order_decided = True
+                order_note = _order_evidence(eq, matched, distinct, runs, row_points,
+                                             others)
+                tried.append(f"the entries' order: the blocks of the points in the order "
+                             f"{', '.join(col_points)}, the rows {', '.join(row_points)} -- a "
+                             f"block moved within the column, which the extraction is not "
+                             f"seen to do; the author's order (print): decided")
+                used.insert(0, f"inconsistent:eq. {eq['id']} right-hand side in the point "
+                               f"order {', '.join(col_points)}, rows "
+                               f"{', '.join(row_points)}")
+            else:
+                order_note = (" The order defect is no whole block of one point's entries "
+                              "in another place (a point's entries stand apart or out of "
+                              "their order): print or extraction, undecided too.")
+        elif problems:
+            order_note = (" The entries that name a row stand in the order of the rows (no "
+                          "order defect).")
+    tried.append("entries lost, repeated or garbled by the print or by the extraction: both "
+                 "explain " + ("them" if order_decided else "the column"))
+    if not problems:
+        evidence = ("each entry is the deviation (measured - nominal) of the point and "
+                    "coordinate of its row")
+    elif order_decided:
+        evidence = ("each entry matched against the derived deviations (measured - nominal) "
+                    "of every point and coordinate: " + "; ".join(problems) + "." + order_note)
+    else:
+        evidence = ("each entry matched against the derived deviations (measured - nominal) "
+                    "of every point and coordinate: " + "; ".join(problems) + "."
+                    + order_note + UNDECIDABLE_ENTRIES.lstrip("."))
+    short = [p for p in problems if not p.startswith("entries in the order")]
+    if order_decided:
+        short = [f"entries in the point order {', '.join(p for p, _ in runs)}, rows "
+                 f"{', '.join(row_points)}"] + short
+    elif len(short) < len(problems):
+        short = short + [p for p in problems if p.startswith("entries in the order")]
+    v = _verdict(eq, "right-hand side", not problems, "; ".join(short[:3]),
+                 evidence, "; ".join(rhs), f"{len(distinct)} deviations",
+                 category="printing_error" if order_decided else "undecidable")
     if problems:
-        out[-1].readings_tried = ["each printed entry matched against the derived deviation of "
-                                  "every point and coordinate",
-                                  "entries lost, repeated or garbled by the print or by the "
-                                  "extraction: both explain the column"]
-        out[-1].readings_used = [f"glyph:eq. {eq['id']} right-hand side entries"]
-    return out
+        v.readings_tried, v.readings_used = tried, used
+    return v
+
+
+#: the extraction's record on the order of a column's entries (checked on every column vector
+#: of the thesis' extraction, the seed text)
+EXTRACTION_ORDER_RECORD = (
+    "every other column vector of the thesis' extraction keeps its entries in their order -- "
+    "the coordinates and deviations of eq. 3.1-3.3 and of the project's eq. (27)-(29), the "
+    "unknown vectors of eq. 31-37, 3.5 and 3.6 -- and where it damages one it loses, repeats "
+    "or exchanges entries in place (the project's eq. (29) prints z'_Pt at the z place of "
+    "the nominal vector, beside the measured vector that lost it); what it does put out of "
+    "order is whole numbered display "
+    "equations laid out side by side on a page (eq. 3.34 is read between eq. 3.30 and 3.31), "
+    "not entries within one bracket")
+
+
+def _order_evidence(eq, matched, distinct, runs, row_points, others) -> str:
+    """Why a right-hand side whose points' blocks stand in another order is decided as printed,
+    and what stays undecided (its lost, repeated or merged entries)."""
+    col_points = [p for p, _ in runs]
+    moved = next(p for p, q in zip(col_points, [p for p in row_points if p in col_points])
+                 if p != q)
+    block = [lab for p, labs in runs if p == moved for lab in dict.fromkeys(labs)]
+    where = col_points.index(moved)
+    rows_at = [p for p in row_points if p in col_points].index(moved)
+    place = lambda i, n: ("the top" if i == 0 else "the bottom" if i == n - 1  # noqa: E731
+                          else f"place {i + 1}")
+    kept = [f"eq. {o}" for o, info in others.items() if o != eq["id"] and info.get("rhs")
+            and _order_kept(info["rhs"], info["labels"])]
+    damaged = [f"eq. {o}" for o, info in others.items() if o != eq["id"] and info.get("rhs")
+               and _order_kept(info["rhs"], info["labels"])
+               and info["rhs"] != list(dict.fromkeys(info["labels"]))]
+    not_kept = [f"eq. {o}" for o, info in others.items() if o != eq["id"] and info.get("rhs")
+                and not _order_kept(info["rhs"], info["labels"])]
+    expected = [lab for p in col_points for lab in distinct if lab[0] == p]
+    named = _points_named(eq, col_points)
+    same_rows = [o for o, info in others.items() if o != eq["id"]
+                 and list(dict.fromkeys(info["labels"])) == distinct]
+    n = len(col_points)
+    return (
+        f" Two kinds of defect. (1) The order: the block of point {moved} "
+        f"({', '.join(block)}) stands at {place(where, n)} of the column while its rows stand "
+        f"at {place(rows_at, n)} of the matrix (rows in the point order "
+        f"{', '.join(row_points)}, entries in the point order {', '.join(col_points)}). That is "
+        f"no lost, repeated or merged entry: the column is well formed in another point "
+        f"order. The extraction is not seen to move entries within a column: "
+        + (f"the right-hand sides of {', '.join(not_kept)} are out of order too" if not_kept
+           else "no other printed system to compare" if not kept else
+           f"the right-hand side of every other printed system keeps the order of its rows "
+           f"({', '.join(kept)}"
+           + (f"; {', '.join(damaged)} with entries lost or merged in place" if damaged else "")
+           + ")")
+        + f", and {EXTRACTION_ORDER_RECORD}. For the print: the author's column written in the "
+        f"point order {', '.join(col_points)}"
+        + (f", the order in which the text names the points ({named})" if named else "")
+        + f", beside a matrix in the order {', '.join(row_points)}"
+        + (f" (the row order of eq. {', '.join(same_rows)}"
+           + ("; the X axis' subscripts left in this matrix show it adapted from the X-axis "
+              "system, see the verdict on the coefficient matrix" if wrong_subscripts(eq)
+              else "") + ")" if same_rows else "")
+        + ". For the extraction: it would have to move a block of one column, which it is "
+        f"nowhere seen to do. So the order is decided: the author's (a printing error). "
+        f"(2) The entries: against the rows' entries in the column's own point order "
+        f"({', '.join(expected)}) the column " + " and ".join(_align(expected, matched))
+        + " -- lost, repeated or merged entries, which the print (a line of the column typed "
+        "wrong, left out or typed twice) and the extraction explain equally (this extraction "
+        "demonstrably repeats and loses entries within one image: " + EXTRACTION_REPEATS
+        + "; " + EXTRACTION_LOSSES + "): undecided. Category printing_error: the order is "
+        "decided to be printed; the lost and repeated entries stay undecided (what would "
+        "decide them: the page of the original PDF).")
 
 
 # --------------------------------------------------------------------------- closed forms
@@ -866,7 +1056,8 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         return []
     out = []
     systems = {eq["id"]: {"labels": [lab for lab, _ in eq["rows"]],
-                          "wrong": wrong_subscripts(eq), "unknowns": eq["unknowns"]}
+                          "wrong": wrong_subscripts(eq), "unknowns": eq["unknowns"],
+                          "rhs": rhs_matched(eq)}
                for eq in printed.get("equation", []) if eq["kind"] == "system"}
     for eq in printed.get("equation", []):
         kind = eq["kind"]

@@ -74,8 +74,9 @@ def test_transfer_rule_omissions_named(verdicts):
     assert "Ez(Z) for Ez(Y)" in v.erratum
     v = find(verdicts, "9", "beta1")
     # a convention: the erratum names the reading, the evidence the extra term it explains
-    assert "slope of the Z line" in v.erratum and "-Ey(Y)" in v.erratum
-    assert "extra +Ey(Y)" in v.evidence
+    # (a squareness rule's errors written at the measuring offset, as Pahk prints them)
+    assert "slope of the Z line" in v.erratum and "-Ey(Yo)" in v.erratum
+    assert "extra +Ey(Yo)" in v.evidence and "Notation:" in v.evidence
     assert "slope of the Z line alone" in v.evidence
     # Pahk's rule (1) (straightness by roll only) reproduces the printed dy(X) rule
     assert "roll Ex(X) only" in find(verdicts, "9", "dy(X)").evidence
@@ -429,3 +430,75 @@ def test_only_minimal_combinations_are_listed_and_pattern_noted(verdicts):
     for lay in bare:
         if lay != "FB1":
             assert lay in v.evidence
+
+
+def _paper(text):
+    """A printed expression of the data file -> sympy, own parse: 'dx(X)' -> symbol dx_X."""
+    import re
+
+    import sympy as sp
+    return sp.sympify(re.sub(r"\b([Ed][xyz])\(([XYZ])o?\)", r"\1_\2", text))
+
+
+def test_a8_dx_is_the_printed_chain_a7_to_first_order(verdicts):
+    """Review 3 (#6): the CY chain A7 as printed, Ty{Tx A + Lx} + Ly = Tz P + Lz with its
+    printed vectors, solved here for A to first order (T = I + [e]x, T^-1 = I - [e]x), gives
+    A8's dX exactly and A8's dY not; the dX convention verdict says so, the dY one does not."""
+    import sympy as sp
+    e = next(x for x in DATA["equation"] if x["id"] == "A7")
+
+    def T(a):
+        ex, ey, ez = (sp.Symbol(f"E{c}_{a}") for c in "xyz")
+        return sp.Matrix([[0, -ez, ey], [ez, 0, -ex], [-ey, ex, 0]])
+
+    L = {k: sp.Matrix([_paper(t) for t in e["L"][k]]) for k in "xyz"}
+    P = sp.Matrix(sp.symbols("Xp Yp Zp"))
+    rhs = (sp.eye(3) + T("Z")) * P + L["z"]
+    A = (sp.eye(3) - T("X")) * ((sp.eye(3) - T("Y")) * (rhs - L["y"]) - L["x"])
+    X, Y, Z = sp.symbols("X Y Z")
+    nominal = sp.Matrix([X, Y, Z]) + P
+    errs = [s for s in A.free_symbols if "_" in s.name or s.name.startswith(("alpha", "beta"))]
+    eps = sp.Symbol("eps")
+    first = [sp.expand((A[i] - nominal[i]).subs({s: eps * s for s in errs},
+                                                 simultaneous=True)).coeff(eps, 1)
+             for i in range(3)]
+    a8 = next(x for x in DATA["equation"] if x["id"] == "A8")["expr"]
+    assert sp.expand(first[0] - _paper(a8["dX"])) == 0
+    assert sp.expand(first[1] - _paper(a8["dY"])) != 0
+    v = find(verdicts, "A8", "dX")
+    assert v.category == "convention" and "eq. A7" in v.evidence
+    assert "expanded to first order, gives exactly this dX" in v.evidence
+    assert "gives exactly this dY" not in find(verdicts, "A8", "dY").evidence
+
+
+def test_mb1_dx_rule_omission_pattern_across_layouts(verdicts):
+    """Review 3 (#2): the bridge layouts MB1 (eq. 9) and FB1 (A3) print the identical
+    'dx(X) - Zo*Ey(X)'; MH2, FH1 and CY print the yaw term in Yo*Ez(X) (read from the data
+    here).  The verdict names the pattern and stays undecidable."""
+    prints = {x["layout"]: x["expr"]["dx(X)"] for x in DATA["equation"]
+              if x["kind"] == "transfer" and "dx(X)" in x["expr"]}
+    assert prints["MB1"] == prints["FB1"] and "Ez(X)" not in prints["MB1"]
+    keep = sorted(n for n, t in prints.items() if "Yo*Ez(X)" in t)
+    assert keep == ["CY", "FH1", "MH2"]
+    v = find(verdicts, "9", "dx(X)")
+    assert v.category == "undecidable"
+    assert f"the identical 'dx(X) = {prints['FB1']}' is printed for FB1 eq. A3" in v.evidence
+    for n in keep:
+        assert f"{n} eq." in v.evidence.split("Across the layouts")[1]
+    assert "one machine type (bridge)" in v.evidence
+    assert "does not change the category" in v.evidence
+
+
+def test_worst_case_names_the_machine_it_scales(verdicts):
+    """Review 3 (#3, #6, #11): a worst case on a layout other than MB1 says whose travels it
+    takes (CMM A's), the layout's own machine in Pahk (MH2: CMM B) or that Pahk has none, and
+    whether the travels enter the term at all."""
+    v = find(verdicts, "10", "dy(X)")            # MH2, term -Xo*Ez(X): offsets only
+    assert "Pahk's own MH2 machine is CMM B (1100 mm cube)" in v.evidence
+    assert "depends on the offsets only" in v.evidence
+    v = find(verdicts, "A8", "dX")               # CY, term -Ez(Y)*Y: CMM A's Y travel
+    assert "Pahk describes no CY machine" in v.evidence
+    assert "the travel of Y (575 mm) enters the size" in v.evidence
+    assert v.dropped_um == pytest.approx(575 * 10e-6 * 1e3)
+    v = find(verdicts, "9", "dx(X)")             # MB1 is CMM A itself
+    assert "this MB1 layout's own machine" in v.evidence

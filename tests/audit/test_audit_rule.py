@@ -46,6 +46,12 @@ def test_the_rule_is_documented_in_formats_and_the_module():
     for k in KIND:
         assert f"`{k}" in sec, k
     assert "readings_tried" in sec and "readings_used" in sec
+    # the recurrence of a failure at the same place in two images is an assumption (review 3)
+    cross = " ".join(sec[sec.index("Cross-copy rule"):].split())
+    assert "is an assumption the documents neither show nor exclude" in cross
+    assert "weighs towards the author's source but does not decide" in cross
+    assert "recurs at the same place" not in " ".join(A.PRIORITY_RULE.split()).replace(
+        "recurs at the same place in another image of the same layout is an assumption", "")
 
 
 @pytest.mark.slow

@@ -191,8 +191,22 @@ def test_b_axis_error_matrix_1_17(htm):
     off = {(i + 1, j + 1) for i in range(4) for j in range(4)
            if abs(printed[i, j] - dev[i, j]) > 1e-12}
     assert off == {(1, 3), (2, 1), (2, 3), (3, 2), (4, 4)}
+    # read as the HTM its label names (T_EB Rz(B), like eq. 1.12): the bottom row is right,
+    # 8 entries differ, and with every error zero the printed block lacks the rotation in 5
+    htm_m = te @ rot
+    off_htm = {(i + 1, j + 1) for i in range(4) for j in range(4)
+               if abs(printed[i, j] - htm_m[i, j]) > 1e-12}
+    assert len(off_htm) == 8 and (4, 4) not in off_htm
+    zero = {k: (0.0 if k.startswith("E") else v) for k, v in env.items()}
+    p0 = np.array([[eval(x, {}, zero) for x in r] for r in item["rows"]])  # noqa: S307
+    lacking = {(i + 1, j + 1) for i in range(3) for j in range(3)
+               if abs(p0[i, j] - rot[i, j]) > 1e-12}
+    assert lacking == {(1, 1), (1, 2), (2, 1), (2, 2), (3, 3)}
     v = find(htm, "paper eq. 1.17")
     assert v.category == "printing_error" and "2.42" in v.evidence
+    assert "Read as that HTM" in v.evidence and f"{len(off_htm)} entries differ" in v.evidence
+    assert f"missing from {len(lacking)} of them" in v.evidence
+    assert "Read as the deviation" in v.evidence and "under either reading" in v.evidence
 
 
 def test_linear_chain_with_angular_errors_dropped_1_19(htm):
@@ -410,6 +424,19 @@ def test_appendix_c1_terms_are_cramers_rule():
     for f in motion:
         assert find(vs, f"appendix C.1 {f}", "formula").category == "extraction"
     assert find(vs, "appendix C.1 E_YX", "unit factor").category == "undecidable"
+    # review 3 (#14): the d_zQ term of E_YX prints (x_xK*z_xP - x_xP*z_xK) three times;
+    # valid Python, but cubed the cofactor has degree 7 in the lengths where the adjugate's
+    # entries of the translational rows have degree 3 (checked here on A): the repair says so
+    t = next(t for t in d["term"] if t["formula"] == "E_YX" and t["d"] == "z_actQt - z_xQ - z_o")
+    f = sp.sympify("(x_xK*z_xP - x_xP*z_xK)", locals=sym)
+    cubed = sp.sympify(t["cofactor"], locals=sym) * f ** 2
+    arms = list(sym.values())
+    assert sp.Poly(cubed, *arms).total_degree() == 7
+    assert {sp.Poly(e, *arms).total_degree() for e in A.adjugate()[:3, :] if e != 0} == {3}
+    assert "degree 7" in " ".join(t["repairs"])
+    ev = find(vs, "appendix C.1 E_YX", "formula").evidence
+    assert "degree 7" in ev and "has degree 3 in the lengths" in ev
+    assert "line 97-99" in ev and "the debris 'N' dropped" in ev
 
 
 def test_appendix_d1_solves_with_the_arms_of_theta_zero():

@@ -374,14 +374,14 @@ def test_listing_constant_term_dropped():
 
 
 # --------------------------------------------------------------------------- all verdicts
-EXPECTED = {"identical": 170, "printing_error": 24, "extraction": 7, "convention": 25,
-            "simplification": 18, "undecidable": 84}
+EXPECTED = {"identical": 170, "printing_error": 25, "extraction": 7, "convention": 25,
+            "simplification": 18, "undecidable": 83}
 #: per document (a verdict that moves between documents or categories fails)
 EXPECTED_BY_SOURCE = {
     "Pahk 1995": {"identical": 37, "printing_error": 7, "extraction": 0, "convention": 17,
                   "simplification": 15, "undecidable": 36},
-    "Ellingsdalen 2021": {"identical": 133, "printing_error": 17, "extraction": 7,
-                          "convention": 8, "simplification": 3, "undecidable": 48},
+    "Ellingsdalen 2021": {"identical": 133, "printing_error": 18, "extraction": 7,
+                          "convention": 8, "simplification": 3, "undecidable": 47},
 }
 
 
@@ -402,3 +402,23 @@ def test_counts_per_category(full_audit):
             assert e["alternative"] or e["statement"]
         if e["category"] == "simplification":
             assert e["statement"]
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("full_audit")
+def test_recurrence_premise_is_stated_as_an_assumption(full_audit):
+    """Review 3: 'a failure driven by the image recurs at the same place' is not shown by the
+    documents (the thesis' two renderings of T_1^2 and T_2^3 are damaged differently); no
+    verdict may state it as a fact, and each that leans on it calls it an assumption."""
+    _, entries, _ = full_audit
+    leaning = 0
+    for e in entries:
+        ev = e["evidence"]
+        for claim in ("recurs at the same place;", "recurs at the same place:",
+                      "deterministic extraction", "would recur wherever",
+                      "where a failure driven by the image recurs"):
+            assert claim not in ev, (e["equation"], e["component"], claim)
+        if "driven by the image" in ev or "driven by that rendering" in ev:
+            leaning += 1
+            assert "assumption" in ev, (e["equation"], e["component"])
+    assert leaning >= 5

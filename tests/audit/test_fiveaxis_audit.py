@@ -106,3 +106,88 @@ def test_t_er_effects_state_their_frame(verdicts):
     v = verdicts["Listing 3.3 T_er (error model)"]
     assert v.category == "simplification"
     assert "workpiece (table) frame" in v.evidence and "not as an approximation" in v.evidence
+
+
+def _rows_of(printed, name, where):
+    if where == "chain":
+        return printed["chain_rendering"][name]
+    return next(m["rows"] for m in printed["matrix"] if m["name"] == name
+                and m["id"][0].isdigit())
+
+
+def test_t34_duplicate_in_both_renderings_weighed_not_decided(verdicts, printed):
+    """Eq. 3.33's T_3^4 and the chain after eq. 3.37 both repeat the row [0, -s45, c45, 0]; in
+    the same two renderings T_1^2 and T_2^3 lose a row each in a different one (counted here
+    from the transcribed rows), and the chain's T_4^5 has T_3^4's four rows.  So the
+    duplicate weighs towards the print but does not decide: undecidable, both explanations
+    and the counter-examples named, and no claim that the extraction is deterministic."""
+    counts = {n: (len(_rows_of(printed, n, "eq")), len(_rows_of(printed, n, "chain")))
+              for n in ("T_1^2", "T_2^3", "T_3^4")}
+    assert counts == {"T_1^2": (3, 4), "T_2^3": (4, 3), "T_3^4": (5, 5)}
+    t34 = _rows_of(printed, "T_3^4", "eq")
+    assert t34 == _rows_of(printed, "T_3^4", "chain") and t34[2] == t34[3]
+    chain45 = next(m for m in printed["matrix"] if m["id"] == "error chain after 3.37")
+    assert len(chain45["rows"]) == 4 and chain45["rows"] == t34[:3] + t34[4:]
+    v = verdicts["eq. 3.33"]
+    assert v.category == "undecidable" and v.readings_used == ["glyph:T_3^4 repeated row"]
+    ev = v.evidence
+    assert "deterministic extraction" not in ev and "not deterministic" in ev
+    assert "T_1^2 has 3 rows in eq. 3.31" in ev and "4 rows in the chain" in ev
+    assert "T_2^3 has 4 rows in eq. 3.32 and 3 rows in the chain" in ev
+    assert "T_4^5 prints T_3^4's rotation with 4 rows, none repeated" in ev
+    assert "weighs towards the author's source" in ev and "It does not decide" in ev
+    assert "What would decide" in ev or "what would decide" in ev
+
+
+def test_t23_sign_decided_by_the_printed_forward_kinematics(verdicts, printed):
+    """The chain T_w^t = (T_0^w)^-1 T_0^t, written here with numpy, reproduces the printed
+    forward kinematics (eq. 3.19-3.24 = project eq. (10)-(15)) with T_2^3 = Rz(B) only: with
+    the printed matrix none of them, with Rz(-B) only k.  The verdict states that consequence
+    and stays printing_error."""
+    d = 154.996
+    form = {f["quantity"]: f["expr"] for f in printed["formula"]
+            if f["quantity"] in ("i", "j", "k", "x", "y", "z")}
+
+    def tr(v):
+        m = np.eye(4)
+        m[:3, 3] = v
+        return m
+
+    def rz(a, sign=-1):
+        c, s = np.cos(a), np.sin(a)
+        return np.array([[c, sign * s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+    rng = np.random.default_rng(11)
+    found = {"Rz(B)": set("ijkxyz"), "printed": set("ijkxyz"), "Rz(-B)": set("ijkxyz")}
+    for x, y, z, b, c in rng.uniform((-200, -200, 0, 0.2, -3), (200, 200, 300, 2.9, 3),
+                                     (4, 5)):
+        env = {"X": x, "Y": y, "Z": z, "B": b, "C": c, "d": d, "sqrt": np.sqrt,
+               "sin": np.sin, "cos": np.cos}
+        want = {q: eval(e, {}, env) for q, e in form.items()}  # noqa: S307
+        for label, t23 in (("Rz(B)", rz(b)), ("printed", rz(b, +1)),
+                           ("Rz(-B)", rz(-b))):
+            t0w = tr([0, 0, d]) @ _rx(np.pi / 4) @ t23 @ _rx(-np.pi / 4) @ tr([0, 0, -d]) \
+                @ rz(-c)
+            twt = np.linalg.solve(t0w, tr([x, y, z]))
+            got = dict(zip("ijk", twt[:3, 2])) | dict(zip("xyz", twt[:3, 3]))
+            found[label] &= {q for q in got if abs(got[q] - want[q]) < 1e-9 * (1 + abs(want[q]))}
+    assert found == {"Rz(B)": set("ijkxyz"), "printed": set(), "Rz(-B)": {"k"}}
+    v = verdicts["eq. 3.32"]
+    assert v.category == "printing_error"
+    assert "all six (i, j, k, x, y, z) with T_2^3 = Rz(B)" in v.evidence
+    assert "none with T_2^3 = the printed matrix" in v.evidence
+    assert "only k with T_2^3 = Rz(-B)" in v.evidence
+    assert any("ruled out as the author's convention" in r for r in v.readings_tried)
+
+
+def test_listing_repetition_states_its_assumption(verdicts, printed):
+    """E_CB / E_CC: the two defective lines are extracted in different modes (plain code and
+    LaTeX, seen in the transcribed text); the evidence says so and states the recurrence
+    premise as an assumption, not as a fact."""
+    texts = printed["listing"]["sources_text"]
+    modes = {n: "_{" in ls[-1] for n, ls in texts.items()}
+    assert modes == {"E_CB": False, "E_CC": True}
+    for name in texts:
+        ev = verdicts[f"Listing 3.3 T_er {name}"].evidence
+        assert "as plain code" in ev and "as LaTeX" in ev
+        assert "recurs at the same place;" not in ev and "is an assumption" in ev

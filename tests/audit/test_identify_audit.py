@@ -1,5 +1,7 @@
 """Derivation of the three-point equations and the audit of the thesis' printed forms."""
 
+import copy
+import re
 import tomllib
 from importlib import resources
 
@@ -120,3 +122,64 @@ def test_mutation_detected_and_named():
 
 def test_layout_filter():
     assert audit_tracker.audit(_printed(), ["MB1"]) == []
+
+
+def _points(entries):
+    """Point letters of a rotary system's printed right-hand side entries, in printed order
+    (own parse of the data file's notation: 'd_xK' -> K)."""
+    return [re.match(r"d_[xyz]([PQK])$", e).group(1) for e in entries]
+
+
+def test_rhs_order_defect_decided_as_printed_entries_left_undecided(verdicts):
+    """Eq. 3.5: the column's K block stands at the top while the rows run P, Q, K (own parse),
+    and the text lists the points K, P, Q: the order is decided (printing_error), the lost Px
+    and the Qy printed for Qx stay undecided (print or extraction) -- each named."""
+    eq = next(e for e in _printed()["equation"] if e["id"] == "3.5")
+    col = [p for p in dict.fromkeys(_points(eq["rhs"]))]
+    rows = list(dict.fromkeys(lab[0] for lab, _ in eq["rows"]))
+    assert col == ["K", "P", "Q"] and rows == ["P", "Q", "K"]
+    # every point's entries stand together: a block moved, not entries scattered
+    pts = _points(eq["rhs"])
+    assert len([k for k in range(len(pts)) if k == 0 or pts[k] != pts[k - 1]]) == len(col)
+    for quote, _ in eq["points_named"]:
+        assert [p for p in dict.fromkeys(re.findall(r"\b([PQK])\b", quote))] == col
+    v = verdicts[("eq. 3.5", "right-hand side")]
+    assert v.category == "printing_error"
+    assert v.readings_used[0].startswith("inconsistent:") and \
+        any(k.startswith("glyph:") for k in v.readings_used)
+    ev = v.evidence
+    assert "block of point K (Kx, Ky, Kz) stands at the top" in ev
+    assert "For the print" in ev and "For the extraction" in ev
+    assert all(q in ev for q, _ in eq["points_named"])
+    assert "lost Px" in ev and "Qy where Qx belongs" in ev and "undecided" in ev
+    # the other systems keep the rows' order: eq. 37 loses and merges entries, undecidable
+    v37 = verdicts[("eq. 37", "right-hand side")]
+    assert v37.category == "undecidable" and "no order defect" in v37.evidence
+    e37 = next(e for e in _printed()["equation"] if e["id"] == "37")
+    printed = [m.group(2) + m.group(1) for m in
+               (re.match(r"([xyz])m_([PQK]) ", e) for e in e37["rhs"])]
+    it = iter(lab for lab, _ in e37["rows"])
+    assert all(lab in it for lab in printed)      # a subsequence of the rows: order kept
+
+
+def _rhs_verdict(eq):
+    return next(v for v in audit_tracker.audit_system(eq, {}) if v.component == "right-hand side")
+
+
+def test_rhs_order_rule_follows_the_column_not_the_equation():
+    """The same code path on altered prints: eq. 3.5's column put in the rows' order (its lost
+    and repeated entries kept) is undecidable; eq. 3.6's correct column with its K block moved
+    to the top is decided as printed; a column with one point's entries split stays
+    undecidable."""
+    eqs = {e["id"]: e for e in _printed()["equation"]}
+    e35 = copy.deepcopy(eqs["3.5"])
+    e35["rhs"] = ["d_yP", "d_zP", "d_yQ", "d_yQ", "d_zQ", "d_xK", "d_yK", "d_zK"]
+    v = _rhs_verdict(e35)
+    assert v.category == "undecidable" and "no order defect" in v.evidence
+    e36 = copy.deepcopy(eqs["3.6"])
+    e36["rhs"] = ["d_yK", "d_zK", "d_xP", "d_yP", "d_xQ", "d_zQ"]
+    v = _rhs_verdict(e36)
+    assert v.category == "printing_error" and "block of point K" in v.evidence
+    e36["rhs"] = ["d_yK", "d_xP", "d_yP", "d_xQ", "d_zQ", "d_zK"]
+    v = _rhs_verdict(e36)
+    assert v.category == "undecidable" and "no whole block" in v.evidence

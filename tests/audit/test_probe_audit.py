@@ -48,3 +48,17 @@ def test_provider_registered():
     from volerr.derive import audit
 
     assert "volerr.derive.audit_probe" in audit.PROVIDERS
+
+
+def test_atan2_reading_supported_by_the_full_azimuth_calibration(verdicts):
+    """Review 3 (#15): the calibration's 100 points on 5 latitude circles at 18 deg steps
+    (seed text, quoted) are 20 azimuths per circle = 360 deg, a range only atan2 covers; a
+    one-argument arctangent returns 180 deg of it (checked here on those azimuths)."""
+    az = np.radians(np.arange(0, 100 // 5) * 18.0)
+    assert np.degrees(az[-1] - az[0]) + 18 == 360
+    one = {round(float(x) % 180, 6) % 180 for x in np.degrees(np.arctan(np.tan(az)))}
+    two = np.unique(np.round(np.degrees(np.arctan2(np.sin(az), np.cos(az))) % 360, 6))
+    assert len(two) == 20 and len(one) == 10
+    v = verdicts[("16", "theta")]
+    assert v.category == "convention"
+    assert "100 on 5 latitude circles" in v.evidence and "= 360 deg" in v.evidence
