@@ -22,6 +22,9 @@ from volerr.audit.numeric import _evaluate, _paper_values, spot_check
 from helpers import reference_chain
 from helpers.audit_rule import KIND, expected
 
+#: the module's verdicts are computed once, in one worker
+pytestmark = pytest.mark.xdist_group("audit_pahk")
+
 audit_pahk = pytest.importorskip("volerr.derive.audit_pahk")
 
 DATA = tomllib.loads((resources.files("volerr") / "data" / "printed_pahk.toml")

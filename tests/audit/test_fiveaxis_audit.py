@@ -9,6 +9,9 @@ import pytest
 
 from volerr.derive import audit_dmu50
 
+#: the module's verdicts are computed once, in one worker
+pytestmark = pytest.mark.xdist_group("audit_fiveaxis")
+
 
 @pytest.fixture(scope="module")
 def printed():

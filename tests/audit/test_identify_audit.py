@@ -10,6 +10,9 @@ import pytest
 
 from volerr.derive import audit_tracker, three_point
 
+#: the module's verdicts are computed once, in one worker
+pytestmark = pytest.mark.xdist_group("audit_tracker")
+
 
 def _printed():
     return tomllib.loads((resources.files("volerr") / "data" / "printed_tracker.toml")
