@@ -412,7 +412,7 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
     raws = {r for e in all_eqs if e.get("kind") == "transfer" for r in e["expr"].values()}
     for v in out:
         if iso_of(lay, v.component) in SQUARENESS and v.category != "identical":
-            _offset_notation(v, raws)
+            _offset_notation(v, raws, eq, _squareness_notations(all_eqs))
     return out
 
 
@@ -420,11 +420,29 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
 _AT_AXIS = re.compile(r"\b([Ed][xyz])\(([XYZ])\)")
 
 
-def _offset_notation(v: Verdict, raws=()) -> None:
+def _squareness_notations(all_eqs) -> tuple[list[str], list[str]]:
+    """(equations that print the squareness rules' error motions at the measuring offset,
+    Ez(Yo); those that print travel arguments, Ez(X)), read from the printed rules."""
+    at_offset, travel = [], []
+    for e in all_eqs:
+        if e.get("kind") != "transfer":
+            continue
+        rules = [t for k, t in e["expr"].items()
+                 if iso_of(layout(e["layout"]), k) in SQUARENESS and re.search(r"[Ed][xyz]\(", t)]
+        if any(_AT_AXIS.search(t) for t in rules):
+            travel.append(f"eq. {e['id']} ({e['layout']})")
+        elif rules:
+            at_offset.append(f"eq. {e['id']} ({e['layout']})")
+    return at_offset, travel
+
+
+def _offset_notation(v: Verdict, raws=(), eq=None, notations=((), ())) -> None:
     """Write the error motions of a squareness rule as Pahk does, at the measuring offset
     (Ez(Yo): the yaw of Y where the line is measured; the derivation evaluates each error
     motion there, :func:`_squareness_shift`), in every field but the print; quoted prints
-    (``raws``, the printed rules) keep their own text."""
+    (``raws``, the printed rules) keep their own text.  A print with travel arguments (A6:
+    Ey(Y) - Ey(X)) is read at the offsets too: that reading is named in ``readings_used``
+    and where the identity with the print is claimed."""
     keep = sorted((r for r in raws if _AT_AXIS.search(r)), key=len, reverse=True)
 
     def fix(t):
@@ -443,9 +461,35 @@ def _offset_notation(v: Verdict, raws=()) -> None:
     for f in ("derived", "alternative", "dropped", "erratum", "evidence"):
         setattr(v, f, fix(getattr(v, f)))
     v.readings_tried = [fix(t) for t in v.readings_tried]
-    v.evidence += (" Notation: as Pahk writes the squareness rules, each error motion is "
-                   "taken at the measuring offset (Ez(Yo): the yaw of the Y axis at Yo), in "
-                   "'derived' and 'alternative' too.")
+    at_offset, travel = notations
+    raw = eq["expr"][v.component] if eq is not None else ""
+    moves = sorted(set(_AT_AXIS.findall(raw)))
+    if moves:
+        shown = ", ".join(f"{e}({a})" for e, a in moves)
+        subst = ", ".join(f"{e}({a}) as {e}({a}o)" for e, a in moves)
+        v.evidence = v.evidence.replace(
+            "(expand(alternative - printed) == 0)",
+            f"(expand(alternative - printed) == 0, with the print's {subst})")
+        v.evidence += (f" Notation: eq. {eq['id']} is the exception: it prints its squareness "
+                       f"rules with travel arguments ({shown} here), where "
+                       f"{', '.join(at_offset)} write the error motions at the measuring "
+                       f"offset (Ez(Yo): the yaw of the Y axis at Yo); they are read at the "
+                       f"offsets like those, in 'derived' and 'alternative' too (the print is "
+                       f"quoted as printed). Taken literally, a travel argument would make a "
+                       f"constant squareness depend on the position; the o may be the author's "
+                       f"notation or lost by the extraction, which does not change the "
+                       f"reading.")
+        key = (f"notation:{eq['id']} squareness rules written with travel arguments, read at "
+               f"the offsets as {', '.join(a.split(' (')[0] for a in at_offset)} write them")
+        if key not in v.readings_used:
+            v.readings_used = list(v.readings_used) + [key]
+    else:
+        v.evidence += (f" Notation: Pahk writes the squareness rules of {', '.join(at_offset)} "
+                       f"with each error motion at the measuring offset (Ez(Yo): the yaw of "
+                       f"the Y axis at Yo)"
+                       + (f" ({', '.join(travel)} prints travel arguments instead)"
+                          if travel else "")
+                       + "; 'derived' and 'alternative' are written so too.")
 
 
 def _cut_verdict(eq, key, name, lay, rr, vf, geometry_key, verdict, note, all_eqs):

@@ -561,3 +561,38 @@ def test_worst_case_names_the_machine_it_scales(verdicts):
     assert v.dropped_um == pytest.approx(575 * 10e-6 * 1e3)
     v = find(verdicts, "9", "dx(X)")             # MB1 is CMM A itself
     assert "this MB1 layout's own machine" in v.evidence
+
+
+def test_a6_squareness_rules_read_at_the_offsets_is_a_named_reading(verdicts):
+    """Review 4 (#18): of the printed squareness rules only A6 writes travel arguments
+    (Ey(Y) - Ey(X), read from the data here); its verdicts name the reading 'at the offsets'
+    in readings_used and state the substitution where the identity with the print is claimed,
+    and the identity holds with that substitution (sympy here); the other layouts' squareness
+    verdicts name A6 as the exception and carry no such reading."""
+    squ = ("alpha", "a", "beta1", "beta2")
+    travel = {x["id"] for x in DATA["equation"] if x["kind"] == "transfer"
+              for k, t in x["expr"].items()
+              if k in squ and re.search(r"[Ed][xyz]\([XYZ]\)", t)}
+    assert travel == {"A6"}
+    import sympy as sp
+    a6 = next(x for x in DATA["equation"] if x["id"] == "A6")["expr"]
+    for key in ("alpha", "beta1", "beta2"):
+        v = find(verdicts, "A6", key)
+        assert any(r.startswith("notation:A6") for r in v.readings_used), key
+        assert "eq. A6 is the exception" in v.evidence
+        moves = sorted(set(re.findall(r"([Ed][xyz])\(([XYZ])\)", a6[key])))
+        subst = ", ".join(f"{e}({a}) as {e}({a}o)" for e, a in moves)
+        assert f"(expand(alternative - printed) == 0, with the print's {subst})" in v.evidence
+        names = lambda t: re.sub(r"([Ed][xyz])\(([XYZ])o?\)", r"\1_\2", t)  # noqa: E731
+        assert sp.expand(sp.sympify(names(v.alternative)) - sp.sympify(names(a6[key]))) == 0
+        assert v.printed == a6[key]                     # the print quoted as printed
+    for x in DATA["equation"]:
+        if x["kind"] != "transfer" or x["id"] == "A6":
+            continue
+        for key in squ:
+            if key not in x["expr"]:
+                continue
+            v = find(verdicts, x["id"], key)
+            if v.category != "identical":
+                assert not any(r.startswith("notation:A6") for r in v.readings_used)
+                assert "eq. A6 (FH1) prints travel arguments instead" in v.evidence
