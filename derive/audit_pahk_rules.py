@@ -376,9 +376,10 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                     f"{r.line} line) reproduces Pahk's non-trivial rules for {key} on the other "
                     f"layouts: " + ("; ".join(support) if support else "none") + ".")
             elif eq["expr"][key] == key and v.category == "undecidable":
-                v.evidence += _pattern_note(all_eqs, eq, key, d0)
+                v.evidence += _pattern_note(all_eqs, eq, key, d0) + _damage_note(eq, key)
             elif v.category == "undecidable" and r.zero:
-                v.evidence += _omission_pattern(all_eqs, eq, key, sp.expand(d0 - d), r.zero)
+                v.evidence += (_omission_pattern(all_eqs, eq, key, sp.expand(d0 - d), r.zero)
+                               + _damage_note(eq, key))
             out.append(v)
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
@@ -673,6 +674,25 @@ def _omission_pattern(all_eqs, eq, key, dropped, zero) -> str:
                                      f"set-up of this layout alone with {' = '.join(zero)} = 0")
             + "; it does not change the category (the offsets of the set-ups are not "
               "printed).")
+
+
+def _damage_note(eq, key) -> str:
+    """For a rule that omits terms: the other rules of the same printed equation whose text is
+    visibly damaged (cut off, a lost glyph), which make an extraction that dropped the omitted
+    term(s) a third explanation beside a set-up choice and a printing error."""
+    ocr = eq.get("ocr", {})
+    cut = [k for k in eq.get("cut", {}) if k != key]
+    glyph = [k for k in ocr if k not in ("kind", "note", "notes") and k != key
+             and k not in cut]
+    if not cut and not glyph:
+        return ""
+    what = "; ".join(
+        [f"{k} '{eq['expr'][k]}' cut off" for k in cut]
+        + [f"{k} '{eq['expr'][k]}' with a lost glyph" for k in glyph])
+    return (f" A third explanation: the extraction of this same eq. {eq['id']} is visibly "
+            f"damaged ({what}), so an extraction that dropped the omitted term(s) at a term "
+            f"boundary cannot be excluded either; the page of the original PDF would decide "
+            f"it.")
 
 
 def _elsewhere_note(all_eqs, eq, key) -> str:

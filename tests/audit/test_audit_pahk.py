@@ -596,3 +596,23 @@ def test_a6_squareness_rules_read_at_the_offsets_is_a_named_reading(verdicts):
             if v.category != "identical":
                 assert not any(r.startswith("notation:A6") for r in v.readings_used)
                 assert "eq. A6 (FH1) prints travel arguments instead" in v.evidence
+
+
+def test_omitted_terms_in_a_damaged_equation_name_the_extraction(verdicts):
+    """Review 4 (#19): in eq. 10 two rules are visibly cut off and one lost a subscript (read
+    from the data here), so for the rules there that omit terms an extraction that dropped
+    them is a third explanation, named with the damaged rules; eq. 9 has no damaged rule and
+    its omissions name none."""
+    e10 = next(x for x in DATA["equation"] if x["id"] == "10")
+    cut = sorted(e10.get("cut", {}))
+    assert len(cut) == 2
+    for key in ("dx(Y)", "dy(Y)"):
+        v = find(verdicts, "10", key)
+        assert v.category == "undecidable"
+        ev = v.evidence
+        assert "A third explanation: the extraction of this same eq. 10 is visibly damaged" in ev
+        for k in cut:
+            assert f"{k} '{e10['expr'][k]}' cut off" in ev
+    e9 = next(x for x in DATA["equation"] if x["id"] == "9")
+    assert not e9.get("cut") and not e9.get("ocr")
+    assert "A third explanation" not in find(verdicts, "9", "dz(Z)").evidence
