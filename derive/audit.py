@@ -134,7 +134,6 @@ READING_KINDS = {
     "line": "convention",              # squareness as the slope of one line
     "notation": "convention",          # a notational convention (atan for atan2 ...)
     "rounding": "convention",          # a printed number from rounded printed intermediates
-    "travel": "convention",            # an axis travel direction the text leaves open
     "rule1": "simplification",         # Pahk's rule (1) of sec. 2.3
     "termwise": "simplification",      # Pahk's term-wise quadrature
     "stated": "simplification",        # another approximation the author states

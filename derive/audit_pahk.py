@@ -31,7 +31,8 @@ from .audit_pahk_chain import audit_chain, audit_vectors, chain_error  # noqa: F
 from .audit_pahk_model import (COMPONENTS, P, Reading, derived_error, geometries,  # noqa: F401
                                geometry_text, iso_error, layout, paper_map, paper_name, parse,
                                printed_component, readings, stacking_text)
-from .audit_pahk_rules import CONVENTION_TABLE, RULE1, _bounds, audit_transfer
+from .audit_pahk_rules import (CONVENTION_TABLE, RULE1, _bounds, audit_transfer,
+                                fill_verdict_refs)
 
 SOURCE = "Pahk 1995"
 DATA_FILE = "printed_pahk.toml"
@@ -443,4 +444,17 @@ def audit(printed: dict, layouts: list[str] | None = None) -> list[Verdict]:
                                    vol_reading.get(name)))
         else:
             raise ValueError(f"equation {e['id']}: unknown kind {kind!r}")
+
+    def category_of_rule(name, eq_id, key):
+        """The category of a rule of a layout not audited in this run (restricted layouts)."""
+        reading = vol_reading.get(name)
+        if reading is None and name in result_of:
+            reading = audit_volumetric(result_of[name], geoms[name])[1]
+        st = dict(stackings)
+        if reading is not None and (reading.tool is not None or reading.work is not None):
+            st[name] = reading.stacking(layout(name))
+        vs = audit_transfer(by_id[eq_id], reading, _verdict, geoms[name], eqs, st)
+        return next(v.category for v in vs if v.component == key)
+
+    fill_verdict_refs(out, category_of_rule)
     return out

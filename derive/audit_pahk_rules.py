@@ -376,9 +376,10 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                     f"{r.line} line) reproduces Pahk's non-trivial rules for {key} on the other "
                     f"layouts: " + ("; ".join(support) if support else "none") + ".")
             elif eq["expr"][key] == key and v.category == "undecidable":
-                v.evidence += _pattern_note(all_eqs, eq, key, d0)
+                v.evidence += _pattern_note(all_eqs, eq, key, d0) + _damage_note(eq, key)
             elif v.category == "undecidable" and r.zero:
-                v.evidence += _omission_pattern(all_eqs, eq, key, sp.expand(d0 - d), r.zero)
+                v.evidence += (_omission_pattern(all_eqs, eq, key, sp.expand(d0 - d), r.zero)
+                               + _damage_note(eq, key))
             out.append(v)
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
@@ -412,7 +413,7 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
     raws = {r for e in all_eqs if e.get("kind") == "transfer" for r in e["expr"].values()}
     for v in out:
         if iso_of(lay, v.component) in SQUARENESS and v.category != "identical":
-            _offset_notation(v, raws)
+            _offset_notation(v, raws, eq, _squareness_notations(all_eqs))
     return out
 
 
@@ -420,11 +421,29 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
 _AT_AXIS = re.compile(r"\b([Ed][xyz])\(([XYZ])\)")
 
 
-def _offset_notation(v: Verdict, raws=()) -> None:
+def _squareness_notations(all_eqs) -> tuple[list[str], list[str]]:
+    """(equations that print the squareness rules' error motions at the measuring offset,
+    Ez(Yo); those that print travel arguments, Ez(X)), read from the printed rules."""
+    at_offset, travel = [], []
+    for e in all_eqs:
+        if e.get("kind") != "transfer":
+            continue
+        rules = [t for k, t in e["expr"].items()
+                 if iso_of(layout(e["layout"]), k) in SQUARENESS and re.search(r"[Ed][xyz]\(", t)]
+        if any(_AT_AXIS.search(t) for t in rules):
+            travel.append(f"eq. {e['id']} ({e['layout']})")
+        elif rules:
+            at_offset.append(f"eq. {e['id']} ({e['layout']})")
+    return at_offset, travel
+
+
+def _offset_notation(v: Verdict, raws=(), eq=None, notations=((), ())) -> None:
     """Write the error motions of a squareness rule as Pahk does, at the measuring offset
     (Ez(Yo): the yaw of Y where the line is measured; the derivation evaluates each error
     motion there, :func:`_squareness_shift`), in every field but the print; quoted prints
-    (``raws``, the printed rules) keep their own text."""
+    (``raws``, the printed rules) keep their own text.  A print with travel arguments (A6:
+    Ey(Y) - Ey(X)) is read at the offsets too: that reading is named in ``readings_used``
+    and where the identity with the print is claimed."""
     keep = sorted((r for r in raws if _AT_AXIS.search(r)), key=len, reverse=True)
 
     def fix(t):
@@ -443,9 +462,35 @@ def _offset_notation(v: Verdict, raws=()) -> None:
     for f in ("derived", "alternative", "dropped", "erratum", "evidence"):
         setattr(v, f, fix(getattr(v, f)))
     v.readings_tried = [fix(t) for t in v.readings_tried]
-    v.evidence += (" Notation: as Pahk writes the squareness rules, each error motion is "
-                   "taken at the measuring offset (Ez(Yo): the yaw of the Y axis at Yo), in "
-                   "'derived' and 'alternative' too.")
+    at_offset, travel = notations
+    raw = eq["expr"][v.component] if eq is not None else ""
+    moves = sorted(set(_AT_AXIS.findall(raw)))
+    if moves:
+        shown = ", ".join(f"{e}({a})" for e, a in moves)
+        subst = ", ".join(f"{e}({a}) as {e}({a}o)" for e, a in moves)
+        v.evidence = v.evidence.replace(
+            "(expand(alternative - printed) == 0)",
+            f"(expand(alternative - printed) == 0, with the print's {subst})")
+        v.evidence += (f" Notation: eq. {eq['id']} is the exception: it prints its squareness "
+                       f"rules with travel arguments ({shown} here), where "
+                       f"{', '.join(at_offset)} write the error motions at the measuring "
+                       f"offset (Ez(Yo): the yaw of the Y axis at Yo); they are read at the "
+                       f"offsets like those, in 'derived' and 'alternative' too (the print is "
+                       f"quoted as printed). Taken literally, a travel argument would make a "
+                       f"constant squareness depend on the position; the o may be the author's "
+                       f"notation or lost by the extraction, which does not change the "
+                       f"reading.")
+        key = (f"notation:{eq['id']} squareness rules written with travel arguments, read at "
+               f"the offsets as {', '.join(a.split(' (')[0] for a in at_offset)} write them")
+        if key not in v.readings_used:
+            v.readings_used = list(v.readings_used) + [key]
+    else:
+        v.evidence += (f" Notation: Pahk writes the squareness rules of {', '.join(at_offset)} "
+                       f"with each error motion at the measuring offset (Ez(Yo): the yaw of "
+                       f"the Y axis at Yo)"
+                       + (f" ({', '.join(travel)} prints travel arguments instead)"
+                          if travel else "")
+                       + "; 'derived' and 'alternative' are written so too.")
 
 
 def _cut_verdict(eq, key, name, lay, rr, vf, geometry_key, verdict, note, all_eqs):
@@ -530,45 +575,124 @@ def _layout_type(name: str) -> str:
     return layout(name).description.split(" CMM")[0].strip().lower()
 
 
+#: the offset of an Abbe term and its error motion: ``Xo*Ez(Y)`` -> ("Xo", "Ez", "Y")
+_ERROR_AT = re.compile(r"^([Ed][xyz])\(([XYZ])\)$")
+
+#: a placeholder for the category of another layout's verdict on a rule, filled in by
+#: :func:`fill_verdict_refs` once every verdict is known (``⟦MB1|9|dy(Y)⟧``)
+_REF = re.compile(r"\u27e6([^|\u27e7]+)\|([^|\u27e7]+)\|([^\u27e7]+)\u27e7")
+
+
+def _abbe_parts(mono):
+    """(offset, error name, argument) of an Abbe monomial such as Ez(Y)*Xo, else None."""
+    names = [str(a) for a in sp.Mul.make_args(mono)]
+    off = [n for n in names if n in OFFSETS_TEXT]
+    err = [m for m in (_ERROR_AT.match(n) for n in names) if m]
+    if len(off) != 1 or len(err) != 1 or len(names) != 2:
+        return None
+    return off[0], err[0].group(1), err[0].group(2)
+
+
+OFFSETS_TEXT = ("Xo", "Yo", "Zo")
+
+
+def fill_verdict_refs(verdicts, category_of_rule) -> None:
+    """Replace every ``⟦layout|eq|rule⟧`` in the evidence by that verdict's category;
+    ``category_of_rule(layout, eq, rule)`` gives it for a verdict not in ``verdicts``."""
+    cats = {(v.layout, v.equation, v.component): v.category for v in verdicts}
+    for v in verdicts:
+        if "\u27e6" in v.evidence:
+            v.evidence = _REF.sub(lambda m: cats.get(m.groups()) or category_of_rule(
+                *m.groups()), v.evidence)
+
+
 def _omission_pattern(all_eqs, eq, key, dropped, zero) -> str:
     """For a rule exact only with a zero offset: on the other layouts whose derived rule has
     the same omitted term (up to its sign), which print it and which omit it too (identical
-    prints named) -- the pattern of the omission over the layouts.  It does not change the
-    category: the offsets of the set-ups stay unprinted."""
+    prints named) -- the pattern of the omission over the layouts.  A printed term with the
+    same offset and error motion but another argument (MB1 eq. 9's -Xo*Ez(Z) for -Xo*Ez(Y))
+    counts as printed, with a wrong argument, and that layout's own verdict is named.  It does
+    not change the category: the offsets of the set-ups stay unprinted."""
     monos = {t.as_coeff_Mul()[1] for t in sp.Add.make_args(sp.expand(dropped))}
     if not monos or dropped == 0:
         return ""
-    has = lambda expr: monos <= {t.as_coeff_Mul()[1]  # noqa: E731
-                                 for t in sp.Add.make_args(sp.expand(expr))}
+    mono_set = lambda expr: {t.as_coeff_Mul()[1]  # noqa: E731
+                             for t in sp.Add.make_args(sp.expand(expr))}
     raw = eq["expr"][key]
-    omit, keep, same = [eq["layout"]], [], []
+    omit, keep, misarg, same = [eq["layout"]], [], [], []
     for e in all_eqs:
         if e.get("kind") != "transfer" or e["layout"] == eq["layout"] or key not in e["expr"] \
-                or key in e.get("cut", {}) or not has(derived_rule(e["layout"], key)):
+                or key in e.get("cut", {}) or not monos <= mono_set(derived_rule(e["layout"], key)):
             continue
         where = f"{e['layout']} eq. {e['id']}"
-        if has(printed_component(e, key)[0]):
+        printed = mono_set(printed_component(e, key)[0])
+        if monos <= printed:
             keep.append(f"{where} ('{key} = {e['expr'][key]}')")
-        else:
-            omit.append(e["layout"])
-            if e["expr"][key] == raw:
-                same.append(where)
-    if not keep and len(omit) == 1:
+            continue
+        other_arg = []
+        for m in monos - printed:
+            parts = _abbe_parts(m)
+            hit = [p for p in map(_abbe_parts, printed) if parts and p
+                   and p[:2] == parts[:2] and p[2] != parts[2]]
+            other_arg.append((parts, hit[0]) if hit else None)
+        if other_arg and all(other_arg):
+            args = ", ".join(f"{p[0]}*{p[1]}({p[2]}) for {m[0]}*{m[1]}({m[2]})"
+                             for m, p in other_arg)
+            misarg.append((e["layout"], f"{where} prints the term with another argument, "
+                           f"{args} ('{key} = {e['expr'][key]}'; that layout's own verdict on "
+                           f"{key}: \u27e6{e['layout']}|{e['id']}|{key}\u27e7)"))
+            continue
+        omit.append(e["layout"])
+        if e["expr"][key] == raw:
+            same.append(where)
+    if not keep and not misarg and len(omit) == 1:
         return ""
-    kinds = {_layout_type(n).split()[-1] for n in omit}
+    kind = lambda n: _layout_type(n).split()[-1]  # noqa: E731
+    kinds = {kind(n) for n in omit}
+    present = [w.split(" eq. ")[0] for w in keep] + [n for n, _ in misarg]
+    kinds_present = {kind(n) for n in present}
     term = " + ".join(sorted(fmt(m) for m in monos))
+    if len(omit) > 1 and present and not kinds & kinds_present:
+        why = (f". The prints split by machine type: the {', '.join(sorted(kinds_present))} "
+               f"layouts write the term, the {', '.join(sorted(kinds))} layouts omit it, which "
+               f"fits a set-up specific to the {' and '.join(sorted(kinds))} layouts "
+               f"({' = '.join(zero)} = 0, the measuring line through that reference) or a rule "
+               f"copied within a machine type")
+    elif len(omit) > 1:
+        why = ((f" -- one machine type ({kinds.pop()})" if len(kinds) == 1 else "")
+               + f". This fits a set-up common to them ({' = '.join(zero)} = 0, the measuring "
+                 f"line through that reference) or a rule copied from one to the other")
+    else:
+        why = ""
     return (f" Across the layouts whose derived rule has the term {term} (up to its sign): "
             + (f"the identical '{key} = {raw}' is printed for {', '.join(same)}; " if same
                else "")
             + (f"the term stands in {'; '.join(keep)}; " if keep else "")
-            + ("it is omitted by " + ", ".join(f"{n} ({_layout_type(n)})" for n in omit)
-               + (f" -- one machine type ({kinds.pop()})" if len(kinds) == 1 else "")
-               + f". This fits a set-up common to them ({' = '.join(zero)} = 0, the measuring "
-                 f"line through that reference) or a rule copied from one to the other"
+            + "".join(f"{m}; " for _, m in misarg)
+            + ("it is omitted by " + ", ".join(f"{n} ({_layout_type(n)})" for n in omit) + why
                if len(omit) > 1 else f"only {eq['layout']} omits it: a one-off omission or a "
                                      f"set-up of this layout alone with {' = '.join(zero)} = 0")
             + "; it does not change the category (the offsets of the set-ups are not "
               "printed).")
+
+
+def _damage_note(eq, key) -> str:
+    """For a rule that omits terms: the other rules of the same printed equation whose text is
+    visibly damaged (cut off, a lost glyph), which make an extraction that dropped the omitted
+    term(s) a third explanation beside a set-up choice and a printing error."""
+    ocr = eq.get("ocr", {})
+    cut = [k for k in eq.get("cut", {}) if k != key]
+    glyph = [k for k in ocr if k not in ("kind", "note", "notes") and k != key
+             and k not in cut]
+    if not cut and not glyph:
+        return ""
+    what = "; ".join(
+        [f"{k} '{eq['expr'][k]}' cut off" for k in cut]
+        + [f"{k} '{eq['expr'][k]}' with a lost glyph" for k in glyph])
+    return (f" A third explanation: the extraction of this same eq. {eq['id']} is visibly "
+            f"damaged ({what}), so an extraction that dropped the omitted term(s) at a term "
+            f"boundary cannot be excluded either; the page of the original PDF would decide "
+            f"it.")
 
 
 def _elsewhere_note(all_eqs, eq, key) -> str:

@@ -15,8 +15,12 @@ known slopes.  With E_ij = k_ij q_j (the deviation along i while axis j moves, s
 
 Listing 3.1 gives each angle the sign of ``ref[-1] - ref[0]`` (the change along the travel), so
 the result depends on the direction each axis travels.  The text fixes only X (0 .. 500 mm:
-appendix C.1 ``x = np.linspace(0, 500, 11)``, Figure 3.11); the audit tries both directions of
-Y and Z (``travel:`` readings).
+appendix C.1 ``x = np.linspace(0, 500, 11)``); the audit tries both directions of Y and Z.
+A Listing 3.4 entry ``E_<i><q> + (+-q) * S`` is judged as a whole under each: its squareness
+term, and its lookup ``cf(...)[3][round(pos_q)]``, which reads the mirrored position when q
+travels negative (negative index, see :mod:`derive.audit_listings`).  An entry right for some
+directions only is ``undecidable`` (the direction is an unstated set-up fact, not a
+convention); an entry wrong for every direction is ``printing_error``.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ import itertools
 
 import numpy as np
 
-from .audit import Verdict, category_of
+from .audit import Verdict
 
 DATA_FILE = "printed_squareness.toml"
 LAYOUTS = ("DMU50",)
@@ -71,10 +75,6 @@ def _label(sign) -> str:
     return ", ".join(f"{a} travels {'+' if sign[a] > 0 else '-'}" for a in "YZ")
 
 
-def _keys(sign, axes="YZ") -> list[str]:
-    return [f"travel:DMU50 {a} {'positive' if sign[a] > 0 else 'negative'}" for a in axes]
-
-
 def audit(printed: dict, layouts=None) -> list[Verdict]:
     if layouts is not None and "DMU50" not in layouts:
         return []
@@ -109,8 +109,7 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                       "sum of Listing 3.2 is +-(k_ab + k_ba) -- the difference of eq. 2.39 -- "
                       "only where the two rules give opposite senses for the directions the "
                       "axes travel: XY needs Y travelling negative, XZ needs Z positive, YZ "
-                      "needs Y and Z in the same direction (X travels positive: appendix C.1, "
-                      "Figure 3.11). No choice satisfies all three: " + "; ".join(tried)
+                      "needs Y and Z in the same direction (" + X_POSITIVE + "). No choice satisfies all three: " + "; ".join(tried)
                       + ". Elsewhere the sum is +-(k_ab - k_ba), the squareness plus twice a "
                       "rotation of the measuring frame. Category printing_error: a defect of "
                       "the printed code (its sign rules), for every travel direction the text "
@@ -118,71 +117,115 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                       "+-(k_ab + k_ba) for every pair (eq. 2.39)", tried,
                       ["inconsistent:Listing 3.1 sign rules of the six angles"]))
     else:
-        best = next(sign for sign, ok in zip(_signs(), ok_all) if ok)
-        keys = _keys(best)
-        out.append(_v(s["id"], "sum of the two angles", category_of(keys), "sum of signed "
-                      "angles", "the sum of the signed angles is eq. 2.39's difference for "
-                      f"{_label(best)}", s["text"], "eq. 2.39", tried, keys))
-    # Listing 3.4's use of S against eq. 3.17-3.18
-    uses = printed.get("use", [])
-    results = []
-    for sign in _signs():
-        row = {}
-        for u in uses:
-            a1, a2 = u["call"]
-            coef = u["sign"] * squareness(code, a1, a2, sign)
-            want = SLOPES[u["pair"]] + SLOPES[u["pair"][::-1]]
-            row[u["id"]] = abs(coef - want) < 1e-3 * abs(want)
-        results.append((sign, row))
-    best_n = max(sum(r.values()) for _, r in results)
-    best = [(sign, r) for sign, r in results if sum(r.values()) == best_n]
-    for u in uses:
-        tried = [f"{_label(sign)}: {u['term']} " + ("= " if r[u['id']] else "!= ") + u["eq"]
-                 for sign, r in results]
-        right = [sign for sign, r in best if r[u["id"]]]
-        raw = u.get("raw", u["term"])
-        shown = (f"'{u['term']}'" + (f" (extraction text of the line: '{raw}')"
-                                     if raw != u["term"] else ""))
-        base = (f"the entry {u['entry']} of Listing 3.4, {shown}, run with the angles of "
-                f"Listing 3.1 and the sum of Listing 3.2 on lines of known slopes, against "
-                f"{u['eq']} with the X axis as datum (the entry must put back q (k_ab + k_ba), "
-                f"the slope-signed squareness eq. 3.11/3.13 define). Travel directions that "
-                f"make the most of the three squareness entries right ({best_n} of 3): "
-                + "; ".join(_label(sg) for sg, _ in best) + ".")
-        if len(right) == len(best):
-            axes = "Y" if u["pair"] == "XY" else "YZ"
-            keys = _keys(right[0], axes) if len({tuple(_keys(sg, axes)) for sg in right}) == 1 \
-                else []
-            extra = (" With Z travelling positive, S_ZX is eq. 2.39's E_B(0Z)X = "
-                     "-E_B(0X)Z, so (-Z) * S_ZX = +z E_B(0X)Z: the minus converts the "
-                     "squareness of X to Z into the Z to X of eq. 3.18." if u["pair"] == "XZ"
-                     else "")
-            keys = keys + (["notation:S_ZX is E_B(0Z)X = -E_B(0X)Z"] if u["pair"] == "XZ"
-                           else [])
-            out.append(_v(u["id"], u["entry"], category_of(keys), f"equals {u['eq']} for "
-                          + "; ".join(_label(sg) for sg in right), base + " Under every one "
-                          f"of them the entry equals {u['eq']}." + extra + " The travel "
-                          "direction is a reading: the text does not give it.", u["text"],
-                          u["eq"], tried, keys,
-                          statement="the travel direction(s) " + "; ".join(
-                              _label(sg) for sg in right) + " (not printed)"))
-        elif not right:
-            out.append(_v(u["id"], u["entry"], "printing_error", f"{u['term']} != {u['eq']}",
-                          base + f" Under none of them does the entry equal {u['eq']}. "
-                          "Category printing_error: a defect of the printed code", u["text"],
-                          u["eq"], tried, [f"inconsistent:{u['id']} sign"]))
-        else:
-            extra = (" With Z travelling positive S_ZX is eq. 2.39's E_B(0Z)X = -E_B(0X)Z, "
-                     "so (-Z) * S_ZX = +z E_B(0X)Z: the minus converts the squareness of X to "
-                     "Z into the Z to X of eq. 3.18." if u["pair"] == "XZ" else "")
-            out.append(_v(u["id"], u["entry"], "undecidable", f"{u['term']} equals {u['eq']} "
-                          "only for one travel direction of Z", base + " Among these the "
-                          "entry is right for " + "; ".join(_label(sg) for sg in right)
-                          + " and wrong for the other." + extra + " The other Z entry of "
-                          "Listing 3.4 is wrong exactly "
-                          "where this one is right: one of the two Z entries is a printing "
-                          "error whatever the direction. Category undecidable; missing: the "
-                          "travel direction of Z (the sign of the positions in the E_XZ and "
-                          "E_YZ data)", u["text"], u["eq"], tried,
-                          ["missing:DMU50 travel direction of Z"]))
+        right = [sign for sign, ok in zip(_signs(), ok_all) if ok]
+        everywhere = len(right) == len(ok_all)
+        out.append(_v(s["id"], "sum of the two angles",
+                      "identical" if everywhere else "undecidable",
+                      "the sum of signed angles is eq. 2.39's difference only for "
+                      + "; ".join(_label(sg) for sg in right),
+                      "the sum of the signed angles is eq. 2.39's difference for "
+                      + "; ".join(_label(sg) for sg in right) + ("" if everywhere else
+                      ". Category undecidable; missing: the travel directions of Y and Z"),
+                      s["text"], "eq. 2.39", tried,
+                      [] if everywhere else ["missing:DMU50 travel directions of Y and Z"]))
+    # Listing 3.4's use of S against eq. 3.17-3.18: each entry judged as a whole (its
+    # squareness term and its E_<i><q> lookup) under every travel direction the text leaves open
+    for u in printed.get("use", []):
+        out.append(_use_verdict(code, u))
     return out
+
+
+#: why X is taken as travelling positive (the one direction the text gives)
+X_POSITIVE = ("X travels + (the one direction the text gives: appendix C.1 defines the X "
+              "displacements as 'x = np.array(np.linspace(0, 500, num = 11))', 0 .. 500 mm, and the "
+              "NC data of Figure 3.11, extracted as a table, run X = 0, 50, .., 500 mm)")
+
+#: the lines 47-51 of Listing 3.4 that define E_XZ, E_YZ, E_ZZ are blank in the extraction
+LOST_LOOKUP = ("lines 47-51 of Listing 3.4, which define E_XZ, E_YZ and E_ZZ, are blank in the "
+               "extraction; the text says lines 40-50 define the translational errors 'by "
+               "reading the value of the fitted polynomial at the desired positio[n]', and every "
+               "visible line 40-46 does so as cf('E_<i><q>_avg.', n)[3][round(pos_<q>)], so "
+               "the lost lines are read as the same lookup at round(pos_Z)")
+
+
+def _negative_index(u) -> str:
+    """Why the lookup of the entry's E_<i><q> is wrong when q travels negative."""
+    q = u["position"]
+    e = u["term"].split(" + ")[0]
+    shown = (f"line {u['lookup_line']} '{u['lookup']}'" if u.get("lookup")
+             else f"the lost line (47-51) that reads {e} (see 'Reading' below)")
+    return (f"{e} is read by {shown} at round(pos_{q}) < 0 (the NC positions are the measured "
+            f"Axis values, Listing 3.4 lines 76-87, so an axis travelling negative has negative "
+            f"positions), a negative index that reads the curve at the mirrored position "
+            f"-(n - |round(pos_{q})|) mm (the verdict 'Listing 3.1 + 3.4 / negative "
+            f"positions', printing_error)")
+
+
+def _use_verdict(code: str, u: dict) -> Verdict:
+    """One entry of Listing 3.4 (E_<i><q> + (+-q) * S) under the travel directions of Y, Z."""
+    q = u["position"]
+    a1, a2 = u["call"]
+    want = SLOPES[u["pair"]] + SLOPES[u["pair"][::-1]]
+    axes = sorted({q, a1, a2} - {"X"})             # the directions the entry depends on
+    rows = []
+    for signs in itertools.product((1, -1), repeat=len(axes)):
+        sign = {"X": 1, "Y": 1, "Z": 1, **dict(zip(axes, signs))}
+        coef = u["sign"] * squareness(code, a1, a2, sign)
+        rows.append((sign, abs(coef - want) < 1e-3 * abs(want), sign[q] > 0))
+    label = (lambda sg: ", ".join(f"{a} travels {'+' if sg[a] > 0 else '-'}" for a in axes))
+    tried = [f"{label(sg)}: squareness term {u['term'].split(' + ')[1]} "
+             + ("= " if sq else "!= ") + f"the one of {u['eq']}; {u['term'].split(' + ')[0]} "
+             + ("read at its own position" if look else
+                "read at a negative index (mirrored position)") for sg, sq, look in rows]
+    right = [sg for sg, sq, look in rows if sq and look]
+    raw = u.get("raw", u["term"])
+    shown = (f"'{u['term']}'" + (f" (extraction text of the line: '{raw}')"
+                                 if raw != u["term"] else ""))
+    base = (f"the entry {u['entry']} of Listing 3.4, {shown}, judged as a whole: its "
+            f"squareness term run with the angles of Listing 3.1 and the sum of Listing 3.2 on "
+            f"lines of known slopes, against {u['eq']} with the X axis as datum (the entry "
+            f"must put back q (k_ab + k_ba), the slope-signed squareness eq. 3.11/3.13 "
+            f"define), and its lookup of {u['term'].split(' + ')[0]} at round(pos_{q}). "
+            f"{X_POSITIVE}; the text gives no direction for "
+            + " or ".join(axes) + ", so every one is tried. By direction:")
+    per = []
+    for sg, sq, look in rows:
+        bad = []
+        if not sq:
+            bad.append(f"the squareness term is not the one of {u['eq']} (the sign rules of "
+                       f"Listing 3.1, the verdict 'Listing 3.2', printing_error)")
+        if not look:
+            bad.append(_negative_index(u))
+        per.append(f"{label(sg)}: " + ("right" if not bad else "; and ".join(bad)))
+    lost = "" if u.get("lookup") else f" Reading: {LOST_LOOKUP}."
+    extra = (" With Z travelling positive S_ZX is eq. 2.39's E_B(0Z)X = -E_B(0X)Z, so "
+             "(-Z) * S_ZX = +z E_B(0X)Z: the minus converts the squareness of X to Z into the "
+             "Z to X of eq. 3.18. The other Z entry, T_e_Z (2,4), is wrong for every "
+             "direction (its own verdict)." if u["pair"] == "XZ" else "")
+    ocr = [] if u.get("lookup") else ["ocr:Listing 3.4 lines 47-51 read as lines 40-46"]
+    only_lost = [label(sg) for sg, sq, look in rows if sq and not look]
+    if ocr and only_lost:
+        lost += (" Only for " + "; ".join(only_lost) + " does the verdict rest on the lost "
+                 "lines (there the squareness term is right and the entry is wrong by the "
+                 "lookup alone); for every other direction the visible line decides.")
+    if not right:
+        return _v(u["id"], u["entry"], "printing_error",
+                  f"{u['term']} != {u['eq']} for every travel direction (for different "
+                  "reasons)", base + " " + "; ".join(per) + "." + lost + " Category "
+                  "printing_error: the entry is wrong for either direction, each time by a "
+                  "defect of the printed code another verdict decides (no reading makes the "
+                  "whole entry right)", u["text"], u["eq"], tried,
+                  [f"inconsistent:{u['id']} for every travel direction"] + ocr)
+    if len(right) == len(rows):
+        return _v(u["id"], u["entry"], "identical", "", base + " Right for every direction.",
+                  u["text"], u["eq"], tried, [])
+    return _v(u["id"], u["entry"], "undecidable",
+              f"{u['term']} equals {u['eq']} only for " + "; ".join(label(sg) for sg in right),
+              base + " " + "; ".join(per) + "." + extra + lost + " The entry is right for "
+              + "; ".join(label(sg) for sg in right) + " and wrong otherwise; whether it is "
+              "right depends on a set-up fact the text does not give (an unstated set-up fact "
+              "is no convention). Category undecidable; missing: the travel direction of "
+              + " and ".join(sorted({q} | ({a for sg in right for a in axes}))) + " (the sign "
+              "of the positions in the " + ", ".join(sorted({f"E_{a}{q}" for a in "XYZ" if a != q}))
+              + " data)", u["text"], u["eq"], tried,
+              [f"missing:DMU50 travel direction of {q}"] + ocr)

@@ -374,14 +374,14 @@ def test_listing_constant_term_dropped():
 
 
 # --------------------------------------------------------------------------- all verdicts
-EXPECTED = {"identical": 170, "printing_error": 25, "extraction": 7, "convention": 25,
-            "simplification": 18, "undecidable": 83}
+EXPECTED = {"identical": 170, "printing_error": 27, "extraction": 7, "convention": 24,
+            "simplification": 18, "undecidable": 82}
 #: per document (a verdict that moves between documents or categories fails)
 EXPECTED_BY_SOURCE = {
     "Pahk 1995": {"identical": 37, "printing_error": 7, "extraction": 0, "convention": 17,
                   "simplification": 15, "undecidable": 36},
-    "Ellingsdalen 2021": {"identical": 133, "printing_error": 18, "extraction": 7,
-                          "convention": 8, "simplification": 3, "undecidable": 47},
+    "Ellingsdalen 2021": {"identical": 133, "printing_error": 20, "extraction": 7,
+                          "convention": 7, "simplification": 3, "undecidable": 46},
 }
 
 

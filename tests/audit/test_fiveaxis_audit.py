@@ -181,6 +181,11 @@ def test_t23_sign_decided_by_the_printed_forward_kinematics(verdicts, printed):
     assert "none with T_2^3 = the printed matrix" in v.evidence
     assert "only k with T_2^3 = Rz(-B)" in v.evidence
     assert any("ruled out as the author's convention" in r for r in v.readings_tried)
+    # review 4 (#12): the renderings compared are eq. 3.31 / 3.32 and the chain after 3.37
+    # (eq. 3.33 is T_3^4); the defect is a bare sign, no candidate repetition
+    assert "eq. 3.31 and 3.32 against the chain after eq. 3.37" in v.evidence
+    assert "3.31 and 3.33" not in v.evidence and "repeated the entry" not in v.evidence
+    assert "a bare sign is no candidate repetition" in v.evidence
 
 
 def test_listing_repetition_states_its_assumption(verdicts, printed):

@@ -3,7 +3,7 @@
 #: the rule, restated independently: kind of a key prefix -> category
 KIND = {"table_origin": "convention", "geometry": "convention", "flip": "convention",
         "line": "convention", "notation": "convention", "rounding": "convention",
-        "travel": "convention", "rule1": "simplification", "termwise": "simplification",
+        "rule1": "simplification", "termwise": "simplification",
         "stated": "simplification", "ocr": "extraction", "zero": "undecidable",
         "glyph": "undecidable", "missing": "undecidable", "stacking": "printing_error",
         "inconsistent": "printing_error", "copy": "printing_error"}
