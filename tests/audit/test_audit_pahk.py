@@ -670,3 +670,36 @@ def test_omitted_terms_in_a_damaged_equation_name_the_extraction(verdicts):
     e9 = next(x for x in DATA["equation"] if x["id"] == "9")
     assert not e9.get("cut") and not e9.get("ocr")
     assert "A third explanation" not in find(verdicts, "9", "dz(Z)").evidence
+
+
+def test_undecidable_alternative_and_dropped_mean_what_formats_md_says(verdicts):
+    """Review 5 (schema): docs/formats.md describes 'alternative'/'dropped' for undecidable
+    verdicts too.  A zero-offset verdict's alternative reproduces the print once the offset is
+    0 in the derivation (recomputed with sympy here: derived with the offset set to 0 equals
+    the print, and dropped == derived - alternative); a verdict no reading reproduces names its
+    alternative as the closest reading and leaves dropped empty."""
+    import sympy as sp
+    from volerr.derive.audit_pahk_model import parse, printed_component
+    text = (resources.files("volerr") / "data" / "formats.md").read_text("utf-8")
+    assert "an `undecidable` verdict that rests on an unstated zero offset" in text
+    n_zero = n_close = 0
+    for v in verdicts:
+        if v.category != "undecidable" or not v.alternative:
+            continue
+        zero = [r.split(":")[1] for r in v.readings_used if r.startswith("zero:")]
+        if zero:
+            eq = next(x for x in DATA["equation"] if x["id"] == v.equation)
+            printed = printed_component(eq, v.component)[0]    # a lost glyph read as noted
+            derived, alt = parse(v.derived), parse(v.alternative)
+            assert sp.expand(derived - alt - parse(v.dropped)) == 0, (v.equation, v.component)
+            assert sp.expand(alt - printed) == 0, (v.equation, v.component)
+            at_zero = derived.subs({x: 0 for x in derived.free_symbols if str(x) in zero})
+            if v.readings_used == [f"zero:{z}" for z in zero]:     # the offset alone
+                assert sp.expand(at_zero - alt) == 0, (v.equation, v.component)
+            else:                     # with rule (1): the offset's terms are among the dropped
+                assert sp.expand(at_zero - alt) != sp.expand(derived - alt)
+            n_zero += 1
+        else:
+            assert v.dropped == "" and "closest" in v.evidence, (v.equation, v.component)
+            n_close += 1
+    assert n_zero >= 25 and n_close >= 1
