@@ -397,6 +397,7 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                     + rep)
         if repeated:
             v = classify(verdict(eq, key, "differs", erratum, evidence + ocr
+                                 + _outlier_note(all_eqs, eq, key)
                                  + " Category undecidable.", pr, d0), "undecidable")
             v.readings_used = [f"glyph:{eq['id']} {key} repeats a token of the same image"]
         else:
@@ -755,6 +756,22 @@ def _damage_note(eq, key) -> str:
             f"damaged ({what}), so an extraction that dropped the omitted term(s) at a term "
             f"boundary cannot be excluded either; the page of the original PDF would decide "
             f"it.")
+
+
+def _outlier_note(all_eqs, eq, key) -> str:
+    """For a rule whose residual repeats a token of the same image: when every other layout
+    prints this rule with one and the same text, this print is the lone outlier -- which fits
+    the repetition and decides nothing between the print and the extraction."""
+    others = [(e, e["expr"][key]) for e in all_eqs if e.get("kind") == "transfer"
+              and e["layout"] != eq["layout"] and key in e["expr"]
+              and key not in e.get("cut", {})]
+    texts = {t for _, t in others}
+    if len(others) < 2 or len(texts) != 1 or eq["expr"][key] in texts:
+        return ""
+    where = ", ".join(f"eq. {e['id']}" for e, _ in others)
+    return (f" All {len(others)} other layouts print '{key} = {texts.pop()}' ({where}): this "
+            f"print is the lone outlier, which fits the repetition named and does not decide "
+            f"between the print and the extraction.")
 
 
 def _elsewhere_note(all_eqs, eq, key) -> str:

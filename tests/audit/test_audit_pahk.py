@@ -703,3 +703,17 @@ def test_undecidable_alternative_and_dropped_mean_what_formats_md_says(verdicts)
             assert v.dropped == "" and "closest" in v.evidence, (v.equation, v.component)
             n_close += 1
     assert n_zero >= 25 and n_close >= 1
+
+
+def test_a6_dy_x_is_the_lone_outlier_of_its_rule(verdicts):
+    """Review 5 (#2): every other layout prints dy(X) with one text (read from the data), A6
+    another; the verdict says so and stays undecidable; no other rule verdict claims it."""
+    prints = {x["id"]: x["expr"]["dy(X)"] for x in DATA["equation"]
+              if x["kind"] == "transfer" and "dy(X)" in x["expr"]}
+    others = {k: t for k, t in prints.items() if k != "A6"}
+    assert len(set(others.values())) == 1 and prints["A6"] not in others.values()
+    v = find(verdicts, "A6", "dy(X)")
+    assert v.category == "undecidable"
+    assert (f"All {len(others)} other layouts print 'dy(X) = {next(iter(others.values()))}'"
+            in v.evidence and "lone outlier" in v.evidence)
+    assert [w for w in verdicts if "lone outlier" in w.evidence] == [v]
