@@ -106,6 +106,16 @@ def test_chain_factors_against_the_frame_definitions(htm):
     v16 = find(htm, "paper eq. 1.6", "matrix")
     assert "(T_5^w)^{-1}" in v16.evidence and any("inverse" in t and "explicitly" in t
                                                    for t in v16.readings_tried)
+    # review 5 (#13): each foreign label names the other, on its copied matrix (eq. 1.5 is
+    # eq. 1.1 with -d, checked above; eq. 1.6 is eq. 1.3 with B -> C, checked here), and
+    # eq. 1.6's sentence says it rests on eq. 1.5's own verdict
+    m13 = _printed_matrix(items["1.3"], b=c)
+    assert np.allclose(m13[:3, :3], m16[:3, :3])
+    l15, l16 = find(htm, "paper eq. 1.5", "label"), find(htm, "paper eq. 1.6", "label")
+    assert l16.category == "printing_error"
+    assert "eq. 1.5's T_0^{-1}, sits on a copied matrix too (eq. 1.1's with -d" in l16.evidence
+    assert f"eq. 1.5's own verdict ({l15.category})" in l16.evidence
+    assert "eq. 1.6's T_2^3, likewise sits on a copied matrix (eq. 1.3's" in l15.evidence
 
 
 def _factor_ok(name: str) -> bool:
