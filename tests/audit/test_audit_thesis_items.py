@@ -238,6 +238,9 @@ def test_linear_chain_with_angular_errors_dropped_1_19(htm):
     for eq in ("paper eq. 1.19", "thesis eq. 3.40"):
         v = find(htm, eq)
         assert v.category == "simplification" and "neglected" in v.statement
+        # review 5 (#10): which travels are printed and which assumed; Listing 3.4's T_e
+        assert "X 500 mm is printed" in v.evidence and "assumed, not printed" in v.evidence
+        assert "identity rotation blocks" in v.evidence
 
 
 def test_project_report_relations(htm):
