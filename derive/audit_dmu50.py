@@ -577,15 +577,32 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         if t_r_category == "undecidable":
             ev += ("; category undecidable: the extraction renders the underscores of this "
                    "line as '{-}' ('T = -T_{-}d @ T_{-}45 ...'), so the stray '-' may be the same "
-                   "damage; the printed output of the listing (Figure 3.10), which would tell, "
-                   "is not in the text; missing: the original listing")
+                   "damage. A third reading the text does not exclude: a deliberate minus. "
+                   "T_er(B, C) ends in '@ T_r (B, C)', so the minus negates T_er p as well, "
+                   "and the third print, '(T_r (90, 90) @ p) - (T_er(90, 90) @ p)', becomes "
+                   "(-P p) - (-E P p) = E P p - P p = T_er p - T_r p with the minus "
+                   "dropped (P the product, E the error factors): the actual minus the ideal "
+                   "position, which is how sec. 3.5 "
+                   "defines the deviation ('the difference between the actual and the ideal "
+                   "position'); without the minus the listing computes ideal - actual, and the "
+                   "sign of the compensation, which the text obtains 'by reversing the signs of "
+                   "the deviation', flips with it. Against that reading: the Figure 3.10 "
+                   "caption calls the first line 'the coordinates of the point after "
+                   "transformation using the ideal kinematics', which the negated HTM would "
+                   "print with the opposite signs and a homogeneous -1. The printed output of "
+                   "the listing (Figure 3.10), which would tell, is not in the text; missing: "
+                   "the original listing")
         v = _verdict("Listing 3.3 line 46 (T_r)", same, erratum, ev,
                      prod.get(key + "_text", ""), "T_d @ T_45 @ T_B @ T_n45 @ T_nd @ T_C",
                      category=t_r_category)
         if not same:
             v.readings_tried = ["the line as printed: -(product), the homogeneous 1 becomes -1",
                                 "a stray '-' of the print or of the extraction: the product "
-                                "alone equals the derived T_0^w (exact)"]
+                                "alone equals the derived T_0^w (exact)",
+                                "a deliberate minus: the third print becomes actual - ideal "
+                                "(sec. 3.5's deviation) instead of ideal - actual; the Figure "
+                                "3.10 caption ('the coordinates of the point') argues against "
+                                "it"]
             v.readings_used = ["glyph:Listing 3.3 line 46 leading minus"]
         out.append(v)
     std = {"rot_x": rotation((1, 0, 0), A_SYM), "rot_y": rotation((0, 1, 0), A_SYM),

@@ -578,10 +578,15 @@ def _actual_linear(item: dict, by_id: dict) -> Verdict:
               f"thesis does (eq. 3.11/3.13, the convention of eq. 1.10-1.11 / 3.17-3.18) they "
               f"differ only by the Abbe terms of the angular errors: {fmt(dropped)}; up to "
               f"{size:.3g} um with every angular error at 10 urad, X 500, Y 450, Z 400 mm and a "
-              f"tool point up to (100, 100, 200) mm (assumed values: the text prints no "
-              f"error sizes; the dropped terms scale in proportion to the angular errors and "
-              f"the lever arms). The simplification is stated: "
-              f"{item['statement']}", item["text"], fmt(der),
+              f"tool point up to (100, 100, 200) mm (X 500 mm is printed, appendix C.1's "
+              f"'linspace(0, 500, num = 11)' and appendix B; the Y and Z travels (the maker's "
+              f"nominal values), the tool point and the error sizes are assumed, not printed; "
+              f"the dropped terms scale in proportion to the angular errors and the lever "
+              f"arms). The simplification is stated: {item['statement']} The thesis' Listing "
+              f"3.4, the code that applies it (T_e, for eq. 3.40), confirms it in print: "
+              f"T_e_X, T_e_Y, T_e_Z "
+              f"have identity rotation blocks and carry only the translational errors and the "
+              f"squareness terms (Y * S_YX, (-Z) * S_ZX, (-Z) * S_ZY).", item["text"], fmt(der),
               ["the product of the derived stages, first order: differs by the Abbe terms",
                "angular errors set to zero (stated) with the thesis' squareness signs: exact"],
               used, statement=item["statement"], alternative=fmt(pr), dropped=fmt(dropped),

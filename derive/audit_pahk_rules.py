@@ -376,10 +376,12 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                     f"{r.line} line) reproduces Pahk's non-trivial rules for {key} on the other "
                     f"layouts: " + ("; ".join(support) if support else "none") + ".")
             elif eq["expr"][key] == key and v.category == "undecidable":
-                v.evidence += _pattern_note(all_eqs, eq, key, d0) + _damage_note(eq, key)
+                v.evidence += (_pattern_note(all_eqs, eq, key, d0, r.zero)
+                               + (_weighing(all_eqs, eq, key, r.zero) if r.zero else "")
+                               + _damage_note(eq, key))
             elif v.category == "undecidable" and r.zero:
                 v.evidence += (_omission_pattern(all_eqs, eq, key, sp.expand(d0 - d), r.zero)
-                               + _damage_note(eq, key))
+                               + _weighing(all_eqs, eq, key, r.zero) + _damage_note(eq, key))
             out.append(v)
             continue
         near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
@@ -395,6 +397,7 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                     + rep)
         if repeated:
             v = classify(verdict(eq, key, "differs", erratum, evidence + ocr
+                                 + _outlier_note(all_eqs, eq, key)
                                  + " Category undecidable.", pr, d0), "undecidable")
             v.readings_used = [f"glyph:{eq['id']} {key} repeats a token of the same image"]
         else:
@@ -538,8 +541,10 @@ def _cut_verdict(eq, key, name, lay, rr, vf, geometry_key, verdict, note, all_eq
     return classify(v, category)
 
 
-def _pattern_note(all_eqs, eq, key, d0) -> str:
-    """For a rule printed unchanged: how the other layouts print it, and what that shows."""
+def _pattern_note(all_eqs, eq, key, d0, zero=()) -> str:
+    """For a rule printed unchanged: how the other layouts print it, and what that shows.
+    With ``zero`` (the offsets a zero-offset reading sets to 0) the weighing is left to
+    :func:`_weighing`, the one rule of every zero-offset verdict."""
     note = _elsewhere_note(all_eqs, eq, key)
     if not note:
         return ""
@@ -554,6 +559,12 @@ def _pattern_note(all_eqs, eq, key, d0) -> str:
         if is_identical(derived_rule(e["layout"], key), d0):
             same_rule.append(with_terms[-1])
     out = note
+    if zero:
+        return out + (" Several unchanged prints are a pattern rather than a one-off misprint."
+                      if any(e.get("kind") == "transfer" and e["layout"] != eq["layout"]
+                             and e["expr"].get(key) == key for e in all_eqs) else "") + (
+            f" The print with terms on {', '.join(with_terms)} shows the author writing Abbe "
+            f"terms for this rule elsewhere." if with_terms else "")
     if any(e.get("kind") == "transfer" and e["layout"] != eq["layout"]
            and e["expr"].get(key) == key for e in all_eqs):
         out += (" Several unchanged prints are a pattern rather than a one-off misprint, which "
@@ -647,33 +658,85 @@ def _omission_pattern(all_eqs, eq, key, dropped, zero) -> str:
             same.append(where)
     if not keep and not misarg and len(omit) == 1:
         return ""
-    kind = lambda n: _layout_type(n).split()[-1]  # noqa: E731
-    kinds = {kind(n) for n in omit}
-    present = [w.split(" eq. ")[0] for w in keep] + [n for n, _ in misarg]
-    kinds_present = {kind(n) for n in present}
     term = " + ".join(sorted(fmt(m) for m in monos))
-    if len(omit) > 1 and present and not kinds & kinds_present:
-        why = (f". The prints split by machine type: the {', '.join(sorted(kinds_present))} "
-               f"layouts write the term, the {', '.join(sorted(kinds))} layouts omit it, which "
-               f"fits a set-up specific to the {' and '.join(sorted(kinds))} layouts "
-               f"({' = '.join(zero)} = 0, the measuring line through that reference) or a rule "
-               f"copied within a machine type")
-    elif len(omit) > 1:
-        why = ((f" -- one machine type ({kinds.pop()})" if len(kinds) == 1 else "")
-               + f". This fits a set-up common to them ({' = '.join(zero)} = 0, the measuring "
-                 f"line through that reference) or a rule copied from one to the other")
-    else:
-        why = ""
     return (f" Across the layouts whose derived rule has the term {term} (up to its sign): "
             + (f"the identical '{key} = {raw}' is printed for {', '.join(same)}; " if same
                else "")
             + (f"the term stands in {'; '.join(keep)}; " if keep else "")
             + "".join(f"{m}; " for _, m in misarg)
-            + ("it is omitted by " + ", ".join(f"{n} ({_layout_type(n)})" for n in omit) + why
-               if len(omit) > 1 else f"only {eq['layout']} omits it: a one-off omission or a "
-                                     f"set-up of this layout alone with {' = '.join(zero)} = 0")
-            + "; it does not change the category (the offsets of the set-ups are not "
-              "printed).")
+            + ("it is omitted by " + ", ".join(f"{n} ({_layout_type(n)})" for n in omit)
+               if len(omit) > 1 else f"only {eq['layout']} omits it") + ".")
+
+
+#: an Abbe term's offset as printed: ``Yo*Ez(X)`` (not the argument of ``Ez(Yo)``)
+_OFFSET_FACTOR = re.compile(r"\b([XYZ]o)\*[Ed][xyz]\b")
+
+
+def offsets_in_equation(eq) -> dict:
+    """{offset: [rules]}: the rules of the printed equation ``eq`` that write an Abbe term with
+    that offset (``Yo*Ez(X)``; a squareness rule's ``Ez(Yo)`` is an argument, not a term)."""
+    out = {}
+    for k, raw in eq["expr"].items():
+        for o in sorted(set(_OFFSET_FACTOR.findall(raw))):
+            out.setdefault(o, []).append(k)
+    return out
+
+
+def _weighing(all_eqs, eq, key, zero) -> str:
+    """The one weighing rule of every zero-offset verdict on a Pahk transfer rule, offset by
+    offset: a split of the prints by machine type (the layouts whose print of ``key`` has a
+    term with the offset against those whose derived rule has one but whose print has none),
+    or an equation that writes no term with that offset in any rule, fits a set-up without the
+    offset; only where neither holds does the term printed elsewhere point towards an
+    omission.  The category is not touched: the offsets of the set-ups are not printed."""
+    kind = lambda n: _layout_type(n).split()[-1]  # noqa: E731
+    used = offsets_in_equation(eq)
+    parts = []
+    for z in zero:
+        names = lambda expr: {str(x) for x in expr.free_symbols}  # noqa: E731
+        a = "an" if z == "Xo" else "a"
+        present, omit = [], []
+        for e in all_eqs:
+            if e.get("kind") != "transfer" or key not in e["expr"] or key in e.get("cut", {}) \
+                    or z not in names(derived_rule(e["layout"], key)):
+                continue
+            printed = z in names(printed_component(e, key)[0])
+            (present if printed else omit).append(e["layout"])
+        k_present = sorted({kind(n) for n in present})
+        k_omit = sorted({kind(n) for n in omit})
+        split = bool(present) and len(omit) > 1 and not set(k_present) & set(k_omit)
+        name = lambda ns: ", ".join(f"{n} ({_layout_type(n)})" for n in ns)  # noqa: E731
+        verb = lambda ns: "writes" if len(ns) == 1 else "write"  # noqa: E731
+        if split:
+            facts = (f"the prints split by machine type (the {' and '.join(k_present)} layouts "
+                     f"{', '.join(present)} write {a} {z} term in {key}, the "
+                     f"{' and '.join(k_omit)} layouts {', '.join(omit)} write none)")
+        elif present:
+            facts = (f"the prints do not split by machine type ({name(present)} "
+                     f"{verb(present)} {a} {z} term in {key}; {name(omit)} {verb(omit)} none)")
+        else:
+            facts = f"no layout writes {a} {z} term in {key} ({', '.join(omit)} all omit it)"
+        if z in used:
+            facts += f"; eq. {eq['id']} writes {z} terms in {', '.join(used[z])}"
+        else:
+            facts += f"; eq. {eq['id']} writes no {z} term in any rule"
+        if not present:
+            reading = (f"fits a set-up common to the layouts ({z} = 0, the measuring line "
+                       f"through that reference) or a rule copied from one to the other, as no "
+                       f"layout prints the term")
+        elif split or z not in used:
+            reading = (f"fits a set-up " + (f"specific to the {' and '.join(k_omit)} layouts"
+                                            if split else f"of eq. {eq['id']}")
+                       + f" with {z} = 0 (the measuring line through that reference)")
+        else:
+            reading = "points towards an omission of the printed term here"
+        parts.append(f"{z}: {facts}, which {reading}")
+    return (" Weighing (the same rule for every zero-offset verdict, offset by offset: a split "
+            "of the prints by machine type, or an equation that writes no term with the offset "
+            "in any rule, fits a set-up without that offset; otherwise a term printed elsewhere "
+            "points towards an omission): " + "; ".join(parts)
+            + ". The prints do not decide between a set-up and a printing error; the category "
+              "stays undecidable (the offsets of the set-ups are not printed).")
 
 
 def _damage_note(eq, key) -> str:
@@ -693,6 +756,22 @@ def _damage_note(eq, key) -> str:
             f"damaged ({what}), so an extraction that dropped the omitted term(s) at a term "
             f"boundary cannot be excluded either; the page of the original PDF would decide "
             f"it.")
+
+
+def _outlier_note(all_eqs, eq, key) -> str:
+    """For a rule whose residual repeats a token of the same image: when every other layout
+    prints this rule with one and the same text, this print is the lone outlier -- which fits
+    the repetition and decides nothing between the print and the extraction."""
+    others = [(e, e["expr"][key]) for e in all_eqs if e.get("kind") == "transfer"
+              and e["layout"] != eq["layout"] and key in e["expr"]
+              and key not in e.get("cut", {})]
+    texts = {t for _, t in others}
+    if len(others) < 2 or len(texts) != 1 or eq["expr"][key] in texts:
+        return ""
+    where = ", ".join(f"eq. {e['id']}" for e, _ in others)
+    return (f" All {len(others)} other layouts print '{key} = {texts.pop()}' ({where}): this "
+            f"print is the lone outlier, which fits the repetition named and does not decide "
+            f"between the print and the extraction.")
 
 
 def _elsewhere_note(all_eqs, eq, key) -> str:

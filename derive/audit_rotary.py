@@ -203,7 +203,15 @@ def audit_rotary(item: dict) -> list[Verdict]:
                   "repeated from its neighbourhood), while the extraction reads the zero bottom "
                   "row '0 & 0 & 0 & 0' of the deviation matrix of the specialization project's "
                   "eq. (23) right, an image of the same layout at this place (a deviation "
-                  "matrix between [Delta; 0] and [x; y; z; 1]): the author's source",
+                  "matrix between [Delta; 0] and [x; y; z; 1]): the author's source. The "
+                  "paper's eq. 1.17 prints no left-hand side, but its 0 0 0 1 is a defect "
+                  "there too: its diagonal is a deviation matrix's ((1,1) -E_CB s_B, (3,3) 0; "
+                  "no 1 and no c_B, which an HTM T_EB Rz(B) has there), and a deviation "
+                  "matrix has the bottom row 0 0 0 0 (see that verdict). The thesis' "
+                  "error model of the X axis in ch. 2 (the linear-axis model before eq. 2.42, "
+                  "'[Delta_x(x); Delta_y(x); Delta_z(x); 0] = [... ; 0 0 0 1] [x_x; y_x; z_x; "
+                  "1]') also sets [Delta; 0] over a bottom row 0 0 0 1: the author's habit, "
+                  "which supports the category",
                   str(row4), "[0, 0, 0, 0]"))
     if not ok4:
         out[-1].readings_tried = ["deviation matrix (T_ES - I) Rz(C): bottom row 0 0 0 0",

@@ -137,12 +137,18 @@ def audit_c1(c1: dict) -> list[Verdict]:
         n_is = ("the derived determinant" if n_sign == 1 else "minus the derived determinant"
                 if n_sign == -1 else "not the determinant")
         span = _line_span(terms)
+        late = [str(t["line"]) for t in terms if any("followed by N" in r for r in t["repairs"])]
         n_where = (f"every term of the six formulas has its own '/(...)' denominator; the one "
                    f"legible in full is that of E_XX's last term (lines 86-89), which, read "
                    f"with its repairs, is {n_is} (15 monomials); the other denominators"
                    + (f" of {name} ({span})" if name != "E_XX" else " of E_XX") +
                    " are damaged by the extraction (debris, repeated spans) and were not "
-                   "compared one by one -- their legible starts read as N's first monomials")
+                   "compared one by one -- where a '/' is followed directly by a legible "
+                   "start, it reads as N's first monomials"
+                   + ("" if not late else
+                      f"; at line {', '.join(late)} the '/' is followed first by a repeated "
+                      f"span of the deviation, and N starts on the next line (see that "
+                      f"term's repair)"))
         tried = [f"Cramer's rule on eq. 32 (the derived cofactor of each deviation over N): "
                  f"{len(checked)} legible terms compared, {len(bad)} differ",
                  f"the denominator: {n_where}"]
@@ -186,12 +192,22 @@ def audit_c1(c1: dict) -> list[Verdict]:
                           f"'{factor}' where the other translational errors have '{unit}'",
                           f"{c1['factor_text'].get(name, '')}: the mm result is converted to um "
                           f"by '{unit}' in E_XX and E_ZX (and to urad by '* 1e6' in E_AX .. "
-                          f"E_CX); '{factor}' adds 1000 instead, which would plot E_YX near "
-                          f"1000 um, while appendix B sec. 4 reports E_YX 'significantly lower' "
-                          f"than the 23 um of E_XX: the script that made the plots multiplied. "
-                          f"Category undecidable: '+' for '*' is a confusion of one glyph, which "
-                          f"the print (a listing edited after the run) and the text extraction "
-                          f"explain equally; what would decide: the page of the original PDF",
+                          f"E_CX); '{factor}' adds 1000 instead, which would make E_YX near "
+                          f"1000 um and its compensation near -1 mm. The thesis' own results, "
+                          f"made with this script, rule that out: sec. 4.1.1 ('The two "
+                          f"straightness errors E_YX and E_ZX are much lower' than E_XX's "
+                          f"20.5 um), sec. 4.2.1 (E_YX 'improved from 6.6 um before "
+                          f"compensation, to 1.3 um after compensation') and the compensated "
+                          f"NC-data of Figure 3.11 (ideal Y 0), whose Y coordinates all stay "
+                          f"within 1 um (largest -0.000949 mm, at X 49.9956 mm); "
+                          f"appendix B sec. 4 (the project's own script) agrees ('significantly "
+                          f"lower' than E_XX's 23 um): the script that made the results "
+                          f"multiplied. Category undecidable: the extraction demonstrably "
+                          f"renders '*' as '+' in this same function -- the first monomial of "
+                          f"the d_yP term, '(x_xK_{{y_xK}} + z_xP - N)' at the end of line 97, "
+                          f"reads x_xK*y_xK*z_xP (see the E_YX formula verdict) -- but a '+' "
+                          f"typed into a listing edited after the run explains the print as "
+                          f"well; what would decide: the page of the original PDF",
                           factor, unit, [f"'{factor}' as printed: E_YX + 1000 um",
                                          f"'{unit}' (a glyph misread or misprinted): the plotted "
                                          f"values"], [f"glyph:appendix C.1 {name} unit factor"]))

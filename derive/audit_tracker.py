@@ -244,10 +244,13 @@ UNDECIDABLE_N = (
     "N is one product of six factors). For the print: a sign left out while typing. For the "
     "extraction: it damages operators in this document (Listing 3.1 reads 'if degree = 1:', "
     "a Python syntax error, where the copy of the same code in the appendix reads 'if degree "
-    "== 1:'). The specialization project prints the same determinant with its minus (eq. 34, "
-    "'N = (x_{xK} - x_{xQ})(y_{xP} - y_{xQ})(z_{xP} - z_{xK}) - (x_{xK} - x_{xP})...'): the "
-    "defect stands in one copy only, so the cross-copy rule does not decide it; missing to "
-    "decide: the page of the original PDF.")
+    "== 1:'). The specialization project prints the same formula for the X axis (x_x "
+    "symbols) with its minus (eq. 34, 'N = (x_{xK} - x_{xQ})(y_{xP} - y_{xQ})(z_{xP} - "
+    "z_{xK}) - (x_{xK} - x_{xP})...'), and the denominators of the thesis' appendix D.1 script "
+    "are the determinant up to its sign (see the D.1 verdict): the author computed with the "
+    "right N. Neither separates the print from the extraction -- the defect stands in this "
+    "copy only, so the cross-copy rule does not decide it; missing to decide: the page of the "
+    "original PDF.")
 
 
 def _verdict(eq, comp, ok, erratum, evidence, printed, derived,

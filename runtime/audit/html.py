@@ -78,8 +78,10 @@ def _row(e: dict) -> str:
              f"<td>{math_html(e.get('derived', ''))}</td>"]
     extra = []
     if e.get("alternative"):
-        extra.append(f"<p><b>alternative that reproduces the print:</b></p>"
-                     f"{math_html(e['alternative'])}")
+        exact = e.get("dropped") or e["category"] in ("convention", "simplification")
+        label = ("alternative that reproduces the print" if exact else
+                 "alternative reading (the evidence says what it reproduces or leaves)")
+        extra.append(f"<p><b>{label}:</b></p>{math_html(e['alternative'])}")
     if e.get("statement"):
         extra.append(f"<p><b>statement / convention:</b> {html.escape(e['statement'])}</p>")
     if e.get("dropped"):

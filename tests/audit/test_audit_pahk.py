@@ -489,9 +489,9 @@ def test_mb1_dx_rule_omission_pattern_across_layouts(verdicts):
     assert f"the identical 'dx(X) = {prints['FB1']}' is printed for FB1 eq. A3" in v.evidence
     for n in keep:
         assert f"{n} eq." in v.evidence.split("Across the layouts")[1]
-    assert ("The prints split by machine type: the arm, column layouts write the term, the "
-            "bridge layouts omit it") in v.evidence
-    assert "does not change the category" in v.evidence
+    assert ("Yo: the prints split by machine type (the arm and column layouts MH2, FH1, CY "
+            "write a Yo term in dx(X), the bridge layouts MB1, FB1 write none)") in v.evidence
+    assert "the category stays undecidable" in v.evidence
 
 
 def _omission_sentences(verdicts):
@@ -530,6 +530,56 @@ def test_cross_layout_omission_sentences_are_true_to_the_prints(verdicts):
             assert f"{off}*{err}({arg})" in prints[(n, key)], (v.layout, key, n)
 
 
+_LAYOUT_KIND = {"MB1": "bridge", "FB1": "bridge", "MH2": "arm", "FH1": "arm", "CY": "column"}
+
+
+def test_zero_offset_weighing_is_one_rule_consistent_with_the_prints(verdicts):
+    """Review 5 (#5, #15): every zero-offset undecidable verdict weighs each unprinted offset
+    by one rule, recomputed here from the printed data alone (regex, no sympy): which layouts
+    print a term with that offset in the same rule (a cut-off print excluded), whether they
+    split by machine type (the kinds from Pahk's layout names, written out here), and which
+    rules of the same equation write a term with that offset (``Yo*E..``; ``Ez(Yo)`` is an
+    argument).  A split, or an equation with no such term, must read as a set-up, never as
+    "points towards an omission"; the category stays undecidable."""
+    eqs = [x for x in DATA["equation"] if x["kind"] == "transfer"]
+    checked = 0
+    for v in verdicts:
+        zero = [r.split(":")[1] for r in v.readings_used if r.startswith("zero:")]
+        if v.category != "undecidable" or not zero:
+            continue
+        eq = next(x for x in eqs if x["id"] == v.equation)
+        key = v.component
+        assert v.evidence.count(" Weighing (the same rule") == 1, (v.layout, key)
+        for z in zero:
+            part = re.split(rf"(?:\): |; ){z}: ", v.evidence)[1]
+            part = re.split(r"; [XYZ]o: |\. The prints do not decide", part)[0]
+            used = [k for k, t in eq["expr"].items() if re.search(rf"\b{z}\*[Ed][xyz]", t)]
+            if used:
+                assert f"eq. {eq['id']} writes {z} terms in {', '.join(used)}" in part
+            else:
+                assert f"eq. {eq['id']} writes no {z} term in any rule" in part
+            other = [x for x in eqs if key in x["expr"] and key not in x.get("cut", {})]
+            present = {x["layout"] for x in other if re.search(rf"\b{z}\b", x["expr"][key])
+                       or (z == "Yo" and re.search(r"\bY\*E", x["expr"][key]))}
+            omit = {x["layout"] for x in other} - present
+            # only layouts whose derived rule has a term in z can omit it: dz(Z) etc. do for
+            # every layout here; the sentence's own omit list must be a subset of ours
+            split = bool(present) and len(omit) > 1 and not (
+                {_LAYOUT_KIND[n] for n in present} & {_LAYOUT_KIND[n] for n in omit})
+            assert ("the prints split by machine type" in part) == split, (v.layout, key, z)
+            if split or not used or not present:
+                assert "towards an omission" not in part, (v.layout, key, z)
+                assert "fits a set-up" in part
+            else:
+                assert "points towards an omission of the printed term here" in part
+            checked += 1
+        assert "the category stays undecidable" in v.evidence
+    assert checked >= 25
+    for eq_id, key in (("9", "dz(X)"), ("A6", "dz(Y)")):      # the review's two entries
+        ev = find(verdicts, eq_id, key).evidence
+        assert "towards an omission here" not in ev and "omission of the printed term" not in ev
+
+
 def test_fh1_dy_rule_names_mb1s_term_with_the_wrong_argument(verdicts):
     """Review 4 (#8): MB1 eq. 9 prints '- Xo*Ez(Z)' in dy(Y) (seed l. 174): the Xo yaw term is
     there with the argument Z, which MB1's own verdict finds a printing error.  The FH1 and CY
@@ -545,7 +595,8 @@ def test_fh1_dy_rule_names_mb1s_term_with_the_wrong_argument(verdicts):
                 f"('dy(Y) = {mb1}'; that layout's own verdict on dy(Y): {own})") in ev
         omitted = ev.split("it is omitted by ")[1].split(".")[0]
         assert "MB1" not in omitted and "FB1" not in omitted
-        assert "the bridge layouts write the term, the arm, column layouts omit it" in ev
+        assert ("the prints split by machine type (the bridge layouts MB1, FB1 write an Xo "
+                "term in dy(Y), the arm and column layouts") in ev
     alone = audit_pahk.audit(DATA, ["FH1"])
     assert next(v for v in alone if v.equation == "A6" and v.component == "dy(Y)").evidence \
         == find(verdicts, "A6", "dy(Y)").evidence
@@ -619,3 +670,50 @@ def test_omitted_terms_in_a_damaged_equation_name_the_extraction(verdicts):
     e9 = next(x for x in DATA["equation"] if x["id"] == "9")
     assert not e9.get("cut") and not e9.get("ocr")
     assert "A third explanation" not in find(verdicts, "9", "dz(Z)").evidence
+
+
+def test_undecidable_alternative_and_dropped_mean_what_formats_md_says(verdicts):
+    """Review 5 (schema): docs/formats.md describes 'alternative'/'dropped' for undecidable
+    verdicts too.  A zero-offset verdict's alternative reproduces the print once the offset is
+    0 in the derivation (recomputed with sympy here: derived with the offset set to 0 equals
+    the print, and dropped == derived - alternative); a verdict no reading reproduces names its
+    alternative as the closest reading and leaves dropped empty."""
+    import sympy as sp
+    from volerr.derive.audit_pahk_model import parse, printed_component
+    text = (resources.files("volerr") / "data" / "formats.md").read_text("utf-8")
+    assert "an `undecidable` verdict that rests on an unstated zero offset" in text
+    n_zero = n_close = 0
+    for v in verdicts:
+        if v.category != "undecidable" or not v.alternative:
+            continue
+        zero = [r.split(":")[1] for r in v.readings_used if r.startswith("zero:")]
+        if zero:
+            eq = next(x for x in DATA["equation"] if x["id"] == v.equation)
+            printed = printed_component(eq, v.component)[0]    # a lost glyph read as noted
+            derived, alt = parse(v.derived), parse(v.alternative)
+            assert sp.expand(derived - alt - parse(v.dropped)) == 0, (v.equation, v.component)
+            assert sp.expand(alt - printed) == 0, (v.equation, v.component)
+            at_zero = derived.subs({x: 0 for x in derived.free_symbols if str(x) in zero})
+            if v.readings_used == [f"zero:{z}" for z in zero]:     # the offset alone
+                assert sp.expand(at_zero - alt) == 0, (v.equation, v.component)
+            else:                     # with rule (1): the offset's terms are among the dropped
+                assert sp.expand(at_zero - alt) != sp.expand(derived - alt)
+            n_zero += 1
+        else:
+            assert v.dropped == "" and "closest" in v.evidence, (v.equation, v.component)
+            n_close += 1
+    assert n_zero >= 25 and n_close >= 1
+
+
+def test_a6_dy_x_is_the_lone_outlier_of_its_rule(verdicts):
+    """Review 5 (#2): every other layout prints dy(X) with one text (read from the data), A6
+    another; the verdict says so and stays undecidable; no other rule verdict claims it."""
+    prints = {x["id"]: x["expr"]["dy(X)"] for x in DATA["equation"]
+              if x["kind"] == "transfer" and "dy(X)" in x["expr"]}
+    others = {k: t for k, t in prints.items() if k != "A6"}
+    assert len(set(others.values())) == 1 and prints["A6"] not in others.values()
+    v = find(verdicts, "A6", "dy(X)")
+    assert v.category == "undecidable"
+    assert (f"All {len(others)} other layouts print 'dy(X) = {next(iter(others.values()))}'"
+            in v.evidence and "lone outlier" in v.evidence)
+    assert [w for w in verdicts if "lone outlier" in w.evidence] == [v]

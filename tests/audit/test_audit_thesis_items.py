@@ -106,6 +106,16 @@ def test_chain_factors_against_the_frame_definitions(htm):
     v16 = find(htm, "paper eq. 1.6", "matrix")
     assert "(T_5^w)^{-1}" in v16.evidence and any("inverse" in t and "explicitly" in t
                                                    for t in v16.readings_tried)
+    # review 5 (#13): each foreign label names the other, on its copied matrix (eq. 1.5 is
+    # eq. 1.1 with -d, checked above; eq. 1.6 is eq. 1.3 with B -> C, checked here), and
+    # eq. 1.6's sentence says it rests on eq. 1.5's own verdict
+    m13 = _printed_matrix(items["1.3"], b=c)
+    assert np.allclose(m13[:3, :3], m16[:3, :3])
+    l15, l16 = find(htm, "paper eq. 1.5", "label"), find(htm, "paper eq. 1.6", "label")
+    assert l16.category == "printing_error"
+    assert "eq. 1.5's T_0^{-1}, sits on a copied matrix too (eq. 1.1's with -d" in l16.evidence
+    assert f"eq. 1.5's own verdict ({l15.category})" in l16.evidence
+    assert "eq. 1.6's T_2^3, likewise sits on a copied matrix (eq. 1.3's" in l15.evidence
 
 
 def _factor_ok(name: str) -> bool:
@@ -228,6 +238,9 @@ def test_linear_chain_with_angular_errors_dropped_1_19(htm):
     for eq in ("paper eq. 1.19", "thesis eq. 3.40"):
         v = find(htm, eq)
         assert v.category == "simplification" and "neglected" in v.statement
+        # review 5 (#10): which travels are printed and which assumed; Listing 3.4's T_e
+        assert "X 500 mm is printed" in v.evidence and "assumed, not printed" in v.evidence
+        assert "identity rotation blocks" in v.evidence
 
 
 def test_project_report_relations(htm):
@@ -480,6 +493,48 @@ def test_appendix_c1_terms_are_cramers_rule():
     assert "degree 7" in ev and "has degree 3 in the lengths" in ev
     assert "line 97-99" in ev and "the debris 'N' dropped" in ev
 
+
+
+def test_appendix_c1_e_yx_lists_every_repair_and_cites_the_thesis_results():
+    """Review 5 (#3, #14): the two E_YX repairs whose printed form is valid Python are listed
+    and justified: line 94's '/(x_actPt - x_xP)) + ...' (divided by that span the first summand
+    has degree 3 in the lengths, over N degree 1 -- recomputed here) and line 99's '//' (floor
+    division of a sub-mm ratio is 0 or -1, computed here on a typical set-up).  The '+ 1e3'
+    verdict cites the '+' for '*' of the same function, which the data's line 97 repair holds,
+    and the thesis' own results."""
+    d = data("printed_scripts.toml")["c1"]
+    vs = audit_scripts.audit(data("printed_scripts.toml"))
+    sym = {f"{c}_x{p}": sp.Symbol(f"{c}{p}") for c in "xyz" for p in "PQK"}
+    dev = sp.Symbol("dev")                               # a deviation: a length
+    arms = list(sym.values()) + [dev]
+    t94 = next(t for t in d["term"] if t["formula"] == "E_YX" and t["line"] == "94")
+    cof = sp.sympify(t94["cofactor"], locals=sym)
+    N = sp.sympify(d["N"], locals=sym)
+    span = sym["x_xP"] + dev                             # (x_actPt - x_xP): a length
+    deg = lambda e: sp.Poly(sp.numer(sp.together(e)), *arms).total_degree() - \
+        sp.Poly(sp.denom(sp.together(e)), *arms).total_degree()   # noqa: E731
+    assert deg(cof * dev / span) == 3 and deg(cof * dev / N) == 1
+    rep94 = " ".join(t94["repairs"])
+    assert "degree 3" in rep94 and "degree 1" in rep94 and "repeated span" in rep94
+    t99 = next(t for t in d["term"] if t["formula"] == "E_YX" and t["line"] == "97-99")
+    rep99 = " ".join(t99["repairs"])
+    assert "y_o)//' of line 99 read as '/" + "\\" + "'" in rep99 and "'+' for '*'" in rep99
+    # floor division on a typical set-up (arms ~100 mm, deviations of a few um): 0 or -1
+    rng = np.random.default_rng(7)
+    pt = {v: float(rng.uniform(-150, 150)) for v in sym.values()}
+    c99 = float(sp.sympify(t99["cofactor"], locals=sym).subs(pt))
+    n = float(N.subs(pt))
+    for e in (-6.6e-3, 6.6e-3):
+        assert (c99 * e) // n in (0.0, -1.0) and abs(c99 * e / n) < 1
+    ev = find(vs, "appendix C.1 E_YX", "formula").evidence
+    assert "line 94: " in ev and "N starts on the next line" in ev and "y_o)//'" in ev
+    assert "their legible starts read as N's first monomials" not in ev
+    v = find(vs, "appendix C.1 E_YX", "unit factor")
+    assert v.category == "undecidable"
+    for cite in ("line 97", "'(x_xK_{y_xK} + z_xP - N)'", "sec. 4.1.1", "sec. 4.2.1",
+                 "6.6 um", "Figure 3.11"):
+        assert cite in v.evidence, cite
+    assert "'(x_xK_{y_xK} + z_xP - N)' read as 'x_xK*y_xK*z_xP -'" in rep99
 
 def test_appendix_d1_solves_with_the_arms_of_theta_zero():
     vs = audit_scripts.audit(data("printed_scripts.toml"))

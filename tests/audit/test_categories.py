@@ -223,7 +223,21 @@ def test_printing_error_rotary_axis_model_sec_2_5():
     assert "Candidate repetition" in m.evidence
     # the bottom row 0 0 0 1 under the left-hand side 0 stays decided (a digit, two documents)
     assert [str(x) for x in em[3]] == ["0", "0", "0", "1"]
-    assert find(vs, "eq. 2.42", "error matrix row 4").category == "printing_error"
+    row4 = find(vs, "eq. 2.42", "error matrix row 4")
+    assert row4.category == "printing_error"
+    # review 5 (#6): paper eq. 1.17 has no left-hand side, but its diagonal is a deviation
+    # matrix's (read from the data: (3,3) 0, no cos B term at (1,1)), so 0 0 0 1 is a defect
+    # there too; the evidence says so and names the author's [Delta; 0] habit of ch. 2
+    htm = tomllib.loads((resources.files("volerr") / "data" / "printed_htm.toml")
+                        .read_text(encoding="utf-8"))
+    p117 = next(a for a in htm["axis"] if a["id"] == "1.17")["rows"]
+    B = sp.Symbol("B")
+    diag = [sp.sympify(p117[i][i]) for i in range(3)]
+    assert diag[2] == 0 and all(d.subs({n: 0 for n in d.free_symbols - {B}}) == 0
+                                for d in diag)              # no 1, no bare c_B on it
+    assert p117[3] == ["0", "0", "0", "1"]
+    assert "its diagonal is a deviation matrix's ((1,1) -E_CB s_B, (3,3) 0" in row4.evidence
+    assert "the author's habit" in row4.evidence
     tcc = find(vs, "eq. 2.42", "T_CC")
     printed_tcc = np.array([[math.cos(c), -math.sin(c)], [math.sin(c), -math.cos(c)]])
     assert np.linalg.det(printed_tcc) == pytest.approx(-math.cos(2 * c))

@@ -199,3 +199,35 @@ def test_listing_repetition_states_its_assumption(verdicts, printed):
         ev = verdicts[f"Listing 3.3 T_er {name}"].evidence
         assert "as plain code" in ev and "as LaTeX" in ev
         assert "recurs at the same place;" not in ev and "is an assumption" in ev
+
+
+def test_listing_3_3_leading_minus_names_the_deliberate_reading(printed, verdicts):
+    """Review 5 (#4): T_er ends in T_r (the printed order of line 128, read from the data), so
+    a literal minus in line 46 negates T_er p too and the third print T_r p - T_er p turns
+    into actual - ideal, sec. 3.5's deviation.  Checked here with random rigid HTMs (numpy,
+    independent of the audit): P the product, E the error factors; the verdict names that
+    third reading, the caption against it, and stays undecidable."""
+    order = printed["listing"]["T_er"]
+    assert order[-1] == "T_r" and "T_r" not in order[:-1]
+    rng = np.random.default_rng(46)
+
+    def htm(scale):
+        a = rng.normal(size=3) * scale
+        k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+        w, v = np.linalg.eig(k)                               # exp(k) via eigenvectors
+        r = (v @ np.diag(np.exp(w)) @ np.linalg.inv(v)).real
+        t = np.eye(4)
+        t[:3, :3], t[:3, 3] = r, rng.normal(size=3) * 100 * scale
+        return t
+    P, E = htm(1.0), htm(1e-4)
+    p = np.array([179.009, 94.545, 143.533, 1])
+    for sign, want in ((-1, E @ P @ p - P @ p), (1, P @ p - E @ P @ p)):
+        T_r = sign * P
+        T_er = E @ T_r                                        # T_er = errors @ T_r
+        assert np.allclose(T_r @ p - T_er @ p, want)
+    v = verdicts["Listing 3.3 line 46 (T_r)"]
+    assert v.category == "undecidable"
+    assert "A third reading the text does not exclude: a deliberate minus" in v.evidence
+    assert "the difference between the actual and the ideal position" in v.evidence
+    assert "Figure 3.10 caption" in v.evidence
+    assert len(v.readings_tried) == 3

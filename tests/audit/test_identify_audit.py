@@ -186,3 +186,16 @@ def test_rhs_order_rule_follows_the_column_not_the_equation():
     e36["rhs"] = ["d_yK", "d_xP", "d_yP", "d_xQ", "d_zQ", "d_zK"]
     v = _rhs_verdict(e36)
     assert v.category == "undecidable" and "no whole block" in v.evidence
+
+
+def test_lost_minus_of_n_cites_the_x_axis_formula_and_d1(verdicts):
+    """Review 5 (#12): project eq. 34 is the same formula for the X axis (x_x symbols), not a
+    copy of eq. 3.8; the appendix D.1 denominators (+-N, their own verdict) show the author
+    computed with the right N, which does not decide print against extraction."""
+    hits = [v for v in verdicts.values() if "The specialization project prints" in v.evidence]
+    assert hits
+    for v in hits:
+        assert v.category == "undecidable"
+        assert "the same formula for the X axis (x_x symbols)" in v.evidence
+        assert "the same determinant" not in v.evidence
+        assert "appendix D.1" in v.evidence and "Neither separates" in v.evidence
