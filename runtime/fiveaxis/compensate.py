@@ -294,30 +294,15 @@ class ErrorModel:
         """Error functions at ``q`` (the last three evaluations are remembered: the position and
         the orientation error of the same positions share one table look-up, and the
         prediction after a solve of two iterations finds the programmed positions still
-        there).  ``direction``
-        (N, n_axes) -1 / 0 / +1: the approach direction of every axis, for tables with a
-        reversal column (:meth:`volerr.tables.functions.ErrorFunctions.reversal`)."""
+        there).  ``direction`` (N, n_axes) -1 / 0 / +1: the approach direction of every axis,
+        for tables with a reversal column
+        (:meth:`volerr.tables.functions.ErrorFunctions.reversal`)."""
         if self.funcs is None:
             return {}
         if direction is not None and not self.funcs.has_reversal:
             direction = None
-        memo = self.__dict__.setdefault("_memo", [])
-        for qm, dm, e in memo:
-            if qm.shape == q.shape and np.array_equal(qm, q) and \
-                    (dm is None) == (direction is None) and \
-                    (dm is None or np.array_equal(dm, direction)):
-                break
-        else:
-            ql = self._clip_edges(self.lookup(q))
-            e = self.funcs(ql)
-            # constants as scalars: the generated code then takes their sin/cos once
-            e.update({k: float(v) for k, v in self.funcs.constants.items()})
-            if direction is not None:
-                for k, v in self.funcs.reversal(ql, direction).items():
-                    e[k] = e[k] + v if k in e else v
-            memo.insert(0, (np.array(q, dtype=float, copy=True),
-                            None if direction is None else np.array(direction), e))
-            del memo[3:]
+        e = _recall(self.__dict__.setdefault("_memo", []), (q, direction),
+                    lambda: self._evaluate_tables(q, direction))
         if subset is not None:
             e = {k: v for k, v in e.items() if k in subset}
         return e
@@ -326,14 +311,19 @@ class ErrorModel:
         """``q`` validated with the sines and cosines of its rotary axes
         (:meth:`volerr.machine.model.Model.prepared`), shared by the evaluations at the same
         positions (the last three are remembered, as in :meth:`errors`)."""
-        memo = self.__dict__.setdefault("_prepared", [])
-        for qm, p in memo:
-            if qm.shape == q.shape and np.array_equal(qm, q):
-                return p
-        p = self.model.prepared(q)
-        memo.insert(0, (np.array(q, dtype=float, copy=True), p))
-        del memo[3:]
-        return p
+        return _recall(self.__dict__.setdefault("_prepared", []), (q,),
+                       lambda: self.model.prepared(q))
+
+    def _evaluate_tables(self, q: np.ndarray, direction) -> dict:
+        """The error functions at ``q`` (see :meth:`errors`), not remembered."""
+        ql = self._clip_edges(self.lookup(q))
+        e = self.funcs(ql)
+        # constants as scalars: the generated code then takes their sin/cos once
+        e.update({k: float(v) for k, v in self.funcs.constants.items()})
+        if direction is not None:
+            for k, v in self.funcs.reversal(ql, direction).items():
+                e[k] = e[k] + v if k in e else v
+        return e
 
     def nominal_position(self, q) -> np.ndarray:
         """Nominal tool tip with the tool offset, (N, 3) mm."""
@@ -354,6 +344,26 @@ class ErrorModel:
     def tool_axis(self, q) -> np.ndarray:
         """Nominal unit tool axis, (N, 3) (it does not depend on the tool offset)."""
         return self.model.tool_axis(self.prepared(q))
+
+
+def _same(a, b) -> bool:
+    """Both None, or arrays of one shape with equal values."""
+    if a is None or b is None:
+        return a is b
+    return np.shape(a) == np.shape(b) and np.array_equal(a, b)
+
+
+def _recall(memo: list, keys: tuple, compute):
+    """``compute()``, or its value remembered in ``memo`` from one of the last three calls
+    with equal array ``keys`` (None allowed); the keys are kept as copies, so a caller may
+    change its arrays afterwards."""
+    for kept, value in memo:
+        if all(_same(a, b) for a, b in zip(kept, keys)):
+            return value
+    value = compute()
+    memo.insert(0, (tuple(None if k is None else np.array(k, copy=True) for k in keys), value))
+    del memo[3:]
+    return value
 
 
 #: a tool-axis direction that the rotary axes turn by less than this (rad per rad) is left
