@@ -46,10 +46,9 @@ def split_spec(spec: str) -> tuple[str | None, str]:
 
 def detect(path) -> str:
     """The instrument kind of a file, from its header (InputError when it cannot tell)."""
-    from ._csv import read_columns
+    from ._csv import read_header
 
-    c = read_columns(path)
-    names = list(c.numbers) + list(c.text)
+    names = read_header(path)       # the columns alone: the instrument reads the file once
     hits = [k for k, m in kinds().items() if k != FALLBACK and hasattr(m, "detect")
             and m.detect(names)]
     require(len(hits) <= 1, f"{Path(path).name}: columns of several instruments "

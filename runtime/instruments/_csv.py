@@ -37,18 +37,32 @@ class Columns:
         return 0
 
 
-def read_columns(path) -> Columns:
-    """Read a CSV file into :class:`Columns` (InputError, one line, on a defect)."""
+def _rows(path, header_only: bool = False) -> list:
+    """The rows of a CSV file that are neither blank nor ``#`` comments (only the first with
+    ``header_only``); InputError (one line) for a missing or unreadable file."""
     p = Path(path)
     require(p.is_file(), f"data file not found: {path}")
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
             delim = sniff_delimiter(fh.read(65536))
             fh.seek(0)
-            rows = [r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)
-                    and not r[0].lstrip().startswith("#")]
+            rows = (r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)
+                    and not r[0].lstrip().startswith("#"))
+            return [next(rows, [])] if header_only else list(rows)
     except (UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{p.name}: not a readable CSV ({exc})") from None
+
+
+def read_header(path) -> list:
+    """The column names of a CSV file (its first row that is neither blank nor a comment),
+    without reading the rest: enough to tell an instrument's file by its columns."""
+    return [h.strip() for h in _rows(path, header_only=True)[0]]
+
+
+def read_columns(path) -> Columns:
+    """Read a CSV file into :class:`Columns` (InputError, one line, on a defect)."""
+    p = Path(path)
+    rows = _rows(path)
     require(len(rows) >= 2, f"{p.name}: no data rows")
     header = [h.strip() for h in rows[0]]
     require(len(set(header)) == len(header), f"{p.name}: duplicate column names")
