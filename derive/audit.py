@@ -343,10 +343,10 @@ def classify(v: Verdict, category: str, **fields) -> Verdict:
     return v
 
 
-def worst_case_um(expr, bounds: dict) -> float:
+def worst_case_um(expr, bounds: dict, unnamed: float = 1.0) -> float:
     """Worst-case |expr| in um for a polynomial whose every term is a product of bounded
     symbols: sum over terms of |coefficient| * product of the bounds (``bounds``: symbol name
-    -> bound, mm or rad; symbols not named count 1)."""
+    -> bound, mm or rad; symbols not named count ``unnamed``)."""
     total = 0.0
     for t in sp.Add.make_args(sp.expand(expr)):
         if t == 0:
@@ -354,7 +354,7 @@ def worst_case_um(expr, bounds: dict) -> float:
         c, m = t.as_coeff_Mul()
         val = abs(float(c))
         for f, e in m.as_powers_dict().items():
-            val *= float(bounds.get(str(f), 1.0)) ** int(e)
+            val *= float(bounds.get(str(f), unnamed)) ** int(e)
         total += val
     return total * 1e3
 

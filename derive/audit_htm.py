@@ -32,7 +32,7 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from .audit import Verdict, category_of, fmt
+from .audit import Verdict, category_of, fmt, worst_case_um
 from .audit_dmu50 import (T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward,
                           forward_note, forward_tried, t23_forward)
 from .kinematics import Chain, position_symbol, rotation, stage_factors, translation
@@ -566,7 +566,7 @@ def _actual_linear(item: dict, by_id: dict) -> Verdict:
     only_angular = all(all(any(s in ang for s in t.free_symbols) for t in
                            sp.Add.make_args(d) if t != 0) for d in dropped)
     bounds = {"X": 500.0, "Y": 450.0, "Z": 400.0, "xt": 100.0, "yt": 100.0, "zt": 200.0}
-    size = max(_worst_um(d, bounds) for d in dropped)
+    size = max(worst_case_um(d, bounds, unnamed=10e-6) for d in dropped)   # angles 10 urad
     used = ["stated:" + item["statement"], "flip:thesis E_C(0X)Y (slope convention, eq. "
             "3.11/3.13)", "flip:thesis E_A(0Y)Z (slope convention, eq. 3.11/3.13)"]
     return _v(item, "", category_of(used) if only_angular else "printing_error",
@@ -591,19 +591,6 @@ def _actual_linear(item: dict, by_id: dict) -> Verdict:
                "angular errors set to zero (stated) with the thesis' squareness signs: exact"],
               used, statement=item["statement"], alternative=fmt(pr), dropped=fmt(dropped),
               dropped_um=size)
-
-
-def _worst_um(expr, bounds) -> float:
-    total = 0.0
-    for t in sp.Add.make_args(sp.expand(expr)):
-        if t == 0:
-            continue
-        c, m = t.as_coeff_Mul()
-        val = abs(float(c))
-        for fct, e in m.as_powers_dict().items():
-            val *= float(bounds.get(str(fct), 10e-6)) ** int(e)
-        total += val
-    return total * 1e3
 
 
 # ------------------------------------------------------------------------------- entry
