@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections import Counter
 
-#: verdict categories in report order (the same tuple as volerr.derive.audit.CATEGORIES)
+#: verdict categories in report order (the same tuple as
+#: volerr.derive.audit.framework.CATEGORIES)
 CATEGORIES = ("identical", "printing_error", "extraction", "convention", "simplification",
               "undecidable")
 

@@ -1,9 +1,9 @@
 """Numeric spot check of a generated model against the printed equations of its layout.
 
-No sympy: the printed expressions of ``volerr/data/printed_pahk.toml`` (their OCR reading where
-the data file gives one) are evaluated with numpy at random points, with random error values,
-and compared with the generated model (first-order volumetric error; random error by Pahk's
-term-wise quadrature and by exact propagation).  A difference at rounding level (~1e-12 um)
+No sympy: the printed expressions of ``volerr/derive/audit/data/printed_pahk.toml`` (their OCR
+reading where the data file gives one) are evaluated with numpy at random points, with random
+error values, and compared with the generated model (first-order volumetric error; random
+error by Pahk's term-wise quadrature and by exact propagation).  A difference at rounding level (~1e-12 um)
 means the generated code reproduces the printed equation; anything larger is a real
 difference, which ``volerr audit`` names and explains.
 
@@ -32,7 +32,7 @@ _SCALAR = {"a": "alpha", "Ra": "Ralpha"}
 def printed_equations(layout: str, data: dict | None = None) -> list[dict]:
     """The printed volumetric and random-error equations of ``layout`` (data file order)."""
     if data is None:
-        data = tomllib.loads((resources.files("volerr") / "data" / DATA_FILE)
+        data = tomllib.loads((resources.files("volerr.derive.audit") / "data" / DATA_FILE)
                              .read_text(encoding="utf-8"))
     return [e for e in data.get("equation", [])
             if e.get("layout") == layout and e.get("kind") in ("volumetric", "random")]

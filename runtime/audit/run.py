@@ -37,8 +37,9 @@ class Row:
 
 
 def data_file(name: str) -> dict:
-    """The printed material of a provider, ``volerr/data/<name>`` (TOML), as a dict."""
-    path = resources.files("volerr") / "data" / name
+    """The printed material of a provider, ``volerr/derive/audit/data/<name>`` (TOML), as a
+    dict (the audit room's data folder: importing its package does not import sympy)."""
+    path = resources.files("volerr.derive.audit") / "data" / name
     try:
         return tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -49,7 +50,7 @@ def data_file(name: str) -> dict:
 
 def data_paths(mods) -> list[str]:
     """Paths of the data files read by the provider modules ``mods`` (inputs of the run)."""
-    return [str(resources.files("volerr") / "data" / m.DATA_FILE) for m in mods
+    return [str(resources.files("volerr.derive.audit") / "data" / m.DATA_FILE) for m in mods
             if getattr(m, "DATA_FILE", None)]
 
 

@@ -96,8 +96,9 @@ _FINGERPRINT = None
 
 
 def generator_fingerprint() -> str:
-    """sha256 of the generator's source files (``volerr.derive``: *.py and templates) and the
-    sympy version, without importing either."""
+    """sha256 of the generator's source files (``volerr.derive``: *.py and templates, not the
+    audit of printed equations in ``audit/``, which shapes no generated code) and the sympy
+    version, without importing either."""
     global _FINGERPRINT
     if _FINGERPRINT is None:
         import importlib.util
@@ -108,7 +109,8 @@ def generator_fingerprint() -> str:
         for folder in spec.submodule_search_locations or ():
             root = Path(folder)
             for f in sorted(p for p in root.rglob("*") if p.is_file()
-                            and p.suffix not in (".pyc",) and "__pycache__" not in p.parts):
+                            and p.suffix not in (".pyc",) and "__pycache__" not in p.parts
+                            and p.relative_to(root).parts[0] != "audit"):
                 h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
         try:
             h.update(metadata.version("sympy").encode())

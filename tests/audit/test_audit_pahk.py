@@ -26,9 +26,9 @@ from helpers.audit_rule import KIND, expected
 #: the module's verdicts are computed once, in one worker
 pytestmark = pytest.mark.xdist_group("audit_pahk")
 
-audit_pahk = pytest.importorskip("volerr.derive.audit_pahk")
+audit_pahk = pytest.importorskip("volerr.derive.audit.pahk")
 
-DATA = tomllib.loads((resources.files("volerr") / "data" / "printed_pahk.toml")
+DATA = tomllib.loads((resources.files("volerr.derive.audit") / "data" / "printed_pahk.toml")
                      .read_text(encoding="utf-8"))
 
 
@@ -360,7 +360,7 @@ def test_cli_numeric():
 def test_cli_bad_input(tmp_path):
     assert_clean_failure(run("NOPE"), "unknown layout")
     assert_clean_failure(run("MB1", "--points", "0"), "points")
-    data = resources.files("volerr") / "data" / "printed_pahk.toml"
+    data = resources.files("volerr.derive.audit") / "data" / "printed_pahk.toml"
     before = Path(str(data)).read_bytes()
     assert_clean_failure(run("MB1", "--json", str(data)), "refusing to overwrite")
     assert Path(str(data)).read_bytes() == before
@@ -679,7 +679,7 @@ def test_undecidable_alternative_and_dropped_mean_what_formats_md_says(verdicts)
     the print, and dropped == derived - alternative); a verdict no reading reproduces names its
     alternative as the closest reading and leaves dropped empty."""
     import sympy as sp
-    from volerr.derive.audit_pahk_model import parse, printed_component
+    from volerr.derive.audit.pahk_model import parse, printed_component
     text = (resources.files("volerr") / "data" / "formats.md").read_text("utf-8")
     assert "an `undecidable` verdict that rests on an unstated zero offset" in text
     n_zero = n_close = 0

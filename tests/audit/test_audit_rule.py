@@ -1,4 +1,4 @@
-"""The category rule of the audit (derive.audit.PRIORITY_RULE): every combination of readings is
+"""The category rule of the audit (derive.audit.framework.PRIORITY_RULE): every combination of readings is
 tried and the category follows fixed priorities; one reading key has one category on every
 layout and in every document; every verdict lists its readings.  The expected categories are
 derived here from the rule's definition (not through the audit's own search)."""
@@ -10,7 +10,7 @@ from importlib import resources
 
 import pytest
 
-from volerr.derive import audit as A
+from volerr.derive.audit import framework as A
 
 from helpers.audit_rule import KIND, expected
 

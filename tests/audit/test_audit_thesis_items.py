@@ -16,12 +16,13 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from volerr.derive import (audit_ch2, audit_htm, audit_metrology, audit_results,
-                           audit_scripts, audit_squareness, audit_listings)
+from volerr.derive.audit import ch2 as audit_ch2, htm as audit_htm, listings as audit_listings
+from volerr.derive.audit import metrology as audit_metrology, results as audit_results
+from volerr.derive.audit import scripts as audit_scripts, squareness as audit_squareness
 
 
 def data(name):
-    return tomllib.loads((resources.files("volerr") / "data" / name).read_text("utf-8"))
+    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name).read_text("utf-8"))
 
 
 def find(vs, eq, comp=None):

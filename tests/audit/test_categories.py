@@ -16,12 +16,13 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from volerr.derive import audit_listings, audit_numbers, audit_pahk, audit_probe, audit_rotary
-from volerr.derive import audit_tracker
+from volerr.derive.audit import listings as audit_listings, numbers as audit_numbers
+from volerr.derive.audit import pahk as audit_pahk, probe as audit_probe, rotary as audit_rotary
+from volerr.derive.audit import tracker as audit_tracker
 
 
 def data(name):
-    return tomllib.loads((resources.files("volerr") / "data" / name).read_text("utf-8"))
+    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name).read_text("utf-8"))
 
 
 def find(verdicts, eq, comp=""):
@@ -228,7 +229,7 @@ def test_printing_error_rotary_axis_model_sec_2_5():
     # review 5 (#6): paper eq. 1.17 has no left-hand side, but its diagonal is a deviation
     # matrix's (read from the data: (3,3) 0, no cos B term at (1,1)), so 0 0 0 1 is a defect
     # there too; the evidence says so and names the author's [Delta; 0] habit of ch. 2
-    htm = tomllib.loads((resources.files("volerr") / "data" / "printed_htm.toml")
+    htm = tomllib.loads((resources.files("volerr.derive.audit") / "data" / "printed_htm.toml")
                         .read_text(encoding="utf-8"))
     p117 = next(a for a in htm["axis"] if a["id"] == "1.17")["rows"]
     B = sp.Symbol("B")

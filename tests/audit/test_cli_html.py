@@ -30,7 +30,7 @@ def test_html_equal_to_json_refused_before_computing(tmp_path):
 
 
 def test_html_onto_an_input_refused(tmp_path):
-    data = resources.files("volerr") / "data" / "printed_pahk.toml"
+    data = resources.files("volerr.derive.audit") / "data" / "printed_pahk.toml"
     before = data.read_bytes()
     r = run("MB1", "--html", str(data))
     assert r.returncode == 2 and "input" in r.stderr

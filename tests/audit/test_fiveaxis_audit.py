@@ -7,7 +7,7 @@ from importlib import resources
 import numpy as np
 import pytest
 
-from volerr.derive import audit_dmu50
+from volerr.derive.audit import dmu50 as audit_dmu50
 
 #: the module's verdicts are computed once, in one worker
 pytestmark = pytest.mark.xdist_group("audit_fiveaxis")
@@ -15,7 +15,7 @@ pytestmark = pytest.mark.xdist_group("audit_fiveaxis")
 
 @pytest.fixture(scope="module")
 def printed():
-    with (resources.files("volerr") / "data" / audit_dmu50.DATA_FILE).open("rb") as fh:
+    with (resources.files("volerr.derive.audit") / "data" / audit_dmu50.DATA_FILE).open("rb") as fh:
         return tomllib.load(fh)
 
 

@@ -8,14 +8,15 @@ from importlib import resources
 import numpy as np
 import pytest
 
-from volerr.derive import audit_tracker, three_point
+from volerr.derive import three_point
+from volerr.derive.audit import tracker as audit_tracker
 
 #: the module's verdicts are computed once, in one worker
 pytestmark = pytest.mark.xdist_group("audit_tracker")
 
 
 def _printed():
-    return tomllib.loads((resources.files("volerr") / "data" / "printed_tracker.toml")
+    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / "printed_tracker.toml")
                          .read_text(encoding="utf-8"))
 
 

@@ -13,9 +13,9 @@ from volerr.probe import calibration as probe
 
 @pytest.fixture(scope="module")
 def verdicts():
-    from volerr.derive import audit_probe
+    from volerr.derive.audit import probe as audit_probe
 
-    text = (resources.files("volerr") / "data" / audit_probe.DATA_FILE).read_text()
+    text = (resources.files("volerr.derive.audit") / "data" / audit_probe.DATA_FILE).read_text()
     return {(v.equation, v.component): v for v in audit_probe.audit(tomllib.loads(text))}
 
 
@@ -47,7 +47,7 @@ def test_erratum_evidence_numerically():
 def test_provider_registered():
     from volerr.derive import audit
 
-    assert "volerr.derive.audit_probe" in audit.PROVIDERS
+    assert "volerr.derive.audit.probe" in audit.PROVIDERS
 
 
 def test_atan2_reading_supported_by_the_full_azimuth_calibration(verdicts):

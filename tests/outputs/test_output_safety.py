@@ -125,7 +125,7 @@ def test_read_only_demo_folder_is_refused_before_any_work(tmp_path, capsys):
 @pytest.mark.parametrize("argv", [
     ["audit", "MB1", "--json", PACKAGE / "layouts" / "MB1.toml"],
     ["map", "MB1", "--errors", "{errors}", "--out", PACKAGE / "layouts" / "MB1.toml"],
-    ["map", "MB1", "--errors", "{errors}", "--json", PACKAGE / "data" / "printed_pahk.toml"],
+    ["map", "MB1", "--errors", "{errors}", "--json", PACKAGE / "data" / "formats.md"],
     ["map", "MB1", "--errors", "{errors}", "--out", "{errors}/X.csv"],
     ["identify", "MB1", "--axis", "X", "{tracker_copy}", "--out", "{tracker_copy}"],
     ["squareness", "MB1", "{errors}", "--out", "{errors}"],

@@ -3,7 +3,7 @@ Listing 3.1, their sum in Listing 3.2 (against the difference of eq. 2.39) and t
 Listing 3.4 (``Y * S_YX``, ``(-Z) * S_ZX``, ``(-Z) * S_ZY`` against the ``+y E_C(0X)Y``,
 ``+z E_B(0X)Z``, ``+z E_A(0Y)Z`` of eq. 3.17-3.18); numpy only, no file I/O.
 
-The printed code (``volerr/data/printed_squareness.toml``) is RUN on straightness data of
+The printed code (``volerr/derive/audit/data/printed_squareness.toml``) is RUN on straightness data of
 known slopes.  With E_ij = k_ij q_j (the deviation along i while axis j moves, slope k_ij):
 
 * eq. 2.39 (ISO 230-1): the squareness is the difference of the two lines' inclinations
@@ -18,7 +18,7 @@ the result depends on the direction each axis travels.  The text fixes only X (0
 appendix C.1 ``x = np.linspace(0, 500, 11)``); the audit tries both directions of Y and Z.
 A Listing 3.4 entry ``E_<i><q> + (+-q) * S`` is judged as a whole under each: its squareness
 term, and its lookup ``cf(...)[3][round(pos_q)]``, which reads the mirrored position when q
-travels negative (negative index, see :mod:`derive.audit_listings`).  An entry right for some
+travels negative (negative index, see :mod:`volerr.derive.audit.listings`).  An entry right for some
 directions only is ``undecidable`` (the direction is an unstated set-up fact, not a
 convention); an entry wrong for every direction is ``printing_error``.
 """
@@ -29,7 +29,7 @@ import itertools
 
 import numpy as np
 
-from .audit import Verdict
+from .framework import Verdict
 
 DATA_FILE = "printed_squareness.toml"
 LAYOUTS = ("DMU50",)

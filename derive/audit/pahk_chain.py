@@ -4,7 +4,7 @@ translation vectors (eq. 3 and the appendix; sympy, no file I/O).
 A printed chain ``lhs = rhs`` (Tx Ty Tz the small-angle rotations of eq. 2, Lx Ly Lz the
 vectors, P the probe offset, A the actual point) is evaluated literally to first order
 (:func:`chain_error`) and compared with the layout's derived model under every reading of
-:mod:`volerr.derive.audit_pahk_model`.  Its category follows the readings that reproduce it:
+:mod:`volerr.derive.audit.pahk_model`.  Its category follows the readings that reproduce it:
 the literal chain is the layout under a combination of conventions (convention), under the
 stacking the layout's result equation needs (or else the chain contradicts it: printing
 error), or under no reading (printing error; the relabelled chain that would give the model is
@@ -20,12 +20,12 @@ from functools import lru_cache
 
 import sympy as sp
 
-from .audit import (TYPICAL, Verdict, best_combination, category_of, classify,
+from .framework import (TYPICAL, Verdict, best_combination, category_of, classify,
                     describe_diff, fmt, is_identical, n_diff, typical_text, worst_case_um)
-from .audit_pahk_model import (COMPONENTS, POS, derived_error, error_symbols, layout,
+from .pahk_model import (COMPONENTS, POS, derived_error, error_symbols, layout,
                                parse, printed_component, readings)
-from .audit_pahk_rules import CONVENTION_TABLE, _bounds
-from .kinematics import PROBE
+from .pahk_rules import CONVENTION_TABLE, _bounds
+from ..kinematics import PROBE
 
 SOURCE = "Pahk 1995"
 
@@ -317,7 +317,7 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
         keys, r = best_lit
         cat = category_of(keys)
         if r.stacking(lay) != want and cat != "printing_error":
-            from .audit_pahk_model import stacking_text
+            from .pahk_model import stacking_text
             v.evidence += (f" The chain stacks the axes {stacking_text(*r.stacking(lay))}, a "
                            f"geometry the text allows, but the same layout's result equation "
                            f"{result_eq['id'] if result_eq else ''} needs "
@@ -356,7 +356,7 @@ def _convention(v: Verdict, r, lay, literal, physical, keys, geoms=()) -> Verdic
     if r.pivot == "table_origin":
         names.append(CONVENTION_TABLE)
     if r.tool is not None or r.work is not None:
-        from .audit_pahk_model import geometry_text, stacking_text
+        from .pahk_model import geometry_text, stacking_text
         names.append(f"axes stacked {stacking_text(*r.stacking(lay))} (a geometry the text "
                      f"allows; the text: {geometry_text(geoms, r.stacking(lay))})")
     for f in r.flips:

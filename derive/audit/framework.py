@@ -1,13 +1,5 @@
-"""Audit framework: printed equations of a source document against the derivation.
-
-A *provider* module audits one source document.  It has
-
-* ``DATA_FILE``: the name of its data file in ``volerr/data/`` (the printed equations, kept
-  exactly as printed), or ``None``;
-* ``audit(printed: dict, layouts: list[str] | None) -> list[Verdict]``: ``printed`` is the
-  parsed data file (the command reads it; providers do no file I/O), ``layouts`` restricts the
-  audit to those layouts (``None``: all);
-* optionally ``LAYOUTS``: the layout names it covers (for validating command-line names).
+"""Audit framework: the verdict of a printed equation against the derivation, and the rule
+that gives it a category (the provider protocol: :mod:`volerr.derive.audit`).
 
 The derivation from the physical layout is the authority.  Every printed equation (or each
 component of it: ``dX``, ``RY2``, the rule of ``dx(X)`` ...) gets a :class:`Verdict`:
@@ -40,26 +32,15 @@ verdict lists the readings tried (``readings_tried``) and the keys of the readin
 (``readings_used``); a reading key has one kind (:data:`READING_KINDS`), hence one category,
 on every layout and in every document (:func:`category_of`).
 
-This module holds the shared pieces: :class:`Verdict`, the provider registry and the
+This module holds the shared pieces: :class:`Verdict`, the category rule and the
 term-by-term comparison of two polynomials (:func:`term_diff`, :func:`describe_diff`).
 """
 
 from __future__ import annotations
 
-import importlib
 from dataclasses import asdict, dataclass, field
 
 import sympy as sp
-
-#: provider modules, imported when present
-PROVIDERS = ("volerr.derive.audit_pahk", "volerr.derive.audit_tracker",
-             "volerr.derive.audit_dmu50", "volerr.derive.audit_rotary",
-             "volerr.derive.audit_htm", "volerr.derive.audit_ch2",
-             "volerr.derive.audit_metrology", "volerr.derive.audit_listings",
-             "volerr.derive.audit_squareness", "volerr.derive.audit_scripts",
-             "volerr.derive.audit_probe", "volerr.derive.audit_numbers",
-             "volerr.derive.audit_results")
-
 
 #: the assumption behind "a repetition or loss at the same place in two images does not
 #: decide" (quoted by the rule and by the verdicts that apply it): the documents show neither
@@ -357,18 +338,6 @@ def worst_case_um(expr, bounds: dict, unnamed: float = 1.0) -> float:
             val *= float(bounds.get(str(f), unnamed)) ** int(e)
         total += val
     return total * 1e3
-
-
-def providers() -> list:
-    """The provider modules that exist in this build, in :data:`PROVIDERS` order."""
-    out = []
-    for name in PROVIDERS:
-        try:
-            out.append(importlib.import_module(name))
-        except ModuleNotFoundError as exc:
-            if exc.name != name:
-                raise
-    return out
 
 
 # ---------------------------------------------------------------- term-by-term comparison

@@ -1,37 +1,37 @@
 """Audit of Pahk (1995), sec. 2 and appendix, against the derivation (sympy, no file I/O).
 
-The printed equations come as the parsed ``volerr/data/printed_pahk.toml`` (its header states
+The printed equations come as the parsed ``volerr/derive/audit/data/printed_pahk.toml`` (its header states
 the symbol mapping and the geometries the text allows).  The authority is the derivation from
 the physical layout (``volerr/layouts/<name>.toml``: :func:`volerr.derive.volumetric.
 volumetric_error` of ``Chain.from_layout(layout)``), written in the paper's symbols through the
 layout's ``[paper_symbols]`` (ISO name -> paper symbol with sign).
 
 Every combination of the named readings is tried and the category follows the rule of
-:data:`volerr.derive.audit.PRIORITY_RULE`; each verdict lists the readings tried
+:data:`volerr.derive.audit.framework.PRIORITY_RULE`; each verdict lists the readings tried
 (``readings_tried``) and the keys it rests on (``readings_used``):
 
 * volumetric equations (4, 7, A2, A5, A8): table pivot x axis stacking (the geometries the
   text allows; any other order of the axes is another machine) x signs of squareness symbols
-  and of table axes (:mod:`volerr.derive.audit_pahk_model`).  One reading holds for the whole
+  and of table axes (:mod:`volerr.derive.audit.pahk_model`).  One reading holds for the whole
   equation (one machine); each component reports the fewest of its readings it needs;
 * random error (5, 8): exact first-order propagation (the authority), Pahk's term-wise
   quadrature (stated), the other printed layout's equation (a copy: printing error);
-* transfer rules (9, 10, A3, A6, A9): :mod:`volerr.derive.audit_pahk_rules`;
-* chains (1, 6, A1, A4, A7) and their vectors: :mod:`volerr.derive.audit_pahk_chain`.
+* transfer rules (9, 10, A3, A6, A9): :mod:`volerr.derive.audit.pahk_rules`;
+* chains (1, 6, A1, A4, A7) and their vectors: :mod:`volerr.derive.audit.pahk_chain`.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
+from .framework import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
                     describe_diff, fmt, hits_text, is_identical, lost_glyphs, n_diff,
                     n_issues, repetition_check, terms, typical_text, worst_case_um)
-from .audit_pahk_chain import audit_chain, audit_vectors, chain_error  # noqa: F401
-from .audit_pahk_model import (COMPONENTS, P, Reading, derived_error, geometries,  # noqa: F401
+from .pahk_chain import audit_chain, audit_vectors, chain_error  # noqa: F401
+from .pahk_model import (COMPONENTS, P, Reading, derived_error, geometries,  # noqa: F401
                                geometry_text, iso_error, layout, paper_map, paper_name, parse,
                                printed_component, readings, stacking_text)
-from .audit_pahk_rules import (CONVENTION_TABLE, RULE1, _bounds, audit_transfer,
+from .pahk_rules import (CONVENTION_TABLE, RULE1, _bounds, audit_transfer,
                                 fill_verdict_refs)
 
 SOURCE = "Pahk 1995"
@@ -386,7 +386,7 @@ def _chain_is_the_print(chain_eq: dict, by_id: dict, result_eq: dict, verdicts) 
     """A convention verdict on a component of a result equation whose print is exactly what the
     layout's printed chain gives to first order says so: the convention is then Pahk's own
     chain, not only a reading that reproduces the print."""
-    from .audit_pahk_chain import chain_vectors
+    from .pahk_chain import chain_vectors
     L, note, _ = chain_vectors(chain_eq, by_id)
     try:
         literal = chain_error(chain_eq["lhs"], chain_eq["rhs"], L)

@@ -12,7 +12,7 @@ A :class:`Reading` is one combination of
   convention).
 
 Every reading has keys (:meth:`Reading.keys`) whose kinds fix its category
-(:data:`volerr.derive.audit.READING_KINDS`), the same on every layout.
+(:data:`volerr.derive.audit.framework.READING_KINDS`), the same on every layout.
 
 Sign convention of the paper symbols: the layout's ``[paper_symbols]`` (ISO name -> paper
 symbol with sign).  A table axis' errors other than its positioning error are the table's own
@@ -30,8 +30,8 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from . import volumetric as vol
-from .kinematics import PROBE, Chain, parameter_symbol, position_symbol
+from .. import volumetric as vol
+from ..kinematics import PROBE, Chain, parameter_symbol, position_symbol
 
 FUNCS = ("dx", "dy", "dz", "Ex", "Ey", "Ez")
 SCALARS = {"alpha": "alpha", "a": "alpha", "beta1": "beta1", "beta2": "beta2"}

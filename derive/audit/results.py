@@ -3,7 +3,7 @@
 project report that their plots carry (consistency only: the data are not in the text), and
 the parameter counts and band / repeatability pairs of Pahk (1995) sec. 4.
 
-The printed material is the parsed ``volerr/data/printed_results.toml``.  A printed value with
+The printed material is the parsed ``volerr/derive/audit/data/printed_results.toml``.  A printed value with
 k decimals (or k significant digits, as numpy prints) stands for its rounding interval.
 
 * Figure 3.11: Listing 3.4 compensates by ``NC + (T(X) - T_e(X)) [0 0 0 1]``; on a pure X move
@@ -28,7 +28,7 @@ from decimal import Decimal
 
 import numpy as np
 
-from .audit import Verdict
+from .framework import Verdict
 
 DATA_FILE = "printed_results.toml"
 LAYOUT = "-"

@@ -3,9 +3,9 @@ conference paper (thesis appendix A, eq. 1.1-1.19), ch. 3 (eq. 3.1-3.3, 3.16-3.1
 and the specialization project report (appendix B, eq. 1-9, 16, 17, 23, 24, 27-29); sympy, no
 file I/O.
 
-The printed material is the parsed ``volerr/data/printed_htm.toml``.  The authority:
+The printed material is the parsed ``volerr/derive/audit/data/printed_htm.toml``.  The authority:
 
-* chain factors: :func:`volerr.derive.audit_dmu50.derived_factors` of the DMU50 layout (the
+* chain factors: :func:`volerr.derive.audit.dmu50.derived_factors` of the DMU50 layout (the
   factor form the DMU 50 audit checks against the chain), products against
   ``Chain.nominal_htm()`` (tool -> workpiece, T_w^t);
 * linear axis HTMs: the first-order stage of :func:`volerr.derive.kinematics.stage_factors`
@@ -32,10 +32,10 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from .audit import Verdict, category_of, fmt, worst_case_um
-from .audit_dmu50 import (T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward,
+from .framework import Verdict, category_of, fmt, worst_case_um
+from .dmu50 import (T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward,
                           forward_note, forward_tried, t23_forward)
-from .kinematics import Chain, position_symbol, rotation, stage_factors, translation
+from ..kinematics import Chain, position_symbol, rotation, stage_factors, translation
 
 DATA_FILE = "printed_htm.toml"
 LAYOUTS = ("DMU50",)

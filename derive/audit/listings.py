@@ -1,6 +1,6 @@
 """Audit of printed code listings (Ellingsdalen 2021, Listings 3.1, 3.3, 3.4): run them.
 
-The printed code comes as the parsed ``volerr/data/printed_listings.toml`` (the statements as
+The printed code comes as the parsed ``volerr/derive/audit/data/printed_listings.toml`` (the statements as
 printed, with the extraction repairs listed there).  The audit executes that code with numpy on
 small examples whose intended result is known in closed form, and compares:
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .audit import Verdict
+from .framework import Verdict
 
 DATA_FILE = "printed_listings.toml"
 LAYOUTS = ("DMU50",)

@@ -1,6 +1,6 @@
 """Audit of the axis error models of Ellingsdalen (2021), sec. 2.5 and eq. 3.15 (sympy, no I/O).
 
-The printed material is the parsed ``volerr/data/printed_rotary.toml``.  The authority is
+The printed material is the parsed ``volerr/derive/audit/data/printed_rotary.toml``.  The authority is
 written here from first principles, independently of the printed matrices:
 
 * a linear axis X: the moved point is ``Trans(x) E p`` with the small-angle error HTM
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .audit import RECURRENCE_UNSHOWN, Verdict, fmt
+from .framework import RECURRENCE_UNSHOWN, Verdict, fmt
 
 DATA_FILE = "printed_rotary.toml"
 LAYOUTS = ("DMU50",)

@@ -5,7 +5,7 @@ value measured at the offsets (Xo, Yo, Zo).  The authority is the full rigid-bod
 the layout (:func:`volerr.derive.volumetric.transfer_rules`): ``reference = measured - shift``.
 
 Every combination of these readings is tried (:class:`RuleReading`), and the category follows
-the rule of :data:`volerr.derive.audit.PRIORITY_RULE`:
+the rule of :data:`volerr.derive.audit.framework.PRIORITY_RULE`:
 
 * ``rule1`` (simplification): Pahk's rule (1) of sec. 2.3 -- positional errors transferred by
   pitch and yaw only, straightness errors by the roll only;
@@ -30,13 +30,13 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS
 
-from . import volumetric as vol
-from .audit import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
+from .. import volumetric as vol
+from .framework import (RANK, TYPICAL, Verdict, best_combination, category_of, classify,
                     describe_diff, fmt, hits_text, is_identical, n_issues, repetition_check,
                     terms, typical_text, worst_case_um)
-from .audit_pahk_model import (OFFSETS, POS, P, flip_key, iso_error, layout, paper_map,
+from .pahk_model import (OFFSETS, POS, P, flip_key, iso_error, layout, paper_map,
                                paper_name, parse, printed_component, stacking_text)
-from .kinematics import PROBE, parameter_symbol
+from ..kinematics import PROBE, parameter_symbol
 
 _ROLL = {"X": "EA", "Y": "EB", "Z": "EC"}
 _LINES = {"EC0Y": ("X", "Y"), "EB0Z": ("X", "Z"), "EA0Z": ("Y", "Z")}
@@ -302,7 +302,7 @@ def _read_right_elsewhere(expected, printed, comps: dict, own: str, raw: dict) -
     """' The extraction reads the right symbol elsewhere in this equation: Ez(Y) (alpha =
     alpha + Ez(Yo)).' for the symbols a printed rule has in place of the right ones, "" if
     none is printed elsewhere (``raw``: the printed texts of the components)."""
-    from .audit import _swap, term_diff
+    from .framework import _swap, term_diff
     out = []
     for p, e in term_diff(expected, printed)["swapped"]:
         want = _swap(e.as_coeff_Mul()[1], p.as_coeff_Mul()[1])[1]
@@ -864,7 +864,7 @@ def _rule_category(v: Verdict, keys, r: RuleReading, lay, iso: str, alt, d0, tri
     if r.pivot == "table_origin":
         names.append(CONVENTION_TABLE)
     if r.tool is not None or r.work is not None:
-        from .audit_pahk_model import geometry_text
+        from .pahk_model import geometry_text
         names.append(f"axes stacked {stacking_text(r.tool, r.work)}, the geometry of the "
                      f"layout's volumetric equation, which the text allows (the text: "
                      f"{geometry_text(geoms, (r.tool, r.work))})")

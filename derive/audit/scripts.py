@@ -2,7 +2,7 @@
 errors of the X axis from three points on the spindle) and D.1 (the B axis from three points
 on the table); sympy / numpy, no file I/O.
 
-The printed material (``volerr/data/printed_scripts.toml``) keeps only what the extraction left
+The printed material (``volerr/derive/audit/data/printed_scripts.toml``) keeps only what the extraction left
 legible.  The authority:
 
 * C.1: Cramer's rule on the selected system of eq. 32 (rows P x, P y, Q x, Q z, K y, K z of the
@@ -25,8 +25,8 @@ import itertools
 import numpy as np
 import sympy as sp
 
-from .audit import Verdict, category_of, fmt
-from .three_point import closed_form as _closed_form
+from .framework import Verdict, category_of, fmt
+from ..three_point import closed_form as _closed_form
 
 
 @functools.lru_cache(maxsize=None)
