@@ -8,7 +8,7 @@ import sympy as sp
 
 from volerr.machine.layout import Layout, layout_names, read_layout
 
-from . import inverse, symbols
+from . import inverse
 from . import volumetric as vol
 from .codegen import Function, render_module, shared_preparation
 from .kinematics import PROBE, Chain
@@ -79,7 +79,7 @@ def derive_functions(layout: Layout) -> list[Function]:
                  "(columns 0-5, first in the chain: the instrument's placement) and of the tool "
                  "end (columns 6-11, tool frame): array (3, 12, *shape), mm/mm and mm/rad.",
                  shape=(3, 12)),
-        Function("symbol_sensitivity", pos + probe, list(symbols.symbol_sensitivity(chain)),
+        Function("symbol_sensitivity", pos + probe, list(vol.symbol_sensitivity(chain)),
                  "d(nominal tool point x, y, z)/d(nominal symbol) in SYMBOLS order (probe "
                  "offset components, axis positions, layout parameters, frame offsets and "
                  "angles): array (3, n_symbols, *shape), mm/mm or mm/rad; the first-order "

@@ -48,6 +48,7 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS, Layout
 
+from .effects import apply_effects
 from .htm import (PROBE, Factor, _matmul, exact_error_htm, parameter_symbol,  # noqa: F401
                   position_symbol, rotation, translation, twist)
 
@@ -201,8 +202,6 @@ def chain_factors(layout: Layout, table_pivot: str = "tool_point") -> list[Facto
     for entry in layout.tool_chain:
         out.extend(stage_factors(layout, entry))
     if layout.effects:  # declared effects (augmented models): see volerr.derive.effects
-        from .effects import apply_effects
-
         out = apply_effects(layout, out)
     return out
 

@@ -1,4 +1,6 @@
-"""Nominal symbols of a chain: the sensitivity of the tool point to each of them (sympy).
+"""Nominal symbols of a chain: a change of their values as error factors inserted in the chain
+(sympy); the sensitivity of the tool point to each of them is
+:func:`volerr.derive.volumetric.symbol_sensitivity`.
 
 Besides its error parameters, a chain holds *nominal symbols*: the probe / tool offset
 components ``Xp Yp Zp``, the axis positions, the layout's parameters (the DMU 50's ``d``) and
@@ -47,19 +49,3 @@ def insert_variations(factors: list, change: dict) -> list:
         if args:
             out.append(Factor(twist_args=args, owner=f.owner, role="effect"))
     return out
-
-
-def symbol_sensitivity(chain) -> sp.Matrix:
-    """3 x n_symbols matrix d(nominal tool point)/d(symbol), symbols in
-    :attr:`Layout.symbols` order (mm/mm or mm/rad): the nominal chain (error factors left out)
-    with every symbol's variation inserted, differentiated by its first-order machinery."""
-    from .kinematics import Chain
-    from .volumetric import sensitivity
-
-    names = chain.layout.symbols
-    delta = {n: sp.Symbol(f"_dsym{i}", real=True) for i, n in enumerate(names)}
-    factors = insert_variations([f for f in chain.factors if not f.is_error], delta)
-    factors.append(Factor(twist_args={k: delta[s] for s, k in PROBE_TWIST.items()},
-                          owner="tool", role="effect"))
-    varied = Chain(chain.layout, factors, chain.positions, tuple(delta[n] for n in names))
-    return sensitivity(varied)

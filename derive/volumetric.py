@@ -14,8 +14,10 @@ import sympy as sp
 
 from volerr.machine.layout import SQUARENESS
 
-from .kinematics import (NOT_POLYNOMIAL, PROBE, Chain, RingMatrices, parameter_symbol,
-                         position_symbol, twist)
+from .htm import Factor, _matmul
+from .kinematics import (NOT_POLYNOMIAL, PROBE, Chain, RingMatrices, _table_rotary,
+                         parameter_symbol, position_symbol, stage_factors, twist)
+from .symbols import PROBE_TWIST, insert_variations
 
 
 def nominal_point(chain: Chain) -> sp.Matrix:
@@ -32,8 +34,6 @@ def work_rotation(chain: Chain) -> sp.Matrix:
     """Orientation of the workpiece frame in the base frame (the frame of the machine's linear
     axes), 3x3: columns are the workpiece axes in base coordinates.  The workpiece side of
     ``tool2work`` is ``base2work``; this is the transpose of its rotation."""
-    from .kinematics import _table_rotary, stage_factors
-
     layout = chain.layout
     m = sp.eye(4)
     for entry in reversed(layout.workpiece_chain):
@@ -138,8 +138,6 @@ def orientation_error(chain: Chain) -> sp.Matrix:
 
 def exact_error(chain: Chain) -> sp.Matrix:
     """Exact (non-linearised) error: exact actual chain minus nominal chain, applied to the probe."""
-    from .kinematics import _matmul
-
     p = sp.Matrix([*PROBE, 1])
     return (_matmul(chain.exact_htm(), p) - _matmul(chain.nominal_htm(), p))[0:3, 0]
 
@@ -194,6 +192,20 @@ def setup_sensitivity(chain: Chain) -> sp.Matrix:
     work = (d * (T * p))[0:3, 0].jacobian(sp.Matrix(syms))
     tool = (T * (d * p))[0:3, 0].jacobian(sp.Matrix(syms))
     return work.row_join(tool).applyfunc(sp.expand)
+def symbol_sensitivity(chain: Chain) -> sp.Matrix:
+    """3 x n_symbols matrix d(nominal tool point)/d(symbol), symbols in
+    :attr:`Layout.symbols` order (mm/mm or mm/rad): the nominal chain (error factors left out)
+    with every symbol's variation inserted (:func:`volerr.derive.symbols.insert_variations`),
+    differentiated by its first-order machinery."""
+    names = chain.layout.symbols
+    delta = {n: sp.Symbol(f"_dsym{i}", real=True) for i, n in enumerate(names)}
+    factors = insert_variations([f for f in chain.factors if not f.is_error], delta)
+    factors.append(Factor(twist_args={k: delta[s] for s, k in PROBE_TWIST.items()},
+                          owner="tool", role="effect"))
+    varied = Chain(chain.layout, factors, chain.positions, tuple(delta[n] for n in names))
+    return sensitivity(varied)
+
+
 def _is_expanded_factor(f) -> bool:
     if f.is_Atom:
         return True

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       4e622ee7fcbf25114a88ce70a90bf837f7d7bb7c984c275446832d748a0e3760
-derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
+derivation sha256  3c773d87f8f4996be170868040155f261df2892ba8e68ab53b37940e6aa7b078
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

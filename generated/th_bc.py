@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       f33f383453fd86eb89aede0e8d896e5e1639520405e75ca24882d84376f1d8b8
-derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
+derivation sha256  3c773d87f8f4996be170868040155f261df2892ba8e68ab53b37940e6aa7b078
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
