@@ -245,7 +245,8 @@ def test_exported_error_map_is_the_machine(tmp_path, layout, seed, effect):
     """The fitted error functions, written as error tables and read back through
     volerr.tables.table, predict the simulated machine's true (exact-chain) error at new points to
     a small fraction of its size, up to the instrument's rigid placement."""
-    from volerr.tables.table import ErrorFunctions, read_error_dir
+    from volerr.tables.functions import ErrorFunctions
+    from volerr.tables.table import read_error_dir
 
     model = volerr.load(layout)
     camp = simulate(layout, n_points=700, seed=seed, probes=demo_probes(model),
