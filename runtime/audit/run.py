@@ -48,8 +48,13 @@ def data_file(name: str) -> dict:
         raise InputError(f"audit data file {name}: not valid TOML ({exc})") from None
 
 
-def data_paths(mods) -> list[str]:
-    """Paths of the data files read by the provider modules ``mods`` (inputs of the run)."""
+def data_paths(mods=None) -> list[str]:
+    """Paths of the data files read by the provider modules ``mods`` (default: every provider;
+    imports sympy), the inputs of the run."""
+    if mods is None:
+        from volerr.derive.audit import providers
+
+        mods = providers()
     return [str(resources.files("volerr.derive.audit") / "data" / m.DATA_FILE) for m in mods
             if getattr(m, "DATA_FILE", None)]
 

@@ -41,12 +41,11 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ._common import layout_inputs, progress
-    from volerr.derive.audit import providers
     from ..fileio import Outputs
 
     require(args.points >= 1, "--points must be at least 1")
     inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]
-    inputs += audit_run.data_paths(providers())
+    inputs += audit_run.data_paths()
     outs = Outputs(inputs).file("--json", args.json).file("--html", args.html).check()
     args.layouts = audit_run.resolve_layouts(args.layouts)
     mods, verdicts = audit_run.collect(args.layouts, progress=progress)
