@@ -444,6 +444,51 @@ def audit_rotary(item: dict) -> Verdict:
 
 
 # ------------------------------------------------------------------------------- items
+def _linear_deviation(item: dict, o: sp.Matrix, r: sp.Matrix) -> list[Verdict]:
+    """The deviation of a point on the X carriage (measured minus nominal): the result and
+    the middle member of the printed equation."""
+    xm = sp.Matrix([SYM["xmP"], SYM["ymP"], SYM["zmP"], 1])
+    derived = xm - translation(o + sp.Matrix([SYM["x"], 0, 0])) * r
+    res = sp.Matrix([_parse(t) for t in item["result"]])
+    same = sp.expand(res - derived) == sp.zeros(4, 1)
+    out = [_v(item, "result", "identical" if same else "printing_error", "differs",
+              "the right-most member equals measured minus nominal, [x'_Pt - x_xP - x_o - "
+              "x, y'_Pt - y_xP - y_o, z'_Pt - z_xP - z_o, 0]", item["text"],
+              fmt(list(derived)))]
+    out.append(_v(item, "middle member", "undecidable", "entry z'_Pt misplaced",
+                  "the middle member subtracts [x_Pt, y_Pt, z'_Pt, 1] from [x'_Pt, y'_Pt, 1]: "
+                  "the first vector has three entries and the second a measured entry "
+                  "z'_Pt where the nominal z_Pt belongs -- the entry z'_Pt moved from one "
+                  "vector to the other. The right-most member and eq. (30) are right. "
+                  "Category undecidable: a misplaced entry, which the print (a slip while "
+                  "typing) and the text extraction (entries of two stacked vectors "
+                  "exchanged) explain equally; what would decide: the page of the original "
+                  "PDF", "[x'_Pt, y'_Pt, 1] - [x_Pt, y_Pt, z'_Pt, 1]",
+                  "[x'_Pt, y'_Pt, z'_Pt, 1] - [x_Pt, y_Pt, z_Pt, 1]",
+                  ["the vectors as printed: a 3-vector minus a 4-vector",
+                   "z'_Pt read in the first vector and z_Pt in the second: the right-most "
+                   "member exactly"], [f"glyph:project eq. {item['id']} entry z'_Pt"]))
+    return out
+
+
+def _cl_data(item: dict, chain) -> list[Verdict]:
+    """The CL data (tool axis and tip) as T_w^t applied to e_z and the tool frame's origin,
+    against the derived forward kinematics at a test pose."""
+    fwd = derived_forward(chain)
+    tw = chain.nominal_htm()
+    cols = tw * sp.Matrix([[0, 0], [0, 0], [1, 0], [0, 1]])
+    want = sp.Matrix([[fwd["i"], fwd["x"]], [fwd["j"], fwd["y"]], [fwd["k"], fwd["z"]],
+                      [0, 1]])
+    fn = sp.lambdify((X, Y, Z, B, C, D), cols - want, "numpy")
+    worst = float(np.max(np.abs(np.array(fn(30.0, -20.0, 50.0, 0.7, -1.1, 154.996),
+                                          dtype=float))))
+    return [_v(item, "", "identical" if worst < 1e-9 else "printing_error", "differs",
+               f"T_w^t applied to the tool axis e_z (direction, homogeneous 0) and to the "
+               f"tool tip (the tool frame's origin) gives the tool axis (i, j, k) and tip "
+               f"(x, y, z) of the derived forward kinematics (max |difference| {worst:.2g} "
+               f"at a test pose)", item["text"], "[i x; j y; k z; 0 1] = T_w^t [e_z, o_t]")]
+
+
 def audit_item(item: dict, axes: dict) -> list[Verdict]:
     kind = item["kind"]
     layout, chain, f = _derived()
@@ -474,42 +519,9 @@ def audit_item(item: dict, axes: dict) -> list[Verdict]:
                    f"every entry equals {what}" + ("" if not bad else ": " + "; ".join(bad)),
                    str(item["rows"]), fmt(derived))]
     if kind == "linear_deviation":
-        xm = sp.Matrix([SYM["xmP"], SYM["ymP"], SYM["zmP"], 1])
-        derived = xm - translation(o + sp.Matrix([SYM["x"], 0, 0])) * r
-        res = sp.Matrix([_parse(t) for t in item["result"]])
-        same = sp.expand(res - derived) == sp.zeros(4, 1)
-        out = [_v(item, "result", "identical" if same else "printing_error", "differs",
-                  "the right-most member equals measured minus nominal, [x'_Pt - x_xP - x_o - "
-                  "x, y'_Pt - y_xP - y_o, z'_Pt - z_xP - z_o, 0]", item["text"],
-                  fmt(list(derived)))]
-        out.append(_v(item, "middle member", "undecidable", "entry z'_Pt misplaced",
-                      "the middle member subtracts [x_Pt, y_Pt, z'_Pt, 1] from [x'_Pt, y'_Pt, 1]: "
-                      "the first vector has three entries and the second a measured entry "
-                      "z'_Pt where the nominal z_Pt belongs -- the entry z'_Pt moved from one "
-                      "vector to the other. The right-most member and eq. (30) are right. "
-                      "Category undecidable: a misplaced entry, which the print (a slip while "
-                      "typing) and the text extraction (entries of two stacked vectors "
-                      "exchanged) explain equally; what would decide: the page of the original "
-                      "PDF", "[x'_Pt, y'_Pt, 1] - [x_Pt, y_Pt, z'_Pt, 1]",
-                      "[x'_Pt, y'_Pt, z'_Pt, 1] - [x_Pt, y_Pt, z_Pt, 1]",
-                      ["the vectors as printed: a 3-vector minus a 4-vector",
-                       "z'_Pt read in the first vector and z_Pt in the second: the right-most "
-                       "member exactly"], [f"glyph:project eq. {item['id']} entry z'_Pt"]))
-        return out
+        return _linear_deviation(item, o, r)
     if kind == "cl_data":
-        fwd = derived_forward(chain)
-        tw = chain.nominal_htm()
-        cols = tw * sp.Matrix([[0, 0], [0, 0], [1, 0], [0, 1]])
-        want = sp.Matrix([[fwd["i"], fwd["x"]], [fwd["j"], fwd["y"]], [fwd["k"], fwd["z"]],
-                          [0, 1]])
-        fn = sp.lambdify((X, Y, Z, B, C, D), cols - want, "numpy")
-        worst = float(np.max(np.abs(np.array(fn(30.0, -20.0, 50.0, 0.7, -1.1, 154.996),
-                                              dtype=float))))
-        return [_v(item, "", "identical" if worst < 1e-9 else "printing_error", "differs",
-                   f"T_w^t applied to the tool axis e_z (direction, homogeneous 0) and to the "
-                   f"tool tip (the tool frame's origin) gives the tool axis (i, j, k) and tip "
-                   f"(x, y, z) of the derived forward kinematics (max |difference| {worst:.2g} "
-                   f"at a test pose)", item["text"], "[i x; j y; k z; 0 1] = T_w^t [e_z, o_t]")]
+        return _cl_data(item, chain)
     if kind == "inverse_cl":
         return [_v(item, "", "undecidable", "product of a 4x2 by a 4x2 matrix",
                    "as printed, T_t^w [i x; j y; k z; 0 1] (4 x 2) is multiplied by the 4 x 2 "

@@ -287,6 +287,37 @@ def _random_size_um(name: str, i: int) -> float:
     return float(np.max(np.abs(a - b))) * 1e3
 
 
+def _termwise_verdict(eq: dict, c: str, i: int, hit, tried: list, diff0: str, ocr: str, pr,
+                      exact, tw) -> Verdict:
+    """A random component reproduced by Pahk's term-wise quadrature: a simplification, with
+    the size of the dropped cross terms on the typical machine."""
+    m, n, d = hit[1]
+    size = _random_size_um(eq["layout"], i)
+    evidence = (f"differs from exact propagation: {diff0}. Reproduced exactly by {d} "
+                f"(expand(term-wise - printed) == 0); the two agree when the probe offset "
+                f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
+                f"up to {size:.2g} um ("
+                + typical_text(f", random angular errors "
+                               f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, "
+                               f"translational "
+                               f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, "
+                               f"1 sigma") + "). "
+                f"Category simplification: Pahk states the quadrature formula (quoted "
+                f"in 'statement'), not that it is applied term by term; the term-wise "
+                f"form is how he applies it -- every printed random component of both "
+                f"layouts that is not a copy (eq. 5 RX^2, RY^2, RZ^2 and eq. 8 RX^2, the "
+                f"latter up to a lost glyph) is built so -- and it drops the correlation "
+                f"of one parameter's two lever arms (Z and Zp above): an approximation "
+                f"of the stated method, small at the typical machine.")
+    v = classify(_verdict(eq, c, "differs", "term-wise quadrature drops cross terms",
+                          evidence + ocr, pr, exact),
+                 "simplification", alternative=fmt(tw),
+                 statement=STATEMENTS["quadrature"] + "; applied term by term",
+                 dropped=fmt(sp.expand(exact - tw)), dropped_um=size)
+    v.readings_tried, v.readings_used = tried, list(hit[0])
+    return v
+
+
 def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
     name = eq["layout"]
     cands = [("exact", name, "exact first-order propagation (the authority)", ()),
@@ -319,30 +350,7 @@ def audit_random(eq: dict, random_eqs: dict) -> list[Verdict]:
                 if keys and is_identical(derived[(m, n)][i], pr)]
         hit = best_combination(hits)
         if hit and category_of(hit[0]) == "simplification":
-            m, n, d = hit[1]
-            size = _random_size_um(name, i)
-            evidence = (f"differs from exact propagation: {diff0}. Reproduced exactly by {d} "
-                        f"(expand(term-wise - printed) == 0); the two agree when the probe offset "
-                        f"is zero. Size of the dropped cross terms: sqrt(exact) - sqrt(printed) "
-                        f"up to {size:.2g} um ("
-                        + typical_text(f", random angular errors "
-                                       f"{TYPICAL['sigma_angular_rad'] * 1e6:g} urad, "
-                                       f"translational "
-                                       f"{TYPICAL['sigma_translational_mm'] * 1e3:g} um, "
-                                       f"1 sigma") + "). "
-                        f"Category simplification: Pahk states the quadrature formula (quoted "
-                        f"in 'statement'), not that it is applied term by term; the term-wise "
-                        f"form is how he applies it -- every printed random component of both "
-                        f"layouts that is not a copy (eq. 5 RX^2, RY^2, RZ^2 and eq. 8 RX^2, the "
-                        f"latter up to a lost glyph) is built so -- and it drops the correlation "
-                        f"of one parameter's two lever arms (Z and Zp above): an approximation "
-                        f"of the stated method, small at the typical machine.")
-            v = classify(_verdict(eq, c, "differs", "term-wise quadrature drops cross terms",
-                                  evidence + ocr, pr, exact),
-                         "simplification", alternative=fmt(tw),
-                         statement=STATEMENTS["quadrature"] + "; applied term by term",
-                         dropped=fmt(sp.expand(exact - tw)), dropped_um=size)
-            v.readings_tried, v.readings_used = tried, list(hit[0])
+            v = _termwise_verdict(eq, c, i, hit, tried, diff0, ocr, pr, exact, tw)
             out.append(v)
             continue
         if hit:

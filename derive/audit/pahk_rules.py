@@ -314,6 +314,39 @@ def _read_right_elsewhere(expected, printed, comps: dict, own: str, raw: dict) -
             + "; ".join(out) + "." if out else "")
 
 
+def _unreproduced_verdict(eq: dict, key: str, lay, rr, pt, pr, d0, vf, geometry_key: str,
+                          iso: str, diff0: str, erratum: str, ocr: str, verdict, all_eqs,
+                          tried: list) -> Verdict:
+    """A rule no reading reproduces: undecidable when the residual repeats a token of the
+    same image, else a printing error; the closest reading is named."""
+    name = eq["layout"]
+    near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
+    r = min(near, key=lambda x: (n_issues(derived_rule(name, key, x), pr),
+                                 RANK[category_of(x.keys(lay, vf, geometry_key))],
+                                 len(x.keys(lay, vf, geometry_key)), repr(x)))
+    d = derived_rule(name, key, r)
+    comps = {c: printed_component(eq, c)[0] for c in eq["expr"]}
+    rep, repeated = repetition_check(d, pr, comps, key)
+    evidence = (f"derived {key} = {fmt(d0)}; printed differs by: {diff0}. No reading "
+                f"reproduces it (all {len(rr)} combinations tried); closest: "
+                f"{r.describe(lay, iso, vf)}, which leaves: {describe_diff(d, pr)}."
+                + rep)
+    if repeated:
+        v = classify(verdict(eq, key, "differs", erratum, evidence + ocr
+                             + _outlier_note(all_eqs, eq, key)
+                             + " Category undecidable.", pr, d0), "undecidable")
+        v.readings_used = [f"glyph:{eq['id']} {key} repeats a token of the same image"]
+    else:
+        right = _read_right_elsewhere(d, pr, comps, key, eq["expr"])
+        v = classify(verdict(eq, key, "differs", erratum, evidence + right + (
+            " The residual is no lost or confusable glyph but a well-formed term or symbol "
+            "of the paper's notation (the letters X, Y, Z do not resemble one another), "
+            "which an extraction would have to invent: a printing error.")
+            + ocr, pr, d0), "printing_error")
+    v.readings_tried = tried
+    return v
+
+
 def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                    stackings=None) -> list[Verdict]:
     """Verdicts on every rule of a transfer equation.  ``vol_reading``: the reading of the same
@@ -384,30 +417,8 @@ def audit_transfer(eq: dict, vol_reading, verdict, geoms=(), all_eqs=(),
                                + _weighing(all_eqs, eq, key, r.zero) + _damage_note(eq, key))
             out.append(v)
             continue
-        near = sorted(rr, key=lambda x: _n_terms_off(name, key, x, pt))[:12]
-        r = min(near, key=lambda x: (n_issues(derived_rule(name, key, x), pr),
-                                     RANK[category_of(x.keys(lay, vf, geometry_key))],
-                                     len(x.keys(lay, vf, geometry_key)), repr(x)))
-        d = derived_rule(name, key, r)
-        comps = {c: printed_component(eq, c)[0] for c in eq["expr"]}
-        rep, repeated = repetition_check(d, pr, comps, key)
-        evidence = (f"derived {key} = {fmt(d0)}; printed differs by: {diff0}. No reading "
-                    f"reproduces it (all {len(rr)} combinations tried); closest: "
-                    f"{r.describe(lay, iso, vf)}, which leaves: {describe_diff(d, pr)}."
-                    + rep)
-        if repeated:
-            v = classify(verdict(eq, key, "differs", erratum, evidence + ocr
-                                 + _outlier_note(all_eqs, eq, key)
-                                 + " Category undecidable.", pr, d0), "undecidable")
-            v.readings_used = [f"glyph:{eq['id']} {key} repeats a token of the same image"]
-        else:
-            right = _read_right_elsewhere(d, pr, comps, key, eq["expr"])
-            v = classify(verdict(eq, key, "differs", erratum, evidence + right + (
-                " The residual is no lost or confusable glyph but a well-formed term or symbol "
-                "of the paper's notation (the letters X, Y, Z do not resemble one another), "
-                "which an extraction would have to invent: a printing error.")
-                + ocr, pr, d0), "printing_error")
-        v.readings_tried = tried
+        v = _unreproduced_verdict(eq, key, lay, rr, pt, pr, d0, vf, geometry_key, iso, diff0,
+                                  erratum, ocr, verdict, all_eqs, tried)
         out.append(v)
     if eq.get("table_note"):
         for v in out:
