@@ -393,6 +393,88 @@ def _derived_rows(axis: str, rotated: bool) -> dict:
     return {f"{lab}{c}": list(A.row(i)) for i, (lab, c) in enumerate(rows)}
 
 
+def _wrong_subscripts_reading(eq: dict, wrong: list, others: dict | None, labels: list,
+                              raw: list, problems: list) -> tuple[str, list, list]:
+    """Lever arms printed with the X axis' subscript where the C axis' belongs: the problem
+    (appended to ``problems``), the note on its category, the readings tried and used."""
+    problems.append(f"{len(wrong)} lever arms printed with the X axis' subscript x where "
+                    f"the C axis' C belongs: " + ", ".join(
+                        f"row {lab} column {j}: '{text}'" for lab, j, text in wrong))
+    same_in = [other for other, info in (others or {}).items()
+               if other != eq["id"] and _same_places(wrong, info["labels"], info["wrong"],
+                                                     labels)]
+    note = (
+        f" Read with C, every coefficient is the derived one (the rotated lever arms "
+        f"x^_Ci = x_Ci cos C - y_Ci sin C, y^_Ci = y_Ci cos C + x_Ci sin C the thesis "
+        f"defines under eq. 3.5); the other hatted lever arms of this matrix carry C."
+        + (f" Category printing_error by the cross-copy rule: eq. "
+           f"{', '.join(same_in)} prints the x at exactly the same entries of the rows it "
+           f"shares (two images), a substitution an extraction would have to invent "
+           f"identically in both while reading C in the other entries of the same form"
+           f"{_pair_note(eq, wrong)}. It is no repetition within an image: "
+           + ("none of the x-subscripted lever arms stands elsewhere in its matrix"
+              if all(" & ".join(raw).count(re.search(r"\\hat\{[xy]\}_\{x[PQK]\}",
+                                                       t).group(0)) == 1
+                     for _, _, t in wrong) else
+              "(an x-subscripted lever arm stands twice in its matrix)")
+           + f", and the rows that "
+           f"carry them stand at other places in the two images ("
+           + "; ".join(f"eq. {o}: rows " + ", ".join(
+               str(k + 1) for k, lab in enumerate((others or {})[o]["labels"])
+               if lab in {w[0] for w in wrong}) for o in [eq["id"], *same_in])
+           + f"), so the x follows the rows' content, not their places in the "
+           f"images. The competing explanation, the "
+           f"extraction writing x for C, would need the same five misreadings in two "
+           f"images of another row order; the author's source explains it: the C-axis "
+           f"system adapted from the X-axis system of the specialization project (eq. 31 "
+           f"and 32 print x_{{xP}}, y_{{xQ}} ... at these places) with some subscripts "
+           f"left unchanged."
+           if same_in else
+           " Category printing_error: a well-formed lever arm of another axis' "
+           "system (the X axis' subscript of eq. 31-32)."))
+    tried = ["every printed row against the derived row its right-hand side names, the "
+             "lever arms read as printed: " + f"{len(wrong)} entries name the X axis' "
+             f"lever arms", "the entries read with the C axis' subscript: every row the "
+             "derived one"]
+    used = [f"copy:eq. {eq['id']} lever arms of the X-axis system"]
+    return note, tried, used
+
+
+def _unknown_vector_verdicts(eq: dict, axis: str, others: dict | None) -> list[Verdict]:
+    """The verdict on the printed unknown vector: E_X ... E_C of the axis, in this order."""
+    out = []
+    want_u = [m + axis for m in MOTIONS]
+    got_u = list(eq["unknowns"])
+    if got_u == want_u:
+        out.append(_verdict(eq, "unknown vector", True, "", "E_X, E_Y, E_Z, E_A, E_B, E_C of "
+                            f"axis {axis}", ", ".join(got_u), ", ".join(want_u)))
+    else:
+        missing = [u for u in want_u if u not in got_u]
+        twice = sorted({u for u in got_u if got_u.count(u) > 1})
+        parts = []
+        if missing:
+            parts.append(f"{', '.join(missing)} missing")
+        if twice:
+            parts.append(f"{', '.join(twice)} listed twice")
+        if len(got_u) != 6:
+            parts.append(f"{len(got_u)} unknowns for 6 columns")
+        vec = _raw_vector(eq)
+        out.append(_verdict(eq, "unknown vector", False, "; ".join(parts),
+                            "the six columns multiply E_X ... E_C of the axis in this order "
+                            "(every coefficient column is the derived one, read with the "
+                            "subscripts of the axis: see the verdict on the coefficient "
+                            "matrix); the printed vector"
+                            + (f" [{vec}]" if vec else "") + " mislabels them: "
+                            + "; ".join(parts) + "." + _vector_evidence(eq, others or {}),
+                            ", ".join(got_u), ", ".join(want_u), category="undecidable"))
+        out[-1].readings_tried = ["the vector as printed: " + "; ".join(parts),
+                                  "entries repeated or lost by the print (a copied vector) or "
+                                  "by the extraction (a repeated token): the vector the six "
+                                  "columns multiply (E_X ... E_C of the axis)"]
+        out[-1].readings_used = [f"glyph:eq. {eq['id']} unknown vector"]
+    return out
+
+
 def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
     """Verdicts on a printed system; ``others``: equation id -> {"labels": row labels,
     "wrong": lever arms with the X axis' subscript (:func:`wrong_subscripts`), "unknowns":
@@ -445,46 +527,8 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
         used = [f"glyph:eq. {eq['id']} repeated row " + ", ".join(d[0] + " " + d[1]
                                                                   for d in dup)]
     elif wrong and not problems:
-        problems.append(f"{len(wrong)} lever arms printed with the X axis' subscript x where "
-                        f"the C axis' C belongs: " + ", ".join(
-                            f"row {lab} column {j}: '{text}'" for lab, j, text in wrong))
-        same_in = [other for other, info in (others or {}).items()
-                   if other != eq["id"] and _same_places(wrong, info["labels"], info["wrong"],
-                                                         labels)]
-        note = (
-            f" Read with C, every coefficient is the derived one (the rotated lever arms "
-            f"x^_Ci = x_Ci cos C - y_Ci sin C, y^_Ci = y_Ci cos C + x_Ci sin C the thesis "
-            f"defines under eq. 3.5); the other hatted lever arms of this matrix carry C."
-            + (f" Category printing_error by the cross-copy rule: eq. "
-               f"{', '.join(same_in)} prints the x at exactly the same entries of the rows it "
-               f"shares (two images), a substitution an extraction would have to invent "
-               f"identically in both while reading C in the other entries of the same form"
-               f"{_pair_note(eq, wrong)}. It is no repetition within an image: "
-               + ("none of the x-subscripted lever arms stands elsewhere in its matrix"
-                  if all(" & ".join(raw).count(re.search(r"\\hat\{[xy]\}_\{x[PQK]\}",
-                                                           t).group(0)) == 1
-                         for _, _, t in wrong) else
-                  "(an x-subscripted lever arm stands twice in its matrix)")
-               + f", and the rows that "
-               f"carry them stand at other places in the two images ("
-               + "; ".join(f"eq. {o}: rows " + ", ".join(
-                   str(k + 1) for k, lab in enumerate((others or {})[o]["labels"])
-                   if lab in {w[0] for w in wrong}) for o in [eq["id"], *same_in])
-               + f"), so the x follows the rows' content, not their places in the "
-               f"images. The competing explanation, the "
-               f"extraction writing x for C, would need the same five misreadings in two "
-               f"images of another row order; the author's source explains it: the C-axis "
-               f"system adapted from the X-axis system of the specialization project (eq. 31 "
-               f"and 32 print x_{{xP}}, y_{{xQ}} ... at these places) with some subscripts "
-               f"left unchanged."
-               if same_in else
-               " Category printing_error: a well-formed lever arm of another axis' "
-               "system (the X axis' subscript of eq. 31-32)."))
-        tried = ["every printed row against the derived row its right-hand side names, the "
-                 "lever arms read as printed: " + f"{len(wrong)} entries name the X axis' "
-                 f"lever arms", "the entries read with the C axis' subscript: every row the "
-                 "derived one"]
-        used = [f"copy:eq. {eq['id']} lever arms of the X-axis system"]
+        note, tried, used = _wrong_subscripts_reading(eq, wrong, others, labels, raw,
+                                                      problems)
     out.append(_verdict(eq, "coefficient matrix", not problems,
                         "; ".join(problems[:3]) if problems else "",
                         ("every printed row equals the derived row of the equation its "
@@ -500,35 +544,7 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
         out[-1].readings_tried = tried or ["every printed row against the derived row its "
                                            "right-hand side names"]
         out[-1].readings_used = used
-    want_u = [m + axis for m in MOTIONS]
-    got_u = list(eq["unknowns"])
-    if got_u == want_u:
-        out.append(_verdict(eq, "unknown vector", True, "", "E_X, E_Y, E_Z, E_A, E_B, E_C of "
-                            f"axis {axis}", ", ".join(got_u), ", ".join(want_u)))
-    else:
-        missing = [u for u in want_u if u not in got_u]
-        twice = sorted({u for u in got_u if got_u.count(u) > 1})
-        parts = []
-        if missing:
-            parts.append(f"{', '.join(missing)} missing")
-        if twice:
-            parts.append(f"{', '.join(twice)} listed twice")
-        if len(got_u) != 6:
-            parts.append(f"{len(got_u)} unknowns for 6 columns")
-        vec = _raw_vector(eq)
-        out.append(_verdict(eq, "unknown vector", False, "; ".join(parts),
-                            "the six columns multiply E_X ... E_C of the axis in this order "
-                            "(every coefficient column is the derived one, read with the "
-                            "subscripts of the axis: see the verdict on the coefficient "
-                            "matrix); the printed vector"
-                            + (f" [{vec}]" if vec else "") + " mislabels them: "
-                            + "; ".join(parts) + "." + _vector_evidence(eq, others or {}),
-                            ", ".join(got_u), ", ".join(want_u), category="undecidable"))
-        out[-1].readings_tried = ["the vector as printed: " + "; ".join(parts),
-                                  "entries repeated or lost by the print (a copied vector) or "
-                                  "by the extraction (a repeated token): the vector the six "
-                                  "columns multiply (E_X ... E_C of the axis)"]
-        out[-1].readings_used = [f"glyph:eq. {eq['id']} unknown vector"]
+    out.extend(_unknown_vector_verdicts(eq, axis, others))
     # right-hand side: which equation does each printed entry belong to?
     out.append(_audit_rhs(eq, labels, others or {}))
     return out
@@ -922,9 +938,9 @@ def _swap_evidence(eq: dict, motion: str, old, new, n_fixed: bool) -> str:
     return out + " Category undecidable; what would decide: the page of the original PDF."
 
 
-def audit_closed_form(eq: dict) -> list[Verdict]:
-    axis = eq["axis"]
-    out = []
+def _n_verdict(eq: dict, axis: str) -> tuple[Verdict | None, dict]:
+    """The verdict on the printed determinant N (None when not printed) and the reading of N
+    that reproduces it ({N: determinant}, empty when N is right or no reading does)."""
     define_fix = {}
     n_verdict = None
     if "N" in eq.get("define", {}):
@@ -954,6 +970,13 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                         "a '-' between the two triple products lost by the print "
                                         "or by the extraction: the determinant (up to sign)"]
             n_verdict.readings_used = ["glyph:eq. 3.8 N lost minus"]
+    return n_verdict, define_fix
+
+
+def audit_closed_form(eq: dict) -> list[Verdict]:
+    axis = eq["axis"]
+    out = []
+    n_verdict, define_fix = _n_verdict(eq, axis)
     for motion in MOTIONS:
         if motion not in eq["expr"]:
             continue
