@@ -115,21 +115,49 @@ def audit_linear(item: dict) -> list[Verdict]:
 
 
 # ------------------------------------------------------------------------------ rotary axis
-def audit_rotary(item: dict) -> list[Verdict]:
-    eq = f"eq. {item['id']}"
-    e = [SYM[n] for n in ("EAC", "EBC", "ECC")]
-    t = [SYM[n] for n in ("EXC", "EYC", "EZC")]
-    t_es = _small_htm(e, t)
-    t_ss = _small_htm((SYM["SXC"], SYM["SYC"], 0), (0, 0, 0))
-    t_cc = _rz(C)
+def _deviation_rows(eq: str, item: dict, dev: sp.Matrix, printed_m: sp.Matrix) -> list[Verdict]:
+    """The printed rows Delta_x, Delta_y, Delta_z against (T_ES - I) Rz(C) applied to a point
+    of the table."""
     out = []
-    for name, derived, what in (("T_ES", t_es, "the small-angle HTM of the six error motions"),
-                                ("T_SS", t_ss, "the small-angle rotation by S_XC about x and "
-                                               "S_YC about y")):
-        bad = _entries(_mat(item[name]), derived)
-        out.append(_v(eq, name, not bad, "; ".join(bad), f"derived as {what}: "
-                      + ("all 16 entries agree" if not bad else "; ".join(bad)),
-                      str(item[name]), fmt(derived)))
+    p = sp.Matrix([SYM["xC"], SYM["yC"], SYM["zC"], 1])
+    derived_eqs = dev * p
+    printed_rows = printed_m * p
+    for i, c in enumerate(("Delta_x", "Delta_y", "Delta_z")):
+        pr = _parse(item["expr"][c])
+        d = sp.expand(derived_eqs[i])
+        diff = sp.simplify(d - pr)
+        ev = f"derived row {i + 1} of (T_ES - I) Rz(C) [x_C, y_C, z_C, 1]^T = {fmt(d)}; " \
+             f"derived - printed = {fmt(diff)}"
+        erratum = "differs"
+        cat, tried, used = "printing_error", [], []
+        if diff != 0 and sp.simplify(sp.expand(d + pr - 2 * (d - d.coeff(SYM["ECC"])
+                                                             * SYM["ECC"]))) == 0:
+            erratum = "sign of the E_CC term"
+            ecc = SYM["ECC"]
+            same_as_matrix = sp.simplify(sp.expand(printed_rows[i]).coeff(ecc)
+                                         - d.coeff(ecc)) == 0
+            ev += ("; only the sign of the E_CC term differs"
+                   + ("; the printed matrix just above gives the derived sign (+E_CC cos C, "
+                      "-E_CC sin C in its row 2), so the equation contradicts its own matrix"
+                      if same_as_matrix else "")
+                   + "; eq. 3.4 (ch. 3) prints the same row with the derived sign. Category "
+                   "undecidable: one extra minus sign, glyph-level damage that the print and "
+                   "the text extraction explain equally (the matrix above and eq. 3.4 show the "
+                   "intended sign, not whether this print has the minus); what would decide: "
+                   "the page of the original PDF")
+            cat = "undecidable"
+            tried = ["row 2 of (T_ES - I) Rz(C) p (derived; the printed matrix above; eq. 3.4): "
+                     "the sign of the E_CC term differs",
+                     "a minus inserted by the print or by the extraction: exact"]
+            used = ["glyph:eq. 2.42 Delta_y extra minus"]
+        out.append(_v(eq, c, diff == 0, erratum, ev, item["expr"][c], fmt(d), category=cat))
+        out[-1].readings_tried, out[-1].readings_used = tried, used
+    return out
+
+
+def _tcc_verdict(eq: str, item: dict, t_cc: sp.Matrix) -> Verdict:
+    """The printed T_CC against the right-handed rotation Rz(C) of eq. 3.2."""
+    out = []
     printed_cc = _mat(item["T_CC"])
     bad = _entries(printed_cc, t_cc)
     det = sp.simplify(printed_cc[:3, :3].det())
@@ -150,6 +178,25 @@ def audit_rotary(item: dict) -> list[Verdict]:
                               "left-handed Rz(-C), transpose (passive): entry (2,2) differs",
                               "a minus inserted by the print or by the extraction: Rz(C) exactly"]
     out[-1].readings_used = ["glyph:eq. 2.42 T_CC extra minus"]
+    return out[0]
+
+
+def audit_rotary(item: dict) -> list[Verdict]:
+    eq = f"eq. {item['id']}"
+    e = [SYM[n] for n in ("EAC", "EBC", "ECC")]
+    t = [SYM[n] for n in ("EXC", "EYC", "EZC")]
+    t_es = _small_htm(e, t)
+    t_ss = _small_htm((SYM["SXC"], SYM["SYC"], 0), (0, 0, 0))
+    t_cc = _rz(C)
+    out = []
+    for name, derived, what in (("T_ES", t_es, "the small-angle HTM of the six error motions"),
+                                ("T_SS", t_ss, "the small-angle rotation by S_XC about x and "
+                                               "S_YC about y")):
+        bad = _entries(_mat(item[name]), derived)
+        out.append(_v(eq, name, not bad, "; ".join(bad), f"derived as {what}: "
+                      + ("all 16 entries agree" if not bad else "; ".join(bad)),
+                      str(item[name]), fmt(derived)))
+    out.append(_tcc_verdict(eq, item, t_cc))
     # the deviation matrix "neglecting the squareness errors"
     dev = (t_es - sp.eye(4)) * t_cc
     printed_m = _mat(item["error_matrix"])
@@ -218,39 +265,7 @@ def audit_rotary(item: dict) -> list[Verdict]:
                                   "the HTM T_ES Rz(C) (bottom row 0 0 0 1): its other entries "
                                   "would need the identity part, which the printed matrix lacks"]
         out[-1].readings_used = ["inconsistent:eq. 2.42 bottom row vs lhs"]
-    p = sp.Matrix([SYM["xC"], SYM["yC"], SYM["zC"], 1])
-    derived_eqs = dev * p
-    printed_rows = printed_m * p
-    for i, c in enumerate(("Delta_x", "Delta_y", "Delta_z")):
-        pr = _parse(item["expr"][c])
-        d = sp.expand(derived_eqs[i])
-        diff = sp.simplify(d - pr)
-        ev = f"derived row {i + 1} of (T_ES - I) Rz(C) [x_C, y_C, z_C, 1]^T = {fmt(d)}; " \
-             f"derived - printed = {fmt(diff)}"
-        erratum = "differs"
-        cat, tried, used = "printing_error", [], []
-        if diff != 0 and sp.simplify(sp.expand(d + pr - 2 * (d - d.coeff(SYM["ECC"])
-                                                             * SYM["ECC"]))) == 0:
-            erratum = "sign of the E_CC term"
-            ecc = SYM["ECC"]
-            same_as_matrix = sp.simplify(sp.expand(printed_rows[i]).coeff(ecc)
-                                         - d.coeff(ecc)) == 0
-            ev += ("; only the sign of the E_CC term differs"
-                   + ("; the printed matrix just above gives the derived sign (+E_CC cos C, "
-                      "-E_CC sin C in its row 2), so the equation contradicts its own matrix"
-                      if same_as_matrix else "")
-                   + "; eq. 3.4 (ch. 3) prints the same row with the derived sign. Category "
-                   "undecidable: one extra minus sign, glyph-level damage that the print and "
-                   "the text extraction explain equally (the matrix above and eq. 3.4 show the "
-                   "intended sign, not whether this print has the minus); what would decide: "
-                   "the page of the original PDF")
-            cat = "undecidable"
-            tried = ["row 2 of (T_ES - I) Rz(C) p (derived; the printed matrix above; eq. 3.4): "
-                     "the sign of the E_CC term differs",
-                     "a minus inserted by the print or by the extraction: exact"]
-            used = ["glyph:eq. 2.42 Delta_y extra minus"]
-        out.append(_v(eq, c, diff == 0, erratum, ev, item["expr"][c], fmt(d), category=cat))
-        out[-1].readings_tried, out[-1].readings_used = tried, used
+    out.extend(_deviation_rows(eq, item, dev, printed_m))
     return out
 
 
