@@ -3,7 +3,7 @@ numbers recomputed), the squareness of eq. 2.39, the infinitesimal rotation of e
 the straightedge reversal of eq. 2.43-2.44, the Type A statistics of eq. 2.45-2.49 and the
 standard deviation of the appendix C.2 script (sympy / numpy, no file I/O).
 
-The printed material is the parsed ``volerr/derive/audit/data/printed_ch2.toml``.  Printed numbers are
+The printed material is the parsed ``data/printed_ch2.toml``.  Printed numbers are
 compared with the exact value first; a number with k decimals stands for its rounding interval
 (+-0.5e-k).  Where only the rounded intermediates printed in the text reproduce a result, the
 verdict is a convention (``rounding:``), with both values in the evidence.

@@ -1,6 +1,6 @@
 """Audit of the DMU 50 kinematics printed in Ellingsdalen (2021) against the derivation.
 
-The printed material comes as the parsed ``volerr/derive/audit/data/printed_dmu50.toml`` (no file I/O here):
+The printed material comes as the parsed ``data/printed_dmu50.toml`` (no file I/O here):
 Sorby's forward kinematics (eq. 3.19-3.24) and inverse (eq. 3.25-3.29), the chain of HTMs
 (eq. 3.30-3.36), their product (eq. 3.37), the chain "updated" with the errors, and Listing 3.3
 (``T_r``, ``rot_x/y/z``, ``T_er``).  The authority is the derivation from

@@ -3,7 +3,7 @@ conference paper (thesis appendix A, eq. 1.1-1.19), ch. 3 (eq. 3.1-3.3, 3.16-3.1
 and the specialization project report (appendix B, eq. 1-9, 16, 17, 23, 24, 27-29); sympy, no
 file I/O.
 
-The printed material is the parsed ``volerr/derive/audit/data/printed_htm.toml``.  The authority:
+The printed material is the parsed ``data/printed_htm.toml``.  The authority:
 
 * chain factors: :func:`volerr.derive.audit.dmu50.derived_factors` of the DMU50 layout (the
   factor form the DMU 50 audit checks against the chain), products against

@@ -1,6 +1,6 @@
 """Audit of printed code listings (Ellingsdalen 2021, Listings 3.1, 3.3, 3.4): run them.
 
-The printed code comes as the parsed ``volerr/derive/audit/data/printed_listings.toml`` (the statements as
+The printed code comes as the parsed ``data/printed_listings.toml`` (the statements as
 printed, with the extraction repairs listed there).  The audit executes that code with numpy on
 small examples whose intended result is known in closed form, and compares:
 

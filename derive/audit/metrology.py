@@ -3,7 +3,7 @@ coordinates (project report eq. 25), the multilateration residual (eq. 26), and 
 specifications of project report sec. 2.8 against the values the conference paper quotes in its
 sec. 6 (sympy / numpy, no file I/O).
 
-The printed material is the parsed ``volerr/derive/audit/data/printed_metrology.toml``.
+The printed material is the parsed ``data/printed_metrology.toml``.
 
 * eq. 25: a tracker measures the distance r, the azimuth az (in the xy-plane from +x) and the
   elevation el (from the xy-plane): x = r cos el cos az, y = r cos el sin az, z = r sin el.

@@ -1,6 +1,6 @@
 """Arithmetic consistency of printed numbers in both seed documents (no file I/O).
 
-The printed numbers come as the parsed ``volerr/derive/audit/data/printed_numbers.toml`` (values kept with
+The printed numbers come as the parsed ``data/printed_numbers.toml`` (values kept with
 their printed digits).  A printed value ``v`` with ``k`` decimals stands for the interval
 ``v +- 0.5 * 10^-k`` (its rounding interval); two quotes of one quantity agree when their
 intervals meet; a derived quantity (a percentage, a count) agrees when the printed value's

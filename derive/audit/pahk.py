@@ -1,6 +1,6 @@
 """Audit of Pahk (1995), sec. 2 and appendix, against the derivation (sympy, no file I/O).
 
-The printed equations come as the parsed ``volerr/derive/audit/data/printed_pahk.toml`` (its header states
+The printed equations come as the parsed ``data/printed_pahk.toml`` (its header states
 the symbol mapping and the geometries the text allows).  The authority is the derivation from
 the physical layout (``volerr/layouts/<name>.toml``: :func:`volerr.derive.volumetric.
 volumetric_error` of ``Chain.from_layout(layout)``), written in the paper's symbols through the

@@ -1,6 +1,6 @@
 """Audit of Pahk's probe error model (sec. 3, eq. 11-17) against :mod:`volerr.derive.probe`.
 
-The printed material is the parsed ``volerr/derive/audit/data/printed_probe.toml`` (no file I/O here).
+The printed material is the parsed ``data/printed_probe.toml`` (no file I/O here).
 The authority is the construction of eq. (11) itself (cross products of the probe axis with
 e_z) and, for the signs of eq. (13) and (17), a first-order model of a trigger probe on a
 surface: the ball centre is recorded ``delta`` (pretravel) nearer the surface than at the

@@ -3,7 +3,7 @@
 project report that their plots carry (consistency only: the data are not in the text), and
 the parameter counts and band / repeatability pairs of Pahk (1995) sec. 4.
 
-The printed material is the parsed ``volerr/derive/audit/data/printed_results.toml``.  A printed value with
+The printed material is the parsed ``data/printed_results.toml``.  A printed value with
 k decimals (or k significant digits, as numpy prints) stands for its rounding interval.
 
 * Figure 3.11: Listing 3.4 compensates by ``NC + (T(X) - T_e(X)) [0 0 0 1]``; on a pure X move

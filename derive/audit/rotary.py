@@ -1,6 +1,6 @@
 """Audit of the axis error models of Ellingsdalen (2021), sec. 2.5 and eq. 3.15 (sympy, no I/O).
 
-The printed material is the parsed ``volerr/derive/audit/data/printed_rotary.toml``.  The authority is
+The printed material is the parsed ``data/printed_rotary.toml``.  The authority is
 written here from first principles, independently of the printed matrices:
 
 * a linear axis X: the moved point is ``Trans(x) E p`` with the small-angle error HTM

@@ -2,7 +2,7 @@
 errors of the X axis from three points on the spindle) and D.1 (the B axis from three points
 on the table); sympy / numpy, no file I/O.
 
-The printed material (``volerr/derive/audit/data/printed_scripts.toml``) keeps only what the extraction left
+The printed material (``data/printed_scripts.toml``) keeps only what the extraction left
 legible.  The authority:
 
 * C.1: Cramer's rule on the selected system of eq. 32 (rows P x, P y, Q x, Q z, K y, K z of the
@@ -93,6 +93,65 @@ def _line_span(terms) -> str:
     return f"lines {min(nums)}-{max(nums)}" if nums else "its lines"
 
 
+def _c1_terms(terms: list, cof: dict, devs: dict, by_dev: dict, loc: dict) -> tuple[list, list]:
+    """The legible terms of one formula of appendix C.1 against the derived cofactors: the
+    lines that match (checked) and those that do not (bad), each described."""
+    checked, bad, used_d = [], [], set()
+    for t in terms:
+        pc = sp.expand(t["sign"] * sp.sympify(t["cofactor"], locals=loc))
+        if t["status"] == "complete":
+            dv = by_dev.get(sp.expand(sp.sympify(t["d"], locals=loc)))
+            ok = dv is not None and sp.expand(pc - cof[dv]) == 0
+            used_d.add(dv)
+            (checked if ok else bad).append(
+                f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}{_paren(t['cofactor'])} * "
+                f"({t['d']}) " + ("= the derived term of " + str(dv) if ok else
+                                  f"!= the derived {fmt(cof.get(dv, 'none'))} of {dv}")
+                + _repairs(t))
+    for t in terms:
+        if t["status"] != "cofactor":
+            continue
+        pc = sp.expand(t["sign"] * sp.sympify(t["cofactor"], locals=loc))
+        hit = [d for d in devs if d not in used_d and sp.expand(pc - cof[d]) == 0]
+        if hit:
+            used_d.add(hit[0])
+            checked.append(f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}"
+                           f"{_paren(t['cofactor'])} (deviation lost) = the derived cofactor of "
+                           f"{hit[0]}, the one deviation left" + _repairs(t))
+        else:
+            bad.append(f"line {t['line']}: {t['cofactor']} matches no remaining cofactor")
+    return checked, bad
+
+
+def _unit_factor_verdict(c1: dict, name: str, factor: str, unit: str) -> Verdict:
+    """The unit factor of E_YX in appendix C.1 ('+ 1e3' where '* 1e3' belongs): undecidable."""
+    out = []
+    out.append(_v(f"{c1['id']} {name}", "unit factor", "undecidable",
+                  f"'{factor}' where the other translational errors have '{unit}'",
+                  f"{c1['factor_text'].get(name, '')}: the mm result is converted to um "
+                  f"by '{unit}' in E_XX and E_ZX (and to urad by '* 1e6' in E_AX .. "
+                  f"E_CX); '{factor}' adds 1000 instead, which would make E_YX near "
+                  f"1000 um and its compensation near -1 mm. The thesis' own results, "
+                  f"made with this script, rule that out: sec. 4.1.1 ('The two "
+                  f"straightness errors E_YX and E_ZX are much lower' than E_XX's "
+                  f"20.5 um), sec. 4.2.1 (E_YX 'improved from 6.6 um before "
+                  f"compensation, to 1.3 um after compensation') and the compensated "
+                  f"NC-data of Figure 3.11 (ideal Y 0), whose Y coordinates all stay "
+                  f"within 1 um (largest -0.000949 mm, at X 49.9956 mm); "
+                  f"appendix B sec. 4 (the project's own script) agrees ('significantly "
+                  f"lower' than E_XX's 23 um): the script that made the results "
+                  f"multiplied. Category undecidable: the extraction demonstrably "
+                  f"renders '*' as '+' in this same function -- the first monomial of "
+                  f"the d_yP term, '(x_xK_{{y_xK}} + z_xP - N)' at the end of line 97, "
+                  f"reads x_xK*y_xK*z_xP (see the E_YX formula verdict) -- but a '+' "
+                  f"typed into a listing edited after the run explains the print as "
+                  f"well; what would decide: the page of the original PDF",
+                  factor, unit, [f"'{factor}' as printed: E_YX + 1000 um",
+                                 f"'{unit}' (a glyph misread or misprinted): the plotted "
+                                 f"values"], [f"glyph:appendix C.1 {name} unit factor"]))
+    return out[0]
+
+
 def audit_c1(c1: dict) -> list[Verdict]:
     loc = _c1_locals("x")
     cf = closed_form("x")
@@ -108,30 +167,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
         cof = {d: sp.expand(sp.cancel(sp.diff(sol, d) * N)) * n_sign for d in devs}
         terms = [t for t in c1.get("term", []) if t["formula"] == name]
         damaged = [d["what"] for d in c1.get("damaged", []) if d["formula"] == name]
-        checked, bad, used_d = [], [], set()
-        for t in terms:
-            pc = sp.expand(t["sign"] * sp.sympify(t["cofactor"], locals=loc))
-            if t["status"] == "complete":
-                dv = by_dev.get(sp.expand(sp.sympify(t["d"], locals=loc)))
-                ok = dv is not None and sp.expand(pc - cof[dv]) == 0
-                used_d.add(dv)
-                (checked if ok else bad).append(
-                    f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}{_paren(t['cofactor'])} * "
-                    f"({t['d']}) " + ("= the derived term of " + str(dv) if ok else
-                                      f"!= the derived {fmt(cof.get(dv, 'none'))} of {dv}")
-                    + _repairs(t))
-        for t in terms:
-            if t["status"] != "cofactor":
-                continue
-            pc = sp.expand(t["sign"] * sp.sympify(t["cofactor"], locals=loc))
-            hit = [d for d in devs if d not in used_d and sp.expand(pc - cof[d]) == 0]
-            if hit:
-                used_d.add(hit[0])
-                checked.append(f"line {t['line']}: {'+' if t['sign'] > 0 else '-'}"
-                               f"{_paren(t['cofactor'])} (deviation lost) = the derived cofactor of "
-                               f"{hit[0]}, the one deviation left" + _repairs(t))
-            else:
-                bad.append(f"line {t['line']}: {t['cofactor']} matches no remaining cofactor")
+        checked, bad = _c1_terms(terms, cof, devs, by_dev, loc)
         factor = c1["factors"][name]
         unit = "* 1e3" if motion in ("EX", "EY", "EZ") else "* 1e6"
         n_is = ("the derived determinant" if n_sign == 1 else "minus the derived determinant"
@@ -188,29 +224,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
             out.append(_v(f"{c1['id']} {name}", "formula", "identical", "", ev,
                           f"{name} (appendix C.1)", "Cramer's rule", tried))
         if factor != unit:
-            out.append(_v(f"{c1['id']} {name}", "unit factor", "undecidable",
-                          f"'{factor}' where the other translational errors have '{unit}'",
-                          f"{c1['factor_text'].get(name, '')}: the mm result is converted to um "
-                          f"by '{unit}' in E_XX and E_ZX (and to urad by '* 1e6' in E_AX .. "
-                          f"E_CX); '{factor}' adds 1000 instead, which would make E_YX near "
-                          f"1000 um and its compensation near -1 mm. The thesis' own results, "
-                          f"made with this script, rule that out: sec. 4.1.1 ('The two "
-                          f"straightness errors E_YX and E_ZX are much lower' than E_XX's "
-                          f"20.5 um), sec. 4.2.1 (E_YX 'improved from 6.6 um before "
-                          f"compensation, to 1.3 um after compensation') and the compensated "
-                          f"NC-data of Figure 3.11 (ideal Y 0), whose Y coordinates all stay "
-                          f"within 1 um (largest -0.000949 mm, at X 49.9956 mm); "
-                          f"appendix B sec. 4 (the project's own script) agrees ('significantly "
-                          f"lower' than E_XX's 23 um): the script that made the results "
-                          f"multiplied. Category undecidable: the extraction demonstrably "
-                          f"renders '*' as '+' in this same function -- the first monomial of "
-                          f"the d_yP term, '(x_xK_{{y_xK}} + z_xP - N)' at the end of line 97, "
-                          f"reads x_xK*y_xK*z_xP (see the E_YX formula verdict) -- but a '+' "
-                          f"typed into a listing edited after the run explains the print as "
-                          f"well; what would decide: the page of the original PDF",
-                          factor, unit, [f"'{factor}' as printed: E_YX + 1000 um",
-                                         f"'{unit}' (a glyph misread or misprinted): the plotted "
-                                         f"values"], [f"glyph:appendix C.1 {name} unit factor"]))
+            out.append(_unit_factor_verdict(c1, name, factor, unit))
     return out
 
 

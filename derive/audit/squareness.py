@@ -3,7 +3,7 @@ Listing 3.1, their sum in Listing 3.2 (against the difference of eq. 2.39) and t
 Listing 3.4 (``Y * S_YX``, ``(-Z) * S_ZX``, ``(-Z) * S_ZY`` against the ``+y E_C(0X)Y``,
 ``+z E_B(0X)Z``, ``+z E_A(0Y)Z`` of eq. 3.17-3.18); numpy only, no file I/O.
 
-The printed code (``volerr/derive/audit/data/printed_squareness.toml``) is RUN on straightness data of
+The printed code (``data/printed_squareness.toml``) is RUN on straightness data of
 known slopes.  With E_ij = k_ij q_j (the deviation along i while axis j moves, slope k_ij):
 
 * eq. 2.39 (ISO 230-1): the squareness is the difference of the two lines' inclinations

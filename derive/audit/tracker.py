@@ -1,6 +1,6 @@
 """Audit of the three-point identification equations of Ellingsdalen (2021) (sympy, no I/O).
 
-The printed equations come as the parsed ``volerr/derive/audit/data/printed_tracker.toml`` (its header gives
+The printed equations come as the parsed ``data/printed_tracker.toml`` (its header gives
 the symbol mapping).  The authority is :mod:`volerr.derive.three_point`: the small-angle
 displacement of a point fixed on the moving body (``(I + D) r - r`` with the error twist of
 :mod:`volerr.derive.kinematics`), the ``3n x 6`` system, and the Zhang & Hu closed forms solved

@@ -1,11 +1,11 @@
 """Numeric spot check of a generated model against the printed equations of its layout.
 
 No sympy: the printed expressions of ``volerr/derive/audit/data/printed_pahk.toml`` (their OCR
-reading where the data file gives one) are evaluated with numpy at random points, with random
-error values, and compared with the generated model (first-order volumetric error; random
-error by Pahk's term-wise quadrature and by exact propagation).  A difference at rounding level (~1e-12 um)
-means the generated code reproduces the printed equation; anything larger is a real
-difference, which ``volerr audit`` names and explains.
+reading where the data file gives one) are evaluated with numpy at random points, with random error
+values, and compared with the generated model (first-order volumetric error; random error by Pahk's
+term-wise quadrature and by exact propagation). A difference at rounding level (~1e-12 um) means
+the generated code reproduces the printed equation; anything larger is a real difference, which
+``volerr audit`` names and explains.
 
 Units: positions and probe offsets mm, translational errors mm, angular errors rad; reported
 differences in um.

@@ -1,16 +1,15 @@
 """``volerr audit [LAYOUT...] [--json F] [--html F] [--detail] [--numeric]``: printed vs derived.
 
 Every provider of :data:`volerr.derive.audit.PROVIDERS` audits its source document: the command
-reads the provider's data file (``volerr/derive/audit/data/<DATA_FILE>``, the printed
-equations kept as printed) and passes it on.  Output: a table with one row per printed equation (source,
-equation, layout, verdict, erratum) on stdout; ``--detail`` gives one row per component;
-``--json F`` writes the list of verdicts with their evidence; ``--html F`` one page with a
-section per source document (rendered math, category, evidence).  Every verdict has a category
-(identical, printing_error, extraction, convention, simplification, undecidable); the summary
-line counts them.  Finding errata is the purpose,
-so the exit code is 0 when errata are found; 2 for bad input (unknown layout ...).
-``--numeric`` also spot-checks the generated models numerically against the printed equations
-of their layouts (no derivation involved).
+reads the provider's data file (``volerr/derive/audit/data/<DATA_FILE>``, the printed equations
+kept as printed) and passes it on. Output: a table with one row per printed equation (source,
+equation, layout, verdict, erratum) on stdout; ``--detail`` gives one row per component; ``--json
+F`` writes the list of verdicts with their evidence; ``--html F`` one page with a section per
+source document (rendered math, category, evidence). Every verdict has a category (identical,
+printing_error, extraction, convention, simplification, undecidable); the summary line counts them.
+Finding errata is the purpose, so the exit code is 0 when errata are found; 2 for bad input
+(unknown layout ...). ``--numeric`` also spot-checks the generated models numerically against the
+printed equations of their layouts (no derivation involved).
 """
 
 from __future__ import annotations

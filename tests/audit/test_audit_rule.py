@@ -1,6 +1,6 @@
-"""The category rule of the audit (derive.audit.framework.PRIORITY_RULE): every combination of readings is
-tried and the category follows fixed priorities; one reading key has one category on every
-layout and in every document; every verdict lists its readings.  The expected categories are
+"""The category rule of the audit (derive.audit.framework.PRIORITY_RULE): every combination of
+readings is tried and the category follows fixed priorities; one reading key has one category on
+every layout and in every document; every verdict lists its readings. The expected categories are
 derived here from the rule's definition (not through the audit's own search)."""
 
 from __future__ import annotations

@@ -22,7 +22,8 @@ from volerr.derive.audit import scripts as audit_scripts, squareness as audit_sq
 
 
 def data(name):
-    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name).read_text("utf-8"))
+    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name)
+                         .read_text("utf-8"))
 
 
 def find(vs, eq, comp=None):

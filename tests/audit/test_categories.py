@@ -22,7 +22,8 @@ from volerr.derive.audit import tracker as audit_tracker
 
 
 def data(name):
-    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name).read_text("utf-8"))
+    return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name)
+                         .read_text("utf-8"))
 
 
 def find(verdicts, eq, comp=""):
