@@ -214,6 +214,77 @@ def _reading_index(name: str, geoms: tuple) -> dict:
     return out
 
 
+def _chain_erratum(found: list, best, best_lit, name: str, lay, geoms: tuple, literal,
+                   ev: list) -> str:
+    """The erratum of a chain that differs: the chain reading that repairs it, else the reading
+    of the layout it is, else the closest reading (the evidence is appended to ``ev``)."""
+    if best is not None and best[0][0] != found[0][0]:
+        fix = best[0][0].split(" (labels exchanged")[0]
+        how = "" if best[1].cost() == 0 else f" read as: {best[1].describe(lay)}"
+        ev.append(f"The chain {best[0][0]} gives the layout's model{how}.")
+        kind = "labels misplaced" if "labels exchanged" in best[0][0] else "misprinted"
+        fix = fix.split(":")[0] if kind == "misprinted" else fix
+        erratum = f"chain {kind}: {fix}" + ("" if best[1].cost() == 0
+                                            else f" ({best[1].short(lay)} reading)")
+    elif best_lit is not None:
+        erratum = f"{best_lit[1].short(lay)} reading"
+    else:
+        closest = min(readings(name, geoms), key=lambda r: (sum(
+            n_diff(a, b) for a, b in zip(derived_error(name, r), literal)), r.cost()))
+        dd = derived_error(name, closest)
+        k = sum(n_diff(a, b) for a, b in zip(dd, literal))
+        erratum = f"chain matches no reading ({k} terms off {closest.short(lay)})"
+        ev.append(f"No chain reading gives the layout's model under any reading; the printed "
+                  f"chain is closest to the layout read as: {closest.describe(lay)} (" +
+                  " | ".join(describe_diff(a, b) for a, b in zip(dd, literal) if n_diff(a, b))
+                  + ").")
+    return erratum
+
+
+def _chain_category(v: Verdict, best, best_lit, vol_reading, result_eq: dict | None, name: str,
+                    lay, literal, physical, geoms: tuple) -> list[Verdict]:
+    """The category of a chain that differs: by the reading of the layout it is (a stacking
+    the result equation contradicts is a printing error), else a printing error."""
+    want = vol_reading.stacking(lay) if vol_reading is not None else \
+        (tuple(lay.tool_chain), tuple(lay.workpiece_chain))
+    if best_lit is not None:
+        keys, r = best_lit
+        cat = category_of(keys)
+        if r.stacking(lay) != want and cat != "printing_error":
+            from .pahk_model import stacking_text
+            v.evidence += (f" The chain stacks the axes {stacking_text(*r.stacking(lay))}, a "
+                           f"geometry the text allows, but the same layout's result equation "
+                           f"{result_eq['id'] if result_eq else ''} needs "
+                           f"{stacking_text(*want)}: the document contradicts itself, a "
+                           f"printing error of the chain. The other way round (the chain "
+                           f"right, eq. {result_eq['id'] if result_eq else ''} misprinted) "
+                           f"would need every component of the result equation misprinted in "
+                           f"the same way, while the layout's own stacking reproduces it "
+                           f"(see its verdicts); an extraction would have to exchange the "
+                           f"well-formed axis labels of the chain consistently, which no "
+                           f"glyph resemblance explains.")
+            v.readings_used = list(keys) + [f"inconsistent:{name} stacking of the chain"]
+            return [classify(v, "printing_error", alternative=_vec(best[0][2])
+                             if best is not None else "")]
+        v.readings_used = list(keys)
+        if cat in ("convention", "simplification"):
+            return [_convention(v, r, lay, literal, physical, keys, geoms)]
+        if cat == "printing_error":
+            v.evidence += (" The printed chain is the layout only with an axis stacking the "
+                           "text excludes (another machine): a printing error.")
+        return [classify(v, cat, alternative=_vec(best[0][2]) if best is not None else "")]
+    v.evidence += (" The printed chain is not the layout under any reading (conventions, "
+                   "geometries the text allows, or other stackings): a printing error.")
+    if best is not None and "labels exchanged" in best[0][0]:
+        v.evidence += (" The printed labels are a permutation of the right ones (each stands "
+                       "once, none is lost or repeated): no repetition within the image; an "
+                       "extraction would have to exchange well-formed labels consistently, "
+                       "which no glyph resemblance explains (x, y, z).")
+    v.readings_used = []
+    return [classify(v, "printing_error",
+                     alternative=_vec(best[0][2]) if best is not None else "")]
+
+
 def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
                 vol_reading) -> list[Verdict]:
     """One verdict on a printed chain: its first-order error against the derived model.
@@ -288,67 +359,12 @@ def audit_chain(eq: dict, by_id: dict, result_eq: dict | None, geoms: tuple,
             tried.append(f"the chain {f[0]}: gives the layout read as {r.short(lay)}"
                          + (" -- an axis stacking the text excludes for this layout (another "
                             "machine), so it repairs nothing" if other else ""))
-    if best is not None and best[0][0] != found[0][0]:
-        fix = best[0][0].split(" (labels exchanged")[0]
-        how = "" if best[1].cost() == 0 else f" read as: {best[1].describe(lay)}"
-        ev.append(f"The chain {best[0][0]} gives the layout's model{how}.")
-        kind = "labels misplaced" if "labels exchanged" in best[0][0] else "misprinted"
-        fix = fix.split(":")[0] if kind == "misprinted" else fix
-        erratum = f"chain {kind}: {fix}" + ("" if best[1].cost() == 0
-                                            else f" ({best[1].short(lay)} reading)")
-    elif best_lit is not None:
-        erratum = f"{best_lit[1].short(lay)} reading"
-    else:
-        closest = min(readings(name, geoms), key=lambda r: (sum(
-            n_diff(a, b) for a, b in zip(derived_error(name, r), literal)), r.cost()))
-        dd = derived_error(name, closest)
-        k = sum(n_diff(a, b) for a, b in zip(dd, literal))
-        erratum = f"chain matches no reading ({k} terms off {closest.short(lay)})"
-        ev.append(f"No chain reading gives the layout's model under any reading; the printed "
-                  f"chain is closest to the layout read as: {closest.describe(lay)} (" +
-                  " | ".join(describe_diff(a, b) for a, b in zip(dd, literal) if n_diff(a, b))
-                  + ").")
+    erratum = _chain_erratum(found, best, best_lit, name, lay, geoms, literal, ev)
     v = Verdict(SOURCE, eq["id"], name, "differs", erratum, " ".join(ev),
                 f"{text}  =>  {_vec(literal)}", _vec(physical))
     v.readings_tried = tried
-    want = vol_reading.stacking(lay) if vol_reading is not None else \
-        (tuple(lay.tool_chain), tuple(lay.workpiece_chain))
-    if best_lit is not None:
-        keys, r = best_lit
-        cat = category_of(keys)
-        if r.stacking(lay) != want and cat != "printing_error":
-            from .pahk_model import stacking_text
-            v.evidence += (f" The chain stacks the axes {stacking_text(*r.stacking(lay))}, a "
-                           f"geometry the text allows, but the same layout's result equation "
-                           f"{result_eq['id'] if result_eq else ''} needs "
-                           f"{stacking_text(*want)}: the document contradicts itself, a "
-                           f"printing error of the chain. The other way round (the chain "
-                           f"right, eq. {result_eq['id'] if result_eq else ''} misprinted) "
-                           f"would need every component of the result equation misprinted in "
-                           f"the same way, while the layout's own stacking reproduces it "
-                           f"(see its verdicts); an extraction would have to exchange the "
-                           f"well-formed axis labels of the chain consistently, which no "
-                           f"glyph resemblance explains.")
-            v.readings_used = list(keys) + [f"inconsistent:{name} stacking of the chain"]
-            return [classify(v, "printing_error", alternative=_vec(best[0][2])
-                             if best is not None else "")]
-        v.readings_used = list(keys)
-        if cat in ("convention", "simplification"):
-            return [_convention(v, r, lay, literal, physical, keys, geoms)]
-        if cat == "printing_error":
-            v.evidence += (" The printed chain is the layout only with an axis stacking the "
-                           "text excludes (another machine): a printing error.")
-        return [classify(v, cat, alternative=_vec(best[0][2]) if best is not None else "")]
-    v.evidence += (" The printed chain is not the layout under any reading (conventions, "
-                   "geometries the text allows, or other stackings): a printing error.")
-    if best is not None and "labels exchanged" in best[0][0]:
-        v.evidence += (" The printed labels are a permutation of the right ones (each stands "
-                       "once, none is lost or repeated): no repetition within the image; an "
-                       "extraction would have to exchange well-formed labels consistently, "
-                       "which no glyph resemblance explains (x, y, z).")
-    v.readings_used = []
-    return [classify(v, "printing_error",
-                     alternative=_vec(best[0][2]) if best is not None else "")]
+    return _chain_category(v, best, best_lit, vol_reading, result_eq, name, lay, literal,
+                           physical, geoms)
 
 
 def _convention(v: Verdict, r, lay, literal, physical, keys, geoms=()) -> Verdict:
