@@ -413,22 +413,11 @@ def _product_diff(printed: list, derived: list) -> tuple[bool, str, str]:
 
 
 # ------------------------------------------------------------------------------ the audit
-def audit(printed: dict, layouts=None) -> list[Verdict]:
-    if layouts is not None and "DMU50" not in layouts:
-        return []
-    layout, chain, fwd, rinv, linv = _derived()
-    d_value = float(layout.parameters["d"])
-    out: list[Verdict] = []
-    rng = np.random.default_rng(20210)
-    n = 200
-    q = {"X": rng.uniform(-250, 250, n), "Y": rng.uniform(-225, 225, n),
-         "Z": rng.uniform(0, 400, n), "B": np.deg2rad(rng.uniform(1, 179, n)),
-         "C": np.deg2rad(rng.uniform(-179, 179, n))}
-    subs_num = {D: d_value}
-    fnum = {k: sp.lambdify((X, Y, Z, B, C), v.subs(subs_num), "numpy") for k, v in fwd.items()}
-    pose = {k: np.broadcast_to(f(q["X"], q["Y"], q["Z"], q["B"], q["C"]), (n,)) for k, f in
-            fnum.items()}
-
+def _audit_formulas(printed: dict, fwd: dict, rinv: dict, linv: dict, q: dict, pose: dict,
+                    n: int, subs_num: dict) -> list[Verdict]:
+    """The printed forward and inverse formulas against the derivation, symbolically and at the
+    ``n`` random poses ``q`` (axis positions) / ``pose`` (tool tip and axis)."""
+    out = []
     for item in printed.get("formula", []):
         eq, qty = f"eq. {item['id']}", item["quantity"]
         pr = _parse(item["expr"])
@@ -467,17 +456,12 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
               f"printed formula returns the commanded {qty} to {np.nanmax(err_true):.2g}")
         out.append(_verdict(eq, same, "wrong inverse formula", ev, item["expr"], fmt(der), qty))
 
-    factors = derived_factors(layout)
-    # the factor form must reproduce the chain (workpiece side, machine <- workpiece)
-    t0w = sp.eye(4)
-    for name in ("T_0^1", "T_1^2", "T_2^3", "T_3^4", "T_4^5", "T_5^w"):
-        t0w = t0w * factors[name]
-    # T_0^w @ tool2work(X = Y = Z = 0) must be the identity (checked at random angles)
-    wp = chain.nominal_htm().subs({X: 0, Y: 0, Z: 0})
-    check = sp.lambdify((B, C, D), t0w * wp - sp.eye(4), "numpy")
-    for bb, cc in rng.uniform(-3, 3, (5, 2)):
-        assert np.abs(np.array(check(bb, cc, d_value), float)).max() < 1e-9, \
-            "factor form does not reproduce the chain"
+    return out
+
+
+def _audit_matrices(printed: dict, factors: dict, fwd: dict) -> list[Verdict]:
+    """The printed factor matrices (thesis and updated error chain) against the derived factors."""
+    out = []
     chain45 = next((m for m in printed.get("matrix", [])
                     if m["id"].startswith("error chain") and m["name"] == "T_4^5"), None)
     t32 = next((m for m in printed.get("matrix", []) if m["name"] == "T_2^3"
@@ -519,7 +503,12 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
         v.readings_tried, v.readings_used = tried, used
         out.append(v)
 
-    prod = printed.get("product", {})
+    return out
+
+
+def _audit_eq337(prod: dict) -> list[Verdict]:
+    """The printed order of the factors of eq. 3.37 against the derived order."""
+    out = []
     if "3.37" in prod:
         same, erratum, ev = _product_diff(prod["3.37"], DERIVED_ORDER)
         v = _verdict("eq. 3.37", same, erratum, ev + "; T_a^b maps frame b into frame a, "
@@ -544,15 +533,13 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                             "the derived order (see eq. 1.8)"]
         v.readings_used = ["glyph:eq. 3.37 factor T_2^2 repeats its superscript"]
         out.append(v)
-    lst = printed.get("listing", {})
-    names = {"T_d": "T_0^1", "T_45": "T_1^2", "T_B": "T_2^3", "T_n45": "T_3^4", "T_nd": "T_4^5",
-             "T_C": "T_5^w"}
-    for lname, fname in names.items():
-        if lname in lst:
-            same, erratum, ev = _matrix_diff(lst[lname], factors[fname])
-            out.append(_verdict(f"Listing 3.3 {lname}", same, erratum,
-                                ev + f" (derived {fname})", str(lst[lname]),
-                                fmt(factors[fname]), lname))
+    return out
+
+
+def _listing_line46(prod: dict, lst: dict, t0w: sp.Matrix) -> list[Verdict]:
+    """Line 46 of Listing 3.3 (T_r, the product of the listing's factors) against the derived
+    T_0^w, with the reading of its leading minus."""
+    out = []
     key = "listing 3.3 line 46"
     if key in prod:
         pr = prod[key]
@@ -605,6 +592,12 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                                 "it"]
             v.readings_used = ["glyph:Listing 3.3 line 46 leading minus"]
         out.append(v)
+    return out
+
+
+def _listing_rotations(lst: dict) -> list[Verdict]:
+    """rot_x, rot_y, rot_z of Listing 3.3 against the right-handed rotations."""
+    out = []
     std = {"rot_x": rotation((1, 0, 0), A_SYM), "rot_y": rotation((0, 1, 0), A_SYM),
            "rot_z": rotation((0, 0, 1), A_SYM)}
     for rname, m in std.items():
@@ -627,6 +620,12 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
             v = _verdict(f"Listing 3.3 {rname}", same, erratum, ev, str(lst[rname]), fmt(m), rname)
             v.readings_tried, v.readings_used = tried, used
             out.append(v)
+    return out
+
+
+def _listing_sources(lst: dict) -> list[Verdict]:
+    """The data file each parameter of T_er in Listing 3.3 reads ('<name>_avg.')."""
+    out = []
     if "sources" in lst:
         texts = lst.get("sources_text", {})
         modes = "; ".join(f"the line of {n} {'as LaTeX' if '_{' in ls[-1] else 'as plain code'}"
@@ -655,6 +654,54 @@ def audit(printed: dict, layouts=None) -> list[Verdict]:
                                     f"extraction (a token repeated within the image): exact"]
                 v.readings_used = [f"glyph:Listing 3.3 line for {pname} repeats the name above"]
             out.append(v)
+    return out
+
+
+def audit(printed: dict, layouts=None) -> list[Verdict]:
+    if layouts is not None and "DMU50" not in layouts:
+        return []
+    layout, chain, fwd, rinv, linv = _derived()
+    d_value = float(layout.parameters["d"])
+    out: list[Verdict] = []
+    rng = np.random.default_rng(20210)
+    n = 200
+    q = {"X": rng.uniform(-250, 250, n), "Y": rng.uniform(-225, 225, n),
+         "Z": rng.uniform(0, 400, n), "B": np.deg2rad(rng.uniform(1, 179, n)),
+         "C": np.deg2rad(rng.uniform(-179, 179, n))}
+    subs_num = {D: d_value}
+    fnum = {k: sp.lambdify((X, Y, Z, B, C), v.subs(subs_num), "numpy") for k, v in fwd.items()}
+    pose = {k: np.broadcast_to(f(q["X"], q["Y"], q["Z"], q["B"], q["C"]), (n,)) for k, f in
+            fnum.items()}
+
+    out.extend(_audit_formulas(printed, fwd, rinv, linv, q, pose, n, subs_num))
+
+    factors = derived_factors(layout)
+    # the factor form must reproduce the chain (workpiece side, machine <- workpiece)
+    t0w = sp.eye(4)
+    for name in ("T_0^1", "T_1^2", "T_2^3", "T_3^4", "T_4^5", "T_5^w"):
+        t0w = t0w * factors[name]
+    # T_0^w @ tool2work(X = Y = Z = 0) must be the identity (checked at random angles)
+    wp = chain.nominal_htm().subs({X: 0, Y: 0, Z: 0})
+    check = sp.lambdify((B, C, D), t0w * wp - sp.eye(4), "numpy")
+    for bb, cc in rng.uniform(-3, 3, (5, 2)):
+        assert np.abs(np.array(check(bb, cc, d_value), float)).max() < 1e-9, \
+            "factor form does not reproduce the chain"
+    out.extend(_audit_matrices(printed, factors, fwd))
+
+    prod = printed.get("product", {})
+    out.extend(_audit_eq337(prod))
+    lst = printed.get("listing", {})
+    names = {"T_d": "T_0^1", "T_45": "T_1^2", "T_B": "T_2^3", "T_n45": "T_3^4", "T_nd": "T_4^5",
+             "T_C": "T_5^w"}
+    for lname, fname in names.items():
+        if lname in lst:
+            same, erratum, ev = _matrix_diff(lst[lname], factors[fname])
+            out.append(_verdict(f"Listing 3.3 {lname}", same, erratum,
+                                ev + f" (derived {fname})", str(lst[lname]),
+                                fmt(factors[fname]), lname))
+    out.extend(_listing_line46(prod, lst, t0w))
+    out.extend(_listing_rotations(lst))
+    out.extend(_listing_sources(lst))
     if "T_er" in lst:
         out.append(_audit_t_er(layout, chain, lst, factors, d_value))
     return out
