@@ -39,9 +39,17 @@ PENDING_SPLIT_ON_BRANCH_ISSUE31_NC = {
     ("program.py", "interpret"), ("gcode.py", "Interpreter.step"), ("chunkscan.py", "scan"),
     ("heidenhain.py", "parse_line"), ("writer.py", "Writer.run")}
 
-#: the compensate <-> program import circle, broken on branch issue31-nc.  THE LEAD EMPTIES
-#: THIS AT MERGE.  Files (name) in runtime/fiveaxis/ or runtime/nc/.
-PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC = {frozenset({"compensate.py", "program.py"})}
+#: import circles that other branches' files still hold open.  THE LEAD EMPTIES THIS AT MERGE.
+#: * compensate <-> program (files in runtime/fiveaxis/ or runtime/nc/): broken on issue31-nc;
+#: * tables/table.py <-> tables/functions.py: table.py re-exports the names that moved to
+#:   functions.py (a second import path) for tests/fiveaxis/{test_tcpmap,test_chunkscan,
+#:   test_compensate,test_streaming}.py and benchmarks/bench_compensate.py (issue31-nc's
+#:   files), which call ``tables.ErrorFunctions``; once they import it from
+#:   volerr.tables.functions, delete ``_MOVED`` and ``__getattr__`` at the end of table.py.
+PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC = {
+    frozenset({"compensate.py", "program.py"}),
+    frozenset({"runtime/tables/table.py", "runtime/tables/functions.py"})}
+
 
 #: imports that run up the table, each with the reason and the way out
 KNOWN_UPWARD = {
@@ -250,6 +258,8 @@ def test_known_upward_imports_still_exist():
 
 
 def _pending_circle(comp: list[str]) -> bool:
+    if frozenset(comp) in PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC:
+        return True
     nc_rooms = ("runtime/fiveaxis/", "runtime/nc/")
     return (all(p.startswith(nc_rooms) for p in comp)
             and frozenset(Path(p).name for p in comp) in PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC)
