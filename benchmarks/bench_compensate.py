@@ -33,6 +33,7 @@ import volerr
 from _baseline import env_for, export, which_volerr
 from volerr.fiveaxis.compensate import ErrorModel, solve
 from volerr.tables import table as tables
+from volerr.tables.functions import ErrorFunctions
 from volerr.tables.table import ErrorTable, write_constants, write_error_table
 
 RUN = """
@@ -91,7 +92,7 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
                     for p in m.layout.axes[a].component_errors}
             write_error_table(d / f"{a}.csv", ErrorTable(a, x, vals))
         write_constants(d / "constants.csv", {"EC0Y": 20e-6, "EX0C": 0.01, "EA0B": 15e-6})
-        funcs = tables.ErrorFunctions.from_dir(d, m)
+        funcs = ErrorFunctions.from_dir(d, m)
         q = None
         for sh in shapes:
             q = write_program(d / f"big_{sh}.nc", n, np.random.default_rng(1), sh)

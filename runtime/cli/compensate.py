@@ -4,8 +4,8 @@ Reads an NC program (ISO G-code or Heidenhain plain language; axis positions, ar
 TCPM), predicts the tool-tip error of every motion block from the layout's model and the error
 tables (by each block's approach direction where they carry a reversal), and writes a copy
 whose positions make the actual tool tip land on the nominal one (see
-:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.fiveaxis.gcode`,
-:mod:`volerr.fiveaxis.arcs`, :mod:`volerr.fiveaxis.tcpm` and :mod:`volerr.fiveaxis.heidenhain`
+:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.nc.gcode`,
+:mod:`volerr.nc.arcs`, :mod:`volerr.nc.tcpm` and :mod:`volerr.nc.heidenhain`
 for what is supported; ``volerr formats gcode``).  Only position numbers change; the input is
 never overwritten.
 
@@ -115,7 +115,7 @@ def run(args) -> int:
     open_source = program.open_program(args.program)
     table = None
     if args.tool_table:
-        from ..fiveaxis.tcpm import read_tool_table
+        from ..nc.tcpm import read_tool_table
         table = read_tool_table(args.tool_table)
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
               *([args.tool_table] if args.tool_table else [])]

@@ -1,7 +1,7 @@
 """The one Legendre polynomial fit of volerr: weighted least squares on the measured range
 mapped to [-1, 1], degree by leave-one-out cross-validation with the one-standard-error rule.
 
-Used by the error tables (:func:`volerr.tables.table.make_function` ``method="poly"``) and the
+Used by the error tables (:func:`volerr.tables.functions.make_function` ``method="poly"``) and the
 error-function fits (:mod:`volerr.tables.errorfit`); importable by any other capability.
 Positions in any unit (mm or deg), values in any unit (mm or rad): the fit is linear.
 """

@@ -14,7 +14,8 @@ import volerr
 from volerr.cli import main
 from volerr.cmm.diagonals import box_lines, evaluate_lines
 from volerr.cmm.examples import EXAMPLES, write_example_errors
-from volerr.tables.table import ErrorFunctions, read_constants, read_error_table
+from volerr.tables.functions import ErrorFunctions
+from volerr.tables.table import read_constants, read_error_table
 
 CMMS = ["MB1", "MB2", "FB1", "FB2", "MH1", "MH2", "FH1", "FH2", "CX", "CY"]
 

@@ -10,7 +10,7 @@ import volerr
 from volerr.cmm import csvformat
 from volerr.cmm.examples import write_example_errors
 from volerr.cmm.volmap import map_csv, volumetric_map
-from volerr.tables.table import ErrorFunctions
+from volerr.tables.functions import ErrorFunctions
 
 
 def _reference(v: float, d: int) -> str:

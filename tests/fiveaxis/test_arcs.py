@@ -1,5 +1,5 @@
 """Arcs G2/G3: the compensated program, run on an independent controller (tests/helpers/nc_sim:
-its own arc interpolation) and an independent exact chain (test_fiveaxis.tool2work), keeps the
+its own arc interpolation) and an independent exact chain (helpers.fiveaxis_chain.tool2work), keeps the
 actual tool tip within the tolerance (+ the rounding of the written numbers) of the nominal arc,
 in the three planes, for arcs kept as arcs and arcs linearised; the geometry against closed
 forms; arcs whose end is off the circle are refused naming the line."""
@@ -10,13 +10,15 @@ import numpy as np
 import pytest
 from helpers import nc_sim
 from scipy.spatial import cKDTree
-from test_compensate import cli, write_errors
-from test_fiveaxis import tool2work
+from helpers.error_dirs import write_errors
+from test_compensate import cli
+from helpers.fiveaxis_chain import tool2work
 
 import volerr
 from volerr.errors import InputError
-from volerr.fiveaxis import arcs, gcode
-from volerr.fiveaxis.compensate import ErrorModel, compensate_program
+from volerr.nc import arcs, gcode
+from volerr.fiveaxis.compensate import ErrorModel
+from volerr.fiveaxis.program import compensate_program
 from volerr.tables.functions import ErrorFunctions
 
 PROGRAM = """%

@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_compensate import write_errors
+from helpers.error_dirs import write_errors
 
 import volerr
-from volerr.fiveaxis import chunkscan, gcode, program
+from volerr.fiveaxis import program
+from volerr.nc import chunkscan, gcode
 from volerr.errors import InputError
-from volerr.fiveaxis.compensate import compensate_program
+from volerr.fiveaxis.program import compensate_program
 from volerr.tables import table as tables
 from volerr.tables.functions import ErrorFunctions
 
@@ -113,7 +114,7 @@ def test_format_numbers_is_format_number(items):
 def test_edits_replace_their_spans(text, data):
     """writer.Edits (spans replaced in the chunk's bytes, some as byte arrays, some as
     strings) against slicing the text piece by piece."""
-    from volerr.fiveaxis.writer import Edits
+    from volerr.nc.writer import Edits
 
     cuts = sorted(data.draw(st.lists(st.integers(0, len(text)), max_size=12)))
     spans = list(zip(cuts[0::2], cuts[1::2]))
@@ -145,7 +146,7 @@ def test_edits_replace_their_spans(text, data):
 def setup(tmp_path_factory):
     m = volerr.load("DMU50")
     d = write_errors(tmp_path_factory.mktemp("err"), m, seed=5)
-    return m, tables.ErrorFunctions.from_dir(d, m)
+    return m, ErrorFunctions.from_dir(d, m)
 
 
 def _range(a):

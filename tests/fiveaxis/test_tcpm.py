@@ -1,7 +1,7 @@
 """TCPM programs (tool tip in the workpiece frame): a TCPM program and its machine-axis
 equivalent give the same actual tool tips after compensation, on an independent controller
 (tests/helpers/nc_sim with an inverse from the independent exact chain) and chain
-(test_fiveaxis.tool2work); with --orientation the tool-axis error shrinks (tool-vector
+(helpers.fiveaxis_chain.tool2work); with --orientation the tool-axis error shrinks (tool-vector
 programs); Heidenhain plain language gives the same numbers as ISO; bad programs get exit 2
 naming the line."""
 
@@ -10,12 +10,14 @@ import re
 import numpy as np
 import pytest
 from helpers import nc_sim
-from test_compensate import cli, write_errors
-from test_fiveaxis import tool2work
+from helpers.error_dirs import write_errors
+from test_compensate import cli
+from helpers.fiveaxis_chain import tool2work
 
 import volerr
 from volerr.errors import InputError
-from volerr.fiveaxis.compensate import ErrorModel, compensate_program
+from volerr.fiveaxis.compensate import ErrorModel
+from volerr.fiveaxis.program import compensate_program
 from volerr.tables.functions import ErrorFunctions
 
 L = 120.0                       # tool length, mm
@@ -233,7 +235,7 @@ def test_cli_tcpm_without_tool_length_exit_2_one_line(setup, tmp_path):
 
 
 def test_tool_length_rule():
-    from volerr.fiveaxis.tcpm import length_rule
+    from volerr.nc.tcpm import length_rule
 
     assert length_rule(None, None) is None
     rule = length_rule(None, {1: 100.0, 2: 80.5})

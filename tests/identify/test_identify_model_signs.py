@@ -9,7 +9,8 @@ from helpers.tracker_sim import error_rotation, simulate, smooth_errors, to_csv
 
 import volerr  # noqa: E402
 from volerr.cli import main  # noqa: E402
-from volerr.tables.table import ErrorFunctions, read_error_table  # noqa: E402
+from volerr.tables.functions import ErrorFunctions  # noqa: E402
+from volerr.tables.table import read_error_table  # noqa: E402
 
 REF = np.array([[150.0, 40.0, 10.0], [-60.0, 120.0, 30.0], [20.0, -90.0, 5.0]])
 

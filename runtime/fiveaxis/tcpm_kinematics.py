@@ -1,25 +1,8 @@
-"""TCPM programs: the tool tip in the workpiece frame, the controller's nominal kinematics.
+"""The controller's nominal kinematics under TCPM: TCPM words <-> axis positions.
 
-Under TCPM (tool centre point management: Fanuc ``G43.4`` / ``G43.5``, Heidenhain ``M128`` /
-``FUNCTION TCPM``, Siemens ``TRAORI``) a motion block gives the tool tip ``X Y Z`` (mm) in
-the workpiece frame and the tool orientation, either as the rotary axis angles (deg; G43.4,
-M128, TRAORI with rotary words) or as a tool vector (``I J K`` of G43.5, ``A3 B3 C3`` of
-TRAORI: the unit tool-axis direction, from the tip towards the spindle, in the workpiece
-frame).  The controller turns them into axis positions with the machine's nominal inverse
-kinematics and the tool length ``L`` of the active tool:
-
-* rotary angles: the rotary axes go to the angles, the linear axes to the generated
-  ``inverse_linear`` of the layout (derived in :mod:`volerr.derive.inverse`), so that the
-  nominal tool tip lands on ``X Y Z``;
-* tool vector: the rotary axes come from the generated ``inverse_rotary`` (two solutions, and
-  a turn of 360 deg for each): the one nearest the previous block, branch by branch and turn
-  by turn as a controller continues a path (:func:`rotary_from_vector`); on a singular
-  orientation (the tool along the first rotary axis) the undetermined axis stays where it was.
-
-The tool tip lies ``L`` from the point the axis positions refer to, against the tool axis: a
-tool offset ``(0, 0, -L)`` in the tool frame (the same offset ``volerr compensate --tool``
-gives a program in axis positions).
-
+A TCPM block (:mod:`volerr.nc.tcpm`) gives the tool tip ``X Y Z`` (mm) in the workpiece frame
+and the tool orientation as rotary angles or a tool vector; the controller turns them into
+axis positions with the machine's nominal inverse kinematics (:func:`axes_from_words`).
 Compensation moves the programmed tip (and, with ``--orientation``, the orientation) to the
 forward kinematics of the compensated axis positions: after the controller's inverse, the
 actual tool tip lands on the programmed one (:func:`words_from_axes`).
@@ -29,19 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kinematics import _axis_sensitivity, is_five_axis, linear_axes
 from ..errors import InputError, require
-
-#: frames of a row: axis positions, TCPM with rotary angles, TCPM with a tool vector
-AXES, ANGLES, VECTOR = 0, 1, 2
-
-
-def tool_offset(length) -> np.ndarray:
-    """The tool offset (N, 3) of tool lengths ``length`` (N,) mm: ``(0, 0, -L)``."""
-    length = np.asarray(length, dtype=float)
-    out = np.zeros((len(length), 3))
-    out[:, 2] = -length
-    return out
+from ..nc.tcpm import ANGLES, AXES, VECTOR, tool_offset  # noqa: F401
+from .kinematics import _axis_sensitivity, is_five_axis, linear_axes
 
 
 def linear_from_tip(model, tip: np.ndarray, rot_deg: np.ndarray, length) -> np.ndarray:
@@ -157,57 +130,3 @@ def words_from_axes(model, q: np.ndarray, length: np.ndarray) -> np.ndarray:
     out[:, rot_idx] = q[:, rot_idx]
     out[:, len(axes):] = f[:, 3:6]
     return out
-
-
-def length_rule(tool_length: float | None = None, table: dict | None = None):
-    """The tool length a TCPM block uses, as the interpreter asks for it: ``rule(tools,
-    where)`` with ``tools`` the last ``T H D`` words (letter -> number) -> mm.  A given
-    ``tool_length`` always; else the ``table`` (tool number -> mm) at the ``H`` word (Fanuc
-    tool length offset), else at ``T`` (Siemens, Heidenhain ``TOOL CALL``), else at ``D``;
-    plus a Heidenhain ``DL`` (delta length).  None when neither is given."""
-    if tool_length is None and not table:
-        return None
-
-    def rule(tools: dict, where: str) -> float:
-        delta = float(tools.get("DL", 0.0))
-        if tool_length is not None:
-            return float(tool_length) + delta
-        for letter in ("H", "T", "D"):
-            if letter in tools:
-                number = tools[letter]
-                key = int(number) if float(number).is_integer() else number
-                if key in table:
-                    return float(table[key]) + delta
-                raise InputError(f"{where}: tool {letter}{key:g} is not in the tool table "
-                                 f"(tools {' '.join(f'{k:g}' for k in sorted(table))})")
-        raise InputError(f"{where}: TCPM with no T / H / D word before it: the tool length "
-                         "is unknown (give --tool-length)")
-    return rule
-
-
-def read_tool_table(path) -> dict:
-    """A tool table CSV ``tool,length_mm`` (tool number, tool length in mm; other columns
-    ignored) -> {tool number: mm}."""
-    from ..fileio import read_csv_rows
-    from ..units import parse_number
-
-    rows = read_csv_rows(path, missing=f"tool table not found: {path}",
-                         empty=f"{path}: empty tool table")
-    header = [h.lower() for h in rows[0][1]]
-    require("tool" in header and "length_mm" in header,
-            f"{path}: a tool table needs the columns tool,length_mm (got {','.join(header)})")
-    it, il = header.index("tool"), header.index("length_mm")
-    out = {}
-    for lineno, cells in rows[1:]:
-        require(len(cells) == len(header), f"{path}:{lineno}: {len(cells)} fields, header "
-                                           f"has {len(header)}")
-        t = parse_number(cells[it], f"{path}:{lineno}", "tool")
-        key = int(t) if float(t).is_integer() else t
-        require(key not in out, f"{path}:{lineno}: tool {key:g} given twice")
-        length = parse_number(cells[il], f"{path}:{lineno}", "length_mm")
-        require(0 <= length <= 2000, f"{path}:{lineno}: tool length {length:g} mm is not "
-                                     "plausible (0 .. 2000 mm)")
-        out[key] = length
-    require(out, f"{path}: no tools in the tool table")
-    return out
-

@@ -1,5 +1,5 @@
 """Heidenhain plain-language (Klartext) programs: lines read into the tokens of
-:mod:`volerr.fiveaxis.gcode`, so that the same interpreter and writer serve them.
+:mod:`volerr.nc.gcode`, so that the same interpreter and writer serve them.
 
 What is read (TNC conversational format, one block per line, block number first)::
 
@@ -69,7 +69,7 @@ class Dialect:
 
 
 def parse_line(number: int, body: str, ending: str) -> Line:
-    """One plain-language line as a :class:`volerr.fiveaxis.gcode.Line`: axis, ``F M S T``
+    """One plain-language line as a :class:`volerr.nc.gcode.Line`: axis, ``F M S T``
     words as word tokens (``IX``: the letter in the line's ``incremental`` set), statement
     keywords (``L``, ``TCPM``, ``TCPM_OFF``) as keyword tokens, everything else kept as
     ``other`` text.  Raises :class:`InputError` for a statement that cannot be compensated."""

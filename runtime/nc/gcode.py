@@ -22,7 +22,7 @@ Interpretation (modal state, one block per line)
 ------------------------------------------------
 * Motion: ``G0`` and ``G1`` (straight moves in axis space) and ``G2``/``G3`` (arcs in the
   plane of ``G17``/``G18``/``G19``, centre ``I J K`` relative to the start or radius ``R``;
-  see :mod:`volerr.fiveaxis.arcs`), modal.  A block with axis words and no other non-modal
+  see :mod:`volerr.nc.arcs`), modal.  A block with axis words and no other non-modal
   function is a *motion block*.  Canned cycles ``G73 G74 G76 G81``-``G89``, ``G92 G52 G10``
   (offset changes), ``G68 G51`` (rotation, scaling), ``G41 G42`` (cutter radius
   compensation), ``G20`` (inch), ``/`` (block delete) and ``M98`` (subprogram call) are
@@ -30,7 +30,7 @@ Interpretation (modal state, one block per line)
 * TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
   ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
   angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
-  workpiece frame (see :mod:`volerr.fiveaxis.tcpm`); the tool length comes from the
+  workpiece frame (see :mod:`volerr.nc.tcpm`); the tool length comes from the
   interpreter's ``tool_length`` rule (an ``H``, ``D`` or ``T`` word, or a given length).
   At a switch into or out of TCPM the linear positions become unknown until programmed.
 * ``G90``/``G91``: both handled; in ``G91`` an axis word is the increment from the position

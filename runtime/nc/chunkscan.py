@@ -6,7 +6,7 @@ address words (``X-12.5``, ``n0010``, blanks between letter and number allowed),
 comments (``( ... )`` and ``;`` to the end of the line) only, as post-processors write them:
 
 * ``G`` words only ``G0``/``G1`` (``G00``, ``G01``): straight moves in the mode in force;
-* ``M`` words other than those the interpreter acts on (:data:`volerr.fiveaxis.gcode.SPECIAL_M`);
+* ``M`` words other than those the interpreter acts on (:data:`volerr.nc.gcode.SPECIAL_M`);
 * ``T``, ``H``, ``D`` words (tool and offset numbers; the run keeps the last of each);
 * ``N F S`` and every other letter that is not an axis of another machine;
 * no axis written twice.
@@ -16,7 +16,7 @@ interpreter do every other line (and plain lines in a mode where axis words mean
 straight move: incremental, arc, TCPM).  Its words come back as arrays (line, axis, value,
 decimals, ``+`` sign, span in the chunk text); numbers are parsed exactly (integer mantissa /
 power of ten, correctly rounded; Python's ``float`` for the few with more than 15 digits).
-:func:`format_numbers` is :func:`volerr.fiveaxis.gcode.format_number` for arrays.
+:func:`format_numbers` is :func:`volerr.nc.gcode.format_number` for arrays.
 """
 
 from __future__ import annotations

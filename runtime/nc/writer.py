@@ -3,9 +3,9 @@
 Only the numbers of the words that carry positions change (axes; under TCPM the tool tip and
 the orientation; the centre words of an arc kept as an arc); a word is added to a block only
 where the value the controller would hold differs from the one to write (in ``G91``, a
-non-zero increment).  A linearised arc (:mod:`volerr.fiveaxis.arcs`) becomes its own line
+non-zero increment).  A linearised arc (:mod:`volerr.nc.arcs`) becomes its own line
 turned into the first straight move (``G2``/``G3`` -> ``G1``, the centre words dropped) and one
-new line per further segment.  A :class:`~volerr.fiveaxis.gcode.ControllerState` follows the
+new line per further segment.  A :class:`~volerr.nc.gcode.ControllerState` follows the
 program as written (the same rule the interpreter applies to the program as read), and the
 modal motion as written: an arc block that relied on a modal ``G2``/``G3`` gets the word again
 after a linearised arc has left the output in ``G1``.
@@ -93,7 +93,7 @@ class Writer:
 
     # -----------------------------------------------------------------------------------
     def chunk(self, b, w_out: np.ndarray, arcs: dict) -> str:
-        """The chunk's output text (:class:`~volerr.fiveaxis.program.Blocks` ``b``): original
+        """The chunk's output text (:class:`~volerr.nc.interpret.Blocks` ``b``): original
         bytes except the changed / added words.  ``arcs``: row -> (ArcPath, ArcResult)."""
         edits = Edits()
         w_list = nd_list = None
