@@ -71,7 +71,9 @@ def register(sub) -> None:
     p.add_argument("--tool-length", type=float, default=None, metavar="MM",
                    help="TCPM programs (G43.4/G43.5, M128, FUNCTION TCPM, TRAORI): the tool "
                         "length the controller uses, mm (the tip lies this far from the point "
-                        "the axes refer to, against the tool axis)")
+                        "the axes refer to, against the tool axis); with --tool-table, "
+                        "the length of the tools the table does not hold (a tool it holds "
+                        "with another length is refused)")
     p.add_argument("--tool-table", default=None, metavar="CSV",
                    help="TCPM programs: tool lengths by tool number, CSV tool,length_mm, "
                         "looked up at the program's H word (Fanuc), else T (Siemens, "
@@ -156,6 +158,13 @@ def run(args) -> int:
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
+    arcs = s["arcs"]
+    if arcs["linearised"]:
+        print(f"arcs: {arcs['linearised']} linearised into {arcs['segments']} G1 lines "
+              f"(predicted path within {args.arc_tolerance_um:g} um of the arc, max "
+              f"{arcs['max_path_deviation_um']:.3g} um); {arcs['kept']} kept as arcs")
+    elif arcs["kept"]:
+        print(f"arcs: {arcs['kept']} kept as arcs (end point and centre corrected)")
     if s["max_u_after_um"] > 0:
         print(f"standard uncertainty of the remaining error (tables' _std and _s, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")

@@ -38,7 +38,10 @@ def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray) -> np.nd
     n = len(vector)
     if not n:
         return np.zeros((0, 2))
-    k = vector / np.linalg.norm(vector, axis=1, keepdims=True)
+    norm = np.linalg.norm(vector, axis=1, keepdims=True)
+    if not np.all(norm > 0):
+        raise InputError(f"row {int(np.argmin(norm[:, 0] > 0))}: the tool vector is zero")
+    k = vector / norm
     cand = np.empty((2, n, 2))
     for b, branch in enumerate((1.0, -1.0)):
         sol = model.module.inverse_rotary(k[:, 0], k[:, 1], k[:, 2], branch)

@@ -176,10 +176,49 @@ def scan(segs: list, axes) -> Scan:
     ending = (last == 10) | (last == 13)
     ending = ending + (ending & (last == 10) & (lens > 1)
                        & (b[np.maximum(end - 2, 0)] == 13))
-    body_end = end - ending
-    _comments(b, cls, start, body_end, lid, bad)
+    _comments(b, cls, start, end - ending, lid, bad)
     bad[lid(np.flatnonzero(cls >= _OTHER))] = True
-    # numbers: [+-]?(\d+\.?\d*|\.\d+), runs of adjacent number bytes [ns, ne)
+    ns, ne, tok, is_run = _number_runs(cls, lid, bad)
+    frac, ndig, mant = _read_runs(raw, text, ns, ne, lid(ns), bad)
+    # the letter of each run: the token before it (in a line that is not bad)
+    rline = lid(ns)
+    rs = np.flatnonzero(is_run)
+    code = _letter_table(axes)[b[tok[np.maximum(rs - 1, 0)]]]
+    bad[rline[code == NEEDS_INTERPRETER]] = True
+    # an axis programmed twice
+    m = code >= 0
+    key = rline[m] * (len(axes) + 1) + code[m]
+    if len(key):
+        ks = np.sort(key)
+        bad[ks[1:][ks[1:] == ks[:-1]] // (len(axes) + 1)] = True
+    # values of the words that matter (not N F S ...)
+    sel = np.flatnonzero(code != IGNORED)
+    ns, ne, rline, code, frac, ndig = ns[sel], ne[sel], rline[sel], code[sel], frac[sel], \
+        ndig[sel]
+    fr = np.maximum(frac, 0)
+    val = mant[sel] / _POW10[np.minimum(fr, 22)]
+    val = np.where(b[ns] == 45, -val, val)
+    exact = (ndig <= 15) & (fr <= 22)
+    for i in np.flatnonzero(~exact & ~bad[rline]):
+        val[i] = float(text[ns[i]:ne[i]])
+    # G words: only G0 / G1; M words: not those the interpreter acts on
+    gm = np.flatnonzero((code == G_WORD) | (code == M_WORD))
+    if len(gm):
+        v = val[gm]
+        refused = np.where(code[gm] == G_WORD, (v != 0.0) & (v != 1.0),
+                           np.isin(np.round(v), list(gcode.SPECIAL_M)))
+        bad[rline[gm[refused]]] = True
+    fast = ~bad
+    keep = fast[rline]
+    return Scan(text, start, fast, rline[keep], code[keep], val[keep], frac[keep],
+                b[ns[keep]] == 43, ns[keep], ne[keep])
+
+
+def _number_runs(cls: np.ndarray, lid, bad: np.ndarray):
+    """Runs of adjacent number bytes ``[+-]?(\\d+\\.?\\d*|\\.\\d+)`` -> (their starts, ends, the
+    tokens of the chunk: letters, run starts, comment starts and line endings, which of
+    them are runs); a line with a number without its letter or a letter without its number
+    is marked ``bad`` (in place)."""
     nm = cls <= _DOT
     start_m = nm.copy()
     start_m[1:] &= ~nm[:-1]
@@ -187,10 +226,7 @@ def scan(segs: list, axes) -> Scan:
     end_m[:-1] &= ~nm[1:]
     ns = np.flatnonzero(start_m)
     ne = np.flatnonzero(end_m) + 1
-    nr = len(ns)
-    rline = lid(ns)
-    # tokens: letters, number runs (by their first byte), comment starts and line endings
-    # (so that neighbouring tokens are in the same line unless an ending lies between them)
+    # tokens: neighbouring tokens are in the same line unless an ending lies between them
     tok = np.flatnonzero(((cls >= _LETTER) & (cls <= _EOL)) | start_m)
     is_run = start_m[tok]
     isl = cls[tok] == _LETTER
@@ -201,10 +237,17 @@ def scan(segs: list, axes) -> Scan:
     no_number = isl.copy()
     no_number[:-1] &= ~is_run[1:]
     bad[lid(tok[np.flatnonzero(no_letter | no_number)])] = True
-    # the runs read column by column (their first, second ... bytes at once): digits, dots,
-    # signs behind the first byte, and the mantissa (mant * 10 + digit: exact for integers
-    # below 2**53).  Only the first _LONGEST bytes (a sign, 15 digits and a dot): a longer run
-    # has more digits than a double holds and is checked here and read by Python below
+    return ns, ne, tok, is_run
+
+
+def _read_runs(raw: bytes, text: str, ns, ne, rline, bad: np.ndarray):
+    """The number runs ``[ns, ne)`` read column by column (their first, second ... bytes at
+    once): digits, dots, signs behind the first byte, and the mantissa (mant * 10 + digit:
+    exact for integers below 2**53) -> (digits after the dot, -1 without one; digit count;
+    mantissa).  Only the first _LONGEST bytes (a sign, 15 digits and a dot): a longer run has
+    more digits than a double holds and is checked here and read by Python later.  A line
+    with a sign inside a number, two dots or no digit is marked ``bad`` (in place)."""
+    nr = len(ns)
     length = ne - ns
     width = min(int(length.max()), _LONGEST) if nr else 0
     padded = np.frombuffer(raw + bytes(width), np.uint8)
@@ -233,39 +276,7 @@ def scan(segs: list, axes) -> Scan:
         ndig[i] = sum(ch.isdigit() for ch in t)
     # a sign only in front, at most one dot, at least one digit
     bad[rline[misplaced | (ndot > 1) | (ndig == 0)]] = True
-    # the letter of each run: the token before it (in a line that is not bad)
-    rs = np.flatnonzero(is_run)
-    code = _letter_table(axes)[b[tok[np.maximum(rs - 1, 0)]]]
-    bad[rline[code == NEEDS_INTERPRETER]] = True
-    # an axis programmed twice
-    m = code >= 0
-    key = rline[m] * (len(axes) + 1) + code[m]
-    if len(key):
-        ks = np.sort(key)
-        bad[ks[1:][ks[1:] == ks[:-1]] // (len(axes) + 1)] = True
-    # values of the words that matter (not N F S ...)
-    sel = np.flatnonzero(code != IGNORED)
-    ns, ne, rline, code, frac, ndig = ns[sel], ne[sel], rline[sel], code[sel], frac[sel], \
-        ndig[sel]
-    mant = mant[sel]
-    fr = np.maximum(frac, 0)
-    val = mant / _POW10[np.minimum(fr, 22)]
-    neg = b[ns] == 45
-    val = np.where(neg, -val, val)
-    exact = (ndig <= 15) & (fr <= 22)
-    for i in np.flatnonzero(~exact & ~bad[rline]):
-        val[i] = float(text[ns[i]:ne[i]])
-    # G words: only G0 / G1; M words: not those the interpreter acts on
-    gm = np.flatnonzero((code == G_WORD) | (code == M_WORD))
-    if len(gm):
-        v = val[gm]
-        refused = np.where(code[gm] == G_WORD, (v != 0.0) & (v != 1.0),
-                           np.isin(np.round(v), list(gcode.SPECIAL_M)))
-        bad[rline[gm[refused]]] = True
-    fast = ~bad
-    keep = fast[rline]
-    return Scan(text, start, fast, rline[keep], code[keep], val[keep], frac[keep],
-                b[ns[keep]] == 43, ns[keep], ne[keep])
+    return frac, ndig, mant
 
 
 def format_numbers(values, nd, keep, plus, template=None) -> list:

@@ -305,6 +305,7 @@ def _blocks(sheet: Sheet, segs, first: int, sc, interp, rotary_axes) -> Blocks:
     need[np.ix_(vec_rows, sheet.rot_idx)] = False
     need[vec_rows, nax:] = True
     known = motion & ~(np.isnan(w) & need).any(axis=1)
+    _refuse_zero_vectors(w, known & vec_rows, nax, first)
     row = np.where(known, np.cumsum(known) - 1, -1)
     rows = np.flatnonzero(known)
     known_rotary = {a for a in rotary_axes
@@ -327,3 +328,11 @@ def _blocks(sheet: Sheet, segs, first: int, sc, interp, rotary_axes) -> Blocks:
                   w[rows, :nax].copy(), sheet.nd[rows], order, pending, known_rotary, motion,
                   w[rows], frame[rows], sheet.length[rows],
                   {int(row[i]): p for i, p in sheet.paths.items() if row[i] >= 0})
+
+
+def _refuse_zero_vectors(w, rows, nax: int, first: int) -> None:
+    """A tool vector of length zero gives no direction: refused naming its line."""
+    zero = rows & np.all(w[:, nax:] == 0.0, axis=1)
+    if zero.any():
+        raise InputError(f"line {first + int(np.argmax(zero))}: the tool vector is zero "
+                         "(I J K or A3 B3 C3 all 0): it gives no tool direction")

@@ -46,28 +46,46 @@ def tool_offset(length) -> np.ndarray:
 
 def length_rule(tool_length: float | None = None, table: dict | None = None):
     """The tool length a TCPM block uses, as the interpreter asks for it: ``rule(tools,
-    where)`` with ``tools`` the last ``T H D`` words (letter -> number) -> mm.  A given
-    ``tool_length`` always; else the ``table`` (tool number -> mm) at the ``H`` word (Fanuc
-    tool length offset), else at ``T`` (Siemens, Heidenhain ``TOOL CALL``), else at ``D``;
-    plus a Heidenhain ``DL`` (delta length).  None when neither is given."""
+    where)`` with ``tools`` the last ``T H D`` words (letter -> number) -> mm.  The ``table``
+    (tool number -> mm) at the ``H`` word (Fanuc tool length offset), else at ``T`` (Siemens,
+    Heidenhain ``TOOL CALL``), else at ``D``; a given ``tool_length`` for every tool the table
+    does not hold (or without a table).  Given both, a tool the table holds with another
+    length is refused (which one is right cannot be told).  Plus a Heidenhain ``DL`` (delta
+    length).  None when neither is given."""
     if tool_length is None and not table:
         return None
 
     def rule(tools: dict, where: str) -> float:
         delta = float(tools.get("DL", 0.0))
-        if tool_length is not None:
+        found = _table_entry(table or {}, tools, where, must=tool_length is None)
+        if found is None:
             return float(tool_length) + delta
-        for letter in ("H", "T", "D"):
-            if letter in tools:
-                number = tools[letter]
-                key = int(number) if float(number).is_integer() else number
-                if key in table:
-                    return float(table[key]) + delta
-                raise InputError(f"{where}: tool {letter}{key:g} is not in the tool table "
-                                 f"(tools {' '.join(f'{k:g}' for k in sorted(table))})")
-        raise InputError(f"{where}: TCPM with no T / H / D word before it: the tool length "
-                         "is unknown (give --tool-length)")
+        word, length = found
+        if tool_length is not None and abs(length - float(tool_length)) > 1e-9:
+            raise InputError(f"{where}: --tool-length {float(tool_length):g} mm and the tool "
+                             f"table's {length:g} mm for tool {word} disagree (give one of "
+                             "them)")
+        return length + delta
     return rule
+
+
+def _table_entry(table: dict, tools: dict, where: str, must: bool):
+    """(word, length mm) of the tool the ``H``, else ``T``, else ``D`` word names in
+    ``table``; None when there is none and not ``must`` (else :class:`InputError`)."""
+    for letter in ("H", "T", "D"):
+        if letter in tools:
+            number = tools[letter]
+            key = int(number) if float(number).is_integer() else number
+            if key in table:
+                return f"{letter}{key:g}", float(table[key])
+            if not must:
+                return None
+            raise InputError(f"{where}: tool {letter}{key:g} is not in the tool table "
+                             f"(tools {' '.join(f'{k:g}' for k in sorted(table))})")
+    if not must:
+        return None
+    raise InputError(f"{where}: TCPM with no T / H / D word before it: the tool length "
+                     "is unknown (give --tool-length)")
 
 
 def read_tool_table(path) -> dict:

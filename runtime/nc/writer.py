@@ -250,96 +250,109 @@ class Writer:
         (start, end, text) replacements of the chunk text; ``written`` is updated.
 
         A programmed word is rewritten where the value to write differs from it by half a
-        step or more; an axis the line does not program gets a word where the controller (as
-        written so far) holds another value -- a chain along the lines, followed one entry at
-        a time for the (line, axis) pairs without a word only."""
-        axes = self.axes
+        step or more (:meth:`_programmed`); an axis the line does not program gets a word
+        where the controller (as written so far) holds another value (:meth:`_added`)."""
         sc = b.scan
-        pos = self.written.position
-        nax = len(axes)
-        m = i1 - i0
         w = _words(sc, i0, i1)
         ax = sc.axis[w] >= 0
-        wl = sc.line[w][ax] - i0
-        wa = sc.axis[w][ax]
-        wv = sc.value[w][ax]
+        words = {k: getattr(sc, k)[w][ax] for k in ("axis", "value", "num_start", "num_end",
+                                                     "frac", "plus")}
+        words["line"] = sc.line[w][ax] - i0
+        m, nax = i1 - i0, len(self.axes)
         row = b.row[i0:i1]
-        wr = row[wl]
-        known = wr >= 0
-        # programmed words of known blocks: rewritten where the value moves by half a step
-        kr, ka = wr[known], wa[known]
-        want = w_out[kr, ka]
-        nd = b.nd[kr, ka]
-        change = np.abs(want - wv[known]) >= 0.5 * 10.0 ** (-nd.astype(float))
-        ci = np.flatnonzero(known)[change]
-        span_s, span_e = sc.num_start[w][ax][ci], sc.num_end[w][ax][ci]
-        fr, pl = sc.frac[w][ax][ci], sc.plus[w][ax][ci]
-        text = sc.text
-        flat, lens, new_vals = chunkscan.format_bytes(want[change], nd[change], fr, pl,
-                                                      lambda k: text[span_s[k]:span_e[k]])
-        wvals = wv.copy()
-        wvals[ci] = new_vals
+        ci, flat, lens, wvals = self._programmed(b, words, row, w_out, sc.text)
         # positions held after every line from the programmed words (as written)
+        wl, wa = words["line"], words["axis"]
         val = np.full((m, nax), np.nan)
         val[wl, wa] = wvals
         has = np.zeros((m, nax), dtype=bool)
         has[wl, wa] = True
         last = np.where(has, np.arange(m)[:, None], -1)
         np.maximum.accumulate(last, axis=0, out=last)
-        # axes without a word in a known block: the chain
-        absent = np.argwhere((row >= 0)[:, None] & ~has)
-        added = {}
-        last_add = {}
-        if len(absent):
-            cand_w = w_out[row[absent[:, 0]], absent[:, 1]]
-            cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
-            li_prev = last[absent[:, 0], absent[:, 1]]
-            held = val[np.maximum(li_prev, 0), absent[:, 1]]
-            start = [pos[a] for a in axes]
-            fmt = gcode.format_number
-            for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
-                                                    cand_nd.tolist(), li_prev.tolist(),
-                                                    held.tolist()):
-                la = last_add.get(c)
-                if la is not None and la[0] > pi:
-                    prev = la[1]
-                elif pi >= 0:
-                    prev = h
-                else:
-                    prev = start[c] if la is None else la[1]
-                if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
-                    txt = fmt(want_a, nd_a)
-                    added.setdefault(li, {})[axes[c]] = txt
-                    last_add[c] = (li, float(txt))
-        for c, a in enumerate(axes):
+        added, last_add = self._added(b, row, has, val, last, w_out)
+        pos = self.written.position
+        for c, a in enumerate(self.axes):
             li = int(last[m - 1, c]) if m else -1
             la = last_add.get(c)
             if la is not None and la[0] > li:
                 pos[a] = la[1]
             elif li >= 0:
                 pos[a] = float(val[li, c])
-        # the edits: a line that gets a word is rewritten whole, else its numbers are replaced
+        span_s, span_e = words["num_start"][ci], words["num_end"][ci]
         if not added:
             edits.add_bytes(span_s, span_e, flat, lens)
             return
+        # a line that gets a word is rewritten whole, else its numbers are replaced
         texts = chunkscan.split_texts(flat, lens)
         line_of = wl[ci]
         by_line = {}
         for k, li in enumerate(line_of.tolist()):
             if li in added:
-                by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
+                by_line.setdefault(li, {})[self.axes[int(wa[ci[k]])]] = texts[k]
         own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
                                                               texts))
                if int(line_of[k]) not in added]
         for li, add in added.items():
             i = i0 + li
-            line = b.line(i)
             s0 = int(sc.start[i])
-            own.append((s0, s0 + len(b.segs[i]),
-                        gcode.rewrite_line(line, by_line.get(li, {}), add, self.spaced)))
+            own.append((s0, s0 + len(b.segs[i]), gcode.rewrite_line(
+                b.line(i), by_line.get(li, {}), add, self.spaced)))
         own.sort()
         for s0, e0, t in own:
             edits.add(s0, e0, t)
+
+    @staticmethod
+    def _programmed(b, words, row, w_out, text):
+        """The programmed words of known blocks rewritten where the value moves by half a
+        step -> (indices of the words that change, their texts as bytes and lengths
+        (:func:`volerr.nc.chunkscan.format_bytes`), every word's value as written)."""
+        wr = row[words["line"]]
+        known = wr >= 0
+        kr, ka = wr[known], words["axis"][known]
+        want = w_out[kr, ka]
+        nd = b.nd[kr, ka]
+        wv = words["value"]
+        change = np.abs(want - wv[known]) >= 0.5 * 10.0 ** (-nd.astype(float))
+        ci = np.flatnonzero(known)[change]
+        span_s, span_e = words["num_start"][ci], words["num_end"][ci]
+        flat, lens, new_vals = chunkscan.format_bytes(
+            want[change], nd[change], words["frac"][ci], words["plus"][ci],
+            lambda k: text[span_s[k]:span_e[k]])
+        wvals = wv.copy()
+        wvals[ci] = new_vals
+        return ci, flat, lens, wvals
+
+    def _added(self, b, row, has, val, last, w_out):
+        """Words added for the axes without a word in a known block, where the controller
+        (as written so far) holds another value: a chain along the lines, followed one entry
+        at a time -> (line -> {axis: text}, axis index -> (line, value) of its last added
+        word)."""
+        absent = np.argwhere((row >= 0)[:, None] & ~has)
+        added, last_add = {}, {}
+        if not len(absent):
+            return added, last_add
+        axes = self.axes
+        cand_w = w_out[row[absent[:, 0]], absent[:, 1]]
+        cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
+        li_prev = last[absent[:, 0], absent[:, 1]]
+        held = val[np.maximum(li_prev, 0), absent[:, 1]]
+        start = [self.written.position[a] for a in axes]
+        fmt = gcode.format_number
+        for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
+                                                cand_nd.tolist(), li_prev.tolist(),
+                                                held.tolist()):
+            la = last_add.get(c)
+            if la is not None and la[0] > pi:
+                prev = la[1]
+            elif pi >= 0:
+                prev = h
+            else:
+                prev = start[c] if la is None else la[1]
+            if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
+                txt = fmt(want_a, nd_a)
+                added.setdefault(li, {})[axes[c]] = txt
+                last_add[c] = (li, float(txt))
+        return added, last_add
 
 
 def _words(sc, i0: int, i1: int) -> slice:

@@ -172,3 +172,23 @@ def test_arc_with_its_end_off_the_circle_is_refused_naming_the_line(tmp_path):
     rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
     assert rc == 2 and se.strip().count("\n") == 0 and "line 2" in se and "circle" in se, se
     assert not (tmp_path / "o").exists()
+
+
+def test_console_says_how_many_arcs_were_linearised_into_how_many_lines(tmp_path):
+    """The console line counts the arcs kept and linearised and the G1 lines written for them,
+    as counted here in the written program (an arc block's line plus the new G1 lines)."""
+    err = write_errors(tmp_path / "err", volerr.load("DMU50"), seed=11)
+    prog = tmp_path / "p.nc"
+    prog.write_text(PROGRAM)
+    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o",
+                     "--json", tmp_path / "s.json")
+    assert rc == 0, se
+    out = (tmp_path / "o").read_text().splitlines()
+    n_in = len(PROGRAM.splitlines())
+    arc_lines = [ln for ln in PROGRAM.splitlines() if ln.startswith(("G2", "G3"))]
+    kept = sum(1 for ln in out if ln.startswith(("G2", "G3")))
+    linearised = len(arc_lines) - kept
+    lines = len(out) - n_in + linearised        # each linearised arc: its line + new lines
+    assert linearised > 0 and kept > 0
+    assert (f"arcs: {linearised} linearised into {lines} G1 lines (predicted path within 1 um "
+            f"of the arc, max ") in so and f"; {kept} kept as arcs" in so, so

@@ -242,6 +242,63 @@ def test_tool_length_rule():
     assert rule({"T": 2.0}, "line 1") == 80.5
     assert rule({"T": 2.0, "H": 1.0}, "line 1") == 100.0        # Fanuc: H wins
     assert rule({"T": 1.0, "DL": 0.25}, "line 1") == 100.25     # Heidenhain delta length
-    assert length_rule(55.0, {1: 100.0})({"T": 1.0}, "x") == 55.0
+    assert length_rule(55.0, None)({"T": 1.0}, "x") == 55.0
+    # both given: the table's tools must agree with --tool-length; others take it
+    assert length_rule(55.0, {1: 55.0})({"T": 1.0}, "x") == 55.0
+    assert length_rule(55.0, {1: 100.0})({"T": 2.0}, "x") == 55.0
+    with pytest.raises(InputError, match="line 4: --tool-length 55 mm and the tool table's "
+                                         "100 mm for tool T1 disagree"):
+        length_rule(55.0, {1: 100.0})({"T": 1.0}, "line 4")
     with pytest.raises(InputError, match="line 9: TCPM with no T"):
         rule({}, "line 9")
+
+
+@pytest.mark.parametrize("body", ["TRAORI\nG1 X1 Y2 Z3 A3=0 B3=0 C3=0\n",
+                                  "G43.5 H1\nG1 X1 Y2 Z3 I0 J0 K0\n",
+                                  "G43.5 H1\nG1 X1 Y2 Z3 I0 J0 K1\nG1 X2 K0\n"])
+def test_cli_zero_tool_vector_one_error_line(setup, tmp_path, body):
+    """A zero tool vector has no direction: one error line naming it (no numpy warning
+    before it), exit 2, nothing written."""
+    _, _, d = setup
+    prog = tmp_path / "p.nc"
+    prog.write_text("G90 G1 X0 Y0 Z200 B0 C0\n" + body)
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+                     "--tool-length", "100")
+    line = len(body.splitlines()) + 1
+    assert rc == 2 and se.strip() == (f"volerr compensate: error: line {line}: the tool vector "
+                                      "is zero (I J K or A3 B3 C3 all 0): it gives no tool "
+                                      "direction"), se
+    assert not (tmp_path / "o").exists()
+
+
+def test_cli_tool_length_and_table_disagreeing_refused(setup, tmp_path):
+    _, _, d = setup
+    prog = tmp_path / "p.nc"
+    prog.write_text("G90 G1 X0 Y0 Z200 B0 C0\nT1 M6\nN30 G43.4\nG1 X1 Y2 Z3 B10 C10\n")
+    (tmp_path / "tools.csv").write_text("tool,length_mm\n1,100\n")
+    args = ("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+            "--tool-table", tmp_path / "tools.csv", "--tool-length")
+    rc, so, se = cli(*args, "50")
+    assert rc == 2 and len(se.strip().splitlines()) == 1 and \
+        "line 3: --tool-length 50 mm and the tool table's 100 mm for tool T1 disagree" in se, se
+    assert not (tmp_path / "o").exists()
+    rc, so, se = cli(*args, "100")
+    assert rc == 0, se
+
+
+def test_tool_vector_program_has_no_note_of_rotary_axes_at_zero(setup, tmp_path):
+    """The vectors of a G43.5 / TRAORI program set the rotary axes: no note that they are
+    never programmed (the program never writes a B or C word)."""
+    m, funcs, d = setup
+    text = "G90 G43.5 H1\nG1 X10 Y20 Z30 I0.1 J0.2 K0.97\nG1 X11 I0.12 J0.2 K0.97\n"
+    res = compensate_program(m, funcs, text, tool_length=L)
+    assert res.assumed_zero == () and res.summary()["compensated"] == 2
+    prog = tmp_path / "p.nc"
+    prog.write_text(text)
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+                     "--tool-length", str(L))
+    assert rc == 0 and "never programmed" not in se, se
+    # an axis-position program that never writes C still gets the note
+    prog.write_text("G90 G1 X0 Y0 Z200 B10\nG1 X1\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o2")
+    assert rc == 0 and "note: axes C are never programmed: taken at 0 deg" in se, se
