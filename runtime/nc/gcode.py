@@ -348,8 +348,6 @@ class Interpreter:
         #: rotary positions (deg) the machine holds after the last known block (TCPM vector
         #: blocks continue from them); None before one
         self.rotary_actual = None
-        #: the :class:`Step` of the last line read (None for a line without words)
-        self.last_step: Step | None = None
 
     @property
     def position(self) -> dict:
@@ -364,6 +362,17 @@ class Interpreter:
             return False
         return self.frame == "axes" or self.orientation == "angles" or \
             (self.orientation == "any" and self._last_orientation != "vector")
+
+    @property
+    def plain_vector(self) -> bool:
+        """True when a line of linear-axis and tool-vector words (and G0 / G1, T H D and
+        ignored words; no rotary word) is a straight TCPM move to the tool tip with the tool
+        vector: absolute, straight motion mode, TCPM with a tool vector (G43.5, or TRAORI
+        after a block with one) (the whole-chunk path of tool-vector programs)."""
+        if self.incremental or self.motion not in (0, 1) or self.frame != "tcpm":
+            return False
+        return self.vector_words is not None and (self.orientation == "vector" or (
+            self.orientation == "any" and self._last_orientation == "vector"))
 
     @property
     def length(self) -> float | None:
@@ -531,7 +540,7 @@ class Interpreter:
     def block(self, line: Line) -> Block | None:
         """Update the modal state with one line; return a :class:`Block` for a motion block
         (straight or arc)."""
-        step = self.last_step = self.step(line)
+        step = self.step(line)
         if step is None:
             return None
         self.state.apply(step)
@@ -598,16 +607,6 @@ def _spaced(kinds: list[str]) -> bool | None:
         if a == "word" and b == "word":
             return False
     return None
-
-
-def spaced_style(lines) -> bool:
-    """True when the program separates words by blanks (``G1 X1 Y2``), False when it writes
-    them together (``G1X1Y2``): decides how an added word is separated."""
-    for line in lines:
-        own = _spaced(_kinds(line))
-        if own is not None:
-            return own
-    return True
 
 
 def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None = None) -> str:

@@ -41,7 +41,7 @@ _VECTOR_TCPM = re.compile(r"[Gg][ \t]*0*43\.5(?!\d)|[ABCabc]3[ \t]*=")
 @dataclass
 class Prescan:
     """Rotary axes whose letter never appears as a word (outside comments) and that no tool
-    vector sets, the word separation of the program (:func:`volerr.nc.gcode.spaced_style`)
+    vector sets, the word separation of the program (:func:`_first_spacing`)
     and its dialect's line parser (None: ISO; :func:`volerr.nc.dialect.parser`)."""
 
     absent_rotary: tuple
@@ -110,8 +110,8 @@ class Blocks:
 
     ``segs``: the lines as read (with their endings), ``first`` the number of the first;
     ``scan``: the plain lines found by :func:`volerr.nc.chunkscan.scan` and their words;
-    ``runs``: (first, end) line indices of the plain lines interpreted together in absolute
-    mode; ``slow``: line index -> (:class:`~volerr.nc.gcode.Line`, step) of the lines
+    ``runs``: (first, end, columns) line indices of the plain lines interpreted together in
+    absolute mode and the columns of their words (the axes, or with the tool vector); ``slow``: line index -> (:class:`~volerr.nc.gcode.Line`, step) of the lines
     interpreted one by one (step None without words); ``row``: per line, the row of a motion
     block whose positions are all known, else -1; ``numbers``: the line number of every row;
     ``pending``: per motion block with an unknown position, (line, target, the first
@@ -164,11 +164,6 @@ def _parse_seg(segs, first: int, i: int) -> gcode.Line:
     return gcode.Line.parse(first + i, body, seg[len(body):])
 
 
-def _words(sc, i0: int, i1: int) -> slice:
-    lo, hi = np.searchsorted(sc.line, [i0, i1])
-    return slice(int(lo), int(hi))
-
-
 class Sheet:
     """The words of the lines of one chunk as they are interpreted, one row per line:
     ``w`` (n, n_axes + 3) the positions after the line (axes, then ``I J K``; NaN unknown or
@@ -206,13 +201,15 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
         sc.fast[:] = False
     sheet = Sheet(n, model.axes, model.rotary_axes, decimals)
     parse = dialect.parse_line if dialect is not None else gcode.Line.parse
-    slow_idx = np.flatnonzero(~sc.fast)
+    ends = _run_ends(sc, sheet)
     i = 0
     while i < n:
-        if sc.fast[i] and interp.plain:
-            k = np.searchsorted(slow_idx, i)
-            j = int(slow_idx[k]) if k < len(slow_idx) else n
-            interpret_run(sheet, sc, i, j, interp)
+        kind = _run_kind(interp)
+        if kind is not None and not ends[kind][0][i]:
+            stop = ends[kind][1]
+            k = np.searchsorted(stop, i)
+            j = int(stop[k]) if k < len(stop) else n
+            interpret_run(sheet, sc, i, j, interp, kind == "vector")
             i = j
         else:
             interpret_line(sheet, segs, first, i, interp, parse)
@@ -220,36 +217,68 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
     return _blocks(sheet, segs, first, sc, interp, model.rotary_axes)
 
 
-def interpret_run(sheet: Sheet, sc, i: int, j: int, interp: gcode.Interpreter) -> None:
+def _run_kind(interp: gcode.Interpreter):
+    """The kind of run the interpreter's mode allows: "axes", "angles" (TCPM with rotary
+    angles), "vector" (TCPM with a tool vector) or None (line by line)."""
+    if interp.plain:
+        return "axes" if interp.frame == "axes" else "angles"
+    return "vector" if interp.plain_vector else None
+
+
+def _run_ends(sc, sheet: Sheet) -> dict:
+    """Per kind of run: (per line, it cannot be in such a run; the indices of those lines).
+    Every kind needs a plain line (:func:`volerr.nc.chunkscan.scan`); under TCPM with rotary
+    angles it holds no tool vector (the interpreter refuses one), with a tool vector no
+    rotary axis word."""
+    n = len(sc.fast)
+    has_vec = np.zeros(n, dtype=bool)
+    has_rot = np.zeros(n, dtype=bool)
+    has_vec[sc.line[sc.axis >= sheet.nax]] = True
+    has_rot[sc.line[np.isin(sc.axis, sheet.rot_idx)]] = True
+    out = {}
+    for kind, other in (("axes", None), ("angles", has_vec), ("vector", has_rot)):
+        stop = ~sc.fast if other is None else ~sc.fast | other
+        out[kind] = (stop, np.flatnonzero(stop))
+    return out
+
+
+def interpret_run(sheet: Sheet, sc, i: int, j: int, interp: gcode.Interpreter,
+                  vector: bool = False) -> None:
     """Lines ``i .. j - 1``, plain (:func:`volerr.nc.chunkscan.scan`) and in a plain mode
-    (``interp.plain``), at once: the position of an axis is its last programmed value."""
-    axes, nax, pos = sheet.axes, sheet.nax, interp.state.position
-    ws = _words(sc, i, j)
+    (``interp.plain``; ``vector``: ``interp.plain_vector``, its tool-vector words read too),
+    at once: the position of an axis (of a vector component) is its last programmed
+    value."""
+    pos = interp.state.position
+    cols = len(sheet.letters) if vector else sheet.nax
+    letters = sheet.letters[:cols]
+    ws = sc.words(i, j)
     interp.tools.update(sc.last_tracked(ws))
     wl, wa = sc.line[ws] - i, sc.axis[ws]
-    ax = wa >= 0
+    ax = (wa >= 0) & (wa < cols)
     wl, wa = wl[ax], wa[ax]
     m = j - i
-    v = np.full((m, nax), np.nan)
+    v = np.full((m, cols), np.nan)
     v[wl, wa] = sc.value[ws][ax]
-    has = np.zeros((m, nax), dtype=bool)
+    has = np.zeros((m, cols), dtype=bool)
     has[wl, wa] = True
-    sheet.nd[i + wl, wa] = np.maximum(sheet.decimals, sc.frac[ws][ax])
+    sheet.nd[i + wl, wa] = np.maximum(sheet.nd[i + wl, wa], sc.frac[ws][ax])
     last = np.where(has, np.arange(m)[:, None], -1)
     np.maximum.accumulate(last, axis=0, out=last)
-    startv = np.array([np.nan if pos[a] is None else pos[a] for a in axes])
-    sheet.w[i:j, :nax] = np.where(last >= 0, v[np.maximum(last, 0), np.arange(nax)], startv)
+    startv = np.array([np.nan if pos[a] is None else pos[a] for a in letters])
+    sheet.w[i:j, :cols] = np.where(last >= 0, v[np.maximum(last, 0), np.arange(cols)], startv)
     sheet.motion[i:j] = has.any(axis=1)
-    if interp.frame == "tcpm":          # TCPM with rotary angles: tip and angles
+    if interp.frame == "tcpm":          # TCPM: the tip, and the angles or the vector
         mrows = i + np.flatnonzero(has.any(axis=1))
-        sheet.frame[mrows] = tcpm.ANGLES
+        sheet.frame[mrows] = tcpm.VECTOR if vector else tcpm.ANGLES
         sheet.length[mrows] = interp.length
+        if vector:
+            sheet.w[np.ix_(mrows, sheet.rot_idx)] = np.nan
         if len(mrows):
-            interp._last_orientation = "angles"
-    for c, a in enumerate(axes):
+            interp._last_orientation = "vector" if vector else "angles"
+    for c, a in enumerate(letters):
         val = sheet.w[j - 1, c]
         pos[a] = None if val != val else float(val)
-    sheet.runs.append((i, j))
+    sheet.runs.append((i, j, cols))
 
 
 def interpret_line(sheet: Sheet, segs, first: int, i: int, interp: gcode.Interpreter,

@@ -103,7 +103,7 @@ class Writer:
         i, n = 0, len(b.segs)
         while i < n:
             if nxt is not None and nxt[0] == i:
-                self.run(b, nxt[0], nxt[1], w_out, edits)
+                self.run(b, nxt[0], nxt[1], w_out, edits, nxt[2])
                 self.motion = 1 if not _straight(self.motion) else self.motion
                 i = nxt[1]
                 nxt = next(runs, None)
@@ -245,33 +245,37 @@ class Writer:
         return ending.join(texts) + line.ending
 
     # -----------------------------------------------------------------------------------
-    def run(self, b, i0: int, i1: int, w_out: np.ndarray, edits) -> None:
+    def run(self, b, i0: int, i1: int, w_out: np.ndarray, edits, cols: int | None = None
+            ) -> None:
         """The plain lines ``i0 .. i1 - 1`` (absolute mode) written together: ``edits`` gets
-        (start, end, text) replacements of the chunk text; ``written`` is updated.
+        (start, end, text) replacements of the chunk text; ``written`` is updated.  ``cols``:
+        the columns of the words (the axes, or with the tool vector ``I J K``).
 
         A programmed word is rewritten where the value to write differs from it by half a
         step or more (:meth:`_programmed`); an axis the line does not program gets a word
         where the controller (as written so far) holds another value (:meth:`_added`)."""
         sc = b.scan
-        w = _words(sc, i0, i1)
-        ax = sc.axis[w] >= 0
+        cols = len(self.axes) if cols is None else cols
+        letters = self.letters[:cols]
+        w = sc.words(i0, i1)
+        ax = (sc.axis[w] >= 0) & (sc.axis[w] < cols)
         words = {k: getattr(sc, k)[w][ax] for k in ("axis", "value", "num_start", "num_end",
                                                      "frac", "plus")}
         words["line"] = sc.line[w][ax] - i0
-        m, nax = i1 - i0, len(self.axes)
+        m = i1 - i0
         row = b.row[i0:i1]
         ci, flat, lens, wvals = self._programmed(b, words, row, w_out, sc.text)
         # positions held after every line from the programmed words (as written)
         wl, wa = words["line"], words["axis"]
-        val = np.full((m, nax), np.nan)
+        val = np.full((m, cols), np.nan)
         val[wl, wa] = wvals
-        has = np.zeros((m, nax), dtype=bool)
+        has = np.zeros((m, cols), dtype=bool)
         has[wl, wa] = True
         last = np.where(has, np.arange(m)[:, None], -1)
         np.maximum.accumulate(last, axis=0, out=last)
         added, last_add = self._added(b, row, has, val, last, w_out)
         pos = self.written.position
-        for c, a in enumerate(self.axes):
+        for c, a in enumerate(letters):
             li = int(last[m - 1, c]) if m else -1
             la = last_add.get(c)
             if la is not None and la[0] > li:
@@ -288,7 +292,7 @@ class Writer:
         by_line = {}
         for k, li in enumerate(line_of.tolist()):
             if li in added:
-                by_line.setdefault(li, {})[self.axes[int(wa[ci[k]])]] = texts[k]
+                by_line.setdefault(li, {})[letters[int(wa[ci[k]])]] = texts[k]
         own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
                                                               texts))
                if int(line_of[k]) not in added]
@@ -328,15 +332,16 @@ class Writer:
         at a time -> (line -> {axis: text}, axis index -> (line, value) of its last added
         word)."""
         absent = np.argwhere((row >= 0)[:, None] & ~has)
+        absent = absent[~np.isnan(w_out[row[absent[:, 0]], absent[:, 1]])]
         added, last_add = {}, {}
         if not len(absent):
             return added, last_add
-        axes = self.axes
+        names = [self.vector_words.get(a, a) for a in self.letters]
         cand_w = w_out[row[absent[:, 0]], absent[:, 1]]
         cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
         li_prev = last[absent[:, 0], absent[:, 1]]
         held = val[np.maximum(li_prev, 0), absent[:, 1]]
-        start = [self.written.position[a] for a in axes]
+        start = [self.written.position[a] for a in self.letters]
         fmt = gcode.format_number
         for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
                                                 cand_nd.tolist(), li_prev.tolist(),
@@ -350,14 +355,9 @@ class Writer:
                 prev = start[c] if la is None else la[1]
             if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
                 txt = fmt(want_a, nd_a)
-                added.setdefault(li, {})[axes[c]] = txt
+                added.setdefault(li, {})[names[c]] = txt
                 last_add[c] = (li, float(txt))
         return added, last_add
-
-
-def _words(sc, i0: int, i1: int) -> slice:
-    lo, hi = np.searchsorted(sc.line, [i0, i1])
-    return slice(int(lo), int(hi))
 
 
 class Edits:

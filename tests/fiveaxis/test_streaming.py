@@ -12,7 +12,6 @@ from helpers.error_dirs import write_errors
 import volerr
 from volerr.nc import gcode
 from volerr.fiveaxis.program import compensate_program
-from volerr.tables import table as tables
 from volerr.tables.functions import ErrorFunctions
 
 PROGRAM = """%

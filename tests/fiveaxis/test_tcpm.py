@@ -302,3 +302,66 @@ def test_tool_vector_program_has_no_note_of_rotary_axes_at_zero(setup, tmp_path)
     prog.write_text("G90 G1 X0 Y0 Z200 B10\nG1 X1\n")
     rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o2")
     assert rc == 0 and "note: axes C are never programmed: taken at 0 deg" in se, se
+
+
+def _controller_rule(m, vectors, previous):
+    """The controller's rule for tool vectors, block by block, written here from the
+    documented rule (volerr formats gcode, TCPM): both solutions of the generated inverse,
+    an axis that does not turn the tool there stays, each value turned to the one nearest
+    the previous block's, then by 360 deg into the travel; the solution inside the travel
+    with the smaller move, the first on a tie."""
+    rot = m.rotary_axes
+    lo = [m.travel[a][0] - 1e-9 for a in rot]
+    hi = [m.travel[a][1] + 1e-9 for a in rot]
+    prev, out = [float(v) for v in previous], []
+    for k in vectors / np.linalg.norm(vectors, axis=1, keepdims=True):
+        sols = []
+        for branch in (1.0, -1.0):
+            r = [float(np.rad2deg(v)) for v in m.module.inverse_rotary(*k, branch)]
+            q = np.r_[0.0, 0.0, 0.0, r]
+            turns = [np.linalg.norm((_axis(m, q + 1e-7 * np.eye(5)[3 + j]) - _axis(m, q))
+                                    / np.deg2rad(1e-7)) for j in range(2)]
+            sols.append([x if t > 1e-6 else None for x, t in zip(r, turns)])
+        best = None
+        for sol in sols:
+            vals, inside, move = [], True, 0.0
+            for j, x in enumerate(sol):
+                x = prev[j] if x is None else x
+                x = prev[j] + (x - prev[j] + 180.0) % 360.0 - 180.0
+                for turn in (0.0, 360.0, -360.0):
+                    if lo[j] <= x + turn <= hi[j]:
+                        x += turn
+                        break
+                else:
+                    inside = False
+                vals.append(x)
+                move += abs(x - prev[j])
+            score = move + (0.0 if inside else 1e6)
+            if best is None or score < best[0]:
+                best = (score, vals)
+        prev = best[1]
+        out.append(prev)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("layout", ["DMU50", "HH_BC", "TT_AC"])
+def test_rotary_positions_of_tool_vectors_follow_the_controller_rule(layout):
+    """All rows at once (rotary_from_vector) = the rule block by block, written
+    independently: random and smooth tool paths, vertical stretches (an undetermined axis
+    stays), paths turning the endless axis beyond its travel (turned back by 360 deg)."""
+    from volerr.fiveaxis.tcpm_kinematics import rotary_from_vector
+
+    m = volerr.load(layout)
+    rng = np.random.default_rng(7)
+    n = 450
+    t = np.linspace(0, 60, n)
+    tilt = np.r_[np.deg2rad(rng.uniform(3, 60, n // 3)),
+                 np.deg2rad(np.maximum(0, 40 * np.sin(t[:n // 3] / 2))),
+                 np.deg2rad(30 + 25 * np.sin(t[:n - 2 * (n // 3)] / 7))]
+    az = np.r_[np.deg2rad(rng.uniform(0, 360, n // 3)), t[:n // 3] * 1.3,
+               t[:n - 2 * (n // 3)] * 2.0]
+    vec = np.column_stack([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), np.cos(tilt)])
+    want = _controller_rule(m, vec, [0.0, 10.0])
+    got = rotary_from_vector(m, vec, np.array([0.0, 10.0]))
+    assert np.ptp(want[:, 1]) > 360                      # the endless axis turns more than once
+    assert np.abs(got - want).max() < 1e-9

@@ -8,7 +8,6 @@ from helpers.error_dirs import write_errors
 
 import volerr
 from volerr.fiveaxis.tcpmap import TcpMap, tcp_map
-from volerr.tables import table as tables
 from volerr.tables.functions import ErrorFunctions
 
 
