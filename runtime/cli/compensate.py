@@ -158,13 +158,7 @@ def run(args) -> int:
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
-    arcs = s["arcs"]
-    if arcs["linearised"]:
-        print(f"arcs: {arcs['linearised']} linearised into {arcs['segments']} G1 lines "
-              f"(predicted path within {args.arc_tolerance_um:g} um of the arc, max "
-              f"{arcs['max_path_deviation_um']:.3g} um); {arcs['kept']} kept as arcs")
-    elif arcs["kept"]:
-        print(f"arcs: {arcs['kept']} kept as arcs (end point and centre corrected)")
+    _print_arcs(s["arcs"], args.arc_tolerance_um)
     if s["max_u_after_um"] > 0:
         print(f"standard uncertainty of the remaining error (tables' _std and _s, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
@@ -183,3 +177,14 @@ def run(args) -> int:
         print(f"warning: {len(s['not_compensated']) - 5} more blocks not compensated",
               file=sys.stderr)
     return 0
+
+
+def _print_arcs(arcs: dict, tol_um: float) -> None:
+    """The console line on the program's arcs: how many were kept, how many linearised into
+    how many G1 lines."""
+    if arcs["linearised"]:
+        print(f"arcs: {arcs['linearised']} linearised into {arcs['segments']} G1 lines "
+              f"(predicted path within {tol_um:g} um of the arc, max "
+              f"{arcs['max_path_deviation_um']:.3g} um); {arcs['kept']} kept as arcs")
+    elif arcs["kept"]:
+        print(f"arcs: {arcs['kept']} kept as arcs (end point and centre corrected)")

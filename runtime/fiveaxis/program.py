@@ -47,7 +47,7 @@ WHOLE_CHUNK = True
 
 @dataclass(frozen=True)
 class Options:
-    """Validated options of a compensation (see :func:`volerr.fiveaxis.compensate.compensate_program`)."""
+    """Validated options of a compensation (see :func:`compensate_program`)."""
 
     tool: tuple = (0.0, 0.0, 0.0)
     orientation: bool = False
@@ -329,9 +329,9 @@ def round_positions(em, blocks: Blocks, sol: Solution, opts: Options):
 
 def compensate_arcs(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> dict:
     """Row -> (:class:`~volerr.nc.arcs.ArcPath`, :class:`~volerr.nc.arcs.ArcResult`)
-    of the arc blocks (:func:`volerr.fiveaxis.arc_compensation.compensate`); the points of a linearised
-    arc are rounded as every written position, its last point is the block's end as
-    written.  With the orientation compensated an arc is always linearised (a corrected
+    of the arc blocks (:func:`volerr.fiveaxis.arc_compensation.compensate`); the points of
+    a linearised arc are rounded as every written position, its last point is the block's
+    end as written.  With the orientation compensated an arc is always linearised (a corrected
     rotary position cannot move in an arc block)."""
     from .arc_compensation import compensate
 
@@ -851,8 +851,9 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
     model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL).
     ``chunk_lines``: lines per chunk (the output does not depend on it; :func:`run` also
     streams a program file of any length).  ``arc_tol_um``: path tolerance of arcs
-    (:mod:`volerr.fiveaxis.arc_compensation`); ``tool_length`` (mm) or ``tool_table`` (tool number -> mm): the tool length of TCPM blocks
-    (:mod:`volerr.nc.tcpm`); ``dialect``: "auto", "iso" or "heidenhain"."""
+    (:mod:`volerr.fiveaxis.arc_compensation`); ``tool_length`` (mm) or ``tool_table`` (tool
+    number -> mm): the tool length of TCPM blocks (:mod:`volerr.nc.tcpm`); ``dialect``:
+    "auto", "iso" or "heidenhain"."""
     import io
 
     opts = Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),

@@ -2,7 +2,17 @@
 
 A TCPM block (:mod:`volerr.nc.tcpm`) gives the tool tip ``X Y Z`` (mm) in the workpiece frame
 and the tool orientation as rotary angles or a tool vector; the controller turns them into
-axis positions with the machine's nominal inverse kinematics (:func:`axes_from_words`).
+axis positions (:func:`axes_from_words`) with the machine's nominal inverse kinematics and
+the tool length ``L`` of the active tool:
+
+* rotary angles: the rotary axes go to the angles, the linear axes to the generated
+  ``inverse_linear`` of the layout (derived in :mod:`volerr.derive.inverse`), so that the
+  nominal tool tip lands on ``X Y Z``;
+* tool vector: the rotary axes come from the generated ``inverse_rotary`` (two solutions, and
+  a turn of 360 deg for each): the one nearest the previous block, branch by branch and turn
+  by turn as a controller continues a path (:func:`rotary_from_vector`); on a singular
+  orientation (the tool along the first rotary axis) the undetermined axis stays where it was.
+
 Compensation moves the programmed tip (and, with ``--orientation``, the orientation) to the
 forward kinematics of the compensated axis positions: after the controller's inverse, the
 actual tool tip lands on the programmed one (:func:`words_from_axes`).

@@ -60,9 +60,9 @@ class Scan:
     line of the kind above; the words of the fast lines that matter (not those the
     interpreter ignores, such as ``N`` or ``F``), in text order: ``line`` (line index),
     ``axis`` (index into the axes, ``n_axes + 0 .. 2`` for the tool vector ``I J K``, or a
-    negative letter code: :data:`G_WORD`, :data:`M_WORD`, a :data:`TRACKED` code), ``value``, ``frac`` (digits after the dot, -1
-    without a dot), ``plus`` (written with ``+``), ``num_start`` / ``num_end`` (span of the
-    number in ``text``)."""
+    negative letter code: :data:`G_WORD`, :data:`M_WORD`, a :data:`TRACKED` code),
+    ``value``, ``frac`` (digits after the dot, -1 without a dot), ``plus`` (written with
+    ``+``), ``num_start`` / ``num_end`` (span of the number in ``text``)."""
 
     text: str
     start: np.ndarray

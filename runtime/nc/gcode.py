@@ -142,9 +142,6 @@ class Line:
             self._tokens = tokenize(self.body, self.number)
         return self._tokens
 
-    def words(self) -> list[Token]:
-        return [t for t in self.tokens if t.kind == "word"]
-
     def items(self) -> list[tuple[str, float, str]]:
         """(upper-case letter, value, number text) of every word, in order."""
         if self._items is None:
@@ -648,7 +645,7 @@ def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None 
                     and t.num_end <= anchor)
         at = anchor + shift
         head, tail = out[:at], out[at:]
-        words = line.words()
+        words = [t for t in line.tokens if t.kind == "word"]
         own = _spaced(_kinds(line)) if len(words) > 1 else None
         if len(words) > 1 and own is None:
             own = True

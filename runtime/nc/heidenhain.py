@@ -63,11 +63,6 @@ class Dialect:
     #: added words carry an explicit sign
     signed = True
 
-    @staticmethod
-    def parse_line(number: int, body: str, ending: str) -> Line:
-        return parse_line(number, body, ending)
-
-
 def parse_line(number: int, body: str, ending: str) -> Line:
     """One plain-language line as a :class:`volerr.nc.gcode.Line`: axis, ``F M S T``
     words as word tokens (``IX``: the letter in the line's ``incremental`` set), statement
@@ -104,6 +99,9 @@ def parse_line(number: int, body: str, ending: str) -> Line:
     if k >= 0:
         tokens.append(Token("comment", rest[k:], i + k))
     return _line(number, body, ending, tokens, incremental, anchor)
+
+
+Dialect.parse_line = staticmethod(parse_line)
 
 
 def _statement(head: str, text: str, i: int, tokens: list, where: str) -> bool:

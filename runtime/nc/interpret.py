@@ -111,13 +111,13 @@ class Blocks:
     ``segs``: the lines as read (with their endings), ``first`` the number of the first;
     ``scan``: the plain lines found by :func:`volerr.nc.chunkscan.scan` and their words;
     ``runs``: (first, end, columns) line indices of the plain lines interpreted together in
-    absolute mode and the columns of their words (the axes, or with the tool vector); ``slow``: line index -> (:class:`~volerr.nc.gcode.Line`, step) of the lines
-    interpreted one by one (step None without words); ``row``: per line, the row of a motion
-    block whose positions are all known, else -1; ``numbers``: the line number of every row;
-    ``pending``: per motion block with an unknown position, (line, target, the first
-    unknown letter); ``q_nom`` (n, n_axes)
-    the axis positions, mm / deg (under TCPM those the controller's inverse gives: filled in
-    by the caller, :func:`volerr.fiveaxis.tcpm_kinematics.axes_from_words`); ``w_nom``
+    absolute mode, the columns of their words (the axes, or with the tool vector); ``slow``:
+    line index -> (:class:`~volerr.nc.gcode.Line`, step) of the lines interpreted one by one
+    (step None without words); ``row``: per line, the row of a motion block whose positions
+    are all known, else -1; ``numbers``: the line number of every row; ``pending``: per
+    motion block with an unknown position, (line, target, the first unknown letter);
+    ``q_nom`` (n, n_axes) the axis positions, mm / deg (under TCPM those the controller's
+    inverse gives, filled in by the caller); ``w_nom``
     (n, n_axes + 3) the words as programmed (axes, then the tool vector ``I J K``; NaN where
     a row has none; under TCPM the linear columns are the tool tip in the workpiece frame);
     ``nd`` (n, n_axes + 3) decimals to write (never fewer than the programmed word had);
@@ -204,7 +204,8 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
     ends = _run_ends(sc, sheet)
     i = 0
     while i < n:
-        kind = _run_kind(interp)
+        kind = ("axes" if interp.frame == "axes" else "angles") if interp.plain else \
+            "vector" if interp.plain_vector else None
         if kind is not None and not ends[kind][0][i]:
             stop = ends[kind][1]
             k = np.searchsorted(stop, i)
@@ -217,19 +218,11 @@ def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
     return _blocks(sheet, segs, first, sc, interp, model.rotary_axes)
 
 
-def _run_kind(interp: gcode.Interpreter):
-    """The kind of run the interpreter's mode allows: "axes", "angles" (TCPM with rotary
-    angles), "vector" (TCPM with a tool vector) or None (line by line)."""
-    if interp.plain:
-        return "axes" if interp.frame == "axes" else "angles"
-    return "vector" if interp.plain_vector else None
-
-
 def _run_ends(sc, sheet: Sheet) -> dict:
-    """Per kind of run: (per line, it cannot be in such a run; the indices of those lines).
-    Every kind needs a plain line (:func:`volerr.nc.chunkscan.scan`); under TCPM with rotary
-    angles it holds no tool vector (the interpreter refuses one), with a tool vector no
-    rotary axis word."""
+    """Per kind of run ("axes"; TCPM with rotary "angles" or a tool "vector"): (per line, it
+    cannot be in such a run; the indices of those lines).  Every kind needs a plain line
+    (:func:`volerr.nc.chunkscan.scan`); with rotary angles it holds no tool vector (the
+    interpreter refuses one), with a tool vector no rotary axis word."""
     n = len(sc.fast)
     has_vec = np.zeros(n, dtype=bool)
     has_rot = np.zeros(n, dtype=bool)

@@ -5,25 +5,16 @@ Under TCPM (tool centre point management: Fanuc ``G43.4`` / ``G43.5``, Heidenhai
 the workpiece frame and the tool orientation, either as the rotary axis angles (deg; G43.4,
 M128, TRAORI with rotary words) or as a tool vector (``I J K`` of G43.5, ``A3 B3 C3`` of
 TRAORI: the unit tool-axis direction, from the tip towards the spindle, in the workpiece
-frame).  The controller turns them into axis positions with the machine's nominal inverse
-kinematics and the tool length ``L`` of the active tool:
+frame).
 
-* rotary angles: the rotary axes go to the angles, the linear axes to the generated
-  ``inverse_linear`` of the layout (derived in :mod:`volerr.derive.inverse`), so that the
-  nominal tool tip lands on ``X Y Z``;
-* tool vector: the rotary axes come from the generated ``inverse_rotary`` (two solutions, and
-  a turn of 360 deg for each): the one nearest the previous block, branch by branch and turn
-  by turn as a controller continues a path (:func:`rotary_from_vector`); on a singular
-  orientation (the tool along the first rotary axis) the undetermined axis stays where it was.
-
-The tool tip lies ``L`` from the point the axis positions refer to, against the tool axis: a
+The tool tip lies the tool length ``L`` from the point the axes refer to, against the tool axis: a
 tool offset ``(0, 0, -L)`` in the tool frame (the same offset ``volerr compensate --tool``
 gives a program in axis positions).
 
 This module holds what the program says: the frame of a row (:data:`AXES`, :data:`ANGLES`,
 :data:`VECTOR`), the tool offset of a tool length, the rule that finds a block's tool length
-(:func:`length_rule`) and the tool table file (:func:`read_tool_table`).  The controller's
-kinematics (words <-> axis positions) is the machine's: :mod:`volerr.fiveaxis.tcpm_kinematics`.
+(:func:`length_rule`) and the tool table file (:func:`read_tool_table`).  How the controller
+turns the words into axis positions is the machine's: :mod:`volerr.fiveaxis.tcpm_kinematics`.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Arcs G2/G3: the compensated program, run on an independent controller (tests/helpers/nc_sim:
-its own arc interpolation) and an independent exact chain (helpers.fiveaxis_chain.tool2work), keeps the
-actual tool tip within the tolerance (+ the rounding of the written numbers) of the nominal arc,
-in the three planes, for arcs kept as arcs and arcs linearised; the geometry against closed
-forms; arcs whose end is off the circle are refused naming the line."""
+its own arc interpolation) and an independent exact chain (helpers.fiveaxis_chain.tool2work),
+keeps the actual tool tip within the tolerance (+ the rounding of the written numbers) of the
+nominal arc, in the three planes, for arcs kept as arcs and arcs linearised; the geometry
+against closed forms; arcs whose end is off the circle are refused naming the line."""
 
 import math
 
