@@ -97,7 +97,7 @@ class TableParameter(Source):
         return self.parameter if self.column != "s" else f"{self.parameter} repeatability"
 
     def prepare(self, model, task, ctx):
-        from ..tables import make_function
+        from ..tables.functions import make_function
 
         q = np.asarray(task.positions[self.axis], dtype=float)
         if self.mode == "repeatability":
