@@ -4,7 +4,11 @@ each shape of program post-processors write.
 Shapes (the same positions in every one): ``bare`` (``X.. Y.. Z.. B.. C..``), ``g1`` (``G1`` on
 every line), ``post`` (``N.. G01 X.. Y.. Z.. B.. C.. F1500. S12000 M8 (cut) ; fin`` with CRLF),
 ``lower`` (``g1 x 1.0 y 2.0 ...``: lower case, blanks between letter and number), ``tools``
-(``G0``/``G1`` alternating, ``T`` and ``M`` words, comments between the words).
+(``G0``/``G1`` alternating, ``T`` and ``M`` words, comments between the words), and two TCPM
+tool-vector programs as post-processors write them (the tool tip and the unit tool vector of
+the same positions, tool length 120 mm): ``vector`` (Fanuc ``G43.5``: ``N.. G01 X.. Y.. Z..
+I.. J.. K.. F1500. (cut)``) and ``traori`` (Siemens ``TRAORI``: ``N.. G01 X.. Y.. Z.. A3=..
+B3=.. C3=.. F1500 ; cut``).
 
 Reports, for N blocks of each shape: the whole command (parse, interpret, solve, round,
 predict, write) in a subprocess, wall and CPU time and peak RSS (resource.getrusage), and the
@@ -15,7 +19,8 @@ at N; it takes ~100 s per 10^6 blocks).  Also: the vectorised solve alone on the
 positions and the solve block by block (a per-line script).
 
 With ``--base REV`` the whole command of commit REV (exported with ``git archive``, run
-through ``PYTHONPATH``) runs on the N-block bare program too, interleaved, output compared.
+through ``PYTHONPATH``) runs on the N-block program of every shape too, interleaved, output
+compared byte for byte; the table gives before (REV), after (this tree) and their ratio.
 
 Run: python benchmarks/bench_compensate.py [N_BLOCKS] [--runs R] [--shapes bare,post,...]
      [--baseline-full] [--base REV]     (default 1000000 blocks, 2 runs, every shape)
@@ -32,7 +37,7 @@ import numpy as np
 import volerr
 from _baseline import env_for, export, which_volerr
 from volerr.fiveaxis.compensate import ErrorModel, solve
-from volerr.tables import table as tables
+from volerr.tables.functions import ErrorFunctions
 from volerr.tables.table import ErrorTable, write_constants, write_error_table
 
 RUN = """
@@ -41,7 +46,8 @@ from volerr.cli import main
 from volerr.fiveaxis import program
 program.WHOLE_CHUNK = sys.argv[4] == "1"
 t0 = time.perf_counter(); c0 = time.process_time()
-rc = main(["compensate", "DMU50", sys.argv[1], "--errors", sys.argv[2], "--out", sys.argv[3]])
+rc = main(["compensate", "DMU50", sys.argv[1], "--errors", sys.argv[2], "--out", sys.argv[3],
+           "--tool-length", "120"])
 print(time.perf_counter() - t0, time.process_time() - c0,
       resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
 """
@@ -55,17 +61,29 @@ SHAPES = {
     "lower": lambda k, r: "g1 x %.3f y %.3f z %.3f b %.3f c %.3f\n" % r,
     "tools": lambda k, r: ("G%d X%.3f (a) Y%.3f Z%.3f B%.3f C%.3f T%d M%d ;x\n"
                            % ((k % 2,) + r + (k % 7, 8 + k % 2))),
+    # TCPM: r is (tip x y z, tool vector i j k) here
+    "vector": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f F1500. (cut)\r\n"
+                           % ((k,) + r),
+    "traori": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f A3=%.6f B3=%.6f C3=%.6f F1500 ; cut\n"
+                           % ((k,) + r),
 }
+#: the first lines of a TCPM program: tool 1, TCPM on
+TCPM_HEAD = {"vector": "T1 M6\nG43.5 H1\n", "traori": "T1 M6\nTRAORI\n"}
 
 
 def write_program(path: Path, n: int, rng, shape: str = "bare") -> np.ndarray:
     q = np.column_stack([rng.uniform(-240, 240, n), rng.uniform(-220, 220, n),
                          rng.uniform(10, 390, n), rng.uniform(1, 179, n), rng.uniform(0, 359, n)])
     line = SHAPES[shape]
+    rows = q
+    if shape in TCPM_HEAD:      # the same positions as tool tip and tool vector
+        q[:, 2] = rng.uniform(150, 390, n)
+        q[:, 3] = rng.uniform(1, 90, n)
+        rows = volerr.load("DMU50").forward(q, np.tile([0.0, 0.0, -120.0], (n, 1)))
     with open(path, "w", encoding="latin-1", newline="") as fh:
-        fh.write("G90 G1 X0 Y0 Z100 B10 C0\n")
+        fh.write("G90 G1 X0 Y0 Z100 B10 C0\n" + TCPM_HEAD.get(shape, ""))
         for i in range(0, n, 100000):
-            fh.write("".join(line(i + k, tuple(r)) for k, r in enumerate(q[i:i + 100000])))
+            fh.write("".join(line(i + k, tuple(r)) for k, r in enumerate(rows[i:i + 100000])))
     return np.round(q, 3)
 
 
@@ -91,16 +109,16 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
                     for p in m.layout.axes[a].component_errors}
             write_error_table(d / f"{a}.csv", ErrorTable(a, x, vals))
         write_constants(d / "constants.csv", {"EC0Y": 20e-6, "EX0C": 0.01, "EA0B": 15e-6})
-        funcs = tables.ErrorFunctions.from_dir(d, m)
+        funcs = ErrorFunctions.from_dir(d, m)
         q = None
         for sh in shapes:
             q = write_program(d / f"big_{sh}.nc", n, np.random.default_rng(1), sh)
             write_program(d / f"small_{sh}.nc", max(n // 10, 1), np.random.default_rng(2), sh)
         em = ErrorModel(m, funcs)
         k = min(300, n)
-        res = {key: [] for key in ["solve", "base"] + [f"{sh}{x}" for sh in shapes
-                                                       for x in ("", "_small", "_line",
-                                                                 "_big_line")]}
+        res = {key: [] for key in ["solve"] + [f"{sh}{x}" for sh in shapes
+                                               for x in ("", "_small", "_line", "_big_line",
+                                                         "_base", "_pair")]}
         pkg = export(base, d / "base") if base else None
         if pkg is not None:
             assert which_volerr(pkg).startswith(str(pkg)), "baseline import not taken"
@@ -115,11 +133,11 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
                     res[f"{sh}_big_line"].append(command(d / f"big_{sh}.nc", d, d / "ref.nc",
                                                          whole=False))
                     assert (d / "out.nc").read_bytes() == (d / "ref.nc").read_bytes(), sh
-            if pkg is not None and "bare" in shapes:
-                command(d / "big_bare.nc", d, d / "out.nc")
-                res["base"].append(command(d / "big_bare.nc", d, d / "out_base.nc",
-                                           pythonpath=pkg))
-                assert (d / "out.nc").read_bytes() == (d / "out_base.nc").read_bytes()
+            for sh in shapes if pkg is not None else ():     # interleaved pairs
+                res[f"{sh}_pair"].append(command(d / f"big_{sh}.nc", d, d / "out.nc"))
+                res[f"{sh}_base"].append(command(d / f"big_{sh}.nc", d, d / "out_base.nc",
+                                                 pythonpath=pkg))
+                assert (d / "out.nc").read_bytes() == (d / "out_base.nc").read_bytes(), sh
             t0 = time.perf_counter()
             for i in range(0, n, 20000):
                 solve(em, q[i:i + 20000])
@@ -130,7 +148,7 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
         t_loop = (time.perf_counter() - t0) * n / k
         t_vec = min(res["solve"])
         best = {key: tuple(min(r[i] for r in v) for i in range(3))
-                for key, v in res.items() if v and key not in ("solve", "base")}
+                for key, v in res.items() if v and key != "solve"}
         print(f"DMU50, full strategy, min of {runs} interleaved runs "
               f"(wall s, CPU s, peak RSS MB; ratio to the bare shape)")
         ref = best.get("bare")
@@ -147,12 +165,12 @@ def main(n: int = 1000000, runs: int = 2, baseline_full: bool = False, base=None
                 bw = best[f"{sh}_big_line"][0]
                 line += f"; at {n}: line by line {bw:.1f} s ({bw / w:.1f}x)"
             print(line)
-        if res["base"]:
-            w = best["bare"][0]
-            bw, bc, br = (min(r[i] for r in res["base"]) for i in range(3))
-            print(f"  bare {n:>8} blocks, commit {base}: {bw:.1f} s wall, {bc:.1f} s CPU, "
-                  f"{br:.0f} MB; ratio {bw / w:.2f}x wall, {bc / best['bare'][1]:.2f}x CPU; "
-                  "output identical")
+        if pkg is not None:
+            print(f"  {n} blocks, commit {base} (before) and this tree (after), interleaved "
+                  "pairs, output identical; shape, before, after (CPU s), ratio after / before:")
+            for sh in shapes:
+                bc, c = best[f"{sh}_base"][1], best[f"{sh}_pair"][1]
+                print(f"  {sh:>6} {bc:8.1f} {c:8.1f} {c / bc:6.2f}x")
         print(f"  solve alone (chunks of 20000): {t_vec:.2f} s; block by block (extrapolated "
               f"from {k}): {t_loop:.0f} s")
 

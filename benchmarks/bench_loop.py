@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 import volerr
-from volerr.loop.fit import data_ranges, declared_design
+from volerr.estimate.design import data_ranges, declared_design
 from volerr.loop.run import columns_to_data, run_loop
 from volerr.loop.simulate import demo_probes, simulate
 

@@ -10,7 +10,3 @@ from .machine.model import Model, load  # noqa: F401
 
 __all__ = ["InputError", "Model", "layouts", "load"]
 __version__ = "0.1.0"
-
-from . import _legacy
-
-_legacy.install()

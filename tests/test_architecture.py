@@ -32,23 +32,11 @@ pytestmark = pytest.mark.xdist_group("architecture")
 #: was longer (dmu50.audit 245 lines ...) was a sequence of items, now one function per item.
 TABLES_OF_PRINTED_EQUATIONS: dict = {}
 
-#: the five functions over 90 lines of the NC-program reader / writer, split by engineer NC on
-#: branch issue31-nc (where they move to runtime/nc/).  THE LEAD EMPTIES THIS AT MERGE.
-#: key: (module file name, qualified name), in runtime/fiveaxis/ or runtime/nc/
-PENDING_SPLIT_ON_BRANCH_ISSUE31_NC = {
-    ("program.py", "interpret"), ("gcode.py", "Interpreter.step"), ("chunkscan.py", "scan"),
-    ("heidenhain.py", "parse_line"), ("writer.py", "Writer.run")}
+#: functions over MAX_LINES waiting for a split on another branch (none)
+PENDING_SPLIT_ON_BRANCH_ISSUE31_NC: set = set()
 
-#: import circles that other branches' files still hold open.  THE LEAD EMPTIES THIS AT MERGE.
-#: * compensate <-> program (files in runtime/fiveaxis/ or runtime/nc/): broken on issue31-nc;
-#: * tables/table.py <-> tables/functions.py: table.py re-exports the names that moved to
-#:   functions.py (a second import path) for tests/fiveaxis/{test_tcpmap,test_chunkscan,
-#:   test_compensate,test_streaming}.py and benchmarks/bench_compensate.py (issue31-nc's
-#:   files), which call ``tables.ErrorFunctions``; once they import it from
-#:   volerr.tables.functions, delete ``_MOVED`` and ``__getattr__`` at the end of table.py.
-PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC = {
-    frozenset({"compensate.py", "program.py"}),
-    frozenset({"runtime/tables/table.py", "runtime/tables/functions.py"})}
+#: import circles other branches' files still hold open (none)
+PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC: set = set()
 
 
 #: imports that run up the table, each with the reason and the way out

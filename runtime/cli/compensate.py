@@ -4,8 +4,8 @@ Reads an NC program (ISO G-code or Heidenhain plain language; axis positions, ar
 TCPM), predicts the tool-tip error of every motion block from the layout's model and the error
 tables (by each block's approach direction where they carry a reversal), and writes a copy
 whose positions make the actual tool tip land on the nominal one (see
-:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.fiveaxis.gcode`,
-:mod:`volerr.fiveaxis.arcs`, :mod:`volerr.fiveaxis.tcpm` and :mod:`volerr.fiveaxis.heidenhain`
+:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.nc.gcode`,
+:mod:`volerr.nc.arcs`, :mod:`volerr.nc.tcpm` and :mod:`volerr.nc.heidenhain`
 for what is supported; ``volerr formats gcode``).  Only position numbers change; the input is
 never overwritten.
 
@@ -71,7 +71,9 @@ def register(sub) -> None:
     p.add_argument("--tool-length", type=float, default=None, metavar="MM",
                    help="TCPM programs (G43.4/G43.5, M128, FUNCTION TCPM, TRAORI): the tool "
                         "length the controller uses, mm (the tip lies this far from the point "
-                        "the axes refer to, against the tool axis)")
+                        "the axes refer to, against the tool axis); with --tool-table, "
+                        "the length of the tools the table does not hold (a tool it holds "
+                        "with another length is refused)")
     p.add_argument("--tool-table", default=None, metavar="CSV",
                    help="TCPM programs: tool lengths by tool number, CSV tool,length_mm, "
                         "looked up at the program's H word (Fanuc), else T (Siemens, "
@@ -115,7 +117,7 @@ def run(args) -> int:
     open_source = program.open_program(args.program)
     table = None
     if args.tool_table:
-        from ..fiveaxis.tcpm import read_tool_table
+        from ..nc.tcpm import read_tool_table
         table = read_tool_table(args.tool_table)
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
               *([args.tool_table] if args.tool_table else [])]
@@ -156,6 +158,7 @@ def run(args) -> int:
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
+    _print_arcs(s["arcs"], args.arc_tolerance_um)
     if s["max_u_after_um"] > 0:
         print(f"standard uncertainty of the remaining error (tables' _std and _s, k = 1): max "
               f"{s['max_u_after_um']:.3f} um")
@@ -174,3 +177,14 @@ def run(args) -> int:
         print(f"warning: {len(s['not_compensated']) - 5} more blocks not compensated",
               file=sys.stderr)
     return 0
+
+
+def _print_arcs(arcs: dict, tol_um: float) -> None:
+    """The console line on the program's arcs: how many were kept, how many linearised into
+    how many G1 lines."""
+    if arcs["linearised"]:
+        print(f"arcs: {arcs['linearised']} linearised into {arcs['segments']} G1 lines "
+              f"(predicted path within {tol_um:g} um of the arc, max "
+              f"{arcs['max_path_deviation_um']:.3g} um); {arcs['kept']} kept as arcs")
+    elif arcs["kept"]:
+        print(f"arcs: {arcs['kept']} kept as arcs (end point and centre corrected)")

@@ -57,9 +57,6 @@ that the block does not program needs a value different from the one the control
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..errors import InputError, require
@@ -117,60 +114,6 @@ def parameters_for_types(model, types) -> set | None:
                 f"unknown compensation type {t!r} (use {' '.join(TYPES)} or L-VOL R-VOL)")
         wanted.update(TYPE_GROUPS.get(t, (t,)))
     return {p for p, ts in parameter_types(model).items() if wanted.intersection(ts)}
-
-
-@dataclass
-class LineReport:
-    """Predicted error of one motion block before and after compensation."""
-
-    line: int
-    nominal: dict
-    output: dict
-    before_um: tuple
-    after_um: tuple
-    orientation_before_urad: float
-    orientation_after_urad: float
-    iterations: int
-    status: str
-    #: standard uncertainty (k = 1) of the remaining error, from the tables' Type A std,
-    #: per axis x y z (NaN when the tables carry none)
-    u_after_um: tuple = (math.nan,) * 3
-
-
-@dataclass
-class Result:
-    text: str
-    reports: list = field(default_factory=list)
-    #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
-    assumed_zero: tuple = ()
-    #: what the program held besides straight moves: ``tcpm_blocks`` and ``arcs`` (kept,
-    #: linearised, segments, max_path_deviation_um), as in the streamed summary
-    shapes: dict = field(default_factory=dict)
-
-    def summary(self) -> dict:
-        done = [r for r in self.reports if r.status.startswith("compensated")]
-        b = np.array([np.linalg.norm(r.before_um) for r in done]) if done else np.zeros(0)
-        a = np.array([np.linalg.norm(r.after_um) for r in done]) if done else np.zeros(0)
-        ob = np.array([r.orientation_before_urad for r in done]) if done else np.zeros(0)
-        oa = np.array([r.orientation_after_urad for r in done]) if done else np.zeros(0)
-
-        def mx(v):
-            return float(v.max()) if v.size else 0.0
-
-        return {
-            "motion_blocks": len(self.reports),
-            "compensated": len(done),
-            "not_compensated": [{"line": r.line, "reason": r.status} for r in self.reports
-                                if not r.status.startswith("compensated")],
-            "max_before_um": mx(b), "max_after_um": mx(a),
-            "rms_before_um": float(np.sqrt(np.mean(b ** 2))) if b.size else 0.0,
-            "rms_after_um": float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0,
-            "max_orientation_before_urad": mx(ob), "max_orientation_after_urad": mx(oa),
-            "max_iterations": max((r.iterations for r in done), default=0),
-            "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
-                                           if np.all(np.isfinite(r.u_after_um))])),
-            **self.shapes,
-        }
 
 
 # ---------------------------------------------------------------------------------------
@@ -497,67 +440,6 @@ def solve_thesis(em: ErrorModel, q_nom: np.ndarray, direction=None) -> np.ndarra
     q2 = q1.copy()
     q2[:, lin_idx] -= solve_linear(linear_jacobian(m, q1, em.tool), e_lin)
     return q2
-
-
-# ---------------------------------------------------------------------------------------
-# programs
-class _Collect:
-    """Sink of :func:`volerr.fiveaxis.program.run` that keeps the text and a report per block."""
-
-    def __init__(self, model):
-        self.model = model
-
-    def start(self):
-        self.text, self.reports = [], []
-
-    def add(self, chunk) -> None:
-        axes = self.model.axes
-        b, p = chunk.blocks, chunk.prediction
-        self.text.append(chunk.text)
-        q_nom, q_out = b.q_nom.tolist(), chunk.q_out.tolist()
-        rows = b.numbers.tolist()
-        for o in b.order:
-            if o >= 0:
-                self.reports.append(LineReport(
-                    rows[o], dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
-                    tuple(p.before_um[o]), tuple(p.after_um[o]),
-                    float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
-                    int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))
-            else:
-                line, target, missing = b.pending[-1 - o]
-                self.reports.append(LineReport(
-                    line.number, dict(target), dict(target), (math.nan,) * 3, (math.nan,) * 3,
-                    math.nan, math.nan, 0, f"not compensated: position of {missing} unknown"))
-
-
-def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
-                       strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
-                       initial: dict | None = None, check_travel: bool = True,
-                       max_iter: int = 50, types=None, chunk_lines: int | None = None,
-                       arc_tol_um: float = 1.0, tool_length: float | None = None,
-                       tool_table: dict | None = None, dialect: str = "auto") -> Result:
-    """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
-
-    ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
-    that compensates the linear axes only); the report still predicts the error of the full
-    model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL).
-    ``chunk_lines``: lines per chunk (the output does not depend on it; see
-    :mod:`volerr.fiveaxis.program`, which also streams a program file of any length).
-    ``arc_tol_um``: path tolerance of arcs (:mod:`volerr.fiveaxis.arcs`); ``tool_length``
-    (mm) or ``tool_table`` (tool number -> mm): the tool length of TCPM blocks
-    (:mod:`volerr.fiveaxis.tcpm`); ``dialect``: "auto", "iso" or "heidenhain"."""
-    import io
-
-    from . import program
-
-    opts = program.Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
-                           check_travel, max_iter, None if types is None else tuple(types),
-                           arc_tol_um, tool_length, tool_table, dialect)
-    sink = _Collect(model)
-    s, never = program.run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
-                           chunk_lines or program.CHUNK_LINES)
-    return Result("".join(sink.text), sink.reports, never,
-                  {k: s[k] for k in ("tcpm_blocks", "arcs")})
 
 
 def resolve_linear(em: ErrorModel, q_nom, q_out, tol, max_iter, direction=None) -> np.ndarray:

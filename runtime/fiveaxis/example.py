@@ -100,7 +100,7 @@ def hemisphere_program(model, radius: float = 40.0, center=(30.0, 20.0, 20.0), r
 
 
 def _inside(model, text: str) -> bool:
-    from . import gcode
+    from ..nc import gcode
 
     for b in gcode.blocks(gcode.parse(text), model.axes):
         for a, v in b.target.items():

@@ -72,8 +72,9 @@ def inverse(model, target, tool=(0.0, 0.0, 0.0), near=None) -> np.ndarray:
         candidates.append(cand)
     # an axis that does not turn the tool axis at the solution is undetermined: keep near
     for cand in candidates:
+        sens_all = _sensitivities(model, cand)
         for a in rot:
-            sens = _axis_sensitivity(model, cand, a)
+            sens = sens_all[a]
             undetermined = sens < SINGULAR
             if undetermined.any():
                 cand[a] = np.where(undetermined, near_rot[a], cand[a])
@@ -136,13 +137,20 @@ def nominal_jacobian(model, positions, tool=(0.0, 0.0, 0.0)) -> np.ndarray:
 
 def _axis_sensitivity(model, rot_deg: dict, axis: str) -> np.ndarray:
     """|d(tool axis)/d(axis)| (per rad) at the rotary positions ``rot_deg`` (exact)."""
+    return _sensitivities(model, rot_deg)[axis]
+
+
+def _sensitivities(model, rot_deg: dict) -> dict:
+    """Rotary axis -> |d(tool axis)/d(axis)| (per rad) at the rotary positions ``rot_deg``
+    (exact; one Jacobian for all axes)."""
     n = len(next(iter(rot_deg.values())))
     q = np.zeros((n, len(model.axes)))
     for a in model.rotary_axes:
         if a in rot_deg:
             q[:, model.axes.index(a)] = np.nan_to_num(rot_deg[a])
     j = nominal_jacobian(model, q)
-    return np.linalg.norm(j[:, 3:6, model.axes.index(axis)], axis=1)
+    return {a: np.linalg.norm(j[:, 3:6, model.axes.index(a)], axis=1)
+            for a in model.rotary_axes}
 
 
 def linear_jacobian(model, positions: np.ndarray, tool=(0.0, 0.0, 0.0)) -> np.ndarray:

@@ -2,19 +2,22 @@
 
 One chunk (``CHUNK_LINES`` lines) goes through
 
-1. :func:`interpret`   lines -> :class:`Blocks` (programmed positions of the motion blocks whose
-   axes are all known, the decimals to write), the modal state carried by one
-   :class:`~volerr.fiveaxis.gcode.Interpreter` from chunk to chunk;
+1. :func:`volerr.nc.interpret.interpret`   lines -> :class:`~volerr.nc.interpret.Blocks`
+   (programmed words of the motion blocks whose positions are all known, the decimals to
+   write), the modal state carried by one :class:`~volerr.nc.gcode.Interpreter` from chunk to
+   chunk; :func:`axes_of_blocks` the axis positions of TCPM blocks (the controller's inverse);
 2. :func:`check_positions`   travel and error-table ranges (bad input is refused);
 3. :func:`solve_blocks`   the compensation (:func:`volerr.fiveaxis.compensate.solve` or the
    thesis strategy) -> :class:`Solution`;
 4. :func:`round_positions`   the values actually written;
 5. :func:`predict`   predicted tool-tip / tool-axis error before and after -> :class:`Prediction`;
-6. :func:`write`   the output lines; a :class:`~volerr.fiveaxis.gcode.ControllerState` follows
-   the program as written (the same rule the interpreter applies to the program as read).
+6. :class:`volerr.nc.writer.Writer`   the output lines; a
+   :class:`~volerr.nc.gcode.ControllerState` follows the program as written (the same rule the
+   interpreter applies to the program as read).
 
 Every step works row by row, so the output does not depend on the chunk size: a program of
-any length runs in memory bounded by the chunk.  Before the chunks, :func:`prescan` reads the
+any length runs in memory bounded by the chunk.  Before the chunks,
+:func:`volerr.nc.interpret.prescan` reads the
 program once more cheaply (no interpretation) for the two facts that need the whole program:
 which rotary axes it never commands (taken at 0 deg) and how it separates words.
 """
@@ -23,28 +26,28 @@ from __future__ import annotations
 
 import itertools
 import math
-import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError, require
-from . import chunkscan, gcode
-from .kinematics import is_five_axis, linear_axes
-
-#: lines per chunk: large enough for the vectorised solve, small enough for the memory
-CHUNK_LINES = 20000
+from ..nc import gcode, tcpm
+from ..nc.interpret import CHUNK_LINES, Blocks, interpret, prescan
+from ..nc.writer import Writer
+from . import tcpm_kinematics
+from .compensate import (STRATEGIES, ErrorModel, parameters_for_types, resolve_linear, solve,
+                         solve_thesis)
+from .kinematics import inverse, is_five_axis, linear_axes
 
 #: False: every line is interpreted and written one by one (the reference the whole-chunk
 #: path is tested and benchmarked against; the output is the same)
 WHOLE_CHUNK = True
 
-_COMMENTS = re.compile(r"\([^)\r\n]*\)|;[^\r\n]*")
 
 
 @dataclass(frozen=True)
 class Options:
-    """Validated options of a compensation (see :func:`volerr.fiveaxis.compensate.compensate_program`)."""
+    """Validated options of a compensation (see :func:`compensate_program`)."""
 
     tool: tuple = (0.0, 0.0, 0.0)
     orientation: bool = False
@@ -55,17 +58,15 @@ class Options:
     check_travel: bool = True
     max_iter: int = 50
     types: tuple | None = None
-    #: arcs: the path tolerance (:mod:`volerr.fiveaxis.arcs`), um
+    #: arcs: the path tolerance (:mod:`volerr.nc.arcs`), um
     arc_tol_um: float = 1.0
     #: TCPM: the tool length (mm), or a tool table (tool number -> mm) for T / H / D words
     tool_length: float | None = None
     tool_table: dict | None = None
-    #: "auto", "iso" or "heidenhain" (:mod:`volerr.fiveaxis.dialect`)
+    #: "auto", "iso" or "heidenhain" (:mod:`volerr.nc.dialect`)
     dialect: str = "auto"
 
     def validated(self, model) -> "Options":
-        from .compensate import STRATEGIES
-
         require(self.strategy in STRATEGIES,
                 f"unknown strategy {self.strategy!r} ({' '.join(STRATEGIES)})")
         require(self.tol_um > 0 and math.isfinite(self.tol_um),
@@ -87,7 +88,7 @@ class Options:
         require(self.tool_length is None or (math.isfinite(self.tool_length)
                                              and self.tool_length >= 0),
                 "the tool length must be a finite number >= 0 (mm)")
-        from .dialect import DIALECTS
+        from ..nc.dialect import DIALECTS
         require(self.dialect in DIALECTS, f"unknown dialect {self.dialect!r} "
                                           f"({' '.join(DIALECTS)})")
         return Options(tuple(float(v) for v in tool), bool(self.orientation), self.strategy,
@@ -101,267 +102,23 @@ class Options:
 
 
 # ---------------------------------------------------------------------------------------
-# step 0: what needs the whole program
-@dataclass
-class Prescan:
-    """Rotary axes whose letter never appears as a word (outside comments), the word
-    separation of the program (:func:`volerr.fiveaxis.gcode.spaced_style`) and its dialect's
-    line parser (None: ISO; :func:`volerr.fiveaxis.dialect.parser`)."""
-
-    absent_rotary: tuple
-    spaced: bool
-    dialect: object = None
-
-
-def prescan(open_source, model, chunk_lines: int = CHUNK_LINES,
-            dialect: str = "auto") -> Prescan:
-    from . import dialect as dialects
-
-    rot = [a for a in model.rotary_axes]
-    pats = {a: re.compile(rf"[{a}{a.lower()}][ \t]*[+-]?\.?\d") for a in rot}
-    seen = set()
-    spaced = None
-    fh = open_source()
-    try:
-        first = 1
-        while True:
-            buf = list(itertools.islice(fh, chunk_lines))
-            if dialect == "auto":
-                dialect = dialects.detect(buf, first)
-            if dialect == "heidenhain":
-                spaced = True
-            for n, seg in enumerate(buf if spaced is None else (), start=first):
-                try:
-                    spaced = gcode._spaced(gcode._kinds(gcode.Line.parse(n, seg.rstrip("\r\n"),
-                                                                         "")))
-                except InputError:
-                    pass        # reported with its line number by the interpreter
-                if spaced is not None:
-                    break
-            seen |= _letters(buf, pats, seen)
-            first += len(buf)
-            if len(buf) < chunk_lines or (len(seen) == len(rot) and spaced is not None):
-                break           # the end, or nothing left to learn from the rest
-    finally:
-        if hasattr(fh, "close"):
-            fh.close()
-    return Prescan(tuple(a for a in rot if a not in seen), True if spaced is None else spaced,
-                   dialects.parser(dialect))
-
-
-def _letters(segs, pats, seen) -> set:
-    text = _COMMENTS.sub("", "".join(segs))
-    return {a for a, p in pats.items() if a not in seen and p.search(text)}
-
-
-# ---------------------------------------------------------------------------------------
-# step 1: interpret
-@dataclass
-class Blocks:
-    """The lines of one chunk and its motion blocks.
-
-    ``segs``: the lines as read (with their endings), ``first`` the number of the first;
-    ``scan``: the plain lines found by :func:`volerr.fiveaxis.chunkscan.scan` and their words;
-    ``runs``: (first, end) line indices of the plain lines interpreted together in absolute
-    mode; ``slow``: line index -> (:class:`~volerr.fiveaxis.gcode.Line`, step) of the lines
-    interpreted one by one (step None without words); ``row``: per line, the row of a motion
-    block whose positions are all known, else -1; ``numbers``: the line number of every row;
-    ``pending``: per motion block with an unknown position, (line, target, the first
-    unknown letter); ``q_nom`` (n, n_axes)
-    the axis positions, mm / deg (under TCPM those the controller's inverse gives); ``w_nom``
-    (n, n_axes + 3) the words as programmed (axes, then the tool vector ``I J K``; NaN where
-    a row has none; under TCPM the linear columns are the tool tip in the workpiece frame);
-    ``nd`` (n, n_axes + 3) decimals to write (never fewer than the programmed word had);
-    ``frame`` (n,) :data:`volerr.fiveaxis.tcpm.AXES` / ``ANGLES`` / ``VECTOR``; ``length``
-    (n,) the tool length of TCPM rows (NaN elsewhere), mm; ``arcs`` row -> the
-    :class:`~volerr.fiveaxis.arcs.ArcPath` of an arc block; ``direction`` (n, n_axes) the
-    approach directions (:mod:`volerr.fiveaxis.reversal`) when the tables carry a reversal,
-    else None."""
-
-    segs: list
-    first: int
-    scan: object
-    runs: list
-    slow: dict
-    row: np.ndarray
-    numbers: np.ndarray
-    q_nom: np.ndarray
-    nd: np.ndarray
-    order: list          # per motion block in order: row (>= 0) or -(1 + index into pending)
-    pending: list
-    known_rotary: set
-    motion: np.ndarray   # per line: a motion block
-    w_nom: np.ndarray = None
-    frame: np.ndarray = None
-    length: np.ndarray = None
-    arcs: dict = field(default_factory=dict)
-    direction: np.ndarray | None = None
-    dir_before: np.ndarray | None = None
-    #: the approach directions of the program as read (its own moves), for "before"
-    dir_program: np.ndarray | None = None
-
-    def dir(self, rows):
-        """The directions of ``rows`` (None without reversal)."""
-        return None if self.direction is None else self.direction[rows]
-
-    def line(self, i: int) -> gcode.Line:
-        """Line ``i`` of the chunk, parsed."""
-        return self.slow[i][0] if i in self.slow else _parse_seg(self.segs, self.first, i)
-
-
-def _parse_seg(segs, first: int, i: int) -> gcode.Line:
-    seg = segs[i]
-    body = seg.rstrip("\r\n")
-    return gcode.Line.parse(first + i, body, seg[len(body):])
-
-
-def _words(sc, i0: int, i1: int) -> slice:
-    lo, hi = np.searchsorted(sc.line, [i0, i1])
-    return slice(int(lo), int(hi))
-
-
-#: decimals of a tool-vector component at least (1e-7: 0.1 urad)
-VECTOR_DECIMALS = 7
-
-
-def interpret(segs, first: int, interp: gcode.Interpreter, model, decimals: int,
-              dialect=None) -> Blocks:
-    """Interpret the lines ``segs`` (numbered from ``first``); ``interp`` carries the modal
-    state from chunk to chunk.  Runs of plain lines in a plain mode (absolute, straight, axis
-    positions or TCPM with rotary angles) are done together (the position of an axis is its last programmed value: a
-    forward fill); every other line goes through ``interp`` one by one.  ``dialect``: the
-    line parser of another dialect (:mod:`volerr.fiveaxis.heidenhain`; its lines are all
-    interpreted one by one)."""
-    from . import arcs, tcpm
-
-    axes = model.axes
-    nax = len(axes)
-    letters = (*axes, *gcode.VECTOR)
-    ncol = len(letters)
-    n = len(segs)
-    sc = chunkscan.scan(segs, axes)
-    if not WHOLE_CHUNK or dialect is not None:
-        sc.fast[:] = False
-    w = np.full((n, ncol), np.nan)
-    nd = np.full((n, ncol), decimals, dtype=np.int64)
-    nd[:, nax:] = max(decimals, VECTOR_DECIMALS)
-    motion = np.zeros(n, dtype=bool)
-    frame = np.zeros(n, dtype=np.int8)
-    length = np.full(n, np.nan)
-    paths = {}
-    slow, runs = {}, []
-    pos = interp.state.position
-    index = {a: i for i, a in enumerate(letters)}
-    rot_idx = [axes.index(a) for a in model.rotary_axes]
-    parse = dialect.parse_line if dialect is not None else gcode.Line.parse
-    slow_idx = np.flatnonzero(~sc.fast)
-    i = 0
-    while i < n:
-        if sc.fast[i] and interp.plain:
-            k = np.searchsorted(slow_idx, i)
-            j = int(slow_idx[k]) if k < len(slow_idx) else n
-            ws = _words(sc, i, j)
-            interp.tools.update(sc.last_tracked(ws))
-            wl, wa = sc.line[ws] - i, sc.axis[ws]
-            ax = wa >= 0
-            wl, wa = wl[ax], wa[ax]
-            m = j - i
-            v = np.full((m, nax), np.nan)
-            v[wl, wa] = sc.value[ws][ax]
-            has = np.zeros((m, nax), dtype=bool)
-            has[wl, wa] = True
-            fr = sc.frac[ws][ax]
-            nd[i + wl, wa] = np.maximum(decimals, fr)
-            last = np.where(has, np.arange(m)[:, None], -1)
-            np.maximum.accumulate(last, axis=0, out=last)
-            startv = np.array([np.nan if pos[a] is None else pos[a] for a in axes])
-            cols = np.arange(nax)
-            w[i:j, :nax] = np.where(last >= 0, v[np.maximum(last, 0), cols], startv)
-            motion[i:j] = has.any(axis=1)
-            if interp.frame == "tcpm":          # TCPM with rotary angles: tip and angles
-                mrows = i + np.flatnonzero(has.any(axis=1))
-                frame[mrows] = tcpm.ANGLES
-                length[mrows] = interp.length
-                if len(mrows):
-                    interp._last_orientation = "angles"
-            for c, a in enumerate(axes):
-                val = w[j - 1, c]
-                pos[a] = None if val != val else float(val)
-            runs.append((i, j))
-            i = j
-            continue
-        seg = segs[i]
-        body = seg.rstrip("\r\n")
-        line = parse(first + i, body, seg[len(body):])
-        step = interp.step(line)
-        slow[i] = (line, step)
-        if step is not None:
-            start = None
-            if step.kind == "arc":
-                start = dict(pos)
-                start.update({a: None for a in step.forget})
-            interp.state.apply(step)
-            if step.kind in ("motion", "arc"):
-                motion[i] = True
-                w[i] = [np.nan if pos[a] is None else pos[a] for a in letters]
-                if step.frame == "tcpm":
-                    vec = step.orientation == "vector"
-                    frame[i] = tcpm.VECTOR if vec else tcpm.ANGLES
-                    length[i] = step.tool_length
-                    if vec:
-                        w[i, rot_idx] = np.nan
-                    else:
-                        w[i, nax:] = np.nan
-                else:
-                    w[i, nax:] = np.nan
-                for a, _, txt in line.items():
-                    c = index.get(a)
-                    if c is not None and "." in txt and not (step.kind == "arc" and c >= nax):
-                        nd[i, c] = max(nd[i, c], len(txt) - txt.index(".") - 1)
-                if start is not None and all(start[a] is not None for a in axes) and \
-                        all(pos[a] is not None for a in axes):
-                    paths[i] = arcs.arc_path(axes, start, pos, step.arc,
-                                             f"line {line.number}")
-        i += 1
-    # a row is known when the words its frame needs are: axes; under TCPM the tip and the
-    # angles or the vector
-    need = np.ones((n, ncol), dtype=bool)
-    need[:, nax:] = False
-    vec_rows = frame == tcpm.VECTOR
-    need[np.ix_(vec_rows, rot_idx)] = False
-    need[vec_rows, nax:] = True
-    known = motion & ~(np.isnan(w) & need).any(axis=1)
-    row = np.where(known, np.cumsum(known) - 1, -1)
-    rows = np.flatnonzero(known)
-    q = w[rows, :nax].copy()
-    fr_rows = frame[rows]
-    if (fr_rows != tcpm.AXES).any():
+# step 1b: the axis positions of TCPM blocks
+def axes_of_blocks(blocks: Blocks, interp: gcode.Interpreter, model) -> None:
+    """``blocks.q_nom`` of TCPM rows: the axis positions the controller's inverse gives for
+    their words (:func:`volerr.fiveaxis.tcpm_kinematics.axes_from_words`); tool-vector rows
+    continue from the rotary positions the machine held before the chunk
+    (``interp.rotary_actual``, kept here for the next chunk)."""
+    b = blocks
+    rot_idx = [model.axes.index(a) for a in model.rotary_axes]
+    if (b.frame != tcpm.AXES).any():
         before = interp.rotary_actual
         if before is None:
+            pos = interp.state.position
             before = np.array([pos[a] if pos[a] is not None else 0.0
                                for a in model.rotary_axes])
-        q = tcpm.axes_from_words(model, w[rows], fr_rows, length[rows], before)
-    if len(rows):
-        interp.rotary_actual = q[-1, rot_idx].copy()
-    known_rotary = {a for a in model.rotary_axes
-                    if (motion & ~np.isnan(w[:, index[a]])).any()}
-    if vec_rows.any():
-        known_rotary |= set(model.rotary_axes)
-    unk = motion & ~known
-    pend = np.cumsum(unk) - 1
-    ml = np.flatnonzero(motion)
-    order = np.where(known[ml], row[ml], -1 - pend[ml]).tolist()
-    pending = []
-    for li in np.flatnonzero(unk).tolist():
-        line = slow[li][0] if li in slow else _parse_seg(segs, first, li)
-        miss = [letters[c] for c in range(ncol) if need[li, c] and w[li, c] != w[li, c]]
-        pending.append((line, {a: (None if w[li, c] != w[li, c] else float(w[li, c]))
-                               for c, a in enumerate(axes)},
-                        f"axis {miss[0]}" if miss[0] in axes else
-                        f"tool-vector component {miss[0]}"))
-    return Blocks(list(segs), first, sc, runs, slow, row, first + rows, q, nd[rows], order,
-                  pending, known_rotary, motion, w[rows], fr_rows, length[rows],
-                  {int(row[i]): p for i, p in paths.items() if row[i] >= 0})
+        b.q_nom = tcpm_kinematics.axes_from_words(model, b.w_nom, b.frame, b.length, before)
+    if len(b.q_nom):
+        interp.rotary_actual = b.q_nom[-1, rot_idx].copy()
 
 
 # ---------------------------------------------------------------------------------------
@@ -420,28 +177,24 @@ class Solution:
 def tool_groups(em, blocks: Blocks, opts: Options) -> list:
     """The rows of a chunk by the tool offset they use: (error model with that offset, row
     index or ``slice(None)``).  Axis-position rows use the ``--tool`` offset; TCPM rows the
-    offset of their tool length (:func:`volerr.fiveaxis.tcpm.tool_offset`)."""
-    from .tcpm import AXES, tool_offset
-
+    offset of their tool length (:func:`volerr.nc.tcpm.tool_offset`)."""
     fr = blocks.frame
-    if fr is None or not (fr != AXES).any():
+    if fr is None or not (fr != tcpm.AXES).any():
         return [(em, slice(None))]
-    key = np.where(fr == AXES, np.nan, blocks.length)
+    key = np.where(fr == tcpm.AXES, np.nan, blocks.length)
     out = []
-    axis_rows = np.flatnonzero(fr == AXES)
+    axis_rows = np.flatnonzero(fr == tcpm.AXES)
     if len(axis_rows):
         out.append((em, axis_rows))
-    for length in np.unique(key[fr != AXES]):
-        rows = np.flatnonzero((fr != AXES) & (key == length))
-        out.append((em.with_tool(tool_offset([length])[0]), rows))
+    for length in np.unique(key[fr != tcpm.AXES]):
+        rows = np.flatnonzero((fr != tcpm.AXES) & (key == length))
+        out.append((em.with_tool(tcpm.tool_offset([length])[0]), rows))
     return out
 
 
 def solve_positions(em, q_nom: np.ndarray, opts: Options, direction=None) -> Solution:
     """The compensation of the positions ``q_nom`` (one tool offset: ``em``'s; ``direction``
     the approach directions of the rows, or None)."""
-    from .compensate import solve, solve_thesis
-
     n = len(q_nom)
     if not n:
         return Solution(q_nom.copy(), np.zeros(0, dtype=int), np.zeros(0, dtype=bool))
@@ -494,8 +247,6 @@ def round_axes(em, q_nom: np.ndarray, q_c: np.ndarray, nd: np.ndarray,
                opts: Options, direction=None) -> np.ndarray:
     """Axis positions as written: rotary values rounded first, the linear axes solved again
     for them (orientation), then rounded; a value equal to the programmed one is kept."""
-    from .compensate import resolve_linear
-
     model = em.model
     q_out = q_c.copy()
     if not len(q_nom):
@@ -518,16 +269,12 @@ def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np
     ones unless the orientation is compensated, then those of the corrected axes, rounded;
     the linear axes are solved again for the rotary positions the controller takes from
     them; the tool tip is the forward kinematics of the result, rounded."""
-    from . import tcpm
-    from .compensate import resolve_linear
-    from .kinematics import inverse
-
     model = em.model
     axes = model.axes
     nax = len(axes)
     rot_idx = [axes.index(a) for a in model.rotary_axes]
     lin_idx = [axes.index(a) for a in linear_axes(model)]
-    w_c = tcpm.words_from_axes(model, q_c, length)
+    w_c = tcpm_kinematics.words_from_axes(model, q_c, length)
     w_out = w_nom.copy()
     q_rot = q_c.copy()
     ang = frame == tcpm.ANGLES
@@ -551,10 +298,10 @@ def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np
         q_rot[moved] = resolve_linear(em, q_nom[moved], q_rot[moved], opts.tol_um * 1e-3,
                                       opts.max_iter,
                                       None if direction is None else direction[moved])
-    tip = tcpm.words_from_axes(model, q_rot, length)[:, lin_idx]
+    tip = tcpm_kinematics.words_from_axes(model, q_rot, length)[:, lin_idx]
     for k, j in enumerate(lin_idx):
         w_out[:, j] = _keep_or_round(tip[:, k], w_nom[:, j], nd[:, j])
-    q_out = tcpm.axes_from_words(model, w_out, frame, length, q_rot[0, rot_idx]
+    q_out = tcpm_kinematics.axes_from_words(model, w_out, frame, length, q_rot[0, rot_idx]
                                  if len(q_rot) else np.zeros(2))
     return w_out, q_out
 
@@ -563,15 +310,13 @@ def round_positions(em, blocks: Blocks, sol: Solution, opts: Options):
     """The values written -> (words (n, n_axes + 3), axis positions the controller goes to):
     :func:`round_axes` for axis rows, :func:`round_tcpm` for TCPM rows (each with the error
     model of its tool, :func:`tool_groups`)."""
-    from .tcpm import AXES
-
     b = blocks
     q_out = sol.q.copy()
     w_out = b.w_nom.copy()
     nax = len(em.model.axes)
     for g_em, rows in tool_groups(em, b, opts):
         fr = b.frame[rows]
-        if isinstance(rows, slice) or (fr == AXES).all():
+        if isinstance(rows, slice) or (fr == tcpm.AXES).all():
             q_out[rows] = round_axes(g_em, b.q_nom[rows], sol.q[rows], b.nd[rows, :nax], opts,
                                      b.dir(rows))
             w_out[rows, :nax] = q_out[rows]
@@ -583,12 +328,12 @@ def round_positions(em, blocks: Blocks, sol: Solution, opts: Options):
 
 
 def compensate_arcs(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> dict:
-    """Row -> (:class:`~volerr.fiveaxis.arcs.ArcPath`, :class:`~volerr.fiveaxis.arcs.ArcResult`)
-    of the arc blocks (:func:`volerr.fiveaxis.arcs.compensate`); the points of a linearised
-    arc are rounded as every written position, its last point is the block's end as
-    written.  With the orientation compensated an arc is always linearised (a corrected
+    """Row -> (:class:`~volerr.nc.arcs.ArcPath`, :class:`~volerr.nc.arcs.ArcResult`)
+    of the arc blocks (:func:`volerr.fiveaxis.arc_compensation.compensate`); the points of
+    a linearised arc are rounded as every written position, its last point is the block's
+    end as written.  With the orientation compensated an arc is always linearised (a corrected
     rotary position cannot move in an arc block)."""
-    from . import arcs
+    from .arc_compensation import compensate
 
     b = blocks
     if not b.arcs:
@@ -599,7 +344,7 @@ def compensate_arcs(em, blocks: Blocks, q_out: np.ndarray, opts: Options) -> dic
     starts = None
     if b.direction is not None:
         starts = [b.direction[r - 1] if r > 0 else b.dir_before for r in rows]
-    results = arcs.compensate(em, paths, lambda q, d: solve_positions(em, q, opts, d).q,
+    results = compensate(em, paths, lambda q, d: solve_positions(em, q, opts, d).q,
                               opts.arc_tol_um * 1e-3, keep=not opts.orientation,
                               start_dirs=starts)
     out = {}
@@ -701,8 +446,6 @@ class Chunk:
     arcs: dict = field(default_factory=dict)
 
     def status(self, r: int) -> str:
-        from .tcpm import AXES
-
         if self.strategy == "thesis":
             s = "compensated (thesis strategy)"
         elif self.solution.limited[r]:
@@ -711,7 +454,7 @@ class Chunk:
         else:
             s = "compensated"
         fr = self.blocks.frame
-        if fr is not None and fr[r] != AXES:
+        if fr is not None and fr[r] != tcpm.AXES:
             s += "; TCPM (tool tip in the workpiece frame)"
         if r in self.arcs:
             s += "; " + self.arcs[r][1].status
@@ -789,16 +532,13 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     read a second time (``start`` called again) only when a rotary axis turns out never to be
     known although its letter appears (e.g. only in a G28 block), which the prescan cannot
     tell.  ``progress(n_lines)`` is called after every chunk."""
-    from .compensate import ErrorModel, parameters_for_types
     from .reversal import Directions
-    from .tcpm import length_rule
-    from .writer import Writer
 
     opts = opts.validated(model)
-    pre = prescan(open_source, model, chunk_lines, opts.dialect)
+    pre = prescan(open_source, model.rotary_axes, chunk_lines, opts.dialect)
     never = tuple(a for a in pre.absent_rotary if a not in opts.initial)
     em = ErrorModel(model, funcs, opts.tool, parameters_for_types(model, opts.types))
-    rule = length_rule(opts.tool_length, opts.tool_table)
+    rule = tcpm.length_rule(opts.tool_length, opts.tool_table)
     while True:
         initial = {**opts.initial, **{a: 0.0 for a in never}}
         interp = gcode.Interpreter(model.axes, initial, rule)
@@ -836,7 +576,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
 def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None,
                directions=None) -> Chunk:
     model = em.model
-    b = interpret(segs, first, interp, model, opts.decimals, dialect)
+    b = interpret(segs, first, interp, model, opts.decimals, dialect, WHOLE_CHUNK)
+    axes_of_blocks(b, interp, model)
     known |= b.known_rotary
     if directions is not None:
         b.dir_before = directions.last_dir.copy()
@@ -1010,3 +751,116 @@ def open_program(path):
     if not p.is_file():
         raise InputError(f"program not found: {path}")
     return lambda: open(p, encoding="latin-1", newline="")
+
+
+# ---------------------------------------------------------------------------------------
+# a program as text: the compensated text and a report per block
+@dataclass
+class LineReport:
+    """Predicted error of one motion block before and after compensation."""
+
+    line: int
+    nominal: dict
+    output: dict
+    before_um: tuple
+    after_um: tuple
+    orientation_before_urad: float
+    orientation_after_urad: float
+    iterations: int
+    status: str
+    #: standard uncertainty (k = 1) of the remaining error, from the tables' Type A std,
+    #: per axis x y z (NaN when the tables carry none)
+    u_after_um: tuple = (math.nan,) * 3
+
+
+@dataclass
+class Result:
+    text: str
+    reports: list = field(default_factory=list)
+    #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
+    assumed_zero: tuple = ()
+    #: what the program held besides straight moves: ``tcpm_blocks`` and ``arcs`` (kept,
+    #: linearised, segments, max_path_deviation_um), as in the streamed summary
+    shapes: dict = field(default_factory=dict)
+
+    def summary(self) -> dict:
+        done = [r for r in self.reports if r.status.startswith("compensated")]
+        b = np.array([np.linalg.norm(r.before_um) for r in done]) if done else np.zeros(0)
+        a = np.array([np.linalg.norm(r.after_um) for r in done]) if done else np.zeros(0)
+        ob = np.array([r.orientation_before_urad for r in done]) if done else np.zeros(0)
+        oa = np.array([r.orientation_after_urad for r in done]) if done else np.zeros(0)
+
+        def mx(v):
+            return float(v.max()) if v.size else 0.0
+
+        return {
+            "motion_blocks": len(self.reports),
+            "compensated": len(done),
+            "not_compensated": [{"line": r.line, "reason": r.status} for r in self.reports
+                                if not r.status.startswith("compensated")],
+            "max_before_um": mx(b), "max_after_um": mx(a),
+            "rms_before_um": float(np.sqrt(np.mean(b ** 2))) if b.size else 0.0,
+            "rms_after_um": float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0,
+            "max_orientation_before_urad": mx(ob), "max_orientation_after_urad": mx(oa),
+            "max_iterations": max((r.iterations for r in done), default=0),
+            "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
+                                           if np.all(np.isfinite(r.u_after_um))])),
+            **self.shapes,
+        }
+
+
+class _Collect:
+    """Sink of :func:`run` that keeps the text and a report per block."""
+
+    def __init__(self, model):
+        self.model = model
+
+    def start(self):
+        self.text, self.reports = [], []
+
+    def add(self, chunk) -> None:
+        axes = self.model.axes
+        b, p = chunk.blocks, chunk.prediction
+        self.text.append(chunk.text)
+        q_nom, q_out = b.q_nom.tolist(), chunk.q_out.tolist()
+        rows = b.numbers.tolist()
+        for o in b.order:
+            if o >= 0:
+                self.reports.append(LineReport(
+                    rows[o], dict(zip(axes, q_nom[o])), dict(zip(axes, q_out[o])),
+                    tuple(p.before_um[o]), tuple(p.after_um[o]),
+                    float(p.orientation_before_urad[o]), float(p.orientation_after_urad[o]),
+                    int(chunk.solution.iterations[o]), chunk.status(o), tuple(p.u_after_um[o])))
+            else:
+                line, target, missing = b.pending[-1 - o]
+                self.reports.append(LineReport(
+                    line.number, dict(target), dict(target), (math.nan,) * 3, (math.nan,) * 3,
+                    math.nan, math.nan, 0, f"not compensated: position of {missing} unknown"))
+
+
+def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientation: bool = False,
+                       strategy: str = "full", tol_um: float = 0.1, decimals: int = 4,
+                       initial: dict | None = None, check_travel: bool = True,
+                       max_iter: int = 50, types=None, chunk_lines: int | None = None,
+                       arc_tol_um: float = 1.0, tool_length: float | None = None,
+                       tool_table: dict | None = None, dialect: str = "auto") -> Result:
+    """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
+
+    ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
+    that compensates the linear axes only); the report still predicts the error of the full
+    model, so it shows what the other types leave.  Default: all (L-VOL + R-VOL).
+    ``chunk_lines``: lines per chunk (the output does not depend on it; :func:`run` also
+    streams a program file of any length).  ``arc_tol_um``: path tolerance of arcs
+    (:mod:`volerr.fiveaxis.arc_compensation`); ``tool_length`` (mm) or ``tool_table`` (tool
+    number -> mm): the tool length of TCPM blocks (:mod:`volerr.nc.tcpm`); ``dialect``:
+    "auto", "iso" or "heidenhain"."""
+    import io
+
+    opts = Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
+                   check_travel, max_iter, None if types is None else tuple(types),
+                   arc_tol_um, tool_length, tool_table, dialect)
+    sink = _Collect(model)
+    s, never = run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
+                   chunk_lines or CHUNK_LINES)
+    return Result("".join(sink.text), sink.reports, never,
+                  {k: s[k] for k in ("tcpm_blocks", "arcs")})

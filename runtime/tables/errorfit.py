@@ -2,8 +2,8 @@
 
 The thesis (ch. 3.4, Listing 3.1) fits each error motion with a polynomial whose degree (4-8)
 was picked by eye.  Here the degree is chosen by leave-one-out cross-validation with the
-one-standard-error rule (``volerr.tables.functions.choose_degree``), or a cubic smoothing spline
-whose smoothing is chosen by generalised cross-validation (``scipy.interpolate.
+one-standard-error rule (``volerr.tables.functions.choose_degree``), or a cubic smoothing spline whose
+smoothing is chosen by generalised cross-validation (``scipy.interpolate.
 make_smoothing_spline``), or the interpolating methods of ``volerr.tables.table`` (linear, cubic).
 Every fit reports its residual (RMS and maximum at the measured positions) and, for the
 smoothing methods, the leave-one-out prediction error.  Evaluating a fit outside the measured

@@ -437,16 +437,3 @@ def write_error_dir(directory, tables: dict, constants: dict | None = None,
     if constants:
         write_constants(d / "constants.csv", constants, inputs=inputs, std=constants_std)
     return d
-
-
-#: names that moved to :mod:`volerr.tables.functions`, still importable from here (a second import
-#: path that closes the circle table <-> functions; it goes once tests/fiveaxis/ and
-#: benchmarks/bench_compensate.py import them from volerr.tables.functions)
-_MOVED = ("METHODS", "ErrorFunctions", "choose_degree", "loo_press", "make_function")
-
-
-def __getattr__(name):
-    if name in _MOVED:
-        from . import functions
-        return getattr(functions, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,8 +1,8 @@
 """Arcs G2/G3: the compensated program, run on an independent controller (tests/helpers/nc_sim:
-its own arc interpolation) and an independent exact chain (test_fiveaxis.tool2work), keeps the
-actual tool tip within the tolerance (+ the rounding of the written numbers) of the nominal arc,
-in the three planes, for arcs kept as arcs and arcs linearised; the geometry against closed
-forms; arcs whose end is off the circle are refused naming the line."""
+its own arc interpolation) and an independent exact chain (helpers.fiveaxis_chain.tool2work),
+keeps the actual tool tip within the tolerance (+ the rounding of the written numbers) of the
+nominal arc, in the three planes, for arcs kept as arcs and arcs linearised; the geometry
+against closed forms; arcs whose end is off the circle are refused naming the line."""
 
 import math
 
@@ -10,13 +10,15 @@ import numpy as np
 import pytest
 from helpers import nc_sim
 from scipy.spatial import cKDTree
-from test_compensate import cli, write_errors
-from test_fiveaxis import tool2work
+from helpers.error_dirs import write_errors
+from test_compensate import cli
+from helpers.fiveaxis_chain import tool2work
 
 import volerr
 from volerr.errors import InputError
-from volerr.fiveaxis import arcs, gcode
-from volerr.fiveaxis.compensate import ErrorModel, compensate_program
+from volerr.nc import arcs, gcode
+from volerr.fiveaxis.compensate import ErrorModel
+from volerr.fiveaxis.program import compensate_program
 from volerr.tables.functions import ErrorFunctions
 
 PROGRAM = """%
@@ -170,3 +172,23 @@ def test_arc_with_its_end_off_the_circle_is_refused_naming_the_line(tmp_path):
     rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o")
     assert rc == 2 and se.strip().count("\n") == 0 and "line 2" in se and "circle" in se, se
     assert not (tmp_path / "o").exists()
+
+
+def test_console_says_how_many_arcs_were_linearised_into_how_many_lines(tmp_path):
+    """The console line counts the arcs kept and linearised and the G1 lines written for them,
+    as counted here in the written program (an arc block's line plus the new G1 lines)."""
+    err = write_errors(tmp_path / "err", volerr.load("DMU50"), seed=11)
+    prog = tmp_path / "p.nc"
+    prog.write_text(PROGRAM)
+    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o",
+                     "--json", tmp_path / "s.json")
+    assert rc == 0, se
+    out = (tmp_path / "o").read_text().splitlines()
+    n_in = len(PROGRAM.splitlines())
+    arc_lines = [ln for ln in PROGRAM.splitlines() if ln.startswith(("G2", "G3"))]
+    kept = sum(1 for ln in out if ln.startswith(("G2", "G3")))
+    linearised = len(arc_lines) - kept
+    lines = len(out) - n_in + linearised        # each linearised arc: its line + new lines
+    assert linearised > 0 and kept > 0
+    assert (f"arcs: {linearised} linearised into {lines} G1 lines (predicted path within 1 um "
+            f"of the arc, max ") in so and f"; {kept} kept as arcs" in so, so

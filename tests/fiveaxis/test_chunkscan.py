@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_compensate import write_errors
+from helpers.error_dirs import write_errors
 
 import volerr
-from volerr.fiveaxis import chunkscan, gcode, program
+from volerr.fiveaxis import program
+from volerr.nc import chunkscan, gcode
 from volerr.errors import InputError
-from volerr.fiveaxis.compensate import compensate_program
-from volerr.tables import table as tables
+from volerr.fiveaxis.program import compensate_program
 from volerr.tables.functions import ErrorFunctions
 
 AXES = ("X", "Y", "Z", "B", "C")
@@ -28,8 +28,8 @@ number = st.one_of(
                      "--1", "+", ".", "0", "1", "00", "01", "2", "3", "98", "128", "129.",
                      "6", "-0000000000000000012.5", "123456789012345678.5",
                      "1234567890123456789.1.2", "12345678901234567-8", "+1234567890123456"]))
-word = st.tuples(st.sampled_from("XYZBCxyzbNFGgMmAUSTHDI"), st.sampled_from(["", " ", "\t"]),
-                 number)
+word = st.tuples(st.sampled_from([*"XYZBCxyzbNFGgMmAUSTHDIJKk", "A3=", "b3 =", "C3= ", "B3"]),
+                 st.sampled_from(["", " ", "\t"]), number)
 comment = st.sampled_from(["(cut X1)", "(a;b)", "; fin (x", ";", "()", "(", ")", "(G2 M98)",
                            "(\u00d810 \u2014)"])
 piece = st.one_of(word.map(lambda w: "".join(w)), comment)
@@ -51,7 +51,7 @@ def reference_fast(body: str) -> list | None:
     if any(t.kind == "other" for t in toks) and body.strip():
         return None
     words = [t for t in toks if t.kind == "word"]
-    axes_ = [t.letter for t in words if t.letter in AXES]
+    axes_ = [t.letter for t in words if t.letter in AXES + gcode.VECTOR]
     if len(set(axes_)) != len(axes_) or any(t.letter in "AU" for t in words):
         return None
     for t in words:
@@ -74,8 +74,9 @@ def test_scan_finds_the_plain_lines_and_their_numbers(lines):
         assert bool(sc.fast[i]) == (words is not None), body
         if words is not None:
             k = sc.line == i
-            words = [t for t in words if t.letter in AXES or t.letter in codes]
-            assert list(sc.axis[k]) == [AXES.index(t.letter) if t.letter in AXES else
+            cols = AXES + gcode.VECTOR          # the tool vector I J K (A3= B3= C3=) after the axes
+            words = [t for t in words if t.letter in cols or t.letter in codes]
+            assert list(sc.axis[k]) == [cols.index(t.letter) if t.letter in cols else
                                         codes[t.letter] for t in words]
             texts = [body[t.num_start:t.num_end] for t in words]
             assert [sc.text[s:e] for s, e in zip(sc.num_start[k], sc.num_end[k])] == texts
@@ -113,7 +114,7 @@ def test_format_numbers_is_format_number(items):
 def test_edits_replace_their_spans(text, data):
     """writer.Edits (spans replaced in the chunk's bytes, some as byte arrays, some as
     strings) against slicing the text piece by piece."""
-    from volerr.fiveaxis.writer import Edits
+    from volerr.nc.writer import Edits
 
     cuts = sorted(data.draw(st.lists(st.integers(0, len(text)), max_size=12)))
     spans = list(zip(cuts[0::2], cuts[1::2]))
@@ -145,7 +146,7 @@ def test_edits_replace_their_spans(text, data):
 def setup(tmp_path_factory):
     m = volerr.load("DMU50")
     d = write_errors(tmp_path_factory.mktemp("err"), m, seed=5)
-    return m, tables.ErrorFunctions.from_dir(d, m)
+    return m, ErrorFunctions.from_dir(d, m)
 
 
 def _range(a):
@@ -243,3 +244,68 @@ def test_text_beyond_latin1_keeps_its_characters(setup, monkeypatch):
     got = compensate_program(m, funcs, text)
     assert got.text == ref.text and got.text != text
     assert got.text.count("(Ø10 — Ω roughing)") == text.count("(Ø10 — Ω roughing)")
+
+
+def vector_program(m, seed: int, n: int, siemens: bool) -> str:
+    """A TCPM tool-vector program as post-processors write it (``G43.5`` with ``I J K``, or
+    ``TRAORI`` with ``A3= B3= C3=``): N numbers, G01 / G0, F, comments, the vector not always
+    complete or written, vertical tool vectors (the C axis undetermined), a few rotary-angle
+    blocks (TRAORI), a switch out of TCPM and back."""
+    rng = np.random.default_rng(seed)
+    q = np.column_stack([rng.uniform(-150, 150, n), rng.uniform(-150, 150, n),
+                         rng.uniform(180, 380, n), rng.uniform(0, 80, n),
+                         np.cumsum(rng.uniform(-40, 40, n)) % 720 - 360])
+    vertical = rng.uniform(size=n) < 0.1
+    q[vertical, 3] = 0.0
+    f = m.forward(q, np.tile([0.0, 0.0, -100.0], (n, 1)))
+    f[vertical, 3:6] = [0.0, 0.0, 1.0]
+    names = ("A3=", "B3=", "C3=") if siemens else ("I", "J", "K")
+    on = "TRAORI" if siemens else "G43.5 H1"
+    out = ["%", "N1 G90 G17 T1 M6", "N2 G0 X0 Y0 Z300 B0 C0", f"N3 {on}"]
+    for i, row in enumerate(f):
+        words = [f"X{row[0]:.4f}", f"Y{row[1]:.4f}", f"Z{row[2]:.4f}"]
+        keep = rng.uniform(size=3) < 0.9
+        words += [f"{a}{v:.6f}" for a, v, k in zip(names, row[3:], keep) if k or i == 0]
+        r = rng.uniform()
+        if r < 0.01:
+            out += ["G49" if not siemens else "TRAFOOF", "G0 Z380", on]
+        elif r < 0.02 and siemens:
+            words = words[:3] + [f"B{q[i, 3]:.3f}", f"C{q[i, 4]:.3f}"]    # rotary angles
+        elif r < 0.04:
+            words = words[:2]                    # the tool vector held
+        head = f"N{10 + i} " + ("G0 " if r > 0.97 else "G01 ")
+        out.append(head + " ".join(words) + (" F1500." if r < 0.5 else "")
+                   + (" (cut)" if r < 0.3 else " ; fin" if r < 0.4 else ""))
+    return "\n".join(out + ["G49" if not siemens else "TRAFOOF", "M30", "%"]) + "\n"
+
+
+@pytest.mark.parametrize("siemens", [False, True])
+def test_tool_vector_programs_whole_chunk_equal_line_by_line(setup, siemens, monkeypatch):
+    """TCPM tool-vector programs go through the whole-chunk path (runs of plain lines with
+    the vector words) and give the bytes and reports of the line-by-line path, for any chunk
+    size; their rotary axes are set by the vectors (no axis taken at 0 deg)."""
+    from volerr.nc import interpret as nc_interpret
+
+    m, funcs = setup
+    funcs = ErrorFunctions(funcs.tables, funcs.constants, m, extrapolate=True)
+    text = vector_program(m, 4 + siemens, 5000, siemens)
+    kw = {"tool_length": 100.0, "check_travel": False}
+    texts = set()
+    for k in (None, 997):
+        monkeypatch.setattr(program, "WHOLE_CHUNK", False)
+        ref = compensate_program(m, funcs, text, chunk_lines=k, **kw)
+        monkeypatch.setattr(program, "WHOLE_CHUNK", True)
+        s = ref.summary()
+        assert s["tcpm_blocks"] > 4500 and ref.text != text and ref.assumed_zero == ()
+        got = compensate_program(m, funcs, text, chunk_lines=k, **kw)
+        assert got.text == ref.text, k
+        assert [(r.line, r.status, r.output) for r in got.reports] == \
+            [(r.line, r.status, r.output) for r in ref.reports], k
+        texts.add(got.text)
+    assert len(texts) == 1
+    # most lines were read in runs with the tool-vector columns
+    segs = text.splitlines(keepends=True)
+    interp = gcode.Interpreter(m.axes, {}, lambda tools, where: 100.0)
+    b = nc_interpret.interpret(segs, 1, interp, m, 4)
+    in_runs = sum(j - i for i, j, cols in b.runs if cols == len(m.axes) + 3)
+    assert in_runs > 0.9 * len(segs), in_runs

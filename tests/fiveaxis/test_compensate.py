@@ -5,19 +5,20 @@ tables; plots."""
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_fiveaxis import tool2work
+from helpers.error_dirs import write_errors
+from helpers.fiveaxis_chain import tool2work
 
 import volerr
-from volerr.fiveaxis import gcode
+from volerr.nc import gcode
 from volerr.tables import table as tables
-from volerr.fiveaxis.compensate import compensate_program
-from volerr.tables.table import ErrorTable, write_constants, write_error_table
+from volerr.tables.functions import ErrorFunctions
+from volerr.fiveaxis.program import compensate_program
+from volerr.tables.table import ErrorTable, write_error_table
 
 FAMILIES = ("DMU50", "TT_AC", "HH_BC", "TH_BC")
 
@@ -26,37 +27,6 @@ def cli(*args, cwd=None):
     r = subprocess.run([sys.executable, "-m", "volerr", *map(str, args)], capture_output=True,
                        text=True, cwd=cwd)
     return r.returncode, r.stdout, r.stderr
-
-
-def write_errors(d: Path, m, seed=0, scale_um=10.0, scale_urad=30.0, only=None):
-    """Smooth random error tables over the whole travel (C: 0..360) and constants."""
-    rng = np.random.default_rng(seed)
-    d.mkdir(parents=True, exist_ok=True)
-    for a in m.axes:
-        lo, hi = m.travel[a]
-        if a in m.rotary_axes and hi - lo > 360:
-            lo, hi = 0.0, 360.0
-        x = np.linspace(lo, hi, 25)
-        t = (x - lo) / (hi - lo)
-        vals = {}
-        for p in m.layout.axes[a].component_errors:
-            if only is not None and p not in only:
-                continue
-            s = (scale_urad * 1e-6) if p[1] in "ABC" else (scale_um * 1e-3)
-            c = rng.normal(0, s, 3)
-            v = c[0] * t + c[1] * np.sin(2 * np.pi * t) + c[2] * (t - 0.5) ** 2
-            if a in m.rotary_axes and m.travel[a][1] - m.travel[a][0] > 360:
-                v = c[0] * np.sin(2 * np.pi * t) + c[1] * np.cos(4 * np.pi * t)  # periodic
-            vals[p] = v
-        if vals:
-            write_error_table(d / f"{a}.csv", ErrorTable(a, x, vals))
-    consts = {p: rng.normal(0, 1e-3 * scale_um if p[1] in "XYZ" else 1e-6 * scale_urad)
-              for p in m.parameters if m.parameter_axis[p] is None}
-    if only is not None:
-        consts = {k: v for k, v in consts.items() if k in only}
-    if consts:
-        write_constants(d / "constants.csv", consts)
-    return d
 
 
 def random_program(m, rng, n, crlf=False):
@@ -124,7 +94,7 @@ def test_compensated_program_lands_within_0p1_um(tmp_path, name):
     rc, so, se = cli("compensate", name, "--errors", err, prog, "--out", out,
                      "--report", tmp_path / "rep.csv", "--json", tmp_path / "s.json")
     assert rc == 0, se
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text_in = prog.read_bytes().decode("latin-1")
     text_out = out.read_bytes().decode("latin-1")
     want = nominal(m, text_in)
@@ -170,7 +140,7 @@ def test_linear_jacobian_depends_on_the_rotary_positions_only(name):
 def test_orientation_compensation_corrects_the_tool_axis(tmp_path):
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m, seed=3)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text = random_program(m, np.random.default_rng(11), 40)
     res = compensate_program(m, funcs, text, orientation=True)
     want = nominal(m, text)
@@ -210,7 +180,7 @@ def test_words_added_only_where_a_modal_axis_needs_a_correction(tmp_path):
     # EXX depends on X only: once X is corrected, Y moves need no X word
     x = np.linspace(-250, 250, 11)
     write_error_table(tmp_path / "X.csv", ErrorTable("X", x, {"EXX": 1e-5 * x}))
-    funcs = tables.ErrorFunctions.from_dir(tmp_path, m)
+    funcs = ErrorFunctions.from_dir(tmp_path, m)
     out = compensate_program(m, funcs, text).text.splitlines()
     assert out[0].startswith("G90 G1 X9.9999 Y0 Z100 B0 C0")
     assert out[1:] == ["Y10", "Y20 (y)"]
@@ -219,7 +189,7 @@ def test_words_added_only_where_a_modal_axis_needs_a_correction(tmp_path):
     d2.mkdir()
     y = np.linspace(-225, 225, 11)
     write_error_table(d2 / "Y.csv", ErrorTable("Y", y, {"EXY": 1e-5 * y}))
-    funcs = tables.ErrorFunctions.from_dir(d2, m)
+    funcs = ErrorFunctions.from_dir(d2, m)
     out = compensate_program(m, funcs, text).text.splitlines()
     assert out[0] == "G90 G1 X10 Y0 Z100 B0 C0"
     assert out[1] == "Y10 X9.9999"
@@ -231,7 +201,7 @@ def test_incremental_mode_is_compensated_without_drift(tmp_path):
     y = np.linspace(-225, 225, 11)
     write_error_table(tmp_path / "Y.csv", ErrorTable("Y", y, {"EXY": 1e-5 * y,
                                                              "EZY": 2e-6 * y}))
-    funcs = tables.ErrorFunctions.from_dir(tmp_path, m)
+    funcs = ErrorFunctions.from_dir(tmp_path, m)
     text = "G90 G1 X10 Y0 Z100 B0 C0\nG91\n" + "Y7.3\n" * 20 + "X1 Y-3\nG90\n"
     res = compensate_program(m, funcs, text)
     want = nominal(m, text)
@@ -243,7 +213,7 @@ def test_incremental_mode_is_compensated_without_drift(tmp_path):
 def test_thesis_strategy_leaves_what_it_neglects(tmp_path):
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m, seed=5)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text = random_program(m, np.random.default_rng(2), 30)
     full = compensate_program(m, funcs, text).summary()
     thesis = compensate_program(m, funcs, text, strategy="thesis").summary()
@@ -258,7 +228,7 @@ def test_thesis_strategy_leaves_what_it_neglects(tmp_path):
     for a, p in zip("XYZ", ("EXX", "EYY", "EZZ")):
         lo, hi = m.travel[a]
         write_error_table(d2 / f"{a}.csv", ErrorTable(a, [lo, hi], {p: [0.01, 0.01]}))
-    f2 = tables.ErrorFunctions.from_dir(d2, m)
+    f2 = ErrorFunctions.from_dir(d2, m)
     assert compensate_program(m, f2, text, strategy="thesis").summary()["max_after_um"] < 0.06
     assert only
 
@@ -304,7 +274,7 @@ def test_unsupported_constructs_are_refused(text, msg):
 def test_unknown_axes_are_reported_not_guessed(tmp_path):
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text = "G1 X10 Y10\nZ50 B10 C0\nX20\nG28 Z0\nX30\nZ60\n"
     res = compensate_program(m, funcs, text)
     status = [r.status for r in res.reports]
@@ -323,7 +293,7 @@ def test_rotary_axes_never_programmed_are_taken_at_zero(tmp_path):
     compensated; executed on the independent chain it lands within 0.1 um."""
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m, seed=3)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text = "G90 G1 X10 Y-20 Z30\nX40\nY15 Z110\n"
     res = compensate_program(m, funcs, text)
     assert res.assumed_zero == ("B", "C")
@@ -412,7 +382,7 @@ def test_cli_outputs_report_json_and_plot(tmp_path):
     # the grid's axis positions put the tool tip on the point
     q = np.column_stack([grid["X_mm"], grid["Y_mm"], grid["Z_mm"], grid["B_deg"], grid["C_deg"]])
     assert np.allclose(m.forward(q)[:, :3], [20, 10, 50], atol=1e-9)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     ok = np.isfinite(grid["e_um"])
     e = m.exact_error(q[ok], funcs(_lookup(m, funcs, q[ok])))
     assert np.allclose(np.linalg.norm(e, axis=1) * 1e3, grid["e_um"][ok], rtol=1e-5)
@@ -479,7 +449,7 @@ def test_added_words_follow_the_program_style(tmp_path):
     m = volerr.load("DMU50")
     y = np.linspace(-225, 225, 11)
     write_error_table(tmp_path / "Y.csv", ErrorTable("Y", y, {"EXY": 1e-5 * y}))
-    funcs = tables.ErrorFunctions.from_dir(tmp_path, m)
+    funcs = ErrorFunctions.from_dir(tmp_path, m)
     out = compensate_program(m, funcs, "G90G1X10Y0Z100B0C0\ny10\n").text
     assert out == "G90G1X10Y0Z100B0C0\ny10x9.9999\n"
 
@@ -491,7 +461,7 @@ def test_builtin_example_hemisphere(tmp_path):
 
     paths = write_example(tmp_path / "ex")
     m = volerr.load("DMU50")
-    funcs = tables.ErrorFunctions.from_dir(paths["errors"], m)
+    funcs = ErrorFunctions.from_dir(paths["errors"], m)
     text = paths["program"].read_bytes().decode("latin-1")
     want = nominal(m, text)
     blocks = gcode.blocks(gcode.parse(text), m.axes)
@@ -513,7 +483,7 @@ def test_builtin_example_hemisphere(tmp_path):
 def test_orientation_compensation_other_families(tmp_path, name):
     m = volerr.load(name)
     err = write_errors(tmp_path / "err", m, seed=8)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text = random_program(m, np.random.default_rng(5), 25)
     res = compensate_program(m, funcs, text, orientation=True)
     want = nominal(m, text)
@@ -555,7 +525,7 @@ def test_endless_rotary_table_is_closed_over_the_turn(tmp_path):
     rep = np.genfromtxt(tmp_path / "r.csv", delimiter=",", names=True, dtype=None,
                         encoding=None)
     # at C = 350: halfway between EXC(340) and EXC(360) = EXC(0); the tool-relative error of
-    # the table's C axis turns with C (see test_fiveaxis)
+    # the table's C axis turns with C (see helpers.fiveaxis_chain)
     want = 0.5 * (exc[-1] + exc[0])
     cc = np.deg2rad(350.0)
     assert rep["dx_before_um"] == pytest.approx(1e3 * want * np.cos(cc), abs=1e-6)
@@ -569,7 +539,7 @@ def test_report_carries_the_uncertainty_of_the_remaining_error(tmp_path):
     x = np.linspace(-250, 250, 6)
     write_error_table(tmp_path / "X.csv", ErrorTable("X", x, {"EXX": 1e-5 * x},
                                                      std={"EXX": np.full(6, 0.7e-3)}))
-    funcs = tables.ErrorFunctions.from_dir(tmp_path, m)
+    funcs = ErrorFunctions.from_dir(tmp_path, m)
     text = random_program(m, np.random.default_rng(4), 10)
     res = compensate_program(m, funcs, text)
     u = np.array([r.u_after_um for r in res.reports])
@@ -582,7 +552,7 @@ def test_iso_16907_types_select_what_is_compensated(tmp_path):
     rotary_only = {p for p in m.parameters if m.parameter_axis[p] in ("B", "C") or "0B" in p
                    or "0C" in p}
     err = write_errors(tmp_path / "err", m, seed=9, only=rotary_only)
-    funcs = tables.ErrorFunctions.from_dir(err, m)
+    funcs = ErrorFunctions.from_dir(err, m)
     text = random_program(m, np.random.default_rng(3), 15)
     lin = compensate_program(m, funcs, text, types=["L-VOL"])
     assert lin.text == text                    # nothing of the linear axes to compensate

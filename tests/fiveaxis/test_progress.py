@@ -6,7 +6,7 @@ import sys
 
 from volerr.cli._common import progress_bar
 from volerr.fiveaxis import program
-from volerr.fiveaxis.compensate import _Collect
+from volerr.fiveaxis.program import _Collect
 
 import volerr
 

@@ -7,11 +7,12 @@ columns leaves about B_i / 2; the approach directions against a hand-made sequen
 import numpy as np
 import pytest
 from helpers import nc_sim
-from test_compensate import write_errors
-from test_fiveaxis import tool2work
+from helpers.error_dirs import write_errors
+from helpers.fiveaxis_chain import tool2work
 
 import volerr
-from volerr.fiveaxis.compensate import ErrorModel, compensate_program
+from volerr.fiveaxis.compensate import ErrorModel
+from volerr.fiveaxis.program import compensate_program
 from volerr.fiveaxis.reversal import Directions
 from volerr.tables.functions import ErrorFunctions
 from volerr.tables.table import ErrorTable, read_error_table, write_error_table

@@ -7,12 +7,12 @@ import sys
 
 import numpy as np
 import pytest
-from test_compensate import write_errors
+from helpers.error_dirs import write_errors
 
 import volerr
-from volerr.fiveaxis import gcode
-from volerr.fiveaxis.compensate import compensate_program
-from volerr.tables import table as tables
+from volerr.nc import gcode
+from volerr.fiveaxis.program import compensate_program
+from volerr.tables.functions import ErrorFunctions
 
 PROGRAM = """%
 O0001 (STREAM)
@@ -39,7 +39,7 @@ G90 X0 Y0 Z150 B20 C30
 def setup(tmp_path_factory):
     m = volerr.load("DMU50")
     d = write_errors(tmp_path_factory.mktemp("err"), m, seed=3)
-    return m, tables.ErrorFunctions.from_dir(d, m), d
+    return m, ErrorFunctions.from_dir(d, m), d
 
 
 @pytest.mark.parametrize("orientation", [False, True])

@@ -1,7 +1,7 @@
 """TCPM programs (tool tip in the workpiece frame): a TCPM program and its machine-axis
 equivalent give the same actual tool tips after compensation, on an independent controller
 (tests/helpers/nc_sim with an inverse from the independent exact chain) and chain
-(test_fiveaxis.tool2work); with --orientation the tool-axis error shrinks (tool-vector
+(helpers.fiveaxis_chain.tool2work); with --orientation the tool-axis error shrinks (tool-vector
 programs); Heidenhain plain language gives the same numbers as ISO; bad programs get exit 2
 naming the line."""
 
@@ -10,12 +10,14 @@ import re
 import numpy as np
 import pytest
 from helpers import nc_sim
-from test_compensate import cli, write_errors
-from test_fiveaxis import tool2work
+from helpers.error_dirs import write_errors
+from test_compensate import cli
+from helpers.fiveaxis_chain import tool2work
 
 import volerr
 from volerr.errors import InputError
-from volerr.fiveaxis.compensate import ErrorModel, compensate_program
+from volerr.fiveaxis.compensate import ErrorModel
+from volerr.fiveaxis.program import compensate_program
 from volerr.tables.functions import ErrorFunctions
 
 L = 120.0                       # tool length, mm
@@ -233,13 +235,133 @@ def test_cli_tcpm_without_tool_length_exit_2_one_line(setup, tmp_path):
 
 
 def test_tool_length_rule():
-    from volerr.fiveaxis.tcpm import length_rule
+    from volerr.nc.tcpm import length_rule
 
     assert length_rule(None, None) is None
     rule = length_rule(None, {1: 100.0, 2: 80.5})
     assert rule({"T": 2.0}, "line 1") == 80.5
     assert rule({"T": 2.0, "H": 1.0}, "line 1") == 100.0        # Fanuc: H wins
     assert rule({"T": 1.0, "DL": 0.25}, "line 1") == 100.25     # Heidenhain delta length
-    assert length_rule(55.0, {1: 100.0})({"T": 1.0}, "x") == 55.0
+    assert length_rule(55.0, None)({"T": 1.0}, "x") == 55.0
+    # both given: the table's tools must agree with --tool-length; others take it
+    assert length_rule(55.0, {1: 55.0})({"T": 1.0}, "x") == 55.0
+    assert length_rule(55.0, {1: 100.0})({"T": 2.0}, "x") == 55.0
+    with pytest.raises(InputError, match="line 4: --tool-length 55 mm and the tool table's "
+                                         "100 mm for tool T1 disagree"):
+        length_rule(55.0, {1: 100.0})({"T": 1.0}, "line 4")
     with pytest.raises(InputError, match="line 9: TCPM with no T"):
         rule({}, "line 9")
+
+
+@pytest.mark.parametrize("body", ["TRAORI\nG1 X1 Y2 Z3 A3=0 B3=0 C3=0\n",
+                                  "G43.5 H1\nG1 X1 Y2 Z3 I0 J0 K0\n",
+                                  "G43.5 H1\nG1 X1 Y2 Z3 I0 J0 K1\nG1 X2 K0\n"])
+def test_cli_zero_tool_vector_one_error_line(setup, tmp_path, body):
+    """A zero tool vector has no direction: one error line naming it (no numpy warning
+    before it), exit 2, nothing written."""
+    _, _, d = setup
+    prog = tmp_path / "p.nc"
+    prog.write_text("G90 G1 X0 Y0 Z200 B0 C0\n" + body)
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+                     "--tool-length", "100")
+    line = len(body.splitlines()) + 1
+    assert rc == 2 and se.strip() == (f"volerr compensate: error: line {line}: the tool vector "
+                                      "is zero (I J K or A3 B3 C3 all 0): it gives no tool "
+                                      "direction"), se
+    assert not (tmp_path / "o").exists()
+
+
+def test_cli_tool_length_and_table_disagreeing_refused(setup, tmp_path):
+    _, _, d = setup
+    prog = tmp_path / "p.nc"
+    prog.write_text("G90 G1 X0 Y0 Z200 B0 C0\nT1 M6\nN30 G43.4\nG1 X1 Y2 Z3 B10 C10\n")
+    (tmp_path / "tools.csv").write_text("tool,length_mm\n1,100\n")
+    args = ("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+            "--tool-table", tmp_path / "tools.csv", "--tool-length")
+    rc, so, se = cli(*args, "50")
+    assert rc == 2 and len(se.strip().splitlines()) == 1 and \
+        "line 3: --tool-length 50 mm and the tool table's 100 mm for tool T1 disagree" in se, se
+    assert not (tmp_path / "o").exists()
+    rc, so, se = cli(*args, "100")
+    assert rc == 0, se
+
+
+def test_tool_vector_program_has_no_note_of_rotary_axes_at_zero(setup, tmp_path):
+    """The vectors of a G43.5 / TRAORI program set the rotary axes: no note that they are
+    never programmed (the program never writes a B or C word)."""
+    m, funcs, d = setup
+    text = "G90 G43.5 H1\nG1 X10 Y20 Z30 I0.1 J0.2 K0.97\nG1 X11 I0.12 J0.2 K0.97\n"
+    res = compensate_program(m, funcs, text, tool_length=L)
+    assert res.assumed_zero == () and res.summary()["compensated"] == 2
+    prog = tmp_path / "p.nc"
+    prog.write_text(text)
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o",
+                     "--tool-length", str(L))
+    assert rc == 0 and "never programmed" not in se, se
+    # an axis-position program that never writes C still gets the note
+    prog.write_text("G90 G1 X0 Y0 Z200 B10\nG1 X1\n")
+    rc, so, se = cli("compensate", "DMU50", "--errors", d, prog, "--out", tmp_path / "o2")
+    assert rc == 0 and "note: axes C are never programmed: taken at 0 deg" in se, se
+
+
+def _controller_rule(m, vectors, previous):
+    """The controller's rule for tool vectors, block by block, written here from the
+    documented rule (volerr formats gcode, TCPM): both solutions of the generated inverse,
+    an axis that does not turn the tool there stays, each value turned to the one nearest
+    the previous block's, then by 360 deg into the travel; the solution inside the travel
+    with the smaller move, the first on a tie."""
+    rot = m.rotary_axes
+    lo = [m.travel[a][0] - 1e-9 for a in rot]
+    hi = [m.travel[a][1] + 1e-9 for a in rot]
+    prev, out = [float(v) for v in previous], []
+    for k in vectors / np.linalg.norm(vectors, axis=1, keepdims=True):
+        sols = []
+        for branch in (1.0, -1.0):
+            r = [float(np.rad2deg(v)) for v in m.module.inverse_rotary(*k, branch)]
+            q = np.r_[0.0, 0.0, 0.0, r]
+            turns = [np.linalg.norm((_axis(m, q + 1e-7 * np.eye(5)[3 + j]) - _axis(m, q))
+                                    / np.deg2rad(1e-7)) for j in range(2)]
+            sols.append([x if t > 1e-6 else None for x, t in zip(r, turns)])
+        best = None
+        for sol in sols:
+            vals, inside, move = [], True, 0.0
+            for j, x in enumerate(sol):
+                x = prev[j] if x is None else x
+                x = prev[j] + (x - prev[j] + 180.0) % 360.0 - 180.0
+                for turn in (0.0, 360.0, -360.0):
+                    if lo[j] <= x + turn <= hi[j]:
+                        x += turn
+                        break
+                else:
+                    inside = False
+                vals.append(x)
+                move += abs(x - prev[j])
+            score = move + (0.0 if inside else 1e6)
+            if best is None or score < best[0]:
+                best = (score, vals)
+        prev = best[1]
+        out.append(prev)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("layout", ["DMU50", "HH_BC", "TT_AC"])
+def test_rotary_positions_of_tool_vectors_follow_the_controller_rule(layout):
+    """All rows at once (rotary_from_vector) = the rule block by block, written
+    independently: random and smooth tool paths, vertical stretches (an undetermined axis
+    stays), paths turning the endless axis beyond its travel (turned back by 360 deg)."""
+    from volerr.fiveaxis.tcpm_kinematics import rotary_from_vector
+
+    m = volerr.load(layout)
+    rng = np.random.default_rng(7)
+    n = 450
+    t = np.linspace(0, 60, n)
+    tilt = np.r_[np.deg2rad(rng.uniform(3, 60, n // 3)),
+                 np.deg2rad(np.maximum(0, 40 * np.sin(t[:n // 3] / 2))),
+                 np.deg2rad(30 + 25 * np.sin(t[:n - 2 * (n // 3)] / 7))]
+    az = np.r_[np.deg2rad(rng.uniform(0, 360, n // 3)), t[:n // 3] * 1.3,
+               t[:n - 2 * (n // 3)] * 2.0]
+    vec = np.column_stack([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), np.cos(tilt)])
+    want = _controller_rule(m, vec, [0.0, 10.0])
+    got = rotary_from_vector(m, vec, np.array([0.0, 10.0]))
+    assert np.ptp(want[:, 1]) > 360                      # the endless axis turns more than once
+    assert np.abs(got - want).max() < 1e-9

@@ -4,16 +4,16 @@ alone."""
 import sys
 
 import numpy as np
-from test_compensate import write_errors
+from helpers.error_dirs import write_errors
 
 import volerr
 from volerr.fiveaxis.tcpmap import TcpMap, tcp_map
-from volerr.tables import table as tables
+from volerr.tables.functions import ErrorFunctions
 
 
 def test_map_positions_keep_the_tip_on_the_point_and_errors_match_the_model(tmp_path):
     m = volerr.load("DMU50")
-    funcs = tables.ErrorFunctions.from_dir(write_errors(tmp_path, m, seed=2), m)
+    funcs = ErrorFunctions.from_dir(write_errors(tmp_path, m, seed=2), m)
     point, tool = (20.0, -10.0, 60.0), (0.0, 0.0, 25.0)
     t = tcp_map(m, funcs, point, tool, n1=7, n2=5)
     assert t.positions.shape == (5, 7, 5) and t.err.shape == (5, 7, 3)

@@ -1,4 +1,4 @@
-"""The loop's blockwise least squares (volerr.loop.blocks) against dense computations written
+"""The loop's blockwise least squares (volerr.estimate.blocks) against dense computations written
 here: the normal equations, held-out residuals and screening scores must not depend on the
 block size beyond round-off.  Blocks of 7 points force many partial blocks."""
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import volerr
-from volerr.loop import blocks
-from volerr.loop.fit import data_ranges, declared_design, gauge_mask
+from volerr.estimate import blocks
+from volerr.estimate.design import data_ranges, declared_design, gauge_mask
 from volerr.loop.run import columns_to_data
 from volerr.loop.simulate import demo_probes, simulate
 

@@ -162,7 +162,7 @@ def test_demo_campaign_runs():
 
 def test_leave_one_point_out_equals_refits():
     """The hat-matrix shortcut against brute-force refits without each point."""
-    from volerr.loop.fit import Problem, rows_of
+    from volerr.estimate.design import Problem, rows_of
 
     rng = np.random.default_rng(3)
     A = rng.normal(size=(3 * 30, 8))
@@ -206,7 +206,7 @@ def test_candidate_bases_agree_with_the_derivation(layout):
     from volerr.loop import candidates
     from volerr.machine.expressions import evaluate, variables
     from volerr.derive.effects import basis_expr
-    from volerr.loop.fit import data_ranges, rotary_rad
+    from volerr.estimate.design import data_ranges, rotary_rad
     from volerr.loop.run import columns_to_data
 
     model = volerr.load(layout)

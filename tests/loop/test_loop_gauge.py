@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import volerr
-from volerr.loop.fit import Data, declared_design, gauge_mask, ideal_data
+from volerr.estimate.design import Data, declared_design, gauge_mask, ideal_data
 
 
 def _data(model, rng):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import volerr
-from volerr.loop.fit import TWIST, Data, twist_sensitivity
+from volerr.estimate.design import TWIST, Data, twist_sensitivity
 
 
 def _rot(v):

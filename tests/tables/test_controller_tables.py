@@ -2,7 +2,7 @@
 error compensation): export -> import gives the error values back within the format's
 increment, inside the documented limits (points per table, equal spacing, modulo turn, Fanuc
 steps); "what it leaves" equals an independent computation: the exact chain of
-test_fiveaxis.tool2work at the positions the controller commands after its own (numpy)
+helpers.fiveaxis_chain.tool2work at the positions the controller commands after its own (numpy)
 interpolation of the tables."""
 
 import json
@@ -13,14 +13,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fiveaxis"))
-from test_compensate import write_errors  # noqa: E402
-from test_fiveaxis import tool2work  # noqa: E402
+from helpers.error_dirs import write_errors
+from helpers.fiveaxis_chain import tool2work
 
-import volerr  # noqa: E402
-from volerr.tables import comp_tables, controller_tables as ctl, fanuc  # noqa: E402
-from volerr.tables.functions import ErrorFunctions  # noqa: E402
-from volerr.tables.table import ErrorTable  # noqa: E402
+import volerr
+from volerr.tables import comp_tables, controller_tables as ctl, fanuc
+from volerr.tables.functions import ErrorFunctions
+from volerr.tables.table import ErrorTable
 
 INCREMENT = {"sinumerik-lec": 1e-4, "sinumerik-cec": 1e-4, "heidenhain": 1e-4,
              "fanuc": 1e-3}

@@ -9,8 +9,8 @@ from hypothesis import given, settings, strategies as st
 import volerr
 from volerr.errors import InputError
 from volerr.tables.functions import ErrorFunctions, choose_degree, make_function
-from volerr.tables.table import (ErrorTable, read_constants, read_constants_full,
-                                 read_error_table, write_constants, write_error_table)
+from volerr.tables.table import (ErrorTable, read_constants, read_constants_full, read_error_table,
+                                 write_constants, write_error_table)
 
 MB1 = volerr.load("MB1")
 

@@ -51,8 +51,8 @@ def detect(lines, first: int = 1) -> str:
 
 
 def parser(name: str):
-    """The line parser of a dialect for :func:`volerr.fiveaxis.program.interpret`: None for
-    ISO, :class:`volerr.fiveaxis.heidenhain.Dialect` for Heidenhain."""
+    """The line parser of a dialect for :func:`volerr.nc.interpret.interpret`: None for
+    ISO, :class:`volerr.nc.heidenhain.Dialect` for Heidenhain."""
     if name == "heidenhain":
         from .heidenhain import Dialect
         return Dialect()

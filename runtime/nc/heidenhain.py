@@ -1,5 +1,5 @@
 """Heidenhain plain-language (Klartext) programs: lines read into the tokens of
-:mod:`volerr.fiveaxis.gcode`, so that the same interpreter and writer serve them.
+:mod:`volerr.nc.gcode`, so that the same interpreter and writer serve them.
 
 What is read (TNC conversational format, one block per line, block number first)::
 
@@ -63,20 +63,14 @@ class Dialect:
     #: added words carry an explicit sign
     signed = True
 
-    @staticmethod
-    def parse_line(number: int, body: str, ending: str) -> Line:
-        return parse_line(number, body, ending)
-
-
 def parse_line(number: int, body: str, ending: str) -> Line:
-    """One plain-language line as a :class:`volerr.fiveaxis.gcode.Line`: axis, ``F M S T``
+    """One plain-language line as a :class:`volerr.nc.gcode.Line`: axis, ``F M S T``
     words as word tokens (``IX``: the letter in the line's ``incremental`` set), statement
     keywords (``L``, ``TCPM``, ``TCPM_OFF``) as keyword tokens, everything else kept as
     ``other`` text.  Raises :class:`InputError` for a statement that cannot be compensated."""
     where = f"line {number}"
     tokens: list = []
-    incremental = set()
-    anchor = None
+    incremental, anchor = set(), None
     i = 0
     m = _BLOCK.match(body)
     if m and m.end() > 0 and body[:m.end()].strip():
@@ -86,92 +80,100 @@ def parse_line(number: int, body: str, ending: str) -> Line:
     text = rest.split(";", 1)[0]
     head = text.strip().upper()
     word0 = head.split(" ", 1)[0] if head else ""
-
-    def tail_comment():
-        k = rest.find(";")
-        if k >= 0:
-            tokens.append(Token("comment", rest[k:], i + k))
-
     if not head or head.startswith("*"):
         if rest:
             tokens.append(Token("comment" if head else "space", rest, i))
         return _line(number, body, ending, tokens, incremental, anchor)
+    if _statement(head, text, i, tokens, where):
+        pass
+    elif head.startswith("TOOL CALL"):
+        return _tool_call(number, body, ending, tokens, i, text, rest)
+    elif word0 in REFUSED:
+        raise InputError(f"{where}: {word0} ({REFUSED[word0]}) is not supported")
+    elif word0 == "L" or word0.startswith("M"):
+        incremental, anchor = _block_words(body, i, i + len(text), word0, tokens, where)
+    else:
+        raise InputError(f"{where}: cannot interpret {head[:30]!r} (plain-language statement "
+                         "not supported)")
+    k = rest.find(";")
+    if k >= 0:
+        tokens.append(Token("comment", rest[k:], i + k))
+    return _line(number, body, ending, tokens, incremental, anchor)
+
+
+Dialect.parse_line = staticmethod(parse_line)
+
+
+def _statement(head: str, text: str, i: int, tokens: list, where: str) -> bool:
+    """A statement kept as it is (program begin / end, blank form, tool definition, stop,
+    plane reset) or a TCPM switch: its token appended; False for any other line."""
     if head.startswith("BEGIN PGM") or head.startswith("END PGM"):
         if re.search(r"\bINCH\b", head):
             raise InputError(f"{where}: a program in inch (INCH) is not supported")
         tokens.append(Token("other", text, i))
-        tail_comment()
-        return _line(number, body, ending, tokens, incremental, anchor)
-    if head.startswith(("BLK FORM", "TOOL DEF", "STOP")) or \
+    elif head.startswith(("BLK FORM", "TOOL DEF", "STOP")) or \
             re.fullmatch(r"PLANE RESET( STAY)?", head):
         tokens.append(Token("other", text, i))
-        tail_comment()
-        return _line(number, body, ending, tokens, incremental, anchor)
-    if head.startswith("FUNCTION"):
+    elif head.startswith("FUNCTION"):
         if re.fullmatch(r"FUNCTION\s+RESET\s+TCPM", head):
             tokens.append(Token("keyword", text, i, "TCPM_OFF"))
         elif re.match(r"FUNCTION\s+TCPM\b", head):
             tokens.append(Token("keyword", text, i, "TCPM"))
         else:
             raise InputError(f"{where}: {head[:30]!r} is not supported")
-        tail_comment()
-        return _line(number, body, ending, tokens, incremental, anchor)
-    if head.startswith("TOOL CALL"):
-        return _tool_call(number, body, ending, tokens, i, text, rest)
-    if word0 in REFUSED:
-        raise InputError(f"{where}: {word0} ({REFUSED[word0]}) is not supported")
-    if word0 == "L" or word0.startswith("M"):
-        j = i
-        if word0 == "L":
-            k = body.index("L", i) if "L" in body[i:] else body.index("l", i)
-            tokens.append(Token("keyword", body[i:k + 1], i, "L"))
-            j = k + 1
+    else:
+        return False
+    return True
+
+
+def _block_words(body: str, i: int, end: int, word0: str, tokens: list, where: str):
+    """The words of a straight block ``L ...`` (or of a line of M functions) from ``i`` to
+    ``end`` appended to ``tokens`` -> (letters written incrementally ``IX``, index of the token
+    after which added words go)."""
+    incremental, anchor = set(), None
+    j = i
+    if word0 == "L":
+        k = body.index("L", i) if "L" in body[i:] else body.index("l", i)
+        tokens.append(Token("keyword", body[i:k + 1], i, "L"))
+        j = k + 1
+        anchor = len(tokens) - 1
+    while j < end:
+        if body[j] in " \t":
+            s = _SPACE.match(body, j)
+            tokens.append(Token("space", s.group(0), j))
+            j = s.end()
+            continue
+        for rx, kind in ((_AXIS_WORD, "axis"), (_R_WORD, "r"), (_F_WORD, "f"),
+                         (_M_WORD, "m"), (_S_WORD, "s")):
+            mm = rx.match(body, j)
+            if mm:
+                break
+        else:
+            raise InputError(f"{where}: cannot interpret {body[j:j + 12]!r} in a "
+                             "plain-language block")
+        if kind == "axis":
+            letter = mm.group(2).upper()
+            if mm.group(1):
+                incremental.add(letter)
+            tokens.append(Token("word", mm.group(0), j, letter, float(mm.group(3)),
+                                mm.start(3), mm.end(3)))
             anchor = len(tokens) - 1
-        end = i + len(text)
-        while j < end:
-            c = body[j]
-            if c in " \t":
-                s = _SPACE.match(body, j)
-                tokens.append(Token("space", s.group(0), j))
-                j = s.end()
-                continue
-            for rx, kind in ((_AXIS_WORD, "axis"), (_R_WORD, "r"), (_F_WORD, "f"),
-                             (_M_WORD, "m"), (_S_WORD, "s")):
-                mm = rx.match(body, j)
-                if mm:
-                    break
-            else:
-                raise InputError(f"{where}: cannot interpret {body[j:j + 12]!r} in a "
-                                 "plain-language block")
-            if kind == "axis":
-                letter = mm.group(2).upper()
-                if mm.group(1):
-                    incremental.add(letter)
-                tokens.append(Token("word", mm.group(0), j, letter, float(mm.group(3)),
-                                    mm.start(3), mm.end(3)))
-                anchor = len(tokens) - 1
-            elif kind == "r":
-                if mm.group(1).upper() != "R0":
-                    raise InputError(f"{where}: radius compensation {mm.group(1).upper()} "
-                                     "is not supported (the path would be offset by the "
-                                     "controller)")
-                tokens.append(Token("other", mm.group(0), j))
-            elif kind == "f":
-                if mm.group(2):
-                    tokens.append(Token("word", mm.group(0), j, "F", float(mm.group(2)),
-                                        mm.start(2), mm.end(2)))
-                else:
-                    tokens.append(Token("other", mm.group(0), j))
-            else:
-                tokens.append(Token("word", mm.group(0), j, kind.upper(), float(mm.group(2)),
-                                    mm.start(2), mm.end(2)))
-            j = mm.end()
-        if word0 != "L" and any(t.kind == "word" and t.letter in "XYZABC" for t in tokens):
-            raise InputError(f"{where}: axis words outside an L block")
-        tail_comment()
-        return _line(number, body, ending, tokens, incremental, anchor)
-    raise InputError(f"{where}: cannot interpret {head[:30]!r} (plain-language statement "
-                     "not supported)")
+        elif kind == "r":
+            if mm.group(1).upper() != "R0":
+                raise InputError(f"{where}: radius compensation {mm.group(1).upper()} "
+                                 "is not supported (the path would be offset by the "
+                                 "controller)")
+            tokens.append(Token("other", mm.group(0), j))
+        elif kind == "f" and not mm.group(2):
+            tokens.append(Token("other", mm.group(0), j))
+        else:
+            letter = "F" if kind == "f" else kind.upper()
+            tokens.append(Token("word", mm.group(0), j, letter, float(mm.group(2)),
+                                mm.start(2), mm.end(2)))
+        j = mm.end()
+    if word0 != "L" and any(t.kind == "word" and t.letter in "XYZABC" for t in tokens):
+        raise InputError(f"{where}: axis words outside an L block")
+    return incremental, anchor
 
 
 def _tool_call(number, body, ending, tokens, i, text, rest) -> Line:

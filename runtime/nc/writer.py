@@ -3,9 +3,9 @@
 Only the numbers of the words that carry positions change (axes; under TCPM the tool tip and
 the orientation; the centre words of an arc kept as an arc); a word is added to a block only
 where the value the controller would hold differs from the one to write (in ``G91``, a
-non-zero increment).  A linearised arc (:mod:`volerr.fiveaxis.arcs`) becomes its own line
+non-zero increment).  A linearised arc (:mod:`volerr.nc.arcs`) becomes its own line
 turned into the first straight move (``G2``/``G3`` -> ``G1``, the centre words dropped) and one
-new line per further segment.  A :class:`~volerr.fiveaxis.gcode.ControllerState` follows the
+new line per further segment.  A :class:`~volerr.nc.gcode.ControllerState` follows the
 program as written (the same rule the interpreter applies to the program as read), and the
 modal motion as written: an arc block that relied on a modal ``G2``/``G3`` gets the word again
 after a linearised arc has left the output in ``G1``.
@@ -93,7 +93,7 @@ class Writer:
 
     # -----------------------------------------------------------------------------------
     def chunk(self, b, w_out: np.ndarray, arcs: dict) -> str:
-        """The chunk's output text (:class:`~volerr.fiveaxis.program.Blocks` ``b``): original
+        """The chunk's output text (:class:`~volerr.nc.interpret.Blocks` ``b``): original
         bytes except the changed / added words.  ``arcs``: row -> (ArcPath, ArcResult)."""
         edits = Edits()
         w_list = nd_list = None
@@ -103,7 +103,7 @@ class Writer:
         i, n = 0, len(b.segs)
         while i < n:
             if nxt is not None and nxt[0] == i:
-                self.run(b, nxt[0], nxt[1], w_out, edits)
+                self.run(b, nxt[0], nxt[1], w_out, edits, nxt[2])
                 self.motion = 1 if not _straight(self.motion) else self.motion
                 i = nxt[1]
                 nxt = next(runs, None)
@@ -245,106 +245,119 @@ class Writer:
         return ending.join(texts) + line.ending
 
     # -----------------------------------------------------------------------------------
-    def run(self, b, i0: int, i1: int, w_out: np.ndarray, edits) -> None:
+    def run(self, b, i0: int, i1: int, w_out: np.ndarray, edits, cols: int | None = None
+            ) -> None:
         """The plain lines ``i0 .. i1 - 1`` (absolute mode) written together: ``edits`` gets
-        (start, end, text) replacements of the chunk text; ``written`` is updated.
+        (start, end, text) replacements of the chunk text; ``written`` is updated.  ``cols``:
+        the columns of the words (the axes, or with the tool vector ``I J K``).
 
         A programmed word is rewritten where the value to write differs from it by half a
-        step or more; an axis the line does not program gets a word where the controller (as
-        written so far) holds another value -- a chain along the lines, followed one entry at
-        a time for the (line, axis) pairs without a word only."""
-        axes = self.axes
+        step or more (:meth:`_programmed`); an axis the line does not program gets a word
+        where the controller (as written so far) holds another value (:meth:`_added`)."""
         sc = b.scan
-        pos = self.written.position
-        nax = len(axes)
+        cols = len(self.axes) if cols is None else cols
+        letters = self.letters[:cols]
+        w = sc.words(i0, i1)
+        ax = (sc.axis[w] >= 0) & (sc.axis[w] < cols)
+        words = {k: getattr(sc, k)[w][ax] for k in ("axis", "value", "num_start", "num_end",
+                                                     "frac", "plus")}
+        words["line"] = sc.line[w][ax] - i0
         m = i1 - i0
-        w = _words(sc, i0, i1)
-        ax = sc.axis[w] >= 0
-        wl = sc.line[w][ax] - i0
-        wa = sc.axis[w][ax]
-        wv = sc.value[w][ax]
         row = b.row[i0:i1]
-        wr = row[wl]
-        known = wr >= 0
-        # programmed words of known blocks: rewritten where the value moves by half a step
-        kr, ka = wr[known], wa[known]
-        want = w_out[kr, ka]
-        nd = b.nd[kr, ka]
-        change = np.abs(want - wv[known]) >= 0.5 * 10.0 ** (-nd.astype(float))
-        ci = np.flatnonzero(known)[change]
-        span_s, span_e = sc.num_start[w][ax][ci], sc.num_end[w][ax][ci]
-        fr, pl = sc.frac[w][ax][ci], sc.plus[w][ax][ci]
-        text = sc.text
-        flat, lens, new_vals = chunkscan.format_bytes(want[change], nd[change], fr, pl,
-                                                      lambda k: text[span_s[k]:span_e[k]])
-        wvals = wv.copy()
-        wvals[ci] = new_vals
+        ci, flat, lens, wvals = self._programmed(b, words, row, w_out, sc.text)
         # positions held after every line from the programmed words (as written)
-        val = np.full((m, nax), np.nan)
+        wl, wa = words["line"], words["axis"]
+        val = np.full((m, cols), np.nan)
         val[wl, wa] = wvals
-        has = np.zeros((m, nax), dtype=bool)
+        has = np.zeros((m, cols), dtype=bool)
         has[wl, wa] = True
         last = np.where(has, np.arange(m)[:, None], -1)
         np.maximum.accumulate(last, axis=0, out=last)
-        # axes without a word in a known block: the chain
-        absent = np.argwhere((row >= 0)[:, None] & ~has)
-        added = {}
-        last_add = {}
-        if len(absent):
-            cand_w = w_out[row[absent[:, 0]], absent[:, 1]]
-            cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
-            li_prev = last[absent[:, 0], absent[:, 1]]
-            held = val[np.maximum(li_prev, 0), absent[:, 1]]
-            start = [pos[a] for a in axes]
-            fmt = gcode.format_number
-            for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
-                                                    cand_nd.tolist(), li_prev.tolist(),
-                                                    held.tolist()):
-                la = last_add.get(c)
-                if la is not None and la[0] > pi:
-                    prev = la[1]
-                elif pi >= 0:
-                    prev = h
-                else:
-                    prev = start[c] if la is None else la[1]
-                if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
-                    txt = fmt(want_a, nd_a)
-                    added.setdefault(li, {})[axes[c]] = txt
-                    last_add[c] = (li, float(txt))
-        for c, a in enumerate(axes):
+        added, last_add = self._added(b, row, has, val, last, w_out)
+        pos = self.written.position
+        for c, a in enumerate(letters):
             li = int(last[m - 1, c]) if m else -1
             la = last_add.get(c)
             if la is not None and la[0] > li:
                 pos[a] = la[1]
             elif li >= 0:
                 pos[a] = float(val[li, c])
-        # the edits: a line that gets a word is rewritten whole, else its numbers are replaced
+        span_s, span_e = words["num_start"][ci], words["num_end"][ci]
         if not added:
             edits.add_bytes(span_s, span_e, flat, lens)
             return
+        # a line that gets a word is rewritten whole, else its numbers are replaced
         texts = chunkscan.split_texts(flat, lens)
         line_of = wl[ci]
         by_line = {}
         for k, li in enumerate(line_of.tolist()):
             if li in added:
-                by_line.setdefault(li, {})[axes[int(wa[ci[k]])]] = texts[k]
+                by_line.setdefault(li, {})[letters[int(wa[ci[k]])]] = texts[k]
         own = [(s0, e0, t) for k, (s0, e0, t) in enumerate(zip(span_s.tolist(), span_e.tolist(),
                                                               texts))
                if int(line_of[k]) not in added]
         for li, add in added.items():
             i = i0 + li
-            line = b.line(i)
             s0 = int(sc.start[i])
-            own.append((s0, s0 + len(b.segs[i]),
-                        gcode.rewrite_line(line, by_line.get(li, {}), add, self.spaced)))
+            own.append((s0, s0 + len(b.segs[i]), gcode.rewrite_line(
+                b.line(i), by_line.get(li, {}), add, self.spaced)))
         own.sort()
         for s0, e0, t in own:
             edits.add(s0, e0, t)
 
+    @staticmethod
+    def _programmed(b, words, row, w_out, text):
+        """The programmed words of known blocks rewritten where the value moves by half a
+        step -> (indices of the words that change, their texts as bytes and lengths
+        (:func:`volerr.nc.chunkscan.format_bytes`), every word's value as written)."""
+        wr = row[words["line"]]
+        known = wr >= 0
+        kr, ka = wr[known], words["axis"][known]
+        want = w_out[kr, ka]
+        nd = b.nd[kr, ka]
+        wv = words["value"]
+        change = np.abs(want - wv[known]) >= 0.5 * 10.0 ** (-nd.astype(float))
+        ci = np.flatnonzero(known)[change]
+        span_s, span_e = words["num_start"][ci], words["num_end"][ci]
+        flat, lens, new_vals = chunkscan.format_bytes(
+            want[change], nd[change], words["frac"][ci], words["plus"][ci],
+            lambda k: text[span_s[k]:span_e[k]])
+        wvals = wv.copy()
+        wvals[ci] = new_vals
+        return ci, flat, lens, wvals
 
-def _words(sc, i0: int, i1: int) -> slice:
-    lo, hi = np.searchsorted(sc.line, [i0, i1])
-    return slice(int(lo), int(hi))
+    def _added(self, b, row, has, val, last, w_out):
+        """Words added for the axes without a word in a known block, where the controller
+        (as written so far) holds another value: a chain along the lines, followed one entry
+        at a time -> (line -> {axis: text}, axis index -> (line, value) of its last added
+        word)."""
+        absent = np.argwhere((row >= 0)[:, None] & ~has)
+        absent = absent[~np.isnan(w_out[row[absent[:, 0]], absent[:, 1]])]
+        added, last_add = {}, {}
+        if not len(absent):
+            return added, last_add
+        names = [self.vector_words.get(a, a) for a in self.letters]
+        cand_w = w_out[row[absent[:, 0]], absent[:, 1]]
+        cand_nd = b.nd[row[absent[:, 0]], absent[:, 1]]
+        li_prev = last[absent[:, 0], absent[:, 1]]
+        held = val[np.maximum(li_prev, 0), absent[:, 1]]
+        start = [self.written.position[a] for a in self.letters]
+        fmt = gcode.format_number
+        for (li, c), want_a, nd_a, pi, h in zip(absent.tolist(), cand_w.tolist(),
+                                                cand_nd.tolist(), li_prev.tolist(),
+                                                held.tolist()):
+            la = last_add.get(c)
+            if la is not None and la[0] > pi:
+                prev = la[1]
+            elif pi >= 0:
+                prev = h
+            else:
+                prev = start[c] if la is None else la[1]
+            if prev is None or abs(want_a - prev) >= 0.5 * 10.0 ** (-nd_a):
+                txt = fmt(want_a, nd_a)
+                added.setdefault(li, {})[names[c]] = txt
+                last_add[c] = (li, float(txt))
+        return added, last_add
 
 
 class Edits:

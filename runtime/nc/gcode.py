@@ -22,7 +22,7 @@ Interpretation (modal state, one block per line)
 ------------------------------------------------
 * Motion: ``G0`` and ``G1`` (straight moves in axis space) and ``G2``/``G3`` (arcs in the
   plane of ``G17``/``G18``/``G19``, centre ``I J K`` relative to the start or radius ``R``;
-  see :mod:`volerr.fiveaxis.arcs`), modal.  A block with axis words and no other non-modal
+  see :mod:`volerr.nc.arcs`), modal.  A block with axis words and no other non-modal
   function is a *motion block*.  Canned cycles ``G73 G74 G76 G81``-``G89``, ``G92 G52 G10``
   (offset changes), ``G68 G51`` (rotation, scaling), ``G41 G42`` (cutter radius
   compensation), ``G20`` (inch), ``/`` (block delete) and ``M98`` (subprogram call) are
@@ -30,7 +30,7 @@ Interpretation (modal state, one block per line)
 * TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
   ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
   angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
-  workpiece frame (see :mod:`volerr.fiveaxis.tcpm`); the tool length comes from the
+  workpiece frame (see :mod:`volerr.nc.tcpm`); the tool length comes from the
   interpreter's ``tool_length`` rule (an ``H``, ``D`` or ``T`` word, or a given length).
   At a switch into or out of TCPM the linear positions become unknown until programmed.
 * ``G90``/``G91``: both handled; in ``G91`` an axis word is the increment from the position
@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from pathlib import Path
 
 from ..errors import InputError
 
@@ -143,9 +142,6 @@ class Line:
             self._tokens = tokenize(self.body, self.number)
         return self._tokens
 
-    def words(self) -> list[Token]:
-        return [t for t in self.tokens if t.kind == "word"]
-
     def items(self) -> list[tuple[str, float, str]]:
         """(upper-case letter, value, number text) of every word, in order."""
         if self._items is None:
@@ -180,13 +176,6 @@ class Block:
     target: dict
     programmed: tuple
     incremental: bool
-
-
-def read_program(path) -> str:
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"program not found: {path}")
-    return p.read_bytes().decode("latin-1")
 
 
 def split_lines(text: str) -> list[tuple[str, str]]:
@@ -251,17 +240,6 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
 def parse(text: str) -> list[Line]:
     """All lines of a program with their tokens."""
     return [Line.parse(n, body, end) for n, (body, end) in enumerate(split_lines(text), start=1)]
-
-
-def iter_lines(source, first: int = 1):
-    """Parsed lines of a program, one at a time: ``source`` is the program text or an open
-    text file (latin-1, ``newline=""`` so that every line keeps its own ending)."""
-    import io
-
-    fh = io.StringIO(source, newline="") if isinstance(source, str) else source
-    for n, seg in enumerate(fh, start=first):
-        body = seg.rstrip("\r\n")
-        yield Line.parse(n, body, seg[len(body):])
 
 
 @dataclass
@@ -367,8 +345,6 @@ class Interpreter:
         #: rotary positions (deg) the machine holds after the last known block (TCPM vector
         #: blocks continue from them); None before one
         self.rotary_actual = None
-        #: the :class:`Step` of the last line read (None for a line without words)
-        self.last_step: Step | None = None
 
     @property
     def position(self) -> dict:
@@ -383,6 +359,17 @@ class Interpreter:
             return False
         return self.frame == "axes" or self.orientation == "angles" or \
             (self.orientation == "any" and self._last_orientation != "vector")
+
+    @property
+    def plain_vector(self) -> bool:
+        """True when a line of linear-axis and tool-vector words (and G0 / G1, T H D and
+        ignored words; no rotary word) is a straight TCPM move to the tool tip with the tool
+        vector: absolute, straight motion mode, TCPM with a tool vector (G43.5, or TRAORI
+        after a block with one) (the whole-chunk path of tool-vector programs)."""
+        if self.incremental or self.motion not in (0, 1) or self.frame != "tcpm":
+            return False
+        return self.vector_words is not None and (self.orientation == "vector" or (
+            self.orientation == "any" and self._last_orientation == "vector"))
 
     @property
     def length(self) -> float | None:
@@ -417,11 +404,49 @@ class Interpreter:
         if not items and not keywords:
             return None
         where = f"line {line.number}"
-        foreign = self.FOREIGN_AXES
+        gs, ms, axis_words, centre, vector, radius = self._read_words(items, where)
+        if "L" in keywords:                 # Heidenhain straight move
+            gs.append(1.0)
+        self._set_modes(gs)
+        forget = self._tcpm_switch(gs, ms, keywords, where)
+        self._check_axes(axis_words, where)
+        if vector and self.vector_words is None and line.parts is None:
+            siemens = any(t.kind == "word" and t.letter in VECTOR and t.text[:1].upper() in "ABC"
+                          for t in line.tokens)
+            self.vector_words = ({"I": "A3=", "J": "B3=", "K": "C3="} if siemens else
+                                 {v: v for v in VECTOR})
+        tcpm = self.frame == "tcpm"
+        orientation = None
+        if tcpm:
+            orientation = "vector" if self.orientation == "vector" else "angles"
+        if tcpm and vector:
+            orientation = "vector"
+            self._check_vector(axis_words, vector, where)
+            axis_words = axis_words + vector
+        kind = "none"
+        if axis_words and 4 not in gs:      # dwell: X / P are times
+            kind = "reference" if (28 in gs or 30 in gs) else \
+                "arc" if self.motion in (2, 3) else "motion"
+        arc = self._arc(axis_words, centre, radius, where) if kind == "arc" else None
+        if tcpm and self.orientation == "any" and kind == "motion":
+            # TRAORI: rotary words give angles, A3 B3 C3 a vector; a block with neither
+            # keeps the orientation of the block before
+            rot = any(a not in self.state.linear for a, _ in axis_words)
+            orientation = "vector" if vector else "angles" if rot else \
+                (self._last_orientation or "angles")
+        if tcpm and kind == "motion":
+            self._last_orientation = orientation
+        return Step(kind, axis_words, self.incremental, arc, self.frame, forget,
+                    self._length if tcpm else None, line.incremental, orientation,
+                    self.motion, any(g in (0, 1, 2, 3) for g in gs))
+
+    def _read_words(self, items, where: str) -> tuple:
+        """The words of a line by kind -> (G numbers, M numbers, axis words, centre words,
+        tool-vector words, radius); refused G / M functions raise; ``T H D DL`` are kept."""
         gs, ms, axis_words, centre, vector = [], [], [], {}, []
         radius = None
         for letter, value, _ in items:
-            if letter in foreign:
+            if letter in self.FOREIGN_AXES:
                 axis_words.append((letter, value))
             elif letter == "G":
                 g = round(value, 1)
@@ -442,8 +467,10 @@ class Interpreter:
                 self.tools[letter] = value
         if any(a == "T" for a, _, _ in items) and not any(a == "DL" for a, _, _ in items):
             self.tools.pop("DL", None)      # a new tool: no delta length unless given
-        if "L" in keywords:                 # Heidenhain straight move
-            gs.append(1.0)
+        return gs, ms, axis_words, centre, vector, radius
+
+    def _set_modes(self, gs) -> None:
+        """Distance mode, motion mode and plane from the line's G numbers."""
         for g in gs:
             if g == 90:
                 self.incremental = False
@@ -453,8 +480,10 @@ class Interpreter:
                 self.motion = int(g)
             elif g in (17, 18, 19):
                 self.plane = int(g)
-        # TCPM on / off (the tool numbers of this line count)
-        forget = ()
+
+    def _tcpm_switch(self, gs, ms, keywords, where: str) -> tuple:
+        """TCPM on / off by the line's G, M and keywords (the tool numbers of this line
+        count) -> the letters whose positions become unknown (:meth:`_switch`)."""
         want = None
         for g in gs:
             if g in TCPM_ON:
@@ -471,68 +500,44 @@ class Interpreter:
                 want = ("tcpm", "any" if k == "TRAORI" else "angles")
             elif k in ("TRAFOOF", "TCPM_OFF"):
                 want = ("axes", None)
-        if want is not None:
-            forget = self._switch(*want, where)
-        if axis_words:
-            axes = self.axes
-            for a, _ in axis_words:
-                if a not in axes:
-                    raise InputError(f"{where}: axis {a} is not an axis of this machine "
-                                     f"(axes {' '.join(axes)})")
-            seen = set()
-            for a, _ in axis_words:
-                if a in seen:
-                    raise InputError(f"{where}: axis {a} programmed twice")
-                seen.add(a)
-        if vector and self.vector_words is None and line.parts is None:
-            siemens = any(t.kind == "word" and t.letter in VECTOR and t.text[:1].upper() in "ABC"
-                          for t in line.tokens)
-            self.vector_words = ({"I": "A3=", "J": "B3=", "K": "C3="} if siemens else
-                                 {v: v for v in VECTOR})
-        tcpm = self.frame == "tcpm"
-        orientation = None
-        if tcpm:
-            orientation = "vector" if self.orientation == "vector" else "angles"
-        if tcpm and vector:
-            orientation = "vector"
-            if self.orientation == "angles":
-                raise InputError(f"{where}: a tool vector ({' '.join(a for a, _ in vector)}) "
-                                 "under TCPM with rotary angles (G43.4 / M128)")
-            rot = [a for a, _ in axis_words if a not in self.state.linear]
-            if rot:
-                raise InputError(f"{where}: rotary axis {rot[0]} and a tool vector in one "
-                                 "block")
-            axis_words = axis_words + vector
-        kind = "none"
-        if axis_words and 4 not in gs:      # dwell: X / P are times
-            kind = "reference" if (28 in gs or 30 in gs) else \
-                "arc" if self.motion in (2, 3) else "motion"
-        arc = None
-        if kind == "arc":
-            if tcpm:
-                raise InputError(f"{where}: an arc (G{self.motion}) under TCPM is not "
-                                 "supported")
-            rot = [a for a, _ in axis_words if a not in self.state.linear]
-            if rot:
-                raise InputError(f"{where}: rotary axis {rot[0]} in an arc block (G"
-                                 f"{self.motion}) is not supported")
-            arc = Arc(self.plane, self.motion == 3, centre, radius)
-        if tcpm and self.orientation == "any" and kind == "motion":
-            # TRAORI: rotary words give angles, A3 B3 C3 a vector; a block with neither
-            # keeps the orientation of the block before
-            rot = any(a not in self.state.linear for a, _ in axis_words)
-            orientation = "vector" if vector else "angles" if rot else \
-                (self._last_orientation or "angles")
-        if tcpm and kind == "motion":
-            self._last_orientation = orientation
-        return Step(kind, axis_words, self.incremental, arc, self.frame, forget,
-                    self._length if tcpm else None, line.incremental, orientation,
-                    self.motion, any(g in (0, 1, 2, 3) for g in gs))
+        return self._switch(*want, where) if want is not None else ()
+
+    def _check_axes(self, axis_words, where: str) -> None:
+        """Every axis word an axis of the machine, none twice."""
+        for a, _ in axis_words:
+            if a not in self.axes:
+                raise InputError(f"{where}: axis {a} is not an axis of this machine "
+                                 f"(axes {' '.join(self.axes)})")
+        seen = set()
+        for a, _ in axis_words:
+            if a in seen:
+                raise InputError(f"{where}: axis {a} programmed twice")
+            seen.add(a)
+
+    def _check_vector(self, axis_words, vector, where: str) -> None:
+        """A tool vector under TCPM: not with rotary angles (G43.4 / M128), not with a rotary
+        axis word."""
+        if self.orientation == "angles":
+            raise InputError(f"{where}: a tool vector ({' '.join(a for a, _ in vector)}) "
+                             "under TCPM with rotary angles (G43.4 / M128)")
+        rot = [a for a, _ in axis_words if a not in self.state.linear]
+        if rot:
+            raise InputError(f"{where}: rotary axis {rot[0]} and a tool vector in one block")
+
+    def _arc(self, axis_words, centre, radius, where: str) -> Arc:
+        """The :class:`Arc` of an arc block (not under TCPM, no rotary axis)."""
+        if self.frame == "tcpm":
+            raise InputError(f"{where}: an arc (G{self.motion}) under TCPM is not supported")
+        rot = [a for a, _ in axis_words if a not in self.state.linear]
+        if rot:
+            raise InputError(f"{where}: rotary axis {rot[0]} in an arc block (G"
+                             f"{self.motion}) is not supported")
+        return Arc(self.plane, self.motion == 3, centre, radius)
 
     def block(self, line: Line) -> Block | None:
         """Update the modal state with one line; return a :class:`Block` for a motion block
         (straight or arc)."""
-        step = self.last_step = self.step(line)
+        step = self.step(line)
         if step is None:
             return None
         self.state.apply(step)
@@ -601,16 +606,6 @@ def _spaced(kinds: list[str]) -> bool | None:
     return None
 
 
-def spaced_style(lines) -> bool:
-    """True when the program separates words by blanks (``G1 X1 Y2``), False when it writes
-    them together (``G1X1Y2``): decides how an added word is separated."""
-    for line in lines:
-        own = _spaced(_kinds(line))
-        if own is not None:
-            return own
-    return True
-
-
 def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None = None) -> str:
     """The line with the numbers of axis words in ``new_values`` (letter -> text) replaced and
     the words of ``added`` (letter -> text) appended after the last word; every other byte kept.
@@ -650,7 +645,7 @@ def rewrite_line(line: Line, new_values: dict, added: dict, spaced: bool | None 
                     and t.num_end <= anchor)
         at = anchor + shift
         head, tail = out[:at], out[at:]
-        words = line.words()
+        words = [t for t in line.tokens if t.kind == "word"]
         own = _spaced(_kinds(line)) if len(words) > 1 else None
         if len(words) > 1 and own is None:
             own = True

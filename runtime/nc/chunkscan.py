@@ -6,17 +6,18 @@ address words (``X-12.5``, ``n0010``, blanks between letter and number allowed),
 comments (``( ... )`` and ``;`` to the end of the line) only, as post-processors write them:
 
 * ``G`` words only ``G0``/``G1`` (``G00``, ``G01``): straight moves in the mode in force;
-* ``M`` words other than those the interpreter acts on (:data:`volerr.fiveaxis.gcode.SPECIAL_M`);
+* ``M`` words other than those the interpreter acts on (:data:`volerr.nc.gcode.SPECIAL_M`);
 * ``T``, ``H``, ``D`` words (tool and offset numbers; the run keeps the last of each);
+* the tool-vector words ``I J K`` and Siemens ``A3= B3= C3=`` (read as ``I J K``);
 * ``N F S`` and every other letter that is not an axis of another machine;
-* no axis written twice.
+* no axis or tool-vector component written twice.
 
 Such a line is a motion block in the distance mode in force, or nothing; the caller lets the
 interpreter do every other line (and plain lines in a mode where axis words mean more than a
 straight move: incremental, arc, TCPM).  Its words come back as arrays (line, axis, value,
 decimals, ``+`` sign, span in the chunk text); numbers are parsed exactly (integer mantissa /
 power of ten, correctly rounded; Python's ``float`` for the few with more than 15 digits).
-:func:`format_numbers` is :func:`volerr.fiveaxis.gcode.format_number` for arrays.
+:func:`format_numbers` is :func:`volerr.nc.gcode.format_number` for arrays.
 """
 
 from __future__ import annotations
@@ -58,10 +59,10 @@ class Scan:
     """``text``: the chunk; ``start`` (n,) offset of every line; ``fast`` (n,) bool: a plain
     line of the kind above; the words of the fast lines that matter (not those the
     interpreter ignores, such as ``N`` or ``F``), in text order: ``line`` (line index),
-    ``axis`` (index into the axes, or a negative letter code: :data:`G_WORD`,
-    :data:`M_WORD`, a :data:`TRACKED` code), ``value``, ``frac`` (digits after the dot, -1
-    without a dot), ``plus`` (written with ``+``), ``num_start`` / ``num_end`` (span of the
-    number in ``text``)."""
+    ``axis`` (index into the axes, ``n_axes + 0 .. 2`` for the tool vector ``I J K``, or a
+    negative letter code: :data:`G_WORD`, :data:`M_WORD`, a :data:`TRACKED` code),
+    ``value``, ``frac`` (digits after the dot, -1 without a dot), ``plus`` (written with
+    ``+``), ``num_start`` / ``num_end`` (span of the number in ``text``)."""
 
     text: str
     start: np.ndarray
@@ -73,6 +74,11 @@ class Scan:
     plus: np.ndarray
     num_start: np.ndarray
     num_end: np.ndarray
+
+    def words(self, i0: int, i1: int) -> slice:
+        """The words of the lines ``i0 .. i1 - 1``."""
+        lo, hi = np.searchsorted(self.line, [i0, i1])
+        return slice(int(lo), int(hi))
 
     def last_tracked(self, w: slice) -> dict:
         """Letter -> value of the last ``T``/``H``/``D`` word among the words ``w``."""
@@ -86,17 +92,51 @@ class Scan:
 
 
 def _letter_table(axes) -> np.ndarray:
-    """Per byte: the axis index of an axis letter, else a negative code: G and M words (their
-    values decide), tracked tool numbers, letters that need the interpreter (an axis of
-    another machine), letters it ignores."""
+    """Per byte: the axis index of an axis letter (``n_axes + k`` for the tool-vector
+    component ``I J K``), else a negative code: G and M words (their values decide), tracked
+    tool numbers, letters that need the interpreter (an axis of another machine), letters it
+    ignores."""
     t = np.full(256, IGNORED, dtype=np.int64)
     for c in sorted(gcode.Interpreter.FOREIGN_AXES):
         t[ord(c)] = t[ord(c.lower())] = NEEDS_INTERPRETER
     for c, code in (("G", G_WORD), ("M", M_WORD), *TRACKED.items()):
         t[ord(c)] = t[ord(c.lower())] = code
-    for i, a in enumerate(axes):
+    for i, a in enumerate((*axes, *gcode.VECTOR)):
         t[ord(a)] = t[ord(a.lower())] = i
     return t
+
+
+#: blanks between the parts of a Siemens tool-vector word read by the scan at most (more:
+#: the line goes to the interpreter)
+_SIEMENS_BLANKS = 4
+
+
+def _siemens_words(b: np.ndarray, cls: np.ndarray) -> np.ndarray:
+    """The tool-vector words ``A3= B3= C3=`` (Siemens, TRAORI) outside comments read as
+    ``I J K``: their ``3=`` (with the blanks around ``=``) become blanks, so that the number
+    follows the letter -> the bytes with those letters changed to ``I J K`` (``b`` itself
+    when there is none).  ``cls`` changed in place."""
+    eq = np.flatnonzero((b == 61) & (cls == _OTHER))
+    if not len(eq):
+        return b
+    blank = (b == 32) | (b == 9)
+    last = len(b) - 1
+    back, ahead = eq - 1, np.minimum(eq + 1, last)
+    for _ in range(_SIEMENS_BLANKS):
+        back = np.where((back > 0) & blank[np.maximum(back, 0)], back - 1, back)
+        ahead = np.where((ahead < last) & blank[ahead], ahead + 1, ahead)
+    letter = back - 1
+    ok = (back >= 1) & (b[np.maximum(back, 0)] == 51) & (cls[ahead] <= _DOT) & (ahead > eq)
+    ok &= cls[np.maximum(letter, 0)] == _LETTER
+    ok &= np.isin(b[np.maximum(letter, 0)] | 32, (97, 98, 99))          # a b c, any case
+    ok &= (letter == 0) | (cls[np.maximum(letter - 1, 0)] != _LETTER)
+    if not ok.any():
+        return b
+    letter, back, ahead = letter[ok], back[ok], ahead[ok]
+    out = b.copy()
+    out[letter] = (b[letter] | 32) - 97 + ord("I")
+    cls[_spans(back, ahead)] = _BLANK
+    return out
 
 
 def _spans(s: np.ndarray, e: np.ndarray) -> np.ndarray:
@@ -176,10 +216,50 @@ def scan(segs: list, axes) -> Scan:
     ending = (last == 10) | (last == 13)
     ending = ending + (ending & (last == 10) & (lens > 1)
                        & (b[np.maximum(end - 2, 0)] == 13))
-    body_end = end - ending
-    _comments(b, cls, start, body_end, lid, bad)
+    _comments(b, cls, start, end - ending, lid, bad)
+    letters = _siemens_words(b, cls)
     bad[lid(np.flatnonzero(cls >= _OTHER))] = True
-    # numbers: [+-]?(\d+\.?\d*|\.\d+), runs of adjacent number bytes [ns, ne)
+    ns, ne, tok, is_run = _number_runs(cls, lid, bad)
+    frac, ndig, mant = _read_runs(raw, text, ns, ne, lid(ns), bad)
+    # the letter of each run: the token before it (in a line that is not bad)
+    rline = lid(ns)
+    rs = np.flatnonzero(is_run)
+    code = _letter_table(axes)[letters[tok[np.maximum(rs - 1, 0)]]]
+    bad[rline[code == NEEDS_INTERPRETER]] = True
+    # an axis programmed twice
+    m = code >= 0
+    key = rline[m] * (len(axes) + 4) + code[m]
+    if len(key):
+        ks = np.sort(key)
+        bad[ks[1:][ks[1:] == ks[:-1]] // (len(axes) + 4)] = True
+    # values of the words that matter (not N F S ...)
+    sel = np.flatnonzero(code != IGNORED)
+    ns, ne, rline, code, frac, ndig = ns[sel], ne[sel], rline[sel], code[sel], frac[sel], \
+        ndig[sel]
+    fr = np.maximum(frac, 0)
+    val = mant[sel] / _POW10[np.minimum(fr, 22)]
+    val = np.where(b[ns] == 45, -val, val)
+    exact = (ndig <= 15) & (fr <= 22)
+    for i in np.flatnonzero(~exact & ~bad[rline]):
+        val[i] = float(text[ns[i]:ne[i]])
+    # G words: only G0 / G1; M words: not those the interpreter acts on
+    gm = np.flatnonzero((code == G_WORD) | (code == M_WORD))
+    if len(gm):
+        v = val[gm]
+        refused = np.where(code[gm] == G_WORD, (v != 0.0) & (v != 1.0),
+                           np.isin(np.round(v), list(gcode.SPECIAL_M)))
+        bad[rline[gm[refused]]] = True
+    fast = ~bad
+    keep = fast[rline]
+    return Scan(text, start, fast, rline[keep], code[keep], val[keep], frac[keep],
+                b[ns[keep]] == 43, ns[keep], ne[keep])
+
+
+def _number_runs(cls: np.ndarray, lid, bad: np.ndarray):
+    """Runs of adjacent number bytes ``[+-]?(\\d+\\.?\\d*|\\.\\d+)`` -> (their starts, ends, the
+    tokens of the chunk: letters, run starts, comment starts and line endings, which of
+    them are runs); a line with a number without its letter or a letter without its number
+    is marked ``bad`` (in place)."""
     nm = cls <= _DOT
     start_m = nm.copy()
     start_m[1:] &= ~nm[:-1]
@@ -187,10 +267,7 @@ def scan(segs: list, axes) -> Scan:
     end_m[:-1] &= ~nm[1:]
     ns = np.flatnonzero(start_m)
     ne = np.flatnonzero(end_m) + 1
-    nr = len(ns)
-    rline = lid(ns)
-    # tokens: letters, number runs (by their first byte), comment starts and line endings
-    # (so that neighbouring tokens are in the same line unless an ending lies between them)
+    # tokens: neighbouring tokens are in the same line unless an ending lies between them
     tok = np.flatnonzero(((cls >= _LETTER) & (cls <= _EOL)) | start_m)
     is_run = start_m[tok]
     isl = cls[tok] == _LETTER
@@ -201,10 +278,17 @@ def scan(segs: list, axes) -> Scan:
     no_number = isl.copy()
     no_number[:-1] &= ~is_run[1:]
     bad[lid(tok[np.flatnonzero(no_letter | no_number)])] = True
-    # the runs read column by column (their first, second ... bytes at once): digits, dots,
-    # signs behind the first byte, and the mantissa (mant * 10 + digit: exact for integers
-    # below 2**53).  Only the first _LONGEST bytes (a sign, 15 digits and a dot): a longer run
-    # has more digits than a double holds and is checked here and read by Python below
+    return ns, ne, tok, is_run
+
+
+def _read_runs(raw: bytes, text: str, ns, ne, rline, bad: np.ndarray):
+    """The number runs ``[ns, ne)`` read column by column (their first, second ... bytes at
+    once): digits, dots, signs behind the first byte, and the mantissa (mant * 10 + digit:
+    exact for integers below 2**53) -> (digits after the dot, -1 without one; digit count;
+    mantissa).  Only the first _LONGEST bytes (a sign, 15 digits and a dot): a longer run has
+    more digits than a double holds and is checked here and read by Python later.  A line
+    with a sign inside a number, two dots or no digit is marked ``bad`` (in place)."""
+    nr = len(ns)
     length = ne - ns
     width = min(int(length.max()), _LONGEST) if nr else 0
     padded = np.frombuffer(raw + bytes(width), np.uint8)
@@ -233,39 +317,7 @@ def scan(segs: list, axes) -> Scan:
         ndig[i] = sum(ch.isdigit() for ch in t)
     # a sign only in front, at most one dot, at least one digit
     bad[rline[misplaced | (ndot > 1) | (ndig == 0)]] = True
-    # the letter of each run: the token before it (in a line that is not bad)
-    rs = np.flatnonzero(is_run)
-    code = _letter_table(axes)[b[tok[np.maximum(rs - 1, 0)]]]
-    bad[rline[code == NEEDS_INTERPRETER]] = True
-    # an axis programmed twice
-    m = code >= 0
-    key = rline[m] * (len(axes) + 1) + code[m]
-    if len(key):
-        ks = np.sort(key)
-        bad[ks[1:][ks[1:] == ks[:-1]] // (len(axes) + 1)] = True
-    # values of the words that matter (not N F S ...)
-    sel = np.flatnonzero(code != IGNORED)
-    ns, ne, rline, code, frac, ndig = ns[sel], ne[sel], rline[sel], code[sel], frac[sel], \
-        ndig[sel]
-    mant = mant[sel]
-    fr = np.maximum(frac, 0)
-    val = mant / _POW10[np.minimum(fr, 22)]
-    neg = b[ns] == 45
-    val = np.where(neg, -val, val)
-    exact = (ndig <= 15) & (fr <= 22)
-    for i in np.flatnonzero(~exact & ~bad[rline]):
-        val[i] = float(text[ns[i]:ne[i]])
-    # G words: only G0 / G1; M words: not those the interpreter acts on
-    gm = np.flatnonzero((code == G_WORD) | (code == M_WORD))
-    if len(gm):
-        v = val[gm]
-        refused = np.where(code[gm] == G_WORD, (v != 0.0) & (v != 1.0),
-                           np.isin(np.round(v), list(gcode.SPECIAL_M)))
-        bad[rline[gm[refused]]] = True
-    fast = ~bad
-    keep = fast[rline]
-    return Scan(text, start, fast, rline[keep], code[keep], val[keep], frac[keep],
-                b[ns[keep]] == 43, ns[keep], ne[keep])
+    return frac, ndig, mant
 
 
 def format_numbers(values, nd, keep, plus, template=None) -> list:
