@@ -135,3 +135,34 @@ def negligible(model, obs, labels, degree: int, ranges: dict, colsq: np.ndarray,
             continue
         out[j] = rms[j] < NEGLIGIBLE * rms_ideal[lab]
     return out
+
+
+#: a column left out enters a kept column's combination when its unit-scaled coefficient
+#: exceeds this (smaller contributions are below what any campaign resolves)
+COMBINATION_TOL = 1e-3
+
+
+def combinations(G: np.ndarray, kept: np.ndarray, parameter: np.ndarray) -> dict:
+    """What the solution's kept columns estimate where the design is rank-deficient.
+
+    The solution keeps the columns ``kept`` (indices) and holds the others at 0; a column
+    ``d`` left out lies in the span of the kept ones, ``A_d = sum_k B_kd A_k``, so the kept
+    column ``k`` estimates ``x_k + sum_d B_kd x_d``.  Returns ``{k: {d: B_kd}}`` (natural
+    units of the columns: mm, rad) for the kept ``parameter`` columns (bool mask, set-up
+    unknowns excluded) whose estimate mixes in any left-out parameter column (unit-scaled
+    coefficient above :data:`COMBINATION_TOL`)."""
+    C, nonzero = _unit(G)
+    norms = np.sqrt(np.maximum(np.diag(G), 0.0))
+    kept = np.asarray(kept)
+    left = [d for d in np.flatnonzero(parameter & nonzero) if d not in set(kept.tolist())]
+    if not left or not len(kept):
+        return {}
+    B = np.linalg.lstsq(C[np.ix_(kept, kept)], C[np.ix_(kept, left)], rcond=1e-12)[0]
+    out: dict = {}
+    for a, k in enumerate(kept):
+        if not parameter[k]:
+            continue
+        for b, d in enumerate(left):
+            if abs(B[a, b]) > COMBINATION_TOL:
+                out.setdefault(int(k), {})[int(d)] = float(B[a, b] * norms[d] / norms[k])
+    return out

@@ -26,9 +26,11 @@ GRID = 9
 
 def covariance(cal, cols) -> np.ndarray:
     """Covariance (mm, rad) of the design columns ``cols`` (indices into ``cal.labels``); zero
-    rows and columns for columns not in the solution."""
+    rows and columns for columns not in the solution or not written (not determined:
+    :attr:`volerr.calibrate.run.Calibration.written`)."""
     sol = cal.solution
-    where = {int(j): i for i, j in enumerate(sol.kept)}
+    written = cal.written
+    where = {int(j): i for i, j in enumerate(sol.kept) if written[int(j)]}
     idx = [where.get(int(j), -1) for j in cols]
     C = np.zeros((len(cols), len(cols)))
     ok = np.array([i >= 0 for i in idx])
@@ -78,7 +80,7 @@ def predict(cal, positions: dict, probe) -> tuple[np.ndarray, np.ndarray, np.nda
     """Identified volumetric error (n, 3) mm at the poses, its standard uncertainty (n, 3) mm,
     and the parameter rows (k, 3, n) with their column indices (for derived quantities)."""
     A, cols = rows_at(cal, positions, probe)
-    theta = cal.coef[cols]
+    theta = cal.coef_written[cols]
     C = covariance(cal, cols)
     e = np.einsum("k,kin->ni", theta, A)
     var = np.einsum("kin,kl,lin->ni", A, C, A)
