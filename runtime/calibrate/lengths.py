@@ -73,7 +73,9 @@ def report(cal) -> dict | None:
                    "identified model (probing error not included); u: standard uncertainty "
                    "(k = 1) from the calibration's covariance; step gauges: measured beside "
                    "predicted, En = difference / combined standard uncertainty (the gauge's "
-                   "readings are in the fit)")
+                   "readings are in the fit); parameters not determined are 0 in it "
+                   "(undetermined), combinations enter under their written_as name")
+    out.update(mapping.what_enters(cal))
     return out
 
 

@@ -123,11 +123,21 @@ def summary(cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0)) -> dict | Non
             "rms_length_um": round(float(np.sqrt(np.mean(length ** 2))), 4),
             "u_max_um": round(float(u_um.max()), 5),
             "u_rms_um": round(float(np.sqrt(np.mean(u_um ** 2))), 5),
-            "undetermined": list(cal.data.get("unidentifiable", [])),
+            **what_enters(cal),
             "note": "identified volumetric error (actual minus nominal tool point, workpiece "
                     "frame) over the measured range and its standard uncertainty from the "
                     "calibration's covariance (k = 1); parameters not determined by the "
-                    "campaign are not in it; --map-out writes every node"}
+                    "campaign are 0 in it (undetermined), a determined combination enters "
+                    "under its written_as name (combinations); --map-out writes every node"}
+
+
+def what_enters(cal) -> dict:
+    """``{"undetermined": [names written as 0], "combinations": [expressions written under
+    one of their names]}``: what a map or an ISO 10360 number built from ``cal`` holds."""
+    combos = cal.data.get("combinations", [])
+    written = {c["written_as"] for c in combos}
+    return {"undetermined": [n for n in cal.data.get("unidentifiable", []) if n not in written],
+            "combinations": [c["expression"] for c in combos]}
 
 
 def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), inputs=()):
