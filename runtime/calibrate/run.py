@@ -267,6 +267,9 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     gauge = [g for g in gauge if req.fits(g)]
     design = blocks.Design(model, obs, degree, ranges, keep)
     labels = list(design.labels)
+    require(extra_terms or any(lab[0] != "setup" for lab in labels),
+            f"--parameters {parameters!r}: nothing left to fit (fixed by the gauge: "
+            f"{', '.join(terms.namer(model, ranges)(g) for g in gauge) or 'none'})")
     if extra_terms:
         design = design.plus([extra_columns(model, obs, extra_terms)])
         labels += [(name, "extra") for name, *_ in extra_terms]
@@ -282,7 +285,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     units = {name: unit for name, _, _, unit in extra_terms}
     report = _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl,
                      u_ref, units)
-    report["fitted_terms"] = _fitted_terms(req)
+    report["fitted_terms"] = _fitted_terms(req, terms.namer(model, ranges))
     if plan:
         from .plan import suggest
 
@@ -352,18 +355,16 @@ def reversal_terms(model, obs, req, explicit: bool) -> list:
     return out
 
 
-def _fitted_terms(req) -> list:
-    """The request as names: whole parameters, ``NAME@term`` of term requests, ``RV_<axis>``."""
+def _fitted_terms(req, name_of) -> list:
+    """The request as names: whole parameters, the terms of term requests (``name_of`` a
+    :func:`volerr.calibrate.terms.namer`), ``RV_<axis>``."""
     out = []
     for p in req.parameters:
         if p in req.only:
-            out += [f"{p}@{_TERM_WORD.get(k, f'P{k}')}" for k in sorted(req.only[p])]
+            out += [name_of((p, k)) for k in sorted(req.only[p])]
         else:
             out.append(p)
     return out + [f"RV_{a}" for a in req.reversals]
-
-
-_TERM_WORD = {0: "offset", 1: "slope"}
 
 
 def _preferred(model, obs, labels) -> np.ndarray:
