@@ -120,4 +120,6 @@ def run_evaluate(args) -> int:
               f"{h}, F {r['F_min_um']:.3f} .. {r['F_max_um']:.3f} um")
     for d in ev.data["diagnosis"]:
         print(f"  {d['parameter']} = {d['value']:.4g} +- {d['std']:.2g} {d['unit']}")
+    if ev.data.get("diagnosis_note"):
+        print(f"  no diagnosis: {ev.data['diagnosis_note']}")
     return 0
