@@ -176,10 +176,10 @@ class Calibration:
         files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} rows): RMS "
                           f"{i['rms_residual']:.3f} um, held-out {i['heldout_rms']:.3f} um"
                           for i in d["instruments"])
-        combos = (f", {len(d['combinations'])} determined only in combination"
+        combos = (f" ({len(d['combinations'])} of them in a determined combination)"
                   if d.get("combinations") else "")
         return (f"{d['layout']}: {len(d['parameters'])} parameters identified, "
-                f"{len(d['unidentifiable'])} not determined by these data{combos}; {files}")
+                f"{len(d['unidentifiable'])} not determined one by one{combos}; {files}")
 
     def undetermined_lines(self) -> list:
         """Console lines: the combinations written under one of their names, and the names
