@@ -169,6 +169,10 @@ def test_degenerate_traces_refused(circles, tmp_path):
     for path, words in ((point, ("1 distinct angle",)), (arc, ("half a circle",))):
         _refused(_cli("ballbar", "evaluate", path), path.name, *words)
         _refused(_cli("calibrate", circles["layout"], path), path.name, *words)
+    partial = tmp_path / "arc220.csv"                   # a ballbar's partial arc: accepted
+    partial.write_text("\n".join([header] + rows[:N * 220 // 360]) + "\n")
+    r = _cli("ballbar", "evaluate", partial)
+    assert r.returncode == 0, r.stderr
 
 
 def test_same_file_twice_refused(circles, tmp_path):
