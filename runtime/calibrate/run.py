@@ -146,6 +146,8 @@ class Calibration:
         out: dict = {}
         for c in self.data.get("combinations", []):
             name = c["written_as"].split("@")[0]
+            if name not in self.model.parameters:
+                continue            # a reversal RV_<axis>: not in the error tables
             axis = self.model.parameter_axis.get(name)
             where = "constants" if axis is None else axis
             out.setdefault(where, []).append(
@@ -153,7 +155,8 @@ class Calibration:
                 f"{c['value']:.4g} +- {c['std']:.2g} {c['unit']} (the campaign does not "
                 f"determine its terms one by one)")
         zero = [n for n in self.data.get("unidentifiable", [])
-                if n not in {c["written_as"] for c in self.data.get("combinations", [])}]
+                if n not in {c["written_as"] for c in self.data.get("combinations", [])}
+                and n.split("@")[0] in self.model.parameters]
         if zero:
             for where in ["constants", *self.model.axes]:
                 out.setdefault(where, []).append(
