@@ -3,9 +3,6 @@ print (constants, ``EXX@slope``, ``EZY@P2``, Fourier ``EXC@cos1``, reversals ``R
 diagnosis' differences ``EXX@slope-EYY@slope``) and refuses empty or malformed text with one
 line.  Before: ``--parameters EXX@slope`` was refused and ``--parameters ''`` accepted."""
 
-import subprocess
-import sys
-
 import pytest
 
 from volerr.calibrate import calibrate, terms
@@ -16,9 +13,15 @@ from volerr.machine.model import load
 pytestmark = pytest.mark.xdist_group("test_calibrate_parameters")
 
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
-                          capture_output=True, text=True)
+class _Run:
+    """``volerr ARGS`` run in this process: ``returncode``, ``stdout``, ``stderr``."""
+
+    def __init__(self, capsys, args):
+        from volerr.cli import main
+
+        self.returncode = main([str(a) for a in args])
+        cap = capsys.readouterr()
+        self.stdout, self.stderr = cap.out, cap.err
 
 
 @pytest.fixture(scope="module")
@@ -51,10 +54,10 @@ def test_every_printed_name_is_accepted(printed):
     assert {"offset", "slope", "P", "cos", "sin", "const"} <= kinds, kinds
 
 
-def test_printed_terms_fit_through_the_cli(printed):
+def test_printed_terms_fit_through_the_cli(printed, capsys):
     names, files = printed["MB1"]
-    r = _cli("calibrate", "MB1", *files, "--parameters",
-             "EXX@slope-EYY@slope,EZZ@slope,EC0Y,EB0Z,EA0Z,EYX@P2,RV_X")
+    r = _Run(capsys, ("calibrate", "MB1", *files, "--parameters",
+                      "EXX@slope-EYY@slope,EZZ@slope,EC0Y,EB0Z,EA0Z,EYX@P2,RV_X"))
     assert r.returncode == 0, r.stderr
     assert "EC0Y = " in r.stdout
 
@@ -69,9 +72,9 @@ def test_malformed_refused(spec, words):
         terms.request(spec, load("DMU50"))
 
 
-def test_empty_refused_on_the_command_line(printed):
+def test_empty_refused_on_the_command_line(printed, capsys):
     _, files = printed["MB1"]
     for spec in ("", "EXX@offset"):
-        r = _cli("calibrate", "MB1", *files, "--parameters", spec)
+        r = _Run(capsys, ("calibrate", "MB1", *files, "--parameters", spec))
         assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
         assert "Traceback" not in r.stderr and "--parameters" in r.stderr

@@ -6,8 +6,6 @@ independent simulator (tests/helpers/instrument_sim.py)."""
 
 import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -18,12 +16,18 @@ from instruments._common import Campaign, random_setup
 TRUTH = {"EX0C": 15.0, "EY0C": -10.0, "EA0C": 25.0, "EB0C": -35.0}
 
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
-                          capture_output=True, text=True)
+class _Run:
+    """``volerr ARGS`` run in this process: ``returncode``, ``stdout``, ``stderr``."""
+
+    def __init__(self, capsys, args):
+        from volerr.cli import main
+
+        self.returncode = main([str(a) for a in args])
+        cap = capsys.readouterr()
+        self.stdout, self.stderr = cap.out, cap.err
 
 
-def test_radial_sweep_says_why(tmp_path):
+def test_radial_sweep_says_why(tmp_path, capsys):
     m = S.Machine("TT_AC")
     blocks = [S.concat([S.ballbar_sweep(m, "sweep_c.csv", "C", a, b, 60, (150.0, 0, 20.0),
                                         (100.0, 0, 0), "rad", u_um=0.3)
@@ -31,8 +35,8 @@ def test_radial_sweep_says_why(tmp_path):
     camp = Campaign(m, blocks, [S.constant(c) for c in TRUTH], TRUTH,
                     random_setup(blocks, np.random.default_rng(1)), seed=2)
     (path,) = camp.write(tmp_path)
-    r = _cli("ballbar", "evaluate", path, "--layout", "TT_AC", "--json", tmp_path / "e.json",
-             "--html", tmp_path / "e.html")
+    r = _Run(capsys, ("ballbar", "evaluate", path, "--layout", "TT_AC", "--json",
+                      tmp_path / "e.json", "--html", tmp_path / "e.html"))
     assert r.returncode == 0, r.stderr
     doc = json.loads((tmp_path / "e.json").read_text())
     assert doc["diagnosis"] == []
@@ -46,12 +50,12 @@ def test_radial_sweep_says_why(tmp_path):
     assert abs(value - (TRUTH["EX0C"] + arm * 1e-3 * TRUTH["EB0C"])) <= 3 * std, note
 
 
-def test_rotary_calibration_page(tmp_path):
+def test_rotary_calibration_page(tmp_path, capsys):
     from importlib.resources import files
 
     src = files("volerr") / "data" / "sphere_example_DMU50.csv"
-    r = _cli("calibrate", "DMU50", src, "--html", tmp_path / "r.html", "--json",
-             tmp_path / "r.json")
+    r = _Run(capsys, ("calibrate", "DMU50", src, "--html", tmp_path / "r.html", "--json",
+                      tmp_path / "r.json"))
     assert r.returncode == 0, r.stderr
     text = re.sub(r"<img[^>]*>|<style>.*?</style>", "", (tmp_path / "r.html").read_text(),
                   flags=re.S)
