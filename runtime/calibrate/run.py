@@ -205,6 +205,11 @@ def campaign_kinds(obs) -> list:
     return list(dict.fromkeys(f.kind for f in obs.files)) or ["deviations"]
 
 
+def moving_axes(model, ranges: dict) -> set:
+    """The axes the campaign moves: a measured range wider than 1 deg (rotary) or 1 mm."""
+    return {a for a, (lo, hi) in ranges.items() if hi - lo > 1.0}
+
+
 def reading_weights(obs) -> tuple[np.ndarray, float]:
     """Relative weights (N,) of the points' readings, ``(u_ref / u)^2``, and ``u_ref`` (mm)."""
     return obs.point_weights(), obs.reference_sigma()
@@ -254,11 +259,12 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
         obs = instruments.stack(parts)
     from .defaults import default_parameters
 
-    req = terms.request(parameters, model, default_parameters(model, campaign_kinds(obs)))
+    ranges = data_ranges(model, obs)
+    req = terms.request(parameters, model, default_parameters(
+        model, campaign_kinds(obs), moving_axes(model, ranges)))
     chosen = req.parameters
     obs = with_directions(obs, parts, req.reversals)
     extra_terms = extra_terms + reversal_terms(model, obs, req, explicit=parameters is not None)
-    ranges = data_ranges(model, obs)
     spl = split_points(obs.n, seed, test_fraction, None)
     w, u_ref = reading_weights(obs)
     degree, degree_scores = _degree(model, obs, spl, ranges, req, degree, max_degree, w)
@@ -281,7 +287,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     fit = _normal_equations(design, obs, spl, np.sqrt(w))
     bar.update()
     bar.set_postfix_str("solve, residuals")
-    prefer = _preferred(model, obs, labels)
+    prefer = _preferred(model, obs, labels, ranges)
     out = _solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref, prefer)
     bar.update()
     bar.close()
@@ -370,13 +376,14 @@ def _fitted_terms(req, name_of) -> list:
     return out + [f"RV_{a}" for a in req.reversals]
 
 
-def _preferred(model, obs, labels) -> np.ndarray:
+def _preferred(model, obs, labels, obs_ranges) -> np.ndarray:
     """(p,) bool: the columns the campaign's instruments are used for
     (:func:`volerr.calibrate.defaults.default_parameters`); where the requested set is
     rank-deficient the solution keeps them before the others."""
     from .defaults import default_parameters
 
-    req = terms.request(None, model, default_parameters(model, campaign_kinds(obs)))
+    req = terms.request(None, model, default_parameters(model, campaign_kinds(obs),
+                                                         moving_axes(model, obs_ranges)))
     return np.array([lab[0] != "setup" and (lab[1] == "extra" or req.fits(lab))
                      for lab in labels])
 
