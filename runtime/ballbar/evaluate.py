@@ -36,6 +36,7 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
     """Evaluate ballbar ``files`` (paths); ``layout`` None: :data:`DEFAULT_LAYOUT` for
     X, Y, Z traces (the travel of the generic layout is not enforced)."""
     model = load(layout or DEFAULT_LAYOUT)
+    instruments.refuse_duplicates(files)
     parts, trs = [], []
     for path in files:
         obs = reader.read(path, model, check_travel=layout is not None)
@@ -48,7 +49,10 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
         stacked = instruments.stack(parts)
         planes = list(dict.fromkeys(t.plane for t in trs))
         swept = [a for a in model.rotary_axes if np.ptp(stacked.positions[a]) > 1.0]
-        data["diagnosis"] = diagnosis.diagnose(model, stacked, [] if swept else planes, swept)
+        data["diagnosis"], note = diagnosis.diagnose_with_note(
+            model, stacked, [] if swept else planes, swept)
+        if note:
+            data["diagnosis_note"] = note
     return Evaluation(data, trs, results)
 
 

@@ -26,9 +26,11 @@ GRID = 9
 
 def covariance(cal, cols) -> np.ndarray:
     """Covariance (mm, rad) of the design columns ``cols`` (indices into ``cal.labels``); zero
-    rows and columns for columns not in the solution."""
+    rows and columns for columns not in the solution or not written (not determined:
+    :attr:`volerr.calibrate.run.Calibration.written`)."""
     sol = cal.solution
-    where = {int(j): i for i, j in enumerate(sol.kept)}
+    written = cal.written
+    where = {int(j): i for i, j in enumerate(sol.kept) if written[int(j)]}
     idx = [where.get(int(j), -1) for j in cols]
     C = np.zeros((len(cols), len(cols)))
     ok = np.array([i >= 0 for i in idx])
@@ -78,7 +80,7 @@ def predict(cal, positions: dict, probe) -> tuple[np.ndarray, np.ndarray, np.nda
     """Identified volumetric error (n, 3) mm at the poses, its standard uncertainty (n, 3) mm,
     and the parameter rows (k, 3, n) with their column indices (for derived quantities)."""
     A, cols = rows_at(cal, positions, probe)
-    theta = cal.coef[cols]
+    theta = cal.coef_written[cols]
     C = covariance(cal, cols)
     e = np.einsum("k,kin->ni", theta, A)
     var = np.einsum("kin,kl,lin->ni", A, C, A)
@@ -121,16 +123,27 @@ def summary(cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0)) -> dict | Non
             "rms_length_um": round(float(np.sqrt(np.mean(length ** 2))), 4),
             "u_max_um": round(float(u_um.max()), 5),
             "u_rms_um": round(float(np.sqrt(np.mean(u_um ** 2))), 5),
-            "undetermined": list(cal.data.get("unidentifiable", [])),
+            **what_enters(cal),
             "note": "identified volumetric error (actual minus nominal tool point, workpiece "
                     "frame) over the measured range and its standard uncertainty from the "
                     "calibration's covariance (k = 1); parameters not determined by the "
-                    "campaign are not in it; --map-out writes every node"}
+                    "campaign are 0 in it (undetermined), a determined combination enters "
+                    "under its written_as name (combinations); --map-out writes every node"}
+
+
+def what_enters(cal) -> dict:
+    """``{"undetermined": [names written as 0], "combinations": [expressions written under
+    one of their names]}``: what a map or an ISO 10360 number built from ``cal`` holds."""
+    combos = cal.data.get("combinations", [])
+    written = {c["written_as"] for c in combos}
+    return {"undetermined": [n for n in cal.data.get("unidentifiable", []) if n not in written],
+            "combinations": [c["expression"] for c in combos]}
 
 
 def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), inputs=()):
     """The map as CSV: axis positions (mm / deg), ``Xp,Yp,Zp``, ``dx_um,dy_um,dz_um`` (the
-    identified error) and ``u_dx_um,u_dy_um,u_dz_um`` (its standard uncertainty)."""
+    identified error) and ``u_dx_um,u_dy_um,u_dz_um`` (its standard uncertainty); ``#`` lines
+    above the header name what it holds as 0 and the combinations in it."""
     from ..cmm import csvformat
     from ..fileio import AtomicFile
 
@@ -146,8 +159,12 @@ def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), input
     cols = [pos[a] for a in model.axes] + [float(v) for v in probe]
     cols += [1e3 * e[:, i] for i in range(3)] + [1e3 * u[:, i] for i in range(3)]
     out = AtomicFile(path, list(inputs))
+    held = what_enters(cal)
+    notes = ([f"# not determined, 0 in this map: {', '.join(held['undetermined'])}\n"]
+             if held["undetermined"] else [])
+    notes += [f"# in this map under one of its names: {c}\n" for c in held["combinations"]]
     try:
-        out.write((",".join(header) + "\n").encode("ascii"))
+        out.write(("".join(notes) + ",".join(header) + "\n").encode("utf-8"))
         out.write(csvformat.rows_text(cols, [6] * len(cols)))
     except BaseException:
         out.discard()
