@@ -181,7 +181,11 @@ class AtomicFile:
         self.fh = os.fdopen(fd, mode)
 
     def write(self, data) -> None:
-        self.fh.write(data)
+        try:
+            self.fh.write(data)
+        except OSError as exc:      # a full disk, a quota, an I/O error: one line, nothing left
+            self.discard()
+            raise write_error(self.path, exc) from None
 
     def truncate(self) -> None:
         self.fh.seek(0)
@@ -194,14 +198,23 @@ class AtomicFile:
             os.replace(self.tmp, self.path)
         except OSError as exc:
             self.discard()
-            raise InputError(f"cannot write {self.path}: {exc.strerror or exc}") from None
+            raise write_error(self.path, exc) from None
         return self.path
 
     def discard(self) -> None:
         if not self.fh.closed:
-            self.fh.close()
+            try:
+                self.fh.close()
+            except OSError:         # the buffered rest could not be written: dropped anyway
+                pass
         if os.path.exists(self.tmp):
             os.unlink(self.tmp)
+
+
+def write_error(path, exc: OSError) -> InputError:
+    """The one-line error of an OS failure while writing ``path`` (ENOSPC: "no space left on
+    the device", EDQUOT, EIO, EACCES ...)."""
+    return InputError(f"cannot write {path}: {exc.strerror or exc}")
 # ---------------------------------------------------------------------------------------------
 # package protection
 _PACKAGE_ROOTS: list | None = None
@@ -606,6 +619,23 @@ class Outputs:
     def __exit__(self, exc_type, exc, tb) -> bool:
         if exc_type is None:
             self.commit()
-        else:
-            self.discard()
+            return False
+        where = self._role_of(exc) if isinstance(exc, OSError) else None
+        self.discard()
+        if where is not None:
+            # an OS error while writing a staged output (full disk, quota, I/O error): one
+            # line naming the output, nothing written
+            raise write_error(where, exc) from None
         return False
+
+    def _role_of(self, exc: OSError) -> str:
+        """The declared output an OS error concerns (its final path), else the file it names."""
+        name = getattr(exc, "filename", None)
+        if name:
+            staged = Path(name)
+            for role, st in self._stage.items():
+                if staged == st or (st in staged.parents):
+                    final = dict(self.declared)[role]
+                    return f"{role} {final}"
+            return str(name)
+        return " ".join(f"{r} {p}" for r, p in self.declared) or "the outputs"

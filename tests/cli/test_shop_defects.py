@@ -1,0 +1,154 @@
+"""Defects a new user hit (issue 32): each test failed before its fix.
+
+Every bad input ends in exit 2 and ONE line on stderr (no traceback, no warning before it),
+nothing written or replaced; every output option is optional."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from volerr.cli import main
+from tests.helpers.full_disk import full_disk
+
+
+def one_line_error(capsys, code, fragment=""):
+    """Exit 2 and exactly one stderr line containing ``fragment``."""
+    err = capsys.readouterr().err
+    assert code == 2, err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    assert fragment.lower() in lines[0].lower(), lines[0]
+    return lines[0]
+
+
+def write_run(path, header="deviation_um", scale=1.0, targets=np.linspace(0, 800, 9)):
+    """An ISO 230-2 long-format run: 3 cycles, both directions, deviations in um (x scale)."""
+    rng = np.random.default_rng(5)
+    lines = [f"target_mm,cycle,direction,{header}"]
+    for t in targets:
+        for c in (1, 2, 3):
+            for word, half in (("+1", 1.2), ("-1", -1.2)):
+                dev = 4.0 * np.sin(t / 200.0) + half + rng.normal(0, 0.3)
+                lines.append(f"{t:g},{c},{word},{dev * scale:.4f}")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+# ---------------------------------------------------------------------------------------------
+# every output optional
+def test_iso230_2_without_outputs_prints_the_result(tmp_path, capsys):
+    run = write_run(tmp_path / "run.csv")
+    assert main(["iso230-2", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert "A " in out and " um" in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
+
+
+def test_iso230_2_html_alone(tmp_path, capsys):
+    run = write_run(tmp_path / "run.csv")
+    assert main(["iso230-2", str(run), "--html", str(tmp_path / "c.html")]) == 0
+    assert (tmp_path / "c.html").read_text().lstrip().lower().startswith("<!doctype html")
+
+
+# ---------------------------------------------------------------------------------------------
+# empty or malformed option text
+@pytest.mark.parametrize("text, fragment", [("", "--tolerance"), (" ", "--tolerance"),
+                                            ("A=", "--tolerance"), ("A10", "--tolerance"),
+                                            ("Q=3", "--tolerance")])
+def test_iso230_2_tolerance_refused(tmp_path, capsys, text, fragment):
+    run = write_run(tmp_path / "run.csv")
+    one_line_error(capsys, main(["iso230-2", str(run), "--tolerance", text]), fragment)
+
+
+@pytest.mark.parametrize("text", ["", " ", "E0=", "E0=1.5+L/", "banana"])
+def test_iso10360_mpe_refused(tmp_path, capsys, text):
+    from volerr.cmm.examples import write_example_errors
+
+    write_example_errors(tmp_path / "errors", "MB1")
+    one_line_error(capsys, main(["iso10360", "MB1", "--errors", str(tmp_path / "errors"),
+                                 "--mpe", text]), "--mpe")
+
+
+# ---------------------------------------------------------------------------------------------
+# a unit header contradicted by the magnitudes
+def test_iso230_2_um_values_under_mm_header_refused(tmp_path, capsys):
+    run = write_run(tmp_path / "run.csv", header="deviation_mm")
+    one_line_error(capsys, main(["iso230-2", str(run), "--json", str(tmp_path / "r.json")]),
+                   "_mm header")
+    assert not (tmp_path / "r.json").exists()
+
+
+def test_iso230_2_deviation_beyond_half_the_target_spacing_refused(tmp_path, capsys):
+    # targets 1 mm apart, deviations near 0.7 mm: the machine would stand at the next target
+    run = write_run(tmp_path / "run.csv", header="deviation_mm", scale=0.5,
+                    targets=np.arange(0.0, 9.0))
+    one_line_error(capsys, main(["iso230-2", str(run)]), "half the smallest target spacing")
+
+
+def test_iso230_2_mm_header_with_mm_values_accepted(tmp_path, capsys):
+    run = write_run(tmp_path / "run.csv", header="deviation_mm", scale=1e-3)
+    assert main(["iso230-2", str(run)]) == 0
+
+
+# ---------------------------------------------------------------------------------------------
+# demo: the folder is checked before any computing
+def test_demo_refuses_a_used_folder_before_computing(tmp_path, capsys, monkeypatch):
+    import volerr.cli.demo as demo
+
+    def never(*a, **k):
+        raise AssertionError("the demo computed before refusing its folder")
+
+    monkeypatch.setattr(demo, "_cmm", never)
+    (tmp_path / "D").mkdir()
+    (tmp_path / "D" / "index.html").write_text("earlier run")
+    one_line_error(capsys, main(["demo", "--out", str(tmp_path / "D"), "--only", "cmm_a"]),
+                   "--force")
+    assert (tmp_path / "D" / "index.html").read_text() == "earlier run"
+
+
+# ---------------------------------------------------------------------------------------------
+# a full disk at write time
+@pytest.fixture(scope="module")
+def dmu50_example(tmp_path_factory):
+    from volerr.fiveaxis.example import write_example
+
+    d = tmp_path_factory.mktemp("dmu50")
+    ex = write_example(d, "DMU50")
+    # a short program: the first 40 lines of the hemisphere
+    short = d / "short.nc"
+    short.write_text("".join(ex["program"].read_text().splitlines(True)[:40]))
+    return {"errors": ex["errors"], "program": short}
+
+
+@pytest.mark.parametrize("room", [0, 2000])
+def test_compensate_on_a_full_disk_is_one_line(tmp_path, capsys, monkeypatch, dmu50_example,
+                                               room):
+    out = tmp_path / "F.nc"
+    argv = ["compensate", "DMU50", "--errors", str(dmu50_example["errors"]),
+            str(dmu50_example["program"]), "--out", str(out), "--report",
+            str(tmp_path / "r.csv")]
+    with full_disk(monkeypatch, room):
+        code = main(argv)
+    one_line_error(capsys, code, "no space left")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []   # nothing staged left, nothing
+
+
+@pytest.mark.parametrize("option", ["--json", "--html", "--plot"])
+def test_iso230_2_on_a_full_disk_is_one_line(tmp_path, capsys, monkeypatch, option):
+    run = write_run(tmp_path / "run.csv")
+    name = {"--json": "r.json", "--html": "r.html", "--plot": "r.png"}[option]
+    with full_disk(monkeypatch):
+        code = main(["iso230-2", str(run), option, str(tmp_path / name)])
+    one_line_error(capsys, code, "no space left")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
+
+
+def test_a_replaced_file_survives_a_full_disk(tmp_path, capsys, monkeypatch):
+    run = write_run(tmp_path / "run.csv")
+    (tmp_path / "r.json").write_text("before")
+    with full_disk(monkeypatch):
+        code = main(["iso230-2", str(run), "--json", str(tmp_path / "r.json")])
+    one_line_error(capsys, code, "no space left")
+    assert (tmp_path / "r.json").read_text() == "before"
