@@ -373,6 +373,29 @@ class Outputs:
             self._items.append((role, Path(path), "plot" if plot else "file", None))
         return self
 
+    def group(self, role: str, paths) -> "Outputs":
+        """Declare the files one output name stands for (Heidenhain: the ``.cma`` named by
+        ``--out`` and the ``.com`` tables beside it): each checked like a file, and -- as for
+        a folder -- none replaces a file that was there before without ``force``, since the
+        user named only the first.  Roles: ``role`` for the first, ``role (NAME)`` after."""
+        paths = [Path(p) for p in paths]
+        require(not self._checked, "internal: output declared after check()")
+        for k, p in enumerate(paths):
+            self._items.append((self.group_role(role, paths, k), p, "member", None))
+        return self
+
+    @staticmethod
+    def group_role(role: str, paths, k: int) -> str:
+        """The role of the ``k``-th file of a :meth:`group`."""
+        return role if k == 0 else f"{role} ({Path(list(paths)[k]).name})"
+
+    def _refuse_replaced_member(self, role, p: Path) -> None:
+        if self.force:
+            return
+        require(not (p.exists() or p.is_symlink()),
+                f"{role}: {p} exists already (the output writes several files for one "
+                f"name); give --force to replace it, or another name")
+
     def plot(self, role: str, path) -> "Outputs":
         """Declare a PNG plot (must end in ``.png``)."""
         return self.file(role, path, plot=True)
@@ -478,6 +501,9 @@ class Outputs:
                     self._probe_writable(role, p.parent, p)
         for role, p, f in existing:
             self._refuse_existing(role, p, f)
+        for role, p, kind, _ in self._items:
+            if kind == "member":
+                self._refuse_replaced_member(role, p)
         # a file inside a folder whose file names are not known in advance
         for role, p, kind, files in self._items:
             if kind == "folder" and files is None:
@@ -553,10 +579,13 @@ class Outputs:
         try:
             seen = {}
             folders = {r: p for r, p, kind, _ in self._items if kind == "folder"}
+            members = {r for r, _, kind, _ in self._items if kind == "member"}
             for _, final, role in moves:
                 self._refuse_target(role, final)
                 if role in folders:
                     self._refuse_existing(role, folders[role], final)
+                if role in members:
+                    self._refuse_replaced_member(role, final)
                 key = final.resolve()
                 require(key not in seen, _same(role, seen.get(key), final))
                 seen[key] = role

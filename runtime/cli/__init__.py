@@ -96,6 +96,7 @@ class _Parser(argparse.ArgumentParser):
         """As argparse, but an unknown option is named by the (sub)command it was given to,
         with the closest option of that command ("did you mean --json?")."""
         _ARGV[:] = [str(a) for a in (sys.argv[1:] if args is None else args)]
+        _refuse_empty(self, _ARGV)
         ns, extras = self.parse_known_args(args, namespace)
         if extras:
             leaf = getattr(ns, "_parser", None) or self
@@ -110,6 +111,19 @@ class _Parser(argparse.ArgumentParser):
 
 
 _ARGV: list = []   # the arguments being parsed (for the messages of a subcommand's parser)
+
+
+def _refuse_empty(parser, argv) -> None:
+    """An empty or blank argument (``--tolerance ''``, ``--json=``, a file name ``''``) is a
+    mistake, never "option not given": one line naming it."""
+    for i, token in enumerate(argv):
+        name, eq, value = token.partition("=")
+        if token.startswith("--") and eq and not value.strip():
+            parser.error(f"{name}: empty value")
+        if not token.strip():
+            before = argv[i - 1] if i else ""
+            parser.error(f"{before}: empty value" if before.startswith("-") else
+                         "empty argument ('')")
 
 
 def _visible_options(parser) -> list:

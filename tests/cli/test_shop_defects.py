@@ -152,3 +152,44 @@ def test_a_replaced_file_survives_a_full_disk(tmp_path, capsys, monkeypatch):
         code = main(["iso230-2", str(run), "--json", str(tmp_path / "r.json")])
     one_line_error(capsys, code, "no space left")
     assert (tmp_path / "r.json").read_text() == "before"
+
+
+# ---------------------------------------------------------------------------------------------
+# controller tables
+@pytest.fixture(scope="module")
+def mb1_errors(tmp_path_factory):
+    from volerr.cmm.examples import write_example_errors
+
+    d = tmp_path_factory.mktemp("mb1") / "errors"
+    write_example_errors(d, "MB1")
+    return d
+
+
+def test_heidenhain_export_never_replaces_a_com_beside_it(tmp_path, capsys, dmu50_example):
+    argv = ["controller", "export", "DMU50", "--errors", str(dmu50_example["errors"]),
+            "--format", "heidenhain", "--out", str(tmp_path / "c.cma")]
+    (tmp_path / "c_X.com").write_text("the user's table\n")
+    one_line_error(capsys, main(argv), "--force")
+    assert (tmp_path / "c_X.com").read_text() == "the user's table\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c_X.com"]
+    assert main(argv + ["--force"]) == 0
+    assert (tmp_path / "c_X.com").read_text().startswith("BEGIN c_X.com")
+    capsys.readouterr()
+    # a second export without --force: the .cma and its .com files are there now
+    one_line_error(capsys, main(argv), "--force")
+
+
+@pytest.mark.parametrize("fmt, good, bad", [("sinumerik-lec", ",X1]", ",X9]"),
+                                            ("sinumerik-lec", ",X1]", ",X2]"),
+                                            ("sinumerik-cec", "(AX1)", "(X9)")])
+def test_sinumerik_unknown_machine_axis_refused(tmp_path, capsys, mb1_errors, fmt, good, bad):
+    f = tmp_path / "t.spf"
+    assert main(["controller", "export", "MB1", "--errors", str(mb1_errors), "--format", fmt,
+                 "--out", str(f)]) == 0
+    text = f.read_text()
+    assert good in text
+    f.write_text(text.replace(good, bad))
+    capsys.readouterr()
+    one_line_error(capsys, main(["controller", "import", "MB1", str(f), "--format", fmt,
+                                 "--errors-out", str(tmp_path / "imp")]), "unknown axis")
+    assert not (tmp_path / "imp").exists()
