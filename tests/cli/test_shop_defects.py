@@ -193,3 +193,76 @@ def test_sinumerik_unknown_machine_axis_refused(tmp_path, capsys, mb1_errors, fm
     one_line_error(capsys, main(["controller", "import", "MB1", str(f), "--format", fmt,
                                  "--errors-out", str(tmp_path / "imp")]), "unknown axis")
     assert not (tmp_path / "imp").exists()
+
+
+# ---------------------------------------------------------------------------------------------
+# bad data refused: artifacts, multilateration
+@pytest.fixture(scope="module")
+def ballplate(tmp_path_factory):
+    from volerr.calibrate.examples import write_ballplate_example
+
+    d = tmp_path_factory.mktemp("plate")
+    return write_ballplate_example(d / "plate.csv", "MB1")["path"]
+
+
+def _calibrate(*argv):
+    return main(["calibrate", *map(str, argv)])
+
+
+def test_artifact_every_row_twice_refused(tmp_path, capsys, ballplate):
+    head, *rows = ballplate.read_text().splitlines()
+    f = tmp_path / "twice.csv"
+    f.write_text("\n".join([head, *rows, *rows]) + "\n")
+    one_line_error(capsys, _calibrate("MB1", f, "--json", tmp_path / "r.json"),
+                   "a row given twice")
+    assert not (tmp_path / "r.json").exists()
+
+
+def test_artifact_placement_copied_under_a_new_label_refused(tmp_path, capsys, ballplate):
+    head, *rows = ballplate.read_text().splitlines()
+    first = rows[0].split(",")[0]
+    copy = [r.replace(first + ",", "copy,", 1) for r in rows if r.startswith(first + ",")]
+    f = tmp_path / "copied.csv"
+    f.write_text("\n".join([head, *rows, *copy]) + "\n")
+    one_line_error(capsys, _calibrate("MB1", f), "copied under a new label")
+
+
+def test_artifact_ball_twice_with_different_coordinates_refused(tmp_path, capsys, ballplate):
+    head, *rows = ballplate.read_text().splitlines()
+    cells = rows[1].split(",")
+    cells[1] = rows[0].split(",")[1]           # the second ball gets the first one's label
+    f = tmp_path / "label.csv"
+    f.write_text("\n".join([head, rows[0], ",".join(cells), *rows[2:]]) + "\n")
+    one_line_error(capsys, _calibrate("MB1", f), "different calibrated coordinates")
+
+
+def test_artifact_repeated_probing_of_a_ball_accepted(tmp_path, capsys, ballplate):
+    """The same ball probed twice (same calibrated coordinates, its own reading) is data."""
+    head, *rows = ballplate.read_text().splitlines()
+    cells = rows[0].split(",")
+    cells[6] = f"{float(cells[6]) + 0.0003:.6f}"
+    f = tmp_path / "repeat.csv"
+    f.write_text("\n".join([head, *rows, ",".join(cells)]) + "\n")
+    assert _calibrate("MB1", f, "--parameters", "EXX,EYY,EZZ,EC0Y,EB0Z,EA0Z",
+                      "--degree", "1") == 0
+
+
+@pytest.fixture(scope="module")
+def multilateration(tmp_path_factory):
+    from volerr.calibrate.examples import write_multilateration_example
+
+    d = tmp_path_factory.mktemp("ml")
+    return write_multilateration_example(d / "ml.csv", "DMU50", n=200)["path"]
+
+
+@pytest.mark.parametrize("command", ["calibrate", "loop"])
+@pytest.mark.parametrize("keep", [("S1",), ("S1", "S2")])
+def test_distances_from_too_few_stations_refused(tmp_path, capsys, multilateration, command,
+                                                 keep):
+    head, *rows = multilateration.read_text().splitlines()
+    j = head.split(",").index("station")
+    f = tmp_path / "few.csv"
+    f.write_text("\n".join([head, *[r for r in rows if r.split(",")[j] in keep]]) + "\n")
+    one_line_error(capsys, main([command, "DMU50", str(f), "--json", str(tmp_path / "r.json")]),
+                   "at least 3")
+    assert not (tmp_path / "r.json").exists()
