@@ -62,6 +62,9 @@ class Options:
     tool_table: dict | None = None
     #: "auto", "iso" or "heidenhain" (:mod:`volerr.fiveaxis.dialect`)
     dialect: str = "auto"
+    #: the work datum: axis positions (layout order) where the work offset was set, or None
+    #: (:meth:`volerr.fiveaxis.compensate.ErrorModel.relative_to`)
+    datum: tuple | None = None
 
     def validated(self, model) -> "Options":
         from .compensate import STRATEGIES
@@ -97,7 +100,7 @@ class Options:
                        float(self.arc_tol_um),
                        None if self.tool_length is None else float(self.tool_length),
                        None if self.tool_table is None else dict(self.tool_table),
-                       self.dialect)
+                       self.dialect, None if self.datum is None else tuple(self.datum))
 
 
 # ---------------------------------------------------------------------------------------
@@ -798,6 +801,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     pre = prescan(open_source, model, chunk_lines, opts.dialect)
     never = tuple(a for a in pre.absent_rotary if a not in opts.initial)
     em = ErrorModel(model, funcs, opts.tool, parameters_for_types(model, opts.types))
+    if opts.datum is not None:
+        em = em.relative_to(opts.datum)
     rule = length_rule(opts.tool_length, opts.tool_table)
     while True:
         initial = {**opts.initial, **{a: 0.0 for a in never}}
@@ -974,8 +979,11 @@ class FileSink:
         for f in self.files:
             f.truncate()
         if self.report:
-            self.report.write(report_header(self.model).encode("utf-8"))
+            self.report.write((self.preamble + report_header(self.model)).encode("utf-8"))
         self.errors = []
+
+    #: comment lines (``# ...``) written before the report's header (the work datum)
+    preamble = ""
 
     def add(self, chunk: Chunk) -> None:
         self.out.write(chunk.text.encode("latin-1"))
