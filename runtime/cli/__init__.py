@@ -21,7 +21,7 @@ __all__ = ["InputError"]
 COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
             "probe_cal", "compensate", "tcpmap", "controller", "calibrate", "ballbar", "loop",
             "simulate", "iso230_2",
-            "uncertainty", "iso10360", "demo", "formats")
+            "uncertainty", "iso10360", "demo", "examples", "formats")
 
 #: closes every ``--help``
 EPILOG = ("File formats: 'volerr formats' lists them, 'volerr formats NAME' prints one\n"
