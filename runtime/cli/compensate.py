@@ -17,6 +17,9 @@ tool-axis error ``orientation_before_urad, orientation_after_urad``, ``iteration
 standard uncertainty of the remaining error ``ux_after_um, uy_after_um, uz_after_um`` from the
 tables' std columns, empty without them),
 ``--json`` (summary) and ``--plot`` (PNG: error along the program before and after).
+With ``--datum`` the report's errors are relative to the work datum and three more columns
+``dx_datum_um, dy_datum_um, dz_datum_um`` give the error at the datum (the same on every row:
+what the work offset absorbed).
 """
 
 from __future__ import annotations
@@ -192,7 +195,9 @@ def run(args) -> int:
         sink = program.FileSink(model, outs.path("--out"),
                                 outs.path("--report") if args.report else None, inputs,
                                 keep_errors=bool(args.plot))
-        sink.preamble = f"# {datum_text}\n"
+        if datum_doc is not None:   # the report shows the datum's error on every row
+            sink.constant_columns = {f"{c}_datum_um": f"{v:.6f}" for c, v in
+                                     zip(("dx", "dy", "dz"), datum_doc["error_um"])}
         try:
             with progress_bar(Path(args.program), "compensate") as tick:
                 s, assumed_zero = program.run(open_source, model, funcs, opts, sink,

@@ -979,16 +979,22 @@ class FileSink:
         for f in self.files:
             f.truncate()
         if self.report:
-            self.report.write((self.preamble + report_header(self.model)).encode("utf-8"))
+            head = report_header(self.model)
+            if self.constant_columns:
+                head = head[:-1] + "," + ",".join(self.constant_columns) + "\n"
+            self.report.write(head.encode("utf-8"))
         self.errors = []
 
-    #: comment lines (``# ...``) written before the report's header (the work datum)
-    preamble = ""
+    #: report columns of one value for every block, name -> text (the work datum's error)
+    constant_columns: dict = {}
 
     def add(self, chunk: Chunk) -> None:
         self.out.write(chunk.text.encode("latin-1"))
         if self.report:
-            self.report.write(report_rows(self.model, chunk).encode("utf-8"))
+            rows = report_rows(self.model, chunk)
+            if self.constant_columns:
+                rows = rows.replace("\n", "," + ",".join(self.constant_columns.values()) + "\n")
+            self.report.write(rows.encode("utf-8"))
         if self.keep_errors and len(chunk.blocks.q_nom):
             b, p = chunk.blocks, chunk.prediction
             self.errors.append((

@@ -103,8 +103,7 @@ def _compensate(d, prog, name, *extra):
     code = main(["compensate", "DMU50", "--errors", str(d / "errors"), str(prog), "--out",
                  str(out), "--report", str(report), "--json", str(d / f"{name}.json"), *extra])
     assert code == 0
-    rows = [r for r in csv.DictReader(ln for ln in report.read_text().splitlines()
-                                      if not ln.startswith("#"))]
+    rows = list(csv.DictReader(report.read_text().splitlines()))
     return out.read_text(), rows, json.loads((d / f"{name}.json").read_text())
 
 
@@ -129,8 +128,9 @@ def test_probed_part_lands_on_its_nominal_points(setup, capsys):
     assert miss_um.max() < 0.2
     # the datum's error is reported: JSON, report comment line, console
     assert np.allclose(doc["datum"]["error_um"], 1e3 * shift, atol=1e-3)
-    head = (d / "datum.csv").read_text().splitlines()[0]
-    assert head.startswith("# datum X=20 Y=-10 Z=150 B=0 C=0: tool-tip error there")
+    for r in rows:
+        got = [float(r[f"{c}_datum_um"]) for c in ("dx", "dy", "dz")]
+        assert np.allclose(got, 1e3 * shift, atol=1e-3)
     assert "datum X=20" in capsys.readouterr().out
 
 
@@ -140,6 +140,7 @@ def test_without_datum_a_probed_part_is_compensated_twice(setup, capsys):
     d, m, prog = setup
     text, rows, doc = _compensate(d, prog, "absolute")
     assert doc["datum"] is None
+    assert "dx_datum_um" not in rows[0]             # the report as before
     assert "datum: none" in capsys.readouterr().out
     q_nom, q_out = _block_ends(prog.read_text()), _block_ends(text)
     nominal = m.tool_point({a: q_nom[:, i] for i, a in enumerate(AXES)})
