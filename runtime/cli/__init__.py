@@ -98,6 +98,7 @@ class _Parser(argparse.ArgumentParser):
         _ARGV[:] = [str(a) for a in (sys.argv[1:] if args is None else args)]
         _refuse_empty(self, _ARGV)
         ns, extras = self.parse_known_args(args, namespace)
+        _refuse_nonfinite(getattr(ns, "_parser", None) or self, ns)
         if extras:
             leaf = getattr(ns, "_parser", None) or self
             bad = next((e for e in extras if e.startswith("-")), extras[0])
@@ -111,6 +112,24 @@ class _Parser(argparse.ArgumentParser):
 
 
 _ARGV: list = []   # the arguments being parsed (for the messages of a subcommand's parser)
+
+
+def _refuse_nonfinite(parser, ns) -> None:
+    """Every number option is finite (``nan``, ``inf`` parse as floats but are never a
+    tolerance, radius or limit), and a ``--seed`` is an integer 0 .. 2^32 - 1 (numpy's
+    seeds)."""
+    import math
+
+    for action in parser._actions:
+        if action.type not in (float, int) or not action.option_strings:
+            continue
+        value = getattr(ns, action.dest, None)
+        for v in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(v, float) and not math.isfinite(v):
+                parser.error(f"{action.option_strings[-1]}: {v} is not a finite number")
+    seed = getattr(ns, "seed", None)
+    if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
+        parser.error(f"--seed: {seed} is not an integer from 0 to {2 ** 32 - 1}")
 
 
 def _refuse_empty(parser, argv) -> None:

@@ -17,6 +17,8 @@ AXIS_NAMES = "XYZUVWABC"
 def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
     """Numeric columns holding NaN or infinity become text columns with a message naming the
     first bad row (an error if the column is needed, else left out with a warning)."""
+    from ..fileio import MAX_ABS
+
     cols, text = dict(cols), dict(text or {})
     for h in list(cols):
         v = np.asarray(cols[h], dtype=float)
@@ -24,7 +26,26 @@ def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
             k = int(np.flatnonzero(~np.isfinite(v))[0])
             text[h] = f"{where}: column {h} row {k + 2} is NaN or infinite"
             del cols[h]
+        elif np.any(np.abs(v) > MAX_ABS):   # squares would overflow: never a reading
+            k = int(np.flatnonzero(np.abs(v) > MAX_ABS)[0])
+            text[h] = (f"{where}: column {h} row {k + 2} = {v[k]:g} is implausibly large "
+                       f"(more than {MAX_ABS:g} in the file's unit)")
+            del cols[h]
     return cols, text
+
+
+def check_groups(labels, what: str, where: str, minimum: int, why: str) -> None:
+    """Refuse an empty label and a group (placement, station) of fewer than ``minimum`` rows
+    (a label mistyped on one row makes a group of its own that carries nothing)."""
+    names = np.asarray(labels).astype(str)
+    blank = np.flatnonzero(np.char.strip(names) == "")
+    require(len(blank) == 0, f"{where}: row {blank[0] + 2 if len(blank) else 0}: empty "
+                             f"{what} label")
+    found, counts = np.unique(names, return_counts=True)
+    few = [(g, int(c)) for g, c in zip(found, counts) if c < minimum]
+    require(not few, f"{where}: {what} {few[0][0] if few else ''!r} has "
+                     f"{few[0][1] if few else 0} row{'s' if few and few[0][1] > 1 else ''}; a "
+                     f"{what} needs at least {minimum} ({why}; a mistyped label?)")
 
 
 def text_columns(text: dict, needed, where: str, labels=()) -> list:

@@ -114,6 +114,8 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(placement.astype(str), return_inverse=True)
     gidx = gidx.ravel()
+    f.check_groups(placement, "placement", where, 3, "its pose is unknown")
+    f.check_groups(ball, "ball", where, 1, "")
     refuse_repeats(where, names[gidx], ball.astype(str), point, measured)
     pos = _hold_still_axes(pos, gidx, lin_axes)
     R0 = np.zeros((n, 3, 3))

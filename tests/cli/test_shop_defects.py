@@ -266,3 +266,62 @@ def test_distances_from_too_few_stations_refused(tmp_path, capsys, multilaterati
     one_line_error(capsys, main([command, "DMU50", str(f), "--json", str(tmp_path / "r.json")]),
                    "at least 3")
     assert not (tmp_path / "r.json").exists()
+
+
+# ---------------------------------------------------------------------------------------------
+# found by the hostile sweep
+@pytest.fixture(scope="module")
+def sphere_file(tmp_path_factory):
+    from volerr.calibrate.examples import write_sphere_example
+
+    d = tmp_path_factory.mktemp("sphere")
+    return write_sphere_example(d / "s.csv", "DMU50")["path"]
+
+
+def _replace_cell(src, dst, row, column, value):
+    head, *rows = src.read_text().splitlines()
+    j = head.split(",").index(column)
+    cells = rows[row].split(",")
+    cells[j] = value
+    rows[row] = ",".join(cells)
+    dst.write_text("\n".join([head, *rows]) + "\n")
+    return dst
+
+
+@pytest.mark.parametrize("column", ["X", "sphere_x", "dx_um", "Zp"])
+def test_sphere_implausibly_large_number_refused(tmp_path, capsys, sphere_file, column):
+    f = _replace_cell(sphere_file, tmp_path / "big.csv", 3, column, "1e300")
+    one_line_error(capsys, _calibrate("DMU50", f), "implausibly large")
+
+
+@pytest.mark.parametrize("value, fragment", [("", "empty placement label"),
+                                             ("typo", "has 1 row")])
+def test_sphere_placement_label_of_one_row_refused(tmp_path, capsys, sphere_file, value,
+                                                   fragment):
+    f = _replace_cell(sphere_file, tmp_path / "label.csv", 5, "placement", value)
+    one_line_error(capsys, _calibrate("DMU50", f), fragment)
+
+
+@pytest.mark.parametrize("column, value, fragment", [
+    ("placement", "typo", "has 1 row"), ("placement", "", "empty placement label"),
+    ("ball", "", "empty ball label"), ("x_mm", "1e300", "implausibly large")])
+def test_artifact_bad_label_or_number_refused(tmp_path, capsys, ballplate, column, value,
+                                              fragment):
+    f = _replace_cell(ballplate, tmp_path / "bad.csv", 7, column, value)
+    one_line_error(capsys, _calibrate("MB1", f), fragment)
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["probe-cal", "p.csv", "--sphere-radius", "nan", "--out", "m.csv"], "--sphere-radius"),
+    (["probe-cal", "p.csv", "--sphere-radius", "25", "--ball-radius", "inf", "--out", "m.csv"],
+     "--ball-radius"),
+    (["calibrate", "MB1", "f.csv", "--seed", "-1"], "--seed"),
+    (["ballbar", "simulate", "MB1", "--errors", "e", "--plane", "XY", "--radius", "1e9",
+      "--centre", "0,0,0", "--out", "t.csv"], "--radius"),
+])
+def test_nonfinite_or_out_of_range_option_refused(tmp_path, capsys, monkeypatch, argv,
+                                                  fragment, mb1_errors):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "e").symlink_to(mb1_errors)
+    one_line_error(capsys, main(argv), fragment)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e"]
