@@ -96,8 +96,8 @@ class _Parser(argparse.ArgumentParser):
         """As argparse, but an unknown option is named by the (sub)command it was given to,
         with the closest option of that command ("did you mean --json?")."""
         _ARGV[:] = [str(a) for a in (sys.argv[1:] if args is None else args)]
-        _refuse_empty(self, _ARGV)
         ns, extras = self.parse_known_args(args, namespace)
+        _refuse_empty(getattr(ns, "_parser", None) or self, _ARGV)
         _refuse_nonfinite(getattr(ns, "_parser", None) or self, ns)
         if extras:
             leaf = getattr(ns, "_parser", None) or self

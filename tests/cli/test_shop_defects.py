@@ -325,3 +325,15 @@ def test_nonfinite_or_out_of_range_option_refused(tmp_path, capsys, monkeypatch,
     (tmp_path / "e").symlink_to(mb1_errors)
     one_line_error(capsys, main(argv), fragment)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["e"]
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["iso230-2", "RUN", "--json="], "--json: empty value"),
+    (["iso230-2", ""], "empty argument"),
+    (["map", "MB1", "--errors", " "], "--errors: empty value"),
+    (["calibrate", "MB1", "RUN", "--parameters", ""], "--parameters: empty value"),
+])
+def test_empty_argument_refused(tmp_path, capsys, argv, fragment):
+    run = write_run(tmp_path / "run.csv")
+    argv = [str(run) if a == "RUN" else a for a in argv]
+    one_line_error(capsys, main(argv), fragment)
