@@ -23,23 +23,38 @@ def add_arguments(p) -> None:
                         "formats sphere') or ballbar (three ISO 230-4 circles XY, YZ, ZX about "
                         "the middle of the travel, both directions, 180 readings each, one "
                         "file with a placement column; 'volerr formats ballbar')")
+    from ..instruments.simulated_files import DEFAULT_PLANTED
+
+    shown = {k: ", ".join(f"{n}={v:g}" for n, v in d.items())
+             for k, d in DEFAULT_PLANTED.items()}
     g.add_argument("--plant", metavar="NAME=V,...",
                    help="sphere / ballbar: the planted errors, in the units calibrate reports: "
                         "constants (EX0C=15 um, EA0C=25 urad, EC0Y=20 urad) and slopes of "
                         "component errors (EXX@slope=0.01 um/mm, zero at mid-travel); every "
                         "other error 0 (default: sphere the location errors of the rotary "
-                        "axes EX0B=12,EY0B=-8,EA0B=35,EB0B=-20,EX0C=15,EY0C=-10,EA0C=25,"
-                        "EB0C=-40 (those the layout has); ballbar squareness EC0Y=20,EB0Z=-12,"
-                        "EA0Z=8 and scales EXX@slope=0.015,EYY@slope=-0.005,EZZ@slope=0.01)")
+                        f"axes the layout has among {shown['sphere']}; ballbar squareness "
+                        f"and scales {shown['ballbar']})")
     g.add_argument("--errors", metavar="DIR",
                    help="sphere / ballbar: plant the errors of an error directory instead "
                         "(tables and constants, 'volerr formats tables')")
-    g.add_argument("--steps", type=int, default=9,
+    g.add_argument("--steps", type=int, default=None,
                    help="sphere: positions of each rotary axis over its travel (at most 320 "
                         "deg), every combination (default 9)")
     g.add_argument("--radius", type=float, default=None, metavar="MM",
                    help="ballbar: circle radius = bar length, mm (default 100, at most 40 %% of "
                         "the shortest linear travel)")
+
+
+#: options of the instrument files: (attribute, the instruments that use it)
+INSTRUMENT_ONLY = (("plant", ("sphere", "ballbar")), ("errors", ("sphere", "ballbar")),
+                   ("steps", ("sphere",)), ("radius", ("ballbar",)))
+
+
+def refuse_unused(args) -> None:
+    """An option the chosen --instrument does not use is refused, never silently ignored."""
+    for attr, users in INSTRUMENT_ONLY:
+        require(getattr(args, attr, None) is None or args.instrument in users,
+                f"--{attr} is for --instrument {' / '.join(users)}")
 
 
 def run(args) -> int:
@@ -55,6 +70,7 @@ def run(args) -> int:
     for attr, default in DEVIATION_ONLY:
         require(getattr(args, attr) in (default, None) or getattr(args, attr) == default,
                 f"--{attr.replace('_', '-')} is for --instrument deviations")
+    refuse_unused(args)
     require(not (args.plant and args.errors), "give --plant or --errors, not both")
     require(math.isfinite(args.noise_um) and 0 <= args.noise_um <= 1e3,
             "--noise-um must be finite, between 0 and 1000 um")
@@ -72,7 +88,7 @@ def run(args) -> int:
                    else sim.default_planted(model, args.instrument))
         funcs = sim.planted_functions(model, planted)
     if args.instrument == "sphere":
-        cols = sim.sphere_columns(model, funcs, steps=args.steps, noise_um=args.noise_um,
+        cols = sim.sphere_columns(model, funcs, steps=args.steps or 9, noise_um=args.noise_um,
                                   seed=args.seed)
     else:
         cols = sim.ballbar_columns(model, funcs, args.radius, args.noise_um, args.seed)

@@ -89,10 +89,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    if getattr(args, "instrument", "deviations") != "deviations":
-        from . import _simulate_instruments
+    from . import _simulate_instruments
 
+    if getattr(args, "instrument", "deviations") != "deviations":
         return _simulate_instruments.run(args)
+    _simulate_instruments.refuse_unused(args)
     from ..machine.model import load
     from ..loop.simulate import demo_probes, simulate
 

@@ -110,3 +110,14 @@ def test_bad_options_refused(tmp_path, capsys, argv, fragment):
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1 and fragment in err, err
     assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["MB1", "--plant", "EC0Y=3"], "--plant is for --instrument sphere / ballbar"),
+    (["DMU50", "--instrument", "ballbar", "--steps", "3"], "--steps is for --instrument sphere"),
+    (["DMU50", "--instrument", "sphere", "--radius", "50"], "--radius is for --instrument"),
+])
+def test_an_option_the_instrument_does_not_use_is_refused(tmp_path, capsys, argv, fragment):
+    code = main(["simulate", *argv, "--out", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and fragment in err, err
