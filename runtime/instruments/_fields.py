@@ -34,6 +34,26 @@ def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
     return cols, text
 
 
+def refuse_duplicate_rows(columns, where: str) -> None:
+    """Refuse a file in which a row repeats an earlier one in every cell (a file or a block
+    pasted twice: real readings never agree to the last digit in every column, and a copied
+    reading would count twice in the fit).  ``columns``: a
+    :class:`volerr.instruments._csv.Columns` (numbers and label columns)."""
+    cells = [np.asarray(v, dtype=float) for v in columns.numbers.values()]
+    cells += [np.unique(np.asarray(v, dtype=str), return_inverse=True)[1].ravel()
+              for v in columns.labels.values()]
+    if not cells or len(cells[0]) < 2:
+        return
+    rows = np.column_stack(cells)
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    dup = np.flatnonzero(first[inverse] != np.arange(len(rows)))
+    require(len(dup) == 0, f"{where}: row {dup[0] + 2 if len(dup) else 0} repeats row "
+                           f"{first[inverse[dup[0]]] + 2 if len(dup) else 0} in every column "
+                           f"({len(dup)} such row{'s' if len(dup) > 1 else ''}: a file or a "
+                           f"block pasted twice?)")
+
+
 def check_groups(labels, what: str, where: str, minimum: int, why: str) -> None:
     """Refuse an empty label and a group (placement, station) of fewer than ``minimum`` rows
     (a label mistyped on one row makes a group of its own that carries nothing)."""

@@ -51,6 +51,7 @@ def detect(names) -> bool:
 def read(path, model: Model) -> Observations:
     """Read a distances CSV into :class:`Observations` (InputError, one line, on a defect)."""
     c = read_columns(path)
+    f.refuse_duplicate_rows(c, c.name)
     return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
 
 

@@ -48,6 +48,7 @@ def detect(names) -> bool:
 def read(path, model: Model) -> Observations:
     """Read a sphere / R-test CSV into :class:`Observations` (InputError, one line)."""
     c = read_columns(path)
+    f.refuse_duplicate_rows(c, c.name)
     return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
 
 

@@ -337,3 +337,24 @@ def test_empty_argument_refused(tmp_path, capsys, argv, fragment):
     run = write_run(tmp_path / "run.csv")
     argv = [str(run) if a == "RUN" else a for a in argv]
     one_line_error(capsys, main(argv), fragment)
+
+
+def _twice(src, dst, block=slice(None)):
+    """The file with a block of its rows given a second time at the end."""
+    head, *rows = [ln for ln in src.read_text().splitlines() if not ln.startswith("#")]
+    dst.write_text("\n".join([head, *rows, *rows[block]]) + "\n")
+    return dst
+
+
+@pytest.mark.parametrize("kind", ["sphere", "distances", "deviations"])
+def test_rows_pasted_twice_refused(tmp_path, capsys, sphere_file, multilateration, kind):
+    if kind == "sphere":
+        f, layout = _twice(sphere_file, tmp_path / "s.csv", slice(3, 9)), "DMU50"
+    elif kind == "distances":
+        f, layout = _twice(multilateration, tmp_path / "d.csv"), "DMU50"
+    else:
+        src = tmp_path / "dev.csv"
+        assert main(["simulate", "MB1", "--points", "60", "--out", str(src)]) == 0
+        f, layout = _twice(src, tmp_path / "twice.csv", slice(0, 1)), "MB1"
+    capsys.readouterr()
+    one_line_error(capsys, _calibrate(layout, f), "pasted twice")
