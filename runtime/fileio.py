@@ -181,7 +181,11 @@ class AtomicFile:
         self.fh = os.fdopen(fd, mode)
 
     def write(self, data) -> None:
-        self.fh.write(data)
+        try:
+            self.fh.write(data)
+        except OSError as exc:      # a full disk, a quota, an I/O error: one line, nothing left
+            self.discard()
+            raise write_error(self.path, exc) from None
 
     def truncate(self) -> None:
         self.fh.seek(0)
@@ -194,14 +198,23 @@ class AtomicFile:
             os.replace(self.tmp, self.path)
         except OSError as exc:
             self.discard()
-            raise InputError(f"cannot write {self.path}: {exc.strerror or exc}") from None
+            raise write_error(self.path, exc) from None
         return self.path
 
     def discard(self) -> None:
         if not self.fh.closed:
-            self.fh.close()
+            try:
+                self.fh.close()
+            except OSError:         # the buffered rest could not be written: dropped anyway
+                pass
         if os.path.exists(self.tmp):
             os.unlink(self.tmp)
+
+
+def write_error(path, exc: OSError) -> InputError:
+    """The one-line error of an OS failure while writing ``path`` (ENOSPC: "no space left on
+    the device", EDQUOT, EIO, EACCES ...)."""
+    return InputError(f"cannot write {path}: {exc.strerror or exc}")
 # ---------------------------------------------------------------------------------------------
 # package protection
 _PACKAGE_ROOTS: list | None = None
@@ -360,6 +373,29 @@ class Outputs:
             self._items.append((role, Path(path), "plot" if plot else "file", None))
         return self
 
+    def group(self, role: str, paths) -> "Outputs":
+        """Declare the files one output name stands for (Heidenhain: the ``.cma`` named by
+        ``--out`` and the ``.com`` tables beside it): each checked like a file, and -- as for
+        a folder -- none replaces a file that was there before without ``force``, since the
+        user named only the first.  Roles: ``role`` for the first, ``role (NAME)`` after."""
+        paths = [Path(p) for p in paths]
+        require(not self._checked, "internal: output declared after check()")
+        for k, p in enumerate(paths):
+            self._items.append((self.group_role(role, paths, k), p, "member", None))
+        return self
+
+    @staticmethod
+    def group_role(role: str, paths, k: int) -> str:
+        """The role of the ``k``-th file of a :meth:`group`."""
+        return role if k == 0 else f"{role} ({Path(list(paths)[k]).name})"
+
+    def _refuse_replaced_member(self, role, p: Path) -> None:
+        if self.force:
+            return
+        require(not (p.exists() or p.is_symlink()),
+                f"{role}: {p} exists already (the output writes several files for one "
+                f"name); give --force to replace it, or another name")
+
     def plot(self, role: str, path) -> "Outputs":
         """Declare a PNG plot (must end in ``.png``)."""
         return self.file(role, path, plot=True)
@@ -465,6 +501,9 @@ class Outputs:
                     self._probe_writable(role, p.parent, p)
         for role, p, f in existing:
             self._refuse_existing(role, p, f)
+        for role, p, kind, _ in self._items:
+            if kind == "member":
+                self._refuse_replaced_member(role, p)
         # a file inside a folder whose file names are not known in advance
         for role, p, kind, files in self._items:
             if kind == "folder" and files is None:
@@ -540,10 +579,13 @@ class Outputs:
         try:
             seen = {}
             folders = {r: p for r, p, kind, _ in self._items if kind == "folder"}
+            members = {r for r, _, kind, _ in self._items if kind == "member"}
             for _, final, role in moves:
                 self._refuse_target(role, final)
                 if role in folders:
                     self._refuse_existing(role, folders[role], final)
+                if role in members:
+                    self._refuse_replaced_member(role, final)
                 key = final.resolve()
                 require(key not in seen, _same(role, seen.get(key), final))
                 seen[key] = role
@@ -606,6 +648,23 @@ class Outputs:
     def __exit__(self, exc_type, exc, tb) -> bool:
         if exc_type is None:
             self.commit()
-        else:
-            self.discard()
+            return False
+        where = self._role_of(exc) if isinstance(exc, OSError) else None
+        self.discard()
+        if where is not None:
+            # an OS error while writing a staged output (full disk, quota, I/O error): one
+            # line naming the output, nothing written
+            raise write_error(where, exc) from None
         return False
+
+    def _role_of(self, exc: OSError) -> str:
+        """The declared output an OS error concerns (its final path), else the file it names."""
+        name = getattr(exc, "filename", None)
+        if name:
+            staged = Path(name)
+            for role, st in self._stage.items():
+                if staged == st or (st in staged.parents):
+                    final = dict(self.declared)[role]
+                    return f"{role} {final}"
+            return str(name)
+        return " ".join(f"{r} {p}" for r, p in self.declared) or "the outputs"

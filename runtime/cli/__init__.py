@@ -21,7 +21,7 @@ __all__ = ["InputError"]
 COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
             "probe_cal", "compensate", "tcpmap", "controller", "calibrate", "ballbar", "loop",
             "simulate", "iso230_2",
-            "uncertainty", "iso10360", "demo", "formats")
+            "uncertainty", "iso10360", "demo", "examples", "formats")
 
 #: closes every ``--help``
 EPILOG = ("File formats: 'volerr formats' lists them, 'volerr formats NAME' prints one\n"
@@ -97,6 +97,8 @@ class _Parser(argparse.ArgumentParser):
         with the closest option of that command ("did you mean --json?")."""
         _ARGV[:] = [str(a) for a in (sys.argv[1:] if args is None else args)]
         ns, extras = self.parse_known_args(args, namespace)
+        _refuse_empty(getattr(ns, "_parser", None) or self, _ARGV)
+        _refuse_nonfinite(getattr(ns, "_parser", None) or self, ns)
         if extras:
             leaf = getattr(ns, "_parser", None) or self
             bad = next((e for e in extras if e.startswith("-")), extras[0])
@@ -110,6 +112,37 @@ class _Parser(argparse.ArgumentParser):
 
 
 _ARGV: list = []   # the arguments being parsed (for the messages of a subcommand's parser)
+
+
+def _refuse_nonfinite(parser, ns) -> None:
+    """Every number option is finite (``nan``, ``inf`` parse as floats but are never a
+    tolerance, radius or limit), and a ``--seed`` is an integer 0 .. 2^32 - 1 (numpy's
+    seeds)."""
+    import math
+
+    for action in parser._actions:
+        if action.type not in (float, int) or not action.option_strings:
+            continue
+        value = getattr(ns, action.dest, None)
+        for v in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(v, float) and not math.isfinite(v):
+                parser.error(f"{action.option_strings[-1]}: {v} is not a finite number")
+    seed = getattr(ns, "seed", None)
+    if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
+        parser.error(f"--seed: {seed} is not an integer from 0 to {2 ** 32 - 1}")
+
+
+def _refuse_empty(parser, argv) -> None:
+    """An empty or blank argument (``--tolerance ''``, ``--json=``, a file name ``''``) is a
+    mistake, never "option not given": one line naming it."""
+    for i, token in enumerate(argv):
+        name, eq, value = token.partition("=")
+        if token.startswith("--") and eq and not value.strip():
+            parser.error(f"{name}: empty value")
+        if not token.strip():
+            before = argv[i - 1] if i else ""
+            parser.error(f"{before}: empty value" if before.startswith("-") else
+                         "empty argument ('')")
 
 
 def _visible_options(parser) -> list:
@@ -178,6 +211,10 @@ def main(argv=None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stderr.close()
         return 0
+    except OSError as exc:  # a file the checks could not foresee (full disk, I/O error)
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        print(f"volerr {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     return int(result or 0)
 
 

@@ -88,6 +88,10 @@ def run_simulate(args) -> int:
     inputs = error_dir_inputs(args.errors) + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force).file("--out", args.out).check()
     require(args.noise_um >= 0, "--noise-um must not be negative")
+    require(0 < args.radius <= 1e5, f"--radius must be a positive length of at most 1e5 mm, "
+                                    f"got {args.radius:g}")
+    require(8 <= args.points <= 10 ** 6, f"--points must be between 8 and 10^6 readings per "
+                                         f"direction, got {args.points}")
     funcs = error_functions_from_args(args, model)
     cols = simulate(model, funcs, args.plane, args.radius, args.centre, args.tool,
                     _rotary(args.rotary or ""), args.points, args.noise_um, args.direction, args.seed)

@@ -17,6 +17,9 @@ tool-axis error ``orientation_before_urad, orientation_after_urad``, ``iteration
 standard uncertainty of the remaining error ``ux_after_um, uy_after_um, uz_after_um`` from the
 tables' std columns, empty without them),
 ``--json`` (summary) and ``--plot`` (PNG: error along the program before and after).
+With ``--datum`` the report's errors are relative to the work datum and three more columns
+``dx_datum_um, dy_datum_um, dz_datum_um`` give the error at the datum (the same on every row:
+what the work offset absorbed).
 """
 
 from __future__ import annotations
@@ -24,6 +27,8 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+
+import numpy as np
 
 from ._common import add_error_arguments, add_vector, progress_bar
 from ..errors import InputError, require
@@ -81,6 +86,17 @@ def register(sub) -> None:
     p.add_argument("--dialect", choices=("auto", "iso", "heidenhain"), default="auto",
                    help="program language: ISO G-code (Fanuc, Siemens, Heidenhain ISO) or "
                         "Heidenhain plain language (auto: detected from the first lines)")
+    p.add_argument("--datum", default="none", metavar="X,Y,Z[,B,C]",
+                   help="the work datum: the axis positions (layout order, mm / deg; rotary "
+                        "axes not given: 0) where the part zero was probed or the work offset "
+                        "set.  The work offset has absorbed the tool-tip error there, so only "
+                        "the error relative to it is compensated and the report's before / "
+                        "after errors are relative to it.  'none' (the default): the full "
+                        "volumetric error, relative to the machine's reference (the error "
+                        "tables' zero), is compensated -- right when the work offset comes "
+                        "from the machine's reference (a calibrated fixture or pallet), and "
+                        "volerr cannot know where a part was probed; after probing the part, "
+                        "give the probing position or the error there is compensated twice")
     p.add_argument("--report", help="per-block CSV report")
     p.add_argument("--json", help="summary as JSON")
     p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")
@@ -99,6 +115,52 @@ def _initial(text: str) -> dict:
         require(math.isfinite(val), f"--initial: {a} is not finite")
         out[a.strip().upper()] = val
     return out
+
+
+def _datum(text: str, model) -> tuple | None:
+    """``--datum``: None for 'none', else the axis positions (layout order; rotary axes not
+    given are at 0 deg), inside the travel."""
+    if text.strip().lower() == "none":
+        return None
+    parts = [c.strip() for c in text.replace(";", ",").split(",") if c.strip()]
+    n_lin = len(model.axes) - len(model.rotary_axes)
+    require(n_lin <= len(parts) <= len(model.axes),
+            f"--datum: give {n_lin} to {len(model.axes)} numbers "
+            f"({','.join(model.axes)}, mm / deg) or 'none', got {text!r}")
+    try:
+        values = [float(c) for c in parts]
+    except ValueError:
+        raise InputError(f"--datum: {text!r} is not a list of numbers "
+                         f"({','.join(model.axes)}) or 'none'") from None
+    values += [0.0] * (len(model.axes) - len(values))
+    for a, v in zip(model.axes, values):
+        lo, hi = model.travel[a]
+        require(math.isfinite(v) and lo <= v <= hi,
+                f"--datum: {a} = {v:g} is outside the travel of {model.name} ({lo:g} .. {hi:g})")
+    return tuple(values)
+
+
+def _datum_lines(model, funcs, tool, datum) -> tuple[str, dict | None]:
+    """The console sentence on the datum and its JSON entry (the error there, um)."""
+    from ..fiveaxis.compensate import ErrorModel
+
+    if datum is None:
+        return ("datum: none -- every block is moved by its full volumetric error, relative to "
+                "the machine's reference (the error tables' zero); if the work offset was set "
+                "by probing the part, give --datum with the probing position"), None
+    em = ErrorModel(model, funcs, tool).relative_to(datum)
+    require(bool(em.admissible(em.datum)[0]),
+            f"--datum: {_positions(model, datum)} lies outside the range of the error tables")
+    e = 1e3 * em.datum_error()
+    where = _positions(model, datum)
+    return (f"datum {where}: tool-tip error there dx {e[0]:+.3f} dy {e[1]:+.3f} dz {e[2]:+.3f} "
+            f"um (|e| {np.linalg.norm(e):.3f} um), absorbed by the work offset; compensated: "
+            f"the error relative to it"), {
+        "positions": dict(zip(model.axes, datum)), "error_um": [round(float(v), 6) for v in e]}
+
+
+def _positions(model, q) -> str:
+    return " ".join(f"{a}={v:g}" for a, v in zip(model.axes, q))
 
 
 def run(args) -> int:
@@ -123,16 +185,21 @@ def run(args) -> int:
               *([args.tool_table] if args.tool_table else [])]
     outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
         .file("--json", args.json).plot("--plot", args.plot).check()
+    datum = _datum(args.datum, model)
+    datum_text, datum_doc = _datum_lines(model, funcs, tuple(args.tool), datum)
     opts = program.Options(
         tuple(args.tool), args.orientation, args.strategy, args.tol_um, args.decimals,
         _initial(args.initial or ""), not args.ignore_travel, 50,
         None if args.types is None else tuple(t for t in args.types.split(",") if t.strip()),
-        args.arc_tolerance_um, args.tool_length, table, args.dialect)
+        args.arc_tolerance_um, args.tool_length, table, args.dialect, datum)
     with outs:  # all or nothing: staged outputs are put in place at the end
         # streamed: the program and the report are written chunk by chunk
         sink = program.FileSink(model, outs.path("--out"),
                                 outs.path("--report") if args.report else None, inputs,
                                 keep_errors=bool(args.plot))
+        if datum_doc is not None:   # the report shows the datum's error on every row
+            sink.constant_columns = {f"{c}_datum_um": f"{v:.6f}" for c, v in
+                                     zip(("dx", "dy", "dz"), datum_doc["error_um"])}
         try:
             with progress_bar(Path(args.program), "compensate") as tick:
                 s, assumed_zero = program.run(open_source, model, funcs, opts, sink,
@@ -143,7 +210,7 @@ def run(args) -> int:
                 write_text(outs.path("--json"), json.dumps(
                     {"layout": model.name, "strategy": args.strategy,
                      "orientation": bool(args.orientation), "types": args.types or "L-VOL,R-VOL",
-                     **s}, indent=2) + "\n", inputs)
+                     "datum": datum_doc, **s}, indent=2) + "\n", inputs)
             if args.plot:
                 from ..fiveaxis.plots import plot_program_errors
 
@@ -158,6 +225,7 @@ def run(args) -> int:
           f"{', types ' + args.types if args.types else ''}); predicted tool-tip "
           f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
           f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um; wrote {args.out}")
+    print(datum_text)
     _print_arcs(s["arcs"], args.arc_tolerance_um)
     if s["max_u_after_um"] > 0:
         print(f"standard uncertainty of the remaining error (tables' _std and _s, k = 1): max "

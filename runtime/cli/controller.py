@@ -40,6 +40,9 @@ def register(sub) -> None:
     e.add_argument("--negate", action="store_true",
                    help="isg / etalon: write compensation values (the errors with reversed "
                         "sign) for a controller that expects them")
+    e.add_argument("--force", action="store_true",
+                   help="heidenhain: let the export replace existing .cma / .com files (the "
+                        "user names only the .cma: without --force no file is replaced)")
     e.add_argument("--points", type=int, default=None, metavar="N",
                    help="axis tables: at most N equally spaced points per table (default: "
                         "the finest spacing of the error table, up to the format's limit)")
@@ -125,12 +128,13 @@ def _export_axis_tables(args, model) -> int:
     funcs = ErrorFunctions.from_dir(args.errors, model)
     tables = ctl.build(funcs, args.format, args.points)
     inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
-    outs = Outputs(inputs)
+    outs = Outputs(inputs, force=args.force)
     files = ctl.write(model, tables, args.format, Path(args.out))
-    roles = {}
-    for k, path in enumerate(files):
-        roles[path] = "--out" if k == 0 else f"--out ({Path(path).name})"
-        outs.file(roles[path], path)
+    roles = {path: Outputs.group_role("--out", files, k) for k, path in enumerate(files)}
+    if len(files) > 1:   # Heidenhain .cma + .com: nothing replaced without --force
+        outs.group("--out", files)
+    else:
+        outs.file("--out", args.out)
     outs.file("--json", args.json).plot("--plot", args.plot).check()
     result = left(model, funcs, tables, args.grid, parse_at(args.at))
     s = result.summary()

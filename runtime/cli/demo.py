@@ -498,6 +498,18 @@ def _index(out: Path, results: list) -> None:
     write_text(out / "index.html", html)
 
 
+def _refuse_used_folder(folder: Path, force: bool) -> None:
+    """Before any computing: the demo writes some hundred files whose names are known only
+    once it has run, so a folder that holds any file already is refused without --force
+    (a second run into the same folder would otherwise compute for 20 s and then refuse)."""
+    if force or not folder.is_dir():
+        return
+    held = sorted(p.name for p in folder.iterdir() if not p.name.startswith(".volerr-"))
+    require(not held, f"--out {folder}: the folder holds files already ({held[0]}"
+                      f"{f' and {len(held) - 1} more' if len(held) > 1 else ''}); give "
+                      f"--force to replace the demo's files, or a new or empty folder")
+
+
 def run(args) -> int:
     import os
 
@@ -505,6 +517,7 @@ def run(args) -> int:
 
     final = Path(args.out)
     outs = Outputs(force=args.force).folder("--out", final).check()
+    _refuse_used_folder(final, args.force)
     results = []
     t0 = time.perf_counter()
     here = os.getcwd()

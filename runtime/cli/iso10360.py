@@ -72,7 +72,7 @@ def run(args) -> int:
     inputs = inputs_of(args)
     outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).check()
-    spec = iso10360.parse_spec(args.mpe, "--mpe") if args.mpe else None
+    spec = iso10360.parse_spec(args.mpe, "--mpe") if args.mpe is not None else None
     tu = _test_uncertainty(args)
     ident = identification_from_args(args, {
         "artefact temperature": f"{args.temperature_C:g} \u00b0C (u = {args.temperature_u_K:g} K)",

@@ -152,7 +152,7 @@ def run(args) -> int:
         finite_option(getattr(args, opt), "--" + opt.replace("_", "-"), 0.0, 1e3)
     from .. import conformance
     tolerance = (conformance.parse_tolerances(args.tolerance, ("A", "E", "M", "R", "B"))
-                 if args.tolerance else None)
+                 if args.tolerance is not None else None)
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .plot("--plot", args.plot).file("--html", args.html) \
         .folder("--errors-out", args.errors_out, files=[f"{a}.csv" for a in axes]).check()
@@ -185,7 +185,8 @@ def run(args) -> int:
 
     # all outputs at the end, all or nothing
     with outs:
-        write_text(outs.path("--json"), json_text(report), inputs=inputs)
+        if args.json:   # every output optional: without any, the result is on the console
+            write_text(outs.path("--json"), json_text(report), inputs=inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), png, inputs=inputs)
         if html_text is not None:

@@ -82,10 +82,18 @@ def register(sub) -> None:
     p.add_argument("--noise-um", type=float, default=0.3, help="instrument noise, um (1 sigma)")
     p.add_argument("--magnitude-um", type=float, default=5.0,
                    help="size of the random error functions, um")
+    from . import _simulate_instruments
+
+    _simulate_instruments.add_arguments(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    from . import _simulate_instruments
+
+    if getattr(args, "instrument", "deviations") != "deviations":
+        return _simulate_instruments.run(args)
+    _simulate_instruments.refuse_unused(args)
     from ..machine.model import load
     from ..loop.simulate import demo_probes, simulate
 

@@ -138,7 +138,8 @@ def _check_options(args) -> None:
     require(args.seed >= 0, "--seed must be a non-negative integer")
     require(args.chunks >= 1, "--chunks must be >= 1")
     require(args.workers >= 1, "--workers must be >= 1")
-    require(args.contributions >= 0, "--contributions must be >= 0")
+    require(0 <= args.contributions <= 10 ** 6, "--contributions must be between 0 and 1e6")
+    require(args.max_samples <= 10 ** 9, "--max-samples must be at most 1e9")
     _temperature(args)  # validates the temperature options
 
 

@@ -273,9 +273,43 @@ class ErrorModel:
         return self.model.nominal_position(self.prepared(q), self.tool)
 
     def position_error(self, q, subset=None, direction=None) -> np.ndarray:
-        """Exact error of the tool tip, (N, 3) mm (``direction``: see :meth:`errors`)."""
-        return self.model.exact_error(self.prepared(q), self.errors(q, subset, direction),
-                                      probe=self.tool)
+        """Exact error of the tool tip, (N, 3) mm (``direction``: see :meth:`errors`); with a
+        work datum (:meth:`relative_to`) minus the error at the datum."""
+        e = self.model.exact_error(self.prepared(q), self.errors(q, subset, direction),
+                                   probe=self.tool)
+        if self.datum is not None:
+            e = e - self.datum_error(subset)
+        return e
+
+    # -- the work datum -------------------------------------------------------------------
+    #: axis positions (1, n_axes) where the work offset was set by probing the part zero, or
+    #: None (errors relative to the machine's reference, the tables' own zero)
+    datum = None
+
+    def relative_to(self, datum) -> "ErrorModel":
+        """The same model with errors relative to the work datum ``datum`` (n_axes,) mm / deg:
+        the work offset, set by probing the part zero there, has absorbed the tool-tip error
+        at the datum (a translation of the workpiece frame), so only ``e(q) - e(datum)`` is
+        left to compensate.  The datum's error is evaluated with the model's tool offset
+        (the part zero touched with the tool point) and without reversal (the approach of
+        the probing is not known); the tool axis error is not changed by a work offset."""
+        other = self.with_tool(self.tool)
+        other.datum = np.asarray(datum, dtype=float).reshape(1, -1)
+        other._datum_errors = {}
+        return other
+
+    def datum_error(self, subset=None) -> np.ndarray:
+        """Tool-tip error at the work datum, (3,) mm, of the parameters ``subset`` (None:
+        all); zeros without a datum."""
+        if self.datum is None:
+            return np.zeros(3)
+        key = (None if subset is None else frozenset(subset), tuple(self.tool))
+        cache = self.__dict__.setdefault("_datum_errors", {})
+        if key not in cache:
+            d = self.datum
+            cache[key] = self.model.exact_error(self.prepared(d), self.errors(d, subset),
+                                                probe=self.tool)[0]
+        return cache[key]
 
     def orientation_error(self, q, subset=None, direction=None) -> np.ndarray:
         """First-order error of the tool axis, (N, 3) rad."""

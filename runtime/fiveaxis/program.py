@@ -65,6 +65,9 @@ class Options:
     tool_table: dict | None = None
     #: "auto", "iso" or "heidenhain" (:mod:`volerr.nc.dialect`)
     dialect: str = "auto"
+    #: the work datum: axis positions (layout order) where the work offset was set, or None
+    #: (:meth:`volerr.fiveaxis.compensate.ErrorModel.relative_to`)
+    datum: tuple | None = None
 
     def validated(self, model) -> "Options":
         require(self.strategy in STRATEGIES,
@@ -98,7 +101,7 @@ class Options:
                        float(self.arc_tol_um),
                        None if self.tool_length is None else float(self.tool_length),
                        None if self.tool_table is None else dict(self.tool_table),
-                       self.dialect)
+                       self.dialect, None if self.datum is None else tuple(self.datum))
 
 
 # ---------------------------------------------------------------------------------------
@@ -538,6 +541,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     pre = prescan(open_source, model.rotary_axes, chunk_lines, opts.dialect)
     never = tuple(a for a in pre.absent_rotary if a not in opts.initial)
     em = ErrorModel(model, funcs, opts.tool, parameters_for_types(model, opts.types))
+    if opts.datum is not None:
+        em = em.relative_to(opts.datum)
     rule = tcpm.length_rule(opts.tool_length, opts.tool_table)
     while True:
         initial = {**opts.initial, **{a: 0.0 for a in never}}
@@ -715,13 +720,22 @@ class FileSink:
         for f in self.files:
             f.truncate()
         if self.report:
-            self.report.write(report_header(self.model).encode("utf-8"))
+            head = report_header(self.model)
+            if self.constant_columns:
+                head = head[:-1] + "," + ",".join(self.constant_columns) + "\n"
+            self.report.write(head.encode("utf-8"))
         self.errors = []
+
+    #: report columns of one value for every block, name -> text (the work datum's error)
+    constant_columns: dict = {}
 
     def add(self, chunk: Chunk) -> None:
         self.out.write(chunk.text.encode("latin-1"))
         if self.report:
-            self.report.write(report_rows(self.model, chunk).encode("utf-8"))
+            rows = report_rows(self.model, chunk)
+            if self.constant_columns:
+                rows = rows.replace("\n", "," + ",".join(self.constant_columns.values()) + "\n")
+            self.report.write(rows.encode("utf-8"))
         if self.keep_errors and len(chunk.blocks.q_nom):
             b, p = chunk.blocks, chunk.prediction
             self.errors.append((

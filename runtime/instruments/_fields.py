@@ -17,6 +17,8 @@ AXIS_NAMES = "XYZUVWABC"
 def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
     """Numeric columns holding NaN or infinity become text columns with a message naming the
     first bad row (an error if the column is needed, else left out with a warning)."""
+    from ..fileio import MAX_ABS
+
     cols, text = dict(cols), dict(text or {})
     for h in list(cols):
         v = np.asarray(cols[h], dtype=float)
@@ -24,7 +26,53 @@ def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
             k = int(np.flatnonzero(~np.isfinite(v))[0])
             text[h] = f"{where}: column {h} row {k + 2} is NaN or infinite"
             del cols[h]
+        elif np.any(np.abs(v) > MAX_ABS):   # squares would overflow: never a reading
+            k = int(np.flatnonzero(np.abs(v) > MAX_ABS)[0])
+            text[h] = (f"{where}: column {h} row {k + 2} = {v[k]:g} is implausibly large "
+                       f"(more than {MAX_ABS:g} in the file's unit)")
+            del cols[h]
     return cols, text
+
+
+def refuse_duplicate_rows(columns, where: str) -> None:
+    """Refuse a file in which a row repeats an earlier one in every cell (a file or a block
+    pasted twice: real readings never agree to the last digit in every column, and a copied
+    reading would count twice in the fit).  ``columns``: a
+    :class:`volerr.instruments._csv.Columns` (numbers and label columns)."""
+    cells = [np.asarray(v, dtype=float) for v in columns.numbers.values()]
+    for v in columns.labels.values():       # labels as codes in order of appearance
+        codes: dict = {}
+        cells.append(np.array([codes.setdefault(str(x), len(codes)) for x in v], dtype=float))
+    if not cells or len(cells[0]) < 2:
+        return
+    rows = np.ascontiguousarray(np.column_stack(cells).astype(float) + 0.0)   # -0.0 == 0.0
+    # a 64-bit hash of every row's bits (sorting 1-D keys: 100 000 rows in milliseconds),
+    # then the rows of equal hash compared cell by cell
+    bits = rows.view(np.uint64)
+    mult = np.random.default_rng(0).integers(1, 2 ** 63, bits.shape[1], dtype=np.uint64) | 1
+    with np.errstate(over="ignore"):
+        key = (bits * mult).sum(axis=1)
+    order = np.argsort(key, kind="stable")
+    same = np.flatnonzero(key[order][1:] == key[order][:-1])
+    for k in same:
+        i, j = sorted((int(order[k]), int(order[k + 1])))
+        require(not np.array_equal(rows[i], rows[j]),
+                f"{where}: row {j + 2} repeats row {i + 2} in every column (a file or a block "
+                f"pasted twice?)")
+
+
+def check_groups(labels, what: str, where: str, minimum: int, why: str) -> None:
+    """Refuse an empty label and a group (placement, station) of fewer than ``minimum`` rows
+    (a label mistyped on one row makes a group of its own that carries nothing)."""
+    names = np.asarray(labels).astype(str)
+    blank = np.flatnonzero(np.char.strip(names) == "")
+    require(len(blank) == 0, f"{where}: row {blank[0] + 2 if len(blank) else 0}: empty "
+                             f"{what} label")
+    found, counts = np.unique(names, return_counts=True)
+    few = [(g, int(c)) for g, c in zip(found, counts) if c < minimum]
+    require(not few, f"{where}: {what} {few[0][0] if few else ''!r} has "
+                     f"{few[0][1] if few else 0} row{'s' if few and few[0][1] > 1 else ''}; a "
+                     f"{what} needs at least {minimum} ({why}; a mistyped label?)")
 
 
 def text_columns(text: dict, needed, where: str, labels=()) -> list:

@@ -114,6 +114,9 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(placement.astype(str), return_inverse=True)
     gidx = gidx.ravel()
+    f.check_groups(placement, "placement", where, 3, "its pose is unknown")
+    f.check_groups(ball, "ball", where, 1, "")
+    refuse_repeats(where, names[gidx], ball.astype(str), point, measured)
     pos = _hold_still_axes(pos, gidx, lin_axes)
     R0 = np.zeros((n, 3, 3))
     origin = np.zeros((n, 3))
@@ -189,6 +192,36 @@ def _calibration_uncertainty(find, n, where) -> np.ndarray | None:
     v = find.cols[h]
     require(np.all(v >= 0), f"{where}: u_std_um must not be negative")
     return v * 1e-3
+
+
+#: calibrated coordinates of one ball closer than this are the same, mm
+SAME_POINT_MM = 1e-6
+
+
+def refuse_repeats(where, placement, ball, point, measured) -> None:
+    """Data that cannot be right (one line): a row given twice (every cell equal: a file
+    pasted twice), a ball given twice in one placement with different calibrated coordinates
+    (two balls with one label), a placement that repeats another one's measured points row
+    for row (a placement copied under a new label).  A ball probed twice in one placement
+    with the same calibrated coordinates (a repeated probing) is accepted."""
+    seen: dict = {}
+    calibrated: dict = {}
+    for i, key in enumerate(zip(placement, ball, map(tuple, point), map(tuple, measured))):
+        j = seen.setdefault(key, i)
+        require(j == i, f"{where}: rows {j + 2} and {i + 2} are the same (placement "
+                        f"{key[0]}, ball {key[1]}, same coordinates): a row given twice")
+        first = calibrated.setdefault(key[:2], (i, point[i]))
+        require(np.max(np.abs(first[1] - point[i])) <= SAME_POINT_MM,
+                f"{where}: placement {key[0]}: ball {key[1]} has different calibrated "
+                f"coordinates in rows {first[0] + 2} and {i + 2} (two balls with one label?)")
+    groups: dict = {}
+    for name in dict.fromkeys(placement.tolist()):
+        m = placement == name
+        key = (tuple(ball[m]), measured[m].round(9).tobytes())
+        require(key not in groups, f"{where}: placement {name} repeats placement "
+                                   f"{groups.get(key)} row for row (the same balls measured at "
+                                   f"the same points): a placement copied under a new label")
+        groups[key] = name
 
 
 def _ordered(keys) -> tuple:

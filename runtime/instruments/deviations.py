@@ -21,6 +21,7 @@ KIND = "deviations"
 def read_deviations(path, model: Model) -> Observations:
     """Read a measured-deviation CSV and check it against ``model`` (InputError on defects)."""
     c = read_columns(path)
+    f.refuse_duplicate_rows(c, c.name)
     obs = columns_to_data(c.numbers, model, c.name, c.text)
     obs.files = (FileInfo(c.name, KIND, "um", 3),)
     return obs

@@ -38,6 +38,10 @@ SETUP_KEYS = tuple(generated.SETUP[KIND])
 FIT_TOLERANCE_MM = 0.5
 
 
+#: the fewest stations a distances file may hold: three distances fix a point (trilateration)
+MIN_STATIONS = 3
+
+
 def detect(names) -> bool:
     """A distances file has a station column or a distance reading."""
     low = {n.lower() for n in names}
@@ -47,6 +51,7 @@ def detect(names) -> bool:
 def read(path, model: Model) -> Observations:
     """Read a distances CSV into :class:`Observations` (InputError, one line, on a defect)."""
     c = read_columns(path)
+    f.refuse_duplicate_rows(c, c.name)
     return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
 
 
@@ -76,6 +81,11 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(station.astype(str), return_inverse=True)
     gidx = gidx.ravel()
+    require(len(names) >= MIN_STATIONS,
+            f"{where}: {len(names)} station{'s' if len(names) > 1 else ''} "
+            f"({', '.join(names)}); multilateration needs at least {MIN_STATIONS}: the "
+            f"distances from fewer stations do not fix the tool point in space (each station's "
+            f"position and dead path are unknowns too)")
     s0 = np.zeros((n, 3))
     dead0 = np.zeros(n)
     for g, name in enumerate(names):

@@ -48,6 +48,7 @@ def detect(names) -> bool:
 def read(path, model: Model) -> Observations:
     """Read a sphere / R-test CSV into :class:`Observations` (InputError, one line)."""
     c = read_columns(path)
+    f.refuse_duplicate_rows(c, c.name)
     return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
 
 
@@ -71,6 +72,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     placement = f.labels(find, "placement", raw, n)
     require(placement is not None, f"{where}: no placement column: give each reading the "
                                    f"label of its sphere placement (column placement)")
+    f.check_groups(placement, "placement", where, 2, "its sphere's true centre is unknown")
     frame = _frames(find, raw, n, where)
     # a tool measured on a presetter or a tool setter: its length error known to within it
     tool_u = f.known_uncertainty(find, "tool_u", where)

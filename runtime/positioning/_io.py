@@ -350,5 +350,31 @@ def read_run(path, axis: str = "X") -> PositioningRun:
     header, body = _rows(path)
     low = [h.lower() for h in header]
     if _find(low, _DIRECTION) is not None:
-        return _read_long(path, axis.upper(), header, body, low)
-    return _read_wide(path, axis.upper(), header, body, low)
+        run = _read_long(path, axis.upper(), header, body, low)
+    else:
+        run = _read_wide(path, axis.upper(), header, body, low)
+    check_plausible_deviations(run)
+    return run
+
+
+#: the largest positional deviation accepted, mm: ISO 230-2 deviations of a machine axis are
+#: micrometres to tens of micrometres; 1 mm or more is a unit error (um under a _mm header)
+MAX_DEVIATION_MM = 1.0
+
+
+def check_plausible_deviations(run: PositioningRun) -> None:
+    """Refuse deviations a positioning run cannot hold: |x_ij| of :data:`MAX_DEVIATION_MM` or
+    more, or more than half the smallest target spacing (the machine would then stand nearer
+    the next target than its own).  Such values are micrometres read under a ``_mm`` header
+    (9.4 um read as 9.4 mm) or a target column in the wrong unit (one line)."""
+    worst = float(np.max(np.abs(run.deviation)))
+    spacing = float(np.min(np.diff(run.targets)))
+    limit = min(MAX_DEVIATION_MM, 0.5 * spacing)
+    if worst >= limit:
+        i = np.unravel_index(int(np.argmax(np.abs(run.deviation))), run.deviation.shape)
+        why = (f"{MAX_DEVIATION_MM:g} mm or more" if limit == MAX_DEVIATION_MM else
+               f"more than half the smallest target spacing ({spacing:g} mm)")
+        raise InputError(
+            f"{run.source}: deviation {1e3 * worst:g} um at target {run.targets[i[0]]:g} mm "
+            f"is {why}: not a positioning deviation (values in um under a _mm header? the "
+            f"target column in the wrong unit?)")

@@ -161,8 +161,14 @@ def _axis(text: str, axes, where: str) -> str:
         require(1 <= k <= len(axes), f"{where}: machine axis AX{k} (the layout has "
                                      f"{len(axes)} axes)")
         return axes[k - 1]
-    m = re.fullmatch(r"([XYZABC])\d*", t)
-    require(m is not None and m.group(1) in axes, f"{where}: unknown axis {text.strip()!r}")
+    # the layout's letter alone or with the index 1 (X, X1: the names volerr writes and the
+    # default machine axis names of MD10000 $MN_AXCONF_MACHAX_NAME_TAB); any other index
+    # (X2, X9) is another machine axis, never read as X
+    m = re.fullmatch(r"([XYZABC])(1?)", t)
+    require(m is not None and m.group(1) in axes,
+            f"{where}: unknown axis {text.strip()!r} (read: the layout's axes "
+            f"{' '.join(axes)} as {axes[0]} or {axes[0]}1, or AX1..AX{len(axes)} in their "
+            f"order; rename the machine's axes)")
     return m.group(1)
 
 
