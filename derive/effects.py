@@ -43,7 +43,17 @@ _SYMPY_FUNCTIONS = {
     "sin": sp.sin, "cos": sp.cos, "exp": sp.exp, "sqrt": sp.sqrt, "abs": sp.Abs, "pi": sp.pi,
     "ind": lambda a, b: sp.Piecewise((1, sp.Eq(a, b)), (0, True)),
     "legendre": lambda n, x: sp.expand(sp.legendre(int(n), x)),
+    "lag": lambda u, tau, t=None: _lag_symbol(u, tau, t),
 }
+
+
+def _lag_symbol(u, tau, t=None) -> sp.Symbol:
+    """A lag ``lag(C, tau_s[, time])`` as a plain real symbol (computed by the generated
+    module from the series: :mod:`volerr.derive.lags`)."""
+    from volerr.machine.lags import lag_symbol
+
+    return sp.Symbol(lag_symbol(str(u), float(tau), str(t) if t is not None else "t_s"),
+                     real=True)
 
 
 def basis_expr(text: str) -> sp.Expr:

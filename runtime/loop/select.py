@@ -23,7 +23,7 @@ import numpy as np
 from . import candidates as cands
 from ..estimate.blocks import BlockBase, blocks, cv_sq
 from ..estimate.design import TWIST, rows_of
-from ..machine.expressions import evaluate
+from ..machine.expressions import evaluate, lag_calls
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
 CV_T = 3.0           # minimum paired t of the held-out improvement
@@ -31,6 +31,7 @@ MAX_EFFECTS = 8
 TOP_FIT = 3          # candidates fitted fully per forward step
 SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
 N_SOURCES = 10       # residual sources reported
+LAG_CACHE = 48       # lagged series (all points) kept while screening
 
 
 def _pinv_sym(G, tol=1e-12):
@@ -103,7 +104,35 @@ class Context:
     def on(self, pts, sw) -> "Context":
         """The same context on other points (shares nothing that depends on the points)."""
         return Context(self.model, self.data, self.sens, self.twist, pts, sw, self.ranges,
-                       {"fixed": self.cache.setdefault("fixed", {})}, self.sym)
+                       {"fixed": self.cache.setdefault("fixed", {}),
+                        "lags": self.cache.setdefault("lags", {})}, self.sym)
+
+    def basis_values(self, basis: str, full: bool = False) -> dict:
+        """:meth:`values`, plus the lags of ``basis`` (:mod:`volerr.machine.lags`) filtered over
+        all points of the data (file by file) and taken at the context's points: a lag is a
+        property of the whole time series, not of the points a fit looks at."""
+        vals = self.values(full)
+        calls = lag_calls(basis) if "lag(" in basis else ()
+        if not calls:
+            return vals
+        vals = dict(vals)
+        for key, col, tau, time in calls:
+            series = self.lag_series(key, col, tau, time)
+            vals[key] = series if full else series[self.pts]
+        return vals
+
+    def lag_series(self, key, col, tau, time) -> np.ndarray:
+        """The lag ``key`` of column ``col`` at all points (the last ``LAG_CACHE`` kept)."""
+        from ..machine.lags import lag_of_columns
+
+        store = self.cache.setdefault("lags", {})
+        if key in store:
+            store[key] = store.pop(key)           # most recently used last
+            return store[key]
+        while len(store) >= LAG_CACHE:
+            store.pop(next(iter(store)))
+        store[key] = lag_of_columns(self.data.covariates, col, tau, time, self.data.file)
+        return store[key]
 
     def values(self, full: bool = False):
         """Basis variables at the context's points (all when ``full``): axis positions
@@ -167,11 +196,10 @@ class Context:
             for s, idx in blocks(np.arange(self.data.n)):
                 out[s] = self.columns_at(terms, idx)
             return out, params
-        vals = self.values(full)
         n = self.data.n if full else len(self.pts)
         out = np.zeros((n, 3, len(params)))
         for pn, target, basis in terms:
-            b = np.broadcast_to(evaluate(basis, vals), (n,))
+            b = np.broadcast_to(evaluate(basis, self.basis_values(basis, full)), (n,))
             out[:, :, params.index(pn)] += self.target_column(target, full) * b[:, None]
         if not full and len(self.pts) * len(params) <= 20000 * 3:
             self.cache[key] = (out, params)
@@ -180,11 +208,14 @@ class Context:
     def columns_at(self, terms, idx) -> np.ndarray:
         """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
         params = list(dict.fromkeys(t[0] for t in terms))
-        vals = {k: v[idx] for k, v in self.values(True).items()}
         arrays = self.sensitivities(idx)
         out = np.zeros((len(idx), 3, len(params)))
+        vals = {k: v[idx] for k, v in self.values(True).items()}
         for pn, target, basis in terms:
-            b = np.broadcast_to(evaluate(basis, vals), (len(idx),))
+            lagged = {k: self.lag_series(k, *rest)[idx] for k, *rest in lag_calls(basis)} \
+                if "lag(" in basis else {}
+            b = np.broadcast_to(evaluate(basis, {**vals, **lagged} if lagged else vals),
+                                (len(idx),))
             out[:, :, params.index(pn)] += self._column(target, *arrays) * b[:, None]
         return out
 
@@ -205,8 +236,8 @@ class Context:
             n = len(self.pts)
             cols = np.zeros((n, 3, len(values)))
             for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
-                basis = np.column_stack([np.broadcast_to(evaluate(m[i][2], self.values()), (n,))
-                                         for m in made])
+                basis = np.column_stack([np.broadcast_to(
+                    evaluate(m[i][2], self.basis_values(m[i][2])), (n,)) for m in made])
                 cols += self.target_column(target)[:, :, None] * basis[:, None, :]
             self.cache[key] = (cols * self.sw[:, None, None]).reshape(-1, len(values))
         return self.cache[key]
