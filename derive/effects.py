@@ -66,12 +66,33 @@ def basis_expr(text: str) -> sp.Expr:
 
 
 def additions(layout: Layout) -> dict:
-    """target -> sympy expression added to it (sum of parameter * basis of all terms)."""
+    """target -> sympy expression added to it (sum of parameter * basis of all terms); a term
+    on a parameter of another effect (nested effects) is folded into that effect's terms."""
     out: dict = {}
     for e in layout.effects:
         for t in e.terms:
             term = sp.Symbol(t.parameter, real=True) * basis_expr(t.basis)
             out[t.target] = out.get(t.target, 0) + term
+    return _fold_nested(out, {p for e in layout.effects for p in e.parameters})
+
+
+def _fold_nested(add: dict, effect_parameters: set) -> dict:
+    """``add`` with every effect parameter ``K`` that is itself a target replaced by
+    ``K + (its additions)`` wherever it appears (effects refer to earlier ones only: the
+    substitution ends)."""
+    inner = {t: add.pop(t) for t in list(add) if t in effect_parameters}
+    if not inner:
+        return add
+    keep = {t: sp.Dummy(t, real=True) for t in inner}
+    subs = {sp.Symbol(t, real=True): keep[t] + v for t, v in inner.items()}
+    out = {}
+    for target, expr in add.items():
+        for _ in range(len(subs) + 1):
+            new = sp.sympify(expr).xreplace(subs)
+            if new == expr:
+                break
+            expr = new
+        out[target] = expr.xreplace({d: sp.Symbol(t, real=True) for t, d in keep.items()})
     return out
 
 

@@ -267,10 +267,12 @@ class Augmented:
         return self._source
 
 
-def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augmented:
+def augment_step(model, dat, decl: Declared, selection, degree, ranges,
+                 source=None) -> Augmented:
+    """``source``: the layout as the user named it (a file path or a shipped name)."""
     if not selection.accepted:
         return Augmented("", None, model, decl.design, decl.labels)
-    text = augmented_layout_text(model, selection.accepted)
+    text = augmented_layout_text(model, selection.accepted, source)
     lay = parse_layout(text, f"{model.name}_aug.toml")
     aug = Model(lay, derivation.module_from_source(derivation.fit_source(lay), lay.name))
     labels = declared_design(aug, dat.subset(np.arange(1)), degree, ranges).labels
@@ -554,7 +556,8 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     _explain(decl.unidentifiable, dat, model)
     bar.update()
     bar.set_postfix_str("augment, derive, generate")
-    aug = augment_step(model, dat, decl, selection, degree, ranges)
+    aug = augment_step(model, dat, decl, selection, degree, ranges,
+                       layout if isinstance(layout, (str, Path)) else None)
     bar.update()
     bar.set_postfix_str("held-out before/after")
     out = outcome_step(decl, aug, spl, robust, y, effect_columns(selection, aug))
@@ -743,10 +746,14 @@ def _toml_value(v) -> str:
     return json.dumps(str(v))
 
 
-def augmented_layout_text(model: Model, selected) -> str:
-    """The layout text with one ``[effects.NAME]`` table per selected effect (name + _aug)."""
-    text, _ = layout_text(model.layout.path if model.layout.path and
-                          Path(model.layout.path).is_file() else model.name)
+def augmented_layout_text(model: Model, selected, source=None) -> str:
+    """The layout text with one ``[effects.NAME]`` table per selected effect (name + _aug).
+    ``source``: the layout file (or shipped name) ``model`` was read from; else the layout's
+    own path (when it is a file there) or its name."""
+    if source is None:
+        source = (model.layout.path if model.layout.path and Path(model.layout.path).is_file()
+                  else model.name)
+    text, _ = layout_text(source)
     new_name = f"{model.name}_aug"
     text, k = re.subn(r'(?m)^name\s*=\s*"[^"]*"', f'name = "{new_name}"', text, count=1)
     require(k == 1, f"layout {model.name}: no top-level name line to rename")
