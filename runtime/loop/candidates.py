@@ -128,6 +128,15 @@ class Candidate:
                          self.units)
 
 
+def extra_parameters(cand) -> int:
+    """Parameters a candidate costs in the BIC beyond its columns: a searched basis parameter
+    (a time constant, a period, a step location) and the second sensor of a difference of
+    two temperatures (the choice among the pairs): a single sensor is preferred over a
+    combination of sensors that explains the data equally well."""
+    kind_two = cand.kind == "thermal" and " - " in str(cand.info.get("covariate", ""))
+    return (1 if cand.search is not None else 0) + (1 if kind_two else 0)
+
+
 def _f(x: float) -> str:
     """A number for a basis expression, short and exact enough."""
     return repr(round(float(x), 9))
@@ -382,10 +391,12 @@ def _lagged(model, target: Target, cov: Covariate, special, gauge) -> list:
     sensor's column name as ``covariate``)."""
     out = []
     for c in _linear(model, target, cov, special, gauge):
-        def make(tau, terms=tuple(c.terms)):
-            text = _f(round(float(tau), 1))
-            return ([(p, t, b.replace("TAU", text)) for p, t, b in terms],
-                    {"lag_s": round(float(tau), 1)})
+        def make(tau, terms=tuple(c.terms), basis=c.info["basis"]):
+            from ..machine.lags import lag_key
+
+            tau = round(float(tau), 1)
+            return ([(p, t, b.replace("TAU", _f(tau))) for p, t, b in terms],
+                    {"lag_s": tau, "basis": f"{basis}, {lag_key(cov.columns[0], tau, cov.columns[1])}"})
 
         grid = cov.levels
         terms, extra = make(grid[len(grid) // 2])

@@ -394,7 +394,7 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
             a_s, a_c = (pars[t[0]] for t in c.terms)
             info["amplitude_um"] = round(math.hypot(a_s, a_c), 4)
             info["phase_rad"] = round(math.atan2(a_c, a_s), 4)   # a sin(2 pi q / P + phase)
-        ev = dict(s.evidence)
+        ev = {k: v for k, v in s.evidence.items() if k != "alternatives"}
         ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
         ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)
         effects.append({"kind": c.kind, "name": c.name, "parameters": pars, "units": units,
@@ -403,8 +403,41 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
                         "covariate": info.get("covariate"), "basis": info.get("basis"),
                         "target": sorted({t[1] for t in c.terms}), "info": info,
                         "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}
-                                  for t in c.terms], "evidence": ev})
+                                  for t in c.terms], "evidence": ev,
+                        **_lag_entry(info), "alternatives": [], "separate_by": None})
     return effects
+
+
+def _lag_entry(info: dict) -> dict:
+    """``lag_s`` of an effect through a lag (:mod:`volerr.loop.lags`), else nothing."""
+    if info.get("lag_s") is None:
+        return {}
+    return {"lag_s": {"value": info["lag_s"], "std": info.get("lag_std_s")}}
+
+
+def alternatives_step(effects: list, selection, decl: Declared, spl: Split, robust: Robust,
+                      y) -> None:
+    """Each effect's ``alternatives`` (explanations the campaign cannot tell from it,
+    :func:`volerr.loop.lags.alternatives`: covariate, lag, basis, held-out RMS of the model
+    with it in the effect's place) and ``separate_by`` (what campaign would separate them)."""
+    from .lags import separate_by
+
+    sw = np.sqrt(robust.weights)
+    for e, s in zip(effects, selection.accepted):
+        alts = s.evidence.get("alternatives") or []
+        for x in alts:
+            cols = [x["cols"] if o is s else o.cols for o in selection.accepted]
+            design = decl.design.plus(cols)
+            c_tr, c_all, _, _ = _fits(design, spl, sw, y)
+            _, r_test, _ = _residuals(design, len(sw), spl.test, y, c_tr, c_all)
+            info = x["cand"].info
+            e["alternatives"].append({
+                "covariate": info.get("covariate"), "lag_s": info.get("lag_s"),
+                "basis": info.get("basis"), "parameter": info.get("parameter"),
+                "name": x["cand"].name, "held_out_rms_um": round(1e3 * rms(r_test), 4),
+                "delta_bic": x["delta_bic"], "cv_paired_t": x["cv_paired_t"]})
+        if alts:
+            e["separate_by"] = separate_by(s.cand.info, alts[0]["cand"].info)
 
 
 def _replicate_sigma(dat: Data, res_rows, weights) -> tuple[float, int] | None:
@@ -562,6 +595,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     bar.set_postfix_str("held-out before/after")
     out = outcome_step(decl, aug, spl, robust, y, effect_columns(selection, aug))
     effects = effects_step(selection, aug, out, dat.n)
+    alternatives_step(effects, selection, decl, spl, robust, y)
     bar.update()
     paths = _write_augmented(out_dir, aug, selection, inputs, data)
     bar.update()

@@ -309,7 +309,7 @@ def _periodic_best(c, ctx: Context, base: Base) -> float:
 def _scored(c, ctx: Context, base: Base) -> "Scored":
     cols, params = ctx.columns(c.terms)
     gain, rank = base.score(ctx.rows(cols))
-    m_eff = rank + (1 if c.search is not None else 0)
+    m_eff = rank + cands.extra_parameters(c)
     return Scored(base.dbic(gain, m_eff), gain, rank, c, params)
 
 
@@ -318,7 +318,7 @@ def _scored_many(cs, ctx: Context, base) -> list:
     if not isinstance(base, BlockBase):
         return [_scored(c, ctx, base) for c in cs]
     res = base.score_many([ctx.group(c.terms) for c in cs])
-    return [Scored(base.dbic(g, r + (1 if c.search is not None else 0)), g, r, c,
+    return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
                    c.parameters) for c, (g, r) in zip(cs, res)]
 
 
@@ -483,6 +483,8 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     if accepted:
         accepted = _backward(A0, accepted, train, w_rows, y)
         accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, train, w_rows, y)
+        from . import lags
+        lags.refine(accepted, A0, ctx, train, w_rows, y)
         A_all = _stack(A0, accepted)
         base = full(A_all)
         names = {a.cand.name for a in accepted}
@@ -491,6 +493,10 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
                            ctx, base, candidates, 2 * N_SOURCES)
         else:
             last = screen(candidates, ctx, base, names)
+    if accepted:
+        from . import lags
+        lags.alternatives(accepted, (first or [])[:2 * N_SOURCES] + last[:2 * N_SOURCES], A0,
+                          ctx, train, w_rows, y, folds)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
 
@@ -509,7 +515,7 @@ def _backward(A0, selected, train, w_rows, y) -> list:
     def dbic_without(sel, i):
         base = _full_base(_stack(A0, sel[:i] + sel[i + 1:]), train, w_rows, y)
         gain, rank = base.score(_dense_group(sel[i].cols))
-        return base.dbic(gain, rank + (1 if sel[i].cand.search is not None else 0))
+        return base.dbic(gain, rank + cands.extra_parameters(sel[i].cand))
 
     sel = list(selected)
     while sel:
@@ -544,9 +550,9 @@ def _merge(A0, accepted, pool, ctx: Context, train, w_rows, y) -> list:
                 scores = base.score_many([_dense_group(pair)] +
                                          [ctx.group(x.cand.terms) for x in xs])
                 g_ij, r_ij = scores[0]
-                m_ij = r_ij + sum(1 for s_ in (sel[i], sel[j]) if s_.cand.search is not None)
+                m_ij = r_ij + sum(cands.extra_parameters(s_.cand) for s_ in (sel[i], sel[j]))
                 for x, (g_c, r_c) in zip(xs, scores[1:]):
-                    m_c = r_c + (1 if x.cand.search is not None else 0)
+                    m_c = r_c + cands.extra_parameters(x.cand)
                     d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
                     if r_c and d < best[0]:
                         best = (d, (i, j, x))

@@ -1,0 +1,132 @@
+"""Effects through a lag after selection: the time constant refined with its standard
+uncertainty, and the explanations the campaign cannot tell apart (step 5 of
+:func:`volerr.loop.run.run_loop`; the candidates: :func:`volerr.loop.candidates.lagged_covariates`).
+
+Time constant: screening profiles ``tau`` on a geometric grid and refines it between the grid
+neighbours (:func:`volerr.loop.select._profile`).  Here the accepted effect's ``tau`` is
+profiled again on all training points, given the other accepted effects: the weighted RSS at
+13 values ``tau exp(+-0.3)`` (one pass over the rows), a parabola in ``x = ln tau`` through the
+best seven; its vertex is the estimate and its curvature gives the standard uncertainty
+``u(x) = sqrt(2 s^2 / RSS''(x))``, ``u(tau) = tau u(x)``, with ``s^2 = RSS / (n - p)``
+(the profile-likelihood curvature: the other parameters re-fitted at every ``tau``).
+
+Sensor selection (the rule ``docs/formats.md`` states): forward selection takes the candidate
+with the best BIC, where a searched time constant costs one parameter and a difference of two
+sensors ``T_a - T_b`` costs one more than a single sensor (the choice of its second sensor);
+two accepted effects are replaced by one candidate whenever it explains the data at least as
+well by BIC (:func:`volerr.loop.select._merge`).  Then, for every accepted effect, each other
+explanation among the leading candidates (another sensor, the same sensor with or without a
+lag, another parameter) that, in place of the accepted effect, is within ``BIC_TIE`` of it
+*and* whose cross-validated per-point squared residuals do not differ from the accepted
+effect's significantly (|paired t| < ``select.CV_T`` over the cross-validation splits) is an
+*alternative*: the campaign cannot tell the two apart.  The effect then lists them
+(``alternatives``) and says what campaign would separate them (``separate_by``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import select as sel
+from .candidates import extra_parameters as _extra
+
+BIC_TIE = 10.0          # BIC difference below which two explanations are not told apart
+PROFILE_STEPS = np.linspace(-0.3, 0.3, 13)
+MAX_ALTERNATIVES = 3
+
+
+def refine(accepted: list, A0, ctx, train, w_rows, y) -> None:
+    """Refine the time constant of every accepted lag effect (in place: candidate, columns,
+    ``lag_s`` and ``lag_std_s`` in its info)."""
+    for i, a in enumerate(accepted):
+        if a.cand.search is None or a.cand.search.what != "lag_s":
+            continue
+        others = accepted[:i] + accepted[i + 1:]
+        base = sel._full_base(sel._stack(A0, others), train, w_rows, y)
+        tau, std = _profile_tau(a.cand, ctx, base, float(a.cand.info["lag_s"]))
+        a.cand = a.cand.fixed(tau)
+        a.cand.info["lag_std_s"] = None if std is None else round(std, 1)
+        a.cols, _ = ctx.columns(a.cand.terms, full=True)
+
+
+def _profile_tau(cand, ctx, base, tau0: float) -> tuple[float, float | None]:
+    """(tau, standard uncertainty or None) from the RSS profile around ``tau0`` (s)."""
+    x0 = math.log(tau0)
+    for _ in range(4):                    # re-centre while the minimum is at an edge
+        xs = x0 + PROFILE_STEPS
+        groups = [ctx.group(cand.fixed(math.exp(x)).terms) for x in xs]
+        scores = base.score_many(groups)
+        rss = np.array([base.rss - g for g, _ in scores])
+        k = int(np.argmin(rss))
+        if 0 < k < len(xs) - 1:
+            break
+        x0 = xs[k]
+    lo, hi = max(k - 3, 0), min(k + 4, len(xs))
+    q, b, _ = np.polyfit(xs[lo:hi] - xs[k], rss[lo:hi], 2)
+    if not q > 0:
+        return math.exp(xs[k]), None
+    x_best = xs[k] + float(np.clip(-b / (2 * q), xs[lo] - xs[k], xs[hi - 1] - xs[k]))
+    rank = scores[k][1]
+    dof = max(base.n - len(base.scale) - rank - 1, 1)
+    s2 = float(rss[k]) / dof
+    std_x = math.sqrt(2 * s2 / (2 * q))
+    tau = math.exp(x_best)
+    return round(tau, 1), tau * std_x
+
+
+def _explanation(cand) -> tuple:
+    info = cand.info
+    return (info.get("parameter"), info.get("covariate"), info.get("lag_s") is not None)
+
+
+def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -> None:
+    """Attach ``alternatives`` (candidates the campaign cannot tell from the accepted effect,
+    by the rule of the module docstring) to each accepted effect's evidence (in place)."""
+    for i, a in enumerate(accepted):
+        others = accepted[:i] + accepted[i + 1:]
+        A_o = sel._stack(A0, others)
+        base = sel._full_base(A_o, train, w_rows, y)
+        mine = _explanation(a.cand)
+        rivals, seen = [], {mine}
+        for x in pool:
+            key = _explanation(x.cand)
+            if key in seen or x.cand.name == a.cand.name:
+                continue
+            seen.add(key)
+            rivals.append(x.cand)
+        scores = base.score_many([sel._dense_group(a.cols)] + [ctx.group(c.terms)
+                                                               for c in rivals])
+        d_a = base.dbic(scores[0][0], scores[0][1] + _extra(a.cand))
+        close = [(base.dbic(g, r + _extra(c)), c) for c, (g, r) in zip(rivals, scores[1:])
+                 if r and base.dbic(g, r + _extra(c)) - d_a < BIC_TIE]
+        close.sort(key=lambda t: t[0])
+        cv_a = sel._cv_sq(A_o.plus([a.cols]), y, folds, train, w_rows)
+        found = []
+        for d_x, c in close[:2 * MAX_ALTERNATIVES]:
+            cols, _ = ctx.columns(c.terms, full=True)
+            d = sel._cv_sq(A_o.plus([cols]), y, folds, train, w_rows) - cv_a
+            t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
+            if abs(t) < sel.CV_T:
+                found.append({"cand": c, "cols": cols, "delta_bic": round(d_x - d_a, 2),
+                              "cv_paired_t": round(t, 2)})
+            if len(found) == MAX_ALTERNATIVES:
+                break
+        a.evidence["alternatives"] = found
+
+
+def separate_by(a_info: dict, b_info: dict) -> str:
+    """One sentence: what campaign would separate two explanations."""
+    ca, cb = a_info.get("covariate"), b_info.get("covariate")
+    pa, pb = a_info.get("parameter"), b_info.get("parameter")
+    if ca != cb:
+        return (f"a campaign in which {ca} and {cb} do not move together: another duty cycle "
+                f"(drives switched on and off at other times, the coolant pump on its own "
+                f"schedule) or one heat source switched alone")
+    if pa != pb:
+        return (f"measurements at other positions and probe offsets, where {pa} and {pb} act "
+                f"differently")
+    tau = a_info.get("lag_s") or b_info.get("lag_s")
+    return (f"a campaign in which {ca} changes faster than the lag of {tau / 60:.0f} min "
+            f"(shorter on/off periods of its heat source)")
