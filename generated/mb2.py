@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9f5664e7e76c63758343031e2e71c38e0cb7e6231fb10646e63c6605339e98de
-derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
+derivation sha256  ff1e0efcbf6dac56e4efdbb550f064529e1cc595ce9e418924cb556f30cab67f
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       3a3a534a68c538a1437d4e5e1ddd5db71b1af141d519570f0656ef89cb7a4597
-derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
+derivation sha256  ff1e0efcbf6dac56e4efdbb550f064529e1cc595ce9e418924cb556f30cab67f
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

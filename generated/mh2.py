@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       14c00cbdd4320c30c61d6c8934b7e649bc3fee4d78e7c7cc3d4d29e6aee0c398
-derivation sha256  822c004bb60c899c6526ff6718e5620f2a2ccb0578a957a343230fb9e0a922b3
+derivation sha256  ff1e0efcbf6dac56e4efdbb550f064529e1cc595ce9e418924cb556f30cab67f
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
-derivation sha256  9583b6a36bf2bf20d65ea43860969fe80b643dd264b160d8239864e6187b35db
+derivation sha256  1fd6c1f4eb3c34fc06b2db675c4ab8252554fb1559be4214f0d4b5f5156da92f
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,

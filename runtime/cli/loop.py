@@ -47,6 +47,23 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def loop_lines(e: dict) -> list:
+    """Console lines of an effect's lag and of the explanations the data cannot tell from it."""
+    out = []
+    lag = e.get("lag_s")
+    if lag:
+        std = f" +- {lag['std']:.0f}" if lag.get("std") is not None else ""
+        out.append(f"through a first-order lag of {e['covariate']}: tau = {lag['value']:.0f}"
+                   f"{std} s ({lag['value'] / 60:.1f} min)")
+    for a in e.get("alternatives") or []:
+        lag_a = f" through a lag of {a['lag_s']:.0f} s" if a.get("lag_s") else ""
+        out.append(f"these data cannot tell it from {a['parameter']} x {a['covariate']}"
+                   f"{lag_a} (held-out RMS {a['held_out_rms_um']:.3f} um)")
+    if e.get("separate_by"):
+        out.append(f"would separate them: {e['separate_by']}")
+    return out
+
+
 def run(args) -> int:
     from ..loop import candidates
     from ..loop.run import run_loop
@@ -95,6 +112,8 @@ def run(args) -> int:
     for e in report.effects:
         pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
         print(f"  {e['kind']} {e['name']}: {pars}")
+        for line in loop_lines(e):
+            print(f"    {line}")
     if report["augmented_layout"]:
         print(f"  augmented layout: {report['augmented_layout']}; generated module: "
               f"{report['generated_module']}")
