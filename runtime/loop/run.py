@@ -812,22 +812,28 @@ def demo_campaign(out=None, seed: int = 0, n_points: int = 900, kind: str = "the
     """A simulated MB1 campaign with one undeclared effect and five probe offsets.
 
     ``out``: CSV path to write (a temporary file when None; an int is taken as ``seed``).
-    ``kind``: ``"thermal"`` (the scale of X grows 11.5 um/m/K with T_C - 20) or ``"periodic"``
-    (a 2 um cyclic error of EXX, period 40 mm).  Sized so that the loop on it takes a few
-    seconds.  Returns ``("MB1", csv_path)``."""
+    ``kind``: ``"thermal"`` (the scale of X grows 11.5 um/m/K with T_C - 20), ``"periodic"``
+    (a 2 um cyclic error of EXX, period 40 mm) or ``"thermal_lag"`` (four logged sensors over
+    4 h, drives 2 h on then off; the scale of X grows 2 um/m/K with T_motorX through a 20 min
+    lag).  Sized so that the loop on it takes a few seconds.  Returns ``("MB1", csv_path)``."""
     import tempfile
 
     from .simulate import demo_probes, simulate
 
     if isinstance(out, int) and not isinstance(out, bool):
         seed, out = out, None
-    require(kind in ("thermal", "periodic"), f"demo effect must be thermal or periodic")
+    require(kind in ("thermal", "periodic", "thermal_lag"),
+            "demo effect must be thermal, periodic or thermal_lag")
     model = load("MB1")
     effect = {"thermal": {"kind": "thermal", "axis": "X", "ppm_per_K": 11.5},
               "periodic": {"kind": "periodic", "component": "EXX", "period_mm": 40.0,
-                           "um": 2.0}}[kind]
+                           "um": 2.0},
+              "thermal_lag": {"kind": "thermal_lag", "sensor": "T_motorX", "tau_min": 20.0,
+                              "axis": "X", "ppm_per_K": 2.0}}[kind]
+    logged = {"sensors": "T_spindle,T_motorX,T_coolant,T_air1", "duty": "on:2h,off:2h",
+              "duration_h": 4.0} if kind == "thermal_lag" else {}
     camp = simulate("MB1", n_points=n_points, seed=seed, probes=demo_probes(model),
-                    effects=[effect], noise_um=0.3)
+                    effects=[effect], noise_um=0.3, **logged)
     if out is None:
         out = Path(tempfile.mkdtemp(prefix="volerr_demo_")) / "MB1_campaign.csv"
     return "MB1", str(camp.write_csv(out))
