@@ -388,7 +388,8 @@ def _squareness_as_slopes(model, target: Target) -> list:
 def _lagged(model, target: Target, cov: Covariate, special, gauge) -> list:
     """P x lag(C, tau): the linear candidates of P x C with C through a first-order lag, its
     time constant searched on the covariate's grid (``cov.levels``; ``lag_s`` in the info, the
-    sensor's column name as ``covariate``)."""
+    sensor's column name as ``covariate``; the info's ``basis`` names the lag as
+    ``lag(C, tau_s)`` whatever the time column, the terms over the data's time column)."""
     out = []
     for c in _linear(model, target, cov, special, gauge):
         def make(tau, terms=tuple(c.terms), basis=c.info["basis"]):
@@ -396,7 +397,7 @@ def _lagged(model, target: Target, cov: Covariate, special, gauge) -> list:
 
             tau = round(float(tau), 1)
             return ([(p, t, b.replace("TAU", _f(tau))) for p, t, b in terms],
-                    {"lag_s": tau, "basis": f"{basis}, {lag_key(cov.columns[0], tau, cov.columns[1])}"})
+                    {"lag_s": tau, "basis": f"{basis}, {lag_key(cov.columns[0], tau)}"})
 
         grid = cov.levels
         terms, extra = make(grid[len(grid) // 2])

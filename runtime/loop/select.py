@@ -105,7 +105,8 @@ class Context:
         """The same context on other points (shares nothing that depends on the points)."""
         return Context(self.model, self.data, self.sens, self.twist, pts, sw, self.ranges,
                        {"fixed": self.cache.setdefault("fixed", {}),
-                        "lags": self.cache.setdefault("lags", {})}, self.sym)
+                        "lags": self.cache.setdefault("lags", {}),
+                        "lag_orders": self.cache.setdefault("lag_orders", {})}, self.sym)
 
     def basis_values(self, basis: str, full: bool = False) -> dict:
         """:meth:`values`, plus the lags of ``basis`` (:mod:`volerr.machine.lags`) filtered over
@@ -117,13 +118,20 @@ class Context:
             return vals
         vals = dict(vals)
         for key, col, tau, time in calls:
-            series = self.lag_series(key, col, tau, time)
-            vals[key] = series if full else series[self.pts]
+            vals[key] = self.lag_series(key, col, tau, time) if full else \
+                self.lag_at_points(key, col, tau, time)
         return vals
+
+    def lag_at_points(self, key, col, tau, time) -> np.ndarray:
+        """The lag ``key`` at the context's points (kept: a few thousand values each)."""
+        mine = self.cache.setdefault("_lag_pts", {})
+        if key not in mine:
+            mine[key] = self.lag_series(key, col, tau, time)[self.pts]
+        return mine[key]
 
     def lag_series(self, key, col, tau, time) -> np.ndarray:
         """The lag ``key`` of column ``col`` at all points (the last ``LAG_CACHE`` kept)."""
-        from ..machine.lags import lag_of_columns
+        from ..machine.lags import lag_of_columns, time_order
 
         store = self.cache.setdefault("lags", {})
         if key in store:
@@ -131,7 +139,11 @@ class Context:
             return store[key]
         while len(store) >= LAG_CACHE:
             store.pop(next(iter(store)))
-        store[key] = lag_of_columns(self.data.covariates, col, tau, time, self.data.file)
+        orders = self.cache.setdefault("lag_orders", {})
+        if time not in orders:
+            orders[time] = time_order(self.data.covariates[time], self.data.file)
+        store[key] = lag_of_columns(self.data.covariates, col, tau, time, self.data.file,
+                                    orders[time])
         return store[key]
 
     def values(self, full: bool = False):
@@ -231,7 +243,7 @@ class Context:
         """Weighted rows (3n, G) of a one-parameter searched candidate at ``values`` (its
         terms summed: a proportional warm-up of the probe offset has three)."""
         key = ("profile", c.name, tuple(values))
-        if key not in self.cache:
+        if key not in self.cache or c.search.what == "lag_s":
             made = [c.search.make(v)[0] for v in values]
             n = len(self.pts)
             cols = np.zeros((n, 3, len(values)))
@@ -239,7 +251,10 @@ class Context:
                 basis = np.column_stack([np.broadcast_to(
                     evaluate(m[i][2], self.basis_values(m[i][2])), (n,)) for m in made])
                 cols += self.target_column(target)[:, :, None] * basis[:, None, :]
-            self.cache[key] = (cols * self.sw[:, None, None]).reshape(-1, len(values))
+            rows = (cols * self.sw[:, None, None]).reshape(-1, len(values))
+            if c.search.what == "lag_s":    # hundreds of lag candidates: not kept
+                return rows
+            self.cache[key] = rows
         return self.cache[key]
 
 

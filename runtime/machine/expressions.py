@@ -89,6 +89,7 @@ def _check_lag(text: str, node: ast.Call) -> None:
                          f"{' '.join(TIME_COLUMNS)}")
 
 
+@functools.lru_cache(maxsize=4096)
 def lag_calls(text: str) -> tuple:
     """The lags of a basis expression: ((key, column, tau_s, time column), ...) with ``key``
     the canonical text :func:`volerr.machine.lags.lag_key`."""

@@ -31,32 +31,50 @@ TIME_COLUMNS = {"t_s": 1.0, "time_s": 1.0, "t_min": 60.0, "time_min": 60.0, "t_h
                 "time_h": 3600.0}
 
 
-def lag(u, tau_s: float, t, groups=None) -> np.ndarray:
+def lag(u, tau_s: float, t, groups=None, order=None) -> np.ndarray:
     """``u`` (N,) filtered through a first-order lag of time constant ``tau_s`` over the
     times ``t`` (N,), same unit as ``tau_s``; ``groups`` (N,) ints: filter each group (file)
-    on its own.  A scalar ``u`` is returned unchanged.  Returns (N,) floats."""
+    on its own; ``order``: :func:`time_order` of ``(t, groups)`` when already known.  A scalar
+    ``u`` is returned unchanged.  Returns (N,) floats."""
     u = np.asarray(u, dtype=float)
     if u.ndim == 0:
         return u
-    t = np.broadcast_to(np.asarray(t, dtype=float), u.shape)
-    if groups is None or len(np.unique(groups)) < 2:
-        return _lag_sorted(u.ravel(), float(tau_s), t.ravel()).reshape(u.shape)
-    out = np.empty(u.size)
-    flat_u, flat_t, g = u.ravel(), t.ravel(), np.asarray(groups).ravel()
-    for k in np.unique(g):
-        m = g == k
-        out[m] = _lag_sorted(flat_u[m], float(tau_s), flat_t[m])
+    t = np.broadcast_to(np.asarray(t, dtype=float), u.shape).ravel()
+    if order is None:
+        order = time_order(t, groups)
+    flat = u.ravel()
+    y = _lag_sorted(flat[order], float(tau_s), t[order], presorted=True,
+                    restart=None if groups is None else _starts(groups, order))
+    out = np.empty(flat.size)
+    out[order] = y
     return out.reshape(u.shape)
 
 
-def _lag_sorted(u: np.ndarray, tau: float, t: np.ndarray) -> np.ndarray:
-    if u.size < 2:
+def time_order(t, groups=None) -> np.ndarray:
+    """Indices that sort the points by (group, time), ties in their given order."""
+    t = np.asarray(t, dtype=float).ravel()
+    if groups is None:
+        return np.argsort(t, kind="stable")
+    return np.lexsort((t, np.asarray(groups).ravel()))
+
+
+def _starts(groups, order) -> np.ndarray:
+    """Mask (N-1,) of the sorted steps that begin a new group (the filter restarts there)."""
+    g = np.asarray(groups).ravel()[order]
+    return g[1:] != g[:-1]
+
+
+def _lag_sorted(u: np.ndarray, tau: float, t: np.ndarray, presorted: bool = False,
+                restart=None) -> np.ndarray:
+    """The lag of ``u`` over ``t`` (any order; ``presorted``: already in time order, the
+    result in that order; ``restart``: mask of steps where the filter starts afresh)."""
+    if u.size < 2 or not tau > 0:
         return u.copy()
-    if not tau > 0:
-        return u.copy()
-    order = np.argsort(t, kind="stable")
-    us, ts = u[order], t[order]
+    order = None if presorted else np.argsort(t, kind="stable")
+    us, ts = (u, t) if presorted else (u[order], t[order])
     x = np.diff(ts) / tau                      # steps in time constants, >= 0
+    if restart is not None:
+        x = np.where(restart, 1e12, x)         # a new file: the past is forgotten
     one_minus_a = -np.expm1(-x)
     small = x < 1e-6
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -74,6 +92,8 @@ def _lag_sorted(u: np.ndarray, tau: float, t: np.ndarray) -> np.ndarray:
         s = np.cumsum(g[start:stop - 1] * np.exp(Ls[1:]))
         y[start + 1:stop] = np.exp(-Ls[1:]) * (y[start] + s)
         start = stop - 1
+    if presorted:
+        return y
     out = np.empty_like(y)
     out[order] = y
     return out
@@ -87,11 +107,12 @@ def lag_key(covariate: str, tau_s: float, time: str = "t_s") -> str:
 
 
 def lag_of_columns(columns: dict, covariate: str, tau_s: float, time: str = "t_s",
-                   groups=None) -> np.ndarray:
+                   groups=None, order=None) -> np.ndarray:
     """The lag of a data column over the data's time column ``time`` (``t_min`` and ``t_h``
-    converted to seconds); ``groups``: file index of each point."""
+    converted to seconds); ``groups``: file index of each point; ``order``: their
+    :func:`time_order` when known."""
     t = np.asarray(columns[time], dtype=float) * TIME_COLUMNS.get(time, 1.0)
-    return lag(columns[covariate], tau_s, t, groups)
+    return lag(columns[covariate], tau_s, t, groups, order)
 
 
 def lag_symbol(covariate: str, tau_s: float, time: str = "t_s") -> str:
