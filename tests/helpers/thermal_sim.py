@@ -193,7 +193,7 @@ class Planted:
     target: str = "EXX"
     sensor: str = "T_motorX"
     tau_s: float = 2400.0
-    value: float = 3.0
+    value: float = 5.0
 
 
 @dataclass

@@ -108,9 +108,10 @@ def day_a():
 
 
 def test_campaign_separates_the_planted_sensor_and_tau(day_a):
-    """Day A (MB1): every other single sensor, at its best tau, stays >= 1.1 x the floor (a
-    difference of thousands in BIC on 2250 points); the planted sensor's best tau on the
-    logged column is within 10 % of the planted one and reaches the floor."""
+    """Day A (MB1): every other single sensor, at its best tau, stays >= 1.2 x the floor (the
+    nearest, the coolant, 1.30 x: a difference of thousands in BIC on 2250 points); the
+    planted sensor's best tau on the logged column is within 10 % of the planted one and
+    reaches the floor."""
     camp, test = day_a
     floor = camp.floor(test)
     rms, tau = camp.best_proxy(test, "T_motorX", 60.0 * np.arange(20.0, 61.0, 1.0))
@@ -118,18 +119,20 @@ def test_campaign_separates_the_planted_sensor_and_tau(day_a):
     for s in camp.sensors:
         if s != "T_motorX":
             r, _ = camp.best_proxy(test, s)
-            assert r > 1.1 * floor, (s, r, floor)
+            assert r > 1.2 * floor, (s, r, floor)
 
 
 def test_day_b_breaks_the_coolant_proxy(day_a):
     """The coolant proxy at its best day-A tau refitted on day B leaves several times the
-    floor; the planted sensor at the planted tau stays at it."""
+    floor; the planted sensor at the planted tau stays at it, at a tau 10 % off it reaches
+    about 1.11 x (the refit on day B needs tau to better than ~10 %)."""
     camp, test = day_a
     _, tau = camp.best_proxy(test, "T_coolant")
     day_b = T.campaign("MB1", T.DAY_B, n=3000, seed=2)
     floor_b = day_b.floor(test)
     assert day_b.heldout_rms(test, day_b.logged_lag("T_coolant", tau)) > 2 * floor_b
     assert day_b.heldout_rms(test, day_b.logged_lag("T_motorX", 2400.0)) < 1.02 * floor_b
+    assert day_b.heldout_rms(test, day_b.logged_lag("T_motorX", 2160.0)) > 1.05 * floor_b
 
 
 def test_five_axis_campaign_separates_the_table_sensor():
