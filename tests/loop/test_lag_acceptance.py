@@ -130,7 +130,7 @@ def mb1(tmp_path_factory):
         out["b"] = Run(aug, b_csv, folder, "dayB_aug")
         # the proxy: the same augmented layout with the coolant in place of the X motor, at
         # the coolant's best lag on day A by the simulator's own least squares
-        _, tau_c = day_a.best_proxy(a.test_rows, "T_coolant")
+        _, tau_c = day_a.best_proxy(a.test_rows, "T_coolant", 60.0 * np.geomspace(1, 240, 25))
         text = aug.read_text()
         proxy, n = lag_pattern("T_motorX").subn(f"lag(T_coolant, {tau_c:.1f})", text)
         out["proxy_substitutions"] = n
