@@ -16,6 +16,7 @@ styli on MB1; 0.3 um noise; 10 h):
   at the coolant's best day-A lag by the simulator's own fit).
 * MB1 day A with a second X-motor sensor ``T_screwX`` that repeats ``T_motorX`` up to 0.01 K
   noise and a 0.3 K offset: no campaign can separate them.
+* MB1 day B with another cause: the Y scale through lag(T_spindle, 25 min) (slow).
 * DMU50 (five-axis, random B and C; 2000 points): the C axis location ``EX0C`` follows the table
   drive's temperature through a 30 min lag (3 um/K); clean; and its day-A model refitted on
   day B.
@@ -97,6 +98,8 @@ def _check_named(run: Run, plant: T.Planted):
     assert isinstance(lag, dict), _describe(effects)
     assert abs(lag["value"] - plant.tau_s) <= TAU_TOLERANCE * plant.tau_s, lag
     assert np.isfinite(lag["std"]) and 0 < lag["std"] < 0.25 * plant.tau_s, lag
+    # an honest uncertainty: the error within 5 stated std (or 5 %, the model's own bias)
+    assert abs(lag["value"] - plant.tau_s) <= max(5 * lag["std"], 0.05 * plant.tau_s), lag
     own = json.dumps({k: v for k, v in e.items() if k != "alternatives"})
     taus = [float(t) for t in lag_pattern(plant.sensor).findall(own)]
     assert taus, ("no lag(SENSOR, TAU_S) in the effect's basis", e.get("terms"), e.get("basis"))
@@ -181,6 +184,17 @@ def test_proxy_sensor_model_refitted_on_day_b_does_not(mb1):
     rep = run.ok()
     floor_b = mb1["day_b"].floor(run.test_rows)
     assert rep["rms_before_um"] > FLOOR_FACTOR * floor_b, (rep["rms_before_um"], floor_b)
+
+
+@pytest.mark.slow
+def test_mb1_day_b_the_y_scale_through_the_spindle(tmp_path):
+    """Another cause, sensor, tau and duty cycle: EYY through lag(T_spindle, 25 min) on day B
+    (the nearest wrong sensor, the X motor, reaches 1.5 x the floor at its best lag)."""
+    plant = T.Planted("EYY", "T_spindle", 1500.0, 5.0)
+    camp = T.campaign("MB1", T.DAY_B, plant, n=3000, seed=11)
+    run = Run("MB1", camp.write(tmp_path / "dayB.csv"), tmp_path, "spindle")
+    _check_named(run, plant)
+    _check_floor(run, camp)
 
 
 # ---- MB1 clean -----------------------------------------------------------------------------
