@@ -151,3 +151,16 @@ def test_twin_sensor_repeats_its_sensor():
     d = camp.block.cov["T_screwX"] - camp.block.cov["T_motorX"]
     assert abs(d.mean() - 0.3) < 0.01 and d.std() < 3 * T.SENSOR_NOISE_K
     assert "T_screwX" in camp.columns() and "_true" not in camp.columns()
+
+
+def test_day_b_spindle_campaign_separates_the_spindle():
+    """The second MB1 cause (EYY through lag(T_spindle, 25 min), day B): every other sensor
+    >= 1.3 x the floor at its best lag."""
+    camp = T.campaign("MB1", T.DAY_B, T.Planted("EYY", "T_spindle", 1500.0, 5.0), n=3000,
+                      seed=11)
+    test = np.arange(1, 3000, 4)
+    floor = camp.floor(test)
+    for s in camp.sensors:
+        if s != "T_spindle":
+            r, _ = camp.best_proxy(test, s)
+            assert r > 1.3 * floor, (s, r, floor)
