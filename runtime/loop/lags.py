@@ -18,8 +18,10 @@ well by BIC (:func:`volerr.loop.select._merge`).  Then, for every accepted effec
 explanation among the leading candidates (another sensor, the same sensor with or without a
 lag, another parameter) that, in place of the accepted effect, is within ``BIC_TIE`` of it
 *and* whose cross-validated per-point squared residuals do not differ from the accepted
-effect's significantly (|paired t| < ``select.CV_T`` over the cross-validation splits) is an
-*alternative*: the campaign cannot tell the two apart.  The effect then lists them
+effect's significantly (|paired t| < ``select.CV_T`` over the cross-validation splits) or
+whose cross-validated RMS is within ``CV_SAME`` (1 %) of it (nearly equal predictions make a
+paired t large for a difference of no consequence) is an *alternative*: the campaign cannot
+tell the two apart.  Where an alternative has the better BIC, the two swap places.  The effect then lists them
 (``alternatives``) and says what campaign would separate them (``separate_by``).
 """
 
@@ -35,6 +37,9 @@ from .candidates import extra_parameters as _extra
 BIC_TIE = 10.0          # BIC difference below which two explanations are not told apart
 PROFILE_STEPS = np.linspace(-0.3, 0.3, 13)
 MAX_ALTERNATIVES = 3
+NEAR = 0.9              # rivals explaining this share of the effect's RSS reduction are refined
+BIC_SWAP = 1.0          # an alternative better by more than this is named instead
+CV_SAME = 0.01          # cross-validated RMS within 1 %: not told apart in practice
 
 
 def refine(accepted: list, A0, ctx, train, w_rows, y) -> None:
@@ -45,13 +50,13 @@ def refine(accepted: list, A0, ctx, train, w_rows, y) -> None:
             continue
         others = accepted[:i] + accepted[i + 1:]
         base = sel._full_base(sel._stack(A0, others), train, w_rows, y)
-        tau, std = _profile_tau(a.cand, ctx, base, float(a.cand.info["lag_s"]))
+        tau, std = profile_tau(a.cand, ctx, base, float(a.cand.info["lag_s"]))
         a.cand = a.cand.fixed(tau)
         a.cand.info["lag_std_s"] = None if std is None else round(std, 1)
         a.cols, _ = ctx.columns(a.cand.terms, full=True)
 
 
-def _profile_tau(cand, ctx, base, tau0: float) -> tuple[float, float | None]:
+def profile_tau(cand, ctx, base, tau0: float) -> tuple[float, float | None]:
     """(tau, standard uncertainty or None) from the RSS profile around ``tau0`` (s)."""
     x0 = math.log(tau0)
     for _ in range(4):                    # re-centre while the minimum is at an edge
@@ -96,24 +101,60 @@ def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -
                 continue
             seen.add(key)
             rivals.append(x.cand)
-        scores = base.score_many([sel._dense_group(a.cols)] + [ctx.group(c.terms)
-                                                               for c in rivals])
-        d_a = base.dbic(scores[0][0], scores[0][1] + _extra(a.cand))
-        close = [(base.dbic(g, r + _extra(c)), c) for c, (g, r) in zip(rivals, scores[1:])
-                 if r and base.dbic(g, r + _extra(c)) - d_a < BIC_TIE]
-        close.sort(key=lambda t: t[0])
+        close, d_a = _close_rivals(a, rivals, ctx, base)
         cv_a = sel._cv_sq(A_o.plus([a.cols]), y, folds, train, w_rows)
         found = []
         for d_x, c in close[:2 * MAX_ALTERNATIVES]:
             cols, _ = ctx.columns(c.terms, full=True)
-            d = sel._cv_sq(A_o.plus([cols]), y, folds, train, w_rows) - cv_a
+            cv_x = sel._cv_sq(A_o.plus([cols]), y, folds, train, w_rows)
+            d = cv_x - cv_a
             t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
-            if abs(t) < sel.CV_T:
+            ratio = math.sqrt(cv_x.mean() / max(cv_a.mean(), 1e-300))
+            if abs(t) < sel.CV_T or abs(ratio - 1.0) < CV_SAME:
                 found.append({"cand": c, "cols": cols, "delta_bic": round(d_x - d_a, 2),
                               "cv_paired_t": round(t, 2)})
             if len(found) == MAX_ALTERNATIVES:
                 break
-        a.evidence["alternatives"] = found
+        a.evidence["alternatives"] = _best_first(a, found)
+
+
+def _best_first(a, found: list) -> list:
+    """Name the explanation with the best BIC: when an alternative beats the accepted effect
+    by more than ``BIC_SWAP`` (they are tied, the screening on a subset chose), the two swap
+    places (in place); identical columns (a rotary axis' radial error and its location
+    error) keep the order of the candidates."""
+    if not found or found[0]["delta_bic"] > -BIC_SWAP:
+        return found
+    best = found.pop(0)
+    old = {"cand": a.cand, "cols": a.cols, "delta_bic": -best["delta_bic"],
+           "cv_paired_t": -best["cv_paired_t"]}
+    a.cand, a.cols, a.params = best["cand"], best["cols"], best["cand"].parameters
+    for x in found:
+        x["delta_bic"] = round(x["delta_bic"] - best["delta_bic"], 2)
+    return sorted([old] + found, key=lambda x: x["delta_bic"])
+
+
+def _close_rivals(a, rivals: list, ctx, base) -> tuple[list, float]:
+    """([(dBIC, candidate)] of the rivals within ``BIC_TIE`` of the accepted effect ``a`` in
+    its place, best first; a's dBIC).  Rivals that explain at least ``NEAR`` of what ``a``
+    explains get their time constant refined on all training points first (as ``a`` had)."""
+    scores = base.score_many([sel._dense_group(a.cols)] + [ctx.group(c.terms) for c in rivals])
+    g_a = scores[0][0]
+    d_a = base.dbic(g_a, scores[0][1] + _extra(a.cand))
+    near = [c for c, (g, r) in zip(rivals, scores[1:]) if r and g >= NEAR * g_a]
+    near = sorted(near, key=lambda c: -scores[1 + rivals.index(c)][0])[:2 * MAX_ALTERNATIVES]
+    refined = []
+    for c in near:
+        if c.search is not None and c.search.what == "lag_s":
+            tau, std = profile_tau(c, ctx, base, float(c.info["lag_s"]))
+            c = c.fixed(tau)
+            c.info["lag_std_s"] = None if std is None else round(std, 1)
+        refined.append(c)
+    scores = base.score_many([ctx.group(c.terms) for c in refined]) if refined else []
+    close = [(base.dbic(g, r + _extra(c)), c) for c, (g, r) in zip(refined, scores)
+             if r and base.dbic(g, r + _extra(c)) - d_a < BIC_TIE]
+    close.sort(key=lambda t: t[0])
+    return close, d_a
 
 
 def separate_by(a_info: dict, b_info: dict) -> str:

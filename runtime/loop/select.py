@@ -473,6 +473,7 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
         for x in scored[:TOP_FIT]:
             if x.dbic > -BIC_GAIN:
                 break
+            x = _lag_refined(x, A_all, ctx, train, w_rows, y)
             cols, _ = ctx.columns(x.cand.terms, full=True)
             A_try = A_all.plus([cols])
             cv_new = _cv_sq(A_try, y, folds, train, w_rows)
@@ -500,6 +501,8 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
         accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, train, w_rows, y)
         from . import lags
         lags.refine(accepted, A0, ctx, train, w_rows, y)
+        lags.alternatives(accepted, (first or [])[:2 * N_SOURCES] + last[:2 * N_SOURCES], A0,
+                          ctx, train, w_rows, y, folds)
         A_all = _stack(A0, accepted)
         base = full(A_all)
         names = {a.cand.name for a in accepted}
@@ -508,12 +511,23 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
                            ctx, base, candidates, 2 * N_SOURCES)
         else:
             last = screen(candidates, ctx, base, names)
-    if accepted:
-        from . import lags
-        lags.alternatives(accepted, (first or [])[:2 * N_SOURCES] + last[:2 * N_SOURCES], A0,
-                          ctx, train, w_rows, y, folds)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
+
+
+def _lag_refined(x: Scored, A_all, ctx, train, w_rows, y) -> Scored:
+    """A lag candidate with its time constant refined on all training points before it is
+    judged (screening fixed it on a subset and a grid: a few per cent off leave a residual
+    that a second, spurious effect would take up); other candidates as they are."""
+    if x.cand.search is None or x.cand.search.what != "lag_s":
+        return x
+    from .lags import profile_tau
+
+    base = _full_base(A_all, train, w_rows, y)
+    tau, std = profile_tau(x.cand, ctx, base, float(x.cand.info["lag_s"]))
+    cand = x.cand.fixed(tau)
+    cand.info["lag_std_s"] = None if std is None else round(std, 1)
+    return Scored(x.dbic, x.gain, x.rank, cand, x.params)
 
 
 def _stack(A0, sel):

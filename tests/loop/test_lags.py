@@ -125,6 +125,7 @@ def campaigns(tmp_path_factory):
     a.covariates["T_screwX"] = np.round(a.covariates["T_motorX"] + 0.4, 2)
     b = simulate("MB1", n_points=1500, seed=12, probes=probes, duration_h=6, sensors=6,
                  duty="drives=on:1h,off:2h,on:3h;coolant=on:6h", effects=[effect])
+    b.covariates["T_screwX"] = np.round(b.covariates["T_motorX"] + 0.4, 2)
     return d, a.write_csv(d / "a.csv"), b.write_csv(d / "b.csv")
 
 
