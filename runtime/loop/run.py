@@ -238,13 +238,17 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
 
 
 def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, families,
-                   robust: Robust, y) -> tuple[sel.Selection, list]:
+                   robust: Robust, y, lag_caches=None) -> tuple[sel.Selection, list]:
+    """``lag_caches``: the lagged series of an earlier selection on the same data (a dict
+    filled here), reused."""
     covs, warns = cands.covariates(dat.covariates, model)
     candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
                   if c.kind in families]
     w_rows = robust.rows()
+    shared = lag_caches if lag_caches is not None else {}
     ctx = sel.Context(model, dat, None, None, spl.train,    # sensitivities per block
-                      np.sqrt(robust.weights[spl.train]), ranges)
+                      np.sqrt(robust.weights[spl.train]), ranges,
+                      {k: shared.setdefault(k, {}) for k in sel.SHARED_LAG_CACHES})
     return sel.select(candidates, ctx, decl.design, y, spl.folds, w_rows,
                       sel.SCREEN_POINTS), warns
 
@@ -537,8 +541,9 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
                                                max_degree, weights=w0)
     decl = declared_step(model, dat, degree, ranges, spl.train)
     robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
+    lag_caches: dict = {}
     selection, warns = selection_step(model, dat, decl, spl, ranges, degree, families,
-                                      robust, y)
+                                      robust, y, lag_caches)
     keepers = [s for s in selection.accepted if s.cand.kind != "higher_order"]
     if keepers and not fixed_degree:
         # the degree was chosen with the effects unmodelled: choose it again with them
@@ -550,7 +555,7 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
             decl = declared_step(model, dat, degree, ranges, spl.train)
             robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
             selection, warns = selection_step(model, dat, decl, spl, ranges, degree,
-                                              families, robust, y)
+                                              families, robust, y, lag_caches)
     return degree, degree_scores, decl, robust, selection, warns
 
 

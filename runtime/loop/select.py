@@ -32,6 +32,9 @@ TOP_FIT = 3          # candidates fitted fully per forward step
 SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
 N_SOURCES = 10       # residual sources reported
 LAG_CACHE = 48       # lagged series (all points) kept while screening
+#: caches of lagged series a context shares with its sub-contexts (and a second selection
+#: on the same data: :func:`volerr.loop.run.selection_step`)
+SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
 
 
 def _pinv_sym(G, tol=1e-12):
@@ -105,8 +108,8 @@ class Context:
         """The same context on other points (shares nothing that depends on the points)."""
         return Context(self.model, self.data, self.sens, self.twist, pts, sw, self.ranges,
                        {"fixed": self.cache.setdefault("fixed", {}),
-                        "lags": self.cache.setdefault("lags", {}),
-                        "lag_orders": self.cache.setdefault("lag_orders", {})}, self.sym)
+                        **{k: self.cache.setdefault(k, {}) for k in SHARED_LAG_CACHES}},
+                       self.sym)
 
     def basis_values(self, basis: str, full: bool = False) -> dict:
         """:meth:`values`, plus the lags of ``basis`` (:mod:`volerr.machine.lags`) filtered over
@@ -124,10 +127,13 @@ class Context:
 
     def lag_at_points(self, key, col, tau, time) -> np.ndarray:
         """The lag ``key`` at the context's points (kept: a few thousand values each)."""
-        mine = self.cache.setdefault("_lag_pts", {})
-        if key not in mine:
-            mine[key] = self.lag_series(key, col, tau, time)[self.pts]
-        return mine[key]
+        if "_pts_key" not in self.cache:
+            self.cache["_pts_key"] = hash(np.asarray(self.pts).tobytes())
+        mine = self.cache.setdefault("lag_pts", {})
+        at = (key, self.cache["_pts_key"])
+        if at not in mine:
+            mine[at] = self.lag_series(key, col, tau, time)[self.pts]
+        return mine[at]
 
     def lag_series(self, key, col, tau, time) -> np.ndarray:
         """The lag ``key`` of column ``col`` at all points (the last ``LAG_CACHE`` kept)."""
@@ -289,7 +295,9 @@ def _profile(c: cands.Candidate, ctx: Context, base: Base) -> cands.Candidate:
         if len(fine) > 40:
             fine = fine[np.linspace(0, len(fine) - 1, 40).astype(int)]
     else:
-        fine = np.geomspace(max(lo, 1e-3), hi, 15)
+        # a lag's tau: 7 values (5 % steps) suffice here, the accepted one is refined on all
+        # training points (volerr.loop.lags.profile_tau); hundreds of lag candidates
+        fine = np.geomspace(max(lo, 1e-3), hi, 7 if c.search.what == "lag_s" else 15)
     if len(fine):
         v0 = best_of([v0] + [float(x) for x in fine])
     return c.fixed(v0)
