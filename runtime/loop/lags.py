@@ -14,7 +14,8 @@ Sensor selection (the rule ``docs/formats.md`` states): forward selection takes 
 with the best BIC, where a searched time constant costs one parameter and a difference of two
 sensors ``T_a - T_b`` costs one more than a single sensor (the choice of its second sensor);
 two accepted effects are replaced by one candidate whenever it explains the data at least as
-well by BIC (:func:`volerr.loop.select._merge`).  Then, for every accepted effect, each other
+well by BIC (:func:`volerr.loop.select._merge`); a lag is taken only where it gains more
+than ``LAG_EARN`` BIC over the same parameter x the same sensor without one.  Then, for every accepted effect, each other
 explanation among the leading candidates (another sensor, the same sensor with or without a
 lag, another parameter) that, in place of the accepted effect, is within ``BIC_TIE`` of it
 *and* whose cross-validated per-point squared residuals do not differ from the accepted
@@ -34,12 +35,29 @@ import numpy as np
 from . import select as sel
 from .candidates import extra_parameters as _extra
 
+LAG_EARN = 10.0         # BIC a lag must gain over the same sensor without one
 BIC_TIE = 10.0          # BIC difference below which two explanations are not told apart
 PROFILE_STEPS = np.linspace(-0.3, 0.3, 13)
 MAX_ALTERNATIVES = 3
 NEAR = 0.9              # rivals explaining this share of the effect's RSS reduction are refined
 BIC_SWAP = 1.0          # an alternative better by more than this is named instead
 CV_SAME = 0.01          # cross-validated RMS within 1 %: not told apart in practice
+
+
+def prefer_plain(scored: list, top: int) -> None:
+    """A lag must earn its place: a lag candidate among the ``top`` leaders gives way (in
+    place) to the same parameter x the same sensor without a lag when that one's BIC is not
+    worse by ``LAG_EARN`` or more (the plain sensor is the limit tau -> 0)."""
+    for i in range(min(top, len(scored))):
+        x = scored[i]
+        if x.cand.search is None or x.cand.search.what != "lag_s":
+            continue
+        key = (x.cand.info.get("parameter"), x.cand.info.get("covariate"))
+        plain = [j for j, o in enumerate(scored) if j > i and o.cand.info.get("lag_s") is None
+                 and (o.cand.info.get("parameter"), o.cand.info.get("covariate")) == key
+                 and o.dbic < x.dbic + LAG_EARN]
+        if plain:
+            scored.insert(i, scored.pop(min(plain, key=lambda j: scored[j].dbic)))
 
 
 def refine(accepted: list, A0, ctx, train, w_rows, y) -> None:
@@ -123,7 +141,11 @@ def _best_first(a, found: list) -> list:
     by more than ``BIC_SWAP`` (they are tied, the screening on a subset chose), the two swap
     places (in place); identical columns (a rotary axis' radial error and its location
     error) keep the order of the candidates."""
-    if not found or found[0]["delta_bic"] > -BIC_SWAP:
+    if not found:
+        return found
+    earn = LAG_EARN if (found[0]["cand"].info.get("lag_s") is not None
+                        and a.cand.info.get("lag_s") is None) else 0.0
+    if found[0]["delta_bic"] > -BIC_SWAP - earn:
         return found
     best = found.pop(0)
     old = {"cand": a.cand, "cols": a.cols, "delta_bic": -best["delta_bic"],

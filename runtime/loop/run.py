@@ -835,7 +835,7 @@ def demo_campaign(out=None, seed: int = 0, n_points: int = 900, kind: str = "the
                            "um": 2.0},
               "thermal_lag": {"kind": "thermal_lag", "sensor": "T_motorX", "tau_min": 20.0,
                               "axis": "X", "ppm_per_K": 2.0}}[kind]
-    logged = {"sensors": "T_spindle,T_motorX,T_coolant,T_air1", "duty": "on:2h,off:2h",
+    logged = {"sensors": "T_motorX,T_coolant,T_column,T_air1", "duty": "on:2h,off:2h",
               "duration_h": 4.0} if kind == "thermal_lag" else {}
     camp = simulate("MB1", n_points=n_points, seed=seed, probes=demo_probes(model),
                     effects=[effect], noise_um=0.3, **logged)

@@ -478,6 +478,8 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
         if len(accepted) >= MAX_EFFECTS:
             break
         hit = None
+        from .lags import prefer_plain
+        prefer_plain(scored, TOP_FIT)
         for x in scored[:TOP_FIT]:
             if x.dbic > -BIC_GAIN:
                 break

@@ -4,7 +4,8 @@
 A machine's heat sources switch with its duty cycle: the drives (axis motors, spindle,
 hydraulics) and the coolant pump.  Each logged sensor reads the room temperature (a slow
 daily swing, its own share of it) plus its sources' heat through its own first-order lag;
-the readings carry 0.01 K noise and 0.01 K resolution.  A *lagged thermal effect* lets a
+the readings carry 0.01 K noise and 0.01 K resolution; the machine stood cold (every source
+off) before the campaign.  A *lagged thermal effect* lets a
 component error follow one sensor through a further first-order lag (heat flowing from a
 motor into a ballscrew): ``EXX += k X (lag(T_motorX, tau) - 20)``.
 
@@ -93,15 +94,17 @@ def _state(segments, tf) -> np.ndarray:
     return states[np.searchsorted(ends, tf, side="right")]
 
 
-def first_order(u, tau_s: float, dt: float = FINE_S) -> np.ndarray:
-    """``tau dy/dt + y = u`` on a uniform grid (trapezoidal input), starting at ``u[0]``."""
+def first_order(u, tau_s: float, dt: float = FINE_S, start: float | None = None) -> np.ndarray:
+    """``tau dy/dt + y = u`` on a uniform grid (trapezoidal input), in equilibrium with
+    ``start`` (default ``u[0]``) before the first sample."""
     from scipy.signal import lfilter, lfilter_zi
 
     a = np.exp(-dt / tau_s)
     u = np.asarray(u, dtype=float)
     b, den = [(1 - a) / 2, (1 - a) / 2], [1.0, -a]
-    y, _ = lfilter(b, den, u, zi=lfilter_zi(b, den) * u[0])
-    return y
+    u0 = u[0] if start is None else start
+    y, _ = lfilter(b, den, np.concatenate([[u0], u]), zi=lfilter_zi(b, den) * u0)
+    return y[1:]
 
 
 @dataclass
@@ -140,7 +143,8 @@ def log_sensors(names, duty_spec, duration_s: float, rng) -> SensorLog:
         source, rise, tau_min, share = CATALOGUE[name]
         v = ROOM_C + share * (room - ROOM_C) + rng.normal(0, 0.05)
         if source is not None:
-            v = v + rise * first_order(sources[source], 60.0 * tau_min)
+            # the machine stood cold before the campaign: every source off
+            v = v + rise * first_order(sources[source], 60.0 * tau_min, start=0.0)
         fine[name] = v
     return SensorLog(tf, fine, duty)
 

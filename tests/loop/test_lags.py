@@ -152,3 +152,32 @@ def test_loop_finds_sensor_and_lag_names_the_twin_and_refits_another_duty_cycle(
     rep_b = json.loads((d / "b.json").read_text())
     assert rep_b["layout"] == "MB1_aug" and rep_b["effects"] == []
     assert rep_b["rms_before_um"] < 1.15 * 0.3 * math.sqrt(3)
+
+
+def test_simulate_sensors_duty_and_refusals(tmp_path, capsys):
+    """Logged sensors follow the duty cycle (heating while the drives run, cooling after);
+    bad options: one line, exit 2."""
+    import csv
+
+    from volerr.cli import main
+
+    out = tmp_path / "s.csv"
+    assert main(["simulate", "MB1", "--out", str(out), "--points", "400", "--hours", "4",
+                 "--sensors", "T_motorX,T_air1", "--duty", "on:2h,off:2h",
+                 "--effect", "thermal_lag:sensor=T_motorX,tau_min=20,axis=X,ppm_per_K=2"]) == 0
+    rows = list(csv.DictReader(out.open()))
+    assert "T_C" not in rows[0] and {"T_motorX", "T_air1", "t_s"} <= set(rows[0])
+    t = np.array([float(r["t_s"]) for r in rows])
+    motor = np.array([float(r["T_motorX"]) for r in rows])
+    at = lambda h: motor[np.argmin(np.abs(t - 3600 * h))]  # noqa: E731
+    assert at(1.9) > at(0.05) + 3.0 and at(3.9) < at(2.0) - 3.0
+    for args in (["--duty", "on:2x"], ["--sensors", "T_nowhere"], ["--duty", "on:1h"],
+                 ["--sensors", "2", "--effect", "thermal_lag:sensor=T_bed"],
+                 ["--effect", "thermal_lag:sensor=T_motorX"]):
+        capsys.readouterr()
+        with pytest.raises(SystemExit) as exc:
+            code = main(["simulate", "MB1", "--out", str(tmp_path / "x.csv"), *args])
+            raise SystemExit(code)
+        assert exc.value.code == 2, args
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "error" in err[0], err
