@@ -23,7 +23,12 @@ def register(sub) -> None:
                     "optional Xp,Yp,Zp, dx_um,dy_um,dz_um, covariates such as T_C, t_s, "
                     "dir_X, nx,ny,nz, setup), search candidate effects by forward stepwise "
                     "selection (BIC and cross-validated residual), augment the layout and "
-                    "report RMS/max before and after on held-out points.")
+                    "report RMS/max before and after on held-out points.  Logged temperatures "
+                    "(T_<name>) with a time column (t_s, t_min, t_h) are also tried through a "
+                    "first-order lag, its time constant estimated with its uncertainty "
+                    "(lag_s); explanations the data cannot tell apart are named "
+                    "(alternatives, separate_by): 'volerr formats loop-lags'.  LAYOUT may be "
+                    "an augmented layout (*_aug.toml) written by an earlier run.")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", nargs="+", metavar="FILE",
                    help="measurement files of any instruments (deviations, ballbar, sphere; "

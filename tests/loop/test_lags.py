@@ -181,3 +181,42 @@ def test_simulate_sensors_duty_and_refusals(tmp_path, capsys):
         assert exc.value.code == 2, args
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and "error" in err[0], err
+
+
+def test_a_loop_effect_on_an_augmented_parameter_is_derived_as_the_loop_saw_it(tmp_path):
+    """The loop's columns of a candidate whose target is an augmented parameter (a thermal
+    coefficient that itself varies) equal the sensitivity the nested effect of the written
+    augmented layout derives (before issue 30: 'unknown target')."""
+    import volerr
+    from volerr.instruments.deviations import columns_to_data
+    from volerr.loop import candidates as cands
+    from volerr.loop import select as sel
+    from volerr.loop.run import augmented_layout_text
+    from volerr.estimate.design import data_ranges
+
+    text, _ = layout_text("MB1")
+    path = tmp_path / "MB1L.toml"
+    path.write_text(text.replace('name = "MB1"', 'name = "MB1L"', 1)
+                    + LAGGED.split("[effects.nested]")[0])
+    model = volerr.load(str(path))
+    rng = np.random.default_rng(2)
+    n = 200
+    cols = {a: rng.uniform(*model.travel[a], n) for a in model.axes}
+    t = np.sort(rng.uniform(0, 36000, n))
+    cols.update({"Xp": np.zeros(n), "Yp": np.zeros(n), "Zp": np.full(n, -100.0),
+                 "dx_um": np.zeros(n), "dy_um": np.zeros(n), "dz_um": np.zeros(n), "t_s": t,
+                 "T_motorX": 20 + 3 * np.sin(t / 5000), "T_air": 20 + np.cos(t / 3000)})
+    dat = columns_to_data(cols, model)
+    cand = cands.Candidate("thermal", "thermal_KL_X_T_air", [("KN2", "KL_X", "(T_air - 20)")],
+                           {"parameter": "KL_X", "covariate": "T_air", "basis": "linear"})
+    ctx = sel.Context(model, dat, None, None, np.arange(n), np.ones(n), data_ranges(model, dat))
+    seen, _ = ctx.columns(cand.terms, full=True)
+
+    class Picked:       # what augmented_layout_text reads of an accepted effect
+        pass
+    picked = Picked()
+    picked.cand = cand
+    aug = parse_layout(augmented_layout_text(model, [picked], str(path)), "MB1L_aug.toml")
+    aug_model = Model(aug, derivation.module_from_source(derivation.fit_source(aug), aug.name))
+    derived = dat.sensitivity(aug_model)[:, :, aug_model.parameters.index("KN2")]
+    np.testing.assert_allclose(derived, seen[:, :, 0], rtol=1e-9, atol=1e-12)
