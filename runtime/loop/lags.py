@@ -134,6 +134,12 @@ def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -
             if len(found) == MAX_ALTERNATIVES:
                 break
         a.evidence["alternatives"] = _best_first(a, found)
+        # the screening's list (RSS reduction within 2 % on a subset), less the rivals judged
+        # here and told apart
+        told = {c.name for c in rivals} - {x["cand"].name for x in a.evidence["alternatives"]}
+        a.evidence["indistinguishable_from"] = [
+            n for n in a.evidence.get("indistinguishable_from", [])
+            if n not in told and n != a.cand.name]
 
 
 def _best_first(a, found: list) -> list:
