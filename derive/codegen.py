@@ -72,6 +72,8 @@ class Function:
     signature: list = field(default_factory=list)
     doc_lines: list = field(default_factory=list)
     result_lines: list = field(default_factory=list)
+    keywords: list = field(default_factory=list)    # e.g. "lags=None" (derive/lags.py)
+    prelude: list = field(default_factory=list)     # statements before the expressions
 
 
 @contextmanager
@@ -142,7 +144,8 @@ def shared_preparation():
 def _prepare(f: Function) -> Function:
     if _PREPARED is None:
         return _prepare_new(f)
-    key = (f.name, tuple(f.args), tuple(f.outputs), f.shape, tuple(f.output_names or ()), f.doc)
+    key = (f.name, tuple(f.args), tuple(f.outputs), f.shape, tuple(f.output_names or ()), f.doc,
+           tuple(f.keywords), tuple(f.prelude))
     done = _PREPARED.get(key)
     if done is None:
         done = _PREPARED[key] = _prepare_new(f)
@@ -175,9 +178,10 @@ def _prepare_new(f: Function) -> Function:
                     for i, r in enumerate(reduced))
         f.result = ", ".join(f"_o{i}" for i in range(len(reduced))) + ("," if len(reduced) == 1
                                                                         else "")
-    f.signature = wrap_statement(f"def {f.name}({', '.join(f.args)}):", hang=8)
+    f.signature = wrap_statement(f"def {f.name}({', '.join(f.args + f.keywords)}):", hang=8)
     shapes = ", ".join(f"numpy.shape({a})" for a in f.args)
     body.insert(0, f"_shape = numpy.broadcast_shapes({shapes})")
+    body[:0] = f.prelude
     f.body = [line for stmt in body for line in wrap_statement(stmt, indent="    ")]
     f.doc_lines = wrap_text(f.doc, indent="    ")
     f.result_lines = wrap_statement(f"return {f.result}", indent="    ")
@@ -211,14 +215,16 @@ def sources_sha256(names) -> str:
     return h.hexdigest()
 
 
-def render_module(header: dict, constants: dict, functions: list[Function]) -> str:
+def render_module(header: dict, constants: dict, functions: list[Function],
+                  helpers=()) -> str:
     """Module source text.
 
     ``header``: ``title``, ``layout`` (the ``volerr derive`` argument), ``layout_file`` and its
     ``sha256``, ``sources`` (derivation sources relative to the repository; the printer's are
     added) and optionally ``units`` (the module's Units paragraph, default: error-model units).
     ``constants``: name -> Python literal.  The header records the sympy version and the
-    sha256 over the derivation sources next to the input's sha256."""
+    sha256 over the derivation sources next to the input's sha256.  ``helpers``: source lines
+    of module-level helper functions (printed after the constants)."""
     sources = tuple(header.get("sources", ())) + PRINTER_SOURCES
     header = {**header, "sympy_version": sp.__version__,
               "sources_sha256": sources_sha256(sources),
@@ -230,5 +236,5 @@ def render_module(header: dict, constants: dict, functions: list[Function]) -> s
         keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True,
         undefined=jinja2.StrictUndefined)
     template = env.get_template("model.py.j2")
-    return template.render(header=header, constants=consts,
+    return template.render(header=header, constants=consts, helpers=list(helpers),
                            functions=[_prepare(f) for f in functions])

@@ -43,7 +43,17 @@ _SYMPY_FUNCTIONS = {
     "sin": sp.sin, "cos": sp.cos, "exp": sp.exp, "sqrt": sp.sqrt, "abs": sp.Abs, "pi": sp.pi,
     "ind": lambda a, b: sp.Piecewise((1, sp.Eq(a, b)), (0, True)),
     "legendre": lambda n, x: sp.expand(sp.legendre(int(n), x)),
+    "lag": lambda u, tau, t=None: _lag_symbol(u, tau, t),
 }
+
+
+def _lag_symbol(u, tau, t=None) -> sp.Symbol:
+    """A lag ``lag(C, tau_s[, time])`` as a plain real symbol (computed by the generated
+    module from the series: :mod:`volerr.derive.lags`)."""
+    from volerr.machine.lags import lag_symbol
+
+    return sp.Symbol(lag_symbol(str(u), float(tau), str(t) if t is not None else "t_s"),
+                     real=True)
 
 
 def basis_expr(text: str) -> sp.Expr:
@@ -56,12 +66,33 @@ def basis_expr(text: str) -> sp.Expr:
 
 
 def additions(layout: Layout) -> dict:
-    """target -> sympy expression added to it (sum of parameter * basis of all terms)."""
+    """target -> sympy expression added to it (sum of parameter * basis of all terms); a term
+    on a parameter of another effect (nested effects) is folded into that effect's terms."""
     out: dict = {}
     for e in layout.effects:
         for t in e.terms:
             term = sp.Symbol(t.parameter, real=True) * basis_expr(t.basis)
             out[t.target] = out.get(t.target, 0) + term
+    return _fold_nested(out, {p for e in layout.effects for p in e.parameters})
+
+
+def _fold_nested(add: dict, effect_parameters: set) -> dict:
+    """``add`` with every effect parameter ``K`` that is itself a target replaced by
+    ``K + (its additions)`` wherever it appears (effects refer to earlier ones only: the
+    substitution ends)."""
+    inner = {t: add.pop(t) for t in list(add) if t in effect_parameters}
+    if not inner:
+        return add
+    keep = {t: sp.Dummy(t, real=True) for t in inner}
+    subs = {sp.Symbol(t, real=True): keep[t] + v for t, v in inner.items()}
+    out = {}
+    for target, expr in add.items():
+        for _ in range(len(subs) + 1):
+            new = sp.sympify(expr).xreplace(subs)
+            if new == expr:
+                break
+            expr = new
+        out[target] = expr.xreplace({d: sp.Symbol(t, real=True) for t, d in keep.items()})
     return out
 
 

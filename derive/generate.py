@@ -8,7 +8,7 @@ import sympy as sp
 
 from volerr.machine.layout import Layout, layout_names, read_layout
 
-from . import inverse
+from . import inverse, lags
 from . import volumetric as vol
 from .codegen import Function, render_module, shared_preparation
 from .kinematics import PROBE, Chain
@@ -96,6 +96,7 @@ def derive_functions(layout: Layout) -> list[Function]:
         Function("orientation_error", pos + cov + params, list(vol.orientation_error(chain)),
                  "First-order error of the tool-axis direction (i, j, k), rad."),
     ]
+    lags.attach(funcs, lags.layout_lags(layout), cov)
     if inverse.applies(layout):
         funcs.extend(inverse.inverse_functions(layout, chain))
     if rules.shift:
@@ -123,21 +124,29 @@ def _constants(layout: Layout) -> dict:
     if layout.effects:
         constants["COVARIATES"] = repr(tuple(layout.covariates))
         constants["EFFECTS"] = repr({e.name: e.kind for e in layout.effects})
+        if lags.layout_lags(layout):    # (canonical text, column, tau_s, time column)
+            constants["LAGS"] = repr(tuple(x[1:] for x in lags.layout_lags(layout)))
     for k, v in sorted(layout.parameters.items()):
         constants[k] = repr(float(v))
     return constants
 
 
 def _header(layout: Layout, title: str) -> dict:
+    sources = LAYOUT_SOURCES + (lags.SOURCES if lags.layout_lags(layout) else ())
     return {"title": title, "layout": layout.name,
             "layout_file": layout.path or f"{layout.name}.toml", "sha256": layout.sha256,
-            "sources": LAYOUT_SOURCES}
+            "sources": sources}
+
+
+def _helpers(layout: Layout) -> list:
+    """Module-level helper source lines (the lag filter, when the effects use one)."""
+    return lags.helper_lines() if lags.layout_lags(layout) else []
 
 
 def generate_module(layout: Layout) -> str:
     """The complete module text of one layout (deterministic)."""
     return render_module(_header(layout, f"Error model of layout {layout.name}."),
-                         _constants(layout), derive_functions(layout))
+                         _constants(layout), derive_functions(layout), _helpers(layout))
 
 
 def generate_fit_module(layout: Layout) -> str:
@@ -155,8 +164,10 @@ def generate_fit_module(layout: Layout) -> str:
              Function("setup_sensitivity", pos + probe, list(vol.setup_sensitivity(chain)),
                       "d(dX, dY, dZ)/d(rigid twist of the workpiece frame, then of the tool "
                       "end): array (3, 12, *shape), mm/mm and mm/rad.", shape=(3, 12))]
+    lags.attach(funcs, lags.layout_lags(layout), layout.covariates)
     return render_module(_header(layout, f"Fitting functions of layout {layout.name} "
-                                         f"(reduced module)."), _constants(layout), funcs)
+                                         f"(reduced module)."), _constants(layout), funcs,
+                         _helpers(layout))
 
 
 def all_generated(progress=None) -> dict:

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       8d1fff502794c1f3a2c99e1c2555b47aa7abd14cf69caec93c9cc91d4bdab3a6
-derivation sha256  ac0d54ec1a2d80e9523c8f4d5c4a8f3a97fc55c10b64c4a221af97765e271ef6
+derivation sha256  a884e476c078e6f8924b3f88d3d3eccbae995b75d2dab0a2f44c2b4c61875477
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/observations.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       26ff981565755ae2f06cdbc614479e95b74eb63685bed151847c32178de4a711
-derivation sha256  8f017ba91620648e62e1f99c274d5f90c10ae17eaf37b32c3c26e8fa68fc96d1
+derivation sha256  c6f3041f5f5467b2d1f8ef91817f34c62ab77cd35a483f43fa2a3d4775f12136
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/probe.py, derive/codegen.py, derive/linewrap.py, derive/templates/model.py.j2

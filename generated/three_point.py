@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
-derivation sha256  122acd15256a17721e6852ecfad4764f84c199edcf6dbe7ef64f94898b8eaaf8
+derivation sha256  8d24f58aee76e7932aeabd80e15848146a211282d09f0dca97d2aebf9d49470a
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,

@@ -23,7 +23,12 @@ def register(sub) -> None:
                     "optional Xp,Yp,Zp, dx_um,dy_um,dz_um, covariates such as T_C, t_s, "
                     "dir_X, nx,ny,nz, setup), search candidate effects by forward stepwise "
                     "selection (BIC and cross-validated residual), augment the layout and "
-                    "report RMS/max before and after on held-out points.")
+                    "report RMS/max before and after on held-out points.  Logged temperatures "
+                    "(T_<name>) with a time column (t_s, t_min, t_h) are also tried through a "
+                    "first-order lag, its time constant estimated with its uncertainty "
+                    "(lag_s); explanations the data cannot tell apart are named "
+                    "(alternatives, separate_by): 'volerr formats loop-lags'.  LAYOUT may be "
+                    "an augmented layout (*_aug.toml) written by an earlier run.")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", nargs="+", metavar="FILE",
                    help="measurement files of any instruments (deviations, ballbar, sphere; "
@@ -45,6 +50,23 @@ def register(sub) -> None:
     p.add_argument("--families", help="comma list of candidate families to search (default: "
                                       "all)")
     p.set_defaults(func=run)
+
+
+def loop_lines(e: dict) -> list:
+    """Console lines of an effect's lag and of the explanations the data cannot tell from it."""
+    out = []
+    lag = e.get("lag_s")
+    if lag:
+        std = f" +- {lag['std']:.0f}" if lag.get("std") is not None else ""
+        out.append(f"through a first-order lag of {e['covariate']}: tau = {lag['value']:.0f}"
+                   f"{std} s ({lag['value'] / 60:.1f} min)")
+    for a in e.get("alternatives") or []:
+        lag_a = f" through a lag of {a['lag_s']:.0f} s" if a.get("lag_s") else ""
+        out.append(f"these data cannot tell it from {a['parameter']} x {a['covariate']}"
+                   f"{lag_a} (held-out RMS {a['held_out_rms_um']:.3f} um)")
+    if e.get("separate_by"):
+        out.append(f"would separate them: {e['separate_by']}")
+    return out
 
 
 def run(args) -> int:
@@ -95,6 +117,8 @@ def run(args) -> int:
     for e in report.effects:
         pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
         print(f"  {e['kind']} {e['name']}: {pars}")
+        for line in loop_lines(e):
+            print(f"    {line}")
     if report["augmented_layout"]:
         print(f"  augmented layout: {report['augmented_layout']}; generated module: "
               f"{report['generated_module']}")

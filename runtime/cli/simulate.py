@@ -27,7 +27,7 @@ def _effect(text: str) -> dict:
 
 
 #: keys of --effect that name something; every other key is a number
-_TEXT_KEYS = ("axis", "component", "direction")
+_TEXT_KEYS = ("axis", "component", "direction", "sensor")
 
 
 def _check_effect(e: dict, model, text: str) -> dict:
@@ -45,6 +45,8 @@ def _check_effect(e: dict, model, text: str) -> dict:
                                            f"error of {model.name}")
         elif key == "direction":
             require(v in ("x", "y", "z"), f"--effect {text!r}: direction must be x, y or z")
+        elif key == "sensor":
+            require(isinstance(v, str), f"--effect {text!r}: sensor must be a sensor's name")
         else:
             require(isinstance(v, float), f"--effect {text!r}: {key} = {v!r} is not a number")
             require(math.isfinite(v) and abs(v) <= 1e6,
@@ -67,7 +69,10 @@ def register(sub) -> None:
                     "reversal:axis=X,um=4  coupling:component=EZX,axis=Y,um=6  "
                     "periodic:component=EXX,period_mm=25,um=2  "
                     "higher_order:component=EYZ,um=3,degree=10  probe_direction:um=2  "
-                    "setup:um=8,urad=15 (needs --rounds 2 or more).")
+                    "setup:um=8,urad=15 (needs --rounds 2 or more)  "
+                    "thermal_lag:sensor=T_motorX,tau_min=40,axis=X,ppm_per_K=2 (the scale of X "
+                    "follows a logged sensor through a first-order lag; or component=EYX,"
+                    "um_per_K=0.5; needs --sensors).")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("--out", required=True, help="measured-deviation CSV to write")
     p.add_argument("--points", type=int, default=600, help="number of points (default 600)")
@@ -82,6 +87,17 @@ def register(sub) -> None:
     p.add_argument("--noise-um", type=float, default=0.3, help="instrument noise, um (1 sigma)")
     p.add_argument("--magnitude-um", type=float, default=5.0,
                    help="size of the random error functions, um")
+    p.add_argument("--sensors", metavar="N|NAMES",
+                   help="log temperatures in place of T_C: a number (the first N of T_spindle "
+                        "T_motorX T_column T_bed T_coolant T_air1 T_air2 T_hydraulics T_motorY "
+                        "T_motorZ T_table T_cabinet) or comma-separated names (default: none, "
+                        "one column T_C)")
+    p.add_argument("--duty", metavar="SPEC",
+                   help="duty cycle of the heat sources, e.g. on:6h,off:4h (the drives; the "
+                        "coolant pump follows) or drives=on:2h,off:2h,on:6h;coolant=on:10h "
+                        "(default with --sensors: on:6h,off:4h)")
+    p.add_argument("--hours", type=float, default=8.0,
+                   help="duration of the campaign, h (the points in time order; default 8)")
     from . import _simulate_instruments
 
     _simulate_instruments.add_arguments(p)
@@ -110,9 +126,13 @@ def run(args) -> int:
     outs = Outputs(inputs).file("--out", args.out).check()
     effects = [_check_effect(_effect(e), model, e) for e in args.effect]
     probes = [tuple(v) for v in args.probe] if args.probe else demo_probes(model)
+    require(math.isfinite(args.hours) and 0.1 <= args.hours <= 1000,
+            "--hours must be between 0.1 and 1000")
+    require(args.duty is None or args.sensors, "--duty needs --sensors")
     camp = simulate(args.layout, n_points=args.points, seed=args.seed, probes=probes,
                     rounds=args.rounds, effects=effects,
-                    noise_um=args.noise_um, magnitude_um=args.magnitude_um)
+                    noise_um=args.noise_um, magnitude_um=args.magnitude_um,
+                    duration_h=args.hours, sensors=args.sensors, duty=args.duty)
     with outs:
         camp.write_csv(outs.path("--out"), inputs=inputs)
     print(f"{camp.n_points} points of {model.name} -> {args.out}")

@@ -173,6 +173,9 @@ class Observations:
     #: offset (N, 3) mm and projection (N, 3, 3), or None
     probe2: np.ndarray | None = None
     proj2: np.ndarray | None = None
+    #: (the observations this is a subset of, the indices there) or None: a lag of a
+    #: covariate (:mod:`volerr.machine.lags`) is filtered over the whole series
+    lag_source: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def n(self) -> int:
@@ -196,7 +199,28 @@ class Observations:
                             None if self.setup is None else self.setup.subset(idx),
                             take(self.file), take(self.row), self.files, take(self.sigma),
                             {k: v[idx] for k, v in self.info.items()}, take(self.probe2),
-                            take(self.proj2))
+                            take(self.proj2), self._lag_subset(idx))
+
+    def _lag_subset(self, idx) -> tuple:
+        if self.lag_source is None:
+            return (self, np.arange(self.n)[idx])
+        return (self.lag_source[0], self.lag_source[1][idx])
+
+    def lag_values(self, model) -> dict:
+        """The lags of ``model``'s effects ({canonical text: (N,) values}) at these points,
+        each filtered over the whole series these points were taken from, file by file."""
+        from ..machine.lags import lag_of_columns
+
+        if not getattr(model, "lags", ()):
+            return {}
+        root, idx = self.lag_source if self.lag_source is not None else (self, None)
+        cache = root.__dict__.setdefault("_lag_cache", {})
+        out = {}
+        for key, col, tau, time in model.lags:
+            if key not in cache:
+                cache[key] = lag_of_columns(root.covariates, col, tau, time, root.file)
+            out[key] = cache[key] if idx is None else cache[key][idx]
+        return out
 
     # ---- the rows of the linear model ------------------------------------------------
     def project(self, cols: np.ndarray) -> np.ndarray:
@@ -208,6 +232,7 @@ class Observations:
     def sensitivity(self, model) -> np.ndarray:
         """(N, 3, n_parameters) d(readings)/d(parameter), mm/mm or mm/rad."""
         cov = {c: self.covariates[c] for c in model.covariates}
+        cov.update(self.lag_values(model))
         out = self.project(model.sensitivity(self.positions, self.probe, covariates=cov))
         if self.proj2 is not None:
             out = out + np.einsum("nij,njm->nim", self.proj2, model.sensitivity(

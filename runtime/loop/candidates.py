@@ -128,6 +128,15 @@ class Candidate:
                          self.units)
 
 
+def extra_parameters(cand) -> int:
+    """Parameters a candidate costs in the BIC beyond its columns: a searched basis parameter
+    (a time constant, a period, a step location) and the second sensor of a difference of
+    two temperatures (the choice among the pairs): a single sensor is preferred over a
+    combination of sensors that explains the data equally well."""
+    kind_two = cand.kind == "thermal" and " - " in str(cand.info.get("covariate", ""))
+    return (1 if cand.search is not None else 0) + (1 if kind_two else 0)
+
+
 def _f(x: float) -> str:
     """A number for a basis expression, short and exact enough."""
     return repr(round(float(x), 9))
@@ -211,11 +220,48 @@ def covariates(cov: dict, model=None) -> tuple[list, list]:
     for a, b in itertools.combinations(temps, 2):
         if np.ptp(good[a] - good[b]) > 0:
             out.append(Covariate(f"{a} - {b}", "difference", f"({a} - {b})", "K", (a, b)))
+    out += lagged_covariates(temps, good)
     return out, warn
 
 
+def lagged_covariates(temps, good: dict) -> list:
+    """Every temperature channel through a first-order lag over the data's time column
+    (:mod:`volerr.machine.lags`; ``TAU`` in the expression stands for the time constant, in
+    seconds, searched on :func:`lag_grid`); none without a time column."""
+    from ..machine.lags import TIME_COLUMNS
+
+    time = next((c for c in TIME_COLUMNS if c in good), None)
+    if time is None:
+        return []
+    grid = lag_grid(good[time] * TIME_COLUMNS[time])
+    if not grid:
+        return []
+    arg = "" if time == "t_s" else f", {time}"
+    return [Covariate(f"lag({c})", "lagged", f"(lag({c}, TAU{arg}) - 20)", "K", (c, time),
+                      grid) for c in temps]
+
+
+#: ratio of neighbouring time constants of the lag grid (refined between neighbours)
+LAG_GRID_RATIO = 1.5
+
+
+def lag_grid(t_s) -> tuple:
+    """Time constants (s) searched for a lag: a geometric grid from 3 times the median
+    sampling interval (at least 60 s) to the campaign's duration; () when the campaign is
+    shorter than 10 minutes or the sampling too sparse to show a lag."""
+    t = np.unique(np.asarray(t_s, dtype=float))
+    if len(t) < 20 or np.ptp(t) < 600.0:
+        return ()
+    lo = max(60.0, 3.0 * float(np.median(np.diff(t))))
+    hi = float(np.ptp(t))
+    if hi < 4 * lo:
+        return ()
+    k = int(np.ceil(np.log(hi / lo) / np.log(LAG_GRID_RATIO)))
+    return tuple(round(float(x), 1) for x in np.geomspace(lo, hi, k + 1))
+
+
 # ---- P x C x basis ------------------------------------------------------------------------
-_KIND = {"temperature": "thermal", "difference": "thermal", "time": "drift",
+_KIND = {"temperature": "thermal", "difference": "thermal", "lagged": "thermal", "time": "drift",
          "direction": "reversal", "numeric": "covariate", "group": "group"}
 _PREFIX = {"thermal": "KT", "drift": "DR", "reversal": "RV", "covariate": "CV", "group": "GR"}
 
@@ -336,6 +382,28 @@ def _squareness_as_slopes(model, target: Target) -> list:
         comp = "E" + "XYZ"[j] + a
         if comp in model.parameters:
             out.append((comp, a))
+    return out
+
+
+def _lagged(model, target: Target, cov: Covariate, special, gauge) -> list:
+    """P x lag(C, tau): the linear candidates of P x C with C through a first-order lag, its
+    time constant searched on the covariate's grid (``cov.levels``; ``lag_s`` in the info, the
+    sensor's column name as ``covariate``; the info's ``basis`` names the lag as
+    ``lag(C, tau_s)`` whatever the time column, the terms over the data's time column)."""
+    out = []
+    for c in _linear(model, target, cov, special, gauge):
+        def make(tau, terms=tuple(c.terms), basis=c.info["basis"]):
+            from ..machine.lags import lag_key
+
+            tau = round(float(tau), 1)
+            return ([(p, t, b.replace("TAU", _f(tau))) for p, t, b in terms],
+                    {"lag_s": tau, "basis": f"{basis}, {lag_key(cov.columns[0], tau)}"})
+
+        grid = cov.levels
+        terms, extra = make(grid[len(grid) // 2])
+        info = {**c.info, "covariate": cov.columns[0], "lag_time_column": cov.columns[1],
+                **extra}
+        out.append(Candidate(c.kind, c.name, terms, info, Search("lag_s", grid, make), c.units))
     return out
 
 
@@ -506,6 +574,10 @@ def build(model, data: Data, ranges: dict, degree: int, covs=None, gauge=()) -> 
                                  {"parameter": "probe radius", "covariate": cov.name,
                                   "basis": "linear", "covariates": list(cov.columns)},
                                  units={"PR_R": (1e3, "um")}))
+            continue
+        if cov.kind == "lagged":
+            for t in tgts:
+                out += _lagged(model, t, cov, special, gauge)
             continue
         for t in ordered:
             if isinstance(t, syms.SymbolTarget):

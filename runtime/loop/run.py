@@ -238,13 +238,17 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
 
 
 def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, families,
-                   robust: Robust, y) -> tuple[sel.Selection, list]:
+                   robust: Robust, y, lag_caches=None) -> tuple[sel.Selection, list]:
+    """``lag_caches``: the lagged series of an earlier selection on the same data (a dict
+    filled here), reused."""
     covs, warns = cands.covariates(dat.covariates, model)
     candidates = [c for c in cands.build(model, dat, ranges, degree, covs, decl.gauge)
                   if c.kind in families]
     w_rows = robust.rows()
+    shared = lag_caches if lag_caches is not None else {}
     ctx = sel.Context(model, dat, None, None, spl.train,    # sensitivities per block
-                      np.sqrt(robust.weights[spl.train]), ranges)
+                      np.sqrt(robust.weights[spl.train]), ranges,
+                      {k: shared.setdefault(k, {}) for k in sel.SHARED_LAG_CACHES})
     return sel.select(candidates, ctx, decl.design, y, spl.folds, w_rows,
                       sel.SCREEN_POINTS), warns
 
@@ -267,10 +271,12 @@ class Augmented:
         return self._source
 
 
-def augment_step(model, dat, decl: Declared, selection, degree, ranges) -> Augmented:
+def augment_step(model, dat, decl: Declared, selection, degree, ranges,
+                 source=None) -> Augmented:
+    """``source``: the layout as the user named it (a file path or a shipped name)."""
     if not selection.accepted:
         return Augmented("", None, model, decl.design, decl.labels)
-    text = augmented_layout_text(model, selection.accepted)
+    text = augmented_layout_text(model, selection.accepted, source)
     lay = parse_layout(text, f"{model.name}_aug.toml")
     aug = Model(lay, derivation.module_from_source(derivation.fit_source(lay), lay.name))
     labels = declared_design(aug, dat.subset(np.arange(1)), degree, ranges).labels
@@ -392,7 +398,7 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
             a_s, a_c = (pars[t[0]] for t in c.terms)
             info["amplitude_um"] = round(math.hypot(a_s, a_c), 4)
             info["phase_rad"] = round(math.atan2(a_c, a_s), 4)   # a sin(2 pi q / P + phase)
-        ev = dict(s.evidence)
+        ev = {k: v for k, v in s.evidence.items() if k != "alternatives"}
         ev["contribution_rms_um"] = round(1e3 * rms(contrib), 4)
         ev["contribution_max_um"] = round(1e3 * float(np.max(point_norm(contrib))), 4)
         effects.append({"kind": c.kind, "name": c.name, "parameters": pars, "units": units,
@@ -401,8 +407,41 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
                         "covariate": info.get("covariate"), "basis": info.get("basis"),
                         "target": sorted({t[1] for t in c.terms}), "info": info,
                         "terms": [{"parameter": t[0], "target": t[1], "basis": t[2]}
-                                  for t in c.terms], "evidence": ev})
+                                  for t in c.terms], "evidence": ev,
+                        **_lag_entry(info), "alternatives": [], "separate_by": None})
     return effects
+
+
+def _lag_entry(info: dict) -> dict:
+    """``lag_s`` of an effect through a lag (:mod:`volerr.loop.lags`), else nothing."""
+    if info.get("lag_s") is None:
+        return {}
+    return {"lag_s": {"value": info["lag_s"], "std": info.get("lag_std_s")}}
+
+
+def alternatives_step(effects: list, selection, decl: Declared, spl: Split, robust: Robust,
+                      y) -> None:
+    """Each effect's ``alternatives`` (explanations the campaign cannot tell from it,
+    :func:`volerr.loop.lags.alternatives`: covariate, lag, basis, held-out RMS of the model
+    with it in the effect's place) and ``separate_by`` (what campaign would separate them)."""
+    from .lags import separate_by
+
+    sw = np.sqrt(robust.weights)
+    for e, s in zip(effects, selection.accepted):
+        alts = s.evidence.get("alternatives") or []
+        for x in alts:
+            cols = [x["cols"] if o is s else o.cols for o in selection.accepted]
+            design = decl.design.plus(cols)
+            c_tr, c_all, _, _ = _fits(design, spl, sw, y)
+            _, r_test, _ = _residuals(design, len(sw), spl.test, y, c_tr, c_all)
+            info = x["cand"].info
+            e["alternatives"].append({
+                "covariate": info.get("covariate"), "lag_s": info.get("lag_s"),
+                "basis": info.get("basis"), "parameter": info.get("parameter"),
+                "name": x["cand"].name, "held_out_rms_um": round(1e3 * rms(r_test), 4),
+                "delta_bic": x["delta_bic"], "cv_paired_t": x["cv_paired_t"]})
+        if alts:
+            e["separate_by"] = separate_by(s.cand.info, alts[0]["cand"].info)
 
 
 def _replicate_sigma(dat: Data, res_rows, weights) -> tuple[float, int] | None:
@@ -502,8 +541,9 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
                                                max_degree, weights=w0)
     decl = declared_step(model, dat, degree, ranges, spl.train)
     robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
+    lag_caches: dict = {}
     selection, warns = selection_step(model, dat, decl, spl, ranges, degree, families,
-                                      robust, y)
+                                      robust, y, lag_caches)
     keepers = [s for s in selection.accepted if s.cand.kind != "higher_order"]
     if keepers and not fixed_degree:
         # the degree was chosen with the effects unmodelled: choose it again with them
@@ -515,7 +555,7 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
             decl = declared_step(model, dat, degree, ranges, spl.train)
             robust = robust_weights(decl.design, y, np.arange(dat.n), dat.n)
             selection, warns = selection_step(model, dat, decl, spl, ranges, degree,
-                                              families, robust, y)
+                                              families, robust, y, lag_caches)
     return degree, degree_scores, decl, robust, selection, warns
 
 
@@ -554,11 +594,13 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     _explain(decl.unidentifiable, dat, model)
     bar.update()
     bar.set_postfix_str("augment, derive, generate")
-    aug = augment_step(model, dat, decl, selection, degree, ranges)
+    aug = augment_step(model, dat, decl, selection, degree, ranges,
+                       layout if isinstance(layout, (str, Path)) else None)
     bar.update()
     bar.set_postfix_str("held-out before/after")
     out = outcome_step(decl, aug, spl, robust, y, effect_columns(selection, aug))
     effects = effects_step(selection, aug, out, dat.n)
+    alternatives_step(effects, selection, decl, spl, robust, y)
     bar.update()
     paths = _write_augmented(out_dir, aug, selection, inputs, data)
     bar.update()
@@ -743,10 +785,14 @@ def _toml_value(v) -> str:
     return json.dumps(str(v))
 
 
-def augmented_layout_text(model: Model, selected) -> str:
-    """The layout text with one ``[effects.NAME]`` table per selected effect (name + _aug)."""
-    text, _ = layout_text(model.layout.path if model.layout.path and
-                          Path(model.layout.path).is_file() else model.name)
+def augmented_layout_text(model: Model, selected, source=None) -> str:
+    """The layout text with one ``[effects.NAME]`` table per selected effect (name + _aug).
+    ``source``: the layout file (or shipped name) ``model`` was read from; else the layout's
+    own path (when it is a file there) or its name."""
+    if source is None:
+        source = (model.layout.path if model.layout.path and Path(model.layout.path).is_file()
+                  else model.name)
+    text, _ = layout_text(source)
     new_name = f"{model.name}_aug"
     text, k = re.subn(r'(?m)^name\s*=\s*"[^"]*"', f'name = "{new_name}"', text, count=1)
     require(k == 1, f"layout {model.name}: no top-level name line to rename")
@@ -771,22 +817,28 @@ def demo_campaign(out=None, seed: int = 0, n_points: int = 900, kind: str = "the
     """A simulated MB1 campaign with one undeclared effect and five probe offsets.
 
     ``out``: CSV path to write (a temporary file when None; an int is taken as ``seed``).
-    ``kind``: ``"thermal"`` (the scale of X grows 11.5 um/m/K with T_C - 20) or ``"periodic"``
-    (a 2 um cyclic error of EXX, period 40 mm).  Sized so that the loop on it takes a few
-    seconds.  Returns ``("MB1", csv_path)``."""
+    ``kind``: ``"thermal"`` (the scale of X grows 11.5 um/m/K with T_C - 20), ``"periodic"``
+    (a 2 um cyclic error of EXX, period 40 mm) or ``"thermal_lag"`` (four logged sensors over
+    4 h, drives 2 h on then off; the scale of X grows 2 um/m/K with T_motorX through a 20 min
+    lag).  Sized so that the loop on it takes a few seconds.  Returns ``("MB1", csv_path)``."""
     import tempfile
 
     from .simulate import demo_probes, simulate
 
     if isinstance(out, int) and not isinstance(out, bool):
         seed, out = out, None
-    require(kind in ("thermal", "periodic"), f"demo effect must be thermal or periodic")
+    require(kind in ("thermal", "periodic", "thermal_lag"),
+            "demo effect must be thermal, periodic or thermal_lag")
     model = load("MB1")
     effect = {"thermal": {"kind": "thermal", "axis": "X", "ppm_per_K": 11.5},
               "periodic": {"kind": "periodic", "component": "EXX", "period_mm": 40.0,
-                           "um": 2.0}}[kind]
+                           "um": 2.0},
+              "thermal_lag": {"kind": "thermal_lag", "sensor": "T_motorX", "tau_min": 20.0,
+                              "axis": "X", "ppm_per_K": 2.0}}[kind]
+    logged = {"sensors": "T_motorX,T_coolant,T_column,T_air1", "duty": "on:2h,off:2h",
+              "duration_h": 4.0} if kind == "thermal_lag" else {}
     camp = simulate("MB1", n_points=n_points, seed=seed, probes=demo_probes(model),
-                    effects=[effect], noise_um=0.3)
+                    effects=[effect], noise_um=0.3, **logged)
     if out is None:
         out = Path(tempfile.mkdtemp(prefix="volerr_demo_")) / "MB1_campaign.csv"
     return "MB1", str(camp.write_csv(out))

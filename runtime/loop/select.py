@@ -23,7 +23,7 @@ import numpy as np
 from . import candidates as cands
 from ..estimate.blocks import BlockBase, blocks, cv_sq
 from ..estimate.design import TWIST, rows_of
-from ..machine.expressions import evaluate
+from ..machine.expressions import evaluate, lag_calls
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
 CV_T = 3.0           # minimum paired t of the held-out improvement
@@ -31,6 +31,10 @@ MAX_EFFECTS = 8
 TOP_FIT = 3          # candidates fitted fully per forward step
 SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
 N_SOURCES = 10       # residual sources reported
+LAG_CACHE = 48       # lagged series (all points) kept while screening
+#: caches of lagged series a context shares with its sub-contexts (and a second selection
+#: on the same data: :func:`volerr.loop.run.selection_step`)
+SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
 
 
 def _pinv_sym(G, tol=1e-12):
@@ -103,7 +107,50 @@ class Context:
     def on(self, pts, sw) -> "Context":
         """The same context on other points (shares nothing that depends on the points)."""
         return Context(self.model, self.data, self.sens, self.twist, pts, sw, self.ranges,
-                       {"fixed": self.cache.setdefault("fixed", {})}, self.sym)
+                       {"fixed": self.cache.setdefault("fixed", {}),
+                        **{k: self.cache.setdefault(k, {}) for k in SHARED_LAG_CACHES}},
+                       self.sym)
+
+    def basis_values(self, basis: str, full: bool = False) -> dict:
+        """:meth:`values`, plus the lags of ``basis`` (:mod:`volerr.machine.lags`) filtered over
+        all points of the data (file by file) and taken at the context's points: a lag is a
+        property of the whole time series, not of the points a fit looks at."""
+        vals = self.values(full)
+        calls = lag_calls(basis) if "lag(" in basis else ()
+        if not calls:
+            return vals
+        vals = dict(vals)
+        for key, col, tau, time in calls:
+            vals[key] = self.lag_series(key, col, tau, time) if full else \
+                self.lag_at_points(key, col, tau, time)
+        return vals
+
+    def lag_at_points(self, key, col, tau, time) -> np.ndarray:
+        """The lag ``key`` at the context's points (kept: a few thousand values each)."""
+        if "_pts_key" not in self.cache:
+            self.cache["_pts_key"] = hash(np.asarray(self.pts).tobytes())
+        mine = self.cache.setdefault("lag_pts", {})
+        at = (key, self.cache["_pts_key"])
+        if at not in mine:
+            mine[at] = self.lag_series(key, col, tau, time)[self.pts]
+        return mine[at]
+
+    def lag_series(self, key, col, tau, time) -> np.ndarray:
+        """The lag ``key`` of column ``col`` at all points (the last ``LAG_CACHE`` kept)."""
+        from ..machine.lags import lag_of_columns, time_order
+
+        store = self.cache.setdefault("lags", {})
+        if key in store:
+            store[key] = store.pop(key)           # most recently used last
+            return store[key]
+        while len(store) >= LAG_CACHE:
+            store.pop(next(iter(store)))
+        orders = self.cache.setdefault("lag_orders", {})
+        if time not in orders:
+            orders[time] = time_order(self.data.covariates[time], self.data.file)
+        store[key] = lag_of_columns(self.data.covariates, col, tau, time, self.data.file,
+                                    orders[time])
+        return store[key]
 
     def values(self, full: bool = False):
         """Basis variables at the context's points (all when ``full``): axis positions
@@ -167,11 +214,10 @@ class Context:
             for s, idx in blocks(np.arange(self.data.n)):
                 out[s] = self.columns_at(terms, idx)
             return out, params
-        vals = self.values(full)
         n = self.data.n if full else len(self.pts)
         out = np.zeros((n, 3, len(params)))
         for pn, target, basis in terms:
-            b = np.broadcast_to(evaluate(basis, vals), (n,))
+            b = np.broadcast_to(evaluate(basis, self.basis_values(basis, full)), (n,))
             out[:, :, params.index(pn)] += self.target_column(target, full) * b[:, None]
         if not full and len(self.pts) * len(params) <= 20000 * 3:
             self.cache[key] = (out, params)
@@ -180,11 +226,14 @@ class Context:
     def columns_at(self, terms, idx) -> np.ndarray:
         """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
         params = list(dict.fromkeys(t[0] for t in terms))
-        vals = {k: v[idx] for k, v in self.values(True).items()}
         arrays = self.sensitivities(idx)
         out = np.zeros((len(idx), 3, len(params)))
+        vals = {k: v[idx] for k, v in self.values(True).items()}
         for pn, target, basis in terms:
-            b = np.broadcast_to(evaluate(basis, vals), (len(idx),))
+            lagged = {k: self.lag_series(k, *rest)[idx] for k, *rest in lag_calls(basis)} \
+                if "lag(" in basis else {}
+            b = np.broadcast_to(evaluate(basis, {**vals, **lagged} if lagged else vals),
+                                (len(idx),))
             out[:, :, params.index(pn)] += self._column(target, *arrays) * b[:, None]
         return out
 
@@ -200,15 +249,18 @@ class Context:
         """Weighted rows (3n, G) of a one-parameter searched candidate at ``values`` (its
         terms summed: a proportional warm-up of the probe offset has three)."""
         key = ("profile", c.name, tuple(values))
-        if key not in self.cache:
+        if key not in self.cache or c.search.what == "lag_s":
             made = [c.search.make(v)[0] for v in values]
             n = len(self.pts)
             cols = np.zeros((n, 3, len(values)))
             for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
-                basis = np.column_stack([np.broadcast_to(evaluate(m[i][2], self.values()), (n,))
-                                         for m in made])
+                basis = np.column_stack([np.broadcast_to(
+                    evaluate(m[i][2], self.basis_values(m[i][2])), (n,)) for m in made])
                 cols += self.target_column(target)[:, :, None] * basis[:, None, :]
-            self.cache[key] = (cols * self.sw[:, None, None]).reshape(-1, len(values))
+            rows = (cols * self.sw[:, None, None]).reshape(-1, len(values))
+            if c.search.what == "lag_s":    # hundreds of lag candidates: not kept
+                return rows
+            self.cache[key] = rows
         return self.cache[key]
 
 
@@ -243,7 +295,9 @@ def _profile(c: cands.Candidate, ctx: Context, base: Base) -> cands.Candidate:
         if len(fine) > 40:
             fine = fine[np.linspace(0, len(fine) - 1, 40).astype(int)]
     else:
-        fine = np.geomspace(max(lo, 1e-3), hi, 15)
+        # a lag's tau: 7 values (5 % steps) suffice here, the accepted one is refined on all
+        # training points (volerr.loop.lags.profile_tau); hundreds of lag candidates
+        fine = np.geomspace(max(lo, 1e-3), hi, 7 if c.search.what == "lag_s" else 15)
     if len(fine):
         v0 = best_of([v0] + [float(x) for x in fine])
     return c.fixed(v0)
@@ -278,7 +332,7 @@ def _periodic_best(c, ctx: Context, base: Base) -> float:
 def _scored(c, ctx: Context, base: Base) -> "Scored":
     cols, params = ctx.columns(c.terms)
     gain, rank = base.score(ctx.rows(cols))
-    m_eff = rank + (1 if c.search is not None else 0)
+    m_eff = rank + cands.extra_parameters(c)
     return Scored(base.dbic(gain, m_eff), gain, rank, c, params)
 
 
@@ -287,7 +341,7 @@ def _scored_many(cs, ctx: Context, base) -> list:
     if not isinstance(base, BlockBase):
         return [_scored(c, ctx, base) for c in cs]
     res = base.score_many([ctx.group(c.terms) for c in cs])
-    return [Scored(base.dbic(g, r + (1 if c.search is not None else 0)), g, r, c,
+    return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
                    c.parameters) for c, (g, r) in zip(cs, res)]
 
 
@@ -424,9 +478,12 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
         if len(accepted) >= MAX_EFFECTS:
             break
         hit = None
+        from .lags import prefer_plain
+        prefer_plain(scored, TOP_FIT)
         for x in scored[:TOP_FIT]:
             if x.dbic > -BIC_GAIN:
                 break
+            x = _lag_refined(x, A_all, ctx, train, w_rows, y)
             cols, _ = ctx.columns(x.cand.terms, full=True)
             A_try = A_all.plus([cols])
             cv_new = _cv_sq(A_try, y, folds, train, w_rows)
@@ -452,6 +509,10 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     if accepted:
         accepted = _backward(A0, accepted, train, w_rows, y)
         accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, train, w_rows, y)
+        from . import lags
+        lags.refine(accepted, A0, ctx, train, w_rows, y)
+        lags.alternatives(accepted, (first or [])[:2 * N_SOURCES] + last[:2 * N_SOURCES], A0,
+                          ctx, train, w_rows, y, folds)
         A_all = _stack(A0, accepted)
         base = full(A_all)
         names = {a.cand.name for a in accepted}
@@ -462,6 +523,21 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             last = screen(candidates, ctx, base, names)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
+
+
+def _lag_refined(x: Scored, A_all, ctx, train, w_rows, y) -> Scored:
+    """A lag candidate with its time constant refined on all training points before it is
+    judged (screening fixed it on a subset and a grid: a few per cent off leave a residual
+    that a second, spurious effect would take up); other candidates as they are."""
+    if x.cand.search is None or x.cand.search.what != "lag_s":
+        return x
+    from .lags import profile_tau
+
+    base = _full_base(A_all, train, w_rows, y)
+    tau, std = profile_tau(x.cand, ctx, base, float(x.cand.info["lag_s"]))
+    cand = x.cand.fixed(tau)
+    cand.info["lag_std_s"] = None if std is None else round(std, 1)
+    return Scored(x.dbic, x.gain, x.rank, cand, x.params)
 
 
 def _stack(A0, sel):
@@ -478,7 +554,7 @@ def _backward(A0, selected, train, w_rows, y) -> list:
     def dbic_without(sel, i):
         base = _full_base(_stack(A0, sel[:i] + sel[i + 1:]), train, w_rows, y)
         gain, rank = base.score(_dense_group(sel[i].cols))
-        return base.dbic(gain, rank + (1 if sel[i].cand.search is not None else 0))
+        return base.dbic(gain, rank + cands.extra_parameters(sel[i].cand))
 
     sel = list(selected)
     while sel:
@@ -513,9 +589,9 @@ def _merge(A0, accepted, pool, ctx: Context, train, w_rows, y) -> list:
                 scores = base.score_many([_dense_group(pair)] +
                                          [ctx.group(x.cand.terms) for x in xs])
                 g_ij, r_ij = scores[0]
-                m_ij = r_ij + sum(1 for s_ in (sel[i], sel[j]) if s_.cand.search is not None)
+                m_ij = r_ij + sum(cands.extra_parameters(s_.cand) for s_ in (sel[i], sel[j]))
                 for x, (g_c, r_c) in zip(xs, scores[1:]):
-                    m_c = r_c + (1 if x.cand.search is not None else 0)
+                    m_c = r_c + cands.extra_parameters(x.cand)
                     d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
                     if r_c and d < best[0]:
                         best = (d, (i, j, x))

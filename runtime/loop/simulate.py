@@ -24,6 +24,10 @@ Effects (``effects=[{...}, ...]``, magnitudes in um, um/m/K, um/h, urad):
   direction (``nx, ny, nz``).
 * ``{"kind": "setup", "um": 8, "urad": 15}``: the instrument is re-placed between rounds
   (``setup`` = round number): every round after the first has its own rigid placement.
+* ``{"kind": "thermal_lag", "sensor": "T_motorX", "tau_min": 40, "axis": "X",
+  "ppm_per_K": 2}``: the scale of X follows a logged sensor through a first-order lag
+  (``component`` + ``um_per_K``: another error, an offset); needs ``sensors``
+  (:mod:`volerr.loop.thermal`: sensors, duty cycles).
 """
 
 from __future__ import annotations
@@ -34,14 +38,18 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require
+from ..machine.iso_names import along_component
 from ..machine.model import Model, load
+from . import thermal
 
 #: effect kind -> the keys it accepts (besides "kind")
 EFFECT_KEYS = {"thermal": {"axis", "ppm_per_K"}, "drift": {"direction", "um_per_h"},
                "reversal": {"axis", "um"}, "coupling": {"component", "axis", "um"},
                "periodic": {"component", "period_mm", "um", "phase"},
                "higher_order": {"component", "um", "degree"}, "probe_direction": {"um"},
-               "setup": {"um", "urad"}}
+               "setup": {"um", "urad"},
+               "thermal_lag": {"sensor", "tau_s", "tau_min", "axis", "ppm_per_K", "component",
+                               "um_per_K"}}
 KINDS = tuple(EFFECT_KEYS)
 
 
@@ -153,7 +161,8 @@ def make_plan(model: Model, n_points: int, rng: np.random.Generator, probes=None
 def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, rounds: int = 1,
              effects=(), noise_um: float = 0.3, magnitude_um: float = 5.0, degree: int = 4,
              setup_um: float = 20.0, setup_urad: float = 20.0, temperature_K: float = 4.0,
-             duration_h: float = 8.0, errors=None, shape: str = "poly") -> Campaign:
+             duration_h: float = 8.0, errors=None, shape: str = "poly", sensors=None,
+             duty: str | None = None) -> Campaign:
     """Simulate a campaign on a virtual machine of ``layout`` (name or layout file).
 
     The covariate columns ``T_C`` (deg C), ``t_s`` (s), ``dir_<axis>`` (+1 / -1, linear axes),
@@ -161,7 +170,10 @@ def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, roun
     a loop has every candidate family to consider whether or not an effect is present.
     ``shape``: ``"poly"`` or ``"smooth"`` error functions (:func:`random_errors`).
     ``errors``: {name: constant or callable(position)} replacing random error functions
-    (mm / rad; a callable of a component error gets its own axis' positions, mm | deg)."""
+    (mm / rad; a callable of a component error gets its own axis' positions, mm | deg).
+    ``sensors`` (a number or names, :func:`volerr.loop.thermal.sensor_names`): logged
+    temperatures in place of ``T_C``, heated by the duty cycle ``duty`` (``on:6h,off:4h``;
+    :mod:`volerr.loop.thermal`), over ``duration_h``."""
     model = load(layout)
     rng = np.random.default_rng(seed)
     effects = [dict(e) for e in effects]
@@ -191,6 +203,7 @@ def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, roun
     for a in linear:
         cov[f"dir_{a}"] = rng.choice([-1.0, 1.0], n)
     cov.update({"nx": n_dir[:, 0], "ny": n_dir[:, 1], "nz": n_dir[:, 2], "setup": rnd.astype(float)})
+    log = _sensors(sensors, duty, duration_h, seed, cov)
 
     values = {}
     for p, f in funcs.items():
@@ -199,6 +212,11 @@ def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, roun
     extra_dev = np.zeros((n, 3))
     placements = {}
     for e in effects:
+        if e["kind"] == "thermal_lag":
+            require(log is not None, "a thermal_lag effect needs logged sensors (--sensors)")
+            thermal.thermal_lag(e, log, positions, values, cov["t_s"],
+                                {a: along_component(model.layout, a) for a in linear})
+            continue
         _apply(e, model, positions, cov, values, extra_dev, placements, rng)
     dev = model.exact_error(positions, values, probe)
     nominal = model.nominal_position(positions, probe)
@@ -218,6 +236,20 @@ def simulate(layout="MB1", n_points: int = 600, seed: int = 0, probes=None, roun
              "setup_placements": placements, "noise_um": noise_um, "seed": seed}
     return Campaign(model.name if str(layout) == model.name else str(layout),
                     positions, probe, dev, cov, truth)
+
+
+def _sensors(sensors, duty, duration_h, seed, cov):
+    """Logged sensors in place of ``T_C`` (their own random stream: campaigns without sensors
+    are unchanged); the :class:`volerr.loop.thermal.SensorLog` or None."""
+    if sensors is None:
+        require(duty is None, "a duty cycle needs logged sensors (--sensors)")
+        return None
+    rng = np.random.default_rng([seed, 30])
+    log = thermal.log_sensors(thermal.sensor_names(sensors), duty, duration_h * 3600.0, rng)
+    del cov["T_C"]
+    readings = log.at(cov["t_s"], rng)
+    cov.update(readings)
+    return log
 
 
 def _component_axis(model: Model, component: str) -> str:

@@ -7,7 +7,9 @@ here for the fitting loop, so both always agree.
 
 Grammar: numbers, names, ``+ - * / **``, unary minus, parentheses and the functions
 ``sin cos exp sqrt abs``, ``ind(a, b)`` (1 where ``a == b``, else 0) and ``legendre(n, x)``
-(the Legendre polynomial of integer degree ``n``).  ``pi`` is the
+(the Legendre polynomial of integer degree ``n``), ``lag(C, tau_s)`` (the covariate column ``C``
+through a first-order lag of time constant ``tau_s`` seconds over the time column ``t_s``;
+``lag(C, tau_s, t_min)`` over another time column: :mod:`volerr.machine.lags`).  ``pi`` is the
 constant.  Bounds: at most 400 characters and 200 terms, numbers finite and at most 1e9 in
 magnitude, an exponent a number between -64 and 64 (``9**9**9**9`` is refused).  Every other name is a variable: an axis position (mm; rad for rotary axes, as in
 the derivation) or a covariate column of the measured data (``T_C``, ``t_s``, ``dir_X`` ...).
@@ -24,7 +26,8 @@ from ..errors import InputError
 
 FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "sqrt": np.sqrt, "abs": np.abs,
              "ind": lambda a, b: (np.asarray(a) == np.asarray(b)).astype(float),
-             "legendre": lambda n, x: np.polynomial.legendre.legval(x, [0.0] * int(n) + [1.0])}
+             "legendre": lambda n, x: np.polynomial.legendre.legval(x, [0.0] * int(n) + [1.0]),
+             "lag": None}     # evaluated by _lag_value: it needs the whole time series
 CONSTANTS = {"pi": np.pi}
 #: bounds that keep parsing, the derivation and the evaluation finite and fast
 MAX_CHARS, MAX_NODES, MAX_EXPONENT, MAX_CONSTANT = 400, 200, 64, 1e9
@@ -67,18 +70,52 @@ def parse(text: str) -> ast.Expression:
                   and not node.keywords)
         if not ok:
             raise InputError(f"basis expression {text!r}: {type(node).__name__} not allowed")
+        if isinstance(node, ast.Call) and node.func.id == "lag":
+            _check_lag(text, node)
     return tree
+
+
+def _check_lag(text: str, node: ast.Call) -> None:
+    """``lag(NAME, TAU_S[, TIME])``: a column, a positive number of seconds, a time column."""
+    from .lags import TIME_COLUMNS
+
+    a = node.args
+    ok = (len(a) in (2, 3) and isinstance(a[0], ast.Name) and isinstance(a[1], ast.Constant)
+          and float(a[1].value) > 0
+          and (len(a) == 2 or (isinstance(a[2], ast.Name) and a[2].id in TIME_COLUMNS)))
+    if not ok:
+        raise InputError(f"basis expression {text!r}: write a lag as lag(COLUMN, TAU_S) or "
+                         f"lag(COLUMN, TAU_S, TIME) with TAU_S > 0 seconds and TIME one of "
+                         f"{' '.join(TIME_COLUMNS)}")
+
+
+@functools.lru_cache(maxsize=4096)
+def lag_calls(text: str) -> tuple:
+    """The lags of a basis expression: ((key, column, tau_s, time column), ...) with ``key``
+    the canonical text :func:`volerr.machine.lags.lag_key`."""
+    from .lags import lag_key
+
+    out = []
+    for node in ast.walk(parse(text)):
+        if isinstance(node, ast.Call) and node.func.id == "lag":
+            col, tau = node.args[0].id, float(node.args[1].value)
+            time = node.args[2].id if len(node.args) == 3 else "t_s"
+            out.append((lag_key(col, tau, time), col, tau, time))
+    return tuple(dict.fromkeys(out))
 
 
 def variables(text: str) -> tuple[str, ...]:
     """The variable names of a basis expression (positions and covariates), sorted."""
     tree = parse(text)
     names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+    names |= {call[3] for call in lag_calls(text)}      # a lag's time column, named or not
     return tuple(sorted(names - set(FUNCTIONS) - set(CONSTANTS)))
 
 
 def evaluate(text: str, values: dict) -> np.ndarray:
-    """Evaluate a basis expression with numpy; ``values`` maps every variable to an array."""
+    """Evaluate a basis expression with numpy; ``values`` maps every variable to an array.
+    A lag is taken from ``values[key]`` when given there (the key of :func:`lag_calls`: the
+    lag of the whole series, for a subset of its points), else computed from the values."""
     tree = parse(text)
 
     def ev(node):
@@ -97,9 +134,25 @@ def evaluate(text: str, values: dict) -> np.ndarray:
             return -v if isinstance(node.op, ast.USub) else v
         if isinstance(node, ast.BinOp):
             return _BINOPS[type(node.op)](ev(node.left), ev(node.right))
+        if node.func.id == "lag":
+            return _lag_value(text, node, values)
         return FUNCTIONS[node.func.id](*(ev(a) for a in node.args))
 
     return np.asarray(ev(tree), dtype=float)
+
+
+def _lag_value(text: str, node: ast.Call, values: dict) -> np.ndarray:
+    from .lags import lag_key, lag_of_columns
+
+    col, tau = node.args[0].id, float(node.args[1].value)
+    time = node.args[2].id if len(node.args) == 3 else "t_s"
+    key = lag_key(col, tau, time)
+    if key in values:
+        return np.asarray(values[key], dtype=float)
+    for name in (col, time):
+        if name not in values:
+            raise InputError(f"basis expression {text!r} needs {name!r}")
+    return lag_of_columns(values, col, tau, time)
 
 
 def number(value, values: dict, what: str = "expression") -> float:

@@ -423,7 +423,10 @@ def _parse_effects(raw, axes: dict, squareness: dict, params: dict, where: str,
                     f"{where}: effect {en}: bad or clashing parameter name {pn!r}")
             require(seen.setdefault(pn, en) == en,
                     f"{where}: parameter {pn} used by effects {seen[pn]} and {en}")
-            require(target in targets, f"{where}: effect {en}: unknown target {target!r}")
+            # a parameter of an earlier effect is a target too (the loop run on an augmented
+            # layout: a thermal coefficient that itself varies): nested effects
+            require(target in targets or (target in seen and seen[target] != en),
+                    f"{where}: effect {en}: unknown target {target!r}")
             for v in variables(basis):
                 require(_NAME.match(v) is not None and v not in builtin - set(axes)
                         - set(PROBE_NAMES) and v not in seen,

@@ -193,6 +193,12 @@ class Model:
         return tuple(getattr(self.module, "COVARIATES", ()))
 
     @property
+    def lags(self) -> tuple:
+        """Lags of declared effects: ((canonical text ``lag(C, tau_s)``, column C, tau_s,
+        time column), ...) (:mod:`volerr.machine.lags`); () usually."""
+        return tuple(getattr(self.module, "LAGS", ()))
+
+    @property
     def symbols(self) -> tuple[str, ...]:
         """Nominal symbols of the chain (``probe.Zp``, ``axis.C``, ``param.d``, ``frame.F.x``
         ...; :attr:`volerr.machine.layout.Layout.symbols`) in the order of the generated
@@ -299,6 +305,9 @@ class Model:
             require(v.shape in ((), (n,), (1,)), f"covariate {c} must be a scalar or ({n},) array")
             require(np.all(np.isfinite(v)), f"covariate {c} has NaN or infinite values")
             out[c] = v
+        if self.lags:   # a lag of a longer series, at these points (else computed from these)
+            given = {k: covariates[k] for k, *_ in self.lags if k in covariates}
+            out["lags"] = given or None
         return out
 
     def _errors(self, errors, n: int) -> dict:

@@ -219,6 +219,8 @@ def test_candidate_bases_agree_with_the_derivation(layout):
     terms += candidates.periodic_terms("EXX", "X", 37.5)
     assert set(candidates.FAMILIES) - {c.kind for c in cands} <= {"covariate"}
     for text in sorted({t[2] for t in terms}):          # each basis text once
+        if "lag(" in text:      # a symbol in the derivation: test_lags.py checks the module
+            continue
         names = variables(text)
         f = sp.lambdify([sp.Symbol(v, real=True) for v in names], basis_expr(text), "numpy")
         want = np.broadcast_to(f(*(values[v] for v in names)), (data.n,))
