@@ -1,0 +1,221 @@
+"""``volerr plan``: the steps from the instruments named to the predicted result.
+
+1. the request: ``--parameters`` or what ``calibrate`` fits by default for these instruments;
+2. the candidate set-ups of every instrument (:mod:`volerr.plan._candidates`);
+3. their information on the requested parameters (:mod:`volerr.plan._information`);
+4. the set-ups and their readings (:mod:`volerr.plan._design`);
+5. the files, and the prediction on calibrate's own path (:mod:`volerr.plan._predict`) for
+   the plan, for each instrument alone (``determined_alone_by``) and for the instruments'
+   conventional plan at the same number of readings (:mod:`volerr.plan._baseline`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..calibrate import estimability, terms
+from ..errors import require
+from ..machine.model import Model, load
+from . import _baseline, _candidates, _design, _files, _information, _spec
+from ._predict import predict
+
+#: what each instrument kind is used for when --parameters is not given (the request
+#: ``calibrate`` fits by default; replaced by ``volerr.calibrate.defaults`` when it exists)
+DEFAULT_REQUEST = {"ballbar": "squareness", "sphere": "location", "distances": "constants"}
+
+
+def default_request(model, kinds) -> list:
+    """The parameter names ``calibrate`` fits by default for instruments of ``kinds``."""
+    try:
+        from ..calibrate.defaults import default_parameters
+    except ImportError:
+        text = ",".join(DEFAULT_REQUEST[k] for k in sorted(set(kinds)))
+        return terms.resolve(text, model)
+    return terms.resolve(",".join(default_parameters(model, sorted(set(kinds)))), model)
+
+
+@dataclass
+class Plan:
+    """A designed campaign: ``files`` [PlanFile], ``prediction`` and ``baseline`` (with its
+    name and files), ``alone`` {kind: Prediction}, ``minutes`` per file, the request."""
+
+    model: Model
+    instruments: list
+    chosen: list
+    files: list
+    prediction: object
+    baseline: dict
+    alone: dict
+    minutes: list
+    criterion: str
+    readings: int
+    candidates: int = 0
+    candidate_readings: int = 0
+    notes: list = field(default_factory=list)
+
+    @property
+    def total_minutes(self) -> float:
+        return float(sum(self.minutes))
+
+
+def plan(layout, specs, readings: int, parameters: str | None = None, minutes=None,
+         criterion: str = "I", seed: int = 0) -> Plan:
+    """Design a campaign for ``layout`` with the instruments ``specs`` (``--instrument``
+    texts) of ``readings`` readings in all (module docstring).  ``seed`` is reserved for
+    randomised tie-breaking (the design is deterministic)."""
+    model = layout if isinstance(layout, Model) else load(layout)
+    insts = [_spec.parse(s) for s in specs]
+    require(insts, "give at least one --instrument")
+    require(criterion in ("I", "D"), "--criterion must be I or D")
+    chosen = (terms.resolve(parameters, model) if parameters
+              else default_request(model, [i.kind for i in insts]))
+    pool = []
+    for i, inst in enumerate(insts):
+        found = _candidates.setups(model, inst)
+        require(found, f"--instrument {inst.text}: no set-up of it fits inside the travel "
+                       f"of {model.name}")
+        pool += [(i, s) for s in found]
+    need = sum(_floor(inst) * min(s.min_readings for j, s in pool if j == i)
+               for i, inst in enumerate(insts))
+    require(readings >= need, f"--readings {readings}: these instruments need at least "
+                              f"{need} readings (the smallest set-ups)")
+    prob = _information.problem(model, insts, pool, chosen)
+    cand = _pool(prob, insts, pool)
+    picked, counts = _choose(cand, prob, insts, pool, readings, minutes, criterion)
+    require(picked, f"--minutes {minutes}: no plan of these instruments fits in that time"
+            if minutes is not None else f"--readings {readings}: more readings than the "
+            f"candidate set-ups of these instruments can take (give more set-ups: places=, "
+            f"stations=)")
+    files = _files.group(insts, [(pool[c][0], pool[c][1], int(m))
+                                 for c, m in zip(picked, counts)])
+    return _finish(model, insts, chosen, files, cand, picked, counts, criterion, readings,
+                   pool)
+
+
+def _floor(inst) -> int:
+    """Fewest set-ups of an instrument: 3 stations for multilateration, else 1."""
+    return 3 if inst.kind == "distances" else 1
+
+
+def _cap(inst) -> int:
+    return {"sphere": inst.places, "distances": inst.stations}.get(inst.kind, 50)
+
+
+def _pool(prob, insts, pool) -> _design.Candidates:
+    """Per-reading information of every candidate, columns scaled to unit pool information."""
+    info = np.array([_information.setup_information(prob, insts, i, s) / s.template
+                     for i, s in pool])
+    total = info.sum(axis=0) + _prior(prob)
+    d = np.sqrt(np.maximum(np.diag(total), 0.0))
+    prob.scale = np.where(d > 0, d, 1.0)
+    est, _ = estimability.estimable(total)
+    prob.free = est | (np.arange(prob.q) < prob.n_global)
+    S = np.outer(1 / prob.scale, 1 / prob.scale)
+    info = info * S
+    setup_min, read_min = [], []
+    for i, s in pool:
+        extra = 0.0
+        if s.kind == "ballbar":
+            extra = 2 * 1.25 * 2 * math.pi * s.geometry["length"] / _spec.BALLBAR_FEED_MM_MIN
+        setup_min.append(_spec.SETUP_MIN[s.kind] + extra)
+        read_min.append(_spec.READING_S[s.kind] / 60.0)
+    f = prob.free
+    info = info[:, f][:, :, f]
+    return _design.Candidates(info, _design.factors(info), np.array([i for i, _ in pool]),
+                              np.array([s.min_readings for _, s in pool]),
+                              np.array([s.max_readings for _, s in pool]),
+                              np.array([s.template for _, s in pool]), np.array(setup_min),
+                              np.array(read_min))
+
+
+def _prior(prob) -> np.ndarray:
+    """(q, q) the priors of the campaign-wide nuisances (1 / u^2, mm^-2)."""
+    P = np.zeros((prob.q, prob.q))
+    g = prob.n_global
+    P[:g, :g] = np.diag(prob.prior)
+    return P
+
+
+def _scaled(prob):
+    f = prob.free
+    W = prob.W / np.outer(prob.scale, prob.scale)
+    P0 = _prior(prob) / np.outer(prob.scale, prob.scale)
+    return W[np.ix_(f, f)], P0[np.ix_(f, f)]
+
+
+def _choose(cand, prob, insts, pool, readings, minutes, criterion):
+    """The set-ups (pool indices) and their readings (module docstring of _design)."""
+    W, P0 = _scaled(prob)
+    caps = {i: _cap(inst) for i, inst in enumerate(insts)}
+    path = _greedy_path(cand, W, P0, criterion, caps, readings)
+    best = None
+    options = []
+    for k in range(1, len(path) + 1):
+        sel = path[:k]
+        if not _feasible(sel, cand, insts, readings):
+            continue
+        m = _design.allocate(cand, W, P0, criterion, sel, readings)
+        t = _design.minutes(cand, sel, m)
+        if minutes is not None and t > minutes:
+            continue
+        options.append((_design.plan_value(cand, W, P0, criterion, sel, m), k, sel, m))
+    if not options:
+        return [], []
+    top = min(v for v, *_ in options)
+    good = [o for o in options if _close(o[0], top)]
+    value, _, sel, m = good[0]
+    swapped = _design.exchange(cand, W, P0, criterion, sel)
+    if swapped != sel:
+        m2 = _design.allocate(cand, W, P0, criterion, swapped, readings)
+        v2 = _design.plan_value(cand, W, P0, criterion, swapped, m2)
+        if v2 < value and (minutes is None or _design.minutes(cand, swapped, m2) <= minutes):
+            sel, m = swapped, m2
+    return sel, m
+
+
+def _close(value, top) -> bool:
+    if not np.isfinite(value):
+        return False
+    if top > 0:
+        return value <= _design.GOOD_ENOUGH * top
+    return value <= top + abs(top) * (_design.GOOD_ENOUGH - 1) + math.log(_design.GOOD_ENOUGH)
+
+
+def _greedy_path(cand, W, P0, criterion, caps, readings) -> list:
+    """The greedy order, each instrument up to its cap, at most as many set-ups as the
+    readings allow (each its minimum)."""
+    k_max = int(min(len(cand.info), readings // max(int(cand.min_readings.min()), 1), 40))
+    return _design.greedy(cand, W, P0, criterion, k_max, caps)
+
+
+def _feasible(sel, cand, insts, readings) -> bool:
+    """Every instrument present with its fewest set-ups and the minimum readings fit."""
+    for i, inst in enumerate(insts):
+        if sum(1 for s in sel if cand.inst[s] == i) < _floor(inst):
+            return False
+    return int(cand.min_readings[sel].sum()) <= readings <= int(cand.max_readings[sel].sum())
+
+
+def _finish(model, insts, chosen, files, cand, picked, counts, criterion, readings, pool):
+    tool = _information.tool_of(insts)
+    parts = [_files.observations(model, f) for f in files]
+    pred = predict(model, parts, chosen, tool)
+    alone = {}
+    for kind in sorted({f.kind for f in files}):
+        sub = [p for p, f in zip(parts, files) if f.kind == kind]
+        alone[kind] = predict(model, sub, chosen, tool) if len(alone) < 3 else None
+    mins = [_file_minutes(f, cand, picked, counts, pool) for f in files]
+    base = _baseline.baseline(model, insts, chosen, files, tool)
+    return Plan(model, insts, chosen, files, pred, base, alone, mins, criterion, readings,
+                len(pool), int(cand.template.sum()))
+
+
+def _file_minutes(f, cand, picked, counts, pool) -> float:
+    total = 0.0
+    for c, m in zip(picked, counts):
+        if any(pool[c][1] is s for s, _ in f.setups):
+            total += cand.setup_min[c] + m * cand.read_min[c]
+    return round(total, 1)
