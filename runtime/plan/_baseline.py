@@ -4,7 +4,9 @@ same path as the plan, so that the user sees what the design gains:
 * ballbar: ISO 230-4 -- three circles in XY, YZ and ZX about one pivot at the centre of the
   working volume, the middle of the bar lengths given (the longest that fits when it does
   not), the readings split equally;
-* sphere / R-test: one placement at the centre of the table (the lowest candidate height),
+* sphere / R-test: one placement off the table's centre (a third of the half width along x,
+  as a kinematics cycle places its sphere so that a turning axis moves it; the lowest
+  candidate height),
   the rotary axes in equal steps over their travel (a turning axis over one turn), as
   many poses as readings;
 * tracking interferometer: four stations at the bottom corners of the working volume, the
@@ -57,16 +59,18 @@ def _ballbar(model, inst, n: int) -> list:
 
 def _sphere(model, inst, n: int) -> list:
     lo, hi = _candidates.volume(model, inst.tool)
-    centre = np.array([0.0, 0.0, round(float(lo[2] + 0.1 * (hi[2] - lo[2])), 1)])
+    half = 0.5 * min(hi[0] - lo[0], hi[1] - lo[1])
+    centre = np.array([round(half / 3.0, 1), 0.0, round(float(lo[2] + 0.1 * (hi[2] - lo[2])), 1)])
     axes = model.rotary_axes
     steps = max(2, math.ceil(n ** (1.0 / max(len(axes), 1))))
-    for _ in range(6):
+    s = None
+    for _ in range(12):
         grid = _candidates.rotary_grid(model, steps, steps)
-        s = _candidates.sphere_placement(model, inst, centre, grid, "S1")
+        s = _candidates.sphere_placement(model, inst, centre, grid, "S1") or s
         if s is not None and s.template >= n:
-            return [(s, n)]
+            break
         steps += 1
-    return [(s, min(n, s.template))] if s is not None else []
+    return [(s, n)] if s is not None else []        # beyond the poses: whole cycles repeated
 
 
 def _distances(model, inst, n: int) -> list:

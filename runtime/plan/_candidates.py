@@ -27,7 +27,7 @@ BALLBAR_TEMPLATE = 36
 #: steps of every rotary axis in a sphere placement's template (over its travel, one turn)
 SPHERE_STEPS = {"tilt": 7, "turn": 12}
 #: share of a sphere placement's template poses that must lie inside the travel
-SPHERE_INSIDE = 0.6
+SPHERE_INSIDE = 0.25
 #: most readings of one ballbar circle (both directions)
 MAX_CIRCLE = 3600
 #: most repetitions of a sphere placement's or a station's cycle of poses

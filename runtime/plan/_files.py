@@ -1,5 +1,6 @@
-"""A plan's set-ups as instrument files: columns (reading columns zero inside, empty when
-written), grouped into files, read back through the instruments' own readers into
+"""A plan's set-ups as instrument files: columns (reading columns zero inside -- the nominal
+distance for a tracking interferometer, from which its reader locates the station --, empty
+when written), grouped into files, read back through the instruments' own readers into
 :class:`volerr.instruments.Observations` -- the rows ``calibrate`` will build from the filled
 files, so that the prediction and the calibration share one observation model.
 
@@ -49,7 +50,8 @@ def columns_of(model, inst, setups: list) -> dict:
     cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     n = len(next(iter(cols.values())))
     for k in READINGS[inst.kind]:
-        cols[k] = np.zeros(n)
+        if inst.kind != "distances":    # a station is located from its nominal distances
+            cols[k] = np.zeros(n)
     if inst.kind == "sphere" and inst.frame == "machine":
         cols["frame"] = np.full(n, "machine", dtype=object)
     if inst.u_um is not None:

@@ -54,7 +54,33 @@ class Plan:
     readings: int
     candidates: int = 0
     candidate_readings: int = 0
-    notes: list = field(default_factory=list)
+    parameters_text: str | None = None
+    map_grid: dict = field(default_factory=dict)
+
+    def write(self, folder, json_path=None, html_path=None, inputs=()) -> None:
+        """The files, NC programs, ``plan.html`` (or ``html_path``) and the JSON."""
+        from ..fileio import json_text, write_text
+        from . import _nc, _report, _sheet
+        from ._files import csv_text
+
+        for pf in self.files:
+            header = _report.file_header(self, pf)
+            write_text(f"{folder}/{pf.name}", csv_text(pf, header), inputs=list(inputs))
+            write_text(f"{folder}/{_report.nc_name(pf)}", _nc.program(self.model, pf, header),
+                       inputs=list(inputs))
+        write_text(html_path or f"{folder}/plan.html", _sheet.html(self), inputs=list(inputs))
+        if json_path:
+            write_text(json_path, json_text(_report.data(self)), inputs=list(inputs))
+
+    def data(self) -> dict:
+        from ._report import data
+
+        return data(self)
+
+    def summary(self) -> str:
+        from ._report import summary
+
+        return summary(self)
 
     @property
     def total_minutes(self) -> float:
@@ -91,8 +117,9 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
             f"stations=)")
     files = _files.group(insts, [(pool[c][0], pool[c][1], int(m))
                                  for c, m in zip(picked, counts)])
-    return _finish(model, insts, chosen, files, cand, picked, counts, criterion, readings,
-                   pool)
+    out = _finish(model, insts, chosen, files, cand, picked, counts, criterion, readings, pool)
+    out.parameters_text = parameters
+    return out
 
 
 def _floor(inst) -> int:
@@ -209,8 +236,13 @@ def _finish(model, insts, chosen, files, cand, picked, counts, criterion, readin
         alone[kind] = predict(model, sub, chosen, tool) if len(alone) < 3 else None
     mins = [_file_minutes(f, cand, picked, counts, pool) for f in files]
     base = _baseline.baseline(model, insts, chosen, files, tool)
+    grid = {"linear_points": _information.GRID_LINEAR, "rotary_points": _information.GRID_ROTARY,
+            "tool_mm": [float(v) for v in tool],
+            "note": "every axis over its travel (rotary axes at most one turn), the tool point "
+                    "at the instruments' tool offset; standard uncertainty (k = 1) of each "
+                    "component of the volumetric error from the determined parameters"}
     return Plan(model, insts, chosen, files, pred, base, alone, mins, criterion, readings,
-                len(pool), int(cand.template.sum()))
+                len(pool), int(sum(s.template for _, s in pool)), map_grid=grid)
 
 
 def _file_minutes(f, cand, picked, counts, pool) -> float:
