@@ -142,7 +142,13 @@ class Calibration:
 
 def default_parameters(obs) -> str:
     """``location`` when every file is a sphere / R-test (a kinematics cycle identifies the
-    rotary axes' location errors), else ``all``."""
+    rotary axes' location errors), else ``all``; the files' declared ``# parameters:`` (a
+    ``volerr plan`` request) first."""
+    declared = {f.parameters for f in obs.files if f.parameters}
+    require(len(declared) <= 1, "the files declare different '# parameters:' lines; give "
+                                "--parameters")
+    if declared:
+        return declared.pop()
     kinds = {f.kind for f in obs.files}
     return "location" if kinds == {"sphere"} else "all"
 

@@ -24,9 +24,9 @@ from helpers import instrument_sim as S
 def read(path) -> tuple[list, dict]:
     """(header comment lines, columns: name -> list of cell texts) of a plan file."""
     with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    comments = [r[0] for r in rows if r and r[0].startswith("#")]
-    body = [r for r in rows if r and not r[0].startswith("#")]
+        lines = fh.read().splitlines()
+    comments = [ln for ln in lines if ln.startswith("#")]
+    body = list(csv.reader(ln for ln in lines if ln.strip() and not ln.startswith("#")))
     names = body[0]
     return comments, {n: [r[j] for r in body[1:]] for j, n in enumerate(names)}
 
