@@ -31,7 +31,7 @@ SPHERE_INSIDE = 0.25
 #: most readings of one ballbar circle (both directions)
 MAX_CIRCLE = 3600
 #: most repetitions of a sphere placement's or a station's cycle of poses
-REPEATS = 4
+REPEATS = 20
 #: decimals of every commanded position (mm, deg): file and NC program carry the same numbers
 DECIMALS = 4
 
@@ -171,12 +171,12 @@ def sphere_placement(model, inst, centre, grid: dict, label: str) -> SetUp | Non
 
 
 def sphere_setups(model, inst) -> list:
-    """Sphere placements on a grid of the table (x, y at -1/3, 0, 1/3 of the volume's half
+    """Sphere placements on a grid of the table (x, y at 0, +-1/3, +-2/3 of the volume's half
     width about the workpiece origin; three heights), each read at the rotary template
     positions inside the travel."""
     lo, hi = volume(model, inst.tool)
     half = 0.5 * min(hi[0] - lo[0], hi[1] - lo[1])
-    xy = np.round(np.array([-1.0, 0.0, 1.0]) * half / 3.0, 1)
+    xy = np.round(np.array([-2.0, -1.0, 0.0, 1.0, 2.0]) * half / 3.0, 1)
     zs = np.round(lo[2] + np.array([0.1, 0.25, 0.4]) * (hi[2] - lo[2]), 1)
     grid = rotary_grid(model)
     n_grid = int(np.prod([len(v) for v in grid.values()])) if grid else 1
