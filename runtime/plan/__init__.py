@@ -10,6 +10,8 @@ calibrate's path :mod:`._predict`; the conventional plan :mod:`._baseline`; outp
 :mod:`._write`, :mod:`._nc`, :mod:`._sheet`.
 """
 
+from ._execute import execute
 from ._run import Plan, default_request, plan
+from ._sheet import comparison_png
 
-__all__ = ["Plan", "default_request", "plan"]
+__all__ = ["Plan", "comparison_png", "default_request", "execute", "plan"]

@@ -39,8 +39,9 @@ def figure(plan) -> bytes:
         ax.set_xlabel(plotstyle.label(a, "mm"))
         ax.set_ylabel(plotstyle.label(b, "mm"))
         ax.set_aspect("equal", adjustable="datalim")
-    fig.suptitle(f"{model.name}: where each set-up goes (workpiece frame; o pivot, "
-                 f"s sphere, ^ station; dots: the tool point at each reading)")
+    fig.suptitle(f"{model.name}: where each set-up goes (workpiece frame)\n"
+                 f"o pivot, square sphere, triangle station; dots: the tool point at each "
+                 f"reading; dashed: the working volume")
     return plotstyle.png(fig)
 
 
@@ -92,3 +93,18 @@ max {b['max']:.3g} µm.</p>
 def _base(d, name) -> str:
     b = d["baseline"]["parameters"].get(name)
     return f"{b['predicted_std']:.3g}" if b else "not determined"
+
+
+@plotstyle.styled
+def comparison_png(rows) -> bytes:
+    """PNG of predicted (bars) against realised (dots) standard uncertainties; ``rows``
+    [(label, predicted, realised, unit)]."""
+    fig, ax = plotstyle.figure(height=max(3.0, 0.32 * len(rows) + 1.2))
+    y = np.arange(len(rows))
+    ax.barh(y, [r[1] for r in rows], color="C0", alpha=0.5, label="predicted (volerr plan)")
+    ax.plot([r[2] for r in rows], y, "o", color="C3", label="realised (volerr calibrate)")
+    ax.set_yticks(y, [f"{r[0]} / {plotstyle.unit(r[3])}" for r in rows])
+    ax.invert_yaxis()
+    ax.set_xlabel("standard uncertainty (k = 1), unit of each row")
+    ax.legend(loc="lower right")
+    return plotstyle.png(fig)
