@@ -1,7 +1,24 @@
 """Shared test set-up.  The independent references (exact numpy chains, rigid-body and tracker
 simulators) live in ``tests/helpers/`` and are imported as ``helpers.<module>``
-(``pythonpath = ["tests"]`` in pyproject.toml)."""
+(``pythonpath = ["tests"]`` in pyproject.toml).
+
+Hypothesis runs derandomized, always (profile ``deterministic``): the examples follow from the
+test's source, so every run -- a developer's, CI's, another checkout's -- tries the same ones,
+and no example database (``database=None``) carries a failure found on one machine into the
+runs of that machine only.  A test that fails does so on every run, where it can be fixed; one
+that passes cannot fail at random.  It is loaded always, not only when ``CI`` is set, because a
+local run must reproduce CI's verdict.  To search for new failing examples on purpose:
+``HYPOTHESIS_PROFILE=explore python -m pytest ...`` (random, with a database under
+``.hypothesis/``, which .gitignore keeps out of the repository)."""
+
+import os
 
 import matplotlib
+from hypothesis import settings
 
 matplotlib.use("Agg")  # no display on CI; every plot goes to a file
+
+settings.register_profile("deterministic", derandomize=True, database=None,
+                          print_blob=True)
+settings.register_profile("explore", derandomize=False)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))

@@ -36,6 +36,7 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
     """Evaluate ballbar ``files`` (paths); ``layout`` None: :data:`DEFAULT_LAYOUT` for
     X, Y, Z traces (the travel of the generic layout is not enforced)."""
     model = load(layout or DEFAULT_LAYOUT)
+    instruments.refuse_duplicates(files)
     parts, trs = [], []
     for path in files:
         obs = reader.read(path, model, check_travel=layout is not None)

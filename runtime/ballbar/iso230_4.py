@@ -2,7 +2,8 @@
 tools, ISO 230-4:2005 clause 3 definitions).
 
 A trace is one circle run in one direction: the readings of one file with the same
-``placement`` and ``direction``.  For each reading ``i``:
+``placement`` and ``direction``; a file without ``placement`` is cut into its circles by their
+geometry (plane, pivot, radius, direction: :func:`volerr.instruments.ballbar.split_traces`).  For each reading ``i``:
 
 * ``theta_i``: the angle of the nominal tool-ball centre about the pivot in the trace's plane
   (from the plane's first axis towards its second: XY from +X to +Y, YZ from +Y to +Z, ZX from
@@ -60,33 +61,33 @@ class Trace:
 
 
 def traces(obs, model) -> list:
-    """The traces of one ballbar file (its :class:`volerr.instruments.Observations`)."""
+    """The traces of one ballbar file (its :class:`volerr.instruments.Observations`): as the
+    reader cut them (``info["trace"]``: one placement and direction, or, without a
+    ``placement`` column, one circle by its geometry)."""
     where = obs.files[0].name if obs.files else "ballbar"
     t = model.nominal_position(obs.positions, obs.probe)
     pivot, length = obs.info["pivot"], obs.info["length"]
     place = np.asarray(obs.info["placement"], dtype=str)
     dirs = np.asarray(obs.info["direction"], dtype=float)
+    ids = np.asarray(obs.info["trace"])
     out = []
-    for pl in dict.fromkeys(place):
-        for d in (1.0, -1.0):
-            m = (place == pl) & (dirs == d)
-            if not m.any():
-                continue
-            idx = np.flatnonzero(m)
-            rel = t[idx] - pivot[idx]
-            swept = [a for a in model.rotary_axes if np.ptp(obs.positions[a][idx]) > 1.0]
-            if swept:       # ISO 10791-6: the deviation against the swept axis' angle
-                theta = np.deg2rad(obs.positions[swept[0]][idx])
-                plane = f"{swept[0]} sweep"
-            else:
-                k = plane_of(rel)
-                i, j = PLANE_AXES[k]
-                theta = np.arctan2(rel[:, j], rel[:, i])
-                plane = PLANE_NAMES[k]
-            require(len(idx) >= 8, f"{where}: trace {pl} ({'ccw' if d > 0 else 'cw'}) has "
-                                   f"{len(idx)} readings; ISO 230-4 needs a full circle")
-            out.append(Trace(where, str(pl), int(d), plane, float(length[idx[0]]),
-                             theta, obs.info["dr"][idx], idx, pivot[idx[0]]))
+    for k in dict.fromkeys(ids.tolist()):
+        idx = np.flatnonzero(ids == k)
+        pl, d = place[idx[0]], dirs[idx[0]]
+        rel = t[idx] - pivot[idx]
+        swept = [a for a in model.rotary_axes if np.ptp(obs.positions[a][idx]) > 1.0]
+        if swept:       # ISO 10791-6: the deviation against the swept axis' angle
+            theta = np.deg2rad(obs.positions[swept[0]][idx])
+            plane = f"{swept[0]} sweep"
+        else:
+            k_normal = plane_of(rel)
+            i, j = PLANE_AXES[k_normal]
+            theta = np.arctan2(rel[:, j], rel[:, i])
+            plane = PLANE_NAMES[k_normal]
+        require(len(idx) >= 8, f"{where}: trace {pl} ({'ccw' if d > 0 else 'cw'}) has "
+                               f"{len(idx)} readings; ISO 230-4 needs a full circle")
+        out.append(Trace(where, str(pl), int(d), plane, float(length[idx[0]]),
+                         theta, obs.info["dr"][idx], idx, pivot[idx[0]]))
     return out
 
 

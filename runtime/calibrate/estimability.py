@@ -30,6 +30,12 @@ NULL_TOL = 1e-10
 #: designs of five-axis chains); a column closer than 1e-4 would have a standard uncertainty
 #: 10^4 times that of an orthogonal design anyway
 DISTANCE_TOL = 1e-4
+#: eigenvalues of the unit-scaled Gram matrix below this fraction of the largest are rounding
+#: noise: their directions are exact dependencies of the columns
+ROUNDING_TOL = 1e-13
+#: a column whose component in an exact dependency exceeds this (unit-scaled; eigenvector noise
+#: is ~1e-13 / eigenvalue gap) is not estimable, however small its coefficient in it
+PARTICIPATION_TOL = 1e-7
 #: a parameter column below this fraction of its RMS on an ideal plan is not seen at all
 NEGLIGIBLE = 1e-6
 #: a file sees a column when what its set-up leaves of the column's squared norm exceeds
@@ -66,9 +72,24 @@ def distances(G: np.ndarray) -> np.ndarray:
     return out
 
 
+def in_exact_dependency(G: np.ndarray) -> np.ndarray:
+    """(p,) bool: the unit-scaled column takes part in an exact linear dependency of the
+    columns (an eigenvector of a rounding-level eigenvalue, component above
+    :data:`PARTICIPATION_TOL`).  :func:`distances` cannot see a column that enters a dependency
+    with a tiny coefficient (``a = b + 1e-5 c``): from the Gram matrix its distance to the span
+    of the others is resolved only to ``sqrt(eps / smallest eigenvalue of the others)``; the
+    eigenvector of the whole matrix resolves it to ``eps / eigenvalue gap``."""
+    C, _ = _unit(G)
+    w, V = np.linalg.eigh(C)
+    N = V[:, w < ROUNDING_TOL * max(float(w[-1]), 1e-300)]
+    return np.sqrt(np.sum(N * N, axis=1)) > PARTICIPATION_TOL
+
+
 def estimable(G: np.ndarray) -> tuple[np.ndarray, dict]:
-    """(mask of individually estimable columns, column -> the columns it is confounded with)."""
-    est = distances(G) > DISTANCE_TOL
+    """(mask of individually estimable columns, column -> the columns it is confounded with).
+    Estimable: the unit-scaled column is farther than :data:`DISTANCE_TOL` from the span of
+    the others and takes part in no exact dependency (:func:`in_exact_dependency`)."""
+    est = (distances(G) > DISTANCE_TOL) & ~in_exact_dependency(G)
     N = null_space(G)
     P = N @ N.T
     partners = {}
@@ -113,4 +134,35 @@ def negligible(model, obs, labels, degree: int, ranges: dict, colsq: np.ndarray,
         if lab[0] == "setup" or lab not in rms_ideal:
             continue
         out[j] = rms[j] < NEGLIGIBLE * rms_ideal[lab]
+    return out
+
+
+#: a column left out enters a kept column's combination when its unit-scaled coefficient
+#: exceeds this (smaller contributions are below what any campaign resolves)
+COMBINATION_TOL = 1e-3
+
+
+def combinations(G: np.ndarray, kept: np.ndarray, parameter: np.ndarray) -> dict:
+    """What the solution's kept columns estimate where the design is rank-deficient.
+
+    The solution keeps the columns ``kept`` (indices) and holds the others at 0; a column
+    ``d`` left out lies in the span of the kept ones, ``A_d = sum_k B_kd A_k``, so the kept
+    column ``k`` estimates ``x_k + sum_d B_kd x_d``.  Returns ``{k: {d: B_kd}}`` (natural
+    units of the columns: mm, rad) for the kept ``parameter`` columns (bool mask, set-up
+    unknowns excluded) whose estimate mixes in any left-out parameter column (unit-scaled
+    coefficient above :data:`COMBINATION_TOL`)."""
+    C, nonzero = _unit(G)
+    norms = np.sqrt(np.maximum(np.diag(G), 0.0))
+    kept = np.asarray(kept)
+    left = [d for d in np.flatnonzero(parameter & nonzero) if d not in set(kept.tolist())]
+    if not left or not len(kept):
+        return {}
+    B = np.linalg.lstsq(C[np.ix_(kept, kept)], C[np.ix_(kept, left)], rcond=1e-12)[0]
+    out: dict = {}
+    for a, k in enumerate(kept):
+        if not parameter[k]:
+            continue
+        for b, d in enumerate(left):
+            if abs(B[a, b]) > COMBINATION_TOL:
+                out.setdefault(int(k), {})[int(d)] = float(B[a, b] * norms[d] / norms[k])
     return out

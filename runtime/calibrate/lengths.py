@@ -55,7 +55,7 @@ def report(cal) -> dict | None:
         shape = test.targets.shape[:3]                              # (7, 5, 2)
         A = A.reshape((len(cols), 3) + shape)
         J = -np.einsum("kifl,fi->kfl", A[..., 1] - A[..., 0], test.u)   # (k, 7, 5)
-        E = 1e3 * np.einsum("k,kfl->fl", cal.coef[cols], J)
+        E = 1e3 * np.einsum("k,kfl->fl", cal.coef_written[cols], J)
         uE = 1e3 * np.sqrt(np.maximum(np.einsum("kfl,km,mfl->fl", J, C, J), 0.0))
         out["predicted"] = [{"line": name, "lengths_mm": [round(float(v), 4) for v in
                                                           test.lengths[i]],
@@ -73,7 +73,9 @@ def report(cal) -> dict | None:
                    "identified model (probing error not included); u: standard uncertainty "
                    "(k = 1) from the calibration's covariance; step gauges: measured beside "
                    "predicted, En = difference / combined standard uncertainty (the gauge's "
-                   "readings are in the fit)")
+                   "readings are in the fit); parameters not determined are 0 in it "
+                   "(undetermined), combinations enter under their written_as name")
+    out.update(mapping.what_enters(cal))
     return out
 
 
@@ -97,7 +99,7 @@ def step_gauges(cal) -> list:
             sub = part.subset(order)
             e, _, A, cols = mapping.predict(cal, sub.positions, sub.probe)
             J = -np.einsum("kin,i->kn", A - A[:, :, :1], n_dir)           # (k, faces)
-            pred = 1e3 * (cal.coef[cols] @ J)
+            pred = 1e3 * (cal.coef_written[cols] @ J)
             C = mapping.covariance(cal, cols)
             u_pred = 1e3 * np.sqrt(np.maximum(np.einsum("kn,km,mn->n", J, C, J), 0.0))
             s = np.asarray(part.sigma)[order] if part.sigma is not None else np.zeros(len(m))

@@ -26,9 +26,11 @@ GRID = 9
 
 def covariance(cal, cols) -> np.ndarray:
     """Covariance (mm, rad) of the design columns ``cols`` (indices into ``cal.labels``); zero
-    rows and columns for columns not in the solution."""
+    rows and columns for columns not in the solution or not written (not determined:
+    :attr:`volerr.calibrate.run.Calibration.written`)."""
     sol = cal.solution
-    where = {int(j): i for i, j in enumerate(sol.kept)}
+    written = cal.written
+    where = {int(j): i for i, j in enumerate(sol.kept) if written[int(j)]}
     idx = [where.get(int(j), -1) for j in cols]
     C = np.zeros((len(cols), len(cols)))
     ok = np.array([i >= 0 for i in idx])
@@ -78,7 +80,7 @@ def predict(cal, positions: dict, probe) -> tuple[np.ndarray, np.ndarray, np.nda
     """Identified volumetric error (n, 3) mm at the poses, its standard uncertainty (n, 3) mm,
     and the parameter rows (k, 3, n) with their column indices (for derived quantities)."""
     A, cols = rows_at(cal, positions, probe)
-    theta = cal.coef[cols]
+    theta = cal.coef_written[cols]
     C = covariance(cal, cols)
     e = np.einsum("k,kin->ni", theta, A)
     var = np.einsum("kin,kl,lin->ni", A, C, A)
@@ -121,11 +123,21 @@ def summary(cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0)) -> dict | Non
             "rms_length_um": round(float(np.sqrt(np.mean(length ** 2))), 4),
             "u_max_um": round(float(u_um.max()), 5),
             "u_rms_um": round(float(np.sqrt(np.mean(u_um ** 2))), 5),
-            "undetermined": list(cal.data.get("unidentifiable", [])),
+            **what_enters(cal),
             "note": "identified volumetric error (actual minus nominal tool point, workpiece "
                     "frame) over the measured range and its standard uncertainty from the "
                     "calibration's covariance (k = 1); parameters not determined by the "
-                    "campaign are not in it; --map-out writes every node"}
+                    "campaign are 0 in it (undetermined), a determined combination enters "
+                    "under its written_as name (combinations); --map-out writes every node"}
+
+
+def what_enters(cal) -> dict:
+    """``{"undetermined": [names written as 0], "combinations": [expressions written under
+    one of their names]}``: what a map or an ISO 10360 number built from ``cal`` holds."""
+    combos = cal.data.get("combinations", [])
+    written = {c["written_as"] for c in combos}
+    return {"undetermined": [n for n in cal.data.get("unidentifiable", []) if n not in written],
+            "combinations": [c["expression"] for c in combos]}
 
 
 def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), inputs=()):

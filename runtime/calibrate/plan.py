@@ -28,6 +28,8 @@ def suggest(model, parts: list, design, labels: list, G: np.ndarray, undetermine
     names = [name_of(lab) for lab in labels]
     setup_c = [j for j, lab in enumerate(labels) if lab[0] == "setup"]
     params = [j for j, lab in enumerate(labels) if lab[0] != "setup"]
+    # extra columns (reversals ...) come last; an extension's plan holds none of them
+    n_design = sum(1 for j in params if labels[j][1] != "extra")
     m_c = len(setup_c)
     param_keep = design.keep[len(design.data.setup_labels):]
     kinds = instruments.kinds()
@@ -50,7 +52,7 @@ def suggest(model, parts: list, design, labels: list, G: np.ndarray, undetermine
             comb = np.zeros((size, size))
             idx_c = np.r_[np.arange(m_c), m_c + m_e + np.arange(len(params))]
             comb[np.ix_(idx_c, idx_c)] += G[np.ix_(setup_c + params, setup_c + params)]
-            idx_e = np.r_[m_c + np.arange(m_e), m_c + m_e + np.arange(len(params))]
+            idx_e = np.r_[m_c + np.arange(m_e), m_c + m_e + np.arange(n_design)]
             comb[np.ix_(idx_e, idx_e)] += G_e
             est, _ = estimability.estimable(comb)
             now = [names[params[k]] for k in range(len(params))

@@ -35,7 +35,7 @@ import numpy as np
 from .. import instruments
 from ..errors import require
 from ..estimate import blocks
-from ..estimate.design import data_ranges, gauge_mask, identifiability_gram
+from ..estimate.design import data_ranges, declared_design, gauge_mask, identifiability_gram
 from ..estimate.steps import choose_degree, split_points
 from ..machine.model import Model, load
 from . import estimability, terms
@@ -59,6 +59,24 @@ class Calibration:
     residuals: dict = field(default_factory=dict)   # file -> (positions, residual um, rows)
     solution: "Solution | None" = None
     parts: list = field(default_factory=list)       # the files' Observations
+
+    @property
+    def written(self) -> np.ndarray:
+        """(p,) bool: the columns written into error tables, maps and ISO 10360 numbers: those
+        determined on their own and those carrying a determined combination
+        (``combinations``, ``written_as``); every other column is written as 0."""
+        sol = self.solution
+        if sol is None:
+            return np.ones(len(self.labels), bool)
+        out = np.asarray(sol.estimable, bool).copy()
+        out[list(sol.mixes)] = True
+        out[[j for j, lab in enumerate(self.labels) if lab[0] == "setup"]] = False
+        return out
+
+    @property
+    def coef_written(self) -> np.ndarray:
+        """:attr:`coef` with the columns not :attr:`written` set to 0."""
+        return np.where(self.written, self.coef, 0.0)
 
     def combination(self, weights: dict) -> tuple[float, float] | None:
         """(value, standard uncertainty) of ``sum w_label * coefficient`` (mm / rad), or None
@@ -90,6 +108,7 @@ class Calibration:
 
         model, ranges, deg = self.model, self.ranges, self.degree
         index = {lab: j for j, lab in enumerate(self.labels)}
+        coef, std_all = self.coef_written, np.where(self.written, self.std, 0.0)
         tables, constants, cstd = {}, {}, {}
         for a in model.axes:
             q = np.linspace(*ranges[a], n_grid)
@@ -102,15 +121,15 @@ class Calibration:
                 if model.parameter_axis.get(p) != a:
                     continue
                 js = [(k, index[(p, k)]) for k in range(deg + 1) if (p, k) in index]
-                vals[p] = sum((P[:, k] * self.coef[j] for k, j in js), np.zeros(n_grid))
+                vals[p] = sum((P[:, k] * coef[j] for k, j in js), np.zeros(n_grid))
                 std[p] = function_std(self, P, js)
             if vals:
                 tables[a] = ErrorTable(a, q, vals, std=std)
         for p in model.parameters:
             j = index.get((p, None))
             if j is not None:
-                constants[p] = float(self.coef[j])
-                cstd[p] = float(self.std[j])
+                constants[p] = float(coef[j])
+                cstd[p] = float(std_all[j])
         return tables, constants, cstd
 
     def write_error_tables(self, directory, inputs=()) -> Path:
@@ -118,7 +137,28 @@ class Calibration:
 
         tables, constants, cstd = self.error_tables()
         return write_error_dir(directory, tables, constants or None, cstd or None,
-                               inputs=list(inputs))
+                               inputs=list(inputs), comments=self.table_comments())
+
+    def table_comments(self) -> dict:
+        """``{axis or "constants": [line ...]}``: what the error directory holds under a name
+        that is not determined on its own (a combination's ``written_as``), and that every
+        other undetermined name is written as 0."""
+        out: dict = {}
+        for c in self.data.get("combinations", []):
+            name = c["written_as"].split("@")[0]
+            axis = self.model.parameter_axis.get(name)
+            where = "constants" if axis is None else axis
+            out.setdefault(where, []).append(
+                f"{c['written_as']} holds the combination {c['expression']} = "
+                f"{c['value']:.4g} +- {c['std']:.2g} {c['unit']} (the campaign does not "
+                f"determine its terms one by one)")
+        zero = [n for n in self.data.get("unidentifiable", [])
+                if n not in {c["written_as"] for c in self.data.get("combinations", [])}]
+        if zero:
+            for where in ["constants", *self.model.axes]:
+                out.setdefault(where, []).append(
+                    f"not determined, written as 0: {', '.join(zero)}")
+        return out
 
     def write_json(self, path, inputs=()) -> Path:
         from ..fileio import json_text, write_text
@@ -136,21 +176,39 @@ class Calibration:
         files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} rows): RMS "
                           f"{i['rms_residual']:.3f} um, held-out {i['heldout_rms']:.3f} um"
                           for i in d["instruments"])
+        combos = (f", {len(d['combinations'])} determined only in combination"
+                  if d.get("combinations") else "")
         return (f"{d['layout']}: {len(d['parameters'])} parameters identified, "
-                f"{len(d['unidentifiable'])} not determined by these data; {files}")
+                f"{len(d['unidentifiable'])} not determined by these data{combos}; {files}")
+
+    def undetermined_lines(self) -> list:
+        """Console lines: the combinations written under one of their names, and the names
+        written as 0 (what the error directory, the map and the ISO 10360 numbers hold)."""
+        d = self.data
+        out = [f"  determined only in combination: {c['expression']} = {c['value']:.4g} +- "
+               f"{c['std']:.2g} {c['unit']} (written as {c['written_as']})"
+               for c in d.get("combinations", [])]
+        written = {c["written_as"] for c in d.get("combinations", [])}
+        zero = [n for n in d["unidentifiable"] if n not in written]
+        if zero:
+            out.append(f"  not determined by these data (written as 0 in the error directory, "
+                       f"the map and the ISO 10360 numbers): {', '.join(zero[:12])}"
+                       f"{' ...' if len(zero) > 12 else ''} (see the report)")
+        return out
 
 
-def default_parameters(obs) -> str:
-    """``location`` when every file is a sphere / R-test (a kinematics cycle identifies the
-    rotary axes' location errors), else ``all``; the files' declared ``# parameters:`` (a
-    ``volerr plan`` request) first."""
+def campaign_kinds(obs) -> list:
+    """The instrument kinds of the stacked files (``deviations`` for bare observations)."""
+    return list(dict.fromkeys(f.kind for f in obs.files)) or ["deviations"]
+
+
+def declared_parameters(obs) -> str | None:
+    """The files' declared ``# parameters:`` (a ``volerr plan`` request), or None; files
+    declaring different requests are refused."""
     declared = {f.parameters for f in obs.files if f.parameters}
     require(len(declared) <= 1, "the files declare different '# parameters:' lines; give "
                                 "--parameters")
-    if declared:
-        return declared.pop()
-    kinds = {f.kind for f in obs.files}
-    return "location" if kinds == {"sphere"} else "all"
+    return declared.pop() if declared else None
 
 
 def reading_weights(obs) -> tuple[np.ndarray, float]:
@@ -200,20 +258,23 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     else:
         parts = instruments.read_parts(list(files), model)
         obs = instruments.stack(parts)
-    chosen = terms.resolve(parameters, model, default_parameters(obs))
+    from .defaults import default_parameters
+
+    req = terms.request(parameters or declared_parameters(obs), model,
+                        default_parameters(model, campaign_kinds(obs)))
+    chosen = req.parameters
+    obs = with_directions(obs, parts, req.reversals)
+    extra_terms = extra_terms + reversal_terms(model, obs, req, explicit=parameters is not None)
     ranges = data_ranges(model, obs)
     spl = split_points(obs.n, seed, test_fraction, None)
     w, u_ref = reading_weights(obs)
-    series = any(model.parameter_axis.get(p) for p in chosen)
-    degree_scores = {}
+    degree, degree_scores = _degree(model, obs, spl, ranges, req, degree, max_degree, w)
     bar.update()
     bar.set_postfix_str("degree")
-    if degree is None:
-        degree = 1
-        if series:
-            degree, degree_scores = choose_degree(model, obs, spl.train, None, ranges,
-                                                  max_degree, weights=w, parameters=chosen)
     keep, gauge = gauge_mask(model, obs, degree, ranges, chosen, constants=False)
+    keep &= np.array([req.fits(lab) for lab in
+                      declared_design(model, obs.subset(np.arange(1)), degree, ranges).labels])
+    gauge = [g for g in gauge if req.fits(g)]
     design = blocks.Design(model, obs, degree, ranges, keep)
     labels = list(design.labels)
     if extra_terms:
@@ -224,13 +285,15 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     fit = _normal_equations(design, obs, spl, np.sqrt(w))
     bar.update()
     bar.set_postfix_str("solve, residuals")
-    out = _solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref)
+    prefer = _preferred(model, obs, labels)
+    out = _solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref, prefer)
     bar.update()
     bar.close()
     units = {name: unit for name, _, _, unit in extra_terms}
     report = _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl,
                      u_ref, units)
-    if plan and not extra_terms:
+    report["fitted_terms"] = _fitted_terms(req)
+    if plan:
         from .plan import suggest
 
         report["plan"] = suggest(model, parts, design, labels, fit.G, report["unidentifiable"],
@@ -242,6 +305,86 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     _lab_report(cal, fit, obs, u_ref)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     return cal
+
+
+def _degree(model, obs, spl, ranges, req, degree, max_degree, w) -> tuple[int, dict]:
+    """Degree of the component series and the cross-validation scores (``{}`` when none ran):
+    ``degree`` when given (at least the highest term requested), else the highest term
+    requested when every series fitted is a term request (``EXX@slope``), else by
+    cross-validation (:func:`volerr.estimate.steps.choose_degree`) and at least that."""
+    need = req.max_term()
+    if degree is not None:
+        require(degree >= need, f"--degree {degree} is below the term requested in "
+                                f"--parameters (degree {need})")
+        return degree, {}
+    series = [p for p in req.parameters if model.parameter_axis.get(p)]
+    if not series or all(p in req.only for p in series):
+        return max(1, need), {}
+    found, scores = choose_degree(model, obs, spl.train, None, ranges, max_degree, weights=w,
+                                  parameters=req.parameters)
+    return max(found, need), scores
+
+
+def with_directions(obs, parts, axes):
+    """``obs`` with the direction covariates ``dir_<axis>`` of ``axes`` over all files: a
+    file where the axis does not move (a circle in YZ for X) has none of its own and gets 0
+    (no reversal acts); stacking keeps only the covariates every file has."""
+    if len(parts) < 2:
+        return obs
+    for axis in axes:
+        name = f"dir_{axis}"
+        if name in obs.covariates or not any(name in p.covariates for p in parts):
+            continue
+        obs.covariates[name] = np.concatenate([np.asarray(p.covariates.get(name, np.zeros(p.n)),
+                                                          float) for p in parts])
+    return obs
+
+
+def reversal_terms(model, obs, req, explicit: bool) -> list:
+    """Extra terms (see :func:`calibrate`) of the reversals ``RV_<axis>`` requested: the
+    positioning error of the axis plus ``RV/2`` approaching in the positive direction, minus
+    ``RV/2`` in the negative one (``dir_<axis>`` of the readings).  A reversal the readings
+    cannot show (one direction only) is refused when asked for explicitly, skipped when it
+    comes from the defaults."""
+    from ..machine.iso_names import along_component
+
+    out = []
+    for axis in req.reversals:
+        d = obs.covariates.get(f"dir_{axis}")
+        both = d is not None and len(np.unique(np.sign(np.asarray(d)[np.asarray(d) != 0]))) == 2
+        if not both:
+            require(not explicit, f"--parameters: RV_{axis} needs readings approaching in "
+                                  f"both directions of {axis} (dir_{axis} +1 and -1)")
+            continue
+        comp = along_component(model.layout, axis)
+        if comp in model.parameters:
+            out.append((f"RV_{axis}", comp, f"dir_{axis}/2", (1e3, "um")))
+    return out
+
+
+def _fitted_terms(req) -> list:
+    """The request as names: whole parameters, ``NAME@term`` of term requests, ``RV_<axis>``."""
+    out = []
+    for p in req.parameters:
+        if p in req.only:
+            out += [f"{p}@{_TERM_WORD.get(k, f'P{k}')}" for k in sorted(req.only[p])]
+        else:
+            out.append(p)
+    return out + [f"RV_{a}" for a in req.reversals]
+
+
+_TERM_WORD = {0: "offset", 1: "slope"}
+
+
+def _preferred(model, obs, labels) -> np.ndarray:
+    """(p,) bool: the columns the campaign's instruments are used for
+    (:func:`volerr.calibrate.defaults.default_parameters`); where the requested set is
+    rank-deficient the solution keeps them before the others."""
+    from .defaults import default_parameters
+
+    req = terms.request(None, model, default_parameters(model, campaign_kinds(obs)))
+    return np.array([lab[0] != "setup" and (lab[1] == "extra" or req.fits(lab))
+                     for lab in labels])
 
 
 def _lab_report(cal, fit, obs, u_ref) -> None:
@@ -388,15 +531,18 @@ class Solution:
     residuals: dict
     rss_files: dict = field(default_factory=dict)   # file -> weighted residual SS (mm^2)
     Gi: np.ndarray | None = None                     # inverse of the unit-scaled kept Gram
+    mixes: dict = field(default_factory=dict)        # kept column -> {left-out column: B}
 
 
-def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
+def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float, prefer=None) -> Solution:
     est, partners = estimability.estimable(fit.G)
     setup_idx = [j for j, lab in enumerate(labels) if lab[0] == "setup"]
     setup_of_file = [[j for j in setup_idx if Gf[j, j] > 0] for Gf in fit.G_files]
     seen = estimability.seen_by(fit.G_files, setup_of_file)
-    keep_d, _ = identifiability_gram(fit.G, labels)
+    keep_d, _ = identifiability_gram(fit.G, labels, prefer=prefer)
     kept = np.flatnonzero(keep_d)
+    is_param = np.array([lab[0] != "setup" for lab in labels])
+    mixes = estimability.combinations(fit.G, kept, is_param & ~est)
     sc = fit.scale[kept]
     S = np.outer(sc, sc)
     Gk = fit.G[np.ix_(kept, kept)] / S
@@ -444,7 +590,7 @@ def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float) -> Solution:
     s0 /= u_ref                                  # the a-posteriori factor, dimensionless
     return Solution(kept, cov, estimability.null_space(fit.G),
                     np.sqrt(np.maximum(np.diag(fit.G), 0.0)), coef, coef_tr, std, est, partners,
-                    seen, s0, dof, rms_all, rms_test, n_test, residuals, rss_files, Gi)
+                    seen, s0, dof, rms_all, rms_test, n_test, residuals, rss_files, Gi, mixes)
 
 
 def unit_factor(obs, f: int) -> float:
@@ -476,6 +622,8 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
                                         units.get(lab[0]))
         else:
             unident.append(name)
+    combos = [_combination(k, mix, labels, names, out, std_of, model, ranges, units)
+              for k, mix in sorted(out.mixes.items())]
     setup = {}
     units = obs.setup_units
     setup_labels = obs.setup_labels
@@ -508,6 +656,7 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
         "layout": model.name,
         "parameters": params,
         "unidentifiable": unident,
+        "combinations": combos,
         "setup": setup,
         "instruments": inst,
         "identifiability": ident,
@@ -522,6 +671,49 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
                    "variance factor; held-out: a random {:.0%} of the points, fitted on the "
                    "others").format(len(spl.test) / max(obs.n, 1)),
     }
+
+
+def _combination(k, mix, labels, names, out, std_of, model, ranges, units) -> dict:
+    """``{"expression", "value", "unit", "std", "written_as"}`` of the combination the kept
+    column ``k`` estimates (``mix`` {left-out column: coefficient}, natural units; see
+    :func:`volerr.calibrate.estimability.combinations`), in the report units of ``k``."""
+    def factor(j):
+        return terms.report(labels[j], 1.0, 0.0, model, ranges, units.get(labels[j][0]))
+
+    rep_k = factor(k)
+    text = names[k]
+    for d, b in sorted(mix.items(), key=lambda e: -abs(e[1]) * factor(e[0])["value"]):
+        rep_d = factor(d)
+        f, unit = _ratio_unit(rep_k["unit"], rep_d["unit"])
+        c = b * rep_k["value"] / rep_d["value"] * f
+        coeff = "" if abs(abs(c) - 1.0) < 1e-6 and not unit else f"{abs(c):.4g}{unit} * "
+        text += f" {'-' if c < 0 else '+'} {coeff}{names[d]}"
+    entry = terms.report(labels[k], out.coef[k], std_of.get(k, 0.0), model, ranges,
+                         units.get(labels[k][0]))
+    return {"expression": text, **entry, "written_as": names[k]}
+
+
+def _ratio_unit(num: str, den: str) -> tuple[float, str]:
+    """(factor, unit) of a coefficient turning a ``den`` quantity into a ``num`` one (the
+    coefficient in ``num / den`` times the factor is in the unit): a lever arm in mm (um per
+    urad), a length in mm (urad per urad/mm) ...; (1, "") when the units are equal."""
+    n, _, n_per = num.partition("/")
+    d, _, d_per = den.partition("/")
+    if n_per == d_per:
+        n_per = d_per = ""
+    base = {("um", "urad"): (1e3, 1), ("urad", "um"): (1e-3, -1), ("um", "um"): (1.0, 0),
+            ("urad", "urad"): (1.0, 0)}.get((n, d))
+    if base is None or (n_per and d_per):
+        return 1.0, f" {num}/({den})"
+    factor, mm = base
+    mm += d_per == "mm"
+    mm -= n_per == "mm"
+    parts = {0: [], 1: ["mm"], 2: ["mm^2"], -1: ["/mm"], -2: ["/mm^2"]}[mm]
+    if d_per == "deg":
+        parts.append("deg")
+    if n_per == "deg":
+        parts.append("/deg")
+    return factor, (" " + " ".join(parts)) if parts else ""
 
 
 def _file_u(obs, pts, u_ref) -> float:

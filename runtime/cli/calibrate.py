@@ -40,9 +40,11 @@ def register(sub) -> None:
     add_force(p)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters fitted, the others held at zero: comma list of names "
-                        "(EC0Y, EX0C), axes (X: its six component errors) and groups (all, "
-                        "constants, squareness, location, linear, rotary); default: location "
-                        "when every file is a sphere file, else all")
+                        "(EC0Y, EX0C), terms as printed (EXX@slope, EZY@P2, EXC@cos1), "
+                        "reversals (RV_X), axes (X: its six component errors) and groups "
+                        "(all, constants, squareness, location, linear, rotary); default: "
+                        "what each instrument kind of the campaign is used for, the union "
+                        "for a mixed campaign ('volerr formats calibrate-json')")
     p.add_argument("--degree", type=int, help="degree of the component errors' Legendre series "
                                               "(default: by cross-validation, 1..8)")
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split")
@@ -88,7 +90,6 @@ def run(args) -> int:
         print("  inconsistent with the rest (leave-one-file-out test): " + ", ".join(
             f"{f} (p = {worst[f]['p_value']:.2g}, Birge ratio {worst[f]['birge_ratio']})"
             for f in bad))
-    if result["unidentifiable"]:
-        print(f"  not determined by these data: {', '.join(result['unidentifiable'][:12])}"
-              f"{' ...' if len(result['unidentifiable']) > 12 else ''} (see the report)")
+    for line in result.undetermined_lines():
+        print(line)
     return 0

@@ -364,14 +364,17 @@ def identifiability(A2: np.ndarray, labels: list, tol: float = SV_TOL) -> tuple[
     return identifiability_gram(A2.T @ A2, labels, tol)
 
 
-def identifiability_gram(G: np.ndarray, labels: list, tol: float = SV_TOL):
-    """:func:`identifiability` from the Gram matrix A2^T A2 of the columns."""
+def identifiability_gram(G: np.ndarray, labels: list, tol: float = SV_TOL, prefer=None):
+    """:func:`identifiability` from the Gram matrix A2^T A2 of the columns.  ``prefer``: (p,)
+    bool, the columns the instruments are used for (a ballbar's squareness before the angular
+    slopes it shares a null direction with): taken before all other parameter columns."""
     G = _correlation(G)   # scale-free: mm and rad columns alike
+    first = np.zeros(len(labels), bool) if prefer is None else np.asarray(prefer, bool)
     # translational terms before angular ones: an angular error is what a plan without the
     # lever arms cannot see, not the scale or straightness it would be confused with
     order = sorted(range(len(labels)), key=lambda j: (
-        0 if labels[j][0] == "setup" else 1 if labels[j][1] is None else
-        2 if labels[j][0][1] in "XYZ" else 3, j))
+        0 if labels[j][0] == "setup" else 1 if first[j] else 2 if labels[j][1] is None else
+        3 if labels[j][1] == "extra" or labels[j][0][1] in "XYZ" else 4, j))
     keep = independent_columns(G, order, tol)
     dropped = np.flatnonzero(~keep)
     if len(dropped) == 0:

@@ -71,11 +71,31 @@ def read(spec, model) -> Observations:
     return obs
 
 
+def refuse_duplicates(paths) -> None:
+    """Refuse (InputError, one line) the same file given twice: the same path, or two files
+    with the same bytes (a copy would count its readings twice and halve every standard
+    uncertainty it contributes)."""
+    import hashlib
+
+    seen: dict = {}
+    for p in paths:
+        path = Path(p)
+        try:
+            key = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() \
+                else str(path.resolve())
+        except OSError:
+            key = str(path.resolve())
+        first = seen.setdefault(key, path)
+        same = first.resolve() == path.resolve()
+        require(first is path, f"{path.name}: the same file given twice" if same else
+                f"{path.name} and {first.name} hold the same readings (the same file given "
+                f"twice)")
+
+
 def read_parts(specs, model) -> list:
-    """Several files, each as its own :class:`Observations` (the same file twice refused)."""
-    names = [Path(split_spec(s)[1]).resolve() for s in specs]
-    dup = [str(n) for n in names if names.count(n) > 1]
-    require(not dup, f"{Path(dup[0]).name if dup else ''}: the same file given twice")
+    """Several files, each as its own :class:`Observations` (the same file twice refused:
+    :func:`refuse_duplicates`)."""
+    refuse_duplicates([split_spec(s)[1] for s in specs])
     return [read(s, model) for s in specs]
 
 

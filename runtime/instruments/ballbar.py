@@ -87,7 +87,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
     # a bar calibrated with its calibrator: its length offset known to within length_u_um
     length_u = f.known_uncertainty(find, "length_u", where)
-    direction = _direction(find, n, where)
+    direction, direction_given = _direction(find, n, where)
     placement = f.labels(find, "placement", raw, n)
     t = model.nominal_position(pos, probe)
     lin = generated.ballbar(t[:, 0], t[:, 1], t[:, 2], pivot[:, 0], pivot[:, 1], pivot[:, 2],
@@ -98,6 +98,11 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
             f"{float(np.linalg.norm(t[bad[0]] - pivot[bad[0]])) if len(bad) else 0:.4f} mm "
             f"from the pivot, length_mm is {float(length[bad[0]]) if len(bad) else 0:g}: "
             f"the bar length and the positions disagree")
+    swept = np.zeros(n, bool)
+    for a in model.rotary_axes:
+        swept |= np.ptp(pos[a]) > 1.0
+    trace, direction, placement = split_traces(t - pivot, pivot, length, placement, direction,
+                                               direction_given, swept, where)
     groups, names = _placements(placement, pivot, length, where)
     proj = np.zeros((n, 3, 3))
     proj[:, 0, :] = lin[1:4].T
@@ -111,22 +116,208 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                   [("um",) * len(SETUP_KEYS)] * len(names),
                   [(None, None, None, length_u)] * len(names))
     covs = f.covariates(find, model, where, skip=())
-    covs = {**motion_directions(model, pos, groups, direction), **covs}
+    covs = {**motion_directions(model, pos, trace, np.ones(n)), **covs}
     info = {"pivot": pivot, "length": length, "dr": dr, "direction": direction,
-            "placement": np.asarray(names, dtype=object)[groups]}
+            "placement": np.asarray(names, dtype=object)[groups], "trace": trace}
     return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
                         setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u,
                         info=info)
 
 
-def _direction(find, n: int, where: str) -> np.ndarray:
+def _direction(find, n: int, where: str) -> tuple[np.ndarray, bool]:
+    """The ``direction`` column (+1 / -1) and whether the file has one (else all +1)."""
     h = find("direction", ("",), "direction")
     if h is None:
-        return np.ones(n)
+        return np.ones(n), False
     d = find.cols[h]
     require(np.all(np.isin(d, (-1.0, 1.0))), f"{where}: direction must be +1 (counter-"
                                               f"clockwise) or -1 (clockwise)")
-    return d
+    return d, True
+
+
+#: a circle trace needs this many readings at distinct angles ...
+MIN_TRACE_READINGS = 8
+#: ... and no gap between consecutive angles wider than this (deg): at least half a circle
+MAX_TRACE_GAP_DEG = 180.0
+#: a reading lies in a plane through the pivot when its offset along the plane's normal is
+#: below this fraction of the bar length
+IN_PLANE_TOL = 1e-4
+
+
+def split_traces(rel, pivot, length, placement, direction, direction_given, swept, where):
+    """Trace of every reading, and the directions and placement labels completed.
+
+    A trace is one circle (or rotary sweep) run in one direction.  With a ``placement``
+    column: the readings of one placement and one direction.  Without: the file is cut into
+    its traces by geometry -- consecutive readings with the same pivot, bar length, plane (the
+    plane through the pivot holding the offsets ``rel`` = tool ball minus pivot, mm) and
+    direction (the ``direction`` column, else the sense in which the angle turns) -- and each
+    (plane, pivot, length) is a placement of its own, labelled by its plane (``XY``, ``YZ``
+    ...).  Every circle trace is checked (:func:`check_trace`).  Returns (trace index (n,),
+    direction (n,), placement labels (n,) or None)."""
+    n = len(rel)
+    if placement is not None:
+        key = np.unique(np.column_stack([np.unique(placement.astype(str),
+                                                   return_inverse=True)[1].ravel(),
+                                         direction]), axis=0, return_inverse=True)[1].ravel()
+        trace = key
+    else:
+        trace = _geometric_traces(rel, pivot, length, direction if direction_given else None,
+                                  swept)
+    if not direction_given:
+        direction = _trace_senses(rel, trace, swept)
+    for k in np.unique(trace):
+        idx = np.flatnonzero(trace == k)
+        if not swept[idx].any():
+            check_trace(rel[idx], where, _label(placement, rel, idx), direction[idx[0]])
+    if placement is None:
+        placement = _geometric_labels(rel, pivot, length, trace)
+    return trace, direction, placement
+
+
+def _plane_candidates(rel, length) -> np.ndarray:
+    """(n, 3) bool: the plane with normal k holds the reading (offset along k ~ 0)."""
+    return np.abs(rel) <= IN_PLANE_TOL * np.asarray(length)[:, None]
+
+
+def _geometric_traces(rel, pivot, length, direction, swept) -> np.ndarray:
+    """Trace index of every reading of a file without ``placement`` (see
+    :func:`split_traces`): a new trace where the pivot, the length, the given direction or the
+    plane changes (no plane holds every reading of the current trace any more), and, without
+    a direction column, where the angle turns the other way for at least
+    :data:`MIN_REVERSAL_RUN` readings."""
+    n = len(rel)
+    cand = _plane_candidates(rel, length)
+    same = np.ones(n, bool)
+    same[1:] = (np.all(np.isclose(pivot[1:], pivot[:-1], atol=1e-6), axis=1)
+                & np.isclose(length[1:], length[:-1], atol=1e-6) & (swept[1:] == swept[:-1]))
+    if direction is not None:
+        same[1:] &= direction[1:] == direction[:-1]
+    trace = np.zeros(n, int)
+    planes = cand[0].copy()
+    steps: list = []
+    for i in range(1, n):
+        both = planes & cand[i]
+        new = not same[i] or (not swept[i] and planes.any() and not both.any())
+        if not new and not swept[i] and both.sum() == 1:
+            step = abs(_step(rel[i - 1], rel[i], int(np.argmax(both))))
+            # a reading in two planes (where one circle ends and the next begins) after a
+            # jump of the angle: the first reading of the next circle
+            new = cand[i].sum() > 1 and len(steps) >= 3 and step > 5 * np.median(steps)
+            steps.append(step)
+        if new:
+            planes, steps = cand[i].copy(), []
+        else:
+            planes = both
+        trace[i] = trace[i - 1] + int(new)
+    if direction is None:
+        trace = _split_reversals(rel, trace, swept)
+    return trace
+
+
+#: a trace is cut where its angle turns the other way for at least this many readings
+MIN_REVERSAL_RUN = 3
+
+
+def _split_reversals(rel, trace, swept) -> np.ndarray:
+    """Cut the traces where the angle's sense of turning reverses (a counter-clockwise circle
+    followed by a clockwise one, no direction column); shorter runs of the other sense (a
+    reading shared by two planes) do not cut."""
+    out = np.zeros(len(rel), int)
+    label = 0
+    for k in np.unique(trace):
+        idx = np.flatnonzero(trace == k)
+        cuts = []
+        if not swept[idx].any() and len(idx) > 2:
+            step = np.sign([_wrap(d) for d in np.diff(_angles(rel[idx]))])
+            sense = 0.0
+            for j in range(len(step)):
+                run = step[j:j + MIN_REVERSAL_RUN]
+                if sense and step[j] == -sense and len(run) == MIN_REVERSAL_RUN \
+                        and np.all(run == step[j]):
+                    cuts.append(j + 1)
+                    sense = step[j]
+                elif not sense and step[j]:
+                    sense = step[j]
+        piece = np.zeros(len(idx), int)
+        for c in cuts:
+            piece[c:] += 1
+        out[idx] = label + piece
+        label += int(piece[-1]) + 1 if len(idx) else 0
+    return out
+
+
+def _step(r0, r1, normal: int) -> float:
+    """Angle (rad) turned from offset ``r0`` to ``r1`` in the plane of the given normal."""
+    a, b = [(1, 2), (2, 0), (0, 1)][normal]
+    return _wrap(np.arctan2(r1[b], r1[a]) - np.arctan2(r0[b], r0[a]))
+
+
+def _wrap(a: float) -> float:
+    return float((a + np.pi) % (2 * np.pi) - np.pi)
+
+
+def _trace_plane(rel) -> int:
+    """Index of the normal of the plane of a trace's offsets (the smallest spread)."""
+    return int(np.argmin(np.ptp(rel, axis=0)))
+
+
+def _angles(rel) -> np.ndarray:
+    """Angles (rad) of a circle trace's offsets in its plane (first axis towards second)."""
+    a, b = [(1, 2), (2, 0), (0, 1)][_trace_plane(rel)]
+    return np.arctan2(rel[:, b], rel[:, a])
+
+
+def _trace_senses(rel, trace, swept) -> np.ndarray:
+    """+1 / -1 of every reading: the sense in which its trace's angle turns (a rotary sweep:
+    +1, the sweep's own order is its direction)."""
+    out = np.ones(len(rel))
+    for k in np.unique(trace):
+        idx = np.flatnonzero(trace == k)
+        if swept[idx].any() or len(idx) < 2:
+            continue
+        step = np.array([_wrap(d) for d in np.diff(_angles(rel[idx]))])
+        out[idx] = -1.0 if np.sum(step) < 0 else 1.0
+    return out
+
+
+def check_trace(rel, where: str, label: str, direction) -> None:
+    """Refuse a degenerate circle trace (InputError, one line): fewer than
+    :data:`MIN_TRACE_READINGS` readings at distinct angles (all readings at one point), or a
+    gap between consecutive angles wider than :data:`MAX_TRACE_GAP_DEG` (less than half a
+    circle: its least-squares centre, G and the diagnosis are not determined)."""
+    deg = np.sort(np.unique(np.round(np.rad2deg(np.mod(_angles(rel), 2 * np.pi)), 3)))
+    name = f"{where}: trace {label} ({'ccw' if direction > 0 else 'cw'})"
+    require(len(deg) >= MIN_TRACE_READINGS,
+            f"{name} has {len(rel)} readings at {len(deg)} distinct angle(s); a circle trace "
+            f"needs at least {MIN_TRACE_READINGS} over at least half a circle")
+    gaps = np.diff(np.concatenate([deg, [deg[0] + 360.0]]))
+    require(gaps.max() <= MAX_TRACE_GAP_DEG,
+            f"{name} covers only {360.0 - gaps.max():.0f} deg; a circle trace needs readings "
+            f"over at least half a circle (no gap wider than {MAX_TRACE_GAP_DEG:.0f} deg)")
+
+
+def _label(placement, rel, idx) -> str:
+    if placement is not None:
+        return str(placement[idx[0]])
+    return PLANE_NAMES[_trace_plane(rel[idx])]
+
+
+def _geometric_labels(rel, pivot, length, trace) -> np.ndarray:
+    """Placement label of every reading of a file without ``placement``: one placement per
+    (plane, pivot, bar length), named by its plane (``XY``; ``XY-2`` ... when the plane
+    recurs with another pivot or length)."""
+    out = np.empty(len(rel), dtype=object)
+    seen: dict = {}
+    for k in np.unique(trace):
+        idx = np.flatnonzero(trace == k)
+        plane = PLANE_NAMES[_trace_plane(rel[idx])]
+        key = (plane, *np.round(pivot[idx[0]], 6), round(float(length[idx[0]]), 6))
+        if key not in seen:
+            count = sum(1 for q in seen if q[0] == plane)
+            seen[key] = plane if count == 0 else f"{plane}-{count + 1}"
+        out[idx] = seen[key]
+    return out
 
 
 def _placements(placement, pivot, length, where) -> tuple[np.ndarray, list]:

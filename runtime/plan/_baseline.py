@@ -27,7 +27,7 @@ NAMES = {"ballbar": "ISO 230-4: three orthogonal circles about the centre",
          "distances": "four stations at the bottom corners"}
 
 
-def baseline(model, insts, chosen, files, tool) -> dict:
+def baseline(model, insts, spec, files, tool) -> dict:
     """``{"name", "readings", "prediction", "files"}`` of the conventional plan with the
     plan's readings per instrument."""
     picks, names = [], []
@@ -40,7 +40,7 @@ def baseline(model, insts, chosen, files, tool) -> dict:
     bfiles = _files.group(insts, picks)
     parts = [_files.observations(model, f) for f in bfiles]
     return {"name": "; ".join(names), "readings": int(sum(f.n for f in bfiles)),
-            "prediction": predict(model, parts, chosen, tool), "files": bfiles}
+            "prediction": predict(model, parts, spec, tool), "files": bfiles}
 
 
 def _ballbar(model, inst, n: int) -> list:

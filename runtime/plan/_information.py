@@ -65,17 +65,22 @@ def ranges_of(model, positions: list) -> dict:
     return out
 
 
-def problem(model, instruments, pool: list, chosen: list, degree: int = 1) -> Problem:
-    """The optimisation's columns for the candidate ``pool`` [(instrument index, SetUp)]."""
+def problem(model, instruments, pool: list, req) -> Problem:
+    """The optimisation's columns for the candidate ``pool`` [(instrument index, SetUp)] and
+    the request ``req`` (:class:`volerr.calibrate.terms.Request`; its reversals are left to the
+    prediction)."""
+    degree = max(1, req.max_term())
     builds = [s.build(s.template) for _, s in pool]
     ranges = ranges_of(model, builds)
     i0, s0 = pool[0]
     obs0 = _files.observations(model, _files.PlanFile("x.csv", s0.kind, i0, [(s0, s0.template)],
                                                       _files.columns_of(None, instruments[i0],
                                                                         [(s0, s0.template)])))
-    keep, _ = gauge_mask(model, obs0, degree, ranges, chosen, constants=False)
+    keep, _ = gauge_mask(model, obs0, degree, ranges, req.parameters, constants=False)
     param_keep = keep[len(obs0.setup_labels):]
+    param_keep &= np.array([req.fits(lab) for lab in parameter_labels(model, degree)])
     labels = [lab for lab, k in zip(parameter_labels(model, degree), param_keep) if k]
+    chosen = req.parameters
     globals_of, prior = {}, []
     for i, inst in enumerate(instruments):
         if inst.kind == "sphere":

@@ -1,13 +1,17 @@
 """The predicted result of a plan: what ``calibrate`` (no options) will report once the files
-are filled, computed on the same path -- the files read by the instruments' readers (readings
-zero), calibrate's gauge fixing, its normal equations (weights ``(u_ref / u)^2``, the priors of
-known set-up values), its estimability rule and its solution's column choice -- with the
-a-posteriori variance factor replaced by its expectation, 1 (readings with noise ``u_um``):
+are filled, computed on calibrate's own steps (:mod:`volerr.calibrate.run`): the files read by
+the instruments' readers (readings zero), the request and its defaults, the reversal terms from
+the readings' directions, calibrate's gauge fixing, its normal equations (weights
+``(u_ref / u)^2``, the priors of known set-up values), its estimability rule, its column choice
+and combinations, and its report -- with the a-posteriori variance factor at its expectation,
+1 (readings with noise ``u_um``)::
 
-    C = u_ref^2 (A^T W A)^-1   (kept columns, unit-scaled as calibrate scales them)
+    C = u_ref^2 (A^T W A)^-1   (the kept columns, unit-scaled as calibrate scales them)
 
-so that a plan executed and calibrated gives ``std`` equal to ``predicted_std`` up to the
-noise of the variance factor (relative standard deviation about ``1 / sqrt(2 dof)``).
+so that a plan executed and calibrated gives ``std`` equal to ``predicted_std`` up to the noise
+of the variance factor (relative standard deviation about ``1 / sqrt(2 dof)``).  The degree of
+the component series is the highest term requested (at least 1); ``calibrate`` chooses it by
+cross-validation only when a whole component error (``EXX``, not ``EXX@slope``) is requested.
 """
 
 from __future__ import annotations
@@ -17,26 +21,25 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import instruments
-from ..calibrate import estimability, terms
-from ..calibrate.run import SOLVE_TOL, _normal_equations, reading_weights
+from ..calibrate import run as calibration
+from ..calibrate import terms
+from ..calibrate.defaults import default_parameters
 from ..estimate import blocks
-from ..estimate.design import data_ranges, gauge_mask, identifiability_gram, parameter_labels
+from ..estimate.design import data_ranges, declared_design, gauge_mask, parameter_labels
 from ..estimate.steps import split_points
 from . import _information
-
-#: the degree of the component series the prediction assumes (calibrate chooses it by
-#: cross-validation when component errors are requested; constants have none)
-DEGREE = 1
 
 
 @dataclass
 class Prediction:
     """``parameters`` {name: {"predicted_std", "unit"}}, ``unidentifiable`` [name],
-    ``why`` {name: text}, ``map_u_um`` {"max", "rms"}, ``determined`` set of names."""
+    ``why`` {name: text}, ``combinations`` (calibrate's entries with the predicted std),
+    ``map_u_um`` {"max", "rms"}."""
 
     parameters: dict
     unidentifiable: list
     why: dict = field(default_factory=dict)
+    combinations: list = field(default_factory=list)
     map_u_um: dict = field(default_factory=dict)
 
     @property
@@ -44,42 +47,58 @@ class Prediction:
         return set(self.parameters)
 
 
-def predict(model, parts: list, chosen: list, tool=(0.0, 0.0, 0.0)) -> Prediction:
-    """The prediction for the files' Observations ``parts`` and the requested ``chosen``
-    parameter names (module docstring)."""
+def request(model, parts, spec):
+    """calibrate's :class:`volerr.calibrate.terms.Request` for these files and ``spec``."""
     obs = instruments.stack(parts)
+    return terms.request(spec or calibration.declared_parameters(obs), model,
+                         default_parameters(model, calibration.campaign_kinds(obs)))
+
+
+def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0),
+            explicit: bool | None = None) -> Prediction:
+    """The prediction for the files' Observations ``parts`` and the ``--parameters`` text
+    ``spec`` (None: calibrate's defaults for these instruments); ``explicit`` False: a
+    reversal the readings cannot show is skipped, not refused (default: ``spec`` given)."""
+    obs = instruments.stack(parts)
+    req = request(model, parts, spec)
+    obs = calibration.with_directions(obs, parts, req.reversals)
+    explicit = spec is not None if explicit is None else explicit
+    extra = calibration.reversal_terms(model, obs, req, explicit=explicit)
     ranges = data_ranges(model, obs)
-    keep, _ = gauge_mask(model, obs, DEGREE, ranges, chosen, constants=False)
-    design = blocks.Design(model, obs, DEGREE, ranges, keep)
+    spl = split_points(obs.n, 0, 0.25, None)
+    w, u_ref = calibration.reading_weights(obs)
+    degree = max(1, req.max_term())
+    keep, gauge = gauge_mask(model, obs, degree, ranges, req.parameters, constants=False)
+    keep &= np.array([req.fits(lab) for lab in
+                      declared_design(model, obs.subset(np.arange(1)), degree, ranges).labels])
+    gauge = [g for g in gauge if req.fits(g)]
+    design = blocks.Design(model, obs, degree, ranges, keep)
     labels = list(design.labels)
-    w, u_ref = reading_weights(obs)
-    fit = _normal_equations(design, obs, split_points(obs.n, 0, 0.25, None), np.sqrt(w))
-    est, partners = estimability.estimable(fit.G)
-    keep_d, _ = identifiability_gram(fit.G, labels)
-    kept = np.flatnonzero(keep_d)
-    sc = fit.scale[kept]
-    S = np.outer(sc, sc)
-    cov = blocks.eig_inverse(fit.G[np.ix_(kept, kept)] / S, SOLVE_TOL) / S * u_ref ** 2
-    std = dict(zip(kept.tolist(), np.sqrt(np.maximum(np.diag(cov), 0.0)).tolist()))
-    name_of = terms.namer(model, ranges)
-    params, unident, why = {}, [], {}
-    for j, lab in enumerate(labels):
-        if lab[0] == "setup":
-            continue
-        name = name_of(lab)
-        if est[j] and j in std:
-            r = terms.report(lab, 0.0, std[j], model, ranges)
-            params[name] = {"predicted_std": r["std"], "unit": r["unit"]}
-        else:
-            unident.append(name)
-            why[name] = _why(fit.G[j, j], [name_of(labels[k]) for k in partners.get(j, [])])
-    pred = Prediction(params, unident, why)
-    pred.map_u_um = map_uncertainty(model, design, labels, kept, cov, ranges, tool)
+    if extra:
+        design = design.plus([calibration.extra_columns(model, obs, extra)])
+        labels += [(name, "extra") for name, *_ in extra]
+    fit = calibration._normal_equations(design, obs, spl, np.sqrt(w))
+    out = calibration._solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref,
+                             calibration._preferred(model, obs, labels))
+    sc = fit.scale[out.kept]
+    out.cov = out.Gi / np.outer(sc, sc) * u_ref ** 2     # the variance factor at 1
+    out.std = np.sqrt(np.maximum(np.diag(out.cov), 0.0))
+    out.s0 = 1.0
+    report = calibration._report(model, obs, labels, ranges, degree, {}, req.parameters, gauge,
+                                 out, spl, u_ref, {name: unit for name, _, _, unit in extra})
+    params = {n: {"predicted_std": v["std"], "unit": v["unit"]}
+              for n, v in report["parameters"].items()}
+    ident = report["identifiability"]
+    why = {n: _why(ident.get(n, {})) for n in report["unidentifiable"]}
+    pred = Prediction(params, list(report["unidentifiable"]), why,
+                      list(report.get("combinations", [])))
+    pred.map_u_um = map_uncertainty(model, labels, out.kept, out.cov, degree, ranges, tool)
     return pred
 
 
-def _why(diag: float, partners: list) -> str:
-    if diag <= 0:
+def _why(entry: dict) -> str:
+    partners = entry.get("confounded_with", [])
+    if not entry.get("seen_by"):
         return "no reading of the plan depends on it"
     setup = [p for p in partners if p.startswith("setup:")]
     if partners and len(setup) == len(partners):
@@ -90,21 +109,20 @@ def _why(diag: float, partners: list) -> str:
     return "its column lies in the span of the others"
 
 
-def map_uncertainty(model, design, labels, kept, cov, ranges, tool) -> dict:
+def map_uncertainty(model, labels, kept, cov, degree, ranges, tool) -> dict:
     """``{"max", "rms"}`` um: the standard uncertainty of the volumetric error's components
-    over the map grid (:func:`volerr.plan._information.grid`) from the kept columns."""
-    params = [k for k in kept if labels[k][0] != "setup"]
-    if not params:
+    over the map grid (:func:`volerr.plan._information.grid`) from the kept parameter columns
+    (not the set-up columns, not the reversals)."""
+    pos = [i for i, k in enumerate(kept) if labels[k][0] != "setup" and labels[k][1] != "extra"]
+    if not pos:
         return {"max": 0.0, "rms": 0.0}
-    pos = [kept.tolist().index(k) for k in params]
-    C = cov[np.ix_(pos, pos)]
-    plabs = [labels[k] for k in params]
-    all_labels = parameter_labels(model, DEGREE)
+    plabs = [labels[kept[i]] for i in pos]
+    all_labels = parameter_labels(model, degree)
     keep = np.array([lab in plabs for lab in all_labels])
-    J = _information.map_rows(model, [lab for lab in all_labels if lab in plabs], keep,
-                              DEGREE, ranges, tool)
     order = [plabs.index(lab) for lab in all_labels if lab in plabs]
-    C = C[np.ix_(order, order)]
+    J = _information.map_rows(model, [lab for lab in all_labels if lab in plabs], keep,
+                              degree, ranges, tool)
+    C = cov[np.ix_(pos, pos)][np.ix_(order, order)]
     var = np.einsum("kin,kl,lin->ni", J, C, J)
     u = 1e3 * np.sqrt(np.maximum(var, 0.0))
     return {"max": round(float(u.max()), 5), "rms": round(float(np.sqrt(np.mean(u ** 2))), 5)}

@@ -17,24 +17,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..calibrate import estimability, terms
+from ..calibrate.defaults import default_parameters
+from ..calibrate.run import _fitted_terms
 from ..errors import require
 from ..machine.model import Model, load
 from . import _baseline, _candidates, _design, _files, _information, _spec
 from ._predict import predict
 
-#: what each instrument kind is used for when --parameters is not given (the request
-#: ``calibrate`` fits by default; replaced by ``volerr.calibrate.defaults`` when it exists)
-DEFAULT_REQUEST = {"ballbar": "squareness", "sphere": "location", "distances": "constants"}
-
-
 def default_request(model, kinds) -> list:
-    """The parameter names ``calibrate`` fits by default for instruments of ``kinds``."""
-    try:
-        from ..calibrate.defaults import default_parameters
-    except ImportError:
-        text = ",".join(DEFAULT_REQUEST[k] for k in sorted(set(kinds)))
-        return terms.resolve(text, model)
-    return terms.resolve(",".join(default_parameters(model, sorted(set(kinds)))), model)
+    """The request ``calibrate`` fits by default for instruments of ``kinds``
+    (:func:`volerr.calibrate.defaults.default_parameters`)."""
+    return default_parameters(model, list(dict.fromkeys(kinds)))
 
 
 @dataclass
@@ -96,8 +89,8 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
     insts = [_spec.parse(s) for s in specs]
     require(insts, "give at least one --instrument")
     require(criterion in ("I", "D"), "--criterion must be I or D")
-    chosen = (terms.resolve(parameters, model) if parameters
-              else default_request(model, [i.kind for i in insts]))
+    union = default_request(model, [i.kind for i in insts])
+    req = terms.request(parameters, model, union)
     pool = []
     for i, inst in enumerate(insts):
         found = _candidates.setups(model, inst)
@@ -108,7 +101,7 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
                for i, inst in enumerate(insts))
     require(readings >= need, f"--readings {readings}: these instruments need at least "
                               f"{need} readings (the smallest set-ups)")
-    prob = _information.problem(model, insts, pool, chosen)
+    prob = _information.problem(model, insts, pool, req)
     cand = _pool(prob, insts, pool)
     picked, counts = _choose(cand, prob, insts, pool, readings, minutes, criterion)
     require(picked, f"--minutes {minutes}: no plan of these instruments fits in that time"
@@ -117,7 +110,8 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
             f"stations=)")
     files = _files.group(insts, [(pool[c][0], pool[c][1], int(m))
                                  for c, m in zip(picked, counts)])
-    out = _finish(model, insts, chosen, files, cand, picked, counts, criterion, readings, pool)
+    out = _finish(model, insts, (parameters, union, req), files, cand, picked, counts,
+                  criterion, readings, pool)
     out.parameters_text = parameters
     return out
 
@@ -186,7 +180,7 @@ def _choose(cand, prob, insts, pool, readings, minutes, criterion):
             continue
         m = _design.allocate(cand, W, P0, criterion, sel, readings)
         t = _design.minutes(cand, sel, m)
-        if minutes is not None and t > minutes:
+        if (minutes is not None and t > minutes) or not _determined(cand, P0, sel, m, prob):
             continue
         options.append((_design.plan_value(cand, W, P0, criterion, sel, m), k, sel, m))
     if not options:
@@ -198,9 +192,19 @@ def _choose(cand, prob, insts, pool, readings, minutes, criterion):
     if swapped != sel:
         m2 = _design.allocate(cand, W, P0, criterion, swapped, readings)
         v2 = _design.plan_value(cand, W, P0, criterion, swapped, m2)
-        if v2 < value and (minutes is None or _design.minutes(cand, swapped, m2) <= minutes):
+        if v2 < value and (minutes is None or _design.minutes(cand, swapped, m2) <= minutes) \
+                and _determined(cand, P0, swapped, m2, prob):
             sel, m = swapped, m2
     return sel, m
+
+
+def _determined(cand, P0, sel, m, prob) -> bool:
+    """Every requested column the pool determines is determined by the set-ups ``sel`` with
+    readings ``m`` (calibrate's estimability rule on their information)."""
+    M = P0 + np.einsum("s,sij->ij", np.asarray(m, float), cand.info[sel])
+    est, _ = estimability.estimable(M)
+    g = int(np.sum(prob.free[:prob.n_global]))
+    return bool(est[g:].all())
 
 
 def _close(value, top) -> bool:
@@ -226,23 +230,26 @@ def _feasible(sel, cand, insts, readings) -> bool:
     return int(cand.min_readings[sel].sum()) <= readings <= int(cand.max_readings[sel].sum())
 
 
-def _finish(model, insts, chosen, files, cand, picked, counts, criterion, readings, pool):
+def _finish(model, insts, request, files, cand, picked, counts, criterion, readings, pool):
+    """The prediction of the plan, of each instrument alone (with the plan's whole request)
+    and of the baseline."""
+    spec, union, req = request
     tool = _information.tool_of(insts)
     parts = [_files.observations(model, f) for f in files]
-    pred = predict(model, parts, chosen, tool)
+    pred = predict(model, parts, spec, tool)
     alone = {}
     for kind in sorted({f.kind for f in files}):
         sub = [p for p, f in zip(parts, files) if f.kind == kind]
-        alone[kind] = predict(model, sub, chosen, tool) if len(alone) < 3 else None
+        alone[kind] = predict(model, sub, spec or ",".join(union), tool, explicit=False)
     mins = [_file_minutes(f, cand, picked, counts, pool) for f in files]
-    base = _baseline.baseline(model, insts, chosen, files, tool)
+    base = _baseline.baseline(model, insts, spec, files, tool)
     grid = {"linear_points": _information.GRID_LINEAR, "rotary_points": _information.GRID_ROTARY,
             "tool_mm": [float(v) for v in tool],
             "note": "every axis over its travel (rotary axes at most one turn), the tool point "
                     "at the instruments' tool offset; standard uncertainty (k = 1) of each "
                     "component of the volumetric error from the determined parameters"}
-    return Plan(model, insts, chosen, files, pred, base, alone, mins, criterion, readings,
-                len(pool), int(sum(s.template for _, s in pool)), map_grid=grid)
+    return Plan(model, insts, _fitted_terms(req), files, pred, base, alone, mins, criterion,
+                readings, len(pool), int(sum(s.template for _, s in pool)), map_grid=grid)
 
 
 def _file_minutes(f, cand, picked, counts, pool) -> float:

@@ -314,9 +314,15 @@ def table_to_csv(table: ErrorTable) -> str:
         np.column_stack([np.asarray(c, dtype=float) for c in columns]), 12)
 
 
-def write_error_table(path, table: ErrorTable, inputs=()) -> Path:
-    """Write ``table`` as CSV (um / urad); refuses to overwrite any file in ``inputs``."""
-    return write_text(path, table_to_csv(table), inputs=inputs)
+def _comment_lines(comments) -> str:
+    """``# ...`` lines before a CSV header (every reader skips them: :func:`read_csv_rows`)."""
+    return "".join(f"# {' '.join(str(c).split())}\n" for c in comments)
+
+
+def write_error_table(path, table: ErrorTable, inputs=(), comments=()) -> Path:
+    """Write ``table`` as CSV (um / urad), ``comments`` as ``#`` lines above the header;
+    refuses to overwrite any file in ``inputs``."""
+    return write_text(path, _comment_lines(comments) + table_to_csv(table), inputs=inputs)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -363,11 +369,12 @@ def read_constants(path) -> dict:
 
 
 def write_constants(path, values: dict, inputs=(), std: dict | None = None,
-                    u95: dict | None = None) -> Path:
-    """Write constants (mm / rad) as ``name,value,unit[,std][,u95]`` in um / urad."""
+                    u95: dict | None = None, comments=()) -> Path:
+    """Write constants (mm / rad) as ``name,value,unit[,std][,u95]`` in um / urad,
+    ``comments`` as ``#`` lines above the header."""
     std, u95 = dict(std or {}), dict(u95 or {})
     header = ["name", "value", "unit"] + (["std"] if std else []) + (["u95"] if u95 else [])
-    lines = [",".join(header)]
+    lines = [_comment_lines(comments) + ",".join(header)]
     for name, v in values.items():
         require(_CONST_NAME.match(name) is not None, f"{name!r} is not a constant error name")
         require(math.isfinite(float(v)), f"constant {name} is NaN or infinite")
@@ -428,14 +435,18 @@ def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]
 
 
 def write_error_dir(directory, tables: dict, constants: dict | None = None,
-                    constants_std: dict | None = None, inputs=()) -> Path:
-    """Write ``<AXIS>.csv`` for each table and ``constants.csv`` (when given) into ``directory``."""
+                    constants_std: dict | None = None, inputs=(), comments=None) -> Path:
+    """Write ``<AXIS>.csv`` for each table and ``constants.csv`` (when given) into ``directory``;
+    ``comments``: {axis or "constants": [line ...]} written as ``#`` lines above the header
+    (what a value written under a name stands for)."""
     d = Path(directory)
+    comments = comments or {}
     for ax, t in tables.items():
         require(ax == t.axis, f"table for {t.axis} stored under {ax}")
-        write_error_table(d / f"{ax}.csv", t, inputs=inputs)
+        write_error_table(d / f"{ax}.csv", t, inputs=inputs, comments=comments.get(ax, ()))
     if constants:
-        write_constants(d / "constants.csv", constants, inputs=inputs, std=constants_std)
+        write_constants(d / "constants.csv", constants, inputs=inputs, std=constants_std,
+                        comments=comments.get("constants", ()))
     return d
 
 

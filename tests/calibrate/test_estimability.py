@@ -2,25 +2,36 @@
 directly with numpy's SVD on designs with planted dependencies."""
 
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 from volerr.calibrate import estimability
 
 
-def _in_span(A, j) -> bool:
-    """Column j of A lies in the span of the others (independent reference: SVD rank)."""
-    others = np.delete(A, j, axis=1)
-    r0 = np.linalg.matrix_rank(others, tol=1e-9 * np.linalg.norm(A, 2))
-    r1 = np.linalg.matrix_rank(np.column_stack([others, A[:, j]]),
-                               tol=1e-9 * np.linalg.norm(A, 2))
-    return r1 == r0
+def _distance(A, j) -> float:
+    """Distance of column j of A, scaled to unit length, to the span of the others, likewise
+    scaled (independent reference: numpy's SVD least squares on the columns themselves, not
+    on a Gram matrix; 0 for a zero column)."""
+    norms = np.linalg.norm(A, axis=0)
+    if norms[j] == 0:
+        return 0.0
+    U = A / np.where(norms > 0, norms, 1.0)
+    others = np.delete(U, j, axis=1)
+    x = np.linalg.lstsq(others, U[:, j], rcond=1e-12)[0]
+    return float(np.linalg.norm(U[:, j] - others @ x))
 
 
 @settings(max_examples=60, deadline=None)
 @given(seed=st.integers(0, 10_000), n_dep=st.integers(0, 3))
+@example(seed=35, n_dep=2)
+@example(seed=35, n_dep=3)
 def test_estimable_matches_rank(seed, n_dep):
     """Columns with planted dependencies, then scaled to very different units (mm, rad, um
-    per mm ...): the verdict is the rank analysis of the unscaled columns."""
+    per mm ...): the verdict is the one of the rank analysis of the unscaled columns with the
+    estimability tolerance (a column farther than DISTANCE_TOL from the span of the others),
+    including near-degenerate columns (seed 35, n_dep 2: a column entering a dependency with
+    a coefficient 7e-5, in the span exactly, which the Gram matrix alone resolved only to
+    3e-4).  Columns within a factor 2 of the tolerance are the stated resolution, not
+    checked (none among these examples)."""
     rng = np.random.default_rng(seed)
     p = 8
     A = rng.normal(size=(60, p))
@@ -32,7 +43,10 @@ def test_estimable_matches_rank(seed, n_dep):
     scaled = A * 10.0 ** rng.uniform(-6, 3, p)
     est, partners = estimability.estimable(scaled.T @ scaled)
     for j in range(p):
-        expected = np.any(A[:, j]) and not _in_span(A, j)
+        d = _distance(A, j)
+        if 0.5 * estimability.DISTANCE_TOL < d < 2 * estimability.DISTANCE_TOL:
+            continue
+        expected = d > estimability.DISTANCE_TOL
         assert bool(est[j]) == bool(expected), (j, est, partners)
         if not est[j] and np.any(A[:, j]):
             assert partners[j], j                  # who it is confounded with is named
