@@ -20,7 +20,8 @@ from volerr.machine.layout import read_layout
 BALLBAR = ["MB1", "--instrument", "ballbar:lengths=100,150,250:u_um=0.5", "--readings", "600"]
 SPHERE = ["DMU50", "--instrument", "sphere:tool=100:tool_u_um=0.5", "--readings", "300"]
 MIXED = ["DMU50", "--instrument", "sphere:tool=100:tool_u_um=0.5:places=1", "--instrument",
-         "distances", "--readings", "600", "--parameters", "location,squareness,EXX@slope,EYY@slope,EZZ@slope"]
+         "distances", "--readings", "600", "--parameters",
+         "location,squareness,EXX@slope,EYY@slope,EZZ@slope"]
 PLANTED = {"MB1": {"EC0Y": 25.0, "EB0Z": -15.0, "EA0Z": 10.0},
            "DMU50": {"EX0B": 20.0, "EY0B": -10.0, "EA0B": 30.0, "EB0B": -20.0, "EX0C": 5.0,
                      "EY0C": 7.0, "EA0C": 10.0, "EB0C": 15.0}}
