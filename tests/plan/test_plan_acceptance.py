@@ -20,6 +20,9 @@ with NO options and checks
 * the mixed campaign (DMU50 sphere + distances) holds a parameter that only the combination
   determines (``determined_alone_by`` empty, ``predicted_std`` finite), and calibrate on each
   kind's files alone indeed does not determine it;
+* one case planned with ``--parameters`` (MB1 ballbar, squareness): the plan writes the
+  request into the files' header (``# parameters: ...``) and calibrate with no options fits
+  exactly it;
 * bad input: one error line, exit 2, nothing written.
 
 The map comparison uses ``map_u_um.rms`` (the I-optimal criterion: the mean predicted variance
@@ -53,7 +56,10 @@ CASES = {
     "TT_AC-rtest": ("TT_AC", ["sphere:tool_u_um=0.5"], 240, 0.8, 2902),
     "DMU50-rtest": ("DMU50", ["sphere:tool_u_um=0.5"], 240, 0.8, 2903),
     "DMU50-mixed": ("DMU50", ["sphere:tool_u_um=0.5", "distances"], 480, None, 2904),
+    "MB1-ballbar-squareness": ("MB1", ["ballbar:lengths=100,150,250"], 200, None, 2905),
 }
+#: cases planned with --parameters (the others: the instruments' defaults)
+REQUEST = {"MB1-ballbar-squareness": "EC0Y,EB0Z,EA0Z"}
 
 
 def _case(name):
@@ -89,6 +95,9 @@ class Plan:
         args = ["plan", layout]
         for s in specs:
             args += ["--instrument", s]
+        self.request = REQUEST.get(name)
+        if self.request:
+            args += ["--parameters", self.request]
         self.proc = cli(*args, "--readings", n, "--out", self.dir, "--json", self.json,
                         "--seed", 1)
         assert self.proc.returncode == 0, self.proc.stderr[-3000:]
@@ -164,6 +173,19 @@ def test_report_states_the_plan(runs, case):
     for key in ("max", "rms"):
         assert doc["map_u_um"][key] > 0 and doc["baseline"]["map_u_um"][key] > 0, doc
     assert doc["baseline"]["readings"] == doc["readings"], doc["baseline"]
+    assert doc["baseline"]["name"] and isinstance(doc["baseline"]["parameters"], dict)
+    assert isinstance(doc["unidentifiable"], list)
+    for e in doc["files"]:
+        assert not Path(e["file"]).is_absolute() and not Path(e["nc"]).is_absolute(), e
+    sheet = p.dir / "plan.html"
+    assert sheet.is_file(), sorted(q.name for q in p.dir.iterdir())
+    text = sheet.read_text()
+    assert "<svg" in text or "<img" in text, "the set-up sheet has no figure"
+    if p.request:
+        # the request is the plan's, written into the files so that calibrate uses it
+        assert set(doc["parameters"]) == set(p.request.split(",")), sorted(doc["parameters"])
+        for f in p.files:
+            assert "parameters" in f.meta, (f.path.name, f.meta)
 
 
 @pytest.mark.parametrize("case", ALL)
@@ -232,8 +254,13 @@ def test_nc_program_moves_through_the_rows_in_order(runs, case):
         if f.kind not in P.READS_AT_A_STOP:
             continue
         for i, h in enumerate(hits):
-            nxt = blocks[h + 1] if h + 1 < len(blocks) else None
-            assert nxt is not None and nxt.dwell is not None and nxt.dwell > 0, (
+            # the blocks after the reading's move, up to the next move: one is a dwell
+            after = []
+            for b in blocks[h + 1:]:
+                if b.end is not None:
+                    break
+                after.append(b)
+            assert any(b.dwell is not None and b.dwell > 0 for b in after), (
                 case, e["nc"], "no G4 dwell after the reading of row", i, blocks[h].line)
 
 
@@ -253,6 +280,16 @@ def test_calibrate_recovers_the_planted_parameters(runs, case):
         if not abs(e["value"] - truth) <= K_SIGMA * e["std"]:
             bad.append((name, e["value"], truth, e["std"]))
     assert not bad, (case, "outside 3 std of the planted value", bad)
+
+
+@pytest.mark.parametrize("case", ALL)
+def test_calibrate_fits_what_the_plan_requested(runs, case):
+    """No option: calibrate determines exactly the parameters the plan predicts for (the
+    instruments' defaults, or the plan's --parameters read from the files' header)."""
+    p, x = runs.plan(case), runs.executed(case)
+    got = set(x.doc["parameters"])
+    assert got == set(p.requested), (case, "calibrate only", sorted(got - set(p.requested)),
+                                     "plan only", sorted(set(p.requested) - got))
 
 
 @pytest.mark.parametrize("case", ALL)
