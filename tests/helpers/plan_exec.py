@@ -365,7 +365,7 @@ def nc_blocks(text: str, axes) -> list:
     """The blocks of an ISO program that carry words (modal ``G0-G3``, ``G90/G91``, ``G20/21``;
     a ``G4`` block is a dwell whose ``P`` / ``X`` word is its time, not a move; ``G28``/``G30``
     blocks are skipped).  A move's ``errors`` name what the contract forbids (incremental,
-    inch)."""
+    inch, an axis word the layout does not have)."""
     state = {"motion": None, "absolute": True, "mm": True}
     where: dict = {}
     out = []
@@ -397,10 +397,12 @@ def nc_blocks(text: str, axes) -> list:
             out.append(Block(no))
             continue
         moved = {k: float(v) for k, v in words if k in axes}
-        if not moved or state["motion"] is None:
+        foreign = sorted({k for k, _ in words if k in "XYZABCUVW" and k not in axes})
+        if (not moved and not foreign) or state["motion"] is None:
             out.append(Block(no))
             continue
         errs = ([] if state["absolute"] else ["G91"]) + ([] if state["mm"] else ["G20"])
+        errs += [f"axis {k} not in the layout" for k in foreign]
         where.update(moved)
         out.append(Block(no, end=dict(where), errors=errs))
     return out

@@ -314,6 +314,25 @@ def test_map_uncertainty_against_the_baseline(runs, case):
         case, p.doc["baseline"].get("name"), mine, base, factor)
 
 
+@pytest.mark.parametrize("case", [_case("DMU50-rtest")])
+def test_time_budget_is_kept(runs, case, tmp_path):
+    """--minutes M with the readings budget of the case: a plan of at most M minutes (the
+    files' ``minutes``) and at most N readings, when M is half the unconstrained plan's."""
+    p = runs.plan(case)
+    full = sum(e["minutes"] for e in p.doc["files"])
+    budget = round(full / 2, 1)
+    js = tmp_path / "p.json"
+    args = ["plan", p.layout, *sum((["--instrument", s] for s in p.specs), []),
+            "--readings", p.readings, "--minutes", budget, "--out", tmp_path / "out",
+            "--json", js, "--seed", 1]
+    r = cli(*args)
+    assert r.returncode == 0, r.stderr[-2000:]
+    doc = json.loads(js.read_text())
+    spent = sum(e["minutes"] for e in doc["files"])
+    assert 0 < spent <= budget + 1e-9, (spent, budget, full)
+    assert 0 < sum(e["readings"] for e in doc["files"]) <= p.readings
+
+
 # ---- a mixed campaign: determined by the combination only ----------------------------------
 @pytest.mark.parametrize("case", MIXED)
 def test_mixed_campaign_determines_what_no_instrument_does_alone(runs, case):

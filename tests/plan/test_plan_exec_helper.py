@@ -195,14 +195,16 @@ N60 M5
 N70 G4 X2.0
 N80 G91 G1 X1
 N90 G90 G20 X2
+N95 G21 A10
 %"""
     blocks = P.nc_blocks(text, ("X", "Y", "Z", "B", "C"))
     moves = [b for b in blocks if b.end is not None]
-    assert [b.line for b in moves] == [4, 5, 7, 10, 11]
+    assert [b.line for b in moves] == [4, 5, 7, 10, 11, 12]
     assert moves[1].end == {"X": 11.0004, "Y": 20.0, "Z": 30.0, "B": 0.0, "C": 0.0}
     assert moves[2].end["Y"] == 21.0 and moves[2].end["X"] == 11.0004
     assert [b.dwell for b in blocks if b.dwell is not None] == [0.5, 2.0]
     assert moves[3].errors == ["G91"] and moves[4].errors == ["G20"]
+    assert moves[5].errors == ["axis A not in the layout"]
     rows = [{"X": 10.0, "Y": 20.0}, {"X": 11.0, "Y": 21.0}]
     hits = P.match_rows(blocks, rows)
     assert [blocks[h].line for h in hits] == [4, 7]
