@@ -154,18 +154,29 @@ def read_plan_file(path, kind: str) -> PlanFile:
 # ---- planted parameters --------------------------------------------------------------------
 @dataclass
 class View:
-    """What a planted term needs: positions (mm / deg) and their number."""
+    """What a planted term needs: positions (mm / deg), the sign of each axis' motion that
+    brought it to the reading (+1 / -1; for reversals) and their number."""
 
     pos: dict
+    vel: dict = field(default_factory=dict)
 
     @property
     def n(self):
         return len(next(iter(self.pos.values())))
 
 
+def along(machine: S.Machine, axis: str) -> str:
+    """The positioning error of a linear axis (``EXX`` for X along x)."""
+    d = np.abs(np.asarray(machine.layout.axes[axis].direction, float))
+    return f"E{'XYZ'[int(np.argmax(d))]}{axis}"
+
+
 def known_to_machine(machine: S.Machine, name: str) -> bool:
-    """The ISO name (before ``@``) is an error the exact chain models for this layout."""
+    """The ISO name (before ``@``) is an error the exact chain models for this layout (or
+    ``RV_<axis>``, the reversal of a linear axis)."""
     lay = machine.layout
+    if name.startswith("RV_"):
+        return name[3:] in machine.axes and name[3:] not in machine.rotary
     base = name.split("@")[0]
     if base in lay.squareness:
         return True
@@ -184,10 +195,16 @@ def _fourier(comp: str, kind: str, k: int) -> S.Term:
 def planted_terms(machine: S.Machine, names, ranges: dict) -> list:
     """Simulator terms of the report names ``names`` (constants, ``NAME@offset``,
     ``@slope``, ``@Pk`` over the measured range ``ranges[axis] = (lo, hi)``, ``@cosk`` /
-    ``@sink`` of a periodic rotary axis, angle in rad)."""
+    ``@sink`` of a periodic rotary axis, angle in rad; ``RV_<axis>``: the reversal value of
+    ISO 230-2, half of it added to the axis' positioning error with the sign of the motion
+    that brought the axis to the reading)."""
     out = []
     for name in names:
         assert known_to_machine(machine, name), f"{machine.name}: no error {name!r}"
+        if name.startswith("RV_"):
+            t = S.reversal(along(machine, name[3:]), name[3:])
+            out.append(S.Term(name, t.target, t.basis))
+            continue
         base, _, term = name.partition("@")
         if not term:
             out.append(S.constant(base))
@@ -211,7 +228,9 @@ def planted_value(machine: S.Machine, name: str, rng) -> float:
     """A realistic value in the report unit: squareness 10-30 urad, location errors 5-30 um /
     10-50 urad, scales and straightness slopes 5-20 um/m, angular slopes 10-40 urad/m,
     slopes over a rotary axis 0.005-0.02 um/deg (0.02-0.1 urad/deg), offsets 5-20, Legendre
-    and Fourier terms 1-5 (um / urad)."""
+    and Fourier terms 1-5 (um / urad), reversals 1-4 um."""
+    if name.startswith("RV_"):
+        return _between(rng, 1, 4)
     base, _, term = name.partition("@")
     angular = S.is_angular(base)
     if not term:
@@ -237,8 +256,35 @@ def measured_ranges(machine: S.Machine, files) -> dict:
     return out
 
 
-def _errors(machine, terms, values, pos) -> dict:
-    return S.errors_at(View(pos), terms, values)
+def _errors(machine, terms, values, pos, vel=None) -> dict:
+    vel = vel or {a: np.zeros(len(pos[a])) for a in machine.axes}
+    return S.errors_at(View(pos, vel), terms, values)
+
+
+def motion_signs(machine, f: PlanFile, traces) -> dict:
+    """Axis -> (N,) sign of the motion that brought the axis to each reading: the file's
+    ``dir_<axis>`` column, else from the order of the readings within each trace (``traces``
+    (N,) labels): the sign of the step from the previous reading (the first reading: of the
+    step to the second), standing still keeps the last sign; 0 for an axis that does not
+    move in a trace (its state is constant there)."""
+    out = {}
+    for a in machine.axes:
+        if f.has(f"dir_{a}"):
+            out[a] = f.number(f"dir_{a}")
+            continue
+        q, s = f.number(a), np.zeros(f.n)
+        for t in _groups(traces):
+            idx = np.flatnonzero(traces == t)
+            step = np.sign(np.diff(q[idx]))
+            if len(idx) < 2 or not step.any():
+                continue
+            sign = np.concatenate([[step[0]], step])
+            for i in range(len(sign)):
+                if sign[i] == 0:
+                    sign[i] = sign[i - 1] if i else next(v for v in step if v)
+            s[idx] = sign
+        out[a] = s
+    return out
 
 
 def _groups(labels) -> list:
@@ -257,10 +303,13 @@ def ballbar_placements(f: PlanFile) -> np.ndarray:
 
 def fill_ballbar(machine, f: PlanFile, terms, values, rng, setup: dict) -> dict:
     pos, probe = f.positions(machine.axes), f.probe()
-    t = machine.tool_point(pos, _errors(machine, terms, values, pos), probe)
+    placement = ballbar_placements(f)
+    sense = np.sign(f.number("direction", 1.0))
+    traces = np.array([f"{p}|{d}" for p, d in zip(placement, sense)], dtype=object)
+    vel = motion_signs(machine, f, traces)
+    t = machine.tool_point(pos, _errors(machine, terms, values, pos, vel), probe)
     pivot = np.column_stack([f.number(c) for c in ("pivot_x", "pivot_y", "pivot_z")])
     length = f.number("length_mm")
-    placement = ballbar_placements(f)
     length_u = f.declared("length_u_um")
     dp, dl = np.zeros((f.n, 3)), np.zeros(f.n)
     for p in _groups(placement):

@@ -108,7 +108,16 @@ class Plan:
 
     @property
     def requested(self) -> dict:
+        """The parameters the plan determines (finite predicted_std)."""
         return {k: v for k, v in self.doc["parameters"].items() if determined(v)}
+
+    @property
+    def planted(self) -> list:
+        """What the simulated machine has: every parameter of the plan's request, the ones it
+        leaves undetermined too (scales without a calibrated bar ...), as calibrate fits them
+        all (their determined combinations)."""
+        names = set(self.doc["parameters"]) | set(self.doc.get("unidentifiable", []))
+        return sorted(n for n in names if P.known_to_machine(self.machine, n))
 
 
 class Executed:
@@ -117,7 +126,7 @@ class Executed:
     def __init__(self, plan: Plan, root: Path):
         seed = CASES[plan.name][4]
         rng = np.random.default_rng(seed)
-        self.truth = {k: P.planted_value(plan.machine, k, rng) for k in sorted(plan.requested)}
+        self.truth = {k: P.planted_value(plan.machine, k, rng) for k in plan.planted}
         self.filled = root / "filled"
         self.paths, self.setup = P.execute(plan.machine, plan.files, self.truth, self.filled,
                                            rng, plan.dir)

@@ -209,3 +209,20 @@ N95 G21 A10
     hits = P.match_rows(blocks, rows)
     assert [blocks[h].line for h in hits] == [4, 7]
     assert P.match_rows(blocks, rows[::-1])[1] is None      # order matters
+
+
+def test_motion_signs_and_reversal(tmp_path):
+    """The sign of the motion that brought each axis to a reading, per trace; a reversal
+    planted on X shifts the readings by +-RV/2 along the bar's x component."""
+    p = tmp_path / "b.csv"
+    p.write_text("X,Y,Z,placement,direction\n0,0,0,P1,1\n1,0,0,P1,1\n1,0,0,P1,1\n0,1,0,P1,1\n"
+                 "5,0,0,P2,1\n4,0,0,P2,1\n")
+    f = P.read_plan_file(p, "ballbar")
+    m = S.Machine("MB1")
+    v = P.motion_signs(m, f, f.labels("placement"))
+    assert list(v["X"]) == [1, 1, 1, -1, -1, -1] and list(v["Y"]) == [1, 1, 1, 1, 0, 0]
+    assert list(v["Z"]) == [0] * 6
+    (term,) = P.planted_terms(m, ["RV_X"], {})
+    assert term.target == "EXX"
+    err = S.errors_at(P.View(f.positions(m.axes), v), [term], {"RV_X": 4.0})
+    assert np.allclose(err["EXX"], 2e-3 * v["X"])
