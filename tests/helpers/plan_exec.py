@@ -78,10 +78,16 @@ class PlanFile:
         if self.has(name):
             return np.array([float(v) for v in self.text(name)])
         if name.lower() in self.meta:
-            return np.full(self.n, float(self.meta[name.lower()]))
+            return np.full(self.n, self.meta_number(name))
         if default is None:
             raise KeyError(f"{self.path.name}: no column or header {name!r}")
         return np.full(self.n, float(default))
+
+    def meta_number(self, name) -> float:
+        """The number a header line ``# name: value [remark]`` declares."""
+        m = re.match(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)", self.meta[name.lower()])
+        assert m, (self.path.name, name, self.meta[name.lower()])
+        return float(m.group(1))
 
     def declared(self, name):
         """The value of ``name`` declared as a column (one value for all rows) or a header
@@ -93,7 +99,7 @@ class PlanFile:
             assert len(vals) == 1, (self.path.name, name, sorted(vals)[:5])
             return float(vals.pop())
         if name.lower() in self.meta:
-            return float(self.meta[name.lower()])
+            return self.meta_number(name)
         return None
 
     def positions(self, axes) -> dict:
@@ -287,6 +293,21 @@ def motion_signs(machine, f: PlanFile, traces) -> dict:
     return out
 
 
+#: the standard uncertainty of one reading calibrate assumes when a file declares none (um;
+#: docs/formats.md; distances: 0.3 um + 0.3 um/m times the distance)
+DEFAULT_U_UM = {"ballbar": 0.5, "sphere": 1.0}
+
+
+def reading_u(f: PlanFile, distance_mm=None) -> np.ndarray:
+    """(N,) standard uncertainty of each reading, um: the file's ``u_um`` column or header
+    line, else the documented default of its kind."""
+    if f.has("u_um") or "u_um" in f.meta:
+        return f.number("u_um")
+    if f.kind == "distances":
+        return 0.3 + 0.3e-3 * np.asarray(distance_mm, float)
+    return np.full(f.n, DEFAULT_U_UM[f.kind])
+
+
 def _groups(labels) -> list:
     return list(dict.fromkeys(labels.tolist()))
 
@@ -320,8 +341,7 @@ def fill_ballbar(machine, f: PlanFile, terms, values, rng, setup: dict) -> dict:
         dp[m] = setup[key + ":pivot"] * 1e-3
         dl[m] = setup[key + ":length"]
     exact = 1e3 * (np.linalg.norm(t - pivot - dp, axis=1) - length) + dl
-    u = f.number("u_um")
-    return {"dr_um": exact + rng.normal(0.0, 1.0, f.n) * u}
+    return {"dr_um": exact + rng.normal(0.0, 1.0, f.n) * reading_u(f)}
 
 
 def fill_sphere(machine, f: PlanFile, terms, values, rng, setup: dict) -> dict:
@@ -344,8 +364,7 @@ def fill_sphere(machine, f: PlanFile, terms, values, rng, setup: dict) -> dict:
     if mach.any():
         R = machine.work_orientation({a: pos[a][mach] for a in machine.axes})
         v[mach] = np.einsum("nij,nj->ni", R, v[mach])
-    u = f.number("u_um")[:, None]
-    d = 1e3 * v + rng.normal(0.0, 1.0, v.shape) * u
+    d = 1e3 * v + rng.normal(0.0, 1.0, v.shape) * reading_u(f)[:, None]
     return {"dx_um": d[:, 0], "dy_um": d[:, 1], "dz_um": d[:, 2]}
 
 
@@ -366,8 +385,7 @@ def fill_distances(machine, f: PlanFile, terms, values, rng, setup: dict) -> dic
         s[m] = s[m] + setup[key + ":station"] * 1e-3
         dd[m] = setup[key + ":dead_path"] * 1e-3
     d = np.linalg.norm(t - s, axis=1) + dd
-    u = f.number("u_um") if (f.has("u_um") or "u_um" in f.meta) else 0.3 + 0.3e-3 * d
-    d = d + rng.normal(0.0, 1.0, f.n) * u * 1e-3
+    d = d + rng.normal(0.0, 1.0, f.n) * reading_u(f, d) * 1e-3
     if f.has("dd_mm"):
         first = {k: d[np.flatnonzero(station == k)[0]] for k in _groups(station)}
         return {"dd_mm": d - np.array([first[k] for k in station])}
