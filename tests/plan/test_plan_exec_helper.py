@@ -226,3 +226,31 @@ def test_motion_signs_and_reversal(tmp_path):
     assert term.target == "EXX"
     err = S.errors_at(P.View(f.positions(m.axes), v), [term], {"RV_X": 4.0})
     assert np.allclose(err["EXX"], 2e-3 * v["X"])
+
+
+def test_reversal_as_calibrate_reads_it(tmp_path):
+    """A reversal planted by the executor on an MB1 ballbar plan (XY circle both directions)
+    is found by calibrate's reversal term (the documented ``RV_<axis>``: half of it on the
+    axis' positioning error with the sign of the motion, from the order of the readings)."""
+    from volerr.calibrate import calibrate
+
+    m = S.Machine("MB1")
+    blk = S.concat([S.ballbar_circle(m, "bb.csv", "XY", (450.0, 287.0, 200.0), 150.0, 60,
+                                     direction=d, placement="P1") for d in (1, -1)])
+    cols = S.columns(m, blk, np.zeros(blk.n), covariates=False)
+    cols.pop("dr_um")
+    cols["placement"] = [str(p) for p in cols["placement"]]
+    cols["direction"] = [str(int(v)) for v in cols["direction"]]
+    plan = tmp_path / "plan"
+    plan.mkdir()
+    f = P.read_plan_file(_write_empty(plan / "bb.csv", cols, ["dr_um"]), "ballbar")
+    rng = np.random.default_rng(23)
+    truth = {"EC0Y": 18.0, "RV_X": 3.0, "RV_Y": -2.5}
+    (path,), _ = P.execute(m, [f], truth, tmp_path / "filled", rng, plan)
+    cal = calibrate("MB1", [str(path)], parameters="EC0Y", degree=1, plan=False,
+                    extra_terms=[("RV_X", "EXX", "dir_X/2", (1e3, "um")),
+                                 ("RV_Y", "EYY", "dir_Y/2", (1e3, "um"))])
+    got = cal["parameters"]
+    for k, v in truth.items():
+        assert abs(got[k]["value"] - v) <= 3 * got[k]["std"], (k, got[k], v)
+    assert got["RV_X"]["std"] < 0.5, got["RV_X"]
