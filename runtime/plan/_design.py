@@ -82,12 +82,13 @@ def gains(Minv: np.ndarray, W: np.ndarray, U: np.ndarray, kind: str, scale: floa
           ) -> np.ndarray:
     """Decrease of the criterion (C,) when ``scale * U_c U_c^T`` is added to ``M``."""
     U = U * np.sqrt(scale)
-    B = np.einsum("ij,cjr->cir", Minv, U)                       # M^-1 U
-    C = np.eye(U.shape[2]) + np.einsum("cir,cis->crs", U, B)
+    B = np.matmul(Minv, U)                                      # M^-1 U  (C, q, r)
+    Ut = np.transpose(U, (0, 2, 1))
+    C = np.eye(U.shape[2]) + np.matmul(Ut, B)
     if kind == "D":
         return np.linalg.slogdet(C)[1]
-    D = np.einsum("cir,ij,cjs->crs", B, W, B)                  # U^T M^-1 W M^-1 U
-    return np.einsum("crr->c", np.linalg.solve(C, D))
+    D = np.matmul(np.transpose(B, (0, 2, 1)), np.matmul(W, B))   # U^T M^-1 W M^-1 U
+    return np.trace(np.linalg.solve(C, D), axis1=1, axis2=2)
 
 
 def greedy(cand: Candidates, W, P0, kind: str, k_max: int, caps: dict) -> list:
@@ -146,13 +147,13 @@ def allocate(cand: Candidates, W, P0, kind: str, chosen: list, readings: int) ->
     hi = cand.max_readings[chosen]
     w = np.full(len(chosen), 1.0 / len(chosen))
     for _ in range(ALLOCATION_STEPS):
-        M = P0 + readings * np.einsum("s,sij->ij", w, info)
+        M = P0 + readings * np.tensordot(w, info, axes=1)
         try:
             Minv = np.linalg.inv(M)
         except np.linalg.LinAlgError:
             break
         A = Minv if kind == "D" else Minv @ W @ Minv
-        d = np.einsum("ij,sji->s", A, info)
+        d = np.tensordot(info, A, axes=([1, 2], [1, 0]))
         w = w * np.sqrt(np.maximum(d, 1e-300) / max(float(w @ d), 1e-300))
         w = np.clip(w / w.sum(), lo / readings, hi / readings)
     return _whole(w * readings, lo, hi, readings)
@@ -177,5 +178,5 @@ def minutes(cand: Candidates, chosen: list, m) -> float:
 
 
 def plan_value(cand, W, P0, kind, chosen, m) -> float:
-    M = P0 + np.einsum("s,sij->ij", np.asarray(m, float), cand.info[chosen])
+    M = P0 + np.tensordot(np.asarray(m, float), cand.info[chosen], axes=1)
     return criterion(M, W, kind)

@@ -54,8 +54,7 @@ def columns_of(model, inst, setups: list) -> dict:
             cols[k] = np.zeros(n)
     if inst.kind == "sphere" and inst.frame == "machine":
         cols["frame"] = np.full(n, "machine", dtype=object)
-    if inst.u_um is not None:
-        cols["u_um"] = np.full(n, float(inst.u_um))
+    cols["u_um"] = reading_u(inst, cols, n)
     if inst.kind == "sphere" and inst.tool_u_um is not None:
         cols["tool_u_um"] = np.full(n, float(inst.tool_u_um))
     if inst.kind == "ballbar" and inst.length_u_um is not None:
@@ -64,6 +63,20 @@ def columns_of(model, inst, setups: list) -> dict:
         cols.pop("direction", None)
         cols["direction"] = _directions(setups, parts)
     return cols
+
+
+#: the standard uncertainty of one reading the readers assume when a file declares none (um)
+DEFAULT_U_UM = {"ballbar": ballbar.DEFAULT_U_UM, "sphere": sphere.DEFAULT_U_UM}
+
+
+def reading_u(inst, cols: dict, n: int) -> np.ndarray:
+    """(n,) um: the ``u_um`` the plan assumes for each reading -- the instrument's ``u_um=``,
+    else the reader's default (distances: U0 + K x the nominal distance)."""
+    if inst.u_um is not None:
+        return np.full(n, float(inst.u_um))
+    if inst.kind == "distances":
+        return distances.DEFAULT_U0_UM + distances.DEFAULT_K_UM_PER_M * 1e-3 * cols["d_mm"]
+    return np.full(n, float(DEFAULT_U_UM[inst.kind]))
 
 
 def _directions(setups, parts) -> np.ndarray:

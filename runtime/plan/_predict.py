@@ -34,13 +34,15 @@ from . import _information
 class Prediction:
     """``parameters`` {name: {"predicted_std", "unit"}}, ``unidentifiable`` [name],
     ``why`` {name: text}, ``combinations`` (calibrate's entries with the predicted std),
-    ``map_u_um`` {"max", "rms"}."""
+    ``map_u_um`` {"max", "rms"}, ``gauge`` the names calibrate holds at zero by convention
+    (what no measurement of the chain determines)."""
 
     parameters: dict
     unidentifiable: list
     why: dict = field(default_factory=dict)
     combinations: list = field(default_factory=list)
     map_u_um: dict = field(default_factory=dict)
+    gauge: list = field(default_factory=list)
 
     @property
     def determined(self) -> set:
@@ -54,16 +56,14 @@ def request(model, parts, spec):
                          default_parameters(model, calibration.campaign_kinds(obs)))
 
 
-def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0),
-            explicit: bool | None = None) -> Prediction:
-    """The prediction for the files' Observations ``parts`` and the ``--parameters`` text
-    ``spec`` (None: calibrate's defaults for these instruments); ``explicit`` False: a
-    reversal the readings cannot show is skipped, not refused (default: ``spec`` given)."""
+def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0)) -> Prediction:
+    """The prediction for the files' Observations ``parts`` and the request ``spec`` (the
+    files' ``# parameters:`` declaration; None: calibrate's defaults for these instruments).
+    As ``calibrate`` with no options: a reversal the readings cannot show is skipped."""
     obs = instruments.stack(parts)
     req = request(model, parts, spec)
     obs = calibration.with_directions(obs, parts, req.reversals)
-    explicit = spec is not None if explicit is None else explicit
-    extra = calibration.reversal_terms(model, obs, req, explicit=explicit)
+    extra = calibration.reversal_terms(model, obs, req, explicit=False)
     ranges = data_ranges(model, obs)
     spl = split_points(obs.n, 0, 0.25, None)
     w, u_ref = calibration.reading_weights(obs)
@@ -92,6 +92,7 @@ def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0),
     why = {n: _why(ident.get(n, {})) for n in report["unidentifiable"]}
     pred = Prediction(params, list(report["unidentifiable"]), why,
                       list(report.get("combinations", [])))
+    pred.gauge = list(report.get("gauge_fixed", []))
     pred.map_u_um = map_uncertainty(model, labels, out.kept, out.cov, degree, ranges, tool)
     return pred
 

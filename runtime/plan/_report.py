@@ -14,8 +14,12 @@ def file_header(plan, pf) -> list:
              f"filled files to: volerr calibrate {plan.model.name} FILES"]
     for s, m in pf.setups:
         lines.append(f"set-up {s.label}: {s.text}; {m} readings")
-    if inst.u_um is not None:
-        lines.append(f"u_um: {inst.u_um:g} (column u_um)")
+    if inst.u_um is not None or inst.kind != "distances":
+        u = inst.u_um if inst.u_um is not None else float(pf.columns["u_um"][0])
+        lines.append(f"u_um: {u:g} (column u_um: the standard uncertainty of one reading the "
+                     f"plan assumes)")
+    else:
+        lines.append("u_um: 0.3 + 0.3 um/m x the distance (column u_um, per reading)")
     if inst.kind == "sphere" and inst.tool_u_um is not None:
         lines.append(f"tool_u_um: {inst.tool_u_um:g} (column tool_u_um)")
     if plan.parameters_text:

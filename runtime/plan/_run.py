@@ -18,11 +18,38 @@ import numpy as np
 
 from ..calibrate import estimability, terms
 from ..calibrate.defaults import default_parameters
-from ..calibrate.run import _fitted_terms
 from ..errors import require
 from ..machine.model import Model, load
 from . import _baseline, _candidates, _design, _files, _information, _spec
 from ._predict import predict
+
+#: highest series term planned for a component error requested whole (``EXX``, ``all``):
+#: the files declare the terms, so that calibrate fits that degree (not one it would choose
+#: by cross-validation on the readings, which no plan can predict)
+SERIES_DEGREE = 2
+
+
+def fixed_degree(model, req) -> str | None:
+    """The request ``req`` with every component error requested whole written as its series
+    terms up to :data:`SERIES_DEGREE` (``EXX@offset,EXX@slope,EXX@P2``; a rotary axis that
+    turns: ``@cos1``, ``@sin1``), as ``--parameters`` text; None when no series is requested
+    whole."""
+    axis_of = model.parameter_axis
+    whole = [p for p in req.parameters if axis_of.get(p) and p not in req.only]
+    if not whole:
+        return None
+    words = []
+    for p in req.parameters:
+        axis = axis_of.get(p)
+        if not axis:
+            words.append(p)
+            continue
+        ks = sorted(req.only[p]) if p in req.only else range(SERIES_DEGREE + 1)
+        lo, hi = model.travel[axis]
+        turns = axis in model.rotary_axes and hi - lo >= 300.0
+        words += [terms.term_name((p, k), turns) for k in ks]
+    return ",".join(words + [f"RV_{a}" for a in req.reversals])
+
 
 def default_request(model, kinds) -> list:
     """The request ``calibrate`` fits by default for instruments of ``kinds``
@@ -91,6 +118,9 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
     require(criterion in ("I", "D"), "--criterion must be I or D")
     union = default_request(model, [i.kind for i in insts])
     req = terms.request(parameters, model, union)
+    fixed = fixed_degree(model, req)
+    if fixed is not None:                    # whole series: their terms up to SERIES_DEGREE
+        parameters, req = fixed, terms.request(fixed, model)
     pool = []
     for i, inst in enumerate(insts):
         found = _candidates.setups(model, inst)
@@ -200,11 +230,22 @@ def _choose(cand, prob, insts, pool, readings, minutes, criterion):
 
 def _determined(cand, P0, sel, m, prob) -> bool:
     """Every requested column the pool determines is determined by the set-ups ``sel`` with
-    readings ``m`` (calibrate's estimability rule on their information)."""
-    M = P0 + np.einsum("s,sij->ij", np.asarray(m, float), cand.info[sel])
-    est, _ = estimability.estimable(M)
+    readings ``m``: calibrate's rule (:mod:`volerr.calibrate.estimability`, the relative
+    distance of each unit-scaled column to the span of the others above ``DISTANCE_TOL``),
+    with the campaign-wide nuisances eliminated; ``d_j^2 = 1 / (C^-1)_jj``."""
+    M = P0 + np.tensordot(np.asarray(m, float), cand.info[sel], axes=1)
     g = int(np.sum(prob.free[:prob.n_global]))
-    return bool(est[g:].all())
+    A = M[g:, g:]
+    if g:
+        A = A - M[g:, :g] @ np.linalg.pinv(M[:g, :g], hermitian=True) @ M[:g, g:]
+    d = np.sqrt(np.maximum(np.diag(A), 0.0))
+    if np.any(d <= 0):
+        return False
+    w, V = np.linalg.eigh(A / np.outer(d, d))
+    if w[0] <= 1e-14 * w[-1]:
+        return False
+    inv_diag = np.einsum("ij,j,ij->i", V, 1.0 / w, V)
+    return bool(np.all(inv_diag < 1.0 / estimability.DISTANCE_TOL ** 2))
 
 
 def _close(value, top) -> bool:
@@ -240,7 +281,7 @@ def _finish(model, insts, request, files, cand, picked, counts, criterion, readi
     alone = {}
     for kind in sorted({f.kind for f in files}):
         sub = [p for p, f in zip(parts, files) if f.kind == kind]
-        alone[kind] = predict(model, sub, spec or ",".join(union), tool, explicit=False)
+        alone[kind] = predict(model, sub, spec or ",".join(union), tool)
     mins = [_file_minutes(f, cand, picked, counts, pool) for f in files]
     base = _baseline.baseline(model, insts, spec, files, tool)
     grid = {"linear_points": _information.GRID_LINEAR, "rotary_points": _information.GRID_ROTARY,
@@ -248,7 +289,10 @@ def _finish(model, insts, request, files, cand, picked, counts, criterion, readi
             "note": "every axis over its travel (rotary axes at most one turn), the tool point "
                     "at the instruments' tool offset; standard uncertainty (k = 1) of each "
                     "component of the volumetric error from the determined parameters"}
-    return Plan(model, insts, _fitted_terms(req), files, pred, base, alone, mins, criterion,
+    # the request as calibrate will print it (its namer: Fourier terms of a turning axis),
+    # without what it holds at zero by convention (the gauge)
+    requested = list(pred.parameters) + list(pred.unidentifiable)
+    return Plan(model, insts, requested, files, pred, base, alone, mins, criterion,
                 readings, len(pool), int(sum(s.template for _, s in pool)), map_grid=grid)
 
 
