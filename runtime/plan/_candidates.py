@@ -40,7 +40,8 @@ DECIMALS = 4
 class SetUp:
     """One candidate set-up: ``kind``, ``label`` (the file's ``placement`` / ``station``),
     ``build(m)`` -> file columns for m readings, ``template`` readings of the information
-    computed, ``min_readings`` and ``max_readings`` (the poses it has), ``geometry`` (for the set-up sheet) and a one-line ``text``."""
+    computed, ``min_readings`` and ``max_readings`` (the poses it has), ``geometry`` (for
+    the set-up sheet) and a one-line ``text``."""
 
     kind: str
     label: str

@@ -100,6 +100,10 @@ def _geometry(g: dict) -> dict:
     return out
 
 
+#: parameters listed on the console (all of them in the JSON and plan.html)
+SHOWN = 24
+
+
 def summary(plan) -> str:
     """The console summary."""
     d = data(plan)
@@ -110,21 +114,25 @@ def summary(plan) -> str:
         for s in f["setups"]:
             lines.append(f"  {f['file']} {s['label']}: {s['text']}, {s['readings']} readings")
     lines.append("  predicted standard uncertainties (calibrate with no options):")
-    for name, v in d["parameters"].items():
+    shown = list(d["parameters"].items())
+    for name, v in shown[:SHOWN]:
         alone = v["determined_alone_by"]
         tag = f"determined by {', '.join(alone)} alone" if alone else "only the combination " \
                                                                       "determines it"
         b = d["baseline"]["parameters"].get(name)
         base = f", baseline {b['predicted_std']:.3g}" if b else ", baseline: not determined"
         lines.append(f"    {name}: {v['predicted_std']:.3g} {v['unit']}{base} ({tag})")
+    if len(shown) > SHOWN:
+        lines.append(f"    ... {len(shown) - SHOWN} more (the JSON and plan.html list all)")
     if d["unidentifiable"]:
         lines.append("  not determined by this plan: " + "; ".join(
             f"{n} ({d['why_unidentifiable'][n]})" for n in d["unidentifiable"][:8]))
     m, b = d["map_u_um"], d["baseline"]["map_u_um"]
     gain = d["map_gain"]
+    base = d["baseline"]
     lines.append(f"  map uncertainty over the working volume: RMS {m['rms']:.3g} um, max "
-                 f"{m['max']:.3g} um; baseline ({d['baseline']['name']}, {d['baseline']['readings']}"
-                 f" readings): RMS {b['rms']:.3g} um, max {b['max']:.3g} um"
+                 f"{m['max']:.3g} um; baseline ({base['name']}, {base['readings']} readings): "
+                 f"RMS {b['rms']:.3g} um, max {b['max']:.3g} um"
                  + (f" -> {100 * gain:.0f} % lower" if gain is not None and gain >= 0 else
                     f" -> {-100 * gain:.0f} % higher" if gain is not None else ""))
     return "\n".join(lines)
