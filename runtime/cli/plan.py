@@ -51,8 +51,9 @@ def register(sub) -> None:
     p.add_argument("--criterion", choices=("I", "D"), default="I",
                    help="I: mean predicted variance of the volumetric error over the working "
                         "volume; D: determinant of the information matrix")
-    p.add_argument("--seed", type=int, default=0, help="reserved (the design is "
-                                                        "deterministic)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the random starts of the exchange (the same seed, the same "
+                        "plan)")
     add_force(p)
     p.set_defaults(func=run)
 

@@ -18,7 +18,8 @@ through the Woodbury identity from its low-rank factor ``I_s = U U^T``; (2) the 
 set-ups ``K`` along the greedy path: the smallest whose criterion, with the readings spread
 over its set-ups, is within ``GOOD_ENOUGH`` of the best (a set-up change costs more than
 readings), within the time budget; (3) Fedorov exchange at that ``K``: swap a chosen set-up
-for a candidate while that lowers the criterion; (4) the readings per set-up by the
+for a candidate while that lowers the criterion, from the greedy start and a few random
+ones (``--seed``), the best end point kept; (4) the readings per set-up by the
 multiplicative algorithm for the approximate design (weights ``w_s <- w_s (d_s / mean d)^0.5``
 with ``d_s = trace(M^-1 W M^-1 I_s)``, Silvey, Titterington & Torsney 1978), rounded to whole
 readings, each set-up at least its minimum.
@@ -35,7 +36,9 @@ RIDGE = 1e-8
 #: a number of set-ups whose criterion is within this factor of the best is enough
 GOOD_ENOUGH = 1.05
 #: most passes of the exchange
-EXCHANGE_PASSES = 8
+EXCHANGE_PASSES = 20
+#: random starts of the exchange besides the greedy one
+RESTARTS = 4
 #: iterations of the multiplicative algorithm
 ALLOCATION_STEPS = 200
 
@@ -78,17 +81,22 @@ def criterion(M: np.ndarray, W: np.ndarray, kind: str) -> float:
         return np.inf
 
 
-def gains(Minv: np.ndarray, W: np.ndarray, U: np.ndarray, kind: str, scale: float = 1.0
+def gains(Minv: np.ndarray, W: np.ndarray, U: np.ndarray, kind: str, sign=None
           ) -> np.ndarray:
-    """Decrease of the criterion (C,) when ``scale * U_c U_c^T`` is added to ``M``."""
-    U = U * np.sqrt(scale)
+    """Decrease of the criterion (C,) when ``U_c S U_c^T`` is added to ``M`` (``S`` the
+    diagonal ``sign``, +1 by default: an added set-up; -1 columns remove one), through the
+    Woodbury identity: ``(M + U S U^T)^-1 = M^-1 - B (S + U^T B)^-1 B^T``, ``B = M^-1 U``.
+    A change that leaves ``M`` not positive definite gives -inf."""
+    r = U.shape[2]
+    S = np.diag(np.ones(r) if sign is None else np.asarray(sign, float))
     B = np.matmul(Minv, U)                                      # M^-1 U  (C, q, r)
-    Ut = np.transpose(U, (0, 2, 1))
-    C = np.eye(U.shape[2]) + np.matmul(Ut, B)
+    K = S + np.matmul(np.transpose(U, (0, 2, 1)), B)            # S^-1 = S
+    sgn, logdet = np.linalg.slogdet(np.matmul(S, K))            # det(I + S U^T M^-1 U)
     if kind == "D":
-        return np.linalg.slogdet(C)[1]
+        return np.where(sgn > 0, logdet, -np.inf)
     D = np.matmul(np.transpose(B, (0, 2, 1)), np.matmul(W, B))   # U^T M^-1 W M^-1 U
-    return np.trace(np.linalg.solve(C, D), axis1=1, axis2=2)
+    out = np.trace(np.linalg.solve(K, D), axis1=1, axis2=2)
+    return np.where(sgn > 0, out, -np.inf)
 
 
 def greedy(cand: Candidates, W, P0, kind: str, k_max: int, caps: dict) -> list:
@@ -113,30 +121,55 @@ def greedy(cand: Candidates, W, P0, kind: str, k_max: int, caps: dict) -> list:
 
 def exchange(cand: Candidates, W, P0, kind: str, chosen: list, locked=()) -> list:
     """Fedorov exchange on the equal-readings criterion: swap a chosen set-up (not
-    ``locked``) for a free candidate of the same instrument while that lowers it."""
+    ``locked``) for a free candidate of the same instrument while that lowers it; each swap
+    scored as one rank update of the current information (:func:`gains` with the removed
+    set-up's factor signed -1: no near-singular intermediate)."""
     chosen = list(chosen)
     q = W.shape[0]
     ridge = RIDGE * max(float(np.mean(np.trace(cand.info, axis1=1, axis2=2))) / q, 1e-300)
+    r = cand.factor.shape[2]
+    sign = np.concatenate([np.ones(r), -np.ones(r)])
     for _ in range(EXCHANGE_PASSES):
         M = P0 + ridge * np.eye(q) + cand.info[chosen].sum(axis=0)
-        now = criterion(M, W, kind)
-        best = (0.0, None, None)
+        Minv = np.linalg.inv(M)
+        best = (1e-9 * abs(criterion(M, W, kind)), None, None)
         for pos, s in enumerate(chosen):
             if s in locked:
                 continue
-            Mm = M - cand.info[s]
-            g = gains(np.linalg.pinv(Mm, hermitian=True), W, cand.factor, kind)
-            base = criterion(Mm, W, kind)
-            new = base - g
-            new[chosen] = np.inf
-            new[cand.inst != cand.inst[s]] = np.inf
-            c = int(np.argmin(new))
-            if now - new[c] > best[0] + 1e-9 * abs(now):
-                best = (now - new[c], pos, c)
+            V = np.concatenate([cand.factor, np.broadcast_to(cand.factor[s],
+                                                             cand.factor.shape)], axis=2)
+            g = gains(Minv, W, V, kind, sign)
+            g[chosen] = -np.inf
+            g[cand.inst != cand.inst[s]] = -np.inf
+            c = int(np.argmax(g))
+            if g[c] > best[0]:
+                best = (g[c], pos, c)
         if best[1] is None:
             break
         chosen[best[1]] = best[2]
     return chosen
+
+
+def best_exchange(cand: Candidates, W, P0, kind: str, start: list, restarts: int = RESTARTS,
+                  seed: int = 0) -> list:
+    """:func:`exchange` from the greedy ``start`` and from ``restarts`` random starts with as
+    many set-ups of each instrument (seeded by ``seed``): the best end point (a single-swap
+    exchange stops at a local optimum)."""
+    rng = np.random.default_rng(seed)
+    q = W.shape[0]
+    ridge = RIDGE * max(float(np.mean(np.trace(cand.info, axis1=1, axis2=2))) / q, 1e-300)
+    starts = [list(start)]
+    for _ in range(restarts):
+        trial = []
+        for i in dict.fromkeys(cand.inst[start].tolist()):
+            pool = np.flatnonzero(cand.inst == i)
+            k = int(np.sum(cand.inst[start] == i))
+            trial += rng.choice(pool, size=k, replace=False).tolist()
+        starts.append(trial)
+    ends = [exchange(cand, W, P0, kind, s) for s in starts]
+    value = [criterion(P0 + ridge * np.eye(q) + cand.info[e].sum(axis=0), W, kind)
+             for e in ends]
+    return ends[int(np.argmin(value))]
 
 
 def allocate(cand: Candidates, W, P0, kind: str, chosen: list, readings: int) -> np.ndarray:

@@ -110,8 +110,8 @@ class Plan:
 def plan(layout, specs, readings: int, parameters: str | None = None, minutes=None,
          criterion: str = "I", seed: int = 0) -> Plan:
     """Design a campaign for ``layout`` with the instruments ``specs`` (``--instrument``
-    texts) of ``readings`` readings in all (module docstring).  ``seed`` is reserved for
-    randomised tie-breaking (the design is deterministic)."""
+    texts) of ``readings`` readings in all (module docstring).  ``seed``: the random starts of
+    the exchange (the same seed, the same plan)."""
     model = layout if isinstance(layout, Model) else load(layout)
     insts = [_spec.parse(s) for s in specs]
     require(insts, "give at least one --instrument")
@@ -133,7 +133,7 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
                               f"{need} readings (the smallest set-ups)")
     prob = _information.problem(model, insts, pool, req)
     cand = _pool(prob, insts, pool)
-    picked, counts = _choose(cand, prob, insts, pool, readings, minutes, criterion)
+    picked, counts = _choose(cand, prob, insts, pool, readings, minutes, criterion, seed)
     require(picked, f"--minutes {minutes}: no plan of these instruments fits in that time"
             if minutes is not None else f"--readings {readings}: more readings than the "
             f"candidate set-ups of these instruments can take (give more set-ups: places=, "
@@ -197,7 +197,7 @@ def _scaled(prob):
     return W[np.ix_(f, f)], P0[np.ix_(f, f)]
 
 
-def _choose(cand, prob, insts, pool, readings, minutes, criterion):
+def _choose(cand, prob, insts, pool, readings, minutes, criterion, seed):
     """The set-ups (pool indices) and their readings (module docstring of _design)."""
     W, P0 = _scaled(prob)
     caps = {i: _cap(inst) for i, inst in enumerate(insts)}
@@ -218,7 +218,7 @@ def _choose(cand, prob, insts, pool, readings, minutes, criterion):
     top = min(v for v, *_ in options)
     good = [o for o in options if _close(o[0], top)]
     value, _, sel, m = good[0]
-    swapped = _design.exchange(cand, W, P0, criterion, sel)
+    swapped = _design.best_exchange(cand, W, P0, criterion, sel, seed=seed)
     if swapped != sel:
         m2 = _design.allocate(cand, W, P0, criterion, swapped, readings)
         v2 = _design.plan_value(cand, W, P0, criterion, swapped, m2)
