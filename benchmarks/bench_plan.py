@@ -34,7 +34,7 @@ def main(argv) -> int:
     for layout, specs, n, params in cases:
         p, wall, cpu = timed(plan, layout, specs, n, params)
         parts = [_files.observations(p.model, f) for f in p.files]
-        _, wall_p, _ = timed(predict, p.model, parts, p.chosen)
+        _, wall_p, _ = timed(predict, p.model, parts, p.parameters_text)
         chosen = sum(f.n for f in p.files)
         print(f"{layout} {' + '.join(specs)}: {chosen} readings in {len(p.files)} files from "
               f"{p.candidate_readings} candidate readings ({p.candidates} set-ups): "

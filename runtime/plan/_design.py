@@ -35,12 +35,15 @@ import numpy as np
 RIDGE = 1e-8
 #: a number of set-ups whose criterion is within this factor of the best is enough
 GOOD_ENOUGH = 1.05
-#: most passes of the exchange
+#: most passes of the exchange, and its time budget per start (s)
 EXCHANGE_PASSES = 20
+EXCHANGE_SECONDS = 10.0
 #: random starts of the exchange besides the greedy one
 RESTARTS = 4
+#: largest columns x factor rank of a problem restarted (the exchange's cost grows as its cube)
+RESTART_SIZE = 600
 #: iterations of the multiplicative algorithm
-ALLOCATION_STEPS = 200
+ALLOCATION_STEPS = 60
 
 
 @dataclass
@@ -124,26 +127,33 @@ def exchange(cand: Candidates, W, P0, kind: str, chosen: list, locked=()) -> lis
     ``locked``) for a free candidate of the same instrument while that lowers it; each swap
     scored as one rank update of the current information (:func:`gains` with the removed
     set-up's factor signed -1: no near-singular intermediate)."""
+    import time
+
     chosen = list(chosen)
     q = W.shape[0]
     ridge = RIDGE * max(float(np.mean(np.trace(cand.info, axis1=1, axis2=2))) / q, 1e-300)
     r = cand.factor.shape[2]
     sign = np.concatenate([np.ones(r), -np.ones(r)])
+    stop = time.perf_counter() + EXCHANGE_SECONDS
     for _ in range(EXCHANGE_PASSES):
+        if time.perf_counter() > stop:
+            break
         M = P0 + ridge * np.eye(q) + cand.info[chosen].sum(axis=0)
         Minv = np.linalg.inv(M)
         best = (1e-9 * abs(criterion(M, W, kind)), None, None)
         for pos, s in enumerate(chosen):
             if s in locked:
                 continue
-            V = np.concatenate([cand.factor, np.broadcast_to(cand.factor[s],
-                                                             cand.factor.shape)], axis=2)
+            free = np.flatnonzero(cand.inst == cand.inst[s])
+            free = free[~np.isin(free, chosen)]
+            if not len(free):
+                continue
+            F = cand.factor[free]
+            V = np.concatenate([F, np.broadcast_to(cand.factor[s], F.shape)], axis=2)
             g = gains(Minv, W, V, kind, sign)
-            g[chosen] = -np.inf
-            g[cand.inst != cand.inst[s]] = -np.inf
             c = int(np.argmax(g))
             if g[c] > best[0]:
-                best = (g[c], pos, c)
+                best = (g[c], pos, int(free[c]))
         if best[1] is None:
             break
         chosen[best[1]] = best[2]
@@ -157,6 +167,8 @@ def best_exchange(cand: Candidates, W, P0, kind: str, start: list, restarts: int
     exchange stops at a local optimum)."""
     rng = np.random.default_rng(seed)
     q = W.shape[0]
+    if q * cand.factor.shape[2] > RESTART_SIZE:      # large problems: the greedy start only
+        restarts = 0
     ridge = RIDGE * max(float(np.mean(np.trace(cand.info, axis1=1, axis2=2))) / q, 1e-300)
     starts = [list(start)]
     for _ in range(restarts):
