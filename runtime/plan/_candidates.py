@@ -105,14 +105,20 @@ def ballbar_setups(model, inst) -> list:
     return out
 
 
-def _circle(model, inst, plane, length, centre, number) -> SetUp | None:
-    label = f"C{number}"
+def _circle(model, inst, plane, length, centre, number, sweep=None) -> SetUp | None:
+    """A circle (rotary axes at home) or, with ``sweep`` = (axis, (start, stop)), an ISO
+    10791-6 sweep: the rotary axis turns, the tool ball held at ``centre + length`` along the
+    plane's first axis on the table."""
+    label = f"{'R' if sweep else 'C'}{number}"
+    rotary = home(model)
+    if sweep:
+        rotary[sweep[0]] = sweep[1]
 
     def build(m: int) -> dict:
         m = max(m, 16)
-        ccw = ballbar.simulate(model, None, plane, length, centre, inst.tool, home(model),
+        ccw = ballbar.simulate(model, None, plane, length, centre, inst.tool, rotary,
                                points=m - m // 2, direction="ccw")
-        cw = ballbar.simulate(model, None, plane, length, centre, inst.tool, home(model),
+        cw = ballbar.simulate(model, None, plane, length, centre, inst.tool, rotary,
                               points=m // 2, direction="cw")
         cols = {k: np.concatenate([ccw[k], cw[k]]) for k in ccw}
         pos = rounded({a: cols[a] for a in model.axes})
@@ -127,10 +133,39 @@ def _circle(model, inst, plane, length, centre, number) -> SetUp | None:
         return None
     if not inside(model, {a: cols[a] for a in model.axes}).all():
         return None
-    text = (f"ballbar {length:g} mm, circle in {plane} about the pivot at "
-            f"({centre[0]:g}, {centre[1]:g}, {centre[2]:g}) mm, both directions")
-    return SetUp("ballbar", label, build, 2 * BALLBAR_TEMPLATE, 16, MAX_CIRCLE,
-                 {"pivot": centre, "length": length, "plane": plane}, text)
+    where = f"({centre[0]:g}, {centre[1]:g}, {centre[2]:g}) mm"
+    if sweep:
+        a, (lo, hi) = sweep
+        text = (f"ballbar {length:g} mm, pivot on the table at {where}, bar along "
+                f"{plane[0]}, {a} sweeping {lo:g}..{hi:g} deg (ISO 10791-6), both directions")
+        geometry = {"pivot": centre, "length": length, "plane": plane, "sweep": a}
+    else:
+        text = f"ballbar {length:g} mm, circle in {plane} about the pivot at {where}, both " \
+               f"directions"
+        geometry = {"pivot": centre, "length": length, "plane": plane}
+    return SetUp("ballbar", label, build, 2 * BALLBAR_TEMPLATE, 16, MAX_CIRCLE, geometry,
+                 text)
+
+
+def sweep_setups(model, inst) -> list:
+    """ISO 10791-6 sweeps of every rotary axis (a turning axis one turn, a tilting axis its
+    travel; the others at home): the pivot on the table at x = -1/3, 1/3 of the volume's half
+    width and two heights, the bar along x, y or z of the table, every length."""
+    if not model.rotary_axes:
+        return []
+    lo, hi = volume(model, inst.tool)
+    half = 0.5 * min(hi[0] - lo[0], hi[1] - lo[1])
+    pivots = [np.round(np.array([x, 0.0, lo[2] + f * (hi[2] - lo[2])]), 1)
+              for x in (-half / 3.0, half / 3.0) for f in (0.1, 0.3)]
+    out = []
+    for a in model.rotary_axes:
+        tlo, thi = model.travel[a]
+        span = (0.0, 360.0) if thi - tlo >= 360.0 else (tlo, thi)
+        for plane, length, p in itertools.product(("XY", "YZ", "ZX"), inst.lengths, pivots):
+            s = _circle(model, inst, plane, length, p, len(out) + 1, (a, span))
+            if s is not None:
+                out.append(s)
+    return out
 
 
 def spread(m: int, n_t: int) -> np.ndarray:
@@ -260,7 +295,12 @@ def _station(model, inst, where, pos, n_t, label) -> SetUp:
     return SetUp("distances", label, build, n_t, 12, REPEATS * n_t, {"station": where}, text)
 
 
-MAKERS = {"ballbar": ballbar_setups, "sphere": sphere_setups, "distances": distances_setups}
+def ballbar_all(model, inst) -> list:
+    """Circles and, on a layout with rotary axes, sweeps."""
+    return ballbar_setups(model, inst) + sweep_setups(model, inst)
+
+
+MAKERS = {"ballbar": ballbar_all, "sphere": sphere_setups, "distances": distances_setups}
 
 
 def setups(model, inst) -> list:

@@ -135,4 +135,9 @@ def summary(plan) -> str:
                  f"RMS {b['rms']:.3g} um, max {b['max']:.3g} um"
                  + (f" -> {100 * gain:.0f} % lower" if gain is not None and gain >= 0 else
                     f" -> {-100 * gain:.0f} % higher" if gain is not None else ""))
+    left = [n for n in base["unidentifiable"] if n in d["parameters"]]
+    if left:
+        lines.append(f"  (the baseline leaves {len(left)} of the plan's determined parameters "
+                     f"undetermined -- {', '.join(left[:6])}{' ...' if len(left) > 6 else ''} --"
+                     f" and its map holds only what it determines)")
     return "\n".join(lines)
