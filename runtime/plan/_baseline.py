@@ -20,7 +20,8 @@ import math
 import numpy as np
 
 from . import _candidates, _files
-from ._predict import predict
+from ..errors import InputError
+from ._predict import Prediction, predict
 
 NAMES = {"ballbar": "ISO 230-4: three orthogonal circles about the centre",
          "sphere": "one sphere placement, rotary axes in equal steps",
@@ -37,10 +38,16 @@ def baseline(model, insts, spec, files, tool) -> dict:
             continue
         picks += [(i, s, m) for s, m in MAKERS[inst.kind](model, inst, n)]
         names.append(NAMES[inst.kind])
-    bfiles = _files.group(insts, picks)
-    parts = [_files.observations(model, f) for f in bfiles]
-    return {"name": "; ".join(names), "readings": int(sum(f.n for f in bfiles)),
-            "prediction": predict(model, parts, spec, tool), "files": bfiles}
+    name = "; ".join(names)
+    try:
+        bfiles = _files.group(insts, picks)
+        parts = [_files.observations(model, f) for f in bfiles]
+        pred = predict(model, parts, spec, tool)
+    except InputError as exc:      # too few readings for the conventional set-ups
+        return {"name": name, "readings": 0, "files": [], "why": str(exc),
+                "prediction": Prediction({}, [], map_u_um={"max": None, "rms": None})}
+    return {"name": name, "readings": int(sum(f.n for f in bfiles)), "prediction": pred,
+            "files": bfiles}
 
 
 def _ballbar(model, inst, n: int) -> list:

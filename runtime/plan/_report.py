@@ -57,7 +57,8 @@ def data(plan) -> dict:
                       "minutes": minutes,
                       "setups": [{"label": s.label, "text": s.text, "readings": int(m),
                                   **_geometry(s.geometry)} for s, m in pf.setups]})
-    gain = (1.0 - pred.map_u_um["rms"] / base.map_u_um["rms"]) if base.map_u_um["rms"] else None
+    gain = ((1.0 - pred.map_u_um["rms"] / base.map_u_um["rms"]) if base.map_u_um["rms"]
+            else None)
     return {
         "layout": plan.model.name,
         "readings": int(sum(pf.n for pf in plan.files)),
@@ -78,7 +79,8 @@ def data(plan) -> dict:
         "map_grid": plan.map_grid,
         "baseline": {"name": plan.baseline["name"], "readings": plan.baseline["readings"],
                      "parameters": _params(base), "unidentifiable": list(base.unidentifiable),
-                     "map_u_um": dict(base.map_u_um)},
+                     "map_u_um": dict(base.map_u_um),
+                     **({"why_none": plan.baseline["why"]} if "why" in plan.baseline else {})},
         "map_gain": None if gain is None else round(gain, 4),
         "minutes": round(plan.total_minutes, 1),
         "files": files,
@@ -130,6 +132,10 @@ def summary(plan) -> str:
     m, b = d["map_u_um"], d["baseline"]["map_u_um"]
     gain = d["map_gain"]
     base = d["baseline"]
+    if b["rms"] is None:
+        lines.append(f"  map uncertainty over the working volume: RMS {m['rms']:.3g} um, max "
+                     f"{m['max']:.3g} um; no baseline ({base['name']}: {base['why_none']})")
+        return "\n".join(lines)
     lines.append(f"  map uncertainty over the working volume: RMS {m['rms']:.3g} um, max "
                  f"{m['max']:.3g} um; baseline ({base['name']}, {base['readings']} readings): "
                  f"RMS {b['rms']:.3g} um, max {b['max']:.3g} um"

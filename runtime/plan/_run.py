@@ -115,6 +115,10 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
     model = layout if isinstance(layout, Model) else load(layout)
     insts = [_spec.parse(s) for s in specs]
     require(insts, "give at least one --instrument")
+    for inst in insts:
+        require(inst.kind != "sphere" or model.rotary_axes,
+                f"--instrument {inst.text}: layout {model.name} has no rotary axis; a sphere / "
+                f"R-test plan turns the rotary axes (plan a ballbar or distances campaign)")
     require(criterion in ("I", "D"), "--criterion must be I or D")
     union = default_request(model, [i.kind for i in insts])
     req = terms.request(parameters, model, union)

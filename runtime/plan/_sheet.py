@@ -82,12 +82,18 @@ FILES</code> (no options).</p>
 <h2>Predicted result</h2><table><tr><th class=l>parameter</th><th>predicted std</th>
 <th class=l>unit</th><th class=l>determined alone by</th><th>baseline std</th></tr>{params}
 </table><p>Map of the volumetric error over the working volume: predicted standard uncertainty
-RMS {m['rms']:.3g} µm, max {m['max']:.3g} µm (k = 1); the conventional plan
-({escape(d['baseline']['name'])}, {d['baseline']['readings']} readings): RMS {b['rms']:.3g} µm,
-max {b['max']:.3g} µm.</p>
+RMS {m['rms']:.3g} µm, max {m['max']:.3g} µm (k = 1); {_baseline_text(d, b)}.</p>
 {'<h2>Not determined by this plan</h2><ul>' + why + '</ul>' if why else ''}
 </body></html>
 """
+
+
+def _baseline_text(d, b) -> str:
+    base = d["baseline"]
+    if b["rms"] is None:
+        return f"no conventional plan at this number of readings ({escape(base['why_none'])})"
+    return (f"the conventional plan ({escape(base['name'])}, {base['readings']} readings): RMS "
+            f"{b['rms']:.3g} µm, max {b['max']:.3g} µm")
 
 
 def _base(d, name) -> str:
