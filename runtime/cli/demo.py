@@ -16,7 +16,10 @@ Sections (each runs the real command or API on built-in data and writes into DIR
 7. closing the loop: a virtual MB1 with an undeclared effect, fit, diagnosis, augmented model;
 8. ISO 230-2 evaluation of a simulated positioning run;
 9. task-specific uncertainty of a distance (Monte Carlo);
-10. ``index.html`` with a section, figures and captions per step, and the headline figures
+10. measurement plans (``volerr plan``): an R-test campaign for the DMU 50 and a ballbar +
+    tracking-interferometer campaign for MB1, executed on volerr's model and calibrated, the
+    predicted against the realised standard uncertainties;
+11. ``index.html`` with a section, figures and captions per step, and the headline figures
     printed.  Everything is written at the end, all or nothing.
 """
 
