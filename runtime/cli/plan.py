@@ -37,7 +37,7 @@ def register(sub) -> None:
                    help="readings in all (rows of the plan files)")
     p.add_argument("--out", required=True, metavar="DIR",
                    help="folder of the plan files (created when missing, its parent must "
-                        "exist; an existing folder must hold no file of the same name "
+                        "exist; an existing folder must hold no .csv, .nc or .html file "
                         "unless --force)")
     add_json(p, "the plan: predicted standard uncertainties, files, baseline")
     add_html(p, "the set-up sheet (default: DIR/plan.html)")

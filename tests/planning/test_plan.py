@@ -22,6 +22,7 @@ SPHERE = ["DMU50", "--instrument", "sphere:tool=100:tool_u_um=0.5", "--readings"
 MIXED = ["DMU50", "--instrument", "sphere:tool=100:tool_u_um=0.5:places=1", "--instrument",
          "distances", "--readings", "600", "--parameters",
          "location,squareness,EXX@slope,EYY@slope,EZZ@slope"]
+SWEEPS = ["DMU50", "--instrument", "ballbar:lengths=150", "--readings", "300"]
 PLANTED = {"MB1": {"EC0Y": 25.0, "EB0Z": -15.0, "EA0Z": 10.0},
            "DMU50": {"EX0B": 20.0, "EY0B": -10.0, "EA0B": 30.0, "EB0B": -20.0, "EX0C": 5.0,
                      "EY0C": 7.0, "EA0C": 10.0, "EB0C": 15.0}}
@@ -36,7 +37,8 @@ def _plan(tmp, argv):
 @pytest.fixture(scope="module")
 def plans(tmp_path_factory):
     return {name: _plan(tmp_path_factory.mktemp(name), argv)
-            for name, argv in (("ballbar", BALLBAR), ("sphere", SPHERE), ("mixed", MIXED))}
+            for name, argv in (("ballbar", BALLBAR), ("sphere", SPHERE), ("mixed", MIXED),
+                               ("sweeps", SWEEPS))}
 
 
 def _execute(tmp, folder, doc, planted, seed):
@@ -55,7 +57,8 @@ def _execute(tmp, folder, doc, planted, seed):
                      plan=False).data
 
 
-@pytest.mark.parametrize("name,seed", [("ballbar", 3), ("sphere", 4), ("mixed", 5)])
+@pytest.mark.parametrize("name,seed", [("ballbar", 3), ("sphere", 4), ("mixed", 5),
+                                       ("sweeps", 6)])
 def test_executed_plan_gives_the_predicted_std(plans, tmp_path, name, seed):
     folder, doc = plans[name]
     layout = doc["layout"]
@@ -73,6 +76,15 @@ def test_executed_plan_gives_the_predicted_std(plans, tmp_path, name, seed):
         assert 0.7 <= got["std"] / pred["predicted_std"] <= 1.4, (n, got, pred)
         # the same normal equations: equal once the a-posteriori variance factor is removed
         assert got["std"] / np.sqrt(vf) == pytest.approx(pred["predicted_std"], rel=2e-3)
+
+
+def test_ballbar_sweeps_determine_the_rotary_axes_location(plans):
+    """On a five-axis layout the ballbar plan sweeps the rotary axes (ISO 10791-6) and so
+    determines location errors that circles at home cannot."""
+    _, doc = plans["sweeps"]
+    assert {"EA0B", "EB0B", "EA0C", "EB0C"} <= set(doc["parameters"])
+    assert any(s["label"].startswith("R") for f in doc["files"] for s in f["setups"])
+    assert {"EA0B", "EB0B"} <= set(doc["baseline"]["unidentifiable"])
 
 
 def test_mixed_plan_names_what_only_the_combination_determines(plans):
@@ -95,7 +107,7 @@ def _moves(nc: str):
     return moves
 
 
-@pytest.mark.parametrize("name", ["ballbar", "sphere", "mixed"])
+@pytest.mark.parametrize("name", ["ballbar", "sphere", "mixed", "sweeps"])
 def test_files_and_nc_programs_carry_the_plan_inside_the_travel(plans, name):
     folder, doc = plans[name]
     layout = read_layout(doc["layout"])
