@@ -40,6 +40,12 @@ def _axis_along(model, k: int) -> str | None:
 def diagnose(model, obs, planes: list, swept: list = ()) -> list:
     """``[{"parameter", "value", "unit", "std"}]`` of the traces ``obs`` (stacked ballbar
     files) in ``planes`` (XY, YZ, ZX) with rotary axes ``swept``."""
+    return diagnose_with_note(model, obs, planes, swept)[0]
+
+
+def diagnose_with_note(model, obs, planes: list, swept: list = ()) -> tuple[list, str | None]:
+    """:func:`diagnose` and, for a rotary sweep that determines none of its axis' location
+    errors, the sentence saying why (:func:`why_not`; None otherwise)."""
     params, extra, report = [], [], []
     for plane in planes:
         i, j = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}[plane]
@@ -63,8 +69,40 @@ def diagnose(model, obs, planes: list, swept: list = ()) -> list:
                    and p[-1] == r and p[2] == "0"]
     require(params, "nothing to diagnose in these traces")
     cal = calibrate(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
-                    extra_terms=extra, plan=False)
-    return _entries(cal, report, swept, extra)
+                    extra_terms=extra, plan=False, progress=False)
+    entries = _entries(cal, report, swept, extra)
+    return entries, why_not(cal, swept, entries)
+
+
+def why_not(cal, swept: list, entries: list) -> str | None:
+    """One sentence: why a rotary sweep determines none of its axis' location errors (None
+    when it determines some, or no axis swept): what they act like on these readings (the
+    combinations the traces do determine, or the set-up unknowns -- pivot position, bar
+    length), and what would separate them."""
+    if not swept:
+        return None
+    model = cal.model
+    names = [p for r in swept for p in model.parameters
+             if model.parameter_axis.get(p) is None and p[-1] == r and p[2] == "0"]
+    if any(e["parameter"] in names for e in entries):
+        return None
+    ident = cal.data["identifiability"]
+    setup_only = [n for n in names if ident.get(n, {}).get("confounded_with")
+                  and all(c.startswith("setup:") for c in ident[n]["confounded_with"])]
+    combos = [f"{c['expression']} = {c['value']:.4g} +- {c['std']:.2g} {c['unit']}"
+              for c in cal.data["combinations"]
+              if any(n in c["expression"] for n in names)]
+    parts = [f"the sweep of {', '.join(swept)} determines none of "
+             f"{', '.join(names)} on its own"]
+    if combos:
+        parts.append(f"it determines only the combinations {'; '.join(combos)}")
+    if setup_only:
+        parts.append(f"{', '.join(setup_only)} act on the bar length exactly as the set-up "
+                     f"does (the pivot's position, the bar's length)")
+    parts.append("sweeps with the bar in other directions (radial, tangential, axial) and "
+                 "the pivot at other heights separate them (ISO 10791-6)")
+    return "; ".join(parts) + "."
+
 
 
 def _entry(name, value_std, factor, unit) -> dict:

@@ -49,7 +49,10 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
         stacked = instruments.stack(parts)
         planes = list(dict.fromkeys(t.plane for t in trs))
         swept = [a for a in model.rotary_axes if np.ptp(stacked.positions[a]) > 1.0]
-        data["diagnosis"] = diagnosis.diagnose(model, stacked, [] if swept else planes, swept)
+        data["diagnosis"], note = diagnosis.diagnose_with_note(
+            model, stacked, [] if swept else planes, swept)
+        if note:
+            data["diagnosis_note"] = note
     return Evaluation(data, trs, results)
 
 

@@ -21,7 +21,8 @@ def render(ev) -> str:
         for r in ev.data["traces"])
     diag = "".join(f"<tr><td>{html.escape(d['parameter'])}</td><td>{num(d['value'], '.4g')}</td>"
                    f"<td>{num(d['std'], '.2g')}</td><td>{html.escape(d['unit'])}</td></tr>"
-                   for d in ev.data["diagnosis"]) or "<tr><td colspan=4>none</td></tr>"
+                   for d in ev.data["diagnosis"]) or (
+        f"<tr><td colspan=4>none: {html.escape(ev.data.get('diagnosis_note', ''))}</td></tr>")
     return f"""<!DOCTYPE html><html><head><meta charset="utf-8"><title>Ballbar evaluation</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:1em auto}}table{{border-collapse:
 collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}</style></head><body>

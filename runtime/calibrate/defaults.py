@@ -73,15 +73,20 @@ def _names(model, use: str) -> list:
     raise ValueError(use)
 
 
-def default_parameters(model, kinds) -> list[str]:
+def default_parameters(model, kinds, moving=None) -> list[str]:
     """The parameter request (names as ``--parameters`` accepts: parameter names, terms such as
     ``EXX@slope`` / ``EYX@P2``, reversals ``RV_X``) each instrument kind in ``kinds`` is used
     for, the union for several kinds; ordered as the model's parameters, the reversals last.
-    Unknown kinds count as ``deviations`` (every parameter)."""
+    Unknown kinds count as ``deviations`` (every parameter).  ``moving``: the axes the
+    campaign moves (None: all); a ballbar's location errors of a rotary axis it never turns
+    are left out (circles with the rotary axes fixed are not used for them)."""
     wanted: list = []
     for kind in dict.fromkeys(kinds):
         for use in USES.get(kind, ("all",)):
-            wanted += _names(model, use)
+            names = _names(model, use)
+            if kind == "ballbar" and use == "location" and moving is not None:
+                names = [p for p in names if p[-1] in moving]
+            wanted += names
     wanted = list(dict.fromkeys(wanted))
     whole = {w for w in wanted if "@" not in w}
     # a term of a parameter fitted whole is already in the request

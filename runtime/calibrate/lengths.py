@@ -24,6 +24,11 @@ import numpy as np
 from . import mapping
 
 
+#: predicted length errors and their uncertainties all below this (um): the determined
+#: parameters do not act on lengths, the ISO 10360-2 table is left out
+NO_LENGTH_UM = 1e-4
+
+
 def report(cal) -> dict | None:
     """The report's ``iso10360`` entry, or None for a layout whose linear axes are not X, Y,
     Z."""
@@ -64,6 +69,12 @@ def report(cal) -> dict | None:
                             for i, name in enumerate(test.names)]
         out["max_abs_E_um"] = round(float(np.max(np.abs(E))), 4)
         out["box_mm"] = {a: [round(v, 4) for v in box[a]] for a in "XYZ"}
+        if max(float(np.max(np.abs(E))), float(np.max(uE))) < NO_LENGTH_UM:
+            del out["predicted"], out["max_abs_E_um"]
+            out["predicted_omitted"] = (
+                "the determined parameters do not change lengths measured along lines at "
+                "fixed rotary-axis positions (the location errors of rotary axes move the "
+                "workpiece frame rigidly): no ISO 10360-2 length error follows from them")
     gauges = step_gauges(cal)
     if gauges:
         out["step_gauges"] = gauges

@@ -142,7 +142,8 @@ def what_enters(cal) -> dict:
 
 def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), inputs=()):
     """The map as CSV: axis positions (mm / deg), ``Xp,Yp,Zp``, ``dx_um,dy_um,dz_um`` (the
-    identified error) and ``u_dx_um,u_dy_um,u_dz_um`` (its standard uncertainty)."""
+    identified error) and ``u_dx_um,u_dy_um,u_dz_um`` (its standard uncertainty); ``#`` lines
+    above the header name what it holds as 0 and the combinations in it."""
     from ..cmm import csvformat
     from ..fileio import AtomicFile
 
@@ -158,8 +159,12 @@ def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), input
     cols = [pos[a] for a in model.axes] + [float(v) for v in probe]
     cols += [1e3 * e[:, i] for i in range(3)] + [1e3 * u[:, i] for i in range(3)]
     out = AtomicFile(path, list(inputs))
+    held = what_enters(cal)
+    notes = ([f"# not determined, 0 in this map: {', '.join(held['undetermined'])}\n"]
+             if held["undetermined"] else [])
+    notes += [f"# in this map under one of its names: {c}\n" for c in held["combinations"]]
     try:
-        out.write((",".join(header) + "\n").encode("ascii"))
+        out.write(("".join(notes) + ",".join(header) + "\n").encode("utf-8"))
         out.write(csvformat.rows_text(cols, [6] * len(cols)))
     except BaseException:
         out.discard()

@@ -142,13 +142,16 @@ frame and its rotation (rotation vector) as identified with the machine.</p>
 <th>u / µm</th></tr>{rows}</table>""")
     m = d.get("volumetric_map")
     if m:
+        rot = "".join(f", {a} at {num(v, '.4g')} deg" for a, v in m.get("rotary_deg", {}).items())
         out.append(f"""<h2>Volumetric error map</h2><p>{html.escape(m['note'])}.  Grid
-{' x '.join(map(str, m['grid']))} over {html.escape(str(m['box_mm']))}: largest error
+{' x '.join(map(str, m['grid']))} over {html.escape(_box(m['box_mm']) + rot)}: largest error
 {_f(m['max_length_um'])} µm (RMS {_f(m['rms_length_um'])} µm); standard uncertainty up to
-{_f(m['u_max_um'], '.2g')} µm (RMS {_f(m['u_rms_um'], '.2g')} µm).  Not determined (not in the
-map): {html.escape(', '.join(m['undetermined']) or 'none')}.</p>""")
+{_f(m['u_max_um'], '.2g')} µm (RMS {_f(m['u_rms_um'], '.2g')} µm).</p>{_holds(m)}""")
     iso = d.get("iso10360")
-    if iso:
+    if iso and not iso.get("predicted") and not iso.get("step_gauges"):
+        out.append(f"<h2>ISO 10360-2 length errors</h2><p>Not shown: "
+                   f"{html.escape(iso.get('predicted_omitted', 'no length test applies'))}.</p>")
+    elif iso:
         rows = "".join(_row([e["line"], _list(e["lengths_mm"], ".0f"), _list(e["E_um"], ".3g"),
                              _list(e["u_um"], ".2g")]) for e in iso.get("predicted", []))
         gauges = "".join(_row([f"{g['file']} {g['placement']}", _f(g["lengths_mm"][-1], ".0f"),
@@ -156,11 +159,41 @@ map): {html.escape(', '.join(m['undetermined']) or 'none')}.</p>""")
                                _f(g["max_abs_En"])]) for g in iso.get("step_gauges", []))
         fig = embedded_img(png(length_figure(iso)), "ISO 10360-2 length errors")
         out.append(f"""<h2>ISO 10360-2 length errors</h2><p>{html.escape(iso['note'])}.
-Largest |E| predicted: {_f(iso.get('max_abs_E_um'))} µm.</p>
+Largest |E| predicted: {_f(iso.get('max_abs_E_um'))} µm.</p>{_holds(iso)}
 <table><tr><th>line</th><th>L / mm</th><th>E / µm</th><th>u / µm</th></tr>{rows}</table>
 """ + (f"""<table><tr><th>step gauge</th><th>longest L / mm</th><th>measured E / µm</th>
 <th>predicted E / µm</th><th>max |En|</th></tr>{gauges}</table>""" if gauges else "") + fig)
     return "\n".join(out)
+
+
+def _box(box: dict) -> str:
+    """``X -90.62 .. 158.6 mm, Y ...`` of a box ``{axis: [lo, hi]}``."""
+    return ", ".join(f"{a} {num(lo, '.4g')} .. {num(hi, '.4g')} mm" for a, (lo, hi) in
+                     box.items())
+
+
+def _holds(entry: dict) -> str:
+    """What a map or a length test holds: the names written as 0, the combinations."""
+    text = (f"Not determined, 0 in it: {', '.join(entry.get('undetermined', [])) or 'none'}."
+            + (f"  Determined only in combination, entered under one of their names: "
+               f"{'; '.join(entry['combinations'])}." if entry.get("combinations") else ""))
+    return f"<p>{html.escape(text)}</p>"
+
+
+def _combinations(d) -> str:
+    """The section on combinations (what is written under a name not determined alone)."""
+    combos = d.get("combinations", [])
+    written = {c["written_as"] for c in combos}
+    zero = [n for n in d.get("unidentifiable", []) if n not in written]
+    rows = "".join(_row([c["expression"], num(c["value"], ".4g"), num(c["std"], ".2g"),
+                         unit(c["unit"]), c["written_as"]]) for c in combos)
+    table = (f"""<table><tr><th>combination</th><th>value</th><th>u</th><th>unit</th>
+<th>written as</th></tr>{rows}</table>""" if combos else "")
+    return f"""<h2>Determined only in combination</h2>
+<p>The campaign determines these combinations, not their terms one by one; the error directory,
+the map and the ISO 10360 numbers hold each under the name given (a comment line in the
+error directory says so).  Every other parameter not determined is written as 0:
+{html.escape(', '.join(zero) or 'none')}.</p>{table}"""
 
 
 def _row(cells) -> str:
@@ -202,6 +235,7 @@ reading uncertainties).  Standard uncertainties u (k = 1); the figure's bars ± 
 <h2>Identified parameters</h2>
 <table><tr><th>parameter</th><th>value</th><th>u</th><th>unit</th></tr>{params}</table>
 {''.join(figs)}
+{_combinations(d)}
 <h2>What the campaign determines</h2>
 <p>A parameter is identifiable when its column is not in the span of all other columns (the
 instruments' set-up unknowns included); a file sees it when its readings depend on it once its

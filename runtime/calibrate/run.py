@@ -146,6 +146,8 @@ class Calibration:
         out: dict = {}
         for c in self.data.get("combinations", []):
             name = c["written_as"].split("@")[0]
+            if name not in self.model.parameters:
+                continue            # a reversal RV_<axis>: not in the error tables
             axis = self.model.parameter_axis.get(name)
             where = "constants" if axis is None else axis
             out.setdefault(where, []).append(
@@ -153,7 +155,8 @@ class Calibration:
                 f"{c['value']:.4g} +- {c['std']:.2g} {c['unit']} (the campaign does not "
                 f"determine its terms one by one)")
         zero = [n for n in self.data.get("unidentifiable", [])
-                if n not in {c["written_as"] for c in self.data.get("combinations", [])}]
+                if n not in {c["written_as"] for c in self.data.get("combinations", [])}
+                and n.split("@")[0] in self.model.parameters]
         if zero:
             for where in ["constants", *self.model.axes]:
                 out.setdefault(where, []).append(
@@ -176,10 +179,10 @@ class Calibration:
         files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} rows): RMS "
                           f"{i['rms_residual']:.3f} um, held-out {i['heldout_rms']:.3f} um"
                           for i in d["instruments"])
-        combos = (f", {len(d['combinations'])} determined only in combination"
+        combos = (f" ({len(d['combinations'])} of them in a determined combination)"
                   if d.get("combinations") else "")
         return (f"{d['layout']}: {len(d['parameters'])} parameters identified, "
-                f"{len(d['unidentifiable'])} not determined by these data{combos}; {files}")
+                f"{len(d['unidentifiable'])} not determined one by one{combos}; {files}")
 
     def undetermined_lines(self) -> list:
         """Console lines: the combinations written under one of their names, and the names
@@ -200,6 +203,11 @@ class Calibration:
 def campaign_kinds(obs) -> list:
     """The instrument kinds of the stacked files (``deviations`` for bare observations)."""
     return list(dict.fromkeys(f.kind for f in obs.files)) or ["deviations"]
+
+
+def moving_axes(model, ranges: dict) -> set:
+    """The axes the campaign moves: a measured range wider than 1 deg (rotary) or 1 mm."""
+    return {a for a, (lo, hi) in ranges.items() if hi - lo > 1.0}
 
 
 def declared_parameters(obs) -> str | None:
@@ -260,12 +268,12 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
         obs = instruments.stack(parts)
     from .defaults import default_parameters
 
-    req = terms.request(parameters or declared_parameters(obs), model,
-                        default_parameters(model, campaign_kinds(obs)))
+    ranges = data_ranges(model, obs)
+    req = terms.request(parameters or declared_parameters(obs), model, default_parameters(
+        model, campaign_kinds(obs), moving_axes(model, ranges)))
     chosen = req.parameters
     obs = with_directions(obs, parts, req.reversals)
     extra_terms = extra_terms + reversal_terms(model, obs, req, explicit=parameters is not None)
-    ranges = data_ranges(model, obs)
     spl = split_points(obs.n, seed, test_fraction, None)
     w, u_ref = reading_weights(obs)
     degree, degree_scores = _degree(model, obs, spl, ranges, req, degree, max_degree, w)
@@ -277,6 +285,9 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     gauge = [g for g in gauge if req.fits(g)]
     design = blocks.Design(model, obs, degree, ranges, keep)
     labels = list(design.labels)
+    require(extra_terms or any(lab[0] != "setup" for lab in labels),
+            f"--parameters {parameters!r}: nothing left to fit (fixed by the gauge: "
+            f"{', '.join(terms.namer(model, ranges)(g) for g in gauge) or 'none'})")
     if extra_terms:
         design = design.plus([extra_columns(model, obs, extra_terms)])
         labels += [(name, "extra") for name, *_ in extra_terms]
@@ -285,14 +296,14 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     fit = _normal_equations(design, obs, spl, np.sqrt(w))
     bar.update()
     bar.set_postfix_str("solve, residuals")
-    prefer = _preferred(model, obs, labels)
+    prefer = _preferred(model, obs, labels, ranges)
     out = _solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref, prefer)
     bar.update()
     bar.close()
     units = {name: unit for name, _, _, unit in extra_terms}
     report = _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, out, spl,
                      u_ref, units)
-    report["fitted_terms"] = _fitted_terms(req)
+    report["fitted_terms"] = _fitted_terms(req, terms.namer(model, ranges))
     if plan:
         from .plan import suggest
 
@@ -362,27 +373,26 @@ def reversal_terms(model, obs, req, explicit: bool) -> list:
     return out
 
 
-def _fitted_terms(req) -> list:
-    """The request as names: whole parameters, ``NAME@term`` of term requests, ``RV_<axis>``."""
+def _fitted_terms(req, name_of) -> list:
+    """The request as names: whole parameters, the terms of term requests (``name_of`` a
+    :func:`volerr.calibrate.terms.namer`), ``RV_<axis>``."""
     out = []
     for p in req.parameters:
         if p in req.only:
-            out += [f"{p}@{_TERM_WORD.get(k, f'P{k}')}" for k in sorted(req.only[p])]
+            out += [name_of((p, k)) for k in sorted(req.only[p])]
         else:
             out.append(p)
     return out + [f"RV_{a}" for a in req.reversals]
 
 
-_TERM_WORD = {0: "offset", 1: "slope"}
-
-
-def _preferred(model, obs, labels) -> np.ndarray:
+def _preferred(model, obs, labels, obs_ranges) -> np.ndarray:
     """(p,) bool: the columns the campaign's instruments are used for
     (:func:`volerr.calibrate.defaults.default_parameters`); where the requested set is
     rank-deficient the solution keeps them before the others."""
     from .defaults import default_parameters
 
-    req = terms.request(None, model, default_parameters(model, campaign_kinds(obs)))
+    req = terms.request(None, model, default_parameters(model, campaign_kinds(obs),
+                                                         moving_axes(model, obs_ranges)))
     return np.array([lab[0] != "setup" and (lab[1] == "extra" or req.fits(lab))
                      for lab in labels])
 

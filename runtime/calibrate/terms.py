@@ -102,7 +102,10 @@ def request(spec, model, default=("all",)) -> Request:
                 f"{', '.join(GROUPS)})")
     whole, only, reversals = set(), {}, []
     for word in words:
-        _add(word, model, whole, only, reversals)
+        # a combination as printed (EXX@slope-EYY@slope): each of its terms
+        for part in re.split(r"\s*[-+]\s*", word) if "@" in word else [word]:
+            require(part, f"--parameters: {word!r}: malformed combination")
+            _add(part, model, whole, only, reversals)
     for p in whole:
         only.pop(p, None)
     chosen = whole | set(only)

@@ -46,10 +46,14 @@ def register(sub) -> None:
     add_force(sim)
     sim.set_defaults(func=run_simulate)
     ev = s.add_parser("evaluate", help="ISO 230-4 G, H, F of traces and a diagnosis",
-                      description="Evaluate ballbar traces (one trace per file, placement and "
-                                  "direction): G, H, F and the least-squares centre (ISO "
-                                  "230-4), a polar plot, and a diagnosis in ISO 230-1 "
-                                  "parameters from the layout's observation model.")
+                      description="Evaluate ballbar traces (one trace per placement and "
+                                  "direction; a file without a placement column is cut into "
+                                  "its circles by plane, pivot, radius and direction): G, H, "
+                                  "F and the least-squares centre (ISO 230-4), a polar plot, "
+                                  "and a diagnosis in ISO 230-1 parameters from the layout's "
+                                  "observation model.  A trace with fewer than 8 readings at "
+                                  "distinct angles or less than half a circle, and the same "
+                                  "file given twice, are refused ('volerr formats ballbar').")
     ev.add_argument("files", nargs="+", metavar="TRACE.csv", help="ballbar files")
     ev.add_argument("--layout", help="the machine's layout (needed for traces with rotary "
                                      "axes; default: a generic Cartesian layout, MB1)")
@@ -120,4 +124,6 @@ def run_evaluate(args) -> int:
               f"{h}, F {r['F_min_um']:.3f} .. {r['F_max_um']:.3f} um")
     for d in ev.data["diagnosis"]:
         print(f"  {d['parameter']} = {d['value']:.4g} +- {d['std']:.2g} {d['unit']}")
+    if ev.data.get("diagnosis_note"):
+        print(f"  no diagnosis: {ev.data['diagnosis_note']}")
     return 0

@@ -298,6 +298,10 @@ def _rotary(out: Path) -> dict:
                      f"2 placements)",
             "value": "; ".join(rows) + f"; not determined by this plan: "
                      f"{', '.join(rep['unidentifiable']) or 'none'}"
+                     + "".join(f"; determined only in combination: {c['expression']} = "
+                               f"{num(c['value'], '+.1f')} +/- {num(c['std'], '.1f')} "
+                               f"{c['unit']} (written as {c['written_as']})"
+                               for c in rep.get("combinations", []))
                      + (f" (would be by: {plan})" if plan else ""),
             "files": ["sphere_DMU50.csv", "calibrate_rotary.json", "calibrate_rotary.html",
                       "calibrate_rotary.png", "errors_rotary/"]}

@@ -373,8 +373,9 @@ def identifiability_gram(G: np.ndarray, labels: list, tol: float = SV_TOL, prefe
     # translational terms before angular ones: an angular error is what a plan without the
     # lever arms cannot see, not the scale or straightness it would be confused with
     order = sorted(range(len(labels)), key=lambda j: (
-        0 if labels[j][0] == "setup" else 1 if first[j] else 2 if labels[j][1] is None else
-        3 if labels[j][1] == "extra" or labels[j][0][1] in "XYZ" else 4, j))
+        0 if labels[j][0] == "setup" else 1 if first[j] else 2,
+        0 if labels[j][0] == "setup" else 1 if labels[j][1] is None else
+        2 if labels[j][1] == "extra" or labels[j][0][1] in "XYZ" else 3, j))
     keep = independent_columns(G, order, tol)
     dropped = np.flatnonzero(~keep)
     if len(dropped) == 0:

@@ -193,23 +193,29 @@ def _geometric_traces(rel, pivot, length, direction, swept) -> np.ndarray:
                 & np.isclose(length[1:], length[:-1], atol=1e-6) & (swept[1:] == swept[:-1]))
     if direction is not None:
         same[1:] &= direction[1:] == direction[:-1]
-    trace = np.zeros(n, int)
+    steps = np.abs(np.column_stack([_steps(rel, k) for k in range(3)]))    # (n, 3) rad
+    code = cand @ np.array([1, 2, 4])
+    # the running intersection of planes changes only where a reading's planes change
+    events = np.flatnonzero(~same[1:] | (code[1:] != code[:-1])) + 1
+    starts = [0]
     planes = cand[0].copy()
-    steps: list = []
-    for i in range(1, n):
+    for i in events:
         both = planes & cand[i]
         new = not same[i] or (not swept[i] and planes.any() and not both.any())
-        if not new and not swept[i] and both.sum() == 1:
-            step = abs(_step(rel[i - 1], rel[i], int(np.argmax(both))))
+        if not new and not swept[i] and both.sum() == 1 and cand[i].sum() > 1:
             # a reading in two planes (where one circle ends and the next begins) after a
             # jump of the angle: the first reading of the next circle
-            new = cand[i].sum() > 1 and len(steps) >= 3 and step > 5 * np.median(steps)
-            steps.append(step)
+            k = int(np.argmax(both))
+            before = steps[starts[-1] + 1:i, k]
+            new = len(before) >= 3 and steps[i, k] > 5 * np.median(before)
         if new:
-            planes, steps = cand[i].copy(), []
+            starts.append(int(i))
+            planes = cand[i].copy()
         else:
             planes = both
-        trace[i] = trace[i - 1] + int(new)
+    trace = np.zeros(n, int)
+    trace[starts[1:]] = 1
+    trace = np.cumsum(trace)
     if direction is None:
         trace = _split_reversals(rel, trace, swept)
     return trace
@@ -229,16 +235,18 @@ def _split_reversals(rel, trace, swept) -> np.ndarray:
         idx = np.flatnonzero(trace == k)
         cuts = []
         if not swept[idx].any() and len(idx) > 2:
-            step = np.sign([_wrap(d) for d in np.diff(_angles(rel[idx]))])
+            step = np.sign(_steps(rel[idx], _trace_plane(rel[idx]))[1:])
+            moving = np.flatnonzero(step)
+            sg = step[moving]
+            run_starts = np.r_[0, np.flatnonzero(np.diff(sg)) + 1]
+            run_lengths = np.diff(np.r_[run_starts, len(sg)])
             sense = 0.0
-            for j in range(len(step)):
-                run = step[j:j + MIN_REVERSAL_RUN]
-                if sense and step[j] == -sense and len(run) == MIN_REVERSAL_RUN \
-                        and np.all(run == step[j]):
-                    cuts.append(j + 1)
-                    sense = step[j]
-                elif not sense and step[j]:
-                    sense = step[j]
+            for first, length in zip(run_starts, run_lengths):     # runs of one sense
+                if length < MIN_REVERSAL_RUN:
+                    continue
+                if sense and sg[first] != sense:
+                    cuts.append(int(moving[first]) + 1)
+                sense = sg[first]
         piece = np.zeros(len(idx), int)
         for c in cuts:
             piece[c:] += 1
@@ -247,14 +255,14 @@ def _split_reversals(rel, trace, swept) -> np.ndarray:
     return out
 
 
-def _step(r0, r1, normal: int) -> float:
-    """Angle (rad) turned from offset ``r0`` to ``r1`` in the plane of the given normal."""
+def _steps(rel, normal: int) -> np.ndarray:
+    """(n,) angle (rad) turned from each reading's predecessor to it in the plane of the given
+    normal (0 for the first reading)."""
     a, b = [(1, 2), (2, 0), (0, 1)][normal]
-    return _wrap(np.arctan2(r1[b], r1[a]) - np.arctan2(r0[b], r0[a]))
-
-
-def _wrap(a: float) -> float:
-    return float((a + np.pi) % (2 * np.pi) - np.pi)
+    ang = np.arctan2(rel[:, b], rel[:, a])
+    d = np.zeros(len(rel))
+    d[1:] = (np.diff(ang) + np.pi) % (2 * np.pi) - np.pi
+    return d
 
 
 def _trace_plane(rel) -> int:
@@ -276,8 +284,7 @@ def _trace_senses(rel, trace, swept) -> np.ndarray:
         idx = np.flatnonzero(trace == k)
         if swept[idx].any() or len(idx) < 2:
             continue
-        step = np.array([_wrap(d) for d in np.diff(_angles(rel[idx]))])
-        out[idx] = -1.0 if np.sum(step) < 0 else 1.0
+        out[idx] = -1.0 if np.sum(_steps(rel[idx], _trace_plane(rel[idx]))) < 0 else 1.0
     return out
 
 

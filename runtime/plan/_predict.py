@@ -52,8 +52,9 @@ class Prediction:
 def request(model, parts, spec):
     """calibrate's :class:`volerr.calibrate.terms.Request` for these files and ``spec``."""
     obs = instruments.stack(parts)
+    moving = calibration.moving_axes(model, data_ranges(model, obs))
     return terms.request(spec or calibration.declared_parameters(obs), model,
-                         default_parameters(model, calibration.campaign_kinds(obs)))
+                         default_parameters(model, calibration.campaign_kinds(obs), moving))
 
 
 def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0)) -> Prediction:
@@ -79,7 +80,7 @@ def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0)) -> Predi
         labels += [(name, "extra") for name, *_ in extra]
     fit = calibration._normal_equations(design, obs, spl, np.sqrt(w))
     out = calibration._solve(design, labels, obs, spl, fit, np.sqrt(w), u_ref,
-                             calibration._preferred(model, obs, labels))
+                             calibration._preferred(model, obs, labels, ranges))
     sc = fit.scale[out.kept]
     out.cov = out.Gi / np.outer(sc, sc) * u_ref ** 2     # the variance factor at 1
     out.std = np.sqrt(np.maximum(np.diag(out.cov), 0.0))

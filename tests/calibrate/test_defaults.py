@@ -59,12 +59,32 @@ def _one_file(camp, path):
     return path
 
 
+def _circles(layout, tmp_path_factory):
+    folder = tmp_path_factory.mktemp(f"circles_{layout}")
+    camp = _campaign(layout)
+    return dict(layout=layout, camp=camp, files=camp.write(folder),
+                one=_one_file(camp, folder / "three_circles.csv"), folder=folder)
+
+
 @pytest.fixture(scope="module", params=["MB1", "FB1"])
 def circles(request, tmp_path_factory):
-    folder = tmp_path_factory.mktemp(f"circles_{request.param}")
-    camp = _campaign(request.param)
-    return dict(layout=request.param, camp=camp, files=camp.write(folder),
-                one=_one_file(camp, folder / "three_circles.csv"), folder=folder)
+    """The circles on a moving-bridge and a fixed-bridge CMM."""
+    return _circles(request.param, tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def mb1(tmp_path_factory):
+    """The circles on MB1 only (the checks that do not depend on the family)."""
+    return _circles("MB1", tmp_path_factory)
+
+
+def _main(capsys, *args) -> tuple[int, str, str]:
+    """``volerr ARGS`` in this process: (exit code, stdout, stderr)."""
+    from volerr.cli import main
+
+    code = main([str(a) for a in args])
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
 
 
 def _calibrate_no_options(circles, files, name):
@@ -84,8 +104,12 @@ def test_no_options_reports_the_squareness(circles, form):
         assert abs(v["value"] - TRUTH[sq]) <= K * v["std"], (sq, v)
         assert v["std"] < 2.0, v                                       # urad
         assert f"{sq} = " in stdout
-    rv = doc["parameters"]["RV_X"]                                     # ISO 230-2 B of X
-    assert abs(rv["value"] - TRUTH["EXX@reversal"]) <= K * rv["std"], rv
+    # ISO 230-2 B of X.  At the 2 turning points of X per circle the simulator takes the
+    # direction of motion from central differences (0 at the extreme), volerr from the motion
+    # that brought the axis there: over 12 seeds this biases RV_X by -0.085 um (-1.1 std);
+    # 0.1 um is allowed for that difference of conventions
+    rv = doc["parameters"]["RV_X"]
+    assert abs(rv["value"] - TRUTH["EXX@reversal"]) <= K * rv["std"] + 0.1, rv
     # nothing the ballbar is not used for (the angular errors it cannot separate)
     assert not [n for n in doc["parameters"] if n[:2] in ("EA", "EB", "EC") and "@" in n]
     # the bar length is not calibrated: only the scale differences, as combinations
@@ -97,7 +121,7 @@ def test_no_options_reports_the_squareness(circles, form):
     assert "determined only in combination: EXX@slope - EZZ@slope" in stdout
 
 
-def test_all_keeps_the_instruments_columns(circles):
+def test_all_keeps_the_instruments_columns(mb1):
     """``--parameters all`` (the old default): rank-deficient; the squareness is written under
     its own name as a combination with the angular slopes it cannot be told from (their
     planted value 0, so the combination's truth is the squareness), and no angular slope is
@@ -105,7 +129,7 @@ def test_all_keeps_the_instruments_columns(circles):
     the lever arms unlike anything else, may be determined on its own)."""
     from volerr.calibrate import calibrate
 
-    cal = calibrate(circles["layout"], circles["files"], parameters="all", plan=False,
+    cal = calibrate(mb1["layout"], mb1["files"], parameters="all", plan=False,
                     progress=False)
     doc = cal.data
     written = {c["written_as"]: c for c in doc["combinations"]}
@@ -134,13 +158,13 @@ def _independent_g_h(camp):
     return {k: (g, h[k[0]]) for k, g in out.items()}
 
 
-def test_evaluate_splits_one_file_into_its_circles(circles):
-    out = circles["folder"] / "evaluate.json"
-    r = _cli("ballbar", "evaluate", circles["one"], "--json", out)
-    assert r.returncode == 0, r.stderr[-2000:]
+def test_evaluate_splits_one_file_into_its_circles(mb1, capsys):
+    out = mb1["folder"] / "evaluate.json"
+    code, _, err = _main(capsys, "ballbar", "evaluate", mb1["one"], "--json", out)
+    assert code == 0, err
     traces = json.loads(out.read_text())["traces"]
     assert len(traces) == 6, [(t["plane"], t["direction"]) for t in traces]
-    ref = _independent_g_h(circles["camp"])
+    ref = _independent_g_h(mb1["camp"])
     for t in traces:
         g, h = ref[(t["plane"], 1 if t["direction"] == "ccw" else -1)]
         assert t["n"] == N
@@ -148,10 +172,11 @@ def test_evaluate_splits_one_file_into_its_circles(circles):
         assert abs(t["H_um"] - h) <= 0.02, (t, h)
 
 
-def _refused(r, *words):
-    assert r.returncode == 2, (r.returncode, r.stdout[-500:], r.stderr[-1500:])
-    lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
+def _refused(result, *words):
+    code, out, err = result
+    assert code == 2, (code, out[-500:], err[-1500:])
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
     assert all(w in lines[0] for w in words), lines[0]
 
 
@@ -160,22 +185,26 @@ def _rows(path):
     return text[0], text[1:]
 
 
-def test_degenerate_traces_refused(circles, tmp_path):
-    header, rows = _rows(circles["one"])
+def test_degenerate_traces_refused(mb1, tmp_path, capsys):
+    header, rows = _rows(mb1["one"])
     point = tmp_path / "one_point.csv"                  # every reading at one point
     point.write_text("\n".join([header] + [rows[0]] * 30) + "\n")
     arc = tmp_path / "quarter.csv"                      # the first quarter of the XY circle
     arc.write_text("\n".join([header] + rows[:N // 4]) + "\n")
     for path, words in ((point, ("1 distinct angle",)), (arc, ("half a circle",))):
-        _refused(_cli("ballbar", "evaluate", path), path.name, *words)
-        _refused(_cli("calibrate", circles["layout"], path), path.name, *words)
+        _refused(_main(capsys, "ballbar", "evaluate", path), path.name, *words)
+        _refused(_main(capsys, "calibrate", "MB1", path), path.name, *words)
+    partial = tmp_path / "arc220.csv"                   # a ballbar's partial arc: accepted
+    partial.write_text("\n".join([header] + rows[:N * 220 // 360]) + "\n")
+    code, _, err = _main(capsys, "ballbar", "evaluate", partial)
+    assert code == 0, err
 
 
-def test_same_file_twice_refused(circles, tmp_path):
-    f = circles["files"][0]
+def test_same_file_twice_refused(mb1, tmp_path, capsys):
+    f = mb1["files"][0]
     copy = tmp_path / "copy.csv"
     copy.write_bytes(open(f, "rb").read())
-    _refused(_cli("ballbar", "evaluate", f, f), "twice")
-    _refused(_cli("ballbar", "evaluate", f, copy), "twice")
-    _refused(_cli("calibrate", circles["layout"], f, copy), "twice")
-    _refused(_cli("loop", circles["layout"], copy, f), "twice")
+    _refused(_main(capsys, "ballbar", "evaluate", f, f), "twice")
+    _refused(_main(capsys, "ballbar", "evaluate", f, copy), "twice")
+    _refused(_main(capsys, "calibrate", "MB1", f, copy), "twice")
+    _refused(_main(capsys, "loop", "MB1", copy, f), "twice")

@@ -125,3 +125,26 @@ def test_dmu50_shipped_example_cli(tmp_path):
     assert consts["EY0C"] == 0.0
     cal = calibrate("DMU50", [str(src)], plan=False, progress=False)
     _check_written(cal, tmp_path / "d")
+
+
+def test_every_reader_accepts_the_comment_lines(tmp_path):
+    """The error directory of a calibration with combinations (comment lines in X.csv, Y.csv,
+    Z.csv and constants.csv) is read by map, iso10360, diagonals, squareness, controller
+    export and compensate."""
+    ex = write_ballbar_example(tmp_path / "bb", "MB1")
+    cal = calibrate("MB1", [str(f) for f in ex["files"]], plan=False, progress=False)
+    d = cal.write_error_tables(tmp_path / "d")
+    assert all(f.read_text().startswith("# ") for f in d.iterdir())
+    (tmp_path / "p.nc").write_text("G90 G1 X350 Y300 Z100 F1000\nG1 X400 Y320 Z120\n")
+    t = tmp_path
+    for args in (["map", "MB1", "--errors", d, "--out", t / "m.csv", "--extrapolate"],
+                 ["iso10360", "MB1", "--errors", d, "--json", t / "i.json", "--extrapolate"],
+                 ["diagonals", "MB1", "--errors", d, "--json", t / "g.json", "--extrapolate"],
+                 ["squareness", "MB1", d, "--out", t / "sq"],
+                 ["controller", "export", "MB1", "--errors", d, "--format", "isg", "--out",
+                  t / "c.csv"],
+                 ["compensate", "MB1", t / "p.nc", "--errors", d, "--out", t / "pc.nc",
+                  "--extrapolate"]):
+        r = subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, (args[0], r.stderr)

@@ -116,8 +116,8 @@ def _identifiability_and_values(doc, ok):
 def _map_within_its_uncertainty(m, terms, path):
     """RMS over the grid of (identified - exact volumetric error) <= 3 x RMS of the
     propagated standard uncertainty, per component; the uncertainty is not vacuous."""
-    with open(path) as fh:
-        rows = list(csv.DictReader(fh))
+    with open(path) as fh:     # '#' lines: what the map holds as 0 (docs/formats.md)
+        rows = list(csv.DictReader(line for line in fh if not line.startswith("#")))
     pos = {a: np.array([float(r[a]) for r in rows]) for a in m.axes}
     ident = np.array([[float(r[f"d{c}_um"]) for c in "xyz"] for r in rows])
     u = np.array([[float(r[f"u_d{c}_um"]) for c in "xyz"] for r in rows])
