@@ -269,7 +269,8 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     from .defaults import default_parameters
 
     ranges = data_ranges(model, obs)
-    req = terms.request(parameters or declared_parameters(obs), model, default_parameters(
+    declared = parameters if parameters is not None else declared_parameters(obs)
+    req = terms.request(declared, model, default_parameters(
         model, campaign_kinds(obs), moving_axes(model, ranges)))
     chosen = req.parameters
     obs = with_directions(obs, parts, req.reversals)

@@ -53,7 +53,8 @@ def request(model, parts, spec):
     """calibrate's :class:`volerr.calibrate.terms.Request` for these files and ``spec``."""
     obs = instruments.stack(parts)
     moving = calibration.moving_axes(model, data_ranges(model, obs))
-    return terms.request(spec or calibration.declared_parameters(obs), model,
+    declared = spec if spec is not None else calibration.declared_parameters(obs)
+    return terms.request(declared, model,
                          default_parameters(model, calibration.campaign_kinds(obs), moving))
 
 

@@ -174,3 +174,18 @@ def test_existing_plan_files_are_not_replaced(plans, tmp_path, capsys):
     assert main(["plan", *BALLBAR, "--out", str(tmp_path / "p")]) == 2
     assert "--force" in capsys.readouterr().err
     assert before == {p.name: p.read_bytes() for p in (tmp_path / "p").iterdir()}
+
+
+def test_files_declaring_different_requests_are_refused(plans, tmp_path, capsys):
+    folder, doc = plans["mixed"]
+    run = tmp_path / "run"
+    shutil.copytree(folder, run)
+    rng = np.random.default_rng(8)
+    paths = [run / f["file"] for f in doc["files"]]
+    for p in paths:
+        plan_fill.fill(p, doc["layout"], PLANTED["DMU50"], rng)
+    text = paths[0].read_text().replace("# parameters: location,", "# parameters: ")
+    paths[0].write_text(text)
+    assert main(["calibrate", doc["layout"], *map(str, paths)]) == 2
+    err = capsys.readouterr().err
+    assert "# parameters:" in err and len(err.strip().splitlines()) == 1
