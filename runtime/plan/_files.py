@@ -43,7 +43,7 @@ class PlanFile:
         return len(next(iter(self.columns.values())))
 
 
-def columns_of(model, inst, setups: list) -> dict:
+def columns_of(inst, setups: list) -> dict:
     """Columns of one file holding ``setups`` [(SetUp, readings)], in order, with the
     instrument's declared uncertainties (``u_um``, ``tool_u_um``, ``length_u_um``)."""
     parts = [s.build(m) for s, m in setups]
@@ -59,9 +59,6 @@ def columns_of(model, inst, setups: list) -> dict:
         cols["tool_u_um"] = np.full(n, float(inst.tool_u_um))
     if inst.kind == "ballbar" and inst.length_u_um is not None:
         cols["length_u_um"] = np.full(n, float(inst.length_u_um))
-    if inst.kind == "ballbar":
-        cols.pop("direction", None)
-        cols["direction"] = _directions(setups, parts)
     return cols
 
 
@@ -77,10 +74,6 @@ def reading_u(inst, cols: dict, n: int) -> np.ndarray:
     if inst.kind == "distances":
         return distances.DEFAULT_U0_UM + distances.DEFAULT_K_UM_PER_M * 1e-3 * cols["d_mm"]
     return np.full(n, float(DEFAULT_U_UM[inst.kind]))
-
-
-def _directions(setups, parts) -> np.ndarray:
-    return np.concatenate([p["direction"] for p in parts])
 
 
 def group(instruments: list, chosen: list) -> list:
@@ -100,7 +93,7 @@ def group(instruments: list, chosen: list) -> list:
         else:
             files.append(PlanFile(f"{stem}.csv", kind, i, sets))
     for f in files:
-        f.columns = columns_of(None, instruments[f.inst], f.setups)
+        f.columns = columns_of(instruments[f.inst], f.setups)
     return files
 
 

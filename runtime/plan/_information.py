@@ -74,7 +74,7 @@ def problem(model, instruments, pool: list, req) -> Problem:
     ranges = ranges_of(model, builds)
     i0, s0 = pool[0]
     obs0 = _files.observations(model, _files.PlanFile("x.csv", s0.kind, i0, [(s0, s0.template)],
-                                                      _files.columns_of(None, instruments[i0],
+                                                      _files.columns_of(instruments[i0],
                                                                         [(s0, s0.template)])))
     keep, _ = gauge_mask(model, obs0, degree, ranges, req.parameters, constants=False)
     param_keep = keep[len(obs0.setup_labels):]
@@ -99,7 +99,7 @@ def setup_information(prob: Problem, instruments, i: int, s, m: int | None = Non
     m = s.template if m is None else m
     inst = instruments[i]
     pf = _files.PlanFile("x.csv", s.kind, i, [(s, m)],
-                         _files.columns_of(None, inst, [(s, m)]))
+                         _files.columns_of(inst, [(s, m)]))
     obs = _files.observations(prob.model, pf)
     return information(prob, obs, i)
 
