@@ -138,10 +138,11 @@ def plan(layout, specs, readings: int, parameters: str | None = None, minutes=No
     prob = _information.problem(model, insts, pool, req)
     cand = _pool(prob, insts, pool)
     picked, counts = _choose(cand, prob, insts, pool, readings, minutes, criterion, seed)
-    require(picked, f"--minutes {minutes}: no plan of these instruments fits in that time"
-            if minutes is not None else f"--readings {readings}: more readings than the "
-            f"candidate set-ups of these instruments can take (give more set-ups: places=, "
-            f"stations=)")
+    budget = f"--readings {readings}" + (f" and --minutes {minutes:g}" if minutes else "")
+    require(picked, f"{budget}: no plan of these instruments fits that budget and determines "
+                    f"every requested parameter their set-ups can determine (give more "
+                    f"readings or minutes, more set-ups with places= / stations=, or a "
+                    f"smaller --parameters)")
     files = _files.group(insts, [(pool[c][0], pool[c][1], int(m))
                                  for c, m in zip(picked, counts)])
     out = _finish(model, insts, (parameters, union, req), files, cand, picked, counts,
