@@ -210,6 +210,15 @@ def moving_axes(model, ranges: dict) -> set:
     return {a for a, (lo, hi) in ranges.items() if hi - lo > 1.0}
 
 
+def declared_parameters(obs) -> str | None:
+    """The files' declared ``# parameters:`` (a ``volerr plan`` request), or None; files
+    declaring different requests are refused."""
+    declared = {f.parameters for f in obs.files if f.parameters}
+    require(len(declared) <= 1, "the files declare different '# parameters:' lines; give "
+                                "--parameters")
+    return declared.pop() if declared else None
+
+
 def reading_weights(obs) -> tuple[np.ndarray, float]:
     """Relative weights (N,) of the points' readings, ``(u_ref / u)^2``, and ``u_ref`` (mm)."""
     return obs.point_weights(), obs.reference_sigma()
@@ -260,7 +269,8 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     from .defaults import default_parameters
 
     ranges = data_ranges(model, obs)
-    req = terms.request(parameters, model, default_parameters(
+    declared = parameters if parameters is not None else declared_parameters(obs)
+    req = terms.request(declared, model, default_parameters(
         model, campaign_kinds(obs), moving_axes(model, ranges)))
     chosen = req.parameters
     obs = with_directions(obs, parts, req.reversals)

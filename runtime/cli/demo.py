@@ -16,7 +16,10 @@ Sections (each runs the real command or API on built-in data and writes into DIR
 7. closing the loop: a virtual MB1 with an undeclared effect, fit, diagnosis, augmented model;
 8. ISO 230-2 evaluation of a simulated positioning run;
 9. task-specific uncertainty of a distance (Monte Carlo);
-10. ``index.html`` with a section, figures and captions per step, and the headline figures
+10. measurement plans (``volerr plan``): an R-test campaign for the DMU 50 and a ballbar +
+    tracking-interferometer campaign for MB1, executed on volerr's model and calibrated, the
+    predicted against the realised standard uncertainties;
+11. ``index.html`` with a section, figures and captions per step, and the headline figures
     printed.  Everything is written at the end, all or nothing.
 """
 
@@ -33,10 +36,16 @@ from ..fileio import json_text, write_text
 from ..units import num
 
 SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "ballplate",
-            "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty")
+            "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty", "plan")
 
 #: one sentence per section of index.html: what it shows and how to read it
 ABOUT = {
+    "plan": "Measurement plans made before any machine time (volerr plan): an R-test "
+            "campaign for the DMU 50 and a ballbar + tracking-interferometer campaign for "
+            "MB1, each executed on volerr's model with planted errors and calibrated with no "
+            "options; the plan's predicted standard uncertainties beside the realised ones "
+            "(equal up to the noise of the variance factor) and its map uncertainty beside "
+            "the conventional plan's.",
     "cmm_a": "Pahk's CMM A (moving bridge MB1) with synthetic example error tables: the "
              "volumetric error over the working volume (nominal grid dashed, actual solid, "
              "magnified) and the length deviations of the space diagonals.",
@@ -125,6 +134,9 @@ CAPTIONS = {
     "iso230_2.png": "ISO 230-2 plot: mean deviations per direction with bands \u00b1 2 S "
                     "(k = 2) of one reading; ringed: readings that decide a quantity that "
                     "fails or is undecided.",
+    "plan_predicted.png": "Standard uncertainty of each parameter: predicted by volerr plan "
+                          "before the measurement (bars) and realised by volerr calibrate on "
+                          "the executed plan (dots), k = 1.",
     "uncertainty.png": "Distribution of the Monte Carlo readings of the distance about their "
                        "mean: 95 % coverage interval (red) and \u00b1 U (k = 2, blue).",
 }
@@ -447,6 +459,58 @@ def _uncertainty(out: Path) -> dict:
                       "uncertainty.json", "uncertainty.png"]}
 
 
+#: the demo's planned campaigns: layout, instruments, readings, --parameters, planted errors
+#: (mm / rad)
+PLAN_CASES = (
+    ("DMU50", ("sphere:tool=100:tool_u_um=0.5",), 300, None,
+     {"EX0B": 20e-3, "EY0B": -10e-3, "EA0B": 30e-6, "EB0B": -20e-6, "EX0C": 5e-3,
+      "EY0C": 7e-3, "EA0C": 10e-6, "EB0C": 15e-6}),
+    ("MB1", ("ballbar:u_um=0.5:lengths=150,250", "distances:stations=4"), 600, "squareness",
+     {"EC0Y": 25e-6, "EB0Z": -15e-6, "EA0Z": 10e-6}))
+
+
+def _plan(out: Path) -> dict:
+    import numpy as np
+
+    from ..machine.model import load
+    from ..plan import comparison_png, execute
+
+    rows, files, values = [], [], []
+    for layout, specs, n, params, truth in PLAN_CASES:
+        folder, js, cj = out / f"plan_{layout}", out / f"plan_{layout}.json", \
+            out / f"plan_{layout}_calibrate.json"
+        inst = [a for s in specs for a in ("--instrument", s)]
+        _cli("plan", layout, *inst, "--readings", n, "--out", folder, "--json", js,
+             *(("--parameters", params) if params else ()))
+        doc = json.loads(js.read_text())
+        rng = np.random.default_rng(7)
+        model = load(layout)
+        for f in doc["files"]:
+            execute(folder / f["file"], model, truth, rng)
+        _cli("calibrate", layout, *[folder / f["file"] for f in doc["files"]], "--json", cj)
+        cal = json.loads(cj.read_text())["parameters"]
+        for name, v in doc["parameters"].items():
+            rows.append((f"{layout} {name}", v["predicted_std"], cal[name]["std"], v["unit"]))
+        ratio = [cal[k]["std"] / v["predicted_std"] for k, v in doc["parameters"].items()]
+        values.append(f"{layout} ({' + '.join(sorted({f['kind'] for f in doc['files']}))}, "
+                      f"{doc['readings']} readings, {len(doc['files'])} files): realised / "
+                      f"predicted std {min(ratio):.2f}-{max(ratio):.2f}; map u RMS "
+                      f"{doc['map_u_um']['rms']:.3g} um vs {doc['baseline']['map_u_um']['rms']:.3g}"
+                      f" um for {doc['baseline']['name']}")
+        files += [f"plan_{layout}/", f"plan_{layout}.json", f"plan_{layout}/plan.html",
+                  f"plan_{layout}_calibrate.json"]
+    write_bytes_png(out / "plan_predicted.png", comparison_png(rows))
+    return {"title": "measurement plans before the machine time: DMU50 R-test, MB1 ballbar + "
+                     "tracking interferometer, executed and calibrated",
+            "value": "; ".join(values), "files": files + ["plan_predicted.png"]}
+
+
+def write_bytes_png(path: Path, data: bytes) -> None:
+    from ..fileio import write_bytes
+
+    write_bytes(path, data)
+
+
 def _index(out: Path, results: list) -> None:
     """index.html: a section per step with its figures (each shown at its own pixel width,
     :func:`volerr.plotstyle.img_tag`), captions, the result line, a link to every report page
@@ -543,6 +607,7 @@ def run(args) -> int:
                 "loop": lambda: _loop(out),
                 "iso230_2": lambda: _iso230_2(out),
                 "uncertainty": lambda: _uncertainty(out),
+                "plan": lambda: _plan(out),
             }
             from ..progress import bar
 

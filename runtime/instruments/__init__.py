@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from dataclasses import replace
 from pathlib import Path
 
 from ..errors import require
+from ._csv import read_directives
 from .observations import FileInfo, Observations, Setup, stack
 
 __all__ = ["FileInfo", "Observations", "Setup", "kinds", "read", "read_files", "read_parts",
@@ -63,6 +65,9 @@ def read(spec, model) -> Observations:
     obs = kinds()[kind].read(path, model)
     if not obs.files:
         obs.files = (FileInfo(Path(path).name, kind),)
+    declared = read_directives(path).get("parameters")
+    if declared:
+        obs.files = tuple(replace(f, parameters=declared) for f in obs.files)
     return obs
 
 

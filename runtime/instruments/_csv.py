@@ -53,6 +53,29 @@ def _rows(path, header_only: bool = False) -> list:
         raise InputError(f"{p.name}: not a readable CSV ({exc})") from None
 
 
+#: ``# key: value`` comment lines a file may carry above its header row that ``calibrate``
+#: uses (``parameters``: the parameters the file was planned for, ``volerr plan --parameters``)
+DIRECTIVES = ("parameters",)
+
+
+def read_directives(path) -> dict:
+    """``{key: value}`` of the ``# key: value`` comment lines above the header row whose key is
+    one of :data:`DIRECTIVES` (other comments are ignored)."""
+    out = {}
+    try:
+        with open(Path(path), encoding="utf-8-sig") as fh:
+            for line in fh:
+                text = line.strip()
+                if text and not text.startswith("#"):
+                    break
+                key, sep, value = text.lstrip("#").partition(":")
+                if sep and key.strip().lower() in DIRECTIVES and value.strip():
+                    out[key.strip().lower()] = value.strip()
+    except (OSError, UnicodeDecodeError):
+        return {}
+    return out
+
+
 def read_header(path) -> list:
     """The column names of a CSV file (its first row that is neither blank nor a comment),
     without reading the rest: enough to tell an instrument's file by its columns."""

@@ -39,12 +39,15 @@ PLACEMENT = ("dx", "dy", "dz", "ex", "ey", "ez")
 @dataclass(frozen=True)
 class FileInfo:
     """One measurement file of a campaign: its ``name`` (as reported), instrument ``kind``,
-    reading unit (``um``) and the number of readings per point (1 or 3)."""
+    reading unit (``um``), the number of readings per point (1 or 3) and the parameters its
+    header declares (``# parameters: SPEC``, written by ``volerr plan``)."""
 
     name: str
     kind: str
     unit: str = "um"
     rows: int = 3
+    #: the parameters the file declares it was planned for (``# parameters: SPEC``), or None
+    parameters: str | None = None
 
 
 @dataclass
