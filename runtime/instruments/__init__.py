@@ -95,8 +95,12 @@ def refuse_duplicates(paths) -> None:
 def read_parts(specs, model) -> list:
     """Several files, each as its own :class:`Observations` (the same file twice refused:
     :func:`refuse_duplicates`)."""
+    from . import distances
+
     refuse_duplicates([split_spec(s)[1] for s in specs])
-    return [read(s, model) for s in specs]
+    parts = [read(s, model) for s in specs]
+    distances.require_stations(parts)
+    return parts
 
 
 def read_files(specs, model) -> Observations:

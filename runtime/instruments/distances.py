@@ -48,6 +48,22 @@ def detect(names) -> bool:
     return bool(low & {"station", "d_mm", "dd_mm", "station_x", "station_y", "station_z"})
 
 
+def require_stations(parts) -> None:
+    """Refuse (InputError, one line) a campaign whose distances come from fewer than
+    :data:`MIN_STATIONS` stations in all: the distances from fewer stations do not fix the
+    tool point in space (each station's position and dead path are unknowns too).  Counted over
+    the campaign, not per file: a tracking interferometer moved from station to station is
+    often saved as one file per station."""
+    stations = [(o.files[0].name, str(s)) for o in parts if o.files and o.files[0].kind == KIND
+                for s in np.unique(o.info["station"].astype(str))]
+    files = ", ".join(dict.fromkeys(f for f, _ in stations))
+    require(not stations or len(stations) >= MIN_STATIONS,
+            f"{files}: {len(stations)} station{'s' if len(stations) > 1 else ''} in the campaign "
+            f"({', '.join(s for _, s in stations)}); multilateration needs at least "
+            f"{MIN_STATIONS}: the distances from fewer stations do not fix the tool point in "
+            f"space (each station's position and dead path are unknowns too)")
+
+
 def read(path, model: Model) -> Observations:
     """Read a distances CSV into :class:`Observations` (InputError, one line, on a defect)."""
     c = read_columns(path)
@@ -81,11 +97,6 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(station.astype(str), return_inverse=True)
     gidx = gidx.ravel()
-    require(len(names) >= MIN_STATIONS,
-            f"{where}: {len(names)} station{'s' if len(names) > 1 else ''} "
-            f"({', '.join(names)}); multilateration needs at least {MIN_STATIONS}: the "
-            f"distances from fewer stations do not fix the tool point in space (each station's "
-            f"position and dead path are unknowns too)")
     s0 = np.zeros((n, 3))
     dead0 = np.zeros(n)
     for g, name in enumerate(names):

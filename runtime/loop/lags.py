@@ -19,7 +19,7 @@ than ``LAG_EARN`` BIC over the same parameter x the same sensor without one.  Th
 explanation among the leading candidates (another sensor, the same sensor with or without a
 lag, another parameter) that, in place of the accepted effect, is within ``BIC_TIE`` of it
 *and* whose cross-validated per-point squared residuals do not differ from the accepted
-effect's significantly (|paired t| < ``select.CV_T`` over the cross-validation splits) or
+effect's significantly (|paired t| < ``fitting.CV_T`` over the cross-validation splits) or
 whose cross-validated RMS is within ``CV_SAME`` (1 %) of it (nearly equal predictions make a
 paired t large for a difference of no consequence) is an *alternative*: the campaign cannot
 tell the two apart.  Where an alternative has the better BIC, the two swap places.  The effect then lists them
@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from . import select as sel
+from . import fitting
 from .candidates import extra_parameters as _extra
 
 LAG_EARN = 10.0         # BIC a lag must gain over the same sensor without one
@@ -67,7 +67,7 @@ def refine(accepted: list, A0, ctx, train, w_rows, y) -> None:
         if a.cand.search is None or a.cand.search.what != "lag_s":
             continue
         others = accepted[:i] + accepted[i + 1:]
-        base = sel._full_base(sel._stack(A0, others), train, w_rows, y)
+        base = fitting.full_base(fitting.stack(A0, others), train, w_rows, y)
         tau, std = profile_tau(a.cand, ctx, base, float(a.cand.info["lag_s"]))
         a.cand = a.cand.fixed(tau)
         a.cand.info["lag_std_s"] = None if std is None else round(std, 1)
@@ -109,8 +109,8 @@ def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -
     by the rule of the module docstring) to each accepted effect's evidence (in place)."""
     for i, a in enumerate(accepted):
         others = accepted[:i] + accepted[i + 1:]
-        A_o = sel._stack(A0, others)
-        base = sel._full_base(A_o, train, w_rows, y)
+        A_o = fitting.stack(A0, others)
+        base = fitting.full_base(A_o, train, w_rows, y)
         mine = _explanation(a.cand)
         rivals, seen = [], {mine}
         for x in pool:
@@ -120,15 +120,15 @@ def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -
             seen.add(key)
             rivals.append(x.cand)
         close, d_a = _close_rivals(a, rivals, ctx, base)
-        cv_a = sel._cv_sq(A_o.plus([a.cols]), y, folds, train, w_rows)
+        cv_a = fitting.cv_sq(A_o.plus([a.cols]), y, folds, train, w_rows)
         found = []
         for d_x, c in close[:2 * MAX_ALTERNATIVES]:
             cols, _ = ctx.columns(c.terms, full=True)
-            cv_x = sel._cv_sq(A_o.plus([cols]), y, folds, train, w_rows)
+            cv_x = fitting.cv_sq(A_o.plus([cols]), y, folds, train, w_rows)
             d = cv_x - cv_a
             t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
             ratio = math.sqrt(cv_x.mean() / max(cv_a.mean(), 1e-300))
-            if abs(t) < sel.CV_T or abs(ratio - 1.0) < CV_SAME:
+            if abs(t) < fitting.CV_T or abs(ratio - 1.0) < CV_SAME:
                 found.append({"cand": c, "cols": cols, "delta_bic": round(d_x - d_a, 2),
                               "cv_paired_t": round(t, 2)})
             if len(found) == MAX_ALTERNATIVES:
@@ -166,7 +166,7 @@ def _close_rivals(a, rivals: list, ctx, base) -> tuple[list, float]:
     """([(dBIC, candidate)] of the rivals within ``BIC_TIE`` of the accepted effect ``a`` in
     its place, best first; a's dBIC).  Rivals that explain at least ``NEAR`` of what ``a``
     explains get their time constant refined on all training points first (as ``a`` had)."""
-    scores = base.score_many([sel._dense_group(a.cols)] + [ctx.group(c.terms) for c in rivals])
+    scores = base.score_many([fitting.dense_group(a.cols)] + [ctx.group(c.terms) for c in rivals])
     g_a = scores[0][0]
     d_a = base.dbic(g_a, scores[0][1] + _extra(a.cand))
     near = [c for c, (g, r) in zip(rivals, scores[1:]) if r and g >= NEAR * g_a]

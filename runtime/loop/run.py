@@ -526,7 +526,7 @@ def _load(layout, data) -> tuple[Model, Data]:
         return model, columns_to_data(data.columns(), model, "campaign")
     if isinstance(data, (list, tuple)):          # files of any instruments, one campaign
         return model, instruments.read_files(list(data), model)
-    return model, instruments.read(data, model)
+    return model, instruments.read_files([data], model)
 
 
 def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, families):

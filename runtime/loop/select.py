@@ -21,12 +21,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import candidates as cands
-from ..estimate.blocks import BlockBase, blocks, cv_sq
+from .fitting import CV_T, cv_sq as _cv_sq, dense_group as _dense_group
+from .fitting import full_base as _full_base, stack as _stack
+from ..estimate.blocks import BlockBase, blocks
 from ..estimate.design import TWIST, rows_of
 from ..machine.expressions import evaluate, lag_calls
 
 BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
-CV_T = 3.0           # minimum paired t of the held-out improvement
 MAX_EFFECTS = 8
 TOP_FIT = 3          # candidates fitted fully per forward step
 SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
@@ -434,16 +435,6 @@ class Selection:
     n_candidates: int
 
 
-def _cv_sq(design, y, folds, train, w_rows) -> np.ndarray:
-    """Per-point squared cross-validated residual (weighted rows; blockwise)."""
-    return cv_sq(design, y, folds, train, w_rows[3 * np.asarray(train)])
-
-
-def _full_base(design, train, w_rows, y) -> BlockBase:
-    """The base on all training points (blockwise: no copy of the rows)."""
-    return BlockBase(design, train, w_rows[3 * np.asarray(train)], y)
-
-
 def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -> Selection:
     """Forward selection with held-out evidence, then the backward check.  ``ctx`` is on the
     training points; screening uses at most ``screen_points`` of them (a random subset), the
@@ -538,14 +529,6 @@ def _lag_refined(x: Scored, A_all, ctx, train, w_rows, y) -> Scored:
     cand = x.cand.fixed(tau)
     cand.info["lag_std_s"] = None if std is None else round(std, 1)
     return Scored(x.dbic, x.gain, x.rank, cand, x.params)
-
-
-def _stack(A0, sel):
-    return A0.plus([s.cols for s in sel])
-
-
-def _dense_group(cols):
-    return lambda idx: cols[idx]
 
 
 def _backward(A0, selected, train, w_rows, y) -> list:

@@ -44,6 +44,7 @@ SHORTEST = {
     "iso10360": ["MB1", "--errors", "errors_MB1"],
     "demo": None,                          # tests/cli/test_demo.py runs it
     "examples": ["--out", "more_examples"],
+    "plan": ["MB1", "--instrument", "ballbar", "--readings", "200", "--out", "plan_MB1"],
 }
 
 

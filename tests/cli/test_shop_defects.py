@@ -358,3 +358,19 @@ def test_rows_pasted_twice_refused(tmp_path, capsys, sphere_file, multilateratio
         f, layout = _twice(src, tmp_path / "twice.csv", slice(0, 1)), "MB1"
     capsys.readouterr()
     one_line_error(capsys, _calibrate(layout, f), "pasted twice")
+
+
+def test_distances_one_station_per_file_counted_over_the_campaign(tmp_path, capsys,
+                                                                   multilateration):
+    """A tracking interferometer moved from station to station is often saved one file per
+    station: three such files make a campaign of three stations (accepted), two do not."""
+    head, *rows = multilateration.read_text().splitlines()
+    j = head.split(",").index("station")
+    files = []
+    for name in ("S1", "S2", "S3"):
+        f = tmp_path / f"{name}.csv"
+        f.write_text("\n".join([head, *[r for r in rows if r.split(",")[j] == name]]) + "\n")
+        files.append(str(f))
+    one_line_error(capsys, main(["calibrate", "DMU50", *files[:2], "--json",
+                                 str(tmp_path / "r2.json")]), "at least 3")
+    assert main(["calibrate", "DMU50", *files, "--json", str(tmp_path / "r3.json")]) == 0
