@@ -32,21 +32,6 @@ pytestmark = pytest.mark.xdist_group("architecture")
 #: was longer (dmu50.audit 245 lines ...) was a sequence of items, now one function per item.
 TABLES_OF_PRINTED_EQUATIONS: dict = {}
 
-#: functions over MAX_LINES waiting for a split on another branch (none)
-PENDING_SPLIT_ON_BRANCH_ISSUE31_NC: set = set()
-
-#: import circles other branches' files still hold open (none)
-PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC: set = set()
-
-
-#: imports that run up the table, each with the reason and the way out
-KNOWN_UPWARD = {
-    ("runtime/machine/model.py", "runtime/fiveaxis/kinematics.py"):
-        "Model.inverse delegates to the five-axis inverse kinematics (a function-level import); "
-        "the way out: fiveaxis/kinematics.py (numpy only) moves down into machine/ once branch "
-        "issue31-nc, which owns runtime/fiveaxis/, is merged",
-}
-
 
 # ---------------------------------------------------------------------------- the table
 def _cells(line: str) -> list[str]:
@@ -231,30 +216,14 @@ def test_imports_go_only_the_allowed_ways():
         here = room_of(path)
         for target, line in edges.items():
             there = room_of(target)
-            if there != here and there not in allowed[here] \
-                    and (path, target) not in KNOWN_UPWARD:
+            if there != here and there not in allowed[here]:
                 wrong.append(f"{path}:{line} ({here}) imports {target} ({there})")
     assert not wrong, "imports the table of docs/architecture.md does not allow:\n" + \
         "\n".join(wrong)
 
 
-def test_known_upward_imports_still_exist():
-    """An exception that the code no longer needs is struck from the list."""
-    graph = imports()
-    stale = [k for k in KNOWN_UPWARD if k[1] not in graph.get(k[0], {})]
-    assert not stale, f"KNOWN_UPWARD lists imports that are gone: {stale}"
-
-
-def _pending_circle(comp: list[str]) -> bool:
-    if frozenset(comp) in PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC:
-        return True
-    nc_rooms = ("runtime/fiveaxis/", "runtime/nc/")
-    return (all(p.startswith(nc_rooms) for p in comp)
-            and frozenset(Path(p).name for p in comp) in PENDING_CIRCLE_ON_BRANCH_ISSUE31_NC)
-
-
 def test_no_import_circle_between_files():
-    found = [c for c in circles(imports()) if not _pending_circle(c)]
+    found = circles(imports())
     assert not found, "files that import each other in a circle:\n" + "\n".join(
         " -> ".join(c) for c in found)
 
@@ -289,10 +258,7 @@ def long_functions(limit: int = MAX_LINES) -> list[tuple[str, str, int]]:
 
 
 def _excused(path: str, name: str) -> bool:
-    if (path, name) in TABLES_OF_PRINTED_EQUATIONS:
-        return True
-    return (path.startswith(("runtime/fiveaxis/", "runtime/nc/"))
-            and (Path(path).name, name) in PENDING_SPLIT_ON_BRANCH_ISSUE31_NC)
+    return (path, name) in TABLES_OF_PRINTED_EQUATIONS
 
 
 def test_functions_a_reader_can_hold():

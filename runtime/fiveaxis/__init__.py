@@ -3,7 +3,7 @@ TCPM), compensation of NC programs on the full error model (the programs themsel
 and written by :mod:`volerr.nc`), tool-centre-point maps, the DMU 50 example, and the plots.
 """
 
-from .kinematics import inverse, is_five_axis, linear_axes
+from ..machine.kinematics import inverse, is_five_axis, linear_axes
 
 __all__ = ["inverse", "is_five_axis", "linear_axes"]
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..nc.arcs import ArcResult, segments_for_chord
-from .kinematics import linear_jacobian
+from ..machine.kinematics import linear_jacobian
 from .reversal import along
 
 #: halvings of the segments of one arc at most

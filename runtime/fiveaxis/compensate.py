@@ -60,7 +60,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, require
-from .kinematics import linear_axes, linear_jacobian, rotary_jacobian
+from ..machine.kinematics import linear_axes, linear_jacobian, rotary_jacobian
 from ..machine import iso_names
 
 STRATEGIES = ("full", "thesis")

@@ -37,7 +37,7 @@ from ..nc.writer import Writer
 from . import tcpm_kinematics
 from .compensate import (STRATEGIES, ErrorModel, parameters_for_types, resolve_linear, solve,
                          solve_thesis)
-from .kinematics import inverse, is_five_axis, linear_axes
+from ..machine.kinematics import inverse, is_five_axis, linear_axes
 
 #: False: every line is interpreted and written one by one (the reference the whole-chunk
 #: path is tested and benchmarked against; the output is the same)

@@ -3,7 +3,7 @@ over the working volume (:mod:`volerr.tables.comp_tables` for the tables and the
 they command): at every node of a grid, the first-order volumetric error minus the tool-tip
 motion of the corrections ``J(q) v(q)``.  Here, above the tables, because it needs the
 volume of the error tables (:mod:`volerr.cmm.volmap`) and the nominal Jacobian of the chain
-(:mod:`volerr.fiveaxis.kinematics`).  Units: mm inside, um in the summary."""
+(:mod:`volerr.machine.kinematics`).  Units: mm inside, um in the summary."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def left(model, funcs, tables: list, grid: int = 9, at=None, probe=(0.0, 0.0, 0.
     points per linear axis over the part of the travel the error tables cover; rotary axes at
     ``at`` (axis -> deg, default 0 or the nearest travel limit)."""
     from ..cmm.volmap import fixed_positions, volume
-    from .kinematics import nominal_jacobian
+    from ..machine.kinematics import nominal_jacobian
 
     require(2 <= grid <= 60, "--grid must be 2..60 points per axis")
     box = volume(model, funcs, "measured")

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import InputError, require
 from ..nc.tcpm import AXES, VECTOR, tool_offset
-from .kinematics import is_five_axis, linear_axes, nominal_jacobian
+from ..machine.kinematics import is_five_axis, linear_axes, nominal_jacobian
 
 
 def linear_from_tip(model, tip: np.ndarray, rot_deg: np.ndarray, length) -> np.ndarray:

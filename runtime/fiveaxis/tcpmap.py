@@ -56,7 +56,7 @@ def tcp_map(model, funcs, point, tool=(0.0, 0.0, 0.0), n1: int = 73, n2: int = 7
     every point in the direction it moves there (default: the bidirectional mean).
     ``progress(n)``: called with the number of grid points done, block by block."""
     from .compensate import ErrorModel
-    from .kinematics import is_five_axis
+    from ..machine.kinematics import is_five_axis
 
     require(is_five_axis(model), f"{model.name}: not a five-axis layout")
     a1, a2 = model.rotary_axes

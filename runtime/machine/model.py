@@ -534,9 +534,9 @@ class Model:
     def inverse(self, target, probe=None, near=None, *, tool=None) -> np.ndarray:
         """Five-axis only: axis positions (N, n_axes), mm / deg, that give the tool tip and tool
         axis ``target`` (N, 6) = x, y, z, i, j, k; ``near`` picks the branch, the turn and an
-        undetermined rotary axis (see :func:`volerr.fiveaxis.kinematics.inverse`).  ``probe``:
+        undetermined rotary axis (see :func:`volerr.machine.kinematics.inverse`).  ``probe``:
         tool offset (3,) mm, ``tool=`` an alias."""
-        from ..fiveaxis.kinematics import inverse
+        from .kinematics import inverse
 
         return inverse(self, target, _offset(probe, tool), near)
 

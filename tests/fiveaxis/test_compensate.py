@@ -121,7 +121,7 @@ def test_linear_jacobian_depends_on_the_rotary_positions_only(name):
     """The solve evaluates d(tip)/d(linear axes) once and keeps it while only the linear axes
     move (the nominal chain is affine in them): the generated Jacobian of every shipped layout
     gives bitwise the same values at other linear positions."""
-    from volerr.fiveaxis.kinematics import linear_axes, linear_jacobian
+    from volerr.machine.kinematics import linear_axes, linear_jacobian
 
     m = volerr.load(name)
     rng = np.random.default_rng(4)

@@ -154,7 +154,7 @@ def test_inverse_after_forward_is_identity(name, data):
     qi = m.inverse(f, tool, near=q)
     assert np.allclose(m.forward(qi, tool), f, atol=1e-8)
     rot = dict(zip(m.rotary_axes, q[0, 3:, None]))
-    sens = min(volerr.fiveaxis.kinematics._axis_sensitivity(m, rot, a)[0] for a in m.rotary_axes)
+    sens = min(volerr.machine.kinematics._axis_sensitivity(m, rot, a)[0] for a in m.rotary_axes)
     if sens > 1e-3:
         assert np.allclose(qi, q, atol=1e-7)
 
