@@ -73,7 +73,7 @@ def shipped_path(name: str):
     return resources.files("volerr") / "data" / name
 
 
-def _iso230_2_run(path) -> None:
+def write_iso230_2_run(path) -> None:
     """A positioning run of X: 9 targets over 800 mm, 5 cycles, both directions (um)."""
     import numpy as np
 
@@ -110,7 +110,7 @@ def write_examples(folder) -> list:
     write_multilateration_example(d / "multilateration_DMU50.csv", "DMU50", n=60)
     simulate_demo_sphere(d / "probe_sphere.csv")
     demo_campaign(d / "deviations_MB1.csv", n_points=400)
-    _iso230_2_run(d / "iso230_2_run_X.csv")
+    write_iso230_2_run(d / "iso230_2_run_X.csv")
     write_text(d / "task_distance.csv", "X,Y,Z\n100,200,150\n500,200,150\n")
     write_text(d / "README.txt", readme())
     return sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())

@@ -411,16 +411,9 @@ def _loop(out: Path) -> dict:
 
 
 def _iso230_2(out: Path) -> dict:
-    import numpy as np
+    from ..example_files import write_iso230_2_run
 
-    rng = np.random.default_rng(2)
-    lines = ["target_mm,cycle,direction,deviation_um"]
-    for t in np.linspace(0.0, 800.0, 9):
-        base = 4.0 * np.sin(t / 200.0) + 0.005 * t
-        for c in range(1, 6):
-            for word, half in (("+1", 1.2), ("-1", -1.2)):
-                lines.append(f"{t:g},{c},{word},{base + half + rng.normal(0, 0.3):.4f}")
-    write_text(out / "iso230_2_run_X.csv", "\n".join(lines) + "\n")
+    write_iso230_2_run(out / "iso230_2_run_X.csv")
     _cli("iso230-2", out / "iso230_2_run_X.csv", "--axis", "X", "--json", out / "iso230_2.json",
          "--plot", out / "iso230_2.png", "--html", out / "iso230_2.html",
          "--tolerance", DEMO_TOLERANCE, "--machine", "virtual machine, axis X (demo)",
