@@ -21,7 +21,9 @@ from ..errors import require
 #: set-up change, minutes per set-up
 SETUP_MIN = {"ballbar": 5.0, "sphere": 10.0, "distances": 15.0}
 #: time per reading, seconds (0 for the ballbar: it samples during the motion)
-READING_S = {"ballbar": 0.0, "sphere": 6.0, "distances": 5.0}
+READING_S = {"ballbar": 0.0, "sphere": 12.0, "distances": 5.0}
+#: (sphere: up to the clearance height and back down, 2 x 20 mm along the tool axis at
+#: 1000 mm/min, the dwell: runtime/plan/_nc.py)
 #: feed of a ballbar circle (mm/min), ISO 230-4 tests at the machine's contouring feed
 BALLBAR_FEED_MM_MIN = 1000.0
 #: dwell at a reading (s) written into the NC program for instruments that read at a stop
