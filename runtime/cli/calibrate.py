@@ -81,9 +81,15 @@ def run(args) -> int:
 
             write_csv(outs.path("--map-out"), result, (args.map_grid,) * 3, inputs=inputs)
     print(result.summary())
+    hidden = []
     for name, v in result["parameters"].items():
         if "@" not in name or name.endswith("@slope"):
             print(f"  {name} = {v['value']:.4g} +- {v['std']:.2g} {v['unit']}")
+        else:
+            hidden.append(name)
+    if hidden:
+        print(f"  and {len(hidden)} higher series terms ({', '.join(hidden[:6])}"
+              f"{' ...' if len(hidden) > 6 else ''}: in --json and --html)")
     bad = result["consistency"]["inconsistent"]
     if bad:
         worst = {e["file"]: e for e in result["consistency"]["files"]}
