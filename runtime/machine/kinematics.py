@@ -129,8 +129,9 @@ def pinv_apply_3x2(j: np.ndarray, r: np.ndarray, rcond: float = 1e-6) -> np.ndar
     the 2x2 Gram matrix ``j^T j`` diagonalised by one Jacobi rotation (stable for nearly
     orthogonal columns, as the tool-axis derivatives of two rotary axes are), a singular value
     ``sqrt(eigenvalue)`` at or below ``rcond`` times the largest dropped as numpy's ``pinv``
-    drops it.  Batched; replaces one SVD per row (the Newton step of :func:`_polish_rotary`
-    adds a correction of a few ulps, so the result agrees with the SVD's to the last bit)."""
+    drops it.  Batched; replaces one SVD per row.  The Newton step of :func:`_polish_rotary`
+    adds a correction of a few ulps, so its result is the SVD's to the last bit, except within
+    ~1e-5 deg of a singular orientation (measured: 34 of 200000 rows, by <= 1e-21 deg)."""
     c0, c1 = j[:, :, 0], j[:, :, 1]
     a = np.einsum("ni,ni->n", c0, c0)
     b = np.einsum("ni,ni->n", c0, c1)
