@@ -304,8 +304,10 @@ def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np
     tip = tcpm_kinematics.words_from_axes(model, q_rot, length)[:, lin_idx]
     for k, j in enumerate(lin_idx):
         w_out[:, j] = _keep_or_round(tip[:, k], w_nom[:, j], nd[:, j])
+    # the rotary positions of the corrected axes are near those the controller takes from
+    # the written vectors: the guess of their solve (which is exact whatever the guess)
     q_out = tcpm_kinematics.axes_from_words(model, w_out, frame, length, q_rot[0, rot_idx]
-                                 if len(q_rot) else np.zeros(2))
+                                            if len(q_rot) else np.zeros(2), q_c[:, rot_idx])
     return w_out, q_out
 
 

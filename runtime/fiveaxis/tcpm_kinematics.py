@@ -38,7 +38,8 @@ def linear_from_tip(model, tip: np.ndarray, rot_deg: np.ndarray, length) -> np.n
                             for v in lin])
 
 
-def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray) -> np.ndarray:
+def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray,
+                       guess: np.ndarray | None = None) -> np.ndarray:
     """Rotary positions (N, 2) deg for the tool vectors ``vector`` (N, 3), continuing from the
     rotary positions ``previous`` (2,) deg held before the first row, block by block as a
     controller does (:func:`decide`): of the two solutions, each turned (multiples of 360 deg)
@@ -46,16 +47,35 @@ def rotary_from_vector(model, vector: np.ndarray, previous: np.ndarray) -> np.nd
     previous block; an axis undetermined on a singular orientation keeps its previous value.
     Raises :class:`InputError` (row index in the message) for an unreachable orientation.
 
-    All rows at once: a guess (:func:`_guess`) checked row by row against the rule
-    (:func:`_settle`): the result is bit for bit that of the block-by-block rule
-    (:func:`block_by_block`, the reference)."""
+    All rows at once: a guess (:func:`_guess`; or ``guess`` (N, 2) deg, rotary positions
+    near the result, e.g. those of the same vectors continued from another start, improved by
+    :func:`_follow`) checked row by row against the rule (:func:`_settle`): the result is bit
+    for bit that of the block-by-block rule (:func:`block_by_block`, the reference) whatever
+    the guess."""
     n = len(vector)
     if not n:
         return np.zeros((0, 2))
     cand = _candidates(model, vector)
     lo, hi = _limits(model)
     prev = np.asarray(previous, dtype=float)
-    return _settle(cand, _guess(cand, prev, lo, hi), prev, lo, hi)
+    if guess is None or np.shape(guess) != (n, 2):
+        q = _guess(cand, prev, lo, hi)
+    else:
+        q = _follow(cand, np.array(guess, dtype=float), prev, lo, hi)
+    return _settle(cand, q, prev, lo, hi)
+
+
+def _follow(cand, q, previous, lo, hi, rounds: int = 4) -> np.ndarray:
+    """``q`` (N, 2) deg decided again from its own rows (:func:`decide`, all rows at once),
+    up to ``rounds`` times or until it no longer changes: after round r the first r rows are
+    the rule's; a guess that differs from the result in the last bits only (the start moved
+    by an ulp) becomes it in a round or two."""
+    for _ in range(rounds):
+        new = decide(cand, np.vstack([previous[None, :], q[:-1]]), lo, hi)[0]
+        if np.array_equal(new, q):
+            break
+        q = new
+    return q
 
 
 def _candidates(model, vector: np.ndarray) -> np.ndarray:
@@ -237,13 +257,15 @@ def block_by_block(cand, previous, lo, hi) -> np.ndarray:
 
 
 def axes_from_words(model, w: np.ndarray, frame: np.ndarray, length: np.ndarray,
-                    previous_rot: np.ndarray) -> np.ndarray:
+                    previous_rot: np.ndarray, guess_rot: np.ndarray | None = None) -> np.ndarray:
     """Axis positions (N, n_axes) the controller goes to: ``w`` (N, n_axes + 3) the words
     (for TCPM rows the linear columns the tip, rotary columns the angles of :data:`ANGLES`
     rows, the last three the tool vector of :data:`VECTOR` rows; :data:`AXES` rows the axis
     positions themselves), ``frame`` (N,), ``length`` (N,) mm (TCPM rows);
     ``previous_rot`` (2,) deg the rotary positions before the first row (vector rows continue
-    from the row before them)."""
+    from the row before them); ``guess_rot`` (N, 2) deg or None: rotary positions near those
+    of the vector rows, which speed up their solve (:func:`rotary_from_vector`), never
+    change it."""
     require(is_five_axis(model), f"{model.name}: TCPM needs a five-axis layout with its "
                                  "inverse kinematics")
     axes = model.axes
@@ -263,7 +285,8 @@ def axes_from_words(model, w: np.ndarray, frame: np.ndarray, length: np.ndarray,
         for part in np.split(vec, breaks):
             before = part[0] - 1
             p = rot[before] if before >= 0 and np.all(np.isfinite(rot[before])) else prev
-            rot[part] = rotary_from_vector(model, w[part, nax:nax + 3], p)
+            rot[part] = rotary_from_vector(model, w[part, nax:nax + 3], p,
+                                           None if guess_rot is None else guess_rot[part])
     q[:, rot_idx] = rot
     tc = frame != AXES
     q[np.ix_(tc, lin_idx)] = linear_from_tip(model, w[tc][:, lin_idx], rot[tc], length[tc])

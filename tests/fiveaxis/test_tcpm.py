@@ -365,3 +365,51 @@ def test_rotary_positions_of_tool_vectors_follow_the_controller_rule(layout):
     got = rotary_from_vector(m, vec, np.array([0.0, 10.0]))
     assert np.ptp(want[:, 1]) > 360                      # the endless axis turns more than once
     assert np.abs(got - want).max() < 1e-9
+
+
+@pytest.mark.parametrize("layout", ["DMU50", "HH_BC", "TT_AC"])
+def test_rotary_solve_with_a_guess_is_the_rule_bit_for_bit(layout):
+    """A guess (round_tcpm passes the corrected axes' rotary positions) only speeds the
+    solve up: with a guess a few ulps off, one from another start, one on the other branch
+    or turned by 360 deg, and one of noise, the result is that of the block-by-block rule to
+    the last bit (block_by_block, the reference the guess-free solve is tested against
+    above)."""
+    from volerr.fiveaxis.tcpm_kinematics import (_candidates, _limits, block_by_block,
+                                                 rotary_from_vector)
+
+    m = volerr.load(layout)
+    rng = np.random.default_rng(11)
+    n = 400
+    tilt = np.deg2rad(np.r_[rng.uniform(3, 60, n - 40), np.zeros(20), rng.uniform(3, 60, 20)])
+    az = np.r_[np.deg2rad(rng.uniform(0, 360, n - 40)), np.zeros(20), np.linspace(0, 20, 20)]
+    vec = np.column_stack([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), np.cos(tilt)])
+    start = np.array([0.0, 10.0])
+    lo, hi = _limits(m)
+    want = block_by_block(_candidates(m, vec), start, lo, hi)
+    near = rotary_from_vector(m, vec, start + [1e-9, -1e-9])
+    flipped = want.copy()
+    flipped[::7, 1] += 360.0
+    flipped[3::11] = -flipped[3::11]
+    for guess in (near, want * (1 + 1e-15), flipped, rng.uniform(-400, 400, (n, 2))):
+        got = rotary_from_vector(m, vec, start, guess)
+        assert np.array_equal(got, want)
+
+
+def test_closed_form_pseudo_inverse_step_matches_numpy_pinv():
+    """The batched 2x2 closed form of the Newton step (pinv_apply_3x2) against numpy's SVD
+    pinv with the same cutoff: well conditioned, nearly and exactly rank deficient, zero."""
+    from volerr.machine.kinematics import pinv_apply_3x2
+
+    rng = np.random.default_rng(5)
+    j = rng.normal(size=(4000, 3, 2))
+    r = rng.normal(size=(4000, 3))
+    j[:100, :, 1] = 2 * j[:100, :, 0]                   # rank 1
+    j[100:200, :, 1] *= 1e-8                             # below the cutoff: dropped
+    j[200:300, :, 1] *= 1e-4                             # above it: kept
+    j[300:310] = 0.0
+    want = np.einsum("nij,nj->ni", np.linalg.pinv(j, rcond=1e-6), r)
+    got = pinv_apply_3x2(j, r, rcond=1e-6)
+    scale = np.abs(want).max(axis=1, keepdims=True) + 1e-300
+    assert np.abs(got - want).max(axis=1).max() < 1e-6          # the 1e-4 rows: cond 1e4
+    assert np.all(np.abs(got - want)[300:] / scale[300:] < 1e-12)
+    assert np.all(got[300:310] == 0.0)
