@@ -112,10 +112,13 @@ def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -
         A_o = fitting.stack(A0, others)
         base = fitting.full_base(A_o, train, w_rows, y)
         mine = _explanation(a.cand)
-        rivals, seen = [], {mine}
+        # another accepted effect's parameter and sensor is that effect's cause: naming it
+        # here (or swapping to it) would make two effects of one cause
+        rivals, seen = [], {mine} | {_explanation(o.cand)[:2] for o in others}
+        names = {o.cand.name for o in accepted}
         for x in pool:
             key = _explanation(x.cand)
-            if key in seen or x.cand.name == a.cand.name:
+            if key in seen or key[:2] in seen or x.cand.name in names:
                 continue
             seen.add(key)
             rivals.append(x.cand)
