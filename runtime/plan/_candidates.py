@@ -51,6 +51,7 @@ class SetUp:
     max_readings: int
     geometry: dict = field(default_factory=dict)
     text: str = ""
+    line: object = None         # an interferometer line (volerr.instruments.interferometer.Line)
 
 
 def home(model) -> dict:
@@ -306,3 +307,85 @@ MAKERS = {"ballbar": ballbar_all, "sphere": sphere_setups, "distances": distance
 def setups(model, inst) -> list:
     """Every candidate set-up of the instrument ``inst`` on ``model``."""
     return MAKERS[inst.kind](model, inst)
+
+
+# ---- interferometer (laser lines) ---------------------------------------------------------
+#: targets of an interferometer line (ISO 230-2: equally spaced over the travel, 5 % in from
+#: its ends), cycles of its template and the fewest / most cycles of a run (ISO 230-2: 5)
+LINE_TARGETS, LINE_CYCLES, LINE_MIN_CYCLES, LINE_MAX_CYCLES = 11, 1, 2, 5
+#: optic of the spec -> interferometer mode (``volerr formats interferometer``)
+OPTIC_MODE = {"linear": "positioning", "straightness": "straightness", "angular": "angular"}
+#: where the other linear axes stand for a line (share of their travel): the Abbe offsets
+LINE_AT = (0.1, 0.5, 0.9)
+
+
+def line_targets(model, axis) -> np.ndarray:
+    """ISO 230-2 targets of a line along ``axis``: :data:`LINE_TARGETS` equally spaced over
+    the travel, 5 % in from its ends (mm)."""
+    lo, hi = model.travel[axis]
+    pad = 0.05 * (hi - lo)
+    return np.round(np.linspace(lo + pad, hi - pad, LINE_TARGETS), 3)
+
+
+def interferometer_setups(model, inst) -> list:
+    """Beam lines along each linear axis, the other linear axes at :data:`LINE_AT` of their
+    travel (a 3 x 3 grid of Abbe offsets), rotary axes at home, the moving optic at the
+    instrument's tool offset; for each optic asked (straightness and angular optics: both
+    directions normal to the beam)."""
+    from ..instruments import interferometer
+
+    lin = [a for a in model.axes if a not in model.rotary_axes]
+    out = []
+    for axis in lin:
+        others = [a for a in lin if a != axis]
+        ticks = [[round(model.travel[a][0] + f * (model.travel[a][1] - model.travel[a][0]), 1)
+                  for f in LINE_AT] for a in others]
+        normals = [v for v in np.eye(3) if abs(v[lin.index(axis)]) < 0.5]
+        for optic in inst.optics:
+            mode = OPTIC_MODE[optic]
+            senses = [None] if mode == "positioning" else normals
+            for values, sense in itertools.product(itertools.product(*ticks), senses):
+                at = dict(zip(others, values), **home(model))
+                line = interferometer.Line(axis, mode, at, np.asarray(inst.tool, float),
+                                           sense=sense, u=inst.u_urad if mode == "angular"
+                                           else inst.u_um)
+                out.append(_line(model, line, f"L{len(out) + 1}"))
+    return out
+
+
+def _line(model, line, label) -> SetUp:
+    targets = line_targets(model, line.axis)
+    k = len(targets)
+    reading = "deviation_urad" if line.mode == "angular" else "deviation_um"
+
+    def build(m: int) -> dict:
+        cycles = max(int(round(m / (2 * k))), 1)
+        rows = [(p, c, d) for c in range(1, cycles + 1) for d in (1.0, -1.0)
+                for p in (targets if d > 0 else targets[::-1])]
+        n = len(rows)
+        cols = {"target_mm": np.array([r[0] for r in rows]),
+                "cycle": np.array([str(r[1]) for r in rows], dtype=object),
+                "direction": np.array([r[2] for r in rows]), reading: np.zeros(n)}
+        pos = {a: (cols["target_mm"] if a == line.axis else np.full(n, float(line.at[a])))
+               for a in model.axes}
+        cols.update(rounded(pos))
+        cols["placement"] = np.full(n, label, dtype=object)
+        for j, c in enumerate(("Xp", "Yp", "Zp")):
+            cols[c] = np.full(n, float(line.optics[j]))
+        return cols
+
+    at = ", ".join(f"{a}={v:g}" for a, v in line.at.items())
+    what = {"positioning": "linear optics",
+            "straightness": "straightness optics, displacement along {}",
+            "angular": "angular optics, rotation about {}"}[line.mode]
+    if line.sense is not None:
+        what = what.format("XYZ"[int(np.argmax(np.abs(line.sense)))])
+    text = f"laser line along {line.axis} at {at}, {what}, {k} targets both directions"
+    start = model.nominal_position({a: np.array([targets[0] if a == line.axis else line.at[a]])
+                                    for a in model.axes}, line.optics)[0]
+    geometry = {"start": np.round(start, 3), "axis": line.axis, "mode": line.mode}
+    return SetUp("interferometer", label, build, 2 * k * LINE_CYCLES, 2 * k * LINE_MIN_CYCLES,
+                 2 * k * LINE_MAX_CYCLES, geometry, text, line)
+
+
+MAKERS["interferometer"] = interferometer_setups

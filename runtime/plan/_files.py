@@ -16,15 +16,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..instruments import ballbar, distances, sphere
+from ..instruments import ballbar, distances, interferometer, sphere
 
 #: reading columns of each kind: present and empty in a plan file
 READINGS = {"ballbar": ("dr_um",), "sphere": ("dx_um", "dy_um", "dz_um"),
-            "distances": ("d_mm",)}
+            "distances": ("d_mm",), "interferometer": ("deviation_um", "deviation_urad")}
 READERS = {"ballbar": ballbar, "sphere": sphere, "distances": distances}
 #: label columns (text) of each kind
 LABELS = {"ballbar": ("placement",), "sphere": ("placement", "frame"),
-          "distances": ("station",)}
+          "distances": ("station",), "interferometer": ("placement", "cycle")}
+#: columns a plan keeps for its NC program and set-up sheet but does not write into the file
+#: (an interferometer run gives its line in ``# axis:`` ... header lines)
+HIDDEN = {"interferometer": ("placement", "Xp", "Yp", "Zp")}
 
 
 @dataclass
@@ -49,6 +52,8 @@ def columns_of(inst, setups: list) -> dict:
     parts = [s.build(m) for s, m in setups]
     cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     n = len(next(iter(cols.values())))
+    if inst.kind == "interferometer":       # one line a file; u in the header lines
+        return cols
     for k in READINGS[inst.kind]:
         if inst.kind != "distances":    # a station is located from its nominal distances
             cols[k] = np.zeros(n)
@@ -81,13 +86,15 @@ def group(instruments: list, chosen: list) -> list:
     files = []
     by_inst: dict = {}
     for i, s, m in chosen:
+        if s.kind == "interferometer":      # whole ISO 230-2 cycles
+            m = len(s.build(m)["target_mm"])
         by_inst.setdefault(i, []).append((s, m))
     many = {k: sum(1 for inst in instruments if inst.kind == k) > 1
             for k in READINGS}
     for i, sets in by_inst.items():
         kind = instruments[i].kind
         stem = f"{kind}{i + 1}" if many[kind] else kind
-        if kind == "ballbar":
+        if kind in ("ballbar", "interferometer"):
             for s, m in sets:
                 files.append(PlanFile(f"{stem}_{s.label}.csv", kind, i, [(s, m)]))
         else:
@@ -99,6 +106,10 @@ def group(instruments: list, chosen: list) -> list:
 
 def observations(model, pf: PlanFile):
     """The file's rows as ``calibrate`` reads them (readings zero)."""
+    if pf.kind == "interferometer":
+        c, line = pf.columns, pf.setups[0][0].line
+        return interferometer.observations(model, line, c["target_mm"], np.zeros(pf.n),
+                                           c["direction"], pf.name, cycle=c["cycle"])
     numbers = {k: np.asarray(v, float) for k, v in pf.columns.items()
                if k not in LABELS[pf.kind]}
     labels = {k: [str(x) for x in v] for k, v in pf.columns.items() if k in LABELS[pf.kind]}
@@ -109,7 +120,8 @@ def observations(model, pf: PlanFile):
 def csv_text(pf: PlanFile, header: list) -> str:
     """The file as text: ``#`` comment lines ``header``, the columns, reading columns empty
     (6 decimals for mm / deg; positions carry 4)."""
-    names = list(pf.columns)
+    names = [k for k in pf.columns if k not in HIDDEN.get(pf.kind, ()) and
+             (pf.kind != "interferometer" or k not in model_axes(pf))]
     empty = set(READINGS[pf.kind])
     lines = [f"# {h}" for h in header] + [",".join(names)]
     cols = [pf.columns[k] for k in names]
@@ -121,7 +133,7 @@ def csv_text(pf: PlanFile, header: list) -> str:
             elif k in LABELS[pf.kind]:
                 cells.append(str(c[i]))
             elif k == "direction":
-                cells.append(f"{c[i]:.0f}")
+                cells.append(f"{c[i]:+.0f}" if pf.kind == "interferometer" else f"{c[i]:.0f}")
             else:
                 cells.append(_number(float(c[i])))
         lines.append(",".join(cells))
@@ -132,3 +144,9 @@ def _number(v: float) -> str:
     """Shortest fixed-point text of ``v`` with at most 6 decimals, no negative zero."""
     text = f"{v:.6f}".rstrip("0").rstrip(".")
     return "0" if text in ("", "-0") else text
+
+
+def model_axes(pf: PlanFile) -> set:
+    """The machine-axis columns of an interferometer file's set-up (kept for the NC program)."""
+    line = pf.setups[0][0].line
+    return {line.axis, *line.at}
