@@ -31,7 +31,9 @@ def register(sub) -> None:
     p.add_argument("--instrument", action="append", required=True, metavar="SPEC",
                    help="an instrument: KIND[:key=value[,value...]]... with KIND ballbar "
                         "(lengths=100,150,250 length_u_um=U), sphere (places=K tool_u_um=U "
-                        "frame=work|machine), distances (stations=K); every kind takes "
+                        "frame=work|machine), distances (stations=K), interferometer "
+                        "(optics=linear,straightness,angular, the default all three; "
+                        "u_urad=U); every kind takes "
                         "u_um=U and tool=L or tool=X,Y,Z (mm); repeat for a mixed campaign")
     p.add_argument("--readings", type=int, required=True, metavar="N",
                    help="readings in all (rows of the plan files)")
