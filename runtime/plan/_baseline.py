@@ -29,7 +29,8 @@ NAMES = {"ballbar": "ISO 230-4: three orthogonal circles about the centre",
          "sphere": "one sphere placement, rotary axes in equal steps",
          "distances": "four stations at the bottom corners",
          "interferometer": "ISO 230-2: one linear-optics line along each linear axis through "
-                           "the middle of the travel"}
+                           "the middle of the travel",
+         "artifact": "ball plate in XY at the bottom and the top, YZ and ZX in the middle"}
 
 
 def baseline(model, insts, spec, files, tool) -> dict:
@@ -101,5 +102,18 @@ def _interferometer(model, inst, n: int) -> list:
     return list(zip(mid, per))
 
 
+def _artifact(model, inst, n: int) -> list:
+    """The ball-plate method's usual placements (XY at the bottom and the top, YZ, ZX in the
+    middle, not turned), as many of them as the readings allow."""
+    levels = _candidates.PLATE_LEVELS
+    found = {(s.geometry["plane"], s.geometry["turn"], s.geometry["level"]): s
+             for s in _candidates.artifact_setups(model, inst)}
+    order = [found.get(key) for key in (("XY", 0, levels[0]), ("XY", 0, levels[-1]),
+                                        ("YZ", 0, levels[1]), ("ZX", 0, levels[1]))]
+    order = [s for s in order if s is not None]
+    count = min(len(order), max(1, n // order[0].template)) if order else 0
+    return [(s, s.template) for s in order[:count]]
+
+
 MAKERS = {"ballbar": _ballbar, "sphere": _sphere, "distances": _distances,
-          "interferometer": _interferometer}
+          "interferometer": _interferometer, "artifact": _artifact}

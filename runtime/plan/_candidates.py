@@ -52,6 +52,7 @@ class SetUp:
     geometry: dict = field(default_factory=dict)
     text: str = ""
     line: object = None         # an interferometer line (volerr.instruments.interferometer.Line)
+    hidden: tuple = ()          # columns kept for the NC program, not written into the file
 
 
 def home(model) -> dict:
@@ -389,3 +390,80 @@ def _line(model, line, label) -> SetUp:
 
 
 MAKERS["interferometer"] = interferometer_setups
+
+
+# ---- artifact (ball plate) ------------------------------------------------------------------
+#: where a plate lies along its plane's normal (share of the working volume)
+PLATE_LEVELS = (0.15, 0.5, 0.85)
+#: plane -> (workpiece axis of the plate's u, of its v) at 0 deg; turned 90 deg: u along the
+#: second, v along minus the first (w = u x v, the plane's normal, either way)
+PLATE_PLANES = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}
+
+
+def plate_points(inst) -> np.ndarray:
+    """(N M, 3) calibrated ball centres of the plate in its own frame (mm): a grid of
+    ``balls`` at ``pitch``, origin at the first ball, w = 0."""
+    n, m = inst.balls
+    u, v = np.meshgrid(np.arange(n) * inst.pitch, np.arange(m) * inst.pitch, indexing="ij")
+    return np.column_stack([u.ravel(), v.ravel(), np.zeros(n * m)])
+
+
+def artifact_setups(model, inst) -> list:
+    """Ball-plate placements in the planes XY, YZ, ZX, turned 0 and 90 deg in the plane,
+    centred in the working volume in the plane, at :data:`PLATE_LEVELS` along the normal;
+    every ball's nominal position inside the travel, rotary axes at home."""
+    lo, hi = volume(model, inst.tool)
+    pts = plate_points(inst)
+    half = 0.5 * (pts.max(axis=0) - pts.min(axis=0))
+    out = []
+    for plane, (i, j) in PLATE_PLANES.items():
+        k = 3 - i - j
+        for turn, level in itertools.product((0, 90), PLATE_LEVELS):
+            R = np.zeros((3, 3))
+            a, b = (i, j) if turn == 0 else (j, i)
+            R[a, 0] = 1.0
+            R[b, 1] = 1.0 if turn == 0 else -1.0
+            R[:, 2] = np.cross(R[:, 0], R[:, 1])
+            centre = 0.5 * (lo + hi)
+            centre[k] = lo[k] + level * (hi[k] - lo[k])
+            origin = np.round(centre - R @ half, 1)
+            s = _plate(model, inst, pts, R, origin, (plane, turn, level), f"P{len(out) + 1}")
+            if s is not None:
+                out.append(s)
+    return out
+
+
+def _plate(model, inst, pts, R, origin, where, label) -> SetUp | None:
+    plane, turn, level = where
+    nominal = pts @ R.T + origin
+    n = len(pts)
+    rot = {a: np.full(n, v) for a, v in home(model).items()}
+    try:
+        pos = rounded(model.linear_positions(nominal, rot, np.asarray(inst.tool, float)))
+    except Exception:       # not reachable
+        return None
+    pos.update(rot)
+    if not inside(model, pos).all():
+        return None
+    lin = tuple(a for a in model.axes if a not in model.rotary_axes)
+
+    def build(m: int) -> dict:
+        cols = {"placement": np.full(n, label, dtype=object),
+                "ball": np.array([f"B{b + 1}" for b in range(n)], dtype=object),
+                "u_mm": pts[:, 0], "v_mm": pts[:, 1], "w_mm": pts[:, 2]}
+        for c, name in enumerate(("x", "y", "z")):
+            cols[f"{name}_mm"] = nominal[:, c]
+        for c, name in enumerate(("x", "y", "z")):
+            cols[f"{name}_nom_mm"] = nominal[:, c]
+        for c, name in enumerate(("Xp", "Yp", "Zp")):
+            cols[name] = np.full(n, float(inst.tool[c]))
+        cols.update({a: v for a, v in pos.items()})
+        return cols
+
+    text = (f"ball plate {inst.balls[0]} x {inst.balls[1]} at {inst.pitch:g} mm in {plane}, "
+            f"turned {turn} deg, first ball at ({origin[0]:g}, {origin[1]:g}, {origin[2]:g}) mm")
+    geometry = {"start": origin, "plane": plane, "turn": turn, "level": level}
+    return SetUp("artifact", label, build, n, n, n, geometry, text, hidden=lin)
+
+
+MAKERS["artifact"] = artifact_setups

@@ -16,15 +16,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..instruments import ballbar, distances, interferometer, sphere
+from ..instruments import artifact, ballbar, distances, interferometer, sphere
 
 #: reading columns of each kind: present and empty in a plan file
 READINGS = {"ballbar": ("dr_um",), "sphere": ("dx_um", "dy_um", "dz_um"),
-            "distances": ("d_mm",), "interferometer": ("deviation_um", "deviation_urad")}
-READERS = {"ballbar": ballbar, "sphere": sphere, "distances": distances}
+            "distances": ("d_mm",), "interferometer": ("deviation_um", "deviation_urad"),
+            "artifact": ("x_mm", "y_mm", "z_mm")}
+READERS = {"ballbar": ballbar, "sphere": sphere, "distances": distances, "artifact": artifact}
 #: label columns (text) of each kind
 LABELS = {"ballbar": ("placement",), "sphere": ("placement", "frame"),
-          "distances": ("station",), "interferometer": ("placement", "cycle")}
+          "distances": ("station",), "interferometer": ("placement", "cycle"),
+          "artifact": ("placement", "ball")}
 #: columns a plan keeps for its NC program and set-up sheet but does not write into the file
 #: (an interferometer run gives its line in ``# axis:`` ... header lines)
 HIDDEN = {"interferometer": ("placement", "Xp", "Yp", "Zp")}
@@ -53,6 +55,11 @@ def columns_of(inst, setups: list) -> dict:
     cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     n = len(next(iter(cols.values())))
     if inst.kind == "interferometer":       # one line a file; u in the header lines
+        return cols
+    if inst.kind == "artifact":     # readings: the nominal points (the reader poses on them)
+        u = artifact.DEFAULT_U_UM if inst.u_um is None else inst.u_um
+        cols["probe_u_um"] = np.full(n, float(u))
+        cols["u_std_um"] = np.full(n, float(inst.cal_u_um))
         return cols
     for k in READINGS[inst.kind]:
         if inst.kind != "distances":    # a station is located from its nominal distances
@@ -110,8 +117,9 @@ def observations(model, pf: PlanFile):
         c, line = pf.columns, pf.setups[0][0].line
         return interferometer.observations(model, line, c["target_mm"], np.zeros(pf.n),
                                            c["direction"], pf.name, cycle=c["cycle"])
+    hidden = hidden_columns(pf)
     numbers = {k: np.asarray(v, float) for k, v in pf.columns.items()
-               if k not in LABELS[pf.kind]}
+               if k not in LABELS[pf.kind] and k not in hidden}
     labels = {k: [str(x) for x in v] for k, v in pf.columns.items() if k in LABELS[pf.kind]}
     text = {k: None for k in labels}
     return READERS[pf.kind].columns_to_observations(numbers, text, labels, model, pf.name)
@@ -120,8 +128,7 @@ def observations(model, pf: PlanFile):
 def csv_text(pf: PlanFile, header: list) -> str:
     """The file as text: ``#`` comment lines ``header``, the columns, reading columns empty
     (6 decimals for mm / deg; positions carry 4)."""
-    names = [k for k in pf.columns if k not in HIDDEN.get(pf.kind, ()) and
-             (pf.kind != "interferometer" or k not in model_axes(pf))]
+    names = [k for k in pf.columns if k not in hidden_columns(pf)]
     empty = set(READINGS[pf.kind])
     lines = [f"# {h}" for h in header] + [",".join(names)]
     cols = [pf.columns[k] for k in names]
@@ -146,7 +153,14 @@ def _number(v: float) -> str:
     return "0" if text in ("", "-0") else text
 
 
-def model_axes(pf: PlanFile) -> set:
-    """The machine-axis columns of an interferometer file's set-up (kept for the NC program)."""
-    line = pf.setups[0][0].line
-    return {line.axis, *line.at}
+def hidden_columns(pf: PlanFile) -> set:
+    """Columns a plan keeps for its NC program and set-up sheet but does not write: an
+    interferometer run's axis positions (its header lines give the line), an artifact's
+    linear-axis positions (its reader refuses axis columns: the nominal ball positions are
+    written as ``x_nom_mm, y_nom_mm, z_nom_mm``)."""
+    out = set(HIDDEN.get(pf.kind, ()))
+    for s, _ in pf.setups:
+        out |= set(s.hidden)
+        if s.line is not None:
+            out |= {s.line.axis, *s.line.at}
+    return out

@@ -13,7 +13,9 @@ Sphere / R-test readings are approached safely: before each reading the tool goe
 clearance height (the top of the Z travel: +Z moves the tool away from the workpiece, ISO 841),
 turns the rotary axes there, comes down to a point ``RETRACT_MM`` back along the tool axis from
 the reading (rotary axes held, so the last move is straight along the tool axis into the nest or
-onto the sphere), moves to the reading at the feed, dwells, and leaves the same way.  A
+onto the sphere), moves to the reading at the feed, dwells, and leaves the same way.  A ball of
+an artifact (ball plate) is approached the same way: its row is the ball's nominal centre, the
+dwell stands for the control's ball-probing cycle there.  A
 straight ``G1`` from one reading to the next would turn the table under the tool and sweep the
 tool through the sphere or out of the R-test's nest.
 """
@@ -26,7 +28,7 @@ from . import _spec
 
 #: feed of the motion blocks, mm/min (ballbar circles: the ISO 230-4 test feed)
 FEED = {"ballbar": _spec.BALLBAR_FEED_MM_MIN, "sphere": 1000.0, "distances": 2000.0,
-        "interferometer": 2000.0}
+        "interferometer": 2000.0, "artifact": 1000.0}
 #: distances tried, largest first, for the point back along the tool axis from a sphere reading
 #: (the first whose axis positions lie inside the travel), mm
 RETRACT_MM = (20.0, 10.0, 5.0, 2.0)
@@ -45,7 +47,7 @@ def program(model, pf, header: list) -> str:
     dwell = _spec.DWELL_S.get(pf.kind)
     texts = {s.label: s.text for s, _ in pf.setups}
     previous = None
-    retract = _retract_positions(model, pf) if pf.kind == "sphere" else None
+    retract = _retract_positions(model, pf) if pf.kind in ("sphere", "artifact") else None
     for i in range(pf.n):
         if labels[i] != previous:
             if previous is not None:

@@ -17,6 +17,12 @@ def file_header(plan, pf) -> list:
         lines.append(f"set-up {s.label}: {s.text}; {m} readings")
     if inst.kind == "interferometer":
         lines += line_header(pf.setups[0][0].line)
+    elif inst.kind == "artifact":
+        lines += [f"probe_u_um: {float(pf.columns['probe_u_um'][0]):g} (column probe_u_um: "
+                  f"the standard uncertainty of one probed coordinate the plan assumes)",
+                  f"u_std_um: {inst.cal_u_um:g} (column u_std_um: the plate's calibration)",
+                  "x_nom_mm, y_nom_mm, z_nom_mm: where the plan puts each ball (machine "
+                  "coordinates); fill x_mm, y_mm, z_mm with the centres the machine measures"]
     elif inst.u_um is not None or inst.kind != "distances":
         u = inst.u_um if inst.u_um is not None else float(pf.columns["u_um"][0])
         lines.append(f"u_um: {u:g} (column u_um: the standard uncertainty of one reading the "

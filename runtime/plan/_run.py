@@ -157,7 +157,8 @@ def _floor(inst) -> int:
 
 
 def _cap(inst) -> int:
-    return {"sphere": inst.places, "distances": inst.stations}.get(inst.kind, 50)
+    return {"sphere": inst.places, "distances": inst.stations,
+            "artifact": inst.places}.get(inst.kind, 50)
 
 
 def _pool(prob, insts, pool) -> _design.Candidates:

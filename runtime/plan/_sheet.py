@@ -12,7 +12,7 @@ from .. import plotstyle
 from . import _candidates, _report
 
 VIEWS = (("X", "Y", 0, 1), ("X", "Z", 0, 2), ("Y", "Z", 1, 2))
-MARKERS = {"ballbar": "o", "sphere": "s", "distances": "^", "interferometer": "D"}
+MARKERS = {"ballbar": "o", "sphere": "s", "distances": "^", "interferometer": "D", "artifact": "P"}
 
 
 @plotstyle.styled
