@@ -15,7 +15,8 @@ def register(sub) -> None:
         "plan", help="design a measurement campaign (optimal set-ups, files, NC programs)",
         description="Design a calibration campaign for LAYOUT with the instruments named: "
                     "from candidate set-ups inside the travel (ballbar circles, sphere / "
-                    "R-test placements, tracking-interferometer stations, laser-interferometer lines, ball-plate placements) choose the set-ups "
+                    "R-test placements, tracking-interferometer stations, laser-interferometer "
+                    "lines, ball-plate placements) choose the set-ups "
                     "and readings that minimise the predicted standard uncertainty of the "
                     "volumetric error over the working volume (I-optimal; --criterion D) "
                     "while every requested parameter stays determined (greedy design, "

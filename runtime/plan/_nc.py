@@ -4,7 +4,8 @@ rotary axes in deg, named as the layout names them).
 Contract (``volerr formats plan``): every row of the plan file is, in order, the end point of
 one motion block (``G0`` for the first, ``G1`` for the others; absolute ``G90``, metric
 ``G21``, feed per minute ``G94``); where the instrument reads at a stop (sphere / R-test,
-tracking interferometer, laser interferometer) the block is followed by a dwell ``G4 P<s>`` (seconds, as LinuxCNC and
+tracking interferometer, laser interferometer, artifact) the block is followed by a dwell
+``G4 P<s>`` (seconds, as LinuxCNC and
 ISO 6983 controls read it; a Fanuc-type control reads ``G4 X<s>``).  A set-up change inside
 one file (the next sphere placement, the next station) is a program stop ``M0`` with a comment
 saying what to move; the program ends with ``M30``.

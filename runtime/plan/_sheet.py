@@ -40,7 +40,8 @@ def figure(plan) -> bytes:
         ax.set_ylabel(plotstyle.label(b, "mm"))
         ax.set_aspect("equal", adjustable="datalim")
     fig.suptitle(f"{model.name}: where each set-up goes (workpiece frame)\n"
-                 f"o pivot, square sphere, triangle station, diamond laser line start; dots: the tool point at each "
+                 f"o pivot, square sphere, triangle station, diamond laser line start, pentagon "
+                 f"ball plate's first ball; dots: the tool point at each "
                  f"reading; dashed: the working volume")
     return plotstyle.png(fig)
 

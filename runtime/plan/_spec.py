@@ -22,7 +22,8 @@ from ..errors import require
 SETUP_MIN = {"ballbar": 5.0, "sphere": 10.0, "distances": 15.0, "interferometer": 20.0,
              "artifact": 20.0}
 #: time per reading, seconds (0 for the ballbar: it samples during the motion)
-READING_S = {"ballbar": 0.0, "sphere": 12.0, "distances": 5.0, "interferometer": 6.0, "artifact": 30.0}
+READING_S = {"ballbar": 0.0, "sphere": 12.0, "distances": 5.0, "interferometer": 6.0,
+             "artifact": 30.0}
 #: (interferometer: the move to the next target at 2000 mm/min and the dwell; a set-up change
 #: is mounting and aligning the optics on a new line)
 #: (artifact: move and clamp the plate, align it; a ball probed by a five-point cycle)

@@ -140,6 +140,7 @@ def test_every_optic_and_axis_is_used_and_targets_stay_inside_the_travel(plan):
         cycles = len(t) // (2 * len(targets))
         assert cycles >= 2 and len(t) == 2 * cycles * len(targets)
         assert sorted(set(cols["direction"])) == ["+1", "-1"]
+    assert sum(f["readings"] for f in doc["files"]) == doc["readings"] <= 1200
     modes = {m for _, m in seen}
     assert modes == {"positioning", "straightness", "angular"}
     assert {a for a, _ in seen} == {"X", "Y", "Z"}
