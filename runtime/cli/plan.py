@@ -15,7 +15,8 @@ def register(sub) -> None:
         "plan", help="design a measurement campaign (optimal set-ups, files, NC programs)",
         description="Design a calibration campaign for LAYOUT with the instruments named: "
                     "from candidate set-ups inside the travel (ballbar circles, sphere / "
-                    "R-test placements, tracking-interferometer stations) choose the set-ups "
+                    "R-test placements, tracking-interferometer stations, laser-interferometer "
+                    "lines, ball-plate placements) choose the set-ups "
                     "and readings that minimise the predicted standard uncertainty of the "
                     "volumetric error over the working volume (I-optimal; --criterion D) "
                     "while every requested parameter stays determined (greedy design, "
@@ -31,7 +32,10 @@ def register(sub) -> None:
     p.add_argument("--instrument", action="append", required=True, metavar="SPEC",
                    help="an instrument: KIND[:key=value[,value...]]... with KIND ballbar "
                         "(lengths=100,150,250 length_u_um=U), sphere (places=K tool_u_um=U "
-                        "frame=work|machine), distances (stations=K); every kind takes "
+                        "frame=work|machine), distances (stations=K), interferometer "
+                        "(optics=linear,straightness,angular, the default all three; "
+                        "u_urad=U), artifact (a ball plate: balls=5x5 pitch=100 "
+                        "cal_u_um=0.5 places=4); every kind takes "
                         "u_um=U and tool=L or tool=X,Y,Z (mm); repeat for a mixed campaign")
     p.add_argument("--readings", type=int, required=True, metavar="N",
                    help="readings in all (rows of the plan files)")

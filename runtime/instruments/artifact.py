@@ -138,7 +138,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     used = (np.arange(3)[None, :] < rows[:, None]).astype(float)          # (n, 3)
     lin = lin * used[:, :, None]
     setup = _setup(where, names, gidx, ball, feature, u_std, lin)
-    covs = f.covariates(find, model, where)
+    covs = f.covariates(find, model, where, skip=NOMINAL_COLUMNS)
     info = {"placement": names[gidx].astype(object), "ball": ball, "feature": feature,
             "point": point, "measured": measured, "rotation": R0, "origin": origin,
             "u_std": np.zeros(n) if u_std is None else u_std}
@@ -193,6 +193,10 @@ def _calibration_uncertainty(find, n, where) -> np.ndarray | None:
     require(np.all(v >= 0), f"{where}: u_std_um must not be negative")
     return v * 1e-3
 
+
+#: where a plan (``volerr plan``) puts each feature, machine coordinates mm: informative, not
+#: read (the measured point is ``x_mm, y_mm, z_mm``), not a covariate
+NOMINAL_COLUMNS = ("x_nom_mm", "y_nom_mm", "z_nom_mm")
 
 #: calibrated coordinates of one ball closer than this are the same, mm
 SAME_POINT_MM = 1e-6

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 
+from dataclasses import replace
+
 import numpy as np
 
 from . import _candidates, _files
@@ -25,7 +27,10 @@ from ._predict import Prediction, predict
 
 NAMES = {"ballbar": "ISO 230-4: three orthogonal circles about the centre",
          "sphere": "one sphere placement, rotary axes in equal steps",
-         "distances": "four stations at the bottom corners"}
+         "distances": "four stations at the bottom corners",
+         "interferometer": "ISO 230-2: one linear-optics line along each linear axis through "
+                           "the middle of the travel",
+         "artifact": "ball plate in XY at the bottom and the top, YZ and ZX in the middle"}
 
 
 def baseline(model, insts, spec, files, tool) -> dict:
@@ -88,4 +93,27 @@ def _distances(model, inst, n: int) -> list:
     return list(zip(corners, per))
 
 
-MAKERS = {"ballbar": _ballbar, "sphere": _sphere, "distances": _distances}
+def _interferometer(model, inst, n: int) -> list:
+    found = _candidates.interferometer_setups(model, replace(inst, optics=("linear",)))
+    mid = [s for s in found if all(abs(v - 0.5 * sum(model.travel[a])) < 0.051 *
+                                   (model.travel[a][1] - model.travel[a][0])
+                                   for a, v in s.line.at.items() if a not in model.rotary_axes)]
+    per = [n // len(mid) + (1 if k < n % len(mid) else 0) for k in range(len(mid))]
+    return list(zip(mid, per))
+
+
+def _artifact(model, inst, n: int) -> list:
+    """The ball-plate method's usual placements (XY at the bottom and the top, YZ, ZX in the
+    middle, not turned), as many of them as the readings allow."""
+    levels = _candidates.PLATE_LEVELS
+    found = {(s.geometry["plane"], s.geometry["turn"], s.geometry["level"]): s
+             for s in _candidates.artifact_setups(model, inst)}
+    order = [found.get(key) for key in (("XY", 0, levels[0]), ("XY", 0, levels[-1]),
+                                        ("YZ", 0, levels[1]), ("ZX", 0, levels[1]))]
+    order = [s for s in order if s is not None]
+    count = min(len(order), max(1, n // order[0].template)) if order else 0
+    return [(s, s.template) for s in order[:count]]
+
+
+MAKERS = {"ballbar": _ballbar, "sphere": _sphere, "distances": _distances,
+          "interferometer": _interferometer, "artifact": _artifact}

@@ -51,6 +51,8 @@ class SetUp:
     max_readings: int
     geometry: dict = field(default_factory=dict)
     text: str = ""
+    line: object = None         # an interferometer line (volerr.instruments.interferometer.Line)
+    hidden: tuple = ()          # columns kept for the NC program, not written into the file
 
 
 def home(model) -> dict:
@@ -306,3 +308,162 @@ MAKERS = {"ballbar": ballbar_all, "sphere": sphere_setups, "distances": distance
 def setups(model, inst) -> list:
     """Every candidate set-up of the instrument ``inst`` on ``model``."""
     return MAKERS[inst.kind](model, inst)
+
+
+# ---- interferometer (laser lines) ---------------------------------------------------------
+#: targets of an interferometer line (ISO 230-2: equally spaced over the travel, 5 % in from
+#: its ends), cycles of its template and the fewest / most cycles of a run (ISO 230-2: 5)
+LINE_TARGETS, LINE_CYCLES, LINE_MIN_CYCLES, LINE_MAX_CYCLES = 11, 1, 2, 5
+#: optic of the spec -> interferometer mode (``volerr formats interferometer``)
+OPTIC_MODE = {"linear": "positioning", "straightness": "straightness", "angular": "angular"}
+#: where the other linear axes stand for a line (share of their travel): the Abbe offsets
+LINE_AT = (0.1, 0.5, 0.9)
+
+
+def line_targets(model, axis) -> np.ndarray:
+    """ISO 230-2 targets of a line along ``axis``: :data:`LINE_TARGETS` equally spaced over
+    the travel, 5 % in from its ends (mm)."""
+    lo, hi = model.travel[axis]
+    pad = 0.05 * (hi - lo)
+    return np.round(np.linspace(lo + pad, hi - pad, LINE_TARGETS), 3)
+
+
+def interferometer_setups(model, inst) -> list:
+    """Beam lines along each linear axis, the other linear axes at :data:`LINE_AT` of their
+    travel (a 3 x 3 grid of Abbe offsets), rotary axes at home, the moving optic at the
+    instrument's tool offset; for each optic asked (straightness and angular optics: both
+    directions normal to the beam)."""
+    from ..instruments import interferometer
+
+    lin = [a for a in model.axes if a not in model.rotary_axes]
+    out = []
+    for axis in lin:
+        others = [a for a in lin if a != axis]
+        ticks = [[round(model.travel[a][0] + f * (model.travel[a][1] - model.travel[a][0]), 1)
+                  for f in LINE_AT] for a in others]
+        normals = [v for v in np.eye(3) if abs(v[lin.index(axis)]) < 0.5]
+        for optic in inst.optics:
+            mode = OPTIC_MODE[optic]
+            senses = [None] if mode == "positioning" else normals
+            for values, sense in itertools.product(itertools.product(*ticks), senses):
+                at = dict(zip(others, values), **home(model))
+                line = interferometer.Line(axis, mode, at, np.asarray(inst.tool, float),
+                                           sense=sense, u=inst.u_urad if mode == "angular"
+                                           else inst.u_um)
+                out.append(_line(model, line, f"L{len(out) + 1}"))
+    return out
+
+
+def _line(model, line, label) -> SetUp:
+    targets = line_targets(model, line.axis)
+    k = len(targets)
+    reading = "deviation_urad" if line.mode == "angular" else "deviation_um"
+
+    def build(m: int) -> dict:
+        cycles = max(int(round(m / (2 * k))), 1)
+        rows = [(p, c, d) for c in range(1, cycles + 1) for d in (1.0, -1.0)
+                for p in (targets if d > 0 else targets[::-1])]
+        n = len(rows)
+        cols = {"target_mm": np.array([r[0] for r in rows]),
+                "cycle": np.array([str(r[1]) for r in rows], dtype=object),
+                "direction": np.array([r[2] for r in rows]), reading: np.zeros(n)}
+        pos = {a: (cols["target_mm"] if a == line.axis else np.full(n, float(line.at[a])))
+               for a in model.axes}
+        cols.update(rounded(pos))
+        cols["placement"] = np.full(n, label, dtype=object)
+        for j, c in enumerate(("Xp", "Yp", "Zp")):
+            cols[c] = np.full(n, float(line.optics[j]))
+        return cols
+
+    at = ", ".join(f"{a}={v:g}" for a, v in line.at.items())
+    what = {"positioning": "linear optics",
+            "straightness": "straightness optics, displacement along {}",
+            "angular": "angular optics, rotation about {}"}[line.mode]
+    if line.sense is not None:
+        what = what.format("XYZ"[int(np.argmax(np.abs(line.sense)))])
+    text = f"laser line along {line.axis} at {at}, {what}, {k} targets both directions"
+    start = model.nominal_position({a: np.array([targets[0] if a == line.axis else line.at[a]])
+                                    for a in model.axes}, line.optics)[0]
+    geometry = {"start": np.round(start, 3), "axis": line.axis, "mode": line.mode}
+    return SetUp("interferometer", label, build, 2 * k * LINE_CYCLES, 2 * k * LINE_MIN_CYCLES,
+                 2 * k * LINE_MAX_CYCLES, geometry, text, line)
+
+
+MAKERS["interferometer"] = interferometer_setups
+
+
+# ---- artifact (ball plate) ------------------------------------------------------------------
+#: where a plate lies along its plane's normal (share of the working volume)
+PLATE_LEVELS = (0.15, 0.5, 0.85)
+#: plane -> (workpiece axis of the plate's u, of its v) at 0 deg; turned 90 deg: u along the
+#: second, v along minus the first (w = u x v, the plane's normal, either way)
+PLATE_PLANES = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}
+
+
+def plate_points(inst) -> np.ndarray:
+    """(N M, 3) calibrated ball centres of the plate in its own frame (mm): a grid of
+    ``balls`` at ``pitch``, origin at the first ball, w = 0."""
+    n, m = inst.balls
+    u, v = np.meshgrid(np.arange(n) * inst.pitch, np.arange(m) * inst.pitch, indexing="ij")
+    return np.column_stack([u.ravel(), v.ravel(), np.zeros(n * m)])
+
+
+def artifact_setups(model, inst) -> list:
+    """Ball-plate placements in the planes XY, YZ, ZX, turned 0 and 90 deg in the plane,
+    centred in the working volume in the plane, at :data:`PLATE_LEVELS` along the normal;
+    every ball's nominal position inside the travel, rotary axes at home."""
+    lo, hi = volume(model, inst.tool)
+    pts = plate_points(inst)
+    half = 0.5 * (pts.max(axis=0) - pts.min(axis=0))
+    out = []
+    for plane, (i, j) in PLATE_PLANES.items():
+        k = 3 - i - j
+        for turn, level in itertools.product((0, 90), PLATE_LEVELS):
+            R = np.zeros((3, 3))
+            a, b = (i, j) if turn == 0 else (j, i)
+            R[a, 0] = 1.0
+            R[b, 1] = 1.0 if turn == 0 else -1.0
+            R[:, 2] = np.cross(R[:, 0], R[:, 1])
+            centre = 0.5 * (lo + hi)
+            centre[k] = lo[k] + level * (hi[k] - lo[k])
+            origin = np.round(centre - R @ half, 1)
+            s = _plate(model, inst, pts, R, origin, (plane, turn, level), f"P{len(out) + 1}")
+            if s is not None:
+                out.append(s)
+    return out
+
+
+def _plate(model, inst, pts, R, origin, where, label) -> SetUp | None:
+    plane, turn, level = where
+    nominal = pts @ R.T + origin
+    n = len(pts)
+    rot = {a: np.full(n, v) for a, v in home(model).items()}
+    try:
+        pos = rounded(model.linear_positions(nominal, rot, np.asarray(inst.tool, float)))
+    except Exception:       # not reachable
+        return None
+    pos.update(rot)
+    if not inside(model, pos).all():
+        return None
+    lin = tuple(a for a in model.axes if a not in model.rotary_axes)
+
+    def build(m: int) -> dict:
+        cols = {"placement": np.full(n, label, dtype=object),
+                "ball": np.array([f"B{b + 1}" for b in range(n)], dtype=object),
+                "u_mm": pts[:, 0], "v_mm": pts[:, 1], "w_mm": pts[:, 2]}
+        for c, name in enumerate(("x", "y", "z")):
+            cols[f"{name}_mm"] = nominal[:, c]
+        for c, name in enumerate(("x", "y", "z")):
+            cols[f"{name}_nom_mm"] = nominal[:, c]
+        for c, name in enumerate(("Xp", "Yp", "Zp")):
+            cols[name] = np.full(n, float(inst.tool[c]))
+        cols.update({a: v for a, v in pos.items()})
+        return cols
+
+    text = (f"ball plate {inst.balls[0]} x {inst.balls[1]} at {inst.pitch:g} mm in {plane}, "
+            f"turned {turn} deg, first ball at ({origin[0]:g}, {origin[1]:g}, {origin[2]:g}) mm")
+    geometry = {"start": origin, "plane": plane, "turn": turn, "level": level}
+    return SetUp("artifact", label, build, n, n, n, geometry, text, hidden=lin)
+
+
+MAKERS["artifact"] = artifact_setups

@@ -16,15 +16,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..instruments import ballbar, distances, sphere
+from ..instruments import artifact, ballbar, distances, interferometer, sphere
 
 #: reading columns of each kind: present and empty in a plan file
 READINGS = {"ballbar": ("dr_um",), "sphere": ("dx_um", "dy_um", "dz_um"),
-            "distances": ("d_mm",)}
-READERS = {"ballbar": ballbar, "sphere": sphere, "distances": distances}
+            "distances": ("d_mm",), "interferometer": ("deviation_um", "deviation_urad"),
+            "artifact": ("x_mm", "y_mm", "z_mm")}
+READERS = {"ballbar": ballbar, "sphere": sphere, "distances": distances, "artifact": artifact}
 #: label columns (text) of each kind
 LABELS = {"ballbar": ("placement",), "sphere": ("placement", "frame"),
-          "distances": ("station",)}
+          "distances": ("station",), "interferometer": ("placement", "cycle"),
+          "artifact": ("placement", "ball")}
+#: columns a plan keeps for its NC program and set-up sheet but does not write into the file
+#: (an interferometer run gives its line in ``# axis:`` ... header lines)
+HIDDEN = {"interferometer": ("placement", "Xp", "Yp", "Zp")}
 
 
 @dataclass
@@ -49,6 +54,13 @@ def columns_of(inst, setups: list) -> dict:
     parts = [s.build(m) for s, m in setups]
     cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     n = len(next(iter(cols.values())))
+    if inst.kind == "interferometer":       # one line a file; u in the header lines
+        return cols
+    if inst.kind == "artifact":     # readings: the nominal points (the reader poses on them)
+        u = artifact.DEFAULT_U_UM if inst.u_um is None else inst.u_um
+        cols["probe_u_um"] = np.full(n, float(u))
+        cols["u_std_um"] = np.full(n, float(inst.cal_u_um))
+        return cols
     for k in READINGS[inst.kind]:
         if inst.kind != "distances":    # a station is located from its nominal distances
             cols[k] = np.zeros(n)
@@ -81,13 +93,15 @@ def group(instruments: list, chosen: list) -> list:
     files = []
     by_inst: dict = {}
     for i, s, m in chosen:
+        if s.kind == "interferometer":      # whole ISO 230-2 cycles
+            m = len(s.build(m)["target_mm"])
         by_inst.setdefault(i, []).append((s, m))
     many = {k: sum(1 for inst in instruments if inst.kind == k) > 1
             for k in READINGS}
     for i, sets in by_inst.items():
         kind = instruments[i].kind
         stem = f"{kind}{i + 1}" if many[kind] else kind
-        if kind == "ballbar":
+        if kind in ("ballbar", "interferometer"):
             for s, m in sets:
                 files.append(PlanFile(f"{stem}_{s.label}.csv", kind, i, [(s, m)]))
         else:
@@ -99,8 +113,13 @@ def group(instruments: list, chosen: list) -> list:
 
 def observations(model, pf: PlanFile):
     """The file's rows as ``calibrate`` reads them (readings zero)."""
+    if pf.kind == "interferometer":
+        c, line = pf.columns, pf.setups[0][0].line
+        return interferometer.observations(model, line, c["target_mm"], np.zeros(pf.n),
+                                           c["direction"], pf.name, cycle=c["cycle"])
+    hidden = hidden_columns(pf)
     numbers = {k: np.asarray(v, float) for k, v in pf.columns.items()
-               if k not in LABELS[pf.kind]}
+               if k not in LABELS[pf.kind] and k not in hidden}
     labels = {k: [str(x) for x in v] for k, v in pf.columns.items() if k in LABELS[pf.kind]}
     text = {k: None for k in labels}
     return READERS[pf.kind].columns_to_observations(numbers, text, labels, model, pf.name)
@@ -109,7 +128,7 @@ def observations(model, pf: PlanFile):
 def csv_text(pf: PlanFile, header: list) -> str:
     """The file as text: ``#`` comment lines ``header``, the columns, reading columns empty
     (6 decimals for mm / deg; positions carry 4)."""
-    names = list(pf.columns)
+    names = [k for k in pf.columns if k not in hidden_columns(pf)]
     empty = set(READINGS[pf.kind])
     lines = [f"# {h}" for h in header] + [",".join(names)]
     cols = [pf.columns[k] for k in names]
@@ -121,7 +140,7 @@ def csv_text(pf: PlanFile, header: list) -> str:
             elif k in LABELS[pf.kind]:
                 cells.append(str(c[i]))
             elif k == "direction":
-                cells.append(f"{c[i]:.0f}")
+                cells.append(f"{c[i]:+.0f}" if pf.kind == "interferometer" else f"{c[i]:.0f}")
             else:
                 cells.append(_number(float(c[i])))
         lines.append(",".join(cells))
@@ -132,3 +151,16 @@ def _number(v: float) -> str:
     """Shortest fixed-point text of ``v`` with at most 6 decimals, no negative zero."""
     text = f"{v:.6f}".rstrip("0").rstrip(".")
     return "0" if text in ("", "-0") else text
+
+
+def hidden_columns(pf: PlanFile) -> set:
+    """Columns a plan keeps for its NC program and set-up sheet but does not write: an
+    interferometer run's axis positions (its header lines give the line), an artifact's
+    linear-axis positions (its reader refuses axis columns: the nominal ball positions are
+    written as ``x_nom_mm, y_nom_mm, z_nom_mm``)."""
+    out = set(HIDDEN.get(pf.kind, ()))
+    for s, _ in pf.setups:
+        out |= set(s.hidden)
+        if s.line is not None:
+            out |= {s.line.axis, *s.line.at}
+    return out

@@ -4,7 +4,8 @@ rotary axes in deg, named as the layout names them).
 Contract (``volerr formats plan``): every row of the plan file is, in order, the end point of
 one motion block (``G0`` for the first, ``G1`` for the others; absolute ``G90``, metric
 ``G21``, feed per minute ``G94``); where the instrument reads at a stop (sphere / R-test,
-tracking interferometer) the block is followed by a dwell ``G4 P<s>`` (seconds, as LinuxCNC and
+tracking interferometer, laser interferometer, artifact) the block is followed by a dwell
+``G4 P<s>`` (seconds, as LinuxCNC and
 ISO 6983 controls read it; a Fanuc-type control reads ``G4 X<s>``).  A set-up change inside
 one file (the next sphere placement, the next station) is a program stop ``M0`` with a comment
 saying what to move; the program ends with ``M30``.
@@ -13,7 +14,9 @@ Sphere / R-test readings are approached safely: before each reading the tool goe
 clearance height (the top of the Z travel: +Z moves the tool away from the workpiece, ISO 841),
 turns the rotary axes there, comes down to a point ``RETRACT_MM`` back along the tool axis from
 the reading (rotary axes held, so the last move is straight along the tool axis into the nest or
-onto the sphere), moves to the reading at the feed, dwells, and leaves the same way.  A
+onto the sphere), moves to the reading at the feed, dwells, and leaves the same way.  A ball of
+an artifact (ball plate) is approached the same way: its row is the ball's nominal centre, the
+dwell stands for the control's ball-probing cycle there.  A
 straight ``G1`` from one reading to the next would turn the table under the tool and sweep the
 tool through the sphere or out of the R-test's nest.
 """
@@ -25,7 +28,8 @@ import numpy as np
 from . import _spec
 
 #: feed of the motion blocks, mm/min (ballbar circles: the ISO 230-4 test feed)
-FEED = {"ballbar": _spec.BALLBAR_FEED_MM_MIN, "sphere": 1000.0, "distances": 2000.0}
+FEED = {"ballbar": _spec.BALLBAR_FEED_MM_MIN, "sphere": 1000.0, "distances": 2000.0,
+        "interferometer": 2000.0, "artifact": 1000.0}
 #: distances tried, largest first, for the point back along the tool axis from a sphere reading
 #: (the first whose axis positions lie inside the travel), mm
 RETRACT_MM = (20.0, 10.0, 5.0, 2.0)
@@ -44,7 +48,7 @@ def program(model, pf, header: list) -> str:
     dwell = _spec.DWELL_S.get(pf.kind)
     texts = {s.label: s.text for s, _ in pf.setups}
     previous = None
-    retract = _retract_positions(model, pf) if pf.kind == "sphere" else None
+    retract = _retract_positions(model, pf) if pf.kind in ("sphere", "artifact") else None
     for i in range(pf.n):
         if labels[i] != previous:
             if previous is not None:

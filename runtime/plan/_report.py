@@ -9,12 +9,21 @@ from . import _spec
 def file_header(plan, pf) -> list:
     """``#`` comment lines of a plan file (what it is, how to fill it)."""
     inst = plan.instruments[pf.inst]
+    reading = [k for k in _files_readings(pf.kind) if k in pf.columns]
     lines = [f"volerr plan: layout {plan.model.name}, {inst.kind} ({inst.text})",
-             f"fill the reading columns ({', '.join(_files_readings(pf.kind))}) and give the "
+             f"fill the reading columns ({', '.join(reading)}) and give the "
              f"filled files to: volerr calibrate {plan.model.name} FILES"]
     for s, m in pf.setups:
         lines.append(f"set-up {s.label}: {s.text}; {m} readings")
-    if inst.u_um is not None or inst.kind != "distances":
+    if inst.kind == "interferometer":
+        lines += line_header(pf.setups[0][0].line)
+    elif inst.kind == "artifact":
+        lines += [f"probe_u_um: {float(pf.columns['probe_u_um'][0]):g} (column probe_u_um: "
+                  f"the standard uncertainty of one probed coordinate the plan assumes)",
+                  f"u_std_um: {inst.cal_u_um:g} (column u_std_um: the plate's calibration)",
+                  "x_nom_mm, y_nom_mm, z_nom_mm: where the plan puts each ball (machine "
+                  "coordinates); fill x_mm, y_mm, z_mm with the centres the machine measures"]
+    elif inst.u_um is not None or inst.kind != "distances":
         u = inst.u_um if inst.u_um is not None else float(pf.columns["u_um"][0])
         lines.append(f"u_um: {u:g} (column u_um: the standard uncertainty of one reading the "
                      f"plan assumes)")
@@ -25,6 +34,21 @@ def file_header(plan, pf) -> list:
     if plan.parameters_text:
         lines.append(f"parameters: {plan.parameters_text}")
     return lines
+
+
+def line_header(line) -> list:
+    """The ``# key: value`` lines of an interferometer run (``volerr formats
+    interferometer``): the line, its optics and the reading's standard uncertainty."""
+    out = [f"axis: {line.axis}", f"mode: {line.mode}",
+           "at: " + ", ".join(f"{a}={v:g}" for a, v in line.at.items()),
+           "optics: " + ", ".join(f"{v:g}" for v in line.optics)]
+    if line.sense is not None:
+        out.append("sense: " + ", ".join(f"{v:g}" for v in line.sense))
+    if line.mode == "angular":
+        out += [f"separation: {line.separation:g}", f"u_urad: {line.u:g}"]
+    else:
+        out.append(f"u_um: {line.u:g}")
+    return out
 
 
 def _files_readings(kind: str):
@@ -95,7 +119,7 @@ def data(plan) -> dict:
 def _geometry(g: dict) -> dict:
     out = {}
     for k, v in g.items():
-        out[f"{k}_mm" if k in ("pivot", "centre", "station") else
+        out[f"{k}_mm" if k in ("pivot", "centre", "station", "start") else
             ("length_mm" if k == "length" else k)] = (
             [round(float(x), 4) for x in v] if hasattr(v, "__len__") and not isinstance(v, str)
             else (round(float(v), 4) if not isinstance(v, str) else v))

@@ -157,7 +157,8 @@ def _floor(inst) -> int:
 
 
 def _cap(inst) -> int:
-    return {"sphere": inst.places, "distances": inst.stations}.get(inst.kind, 50)
+    return {"sphere": inst.places, "distances": inst.stations,
+            "artifact": inst.places}.get(inst.kind, 50)
 
 
 def _pool(prob, insts, pool) -> _design.Candidates:
@@ -195,11 +196,24 @@ def _prior(prob) -> np.ndarray:
     return P
 
 
+#: weight of a requested parameter the map does not see, relative to the mean of the others
+UNSEEN_WEIGHT = 1e-2
+
+
 def _scaled(prob):
     f = prob.free
     W = prob.W / np.outer(prob.scale, prob.scale)
     P0 = _prior(prob) / np.outer(prob.scale, prob.scale)
-    return W[np.ix_(f, f)], P0[np.ix_(f, f)]
+    W, P0 = W[np.ix_(f, f)], P0[np.ix_(f, f)]
+    # a requested parameter the map does not see at the plan's tool offset (an angular error
+    # of the axis carrying the tool, read by angular optics) still has to be determined: a
+    # small weight so that the greedy and the exchange value it
+    d = np.diag(W).copy()
+    unseen = d <= 1e-12 * max(float(d.max()), 1e-300)
+    unseen[:int(np.sum(f[:prob.n_global]))] = False
+    if unseen.any() and d.max() > 0:
+        W = W + np.diag(np.where(unseen, UNSEEN_WEIGHT * float(d[~unseen].mean()), 0.0))
+    return W, P0
 
 
 def _choose(cand, prob, insts, pool, readings, minutes, criterion, seed):

@@ -12,7 +12,7 @@ from .. import plotstyle
 from . import _candidates, _report
 
 VIEWS = (("X", "Y", 0, 1), ("X", "Z", 0, 2), ("Y", "Z", 1, 2))
-MARKERS = {"ballbar": "o", "sphere": "s", "distances": "^"}
+MARKERS = {"ballbar": "o", "sphere": "s", "distances": "^", "interferometer": "D", "artifact": "P"}
 
 
 @plotstyle.styled
@@ -32,7 +32,7 @@ def figure(plan) -> bytes:
             ax.plot(t[:, i], t[:, j], ".", ms=2, color=colour, alpha=0.5)
             for s, _ in pf.setups:
                 g = s.geometry
-                p = g.get("pivot", g.get("centre", g.get("station")))
+                p = g.get("pivot", g.get("centre", g.get("station", g.get("start"))))
                 ax.plot(p[i], p[j], MARKERS[s.kind], color=colour, ms=7, mec="k")
                 ax.annotate(s.label, (p[i], p[j]), textcoords="offset points", xytext=(4, 4),
                             fontsize=9)
@@ -40,7 +40,8 @@ def figure(plan) -> bytes:
         ax.set_ylabel(plotstyle.label(b, "mm"))
         ax.set_aspect("equal", adjustable="datalim")
     fig.suptitle(f"{model.name}: where each set-up goes (workpiece frame)\n"
-                 f"o pivot, square sphere, triangle station; dots: the tool point at each "
+                 f"o pivot, square sphere, triangle station, diamond laser line start, pentagon "
+                 f"ball plate's first ball; dots: the tool point at each "
                  f"reading; dashed: the working volume")
     return plotstyle.png(fig)
 

@@ -19,20 +19,29 @@ from dataclasses import dataclass, field
 from ..errors import require
 
 #: set-up change, minutes per set-up
-SETUP_MIN = {"ballbar": 5.0, "sphere": 10.0, "distances": 15.0}
+SETUP_MIN = {"ballbar": 5.0, "sphere": 10.0, "distances": 15.0, "interferometer": 20.0,
+             "artifact": 20.0}
 #: time per reading, seconds (0 for the ballbar: it samples during the motion)
-READING_S = {"ballbar": 0.0, "sphere": 12.0, "distances": 5.0}
+READING_S = {"ballbar": 0.0, "sphere": 12.0, "distances": 5.0, "interferometer": 6.0,
+             "artifact": 30.0}
+#: (interferometer: the move to the next target at 2000 mm/min and the dwell; a set-up change
+#: is mounting and aligning the optics on a new line)
+#: (artifact: move and clamp the plate, align it; a ball probed by a five-point cycle)
 #: (sphere: up to the clearance height and back down, 2 x 20 mm along the tool axis at
 #: 1000 mm/min, the dwell: runtime/plan/_nc.py)
 #: feed of a ballbar circle (mm/min), ISO 230-4 tests at the machine's contouring feed
 BALLBAR_FEED_MM_MIN = 1000.0
 #: dwell at a reading (s) written into the NC program for instruments that read at a stop
-DWELL_S = {"sphere": 2.0, "distances": 2.0}
+DWELL_S = {"sphere": 2.0, "distances": 2.0, "interferometer": 3.0, "artifact": 2.0}
 #: keys every kind takes
 COMMON = ("u_um", "tool")
 KEYS = {"ballbar": COMMON + ("lengths", "length_u_um"),
         "sphere": COMMON + ("places", "tool_u_um", "frame"),
-        "distances": COMMON + ("stations",)}
+        "distances": COMMON + ("stations",),
+        "interferometer": COMMON + ("optics", "u_urad"),
+        "artifact": COMMON + ("balls", "pitch", "cal_u_um", "places")}
+#: optics of an interferometer plan (``optics=``), default all
+OPTICS = ("linear", "straightness", "angular")
 
 
 @dataclass
@@ -48,6 +57,11 @@ class Instrument:
     tool_u_um: float | None = None
     frame: str = "work"
     stations: int = 4
+    optics: tuple = OPTICS
+    u_urad: float | None = None
+    balls: tuple = (5, 5)
+    pitch: float = 100.0
+    cal_u_um: float = 0.5
     text: str = ""
     given: set = field(default_factory=set)
 
@@ -56,8 +70,7 @@ def parse(text: str) -> Instrument:
     """``KIND[:key=value[,value...]]...`` -> :class:`Instrument` (InputError, one line)."""
     parts = [p.strip() for p in str(text).split(":")]
     kind = parts[0].lower()
-    require(kind in KEYS, f"--instrument {text!r}: kind must be one of {', '.join(KEYS)} "
-                          f"(interferometer and artifact plans are not written yet)")
+    require(kind in KEYS, f"--instrument {text!r}: kind must be one of {', '.join(KEYS)}")
     inst = Instrument(kind, text=str(text))
     for part in parts[1:]:
         key, eq, value = part.partition("=")
@@ -89,6 +102,19 @@ def _set(inst: Instrument, key: str, value: str, text: str) -> None:
         require(value in ("work", "machine"), f"--instrument {text!r}: frame must be work "
                                               f"or machine")
         inst.frame = value
+        return
+    if key == "balls":
+        n = value.lower().split("x")
+        ok = len(n) == 2 and all(v.strip().isdigit() for v in n)
+        require(ok and all(2 <= int(v) <= 20 for v in n), f"--instrument {text!r}: balls=NxM, "
+                                                         f"2..20 balls a side (a ball plate)")
+        inst.balls = (int(n[0]), int(n[1]))
+        return
+    if key == "optics":
+        words = [w.strip().lower() for w in value.split(",")]
+        require(all(w in OPTICS for w in words), f"--instrument {text!r}: optics are "
+                                                 f"{', '.join(OPTICS)}")
+        inst.optics = tuple(dict.fromkeys(words))
         return
     vals = _numbers(value, key, text)
     if key == "lengths":
