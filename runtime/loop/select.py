@@ -470,6 +470,7 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             break
         hit = None
         from .lags import prefer_plain
+        scored = _lag_leaders_refined(scored, A_all, ctx, train, w_rows, y)
         prefer_plain(scored, TOP_FIT)
         for x in scored[:TOP_FIT]:
             if x.dbic > -BIC_GAIN:
@@ -514,6 +515,35 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             last = screen(candidates, ctx, base, names)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
+
+
+def _lag_leaders_refined(scored: list, A_all, ctx, train, w_rows, y) -> list:
+    """The leaders (``2 TOP_FIT``) with the time constant of every lag candidate among them
+    that explains at least ``lags.NEAR`` of the best one's RSS reduction refined on all
+    training points, scored there and sorted again.  Screening fixes a time constant on a
+    subset and a 5 % grid: correlated sensors (two motors on one duty cycle) are then
+    compared at taus a few per cent off by different amounts, and the wrong one can lead
+    (MB1, 10^5 points: T_motorY ahead of the planted T_motorX at 4 % off its tau)."""
+    from .lags import NEAR, profile_tau
+
+    head = scored[:2 * TOP_FIT]
+    g0 = max((x.gain for x in head), default=0.0)
+    near = [x for x in head if x.cand.search is not None and x.cand.search.what == "lag_s"
+            and x.gain >= NEAR * g0]
+    if not near:
+        return scored
+    base = _full_base(A_all, train, w_rows, y)
+    cs = []
+    for x in head:
+        c = x.cand
+        if any(x is n for n in near):
+            tau, std = profile_tau(c, ctx, base, float(c.info["lag_s"]))
+            c = c.fixed(tau)
+            c.info["lag_std_s"] = None if std is None else round(std, 1)
+        cs.append(c)
+    head = [x for x in _scored_many(cs, ctx, base) if x.rank]
+    head.sort(key=lambda x: x.dbic)
+    return head + scored[2 * TOP_FIT:]
 
 
 def _lag_refined(x: Scored, A_all, ctx, train, w_rows, y) -> Scored:
