@@ -125,12 +125,28 @@ class Calibration:
                 std[p] = function_std(self, P, js)
             if vals:
                 tables[a] = ErrorTable(a, q, vals, std=std)
+        self._write_reversals(tables, index, coef, n_grid)
         for p in model.parameters:
             j = index.get((p, None))
             if j is not None:
                 constants[p] = float(coef[j])
                 cstd[p] = float(std_all[j])
         return tables, constants, cstd
+
+    def _write_reversals(self, tables: dict, index: dict, coef, n_grid: int) -> None:
+        """Each determined reversal ``RV_<axis>`` into its axis' table as the ISO 230-2
+        reversal column (constant over the measured range, mm; the table's errors are the
+        bidirectional mean, as the ``dir_<axis>/2`` term of the fit makes them), so that
+        ``compensate`` and ``map --approach`` apply it; an undetermined one is not written."""
+        from ..tables.table import ErrorTable
+
+        for a in self.model.axes:
+            j = index.get((f"RV_{a}", "extra"))
+            if j is None or not self.written[j]:
+                continue
+            if a not in tables:
+                tables[a] = ErrorTable(a, np.linspace(*self.ranges[a], n_grid), {})
+            tables[a].reversal = np.full(len(tables[a].positions), float(coef[j]))
 
     def write_error_tables(self, directory, inputs=()) -> Path:
         from ..tables.table import write_error_dir
@@ -147,7 +163,7 @@ class Calibration:
         for c in self.data.get("combinations", []):
             name = c["written_as"].split("@")[0]
             if name not in self.model.parameters:
-                continue            # a reversal RV_<axis>: not in the error tables
+                continue            # a reversal RV_<axis>: a column of its axis' table
             axis = self.model.parameter_axis.get(name)
             where = "constants" if axis is None else axis
             out.setdefault(where, []).append(

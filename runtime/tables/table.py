@@ -33,7 +33,7 @@ File formats (INTERFACE.md)
   value B_i at each position = mean positional deviation approaching in the positive direction
   minus approaching in the negative direction (the sign of the loop's ``RV_<axis>`` effect):
   forward EXX + RV/2, backward EXX - RV/2 when EXX is the bidirectional mean.  Read into
-  :attr:`ErrorTable.reversal` (``volerr iso230-2`` writes it); the error functions apply it by
+  :attr:`ErrorTable.reversal` (``volerr iso230-2`` and ``volerr calibrate`` write it); the error functions apply it by
   approach direction (:meth:`volerr.tables.functions.ErrorFunctions.reversal`: ``compensate``
   block by block, ``map`` / ``tcpmap --approach``).
 * blank lines and lines starting with ``#`` are ignored; every other cell must be a finite number.

@@ -208,3 +208,23 @@ def test_same_file_twice_refused(mb1, tmp_path, capsys):
     _refused(_main(capsys, "ballbar", "evaluate", f, copy), "twice")
     _refused(_main(capsys, "calibrate", "MB1", f, copy), "twice")
     _refused(_main(capsys, "loop", "MB1", copy, f), "twice")
+
+
+def test_determined_reversal_written_into_its_table(circles):
+    """The reversal RV_X calibrate determines goes into X.csv's ISO 230-2 column RV_X_um (read
+    back by the table reader, so compensate and map --approach apply it), equal to the JSON's
+    value and, within its uncertainty, to the simulator's planted B."""
+    from volerr.tables.table import read_error_dir
+
+    d = circles["folder"] / "errors_rv"
+    out = circles["folder"] / "rv.json"
+    r = _cli("calibrate", circles["layout"], *circles["files"], "--json", out,
+             "--errors-out", d)
+    assert r.returncode == 0, r.stderr[-2000:]
+    rv = json.loads(out.read_text())["parameters"]["RV_X"]
+    tables = read_error_dir(d)
+    tables = tables[0] if isinstance(tables, tuple) else tables
+    written = tables["X"].reversal
+    assert written is not None
+    assert np.allclose(written * 1e3, rv["value"], rtol=0, atol=1e-6)       # um
+    assert abs(written[0] * 1e3 - TRUTH["EXX@reversal"]) <= K * rv["std"] + 0.1
