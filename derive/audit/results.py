@@ -24,20 +24,16 @@ k decimals (or k significant digits, as numpy prints) stands for its rounding in
 from __future__ import annotations
 
 import math
-from decimal import Decimal
 
 import numpy as np
 
 from .framework import Verdict
+from .numbers import interval
 
 DATA_FILE = "printed_results.toml"
 LAYOUT = "-"
 
 
-def interval(text: str) -> tuple[float, float]:
-    d = Decimal(text)
-    half = Decimal(5) * Decimal(10) ** (d.as_tuple().exponent - 1)
-    return float(d - half), float(d + half)
 
 
 def _v(source, eq, comp, category, erratum, evidence, printed, derived, tried=(), used=(),
