@@ -53,7 +53,7 @@ def program(model, pf, header: list) -> str:
         if labels[i] != previous:
             if previous is not None:
                 if retract is not None:
-                    lines.append(f"G0 Z{_word('', model.travel['Z'][1])}")
+                    lines.append(_to_clearance(model))
                 lines.append(f"M0 (set-up change: {_comment(texts.get(labels[i], labels[i]))})")
             else:
                 lines.append(f"(set-up {labels[i]}: {_comment(texts.get(labels[i], ''))})")
@@ -69,7 +69,7 @@ def program(model, pf, header: list) -> str:
         motion = "G1"
         previous = labels[i]
     if retract is not None:
-        lines.append(f"G0 Z{_word('', model.travel['Z'][1])}")
+        lines.append(_to_clearance(model))
     lines += ["M30", "%"]
     return "\n".join(lines) + "\n"
 
@@ -78,15 +78,20 @@ def _words(model, values) -> str:
     return " ".join(_word(a, v) for a, v in zip(model.axes, values))
 
 
+def _to_clearance(model) -> str:
+    """The block up to the clearance height: the top of the Z travel (+Z moves the tool away
+    from the workpiece, ISO 841)."""
+    return f"G0 Z{_word('', model.travel['Z'][1])}"
+
+
 def _approach(model, above, target, dwell) -> list:
     """The blocks of one sphere reading: up to the clearance height, across with the rotary
     axes turned there, down to ``above`` (the point back along the tool axis), along the tool
     axis to ``target`` at the feed, dwell, and back to ``above``."""
     z = model.axes.index("Z")
-    clear = model.travel["Z"][1]
     across = [v for j, v in enumerate(above) if j != z]
     feed = FEED["sphere"]
-    return [f"G0 Z{_word('', clear)}",
+    return [_to_clearance(model),
             "G0 " + " ".join(_word(a, v) for a, v in zip(
                 [a for a in model.axes if a != "Z"], across)),
             f"G0 Z{_word('', above[z])}",
