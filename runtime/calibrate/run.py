@@ -331,8 +331,41 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     cal = Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out,
                       parts)
     _lab_report(cal, fit, obs, u_ref)
+    report["covariance"] = covariance_block(cal)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     return cal
+
+
+def covariance_block(cal) -> dict | None:
+    """``{"parameters", "units", "values", "matrix", "degree", "ranges", "note"}``: the written
+    model parameters (determined ones and the carriers of determined combinations, not the
+    set-up unknowns nor extra terms), their values and covariance (scaled by the a-posteriori
+    variance factor) in the units the report gives them (um, urad, um/mm ...), and the degree
+    and measured ranges (mm, deg) their series terms refer to -- what ``volerr check`` and
+    ``volerr history`` need of a reference calibration; None without a solution."""
+    sol = cal.solution
+    if sol is None:
+        return None
+    name_of = terms.namer(cal.model, cal.ranges)
+    where = {int(j): i for i, j in enumerate(sol.kept)}
+    cols, names, units, factors, values = [], [], [], [], []
+    for j, lab in enumerate(cal.labels):
+        if lab[0] == "setup" or lab[1] == "extra" or not cal.written[j] or j not in where:
+            continue
+        rep = terms.report(lab, 1.0, 0.0, cal.model, cal.ranges)
+        cols.append(where[j])
+        names.append(name_of(lab))
+        units.append(rep["unit"])
+        factors.append(rep["value"])
+        values.append(float(cal.coef[j]) * rep["value"])
+    f = np.array(factors, float)
+    C = sol.cov[np.ix_(cols, cols)] * np.outer(f, f) if cols else np.zeros((0, 0))
+    return {"parameters": names, "units": units, "values": values,
+            "matrix": [[float(v) for v in row] for row in C], "degree": int(cal.degree),
+            "ranges": {a: [float(lo), float(hi)] for a, (lo, hi) in cal.ranges.items()},
+            "note": "covariance of the written parameters in their report units (the "
+                    "a-posteriori variance factor applied); series terms refer to the degree "
+                    "and measured ranges given (mm, deg)"}
 
 
 def _degree(model, obs, spl, ranges, req, degree, max_degree, w) -> tuple[int, dict]:

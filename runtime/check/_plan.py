@@ -1,0 +1,2 @@
+class CheckPlan: pass
+def plan_check(): pass

@@ -1,0 +1,161 @@
+"""The result of a check (:class:`CheckResult`): what changed, the verdict, the volumetric
+change, the values and covariance after the check (the same ``covariance`` block as
+calibrate's, so that a check can be the reference of the next and ``volerr history add``
+stores it); ``to_dict()`` is the JSON of ``volerr check --json`` (``volerr formats check``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _volume
+
+METHOD = ("the readings against the reference's prediction by generalised least squares, the "
+          "reference's covariance as a measurement of its parameters; the smallest set of "
+          "changed parameters by forward selection (BIC gain > 10 and the chi-square "
+          "quantile of 1 - 0.05/p, and a cross-validated improvement with paired t > 3), "
+          "then a backward pass; uncertainties of a change hold the reference's covariance "
+          "and the check's readings")
+
+
+@dataclass
+class CheckResult:
+    """Result of :func:`volerr.check.check` (module docstring)."""
+
+    model: object
+    reference: object
+    selection: object
+    system: object
+    indistinguishable: list
+    not_seen: list
+    J: np.ndarray
+    tool: np.ndarray
+    files: list
+    date: str | None = None
+    misfit: dict = field(default_factory=dict)
+    tolerance: dict | None = None
+
+    @property
+    def verdict(self) -> str:
+        return "changed" if self.selection.changed or self.misfit.get("unexplained") \
+            else "unchanged"
+
+    def changes(self) -> list:
+        """``[{"parameter", "change", "unit", "std", ...}]`` in the order of entry."""
+        ref, sel = self.reference, self.selection
+        delta, std = sel.fit.change()
+        after, cov = self.after()
+        out = []
+        for k, j in enumerate(sel.changed):
+            name = ref.names[j]
+            alias = sorted({b for a, b in self.indistinguishable if a == name}
+                           | {a for a, b in self.indistinguishable if b == name})
+            entry = {"parameter": name, "change": float(delta[k]), "unit": ref.units[j],
+                     "std": float(std[k]), "reference": float(ref.values[j]),
+                     "value": float(after[j]), "z": float(delta[k] / std[k]) if std[k] else None}
+            if alias:
+                entry["indistinguishable_from"] = alias
+            out.append(entry)
+        return out
+
+    def after(self) -> tuple[np.ndarray, np.ndarray]:
+        """(values, covariance) of the reference's parameters after the check, report units."""
+        d, C = self.selection.fit.delta()
+        return self.reference.values + d, 0.5 * (C + C.T)
+
+    def volumetric_change(self) -> dict:
+        delta, _ = self.selection.fit.change()
+        full = np.zeros(len(self.reference.names))
+        full[self.selection.changed] = delta
+        return _volume.change_um(self.J, full)
+
+    def to_dict(self) -> dict:
+        ref = self.reference
+        values, cov = self.after()
+        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        changed = {ref.names[j] for j in self.selection.changed}
+        out = {"verdict": self.verdict, "changed": self.changes(),
+               "unchanged": [n for n in ref.names if n not in changed],
+               "volumetric_change_um": self.volumetric_change()}
+        if self.date:
+            out["date"] = self.date
+        out.update({
+            "layout": self.model.name, "kind": "check",
+            "reference": {"file": str(ref.path), "sha256": _sha(ref.path),
+                          "date": ref.data.get("date")},
+            "files": self.files,
+            "indistinguishable": self.indistinguishable, "not_seen": self.not_seen,
+            "misfit": self.misfit, "threshold_chi2": round(self.selection.threshold, 4),
+            "selection": [{"parameter": ref.names[s["parameter"]],
+                           "dchi2": round(s["dchi2"], 4),
+                           "cv_t": None if s["cv_t"] != s["cv_t"] else round(s["cv_t"], 3),
+                           "accepted": s["accepted"]} for s in self.selection.steps],
+            "parameters": {n: {"value": float(v), "unit": u, "std": float(s)}
+                           for n, u, v, s in zip(ref.names, ref.units, values, std)},
+            "covariance": {"parameters": list(ref.names), "units": list(ref.units),
+                           "values": [float(v) for v in values],
+                           "matrix": [[float(x) for x in row] for row in cov],
+                           "degree": ref.degree,
+                           "ranges": {a: [lo, hi] for a, (lo, hi) in ref.ranges.items()},
+                           "note": "values and covariance after the check (the reference "
+                                   "updated by the check's readings), report units"},
+            "volume": {"tool_mm": [float(v) for v in self.tool],
+                       "note": "every linear axis in 5 steps over its travel, every rotary "
+                               "axis in 5 steps (at most one turn); length of the change of "
+                               "the volumetric error, um"},
+            "method": METHOD})
+        if self.tolerance is not None:
+            out["tolerance"] = self.tolerance
+        return out
+
+    def summary(self) -> str:
+        d = self.to_dict()
+        v = d["volumetric_change_um"]
+        lines = [f"{d['layout']}: {d['verdict']} against {_file_name(self.reference.path)} "
+                 f"({sum(f['n_readings'] for f in self.files)} readings); volumetric change "
+                 f"max {v['max']:.3g} um, RMS {v['rms']:.3g} um"]
+        for c in d["changed"]:
+            also = (f" (indistinguishable by this check from "
+                    f"{', '.join(c['indistinguishable_from'])})"
+                    if c.get("indistinguishable_from") else "")
+            lines.append(f"  {c['parameter']} changed by {c['change']:+.4g} +- {c['std']:.2g} "
+                         f"{c['unit']}{also}")
+        if self.misfit.get("unexplained"):
+            lines.append(f"  the readings hold a change none of the reference's parameters "
+                         f"explains (Birge ratio {self.misfit['birge_ratio']:.3g})")
+        if self.indistinguishable:
+            lines.append("  this check cannot tell apart: " + "; ".join(
+                f"{a} and {b}" for a, b in self.indistinguishable))
+        if self.tolerance is not None:
+            lines.append(f"  tolerance: {self.tolerance['verdict']}")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return f"<CheckResult {self.model.name}: {self.verdict}, " \
+               f"{len(self.selection.changed)} changed>"
+
+    def write_json(self, path, inputs=()):
+        from ..fileio import json_text, write_text
+
+        return write_text(path, json_text(self.to_dict()), inputs=list(inputs))
+
+    def write_html(self, path, inputs=()):
+        from ..fileio import write_text
+        from ._html import check_html
+
+        return write_text(path, check_html(self.to_dict()), inputs=list(inputs))
+
+
+def _file_name(path) -> str:
+    from pathlib import Path
+
+    return Path(str(path)).name
+
+
+def _sha(path) -> str | None:
+    import hashlib
+    from pathlib import Path
+
+    p = Path(str(path))
+    return hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else None

@@ -1,0 +1,97 @@
+"""``volerr check``: the steps from a check's files to the verdict.
+
+1. the reference (:mod:`volerr.check._reference`) and the check's files, read as calibrate
+   reads them (:func:`volerr.instruments.read_parts`), the layout the same;
+2. the system of the readings against the reference's prediction, the reference's covariance
+   as a measurement (:mod:`volerr.check._system`);
+3. the smallest set of parameters that explains the readings (:mod:`volerr.check._select`),
+   the parameters this check cannot tell apart;
+4. the residual test: ``chi2`` of the final fit against its degrees of freedom (scaled by the
+   reference's variance factor when that exceeds 1); a misfit at ``P_UNEXPLAINED`` is a
+   change no parameter of the reference explains;
+5. the volumetric change over the working volume (:func:`volerr.check._volume.grid_columns`),
+   the values and covariance after the check, the tolerance decisions
+   (:mod:`volerr.check._tolerance`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import instruments
+from ..errors import require
+from ..machine.model import Model, load
+from . import _reference, _select, _system, _volume
+from ._result import CheckResult
+
+#: p-value of the residual chi2 below which the readings hold a change nothing explains
+P_UNEXPLAINED = 1e-3
+
+
+def check(layout, reference, files, *, tolerance: str | None = None, date: str | None = None
+          ) -> CheckResult:
+    """Compare the check's ``files`` (paths or ``KIND:FILE``) with the ``reference`` (path of
+    a calibrate or check JSON) on ``layout`` (module docstring); ``tolerance``:
+    ``"NAME=VALUE [UNIT],...,map=VALUE"`` (:mod:`volerr.check._tolerance`); ``date``
+    (``YYYY-MM-DD``) is carried into the result."""
+    from threadpoolctl import threadpool_limits
+
+    model = layout if isinstance(layout, Model) else load(layout)
+    ref = _reference.load(reference, model)
+    require(files, "give the check's files")
+    tol = None
+    if tolerance is not None:
+        from ._tolerance import parse
+
+        tol = parse(tolerance, ref)
+    with threadpool_limits(limits=1, user_api="blas"):
+        parts = instruments.read_parts(list(files), model)
+        obs = instruments.stack(parts)
+        system = _system.build(model, ref, obs)
+        sel = _select.select(system)
+        pairs, unseen = _select.indistinguishable(system, ref.names)
+        tool = np.median(obs.probe, axis=0)
+        J = _volume.grid_columns(model, ref, tool)
+    res = CheckResult(model, ref, sel, system, pairs, unseen, J, tool,
+                      [_file_entry(s, p) for s, p in zip(files, parts)], date)
+    res.misfit = _misfit(system, sel, ref)
+    if tol is not None:
+        from ._tolerance import decide
+
+        res.tolerance = decide(tol, res)
+    return res
+
+
+def _misfit(system, sel, ref) -> dict:
+    """The residual test of step 4: ``{"chi2", "dof", "birge_ratio", "p", "unexplained"}``."""
+    from scipy.stats import chi2
+
+    G, _ = system.normal()
+    ns = system.ns
+    S = G[:ns, :ns]
+    rank = 0
+    if ns:
+        d = np.sqrt(np.maximum(np.diag(S), 0.0))
+        d[d == 0] = 1.0
+        w = np.linalg.eigvalsh(S / np.outer(d, d))
+        rank = int(np.sum(w > _system.SOLVE_TOL * max(float(w[-1]), 1e-300)))
+    dof = max(system.n_readings - rank - len(sel.changed), 1)
+    vf = float(ref.data.get("variance_factor") or 1.0)
+    scale = max(vf, 1.0)
+    x = sel.fit.chi2
+    p = float(chi2.sf(x / scale, dof))
+    return {"chi2": round(x, 4), "dof": dof, "birge_ratio": round(math.sqrt(x / dof), 4),
+            "reference_variance_factor": vf, "p": p, "unexplained": bool(p < P_UNEXPLAINED)}
+
+
+def _file_entry(spec, part) -> dict:
+    """``{"file", "kind", "sha256", "n_readings"}`` of one check file."""
+    path = Path(instruments.split_spec(str(spec))[1])
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    kind = part.files[0].kind if part.files else "deviations"
+    return {"file": path.name, "kind": kind, "sha256": digest,
+            "n_readings": int(part.n_readings)}

@@ -1,0 +1,142 @@
+"""Which parameters changed: the smallest set that explains the check's readings, by the
+loop's rule (:mod:`volerr.loop.select`): forward selection, a parameter accepted when it
+lowers the BIC by more than ``BIC_GAIN`` and the cross-validated residual significantly
+(paired t > ``CV_T`` on the held-out points' squared residuals); then a backward pass that
+drops a parameter no longer earning its place given the others.
+
+1. ``chi2(S)`` of the generalised least-squares fit of :mod:`volerr.check._system` with the
+   set ``S`` free to change; the BIC of ``S`` is ``chi2(S) + |S| ln n`` (``n`` readings), so
+   a parameter enters when it lowers ``chi2`` by more than :func:`threshold`;
+2. the threshold is at least the chi-square (1 dof) quantile of ``1 - ALPHA / p`` (Bonferroni
+   over the ``p`` candidates), so that a machine that did not change is called "changed"
+   with a probability below ``ALPHA`` whatever ``n``;
+3. cross-validation: ``FOLDS`` folds of the points (point ``i`` in fold ``i mod FOLDS``;
+   every set-up keeps points in the training part), the held-out points' squared weighted
+   residual with and without the candidate;
+4. ties (candidates whose ``chi2`` reductions agree to ``TIE`` relative) are broken by the
+   reference's order; two parameters whose columns in this check correlate by more than
+   ``INDISTINCT`` (set-ups eliminated) cannot be told apart by it and are named.
+
+References: Schwarz (1978) for the BIC; the blocked cross-validation of the loop
+(:mod:`volerr.loop.select`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..loop.fitting import CV_T
+from ..loop.select import BIC_GAIN
+
+#: false-alarm probability the threshold holds at least (a clean machine called "changed")
+ALPHA = 0.05
+#: folds of the cross-validation
+FOLDS = 5
+#: relative agreement of two chi2 reductions that counts as a tie
+TIE = 1e-9
+#: correlation of two parameters' columns above which this check cannot tell them apart
+INDISTINCT = 0.98
+#: most parameters a check names as changed
+MAX_CHANGED = 8
+
+
+def threshold(n_readings: int, p: int) -> float:
+    """chi2 reduction a parameter must bring to enter (module docstring, steps 1-2)."""
+    from scipy.stats import chi2
+
+    bic = math.log(max(n_readings, 2)) + BIC_GAIN
+    return max(bic, float(chi2.isf(ALPHA / max(p, 1), 1)))
+
+
+@dataclass
+class Selection:
+    """``changed`` indices (order of entry), the final :class:`volerr.check._system.Fit`,
+    ``steps`` [{"parameter" index, "dchi2", "cv_t", "accepted"}], ``threshold``."""
+
+    changed: list
+    fit: object
+    threshold: float
+    steps: list = field(default_factory=list)
+
+
+def select(system, candidates=None) -> Selection:
+    """Forward selection over ``candidates`` (indices; default every parameter the check
+    sees), then the backward pass (module docstring)."""
+    cands = list(range(system.p)) if candidates is None else list(candidates)
+    c = threshold(system.n_readings, max(len(cands), 1))
+    folds = system.point % FOLDS
+    S, fit, steps = [], system.solve([]), []
+    while len(S) < MAX_CHANGED:
+        trial = [(j, system.solve(S + [j])) for j in cands if j not in S]
+        if not trial:
+            break
+        best = min(f.chi2 for _, f in trial)
+        j, f = next((j, f) for j, f in trial if f.chi2 <= best + TIE * max(fit.chi2, 1.0))
+        gain = fit.chi2 - f.chi2
+        t = cv_t(system, folds, S, S + [j]) if gain > c else float("nan")
+        ok = gain > c and t > CV_T
+        steps.append({"parameter": j, "dchi2": gain, "cv_t": t, "accepted": bool(ok)})
+        if not ok:
+            break
+        S, fit = S + [j], f
+    S, fit = _backward(system, S, fit, c)
+    return Selection(S, fit, c, steps)
+
+
+def _backward(system, S, fit, c):
+    """Drop, one at a time, the parameter whose removal raises ``chi2`` least while that
+    rise stays below the threshold."""
+    while S:
+        trial = [(j, system.solve([k for k in S if k != j])) for j in S]
+        j, f = min(trial, key=lambda t: t[1].chi2)
+        if f.chi2 - fit.chi2 > c:
+            break
+        S, fit = [k for k in S if k != j], f
+    return S, fit
+
+
+def cv_t(system, folds, without, with_) -> float:
+    """Paired t of the held-out points' squared residuals without minus with the candidate
+    (positive: the candidate predicts held-out points better)."""
+    d = []
+    for k in range(FOLDS):
+        test = folds == k
+        if not test.any() or test.all():
+            continue
+        train = ~test
+        e0 = _heldout(system, system.solve(without, train), test)
+        e1 = _heldout(system, system.solve(with_, train), test)
+        d.append(e0 - e1)
+    d = np.concatenate(d) if d else np.zeros(0)
+    if len(d) < 2:
+        return float("inf")
+    sd = float(np.std(d, ddof=1))
+    return float("inf") if sd == 0 else float(np.mean(d) / (sd / math.sqrt(len(d))))
+
+
+def _heldout(system, fit, test) -> np.ndarray:
+    """Per held-out point: the squared weighted residual (rows of a point summed)."""
+    pred = system.A[test] @ fit.z[:system.ns + system.p]
+    e = (system.r[test] - pred) ** 2
+    pts = system.point[test]
+    uniq, inv = np.unique(pts, return_inverse=True)
+    return np.bincount(inv, weights=e, minlength=len(uniq))
+
+
+def indistinguishable(system, names) -> tuple[list, list]:
+    """(pairs [[a, b]] of parameters this check cannot tell apart, names it does not see):
+    correlation of the columns above ``INDISTINCT`` with the set-ups eliminated; not seen:
+    the check's information on a parameter below 1e-6 of the reference's."""
+    G = system.data_information()
+    ref_info = np.diag(system.Sinv)
+    d = np.diag(G)
+    seen = d > 1e-6 * np.maximum(ref_info, 1e-300)
+    pairs = []
+    for i in range(len(names)):
+        for j in range(i + 1, len(names)):
+            if seen[i] and seen[j] and abs(G[i, j]) > INDISTINCT * math.sqrt(d[i] * d[j]):
+                pairs.append([names[i], names[j]])
+    return pairs, [n for n, s in zip(names, seen) if not s]
