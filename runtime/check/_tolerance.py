@@ -34,8 +34,8 @@ def parse(text: str, ref) -> dict:
                                               f"parameter of the reference "
                                               f"({', '.join(ref.names[:8])} ...)")
         unit = "um" if key == "map" else units[key]
-        require(len(words) == 1 or words[1] == unit,
-                f"--tolerance: {name} is in {unit}, not {words[1]}")
+        given = words[1] if len(words) == 2 else unit
+        require(given == unit, f"--tolerance: {name} is in {unit}, not {given}")
         try:
             v = float(words[0])
         except ValueError:
