@@ -1,0 +1,147 @@
+"""``volerr check plan`` and ``volerr check`` on the DMU50 with a sphere / R-test.
+
+The machine is the EXACT chain of tests/helpers/instrument_sim.py (through
+tests/helpers/plan_fill.py: never volerr's model, instruments or plan code): the reference
+campaign is a ``volerr plan`` of 80 readings filled with planted location errors and noise of
+the declared u, calibrated by ``volerr calibrate``; the checks are ``volerr check plan``'s
+files filled the same way, with the machine unchanged or with one location error jumped.
+
+* the plan fits 20 minutes and claims 95 % power for a 5 um change of the volumetric error;
+  its power formula agrees with scipy's noncentral chi-square;
+* a planted jump is named alone, with its size within 3 std, on several noise draws;
+* an unchanged machine is "unchanged" on every one of 8 noise draws (the threshold holds the
+  false-alarm rate below 5 %, so 8 clean draws show no false alarm at this seed);
+* bad input: one line, exit 2, nothing written.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from helpers import plan_fill
+from volerr.cli import main
+
+LAYOUT = "DMU50"
+PLANTED = {"EX0B": 12.0, "EY0B": -8.0, "EA0B": 35.0, "EB0B": -20.0, "EX0C": 15.0,
+           "EY0C": -10.0, "EA0C": 25.0, "EB0C": -40.0}
+SPHERE = "sphere:u_um=0.5"
+
+
+@pytest.fixture(scope="module")
+def world(tmp_path_factory):
+    """(folder, reference JSON path, check plan JSON, the empty check file)."""
+    d = tmp_path_factory.mktemp("check")
+    assert main(["plan", LAYOUT, "--instrument", SPHERE, "--readings", "80",
+                 "--out", str(d / "ref")]) == 0
+    plan_fill.fill(d / "ref" / "sphere.csv", LAYOUT, PLANTED, np.random.default_rng(11))
+    assert main(["calibrate", LAYOUT, str(d / "ref" / "sphere.csv"),
+                 "--json", str(d / "cal.json")]) == 0
+    assert main(["check", "plan", LAYOUT, "--reference", str(d / "cal.json"),
+                 "--instrument", SPHERE, "--minutes", "20", "--out", str(d / "plan"),
+                 "--json", str(d / "plan.json")]) == 0
+    return d, d / "cal.json", json.loads((d / "plan.json").read_text()), d / "plan" / "sphere.csv"
+
+
+def _filled(world, name, planted, seed):
+    d, _, _, empty = world
+    path = d / f"{name}.csv"
+    shutil.copy(empty, path)
+    plan_fill.fill(path, LAYOUT, planted, np.random.default_rng(seed))
+    return path
+
+
+def _check(world, path, *extra):
+    d, cal, _, _ = world
+    out = d / f"{path.stem}.json"
+    assert main(["check", LAYOUT, "--reference", str(cal), str(path), "--json", str(out),
+                 "--force", *extra]) == 0
+    return json.loads(out.read_text())
+
+
+def test_plan_within_20_minutes(world):
+    d, _, plan, _ = world
+    assert plan["minutes"] <= 20.0 and plan["meets"]
+    assert {"sphere.csv", "sphere.nc"} <= set(plan["files"])
+    for f in plan["files"]:
+        assert (d / "plan" / f).is_file()
+    assert set(plan["detectable"]) >= {"EX0B", "EA0B", "EB0B", "EX0C", "EA0C", "EB0C"}
+    for name, v in plan["detectable"].items():
+        assert v["power"] >= 0.95, name
+        assert v["size_95"] <= v["size"] + 1e-9, name
+
+
+def test_power_is_the_noncentral_chi_square():
+    from scipy.stats import ncx2
+
+    from volerr.check._power import detectable, power
+
+    for size, std, c in [(3.0, 1.0, 12.0), (5.5, 0.8, 14.2), (0.5, 1.0, 9.0)]:
+        assert power(size, std, c) == pytest.approx(float(ncx2.sf(c, 1, (size / std) ** 2)),
+                                                    rel=1e-6)
+    assert power(detectable(1.3, 14.0), 1.3, 14.0) == pytest.approx(0.95, abs=2e-3)
+
+
+@pytest.mark.parametrize("name,jump,seed", [("EX0C", 3.0, 1), ("EA0B", -12.0, 2),
+                                            ("EX0B", 2.0, 3)])
+def test_a_jump_is_named_with_its_size(world, name, jump, seed):
+    path = _filled(world, f"jump_{name}", {**PLANTED, name: PLANTED[name] + jump}, seed)
+    d = _check(world, path, "--date", "2026-11-30")
+    assert d["verdict"] == "changed" and d["date"] == "2026-11-30"
+    assert [c["parameter"] for c in d["changed"]] == [name]
+    c = d["changed"][0]
+    assert abs(c["change"] - jump) < 3 * c["std"], c
+    assert name not in d["unchanged"] and len(d["unchanged"]) == len(d["parameters"]) - 1
+    # the values after the check: the machine's now (planted + jump), within 3 std
+    after = d["parameters"][name]
+    assert abs(after["value"] - (PLANTED[name] + jump)) < 3 * after["std"], after
+    # a location error moves the tool point rigidly: |change| um (an angle: more)
+    assert d["volumetric_change_um"]["max"] >= 0.99 * abs(c["change"]) * (
+        1 if c["unit"] == "um" else 0.0)
+    assert d["files"][0]["sha256"] and len(d["files"][0]["sha256"]) == 64
+
+
+def test_a_clean_machine_is_unchanged(world):
+    for seed in range(20, 28):
+        d = _check(world, _filled(world, f"clean{seed}", PLANTED, seed))
+        assert d["verdict"] == "unchanged", (seed, d["selection"], d["misfit"])
+        assert d["changed"] == [] and d["volumetric_change_um"]["max"] == 0.0
+
+
+def test_tolerance_by_the_decision_rule(world):
+    path = _filled(world, "tol", {**PLANTED, "EX0C": PLANTED["EX0C"] + 3.0}, 5)
+    d = _check(world, path, "--tolerance", "EX0C=30 um,EX0B=12 um")
+    items = {i["quantity"]: i for i in d["tolerance"]["items"]}
+    assert items["EX0C"]["verdict"] == "pass"            # 18 um against 30
+    # EX0B is 12 um against 12: undecided (the uncertainty straddles the limit)
+    assert items["EX0B"]["verdict"] == "undecided"
+    assert d["tolerance"]["verdict"] == "undecided"
+
+
+def _bad(argv, capsys):
+    rc = main(argv)
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "Traceback" not in err, err
+    return err
+
+
+def test_bad_input(world, tmp_path, capsys):
+    _, cal, _, empty = world
+    path = _filled(world, "bad", PLANTED, 9)
+    doc = json.loads(cal.read_text())
+    doc.pop("covariance")
+    nocov = tmp_path / "nocov.json"
+    nocov.write_text(json.dumps(doc))
+    out = tmp_path / "out.json"
+    assert "covariance" in _bad(["check", LAYOUT, "--reference", str(nocov), str(path),
+                                 "--json", str(out)], capsys)
+    assert "not of" in _bad(["check", "FH1", "--reference", str(cal), str(path),
+                             "--json", str(out)], capsys)
+    _bad(["check", LAYOUT, "--reference", str(cal), str(cal), "--json", str(out)], capsys)
+    _bad(["check", LAYOUT, "--reference", str(path), str(path), "--json", str(out)], capsys)
+    _bad(["check", "plan", LAYOUT, "--reference", str(nocov), "--instrument", SPHERE,
+          "--out", str(tmp_path / "p")], capsys)
+    assert not out.exists() and not (tmp_path / "p").exists()
