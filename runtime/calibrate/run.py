@@ -337,7 +337,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
 
 
 def covariance_block(cal) -> dict | None:
-    """``{"parameters", "units", "values", "matrix", "degree", "ranges", "note"}``: the written
+    """``{"names", "units", "values", "matrix", "degree", "ranges", "note"}``: the written
     model parameters (determined ones and the carriers of determined combinations, not the
     set-up unknowns nor extra terms), their values and covariance (scaled by the a-posteriori
     variance factor) in the units the report gives them (um, urad, um/mm ...), and the degree
@@ -360,7 +360,7 @@ def covariance_block(cal) -> dict | None:
         values.append(float(cal.coef[j]) * rep["value"])
     f = np.array(factors, float)
     C = sol.cov[np.ix_(cols, cols)] * np.outer(f, f) if cols else np.zeros((0, 0))
-    return {"parameters": names, "units": units, "values": values,
+    return {"names": names, "units": units, "values": values,
             "matrix": [[float(v) for v in row] for row in C], "degree": int(cal.degree),
             "ranges": {a: [float(lo), float(hi)] for a, (lo, hi) in cal.ranges.items()},
             "note": "covariance of the written parameters in their report units (the "

@@ -85,14 +85,14 @@ def load(path, model) -> Reference:
 
 def _parse(block: dict, doc: dict, path: str, model) -> Reference:
     try:
-        names = [str(n) for n in block["parameters"]]
+        names = [str(n) for n in block["names"]]
         units = [str(u) for u in block["units"]]
         values = np.array(block["values"], float)
         cov = np.array(block["matrix"], float).reshape(len(names), len(names))
         degree = int(block["degree"])
         ranges = {a: (float(v[0]), float(v[1])) for a, v in block["ranges"].items()}
     except (KeyError, TypeError, ValueError):
-        raise InputError(f"--reference {path}: a malformed 'covariance' block (parameters, "
+        raise InputError(f"--reference {path}: a malformed 'covariance' block (names, "
                          f"units, values, matrix, degree, ranges)") from None
     p = len(names)
     require(p > 0, f"--reference {path}: determines no parameter (nothing to check against)")

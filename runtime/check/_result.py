@@ -93,7 +93,7 @@ class CheckResult:
                            "accepted": s["accepted"]} for s in self.selection.steps],
             "parameters": {n: {"value": float(v), "unit": u, "std": float(s)}
                            for n, u, v, s in zip(ref.names, ref.units, values, std)},
-            "covariance": {"parameters": list(ref.names), "units": list(ref.units),
+            "covariance": {"names": list(ref.names), "units": list(ref.units),
                            "values": [float(v) for v in values],
                            "matrix": [[float(x) for x in row] for row in cov],
                            "degree": ref.degree,
