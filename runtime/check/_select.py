@@ -1,8 +1,8 @@
 """Which parameters changed: the smallest set that explains the check's readings, by the
 loop's rule (:mod:`volerr.loop.select`): forward selection, a parameter accepted when it
 lowers the BIC by more than ``BIC_GAIN`` and the cross-validated residual significantly
-(paired t > ``CV_T`` on the held-out points' squared residuals); then a backward pass that
-drops a parameter no longer earning its place given the others.
+(paired t on the held-out points' squared residuals above :func:`cv_limit`); then a backward
+pass that drops a parameter no longer earning its place given the others.
 
 1. ``chi2(S)`` of the generalised least-squares fit of :mod:`volerr.check._system` with the
    set ``S`` free to change; the BIC of ``S`` is ``chi2(S) + |S| ln n`` (``n`` readings), so
@@ -12,7 +12,11 @@ drops a parameter no longer earning its place given the others.
    with a probability below ``ALPHA`` whatever ``n``;
 3. cross-validation: ``FOLDS`` folds of the points (point ``i`` in fold ``i mod FOLDS``;
    every set-up keeps points in the training part), the held-out points' squared weighted
-   residual with and without the candidate;
+   residual with and without the candidate; the paired t must exceed the loop's ``CV_T``
+   (3, for campaigns of thousands of points) or, for a check of few points, the one-sided
+   5 % quantile of Student's t on ``n - 1`` degrees of freedom, whichever is smaller (a
+   check of 15 points would otherwise refuse a change of 8 standard uncertainties that the
+   held-out points confirm at t = 2.8);
 4. ties (candidates whose ``chi2`` reductions agree to ``TIE`` relative) are broken by the
    reference's order; two parameters whose columns in this check correlate by more than
    ``INDISTINCT`` (set-ups eliminated) cannot be told apart by it and are named.
@@ -77,13 +81,20 @@ def select(system, candidates=None) -> Selection:
         j, f = next((j, f) for j, f in trial if f.chi2 <= best + TIE * max(fit.chi2, 1.0))
         gain = fit.chi2 - f.chi2
         t = cv_t(system, folds, S, S + [j]) if gain > c else float("nan")
-        ok = gain > c and t > CV_T
+        ok = gain > c and t > cv_limit(len(np.unique(system.point)))
         steps.append({"parameter": j, "dchi2": gain, "cv_t": t, "accepted": bool(ok)})
         if not ok:
             break
         S, fit = S + [j], f
     S, fit = _backward(system, S, fit, c)
     return Selection(S, fit, c, steps)
+
+
+def cv_limit(n_points: int) -> float:
+    """The paired t the cross-validation must exceed (module docstring, step 3)."""
+    from scipy.stats import t
+
+    return min(CV_T, float(t.ppf(0.95, max(n_points - 1, 1))))
 
 
 def _backward(system, S, fit, c):
