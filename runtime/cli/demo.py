@@ -18,7 +18,8 @@ Sections (each runs the real command or API on built-in data and writes into DIR
 9. task-specific uncertainty of a distance (Monte Carlo);
 10. measurement plans (``volerr plan``): an R-test campaign for the DMU 50 and a ballbar +
     tracking-interferometer campaign for MB1, executed on volerr's model and calibrated, the
-    predicted against the realised standard uncertainties;
+    predicted against the realised standard uncertainties; weekly interim checks of a DMU 50
+    (``volerr check``; the history page by ``volerr history`` when installed);
 11. ``index.html`` with a section, figures and captions per step, and the headline figures
     printed.  Everything is written at the end, all or nothing.
 """
@@ -36,10 +37,15 @@ from ..fileio import json_text, write_text
 from ..units import num
 
 SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "ballplate",
-            "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty", "plan")
+            "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty", "plan", "check")
 
 #: one sentence per section of index.html: what it shows and how to read it
 ABOUT = {
+    "check": "A DMU 50 calibrated with an R-test campaign and then checked every week with "
+             "the shortest check 'volerr check plan' designs (at most 20 minutes, 95 % power "
+             "for a 5 um change of the volumetric error); its C-axis pivot drifts and a "
+             "collision at week 12 tilts its B axis: each check names what changed with its "
+             "uncertainty; the history page (volerr history) shows events and trends.",
     "plan": "Measurement plans made before any machine time (volerr plan): an R-test "
             "campaign for the DMU 50 and a ballbar + tracking-interferometer campaign for "
             "MB1, each executed on volerr's model with planted errors and calibrated with no "
@@ -134,6 +140,9 @@ CAPTIONS = {
     "iso230_2.png": "ISO 230-2 plot: mean deviations per direction with bands \u00b1 2 S "
                     "(k = 2) of one reading; ringed: readings that decide a quantity that "
                     "fails or is undecided.",
+    "check_weekly.png": "EX0C and EA0B after each weekly check (the reference updated by the "
+                        "check, 2 std bars); ringed: the weeks the check names the parameter "
+                        "changed.",
     "plan_predicted.png": "Standard uncertainty of each parameter: predicted by volerr plan "
                           "before the measurement (bars) and realised by volerr calibrate on "
                           "the executed plan (dots), k = 1.",
@@ -498,6 +507,26 @@ def _plan(out: Path) -> dict:
             "value": "; ".join(values), "files": files + ["plan_predicted.png"]}
 
 
+def _check(out: Path) -> dict:
+    """Weekly interim checks of a DMU 50 (:mod:`volerr.check.demo`); the history page when
+    ``volerr history`` is installed (its command module present)."""
+    import importlib.util
+
+    from ..check import demo
+
+    run = demo.weekly(out)
+    files = list(run["files"])
+    if importlib.util.find_spec("volerr.cli.history") is not None:
+        db = out / "check_history.sqlite"
+        _cli("history", "add", "--db", db, "--machine", "DMU50 demo", run["reference"],
+             *run["checks"])
+        _cli("history", "show", "--db", db, "--machine", "DMU50 demo", "--json",
+             out / "check_history.json", "--html", out / "check_history.html")
+        files += ["check_history.sqlite", "check_history.json", "check_history.html"]
+    return {"title": "between calibrations: a DMU 50 checked weekly (a drifting pivot, a "
+                     "collision at week 12)", "value": demo.summary(run), "files": files}
+
+
 def write_bytes_png(path: Path, data: bytes) -> None:
     from ..fileio import write_bytes
 
@@ -601,6 +630,7 @@ def run(args) -> int:
                 "iso230_2": lambda: _iso230_2(out),
                 "uncertainty": lambda: _uncertainty(out),
                 "plan": lambda: _plan(out),
+                "check": lambda: _check(out),
             }
             from ..progress import bar
 
