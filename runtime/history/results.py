@@ -1,0 +1,217 @@
+"""A result file (``volerr calibrate --json`` or ``volerr check --json``) as one history entry.
+
+What an entry keeps of its result (:class:`Entry`):
+
+* ``kind``: ``calibration`` (a JSON with ``"parameters": {NAME: {"value", "unit", "std"}}``)
+  or ``check`` (a JSON with ``"verdict"`` and ``"changed": [{"parameter", "change", "unit",
+  "std"}]``);
+* ``values``: ``{NAME: Value(value, std, unit, status)}`` in the result's report units (um,
+  urad, um/mm ...).  A calibration's values are its estimates (status ``estimated``).  A
+  check states changes against its reference calibration; its values are the reference's
+  value plus the change (status ``changed``), so every entry of a parameter lies on one
+  scale.  A parameter the check lists as ``unchanged`` with a number (``{"parameter",
+  "change", "std"}``) is stored the same way (status ``unchanged``); one listed by name only
+  carries no number (value and std ``None``) and is left out of every statistic;
+* ``covariance``: ``{"names": [...], "matrix": [[...]]}`` when the result carries one (in the
+  report units of the names), else ``None``;
+* ``files``: the instrument files the result names, each with the SHA-256 of the file found
+  beside the result (its path as written, relative to the result's folder), or ``None``
+  when it is not there;
+* ``sha256``: of the result file's bytes (the identity of a result in the store).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError, require
+
+CALIBRATION, CHECK = "calibration", "check"
+ESTIMATED, CHANGED, UNCHANGED = "estimated", "changed", "unchanged"
+
+
+@dataclass(frozen=True)
+class Value:
+    """One parameter of one entry: ``value`` and standard uncertainty ``std`` (k = 1) in
+    ``unit``; both ``None`` for a parameter a check names as unchanged without a number."""
+    value: float | None
+    std: float | None
+    unit: str
+    status: str
+    change: float | None = None     # a check's stated change (None for a calibration)
+
+
+@dataclass
+class Entry:
+    """One result in a machine's history (module docstring)."""
+    kind: str
+    layout: str
+    values: dict
+    sha256: str
+    source: str
+    document: str
+    date: str | None = None
+    verdict: str | None = None
+    covariance: dict | None = None
+    files: list = field(default_factory=list)
+    reference_sha256: str | None = None
+
+
+def read(path) -> Entry:
+    """The entry of the result file ``path`` (its reference not yet applied for a check:
+    :func:`apply_reference`).  Raises :class:`InputError` for a file that is not a volerr
+    calibrate or check result."""
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    try:
+        doc = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{path}: not a JSON file ({exc})".split("\n")[0]) from None
+    require(isinstance(doc, dict), f"{path}: not a volerr calibrate or check result (a JSON "
+                                   f"object expected)")
+    sha = hashlib.sha256(raw).hexdigest()
+    text = raw.decode("utf-8")
+    if "verdict" in doc and "changed" in doc:
+        entry = _check(doc, path, sha, text)
+    elif isinstance(doc.get("parameters"), dict) and "layout" in doc:
+        entry = _calibration(doc, path, sha, text)
+    else:
+        raise InputError(f"{path}: not a volerr calibrate or check result (neither "
+                         f"'parameters' with 'layout' nor 'verdict' with 'changed')")
+    entry.files = _file_hashes(doc, p)
+    entry.date = _own_date(doc, path)
+    return entry
+
+
+def _number(v, where: str) -> float:
+    require(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v),
+            f"{where}: a finite number expected, got {v!r}")
+    return float(v)
+
+
+def _calibration(doc: dict, path, sha: str, text: str) -> Entry:
+    require(isinstance(doc["layout"], str) and doc["layout"],
+            f"{path}: 'layout' must be a layout name")
+    values = {}
+    for name, rec in doc["parameters"].items():
+        where = f"{path}: parameter {name}"
+        require(isinstance(rec, dict) and "value" in rec and "std" in rec,
+                f"{where}: {{'value', 'unit', 'std'}} expected")
+        std = _number(rec["std"], f"{where} std")
+        require(std >= 0, f"{where}: std must be >= 0, got {std}")
+        values[str(name)] = Value(_number(rec["value"], f"{where} value"), std,
+                                  str(rec.get("unit", "")), ESTIMATED)
+    require(values, f"{path}: the calibration determined no parameter")
+    return Entry(CALIBRATION, doc["layout"], values, sha, Path(path).name, text,
+                 covariance=_covariance(doc.get("covariance"), values, path))
+
+
+def _covariance(cov, values: dict, path) -> dict | None:
+    """``{"names", "matrix"}`` checked (square, symmetric, names known), or None."""
+    if cov is None:
+        return None
+    require(isinstance(cov, dict) and isinstance(cov.get("names"), list)
+            and isinstance(cov.get("matrix"), list),
+            f"{path}: 'covariance' must be {{'names': [...], 'matrix': [[...]]}}")
+    names = [str(n) for n in cov["names"]]
+    m = cov["matrix"]
+    require(len(m) == len(names) and all(isinstance(r, list) and len(r) == len(names)
+                                         for r in m),
+            f"{path}: 'covariance' matrix is not {len(names)} x {len(names)}")
+    rows = [[_number(v, f"{path}: covariance") for v in r] for r in m]
+    return {"names": names, "matrix": rows}
+
+
+def _check(doc: dict, path, sha: str, text: str) -> Entry:
+    verdict = doc["verdict"]
+    require(verdict in (CHANGED, UNCHANGED),
+            f"{path}: 'verdict' must be 'changed' or 'unchanged', got {verdict!r}")
+    require(isinstance(doc["changed"], list) and isinstance(doc.get("unchanged", []), list),
+            f"{path}: 'changed' and 'unchanged' must be lists")
+    values = {}
+    for status, items in ((CHANGED, doc["changed"]), (UNCHANGED, doc.get("unchanged", []))):
+        for item in items:
+            if isinstance(item, str):
+                require(status == UNCHANGED, f"{path}: a changed parameter needs "
+                                             f"{{'parameter', 'change', 'unit', 'std'}}")
+                values[item] = Value(None, None, "", status)
+                continue
+            require(isinstance(item, dict) and "parameter" in item,
+                    f"{path}: {status}: {{'parameter', 'change', 'unit', 'std'}} expected")
+            name = str(item["parameter"])
+            if "change" not in item:
+                values[name] = Value(None, None, str(item.get("unit", "")), status)
+                continue
+            where = f"{path}: {status} {name}"
+            std = _number(item.get("std"), f"{where} std")
+            require(std >= 0, f"{where}: std must be >= 0, got {std}")
+            values[name] = Value(None, std, str(item.get("unit", "")), status,
+                                 _number(item["change"], f"{where} change"))
+    layout = doc.get("layout")
+    require(layout is None or (isinstance(layout, str) and layout),
+            f"{path}: 'layout' must be a layout name")
+    ref = doc.get("reference")
+    ref_sha = doc.get("reference_sha256") or (ref.get("sha256") if isinstance(ref, dict)
+                                              else None)
+    return Entry(CHECK, layout or "", values, sha, Path(path).name, text, verdict=verdict,
+                 reference_sha256=ref_sha)
+
+
+def apply_reference(entry: Entry, reference: Entry, path) -> None:
+    """A check's values: the reference's value plus the stated change (same unit), in place.
+    Raises :class:`InputError` when the check names a parameter the reference does not hold,
+    or another layout or unit."""
+    require(not entry.layout or entry.layout == reference.layout,
+            f"{path}: a check of layout {entry.layout}, its reference calibration "
+            f"({reference.source}, {reference.date}) is of {reference.layout}")
+    entry.layout = reference.layout
+    entry.reference_sha256 = reference.sha256
+    out = {}
+    for name, v in entry.values.items():
+        ref = reference.values.get(name)
+        require(ref is not None, f"{path}: the check names {name}, which its reference "
+                                 f"calibration ({reference.source}) does not determine")
+        require(not v.unit or v.unit == ref.unit,
+                f"{path}: {name} in {v.unit}, its reference in {ref.unit}")
+        if v.change is None:
+            out[name] = Value(None, None, ref.unit, v.status)
+        else:
+            out[name] = Value(ref.value + v.change, v.std, ref.unit, v.status, v.change)
+    entry.values = out
+
+
+def _file_hashes(doc: dict, path: Path) -> list:
+    """``[{"file", "sha256"}]`` of the instrument files the result names (its
+    ``instruments`` list, or ``files``): each looked for beside the result."""
+    names = []
+    for item in doc.get("instruments", []) or []:
+        if isinstance(item, dict) and isinstance(item.get("file"), str):
+            names.append(item["file"])
+    for item in doc.get("files", []) or []:
+        if isinstance(item, str):
+            names.append(item)
+    out = []
+    for name in dict.fromkeys(names):
+        f = Path(name) if Path(name).is_absolute() else path.parent / name
+        try:
+            digest = hashlib.sha256(f.read_bytes()).hexdigest() if f.is_file() else None
+        except OSError:
+            digest = None
+        out.append({"file": name, "sha256": digest})
+    return out
+
+
+def _own_date(doc: dict, path) -> str | None:
+    """The result's own date (``"date"`` or ``identification.date``), when it states one."""
+    for d in (doc.get("date"), (doc.get("identification") or {}).get("date")
+              if isinstance(doc.get("identification"), dict) else None):
+        if isinstance(d, str) and d:
+            return d
+    return None

@@ -1,0 +1,153 @@
+"""``volerr history add`` and ``volerr history show`` as functions (the commands are thin
+layers over :func:`add` and :func:`show`).
+
+Rules of ``add`` (the store's own rules in :mod:`volerr.history.store`):
+
+* A machine id is 1 to 64 characters: letters, digits, space and ``. _ - : / + #``, not
+  starting or ending with a space (:data:`MACHINE_RULE`).  Anything else (quotes, ``;``,
+  control characters) is refused; every id is sent to the database as a bound parameter
+  anyway.
+* A result's date: ``--date`` (YYYY-MM-DD, for every file of one ``add``), else the date the
+  result states (``"date"``), else today (UTC).  A date after today is refused (a result is
+  not from the future); a date before the stored entries is accepted (an old certificate
+  back-filled takes its place in date order).
+* All entries of a machine are of one layout; a parameter keeps its unit.
+* A check needs its reference calibration in the machine's history: the one it names by
+  SHA-256 (``"reference_sha256"`` or ``"reference": {"sha256"}``), else the latest
+  calibration dated on or before the check; it must not be dated after the check.
+* Several files in one ``add``: one transaction, all or none.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import re
+
+from ..errors import InputError, require
+from . import results
+from .results import CALIBRATION, CHECK
+
+MACHINE_RULE = re.compile(r"[A-Za-z0-9._:/+#-](?:[A-Za-z0-9 ._:/+#-]{0,62}[A-Za-z0-9._:/+#-])?")
+
+
+def check_machine(machine: str) -> str:
+    """``machine`` when it follows :data:`MACHINE_RULE`, else :class:`InputError`."""
+    require(isinstance(machine, str) and MACHINE_RULE.fullmatch(machine) is not None,
+            f"--machine {machine!r}: a machine id is 1 to 64 letters, digits, spaces (not at "
+            f"either end) and . _ - : / + # (no quotes, no ';')")
+    return machine
+
+
+def today() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).date().isoformat()
+
+
+def check_date(text: str, where: str = "--date") -> str:
+    """``text`` as YYYY-MM-DD, not after today (UTC)."""
+    try:
+        d = _dt.date.fromisoformat(str(text))
+    except ValueError:
+        raise InputError(f"{where} {text!r}: a date YYYY-MM-DD expected") from None
+    require(len(str(text)) == 10, f"{where} {text!r}: a date YYYY-MM-DD expected")
+    require(d.isoformat() <= today(), f"{where} {text}: lies in the future (today is "
+                                      f"{today()} UTC); a result is dated when it was "
+                                      f"measured")
+    return d.isoformat()
+
+
+def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 10.0) -> list:
+    """Add the result files to ``machine``'s history in ``db`` (module docstring); returns
+    ``[(Entry, "added" | "already stored")]``."""
+    from .store import Store
+
+    check_machine(machine)
+    files = list(files)
+    require(files, "give at least one RESULT.json")
+    date = check_date(date) if date is not None else None
+    entries = []
+    for f in files:
+        e = results.read(f)
+        e.date = date or (check_date(e.date, f"{f}: its date") if e.date else today())
+        entries.append((f, e))
+    store = Store(db, wait_s=wait_s, create=True)
+    paths = {id(e): f for f, e in entries}
+
+    def prepare(entry, stored):
+        _prepare(entry, stored, paths[id(entry)])
+
+    return store.add(machine, [e for _, e in entries], prepare)
+
+
+def _prepare(entry, stored: list, path) -> None:
+    """Inside the store's transaction: the reference of a check applied, the layout and the
+    units checked against the machine's stored entries."""
+    if entry.kind == CHECK:
+        ref = _reference(entry, stored, path)
+        results.apply_reference(entry, ref, path)
+    layouts = {e.layout for e in stored}
+    require(not layouts or layouts == {entry.layout},
+            f"{path}: layout {entry.layout}, the machine's history is of "
+            f"{', '.join(sorted(layouts))}")
+    units = {}
+    for e in stored:
+        for n, v in e.values.items():
+            units.setdefault(n, v.unit)
+    for n, v in entry.values.items():
+        require(n not in units or units[n] == v.unit,
+                f"{path}: {n} in {v.unit}, the history holds it in {units.get(n)}")
+    stored.append(entry)
+
+
+def _reference(entry, stored: list, path):
+    cals = [e for e in stored if e.kind == CALIBRATION]
+    if entry.reference_sha256:
+        named = [e for e in cals if e.sha256 == entry.reference_sha256]
+        require(named, f"{path}: its reference calibration (sha256 "
+                       f"{entry.reference_sha256[:12]}...) is not in this machine's history; "
+                       f"add it first")
+        ref = named[0]
+        require(ref.date <= entry.date, f"{path}: dated {entry.date}, before its reference "
+                                        f"calibration ({ref.source}, {ref.date})")
+        return ref
+    before = [e for e in cals if e.date <= entry.date]
+    require(before, f"{path}: a check dated {entry.date}, and no calibration of this machine "
+                    f"on or before that date in the history; add the reference first")
+    return before[-1]
+
+
+def parse_tolerances(text: str | None) -> dict:
+    """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``; ``map`` in um."""
+    out: dict = {}
+    if not text:
+        return out
+    for part in filter(None, (p.strip() for p in re.split(r"[,;|]", text))):
+        name, eq, rest = part.partition("=")
+        m = re.fullmatch(r"\s*([-+0-9.eE]+)\s*([A-Za-zµ/^0-9]*)\s*", rest)
+        require(eq == "=" and name.strip() and m is not None,
+                f"--tolerance {part!r}: NAME=VALUE UNIT expected (e.g. EX0C=20 um, map=30 um)")
+        try:
+            value = float(m.group(1))
+        except ValueError:
+            raise InputError(f"--tolerance {part!r}: {m.group(1)!r} is not a number") from None
+        require(value > 0 and value < 1e12, f"--tolerance {part!r}: a positive value expected")
+        unit = m.group(2).replace("µ", "u")
+        name = name.strip()
+        require(name not in out, f"--tolerance: {name} given twice")
+        require(name != "map" or unit in ("um", ""), "--tolerance map=VALUE um (the "
+                                                     "volumetric error in um)")
+        out[name] = (value, unit or ("um" if name == "map" else ""))
+    return out
+
+
+def show(db: str, machine: str, tolerance: str | None = None, wait_s: float = 10.0):
+    """The :class:`volerr.history.report.History` of ``machine`` in ``db``."""
+    from .report import History
+    from .store import Store
+
+    check_machine(machine)
+    tol = parse_tolerances(tolerance)
+    store = Store(db, wait_s=wait_s, create=False)
+    entries = store.entries(machine)
+    require(entries, f"--machine {machine!r}: no entries in {store.shown} (machines there: "
+                     f"{', '.join(store.machines()[:8]) or 'none'})")
+    return History.build(machine, entries, tol)
