@@ -39,6 +39,16 @@ class Reference:
     data: dict = field(default_factory=dict)
 
     @property
+    def combinations(self) -> dict:
+        """``{written_as: expression}``: the names that carry a combination the reference
+        determines only as a whole (``EY0B`` holding ``EY0B + EY0C``)."""
+        out = {}
+        for c in self.data.get("combinations", []) or []:
+            if isinstance(c, dict) and c.get("written_as") in self.names:
+                out[str(c["written_as"])] = str(c.get("expression", c["written_as"]))
+        return out
+
+    @property
     def std(self) -> np.ndarray:
         return np.sqrt(np.maximum(np.diag(self.cov), 0.0))
 

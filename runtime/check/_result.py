@@ -56,7 +56,26 @@ class CheckResult:
                      "value": float(after[j]), "z": float(delta[k] / std[k]) if std[k] else None}
             if alias:
                 entry["indistinguishable_from"] = alias
+            if name in ref.combinations:
+                entry["combination"] = ref.combinations[name]
             out.append(entry)
+        return out
+
+    def combinations(self) -> list:
+        """``[{"written_as", "expression", "status", "value", "unit", "std"}]``: the
+        reference's combinations (determined only as a whole) after the check; they are
+        listed here and not under ``unchanged`` (a changed one is under ``changed`` too, with
+        its ``combination``)."""
+        ref = self.reference
+        values, cov = self.after()
+        changed = {ref.names[j] for j in self.selection.changed}
+        out = []
+        for name, expr in ref.combinations.items():
+            j = ref.names.index(name)
+            out.append({"written_as": name, "expression": expr,
+                        "status": "changed" if name in changed else "unchanged",
+                        "value": float(values[j]), "unit": ref.units[j],
+                        "std": float(np.sqrt(max(cov[j, j], 0.0)))})
         return out
 
     def after(self) -> tuple[np.ndarray, np.ndarray]:
@@ -76,7 +95,8 @@ class CheckResult:
         std = np.sqrt(np.maximum(np.diag(cov), 0.0))
         changed = {ref.names[j] for j in self.selection.changed}
         out = {"verdict": self.verdict, "changed": self.changes(),
-               "unchanged": [n for n in ref.names if n not in changed],
+               "unchanged": [n for n in ref.names
+                             if n not in changed and n not in ref.combinations],
                "volumetric_change_um": self.volumetric_change()}
         if self.date:
             out["date"] = self.date
@@ -84,7 +104,7 @@ class CheckResult:
             "layout": self.model.name, "kind": "check",
             "reference": {"file": str(ref.path), "sha256": _sha(ref.path),
                           "date": ref.data.get("date")},
-            "files": self.files,
+            "files": self.files, "combinations": self.combinations(),
             "indistinguishable": self.indistinguishable, "not_seen": self.not_seen,
             "misfit": self.misfit, "threshold_chi2": round(self.selection.threshold, 4),
             "selection": [{"parameter": ref.names[s["parameter"]],

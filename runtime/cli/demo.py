@@ -523,7 +523,8 @@ def _check(out: Path) -> dict:
         try:
             _cli("history", "add", "--db", db, "--machine", "DMU50 demo", run["reference"],
                  *run["checks"])
-            _cli("history", "show", "--db", db, "--machine", "DMU50 demo", "--json",
+            _cli("history", "show", "--db", db, "--machine", "DMU50 demo", "--tolerance",
+                 demo.TOLERANCE, "--json",
                  out / "check_history.json", "--html", out / "check_history.html")
             files += ["check_history.sqlite", "check_history.json", "check_history.html"]
         except InputError as exc:      # the history's own refusal, named on the page

@@ -94,7 +94,10 @@ def test_a_jump_is_named_with_its_size(world, name, jump, seed):
     assert [c["parameter"] for c in d["changed"]] == [name]
     c = d["changed"][0]
     assert abs(c["change"] - jump) < 3 * c["std"], c
-    assert name not in d["unchanged"] and len(d["unchanged"]) == len(d["parameters"]) - 1
+    assert name not in d["unchanged"]
+    # every reference name is changed, unchanged or a combination (EY0B + EY0C, as EY0B)
+    assert [x["written_as"] for x in d["combinations"]] == ["EY0B"]
+    assert len(d["unchanged"]) == len(d["parameters"]) - 2
     # the values after the check: the machine's now (planted + jump), within 3 std
     after = d["parameters"][name]
     assert abs(after["value"] - (PLANTED[name] + jump)) < 3 * after["std"], after
