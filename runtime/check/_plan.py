@@ -53,9 +53,8 @@ class CheckPlan:
     reference: object
 
     def files(self) -> list:
-        from ..plan._report import nc_name
-
-        return [n for pf in self.plan.files for n in (pf.name, nc_name(pf))]
+        """The instrument files and their NC programs, as the plan names them."""
+        return [n for f in self.plan.data()["files"] for n in (f["file"], f["nc"])]
 
     def to_dict(self) -> dict:
         return {"readings": int(sum(pf.n for pf in self.plan.files)),
