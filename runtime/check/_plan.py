@@ -84,11 +84,37 @@ class CheckPlan:
         return "\n".join([head] + rows)
 
     def write(self, folder, json_path=None, html_path=None, inputs=()) -> None:
+        """The plan's files, NC programs and set-up sheet (:meth:`volerr.plan.Plan.write`),
+        the sheet with the check's power table added, and the JSON."""
         from ..fileio import json_text, write_text
+        from ..plan import _sheet
 
         self.plan.write(folder, None, html_path, inputs)
+        page = _sheet.html(self.plan).replace("</body>", self.power_html() + "</body>", 1)
+        write_text(html_path or f"{folder}/plan.html", page, inputs=list(inputs))
         if json_path:
             write_text(json_path, json_text(self.to_dict()), inputs=list(inputs))
+
+    def power_html(self) -> str:
+        """The power table of the check (an HTML section)."""
+        from html import escape
+
+        rows = "".join(
+            f"<tr><td>{escape(n)}</td><td>{_fmt(v['size'])}</td><td>{_fmt(v['power'])}</td>"
+            f"<td>{_fmt(v['size_95'])}</td><td>{_fmt(v['std'])}</td><td>{escape(v['unit'])}"
+            f"</td></tr>" for n, v in self.detectable.items())
+        verdict = "detects" if self.meets else "does NOT detect"
+        return (f"<h2>What this check detects</h2><p>Against the reference "
+                f"{escape(str(self.reference.path))}: it {verdict} a change of the volumetric "
+                f"error by {self.detect_um:g} um anywhere in the working volume with "
+                f"{_power.POWER:.0%} probability (false alarms below 5 %).</p><table><tr>"
+                f"<th>parameter</th><th>size ({self.detect_um:g} um)</th><th>power</th>"
+                f"<th>detected with 95 %</th><th>std of a change</th><th>unit</th></tr>{rows}"
+                f"</table>")
+
+
+def _fmt(v) -> str:
+    return "-" if v is None else f"{v:.3g}"
 
 
 def plan_check(layout, reference, specs, *, minutes: float | None = None,

@@ -66,6 +66,7 @@ def test_plan_within_20_minutes(world):
     d, _, plan, _ = world
     assert plan["minutes"] <= 20.0 and plan["meets"]
     assert {"sphere.csv", "sphere.nc"} <= set(plan["files"])
+    assert "What this check detects" in (d / "plan" / "plan.html").read_text()
     for f in plan["files"]:
         assert (d / "plan" / f).is_file()
     assert set(plan["detectable"]) >= {"EX0B", "EA0B", "EB0B", "EX0C", "EA0C", "EB0C"}
@@ -148,3 +149,40 @@ def test_bad_input(world, tmp_path, capsys):
     _bad(["check", "plan", LAYOUT, "--reference", str(nocov), "--instrument", SPHERE,
           "--out", str(tmp_path / "p")], capsys)
     assert not out.exists() and not (tmp_path / "p").exists()
+
+
+def test_a_check_is_the_next_reference(world):
+    """A check's JSON (the reference updated by it) serves as the next check's reference:
+    after a jump the jumped machine is the reference, the unchanged machine is a change back."""
+    d, _, _, _ = world
+    jumped = {**PLANTED, "EX0C": PLANTED["EX0C"] + 3.0}
+    first = _filled(world, "first", jumped, 41)
+    _check(world, first)
+    again = _filled(world, "again", jumped, 42)
+    out = d / "again.json"
+    assert main(["check", LAYOUT, "--reference", str(d / "first.json"), str(again),
+                 "--json", str(out), "--force"]) == 0
+    assert json.loads(out.read_text())["verdict"] == "unchanged"
+    back = _filled(world, "back", PLANTED, 43)
+    out = d / "back.json"
+    assert main(["check", LAYOUT, "--reference", str(d / "first.json"), str(back),
+                 "--json", str(out), "--force"]) == 0
+    c = json.loads(out.read_text())["changed"]
+    assert [x["parameter"] for x in c] == ["EX0C"] and abs(c[0]["change"] + 3.0) < 3 * c[0]["std"]
+
+
+def test_columns_a_check_cannot_tell_apart_are_named():
+    """Two parameters with proportional columns (set-ups eliminated) are named; an unseen
+    parameter is named as not seen.  Hand-made system: 40 rows, one set-up column."""
+    from volerr.check._system import System
+    from volerr.check._select import indistinguishable
+
+    rng = np.random.default_rng(0)
+    n = 40
+    s = np.ones(n)
+    a = rng.normal(size=n)
+    b = rng.normal(size=n)
+    A = np.column_stack([s, a, 2.0 * a + 0.01 * rng.normal(size=n), b, np.zeros(n)])
+    sysm = System(A, np.zeros(n), np.arange(n), 1, np.zeros(1), np.eye(4), n)
+    pairs, unseen = indistinguishable(sysm, ["P1", "P2", "P3", "P4"])
+    assert pairs == [["P1", "P2"]] and unseen == ["P4"]
