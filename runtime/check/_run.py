@@ -52,7 +52,7 @@ def check(layout, reference, files, *, tolerance: str | None = None, date: str |
         parts = instruments.read_parts(list(files), model)
         obs = instruments.stack(parts)
         system = _system.build(model, ref, obs)
-        sel = _select.select(system)
+        sel = _select.select(system, series=[j for j, n in enumerate(ref.names) if "@" in n])
         pairs, unseen = _select.indistinguishable(system, ref.names)
         tool = np.median(obs.probe, axis=0)
         J = _volume.grid_columns(model, ref, tool)

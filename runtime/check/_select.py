@@ -19,7 +19,10 @@ pass that drops a parameter no longer earning its place given the others.
    held-out points confirm at t = 2.8);
 4. ties (candidates whose ``chi2`` reductions agree to ``TIE`` relative) are broken by the
    reference's order; two parameters whose columns in this check correlate by more than
-   ``INDISTINCT`` (set-ups eliminated) cannot be told apart by it and are named.
+   ``INDISTINCT`` (set-ups eliminated) cannot be told apart by it and are named; among
+   such parameters whose ``chi2`` lies within ``SAME_CHI2`` of the best (a statistical tie)
+   the simpler explanation enters: a constant (squareness, location error) before a series
+   term, then the reference's order.
 
 References: Schwarz (1978) for the BIC; the blocked cross-validation of the loop
 (:mod:`volerr.loop.select`).
@@ -43,6 +46,8 @@ FOLDS = 5
 TIE = 1e-9
 #: correlation of two parameters' columns above which this check cannot tell them apart
 INDISTINCT = 0.98
+#: chi2 difference within which two indistinguishable candidates are a statistical tie
+SAME_CHI2 = 1.0
 #: most parameters a check names as changed
 MAX_CHANGED = 8
 
@@ -66,12 +71,14 @@ class Selection:
     steps: list = field(default_factory=list)
 
 
-def select(system, candidates=None) -> Selection:
+def select(system, candidates=None, series=()) -> Selection:
     """Forward selection over ``candidates`` (indices; default every parameter the check
-    sees), then the backward pass (module docstring)."""
+    sees), then the backward pass (module docstring); ``series``: the indices that are
+    series terms (step 4)."""
     cands = list(range(system.p)) if candidates is None else list(candidates)
     c = threshold(system.n_readings, max(len(cands), 1))
     folds = system.point % FOLDS
+    corr = _correlation(system)
     S, fit, steps = [], system.solve([]), []
     while len(S) < MAX_CHANGED:
         trial = [(j, system.solve(S + [j])) for j in cands if j not in S]
@@ -79,6 +86,9 @@ def select(system, candidates=None) -> Selection:
             break
         best = min(f.chi2 for _, f in trial)
         j, f = next((j, f) for j, f in trial if f.chi2 <= best + TIE * max(fit.chi2, 1.0))
+        tied = [(j2 in series, j2, f2) for j2, f2 in trial
+                if f2.chi2 <= best + SAME_CHI2 and abs(corr[j, j2]) > INDISTINCT]
+        _, j, f = min(tied + [(j in series, j, f)], key=lambda t: (t[0], t[1]))
         gain = fit.chi2 - f.chi2
         t = cv_t(system, folds, S, S + [j]) if gain > c else float("nan")
         ok = gain > c and t > cv_limit(len(np.unique(system.point)))
@@ -135,6 +145,14 @@ def _heldout(system, fit, test) -> np.ndarray:
     pts = system.point[test]
     uniq, inv = np.unique(pts, return_inverse=True)
     return np.bincount(inv, weights=e, minlength=len(uniq))
+
+
+def _correlation(system) -> np.ndarray:
+    """(p, p) correlation of the parameters' columns in this check, set-ups eliminated."""
+    G = system.data_information()
+    d = np.sqrt(np.maximum(np.diag(G), 0.0))
+    d[d == 0] = np.inf
+    return G / np.outer(d, d)
 
 
 def indistinguishable(system, names) -> tuple[list, list]:
