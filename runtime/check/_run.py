@@ -70,7 +70,7 @@ def _misfit(system, sel, ref) -> dict:
     """The residual test of step 4: ``{"chi2", "dof", "birge_ratio", "p", "unexplained"}``."""
     from scipy.stats import chi2
 
-    G, _ = system.normal()
+    G, _, _ = system.normal()
     ns = system.ns
     S = G[:ns, :ns]
     rank = 0
@@ -81,9 +81,8 @@ def _misfit(system, sel, ref) -> dict:
         rank = int(np.sum(w > _system.SOLVE_TOL * max(float(w[-1]), 1e-300)))
     dof = max(system.n_readings - rank - len(sel.changed), 1)
     vf = float(ref.data.get("variance_factor") or 1.0)
-    scale = max(vf, 1.0)
-    x = sel.fit.chi2
-    p = float(chi2.sf(x / scale, dof))
+    x = sel.fit.chi2                       # the readings' u already scaled (_system.build)
+    p = float(chi2.sf(x, dof))
     return {"chi2": round(x, 4), "dof": dof, "birge_ratio": round(math.sqrt(x / dof), 4),
             "reference_variance_factor": vf, "p": p, "unexplained": bool(p < P_UNEXPLAINED)}
 

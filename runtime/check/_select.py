@@ -37,11 +37,10 @@ import numpy as np
 
 from ..loop.fitting import CV_T
 from ..loop.select import BIC_GAIN
+from ._system import FOLDS  # noqa: F401  (the folds of step 3)
 
 #: false-alarm probability the threshold holds at least (a clean machine called "changed")
 ALPHA = 0.05
-#: folds of the cross-validation
-FOLDS = 5
 #: relative agreement of two chi2 reductions that counts as a tie
 TIE = 1e-9
 #: correlation of two parameters' columns above which this check cannot tell them apart
@@ -77,7 +76,6 @@ def select(system, candidates=None, series=()) -> Selection:
     series terms (step 4)."""
     cands = list(range(system.p)) if candidates is None else list(candidates)
     c = threshold(system.n_readings, max(len(cands), 1))
-    folds = system.point % FOLDS
     corr = _correlation(system)
     S, fit, steps = [], system.solve([]), []
     while len(S) < MAX_CHANGED:
@@ -90,7 +88,7 @@ def select(system, candidates=None, series=()) -> Selection:
                 if f2.chi2 <= best + SAME_CHI2 and abs(corr[j, j2]) > INDISTINCT]
         _, j, f = min(tied + [(j in series, j, f)], key=lambda t: (t[0], t[1]))
         gain = fit.chi2 - f.chi2
-        t = cv_t(system, folds, S, S + [j]) if gain > c else float("nan")
+        t = cv_t(system, S, S + [j]) if gain > c else float("nan")
         ok = gain > c and t > cv_limit(len(np.unique(system.point)))
         steps.append({"parameter": j, "dchi2": gain, "cv_t": t, "accepted": bool(ok)})
         if not ok:
@@ -119,17 +117,16 @@ def _backward(system, S, fit, c):
     return S, fit
 
 
-def cv_t(system, folds, without, with_) -> float:
+def cv_t(system, without, with_) -> float:
     """Paired t of the held-out points' squared residuals without minus with the candidate
     (positive: the candidate predicts held-out points better)."""
     d = []
-    for k in range(FOLDS):
-        test = folds == k
+    for k in range(system.folds):
+        test = system.fold_of_row == k
         if not test.any() or test.all():
             continue
-        train = ~test
-        e0 = _heldout(system, system.solve(without, train), test)
-        e1 = _heldout(system, system.solve(with_, train), test)
+        e0 = _heldout(system, system.solve(without, k), test)
+        e1 = _heldout(system, system.solve(with_, k), test)
         d.append(e0 - e1)
     d = np.concatenate(d) if d else np.zeros(0)
     if len(d) < 2:

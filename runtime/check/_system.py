@@ -13,7 +13,9 @@ The generalised least-squares fit gives the changes with uncertainties that hold
 reference's covariance, ``chi2(S)`` for the selection, and the values after the check
 (``theta_ref + delta``, covariance the ``delta`` block of the inverse).
 
-Rows are weighted by ``1 / u`` (dimensionless); parameter columns per report unit (um, urad,
+Rows are weighted by ``1 / u`` (dimensionless; ``u`` times the reference's Birge ratio
+``sqrt(variance_factor)`` when that exceeds 1, as calibrate scales its covariance); parameter
+columns per report unit (um, urad,
 um/mm: the natural column divided by :meth:`volerr.check._reference.Reference.factors`),
 set-up columns per um / urad.
 """
@@ -29,6 +31,8 @@ from ..estimate.design import parameter_labels
 
 #: relative eigenvalue below which a direction of the normal matrix counts as undetermined
 SOLVE_TOL = 1e-12
+#: folds of the cross-validation (:mod:`volerr.check._select`)
+FOLDS = 5
 
 
 @dataclass
@@ -36,7 +40,8 @@ class System:
     """Weighted rows ``A`` (n_rows, ns + p): set-up columns first, ``r`` (n_rows,) the weighted
     residual of the readings against the reference, ``point`` (n_rows,) the point of each row,
     ``prior_s`` (ns,) the set-ups' prior weights (0: unknown), ``Sinv`` (p, p) the inverse of
-    the reference's covariance (report units), ``n_readings``."""
+    the reference's covariance (report units), ``n_readings``, ``folds`` of the
+    cross-validation (point ``i`` in fold ``i mod folds``)."""
 
     A: np.ndarray
     r: np.ndarray
@@ -45,22 +50,35 @@ class System:
     prior_s: np.ndarray
     Sinv: np.ndarray
     n_readings: int
+    folds: int = FOLDS
+
+    def __post_init__(self):
+        # the normal equations of each fold (point i in fold i mod folds), accumulated once
+        fold = self.point % self.folds
+        self.fold_of_row = fold
+        self._parts = []
+        for k in range(self.folds):
+            m = fold == k
+            A, r = self.A[m], self.r[m]
+            self._parts.append((A.T @ A, A.T @ r, float(r @ r)))
 
     @property
     def p(self) -> int:
         return self.A.shape[1] - self.ns
 
-    def normal(self, rows=None) -> tuple[np.ndarray, np.ndarray]:
-        """(G, b) of the data rows ``rows`` (all when None), with the set-up priors."""
-        A, r = (self.A, self.r) if rows is None else (self.A[rows], self.r[rows])
-        G = A.T @ A
+    def normal(self, leave_out=None) -> tuple[np.ndarray, np.ndarray, float]:
+        """(G, b, r.r) of the data rows, all or all but fold ``leave_out``, with the set-up
+        priors."""
+        parts = [q for k, q in enumerate(self._parts) if k != leave_out]
+        G = sum((q[0] for q in parts), np.zeros((self.A.shape[1],) * 2))
+        b = sum((q[1] for q in parts), np.zeros(self.A.shape[1]))
         G[:self.ns, :self.ns] += np.diag(self.prior_s)
-        return G, A.T @ r
+        return G, b, float(sum(q[2] for q in parts))
 
-    def solve(self, changed, rows=None) -> "Fit":
+    def solve(self, changed, leave_out=None) -> "Fit":
         """The fit with the parameters ``changed`` (indices into the reference's) free to
-        change, on the data rows ``rows`` (all when None)."""
-        G, b = self.normal(rows)
+        change, on all data rows or all but the fold ``leave_out``."""
+        G, b, rr = self.normal(leave_out)
         ns, p, k = self.ns, self.p, len(changed)
         E = np.zeros((p, k))
         E[list(changed), np.arange(k)] = 1.0
@@ -74,13 +92,12 @@ class System:
         bb = np.concatenate([b, np.zeros(k)])
         Ni = _inverse(N)
         z = Ni @ bb
-        rr = float(self.r @ self.r) if rows is None else float(self.r[rows] @ self.r[rows])
         return Fit(list(changed), z, Ni, max(rr - float(bb @ z), 0.0), ns, p)
 
     def data_information(self) -> np.ndarray:
         """(p, p) the check's information on the parameters alone, set-ups eliminated (the
         Schur complement of the set-up block), report units."""
-        G, _ = self.normal()
+        G, _, _ = self.normal()
         ns = self.ns
         S, B = G[:ns, :ns], G[:ns, ns:]
         return G[ns:, ns:] - B.T @ _inverse(S) @ B if ns else G
@@ -134,7 +151,9 @@ def build(model, ref, obs) -> System:
     units = obs.setup_units
     sfac = np.array([1e6 if u in ("urad", "ppm") else 1e3 for u in units])
     theta = ref.values / fac                                     # natural units
-    sigma = obs._sigmas()
+    # the readings' u inflated by the reference's Birge ratio when it exceeds 1 (its
+    # covariance is scaled by its variance factor the same way)
+    sigma = obs._sigmas() * np.sqrt(max(float(ref.data.get("variance_factor") or 1.0), 1.0))
     rows_A, rows_r, rows_pt = [], [], []
     y_all = obs.deviation.ravel()
     for _, idx in blocks.blocks(np.arange(obs.n)):
