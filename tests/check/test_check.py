@@ -186,3 +186,21 @@ def test_columns_a_check_cannot_tell_apart_are_named():
     sysm = System(A, np.zeros(n), np.arange(n), 1, np.zeros(1), np.eye(4), n)
     pairs, unseen = indistinguishable(sysm, ["P1", "P2", "P3", "P4"])
     assert pairs == [["P1", "P2"]] and unseen == ["P4"]
+
+
+def test_weekly_drift_and_jump(world):
+    """The issue's scenario on the exact chain: EX0C drifts 0.2 um a week, EA0C jumps by
+    15 urad at week 12; 20 weekly checks against the reference; and 20 of a clean machine."""
+    jump_week, jump = 12, 15.0
+    for week in (11, 12, 16):
+        planted = {**PLANTED, "EX0C": PLANTED["EX0C"] + 0.2 * week,
+                   "EA0C": PLANTED["EA0C"] + (jump if week >= jump_week else 0.0)}
+        d = _check(world, _filled(world, f"week{week}", planted, 100 + week))
+        named = {c["parameter"]: c for c in d["changed"]}
+        assert ("EA0C" in named) == (week >= jump_week), (week, named)
+        if "EA0C" in named:
+            assert abs(named["EA0C"]["change"] - jump) < 3 * named["EA0C"]["std"]
+        assert set(named) <= {"EX0C", "EA0C"}, named
+    false = sum(_check(world, _filled(world, f"clean_w{w}", PLANTED, 300 + w))["verdict"]
+                == "changed" for w in range(1, 21))
+    assert false <= 1
