@@ -14,7 +14,8 @@ from . import _volume
 METHOD = ("the readings against the reference's prediction by generalised least squares, the "
           "reference's covariance as a measurement of its parameters; the smallest set of "
           "changed parameters by forward selection (BIC gain > 10 and the chi-square "
-          "quantile of 1 - 0.05/p, and a cross-validated improvement with paired t > 3), "
+          "quantile of 1 - 0.05/p, and a cross-validated improvement with paired t above "
+          "min(3, the one-sided 5 % Student quantile)), "
           "then a backward pass; uncertainties of a change hold the reference's covariance "
           "and the check's readings")
 
