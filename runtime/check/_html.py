@@ -8,48 +8,47 @@ import html
 
 
 def _figure(d: dict) -> str:
-    """An inline PNG: change / std of every changed parameter, and the threshold."""
-    import base64
-    import io
+    """An ``<img>`` (embedded PNG): change / std of every changed parameter, and the
+    selection threshold."""
+    from ..plotstyle import embedded_img, figure, png, styled
 
-    from ..plotstyle import pyplot
+    @styled
+    def draw() -> bytes:
+        fig, ax = figure(height=2.8)
+        rows = d["changed"]
+        names = [c["parameter"] for c in rows] or ["(none)"]
+        z = [c["change"] / c["std"] if c["std"] else 0.0 for c in rows] or [0.0]
+        ax.barh(names, z, color="C3")
+        t = d["threshold_chi2"] ** 0.5
+        for s in (-t, t):
+            ax.axvline(s, color="0.4", ls="--", lw=0.8)
+        ax.set_xlabel("change / its standard uncertainty (dashed: the selection threshold)")
+        return png(fig)
 
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.0, 2.6))
-    rows = d["changed"]
-    names = [c["parameter"] for c in rows] or ["(none)"]
-    z = [c["change"] / c["std"] if c["std"] else 0.0 for c in rows] or [0.0]
-    ax.barh(names, z, color="C3")
-    t = d["threshold_chi2"] ** 0.5
-    for s in (-t, t):
-        ax.axvline(s, color="0.4", ls="--", lw=0.8)
-    ax.set_xlabel("change / standard uncertainty (dashed: the selection threshold)")
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode()
+    return embedded_img(draw(), "changes over their standard uncertainties")
 
 
 def check_html(d: dict) -> str:
     """The page of a check's JSON ``d`` (:meth:`volerr.check.CheckResult.to_dict`)."""
+    from ..plotstyle import unit
+
     e = html.escape
     v = d["volumetric_change_um"]
     rows = "".join(
         f"<tr><td>{e(c['parameter'])}</td><td>{c['reference']:.4g}</td>"
-        f"<td>{c['change']:+.4g}</td><td>{c['std']:.2g}</td><td>{e(c['unit'])}</td>"
+        f"<td>{c['change']:+.4g}</td><td>{c['std']:.2g}</td><td>{e(unit(c['unit']))}</td>"
         f"<td>{e(', '.join(c.get('indistinguishable_from', [])))}</td></tr>"
         for c in d["changed"])
-    table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>std (k=1)"
+    table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>std (k = 1)"
              f"</th><th>unit</th><th>indistinguishable from</th></tr>{rows}</table>"
              if rows else "<p>No parameter changed.</p>")
     apart = "".join(f"<li>{e(a)} and {e(b)}</li>" for a, b in d["indistinguishable"])
     tol = ""
     if d.get("tolerance"):
         t = d["tolerance"]
-        tol = "<h2>Tolerance</h2><table><tr><th>quantity</th><th>value</th><th>U (k=2)</th>" \
+        tol = "<h2>Tolerance</h2><table><tr><th>quantity</th><th>value</th><th>U (k = 2)</th>" \
               "<th>limit</th><th>verdict</th></tr>" + "".join(
-                  f"<tr><td>{e(i['quantity'])}</td><td>{i['value']:.4g} {e(i['unit'])}</td>"
+                  f"<tr><td>{e(i['quantity'])}</td><td>{i['value']:.4g} {e(unit(i['unit']))}</td>"
                   f"<td>{i['U']:.2g}</td><td>{i['limit']:g}</td><td>{e(i['verdict'])}</td>"
                   f"</tr>" for i in t["items"]) + f"</table><p>{e(t['rule'])}</p>"
     files = "".join(f"<li>{e(f['file'])} ({e(f['kind'])}, {f['n_readings']} readings, "
@@ -60,11 +59,11 @@ def check_html(d: dict) -> str:
 td,th{{padding:2px 8px;text-align:right}}</style></head><body>
 <h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
 <p>Against the reference {e(str(d['reference']['file']))}{' on ' + e(d['date']) if d.get('date') else ''}.
-Volumetric change over the working volume: max {v['max']:.3g} um, RMS {v['rms']:.3g} um.
+Volumetric change over the working volume: max {v['max']:.3g} µm, RMS {v['rms']:.3g} µm.
 Residual: Birge ratio {d['misfit']['birge_ratio']:.3g} on {d['misfit']['dof']} degrees of
 freedom{' -- a change none of the reference parameters explains' if d['misfit']['unexplained'] else ''}.</p>
 <h2>Changed</h2>{table}
-<img alt="changes" src="data:image/png;base64,{_figure(d)}">
+{_figure(d)}
 {'<h2>Cannot be told apart by this check</h2><ul>' + apart + '</ul>' if apart else ''}
 {tol}<h2>Files</h2><ul>{files}</ul><p>{e(d['method'])}</p></body></html>
 """

@@ -99,16 +99,19 @@ class CheckPlan:
         """The power table of the check (an HTML section)."""
         from html import escape
 
+        from ..plotstyle import unit
+
         rows = "".join(
             f"<tr><td>{escape(n)}</td><td>{_fmt(v['size'])}</td><td>{_fmt(v['power'])}</td>"
-            f"<td>{_fmt(v['size_95'])}</td><td>{_fmt(v['std'])}</td><td>{escape(v['unit'])}"
+            f"<td>{_fmt(v['size_95'])}</td><td>{_fmt(v['std'])}</td><td>{escape(unit(v['unit']))}"
             f"</td></tr>" for n, v in self.detectable.items())
         verdict = "detects" if self.meets else "does NOT detect"
         return (f"<h2>What this check detects</h2><p>Against the reference "
                 f"{escape(str(self.reference.path))}: it {verdict} a change of the volumetric "
-                f"error by {self.detect_um:g} um anywhere in the working volume with "
+                f"error by {self.detect_um:g} µm anywhere in the working volume with "
                 f"{_power.POWER:.0%} probability (false alarms below 5 %).</p><table><tr>"
-                f"<th>parameter</th><th>size ({self.detect_um:g} um)</th><th>power</th>"
+                f"<th>parameter</th><th>change moving the map by {self.detect_um:g} µm</th>"
+                f"<th>power</th>"
                 f"<th>detected with 95 %</th><th>std of a change</th><th>unit</th></tr>{rows}"
                 f"</table>")
 

@@ -93,21 +93,22 @@ def summary(run: dict) -> str:
 
 def _figure(path: Path, results: list) -> None:
     """EX0C and EA0B after each check (the reference updated by it) with 2 std bars."""
-    from ..plotstyle import pyplot, save
+    from ..plotstyle import figure, label, save, styled
 
-    plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.2))
-    weeks = np.arange(1, len(results) + 1)
-    for ax, name in zip(axes, ("EX0C", "EA0B")):
-        v = np.array([r["parameters"][name]["value"] for r in results])
-        s = np.array([r["parameters"][name]["std"] for r in results])
-        ax.errorbar(weeks, v, yerr=2 * s, fmt="o", ms=3, capsize=2)
-        hit = [i for i, r in enumerate(results)
-               if any(c["parameter"] == name for c in r["changed"])]
-        ax.plot(weeks[hit], v[hit], "o", mfc="none", mec="C3", ms=8, label="named changed")
-        ax.set_xlabel("week")
-        ax.set_ylabel(f"{name} ({results[0]['parameters'][name]['unit']})")
-        ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    save(fig, path)
-    plt.close(fig)
+    @styled
+    def draw():
+        fig, axes = figure(1, 2, height=3.6)
+        weeks = np.arange(1, len(results) + 1)
+        for ax, name in zip(axes, ("EX0C", "EA0B")):
+            v = np.array([r["parameters"][name]["value"] for r in results])
+            s = np.array([r["parameters"][name]["std"] for r in results])
+            ax.errorbar(weeks, v, yerr=2 * s, fmt="o", ms=3, capsize=2, label="after the check")
+            hit = [i for i, r in enumerate(results)
+                   if any(c["parameter"] == name for c in r["changed"])]
+            ax.plot(weeks[hit], v[hit], "o", mfc="none", mec="C3", ms=8, label="named changed")
+            ax.set_xlabel("week")
+            ax.set_ylabel(label(name, results[0]["parameters"][name]["unit"]))
+            ax.legend(loc="best")
+        save(fig, path)
+
+    draw()
