@@ -21,7 +21,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
 from .. import plan as planning
 from ..errors import InputError, require
@@ -36,7 +35,7 @@ MAX_READINGS = 200
 #: growth of the readings when a smaller check misses the power
 GROW = 1.25
 #: fewest rows (points) of a check: three held-out points in each fold of the
-#: cross-validation that confirms a change (:data:`volerr.check._select.FOLDS` folds)
+#: cross-validation that confirms a change (:data:`volerr.check._system.FOLDS` folds)
 MIN_ROWS = 15
 
 

@@ -10,8 +10,8 @@ pass that drops a parameter no longer earning its place given the others.
 2. the threshold is at least the chi-square (1 dof) quantile of ``1 - ALPHA / p`` (Bonferroni
    over the ``p`` candidates), so that a machine that did not change is called "changed"
    with a probability below ``ALPHA`` whatever ``n``;
-3. cross-validation: ``FOLDS`` folds of the points (point ``i`` in fold ``i mod FOLDS``;
-   every set-up keeps points in the training part), the held-out points' squared weighted
+3. cross-validation: :data:`volerr.check._system.FOLDS` folds of the points (point ``i`` in
+   fold ``i mod FOLDS``; every set-up keeps points in the training part), the held-out points' squared weighted
    residual with and without the candidate; the paired t must exceed the loop's ``CV_T``
    (3, for campaigns of thousands of points) or, for a check of few points, the one-sided
    5 % quantile of Student's t on ``n - 1`` degrees of freedom, whichever is smaller (a
@@ -37,7 +37,6 @@ import numpy as np
 
 from ..loop.fitting import CV_T
 from ..loop.select import BIC_GAIN
-from ._system import FOLDS  # noqa: F401  (the folds of step 3)
 
 #: false-alarm probability the threshold holds at least (a clean machine called "changed")
 ALPHA = 0.05
