@@ -204,3 +204,33 @@ def test_weekly_drift_and_jump(world):
     false = sum(_check(world, _filled(world, f"clean_w{w}", PLANTED, 300 + w))["verdict"]
                 == "changed" for w in range(1, 21))
     assert false <= 1
+
+
+@pytest.mark.slow
+def test_the_uncertainty_of_a_change_holds_the_reference(tmp_path):
+    """Over 20 re-drawn references (each its own calibration of the exact chain) and checks,
+    the change of EX0C (+2 um planted) is named every time and its z-score (estimate minus
+    truth over the stated std) has mean ~0 and spread ~1: the stated std holds both the
+    check's noise and the reference's error."""
+    from volerr.calibrate.run import calibrate
+    from volerr.check import check, plan_check
+    from volerr.plan import plan
+
+    plan(LAYOUT, [SPHERE], 80).write(tmp_path / "ref")
+    z = []
+    for k in range(20):
+        rng = np.random.default_rng(1000 + k)
+        ref = tmp_path / "r.csv"
+        shutil.copy(tmp_path / "ref" / "sphere.csv", ref)
+        plan_fill.fill(ref, LAYOUT, PLANTED, rng)
+        calibrate(LAYOUT, [ref], plan=False).write_json(tmp_path / "cal.json")
+        if k == 0:
+            plan_check(LAYOUT, tmp_path / "cal.json", [SPHERE], minutes=20).write(tmp_path / "c")
+        f = tmp_path / "c.csv"
+        shutil.copy(tmp_path / "c" / "sphere.csv", f)
+        plan_fill.fill(f, LAYOUT, {**PLANTED, "EX0C": PLANTED["EX0C"] + 2.0}, rng)
+        changed = {c["parameter"]: c for c in check(LAYOUT, tmp_path / "cal.json",
+                                                    [f]).to_dict()["changed"]}
+        assert "EX0C" in changed, (k, changed)
+        z.append((changed["EX0C"]["change"] - 2.0) / changed["EX0C"]["std"])
+    assert abs(np.mean(z)) < 0.6 and 0.6 < np.std(z, ddof=1) < 1.5, z
