@@ -81,9 +81,13 @@ def day(date: str) -> int:
     return _dt.date.fromisoformat(date).toordinal() - _dt.date(1970, 1, 1).toordinal()
 
 
-def date_of(d: float) -> str:
-    """ISO date of day ``d`` since 1970-01-01 (rounded to the nearest day)."""
-    return (_dt.date(1970, 1, 1) + _dt.timedelta(days=int(round(d)))).isoformat()
+def date_of(d: float) -> str | None:
+    """ISO date of day ``d`` since 1970-01-01 (rounded to the nearest day); None beyond the
+    calendar (years 1 to 9999: a forecast that far is "not foreseen")."""
+    try:
+        return (_dt.date(1970, 1, 1) + _dt.timedelta(days=int(round(d)))).isoformat()
+    except (OverflowError, ValueError):
+        return None
 
 
 def series_of(entries) -> dict:
