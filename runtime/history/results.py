@@ -176,6 +176,8 @@ def apply_reference(entry: Entry, reference: Entry, path) -> None:
     out = {}
     for name, v in entry.values.items():
         ref = reference.values.get(name)
+        if ref is None and v.change is None:
+            continue                # named unchanged, no number: nothing to keep
         require(ref is not None, f"{path}: the check names {name}, which its reference "
                                  f"calibration ({reference.source}) does not determine")
         require(not v.unit or v.unit == ref.unit,
@@ -189,23 +191,45 @@ def apply_reference(entry: Entry, reference: Entry, path) -> None:
 
 def _file_hashes(doc: dict, path: Path) -> list:
     """``[{"file", "sha256"}]`` of the instrument files the result names (its
-    ``instruments`` list, or ``files``): each looked for beside the result."""
-    names = []
-    for item in doc.get("instruments", []) or []:
-        if isinstance(item, dict) and isinstance(item.get("file"), str):
-            names.append(item["file"])
-    for item in doc.get("files", []) or []:
-        if isinstance(item, str):
-            names.append(item)
+    ``instruments`` or ``files`` list): the SHA-256 the result states, else that of the file
+    found beside the result (its path as written, relative to the result's folder), else
+    ``None``."""
+    named: dict = {}
+    for key in ("instruments", "files"):
+        for item in doc.get(key, []) or []:
+            if isinstance(item, str):
+                named.setdefault(item, None)
+            elif isinstance(item, dict) and isinstance(item.get("file"), str):
+                sha = item.get("sha256")
+                named[item["file"]] = sha if isinstance(sha, str) else named.get(item["file"])
     out = []
-    for name in dict.fromkeys(names):
-        f = Path(name) if Path(name).is_absolute() else path.parent / name
-        try:
-            digest = hashlib.sha256(f.read_bytes()).hexdigest() if f.is_file() else None
-        except OSError:
-            digest = None
+    for name, digest in named.items():
+        if digest is None:
+            f = Path(name) if Path(name).is_absolute() else path.parent / name
+            try:
+                digest = hashlib.sha256(f.read_bytes()).hexdigest() if f.is_file() else None
+            except OSError:
+                digest = None
         out.append({"file": name, "sha256": digest})
     return out
+
+
+def as_reference(entry: Entry, path) -> Entry:
+    """The values a later check's changes are relative to: a calibration's own; a check's
+    ``parameters`` (the reference updated by the check, as ``volerr check`` writes them)."""
+    if entry.kind == CALIBRATION:
+        return entry
+    import json as _json
+
+    doc = _json.loads(entry.document)
+    params = doc.get("parameters")
+    require(isinstance(params, dict) and params,
+            f"{path}: its reference is the check {entry.source}, which states no parameter "
+            f"values")
+    ref = _calibration({"layout": entry.layout, "parameters": params}, entry.source,
+                       entry.sha256, entry.document)
+    ref.date = entry.date
+    return ref
 
 
 def _own_date(doc: dict, path) -> str | None:
