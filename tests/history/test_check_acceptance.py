@@ -87,9 +87,11 @@ def campaign(tmp_path_factory):
                          "--json", str(js)]) == 0
             out.append(json.loads(js.read_text()) | {"_path": str(js)})
         checks[kind] = out
-    db = d / "history.sqlite"
     shown = {}
     for kind in ("drift", "clean"):
+        # one store per machine: both start from the same reference result, and a result
+        # belongs to one machine in a store
+        db = d / f"history_{kind}.sqlite"
         machine = f"DMU50-{kind}"
         assert main(["history", "add", "--db", str(db), "--machine", machine, "--date",
                      _date(0), str(cal)]) == 0
