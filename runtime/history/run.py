@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import re
+from pathlib import Path
 
 from ..errors import InputError, require
 from . import results
@@ -73,13 +74,20 @@ def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 1
         e.date = date or (check_date(e.date, f"{f}: its date") if e.date else today())
         entries.append((f, e))
     entries.sort(key=lambda fe: (fe[1].date, fe[1].kind != CALIBRATION))
-    store = Store(db, wait_s=wait_s, create=True)
     paths = {id(e): f for f, e in entries}
 
     def prepare(entry, stored):
         _prepare(entry, stored, paths[id(entry)])
 
-    return store.add(machine, [e for _, e in entries], prepare)
+    new_file = None if "://" in str(db) or Path(db).exists() else Path(db)
+    try:
+        store = Store(db, wait_s=wait_s, create=True)
+        return store.add(machine, [e for _, e in entries], prepare)
+    except InputError:
+        if new_file is not None:        # nothing written: not even the empty store
+            for f in (new_file, Path(f"{new_file}-journal")):
+                f.unlink(missing_ok=True)
+        raise
 
 
 def _prepare(entry, stored: list, path) -> None:
