@@ -259,3 +259,19 @@ def test_postgresql_two_processes_and_refusals(tmp_path, capsys, pg_db):
     bad = pg_db.rsplit(":", 1)[0] + ":1/none"
     code, _, err = run(["history", "show", "--db", bad, "--machine", "M1"], capsys)
     assert code == 2 and "cannot connect" in err and len(err.strip().splitlines()) == 1
+
+
+def test_postgresql_locked_one_line_nothing_lost(tmp_path, capsys, pg_db):
+    import psycopg
+
+    from volerr.history.store import _PG_LOCK_KEY
+
+    files = weekly(tmp_path, weeks=2)
+    add_all(pg_db, "M1", files[:1], capsys)
+    with psycopg.connect(pg_db.replace("postgresql://", "postgresql://", 1)) as holder:
+        holder.execute("SELECT pg_advisory_xact_lock(%s)", (_PG_LOCK_KEY,))
+        code, _, err = run(["history", "add", "--db", pg_db, "--machine", "M1", "--date",
+                            files[1][1], "--wait", "0.3", files[1][0]], capsys)
+        holder.rollback()
+    assert code == 2 and "locked" in err and len(err.strip().splitlines()) == 1, err
+    assert len(Store(pg_db).entries("M1")) == 1
