@@ -102,3 +102,22 @@ def test_forecast_date_and_band():
     assert away["date"] is not None      # -y falls towards -1e3: it is reached, far out
     flat = an.forecast(an.trend(series(1.0 + 0.2 * (-1.0) ** np.arange(10), s_i)), 50.0)
     assert None in flat["interval"]     # a slope not significant: one end open
+
+
+def test_a_drift_that_starts_later_is_no_event():
+    """Flat for 8 weeks, then 0.5 per week: a change of slope (no step, no event), and the
+    trend from where the drift starts."""
+    hits, slopes = 0, []
+    rng = np.random.default_rng(8)
+    for _ in range(40):
+        w = np.arange(20)
+        y = np.where(w >= 8, 0.5 * (w - 8), 0.0) + rng.normal(0, 0.2, 20)
+        s = series(y, np.full(20, 0.2))
+        ch = an.changes(s)
+        hits += bool(an.steps(s))
+        tr = an.trend(s, ch[-1]["index"] if ch else 0)
+        slopes.append(tr.b * 7)
+        if ch and ch[-1]["kind"] == an.SLOPE:
+            assert abs(ch[-1]["index"] - 8) <= 1
+    assert hits <= 1
+    assert abs(np.mean(slopes) - 0.5) < 0.02
