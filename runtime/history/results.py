@@ -9,7 +9,9 @@ What an entry keeps of its result (:class:`Entry`):
   urad, um/mm ...).  A calibration's values are its estimates (status ``estimated``).  A
   check states changes against its reference calibration; its values are the reference's
   value plus the change (status ``changed``), so every entry of a parameter lies on one
-  scale.  A parameter the check lists as ``unchanged`` with a number (``{"parameter",
+  scale.  A combination a calibration determines (``combinations``: ``EY0B + EY0C`` written
+  as ``EY0B``) is kept under its ``written_as`` name (status ``combination``), as a check
+  names it.  A parameter the check lists as ``unchanged`` with a number (``{"parameter",
   "change", "std"}``) is stored the same way (status ``unchanged``); one listed by name only
   carries no number (value and std ``None``) and is left out of every statistic;
 * ``covariance``: ``{"names": [...], "matrix": [[...]]}`` when the result carries one (in the
@@ -32,6 +34,7 @@ from ..errors import InputError, require
 
 CALIBRATION, CHECK = "calibration", "check"
 ESTIMATED, CHANGED, UNCHANGED = "estimated", "changed", "unchanged"
+COMBINATION = "combination"
 
 
 @dataclass(frozen=True)
@@ -108,6 +111,16 @@ def _calibration(doc: dict, path, sha: str, text: str) -> Entry:
         require(std >= 0, f"{where}: std must be >= 0, got {std}")
         values[str(name)] = Value(_number(rec["value"], f"{where} value"), std,
                                   str(rec.get("unit", "")), ESTIMATED)
+    for c in doc.get("combinations", []) or []:
+        # a combination the campaign determines (EY0B + EY0C), under the name it is written
+        # as: a later check states its change under that name
+        if not (isinstance(c, dict) and isinstance(c.get("written_as"), str)) \
+                or c["written_as"] in values:
+            continue
+        where = f"{path}: combination {c.get('expression', c['written_as'])}"
+        std = _number(c.get("std"), f"{where} std")
+        values[c["written_as"]] = Value(_number(c.get("value"), f"{where} value"), std,
+                                        str(c.get("unit", "")), COMBINATION)
     require(values, f"{path}: the calibration determined no parameter")
     return Entry(CALIBRATION, doc["layout"], values, sha, Path(path).name, text,
                  covariance=_covariance(doc.get("covariance"), values, path))

@@ -275,3 +275,20 @@ def test_postgresql_locked_one_line_nothing_lost(tmp_path, capsys, pg_db):
         holder.rollback()
     assert code == 2 and "locked" in err and len(err.strip().splitlines()) == 1, err
     assert len(Store(pg_db).entries("M1")) == 1
+
+
+def test_a_combination_of_the_reference_is_a_parameter_of_the_history(tmp_path, capsys):
+    """A calibration that determines only EY0B + EY0C (written as EY0B): a check's change of
+    EY0B is a change of that combination."""
+    ref = write_cal(tmp_path / "ref.json", {"EX0C": 1.0}, {"EX0C": 0.1}, extra={
+        "unidentifiable": ["EY0B", "EY0C"],
+        "combinations": [{"expression": "EY0B + EY0C", "value": -18.0, "unit": "um",
+                          "std": 0.1, "written_as": "EY0B"}]})
+    chk = _check_json(tmp_path / "c.json", [{"parameter": "EY0B", "change": 0.8, "unit": "um",
+                                             "std": 0.2, "combination": "EY0B + EY0C"}],
+                      ["EX0C"])
+    db = tmp_path / "h.sqlite"
+    add_all(db, "M1", [(ref, "2025-01-06"), (chk, "2025-01-13")], capsys)
+    e = Store(str(db)).entries("M1")
+    assert e[0].values["EY0B"].status == "combination"
+    assert e[1].values["EY0B"].value == pytest.approx(-17.2, abs=1e-12)
