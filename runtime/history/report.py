@@ -187,17 +187,22 @@ def parameter_figure(h: History, name: str):
         ax.axhline(c["centre"], color="0.5", lw=0.8)
         for e in st:
             ax.axvline(_dates([s.t[e["index"]]])[0], color="C1", lw=1.2)
+        f = h.data["forecast"].get(name)
         if tr is not None:
-            tt = np.linspace(s.t[len(s.t) - tr.n], s.t[-1] + 0.3 *
-                             max(np.ptp(s.t), 1.0), 60)
+            end = s.t[-1] + 0.3 * max(np.ptp(s.t), 1.0)
+            if f and f.get("date") and f.get("interval", [None, None])[1]:
+                end = max(end, an.day(f["interval"][1]) + 7.0)
+            tt = np.linspace(s.t[len(s.t) - tr.n], end, 80)
             v = np.array([tr.at(t) for t in tt])
             ax.plot(_dates(tt), v[:, 0], color="C2", label="trend since the last change")
             ax.fill_between(_dates(tt), v[:, 0] - 1.96 * v[:, 1], v[:, 0] + 1.96 * v[:, 1],
                             color="C2", alpha=0.2, label="trend, 95 % band")
-        f = h.data["forecast"].get(name)
         if f:
             for sgn in (1, -1):
                 ax.axhline(sgn * f["tolerance"], color="k", lw=0.8, ls=":")
+            if f.get("date"):
+                ax.axvline(_dates([an.day(f["date"])])[0], color="k", lw=1.0, ls="--",
+                           label=f"leaves the tolerance {f['date']}")
         ax.set_ylabel(label(name, s.unit))
         ax.legend(loc="best", fontsize=9)
         ax2.plot(x, [p["z"] for p in c["ewma"]], "o-", ms=3, label="EWMA z")
