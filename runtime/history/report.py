@@ -42,15 +42,18 @@ class History:
         from ..errors import require
 
         series = an.series_of(entries)
-        events, trends, control, forecast = [], {}, {}, {}
+        events, slopes, trends, control, forecast = [], [], {}, {}, {}
         fits = {}
         for name, s in series.items():
             control[name] = an.control(s)
-            st = an.steps(s)
+            ch = an.changes(s)
+            st = [c for c in ch if c["kind"] == an.STEP]
             events += [{"date": e["date"], "parameter": name, "change": e["change"],
                         "unit": s.unit, "std": e["std"], "previous_date": e["previous_date"]}
                        for e in st]
-            tr = an.trend(s, st[-1]["index"] if st else 0)
+            slopes += [{"date": e["date"], "parameter": name, "change_per_day": e["change"],
+                        "unit": s.unit, "std": e["std"]} for e in ch if e["kind"] == an.SLOPE]
+            tr = an.trend(s, ch[-1]["index"] if ch else 0)
             fits[name] = (st, tr)
             if tr is not None:
                 v, u = tr.at(tr.t0)
@@ -71,8 +74,10 @@ class History:
                   f"{an.MIN_TREND_POINTS} entries since the last event)"})
             forecast[name] = {**f, "tolerance": tol, "unit": series[name].unit}
         events.sort(key=lambda e: (e["date"], e["parameter"]))
+        slopes.sort(key=lambda e: (e["date"], e["parameter"]))
         data = {"machine": machine, "layout": entries[0].layout,
                 "entries": [_entry_dict(e) for e in entries], "events": events,
+                "slope_changes": slopes,
                 "trends": trends, "forecast": forecast, "control": control,
                 "method": METHOD}
         return cls(data, series, {n: f for n, f in fits.items()})
@@ -182,17 +187,22 @@ def parameter_figure(h: History, name: str):
         ax.axhline(c["centre"], color="0.5", lw=0.8)
         for e in st:
             ax.axvline(_dates([s.t[e["index"]]])[0], color="C1", lw=1.2)
+        f = h.data["forecast"].get(name)
         if tr is not None:
-            tt = np.linspace(s.t[st[-1]["index"]] if st else s.t[0], s.t[-1] + 0.3 *
-                             max(np.ptp(s.t), 1.0), 60)
+            end = s.t[-1] + 0.3 * max(np.ptp(s.t), 1.0)
+            if f and f.get("date") and f.get("interval", [None, None])[1]:
+                end = max(end, an.day(f["interval"][1]) + 7.0)
+            tt = np.linspace(s.t[len(s.t) - tr.n], end, 80)
             v = np.array([tr.at(t) for t in tt])
-            ax.plot(_dates(tt), v[:, 0], color="C2", label="trend since the last event")
+            ax.plot(_dates(tt), v[:, 0], color="C2", label="trend since the last change")
             ax.fill_between(_dates(tt), v[:, 0] - 1.96 * v[:, 1], v[:, 0] + 1.96 * v[:, 1],
                             color="C2", alpha=0.2, label="trend, 95 % band")
-        f = h.data["forecast"].get(name)
         if f:
             for sgn in (1, -1):
                 ax.axhline(sgn * f["tolerance"], color="k", lw=0.8, ls=":")
+            if f.get("date"):
+                ax.axvline(_dates([an.day(f["date"])])[0], color="k", lw=1.0, ls="--",
+                           label=f"leaves the tolerance {f['date']}")
         ax.set_ylabel(label(name, s.unit))
         ax.legend(loc="best", fontsize=9)
         ax2.plot(x, [p["z"] for p in c["ewma"]], "o-", ms=3, label="EWMA z")

@@ -9,7 +9,9 @@ What an entry keeps of its result (:class:`Entry`):
   urad, um/mm ...).  A calibration's values are its estimates (status ``estimated``).  A
   check states changes against its reference calibration; its values are the reference's
   value plus the change (status ``changed``), so every entry of a parameter lies on one
-  scale.  A parameter the check lists as ``unchanged`` with a number (``{"parameter",
+  scale.  A combination a calibration determines (``combinations``: ``EY0B + EY0C`` written
+  as ``EY0B``) is kept under its ``written_as`` name (status ``combination``), as a check
+  names it.  A parameter the check lists as ``unchanged`` with a number (``{"parameter",
   "change", "std"}``) is stored the same way (status ``unchanged``); one listed by name only
   carries no number (value and std ``None``) and is left out of every statistic;
 * ``covariance``: ``{"names": [...], "matrix": [[...]]}`` when the result carries one (in the
@@ -32,6 +34,7 @@ from ..errors import InputError, require
 
 CALIBRATION, CHECK = "calibration", "check"
 ESTIMATED, CHANGED, UNCHANGED = "estimated", "changed", "unchanged"
+COMBINATION = "combination"
 
 
 @dataclass(frozen=True)
@@ -108,6 +111,16 @@ def _calibration(doc: dict, path, sha: str, text: str) -> Entry:
         require(std >= 0, f"{where}: std must be >= 0, got {std}")
         values[str(name)] = Value(_number(rec["value"], f"{where} value"), std,
                                   str(rec.get("unit", "")), ESTIMATED)
+    for c in doc.get("combinations", []) or []:
+        # a combination the campaign determines (EY0B + EY0C), under the name it is written
+        # as: a later check states its change under that name
+        if not (isinstance(c, dict) and isinstance(c.get("written_as"), str)) \
+                or c["written_as"] in values:
+            continue
+        where = f"{path}: combination {c.get('expression', c['written_as'])}"
+        std = _number(c.get("std"), f"{where} std")
+        values[c["written_as"]] = Value(_number(c.get("value"), f"{where} value"), std,
+                                        str(c.get("unit", "")), COMBINATION)
     require(values, f"{path}: the calibration determined no parameter")
     return Entry(CALIBRATION, doc["layout"], values, sha, Path(path).name, text,
                  covariance=_covariance(doc.get("covariance"), values, path))
@@ -176,6 +189,8 @@ def apply_reference(entry: Entry, reference: Entry, path) -> None:
     out = {}
     for name, v in entry.values.items():
         ref = reference.values.get(name)
+        if ref is None and v.change is None:
+            continue                # named unchanged, no number: nothing to keep
         require(ref is not None, f"{path}: the check names {name}, which its reference "
                                  f"calibration ({reference.source}) does not determine")
         require(not v.unit or v.unit == ref.unit,
@@ -189,23 +204,45 @@ def apply_reference(entry: Entry, reference: Entry, path) -> None:
 
 def _file_hashes(doc: dict, path: Path) -> list:
     """``[{"file", "sha256"}]`` of the instrument files the result names (its
-    ``instruments`` list, or ``files``): each looked for beside the result."""
-    names = []
-    for item in doc.get("instruments", []) or []:
-        if isinstance(item, dict) and isinstance(item.get("file"), str):
-            names.append(item["file"])
-    for item in doc.get("files", []) or []:
-        if isinstance(item, str):
-            names.append(item)
+    ``instruments`` or ``files`` list): the SHA-256 the result states, else that of the file
+    found beside the result (its path as written, relative to the result's folder), else
+    ``None``."""
+    named: dict = {}
+    for key in ("instruments", "files"):
+        for item in doc.get(key, []) or []:
+            if isinstance(item, str):
+                named.setdefault(item, None)
+            elif isinstance(item, dict) and isinstance(item.get("file"), str):
+                sha = item.get("sha256")
+                named[item["file"]] = sha if isinstance(sha, str) else named.get(item["file"])
     out = []
-    for name in dict.fromkeys(names):
-        f = Path(name) if Path(name).is_absolute() else path.parent / name
-        try:
-            digest = hashlib.sha256(f.read_bytes()).hexdigest() if f.is_file() else None
-        except OSError:
-            digest = None
+    for name, digest in named.items():
+        if digest is None:
+            f = Path(name) if Path(name).is_absolute() else path.parent / name
+            try:
+                digest = hashlib.sha256(f.read_bytes()).hexdigest() if f.is_file() else None
+            except OSError:
+                digest = None
         out.append({"file": name, "sha256": digest})
     return out
+
+
+def as_reference(entry: Entry, path) -> Entry:
+    """The values a later check's changes are relative to: a calibration's own; a check's
+    ``parameters`` (the reference updated by the check, as ``volerr check`` writes them)."""
+    if entry.kind == CALIBRATION:
+        return entry
+    import json as _json
+
+    doc = _json.loads(entry.document)
+    params = doc.get("parameters")
+    require(isinstance(params, dict) and params,
+            f"{path}: its reference is the check {entry.source}, which states no parameter "
+            f"values")
+    ref = _calibration({"layout": entry.layout, "parameters": params}, entry.source,
+                       entry.sha256, entry.document)
+    ref.date = entry.date
+    return ref
 
 
 def _own_date(doc: dict, path) -> str | None:

@@ -12,9 +12,12 @@ Rules of ``add`` (the store's own rules in :mod:`volerr.history.store`):
   not from the future); a date before the stored entries is accepted (an old certificate
   back-filled takes its place in date order).
 * All entries of a machine are of one layout; a parameter keeps its unit.
-* A check needs its reference calibration in the machine's history: the one it names by
-  SHA-256 (``"reference_sha256"`` or ``"reference": {"sha256"}``), else the latest
-  calibration dated on or before the check; it must not be dated after the check.
+* A check needs its reference in the machine's history: the calibration (or earlier check,
+  whose ``parameters`` are then the base) it names by SHA-256 (``"reference_sha256"`` or
+  ``"reference": {"sha256"}``), else the latest calibration dated on or before the check; the
+  reference must not be dated after the check.
+* The files of one ``add`` are stored in date order (calibrations before checks of the same
+  date), so a reference and its checks can be added at once.
 * Several files in one ``add``: one transaction, all or none.
 """
 
@@ -22,6 +25,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import re
+from pathlib import Path
 
 from ..errors import InputError, require
 from . import results
@@ -69,13 +73,21 @@ def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 1
         e = results.read(f)
         e.date = date or (check_date(e.date, f"{f}: its date") if e.date else today())
         entries.append((f, e))
-    store = Store(db, wait_s=wait_s, create=True)
+    entries.sort(key=lambda fe: (fe[1].date, fe[1].kind != CALIBRATION))
     paths = {id(e): f for f, e in entries}
 
     def prepare(entry, stored):
         _prepare(entry, stored, paths[id(entry)])
 
-    return store.add(machine, [e for _, e in entries], prepare)
+    new_file = None if "://" in str(db) or Path(db).exists() else Path(db)
+    try:
+        store = Store(db, wait_s=wait_s, create=True)
+        return store.add(machine, [e for _, e in entries], prepare)
+    except InputError:
+        if new_file is not None:        # nothing written: not even the empty store
+            for f in (new_file, Path(f"{new_file}-journal")):
+                f.unlink(missing_ok=True)
+        raise
 
 
 def _prepare(entry, stored: list, path) -> None:
@@ -99,17 +111,15 @@ def _prepare(entry, stored: list, path) -> None:
 
 
 def _reference(entry, stored: list, path):
-    cals = [e for e in stored if e.kind == CALIBRATION]
     if entry.reference_sha256:
-        named = [e for e in cals if e.sha256 == entry.reference_sha256]
-        require(named, f"{path}: its reference calibration (sha256 "
-                       f"{entry.reference_sha256[:12]}...) is not in this machine's history; "
-                       f"add it first")
+        named = [e for e in stored if e.sha256 == entry.reference_sha256]
+        require(named, f"{path}: its reference (sha256 {entry.reference_sha256[:12]}...) is "
+                       f"not in this machine's history; add it first")
         ref = named[0]
         require(ref.date <= entry.date, f"{path}: dated {entry.date}, before its reference "
-                                        f"calibration ({ref.source}, {ref.date})")
-        return ref
-    before = [e for e in cals if e.date <= entry.date]
+                                        f"({ref.source}, {ref.date})")
+        return results.as_reference(ref, path)
+    before = [e for e in stored if e.kind == CALIBRATION and e.date <= entry.date]
     require(before, f"{path}: a check dated {entry.date}, and no calibration of this machine "
                     f"on or before that date in the history; add the reference first")
     return before[-1]

@@ -1,8 +1,10 @@
 """The volumetric error over the working volume from a history's parameters (``map=`` tolerances).
 
-``M(p)`` = the largest length of the volumetric error vector (um) over a grid of the layout's
-travel (:data:`GRID` points per axis, corners included; tool point at the spindle reference,
-offset 0) for parameter values ``p``.  The model is first order (linear in the parameters),
+``M(p)`` = the largest length of the volumetric error vector (um) over the layout's travel
+(tool point at the spindle reference, offset 0) for parameter values ``p``: the linear axes
+at the corners of their travel (with the rotary axes fixed the error of the constant
+parameters is affine in the linear axes, so its length is largest at a corner), the rotary
+axes every :data:`ROTARY_STEP_DEG` (each angle once modulo 360).  The model is first order (linear in the parameters),
 so ``E(pos) = sum_j A_j(pos) p_j`` with ``A_j`` the model's volumetric error for a unit value
 of parameter j, computed once.  The parameters that enter: the layout's constants
 (squareness, location and orientation of rotary axes: the ISO names of ``m.parameters``
@@ -23,14 +25,14 @@ import itertools
 
 import numpy as np
 
-#: grid points per axis of the travel
-GRID = 3
+#: angle step of the rotary axes' grid, deg
+ROTARY_STEP_DEG = 30.0
 #: days after the last entry the forecast looks ahead
 HORIZON_DAYS = 3650
 #: days between the evaluations of M (linear between them)
 STEP_DAYS = 7.0
 #: Monte Carlo draws of the trends
-SAMPLES = 400
+SAMPLES = 200
 #: seed of the draws
 SEED = 37
 _SCALE = {"um": 1e-3, "urad": 1e-6}
@@ -42,13 +44,22 @@ def sensitivities(layout: str, units: dict) -> tuple[list, np.ndarray, list]:
     from ..machine import load
 
     m = load(layout)
-    grids = [np.linspace(*m.travel[a], GRID) for a in m.axes]
+    grids = [_rotary_grid(*m.travel[a]) if a in m.rotary_axes else np.array(m.travel[a])
+             for a in m.axes]
     pos = np.array(list(itertools.product(*grids)))
     used = [n for n in sorted(units) if n in m.parameters and m.parameter_axis.get(n) is None
             and units[n] in _SCALE]
     cols = [m.volumetric_error(pos, {n: _SCALE[units[n]]}) * 1e3 for n in used]
     A = np.stack(cols, axis=2) if cols else np.zeros((len(pos), 3, 0))
     return used, A, [n for n in sorted(units) if n not in used]
+
+
+def _rotary_grid(lo: float, hi: float) -> np.ndarray:
+    """Angles every :data:`ROTARY_STEP_DEG` over the travel, each angle once modulo 360."""
+    n = int(np.floor((hi - lo) / ROTARY_STEP_DEG + 1e-9)) + 1
+    a = lo + ROTARY_STEP_DEG * np.arange(n)
+    _, first = np.unique(np.round(np.mod(a, 360.0), 9), return_index=True)
+    return a[np.sort(first)]
 
 
 def map_max(A: np.ndarray, p: np.ndarray) -> np.ndarray:

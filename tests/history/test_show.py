@@ -1,0 +1,65 @@
+"""``volerr history show``: the weekly scenario's event, trend and forecast against the
+planted truth, the map= forecast against the model's volumetric error on a dense grid, the
+HTML page."""
+
+import datetime as dt
+import itertools
+import json
+
+import numpy as np
+import pytest
+
+import volerr
+
+from .conftest import START, add_all, run, weekly, write_cal
+
+
+def test_weekly_calibrations_event_trend_forecast(tmp_path, capsys):
+    db = tmp_path / "h.sqlite"
+    add_all(db, "M1", weekly(tmp_path, weeks=21, seed=7), capsys)
+    code, out, err = run(["history", "show", "--db", db, "--machine", "M1", "--tolerance",
+                          "EX0C=15 um,EY0C=0.003 mm", "--json", tmp_path / "s.json", "--html",
+                          tmp_path / "s.html"], capsys)
+    assert code == 0, err
+    d = json.loads((tmp_path / "s.json").read_text())
+    ev = d["events"]
+    assert [(e["parameter"], e["date"]) for e in ev] == [
+        ("EY0C", (START + dt.timedelta(weeks=12)).isoformat())]
+    assert abs(ev[0]["change"] - 4.0) < 3 * ev[0]["std"]
+    slope = d["trends"]["EX0C"]["slope_per_day"]
+    assert abs(slope - 0.3 / 7) < 3 * d["trends"]["EX0C"]["std"]
+    truth = START + dt.timedelta(days=(15 - 5) / (0.3 / 7))
+    f = d["forecast"]["EX0C"]
+    assert abs((dt.date.fromisoformat(f["date"]) - truth).days) <= 20
+    lo, hi = (dt.date.fromisoformat(x) for x in f["interval"])
+    assert lo <= truth <= hi
+    assert d["forecast"]["EY0C"]["tolerance"] == pytest.approx(3.0)
+    page = (tmp_path / "s.html").read_text()
+    assert page.count("data:image/png;base64,") == 3 and "EY0C" in page
+
+
+def test_map_forecast_against_a_dense_grid(tmp_path, capsys):
+    """Only EX0C drifts (0.5 um/week from 2 um): the map's date is when 2 + 0.5 w times the
+    largest |error| per um of EX0C over a dense grid of the travel reaches the tolerance."""
+    m = volerr.load("DMU50")
+    grids = [np.linspace(*m.travel[a], 2) if a not in m.rotary_axes else
+             np.arange(m.travel[a][0], m.travel[a][1] + 1e-9, 5.0) for a in m.axes]
+    pos = np.array(list(itertools.product(*grids)))
+    k = np.linalg.norm(m.volumetric_error(pos, {"EX0C": 1e-3}), axis=1).max() * 1e3
+    rng = np.random.default_rng(2)
+    files = []
+    for w in range(10):
+        f = write_cal(tmp_path / f"c{w}.json", {"EX0C": 2 + 0.5 * w + rng.normal(0, 0.05)},
+                      {"EX0C": 0.05})
+        files.append((f, (START + dt.timedelta(weeks=w)).isoformat()))
+    db = tmp_path / "h.sqlite"
+    add_all(db, "M1", files, capsys)
+    tol = 30.0
+    code, _, err = run(["history", "show", "--db", db, "--machine", "M1", "--tolerance",
+                        f"map={tol} um", "--json", tmp_path / "s.json"], capsys)
+    assert code == 0, err
+    f = json.loads((tmp_path / "s.json").read_text())["forecast"]["map"]
+    truth = START + dt.timedelta(weeks=(tol / k - 2) / 0.5)
+    assert abs((dt.date.fromisoformat(f["date"]) - truth).days) <= 7
+    lo, hi = (dt.date.fromisoformat(x) for x in f["interval"])
+    assert lo <= truth <= hi
