@@ -200,7 +200,8 @@ def _close_rivals(a, rivals: list, ctx, base) -> tuple[list, float]:
     scores = base.score_many([ctx.group(c.terms) for c in refined]) if refined else []
     close = [(base.dbic(g, r + _extra(c)), c) for c, (g, r) in zip(refined, scores)
              if r and base.dbic(g, r + _extra(c)) - d_a < BIC_TIE]
-    close.sort(key=lambda t: t[0])
+    fitting.rank(close, {c.name: i for i, c in enumerate(rivals)}, dbic=lambda t: t[0],
+                 name=lambda t: t[1].name)
     return close, d_a
 
 

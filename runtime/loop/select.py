@@ -22,7 +22,7 @@ import numpy as np
 
 from . import candidates as cands
 from .fitting import CV_T, cv_sq as _cv_sq, dense_group as _dense_group
-from .fitting import full_base as _full_base, stack as _stack
+from .fitting import full_base as _full_base, rank, stack as _stack
 from ..estimate.blocks import BlockBase, blocks
 from ..estimate.design import TWIST, rows_of
 from ..machine.expressions import evaluate, lag_calls
@@ -367,8 +367,7 @@ def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
             fixed[c.name] = c
             out[i] = _scored(c, ctx, base)
     out = [x for x in out if x.rank]
-    out.sort(key=lambda x: x.dbic)
-    _prefer_first_of_ties(out, candidates)
+    rank(out, _order(candidates))
     return out
 
 
@@ -377,22 +376,15 @@ def rescore(scored: list, ctx: Context, base: Base, candidates, top: int) -> lis
     training points, then the rest as they were."""
     head = _scored_many([x.cand for x in scored[:top]], ctx, base)
     head = [x for x in head if x.rank]
-    head.sort(key=lambda x: x.dbic)
-    _prefer_first_of_ties(head, candidates)
+    rank(head, _order(candidates))
     return head + scored[top:]
 
 
-def _prefer_first_of_ties(scored: list, candidates: list) -> None:
-    """Among candidates that fit the data identically (e.g. on a CMM ``EZX`` depending on ``Y``
-    and ``EZY`` depending on ``X``), put the one listed first by
-    :func:`volerr.loop.candidates.build` in front: the choice does not depend on rounding."""
-    if len(scored) < 2:
-        return
-    order = {c.name: i for i, c in enumerate(candidates)}
-    d0 = scored[0].dbic
-    ties = [i for i, s in enumerate(scored) if abs(s.dbic - d0) <= 1e-7 * abs(d0) + 1e-9]
-    first = min(ties, key=lambda i: order.get(scored[i].cand.name, len(order)))
-    scored.insert(0, scored.pop(first))
+def _order(candidates: list) -> dict:
+    """Candidate name -> its position in the candidate list: the order in which candidates
+    that fit the data identically (on a CMM ``EZX`` depending on ``Y`` and ``EZY`` depending
+    on ``X``; a growing tool and ``EZB`` at one tool length) are named (:func:`fitting.rank`)."""
+    return {c.name: i for i, c in enumerate(candidates)}
 
 
 def sources(scored: list, n_points: int, accepted=()) -> list:
@@ -470,7 +462,7 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             break
         hit = None
         from .lags import prefer_plain
-        scored = _lag_leaders_refined(scored, A_all, ctx, train, w_rows, y)
+        scored = _lag_leaders_refined(scored, A_all, ctx, train, w_rows, y, _order(candidates))
         prefer_plain(scored, TOP_FIT)
         for x in scored[:TOP_FIT]:
             if x.dbic > -BIC_GAIN:
@@ -517,7 +509,7 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     return Selection(accepted, A_all, first or [], last, len(candidates))
 
 
-def _lag_leaders_refined(scored: list, A_all, ctx, train, w_rows, y) -> list:
+def _lag_leaders_refined(scored: list, A_all, ctx, train, w_rows, y, order: dict) -> list:
     """The leaders (``2 TOP_FIT``) with the time constant of every lag candidate among them
     that explains at least ``lags.NEAR`` of the best one's RSS reduction refined on all
     training points, scored there and sorted again.  Screening fixes a time constant on a
@@ -542,7 +534,7 @@ def _lag_leaders_refined(scored: list, A_all, ctx, train, w_rows, y) -> list:
             c.info["lag_std_s"] = None if std is None else round(std, 1)
         cs.append(c)
     head = [x for x in _scored_many(cs, ctx, base) if x.rank]
-    head.sort(key=lambda x: x.dbic)
+    rank(head, order)
     return head + scored[2 * TOP_FIT:]
 
 

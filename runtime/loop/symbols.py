@@ -28,7 +28,7 @@ Which symbols, with which bases:
   The scale of a linear axis is its positioning error's slope (``thermal_X``), already one.
 
 Order of the candidates (ties between candidates that give the same columns go to the one
-listed first, :func:`volerr.loop.select._prefer_first_of_ties`): the layout's constants
+listed first, :func:`volerr.loop.fitting.rank`): the layout's constants
 before the declared parameters (``d`` of the DMU 50 moves the tool exactly as the location
 error ``EY0B`` does: the report names the layout's ``d`` and lists the other as
 indistinguishable), the probe and axis symbols after the instrument's set-up and before the

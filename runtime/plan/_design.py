@@ -44,6 +44,22 @@ RESTARTS = 4
 RESTART_SIZE = 600
 #: iterations of the multiplicative algorithm
 ALLOCATION_STEPS = 60
+#: gains within this fraction of the best are one gain (a tie): the candidate listed first
+#: wins.  Mirror-image set-ups bring the same information; computed through a nearly
+#: singular start their gains differ in the last bits, which differ between BLAS kernels
+TIE_REL = 1e-6
+
+
+def argbest(values, tol: float | None = None) -> int:
+    """Index of the largest value; values within ``tol`` of it (default ``TIE_REL`` of its
+    size) are one value, and the lowest index (the candidates' order) wins: the plan does not
+    depend on rounding."""
+    v = np.asarray(values, float)
+    top = float(np.max(v))
+    if not np.isfinite(top):
+        return int(np.argmax(v))
+    tol = TIE_REL * abs(top) if tol is None else tol
+    return int(np.flatnonzero(v >= top - tol)[0])
 
 
 @dataclass
@@ -112,7 +128,7 @@ def greedy(cand: Candidates, W, P0, kind: str, k_max: int, caps: dict) -> list:
     while len(chosen) < k_max and free.any():
         g = gains(np.linalg.inv(M), W, cand.factor, kind)
         g[~free] = -np.inf
-        best = int(np.argmax(g))
+        best = argbest(g)
         chosen.append(best)
         free[best] = False
         M = M + cand.info[best]
@@ -151,8 +167,8 @@ def exchange(cand: Candidates, W, P0, kind: str, chosen: list, locked=()) -> lis
             F = cand.factor[free]
             V = np.concatenate([F, np.broadcast_to(cand.factor[s], F.shape)], axis=2)
             g = gains(Minv, W, V, kind, sign)
-            c = int(np.argmax(g))
-            if g[c] > best[0]:
+            c = argbest(g)
+            if g[c] > best[0] * (1 + TIE_REL):
                 best = (g[c], pos, int(free[c]))
         if best[1] is None:
             break
@@ -181,7 +197,7 @@ def best_exchange(cand: Candidates, W, P0, kind: str, start: list, restarts: int
     ends = [exchange(cand, W, P0, kind, s) for s in starts]
     value = [criterion(P0 + ridge * np.eye(q) + cand.info[e].sum(axis=0), W, kind)
              for e in ends]
-    return ends[int(np.argmin(value))]
+    return ends[argbest(-np.asarray(value))]
 
 
 def allocate(cand: Candidates, W, P0, kind: str, chosen: list, readings: int) -> np.ndarray:
@@ -209,10 +225,10 @@ def _whole(target, lo, hi, readings: int) -> np.ndarray:
     allow)."""
     m = np.clip(np.floor(target).astype(int), lo, hi)
     while m.sum() > readings and (m > lo).any():
-        j = int(np.argmax(np.where(m > lo, m - target, -np.inf)))
+        j = argbest(np.where(m > lo, m - target, -np.inf), tol=1e-9)
         m[j] -= 1
     while m.sum() < readings and (m < hi).any():
-        m[int(np.argmax(np.where(m < hi, target - m, -np.inf)))] += 1
+        m[argbest(np.where(m < hi, target - m, -np.inf), tol=1e-9)] += 1
     return m
 
 

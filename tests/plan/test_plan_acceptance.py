@@ -44,7 +44,19 @@ import pytest
 from helpers import instrument_sim as S
 from helpers import plan_exec as P
 
-K_SIGMA = 3.0
+#: the chance that an unbiased calibration fails the value check of one case: the bound per
+#: parameter is Bonferroni's over the parameters checked together (a 3-std bound on each of
+#: 12 parameters fails 3 % of unbiased runs: which cases passed depended on the seed)
+FAMILY_ALPHA = 1e-3
+
+
+def k_sigma(n_checked: int) -> float:
+    """|value - truth| / std bound for ``n_checked`` estimates checked together."""
+    from scipy.stats import norm
+
+    return float(norm.isf(FAMILY_ALPHA / (2 * max(n_checked, 1))))
+
+
 STD_RATIO = (0.7, 1.4)
 UNITS = {"um", "urad", "um/mm", "urad/mm", "um/deg", "urad/deg"}
 KINDS = {"ballbar", "sphere", "distances", "interferometer", "artifact"}
@@ -286,13 +298,14 @@ def test_calibrate_recovers_the_planted_parameters(runs, case):
     assert not missing, (case, "requested but not determined", missing,
                          x.doc.get("unidentifiable"))
     bad = []
+    k = k_sigma(len(got))
     for name, e in got.items():
         truth = x.truth.get(name, 0.0)
         if name in p.requested:
             assert e["unit"] == p.requested[name]["unit"], (name, e, p.requested[name])
-        if not abs(e["value"] - truth) <= K_SIGMA * e["std"]:
+        if not abs(e["value"] - truth) <= k * e["std"]:
             bad.append((name, e["value"], truth, e["std"]))
-    assert not bad, (case, "outside 3 std of the planted value", bad)
+    assert not bad, (case, f"outside {k:.2f} std of the planted value", bad)
 
 
 @pytest.mark.parametrize("case", ALL)
@@ -368,7 +381,7 @@ def test_mixed_campaign_determines_what_no_instrument_does_alone(runs, case):
     for n in joint:
         e = x.doc["parameters"].get(n)
         assert e is not None, (n, "not determined by calibrate", x.doc.get("unidentifiable"))
-        assert abs(e["value"] - x.truth[n]) <= K_SIGMA * e["std"], (n, e, x.truth[n])
+        assert abs(e["value"] - x.truth[n]) <= k_sigma(len(joint)) * e["std"], (n, e, x.truth[n])
     # the claim checked: each kind's files alone, asked for the same parameters (the plan's
     # whole request), leave every "joint" parameter undetermined and determine those the
     # plan says they determine

@@ -57,6 +57,20 @@ def _execute(tmp, folder, doc, planted, seed):
                      plan=False).data
 
 
+#: probability that an unbiased calibration fails the value check of one executed plan
+FAMILY_ALPHA = 1e-3
+
+
+def _family_bound(n_parameters: int) -> float:
+    """The |value - planted| / std bound that ``n_parameters`` unbiased estimates all meet
+    with probability 1 - FAMILY_ALPHA (Bonferroni).  A 3-std bound on each of 17 parameters
+    fails 4.5 % of unbiased runs: the DMU50 sweeps plan's EA0Z at -3.27 std was one of them
+    (over 300 seeds of that plan every parameter's z has mean within 0.15 and s.d. 0.93-1.06)."""
+    from scipy.stats import norm
+
+    return float(norm.isf(FAMILY_ALPHA / (2 * n_parameters)))
+
+
 @pytest.mark.parametrize("name,seed", [("ballbar", 3), ("sphere", 4), ("mixed", 5),
                                        ("sweeps", 6)])
 def test_executed_plan_gives_the_predicted_std(plans, tmp_path, name, seed):
@@ -69,10 +83,11 @@ def test_executed_plan_gives_the_predicted_std(plans, tmp_path, name, seed):
     cal = _execute(tmp_path, folder, doc, planted, seed)
     assert set(cal["parameters"]) == set(doc["parameters"])
     vf = cal["variance_factor"]
+    k = _family_bound(len(doc["parameters"]))
     for n, pred in doc["parameters"].items():
         got = cal["parameters"][n]
         assert got["unit"] == pred["unit"]
-        assert abs(got["value"] - planted.get(n, 0.0)) < 3 * got["std"], (n, got)
+        assert abs(got["value"] - planted.get(n, 0.0)) < k * got["std"], (n, got, k)
         assert 0.7 <= got["std"] / pred["predicted_std"] <= 1.4, (n, got, pred)
         # the same normal equations: equal once the a-posteriori variance factor is removed
         assert got["std"] / np.sqrt(vf) == pytest.approx(pred["predicted_std"], rel=2e-3)
