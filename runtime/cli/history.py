@@ -10,7 +10,7 @@ Parses arguments and calls :mod:`volerr.history`; the rules are stated there and
 
 from __future__ import annotations
 
-from ._common import add_force, add_html, add_json
+from ._common import add_html, add_json
 
 EPILOG = """\
 DB: a file (SQLite, created by the first add) or a postgresql:// URL (a server; needs
@@ -63,7 +63,6 @@ def register(sub) -> None:
                          "map=): the date each is left, with a 95 %% interval")
     add_json(sh, "the history (entries, events, trends, forecast, control charts)")
     add_html(sh, "the history page (one chart per parameter)")
-    add_force(sh)
     sh.set_defaults(func=run_show)
 
 
@@ -89,7 +88,7 @@ def run_show(args) -> int:
     from ..fileio import Outputs, write_text
 
     wait = _wait(args)
-    outs = Outputs([] if "://" in args.db else [args.db], force=args.force) \
+    outs = Outputs([] if "://" in args.db else [args.db], force=False) \
         .file("--json", args.json).file("--html", args.html).check()
     h = history.show(args.db, args.machine, args.tolerance, wait)
     text = h.html() if args.html else None

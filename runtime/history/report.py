@@ -144,6 +144,11 @@ def _map_forecast(entries, series, fits, tol: float) -> dict:
 
     units = {n: s.unit for n, s in series.items()}
     used, A, left = volume.sensitivities(entries[0].layout, units)
+    if not used:
+        return {"date": None, "interval": [None, None], "tolerance": tol, "unit": "um",
+                "parameters": [], "left_out": left,
+                "note": "no constant parameter (location, squareness) with a value in the "
+                        "history"}
     t_last = max(float(s.t[-1]) for s in series.values())
     lines = []
     for n in used:

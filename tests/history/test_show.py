@@ -63,3 +63,21 @@ def test_map_forecast_against_a_dense_grid(tmp_path, capsys):
     assert abs((dt.date.fromisoformat(f["date"]) - truth).days) <= 7
     lo, hi = (dt.date.fromisoformat(x) for x in f["interval"])
     assert lo <= truth <= hi
+
+
+def test_map_without_constants_and_unknown_tolerance(tmp_path, capsys):
+    f = write_cal(tmp_path / "c.json", {"EXX@slope": 1.0}, {"EXX@slope": 0.1})
+    db = tmp_path / "h.sqlite"
+    add_all(db, "M1", [(f, "2025-01-06")], capsys)
+    code, _, err = run(["history", "show", "--db", db, "--machine", "M1", "--tolerance",
+                        "map=30 um", "--json", tmp_path / "s.json"], capsys)
+    assert code == 0, err
+    m = json.loads((tmp_path / "s.json").read_text())["forecast"]["map"]
+    assert m["date"] is None and m["left_out"] == ["EXX@slope"]
+    for tol, word in (("EX0C=3 um", "not a parameter"), ("EXX@slope=3 urad", "given in urad"),
+                      ("map=3 urad", "map=VALUE um"), ("EXX@slope", "NAME=VALUE")):
+        code, _, err = run(["history", "show", "--db", db, "--machine", "M1", "--tolerance",
+                            tol], capsys)
+        assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (tol, err)
+    code, _, err = run(["history", "show", "--db", db, "--machine", "M2"], capsys)
+    assert code == 2 and "no entries" in err and "M1" in err
