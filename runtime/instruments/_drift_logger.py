@@ -40,7 +40,7 @@ _DEGC = ("°c", "degc", "c", "℃", "deg c", "° c")
 _RPM = ("rpm", "1/min", "min-1", "u/min")
 _SPINDLE = ("spindle", "s", "speed", "n", "spindle speed", "spindle_speed", "sp")
 #: ``NAME(unit)``, ``NAME [unit]``, ``NAME_unit`` (the last only for known units)
-_BRACKET = re.compile(r"^(.*?)\s*[(\[]\s*([^)\]]*)\s*[)\]]\s*$")
+BRACKET = re.compile(r"^(.*?)\s*[(\[]\s*([^)\]]*)\s*[)\]]\s*$")
 
 
 def _ident(text: str) -> str:
@@ -50,7 +50,7 @@ def _ident(text: str) -> str:
 
 def split_unit(cell: str) -> tuple[str, str | None]:
     """``'ch1(um)'`` -> (``'ch1'``, ``'um'``); ``'Time'`` -> (``'Time'``, None)."""
-    m = _BRACKET.match(cell.strip())
+    m = BRACKET.match(cell.strip())
     if m:
         return m.group(1).strip(), m.group(2).strip()
     head, sep, tail = cell.strip().rpartition("_")

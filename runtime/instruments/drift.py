@@ -93,12 +93,16 @@ class DriftRun:
 
 
 def detect(names) -> bool:
-    """A drift file has a time column and at least one displacement channel (after the
-    logger mapping)."""
-    try:
-        mapped = logger.map_header(names, "file", time_unit="s")
-    except InputError:
-        return False
+    """A drift file has a time column and at least one displacement channel: by their drift
+    names, or a logger's bracketed ones (``Time(min)``, ``ch1(um)``; the underscore forms of
+    the mapping, ``ch1_um``, are other instruments' names: ``dx_um``, ``dr_um``)."""
+    mapped = []
+    for h in names:
+        try:
+            bracketed = logger.BRACKET.match(h.strip()) or h.strip().lower() in logger.TIME_WORDS
+            mapped.append(logger.drift_name(h, "file", "s") if bracketed else h.strip())
+        except InputError:
+            mapped.append(h)
     return (any(n in TIME_COLUMNS for n in mapped)
             and any(re.fullmatch(r"d_\w+_(um|mm)", n) for n in mapped))
 

@@ -181,3 +181,11 @@ def test_logger_mapping_rules():
     assert map_header(["Time", "A"], "f", {"Time": "t_h", "A": "d_a_um"}) == ["t_h", "d_a_um"]
     with pytest.raises(InputError, match="both become"):
         map_header(["ch1(um)", "ch1 [um]"], "f")
+
+
+def test_detect_leaves_other_instruments_alone():
+    assert drift.detect(["t_s", "d_ch1_um"]) and drift.detect(["Time(min)", "ch1(um)"])
+    assert drift.detect(["Time", "ch1(um)"])          # read: refused for the missing unit
+    for names in (["t_s", "dr_um", "X", "Y"], ["t_s", "dx_um", "dy_um", "dz_um"],
+                  ["time_s", "d_mm", "station"]):
+        assert not drift.detect(names)
