@@ -131,3 +131,18 @@ def test_command_refuses_bad_file(tmp_path, capsys):
     assert main(["iso230-3", str(_write(tmp_path / "ok.csv", _planted()[0])),
                  "--stage-column", "feed"]) == 2
     assert "no such logged column" in capsys.readouterr().err
+
+
+def test_real_spindle_programme_stages():
+    """The FL_THERMAL file's stages are its README's spindle programme (start h -> rpm)."""
+    fl = Path("/work/shared/data/thermal/fl_thermal_spindle.csv")
+    if not fl.is_file():
+        pytest.skip(f"{fl} not present")
+    doc = iso230_3.evaluate(drift.read_runs(fl)[0]).to_dict()
+    readme = [(0, 0), (0.13, 1250), (4.13, 0), (8.13, 2500), (12.13, 0), (16.13, 3750),
+              (20.13, 0), (24.13, 5000), (28.13, 0), (32.13, 3500), (36.13, 0), (40.13, 500),
+              (42.13, 1500), (44.13, 2500), (45.13, 4500), (46.13, 0)]
+    got = [(s["t_start_s"] / H, s["value"]) for s in doc["stages"]]
+    assert [v for _, v in got] == [float(v) for _, v in readme]
+    assert np.allclose([t for t, _ in got], [t for t, _ in readme], atol=0.01)
+    assert doc["tilts"] == {} and len(doc["channels"]) == 5
