@@ -18,7 +18,7 @@ input: a drift file (volerr formats drift): t_s | t_min | t_h, channels d_<label
   '# channel d_<label>: DIR [at z=<mm>]' header lines, temperatures T_*, spindle speed S_rpm.
   A logger's file as saved is read with the mapping of 'volerr drift convert'.
 
-evaluation (ISO 230-3:2020, clauses 5.4, 6.4, 7.4):
+evaluation (ISO 230-3:2020, clauses 5 ETVE, 6 rotating spindle, 7 moving linear axes):
   drift d(t) = reading(t) - first reading, um; per channel max, min (and their times), range
   = max - min (the ETVE in an environmental test, the thermal drift in a spindle test);
   tilts from two channels of one direction at two heights z1 < z2:

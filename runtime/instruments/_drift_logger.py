@@ -206,8 +206,9 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
             names[j] = n[:-3] + "_um"
         else:
             factors.append(1.0)
-    require(len(set(names)) == len(names), f"{where}: two columns become the same drift column "
-                                           f"({', '.join(sorted({n for n in names if names.count(n) > 1}))})")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    require(not twice, f"{where}: two columns become the same drift column "
+                       f"({', '.join(twice)}); name one with --map")
     present = {n[2:-3] for n in names if re.fullmatch(r"d_\w+_um", n)}
     for label in channels or {}:
         require(label in present, f"--channel: {where} has no channel {label} (channels: "

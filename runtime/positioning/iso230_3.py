@@ -9,29 +9,32 @@ sensors round a test mandrel -- two radial pairs at two heights, one axial), by 
 axes (clause 7) and by rotary motion of components (clause 8).  Its evaluation, which this
 module implements for a run of any of them (a ``drift`` file, :mod:`volerr.instruments.drift`):
 
-1. **drift of each channel** (clauses 5.4, 6.4, 7.4: the displacement plotted against time
+1. **drift of each channel** (the evaluation of clauses 5, 6 and 7: the displacement against time
    from the start of the test): ``d(t) = reading(t) - reading(t_0)`` um, its largest and
    smallest value (``max_um``, ``min_um``, with their times) and its range
    ``range_um = max - min`` -- in the ETVE test the ETVE of that direction; in the spindle
    test the thermal drift of that direction over the test;
-2. **tilts** (clause 6.4: the angular deviations of the spindle from two sensors of one
+2. **tilts** (clause 6: the angular deviations of the spindle from two sensors of one
    direction at two heights ``z1 < z2`` on the mandrel): ``(s(z2) - s(z1)) / (z2 - z1)``,
    ``s`` the channel's drift along the positive axis (a ``-X`` channel's sign turned), um/mm =
    1000 urad; a pair along X gives the tilt about +Y (``+ds_X/dz``), a pair along Y the tilt
    about +X (``-ds_Y/dz``): the tool side's rotation relative to the workpiece side, right
    hand;
-3. **per stage of the programme** (clause 6.3: runs at constant speed, a spindle stop, a speed
+3. **per stage of the programme** (clause 6: runs at constant speed, a spindle stop, a speed
    spectrum): a stage is a maximal stretch of readings whose stage value (``S_rpm``, or a
    declared column: a feed for clause 7) stays within :data:`STAGE_TOLERANCE` of the largest
    magnitude of the column of the value at the stage's first reading; per stage each channel's
    and tilt's drift at its start and end, its change and its range within the stage;
-4. the logged temperatures' ranges beside them (clause 5.3: the temperature of the room and
+4. the logged temperatures' ranges beside them (clause 5: the temperature of the room and
    of the machine recorded with the displacements).
 
 Units: time s (plots in h), displacements um, tilts urad, temperatures degC.  Sign: as the
 sensor reads the tool side relative to the workpiece side (the drift file's convention).
 The evaluation reads no tolerance: ISO 230-3 leaves the acceptance values to the machine's
-test code; the range is the figure a tolerance applies to.
+test code; the range is the figure a tolerance applies to.  Clause numbers are those of the
+2020 edition's scope (clause 7 the linear axes); the sub-clauses are not cited here (the text of
+the standard was not at hand: the evaluation follows the drift test procedure the standard
+refers to, ISO/TR 16015:2003, A.4.2).
 """
 
 from __future__ import annotations
@@ -320,6 +323,31 @@ def _stage_rows(doc: dict) -> str:
             f"</th>{head}</tr>{''.join(rows)}</table>")
 
 
+def _run_html(ev: DriftEvaluation, img: bytes | None, head: str) -> str:
+    """The part of the report of one run."""
+    e = html.escape
+    doc = ev.to_dict()
+    temps = "".join(f"<tr><th class='l'>{e(k)}</th><td>{v['min_C']:.2f}</td>"
+                    f"<td>{v['max_C']:.2f}</td><td>{v['range_K']:.2f}</td></tr>"
+                    for k, v in doc["temperatures"].items())
+    tilts = (f"<h3>Tilts / &micro;rad</h3><table>{head}{_rows(doc['tilts'], 'urad')}</table>"
+             if doc["tilts"] else "")
+    stages = _stage_rows(doc) if doc["stage_column"] else "<p>one stage: the whole run</p>"
+    notes = ("<ul>" + "".join(f"<li>{e(n)}</li>" for n in ev.notes) + "</ul>"
+             if ev.notes else "")
+    plot = embedded_img(img, "drift against time") if img else ""
+    return f"""<h2>{e(ev.name)}: {e(ev.test)}</h2>
+<p>{doc['n_readings']} readings over {doc['duration_s'] / 3600:.2f} h.</p>
+<h3>Drift per channel / &micro;m (from the first reading)</h3>
+<table>{head}{_rows(doc['channels'], 'um')}</table>
+{tilts}
+<h3>Stages (change / range within the stage)</h3>{stages}
+<h3>Temperatures / &deg;C</h3>
+<table><tr><th></th><th>min</th><th>max</th><th>range / K</th></tr>{temps}</table>
+<h3>Plot</h3>{plot}
+{notes}"""
+
+
 def report_html(evaluations: list, pngs: list, generated: str = "",
                 identification=None) -> str:
     """A one-page test report per ISO 230-3 (identification, the test, per channel and tilt
@@ -332,19 +360,7 @@ def report_html(evaluations: list, pngs: list, generated: str = "",
     head = ("<tr><th></th><th>direction</th><th>range</th><th>max</th><th>min</th>"
             "<th>t(max) / h</th><th>t(min) / h</th></tr>")
     for ev, img in zip(evaluations, pngs):
-        doc = ev.to_dict()
-        temps = "".join(f"<tr><th class='l'>{e(k)}</th><td>{v['min_C']:.2f}</td>"
-                        f"<td>{v['max_C']:.2f}</td><td>{v['range_K']:.2f}</td></tr>"
-                        for k, v in doc["temperatures"].items())
-        parts.append(f"""<h2>{e(ev.name)}: {e(ev.test)}</h2>
-<p>{doc['n_readings']} readings over {doc['duration_s'] / 3600:.2f} h.</p>
-<h3>Drift per channel / &micro;m (from the first reading)</h3>
-<table>{head}{_rows(doc['channels'], 'um')}</table>
-{f"<h3>Tilts / &micro;rad</h3><table>{head}{_rows(doc['tilts'], 'urad')}</table>" if doc['tilts'] else ''}
-<h3>Stages (change / range within the stage)</h3>{_stage_rows(doc) if doc['stage_column'] else '<p>one stage: the whole run</p>'}
-<h3>Temperatures / &deg;C</h3><table><tr><th></th><th>min</th><th>max</th><th>range / K</th></tr>{temps}</table>
-<h3>Plot</h3>{embedded_img(img, 'drift against time') if img else ''}
-{'<ul>' + ''.join(f'<li>{e(n)}</li>' for n in ev.notes) + '</ul>' if ev.notes else ''}""")
+        parts.append(_run_html(ev, img, head))
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <title>ISO 230-3 thermal drift test</title>
