@@ -258,11 +258,16 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
              not in (channels or {})]
     lines.append(f"# converted by volerr drift convert from {where}")
     lines += [f"# channel d_{k}: {v}" for k, v in (channels or {}).items()]
-    lines.append(",".join(names))
+    import csv
+    import io
+
+    buf = io.StringIO()
+    out = csv.writer(buf, lineterminator="\n")        # a cell with a comma stays one cell
+    out.writerow(names)
     for r in rows[1:]:
-        lines.append(",".join(_scaled(cell, f) for cell, f in zip(r, factors))
-                     + ("," * (len(names) - len(r)) if len(r) < len(names) else ""))
-    return "\n".join(lines) + "\n"
+        out.writerow([_scaled(cell, f) for cell, f in zip(r, factors)]
+                     + [""] * (len(names) - len(r)))
+    return "\n".join(lines) + "\n" + buf.getvalue()
 
 
 #: names of a column of dates or timestamps (lower case)
