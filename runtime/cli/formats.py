@@ -19,7 +19,8 @@ def register(sub) -> None:
                                    "section names, or one section.")
     p.add_argument("name", nargs="?", metavar="NAME",
                    help="section: tables, tracker, probe-sphere, deviations, ballbar, sphere, "
-                        "artifact, interferometer, distances, calibrate-json, check, loop-json, "
+                        "artifact, interferometer, distances, drift, iso230-3, calibrate-json, check, "
+                        "loop-json, history, "
                         "layout, gcode, tools, controller, axis-tables, uncertainty, iso230-2, "
                         "outputs, audit, or 'all'")
     p.set_defaults(func=run)
