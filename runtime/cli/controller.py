@@ -5,8 +5,11 @@ SINUMERIK (LEC, CEC), Heidenhain (``.CMA`` / ``.COM``) and Fanuc (pitch error co
 
 ``volerr controller export LAYOUT --errors DIR --format FORMAT --out F [--json F] [--plot P]``
     writes the tables and constants of an error directory; for the axis compensation formats
-    ``--json`` / ``--plot`` give what compensating with the tables leaves (the model's
-    volumetric error over the working volume after their correction).
+    it compares what compensating with the tables leaves (the model's volumetric error over
+    the working volume after their correction, max and rms) with the uncompensated error, on
+    the console and in ``--json``, and refuses (exit 2) tables that leave more than none
+    unless ``--force``; ``--plot`` maps both.  ``--format linuxcnc``: ``--out`` is a folder
+    (one ``COMP_FILE`` per joint and the ini lines).
 ``volerr controller import LAYOUT FILE --out DIR [--format ...]``
     reads such a file back into an error directory (``X.csv`` ... ``constants.csv``).
 """
@@ -17,7 +20,7 @@ from pathlib import Path
 
 from ..errors import require
 
-AXIS_FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc")
+AXIS_FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc", "linuxcnc")
 
 
 def register(sub) -> None:
@@ -32,24 +35,29 @@ def register(sub) -> None:
                    help="isg / etalon: volumetric compensation parameters; sinumerik-lec "
                         "(positioning), sinumerik-cec (straightness), heidenhain (.CMA with "
                         ".COM tables next to it), fanuc (pitch error compensation tape): axis "
-                        "compensation tables, within each controller's documented limits "
-                        "(volerr formats controller)")
+                        "compensation tables, within each controller's documented limits; "
+                        "linuxcnc: [JOINT_n] COMP_FILE tables (volerr formats controller)")
     e.add_argument("--out", required=True,
                    help="controller file to write (heidenhain: the .cma; its .com tables "
-                        "are written next to it)")
+                        "are written next to it; linuxcnc: a folder for <axis>.comp and "
+                        "compensation.ini)")
+    e.add_argument("--comp-file-type", type=int, choices=(0, 1), default=None,
+                   help="linuxcnc: COMP_FILE_TYPE 0 (nominal, actual forward, actual "
+                        "reverse; default) or 1 (nominal, forward trim, reverse trim)")
     e.add_argument("--negate", action="store_true",
                    help="isg / etalon: write compensation values (the errors with reversed "
                         "sign) for a controller that expects them")
     e.add_argument("--force", action="store_true",
-                   help="heidenhain: let the export replace existing .cma / .com files (the "
-                        "user names only the .cma: without --force no file is replaced)")
+                   help="axis tables: write tables that leave more of the volumetric error "
+                        "than no compensation (refused without it); heidenhain / linuxcnc: "
+                        "let the export replace existing files")
     e.add_argument("--points", type=int, default=None, metavar="N",
                    help="axis tables: at most N equally spaced points per table (default: "
                         "the finest spacing of the error table, up to the format's limit)")
     e.add_argument("--json", metavar="F",
-                   help="axis tables: JSON {format, left_um: {max, rms}, before_um, tables}: "
-                        "what compensating with the tables leaves of the model's volumetric "
-                        "error over the working volume")
+                   help="axis tables: JSON {format, left_um: {max, rms}, before_um, "
+                        "worse_than_none, tables}: what compensating with the tables leaves "
+                        "of the model's volumetric error over the working volume")
     e.add_argument("--plot", metavar="PNG",
                    help="axis tables: map of the volumetric error before and after the "
                         "tables' correction (three levels of the last linear axis)")
@@ -63,7 +71,7 @@ def register(sub) -> None:
     i = s.add_parser("import", help="controller file -> error directory")
     i.add_argument("layout", help="layout name or file")
     i.add_argument("file", help="controller file (heidenhain: the .cma, its .com tables next "
-                                "to it)")
+                                "to it; linuxcnc: the ini naming the COMP_FILEs)")
     i.add_argument("--format", choices=("auto", "isg", "etalon") + AXIS_FORMATS,
                    default="auto", help="the file's format (auto: isg or etalon)")
     from ._common import add_errors_out, add_force
@@ -125,25 +133,29 @@ def _export_axis_tables(args, model) -> int:
 
     require(not args.negate, "--negate is for isg / etalon (the axis formats have their own "
                              "sign conventions, volerr formats controller)")
+    require(args.comp_file_type is None or args.format == "linuxcnc",
+            "--comp-file-type is for --format linuxcnc")
     funcs = ErrorFunctions.from_dir(args.errors, model)
     tables = ctl.build(funcs, args.format, args.points)
     inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force)
-    files = ctl.write(model, tables, args.format, Path(args.out))
-    roles = {path: Outputs.group_role("--out", files, k) for k, path in enumerate(files)}
-    if len(files) > 1:   # Heidenhain .cma + .com: nothing replaced without --force
-        outs.group("--out", files)
-    else:
-        outs.file("--out", args.out)
+    files = ctl.write(model, tables, args.format, Path(args.out), args.comp_file_type or 0)
+    roles = _declare_tables(outs, args, files)
     outs.file("--json", args.json).plot("--plot", args.plot).check()
     result = left(model, funcs, tables, args.grid, parse_at(args.at))
     s = result.summary()
+    worse = worse_than_none(s)
+    require(not worse or args.force,
+            f"{model.name}: these {args.format} tables leave more than no compensation "
+            f"(max {_change(s, 'max')}, rms {_change(s, 'rms')}); nothing written "
+            "(--force writes them anyway)")
     with outs:
         for path, text in files.items():
-            write_text(outs.path(roles[path]), text, inputs)
+            write_text(_staged(outs, roles[path]), text, inputs)
         if args.json:
             write_text(outs.path("--json"), json_text(
                 {"layout": model.name, "format": args.format, **s,
+                 "worse_than_none": worse,
                  "tables": [{"parameter": t.parameter, "input": t.input, "output": t.output,
                              "points": len(t.values), "start": t.start, "step": t.step,
                              "modulo": t.modulo, "direction": t.direction}
@@ -154,10 +166,44 @@ def _export_axis_tables(args, model) -> int:
     print(f"{model.name}: wrote {len(tables)} {args.format} tables "
           f"({', '.join(sorted({t.parameter for t in tables}))}) to {args.out}")
     print(f"  volumetric error over the working volume ({s['points']} points): max "
-          f"{s['before_um']['max']:.2f} -> {s['left_um']['max']:.2f} um, rms "
-          f"{s['before_um']['rms']:.2f} -> {s['left_um']['rms']:.2f} um left after the "
-          "tables' correction")
+          f"{_change(s, 'max')}, rms {_change(s, 'rms')} left after the tables' correction")
+    print("  WORSE than no compensation: written because of --force" if worse else
+          "  better than no compensation (max and rms)")
     return 0
+
+
+def worse_than_none(summary: dict) -> bool:
+    """Tables that leave a larger max or rms of the volumetric error than no compensation
+    (compared at 1 nm, below which a difference is the rounding of the tables' values)."""
+    b, a = summary["before_um"], summary["left_um"]
+    return a["max"] > b["max"] + 1e-3 or a["rms"] > b["rms"] + 1e-3
+
+
+def _change(s: dict, key: str) -> str:
+    return f"{s['before_um'][key]:.2f} -> {s['left_um'][key]:.2f} um"
+
+
+def _declare_tables(outs, args, files: dict) -> dict:
+    """Declare the table files on ``outs``; {path: its role}.  One file: ``--out``; Heidenhain
+    (.cma + .com): a group, nothing replaced without --force; LinuxCNC: the folder --out."""
+    if args.format == "linuxcnc":
+        outs.folder("--out", args.out, files=[Path(p).name for p in files])
+        return {path: ("--out", Path(path).name) for path in files}
+    from ..fileio import Outputs
+
+    roles = {path: Outputs.group_role("--out", files, k) for k, path in enumerate(files)}
+    if len(files) > 1:
+        outs.group("--out", files)
+    else:
+        outs.file("--out", args.out)
+    return roles
+
+
+def _staged(outs, role):
+    """Where to write a table file now: a file role, or (folder role, name in it)."""
+    if isinstance(role, tuple):
+        return outs.path(role[0]) / role[1]
+    return outs.path(role)
 
 
 def _import_volumetric(args, model) -> int:
