@@ -10,6 +10,11 @@ SINUMERIK (LEC, CEC), Heidenhain (``.CMA`` / ``.COM``) and Fanuc (pitch error co
     the console and in ``--json``, and refuses (exit 2) tables that leave more than none
     unless ``--force``; ``--plot`` maps both.  ``--format linuxcnc``: ``--out`` is a folder
     (one ``COMP_FILE`` per joint and the ini lines).
+``volerr controller export LAYOUT_aug.toml --format sinumerik-temp|isg-temp --loop-json F
+--temperatures LOG.csv --out DIR``
+    the temperature compensation a controller runs (per axis offset and gradient, linear in
+    the temperatures it reads) fitted to an augmented layout's thermal effects on a logged
+    series, with what it leaves against the full model (:mod:`volerr.tables.thermal_comp`).
 ``volerr controller import LAYOUT FILE --out DIR [--format ...]``
     reads such a file back into an error directory (``X.csv`` ... ``constants.csv``).
 """
@@ -21,6 +26,7 @@ from pathlib import Path
 from ..errors import require
 
 AXIS_FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc", "linuxcnc")
+TEMP_FORMATS = ("sinumerik-temp", "isg-temp")
 
 
 def register(sub) -> None:
@@ -30,17 +36,31 @@ def register(sub) -> None:
     s.required = True
     e = s.add_parser("export", help="error directory -> controller file")
     e.add_argument("layout", help="layout name or file")
-    e.add_argument("--errors", required=True, metavar="DIR", help="error directory")
-    e.add_argument("--format", choices=("isg", "etalon") + AXIS_FORMATS, required=True,
+    e.add_argument("--errors", metavar="DIR", help="error directory (not for the -temp "
+                                                   "formats)")
+    e.add_argument("--format", choices=("isg", "etalon") + AXIS_FORMATS + TEMP_FORMATS,
+                   required=True,
                    help="isg / etalon: volumetric compensation parameters; sinumerik-lec "
                         "(positioning), sinumerik-cec (straightness), heidenhain (.CMA with "
                         ".COM tables next to it), fanuc (pitch error compensation tape): axis "
                         "compensation tables, within each controller's documented limits; "
-                        "linuxcnc: [JOINT_n] COMP_FILE tables (volerr formats controller)")
+                        "linuxcnc: [JOINT_n] COMP_FILE tables; sinumerik-temp / isg-temp: "
+                        "temperature compensation from an augmented layout's thermal effects "
+                        "(volerr formats axis-tables, thermal-comp)")
     e.add_argument("--out", required=True,
                    help="controller file to write (heidenhain: the .cma; its .com tables "
                         "are written next to it; linuxcnc: a folder for <axis>.comp and "
                         "compensation.ini)")
+    e.add_argument("--loop-json", metavar="F",
+                   help="-temp formats: the report (volerr loop --json) of the run that wrote "
+                        "the augmented layout: its effects' fitted parameters")
+    e.add_argument("--temperatures", metavar="LOG.csv",
+                   help="-temp formats: a logged series (time column t_s / t_min / t_h, the "
+                        "temperatures T_*) on which the controller's model is fitted and "
+                        "judged against the full one")
+    e.add_argument("--sensors", metavar="T_a,T_b",
+                   help="-temp formats: the temperatures the controller reads (default: "
+                        "those the thermal effects read)")
     e.add_argument("--comp-file-type", type=int, choices=(0, 1), default=None,
                    help="linuxcnc: COMP_FILE_TYPE 0 (nominal, actual forward, actual "
                         "reverse; default) or 1 (nominal, forward trim, reverse trim)")
@@ -88,6 +108,12 @@ def run(args) -> int:
 
     model = load(args.layout)
     if args.action == "export":
+        if args.format in TEMP_FORMATS:
+            return _export_temperature(args, model)
+        for flag in ("loop_json", "temperatures", "sensors"):
+            require(getattr(args, flag) is None, f"--{flag.replace('_', '-')} is for "
+                                                 f"{' / '.join(TEMP_FORMATS)}")
+        require(args.errors is not None, f"--errors DIR is needed for --format {args.format}")
         require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
                                                   f"directory (the folder holding X.csv ...)")
         require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
@@ -204,6 +230,63 @@ def _staged(outs, role):
     if isinstance(role, tuple):
         return outs.path(role[0]) / role[1]
     return outs.path(role)
+
+
+def _export_temperature(args, model) -> int:
+    from ..fileio import Outputs, json_text, write_text
+    from ..tables import thermal_comp as tc
+    from ._common import layout_inputs, parse_at
+
+    require(args.errors is None, f"--errors is not for {args.format} (the augmented "
+                                 "layout's thermal effects and --loop-json give the model)")
+    for flag in ("negate", "comp_file_type", "points", "plot"):
+        require(getattr(args, flag) in (None, False),
+                f"--{flag.replace('_', '-')} is not for {args.format}")
+    require(args.loop_json is not None, f"--loop-json F is needed for {args.format} (the "
+                                        "loop report with the effects' fitted values)")
+    require(args.temperatures is not None, f"--temperatures LOG.csv is needed for "
+                                           f"{args.format}")
+    name = "temp_comp.spf" if args.format == "sinumerik-temp" else "temp_comp.lis"
+    inputs = [args.loop_json, args.temperatures] + layout_inputs(args.layout)
+    outs = Outputs(inputs, force=args.force).folder("--out", args.out, files=[name])
+    outs.file("--json", args.json).check()
+    values = tc.effect_values(model, args.loop_json)
+    log = tc.read_log(args.temperatures)
+    sensors = [s.strip() for s in args.sensors.split(",")] if args.sensors else None
+    res = tc.fit(model, values, log, sensors, args.grid, parse_at(args.at))
+    s = res.summary()
+    worse = worse_than_none(s)
+    require(not worse or args.force,
+            f"{model.name}: this {args.format} model leaves more of the thermal error than "
+            f"no compensation (max {_change(s, 'max')}, rms {_change(s, 'rms')}); nothing "
+            "written (--force writes it anyway)")
+    text = tc.write_sinumerik(res) if args.format == "sinumerik-temp" else \
+        tc.write_isg(res, model.axes)
+    with outs:
+        write_text(outs.path("--out") / name, text, inputs)
+        if args.json:
+            write_text(outs.path("--json"), json_text(
+                {"format": args.format, **s, "worse_than_none": worse}), inputs)
+    _print_temperature(model, args, res, s, worse, name)
+    return 0
+
+
+def _print_temperature(model, args, res, s, worse, name) -> None:
+    print(f"{model.name}: wrote {args.format} ({', '.join(a.axis for a in res.axes)}; "
+          f"reading {', '.join(res.sensors)}) to {Path(args.out) / name}")
+    print(f"  thermal error of the full model on {s['samples']} readings of the log x "
+          f"{s['points']} points: max {s['before_um']['max']:.2f} um, rms "
+          f"{s['before_um']['rms']:.2f} um; left by the controller's model (static, linear in "
+          f"position and in the sensors): max {s['left_um']['max']:.2f} um, rms "
+          f"{s['left_um']['rms']:.2f} um")
+    if res.lags:
+        lg = s["left_with_lagged_sensors_um"]
+        print("  the effects act through lags the controller's model does not compute ("
+              + ", ".join(f"{c}: {tau:g} s" for c, tau in res.lags) + f"); with the sensors "
+              f"filtered by those lags (in the PLC) it would leave max {lg['max']:.2f} um, rms "
+              f"{lg['rms']:.2f} um")
+    print("  WORSE than no compensation: written because of --force" if worse else
+          "  better than no compensation (max and rms)")
 
 
 def _import_volumetric(args, model) -> int:
