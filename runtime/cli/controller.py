@@ -75,7 +75,7 @@ def register(sub) -> None:
                    help="axis tables: at most N equally spaced points per table (default: "
                         "the finest spacing of the error table, up to the format's limit)")
     e.add_argument("--json", metavar="F",
-                   help="axis tables: JSON {format, left_um: {max, rms}, before_um, "
+                   help="JSON {format, left_um: {max, rms}, before_um, "
                         "worse_than_none, tables}: what compensating with the tables leaves "
                         "of the model's volumetric error over the working volume")
     e.add_argument("--plot", metavar="PNG",
@@ -129,11 +129,11 @@ def _export_volumetric(args, model) -> int:
     from ..tables import controller as ct
     from ..tables.table import read_error_dir
     from ._common import layout_inputs
-    from ..fileio import Outputs, write_text
+    from ..fileio import Outputs, json_text, write_text
 
-    for flag in ("json", "plot", "points"):
-        require(getattr(args, flag) is None, f"--{flag} is for the axis compensation formats "
-                                             f"({' '.join(AXIS_FORMATS)})")
+    for flag in ("plot", "points", "comp_file_type"):
+        require(getattr(args, flag) is None, f"--{flag.replace('_', '-')} is for the axis "
+                                             f"compensation formats ({' '.join(AXIS_FORMATS)})")
     tables, (consts, _, _) = read_error_dir(args.errors, model.axes)
     ct.check_against_model(model, tables, consts, args.errors)
     require(tables or consts, f"{args.errors}: no error tables or constants to export")
@@ -141,13 +141,32 @@ def _export_volumetric(args, model) -> int:
         tables, consts = ct.negated(tables, consts)
     writer = ct.write_isg if args.format == "isg" else ct.write_etalon
     inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
-    with Outputs(inputs).file("--out", args.out) as outs:
+    outs = Outputs(inputs).file("--out", args.out).file("--json", args.json).check()
+    s = _volumetric_left(args, model)
+    with outs:
         write_text(outs.path("--out"), writer(model.name, tables, consts), inputs)
+        if args.json:
+            write_text(outs.path("--json"), json_text(
+                {"layout": model.name, "format": args.format, **s,
+                 "worse_than_none": worse_than_none(s)}), inputs)
     n = sum(len(t.values) for t in tables.values())
     print(f"{model.name}: wrote {n} component errors ({len(tables)} axes) and "
           f"{len(consts)} position errors to {args.out} ({args.format}"
           f"{', negated: compensation values' if args.negate else ''})")
+    print(f"  volumetric error over the working volume ({s['points']} points): max "
+          f"{_change(s, 'max')}, rms {_change(s, 'rms')} left by a volumetric compensation "
+          "with every parameter by the first-order model (its second-order remainder)")
     return 0
+
+
+def _volumetric_left(args, model) -> dict:
+    """What a volumetric compensation with the whole error directory leaves (summary)."""
+    from ..fiveaxis.tables_left import volumetric_left
+    from ..tables.functions import ErrorFunctions
+    from ._common import parse_at
+
+    funcs = ErrorFunctions.from_dir(args.errors, model)
+    return volumetric_left(model, funcs, args.grid, parse_at(args.at)).summary()
 
 
 def _export_axis_tables(args, model) -> int:
