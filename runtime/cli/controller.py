@@ -143,6 +143,10 @@ def _export_volumetric(args, model) -> int:
     inputs = list(Path(args.errors).glob("*.csv")) + layout_inputs(args.layout)
     outs = Outputs(inputs).file("--out", args.out).file("--json", args.json).check()
     s = _volumetric_left(args, model)
+    require(not worse_than_none(s) or args.force,
+            f"{model.name}: a volumetric compensation with these parameters leaves more than "
+            f"none (max {_change(s, 'max')}, rms {_change(s, 'rms')}); nothing written "
+            "(--force writes it anyway)")
     with outs:
         write_text(outs.path("--out"), writer(model.name, tables, consts), inputs)
         if args.json:
