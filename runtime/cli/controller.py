@@ -82,10 +82,11 @@ def register(sub) -> None:
                    help="axis tables: map of the volumetric error before and after the "
                         "tables' correction (three levels of the last linear axis)")
     e.add_argument("--grid", type=int, default=9, metavar="N",
-                   help="axis tables: grid points per linear axis for --json / --plot over "
-                        "the part of the travel the error tables cover (default 9)")
+                   help="grid points per linear axis of what the export leaves (console, "
+                        "--json, --plot): over the part of the travel the error tables cover "
+                        "(-temp formats: the travel; default 9)")
     e.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
-                   help="axis tables: position of a rotary axis for --json / --plot, "
+                   help="position of a rotary axis for what the export leaves, "
                         "repeatable (default 0 deg)")
     e.set_defaults(func=run)
     i = s.add_parser("import", help="controller file -> error directory")
