@@ -20,7 +20,7 @@ def register(sub) -> None:
     p.add_argument("name", nargs="?", metavar="NAME",
                    help="section: tables, tracker, probe-sphere, deviations, ballbar, sphere, "
                         "artifact, interferometer, distances, calibrate-json, loop-json, "
-                        "layout, gcode, tools, controller, axis-tables, thermal-comp, uncertainty, iso230-2, "
+                        "layout, gcode, tools, controller, axis-tables, uncertainty, iso230-2, "
                         "outputs, audit, or 'all'")
     p.set_defaults(func=run)
 
