@@ -85,7 +85,8 @@ class TempLog:
 
 def read_log(path) -> TempLog:
     """A CSV log: a time column (``t_s``, ``t_min``, ``t_h``, ``time_s`` ...) increasing, and
-    numeric columns (temperatures ``T_*`` degC, anything else)."""
+    numeric columns (temperatures ``T_*`` degC, anything else); ``t_s`` is added in seconds
+    when the log has another time column."""
     rows = read_csv_rows(path, missing=f"temperature log not found: {path}")
     header, body = rows[0][1], rows[1:]
     require(len(body) >= 2, f"{path}: fewer than two readings")
@@ -111,6 +112,7 @@ def read_log(path) -> TempLog:
     t = cols[time] * TIME_COLUMNS[time]
     require(np.all(np.diff(t) > 0), f"{path}: the time column {time} must increase from "
                                     "reading to reading")
+    cols.setdefault("t_s", t)           # the lags of a layout run over t_s by default
     return TempLog(str(path), time, t, cols)
 
 
