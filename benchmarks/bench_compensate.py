@@ -4,12 +4,15 @@ each shape of program post-processors write.
 Shapes (the same positions in every one): ``bare`` (``X.. Y.. Z.. B.. C..``), ``g1`` (``G1`` on
 every line), ``post`` (``N.. G01 X.. Y.. Z.. B.. C.. F1500. S12000 M8 (cut) ; fin`` with CRLF),
 ``lower`` (``g1 x 1.0 y 2.0 ...``: lower case, blanks between letter and number), ``tools``
-(``G0``/``G1`` alternating, ``T`` and ``M`` words, comments between the words), and two TCPM
+(``G0``/``G1`` alternating, ``T`` and ``M`` words, comments between the words), and TCPM
 tool-vector programs as post-processors write them (the tool tip and the unit tool vector of
-the same positions, tool length 120 mm): ``vector`` (Fanuc ``G43.5``: ``N.. G01 X.. Y.. Z..
-I.. J.. K.. F1500. (cut)``) and ``traori`` (Siemens ``TRAORI``: ``N.. G01 X.. Y.. Z.. A3=..
-B3=.. C3=.. F1500 ; cut``).  The aim for the TCPM shapes (issue 31 item 5): under 10 s per
-10^6 blocks on the 2-core CI machine.
+the same positions, tool length 120 mm; the program starts ``G90 G21 G17``, ``T1 M6`` and the
+TCPM block, no rotary word before it): ``vector`` (Fanuc ``G43.5``: ``G1 X.. Y.. Z.. I.. J..
+K.. F2000``, no comment), ``vector_n`` (``N.. G01 X.. Y.. Z.. I.. J.. K.. F2000.`` with CRLF),
+``vector_cut`` (``N.. G01 ... F1500. (cut)`` with CRLF: a comment on every line) and
+``traori`` (Siemens ``TRAORI``: ``N.. G01 X.. Y.. Z.. A3=.. B3=.. C3=.. F2000``).  The aim for
+the TCPM shapes (issues 31 item 5, 36 item 6): under 10 s per 10^6 blocks on the 2-core CI
+machine, in every shape.
 
 Reports, for N blocks of each shape: the whole command (parse, interpret, solve, round,
 predict, write) in a subprocess, wall and CPU time and peak RSS (resource.getrusage), and the
@@ -63,13 +66,19 @@ SHAPES = {
     "tools": lambda k, r: ("G%d X%.3f (a) Y%.3f Z%.3f B%.3f C%.3f T%d M%d ;x\n"
                            % ((k % 2,) + r + (k % 7, 8 + k % 2))),
     # TCPM: r is (tip x y z, tool vector i j k) here
-    "vector": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f F1500. (cut)\r\n"
-                           % ((k,) + r),
-    "traori": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f A3=%.6f B3=%.6f C3=%.6f F1500 ; cut\n"
+    "vector": lambda k, r: "G1 X%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f F2000\n" % r,
+    "vector_n": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f F2000.\r\n"
+                             % ((k,) + r),
+    "vector_cut": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f F1500. (cut)\r\n"
+                               % ((k,) + r),
+    "traori": lambda k, r: "N%d G01 X%.4f Y%.4f Z%.4f A3=%.6f B3=%.6f C3=%.6f F2000\n"
                            % ((k,) + r),
 }
-#: the first lines of a TCPM program: tool 1, TCPM on
-TCPM_HEAD = {"vector": "T1 M6\nG43.5 H1\n", "traori": "T1 M6\nTRAORI\n"}
+#: the first lines of a TCPM program: absolute, mm, tool 1, TCPM on (no rotary word before)
+TCPM_HEAD = {"vector": "G90 G21 G17\nT1 M6\nG43.5 H1\n",
+             "vector_n": "N1 G90 G21 G17\r\nN2 T1 M6\r\nN3 G43.5 H1\r\n",
+             "vector_cut": "N1 G90 G21 G17\r\nN2 T1 M6\r\nN3 G43.5 H1\r\n",
+             "traori": "N1 G90 G17\nN2 T1 M6\nN3 TRAORI\n"}
 
 
 def write_program(path: Path, n: int, rng, shape: str = "bare") -> np.ndarray:
@@ -82,7 +91,7 @@ def write_program(path: Path, n: int, rng, shape: str = "bare") -> np.ndarray:
         q[:, 3] = rng.uniform(1, 90, n)
         rows = volerr.load("DMU50").forward(q, np.tile([0.0, 0.0, -120.0], (n, 1)))
     with open(path, "w", encoding="latin-1", newline="") as fh:
-        fh.write("G90 G1 X0 Y0 Z100 B10 C0\n" + TCPM_HEAD.get(shape, ""))
+        fh.write(TCPM_HEAD.get(shape, "G90 G1 X0 Y0 Z100 B10 C0\n"))
         for i in range(0, n, 100000):
             fh.write("".join(line(i + k, tuple(r)) for k, r in enumerate(rows[i:i + 100000])))
     return np.round(q, 3)

@@ -293,9 +293,11 @@ def round_tcpm(em, q_nom: np.ndarray, w_nom: np.ndarray, q_c: np.ndarray, nd: np
     # the rotary positions the controller takes from the written orientation
     q_rot[ang] = q_c[ang]
     q_rot[np.ix_(ang, rot_idx)] = w_out[np.ix_(ang, rot_idx)]
-    if vec.any():
+    if vec.any() and opts.orientation:
         target = np.column_stack([w_c[vec][:, lin_idx], w_out[vec, nax:]])
         q_rot[vec] = inverse(model, target, tcpm.tool_offset(length[vec]), near=q_c[vec])
+    # (the programmed vectors written: the controller takes the rotary positions it took for
+    # them, those of q_nom, which the solve kept in q_c; nothing to solve again)
     moved = ~np.all(q_rot[:, rot_idx] == q_c[:, rot_idx], axis=1)
     if moved.any():
         q_rot[moved] = resolve_linear(em, q_nom[moved], q_rot[moved], opts.tol_um * 1e-3,

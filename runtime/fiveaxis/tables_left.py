@@ -38,12 +38,10 @@ class Left:
 
 
 
-def left(model, funcs, tables: list, grid: int = 9, at=None, probe=(0.0, 0.0, 0.0)) -> Left:
-    """What compensating with ``tables`` leaves (module docstring) on a grid of ``grid``
-    points per linear axis over the part of the travel the error tables cover; rotary axes at
-    ``at`` (axis -> deg, default 0 or the nearest travel limit)."""
+def _grid(model, funcs, grid: int, at) -> tuple:
+    """(q (N, n_axes), ticks of the linear axes): ``grid`` points per linear axis over the
+    part of the travel the error tables cover, rotary axes at ``at``."""
     from ..cmm.volmap import fixed_positions, volume
-    from ..machine.kinematics import nominal_jacobian
 
     require(2 <= grid <= 60, "--grid must be 2..60 points per axis")
     box = volume(model, funcs, "measured")
@@ -56,6 +54,17 @@ def left(model, funcs, tables: list, grid: int = 9, at=None, probe=(0.0, 0.0, 0.
         q[:, model.axes.index(a)] = m.ravel()
     for a, v in fixed_positions(model, at).items():
         q[:, model.axes.index(a)] = v
+    return q, ticks
+
+
+def left(model, funcs, tables: list, grid: int = 9, at=None, probe=(0.0, 0.0, 0.0)) -> Left:
+    """What compensating with ``tables`` leaves (module docstring) on a grid of ``grid``
+    points per linear axis over the part of the travel the error tables cover; rotary axes at
+    ``at`` (axis -> deg, default 0 or the nearest travel limit)."""
+    from ..machine.kinematics import nominal_jacobian
+
+    q, ticks = _grid(model, funcs, grid, at)
+    lin = tuple(a for a in model.axes if a not in model.rotary_axes)
     probe = np.asarray(probe, dtype=float)
     e = model.volumetric_error(q, funcs(q), probe=probe)
     v = correction(model, tables, q)
@@ -64,3 +73,16 @@ def left(model, funcs, tables: list, grid: int = 9, at=None, probe=(0.0, 0.0, 0.
     jac = nominal_jacobian(model, q, probe)[:, 0:3, :]
     after = e - np.einsum("nij,nj->ni", jac, v)
     return Left(q, e, after, tuple(len(t) for t in ticks), lin, tuple(model.axes))
+
+
+def volumetric_left(model, funcs, grid: int = 9, at=None) -> Left:
+    """What a controller's volumetric compensation with every parameter of the error
+    functions (ISG, Etalon) leaves when it corrects by the first-order model: the exact error
+    of the chain (:meth:`volerr.machine.model.Model.exact_error`) minus the first-order one,
+    on the grid of :func:`left`."""
+    q, ticks = _grid(model, funcs, grid, at)
+    lin = tuple(a for a in model.axes if a not in model.rotary_axes)
+    errs = funcs(q)
+    e = model.volumetric_error(q, errs)
+    return Left(q, e, model.exact_error(q, errs) - e, tuple(len(t) for t in ticks), lin,
+                tuple(model.axes))

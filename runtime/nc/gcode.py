@@ -410,9 +410,11 @@ class Interpreter:
         self._set_modes(gs)
         forget = self._tcpm_switch(gs, ms, keywords, where)
         self._check_axes(axis_words, where)
-        if vector and self.vector_words is None and line.parts is None:
-            siemens = any(t.kind == "word" and t.letter in VECTOR and t.text[:1].upper() in "ABC"
-                          for t in line.tokens)
+        if vector and self.vector_words is None:
+            # a line of address words only (parts) cannot hold a Siemens A3=: I J K
+            siemens = line.parts is None and any(
+                t.kind == "word" and t.letter in VECTOR and t.text[:1].upper() in "ABC"
+                for t in line.tokens)
             self.vector_words = ({"I": "A3=", "J": "B3=", "K": "C3="} if siemens else
                                  {v: v for v in VECTOR})
         tcpm = self.frame == "tcpm"

@@ -12,6 +12,9 @@ The formats (each module documents its file, limits and sources):
                                                                  (BACKLASH: reversal)
 ``fanuc``          :mod:`volerr.tables.fanuc`                    positioning, relative to the
                                                                  reference position
+``linuxcnc``       :mod:`volerr.tables.linuxcnc`                 positioning per joint, forward
+                                                                 and reverse (a folder of
+                                                                 ``COMP_FILE`` s + ini lines)
 =================  ===========================================  ==============================
 
 What compensating leaves: :func:`volerr.fiveaxis.tables_left.left`.
@@ -24,15 +27,16 @@ from pathlib import Path
 from ..errors import require
 from . import comp_tables as ct
 
-FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc")
+FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc", "linuxcnc")
 
 
 def build(funcs, fmt: str, points: int | None = None) -> list:
     """The :class:`~volerr.tables.comp_tables.CompTable` list of format ``fmt`` from error
     functions (``points``: at most this many per table, within the format's limit)."""
-    from . import fanuc, heidenhain_tables, sinumerik
+    from . import fanuc, heidenhain_tables, linuxcnc, sinumerik
 
-    builders = {"sinumerik-lec": (sinumerik.build_lec, sinumerik.MAX_POINTS),
+    builders = {"linuxcnc": (linuxcnc.build, linuxcnc.MAX_POINTS),
+                "sinumerik-lec": (sinumerik.build_lec, sinumerik.MAX_POINTS),
                 "sinumerik-cec": (sinumerik.build_cec, sinumerik.MAX_POINTS),
                 "heidenhain": (heidenhain_tables.build, heidenhain_tables.MAX_POINTS),
                 "fanuc": (fanuc.build, fanuc.MAX_POINTS)}
@@ -41,18 +45,22 @@ def build(funcs, fmt: str, points: int | None = None) -> list:
     require(points is None or 2 <= points <= limit,
             f"--points must be 2 .. {limit} for {fmt}")
     tables = fn(funcs, points or limit)
-    require(tables, f"{fmt}: the error tables hold nothing this format carries "
-                    f"({'positioning' if fmt in ('sinumerik-lec', 'fanuc') else 'straightness'}"
-                    " errors of the axes)")
+    kind = "straightness" if fmt in ("sinumerik-cec", "heidenhain") else "positioning"
+    require(tables, f"{fmt}: the error tables hold nothing this format carries ({kind} "
+                    "errors of the axes)")
     return tables
 
 
-def write(model, tables: list, fmt: str, out: Path) -> dict:
+def write(model, tables: list, fmt: str, out: Path, comp_type: int = 0) -> dict:
     """{path: text} of the files of ``tables`` in format ``fmt``, the main file (at ``out``)
-    first (Heidenhain: the ``.CMA`` there and its ``.COM`` tables next to it)."""
-    from . import fanuc, heidenhain_tables, sinumerik
+    first (Heidenhain: the ``.CMA`` there and its ``.COM`` tables next to it; LinuxCNC: the
+    files in the folder ``out``, ``comp_type`` its ``COMP_FILE_TYPE``)."""
+    from . import fanuc, heidenhain_tables, linuxcnc, sinumerik
 
     out = Path(out)
+    if fmt == "linuxcnc":
+        return {out / name: text for name, text in
+                linuxcnc.write(model.name, tables, model.axes, comp_type).items()}
     if fmt == "sinumerik-lec":
         return {out: sinumerik.write_lec(model.name, tables)}
     if fmt == "sinumerik-cec":
@@ -66,10 +74,12 @@ def write(model, tables: list, fmt: str, out: Path) -> dict:
 
 
 def read(model, path, fmt: str) -> list:
-    """The tables of a controller file (Heidenhain: the ``.CMA``)."""
-    from . import fanuc, heidenhain_tables, sinumerik
+    """The tables of a controller file (Heidenhain: the ``.CMA``; LinuxCNC: the ini)."""
+    from . import fanuc, heidenhain_tables, linuxcnc, sinumerik
 
     p = Path(path)
+    if fmt == "linuxcnc":
+        return linuxcnc.read_tables(p, model)
     require(p.is_file(), f"controller file not found: {path}")
     if fmt == "heidenhain":
         return heidenhain_tables.read(p, model.axes)
@@ -80,10 +90,15 @@ def read(model, path, fmt: str) -> list:
 
 
 def import_tables(model, path, fmt: str) -> dict:
-    """{axis: ErrorTable} of a controller file (values back in volerr's units and signs)."""
+    """{axis: ErrorTable} of a controller file (values back in volerr's units and signs;
+    LinuxCNC: the ini naming the ``COMP_FILE`` s)."""
+    from . import linuxcnc
     from .controller import check_against_model
 
-    tables = ct.to_error_tables(read(model, path, fmt), model)
+    if fmt == "linuxcnc":
+        tables = linuxcnc.read(path, model)
+    else:
+        tables = ct.to_error_tables(read(model, path, fmt), model)
     check_against_model(model, tables, {}, str(path))
     return tables
 

@@ -309,3 +309,59 @@ def test_tool_vector_programs_whole_chunk_equal_line_by_line(setup, siemens, mon
     b = nc_interpret.interpret(segs, 1, interp, m, 4)
     in_runs = sum(j - i for i, j, cols in b.runs if cols == len(m.axes) + 3)
     assert in_runs > 0.9 * len(segs), in_runs
+
+
+#: tool-vector programs in the shapes posts write (issue 36 item 6): (head, line, ending);
+#: the line format gets N, then X Y Z and the vector
+POST_SHAPES = {
+    "bare": ("G90 G21\nT1 M6\nG43.5 H1\n", "G1 X{:.4f} Y{:.4f} Z{:.4f} I{:.6f} J{:.6f} "
+             "K{:.6f} F2000", "\n"),
+    "comment": ("G90 G21\nT1 M6\nG43.5 H1\n", "G1 X{:.4f} Y{:.4f} Z{:.4f} I{:.6f} "
+                "J{:.6f} K{:.6f} F2000 (cut)", "\n"),
+    "n_crlf": ("%\r\nN1 G90 G21\r\nN2 T1 M6\r\nN3 G43.5 H1\r\n", "N{} G01 X{:.4f} Y{:.4f} "
+               "Z{:.4f} I{:.6f} J{:.6f} K{:.6f} F2000.", "\r\n"),
+    "rotary_first": ("G90 G1 X0 Y0 Z300 B10 C0\nT1 M6\nG43.5 H1\n", "X{:.4f} Y{:.4f} "
+                     "Z{:.4f} I{:.6f} J{:.6f} K{:.6f}", "\n"),
+    "f_once": ("G90\nT1 M6\nG43.5 H1\nG1 F2000\n", "X{:.4f} Y{:.4f} Z{:.4f} I{:.6f} "
+               "J{:.6f} K{:.6f}", "\n"),
+    "traori": ("G90\nT1 M6\nTRAORI\n", "N{} G01 X{:.4f} Y{:.4f} Z{:.4f} A3={:.6f} "
+               "B3={:.6f} C3={:.6f} F2000", "\n"),
+}
+
+
+def post_program(m, shape: str, n: int, seed: int = 7) -> str:
+    head, fmt, end = POST_SHAPES[shape]
+    rng = np.random.default_rng(seed)
+    q = np.column_stack([rng.uniform(-150, 150, n), rng.uniform(-150, 150, n),
+                         rng.uniform(180, 380, n), rng.uniform(1, 80, n),
+                         rng.uniform(0, 359, n)])
+    f = m.forward(q, np.tile([0.0, 0.0, -100.0], (n, 1)))
+    numbered = fmt.startswith("N")
+    body = [fmt.format(*(((10 + i,) if numbered else ()) + tuple(r))) for i, r in
+            enumerate(f)]
+    return head + end.join(body) + end + "M30" + end
+
+
+@pytest.mark.parametrize("shape", list(POST_SHAPES))
+def test_every_post_shape_of_a_vector_program_takes_the_whole_chunk_path(setup, shape,
+                                                                         monkeypatch):
+    """With or without comments, N numbers, F words, CRLF, rotary words before the TCPM
+    block: the lines are read in tool-vector runs (not one by one) and the output is the
+    line-by-line path's, byte for byte."""
+    from volerr.nc import interpret as nc_interpret
+
+    m, funcs = setup
+    funcs = ErrorFunctions(funcs.tables, funcs.constants, m, extrapolate=True)
+    text = post_program(m, shape, 300)
+    kw = {"tool_length": 100.0, "check_travel": False}
+    monkeypatch.setattr(program, "WHOLE_CHUNK", False)
+    ref = compensate_program(m, funcs, text, **kw)
+    monkeypatch.setattr(program, "WHOLE_CHUNK", True)
+    assert ref.summary()["tcpm_blocks"] == 300 and ref.text != text
+    got = compensate_program(m, funcs, text, chunk_lines=97, **kw)
+    assert got.text == ref.text
+    segs = text.splitlines(keepends=True)
+    interp = gcode.Interpreter(m.axes, {}, lambda tools, where: 100.0)
+    b = nc_interpret.interpret(segs, 1, interp, m, 4)
+    in_runs = sum(j - i for i, j, cols in b.runs if cols == len(m.axes) + 3)
+    assert in_runs >= 299, (shape, in_runs)

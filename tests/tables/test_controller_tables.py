@@ -22,8 +22,20 @@ from volerr.tables.functions import ErrorFunctions
 from volerr.tables.table import ErrorTable
 
 INCREMENT = {"sinumerik-lec": 1e-4, "sinumerik-cec": 1e-4, "heidenhain": 1e-4,
-             "fanuc": 1e-3}
-LIMIT = {"sinumerik-lec": 200, "sinumerik-cec": 200, "heidenhain": 256, "fanuc": 128}
+             "fanuc": 1e-3, "linuxcnc": 1e-6}
+LIMIT = {"sinumerik-lec": 200, "sinumerik-cec": 200, "heidenhain": 256, "fanuc": 128,
+         "linuxcnc": 256}
+
+
+def _write_and_read(m, tables, fmt, tmp_path):
+    """Write the format's files under tmp_path and read them back (LinuxCNC: a folder of
+    COMP_FILEs, read through its ini)."""
+    out = tmp_path / ("lcnc" if fmt == "linuxcnc" else "comp.txt")
+    files = ctl.write(m, tables, fmt, out)
+    for p, text in files.items():
+        Path(p).parent.mkdir(exist_ok=True)
+        Path(p).write_text(text)
+    return ctl.read(m, out / "compensation.ini" if fmt == "linuxcnc" else out, fmt)
 
 
 @pytest.fixture(scope="module")
@@ -50,16 +62,13 @@ def _positioning(m, funcs, a, pos):
 def test_export_import_round_trip_within_the_increment(setup, tmp_path, fmt):
     m, funcs, _ = setup
     tables = ctl.build(funcs, fmt)
-    files = ctl.write(m, tables, fmt, tmp_path / "comp.txt")
-    for p, text in files.items():
-        Path(p).write_text(text)
-    back = ctl.read(m, tmp_path / "comp.txt", fmt)
+    back = _write_and_read(m, tables, fmt, tmp_path)
     assert len(back) == len(tables)
     inc = INCREMENT[fmt]
     for t in back:
         pos = t.positions
         assert len(pos) <= LIMIT[fmt] and np.allclose(np.diff(pos), t.step)
-        if t.input == "C":
+        if t.input == "C" and fmt != "linuxcnc":     # LinuxCNC's joint table has no modulo
             assert t.modulo and abs(pos[-1] - pos[0] - 360) < 1e-9
         lo, hi = funcs.tables[t.input].positions[[0, -1]]
         inside = np.mod(pos, 360.0) if t.modulo else np.clip(pos, lo, hi)
@@ -130,13 +139,11 @@ def _controller_left(m, funcs, tables, grid=5):
 def test_what_the_tables_leave_equals_an_independent_computation(setup, tmp_path, fmt):
     m, funcs, _ = setup
     tables = ctl.build(funcs, fmt)
-    files = ctl.write(m, tables, fmt, tmp_path / "comp.txt")
-    for p, text in files.items():
-        Path(p).write_text(text)
+    back = _write_and_read(m, tables, fmt, tmp_path)
     from volerr.fiveaxis.tables_left import left
 
     s = left(m, funcs, tables, grid=5).summary()
-    before, after = _controller_left(m, funcs, ctl.read(m, tmp_path / "comp.txt", fmt))
+    before, after = _controller_left(m, funcs, back)
     assert s["before_um"]["max"] == pytest.approx(before.max(), abs=0.01)
     assert s["left_um"]["max"] == pytest.approx(after.max(), abs=0.01)
     assert s["left_um"]["rms"] == pytest.approx(np.sqrt(np.mean(after ** 2)), abs=0.01)
