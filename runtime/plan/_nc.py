@@ -293,10 +293,10 @@ def _retract_positions(model, q, probe) -> np.ndarray:
 
 # ---- distances, interferometer ------------------------------------------------------------
 def _distances(model, pf, setup, rows) -> list:
-    ops = list(_down_to(model, rows[0]))
-    for q in rows:
-        ops += [Op("line", _at(model, q), FEED["distances"]),
-                Op("dwell", seconds=_spec.DWELL_S["distances"])]
+    dwell = Op("dwell", seconds=_spec.DWELL_S["distances"])
+    ops = [*_down_to(model, rows[0]), dwell]
+    for q in rows[1:]:
+        ops += [Op("line", _at(model, q), FEED["distances"]), dwell]
     return ops
 
 
