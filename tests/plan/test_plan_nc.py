@@ -23,6 +23,7 @@ import math
 import re
 import shutil
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -337,3 +338,32 @@ def test_linuxcnc_interpreter_reads_every_program(programs, tmp_path):
             bad = [ln for ln in (run.stdout + run.stderr).splitlines()
                    if re.search(r"error|too long|unknown", ln, re.IGNORECASE)]
             assert not bad, (case, dialect, pf.name, bad[:3])
+
+
+# ---- the command line ----------------------------------------------------------------------
+def test_dialect_option_writes_that_dialect(tmp_path):
+    import json
+
+    from volerr.cli import main
+
+    out, js = tmp_path / "plan", tmp_path / "plan.json"
+    assert main(["plan", "MB1", "--instrument", "interferometer", "--readings",
+                 "1200", "--dialect", "heidenhain", "--out", str(out), "--json", str(js)]) == 0
+    doc = json.loads(js.read_text())
+    for f in doc["files"]:
+        assert f["nc"].endswith(".h")
+        text = (out / f["nc"]).read_text()
+        assert text.startswith("0 BEGIN PGM ") and "CYCL DEF 9.1 DWELL 3" in text
+        assert max(map(len, text.splitlines())) < 254
+    assert not list(out.glob("*.nc"))
+
+
+@pytest.mark.parametrize("bad", ["ISO"])
+def test_bad_dialect_one_line_exit_2_nothing_written(tmp_path, bad):
+    run = subprocess.run([sys.executable, "-m", "volerr", "plan", "MB1", "--instrument", "ballbar",
+                          "--readings", "100", "--dialect", bad, "--out", str(tmp_path / "p")],
+                         capture_output=True, text=True)
+    assert run.returncode == 2
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--dialect" in lines[0], run.stderr
+    assert not (tmp_path / "p").exists()
