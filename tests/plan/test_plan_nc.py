@@ -12,8 +12,8 @@ probed towards its centre from outside at four points or more, nothing behind th
 plane on the plate; no rotary motion and no motion off the tool axis within 30 mm of a
 sphere; every interferometer reading reached moving in its declared direction, each cycle
 starting beyond its first target; the file's rows a subsequence of the end points; the first
-motion a retract along Z alone; G21, G90, G54 before any motion; M30; lines under 254
-characters.  Where LinuxCNC's ``rs274`` is installed it must read every program without an
+motion a retract along Z alone; G21, G90, G54 before any motion; every end point inside the
+travel; M30; lines under 254 characters.  Where LinuxCNC's ``rs274`` is installed it must read every program without an
 error.  The other dialects: their dwell, probing and comment words.
 """
 
@@ -37,7 +37,7 @@ CASES = {
     "DMU50-ballbar": ("DMU50", "ballbar:lengths=100,250", 25, 20),
     "DMU50-sphere": ("DMU50", "sphere", 30, 10),
     "MB1-artifact": ("MB1", "artifact:balls=3x3:pitch=150", 4, 9),
-    "DMU50-artifact": ("DMU50", "artifact:balls=3x3:pitch=100", 4, 9),
+    "DMU50-artifact": ("DMU50", "artifact", 2, 25),
     "MB1-interferometer": ("MB1", "interferometer", 20, 44),
     "DMU50-interferometer": ("DMU50", "interferometer:optics=linear", 4, 44),
     "MB1-distances": ("MB1", "distances", 5, 14),
@@ -159,6 +159,10 @@ def test_frame_of_every_program(programs, case, dialect):
         moved = {a for a in model.axes if first[1][a] != first[2][a]}
         assert moved == {"Z"} and first[2]["Z"] == model.travel["Z"][1], (case, first)
         assert segs[-1][0] == "M30" and lines[-2:] == ["M30", "%"], (case, pf.name)
+        for seg in segs[1:]:
+            for a in model.axes:
+                lo, hi = model.travel[a]
+                assert lo - 1e-9 <= seg[2][a] <= hi + 1e-9, (case, pf.name, a, seg)
 
 
 @pytest.mark.parametrize("case", [c for c in CASES if "artifact" not in c])
