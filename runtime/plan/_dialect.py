@@ -268,7 +268,8 @@ class Heidenhain(Iso):
     def arc(self, op: Op, start: dict) -> list:
         a, _, b, _ = CENTRE_WORDS[op.normal]
         cc = f"CC {a}{number(op.centre[a], sign=True)} {b}{number(op.centre[b], sign=True)}"
-        return [cc, f"C {self.words(op.to)} DR{'+' if op.ccw else '-'} R0 F{number(op.feed)}"]
+        end = self.words({k: v for k, v in op.to.items() if k in (a, b)})  # the circle's plane
+        return [cc, f"C {end} DR{'+' if op.ccw else '-'} R0 F{number(op.feed)}"]
 
     def probe(self, op: Op) -> list:
         sense = "+" if op.sign > 0 else "-"

@@ -72,6 +72,19 @@ def program(model, pf, header: list, dialect: str = "iso", name: str = "PLAN") -
     return _dialect.dialect(dialect, model.axes).render(operations(model, pf, header), name)
 
 
+def nc_program(model, instrument, setups, dialect: str = "iso", header=(),
+               name: str = "PLAN") -> str:
+    """The NC program of ``setups`` [(SetUp, readings)] of one instrument (an ``--instrument``
+    SPEC text or a parsed :class:`volerr.plan._spec.Instrument`), as ``volerr plan`` writes
+    it, in ``dialect``: for a caller with its own set-ups (an interim check)."""
+    from ._files import PlanFile, columns_of
+
+    inst = _spec.parse(instrument) if isinstance(instrument, str) else instrument
+    pf = PlanFile("program.csv", inst.kind, 0, list(setups))
+    pf.columns = columns_of(inst, pf.setups)
+    return program(model, pf, list(header), dialect, name)
+
+
 def program_name(file_name: str) -> str:
     """A program name a controller takes (Heidenhain ``BEGIN PGM``): the file's stem, letters
     digits and ``_`` only."""

@@ -326,7 +326,17 @@ def test_dialect_words():
     assert f"G4 F{s:g}\n" in texts["sinumerik"] and f"DWELL {s:g}\n" in texts["heidenhain"]
     model, files = _files_of("MB1-ballbar")
     hh = _nc.program(model, files[0], [], "heidenhain")
-    assert " CC X" in hh and re.search(r" C X\S+ Y\S+ Z\S+ DR[+-] R0 F1000", hh)
+    assert " CC X" in hh and re.search(r" C X\S+ Y\S+ DR[+-] R0 F1000", hh)
+
+
+def test_nc_program_of_own_set_ups_is_the_plan_program():
+    """The writer for a caller with its own set-ups (issue 37's check programs)."""
+    from volerr.plan import nc_program
+
+    model, files = _files_of("DMU50-sphere")
+    pf = files[0]
+    text = nc_program(model, "sphere", pf.setups, "linuxcnc", ["a header"])
+    assert text == _nc.program(model, pf, ["a header"], "linuxcnc")
 
 
 @pytest.mark.skipif(shutil.which("rs274") is None, reason="LinuxCNC's rs274 not installed")
@@ -334,7 +344,7 @@ def test_linuxcnc_interpreter_reads_every_program(programs, tmp_path):
     table = tmp_path / "tool.tbl"
     table.write_text("T1 P1 Z0 D3 ;probe\n")
     for (case, dialect), (model, progs) in programs.items():
-        for pf, text in progs[:2]:
+        for pf, text in progs:
             path = tmp_path / "p.ngc"
             path.write_text(text)
             run = subprocess.run(["rs274", "-g", "-t", str(table), str(path)],
