@@ -108,7 +108,7 @@ def walk(text: str, axes):
         arc = None
         if kind in ("G2", "G3"):
             off = {k: v for k, v in words if k in "IJK"}
-            a, b = {"Z": "XY", "Y": "XZ", "X": "YZ"}[plane]
+            a, b = {"Z": "XY", "Y": "ZX", "X": "YZ"}[plane]     # right-handed about it
             arc = (plane, {a: where[a] + off.get("IJK"["XYZ".index(a)], 0.0),
                            b: where[b] + off.get("IJK"["XYZ".index(b)], 0.0)}, kind == "G3")
         segs.append((kind, dict(where), to, arc))
@@ -130,6 +130,7 @@ def samples(seg, axes, rotary) -> np.ndarray:
     t0 = math.atan2(s[b] - c[b], s[a] - c[a])
     t1 = math.atan2(e[b] - c[b], e[a] - c[a])
     sweep = (t1 - t0) % (2 * math.pi) if ccw else -((t0 - t1) % (2 * math.pi))
+    assert abs(sweep) <= math.pi, ("an arc the long way round: wrong G2/G3", seg)
     r = math.hypot(s[a] - c[a], s[b] - c[b])
     k = max(int(abs(sweep) * r / 0.5), 4)
     t = t0 + np.linspace(0, 1, k + 1) * sweep
@@ -352,6 +353,40 @@ def test_linuxcnc_interpreter_reads_every_program(programs, tmp_path):
             bad = [ln for ln in (run.stdout + run.stderr).splitlines()
                    if re.search(r"error|too long|unknown", ln, re.IGNORECASE)]
             assert not bad, (case, dialect, pf.name, bad[:3])
+            assert _short_arcs(run.stdout), (case, dialect, pf.name)
+
+
+#: rs274's canonical arc planes: (first axis, second axis) of ARC_FEED's end and centre
+_CANON = {"XY": (0, 1), "XZ": (2, 0), "YZ": (1, 2)}
+
+
+def _short_arcs(canonical: str) -> bool:
+    """Every ARC_FEED of rs274's canonical output turns less than half a turn from where the
+    move before ended (the plan's arcs join readings at most 45 deg apart: an arc the long way
+    round is a G2 written for a G3).  rotation +1: counter-clockwise, first axis towards the
+    second."""
+    at, plane = np.zeros(3), "XY"
+    for ln in canonical.splitlines():
+        m = re.search(r"(SELECT_PLANE\(CANON_PLANE_(\w+)\)|(STRAIGHT_\w+|ARC_FEED)\(([^)]*)\))",
+                      ln)
+        if not m:
+            continue
+        if m.group(2):
+            plane = m.group(2)
+            continue
+        v = [float(x) for x in m.group(4).split(",")]
+        if m.group(3) != "ARC_FEED":
+            at = np.array(v[:3])
+            continue
+        i, j = _CANON[plane]
+        end, c = np.array(v[:2]), np.array(v[2:4])
+        t0 = math.atan2(at[j] - c[1], at[i] - c[0])
+        t1 = math.atan2(end[1] - c[1], end[0] - c[0])
+        turn = (t1 - t0) % (2 * math.pi) if v[4] > 0 else (t0 - t1) % (2 * math.pi)
+        if turn > math.pi:
+            return False
+        at[i], at[j], at[3 - i - j] = end[0], end[1], v[5]
+    return True
 
 
 # ---- the command line ----------------------------------------------------------------------
