@@ -110,7 +110,6 @@ class Iso:
 
     def __init__(self, axes):
         self.axes = tuple(axes)
-        self.last = {}
 
     # -- words ----------------------------------------------------------------------------
     def words(self, to: dict) -> str:
