@@ -282,7 +282,12 @@ def _sphere(model, pf, setup, rows) -> list:
     dwell = _spec.DWELL_S["sphere"]
     ops = []
     for q, a in zip(rows, above):
-        ops += [Op("rapid", {"Z": _top(model)}), *_down_to(model, a),
+        across, down = _down_to(model, a)
+        if np.allclose(a, q):       # no room to stop short: the whole descent at the feed
+            ops += [Op("rapid", {"Z": _top(model)}), across,
+                    Op("line", _at(model, q), FEED["sphere"]), Op("dwell", seconds=dwell)]
+            continue
+        ops += [Op("rapid", {"Z": _top(model)}), across, down,
                 Op("line", _at(model, q), FEED["sphere"]), Op("dwell", seconds=dwell),
                 Op("line", _at(model, a), FEED["sphere"])]
     return ops
@@ -356,7 +361,8 @@ def _artifact(model, pf, setup, rows) -> list:
                               f"ball probed at {len(dirs)} points towards its centre from "
                               f"{PROBE_START_MM:g} mm, on the plate's free side")]
     for b, c in zip(balls[mine], centres):
-        ops.append(Op("comment", text=f"ball {b}: centre ({c[0]:g}, {c[1]:g}, {c[2]:g}) mm"))
+        where = ", ".join(_dialect.number(v) for v in c)
+        ops.append(Op("comment", text=f"ball {b}: centre ({where}) mm"))
         ops += _ball(model, c, normal, dirs, rot, tool)
     return ops
 
