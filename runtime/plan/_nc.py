@@ -31,9 +31,12 @@ R-test, distances, interferometer) -- a ball of an artifact is probed instead (b
   :data:`PROBE_START_MM` round the ball on its free side; between balls up to the clearance
   height.  Ball :data:`BALL_D_MM`, stylus tip :data:`STYLUS_D_MM` (stated in the program;
   the geometry: :mod:`volerr.plan._probing`).
-* **interferometer** (ISO 230-2:2014 linear cycle, cl. 4.3 / 5.3): each target approached
-  from its declared direction, an overshoot :data:`OVERSHOOT_MM` beyond the last target
-  before each reversal and before the first target, a dwell at each.
+* **interferometer** (ISO 230-2:2014 linear cycle, cl. 4.3 / 5.3; the standard's text as GOST
+  ISO 230-2, docs.cntd.ru/document/1200146046: the moving component is positioned at a series
+  of targets where it stays at rest long enough for the position to be reached, measured and
+  recorded, moving between them at an agreed feed): each target approached from its declared
+  direction, an overshoot :data:`OVERSHOOT_MM` beyond the last target before each reversal
+  and before the first target, a dwell at each.
 * **distances** (tracking interferometer): straight feed moves between the targets, a dwell
   at each.
 """
