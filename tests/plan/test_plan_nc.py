@@ -400,6 +400,7 @@ def test_dialect_option_writes_that_dialect(tmp_path):
     assert main(["plan", "MB1", "--instrument", "interferometer", "--readings",
                  "1200", "--dialect", "heidenhain", "--out", str(out), "--json", str(js)]) == 0
     doc = json.loads(js.read_text())
+    assert doc["nc_dialect"] == "heidenhain"
     for f in doc["files"]:
         assert f["nc"].endswith(".h")
         text = (out / f["nc"]).read_text()
