@@ -362,7 +362,9 @@ def _artifact(model, pf, setup, rows) -> list:
     normal, dirs = _probing.directions(model, setup.geometry["plane"], tool, rot)
     ops = [Op("comment", text=f"ball {BALL_D_MM:g} mm, stylus tip {STYLUS_D_MM:g} mm: each "
                               f"ball probed at {len(dirs)} points towards its centre from "
-                              f"{PROBE_START_MM:g} mm, on the plate's free side")]
+                              f"{PROBE_START_MM:g} mm, on the plate's free side "
+                              f"({', '.join(_dialect.number(v) for v in normal)}): the "
+                              f"plate behind its balls' plane")]
     for b, c in zip(balls[mine], centres):
         where = ", ".join(_dialect.number(v) for v in c)
         ops.append(Op("comment", text=f"ball {b}: centre ({where}) mm"))
