@@ -102,6 +102,12 @@ def wrap(text: str, width: int) -> list:
     return out
 
 
+def _linear(to: dict) -> dict:
+    """The linear axis words of ``to`` (a probing move names only them: the rotary axes
+    stand still)."""
+    return {a: v for a, v in to.items() if a in "XYZ"}
+
+
 class Iso:
     """ISO 6983 / RS274NGC (the module docstring's table)."""
 
@@ -147,7 +153,7 @@ class Iso:
         return [f"{PLANE_CODE[op.normal]} {code} {self.words(op.to)} {off} F{number(op.feed)}"]
 
     def probe(self, op: Op) -> list:
-        return [f"G38.2 {self.words(op.to)} F{number(op.feed)}"]
+        return [f"G38.2 {self.words(_linear(op.to))} F{number(op.feed)}"]
 
     def dwell(self, op: Op) -> list:
         return [f"G4 P{number(op.seconds)}"]
@@ -200,7 +206,7 @@ class Fanuc(Iso):
         return [f"G4 P{int(round(op.seconds * 1000))}"]
 
     def probe(self, op: Op) -> list:
-        return [f"G31 {self.words(op.to)} F{number(op.feed)}"]
+        return [f"G31 {self.words(_linear(op.to))} F{number(op.feed)}"]
 
 
 class Sinumerik(Iso):
@@ -227,7 +233,7 @@ class Sinumerik(Iso):
                               "the plan; G60 exact stop")]
 
     def probe(self, op: Op) -> list:
-        return [f"MEAS=1 G1 {self.words(op.to)} F{number(op.feed)}"]
+        return [f"MEAS=1 G1 {self.words(_linear(op.to))} F{number(op.feed)}"]
 
     def dwell(self, op: Op) -> list:
         return [f"G4 F{number(op.seconds)}"]
@@ -275,7 +281,7 @@ class Heidenhain(Iso):
 
     def probe(self, op: Op) -> list:
         sense = "+" if op.sign > 0 else "-"
-        pre = {a: v for a, v in self.last_position.items() if a in "XYZ"}   # where it stands
+        pre = _linear(self.last_position)       # where it stands
         return [f"TCH PROBE 0.0 REF. PLANE Q1 {op.axis}{sense}",
                 f"TCH PROBE 0.1 {self.words(pre)}"]
 
