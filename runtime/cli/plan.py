@@ -22,7 +22,9 @@ def register(sub) -> None:
                     "while every requested parameter stays determined (greedy design, "
                     "Fedorov exchange, on calibrate's own normal equations).  Writes into "
                     "DIR one instrument file per set-up group with EMPTY reading columns, an "
-                    "NC program (.nc, ISO G-code in the layout's axes) beside each, and "
+                    "NC program beside each (the layout's axes, --dialect; safe along its "
+                    "whole path: ballbar circles as arcs with run-in and run-out, balls "
+                    "probed from outside, ISO 230-2 overshoots), and "
                     "plan.html (the set-up sheet); predicts what 'volerr calibrate LAYOUT "
                     "FILES' (no options) will report once the files are filled, and the same "
                     "for the instrument's conventional plan at the same number of readings "
@@ -55,6 +57,12 @@ def register(sub) -> None:
     p.add_argument("--criterion", choices=("I", "D"), default="I",
                    help="I: mean predicted variance of the volumetric error over the working "
                         "volume; D: determinant of the information matrix")
+    p.add_argument("--dialect", default="iso", metavar="NAME",
+                   help="controller dialect of the NC programs: iso (default; ISO 6983 / "
+                        "RS274NGC, read by LinuxCNC), linuxcnc, fanuc (G4 P in ms, G31 "
+                        "probing), sinumerik (.mpf: G4 F, MEAS=1, ; comments), heidenhain (.h "
+                        "plain language: CYCL DEF 9 dwell, TCH PROBE 0); every program safe "
+                        "along its whole path: 'volerr formats plan'")
     p.add_argument("--seed", type=int, default=0,
                    help="seed of the random starts of the exchange (the same seed, the same "
                         "plan)")
@@ -68,6 +76,10 @@ def run(args) -> int:
 
     require(1 <= args.readings <= 10 ** 7, "--readings must be between 1 and 10000000")
     require(args.minutes is None or args.minutes > 0, "--minutes must be positive")
+    from ..plan._dialect import NAMES
+
+    require(args.dialect in NAMES, f"--dialect {args.dialect}: not a dialect; give one of "
+                                   f"{', '.join(NAMES)}")
     require(args.parameters is None or args.parameters.strip(),
             "--parameters: empty; give names, axes or groups")
     inputs = layout_inputs(args.layout)
@@ -76,7 +88,8 @@ def run(args) -> int:
     outs = Outputs(inputs, force=args.force).folder("--out", out) \
         .file("--json", args.json).file("--html", args.html).check()
     if out.is_dir() and not args.force:
-        taken = sorted(p.name for p in out.iterdir() if p.suffix in (".csv", ".nc", ".html"))
+        taken = sorted(p.name for p in out.iterdir()
+                       if p.suffix in (".csv", ".nc", ".html", ".h", ".mpf"))
         require(not taken, f"--out {out}: holds {taken[0] if taken else ''} already; give "
                            f"--force to replace plan files there, or another folder")
     with outs:
@@ -84,6 +97,6 @@ def run(args) -> int:
                       args.minutes, args.criterion, args.seed)
         folder = outs.path("--out")
         result.write(folder, outs.path("--json") if args.json else None,
-                     outs.path("--html") if args.html else None, inputs)
+                     outs.path("--html") if args.html else None, inputs, args.dialect)
     print(result.summary())
     return 0

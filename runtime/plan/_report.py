@@ -57,8 +57,12 @@ def _files_readings(kind: str):
     return READINGS[kind]
 
 
-def nc_name(pf) -> str:
-    return pf.name[:-4] + ".nc"
+def nc_name(pf, dialect: str = "iso") -> str:
+    """The NC program's file name beside ``pf``: ``.nc`` (``.mpf`` SINUMERIK, ``.h``
+    Heidenhain)."""
+    from ._dialect import DIALECTS
+
+    return pf.name[:-4] + DIALECTS[dialect].suffix
 
 
 def _params(pred, alone=None) -> dict:
@@ -77,7 +81,8 @@ def data(plan) -> dict:
     pred, base = plan.prediction, plan.baseline["prediction"]
     files = []
     for pf, minutes in zip(plan.files, plan.minutes):
-        files.append({"file": pf.name, "kind": pf.kind, "nc": nc_name(pf), "readings": pf.n,
+        files.append({"file": pf.name, "kind": pf.kind, "nc": nc_name(pf, plan.dialect),
+                      "readings": pf.n,
                       "minutes": minutes,
                       "setups": [{"label": s.label, "text": s.text, "readings": int(m),
                                   **_geometry(s.geometry)} for s, m in pf.setups]})
@@ -108,6 +113,7 @@ def data(plan) -> dict:
         "map_gain": None if gain is None else round(gain, 4),
         "minutes": round(plan.total_minutes, 1),
         "files": files,
+        "nc_dialect": plan.dialect,
         "candidates": {"setups": plan.candidates, "readings": plan.candidate_readings},
         "time_model": {"setup_change_min": dict(_spec.SETUP_MIN),
                        "reading_s": dict(_spec.READING_S),
