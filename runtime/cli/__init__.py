@@ -20,7 +20,7 @@ __all__ = ["InputError"]
 #: command modules, in the order shown by ``volerr --help``
 COMMANDS = ("layouts", "derive", "audit", "map", "diagonals", "identify", "squareness",
             "probe_cal", "compensate", "tcpmap", "controller", "calibrate", "ballbar", "loop",
-            "simulate", "plan", "iso230_2",
+            "simulate", "plan", "iso230_2", "iso230_3", "drift",
             "uncertainty", "iso10360", "demo", "examples", "formats")
 
 #: closes every ``--help``

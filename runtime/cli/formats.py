@@ -19,7 +19,7 @@ def register(sub) -> None:
                                    "section names, or one section.")
     p.add_argument("name", nargs="?", metavar="NAME",
                    help="section: tables, tracker, probe-sphere, deviations, ballbar, sphere, "
-                        "artifact, interferometer, distances, calibrate-json, loop-json, "
+                        "artifact, interferometer, distances, drift, iso230-3, calibrate-json, loop-json, "
                         "layout, gcode, tools, controller, axis-tables, uncertainty, iso230-2, "
                         "outputs, audit, or 'all'")
     p.set_defaults(func=run)

@@ -1,0 +1,380 @@
+"""The ``drift`` instrument: a thermal drift test (ISO 230-3) -- a logger's run at one machine
+position while the machine warms and cools (a spindle test with displacement sensors round a
+test mandrel, an environmental temperature variation test, a lathe's tool-point drift).
+
+File (``volerr formats drift``): a time column ``t_s``, ``t_min`` or ``t_h`` (read in seconds);
+displacement channels ``d_<label>_um``; every other numeric column a logged input (temperatures
+``T_<label>`` degC, spindle speed ``S_rpm``, feed, power ...); optional position columns
+``X, Y, Z[, B, C]`` (constant in a run: the test position; axes not given stand at the middle of
+their travel, rotary axes at 0), optional ``run`` (a label: a file is one run unless it says
+otherwise; lags start afresh in every run).  Header lines ``# channel d_<label>: DIR [at
+z=<mm>]`` give a channel's direction, ``DIR`` one of ``X Y Z -X -Y -Z`` (machine axes of the
+workpiece frame) or ``?`` (not known, the default), and the sensor's height ``z`` on the
+mandrel.  A logger's file as saved (``Time(min)``, ``ch1(um)``, ``t1(°C)``) is read by the
+mapping of :mod:`volerr.instruments._drift_logger` (``volerr drift convert`` writes it out).
+
+Reading and sign: a channel reads the displacement of the tool side relative to the workpiece
+side along its direction, as the sensor reads it (positive when the mandrel moves towards +DIR
+relative to the sensor's stand on the table), with any zero: ``d = dir . e(q, p) + z_c`` in um,
+``e`` the volumetric error (tool point relative to the workpiece, workpiece frame) at the test
+position ``q`` and the point ``p = (0, 0, z)`` of the tool frame (the sensor's height, mm, as
+the probe offset ``Zp``; 0 when not given), ``z_c`` the channel's zero in that run (a set-up
+unknown, um).  Two sensors of one direction at two heights read the spindle's tilt:
+``(d(z2) - d(z1)) / (z2 - z1)`` (urad = um / mm).  A ``?`` channel is no row of the layout's
+model (projection zero): its only model term is its zero; the loop models it on its own.
+
+Observations: one point per reading of one channel (one row), channels after each other
+within a run, runs in file order; ``info`` holds ``channel`` (label), ``run`` (label), ``t_s``
+(s) per point; ``covariates`` every logged input and ``t_s`` (so lags run over seconds); each
+run is its own entry of ``files`` (``file`` indexes it: lags restart in each run).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, require
+from . import _drift_logger as logger
+from ._csv import Columns, read_columns, read_header
+from .observations import FileInfo, Observations, Setup
+
+KIND = "drift"
+#: channel directions of the header lines, as unit vectors of the workpiece frame
+DIRECTIONS = {"X": (1, 0, 0), "Y": (0, 1, 0), "Z": (0, 0, 1), "-X": (-1, 0, 0),
+              "-Y": (0, -1, 0), "-Z": (0, 0, -1), "?": None}
+TIME_COLUMNS = ("t_s", "t_min", "t_h")
+POSITION_AXES = "XYZUVWABC"
+#: a channel header line: ``# channel d_ch1: X at z=120`` (``d_`` and ``_um`` optional)
+_CHANNEL_LINE = re.compile(r"^#\s*channel\s+(\S+?)\s*:\s*(.*?)\s*$", re.IGNORECASE)
+_AT = re.compile(r"^(\S+)(?:\s+at\s+z\s*=\s*(\S+?)\s*(?:mm)?)?$", re.IGNORECASE)
+
+
+@dataclass
+class DriftRun:
+    """One run of a drift file.
+
+    ``file`` the file name; ``run`` its label (``"1"`` for a file of one run); ``t_s`` (N,)
+    seconds from the file's time origin, strictly increasing; ``channels`` label -> (N,) um,
+    the tool side relative to the workpiece side along the channel's direction, any zero;
+    ``directions`` label -> ``X Y Z -X -Y -Z`` or ``?``; ``heights`` label -> the sensor's
+    height ``z`` on the mandrel (mm, tool frame) or None; ``inputs`` name -> (N,) every other
+    logged column (``T_*`` degC, ``S_rpm`` rpm, ...); ``position`` axis -> the test position
+    (mm | deg) of the axes the file gives; ``rows`` (N,) the readings' data rows in the file
+    (0-based)."""
+
+    file: str
+    run: str
+    t_s: np.ndarray
+    channels: dict
+    directions: dict
+    heights: dict
+    inputs: dict
+    position: dict = field(default_factory=dict)
+    rows: np.ndarray | None = None
+    #: columns left out (text columns such as a date), one line each
+    notes: list = field(default_factory=list)
+
+    @property
+    def n(self) -> int:
+        return len(self.t_s)
+
+    @property
+    def name(self) -> str:
+        """The run as reported: the file name, ``FILE[run]`` when the file holds several."""
+        return self.file if self.run == "" else f"{self.file}[{self.run}]"
+
+    def __repr__(self) -> str:
+        return (f"DriftRun({self.name!r}: {self.n} readings over {self.t_s[-1] - self.t_s[0]:g} s, "
+                f"channels {', '.join(self.channels)}, {len(self.inputs)} inputs)")
+
+
+def detect(names) -> bool:
+    """A drift file has a time column and at least one displacement channel: by their drift
+    names, or a logger's bracketed ones (``Time(min)``, ``ch1(um)``; the underscore forms of
+    the mapping, ``ch1_um``, are other instruments' names: ``dx_um``, ``dr_um``)."""
+    mapped = []
+    for h in names:
+        try:
+            bracketed = logger.BRACKET.match(h.strip()) or h.strip().lower() in logger.TIME_WORDS
+            mapped.append(logger.drift_name(h, "file", "s") if bracketed else h.strip())
+        except InputError:
+            mapped.append(h)
+    return (any(n in TIME_COLUMNS for n in mapped)
+            and any(re.fullmatch(r"d_\w+_(um|mm)", n) for n in mapped))
+
+
+def channel_lines(path) -> dict:
+    """``# channel d_<label>: DIR [at z=<mm>]`` header lines -> {label: (DIR, z or None)}
+    (InputError for an unknown direction word, a bad height or a channel given twice)."""
+    where = Path(path).name
+    out: dict = {}
+    with open(Path(path), encoding="utf-8-sig") as fh:
+        for line in fh:
+            s = line.strip()
+            if s and not s.startswith("#"):
+                break
+            m = _CHANNEL_LINE.match(s)
+            if not m:
+                continue
+            label = re.sub(r"_um$", "", re.sub(r"^d_", "", m.group(1)))
+            at = _AT.match(m.group(2))
+            require(at is not None, f"{where}: header 'channel {m.group(1)}: {m.group(2)}' is "
+                    f"not 'DIR [at z=<mm>]'")
+            word = at.group(1).upper()
+            require(word in DIRECTIONS, f"{where}: channel d_{label}: direction {at.group(1)!r}"
+                    f" is not one of X Y Z -X -Y -Z ?")
+            z = None
+            if at.group(2) is not None:
+                try:
+                    z = float(at.group(2))
+                except ValueError:
+                    z = float("nan")
+                require(np.isfinite(z), f"{where}: channel d_{label}: height "
+                                        f"{at.group(2)!r} is not a number (mm)")
+            require(label not in out, f"{where}: channel d_{label} has two header lines")
+            out[label] = (word, z)
+    return out
+
+
+def _mapped_columns(path, mapping=None, time_unit=None) -> Columns:
+    """The file's columns under their drift names (:mod:`._drift_logger`)."""
+    c = read_columns(path)
+    raw = read_header(path)
+    names = logger.map_header(raw, c.name, mapping, time_unit)
+    rename = dict(zip([h.strip() for h in raw], names))
+    for k, n in rename.items():             # a channel in mm is read in um
+        if re.fullmatch(r"d_\w+_mm", n):
+            rename[k] = n[:-3] + "_um"
+            require(rename[k] not in names, f"{c.name}: both {n} and {rename[k]} given")
+            if k in c.numbers:
+                c.numbers[k] = c.numbers[k] * 1000.0
+    return Columns({rename[k]: v for k, v in c.numbers.items()},
+                   {rename[k]: v for k, v in c.text.items()},
+                   {rename[k]: v for k, v in c.labels.items()}, c.name)
+
+
+def _column_defects(c: Columns, needed) -> None:
+    """A needed column that is empty, holds text, a blank cell or NaN: one line."""
+    where = c.name
+    for h in needed:
+        if h in c.text:
+            cells = c.labels.get(h, [])
+            require(any(s.strip() for s in cells), f"{where}: column {h} is empty (no reading "
+                                                   f"in any row)")
+            blank = next((i for i, s in enumerate(cells) if not s.strip()), None)
+            require(blank is None, f"{where}: column {h} row {(blank or 0) + 2} is empty")
+            raise InputError(c.text[h] or f"{where}: column {h} is not numeric")
+        v = c.numbers[h]
+        bad = np.flatnonzero(~np.isfinite(v))
+        require(len(bad) == 0, f"{where}: column {h} row {bad[0] + 2 if len(bad) else 0} is NaN "
+                               f"or infinite")
+
+
+def _time(c: Columns) -> tuple[str, np.ndarray]:
+    where = c.name
+    present = [h for h in TIME_COLUMNS if h in c.numbers or h in c.text]
+    require(len(present) == 1, f"{where}: " + (
+        f"several time columns ({', '.join(present)})" if present else
+        "no time column (t_s, t_min or t_h; see volerr formats drift)"))
+    _column_defects(c, present)
+    return present[0], c.numbers[present[0]] * logger.SECONDS[present[0]]
+
+
+def _runs(c: Columns, n: int) -> tuple[list, np.ndarray]:
+    """Run labels in order of appearance and each row's run index."""
+    if "run" not in c.numbers and "run" not in c.labels:
+        return [""], np.zeros(n, int)
+    raw = (c.labels["run"] if "run" in c.labels else [f"{x:g}" for x in c.numbers["run"]])
+    blank = next((i for i, s in enumerate(raw) if not str(s).strip()), None)
+    require(blank is None, f"{c.name}: column run row {(blank or 0) + 2} is empty")
+    labels: dict = {}
+    idx = np.array([labels.setdefault(str(s).strip(), len(labels)) for s in raw])
+    return list(labels), idx
+
+
+def _check_time(t: np.ndarray, rows: np.ndarray, where: str, tcol: str) -> None:
+    """Strictly increasing time within a run: a step back or a repeated time is one line."""
+    step = np.diff(t)
+    k = np.flatnonzero(step <= 0)
+    if len(k):
+        i, j = int(rows[k[0]]) + 2, int(rows[k[0] + 1]) + 2
+        require(step[k[0]] != 0, f"{where}: row {j} repeats the time of row {i} ({tcol}; "
+                                 f"duplicated timestamps)")
+        raise InputError(f"{where}: time goes back at row {j} ({tcol}; the time must increase "
+                         f"within a run)")
+
+
+def _channels(c: Columns, heads: dict) -> list:
+    """The channel columns, in file order; header lines of absent channels and a file without
+    a channel refused."""
+    where = c.name
+    names = [h for h in list(c.numbers) + list(c.text) if re.fullmatch(r"d_\w+_um", h)]
+    order = {h: i for i, h in enumerate(read_order(c))}
+    names.sort(key=lambda h: order.get(h, 0))
+    require(bool(names), f"{where}: no displacement channel d_<label>_um (see volerr formats "
+                         f"drift)")
+    labels = [h[2:-3] for h in names]
+    extra = [k for k in heads if k not in labels]
+    require(not extra, f"{where}: header line for channel d_{extra[0] if extra else ''} but "
+                       f"no column d_{extra[0] if extra else ''}_um")
+    _column_defects(c, names)
+    return names
+
+
+def read_order(c: Columns) -> list:
+    """Column names of ``c`` in one stable order (numbers first as read, then text)."""
+    return list(c.numbers) + [h for h in c.text if h not in c.numbers]
+
+
+def _constant_sensor(v: np.ndarray, h: str, where: str, run: str) -> None:
+    require(np.ptp(v) > 0, f"{where}: {h} is constant{' in run ' + run if run else ''} "
+                           f"(= {v[0]:g}): a sensor disconnected or stuck?")
+
+
+def _position(c: Columns, idx: np.ndarray, where: str, run: str) -> dict:
+    out = {}
+    for h, v in c.numbers.items():
+        m = re.fullmatch(r"([XYZUVWABC])(_mm|_deg)?", h)
+        if not m:
+            continue
+        vals = np.unique(v[idx])
+        require(len(vals) == 1, f"{where}: position {h} changes{' in run ' + run if run else ''}"
+                                f" ({vals[0]:g} .. {vals[-1]:g}); a drift run holds one position")
+        out[m.group(1)] = float(vals[0])
+    return out
+
+
+def read_runs(path, mapping: dict | None = None, time_unit: str | None = None) -> list:
+    """Read a drift file into its :class:`DriftRun` (one per run label, in order of
+    appearance); InputError (one line) on every defect of the module docstring's list."""
+    path = Path(path)
+    c = _mapped_columns(path, mapping, time_unit)
+    where, n = c.name, c.n
+    tcol, t = _time(c)
+    heads = channel_lines(path)
+    names = _channels(c, heads)
+    labels, run_of = _runs(c, n)
+    skip = set(names) | {tcol, "run"} | {h for h in c.numbers
+                                         if re.fullmatch(r"[XYZUVWABC](_mm|_deg)?", h)}
+    inputs = [h for h in c.numbers if h not in skip]
+    _column_defects(c, inputs)
+    notes = _text_inputs(c, skip)
+    out = []
+    for r, label in enumerate(labels):
+        idx = np.flatnonzero(run_of == r)
+        shown = label if len(labels) > 1 else ""
+        _check_time(t[idx], idx, where, tcol)
+        require(len(idx) >= 2, f"{where}: run {label} has one reading; a drift run needs two "
+                               f"or more")
+        chans = {h[2:-3]: c.numbers[h][idx] for h in names}
+        for h in names:
+            _constant_sensor(c.numbers[h][idx], h, where, shown)
+        for h in inputs:
+            if h.startswith("T_"):
+                _constant_sensor(c.numbers[h][idx], h, where, shown)
+        out.append(DriftRun(
+            where, shown or ("" if len(labels) == 1 else label), t[idx], chans,
+            {k: heads.get(k, ("?", None))[0] for k in chans},
+            {k: heads.get(k, ("?", None))[1] for k in chans},
+            {h: c.numbers[h][idx] for h in inputs}, _position(c, idx, where, shown), idx,
+            notes))
+    return out
+
+
+def _text_inputs(c: Columns, skip) -> list:
+    """Text columns besides the run label: a temperature or speed, or a column numeric but
+    for a cell, is refused (one line); a column of labels (a date, a comment) is left out with
+    a note."""
+    notes = []
+    for h, msg in c.text.items():
+        if h in skip:
+            continue
+        require(msg is None and not h.startswith(("T_", "S_")),
+                msg or f"{c.name}: column {h} is not numeric")
+        notes.append(f"column {h} is not numeric: left out of the inputs")
+    return notes
+
+
+def _test_position(run: DriftRun, model) -> dict:
+    """Every axis of ``model`` at the run's position (absent axes: middle of the travel,
+    rotary axes 0 when inside it), inside the travel."""
+    where = run.name
+    extra = [a for a in run.position if a not in model.axes]
+    require(not extra, f"{where}: position column {extra[0] if extra else ''} is not an axis of "
+                       f"layout {model.name} ({' '.join(model.axes)}): layout mismatch")
+    out = {}
+    for a in model.axes:
+        lo, hi = model.travel[a]
+        default = 0.0 if a in model.rotary_axes and lo <= 0 <= hi else 0.5 * (lo + hi)
+        v = run.position.get(a, default)
+        require(lo - 1e-9 <= v <= hi + 1e-9, f"{where}: {a} = {v:g} lies outside the travel "
+                                              f"[{lo:g}, {hi:g}] of layout {model.name}")
+        out[a] = v
+    return out
+
+
+def run_observations(run: DriftRun, model) -> Observations:
+    """One run -> :class:`Observations` (module docstring): one point per reading of each
+    channel; each channel's zero its own set-up group."""
+    labels = list(run.channels)
+    n, k = run.n, len(labels)
+    total = n * k
+    pos = _test_position(run, model)
+    probe = np.zeros((total, 3))
+    proj = np.zeros((total, 3, 3))
+    dev = np.zeros((total, 3))
+    group = np.repeat(np.arange(k), n)
+    local = np.zeros((total, 3, k))
+    local[np.arange(total), 0, group] = 1.0          # the channel's zero, mm per mm
+    for j, lab in enumerate(labels):
+        sl = slice(j * n, (j + 1) * n)
+        dev[sl, 0] = run.channels[lab] * 1e-3
+        probe[sl, 2] = run.heights[lab] or 0.0
+        vec = DIRECTIONS[run.directions[lab]]
+        if vec is not None:
+            proj[sl, 0, :] = vec
+    covs = {h: np.tile(v, k) for h, v in run.inputs.items()}
+    covs["t_s"] = np.tile(run.t_s, k)
+    names = [f"{run.name}:{lab}" for lab in labels]
+    setup = Setup(group[:, None], local, names, [("zero",)] * k,
+                  [("local", j) for j in range(k)], [("um",)] * k)
+    info = {"channel": np.repeat(np.array(labels, dtype=object), n),
+            "run": np.full(total, run.run, dtype=object), "t_s": np.tile(run.t_s, k)}
+    rows = np.tile(run.rows if run.rows is not None else np.arange(n), k)
+    return Observations({a: np.full(total, v) for a, v in pos.items()}, probe, dev, covs,
+                        list(run.notes),
+                        proj, np.ones(total, int), None, setup, np.zeros(total, int), rows,
+                        (FileInfo(run.name, KIND, "um", 1),), None, info)
+
+
+def read(path, model) -> Observations:
+    """Read a drift file into :class:`Observations` for ``model`` (InputError, one line); a
+    file of several runs is their stack (each run its own ``files`` entry)."""
+    from .observations import stack
+
+    runs = read_runs(path)
+    return stack([run_observations(r, model) for r in runs])
+
+
+def convert(path, mapping: dict | None = None, time_unit: str | None = None,
+            channels: dict | None = None) -> tuple[str, list]:
+    """A logger's file -> (the text of its ``drift`` file, its :class:`DriftRun`): the header
+    mapping of :mod:`volerr.instruments._drift_logger` (``mapping`` {raw: name} over its
+    rules), the time in seconds (``time_unit`` ``s|min|h`` for a time column without a unit),
+    ``channels`` {label: ``DIR [at z=<mm>]``} written as header lines.  The text is read back
+    by :func:`read_runs`, so a file that converts is a file that reads (InputError, one line,
+    naming the raw file, otherwise)."""
+    import tempfile
+
+    require(time_unit in (None, "s", "min", "h"), f"--time-unit: {time_unit!r} is not one of "
+                                                  f"s, min, h")
+    text = logger.convert(path, mapping, time_unit, channels)
+    with tempfile.TemporaryDirectory() as tmp:
+        probe = Path(tmp) / Path(path).name
+        probe.write_text(text, encoding="utf-8")
+        runs = read_runs(probe)
+    return text, runs

@@ -1,0 +1,127 @@
+"""Acceptance of the loop on drift runs (issue 35 "Done when": an independent simulator, a
+tester who did not write the loop), against the command line and the JSON contract of
+INTERFACE.md ("Thermal drift tests (ISO 230-3) and the loop on measured heat") only:
+
+    volerr loop DMU50 drift:run1.csv drift:run2.csv --holdout-files run3.csv --json F
+                [--predictions-out P.csv]
+
+Campaigns (tests/helpers/drift_sim.py): three 8 h spindle runs of different duty cycles and
+speeds (run 3 held out), one displacement channel along X, four proxy sensors of one heat source
+(a fast one at the bearings, the coolant return, a slow one in the casting, the room) and the
+spindle speed; the readings are a lag of ONE sensor's true temperature plus 0.15 um noise:
+
+* ``fast``: 2.5 um/K x lag(T_fast, 1800 s); ``slow``: 3 um/K x lag(T_slow, 900 s) -- the loop
+  names that sensor, its time constant within 25 %, one effect, and predicts the held-out run
+  (from its inputs and its first reading) with a mean absolute error at most 1.15 x the true
+  model's (tests/loop/test_drift_sim.py shows every other sensor predicts >= 3 x worse);
+* ``none``: the readings are noise about the sensor's zero -- no effect.
+
+Until ``volerr loop`` takes drift runs (the branch ``loop-drift``) these tests SKIP, naming the
+message the command gave (an unknown ``--holdout-files`` option, or drift files refused as
+points at one position); any other failure fails.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from helpers import drift_sim as D
+
+pytestmark = pytest.mark.slow
+
+FLOOR_FACTOR = 1.15
+TAU_TOLERANCE = 0.25
+#: what ``volerr loop`` answers before it takes drift runs (the skip's reason)
+NOT_YET = ("unrecognized option --holdout-files", "unrecognized arguments",
+           "stand at one position", "invalid choice: 'drift'")
+
+
+def _loop(folder: Path, predictions: bool = True) -> tuple:
+    """Run the command of the module docstring in ``folder``: (process, JSON or None)."""
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
+           "MKL_NUM_THREADS": "1"}
+    args = [sys.executable, "-m", "volerr", "loop", "DMU50", "drift:run1.csv", "drift:run2.csv",
+            "--holdout-files", "run3.csv", "--json", "loop.json"]
+    if predictions:
+        args += ["--predictions-out", "pred.csv"]
+    r = subprocess.run(args, capture_output=True, text=True, cwd=folder, env=env)
+    if r.returncode != 0 and any(m in r.stderr for m in NOT_YET):
+        pytest.skip("volerr loop does not take drift runs yet: "
+                    + (r.stderr.strip().splitlines() or [""])[-1])
+    assert r.returncode == 0, r.stderr
+    return r, json.loads((folder / "loop.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    """Each campaign simulated and run through the loop once (the module's tests share it)."""
+    cache: dict = {}
+
+    def get(case: str):
+        if case not in cache:
+            folder = tmp_path_factory.mktemp(f"drift_{case}")
+            runs = D.campaign(D.CASES[case], folder)
+            cache[case] = (folder, runs, _loop(folder)[1])
+        return cache[case]
+
+    return get
+
+
+def _listed(effect: dict, singular: str, plural: str) -> list:
+    """An effect's ``channel(s)`` / ``covariate(s)`` as a list (the contract names them
+    "its channel(s), covariate(s)")."""
+    v = effect.get(plural, effect.get(singular))
+    return [] if v is None else ([v] if isinstance(v, str) else list(v))
+
+
+@pytest.mark.parametrize("case", ["fast", "slow"])
+def test_names_the_planted_sensor_and_lag(results, case):
+    planted = D.CASES[case]
+    _, _, doc = results(case)
+    effects = doc["effects"]
+    assert len(effects) == 1, [e.get("name") for e in effects]
+    eff = effects[0]
+    assert _listed(eff, "covariate", "covariates") == [planted.sensor], eff
+    chans = _listed(eff, "channel", "channels")
+    assert chans == [] or "x" in chans or "d_x" in chans or "d_x_um" in chans, chans
+    lag = eff["lag_s"]
+    assert abs(lag["value"] / planted.tau_s - 1) <= TAU_TOLERANCE, lag
+    assert np.isfinite(lag["std"]) and lag["std"] > 0
+
+
+@pytest.mark.parametrize("case", ["fast", "slow"])
+def test_predicts_the_held_out_run_to_the_noise_floor(results, case):
+    planted = D.CASES[case]
+    folder, runs, doc = results(case)
+    ch = doc["channels"]
+    label = next(k for k in ch if k in ("x", "d_x", "d_x_um"))
+    held = runs[2]
+    assert ch[label]["n_test"] == len(held["t_s"])
+    floor = D.true_mae(held, planted)
+    assert ch[label]["mae_after_um"] <= FLOOR_FACTOR * floor, (ch[label], floor)
+    assert ch[label]["mae_before_um"] > 5 * floor         # the declared model sees no drift
+    # the predictions file holds the same figures, reading by reading
+    with open(folder / "pred.csv", newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["split"] == "test"]
+    assert len(rows) == len(held["t_s"])
+    measured = np.array([float(r["measured_um"]) for r in rows])
+    after = np.array([float(r["after_um"]) for r in rows])
+    np.testing.assert_allclose(np.sort(measured), np.sort(held["d_x_um"]), atol=1e-5)
+    assert np.mean(np.abs(measured - after)) == pytest.approx(ch[label]["mae_after_um"],
+                                                              rel=1e-6, abs=1e-9)
+
+
+def test_no_planted_effect_no_effect(results):
+    _, runs, doc = results("none")
+    assert doc["effects"] == [], [e.get("name") for e in doc["effects"]]
+    ch = doc["channels"]
+    label = next(k for k in ch if k in ("x", "d_x", "d_x_um"))
+    assert ch[label]["mae_after_um"] <= FLOOR_FACTOR * D.true_mae(runs[2], None)
