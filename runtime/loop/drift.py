@@ -40,6 +40,7 @@ from .drift_cv import Engine
 
 HEAT_TERMS = 3        # plain heat input and up to two time constants
 REFINE = np.linspace(-1.0, 1.0, 9)   # ln-tau steps (in grid steps) tried around a grid value
+RECENTRE = 3         # searches of a fold's time constant re-centred at an edge
 SIG_K = 2.0           # coverage factor of the significance test of a term
 
 
@@ -85,13 +86,30 @@ def _channel(s, cols, X, Z, R, y, fold, rule, cands) -> dict:
         terms = sel.select_terms(eng, cols, n_runs, cands=heat_c, max_terms=HEAT_TERMS)
     if len(sensor_c):
         terms = terms + sel.select_terms(eng, cols, n_runs, cands=sensor_c, start=terms)
-    specs = [_spec(cols, t) for t in terms]
+    specs = _backward(s, [_spec(cols, t) for t in terms], R, y, fold, rule)
     for i in range(len(specs)):
         others = [column(s, o) for j, o in enumerate(specs) if j != i]
         specs[i] = _refine(s, specs[i], R, y, fold, rule, others)
     specs, fit = _significant(s, specs, R, y, fold, rule)
     return {"terms": specs, "fit": fit, "y": y,
             "static": _static(s, R, y), "before": y[s.firsts()][s.run]}
+
+
+def _backward(s, specs, R, y, fold, rule) -> list:
+    """Drop a term that, given all the others, no longer lowers the cross-validated mean
+    square by ``drift_select.CV_GAIN`` (a later term made it redundant: the heat input
+    taken first where a sensor tells the same story better), the least useful first."""
+    while len(specs) > 1:
+        cols = [column(s, sp) for sp in specs]
+        full = _cv(np.column_stack([R] + cols), y, fold, rule, s.run, R.shape[1])
+        without = [_cv(np.column_stack([R] + cols[:i] + cols[i + 1:]), y, fold, rule, s.run,
+                       R.shape[1]) for i in range(len(specs))]
+        i = int(np.argmin(without))
+        if without[i] * (1 - sel.CV_GAIN) < full:
+            specs = specs[:i] + specs[i + 1:]
+            continue
+        return specs
+    return specs
 
 
 def _spec(cols, term) -> dict:
@@ -102,14 +120,31 @@ def _spec(cols, term) -> dict:
           "cv_rms_um": math.sqrt(term["cv_mse"]),
           "cv_rms_before_um": math.sqrt(term["cv_mse_before"]),
           "delta_bic": term["delta_bic"],
-          "alternatives": [_alt(cols, x) for x in term["alternatives"]]}
+          "alternatives": [_alt(cols, x) for x in term["alternatives"]
+                           if not _same_term(cols, x, ca, b)]}
     return sp
+
+
+def _same_term(cols, x, ca, b) -> bool:
+    """An alternative that is the chosen term at a neighbouring grid lag (the refinement
+    searches there) is no other explanation."""
+    c = cols[x[0]]
+    same = (c.source, c.p, x[1] < 0 or cols[x[1]].source) == \
+        (ca.source, ca.p, b < 0 or cols[b].source)
+    return same and (c.tau_s > 0) == (ca.tau_s > 0) and (
+        c.tau_s == 0 or abs(math.log(c.tau_s / ca.tau_s)) < 1.5 * _grid_step(cols))
+
+
+def _grid_step(cols) -> float:
+    taus = sorted({c.tau_s for c in cols if c.tau_s > 0})
+    return math.log(taus[1] / taus[0]) if len(taus) > 1 else 1.0
 
 
 def _alt(cols, x) -> dict:
     a, b, rms = x
     c = cols[a]
-    return {"covariate": c.source if b < 0 else f"{c.source} - {cols[b].source}",
+    src = basis.SPEED if c.source == "heat" else c.source
+    return {"covariate": src if b < 0 else f"{src} - {cols[b].source}",
             "p": c.p, "lag_s": c.tau_s or None, "cv_rms_um": round(rms, 4)}
 
 
@@ -212,14 +247,19 @@ def _tau_on(s, sp, i, specs, R, y, mask) -> float:
     r = math.log(basis.tau_grid(s)[1] / basis.tau_grid(s)[0])
     xs = np.linspace(-r, r, 7)
     others = [column(s, o) for j, o in enumerate(specs) if j != i]
-    rss = []
-    for x in xs:
-        D = np.column_stack([R] + others + [column(s, sp, sp["tau_s"] * math.exp(x))])
-        e = y[mask] - D[mask] @ _fit(D, y, mask)
-        rss.append(float(e @ e))
-    q, lin, _ = np.polyfit(xs, rss, 2)
-    x = float(np.clip(-lin / (2 * q), -r, r)) if q > 0 else float(xs[int(np.argmin(rss))])
-    return sp["tau_s"] * math.exp(x), bool(abs(x) >= r * (1 - 1e-9))
+    x0 = 0.0
+    for _ in range(RECENTRE):
+        rss = []
+        for x in x0 + xs:
+            D = np.column_stack([R] + others + [column(s, sp, sp["tau_s"] * math.exp(x))])
+            e = y[mask] - D[mask] @ _fit(D, y, mask)
+            rss.append(float(e @ e))
+        q, lin, _ = np.polyfit(xs, rss, 2)
+        x = float(np.clip(-lin / (2 * q), -r, r)) if q > 0 else float(xs[int(np.argmin(rss))])
+        if abs(x) < r * (1 - 1e-9):
+            return sp["tau_s"] * math.exp(x0 + x), False
+        x0 += x                 # the least RSS at the edge: search again around it
+    return sp["tau_s"] * math.exp(x0), True
 
 
 def _static(s, R, y) -> np.ndarray:
