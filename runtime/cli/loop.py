@@ -169,14 +169,15 @@ def run_drift(args) -> int:
     from ._common import layout_inputs
 
     paths = [split_spec(d)[1] for d in args.data]
+    held = [split_spec(d)[1] for d in (args.holdout_files or [])]
     require(not (args.out_dir or args.errors_out), "loop: --out-dir and --errors-out are not "
             "written for drift runs (their effects are per channel, not in the layout)")
-    inputs = paths + layout_inputs(args.layout)
+    inputs = paths + held + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).file("--predictions-out", args.predictions_out).check()
     with outs:
         report = loop_drift(args.layout, paths, window=args.holdout_time,
-                            files=args.holdout_files or (), differences=args.differences)
+                            files=held, differences=args.differences)
         if args.json:
             report.write_json(outs.path("--json"), inputs=inputs)
         if args.html:

@@ -122,11 +122,13 @@ def _term_line(t: dict) -> str:
 
 def loop_drift(layout: str, paths, window=None, files=(), differences: bool = False,
                progress=None) -> DriftReport:
-    """The loop on drift files ``paths`` (see :mod:`volerr.loop.drift`)."""
+    """The loop on drift files ``paths`` and the held-out ``files`` (read beside them, every
+    run of theirs held out; see :mod:`volerr.loop.drift`)."""
     from ..machine.model import load
 
     model = load(layout)
-    s = load_series(paths)
+    named = {Path(p).resolve() for p in paths}
+    s = load_series(list(paths) + [f for f in files if Path(f).resolve() not in named])
     s.test, said = held_out(s, window, files)
     res = core.run_drift(s, differences=differences, progress=progress)
     data = {"layout": model.name, "kind": "drift",
