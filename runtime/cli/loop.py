@@ -97,6 +97,27 @@ def _is_drift(specs) -> bool:
     return all(drift)
 
 
+K_PRINT = 2.0    # coverage factor of the printed uncertainties
+SIG_K = 2.0      # a term below this many standard uncertainties is not part of the effect
+
+
+def effect_terms(e: dict) -> str:
+    """The effect's parameters with their expanded uncertainty (k = 2); a term that is not
+    significant (|value| < 2 u) is said to be so, apart from the effect's terms."""
+    std = e.get("std") or {}
+    shown, weak = [], []
+    for k, v in e["parameters"].items():
+        u = std.get(k)
+        text = f"{k} = {v:.4g} {e['units'][k]}"
+        if u is not None:
+            text += f" +- {K_PRINT * u:.2g} (k = {K_PRINT:g})"
+        (weak if u is not None and abs(v) < SIG_K * u else shown).append(text)
+    out = ", ".join(shown) or "no significant term"
+    if weak:
+        out += f"; not significant, not part of the effect: {', '.join(weak)}"
+    return out
+
+
 def run(args) -> int:
     if _is_drift(args.data):
         return run_drift(args)
@@ -146,8 +167,7 @@ def run(args) -> int:
         print(f"  warning: {w}")
     print(report.summary())
     for e in report.effects:
-        pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
-        print(f"  {e['kind']} {e['name']}: {pars}")
+        print(f"  {e['kind']} {e['name']}: {effect_terms(e)}")
         for line in loop_lines(e):
             print(f"    {line}")
     if report["augmented_layout"]:
