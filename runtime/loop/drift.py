@@ -54,10 +54,11 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
     Z = np.column_stack([R, X])
     cands = _candidates(s, cols, differences)
     out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {}}
+    cache: dict = {}
     for label, y in s.channels.items():
         if progress:
             progress(label)
-        out["channels"][label] = _channel(s, cols, X, Z, R, y, fold, rule, cands)
+        out["channels"][label] = _channel(s, cols, X, Z, R, y, fold, rule, cands, cache)
     return out
 
 
@@ -77,9 +78,9 @@ def _candidates(s, cols, differences: bool) -> tuple:
     return c[heat], c[~heat]
 
 
-def _channel(s, cols, X, Z, R, y, fold, rule, cands) -> dict:
+def _channel(s, cols, X, Z, R, y, fold, rule, cands, cache) -> dict:
     n_runs = R.shape[1]
-    eng = Engine(Z, y, fold, rule == "runs", s.run, n_runs)
+    eng = Engine(Z, y, fold, rule == "runs", s.run, n_runs, cache)
     heat_c, sensor_c = cands
     terms = []
     if len(heat_c):

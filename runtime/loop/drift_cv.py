@@ -26,32 +26,39 @@ class Engine:
     ``Z`` (N, mz): run indicators then basis columns; ``y`` (N,); ``fold`` (N,) fold index of
     each training reading (-1 held out); ``by_runs``: folds are whole runs (anchored test)."""
 
-    def __init__(self, Z, y, fold, by_runs: bool, run, n_runs: int, forward: int = 0):
+    def __init__(self, Z, y, fold, by_runs: bool, run, n_runs: int, cache=None):
+        """``cache``: a dict shared by the channels of one basis (the cross-products of
+        ``Z`` with itself do not depend on the channel: computed once)."""
+        cache = {} if cache is None else cache
         self.n_runs = n_runs
-        self.forward = forward
         self.K = int(fold.max()) + 1
-        tr = fold >= 0
-        self.n = int(tr.sum())
-        self.G = Z[tr].T @ Z[tr]
-        self.h = Z[tr].T @ y[tr]
-        self.yy = float(y[tr] @ y[tr])
-        self.fold_fit, self.fold_test = [], []
-        first = {}
+        self.n = int((fold >= 0).sum())
+        first = np.zeros(n_runs)
         for r in range(n_runs):
             idx = np.flatnonzero(run == r)
             first[r] = y[idx[0]] if len(idx) else 0.0
+        self.fold_fit, self.fold_test = [], []
         for k in range(self.K):
             m = fold == k
-            Zk, yk = Z[m], y[m]
-            fit = (Zk.T @ Zk, Zk.T @ yk, float(yk @ yk))
+            if ("fit", k) not in cache:
+                Zk = Z[m]
+                cache[("fit", k)] = Zk.T @ Zk
+                if by_runs:
+                    Zt = Zk.copy()
+                    Zt[:, :n_runs] = 0.0
+                    cache[("test", k)] = (Zt, Zt.T @ Zt)
+            Gk, yk = cache[("fit", k)], y[m]
+            fit = (Gk, Z[m].T @ yk, float(yk @ yk))
             self.fold_fit.append(fit)
             if by_runs:
-                Zt = Zk.copy()
-                Zt[:, :n_runs] = 0.0
-                yt = yk - np.array([first[r] for r in run[m]])
-                self.fold_test.append((Zt.T @ Zt, Zt.T @ yt, float(yt @ yt), int(m.sum())))
+                Zt, TG = cache[("test", k)]
+                yt = yk - first[run[m]]
+                self.fold_test.append((TG, Zt.T @ yt, float(yt @ yt), int(m.sum())))
             else:
                 self.fold_test.append(fit + (int(m.sum()),))
+        self.G = sum(f[0] for f in self.fold_fit)
+        self.h = sum(f[1] for f in self.fold_fit)
+        self.yy = sum(f[2] for f in self.fold_fit)
 
     # ---- the model so far, and one candidate more --------------------------------------
     def _active(self, W, G):
@@ -70,14 +77,8 @@ class Engine:
         a, b = cands[:, 0], cands[:, 1]
         tot = np.zeros(len(cands))
         base = 0.0
-        for k, ((Gk, hk, _), (TG, Th, Tyy, _)) in enumerate(zip(self.fold_fit, self.fold_test)):
-            if self.forward:
-                if k < self.forward:
-                    continue
-                Gt = sum(f[0] for f in self.fold_fit[:k])
-                ht = sum(f[1] for f in self.fold_fit[:k])
-            else:
-                Gt, ht = self.G - Gk, self.h - hk
+        for (Gk, hk, _), (TG, Th, Tyy, _) in zip(self.fold_fit, self.fold_test):
+            Gt, ht = self.G - Gk, self.h - hk
             on = self._active(W, Gt)
             Wf = W[:, on]
             sse, sse0 = _bordered(Gt, ht, TG, Th, Tyy, Wf, a, b)
