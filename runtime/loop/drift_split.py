@@ -83,14 +83,26 @@ def default_split(s: DriftSeries) -> tuple[np.ndarray, str]:
                       f"(t >= {cut:.0f} s)")
 
 
+#: equal-time blocks per file of the 3-D loop's held-out split
+N_BLOCKS = 20
+
+
 def stretch_split(t, groups, fraction: float) -> np.ndarray:
-    """Held-out mask of the 3-D loop's points with a time column: the last ``fraction`` of
-    every file's time span (whole contiguous stretches, never points drawn at random)."""
+    """Held-out mask of the 3-D loop's points with a time column: every file's time span cut
+    into ``N_BLOCKS`` equal blocks and ``round(fraction N_BLOCKS)`` of them held out, spread
+    evenly (block ``floor((j + 1/2) N_BLOCKS / m)``, j = 0..m-1): whole contiguous stretches
+    over the whole campaign (every phase of a duty cycle is judged), never points drawn at
+    random (a point's neighbour in time is almost the same reading)."""
     t = np.asarray(t, float)
-    g = np.asarray(groups)
+    g = np.zeros(len(t), int) if groups is None else np.asarray(groups)
+    m = max(1, int(round(fraction * N_BLOCKS)))
+    held = np.floor((np.arange(m) + 0.5) * N_BLOCKS / m).astype(int)
     test = np.zeros(len(t), bool)
     for f in np.unique(g):
-        m = g == f
-        lo, hi = t[m].min(), t[m].max()
-        test |= m & (t >= lo + (1 - fraction) * (hi - lo)) & (hi > lo)
+        sel = g == f
+        lo, hi = t[sel].min(), t[sel].max()
+        if not hi > lo:
+            continue
+        block = np.minimum(((t[sel] - lo) / (hi - lo) * N_BLOCKS).astype(int), N_BLOCKS - 1)
+        test[np.flatnonzero(sel)[np.isin(block, held)]] = True
     return test
