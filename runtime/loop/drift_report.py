@@ -40,7 +40,8 @@ def load_series(paths) -> basis.DriftSeries:
     cat = np.concatenate
     return basis.DriftSeries(
         cat([r.t_s for r in runs]), cat([np.full(r.n, i) for i, r in enumerate(runs)]),
-        [(r.file, r.run) for r in runs], {k: cat([r.inputs[k] for r in runs]) for k in first.inputs},
+        [(r.file, r.run) for r in runs],
+        {k: cat([r.inputs[k] for r in runs]) for k in first.inputs},
         {k: cat([r.channels[k] for r in runs]) for k in first.channels},
         dict(first.directions), dict(first.heights))
 

@@ -575,6 +575,25 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
                     progress, families, inputs)
 
 
+def _split(dat, seed, test_fraction, folds) -> Split:
+    """The held-out points: with a time column whole stretches of time
+    (:func:`volerr.loop.drift_split.stretch_split`), else drawn at random (``seed``)."""
+    from ..machine.lags import TIME_COLUMNS
+    from .drift_split import stretch_split
+
+    spl = split_points(dat.n, seed, test_fraction, folds)
+    time = next((c for c in TIME_COLUMNS if c in dat.covariates), None)
+    if time is None:
+        return spl
+    test = stretch_split(dat.covariates[time], dat.file, test_fraction)
+    if not test.any() or test.all():
+        return spl
+    train = np.flatnonzero(~test)
+    fold_t = None if folds is None else \
+        np.random.default_rng(seed).permutation(len(train)) % folds
+    return Split(train, np.flatnonzero(test), fold_t)
+
+
 def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, progress,
          families, inputs) -> Report:
     t_start = time.perf_counter()
@@ -585,7 +604,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     if degree is not None:
         require(1 <= degree <= 12, "degree must be between 1 and 12")
     bar = _progress(4, progress)
-    spl = split_points(dat.n, seed, test_fraction, folds)
+    spl = _split(dat, seed, test_fraction, folds)
     ranges = data_ranges(model, dat)
     y = dat.deviation.ravel()
     bar.set_postfix_str("degree, screening and selection")
