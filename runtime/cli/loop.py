@@ -43,8 +43,9 @@ def register(sub) -> None:
                    help="folder for the augmented layout and its generated module (not given: "
                         "not written)")
     p.add_argument("--holdout-time", metavar="A:B",
-                   help="drift runs: hold out the readings with A <= t < B (units s, min, h; "
-                        "an open end allowed: 100035s:)")
+                   help="hold out the readings (points) with A <= t < B of the time column "
+                        "(units s, min, h; an open end allowed: 100035s:); default: whole "
+                        "stretches of time where there is a time column")
     p.add_argument("--holdout-files", nargs="+", metavar="FILE",
                    help="drift runs: hold out every run of these files")
     p.add_argument("--predictions-out", metavar="P.csv",
@@ -121,9 +122,8 @@ def effect_terms(e: dict) -> str:
 def run(args) -> int:
     if _is_drift(args.data):
         return run_drift(args)
-    require(not (args.holdout_time or args.holdout_files or args.predictions_out),
-            "loop: --holdout-time, --holdout-files and --predictions-out are for drift runs "
-            "(drift:FILE)")
+    require(not (args.holdout_files or args.predictions_out),
+            "loop: --holdout-files and --predictions-out are for drift runs (drift:FILE)")
     from ..loop import candidates
     from ..loop.run import run_loop
 
@@ -153,7 +153,8 @@ def run(args) -> int:
         data = args.data[0] if len(args.data) == 1 else args.data
         report = run_loop(args.layout, data, seed=args.seed, folds=args.folds,
                           test_fraction=args.test_fraction, degree=args.degree,
-                          out_dir=staged, families=families, inputs=inputs)
+                          out_dir=staged, families=families, inputs=inputs,
+                          holdout_time=args.holdout_time)
         for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
             if report.data.get(key):
                 report.data[key] = str(out_dir / Path(report.data[key]).name)

@@ -172,3 +172,18 @@ def test_cli_refusals_one_line_nothing_written(tmp_path):
     head = (tmp_path / "p.csv").read_text().splitlines()[0]
     assert head == "file,run,t_s,channel,measured_um,before_um,after_um,split"
     assert "<img" in (tmp_path / "p.html").read_text()
+
+
+def test_3d_loop_split_by_time_window_or_stretches():
+    from types import SimpleNamespace
+
+    from volerr.loop.run import _split
+
+    n = 400
+    dat = SimpleNamespace(n=n, covariates={"t_min": np.arange(n) * 0.5}, file=np.zeros(n, int))
+    spl = _split(dat, 0, 0.25, None, "100min:")         # t_min: 0 .. 199.5 min
+    np.testing.assert_array_equal(spl.test, np.arange(200, n))
+    spl = _split(dat, 0, 0.25, None)                     # default: stretches, not random
+    assert len(spl.test) == 100 and len(np.flatnonzero(np.diff(spl.test) > 1)) <= 4
+    with pytest.raises(InputError):
+        _split(SimpleNamespace(n=n, covariates={}, file=None), 0, 0.25, None, "1s:")
