@@ -3,8 +3,8 @@
 The files shipped in the package (``volerr/data``: laser-tracker runs, a sphere probing run, a
 ballbar circle) are copied; the rest are the built-in campaigns of ``volerr demo`` written
 afresh (error tables, a five-axis program, instrument files of known truth, a positioning
-run, an uncertainty task), all simulated.  :data:`EXAMPLES` lists every file with what it is
-and a command that reads it; ``DIR/README.txt`` says the same.
+run, a thermal drift test, an uncertainty task), all simulated.  :data:`EXAMPLES` lists every
+file with what it is and a command that reads it; ``DIR/README.txt`` says the same.
 """
 
 from __future__ import annotations
@@ -57,6 +57,14 @@ EXAMPLES = {
                            "volerr loop MB1 deviations_MB1.csv"),
     "iso230_2_run_X.csv": ("laser-interferometer positioning run of X (ISO 230-2)",
                            "volerr iso230-2 iso230_2_run_X.csv"),
+    "drift_spindle.csv": ("ISO 230-3 spindle drift test (simulated): five sensors round a "
+                          "test mandrel (X and Y at two heights, Z), the spindle programme, "
+                          "three temperatures",
+                          "volerr iso230-3 drift_spindle.csv --html drift_spindle.html"),
+    "drift_logger_raw.csv": ("the same test as a logger saves it (Time(min), ch1(um), "
+                             "t1(°C), spindle(RPM))",
+                             "volerr drift convert drift_logger_raw.csv --out drift.csv "
+                             "--channel 'ch1=X at z=20' --channel 'ch2=Z'"),
     "task_distance.csv": ("uncertainty task: a 400 mm distance",
                           "volerr uncertainty MH2 --task task_distance.csv --evaluate "
                           "distance --spec E0=2+L/300"),
@@ -89,6 +97,70 @@ def write_iso230_2_run(path) -> None:
     write_text(path, "\n".join(lines) + "\n")
 
 
+def drift_spindle_columns(hours: float = 9.0, step_s: float = 30.0) -> dict:
+    """A simulated spindle drift test (ISO 230-3): at rest 0.5 h, 3000 rpm for 2 h, stop 1 h,
+    6000 rpm 2 h, stop; the loss ``P = (S / 6000) ** 1.5`` heats the bearings (``T_spindle``:
+    12 K x P through a 15 min lag) and the motor (``T_motor``: 8 K x P, 5 min) above the room
+    (``T_room``: 0.4 K swing); the headstock follows the bearings through a 20 min lag ``h``
+    (K above the start): the tool point moves by -1.2 um/K x h along Z (the spindle grows
+    towards the table), 0.25 um/K along X, and the spindle tilts 1.5 urad/K about +Y, 0.5
+    about +X; sensors X and Y at z = 20 and 120 mm (Y read along -Y), 0.1 um noise.
+    Columns of the drift format (:mod:`volerr.instruments.drift`)."""
+    import numpy as np
+
+    rng = np.random.default_rng(7)
+    t = np.arange(0.0, hours * 3600 + step_s / 2, step_s)
+    hr = t / 3600.0
+    s = np.select([hr < 0.5, hr < 2.5, hr < 3.5, hr < 5.5], [0.0, 3000.0, 0.0, 6000.0], 0.0)
+
+    def lag(u, tau):                    # first-order lag, the input held over each step
+        a, y = np.exp(-step_s / tau), np.empty_like(u)
+        y[0] = u[0]
+        for k in range(1, len(u)):
+            y[k] = a * y[k - 1] + (1 - a) * u[k - 1]
+        return y
+
+    p = (s / 6000.0) ** 1.5
+    room = 20.5 + 0.4 * np.sin(2 * np.pi * t / (10 * 3600))
+    spindle, motor = room + 12 * lag(p, 900.0), room + 8 * lag(p, 300.0)
+    h = lag(spindle, 1200.0) - spindle[0]
+    beta, alpha = 1.5 * h, 0.5 * h                              # urad about +Y, +X
+    noise = lambda: rng.normal(0.0, 0.1, len(t))                # noqa: E731
+    out = {"t_s": t, "S_rpm": s}
+    for z, tag in ((20.0, "1"), (120.0, "2")):
+        out[f"d_x{tag}_um"] = 0.25 * h + beta * z * 1e-3 + noise()
+        out[f"d_y{tag}_um"] = alpha * z * 1e-3 + noise()       # -Y reads +alpha z
+    out["d_z_um"] = -1.2 * h + noise()
+    out.update(T_spindle=spindle + rng.normal(0, 0.01, len(t)),
+               T_motor=motor + rng.normal(0, 0.01, len(t)),
+               T_room=room + rng.normal(0, 0.01, len(t)))
+    return out
+
+
+def write_drift_examples(folder) -> None:
+    """``drift_spindle.csv`` (drift format) and ``drift_logger_raw.csv`` (a logger's names,
+    minutes) of :func:`drift_spindle_columns`."""
+    import numpy as np
+
+    from .fileio import write_text
+
+    cols = drift_spindle_columns()
+    head = ["# simulated ISO 230-3 spindle drift test (volerr examples)",
+            "# channel d_x1: X at z=20", "# channel d_x2: X at z=120",
+            "# channel d_y1: -Y at z=20", "# channel d_y2: -Y at z=120", "# channel d_z: Z"]
+    names = ["t_s", "S_rpm", "d_x1_um", "d_x2_um", "d_y1_um", "d_y2_um", "d_z_um",
+             "T_spindle", "T_motor", "T_room"]
+    rows = np.column_stack([cols[k] for k in names])
+    body = [",".join(f"{v:.4f}".rstrip("0").rstrip(".") for v in r) for r in rows]
+    write_text(Path(folder) / "drift_spindle.csv", "\n".join(head + [",".join(names)] + body)
+               + "\n")
+    raw = ["Time(min),ch1(um),ch2(um),t1(°C),t2(°C),spindle(RPM)"]
+    raw += [f"{t / 60:g},{x:.3f},{z:.3f},{a:.3f},{b:.3f},{s:g}" for t, x, z, a, b, s in zip(
+        cols["t_s"], cols["d_x1_um"], cols["d_z_um"], cols["T_spindle"], cols["T_room"],
+        cols["S_rpm"])]
+    write_text(Path(folder) / "drift_logger_raw.csv", "\n".join(raw) + "\n")
+
+
 def write_examples(folder) -> list:
     """Write every example of :data:`EXAMPLES` and ``README.txt`` into ``folder`` (which must
     exist); returns the relative paths written."""
@@ -111,6 +183,7 @@ def write_examples(folder) -> list:
     simulate_demo_sphere(d / "probe_sphere.csv")
     demo_campaign(d / "deviations_MB1.csv", n_points=400)
     write_iso230_2_run(d / "iso230_2_run_X.csv")
+    write_drift_examples(d)
     write_text(d / "task_distance.csv", "X,Y,Z\n100,200,150\n500,200,150\n")
     write_text(d / "README.txt", readme())
     return sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())

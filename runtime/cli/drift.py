@@ -12,7 +12,8 @@ from __future__ import annotations
 EPILOG = """\
 header mapping (each cell, the first rule that fits; --map overrides any):
   Time(s) 時間(s) time_s -> t_s; Time(min) -> t_s (x 60); Time(h) -> t_s (x 3600);
-    a time without a unit needs --time-unit
+    a time without a unit needs --time-unit; clock times (14:05:30, 2024-03-01 14:05:30,
+    01.03.2024 14:05:30; a Date column beside) -> t_s from the first reading
   ch1(um) ch1 [µm] -> d_ch1_um;  ch1(mm) -> d_ch1_um (x 1000)
   t1(°C) -> T_1;  motor(degC) -> T_motor
   spindle(RPM) S(rpm) speed(rpm) -> S_rpm;  other NAME(rpm) -> NAME_rpm

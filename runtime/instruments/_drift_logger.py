@@ -17,6 +17,15 @@ header cell that is not already a ``drift`` name, one rule per cell, the first t
    (the spindle speed); another name ``NAME(rpm)`` -> ``NAME_rpm``;
 5. any other ``NAME(unit)`` -> ``NAME_unit``; a name without a unit is kept.
 
+**Clock times.**  A time column (a time word above, or ``datetime``, ``timestamp``) whose cells
+are clock times or dates with times -- ``14:05:30``, ``14:05:30.250``, ``14:05``,
+``2024-03-01 14:05:30`` (or with ``T``), ``2024/03/01 14:05:30``, ``01.03.2024 14:05:30`` --
+becomes ``t_s``, seconds from its first cell (:func:`clock_seconds`: the first of these forms
+that reads every cell; day-first and month-first slashed dates such as ``03/01/2024`` are
+ambiguous and refused).  A clock without a date that goes back by more than 12 h has passed
+midnight (a day added).  A separate date column (``date``, ``datum``, ``日付``) beside a clock
+column is joined to it (and not kept as an input).
+
 Labels are made identifiers: every run of characters other than letters, digits and ``_``
 becomes one ``_``.  ``--map "RAW=NAME,..."`` overrides the rule of any column.
 """
@@ -24,6 +33,8 @@ becomes one ``_``.  ``--map "RAW=NAME,..."`` overrides the rule of any column.
 from __future__ import annotations
 
 import re
+
+from datetime import datetime
 
 from ..errors import require
 
@@ -184,6 +195,34 @@ def _scaled(cell: str, factor: float) -> str:
         return cell
 
 
+def _clock_rows(rows: list, mapping: dict | None) -> list:
+    """The raw rows with a clock time column as seconds (``t_s``) and its date column
+    dropped (:func:`clock_time`); unchanged without one or when ``mapping`` names it."""
+    header = [h.strip() for h in rows[0]]
+    cols = {h: [r[j] if j < len(r) else "" for r in rows[1:]] for j, h in enumerate(header)}
+    text = {h: v for h, v in cols.items() if not all(_is_number(c) for c in v)}
+    found = clock_time(header, text)
+    if found is None or found[0] in (mapping or {}):
+        return rows
+    name, secs, date = found
+    j = header.index(name)
+    out = [[("t_s" if k == j else c) for k, c in enumerate(rows[0])]]
+    out += [[(repr(float(secs[i])) if k == j else c) for k, c in enumerate(r)]
+            for i, r in enumerate(rows[1:])]
+    if date is not None:
+        d = header.index(date)
+        out = [[c for k, c in enumerate(r) if k != d] for r in out]
+    return out
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+        return True
+    except ValueError:
+        return False
+
+
 def convert(path, mapping: dict | None = None, time_unit: str | None = None,
             channels: dict | None = None) -> str:
     """A logger's file -> the text of a ``drift`` file: header cells renamed (``mapping`` over
@@ -195,6 +234,7 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
 
     where = Path(path).name
     comments, rows = _raw_rows(path)
+    rows = _clock_rows(rows, mapping)
     names = map_header(rows[0], where, mapping, time_unit)
     factors = []
     for j, n in enumerate(names):
@@ -218,8 +258,65 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
              not in (channels or {})]
     lines.append(f"# converted by volerr drift convert from {where}")
     lines += [f"# channel d_{k}: {v}" for k, v in (channels or {}).items()]
-    lines.append(",".join(names))
+    import csv
+    import io
+
+    buf = io.StringIO()
+    out = csv.writer(buf, lineterminator="\n")        # a cell with a comma stays one cell
+    out.writerow(names)
     for r in rows[1:]:
-        lines.append(",".join(_scaled(cell, f) for cell, f in zip(r, factors))
-                     + ("," * (len(names) - len(r)) if len(r) < len(names) else ""))
-    return "\n".join(lines) + "\n"
+        out.writerow([_scaled(cell, f) for cell, f in zip(r, factors)]
+                     + [""] * (len(names) - len(r)))
+    return "\n".join(lines) + "\n" + buf.getvalue()
+
+
+#: names of a column of dates or timestamps (lower case)
+CLOCK_WORDS = TIME_WORDS + ("datetime", "timestamp", "date_time", "zeitstempel", "日時")
+DATE_WORDS = ("date", "datum", "日付", "fecha", "data")
+#: the clock forms, tried in this order; a form must read every cell
+CLOCK_FORMATS = ("%Y-%m-%d %H:%M:%S.%f", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M:%S.%f",
+                 "%Y-%m-%dT%H:%M:%S", "%Y/%m/%d %H:%M:%S", "%d.%m.%Y %H:%M:%S",
+                 "%Y-%m-%d %H:%M", "%d.%m.%Y %H:%M", "%H:%M:%S.%f", "%H:%M:%S", "%H:%M")
+
+
+def clock_seconds(cells) -> list | None:
+    """Seconds from the first cell of clock / date-time cells (module docstring), or None when
+    no form of :data:`CLOCK_FORMATS` reads every cell."""
+    cells = [str(c).strip() for c in cells]
+    for fmt in CLOCK_FORMATS:
+        try:
+            stamps = [datetime.strptime(c, fmt) for c in cells]
+        except ValueError:
+            continue
+        secs = [(d - stamps[0]).total_seconds() for d in stamps]
+        if "%d" not in fmt:                     # a clock alone: passing midnight adds a day
+            day, out = 0.0, []
+            for k, v in enumerate(secs):
+                if k and v + day < out[-1] - 43200.0:
+                    day += 86400.0
+                out.append(v + day)
+            secs = out
+        return secs
+    return None
+
+
+def clock_time(header, text_cells: dict) -> tuple | None:
+    """(the raw time column, its seconds, the raw date column joined or None) of a file whose
+    time column holds clock times (``text_cells``: raw name -> cells of its text columns), or
+    None."""
+    names = [h.strip() for h in header]
+    dates = [h for h in names if split_unit(h)[0].lower() in DATE_WORDS and h in text_cells]
+    for h in names:
+        if split_unit(h)[0].lower() not in CLOCK_WORDS or h not in text_cells:
+            continue
+        cells = text_cells[h]
+        if dates and clock_seconds(cells) is not None and ":" in cells[0] \
+                and "-" not in cells[0] and "." not in cells[0].split(":")[0]:
+            joined = [f"{d} {c}" for d, c in zip(text_cells[dates[0]], cells)]
+            secs = clock_seconds(joined)
+            if secs is not None:
+                return h, secs, dates[0]
+        secs = clock_seconds(cells)
+        if secs is not None:
+            return h, secs, None
+    return None

@@ -99,7 +99,11 @@ def detect(names) -> bool:
     mapped = []
     for h in names:
         try:
-            bracketed = logger.BRACKET.match(h.strip()) or h.strip().lower() in logger.TIME_WORDS
+            word = h.strip().lower()
+            if word in logger.CLOCK_WORDS:              # Time, Timestamp: a time column
+                mapped.append("t_s")
+                continue
+            bracketed = logger.BRACKET.match(h.strip())
             mapped.append(logger.drift_name(h, "file", "s") if bracketed else h.strip())
         except InputError:
             mapped.append(h)
@@ -143,9 +147,27 @@ def channel_lines(path) -> dict:
 def _mapped_columns(path, mapping=None, time_unit=None) -> Columns:
     """The file's columns under their drift names (:mod:`._drift_logger`)."""
     c = read_columns(path)
-    raw = read_header(path)
+    raw = [h.strip() for h in read_header(path)]
+    found = logger.clock_time(raw, c.labels)
+    if found is not None and found[0] not in (mapping or {}):   # clock times -> t_s
+        name, secs, date = found
+        c.numbers[name] = np.asarray(secs, dtype=float)
+        mapping = {**(mapping or {}), name: "t_s"}
+        for gone in (name, date):
+            c.text.pop(gone, None)
+            c.labels.pop(gone, None)
+        if date is not None:
+            raw = [h for h in raw if h != date]
+    for h in raw:
+        if h in c.labels and logger.split_unit(h)[0].lower() in logger.CLOCK_WORDS \
+                and h not in (mapping or {}):
+            cell = next((x for x in c.labels[h] if logger.clock_seconds([x]) is None),
+                        c.labels[h][0])
+            raise InputError(f"{c.name}: time column {h}: {cell!r} is neither a number nor a "
+                             f"clock time (14:05:30, 2024-03-01 14:05:30, 01.03.2024 14:05:30; "
+                             f"see volerr formats drift)")
     names = logger.map_header(raw, c.name, mapping, time_unit)
-    rename = dict(zip([h.strip() for h in raw], names))
+    rename = dict(zip(raw, names))
     for k, n in rename.items():             # a channel in mm is read in um
         if re.fullmatch(r"d_\w+_mm", n):
             rename[k] = n[:-3] + "_um"

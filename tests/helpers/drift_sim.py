@@ -193,12 +193,36 @@ CASES = {"fast": Planted("T_fast", 1800.0, 2.5), "slow": Planted("T_slow", 900.0
          "none": None}
 
 
-def campaign(planted: Planted | None, folder: Path, seed: int = 10) -> list:
+def campaign(planted: Planted | None, folder: Path, seed: int = 10,
+             direction: str = "X") -> list:
     """The runs of :data:`SPECS` with ``planted`` (None: no effect), written to
-    ``folder/run1.csv`` .. ``run3.csv``; returns the runs' columns (with ``truth_um``)."""
+    ``folder/run1.csv`` .. ``run3.csv`` (the channel along ``direction``, ``?``: unknown);
+    returns the runs' columns (with ``truth_um``)."""
     runs = []
     for i, (spec, rpm, phase) in enumerate(SPECS):
         run = simulate_run(spec, rpm, planted, seed + i, room_phase=phase, zero_um=3.0 * i)
-        write_drift(Path(folder) / f"run{i + 1}.csv", run)
+        write_drift(Path(folder) / f"run{i + 1}.csv", run, direction)
         runs.append(run)
     return runs
+
+
+#: one long run whose last part is held out by time (``--holdout-time``): spec, rpm, phase,
+#: the start of the held-out window (s)
+LONG_RUN = ("on:2h,off:1h,on:4h,off:3h,on:1h,off:1h,on:3h,off:3h", 4000.0, 1.0, 36000.0)
+
+
+def long_run(planted: Planted, folder: Path, seed: int = 20) -> dict:
+    """:data:`LONG_RUN` with ``planted``, written to ``folder/long.csv`` (zero 1.5 um)."""
+    spec, rpm, phase, _ = LONG_RUN
+    run = simulate_run(spec, rpm, planted, seed, room_phase=phase, zero_um=1.5)
+    write_drift(Path(folder) / "long.csv", run)
+    return run
+
+
+def true_window_mae(run: dict, planted: Planted, start_s: float, zero_um: float = 1.5) -> float:
+    """MAE over the readings at ``t >= start_s`` of the TRUE model continued through the run
+    (its lag over the whole logged series, its true zero): the floor of a time hold-out."""
+    T = run[planted.sensor]
+    pred = zero_um + planted.um_per_K * (lag_irregular(T, planted.tau_s, run["t_s"]) - T[0])
+    m = run["t_s"] >= start_s
+    return float(np.mean(np.abs(run["d_x_um"][m] - pred[m])))

@@ -189,3 +189,31 @@ def test_detect_leaves_other_instruments_alone():
     for names in (["t_s", "dr_um", "X", "Y"], ["t_s", "dx_um", "dy_um", "dz_um"],
                   ["time_s", "d_mm", "station"]):
         assert not drift.detect(names)
+
+
+def test_clock_times(tmp_path):
+    """A logger's clock column (with a date column, or alone across midnight) is read as
+    seconds from the first reading; an ambiguous date is refused in one line."""
+    rng = np.random.default_rng(4)
+    secs = 23 * 3600 + 50 * 60 + 60 * np.arange(30)           # 23:50 .. 00:19 next day
+
+    def clock(s):
+        s = int(s) % 86400
+        return f"{s // 3600:02d}:{s % 3600 // 60:02d}:{s % 60:02d}"
+
+    rows = [(("2024-03-01" if s < 86400 else "2024-03-02"), clock(s), f"{rng.normal():.3f}",
+             f"{20 + 0.01 * k:.3f}") for k, s in enumerate(secs)]
+    f = _write(tmp_path / "dated.csv", "Date,Time,ch1(um),t1(°C)", rows)
+    r = drift.read_runs(f)[0]
+    np.testing.assert_array_equal(r.t_s, secs - secs[0])
+    assert list(r.inputs) == ["T_1"] and r.notes == []
+    g = _write(tmp_path / "clock.csv", "Timestamp,ch1(um),t1(°C)", [x[1:] for x in rows])
+    assert detect(g) == "drift"
+    np.testing.assert_array_equal(drift.read_runs(g)[0].t_s, secs - secs[0])
+    out = tmp_path / "conv.csv"
+    assert main(["drift", "convert", str(f), "--out", str(out)]) == 0
+    assert out.read_text(encoding="utf-8").splitlines()[1] == "t_s,d_ch1_um,T_1"
+    bad = _write(tmp_path / "us.csv", "Timestamp,ch1(um),t1(°C)",
+                 [(f"03/01/2024 {x[1]}",) + x[2:] for x in rows])
+    with pytest.raises(InputError, match="is neither a number nor a clock time"):
+        drift.read_runs(bad)

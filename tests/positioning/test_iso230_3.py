@@ -146,3 +146,22 @@ def test_real_spindle_programme_stages():
     assert [v for _, v in got] == [float(v) for _, v in readme]
     assert np.allclose([t for t, _ in got], [t for t, _ in readme], atol=0.01)
     assert doc["tilts"] == {} and len(doc["channels"]) == 5
+
+
+def test_example_files_evaluate_and_convert(tmp_path):
+    """The example drift files (volerr examples): the spindle test evaluates with the tilts it
+    plants (1.5 urad/K about +Y, 0.5 about +X, the headstock up to ~12 K), the logger's file
+    converts."""
+    from volerr.example_files import write_drift_examples
+
+    write_drift_examples(tmp_path)
+    doc = iso230_3.evaluate(drift.read_runs(tmp_path / "drift_spindle.csv")[0]).to_dict()
+    assert 14 < doc["tilts"]["x1-x2"]["max_urad"] < 24
+    assert 4 < doc["tilts"]["y1-y2"]["max_urad"] < 10
+    assert doc["channels"]["z"]["min_um"] < -12
+    assert [s["value"] for s in doc["stages"]] == [0, 3000, 0, 6000, 0]
+    out = tmp_path / "drift.csv"
+    assert main(["drift", "convert", str(tmp_path / "drift_logger_raw.csv"), "--out",
+                 str(out), "--channel", "ch1=X at z=20", "--channel", "ch2=Z"]) == 0
+    r = drift.read_runs(out)[0]
+    assert r.t_s[1] == 30.0 and r.directions == {"ch1": "X", "ch2": "Z"}
