@@ -407,7 +407,8 @@ def _loop(out: Path) -> dict:
     from ..loop.run import demo_campaign
 
     layout, data = demo_campaign(out / "loop_measured.csv", kind="thermal_lag")
-    _cli("loop", layout, data, "--json", out / "loop.json", "--html", out / "loop.html")
+    _cli("loop", layout, data, "--json", out / "loop.json", "--html", out / "loop.html",
+         "--out-dir", out)
     rep = json.loads((out / "loop.json").read_text())
     found = ", ".join(f"{e['kind']} ({e['name']}" + (
         f", lag of {e['covariate']} {e['lag_s']['value'] / 60:.0f} min" if e.get("lag_s")

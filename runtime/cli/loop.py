@@ -3,8 +3,12 @@
 Fits the declared model, traces what is left to candidate effects "parameter P of the chain
 varies with covariate C" (thermal, drift, reversal, coupling, periodic, higher_order, step,
 probe_direction, setup, group ...), writes the augmented layout and its
-generated module (``--out-dir``, default: the folder of the json report) and reports the error
+generated module where ``--out-dir`` says (not given: not written) and reports the error
 before and after on held-out points.  See :mod:`volerr.loop.run`.
+
+Drift runs (``drift:FILE`` or a file detected as one; ``volerr formats loop-lags``): the loop
+on a position held while the machine heats and cools, ``--holdout-time`` / ``--holdout-files``
+and ``--predictions-out``; see :mod:`volerr.loop.drift`.
 """
 
 from __future__ import annotations
@@ -37,7 +41,19 @@ def register(sub) -> None:
     add_html(p, "the report with figures")
     p.add_argument("--out-dir", metavar="DIR",
                    help="folder for the augmented layout and its generated module (not given: "
-                        "the folder of --json or --html; neither: not written)")
+                        "not written)")
+    p.add_argument("--holdout-time", metavar="A:B",
+                   help="hold out the readings (points) with A <= t < B of the time column "
+                        "(units s, min, h; an open end allowed: 100035s:); default: whole "
+                        "stretches of time where there is a time column")
+    p.add_argument("--holdout-files", nargs="+", metavar="FILE",
+                   help="drift runs: hold out every run of these files")
+    p.add_argument("--predictions-out", metavar="P.csv",
+                   help="drift runs: CSV file,run,t_s,channel,measured_um,before_um,after_um,"
+                        "split of every reading")
+    p.add_argument("--differences", action="store_true",
+                   help="drift runs: try differences of two sensors as well (off by default: "
+                        "volerr formats loop-lags)")
     add_errors_out(p, "the fitted error functions (effects removed)")
     add_force(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
@@ -69,7 +85,45 @@ def loop_lines(e: dict) -> list:
     return out
 
 
+def _is_drift(specs) -> bool:
+    from ..instruments import detect, split_spec
+
+    kinds = []
+    for d in specs:
+        kind, path = split_spec(d)
+        kinds.append(kind or (detect(path) if Path(path).is_file() else None))
+    drift = [k == "drift" for k in kinds]
+    require(all(drift) or not any(drift), "loop: drift runs and other measurements in one "
+            "call; give the drift files alone")
+    return all(drift)
+
+
+K_PRINT = 2.0    # coverage factor of the printed uncertainties
+SIG_K = 2.0      # a term below this many standard uncertainties is not part of the effect
+
+
+def effect_terms(e: dict) -> str:
+    """The effect's parameters with their expanded uncertainty (k = 2); a term that is not
+    significant (|value| < 2 u) is said to be so, apart from the effect's terms."""
+    std = e.get("std") or {}
+    shown, weak = [], []
+    for k, v in e["parameters"].items():
+        u = std.get(k)
+        text = f"{k} = {v:.4g} {e['units'][k]}"
+        if u is not None:
+            text += f" +- {K_PRINT * u:.2g} (k = {K_PRINT:g})"
+        (weak if u is not None and abs(v) < SIG_K * u else shown).append(text)
+    out = ", ".join(shown) or "no significant term"
+    if weak:
+        out += f"; not significant, not part of the effect: {', '.join(weak)}"
+    return out
+
+
 def run(args) -> int:
+    if _is_drift(args.data):
+        return run_drift(args)
+    require(not (args.holdout_files or args.predictions_out),
+            "loop: --holdout-files and --predictions-out are for drift runs (drift:FILE)")
     from ..loop import candidates
     from ..loop.run import run_loop
 
@@ -82,10 +136,8 @@ def run(args) -> int:
     model = load(args.layout)
     aug = (f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py")
     # as the user named it (no resolve): the report names the files where they end up
-    out_dir = (Path(args.out_dir) if args.out_dir else
-               Path(args.json or args.html).parent if (args.json or args.html) else None)
-    # named in messages: the option, or where its default put the folder
-    OUT_DIR = "--out-dir" if args.out_dir else "--out-dir (not given: the report's folder)"
+    out_dir = Path(args.out_dir) if args.out_dir else None
+    OUT_DIR = "--out-dir"
     outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
         .folder(OUT_DIR, out_dir, files=aug) \
         .folder("--errors-out", args.errors_out,
@@ -101,7 +153,8 @@ def run(args) -> int:
         data = args.data[0] if len(args.data) == 1 else args.data
         report = run_loop(args.layout, data, seed=args.seed, folds=args.folds,
                           test_fraction=args.test_fraction, degree=args.degree,
-                          out_dir=staged, families=families, inputs=inputs)
+                          out_dir=staged, families=families, inputs=inputs,
+                          holdout_time=args.holdout_time)
         for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
             if report.data.get(key):
                 report.data[key] = str(out_dir / Path(report.data[key]).name)
@@ -115,8 +168,7 @@ def run(args) -> int:
         print(f"  warning: {w}")
     print(report.summary())
     for e in report.effects:
-        pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
-        print(f"  {e['kind']} {e['name']}: {pars}")
+        print(f"  {e['kind']} {e['name']}: {effect_terms(e)}")
         for line in loop_lines(e):
             print(f"    {line}")
     if report["augmented_layout"]:
@@ -128,4 +180,31 @@ def run(args) -> int:
               if not (u["parameters"][0].startswith("setup.") and u.get("no_sensitivity"))]
     if hidden:
         print(f"  not separable by these data: {', '.join(hidden)} (see the report)")
+    return 0
+
+
+def run_drift(args) -> int:
+    """The loop on drift runs (:func:`volerr.loop.drift_report.loop_drift`)."""
+    from ..instruments import split_spec
+    from ..loop.drift_report import loop_drift
+    from ._common import layout_inputs
+
+    paths = [split_spec(d)[1] for d in args.data]
+    held = [split_spec(d)[1] for d in (args.holdout_files or [])]
+    require(not (args.out_dir or args.errors_out), "loop: --out-dir and --errors-out are not "
+            "written for drift runs (their effects are per channel, not in the layout)")
+    inputs = paths + held + layout_inputs(args.layout)
+    outs = Outputs(inputs, force=args.force).file("--json", args.json) \
+        .file("--html", args.html).file("--predictions-out", args.predictions_out).check()
+    with outs:
+        report = loop_drift(args.layout, paths, window=args.holdout_time,
+                            files=held, differences=args.differences)
+        if args.json:
+            report.write_json(outs.path("--json"), inputs=inputs)
+        if args.html:
+            report.write_html(outs.path("--html"), inputs=inputs)
+        if args.predictions_out:
+            report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
+    for line in report.summary_lines():
+        print(line)
     return 0

@@ -9,7 +9,16 @@ undeclared effects).
 
 from .run import Report, read_deviations, run_loop
 
-__all__ = ["Report", "read_deviations", "run_loop"]
+
+def loop_drift(layout, paths, window=None, files=(), differences=False, progress=None):
+    """The loop on drift runs: :func:`volerr.loop.drift_report.loop_drift`."""
+    from .drift_report import loop_drift as _loop_drift
+
+    return _loop_drift(layout, paths, window=window, files=files, differences=differences,
+                       progress=progress)
+
+
+__all__ = ["Report", "loop_drift", "read_deviations", "run_loop"]
 
 
 def __getattr__(name):

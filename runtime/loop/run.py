@@ -562,21 +562,53 @@ def _search(model, dat, spl, ranges, y, degree, max_degree, fixed_degree, famili
 def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
              test_fraction: float = 0.25,
              degree: int | None = None, max_degree: int = 10, out_dir=None,
-             progress=None, families=cands.FAMILIES, inputs=()) -> Report:
+             progress=None, families=cands.FAMILIES, inputs=(),
+             holdout_time: str | None = None) -> Report:
     """Run the loop on ``data`` (CSV path, :class:`volerr.loop.simulate.Campaign` or
     :class:`volerr.estimate.design.Data`) for ``layout`` (name or layout file). Returns a :class:`Report`.
 
     ``out_dir``: where the augmented layout and its generated module are written (nothing is
-    written when None; the texts are in the report object either way)."""
+    written when None; the texts are in the report object either way).  ``holdout_time``
+    ``"A:B"`` (units s, min, h): hold out the points with A <= t < B of the time column
+    (:func:`volerr.loop.drift_split.parse_window`) instead of the default stretches."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
         return _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir,
-                    progress, families, inputs)
+                    progress, families, inputs, holdout_time)
+
+
+def _split(dat, seed, test_fraction, folds, holdout_time=None) -> Split:
+    """The held-out points: ``holdout_time`` ``"A:B"`` (the points with A <= t < B), else
+    with a time column whole stretches of time
+    (:func:`volerr.loop.drift_split.stretch_split`), else drawn at random (``seed``)."""
+    from ..machine.lags import TIME_COLUMNS
+    from .drift_split import parse_window, stretch_split
+
+    spl = split_points(dat.n, seed, test_fraction, folds)
+    time = next((c for c in TIME_COLUMNS if c in dat.covariates), None)
+    require(holdout_time is None or time is not None, "--holdout-time needs a time column "
+            "(t_s, t_min, t_h) in the data")
+    if time is None:
+        return spl
+    if holdout_time is not None:
+        a, b = parse_window(holdout_time)
+        t = np.asarray(dat.covariates[time], float) * TIME_COLUMNS[time]
+        test = (t >= a) & (t < b)
+        require(test.any() and (~test).sum() >= 20, f"--holdout-time {holdout_time}: holds "
+                f"out {int(test.sum())} of {dat.n} points (some, and all but 20 at most)")
+    else:
+        test = stretch_split(dat.covariates[time], dat.file, test_fraction)
+    if not test.any() or test.all():
+        return spl
+    train = np.flatnonzero(~test)
+    fold_t = None if folds is None else \
+        np.random.default_rng(seed).permutation(len(train)) % folds
+    return Split(train, np.flatnonzero(test), fold_t)
 
 
 def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, progress,
-         families, inputs) -> Report:
+         families, inputs, holdout_time=None) -> Report:
     t_start = time.perf_counter()
     model, dat = _load(layout, data)
     checks.one_position(dat)
@@ -585,7 +617,7 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     if degree is not None:
         require(1 <= degree <= 12, "degree must be between 1 and 12")
     bar = _progress(4, progress)
-    spl = split_points(dat.n, seed, test_fraction, folds)
+    spl = _split(dat, seed, test_fraction, folds, holdout_time)
     ranges = data_ranges(model, dat)
     y = dat.deviation.ravel()
     bar.set_postfix_str("degree, screening and selection")

@@ -42,8 +42,9 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     # relative paths, as a user types them: the report names the files where they end up
     r1 = _cli("loop", "MB1", um, "--json", "a.json", "--degree", "4",
               "--out-dir", "aug", "--errors-out", "errors", cwd=tmp_path)
-    # the same data in mm, with --html and no --json: the augmented layout goes next to the
-    # page; the page holds the residual sources as tables, no raw JSON dump, no absolute paths
+    # the same data in mm, with --html and no --json nor --out-dir: the augmented layout is
+    # not written (issue 38: only what was asked); the page holds the residual sources as
+    # tables, no raw JSON dump, no absolute paths
     html = tmp_path / "page" / "r.html"
     html.parent.mkdir()
     r2 = _cli("loop", "MB1", mm, "--html", html, "--degree", "4")
@@ -53,7 +54,7 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     text = html.read_text()
     assert "Where the residual lives" in text and "parameter P" in text
     assert str(tmp_path) not in text and '"rms_before_um"' not in text
-    assert (html.parent / "MB1_aug.toml").is_file()
+    assert sorted(p.name for p in html.parent.iterdir()) == ["r.html"]
     assert [e["name"] for e in a["effects"]] == ["reversal_X"]
     assert (tmp_path / "aug" / "MB1_aug.toml").is_file()
     assert a["augmented_layout"] == "aug/MB1_aug.toml" and a["generated_module"] == \
@@ -61,6 +62,9 @@ def test_cli_loop_success_and_mm_units(tmp_path, campaign):
     assert sorted(p.name for p in (tmp_path / "errors").iterdir()) == [
         "X.csv", "Y.csv", "Z.csv", "constants.csv"]
     assert "reversal" in r1.stdout
+    # a second run is never refused for a file the first wrote itself
+    r3 = _cli("loop", "MB1", um, "--json", "a.json", "--degree", "4", cwd=tmp_path)
+    assert r3.returncode == 0, r3.stderr
 
 
 def _bad_cases(campaign):

@@ -1,0 +1,164 @@
+"""The basis of the loop on drift runs: what a displacement channel may vary with, and the
+blocked folds it is judged on (:mod:`volerr.loop.drift` runs the selection).
+
+A drift run holds one machine position while the machine heats and cools: the declared
+geometric model predicts a constant per channel (the run's zero).  What varies is heat; the
+columns a channel may vary with are, over every reading of every run (train and test: a lag
+is causal, the held-out part is predicted from its own inputs):
+
+* each sensor ``T_*`` (and any other logged input but the spindle speed), as its change since
+  the run's first reading, plain and through a first-order lag ``lag(T, tau)``
+  (:func:`volerr.machine.lags.lag`: exact for readings linear between samples, started in
+  equilibrium at the run's first reading, afresh in every run);
+* the heat input of the spindle: ``q = (S / S_ref) ** p`` with ``S_ref`` the largest speed of
+  the training part (so a coefficient is the displacement at that speed) and ``p`` an
+  exponent on ``P_GRID`` (friction heat of a bearing grows with the speed to a power between
+  about 1 and 2: Bossmanns & Tu 1999; Palmgren's friction moment), plain and through a lag:
+  ``lag(q, tau)`` is the standard first-order thermal response to a heat source switched on
+  and off;
+* differences of two sensors (a gradient) are combinations of these columns
+  (:mod:`volerr.loop.drift` forms them from the cross-products).
+
+Time constants: a geometric grid of ``N_TAU`` values from ``TAU_MIN_STEPS`` reading intervals
+(at least 60 s) to half the training duration; the selected one is refined between its grid
+neighbours.  Columns are scaled to unit RMS over the training part (conditioning; the
+reported coefficients are in the units of the unscaled column).
+
+Folds (the split rule of ``volerr formats loop-lags``): with at least ``RUN_FOLDS_MIN``
+training runs every fold is one whole run (predicted from its own zero, its first reading);
+otherwise ``K_FOLDS`` folds, fold k being the k-th of ``K_FOLDS`` contiguous stretches of
+every run's training readings (each run keeps a zero fitted on its other stretches).  Folds
+are whole stretches, never readings drawn at random: readings 15 s apart are almost equal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import require
+
+P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
+N_TAU = 14                # time constants on the grid
+TAU_MIN_STEPS = 4.0       # the shortest lag: this many reading intervals (and >= 60 s)
+K_FOLDS = 6               # contiguous stretches per run when the folds are not whole runs
+RUN_FOLDS_MIN = 3         # training runs from which every fold is one whole run
+SENSOR_TAU_SPAN = 0.125  # a sensor's lag is searched up to this share of the training span
+SPEED = "S_rpm"           # the logged input the heat input is derived from
+
+
+@dataclass
+class DriftSeries:
+    """Drift runs stacked in time order within each run.
+
+    ``t_s`` (N,) seconds; ``run`` (N,) run index into ``runs`` [(file, label)];
+    ``inputs`` {name: (N,)} logged inputs (degC, rpm, ...); ``channels`` {label: (N,)} um;
+    ``directions`` {label: "X".."-Z" or "?"}; ``heights`` {label: mm or None};
+    ``test`` (N,) bool: held out."""
+
+    t_s: np.ndarray
+    run: np.ndarray
+    runs: list
+    inputs: dict
+    channels: dict
+    directions: dict = field(default_factory=dict)
+    heights: dict = field(default_factory=dict)
+    test: np.ndarray | None = None
+
+    @property
+    def train(self) -> np.ndarray:
+        return ~self.test
+
+    def firsts(self) -> np.ndarray:
+        """Index (n_runs,) of every run's first reading."""
+        return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
+
+
+@dataclass
+class Column:
+    """One basis column: ``source`` (a sensor or ``heat``), ``tau_s`` (0: no lag), ``p`` (the
+    heat input's exponent, None for a sensor), ``scale`` (its RMS over training)."""
+
+    source: str
+    tau_s: float
+    p: float | None = None
+    scale: float = 1.0
+
+    @property
+    def label(self) -> str:
+        what = self.source if self.p is None else f"(S/S_ref)^{self.p:g}"
+        return f"lag({what}, {self.tau_s:.0f} s)" if self.tau_s > 0 else what
+
+
+def tau_grid(s: DriftSeries) -> np.ndarray:
+    """The time constants (s) searched: ``N_TAU`` from the shortest lag to half the training
+    duration (geometric)."""
+    tr = s.train
+    dt = float(np.median(np.diff(s.t_s)[np.diff(s.run) == 0])) if len(s.t_s) > 1 else 1.0
+    lo = max(60.0, TAU_MIN_STEPS * dt)
+    span = max(float(np.ptp(s.t_s[tr & (s.run == r)])) if np.any(tr & (s.run == r)) else 0.0
+               for r in range(len(s.runs)))
+    hi = max(span / 2.0, 4 * lo)
+    return np.geomspace(lo, hi, N_TAU)
+
+
+def sensors(s: DriftSeries) -> list:
+    """The logged inputs read as sensors: every input but the speed and constant ones, in the
+    order of the file."""
+    tr = s.train
+    return [k for k, v in s.inputs.items() if k != SPEED and np.ptp(v[tr]) > 0]
+
+
+def heat(s: DriftSeries, p: float) -> np.ndarray:
+    """``(S / S_ref) ** p`` (N,), ``S_ref`` the largest |speed| of the training part."""
+    S = np.abs(np.asarray(s.inputs[SPEED], float))
+    ref = float(S[s.train].max())
+    return (S / ref) ** p
+
+
+def series(s: DriftSeries, source: str, tau_s: float, p: float | None = None) -> np.ndarray:
+    """The unscaled column: the change since each run's first reading of a sensor, or the
+    heat input, through a lag ``tau_s`` (0: none), restarted in every run."""
+    from ..machine.lags import lag
+
+    u = heat(s, p) if source == "heat" else np.asarray(s.inputs[source], float)
+    y = lag(u, tau_s, s.t_s, s.run) if tau_s > 0 else u
+    return y - y[s.firsts()][s.run]
+
+
+def library(s: DriftSeries) -> tuple[list, np.ndarray]:
+    """Every basis column (list of :class:`Column`) and their values (N, m), scaled."""
+    taus = tau_grid(s)
+    cols = []
+    for name in sensors(s):
+        cols += [Column(name, 0.0)] + [Column(name, float(t)) for t in taus]
+    if SPEED in s.inputs and np.ptp(s.inputs[SPEED][s.train]) > 0:
+        for p in P_GRID:
+            cols += [Column("heat", 0.0, p)] + [Column("heat", float(t), p) for t in taus]
+    X = np.empty((len(s.t_s), len(cols)))
+    for j, c in enumerate(cols):
+        X[:, j] = series(s, c.source, c.tau_s, c.p)
+    sc = np.sqrt(np.mean(X[s.train] ** 2, axis=0))
+    sc = np.where(sc > 0, sc, 1.0)
+    for c, v in zip(cols, sc):
+        c.scale = float(v)
+    return cols, X / sc
+
+
+def folds(s: DriftSeries) -> tuple[np.ndarray, str]:
+    """Fold index (N,) of every training reading (-1: held out) and the rule used
+    (``"runs"`` or ``"stretches"``), by the rule of the module docstring."""
+    tr = s.train
+    f = np.full(len(s.t_s), -1)
+    train_runs = [r for r in range(len(s.runs)) if np.any(tr & (s.run == r))]
+    if len(train_runs) >= RUN_FOLDS_MIN:
+        for k, r in enumerate(train_runs):
+            f[tr & (s.run == r)] = k
+        return f, "runs"
+    for r in train_runs:
+        idx = np.flatnonzero(tr & (s.run == r))
+        f[idx] = np.minimum(np.arange(len(idx)) * K_FOLDS // len(idx), K_FOLDS - 1)
+    require(len(set(f[tr])) >= 2, "loop: too few training readings for a cross-validation "
+            "(at least two stretches of time are needed)")
+    return f, "stretches"

@@ -1,0 +1,137 @@
+"""Blocked cross-validation of linear drift models from cross-products, for many candidate
+columns at once (:mod:`volerr.loop.drift` selects with it).
+
+A model of one channel is ``y = Z W b`` (``Z`` the run indicators and the basis columns of
+:func:`volerr.loop.drift_basis.library`, ``W`` the combinations chosen so far: a run's zero,
+a column, a difference of two columns).  For a fold k the fit on the other folds and its
+squared error on fold k follow from the cross-products ``Z'Z``, ``Z'y``, ``y'y`` of fold k
+and of all training readings: no pass over the readings per candidate.  Adding a candidate
+column ``c = Z (e_a - e_b)`` to ``W`` is a bordered system solved in closed form (the Schur
+complement ``v - u' M^-1 u``), vectorised over all candidates.
+
+A fold of whole runs is predicted from each run's zero (its first reading: the basis columns
+are zero there), so its test cross-products use ``y - y_first`` and no run indicator.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+SINGULAR = 1e-9         # a candidate whose Schur complement is below this share of c'c: dependent
+
+
+class Engine:
+    """Cross-products of one channel per fold.
+
+    ``Z`` (N, mz): run indicators then basis columns; ``y`` (N,); ``fold`` (N,) fold index of
+    each training reading (-1 held out); ``by_runs``: folds are whole runs (anchored test)."""
+
+    def __init__(self, Z, y, fold, by_runs: bool, run, n_runs: int, cache=None):
+        """``cache``: a dict shared by the channels of one basis (the cross-products of
+        ``Z`` with itself do not depend on the channel: computed once)."""
+        cache = {} if cache is None else cache
+        self.n_runs = n_runs
+        self.K = int(fold.max()) + 1
+        self.n = int((fold >= 0).sum())
+        first = np.zeros(n_runs)
+        for r in range(n_runs):
+            idx = np.flatnonzero(run == r)
+            first[r] = y[idx[0]] if len(idx) else 0.0
+        self.fold_fit, self.fold_test = [], []
+        for k in range(self.K):
+            m = fold == k
+            if ("fit", k) not in cache:
+                Zk = Z[m]
+                cache[("fit", k)] = Zk.T @ Zk
+                if by_runs:
+                    Zt = Zk.copy()
+                    Zt[:, :n_runs] = 0.0
+                    cache[("test", k)] = (Zt, Zt.T @ Zt)
+            Gk, yk = cache[("fit", k)], y[m]
+            fit = (Gk, Z[m].T @ yk, float(yk @ yk))
+            self.fold_fit.append(fit)
+            if by_runs:
+                Zt, TG = cache[("test", k)]
+                yt = yk - first[run[m]]
+                self.fold_test.append((TG, Zt.T @ yt, float(yt @ yt), int(m.sum())))
+            else:
+                self.fold_test.append(fit + (int(m.sum()),))
+        self.G = sum(f[0] for f in self.fold_fit)
+        self.h = sum(f[1] for f in self.fold_fit)
+        self.yy = sum(f[2] for f in self.fold_fit)
+
+    # ---- the model so far, and one candidate more --------------------------------------
+    def _active(self, W, G):
+        """Columns of ``W`` that the fit on ``G`` determines (a run without training
+        readings in it has no zero there)."""
+        return np.einsum("ij,ij->j", W, G @ W) > 0
+
+    def cv_sse(self, W) -> float:
+        """Cross-validated sum of squared errors of the model ``W`` (mz, s)."""
+        return float(self.cv_many(W, np.zeros((0, 2), int))[1])
+
+    def cv_many(self, W, cands) -> tuple[np.ndarray, float]:
+        """(cross-validated SSE (nc,) of ``W`` plus each candidate, SSE of ``W`` alone).
+        ``cands`` (nc, 2) index pairs (a, b) into Z's columns, b = -1 for a single column;
+        dependent candidates get +inf."""
+        a, b = cands[:, 0], cands[:, 1]
+        tot = np.zeros(len(cands))
+        base = 0.0
+        for (Gk, hk, _), (TG, Th, Tyy, _) in zip(self.fold_fit, self.fold_test):
+            Gt, ht = self.G - Gk, self.h - hk
+            on = self._active(W, Gt)
+            Wf = W[:, on]
+            sse, sse0 = _bordered(Gt, ht, TG, Th, Tyy, Wf, a, b)
+            tot += sse
+            base += sse0
+        return tot, base
+
+    def train_rss_many(self, W, cands) -> tuple[np.ndarray, float]:
+        """(training RSS (nc,) with each candidate, RSS of ``W``), fitted on all training."""
+        a, b = cands[:, 0], cands[:, 1]
+        on = self._active(W, self.G)
+        return _bordered(self.G, self.h, self.G, self.h, self.yy, W[:, on], a, b)
+
+
+def _pair(Mat, a, b):
+    """Rows ``Mat[a] - Mat[b]`` (b = -1: ``Mat[a]``)."""
+    out = Mat[a].copy()
+    m = b >= 0
+    out[m] -= Mat[b[m]]
+    return out
+
+
+def _quad(G, a, b):
+    """``c' G c`` for c = e_a - e_b (b = -1: e_a)."""
+    v = G[a, a].copy()
+    m = b >= 0
+    v[m] += G[b[m], b[m]] - 2.0 * G[a[m], b[m]]
+    return v
+
+
+def _bordered(Gt, ht, TG, Th, Tyy, W, a, b):
+    """SSE on the test cross-products (TG, Th, Tyy) of the fit on (Gt, ht) with the columns
+    ``W`` plus each candidate, and of ``W`` alone."""
+    M = W.T @ Gt @ W
+    hS = W.T @ ht
+    Minv = np.linalg.pinv(M, rcond=1e-12, hermitian=True) if M.size else M
+    b0 = Minv @ hS
+    TGW = TG @ W
+    GkSS, hkS = W.T @ TGW, W.T @ Th
+    sse0 = Tyy - 2 * b0 @ hkS + b0 @ GkSS @ b0
+    if len(a) == 0:
+        return np.zeros(0), float(sse0)
+    U = _pair(Gt @ W, a, b).T                 # (s, nc)  W' Gt c
+    v = _quad(Gt, a, b)
+    hc = _pair(ht[:, None], a, b)[:, 0]
+    Zm = Minv @ U
+    schur = v - np.einsum("ij,ij->j", U, Zm)
+    ok = schur > SINGULAR * np.maximum(v, 1e-300)
+    beta = np.where(ok, (hc - U.T @ b0) / np.where(ok, schur, 1.0), 0.0)
+    B = b0[:, None] - Zm * beta
+    GkSc = _pair(TGW, a, b).T
+    Gkcc = _quad(TG, a, b)
+    hkc = _pair(Th[:, None], a, b)[:, 0]
+    sse = (Tyy - 2 * (B.T @ hkS + beta * hkc) + np.einsum("ij,ij->j", B, GkSS @ B)
+           + 2 * beta * np.einsum("ij,ij->j", B, GkSc) + beta ** 2 * Gkcc)
+    return np.where(ok, sse, np.inf), float(sse0)

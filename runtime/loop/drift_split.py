@@ -1,0 +1,108 @@
+"""Honest splits of time series: which readings are held out (the split rule of
+``volerr formats loop-lags``).
+
+* ``--holdout-time A:B``: the readings with ``A <= t < B`` (``t`` the time of the run's file,
+  units ``s``, ``min``, ``h``; an open end: ``100035s:``, ``:2h``);
+* ``--holdout-files FILE...``: every run of those files;
+* neither: with two runs or more the last run (whole) is held out; with one run the last
+  ``DEFAULT_TEST`` of its time (one contiguous stretch).  Never readings drawn at random:
+  readings seconds apart are almost equal, a model judged on them is judged on its neighbours.
+
+The same rule splits the points of the 3-D loop when its file has a time column
+(:func:`stretch_split`).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import require
+from .drift_basis import DriftSeries
+
+DEFAULT_TEST = 0.25          # share of a single run's time held out at its end
+_UNITS = {"s": 1.0, "min": 60.0, "h": 3600.0}
+_END = re.compile(r"^\s*([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*(s|min|h)\s*$")
+
+
+def parse_window(text: str) -> tuple[float, float]:
+    """``"A:B"`` -> (A, B) in seconds (an open end -inf / +inf); InputError otherwise."""
+    head, sep, tail = str(text).partition(":")
+    require(sep == ":" and (head.strip() or tail.strip()),
+            f"--holdout-time {text!r}: give A:B with units s, min or h (e.g. 100035s:, "
+            f"2h:4h)")
+    out = []
+    for part, inf in ((head, -np.inf), (tail, np.inf)):
+        if not part.strip():
+            out.append(inf)
+            continue
+        m = _END.match(part)
+        require(m is not None, f"--holdout-time {text!r}: {part.strip()!r} is not a time "
+                               f"with a unit s, min or h")
+        out.append(float(m.group(1)) * _UNITS[m.group(2)])
+    require(out[0] < out[1], f"--holdout-time {text!r}: the window is empty (A >= B)")
+    return out[0], out[1]
+
+
+def held_out(s: DriftSeries, window=None, files=()) -> tuple[np.ndarray, str]:
+    """The test mask (N,) and a sentence saying how it was drawn."""
+    test = np.zeros(len(s.t_s), bool)
+    said = []
+    if window is not None:
+        a, b = parse_window(window)
+        test |= (s.t_s >= a) & (s.t_s < b)
+        said.append(f"readings with {window} held out")
+    if files:
+        names = {Path(f).name for f in files}
+        known = {Path(f).name for f, _ in s.runs}
+        bad = sorted(names - known)
+        require(not bad, f"--holdout-files: {bad[0] if bad else ''} is not one of the drift "
+                         f"files given ({', '.join(sorted(known))})")
+        for r, (f, _) in enumerate(s.runs):
+            if Path(f).name in names:
+                test |= s.run == r
+        said.append(f"runs of {', '.join(sorted(names))} held out")
+    if window is None and not files:
+        test, text = default_split(s)
+        said.append(text)
+    require(test.any(), "loop: nothing is held out (the window or files select no reading)")
+    require((~test).sum() >= 20, "loop: fewer than 20 training readings are left")
+    return test, "; ".join(said)
+
+
+def default_split(s: DriftSeries) -> tuple[np.ndarray, str]:
+    """The rule of the module docstring without ``--holdout-*``."""
+    n_runs = len(s.runs)
+    if n_runs >= 2:
+        return s.run == n_runs - 1, f"the last run ({s.runs[-1][0]}) held out"
+    t = s.t_s
+    cut = t[0] + (1 - DEFAULT_TEST) * (t[-1] - t[0])
+    return t >= cut, (f"the last {DEFAULT_TEST:.0%} of the run's time held out "
+                      f"(t >= {cut:.0f} s)")
+
+
+#: equal-time blocks per file of the 3-D loop's held-out split
+N_BLOCKS = 20
+
+
+def stretch_split(t, groups, fraction: float) -> np.ndarray:
+    """Held-out mask of the 3-D loop's points with a time column: every file's time span cut
+    into ``N_BLOCKS`` equal blocks and ``round(fraction N_BLOCKS)`` of them held out, spread
+    evenly (block ``floor((j + 1/2) N_BLOCKS / m)``, j = 0..m-1): whole contiguous stretches
+    over the whole campaign (every phase of a duty cycle is judged), never points drawn at
+    random (a point's neighbour in time is almost the same reading)."""
+    t = np.asarray(t, float)
+    g = np.zeros(len(t), int) if groups is None else np.asarray(groups)
+    m = max(1, int(round(fraction * N_BLOCKS)))
+    held = np.floor((np.arange(m) + 0.5) * N_BLOCKS / m).astype(int)
+    test = np.zeros(len(t), bool)
+    for f in np.unique(g):
+        sel = g == f
+        lo, hi = t[sel].min(), t[sel].max()
+        if not hi > lo:
+            continue
+        block = np.minimum(((t[sel] - lo) / (hi - lo) * N_BLOCKS).astype(int), N_BLOCKS - 1)
+        test[np.flatnonzero(sel)[np.isin(block, held)]] = True
+    return test
