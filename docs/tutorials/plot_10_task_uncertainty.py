@@ -19,10 +19,13 @@ examples()
 main(["uncertainty", "MH2", "--task", "task_distance.csv", "--evaluate", "distance",
       "--spec", "E0=2+L/300", "--samples", "300", "--json", "u.json", "--quiet"])
 doc = json.load(open("u.json"))
-q = next(iter(doc["results"].values())) if isinstance(doc.get("results"), dict) else doc
-print({k: v for k, v in q.items() if not isinstance(v, (list, dict))})
+for name, q in doc["quantities"].items():
+    print(f"{name}: result {q['result_mm']:.6f} mm, u {q['standard_uncertainty_um']:.3f} um "
+          f"(k = 1), U {q['expanded_uncertainty_um']:.3f} um (k = 2)")
+names = list(doc["quantities"])
 fig, ax = plt.subplots(figsize=(5, 2.5))
-u = q.get("standard_uncertainty_um", 0.0)
-U = q.get("expanded_uncertainty_um", 0.0)
-ax.bar(["u (k = 1)", "U (k = 2)"], [u, U])
+ax.bar([f"{n}: u (k = 1)" for n in names],
+       [doc["quantities"][n]["standard_uncertainty_um"] for n in names])
+ax.bar([f"{n}: U (k = 2)" for n in names],
+       [doc["quantities"][n]["expanded_uncertainty_um"] for n in names])
 ax.set_ylabel("µm")

@@ -1,0 +1,147 @@
+"""The Python API (issue 38): every command one call, its result equal to what the command
+writes and prints; the callable packages whatever was imported first; InputError one line;
+the README's and the manual's Python blocks run."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import volerr
+from volerr.cli import main
+from volerr.example_files import shipped_path
+
+ROOT = Path(__file__).resolve().parents[2]
+SPHERE = str(shipped_path("sphere_example_DMU50.csv"))
+
+
+def _cli_json(tmp_path, argv, capsys) -> tuple[dict, str]:
+    out = tmp_path / "cli.json"
+    capsys.readouterr()
+    assert main([*argv, "--json", str(out)]) == 0
+    return json.loads(out.read_text()), capsys.readouterr().out
+
+
+def test_calibrate_equals_the_command(tmp_path, capsys):
+    doc, printed = _cli_json(tmp_path, ["calibrate", "DMU50", SPHERE], capsys)
+    cal = volerr.calibrate("DMU50", [SPHERE])
+    assert cal.to_dict()["parameters"] == doc["parameters"]
+    timeless = {k for k in doc if k != "seconds"}
+    assert {k: cal.to_dict()[k] for k in timeless} == {k: doc[k] for k in timeless}
+    assert cal.summary() == printed.rstrip("\n")
+    assert len(repr(cal).splitlines()) == 1 and len(repr(cal)) < 160
+    rows = cal.table()
+    rows = rows.to_dict("records") if hasattr(rows, "to_dict") else [r._asdict() for r in rows]
+    assert {r["name"]: (r["value"], r["std"], r["unit"], r["k"]) for r in rows} == {
+        n: (v["value"], v["std"], v["unit"], 1.0) for n, v in doc["parameters"].items()}
+    cal.write_json(tmp_path / "api.json")
+    assert json.loads((tmp_path / "api.json").read_text()) == cal.to_dict()
+
+
+def test_every_plus_minus_printed_says_its_k(capsys):
+    assert main(["calibrate", "DMU50", SPHERE]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "+-" in ln]
+    assert lines and all("k = 1" in ln for ln in lines), lines
+
+
+def test_a_variance_factor_below_one_keeps_the_stated_uncertainties():
+    """The DMU50 example scatters less than stated (variance factor 0.28): the stds are the
+    a-priori ones, so they equal those of the same campaign re-weighted to a factor of exactly
+    1 by hand (the readings' residuals scaled up so that s0 = 1 would be reached only by
+    shrinking): independent of s0 below 1, and printed as such."""
+    cal = volerr.calibrate("DMU50", [SPHERE])
+    vf = cal["variance_factor"]
+    assert vf < 1 and not cal["uncertainty_scaled"]
+    # the covariance of the kept columns is the a-priori one: (A^T W A)^-1 u_ref^2 with
+    # weights of the stated u; s0 enters only through max(s0, 1) = 1
+    sol = cal.solution
+    assert sol.s0 ** 2 == pytest.approx(vf, abs=1e-4)
+    assert "are kept, not shrunk" in cal.summary()
+
+
+def test_combination_by_names_equals_the_reported_combination():
+    cal = volerr.calibrate("DMU50", [SPHERE])
+    combo = cal["combinations"][0]
+    assert combo["expression"] == "EY0B + EY0C"
+    value, std = cal.combination({"EY0B": 1, "EY0C": 1})
+    assert 1e3 * value == pytest.approx(combo["value"], rel=1e-9)   # mm -> um
+    assert 1e3 * std == pytest.approx(combo["std"], rel=1e-9)
+    labels = {n: cal.labels[j] for n, j in cal._label_names().items()}
+    assert cal.combination({labels["EY0B"]: 1, labels["EY0C"]: 1}) == (value, std)
+    assert cal.combination({"EY0B": 1}) is None          # not determined alone
+    assert cal.combination({"NOPE": 1}) is None
+
+
+@pytest.mark.slow
+def test_plan_equals_the_command(tmp_path, capsys):
+    doc, printed = _cli_json(tmp_path, ["plan", "MB1", "--instrument", "ballbar", "--readings",
+                                        "200", "--out", str(tmp_path / "p")], capsys)
+    p = volerr.plan("MB1", "ballbar", readings=200)
+    d = p.to_dict()
+    assert d["parameters"] == doc["parameters"]
+    timeless = {k for k in doc if k not in ("seconds", "files")}
+    assert {k: d[k] for k in timeless} == {k: doc[k] for k in timeless}
+    assert p.summary() == printed.rstrip("\n")
+
+
+@pytest.mark.slow
+def test_loop_equals_the_command(tmp_path, capsys):
+    from volerr.example_files import write_examples
+
+    write_examples(tmp_path)
+    data = str(tmp_path / "deviations_MB1.csv")
+    doc, printed = _cli_json(tmp_path, ["loop", "MB1", data, "--out-dir", str(tmp_path / "o")],
+                             capsys)
+    r = volerr.loop("MB1", data)
+    d = r.to_dict()
+    assert d["effects"] == doc["effects"]
+    same = {k for k in doc if k not in ("augmented_layout", "generated_module") and
+            k != "seconds"}
+    assert {k: d[k] for k in same} == {k: doc[k] for k in same}
+    assert r.summary().splitlines()[:3] == printed.splitlines()[:3]
+
+
+def test_input_error_is_the_commands_one_line(capsys):
+    with pytest.raises(volerr.InputError) as exc:
+        volerr.calibrate("NOPE", [SPHERE])
+    assert main(["calibrate", "NOPE", SPHERE]) == 2
+    err = capsys.readouterr().err
+    assert err == f"volerr calibrate: error: {exc.value}\n"
+    assert "\n" not in str(exc.value)
+
+
+def test_packages_are_callable_whatever_was_imported_first():
+    code = ("import sys\nimport volerr\nassert 'volerr.calibrate' not in sys.modules\n"
+            "assert 'sympy' not in sys.modules\n"
+            "import volerr.calibrate.run, volerr.plan._run, volerr.loop.run, "
+            "volerr.identify.solve\n"
+            "from volerr.calibrate import terms\n"
+            "assert all(callable(getattr(volerr, n)) for n in "
+            "('calibrate', 'plan', 'loop', 'identify', 'compensate', 'ballbar_evaluate', "
+            "'iso230_2'))\n"
+            "assert volerr.calibrate.run.calibrate is volerr.calibrate.__api__\n"
+            "print('ok')\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+
+
+def _python_blocks(path: Path) -> list:
+    return re.findall(r"```python\n(.*?)```", path.read_text(encoding="utf-8"), re.S)
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/getting_started.md"])
+def test_the_python_blocks_run(page, tmp_path, monkeypatch):
+    import shutil
+
+    blocks = _python_blocks(ROOT / page)
+    assert blocks
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(SPHERE, tmp_path / "sphere_example_DMU50.csv")
+    for code in blocks:
+        exec(compile(code, page, "exec"), {"__name__": "__main__"})
