@@ -9,8 +9,8 @@ One function per command, its options as keywords (imported when first used, so 
 volerr`` stays light):
 
 * :func:`volerr.calibrate` (``volerr calibrate``), :func:`volerr.plan` (``volerr plan``),
-  :func:`volerr.loop` (``volerr loop``), :func:`volerr.identify` (``volerr identify``):
-  callable sub-packages (:mod:`volerr.results`);
+  :func:`volerr.loop` (``volerr loop``), :func:`volerr.identify` (``volerr identify``),
+  :func:`volerr.uncertainty` (``volerr uncertainty``): callable sub-packages (:mod:`volerr.results`);
 * :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`.
 
 Bad input raises :class:`volerr.InputError` with the command's one-line message.
@@ -25,7 +25,7 @@ from .machine.model import Model, load  # noqa: F401
 __version__ = "0.1.0"
 
 #: callable sub-packages: ``volerr.NAME(...)`` (``volerr/NAME/__init__.py`` makes itself callable)
-_PACKAGES = ("calibrate", "plan", "loop", "identify")
+_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty")
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api"}

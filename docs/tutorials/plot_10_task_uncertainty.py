@@ -4,21 +4,21 @@ Task-specific uncertainty
 
 A 400 mm distance measured on Pahk's CMM B (``MH2``) whose errors are known only through its
 specification ``E0 = 2 + L/300 um``: a Monte Carlo over plausible machines (JCGM 101) gives
-the result, its standard uncertainty u (k = 1) and expanded U (k = 2).  Run through the
-command here (``volerr uncertainty MH2 --task task_distance.csv --evaluate distance --spec
-E0=2+L/300 --samples 300 --json u.json``).
+the result, its standard uncertainty u (k = 1) and expanded U (k = 2).  The command:
+``volerr uncertainty MH2 --task task_distance.csv --evaluate distance --spec E0=2+L/300``
+(10 000 samples by default; 500 here).
 """
-import json
-
 import matplotlib.pyplot as plt
 
-from volerr.cli import main
+import volerr
 from _common import examples
 
 examples()
-main(["uncertainty", "MH2", "--task", "task_distance.csv", "--evaluate", "distance",
-      "--spec", "E0=2+L/300", "--samples", "300", "--json", "u.json", "--quiet"])
-doc = json.load(open("u.json"))
+res = volerr.uncertainty("MH2", "task_distance.csv", "distance", spec="E0=2+L/300",
+                         samples=500)
+print(res.summary())
+fig = res.figures()["histogram"]
+doc = res.to_dict()
 for name, q in doc["quantities"].items():
     print(f"{name}: result {q['result_mm']:.6f} mm, u {q['standard_uncertainty_um']:.3f} um "
           f"(k = 1), U {q['expanded_uncertainty_um']:.3f} um (k = 2)")

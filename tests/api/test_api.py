@@ -122,7 +122,7 @@ def test_packages_are_callable_whatever_was_imported_first():
             "volerr.identify.solve\n"
             "from volerr.calibrate import terms\n"
             "assert all(callable(getattr(volerr, n)) for n in "
-            "('calibrate', 'plan', 'loop', 'identify', 'compensate', 'ballbar_evaluate', "
+            "('calibrate', 'plan', 'loop', 'identify', 'uncertainty', 'compensate', 'ballbar_evaluate', "
             "'iso230_2'))\n"
             "assert volerr.calibrate.run.calibrate is volerr.calibrate.__api__\n"
             "print('ok')\n")
@@ -145,3 +145,17 @@ def test_the_python_blocks_run(page, tmp_path, monkeypatch):
     shutil.copy(SPHERE, tmp_path / "sphere_example_DMU50.csv")
     for code in blocks:
         exec(compile(code, page, "exec"), {"__name__": "__main__"})
+
+
+def test_uncertainty_equals_the_command(tmp_path, capsys):
+    from volerr.example_files import write_examples
+
+    write_examples(tmp_path)
+    task = str(tmp_path / "task_distance.csv")
+    argv = ["uncertainty", "MH2", "--task", task, "--evaluate", "distance", "--spec",
+            "E0=2+L/300", "--samples", "200"]
+    doc, printed = _cli_json(tmp_path, argv, capsys)
+    r = volerr.uncertainty("MH2", task, "distance", spec="E0=2+L/300", samples=200)
+    assert r.to_dict() == doc
+    assert r.summary() == printed.rstrip("\n")
+    assert "u 1." in printed and "(k = 1)" in printed and "(k = 2)" in printed
