@@ -16,6 +16,7 @@ class Iso230_2(ResultMixin):
     data: dict
     evaluations: list
     notes: list = field(default_factory=list)
+    identification: dict | None = None
 
     def summary(self) -> str:
         """What ``volerr iso230-2`` prints."""
@@ -36,19 +37,33 @@ class Iso230_2(ResultMixin):
                                None if u is None else u / k, "um", 1.0))
         return out
 
+    def png(self) -> bytes:
+        """The plot of the runs (deviation against target per direction, the verdicts)."""
+        from . import plot_runs
+
+        per_run = self.data["runs"] if "runs" in self.data else [self.data]
+        return plot_runs(self.evaluations, verdicts_per_run=[r.get("verdicts") for r in per_run])
+
     def write_html(self, path, inputs=()):
-        from . import plot_runs, report_html
+        """The certificate page (``--html``)."""
+        import datetime
+        from importlib.metadata import version
+
+        from . import report_html
         from ..fileio import write_text
 
-        png = plot_runs(self.evaluations)
-        return write_text(path, report_html(self.data, png, list(inputs)), inputs=list(inputs))
+        made = f"Evaluated with volerr {version('volerr')} on {datetime.date.today().isoformat()}."
+        return write_text(path, report_html(self.data, self.png(), list(inputs), made,
+                                            identification=self.identification),
+                          inputs=list(inputs))
 
 
 def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
              instrument_ppm: float = 0.5, alignment_mm: float = 0.1,
              temperature_u_K: float = 0.2, cte_u_ppm_per_K: float = 1.0,
              eve_um: float | None = None, cte_ppm_per_K: float | None = None,
-             material_temp_C: float | None = None, cte_reference_mm: float = 0.0) -> Iso230_2:
+             material_temp_C: float | None = None, cte_reference_mm: float = 0.0,
+             identification=None) -> Iso230_2:
     """ISO 230-2 evaluation of positioning runs (``volerr iso230-2``).
 
     Parameters
@@ -64,6 +79,9 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
         The ISO/TR 230-9 uncertainty budget (ppm, mm, K, ppm/K, um), as the command's options.
     cte_ppm_per_K, material_temp_C, cte_reference_mm
         Correction to 20 degC (ppm/K, degC, mm).
+    identification : dict, optional
+        What identifies the instrument and the machine in the report (as the command's
+        identification options give it).
 
     Returns
     -------
@@ -87,5 +105,6 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
            if tolerance is not None else None)
     rs = evaluate_files(inputs, axes, cte_ppm_per_K, material_temp_C, cte_reference_mm)
     report = rs.report(inputs=BudgetInputs(instrument_ppm, alignment_mm, temperature_u_K,
-                                           cte_u_ppm_per_K, eve_um), tolerance=tol)
-    return Iso230_2(report, rs.evaluations)
+                                           cte_u_ppm_per_K, eve_um), tolerance=tol,
+                       identification=identification)
+    return Iso230_2(report, rs.evaluations, identification=identification)

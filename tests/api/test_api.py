@@ -159,3 +159,39 @@ def test_uncertainty_equals_the_command(tmp_path, capsys):
     assert r.to_dict() == doc
     assert r.summary() == printed.rstrip("\n")
     assert "u 1." in printed and "(k = 1)" in printed and "(k = 2)" in printed
+
+
+@pytest.fixture(scope="module")
+def example_dir(tmp_path_factory):
+    from volerr.example_files import write_examples
+
+    d = tmp_path_factory.mktemp("api_examples")
+    write_examples(d)
+    return d
+
+
+@pytest.mark.parametrize("argv,call", [
+    (["ballbar", "evaluate", "ballbar_example_XY.csv"],
+     lambda: volerr.ballbar_evaluate("ballbar_example_XY.csv")),
+    (["iso230-2", "iso230_2_run_X.csv"], lambda: volerr.iso230_2("iso230_2_run_X.csv")),
+])
+def test_evaluations_equal_the_commands(argv, call, example_dir, monkeypatch, capsys):
+    monkeypatch.chdir(example_dir)
+    doc, printed = _cli_json(example_dir, argv, capsys)
+    r = call()
+    doc.pop("identification", None)   # the command's --instrument/--machine/--operator (none)
+    assert r.to_dict() == doc
+    assert r.summary() == printed.rstrip("\n")
+    assert all(("k = " in ln) for ln in printed.splitlines() if "+-" in ln or "(U " in ln)
+
+
+def test_identify_equals_the_command(example_dir, monkeypatch, capsys):
+    monkeypatch.chdir(example_dir)
+    capsys.readouterr()
+    assert main(["identify", "MB1", "--axis", "X", "tracker_example_X.csv", "--out",
+                 "X_api.csv", "--json", "id.json"]) == 0
+    printed = capsys.readouterr().out
+    r = volerr.identify("MB1", "X", "tracker_example_X.csv")
+    assert r.to_dict() == json.loads(Path("id.json").read_text())
+    assert r.error_table_csv() == Path("X_api.csv").read_text()
+    assert r.summary().split(" -> ")[0] == printed.split(" -> ")[0]
