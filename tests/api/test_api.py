@@ -5,6 +5,7 @@ the README's and the manual's Python blocks run."""
 from __future__ import annotations
 
 import json
+import math
 import re
 import subprocess
 import sys
@@ -49,19 +50,26 @@ def test_every_plus_minus_printed_says_its_k(capsys):
     assert lines and all("k = 1" in ln for ln in lines), lines
 
 
-def test_a_variance_factor_below_one_keeps_the_stated_uncertainties():
-    """The DMU50 example scatters less than stated (variance factor 0.28): the stds are the
-    a-priori ones, so they equal those of the same campaign re-weighted to a factor of exactly
-    1 by hand (the readings' residuals scaled up so that s0 = 1 would be reached only by
-    shrinking): independent of s0 below 1, and printed as such."""
-    cal = volerr.calibrate("DMU50", [SPHERE])
-    vf = cal["variance_factor"]
-    assert vf < 1 and not cal["uncertainty_scaled"]
-    # the covariance of the kept columns is the a-priori one: (A^T W A)^-1 u_ref^2 with
-    # weights of the stated u; s0 enters only through max(s0, 1) = 1
-    sol = cal.solution
-    assert sol.s0 ** 2 == pytest.approx(vf, abs=1e-4)
-    assert "are kept, not shrunk" in cal.summary()
+def test_a_variance_factor_below_one_keeps_the_stated_uncertainties(tmp_path):
+    """The DMU50 example scatters less than stated (u = 1 um per coordinate by default;
+    variance factor s0^2 = 0.28): its stds are the a-priori ones.  The same readings stated
+    at u = 0.5 um have s0^2 = 4 x 0.28 > 1, so their stds are the a-priori ones (half) widened
+    by s0: std(0.5) / std(1) = sqrt(4 s0^2) / 2 = s0.  Scaling by s0 below 1 too (the former
+    rule) would give the same stds for both files (ratio 1)."""
+    lines = Path(SPHERE).read_text().splitlines()
+    half = tmp_path / "sphere_u05.csv"
+    half.write_text("\n".join([lines[0] + ",u_um"] + [ln + ",0.5" for ln in lines[1:]]) + "\n")
+    a = volerr.calibrate("DMU50", [SPHERE])
+    b = volerr.calibrate("DMU50", [str(half)])
+    vf = a["variance_factor"]
+    assert vf < 1 and not a["uncertainty_scaled"]
+    assert b["variance_factor"] == pytest.approx(4 * vf, rel=1e-3) and b["uncertainty_scaled"]
+    for name, pa in a["parameters"].items():
+        pb = b["parameters"][name]
+        assert pb["value"] == pytest.approx(pa["value"], rel=1e-9)   # the same weights' ratio
+        assert pb["std"] / pa["std"] == pytest.approx(math.sqrt(vf), rel=2e-3), name
+    assert "are kept, not shrunk" in a.summary()
+    assert "are kept, not shrunk" not in b.summary()
 
 
 def test_combination_by_names_equals_the_reported_combination():
