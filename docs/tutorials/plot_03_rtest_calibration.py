@@ -20,8 +20,7 @@ print(cal.summary())
 # %%
 # The determined combination of the two Y locations, and the table of values.
 print(cal.combination({"EY0B": 1, "EY0C": 1}))
-for row in cal._rows():
-    print(row)
+print(cal.table())   # a pandas DataFrame where pandas is installed
 
 # %%
 # The figures of the report.

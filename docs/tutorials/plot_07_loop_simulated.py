@@ -15,8 +15,7 @@ from _common import examples
 examples()
 res = volerr.loop("MB1", "deviations_MB1.csv")
 print(res.summary())
-for row in res._rows():
-    print(row)
+print(res.table())   # a pandas DataFrame where pandas is installed
 d = res.to_dict()
 fig, ax = plt.subplots(figsize=(4, 3))
 ax.bar(["before", "after"], [d["rms_before_um"], d["rms_after_um"]])

@@ -321,14 +321,50 @@ def reading_weights(obs) -> tuple[np.ndarray, float]:
 def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,
               max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
               extra_terms=(), plan: bool = True, progress=None) -> Calibration:
-    """Identify ``layout``'s parameters from measurement ``files`` (paths or ``KIND:FILE``;
-    or an :class:`volerr.instruments.Observations`).  Returns a :class:`Calibration`.
+    """Identify ``layout``'s parameters from measurement files of any instruments, mixed in
+    one campaign, by weighted least squares (``volerr calibrate``; ``volerr.calibrate(...)``).
 
-    ``extra_terms``: more columns ``(name, target, basis, (factor, unit))``: a parameter
-    ``name`` that adds ``name * basis`` to the declared parameter ``target`` (e.g. a reversal
-    ``("RV_X", "EXX", "dir_X/2", (1e3, "um"))``); the basis is an expression in the axis
-    positions (rad for rotary axes) and the covariates of the files.  ``plan``: suggest the
-    plan extensions that would determine what the campaign does not."""
+    Parameters
+    ----------
+    layout : str or path
+        Layout name (``volerr.layouts()``) or layout file.
+    files : list of str or path, or volerr.instruments.Observations
+        Measurement files (``KIND:FILE`` names the kind: deviations, ballbar, sphere,
+        artifact, interferometer, distances; 'volerr formats NAME').  Each file states its
+        reading's sign and frame in its format; readings in um / urad, positions mm / deg.
+    parameters : str, optional
+        The parameters fitted (the others held at zero), as ``--parameters``: names
+        (``EC0Y``), terms (``EXX@slope``), reversals (``RV_X``), axes (``X``) and groups
+        (``all``, ``squareness`` ...); default: what each instrument kind is used for.
+    degree : int, optional
+        Degree of the component errors' Legendre series (default: by cross-validation,
+        1 .. ``max_degree``).
+    seed : int
+        Seed of the held-out split (a random ``test_fraction`` of the points).
+    extra_terms : sequence, optional
+        More columns ``(name, target, basis, (factor, unit))``: a parameter ``name`` that
+        adds ``name * basis`` to the declared parameter ``target`` (e.g. a reversal
+        ``("RV_X", "EXX", "dir_X/2", (1e3, "um"))``); the basis is an expression in the axis
+        positions (rad for rotary axes) and the covariates of the files.
+    plan : bool
+        Suggest the plan extensions that would determine what the campaign does not.
+    progress : bool, optional
+        Progress bar on stderr (None: when stderr is a terminal).
+
+    Returns
+    -------
+    Calibration
+        ``to_dict()`` is ``--json``: ``parameters`` name -> ``{"value", "std", "unit"}``
+        (std a standard uncertainty, k = 1; translational parameters in um, angular in urad,
+        slopes um/mm ...; signs per ISO 230-1, 'volerr formats calibrate-json'),
+        ``unidentifiable``, ``combinations``, set-ups, residuals, consistency.  The
+        covariance is scaled by the a-posteriori variance factor only when it exceeds 1.
+
+    Raises
+    ------
+    volerr.InputError
+        Bad input, with the command's one-line message.
+    """
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
