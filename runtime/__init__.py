@@ -11,7 +11,8 @@ volerr`` stays light):
 * :func:`volerr.calibrate` (``volerr calibrate``), :func:`volerr.plan` (``volerr plan``),
   :func:`volerr.loop` (``volerr loop``), :func:`volerr.identify` (``volerr identify``),
   :func:`volerr.uncertainty` (``volerr uncertainty``): callable sub-packages (:mod:`volerr.results`);
-* :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`.
+* :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`,
+  :func:`volerr.error_map` (``volerr map``).
 
 Bad input raises :class:`volerr.InputError` with the command's one-line message.
 """
@@ -28,7 +29,7 @@ __version__ = "0.1.0"
 _PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty")
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
-              "iso230_2": "positioning.api"}
+              "iso230_2": "positioning.api", "error_map": "cmm.api"}
 
 __all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_FUNCTIONS]
 

@@ -35,3 +35,8 @@ fig.colorbar(c, label="|volumetric error| (µm)")
 ax.set_xlabel("X (mm)")
 ax.set_ylabel("Y (mm)")
 ax.set_title("MB1: volumetric error at mid Z")
+
+# %%
+# The same through the API of ``volerr map`` (max components and RMS over a 9^3 grid, um):
+res = volerr.error_map("MB1", folder, grid=9, probe=(0.0, 0.0, -100.0))
+print(res.summary())

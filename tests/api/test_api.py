@@ -131,7 +131,7 @@ def test_packages_are_callable_whatever_was_imported_first():
             "from volerr.calibrate import terms\n"
             "assert all(callable(getattr(volerr, n)) for n in "
             "('calibrate', 'plan', 'loop', 'identify', 'uncertainty', 'compensate', 'ballbar_evaluate', "
-            "'iso230_2'))\n"
+            "'iso230_2', 'error_map'))\n"
             "assert volerr.calibrate.run.calibrate is volerr.calibrate.__api__\n"
             "print('ok')\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
@@ -182,6 +182,8 @@ def example_dir(tmp_path_factory):
     (["ballbar", "evaluate", "ballbar_example_XY.csv"],
      lambda: volerr.ballbar_evaluate("ballbar_example_XY.csv")),
     (["iso230-2", "iso230_2_run_X.csv"], lambda: volerr.iso230_2("iso230_2_run_X.csv")),
+    (["map", "MB1", "--errors", "errors_MB1", "--grid", "5"],
+     lambda: volerr.error_map("MB1", "errors_MB1", grid=5)),
 ])
 def test_evaluations_equal_the_commands(argv, call, example_dir, monkeypatch, capsys):
     monkeypatch.chdir(example_dir)
@@ -189,7 +191,7 @@ def test_evaluations_equal_the_commands(argv, call, example_dir, monkeypatch, ca
     r = call()
     doc.pop("identification", None)   # the command's --instrument/--machine/--operator (none)
     assert r.to_dict() == doc
-    assert r.summary() == printed.rstrip("\n")
+    assert printed.startswith(r.summary())
     assert all(("k = " in ln) for ln in printed.splitlines() if "+-" in ln or "(U " in ln)
 
 
@@ -203,3 +205,11 @@ def test_identify_equals_the_command(example_dir, monkeypatch, capsys):
     assert r.to_dict() == json.loads(Path("id.json").read_text())
     assert r.error_table_csv() == Path("X_api.csv").read_text()
     assert r.summary().split(" -> ")[0] == printed.split(" -> ")[0]
+
+
+def test_the_readme_fits_on_a_screen():
+    """At most 15 KB (issue 38): the rest is in the manual (docs/), each capability linked."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.encode("utf-8")) <= 15 * 1024
+    for link in re.findall(r"\]\(((?:docs/)[^)#]+)\)", text):
+        assert (ROOT / link).exists(), link
