@@ -69,7 +69,7 @@ def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
     Returns
     -------
     ErrorMap
-        ``to_dict()`` is ``--json``: max |dx|, |dy|, |dz|, max and RMS |d| (um; actual minus
+        ``to_dict()`` is ``--json``: max ``|dx|``, ``|dy|``, ``|dz|``, max and RMS ``|d|`` (um; actual minus
         nominal probe tip), and the random part's maximum (k = 1).
     """
     from ..machine.model import Model, load
