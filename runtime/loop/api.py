@@ -12,7 +12,9 @@ from .run import Report, run_loop
 @dataclass(repr=False)
 class Loop(Report):
     """Result of :func:`loop`: a :class:`volerr.loop.Report` whose :meth:`summary` is the
-    whole console text of ``volerr loop``."""
+    whole console text of ``volerr loop``.  Its ``figures`` attribute is the data behind the
+    report's figures (:class:`volerr.loop.run.Figures`, a field of the report that predates
+    the API), not a method: ``write_html`` draws them."""
 
     def headline(self) -> str:
         """The first line: points, held-out RMS and max before -> after (um), effects."""
