@@ -12,7 +12,8 @@ volerr`` stays light):
   :func:`volerr.loop` (``volerr loop``), :func:`volerr.identify` (``volerr identify``),
   :func:`volerr.uncertainty` (``volerr uncertainty``): callable sub-packages (:mod:`volerr.results`);
 * :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`,
-  :func:`volerr.error_map` (``volerr map``), :func:`volerr.probe_cal` (``volerr probe-cal``).
+  :func:`volerr.error_map` (``volerr map``), :func:`volerr.diagonals`,
+  :func:`volerr.probe_cal` (``volerr probe-cal``).
 
 Bad input raises :class:`volerr.InputError` with the command's one-line message.
 """
@@ -30,7 +31,7 @@ _PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty")
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api", "error_map": "cmm.api",
-              "probe_cal": "probe.api"}
+              "probe_cal": "probe.api", "diagonals": "cmm.api"}
 
 __all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_FUNCTIONS]
 

@@ -86,3 +86,75 @@ def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
     if approach:
         s["approach"] = {a: ("+" if v > 0 else "-") for a, v in approach.items()}
     return ErrorMap(s, vmap)
+
+
+@dataclass(repr=False)
+class Diagonals(ResultMixin):
+    """Result of :func:`diagonals`: ``data`` the ``--json`` document (per line its length
+    deviation dL = actual minus nominal distance of the probe tip, um, with its random part
+    u(dL), k = 1, where the tables carry standard deviations, and the profile along it),
+    ``lines`` the evaluated lines."""
+
+    data: dict
+    lines: list
+
+    def summary(self) -> str:
+        """What ``volerr diagonals`` prints (without the lines naming the written files)."""
+        from .diagonals import format_table
+
+        probe = " ".join(f"{v:g}" for v in self.data["probe_mm"])
+        return (f"{self.data['layout']}: length deviation dL = actual - nominal distance of "
+                f"the probe tip (first order), probe {probe} mm\n{format_table(self.lines)}")
+
+    def _rows(self) -> list:
+        return []
+
+
+def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
+              volume: str = "travel", profile_points: int = 21, method: str = "linear",
+              degree: int | None = None, extrapolate: bool = False) -> Diagonals:
+    """Length deviations of the space diagonals (Pahk sec. 4), face diagonals and
+    axis-parallel lines of the working volume (``volerr diagonals``).
+
+    Parameters
+    ----------
+    layout : str, path or volerr.Model
+        Layout name or file (or a loaded model).
+    errors : path or volerr.tables.ErrorFunctions
+        Error directory or error functions made from one.
+    lines : sequence of str, optional
+        Which lines (:data:`volerr.cmm.diagonals.KINDS`; default all).
+    probe : (3,) mm
+        Probe / tool offset.
+    at : dict, optional
+        Positions of the rotary axes, deg.
+    volume : {"travel", "measured"}
+        The box of the lines.
+    profile_points : int
+        Points along each line for its profile (2 .. 10000).
+    method, degree, extrapolate
+        How the tables are interpolated.
+
+    Returns
+    -------
+    Diagonals
+        ``to_dict()`` is ``--json``; dL in um (positive: the line measures long).
+    """
+    from ..errors import require
+    from ..machine.model import Model, load
+    from ..tables.functions import ErrorFunctions
+    from . import diagonals as dg
+    from .volmap import linear_axes, volume as box
+
+    require(2 <= profile_points <= 10000, "--profile-points must be between 2 and 10000")
+    model = layout if isinstance(layout, Model) else load(layout)
+    funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
+        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+    found = dg.box_lines(box(model, funcs, volume), linear_axes(model),
+                         tuple(lines or dg.KINDS))
+    results = dg.evaluate_lines(model, funcs, found, tuple(probe), dict(at or {}),
+                                profile_points)
+    doc = {"layout": model.name, "probe_mm": [float(v) for v in probe],
+           "errors": (funcs.source or "") if errors is funcs else str(errors), "method": method,
+           "lines": [r.as_dict() for r in results]}
+    return Diagonals(doc, results)

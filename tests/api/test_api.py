@@ -131,7 +131,7 @@ def test_packages_are_callable_whatever_was_imported_first():
             "from volerr.calibrate import terms\n"
             "assert all(callable(getattr(volerr, n)) for n in "
             "('calibrate', 'plan', 'loop', 'identify', 'uncertainty', 'compensate', 'ballbar_evaluate', "
-            "'iso230_2', 'error_map', 'probe_cal'))\n"
+            "'iso230_2', 'error_map', 'probe_cal', 'diagonals'))\n"
             "assert volerr.calibrate.run.calibrate is volerr.calibrate.__api__\n"
             "print('ok')\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
@@ -184,6 +184,8 @@ def example_dir(tmp_path_factory):
     (["iso230-2", "iso230_2_run_X.csv"], lambda: volerr.iso230_2("iso230_2_run_X.csv")),
     (["map", "MB1", "--errors", "errors_MB1", "--grid", "5"],
      lambda: volerr.error_map("MB1", "errors_MB1", grid=5)),
+    (["diagonals", "MB1", "--errors", "errors_MB1"],
+     lambda: volerr.diagonals("MB1", "errors_MB1")),
     (["probe-cal", "probe_sphere.csv", "--sphere-radius", "25.006", "--out", "pm.csv"],
      lambda: volerr.probe_cal("probe_sphere.csv", 25.006)),
 ])
