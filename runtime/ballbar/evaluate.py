@@ -12,19 +12,55 @@ from .. import instruments
 from ..errors import require
 from ..instruments import ballbar as reader
 from ..machine.model import load
+from ..results import ResultMixin
 from . import diagnosis, iso230_4
 
 #: the layout standing in for a Cartesian machine when none is given (its travel not enforced)
 DEFAULT_LAYOUT = "MB1"
 
 
-@dataclass
-class Evaluation:
-    """``data`` the JSON report; ``traces`` the ISO 230-4 traces (for the polar plot)."""
+@dataclass(repr=False)
+class Evaluation(ResultMixin):
+    """``data`` the JSON report; ``traces`` the ISO 230-4 traces (for the polar plot).
+
+    :meth:`summary` is what ``volerr ballbar evaluate`` prints; :meth:`table` the diagnosed
+    parameters with their standard uncertainties (k = 1); :meth:`figures` the polar plot."""
 
     data: dict
     traces: list
     results: list
+
+    def summary(self) -> str:
+        """G, H and F per trace (um) and the diagnosis (value +- u, k = 1)."""
+        out = []
+        for r in self.data["traces"]:
+            h = f", H {r['H_um']:.3f} um" if "H_um" in r else ""
+            out.append(f"{r['file']} {r['placement']} {r['plane']} {r['direction']}: G "
+                       f"{r['G_um']:.3f} um{h}, F {r['F_min_um']:.3f} .. {r['F_max_um']:.3f} um")
+        for d in self.data["diagnosis"]:
+            out.append(f"  {d['parameter']} = {d['value']:.4g} +- {d['std']:.2g} {d['unit']} "
+                       f"(u, k = 1)")
+        if self.data.get("diagnosis_note"):
+            out.append(f"  no diagnosis: {self.data['diagnosis_note']}")
+        return "\n".join(out)
+
+    def _rows(self) -> list:
+        from ..results import Row
+
+        return [Row(d["parameter"], d["value"], d["std"], d["unit"], 1.0)
+                for d in self.data["diagnosis"]]
+
+    def figures(self) -> dict:
+        """``{"polar": Figure}``: the traces' polar plot."""
+        from .plots import polar_figure
+
+        return {"polar": polar_figure(self.traces, self.results)}
+
+    def write_html(self, path, inputs=()):
+        """The report page (polar plot, ISO 230-4 table, diagnosis)."""
+        from .report import write_html
+
+        return write_html(path, self, inputs=inputs)
 
     def write_json(self, path, inputs=()) -> Path:
         from ..fileio import json_text, write_text

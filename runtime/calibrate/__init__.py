@@ -7,3 +7,8 @@ the campaign cannot determine and which file sees what (``volerr calibrate``).  
 from .run import Calibration, calibrate
 
 __all__ = ["Calibration", "calibrate"]
+
+from ..results import callable_package  # noqa: E402
+
+# volerr.calibrate(...) is calibrate(...), whatever was imported before (runtime/results.py)
+callable_package(__name__, calibrate)

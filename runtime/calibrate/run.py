@@ -16,8 +16,10 @@ Steps (:func:`calibrate`):
 5. estimability of every parameter from the stacked Gram matrix and which file sees it
    (:mod:`volerr.calibrate.estimability`); the solution takes the columns in the gauge order
    and leaves out those in the span of the ones before (their value 0);
-6. the covariance ``s0^2 (A^T W A)^-1`` with the a-posteriori variance factor ``s0^2`` (weighted
-   residual sum of squares per degree of freedom), set-up estimates per file / placement,
+6. the covariance ``max(s0^2, 1) (A^T W A)^-1`` with the a-posteriori variance factor ``s0^2``
+   (weighted residual sum of squares per degree of freedom): a factor above 1 widens the
+   stated uncertainties, one below 1 never shrinks them (GUM practice: the a-priori
+   uncertainties are kept, JCGM 100 4.2, Birge 1932); set-up estimates per file / placement,
    residual RMS per file on all readings and on the held-out ones.
 
 Units: readings mm inside; reports um, urad, um/mm ... (:mod:`volerr.calibrate.terms`).
@@ -38,16 +40,22 @@ from ..estimate import blocks
 from ..estimate.design import data_ranges, declared_design, gauge_mask, identifiability_gram
 from ..estimate.steps import choose_degree, split_points
 from ..machine.model import Model, load
+from ..results import ResultMixin
 from . import estimability, terms
 
 #: relative eigenvalue below which the solution leaves a direction out (unit-scaled columns)
 SOLVE_TOL = 1e-12
 
 
-@dataclass
-class Calibration:
+@dataclass(repr=False)
+class Calibration(ResultMixin):
     """Result of :func:`calibrate`: ``data`` the JSON report (INTERFACE.md keys first) and what
-    the error tables and the HTML page need."""
+    the error tables and the HTML page need.
+
+    The JSON keys are attributes too (``cal.parameters``: name -> ``{"value", "std", "unit"}``
+    with the standard uncertainty ``std`` at k = 1); :meth:`summary` is what ``volerr
+    calibrate`` prints, :meth:`table` one row per identified parameter, :meth:`figures` the
+    report's figures."""
 
     data: dict
     model: Model
@@ -79,22 +87,62 @@ class Calibration:
         return np.where(self.written, self.coef, 0.0)
 
     def combination(self, weights: dict) -> tuple[float, float] | None:
-        """(value, standard uncertainty) of ``sum w_label * coefficient`` (mm / rad), or None
-        when the campaign does not determine that combination."""
+        """Value and standard uncertainty (k = 1) of a linear combination of the fitted
+        parameters.
+
+        Parameters
+        ----------
+        weights : dict
+            ``{name: w}``: a parameter's report name (``"EY0B"``, ``"EXX@slope"``, as in
+            :attr:`parameters` and :attr:`unidentifiable`) or its design label (a tuple, as in
+            :attr:`labels`) -> its weight ``w`` (dimensionless).
+
+        Returns
+        -------
+        (value, std) : tuple of float or None
+            ``sum w * coefficient`` in the coefficients' natural units (mm for translational
+            parameters, rad for angular ones; mm/mm or rad/mm for slopes), or None when the
+            campaign does not determine that combination (or a name is unknown).
+
+        Examples
+        --------
+        ``cal.combination({"EY0B": 1, "EY0C": 1})``: the sum of two location errors that only
+        a combination of set-ups determines.
+        """
         sol = self.solution
+        names = self._label_names()
         c = np.zeros(len(self.labels))
         for lab, w in weights.items():
-            if lab not in self.labels:
+            j = names.get(lab) if isinstance(lab, str) else (
+                self.labels.index(lab) if lab in self.labels else None)
+            if j is None:
                 return None
-            c[self.labels.index(lab)] = w
+            c[j] = w
         d = np.where(sol.norms > 0, sol.norms, 1.0)
         if np.linalg.norm(sol.null.T @ (c / d)) > 1e-6 * np.linalg.norm(c / d):
             return None
         ck = c[sol.kept]
         return float(c @ self.coef), float(np.sqrt(max(ck @ sol.cov @ ck, 0.0)))
 
+    def _label_names(self) -> dict:
+        """report name -> design column (parameters only)."""
+        name_of = terms.namer(self.model, self.ranges)
+        return {name_of(lab): j for j, lab in enumerate(self.labels) if lab[0] != "setup"}
+
     def __getitem__(self, key):
         return self.data[key]
+
+    def figures(self) -> dict:
+        """``{"parameters", "residuals"}``: the identified values with +-2 u bars (k = 2) and
+        the residual of every reading per file (:class:`matplotlib.figure.Figure`)."""
+        from .report import parameter_figure, residual_figure
+
+        out = {}
+        if self.data["parameters"]:
+            out["parameters"] = parameter_figure(self.data["parameters"])
+        if self.residuals:
+            out["residuals"] = residual_figure(self)
+        return out
 
     def error_tables(self, n_grid: int = 41):
         """The identified error functions as error tables over the measured range and the
@@ -191,6 +239,36 @@ class Calibration:
         return write_text(path, render_html(self), inputs=list(inputs))
 
     def summary(self) -> str:
+        """What ``volerr calibrate`` prints: the headline, each identified value with its
+        standard uncertainty (k = 1), the inconsistent files and what is not determined."""
+        return "\n".join([self.headline(), *self.console_lines()])
+
+    def console_lines(self) -> list:
+        """The lines ``volerr calibrate`` prints below :meth:`headline`."""
+        out, hidden = [], []
+        if self.data.get("variance_factor", 1.0) < 1.0:
+            out.append(f"  a-posteriori variance factor {self.data['variance_factor']:.3g} < 1: "
+                       f"the readings scatter less than their stated uncertainty; the stated "
+                       f"(a-priori) uncertainties are kept, not shrunk")
+        for name, v in self.data["parameters"].items():
+            if "@" not in name or name.endswith("@slope"):
+                out.append(f"  {name} = {v['value']:.4g} +- {v['std']:.2g} {v['unit']} "
+                           f"(u, k = 1)")
+            else:
+                hidden.append(name)
+        if hidden:
+            out.append(f"  and {len(hidden)} higher series terms ({', '.join(hidden[:6])}"
+                       f"{' ...' if len(hidden) > 6 else ''}: in --json and --html)")
+        bad = self.data.get("consistency", {}).get("inconsistent")
+        if bad:
+            worst = {e["file"]: e for e in self.data["consistency"]["files"]}
+            out.append("  inconsistent with the rest (leave-one-file-out test): " + ", ".join(
+                f"{f} (p = {worst[f]['p_value']:.2g}, Birge ratio {worst[f]['birge_ratio']})"
+                for f in bad))
+        return out + self.undetermined_lines()
+
+    def headline(self) -> str:
+        """The first line of :meth:`summary`: layout, counts, RMS residual per file."""
         d = self.data
         files = "; ".join(f"{i['file']} ({i['kind']}, {i['n']} rows): RMS "
                           f"{i['rms_residual']:.3f} um, held-out {i['heldout_rms']:.3f} um"
@@ -205,7 +283,7 @@ class Calibration:
         written as 0 (what the error directory, the map and the ISO 10360 numbers hold)."""
         d = self.data
         out = [f"  determined only in combination: {c['expression']} = {c['value']:.4g} +- "
-               f"{c['std']:.2g} {c['unit']} (written as {c['written_as']})"
+               f"{c['std']:.2g} {c['unit']} (u, k = 1; written as {c['written_as']})"
                for c in d.get("combinations", [])]
         written = {c["written_as"] for c in d.get("combinations", [])}
         zero = [n for n in d["unidentifiable"] if n not in written]
@@ -243,14 +321,50 @@ def reading_weights(obs) -> tuple[np.ndarray, float]:
 def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,
               max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
               extra_terms=(), plan: bool = True, progress=None) -> Calibration:
-    """Identify ``layout``'s parameters from measurement ``files`` (paths or ``KIND:FILE``;
-    or an :class:`volerr.instruments.Observations`).  Returns a :class:`Calibration`.
+    """Identify ``layout``'s parameters from measurement files of any instruments, mixed in
+    one campaign, by weighted least squares (``volerr calibrate``; ``volerr.calibrate(...)``).
 
-    ``extra_terms``: more columns ``(name, target, basis, (factor, unit))``: a parameter
-    ``name`` that adds ``name * basis`` to the declared parameter ``target`` (e.g. a reversal
-    ``("RV_X", "EXX", "dir_X/2", (1e3, "um"))``); the basis is an expression in the axis
-    positions (rad for rotary axes) and the covariates of the files.  ``plan``: suggest the
-    plan extensions that would determine what the campaign does not."""
+    Parameters
+    ----------
+    layout : str or path
+        Layout name (``volerr.layouts()``) or layout file.
+    files : list of str or path, or volerr.instruments.Observations
+        Measurement files (``KIND:FILE`` names the kind: deviations, ballbar, sphere,
+        artifact, interferometer, distances; 'volerr formats NAME').  Each file states its
+        reading's sign and frame in its format; readings in um / urad, positions mm / deg.
+    parameters : str, optional
+        The parameters fitted (the others held at zero), as ``--parameters``: names
+        (``EC0Y``), terms (``EXX@slope``), reversals (``RV_X``), axes (``X``) and groups
+        (``all``, ``squareness`` ...); default: what each instrument kind is used for.
+    degree : int, optional
+        Degree of the component errors' Legendre series (default: by cross-validation,
+        1 .. ``max_degree``).
+    seed : int
+        Seed of the held-out split (a random ``test_fraction`` of the points).
+    extra_terms : sequence, optional
+        More columns ``(name, target, basis, (factor, unit))``: a parameter ``name`` that
+        adds ``name * basis`` to the declared parameter ``target`` (e.g. a reversal
+        ``("RV_X", "EXX", "dir_X/2", (1e3, "um"))``); the basis is an expression in the axis
+        positions (rad for rotary axes) and the covariates of the files.
+    plan : bool
+        Suggest the plan extensions that would determine what the campaign does not.
+    progress : bool, optional
+        Progress bar on stderr (None: when stderr is a terminal).
+
+    Returns
+    -------
+    Calibration
+        ``to_dict()`` is ``--json``: ``parameters`` name -> ``{"value", "std", "unit"}``
+        (std a standard uncertainty, k = 1; translational parameters in um, angular in urad,
+        slopes um/mm ...; signs per ISO 230-1, 'volerr formats calibrate-json'),
+        ``unidentifiable``, ``combinations``, set-ups, residuals, consistency.  The
+        covariance is scaled by the a-posteriori variance factor only when it exceeds 1.
+
+    Raises
+    ------
+    volerr.InputError
+        Bad input, with the command's one-line message.
+    """
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
@@ -644,10 +758,11 @@ def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float, prefer=None)
         residuals[f] = (pts, factor * r_all, k)
     rank = int(np.sum(np.linalg.eigvalsh(Gk) > SOLVE_TOL * np.linalg.eigvalsh(Gk)[-1]))
     dof = max(float(obs.n_readings - rank), 1.0)
-    s0 = math.sqrt(rss_w / dof)                 # mm: the weights are relative to u_ref
-    cov = Gi / np.outer(sc, sc) * s0 ** 2
+    s0 = math.sqrt(rss_w / dof) / u_ref         # the a-posteriori factor, dimensionless
+    # GUM practice: a scatter below the stated reading uncertainty (s0 < 1) never shrinks the
+    # stated uncertainties (the a-priori covariance is kept); s0 > 1 widens them
+    cov = Gi / np.outer(sc, sc) * (max(s0, 1.0) * u_ref) ** 2
     std = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    s0 /= u_ref                                  # the a-posteriori factor, dimensionless
     return Solution(kept, cov, estimability.null_space(fit.G),
                     np.sqrt(np.maximum(np.diag(fit.G), 0.0)), coef, coef_tr, std, est, partners,
                     seen, s0, dof, rms_all, rms_test, n_test, residuals, rss_files, Gi, mixes)
@@ -725,10 +840,12 @@ def _report(model, obs, labels, ranges, degree, degree_scores, chosen, gauge, ou
         "degree_cv_rms_um": {str(k): round(1e3 * v, 4) for k, v in degree_scores.items()},
         "gauge_fixed": [name_of(g) for g in gauge],
         "variance_factor": round(out.s0 ** 2, 4),
+        "uncertainty_scaled": bool(out.s0 > 1.0),
         "dof": out.dof,
         "method": ("weighted least squares (weights 1/u^2 per reading) over all files; "
-                   "standard uncertainties from the covariance scaled by the a-posteriori "
-                   "variance factor; held-out: a random {:.0%} of the points, fitted on the "
+                   "standard uncertainties (k = 1) from the covariance scaled by the "
+                   "a-posteriori variance factor when it exceeds 1 (a factor below 1 never "
+                   "shrinks the stated uncertainties: the a-priori ones are kept); held-out: a random {:.0%} of the points, fitted on the "
                    "others").format(len(spl.test) / max(obs.n, 1)),
     }
 

@@ -104,13 +104,12 @@ def run_simulate(args) -> int:
 
 
 def run_evaluate(args) -> int:
-    from ..ballbar.evaluate import check_layout_for, evaluate
+    from ..ballbar.api import ballbar_evaluate
 
     inputs = list(args.files) + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).check()
-    check_layout_for(args.files, args.layout)
-    ev = evaluate(args.files, args.layout)
+    ev = ballbar_evaluate(args.files, args.layout)
     with outs:
         if args.json:
             ev.write_json(outs.path("--json"), inputs=inputs)
@@ -122,12 +121,5 @@ def run_evaluate(args) -> int:
             from ..ballbar.report import write_html
 
             write_html(outs.path("--html"), ev, inputs=inputs)
-    for r in ev.data["traces"]:
-        h = f", H {r['H_um']:.3f} um" if "H_um" in r else ""
-        print(f"{r['file']} {r['placement']} {r['plane']} {r['direction']}: G {r['G_um']:.3f} um"
-              f"{h}, F {r['F_min_um']:.3f} .. {r['F_max_um']:.3f} um")
-    for d in ev.data["diagnosis"]:
-        print(f"  {d['parameter']} = {d['value']:.4g} +- {d['std']:.2g} {d['unit']}")
-    if ev.data.get("diagnosis_note"):
-        print(f"  no diagnosis: {ev.data['diagnosis_note']}")
+    print(ev.summary())
     return 0

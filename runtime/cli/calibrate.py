@@ -81,21 +81,4 @@ def run(args) -> int:
 
             write_csv(outs.path("--map-out"), result, (args.map_grid,) * 3, inputs=inputs)
     print(result.summary())
-    hidden = []
-    for name, v in result["parameters"].items():
-        if "@" not in name or name.endswith("@slope"):
-            print(f"  {name} = {v['value']:.4g} +- {v['std']:.2g} {v['unit']}")
-        else:
-            hidden.append(name)
-    if hidden:
-        print(f"  and {len(hidden)} higher series terms ({', '.join(hidden[:6])}"
-              f"{' ...' if len(hidden) > 6 else ''}: in --json and --html)")
-    bad = result["consistency"]["inconsistent"]
-    if bad:
-        worst = {e["file"]: e for e in result["consistency"]["files"]}
-        print("  inconsistent with the rest (leave-one-file-out test): " + ", ".join(
-            f"{f} (p = {worst[f]['p_value']:.2g}, Birge ratio {worst[f]['birge_ratio']})"
-            for f in bad))
-    for line in result.undetermined_lines():
-        print(line)
     return 0

@@ -9,12 +9,11 @@ Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
 from __future__ import annotations
 
 
-from ..cmm import diagonals
+from ..cmm import api, diagonals
 from ._common import add_common, error_functions_from_args, inputs_of, parse_at
 from ..errors import require
-from ..fileio import Outputs, json_text, write_text
+from ..fileio import Outputs
 from ..machine.model import load
-from ..cmm.volmap import linear_axes, volume
 
 
 def register(sub) -> None:
@@ -38,21 +37,16 @@ def run(args) -> int:
     funcs = error_functions_from_args(args, model)
     inputs = inputs_of(args)
     outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot).check()
-    lin = linear_axes(model)
-    lines = diagonals.box_lines(volume(model, funcs, args.volume), lin, tuple(args.lines))
-    results = diagonals.evaluate_lines(model, funcs, lines, tuple(args.probe), parse_at(args.at),
-                                       args.profile_points)
-    print(f"{model.name}: length deviation dL = actual - nominal distance of the probe tip "
-          f"(first order), probe {' '.join(f'{v:g}' for v in args.probe)} mm")
-    print(diagonals.format_table(results))
+    res = api.diagonals(model, funcs, lines=args.lines, probe=tuple(args.probe),
+                        at=parse_at(args.at), volume=args.volume,
+                        profile_points=args.profile_points, method=args.method)
+    res.data["errors"] = str(args.errors)
+    print(res.summary())
     with outs:
         if args.json:
-            doc = {"layout": model.name, "probe_mm": [float(v) for v in args.probe],
-                   "errors": str(args.errors), "method": args.method,
-                   "lines": [r.as_dict() for r in results]}
-            write_text(outs.path("--json"), json_text(doc), inputs)
+            res.write_json(outs.path("--json"), inputs)
         if args.plot:
-            diagonals.plot_lines(results, outs.path("--plot"),
+            diagonals.plot_lines(res.lines, outs.path("--plot"),
                                  f"{model.name}: length deviations ({args.errors})", inputs)
     if args.json:
         print(f"json: {args.json}")

@@ -86,10 +86,9 @@ def _vec(text, what):
 
 def run(args) -> int:
     from ..fileio import Outputs, json_text, write_text
-    from ..identify.inputs import read_rounds, refuse_repeated_files
+    from ..identify.api import identify
+    from ..identify.inputs import refuse_repeated_files
     from ..identify.report import outlier_warnings, residual_csv, summary_lines
-    from ..identify.solve import identify, to_model_signs
-    from ..machine.layout import read_layout
     from ..tables.table import table_to_csv
 
     from ._common import layout_inputs
@@ -101,21 +100,17 @@ def run(args) -> int:
         .folder("--errors-out", args.errors_out, files=[f"{axis}.csv"]) \
         .file("--residuals", args.residuals) \
         .file("--json", args.json).plot("--plot", args.plot).check()
-    layout = read_layout(args.layout)
-    rounds = read_rounds(args.files, args.format, args.positions, args.points)
-    sense = {"auto": "auto", "+": 1, "-": -1}[args.sense]
-    result = identify(
-        rounds, layout, args.axis, method=args.method,
+    res = identify(
+        args.layout, args.axis, args.files, format=args.format, positions=args.positions,
+        points=args.points, method=args.method,
         tracker=_vec(args.tracker, "--tracker") if args.tracker else None,
         direction=_vec(args.direction, "--direction") if args.direction else None,
         origin=("layout" if args.origin == ["layout"] else
                 _vec(args.origin, "--origin") if args.origin else None),
-        sense=sense, max_cond=args.max_cond, outlier_k=args.outlier_k)
-    table = result.table()
-    if args.signs == "model":
-        table = to_model_signs(table, layout, reference=result.rounds[0].positions[0])
+        sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k, signs=args.signs)
+    result, table = res.identification, res.errors
     text = table_to_csv(table)
-    summary = result.summary()
+    summary = res.data
     fits = None
     if args.fit:
         from ..tables.errorfit import fit_table

@@ -151,15 +151,13 @@ def run(args) -> int:
                 "eve_um"):
         finite_option(getattr(args, opt), "--" + opt.replace("_", "-"), 0.0, 1e3)
     from .. import conformance
-    tolerance = (conformance.parse_tolerances(args.tolerance, ("A", "E", "M", "R", "B"))
-                 if args.tolerance is not None else None)
+    from ..positioning.api import iso230_2
+    if args.tolerance is not None:   # checked before any output is planned
+        conformance.parse_tolerances(args.tolerance, ("A", "E", "M", "R", "B"))
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .plot("--plot", args.plot).file("--html", args.html) \
         .folder("--errors-out", args.errors_out, files=[f"{a}.csv" for a in axes]).check()
 
-    runs = pos.evaluate_files(inputs, axes, args.cte_ppm_per_K, args.material_temp_C,
-                              args.cte_reference_mm)
-    evaluations = runs.evaluations
     conditions = {}
     if args.cte_ppm_per_K is not None:
         conditions["expansion coefficient"] = f"{args.cte_ppm_per_K:g} ppm/K (corrected to " \
@@ -167,21 +165,16 @@ def run(args) -> int:
     if args.material_temp_C is not None:
         conditions["material temperature"] = f"{args.material_temp_C:g} \u00b0C"
     ident = identification_from_args(args, conditions)
-    report = runs.report(inputs=pos.BudgetInputs(args.instrument_ppm, args.alignment_mm,
-                                                 args.temperature_u_K, args.cte_u_ppm_per_K,
-                                                 args.eve_um),
-                         tolerance=tolerance, identification=ident)
+    res = iso230_2(inputs, ",".join(axes), tolerance=args.tolerance,
+                   instrument_ppm=args.instrument_ppm, alignment_mm=args.alignment_mm,
+                   temperature_u_K=args.temperature_u_K, cte_u_ppm_per_K=args.cte_u_ppm_per_K,
+                   eve_um=args.eve_um, cte_ppm_per_K=args.cte_ppm_per_K,
+                   material_temp_C=args.material_temp_C, cte_reference_mm=args.cte_reference_mm,
+                   identification=ident)
+    report, evaluations = res.data, res.evaluations
     table_texts = [pos.error_table_csv(ev) for ev in evaluations] if args.errors_out else []
     per_run = report["runs"] if "runs" in report else [report]
-    png = (pos.plot_runs(evaluations, verdicts_per_run=[r.get("verdicts") for r in per_run])
-           if (args.plot or args.html) else None)
-    html_text = None
-    if args.html:
-        from .. import __version__ as ver
-        import datetime
-        html_text = pos.report_html(report, png, inputs, f"Evaluated with volerr {ver} on "
-                                                         f"{datetime.date.today().isoformat()}.",
-                                    identification=ident)
+    png = res.png() if args.plot else None
 
     # all outputs at the end, all or nothing
     with outs:
@@ -189,13 +182,13 @@ def run(args) -> int:
             write_text(outs.path("--json"), json_text(report), inputs=inputs)
         if args.plot:
             write_bytes(outs.path("--plot"), png, inputs=inputs)
-        if html_text is not None:
-            write_text(outs.path("--html"), html_text, inputs=inputs)
+        if args.html:
+            res.write_html(outs.path("--html"), inputs=inputs)
         for a, text in zip(axes, table_texts):
             write_text(outs.path("--errors-out") / f"{a}.csv", text, inputs=inputs)
 
-    lines, notes = pos.summary_lines(report)
-    print("\n".join(lines))
+    print(res.summary())
+    notes = pos.summary_lines(report)[1]
     notes += [f"{r['file']}: {n}" for r in per_run for n in r["uncertainty_budget"]["notes"]]
     for n in notes:
         print(f"volerr iso230-2: note: {n}", file=sys.stderr)

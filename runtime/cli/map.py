@@ -50,15 +50,13 @@ def run(args) -> int:
         rnd_plot = volmap.random_plot_path(args.plot)
     outs = Outputs(inputs).file("--out", args.out).plot("--plot", args.plot) \
         .plot("--plot-random", rnd_plot).file("--json", args.json).check()
+    from ..cmm.api import error_map
     from ..tables.functions import parse_approach
 
     approach = parse_approach(args.approach, model, funcs)
-    vmap = volmap.volumetric_map(model, funcs, args.grid, tuple(args.probe), parse_at(args.at),
-                                 box=volmap.volume(model, funcs, args.volume),
-                                 approach=approach)
-    s = vmap.summary()
-    if approach:
-        s["approach"] = {a: ("+" if v > 0 else "-") for a, v in approach.items()}
+    res = error_map(model, funcs, grid=args.grid, probe=tuple(args.probe), at=parse_at(args.at),
+                    volume=args.volume, approach=approach)
+    vmap, s = res.map, res.data
     with outs:
         if args.out:
             volmap.write_map_csv(outs.path("--out"), vmap, inputs)
@@ -69,14 +67,7 @@ def run(args) -> int:
                                                            args.magnify, inputs)
         if args.json:
             write_text(outs.path("--json"), json_text(s), inputs)
-    print(f"{model.name}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
-          f"probe {' '.join(f'{v:g}' for v in vmap.probe)} mm")
-    m = s["max_abs_um"]
-    print(f"  max |dx| {m['x']:.2f} um, |dy| {m['y']:.2f} um, |dz| {m['z']:.2f} um; "
-          f"max |d| {s['max_length_um']:.2f} um, RMS |d| {s['rms_length_um']:.2f} um")
-    if vmap.random is not None:
-        r = s["random_max_um"]
-        print(f"  random (1 sigma) max rx {r['x']:.2f} um, ry {r['y']:.2f} um, rz {r['z']:.2f} um")
+    print(res.summary())
     for label, path in (("map", args.out), ("plot", args.plot), ("random plot", rnd_plot),
                         ("summary", args.json)):
         if path:

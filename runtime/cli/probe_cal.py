@@ -106,7 +106,7 @@ def run(args) -> int:
     if args.plan:
         return _run_plan(args)
     from ..probe import calibration as probe
-    from ..probe.report import summary_lines
+    from ..probe.api import probe_cal
 
     require(args.data, "name the probing data DATA.csv (or use --plan to write a plan)")
     require(args.out, "--out MAP.csv is required")
@@ -121,11 +121,10 @@ def run(args) -> int:
         .folder("--plots", args.plots, files=("probe_map_3d.png", "probe_map_2d.png")).check()
     require(args.degree is None or 0 <= args.degree <= 20,
             f"--degree must be between 0 and 20, got {args.degree}")
-    data = probe.read_sphere_csv(args.data)
-    cal = probe.calibrate_data(data, args.sphere_radius, tilt_deg=args.tilt_deg,
-                               roll_deg=args.roll_deg, degree=args.degree,
-                               outlier_k=args.outlier_k, exclude_outliers=args.exclude_outliers)
-    summary = cal.summary()
+    res = probe_cal(args.data, args.sphere_radius, tilt_deg=args.tilt_deg,
+                    roll_deg=args.roll_deg, degree=args.degree, outlier_k=args.outlier_k,
+                    exclude_outliers=args.exclude_outliers)
+    cal, summary = res.calibration, res.data
     with outs:
         write_text(outs.path("--out"), probe.map_csv_text(cal), inputs=inputs)
         if args.json:
@@ -142,6 +141,6 @@ def run(args) -> int:
             plot_probe_map_2d(cal, d / "probe_map_2d.png")
     for note in cal.notes:
         print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
-    print("\n".join(summary_lines(cal, args.exclude_outliers)))
+    print(res.summary())
     print(f"map: {args.out}")
     return 0

@@ -16,10 +16,9 @@ from pathlib import Path
 
 from ._common import add_error_arguments, add_html, add_json, add_plot
 from ..errors import require
-from ..fileio import Outputs, json_text, write_bytes, write_text
+from ..fileio import Outputs, write_bytes
 from ..machine.model import load
-from ..uncertainty import ensemble, montecarlo as mc, tasks
-from ..uncertainty import report
+from ..uncertainty import ensemble, tasks
 from ..uncertainty.report import BIAS_MODES
 
 
@@ -99,13 +98,6 @@ def register(sub) -> None:
 
 
 #: captions of the report's figures
-CAPTIONS = ("Distribution of the Monte Carlo readings about their mean (the estimate): red, the "
-            "probabilistically symmetric 95 % coverage interval; blue dashed, estimate \u00b1 U "
-            "(k = 2).",
-            "Convergence: running mean (about the final mean) and running standard "
-            "uncertainty u (k = 1) against the number of samples.")
-
-
 def _temperature(args):
     vals = {k: getattr(args, k) for k in ("part_cte", "part_dt", "scale_cte", "scale_dt")}
     if all(v is None for v in vals.values()):
@@ -143,91 +135,44 @@ def _check_options(args) -> None:
     _temperature(args)  # validates the temperature options
 
 
-def _backend(name: str) -> str:
-    """The backend to use; a missing numba is one warning line on stderr, then numpy."""
-    import sys
-    import warnings
-
-    from ..machine.fused import resolve_backend
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        backend = resolve_backend(name)
-    for w in caught:
-        print(f"volerr: warning: {w.message}", file=sys.stderr)
-    return backend
-
-
 def run(args) -> int:
-    from ._common import error_functions_from_args, inputs_of
+    from ..uncertainty.api import uncertainty
+    from ._common import inputs_of, layout_inputs
 
     _check_options(args)
     require(args.evaluate in tasks.EVALUATIONS, f"unknown evaluation {args.evaluate!r} "
                                                 f"(one of {', '.join(tasks.EVALUATIONS)})")
-    model = load(args.layout)
+    load(args.layout)
     inputs = [Path(args.task)] + ([Path(args.probe_map)] if args.probe_map else [])
     if args.errors:
         inputs += inputs_of(args)
-    from ._common import layout_inputs
-
     inputs += layout_inputs(args.layout)
     outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
         .plot("--plot", args.plot).check()
-    task = tasks.read_task(args.task, model.axes)
-    funcs = error_functions_from_args(args, model) if args.errors else None
-    spec = ensemble.parse_spec(args.spec) if args.spec else None
-    require(funcs is not None or spec is not None or args.noise_um > 0 or args.probe_map
-            or _temperature(args) is not None,
-            "nothing is uncertain: give --errors, --spec, --noise-um or temperatures")
     pmap = None
     if args.probe_map:
         from ..probe import read_probe_map
         pmap = read_probe_map(args.probe_map)
-    ens = ensemble.Ensemble.build(funcs, spec, args.noise_um, args.table_std, args.correlation_mm,
-                                  _temperature(args), pmap, args.seed,
-                                  spec_acceptance=args.spec_acceptance,
-                                  repeatability=args.repeatability)
-    backend = _backend(args.backend)
-    prob = mc.prepare(model, str(args.layout), task, args.evaluate, ens, seed=args.seed,
-                      backend=backend)
-    require(prob.sources, "nothing is random: the tables have no _std / _u95 columns (their _s "
-                          "columns need --repeatability) and no noise, spec or temperature "
-                          "uncertainty is given")
-    runner = mc.Runner(args.scheduler, args.chunks, args.workers, args.scheduler_address,
-                       progress=not args.quiet)
-    adaptive = None
-    with runner:
-        if args.adaptive:
-            values, info, adaptive = mc.run_adaptive(prob, runner, args.digits,
-                                                     max_samples=args.max_samples)
-        else:
-            n = 10_000 if args.samples is None else args.samples
-            require(2 <= n <= 10**8, "--samples must be between 2 and 1e8")
-            values, info = mc.run(prob, n, runner)
-    summary = mc.summarize(prob, values)
-    doc = report.result_document(
-        prob, values, summary, info, layout=model.name, task=str(args.task),
-        evaluation=args.evaluate, seed=args.seed, chunks=args.chunks, scheduler=args.scheduler,
-        machine=report.machine_text(spec, args.errors if funcs else None, args.table_std,
-                                    args.repeatability),
-        noise_um=args.noise_um, adaptive=adaptive, digits=args.digits,
-        contributions=(mc.contributions(prob, args.contributions) if args.contributions
-                       else None), bias=args.bias, table_uncertainty=ens.table_columns,
-        task_points=task.n_points)
-    title = f"{model.name} {args.evaluate} ({values.shape[0]} samples)"
-    hist = None
-    if args.plot or args.html:
-        from ..uncertainty import plots
-        hist = plots.histogram_png(values, prob.names, summary, title)
+    res = uncertainty(
+        args.layout, args.task, args.evaluate, errors=args.errors, method=args.method,
+        degree=args.degree, extrapolate=args.extrapolate, spec=args.spec,
+        noise_um=args.noise_um, table_std=args.table_std, repeatability=args.repeatability,
+        correlation_mm=args.correlation_mm, spec_acceptance=args.spec_acceptance,
+        temperature=_temperature(args), probe_map=pmap, samples=args.samples,
+        adaptive=args.adaptive, digits=args.digits, max_samples=args.max_samples,
+        seed=args.seed, chunks=args.chunks, scheduler=args.scheduler,
+        scheduler_address=args.scheduler_address, workers=args.workers,
+        contributions=args.contributions, backend=args.backend, bias=args.bias,
+        progress=not args.quiet)
     if not args.quiet:
-        print("\n".join(report.summary_lines(doc)))
+        print(res.summary())
     with outs:
         if args.json:
-            write_text(outs.path("--json"), json_text(doc), inputs)
+            res.write_json(outs.path("--json"), inputs)
         if args.plot:
-            write_bytes(outs.path("--plot"), hist, inputs)
-        if args.html:
             from ..uncertainty import plots
-            conv = plots.convergence_png(values, prob.names, title)
-            write_text(outs.path("--html"), report.html_report(doc, [hist, conv], CAPTIONS),
-                       inputs)
+            write_bytes(outs.path("--plot"), plots.histogram_png(
+                res.values, res.names, res.summary_stats, res.title), inputs)
+        if args.html:
+            res.write_html(outs.path("--html"), inputs)
     return 0

@@ -861,7 +861,8 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
                        initial: dict | None = None, check_travel: bool = True,
                        max_iter: int = 50, types=None, chunk_lines: int | None = None,
                        arc_tol_um: float = 1.0, tool_length: float | None = None,
-                       tool_table: dict | None = None, dialect: str = "auto") -> Result:
+                       tool_table: dict | None = None, dialect: str = "auto",
+                       datum=None) -> Result:
     """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
 
     ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
@@ -871,12 +872,17 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
     streams a program file of any length).  ``arc_tol_um``: path tolerance of arcs
     (:mod:`volerr.fiveaxis.arc_compensation`); ``tool_length`` (mm) or ``tool_table`` (tool
     number -> mm): the tool length of TCPM blocks (:mod:`volerr.nc.tcpm`); ``dialect``:
-    "auto", "iso" or "heidenhain"."""
+    "auto", "iso" or "heidenhain".  ``datum``: the work datum, the axis positions (layout
+    order, mm / deg) where the work offset was set (by probing the part), or None: the
+    corrections are then relative to the error at the datum, which the work offset absorbs
+    (:meth:`volerr.fiveaxis.compensate.ErrorModel.relative_to`; ``volerr compensate
+    --datum``)."""
     import io
 
     opts = Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
                    check_travel, max_iter, None if types is None else tuple(types),
-                   arc_tol_um, tool_length, tool_table, dialect)
+                   arc_tol_um, tool_length, tool_table, dialect,
+                   None if datum is None else tuple(float(v) for v in datum))
     sink = _Collect(model)
     s, never = run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
                    chunk_lines or CHUNK_LINES)

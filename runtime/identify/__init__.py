@@ -15,3 +15,10 @@ def __getattr__(name):
         return getattr(_m, name)
     except AttributeError:
         raise AttributeError(f"module 'volerr.identify' has no attribute {name!r}") from None
+
+
+from . import api as _api  # noqa: E402
+from ..results import callable_package  # noqa: E402
+
+# volerr.identify(...) is volerr.identify.api.identify(...), whatever was imported before
+callable_package(__name__, _api.identify)

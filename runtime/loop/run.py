@@ -56,6 +56,7 @@ from ..instruments.deviations import columns_to_data, read_deviations  # noqa: F
 from ..machine.layout import layout_text, parse_layout
 from ..machine import derivation
 from ..machine.model import Model, load
+from ..results import ResultMixin
 
 from .select import BIC_GAIN, CV_T, MAX_EFFECTS  # noqa: F401  (former names)
 from .symbols import describe
@@ -65,8 +66,8 @@ OUTLIER_Z = 5.0      # robust sigmas beyond which a point is flagged as an outli
 
 
 # ---- report ---------------------------------------------------------------------
-@dataclass
-class Report:
+@dataclass(repr=False)
+class Report(ResultMixin):
     """Result of :func:`run_loop`; ``data`` is the json report (INTERFACE.md keys first)."""
 
     data: dict

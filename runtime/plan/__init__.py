@@ -17,3 +17,9 @@ from ._run import Plan, default_request, plan
 from ._sheet import comparison_png
 
 __all__ = ["Plan", "comparison_png", "default_request", "execute", "nc_program", "plan"]
+
+from . import api as _api  # noqa: E402
+from ..results import callable_package  # noqa: E402
+
+# volerr.plan(...) is volerr.plan.api.plan(...), whatever was imported before
+callable_package(__name__, _api.plan)

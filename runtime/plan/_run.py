@@ -20,6 +20,7 @@ from ..calibrate import estimability, terms
 from ..calibrate.defaults import default_parameters
 from ..errors import require
 from ..machine.model import Model, load
+from ..results import ResultMixin
 from . import _baseline, _candidates, _design, _files, _information, _spec
 from ._predict import predict
 
@@ -57,8 +58,8 @@ def default_request(model, kinds) -> list:
     return default_parameters(model, list(dict.fromkeys(kinds)))
 
 
-@dataclass
-class Plan:
+@dataclass(repr=False)
+class Plan(ResultMixin):
     """A designed campaign: ``files`` [PlanFile], ``prediction`` and ``baseline`` (with its
     name and files), ``alone`` {kind: Prediction}, ``minutes`` per file, the request."""
 
@@ -96,6 +97,19 @@ class Plan:
         write_text(html_path or f"{folder}/plan.html", _sheet.html(self), inputs=list(inputs))
         if json_path:
             write_text(json_path, json_text(_report.data(self)), inputs=list(inputs))
+
+    def write_html(self, path, inputs=()) -> None:
+        """The set-up sheet (``plan.html``) alone."""
+        from ..fileio import write_text
+        from . import _sheet
+
+        write_text(path, _sheet.html(self), inputs=list(inputs))
+
+    def _rows(self) -> list:
+        from ..results import Row
+
+        return [Row(n, None, e["predicted_std"], e["unit"], 1.0)
+                for n, e in self.data()["parameters"].items()]
 
     def data(self) -> dict:
         from ._report import data

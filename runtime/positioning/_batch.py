@@ -82,7 +82,8 @@ def summary_lines(report: dict) -> tuple[list[str], list[str]]:
             return text
         lines.append(f"{name}: axis {r['axis']}, {r['n_targets']} targets x "
                      f"{r['n_cycles']} cycles: {'  '.join(q(k) for k in 'AEMRB')}  "
-                     f"(B_avg {num(r['B_avg_um'], '+.2f')}) um")
+                     f"(B_avg {num(r['B_avg_um'], '+.2f')}) um"
+                     f"{'; U expanded, k = 2 (ISO/TR 230-9)' if U else ''}")
         if r.get("verdict"):
             lines.append(f"  verdict {r['verdict'].upper()} (ISO 14253-1, tolerance reduced / "
                          f"widened by U, k = 2)")

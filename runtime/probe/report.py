@@ -17,7 +17,7 @@ def summary_lines(cal, excluded: bool) -> list[str]:
         f"{cal.n_points} points, sphere radius {cal.sphere_radius:.4f} mm, "
         f"directions from {cal.direction_source}",
         f"centre {c[0]:.4f} {c[1]:.4f} {c[2]:.4f} mm, R_eff {cal.r_eff:.4f} mm "
-        f"(u: centre {max(u['u_center_um']):.2f} um, R_eff {u['u_r_eff_um']:.2f} um; "
+        f"(u, k = 1: centre {max(u['u_center_um']):.2f} um, R_eff {u['u_r_eff_um']:.2f} um; "
         f"noise {u['noise_um']:.2f} um)",
         f"probe error max {e['max']:.1f} um, min {e['min']:.1f} um, rms {e['rms']:.1f} um; "
         f"map degree {cal.map.degree}, residual rms {summary['map']['residual_rms_um']:.2f} um;"

@@ -123,7 +123,7 @@ def summary_lines(doc: dict) -> list[str]:
         lines.append(f"  {name:9s} {num(q['result_mm'], '.6f')} mm, 95 % [{num(lo, '.6f')}, "
                      f"{num(hi, '.6f')}] mm  (reading {num(q['estimate_mm'], '.6f')} mm, bias "
                      f"{num(q['bias_um'], '+.3f')} um, u {num(q['standard_uncertainty_um'], '.3f')} "
-                     f"um, U {num(q['expanded_uncertainty_um'], '.3f')} um)")
+                     f"um (k = 1), U {num(q['expanded_uncertainty_um'], '.3f')} um (k = 2))")
     return lines
 
 

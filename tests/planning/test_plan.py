@@ -90,7 +90,8 @@ def test_executed_plan_gives_the_predicted_std(plans, tmp_path, name, seed):
         assert abs(got["value"] - planted.get(n, 0.0)) < k * got["std"], (n, got, k)
         assert 0.7 <= got["std"] / pred["predicted_std"] <= 1.4, (n, got, pred)
         # the same normal equations: equal once the a-posteriori variance factor is removed
-        assert got["std"] / np.sqrt(vf) == pytest.approx(pred["predicted_std"], rel=2e-3)
+        # (a factor below 1 is never applied: the stated uncertainties are kept)
+        assert got["std"] / np.sqrt(max(vf, 1.0)) == pytest.approx(pred["predicted_std"], rel=2e-3)
 
 
 def test_ballbar_sweeps_determine_the_rotary_axes_location(plans):

@@ -1,0 +1,160 @@
+"""``volerr.error_map(...)``: the Python API of ``volerr map`` (:mod:`volerr.results`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..results import ResultMixin
+
+
+@dataclass(repr=False)
+class ErrorMap(ResultMixin):
+    """Result of :func:`error_map`: ``data`` the ``--json`` summary (um), ``map`` the
+    :class:`volerr.cmm.volmap.VolumetricMap` (positions mm / deg, errors (N, 3) mm, their
+    standard uncertainty (k = 1) ``random`` where the tables carry one)."""
+
+    data: dict
+    map: object
+
+    def summary(self) -> str:
+        """What ``volerr map`` prints (without the lines naming the written files)."""
+        s, vmap = self.data, self.map
+        m = s["max_abs_um"]
+        out = [f"{s['layout']}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
+               f"probe {' '.join(f'{v:g}' for v in vmap.probe)} mm",
+               f"  max |dx| {m['x']:.2f} um, |dy| {m['y']:.2f} um, |dz| {m['z']:.2f} um; "
+               f"max |d| {s['max_length_um']:.2f} um, RMS |d| {s['rms_length_um']:.2f} um"]
+        if vmap.random is not None:
+            r = s["random_max_um"]
+            out.append(f"  random (1 sigma, k = 1) max rx {r['x']:.2f} um, ry {r['y']:.2f} um, "
+                       f"rz {r['z']:.2f} um")
+        return "\n".join(out)
+
+    def write_csv(self, path, inputs=()):
+        """The map CSV of ``volerr map --out``: positions, probe, dx_um dy_um dz_um (and
+        their u columns)."""
+        from .volmap import write_map_csv
+
+        return write_map_csv(path, self.map, inputs)
+
+    def _rows(self) -> list:
+        return []
+
+
+def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
+              volume: str = "travel", approach=None, method: str = "linear",
+              degree: int | None = None, extrapolate: bool = False) -> ErrorMap:
+    """The volumetric error over the working volume (``volerr map``).
+
+    Parameters
+    ----------
+    layout : str, path or volerr.Model
+        Layout name or file (or a loaded model).
+    errors : path or volerr.tables.ErrorFunctions
+        Error directory (``X.csv`` ... ``constants.csv``; 'volerr formats tables') or error
+        functions already made from one.
+    grid : int or sequence of int, optional
+        Points per linear axis (default: the command's).
+    probe : (3,) mm
+        Probe / tool offset.
+    at : dict, optional
+        Positions of the rotary axes during the test, deg (default 0).
+    volume : {"travel", "measured"}
+        The layout's travel, or the part of it the tables cover.
+    approach : dict, optional
+        ``{axis: +1 or -1}``: evaluate the tables' reversal for that approach direction.
+    method, degree, extrapolate
+        How the tables are interpolated (as ``--method``, ``--degree``, ``--extrapolate``).
+
+    Returns
+    -------
+    ErrorMap
+        ``to_dict()`` is ``--json``: max ``|dx|``, ``|dy|``, ``|dz|``, max and RMS ``|d|`` (um; actual minus
+        nominal probe tip), and the random part's maximum (k = 1).
+    """
+    from ..machine.model import Model, load
+    from ..tables.functions import ErrorFunctions
+    from . import volmap
+
+    model = layout if isinstance(layout, Model) else load(layout)
+    funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
+        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+    grid = [grid] if isinstance(grid, int) else grid
+    vmap = volmap.volumetric_map(model, funcs, grid, tuple(probe), dict(at or {}),
+                                 box=volmap.volume(model, funcs, volume), approach=approach)
+    s = vmap.summary()
+    if approach:
+        s["approach"] = {a: ("+" if v > 0 else "-") for a, v in approach.items()}
+    return ErrorMap(s, vmap)
+
+
+@dataclass(repr=False)
+class Diagonals(ResultMixin):
+    """Result of :func:`diagonals`: ``data`` the ``--json`` document (per line its length
+    deviation dL = actual minus nominal distance of the probe tip, um, with its random part
+    u(dL), k = 1, where the tables carry standard deviations, and the profile along it),
+    ``lines`` the evaluated lines."""
+
+    data: dict
+    lines: list
+
+    def summary(self) -> str:
+        """What ``volerr diagonals`` prints (without the lines naming the written files)."""
+        from .diagonals import format_table
+
+        probe = " ".join(f"{v:g}" for v in self.data["probe_mm"])
+        return (f"{self.data['layout']}: length deviation dL = actual - nominal distance of "
+                f"the probe tip (first order), probe {probe} mm\n{format_table(self.lines)}")
+
+    def _rows(self) -> list:
+        return []
+
+
+def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
+              volume: str = "travel", profile_points: int = 21, method: str = "linear",
+              degree: int | None = None, extrapolate: bool = False) -> Diagonals:
+    """Length deviations of the space diagonals (Pahk sec. 4), face diagonals and
+    axis-parallel lines of the working volume (``volerr diagonals``).
+
+    Parameters
+    ----------
+    layout : str, path or volerr.Model
+        Layout name or file (or a loaded model).
+    errors : path or volerr.tables.ErrorFunctions
+        Error directory or error functions made from one.
+    lines : sequence of str, optional
+        Which lines (:data:`volerr.cmm.diagonals.KINDS`; default all).
+    probe : (3,) mm
+        Probe / tool offset.
+    at : dict, optional
+        Positions of the rotary axes, deg.
+    volume : {"travel", "measured"}
+        The box of the lines.
+    profile_points : int
+        Points along each line for its profile (2 .. 10000).
+    method, degree, extrapolate
+        How the tables are interpolated.
+
+    Returns
+    -------
+    Diagonals
+        ``to_dict()`` is ``--json``; dL in um (positive: the line measures long).
+    """
+    from ..errors import require
+    from ..machine.model import Model, load
+    from ..tables.functions import ErrorFunctions
+    from . import diagonals as dg
+    from .volmap import linear_axes, volume as box
+
+    require(2 <= profile_points <= 10000, "--profile-points must be between 2 and 10000")
+    model = layout if isinstance(layout, Model) else load(layout)
+    funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
+        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+    found = dg.box_lines(box(model, funcs, volume), linear_axes(model),
+                         tuple(lines or dg.KINDS))
+    results = dg.evaluate_lines(model, funcs, found, tuple(probe), dict(at or {}),
+                                profile_points)
+    doc = {"layout": model.name, "probe_mm": [float(v) for v in probe],
+           "errors": (funcs.source or "") if errors is funcs else str(errors), "method": method,
+           "lines": [r.as_dict() for r in results]}
+    return Diagonals(doc, results)

@@ -1,0 +1,92 @@
+"""``volerr.identify(...)``: the Python API of ``volerr identify`` (:mod:`volerr.results`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..results import ResultMixin
+
+
+@dataclass(repr=False)
+class Identified(ResultMixin):
+    """Result of :func:`identify`: ``data`` the ``--json`` summary (um, urad), ``errors`` the
+    identified error table (:class:`volerr.tables.table.ErrorTable`, mm / rad, with ``std``
+    (Type A, k = 1) when there are several rounds), ``identification`` the full solve."""
+
+    data: dict
+    errors: object
+    identification: object
+    axis: str
+
+    def summary(self) -> str:
+        """What ``volerr identify`` prints (without the line naming the written table)."""
+        from ..identify.report import summary_lines
+
+        return "\n".join(summary_lines(self.axis, self.data, "(not written)"))
+
+    def error_table_csv(self) -> str:
+        """The error table as ``volerr identify --out`` writes it (``_um``, ``_urad``)."""
+        from ..tables.table import table_to_csv
+
+        return table_to_csv(self.errors)
+
+    def _rows(self) -> list:
+        from ..results import Row
+
+        t, out = self.errors, []
+        for name, values in t.values.items():
+            ang = name[1] in "ABC"
+            f, unit = (1e6, "urad") if ang else (1e3, "um")
+            std = t.std.get(name) if t.std else None
+            for i, q in enumerate(t.positions):
+                out.append(Row(f"{name}({q:g})", f * float(values[i]),
+                               None if std is None else f * float(std[i]), unit, 1.0))
+        return out
+
+    def figures(self) -> dict:
+        return {}
+
+
+def identify(layout, axis: str, files, *, format: str = "csv", positions: str | None = None,
+             points: str | None = None, method: str = "lsq", tracker=None, direction=None,
+             origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
+             signs: str = "component") -> Identified:
+    """Three-point (or more) laser-tracker identification of the six error motions of an axis
+    (``volerr identify``; the thesis' eq. 30 for linear axes, eq. 3.4 for rotary axes).
+
+    Parameters
+    ----------
+    layout : str or path
+        Layout name or file.
+    axis : str
+        The measured axis (``"X"`` ... ``"C"``).
+    files : str, path or list
+        Tracker point files ('volerr formats tracker'): ``round,point,position,x,y,z`` in mm
+        (position in mm or deg); the first position of each round is the reference.
+    format, positions, points, method, tracker, direction, origin, sense, max_cond, outlier_k
+        As the command's options of the same names (``volerr identify --help``);
+        ``tracker`` / ``direction`` / ``origin``: 3-vectors (mm; direction unitless).
+    signs : {"component", "model"}
+        component: the error motions of the moving component that carries the points (as
+        the thesis); model: volerr's tool-relative convention, ready for map / compensate.
+
+    Returns
+    -------
+    Identified
+        ``to_dict()`` is ``--json``; ``errors`` the error table (mm / rad).
+    """
+    from ..identify.inputs import read_rounds, refuse_repeated_files
+    from ..identify.solve import identify as solve, to_model_signs
+    from ..machine.layout import read_layout
+
+    files = [files] if isinstance(files, str) or hasattr(files, "__fspath__") else list(files)
+    refuse_repeated_files(files)
+    lay = read_layout(layout)
+    rounds = read_rounds(files, format, positions, points)
+    sense = {"auto": "auto", "+": 1, "-": -1}.get(sense, sense)
+    result = solve(rounds, lay, axis, method=method, tracker=tracker, direction=direction,
+                   origin=origin, sense=sense, max_cond=max_cond, outlier_k=outlier_k)
+    table = result.table()
+    if signs == "model":
+        table = to_model_signs(table, lay, reference=result.rounds[0].positions[0])
+    return Identified(result.summary(), table, result, axis.strip().upper())

@@ -1,0 +1,124 @@
+"""``volerr.loop(...)``: the Python API of ``volerr loop`` (:mod:`volerr.results`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import require
+from . import candidates
+from .run import Report, run_loop
+
+
+@dataclass(repr=False)
+class Loop(Report):
+    """Result of :func:`loop`: a :class:`volerr.loop.Report` whose :meth:`summary` is the
+    whole console text of ``volerr loop``.  Its ``figures`` attribute is the data behind the
+    report's figures (:class:`volerr.loop.run.Figures`, a field of the report that predates
+    the API), not a method: ``write_html`` draws them."""
+
+    def headline(self) -> str:
+        """The first line: points, held-out RMS and max before -> after (um), effects."""
+        return Report.summary(self)
+
+    def summary(self) -> str:
+        return "\n".join(console_lines(self))
+
+    def _rows(self) -> list:
+        from ..results import Row
+
+        out = []
+        for e in self.data["effects"]:
+            std = e.get("std") or {}
+            for k, v in e["parameters"].items():
+                out.append(Row(f"{e['name']}:{k}", v, std.get(k) if isinstance(std, dict)
+                               else None, e["units"][k], 1.0))
+        return out
+
+
+def lag_lines(e: dict) -> list:
+    """Console lines of an effect's lag and of the explanations the data cannot tell from it."""
+    out = []
+    lag = e.get("lag_s")
+    if lag:
+        std = f" +- {lag['std']:.0f}" if lag.get("std") is not None else ""
+        out.append(f"through a first-order lag of {e['covariate']}: tau = {lag['value']:.0f}"
+                   f"{std} s ({lag['value'] / 60:.1f} min)")
+    for a in e.get("alternatives") or []:
+        lag_a = f" through a lag of {a['lag_s']:.0f} s" if a.get("lag_s") else ""
+        out.append(f"these data cannot tell it from {a['parameter']} x {a['covariate']}"
+                   f"{lag_a} (held-out RMS {a['held_out_rms_um']:.3f} um)")
+    if e.get("separate_by"):
+        out.append(f"would separate them: {e['separate_by']}")
+    return out
+
+
+def console_lines(report: Report) -> list:
+    """What ``volerr loop`` prints for ``report``."""
+    out = [f"  warning: {w}" for w in report["warnings"]]
+    out.append(Report.summary(report))
+    for e in report.effects:
+        pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
+        out.append(f"  {e['kind']} {e['name']}: {pars}")
+        out += [f"    {line}" for line in lag_lines(e)]
+    if report["augmented_layout"]:
+        out.append(f"  augmented layout: {report['augmented_layout']}; generated module: "
+                   f"{report['generated_module']}")
+    if report["residual_note"]:
+        out.append(f"  {report['residual_note']}")
+    hidden = [u["parameters"][0] for u in report["unidentifiable"]
+              if not (u["parameters"][0].startswith("setup.") and u.get("no_sensitivity"))]
+    if hidden:
+        out.append(f"  not separable by these data: {', '.join(hidden)} (see the report)")
+    return out
+
+
+def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None,
+         test_fraction: float = 0.25, degree: int | None = None, families=None,
+         progress=None) -> Loop:
+    """Close the loop on measured deviations (``volerr loop``): fit the declared model, trace
+    the residual to candidate effects "parameter P varies with covariate C", augment the
+    layout, report the error before and after on held-out points.
+
+    Parameters
+    ----------
+    layout : str or path
+        Layout name or layout file (an augmented ``*_aug.toml`` of an earlier run too).
+    files : str, path or list
+        Measurement files of one campaign (deviations, ballbar, sphere; ``KIND:FILE`` names
+        the kind); deviations in um, positions in mm / deg, covariates as in 'volerr formats
+        loop'.  A :class:`volerr.loop.simulate.Campaign` is taken as well.
+    out_dir : path, optional
+        Folder for the augmented layout and its generated module; None: not written (the
+        texts are in the result: ``augmented_text``, ``generated_text``).
+    seed : int
+        Seed of the held-out split and of the folds.
+    folds : int, optional
+        k-fold cross-validation with this k (2 .. 20); default: leave-one-point-out.
+    test_fraction : float
+        Fraction of the points held out for before / after (0.05 .. 0.5).
+    degree : int, optional
+        Degree of the component series; default: by cross-validation.
+    families : str or list of str, optional
+        Candidate families to search (comma list or list; default: all,
+        :data:`volerr.loop.candidates.FAMILIES`).
+    progress : bool, optional
+        Progress bar on stderr (None: when stderr is a terminal).
+
+    Returns
+    -------
+    Loop
+        ``to_dict()`` is ``volerr loop --json``: RMS / max before and after (um), the effects
+        with their parameters (their units in ``units``) and standard uncertainties (k = 1).
+    """
+    chosen = candidates.FAMILIES
+    if families:
+        parts = families.split(",") if isinstance(families, str) else list(families)
+        chosen = tuple(f.strip() for f in parts if f.strip())
+        bad = [f for f in chosen if f not in candidates.FAMILIES]
+        require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
+                f"{' '.join(candidates.FAMILIES)}")
+    if isinstance(files, (list, tuple)):
+        files = files[0] if len(files) == 1 else list(files)
+    r = run_loop(layout, files, seed=seed, folds=folds, test_fraction=test_fraction,
+                 degree=degree, out_dir=out_dir, families=chosen, progress=progress)
+    return Loop(r.data, r.figures, r.augmented_text, r.generated)

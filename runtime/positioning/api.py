@@ -1,0 +1,110 @@
+"""``volerr.iso230_2(...)``: the Python API of ``volerr iso230-2`` (:mod:`volerr.results`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..errors import require
+from ..results import ResultMixin
+
+
+@dataclass(repr=False)
+class Iso230_2(ResultMixin):
+    """Result of :func:`iso230_2`: ``data`` the ``--json`` report (A, B, E, M, R ... in um,
+    with their expanded uncertainty U at k = 2 per ISO/TR 230-9), ``evaluations`` per run."""
+
+    data: dict
+    evaluations: list
+    notes: list = field(default_factory=list)
+    identification: dict | None = None
+
+    def summary(self) -> str:
+        """What ``volerr iso230-2`` prints."""
+        from . import summary_lines
+
+        return "\n".join(summary_lines(self.data)[0])
+
+    def _rows(self) -> list:
+        from ..results import Row
+
+        out = []
+        for r in self.data["runs"] if "runs" in self.data else [self.data]:
+            U = r.get("uncertainty_um") or {}
+            k = (r.get("uncertainty_budget") or {}).get("coverage_factor", 2)
+            for key in ("A", "E", "M", "R", "B"):
+                u = U.get(key)
+                out.append(Row(f"{r.get('axis', '')}:{key}", r[f"{key}_um"],
+                               None if u is None else u / k, "um", 1.0))
+        return out
+
+    def png(self) -> bytes:
+        """The plot of the runs (deviation against target per direction, the verdicts)."""
+        from . import plot_runs
+
+        per_run = self.data["runs"] if "runs" in self.data else [self.data]
+        return plot_runs(self.evaluations, verdicts_per_run=[r.get("verdicts") for r in per_run])
+
+    def write_html(self, path, inputs=()):
+        """The certificate page (``--html``)."""
+        import datetime
+        from importlib.metadata import version
+
+        from . import report_html
+        from ..fileio import write_text
+
+        made = f"Evaluated with volerr {version('volerr')} on {datetime.date.today().isoformat()}."
+        return write_text(path, report_html(self.data, self.png(), list(inputs), made,
+                                            identification=self.identification),
+                          inputs=list(inputs))
+
+
+def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
+             instrument_ppm: float = 0.5, alignment_mm: float = 0.1,
+             temperature_u_K: float = 0.2, cte_u_ppm_per_K: float = 1.0,
+             eve_um: float | None = None, cte_ppm_per_K: float | None = None,
+             material_temp_C: float | None = None, cte_reference_mm: float = 0.0,
+             identification=None) -> Iso230_2:
+    """ISO 230-2 evaluation of positioning runs (``volerr iso230-2``).
+
+    Parameters
+    ----------
+    runs : str, path or list
+        RUN files (``target_mm,cycle,direction,deviation_um``; 'volerr formats iso230-2');
+        deviation = actual minus target, um.
+    axis : str
+        One axis, or a comma list with one per run.
+    tolerance : str, optional
+        ``"A=..,E=.."`` tolerances in um: verdicts per ISO 14253-1.
+    instrument_ppm, alignment_mm, temperature_u_K, cte_u_ppm_per_K, eve_um
+        The ISO/TR 230-9 uncertainty budget (ppm, mm, K, ppm/K, um), as the command's options.
+    cte_ppm_per_K, material_temp_C, cte_reference_mm
+        Correction to 20 degC (ppm/K, degC, mm).
+    identification : dict, optional
+        What identifies the instrument and the machine in the report (as the command's
+        identification options give it).
+
+    Returns
+    -------
+    Iso230_2
+        ``to_dict()`` is ``--json`` (keys ``A_um B_um E_um M_um R_um`` ... per run).
+    """
+    from .. import conformance
+    from . import BudgetInputs, evaluate_files
+    from pathlib import Path
+
+    inputs = [runs] if isinstance(runs, str) or hasattr(runs, "__fspath__") else list(runs)
+    require(len({Path(f).resolve() for f in inputs}) == len(inputs),
+            "the same RUN file is given twice")
+    require(material_temp_C is None or cte_ppm_per_K is not None,
+            "--material-temp-C is used only with --cte-ppm-per-K")
+    axes = [a.strip().upper() for a in axis.split(",")]
+    require(len(axes) in (1, len(inputs)), f"--axis: give one axis or one per RUN file "
+                                           f"({len(inputs)}), got {len(axes)}")
+    axes = axes * len(inputs) if len(axes) == 1 else axes
+    tol = (conformance.parse_tolerances(tolerance, ("A", "E", "M", "R", "B"))
+           if tolerance is not None else None)
+    rs = evaluate_files(inputs, axes, cte_ppm_per_K, material_temp_C, cte_reference_mm)
+    report = rs.report(inputs=BudgetInputs(instrument_ppm, alignment_mm, temperature_u_K,
+                                           cte_u_ppm_per_K, eve_um), tolerance=tol,
+                       identification=identification)
+    return Iso230_2(report, rs.evaluations, identification=identification)

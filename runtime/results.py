@@ -1,0 +1,135 @@
+"""What every result of the Python API shares, and the callable capability packages.
+
+A result (``volerr.calibrate(...)``, ``volerr.plan(...)``, ``volerr.loop(...)`` ...) is an
+object you can read, after statsmodels' ``RegressionResults`` and scipy's ``OptimizeResult``:
+
+* its values as attributes (and ``result["key"]``, the keys of the command's JSON);
+* ``to_dict()``: the command's ``--json`` document, as :func:`json.loads` reads it back;
+* ``write_json(path)``, ``write_html(path)``: the command's ``--json`` and ``--html`` files;
+* ``summary()``: the text the command prints;
+* ``table()``: one row per reported value: name, value, standard uncertainty (k = 1), unit
+  and the coverage factor ``k`` of the uncertainty column (always 1: a standard
+  uncertainty; an expanded one is ``k * u``); a :class:`pandas.DataFrame` where pandas is
+  installed, a list of :class:`Row` otherwise;
+* ``figures()``: the figures as :class:`matplotlib.figure.Figure` objects;
+* a ``repr`` of one line.
+
+The callable packages: ``volerr.calibrate`` is both a sub-package (``volerr.calibrate.run``,
+``volerr.calibrate.terms`` ...) and the function of the command.  Python binds the attribute
+``volerr.calibrate`` to the sub-package's module object as soon as anything imports it, so a
+function of that name in ``volerr/__init__.py`` would be replaced by the module after
+``import volerr.calibrate.run``.  Instead the package module itself is made callable
+(:func:`callable_package`: its ``__class__`` becomes :class:`CallableModule`, whose
+``__call__`` calls the package's own API function), so ``volerr.calibrate(...)`` works
+whatever was imported before, and ``volerr.calibrate.run`` keeps working.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import types
+from typing import NamedTuple
+
+
+class Row(NamedTuple):
+    """One row of :meth:`ResultMixin.table`: a reported value with its standard uncertainty
+    ``std`` (k = 1; the expanded uncertainty is ``k * std``), both in ``unit``."""
+
+    name: str
+    value: float
+    std: float | None
+    unit: str
+    k: float = 1.0
+
+
+def _plain(o):
+    """numpy scalars and arrays as JSON values (as the commands write them)."""
+    import numpy as np
+
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def rows_of(parameters: dict) -> list:
+    """Rows of a ``{name: {"value", "std", "unit"}}`` mapping (the commands' JSON form)."""
+    return [Row(n, v.get("value"), v.get("std"), v.get("unit", ""), 1.0)
+            for n, v in (parameters or {}).items() if isinstance(v, dict) and "value" in v]
+
+
+def as_table(rows: list):
+    """``rows`` as a :class:`pandas.DataFrame` (columns name, value, std, unit, k) where
+    pandas is installed, else the list itself."""
+    try:
+        import pandas as pd
+    except ImportError:
+        return list(rows)
+    return pd.DataFrame([r._asdict() for r in rows], columns=list(Row._fields))
+
+
+class ResultMixin:
+    """The shared methods of the API's results (see the module docstring).  A result keeps
+    its JSON document in ``data`` (a dict, or a method returning it) and may override
+    :meth:`_rows` and :meth:`figures`."""
+
+    def _document(self) -> dict:
+        d = self.data
+        return d() if callable(d) else d
+
+    def to_dict(self) -> dict:
+        """The command's ``--json`` document (a fresh copy of plain JSON values)."""
+        return json.loads(json.dumps(self._document(), default=_plain))
+
+    def write_json(self, path, inputs=()):
+        """Write :meth:`to_dict` as the command's ``--json`` file; returns its path.
+        ``inputs``: files the output must not overwrite."""
+        from .fileio import json_text, write_text
+
+        return write_text(path, json_text(self._document(), default=_plain),
+                          inputs=list(inputs))
+
+    def _rows(self) -> list:
+        return rows_of(self._document().get("parameters"))
+
+    def table(self):
+        """Value, standard uncertainty (k = 1), unit and k of every reported value: a
+        :class:`pandas.DataFrame` where pandas is installed, else a list of :class:`Row`."""
+        return as_table(self._rows())
+
+    def figures(self) -> dict:
+        """The result's figures, ``{name: matplotlib.figure.Figure}`` (none by default)."""
+        return {}
+
+    def __getattr__(self, name):
+        # the JSON document's keys as attributes (cal.parameters, plan.files ...)
+        if name.startswith("_") or name in ("data",):
+            raise AttributeError(name)
+        doc = self._document()
+        if isinstance(doc, dict) and name in doc:
+            return doc[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __repr__(self) -> str:
+        text = self.summary().splitlines()
+        first = text[0] if text else ""
+        if len(first) > 110:
+            first = first[:107] + "..."
+        return f"<volerr {type(self).__name__}: {first}>"
+
+
+class CallableModule(types.ModuleType):
+    """A package module that can be called: ``volerr.calibrate(...)`` is
+    ``volerr.calibrate.__api__(...)``, the package's API function."""
+
+    def __call__(self, *args, **kwargs):
+        return self.__api__(*args, **kwargs)
+
+
+def callable_package(name: str, function) -> None:
+    """Make the (already imported) package module ``name`` callable as ``function``."""
+    module = sys.modules[name]
+    module.__api__ = function
+    module.__class__ = CallableModule
