@@ -528,7 +528,8 @@ def artifact_check(path: Trace, cols: dict, model, clear_mm: float = 10.0) -> li
         else:
             hits[(lab, own)].append(u)
     for (lab, b), dirs in hits.items():
-        rank = np.linalg.matrix_rank(np.array(dirs[1:]) - dirs[0], tol=1e-3) if dirs else 0
+        rank = (np.linalg.matrix_rank(np.array(dirs[1:]) - dirs[0], tol=1e-3)
+                if len(dirs) > 1 else 0)
         if len(dirs) < 4 or rank < 3:
             bad.append(f"ball {b} of {lab}: {len(dirs)} radial probing moves, directions of "
                        f"affine rank {rank} (a centre needs 4 not coplanar)")
