@@ -55,6 +55,12 @@ def register(sub) -> None:
     p.add_argument("--criterion", choices=("I", "D"), default="I",
                    help="I: mean predicted variance of the volumetric error over the working "
                         "volume; D: determinant of the information matrix")
+    p.add_argument("--dialect", default="iso", metavar="NAME",
+                   help="controller dialect of the NC programs: iso (default; ISO 6983 / "
+                        "RS274NGC, read by LinuxCNC), linuxcnc, fanuc (G4 P in ms, G31 "
+                        "probing), sinumerik (.mpf: G4 F, MEAS=1, ; comments), heidenhain (.h "
+                        "plain language: CYCL DEF 9 dwell, TCH PROBE 0); every program safe "
+                        "along its whole path: 'volerr formats plan'")
     p.add_argument("--seed", type=int, default=0,
                    help="seed of the random starts of the exchange (the same seed, the same "
                         "plan)")
@@ -68,6 +74,10 @@ def run(args) -> int:
 
     require(1 <= args.readings <= 10 ** 7, "--readings must be between 1 and 10000000")
     require(args.minutes is None or args.minutes > 0, "--minutes must be positive")
+    from ..plan._dialect import NAMES
+
+    require(args.dialect in NAMES, f"--dialect {args.dialect}: not a dialect; give one of "
+                                   f"{', '.join(NAMES)}")
     require(args.parameters is None or args.parameters.strip(),
             "--parameters: empty; give names, axes or groups")
     inputs = layout_inputs(args.layout)
@@ -76,7 +86,8 @@ def run(args) -> int:
     outs = Outputs(inputs, force=args.force).folder("--out", out) \
         .file("--json", args.json).file("--html", args.html).check()
     if out.is_dir() and not args.force:
-        taken = sorted(p.name for p in out.iterdir() if p.suffix in (".csv", ".nc", ".html"))
+        taken = sorted(p.name for p in out.iterdir()
+                       if p.suffix in (".csv", ".nc", ".html", ".h", ".mpf"))
         require(not taken, f"--out {out}: holds {taken[0] if taken else ''} already; give "
                            f"--force to replace plan files there, or another folder")
     with outs:

@@ -57,8 +57,12 @@ def _files_readings(kind: str):
     return READINGS[kind]
 
 
-def nc_name(pf) -> str:
-    return pf.name[:-4] + ".nc"
+def nc_name(pf, dialect: str = "iso") -> str:
+    """The NC program's file name beside ``pf``: ``.nc`` (``.mpf`` SINUMERIK, ``.h``
+    Heidenhain)."""
+    from ._dialect import DIALECTS
+
+    return pf.name[:-4] + DIALECTS[dialect].suffix
 
 
 def _params(pred, alone=None) -> dict:
@@ -77,7 +81,7 @@ def data(plan) -> dict:
     pred, base = plan.prediction, plan.baseline["prediction"]
     files = []
     for pf, minutes in zip(plan.files, plan.minutes):
-        files.append({"file": pf.name, "kind": pf.kind, "nc": nc_name(pf), "readings": pf.n,
+        files.append({"file": pf.name, "kind": pf.kind, "nc": nc_name(pf, plan.dialect), "readings": pf.n,
                       "minutes": minutes,
                       "setups": [{"label": s.label, "text": s.text, "readings": int(m),
                                   **_geometry(s.geometry)} for s, m in pf.setups]})

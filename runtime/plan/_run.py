@@ -76,17 +76,22 @@ class Plan:
     candidate_readings: int = 0
     parameters_text: str | None = None
     map_grid: dict = field(default_factory=dict)
+    dialect: str = "iso"
 
-    def write(self, folder, json_path=None, html_path=None, inputs=()) -> None:
-        """The files, NC programs, ``plan.html`` (or ``html_path``) and the JSON."""
+    def write(self, folder, json_path=None, html_path=None, inputs=(), dialect=None) -> None:
+        """The files, NC programs (in ``dialect``, default :attr:`dialect`: one of
+        :data:`volerr.plan._dialect.NAMES`), ``plan.html`` (or ``html_path``) and the JSON."""
         from ..fileio import json_text, write_text
         from . import _nc, _report, _sheet
         from ._files import csv_text
 
+        self.dialect = dialect or self.dialect
         for pf in self.files:
             header = _report.file_header(self, pf)
             write_text(f"{folder}/{pf.name}", csv_text(pf, header), inputs=list(inputs))
-            write_text(f"{folder}/{_report.nc_name(pf)}", _nc.program(self.model, pf, header),
+            nc = _report.nc_name(pf, self.dialect)
+            write_text(f"{folder}/{nc}", _nc.program(self.model, pf, header, self.dialect,
+                                                     _nc.program_name(nc)),
                        inputs=list(inputs))
         write_text(html_path or f"{folder}/plan.html", _sheet.html(self), inputs=list(inputs))
         if json_path:

@@ -15,15 +15,33 @@ VIEWS = (("X", "Y", 0, 1), ("X", "Z", 0, 2), ("Y", "Z", 1, 2))
 MARKERS = {"ballbar": "o", "sphere": "s", "distances": "^", "interferometer": "D", "artifact": "P"}
 
 
+#: what each marker stands for (the figure's legend)
+KEYS = {"ballbar": "ballbar pivot", "sphere": "sphere", "distances": "station",
+        "interferometer": "laser line start", "artifact": "ball plate's first ball"}
+#: labels closer than this share of a view's span are one label ("C57, C63")
+MERGE = 0.02
+
+
 @plotstyle.styled
 def figure(plan) -> bytes:
-    """PNG of the three views (module docstring)."""
+    """PNG of :func:`views`."""
+    return plotstyle.png(views(plan))
+
+
+def views(plan):
+    """The matplotlib figure of the three views (module docstring): the title above, the key
+    below (a legend of the markers), set-ups at the same place in a view labelled once ("C57,
+    C63"), labels of set-ups close together moved apart instead of overlapping."""
+    from matplotlib.lines import Line2D
+
     model = plan.model
     tool = next((i.tool for i in plan.instruments if any(i.tool)), (0.0, 0.0, 0.0))
     lo, hi = _candidates.volume(model, tool)
-    fig, axes = plotstyle.figure(1, 3, height=3.8)
+    fig, axes = plotstyle.figure(1, 3, height=4.2)
+    kinds = []
     for ax, (a, b, i, j) in zip(axes, VIEWS):
         ax.add_patch(_box(lo[i], lo[j], hi[i] - lo[i], hi[j] - lo[j]))
+        marks = []
         for k, pf in enumerate(plan.files):
             pos = {x: np.asarray(pf.columns[x], float) for x in model.axes}
             probe = np.column_stack([pf.columns[c] for c in ("Xp", "Yp", "Zp")])
@@ -34,16 +52,51 @@ def figure(plan) -> bytes:
                 g = s.geometry
                 p = g.get("pivot", g.get("centre", g.get("station", g.get("start"))))
                 ax.plot(p[i], p[j], MARKERS[s.kind], color=colour, ms=7, mec="k")
-                ax.annotate(s.label, (p[i], p[j]), textcoords="offset points", xytext=(4, 4),
-                            fontsize=9)
+                marks.append((float(p[i]), float(p[j]), s.label))
+                kinds.append(s.kind)
+        _labels(ax, marks, max(hi[i] - lo[i], hi[j] - lo[j], 1.0))
         ax.set_xlabel(plotstyle.label(a, "mm"))
         ax.set_ylabel(plotstyle.label(b, "mm"))
         ax.set_aspect("equal", adjustable="datalim")
-    fig.suptitle(f"{model.name}: where each set-up goes (workpiece frame)\n"
-                 f"o pivot, square sphere, triangle station, diamond laser line start, pentagon "
-                 f"ball plate's first ball; dots: the tool point at each "
-                 f"reading; dashed: the working volume")
-    return plotstyle.png(fig)
+    fig.suptitle(f"{model.name}: where each set-up goes (workpiece frame)")
+    handles = [Line2D([], [], marker=MARKERS[k], ls="none", color="0.7", mec="k", ms=7,
+                      label=KEYS[k]) for k in dict.fromkeys(kinds)]
+    handles += [Line2D([], [], marker=".", ls="none", color="0.4", label="tool point at "
+                       "each reading"),
+                Line2D([], [], ls="--", color="0.4", label="working volume")]
+    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 4),
+               fontsize=8, frameon=False)
+    return fig
+
+
+def _labels(ax, marks, span) -> None:
+    """Annotate ``marks`` [(x, y, label)]: labels at one place (within :data:`MERGE` of the
+    span) joined; each label put right above its mark, or moved down (then left of the mark)
+    in steps of 11 points until its box (estimated: 4.8 points a character, 9 high, a view
+    about 190 points for 1.15 spans) overlaps no marker and no label placed before."""
+    groups: list = []
+    for x, y, lab in marks:
+        for g in groups:
+            if abs(g[0] - x) <= MERGE * span and abs(g[1] - y) <= MERGE * span:
+                g[2].append(lab)
+                break
+        else:
+            groups.append([x, y, [lab]])
+    unit = 190.0 / (1.15 * span)            # points per mm
+    boxes = [(x * unit - 4, y * unit - 4, x * unit + 4, y * unit + 4) for x, y, _ in groups]
+    for x, y, labs in sorted(groups, key=lambda g: (-g[1], g[0])):
+        text = ", ".join(labs)
+        w = 4.8 * len(text)
+        tries = [(4.0, 4.0 - 11.0 * k) for k in range(4)] + \
+                [(-4.0 - w, 4.0 - 11.0 * k) for k in range(4)]
+        px, py = x * unit, y * unit
+        for dx, dy in tries:
+            box = (px + dx, py + dy, px + dx + w, py + dy + 9.0)
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3]
+                       for b in boxes):
+                break
+        boxes.append(box)
+        ax.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), fontsize=8)
 
 
 def _box(x, y, w, h):

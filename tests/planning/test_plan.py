@@ -96,14 +96,17 @@ def test_mixed_plan_names_what_only_the_combination_determines(plans):
 
 
 def _moves(nc: str):
-    """(end points of G0/G1 blocks as {axis: value}, modal: an axis a block does not name
-    stays where it was; the block after each)."""
+    """(end points of G0/G1/G2/G3 blocks as {axis: value}, modal: an axis a block does not
+    name stays where it was; the block after each).  A plane word (G17-G19) may come first;
+    arc centre words I J K and the feed are not positions."""
     lines = [ln.strip() for ln in nc.splitlines()]
     moves, at = [], {}
     for i, ln in enumerate(lines):
         code = re.sub(r"\(.*?\)", "", ln).split()
-        if code and code[0] in ("G0", "G1"):
-            at = {**at, **{w[0]: float(w[1:]) for w in code[1:] if w[0] != "F"}}
+        if code and code[0] in ("G17", "G18", "G19"):
+            code = code[1:]
+        if code and code[0] in ("G0", "G1", "G2", "G3"):
+            at = {**at, **{w[0]: float(w[1:]) for w in code[1:] if w[0] in "XYZABC"}}
             moves.append((dict(at), lines[i + 1] if i + 1 < len(lines) else ""))
     return moves
 

@@ -4,8 +4,8 @@ tests/helpers/metrology_sim.py (never volerr's model): the true plate poses are 
 nominal ones (fitted here, Kabsch), perturbed per placement, the balls' calibration errors drawn
 from the declared ``u_std_um``, probing noise of ``probe_u_um``; calibrated with no options:
 every parameter within 3 std of the planted value and the realised std within 0.7-1.4 x the
-plan's ``predicted_std``; every ball inside the travel; the NC program passes through the balls
-in order, each followed by a dwell."""
+plan's ``predicted_std``; every ball inside the travel; the NC program probes every ball, in
+order, with probing moves aimed at its centre."""
 
 from __future__ import annotations
 
@@ -126,21 +126,39 @@ def test_file_lists_the_balls_inside_the_travel_with_empty_readings(plan):
     assert {c.split(",")[0] for c in comments if c.startswith("# set-up")}
 
 
-def test_nc_program_passes_through_the_balls_with_a_dwell(plan):
+def test_nc_program_probes_every_ball_towards_its_centre_in_order(plan):
+    """Issue 36: a ball is measured by probing moves (``G38.2``) aimed at its centre from
+    outside, at least four per ball (a centre and a radius), not all in one plane; the balls
+    in the file's order."""
     folder, doc = plan
     axes = read_layout(doc["layout"]).axis_names
     (f,) = doc["files"]
     _, cols = plan_fill.read(folder / f["file"])
-    rows = [{a: float(cols[k][i]) for a, k in zip(axes, ("x_nom_mm", "y_nom_mm", "z_nom_mm"))}
-            for i in range(len(cols["ball"]))]
-    lines = [ln.strip() for ln in (folder / f["nc"]).read_text().splitlines()]
-    where, k = {}, 0
-    for i, ln in enumerate(lines):
+    centres = np.array([[float(cols[k][i]) for k in ("x_nom_mm", "y_nom_mm", "z_nom_mm")]
+                        for i in range(len(cols["ball"]))])
+    where, probes = {}, []
+    for ln in (folder / f["nc"]).read_text().splitlines():
         code = re.sub(r"\(.*?\)", "", ln).split()
-        if not code or code[0] not in ("G0", "G1"):
+        if not code or code[0] not in ("G0", "G1", "G38.2"):
             continue
-        where = {**where, **{w[0]: float(w[1:]) for w in code[1:] if w[0] != "F"}}
-        if k < len(rows) and all(abs(where.get(a, np.nan) - rows[k][a]) < 1e-9 for a in axes):
-            assert lines[i + 1].startswith("G4 P")
-            k += 1
-    assert k == len(rows)
+        to = {**where, **{w[0]: float(w[1:]) for w in code[1:] if w[0] in "XYZ"}}
+        if code[0] == "G38.2":
+            probes.append((np.array([where[a] for a in axes]), np.array([to[a] for a in axes])))
+        where = to
+    def aimed(p0, p1, c):
+        d = (p1 - p0) / np.linalg.norm(p1 - p0)
+        along = (c - p0) @ d
+        return (np.linalg.norm(c - p0 - along * d) < 1e-3
+                and along > np.linalg.norm(p1 - p0) > 0)   # stops short of the centre
+
+    owner, b = [], 0            # the balls in the file's order (placements may share places)
+    for p0, p1 in probes:
+        while b < len(centres) and not aimed(p0, p1, centres[b]):
+            b += 1
+        assert b < len(centres), (p0, p1, "a probing move not aimed at the next ball's centre")
+        owner.append(b)
+    for b in range(len(centres)):
+        starts = np.array([p0 for (p0, _), o in zip(probes, owner) if o == b])
+        assert len(starts) >= 4, (b, "fewer than four probing points")
+        rel = starts - starts.mean(axis=0)
+        assert np.linalg.svd(rel, compute_uv=False)[-1] > 1.0, (b, "points in one plane")
