@@ -430,8 +430,9 @@ def _probe(cols: dict, mask=None) -> np.ndarray:
 def ballbar_check(path: Trace, cols: dict, model, tol_mm: float = 1.0) -> tuple:
     """Every reading on the path in order, and the bar (tool-ball centre through the layout's
     nominal forward kinematics, in the workpiece frame, to the pivot on the table) within
-    ``tol_mm`` of its length along the whole path from the first to the last reading of each
-    set-up.  Returns (violations, {set-up: worst deviation mm})."""
+    ``tol_mm`` of its length along the whole path while it is mounted: from the program stop
+    before the first reading of a set-up (mount the bar) to the one after its last (remove
+    it), or from the first to the last reading where the program has no such stops.  Returns (violations, {set-up: worst deviation mm})."""
     bad, worst = [], {}
     label = np.array(cols["placement"])
     for lab in _labels(cols):
@@ -442,7 +443,7 @@ def ballbar_check(path: Trace, cols: dict, model, tol_mm: float = 1.0) -> tuple:
             bad.append(f"set-up {lab}: readings {missing[:5]} (of {m.sum()}) not on the path "
                        "in the file's order")
             continue
-        q6, lines = sample_between(path, where[0], where[-1])
+        q6, lines = sample_between(path, *_mounted(path, where[0], where[-1]))
         tip = model.forward(layout_positions(q6, model.axes), probe=_probe(cols, m)[0])[:, :3]
         pivot = np.array([column(cols, c)[m][0] for c in ("pivot_x", "pivot_y", "pivot_z")])
         length = column(cols, "length_mm")[m][0]
@@ -453,6 +454,16 @@ def ballbar_check(path: Trace, cols: dict, model, tol_mm: float = 1.0) -> tuple:
             bad.append(f"set-up {lab}: bar {length:g} mm {'squeezed' if dev[k] < 0 else 'pulled'}"
                        f" by {abs(dev[k]):.2f} mm at line {lines[k]} (limit {tol_mm:g} mm)")
     return bad, worst
+
+
+def _mounted(path: Trace, first: tuple, last: tuple) -> tuple:
+    """The path locations between which a ballbar is mounted (see :func:`ballbar_check`)."""
+    stops = [e.after for e in path.events if e.kind == "stop"]
+    before = [a for a in stops if a <= first[0]]
+    after = [a for a in stops if a > last[0]]
+    if not before or not after or after[0] - 1 < before[-1]:
+        return first, last
+    return (before[-1], 0.0), (after[0] - 1, 1.0)
 
 
 def _tips(model, q6, probe):
