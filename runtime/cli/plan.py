@@ -95,6 +95,6 @@ def run(args) -> int:
                       args.minutes, args.criterion, args.seed)
         folder = outs.path("--out")
         result.write(folder, outs.path("--json") if args.json else None,
-                     outs.path("--html") if args.html else None, inputs)
+                     outs.path("--html") if args.html else None, inputs, args.dialect)
     print(result.summary())
     return 0

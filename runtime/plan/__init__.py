@@ -7,11 +7,13 @@ and predicts what ``calibrate`` will report on the filled files.
 Steps: :mod:`volerr.plan._run`; candidates :mod:`._candidates`; information (calibrate's
 observation model) :mod:`._information`; the design algorithm :mod:`._design`; prediction on
 calibrate's path :mod:`._predict`; the conventional plan :mod:`._baseline`; outputs
-:mod:`._write`, :mod:`._nc`, :mod:`._sheet`.
+:mod:`._write`, :mod:`._nc` (programs safe along their whole path; the controller dialects
+:mod:`._dialect`, a ball plate's probing :mod:`._probing`), :mod:`._sheet`.
 """
 
 from ._execute import execute
+from ._nc import nc_program
 from ._run import Plan, default_request, plan
 from ._sheet import comparison_png
 
-__all__ = ["Plan", "comparison_png", "default_request", "execute", "plan"]
+__all__ = ["Plan", "comparison_png", "default_request", "execute", "nc_program", "plan"]

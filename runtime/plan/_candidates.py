@@ -411,7 +411,8 @@ def plate_points(inst) -> np.ndarray:
 def artifact_setups(model, inst) -> list:
     """Ball-plate placements in the planes XY, YZ, ZX, turned 0 and 90 deg in the plane,
     centred in the working volume in the plane, at :data:`PLATE_LEVELS` along the normal;
-    every ball's nominal position inside the travel, rotary axes at home."""
+    every ball's nominal position and the touch probe's path round it inside the travel,
+    rotary axes at home."""
     lo, hi = volume(model, inst.tool)
     pts = plate_points(inst)
     half = 0.5 * (pts.max(axis=0) - pts.min(axis=0))
@@ -443,7 +444,7 @@ def _plate(model, inst, pts, R, origin, where, label) -> SetUp | None:
     except Exception:       # not reachable
         return None
     pos.update(rot)
-    if not inside(model, pos).all():
+    if not inside(model, pos).all() or not _probe_path_inside(model, inst, nominal, plane):
         return None
     lin = tuple(a for a in model.axes if a not in model.rotary_axes)
 
@@ -464,6 +465,20 @@ def _plate(model, inst, pts, R, origin, where, label) -> SetUp | None:
             f"turned {turn} deg, first ball at ({origin[0]:g}, {origin[1]:g}, {origin[2]:g}) mm")
     geometry = {"start": origin, "plane": plane, "turn": turn, "level": level}
     return SetUp("artifact", label, build, n, n, n, geometry, text, hidden=lin)
+
+
+def _probe_path_inside(model, inst, nominal, plane) -> bool:
+    """Every point the touch probe goes to round the balls ``nominal`` (N, 3) inside the
+    travel (:mod:`volerr.plan._probing`)."""
+    from . import _probing
+
+    rot = home(model)
+    tool = np.asarray(inst.tool, float)
+    n, dirs = _probing.directions(model, plane, tool, rot)
+    pts = np.vstack([_probing.ball_path(c, n, dirs) for c in nominal])
+    pos = model.linear_positions(pts, {a: np.full(len(pts), v) for a, v in rot.items()}, tool)
+    pos.update({a: np.full(len(pts), v) for a, v in rot.items()})
+    return bool(inside(model, pos).all())
 
 
 MAKERS["artifact"] = artifact_setups

@@ -42,8 +42,10 @@ NAMES = ("iso", "linuxcnc", "fanuc", "sinumerik", "heidenhain")
 LINE_MAX = 200
 #: arc plane of a circle about the axis named (G17 XY about Z, G18 ZX about Y, G19 YZ about X)
 PLANE_CODE = {"Z": "G17", "Y": "G18", "X": "G19"}
-#: centre words of each arc plane, in the order of its axes
-CENTRE_WORDS = {"Z": ("X", "I", "Y", "J"), "Y": ("X", "I", "Z", "K"), "X": ("Y", "J", "Z", "K")}
+#: centre words of each arc plane, the plane's axes in their right-handed order about the
+#: normal (G17 X, Y; G18 Z, X; G19 Y, Z: counter-clockwise seen from the normal's positive
+#: end turns the first towards the second)
+CENTRE_WORDS = {"Z": ("X", "I", "Y", "J"), "Y": ("Z", "K", "X", "I"), "X": ("Y", "J", "Z", "K")}
 
 
 @dataclass
@@ -141,7 +143,8 @@ class Iso:
     def arc(self, op: Op, start: dict) -> list:
         a, i, b, j = CENTRE_WORDS[op.normal]
         code = "G3" if op.ccw else "G2"
-        off = (f"{i}{number(op.centre[a] - start[a])} {j}{number(op.centre[b] - start[b])}")
+        off = " ".join(sorted([f"{i}{number(op.centre[a] - start[a])}",
+                               f"{j}{number(op.centre[b] - start[b])}"]))    # I J K
         return [f"{PLANE_CODE[op.normal]} {code} {self.words(op.to)} {off} F{number(op.feed)}"]
 
     def probe(self, op: Op) -> list:
@@ -268,7 +271,8 @@ class Heidenhain(Iso):
     def arc(self, op: Op, start: dict) -> list:
         a, _, b, _ = CENTRE_WORDS[op.normal]
         cc = f"CC {a}{number(op.centre[a], sign=True)} {b}{number(op.centre[b], sign=True)}"
-        return [cc, f"C {self.words(op.to)} DR{'+' if op.ccw else '-'} R0 F{number(op.feed)}"]
+        end = self.words({k: v for k, v in op.to.items() if k in (a, b)})  # the circle's plane
+        return [cc, f"C {end} DR{'+' if op.ccw else '-'} R0 F{number(op.feed)}"]
 
     def probe(self, op: Op) -> list:
         sense = "+" if op.sign > 0 else "-"

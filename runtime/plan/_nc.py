@@ -29,7 +29,8 @@ R-test, distances, interferometer) -- a ball of an artifact is probed instead (b
   four round the equator and the pole; a standing plate: the pole on its free side, both
   horizontal equator points and the top), the stylus moving between them on a box
   :data:`PROBE_START_MM` round the ball on its free side; between balls up to the clearance
-  height.  Ball :data:`BALL_D_MM`, stylus tip :data:`STYLUS_D_MM` (stated in the program).
+  height.  Ball :data:`BALL_D_MM`, stylus tip :data:`STYLUS_D_MM` (stated in the program;
+  the geometry: :mod:`volerr.plan._probing`).
 * **interferometer** (ISO 230-2:2014 linear cycle, cl. 4.3 / 5.3): each target approached
   from its declared direction, an overshoot :data:`OVERSHOOT_MM` beyond the last target
   before each reversal and before the first target, a dwell at each.
@@ -41,9 +42,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _dialect, _spec
+from . import _dialect, _probing, _spec
 from ._candidates import home
 from ._dialect import Op
+from ._probing import BALL_D_MM, PROBE_START_MM, STYLUS_D_MM
 
 #: feed of the motion blocks, mm/min (ballbar circles: the ISO 230-4 test feed)
 FEED = {"ballbar": _spec.BALLBAR_FEED_MM_MIN, "sphere": 1000.0, "distances": 2000.0,
@@ -60,15 +62,27 @@ BAR_TOL_MM = 0.05
 #: interferometer overshoot beyond the end targets before a reversal, mm (at most the room
 #: left in the travel)
 OVERSHOOT_MM = 5.0
-#: ball plate: ball and stylus tip diameters (mm), the start of a probing move from the ball
-#: centre, how far past the expected contact a probing move is programmed (mm), probing feed
-BALL_D_MM, STYLUS_D_MM, PROBE_START_MM, PROBE_PAST_MM, PROBE_FEED = 25.0, 3.0, 22.0, 2.0, 200.0
+#: ball plate: probing feed, mm/min (the geometry: :mod:`volerr.plan._probing`)
+PROBE_FEED = 200.0
 
 
 def program(model, pf, header: list, dialect: str = "iso", name: str = "PLAN") -> str:
     """The NC program of plan file ``pf`` (a :class:`volerr.plan._files.PlanFile`) in
     ``dialect`` (:data:`volerr.plan._dialect.NAMES`); ``header`` comment lines first."""
     return _dialect.dialect(dialect, model.axes).render(operations(model, pf, header), name)
+
+
+def nc_program(model, instrument, setups, dialect: str = "iso", header=(),
+               name: str = "PLAN") -> str:
+    """The NC program of ``setups`` [(SetUp, readings)] of one instrument (an ``--instrument``
+    SPEC text or a parsed :class:`volerr.plan._spec.Instrument`), as ``volerr plan`` writes
+    it, in ``dialect``: for a caller with its own set-ups (an interim check)."""
+    from ._files import PlanFile, columns_of
+
+    inst = _spec.parse(instrument) if isinstance(instrument, str) else instrument
+    pf = PlanFile("program.csv", inst.kind, 0, list(setups))
+    pf.columns = columns_of(inst, pf.setups)
+    return program(model, pf, list(header), dialect, name)
 
 
 def program_name(file_name: str) -> str:
@@ -337,51 +351,21 @@ def _artifact(model, pf, setup, rows) -> list:
     centres = np.column_stack([np.asarray(pf.columns[f"{c}_nom_mm"], float)[mine]
                                for c in "xyz"])
     rot = home(model)
-    axis = model.forward({**{a: np.zeros(1) for a in model.axes},
-                          **{a: np.array([v]) for a, v in rot.items()}}, probe=tool)[0, 3:]
-    normal = np.eye(3)[3 - sum(_PLATE_AXES[setup.geometry["plane"]])]
-    dirs = probe_directions(normal, axis)
-    contact = 0.5 * (BALL_D_MM + STYLUS_D_MM)
+    normal, dirs = _probing.directions(model, setup.geometry["plane"], tool, rot)
     ops = [Op("comment", text=f"ball {BALL_D_MM:g} mm, stylus tip {STYLUS_D_MM:g} mm: each "
                               f"ball probed at {len(dirs)} points towards its centre from "
                               f"{PROBE_START_MM:g} mm, on the plate's free side")]
     for b, c in zip(balls[mine], centres):
         ops.append(Op("comment", text=f"ball {b}: centre ({c[0]:g}, {c[1]:g}, {c[2]:g}) mm"))
-        ops += _ball(model, c, normal, dirs, contact, rot, tool)
+        ops += _ball(model, c, normal, dirs, rot, tool)
     return ops
 
 
-#: plate plane -> (workpiece axis of u, of v) at 0 deg (as volerr.plan._candidates)
-_PLATE_AXES = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}
-
-
-def probe_directions(normal, axis) -> list:
-    """Unit directions (3,) from a ball's centre to the points probed on it: a plate lying
-    flat (its free-side ``normal`` along the tool ``axis``): the four equator directions of
-    the plate's axes and the pole; a standing plate: the pole, both in-plane directions normal
-    to the tool axis, and the in-plane direction up the tool axis."""
-    n, a = np.asarray(normal, float), np.asarray(axis, float)
-    inplane = [e for e in np.eye(3) if abs(e @ n) < 0.5]
-    if abs(n @ a) > 0.99:
-        return [e * s for e in inplane for s in (1.0, -1.0)] + [n]
-    up = a - (a @ n) * n
-    up = up / np.linalg.norm(up)
-    side = np.cross(n, up)
-    return [n, side, -side, up]
-
-
-def _ball(model, c, n, dirs, contact, rot, tool) -> list:
+def _ball(model, c, n, dirs, rot, tool) -> list:
     """The blocks of one ball: up, across, down to the point :data:`PROBE_START_MM` out along
-    the free-side normal, then each probing point by the box corner ``n + d``."""
-    r = PROBE_START_MM
-    pts = [c + r * n]
-    for d in dirs:
-        pts += [c + r * n + (r * d if abs(d @ n) < 0.5 else 0.0), c + r * d,
-                c + (contact - PROBE_PAST_MM) * d, c + r * d,
-                c + r * n + (r * d if abs(d @ n) < 0.5 else 0.0)]
-    pts.append(c + r * n)
-    pos = model.linear_positions(np.array(pts), {a: np.full(len(pts), v) for a, v in
-                                                 rot.items()}, tool)
+    the free-side normal, then each probing point by the box corner (module docstring)."""
+    pts = _probing.ball_path(c, n, dirs)
+    pos = model.linear_positions(pts, {a: np.full(len(pts), v) for a, v in rot.items()}, tool)
     q = np.round(np.column_stack([pos[a] for a in model.axes]), 4)
     ops = [Op("rapid", {"Z": _top(model)}), *_down_to(model, q[0])]
     for k, d in enumerate(dirs):
@@ -389,7 +373,8 @@ def _ball(model, c, n, dirs, contact, rot, tool) -> list:
         j = int(np.argmax(np.abs(d)))
         ops += [Op("line", _at(model, corner), FEED["artifact"]),
                 Op("line", _at(model, start), FEED["artifact"]),
-                Op("probe", _at(model, past), PROBE_FEED, axis="XYZ"[j], sign=int(np.sign(-d[j]))),
+                Op("probe", _at(model, past), PROBE_FEED, axis="XYZ"[j],
+                   sign=int(np.sign(-d[j]))),
                 Op("line", _at(model, start), FEED["artifact"]),
                 Op("line", _at(model, corner), FEED["artifact"])]
     return ops + [Op("line", _at(model, q[-1]), FEED["artifact"])]

@@ -81,7 +81,8 @@ def data(plan) -> dict:
     pred, base = plan.prediction, plan.baseline["prediction"]
     files = []
     for pf, minutes in zip(plan.files, plan.minutes):
-        files.append({"file": pf.name, "kind": pf.kind, "nc": nc_name(pf, plan.dialect), "readings": pf.n,
+        files.append({"file": pf.name, "kind": pf.kind, "nc": nc_name(pf, plan.dialect),
+                      "readings": pf.n,
                       "minutes": minutes,
                       "setups": [{"label": s.label, "text": s.text, "readings": int(m),
                                   **_geometry(s.geometry)} for s, m in pf.setups]})

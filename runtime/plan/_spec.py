@@ -9,7 +9,8 @@ Time model (minutes; planning assumptions, documented in ``volerr formats plan``
 sources): a set-up change (mount and centre a pivot, move the sphere, move a station) costs
 ``SETUP_MIN[kind]``; a reading costs ``READING_S[kind]`` seconds (a stop, the dwell and the
 move to the next pose); a ballbar trace is read on the fly at ``BALLBAR_FEED_MM_MIN``, its time
-is the circle's length at that feed (both directions, with a quarter-turn run-in each).
+is the circle's length at that feed (both directions, each with a 45 deg run-in and a 45 deg
+run-out arc: runtime/plan/_nc.py).
 """
 
 from __future__ import annotations

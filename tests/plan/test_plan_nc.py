@@ -12,8 +12,8 @@ probed towards its centre from outside at four points or more, nothing behind th
 plane on the plate; no rotary motion and no motion off the tool axis within 30 mm of a
 sphere; every interferometer reading reached moving in its declared direction, each cycle
 starting beyond its first target; the file's rows a subsequence of the end points; the first
-motion a retract along Z alone; G21, G90, G54 before any motion; M30; lines under 254
-characters.  Where LinuxCNC's ``rs274`` is installed it must read every program without an
+motion a retract along Z alone; G21, G90, G54 before any motion; every end point inside the
+travel; M30; lines under 254 characters.  Where LinuxCNC's ``rs274`` is installed it must read every program without an
 error.  The other dialects: their dwell, probing and comment words.
 """
 
@@ -23,6 +23,7 @@ import math
 import re
 import shutil
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -36,7 +37,7 @@ CASES = {
     "DMU50-ballbar": ("DMU50", "ballbar:lengths=100,250", 25, 20),
     "DMU50-sphere": ("DMU50", "sphere", 30, 10),
     "MB1-artifact": ("MB1", "artifact:balls=3x3:pitch=150", 4, 9),
-    "DMU50-artifact": ("DMU50", "artifact:balls=3x3:pitch=100", 4, 9),
+    "DMU50-artifact": ("DMU50", "artifact", 2, 25),
     "MB1-interferometer": ("MB1", "interferometer", 20, 44),
     "DMU50-interferometer": ("DMU50", "interferometer:optics=linear", 4, 44),
     "MB1-distances": ("MB1", "distances", 5, 14),
@@ -107,7 +108,7 @@ def walk(text: str, axes):
         arc = None
         if kind in ("G2", "G3"):
             off = {k: v for k, v in words if k in "IJK"}
-            a, b = {"Z": "XY", "Y": "XZ", "X": "YZ"}[plane]
+            a, b = {"Z": "XY", "Y": "ZX", "X": "YZ"}[plane]     # right-handed about it
             arc = (plane, {a: where[a] + off.get("IJK"["XYZ".index(a)], 0.0),
                            b: where[b] + off.get("IJK"["XYZ".index(b)], 0.0)}, kind == "G3")
         segs.append((kind, dict(where), to, arc))
@@ -129,6 +130,7 @@ def samples(seg, axes, rotary) -> np.ndarray:
     t0 = math.atan2(s[b] - c[b], s[a] - c[a])
     t1 = math.atan2(e[b] - c[b], e[a] - c[a])
     sweep = (t1 - t0) % (2 * math.pi) if ccw else -((t0 - t1) % (2 * math.pi))
+    assert abs(sweep) <= math.pi, ("an arc the long way round: wrong G2/G3", seg)
     r = math.hypot(s[a] - c[a], s[b] - c[b])
     k = max(int(abs(sweep) * r / 0.5), 4)
     t = t0 + np.linspace(0, 1, k + 1) * sweep
@@ -158,6 +160,10 @@ def test_frame_of_every_program(programs, case, dialect):
         moved = {a for a in model.axes if first[1][a] != first[2][a]}
         assert moved == {"Z"} and first[2]["Z"] == model.travel["Z"][1], (case, first)
         assert segs[-1][0] == "M30" and lines[-2:] == ["M30", "%"], (case, pf.name)
+        for seg in segs[1:]:
+            for a in model.axes:
+                lo, hi = model.travel[a]
+                assert lo - 1e-9 <= seg[2][a] <= hi + 1e-9, (case, pf.name, a, seg)
 
 
 @pytest.mark.parametrize("case", [c for c in CASES if "artifact" not in c])
@@ -321,7 +327,17 @@ def test_dialect_words():
     assert f"G4 F{s:g}\n" in texts["sinumerik"] and f"DWELL {s:g}\n" in texts["heidenhain"]
     model, files = _files_of("MB1-ballbar")
     hh = _nc.program(model, files[0], [], "heidenhain")
-    assert " CC X" in hh and re.search(r" C X\S+ Y\S+ Z\S+ DR[+-] R0 F1000", hh)
+    assert " CC X" in hh and re.search(r" C X\S+ Y\S+ DR[+-] R0 F1000", hh)
+
+
+def test_nc_program_of_own_set_ups_is_the_plan_program():
+    """The writer for a caller with its own set-ups (issue 37's check programs)."""
+    from volerr.plan import nc_program
+
+    model, files = _files_of("DMU50-sphere")
+    pf = files[0]
+    text = nc_program(model, "sphere", pf.setups, "linuxcnc", ["a header"])
+    assert text == _nc.program(model, pf, ["a header"], "linuxcnc")
 
 
 @pytest.mark.skipif(shutil.which("rs274") is None, reason="LinuxCNC's rs274 not installed")
@@ -329,7 +345,7 @@ def test_linuxcnc_interpreter_reads_every_program(programs, tmp_path):
     table = tmp_path / "tool.tbl"
     table.write_text("T1 P1 Z0 D3 ;probe\n")
     for (case, dialect), (model, progs) in programs.items():
-        for pf, text in progs[:2]:
+        for pf, text in progs:
             path = tmp_path / "p.ngc"
             path.write_text(text)
             run = subprocess.run(["rs274", "-g", "-t", str(table), str(path)],
@@ -337,3 +353,66 @@ def test_linuxcnc_interpreter_reads_every_program(programs, tmp_path):
             bad = [ln for ln in (run.stdout + run.stderr).splitlines()
                    if re.search(r"error|too long|unknown", ln, re.IGNORECASE)]
             assert not bad, (case, dialect, pf.name, bad[:3])
+            assert _short_arcs(run.stdout), (case, dialect, pf.name)
+
+
+#: rs274's canonical arc planes: (first axis, second axis) of ARC_FEED's end and centre
+_CANON = {"XY": (0, 1), "XZ": (2, 0), "YZ": (1, 2)}
+
+
+def _short_arcs(canonical: str) -> bool:
+    """Every ARC_FEED of rs274's canonical output turns less than half a turn from where the
+    move before ended (the plan's arcs join readings at most 45 deg apart: an arc the long way
+    round is a G2 written for a G3).  rotation +1: counter-clockwise, first axis towards the
+    second."""
+    at, plane = np.zeros(3), "XY"
+    for ln in canonical.splitlines():
+        m = re.search(r"(SELECT_PLANE\(CANON_PLANE_(\w+)\)|(STRAIGHT_\w+|ARC_FEED)\(([^)]*)\))",
+                      ln)
+        if not m:
+            continue
+        if m.group(2):
+            plane = m.group(2)
+            continue
+        v = [float(x) for x in m.group(4).split(",")]
+        if m.group(3) != "ARC_FEED":
+            at = np.array(v[:3])
+            continue
+        i, j = _CANON[plane]
+        end, c = np.array(v[:2]), np.array(v[2:4])
+        t0 = math.atan2(at[j] - c[1], at[i] - c[0])
+        t1 = math.atan2(end[1] - c[1], end[0] - c[0])
+        turn = (t1 - t0) % (2 * math.pi) if v[4] > 0 else (t0 - t1) % (2 * math.pi)
+        if turn > math.pi:
+            return False
+        at[i], at[j], at[3 - i - j] = end[0], end[1], v[5]
+    return True
+
+
+# ---- the command line ----------------------------------------------------------------------
+def test_dialect_option_writes_that_dialect(tmp_path):
+    import json
+
+    from volerr.cli import main
+
+    out, js = tmp_path / "plan", tmp_path / "plan.json"
+    assert main(["plan", "MB1", "--instrument", "interferometer", "--readings",
+                 "1200", "--dialect", "heidenhain", "--out", str(out), "--json", str(js)]) == 0
+    doc = json.loads(js.read_text())
+    for f in doc["files"]:
+        assert f["nc"].endswith(".h")
+        text = (out / f["nc"]).read_text()
+        assert text.startswith("0 BEGIN PGM ") and "CYCL DEF 9.1 DWELL 3" in text
+        assert max(map(len, text.splitlines())) < 254
+    assert not list(out.glob("*.nc"))
+
+
+@pytest.mark.parametrize("bad", ["ISO"])
+def test_bad_dialect_one_line_exit_2_nothing_written(tmp_path, bad):
+    run = subprocess.run([sys.executable, "-m", "volerr", "plan", "MB1", "--instrument", "ballbar",
+                          "--readings", "100", "--dialect", bad, "--out", str(tmp_path / "p")],
+                         capture_output=True, text=True)
+    assert run.returncode == 2
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--dialect" in lines[0], run.stderr
+    assert not (tmp_path / "p").exists()
