@@ -352,22 +352,43 @@ def path_checks(path: Trace, clearance_z: float) -> list:
 # ---------------------------------------------------------------------------------------------
 # where the readings are
 
-def locate(path: Trace, targets: np.ndarray, tol: float = 2e-3) -> list:
+def locate(path: Trace, targets: np.ndarray, tol: float = 2e-3, headings=None) -> list:
     """For each target (N, 6) in order: (segment index, parameter) of the first point of the
-    path at or after the previous one that is within ``tol`` of it in every axis; None where
-    none is."""
+    path at or after the previous one that is within ``tol`` of it in every axis and, where
+    ``headings`` (N, 6) gives a direction, where the path moves along it (the tangent's dot
+    product with it positive: a point visited twice, once each way, is read on its pass in
+    the reading's direction); None where there is none."""
     out, k0, t0 = [], 0, 0.0
-    for q in targets:
+    for i, q in enumerate(targets):
+        h = None if headings is None else headings[i]
         hit = None
         for k in range(k0, len(path.segments)):
-            t = path.segments[k].locate(q, tol)
-            if t is not None and (k > k0 or t >= t0 - 1e-12):
-                hit = (k, t)
-                break
+            seg = path.segments[k]
+            t = seg.locate(q, tol)
+            if t is None or (k == k0 and t < t0 - 1e-12):
+                continue
+            if h is not None and np.linalg.norm(h) > 1e-6:
+                lo, hi = max(t - 1e-6, 0.0), min(t + 1e-6, 1.0)
+                if (seg.at(hi)[0] - seg.at(lo)[0]) @ h <= 0:
+                    continue
+            hit = (k, t)
+            break
         out.append(hit)
         if hit is not None:
             k0, t0 = hit
     return out
+
+
+def headings(rows: np.ndarray, sense: np.ndarray) -> np.ndarray:
+    """Per reading the direction towards the next reading of the same ``sense`` (from the
+    previous one for the last of a run of one sense); zero where a run has one reading."""
+    h = np.zeros_like(rows)
+    for i in range(len(rows)):
+        if i + 1 < len(rows) and sense[i + 1] == sense[i]:
+            h[i] = rows[i + 1] - rows[i]
+        elif i > 0 and sense[i - 1] == sense[i]:
+            h[i] = rows[i] - rows[i - 1]
+    return h
 
 
 def sample_between(path: Trace, a: tuple, b: tuple, **steps) -> tuple:
@@ -428,7 +449,8 @@ def _probe(cols: dict, mask=None) -> np.ndarray:
 # the kinds' checks
 
 def ballbar_check(path: Trace, cols: dict, model, tol_mm: float = 1.0) -> tuple:
-    """Every reading on the path in order, and the bar (tool-ball centre through the layout's
+    """Every reading on the path in order (each on a pass in its direction of the circle), and
+    the bar (tool-ball centre through the layout's
     nominal forward kinematics, in the workpiece frame, to the pivot on the table) within
     ``tol_mm`` of its length along the whole path while it is mounted: from the program stop
     before the first reading of a set-up (mount the bar) to the one after its last (remove
@@ -437,12 +459,14 @@ def ballbar_check(path: Trace, cols: dict, model, tol_mm: float = 1.0) -> tuple:
     label = np.array(cols["placement"])
     for lab in _labels(cols):
         m = label == lab
-        where = locate(path, _rows(cols, model.axes, m))
+        rows = _rows(cols, model.axes, m)
+        where = locate(path, rows, headings=headings(rows, column(cols, "direction")[m]))
         missing = [k for k, w in enumerate(where) if w is None]
         if missing:
             bad.append(f"set-up {lab}: readings {missing[:5]} (of {m.sum()}) not on the path "
                        "in the file's order")
             continue
+        bad += _detours(path, where, cols, m, model, lab)
         q6, lines = sample_between(path, *_mounted(path, where[0], where[-1]))
         tip = model.forward(layout_positions(q6, model.axes), probe=_probe(cols, m)[0])[:, :3]
         pivot = np.array([column(cols, c)[m][0] for c in ("pivot_x", "pivot_y", "pivot_z")])
@@ -454,6 +478,27 @@ def ballbar_check(path: Trace, cols: dict, model, tol_mm: float = 1.0) -> tuple:
             bad.append(f"set-up {lab}: bar {length:g} mm {'squeezed' if dev[k] < 0 else 'pulled'}"
                        f" by {abs(dev[k]):.2f} mm at line {lines[k]} (limit {tol_mm:g} mm)")
     return bad, worst
+
+
+def _detours(path: Trace, where: list, cols: dict, m, model, lab: str) -> list:
+    """Between two consecutive readings of one direction the tool point travels at most
+    pi/2 times their distance: the most a circular arc of half a turn or less can (an arc
+    taken the long way round, or any other detour, travels more).  Readings less than 1 mm
+    apart (a sweep of ISO 10791-6, the tool following the table) are left to the bar check."""
+    bad, sense = [], column(cols, "direction")[m]
+    probe = _probe(cols, m)[0]
+    for k in range(len(where) - 1):
+        if sense[k] != sense[k + 1]:
+            continue
+        q6, lines = sample_between(path, where[k], where[k + 1])
+        tip = model.forward(layout_positions(q6, model.axes), probe=probe)[:, :3]
+        run = float(np.linalg.norm(np.diff(tip, axis=0), axis=1).sum())
+        chord = float(np.linalg.norm(tip[-1] - tip[0]))
+        if chord >= 1.0 and run > math.pi / 2 * chord + 1e-3:
+            bad.append(f"set-up {lab}: from reading {k} to {k + 1} (lines {lines[0]}-"
+                       f"{lines[-1]}) the tool point travels {run:.1f} mm for {chord:.1f} mm "
+                       "apart (more than half a turn round)")
+    return bad
 
 
 def _mounted(path: Trace, first: tuple, last: tuple) -> tuple:

@@ -69,7 +69,7 @@ def _ballbar_cols(pts, pivot, length):
     cols = {a: [str(v) for v in pts[:, k]] for k, a in enumerate("XYZ")}
     cols.update({c: ["0"] * n for c in ("Xp", "Yp", "Zp")})
     cols.update({f"pivot_{c}": [str(pivot[k])] * n for k, c in enumerate("xyz")})
-    cols.update(length_mm=[str(length)] * n, placement=["C1"] * n)
+    cols.update(length_mm=[str(length)] * n, placement=["C1"] * n, direction=["1"] * n)
     return cols
 
 
@@ -89,6 +89,12 @@ def test_checker_finds_a_chord_squeeze_and_passes_an_arc(tmp_path):
     bad, worst = R.ballbar_check(R.load(_write(tmp_path, arc, "a.ngc")),
                                  _ballbar_cols(pts, pivot, L), model)
     assert bad == [] and abs(worst["C1"]) < 1e-3
+    longway = (HEAD + f"G0 X{pts[0, 0]:.4f} Y{pts[0, 1]:.4f}\nG0 Z200\n" + "".join(
+        f"G2 X{p[0]:.4f} Y{p[1]:.4f} I{c[0]:.4f} J{c[1]:.4f} F1000\n"
+        for p, c in zip(pts[1:], pivot[:2] - pts[:-1, :2])) + "M30\n%\n")
+    bad, _ = R.ballbar_check(R.load(_write(tmp_path, longway, "w.ngc")),
+                             _ballbar_cols(pts, pivot, L), model)
+    assert bad and all("more than half a turn" in b or "not on the path" in b for b in bad)
 
 
 @needs_rs274
