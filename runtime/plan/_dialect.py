@@ -110,7 +110,6 @@ class Iso:
 
     def __init__(self, axes):
         self.axes = tuple(axes)
-        self.last = {}
 
     # -- words ----------------------------------------------------------------------------
     def words(self, to: dict) -> str:
@@ -276,8 +275,9 @@ class Heidenhain(Iso):
 
     def probe(self, op: Op) -> list:
         sense = "+" if op.sign > 0 else "-"
+        pre = {a: v for a, v in self.last_position.items() if a in "XYZ"}   # where it stands
         return [f"TCH PROBE 0.0 REF. PLANE Q1 {op.axis}{sense}",
-                f"TCH PROBE 0.1 {self.words(self.last_position)}"]
+                f"TCH PROBE 0.1 {self.words(pre)}"]
 
     def dwell(self, op: Op) -> list:
         return ["CYCL DEF 9.0 DWELL TIME", f"CYCL DEF 9.1 DWELL {number(op.seconds)}"]

@@ -31,9 +31,12 @@ R-test, distances, interferometer) -- a ball of an artifact is probed instead (b
   :data:`PROBE_START_MM` round the ball on its free side; between balls up to the clearance
   height.  Ball :data:`BALL_D_MM`, stylus tip :data:`STYLUS_D_MM` (stated in the program;
   the geometry: :mod:`volerr.plan._probing`).
-* **interferometer** (ISO 230-2:2014 linear cycle, cl. 4.3 / 5.3): each target approached
-  from its declared direction, an overshoot :data:`OVERSHOOT_MM` beyond the last target
-  before each reversal and before the first target, a dwell at each.
+* **interferometer** (ISO 230-2:2014 linear cycle, cl. 4.3 / 5.3; the standard's text as GOST
+  ISO 230-2, docs.cntd.ru/document/1200146046: the moving component is positioned at a series
+  of targets where it stays at rest long enough for the position to be reached, measured and
+  recorded, moving between them at an agreed feed): each target approached from its declared
+  direction, an overshoot :data:`OVERSHOOT_MM` beyond the last target before each reversal
+  and before the first target, a dwell at each.
 * **distances** (tracking interferometer): straight feed moves between the targets, a dwell
   at each.
 """
@@ -282,7 +285,12 @@ def _sphere(model, pf, setup, rows) -> list:
     dwell = _spec.DWELL_S["sphere"]
     ops = []
     for q, a in zip(rows, above):
-        ops += [Op("rapid", {"Z": _top(model)}), *_down_to(model, a),
+        across, down = _down_to(model, a)
+        if np.allclose(a, q):       # no room to stop short: the whole descent at the feed
+            ops += [Op("rapid", {"Z": _top(model)}), across,
+                    Op("line", _at(model, q), FEED["sphere"]), Op("dwell", seconds=dwell)]
+            continue
+        ops += [Op("rapid", {"Z": _top(model)}), across, down,
                 Op("line", _at(model, q), FEED["sphere"]), Op("dwell", seconds=dwell),
                 Op("line", _at(model, a), FEED["sphere"])]
     return ops
@@ -354,9 +362,12 @@ def _artifact(model, pf, setup, rows) -> list:
     normal, dirs = _probing.directions(model, setup.geometry["plane"], tool, rot)
     ops = [Op("comment", text=f"ball {BALL_D_MM:g} mm, stylus tip {STYLUS_D_MM:g} mm: each "
                               f"ball probed at {len(dirs)} points towards its centre from "
-                              f"{PROBE_START_MM:g} mm, on the plate's free side")]
+                              f"{PROBE_START_MM:g} mm, on the plate's free side "
+                              f"({', '.join(_dialect.number(v) for v in normal)}): the "
+                              f"plate behind its balls' plane")]
     for b, c in zip(balls[mine], centres):
-        ops.append(Op("comment", text=f"ball {b}: centre ({c[0]:g}, {c[1]:g}, {c[2]:g}) mm"))
+        where = ", ".join(_dialect.number(v) for v in c)
+        ops.append(Op("comment", text=f"ball {b}: centre ({where}) mm"))
         ops += _ball(model, c, normal, dirs, rot, tool)
     return ops
 

@@ -113,6 +113,7 @@ def data(plan) -> dict:
         "map_gain": None if gain is None else round(gain, 4),
         "minutes": round(plan.total_minutes, 1),
         "files": files,
+        "nc_dialect": plan.dialect,
         "candidates": {"setups": plan.candidates, "readings": plan.candidate_readings},
         "time_model": {"setup_change_min": dict(_spec.SETUP_MIN),
                        "reading_s": dict(_spec.READING_S),

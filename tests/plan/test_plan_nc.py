@@ -13,8 +13,9 @@ plane on the plate; no rotary motion and no motion off the tool axis within 30 m
 sphere; every interferometer reading reached moving in its declared direction, each cycle
 starting beyond its first target; the file's rows a subsequence of the end points; the first
 motion a retract along Z alone; G21, G90, G54 before any motion; every end point inside the
-travel; M30; lines under 254 characters.  Where LinuxCNC's ``rs274`` is installed it must read every program without an
-error.  The other dialects: their dwell, probing and comment words.
+travel; M30; lines under 254 characters.  Where LinuxCNC's ``rs274`` is installed it must
+read every program without an error, and its canonical arcs turn the short way.  The other
+dialects: their dwell, probing and comment words.
 """
 
 from __future__ import annotations
@@ -399,6 +400,7 @@ def test_dialect_option_writes_that_dialect(tmp_path):
     assert main(["plan", "MB1", "--instrument", "interferometer", "--readings",
                  "1200", "--dialect", "heidenhain", "--out", str(out), "--json", str(js)]) == 0
     doc = json.loads(js.read_text())
+    assert doc["nc_dialect"] == "heidenhain"
     for f in doc["files"]:
         assert f["nc"].endswith(".h")
         text = (out / f["nc"]).read_text()
