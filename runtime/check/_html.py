@@ -28,6 +28,12 @@ def _figure(d: dict) -> str:
     return embedded_img(draw(), "changes over their standard uncertainties")
 
 
+def _alternatives(c: dict) -> str:
+    """The alternatives of a change, one text: 'EB0C +2.9 +- 0.7 urad; ...'."""
+    return "; ".join(f"{a['parameter']} {a['change']:+.3g} +- {a['std']:.2g} {a['unit']}"
+                     for a in c.get("alternatives", []))
+
+
 def check_html(d: dict) -> str:
     """The page of a check's JSON ``d`` (:meth:`volerr.check.CheckResult.to_dict`)."""
     from ..plotstyle import unit
@@ -37,10 +43,12 @@ def check_html(d: dict) -> str:
     rows = "".join(
         f"<tr><td>{e(c['parameter'])}</td><td>{c['reference']:.4g}</td>"
         f"<td>{c['change']:+.4g}</td><td>{c['std']:.2g}</td><td>{e(unit(c['unit']))}</td>"
-        f"<td>{e(', '.join(c.get('indistinguishable_from', [])))}</td></tr>"
+        f"<td>{e(', '.join(c.get('indistinguishable_from', [])))}</td>"
+        f"<td>{e(_alternatives(c))}</td></tr>"
         for c in d["changed"])
     table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>std (k = 1)"
-             f"</th><th>unit</th><th>indistinguishable from</th></tr>{rows}</table>"
+             f"</th><th>unit</th><th>indistinguishable from</th>"
+             f"<th>or (not told apart by this check)</th></tr>{rows}</table>"
              if rows else "<p>No parameter changed.</p>")
     apart = "".join(f"<li>{e(a)} and {e(b)}</li>" for a, b in d["indistinguishable"])
     tol = ""

@@ -57,10 +57,26 @@ class CheckResult:
                      "value": float(after[j]), "z": float(delta[k] / std[k]) if std[k] else None}
             if alias:
                 entry["indistinguishable_from"] = alias
+            alts = self.alternatives(j)
+            if alts:
+                entry["alternatives"] = alts
+                entry["separate_by"] = separate_by(name, [a["parameter"] for a in alts])
             if name in ref.combinations:
                 entry["combination"] = ref.combinations[name]
             out.append(entry)
         return out
+
+    def alternatives(self, j: int) -> list:
+        """``[{"parameter", "change", "unit", "std", "delta_bic", "cv_paired_t"}]``: the
+        parameters that explain the readings in place of the changed parameter ``j`` about as
+        well (:func:`volerr.check._select.alternatives`): this check cannot tell them apart;
+        ``change`` / ``std`` the change of the alternative in that place."""
+        ref = self.reference
+        return [{"parameter": ref.names[a["parameter"]], "change": a["change"],
+                 "unit": ref.units[a["parameter"]], "std": a["std"],
+                 "delta_bic": round(a["delta_bic"], 3),
+                 "cv_paired_t": round(a["cv_paired_t"], 3)}
+                for a in self.selection.alternatives.get(j, [])]
 
     def combinations(self) -> list:
         """``[{"written_as", "expression", "status", "value", "unit", "std"}]``: the
@@ -142,6 +158,12 @@ class CheckResult:
                     if c.get("indistinguishable_from") else "")
             lines.append(f"  {c['parameter']} changed by {c['change']:+.4g} +- {c['std']:.2g} "
                          f"{c['unit']}{also}")
+            for a in c.get("alternatives", []):
+                lines.append(f"    or {a['parameter']} by {a['change']:+.4g} +- {a['std']:.2g} "
+                             f"{a['unit']}: this check cannot tell it apart (BIC "
+                             f"{a['delta_bic']:+.3g}, cross-validated t {a['cv_paired_t']:+.2f})")
+            if c.get("alternatives"):
+                lines.append(f"    separate by: {c['separate_by']}")
         if self.misfit.get("unexplained"):
             lines.append(f"  the readings hold a change none of the reference's parameters "
                          f"explains (Birge ratio {self.misfit['birge_ratio']:.3g})")
@@ -166,6 +188,15 @@ class CheckResult:
         from ._html import check_html
 
         return write_text(path, check_html(self.to_dict()), inputs=list(inputs))
+
+
+def separate_by(name: str, others: list) -> str:
+    """One sentence: what would tell ``name`` from its alternatives ``others``."""
+    pair = ",".join([name] + list(others))
+    return (f"a check whose readings move {name} and {', '.join(others)} differently: a second "
+            f"placement of the instrument (another position on the table or tool length; "
+            f"'volerr check plan ... --separate {pair}' plans one within the budget), or a "
+            f"calibration")
 
 
 def _file_name(path) -> str:

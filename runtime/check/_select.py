@@ -22,7 +22,15 @@ pass that drops a parameter no longer earning its place given the others.
    ``INDISTINCT`` (set-ups eliminated) cannot be told apart by it and are named; among
    such parameters whose ``chi2`` lies within ``SAME_CHI2`` of the best (a statistical tie)
    the simpler explanation enters: a constant (squareness, location error) before a series
-   term, then the reference's order.
+   term, then the reference's order;
+5. alternatives (the loop's rule, :mod:`volerr.loop.lags`): for every parameter named
+   changed, each other parameter that in its place (the other named ones kept) explains the
+   readings within the loop's ``BIC_TIE`` (``chi2`` higher by less than 10: the sets are of
+   one size, so the BIC difference is the ``chi2`` difference) *and* whose cross-validated
+   squared residuals do not differ significantly (|paired t| below :func:`cv_limit`, or the
+   held-out RMS within the loop's ``CV_SAME``) is an *alternative*: this check cannot tell
+   the two apart, whatever their correlation; the result names them and what would separate
+   them (a second placement, :func:`separate_by`).
 
 References: Schwarz (1978) for the BIC; the blocked cross-validation of the loop
 (:mod:`volerr.loop.select`).
@@ -36,6 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..loop.fitting import CV_T
+from ..loop.lags import BIC_TIE, CV_SAME
 from ..loop.select import BIC_GAIN
 
 #: false-alarm probability the threshold holds at least (a clean machine called "changed")
@@ -48,6 +57,8 @@ INDISTINCT = 0.98
 SAME_CHI2 = 1.0
 #: most parameters a check names as changed
 MAX_CHANGED = 8
+#: most alternatives named per changed parameter
+MAX_ALTERNATIVES = 3
 
 
 def threshold(n_readings: int, p: int) -> float:
@@ -67,6 +78,7 @@ class Selection:
     fit: object
     threshold: float
     steps: list = field(default_factory=list)
+    alternatives: dict = field(default_factory=dict)
 
 
 def select(system, candidates=None, series=()) -> Selection:
@@ -94,7 +106,7 @@ def select(system, candidates=None, series=()) -> Selection:
             break
         S, fit = S + [j], f
     S, fit = _backward(system, S, fit, c)
-    return Selection(S, fit, c, steps)
+    return Selection(S, fit, c, steps, alternatives(system, S, fit, cands))
 
 
 def cv_limit(n_points: int) -> float:
@@ -114,6 +126,46 @@ def _backward(system, S, fit, c):
             break
         S, fit = [k for k in S if k != j], f
     return S, fit
+
+
+def alternatives(system, S, fit, candidates) -> dict:
+    """``{j: [{"parameter" k, "delta_bic", "cv_paired_t", "change", "std"}]}``: for every
+    changed ``j`` the candidates that explain the readings in its place about as well (module
+    docstring, step 5), best BIC first (ties: the reference's order); ``change`` and ``std``
+    of ``k`` in that place."""
+    out = {}
+    limit = cv_limit(len(np.unique(system.point)))
+    for pos, j in enumerate(S):
+        others = S[:pos] + S[pos + 1:]
+        found = []
+        for k in candidates:
+            if k in S:
+                continue
+            f = system.solve(others + [k])
+            d_bic = f.chi2 - fit.chi2
+            if d_bic >= BIC_TIE:
+                continue
+            t = cv_t(system, others + [k], S)
+            if not (abs(t) < limit or abs(_cv_rms_ratio(system, others + [k], S) - 1) < CV_SAME):
+                continue
+            delta, std = f.change()
+            found.append({"parameter": k, "delta_bic": d_bic, "cv_paired_t": t,
+                          "change": float(delta[-1]), "std": float(std[-1])})
+        found.sort(key=lambda a: (round(a["delta_bic"], 6), a["parameter"]))
+        out[j] = found[:MAX_ALTERNATIVES]
+    return out
+
+
+def _cv_rms_ratio(system, a, b) -> float:
+    """Held-out RMS of the fit with ``a`` free over that with ``b`` free."""
+    ea = eb = 0.0
+    for k in range(system.folds):
+        test = system.fold_of_row == k
+        if not test.any() or test.all():
+            continue
+        ea += float(_heldout(system, system.solve(a, k), test).sum())
+        eb += float(_heldout(system, system.solve(b, k), test).sum())
+    return math.sqrt(ea / eb) if eb > 0 else float("inf")
 
 
 def cv_t(system, without, with_) -> float:

@@ -81,14 +81,20 @@ def summary(run: dict) -> str:
     """One line: the plan, the weeks called changed and what changed in each."""
     changed = [(i + 1, r) for i, r in enumerate(run["results"]) if r["verdict"] == "changed"]
     p = run["plan"]
-    text = "; ".join(f"week {w}: " + ", ".join(f"{c['parameter']} {c['change']:+.3g} +- "
-                                                 f"{c['std']:.2g} {c['unit']}"
-                                                 for c in r["changed"])
+    text = "; ".join(f"week {w}: " + ", ".join(_change(c) for c in r["changed"])
                      for w, r in changed[:6])
     return (f"check plan {p['readings']} readings, {p['minutes']:g} min; {len(changed)} of "
             f"{len(run['results'])} weekly checks changed ({text}{' ...' if len(changed) > 6 else ''})"
             f"; planted: EX0C drifts {DRIFT_UM_PER_WEEK:g} um/week, EA0B +{COLLISION_URAD:g} urad "
             f"at week {COLLISION_WEEK}")
+
+
+def _change(c: dict) -> str:
+    """'EX0C +0.86 +- 0.16 um (or EB0C +3.3 +- 0.7 urad: not told apart)'."""
+    alts = ", ".join(f"{a['parameter']} {a['change']:+.3g} +- {a['std']:.2g} {a['unit']}"
+                     for a in c.get("alternatives", []))
+    return (f"{c['parameter']} {c['change']:+.3g} +- {c['std']:.2g} {c['unit']}"
+            + (f" (or {alts}: this check cannot tell them apart)" if alts else ""))
 
 
 def _figure(path: Path, results: list) -> None:

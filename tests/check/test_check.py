@@ -234,3 +234,28 @@ def test_the_uncertainty_of_a_change_holds_the_reference(tmp_path):
         assert "EX0C" in changed, (k, changed)
         z.append((changed["EX0C"]["change"] - 2.0) / changed["EX0C"]["std"])
     assert abs(np.mean(z)) < 0.6 and 0.6 < np.std(z, ddof=1) < 1.5, z
+
+
+@pytest.mark.slow
+def test_a_small_change_names_what_it_cannot_tell_apart(world):
+    """A 0.75 um move of the C pivot (EX0C), below the plan's 95 % size: in this one-placement
+    check EX0C and EB0C correlate at ~0.7, so noise may let EB0C explain the readings nearly as
+    well.  On every draw called "changed", the planted EX0C must be named or be among the
+    alternatives of what is named (before the rule of alternatives, draws named EB0C alone);
+    an alternative is within the loop's BIC tie band and says what would separate the two."""
+    planted = dict(PLANTED, EX0C=PLANTED["EX0C"] + 0.75)
+    hits, alternatives = 0, 0
+    for seed in range(300, 312):
+        d = _check(world, _filled(world, f"small{seed}", planted, seed))
+        if d["verdict"] != "changed":
+            continue
+        hits += 1
+        named = {c["parameter"] for c in d["changed"]}
+        alts = {a["parameter"] for c in d["changed"] for a in c.get("alternatives", [])}
+        assert "EX0C" in named | alts, (seed, d["changed"])
+        for c in d["changed"]:
+            for a in c.get("alternatives", []):
+                alternatives += 1
+                assert a["delta_bic"] < 10.0 and a["std"] > 0
+                assert c["parameter"] in c["separate_by"] and a["parameter"] in c["separate_by"]
+    assert hits >= 6 and alternatives >= 1
