@@ -554,7 +554,7 @@ def artifact_check(path: Trace, cols: dict, model, clear_mm: float = 10.0) -> li
     centre of the ball it ends nearest, within 2 um: the touch normal to the surface), from
     outside (starting ``clear_mm`` or more from every centre, ending nearer its own), and passing
     no other ball; every ball probed at the points a centre needs (4 or more radial moves whose
-    directions are not coplanar)."""
+    directions are not coplanar); and never behind the plate (:func:`plate_check`)."""
     bad, labels, group = [], _labels(cols), _groups(path)
     label = np.array(cols["placement"])
     hits = {(lab, b): [] for lab in labels for b in range(int((label == lab).sum()))}
@@ -583,12 +583,52 @@ def artifact_check(path: Trace, cols: dict, model, clear_mm: float = 10.0) -> li
                        f"centre by {miss:.3f} mm)")
         else:
             hits[(lab, own)].append(u)
+    bad += plate_check(path, cols, model)
     for (lab, b), dirs in hits.items():
         rank = (np.linalg.matrix_rank(np.array(dirs[1:]) - dirs[0], tol=1e-3)
                 if len(dirs) > 1 else 0)
         if len(dirs) < 4 or rank < 3:
             bad.append(f"ball {b} of {lab}: {len(dirs)} radial probing moves, directions of "
                        f"affine rank {rank} (a centre needs 4 not coplanar)")
+    return bad
+
+
+def plate_check(path: Trace, cols: dict, model, margin_mm: float = 25.0,
+                behind_mm: float = 1.0) -> list:
+    """The probe never goes behind a mounted plate: the plane of the placement's ball centres
+    (fitted here), its free side the one the probe is on when it starts the placement's first
+    probing move; inside the outline (the centres' extent along the plate's rows and columns,
+    ball 0 to its nearest neighbour the first, widened by ``margin_mm``) the tool point stays on that side, at most ``behind_mm`` behind the plane
+    (the plate and the balls' stems are there).  Placements of fewer than 3 balls out of one
+    line are left out."""
+    bad, labels, group = [], _labels(cols), _groups(path)
+    label = np.array(cols["placement"])
+    for g, lab in enumerate(labels):
+        m = label == lab
+        centres, probe = _balls(cols, m), _probe(cols, m)[0]
+        mid = centres.mean(axis=0)
+        _, sv, vt = np.linalg.svd(centres - mid)
+        segs = [s for k, s in enumerate(path.segments) if group[k] == g]
+        first = next((s for s in segs if s.kind == "probe"), None)
+        if len(centres) < 3 or sv[1] < 1e-6 or first is None:
+            continue
+        n = vt[2]                            # the plate's rows: ball 0 to its nearest ball
+        d = np.linalg.norm(centres[1:] - centres[0], axis=1)
+        e1 = centres[1 + int(np.argmin(d))] - centres[0]
+        e1 = e1 - (e1 @ n) * n
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(n, e1)
+        side = np.sign((_tips(model, first.start[None], probe)[0][0] - mid) @ n)
+        uv = (centres - mid) @ np.column_stack([e1, e2])
+        lo, hi = uv.min(axis=0) - margin_mm, uv.max(axis=0) + margin_mm
+        for seg in segs:
+            tip, _ = _tips(model, seg.at(seg.samples()), probe)
+            w = (tip - mid) @ np.column_stack([e1, e2])
+            inside = np.all((w >= lo) & (w <= hi), axis=1)
+            depth = side * ((tip - mid) @ n)
+            if inside.any() and depth[inside].min() < -behind_mm:
+                bad.append(f"line {seg.line}: {seg.kind} goes {-depth[inside].min():.1f} mm "
+                           f"behind plate {lab} (its free side {np.round(side * n, 3).tolist()})")
     return bad
 
 

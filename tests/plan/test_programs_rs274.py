@@ -168,6 +168,21 @@ def test_checker_finds_a_move_through_a_ball_and_passes_five_point_probing(tmp_p
 
 
 @needs_rs274
+def test_checker_finds_a_move_behind_the_plate(tmp_path):
+    model = volerr.load("MB1")
+    centres = np.array([[300.0, 200.0, 100.0], [450.0, 200.0, 100.0], [300.0, 350.0, 100.0]])
+    probes = "".join(f"G0 X{c[0]:g} Y{c[1]:g}\nG0 Z124\nG38.2 Z112 F100\nG0 Z124\n"
+                     for c in centres)
+    ok = HEAD + probes + "G53 G0 Z400\nM30\n"
+    path = R.load(_write(tmp_path, ok))
+    assert R.plate_check(path, _plate_cols(centres), model) == []
+    under = HEAD + probes + "G0 X520 Y420\nG0 Z90\nG0 X400 Y300\nG53 G0 Z400\nM30\n"
+    bad = R.plate_check(R.load(_write(tmp_path, under, "u.ngc")), _plate_cols(centres), model)
+    assert len(bad) == 2 and all("10.0 mm behind plate P1" in b for b in bad)
+    assert "[0.0, 0.0, 1.0]" in bad[0]
+
+
+@needs_rs274
 def test_checker_finds_a_turn_near_the_sphere(tmp_path):
     model = volerr.load("DMU50")
     cols = {"X": ["0"], "Y": ["0"], "Z": ["160"], "B": ["0"], "C": ["0"], "Xp": ["0"],
