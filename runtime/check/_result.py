@@ -220,11 +220,9 @@ class CheckResult:
 
 def separate_by(name: str, others: list) -> str:
     """One sentence: what would tell ``name`` from its alternatives ``others``."""
-    pair = ",".join([name] + list(others))
     return (f"a check whose readings move {name} and {', '.join(others)} differently: a second "
-            f"placement of the instrument (another position on the table or tool length; "
-            f"'volerr check plan ... --separate {pair}' plans one within the budget), or a "
-            f"calibration")
+            f"placement of the instrument (another position on the table or tool length), "
+            f"or a calibration")
 
 
 def _file_name(path) -> str:
