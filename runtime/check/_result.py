@@ -78,6 +78,35 @@ class CheckResult:
                  "cv_paired_t": round(a["cv_paired_t"], 3)}
                 for a in self.selection.alternatives.get(j, [])]
 
+    def parameters(self) -> dict:
+        """``{NAME: {"value", "unit", "std", "reference", "status", "change", "change_std"}}``
+        of every reference parameter: ``value`` / ``std`` after the check (the reference
+        updated by its readings), ``reference`` the reference's value, ``status`` changed |
+        unchanged; ``change`` / ``change_std``: for a changed parameter its stated change,
+        for an unchanged one the change the check measures with it free beside the changed
+        ones (below the threshold: :func:`volerr.check._select.freed`) and its standard
+        uncertainty, the check's uncertainty of "no change" (both ``None`` for a parameter
+        the check does not see)."""
+        from . import _select
+
+        ref, sel = self.reference, self.selection
+        values, cov = self.after()
+        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        delta, dstd = sel.fit.change()
+        measured = {j: (float(delta[k]), float(dstd[k])) for k, j in enumerate(sel.changed)}
+        if not hasattr(self, "_freed"):
+            self._freed = _select.freed(self.system, sel.changed)
+        measured.update({j: v for j, v in self._freed.items()
+                         if ref.names[j] not in self.not_seen and np.isfinite(v[1])})
+        out = {}
+        for j, (n, u) in enumerate(zip(ref.names, ref.units)):
+            c, s = measured.get(j, (None, None))
+            out[n] = {"value": float(values[j]), "unit": u, "std": float(std[j]),
+                      "reference": float(ref.values[j]),
+                      "status": "changed" if j in sel.changed else "unchanged",
+                      "change": c, "change_std": s}
+        return out
+
     def combinations(self) -> list:
         """``[{"written_as", "expression", "status", "value", "unit", "std"}]``: the
         reference's combinations (determined only as a whole) after the check; they are
@@ -128,8 +157,7 @@ class CheckResult:
                            "dchi2": round(s["dchi2"], 4),
                            "cv_t": None if s["cv_t"] != s["cv_t"] else round(s["cv_t"], 3),
                            "accepted": s["accepted"]} for s in self.selection.steps],
-            "parameters": {n: {"value": float(v), "unit": u, "std": float(s)}
-                           for n, u, v, s in zip(ref.names, ref.units, values, std)},
+            "parameters": self.parameters(),
             "covariance": {"names": list(ref.names), "units": list(ref.units),
                            "values": [float(v) for v in values],
                            "matrix": [[float(x) for x in row] for row in cov],
@@ -192,11 +220,9 @@ class CheckResult:
 
 def separate_by(name: str, others: list) -> str:
     """One sentence: what would tell ``name`` from its alternatives ``others``."""
-    pair = ",".join([name] + list(others))
     return (f"a check whose readings move {name} and {', '.join(others)} differently: a second "
-            f"placement of the instrument (another position on the table or tool length; "
-            f"'volerr check plan ... --separate {pair}' plans one within the budget), or a "
-            f"calibration")
+            f"placement of the instrument (another position on the table or tool length), "
+            f"or a calibration")
 
 
 def _file_name(path) -> str:

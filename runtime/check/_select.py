@@ -156,6 +156,21 @@ def alternatives(system, S, fit, candidates) -> dict:
     return out
 
 
+def freed(system, S) -> dict:
+    """``{j: (change, std)}`` for every parameter ``j`` not in ``S``: its change estimated
+    with it free beside ``S`` (report units): the check's measurement of a parameter it calls
+    unchanged (below the threshold), ``std`` its uncertainty of "no change"; ``std`` inf
+    where the check does not see the parameter."""
+    out = {}
+    for j in range(system.p):
+        if j in S:
+            continue
+        delta, std = system.solve(list(S) + [j]).change()
+        s = float(std[-1])
+        out[j] = (float(delta[-1]), s) if s > 0 and math.isfinite(s) else (0.0, math.inf)
+    return out
+
+
 def _cv_rms_ratio(system, a, b) -> float:
     """Held-out RMS of the fit with ``a`` free over that with ``b`` free."""
     ea = eb = 0.0

@@ -12,8 +12,11 @@ What an entry keeps of its result (:class:`Entry`):
   scale.  A combination a calibration determines (``combinations``: ``EY0B + EY0C`` written
   as ``EY0B``) is kept under its ``written_as`` name (status ``combination``), as a check
   names it.  A parameter the check lists as ``unchanged`` with a number (``{"parameter",
-  "change", "std"}``) is stored the same way (status ``unchanged``); one listed by name only
-  carries no number (value and std ``None``) and is left out of every statistic;
+  "change", "std"}``, or by name with ``change`` and ``change_std`` in the check's
+  ``parameters`` block: the change the check measures with it free, below its threshold, and
+  the uncertainty of "no change") is stored the same way (status ``unchanged``); a
+  combination the check lists with status ``unchanged`` likewise; one listed by name only
+  without a number carries none (value and std ``None``) and is left out of every statistic;
 * ``covariance``: ``{"names": [...], "matrix": [[...]]}`` when the result carries one (in the
   report units of the names), else ``None``;
 * ``files``: the instrument files the result names, each with the SHA-256 of the file found
@@ -111,19 +114,48 @@ def _calibration(doc: dict, path, sha: str, text: str) -> Entry:
         require(std >= 0, f"{where}: std must be >= 0, got {std}")
         values[str(name)] = Value(_number(rec["value"], f"{where} value"), std,
                                   str(rec.get("unit", "")), ESTIMATED)
+    cov = _covariance(doc.get("covariance"), values, path)
+    from_cov = _covariance_values(doc.get("covariance"), cov, path)
     for c in doc.get("combinations", []) or []:
         # a combination the campaign determines (EY0B + EY0C), under the name it is written
         # as: a later check states its change under that name
         if not (isinstance(c, dict) and isinstance(c.get("written_as"), str)) \
                 or c["written_as"] in values:
             continue
-        where = f"{path}: combination {c.get('expression', c['written_as'])}"
+        name = c["written_as"]
+        where = f"{path}: combination {c.get('expression', name)}"
+        if name in from_cov and (c.get("value") is None or c.get("std") is None):
+            values[name] = Value(from_cov[name].value, from_cov[name].std,
+                                 str(c.get("unit") or from_cov[name].unit), COMBINATION)
+            continue
         std = _number(c.get("std"), f"{where} std")
-        values[c["written_as"]] = Value(_number(c.get("value"), f"{where} value"), std,
-                                        str(c.get("unit", "")), COMBINATION)
+        values[name] = Value(_number(c.get("value"), f"{where} value"), std,
+                             str(c.get("unit", "")), COMBINATION)
+    for name, v in from_cov.items():
+        # a name the covariance block holds beside 'parameters' (a combination's carrier,
+        # EY0B for EY0B + EY0C, when 'combinations' does not state it)
+        values.setdefault(name, v)
     require(values, f"{path}: the calibration determined no parameter")
     return Entry(CALIBRATION, doc["layout"], values, sha, Path(path).name, text,
-                 covariance=_covariance(doc.get("covariance"), values, path))
+                 covariance=cov)
+
+
+def _covariance_values(raw, cov: dict | None, path) -> dict:
+    """``{NAME: Value}`` of the covariance block's names with a value: ``values[i]`` and
+    ``sqrt(matrix[i][i])`` in ``units[i]`` (status ``combination``: a name calibrate writes
+    there and not under ``parameters`` is a combination's carrier)."""
+    if cov is None or not isinstance(raw.get("values"), list) \
+            or len(raw["values"]) != len(cov["names"]):
+        return {}
+    units = raw.get("units") if isinstance(raw.get("units"), list) \
+        and len(raw["units"]) == len(cov["names"]) else [""] * len(cov["names"])
+    out = {}
+    for i, name in enumerate(cov["names"]):
+        var = cov["matrix"][i][i]
+        require(var >= 0, f"{path}: covariance of {name}: a negative variance {var}")
+        out[name] = Value(_number(raw["values"][i], f"{path}: covariance value of {name}"),
+                          math.sqrt(var), str(units[i]), COMBINATION)
+    return out
 
 
 def _covariance(cov, values: dict, path) -> dict | None:
@@ -149,12 +181,17 @@ def _check(doc: dict, path, sha: str, text: str) -> Entry:
     require(isinstance(doc["changed"], list) and isinstance(doc.get("unchanged", []), list),
             f"{path}: 'changed' and 'unchanged' must be lists")
     values = {}
-    for status, items in ((CHANGED, doc["changed"]), (UNCHANGED, doc.get("unchanged", []))):
+    measured = _measured(doc, path)
+    unchanged = list(doc.get("unchanged", [])) + [
+        c["written_as"] for c in doc.get("combinations", []) or []
+        if isinstance(c, dict) and c.get("status") == UNCHANGED
+        and isinstance(c.get("written_as"), str)]
+    for status, items in ((CHANGED, doc["changed"]), (UNCHANGED, unchanged)):
         for item in items:
             if isinstance(item, str):
                 require(status == UNCHANGED, f"{path}: a changed parameter needs "
                                              f"{{'parameter', 'change', 'unit', 'std'}}")
-                values[item] = Value(None, None, "", status)
+                values[item] = measured.get(item) or Value(None, None, "", status)
                 continue
             require(isinstance(item, dict) and "parameter" in item,
                     f"{path}: {status}: {{'parameter', 'change', 'unit', 'std'}} expected")
@@ -175,6 +212,27 @@ def _check(doc: dict, path, sha: str, text: str) -> Entry:
                                               else None)
     return Entry(CHECK, layout or "", values, sha, Path(path).name, text, verdict=verdict,
                  reference_sha256=ref_sha)
+
+
+def _measured(doc: dict, path) -> dict:
+    """``{NAME: Value}`` of the parameters a check calls unchanged and measures: its
+    ``parameters`` block's ``change`` and ``change_std`` (the change the check measures with
+    the parameter free, below its threshold, and the uncertainty of "no change"); a check
+    JSON without them (an older one) gives ``{}``."""
+    params = doc.get("parameters")
+    out = {}
+    if not isinstance(params, dict):
+        return out
+    for name, rec in params.items():
+        if not (isinstance(rec, dict) and rec.get("status") == UNCHANGED
+                and rec.get("change") is not None and rec.get("change_std") is not None):
+            continue
+        where = f"{path}: parameters {name}"
+        std = _number(rec["change_std"], f"{where} change_std")
+        require(std >= 0, f"{where}: change_std must be >= 0, got {std}")
+        out[str(name)] = Value(None, std, str(rec.get("unit", "")), UNCHANGED,
+                               _number(rec["change"], f"{where} change"))
+    return out
 
 
 def apply_reference(entry: Entry, reference: Entry, path) -> None:

@@ -156,6 +156,23 @@ def test_history_forecast_of_the_tolerance(campaign):
     assert dt.date.fromisoformat(lo) <= truth <= dt.date.fromisoformat(hi), (f, truth)
 
 
+@pytest.mark.slow
+@needs_check
+def test_every_check_entry_holds_every_parameter(campaign):
+    """A parameter a check finds unchanged is stored with the change the check measures (free
+    beside the named ones) and its uncertainty of "no change", and the R-test's combination
+    EY0B (EY0B + EY0C) too: the clean machine's entries hold every reference parameter, each
+    within 4 std of its reference value (nothing changed); before, they held no number."""
+    entries = campaign["show"]["clean"]["entries"]
+    ref = entries[0]["parameters"]
+    assert "EY0B" in ref
+    for e in entries[1:]:
+        assert set(e["parameters"]) == set(ref), e["date"]
+        for name, v in e["parameters"].items():
+            assert v["value"] is not None and v["std"] > 0, (e["date"], name, v)
+            assert abs(v["value"] - ref[name]["value"]) < 4 * v["std"], (e["date"], name)
+
+
 def test_the_simulator_is_the_models_first_order():
     """The simulator's exact chain and volerr's first-order model agree to second order
     (conventions of the location errors checked, not assumed)."""

@@ -292,3 +292,51 @@ def test_a_combination_of_the_reference_is_a_parameter_of_the_history(tmp_path, 
     e = Store(str(db)).entries("M1")
     assert e[0].values["EY0B"].status == "combination"
     assert e[1].values["EY0B"].value == pytest.approx(-17.2, abs=1e-12)
+
+
+def test_an_unchanged_parameter_is_stored_with_the_checks_number(tmp_path, capsys):
+    """A check JSON lists unchanged parameters by name; its ``parameters`` block carries the
+    change it measures with the parameter free and the uncertainty of "no change": stored as
+    the reference's value plus that change with that std (before: no value)."""
+    (ref, d0), = weekly(tmp_path, weeks=1)
+    chk = tmp_path / "c.json"
+    chk.write_text(json.dumps({
+        "layout": "DMU50", "verdict": "changed", "unchanged": ["EX0C", "EA0C"],
+        "changed": [{"parameter": "EY0C", "change": 4.0, "unit": "um", "std": 0.3}],
+        "volumetric_change_um": {"max": 4.0, "rms": 4.0},
+        "parameters": {"EX0C": {"value": 5.1, "unit": "um", "std": 0.1, "status": "unchanged",
+                                "change": -0.07, "change_std": 0.25},
+                       "EA0C": {"value": 10.0, "unit": "urad", "std": 1.0,
+                                "status": "unchanged", "change": None, "change_std": None},
+                       "EY0C": {"value": 1.0, "unit": "um", "std": 0.3, "status": "changed",
+                                "change": 4.0, "change_std": 0.3}}}))
+    db = tmp_path / "h.sqlite"
+    add_all(db, "M1", [(ref, d0), (chk, "2025-02-01")], capsys)
+    e = Store(str(db)).entries("M1")
+    refv = json.loads(ref.read_text())["parameters"]
+    x = e[1].values["EX0C"]
+    assert x.status == "unchanged" and x.std == 0.25 and x.change == -0.07
+    assert x.value == pytest.approx(refv["EX0C"]["value"] - 0.07, abs=1e-12)
+    assert e[1].values["EA0C"].value is None            # not seen by the check: no number
+    assert e[1].values["EY0C"].value == pytest.approx(refv["EY0C"]["value"] + 4.0, abs=1e-12)
+
+
+def test_a_carrier_only_in_the_covariance_block_is_accepted(tmp_path, capsys):
+    """A reference whose ``parameters`` lack EY0B (it carries EY0B + EY0C) and whose
+    ``combinations`` entry states no value (or that is absent): EY0B's value and std come from
+    the ``covariance`` block, and a check that changed EY0B is stored (before: refused, 'the
+    check names EY0B, which its reference calibration does not determine')."""
+    cov = {"names": ["EX0C", "EY0B"], "units": ["um", "um"], "values": [1.0, -18.0],
+           "matrix": [[0.01, 0.002], [0.002, 0.04]]}
+    chk = _check_json(tmp_path / "c.json", [{"parameter": "EY0B", "change": 0.8, "unit": "um",
+                                             "std": 0.2, "combination": "EY0B + EY0C"}],
+                      ["EX0C"])
+    for i, combos in enumerate(([{"expression": "EY0B + EY0C", "written_as": "EY0B"}], [])):
+        ref = write_cal(tmp_path / f"ref{i}.json", {"EX0C": 1.0}, {"EX0C": 0.1},
+                        extra={"covariance": cov, "combinations": combos})
+        db = tmp_path / f"h{i}.sqlite"
+        add_all(db, "M1", [(ref, "2025-01-06"), (chk, "2025-01-13")], capsys)
+        e = Store(str(db)).entries("M1")
+        assert e[0].values["EY0B"].value == -18.0 and e[0].values["EY0B"].std == 0.2
+        assert e[1].values["EY0B"].value == pytest.approx(-17.2, abs=1e-12)
+        assert e[1].values["EY0B"].status == "changed"
