@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ..errors import require
 from ..fileio import Outputs
+from ..loop.api import console_lines
 from ._common import add_errors_out, add_force, add_html, add_json
 
 
@@ -68,23 +69,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def loop_lines(e: dict) -> list:
-    """Console lines of an effect's lag and of the explanations the data cannot tell from it."""
-    out = []
-    lag = e.get("lag_s")
-    if lag:
-        std = f" +- {lag['std']:.0f}" if lag.get("std") is not None else ""
-        out.append(f"through a first-order lag of {e['covariate']}: tau = {lag['value']:.0f}"
-                   f"{std} s ({lag['value'] / 60:.1f} min)")
-    for a in e.get("alternatives") or []:
-        lag_a = f" through a lag of {a['lag_s']:.0f} s" if a.get("lag_s") else ""
-        out.append(f"these data cannot tell it from {a['parameter']} x {a['covariate']}"
-                   f"{lag_a} (held-out RMS {a['held_out_rms_um']:.3f} um)")
-    if e.get("separate_by"):
-        out.append(f"would separate them: {e['separate_by']}")
-    return out
-
-
 def _is_drift(specs) -> bool:
     from ..instruments import detect, split_spec
 
@@ -98,25 +82,6 @@ def _is_drift(specs) -> bool:
     return all(drift)
 
 
-K_PRINT = 2.0    # coverage factor of the printed uncertainties
-SIG_K = 2.0      # a term below this many standard uncertainties is not part of the effect
-
-
-def effect_terms(e: dict) -> str:
-    """The effect's parameters with their expanded uncertainty (k = 2); a term that is not
-    significant (|value| < 2 u) is said to be so, apart from the effect's terms."""
-    std = e.get("std") or {}
-    shown, weak = [], []
-    for k, v in e["parameters"].items():
-        u = std.get(k)
-        text = f"{k} = {v:.4g} {e['units'][k]}"
-        if u is not None:
-            text += f" +- {K_PRINT * u:.2g} (k = {K_PRINT:g})"
-        (weak if u is not None and abs(v) < SIG_K * u else shown).append(text)
-    out = ", ".join(shown) or "no significant term"
-    if weak:
-        out += f"; not significant, not part of the effect: {', '.join(weak)}"
-    return out
 
 
 def run(args) -> int:
@@ -164,22 +129,8 @@ def run(args) -> int:
             report.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
             report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
-    for w in report["warnings"]:
-        print(f"  warning: {w}")
-    print(report.summary())
-    for e in report.effects:
-        print(f"  {e['kind']} {e['name']}: {effect_terms(e)}")
-        for line in loop_lines(e):
-            print(f"    {line}")
-    if report["augmented_layout"]:
-        print(f"  augmented layout: {report['augmented_layout']}; generated module: "
-              f"{report['generated_module']}")
-    if report["residual_note"]:
-        print(f"  {report['residual_note']}")
-    hidden = [u["parameters"][0] for u in report["unidentifiable"]
-              if not (u["parameters"][0].startswith("setup.") and u.get("no_sensitivity"))]
-    if hidden:
-        print(f"  not separable by these data: {', '.join(hidden)} (see the report)")
+    for line in console_lines(report):
+        print(line)
     return 0
 
 

@@ -35,6 +35,27 @@ class Loop(Report):
         return out
 
 
+K_PRINT = 2.0    # coverage factor of the printed uncertainties
+SIG_K = 2.0      # a term below this many standard uncertainties is not part of the effect
+
+
+def effect_terms(e: dict) -> str:
+    """The effect's parameters with their expanded uncertainty (k = 2); a term that is not
+    significant (|value| < 2 u) is said to be so, apart from the effect's terms."""
+    std = e.get("std") or {}
+    shown, weak = [], []
+    for k, v in e["parameters"].items():
+        u = std.get(k)
+        text = f"{k} = {v:.4g} {e['units'][k]}"
+        if u is not None:
+            text += f" +- {K_PRINT * u:.2g} (k = {K_PRINT:g})"
+        (weak if u is not None and abs(v) < SIG_K * u else shown).append(text)
+    out = ", ".join(shown) or "no significant term"
+    if weak:
+        out += f"; not significant, not part of the effect: {', '.join(weak)}"
+    return out
+
+
 def lag_lines(e: dict) -> list:
     """Console lines of an effect's lag and of the explanations the data cannot tell from it."""
     out = []
@@ -57,8 +78,7 @@ def console_lines(report: Report) -> list:
     out = [f"  warning: {w}" for w in report["warnings"]]
     out.append(Report.summary(report))
     for e in report.effects:
-        pars = ", ".join(f"{k} = {v:.4g} {e['units'][k]}" for k, v in e["parameters"].items())
-        out.append(f"  {e['kind']} {e['name']}: {pars}")
+        out.append(f"  {e['kind']} {e['name']}: {effect_terms(e)}")
         out += [f"    {line}" for line in lag_lines(e)]
     if report["augmented_layout"]:
         out.append(f"  augmented layout: {report['augmented_layout']}; generated module: "
