@@ -27,18 +27,20 @@ from .machine.model import Model, load  # noqa: F401
 __version__ = "0.1.0"
 
 #: callable sub-packages: ``volerr.NAME(...)`` (``volerr/NAME/__init__.py`` makes itself callable)
-_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty")
+_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check")
+#: capability packages named as modules: ``volerr.history.add(...)``, ``volerr.history.show(...)``
+_MODULES = ("history",)
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api", "error_map": "cmm.api",
               "probe_cal": "probe.api", "diagonals": "cmm.api"}
 
-__all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_FUNCTIONS]
+__all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_MODULES, *_FUNCTIONS]
 
 
 def __getattr__(name):
     # lazy: the capability is imported when first named (numpy, scipy, matplotlib ...)
-    if name in _PACKAGES:
+    if name in _PACKAGES or name in _MODULES:
         return importlib.import_module(f"{__name__}.{name}")
     if name in _FUNCTIONS:
         return getattr(importlib.import_module(f"{__name__}.{_FUNCTIONS[name]}"), name)

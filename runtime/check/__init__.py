@@ -19,3 +19,8 @@ from ._result import CheckResult
 from ._run import check
 
 __all__ = ["CheckPlan", "CheckResult", "Reference", "check", "load_reference", "plan_check"]
+
+from ..results import callable_package  # noqa: E402
+
+# volerr.check(...) is volerr.check.check(...), whatever was imported before
+callable_package(__name__, check)

@@ -217,3 +217,16 @@ def test_the_readme_fits_on_a_screen():
     assert len(text.encode("utf-8")) <= 15 * 1024
     for link in re.findall(r"\]\(((?:docs/)[^)#]+)\)", text):
         assert (ROOT / link).exists(), link
+
+
+def test_check_and_history_are_reachable_from_the_top():
+    """``volerr.check(...)`` is the check command's function whatever was imported first;
+    ``volerr.history.add`` / ``show`` are the history commands'."""
+    import subprocess
+    import sys
+
+    code = ("import volerr.check._run, volerr; from volerr.check import check; "
+            "assert callable(volerr.check) and volerr.check.__api__ is check; "
+            "assert volerr.history.add.__module__ == 'volerr.history.run'; "
+            "import sys; assert 'sympy' not in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True)

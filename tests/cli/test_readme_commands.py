@@ -40,6 +40,12 @@ SHORTEST = {
     "simulate": ["MB1", "--out", "simulated.csv"],
     "loop": ["MB1", "deviations_MB1.csv"],
     "iso230-2": ["iso230_2_run_X.csv"],
+    "iso230-3": ["drift_spindle.csv"],
+    "drift convert": ["drift_logger_raw.csv", "--out", "drift.csv"],
+    "check plan": None,                    # tests/check and tests/history run them
+    "check": None,
+    "history add": None,
+    "history show": None,
     "uncertainty": ["MH2", "--task", "task_distance.csv", "--evaluate", "distance",
                     "--noise-um", "0.5"],
     "iso10360": ["MB1", "--errors", "errors_MB1"],
