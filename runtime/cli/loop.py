@@ -70,18 +70,9 @@ def register(sub) -> None:
 
 
 def _is_drift(specs) -> bool:
-    from ..instruments import detect, split_spec
+    from ..loop.api import is_drift
 
-    kinds = []
-    for d in specs:
-        kind, path = split_spec(d)
-        kinds.append(kind or (detect(path) if Path(path).is_file() else None))
-    drift = [k == "drift" for k in kinds]
-    require(all(drift) or not any(drift), "loop: drift runs and other measurements in one "
-            "call; give the drift files alone")
-    return all(drift)
-
-
+    return is_drift(specs)
 
 
 def run(args) -> int:
@@ -156,6 +147,5 @@ def run_drift(args) -> int:
             report.write_html(outs.path("--html"), inputs=inputs)
         if args.predictions_out:
             report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
-    for line in report.summary_lines():
-        print(line)
+    print(report.summary())
     return 0

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 from ..errors import require
 from . import candidates
+from .drift_report import K_PRINT
 from .run import Report, run_loop
 
 
@@ -35,7 +37,6 @@ class Loop(Report):
         return out
 
 
-K_PRINT = 2.0    # coverage factor of the printed uncertainties
 SIG_K = 2.0      # a term below this many standard uncertainties is not part of the effect
 
 
@@ -92,9 +93,27 @@ def console_lines(report: Report) -> list:
     return out
 
 
+def is_drift(specs) -> bool:
+    """Whether the files ``specs`` (``KIND:FILE`` or paths) are drift runs: all of them
+    (``drift:FILE`` or detected as such), or none; a mixture is refused (one line)."""
+    from pathlib import Path
+
+    from ..instruments import detect, split_spec
+
+    kinds = []
+    for d in specs:
+        kind, path = split_spec(str(d))
+        kinds.append(kind or (detect(path) if Path(path).is_file() else None))
+    drift = [k == "drift" for k in kinds]
+    require(all(drift) or not any(drift), "loop: drift runs and other measurements in one "
+            "call; give the drift files alone")
+    return bool(drift) and all(drift)
+
+
 def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None,
          test_fraction: float = 0.25, degree: int | None = None, families=None,
-         progress=None) -> Loop:
+         progress=None, holdout_time: str | None = None, holdout_files=(),
+         differences: bool = False):
     """Close the loop on measured deviations (``volerr loop``): fit the declared model, trace
     the residual to candidate effects "parameter P varies with covariate C", augment the
     layout, report the error before and after on held-out points.
@@ -124,12 +143,30 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
     progress : bool, optional
         Progress bar on stderr (None: when stderr is a terminal).
 
+    holdout_time : str, optional
+        ``"A:B"`` (units s, min, h; an open end allowed: ``"100035s:"``): hold out the
+        readings (points) with A <= t < B.
+    holdout_files : list, optional
+        Drift runs: every run of these files held out (read beside ``files``).
+    differences : bool
+        Drift runs: try differences of two sensors as well.
+
     Returns
     -------
     Loop
         ``to_dict()`` is ``volerr loop --json``: RMS / max before and after (um), the effects
         with their parameters (their units in ``units``) and standard uncertainties (k = 1).
+    DriftReport
+        For drift runs (``drift:FILE`` or files detected as drift; 'volerr formats
+        loop-lags'): ``data`` / ``["channels"]`` / ``effects`` the JSON of ``volerr loop
+        --json``, ``summary()`` the console text, ``write_json``, ``write_html``,
+        ``write_predictions`` (:class:`volerr.loop.drift_report.DriftReport`).
     """
+    specs = list(files) if isinstance(files, (list, tuple)) else [files]
+    if specs and all(isinstance(f, (str, os.PathLike)) for f in specs) and is_drift(specs):
+        return _drift(layout, specs, out_dir, holdout_time, holdout_files, differences,
+                      progress)
+    require(not holdout_files, "loop: holdout_files is for drift runs (drift:FILE)")
     chosen = candidates.FAMILIES
     if families:
         parts = families.split(",") if isinstance(families, str) else list(families)
@@ -140,5 +177,19 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
     if isinstance(files, (list, tuple)):
         files = files[0] if len(files) == 1 else list(files)
     r = run_loop(layout, files, seed=seed, folds=folds, test_fraction=test_fraction,
-                 degree=degree, out_dir=out_dir, families=chosen, progress=progress)
+                 degree=degree, out_dir=out_dir, families=chosen, progress=progress,
+                 holdout_time=holdout_time)
     return Loop(r.data, r.figures, r.augmented_text, r.generated)
+
+
+def _drift(layout, specs, out_dir, holdout_time, holdout_files, differences, progress):
+    """The loop on drift runs (:func:`volerr.loop.drift_report.loop_drift`)."""
+    from ..instruments import split_spec
+    from .drift_report import loop_drift
+
+    require(out_dir is None, "loop: out_dir is not written for drift runs (their effects are "
+            "per channel, not in the layout)")
+    held = [split_spec(str(d))[1] for d in (holdout_files or [])]
+    return loop_drift(layout, [split_spec(str(d))[1] for d in specs], window=holdout_time,
+                      files=held, differences=differences,
+                      progress=progress if callable(progress) else None)

@@ -21,14 +21,20 @@ from ..errors import require
 from ..fileio import json_text
 from . import drift as core
 from . import drift_basis as basis
+from . import drift_rows as rows_mod
 from .drift_split import held_out
 
-K_PRINT = 2.0      # coverage factor of the printed uncertainties
+K_PRINT = 2.0      # coverage factor of the printed uncertainties (the loop's console, 3-D too)
+
 
 
 def load_series(paths) -> basis.DriftSeries:
     """Drift files (paths) -> one :class:`~volerr.loop.drift_basis.DriftSeries` (every run
     its own zero and its own lag start); runs must log the same channels and inputs."""
+    return _series(_runs(paths))
+
+
+def _runs(paths) -> list:
     from ..instruments.drift import read_runs
 
     runs = [r for p in paths for r in read_runs(p)]
@@ -37,6 +43,11 @@ def load_series(paths) -> basis.DriftSeries:
         require(set(r.channels) == set(first.channels) and set(r.inputs) == set(first.inputs),
                 f"{r.name}: its channels and logged inputs differ from {first.name}'s; the "
                 f"runs of one loop log the same ones")
+    return runs
+
+
+def _series(runs) -> basis.DriftSeries:
+    first = runs[0]
     cat = np.concatenate
     return basis.DriftSeries(
         cat([r.t_s for r in runs]), cat([np.full(r.n, i) for i, r in enumerate(runs)]),
@@ -87,6 +98,13 @@ class DriftReport:
 
         return write_text(path, render_html(self), inputs=list(inputs))
 
+    def summary(self) -> str:
+        """The whole console text of ``volerr loop`` on drift runs."""
+        return "\n".join(self.summary_lines())
+
+    def to_dict(self) -> dict:
+        return self.data
+
     def summary_lines(self) -> list:
         d = self.data
         out = [f"{d['layout']}: drift runs {', '.join(d['runs'])}; {d['split']}; "
@@ -98,8 +116,15 @@ class DriftReport:
                        f"{c['mae_static_um']:.3f}), RMS {c['rms_before_um']:.3f} -> "
                        f"{c['rms_after_um']:.3f}, max {c['max_abs_before_um']:.3f} -> "
                        f"{c['max_abs_after_um']:.3f} um")
+        for sym, q in d.get("quantities", {}).items():
+            rows = ", ".join(f"{c} {w:+.4g}" for c, w in q["rows"].items())
+            own = ", ".join(q["layout_parameters"]) or "none"
+            out.append(f"  {sym} ({q['unit']}): {q['description']}, rows {rows}; the layout's "
+                       f"parameters it is at this position: {own}")
         for e in d["effects"]:
-            out.append(f"  {e['kind']} {e['name']}: {e['channel']} varies with {e['basis']}")
+            what = e["channel"] if not e.get("quantity") else \
+                f"{e['quantity']} (channels {', '.join(e['channels'])})"
+            out.append(f"  {e['kind']} {e['name']}: {what} varies with {e['basis']}")
             for t in e["terms"]:
                 out.append("    " + _term_line(t))
         for n in d["not_significant"]:
@@ -124,37 +149,75 @@ def _term_line(t: dict) -> str:
 def loop_drift(layout: str, paths, window=None, files=(), differences: bool = False,
                progress=None) -> DriftReport:
     """The loop on drift files ``paths`` and the held-out ``files`` (read beside them, every
-    run of theirs held out; see :mod:`volerr.loop.drift`)."""
+    run of theirs held out; see :mod:`volerr.loop.drift`).  Channels with a direction are
+    rows of the layout's model (:mod:`volerr.loop.drift_rows`): the quantities of the chain
+    they read are modelled, each channel predicted by its row of them."""
     from ..machine.model import load
 
     model = load(layout)
     named = {Path(p).resolve() for p in paths}
-    s = load_series(list(paths) + [f for f in files if Path(f).resolve() not in named])
+    runs = _runs(list(paths) + [f for f in files if Path(f).resolve() not in named])
+    s = _series(runs)
     s.test, said = held_out(s, window, files)
-    res = core.run_drift(s, differences=differences, progress=progress)
+    rows = _rows(s, runs[0], model)
+    m, resid = (s, {}) if rows is None else rows_mod.modelled_series(s, rows)
+    res = core.run_drift(m, differences=differences, progress=progress)
     data = {"layout": model.name, "kind": "drift",
             "runs": [f if not r else f"{f}[{r}]" for f, r in s.runs], "split": said,
             "n_points": int(len(s.t_s) * len(s.channels)), "n_train": int(s.train.sum()),
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
-            "n_folds": res["n_folds"], "channels": {}, "effects": [], "not_significant": [],
-            "static_regression": {}, "unidentifiable": []}
-    pred = {}
+            "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
+            "not_significant": [], "static_regression": {}, "unidentifiable": []}
     R = (s.run[:, None] == np.arange(len(s.runs))[None, :]).astype(float)
+    qpred = {label: _prediction(m, R, r) for label, r in res["channels"].items()}
+    pred = {k: qpred[k] for k in s.channels if k not in resid}
+    if rows is not None:
+        pred.update(rows_mod.map_back(s, rows, qpred, resid))
+        data["quantities"] = {q.symbol: _quantity(q, rows) for q in rows.quantities}
+    pred = {k: pred[k] for k in s.channels}
+    for label, p in pred.items():
+        c = data["channels"][label] = _metrics(s, s.channels[label], p["before"], p["after"],
+                                               p["static"])
+        c["direction"] = s.directions.get(label, "?")
+        if label in resid:
+            c["row"] = rows.row(label)
+            c["row_residual_rms_um"] = rows_mod.residual_rms(s, resid[label])
+    quantity = {q.symbol: q for q in (rows.quantities if rows is not None else ())}
     for label, r in res["channels"].items():
-        f = r["fit"]
-        after = core.predict(s, R, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
-        pred[label] = {"before": r["before"], "after": after, "static": r["static"],
-                       "terms": r["terms"]}
-        data["channels"][label] = _metrics(s, r["y"], r["before"], after, r["static"])
-        data["channels"][label]["direction"] = s.directions.get(label, "?")
-        data["effects"] += _effects(label, r, s)
-        data["not_significant"] += [f"{label}: {_basis(sp)}" for sp in f.get("dropped", [])]
-    tr = [c for c in data["channels"].values()]
+        data["effects"] += _effects(label, r, m, quantity.get(label))
+        data["not_significant"] += [f"{label}: {_basis(sp)}" for sp in r["fit"].get("dropped", [])]
+    tr = list(data["channels"].values())
     data["rms_before_um"] = _pool(tr, "rms_before_um")
     data["rms_after_um"] = _pool(tr, "rms_after_um")
     data["max_before_um"] = max(c["max_abs_before_um"] for c in tr)
     data["max_after_um"] = max(c["max_abs_after_um"] for c in tr)
     return DriftReport(data, s, pred)
+
+
+def _rows(s, run, model):
+    """The rows of the directed channels, named in the layout at the first run's position
+    (None: no channel has a direction)."""
+    from ..instruments.drift import _test_position
+
+    rows = rows_mod.rows_of(s.directions, s.heights)
+    if rows is not None:
+        rows_mod.name_in_layout(rows, model, _test_position(run, model),
+                                taken=[k for k in s.channels if k not in rows.channels])
+    return rows
+
+
+def _prediction(m, R, r) -> dict:
+    f = r["fit"]
+    after = core.predict(m, R, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
+    return {"before": r["before"], "after": after, "static": r["static"], "terms": r["terms"]}
+
+
+def _quantity(q, rows) -> dict:
+    return {"kind": q.kind, "axis": q.axis, "about": q.about, "unit": q.unit,
+            "description": q.describe(), "channels": list(q.channels),
+            "rows": {k: float(rows.A[rows.channels.index(k), rows.quantities.index(q)])
+                     for k in q.channels},
+            "layout_parameters": dict(q.layout_parameters)}
 
 
 def _pool(chs, key) -> float:
@@ -178,14 +241,16 @@ def _basis(sp) -> str:
     return f"lag({what}, {sp['tau_s']:.0f} s)" if sp["tau_s"] > 0 else what
 
 
-def _effects(label, r, s) -> list:
-    """The channel's terms grouped by covariate (module docstring)."""
+def _effects(label, r, s, q=None) -> list:
+    """The channel's (or the quantity ``q``'s) terms grouped by covariate (module
+    docstring)."""
     f = r["fit"]
     groups: dict = {}
     for i, sp in enumerate(r["terms"]):
         key = ("heat",) if sp["source"] == "heat" else (sp["source"], sp["minus"])
         groups.setdefault(key, []).append(i)
     S_ref = float(np.abs(s.inputs[basis.SPEED][s.train]).max()) if basis.SPEED in s.inputs else None
+    unit = q.unit if q is not None else "um"
     out = []
     for key, idx in groups.items():
         sp0 = r["terms"][idx[0]]
@@ -195,14 +260,16 @@ def _effects(label, r, s) -> list:
         for i in idx:
             sp = r["terms"][i]
             t = {"basis": _basis(sp), "value": float(f["coef"][i]), "std": float(f["coef_std"][i]),
-                 "unit": "um" if heat else "um/K",
+                 "unit": unit if heat else f"{unit}/K",
                  "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if f["tau_std"][i] is None
                             else round(f["tau_std"][i], 1)} if sp["tau_s"] > 0 else None),
                  "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"]}
             terms.append(t)
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
-        e = {"kind": "thermal", "name": name, "channel": label, "channels": [label],
-             "covariate": covs[0], "covariates": covs, "parameter": _parameter(s, label),
+        e = {"kind": "thermal", "name": name, "channel": label,
+             "channels": list(q.channels) if q is not None else [label],
+             "quantity": q.symbol if q is not None else None,
+             "covariate": covs[0], "covariates": covs, "parameter": _parameter(s, label, q),
              "basis": " + ".join(t["basis"] for t in terms),
              "lag_s": terms[0]["lag_s"], "terms": terms,
              "parameters": {f"{name}_{j}": t["value"] for j, t in enumerate(terms)},
@@ -216,10 +283,10 @@ def _effects(label, r, s) -> list:
     return out
 
 
-def _parameter(s, label) -> str:
-    """The chain's symbol the channel reads: the tool point's offset along its direction,
-    or its own zero for a ``?`` channel."""
-    d = s.directions.get(label, "?")
-    if d == "?":
-        return f"channel {label} (direction not known: modelled on its own)"
-    return f"tool point offset along {d.lstrip('-')} (E{d.lstrip('-')} of the tool point)"
+def _parameter(s, label, q=None) -> str:
+    """The chain's quantity the effect acts on (its symbol, what it is, the channels whose
+    rows it is part of), or a ``?`` channel's own zero."""
+    if q is not None:
+        return (f"{q.symbol}: {q.describe()} at the test position ({q.unit}; read by "
+                f"{', '.join(q.channels)})")
+    return f"channel {label} (direction not known: modelled on its own)"
