@@ -106,3 +106,36 @@ def stretch_split(t, groups, fraction: float) -> np.ndarray:
         block = np.minimum(((t[sel] - lo) / (hi - lo) * N_BLOCKS).astype(int), N_BLOCKS - 1)
         test[np.flatnonzero(sel)[np.isin(block, held)]] = True
     return test
+
+
+#: a held-out input beyond the training range by more than this share of that range
+EXTRAPOLATION_MARGIN = 0.05
+
+
+def extrapolation(s: DriftSeries) -> list:
+    """The logged inputs whose held-out readings leave the range the training readings span
+    (by more than ``EXTRAPOLATION_MARGIN`` of it): there a fitted drift model extrapolates
+    (a speed never run, a temperature never reached), its prediction is not supported by the
+    data.  [{"input", "train_min", "train_max", "test_min", "test_max"}], in file order."""
+    out = []
+    for name, v in s.inputs.items():
+        v = np.asarray(v, float)
+        tr, te = v[s.train], v[s.test]
+        if not (len(tr) and len(te)):
+            continue
+        lo, hi = float(tr.min()), float(tr.max())
+        pad = EXTRAPOLATION_MARGIN * max(hi - lo, 1e-12)
+        if te.min() < lo - pad or te.max() > hi + pad:
+            out.append({"input": name, "train_min": lo, "train_max": hi,
+                        "test_min": float(te.min()), "test_max": float(te.max())})
+    return out
+
+
+def extrapolation_line(items: list) -> str:
+    """One console line naming the inputs :func:`extrapolation` found (empty: '')."""
+    if not items:
+        return ""
+    parts = [f"{e['input']} {e['test_min']:.4g}..{e['test_max']:.4g} (training "
+             f"{e['train_min']:.4g}..{e['train_max']:.4g})" for e in items]
+    return ("warning: the held-out readings leave the training range of " + ", ".join(parts)
+            + ": there the model extrapolates, its held-out figures judge an extrapolation")
