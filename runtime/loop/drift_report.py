@@ -22,7 +22,7 @@ from ..fileio import json_text
 from . import drift as core
 from . import drift_basis as basis
 from . import drift_rows as rows_mod
-from .drift_split import held_out
+from .drift_split import extrapolation, extrapolation_line, held_out
 
 K_PRINT = 2.0      # coverage factor of the printed uncertainties (the loop's console, 3-D too)
 
@@ -110,6 +110,8 @@ class DriftReport:
         out = [f"{d['layout']}: drift runs {', '.join(d['runs'])}; {d['split']}; "
                f"{d['n_train']} training, {d['n_test']} held-out readings; choices by blocked "
                f"cross-validation over {d['n_folds']} {d['fold_rule']}"]
+        if d.get("extrapolation"):
+            out.insert(0, "  " + extrapolation_line(d["extrapolation"]))
         for label, c in d["channels"].items():
             out.append(f"  channel {label}: held-out MAE {c['mae_before_um']:.3f} -> "
                        f"{c['mae_after_um']:.3f} um (static regression on all temperatures "
@@ -167,7 +169,8 @@ def loop_drift(layout: str, paths, window=None, files=(), differences: bool = Fa
             "n_points": int(len(s.t_s) * len(s.channels)), "n_train": int(s.train.sum()),
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
-            "not_significant": [], "static_regression": {}, "unidentifiable": []}
+            "not_significant": [], "static_regression": {}, "unidentifiable": [],
+            "extrapolation": extrapolation(s)}
     R = (s.run[:, None] == np.arange(len(s.runs))[None, :]).astype(float)
     qpred = {label: _prediction(m, R, r) for label, r in res["channels"].items()}
     pred = {k: qpred[k] for k in s.channels if k not in resid}

@@ -1,0 +1,49 @@
+"""The drift loop says when its held-out readings lie outside the training range of an input
+(a speed never run, a temperature never reached): there a prediction is an extrapolation.
+Checked on a simulated run whose held-out stretch runs the spindle faster than any training
+stretch, against the ranges computed here from the file itself."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from volerr.cli import main
+
+
+def _write(path, fast_test: bool):
+    t = np.arange(0.0, 12 * 3600.0, 30.0)
+    speed = np.where(t < 6 * 3600, 2000.0, 0.0)
+    speed[(t >= 9 * 3600) & (t < 11 * 3600)] = 4000.0 if fast_test else 2000.0
+    rng = np.random.default_rng(5)
+    temp = 22.0 + np.cumsum(speed) * 1e-6 + rng.normal(0, 0.01, len(t))
+    d = 2.0 * (temp - temp[0]) + rng.normal(0, 0.05, len(t))
+    rows = ["t_s,S_rpm,T_spindle,d_z_um"] + [f"{a:.1f},{b:.1f},{c:.5f},{e:.5f}"
+                                             for a, b, c, e in zip(t, speed, temp, d)]
+    path.write_text("\n".join(rows) + "\n")
+    return t, speed, temp
+
+
+def test_held_out_speed_above_training_is_flagged(tmp_path, capsys):
+    f = tmp_path / "run.csv"
+    t, speed, temp = _write(f, fast_test=True)
+    out = tmp_path / "r.json"
+    assert main(["loop", "DMU50", f"drift:{f}", "--holdout-time", "9h:", "--json", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    flagged = {e["input"]: e for e in doc["extrapolation"]}
+    assert "S_rpm" in flagged
+    test = t >= 9 * 3600
+    assert flagged["S_rpm"]["test_max"] == speed[test].max()
+    assert flagged["S_rpm"]["train_max"] == speed[~test].max()
+    assert "extrapolates" in capsys.readouterr().out
+
+
+def test_held_out_within_training_is_not_flagged(tmp_path, capsys):
+    f = tmp_path / "run.csv"
+    _write(f, fast_test=False)
+    out = tmp_path / "r.json"
+    assert main(["loop", "DMU50", f"drift:{f}", "--holdout-time", "9h:11h", "--json",
+                 str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert "S_rpm" not in {e["input"] for e in doc["extrapolation"]}
