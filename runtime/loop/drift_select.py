@@ -30,13 +30,12 @@ import numpy as np
 from .drift_cv import Engine
 from .select import BIC_GAIN
 
-CV_GAIN = 0.03        # relative drop of the cross-validated mean square a term must bring
+CV_GAIN = 0.01        # relative drop of the cross-validated mean square a term must bring
 DIFF_GAIN = 0.10      # a difference of two sensors must beat the best single sensor by this
 MAX_TERMS = 6         # terms per channel (the effects reported)
 TIE_REL = 1e-9        # relative difference of two scores below which they are tied
 ALT_REL = 0.01        # cross-validated RMS within 1 %: not told apart (lags.CV_SAME)
 N_ALT = 3
-TAU_RATIO = 3.0        # two lags of one source: time constants at least this factor apart
 
 
 def candidates(cols) -> np.ndarray:
@@ -52,23 +51,12 @@ def candidates(cols) -> np.ndarray:
 
 
 def _allowed(cands, cols, chosen_p, taken) -> np.ndarray:
-    """Candidates that may join the terms ``taken``: not taken, the heat input at the
-    exponent chosen, and not a second lag of a source already in the model within a factor
-    ``TAU_RATIO`` of its time constant (two such lags are no two time constants: their
-    difference acts as a derivative of one, it fits noise and extrapolates badly)."""
     ok = np.ones(len(cands), bool)
-    lags = {}
-    for a, b in taken:
-        if cols[a].tau_s > 0:
-            lags.setdefault((cols[a].source, b), []).append(cols[a].tau_s)
     for i, (a, b) in enumerate(cands):
         c = cols[a]
         if c.p is not None and chosen_p is not None and c.p != chosen_p:
             ok[i] = False
         if (a, b) in taken:
-            ok[i] = False
-        near = lags.get((c.source, b), ()) if c.tau_s > 0 else ()
-        if any(max(c.tau_s, t) < TAU_RATIO * min(c.tau_s, t) for t in near):
             ok[i] = False
     return ok
 
