@@ -30,7 +30,7 @@ import numpy as np
 from .drift_cv import Engine
 from .select import BIC_GAIN
 
-CV_GAIN = 0.03        # relative drop of the cross-validated mean square a term must bring
+CV_GAIN = 0.01        # relative drop of the cross-validated mean square a term must bring
 DIFF_GAIN = 0.10      # a difference of two sensors must beat the best single sensor by this
 MAX_TERMS = 6         # terms per channel (the effects reported)
 TIE_REL = 1e-9        # relative difference of two scores below which they are tied
