@@ -1,0 +1,181 @@
+"""Does the loop's drift model of the FL_THERMAL spindle test generalise to OTHER held-out
+windows than the published one?  (An independent acceptance test: the loop judged against
+the shop's usual model, computed here, and not against its own report only.)
+
+Data: runtime/data/fl_thermal_spindle.csv (the real 46.3 h spindle test, 11 115 readings every
+15 s, t = 0 .. 166 710 s, 16 temperatures, 5 channels of unknown direction; README in
+/work/shared/data/thermal/).  Each window below is held out of the WHOLE file with
+``volerr loop DMU50 drift:FILE --holdout-time A:B`` (training: every reading outside the
+window, before and after it), run once per window (module fixture, one xdist group per
+window so a window's tests share its run):
+
+=========  ==================  =====================================================
+window     A:B (s)             what the training part has not seen
+=========  ==================  =====================================================
+20-40 %    33345 : 66690       the 2500 rpm cool-down and the 3750 rpm run (most of it)
+40-60 %    66690 : 100035      the 3750 rpm cool-down and the 5000 rpm run (the fastest;
+                               only its last 20 min, 100035 .. 101268 s, are in training)
+60-80 %    100035 : 133380     the published test window (5000 rpm cool-down, 3500 rpm)
+80-100 %   133380 :            the variable-speed block 500/1500/2500/4500 rpm
+=========  ==================  =====================================================
+
+Criteria a metrologist would accept (per channel, on the held-out readings):
+
+* the loop's MAE (recomputed here from ``--predictions-out`` against the data file's own
+  values) is not worse than the STATIC multiple linear regression on all sixteen
+  temperatures (their change since the run's start plus a constant), fitted here with
+  ``numpy.linalg.lstsq`` on the same training readings:
+  ``mae_loop <= STATIC_FACTOR * mae_static + STATIC_SLACK_UM`` -- a model with lags, heat
+  input and cross-validated choices that predicts a new stretch of the run worse than a plain
+  regression on the same temperatures has learnt the training part, not the machine;
+* on the 60-80 % window (the publication's), trained here on everything else, every channel
+  stays below the best published MAE (seq2seq with attention).
+
+The loop's own ``mae_static_um`` must also agree with the regression computed here (it is
+the same model by INTERFACE.md's description), so that its console's comparison can be
+trusted.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+CHANNELS = ("ch1", "ch2", "ch3", "ch4", "ch5")
+PUBLISHED_MAE_UM = {"ch1": 3.561, "ch2": 3.755, "ch3": 3.704, "ch4": 3.461, "ch5": 4.284}
+STATIC_FACTOR = 1.05
+STATIC_SLACK_UM = 0.2
+#: the loop's own static figure vs the regression computed here (same model, other solver)
+STATIC_AGREE_REL = 0.01
+
+#: window name -> (A, B) seconds (B None: open end), as ``--holdout-time`` reads it
+WINDOWS = {"20-40": (33345.0, 66690.0), "40-60": (66690.0, 100035.0),
+           "60-80": (100035.0, 133380.0), "80-100": (133380.0, None)}
+
+#: measured on a shared 2-core machine (load ~4), one loop run each: 20-40 % 27 s,
+#: 40-60 % 14 s, 60-80 % 15 s, 80-100 % 32 s (the training part on both sides of the
+#: window: a longer span, a longer grid of time constants)
+SLOW_WINDOWS = ("20-40", "80-100")
+
+
+def _data() -> Path:
+    return Path(str(resources.files("volerr") / "data" / "fl_thermal_spindle.csv"))
+
+
+def _read_table(path: Path) -> dict:
+    """The drift file's columns {name: (N,) float} (header lines ``#`` skipped)."""
+    with open(path, newline="") as fh:
+        rows = [r for r in csv.reader(ln for ln in fh if not ln.startswith("#"))]
+    head, body = rows[0], np.array(rows[1:], float)
+    return {h: body[:, j] for j, h in enumerate(head)}
+
+
+@pytest.fixture(scope="module")
+def table():
+    return _read_table(_data())
+
+
+def _window_arg(a, b) -> str:
+    return f"{a:g}s:" + ("" if b is None else f"{b:g}s")
+
+
+@pytest.fixture(scope="module")
+def loop_runs(tmp_path_factory):
+    """window -> (JSON, predictions rows): ``volerr loop`` run once per window."""
+    cache: dict = {}
+
+    def get(name: str):
+        if name not in cache:
+            a, b = WINDOWS[name]
+            folder = tmp_path_factory.mktemp(f"fl_{name}")
+            env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
+                   "MKL_NUM_THREADS": "1"}
+            r = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50",
+                                f"drift:{_data()}", "--holdout-time", _window_arg(a, b),
+                                "--json", "w.json", "--predictions-out", "p.csv"],
+                               capture_output=True, text=True, cwd=folder, env=env)
+            assert r.returncode == 0, r.stderr
+            with open(folder / "p.csv", newline="") as fh:
+                rows = list(csv.DictReader(fh))
+            cache[name] = (json.loads((folder / "w.json").read_text()), rows)
+        return cache[name]
+
+    return get
+
+
+def _mask(t, name):
+    a, b = WINDOWS[name]
+    return (t >= a) & (t < (np.inf if b is None else b))
+
+
+def static_regression_mae(table: dict, channel: str, name: str) -> float:
+    """MAE on the window of the static multiple linear regression on all temperatures'
+    change since the run's start plus a constant, least squares on the readings outside it."""
+    t = table["t_s"]
+    test = _mask(t, name)
+    temps = sorted((k for k in table if k.startswith("T_")), key=lambda k: int(k[2:]))
+    assert len(temps) == 16
+    X = np.column_stack([np.ones(len(t))] + [table[k] - table[k][0] for k in temps])
+    y = table[f"d_{channel}_um"]
+    coef, *_ = np.linalg.lstsq(X[~test], y[~test], rcond=None)
+    return float(np.mean(np.abs(y[test] - X[test] @ coef)))
+
+
+def loop_mae(table: dict, rows: list, channel: str, name: str) -> float:
+    """The loop's held-out MAE from its predictions file, against the data file's values."""
+    test = [r for r in rows if r["channel"] == channel and r["split"] == "test"]
+    t = np.array([float(r["t_s"]) for r in test])
+    expected_t = table["t_s"][_mask(table["t_s"], name)]
+    np.testing.assert_array_equal(np.sort(t), expected_t)       # exactly the window held out
+    measured = np.interp(t, table["t_s"], table[f"d_{channel}_um"])
+    after = np.array([float(r["after_um"]) for r in test])
+    return float(np.mean(np.abs(measured - after)))
+
+
+def _param(name):
+    """A window as a parameter: its tests in one xdist group (they share its loop run); the
+    windows whose run takes longest (measured, see SLOW_WINDOWS) marked slow as well."""
+    marks = [pytest.mark.xdist_group(f"fl_window_{name}")]
+    if name in SLOW_WINDOWS:
+        marks.append(pytest.mark.slow)
+    return pytest.param(name, id=name, marks=marks)
+
+
+@pytest.mark.parametrize("name", [_param(n) for n in WINDOWS])
+@pytest.mark.parametrize("channel", CHANNELS)
+def test_no_worse_than_static_regression_on_all_temperatures(loop_runs, table, name, channel):
+    doc, rows = loop_runs(name)
+    mine = loop_mae(table, rows, channel, name)
+    static = static_regression_mae(table, channel, name)
+    assert doc["channels"][channel]["mae_after_um"] == pytest.approx(mine, rel=1e-6)
+    chosen = [t["basis"] for e in doc["effects"] if e["channels"] == [channel]
+              for t in e["terms"]]
+    assert mine <= STATIC_FACTOR * static + STATIC_SLACK_UM, (
+        f"window {name} %, {channel}: loop MAE {mine:.3f} um > {STATIC_FACTOR} x static "
+        f"regression {static:.3f} um + {STATIC_SLACK_UM} um; the loop chose {chosen}")
+
+
+@pytest.mark.parametrize("name", [_param(n) for n in WINDOWS])
+def test_the_reported_static_regression_is_the_one_computed_here(loop_runs, table, name):
+    doc, _ = loop_runs(name)
+    for ch in CHANNELS:
+        static = static_regression_mae(table, ch, name)
+        assert doc["channels"][ch]["mae_static_um"] == pytest.approx(
+            static, rel=STATIC_AGREE_REL), (name, ch)
+
+
+@pytest.mark.parametrize("channel", CHANNELS)
+@pytest.mark.xdist_group("fl_window_60-80")
+def test_published_window_trained_on_the_rest_beats_the_published_best(loop_runs, table,
+                                                                      channel):
+    _, rows = loop_runs("60-80")
+    mae = loop_mae(table, rows, channel, "60-80")
+    assert mae < PUBLISHED_MAE_UM[channel], (channel, mae, PUBLISHED_MAE_UM[channel])
