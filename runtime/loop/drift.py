@@ -47,6 +47,7 @@ SIG_K = 2.0           # coverage factor of the significance test of a term
 def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) -> dict:
     """The loop on the drift runs ``s`` (its ``test`` mask set): per channel the chosen
     terms, predictions and figures (see :mod:`volerr.loop.drift_report` for the JSON)."""
+    s.memo.clear()            # columns depend on the split (S_ref): computed afresh
     cols, X = basis.library(s)
     fold, rule = basis.folds(s)
     n_runs = len(s.runs)
@@ -151,11 +152,14 @@ def _alt(cols, x) -> dict:
 
 def column(s, sp, tau=None) -> np.ndarray:
     """The unscaled values (N,) of a term ``sp`` (its lag ``tau`` if given)."""
-    tau = sp["tau_s"] if tau is None else tau
-    v = basis.series(s, sp["source"], tau, sp["p"])
-    if sp["minus"]:
-        v = v - basis.series(s, sp["minus"], tau)
-    return v
+    tau = float(sp["tau_s"] if tau is None else tau)
+    key = (sp["source"], sp["minus"], sp["p"], tau)
+    if key not in s.memo:
+        v = basis.series(s, sp["source"], tau, sp["p"])
+        if sp["minus"]:
+            v = v - basis.series(s, sp["minus"], tau)
+        s.memo[key] = v
+    return s.memo[key]
 
 
 def _design(s, specs, R, taus=None) -> np.ndarray:
@@ -221,11 +225,11 @@ def _jackknife(s, specs, R, y, fold) -> dict:
     b = _fit(D, y, tr)
     K = int(fold.max()) + 1
     bk, tk, edge = [], [], []
-    for k in range(K):
-        m = tr & (fold != k)
-        got = [_tau_on(s, sp, i, specs, R, y, m) for i, sp in enumerate(specs)]
-        taus = [g[0] for g in got]
-        edge = [e or g[1] for e, g in zip(edge, got)] if k else [g[1] for g in got]
+    masks = [tr & (fold != k) for k in range(K)]
+    got = [_tau_on(s, sp, i, specs, R, y, masks) for i, sp in enumerate(specs)]
+    edge = [any(g[1] for g in gi) for gi in got]
+    for k, m in enumerate(masks):
+        taus = [gi[k][0] for gi in got]
         bk.append(_fit(_design(s, specs, R, taus), y, m)[n_runs:])
         tk.append(taus)
     bk, tk = np.array(bk).reshape(K, len(specs)), np.array(tk).reshape(K, len(specs))
@@ -239,28 +243,48 @@ def _jackknife(s, specs, R, y, fold) -> dict:
             "tau_std": tau_std, "design": D}
 
 
-def _tau_on(s, sp, i, specs, R, y, mask) -> float:
-    """(the term's time constant re-estimated on the readings ``mask``, whether it lies at
-    the edge of the range searched): least RSS over ln tau within +- one grid step, the
-    others fixed (a parabola through 7 values)."""
+def _tau_on(s, sp, i, specs, R, y, masks) -> list:
+    """Per mask of ``masks``: (the term's time constant re-estimated on those readings,
+    whether it lies at the edge of the range searched): least RSS over ln tau within +- one
+    grid step, the others fixed (a parabola through 7 values; the RSS of every trial from
+    one set of cross-products per mask)."""
     if not sp["tau_s"] > 0:
-        return 0.0, False
+        return [(0.0, False)] * len(masks)
     r = math.log(basis.tau_grid(s)[1] / basis.tau_grid(s)[0])
     xs = np.linspace(-r, r, 7)
-    others = [column(s, o) for j, o in enumerate(specs) if j != i]
-    x0 = 0.0
-    for _ in range(RECENTRE):
-        rss = []
-        for x in x0 + xs:
-            D = np.column_stack([R] + others + [column(s, sp, sp["tau_s"] * math.exp(x))])
-            e = y[mask] - D[mask] @ _fit(D, y, mask)
-            rss.append(float(e @ e))
-        q, lin, _ = np.polyfit(xs, rss, 2)
-        x = float(np.clip(-lin / (2 * q), -r, r)) if q > 0 else float(xs[int(np.argmin(rss))])
-        if abs(x) < r * (1 - 1e-9):
-            return sp["tau_s"] * math.exp(x0 + x), False
-        x0 += x                 # the least RSS at the edge: search again around it
-    return sp["tau_s"] * math.exp(x0), True
+    base = np.column_stack([R] + [column(s, o) for j, o in enumerate(specs) if j != i])
+    out = []
+    for m in masks:
+        x0, res = 0.0, None
+        for _ in range(RECENTRE):
+            trial = np.column_stack([column(s, sp, sp["tau_s"] * math.exp(x0 + x)) for x in xs])
+            rss = _trial_rss(base[m], trial[m], y[m])
+            q, lin, _ = np.polyfit(xs, rss, 2)
+            x = float(np.clip(-lin / (2 * q), -r, r)) if q > 0 else float(xs[int(np.argmin(rss))])
+            if abs(x) < r * (1 - 1e-9):
+                res = (sp["tau_s"] * math.exp(x0 + x), False)
+                break
+            x0 += x             # the least RSS at the edge: search again around it
+        out.append(res or (sp["tau_s"] * math.exp(x0), True))
+    return out
+
+
+def _trial_rss(B, T, y) -> list:
+    """RSS of the least-squares fit of ``y`` on the columns ``B`` plus each column of ``T``
+    in turn (columns scaled to unit norm, as :func:`_fit`)."""
+    A = np.column_stack([B, T])
+    G = A.T @ A
+    d = np.sqrt(np.diag(G))
+    d = np.where(d > 0, d, 1.0)
+    Gs, hs, yy = G / np.outer(d, d), (A.T @ y) / d, float(y @ y)
+    nb = B.shape[1]
+    out = []
+    for j in range(T.shape[1]):
+        idx = list(range(nb)) + [nb + j]
+        g, h = Gs[np.ix_(idx, idx)], hs[idx]
+        b = np.linalg.pinv(g, rcond=1e-12, hermitian=True) @ h
+        out.append(max(yy - 2 * b @ h + b @ g @ b, 0.0))
+    return out
 
 
 def _static(s, R, y) -> np.ndarray:

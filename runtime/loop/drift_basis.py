@@ -65,6 +65,7 @@ class DriftSeries:
     directions: dict = field(default_factory=dict)
     heights: dict = field(default_factory=dict)
     test: np.ndarray | None = None
+    memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def train(self) -> np.ndarray:
