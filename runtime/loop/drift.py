@@ -89,9 +89,7 @@ def _channel(s, cols, X, Z, R, y, fold, rule, cands, cache) -> dict:
     if len(sensor_c):
         terms = terms + sel.select_terms(eng, cols, n_runs, cands=sensor_c, start=terms)
     specs = _backward(s, [_spec(cols, t) for t in terms], R, y, fold, rule)
-    for i in range(len(specs)):
-        others = [column(s, o) for j, o in enumerate(specs) if j != i]
-        specs[i] = _refine(s, specs[i], R, y, fold, rule, others)
+    specs = _refine_all(s, specs, R, y, fold, rule)
     specs, fit = _significant(s, specs, R, y, fold, rule)
     return {"terms": specs, "fit": fit, "y": y,
             "static": _static(s, R, y), "before": y[s.firsts()][s.run]}
@@ -170,6 +168,15 @@ def _design(s, specs, R, taus=None) -> np.ndarray:
 def _cv(D, y, fold, rule, run, n_runs) -> float:
     eng = Engine(D, y, fold, rule == "runs", run, n_runs)
     return eng.cv_sse(np.eye(D.shape[1])) / eng.n
+
+
+def _refine_all(s, specs, R, y, fold, rule) -> list:
+    """Every term's time constant refined in turn, the others as they stand."""
+    specs = list(specs)
+    for i in range(len(specs)):
+        others = [column(s, o) for j, o in enumerate(specs) if j != i]
+        specs[i] = _refine(s, specs[i], R, y, fold, rule, others)
+    return specs
 
 
 def _refine(s, sp, R, y, fold, rule, others=()) -> dict:
