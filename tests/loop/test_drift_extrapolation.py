@@ -47,3 +47,33 @@ def test_held_out_within_training_is_not_flagged(tmp_path, capsys):
                  str(out)]) == 0
     doc = json.loads(out.read_text())
     assert "S_rpm" not in {e["input"] for e in doc["extrapolation"]}
+
+
+def test_a_term_dropped_as_not_significant_is_listed(tmp_path):
+    """A term the selection took and the significance test dropped is named under
+    ``not_significant`` (before: the list was reset at every refit and always empty).  The
+    run: a drift that follows one sensor, a second sensor that wanders on its own (given to
+    the test as a term; its coefficient is within 2 u of zero, checked here)."""
+    from volerr.loop import drift as core
+    from volerr.loop import drift_basis as basis
+
+    rng = np.random.default_rng(11)
+    t = np.arange(0.0, 16 * 3600.0, 30.0)
+    S = np.where((t % (4 * 3600)) < 2 * 3600, 3000.0, 0.0)
+    a = 22 + np.convolve(S / 3000.0, np.ones(60) / 60, mode="full")[:len(t)] * 3
+    ins = {"S_rpm": S, "T_a": a + rng.normal(0, 0.02, len(t)),
+           "T_b": 22 + np.cumsum(rng.normal(0, 0.002, len(t)))}
+    y = 2.0 * (a - a[0]) + rng.normal(0, 0.05, len(t))
+    s = basis.DriftSeries(t, np.zeros(len(t), int), [("f.csv", "")], ins, {"c": y})
+    s.test = t >= 12 * 3600
+    sig = core._significant
+    specs = [{"source": "T_a", "p": None, "tau_s": 0.0, "minus": None},
+             {"source": "T_b", "p": None, "tau_s": 0.0, "minus": None}]
+    fold, rule = basis.folds(s)
+    R = np.ones((len(t), 1))
+    kept, fit = sig(s, specs, R, y, fold, rule)
+    full = core._jackknife(s, specs, R, y, fold)
+    assert abs(full["coef"][1]) < 1.5 * full["coef_std"][1]      # clearly not significant
+    assert abs(full["coef"][0]) > 10 * full["coef_std"][0]
+    assert [k["source"] for k in kept] == ["T_a"]
+    assert [d["source"] for d in fit["dropped"]] == ["T_b"]
