@@ -212,14 +212,16 @@ def _fit(D, y, mask) -> np.ndarray:
 
 def _significant(s, specs, R, y, fold, rule) -> tuple[list, dict]:
     """Fit, jackknife, and drop non-significant terms one at a time (module step 5)."""
+    dropped = []
     while True:
         fit = _jackknife(s, specs, R, y, fold)
+        fit["dropped"] = dropped
         t = [abs(c) / u if u > 0 else math.inf for c, u in zip(fit["coef"], fit["coef_std"])]
         weak = [i for i, v in enumerate(t) if v < SIG_K]
         if not weak:
             return specs, fit
         drop = min(weak, key=lambda i: (t[i], i))
-        fit["dropped"] = fit.get("dropped", []) + [specs[drop]]
+        dropped.append(specs[drop])
         specs = specs[:drop] + specs[drop + 1:]
 
 
