@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import InputError, require
 from . import fused
 from .derivation import derive_module
+from .lags import lag_of_columns
 from .layout import Layout, read_layout
 
 
@@ -92,12 +93,17 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
         scratch = np.empty((n_scratch, min(BLOCK, n)))
     out = np.empty((n, n_out))
     ok = True
-    sliced = [k for k, v in kwargs.items() if np.ndim(v) == 1 and np.shape(v)[0] == n and n > 1]
+    sliced = [k for k, v in kwargs.items() if _per_point(v, n)]
+    # a dict argument (the ``lags`` of a generated function): its (n,) arrays sliced as well
+    nested = {k: [j for j, a in v.items() if _per_point(a, n)] for k, v in kwargs.items()
+              if isinstance(v, Mapping)}
     for start in range(0, n, BLOCK):
         sl = slice(start, min(start + BLOCK, n))
         kw = dict(kwargs)
         for k in sliced:
             kw[k] = kwargs[k][sl]
+        for k, keys in nested.items():
+            kw[k] = {**kwargs[k], **{j: kwargs[k][j][sl] for j in keys}}
         if check_rows is not None:
             check_rows[1](check_rows[0][sl])
         if kernel is not None:
@@ -111,6 +117,11 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
     if finite is not None:
         finite.append(ok or bool(np.isfinite(out).all()))  # ok False: sum overflow or NaN
     return out
+
+
+def _per_point(v, n: int) -> bool:
+    """Whether argument ``v`` holds one value per point ((n,), n > 1): sliced per block."""
+    return np.ndim(v) == 1 and np.shape(v)[0] == n and n > 1
 
 
 def _columns(components, n: int) -> np.ndarray:
@@ -307,6 +318,10 @@ class Model:
             out[c] = v
         if self.lags:   # a lag of a longer series, at these points (else computed from these)
             given = {k: covariates[k] for k, *_ in self.lags if k in covariates}
+            if n > BLOCK:   # evaluated in blocks: each lag filtered over the whole series here
+                for key, column, tau, time in self.lags:
+                    if key not in given and time in out and np.shape(out.get(column)) == (n,):
+                        given[key] = lag_of_columns(out, column, tau, time)
             out["lags"] = given or None
         return out
 

@@ -17,6 +17,9 @@ import volerr
 from volerr.cli import main
 from volerr.example_files import shipped_path
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("api_examples")
+
 ROOT = Path(__file__).resolve().parents[2]
 SPHERE = str(shipped_path("sphere_example_DMU50.csv"))
 

@@ -3,19 +3,26 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
-import subprocess
-import sys
+from types import SimpleNamespace
 
 import pytest
 
 
 @pytest.fixture(scope="session")
 def full_audit(tmp_path_factory):
-    """(completed process, JSON entries, HTML page) of ``volerr audit --json F --html F``."""
+    """(completed command: returncode, stdout, stderr; JSON entries; HTML page) of ``volerr
+    audit --json F --html F``, through ``volerr.cli.main`` in this process (the command's parser
+    and exit code, without a fresh interpreter importing sympy again)."""
+    from volerr.cli import main
+
     d = tmp_path_factory.mktemp("full_audit")
     js, page = d / "all.json", d / "all.html"
-    r = subprocess.run([sys.executable, "-m", "volerr", "audit", "--json", str(js),
-                        "--html", str(page)], capture_output=True, text=True, timeout=900)
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["audit", "--json", str(js), "--html", str(page)])
+    r = SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
     assert r.returncode == 0, r.stderr
     return r, json.loads(js.read_text("utf-8")), page.read_text("utf-8")

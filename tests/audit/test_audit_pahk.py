@@ -333,9 +333,22 @@ def assert_clean_failure(proc, fragment=""):
     assert fragment.lower() in lines[0].lower()
 
 
-def test_cli_table_and_json(tmp_path):
+def in_process(capsys, *args):
+    """``volerr audit ARGS`` through ``volerr.cli.main`` in this process (the parser, command and
+    exit code of ``python -m volerr``, without a fresh interpreter importing sympy again)."""
+    from types import SimpleNamespace
+
+    from volerr.cli import main
+
+    capsys.readouterr()
+    code = main(["audit", *args])
+    out, err = capsys.readouterr()
+    return SimpleNamespace(returncode=code, stdout=out, stderr=err)
+
+
+def test_cli_table_and_json(tmp_path, capsys):
     out = tmp_path / "audit.json"
-    proc = run("MB1", "--json", str(out))
+    proc = in_process(capsys, "MB1", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     rows = json.loads(out.read_text())
     assert isinstance(rows, list) and rows
@@ -351,8 +364,8 @@ def test_cli_table_and_json(tmp_path):
     assert any("omitted Abbe term +Yo*Ez(X)" in ln for ln in lines)
 
 
-def test_cli_numeric():
-    proc = run("MB1", "--numeric", "--points", "20")
+def test_cli_numeric(capsys):
+    proc = in_process(capsys, "MB1", "--numeric", "--points", "20")
     assert proc.returncode == 0, proc.stderr
     assert "numeric spot check" in proc.stdout and "agrees" in proc.stdout
 

@@ -20,6 +20,9 @@ from volerr.derive.audit import ch2 as audit_ch2, htm as audit_htm, listings as 
 from volerr.derive.audit import metrology as audit_metrology, results as audit_results
 from volerr.derive.audit import scripts as audit_scripts, squareness as audit_squareness
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("audit_thesis_items")
+
 
 def data(name):
     return tomllib.loads((resources.files("volerr.derive.audit") / "data" / name)

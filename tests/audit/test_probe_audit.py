@@ -10,6 +10,9 @@ import pytest
 
 from volerr.probe import calibration as probe
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("audit_probe")
+
 
 @pytest.fixture(scope="module")
 def verdicts():

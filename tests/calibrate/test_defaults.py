@@ -15,6 +15,8 @@ independent exact simulator tests/helpers/instrument_sim.py (it never calls vole
   definitions computed here from the simulated readings (0.02 um);
 * degenerate traces and the same file twice: one line, exit 2."""
 
+import contextlib
+import io
 import json
 import subprocess
 import sys
@@ -87,9 +89,22 @@ def _main(capsys, *args) -> tuple[int, str, str]:
     return code, cap.out, cap.err
 
 
+def _run(*args):
+    """``volerr ARGS`` through ``volerr.cli.main`` in this process, console captured (the
+    commands that succeed; the exit-2 paths keep :func:`_cli`)."""
+    from types import SimpleNamespace
+
+    from volerr.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main([str(a) for a in args])
+    return SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
+
+
 def _calibrate_no_options(circles, files, name):
     out = circles["folder"] / f"{name}.json"
-    r = _cli("calibrate", circles["layout"], *files, "--json", out)
+    r = _run("calibrate", circles["layout"], *files, "--json", out)
     assert r.returncode == 0, r.stderr[-2000:]
     return json.loads(out.read_text()), r.stdout
 
@@ -218,7 +233,7 @@ def test_determined_reversal_written_into_its_table(circles):
 
     d = circles["folder"] / "errors_rv"
     out = circles["folder"] / "rv.json"
-    r = _cli("calibrate", circles["layout"], *circles["files"], "--json", out,
+    r = _run("calibrate", circles["layout"], *circles["files"], "--json", out,
              "--errors-out", d)
     assert r.returncode == 0, r.stderr[-2000:]
     rv = json.loads(out.read_text())["parameters"]["RV_X"]

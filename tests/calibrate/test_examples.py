@@ -2,9 +2,9 @@
 planted in them (tables written by volerr.calibrate.examples; checked against the planted
 numbers, not against a run of the code)."""
 
+import contextlib
+import io
 import json
-import subprocess
-import sys
 from importlib import resources
 
 from volerr.calibrate.examples import BALLBAR_TRUTH, SPHERE_TRUTH
@@ -14,12 +14,20 @@ def _data(name):
     return str(resources.files("volerr") / "data" / name)
 
 
+def _run(*args):
+    """``volerr ARGS`` through ``volerr.cli.main`` in this process: (exit code, stderr)."""
+    from volerr.cli import main
+
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return code, err.getvalue()
+
+
 def test_shipped_sphere_example_gives_the_planted_location_errors(tmp_path):
     out = tmp_path / "r.json"
-    r = subprocess.run([sys.executable, "-m", "volerr", "calibrate", "DMU50",
-                        _data("sphere_example_DMU50.csv"), "--json", str(out)],
-                       capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
+    code, err = _run("calibrate", "DMU50", _data("sphere_example_DMU50.csv"), "--json", str(out))
+    assert code == 0, err
     doc = json.loads(out.read_text())
     assert len(doc["parameters"]) >= 4
     for name, v in doc["parameters"].items():
@@ -28,10 +36,8 @@ def test_shipped_sphere_example_gives_the_planted_location_errors(tmp_path):
 
 def test_shipped_ballbar_example_gives_the_planted_squareness(tmp_path):
     out = tmp_path / "b.json"
-    r = subprocess.run([sys.executable, "-m", "volerr", "ballbar", "evaluate",
-                        _data("ballbar_example_XY.csv"), "--json", str(out)],
-                       capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
+    code, err = _run("ballbar", "evaluate", _data("ballbar_example_XY.csv"), "--json", str(out))
+    assert code == 0, err
     diag = {d["parameter"]: d for d in json.loads(out.read_text())["diagnosis"]}
     e = diag["EC0Y"]
     assert abs(e["value"] - BALLBAR_TRUTH["EC0Y"]) < 3 * e["std"], e

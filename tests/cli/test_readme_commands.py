@@ -12,6 +12,9 @@ import pytest
 
 from volerr.cli import main
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("readme_examples")
+
 #: the command table lives in the manual's page of every command (the README links it)
 README = Path(__file__).resolve().parents[2] / "docs" / "commands.md"
 

@@ -2,6 +2,8 @@
 within 0.1 um; zero errors give the same bytes; G-code handling; CLI bad input; controller
 tables; plots."""
 
+import contextlib
+import io
 import math
 import subprocess
 import sys
@@ -27,6 +29,18 @@ def cli(*args, cwd=None):
     r = subprocess.run([sys.executable, "-m", "volerr", *map(str, args)], capture_output=True,
                        text=True, cwd=cwd)
     return r.returncode, r.stdout, r.stderr
+
+
+def main_(*args):
+    """``volerr ARGS`` through ``volerr.cli.main`` in this process: (exit code, stdout, stderr),
+    for the commands expected to succeed (the exit-2 paths and the notes on stderr stay with
+    :func:`cli`, a fresh interpreter)."""
+    from volerr.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main([str(a) for a in args])
+    return code, out.getvalue(), err.getvalue()
 
 
 def random_program(m, rng, n, crlf=False):
@@ -91,7 +105,7 @@ def test_compensated_program_lands_within_0p1_um(tmp_path, name):
     prog = tmp_path / "part.nc"
     prog.write_bytes(random_program(m, np.random.default_rng(7), 60, crlf=True).encode())
     out = tmp_path / "part_comp.nc"
-    rc, so, se = cli("compensate", name, "--errors", err, prog, "--out", out,
+    rc, so, se = main_("compensate", name, "--errors", err, prog, "--out", out,
                      "--report", tmp_path / "rep.csv", "--json", tmp_path / "s.json")
     assert rc == 0, se
     funcs = ErrorFunctions.from_dir(err, m)
@@ -162,13 +176,13 @@ def test_zero_errors_give_byte_identical_program(tmp_path):
     prog.write_bytes(text.encode("latin-1") + "(\xe9t\xe9)\r\n".encode("latin-1"))
     empty = tmp_path / "errs"
     empty.mkdir()
-    rc, so, se = cli("compensate", "DMU50", "--errors", empty, prog, "--out", tmp_path / "o.nc")
+    rc, so, se = main_("compensate", "DMU50", "--errors", empty, prog, "--out", tmp_path / "o.nc")
     assert rc == 0, se
     assert (tmp_path / "o.nc").read_bytes() == prog.read_bytes()
     # tables full of zeros too
     m = volerr.load("DMU50")
     write_errors(tmp_path / "zeros", m, scale_um=0.0, scale_urad=0.0)
-    rc, so, se = cli("compensate", "DMU50", "--errors", tmp_path / "zeros", prog, "--out",
+    rc, so, se = main_("compensate", "DMU50", "--errors", tmp_path / "zeros", prog, "--out",
                      tmp_path / "o2.nc", "--extrapolate")
     assert rc == 0, se
     assert (tmp_path / "o2.nc").read_bytes() == prog.read_bytes()
@@ -367,14 +381,14 @@ def test_cli_outputs_report_json_and_plot(tmp_path):
     err = write_errors(tmp_path / "err", m)
     prog = tmp_path / "p.nc"
     prog.write_text(random_program(m, np.random.default_rng(1), 12))
-    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o.nc",
+    rc, so, se = main_("compensate", "DMU50", "--errors", err, prog, "--out", tmp_path / "o.nc",
                      "--json", tmp_path / "s.json", "--plot", tmp_path / "p.png",
                      "--orientation")
     assert rc == 0, se
     s = json.loads((tmp_path / "s.json").read_text())
     assert s["max_after_um"] < 0.1 < s["max_before_um"]
     assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
-    rc, so, se = cli("tcpmap", "DMU50", "--errors", err, "--point", "20", "10", "50",
+    rc, so, se = main_("tcpmap", "DMU50", "--errors", err, "--point", "20", "10", "50",
                      "--out", tmp_path / "m.png", "--csv", tmp_path / "m.csv", "--steps", "9")
     assert rc == 0, se
     grid = np.genfromtxt(tmp_path / "m.csv", delimiter=",", names=True)
@@ -394,9 +408,10 @@ def test_controller_export_import_round_trip(tmp_path, fmt):
     m = volerr.load("DMU50")
     err = write_errors(tmp_path / "err", m)
     f = tmp_path / f"dmu.{fmt}"
-    rc, so, se = cli("controller", "export", "DMU50", "--errors", err, "--format", fmt, "--out", f)
+    rc, so, se = main_("controller", "export", "DMU50", "--errors", err, "--format", fmt,
+                       "--out", f)
     assert rc == 0, se
-    rc, so, se = cli("controller", "import", "DMU50", f, "--out", tmp_path / "back")
+    rc, so, se = main_("controller", "import", "DMU50", f, "--out", tmp_path / "back")
     assert rc == 0, se
     t0, (c0, _, _) = tables.read_error_dir(err, m.axes)
     t1, (c1, _, _) = tables.read_error_dir(tmp_path / "back", m.axes)
@@ -498,14 +513,14 @@ def test_controller_negate_round_trip(tmp_path):
     m = volerr.load("TT_AC")
     err = write_errors(tmp_path / "err", m)
     f = tmp_path / "comp.isg"
-    assert cli("controller", "export", "TT_AC", "--errors", err, "--format", "isg", "--out", f,
+    assert main_("controller", "export", "TT_AC", "--errors", err, "--format", "isg", "--out", f,
                "--negate")[0] == 0
     t_err, _ = tables.read_error_dir(err, m.axes)
     from volerr.tables.controller import read_controller_file
 
     t_neg, _ = read_controller_file(f, m)
     assert np.allclose(t_neg["X"].values["EXX"], -t_err["X"].values["EXX"])
-    assert cli("controller", "import", "TT_AC", f, "--negate", "--out", tmp_path / "b")[0] == 0
+    assert main_("controller", "import", "TT_AC", f, "--negate", "--out", tmp_path / "b")[0] == 0
     t_back, _ = tables.read_error_dir(tmp_path / "b", m.axes)
     assert np.allclose(t_back["A"].values["EBA"], t_err["A"].values["EBA"], rtol=1e-10)
 
@@ -586,7 +601,7 @@ def test_program_at_the_end_of_the_tables_is_compensated(tmp_path):
     prog = tmp_path / "p.nc"
     prog.write_text(f"G0 X0 Y0 Z100 B0 C0\nG1 X{hi:g}\nG1 X{lo:g}\n")
     out = tmp_path / "o.nc"
-    rc, so, se = cli("compensate", "DMU50", "--errors", err, prog, "--out", out)
+    rc, so, se = main_("compensate", "DMU50", "--errors", err, prog, "--out", out)
     assert rc == 0, se
     blocks = gcode.blocks(gcode.parse(out.read_text()), m.axes)
     q = np.array([[b.target[a] for a in m.axes] for b in blocks])

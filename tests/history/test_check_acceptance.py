@@ -28,6 +28,9 @@ import pytest
 from helpers import check_sim
 from volerr.cli import build_parser, main
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("history_check_campaign")
+
 
 def _has_check() -> bool:
     import argparse

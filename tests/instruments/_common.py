@@ -6,6 +6,8 @@ the layout is only parsed (``read_layout``) by the simulator."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import os
 import subprocess
@@ -30,9 +32,27 @@ def cli(*args, cwd=None):
                           capture_output=True, text=True, cwd=cwd, env=env)
 
 
+def in_process(*args):
+    """``volerr ARGS`` through ``volerr.cli.main`` in this process with one BLAS thread, console
+    captured: (returncode, stdout, stderr) as :func:`cli` gives them, without starting an
+    interpreter (the commands expected to succeed; exit-2 paths use :func:`cli`)."""
+    from types import SimpleNamespace
+
+    from threadpoolctl import threadpool_limits
+
+    from volerr.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with threadpool_limits(limits=1), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        code = main([str(a) for a in args])
+    return SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
+
+
 def run_json(args, json_path: Path):
-    """Run a command that writes --json; return (completed process, parsed JSON or None)."""
-    r = cli(*args, "--json", json_path)
+    """Run a command that writes --json (in this process: :func:`in_process`); return
+    (completed command, parsed JSON or None)."""
+    r = in_process(*args, "--json", json_path)
     doc = json.loads(Path(json_path).read_text()) if r.returncode == 0 and Path(
         json_path).is_file() else None
     return r, doc

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from helpers import instrument_sim as S
-from instruments._common import cli
+from instruments._common import in_process
 
 CASES = {
     "MB1": (["--plane", "XY", "--radius", "100", "--centre", "450,290,200", "--tool",
@@ -44,8 +44,8 @@ def test_simulated_readings_equal_first_order_of_exact_chain(tmp_path, layout):
     m = S.Machine(layout)
     _write_errors(tmp_path / "errors", m, constants)
     out = tmp_path / "trace.csv"
-    r = cli("ballbar", "simulate", layout, "--errors", tmp_path / "errors", *opts,
-            "--points", "48", "--noise-um", "0", "--direction", "both", "--out", out)
+    r = in_process("ballbar", "simulate", layout, "--errors", tmp_path / "errors", *opts,
+                   "--points", "48", "--noise-um", "0", "--direction", "both", "--out", out)
     assert r.returncode == 0, r.stderr[-3000:]
     with open(out) as fh:
         rows = list(csv.DictReader(fh))

@@ -10,7 +10,7 @@ import pytest
 from helpers import instrument_sim as S
 from helpers.tracker_sim import simulate as tracker_simulate
 from helpers.tracker_sim import smooth_errors, to_csv
-from instruments._common import Campaign, check_one_line_error, cli, random_setup
+from instruments._common import Campaign, check_one_line_error, cli, in_process, random_setup
 
 # module-scoped simulated data: keep the module on one xdist worker
 pytestmark = pytest.mark.xdist_group("test_instrument_files")
@@ -99,7 +99,7 @@ def test_loop_deviations_file_still_works(tmp_path):
     camp = Campaign(m, [b], terms, {"EC0Y": 15.0, "EB0Z": -10.0, "EXX@slope": 0.01}, {},
                     seed=9)
     path = S.write_csv(tmp_path / "dev.csv", S.columns(m, b, camp.y[0]))
-    r = cli("loop", "MB1", path, "--json", tmp_path / "l.json", "--degree", "2")
+    r = in_process("loop", "MB1", path, "--json", tmp_path / "l.json", "--degree", "2")
     assert r.returncode == 0, r.stderr[-3000:]
     doc = json.loads((tmp_path / "l.json").read_text())
     assert doc["effects"] == [], doc["effects"]
@@ -119,7 +119,7 @@ def test_identify_tracker_file_still_works(tmp_path):
     f = tmp_path / "tracker.csv"
     f.write_text(to_csv([tracker_simulate("linear", ref, pos, e)], pos, ("P", "Q", "K")))
     out = tmp_path / "X.csv"
-    r = cli("identify", "MB1", "--axis", "X", f, "--out", out)
+    r = in_process("identify", "MB1", "--axis", "X", f, "--out", out)
     assert r.returncode == 0, r.stderr[-3000:]
     vals = np.loadtxt(out, delimiter=",", skiprows=1)
     assert np.allclose(vals[:, 1] * 1e-3, e[:, 0], atol=1e-6)

@@ -22,7 +22,7 @@ import numpy as np
 
 from helpers import instrument_sim as S
 from helpers import metrology_sim as M
-from instruments._common import FLOOR_FACTOR, K_SIGMA, cli, run_json, series_terms
+from instruments._common import FLOOR_FACTOR, K_SIGMA, in_process, run_json, series_terms
 
 VALUES = {"EXX@slope": 0.010, "EXX@P2": 1.5, "EBX@slope": 0.015, "EBX@P2": 4.0,
           "EZX@P2": -1.2}
@@ -66,7 +66,7 @@ def test_abbe_offset_and_pitch(tmp_path):
 
     # the positioning run alone, ISO 230-2 wide format: EXX and the pitch confounded
     wide = _write_wide(tmp_path / "pos.csv", pos, y["pos.csv"])
-    iso = cli("iso230-2", wide, "--axis", "X", "--json", tmp_path / "iso.json")
+    iso = in_process("iso230-2", wide, "--axis", "X", "--json", tmp_path / "iso.json")
     assert iso.returncode == 0, iso.stderr          # the same file volerr iso230-2 reads
     r, doc = run_json(["calibrate", "MB1", wide, *opts], tmp_path / "alone.json")
     assert r.returncode == 0, r.stderr[-3000:]

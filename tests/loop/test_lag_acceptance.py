@@ -2,7 +2,10 @@
 contracts): thermal effects acting through a first-order lag of one of many correlated sensors,
 on data of an independent simulator (tests/helpers/thermal_sim.py: its own exact lag, the exact
 chain of instrument_sim on the parsed layout, never volerr's loop / simulate / model), run
-through the public CLI only (``volerr loop LAYOUT FILE --json F --out-dir D``, a subprocess).
+through the public CLI only (``volerr loop LAYOUT FILE --json F --out-dir D``: its argument list
+given to ``volerr.cli.main`` in this process, console captured -- the same parser, commands and
+exit codes as ``python -m volerr``, whose entry point tests/cli/test_cli_core.py runs; ten
+subprocesses would re-import numpy, scipy and sympy ten times).
 
 Campaigns (deviations files: axes, Xp,Yp,Zp, dx_um,dy_um,dz_um, t_s, 8-9 sensor columns; six
 styli on MB1; 0.3 um noise; 10 h):
@@ -30,10 +33,10 @@ lag), so naming it is possible.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -53,18 +56,23 @@ def lag_pattern(sensor: str) -> re.Pattern:
 
 
 class Run:
-    """One ``volerr loop`` subprocess: exit code, console, the JSON report, its out-dir."""
+    """One ``volerr loop`` command (``volerr.cli.main``): exit code, console, the JSON report,
+    its out-dir."""
 
     def __init__(self, layout, data, folder, tag, html=False):
+        from volerr.cli import main
+
         self.json_path = folder / f"{tag}.json"
         self.out_dir = folder / f"{tag}_out"
         self.html_path = folder / f"{tag}.html" if html else None
-        cmd = [sys.executable, "-m", "volerr", "loop", str(layout), str(data),
-               "--json", str(self.json_path), "--out-dir", str(self.out_dir)]
+        argv = ["loop", str(layout), str(data),
+                "--json", str(self.json_path), "--out-dir", str(self.out_dir)]
         if html:
-            cmd += ["--html", str(self.html_path)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-        self.rc, self.stdout, self.stderr = proc.returncode, proc.stdout, proc.stderr
+            argv += ["--html", str(self.html_path)]
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            self.rc = main(argv)
+        self.stdout, self.stderr = out.getvalue(), err.getvalue()
         self.report = json.loads(self.json_path.read_text()) if self.rc == 0 else None
 
     def ok(self):
@@ -311,10 +319,13 @@ def test_dmu50_day_a_model_refitted_on_day_b(dmu50):
 
 # ---- documentation (contract: --help and docs/formats.md) ----------------------------------
 def _cli(*args):
-    proc = subprocess.run([sys.executable, "-m", "volerr", *args], capture_output=True,
-                          text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    return proc.stdout
+    from volerr.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main(list(args))
+    assert rc == 0, err.getvalue()[-2000:]
+    return out.getvalue()
 
 
 def test_simulate_documents_sensors_duty_cycles_and_the_lagged_effect():

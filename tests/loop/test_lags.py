@@ -105,6 +105,55 @@ def test_generated_module_computes_the_lag_and_nests_effects(lagged_model):
     assert np.allclose(dat.subset(idx).sensitivity(m)[:, 0, k_l], dat.sensitivity(m)[idx, 0, k_l])
 
 
+def test_a_lagged_model_over_more_points_than_one_block(tmp_path):
+    """More points than one evaluation block (volerr.machine.model.BLOCK = 16384): 20000
+    points give, point by point, what the same model gives on slices of 5000 (each within one
+    block) when told the lag of the whole series -- with the lag given (its arrays sliced
+    block by block; before: the whole (20000,) arrays met 16384-point blocks and failed) and
+    without (filtered over the whole series, not block by block)."""
+    import volerr
+    from volerr.machine.model import BLOCK
+
+    text, _ = layout_text("MB1")
+    path = tmp_path / "MB1L.toml"
+    path.write_text(text.replace('name = "MB1"', 'name = "MB1L"', 1) + LAGGED)
+    m = volerr.load(str(path))          # the whole module (fit_source has no error functions)
+    rng = np.random.default_rng(3)
+    n, piece = 20000, 5000
+    assert n > BLOCK >= piece
+    pos = {a: rng.uniform(*m.travel[a], n) for a in m.axes}
+    t = np.sort(rng.uniform(0, 36000, n))
+    cov = {"T_motorX": 20 + 3 * np.sin(t / 5000) + (t > 20000) * 2.0, "t_s": t,
+           "T_air": 20 + np.cos(t / 3000)}
+    key = next(k for k, *_ in m.lags)
+    whole_lag = lag(cov["T_motorX"], 2400.0, t)
+    errors = {"KL_X": 2e-6, "KN": 1e-6, "EXX": 1e-5}
+    probe = (0, 0, -100)
+
+    def sliced(method):
+        return np.concatenate([
+            getattr(m, method)({a: v[i:i + piece] for a, v in pos.items()}, errors, probe,
+                               covariates={**{c: v[i:i + piece] for c, v in cov.items()},
+                                           key: whole_lag[i:i + piece]})
+            for i in range(0, n, piece)])
+
+    for method in ("volumetric_error", "exact_error"):
+        want = sliced(method)
+        assert np.ptp(want[:, 0]) > 1e-4            # the lagged term moves the result
+        given = getattr(m, method)(pos, errors, probe,
+                                   covariates={**cov, key: whole_lag})
+        np.testing.assert_allclose(given, want, rtol=1e-12, atol=1e-15, err_msg=method)
+        computed = getattr(m, method)(pos, errors, probe, covariates=cov)
+        np.testing.assert_allclose(computed, want, rtol=1e-12, atol=1e-15, err_msg=method)
+    sig = {"KL_X": 1e-6, "KN": 1e-6}
+    np.testing.assert_allclose(
+        m.random_error(pos, sig, probe, covariates={**cov, key: whole_lag}),
+        np.concatenate([m.random_error({a: v[i:i + piece] for a, v in pos.items()}, sig, probe,
+                                       covariates={**{c: v[i:i + piece] for c, v in cov.items()},
+                                                   key: whole_lag[i:i + piece]})
+                        for i in range(0, n, piece)]), rtol=1e-12, atol=1e-15)
+
+
 def test_a_nested_target_must_be_an_earlier_effects_parameter():
     with pytest.raises(InputError, match="unknown target 'KZ'"):
         _layout(LAGGED.replace('target = "KL_X"', 'target = "KZ"'))

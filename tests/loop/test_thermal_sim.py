@@ -14,6 +14,9 @@ from volerr.machine.layout import read_layout
 from helpers import reference_chain as R
 from helpers import thermal_sim as T
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("thermal_sim_campaigns")
+
 
 def test_lag_of_a_step_is_the_analytic_exponential():
     tau = 900.0

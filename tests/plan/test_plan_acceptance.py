@@ -31,12 +31,15 @@ over the working volume); the ``max`` is reported in the assertion messages.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import math
 import os
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -90,6 +93,21 @@ def cli(*args):
                           capture_output=True, text=True, env=env)
 
 
+def run(*args):
+    """``volerr ARGS`` through ``volerr.cli.main`` in this process with one BLAS thread: the
+    command's parser, files and exit code as :func:`cli` gives them, without starting an
+    interpreter (the exit-2 paths stay with :func:`cli`)."""
+    from threadpoolctl import threadpool_limits
+
+    from volerr.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with threadpool_limits(limits=1), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        code = main([str(a) for a in args])
+    return SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
+
+
 def determined(entry) -> bool:
     v = entry.get("predicted_std")
     return isinstance(v, (int, float)) and math.isfinite(v) and v > 0
@@ -109,7 +127,7 @@ class Plan:
         self.option = REQUEST.get(name)
         if self.option:
             args += ["--parameters", self.option]
-        self.proc = cli(*args, "--readings", n, "--out", self.dir, "--json", self.json,
+        self.proc = run(*args, "--readings", n, "--out", self.dir, "--json", self.json,
                         "--seed", 1)
         assert self.proc.returncode == 0, self.proc.stderr[-3000:]
         self.doc = json.loads(self.json.read_text())
@@ -147,7 +165,7 @@ class Executed:
         self.paths, self.setup = P.execute(plan.machine, plan.files, self.truth, self.filled,
                                            rng, plan.dir)
         self.json = root / "calibrate.json"
-        self.proc = cli("calibrate", plan.layout, *self.paths, "--json", self.json)
+        self.proc = run("calibrate", plan.layout, *self.paths, "--json", self.json)
         assert self.proc.returncode == 0, self.proc.stderr[-3000:]
         self.doc = json.loads(self.json.read_text())
 
@@ -389,7 +407,7 @@ def test_mixed_campaign_determines_what_no_instrument_does_alone(runs, case):
     for kind in sorted(p.kinds):
         paths = [path for path, f in zip(x.paths, p.files) if f.kind == kind]
         out = x.json.parent / f"alone_{kind}.json"
-        r = cli("calibrate", p.layout, *paths, "--parameters", request, "--json", out)
+        r = run("calibrate", p.layout, *paths, "--parameters", request, "--json", out)
         assert r.returncode == 0, (kind, r.stderr[-2000:])
         alone = json.loads(out.read_text())["parameters"]
         wrong = sorted(set(joint) & set(alone))
@@ -440,7 +458,7 @@ def test_output_folder_with_files_needs_force(plan_exists, tmp_path):
     out = tmp_path / "out"
     args = ["plan", "MB1", "--instrument", "ballbar:lengths=100,150", "--readings", "100",
             "--out", out]
-    r = cli(*args, "--json", tmp_path / "first.json")
+    r = run(*args, "--json", tmp_path / "first.json")
     assert r.returncode == 0, r.stderr[-2000:]
     (out / "notes.txt").write_text("mine\n")
     before = {q.name: q.read_bytes() for q in out.rglob("*") if q.is_file()}
@@ -448,6 +466,6 @@ def test_output_folder_with_files_needs_force(plan_exists, tmp_path):
     _refused(r, "force", "exist")
     after = {q.name: q.read_bytes() for q in out.rglob("*") if q.is_file()}
     assert after == before and not (tmp_path / "second.json").exists()
-    r = cli(*args, "--json", tmp_path / "third.json", "--force")
+    r = run(*args, "--json", tmp_path / "third.json", "--force")
     assert r.returncode == 0 and (tmp_path / "third.json").is_file(), r.stderr[-2000:]
     assert (out / "notes.txt").read_text() == "mine\n"

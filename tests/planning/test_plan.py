@@ -17,6 +17,9 @@ from volerr.calibrate.run import calibrate
 from volerr.cli import main
 from volerr.machine.layout import read_layout
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("planning_plans")
+
 BALLBAR = ["MB1", "--instrument", "ballbar:lengths=100,150,250:u_um=0.5", "--readings", "600"]
 SPHERE = ["DMU50", "--instrument", "sphere:tool=100:tool_u_um=0.5", "--readings", "300"]
 MIXED = ["DMU50", "--instrument", "sphere:tool=100:tool_u_um=0.5:places=1", "--instrument",

@@ -21,6 +21,9 @@ from volerr.calibrate.run import calibrate
 from volerr.cli import main
 from volerr.machine.layout import read_layout
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("planning_interferometer")
+
 PLAN = ["MB1", "--instrument", "interferometer", "--readings", "1200"]
 #: planted errors (JSON units: um, urad; slopes per mm, Legendre coefficients over the range)
 PLANTED = {"EXX@slope": 0.010, "EYY@slope": -0.008, "EZZ@slope": 0.005, "EYX@P2": -1.0,
