@@ -69,14 +69,10 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _is_drift(specs) -> bool:
+def run(args) -> int:
     from ..loop.api import is_drift
 
-    return is_drift(specs)
-
-
-def run(args) -> int:
-    if _is_drift(args.data):
+    if is_drift(args.data):
         return run_drift(args)
     require(not (args.holdout_files or args.predictions_out),
             "loop: --holdout-files and --predictions-out are for drift runs (drift:FILE)")

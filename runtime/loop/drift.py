@@ -200,12 +200,17 @@ def _fit(D, y, mask) -> np.ndarray:
     """Least squares on the readings ``mask`` by the normal equations of the columns scaled
     to unit RMS (a column all zero there, a run without readings, gets 0)."""
     Dm = D[mask]
-    G = Dm.T @ Dm
+    return _solve_normal(Dm.T @ Dm, Dm.T @ y[mask])
+
+
+def _solve_normal(G, h) -> np.ndarray:
+    """The least-squares coefficients from the normal equations ``G b = h``, solved with the
+    columns scaled to unit norm (pseudo-inverse, rcond 1e-12); a column all zero gets 0."""
     d = np.sqrt(np.diag(G))
     on = d > 0
-    b = np.zeros(D.shape[1])
+    b = np.zeros(len(h))
     Gs = G[np.ix_(on, on)] / np.outer(d[on], d[on])
-    b[on] = np.linalg.pinv(Gs, rcond=1e-12, hermitian=True) @ (Dm[:, on].T @ y[mask] / d[on])
+    b[on] = np.linalg.pinv(Gs, rcond=1e-12, hermitian=True) @ (h[on] / d[on])
     b[on] /= d[on]
     return b
 
@@ -280,18 +285,15 @@ def _tau_on(s, sp, i, specs, R, y, masks) -> list:
 
 def _trial_rss(B, T, y) -> list:
     """RSS of the least-squares fit of ``y`` on the columns ``B`` plus each column of ``T``
-    in turn (columns scaled to unit norm, as :func:`_fit`)."""
+    in turn, all from one set of cross-products (solved as :func:`_fit` solves)."""
     A = np.column_stack([B, T])
-    G = A.T @ A
-    d = np.sqrt(np.diag(G))
-    d = np.where(d > 0, d, 1.0)
-    Gs, hs, yy = G / np.outer(d, d), (A.T @ y) / d, float(y @ y)
+    G, hA, yy = A.T @ A, A.T @ y, float(y @ y)
     nb = B.shape[1]
     out = []
     for j in range(T.shape[1]):
         idx = list(range(nb)) + [nb + j]
-        g, h = Gs[np.ix_(idx, idx)], hs[idx]
-        b = np.linalg.pinv(g, rcond=1e-12, hermitian=True) @ h
+        g, h = G[np.ix_(idx, idx)], hA[idx]
+        b = _solve_normal(g, h)
         out.append(max(yy - 2 * b @ h + b @ g @ b, 0.0))
     return out
 
