@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from volerr.errors import InputError
+from helpers import drift_sim as D
 from volerr.loop import drift as core
 from volerr.loop import drift_basis as B
 from volerr.loop.drift_cv import Engine
@@ -15,15 +16,9 @@ from volerr.loop.drift_split import parse_window, stretch_split
 
 
 def _first_order(u, tau, dt):
-    """Independent first-order lag (implicit Euler on a 1 s grid, resampled): tau y' + y = u."""
-    t = np.arange(len(u)) * dt
-    fine = np.arange(0, t[-1] + 1.0, 1.0)
-    uf = np.interp(fine, t, u)
-    y = np.empty_like(fine)
-    y[0] = uf[0]
-    for i in range(1, len(fine)):
-        y[i] = (tau * y[i - 1] + uf[i]) / (tau + 1.0)
-    return np.interp(t, fine, y)
+    """Independent first-order lag, tau y' + y = u, sampled every ``dt`` (exact for ``u``
+    linear between samples: :func:`helpers.drift_sim.lag`)."""
+    return D.lag(u, tau, dt)
 
 
 def _series(n=3000, dt=30.0, plant=True, seed=1, runs=1):

@@ -17,6 +17,7 @@ import sys
 import numpy as np
 import pytest
 
+from helpers import drift_sim as D
 from volerr.loop import drift_rows as R
 
 DT = 30.0
@@ -28,13 +29,9 @@ HEIGHTS = {"x1": 20.0, "x2": 100.0}
 
 
 def _lag(u, tau, t):
-    fine = np.arange(0.0, t[-1] + 1.0, 1.0)
-    uf = np.interp(fine, t, u)
-    y = np.empty_like(fine)
-    y[0] = uf[0]
-    for i in range(1, len(fine)):
-        y[i] = (tau * y[i - 1] + uf[i]) / (tau + 1.0)
-    return np.interp(t, fine, y)
+    """First-order lag of ``u`` at times ``t``, at rest at the start (the tests' independent
+    lag, :func:`helpers.drift_sim.lag_irregular`)."""
+    return D.lag_irregular(u, tau, t)
 
 
 def _run(r: int, rng) -> dict:
