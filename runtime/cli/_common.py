@@ -25,9 +25,20 @@ def add_error_arguments(parser, required: bool = True) -> None:
 
 
 def error_functions_from_args(args, model) -> ErrorFunctions:
-    """:class:`ErrorFunctions` from the arguments added by :func:`add_error_arguments`."""
+    """:class:`ErrorFunctions` from the arguments added by :func:`add_error_arguments` (and
+    :func:`add_accept_implausible`, when the command has it)."""
     return ErrorFunctions.from_dir(args.errors, model, method=args.method, degree=args.degree,
-                                   extrapolate=args.extrapolate)
+                                   extrapolate=args.extrapolate,
+                                   accept_implausible=getattr(args, "accept_implausible", False))
+
+
+def add_accept_implausible(parser) -> None:
+    """``--accept-implausible``: error values beyond what a machine of the layout's travel can
+    have (:mod:`volerr.tables.plausible`) are used instead of refused."""
+    parser.add_argument("--accept-implausible", action="store_true",
+                        help="for a machine that really is that bad: use error values beyond "
+                             "what a machine of this travel can have (default: refused, "
+                             "naming the likely unit mistake)")
 
 
 def add_common(p) -> None:

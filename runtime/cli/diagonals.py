@@ -10,7 +10,8 @@ from __future__ import annotations
 
 
 from ..cmm import api, diagonals
-from ._common import add_common, error_functions_from_args, inputs_of, parse_at
+from ._common import (add_accept_implausible, add_common, error_functions_from_args,
+                      inputs_of, parse_at)
 from ..errors import require
 from ..fileio import Outputs
 from ..machine.model import load
@@ -28,6 +29,7 @@ def register(sub) -> None:
                    help="points along each line for the profile (default 21)")
     p.add_argument("--json", metavar="F", help="results with profiles as JSON")
     p.add_argument("--plot", metavar="PNG", help="space-diagonal profiles and all deviations")
+    add_accept_implausible(p)
     p.set_defaults(func=run)
 
 

@@ -8,7 +8,8 @@ deviations in the tables also ``<plot>_random.png`` or ``--plot-random``) and pr
 from __future__ import annotations
 
 
-from ._common import add_common, error_functions_from_args, inputs_of, parse_at
+from ._common import (add_accept_implausible, add_common, error_functions_from_args,
+                      inputs_of, parse_at)
 from ..cmm import volmap
 from ..errors import require
 from ..fileio import Outputs, json_text, write_text
@@ -34,6 +35,7 @@ def register(sub) -> None:
                    help="approach direction of axes whose tables carry a reversal column "
                         "RV_<axis>_um (ISO 230-2 B_i): X+,Y- per axis, or + / - for all "
                         "(default: the bidirectional mean, the tabulated value)")
+    add_accept_implausible(p)
     p.set_defaults(func=run)
 
 

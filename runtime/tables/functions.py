@@ -223,12 +223,16 @@ class ErrorFunctions:
 
     @classmethod
     def from_dir(cls, directory, model, method: str = "linear", degree: int | None = None,
-                 extrapolate: bool = False) -> "ErrorFunctions":
-        """Read an error directory (``X.csv`` ... ``constants.csv``) for ``model``."""
+                 extrapolate: bool = False,
+                 accept_implausible: bool = False) -> "ErrorFunctions":
+        """Read an error directory (``X.csv`` ... ``constants.csv``) for ``model``; values
+        beyond what a machine of the model's travel can have are refused unless
+        ``accept_implausible`` (:mod:`volerr.tables.plausible`)."""
         if isinstance(model, str):
             from ..machine.model import load
             model = load(model)
-        tables, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
+        tables, (consts, cstd, cu95) = read_error_dir(directory, model.axes, machine=model,
+                                                      accept_implausible=accept_implausible)
         cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}
         return cls(tables, consts, model, method, degree, extrapolate, constants_std=cstd,
                    source=str(directory))

@@ -71,6 +71,7 @@ from ..units import (MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_nu
                      format_rows, parse_number)
 from ..errors import InputError, require
 from ..fileio import check_magnitude, read_csv_rows, write_text
+from . import plausible
 
 #: unit suffix -> (kind, factor to mm or rad)
 UNITS = {"um": ("length", MM_PER_UM), "mm": ("length", 1.0), "urad": ("angle", RAD_PER_URAD),
@@ -226,10 +227,8 @@ def _parse_column(path, col: str, axis: str):
     return name, unit, kind
 
 
-def read_error_table(path, axis: str | None = None) -> ErrorTable:
-    """Read one error table (format in the module docstring) -> :class:`ErrorTable` in mm / rad.
-
-    ``axis``: the expected axis (e.g. from the file name); the first column must name it."""
+def _read_error_table(path, axis: str | None = None) -> ErrorTable:
+    """:func:`read_error_table` without the magnitude check."""
     path = Path(path)
     header, body = _read_rows(path)
     # the axis column comes first (INTERFACE.md); one found elsewhere is moved there, and extra
@@ -281,10 +280,30 @@ def read_error_table(path, axis: str | None = None) -> ErrorTable:
         reversal = _to_internal([_number(path, ln, rv_col[0], c)
                                  for (ln, _), c in zip(body, rv_col[1])], rm.group(2).lower())
     try:
-        return ErrorTable(tax, data[:, 0], values, std, u95, reversal, rep)
+        table = ErrorTable(tax, data[:, 0], values, std, u95, reversal, rep)
     except InputError as exc:
         msg = str(exc).split(": ", 1)[-1]
         raise InputError(f"{path}: {msg}") from None
+    # where each value came from, for the magnitude check's message (check_magnitudes)
+    table._source = str(path)
+    table._columns = {(name, kind): (col, unit) for (name, unit, kind), col in zip(cols, header[1:])}
+    if rv_col is not None:
+        table._columns[("RV", "")] = (rv_col[0], rm.group(2).lower())
+    return table
+
+
+def read_error_table(path, axis: str | None = None, *, machine=None,
+                     accept_implausible: bool = False) -> ErrorTable:
+    """Read one error table (format in the module docstring) -> :class:`ErrorTable` in mm / rad.
+
+    ``axis``: the expected axis (e.g. from the file name); the first column must name it.
+    ``machine``: the Model or Layout whose size limits the values (:mod:`.plausible`; one
+    table alone does not tell the machine's size: without ``machine`` nothing is checked,
+    :func:`read_error_dir` always checks); ``accept_implausible``: skip that check."""
+    table = _read_error_table(path, axis)
+    check_magnitudes({table.axis: table}, machine=machine,
+                     accept_implausible=accept_implausible or machine is None)
+    return table
 
 
 def _fmt(v: float) -> str:
@@ -319,16 +338,81 @@ def _comment_lines(comments) -> str:
     return "".join(f"# {' '.join(str(c).split())}\n" for c in comments)
 
 
-def write_error_table(path, table: ErrorTable, inputs=(), comments=()) -> Path:
+def write_error_table(path, table: ErrorTable, inputs=(), comments=(), *, machine=None,
+                      accept_implausible: bool = False) -> Path:
     """Write ``table`` as CSV (um / urad), ``comments`` as ``#`` lines above the header;
-    refuses to overwrite any file in ``inputs``."""
+    refuses to overwrite any file in ``inputs``, and values beyond what ``machine`` (Model or
+    Layout) can have unless ``accept_implausible`` (:func:`check_magnitudes`; without
+    ``machine`` nothing is checked, :func:`write_error_dir` always checks)."""
+    check_magnitudes({table.axis: _unread(table)}, machine=machine, where=str(Path(path).parent),
+                     cause=WRITE_CAUSE, accept_implausible=accept_implausible or machine is None)
     return write_text(path, _comment_lines(comments) + table_to_csv(table), inputs=inputs)
 
 
 # ---------------------------------------------------------------------------------------------
+# magnitudes (the limits: volerr.tables.plausible)
+#: what the writer's refusal says is likely
+WRITE_CAUSE = "not written: an input in the wrong unit, or a fit that went wrong?"
+
+
+def _column_name(name: str, label: str) -> str:
+    """The column :func:`table_to_csv` writes for parameter ``name`` (``label``: "", "std" ...)."""
+    unit = "um" if parameter_kind(name) == "length" else "urad"
+    return f"{name}_{label}_{unit}" if label else f"{name}_{unit}"
+
+
+def check_magnitudes(tables: dict, constants=None, constants_std=None, constants_u95=None, *,
+                     machine=None, where: str = "", cause: str = "", constants_origin=None,
+                     accept_implausible: bool = False) -> None:
+    """Refuse error values beyond what a machine of this size can have (:mod:`.plausible`).
+
+    Checks every value, uncertainty and reversal of ``tables`` (axis -> :class:`ErrorTable`)
+    and every constant (name -> value, ``constants_std``, ``constants_u95``), mm / rad.  A
+    table read from a file names its file, column and the likely unit (the column's declared
+    unit is known); other values name ``where`` (the folder they come from or go to) and
+    ``cause``.  ``constants_origin``: name -> ("path:line", declared unit).  ``machine``: a
+    Model or Layout (its travel sets the limits); without it, the tables' span.  Raises
+    :class:`InputError`; does nothing with ``accept_implausible``."""
+    if accept_implausible:
+        return
+    limits = plausible.limits_for(machine, tables)
+    for ax, t in tables.items():
+        cols = getattr(t, "_columns", {})
+        src = getattr(t, "_source", "") or (str(Path(where) / f"{ax}.csv") if where
+                                            else f"table {ax}")
+        for label, dct in (("", t.values), ("std", t.std), ("s", t.s), ("u95", t.u95)):
+            for name, v in dct.items():
+                col, unit = cols.get((name, label), (_column_name(name, label), None))
+                plausible.check(v, parameter_kind(name), limits, src, f"column {col}", unit,
+                                cause)
+        if t.reversal is not None:
+            col, unit = cols.get(("RV", ""), (f"RV_{ax}_um", None))
+            plausible.check(t.reversal, "length", limits, src, f"column {col}", unit, cause)
+    origin = constants_origin or {}
+    csrc = str(Path(where) / "constants.csv") if where else "constants"
+    for label, dct in (("", constants), ("std", constants_std), ("u95", constants_u95)):
+        for name, v in (dct or {}).items():
+            src, unit = origin.get(name, (csrc, None))
+            plausible.check([v], parameter_kind(name), limits, src,
+                            f"{name} {label}".strip(), unit, cause)
+
+
+# ---------------------------------------------------------------------------------------------
 # constants
-def read_constants_full(path) -> tuple[dict, dict, dict]:
-    """Read a constants CSV -> (values, std, u95), each name -> float in mm / rad."""
+def read_constants_full(path, *, machine=None,
+                        accept_implausible: bool = False) -> tuple[dict, dict, dict]:
+    """Read a constants CSV -> (values, std, u95), each name -> float in mm / rad; values
+    beyond what ``machine`` (Model or Layout) can have are refused unless
+    ``accept_implausible`` (:mod:`.plausible`; without ``machine`` nothing is checked,
+    :func:`read_error_dir` always checks)."""
+    values, std, u95, origin = _read_constants(path)
+    check_magnitudes({}, values, std, u95, machine=machine, constants_origin=origin,
+                     accept_implausible=accept_implausible or machine is None)
+    return values, std, u95
+
+
+def _read_constants(path) -> tuple[dict, dict, dict, dict]:
+    """(values, std, u95, origin) of a constants CSV; origin: name -> ("path:line", unit)."""
     path = Path(path)
     header, body = _read_rows(path)
     low = [h.lower() for h in header]
@@ -340,7 +424,7 @@ def read_constants_full(path) -> tuple[dict, dict, dict]:
     header = [low[j] for j in order]
     body = [(ln, [cells[j] for j in order]) for ln, cells in body]
     extra = header[3:]
-    values, std, u95 = {}, {}, {}
+    values, std, u95, origin = {}, {}, {}, {}
     for lineno, cells in body:
         name, unit = cells[0].upper(), _unit_text(cells[2]).lower()
         require(_CONST_NAME.match(name) is not None,
@@ -353,6 +437,7 @@ def read_constants_full(path) -> tuple[dict, dict, dict]:
         require(UNITS[unit][0] == need, f"{path}:{lineno}: wrong units {unit!r} for {name} "
                                         f"({'urad or rad' if need == 'angle' else 'um or mm'})")
         values[name] = float(_to_internal(_number(path, lineno, "value", cells[1]), unit))
+        origin[name] = (f"{path}:{lineno}", unit)
         for h in extra:
             dct = std if h == "std" else u95
             if cells[header.index(h)] == "":
@@ -360,19 +445,26 @@ def read_constants_full(path) -> tuple[dict, dict, dict]:
             v = _number(path, lineno, h, cells[header.index(h)])
             require(v >= 0, f"{path}:{lineno}: negative {h} for {name}")
             dct[name] = float(_to_internal(v, unit))
-    return values, std, u95
+    return values, std, u95, origin
 
 
-def read_constants(path) -> dict:
-    """Read a constants CSV ``name,value,unit`` -> name -> float in mm (translational) / rad."""
-    return read_constants_full(path)[0]
+def read_constants(path, *, machine=None, accept_implausible: bool = False) -> dict:
+    """Read a constants CSV ``name,value,unit`` -> name -> float in mm (translational) / rad
+    (magnitudes checked as :func:`read_constants_full`)."""
+    return read_constants_full(path, machine=machine, accept_implausible=accept_implausible)[0]
 
 
 def write_constants(path, values: dict, inputs=(), std: dict | None = None,
-                    u95: dict | None = None, comments=()) -> Path:
+                    u95: dict | None = None, comments=(), *, machine=None,
+                    accept_implausible: bool = False) -> Path:
     """Write constants (mm / rad) as ``name,value,unit[,std][,u95]`` in um / urad,
-    ``comments`` as ``#`` lines above the header."""
+    ``comments`` as ``#`` lines above the header; values beyond what ``machine`` (Model or
+    Layout) can have are refused unless ``accept_implausible`` (:func:`check_magnitudes`;
+    without ``machine`` nothing is checked, :func:`write_error_dir` always checks)."""
     std, u95 = dict(std or {}), dict(u95 or {})
+    check_magnitudes({}, {k: float(v) for k, v in values.items()}, std, u95, machine=machine,
+                     where=str(Path(path).parent), cause=WRITE_CAUSE,
+                     accept_implausible=accept_implausible or machine is None)
     header = ["name", "value", "unit"] + (["std"] if std else []) + (["u95"] if u95 else [])
     lines = [_comment_lines(comments) + ",".join(header)]
     for name, v in values.items():
@@ -390,7 +482,8 @@ def write_constants(path, values: dict, inputs=(), std: dict | None = None,
 
 # ---------------------------------------------------------------------------------------------
 # error directories
-def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]:
+def read_error_dir(directory, axes=None, *, machine=None,
+                   accept_implausible: bool = False) -> tuple[dict, tuple[dict, dict, dict]]:
     """Read an error directory (``<AXIS>.csv`` per measured axis, optional ``constants.csv``).
 
     Parameters
@@ -399,7 +492,13 @@ def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]
         The error directory; a missing table means zero errors for that axis.
     axes : sequence of str, optional
         The axes the machine has; a table for any other axis, or any other CSV file, is
-        refused (default: X Y Z tables).
+        refused (default: the axes of ``machine``, else X Y Z tables).
+    machine : Model or Layout, optional
+        The machine whose travel limits the values (:mod:`volerr.tables.plausible`; without
+        it the span of the linear-axis tables read).
+    accept_implausible : bool
+        Accept values beyond those limits (a machine that really is that bad); by default they
+        are refused naming the file, the column and the likely unit.
 
     Returns
     -------
@@ -413,38 +512,60 @@ def read_error_dir(directory, axes=None) -> tuple[dict, tuple[dict, dict, dict]]
     require(not d.is_file(), f"{d} is a file, not an error directory (give the folder that "
                              f"holds X.csv, Y.csv ... and constants.csv)")
     require(d.is_dir(), f"error directory {d} does not exist")
-    tables, consts = {}, ({}, {}, {})
+    tables, consts, origin = {}, ({}, {}, {}), {}
+    if axes is None and machine is not None:
+        axes = getattr(machine, "layout", machine).axis_names
     allowed = None if axes is None else set(axes)
     for f in sorted(d.iterdir()):
         if f.suffix.lower() != ".csv" or f.name.startswith("."):
             continue
         stem = f.stem
         if stem.lower() == "constants":
-            consts = read_constants_full(f)
+            *consts, origin = _read_constants(f)
             continue
         if len(stem) == 1 and stem.isalpha():
             ax = stem.upper()
             require(allowed is None or ax in allowed,
                     f"{f}: table for axis {ax}, but the machine's axes are {' '.join(sorted(allowed or ()))}")
             require(ax not in tables, f"{d}: two tables for axis {ax}")
-            tables[ax] = read_error_table(f, axis=ax)
+            tables[ax] = _read_error_table(f, axis=ax)
             continue
         raise InputError(f"{f}: unknown file in error directory (expected "
                          f"{', '.join(a + '.csv' for a in (axes or ['X', 'Y', 'Z']))} or constants.csv)")
-    return tables, consts
+    check_magnitudes(tables, *consts, machine=machine, constants_origin=origin,
+                     accept_implausible=accept_implausible)
+    return tables, tuple(consts)
 
 
 def write_error_dir(directory, tables: dict, constants: dict | None = None,
-                    constants_std: dict | None = None, inputs=(), comments=None) -> Path:
+                    constants_std: dict | None = None, inputs=(), comments=None, *,
+                    machine=None, accept_implausible: bool = False) -> Path:
     """Write ``<AXIS>.csv`` for each table and ``constants.csv`` (when given) into ``directory``;
     ``comments``: {axis or "constants": [line ...]} written as ``#`` lines above the header
-    (what a value written under a name stands for)."""
+    (what a value written under a name stands for).  Values beyond what ``machine`` (Model or
+    Layout; default: the tables' span) can have are refused before anything is written,
+    unless ``accept_implausible`` (:func:`check_magnitudes`)."""
     d = Path(directory)
     comments = comments or {}
     for ax, t in tables.items():
         require(ax == t.axis, f"table for {t.axis} stored under {ax}")
-        write_error_table(d / f"{ax}.csv", t, inputs=inputs, comments=comments.get(ax, ()))
+    check_magnitudes({ax: _unread(t) for ax, t in tables.items()}, constants, constants_std,
+                     machine=machine, where=str(d), cause=WRITE_CAUSE,
+                     accept_implausible=accept_implausible)
+    for ax, t in tables.items():
+        write_error_table(d / f"{ax}.csv", t, inputs=inputs, comments=comments.get(ax, ()),
+                          accept_implausible=True)
     if constants:
         write_constants(d / "constants.csv", constants, inputs=inputs, std=constants_std,
-                        comments=comments.get("constants", ()))
+                        comments=comments.get("constants", ()), accept_implausible=True)
     return d
+
+
+def _unread(table: ErrorTable) -> ErrorTable:
+    """``table`` as values to be written: a refusal names the column written (um / urad), not
+    the file it may once have been read from."""
+    if getattr(table, "_columns", None) is None:
+        return table
+    copy = ErrorTable(table.axis, table.positions, table.values, table.std, table.u95,
+                      table.reversal, table.s)
+    return copy
