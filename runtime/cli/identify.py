@@ -14,7 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._common import add_force, add_json, add_plot, add_vector
+from ._common import add_accept_implausible, add_force, add_json, add_plot, add_vector
 
 
 def register(sub) -> None:
@@ -72,6 +72,7 @@ def register(sub) -> None:
                         "and re-referenced to the tool point; a linear axis measured from a "
                         "reference position q0 != 0: re-referenced to q = 0; measurement frame = "
                         "machine frame), ready for map / compensate")
+    add_accept_implausible(p)
     add_json(p, "a summary")
     add_plot(p, "a plot of the error motions")
     add_force(p)
@@ -107,7 +108,8 @@ def run(args) -> int:
         direction=_vec(args.direction, "--direction") if args.direction else None,
         origin=("layout" if args.origin == ["layout"] else
                 _vec(args.origin, "--origin") if args.origin else None),
-        sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k, signs=args.signs)
+        sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k, signs=args.signs,
+        accept_implausible=args.accept_implausible)
     result, table = res.identification, res.errors
     text = table_to_csv(table)
     summary = res.data

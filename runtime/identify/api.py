@@ -50,7 +50,7 @@ class Identified(ResultMixin):
 def identify(layout, axis: str, files, *, format: str = "csv", positions: str | None = None,
              points: str | None = None, method: str = "lsq", tracker=None, direction=None,
              origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
-             signs: str = "component") -> Identified:
+             signs: str = "component", accept_implausible: bool = False) -> Identified:
     """Three-point (or more) laser-tracker identification of the six error motions of an axis
     (``volerr identify``; the thesis' eq. 30 for linear axes, eq. 3.4 for rotary axes).
 
@@ -69,6 +69,9 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     signs : {"component", "model"}
         component: the error motions of the moving component that carries the points (as
         the thesis); model: volerr's tool-relative convention, ready for map / compensate.
+    accept_implausible : bool
+        Accept identified errors beyond what a machine of the layout's travel can have
+        (:mod:`volerr.tables.plausible`); by default they are refused with the likely cause.
 
     Returns
     -------
@@ -89,4 +92,20 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     table = result.table()
     if signs == "model":
         table = to_model_signs(table, lay, reference=result.rounds[0].positions[0])
+    check_identified(table, lay, files, accept_implausible)
     return Identified(result.summary(), table, result, axis.strip().upper())
+
+
+#: what identified errors beyond the size limits likely come from
+IMPLAUSIBLE_CAUSE = ("likely tracker coordinates in another unit, points not fixed to the moving "
+                     "component, or the wrong --direction / --origin")
+
+
+def check_identified(table, layout, files, accept_implausible: bool = False) -> None:
+    """Refuse an identified table (mm / rad) beyond what a machine of ``layout``'s travel can
+    have (:func:`volerr.tables.table.check_magnitudes`), naming the tracker ``files``."""
+    from ..tables.table import check_magnitudes
+
+    table._source = ", ".join(str(f) for f in files)
+    check_magnitudes({table.axis: table}, machine=layout, cause=IMPLAUSIBLE_CAUSE,
+                     accept_implausible=accept_implausible)

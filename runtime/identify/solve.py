@@ -55,6 +55,7 @@ import numpy as np
 
 from ..units import MM_PER_M, MM_PER_UM, UM_PER_MM, URAD_PER_RAD
 from ..errors import InputError, require
+from .motion import likely_cause, motion_fit, nominal as _nominal, rotation_matrix  # noqa: F401
 from .tracker_io import Round, check_rounds
 
 MOTION_PREFIX = ("EX", "EY", "EZ", "EA", "EB", "EC")
@@ -94,15 +95,6 @@ def design(lever) -> np.ndarray:
     lever = np.asarray(lever, dtype=float)
     block = _gen().design_block(lever[..., 0], lever[..., 1], lever[..., 2])
     return np.moveaxis(block, (0, 1), (-2, -1))
-
-
-def rotation_matrix(axis, angle_rad) -> np.ndarray:
-    """Right-hand rotation about ``axis`` (normalised here) by ``angle_rad`` (array, rad) ->
-    (..., 3, 3); generated from :func:`volerr.derive.three_point.axis_rotation`."""
-    k = np.asarray(axis, dtype=float)
-    k = k / np.linalg.norm(k)
-    a = np.asarray(angle_rad, dtype=float)
-    return np.moveaxis(_gen().axis_rotation(k[0], k[1], k[2], a), (0, 1), (-2, -1))
 
 
 def geometry_condition(lever) -> float:
@@ -264,44 +256,17 @@ def _axis_geometry(layout, axis, direction, origin):
     return ax.kind, d / np.linalg.norm(d), o
 
 
-def _nominal(kind, ref, steps, d, o, sense):
-    """Nominal positions (K, n, 3) and lever arms (K, n, 3) for reference points ref (n, 3)."""
-    lever0 = ref - o
-    if kind == "linear":
-        nom = ref[None] + sense * steps[:, None, None] * d
-        lever = np.broadcast_to(lever0, nom.shape)
-    else:
-        R = rotation_matrix(d, sense * np.radians(steps))
-        lever = np.einsum("kab,nb->kna", R, lever0)
-        nom = lever + o
-    return nom, lever
-
-
-def _detect_sense(kind, pts, steps, d, o, name, sense):
-    """Choose the sense (+1/-1) of the nominal motion that fits the data; check plausibility."""
-    ref = pts[0]
+def _detect_sense(kind, pts, steps, d, o, name, sense, others=None):
+    """Choose the sense (+1/-1) of the nominal motion that fits the data; refuse points that
+    do not follow it, naming the likely cause (:mod:`volerr.identify.motion`); ``others``:
+    {axis: (kind, direction)} of the layout's other axes."""
     senses = (1, -1) if sense in (None, 0, "auto") else (int(sense),)
-    best = None
-    for s in senses:
-        nom, _ = _nominal(kind, ref, steps, d, o, s)
-        dev = float(np.max(np.linalg.norm(pts - nom, axis=-1)))
-        if best is None or dev < best[1]:
-            best = (s, dev)
-    s, dev = best
-    # implausibly large deviations: wrong axis, direction, units or origin
-    span = float(np.max(np.abs(steps)))
-    if kind == "linear":
-        limit = max(0.05 * span, 0.5)
-        what = "mm"
-    else:
-        lever = np.linalg.norm(np.cross(ref - o, d), axis=-1).max()
-        limit = max(np.radians(0.5) * lever, 0.5)
-        what = "mm"
-    require(dev <= limit,
-            f"round {name}: measured points deviate up to {dev:.3g} {what} from the nominal "
-            f"{'translation' if kind == 'linear' else 'rotation'} (limit {limit:.3g} mm); check "
-            f"--axis, the axis direction, the units (mm, deg)"
-            f"{', the origin on the axis' if kind == 'rotary' else ''} and the point order")
+    s, dev, limit = motion_fit(kind, pts, steps, d, o, senses)
+    if dev > limit:
+        cause = likely_cause(kind, pts, steps, d, o, senses, others or {})
+        raise InputError(f"round {name}: measured points deviate up to {dev:.3g} mm from the "
+                         f"nominal {'translation' if kind == 'linear' else 'rotation'} (limit "
+                         f"{limit:.3g} mm): {cause}")
     return s
 
 
@@ -458,8 +423,10 @@ class _LsqFit:
     W: np.ndarray | None
 
 
-def _round_geometry(rnd: Round, kind, direction, origin, sense, max_cond) -> _Geometry:
-    """Check the point geometry, detect the sense and build the nominal pose."""
+def _round_geometry(rnd: Round, kind, direction, origin, sense, max_cond,
+                    others=None) -> _Geometry:
+    """Check the point geometry, detect the sense and build the nominal pose (``others``:
+    the layout's other axes, for naming what a round that does not follow the axis is)."""
     pts = rnd.points
     steps = rnd.positions - rnd.positions[0]
     cond = geometry_condition(pts[0])
@@ -469,7 +436,7 @@ def _round_geometry(rnd: Round, kind, direction, origin, sense, max_cond) -> _Ge
             f"round {rnd.name}: degenerate point geometry (condition number {cond:.3g} > "
             f"{max_cond:.3g}): points {','.join(rnd.labels)} are coincident or (nearly) "
             f"collinear; use three well-spread, non-collinear points")
-    s = _detect_sense(kind, pts, steps, direction, origin, rnd.name, sense)
+    s = _detect_sense(kind, pts, steps, direction, origin, rnd.name, sense, others)
     nom, lever = _nominal(kind, pts[0], steps, direction, origin, s)
     return _Geometry(cond, s, lever, pts - nom, design(lever))
 
@@ -524,14 +491,14 @@ def _closed_summary(closed: dict, rnd: Round, axis: str, u_closed, u_lsq) -> dic
 
 def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, method="lsq",
                    tracker=None, sense="auto", max_cond=1e4, outlier_k=5.0,
-                   cross_check=True) -> RoundResult:
+                   cross_check=True, others=None) -> RoundResult:
     """Identify the six error motions of one round (see the module docstring).
 
     Steps: geometry and nominal pose, least squares, closed form (method or cross-check),
     outliers (always judged on the least-squares residuals: the closed form fits six equations
     exactly and leaves all misfit in the other three)."""
     n = rnd.points.shape[1]
-    geo = _round_geometry(rnd, kind, direction, origin, sense, max_cond)
+    geo = _round_geometry(rnd, kind, direction, origin, sense, max_cond, others)
     lsq = _round_lsq(rnd, geo, tracker)
     closed = {}
     if method == "closed":
@@ -655,6 +622,8 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         layout = read_layout(layout)
     require(method in ("lsq", "closed"), f"unknown method {method!r} (lsq, closed)")
     kind, d, o = _axis_geometry(layout, axis, direction, origin)
+    others = {n: (a.kind, tuple(np.asarray(a.direction, float) / np.linalg.norm(a.direction)))
+              for n, a in layout.axes.items() if n != axis}
     rounds = list(rounds)
     check_rounds(rounds)
     # one reference for all rounds: the first position of the first round.  A round measured
@@ -677,7 +646,8 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         order = [r.labels.index(lab) for lab in labels]
         aligned.append(Round(r.name, r.positions, labels, r.points[:, order, :]))
     results = [identify_round(r, kind, axis, d, o, method=method, tracker=tracker, sense=sense,
-                              max_cond=max_cond, outlier_k=outlier_k, cross_check=cross_check)
+                              max_cond=max_cond, outlier_k=outlier_k, cross_check=cross_check,
+                              others=others)
                for r in aligned]
     positions = np.sort(rounds[0].positions)
     stack = np.empty((len(results), positions.size, 6))
