@@ -60,7 +60,10 @@ def register(sub) -> None:
     g.add_argument("--plan", metavar="PLAN.csv",
                    help="write a probing plan (nominal ball centres x,y,z,phi_deg,theta_deg) "
                         "instead of calibrating")
-    g.add_argument("--ball-radius", type=float, metavar="r", help="stylus-ball radius, mm")
+    p.add_argument("--ball-radius", type=float, metavar="r",
+                   help="stylus-ball radius, mm (nominal): needed with --plan; when "
+                        "calibrating, the effective radius the data give must match it within "
+                        "the pretravel (0.1 mm), else --sphere-radius is refused")
     add_vector(g, "--center", default=(0.0, 0.0, 0.0),
                help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
     g.add_argument("--step-deg", type=float, default=18.0,
@@ -112,6 +115,9 @@ def run(args) -> int:
     require(args.out, "--out MAP.csv is required")
     require(math.isfinite(args.sphere_radius) and args.sphere_radius > 0,
             f"--sphere-radius must be a positive length in mm, got {args.sphere_radius}")
+    require(args.ball_radius is None or (math.isfinite(args.ball_radius) and
+                                         args.ball_radius > 0),
+            f"--ball-radius must be a positive length in mm, got {args.ball_radius}")
     from ..fileio import Outputs
 
     inputs = [args.data]
@@ -123,7 +129,7 @@ def run(args) -> int:
             f"--degree must be between 0 and 20, got {args.degree}")
     res = probe_cal(args.data, args.sphere_radius, tilt_deg=args.tilt_deg,
                     roll_deg=args.roll_deg, degree=args.degree, outlier_k=args.outlier_k,
-                    exclude_outliers=args.exclude_outliers)
+                    exclude_outliers=args.exclude_outliers, ball_radius=args.ball_radius)
     cal, summary = res.calibration, res.data
     with outs:
         write_text(outs.path("--out"), probe.map_csv_text(cal), inputs=inputs)

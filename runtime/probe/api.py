@@ -41,7 +41,7 @@ class ProbeCal(ResultMixin):
 
 def probe_cal(data, sphere_radius: float, *, tilt_deg: float = 0.0, roll_deg: float = 0.0,
               degree: int | None = None, outlier_k: float = 5.0,
-              exclude_outliers: bool = False) -> ProbeCal:
+              exclude_outliers: bool = False, ball_radius: float | None = None) -> ProbeCal:
     """Probe (lobing) calibration on a master sphere (``volerr probe-cal``; Pahk's probe frame).
 
     Parameters
@@ -59,6 +59,9 @@ def probe_cal(data, sphere_radius: float, *, tilt_deg: float = 0.0, roll_deg: fl
         Flag points whose residual exceeds k times the noise.
     exclude_outliers : bool
         Refit without the flagged points.
+    ball_radius : float, optional
+        Nominal stylus-ball radius, mm: a sphere radius that implies an effective ball radius
+        farther from it than the pretravel could explain is refused (with the likely mistake).
 
     Returns
     -------
@@ -73,5 +76,5 @@ def probe_cal(data, sphere_radius: float, *, tilt_deg: float = 0.0, roll_deg: fl
             f"--degree must be between 0 and 20, got {degree}")
     cal = probe.calibrate_data(probe.read_sphere_csv(data), sphere_radius, tilt_deg=tilt_deg,
                                roll_deg=roll_deg, degree=degree, outlier_k=outlier_k,
-                               exclude_outliers=exclude_outliers)
+                               exclude_outliers=exclude_outliers, ball_radius=ball_radius)
     return ProbeCal(cal.summary(), cal, exclude_outliers)

@@ -58,10 +58,20 @@ from .fits import (MAX_CONDITION, MAX_DEGREE, MIN_POINTS, OUTLIER_K,  # noqa: F4
                                check_sphere_points, fit_sh, fit_sphere, max_degree_for,
                                robust_flags, sh_design)
 
-#: largest plausible effective stylus-ball radius, mm (a sphere radius that implies more is wrong)
-MAX_BALL_RADIUS_MM = 25.0
+#: largest plausible effective stylus-ball radius, mm (a sphere radius that implies more is
+#: wrong): the largest stylus balls of touch probes are about 20 mm in diameter
+MAX_BALL_RADIUS_MM = 10.0
 #: smallest plausible effective stylus-ball radius, mm
 MIN_BALL_RADIUS_MM = 0.005
+#: largest difference between the effective and the nominal stylus-ball radius, mm: the mean
+#: pretravel and the bending of a stylus stay well below it
+TIP_TOLERANCE_MM = 0.1
+#: what a declared sphere radius that does not fit the ball centres may really be: text,
+#: the radius it then stands for (mm) from the declared one
+_RADIUS_MISTAKES = (("the diameter given for the radius", lambda r: r / 2.0),
+                    ("the radius in inches", lambda r: r * 25.4),
+                    ("the radius in cm", lambda r: r * 10.0),
+                    ("the radius in um", lambda r: r * MM_PER_UM))
 #: tolerance on the probed phi range when evaluating the map, deg
 COVERAGE_TOL_DEG = 2.0
 
@@ -412,7 +422,8 @@ class ProbeCalibration:
 
 def calibrate(points, sphere_radius: float, phi_deg=None, theta_deg=None,
               tilt_deg: float = 0.0, roll_deg: float = 0.0, degree: int | None = None,
-              outlier_k: float = OUTLIER_K, exclude_outliers: bool = False) -> ProbeCalibration:
+              outlier_k: float = OUTLIER_K, exclude_outliers: bool = False,
+              ball_radius: float | None = None) -> ProbeCalibration:
     """Master-sphere calibration (Pahk eq. 13).
 
     Parameters
@@ -432,6 +443,9 @@ def calibrate(points, sphere_radius: float, phi_deg=None, theta_deg=None,
         flagged, with their Probe relative to the refit).
     outlier_k : float
         Flag points whose studentised map residual exceeds ``outlier_k`` x the robust sigma.
+    ball_radius : float, optional
+        Nominal stylus-ball radius, mm: the effective radius R_fit - R_s must lie within
+        ``TIP_TOLERANCE_MM`` of it (:func:`check_stylus`).
 
     Returns
     -------
@@ -446,34 +460,75 @@ def calibrate(points, sphere_radius: float, phi_deg=None, theta_deg=None,
     require(math.isfinite(tilt_deg) and math.isfinite(roll_deg), "tilt/roll must be finite")
     require((phi_deg is None) == (theta_deg is None), "give both phi and theta or neither")
     require(outlier_k > 0, "outlier threshold must be positive")
+    require(ball_radius is None or (math.isfinite(ball_radius) and ball_radius > 0),
+            f"the stylus-ball radius must be a positive length in mm, got {ball_radius}")
     used = np.ones(len(p), dtype=bool)
     result = _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_deg,
-                             degree, outlier_k)
+                             degree, outlier_k, ball_radius=ball_radius)
     if exclude_outliers and result.outlier.any():
         used = ~result.outlier
         require(used.sum() >= MIN_POINTS, "too few points left after excluding the outliers")
         result = _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg,
-                                 roll_deg, degree, outlier_k, flags=result.outlier)
+                                 roll_deg, degree, outlier_k, flags=result.outlier,
+                                 ball_radius=ball_radius)
     return result
 
 
+def _radius_hint(fit_radius: float, sphere_radius: float, ball_radius=None) -> str:
+    """What a sphere radius that does not fit the ball centres (``fit_radius``, mm) likely is:
+    a clause for the refusal ("" when no known mistake explains it)."""
+    def fits(radius):
+        r = fit_radius - radius
+        if ball_radius is not None:
+            return abs(r - ball_radius) <= TIP_TOLERANCE_MM
+        return MIN_BALL_RADIUS_MM <= r <= MAX_BALL_RADIUS_MM
+
+    if abs(fit_radius - sphere_radius) <= TIP_TOLERANCE_MM and \
+            (ball_radius is None or ball_radius > TIP_TOLERANCE_MM):
+        return ("; the points lie on a sphere of the given radius: contact points "
+                "(probe-corrected) instead of stylus-ball centres, or the sphere radius plus "
+                "the ball radius given?")
+    found = [f"{text} ({radius(sphere_radius):.6g} mm would fit)"
+             for text, radius in _RADIUS_MISTAKES if fits(radius(sphere_radius))]
+    if ball_radius is not None and abs((fit_radius - sphere_radius) * 2.0 - ball_radius) \
+            <= 2 * TIP_TOLERANCE_MM:
+        found.append("the ball's diameter given as --ball-radius")
+    if not found and ball_radius is not None:
+        found.append(f"another sphere's radius (with this ball the centres fit a "
+                     f"{fit_radius - ball_radius:.6g} mm sphere)")
+    return f"; likely {', or '.join(found)}?" if found else ""
+
+
+def check_stylus(fit_radius: float, sphere_radius: float, ball_radius=None) -> None:
+    """Refuse a sphere radius R_s (mm) that the ball centres' fitted radius R_fit (mm) cannot
+    explain: R_fit - R_s is the effective stylus-ball radius, which must be a plausible
+    stylus (MIN_BALL_RADIUS_MM .. MAX_BALL_RADIUS_MM) and, with the nominal ``ball_radius``,
+    within TIP_TOLERANCE_MM of it.  The refusal names the likely mistake (the diameter for
+    the radius, inches, contact points instead of ball centres)."""
+    r_eff = fit_radius - sphere_radius
+    hint = _radius_hint(fit_radius, sphere_radius, ball_radius)
+    require(r_eff > 0,
+            f"fitted radius of the ball centres {fit_radius:.6g} mm minus the sphere radius "
+            f"{sphere_radius:.6g} mm gives a stylus-ball radius {r_eff:.4g} mm <= 0: check "
+            f"--sphere-radius (a radius in mm, not a diameter){hint}")
+    shown = f"{r_eff * UM_PER_MM:.3g} um" if r_eff < 1.0 else f"{r_eff:.4g} mm"
+    require(MIN_BALL_RADIUS_MM <= r_eff <= MAX_BALL_RADIUS_MM,
+            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius {shown} "
+            f"(fitted radius {fit_radius:.6g} mm): not a plausible stylus; check "
+            f"--sphere-radius (mm){hint}")
+    require(ball_radius is None or abs(r_eff - ball_radius) <= TIP_TOLERANCE_MM,
+            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius {shown} "
+            f"(fitted radius {fit_radius:.6g} mm), the stylus ball has {ball_radius} mm: more "
+            f"than the probe's pretravel could explain (at most {TIP_TOLERANCE_MM:g} mm); "
+            f"check --sphere-radius and --ball-radius (mm){hint}")
+
+
 def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_deg, degree,
-                    outlier_k, flags=None) -> ProbeCalibration:
+                    outlier_k, flags=None, ball_radius=None) -> ProbeCalibration:
     fit = fit_sphere(p[used])
     c = fit.center
     r_eff = fit.radius - sphere_radius
-    require(r_eff > 0,
-            f"fitted radius of the ball centres {fit.radius:.6g} mm minus the sphere radius "
-            f"{sphere_radius:.6g} mm gives a stylus-ball radius {r_eff:.4g} mm <= 0: check "
-            f"--sphere-radius (a radius in mm, not a diameter)")
-    require(r_eff >= MIN_BALL_RADIUS_MM,
-            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
-            f"{r_eff * UM_PER_MM:.3g} um (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
-            f"check --sphere-radius (mm)")
-    require(r_eff <= MAX_BALL_RADIUS_MM,
-            f"the sphere radius {sphere_radius:.6g} mm implies a stylus-ball radius "
-            f"{r_eff:.4g} mm (fitted radius {fit.radius:.6g} mm): not a plausible stylus; "
-            f"check --sphere-radius (mm)")
+    check_stylus(fit.radius, sphere_radius, ball_radius)
     d = p - c
     r_m = np.linalg.norm(d, axis=1)
     probe = r_eff - (r_m - sphere_radius)            # eq. (13)
