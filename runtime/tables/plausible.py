@@ -149,7 +149,9 @@ def refusal(where: str, what: str, peak_internal: float, kind: str, limits: Limi
         units = likely_units(peak, declared, kind, limits.of(kind))
         if units:
             fix = _FILE_UNITS[kind]
-            how = (f"write it in {fix}" if units[0] == fix else f"convert it to {fix}")
+            other = [u for u in units if u != fix]
+            how = f"give it in {fix}" + (f", converted if it is in {' or '.join(other)}"
+                                         if other else "")
             cause = f"likely in {' or '.join(units)}, not {declared}: {how}"
         else:
             cause = (f"not a {'translational' if kind == 'length' else 'angular'} error in "
