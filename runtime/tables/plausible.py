@@ -158,6 +158,7 @@ def refusal(where: str, what: str, peak_internal: float, kind: str, limits: Limi
                      f"any usual unit (another quantity in this column?)")
     else:
         head = f"{what} = {shown} is" if single else f"{what}: values up to {shown} are"
+        cause = cause or "an error in the wrong unit?"
     return InputError(f"{where}: {head} beyond what a machine of this size can have "
                       f"(limit {limits.rule(kind)}); {cause} ({OPTION} for a machine that "
                       f"really is that bad)")

@@ -154,6 +154,12 @@ class ErrorTable:
             self.reversal = np.asarray(self.reversal, dtype=float)
         self.validate()
 
+    def check_magnitudes(self, machine=None, accept_implausible: bool = False) -> None:
+        """Refuse values beyond what ``machine`` (Model or Layout; default: this table's span)
+        can have (:func:`check_magnitudes`, :mod:`volerr.tables.plausible`)."""
+        check_magnitudes({self.axis: self}, machine=machine,
+                         accept_implausible=accept_implausible)
+
     def validate(self, where: str = "") -> None:
         """Check shapes, names, finiteness and increasing positions; raise InputError."""
         w = where or f"table {self.axis}"
