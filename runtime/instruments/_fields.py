@@ -135,8 +135,13 @@ def positions(find: Finder, model, where: str, min_points: int = 1,
         lo, hi = model.travel[a]
         margin = 0.05 * (hi - lo)
         bad = np.flatnonzero((v < lo - margin) | (v > hi + margin))
-        require(len(bad) == 0, f"{where}: {a} = {v[bad[0]] if len(bad) else 0:g} lies outside "
-                f"the travel [{lo:g}, {hi:g}] of layout {model.name}: layout mismatch")
+        if len(bad):
+            from .geometry_check import travel_cause
+
+            cause = travel_cause(model, out)
+            require(False, f"{where}: {a} = {v[bad[0]]:g} lies outside the travel "
+                    f"[{lo:g}, {hi:g}] of layout {model.name}: "
+                    + (f"likely {cause}" if cause else "layout mismatch"))
     return out
 
 

@@ -147,7 +147,8 @@ def require_consistent(where: str, model, g: Geometry, extra=()) -> None:
     """Refuse (InputError, one line: file, columns, likely cause) a file whose geometry misses
     by more than its tolerance.  ``extra``: the instrument's own alternatives ``(cause,
     columns, {target: value})``."""
-    miss = _trial(g.misfit, model, g.pos, g.probe, g.targets)
+    with np.errstate(all="ignore"):
+        miss = g.misfit(model, g.pos, g.probe, g.targets)   # the file's own defects raise
     if miss.ratio <= 1.0:
         return
     found = diagnose(model, g, extra)
@@ -159,6 +160,29 @@ def require_consistent(where: str, model, g: Geometry, extra=()) -> None:
     cause, cols = found
     word = "columns" if "," in cols else "column"
     raise InputError(f"{where}: {word} {cols}: likely {cause}; {tail}")
+
+
+def inside_travel(model, pos: dict, margin: float = 0.05) -> bool:
+    """Every position inside the layout's travel widened by ``margin`` of its span."""
+    for a, v in pos.items():
+        lo, hi = model.travel[a]
+        m = margin * (hi - lo)
+        if np.any((np.asarray(v) < lo - m) | (np.asarray(v) > hi + m)):
+            return False
+    return True
+
+
+def travel_cause(model, pos: dict) -> str | None:
+    """The usual mistake that brings positions outside the travel back inside it: two linear
+    axis columns swapped, positions in um (None when none does)."""
+    lin = [a for a in model.axes if a not in model.rotary_axes and a in pos]
+    for i, a in enumerate(lin):
+        for b in lin[i + 1:]:
+            if inside_travel(model, {**pos, a: pos[b], b: pos[a]}):
+                return f"columns {a} and {b} swapped"
+    if lin and inside_travel(model, {**pos, **{a: pos[a] * 1e-3 for a in lin}}):
+        return "linear axis positions in um, not mm"
+    return None
 
 
 # ---- the misfits of each instrument ------------------------------------------------------
