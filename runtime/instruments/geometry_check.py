@@ -152,11 +152,11 @@ def require_consistent(where: str, model, g: Geometry, extra=()) -> None:
     if miss.ratio <= 1.0:
         return
     found = diagnose(model, g, extra)
-    tail = f"{miss.text} (at most {miss.tolerance:g} mm with layout {model.name})"
+    tail = (f"{miss.text}: the file and layout {model.name} disagree beyond "
+            f"{miss.tolerance:g} mm")
     if found is None:
-        raise InputError(f"{where}: the file's geometry and layout {model.name} disagree and no "
-                         f"usual mistake (radians, inches, the tool offset's sign, swapped axis "
-                         f"columns, another layout) explains it: {tail}")
+        raise InputError(f"{where}: {tail}; no usual mistake (radians, inches, the tool "
+                         f"offset's sign, swapped axis columns, another layout) explains it")
     cause, cols = found
     word = "columns" if "," in cols else "column"
     raise InputError(f"{where}: {word} {cols}: likely {cause}; {tail}")
@@ -265,5 +265,27 @@ def distances_misfit(labels: np.ndarray, locate, tolerance: float):
                 best = Miss(float(rms) if np.isfinite(rms) else np.inf, tolerance,
                             f"station {name}: the distances do not fit the commanded tool "
                             f"points (RMS {rms:.3g} mm after locating the station)")
+        return best
+    return misfit
+
+
+def artifact_misfit(labels: np.ndarray, rigid_fit, tolerance: float):
+    """The misfit of an artifact file: per placement, the largest distance (mm) between a
+    measured point and its calibrated point placed by the best-fitting rigid pose."""
+    labels = np.asarray(labels).astype(str)
+
+    def misfit(model, pos, probe, targets) -> Miss:
+        measured, point = targets["the measured points"], targets["the calibrated coordinates"]
+        best = Miss(0.0, tolerance, "")
+        for name in dict.fromkeys(labels):
+            m = labels == name
+            R, o = rigid_fit(point[m], measured[m])
+            dist = np.linalg.norm(measured[m] - (point[m] @ R.T + o), axis=1)
+            k = _worst(dist)
+            if not dist[k] <= best.worst:
+                best = Miss(float(dist[k]), tolerance,
+                            f"placement {name} row {np.flatnonzero(m)[k] + 2}: a measured point "
+                            f"lies {dist[k]:.3f} mm from its calibrated point in the "
+                            f"best-fitting pose")
         return best
     return misfit
