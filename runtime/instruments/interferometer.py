@@ -46,6 +46,7 @@ import numpy as np
 from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
+from . import _fields as f
 from .observations import FileInfo, Observations, Setup
 
 KIND = "interferometer"
@@ -196,6 +197,8 @@ def _readings(path, axis, mode, where):
     require(len(hits) == 1, f"{where}: a {mode} run needs one reading column "
             f"({' or '.join(unit)}; long format target_mm,cycle,direction,"
             f"{next(iter(unit))})")
+    f.require_finite(c.numbers[hits[0]], hits[0], where)
+    f.require_finite(targets, _target_column(c, names, where)[1], where)
     dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
     hd = next(h for h in names if h.lower() in _DIRECTION)
     direction = _directions(c, hd, where)
