@@ -106,7 +106,8 @@ def _middle(model) -> np.ndarray:
 
 def default_centres(model) -> list:
     """Two sphere centres (workpiece frame, mm): the nominal tool point at the middle of the
-    travel with a 120 mm probe, and one 20 % of the travel away in X and Y (sphere test
+    travel with the tool offset (0, 0, +120) mm (120 mm from the reference point towards the
+    spindle, docs/conventions.md), and one 20 % of the travel away in X and Y (sphere test
     plans use two or more placements: one alone cannot tell a location error from the
     sphere's own position)."""
     mid = model.nominal_position(_middle(model), (0.0, 0.0, 120.0))[0]
