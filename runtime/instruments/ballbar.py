@@ -51,6 +51,9 @@ DEFAULT_U_UM = 0.5
 #: positions disagree
 RADIUS_TOLERANCE_MM = 0.5
 SETUP_KEYS = tuple(generated.SETUP[KIND])
+#: the shortest bar accepted, mm (telescoping ballbars are 50 mm and longer; a file whose
+#: lengths are all in inches gives 150 mm as 5.9)
+MIN_LENGTH_MM = 25.0
 
 
 def detect(names) -> bool:
@@ -83,6 +86,9 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     pivot = f.vector(find, ("pivot_x", "pivot_y", "pivot_z"), "pivot ball centre", where)
     length = f.vector(find, ("length",), "nominal bar length", where, units=("_mm",))[:, 0]
     require(np.all(length > 0), f"{where}: length_mm must be positive")
+    require(float(np.min(length)) >= MIN_LENGTH_MM, f"{where}: column length_mm: "
+            f"{float(np.min(length)):g} mm is shorter than any ballbar ({MIN_LENGTH_MM:g} mm "
+            f"and longer): likely every length in inches (x 25.4), or cm")
     dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading")[:, 0]
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
     # a bar calibrated with its calibrator: its length offset known to within length_u_um

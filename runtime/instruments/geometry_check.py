@@ -73,10 +73,11 @@ def _alternatives(model, g: Geometry, extra=()):
     are reported when several explain the file equally well."""
     rot = [a for a in model.rotary_axes if a in g.pos]
     lin = [a for a in model.axes if a not in model.rotary_axes and a in g.pos]
-    if rot and max(float(np.max(np.abs(g.pos[a]))) for a in rot) <= 2 * np.pi + 1e-6:
-        yield (f"rotary axes in radians, not degrees (with {', '.join(rot)} x 180/pi the file "
-               f"is consistent)", ", ".join(rot), model,
-               {**g.pos, **{a: np.degrees(g.pos[a]) for a in rot}}, g.probe, g.targets)
+    small = [a for a in rot if float(np.max(np.abs(g.pos[a]))) <= 2 * np.pi + 1e-6]
+    for group in ([small] if len(small) > 1 else []) + [[a] for a in small]:
+        yield (f"rotary {'axes' if len(group) > 1 else 'axis'} in radians, not degrees (with "
+               f"{', '.join(group)} x 180/pi the file is consistent)", ", ".join(group), model,
+               {**g.pos, **{a: np.degrees(g.pos[a]) for a in group}}, g.probe, g.targets)
     off = [c for c, v in zip(("Xp", "Yp", "Zp"), g.probe.T) if np.any(v != 0)]
     if off:
         yield (f"the tool offset with the wrong sign ({', '.join(off)} negated makes the file "
@@ -173,15 +174,29 @@ def inside_travel(model, pos: dict, margin: float = 0.05) -> bool:
 
 
 def travel_cause(model, pos: dict) -> str | None:
-    """The usual mistake that brings positions outside the travel back inside it: two linear
-    axis columns swapped, positions in um (None when none does)."""
+    """The usual mistake that brings positions outside the travel back inside it: two axis
+    columns swapped, linear positions in um, the file of another machine (a shipped layout
+    with the same axes whose travel holds the positions); None when none does."""
+    from ..machine.layout import layout_names
+    from ..machine.model import load
+
     lin = [a for a in model.axes if a not in model.rotary_axes and a in pos]
-    for i, a in enumerate(lin):
-        for b in lin[i + 1:]:
-            if inside_travel(model, {**pos, a: pos[b], b: pos[a]}):
-                return f"columns {a} and {b} swapped"
+    rot = [a for a in model.rotary_axes if a in pos]
+    for group in (lin, rot):
+        for i, a in enumerate(group):
+            for b in group[i + 1:]:
+                if inside_travel(model, {**pos, a: pos[b], b: pos[a]}):
+                    return f"columns {a} and {b} swapped"
     if lin and inside_travel(model, {**pos, **{a: pos[a] * 1e-3 for a in lin}}):
         return "linear axis positions in um, not mm"
+    fits = []
+    for name in layout_names():
+        other = load(name) if name != model.name else None
+        if other is not None and set(other.axes) == set(pos) and inside_travel(other, pos, 0.0):
+            fits.append(name)
+    if fits:
+        return (f"the file of another machine (its positions lie inside the travel of "
+                f"{', '.join(fits[:4])}{' ...' if len(fits) > 4 else ''})")
     return None
 
 
