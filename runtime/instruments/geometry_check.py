@@ -187,7 +187,9 @@ def travel_cause(model, pos: dict) -> str | None:
             for b in group[i + 1:]:
                 if inside_travel(model, {**pos, a: pos[b], b: pos[a]}):
                     return f"columns {a} and {b} swapped"
-    if lin and inside_travel(model, {**pos, **{a: pos[a] * 1e-3 for a in lin}}):
+    spans = [np.ptp(pos[a]) * 1e-3 >= 0.1 * (model.travel[a][1] - model.travel[a][0])
+             for a in lin]
+    if lin and any(spans) and inside_travel(model, {**pos, **{a: pos[a] * 1e-3 for a in lin}}):
         return "linear axis positions in um, not mm"
     fits = []
     for name in layout_names():

@@ -185,6 +185,20 @@ CASES = {
 }
 
 
+ISO = "iso230_2_run_X.csv"
+#: interferometer runs of X on MB1 (the positioning example): name -> (header lines, change,
+#: data row or None, words of the cause)
+RUNS = {
+    "interferometer_run_of_x_headed_y": (["# axis: Y"], None, None, ["run of axis X"]),
+    "interferometer_targets_in_um": (["# axis: X"], scale("target_mm", by=1e3), None,
+                                     ["targets in um"]),
+    "interferometer_beam_of_another_axis": (["# axis: X", "# beam: 0, 1, 0"], None, None,
+                                            ["beam", "another axis"]),
+    "interferometer_deviation_nan": (["# axis: X"], setv("deviation_um", "nan"), 2,
+                                     ["deviation_um", "NaN"]),
+}
+
+
 def _run(tmp_path, case, ex):
     from volerr.cli import main
 
@@ -220,6 +234,36 @@ def test_mistake_refused_naming_the_cause(case, ex, tmp_path, capsys):
     assert not out.exists()
 
 
+def test_the_unchanged_run_passes(ex, tmp_path, capsys):
+    from volerr.cli import main
+
+    path = tmp_path / ISO
+    path.write_text("# axis: X\n" + (ex / ISO).read_text())
+    out = tmp_path / "out.json"
+    assert main(["calibrate", "MB1", f"interferometer:{path}", "--json", str(out)]) == 0, \
+        capsys.readouterr().err
+
+
+@pytest.mark.parametrize("case", list(RUNS))
+def test_interferometer_mistake_refused(case, ex, tmp_path, capsys):
+    from volerr.cli import main
+
+    head, change, row, words = RUNS[case]
+    path = tmp_path / ISO
+    if change is None:
+        path.write_text((ex / ISO).read_text())
+    else:
+        mutate(ex / ISO, path, change, row)
+    path.write_text("\n".join(head) + "\n" + path.read_text())
+    out = tmp_path / "out.json"
+    code = main(["calibrate", "MB1", f"interferometer:{path}", "--json", str(out)])
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert code == 2 and len(lines) == 1 and "Traceback" not in err, err
+    assert all(w.lower() in lines[0].lower() for w in words) and ISO in lines[0], lines[0]
+    assert not out.exists()
+
+
 def test_at_least_25_distinct_mistakes():
-    assert len(CASES) >= 25
+    assert len(CASES) + len(RUNS) >= 25
     assert len({c[2] for c in CASES.values()}) >= 6        # sphere, ballbar, distances, ...
