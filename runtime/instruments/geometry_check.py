@@ -65,7 +65,6 @@ class Geometry:
     targets: dict
     target_columns: dict
     misfit: Callable
-    what: str = "the commanded tool point"
 
 
 def _alternatives(model, g: Geometry, extra=()):
@@ -78,12 +77,15 @@ def _alternatives(model, g: Geometry, extra=()):
         yield (f"rotary {'axes' if len(group) > 1 else 'axis'} in radians, not degrees (with "
                f"{', '.join(group)} x 180/pi the file is consistent)", ", ".join(group), model,
                {**g.pos, **{a: np.degrees(g.pos[a]) for a in group}}, g.probe, g.targets)
-    off = [c for c, v in zip(("Xp", "Yp", "Zp"), g.probe.T) if np.any(v != 0)]
-    if off:
-        yield (f"the tool offset with the wrong sign ({', '.join(off)} negated makes the file "
+    off = [j for j in range(3) if np.any(g.probe[:, j] != 0)]
+    for group in ([off] if off else []) + ([[j] for j in off] if len(off) > 1 else []):
+        names = ", ".join("XYZ"[j] + "p" for j in group)
+        flipped = g.probe.copy()
+        flipped[:, group] *= -1.0
+        yield (f"the tool offset with the wrong sign ({names} negated makes the file "
                f"consistent; the offset is the vector from the reference point to the tool "
-               f"point in the tool frame, +z towards the spindle)", ", ".join(off), model,
-               g.pos, -g.probe, g.targets)
+               f"point in the tool frame, +z towards the spindle)", names, model, g.pos,
+               flipped, g.targets)
     for name, cols in g.target_columns.items():
         yield (f"{name} in inches (x 25.4 makes the file consistent)", cols, model, g.pos,
                g.probe, {**g.targets, name: g.targets[name] * INCH_MM})

@@ -267,3 +267,28 @@ def test_interferometer_mistake_refused(case, ex, tmp_path, capsys):
 def test_at_least_25_distinct_mistakes():
     assert len(CASES) + len(RUNS) >= 25
     assert len({c[2] for c in CASES.values()}) >= 6        # sphere, ballbar, distances, ...
+
+
+@pytest.mark.parametrize("shift,refused", [(4.0, False), (6.0, True)])
+def test_sphere_placement_tolerance(shift, refused, ex, tmp_path, capsys):
+    """A sphere placed ``shift`` mm (in x) from its nominal centre: within the 5 mm placement
+    tolerance the file is read (its centre offset is a set-up unknown); beyond it the file is
+    refused, and as no usual mistake explains a plain offset, the line says so."""
+    from volerr.cli import main
+
+    def change(r):
+        if r["placement"] == "1":
+            r["sphere_x"] = repr(float(r["sphere_x"]) + shift)
+    path = mutate(ex / SPH, tmp_path / SPH, change)
+    out = tmp_path / "out.json"
+    code = main(["calibrate", "DMU50", str(path), "--json", str(out)])
+    err = capsys.readouterr().err
+    assert code == (2 if refused else 0), err
+    assert out.exists() is not refused
+    if refused:
+        line = err.strip()
+        assert "placement 1" in line and "no usual mistake" in line, line
+        import re
+
+        miss = float(re.search(r"misses the sphere centre by ([0-9.]+) mm", line).group(1))
+        assert abs(miss - shift) < 0.1, line         # the readings are tens of um
