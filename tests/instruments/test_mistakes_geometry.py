@@ -174,6 +174,15 @@ CASES = {
                                ["X and Y swapped"]),
     "deviations_positions_in_um": ("loop", "MB1", DEV, scale("X", "Y", "Z", by=1e3), None,
                                    ["in um"]),
+    # ---- NaN / infinity / 1e300 in every reader's reading column
+    "ballbar_reading_1e300": ("calibrate", "MB1", BB, setv("dr_um", "1e300"), 9,
+                              ["dr_um", "implausibly large"]),
+    "distances_reading_inf": ("calibrate", "DMU50", ML, setv("dd_mm", "-inf"), 4,
+                              ["dd_mm", "NaN or infinite"]),
+    "plate_measured_nan": ("calibrate", "MB1", BP, setv("y_mm", "nan"), 6,
+                           ["y_mm", "NaN or infinite"]),
+    "deviations_reading_1e300": ("loop", "MB1", DEV, setv("dz_um", "1e300"), 2,
+                                 ["dz_um", "implausibly large"]),
     # ---- drift (ISO 230-3 spindle test) through the loop
     "drift_channel_1e300": ("loop", "MB1", DRIFT, setv("d_x1_um", "1e300"), 5,
                             ["d_x1_um", "implausibly large"]),
