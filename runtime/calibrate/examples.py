@@ -53,9 +53,10 @@ def write_ballbar_example(folder, layout: str = "MB1", noise_um: float = 0.3) ->
 def write_sphere_example(path, layout: str = "DMU50", noise_um: float = 0.5,
                          seed: int = 3) -> dict:
     """A touch-probe kinematics plan on ``layout``: two sphere placements, the rotary axes over
-    their travel, a 120 mm probe; planted location errors :data:`SPHERE_TRUTH` (those the
-    layout has), unknown true sphere centres (a few um off), noise.  Returns ``{"path",
-    "truth": {name: um or urad}, "n"}``."""
+    their travel, the tool offset (0, 0, +120) mm (the tool point 120 mm from the reference
+    point towards the spindle, docs/conventions.md); planted location errors
+    :data:`SPHERE_TRUTH` (those the layout has), unknown true sphere centres (a few um off),
+    noise.  Returns ``{"path", "truth": {name: um or urad}, "n"}``."""
     from ..instruments import sphere
     from ..machine.model import load
 

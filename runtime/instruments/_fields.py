@@ -34,6 +34,22 @@ def drop_nonfinite(cols: dict, text: dict, where: str) -> tuple[dict, dict]:
     return cols, text
 
 
+def require_finite(values, column: str, where: str) -> None:
+    """Refuse (one line naming the column and row) NaN, infinity and magnitudes above
+    :data:`volerr.fileio.MAX_ABS` in a column the reader computes with (before any
+    computation: squares of 1e300 overflow)."""
+    from ..fileio import MAX_ABS
+
+    v = np.asarray(values, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(v))
+    require(len(bad) == 0, f"{where}: column {column} row {bad[0] + 2 if len(bad) else 0} is "
+                           f"NaN or infinite")
+    big = np.flatnonzero(np.abs(v) > MAX_ABS)
+    require(len(big) == 0, f"{where}: column {column} row {big[0] + 2 if len(big) else 0} = "
+            f"{v[big[0]] if len(big) else 0:g} is implausibly large (more than {MAX_ABS:g} in "
+            f"the file's unit)")
+
+
 def refuse_duplicate_rows(columns, where: str) -> None:
     """Refuse a file in which a row repeats an earlier one in every cell (a file or a block
     pasted twice: real readings never agree to the last digit in every column, and a copied
@@ -135,8 +151,13 @@ def positions(find: Finder, model, where: str, min_points: int = 1,
         lo, hi = model.travel[a]
         margin = 0.05 * (hi - lo)
         bad = np.flatnonzero((v < lo - margin) | (v > hi + margin))
-        require(len(bad) == 0, f"{where}: {a} = {v[bad[0]] if len(bad) else 0:g} lies outside "
-                f"the travel [{lo:g}, {hi:g}] of layout {model.name}: layout mismatch")
+        if len(bad):
+            from .geometry_check import travel_cause
+
+            cause = travel_cause(model, out)
+            require(False, f"{where}: {a} = {v[bad[0]]:g} lies outside the travel "
+                    f"[{lo:g}, {hi:g}] of layout {model.name}: "
+                    + (f"likely {cause}" if cause else "layout mismatch"))
     return out
 
 

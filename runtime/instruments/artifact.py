@@ -120,16 +120,10 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     pos = _hold_still_axes(pos, gidx, lin_axes)
     R0 = np.zeros((n, 3, 3))
     origin = np.zeros((n, 3))
+    check_geometry(model, names[gidx], point, t, where)
     for g, name in enumerate(names):
         m = gidx == g
-        R, o = rigid_fit(point[m], t[m])
-        fit = t[m] - (point[m] @ R.T + o)
-        worst = float(np.max(np.linalg.norm(fit, axis=1)))
-        require(worst <= FIT_TOLERANCE_MM, f"{where}: placement {name}: a measured point lies "
-                f"{worst:.3f} mm from its calibrated point in the best-fitting pose: the "
-                f"calibrated coordinates and the measured points disagree (mm vs um, a wrong "
-                f"ball label?)")
-        R0[m], origin[m] = R, o
+        R0[m], origin[m] = rigid_fit(point[m], t[m])
     lin = generated.artifact(t[:, 0], t[:, 1], t[:, 2], origin[:, 0], origin[:, 1],
                              origin[:, 2], *[R0[:, i, j] for i in range(3) for j in range(3)],
                              point[:, 0], point[:, 1], point[:, 2])      # (3, 13, n)
@@ -145,6 +139,29 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, -lin[:, :, 0], covs, warnings, proj=lin[:, :, 1:4],
                         rows=rows, setup=setup, files=(FileInfo(where, KIND, "um", 3),),
                         sigma=u, info=info)
+
+
+def check_geometry(model, placement, point, measured, where) -> None:
+    """The calibrated coordinates fit the measured points of each placement by a rigid pose
+    within :data:`FIT_TOLERANCE_MM` (:func:`volerr.instruments.geometry_check.artifact_misfit`);
+    a miss is refused naming the likely cause (calibrated coordinates in um or inches, the
+    measured points in inches, their columns swapped)."""
+    from . import geometry_check as gc
+
+    targets = {"the measured points": measured, "the calibrated coordinates": point}
+    extra = [("the calibrated coordinates in um (/ 1000 makes the file consistent)",
+              "u_mm, v_mm, w_mm", {"the calibrated coordinates": point * 1e-3})]
+    for i, j in ((0, 1), (1, 2), (0, 2)):
+        swap = point.copy()
+        swap[:, [i, j]] = swap[:, [j, i]]
+        extra.append((f"columns {'uvw'[i]}_mm and {'uvw'[j]}_mm swapped (a wrong ball "
+                      f"numbering?)", f"{'uvw'[i]}_mm, {'uvw'[j]}_mm",
+                      {"the calibrated coordinates": swap}))
+    gc.require_consistent(where, model, gc.Geometry(
+        {}, np.zeros((len(point), 3)), targets,
+        {"the measured points": "x_mm, y_mm, z_mm",
+         "the calibrated coordinates": "u_mm, v_mm, w_mm"},
+        gc.artifact_misfit(placement, rigid_fit, FIT_TOLERANCE_MM)), extra=extra)
 
 
 def _hold_still_axes(pos: dict, gidx, axes) -> dict:

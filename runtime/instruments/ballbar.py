@@ -51,6 +51,9 @@ DEFAULT_U_UM = 0.5
 #: positions disagree
 RADIUS_TOLERANCE_MM = 0.5
 SETUP_KEYS = tuple(generated.SETUP[KIND])
+#: the shortest bar accepted, mm (telescoping ballbars are 50 mm and longer; a file whose
+#: lengths are all in inches gives 150 mm as 5.9)
+MIN_LENGTH_MM = 25.0
 
 
 def detect(names) -> bool:
@@ -83,21 +86,20 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     pivot = f.vector(find, ("pivot_x", "pivot_y", "pivot_z"), "pivot ball centre", where)
     length = f.vector(find, ("length",), "nominal bar length", where, units=("_mm",))[:, 0]
     require(np.all(length > 0), f"{where}: length_mm must be positive")
+    require(float(np.min(length)) >= MIN_LENGTH_MM, f"{where}: column length_mm: "
+            f"{float(np.min(length)):g} mm is shorter than any ballbar ({MIN_LENGTH_MM:g} mm "
+            f"and longer): likely every length in inches (x 25.4), or cm")
     dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading")[:, 0]
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
     # a bar calibrated with its calibrator: its length offset known to within length_u_um
     length_u = f.known_uncertainty(find, "length_u", where)
     direction, direction_given = _direction(find, n, where)
     placement = f.labels(find, "placement", raw, n)
+    check_geometry(model, pos, probe, pivot, length, dr, where)
     t = model.nominal_position(pos, probe)
     lin = generated.ballbar(t[:, 0], t[:, 1], t[:, 2], pivot[:, 0], pivot[:, 1], pivot[:, 2],
                             length)[0]                       # (8, n)
     off = lin[0]
-    bad = np.flatnonzero(np.abs(off) > RADIUS_TOLERANCE_MM)
-    require(len(bad) == 0, f"{where}: row {bad[0] + 2 if len(bad) else 0}: the tool ball is "
-            f"{float(np.linalg.norm(t[bad[0]] - pivot[bad[0]])) if len(bad) else 0:.4f} mm "
-            f"from the pivot, length_mm is {float(length[bad[0]]) if len(bad) else 0:g}: "
-            f"the bar length and the positions disagree")
     swept = np.zeros(n, bool)
     for a in model.rotary_axes:
         swept |= np.ptp(pos[a]) > 1.0
@@ -122,6 +124,23 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
                         setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u,
                         info=info)
+
+
+def check_geometry(model, pos, probe, pivot, length, dr, where) -> None:
+    """The tool ball lies the bar length from the pivot at every row, within
+    :data:`RADIUS_TOLERANCE_MM` (:func:`volerr.instruments.geometry_check.ballbar_misfit`); a
+    miss is refused naming the likely cause (radians, inches, the offset's sign, swapped
+    columns, another layout, a diameter given for the bar length)."""
+    from . import geometry_check as gc
+
+    gc.require_consistent(where, model, gc.Geometry(
+        pos, probe, {"the pivot": pivot, "the bar length": length},
+        {"the pivot": "pivot_x, pivot_y, pivot_z", "the bar length": "length_mm"},
+        gc.ballbar_misfit(dr, RADIUS_TOLERANCE_MM)),
+        extra=[("twice the bar length in length_mm (a diameter for the radius?)", "length_mm",
+                {"the bar length": length / 2.0}),
+               ("half the bar length in length_mm (x 2 makes the file consistent)", "length_mm",
+                {"the bar length": length * 2.0})])
 
 
 def _direction(find, n: int, where: str) -> tuple[np.ndarray, bool]:

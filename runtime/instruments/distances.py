@@ -94,6 +94,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     if any(find.name(c) for c in ("station_x", "station_y", "station_z")):
         start = f.vector(find, ("station_x", "station_y", "station_z"),
                          "nominal station position", where)
+    check_geometry(model, pos, probe, station, d, h_abs or h_rel, start, where)
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(station.astype(str), return_inverse=True)
     gidx = gidx.ravel()
@@ -128,6 +129,28 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, dev, covs, warnings, proj=proj, rows=np.ones(n, int),
                         setup=setup, files=(FileInfo(where, KIND, "um", 1),), sigma=u,
                         info=info)
+
+
+def check_geometry(model, pos, probe, station, d, column, start, where) -> None:
+    """The distances fit the commanded tool points from one station each, within
+    :data:`FIT_TOLERANCE_MM` RMS (:func:`volerr.instruments.geometry_check.distances_misfit`;
+    with ``station_x ...`` given the station's own refit below still applies); a miss is
+    refused naming the likely cause (radians, inches, the offset's sign, swapped columns,
+    another layout, distances in m)."""
+    from . import geometry_check as gc
+
+    names = np.asarray(station).astype(str)
+    for name in np.unique(names):
+        require((names == name).sum() >= 8, f"{where}: station {name} has "
+                f"{int((names == name).sum())} readings; multilateration needs at least 8 per "
+                f"station")
+    if start is not None:
+        return
+    gc.require_consistent(where, model, gc.Geometry(
+        pos, probe, {"the distances": d}, {"the distances": column},
+        gc.distances_misfit(names, locate, FIT_TOLERANCE_MM)),
+        extra=[("distances in m (x 1000 makes the file consistent)", column,
+                {"the distances": d * 1000.0})])
 
 
 def _uncertainty(find, dist, where) -> np.ndarray:

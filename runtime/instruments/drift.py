@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import InputError, require
 from . import _drift_logger as logger
+from . import _fields as f
 from ._csv import Columns, read_columns, read_header
 from .observations import FileInfo, Observations, Setup
 
@@ -47,6 +48,9 @@ KIND = "drift"
 DIRECTIONS = {"X": (1, 0, 0), "Y": (0, 1, 0), "Z": (0, 0, 1), "-X": (-1, 0, 0),
               "-Y": (0, -1, 0), "-Z": (0, 0, -1), "?": None}
 TIME_COLUMNS = ("t_s", "t_min", "t_h")
+#: the largest drift reading accepted, um (10 mm: beyond the range of the displacement
+#: sensors of a thermal test -- capacitive and inductive probes read a few mm at most)
+MAX_CHANNEL_UM = 10000.0
 POSITION_AXES = "XYZUVWABC"
 #: a channel header line: ``# channel d_ch1: X at z=120`` (``d_`` and ``_um`` optional)
 _CHANNEL_LINE = re.compile(r"^#\s*channel\s+(\S+?)\s*:\s*(.*?)\s*$", re.IGNORECASE)
@@ -190,10 +194,7 @@ def _column_defects(c: Columns, needed) -> None:
             blank = next((i for i, s in enumerate(cells) if not s.strip()), None)
             require(blank is None, f"{where}: column {h} row {(blank or 0) + 2} is empty")
             raise InputError(c.text[h] or f"{where}: column {h} is not numeric")
-        v = c.numbers[h]
-        bad = np.flatnonzero(~np.isfinite(v))
-        require(len(bad) == 0, f"{where}: column {h} row {bad[0] + 2 if len(bad) else 0} is NaN "
-                               f"or infinite")
+        f.require_finite(c.numbers[h], h, where)
 
 
 def _time(c: Columns) -> tuple[str, np.ndarray]:
@@ -244,6 +245,12 @@ def _channels(c: Columns, heads: dict) -> list:
     require(not extra, f"{where}: header line for channel d_{extra[0] if extra else ''} but "
                        f"no column d_{extra[0] if extra else ''}_um")
     _column_defects(c, names)
+    for h in names:
+        big = np.flatnonzero(np.abs(c.numbers[h]) > MAX_CHANNEL_UM)
+        require(len(big) == 0, f"{where}: column {h} row {big[0] + 2 if len(big) else 0} = "
+                f"{c.numbers[h][big[0]] if len(big) else 0:g} um is beyond what a displacement "
+                f"sensor reads ({MAX_CHANNEL_UM / 1000:g} mm): likely nm headed um, or a wrong "
+                f"unit")
     return names
 
 

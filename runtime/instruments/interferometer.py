@@ -46,6 +46,7 @@ import numpy as np
 from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
+from . import _fields as f
 from .observations import FileInfo, Observations, Setup
 
 KIND = "interferometer"
@@ -196,6 +197,8 @@ def _readings(path, axis, mode, where):
     require(len(hits) == 1, f"{where}: a {mode} run needs one reading column "
             f"({' or '.join(unit)}; long format target_mm,cycle,direction,"
             f"{next(iter(unit))})")
+    f.require_finite(c.numbers[hits[0]], hits[0], where)
+    f.require_finite(targets, _target_column(c, names, where)[1], where)
     dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
     hd = next(h for h in names if h.lower() in _DIRECTION)
     direction = _directions(c, hd, where)
@@ -259,6 +262,28 @@ def _unit(v, what, where) -> np.ndarray:
     return np.asarray(v, float) / n
 
 
+#: the largest angle (deg) between a declared beam and the axis' nominal motion: a laser aligned
+#: to the axis is within a fraction of a degree of it
+MAX_BEAM_ANGLE_DEG = 5.0
+
+
+def _travel_cause(model: Model, axis: str, targets) -> str:
+    """The likely cause of targets outside the axis' travel: um for mm, the run of another
+    linear axis (the axis header), else a layout mismatch."""
+    def inside(a, v):
+        lo, hi = model.travel[a]
+        return bool(np.all((v >= lo - 1e-9) & (v <= hi + 1e-9)))
+
+    lo, hi = model.travel[axis]
+    if inside(axis, targets * 1e-3) and np.ptp(targets) * 1e-3 >= 0.1 * (hi - lo):
+        return "likely targets in um, not mm"
+    others = [a for a in model.axes if a not in model.rotary_axes and a != axis
+              and inside(a, targets)]
+    if others:
+        return f"likely the run of axis {others[0]} (the header '# axis:' wrong)"
+    return "layout mismatch"
+
+
 def observations(model: Model, line: Line, targets, deviation, direction, where: str,
                  cycle=None, covariates=None) -> Observations:
     """Readings of a run as :class:`Observations`: ``targets`` (n,) positions of the moving
@@ -270,8 +295,8 @@ def observations(model: Model, line: Line, targets, deviation, direction, where:
     margin = 0.05 * (hi - lo)
     bad = np.flatnonzero((targets < lo - margin) | (targets > hi + margin))
     require(len(bad) == 0, f"{where}: target {targets[bad[0]] if len(bad) else 0:g} lies "
-            f"outside the travel [{lo:g}, {hi:g}] of {line.axis} on {model.name}: layout "
-            f"mismatch")
+            f"outside the travel [{lo:g}, {hi:g}] of {line.axis} on {model.name}: "
+            f"{_travel_cause(model, line.axis, targets)}")
     require(np.ptp(targets) > 0, f"{where}: all targets are equal: not a run along a line")
     pos = {a: (targets.copy() if a == line.axis else np.full(n, float(line.at[a])))
            for a in model.axes}
@@ -282,6 +307,10 @@ def observations(model: Model, line: Line, targets, deviation, direction, where:
     te = model.nominal_position(ends, line.optics)
     motion = _unit(te[1] - te[0], "the direction of motion", where)
     beam = motion if line.beam is None else _unit(line.beam, "beam", where)
+    angle = float(np.degrees(np.arccos(min(1.0, abs(float(beam @ motion))))))
+    require(angle <= MAX_BEAM_ANGLE_DEG, f"{where}: header beam: the beam is {angle:.3g} deg "
+            f"from the motion of {line.axis} (at most {MAX_BEAM_ANGLE_DEG:g}): likely the beam "
+            f"of another axis (swapped components) or the wrong axis header")
     ref = t[int(np.argmin(targets))]
     first = float(np.min(targets))
     rows = np.ones(n, int)

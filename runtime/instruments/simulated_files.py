@@ -15,7 +15,8 @@ Geometry (workpiece frame, mm):
 
 * sphere: spheres at :func:`default_centres` (or given), the rotary axes over their travel
   (at most 320 deg) in ``steps`` equal steps each, every combination; a probe of ``tool``
-  (default 0, 0, 120 mm); poses outside the travel are left out; every placement's true
+  (default 0, 0, -120 mm: a 120 mm probe below the reference point, docs/conventions.md);
+  poses outside the travel are left out; every placement's true
   centre is off its nominal one by a few um (seeded), as a real sphere's is;
 * ballbar: three ISO 230-4 circles (XY, YZ, ZX) about the nominal tool point at the middle
   of the travel (rotary axes at 0), both directions, 180 readings per direction, in one file
@@ -37,6 +38,9 @@ DEFAULT_PLANTED = {
                 "EYY@slope": -0.005, "EZZ@slope": 0.010},
 }
 INSTRUMENTS = ("deviations", "sphere", "ballbar")
+#: the tool offset of simulated sphere files, mm: a 120 mm probe hanging below the reference
+#: point (tool frame, +z towards the spindle: docs/conventions.md)
+PROBE = (0.0, 0.0, -120.0)
 #: readings per direction of a simulated ballbar circle
 BALLBAR_POINTS = 180
 
@@ -106,15 +110,16 @@ def _middle(model) -> np.ndarray:
 
 def default_centres(model) -> list:
     """Two sphere centres (workpiece frame, mm): the nominal tool point at the middle of the
-    travel with a 120 mm probe, and one 20 % of the travel away in X and Y (sphere test
+    travel with the tool offset (0, 0, -120) mm (a 120 mm probe below the reference point,
+    docs/conventions.md), and one 20 % of the travel away in X and Y (sphere test
     plans use two or more placements: one alone cannot tell a location error from the
     sphere's own position)."""
-    mid = model.nominal_position(_middle(model), (0.0, 0.0, 120.0))[0]
+    mid = model.nominal_position(_middle(model), PROBE)[0]
     span = [model.travel[a][1] - model.travel[a][0] for a in model.axes[:2]]
     return [tuple(mid), (mid[0] + 0.2 * span[0], mid[1] + 0.2 * span[1], mid[2])]
 
 
-def sphere_columns(model, funcs, centres=None, steps: int = 9, tool=(0.0, 0.0, 120.0),
+def sphere_columns(model, funcs, centres=None, steps: int = 9, tool=PROBE,
                    noise_um: float = 0.3, seed: int = 0) -> dict:
     """Columns of a sphere file (frame work) of the model with the errors ``funcs``."""
     from . import sphere

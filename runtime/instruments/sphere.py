@@ -76,6 +76,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     frame = _frames(find, raw, n, where)
     # a tool measured on a presetter or a tool setter: its length error known to within it
     tool_u = f.known_uncertainty(find, "tool_u", where)
+    check_geometry(model, pos, probe, centre, reading, placement, frame, where)
     t = model.nominal_position(pos, probe)
     lin = generated.sphere(t[:, 0], t[:, 1], t[:, 2], centre[:, 0], centre[:, 1],
                            centre[:, 2])                   # (3, 7, n)
@@ -100,6 +101,18 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, reading - nominal, covs, warnings, proj=proj,
                         setup=setup, files=(FileInfo(where, KIND, "um", 3),), sigma=u,
                         info={"centre": centre, "placement": placement, "frame": frame})
+
+
+def check_geometry(model, pos, probe, centre, reading, placement, frame, where) -> None:
+    """The commanded tool point meets each placement's sphere centre
+    (:func:`volerr.instruments.geometry_check.sphere_misfit`); a miss is refused naming the
+    likely cause (radians, inches, the offset's sign, swapped columns, another layout)."""
+    from . import geometry_check as gc
+
+    misfit = gc.sphere_misfit(placement, reading, np.asarray(frame) == "machine")
+    gc.require_consistent(where, model, gc.Geometry(
+        pos, probe, {"the sphere centre": centre},
+        {"the sphere centre": "sphere_x, sphere_y, sphere_z"}, misfit))
 
 
 def _frames(find, raw: dict, n: int, where: str) -> np.ndarray:
