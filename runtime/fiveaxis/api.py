@@ -183,3 +183,131 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
         raise
     return Compensation(res.data, res.lines, res.notes, res.corrections, None, [], *axes,
                         sink.program_errors() if keep_errors else None)
+
+
+@dataclass(frozen=True, repr=False)
+class ToolTipMap(ResultMixin):
+    """Result of :func:`tcpmap`: ``map`` the :class:`volerr.fiveaxis.tcpmap.TcpMap` (grid,
+    axis positions, tool-tip error in mm, workpiece frame, actual minus nominal), ``data``
+    its summary (:meth:`to_dict`: tool-tip error |e| max / min / rms over the valid grid
+    points, um), ``lines`` / ``notes`` what ``volerr tcpmap`` prints on stdout / stderr."""
+
+    map: object
+    data: dict
+    lines: tuple
+    notes: tuple
+
+    def summary(self) -> str:
+        """The text ``volerr tcpmap`` prints on stdout."""
+        return "\n".join(self.lines)
+
+    def _rows(self) -> list:
+        s = self.data
+        return [Row("max_error", s["max_um"], None, "um"),
+                Row("min_error", s["min_um"], None, "um"),
+                Row("rms_error", s["rms_um"], None, "um"),
+                Row("valid_points", float(s["valid_points"]), None, "points")]
+
+    def csv_text(self) -> str:
+        """The ``--csv`` grid: ``<R1>_deg,<R2>_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um``, one
+        row per grid point, empty error cells where invalid."""
+        import numpy as np
+
+        t = self.map
+        g1, g2 = np.meshgrid(t.q1, t.q2)
+        lin = t.linear.reshape(-1, 3)
+        e = t.err.reshape(-1, 3) * 1e3
+        m = np.linalg.norm(t.err, axis=2).ravel() * 1e3
+        rows = [f"{t.axis1}_deg,{t.axis2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
+        for i in range(g1.size):
+            cells = [f"{g1.ravel()[i]:.10g}", f"{g2.ravel()[i]:.10g}"] + \
+                [f"{lin[i, k]:.10g}" for k in range(3)]
+            cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
+            rows.append(",".join(cells))
+        return "\n".join(rows) + "\n"
+
+    def write_plot(self, path) -> Path:
+        """The map as PNG (:func:`volerr.fiveaxis.plots.plot_tcp_error_map`)."""
+        from .plots import plot_tcp_error_map
+
+        return plot_tcp_error_map(self.map, path)
+
+    def __repr__(self) -> str:
+        s = self.data
+        return (f"<volerr ToolTipMap: {s['layout']} at {tuple(s['point_mm'])} mm, max "
+                f"{s['max_um']:.3f} um>")
+
+
+def tcpmap(layout, errors, point, *, tool=(0.0, 0.0, 0.0), steps: int = 73, approach=None,
+           method: str = "linear", degree=None, extrapolate: bool = False, plot_name=None,
+           progress=None) -> ToolTipMap:
+    """Tool-tip error of a five-axis machine over the range of its two rotary axes for one
+    workpiece point (``volerr tcpmap``).
+
+    Parameters
+    ----------
+    layout : str or path
+        Five-axis layout name or file.
+    errors : str or path
+        Error directory.
+    point : (3,) mm
+        The workpiece point (workpiece frame); at every pair of rotary positions the linear
+        axes follow the nominal inverse that keeps the tool tip on it.
+    tool : (3,) mm
+        Tool offset in the tool frame (a tool L long: ``(0, 0, -L)``).
+    steps : int
+        Grid steps per rotary axis, 3 .. 1000.
+    approach : str or dict, optional
+        Approach directions of axes whose tables carry a reversal: ``'X+,Y-'``, ``'+'``,
+        ``'-'``, ``'sweep'`` or ``{axis: +1 | -1}`` (default: the bidirectional mean).
+    method, degree, extrapolate
+        Error functions from the tables (as ``--method`` ``--degree`` ``--extrapolate``).
+    plot_name : str, optional
+        The name of the written plot the summary line gives ("; wrote NAME").
+    progress : callable, optional
+        ``progress(n_points)`` block by block.
+
+    Returns
+    -------
+    ToolTipMap
+        ``map`` the grid and errors (mm), ``summary()`` the console line, ``table()`` the
+        error's max / min / rms (um), ``csv_text()``, ``write_plot(path)``.
+    """
+    import numpy as np
+
+    from ..errors import require
+    from ..machine.model import load
+    from ..tables.functions import parse_approach
+    from .compensate import error_functions
+    from .tcpmap import tcp_map
+
+    model = load(layout)
+    require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")
+    require(all(math.isfinite(float(v)) for v in (*point, *tool)), "point/tool must be finite")
+    require(3 <= steps <= 1000, "--steps must be 3..1000")
+    require(not Path(errors).is_file(), f"{errors} is a file, not an error "
+                                        f"directory (the folder holding X.csv ...)")
+    require(Path(errors).is_dir(), f"error directory not found: {errors}")
+    funcs, notes = error_functions(errors, model, method, degree, extrapolate)
+    if approach != "sweep" and not isinstance(approach, dict):
+        approach = parse_approach(approach, model, funcs)
+    tmap = tcp_map(model, funcs, point, tool, steps, steps, approach=approach,
+                   progress=progress)
+    require(tmap.valid.any(), f"{model.name}: the point is outside the travel or the error "
+                              "tables for every rotary position")
+    mag = np.linalg.norm(tmap.err, axis=2) * 1e3
+    ok = mag[tmap.valid]
+    data = {"layout": model.name, "point_mm": [float(v) for v in point],
+            "tool_mm": [float(v) + 0.0 for v in tool], "axes": [tmap.axis1, tmap.axis2],
+            "range_deg": [[float(tmap.q1[0]), float(tmap.q1[-1])],
+                          [float(tmap.q2[0]), float(tmap.q2[-1])]],
+            "max_um": float(np.nanmax(mag)), "min_um": float(np.nanmin(mag)),
+            "rms_um": float(np.sqrt(np.mean(ok ** 2))), "valid_points": int(tmap.valid.sum()),
+            "grid_points": int(tmap.valid.size)}
+    q1, q2 = tmap.q1, tmap.q2
+    line = (f"{model.name}: tool-tip error at ({', '.join(f'{v:g}' for v in point)}) mm over "
+            f"{tmap.axis1} {q1[0]:g}..{q1[-1]:g} deg, {tmap.axis2} {q2[0]:g}..{q2[-1]:g} deg: "
+            f"max {data['max_um']:.3f} um, min {data['min_um']:.3f} um "
+            f"({data['valid_points']} of {data['grid_points']} grid points valid)"
+            f"{'; wrote ' + str(plot_name) if plot_name is not None else ''}")
+    return ToolTipMap(tmap, data, (line,), tuple(f"note: {n}" for n in notes))

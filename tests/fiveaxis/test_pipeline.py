@@ -202,3 +202,26 @@ def test_result_contract(head):
     assert len(res.table()) == len(rows)
     r = repr(res)
     assert "\n" not in r and len(r) < 120 and r.startswith("<volerr Compensation: HH_BC")
+
+
+def test_tcpmap_command_is_the_api(dmu, tmp_path):
+    """``volerr tcpmap`` prints and writes what ``volerr.fiveaxis.api.tcpmap`` holds; the
+    table's max / rms computed here from the map's errors."""
+    from volerr.fiveaxis.api import tcpmap
+
+    png, grid = tmp_path / "m.png", tmp_path / "m.csv"
+    code, so, se = main_("tcpmap", "DMU50", "--errors", dmu["errors"], "--point", "30", "20",
+                         "60", "--tool", "0", "0", "-40", "--steps", "9", "--plot", png,
+                         "--csv", grid)
+    assert code == 0, se
+    res = tcpmap("DMU50", dmu["errors"], (30, 20, 60), tool=(0, 0, -40), steps=9,
+                 plot_name=png)
+    assert so.strip() == res.summary()
+    assert grid.read_text() == res.csv_text()
+    e = np.linalg.norm(res.map.err, axis=2)[res.map.valid] * 1e3
+    rows = {r.name: r for r in res._rows()}
+    assert rows["max_error"].value == pytest.approx(e.max(), rel=1e-12)
+    assert rows["rms_error"].value == pytest.approx(np.sqrt(np.mean(e ** 2)), rel=1e-12)
+    assert rows["valid_points"].value == 81 and rows["max_error"].unit == "um"
+    assert res.to_dict()["tool_mm"] == [0.0, 0.0, -40.0]
+    assert "\n" not in repr(res) and len(repr(res)) < 120
