@@ -144,12 +144,23 @@ def _tool_table(tool_table):
         return read_tool_table(tool_table), Path(tool_table)
     out = {}
     for k, v in tool_table.items():
-        length = float(v)
-        require(math.isfinite(length) and 0 <= length <= 2000,
+        number, length = _number(k, f"tool table: tool {k!r}"), _number(v, f"tool table: "
+                                                                          f"tool {k}: length")
+        require(0 <= length <= 2000,
                 f"tool table: tool {k}: length {v!r} is not plausible (0 .. 2000 mm)")
-        out[k] = length
+        out[int(number) if number.is_integer() else number] = length   # as the CSV's keys
     require(out, "tool table: no tools in the tool table")
     return out, None
+
+
+def _number(value, what: str) -> float:
+    """``value`` as a finite float, else :class:`InputError` naming ``what``."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{what}: {value!r} is not a number") from None
+    require(math.isfinite(v), f"{what}: {value!r} is not finite")
+    return v
 
 
 def _types(types):
@@ -180,6 +191,8 @@ def prepare(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
     opener, name, path = _program_source(program)
     table, table_path = _tool_table(tool_table)
     types = _types(types)
+    if tool_length is not None:
+        tool_length = _number(tool_length, "--tool-length")
     opts = Options(tuple(tool), orientation, strategy, tol_um, decimals, _initial(initial),
                    check_travel, 50, types, arc_tol_um, tool_length, table, dialect,
                    None).validated(model)

@@ -225,3 +225,17 @@ def test_tcpmap_command_is_the_api(dmu, tmp_path):
     assert rows["valid_points"].value == 81 and rows["max_error"].unit == "um"
     assert res.to_dict()["tool_mm"] == [0.0, 0.0, -40.0]
     assert "\n" not in repr(res) and len(repr(res)) < 120
+
+
+def test_api_tool_table_as_a_dict_or_a_file(dmu, tmp_path):
+    """The tool table is available to the API, as the CSV the command reads or as a dict
+    (keys as the tool numbers of the program's H / T / D words)."""
+    text = "G90 G17\nT1 M6\nG43.4 H1\nG1 X10 Y20 Z60 B20 C30\nG1 X12 Y18 Z61 B25 C40\nG49\n"
+    (tmp_path / "tools.csv").write_text("tool,length_mm\n1,120\n")
+    a = volerr.compensate("DMU50", text, dmu["errors"], tool_table=tmp_path / "tools.csv")
+    b = volerr.compensate("DMU50", text, dmu["errors"], tool_table={"1": 120})
+    c = volerr.compensate("DMU50", text, dmu["errors"], tool_length=120)
+    assert a.text == b.text == c.text != text
+    assert a.to_dict()["tcpm_blocks"] == 2
+    with pytest.raises(InputError, match="tool table: tool 1: length: 'long' is not a number"):
+        volerr.compensate("DMU50", text, dmu["errors"], tool_table={1: "long"})
