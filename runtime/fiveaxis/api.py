@@ -59,6 +59,17 @@ class Compensation(ResultMixin):
         """The text ``volerr compensate`` prints on stdout."""
         return "\n".join(self.lines)
 
+    def figures(self) -> dict:
+        """``{"program_errors": Figure}``: the predicted tool-tip and tool-axis errors per
+        block before and after (what ``--plot`` draws); none when the program was streamed
+        into a file without ``keep_errors``."""
+        from .plots import program_errors_figure
+
+        if self.errors is None and self.text is None:
+            return {}
+        return {"program_errors": program_errors_figure(self.program_errors(),
+                                                        f"{self.data['layout']}: program")}
+
     def write_program(self, path, inputs=()) -> Path:
         """Write the compensated program, the bytes ``volerr compensate --out`` writes
         (latin-1, line endings as read); never over an input."""
@@ -225,6 +236,12 @@ class ToolTipMap(ResultMixin):
             cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
             rows.append(",".join(cells))
         return "\n".join(rows) + "\n"
+
+    def figures(self) -> dict:
+        """``{"map": Figure}``: the map ``--plot`` draws."""
+        from .plots import tcp_error_map_figure
+
+        return {"map": tcp_error_map_figure(self.map)}
 
     def write_plot(self, path) -> Path:
         """The map as PNG (:func:`volerr.fiveaxis.plots.plot_tcp_error_map`)."""

@@ -19,6 +19,17 @@ from ..plotstyle import figure, label, save, styled
 def plot_tcp_error_map(tmap, path, title: str = ""):
     """PNG of a :class:`volerr.fiveaxis.tcpmap.TcpMap`: length of the tool-tip error (colour,
     µm), its components and the tool-axis error (µrad)."""
+    save(_tcp_error_map(tmap, title), path)
+    return path
+
+
+@styled
+def tcp_error_map_figure(tmap, title: str = ""):
+    """The figure of :func:`plot_tcp_error_map` (matplotlib, not saved)."""
+    return _tcp_error_map(tmap, title)
+
+
+def _tcp_error_map(tmap, title: str = ""):
     a1, a2, q1, q2, err = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err
     mag = np.linalg.norm(err, axis=2) * 1e3
     fig, grid = figure(2, 3, height=6.6)
@@ -46,8 +57,7 @@ def plot_tcp_error_map(tmap, path, title: str = ""):
     fig.suptitle(title or f"{tmap.model_name}: tool-tip error at workpiece point "
                           f"({p[0]:g}, {p[1]:g}, {p[2]:g}) mm over {a1}, {a2}\n"
                           f"(grey: outside travel or error tables)")
-    save(fig, path)
-    return path
+    return fig
 
 
 @styled
@@ -56,6 +66,17 @@ def plot_program_errors(errors, path, title: str = ""):
     block, before and after compensation.  ``errors``: a
     :class:`volerr.fiveaxis.program.ProgramErrors` (or the line reports of a
     :class:`volerr.fiveaxis.compensate.Result`)."""
+    save(_program_errors(errors, title), path)
+    return path
+
+
+@styled
+def program_errors_figure(errors, title: str = ""):
+    """The figure of :func:`plot_program_errors` (matplotlib, not saved)."""
+    return _program_errors(errors, title)
+
+
+def _program_errors(errors, title: str = ""):
     from .program import ProgramErrors
 
     if not isinstance(errors, ProgramErrors):
@@ -81,5 +102,4 @@ def plot_program_errors(errors, path, title: str = ""):
                       "coincide", color="0.3")
     ax2.legend(loc="best")
     fig.suptitle(title or "predicted error along the program")
-    save(fig, path)
-    return path
+    return fig

@@ -239,3 +239,15 @@ def test_api_tool_table_as_a_dict_or_a_file(dmu, tmp_path):
     assert a.to_dict()["tcpm_blocks"] == 2
     with pytest.raises(InputError, match="tool table: tool 1: length: 'long' is not a number"):
         volerr.compensate("DMU50", text, dmu["errors"], tool_table={1: "long"})
+
+
+def test_figures_are_the_plots(dmu):
+    from volerr.fiveaxis.api import tcpmap
+
+    res = volerr.compensate("DMU50", dmu["lf"], dmu["errors"])
+    fig = res.figures()["program_errors"]
+    before = fig.axes[0].lines[0].get_ydata()
+    want = [np.linalg.norm(b.before_um) for b in res.blocks]
+    assert np.allclose(before, np.maximum(want, 1e-4), rtol=1e-12)
+    m = tcpmap("DMU50", dmu["errors"], (30, 20, 60), steps=5).figures()["map"]
+    assert len(m.axes) >= 5
