@@ -49,9 +49,9 @@ def register(sub) -> None:
                         "L-STR L-SQU L-ANG R-POS R-RAX R-POR R-ANG, or L-VOL R-VOL (default: "
                         "all); the report still predicts the full model's error")
     add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
-               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z), beyond "
-                    "the point the axis positions refer to (0 0 0: the program positions the "
-                    "tip)")
+               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z), from "
+                    "the point the axis positions refer to to the tool tip (0 0 0: the "
+                    "program positions the tip; a tool L long: 0 0 -L, as --tool-length L)")
     p.add_argument("--tol-um", type=float, default=0.1,
                    help="stop iterating when the correction changes by less than this (um)")
     p.add_argument("--decimals", type=int, default=4,
