@@ -63,12 +63,12 @@ class Compensation(ResultMixin):
         """``{"program_errors": Figure}``: the predicted tool-tip and tool-axis errors per
         block before and after (what ``--plot`` draws); none when the program was streamed
         into a file without ``keep_errors``."""
-        from .plots import program_errors_figure
+        from .plots import draw_program_errors, unsaved
 
         if self.errors is None and self.text is None:
             return {}
-        return {"program_errors": program_errors_figure(self.program_errors(),
-                                                        f"{self.data['layout']}: program")}
+        return {"program_errors": unsaved(draw_program_errors, self.program_errors(),
+                                          f"{self.data['layout']}: program")}
 
     def write_program(self, path, inputs=()) -> Path:
         """Write the compensated program, the bytes ``volerr compensate --out`` writes
@@ -239,9 +239,9 @@ class ToolTipMap(ResultMixin):
 
     def figures(self) -> dict:
         """``{"map": Figure}``: the map ``--plot`` draws."""
-        from .plots import tcp_error_map_figure
+        from .plots import draw_tcp_error_map, unsaved
 
-        return {"map": tcp_error_map_figure(self.map)}
+        return {"map": unsaved(draw_tcp_error_map, self.map)}
 
     def write_plot(self, path) -> Path:
         """The map as PNG (:func:`volerr.fiveaxis.plots.plot_tcp_error_map`)."""

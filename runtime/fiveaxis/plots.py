@@ -19,17 +19,19 @@ from ..plotstyle import figure, label, save, styled
 def plot_tcp_error_map(tmap, path, title: str = ""):
     """PNG of a :class:`volerr.fiveaxis.tcpmap.TcpMap`: length of the tool-tip error (colour,
     µm), its components and the tool-axis error (µrad)."""
-    save(_tcp_error_map(tmap, title), path)
+    save(draw_tcp_error_map(tmap, title), path)
     return path
 
 
 @styled
-def tcp_error_map_figure(tmap, title: str = ""):
-    """The figure of :func:`plot_tcp_error_map` (matplotlib, not saved)."""
-    return _tcp_error_map(tmap, title)
+def unsaved(draw, *args):
+    """The figure ``draw(*args)`` in the volerr style, not saved (a result's ``figures()``;
+    ``draw``: :func:`draw_tcp_error_map` or :func:`draw_program_errors`)."""
+    return draw(*args)
 
 
-def _tcp_error_map(tmap, title: str = ""):
+def draw_tcp_error_map(tmap, title: str = ""):
+    """The figure of :func:`plot_tcp_error_map`."""
     a1, a2, q1, q2, err = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err
     mag = np.linalg.norm(err, axis=2) * 1e3
     fig, grid = figure(2, 3, height=6.6)
@@ -66,17 +68,12 @@ def plot_program_errors(errors, path, title: str = ""):
     block, before and after compensation.  ``errors``: a
     :class:`volerr.fiveaxis.program.ProgramErrors` (or the line reports of a
     :class:`volerr.fiveaxis.compensate.Result`)."""
-    save(_program_errors(errors, title), path)
+    save(draw_program_errors(errors, title), path)
     return path
 
 
-@styled
-def program_errors_figure(errors, title: str = ""):
-    """The figure of :func:`plot_program_errors` (matplotlib, not saved)."""
-    return _program_errors(errors, title)
-
-
-def _program_errors(errors, title: str = ""):
+def draw_program_errors(errors, title: str = ""):
+    """The figure of :func:`plot_program_errors`."""
     from .program import ProgramErrors
 
     if not isinstance(errors, ProgramErrors):
