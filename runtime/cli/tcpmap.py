@@ -13,7 +13,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._common import add_error_arguments, add_vector
-from ..errors import require
 from ._common import layout_inputs
 from ..fileio import Outputs, write_text
 
@@ -43,65 +42,24 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import math
     import sys
 
-    import numpy as np
-
-    from ..fiveaxis.compensate import error_functions
-    from ..machine.model import load
-    from ..fiveaxis.plots import plot_tcp_error_map
-    from ..fiveaxis.tcpmap import tcp_map
-
-    model = load(args.layout)
-    require(len(model.rotary_axes) == 2, f"{model.name}: tcpmap needs a five-axis layout")
-    require(all(math.isfinite(v) for v in (*args.point, *args.tool)), "point/tool must be finite")
-    require(3 <= args.steps <= 1000, "--steps must be 3..1000")
-    require(not Path(args.errors).is_file(), f"{args.errors} is a file, not an error "
-                                              f"directory (the folder holding X.csv ...)")
-    require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
-    funcs, notes = error_functions(args.errors, model, args.method, args.degree,
-                                   args.extrapolate)
-    inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
-    outs = Outputs(inputs).plot("--plot", args.plot).file("--csv", args.csv).check()
-    from ..tables.functions import parse_approach
+    from ..fiveaxis.api import tcpmap
     from ._common import progress_bar
 
-    approach = "sweep" if args.approach == "sweep" else \
-        parse_approach(args.approach, model, funcs)
+    inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
+    outs = Outputs(inputs).plot("--plot", args.plot).file("--csv", args.csv).check()
     with progress_bar(None, "tcpmap", total=args.steps * args.steps, unit="points") as tick:
-        tmap = tcp_map(model, funcs, args.point, args.tool, args.steps, args.steps,
-                       approach=approach, progress=tick)
-    a1, a2, q1, q2, err, valid = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err, tmap.valid
-    require(valid.any(), f"{model.name}: the point is outside the travel or the error tables "
-                         "for every rotary position")
+        res = tcpmap(args.layout, args.errors, tuple(args.point), tool=tuple(args.tool),
+                     steps=args.steps, approach=args.approach, method=args.method,
+                     degree=args.degree, extrapolate=args.extrapolate, plot_name=args.plot,
+                     progress=tick)
     with outs:
-        plot_tcp_error_map(tmap, outs.path("--plot"))
+        res.write_plot(outs.path("--plot"))
         if args.csv:
-            write_text(outs.path("--csv"), _grid_csv(tmap), inputs)
-    mag = np.linalg.norm(err, axis=2) * 1e3
-    print(f"{model.name}: tool-tip error at ({', '.join(f'{v:g}' for v in args.point)}) mm over "
-          f"{a1} {q1[0]:g}..{q1[-1]:g} deg, {a2} {q2[0]:g}..{q2[-1]:g} deg: max "
-          f"{np.nanmax(mag):.3f} um, min {np.nanmin(mag):.3f} um "
-          f"({int(valid.sum())} of {valid.size} grid points valid); wrote {args.plot}")
+            write_text(outs.path("--csv"), res.csv_text(), inputs)
+    print(res.summary())
     # notes only after success: bad input gets exactly one line on stderr
-    for note in notes:
-        print(f"note: {note}", file=sys.stderr)
+    for note in res.notes:
+        print(note, file=sys.stderr)
     return 0
-
-
-def _grid_csv(tmap) -> str:
-    """The ``--csv`` text: one row per grid point, empty error cells where invalid."""
-    import numpy as np
-
-    g1, g2 = np.meshgrid(tmap.q1, tmap.q2)
-    lin = tmap.linear.reshape(-1, 3)
-    e = tmap.err.reshape(-1, 3) * 1e3
-    m = np.linalg.norm(tmap.err, axis=2).ravel() * 1e3
-    rows = [f"{tmap.axis1}_deg,{tmap.axis2}_deg,X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um,e_um"]
-    for i in range(g1.size):
-        cells = [f"{g1.ravel()[i]:.10g}", f"{g2.ravel()[i]:.10g}"] + \
-            [f"{lin[i, k]:.10g}" for k in range(3)]
-        cells += [("" if not np.isfinite(v) else f"{v:.6g}") for v in (*e[i], m[i])]
-        rows.append(",".join(cells))
-    return "\n".join(rows) + "\n"

@@ -19,6 +19,19 @@ from ..plotstyle import figure, label, save, styled
 def plot_tcp_error_map(tmap, path, title: str = ""):
     """PNG of a :class:`volerr.fiveaxis.tcpmap.TcpMap`: length of the tool-tip error (colour,
     µm), its components and the tool-axis error (µrad)."""
+    save(draw_tcp_error_map(tmap, title), path)
+    return path
+
+
+@styled
+def unsaved(draw, *args):
+    """The figure ``draw(*args)`` in the volerr style, not saved (a result's ``figures()``;
+    ``draw``: :func:`draw_tcp_error_map` or :func:`draw_program_errors`)."""
+    return draw(*args)
+
+
+def draw_tcp_error_map(tmap, title: str = ""):
+    """The figure of :func:`plot_tcp_error_map`."""
     a1, a2, q1, q2, err = tmap.axis1, tmap.axis2, tmap.q1, tmap.q2, tmap.err
     mag = np.linalg.norm(err, axis=2) * 1e3
     fig, grid = figure(2, 3, height=6.6)
@@ -46,8 +59,7 @@ def plot_tcp_error_map(tmap, path, title: str = ""):
     fig.suptitle(title or f"{tmap.model_name}: tool-tip error at workpiece point "
                           f"({p[0]:g}, {p[1]:g}, {p[2]:g}) mm over {a1}, {a2}\n"
                           f"(grey: outside travel or error tables)")
-    save(fig, path)
-    return path
+    return fig
 
 
 @styled
@@ -56,6 +68,12 @@ def plot_program_errors(errors, path, title: str = ""):
     block, before and after compensation.  ``errors``: a
     :class:`volerr.fiveaxis.program.ProgramErrors` (or the line reports of a
     :class:`volerr.fiveaxis.compensate.Result`)."""
+    save(draw_program_errors(errors, title), path)
+    return path
+
+
+def draw_program_errors(errors, title: str = ""):
+    """The figure of :func:`plot_program_errors`."""
     from .program import ProgramErrors
 
     if not isinstance(errors, ProgramErrors):
@@ -81,5 +99,4 @@ def plot_program_errors(errors, path, title: str = ""):
                       "coincide", color="0.3")
     ax2.legend(loc="best")
     fig.suptitle(title or "predicted error along the program")
-    save(fig, path)
-    return path
+    return fig

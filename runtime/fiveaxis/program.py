@@ -70,6 +70,9 @@ class Options:
     datum: tuple | None = None
 
     def validated(self, model) -> "Options":
+        """The options checked (:class:`InputError` naming the option), ``tool`` the offset
+        of axis-position blocks: with ``tool_length`` L, ``(0, 0, -L)``
+        (:func:`_tool_of_length`)."""
         require(self.strategy in STRATEGIES,
                 f"unknown strategy {self.strategy!r} ({' '.join(STRATEGIES)})")
         require(self.tol_um > 0 and math.isfinite(self.tol_um),
@@ -81,6 +84,7 @@ class Options:
                 "the thesis strategy does not compensate the orientation")
         tool = np.asarray(self.tool, dtype=float)
         require(tool.shape == (3,) and np.all(np.isfinite(tool)), "tool offset must be 3 numbers")
+        tool = _tool_of_length(tool, self.tool_length)
         for a in self.initial or {}:
             require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")
         require(not (self.types is not None and self.strategy == "thesis"),
@@ -102,6 +106,22 @@ class Options:
                        None if self.tool_length is None else float(self.tool_length),
                        None if self.tool_table is None else dict(self.tool_table),
                        self.dialect, None if self.datum is None else tuple(self.datum))
+
+
+def _tool_of_length(tool: np.ndarray, length) -> np.ndarray:
+    """The tool offset (3,) mm of axis-position blocks: ``tool``, or with a tool length L
+    (mm) the offset ``(0, 0, -L)`` of :func:`volerr.nc.tcpm.tool_offset` (the tip L from the
+    point the axes refer to, against the tool axis), the one TCPM blocks use.  A non-zero
+    ``tool`` other than that offset is refused: which of the two is meant cannot be told."""
+    if length is None:
+        return tool
+    L = float(length)
+    require(math.isfinite(L) and L >= 0, "the tool length must be a finite number >= 0 (mm)")
+    off = tcpm.tool_offset([L])[0]
+    require(not tool.any() or np.allclose(tool, off, rtol=0, atol=1e-9),
+            f"--tool {' '.join(f'{v:g}' for v in tool)} and --tool-length {L:g} disagree (a "
+            f"tool length L is the tool offset 0 0 -L mm in the tool frame): give one of them")
+    return off
 
 
 # ---------------------------------------------------------------------------------------
@@ -479,6 +499,8 @@ class Summary:
         self.max_iter = 0
         self.arcs_kept = self.arcs_linearised = self.segments = self.tcpm = 0
         self.max_arc_dev = 0.0
+        #: written minus programmed position per axis: max |.| and sum of squares (mm / deg)
+        self.corr_max = self.corr_sq = None
 
     def add(self, chunk: Chunk) -> None:
         b, p = chunk.blocks, chunk.prediction
@@ -509,6 +531,21 @@ class Summary:
             u = p.u_after_um[np.all(np.isfinite(p.u_after_um), axis=1)]
             if len(u):
                 self.max_u = max(self.max_u, float(np.linalg.norm(u, axis=1).max()))
+            d = chunk.q_out - b.q_nom
+            if self.corr_max is None:
+                self.corr_max, self.corr_sq = np.zeros(d.shape[1]), np.zeros(d.shape[1])
+            self.corr_max = np.maximum(self.corr_max, np.abs(d).max(axis=0))
+            self.corr_sq += np.einsum("ij,ij->j", d, d)
+
+    def corrections(self, axes) -> dict:
+        """Axis -> (max |correction|, rms correction) over the compensated blocks, mm / deg
+        (the written minus the programmed position; under TCPM the axis positions the
+        controller goes to)."""
+        n = self.n_done
+        if not n or self.corr_max is None:
+            return {a: (0.0, 0.0) for a in axes}
+        return {a: (float(self.corr_max[i]), math.sqrt(float(self.corr_sq[i]) / n))
+                for i, a in enumerate(axes)}
 
     def result(self) -> dict:
         n = self.n_done
@@ -529,9 +566,10 @@ class Summary:
 
 
 def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK_LINES,
-        progress=None) -> tuple[dict, tuple]:
+        progress=None, corrections: bool = False) -> tuple:
     """Run the steps chunk by chunk -> (summary dict, rotary axes taken at 0 deg because the
-    program never commands them).
+    program never commands them), with ``corrections`` also the corrections per axis
+    (:meth:`Summary.corrections`).
 
     ``open_source()``: a fresh iterator over the program's lines with their endings (an open
     text file, latin-1, ``newline=""``, or :class:`io.StringIO`).  ``sink.start()`` is called
@@ -578,6 +616,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
                 fh.close()
         late = tuple(a for a in model.rotary_axes if a not in known and a not in never)
         if not late:
+            if corrections:
+                return summary.result(), never, summary.corrections(model.axes)
             return summary.result(), never
         never = tuple(a for a in model.rotary_axes if a in never or a in late)
 
@@ -797,34 +837,16 @@ class Result:
     reports: list = field(default_factory=list)
     #: rotary axes the program never commands, taken at 0 deg (their zero, as after homing)
     assumed_zero: tuple = ()
-    #: what the program held besides straight moves: ``tcpm_blocks`` and ``arcs`` (kept,
-    #: linearised, segments, max_path_deviation_um), as in the streamed summary
-    shapes: dict = field(default_factory=dict)
+    #: the summary of the run, computed once as the chunks stream through (the command's
+    #: ``--json`` numbers: :class:`Summary`)
+    streamed: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
-        done = [r for r in self.reports if r.status.startswith("compensated")]
-        b = np.array([np.linalg.norm(r.before_um) for r in done]) if done else np.zeros(0)
-        a = np.array([np.linalg.norm(r.after_um) for r in done]) if done else np.zeros(0)
-        ob = np.array([r.orientation_before_urad for r in done]) if done else np.zeros(0)
-        oa = np.array([r.orientation_after_urad for r in done]) if done else np.zeros(0)
+        """The summary dict (``motion_blocks``, ``compensated``, ``max_before_um`` ...,
+        ``tcpm_blocks``, ``arcs``), a copy of the one :class:`Summary` computed."""
+        import copy
 
-        def mx(v):
-            return float(v.max()) if v.size else 0.0
-
-        return {
-            "motion_blocks": len(self.reports),
-            "compensated": len(done),
-            "not_compensated": [{"line": r.line, "reason": r.status} for r in self.reports
-                                if not r.status.startswith("compensated")],
-            "max_before_um": mx(b), "max_after_um": mx(a),
-            "rms_before_um": float(np.sqrt(np.mean(b ** 2))) if b.size else 0.0,
-            "rms_after_um": float(np.sqrt(np.mean(a ** 2))) if a.size else 0.0,
-            "max_orientation_before_urad": mx(ob), "max_orientation_after_urad": mx(oa),
-            "max_iterations": max((r.iterations for r in done), default=0),
-            "max_u_after_um": mx(np.array([np.linalg.norm(r.u_after_um) for r in done
-                                           if np.all(np.isfinite(r.u_after_um))])),
-            **self.shapes,
-        }
+        return copy.deepcopy(self.streamed)
 
 
 class _Collect:
@@ -886,5 +908,4 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
     sink = _Collect(model)
     s, never = run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
                    chunk_lines or CHUNK_LINES)
-    return Result("".join(sink.text), sink.reports, never,
-                  {k: s[k] for k in ("tcpm_blocks", "arcs")})
+    return Result("".join(sink.text), sink.reports, never, s)
