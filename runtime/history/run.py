@@ -61,33 +61,54 @@ def check_date(text: str, where: str = "--date") -> str:
 
 def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 10.0) -> list:
     """Add the result files to ``machine``'s history in ``db`` (module docstring); returns
-    ``[(Entry, "added" | "already stored")]``."""
-    from .store import Store
+    ``[(Entry, "added" | "already stored")]``.  Every entry reported ``"added"`` is committed.
+    A new SQLite file appears only with its entries committed
+    (:func:`volerr.history.store.add_to_new_file`); a failing call removes nothing but its
+    own temporary file.  Another writer storing the same result in between (a new file
+    created first by another process, a :class:`~volerr.history.store.Conflict`): the files
+    are read again and added to what is stored."""
+    from .store import Conflict, Store, add_to_new_file
 
     check_machine(machine)
     files = list(files)
     require(files, "give at least one RESULT.json")
     date = check_date(date) if date is not None else None
+    _read_entries(files, date)              # every file checked before the database is touched
+
+    def work(store):
+        entries = _read_entries(files, date)    # fresh: a check's reference is applied in place
+        paths = {id(e): f for f, e in entries}
+        return store.add(machine, [e for _, e in entries],
+                         lambda entry, stored: _prepare(entry, stored, paths[id(entry)]))
+
+    for _ in range(_ATTEMPTS):
+        try:
+            if "://" not in str(db) and not Path(db).exists():
+                made, value = add_to_new_file(db, wait_s, work)
+                if made:
+                    return value
+                continue                        # another process created it: add to that
+            return work(Store(db, wait_s=wait_s, create=True))
+        except Conflict:
+            continue
+    raise InputError(f"--db {db}: other processes kept writing the same results at the same "
+                     f"time; nothing written, try again")
+
+
+#: attempts of one add against writers racing for the same new file or the same result
+_ATTEMPTS = 4
+
+
+def _read_entries(files: list, date: str | None) -> list:
+    """``[(file, Entry)]`` dated (``date``, else the result's own, else today) and in the
+    order they are stored (date, calibrations first)."""
     entries = []
     for f in files:
         e = results.read(f)
         e.date = date or (check_date(e.date, f"{f}: its date") if e.date else today())
         entries.append((f, e))
     entries.sort(key=lambda fe: (fe[1].date, fe[1].kind != CALIBRATION))
-    paths = {id(e): f for f, e in entries}
-
-    def prepare(entry, stored):
-        _prepare(entry, stored, paths[id(entry)])
-
-    new_file = None if "://" in str(db) or Path(db).exists() else Path(db)
-    try:
-        store = Store(db, wait_s=wait_s, create=True)
-        return store.add(machine, [e for _, e in entries], prepare)
-    except InputError:
-        if new_file is not None:        # nothing written: not even the empty store
-            for f in (new_file, Path(f"{new_file}-journal")):
-                f.unlink(missing_ok=True)
-        raise
+    return entries
 
 
 def _prepare(entry, stored: list, path) -> None:
