@@ -97,5 +97,5 @@ def run_show(args) -> int:
             h.write_json(outs.path("--json"))
         if text is not None:
             write_text(outs.path("--html"), text)
-    print("\n".join(h.summary_lines()))
+    print(h.summary())
     return 0
