@@ -15,20 +15,11 @@ import numpy as np
 from ..results import ResultMixin, Row, as_table
 from . import analysis as an
 
-_LENGTH = {"nm": 1e-3, "um": 1.0, "mm": 1e3}
-_ANGLE = {"urad": 1.0, "mrad": 1e3, "rad": 1e6, "arcsec": 4.84813681109536}
-
-
 def _convert(value: float, unit: str, to: str, name: str) -> float:
-    """``value`` in ``unit`` expressed in ``to`` (lengths, angles; other units must match)."""
-    from ..errors import InputError
+    """``value`` in ``unit`` expressed in ``to`` (:func:`volerr.units.convert`)."""
+    from ..units import convert
 
-    if unit == to or not unit:
-        return value
-    for table in (_LENGTH, _ANGLE):
-        if unit in table and to in table:
-            return value * table[unit] / table[to]
-    raise InputError(f"--tolerance {name}: given in {unit}, the history holds {name} in {to}")
+    return convert(value, unit, to, f"--tolerance {name}")
 
 
 @dataclass(repr=False)

@@ -23,11 +23,11 @@ Rules of ``add`` (the store's own rules in :mod:`volerr.history.store`):
 
 from __future__ import annotations
 
-import datetime as _dt
 import re
 from pathlib import Path
 
 from ..errors import InputError, require
+from ..units import QUANTITY_UNITS, convert, parse_assignments, parse_date, today_utc
 from . import results
 from .results import CALIBRATION, CHECK
 
@@ -43,20 +43,13 @@ def check_machine(machine: str) -> str:
 
 
 def today() -> str:
-    return _dt.datetime.now(_dt.timezone.utc).date().isoformat()
+    """Today's date, UTC (:func:`volerr.units.today_utc`)."""
+    return today_utc()
 
 
 def check_date(text: str, where: str = "--date") -> str:
-    """``text`` as YYYY-MM-DD, not after today (UTC)."""
-    try:
-        d = _dt.date.fromisoformat(str(text))
-    except ValueError:
-        raise InputError(f"{where} {text!r}: a date YYYY-MM-DD expected") from None
-    require(len(str(text)) == 10, f"{where} {text!r}: a date YYYY-MM-DD expected")
-    require(d.isoformat() <= today(), f"{where} {text}: lies in the future (today is "
-                                      f"{today()} UTC); a result is dated when it was "
-                                      f"measured")
-    return d.isoformat()
+    """``text`` as YYYY-MM-DD, not after today (UTC): :func:`volerr.units.parse_date`."""
+    return parse_date(text, where)
 
 
 def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 10.0) -> list:
@@ -147,26 +140,18 @@ def _reference(entry, stored: list, path):
 
 
 def parse_tolerances(text: str | None) -> dict:
-    """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``; ``map`` in um."""
-    out: dict = {}
+    """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``: every value with
+    its unit (:func:`volerr.units.parse_assignments`; a bare number is refused, the history
+    holds parameters in different units); ``map`` (the volumetric error) a length, in um."""
     if not text:
-        return out
-    for part in filter(None, (p.strip() for p in re.split(r"[,;|]", text))):
-        name, eq, rest = part.partition("=")
-        m = re.fullmatch(r"\s*([-+0-9.eE]+)\s*([A-Za-zµ/^0-9]*)\s*", rest)
-        require(eq == "=" and name.strip() and m is not None,
-                f"--tolerance {part!r}: NAME=VALUE UNIT expected (e.g. EX0C=20 um, map=30 um)")
-        try:
-            value = float(m.group(1))
-        except ValueError:
-            raise InputError(f"--tolerance {part!r}: {m.group(1)!r} is not a number") from None
-        require(value > 0 and value < 1e12, f"--tolerance {part!r}: a positive value expected")
-        unit = m.group(2).replace("µ", "u")
-        name = name.strip()
-        require(name not in out, f"--tolerance: {name} given twice")
-        require(name != "map" or unit in ("um", ""), "--tolerance map=VALUE um (the "
-                                                     "volumetric error in um)")
-        out[name] = (value, unit or ("um" if name == "map" else ""))
+        return {}
+    out = {}
+    for name, (value, unit) in parse_assignments(text, "--tolerance"):
+        if name == "map":
+            require(QUANTITY_UNITS[unit][0] == "length", "--tolerance map=VALUE um (the "
+                                                         "volumetric error, a length)")
+            value, unit = convert(value, unit, "um"), "um"
+        out[name] = (value, unit)
     return out
 
 
