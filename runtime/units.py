@@ -110,8 +110,9 @@ def unit_name(text: str) -> str:
 def parse_quantity(text, where: str, *, default_unit: str | None = None,
                    kinds=("length", "angle"), positive: bool = True) -> tuple:
     """``"22 um"`` -> ``(22.0, "um")``: one finite number and its unit (:data:`QUANTITY_UNITS`
-    of one of ``kinds``).  A bare number takes ``default_unit`` when the option documents
-    one (``--detect-um``-like options, an ISO 230-2 tolerance in um), else it is refused:
+    of one of ``kinds``, or ``default_unit`` itself, whatever it is).  A bare number takes
+    ``default_unit`` when the option documents one (an ISO 230-2 tolerance in um, a check's
+    tolerance in its parameter's unit), else it is refused:
     ``"<where>: the value needs its unit, e.g. 22 um or 5 urad"``.  ``positive``: the value
     must be > 0.  Every refusal is one :class:`~volerr.errors.InputError` line starting with
     ``where`` (e.g. ``"--tolerance EX0C=22"``)."""
@@ -127,9 +128,12 @@ def parse_quantity(text, where: str, *, default_unit: str | None = None,
             raise InputError(f"{where}: the value needs its unit, e.g. {value:g} um or "
                              f"5 urad")
         unit = default_unit
-    if unit not in QUANTITY_UNITS or QUANTITY_UNITS[unit][0] not in kinds:
-        known = " ".join(u for u, (k, _) in QUANTITY_UNITS.items() if k in kinds)
-        raise InputError(f"{where}: unit {unit!r} unknown here; one of {known}")
+    known = " ".join(u for u, (k, _) in QUANTITY_UNITS.items() if k in kinds)
+    if unit != default_unit and unit not in QUANTITY_UNITS:
+        raise InputError(f"{where}: unit {unit!r} unknown; one of {known}")
+    if unit != default_unit and QUANTITY_UNITS[unit][0] not in kinds:
+        raise InputError(f"{where}: {unit} is a unit of {QUANTITY_UNITS[unit][0]}, not of "
+                         f"{' or '.join(kinds)}: one of {known}")
     if positive and not value > 0:
         raise InputError(f"{where}: a positive value expected")
     return value, unit

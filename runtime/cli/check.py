@@ -10,7 +10,6 @@ Parses arguments and calls :func:`volerr.check.plan_check` or :func:`volerr.chec
 
 from __future__ import annotations
 
-import datetime
 from pathlib import Path
 
 from ..errors import InputError, require
@@ -127,11 +126,10 @@ def _check(args, inputs) -> int:
     from ..instruments import split_spec
 
     layout, files = args.words[0], args.words[1:]
-    if args.date is not None:
-        try:
-            datetime.date.fromisoformat(args.date)
-        except ValueError:
-            raise InputError(f"--date {args.date!r}: write YYYY-MM-DD") from None
+    if args.date is not None:           # YYYY-MM-DD, not in the future
+        from ..units import parse_date
+
+        args.date = parse_date(args.date)
     inputs = inputs + [Path(args.reference)] + [Path(split_spec(f)[1]) for f in files]
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).check()
