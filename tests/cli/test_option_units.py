@@ -20,7 +20,7 @@ from volerr.cli import main
 from volerr.errors import InputError
 from volerr.units import convert, parse_assignments, parse_date, parse_quantity
 
-from tests.history.conftest import add_all, weekly
+from tests.history.conftest import weekly
 
 FUTURE = (dt.datetime.now(dt.timezone.utc).date() + dt.timedelta(days=2)).isoformat()
 MALFORMED = ["2025-2-1", "31.12.2025", "2025-13-01", "2025-02-30", "yesterday", "20250201"]
@@ -99,10 +99,16 @@ def test_dates():
 
 
 # ------------------------------------------------------------------------ history show
-@pytest.fixture
-def history(tmp_path, capsys):
-    db = tmp_path / "h.sqlite"
-    add_all(db, "M1", weekly(tmp_path, weeks=8, seed=3), capsys)
+@pytest.fixture(scope="module")
+def history(tmp_path_factory):
+    """A history of 8 weekly calibrations of machine M1 (made once for these tests; read
+    only)."""
+    from volerr.history.run import add
+
+    d = tmp_path_factory.mktemp("history")
+    db = d / "h.sqlite"
+    for f, date in weekly(d, weeks=8, seed=3):
+        add(str(db), "M1", [f], date)
     return db
 
 
@@ -129,14 +135,17 @@ def test_history_tolerance_needs_its_unit(tmp_path, capsys, history, tol, fragme
 def test_history_tolerance_in_other_units_is_the_same_tolerance(tmp_path, capsys, history):
     capsys.readouterr()
     a, b = tmp_path / "a.json", tmp_path / "b.json"
-    assert _show(history, "EX0C=15 um,EA0C=12 urad,map=40 um", a) == 0
-    assert _show(history, f"EX0C=0.015 mm,EA0C={12 / ARCSEC_URAD!r} arcsec,map=0.04 mm",
-                 b) == 0
+    assert _show(history, "EX0C=15 um,EA0C=12 urad", a) == 0
+    assert _show(history, f"EX0C=0.015 mm,EA0C={12 / ARCSEC_URAD!r} arcsec", b) == 0
     fa, fb = (json.loads(p.read_text())["forecast"] for p in (a, b))
-    for name in ("EX0C", "EA0C", "map"):
+    for name in ("EX0C", "EA0C"):
         assert fb[name]["tolerance"] == pytest.approx(fa[name]["tolerance"], rel=1e-12)
         assert fb[name]["date"] == fa[name]["date"]
     assert fa["EX0C"]["tolerance"] == 15.0 and fa["EA0C"]["unit"] == "urad"
+    # the volumetric error's tolerance, a length, in um (the map forecast itself: test_show)
+    from volerr.history.run import parse_tolerances
+
+    assert parse_tolerances("map=0.04 mm") == {"map": (pytest.approx(40.0, rel=1e-12), "um")}
 
 
 # ------------------------------------------------------------------------ every --date
