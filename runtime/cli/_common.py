@@ -215,7 +215,8 @@ def add_identification(parser, instrument: str = "the measuring instrument") -> 
                    help=f"{instrument}: make, model, serial number, calibration")
     g.add_argument("--operator", metavar="TEXT", help="who made the test")
     g.add_argument("--date", metavar="YYYY-MM-DD",
-                   help="date of the test (not given: the date of the evaluation)")
+                   help="date of the test, not after today (not given: the date of the "
+                        "evaluation)")
 
 
 def identification_from_args(args, conditions: dict | None = None):

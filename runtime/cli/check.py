@@ -61,9 +61,10 @@ def register(sub) -> None:
     p.add_argument("--tolerance", metavar="T",
                    help="check: \"NAME=VALUE [UNIT],...,map=VALUE um\": each parameter's "
                         "|value| and the largest volumetric error after the check against "
-                        "its limit (ISO 14253-1, U = 2 u)")
-    p.add_argument("--date", metavar="YYYY-MM-DD", help="check: the date of the check "
-                                                        "(carried into the JSON)")
+                        "its limit (ISO 14253-1, U = 2 u); a bare VALUE is in the "
+                        "parameter's unit, a unit given is converted")
+    p.add_argument("--date", metavar="YYYY-MM-DD", help="check: the date of the check, not "
+                                                        "after today (carried into the JSON)")
     add_json(p, "the check plan or the check's result")
     add_html(p, "the set-up sheet (check plan) or the check's page")
     add_force(p)
