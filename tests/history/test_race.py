@@ -196,3 +196,32 @@ def test_a_refused_first_add_leaves_no_file_and_keeps_a_racers_history(tmp_path,
     assert [e.source for e in s.entries("M3")] == ["racer.json"]
     assert [e.source for e in s.entries("M1")] == ["mine.json"]
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_a_unique_conflict_is_rolled_back_and_the_add_run_again(tmp_path, monkeypatch,
+                                                                  existing):
+    """A writer that breaks the unique SHA-256 (as one that did not take the lock would):
+    its transaction is rolled back whole (:class:`Conflict`) and ``add`` runs again against
+    what is stored, reporting what it then stores."""
+    from volerr.history import store as st
+    from volerr.history.run import add
+
+    db = tmp_path / "h.sqlite"
+    if existing:
+        add(str(db), "M0", [_result(tmp_path, "seed.json", 3.0)], DATE)
+    f = _result(tmp_path, "one.json", 5.0)
+    real, calls = st.Store._insert, []
+
+    def twice_on_first_call(self, conn, machine, entry):
+        calls.append(entry.source)
+        real(self, conn, machine, entry)
+        if len(calls) == 1:
+            real(self, conn, machine, entry)       # the same sha256 again: IntegrityError
+
+    monkeypatch.setattr(st.Store, "_insert", twice_on_first_call)
+    done = add(str(db), "M1", [f], DATE)
+    assert [(e.source, what) for e, what in done] == [("one.json", "added")]
+    assert calls == ["one.json", "one.json"]
+    assert [e.source for e in Store(str(db)).entries("M1")] == ["one.json"]
+    assert len(Store(str(db)).entries("M0")) == int(existing)
