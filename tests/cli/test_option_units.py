@@ -241,3 +241,24 @@ def test_check_tolerance_converts_to_the_parameters_unit():
                        ("map=3 urad", "not a unit of um"), ("EX0C=1e999 um", "finite")):
         with pytest.raises(InputError, match=word):
             parse(text, ref)
+
+
+def test_iso10360_mpe_bare_um_or_with_a_length_unit(tmp_path, capsys):
+    from volerr.uncertainty.iso10360 import parse_spec
+
+    assert parse_spec("E0=0.0015 mm + L/333, PFTU=2 um", "--mpe") == parse_spec(
+        "E0=1.5+L/333,PFTU=2", "--mpe")
+    err = _errors_dir(tmp_path)
+    docs = []
+    for k, mpe in enumerate(("E0=1.5+L/333", "E0=1.5 um + L/333", "E0=1500nm+L/333")):
+        out = tmp_path / f"m{k}.json"
+        assert main(["iso10360", "MB1", "--errors", str(err), "--mpe", mpe, "--json",
+                     str(out)]) == 0
+        docs.append(json.loads(out.read_text()))
+    assert docs[1] == docs[0] and docs[2] == docs[0]
+    capsys.readouterr()
+    out = tmp_path / "x.json"
+    for mpe, word in (("E0=1.5 urad+L/333", "expected"), ("E0=1e999+L/333", "finite")):
+        one_line(capsys, main(["iso10360", "MB1", "--errors", str(err), "--mpe", mpe,
+                               "--json", str(out)]), "--mpe", word)
+        assert not out.exists()
