@@ -18,9 +18,11 @@ DB: a file (SQLite, created by the first add) or a postgresql:// URL (a server; 
 --json' results.  Machine ids: 1 to 64 letters, digits, spaces and . _ - : / + #.
 A result added twice to the same machine and date is stored once; on another machine or
 date it is refused.  Several adds at once lose nothing (a new SQLite file appears only when
-its first entries are committed; a failing add removes nothing but its own temporary file).  A date after today is refused; a check needs its reference
+its first entries are committed; a failing add removes nothing but its own staging
+folder).  A date (YYYY-MM-DD) after today is refused; a check needs its reference
 calibration in the machine's history.  A locked database (another writer): exit 2 after
---wait seconds, nothing written.
+--wait seconds, nothing written.  show --tolerance: every value with its unit (22 um,
+5 urad, 0.02 mm, 3 arcsec; um/m for a small angle).
 
 show --json: {"machine", "layout", "entries": [...], "events": [{"date", "parameter",
 "change", "unit", "std"}], "trends": {NAME: {"slope_per_day", "unit", "std", "since", "n"}},

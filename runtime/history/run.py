@@ -57,7 +57,7 @@ def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 1
     ``[(Entry, "added" | "already stored")]``.  Every entry reported ``"added"`` is committed.
     A new SQLite file appears only with its entries committed
     (:func:`volerr.history.store.add_to_new_file`); a failing call removes nothing but its
-    own temporary file.  Another writer storing the same result in between (a new file
+    own staging folder.  Another writer storing the same result in between (a new file
     created first by another process, a :class:`~volerr.history.store.Conflict`): the files
     are read again and added to what is stored."""
     from .store import Conflict, Store, add_to_new_file

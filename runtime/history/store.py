@@ -30,11 +30,11 @@ Rules:
 * A file that is not an SQLite database, or an SQLite database with tables of its own but
   none of volerr's, is refused before anything is written (never a foreign file changed).
 * A new SQLite history is never half made and never removed: the first ``add``
-  (:func:`add_to_new_file`) writes schema and entries into a temporary file of its own in the
-  same folder and links it into place only after its transaction committed (``os.link``
+  (:func:`add_to_new_file`) writes schema and entries into a file in a staging folder of its
+  own beside it and links it into place only after its transaction committed (``os.link``
   fails when the name exists, so of two processes creating the same history at once one
   wins and the other adds to the winner's file).  A failing command removes only that
-  temporary file of its own, never the history.
+  staging folder of its own, never the history.
 * Schema creation tolerates a racing creator (``CREATE TABLE IF NOT EXISTS`` under the
   writer's lock, retried on "already exists"); ``sha256`` is unique, and a transaction that
   breaks it (a writer that did not take the lock) is rolled back and raised as
@@ -312,35 +312,35 @@ class Store:
 
 def add_to_new_file(path, wait_s: float, work):
     """Create the SQLite history ``path`` (which does not exist) with what ``work(store)``
-    writes into it: ``work`` runs on a new temporary file of this process in the same folder,
-    which is linked to ``path`` only after ``work`` committed.  Returns ``(True, work's
+    writes into it: ``work`` runs on a new file in a staging folder of this process beside
+    ``path`` (named by :func:`volerr.fileio.staging_prefix`, so that one left by a killed
+    process is removed by the next run, :func:`volerr.fileio.remove_stale_staging`); the
+    file is linked to ``path`` only after ``work`` committed.  Returns ``(True, work's
     value)``, or ``(False, None)`` when another process created ``path`` first (then nothing
-    of ours is left: add to that file instead).  On any failure the temporary file is removed
-    and ``path`` never appears; nothing else is ever removed."""
+    of ours is left: add to that file instead).  On any failure the staging folder is
+    removed and ``path`` never appears; nothing else is ever removed."""
+    import shutil
+
+    from ..fileio import remove_stale_staging, staging_prefix
+
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     require(folder.is_dir(), f"--db {path}: folder {folder} does not exist")
+    remove_stale_staging(folder)
     try:
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".volerr-new",
-                                    dir=folder)
+        stage = Path(tempfile.mkdtemp(prefix=staging_prefix(), dir=folder))
     except OSError as exc:
         raise InputError(f"--db {path}: cannot create a file in {folder} "
                          f"({exc.strerror or exc})") from None
-    os.close(fd)
-    tmp = Path(name)
     try:
-        from ..fileio import default_mode
-
-        os.chmod(tmp, default_mode())
-        store = Store(str(tmp), wait_s=wait_s, create=True, shown=str(path))
+        store = Store(str(stage / path.name), wait_s=wait_s, create=True, shown=str(path))
         value = work(store)
         store.engine.dispose()
-        if not _publish(tmp, path):
+        if not _publish(stage / path.name, path):
             return False, None
         return True, value
     finally:
-        for f in (tmp, Path(f"{tmp}-journal")):     # ours alone: made in this call
-            f.unlink(missing_ok=True)
+        shutil.rmtree(stage, ignore_errors=True)    # ours alone: made in this call
 
 
 def _publish(tmp: Path, path: Path) -> bool:

@@ -11,6 +11,7 @@ its own result (all stored).  The expected outcome is derived from these rules, 
 run: which process wins is free, what is in the database must follow from what they said."""
 
 import hashlib
+import os
 import re
 import subprocess
 import sys
@@ -121,7 +122,7 @@ def check_round(db, reports, seeded, same_machine, same_result):
 def test_sqlite_adders_racing_20_rounds_lose_nothing(tmp_path):
     plan = rounds(20)
     race(tmp_path, [tmp_path / f"h{i:02d}.sqlite" for i in range(len(plan))], plan)
-    # no temporary file of any process left beside the histories
+    # no staging folder of any process left beside the histories
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
 
 
@@ -148,7 +149,7 @@ def test_postgresql_adders_racing_lose_nothing(tmp_path, pg_url):
 def test_a_refused_first_add_leaves_no_file_and_keeps_a_racers_history(tmp_path,
                                                                         monkeypatch):
     """A first add that fails after its store was made (a check without its reference)
-    leaves neither the history nor its temporary file; a history another process made in
+    leaves neither the history nor its staging folder; a history another process made in
     the meantime is never removed by a failing add."""
     import json
 
@@ -163,7 +164,7 @@ def test_a_refused_first_add_leaves_no_file_and_keeps_a_racers_history(tmp_path,
     with pytest.raises(InputError, match="no calibration"):
         add(str(db), "M1", [chk], DATE)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.json"]
-    # a racer creates the history while this add works on its temporary file: a failing
+    # a racer creates the history while this add works in its staging folder: a failing
     # add leaves the racer's history and entry; a succeeding one adds to the racer's file
     racer = _result(tmp_path, "racer.json", 7.0)
     mine = _result(tmp_path, "mine.json", 8.0)
@@ -225,3 +226,22 @@ def test_a_unique_conflict_is_rolled_back_and_the_add_run_again(tmp_path, monkey
     assert calls == ["one.json", "one.json"]
     assert [e.source for e in Store(str(db)).entries("M1")] == ["one.json"]
     assert len(Store(str(db)).entries("M0")) == int(existing)
+
+
+def test_a_killed_adders_staging_folder_is_removed_by_the_next_add(tmp_path):
+    """A first add killed before it linked its file leaves its staging folder; the next add
+    beside it removes it (its process is gone), and keeps that of a live process."""
+    from volerr.fileio import _host
+    from volerr.history.run import add
+
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    dead = tmp_path / f".volerr-staging-{gone.pid}@{_host()}-abc"
+    live = tmp_path / f".volerr-staging-{os.getppid()}@{_host()}-def"
+    for d in (dead, live):
+        d.mkdir()
+        (d / "h.sqlite").write_bytes(b"")
+    db = tmp_path / "h.sqlite"
+    add(str(db), "M1", [_result(tmp_path, "one.json", 5.0)], DATE)
+    assert not dead.exists() and live.is_dir() and db.is_file()
+    assert [e.source for e in Store(str(db)).entries("M1")] == ["one.json"]
