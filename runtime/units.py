@@ -108,14 +108,17 @@ def unit_name(text: str) -> str:
 
 
 def parse_quantity(text, where: str, *, default_unit: str | None = None,
-                   kinds=("length", "angle"), positive: bool = True) -> tuple:
+                   kinds=("length", "angle"), positive: bool = True,
+                   any_unit: bool = False) -> tuple:
     """``"22 um"`` -> ``(22.0, "um")``: one finite number and its unit (:data:`QUANTITY_UNITS`
     of one of ``kinds``, or ``default_unit`` itself, whatever it is).  A bare number takes
     ``default_unit`` when the option documents one (an ISO 230-2 tolerance in um, a check's
     tolerance in its parameter's unit), else it is refused:
     ``"<where>: the value needs its unit, e.g. 22 um or 5 urad"``.  ``positive``: the value
-    must be > 0.  Every refusal is one :class:`~volerr.errors.InputError` line starting with
-    ``where`` (e.g. ``"--tolerance EX0C=22"``)."""
+    must be > 0.  ``any_unit``: a unit not in the table (``um/mm``, ``urad/deg`` of a slope)
+    is returned as written, for the caller to compare with the unit of what it limits (a
+    unit is still required).  Every refusal is one :class:`~volerr.errors.InputError` line
+    starting with ``where`` (e.g. ``"--tolerance EX0C=22"``)."""
     m = _QUANTITY.fullmatch(str(text))
     if m is None:
         raise InputError(f"{where}: write a number and its unit, e.g. 22 um or 5 urad")
@@ -129,9 +132,14 @@ def parse_quantity(text, where: str, *, default_unit: str | None = None,
                              f"5 urad")
         unit = default_unit
     known = " ".join(u for u, (k, _) in QUANTITY_UNITS.items() if k in kinds)
-    if unit != default_unit and unit not in QUANTITY_UNITS:
+    if any_unit and unit not in QUANTITY_UNITS:
+        if not re.fullmatch(r"[A-Za-z/^0-9]+", unit):
+            raise InputError(f"{where}: unit {unit!r} unknown; one of {known} (or the "
+                             f"parameter's own unit, e.g. um/mm)")
+    elif unit != default_unit and unit not in QUANTITY_UNITS:
         raise InputError(f"{where}: unit {unit!r} unknown; one of {known}")
-    if unit != default_unit and QUANTITY_UNITS[unit][0] not in kinds:
+    if unit in QUANTITY_UNITS and unit != default_unit and \
+            QUANTITY_UNITS[unit][0] not in kinds:
         raise InputError(f"{where}: {unit} is a unit of {QUANTITY_UNITS[unit][0]}, not of "
                          f"{' or '.join(kinds)}: one of {known}")
     if positive and not value > 0:

@@ -146,10 +146,10 @@ def parse_tolerances(text: str | None) -> dict:
     if not text:
         return {}
     out = {}
-    for name, (value, unit) in parse_assignments(text, "--tolerance"):
+    for name, (value, unit) in parse_assignments(text, "--tolerance", any_unit=True):
         if name == "map":
-            require(QUANTITY_UNITS[unit][0] == "length", "--tolerance map=VALUE um (the "
-                                                         "volumetric error, a length)")
+            require(QUANTITY_UNITS.get(unit, ("",))[0] == "length",
+                    "--tolerance map=VALUE um (the volumetric error, a length)")
             value, unit = convert(value, unit, "um"), "um"
         out[name] = (value, unit)
     return out

@@ -123,7 +123,7 @@ def _show(db, tol, out=None):
     ("EX0C=22 um,EA0C=5", "--tolerance EA0C=5: the value needs its unit"),
     ("EX0C=22 urad", "given in urad, which is not a unit of um"),
     ("EA0C=3 mm", "given in mm, which is not a unit of urad"),
-    ("EX0C=22 furlong", "'furlong'"), ("EX0C=inf um", "--tolerance EX0C=inf um"),
+    ("EX0C=22 furlong", "given in furlong, which is not a unit of um"), ("EX0C=inf um", "--tolerance EX0C=inf um"),
     ("map=30", "map=30: the value needs its unit"), ("map=30 urad", "map=VALUE um")])
 def test_history_tolerance_needs_its_unit(tmp_path, capsys, history, tol, fragment):
     capsys.readouterr()
@@ -148,6 +148,28 @@ def test_history_tolerance_in_other_units_is_the_same_tolerance(tmp_path, capsys
     assert parse_tolerances("map=0.04 mm") == {"map": (pytest.approx(40.0, rel=1e-12), "um")}
 
 
+def test_history_tolerance_in_a_parameters_own_unit(tmp_path, capsys):
+    """A slope parameter (unit um/mm, as calibrate reports a first-order term) takes its
+    tolerance in that unit; a length is not its unit."""
+    import volerr
+    from volerr.history.run import add
+
+    db = tmp_path / "h.sqlite"
+    for w in range(4):
+        f = tmp_path / f"c{w}.json"
+        f.write_text(json.dumps({"layout": "DMU50", "parameters": {"EXX@slope": {
+            "value": 0.1 + 0.01 * w, "unit": "um/mm", "std": 0.002}}}))
+        add(str(db), "M1", [f], (dt.date(2025, 1, 6) + dt.timedelta(weeks=w)).isoformat())
+    h = volerr.history.show(str(db), "M1", "EXX@slope=0.5 um/mm")
+    assert h.forecast["EXX@slope"]["tolerance"] == 0.5
+    assert h.forecast["EXX@slope"]["unit"] == "um/mm"
+    for tol, word in (("EXX@slope=0.5 um", "given in um, which is not a unit of um/mm"),
+                      ("EXX@slope=0.5", "the value needs its unit"),
+                      ("EXX@slope=0.5 um/mm!", "unknown")):
+        with pytest.raises(InputError, match=word):
+            volerr.history.show(str(db), "M1", tol)
+
+
 # ------------------------------------------------------------------------ every --date
 def _run_csv(path):
     """An ISO 230-2 run (3 cycles, both directions, deviations in um)."""
@@ -156,7 +178,8 @@ def _run_csv(path):
     for t in np.linspace(0, 800, 9):
         for c in (1, 2, 3):
             for word, half in (("+1", 1.0), ("-1", -1.0)):
-                lines.append(f"{t:g},{c},{word},{2 * np.sin(t / 200) + half + rng.normal(0, .2):.4f}")
+                dev = 2 * np.sin(t / 200) + half + rng.normal(0, 0.2)
+                lines.append(f"{t:g},{c},{word},{dev:.4f}")
     path.write_text("\n".join(lines) + "\n")
     return path
 
