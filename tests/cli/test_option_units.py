@@ -20,6 +20,7 @@ from volerr.cli import main
 from volerr.errors import InputError
 from volerr.units import convert, parse_assignments, parse_date, parse_quantity
 
+from tests.cli.test_shop_defects import write_run
 from tests.history.conftest import weekly
 
 FUTURE = (dt.datetime.now(dt.timezone.utc).date() + dt.timedelta(days=2)).isoformat()
@@ -171,19 +172,6 @@ def test_history_tolerance_in_a_parameters_own_unit(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------------ every --date
-def _run_csv(path):
-    """An ISO 230-2 run (3 cycles, both directions, deviations in um)."""
-    lines = ["target_mm,cycle,direction,deviation_um"]
-    rng = np.random.default_rng(4)
-    for t in np.linspace(0, 800, 9):
-        for c in (1, 2, 3):
-            for word, half in (("+1", 1.0), ("-1", -1.0)):
-                dev = 2 * np.sin(t / 200) + half + rng.normal(0, 0.2)
-                lines.append(f"{t:g},{c},{word},{dev:.4f}")
-    path.write_text("\n".join(lines) + "\n")
-    return path
-
-
 def _errors_dir(tmp_path):
     from volerr.tables import ErrorTable, write_error_dir
 
@@ -196,7 +184,7 @@ def _errors_dir(tmp_path):
 
 def _commands(tmp_path, date):
     """Every command with a --date option, given ``date``, each writing a --json."""
-    run = _run_csv(tmp_path / "run.csv")
+    run = write_run(tmp_path / "run.csv")
     cal = tmp_path / "cal.json"
     cal.write_text(json.dumps({"layout": "DMU50", "parameters": {
         "EX0C": {"value": 1.0, "unit": "um", "std": 0.1}}}))
@@ -235,7 +223,7 @@ def test_a_past_date_is_the_certificates_date(tmp_path, capsys):
 
 # ------------------------------------------------------------------------ iso230-2, check
 def test_iso230_2_tolerance_bare_um_or_with_a_length_unit(tmp_path, capsys):
-    run = _run_csv(tmp_path / "run.csv")
+    run = write_run(tmp_path / "run.csv")
     docs = []
     for k, tol in enumerate(("A=10,E=8", "A=0.01 mm,E=8 um", "A=10000 nm, E=8um")):
         out = tmp_path / f"o{k}.json"
