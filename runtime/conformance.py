@@ -53,7 +53,8 @@ def overall(verdicts) -> str | None:
 
 def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
     """``"A=10,E=8,R=4"`` -> ``{"A": 10.0, "E": 8.0, "R": 4.0}`` (um); names from ``names``
-    (any case), each at most once, values positive finite numbers."""
+    (any case), each at most once, values positive finite numbers, in um when bare, else
+    with a length unit (``"A=0.012 mm"``, :func:`volerr.units.parse_quantity`)."""
     allowed = {n.upper(): n for n in names}
     out = {}
     for part in filter(None, (p.strip() for p in re.split(r"[,;]", str(text)))):
@@ -64,11 +65,11 @@ def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
         require(key in allowed, f"{option}: unknown quantity {key!r}; one of "
                                 f"{' '.join(names)}")
         require(allowed[key] not in out, f"{option}: {allowed[key]} given twice")
-        try:
-            v = float(value)
-        except ValueError:
-            raise InputError(f"{option}: {allowed[key]} = {value.strip()!r} is not a "
-                             f"number") from None
+        from .units import convert, parse_quantity   # a bare number: um, as documented
+
+        v, unit = parse_quantity(value, f"{option} {allowed[key]}={value.strip()}",
+                                 default_unit="um", kinds=("length",), positive=False)
+        v = convert(v, unit, "um")
         require(math.isfinite(v) and 0 < v <= 1e6,
                 f"{option}: {allowed[key]} = {value.strip()} must be a positive number of um "
                 f"(at most 1e6)")

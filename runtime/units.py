@@ -83,3 +83,130 @@ def format_rows(data, digits: int = 12, block: int = 20000) -> str:
     row = ",".join([f"%.{digits}g"] * data.shape[1]) + "\n"
     return "".join((row * len(b)) % tuple(b.ravel().tolist())
                    for b in (data[i:i + block] for i in range(0, len(data), block)))
+
+
+# -- quantities: a number with its unit, as options take them ("22 um", "5 urad") ------------
+#: units of the options: unit -> (kind, factor to the kind's base unit).  Lengths in um;
+#: angles in urad (``um/m``, ``mm/m`` are the small angles of a squareness or a slope:
+#: 1 um/m = 1 urad).  Spelled as written (``µm``, ``μrad`` are read as ``um``, ``urad``).
+QUANTITY_UNITS = {
+    "nm": ("length", 1e-3), "um": ("length", 1.0), "mm": ("length", UM_PER_MM),
+    "m": ("length", UM_PER_MM * MM_PER_M),
+    "urad": ("angle", 1.0), "mrad": ("angle", 1e3), "rad": ("angle", URAD_PER_RAD),
+    "arcsec": ("angle", math.pi / 180 / 3600 * URAD_PER_RAD),
+    "deg": ("angle", math.pi / 180 * URAD_PER_RAD),
+    "um/m": ("angle", 1.0), "mm/m": ("angle", 1e3),
+}
+_QUANTITY = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*?)\s*")
+
+
+def unit_name(text: str) -> str:
+    """A unit as volerr spells it: ``µm``/``μm`` -> ``um``, ``µrad`` -> ``urad``, ``"`` ->
+    ``arcsec``, ``°`` -> ``deg``; anything else unchanged."""
+    t = str(text).strip().replace("µ", "u").replace("μ", "u")
+    return {'"': "arcsec", "″": "arcsec", "°": "deg"}.get(t, t)
+
+
+def parse_quantity(text, where: str, *, default_unit: str | None = None,
+                   kinds=("length", "angle"), positive: bool = True,
+                   any_unit: bool = False) -> tuple:
+    """``"22 um"`` -> ``(22.0, "um")``: one finite number and its unit (:data:`QUANTITY_UNITS`
+    of one of ``kinds``, or ``default_unit`` itself, whatever it is).  A bare number takes
+    ``default_unit`` when the option documents one (an ISO 230-2 tolerance in um, a check's
+    tolerance in its parameter's unit), else it is refused:
+    ``"<where>: the value needs its unit, e.g. 22 um or 5 urad"``.  ``positive``: the value
+    must be > 0.  ``any_unit``: a unit not in the table (``um/mm``, ``urad/deg`` of a slope)
+    is returned as written, for the caller to compare with the unit of what it limits (a
+    unit is still required).  Every refusal is one :class:`~volerr.errors.InputError` line
+    starting with ``where`` (e.g. ``"--tolerance EX0C=22"``)."""
+    m = _QUANTITY.fullmatch(str(text))
+    if m is None:
+        raise InputError(f"{where}: write a number and its unit, e.g. 22 um or 5 urad")
+    value = float(m.group(1))
+    unit = unit_name(m.group(2))
+    if not math.isfinite(value) or abs(value) > 1e15:
+        raise InputError(f"{where}: {m.group(1)} is not a finite number")
+    if not unit:
+        if default_unit is None:
+            raise InputError(f"{where}: the value needs its unit, e.g. {value:g} um or "
+                             f"5 urad")
+        unit = default_unit
+    known = " ".join(u for u, (k, _) in QUANTITY_UNITS.items() if k in kinds)
+    if any_unit and unit not in QUANTITY_UNITS:
+        if not re.fullmatch(r"[A-Za-z/^0-9]+", unit):
+            raise InputError(f"{where}: unit {unit!r} unknown; one of {known} (or the "
+                             f"parameter's own unit, e.g. um/mm)")
+    elif unit != default_unit and unit not in QUANTITY_UNITS:
+        raise InputError(f"{where}: unit {unit!r} unknown; one of {known}")
+    if unit in QUANTITY_UNITS and unit != default_unit and \
+            QUANTITY_UNITS[unit][0] not in kinds:
+        raise InputError(f"{where}: {unit} is a unit of {QUANTITY_UNITS[unit][0]}, not of "
+                         f"{' or '.join(kinds)}: one of {known}")
+    if positive and not value > 0:
+        raise InputError(f"{where}: a positive value expected")
+    return value, unit
+
+
+def convert(value: float, unit: str, to: str, where: str = "") -> float:
+    """``value`` in ``unit`` expressed in ``to`` (both in :data:`QUANTITY_UNITS`, of one kind;
+    equal units pass unchanged whatever they are).  Else :class:`InputError`: ``"<where>:
+    given in <unit>, which is not a unit of <to>"``."""
+    unit, to = unit_name(unit), unit_name(to)
+    if unit == to:
+        return float(value)
+    a, b = QUANTITY_UNITS.get(unit), QUANTITY_UNITS.get(to)
+    if a is None or b is None or a[0] != b[0]:
+        raise InputError(f"{where + ': ' if where else ''}given in {unit}, which is not a "
+                         f"unit of {to}")
+    return float(value) * a[1] / b[1]
+
+
+def parse_assignments(text, option: str, **quantity) -> list:
+    """``"EX0C=20 um, EA0C=5 urad"`` -> ``[(name, (value, unit)), ...]`` in the order given:
+    pairs split at ``,`` ``;`` ``|``, each ``NAME=VALUE UNIT`` read by :func:`parse_quantity`
+    (``quantity``: its keywords).  Names as written (stripped); a name given twice, an empty
+    list or a pair without ``=`` is refused, naming ``option`` and the pair."""
+    out, seen = [], set()
+    for part in filter(None, (p.strip() for p in re.split(r"[,;|]", str(text or "")))):
+        name, eq, rest = part.partition("=")
+        name = name.strip()
+        if not (eq and name):
+            raise InputError(f"{option} {part!r}: NAME=VALUE UNIT expected (e.g. EX0C=20 um, "
+                             f"EA0C=5 urad)")
+        if name in seen:
+            raise InputError(f"{option}: {name} given twice")
+        seen.add(name)
+        out.append((name, parse_quantity(rest, f"{option} {part}", **quantity)))
+    if not out:
+        raise InputError(f"{option}: no value given (NAME=VALUE UNIT, e.g. EX0C=20 um)")
+    return out
+
+
+# -- dates -----------------------------------------------------------------------------------
+def today_utc() -> str:
+    """Today's date (UTC), ``YYYY-MM-DD``."""
+    import datetime as _dt
+
+    return _dt.datetime.now(_dt.timezone.utc).date().isoformat()
+
+
+def parse_date(text, where: str = "--date") -> str:
+    """``text`` as a date ``YYYY-MM-DD`` (exactly: ``2025-2-1``, ``01.02.2025`` refused) not
+    after today (UTC: a measurement is not from the future); returns it as written.  One-line
+    :class:`InputError`: ``"--date 2099-01-01 is in the future (today is ... UTC)"``,
+    ``"--date '2025-13-01': a date YYYY-MM-DD expected (year-month-day)"``."""
+    import datetime as _dt
+
+    t = str(text).strip()
+    try:
+        if not re.fullmatch(r"\d{4}-\d{2}-\d{2}", t):
+            raise ValueError(t)
+        d = _dt.date.fromisoformat(t)
+    except ValueError:
+        raise InputError(f"{where} {str(text)!r}: a date YYYY-MM-DD expected "
+                         f"(year-month-day, e.g. 2025-03-31)") from None
+    now = today_utc()
+    if d.isoformat() > now:
+        raise InputError(f"{where} {t} is in the future (today is {now} UTC); a result is "
+                         f"dated when it was measured")
+    return d.isoformat()

@@ -3,7 +3,8 @@ decision rule, as the certificates (:mod:`volerr.conformance`): each quantity ag
 limit with the expanded uncertainty ``U = 2 u`` (k = 2) from the covariance after the check.
 
 Grammar: ``NAME=VALUE [UNIT],...`` with ``NAME`` a parameter of the reference (its ``|value|``
-against ``VALUE`` in the parameter's unit; a unit given must be it) or ``map`` (the largest
+against ``VALUE`` in the parameter's unit; a unit given must be of its kind and is converted,
+:func:`volerr.units.parse_quantity`) or ``map`` (the largest
 length of the volumetric error over the working volume, um).  Example:
 ``"EX0C=20 um,EA0B=40 urad,map=30 um"``.
 """
@@ -14,6 +15,7 @@ import math
 
 from .. import conformance
 from ..errors import require
+from ..units import convert, parse_quantity
 from . import _volume
 
 
@@ -26,22 +28,19 @@ def parse(text: str, ref) -> dict:
     for part in parts:
         name, eq, rest = part.partition("=")
         name = name.strip()
-        words = rest.split()
-        require(eq and name and 1 <= len(words) <= 2,
+        require(eq and name and rest.strip(),
                 f"--tolerance {text!r}: write NAME=VALUE [UNIT] pairs, e.g. \"map=30 um\"")
         key = "map" if name.lower() == "map" else name
         require(key == "map" or key in units, f"--tolerance: {name!r} is neither 'map' nor a "
                                               f"parameter of the reference "
                                               f"({', '.join(ref.names[:8])} ...)")
         unit = "um" if key == "map" else units[key]
-        given = words[1] if len(words) == 2 else unit
-        require(given == unit, f"--tolerance: {name} is in {unit}, not {given}")
-        try:
-            v = float(words[0])
-        except ValueError:
-            v = float("nan")
-        require(math.isfinite(v) and v > 0, f"--tolerance: {name} = {words[0]!r} must be a "
-                                            f"positive number")
+        # a bare number is in the parameter's unit (documented); a unit given is converted
+        v, given = parse_quantity(rest, f"--tolerance {part}", default_unit=unit,
+                                  positive=False)
+        v = convert(v, given, unit, f"--tolerance {name}")
+        require(math.isfinite(v) and v > 0, f"--tolerance: {name} = {rest.strip()!r} must be "
+                                            f"a positive number")
         require(key not in out, f"--tolerance: {name} given twice")
         out[key] = v
     return out

@@ -226,22 +226,19 @@ def add_identification(parser, instrument: str = "the measuring instrument") -> 
                    help=f"{instrument}: make, model, serial number, calibration")
     g.add_argument("--operator", metavar="TEXT", help="who made the test")
     g.add_argument("--date", metavar="YYYY-MM-DD",
-                   help="date of the test (not given: the date of the evaluation)")
+                   help="date of the test, not after today (not given: the date of the "
+                        "evaluation)")
 
 
 def identification_from_args(args, conditions: dict | None = None):
     """:class:`volerr.certificate.Identification` of the options of :func:`add_identification`
     (the date checked)."""
-    import datetime
-
     from ..certificate import Identification
+    from ..units import parse_date
 
     kw = {}
-    if args.date:
-        try:
-            kw["date"] = datetime.date.fromisoformat(args.date).isoformat()
-        except ValueError:
-            raise InputError(f"--date {args.date!r}: expected YYYY-MM-DD") from None
+    if args.date is not None:           # YYYY-MM-DD, not in the future
+        kw["date"] = parse_date(args.date)
     return Identification(args.machine, args.instrument, args.operator,
                           conditions=dict(conditions or {}), **kw)
 

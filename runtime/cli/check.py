@@ -10,7 +10,6 @@ Parses arguments and calls :func:`volerr.check.plan_check` or :func:`volerr.chec
 
 from __future__ import annotations
 
-import datetime
 from pathlib import Path
 
 from ..errors import InputError, require
@@ -62,9 +61,10 @@ def register(sub) -> None:
     p.add_argument("--tolerance", metavar="T",
                    help="check: \"NAME=VALUE [UNIT],...,map=VALUE um\": each parameter's "
                         "|value| and the largest volumetric error after the check against "
-                        "its limit (ISO 14253-1, U = 2 u)")
-    p.add_argument("--date", metavar="YYYY-MM-DD", help="check: the date of the check "
-                                                        "(carried into the JSON)")
+                        "its limit (ISO 14253-1, U = 2 u); a bare VALUE is in the "
+                        "parameter's unit, a unit given is converted")
+    p.add_argument("--date", metavar="YYYY-MM-DD", help="check: the date of the check, not "
+                                                        "after today (carried into the JSON)")
     add_json(p, "the check plan or the check's result")
     add_html(p, "the set-up sheet (check plan) or the check's page")
     add_force(p)
@@ -127,11 +127,10 @@ def _check(args, inputs) -> int:
     from ..instruments import split_spec
 
     layout, files = args.words[0], args.words[1:]
-    if args.date is not None:
-        try:
-            datetime.date.fromisoformat(args.date)
-        except ValueError:
-            raise InputError(f"--date {args.date!r}: write YYYY-MM-DD") from None
+    if args.date is not None:           # YYYY-MM-DD, not in the future
+        from ..units import parse_date
+
+        args.date = parse_date(args.date)
     inputs = inputs + [Path(args.reference)] + [Path(split_spec(f)[1]) for f in files]
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).check()

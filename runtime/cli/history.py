@@ -17,9 +17,12 @@ DB: a file (SQLite, created by the first add) or a postgresql:// URL (a server; 
 'pip install volerr[postgresql]').  RESULT.json: 'volerr calibrate --json' or 'volerr check
 --json' results.  Machine ids: 1 to 64 letters, digits, spaces and . _ - : / + #.
 A result added twice to the same machine and date is stored once; on another machine or
-date it is refused.  A date after today is refused; a check needs its reference
+date it is refused.  Several adds at once lose nothing (a new SQLite file appears only when
+its first entries are committed; a failing add removes nothing but its own staging
+folder).  A date (YYYY-MM-DD) after today is refused; a check needs its reference
 calibration in the machine's history.  A locked database (another writer): exit 2 after
---wait seconds, nothing written.
+--wait seconds, nothing written.  show --tolerance: every value with its unit (22 um,
+5 urad, 0.02 mm, 3 arcsec; um/m for a small angle).
 
 show --json: {"machine", "layout", "entries": [...], "events": [{"date", "parameter",
 "change", "unit", "std"}], "trends": {NAME: {"slope_per_day", "unit", "std", "since", "n"}},
@@ -51,8 +54,8 @@ def register(sub) -> None:
                      epilog=EPILOG)
     _common(a)
     a.add_argument("--date", metavar="YYYY-MM-DD",
-                   help="the date of the results (default: the date a result states, else "
-                        "today, UTC)")
+                   help="the date of the results, not after today (default: the date a "
+                        "result states, else today, UTC)")
     a.add_argument("results", nargs="+", metavar="RESULT.json", help="result files")
     a.set_defaults(func=run_add)
     sh = s.add_parser("show", help="events, trends, forecast of a machine's history",
@@ -60,7 +63,8 @@ def register(sub) -> None:
     _common(sh)
     sh.add_argument("--tolerance", metavar="'NAME=V UNIT,map=V um'",
                     help="tolerances |value| <= V of parameters (or of the volumetric error, "
-                         "map=): the date each is left, with a 95 %% interval")
+                         "map=), each with its unit (22 um, 5 urad, 0.02 mm, 3 arcsec): the "
+                         "date each is left, with a 95 %% interval")
     add_json(sh, "the history (entries, events, trends, forecast, control charts)")
     add_html(sh, "the history page (one chart per parameter)")
     sh.set_defaults(func=run_show)
@@ -97,5 +101,5 @@ def run_show(args) -> int:
             h.write_json(outs.path("--json"))
         if text is not None:
             write_text(outs.path("--html"), text)
-    print("\n".join(h.summary_lines()))
+    print(h.summary())
     return 0

@@ -33,7 +33,8 @@ def register(sub) -> None:
                    help="box of the test: the layout's travel or the part of it the error "
                         "tables cover")
     p.add_argument("--mpe", metavar="'E0=A+L/K'",
-                   help="MPE line to judge against (A um, L mm): verdict per ISO 14253-1")
+                   help="MPE line to judge against (A um, or with a length unit: E0=1.5 um+L/333; "
+                        "L mm): verdict per ISO 14253-1")
     p.add_argument("--noise-um", type=float, default=0.0, metavar="S",
                    help="probing noise per point, standard deviation, um")
     p.add_argument("--seed", type=int, default=0, metavar="K", help="seed of the probing noise")

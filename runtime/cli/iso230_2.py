@@ -94,8 +94,8 @@ def register(sub) -> None:
                       "and the reversal (RV_<axis>_um),", "--table-out")
     add_force(p)
     p.add_argument("--tolerance", metavar="'A=..,E=..'",
-                   help="tolerances in um of any of A E M R B: verdicts per ISO 14253-1 "
-                        "(tolerance reduced / widened by U)")
+                   help="tolerances in um (or with a length unit: A=0.012 mm) of any of "
+                        "A E M R B: verdicts per ISO 14253-1 (tolerance reduced / widened by U)")
     u = p.add_argument_group("measurement uncertainty (ISO/TR 230-9)")
     u.add_argument("--instrument-ppm", type=float, default=0.5, metavar="P",
                    help="accuracy of the interferometer with its environmental compensation, "

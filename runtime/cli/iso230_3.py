@@ -80,6 +80,7 @@ def run(args) -> int:
     from ..instruments import drift
     from ..positioning import iso230_3
 
+    ident = identification_from_args(args)     # --date checked before anything is read
     runs = drift.read_runs(args.file)
     plots = _plot_paths(args.plot, runs)
     outs = Outputs([args.file], force=args.force).file("--json", args.json) \
@@ -98,7 +99,7 @@ def run(args) -> int:
     if args.html:
         html_text = iso230_3.report_html(
             evals, pngs, f"Evaluated with volerr {ver} on {datetime.date.today().isoformat()}.",
-            identification=identification_from_args(args))
+            identification=ident)
     with outs:
         if args.json:
             write_text(outs.path("--json"), json_text(report), inputs=[args.file])

@@ -12,27 +12,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..results import ResultMixin, Row, as_table
 from . import analysis as an
 
-_LENGTH = {"nm": 1e-3, "um": 1.0, "mm": 1e3}
-_ANGLE = {"urad": 1.0, "mrad": 1e3, "rad": 1e6, "arcsec": 4.84813681109536}
-
-
 def _convert(value: float, unit: str, to: str, name: str) -> float:
-    """``value`` in ``unit`` expressed in ``to`` (lengths, angles; other units must match)."""
-    from ..errors import InputError
+    """``value`` in ``unit`` expressed in ``to`` (:func:`volerr.units.convert`)."""
+    from ..units import convert
 
-    if unit == to or not unit:
-        return value
-    for table in (_LENGTH, _ANGLE):
-        if unit in table and to in table:
-            return value * table[unit] / table[to]
-    raise InputError(f"--tolerance {name}: given in {unit}, the history holds {name} in {to}")
+    return convert(value, unit, to, f"--tolerance {name}")
 
 
-@dataclass
-class History:
-    """A machine's history analysed (module docstring); ``data`` is the JSON."""
+@dataclass(repr=False)
+class History(ResultMixin):
+    """A machine's history analysed (module docstring); ``data`` is the JSON
+    (``to_dict()``), ``summary()`` the lines ``volerr history show`` prints, ``table()`` its
+    numbers (:meth:`table`), ``figures()`` one chart per parameter, ``write_json`` /
+    ``write_html`` the command's ``--json`` / ``--html``; the JSON's keys as attributes
+    (``h.events``, ``h.forecast``; ``h.trends`` is the fitted lines, ``h["trends"]`` or
+    ``h.to_dict()["trends"]`` their JSON)."""
     data: dict
     series: dict
     trends: dict
@@ -82,13 +79,44 @@ class History:
                 "method": METHOD}
         return cls(data, series, {n: f for n, f in fits.items()})
 
-    def to_dict(self) -> dict:
-        return self.data
+    def __getitem__(self, key):
+        return self.data[key]
 
-    def write_json(self, path, inputs=()):
-        from ..fileio import json_text, write_text
+    def write_html(self, path, inputs=()):
+        """The history page (``--html``); returns its path."""
+        from ..fileio import write_text
 
-        return write_text(path, json_text(self.data), inputs=list(inputs))
+        return write_text(path, self.html(), inputs=list(inputs))
+
+    def figures(self) -> dict:
+        """``{parameter: Figure}``: the chart of each parameter (values, limits, trend)."""
+        return {n: parameter_figure(self, n) for n in self.series}
+
+    def summary(self) -> str:
+        """What ``volerr history show`` prints."""
+        return "\n".join(self.summary_lines())
+
+    def _rows(self) -> list:
+        """The numbers the command prints: each event (``"EY0C step 2025-03-31"``, the step
+        in the parameter's unit), each trend (``"EX0C slope since 2025-01-06"``, per day:
+        unit ``um/d``, ``urad/d``), each forecast's tolerance (``"EX0C tolerance"``, no
+        uncertainty) and the volumetric error now of a ``map`` forecast; std k = 1."""
+        d = self.data
+        rows = [Row(f"{e['parameter']} step {e['date']}", e["change"], e["std"], e["unit"])
+                for e in d["events"]]
+        rows += [Row(f"{n} slope since {t['since']}", t["slope_per_day"], t["std"],
+                     f"{t['unit']}/d") for n, t in d["trends"].items()]
+        for n, f in d["forecast"].items():
+            rows.append(Row(f"{n} tolerance", f["tolerance"], None, f["unit"]))
+            if "now_um" in f:
+                rows.append(Row("map now", f["now_um"], None, "um"))
+        return rows
+
+    def table(self):
+        """Name, value, standard uncertainty (k = 1), unit, k of every number the command
+        prints (:meth:`_rows`): a :class:`pandas.DataFrame`, or a list of
+        :class:`volerr.results.Row` without pandas."""
+        return as_table(self._rows())
 
     def html(self) -> str:
         return render_html(self)
@@ -112,9 +140,6 @@ class History:
             out.append(f"  {n} leaves its tolerance: {f['date'] or 'not foreseen'}"
                        + (f" (95 %: {lo or 'open'} to {hi or 'open'})" if f["date"] else ""))
         return out
-
-    def __repr__(self) -> str:
-        return f"History({self.summary_lines()[0]})"
 
 
 METHOD = ("control charts against the first calibration: Shewhart individuals +-3 sigma "

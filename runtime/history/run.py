@@ -23,11 +23,11 @@ Rules of ``add`` (the store's own rules in :mod:`volerr.history.store`):
 
 from __future__ import annotations
 
-import datetime as _dt
 import re
 from pathlib import Path
 
 from ..errors import InputError, require
+from ..units import QUANTITY_UNITS, convert, parse_assignments, parse_date, today_utc
 from . import results
 from .results import CALIBRATION, CHECK
 
@@ -43,51 +43,65 @@ def check_machine(machine: str) -> str:
 
 
 def today() -> str:
-    return _dt.datetime.now(_dt.timezone.utc).date().isoformat()
+    """Today's date, UTC (:func:`volerr.units.today_utc`)."""
+    return today_utc()
 
 
 def check_date(text: str, where: str = "--date") -> str:
-    """``text`` as YYYY-MM-DD, not after today (UTC)."""
-    try:
-        d = _dt.date.fromisoformat(str(text))
-    except ValueError:
-        raise InputError(f"{where} {text!r}: a date YYYY-MM-DD expected") from None
-    require(len(str(text)) == 10, f"{where} {text!r}: a date YYYY-MM-DD expected")
-    require(d.isoformat() <= today(), f"{where} {text}: lies in the future (today is "
-                                      f"{today()} UTC); a result is dated when it was "
-                                      f"measured")
-    return d.isoformat()
+    """``text`` as YYYY-MM-DD, not after today (UTC): :func:`volerr.units.parse_date`."""
+    return parse_date(text, where)
 
 
 def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 10.0) -> list:
     """Add the result files to ``machine``'s history in ``db`` (module docstring); returns
-    ``[(Entry, "added" | "already stored")]``."""
-    from .store import Store
+    ``[(Entry, "added" | "already stored")]``.  Every entry reported ``"added"`` is committed.
+    A new SQLite file appears only with its entries committed
+    (:func:`volerr.history.store.add_to_new_file`); a failing call removes nothing but its
+    own staging folder.  Another writer storing the same result in between (a new file
+    created first by another process, a :class:`~volerr.history.store.Conflict`): the files
+    are read again and added to what is stored."""
+    from .store import Conflict, Store, add_to_new_file
 
     check_machine(machine)
     files = list(files)
     require(files, "give at least one RESULT.json")
     date = check_date(date) if date is not None else None
+    _read_entries(files, date)              # every file checked before the database is touched
+
+    def work(store):
+        entries = _read_entries(files, date)    # fresh: a check's reference is applied in place
+        paths = {id(e): f for f, e in entries}
+        return store.add(machine, [e for _, e in entries],
+                         lambda entry, stored: _prepare(entry, stored, paths[id(entry)]))
+
+    for _ in range(_ATTEMPTS):
+        try:
+            if "://" not in str(db) and not Path(db).exists():
+                made, value = add_to_new_file(db, wait_s, work)
+                if made:
+                    return value
+                continue                        # another process created it: add to that
+            return work(Store(db, wait_s=wait_s, create=True))
+        except Conflict:
+            continue
+    raise InputError(f"--db {db}: other processes kept writing the same results at the same "
+                     f"time; nothing written, try again")
+
+
+#: attempts of one add against writers racing for the same new file or the same result
+_ATTEMPTS = 4
+
+
+def _read_entries(files: list, date: str | None) -> list:
+    """``[(file, Entry)]`` dated (``date``, else the result's own, else today) and in the
+    order they are stored (date, calibrations first)."""
     entries = []
     for f in files:
         e = results.read(f)
         e.date = date or (check_date(e.date, f"{f}: its date") if e.date else today())
         entries.append((f, e))
     entries.sort(key=lambda fe: (fe[1].date, fe[1].kind != CALIBRATION))
-    paths = {id(e): f for f, e in entries}
-
-    def prepare(entry, stored):
-        _prepare(entry, stored, paths[id(entry)])
-
-    new_file = None if "://" in str(db) or Path(db).exists() else Path(db)
-    try:
-        store = Store(db, wait_s=wait_s, create=True)
-        return store.add(machine, [e for _, e in entries], prepare)
-    except InputError:
-        if new_file is not None:        # nothing written: not even the empty store
-            for f in (new_file, Path(f"{new_file}-journal")):
-                f.unlink(missing_ok=True)
-        raise
+    return entries
 
 
 def _prepare(entry, stored: list, path) -> None:
@@ -126,26 +140,18 @@ def _reference(entry, stored: list, path):
 
 
 def parse_tolerances(text: str | None) -> dict:
-    """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``; ``map`` in um."""
-    out: dict = {}
+    """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``: every value with
+    its unit (:func:`volerr.units.parse_assignments`; a bare number is refused, the history
+    holds parameters in different units); ``map`` (the volumetric error) a length, in um."""
     if not text:
-        return out
-    for part in filter(None, (p.strip() for p in re.split(r"[,;|]", text))):
-        name, eq, rest = part.partition("=")
-        m = re.fullmatch(r"\s*([-+0-9.eE]+)\s*([A-Za-zµ/^0-9]*)\s*", rest)
-        require(eq == "=" and name.strip() and m is not None,
-                f"--tolerance {part!r}: NAME=VALUE UNIT expected (e.g. EX0C=20 um, map=30 um)")
-        try:
-            value = float(m.group(1))
-        except ValueError:
-            raise InputError(f"--tolerance {part!r}: {m.group(1)!r} is not a number") from None
-        require(value > 0 and value < 1e12, f"--tolerance {part!r}: a positive value expected")
-        unit = m.group(2).replace("µ", "u")
-        name = name.strip()
-        require(name not in out, f"--tolerance: {name} given twice")
-        require(name != "map" or unit in ("um", ""), "--tolerance map=VALUE um (the "
-                                                     "volumetric error in um)")
-        out[name] = (value, unit or ("um" if name == "map" else ""))
+        return {}
+    out = {}
+    for name, (value, unit) in parse_assignments(text, "--tolerance", any_unit=True):
+        if name == "map":
+            require(QUANTITY_UNITS.get(unit, ("",))[0] == "length",
+                    "--tolerance map=VALUE um (the volumetric error, a length)")
+            value, unit = convert(value, unit, "um"), "um"
+        out[name] = (value, unit)
     return out
 
 

@@ -29,12 +29,24 @@ Rules:
   time: :class:`InputError` ("locked"), nothing written.
 * A file that is not an SQLite database, or an SQLite database with tables of its own but
   none of volerr's, is refused before anything is written (never a foreign file changed).
+* A new SQLite history is never half made and never removed: the first ``add``
+  (:func:`add_to_new_file`) writes schema and entries into a file in a staging folder of its
+  own beside it and links it into place only after its transaction committed (``os.link``
+  fails when the name exists, so of two processes creating the same history at once one
+  wins and the other adds to the winner's file).  A failing command removes only that
+  staging folder of its own, never the history.
+* Schema creation tolerates a racing creator (``CREATE TABLE IF NOT EXISTS`` under the
+  writer's lock, retried on "already exists"); ``sha256`` is unique, and a transaction that
+  breaks it (a writer that did not take the lock) is rolled back and raised as
+  :class:`Conflict` so that the caller re-runs it against what is stored.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
 import json
+import os
+import tempfile
 from pathlib import Path
 
 from ..errors import InputError, require
@@ -43,6 +55,13 @@ from .results import Entry, Value
 SCHEMA_VERSION = 1
 #: an arbitrary constant key of the PostgreSQL advisory lock that serialises writers
 _PG_LOCK_KEY = 370_003_001
+#: attempts at creating the schema when a racing creator makes it at the same time
+_SCHEMA_ATTEMPTS = 3
+
+
+class Conflict(Exception):
+    """A write broke a unique constraint (another writer stored the same result in between):
+    the transaction was rolled back, nothing written; run it again."""
 
 
 def _tables(sa):
@@ -91,14 +110,15 @@ class Store:
     first :meth:`add`) or a ``postgresql://`` URL; ``wait_s``: how long a writer waits for
     another one's lock, s; ``create``: make the schema when the database has none."""
 
-    def __init__(self, db: str, wait_s: float = 10.0, create: bool = False):
+    def __init__(self, db: str, wait_s: float = 10.0, create: bool = False,
+                 shown: str | None = None):
         self.sa = sa = _sqlalchemy()
         self.db = str(db)
         self.wait_s = float(wait_s)
         self.md, self.t_version, self.t_entries, self.t_values = _tables(sa)
         self.postgres = self.db.startswith(("postgresql://", "postgresql+psycopg://",
                                             "postgres://"))
-        self.shown = self._shown()
+        self.shown = shown or self._shown()
         self.engine = self._pg_engine() if self.postgres else self._sqlite_engine(create)
         self._open(create)
 
@@ -137,7 +157,8 @@ class Store:
             require(p.parent.is_dir() if str(p.parent) else True,
                     f"--db {self.db}: folder {p.parent} does not exist")
         else:
-            head = p.read_bytes()[:16] if p.stat().st_size else b""
+            with open(p, "rb") as fh:
+                head = fh.read(16)
             require(not head or head == b"SQLite format 3\x00",
                     f"--db {self.db}: not a volerr history (not an SQLite database)")
         engine = sa.create_engine(f"sqlite:///{p}", poolclass=sa.pool.NullPool,
@@ -166,6 +187,18 @@ class Store:
 
     # -- schema --------------------------------------------------------------------------
     def _open(self, create: bool) -> None:
+        """Check the schema (made when ``create`` and there is none), retried when a racing
+        creator made it between our look and our CREATE ("already exists")."""
+        for attempt in range(_SCHEMA_ATTEMPTS):
+            try:
+                return self._open_once(create)
+            except Conflict:
+                if attempt == _SCHEMA_ATTEMPTS - 1:
+                    raise InputError(f"--db {self.shown}: another process kept creating the "
+                                     f"history at the same time; nothing written, try "
+                                     f"again") from None
+
+    def _open_once(self, create: bool) -> None:
         with self._guard():
             with self._connect(create) as conn, conn.begin():
                 if self.postgres and create:
@@ -177,7 +210,7 @@ class Store:
                             f"with other tables: {', '.join(sorted(names)[:5])})")
                     require(create, f"--db {self.shown}: no volerr history there (add "
                                     f"results first)")
-                    self.md.create_all(conn)
+                    self.md.create_all(conn, checkfirst=True)
                     conn.execute(self.t_version.insert().values(version=SCHEMA_VERSION))
                     return
                 rows = conn.execute(self.sa.select(self.t_version.c.version)).all()
@@ -277,6 +310,55 @@ class Store:
             conn.execute(v.insert(), rows)
 
 
+def add_to_new_file(path, wait_s: float, work):
+    """Create the SQLite history ``path`` (which does not exist) with what ``work(store)``
+    writes into it: ``work`` runs on a new file in a staging folder of this process beside
+    ``path`` (named by :func:`volerr.fileio.staging_prefix`, so that one left by a killed
+    process is removed by the next run, :func:`volerr.fileio.remove_stale_staging`); the
+    file is linked to ``path`` only after ``work`` committed.  Returns ``(True, work's
+    value)``, or ``(False, None)`` when another process created ``path`` first (then nothing
+    of ours is left: add to that file instead).  On any failure the staging folder is
+    removed and ``path`` never appears; nothing else is ever removed."""
+    import shutil
+
+    from ..fileio import remove_stale_staging, staging_prefix
+
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    require(folder.is_dir(), f"--db {path}: folder {folder} does not exist")
+    remove_stale_staging(folder)
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=staging_prefix(), dir=folder))
+    except OSError as exc:
+        raise InputError(f"--db {path}: cannot create a file in {folder} "
+                         f"({exc.strerror or exc})") from None
+    try:
+        store = Store(str(stage / path.name), wait_s=wait_s, create=True, shown=str(path))
+        value = work(store)
+        store.engine.dispose()
+        if not _publish(stage / path.name, path):
+            return False, None
+        return True, value
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)    # ours alone: made in this call
+
+
+def _publish(tmp: Path, path: Path) -> bool:
+    """Give the committed file ``tmp`` the name ``path`` unless that name exists (atomic:
+    a hard link; Windows: a rename, which refuses an existing name).  False: it exists."""
+    try:
+        if os.name == "nt":
+            os.rename(tmp, path)
+        else:
+            os.link(tmp, path)
+    except FileExistsError:
+        return False
+    except OSError as exc:
+        raise InputError(f"--db {path}: cannot create it ({exc.strerror or exc}; a folder "
+                         f"without hard links? create the history on a local disk)") from None
+    return True
+
+
 def _entry(r, values: dict) -> Entry:
     return Entry(r["kind"], r["layout"], values, r["sha256"], r["source"], r["document"],
                  date=r["date"], verdict=r["verdict"],
@@ -315,4 +397,6 @@ class _Guard:
         if "not a database" in text or "malformed" in text:
             raise InputError(f"{where}: not a volerr history (a corrupt SQLite file: "
                              f"{text})") from None
+        if isinstance(exc, sa.exc.IntegrityError) or "already exists" in text:
+            raise Conflict(text) from None
         raise InputError(f"{where}: {text}") from None

@@ -49,19 +49,30 @@ class Spec:
 
 
 _NUM = r"([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)"
+#: a number with an optional length unit (um when bare)
+_LEN = r"([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?(?:um|µm|μm|nm|mm)?)"
 
 
 def parse_spec(text: str, option: str = "--spec") -> Spec:
     """``"E0=A+L/K"`` (A um, K dimensionless), optionally ``",PFTU=P"`` (um).  ``option``:
-    the command-line option the text came from, named in the messages."""
+    the command-line option the text came from, named in the messages.  A and P may carry
+    a length unit (``"E0=1.5 um+L/333"``, ``"E0=0.0015mm+L/333"``; bare: um)."""
+    from ..units import convert, parse_quantity
+
     t = str(text).replace(" ", "")
-    m = re.fullmatch(r"(?:MPE_?)?E0?=" + _NUM + r"\+L/" + _NUM + r"(?:[,;](?:MPE_?)?PFTU=" + _NUM
+    m = re.fullmatch(r"(?:MPE_?)?E0?=" + _LEN + r"\+L/" + _NUM + r"(?:[,;](?:MPE_?)?PFTU=" + _LEN
                      + r")?", t, re.IGNORECASE)
     require(m is not None, f"{option} {text!r}: expected \"E0=A+L/K\" (A in um, L in mm, K "
                            f"dimensionless), optionally \",PFTU=P\" (um)")
-    a, k = float(m.group(1)), float(m.group(2))
+
+    def um(cell):
+        v, unit = parse_quantity(cell, f"{option} {text!r}", default_unit="um",
+                                 kinds=("length",), positive=False)
+        return convert(v, unit, "um")
+
+    a, k = um(m.group(1)), float(m.group(2))
     require(a > 0 and k > 0, f"{option} {text!r}: A and K must be positive")
-    p = float(m.group(3)) if m.group(3) else None
+    p = um(m.group(3)) if m.group(3) else None
     require(p is None or p > 0, f"{option} {text!r}: PFTU must be positive")
     return Spec(a, k, p)
 

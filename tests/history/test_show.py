@@ -81,3 +81,35 @@ def test_map_without_constants_and_unknown_tolerance(tmp_path, capsys):
         assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (tol, err)
     code, _, err = run(["history", "show", "--db", db, "--machine", "M2"], capsys)
     assert code == 2 and "no entries" in err and "M1" in err
+
+
+def test_history_result_contract(tmp_path, capsys):
+    """``volerr.history.show`` returns a result: ``summary()`` is what the command prints,
+    ``table()`` holds the printed numbers (the planted step of EY0C, the planted drift of
+    EX0C per day, the tolerances), a short repr, ``to_dict()`` the --json document."""
+    from volerr.results import Row
+
+    db = tmp_path / "h.sqlite"
+    add_all(db, "M1", weekly(tmp_path, weeks=21, seed=7), capsys)
+    code, out, err = run(["history", "show", "--db", db, "--machine", "M1", "--tolerance",
+                          "EX0C=15 um,EY0C=3 um", "--json", tmp_path / "s.json"], capsys)
+    assert code == 0, err
+    h = volerr.history.show(str(db), "M1", "EX0C=15 um,EY0C=3 um")
+    assert h.summary() == out.rstrip("\n")
+    assert h.to_dict() == json.loads((tmp_path / "s.json").read_text())
+    r = repr(h)
+    assert r.startswith("<volerr History: M1 (DMU50): 21 entries") and "\n" not in r
+    assert len(r) < 130
+    rows = {row.name: row for row in h._rows()}
+    assert all(isinstance(x, Row) and x.k == 1.0 for x in rows.values())
+    jump = (START + dt.timedelta(weeks=12)).isoformat()
+    step = rows[f"EY0C step {jump}"]
+    assert step.unit == "um" and abs(step.value - 4.0) < 3 * step.std
+    slope = [x for n, x in rows.items() if n.startswith("EX0C slope since")]
+    assert len(slope) == 1 and slope[0].unit == "um/d"
+    assert abs(slope[0].value - 0.3 / 7) < 3 * slope[0].std
+    assert rows["EX0C tolerance"].value == 15 and rows["EY0C tolerance"].value == 3
+    table = h.table()
+    assert len(table) == len(rows) > 0
+    assert list(getattr(table, "columns", Row._fields)) == list(Row._fields)
+    assert h.events == h.to_dict()["events"] and h["machine"] == "M1"
