@@ -200,6 +200,19 @@ def _row(cells) -> str:
     return "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>"
 
 
+def fit_html(d: dict) -> str:
+    """The fit's residual verdict (and, when forced, the warning) as HTML paragraphs."""
+    f = d.get("fit")
+    if not f:
+        return ""
+    out = (f"<p>Fit: chi2/dof = {f['chi2_per_dof']:.3g} (dof {f['dof']}, p = "
+           f"{f['p_value']:.2g}; {html.escape(f['u'])}): <b>{html.escape(f['verdict'])}</b>"
+           f"</p>\n")
+    if d.get("forced"):
+        out += f"<p style=\"color:#b00\"><b>{html.escape(d['forced'])}</b></p>\n"
+    return out
+
+
 def render_html(cal) -> str:
     d = cal.data
     params = "".join(_row([n, num(v["value"], ".4g"), num(v["std"], ".2g"), unit(v["unit"])])
@@ -229,7 +242,7 @@ def render_html(cal) -> str:
 collapse;margin:0.5em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;
 vertical-align:top;overflow-wrap:anywhere}}</style></head><body>
 <h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
-<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
+{fit_html(d)}<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
 variance factor {num(d['variance_factor'], '.3g')} (1 when the residuals match the stated
 reading uncertainties).  Standard uncertainties u (k = 1); the figure's bars ± 2 u (k = 2).</p>
 <h2>Identified parameters</h2>
