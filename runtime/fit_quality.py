@@ -155,17 +155,35 @@ def forced_note(fit: FitQuality | None) -> str | None:
             f"{FORCE_OPTION}")
 
 
-def gate(data: dict, fit: FitQuality | None, accept: bool, where: str) -> FitQuality | None:
+def gate(data: dict, fit: FitQuality | None, accept: bool, where: str,
+         key: str = "fit") -> FitQuality | None:
     """:func:`require_fit` on a result's JSON ``data``: refuses (InputError) or, when
-    accepted, sets ``data["fit"]`` to the forced verdict and ``data["forced"]`` to
-    :func:`forced_note`, the sentence every output then carries."""
+    accepted, sets ``data[key]`` to the forced verdict and ``data["forced"]`` to
+    :func:`forced_note`, the sentence every output then carries (``key``: ``"fit"``;
+    ``identify``, whose ``"fit"`` lists its ``--fit`` error functions: ``"fit_quality"``)."""
     fit = require_fit(fit, accept, where)
     if fit is not None:
-        data["fit"] = fit.to_dict()
+        data[key] = fit.to_dict()
         note = forced_note(fit)
         if note:
             data["forced"] = note
     return fit
+
+
+def fit_html(d: dict) -> str:
+    """A result's ``d["fit"]`` (and, when forced, ``d["forced"]`` in red) as HTML
+    paragraphs; "" without a fit."""
+    import html
+
+    f = d.get("fit")
+    if not isinstance(f, dict) or "chi2_per_dof" not in f:
+        return ""
+    out = (f"<p>Fit: chi2/dof = {f['chi2_per_dof']:.3g} (dof {f['dof']}, p = "
+           f"{f['p_value']:.2g}; {html.escape(f['u'])}): <b>{html.escape(f['verdict'])}</b>"
+           f"</p>\n")
+    if d.get("forced"):
+        out += f"<p style=\"color:#b00\"><b>{html.escape(d['forced'])}</b></p>\n"
+    return out
 
 
 # --- changes beyond a limit ------------------------------------------------------------

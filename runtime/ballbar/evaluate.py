@@ -29,6 +29,7 @@ class Evaluation(ResultMixin):
     data: dict
     traces: list
     results: list
+    quality: object = None     # the diagnosis fit's residual rule (volerr.fit_quality)
 
     def summary(self) -> str:
         """G, H and F per trace (um) and the diagnosis (value +- u, k = 1)."""
@@ -42,6 +43,8 @@ class Evaluation(ResultMixin):
                        f"(u, k = 1)")
         if self.data.get("diagnosis_note"):
             out.append(f"  no diagnosis: {self.data['diagnosis_note']}")
+        if self.quality is not None:
+            out.append("  diagnosis " + self.quality.line())
         return "\n".join(out)
 
     def _rows(self) -> list:
@@ -85,10 +88,12 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
         stacked = instruments.stack(parts)
         planes = list(dict.fromkeys(t.plane for t in trs))
         swept = [a for a in model.rotary_axes if np.ptp(stacked.positions[a]) > 1.0]
-        data["diagnosis"], note = diagnosis.diagnose_with_note(
+        data["diagnosis"], note, quality = diagnosis.diagnose_fit(
             model, stacked, [] if swept else planes, swept)
         if note:
             data["diagnosis_note"] = note
+        data["fit"] = quality.to_dict()
+        return Evaluation(data, trs, results, quality)
     return Evaluation(data, trs, results)
 
 

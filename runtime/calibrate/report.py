@@ -13,6 +13,7 @@ import html
 import numpy as np
 
 from ..plotstyle import embedded_img, figure, label, png, styled, unit
+from ..fit_quality import fit_html
 from ..units import num
 
 
@@ -198,19 +199,6 @@ error directory says so).  Every other parameter not determined is written as 0:
 
 def _row(cells) -> str:
     return "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>"
-
-
-def fit_html(d: dict) -> str:
-    """The fit's residual verdict (and, when forced, the warning) as HTML paragraphs."""
-    f = d.get("fit")
-    if not f:
-        return ""
-    out = (f"<p>Fit: chi2/dof = {f['chi2_per_dof']:.3g} (dof {f['dof']}, p = "
-           f"{f['p_value']:.2g}; {html.escape(f['u'])}): <b>{html.escape(f['verdict'])}</b>"
-           f"</p>\n")
-    if d.get("forced"):
-        out += f"<p style=\"color:#b00\"><b>{html.escape(d['forced'])}</b></p>\n"
-    return out
 
 
 def render_html(cal) -> str:
