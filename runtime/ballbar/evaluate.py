@@ -47,6 +47,24 @@ class Evaluation(ResultMixin):
             out.append("  diagnosis " + self.quality.line())
         return "\n".join(out)
 
+    def judge(self, accept: bool, where: str) -> None:
+        """The residual rule (:mod:`volerr.fit_quality`) on the diagnosis fit.  The ISO 230-4
+        values (G, H, F) do not depend on any model and are always given; a diagnosis whose
+        fit is far above the readings' declared uncertainty is withheld (``diagnosis`` empty,
+        ``diagnosis_note`` says why, ``fit`` verdict ``refused``) unless ``accept``
+        (``--accept-residual``: given, marked forced in every output)."""
+        from ..errors import InputError
+        from ..fit_quality import gate
+
+        try:
+            self.quality = gate(self.data, self.quality, accept, where)
+        except InputError as e:
+            self.data["diagnosis"] = []
+            self.data["diagnosis_note"] = (f"withheld: {str(e).split(': ', 1)[1]}"
+                                           .replace("nothing written", "diagnosis withheld")
+                                           .replace("writes it", "gives it"))
+            self.data["fit"] = self.quality.to_dict()
+
     def _rows(self) -> list:
         from ..results import Row
 

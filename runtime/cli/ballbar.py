@@ -111,10 +111,7 @@ def run_evaluate(args) -> int:
     outs = Outputs(inputs, force=args.force).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).check()
     ev = ballbar_evaluate(args.files, args.layout)
-    from ..fit_quality import gate
-
-    ev.quality = gate(ev.data, ev.quality, args.accept_residual,
-                      f"ballbar evaluate {' '.join(args.files)} (the diagnosis)")
+    ev.judge(args.accept_residual, f"ballbar evaluate {' '.join(args.files)} (the diagnosis)")
     with outs:
         if args.json:
             ev.write_json(outs.path("--json"), inputs=inputs)
