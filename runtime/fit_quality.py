@@ -128,12 +128,6 @@ def judge(chi2: float, dof: float, u: str) -> FitQuality:
     c = float(chi2)
     require(math.isfinite(c), "the fit's residual is not finite (NaN or overflow in the "
                               "readings)")
-    import os, inspect  # TEMPORARY measurement log
-    if os.environ.get("VOLERR_FITLOG"):
-        with open(os.environ["VOLERR_FITLOG"], "a") as fh:
-            st = [f"{fr.filename.split('/')[-1]}:{fr.function}" for fr in inspect.stack()[1:40]
-                  if "/tests/" in fr.filename][:2]
-            fh.write(f"{c / max(dof, 1):.4g} {dof:.0f} {st} {u[:30]}\n")
     return FitQuality(max(c, 0.0), max(int(round(dof)), 1), u)
 
 
