@@ -290,21 +290,34 @@ def against_reference(data: dict, old: dict, limits: dict | None, accept: bool,
     return beyond
 
 
-def read_reference_parameters(path, option: str = "--reference") -> dict:
-    """``{NAME: {"value", "unit"}}`` of a calibrate or check JSON (its ``parameters``);
-    one-line InputError naming the file."""
+def read_result_json(path, layout: str | None = None, option: str = "--reference") -> dict:
+    """The JSON of ``volerr calibrate --json`` or ``volerr check --json`` in ``path`` (its
+    ``layout`` must be ``layout`` when given): the one reader of a reference calibration
+    (``check --reference``, ``calibrate --reference``); one-line InputError naming the file."""
     import json
     from pathlib import Path
 
     p = Path(path)
-    require(p.is_file(), f"{option} {p}: no such file")
+    require(p.is_file(), f"{option} {path}: no such file")
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
-    except (ValueError, UnicodeDecodeError):
-        raise InputError(f"{option} {p}: not a JSON file (give a calibrate or check "
-                         f"--json)") from None
-    params = doc.get("parameters") if isinstance(doc, dict) else None
+    except (UnicodeDecodeError, ValueError):
+        raise InputError(f"{option} {path}: not a JSON file (give the JSON of 'volerr "
+                         f"calibrate --json' or 'volerr check --json')") from None
+    require(isinstance(doc, dict) and "layout" in doc and "parameters" in doc,
+            f"{option} {path}: not a calibration (no 'layout' and 'parameters'; give the "
+            f"JSON of 'volerr calibrate --json' or 'volerr check --json')")
+    require(layout is None or doc["layout"] == layout,
+            f"{option} {path}: a calibration of layout {doc['layout']}, not of {layout}")
+    return doc
+
+
+def read_reference_parameters(path, layout: str | None = None,
+                              option: str = "--reference") -> dict:
+    """``{NAME: {"value", "unit"}}`` of a calibrate or check JSON (its ``parameters``,
+    :func:`read_result_json`); one-line InputError naming the file."""
+    params = read_result_json(path, layout, option)["parameters"]
     require(isinstance(params, dict) and params and all(
         isinstance(v, dict) and "value" in v for v in params.values()),
-        f"{option} {p}: no 'parameters' with values (give a calibrate or check --json)")
+        f"{option} {path}: no 'parameters' with values (give a calibrate or check --json)")
     return params

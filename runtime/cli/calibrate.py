@@ -67,8 +67,8 @@ def run(args) -> int:
     require(2 <= args.map_grid <= 60, "--map-grid must be between 2 and 60")
     require(args.reference or not args.max_change, "--max-change needs --reference CAL.json")
     limits = fq.parse_max_change(args.max_change) if args.max_change else None
-    old = fq.read_reference_parameters(args.reference) if args.reference else None
     model = load(args.layout)
+    old = fq.read_reference_parameters(args.reference, model.name) if args.reference else None
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
