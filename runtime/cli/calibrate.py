@@ -94,4 +94,8 @@ def run(args) -> int:
 
             write_csv(outs.path("--map-out"), result, (args.map_grid,) * 3, inputs=inputs)
     print(result.summary())
+    beyond = result.data.get("max_change", {}).get("beyond")
+    if beyond:
+        print("  changes beyond --max-change, accepted (--accept-change): " + ", ".join(
+            f"{c['parameter']} {c['old']:.4g} -> {c['new']:.4g} {c['unit']}" for c in beyond))
     return 0
