@@ -146,6 +146,17 @@ def require_fit(fit: FitQuality | None, accept: bool, where: str) -> FitQuality 
         f"likely {LIKELY}; nothing written ({FORCE_OPTION} writes it, marked as forced)")
 
 
+def require_writable(fit: FitQuality | None, accept: bool, what: str) -> None:
+    """The API's guard before an error table or map is written: a fit the rule refuses
+    (verdict ``refused``: far above and not yet accepted) is not written unless ``accept``
+    (then it is marked forced by the command, :func:`gate`).  One-line InputError."""
+    if fit is not None and fit.verdict == "refused" and not accept:
+        raise InputError(f"{what}: not written: the fit's residual is far above the readings' "
+                         f"declared uncertainty (chi2/dof = {fit.chi2_per_dof:.3g}, p = "
+                         f"{fit.p_value:.2g}); accept_residual=True ({FORCE_OPTION}) writes "
+                         f"it")
+
+
 def forced_note(fit: FitQuality | None) -> str | None:
     """The sentence every output of a forced fit carries (None when not forced)."""
     if fit is None or fit.verdict != "forced":

@@ -149,6 +149,9 @@ def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), input
 
     from ..errors import require
 
+    from ..fit_quality import require_writable
+
+    require_writable(getattr(cal, "quality", None), False, f"--map-out {path}")
     model = cal.model
     require(len(model.axes) - len(model.rotary_axes) == 3,
             f"--map-out: {model.name} has not three linear axes")

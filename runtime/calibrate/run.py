@@ -198,9 +198,15 @@ class Calibration(ResultMixin):
                 tables[a] = ErrorTable(a, np.linspace(*self.ranges[a], n_grid), {})
             tables[a].reversal = np.full(len(tables[a].positions), float(coef[j]))
 
-    def write_error_tables(self, directory, inputs=()) -> Path:
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+        """The error directory (``X.csv`` ... ``constants.csv``); refused for a fit far above
+        the readings' uncertainty unless ``accept_residual`` (:mod:`volerr.fit_quality`)."""
+        from ..fit_quality import gate, require_writable
         from ..tables.table import write_error_dir
 
+        require_writable(self.quality, accept_residual, f"error tables {directory}")
+        if accept_residual:
+            self.quality = gate(self.data, self.quality, True, "error tables")
         tables, constants, cstd = self.error_tables()
         return write_error_dir(directory, tables, constants or None, cstd or None,
                                inputs=list(inputs), comments=self.table_comments())

@@ -141,10 +141,16 @@ class Report(ResultMixin):
                 constants[p] = float(coef[index[(p, None)]])
         return tables, constants
 
-    def write_error_tables(self, directory, inputs=()) -> Path:
-        """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``)."""
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+        """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``);
+        refused for a fit far above the readings' uncertainty unless ``accept_residual``
+        (:mod:`volerr.fit_quality`)."""
+        from ..fit_quality import gate, require_writable
         from ..tables.table import write_error_dir
 
+        require_writable(self.quality, accept_residual, f"error tables {directory}")
+        if accept_residual:
+            self.quality = gate(self.data, self.quality, True, "error tables")
         tables, constants = self.error_tables()
         note = self.data.get("forced")
         comments = {w: [note] for w in ["constants", *tables]} if note else None

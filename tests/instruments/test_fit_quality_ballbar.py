@@ -97,3 +97,18 @@ def test_evaluate_withholds_the_diagnosis(traces, tmp_path):
     # the planted -22 urad, fitted 3x (the mistake is in the readings): far from -22
     ec = {d["parameter"]: d for d in doc["diagnosis"]}["EC0Y"]
     assert abs(ec["value"] - 3 * -22.0) < 5 * ec["std"] + 3.0, ec
+
+
+def test_the_api_writes_no_table_of_a_refused_fit(traces, tmp_path):
+    import volerr
+    from volerr.errors import InputError
+
+    _, _, x3 = traces
+    cal = volerr.calibrate("MB1", [x3], plan=False, progress=False)
+    assert cal.fit["verdict"] == "refused" and cal.fit["chi2_per_dof"] > 4.0
+    with pytest.raises(InputError):
+        cal.write_error_tables(tmp_path / "errs")
+    assert not (tmp_path / "errs").exists()
+    cal.write_error_tables(tmp_path / "errs", accept_residual=True)
+    assert "FORCED" in (tmp_path / "errs" / "X.csv").read_text().splitlines()[0]
+    assert cal.fit["verdict"] == "forced"
