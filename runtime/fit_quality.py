@@ -40,6 +40,7 @@ import math
 from dataclasses import dataclass
 
 from .errors import InputError, require
+from .units import parse_number
 
 #: p-value below which (together with :data:`RATIO_REFUSE`) a fit is refused
 P_REFUSE = 1e-6
@@ -222,12 +223,8 @@ def parse_max_change(text: str, option: str = "--max-change") -> dict:
                                  f"\"EX0C=20 um\" or \"50 urad\" (a bare number is refused)")
         require(words[1] in _UNITS, f"{option} {part!r}: unit {words[1]!r} is none of "
                                     f"{', '.join(_UNITS)}")
-        try:
-            v = float(words[0])
-        except ValueError:
-            v = float("nan")
-        require(math.isfinite(v) and v > 0, f"{option} {part!r}: the limit must be a "
-                                            f"positive number")
+        v = parse_number(words[0], option, repr(part))
+        require(v > 0, f"{option} {part!r}: the limit must be a positive number")
         dim, f = _UNITS[words[1]]
         key = name.strip() or {"length": "um", "angle": "urad", "slope": "um/mm"}[dim]
         require(key not in out, f"{option}: {key} given twice")
