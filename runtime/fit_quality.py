@@ -31,7 +31,9 @@ KinematicsOpt cycle): ``--max-change "EX0C=20 um,EA0B=50 urad"`` (a bound per pa
 bare ``"20 um"`` or ``"50 urad"`` bounds every translational or angular parameter; units
 required) against a reference's values; a parameter moved further is refused with one line
 (:func:`require_consent`) naming it, the old and new value and the limit, until the user gives
-``--accept-change``.
+``--accept-change``.  (The controller's own figure: HEIDENHAIN iTNC 530 HSCI technical manual,
+July 2013, sec. 6.5 "Tilting and swivel axes", MP6600 "KinematicsOpt: Amount of change",
+0.010 to 1.000 mm, default 0.05 mm; its newer controllers call it ``maxModification``.)
 """
 
 from __future__ import annotations
