@@ -46,6 +46,12 @@ def diagnose(model, obs, planes: list, swept: list = ()) -> list:
 def diagnose_with_note(model, obs, planes: list, swept: list = ()) -> tuple[list, str | None]:
     """:func:`diagnose` and, for a rotary sweep that determines none of its axis' location
     errors, the sentence saying why (:func:`why_not`; None otherwise)."""
+    return diagnose_fit(model, obs, planes, swept)[:2]
+
+
+def diagnose_fit(model, obs, planes: list, swept: list = ()) -> tuple:
+    """:func:`diagnose_with_note` and the diagnosis fit's residual against the readings'
+    declared uncertainty (:class:`volerr.fit_quality.FitQuality`, the calibration's)."""
     params, extra, report = [], [], []
     for plane in planes:
         i, j = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}[plane]
@@ -71,7 +77,7 @@ def diagnose_with_note(model, obs, planes: list, swept: list = ()) -> tuple[list
     cal = calibrate(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
                     extra_terms=extra, plan=False, progress=False)
     entries = _entries(cal, report, swept, extra)
-    return entries, why_not(cal, swept, entries)
+    return entries, why_not(cal, swept, entries), cal.quality
 
 
 def why_not(cal, swept: list, entries: list) -> str | None:

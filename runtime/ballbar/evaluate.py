@@ -29,6 +29,7 @@ class Evaluation(ResultMixin):
     data: dict
     traces: list
     results: list
+    quality: object = None     # the diagnosis fit's residual rule (volerr.fit_quality)
 
     def summary(self) -> str:
         """G, H and F per trace (um) and the diagnosis (value +- u, k = 1)."""
@@ -42,7 +43,27 @@ class Evaluation(ResultMixin):
                        f"(u, k = 1)")
         if self.data.get("diagnosis_note"):
             out.append(f"  no diagnosis: {self.data['diagnosis_note']}")
+        if self.quality is not None:
+            out.append("  diagnosis " + self.quality.line())
         return "\n".join(out)
+
+    def judge(self, accept: bool, where: str) -> None:
+        """The residual rule (:mod:`volerr.fit_quality`) on the diagnosis fit.  The ISO 230-4
+        values (G, H, F) do not depend on any model and are always given; a diagnosis whose
+        fit is far above the readings' declared uncertainty is withheld (``diagnosis`` empty,
+        ``diagnosis_note`` says why, ``fit`` verdict ``refused``) unless ``accept``
+        (``--accept-residual``: given, marked forced in every output)."""
+        from ..errors import InputError
+        from ..fit_quality import gate
+
+        try:
+            self.quality = gate(self.data, self.quality, accept, where)
+        except InputError as e:
+            self.data["diagnosis"] = []
+            self.data["diagnosis_note"] = (f"withheld: {str(e).split(': ', 1)[1]}"
+                                           .replace("nothing written", "diagnosis withheld")
+                                           .replace("writes it", "gives it"))
+            self.data["fit"] = self.quality.to_dict()
 
     def _rows(self) -> list:
         from ..results import Row
@@ -85,10 +106,12 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
         stacked = instruments.stack(parts)
         planes = list(dict.fromkeys(t.plane for t in trs))
         swept = [a for a in model.rotary_axes if np.ptp(stacked.positions[a]) > 1.0]
-        data["diagnosis"], note = diagnosis.diagnose_with_note(
+        data["diagnosis"], note, quality = diagnosis.diagnose_fit(
             model, stacked, [] if swept else planes, swept)
         if note:
             data["diagnosis_note"] = note
+        data["fit"] = quality.to_dict()
+        return Evaluation(data, trs, results, quality)
     return Evaluation(data, trs, results)
 
 

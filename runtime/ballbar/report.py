@@ -5,6 +5,7 @@ from __future__ import annotations
 import html
 
 from ..plotstyle import embedded_img
+from ..fit_quality import fit_html
 from ..units import num
 
 
@@ -27,7 +28,7 @@ def render(ev) -> str:
 <style>body{{font-family:sans-serif;max-width:1100px;margin:1em auto}}table{{border-collapse:
 collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}</style></head><body>
 <h1>Ballbar evaluation (ISO 230-4), layout {html.escape(ev.data['layout'])}</h1>
-{img}
+{fit_html(ev.data)}{img}
 <p>Radial deviation of each trace about its least-squares circle (the grey ring), magnified;
 angles from the plane's first axis towards its second (a rotary sweep: the reading against the
 swept axis' angle).</p>

@@ -149,6 +149,9 @@ def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), input
 
     from ..errors import require
 
+    from ..fit_quality import require_writable
+
+    require_writable(getattr(cal, "quality", None), False, f"--map-out {path}")
     model = cal.model
     require(len(model.axes) - len(model.rotary_axes) == 3,
             f"--map-out: {model.name} has not three linear axes")
@@ -163,6 +166,8 @@ def write_csv(path, cal, counts=(GRID, GRID, GRID), probe=(0.0, 0.0, 0.0), input
     notes = ([f"# not determined, 0 in this map: {', '.join(held['undetermined'])}\n"]
              if held["undetermined"] else [])
     notes += [f"# in this map under one of its names: {c}\n" for c in held["combinations"]]
+    if cal.data.get("forced"):
+        notes.insert(0, f"# {cal.data['forced']}\n")
     try:
         out.write(("".join(notes) + ",".join(header) + "\n").encode("utf-8"))
         out.write(csvformat.rows_text(cols, [6] * len(cols)))

@@ -13,6 +13,7 @@ import html
 import numpy as np
 
 from ..plotstyle import embedded_img, figure, label, png, styled, unit
+from ..fit_quality import fit_html
 from ..units import num
 
 
@@ -229,7 +230,7 @@ def render_html(cal) -> str:
 collapse;margin:0.5em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;
 vertical-align:top;overflow-wrap:anywhere}}</style></head><body>
 <h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
-<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
+{fit_html(d)}<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
 variance factor {num(d['variance_factor'], '.3g')} (1 when the residuals match the stated
 reading uncertainties).  Standard uncertainties u (k = 1); the figure's bars ± 2 u (k = 2).</p>
 <h2>Identified parameters</h2>

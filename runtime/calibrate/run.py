@@ -39,6 +39,7 @@ from ..errors import require
 from ..estimate import blocks
 from ..estimate.design import data_ranges, declared_design, gauge_mask, identifiability_gram
 from ..estimate.steps import choose_degree, split_points
+from ..fit_quality import FitQuality, judge
 from ..machine.model import Model, load
 from ..results import ResultMixin
 from . import estimability, terms
@@ -67,6 +68,7 @@ class Calibration(ResultMixin):
     residuals: dict = field(default_factory=dict)   # file -> (positions, residual um, rows)
     solution: "Solution | None" = None
     parts: list = field(default_factory=list)       # the files' Observations
+    quality: "FitQuality | None" = None              # the residual rule (volerr.fit_quality)
 
     @property
     def written(self) -> np.ndarray:
@@ -196,9 +198,15 @@ class Calibration(ResultMixin):
                 tables[a] = ErrorTable(a, np.linspace(*self.ranges[a], n_grid), {})
             tables[a].reversal = np.full(len(tables[a].positions), float(coef[j]))
 
-    def write_error_tables(self, directory, inputs=()) -> Path:
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+        """The error directory (``X.csv`` ... ``constants.csv``); refused for a fit far above
+        the readings' uncertainty unless ``accept_residual`` (:mod:`volerr.fit_quality`)."""
+        from ..fit_quality import gate, require_writable
         from ..tables.table import write_error_dir
 
+        require_writable(self.quality, accept_residual, f"error tables {directory}")
+        if accept_residual:
+            self.quality = gate(self.data, self.quality, True, "error tables")
         tables, constants, cstd = self.error_tables()
         return write_error_dir(directory, tables, constants or None, cstd or None,
                                inputs=list(inputs), comments=self.table_comments())
@@ -208,6 +216,9 @@ class Calibration(ResultMixin):
         that is not determined on its own (a combination's ``written_as``), and that every
         other undetermined name is written as 0."""
         out: dict = {}
+        if self.data.get("forced"):
+            for where in ["constants", *self.model.axes]:
+                out.setdefault(where, []).append(self.data["forced"])
         for c in self.data.get("combinations", []):
             name = c["written_as"].split("@")[0]
             if name not in self.model.parameters:
@@ -241,7 +252,10 @@ class Calibration(ResultMixin):
     def summary(self) -> str:
         """What ``volerr calibrate`` prints: the headline, each identified value with its
         standard uncertainty (k = 1), the inconsistent files and what is not determined."""
-        return "\n".join([self.headline(), *self.console_lines()])
+        lines = [self.headline(), *self.console_lines()]
+        if self.quality is not None:
+            lines.insert(1, "  " + self.quality.line())
+        return "\n".join(lines)
 
     def console_lines(self) -> list:
         """The lines ``volerr calibrate`` prints below :meth:`headline`."""
@@ -443,11 +457,20 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     std = np.zeros(design.p)
     std[out.kept] = out.std
     cal = Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out,
-                      parts)
+                      parts, fit_quality(out, u_ref))
+    report["fit"] = cal.quality.to_dict()
     _lab_report(cal, fit, obs, u_ref)
     report["covariance"] = covariance_block(cal)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     return cal
+
+
+def fit_quality(sol, u_ref: float) -> FitQuality:
+    """The residual of the fit against the readings' declared uncertainty
+    (:mod:`volerr.fit_quality`): ``chi2 = s0^2 dof = sum (r / u)^2`` over all readings."""
+    return judge(sol.s0 ** 2 * sol.dof, sol.dof,
+                 f"u of each reading as declared in its file, else its instrument's default; "
+                 f"median {1e3 * u_ref:.3g} um")
 
 
 def covariance_block(cal) -> dict | None:

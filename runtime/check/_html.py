@@ -36,6 +36,7 @@ def _alternatives(c: dict) -> str:
 
 def check_html(d: dict) -> str:
     """The page of a check's JSON ``d`` (:meth:`volerr.check.CheckResult.to_dict`)."""
+    from ..fit_quality import fit_html
     from ..plotstyle import unit
 
     e = html.escape
@@ -66,7 +67,7 @@ def check_html(d: dict) -> str:
 <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
 td,th{{padding:2px 8px;text-align:right}}</style></head><body>
 <h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
-<p>Against the reference {e(str(d['reference']['file']))}{' on ' + e(d['date']) if d.get('date') else ''}.
+{fit_html(d)}<p>Against the reference {e(str(d['reference']['file']))}{' on ' + e(d['date']) if d.get('date') else ''}.
 Volumetric change over the working volume: max {v['max']:.3g} µm, RMS {v['rms']:.3g} µm.
 Residual: Birge ratio {d['misfit']['birge_ratio']:.3g} on {d['misfit']['dof']} degrees of
 freedom{' -- a change none of the reference parameters explains' if d['misfit']['unexplained'] else ''}.</p>

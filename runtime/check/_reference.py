@@ -9,10 +9,8 @@ into the model's natural units (mm, rad): ``natural = report / factor``.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -74,18 +72,9 @@ class Reference:
 def load(path, model) -> Reference:
     """The reference in ``path`` for ``model`` (one-line InputError: not JSON, not a
     calibration or check of this layout, no covariance)."""
-    p = Path(path)
-    require(p.is_file(), f"--reference {path}: no such file")
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, ValueError):
-        raise InputError(f"--reference {path}: not a JSON file (give the JSON of 'volerr "
-                         f"calibrate --json' or 'volerr check --json')") from None
-    require(isinstance(doc, dict) and "layout" in doc and "parameters" in doc,
-            f"--reference {path}: not a calibration (no 'layout' and 'parameters'; give the "
-            f"JSON of 'volerr calibrate --json' or 'volerr check --json')")
-    require(doc["layout"] == model.name, f"--reference {path}: a calibration of layout "
-                                         f"{doc['layout']}, not of {model.name}")
+    from ..fit_quality import read_result_json
+
+    doc = read_result_json(path, model.name)
     block = doc.get("covariance")
     require(isinstance(block, dict), f"--reference {path}: holds no covariance (calibrate it "
                                      f"again with this volerr: its JSON has the 'covariance' "

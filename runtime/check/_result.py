@@ -36,6 +36,8 @@ class CheckResult:
     date: str | None = None
     misfit: dict = field(default_factory=dict)
     tolerance: dict | None = None
+    quality: object = None       # the residual rule (volerr.fit_quality.FitQuality)
+    consent: dict | None = None  # --max-change: {"limits", "beyond", "accepted"}
 
     @property
     def verdict(self) -> str:
@@ -172,7 +174,46 @@ class CheckResult:
             "method": METHOD})
         if self.tolerance is not None:
             out["tolerance"] = self.tolerance
+        return self._fit_entries(out)
+
+    def _fit_entries(self, out: dict) -> dict:
+        """``"fit"`` (:mod:`volerr.fit_quality`), ``"forced"`` and ``"max_change"``."""
+        from ..fit_quality import forced_note
+
+        if self.quality is not None:
+            out["fit"] = self.quality.to_dict()
+            if forced_note(self.quality):
+                out["forced"] = forced_note(self.quality)
+        if self.consent is not None:
+            out["max_change"] = self.consent
         return out
+
+    def gate(self, accept_residual: bool, limits: dict | None, accept_change: bool,
+             where: str) -> None:
+        """Before anything is written: the residual rule (refused far above the readings'
+        uncertainty unless ``accept_residual``) and, with ``limits``
+        (:func:`volerr.fit_quality.parse_max_change`), the parameters moved beyond them
+        against the reference (refused unless ``accept_change``); a ``"map"`` limit (um)
+        bounds the largest volumetric change.  One-line InputError."""
+        from .. import fit_quality as fq
+
+        self.quality = fq.require_fit(self.quality, accept_residual, where)
+        if not limits:
+            return
+        limits = dict(limits)
+        beyond = []
+        if "map" in limits:
+            lim, dim = limits.pop("map")
+            fq.require(dim == "length", "--max-change: map is a length (um)")
+            v = float(self.volumetric_change()["max"])
+            if v > lim:
+                beyond.append({"parameter": "map (largest volumetric change)", "old": 0.0,
+                               "new": v, "change": v, "limit": lim, "unit": "um"})
+        params = self.parameters()
+        old = {n: {"value": e["reference"], "unit": e["unit"]} for n, e in params.items()}
+        beyond += fq.changes_beyond(old, params, limits)
+        fq.require_consent(beyond, accept_change, where)
+        self.consent = fq.consent_block(beyond, limits, accept_change)
 
     def summary(self) -> str:
         d = self.to_dict()
@@ -200,6 +241,12 @@ class CheckResult:
                 f"{a} and {b}" for a, b in self.indistinguishable))
         if self.tolerance is not None:
             lines.append(f"  tolerance: {self.tolerance['verdict']}")
+        if self.quality is not None:
+            lines.append("  " + self.quality.line())
+        if self.consent and self.consent["beyond"]:
+            lines.append("  changes beyond --max-change, accepted (--accept-change): " + ", ".join(
+                f"{c['parameter']} {c['old']:.4g} -> {c['new']:.4g} {c['unit']}"
+                for c in self.consent["beyond"]))
         return "\n".join(lines)
 
     def __repr__(self) -> str:

@@ -24,6 +24,7 @@ import numpy as np
 
 from .. import instruments
 from ..errors import require
+from ..fit_quality import judge
 from ..machine.model import Model, load
 from . import _reference, _select, _system, _volume
 from ._result import CheckResult
@@ -59,6 +60,9 @@ def check(layout, reference, files, *, tolerance: str | None = None, date: str |
     res = CheckResult(model, ref, sel, system, pairs, unseen, J, tool,
                       [_file_entry(s, p) for s, p in zip(files, parts)], date)
     res.misfit = _misfit(system, sel, ref)
+    res.quality = judge(res.misfit["chi2"], res.misfit["dof"],
+                        "u of each reading as declared in its file, else its instrument's "
+                        "default, times the reference's Birge ratio when above 1")
     if tol is not None:
         from ._tolerance import decide
 

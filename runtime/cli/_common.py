@@ -216,6 +216,32 @@ def add_force(parser) -> None:
                              "(without it such a file is named and nothing is written)")
 
 
+def add_accept_residual(parser) -> None:
+    """``--accept-residual``: write a fit whose residual is far above the readings' declared
+    uncertainty (:mod:`volerr.fit_quality`), every output marked as forced."""
+    parser.add_argument("--accept-residual", action="store_true",
+                        help="write the results even when the fit's residual is far above "
+                             "the readings' declared uncertainty (chi2/dof > 4 at p < 1e-6; "
+                             "without it: exit 2, nothing written); every output then says "
+                             "it was forced")
+
+
+def add_max_change(parser, reference: bool) -> None:
+    """``--max-change`` and ``--accept-change`` (the KinematicsOpt maxModification rule,
+    :mod:`volerr.fit_quality`); ``reference``: also ``--reference CAL.json`` (calibrate)."""
+    if reference:
+        parser.add_argument("--reference", metavar="CAL.json",
+                            help="an earlier calibrate or check --json: its parameters are "
+                                 "compared with the new ones (--max-change)")
+    parser.add_argument("--max-change", metavar="LIMITS",
+                        help="largest change of a parameter against the reference written "
+                             "without consent: \"EX0C=20 um,EA0B=50 urad\" or one bound per "
+                             "unit (\"20 um,50 urad\"); units required")
+    parser.add_argument("--accept-change", action="store_true",
+                        help="write the results although a parameter moved more than "
+                             "--max-change")
+
+
 def add_identification(parser, instrument: str = "the measuring instrument") -> None:
     """``--machine --instrument --operator --date``: the identification of a certificate."""
     g = parser.add_argument_group("certificate identification (printed on the page and in "

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from ..errors import InputError, require
 from ..fileio import Outputs
-from ._common import (add_error_arguments, add_force, add_html, add_json, add_plot, add_vector,
-                      error_functions_from_args, layout_inputs)
+from ._common import (add_accept_residual, add_error_arguments, add_force, add_html, add_json,
+                      add_plot, add_vector, error_functions_from_args, layout_inputs)
 
 
 def register(sub) -> None:
@@ -61,6 +61,7 @@ def register(sub) -> None:
     add_plot(ev, "the polar plot")
     add_html(ev, "the report page (polar plot, ISO 230-4 table, diagnosis)")
     add_force(ev)
+    add_accept_residual(ev)
     ev.set_defaults(func=run_evaluate)
 
 
@@ -110,6 +111,7 @@ def run_evaluate(args) -> int:
     outs = Outputs(inputs, force=args.force).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).check()
     ev = ballbar_evaluate(args.files, args.layout)
+    ev.judge(args.accept_residual, f"ballbar evaluate {' '.join(args.files)} (the diagnosis)")
     with outs:
         if args.json:
             ev.write_json(outs.path("--json"), inputs=inputs)

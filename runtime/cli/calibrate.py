@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from ..errors import require
 from ..fileio import Outputs
-from ._common import add_errors_out, add_force, add_html, add_json
+from ._common import add_accept_residual, add_errors_out, add_force, add_html, add_json, \
+    add_max_change
 
 
 def register(sub) -> None:
@@ -38,6 +39,8 @@ def register(sub) -> None:
     p.add_argument("--map-grid", type=int, default=9, metavar="N",
                    help="points per linear axis of --map-out")
     add_force(p)
+    add_accept_residual(p)
+    add_max_change(p, reference=True)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters fitted, the others held at zero: comma list of names "
                         "(EC0Y, EX0C), terms as printed (EXX@slope, EZY@P2, EXC@cos1), "
@@ -59,9 +62,15 @@ def run(args) -> int:
     from ..machine.model import load
     from ._common import layout_inputs
 
+    from .. import fit_quality as fq
+
     require(2 <= args.map_grid <= 60, "--map-grid must be between 2 and 60")
+    require(args.reference or not args.max_change, "--max-change needs --reference CAL.json")
+    limits = fq.parse_max_change(args.max_change) if args.max_change else None
     model = load(args.layout)
-    inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout)
+    old = fq.read_reference_parameters(args.reference, model.name) if args.reference else None
+    inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
+        + ([args.reference] if args.reference else [])
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).file("--map-out", args.map_out) \
         .folder("--errors-out", args.errors_out,
@@ -70,6 +79,10 @@ def run(args) -> int:
         result = calibrate(args.layout, args.files, parameters=args.parameters,
                            degree=args.degree, seed=args.seed,
                            test_fraction=args.test_fraction)
+        where = f"calibrate {' '.join(split_spec(f)[1] for f in args.files)}"
+        result.quality = fq.gate(result.data, result.quality, args.accept_residual, where)
+        if old is not None:
+            fq.against_reference(result.data, old, limits, args.accept_change, where)
         if args.json:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:
@@ -81,4 +94,8 @@ def run(args) -> int:
 
             write_csv(outs.path("--map-out"), result, (args.map_grid,) * 3, inputs=inputs)
     print(result.summary())
+    beyond = result.data.get("max_change", {}).get("beyond")
+    if beyond:
+        print("  changes beyond --max-change, accepted (--accept-change): " + ", ".join(
+            f"{c['parameter']} {c['old']:.4g} -> {c['new']:.4g} {c['unit']}" for c in beyond))
     return 0

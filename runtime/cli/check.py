@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..errors import InputError, require
 from ..fileio import Outputs
-from ._common import add_force, add_html, add_json
+from ._common import add_accept_residual, add_force, add_html, add_json, add_max_change
 
 USAGE = ("volerr check plan LAYOUT --reference CAL.json --instrument SPEC [--minutes M] "
          "[--readings N] [--detect-um D] --out DIR [--json F] [--html H]\n"
@@ -22,7 +22,7 @@ USAGE = ("volerr check plan LAYOUT --reference CAL.json --instrument SPEC [--min
          "[--date YYYY-MM-DD] [--json F] [--html H]")
 #: options of one form only
 PLAN_ONLY = ("instrument", "minutes", "readings", "detect_um", "out")
-CHECK_ONLY = ("tolerance", "date")
+CHECK_ONLY = ("tolerance", "date", "max_change")
 
 
 def register(sub) -> None:
@@ -68,6 +68,8 @@ def register(sub) -> None:
     add_json(p, "the check plan or the check's result")
     add_html(p, "the set-up sheet (check plan) or the check's page")
     add_force(p)
+    add_accept_residual(p)
+    add_max_change(p, reference=False)
     p.set_defaults(func=run)
 
 
@@ -132,11 +134,16 @@ def _check(args, inputs) -> int:
 
         args.date = parse_date(args.date)
     inputs = inputs + [Path(args.reference)] + [Path(split_spec(f)[1]) for f in files]
+    from ..fit_quality import parse_max_change
+
+    limits = parse_max_change(args.max_change) if args.max_change else None
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).check()
     with outs:
         result = check(layout, args.reference, files, tolerance=args.tolerance,
                        date=args.date)
+        result.gate(args.accept_residual, limits, args.accept_change,
+                    f"check {' '.join(split_spec(f)[1] for f in files)}")
         if args.json:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:

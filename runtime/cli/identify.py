@@ -14,7 +14,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._common import add_accept_implausible, add_force, add_json, add_plot, add_vector
+from ._common import (add_accept_implausible, add_accept_residual, add_force, add_json,
+                      add_plot, add_vector)
 
 
 def register(sub) -> None:
@@ -76,6 +77,7 @@ def register(sub) -> None:
     add_json(p, "a summary")
     add_plot(p, "a plot of the error motions")
     add_force(p)
+    add_accept_residual(p)
     p.set_defaults(func=run)
 
 
@@ -110,8 +112,14 @@ def run(args) -> int:
                 _vec(args.origin, "--origin") if args.origin else None),
         sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k, signs=args.signs,
         accept_implausible=args.accept_implausible)
+    from ..fit_quality import gate
+
+    res.quality = gate(res.data, res.quality, args.accept_residual,
+                       f"identify {' '.join(args.files)}", key="fit_quality")
     result, table = res.identification, res.errors
     text = table_to_csv(table)
+    if res.data.get("forced"):
+        text = f"# {res.data['forced']}\n" + text
     summary = res.data
     fits = None
     if args.fit:
@@ -130,7 +138,7 @@ def run(args) -> int:
         if args.json:
             write_text(outs.path("--json"), json_text(summary), inputs=inputs)
     written = args.out or str(Path(args.errors_out) / f"{axis}.csv")
-    print("\n".join(summary_lines(args.axis, summary, written)))
+    print("\n".join(summary_lines(args.axis, summary, written) + ["  " + res.quality.line()]))
     for line in outlier_warnings(summary):
         print(line, file=sys.stderr)
     return 0

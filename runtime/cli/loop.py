@@ -18,7 +18,7 @@ from pathlib import Path
 from ..errors import require
 from ..fileio import Outputs
 from ..loop.api import console_lines
-from ._common import add_errors_out, add_force, add_html, add_json
+from ._common import add_accept_residual, add_errors_out, add_force, add_html, add_json
 
 
 def register(sub) -> None:
@@ -57,6 +57,7 @@ def register(sub) -> None:
                         "volerr formats loop-lags)")
     add_errors_out(p, "the fitted error functions (effects removed)")
     add_force(p)
+    add_accept_residual(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
                                              "leave-one-point-out, exact via the hat matrix)")
@@ -107,6 +108,10 @@ def run(args) -> int:
                           test_fraction=args.test_fraction, degree=args.degree,
                           out_dir=staged, families=families, inputs=inputs,
                           holdout_time=args.holdout_time)
+        from ..fit_quality import gate
+
+        report.quality = gate(report.data, report.quality, args.accept_residual,
+                              f"loop {' '.join(inputs[:len(args.data)])}")
         for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
             if report.data.get(key):
                 report.data[key] = str(out_dir / Path(report.data[key]).name)

@@ -17,12 +17,14 @@ class Identified(ResultMixin):
     errors: object
     identification: object
     axis: str
+    quality: object = None      # the residual rule (volerr.fit_quality), JSON "fit_quality"
 
     def summary(self) -> str:
         """What ``volerr identify`` prints (without the line naming the written table)."""
         from ..identify.report import summary_lines
 
-        return "\n".join(summary_lines(self.axis, self.data, "(not written)"))
+        lines = summary_lines(self.axis, self.data, "(not written)")
+        return "\n".join(lines + (["  " + self.quality.line()] if self.quality else []))
 
     def error_table_csv(self) -> str:
         """The error table as ``volerr identify --out`` writes it (``_um``, ``_urad``)."""
@@ -93,7 +95,10 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     if signs == "model":
         table = to_model_signs(table, lay, reference=result.rounds[0].positions[0])
     check_identified(table, lay, files, accept_implausible)
-    return Identified(result.summary(), table, result, axis.strip().upper())
+    quality = result.fit_quality()
+    data = result.summary()
+    data["fit_quality"] = quality.to_dict()
+    return Identified(data, table, result, axis.strip().upper(), quality)
 
 
 #: what identified errors beyond the size limits likely come from

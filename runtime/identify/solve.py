@@ -130,6 +130,7 @@ class RoundResult:
     sigma_mm: float
     outliers: list = field(default_factory=list)
     closed_form: dict = field(default_factory=dict)
+    chi2: float = 0.0       # sum of squared residuals in units of u (fit_quality)
 
 
 @dataclass
@@ -181,6 +182,19 @@ class Identification:
                 var = var + self.std ** 2 / len(self.rounds)
             u95 = {n: 2.0 * np.sqrt(var[:, j]) for j, n in enumerate(self.names)}
         return ErrorTable(self.axis, self.positions, values, std, u95, s=rep)
+
+    def fit_quality(self):
+        """The residual of every round's fit against the points' uncertainty
+        (:class:`volerr.fit_quality.FitQuality`): ``(K - 1)(3 n - 6)`` degrees of freedom
+        per round (K positions, the reference's residual 0 by definition; n points)."""
+        from ..fit_quality import TRACKER_U_UM, judge
+
+        dof = sum((r.positions.size - 1) * (3 * len(r.labels) - 6) for r in self.rounds)
+        u = ("u of each point from the AT960 MPE figures at its distance from --tracker"
+             if self.weighted else
+             f"u assumed {TRACKER_U_UM:.3g} um per coordinate (no --tracker: the AT960 angle "
+             f"MPE at 3 m, / sqrt 3)")
+        return judge(sum(r.chi2 for r in self.rounds), dof, u)
 
     def outliers(self) -> list:
         """All flagged (round, position, point, residual_um, ratio) over rounds."""
@@ -521,7 +535,20 @@ def identify_round(rnd: Round, kind: str, axis: str, direction, origin, *, metho
         u = u_closed
     summary_cf = _closed_summary(closed, rnd, axis, u_closed, lsq.u) if closed else {}
     return RoundResult(rnd.name, rnd.positions.copy(), rnd.labels, theta, u, resid, geo.delta,
-                       geo.condition, geo.sense, lsq.sigma, outliers, summary_cf)
+                       geo.condition, geo.sense, lsq.sigma, outliers, summary_cf,
+                       _chi2(resid, lsq.W))
+
+
+def _chi2(resid, W) -> float:
+    """The round's residuals (K, n, 3) mm in units of their standard uncertainty: the
+    tracker covariance ``W`` (inverse, with ``--tracker``), else
+    :data:`volerr.fit_quality.TRACKER_U_UM` per coordinate (:mod:`volerr.fit_quality`)."""
+    from ..fit_quality import TRACKER_U_UM
+
+    r = resid[1:]
+    if W is not None:
+        return float(np.einsum("kna,knab,knb->", r, W[1:], r))
+    return float(np.sum(r ** 2)) / (TRACKER_U_UM * MM_PER_UM) ** 2
 
 
 def _closed_uncertainty(A, closed, W, sigma):

@@ -86,6 +86,8 @@ def console_lines(report: Report) -> list:
                    f"{report['generated_module']}")
     if report["residual_note"]:
         out.append(f"  {report['residual_note']}")
+    if getattr(report, "quality", None) is not None:
+        out.append("  " + report.quality.line())
     hidden = [u["parameters"][0] for u in report["unidentifiable"]
               if not (u["parameters"][0].startswith("setup.") and u.get("no_sensitivity"))]
     if hidden:

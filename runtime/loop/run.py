@@ -74,6 +74,7 @@ class Report(ResultMixin):
     figures: "Figures | None" = None       # what the html report and error tables need
     augmented_text: str = ""
     generated: object = ""      # module text, or a function deriving it when first asked
+    quality: object = None      # the residual rule (volerr.fit_quality.FitQuality)
 
     @property
     def generated_text(self) -> str:
@@ -140,12 +141,21 @@ class Report(ResultMixin):
                 constants[p] = float(coef[index[(p, None)]])
         return tables, constants
 
-    def write_error_tables(self, directory, inputs=()) -> Path:
-        """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``)."""
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+        """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``);
+        refused for a fit far above the readings' uncertainty unless ``accept_residual``
+        (:mod:`volerr.fit_quality`)."""
+        from ..fit_quality import gate, require_writable
         from ..tables.table import write_error_dir
 
+        require_writable(self.quality, accept_residual, f"error tables {directory}")
+        if accept_residual:
+            self.quality = gate(self.data, self.quality, True, "error tables")
         tables, constants = self.error_tables()
-        return write_error_dir(directory, tables, constants or None, inputs=list(inputs))
+        note = self.data.get("forced")
+        comments = {w: [note] for w in ["constants", *tables]} if note else None
+        return write_error_dir(directory, tables, constants or None, inputs=list(inputs),
+                               comments=comments)
 
     def summary(self) -> str:
         d = self.data
@@ -302,6 +312,7 @@ class Outcome:
     sigma2: float
     cov_diag: np.ndarray
     test_inliers: np.ndarray
+    chi2_dof: tuple = (0.0, 1.0)    # the augmented fit's sum (r / u_ref)^2 w and its dof (mm^2)
 
 
 def _fits(design, spl: Split, sw, y):
@@ -365,7 +376,7 @@ def outcome_step(decl: Declared, aug: Augmented, spl: Split, robust: Robust, y,
     cov_diag = np.diag(np.linalg.pinv(G, rcond=1e-12)) * sigma2 / scale ** 2
     inl = point_norm(r_after) <= OUTLIER_Z * math.sqrt(sigma2)
     return Outcome(r_before, r_after, contrib, c_all, c_before, res_before, res_after, sigma2,
-                   cov_diag, inl)
+                   cov_diag, inl, (sigma2 * dof, dof))
 
 
 def effect_columns(selection, aug: Augmented) -> dict:
@@ -647,11 +658,27 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     report["residual_sources_after"] = src_after
     report["residual_note"] = residual_note(dat, out, src_after, robust)
     report["instruments"] = instrument_residuals(dat, spl, out)
+    quality = fit_quality(dat, out)
+    report["fit"] = quality.to_dict()
     report["seconds"] = round(time.perf_counter() - t_start, 2)
     figs = Figures(model, dat, ranges, degree, out.res_before, out.res_after, spl.test,
                    out.r_before, out.r_after, selection.accepted, out.contrib, out.c_all,
                    aug.labels, out.c_before, decl.labels, out.cov_diag, robust.weights)
-    return Report(report, figs, aug.text, aug.source)  # the full module: derived when asked
+    return Report(report, figs, aug.text, aug.source, quality)  # module: derived when asked
+
+
+def fit_quality(dat, out: Outcome):
+    """The augmented fit's residual against the readings' declared uncertainty
+    (:mod:`volerr.fit_quality`): ``chi2 = sum w (r / u)^2`` with the robust weights ``w`` of
+    the fit (gross outliers down-weighted, counted in ``outliers``), its degrees of freedom
+    the robustly weighted readings minus the augmented model's rank."""
+    from ..fit_quality import judge
+
+    u_ref = dat.reference_sigma()
+    rss, dof = out.chi2_dof
+    return judge(rss / u_ref ** 2, dof,
+                 f"u of each reading as declared in its file, else its instrument's default "
+                 f"(deviations: 1 um); median {1e3 * u_ref:.3g} um")
 
 
 def instrument_residuals(dat, spl: Split, out: Outcome) -> list:
