@@ -27,9 +27,10 @@ from .machine.model import Model, load  # noqa: F401
 __version__ = "0.1.0"
 
 #: callable sub-packages: ``volerr.NAME(...)`` (``volerr/NAME/__init__.py`` makes itself callable)
-_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check")
-#: capability packages named as modules: ``volerr.history.add(...)``, ``volerr.history.show(...)``
-_MODULES = ("history",)
+_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check", "history")
+#: capability packages named as modules only (none left: ``volerr.history`` is callable as
+#: ``volerr.history.show``, and ``volerr.history.add`` / ``show`` stay)
+_MODULES = ()
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api", "error_map": "cmm.api",

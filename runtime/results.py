@@ -120,12 +120,30 @@ class ResultMixin:
         return f"<volerr {type(self).__name__}: {first}>"
 
 
+def file_list(files) -> list:
+    """``files`` as a list of file names: one ``str`` or path-like is one file (not the
+    characters of its name); a list, tuple or other iterable is taken as it is."""
+    import os
+
+    if isinstance(files, (str, bytes, os.PathLike)):
+        return [files]
+    return list(files)
+
+
 class CallableModule(types.ModuleType):
     """A package module that can be called: ``volerr.calibrate(...)`` is
-    ``volerr.calibrate.__api__(...)``, the package's API function."""
+    ``volerr.calibrate.__api__(...)``, the package's API function.  ``inspect.signature``
+    and ``help`` of the module show that function's keywords and defaults
+    (``__signature__``)."""
 
     def __call__(self, *args, **kwargs):
         return self.__api__(*args, **kwargs)
+
+    @property
+    def __signature__(self):
+        import inspect
+
+        return inspect.signature(self.__api__)
 
 
 def callable_package(name: str, function) -> None:

@@ -328,8 +328,8 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
     ----------
     layout : str or path
         Layout name (``volerr.layouts()``) or layout file.
-    files : list of str or path, or volerr.instruments.Observations
-        Measurement files (``KIND:FILE`` names the kind: deviations, ballbar, sphere,
+    files : str, path, list of them, or volerr.instruments.Observations
+        Measurement files (one string is one file) (``KIND:FILE`` names the kind: deviations, ballbar, sphere,
         artifact, interferometer, distances; 'volerr formats NAME').  Each file states its
         reading's sign and frame in its format; readings in um / urad, positions mm / deg.
     parameters : str, optional
@@ -394,7 +394,9 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     if isinstance(files, instruments.Observations):
         parts, obs = [files], files
     else:
-        parts = instruments.read_parts(list(files), model)
+        from ..results import file_list
+
+        parts = instruments.read_parts(file_list(files), model)
         obs = instruments.stack(parts)
     from .defaults import default_parameters
 

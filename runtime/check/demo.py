@@ -64,7 +64,7 @@ def weekly(out: Path) -> dict:
         f = out / "check_plan" / f"week{week:02d}.csv"
         shutil.copy(out / "check_plan" / cp.plan.files[0].name, f)
         execute(f, model, machine_at(week), rng)
-        res = check(model, reference, [f], date=date_of(week))
+        res = check(model, [f], reference=reference, date=date_of(week))
         path = out / f"check_week{week:02d}.json"
         res.write_json(path)
         paths.append(path)

@@ -136,7 +136,7 @@ def _check(args, inputs) -> int:
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).check()
     with outs:
-        result = check(layout, args.reference, files, tolerance=args.tolerance,
+        result = check(layout, files, reference=args.reference, tolerance=args.tolerance,
                        date=args.date)
         if args.json:
             result.write_json(outs.path("--json"), inputs=inputs)
