@@ -13,7 +13,8 @@ volerr`` stays light):
   :func:`volerr.uncertainty` (``volerr uncertainty``): callable sub-packages (:mod:`volerr.results`);
 * :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`,
   :func:`volerr.error_map` (``volerr map``), :func:`volerr.diagonals`,
-  :func:`volerr.probe_cal` (``volerr probe-cal``).
+  :func:`volerr.probe_cal` (``volerr probe-cal``), :func:`volerr.controller_export` /
+  :func:`volerr.controller_import` (``volerr controller export|import``).
 
 Bad input raises :class:`volerr.InputError` with the command's one-line message.
 """
@@ -34,7 +35,9 @@ _MODULES = ()
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api", "error_map": "cmm.api",
-              "probe_cal": "probe.api", "diagonals": "cmm.api"}
+              "probe_cal": "probe.api", "diagonals": "cmm.api",
+              "controller_export": "fiveaxis.controller_api",
+              "controller_import": "fiveaxis.controller_api"}
 
 __all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_MODULES, *_FUNCTIONS]
 
