@@ -36,6 +36,7 @@ _MODULES = ()
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api", "error_map": "cmm.api",
               "probe_cal": "probe.api", "diagonals": "cmm.api",
+              "iso10360": "uncertainty.api", "iso230_3": "instruments.drift_test",
               "controller_export": "fiveaxis.controller_api",
               "controller_import": "fiveaxis.controller_api"}
 

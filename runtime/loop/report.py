@@ -193,7 +193,7 @@ def fig_functions(report) -> str:
                 ax.fill_between(q, (v - 2 * sd) * f, (v + 2 * sd) * f, color=color, alpha=0.2)
                 ax.plot(before[a].positions, before[a].values[name] * f, "--", color=color,
                         lw=0.8)
-            ax.set_xlabel(label(a, "deg" if a in report.figures.model.rotary_axes else "mm"))
+            ax.set_xlabel(label(a, "deg" if a in report.plot_data.model.rotary_axes else "mm"))
             ax.set_ylabel(label("error", unit))
             ax.legend(fontsize=9, ncol=2)
     fig.suptitle("solid: augmented model (band \u00b12 standard deviations, k = 2), dashed: "
@@ -242,7 +242,7 @@ def render_html(report) -> str:
 
     from importlib import resources
 
-    fg = report.figures
+    fg = report.plot_data
     figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg),
                "functions": fig_functions(report),
                "interactions": fig_interactions(fg, report.data["residual_sources"])}

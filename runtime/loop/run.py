@@ -71,7 +71,7 @@ class Report(ResultMixin):
     """Result of :func:`run_loop`; ``data`` is the json report (INTERFACE.md keys first)."""
 
     data: dict
-    figures: "Figures | None" = None       # what the html report and error tables need
+    plot_data: "Figures | None" = None     # what the html report, figures() and error tables need
     augmented_text: str = ""
     generated: object = ""      # module text, or a function deriving it when first asked
 
@@ -113,7 +113,7 @@ class Report(ResultMixin):
         from ..estimate.design import series_basis
         from ..tables.table import ErrorTable
 
-        fg = self.figures
+        fg = self.plot_data
         model, ranges, deg = fg.model, fg.ranges, fg.degree
         coef, labels, var = fg.c_all, fg.aug_labels, fg.cov_diag
         if which == "before":
