@@ -152,11 +152,11 @@ class Iso230_3(ResultMixin):
         """The test report (``--html``): identification, drift per channel and stage, plot."""
         import datetime
 
-        from .. import __version__
+        from importlib.metadata import version
         from ..fileio import write_text
         from .iso230_3 import report_html
 
-        made = (f"Evaluated with volerr {__version__} on "
+        made = (f"Evaluated with volerr {version('volerr')} on "
                 f"{datetime.date.today().isoformat()}.")
         return write_text(path, report_html(self.evaluations, self.pngs(), made,
                                             identification=self.identification),

@@ -235,12 +235,12 @@ class Iso10360(ResultMixin):
 
     def write_html(self, path, inputs=()):
         """The certificate page (``--html``)."""
-        from .. import __version__
+        from importlib.metadata import version
         from ..fileio import write_text
         from .iso10360_report import report_html
 
         return write_text(path, report_html(self.data, self.png(), self.identification,
-                                            f"Evaluated with volerr {__version__}."),
+                                            f"Evaluated with volerr {version('volerr')}."),
                           inputs=list(inputs))
 
 
