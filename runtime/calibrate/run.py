@@ -444,12 +444,14 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
                                  u_ref, report["identifiability"])
     std = np.zeros(design.p)
     std[out.kept] = out.std
-    cal = Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out,
-                      parts)
-    _lab_report(cal, fit, obs, u_ref)
-    report["covariance"] = covariance_block(cal)
+    fields = (model, ranges, degree, labels, out.coef, std, out.residuals, out, parts)
+    # the lab report and the covariance are computed from a draft of the result, then the
+    # result is built once with the whole report (nothing written back into it afterwards)
+    draft = Calibration(report, *fields)
+    report = _lab_report(draft, fit, obs, u_ref)
+    report["covariance"] = covariance_block(draft)
     report["seconds"] = round(time.perf_counter() - t0, 2)
-    return cal
+    return Calibration(report, *fields)
 
 
 def covariance_block(cal) -> dict | None:
@@ -563,34 +565,36 @@ def _preferred(model, obs, labels, obs_ranges) -> np.ndarray:
                      for lab in labels])
 
 
-def _lab_report(cal, fit, obs, u_ref) -> None:
-    """What a calibration laboratory reports beside the parameters: the consistency of the
-    files with each other (:mod:`volerr.calibrate.consistency`), the instruments' own results
-    (artifact poses, station positions), the volumetric error map with its uncertainty
-    (:mod:`volerr.calibrate.mapping`) and the ISO 10360-2 length errors of the identified model
-    beside the measured step-gauge lengths (:mod:`volerr.calibrate.lengths`)."""
+def _lab_report(cal, fit, obs, u_ref) -> dict:
+    """``cal.data`` (not changed) with what a calibration laboratory reports beside the
+    parameters: the consistency of the files with each other
+    (:mod:`volerr.calibrate.consistency`), the instruments' own results (artifact poses,
+    station positions), the volumetric error map with its uncertainty
+    (:mod:`volerr.calibrate.mapping`) and the ISO 10360-2 length errors of the identified
+    model beside the measured step-gauge lengths (:mod:`volerr.calibrate.lengths`)."""
     from . import consistency, lengths, mapping
 
-    report = cal.data
+    report = dict(cal.data)
     report["consistency"] = consistency.check(fit, cal.solution, obs, u_ref)
     flags = {e["file"]: e for e in report["consistency"]["files"]}
-    for entry in report["instruments"]:
-        c = flags.get(entry["file"], {})
-        entry["birge_ratio"] = c.get("birge_ratio")
-        entry["consistent"] = c.get("consistent", True)
+    report["instruments"] = [
+        {**entry, "birge_ratio": flags.get(entry["file"], {}).get("birge_ratio"),
+         "consistent": flags.get(entry["file"], {}).get("consistent", True)}
+        for entry in report["instruments"]]
     kinds = instruments.kinds()
     for part in cal.parts:
         kind = part.files[0].kind if part.files else "deviations"
         maker = getattr(kinds.get(kind), "results", None)
         if maker is not None:
             for key, value in maker(part, report["setup"]).items():
-                report.setdefault(key, {}).update(value)
+                report[key] = {**report.get(key, {}), **value}
     summary = mapping.summary(cal)
     if summary is not None:
         report["volumetric_map"] = summary
     iso = lengths.report(cal)
     if iso is not None:
         report["iso10360"] = iso
+    return report
 
 
 def extra_columns(model, obs, extra_terms) -> np.ndarray:
