@@ -10,10 +10,13 @@ volerr`` stays light):
 
 * :func:`volerr.calibrate` (``volerr calibrate``), :func:`volerr.plan` (``volerr plan``),
   :func:`volerr.loop` (``volerr loop``), :func:`volerr.identify` (``volerr identify``),
-  :func:`volerr.uncertainty` (``volerr uncertainty``): callable sub-packages (:mod:`volerr.results`);
+  :func:`volerr.uncertainty` (``volerr uncertainty``), :func:`volerr.check` (``volerr check``),
+  :func:`volerr.history` (``volerr history show``; ``volerr.history.add`` stores results):
+  callable sub-packages (:mod:`volerr.results`; ``inspect.signature`` shows their keywords);
 * :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`,
   :func:`volerr.error_map` (``volerr map``), :func:`volerr.diagonals`,
-  :func:`volerr.probe_cal` (``volerr probe-cal``), :func:`volerr.controller_export` /
+  :func:`volerr.probe_cal` (``volerr probe-cal``), :func:`volerr.iso10360`,
+  :func:`volerr.iso230_3` (``volerr iso230-3``), :func:`volerr.controller_export` /
   :func:`volerr.controller_import` (``volerr controller export|import``).
 
 Bad input raises :class:`volerr.InputError` with the command's one-line message.
