@@ -218,6 +218,15 @@ def _dest(out, tail: str = "") -> str:
     return "(not written)" if out is None else f"{Path(str(out)) if tail else out}{tail}"
 
 
+def _refuse_worse(s: dict, force: bool, head: str, it: str = "it") -> bool:
+    """Whether the compensation summarised by ``s`` leaves more than none
+    (:func:`worse_than_none`); refused (one line starting with ``head``) unless ``force``."""
+    worse = worse_than_none(s)
+    require(not worse or force, f"{head} (max {_change(s, 'max')}, rms {_change(s, 'rms')}); "
+                                f"nothing written (--force writes {it} anyway)")
+    return worse
+
+
 def _change(s: dict, key: str) -> str:
     return f"{s['before_um'][key]:.2f} -> {s['left_um'][key]:.2f} um"
 
@@ -242,11 +251,8 @@ def _export_volumetric(o: _Options, model) -> ControllerExport:
     outs = Outputs(inputs).file("--out", o.out).file("--json", o.json).check()
     res = volumetric_left(model, ErrorFunctions.from_dir(o.errors, model), o.grid, o.at)
     s = res.summary()
-    worse = worse_than_none(s)
-    require(not worse or o.force,
-            f"{model.name}: a volumetric compensation with these parameters leaves more than "
-            f"none (max {_change(s, 'max')}, rms {_change(s, 'rms')}); nothing written "
-            "(--force writes it anyway)")
+    worse = _refuse_worse(s, o.force, f"{model.name}: a volumetric compensation with these "
+                                      "parameters leaves more than none")
     doc = {"layout": model.name, "format": o.format, **s, "worse_than_none": worse}
     text = writer(model.name, tables, consts)
     with outs:
@@ -286,11 +292,8 @@ def _export_axis_tables(o: _Options, model) -> ControllerExport:
     outs.file("--json", o.json).plot("--plot", o.plot).check()
     result = left(model, funcs, tables, o.grid, o.at)
     s = result.summary()
-    worse = worse_than_none(s)
-    require(not worse or o.force,
-            f"{model.name}: these {o.format} tables leave more than no compensation "
-            f"(max {_change(s, 'max')}, rms {_change(s, 'rms')}); nothing written "
-            "(--force writes them anyway)")
+    worse = _refuse_worse(s, o.force, f"{model.name}: these {o.format} tables leave more "
+                                      "than no compensation", "them")
     doc = {"layout": model.name, "format": o.format, **s, "worse_than_none": worse,
            "tables": [{"parameter": t.parameter, "input": t.input, "output": t.output,
                        "points": len(t.values), "start": t.start, "step": t.step,
@@ -360,11 +363,8 @@ def _export_temperature(o: _Options, model) -> ControllerExport:
     sensors = [s.strip() for s in o.sensors.split(",")] if o.sensors else None
     res = tc.fit(model, values, log, sensors, o.grid, o.at)
     s = res.summary()
-    worse = worse_than_none(s)
-    require(not worse or o.force,
-            f"{model.name}: this {o.format} model leaves more of the thermal error than "
-            f"no compensation (max {_change(s, 'max')}, rms {_change(s, 'rms')}); nothing "
-            "written (--force writes it anyway)")
+    worse = _refuse_worse(s, o.force, f"{model.name}: this {o.format} model leaves more of "
+                                      "the thermal error than no compensation")
     text = tc.write_sinumerik(res) if o.format == "sinumerik-temp" else \
         tc.write_isg(res, model.axes)
     doc = {"format": o.format, **s, "worse_than_none": worse}
