@@ -92,6 +92,9 @@ CASES = {
     "probe-cal": (["probe-cal", "probe_sphere.csv", "--sphere-radius", "25.006", "--out",
                    "@pm.csv"], lambda: volerr.probe_cal("probe_sphere.csv", 25.006),
                   ("identification",)),
+    "controller": (["controller", "export", "MB1", "--errors", "errors_MB1", "--format",
+                    "fanuc", "--out", "@fanuc.txt"],
+                   lambda: volerr.controller_export("MB1", "errors_MB1", format="fanuc"), ()),
 }
 OWNED = {"compensate": "compensate (runtime/fiveaxis)", "history": "history (runtime/history)",
          "drift": "drift loop (runtime/loop/drift*)"}
