@@ -36,7 +36,11 @@ class Identified(ResultMixin):
         return error_table_rows(self.errors)
 
     def figures(self) -> dict:
-        return {}
+        """``{"motions"}``: the six error motions at every position with +-2 s bars and
+        every round (um, urad; the thesis' Fig. 4.x style, as ``--plot`` draws them)."""
+        from .plots import identification_figure
+
+        return {"motions": identification_figure(self.identification)}
 
 
 def identify(layout, axis: str, files, *, format: str = "csv", positions: str | None = None,

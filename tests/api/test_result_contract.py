@@ -130,6 +130,16 @@ def _rows(table) -> tuple[list, list]:
     return list(table[0]._fields) if table else [], [r._asdict() for r in table]
 
 
+def _figures_are_figures(figs) -> None:
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    assert isinstance(figs, dict)
+    assert all(isinstance(f, Figure) for f in figs.values()), figs
+    for f in figs.values():
+        plt.close(f)
+
+
 @pytest.mark.parametrize("kind", PARAMS)
 def test_the_result_contract(kind, ex, tmp_path, monkeypatch, capsys):
     argv, call, volatile = CASES[kind]
@@ -145,6 +155,7 @@ def test_the_result_contract(kind, ex, tmp_path, monkeypatch, capsys):
     d = r.to_dict()
     assert {k: v for k, v in d.items() if k not in volatile} == \
         {k: v for k, v in doc.items() if k not in volatile}
-    assert callable(r.write_html) and isinstance(r.figures(), dict)
+    assert callable(r.write_html)
+    _figures_are_figures(r.figures())
     r.write_json(tmp_path / "api.json")
     assert json.loads((tmp_path / "api.json").read_text()) == d
