@@ -141,6 +141,13 @@ class Iso230_3(ResultMixin):
                         for what, v in (("range", e.range), ("max", e.max), ("min", e.min))]
         return out
 
+    def figures(self) -> dict:
+        """``{run name: Figure}``: drift, tilts, spindle speed and temperatures against time
+        (um, urad, rpm, degC against h), one figure per run."""
+        from .iso230_3 import drift_figure
+
+        return {ev.name: drift_figure(ev) for ev in self.evaluations}
+
     def pngs(self) -> list:
         """The plot of every run (drift, tilts, spindle speed and temperatures against time),
         PNG bytes."""
