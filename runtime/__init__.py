@@ -10,10 +10,14 @@ volerr`` stays light):
 
 * :func:`volerr.calibrate` (``volerr calibrate``), :func:`volerr.plan` (``volerr plan``),
   :func:`volerr.loop` (``volerr loop``), :func:`volerr.identify` (``volerr identify``),
-  :func:`volerr.uncertainty` (``volerr uncertainty``): callable sub-packages (:mod:`volerr.results`);
+  :func:`volerr.uncertainty` (``volerr uncertainty``), :func:`volerr.check` (``volerr check``),
+  :func:`volerr.history` (``volerr history show``; ``volerr.history.add`` stores results):
+  callable sub-packages (:mod:`volerr.results`; ``inspect.signature`` shows their keywords);
 * :func:`volerr.compensate`, :func:`volerr.ballbar_evaluate`, :func:`volerr.iso230_2`,
   :func:`volerr.error_map` (``volerr map``), :func:`volerr.diagonals`,
-  :func:`volerr.probe_cal` (``volerr probe-cal``).
+  :func:`volerr.probe_cal` (``volerr probe-cal``), :func:`volerr.iso10360`,
+  :func:`volerr.iso230_3` (``volerr iso230-3``), :func:`volerr.controller_export` /
+  :func:`volerr.controller_import` (``volerr controller export|import``).
 
 Bad input raises :class:`volerr.InputError` with the command's one-line message.
 """
@@ -27,13 +31,17 @@ from .machine.model import Model, load  # noqa: F401
 __version__ = "0.1.0"
 
 #: callable sub-packages: ``volerr.NAME(...)`` (``volerr/NAME/__init__.py`` makes itself callable)
-_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check")
-#: capability packages named as modules: ``volerr.history.add(...)``, ``volerr.history.show(...)``
-_MODULES = ("history",)
+_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check", "history")
+#: capability packages named as modules only (none left: ``volerr.history`` is callable as
+#: ``volerr.history.show``, and ``volerr.history.add`` / ``show`` stay)
+_MODULES = ()
 #: API functions living in a capability package: name -> module
 _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "iso230_2": "positioning.api", "error_map": "cmm.api",
-              "probe_cal": "probe.api", "diagonals": "cmm.api"}
+              "probe_cal": "probe.api", "diagonals": "cmm.api",
+              "iso10360": "uncertainty.api", "iso230_3": "instruments.drift_test",
+              "controller_export": "fiveaxis.controller_api",
+              "controller_import": "fiveaxis.controller_api"}
 
 __all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_MODULES, *_FUNCTIONS]
 

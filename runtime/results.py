@@ -12,7 +12,9 @@ object you can read, after statsmodels' ``RegressionResults`` and scipy's ``Opti
   uncertainty; an expanded one is ``k * u``); a :class:`pandas.DataFrame` where pandas is
   installed, a list of :class:`Row` otherwise;
 * ``figures()``: the figures as :class:`matplotlib.figure.Figure` objects;
-* a ``repr`` of one line.
+* a ``repr`` of one line (the first line of the summary, or the result's headline);
+* results are built once: their values are computed before construction, never written
+  back into ``data`` afterwards.
 
 The callable packages: ``volerr.calibrate`` is both a sub-package (``volerr.calibrate.run``,
 ``volerr.calibrate.terms`` ...) and the function of the command.  Python binds the attribute
@@ -70,6 +72,21 @@ def as_table(rows: list):
     return pd.DataFrame([r._asdict() for r in rows], columns=list(Row._fields))
 
 
+def html_page(title: str, summary: str, rows: list) -> str:
+    """A plain HTML page: ``title``, the console text ``summary`` and the table ``rows``
+    (:class:`Row`), every text escaped."""
+    from html import escape
+
+    def cell(v):
+        return "" if v is None else escape(f"{v:.6g}" if isinstance(v, float) else str(v))
+
+    body = "".join(f"<tr>{''.join(f'<td>{cell(v)}</td>' for v in r)}</tr>\n" for r in rows)
+    head = "".join(f"<th>{h}</th>" for h in Row._fields)
+    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{escape(title)}"
+            f"</title></head>\n<body><h1>{escape(title)}</h1>\n<pre>{escape(summary)}</pre>\n"
+            f"<table>\n<tr>{head}</tr>\n{body}</table>\n</body></html>\n")
+
+
 class ResultMixin:
     """The shared methods of the API's results (see the module docstring).  A result keeps
     its JSON document in ``data`` (a dict, or a method returning it) and may override
@@ -103,6 +120,19 @@ class ResultMixin:
         """The result's figures, ``{name: matplotlib.figure.Figure}`` (none by default)."""
         return {}
 
+    def write_html(self, path, inputs=()):
+        """Write an HTML page of the result (the command's ``--html`` where it has one; by
+        default :meth:`summary` and :meth:`table`); returns its path."""
+        from .fileio import write_text
+
+        return write_text(path, html_page(type(self).__name__, self.summary(), self._rows()),
+                          inputs=list(inputs))
+
+    def _headline(self) -> str:
+        """The line :func:`repr` shows: the first line of :meth:`summary`."""
+        text = self.summary().splitlines()
+        return text[0] if text else ""
+
     def __getattr__(self, name):
         # the JSON document's keys as attributes (cal.parameters, plan.files ...)
         if name.startswith("_") or name in ("data",):
@@ -113,19 +143,36 @@ class ResultMixin:
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def __repr__(self) -> str:
-        text = self.summary().splitlines()
-        first = text[0] if text else ""
+        first = self._headline()
         if len(first) > 110:
             first = first[:107] + "..."
         return f"<volerr {type(self).__name__}: {first}>"
 
 
+def file_list(files) -> list:
+    """``files`` as a list of file names: one ``str`` or path-like is one file (not the
+    characters of its name); a list, tuple or other iterable is taken as it is."""
+    import os
+
+    if isinstance(files, (str, bytes, os.PathLike)):
+        return [files]
+    return list(files)
+
+
 class CallableModule(types.ModuleType):
     """A package module that can be called: ``volerr.calibrate(...)`` is
-    ``volerr.calibrate.__api__(...)``, the package's API function."""
+    ``volerr.calibrate.__api__(...)``, the package's API function.  ``inspect.signature``
+    and ``help`` of the module show that function's keywords and defaults
+    (``__signature__``)."""
 
     def __call__(self, *args, **kwargs):
         return self.__api__(*args, **kwargs)
+
+    @property
+    def __signature__(self):
+        import inspect
+
+        return inspect.signature(self.__api__)
 
 
 def callable_package(name: str, function) -> None:

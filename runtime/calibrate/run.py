@@ -342,8 +342,8 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
     ----------
     layout : str or path
         Layout name (``volerr.layouts()``) or layout file.
-    files : list of str or path, or volerr.instruments.Observations
-        Measurement files (``KIND:FILE`` names the kind: deviations, ballbar, sphere,
+    files : str, path, list of them, or volerr.instruments.Observations
+        Measurement files (one string is one file) (``KIND:FILE`` names the kind: deviations, ballbar, sphere,
         artifact, interferometer, distances; 'volerr formats NAME').  Each file states its
         reading's sign and frame in its format; readings in um / urad, positions mm / deg.
     parameters : str, optional
@@ -408,7 +408,9 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     if isinstance(files, instruments.Observations):
         parts, obs = [files], files
     else:
-        parts = instruments.read_parts(list(files), model)
+        from ..results import file_list
+
+        parts = instruments.read_parts(file_list(files), model)
         obs = instruments.stack(parts)
     from .defaults import default_parameters
 
@@ -456,13 +458,16 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
                                  u_ref, report["identifiability"])
     std = np.zeros(design.p)
     std[out.kept] = out.std
-    cal = Calibration(report, model, ranges, degree, labels, out.coef, std, out.residuals, out,
-                      parts, fit_quality(out, u_ref))
-    report["fit"] = cal.quality.to_dict()
-    _lab_report(cal, fit, obs, u_ref)
-    report["covariance"] = covariance_block(cal)
+    fields = (model, ranges, degree, labels, out.coef, std, out.residuals, out, parts,
+              fit_quality(out, u_ref))
+    report["fit"] = fields[-1].to_dict()
+    # the lab report and the covariance are computed from a draft of the result, then the
+    # result is built once with the whole report (nothing written back into it afterwards)
+    draft = Calibration(report, *fields)
+    report = _lab_report(draft, fit, obs, u_ref)
+    report["covariance"] = covariance_block(draft)
     report["seconds"] = round(time.perf_counter() - t0, 2)
-    return cal
+    return Calibration(report, *fields)
 
 
 def fit_quality(sol, u_ref: float) -> FitQuality:
@@ -584,34 +589,36 @@ def _preferred(model, obs, labels, obs_ranges) -> np.ndarray:
                      for lab in labels])
 
 
-def _lab_report(cal, fit, obs, u_ref) -> None:
-    """What a calibration laboratory reports beside the parameters: the consistency of the
-    files with each other (:mod:`volerr.calibrate.consistency`), the instruments' own results
-    (artifact poses, station positions), the volumetric error map with its uncertainty
-    (:mod:`volerr.calibrate.mapping`) and the ISO 10360-2 length errors of the identified model
-    beside the measured step-gauge lengths (:mod:`volerr.calibrate.lengths`)."""
+def _lab_report(cal, fit, obs, u_ref) -> dict:
+    """``cal.data`` (not changed) with what a calibration laboratory reports beside the
+    parameters: the consistency of the files with each other
+    (:mod:`volerr.calibrate.consistency`), the instruments' own results (artifact poses,
+    station positions), the volumetric error map with its uncertainty
+    (:mod:`volerr.calibrate.mapping`) and the ISO 10360-2 length errors of the identified
+    model beside the measured step-gauge lengths (:mod:`volerr.calibrate.lengths`)."""
     from . import consistency, lengths, mapping
 
-    report = cal.data
+    report = dict(cal.data)
     report["consistency"] = consistency.check(fit, cal.solution, obs, u_ref)
     flags = {e["file"]: e for e in report["consistency"]["files"]}
-    for entry in report["instruments"]:
-        c = flags.get(entry["file"], {})
-        entry["birge_ratio"] = c.get("birge_ratio")
-        entry["consistent"] = c.get("consistent", True)
+    report["instruments"] = [
+        {**entry, "birge_ratio": flags.get(entry["file"], {}).get("birge_ratio"),
+         "consistent": flags.get(entry["file"], {}).get("consistent", True)}
+        for entry in report["instruments"]]
     kinds = instruments.kinds()
     for part in cal.parts:
         kind = part.files[0].kind if part.files else "deviations"
         maker = getattr(kinds.get(kind), "results", None)
         if maker is not None:
             for key, value in maker(part, report["setup"]).items():
-                report.setdefault(key, {}).update(value)
+                report[key] = {**report.get(key, {}), **value}
     summary = mapping.summary(cal)
     if summary is not None:
         report["volumetric_map"] = summary
     iso = lengths.report(cal)
     if iso is not None:
         report["iso10360"] = iso
+    return report
 
 
 def extra_columns(model, obs, extra_terms) -> np.ndarray:

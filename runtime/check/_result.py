@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..results import ResultMixin
 from . import _volume
 
 METHOD = ("the readings against the reference's prediction by generalised least squares, the "
@@ -20,9 +21,11 @@ METHOD = ("the readings against the reference's prediction by generalised least 
           "and the check's readings")
 
 
-@dataclass
-class CheckResult:
-    """Result of :func:`volerr.check.check` (module docstring)."""
+@dataclass(repr=False)
+class CheckResult(ResultMixin):
+    """Result of :func:`volerr.check.check` (module docstring): ``to_dict()`` the ``--json``
+    document, ``summary()`` what ``volerr check`` prints, ``table()`` every reference
+    parameter after the check (value, standard uncertainty k = 1, the reference's unit)."""
 
     model: object
     reference: object
@@ -137,7 +140,8 @@ class CheckResult:
         full[self.selection.changed] = delta
         return _volume.change_um(self.J, full)
 
-    def to_dict(self) -> dict:
+    def _document(self) -> dict:
+        """The ``--json`` document (:meth:`to_dict` is its plain-JSON copy)."""
         ref = self.reference
         values, cov = self.after()
         std = np.sqrt(np.maximum(np.diag(cov), 0.0))
@@ -216,6 +220,7 @@ class CheckResult:
         self.consent = fq.consent_block(beyond, limits, accept_change)
 
     def summary(self) -> str:
+        """What ``volerr check`` prints."""
         d = self.to_dict()
         v = d["volumetric_change_um"]
         lines = [f"{d['layout']}: {d['verdict']} against {_file_name(self.reference.path)} "
@@ -252,11 +257,6 @@ class CheckResult:
     def __repr__(self) -> str:
         return f"<CheckResult {self.model.name}: {self.verdict}, " \
                f"{len(self.selection.changed)} changed>"
-
-    def write_json(self, path, inputs=()):
-        from ..fileio import json_text, write_text
-
-        return write_text(path, json_text(self.to_dict()), inputs=list(inputs))
 
     def write_html(self, path, inputs=()):
         from ..fileio import write_text

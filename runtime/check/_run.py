@@ -33,16 +33,40 @@ from ._result import CheckResult
 P_UNEXPLAINED = 1e-3
 
 
-def check(layout, reference, files, *, tolerance: str | None = None, date: str | None = None
-          ) -> CheckResult:
-    """Compare the check's ``files`` (paths or ``KIND:FILE``) with the ``reference`` (path of
-    a calibrate or check JSON) on ``layout`` (module docstring); ``tolerance``:
-    ``"NAME=VALUE [UNIT],...,map=VALUE"`` (:mod:`volerr.check._tolerance`); ``date``
-    (``YYYY-MM-DD``) is carried into the result."""
+def check(layout, files, *, reference, tolerance: str | None = None,
+          date: str | None = None) -> CheckResult:
+    """What changed since the reference calibration (``volerr check LAYOUT --reference REF
+    FILE...``; module docstring).
+
+    Parameters
+    ----------
+    layout : str, path or volerr.Model
+        Layout name or file (the reference's layout).
+    files : str, path or list
+        The check's measurement files (paths or ``KIND:FILE``, as ``volerr calibrate`` reads
+        them: readings in um / urad, positions in mm / deg); one string is one file.
+    reference : str or path
+        The reference: a ``volerr calibrate --json`` or ``volerr check --json`` file with its
+        ``covariance`` block (values and covariance in report units: um, urad, um/mm ...).
+    tolerance : str, optional
+        ``"NAME=VALUE [UNIT],...,map=VALUE"`` (``--tolerance``; ISO 14253-1 decisions,
+        :mod:`volerr.check._tolerance`; ``map`` in um of the volumetric change).
+    date : str, optional
+        ``YYYY-MM-DD``, carried into the result (``--date``).
+
+    Returns
+    -------
+    CheckResult
+        ``to_dict()`` is ``--json`` (changes with standard uncertainties, k = 1, in the
+        reference's units; the volumetric change in um).
+    """
     from threadpoolctl import threadpool_limits
+
+    from ..results import file_list
 
     model = layout if isinstance(layout, Model) else load(layout)
     ref = _reference.load(reference, model)
+    files = file_list(files)
     require(files, "give the check's files")
     tol = None
     if tolerance is not None:
@@ -50,24 +74,28 @@ def check(layout, reference, files, *, tolerance: str | None = None, date: str |
 
         tol = parse(tolerance, ref)
     with threadpool_limits(limits=1, user_api="blas"):
-        parts = instruments.read_parts(list(files), model)
+        parts = instruments.read_parts(files, model)
         obs = instruments.stack(parts)
         system = _system.build(model, ref, obs)
         sel = _select.select(system, series=[j for j, n in enumerate(ref.names) if "@" in n])
         pairs, unseen = _select.indistinguishable(system, ref.names)
         tool = np.median(obs.probe, axis=0)
         J = _volume.grid_columns(model, ref, tool)
+    misfit = _misfit(system, sel, ref)
     res = CheckResult(model, ref, sel, system, pairs, unseen, J, tool,
-                      [_file_entry(s, p) for s, p in zip(files, parts)], date)
-    res.misfit = _misfit(system, sel, ref)
-    res.quality = judge(res.misfit["chi2"], res.misfit["dof"],
-                        "u of each reading as declared in its file, else its instrument's "
-                        "default, times the reference's Birge ratio when above 1")
-    if tol is not None:
-        from ._tolerance import decide
+                      [_file_entry(s, p) for s, p in zip(files, parts)], date, misfit,
+                      quality=judge(misfit["chi2"], misfit["dof"],
+                                    "u of each reading as declared in its file, else its "
+                                    "instrument's default, times the reference's Birge ratio "
+                                    "when above 1"))
+    if tol is None:
+        return res
+    from dataclasses import replace
 
-        res.tolerance = decide(tol, res)
-    return res
+    from ._tolerance import decide
+
+    # a new result with the decisions (the one without them is not changed)
+    return replace(res, tolerance=decide(tol, res))
 
 
 def _misfit(system, sel, ref) -> dict:

@@ -53,10 +53,12 @@ def weekly(out: Path) -> dict:
     ref_dir = out / "check_reference"
     plan(model, [INSTRUMENT], 80).write(ref_dir)
     execute(ref_dir / "sphere.csv", model, machine_at(0), rng)
+    from ..fileio import json_text, write_text
+
     cal = calibrate(model, [ref_dir / "sphere.csv"])
-    cal.data["date"] = date_of(0)
     reference = out / "check_reference.json"
-    cal.write_json(reference)
+    # the calibration's JSON dated (the result itself is not changed)
+    write_text(reference, json_text({**cal.to_dict(), "date": date_of(0)}))
     cp = plan_check(model, reference, [INSTRUMENT], minutes=20)
     cp.write(out / "check_plan", out / "check_plan.json")
     paths, results = [], []
@@ -64,7 +66,7 @@ def weekly(out: Path) -> dict:
         f = out / "check_plan" / f"week{week:02d}.csv"
         shutil.copy(out / "check_plan" / cp.plan.files[0].name, f)
         execute(f, model, machine_at(week), rng)
-        res = check(model, reference, [f], date=date_of(week))
+        res = check(model, [f], reference=reference, date=date_of(week))
         path = out / f"check_week{week:02d}.json"
         res.write_json(path)
         paths.append(path)

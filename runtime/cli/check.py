@@ -140,7 +140,7 @@ def _check(args, inputs) -> int:
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).check()
     with outs:
-        result = check(layout, args.reference, files, tolerance=args.tolerance,
+        result = check(layout, files, reference=args.reference, tolerance=args.tolerance,
                        date=args.date)
         result.gate(args.accept_residual, limits, args.accept_change,
                     f"check {' '.join(split_spec(f)[1] for f in files)}")

@@ -42,7 +42,6 @@ def run(args) -> int:
     res = api.diagonals(model, funcs, lines=args.lines, probe=tuple(args.probe),
                         at=parse_at(args.at), volume=args.volume,
                         profile_points=args.profile_points, method=args.method)
-    res.data["errors"] = str(args.errors)
     print(res.summary())
     with outs:
         if args.json:

@@ -13,13 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, error_functions_from_args, finite_option,
-                      identification_from_args, inputs_of)
-from ..fileio import Outputs, json_text, write_text
-from ..machine.model import load
-from ..uncertainty import iso10360
-from ..units import num
-from ..cmm.volmap import volume
+                      add_vector, identification_from_args, inputs_of)
+from ..fileio import Outputs, write_bytes
 
 
 def register(sub) -> None:
@@ -56,62 +51,26 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _test_uncertainty(args) -> iso10360.TestUncertainty:
-    a, k = iso10360.parse_calibration(args.artefact_u)
-    finite_option(args.artefact_cte_ppm_per_K, "--artefact-cte-ppm-per-K", -100.0, 100.0)
-    finite_option(args.artefact_cte_u_ppm_per_K, "--artefact-cte-u-ppm-per-K", 0.0, 100.0)
-    finite_option(args.temperature_C, "--temperature-C", -50.0, 100.0)
-    finite_option(args.temperature_u_K, "--temperature-u-K", 0.0, 100.0)
-    return iso10360.TestUncertainty(a, k, args.artefact_cte_ppm_per_K,
-                                    args.artefact_cte_u_ppm_per_K, args.temperature_C,
-                                    args.temperature_u_K)
-
-
 def run(args) -> int:
-    model = load(args.layout)
-    funcs = error_functions_from_args(args, model)
+    from ..uncertainty.api import iso10360
+
     inputs = inputs_of(args)
     outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).check()
-    spec = iso10360.parse_spec(args.mpe, "--mpe") if args.mpe is not None else None
-    tu = _test_uncertainty(args)
-    ident = identification_from_args(args, {
-        "artefact temperature": f"{args.temperature_C:g} \u00b0C (u = {args.temperature_u_K:g} K)",
-        "artefact expansion coefficient": f"{args.artefact_cte_ppm_per_K:g} ppm/K (u = "
-                                          f"{args.artefact_cte_u_ppm_per_K:g} ppm/K)"})
-    res = iso10360.simulate(model, funcs, tuple(args.probe),
-                            volume(model, funcs, args.volume), noise_um=args.noise_um,
-                            seed=args.seed, spec=spec, uncertainty=tu)
-    print(f"{model.name}: simulated ISO 10360-2 length test, E0 = measured - true length, um")
-    for i, name in enumerate(res.names):
-        cells = "  ".join(f"L={L:7.1f}: " + " ".join(num(e, "+7.3f") for e in res.E_um[i, j])
-                          for j, L in enumerate(res.lengths[i]))
-        print(f"  {name:16s} {cells}")
-    d = res.as_dict()
-    print(f"  max |E0| = {num(d['max_abs_E_um'], '.3f')} um; test uncertainty U <= "
-          f"{num(d['uncertainty_um']['E0'], '.3f')} um (k = 2)")
-    if spec is not None:
-        c = d["verdict_counts"]
-        print(f"  MPE {spec.text()}: max |E0| / MPE = {num(d['max_ratio_to_mpe'], '.3f')} -> "
-              f"{d['verdict'].upper()} (ISO 14253-1: {c['pass']} pass, {c['undecided']} "
-              f"undecided, {c['fail']} fail)")
-    doc = {"layout": model.name, "errors": str(args.errors),
-           "probe_mm": [float(v) for v in args.probe], "repetitions": int(res.E_um.shape[-1]),
-           **d, "identification": ident.as_dict()}
-    title = f"{model.name}: simulated ISO 10360-2" + (f", {d['verdict']}" if spec else "")
+    res = iso10360(
+        args.layout, args.errors, method=args.method, degree=args.degree,
+        extrapolate=args.extrapolate, probe=args.probe,
+        volume=args.volume, mpe=args.mpe, noise_um=args.noise_um, seed=args.seed,
+        artefact_u=args.artefact_u, artefact_cte_ppm_per_K=args.artefact_cte_ppm_per_K,
+        artefact_cte_u_ppm_per_K=args.artefact_cte_u_ppm_per_K,
+        temperature_C=args.temperature_C, temperature_u_K=args.temperature_u_K,
+        identification=identification_from_args(args))
+    print(res.summary())
     with outs:
         if args.json:
-            write_text(outs.path("--json"), json_text(doc), inputs)
-        png = None
-        if args.plot or args.html:
-            png = iso10360.plot_png(res, title)
-            if args.plot:
-                from ..fileio import write_bytes
-                write_bytes(outs.path("--plot"), png, inputs)
+            res.write_json(outs.path("--json"), inputs)
+        if args.plot:
+            write_bytes(outs.path("--plot"), res.png(), inputs)
         if args.html:
-            from .. import __version__
-            from ..uncertainty.iso10360_report import report_html
-            write_text(outs.path("--html"), report_html(
-                doc, png, ident, f"Evaluated with volerr {__version__}."), inputs)
-    return 0 if np.isfinite(d["max_abs_E_um"]) else 1
-
+            res.write_html(outs.path("--html"), inputs)
+    return 0 if np.isfinite(res.data["max_abs_E_um"]) else 1

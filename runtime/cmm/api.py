@@ -38,7 +38,20 @@ class ErrorMap(ResultMixin):
         return write_map_csv(path, self.map, inputs)
 
     def _rows(self) -> list:
-        return []
+        """The printed figures (um; actual minus nominal probe tip): max |dx|, |dy|, |dz|,
+        max and RMS |d| (exact over the grid, no uncertainty: ``std`` None), and where the
+        tables carry one the largest standard uncertainty (k = 1) of the random part."""
+        from ..results import Row
+
+        s = self.data
+        rows = [Row(f"max_abs_d{a}", float(s["max_abs_um"][a]), None, "um", 1.0)
+                for a in "xyz"]
+        rows += [Row("max_length", float(s["max_length_um"]), None, "um", 1.0),
+                 Row("rms_length", float(s["rms_length_um"]), None, "um", 1.0)]
+        if self.map.random is not None:
+            rows += [Row(f"random_max_{a}", float(s["random_max_um"][a]), None, "um", 1.0)
+                     for a in "xyz"]
+        return rows
 
 
 def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
@@ -107,7 +120,14 @@ class Diagonals(ResultMixin):
                 f"the probe tip (first order), probe {probe} mm\n{format_table(self.lines)}")
 
     def _rows(self) -> list:
-        return []
+        """One row per line: its length deviation dL (um, positive: the line measures long)
+        with the standard uncertainty (k = 1) of its random part where the tables carry
+        one."""
+        from ..results import Row
+
+        return [Row(f"dL({ln['name']})", float(ln["deviation_um"]),
+                    None if ln.get("random_um") is None else float(ln["random_um"]), "um", 1.0)
+                for ln in self.data["lines"]]
 
 
 def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,

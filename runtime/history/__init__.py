@@ -12,3 +12,9 @@
 from .run import add, show
 
 __all__ = ["add", "show"]
+
+from ..results import callable_package  # noqa: E402
+
+# volerr.history(db, machine, ...) is volerr.history.show(...) (the History of `volerr history
+# show`), whatever was imported before; volerr.history.add / show stay
+callable_package(__name__, show)

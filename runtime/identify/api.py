@@ -33,20 +33,16 @@ class Identified(ResultMixin):
         return table_to_csv(self.errors)
 
     def _rows(self) -> list:
-        from ..results import Row
+        from .solve import error_table_rows
 
-        t, out = self.errors, []
-        for name, values in t.values.items():
-            ang = name[1] in "ABC"
-            f, unit = (1e6, "urad") if ang else (1e3, "um")
-            std = t.std.get(name) if t.std else None
-            for i, q in enumerate(t.positions):
-                out.append(Row(f"{name}({q:g})", f * float(values[i]),
-                               None if std is None else f * float(std[i]), unit, 1.0))
-        return out
+        return error_table_rows(self.errors)
 
     def figures(self) -> dict:
-        return {}
+        """``{"motions"}``: the six error motions at every position with +-2 s bars and
+        every round (um, urad; the thesis' Fig. 4.x style, as ``--plot`` draws them)."""
+        from .plots import identification_figure
+
+        return {"motions": identification_figure(self.identification)}
 
 
 def identify(layout, axis: str, files, *, format: str = "csv", positions: str | None = None,
@@ -91,12 +87,12 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     sense = {"auto": "auto", "+": 1, "-": -1}.get(sense, sense)
     result = solve(rounds, lay, axis, method=method, tracker=tracker, direction=direction,
                    origin=origin, sense=sense, max_cond=max_cond, outlier_k=outlier_k)
-    table = result.table()
+    table = result.errors_table()
     if signs == "model":
         table = to_model_signs(table, lay, reference=result.rounds[0].positions[0])
     check_identified(table, lay, files, accept_implausible)
     quality = result.fit_quality()
-    data = result.summary()
+    data = result.report()
     data["fit_quality"] = quality.to_dict()
     return Identified(data, table, result, axis.strip().upper(), quality)
 

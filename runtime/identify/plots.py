@@ -22,9 +22,16 @@ def _sigma(result):
 
 @styled
 def plot_identification(result, path, fits: dict | None = None) -> None:
-    """Write a PNG of the six error motions of ``result`` (:class:`volerr.identify.solve.
-    Identification`); ``fits``: name -> callable of position (mm or rad), optional.  Bars:
-    +-2 s, s the standard deviation of one round (the scatter the table's ``_s`` holds)."""
+    """Write a PNG of :func:`identification_figure` (the six error motions of ``result``)."""
+    save(identification_figure(result, fits), path)
+
+
+@styled
+def identification_figure(result, fits: dict | None = None):
+    """The six error motions of ``result`` (:class:`volerr.identify.solve.Identification`,
+    um and urad against the axis position): a matplotlib figure; ``fits``: name -> callable
+    of position (mm or rad), optional.  Bars: +-2 s, s the standard deviation of one round
+    (the scatter the table's ``_s`` holds)."""
     rotary = result.kind == "rotary"
     sig, sig_label = _sigma(result)
     unit_pos = "deg" if rotary else "mm"
@@ -68,4 +75,4 @@ def plot_identification(result, path, fits: dict | None = None) -> None:
             ax.legend(loc="lower right", bbox_to_anchor=(1.3, -0.1))
     fig.suptitle(f"Error motions of axis {result.axis} ({len(result.rounds)} round(s), "
                  f"{result.method}, {len(result.rounds[0].labels)} points)")
-    save(fig, path)
+    return fig

@@ -36,7 +36,7 @@ def residual_csv(result) -> str:
 def summary_lines(axis: str, summary: dict, out) -> list[str]:
     """The lines printed after an identification of ``axis`` written to ``out``.
 
-    ``summary`` is :meth:`Identification.summary` (with an optional ``"fit"`` list of
+    ``summary`` is :meth:`Identification.report` (with an optional ``"fit"`` list of
     :meth:`volerr.tables.errorfit.ErrorFit.report` dicts)."""
     s = summary
     lines = [f"{axis}: {s['n_positions']} positions x {len(s['points'])} points x "

@@ -158,8 +158,9 @@ class Identification:
         """ISO names of the six motions, e.g. ``EXX ... ECX``."""
         return tuple(p + self.axis for p in MOTION_PREFIX)
 
-    def table(self, with_u95: bool | None = None):
-        """The averaged result as a :class:`volerr.tables.table.ErrorTable`.
+    def errors_table(self, with_u95: bool | None = None):
+        """The averaged result as a :class:`volerr.tables.table.ErrorTable` (formerly
+        ``table()``; :meth:`table` is the contract's rows now).
 
         With several (n) rounds: ``s`` = the experimental standard deviation of one round
         (ddof = 1, the repeatability of one reading, column ``_s``) and ``std`` = s / sqrt(n),
@@ -200,8 +201,24 @@ class Identification:
         """All flagged (round, position, point, residual_um, ratio) over rounds."""
         return [o for r in self.rounds for o in r.outliers]
 
-    def summary(self) -> dict:
-        """JSON-friendly summary (um, urad)."""
+    def summary(self) -> str:
+        """The console text of ``volerr identify`` for this identification (the table not
+        written: the API's call writes nothing)."""
+        from .report import summary_lines
+
+        return "\n".join(summary_lines(self.axis, self.report(), "(not written)"))
+
+    def table(self):
+        """The result contract's rows (:meth:`volerr.results.ResultMixin.table`): every
+        motion at every position, um / urad, with its Type A standard uncertainty (k = 1)
+        where there are several rounds (the error table itself: :meth:`errors_table`)."""
+        from ..results import as_table
+
+        return as_table(error_table_rows(self.errors_table()))
+
+    def report(self) -> dict:
+        """The JSON-friendly summary (um, urad): ``volerr identify --json`` (formerly
+        ``summary()``)."""
         res = np.concatenate([r.residuals[1:].reshape(-1, 3) for r in self.rounds])
         norms = np.linalg.norm(res, axis=1) * UM_PER_MM
         scale = np.array([UM_PER_MM] * 3 + [URAD_PER_RAD] * 3)
@@ -238,6 +255,21 @@ class Identification:
                                                         for c in cf]) for n in self.names},
             }
         return out
+
+
+def error_table_rows(t) -> list:
+    """:class:`volerr.results.Row` of every value of the error table ``t``: ``NAME(q)`` in um
+    (translational) or urad (angular), its ``std`` (k = 1) where the table has one."""
+    from ..results import Row
+
+    out = []
+    for name, values in t.values.items():
+        f, unit = (1e6, "urad") if name[1] in "ABC" else (1e3, "um")
+        std = t.std.get(name) if t.std else None
+        for i, q in enumerate(t.positions):
+            out.append(Row(f"{name}({q:g})", f * float(values[i]),
+                           None if std is None else f * float(std[i]), unit, 1.0))
+    return out
 
 
 def _mean_or_none(values):
@@ -640,7 +672,7 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         Positions (n_positions,) sorted, mm or deg; ``values`` (n_positions, 6), the error
         motions EX EY EZ (mm) EA EB EC (rad) of the component carrying the points, zero at each
         round's reference position (the first position), averaged over the rounds; ``std``
-        (Type A) and ``u_tracker`` the same shape.  ``.table()`` gives the
+        (Type A) and ``u_tracker`` the same shape.  ``.errors_table()`` gives the
         :class:`volerr.tables.ErrorTable`.
     """
     from ..machine.layout import Layout, read_layout
@@ -717,7 +749,7 @@ def to_model_signs(table, layout, reference=None):
     Parameters
     ----------
     table : volerr.tables.ErrorTable
-        The identified table of one axis (:meth:`Identification.table`): positions (n,) mm or
+        The identified table of one axis (:meth:`Identification.errors_table`): positions (n,) mm or
         deg, values mm (translational) / rad (angular).
     layout : Layout
         The machine layout declaring the axis (which chain carries it).

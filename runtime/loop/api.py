@@ -14,16 +14,19 @@ from .run import Report, run_loop
 @dataclass(repr=False)
 class Loop(Report):
     """Result of :func:`loop`: a :class:`volerr.loop.Report` whose :meth:`summary` is the
-    whole console text of ``volerr loop``.  Its ``figures`` attribute is the data behind the
-    report's figures (:class:`volerr.loop.run.Figures`, a field of the report that predates
-    the API), not a method: ``write_html`` draws them."""
+    whole console text of ``volerr loop``; ``plot_data`` is the data behind the report's
+    figures (:class:`volerr.loop.run.Figures`), :meth:`figures` draws them."""
 
     def headline(self) -> str:
         """The first line: points, held-out RMS and max before -> after (um), effects."""
         return Report.summary(self)
 
     def summary(self) -> str:
+        """What ``volerr loop`` prints (warnings first, then :meth:`headline` ...)."""
         return "\n".join(console_lines(self))
+
+    def _headline(self) -> str:
+        return self.headline()
 
     def _rows(self) -> list:
         from ..results import Row
@@ -181,7 +184,7 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
     r = run_loop(layout, files, seed=seed, folds=folds, test_fraction=test_fraction,
                  degree=degree, out_dir=out_dir, families=chosen, progress=progress,
                  holdout_time=holdout_time)
-    return Loop(r.data, r.figures, r.augmented_text, r.generated)
+    return Loop(r.data, r.plot_data, r.augmented_text, r.generated)
 
 
 def _drift(layout, specs, out_dir, holdout_time, holdout_files, differences, progress):

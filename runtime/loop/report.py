@@ -48,6 +48,12 @@ def _unit_label(v: str, model) -> str:
 
 @styled
 def fig_residuals(fg) -> str:
+    """The ``<img>`` tag of :func:`figure_residuals`."""
+    return _png(figure_residuals(fg), "residuals against every axis and covariate")
+
+
+@styled
+def figure_residuals(fg):
     dat = fg.data
     variables = {**dat.positions, **dat.covariates}
     names = [v for v, x in variables.items() if np.ptp(x) > 0][:14]
@@ -74,7 +80,7 @@ def fig_residuals(fg) -> str:
             if j == 0:
                 ax.set_ylabel(label("residual", "um"))
     axes[0, 0].legend(loc="upper right", markerscale=4)
-    return _png(fig, "residuals against every axis and covariate")
+    return fig
 
 
 def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str]:
@@ -105,6 +111,12 @@ def _natural(kind: str, info: dict, model, dat, values) -> tuple[np.ndarray, str
 
 @styled
 def fig_effect(fg, eff: dict) -> str:
+    """The ``<img>`` tag of :func:`figure_effect`."""
+    return _png(figure_effect(fg, eff), f"evidence of {eff['name']}")
+
+
+@styled
+def figure_effect(fg, eff: dict):
     model, dat = fg.model, fg.data
     c3 = fg.contrib[eff["name"]].reshape(-1, 3) * 1e3
     partial = (fg.res_after.reshape(-1, 3) * 1e3) + c3
@@ -136,7 +148,7 @@ def fig_effect(fg, eff: dict) -> str:
     ax.set_ylabel(ylabel)
     ax.set_title(f"{eff['kind']}: {eff['name']}")
     ax.legend(markerscale=4)
-    return _png(fig, f"evidence of {eff['name']}")
+    return fig
 
 
 def _span(x) -> tuple:
@@ -148,6 +160,12 @@ def _span(x) -> tuple:
 
 @styled
 def fig_maps(fg) -> str:
+    """The ``<img>`` tag of :func:`figure_maps`."""
+    return _png(figure_maps(fg), "error maps before and after")
+
+
+@styled
+def figure_maps(fg):
     """Residual length before and after over the first two axes: every panel spans the data
     of both axes (equal scales when both are lengths; the panel's box adapts, never the
     limits)."""
@@ -169,11 +187,17 @@ def fig_maps(fg) -> str:
         if _unit_label(a, model) == _unit_label(b, model):
             ax.set_aspect("equal", adjustable="box")
     fig.colorbar(sc, ax=axes, shrink=0.8, label=label("residual length", "um"))
-    return _png(fig, "error maps before and after")
+    return fig
 
 
 @styled
 def fig_functions(report) -> str:
+    """The ``<img>`` tag of :func:`figure_functions`."""
+    return _png(figure_functions(report), "fitted component errors")
+
+
+@styled
+def figure_functions(report):
     """The fitted component errors of every axis, declared fit (before) and augmented
     fit (after, +-2 standard deviations)."""
     after, _ = report.error_tables()
@@ -193,16 +217,23 @@ def fig_functions(report) -> str:
                 ax.fill_between(q, (v - 2 * sd) * f, (v + 2 * sd) * f, color=color, alpha=0.2)
                 ax.plot(before[a].positions, before[a].values[name] * f, "--", color=color,
                         lw=0.8)
-            ax.set_xlabel(label(a, "deg" if a in report.figures.model.rotary_axes else "mm"))
+            ax.set_xlabel(label(a, "deg" if a in report.plot_data.model.rotary_axes else "mm"))
             ax.set_ylabel(label("error", unit))
             ax.legend(fontsize=9, ncol=2)
     fig.suptitle("solid: augmented model (band \u00b12 standard deviations, k = 2), dashed: "
                  "declared model")
-    return _png(fig, "fitted component errors")
+    return fig
 
 
 @styled
 def fig_interactions(fg, sources) -> str | None:
+    """The ``<img>`` tag of :func:`figure_interactions`."""
+    fig = figure_interactions(fg, sources)
+    return None if fig is None else _png(fig, "residual against covariates")
+
+
+@styled
+def figure_interactions(fg, sources):
     """Residual (after) against the covariates of the top residual sources, coloured by each
     axis position: an interaction shows as a colour gradient across the cloud."""
     dat, model = fg.data, fg.model
@@ -233,7 +264,7 @@ def fig_interactions(fg, sources) -> str | None:
             if j == 0:
                 ax.set_ylabel(label(f"residual d{'xyz'[k]} after", "um"))
             fig.colorbar(sc, ax=ax, label=label(a, _unit_label(a, model)))
-    return _png(fig, "residual against covariates")
+    return fig
 
 
 def render_html(report) -> str:
@@ -242,7 +273,7 @@ def render_html(report) -> str:
 
     from importlib import resources
 
-    fg = report.figures
+    fg = report.plot_data
     figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg),
                "functions": fig_functions(report),
                "interactions": fig_interactions(fg, report.data["residual_sources"])}

@@ -71,7 +71,7 @@ class Report(ResultMixin):
     """Result of :func:`run_loop`; ``data`` is the json report (INTERFACE.md keys first)."""
 
     data: dict
-    figures: "Figures | None" = None       # what the html report and error tables need
+    plot_data: "Figures | None" = None     # what the html report, figures() and error tables need
     augmented_text: str = ""
     generated: object = ""      # module text, or a function deriving it when first asked
     quality: object = None      # the residual rule (volerr.fit_quality.FitQuality)
@@ -96,6 +96,23 @@ class Report(ResultMixin):
         return write_text(path, json_text(self.data, default=_json),
                           inputs=list(inputs))
 
+    def figures(self) -> dict:
+        """``{"residuals", "maps", "functions", "interactions", "effect:NAME" ...}``: the
+        report page's figures as :class:`matplotlib.figure.Figure` (residuals in um against
+        every axis and covariate, before and after; the error maps; the fitted component
+        errors with +-2 standard deviations; each effect's evidence); none without the data
+        behind them (``plot_data``)."""
+        from . import report as rp
+
+        fg = self.plot_data
+        if fg is None:
+            return {}
+        out = {"residuals": rp.figure_residuals(fg), "maps": rp.figure_maps(fg),
+               "functions": rp.figure_functions(self),
+               "interactions": rp.figure_interactions(fg, self.data["residual_sources"])}
+        out.update({f"effect:{e['name']}": rp.figure_effect(fg, e) for e in self.effects})
+        return {k: f for k, f in out.items() if f is not None}
+
     def write_html(self, path, inputs=()) -> Path:
         from ..fileio import write_text
         from .report import render_html
@@ -114,7 +131,7 @@ class Report(ResultMixin):
         from ..estimate.design import series_basis
         from ..tables.table import ErrorTable
 
-        fg = self.figures
+        fg = self.plot_data
         model, ranges, deg = fg.model, fg.ranges, fg.degree
         coef, labels, var = fg.c_all, fg.aug_labels, fg.cov_diag
         if which == "before":

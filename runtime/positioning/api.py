@@ -108,3 +108,73 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
                                            cte_u_ppm_per_K, eve_um), tolerance=tol,
                        identification=identification)
     return Iso230_2(report, rs.evaluations, identification=identification)
+
+
+@dataclass(repr=False)
+class Iso230_3(ResultMixin):
+    """Result of :func:`volerr.iso230_3`: ``data`` the ``--json`` document (per channel the
+    drift range, max, min in um from the first reading, with their times in s; tilts in urad;
+    per stage the change and range; a file of several runs: ``{"standard", "runs"}``),
+    ``evaluations`` the :class:`volerr.positioning.iso230_3.DriftEvaluation` per run."""
+
+    data: dict
+    evaluations: list
+    identification: object = None
+
+    def summary(self) -> str:
+        """What ``volerr iso230-3`` prints: a line per channel and tilt, per run."""
+        return "\n".join(ln for ev in self.evaluations for ln in ev.summary_lines())
+
+    def _rows(self) -> list:
+        """Per run, channel and tilt: the drift range (um; urad for a tilt), the largest
+        and the smallest drift (readings, no uncertainty stated: ``std`` None)."""
+        from ..results import Row
+
+        out = []
+        for ev in self.evaluations:
+            pre = f"{ev.name}:" if len(self.evaluations) > 1 else ""
+            series = [(k, e, "um") for k, e in ev.channel_extremes().items()]
+            series += [(tl.name, e, "urad") for tl, e in zip(ev.tilts,
+                                                            ev.tilt_extremes().values())]
+            for k, e, unit in series:
+                out += [Row(f"{pre}{k}:{what}", float(v), None, unit, 1.0)
+                        for what, v in (("range", e.range), ("max", e.max), ("min", e.min))]
+        return out
+
+    def figures(self) -> dict:
+        """``{run name: Figure}``: drift, tilts, spindle speed and temperatures against time
+        (um, urad, rpm, degC against h), one figure per run."""
+        from .iso230_3 import drift_figure
+
+        return {ev.name: drift_figure(ev) for ev in self.evaluations}
+
+    def pngs(self) -> list:
+        """The plot of every run (drift, tilts, spindle speed and temperatures against time),
+        PNG bytes."""
+        from .iso230_3 import plot
+
+        return [plot(ev) for ev in self.evaluations]
+
+    def write_html(self, path, inputs=()):
+        """The test report (``--html``): identification, drift per channel and stage, plot."""
+        import datetime
+
+        from importlib.metadata import version
+        from ..fileio import write_text
+        from .iso230_3 import report_html
+
+        made = (f"Evaluated with volerr {version('volerr')} on "
+                f"{datetime.date.today().isoformat()}.")
+        return write_text(path, report_html(self.evaluations, self.pngs(), made,
+                                            identification=self.identification),
+                          inputs=list(inputs))
+
+
+def evaluate_drift_runs(runs, stage_column: str | None = None,
+                        identification=None) -> Iso230_3:
+    """The ISO 230-3 evaluation of drift runs already read
+    (:func:`volerr.instruments.drift.read_runs`); :func:`volerr.iso230_3` reads the file."""
+    from . import iso230_3
+
+    evals = [iso230_3.evaluate(r, stage_column) for r in runs]
+    return Iso230_3(iso230_3.report_dict(evals), evals, identification)

@@ -260,9 +260,15 @@ def report_dict(evaluations: list) -> dict:
 
 @styled
 def plot(ev: DriftEvaluation) -> bytes:
+    """:func:`drift_figure` of ``ev`` as PNG bytes."""
+    return png(drift_figure(ev))
+
+
+@styled
+def drift_figure(ev: DriftEvaluation):
     """Drift of every channel against time (h), the tilts below, then the spindle speed (or
     the stage column) and the temperatures: the figures of ISO 230-3 (displacement against
-    time with the heat input beside it).  PNG bytes."""
+    time with the heat input beside it).  A matplotlib figure."""
     panels = 2 + bool(ev.tilts) + bool(ev.stage_column)
     fig, axes = figure(panels, 1, height=2.3 * panels + 0.6, sharex=True)
     th = (ev.t_s - ev.t_s[0]) / 3600.0
@@ -291,7 +297,7 @@ def plot(ev: DriftEvaluation) -> bytes:
     if temps:
         _legend(axes[i], ncols=1 + len(temps) // 9)
     axes[-1].set_xlabel(label("time from the start", "h"))
-    return png(fig)
+    return fig
 
 
 def _legend(ax, ncols: int = 1) -> None:

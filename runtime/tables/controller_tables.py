@@ -17,7 +17,9 @@ The formats (each module documents its file, limits and sources):
                                                                  ``COMP_FILE`` s + ini lines)
 =================  ===========================================  ==============================
 
-What compensating leaves: :func:`volerr.fiveaxis.tables_left.left`.
+What compensating leaves: :func:`volerr.fiveaxis.tables_left.left`; whether that is worse
+than no compensation: :func:`worse_than_none`; the API of the capability:
+:mod:`volerr.fiveaxis.controller_api` (``volerr.controller_export`` / ``controller_import``).
 """
 
 from __future__ import annotations
@@ -103,11 +105,28 @@ def import_tables(model, path, fmt: str) -> dict:
     return tables
 
 
+def worse_than_none(summary: dict) -> bool:
+    """Whether a compensation leaves a larger max or rms of the volumetric error than no
+    compensation: ``summary["left_um"]`` against ``summary["before_um"]`` (``{"max", "rms"}``,
+    um), compared at 1 nm, below which a difference is the rounding of the tables' values."""
+    b, a = summary["before_um"], summary["left_um"]
+    return a["max"] > b["max"] + 1e-3 or a["rms"] > b["rms"] + 1e-3
+
+
 def plot_left(result, path, title: str = "") -> None:
-    """The volumetric error |e| before and after the tables' correction on three levels of
-    the last linear axis (lowest, middle, highest), um."""
+    """:func:`left_figure` saved as a PNG at ``path`` (90 dpi)."""
     import matplotlib
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = left_figure(result, title)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def left_figure(result, title: str = ""):
+    """The volumetric error |e| before and after the tables' correction on three levels of
+    the last linear axis (lowest, middle, highest), um: a matplotlib figure."""
     import matplotlib.pyplot as plt
     import numpy as np
 
@@ -135,5 +154,4 @@ def plot_left(result, path, title: str = "") -> None:
             fig.colorbar(im, ax=ax[row][col], label="|e| (um)")
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig

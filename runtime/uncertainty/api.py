@@ -191,3 +191,123 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
         contributions=mc.contributions(prob, contributions) if contributions else None,
         bias=bias, table_uncertainty=ens.table_columns, task_points=tk.n_points)
     return Uncertainty(doc, values, tuple(prob.names), stats)
+
+
+@dataclass(repr=False)
+class Iso10360(ResultMixin):
+    """Result of :func:`iso10360`: ``data`` the ``--json`` document (E0 = measured minus true
+    length per position, length and repetition, um; the test uncertainty U, k = 2; with an
+    MPE the ISO 14253-1 verdicts), ``result`` the :class:`volerr.uncertainty.iso10360.TestResult`,
+    ``identification`` the certificate's :class:`volerr.certificate.Identification`."""
+
+    data: dict
+    result: object
+    identification: object = None
+
+    def summary(self) -> str:
+        """What ``volerr iso10360`` prints."""
+        from .iso10360 import console_lines
+
+        return "\n".join(console_lines(self.result, self.data))
+
+    def _rows(self) -> list:
+        """One row per position and length: E0 (um, the mean of the repetitions) with the
+        standard uncertainty of the test, U(L) / k (k = 2, ISO 14253-5)."""
+        from ..results import Row
+
+        res, U = self.result, self.data.get("uncertainty_um") or {}
+        u = U.get("E0")
+        out = []
+        for i, name in enumerate(res.names):
+            for j, L in enumerate(res.lengths[i]):
+                out.append(Row(f"E0({name.strip()}, L={L:.1f})",
+                               float(np.mean(res.E_um[i, j])), None if u is None else u / 2.0,
+                               "um", 1.0))
+        return out
+
+    def png(self) -> bytes:
+        """The certificate picture: E0 against L with the MPE and the undecided zone."""
+        from . import iso10360 as iso
+
+        spec = self.data.get("mpe")
+        return iso.plot_png(self.result, f"{self.data['layout']}: simulated ISO 10360-2"
+                            + (f", {self.data['verdict']}" if spec else ""))
+
+    def write_html(self, path, inputs=()):
+        """The certificate page (``--html``)."""
+        from importlib.metadata import version
+        from ..fileio import write_text
+        from .iso10360_report import report_html
+
+        return write_text(path, report_html(self.data, self.png(), self.identification,
+                                            f"Evaluated with volerr {version('volerr')}."),
+                          inputs=list(inputs))
+
+
+def iso10360(layout, errors, *, probe=(0.0, 0.0, 0.0), volume: str = "travel",
+             mpe: str | None = None, noise_um: float = 0.0, seed: int = 0,
+             artefact_u: str = "0.1+L/2000", artefact_cte_ppm_per_K: float = 11.5,
+             artefact_cte_u_ppm_per_K: float = 1.0, temperature_C: float = 20.0,
+             temperature_u_K: float = 0.2, method: str = "linear", degree: int | None = None,
+             extrapolate: bool = False, identification=None) -> Iso10360:
+    """The simulated ISO 10360-2 length measuring test (``volerr iso10360``): 7 positions (4
+    space diagonals, lines along X, Y, Z through the centre), 5 lengths, 3 repetitions.
+
+    Parameters
+    ----------
+    layout : str, path or volerr.Model
+        Layout name or file.
+    errors : path or volerr.tables.ErrorFunctions
+        Error directory (``X.csv`` ... ``constants.csv``) or error functions made from one.
+    probe : (3,) mm
+        Probe offset (E0 is tested with 0 0 0).
+    volume : {"travel", "measured"}
+        The box of the test: the layout's travel or the part the error tables cover.
+    mpe : str, optional
+        MPE line ``"E0=A+L/K"`` (A um, L mm) to judge against (ISO 14253-1 verdicts).
+    noise_um : float
+        Probing noise per point, standard deviation, um; ``seed`` its seed.
+    artefact_u : str
+        Expanded calibration uncertainty of the reference lengths, ``"A+L/K"`` um (L mm).
+    artefact_cte_ppm_per_K, artefact_cte_u_ppm_per_K : float
+        Expansion coefficient of the artefact and its standard uncertainty, ppm/K.
+    temperature_C, temperature_u_K : float
+        Artefact temperature during the test (degC) and its standard uncertainty (K).
+    method, degree, extrapolate
+        How the tables are interpolated (as ``--method``, ``--degree``, ``--extrapolate``).
+    identification : volerr.certificate.Identification, optional
+        Machine, instrument, operator, date of the certificate (the artefact's temperature
+        and expansion coefficient are added to its conditions).
+
+    Returns
+    -------
+    Iso10360
+        ``to_dict()`` is ``--json`` (um; U at k = 2).
+    """
+    from dataclasses import replace
+
+    from ..certificate import Identification
+    from ..cmm.volmap import volume as box
+    from ..machine.model import Model, load
+    from ..tables.functions import ErrorFunctions
+    from . import iso10360 as iso
+
+    model = layout if isinstance(layout, Model) else load(layout)
+    funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
+        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+    spec = iso.parse_spec(mpe, "--mpe") if mpe is not None else None
+    tu = iso.artefact_uncertainty(artefact_u, artefact_cte_ppm_per_K, artefact_cte_u_ppm_per_K,
+                              temperature_C, temperature_u_K)
+    ident = identification or Identification()
+    ident = replace(ident, conditions={
+        **ident.conditions,
+        "artefact temperature": f"{temperature_C:g} \u00b0C (u = {temperature_u_K:g} K)",
+        "artefact expansion coefficient": f"{artefact_cte_ppm_per_K:g} ppm/K (u = "
+                                          f"{artefact_cte_u_ppm_per_K:g} ppm/K)"})
+    res = iso.simulate(model, funcs, tuple(probe), box(model, funcs, volume),
+                       noise_um=noise_um, seed=seed, spec=spec, uncertainty=tu)
+    doc = {"layout": model.name, "errors": str(errors if errors is not funcs else
+                                               (funcs.source or "")),
+           "probe_mm": [float(v) for v in probe], "repetitions": int(res.E_um.shape[-1]),
+           **res.as_dict(), "identification": ident.as_dict()}
+    return Iso10360(doc, res, ident)

@@ -232,6 +232,46 @@ class TestUncertainty:
                 "coverage_factor": 2, "formula": self.text()}
 
 
+def artefact_uncertainty(artefact_u: str = "0.1+L/2000", cte_ppm_per_K: float = 11.5,
+                     cte_u_ppm_per_K: float = 1.0, temperature_C: float = 20.0,
+                     temperature_u_K: float = 0.2) -> TestUncertainty:
+    """:class:`TestUncertainty` of the command's options (each checked finite and in range:
+    one line naming the option otherwise)."""
+    import math
+
+    a, k = parse_calibration(artefact_u)
+    for value, option, low, high in (
+            (cte_ppm_per_K, "--artefact-cte-ppm-per-K", -100.0, 100.0),
+            (cte_u_ppm_per_K, "--artefact-cte-u-ppm-per-K", 0.0, 100.0),
+            (temperature_C, "--temperature-C", -50.0, 100.0),
+            (temperature_u_K, "--temperature-u-K", 0.0, 100.0)):
+        require(math.isfinite(value) and low <= value <= high,
+                f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
+    return TestUncertainty(a, k, cte_ppm_per_K, cte_u_ppm_per_K, temperature_C,
+                           temperature_u_K)
+
+
+def console_lines(res, doc: dict) -> list:
+    """What ``volerr iso10360`` prints for the result ``res`` and its JSON ``doc``: E0 per
+    position and length (um), max |E0| and U (k = 2), the verdict against the MPE."""
+    from ..units import num
+
+    out = [f"{doc['layout']}: simulated ISO 10360-2 length test, E0 = measured - true length, "
+           "um"]
+    for i, name in enumerate(res.names):
+        cells = "  ".join(f"L={L:7.1f}: " + " ".join(num(e, "+7.3f") for e in res.E_um[i, j])
+                          for j, L in enumerate(res.lengths[i]))
+        out.append(f"  {name:16s} {cells}")
+    out.append(f"  max |E0| = {num(doc['max_abs_E_um'], '.3f')} um; test uncertainty U <= "
+               f"{num(doc['uncertainty_um']['E0'], '.3f')} um (k = 2)")
+    if res.spec is not None:
+        c = doc["verdict_counts"]
+        out.append(f"  MPE {res.spec.text()}: max |E0| / MPE = "
+                   f"{num(doc['max_ratio_to_mpe'], '.3f')} -> {doc['verdict'].upper()} (ISO "
+                   f"14253-1: {c['pass']} pass, {c['undecided']} undecided, {c['fail']} fail)")
+    return out
+
+
 def parse_calibration(text: str, option: str = "--artefact-u") -> tuple[float, float]:
     """``"A+L/K"`` (um, L in mm) -> (A, K)."""
     t = str(text).replace(" ", "")

@@ -232,8 +232,8 @@ def test_the_uncertainty_of_a_change_holds_the_reference(tmp_path):
         f = tmp_path / "c.csv"
         shutil.copy(tmp_path / "c" / "sphere.csv", f)
         plan_fill.fill(f, LAYOUT, {**PLANTED, "EX0C": PLANTED["EX0C"] + 2.0}, rng)
-        changed = {c["parameter"]: c for c in check(LAYOUT, tmp_path / "cal.json",
-                                                    [f]).to_dict()["changed"]}
+        changed = {c["parameter"]: c for c in check(LAYOUT, [f], reference=tmp_path
+                                                    / "cal.json").to_dict()["changed"]}
         assert "EX0C" in changed, (k, changed)
         z.append((changed["EX0C"]["change"] - 2.0) / changed["EX0C"]["std"])
     assert abs(np.mean(z)) < 0.6 and 0.6 < np.std(z, ddof=1) < 1.5, z

@@ -153,7 +153,7 @@ def test_closed_form_equals_lsq_on_exact_first_order_data():
         scale = np.array([1, 1, 1, 100, 100, 100])
         assert np.abs((r1.values - theta) * scale).max() < 1e-9
         assert np.abs((r2.values - r1.values) * scale).max() < 1e-8
-        assert r1.summary()["closed_form"]["consistency_max"] < 1e-9
+        assert r1.report()["closed_form"]["consistency_max"] < 1e-9
 
 
 def test_more_than_three_points_better_than_three():

@@ -125,7 +125,7 @@ def test_shipped_example_identifies_and_gives_squareness(tmp_path):
         assert np.allclose(res.positions, pos)
         z = np.abs(res.values - e)[1:] / (res.u_tracker[1:] / 2.0)  # 4 rounds: u of mean
         assert z.max() < 5.0
-        tables[axis] = res.table()
+        tables[axis] = res.errors_table()
     values, std, _, _ = squareness(tables, read_layout("MB1"))
     for k, v in sq.items():
         assert abs(values[k] - v) < 3 * std[k] + 2e-6, k

@@ -45,7 +45,7 @@ def test_error_map_panels_span_the_data(monkeypatch):
     figs = []
     monkeypatch.setattr(rp, "png", lambda fig: figs.append(fig) or b"\x89PNG\r\n\x1a\n"
                         + b"\0" * 8 + (100).to_bytes(4, "big") * 2)
-    rp.fig_maps(rep.figures)
+    rp.fig_maps(rep.plot_data)
     (fig,) = figs
     fig.canvas.draw()
     x, y = (np.asarray(camp.columns()[a], float) for a in ("X", "Y"))
