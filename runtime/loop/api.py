@@ -184,7 +184,7 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
     r = run_loop(layout, files, seed=seed, folds=folds, test_fraction=test_fraction,
                  degree=degree, out_dir=out_dir, families=chosen, progress=progress,
                  holdout_time=holdout_time)
-    return Loop(r.data, r.plot_data, r.augmented_text, r.generated)
+    return Loop(r.data, r.plot_data, r.augmented_text, r.generated, r.quality)
 
 
 def _drift(layout, specs, out_dir, holdout_time, holdout_files, differences, progress):
