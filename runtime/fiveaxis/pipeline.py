@@ -278,7 +278,7 @@ def console_lines(data: dict, job: Job, wrote=None) -> list:
              f"{', types ' + job.types_text if job.types_text else ''}); predicted tool-tip "
              f"error max {s['max_before_um']:.3f} -> {s['max_after_um']:.3f} um, rms "
              f"{s['rms_before_um']:.3f} -> {s['rms_after_um']:.3f} um"
-             f"{'; wrote ' + str(wrote) if wrote is not None else ''}",
+             f"; wrote {wrote if wrote is not None else '(not written)'}",
              job.datum_text, tool_sentence(o, s["tcpm_blocks"])]
     arcs = s["arcs"]
     if arcs["linearised"]:

@@ -100,7 +100,8 @@ class History(ResultMixin):
         """The numbers the command prints: each event (``"EY0C step 2025-03-31"``, the step
         in the parameter's unit), each trend (``"EX0C slope since 2025-01-06"``, per day:
         unit ``um/d``, ``urad/d``), each forecast's tolerance (``"EX0C tolerance"``, no
-        uncertainty) and the volumetric error now of a ``map`` forecast; std k = 1."""
+        uncertainty) and the volumetric error now of a ``map`` forecast, then every
+        parameter's latest entry (``"EX0C latest 2025-06-30"``); std k = 1."""
         d = self.data
         rows = [Row(f"{e['parameter']} step {e['date']}", e["change"], e["std"], e["unit"])
                 for e in d["events"]]
@@ -110,6 +111,8 @@ class History(ResultMixin):
             rows.append(Row(f"{n} tolerance", f["tolerance"], None, f["unit"]))
             if "now_um" in f:
                 rows.append(Row("map now", f["now_um"], None, "um"))
+        rows += [Row(f"{n} latest {s.dates[-1]}", float(s.y[-1]), float(s.s[-1]), s.unit)
+                 for n, s in self.series.items()]
         return rows
 
     def table(self):

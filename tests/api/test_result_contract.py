@@ -96,8 +96,7 @@ CASES = {
                     "fanuc", "--out", "@fanuc.txt"],
                    lambda: volerr.controller_export("MB1", "errors_MB1", format="fanuc"), ()),
 }
-OWNED = {"compensate": "compensate (runtime/fiveaxis)", "history": "history (runtime/history)",
-         "drift": "drift loop (runtime/loop/drift*)"}
+OWNED = {"drift": "drift loop (runtime/loop/drift*)"}
 PARAMS = [pytest.param(k, marks=_by_branch(OWNED[k])) if k in OWNED else k for k in CASES]
 
 
