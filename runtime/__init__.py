@@ -41,7 +41,7 @@ _FUNCTIONS = {"compensate": "fiveaxis.api", "ballbar_evaluate": "ballbar.api",
               "probe_cal": "probe.api", "diagonals": "cmm.api",
               "iso10360": "uncertainty.api", "iso230_3": "instruments.drift_test",
               "controller_export": "fiveaxis.controller_api",
-              "controller_import": "fiveaxis.controller_api"}
+              "controller_import": "fiveaxis.controller_api", "tcpmap": "fiveaxis.api"}
 
 __all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_MODULES, *_FUNCTIONS]
 
