@@ -1,0 +1,70 @@
+"""One page style for every report (HTML): tables whose headers never break a word, units in
+µm and µrad, a print stylesheet (A4, the report id and "page x of y" on every printed page),
+and the identification block put on a command's page that does not carry it itself
+(:func:`stamp_html`)."""
+
+from __future__ import annotations
+
+import html
+import re
+
+#: the shared style, added once to a page's <head> (class ``volerr-certificate``)
+CSS = """
+<style class="volerr-certificate">
+table th { word-break: keep-all; hyphens: none; white-space: nowrap; }
+table td { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
+table.ident { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
+table.ident th, table.ident td { text-align: left; padding: 2px 10px 2px 0;
+  vertical-align: top; border-bottom: 1px solid #ddd; }
+table.ident td { white-space: normal; }
+p.warn { color: #b26a00; font-weight: bold; }
+div.report-id { font: 12px sans-serif; color: #555; text-align: right; }
+@page { size: A4; margin: 16mm 14mm 18mm 14mm;
+  @bottom-right { content: "REPORT_ID  page " counter(page) " of " counter(pages); }
+  @top-right { content: "REPORT_ID"; } }
+@media print { body { max-width: none; margin: 0; font-size: 10pt; }
+  img { max-width: 100%; page-break-inside: avoid; }
+  table { page-break-inside: auto; } tr { page-break-inside: avoid; }
+  h2 { page-break-after: avoid; } }
+</style>
+"""
+
+#: the ASCII spellings of units that every page shows as µm and µrad
+_UNITS = [(re.compile(r"(?<![A-Za-z_])um(?=[ )/,.;:<\]]|$)"), "\u00b5m"),
+          (re.compile(r"(?<![A-Za-z_])urad(?=[ )/,.;:<\]]|$)"), "\u00b5rad")]
+
+
+def units_in_words(text: str) -> str:
+    """``um`` -> ``µm``, ``urad`` -> ``µrad`` in visible text (never inside a tag or a name
+    such as ``A_um``)."""
+    parts = re.split(r"(<[^>]*>)", text)
+    out = []
+    for i, part in enumerate(parts):
+        if i % 2 == 0 and part:
+            for pattern, unit in _UNITS:
+                part = pattern.sub(unit, part)
+        out.append(part)
+    return "".join(out)
+
+
+def stamp_html(text: str, ident) -> str:
+    """The page ``text`` with the shared style, the report id at the top and, when the page
+    has no identification table of its own, :func:`volerr.certificate.html_table` after its
+    first heading."""
+    from ..certificate import html_table
+
+    rid = html.escape(ident.report_id or "")
+    css = CSS.replace("REPORT_ID", f"report {rid}" if rid else "")
+    if "volerr-certificate" not in text:
+        text = (text.replace("</head>", css + "</head>", 1) if "</head>" in text
+                else css + text)
+    block = f"<div class='report-id'>report {rid}</div>" if rid else ""
+    if "class='ident'" not in text and 'class="ident"' not in text:
+        block += "<h2>Identification</h2>" + html_table(ident)
+    m = re.search(r"</h1>", text) or re.search(r"<body[^>]*>", text)
+    at = m.end() if m else 0
+    text = text[:at] + block + text[at:]
+    if "<body" in text:
+        head, body = text.split("<body", 1)
+        text = head + "<body" + units_in_words(body)
+    return text
