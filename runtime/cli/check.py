@@ -15,7 +15,8 @@ from pathlib import Path
 
 from ..errors import InputError, require
 from ..fileio import Outputs
-from ._common import add_force, add_html, add_json
+from ._common import (add_force, add_html, add_identification_arguments, add_json,
+                      identification_from_args, write_certificates)
 
 USAGE = ("volerr check plan LAYOUT --reference CAL.json --instrument SPEC [--minutes M] "
          "[--readings N] [--detect-um D] --out DIR [--json F] [--html H]\n"
@@ -67,6 +68,7 @@ def register(sub) -> None:
                                                         "(carried into the JSON)")
     add_json(p, "the check plan or the check's result")
     add_html(p, "the set-up sheet (check plan) or the check's page")
+    add_identification_arguments(p)
     add_force(p)
     p.set_defaults(func=run)
 
@@ -107,7 +109,8 @@ def _plan(args, inputs) -> int:
     out = Path(args.out)
     require(not out.exists() or out.is_dir(), f"--out {out}: a file, not a folder")
     outs = Outputs(inputs, force=args.force).folder("--out", out) \
-        .file("--json", args.json).file("--html", args.html).check()
+        .file("--json", args.json).file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs[-1:] + inputs[:-1])
     if out.is_dir() and not args.force:
         taken = sorted(p.name for p in out.iterdir() if p.suffix in (".csv", ".nc", ".html"))
         require(not taken, f"--out {out}: holds {taken[0] if taken else ''} already; give "
@@ -118,6 +121,7 @@ def _plan(args, inputs) -> int:
                             readings=args.readings, **kw)
         result.write(outs.path("--out"), outs.path("--json") if args.json else None,
                      outs.path("--html") if args.html else None, inputs)
+        write_certificates(outs, result, ident, inputs)
     print(result.summary())
     return 0
 
@@ -134,7 +138,8 @@ def _check(args, inputs) -> int:
             raise InputError(f"--date {args.date!r}: write YYYY-MM-DD") from None
     inputs = inputs + [Path(args.reference)] + [Path(split_spec(f)[1]) for f in files]
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .file("--html", args.html).check()
+        .file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, [Path(split_spec(f)[1]) for f in files] + inputs)
     with outs:
         result = check(layout, args.reference, files, tolerance=args.tolerance,
                        date=args.date)
@@ -142,5 +147,6 @@ def _check(args, inputs) -> int:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:
             result.write_html(outs.path("--html"), inputs=inputs)
+        write_certificates(outs, result, ident, inputs)
     print(result.summary())
     return 0

@@ -30,7 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import add_error_arguments, add_vector, progress_bar
+from ._common import (add_error_arguments, add_identification_arguments, add_vector,
+                      identification_from_args, progress_bar, write_certificates)
 from ..errors import InputError, require
 from ._common import layout_inputs
 from ..fileio import Outputs, write_text
@@ -100,6 +101,7 @@ def register(sub) -> None:
     p.add_argument("--report", help="per-block CSV report")
     p.add_argument("--json", help="summary as JSON")
     p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")
+    add_identification_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -184,7 +186,8 @@ def run(args) -> int:
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
               *([args.tool_table] if args.tool_table else [])]
     outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
-        .file("--json", args.json).plot("--plot", args.plot).check()
+        .file("--json", args.json).plot("--plot", args.plot).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     datum = _datum(args.datum, model)
     datum_text, datum_doc = _datum_lines(model, funcs, tuple(args.tool), datum)
     opts = program.Options(
@@ -216,6 +219,7 @@ def run(args) -> int:
 
                 plot_program_errors(sink.program_errors(), outs.path("--plot"),
                                     title=f"{model.name}: {args.program}")
+            write_certificates(outs, {"layout": model.name, **s}, ident, inputs)
             sink.commit()
         except BaseException:
             sink.discard()

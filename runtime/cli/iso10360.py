@@ -14,7 +14,7 @@ import numpy as np
 
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
                       add_vector, error_functions_from_args, finite_option,
-                      identification_from_args, inputs_of)
+                      identification_from_args, inputs_of, write_certificates)
 from ..fileio import Outputs, json_text, write_text
 from ..machine.model import load
 from ..uncertainty import iso10360
@@ -71,10 +71,10 @@ def run(args) -> int:
     funcs = error_functions_from_args(args, model)
     inputs = inputs_of(args)
     outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
-        .file("--html", args.html).check()
+        .file("--html", args.html).file("--pdf", args.pdf).check()
     spec = iso10360.parse_spec(args.mpe, "--mpe") if args.mpe is not None else None
     tu = _test_uncertainty(args)
-    ident = identification_from_args(args, {
+    ident = identification_from_args(args, inputs, {
         "artefact temperature": f"{args.temperature_C:g} \u00b0C (u = {args.temperature_u_K:g} K)",
         "artefact expansion coefficient": f"{args.artefact_cte_ppm_per_K:g} ppm/K (u = "
                                           f"{args.artefact_cte_u_ppm_per_K:g} ppm/K)"})
@@ -112,5 +112,6 @@ def run(args) -> int:
             from ..uncertainty.iso10360_report import report_html
             write_text(outs.path("--html"), report_html(
                 doc, png, ident, f"Evaluated with volerr {__version__}."), inputs)
+        write_certificates(outs, doc, ident, inputs, title)
     return 0 if np.isfinite(d["max_abs_E_um"]) else 1
 
