@@ -35,6 +35,8 @@ Options given on the command line replace the file's fields.  Its keys::
     [environment]
     "machine temperature" = "20.4 degC +- 0.2 K (k = 2)"
     "expansion coefficient" = "11.5 ppm/K +- 1 ppm/K"
+    [conditions]                      # test conditions the data cannot tell
+    feed = "1000 mm/min"; compensation = "on (controller tables of 2026-03)"
 
 A due date before the date of the measurement is a warning on the page, never a refusal.
 """
@@ -56,7 +58,7 @@ IDENTIFICATION_FILE = "volerr-identification.toml"
 MACHINE_KEYS = ("id", "make", "model", "serial", "location")
 INSTRUMENT_KEYS = ("id", "description", "serial", "certificate", "due", "uncertainty")
 TOP_KEYS = ("operator", "customer", "authorised_by", "date", "machine", "instrument",
-            "environment")
+            "environment", "conditions")
 
 
 def today() -> str:
@@ -102,6 +104,7 @@ class Identification:
     method: dict = field(default_factory=dict)
     environment: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    test_conditions: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """The JSON form (``"date"``: the date of the measurement)."""
@@ -113,7 +116,7 @@ class Identification:
             out["machine_details"] = dict(self.machine_details)
         if self.instruments:
             out["instruments"] = [dict(i) for i in self.instruments]
-        for key in ("method", "environment"):
+        for key in ("method", "environment", "test_conditions"):
             if getattr(self, key):
                 out[key] = dict(getattr(self, key))
         if self.warnings:
@@ -195,6 +198,10 @@ def read_identification_file(path) -> dict:
     require(isinstance(env, dict), f"{p}: environment must be a table [environment] of "
                                    f"label = \"text\" lines")
     out["environment"] = {str(k): str(v) for k, v in env.items()}
+    cond = doc.get("conditions", {})
+    require(isinstance(cond, dict), f"{p}: conditions must be a table [conditions] of "
+                                    f"label = \"text\" lines (feed, compensation ...)")
+    out["test_conditions"] = {str(k): str(v) for k, v in cond.items()}
     return out
 
 

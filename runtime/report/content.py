@@ -2,8 +2,9 @@
 (heading, kind, payload) that :func:`volerr.report.pdf.render` sets on A4 pages:
 
 1. the identification (:class:`volerr.certificate.Identification`), its warnings;
-2. the test conditions of the standard (``doc["test_conditions"]``, label -> text, else the
-   command's ``doc["conditions"]``);
+2. the test conditions of the standard (:func:`volerr.report.conditions.of`: from the data,
+   else the identification file's ``[conditions]``, else "not stated"; for a result of no
+   standard the file's conditions, else the command's ``doc["conditions"]``);
 3. the results: each reported value with its standard uncertainty u (k = 1), the coverage
    factor k = 2 and the expanded uncertainty U = k u (the result's rows, :meth:`table`);
 4. the verdicts and the decision rule, where a tolerance was given;
@@ -18,12 +19,15 @@ from __future__ import annotations
 #: the coverage factor of the expanded uncertainties on a certificate (about 95 % for a
 #: normal distribution, ISO/TR 230-9 and the GUM's usual choice)
 K_CERTIFICATE = 2.0
-_UNIT_WORDS = {"um": "\u00b5m", "urad": "\u00b5rad", "um/m": "\u00b5m/m", "deg": "\u00b0"}
 
 
 def unit(u: str) -> str:
-    """A unit as printed on a page (``um`` -> ``µm``, ``urad`` -> ``µrad``)."""
-    return _UNIT_WORDS.get(u, u)
+    """A unit as printed on a page (``um`` -> ``µm``, ``urad`` -> ``µrad``, ``um/mm`` ->
+    ``µm/mm``, ``deg`` -> ``°``)."""
+    import re
+
+    text = re.sub(r"\bu(m|rad)\b", "\u00b5\\1", str(u or ""))
+    return "\u00b0" if text == "deg" else text
 
 
 def number(v, digits: int = 4) -> str:
@@ -101,7 +105,10 @@ def sections(doc: dict, rows, figures: dict, ident=None) -> list:
     ident = identification_of(doc, ident)
     out = [("Identification", "pairs", [list(r) for r in ident.rows()])]
     out += [(None, "warn", f"warning: {w}") for w in ident.warnings]
-    cond = doc.get("test_conditions") or doc.get("conditions")
+    from . import conditions
+
+    cond = (conditions.of(doc, ident.test_conditions) or ident.test_conditions
+            or doc.get("conditions"))
     if isinstance(cond, dict) and cond:
         out.append(("Test conditions", "pairs",
                     [[k, v if isinstance(v, str) else number(v)] for k, v in cond.items()]))

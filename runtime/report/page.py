@@ -47,10 +47,18 @@ def units_in_words(text: str) -> str:
     return "".join(out)
 
 
-def stamp_html(text: str, ident) -> str:
+def conditions_table(cond: dict) -> str:
+    """The test conditions (label -> text) as a two-column table."""
+    e = html.escape
+    return ("<h2>Test conditions</h2><table class='ident'>" + "".join(
+        f"<tr><th class='l'>{e(str(k))}</th><td class='l'>{e(str(v))}</td></tr>"
+        for k, v in cond.items()) + "</table>")
+
+
+def stamp_html(text: str, ident, conditions: dict | None = None) -> str:
     """The page ``text`` with the shared style, the report id at the top and, when the page
     has no identification table of its own, :func:`volerr.certificate.html_table` after its
-    first heading."""
+    first heading, then the test ``conditions`` (label -> text) when given."""
     from ..certificate import html_table
 
     rid = html.escape(ident.report_id or "")
@@ -61,6 +69,8 @@ def stamp_html(text: str, ident) -> str:
     block = f"<div class='report-id'>report {rid}</div>" if rid else ""
     if "class='ident'" not in text and 'class="ident"' not in text:
         block += "<h2>Identification</h2>" + html_table(ident)
+    if conditions and "<h2>Test conditions</h2>" not in text:
+        block += conditions_table(conditions)
     m = re.search(r"</h1>", text) or re.search(r"<body[^>]*>", text)
     at = m.end() if m else 0
     text = text[:at] + block + text[at:]

@@ -27,6 +27,9 @@ BODY_PT, TABLE_PT, MIN_TABLE_PT = 10.0, 8.5, 6.5
 #: left and right padding of a table cell, mm; a column's width beyond its text (both
 #: paddings, the rule's width and 1 mm against rounding of the glyph widths)
 CELL_PAD_MM = 1.0
+#: the tallest a figure is set, mm (two figures and a table share a page), and where the
+#: text stops above the footer, mm from the top of the A4 page
+FIGURE_MAX_MM, PAGE_BOTTOM_MM = 115.0, 279.0
 PAD_MM = 2 * CELL_PAD_MM + 1.0
 
 
@@ -141,19 +144,20 @@ def _word_wrap():
     return WrapMode.WORD
 
 
-def figure(pdf, fig, caption: str = "") -> None:
-    """A matplotlib figure as vector graphics (SVG), full text width."""
+def figure(pdf, fig, heading: str = "") -> None:
+    """A matplotlib figure as vector graphics (SVG) under ``heading``, at most
+    :data:`FIGURE_MAX_MM` high, on a new page when it does not fit below (with its heading)."""
     buf = io.BytesIO()
     fig.savefig(buf, format="svg", bbox_inches="tight")
     w_in, h_in = fig.get_size_inches()
-    width = TEXT_WIDTH_MM
+    width = min(TEXT_WIDTH_MM, FIGURE_MAX_MM * w_in / h_in)
     height = width * h_in / w_in
-    if pdf.get_y() + height > 275:
+    if pdf.get_y() + height + 12 > PAGE_BOTTOM_MM:
         pdf.add_page()
+    if heading:
+        _heading(pdf, heading)
     buf.seek(0)
-    pdf.image(buf, w=width)
-    if caption:
-        _paragraph(pdf, caption, "I")
+    pdf.image(buf, x=pdf.l_margin + (TEXT_WIDTH_MM - width) / 2, w=width)
 
 
 def write(path, sections: list, report_id: str, title: str, inputs=()) -> Path:
@@ -173,7 +177,7 @@ def render(sections: list, report_id: str, title: str) -> bytes:
     pdf.multi_cell(0, 8, title, align="L", new_x="LMARGIN", new_y="NEXT")
     pdf.set_font(FONT, "", BODY_PT)
     for heading, kind, payload in sections:
-        if heading:
+        if heading and kind != "figure":
             _heading(pdf, heading)
         if kind == "table":
             table(pdf, payload)
@@ -184,5 +188,5 @@ def render(sections: list, report_id: str, title: str) -> bytes:
         elif kind == "warn":
             _paragraph(pdf, payload, "B", (178, 106, 0))
         elif kind == "figure":
-            figure(pdf, *payload)
+            figure(pdf, payload[0], heading)
     return bytes(pdf.output())

@@ -45,8 +45,12 @@ def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
             doc["identification"] = ident.as_dict()
             write_text(json_path, json_text(doc), inputs=inputs)
     if html_path is not None and Path(html_path).is_file():
+        from . import conditions
+
+        doc = dict(document_of(result), identification=ident.as_dict())
+        cond = conditions.of(doc, ident.test_conditions) or ident.test_conditions
         text = Path(html_path).read_text(encoding="utf-8")
-        write_text(html_path, stamp_html(text, ident), inputs=inputs)
+        write_text(html_path, stamp_html(text, ident, cond), inputs=inputs)
     pdf_path = outs.path("--pdf")
     if pdf_path is not None:
         write_pdf(pdf_path, result, ident, inputs=inputs, title=title)
