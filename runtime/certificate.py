@@ -173,7 +173,8 @@ def read_identification_file(path) -> dict:
     except OSError as exc:
         raise InputError(f"--identification {p}: cannot be read ({exc.strerror})") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: not a TOML file ({str(exc).splitlines()[0]})") from None
+        raise InputError(f"{p}: not valid TOML ({_where(p, exc)}; dates are written "
+                         f"YYYY-MM-DD, texts in quotes)") from None
     _known(p, "", doc, TOP_KEYS)
     out = {k: str(doc[k]) for k in ("operator", "customer", "authorised_by") if k in doc}
     if "date" in doc:
@@ -203,6 +204,19 @@ def read_identification_file(path) -> dict:
                                     f"label = \"text\" lines (feed, compensation ...)")
     out["test_conditions"] = {str(k): str(v) for k, v in cond.items()}
     return out
+
+
+def _where(p: Path, exc) -> str:
+    """The TOML error and the line it points at (``at line N, column M``)."""
+    import re
+
+    msg = str(exc).splitlines()[0]
+    m = re.search(r"line (\d+)", msg)
+    if m is None:
+        return msg
+    lines = p.read_text(encoding="utf-8", errors="replace").splitlines()
+    n = int(m.group(1))
+    return f"{msg}: {lines[n - 1].strip()!r}" if 0 < n <= len(lines) else msg
 
 
 def _known(p: Path, prefix: str, d: dict, keys) -> None:

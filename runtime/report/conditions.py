@@ -53,7 +53,9 @@ def _iso230_2(doc: dict) -> dict:
     if doc.get("mean_bwd_um") is not None:
         out["approach"] = "both directions (standard test cycle, linear)"
     tc = doc.get("temperature_correction")
-    out["temperature correction"] = "none (not corrected to 20 \u00b0C)" if not tc else str(tc)
+    out["temperature correction"] = ("none (not corrected to 20 \u00b0C)"
+                                     if not (tc or {}).get("applied") else
+                                     f"to 20 \u00b0C, {tc.get('cte_ppm_per_K', '?')} ppm/K")
     return out
 
 

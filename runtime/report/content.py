@@ -79,8 +79,9 @@ def budget_rows(b: dict) -> list:
 
 
 def _budgets(doc: dict) -> list:
-    found = list((doc.get("budgets") or {}).values()) if isinstance(doc.get("budgets"),
-                                                                    dict) else []
+    found = [dict(b, quantity=f"{doc.get('axis', '')} {b['quantity']}".strip())
+             for b in (doc.get("budgets") or {}).values()] if isinstance(doc.get("budgets"),
+                                                                          dict) else []
     for run in doc.get("runs") or []:
         if isinstance(run, dict):
             found += [dict(b, quantity=f"{run.get('axis', '')} {b['quantity']}".strip())

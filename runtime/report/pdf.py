@@ -147,8 +147,13 @@ def _word_wrap():
 def figure(pdf, fig, heading: str = "") -> None:
     """A matplotlib figure as vector graphics (SVG) under ``heading``, at most
     :data:`FIGURE_MAX_MM` high, on a new page when it does not fit below (with its heading)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="svg", bbox_inches="tight")
+    import re
+
+    raw = io.StringIO()
+    fig.savefig(raw, format="svg", bbox_inches="tight")
+    # fpdf2 reads no <metadata> (and says so on stderr): the figure's metadata is not drawn
+    svg = re.sub(r"<metadata>.*?</metadata>", "", raw.getvalue(), flags=re.S)
+    buf = io.BytesIO(svg.encode("utf-8"))
     w_in, h_in = fig.get_size_inches()
     width = min(TEXT_WIDTH_MM, FIGURE_MAX_MM * w_in / h_in)
     height = width * h_in / w_in
@@ -156,7 +161,6 @@ def figure(pdf, fig, heading: str = "") -> None:
         pdf.add_page()
     if heading:
         _heading(pdf, heading)
-    buf.seek(0)
     pdf.image(buf, x=pdf.l_margin + (TEXT_WIDTH_MM - width) / 2, w=width)
 
 
