@@ -274,7 +274,25 @@ def write_certificates(outs, result, ident, inputs=(), title: str | None = None)
     ``--pdf`` certificate of ``result`` (a result object or its JSON document)."""
     from ..report import stamp
 
+    if isinstance(result, dict):      # a command's JSON document: its "parameters" as rows
+        result = _Document(result)
     stamp.finish(outs, result, ident, inputs=list(inputs), title=title)
+
+
+class _Document:
+    """A command's JSON document (``map``, ``compensate``, ``iso10360`` ...) as a result for
+    its certificate: ``to_dict()`` and the rows of its ``"parameters"``."""
+
+    def __init__(self, data: dict):
+        self.data = data
+
+    def to_dict(self) -> dict:
+        return self.data
+
+    def _rows(self) -> list:
+        from ..results import rows_of
+
+        return rows_of(self.data.get("parameters"))
 
 
 def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):

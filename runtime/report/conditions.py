@@ -72,7 +72,12 @@ def _iso230_3(doc: dict) -> dict:
 
 
 def _iso10360(doc: dict) -> dict:
+    pos = [p for p in doc.get("positions") or [] if isinstance(p, dict)]
+    lengths = [x for p in pos for x in p.get("lengths_mm") or []]
     return {"probe offset": _join(doc.get("probe_mm") or [], "mm"),
+            "positions": "; ".join(p.get("line", "") for p in pos) or None,
+            "lengths": (f"{len(lengths) // max(len(pos), 1)} per position, "
+                        f"{min(lengths):.1f} to {max(lengths):.1f} mm" if lengths else None),
             "repetitions": doc.get("repetitions"),
             "artefact": (doc.get("test_uncertainty") or {}).get("formula")}
 
@@ -99,9 +104,34 @@ def of(doc: dict, stated: dict | None = None) -> dict:
         probe = runs[0] if runs and isinstance(runs[0], dict) else doc
         if word in command or key in probe:
             found = {k: v for k, v in fill(probe).items() if v not in (None, "")}
+            cal = [i for i in (doc.get("identification") or {}).get("instruments") or []
+                   if i.get("certificate")]
+            if cal and word == "ballbar":
+                found["ballbar calibration"] = "; ".join(
+                    f"{i.get('id', '')} certificate {i['certificate']}" for i in cal)
             out = {"standard": standard}
             for name in FIELDS[standard]:
                 value = found.get(name, stated.get(name, NOT_STATED))
                 out[name] = value if isinstance(value, str) else f"{value:g}"
             return out
     return {}
+
+
+def measured(doc: dict) -> list:
+    """The standard's own results beside the result rows, as (heading, table rows): the
+    ISO 230-4 G, H and F of every ballbar trace (µm; their uncertainty is not evaluated:
+    said in a note row), nothing for the other tests (their rows carry U)."""
+    from .content import number
+
+    tr = [t for t in doc.get("traces") or [] if isinstance(t, dict) and "G_um" in t]
+    if not tr:
+        return []
+    rows = [["file", "plane", "direction", "radius / mm", "G / \u00b5m", "H / \u00b5m",
+             "F min / \u00b5m", "F max / \u00b5m"]]
+    rows += [[t.get("file", ""), t.get("plane", ""), t.get("direction", ""),
+              number(t.get("radius_mm")), number(t["G_um"]), number(t.get("H_um")),
+              number(t.get("F_min_um")), number(t.get("F_max_um"))] for t in tr]
+    return [("ISO 230-4 results per trace", "table", rows),
+            (None, "text", "G: circular deviation, H: circular hysteresis, F: radial "
+                           "deviation (ISO 230-4). Their measurement uncertainty is not "
+                           "evaluated here (no ISO 230-9 budget of the ballbar test yet).")]

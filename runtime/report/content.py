@@ -89,6 +89,16 @@ def _budgets(doc: dict) -> list:
     return found
 
 
+def _headline(doc: dict) -> list:
+    """The ISO 10360-2 headline (largest |E0| with its test uncertainty U, k = 2) as a row."""
+    from ..results import Row
+
+    U = (doc.get("uncertainty_um") or {}).get("E0") if "max_abs_E_um" in doc else None
+    if U is None:
+        return []
+    return [Row("max |E0|", doc["max_abs_E_um"], U / K_CERTIFICATE, "um")]
+
+
 def _verdicts(doc: dict) -> list:
     out = []
     per = doc.get("verdicts")
@@ -108,12 +118,13 @@ def sections(doc: dict, rows, figures: dict, ident=None) -> list:
     out += [(None, "warn", f"warning: {w}") for w in ident.warnings]
     from . import conditions
 
-    cond = (conditions.of(doc, ident.test_conditions) or ident.test_conditions
-            or doc.get("conditions"))
+    stated = {**ident.conditions, **ident.test_conditions}
+    cond = conditions.of(doc, stated) or ident.test_conditions or doc.get("conditions")
     if isinstance(cond, dict) and cond:
         out.append(("Test conditions", "pairs",
                     [[k, v if isinstance(v, str) else number(v)] for k, v in cond.items()]))
-    rows = list(rows)
+    out += conditions.measured(doc)
+    rows = list(rows) + _headline(doc)
     if rows:
         out.append(("Results", "table", result_rows(rows)))
         out.append((None, "text", f"u: standard uncertainty; U: expanded uncertainty, "

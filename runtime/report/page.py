@@ -30,8 +30,8 @@ div.report-id { font: 12px sans-serif; color: #555; text-align: right; }
 """
 
 #: the ASCII spellings of units that every page shows as µm and µrad
-_UNITS = [(re.compile(r"(?<![A-Za-z_])um(?=[ )/,.;:<\]]|$)"), "\u00b5m"),
-          (re.compile(r"(?<![A-Za-z_])urad(?=[ )/,.;:<\]]|$)"), "\u00b5rad")]
+_UNITS = [(re.compile(r"(?<![A-Za-z_\-.])um(?=[ )/,.;:<\]]|$)"), "\u00b5m"),
+          (re.compile(r"(?<![A-Za-z_\-.])urad(?=[ )/,.;:<\]]|$)"), "\u00b5rad")]
 
 
 def units_in_words(text: str) -> str:
@@ -67,10 +67,14 @@ def stamp_html(text: str, ident, conditions: dict | None = None) -> str:
         text = (text.replace("</head>", css + "</head>", 1) if "</head>" in text
                 else css + text)
     block = f"<div class='report-id'>report {rid}</div>" if rid else ""
-    if "class='ident'" not in text and 'class="ident"' not in text:
+    own = re.search(r"<table class=.ident.>.*?</table>(<p class='warn'>.*?</p>)*", text, re.S)
+    if own is None:
         block += "<h2>Identification</h2>" + html_table(ident)
     if conditions and "<h2>Test conditions</h2>" not in text:
-        block += conditions_table(conditions)
+        if own is None:
+            block += conditions_table(conditions)
+        else:   # after the page's own identification
+            text = text[:own.end()] + conditions_table(conditions) + text[own.end():]
     m = re.search(r"</h1>", text) or re.search(r"<body[^>]*>", text)
     at = m.end() if m else 0
     text = text[:at] + block + text[at:]

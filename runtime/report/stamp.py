@@ -16,13 +16,9 @@ def document_of(result) -> dict:
     return result.to_dict() if hasattr(result, "to_dict") else dict(result or {})
 
 
-def rows_of_result(result, doc: dict) -> list:
-    """The reported rows of a result (its ``_rows()``), else of ``doc["parameters"]``."""
-    from ..results import rows_of
-
-    if hasattr(result, "_rows"):
-        return list(result._rows())
-    return rows_of(doc.get("parameters"))
+def rows_of_result(result) -> list:
+    """The reported rows of a result (its ``_rows()``; none for a plain document)."""
+    return list(result._rows()) if hasattr(result, "_rows") else []
 
 
 def figures_of(result) -> dict:
@@ -48,7 +44,8 @@ def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
         from . import conditions
 
         doc = dict(document_of(result), identification=ident.as_dict())
-        cond = conditions.of(doc, ident.test_conditions) or ident.test_conditions
+        cond = conditions.of(doc, {**ident.conditions, **ident.test_conditions}) \
+            or ident.test_conditions
         text = Path(html_path).read_text(encoding="utf-8")
         write_text(html_path, stamp_html(text, ident, cond), inputs=inputs)
     pdf_path = outs.path("--pdf")
@@ -64,7 +61,7 @@ def write_pdf(path, result, ident=None, inputs=(), title: str | None = None) -> 
     ident = content.identification_of(doc, ident)
     doc["identification"] = ident.as_dict()
     title = title or _title(result, doc)
-    secs = content.sections(doc, rows_of_result(result, doc), figures_of(result), ident)
+    secs = content.sections(doc, rows_of_result(result), figures_of(result), ident)
     return pdf.write(path, secs, ident.report_id or "not stated", title, inputs=inputs)
 
 
