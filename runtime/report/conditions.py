@@ -121,7 +121,7 @@ def measured(doc: dict) -> list:
     """The standard's own results beside the result rows, as (heading, table rows): the
     ISO 230-4 G, H and F of every ballbar trace (µm; their uncertainty is not evaluated:
     said in a note row), nothing for the other tests (their rows carry U)."""
-    from .content import number
+    from .fmt import number
 
     tr = [t for t in doc.get("traces") or [] if isinstance(t, dict) and "G_um" in t]
     if not tr:

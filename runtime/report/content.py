@@ -16,30 +16,11 @@ Units: the rows' units as µm and µrad (never "um")."""
 
 from __future__ import annotations
 
+from .fmt import number, unit  # noqa: F401  (the page's numbers and units)
+
 #: the coverage factor of the expanded uncertainties on a certificate (about 95 % for a
 #: normal distribution, ISO/TR 230-9 and the GUM's usual choice)
 K_CERTIFICATE = 2.0
-
-
-def unit(u: str) -> str:
-    """A unit as printed on a page (``um`` -> ``µm``, ``urad`` -> ``µrad``, ``um/mm`` ->
-    ``µm/mm``, ``deg`` -> ``°``)."""
-    import re
-
-    text = re.sub(r"\bu(m|rad)\b", "\u00b5\\1", str(u or ""))
-    return "\u00b0" if text == "deg" else text
-
-
-def number(v, digits: int = 4) -> str:
-    """A value with ``digits`` significant digits, no negative zero, "-" when missing."""
-    if v is None:
-        return "\u2013"
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        return str(v)
-    text = f"{x:.{digits}g}"
-    return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
 def identification_of(doc: dict, ident=None):
@@ -91,12 +72,12 @@ def _budgets(doc: dict) -> list:
 
 def _headline(doc: dict) -> list:
     """The ISO 10360-2 headline (largest |E0| with its test uncertainty U, k = 2) as a row."""
-    from ..results import Row
+    from types import SimpleNamespace as Row   # the fields of volerr.results.Row
 
     U = (doc.get("uncertainty_um") or {}).get("E0") if "max_abs_E_um" in doc else None
     if U is None:
         return []
-    return [Row("max |E0|", doc["max_abs_E_um"], U / K_CERTIFICATE, "um")]
+    return [Row(name="max |E0|", value=doc["max_abs_E_um"], std=U / K_CERTIFICATE, unit="um")]
 
 
 def _verdicts(doc: dict) -> list:
