@@ -446,6 +446,8 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
                       parts)
     _lab_report(cal, fit, obs, u_ref)
     report["covariance"] = covariance_block(cal)
+    from .budget import budgets
+    report["budgets"] = budgets(cal, fit, u_ref)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     return cal
 

@@ -250,3 +250,35 @@ def test_write_pdf_of_an_api_result_has_vector_figures_and_page_numbers(tmp_path
     # the polar plot is drawn as paths, not embedded as a raster image
     assert not any(page.images for page in reader.pages)
     assert "EC0Y" in text[0] and "\u00b5rad" in text[0]
+
+
+def test_calibrate_budget_splits_the_stated_u_by_file_and_model_residual(tmp_path):
+    """Two ballbar files of the same geometry and weights: each file's readings contribute
+    the same share; the single file's u is twice the share of each of two (the a-priori
+    covariance halves with twice the data, then splits in two); the model residual adds
+    (s0^2 - 1) times the a-priori variance; combined u = the stated u (1e-6)."""
+    import numpy as np
+    from importlib import resources
+
+    import volerr
+
+    trace = resources.files("volerr") / "data" / "ballbar_example_XY.csv"
+    lines = trace.read_text().splitlines()
+    rng = np.random.default_rng(7)
+    noisy = [lines[0]]
+    for line in lines[1:]:
+        c = line.split(",")
+        c[10] = f"{float(c[10]) + rng.normal(0.0, 1.5):.5f}"    # dr_um: 1.5 um more scatter
+        noisy.append(",".join(c))
+    (tmp_path / "noisy.csv").write_text("\n".join(noisy) + "\n")
+    one = volerr.calibrate("MB1", [str(trace)]).to_dict()
+    two = volerr.calibrate("MB1", [str(trace), str(tmp_path / "noisy.csv")]).to_dict()
+    s0_sq = two["variance_factor"]
+    assert s0_sq > 1.5 and set(two["budgets"]) == set(two["parameters"])
+    for name, b in two["budgets"].items():
+        f1, f2, model = (s["contribution"] for s in b["sources"])
+        assert f1 == pytest.approx(f2, rel=1e-9)
+        assert f1 == pytest.approx(one["budgets"][name]["u"] / 2, rel=1e-6)
+        assert model ** 2 == pytest.approx((s0_sq - 1) * (f1 ** 2 + f2 ** 2), rel=1e-3)
+        assert b["u"] == pytest.approx(two["parameters"][name]["std"], rel=1e-6)
+        assert b["U"] == pytest.approx(2 * two["parameters"][name]["std"], rel=1e-6)
