@@ -156,8 +156,18 @@ def _instrument_text(d: dict) -> str:
     return ", ".join(parts)
 
 
+def _option_text(v) -> str:
+    """An option's value as typed (lists and vectors space-separated, a flag alone)."""
+    if v is True:
+        return ""
+    if isinstance(v, (list, tuple)):
+        return " ".join(_option_text(x) for x in v)
+    return str(v)
+
+
 def _method_text(m: dict) -> str:
-    opts = " ".join(f"--{k.replace('_', '-')} {v}" for k, v in (m.get("options") or {}).items())
+    opts = " ".join(f"--{k.replace('_', '-')} {_option_text(v)}".strip()
+                    for k, v in (m.get("options") or {}).items())
     return f"{m.get('command', 'volerr')} (volerr {m.get('version', '?')}) {opts}".strip()
 
 

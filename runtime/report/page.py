@@ -10,7 +10,8 @@ import re
 
 #: the shared style, added once to a page's <head> (class ``volerr-certificate``)
 CSS = """
-<style class="volerr-certificate">
+<style>
+/* volerr-certificate: the shared page style */
 table th { word-break: keep-all; hyphens: none; white-space: nowrap; }
 table td { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
 table.ident { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
