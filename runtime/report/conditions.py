@@ -66,9 +66,16 @@ def _iso230_3(doc: dict) -> dict:
                          else None),
             "programme stages": f"{len(doc.get('stages') or [])} stages"
                                 + (f" by {doc['stage_column']}" if doc.get("stage_column") else ""),
-            "sensor positions": "; ".join(f"{k} ({v.get('direction')}, z {v.get('z_mm')} mm)"
-                                          for k, v in ch.items()),
+            "sensor positions": "; ".join(_sensor(k, v) for k, v in ch.items()),
             "temperatures": ", ".join(doc.get("temperatures") or {}) or None}
+
+
+def _sensor(name: str, d: dict) -> str:
+    """``ch1 (X, z 120 mm)``; what the file does not give is said so."""
+    parts = [str(d["direction"]) if d.get("direction") else "direction not given",
+             f"z {d['z_mm']:g} mm" if isinstance(d.get("z_mm"), (int, float)) else
+             "height not given"]
+    return f"{name} ({', '.join(parts)})"
 
 
 def _iso10360(doc: dict) -> dict:

@@ -59,7 +59,9 @@ def budget_rows(b: dict) -> list:
     return out
 
 
-def _budgets(doc: dict) -> list:
+def budgets_of(doc: dict) -> list:
+    """Every budget of the document (``"budgets"``, per run for several runs), its quantity
+    named with the run's axis."""
     found = [dict(b, quantity=f"{doc.get('axis', '')} {b['quantity']}".strip())
              for b in (doc.get("budgets") or {}).values()] if isinstance(doc.get("budgets"),
                                                                           dict) else []
@@ -111,7 +113,7 @@ def sections(doc: dict, rows, figures: dict, ident=None) -> list:
         out.append((None, "text", f"u: standard uncertainty; U: expanded uncertainty, "
                                   f"coverage factor k = {K_CERTIFICATE:g} (about 95 %)."))
     out += _verdicts(doc)
-    for b in _budgets(doc):
+    for b in budgets_of(doc):
         out.append((f"Uncertainty budget: {b['quantity']}", "table", budget_rows(b)))
     notes = [n for n in doc.get("notes") or [] if isinstance(n, str)]
     if notes:

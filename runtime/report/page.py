@@ -18,6 +18,9 @@ table.ident { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
 table.ident th, table.ident td { text-align: left; padding: 2px 10px 2px 0;
   vertical-align: top; border-bottom: 1px solid #ddd; }
 table.ident td { white-space: normal; }
+table.budget { border-collapse: collapse; margin: 0.3em 0 0.8em 0; }
+table.budget th, table.budget td { padding: 2px 8px; border-bottom: 1px solid #ddd;
+  text-align: right; } table.budget td.l { text-align: left; }
 p.warn { color: #b26a00; font-weight: bold; }
 div.report-id { font: 12px sans-serif; color: #555; text-align: right; }
 @page { size: A4; margin: 16mm 14mm 18mm 14mm;
@@ -56,7 +59,25 @@ def conditions_table(cond: dict) -> str:
         for k, v in cond.items()) + "</table>")
 
 
-def stamp_html(text: str, ident, conditions: dict | None = None) -> str:
+def budgets_html(budgets: list) -> str:
+    """The uncertainty budgets (:mod:`volerr.report.budget`), one table per quantity, the
+    same rows as the PDF (:func:`volerr.report.content.budget_rows`)."""
+    from .content import budget_rows
+
+    e = html.escape
+    out = []
+    for b in budgets:
+        rows = budget_rows(b)
+        head = "".join(f"<th>{e(c)}</th>" for c in rows[0])
+        body = "".join("<tr>" + "".join(f"<td class='l'>{e(c)}</td>" if i == 0 else
+                                        f"<td>{e(c)}</td>" for i, c in enumerate(r))
+                       + "</tr>" for r in rows[1:])
+        out.append(f"<h3>Uncertainty budget: {e(b['quantity'])}</h3>"
+                   f"<table class='budget'><tr>{head}</tr>{body}</table>")
+    return "".join(out)
+
+
+def stamp_html(text: str, ident, conditions: dict | None = None, budgets=()) -> str:
     """The page ``text`` with the shared style, the report id at the top and, when the page
     has no identification table of its own, :func:`volerr.certificate.html_table` after its
     first heading, then the test ``conditions`` (label -> text) when given."""
@@ -79,6 +100,13 @@ def stamp_html(text: str, ident, conditions: dict | None = None) -> str:
     m = re.search(r"</h1>", text) or re.search(r"<body[^>]*>", text)
     at = m.end() if m else 0
     text = text[:at] + block + text[at:]
+    if budgets and "Uncertainty budget:" not in text:
+        tail = ("<h2>Uncertainty budgets (GUM, ISO/TR 230-9)</h2><p>u(x_i): standard "
+                "uncertainty of the source in its unit; c_i: sensitivity; contribution "
+                "|c_i| u(x_i); combined u: root sum of squares; U = k u.</p>"
+                + budgets_html(budgets))
+        at = text.rfind("</body>")
+        text = text[:at] + tail + text[at:] if at >= 0 else text + tail
     if "<body" in text:
         head, body = text.split("<body", 1)
         text = head + "<body" + units_in_words(body)

@@ -48,7 +48,8 @@ def _document(report_id: str, title: str):
         def header(self):
             self.set_font(FONT, "", 8)
             self.set_text_color(90)
-            self.cell(TEXT_WIDTH_MM * 0.7, 5, title[:90], align="L")
+            self.cell(TEXT_WIDTH_MM * 0.7, 5, _fit(self, title, TEXT_WIDTH_MM * 0.68),
+                      align="L")
             self.cell(TEXT_WIDTH_MM * 0.3, 5, f"report {report_id}", align="R",
                       new_x="LMARGIN", new_y="NEXT")
             self.ln(3)
@@ -70,6 +71,15 @@ def _document(report_id: str, title: str):
     pdf.set_title(f"{title} {report_id}")
     pdf.set_creator("volerr")
     return pdf
+
+
+def _fit(pdf, text: str, width_mm: float) -> str:
+    """``text`` shortened with an ellipsis to ``width_mm`` in the current font."""
+    if pdf.get_string_width(text) <= width_mm:
+        return text
+    while text and pdf.get_string_width(text + "\u2026") > width_mm:
+        text = text[:-1]
+    return text.rstrip() + "\u2026"
 
 
 def _heading(pdf, text: str) -> None:

@@ -46,8 +46,10 @@ def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
         doc = dict(document_of(result), identification=ident.as_dict())
         cond = conditions.of(doc, {**ident.conditions, **ident.test_conditions}) \
             or ident.test_conditions
+        from .content import budgets_of
+
         text = Path(html_path).read_text(encoding="utf-8")
-        write_text(html_path, stamp_html(text, ident, cond), inputs=inputs)
+        write_text(html_path, stamp_html(text, ident, cond, budgets_of(doc)), inputs=inputs)
     pdf_path = outs.path("--pdf")
     if pdf_path is not None:
         write_pdf(pdf_path, result, ident, inputs=inputs, title=title)
