@@ -17,6 +17,7 @@ the page is set in a smaller type (down to 6.5 pt) before any word could be spli
 from __future__ import annotations
 
 import io
+import math
 from pathlib import Path
 
 FONT = "DejaVu"
@@ -30,6 +31,8 @@ CELL_PAD_MM = 1.0
 #: the tallest a figure is set, mm (two figures and a table share a page), and where the
 #: text stops above the footer, mm from the top of the A4 page
 FIGURE_MAX_MM, PAGE_BOTTOM_MM = 115.0, 279.0
+#: a table up to this height (mm) is kept on one page
+KEEP_TOGETHER_MM = 80.0
 PAD_MM = 2 * CELL_PAD_MM + 1.0
 
 
@@ -120,15 +123,32 @@ def _widths(pdf, rows: list, size: float, header: bool) -> list | None:
     return [lo + spare * e / sum(extra) for lo, e in zip(low, extra)]
 
 
-def table(pdf, rows: list, header: bool = True, align: str = "LEFT") -> None:
-    """``rows`` (first the header when ``header``) as a table that breaks no word."""
-    rows = [[str(c) for c in r] for r in rows]
+def _layout(pdf, rows: list, header: bool) -> tuple:
+    """Type size (pt), column widths (mm) and the estimated height (mm) of a table."""
     size = TABLE_PT
     widths = _widths(pdf, rows, size, header)
     while widths is None and size > MIN_TABLE_PT:
         size -= 0.5
         widths = _widths(pdf, rows, size, header)
     widths = widths or [TEXT_WIDTH_MM / len(rows[0])] * len(rows[0])
+    pdf.set_font(FONT, "", size)
+    height = 0.0
+    for r in rows:
+        lines = max(math.ceil((pdf.get_string_width(c) + PAD_MM) / w) for c, w in zip(r, widths))
+        height += lines * size * 0.5 + 1.2
+    return size, widths, height
+
+
+def table(pdf, rows: list, header: bool = True, align: str = "LEFT", heading: str = "") -> None:
+    """``rows`` (first the header when ``header``) as a table that breaks no word, under
+    ``heading``; a table of at most :data:`KEEP_TOGETHER_MM` starts on a new page rather
+    than break (a longer one breaks, its header repeated)."""
+    rows = [[str(c) for c in r] for r in rows]
+    size, widths, height = _layout(pdf, rows, header)
+    if pdf.get_y() + min(height, KEEP_TOGETHER_MM) + (9 if heading else 0) > PAGE_BOTTOM_MM:
+        pdf.add_page()
+    if heading:
+        _heading(pdf, heading)
     pdf.set_font(FONT, "", size)
     with pdf.table(col_widths=widths, width=sum(widths), align="LEFT", text_align=align,
                    first_row_as_headings=header, line_height=size * 0.5,
@@ -191,12 +211,12 @@ def render(sections: list, report_id: str, title: str) -> bytes:
     pdf.multi_cell(0, 8, title, align="L", new_x="LMARGIN", new_y="NEXT")
     pdf.set_font(FONT, "", BODY_PT)
     for heading, kind, payload in sections:
-        if heading and kind != "figure":
+        if heading and kind not in ("figure", "table", "pairs"):
             _heading(pdf, heading)
         if kind == "table":
-            table(pdf, payload)
+            table(pdf, payload, heading=heading)
         elif kind == "pairs":
-            table(pdf, payload, header=False)
+            table(pdf, payload, header=False, heading=heading)
         elif kind == "text":
             _paragraph(pdf, payload)
         elif kind == "warn":
