@@ -24,9 +24,13 @@ table.budget th, table.budget td { padding: 2px 8px; border-bottom: 1px solid #d
 p.warn { color: #b26a00; font-weight: bold; }
 div.report-id { font: 12px sans-serif; color: #555; text-align: right; }
 @page { size: A4; margin: 16mm 14mm 18mm 14mm;
-  @bottom-right { content: "REPORT_ID  page " counter(page) " of " counter(pages); }
-  @top-right { content: "REPORT_ID"; } }
+  @bottom-right { content: "REPORT_ID  page " counter(page) " of " counter(pages);
+    font: 8pt sans-serif; color: #555; }
+  @top-right { content: "REPORT_ID"; font: 8pt sans-serif; color: #555; } }
 @media print { body { max-width: none; margin: 0; font-size: 10pt; }
+  div.report-id { display: none; }
+  table.budget, table.ident { page-break-inside: avoid; }
+  h3 { page-break-after: avoid; }
   img { max-width: 100%; page-break-inside: avoid; }
   table { page-break-inside: auto; } tr { page-break-inside: avoid; }
   h2 { page-break-after: avoid; } }
