@@ -250,6 +250,13 @@ def test_write_pdf_of_an_api_result_has_vector_figures_and_page_numbers(tmp_path
     # the polar plot is drawn as paths, not embedded as a raster image
     assert not any(page.images for page in reader.pages)
     assert "EC0Y" in text[0] and "\u00b5rad" in text[0]
+    # the diagnosis' budgets: the estimator's, where an entry is one of its parameters
+    budgets = ev.to_dict()["budgets"]
+    std = {e["parameter"]: e["std"] for e in ev.to_dict()["diagnosis"]}
+    assert "EC0Y" in budgets
+    for name, b in budgets.items():
+        assert b["u"] == pytest.approx(std[name], rel=1e-6)
+        assert f"Uncertainty budget: {name}" in "\n".join(text)
 
 
 def test_calibrate_budget_splits_the_stated_u_by_file_and_model_residual(tmp_path):
