@@ -1,4 +1,7 @@
-"""One page style for every report (HTML): tables whose headers never break a word, units in
+"""One page style for every report (HTML): tables whose headers never break a word (they wrap
+between words only: ``word-break: keep-all``, no hyphens; ``white-space: nowrap`` on every
+header was tried and made the uncertainty page's result table wider than a 1100 px window,
+clipped), units in
 µm and µrad, a print stylesheet (A4, the report id and "page x of y" on every printed page),
 and the identification block put on a command's page that does not carry it itself
 (:func:`stamp_html`)."""
@@ -12,7 +15,7 @@ import re
 CSS = """
 <style>
 /* volerr-certificate: the shared page style */
-table th { word-break: keep-all; hyphens: none; white-space: nowrap; }
+table th { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
 table td { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
 table.ident { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
 table.ident th, table.ident td { text-align: left; padding: 2px 10px 2px 0;
