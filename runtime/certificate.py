@@ -128,11 +128,11 @@ class Identification:
         machine = self.machine or _joined(self.machine_details, MACHINE_KEYS)
         rows = [("report id", self.report_id), ("customer", self.customer),
                 ("machine", machine)]
-        if self.instruments:
-            rows += [(f"instrument {i + 1}" if len(self.instruments) > 1 else "instrument",
-                      _instrument_text(d)) for i, d in enumerate(self.instruments)]
-        else:
-            rows.append(("instrument", self.instrument))
+        n = len(self.instruments) + bool(self.instrument)
+        if self.instrument or not self.instruments:     # the option's text first
+            rows.append(("instrument 1" if n > 1 else "instrument", self.instrument))
+        rows += [(f"instrument {i + 1 + bool(self.instrument)}" if n > 1 else "instrument",
+                  _instrument_text(d)) for i, d in enumerate(self.instruments)]
         rows += [("operator", self.operator), ("date of the measurement", self.date),
                  ("date of the report", self.report_date)]
         if self.method:

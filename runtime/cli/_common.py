@@ -207,8 +207,7 @@ def add_force(parser) -> None:
 
 #: options whose values are outputs or switches of writing, not of the method (report id)
 _NOT_METHOD = {"json", "html", "pdf", "plot", "errors_out", "map_out", "out", "force", "func",
-               "command", "action", "identification", "machine", "instrument", "operator",
-               "date", "customer"}
+               "command", "action", "identification", "date"}
 _IDENT_OPTIONS = {"--machine": ("machine", "the machine tested: id, make, model, serial number"),
                   "--operator": ("operator", "who made the measurement"),
                   "--date": ("date", "date of the measurement YYYY-MM-DD (not in the future; "
@@ -256,8 +255,9 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
     given = {k: getattr(args, k, None) for k in ("machine", "instrument", "operator", "date",
                                                  "customer") if k in own}
     paths = {str(f) for f in files}
+    skip = _NOT_METHOD | own          # outputs, and the identification's own fields
     options = {k: (str(v) if isinstance(v, Path) else v) for k, v in sorted(vars(args).items())
-               if not k.startswith("_") and k not in _NOT_METHOD and v not in (None, False, [])
+               if not k.startswith("_") and k not in skip and v not in (None, False, [])
                and str(v) not in paths and not callable(v)}
     options = {k: v for k, v in options.items()
                if not (isinstance(v, list) and {str(x) for x in v} <= paths)}
