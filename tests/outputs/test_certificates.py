@@ -289,3 +289,38 @@ def test_calibrate_budget_splits_the_stated_u_by_file_and_model_residual(tmp_pat
         assert model ** 2 == pytest.approx((s0_sq - 1) * (f1 ** 2 + f2 ** 2), rel=1e-3)
         assert b["u"] == pytest.approx(two["parameters"][name]["std"], rel=1e-6)
         assert b["U"] == pytest.approx(2 * two["parameters"][name]["std"], rel=1e-6)
+
+
+def test_html_page_carries_conditions_budgets_and_the_print_stylesheet(iso):
+    html = iso["out"]["html"].read_text(encoding="utf-8")
+    assert html.index("<h2>Identification</h2>") < html.index("<h2>Test conditions</h2>")
+    assert html.count("class='ident'") >= 2 and "Uncertainty budget: X A" in html
+    for rule in ("size: A4", "counter(page)", "counter(pages)", "word-break: keep-all",
+                 "hyphens: none", iso["doc"]["identification"]["report_id"]):
+        assert rule in html, rule
+    body = html.split("<body", 1)[1]
+    import re
+
+    visible = re.sub(r"<style>.*?</style>|<[^>]*>", " ", body, flags=re.S)
+    assert not re.search(r"\d um\b", visible)          # µm on the page, never "um"
+
+
+def test_printed_html_is_a4_with_page_x_of_y(iso, tmp_path):
+    import shutil
+    import subprocess
+
+    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+    if exe is None:
+        pytest.skip("no Chromium installed (apt-get install chromium)")
+    out = tmp_path / "printed.pdf"
+    subprocess.run([exe, "--headless", "--no-sandbox", "--disable-gpu",
+                    "--no-pdf-header-footer", f"--print-to-pdf={out}",
+                    iso["out"]["html"].as_uri()], check=True, capture_output=True, timeout=120)
+    reader = pypdf.PdfReader(str(out))
+    n = len(reader.pages)
+    rid = iso["doc"]["identification"]["report_id"]
+    for i, page in enumerate(reader.pages, start=1):
+        assert (float(page.mediabox.width), float(page.mediabox.height)) == \
+            pytest.approx(A4_PT, abs=1.0)
+        text = page.extract_text()
+        assert f"page {i} of {n}" in text and rid in text
