@@ -324,3 +324,22 @@ def test_printed_html_is_a4_with_page_x_of_y(iso, tmp_path):
             pytest.approx(A4_PT, abs=1.0)
         text = page.extract_text()
         assert f"page {i} of {n}" in text and rid in text
+
+
+def test_iso10360_test_uncertainty_budget_at_the_largest_U(tmp_path, inputs):
+    """U(L) = 2 sqrt((U_cal/2)^2 + (L |T - 20| u(alpha))^2 + (L alpha u(T))^2), written out
+    by hand for L = the longest length, T = 21.5 degC: its budget combines to the stated U."""
+    out = tmp_path / "i.json"
+    pdf = tmp_path / "i.pdf"
+    assert main(["iso10360", "MB1", "--errors", str(inputs["errors"]), "--json", str(out),
+                 "--temperature-C", "21.5", "--mpe", "E0=2+L/300", "--pdf", str(pdf)]) == 0
+    d = json.loads(out.read_text())
+    L = max(x for p in d["positions"] for x in p["lengths_mm"])
+    by_hand = 2 * math.sqrt((0.5 * (0.1 + L / 2000)) ** 2 + (L * 1.5 * 1.0e-3) ** 2
+                            + (L * 11.5 * 0.2e-3) ** 2)
+    b = d["budgets"]["E0"]
+    assert b["U"] == pytest.approx(by_hand, rel=1e-6)
+    assert b["u"] == pytest.approx(d["uncertainty_um"]["E0"] / 2, rel=1e-6)
+    text = "\n".join(p.extract_text() for p in pypdf.PdfReader(str(pdf)).pages)
+    assert "Uncertainty budget: E0 at L" in text and "Decision rule: ISO 14253-1" in text
+    assert "max |E0|" in text and "repetitions 3" in text
