@@ -256,11 +256,14 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
                                                  "customer") if k in own}
     paths = {str(f) for f in files}
     skip = _NOT_METHOD | own          # outputs, and the identification's own fields
+    def is_input(v) -> bool:          # an input file (also as KIND:FILE): hashed, not an option
+        return str(v) in paths or str(v).split(":", 1)[-1] in paths
+
     options = {k: (str(v) if isinstance(v, Path) else v) for k, v in sorted(vars(args).items())
                if not k.startswith("_") and k not in skip and v not in (None, False, [])
-               and str(v) not in paths and not callable(v)}
+               and not is_input(v) and not callable(v)}
     options = {k: v for k, v in options.items()
-               if not (isinstance(v, list) and {str(x) for x in v} <= paths)}
+               if not (isinstance(v, list) and all(is_input(x) for x in v))}
     method = {"command": getattr(args, "_ident_prog", "volerr"), "version": __version__,
               "options": options}
     file = certificate.find_identification_file(getattr(args, "identification", None),

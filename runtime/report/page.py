@@ -15,6 +15,7 @@ import re
 CSS = """
 <style>
 /* volerr-certificate: the shared page style */
+body { font-family: Helvetica, Arial, "DejaVu Sans", sans-serif; }
 table th { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
 table td { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
 table.ident { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
