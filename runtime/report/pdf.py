@@ -31,6 +31,10 @@ CELL_PAD_MM = 1.0
 #: the tallest a figure is set, mm (two figures and a table share a page), and where the
 #: text stops above the footer, mm from the top of the A4 page
 FIGURE_MAX_MM, PAGE_BOTTOM_MM = 115.0, 279.0
+#: a figure of more SVG elements (markers, paths) than this is set as a PNG of RASTER_DPI
+#: instead: fpdf2 imports about 500 elements a second (3000 markers: 6 s measured), so a
+#: scatter of tens of thousands of readings would take minutes as vectors
+MAX_SVG_ELEMENTS, RASTER_DPI = 2500, 200
 #: a table up to this height (mm) is kept on one page
 KEEP_TOGETHER_MM = 80.0
 PAD_MM = 2 * CELL_PAD_MM + 1.0
@@ -175,7 +179,8 @@ def _word_wrap():
 
 
 def figure(pdf, fig, heading: str = "") -> None:
-    """A matplotlib figure as vector graphics (SVG) under ``heading``, at most
+    """A matplotlib figure as vector graphics (SVG; a PNG beyond :data:`MAX_SVG_ELEMENTS`)
+    under ``heading``, at most
     :data:`FIGURE_MAX_MM` high, on a new page when it does not fit below (with its heading)."""
     import re
 
@@ -184,6 +189,10 @@ def figure(pdf, fig, heading: str = "") -> None:
     # fpdf2 reads no <metadata> (and says so on stderr): the figure's metadata is not drawn
     svg = re.sub(r"<metadata>.*?</metadata>", "", raw.getvalue(), flags=re.S)
     buf = io.BytesIO(svg.encode("utf-8"))
+    if svg.count("<use ") + svg.count("<path ") > MAX_SVG_ELEMENTS:   # a raster, print dpi
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=RASTER_DPI, bbox_inches="tight")
+        buf.seek(0)
     w_in, h_in = fig.get_size_inches()
     width = min(TEXT_WIDTH_MM, FIGURE_MAX_MM * w_in / h_in)
     height = width * h_in / w_in
