@@ -343,3 +343,28 @@ def test_iso10360_test_uncertainty_budget_at_the_largest_U(tmp_path, inputs):
     text = "\n".join(p.extract_text() for p in pypdf.PdfReader(str(pdf)).pages)
     assert "Uncertainty budget: E0 at L" in text and "Decision rule: ISO 14253-1" in text
     assert "max |E0|" in text and "repetitions 3" in text
+
+
+def test_ballbar_page_states_the_iso230_4_conditions(tmp_path):
+    """The ISO 230-4 conditions on the ballbar page: radius, direction, plane, readings from
+    the traces; feed and compensation from [conditions]; the bar's calibration from the
+    instrument's certificate; the rest "not stated"."""
+    from importlib import resources
+
+    src = resources.files("volerr") / "data" / "ballbar_example_XY.csv"
+    trace = tmp_path / "trace.csv"
+    trace.write_bytes(src.read_bytes())
+    (tmp_path / "volerr-identification.toml").write_text(
+        IDENT.replace('"LI-1"', '"QC20-W"').replace("laser interferometer", "ballbar")
+        .replace('dwell = "2 s"', 'compensation = "off"'))
+    out = {k: tmp_path / f"bb.{k}" for k in ("json", "html")}
+    assert main(["ballbar", "evaluate", str(trace), "--json", str(out["json"]), "--html",
+                 str(out["html"])]) == 0
+    assert json.loads(out["json"].read_text())["identification"]["instruments"][0]["id"] == \
+        "QC20-W"
+    html = out["html"].read_text(encoding="utf-8")
+    for cell in ("ISO 230-4 (circular test, ballbar)", "<td class='l'>150 mm</td>",
+                 "<td class='l'>ccw, cw</td>", "<td class='l'>1000 mm/min</td>",
+                 "<td class='l'>off</td>", "QC20-W certificate CAL-2025-17",
+                 "<th class='l'>overrun arcs</th><td class='l'>not stated</td>"):
+        assert cell in html, cell
