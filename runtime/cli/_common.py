@@ -277,20 +277,26 @@ def write_certificates(outs, result, ident, inputs=(), title: str | None = None)
     ``--pdf`` certificate of ``result`` (a result object or its JSON document)."""
     from ..report import stamp
 
-    if isinstance(result, dict):      # a command's JSON document: its "parameters" as rows
+    if isinstance(result, dict) or not hasattr(result, "_rows"):   # its "parameters" as rows
         result = _Document(result)
     stamp.finish(outs, result, ident, inputs=list(inputs), title=title)
 
 
 class _Document:
-    """A command's JSON document (``map``, ``compensate``, ``iso10360`` ...) as a result for
-    its certificate: ``to_dict()`` and the rows of its ``"parameters"``."""
+    """A command's JSON document (``map``, ``compensate``, ``iso10360`` ...) or a result
+    without rows (``check``) as a result for its certificate: ``to_dict()``, the rows of its
+    ``"parameters"`` and the result's figures."""
 
-    def __init__(self, data: dict):
-        self.data = data
+    def __init__(self, result):
+        self.result = result
+        self.data = result if isinstance(result, dict) else result.to_dict()
 
     def to_dict(self) -> dict:
         return self.data
+
+    def figures(self) -> dict:
+        return {} if isinstance(self.result, dict) or not hasattr(self.result, "figures") \
+            else self.result.figures()
 
     def _rows(self) -> list:
         from ..results import rows_of

@@ -82,6 +82,21 @@ def _headline(doc: dict) -> list:
     return [Row(name="max |E0|", value=doc["max_abs_E_um"], std=U / K_CERTIFICATE, unit="um")]
 
 
+def _tolerance_items(doc: dict) -> list:
+    """A ``"tolerance": {"items": [...], "rule", "verdict"}`` block (``volerr check``)."""
+    tol = doc.get("tolerance")
+    if not (isinstance(tol, dict) and isinstance(tol.get("items"), list)):
+        return []
+    rows = [["quantity", "value", "U (k = 2)", "limit", "unit", "verdict"]]
+    rows += [[str(i.get("quantity")), number(i.get("value")), number(i.get("U"), 3),
+              number(i.get("limit")), unit(i.get("unit", "")), str(i.get("verdict")).upper()]
+             for i in tol["items"]]
+    out = [("Tolerances", "table", rows)]
+    if tol.get("rule"):
+        out.append((None, "text", f"Decision rule: {tol['rule']}"))
+    return out
+
+
 def _verdicts(doc: dict) -> list:
     out = []
     per = doc.get("verdicts")
@@ -112,7 +127,7 @@ def sections(doc: dict, rows, figures: dict, ident=None) -> list:
         out.append(("Results", "table", result_rows(rows)))
         out.append((None, "text", f"u: standard uncertainty; U: expanded uncertainty, "
                                   f"coverage factor k = {K_CERTIFICATE:g} (about 95 %)."))
-    out += _verdicts(doc)
+    out += _verdicts(doc) + _tolerance_items(doc)
     for b in budgets_of(doc):
         out.append((f"Uncertainty budget: {b['quantity']}", "table", budget_rows(b)))
     notes = [n for n in doc.get("notes") or [] if isinstance(n, str)]
