@@ -1,48 +1,294 @@
-"""What identifies a test certificate (ISO/IEC 17025 7.8 asks for it): the machine, the
-instrument, the operator, the date, the temperatures and expansion coefficients -- one
-:class:`Identification` shared by every certificate of volerr (``iso230-2``, ``iso10360``),
-printed as the first table of the page (:func:`html_table`) and stored in the JSON
-(:meth:`Identification.as_dict`).  Values are the user's text; none is required, a missing
-one shows as "not stated"."""
+"""What identifies a report (ISO/IEC 17025:2017 7.8.2 asks for it): one
+:class:`Identification` shared by every result of volerr, printed as the first table of every
+page (:func:`html_table`), of every PDF certificate (:mod:`volerr.report.pdf`) and stored in
+the JSON (:meth:`Identification.as_dict`, key ``"identification"``).
+
+Fields (none is required; a missing one shows as "not stated"):
+
+* ``report_id``: unique and stable for the same inputs -- ``VE-`` and 12 hexadecimal digits
+  of the SHA-256 of the input files' bytes, the command's options and the identification
+  fields (:func:`report_id`); the date of the report does not enter it;
+* the machine (text of ``--machine``, or ``[machine]`` of the file: id, make, model, serial,
+  location), the instruments (``--instrument`` text, or ``[[instrument]]`` tables: id,
+  description, serial, certificate, due (date the calibration expires), uncertainty),
+  operator, customer, the person authorising the report;
+* ``date``: the date of the measurement (YYYY-MM-DD; not in the future); ``report_date``: the
+  date of the report (today, UTC);
+* ``method``: the command, volerr's version and the options;
+* ``environment``: temperatures with their uncertainty and expansion coefficients, as the
+  user states them (label -> text), and ``conditions``: further labelled lines a command adds.
+
+The identification file (:func:`read_identification_file`): a small TOML file the user keeps
+beside the data, given by ``--identification F``; without that option a file named
+:data:`IDENTIFICATION_FILE` in the folder of the first data file is read when it is there.
+Options given on the command line replace the file's fields.  Its keys::
+
+    operator = "A. Person"
+    customer = "ACME Precision Ltd"
+    authorised_by = "B. Person, head of the laboratory"
+    date = 2026-11-30                 # the date of the measurement
+    [machine]
+    id = "DMU50-2"; make = "DMG MORI"; model = "DMU 50"; serial = "1234"; location = "hall 3"
+    [[instrument]]
+    id = "XL-80"; description = "laser interferometer"; serial = "9876"
+    certificate = "UKAS 0042/26"; due = 2027-06-30; uncertainty = "0.5 ppm (k = 2)"
+    [environment]
+    "machine temperature" = "20.4 degC +- 0.2 K (k = 2)"
+    "expansion coefficient" = "11.5 ppm/K +- 1 ppm/K"
+    [conditions]                      # test conditions the data cannot tell
+    feed = "1000 mm/min"; compensation = "on (controller tables of 2026-03)"
+
+A due date before the date of the measurement is a warning on the page, never a refusal.
+"""
 
 from __future__ import annotations
 
 import datetime
+import hashlib
 import html
+import json
 from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import InputError, require
 
 NOT_STATED = "not stated"
+#: the identification file read automatically from the folder of the first data file
+IDENTIFICATION_FILE = "volerr-identification.toml"
+MACHINE_KEYS = ("id", "make", "model", "serial", "location")
+INSTRUMENT_KEYS = ("id", "description", "serial", "certificate", "due", "uncertainty")
+TOP_KEYS = ("operator", "customer", "authorised_by", "date", "machine", "instrument",
+            "environment", "conditions")
+
+
+def today() -> str:
+    """Today's date (UTC), YYYY-MM-DD."""
+    return datetime.datetime.now(datetime.timezone.utc).date().isoformat()
+
+
+def check_date(value, where: str, future: bool = False) -> str:
+    """``value`` (a :class:`datetime.date` or YYYY-MM-DD text) as YYYY-MM-DD; one-line
+    :class:`InputError` naming ``where`` when malformed, or after today unless ``future``."""
+    if isinstance(value, datetime.datetime):
+        value = value.date()
+    if not isinstance(value, datetime.date):
+        text = str(value).strip()
+        try:
+            require(len(text) == 10, "")
+            value = datetime.date.fromisoformat(text)
+        except (ValueError, InputError):
+            raise InputError(f"{where} {str(value)!r}: expected a date YYYY-MM-DD "
+                             f"(e.g. 2026-11-30)") from None
+    iso = value.isoformat()
+    require(future or iso <= today(), f"{where} {iso}: a date after today ({today()} UTC); "
+                                      f"the date of a measurement cannot be in the future")
+    return iso
 
 
 @dataclass
 class Identification:
-    """Identification fields of one certificate.  ``conditions``: further labelled lines
-    (temperatures, expansion coefficient ...), in order."""
+    """Identification of one report (module docstring).  ``conditions``: further labelled
+    lines a command adds (temperatures, expansion coefficient ...), in order."""
 
     machine: str | None = None
     instrument: str | None = None
     operator: str | None = None
-    date: str = field(default_factory=lambda: datetime.date.today().isoformat())
+    date: str = field(default_factory=today)
     conditions: dict = field(default_factory=dict)
+    report_id: str | None = None
+    report_date: str = field(default_factory=today)
+    customer: str | None = None
+    authorised_by: str | None = None
+    machine_details: dict = field(default_factory=dict)
+    instruments: list = field(default_factory=list)
+    method: dict = field(default_factory=dict)
+    environment: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    test_conditions: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
-        return {"machine": self.machine, "instrument": self.instrument,
-                "operator": self.operator, "date": self.date, **self.conditions}
+        """The JSON form (``"date"``: the date of the measurement)."""
+        out = {"report_id": self.report_id, "machine": self.machine,
+               "instrument": self.instrument, "operator": self.operator, "date": self.date,
+               "report_date": self.report_date, "customer": self.customer,
+               "authorised_by": self.authorised_by}
+        if self.machine_details:
+            out["machine_details"] = dict(self.machine_details)
+        if self.instruments:
+            out["instruments"] = [dict(i) for i in self.instruments]
+        for key in ("method", "environment", "test_conditions"):
+            if getattr(self, key):
+                out[key] = dict(getattr(self, key))
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
+        return {**out, **self.conditions}
 
     def rows(self) -> list:
         """(label, text) of every field, "not stated" where missing."""
-        rows = [("machine", self.machine), ("instrument", self.instrument),
-                ("operator", self.operator), ("date of the test", self.date)]
-        rows += list(self.conditions.items())
+        machine = self.machine or _joined(self.machine_details, MACHINE_KEYS)
+        rows = [("report id", self.report_id), ("customer", self.customer),
+                ("machine", machine)]
+        n = len(self.instruments) + bool(self.instrument)
+        if self.instrument or not self.instruments:     # the option's text first
+            rows.append(("instrument 1" if n > 1 else "instrument", self.instrument))
+        rows += [(f"instrument {i + 1 + bool(self.instrument)}" if n > 1 else "instrument",
+                  _instrument_text(d)) for i, d in enumerate(self.instruments)]
+        rows += [("operator", self.operator), ("date of the measurement", self.date),
+                 ("date of the report", self.report_date)]
+        if self.method:
+            rows.append(("method", _method_text(self.method)))
+        rows += list(self.environment.items()) + list(self.conditions.items())
+        rows.append(("authorised by", self.authorised_by))
         return [(k, NOT_STATED if v in (None, "") else str(v)) for k, v in rows]
 
 
+def _joined(d: dict, keys) -> str | None:
+    parts = [f"{k} {d[k]}" if k in ("id", "serial") else str(d[k]) for k in keys if d.get(k)]
+    return ", ".join(parts) or None
+
+
+def _instrument_text(d: dict) -> str:
+    parts = [str(d[k]) for k in ("description", "id") if d.get(k)]
+    for key, label in (("serial", "serial"), ("certificate", "calibration certificate"),
+                       ("due", "due"), ("uncertainty", "stated uncertainty")):
+        if d.get(key):
+            parts.append(f"{label} {d[key]}")
+    return ", ".join(parts)
+
+
+def _option_text(v) -> str:
+    """An option's value as typed (lists and vectors space-separated, a flag alone)."""
+    if v is True:
+        return ""
+    if isinstance(v, (list, tuple)):
+        return " ".join(_option_text(x) for x in v)
+    return str(v)
+
+
+def _method_text(m: dict) -> str:
+    opts = " ".join(f"--{k.replace('_', '-')} {_option_text(v)}".strip()
+                    for k, v in (m.get("options") or {}).items())
+    return f"{m.get('command', 'volerr')} (volerr {m.get('version', '?')}) {opts}".strip()
+
+
+def read_identification_file(path) -> dict:
+    """The fields of an identification file (module docstring), checked: unknown keys,
+    malformed dates and a date of measurement in the future are refused in one line naming
+    the file and the key."""
+    import tomllib
+
+    p = Path(path)
+    try:
+        doc = tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError(f"--identification {p}: cannot be read ({exc.strerror})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{p}: not valid TOML ({_where(p, exc)}; dates are written "
+                         f"YYYY-MM-DD, texts in quotes)") from None
+    _known(p, "", doc, TOP_KEYS)
+    out = {k: str(doc[k]) for k in ("operator", "customer", "authorised_by") if k in doc}
+    if "date" in doc:
+        out["date"] = check_date(doc["date"], f"{p}: date")
+    if "machine" in doc:
+        require(isinstance(doc["machine"], dict), f"{p}: machine must be a table "
+                                                  f"[machine] with id, make, model ...")
+        _known(p, "machine.", doc["machine"], MACHINE_KEYS)
+        out["machine_details"] = {k: str(v) for k, v in doc["machine"].items()}
+    items = doc.get("instrument", [])
+    items = [items] if isinstance(items, dict) else items
+    require(isinstance(items, list) and all(isinstance(i, dict) for i in items),
+            f"{p}: instrument must be [[instrument]] tables with id, serial, certificate ...")
+    out["instruments"] = []
+    for i, item in enumerate(items):
+        _known(p, f"instrument[{i + 1}].", item, INSTRUMENT_KEYS)
+        d = {k: str(v) for k, v in item.items()}
+        if "due" in item:
+            d["due"] = check_date(item["due"], f"{p}: instrument[{i + 1}].due", future=True)
+        out["instruments"].append(d)
+    env = doc.get("environment", {})
+    require(isinstance(env, dict), f"{p}: environment must be a table [environment] of "
+                                   f"label = \"text\" lines")
+    out["environment"] = {str(k): str(v) for k, v in env.items()}
+    cond = doc.get("conditions", {})
+    require(isinstance(cond, dict), f"{p}: conditions must be a table [conditions] of "
+                                    f"label = \"text\" lines (feed, compensation ...)")
+    out["test_conditions"] = {str(k): str(v) for k, v in cond.items()}
+    return out
+
+
+def _where(p: Path, exc) -> str:
+    """The TOML error and the line it points at (``at line N, column M``)."""
+    import re
+
+    msg = str(exc).splitlines()[0]
+    m = re.search(r"line (\d+)", msg)
+    if m is None:
+        return msg
+    lines = p.read_text(encoding="utf-8", errors="replace").splitlines()
+    n = int(m.group(1))
+    return f"{msg}: {lines[n - 1].strip()!r}" if 0 < n <= len(lines) else msg
+
+
+def _known(p: Path, prefix: str, d: dict, keys) -> None:
+    bad = sorted(set(d) - set(keys))
+    require(not bad, f"{p}: unknown key {prefix}{bad[0] if bad else ''} (known: "
+                     f"{', '.join(keys)}); a misspelt key?")
+
+
+def find_identification_file(explicit, files) -> Path | None:
+    """The identification file: ``explicit`` (``--identification``), else
+    :data:`IDENTIFICATION_FILE` beside the first data file of ``files`` when it is there."""
+    if explicit:
+        require(Path(explicit).is_file(), f"--identification {explicit}: no such file")
+        return Path(explicit)
+    for f in files:
+        if Path(str(f)).is_file():
+            candidate = Path(str(f)).parent / IDENTIFICATION_FILE
+            return candidate if candidate.is_file() else None
+    return None
+
+
+def report_id(files=(), options: dict | None = None) -> str:
+    """``VE-`` and 12 hexadecimal digits of the SHA-256 of the files' bytes (in order) and the
+    options (JSON, keys sorted): the same inputs and options give the same id."""
+    h = hashlib.sha256()
+    for f in files:
+        p = Path(str(f))
+        h.update(p.name.encode())
+        if p.is_file():
+            h.update(hashlib.sha256(p.read_bytes()).digest())
+    h.update(json.dumps(options or {}, sort_keys=True, default=str).encode())
+    return "VE-" + h.hexdigest()[:12].upper()
+
+
+def build(given: dict, file=None, files=(), method: dict | None = None,
+          conditions: dict | None = None) -> Identification:
+    """One :class:`Identification` from the file's fields (:func:`read_identification_file`)
+    and the options ``given`` (``machine instrument operator date customer``; not None
+    replaces the file's), with its :func:`report_id`, the method and the due-date warnings."""
+    fields = read_identification_file(file) if file is not None else {}
+    for key, value in given.items():
+        if value not in (None, ""):
+            fields[key] = check_date(value, "--date") if key == "date" else str(value)
+    method = dict(method or {})
+    hashed = {"method": method, **{k: v for k, v in fields.items()}}
+    ident = Identification(conditions=dict(conditions or {}), method=method,
+                           report_id=report_id(files, hashed), **fields)
+    for i, d in enumerate(ident.instruments):
+        if d.get("due") and d["due"] < ident.date:
+            ident.warnings.append(
+                f"instrument {d.get('id') or i + 1}: calibration due {d['due']}, before the "
+                f"date of the measurement {ident.date}")
+    return ident
+
+
 def html_table(ident: Identification) -> str:
-    """The identification block of a certificate page (HTML table)."""
+    """The identification block of a report page (HTML table, then its warnings)."""
     e = html.escape
+    warn = "".join(f"<p class='warn'>warning: {e(w)}</p>" for w in ident.warnings)
     return ("<table class='ident'>" + "".join(
         f"<tr><th class='l'>{e(k)}</th><td class='l'>{e(v)}</td></tr>" for k, v in ident.rows())
-        + "</table>")
+        + "</table>" + warn)
 
 
 def verdict_html(verdict: str | None) -> str:

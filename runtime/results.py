@@ -5,7 +5,8 @@ object you can read, after statsmodels' ``RegressionResults`` and scipy's ``Opti
 
 * its values as attributes (and ``result["key"]``, the keys of the command's JSON);
 * ``to_dict()``: the command's ``--json`` document, as :func:`json.loads` reads it back;
-* ``write_json(path)``, ``write_html(path)``: the command's ``--json`` and ``--html`` files;
+* ``write_json(path)``, ``write_html(path)``, ``write_pdf(path)``: the command's ``--json``,
+  ``--html`` and ``--pdf`` files;
 * ``summary()``: the text the command prints;
 * ``table()``: one row per reported value: name, value, standard uncertainty (k = 1), unit
   and the coverage factor ``k`` of the uncertainty column (always 1: a standard
@@ -107,6 +108,15 @@ class ResultMixin:
 
         return write_text(path, json_text(self._document(), default=_plain),
                           inputs=list(inputs))
+
+    def write_pdf(self, path, inputs=(), identification=None, title=None):
+        """Write the PDF certificate (A4: identification, conditions, results with U and k,
+        verdicts and decision rule, budgets, figures; :mod:`volerr.report`); returns its
+        path.  ``identification``: a :class:`volerr.certificate.Identification` (default:
+        the one in the JSON document)."""
+        from .report.stamp import write_pdf
+
+        return write_pdf(path, self, identification, inputs=list(inputs), title=title)
 
     def _rows(self) -> list:
         return rows_of(self._document().get("parameters"))

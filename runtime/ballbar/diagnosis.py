@@ -77,6 +77,10 @@ def diagnose_fit(model, obs, planes: list, swept: list = ()) -> tuple:
     cal = calibrate(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
                     extra_terms=extra, plan=False, progress=False)
     entries = _entries(cal, report, swept, extra)
+    for e in entries:   # the estimator's budget where the entry is one of its parameters
+        b = (cal.data.get("budgets") or {}).get(e["parameter"])
+        if b is not None and abs(b["u"] - e["std"]) <= 1e-9 * max(e["std"], 1e-300):
+            e["budget"] = b
     return entries, why_not(cal, swept, entries), cal.quality
 
 

@@ -110,6 +110,8 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
             model, stacked, [] if swept else planes, swept)
         if note:
             data["diagnosis_note"] = note
+        data["budgets"] = {e["parameter"]: e.pop("budget") for e in data["diagnosis"]
+                           if "budget" in e}
         data["fit"] = quality.to_dict()
         return Evaluation(data, trs, results, quality)
     return Evaluation(data, trs, results)

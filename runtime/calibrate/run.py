@@ -466,6 +466,8 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     draft = Calibration(report, *fields)
     report = _lab_report(draft, fit, obs, u_ref)
     report["covariance"] = covariance_block(draft)
+    from .budget import budgets
+    report["budgets"] = budgets(draft, fit, u_ref)
     report["seconds"] = round(time.perf_counter() - t0, 2)
     return Calibration(report, *fields)
 

@@ -242,31 +242,103 @@ def add_max_change(parser, reference: bool) -> None:
                              "--max-change")
 
 
-def add_identification(parser, instrument: str = "the measuring instrument") -> None:
-    """``--machine --instrument --operator --date``: the identification of a certificate."""
-    g = parser.add_argument_group("certificate identification (printed on the page and in "
-                                  "the JSON)")
-    g.add_argument("--machine", metavar="TEXT",
-                   help="the machine tested: make, model, serial number")
-    g.add_argument("--instrument", metavar="TEXT",
-                   help=f"{instrument}: make, model, serial number, calibration")
-    g.add_argument("--operator", metavar="TEXT", help="who made the test")
-    g.add_argument("--date", metavar="YYYY-MM-DD",
-                   help="date of the test, not after today (not given: the date of the "
-                        "evaluation)")
+#: options whose values are outputs or switches of writing, not of the method (report id)
+_NOT_METHOD = {"json", "html", "pdf", "plot", "errors_out", "map_out", "out", "force", "func",
+               "command", "action", "identification", "date"}
+_IDENT_OPTIONS = {"--machine": ("machine", "the machine tested: id, make, model, serial number"),
+                  "--operator": ("operator", "who made the measurement"),
+                  "--date": ("date", "date of the measurement YYYY-MM-DD (not in the future; "
+                                     "not given: the file's, else today)"),
+                  "--customer": ("customer", "the customer the report is for")}
 
 
-def identification_from_args(args, conditions: dict | None = None):
-    """:class:`volerr.certificate.Identification` of the options of :func:`add_identification`
-    (the date checked)."""
-    from ..certificate import Identification
-    from ..units import parse_date
+def add_identification_arguments(parser, instrument: str = "the measuring instrument") -> None:
+    """``--identification F --machine --instrument --operator --date --customer --pdf F``: the
+    identification of a report (:mod:`volerr.certificate`) and its PDF certificate.  An option
+    the command already has with its own meaning (``check --instrument SPEC``, ``history
+    --machine ID``) keeps it; that field then comes from the identification file."""
+    g = parser.add_argument_group("report identification (on the page, in the JSON and the "
+                                  "PDF; options replace the fields of the identification file)")
+    have = parser._option_string_actions
+    g.add_argument("--identification", metavar="F.toml",
+                   help="identification file (TOML: machine, instruments, operator, customer, "
+                        "date, environment); without it volerr-identification.toml beside the "
+                        "first data file is read when it is there")
+    own = []
+    for flag, (dest, text) in {**_IDENT_OPTIONS, "--instrument": (
+            "instrument", f"{instrument}: make, model, serial number, calibration")}.items():
+        if flag not in have:
+            g.add_argument(flag, dest=dest, metavar="YYYY-MM-DD" if dest == "date" else "TEXT",
+                           help=text)
+            own.append(dest)
+    if "--pdf" not in have:
+        g.add_argument("--pdf", metavar="F.pdf",
+                       help="write the PDF certificate (A4, identification, conditions, "
+                            "results with U and k, budget, figures)")
+    parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog)
 
-    kw = {}
-    if args.date is not None:           # YYYY-MM-DD, not in the future
-        kw["date"] = parse_date(args.date)
-    return Identification(args.machine, args.instrument, args.operator,
-                          conditions=dict(conditions or {}), **kw)
+
+add_identification = add_identification_arguments   # its former name
+
+
+def identification_from_args(args, files=(), conditions: dict | None = None):
+    """:class:`volerr.certificate.Identification` of the options of
+    :func:`add_identification_arguments` and the identification file (``--identification``,
+    else volerr-identification.toml beside the first of ``files``); checked (dates), with
+    its report id (``files``' bytes and the options) and method (command, version, options)."""
+    from .. import __version__, certificate
+
+    own = set(getattr(args, "_ident_own", ())) | {"date"}
+    given = {k: getattr(args, k, None) for k in ("machine", "instrument", "operator", "date",
+                                                 "customer") if k in own}
+    paths = {str(f) for f in files}
+    skip = _NOT_METHOD | own          # outputs, and the identification's own fields
+    def is_input(v) -> bool:          # an input file (also as KIND:FILE): hashed, not an option
+        return str(v) in paths or str(v).split(":", 1)[-1] in paths
+
+    options = {k: (str(v) if isinstance(v, Path) else v) for k, v in sorted(vars(args).items())
+               if not k.startswith("_") and k not in skip and v not in (None, False, [])
+               and not is_input(v) and not callable(v)}
+    options = {k: v for k, v in options.items()
+               if not (isinstance(v, list) and all(is_input(x) for x in v))}
+    method = {"command": getattr(args, "_ident_prog", "volerr"), "version": __version__,
+              "options": options}
+    file = certificate.find_identification_file(getattr(args, "identification", None),
+                                                list(files))
+    return certificate.build(given, file, list(files), method, conditions)
+
+
+def write_certificates(outs, result, ident, inputs=(), title: str | None = None) -> None:
+    """Inside ``with outs:`` after the command's own outputs: the identification stamped into
+    the written ``--json`` and ``--html`` (when the command did not carry it itself) and the
+    ``--pdf`` certificate of ``result`` (a result object or its JSON document)."""
+    from ..report import stamp
+
+    if isinstance(result, dict) or not hasattr(result, "_rows"):   # its "parameters" as rows
+        result = _Document(result)
+    stamp.finish(outs, result, ident, inputs=list(inputs), title=title)
+
+
+class _Document:
+    """A command's JSON document (``map``, ``compensate``, ``iso10360`` ...) or a result
+    without rows (``check``) as a result for its certificate: ``to_dict()``, the rows of its
+    ``"parameters"`` and the result's figures."""
+
+    def __init__(self, result):
+        self.result = result
+        self.data = result if isinstance(result, dict) else result.to_dict()
+
+    def to_dict(self) -> dict:
+        return self.data
+
+    def figures(self) -> dict:
+        return {} if isinstance(self.result, dict) or not hasattr(self.result, "figures") \
+            else self.result.figures()
+
+    def _rows(self) -> list:
+        from ..results import rows_of
+
+        return rows_of(self.data.get("parameters"))
 
 
 def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):

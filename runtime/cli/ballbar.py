@@ -6,8 +6,10 @@ from __future__ import annotations
 
 from ..errors import InputError, require
 from ..fileio import Outputs
-from ._common import (add_accept_residual, add_error_arguments, add_force, add_html, add_json,
-                      add_plot, add_vector, error_functions_from_args, layout_inputs)
+from ._common import (add_accept_residual, add_error_arguments, add_force, add_html,
+                      add_identification_arguments, add_json, add_plot, add_vector,
+                      error_functions_from_args, identification_from_args, layout_inputs,
+                      write_certificates)
 
 
 def register(sub) -> None:
@@ -60,6 +62,7 @@ def register(sub) -> None:
     add_json(ev, "the evaluation (G, H, F per trace; diagnosis)")
     add_plot(ev, "the polar plot")
     add_html(ev, "the report page (polar plot, ISO 230-4 table, diagnosis)")
+    add_identification_arguments(ev, "the ballbar (its calibration length and certificate)")
     add_force(ev)
     add_accept_residual(ev)
     ev.set_defaults(func=run_evaluate)
@@ -109,7 +112,8 @@ def run_evaluate(args) -> int:
 
     inputs = list(args.files) + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force).file("--json", args.json).plot("--plot", args.plot) \
-        .file("--html", args.html).check()
+        .file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     ev = ballbar_evaluate(args.files, args.layout)
     ev.judge(args.accept_residual, f"ballbar evaluate {' '.join(args.files)} (the diagnosis)")
     with outs:
@@ -123,5 +127,6 @@ def run_evaluate(args) -> int:
             from ..ballbar.report import write_html
 
             write_html(outs.path("--html"), ev, inputs=inputs)
+        write_certificates(outs, ev, ident, inputs)
     print(ev.summary())
     return 0

@@ -6,8 +6,9 @@ from __future__ import annotations
 
 from ..errors import require
 from ..fileio import Outputs
-from ._common import add_accept_residual, add_errors_out, add_force, add_html, add_json, \
-    add_max_change
+from ._common import (\     add_max_change, add_accept_residual, add_errors_out, add_force,
+                      add_html, add_identification_arguments, add_json, identification_from_args,
+                      write_certificates)
 
 
 def register(sub) -> None:
@@ -32,6 +33,7 @@ def register(sub) -> None:
                    "distances)")
     add_json(p, "the report (parameters, identifiability, set-ups, residuals per file)")
     add_html(p, "the report with figures")
+    add_identification_arguments(p, "the instruments")
     add_errors_out(p, "the identified model (for map, compensate, uncertainty)")
     p.add_argument("--map-out", metavar="MAP.csv", help="write the identified volumetric "
                    "error map over the measured range with its standard uncertainty "
@@ -72,9 +74,10 @@ def run(args) -> int:
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .file("--html", args.html).file("--map-out", args.map_out) \
+        .file("--html", args.html).file("--map-out", args.map_out).file("--pdf", args.pdf) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
+    ident = identification_from_args(args, inputs)
     with outs:
         result = calibrate(args.layout, args.files, parameters=args.parameters,
                            degree=args.degree, seed=args.seed,
@@ -93,6 +96,7 @@ def run(args) -> int:
             from ..calibrate.mapping import write_csv
 
             write_csv(outs.path("--map-out"), result, (args.map_grid,) * 3, inputs=inputs)
+        write_certificates(outs, result, ident, inputs)
     print(result.summary())
     beyond = result.data.get("max_change", {}).get("beyond")
     if beyond:

@@ -14,7 +14,8 @@ from pathlib import Path
 
 from ..errors import InputError, require
 from ..fileio import Outputs
-from ._common import add_accept_residual, add_force, add_html, add_json, add_max_change
+from ._common import (add_accept_residual, add_force, add_html, add_identification_arguments,
+                      add_json, add_max_change, identification_from_args, write_certificates)
 
 USAGE = ("volerr check plan LAYOUT --reference CAL.json --instrument SPEC [--minutes M] "
          "[--readings N] [--detect-um D] --out DIR [--json F] [--html H]\n"
@@ -67,6 +68,7 @@ def register(sub) -> None:
                                                         "after today (carried into the JSON)")
     add_json(p, "the check plan or the check's result")
     add_html(p, "the set-up sheet (check plan) or the check's page")
+    add_identification_arguments(p)
     add_force(p)
     add_accept_residual(p)
     add_max_change(p, reference=False)
@@ -109,7 +111,8 @@ def _plan(args, inputs) -> int:
     out = Path(args.out)
     require(not out.exists() or out.is_dir(), f"--out {out}: a file, not a folder")
     outs = Outputs(inputs, force=args.force).folder("--out", out) \
-        .file("--json", args.json).file("--html", args.html).check()
+        .file("--json", args.json).file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs[-1:] + inputs[:-1])
     if out.is_dir() and not args.force:
         taken = sorted(p.name for p in out.iterdir() if p.suffix in (".csv", ".nc", ".html"))
         require(not taken, f"--out {out}: holds {taken[0] if taken else ''} already; give "
@@ -120,6 +123,7 @@ def _plan(args, inputs) -> int:
                             readings=args.readings, **kw)
         result.write(outs.path("--out"), outs.path("--json") if args.json else None,
                      outs.path("--html") if args.html else None, inputs)
+        write_certificates(outs, result, ident, inputs)
     print(result.summary())
     return 0
 
@@ -138,7 +142,8 @@ def _check(args, inputs) -> int:
 
     limits = parse_max_change(args.max_change) if args.max_change else None
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .file("--html", args.html).check()
+        .file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, [Path(split_spec(f)[1]) for f in files] + inputs)
     with outs:
         result = check(layout, files, reference=args.reference, tolerance=args.tolerance,
                        date=args.date)
@@ -148,5 +153,6 @@ def _check(args, inputs) -> int:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:
             result.write_html(outs.path("--html"), inputs=inputs)
+        write_certificates(outs, result, ident, inputs)
     print(result.summary())
     return 0

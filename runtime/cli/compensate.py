@@ -26,7 +26,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import add_error_arguments, add_vector, layout_inputs, progress_bar
+from ._common import (add_error_arguments, add_identification_arguments, add_vector,
+                      identification_from_args, layout_inputs, progress_bar, write_certificates)
 from ..fileio import Outputs
 
 
@@ -97,6 +98,7 @@ def register(sub) -> None:
     p.add_argument("--report", help="per-block CSV report")
     p.add_argument("--json", help="summary as JSON")
     p.add_argument("--plot", help="PNG: predicted tool-tip error along the program")
+    add_identification_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -108,7 +110,8 @@ def run(args) -> int:
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
               *([args.tool_table] if args.tool_table else [])]
     outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
-        .file("--json", args.json).plot("--plot", args.plot).check()
+        .file("--json", args.json).plot("--plot", args.plot).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     with outs:  # all or nothing: staged outputs are put in place at the end
         with progress_bar(Path(args.program), "compensate") as tick:
             res = compensate(
@@ -129,6 +132,7 @@ def run(args) -> int:
 
             plot_program_errors(res.program_errors(), outs.path("--plot"),
                                 title=f"{res.layout}: {args.program}")
+        write_certificates(outs, res.to_dict(), ident, inputs)
     print(res.summary())
     # notes only after success: bad input gets exactly one line on stderr
     for note in res.notes:

@@ -10,7 +10,8 @@ Parses arguments and calls :mod:`volerr.history`; the rules are stated there and
 
 from __future__ import annotations
 
-from ._common import add_html, add_json
+from ._common import (add_html, add_identification_arguments, add_json,
+                      identification_from_args, write_certificates)
 
 EPILOG = """\
 DB: a file (SQLite, created by the first add) or a postgresql:// URL (a server; needs
@@ -67,6 +68,7 @@ def register(sub) -> None:
                          "date each is left, with a 95 %% interval")
     add_json(sh, "the history (entries, events, trends, forecast, control charts)")
     add_html(sh, "the history page (one chart per parameter)")
+    add_identification_arguments(sh)
     sh.set_defaults(func=run_show)
 
 
@@ -92,8 +94,11 @@ def run_show(args) -> int:
     from ..fileio import Outputs, write_text
 
     wait = _wait(args)
-    outs = Outputs([] if "://" in args.db else [args.db], force=False) \
-        .file("--json", args.json).file("--html", args.html).check()
+    inputs = [] if "://" in args.db else [args.db]
+    outs = Outputs(inputs, force=False).file("--json", args.json).file("--html", args.html) \
+        .file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
+    ident.machine = ident.machine or (None if ident.machine_details else args.machine)
     h = history.show(args.db, args.machine, args.tolerance, wait)
     text = h.html() if args.html else None
     with outs:
@@ -101,5 +106,6 @@ def run_show(args) -> int:
             h.write_json(outs.path("--json"))
         if text is not None:
             write_text(outs.path("--html"), text)
+        write_certificates(outs, h, ident, inputs)
     print(h.summary())
     return 0

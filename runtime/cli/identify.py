@@ -14,8 +14,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._common import (add_accept_implausible, add_accept_residual, add_force, add_json,
-                      add_plot, add_vector)
+from ._common import (add_accept_implausible, add_accept_residual, add_force,
+                      add_identification_arguments, add_json, add_plot, add_vector,
+                      identification_from_args, write_certificates)
 
 
 def register(sub) -> None:
@@ -78,6 +79,7 @@ def register(sub) -> None:
     add_plot(p, "a plot of the error motions")
     add_force(p)
     add_accept_residual(p)
+    add_identification_arguments(p, "the laser tracker")
     p.set_defaults(func=run)
 
 
@@ -102,7 +104,8 @@ def run(args) -> int:
     outs = Outputs(inputs, force=args.force).file("--out", args.out) \
         .folder("--errors-out", args.errors_out, files=[f"{axis}.csv"]) \
         .file("--residuals", args.residuals) \
-        .file("--json", args.json).plot("--plot", args.plot).check()
+        .file("--json", args.json).plot("--plot", args.plot).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     res = identify(
         args.layout, args.axis, args.files, format=args.format, positions=args.positions,
         points=args.points, method=args.method,
@@ -137,6 +140,7 @@ def run(args) -> int:
             write_text(outs.path("--residuals"), residual_csv(result), inputs=inputs)
         if args.json:
             write_text(outs.path("--json"), json_text(summary), inputs=inputs)
+        write_certificates(outs, res, ident, inputs)
     written = args.out or str(Path(args.errors_out) / f"{axis}.csv")
     print("\n".join(summary_lines(args.axis, summary, written) + ["  " + res.quality.line()]))
     for line in outlier_warnings(summary):

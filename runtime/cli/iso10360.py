@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, identification_from_args, inputs_of)
+                      add_vector, identification_from_args, inputs_of, write_certificates)
 from ..fileio import Outputs, write_bytes
 
 
@@ -56,7 +56,11 @@ def run(args) -> int:
 
     inputs = inputs_of(args)
     outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
-        .file("--html", args.html).check()
+        .file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs, {
+        "artefact temperature": f"{args.temperature_C:g} \u00b0C (u = {args.temperature_u_K:g} K)",
+        "artefact expansion coefficient": f"{args.artefact_cte_ppm_per_K:g} ppm/K (u = "
+                                          f"{args.artefact_cte_u_ppm_per_K:g} ppm/K)"})
     res = iso10360(
         args.layout, args.errors, method=args.method, degree=args.degree,
         extrapolate=args.extrapolate, probe=args.probe,
@@ -64,7 +68,7 @@ def run(args) -> int:
         artefact_u=args.artefact_u, artefact_cte_ppm_per_K=args.artefact_cte_ppm_per_K,
         artefact_cte_u_ppm_per_K=args.artefact_cte_u_ppm_per_K,
         temperature_C=args.temperature_C, temperature_u_K=args.temperature_u_K,
-        identification=identification_from_args(args))
+        identification=ident)
     print(res.summary())
     with outs:
         if args.json:
@@ -73,4 +77,8 @@ def run(args) -> int:
             write_bytes(outs.path("--plot"), res.png(), inputs)
         if args.html:
             res.write_html(outs.path("--html"), inputs)
+        d = res.to_dict()
+        title = f"{d['layout']}: simulated ISO 10360-2" + \
+            (f", {d['verdict']}" if args.mpe is not None else "")
+        write_certificates(outs, d, ident, inputs, title)
     return 0 if np.isfinite(res.data["max_abs_E_um"]) else 1

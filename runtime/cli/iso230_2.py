@@ -15,7 +15,8 @@ from pathlib import Path
 
 from ..errors import require
 from ._common import (add_errors_out, add_force, add_html, add_identification, add_json,
-                      add_plot, finite_option, identification_from_args)
+                      add_plot, finite_option, identification_from_args,
+                      write_certificates)
 
 EPILOG = """\
 input formats (CSV; ';' or tab separated exports are read too; names case-insensitive):
@@ -155,7 +156,7 @@ def run(args) -> int:
     if args.tolerance is not None:   # checked before any output is planned
         conformance.parse_tolerances(args.tolerance, ("A", "E", "M", "R", "B"))
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .plot("--plot", args.plot).file("--html", args.html) \
+        .plot("--plot", args.plot).file("--html", args.html).file("--pdf", args.pdf) \
         .folder("--errors-out", args.errors_out, files=[f"{a}.csv" for a in axes]).check()
 
     conditions = {}
@@ -164,7 +165,7 @@ def run(args) -> int:
                                               f"20 \u00b0C)"
     if args.material_temp_C is not None:
         conditions["material temperature"] = f"{args.material_temp_C:g} \u00b0C"
-    ident = identification_from_args(args, conditions)
+    ident = identification_from_args(args, inputs, conditions)
     res = iso230_2(inputs, ",".join(axes), tolerance=args.tolerance,
                    instrument_ppm=args.instrument_ppm, alignment_mm=args.alignment_mm,
                    temperature_u_K=args.temperature_u_K, cte_u_ppm_per_K=args.cte_u_ppm_per_K,
@@ -186,6 +187,7 @@ def run(args) -> int:
             res.write_html(outs.path("--html"), inputs=inputs)
         for a, text in zip(axes, table_texts):
             write_text(outs.path("--errors-out") / f"{a}.csv", text, inputs=inputs)
+        write_certificates(outs, res, ident, inputs)
 
     print(res.summary())
     notes = pos.summary_lines(report)[1]

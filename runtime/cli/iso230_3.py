@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from ..errors import require
 from ._common import (add_force, add_html, add_identification, add_json, add_plot,
-                      identification_from_args)
+                      identification_from_args, write_certificates)
 
 EPILOG = """\
 input: a drift file (volerr formats drift): t_s | t_min | t_h, channels d_<label>_um with
@@ -84,7 +84,7 @@ def run(args) -> int:
     runs = drift.read_runs(args.file)
     plots = _plot_paths(args.plot, runs)
     outs = Outputs([args.file], force=args.force).file("--json", args.json) \
-        .file("--html", args.html)
+        .file("--html", args.html).file("--pdf", args.pdf)
     if len(plots) == 1:
         outs.plot("--plot", plots[0])
     else:
@@ -92,6 +92,7 @@ def run(args) -> int:
                 f"plot file must end in .png, got {args.plot}")
         outs.group("--plot", plots)
     outs.check()
+    ident = identification_from_args(args, [args.file])
     evals = [iso230_3.evaluate(r, args.stage_column) for r in runs]
     report = iso230_3.report_dict(evals)
     pngs = [iso230_3.plot(ev) for ev in evals] if (args.plot or args.html) else []
@@ -108,6 +109,7 @@ def run(args) -> int:
             write_bytes(outs.path(role), pngs[k], inputs=[args.file])
         if html_text is not None:
             write_text(outs.path("--html"), html_text, inputs=[args.file])
+        write_certificates(outs, report, ident, [args.file])
     for ev in evals:
         print("\n".join(ev.summary_lines()))
     return 0

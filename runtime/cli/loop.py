@@ -18,7 +18,9 @@ from pathlib import Path
 from ..errors import require
 from ..fileio import Outputs
 from ..loop.api import console_lines
-from ._common import add_accept_residual, add_errors_out, add_force, add_html, add_json
+from ._common import (add_accept_residual, add_errors_out, add_force, add_html,
+                      add_identification_arguments, add_json, identification_from_args,
+                      write_certificates)
 
 
 def register(sub) -> None:
@@ -40,6 +42,7 @@ def register(sub) -> None:
                         "KIND:FILE to name the kind), one campaign")
     add_json(p, "the report")
     add_html(p, "the report with figures")
+    add_identification_arguments(p, "the instruments")
     p.add_argument("--out-dir", metavar="DIR",
                    help="folder for the augmented layout and its generated module (not given: "
                         "not written)")
@@ -92,9 +95,10 @@ def run(args) -> int:
     out_dir = Path(args.out_dir) if args.out_dir else None
     OUT_DIR = "--out-dir"
     outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
-        .folder(OUT_DIR, out_dir, files=aug) \
+        .file("--pdf", args.pdf).folder(OUT_DIR, out_dir, files=aug) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
+    ident = identification_from_args(args, inputs)
     families = candidates.FAMILIES
     if args.families:
         families = tuple(f.strip() for f in args.families.split(",") if f.strip())
@@ -121,6 +125,7 @@ def run(args) -> int:
             report.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
             report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+        write_certificates(outs, report, ident, inputs)
     for line in console_lines(report):
         print(line)
     return 0
@@ -138,7 +143,9 @@ def run_drift(args) -> int:
             "written for drift runs (their effects are per channel, not in the layout)")
     inputs = paths + held + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .file("--html", args.html).file("--predictions-out", args.predictions_out).check()
+        .file("--html", args.html).file("--predictions-out", args.predictions_out) \
+        .file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     with outs:
         report = loop_drift(args.layout, paths, window=args.holdout_time,
                             files=held, differences=args.differences)
@@ -148,5 +155,6 @@ def run_drift(args) -> int:
             report.write_html(outs.path("--html"), inputs=inputs)
         if args.predictions_out:
             report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
+        write_certificates(outs, report, ident, inputs)
     print(report.summary())
     return 0

@@ -8,8 +8,9 @@ deviations in the tables also ``<plot>_random.png`` or ``--plot-random``) and pr
 from __future__ import annotations
 
 
-from ._common import (add_accept_implausible, add_common, error_functions_from_args,
-                      inputs_of, parse_at)
+from ._common import (add_accept_implausible, add_common, add_identification_arguments,
+                      error_functions_from_args, identification_from_args, inputs_of, parse_at,
+                      write_certificates)
 from ..cmm import volmap
 from ..errors import require
 from ..fileio import Outputs, json_text, write_text
@@ -36,6 +37,7 @@ def register(sub) -> None:
                         "RV_<axis>_um (ISO 230-2 B_i): X+,Y- per axis, or + / - for all "
                         "(default: the bidirectional mean, the tabulated value)")
     add_accept_implausible(p)
+    add_identification_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -51,7 +53,8 @@ def run(args) -> int:
     if rnd_plot is None and args.plot and funcs.has_random:
         rnd_plot = volmap.random_plot_path(args.plot)
     outs = Outputs(inputs).file("--out", args.out).plot("--plot", args.plot) \
-        .plot("--plot-random", rnd_plot).file("--json", args.json).check()
+        .plot("--plot-random", rnd_plot).file("--json", args.json).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     from ..cmm.api import error_map
     from ..tables.functions import parse_approach
 
@@ -69,6 +72,7 @@ def run(args) -> int:
                                                            args.magnify, inputs)
         if args.json:
             write_text(outs.path("--json"), json_text(s), inputs)
+        write_certificates(outs, res, ident, inputs)
     print(res.summary())
     for label, path in (("map", args.out), ("plot", args.plot), ("random plot", rnd_plot),
                         ("summary", args.json)):

@@ -7,7 +7,8 @@ from pathlib import Path
 
 from ..errors import require
 from ..fileio import Outputs
-from ._common import add_force, add_html, add_json
+from ._common import (add_force, add_html, add_identification_arguments, add_json,
+                      identification_from_args, write_certificates)
 
 
 def register(sub) -> None:
@@ -47,6 +48,7 @@ def register(sub) -> None:
                         "unless --force)")
     add_json(p, "the plan: predicted standard uncertainties, files, baseline")
     add_html(p, "the set-up sheet (default: DIR/plan.html)")
+    add_identification_arguments(p)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters the campaign must determine (as calibrate --parameters; "
                         "written into the files' header); default: what calibrate fits for "
@@ -86,7 +88,8 @@ def run(args) -> int:
     out = Path(args.out)
     require(not out.exists() or out.is_dir(), f"--out {out}: a file, not a folder")
     outs = Outputs(inputs, force=args.force).folder("--out", out) \
-        .file("--json", args.json).file("--html", args.html).check()
+        .file("--json", args.json).file("--html", args.html).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     if out.is_dir() and not args.force:
         taken = sorted(p.name for p in out.iterdir()
                        if p.suffix in (".csv", ".nc", ".html", ".h", ".mpf"))
@@ -98,5 +101,6 @@ def run(args) -> int:
         folder = outs.path("--out")
         result.write(folder, outs.path("--json") if args.json else None,
                      outs.path("--html") if args.html else None, inputs, args.dialect)
+        write_certificates(outs, result, ident, inputs)
     print(result.summary())
     return 0

@@ -14,7 +14,8 @@ from __future__ import annotations
 import math
 import sys
 
-from ._common import add_force, add_vector
+from ._common import (add_force, add_identification_arguments, add_vector,
+                      identification_from_args, write_certificates)
 from ..errors import require
 from ..fileio import json_text, write_text
 from ..units import parse_number
@@ -74,6 +75,7 @@ def register(sub) -> None:
                    help="custom plan: circle latitudes phi, deg (with --per-circle)")
     g.add_argument("--per-circle", type=int, metavar="N", help="custom plan: points per circle")
     g.add_argument("--no-pole", action="store_true", help="leave out the pole point")
+    add_identification_arguments(p, "the reference sphere (its calibration)")
     p.set_defaults(func=run)
 
 
@@ -122,11 +124,12 @@ def run(args) -> int:
 
     inputs = [args.data]
     outs = Outputs(inputs, force=args.force).file("--out", args.out) \
-        .file("--json", args.json) \
+        .file("--json", args.json).file("--pdf", args.pdf) \
         .plot("--plot", args.plot) \
         .folder("--plots", args.plots, files=("probe_map_3d.png", "probe_map_2d.png")).check()
     require(args.degree is None or 0 <= args.degree <= 20,
             f"--degree must be between 0 and 20, got {args.degree}")
+    ident = identification_from_args(args, inputs)
     res = probe_cal(args.data, args.sphere_radius, tilt_deg=args.tilt_deg,
                     roll_deg=args.roll_deg, degree=args.degree, outlier_k=args.outlier_k,
                     exclude_outliers=args.exclude_outliers, ball_radius=args.ball_radius)
@@ -145,6 +148,7 @@ def run(args) -> int:
             d = outs.path("--plots")
             plot_probe_map_3d(cal, d / "probe_map_3d.png")
             plot_probe_map_2d(cal, d / "probe_map_2d.png")
+        write_certificates(outs, res, ident, inputs)
     for note in cal.notes:
         print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
     print(res.summary())

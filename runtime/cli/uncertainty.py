@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import add_error_arguments, add_html, add_json, add_plot
+from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
+                      add_plot, identification_from_args, write_certificates)
 from ..errors import require
 from ..fileio import Outputs, write_bytes
 from ..machine.model import load
@@ -88,6 +89,7 @@ def register(sub) -> None:
     add_html(p, "the report (header, result statement, contributions, histogram and "
                 "convergence plots)")
     add_plot(p, "the histogram with the coverage interval")
+    add_identification_arguments(p)
     p.add_argument("--backend", choices=("numpy", "numba"), default="numpy",
                    help="evaluation of the samples: numpy (default) or the fused numba kernel "
                         "(pip install 'volerr[fast]'; 1-4 s to compile once, pays from ~1e8 "
@@ -148,7 +150,8 @@ def run(args) -> int:
         inputs += inputs_of(args)
     inputs += layout_inputs(args.layout)
     outs = Outputs(inputs).file("--json", args.json).file("--html", args.html) \
-        .plot("--plot", args.plot).check()
+        .plot("--plot", args.plot).file("--pdf", args.pdf).check()
+    ident = identification_from_args(args, inputs)
     pmap = None
     if args.probe_map:
         from ..probe import read_probe_map
@@ -175,4 +178,5 @@ def run(args) -> int:
                 res.values, res.names, res.summary_stats, res.title), inputs)
         if args.html:
             res.write_html(outs.path("--html"), inputs)
+        write_certificates(outs, res, ident, inputs)
     return 0

@@ -304,9 +304,10 @@ def as_reference(entry: Entry, path) -> Entry:
 
 
 def _own_date(doc: dict, path) -> str | None:
-    """The result's own date (``"date"`` or ``identification.date``), when it states one."""
-    for d in (doc.get("date"), (doc.get("identification") or {}).get("date")
-              if isinstance(doc.get("identification"), dict) else None):
+    """The result's own date: the date of the measurement in its identification
+    (``identification.date``), else ``"date"``, when it states one."""
+    for d in ((doc.get("identification") or {}).get("date")
+              if isinstance(doc.get("identification"), dict) else None, doc.get("date")):
         if isinstance(d, str) and d:
             return d
     return None

@@ -74,6 +74,7 @@ def run_dict(ev: Evaluation, thermal=None, notes=(), inputs=None, tolerance=None
                                                    "travel_mm", "inputs", "notes")}
     out["uncertainty_budget"]["method"] = ("ISO/TR 230-9 (contributions in quadrature, k = 2) "
                                            "with the contributors of ISO 230-2:2014 Annex A")
+    out["budgets"] = b["budgets"]
     if tolerance:
         out["tolerance_um"] = dict(tolerance)
         out.update(verdicts(out, b["uncertainty_um"], tolerance))

@@ -91,7 +91,7 @@ def budget(ev, thermal, inputs: BudgetInputs) -> dict:
     for q in QUANTITIES:
         var = sum(v ** 2 for k, v in c.items() if q in _ACTS_ON[k]) + rep[q] ** 2
         U[q] = 2.0 * math.sqrt(var)
-    return {"contributions_um": {**{k: float(v) for k, v in c.items()},
+    return {"budgets": _budgets(c, rep, L, thermal, inputs),"contributions_um": {**{k: float(v) for k, v in c.items()},
                                  **{f"repeatability_{q}": float(v) for q, v in rep.items()}},
             "uncertainty_um": {q: float(v) for q, v in U.items()},
             "coverage_factor": 2, "travel_mm": L, "notes": notes,
@@ -99,6 +99,30 @@ def budget(ev, thermal, inputs: BudgetInputs) -> dict:
                        "alignment_mm": inputs.alignment_mm,
                        "temperature_u_K": inputs.temperature_u_K,
                        "cte_u_ppm_per_K": inputs.cte_u_ppm_per_K, "eve_um": inputs.eve_um}}
+
+
+def _budgets(c: dict, rep: dict, L: float, thermal, inputs: BudgetInputs) -> dict:
+    """Per quantity its GUM budget (:mod:`volerr.report.budget`): each contribution of
+    :func:`budget` as the source's standard uncertainty in its own unit times its
+    sensitivity (the same numbers, written as u(x_i) and c_i), U = 2 u_c."""
+    from ..report.budget import budget as gum, source
+
+    s = {"instrument": lambda: source("instrument (interferometer accuracy, rectangular)",
+                                      inputs.instrument_ppm / math.sqrt(3), "ppm", L * 1e-3),
+         "alignment": lambda: source("alignment (cosine error, rectangular)", c["alignment"],
+                                     "um"),
+         "temperature": lambda: source("material temperature reading", inputs.temperature_u_K,
+                                       "K", L * thermal.cte_ppm_per_K * 1e-3),
+         "cte": lambda: source("expansion coefficient", inputs.cte_u_ppm_per_K, "ppm/K",
+                               L * abs(thermal.temperature_C[1] - 20.0) * 1e-3),
+         "environment": lambda: source("environmental variation (EVE, rectangular)",
+                                       c["environment"], "um")}
+    out = {}
+    for q in QUANTITIES:
+        srcs = [s[k]() for k in c if q in _ACTS_ON[k]]
+        srcs.append(source("repeatability (from the run)", rep[q], "um"))
+        out[q] = gum(q, "um", srcs, k=2.0)
+    return out
 
 
 def verdicts(figures_um: dict, U: dict, tolerance_um: dict) -> dict:

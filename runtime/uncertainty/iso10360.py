@@ -219,6 +219,20 @@ class TestUncertainty:
         u_T = L * self.cte_ppm_per_K * self.temperature_u_K * 1e-3
         return 2.0 * np.sqrt(u_cal ** 2 + u_cte ** 2 + u_T ** 2)
 
+    def budget(self, length_mm: float) -> dict:
+        """The GUM budget of the test uncertainty at ``length_mm`` (the three terms of
+        :meth:`U_um` as sources: u(x_i) in its unit, sensitivity, contribution in um)."""
+        from ..report.budget import budget, source
+
+        L = float(length_mm)
+        return budget(f"E0 at L = {L:.1f} mm (test uncertainty)", "um", [
+            source("reference length calibration (U_cal / 2)",
+                   0.5 * (self.cal_A_um + L / self.cal_K), "um"),
+            source("expansion coefficient u(alpha)", self.cte_u_ppm_per_K, "ppm/K",
+                   L * abs(self.temperature_C - 20.0) * 1e-3),
+            source("temperature reading u(T)", self.temperature_u_K, "K",
+                   L * self.cte_ppm_per_K * 1e-3)], k=2.0)
+
     def text(self) -> str:
         return (f"U(L) = 2 \u221a((U_cal/2)\u00b2 + (L |T \u2212 20| u(\u03b1))\u00b2 + (L \u03b1 "
                 f"u(T))\u00b2), U_cal = {self.cal_A_um:g} + L/{self.cal_K:g} \u00b5m, \u03b1 = "
@@ -331,6 +345,7 @@ class TestResult:
         out["max_abs_E_um"] = float(np.max(np.abs(self.E_um)))
         out["uncertainty_um"] = {"E0": float(U.max())}
         out["test_uncertainty"] = self.uncertainty.as_dict()
+        out["budgets"] = {"E0": self.uncertainty.budget(float(self.lengths.flat[U.argmax()]))}
         if self.spec is not None:
             mpe = self.spec.mpe_um(self.lengths)[..., None]
             ratio = np.abs(self.E_um) / mpe

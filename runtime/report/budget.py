@@ -1,0 +1,35 @@
+"""The uncertainty budget of one reported quantity (GUM, JCGM 100:2008 5.1; ISO/TR 230-9:2005
+for machine tool tests): the sources, each with its standard uncertainty u(x_i) in its own
+unit, its sensitivity coefficient c_i (unit of the quantity per unit of the source) and its
+contribution u_i = |c_i| u(x_i) in the unit of the quantity; the combined standard
+uncertainty u_c = sqrt(sum u_i^2) (uncorrelated sources), the coverage factor k and the
+expanded uncertainty U = k u_c.
+
+The estimators build their budgets from the numbers they already hold (never retyped):
+:func:`budget` returns the JSON form every page and certificate prints,
+``{"quantity", "unit", "sources": [{"source", "u", "unit", "sensitivity", "contribution"}],
+"u", "k", "U"}``."""
+
+from __future__ import annotations
+
+import math
+
+
+def source(name: str, u: float, unit: str, sensitivity: float = 1.0) -> dict:
+    """One source: standard uncertainty ``u`` (in ``unit``), sensitivity coefficient
+    ``sensitivity`` (the quantity's unit per ``unit``); its contribution |c| u."""
+    return {"source": name, "u": float(u), "unit": unit, "sensitivity": float(sensitivity),
+            "contribution": abs(float(sensitivity)) * float(u)}
+
+
+def budget(quantity: str, unit: str, sources: list, k: float = 2.0) -> dict:
+    """The budget of ``quantity`` (in ``unit``) from its uncorrelated ``sources``
+    (:func:`source`): combined u = root sum of squares of the contributions, U = k u."""
+    u = math.sqrt(sum(s["contribution"] ** 2 for s in sources))
+    return {"quantity": quantity, "unit": unit, "sources": list(sources), "u": u,
+            "k": float(k), "U": float(k) * u}
+
+
+def combined(b: dict) -> float:
+    """The combined standard uncertainty of a budget recomputed from its contributions."""
+    return math.sqrt(sum(s["contribution"] ** 2 for s in b["sources"]))
