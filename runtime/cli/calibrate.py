@@ -6,9 +6,9 @@ from __future__ import annotations
 
 from ..errors import require
 from ..fileio import Outputs
-from ._common import (\     add_max_change, add_accept_residual, add_errors_out, add_force,
-                      add_html, add_identification_arguments, add_json, identification_from_args,
-                      write_certificates)
+from ._common import (add_accept_residual, add_errors_out, add_force, add_html,
+                      add_identification_arguments, add_json, add_max_change,
+                      identification_from_args, write_certificates)
 
 
 def register(sub) -> None:
