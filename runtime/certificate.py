@@ -62,27 +62,23 @@ TOP_KEYS = ("operator", "customer", "authorised_by", "date", "machine", "instrum
 
 
 def today() -> str:
-    """Today's date (UTC), YYYY-MM-DD."""
-    return datetime.datetime.now(datetime.timezone.utc).date().isoformat()
+    """Today's date (UTC), YYYY-MM-DD (:func:`volerr.units.today_utc`)."""
+    from .units import today_utc
+
+    return today_utc()
 
 
 def check_date(value, where: str, future: bool = False) -> str:
-    """``value`` (a :class:`datetime.date` or YYYY-MM-DD text) as YYYY-MM-DD; one-line
-    :class:`InputError` naming ``where`` when malformed, or after today unless ``future``."""
+    """``value`` (a :class:`datetime.date` or YYYY-MM-DD text) as YYYY-MM-DD
+    (:func:`volerr.units.parse_date`: one-line :class:`InputError` naming ``where`` when
+    malformed, or after today unless ``future``)."""
+    from .units import parse_date
+
     if isinstance(value, datetime.datetime):
         value = value.date()
-    if not isinstance(value, datetime.date):
-        text = str(value).strip()
-        try:
-            require(len(text) == 10, "")
-            value = datetime.date.fromisoformat(text)
-        except (ValueError, InputError):
-            raise InputError(f"{where} {str(value)!r}: expected a date YYYY-MM-DD "
-                             f"(e.g. 2026-11-30)") from None
-    iso = value.isoformat()
-    require(future or iso <= today(), f"{where} {iso}: a date after today ({today()} UTC); "
-                                      f"the date of a measurement cannot be in the future")
-    return iso
+    if isinstance(value, datetime.date):
+        value = value.isoformat()
+    return parse_date(value, where, future=future)
 
 
 @dataclass
@@ -105,6 +101,9 @@ class Identification:
     environment: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     test_conditions: dict = field(default_factory=dict)
+    #: whether the user stated any field (options or the identification file); a JSON
+    #: document is stamped only then, so a run without one writes the API's JSON unchanged
+    stated: bool = False
 
     def as_dict(self) -> dict:
         """The JSON form (``"date"``: the date of the measurement)."""
@@ -273,7 +272,7 @@ def build(given: dict, file=None, files=(), method: dict | None = None,
     method = dict(method or {})
     hashed = {"method": method, **{k: v for k, v in fields.items()}}
     ident = Identification(conditions=dict(conditions or {}), method=method,
-                           report_id=report_id(files, hashed), **fields)
+                           report_id=report_id(files, hashed), stated=bool(fields), **fields)
     for i, d in enumerate(ident.instruments):
         if d.get("due") and d["due"] < ident.date:
             ident.warnings.append(

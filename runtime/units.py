@@ -190,11 +190,12 @@ def today_utc() -> str:
     return _dt.datetime.now(_dt.timezone.utc).date().isoformat()
 
 
-def parse_date(text, where: str = "--date") -> str:
+def parse_date(text, where: str = "--date", future: bool = False) -> str:
     """``text`` as a date ``YYYY-MM-DD`` (exactly: ``2025-2-1``, ``01.02.2025`` refused) not
     after today (UTC: a measurement is not from the future); returns it as written.  One-line
     :class:`InputError`: ``"--date 2099-01-01 is in the future (today is ... UTC)"``,
-    ``"--date '2025-13-01': a date YYYY-MM-DD expected (year-month-day)"``."""
+    ``"--date '2025-13-01': a date YYYY-MM-DD expected (year-month-day)"``; ``future``:
+    a date after today is taken (a calibration's due date)."""
     import datetime as _dt
 
     t = str(text).strip()
@@ -206,7 +207,7 @@ def parse_date(text, where: str = "--date") -> str:
         raise InputError(f"{where} {str(text)!r}: a date YYYY-MM-DD expected "
                          f"(year-month-day, e.g. 2025-03-31)") from None
     now = today_utc()
-    if d.isoformat() > now:
+    if not future and d.isoformat() > now:
         raise InputError(f"{where} {t} is in the future (today is {now} UTC); a result is "
                          f"dated when it was measured")
     return d.isoformat()

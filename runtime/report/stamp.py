@@ -30,14 +30,15 @@ def figures_of(result) -> dict:
 
 
 def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
-    """Stamp ``--json`` and ``--html`` (when written) and write ``--pdf`` (when given)."""
+    """Stamp ``--json`` (when written and the user stated an identification, or the document
+    carries one of its own) and ``--html`` (when written); write ``--pdf`` (when given)."""
     from ..fileio import json_text, write_text
     from .page import stamp_html
 
     json_path, html_path = outs.path("--json"), outs.path("--html")
     if json_path is not None and Path(json_path).is_file():
         doc = json.loads(Path(json_path).read_text(encoding="utf-8"))
-        if isinstance(doc, dict):
+        if isinstance(doc, dict) and (ident.stated or "identification" in doc):
             doc["identification"] = ident.as_dict()
             write_text(json_path, json_text(doc), inputs=inputs)
     if html_path is not None and Path(html_path).is_file():
