@@ -27,7 +27,7 @@ from .machine.model import Model, load  # noqa: F401
 __version__ = "0.1.0"
 
 #: callable sub-packages: ``volerr.NAME(...)`` (``volerr/NAME/__init__.py`` makes itself callable)
-_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check")
+_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check", "demo")
 #: capability packages named as modules: ``volerr.history.add(...)``, ``volerr.history.show(...)``
 _MODULES = ("history",)
 #: API functions living in a capability package: name -> module
