@@ -15,6 +15,9 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="volerr-demo", help="output folder (default volerr-demo)")
     p.add_argument("--only", nargs="+", choices=SECTIONS, help="run only these sections")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="worker processes for the sections (default: one per core, at most "
+                        "2; 1: all in one process); the files do not depend on it")
     add_force(p)
     p.set_defaults(func=run)
 
@@ -22,5 +25,5 @@ def register(sub) -> None:
 def run(args) -> int:
     from ..demo import demo
 
-    print(demo(args.out, only=args.only, force=args.force).summary())
+    print(demo(args.out, only=args.only, force=args.force, jobs=args.jobs).summary())
     return 0

@@ -147,6 +147,7 @@ def plan(w) -> dict:
     import numpy as np
 
     from ..calibrate.run import calibrate
+    from ..machine.model import load
     from ..plan import comparison_png, execute, plan as make_plan
 
     rows, files, values = [], [], []
@@ -156,7 +157,7 @@ def plan(w) -> dict:
         result.write(folder, w.out / f"plan_{layout}.json", None, (), "iso")
         doc = result.to_dict()
         rng = np.random.default_rng(7)
-        model = w.model(layout)
+        model = load(layout)   # a fresh model: the executed readings as a new run has them
         for f in doc["files"]:
             execute(folder / f["file"], model, truth, rng)
         cal_result = calibrate(layout, [folder / f["file"] for f in doc["files"]])

@@ -21,9 +21,11 @@ def fiveaxis(w) -> dict:
     from ..fiveaxis.plots import plot_program_errors
 
     ex = write_example(w.out / "dmu50", "DMU50")
+    with open(ex["program"], encoding="latin-1", newline="") as f:
+        program = f.read()   # as written, line endings kept (the command streams it so)
     results = {}
     for strategy in ("full", "thesis"):
-        res = compensate("DMU50", ex["program"], ex["errors"], strategy=strategy)
+        res = compensate("DMU50", program, ex["errors"], strategy=strategy)
         results[strategy] = s = res.to_dict()
         w.later(f"dmu50/hemisphere_{strategy}.nc",
                 lambda p, t=res.text: p.write_bytes(t.encode("latin-1")))
@@ -94,7 +96,7 @@ def iso230_2(w) -> dict:
     w.text("iso230_2.json", json_text(res.data))
     png = res.png()
     w.later("iso230_2.png", lambda p: _write_bytes(p, png))
-    w.later("iso230_2.html", res.write_html)
+    w.later("iso230_2.html", lambda p: res.write_html(p, inputs=[run]))
     U = r["uncertainty_um"]
     return {"title": "ISO 230-2 evaluation of a simulated positioning run of X",
             "value": ", ".join(f"{q} {num(r[q + '_um'], '.2f')} \u00b1 {num(U[q], '.2f')}"
