@@ -101,6 +101,11 @@ def _in_parallel(todo: list, progress, jobs: int) -> list:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    from ..machine.model import load
+    from ..plotstyle import pyplot
+
+    pyplot()          # imported once here, before the fork, not once in every worker
+    load("MB1")
     order = sorted(todo, key=lambda n: BY_COST.index(n) if n in BY_COST else -1)
     ctx = multiprocessing.get_context("fork")
     with ProcessPoolExecutor(jobs, mp_context=ctx) as pool:
