@@ -31,7 +31,8 @@ from .machine.model import Model, load  # noqa: F401
 __version__ = "0.1.0"
 
 #: callable sub-packages: ``volerr.NAME(...)`` (``volerr/NAME/__init__.py`` makes itself callable)
-_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check", "history")
+_PACKAGES = ("calibrate", "plan", "loop", "identify", "uncertainty", "check", "history",
+             "demo")
 #: capability packages named as modules only (none left: ``volerr.history`` is callable as
 #: ``volerr.history.show``, and ``volerr.history.add`` / ``show`` stay)
 _MODULES = ()

@@ -59,45 +59,20 @@ def refuse_unused(args) -> None:
 
 def run(args) -> int:
     """Write the sphere or ballbar file of ``args`` (the options checked first)."""
-    import math
-    from pathlib import Path
-
     from ..fileio import Outputs, write_text
-    from ..instruments import simulated_files as sim
-    from ..machine.model import load
+    from ..instruments.simulated_files import instrument_file
     from ._common import layout_inputs
 
     for attr, default in DEVIATION_ONLY:
         require(getattr(args, attr) in (default, None) or getattr(args, attr) == default,
                 f"--{attr.replace('_', '-')} is for --instrument deviations")
     refuse_unused(args)
-    require(not (args.plant and args.errors), "give --plant or --errors, not both")
-    require(math.isfinite(args.noise_um) and 0 <= args.noise_um <= 1e3,
-            "--noise-um must be finite, between 0 and 1000 um")
-    model = load(args.layout)
     inputs = layout_inputs(args.layout) + ([args.errors] if args.errors else [])
-    if args.errors:
-        require(Path(args.errors).is_dir(), f"error directory not found: {args.errors}")
     outs = Outputs(inputs).file("--out", args.out).check()
-    if args.errors:
-        from ..tables.functions import ErrorFunctions
-
-        planted, funcs = None, ErrorFunctions.from_dir(args.errors, model)
-    else:
-        planted = (sim.parse_planted(args.plant, model) if args.plant is not None
-                   else sim.default_planted(model, args.instrument))
-        funcs = sim.planted_functions(model, planted)
-    if args.instrument == "sphere":
-        cols = sim.sphere_columns(model, funcs, steps=args.steps or 9, noise_um=args.noise_um,
-                                  seed=args.seed)
-    else:
-        cols = sim.ballbar_columns(model, funcs, args.radius, args.noise_um, args.seed)
-    text = sim.header_line(model, planted, args.errors) + sim.csv_text(cols)
+    text, line = instrument_file(args.layout, args.instrument, plant=args.plant,
+                                 errors=args.errors, steps=args.steps, radius=args.radius,
+                                 noise_um=args.noise_um, seed=args.seed)
     with outs:
         write_text(outs.path("--out"), text, inputs=inputs)
-    n = len(next(iter(cols.values())))
-    what = ", ".join(f"{k}={v:g}" for k, v in planted.items()) if planted is not None \
-        else f"the errors of {args.errors}"
-    print(f"{n} {args.instrument} readings of {model.name} ({what}; noise "
-          f"{args.noise_um:g} um) -> {args.out}")
+    print(f"{line} -> {args.out}")
     return 0

@@ -9,54 +9,6 @@ CSV ('volerr formats deviations').  See volerr.loop.simulate.
 from __future__ import annotations
 
 from ._common import add_vector
-from ..errors import require
-
-
-def _effect(text: str) -> dict:
-    """``kind[:key=value,...]`` -> effect dict (numbers where they parse)."""
-    kind, _, rest = text.partition(":")
-    out: dict = {"kind": kind.strip()}
-    for item in filter(None, (s.strip() for s in rest.split(","))):
-        key, eq, value = item.partition("=")
-        require(eq == "=", f"--effect {text!r}: write key=value pairs after the kind")
-        try:
-            out[key.strip()] = float(value)
-        except ValueError:
-            out[key.strip()] = value.strip()
-    return out
-
-
-#: keys of --effect that name something; every other key is a number
-_TEXT_KEYS = ("axis", "component", "direction", "sensor")
-
-
-def _check_effect(e: dict, model, text: str) -> dict:
-    """Every value of an --effect checked against the layout: one line for a bad one."""
-    import math
-
-    for key, v in e.items():
-        if key == "kind":
-            continue
-        if key == "axis":
-            require(v in model.axes, f"--effect {text!r}: axis {v!r} is not an axis of "
-                                     f"{model.name} ({' '.join(model.axes)})")
-        elif key == "component":
-            require(v in model.parameters, f"--effect {text!r}: component {v!r} is not an "
-                                           f"error of {model.name}")
-        elif key == "direction":
-            require(v in ("x", "y", "z"), f"--effect {text!r}: direction must be x, y or z")
-        elif key == "sensor":
-            require(isinstance(v, str), f"--effect {text!r}: sensor must be a sensor's name")
-        else:
-            require(isinstance(v, float), f"--effect {text!r}: {key} = {v!r} is not a number")
-            require(math.isfinite(v) and abs(v) <= 1e6,
-                    f"--effect {text!r}: {key} = {v:g} must be a finite number of at most 1e6")
-            if key == "degree":
-                require(v == int(v) and 1 <= v <= 30,
-                        f"--effect {text!r}: degree must be an integer 1..30")
-            if key == "period_mm":
-                require(v > 0, f"--effect {text!r}: period_mm must be positive")
-    return e
 
 
 def register(sub) -> None:
@@ -110,30 +62,18 @@ def run(args) -> int:
     if getattr(args, "instrument", "deviations") != "deviations":
         return _simulate_instruments.run(args)
     _simulate_instruments.refuse_unused(args)
-    from ..machine.model import load
-    from ..loop.simulate import demo_probes, simulate
-
-    require(10 <= args.points <= 10_000_000, "--points must be between 10 and 10^7")
-    import math
-
-    require(all(math.isfinite(v) and 0 <= v <= 1e6 for v in (args.noise_um, args.magnitude_um)),
-            "--noise-um and --magnitude-um must be finite, between 0 and 1e6 um")
     from ._common import layout_inputs
     from ..fileio import Outputs
+    from ..loop.simulate import check_options, simulate_options
 
-    model = load(args.layout)
+    check_options(args.points, args.noise_um, args.magnitude_um)
     inputs = layout_inputs(args.layout)
     outs = Outputs(inputs).file("--out", args.out).check()
-    effects = [_check_effect(_effect(e), model, e) for e in args.effect]
-    probes = [tuple(v) for v in args.probe] if args.probe else demo_probes(model)
-    require(math.isfinite(args.hours) and 0.1 <= args.hours <= 1000,
-            "--hours must be between 0.1 and 1000")
-    require(args.duty is None or args.sensors, "--duty needs --sensors")
-    camp = simulate(args.layout, n_points=args.points, seed=args.seed, probes=probes,
-                    rounds=args.rounds, effects=effects,
-                    noise_um=args.noise_um, magnitude_um=args.magnitude_um,
-                    duration_h=args.hours, sensors=args.sensors, duty=args.duty)
+    camp, name = simulate_options(args.layout, points=args.points, seed=args.seed,
+                                  probes=args.probe, rounds=args.rounds, effects=args.effect,
+                                  noise_um=args.noise_um, magnitude_um=args.magnitude_um,
+                                  hours=args.hours, sensors=args.sensors, duty=args.duty)
     with outs:
         camp.write_csv(outs.path("--out"), inputs=inputs)
-    print(f"{camp.n_points} points of {model.name} -> {args.out}")
+    print(f"{camp.n_points} points of {name} -> {args.out}")
     return 0

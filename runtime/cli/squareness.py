@@ -12,7 +12,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import require
-from ..units import URAD_PER_RAD
 from ._common import add_errors_out, add_force, add_json
 
 
@@ -34,43 +33,21 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ._common import layout_inputs
-    from ..fileio import Outputs, json_text, write_text
-    from ..machine.layout import read_layout
-    from ..cmm.squareness import squareness
-    from ..tables.table import read_error_dir, table_to_csv, write_constants
+    from ..cmm.api import squareness
+    from ..fileio import Outputs
 
-    layout = read_layout(args.layout)
     src, out = Path(args.directory), Path(args.errors_out)
-    require(src.exists(), f"error directory {src} does not exist")
-    require(src.is_dir(), f"{src} is a file: give the error directory (X.csv, Y.csv ...)")
     require(not (out.exists() and out.resolve() == src.resolve()),
             "--errors-out must differ from the input directory (inputs are never overwritten)")
-    tables, (consts, cstd, _) = read_error_dir(src, axes=layout.axis_names)
-    require(tables, f"{src}: no error tables")
-    values, std, corrected, slopes = squareness(tables, layout, args.tables_are)
-    require(values, f"{src}: no pair of straightness tables for a squareness (EC0Y needs EYX "
-                    f"in X.csv and EXY in Y.csv, EB0Z EZX and EXZ, EA0Z EZY and EYZ)")
+    res = squareness(args.layout, src, tables_are=args.tables_are)
     inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
-    texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
     outs = Outputs(inputs, force=args.force) \
-        .folder("--errors-out", out, files=[*texts, "constants.csv"]) \
+        .folder("--errors-out", out, files=[*res.texts, "constants.csv"]) \
         .file("--json", args.json).check()
-    merged = {k: v for k, v in consts.items() if k not in values}
-    merged_std = {k: v for k, v in cstd.items() if k in merged}
-    merged.update(values)
-    merged_std.update(std)
     with outs:
-        staged = outs.path("--errors-out")
-        for name, text in texts.items():
-            write_text(staged / name, text, inputs=inputs)
-        write_constants(staged / "constants.csv", merged, inputs=inputs, std=merged_std)
+        res.write_dir(outs.path("--errors-out"), inputs)
         if args.json:
-            doc = {"squareness_urad": {k: v * URAD_PER_RAD for k, v in values.items()},
-                   "u_urad": {k: v * URAD_PER_RAD for k, v in std.items()},
-                   "slopes_urad": {k: v * URAD_PER_RAD for k, v in slopes.items()},
-                   "tables_are": args.tables_are}
-            write_text(outs.path("--json"), json_text(doc), inputs=inputs)
-    for sq, v in values.items():
-        print(f"{sq} = {v * URAD_PER_RAD:.3f} urad (u = {std[sq] * URAD_PER_RAD:.3f} urad)")
+            res.write_json(outs.path("--json"), inputs)
+    print(res.summary())
     print(f"-> {out}")
     return 0

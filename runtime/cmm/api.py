@@ -178,3 +178,96 @@ def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
            "errors": (funcs.source or "") if errors is funcs else str(errors), "method": method,
            "lines": [r.as_dict() for r in results]}
     return Diagonals(doc, results)
+
+
+@dataclass(repr=False)
+class Squareness(ResultMixin):
+    """Result of :func:`squareness`: ``data`` the ``--json`` document (squareness, its standard
+    uncertainty (k = 1) and the straightness slopes, urad; sign convention
+    :mod:`volerr.cmm.squareness`), ``values`` / ``std`` the squareness in rad, ``texts`` the
+    slope-free tables as CSV text by file name, ``constants`` / ``constants_std`` (rad, mm) the
+    constants to write: those of the input directory with the squareness replaced."""
+
+    data: dict
+    values: dict
+    std: dict
+    texts: dict
+    constants: dict
+    constants_std: dict
+
+    def summary(self) -> str:
+        """What ``volerr squareness`` prints (without the line naming the written folder)."""
+        from ..units import URAD_PER_RAD
+
+        return "\n".join(f"{sq} = {v * URAD_PER_RAD:.3f} urad (u = "
+                         f"{self.std[sq] * URAD_PER_RAD:.3f} urad)"
+                         for sq, v in self.values.items())
+
+    def write_dir(self, folder, inputs=()) -> None:
+        """The slope-free tables and ``constants.csv`` into ``folder`` (``--errors-out``)."""
+        from pathlib import Path
+
+        from ..fileio import write_text
+        from ..tables.table import write_constants
+
+        folder = Path(folder)
+        for name, text in self.texts.items():
+            write_text(folder / name, text, inputs=list(inputs))
+        write_constants(folder / "constants.csv", self.constants, inputs=list(inputs),
+                        std=self.constants_std)
+
+    def _rows(self) -> list:
+        from ..results import Row
+
+        return [Row(k, v, self.data["u_urad"][k], "urad", 1)
+                for k, v in self.data["squareness_urad"].items()]
+
+
+def squareness(layout, directory, *, tables_are: str = "carrier") -> Squareness:
+    """Squareness of the linear axes from the reference straight lines of the straightness
+    tables of ``directory`` (``volerr squareness``).
+
+    Parameters
+    ----------
+    layout : str or path
+        Layout name or file.
+    directory : path
+        Error directory with the straightness tables (``X.csv`` ..., e.g. written by
+        ``volerr identify``).
+    tables_are : {"carrier", "component"}
+        carrier: motions of the component carrying the points (as ``volerr identify``
+        writes them); component: ISO component errors (tool relative to workpiece).
+
+    Returns
+    -------
+    Squareness
+        ``EC0Y EB0Z EA0Z`` (those whose two straightness tables exist), rad, with the tables
+        with the slopes removed.
+    """
+    from pathlib import Path
+
+    from ..errors import require
+    from ..machine.layout import read_layout
+    from ..tables.table import read_error_dir, table_to_csv
+    from ..units import URAD_PER_RAD
+    from .squareness import squareness as fit
+
+    lay = read_layout(layout)
+    src = Path(directory)
+    require(src.exists(), f"error directory {src} does not exist")
+    require(src.is_dir(), f"{src} is a file: give the error directory (X.csv, Y.csv ...)")
+    tables, (consts, cstd, _) = read_error_dir(src, axes=lay.axis_names)
+    require(tables, f"{src}: no error tables")
+    values, std, corrected, slopes = fit(tables, lay, tables_are)
+    require(values, f"{src}: no pair of straightness tables for a squareness (EC0Y needs EYX "
+                    f"in X.csv and EXY in Y.csv, EB0Z EZX and EXZ, EA0Z EZY and EYZ)")
+    merged = {k: v for k, v in consts.items() if k not in values}
+    merged_std = {k: v for k, v in cstd.items() if k in merged}
+    merged.update(values)
+    merged_std.update(std)
+    doc = {"squareness_urad": {k: v * URAD_PER_RAD for k, v in values.items()},
+           "u_urad": {k: v * URAD_PER_RAD for k, v in std.items()},
+           "slopes_urad": {k: v * URAD_PER_RAD for k, v in slopes.items()},
+           "tables_are": tables_are}
+    texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
+    return Squareness(doc, values, std, texts, merged, merged_std)

@@ -187,3 +187,44 @@ def csv_text(cols: dict) -> str:
             num(cols[k][i], ".5f" if k.endswith("_um") else ".0f" if k == "direction"
                 else ".6f") for k in names))
     return "\n".join(lines) + "\n"
+
+
+def instrument_file(layout, instrument: str, *, plant: str | None = None, errors=None,
+                    steps: int | None = None, radius: float | None = None,
+                    noise_um: float = 0.3, seed: int = 0) -> tuple[str, str]:
+    """``volerr simulate --instrument sphere|ballbar``: the file's text and the line the
+    command prints (without its ``-> FILE`` tail).
+
+    ``plant``: the planted errors as ``NAME=V,...`` in the units calibrate reports (um, urad,
+    um/mm; default :func:`default_planted`); ``errors``: an error directory planted instead;
+    ``steps``: sphere positions per rotary axis (default 9); ``radius``: ballbar circle
+    radius, mm; ``noise_um``: reading noise (1 sigma); ``seed`` of the noise.
+    """
+    import math
+    from pathlib import Path
+
+    from ..machine.model import Model, load
+
+    require(not (plant and errors), "give --plant or --errors, not both")
+    require(math.isfinite(noise_um) and 0 <= noise_um <= 1e3,
+            "--noise-um must be finite, between 0 and 1000 um")
+    model = layout if isinstance(layout, Model) else load(layout)
+    if errors:
+        require(Path(errors).is_dir(), f"error directory not found: {errors}")
+        from ..tables.functions import ErrorFunctions
+
+        planted, funcs = None, ErrorFunctions.from_dir(errors, model)
+    else:
+        planted = (parse_planted(plant, model) if plant is not None
+                   else default_planted(model, instrument))
+        funcs = planted_functions(model, planted)
+    if instrument == "sphere":
+        cols = sphere_columns(model, funcs, steps=steps or 9, noise_um=noise_um, seed=seed)
+    else:
+        cols = ballbar_columns(model, funcs, radius, noise_um, seed)
+    text = header_line(model, planted, errors) + csv_text(cols)
+    n = len(next(iter(cols.values())))
+    what = ", ".join(f"{k}={v:g}" for k, v in planted.items()) if planted is not None \
+        else f"the errors of {errors}"
+    return text, (f"{n} {instrument} readings of {model.name} ({what}; noise "
+                  f"{noise_um:g} um)")

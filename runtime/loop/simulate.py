@@ -311,3 +311,77 @@ def demo_probes(model: Model) -> list:
         return [(0.0, 0.0, 100.0), (0.0, 0.0, 200.0), (30.0, 0.0, 150.0), (0.0, 30.0, 150.0)]
     return [(0.0, 0.0, -100.0), (80.0, 0.0, -150.0), (-80.0, 0.0, -150.0),
             (0.0, 80.0, -150.0), (0.0, -80.0, -150.0)]
+
+
+def parse_effect(text: str) -> dict:
+    """``kind[:key=value,...]`` (``volerr simulate --effect``) -> effect dict (numbers where
+    they parse)."""
+    kind, _, rest = text.partition(":")
+    out: dict = {"kind": kind.strip()}
+    for item in filter(None, (s.strip() for s in rest.split(","))):
+        key, eq, value = item.partition("=")
+        require(eq == "=", f"--effect {text!r}: write key=value pairs after the kind")
+        try:
+            out[key.strip()] = float(value)
+        except ValueError:
+            out[key.strip()] = value.strip()
+    return out
+
+
+def check_effect(e: dict, model: Model, text: str) -> dict:
+    """Every value of an ``--effect`` checked against the layout: one line for a bad one."""
+    import math
+
+    for key, v in e.items():
+        if key == "kind":
+            continue
+        if key == "axis":
+            require(v in model.axes, f"--effect {text!r}: axis {v!r} is not an axis of "
+                                     f"{model.name} ({' '.join(model.axes)})")
+        elif key == "component":
+            require(v in model.parameters, f"--effect {text!r}: component {v!r} is not an "
+                                           f"error of {model.name}")
+        elif key == "direction":
+            require(v in ("x", "y", "z"), f"--effect {text!r}: direction must be x, y or z")
+        elif key == "sensor":
+            require(isinstance(v, str), f"--effect {text!r}: sensor must be a sensor's name")
+        else:
+            require(isinstance(v, float), f"--effect {text!r}: {key} = {v!r} is not a number")
+            require(math.isfinite(v) and abs(v) <= 1e6,
+                    f"--effect {text!r}: {key} = {v:g} must be a finite number of at most 1e6")
+            if key == "degree":
+                require(v == int(v) and 1 <= v <= 30,
+                        f"--effect {text!r}: degree must be an integer 1..30")
+            if key == "period_mm":
+                require(v > 0, f"--effect {text!r}: period_mm must be positive")
+    return e
+
+
+def check_options(points: int, noise_um: float, magnitude_um: float) -> None:
+    """The numbers of ``volerr simulate`` checked before any computing."""
+    import math
+
+    require(10 <= points <= 10_000_000, "--points must be between 10 and 10^7")
+    require(all(math.isfinite(v) and 0 <= v <= 1e6 for v in (noise_um, magnitude_um)),
+            "--noise-um and --magnitude-um must be finite, between 0 and 1e6 um")
+
+
+def simulate_options(layout, *, points: int = 600, seed: int = 0, probes=None,
+                     rounds: int = 1, effects=(), noise_um: float = 0.3,
+                     magnitude_um: float = 5.0, hours: float = 8.0, sensors=None, duty=None):
+    """``volerr simulate`` (the deviations campaign) from its options: every option checked
+    (``effects`` as the ``--effect`` texts ``kind:key=value,...``; ``probes`` mm, default
+    :func:`demo_probes`), then :func:`simulate`.  Returns the :class:`Campaign` and the
+    machine's name."""
+    import math
+
+    check_options(points, noise_um, magnitude_um)
+    model = layout if isinstance(layout, Model) else load(layout)
+    found = [check_effect(parse_effect(e), model, e) for e in effects]
+    probes = [tuple(v) for v in probes] if probes else demo_probes(model)
+    require(math.isfinite(hours) and 0.1 <= hours <= 1000,
+            "--hours must be between 0.1 and 1000")
+    require(duty is None or sensors, "--duty needs --sensors")
+    return simulate(layout, n_points=points, seed=seed, probes=probes, rounds=rounds,
+                    effects=found, noise_um=noise_um, magnitude_um=magnitude_um,
+                    duration_h=hours, sensors=sensors, duty=duty), model.name

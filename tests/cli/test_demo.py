@@ -80,7 +80,9 @@ def _run_demo(tmp_path_factory):
     out = tmp_path_factory.mktemp("demo") / "demo"
     matplotlib.figure.Figure.savefig = savefig
     try:
-        assert main(["demo", "--out", str(out)]) == 0
+        # one process: the wrapped savefig sees every figure (worker processes would keep
+        # their records to themselves)
+        assert main(["demo", "--out", str(out), "--jobs", "1"]) == 0
     finally:
         matplotlib.figure.Figure.savefig = original
     return out, records
@@ -217,3 +219,46 @@ def test_demo_refuses_to_write_over_a_file(tmp_path):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
     assert target.read_text() == "keep"
+
+
+#: cheap sections for the checks of the API and of the worker processes (a few seconds)
+QUICK = ["probe", "iso230_2"]
+
+
+def _files(folder: Path) -> dict:
+    """Every file's bytes, the wall times ('seconds' and the index's '[1.2 s]') blanked."""
+    out = {}
+    for f in sorted(folder.rglob("*")):
+        if f.is_file():
+            data = f.read_bytes()
+            data = re.sub(rb'"seconds": [0-9.]+', b'"seconds": T', data)
+            out[str(f.relative_to(folder))] = re.sub(rb"\[[0-9.]+ s\]", b"[T s]", data)
+    return out
+
+
+def test_api_result_is_what_the_command_prints(tmp_path, capsys):
+    """volerr.demo returns a result whose summary() is the console text of 'volerr demo',
+    and the worker processes write the same files as one process."""
+    import volerr
+    from volerr.cli import main
+
+    res = volerr.demo(out=tmp_path / "api", only=QUICK, jobs=1)
+    assert [r["section"] for r in res.data] == QUICK
+    lines = res.summary().splitlines()
+    assert len(lines) == len(QUICK) + 1 and lines[-1].startswith("report: ")
+    assert "R_eff 0.99" in lines[0] and "verdict against" in lines[1]
+    assert len(repr(res).splitlines()) == 1
+    capsys.readouterr()
+    assert main(["demo", "--out", str(tmp_path / "cli"), "--only", *QUICK, "--jobs", "2"]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    strip = re.compile(r"\[[0-9.]+ s\]$|\([0-9]+ s\)$")
+    assert [strip.sub("", x) for x in printed[:-1]] == [strip.sub("", x) for x in lines[:-1]]
+    assert _files(tmp_path / "api") == _files(tmp_path / "cli")
+
+
+def test_only_names_a_section(tmp_path):
+    import volerr
+
+    with pytest.raises(volerr.InputError, match="not a section"):
+        volerr.demo(out=tmp_path / "x", only=["probe", "nothing"])
+    assert not (tmp_path / "x").exists()

@@ -95,12 +95,12 @@ def test_iso230_2_mm_header_with_mm_values_accepted(tmp_path, capsys):
 # ---------------------------------------------------------------------------------------------
 # demo: the folder is checked before any computing
 def test_demo_refuses_a_used_folder_before_computing(tmp_path, capsys, monkeypatch):
-    import volerr.cli.demo as demo
+    import volerr.demo.cmm_sections as demo
 
     def never(*a, **k):
         raise AssertionError("the demo computed before refusing its folder")
 
-    monkeypatch.setattr(demo, "_cmm", never)
+    monkeypatch.setattr(demo, "cmm", never)
     (tmp_path / "D").mkdir()
     (tmp_path / "D" / "index.html").write_text("earlier run")
     one_line_error(capsys, main(["demo", "--out", str(tmp_path / "D"), "--only", "cmm_a"]),

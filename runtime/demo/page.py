@@ -1,0 +1,63 @@
+"""The demo's ``index.html``: a section per step with its figures, captions, the headline
+and links to every report page and file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..fileio import write_text
+from .text import ABOUT, CAPTIONS
+
+
+def index_html(out: Path, results: list) -> None:
+    """index.html: a section per step with its figures (each shown at its own pixel width,
+    :func:`volerr.plotstyle.img_tag`), captions, the result line, a link to every report page
+    (HTML) the step wrote and to every file."""
+    from html import escape
+
+    from ..plotstyle import img_tag, png_size
+
+    parts = []
+    toc = []
+    pages = []
+    for i, r in enumerate(results, start=1):
+        sid = f"s{i}"
+        toc.append(f'<li><a href="#{sid}">{escape(r["title"])}</a></li>')
+        files = " ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in r["files"])
+        reports = [f for f in r["files"] if f.endswith(".html")]
+        pages += reports
+        figs = []
+        for f in r["files"]:
+            if f.endswith(".png"):
+                cap = CAPTIONS.get(f, f)
+                width = png_size((out / f).read_bytes()[:32])[0]
+                figs.append(f'<figure>{img_tag(f, cap, width=width, link=f)}'
+                            f'<figcaption>{escape(cap)} <span class="file">({escape(f)})'
+                            f'</span></figcaption></figure>')
+        report_links = (f'<p class="pages">Report page{"s" if len(reports) > 1 else ""}: '
+                        + " ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in reports)
+                        + "</p>") if reports else ""
+        parts.append(
+            f'<section id="{sid}"><h2>{i}. {escape(r["title"])}</h2>'
+            f'<p>{escape(ABOUT.get(r.get("section", ""), ""))}</p>'
+            f'<p class="result"><strong>Result:</strong> {escape(r["value"])} '
+            f'<span class="file">[{r.get("seconds", 0)} s]</span></p>'
+            + report_links + "".join(figs) + f'<p class="files">Files: {files}</p></section>')
+    page_list = ", ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in pages)
+    html = ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+            "<title>volerr demo</title><style>"
+            "body{font-family:system-ui,sans-serif;font-size:17px;line-height:1.5;"
+            "max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
+            "h1{font-size:1.9em}h2{font-size:1.35em;border-bottom:2px solid #ddd;"
+            "padding-bottom:.2em;margin-top:2em}"
+            "figure{margin:1.2em 0}img{max-width:100%;height:auto;border:1px solid #eee}"
+            "figcaption{font-size:.95em;color:#444}.file{color:#777;font-size:.9em}"
+            ".result{background:#f5f7fa;padding:.6em .9em;border-left:4px solid #4a7}"
+            ".files a{margin-right:.8em}</style></head><body>"
+            "<h1>volerr demo</h1><p>Every step below ran a real <code>volerr</code> command "
+            "on built-in data; units µm and µrad unless stated.  Click a figure for full "
+            "size; the files next to this page hold every number.  Report pages: "
+            f"{page_list}.</p>"
+            f"<ol>{''.join(toc)}</ol>{''.join(parts)}</body></html>\n")
+    write_text(out / "index.html", html)
