@@ -229,6 +229,13 @@ def test_sphere_c_counted_from_zero_to_360_passes(ex, tmp_path, capsys):
     accepted(capsys, ["calibrate", "DMU50", f, "--json", tmp_path / "s.json"], [tmp_path / "s.json"])
 
 
+def test_sphere_file_given_to_another_five_axis_layout(ex, tmp_path, capsys):
+    """The DMU50's file (B/C table) given to a machine with a tilting A / rotary C table."""
+    f = shutil.copy(ex / SPHERE, tmp_path / "sph.csv")
+    refused(capsys, cal_argv("TT_AC", [f], tmp_path), outs_cal(tmp_path), "sph.csv",
+            ("A", "B", "C"), ("layout", "TT_AC", "DMU50", "rotary", "axis", "column"))
+
+
 # ---------------------------------------------------------------------------------------------
 # tracking interferometer / multilateration distances (calibrate DMU50)
 MULTI = "multilateration_DMU50.csv"
@@ -335,6 +342,13 @@ def test_ballbar_set_calibrated_with_one_trace_in_nm(ex, tmp_path, capsys):
             ("dr_um",), ("nm", "unit"))
 
 
+def test_ballbar_cmm_file_evaluated_on_the_dmu50(ex, tmp_path, capsys):
+    """MB1's circle about X 450 mm given with --layout DMU50 (X travel about +-250 mm)."""
+    f = shutil.copy(ex / BALLBAR, tmp_path / "bb.csv")
+    refused(capsys, bb_argv(f, tmp_path, "--layout", "DMU50"), bb_outs(tmp_path), "bb.csv",
+            ("X", "Y", "Z"), ("travel", "layout", "DMU50"))
+
+
 # ---------------------------------------------------------------------------------------------
 # ball plate / artifact (calibrate MB1)
 PLATE = "ballplate_MB1.csv"
@@ -436,6 +450,22 @@ def test_tracker_rows_duplicated(ex, tmp_path, capsys):
                lambda d: pd.concat([d, d[d["round"] == 1]], ignore_index=True))
     refused(capsys, id_argv(f, tmp_path), id_outs(tmp_path), f.name, ("round", "point", "position"),
             ("duplicate", "twice", "more than once"))
+
+
+@xfail("NOT refused: exit 0, id_errors/X.csv, id.json, id.png written ('condition 1.53, residual RMS 3 um'): MB1's X positions 0 .. 650 mm accepted as DMU50 X positions, no travel check in identify")
+def test_tracker_file_given_to_another_machine(ex, tmp_path, capsys):
+    """MB1's X-axis file (positions 0 .. 650 mm) identified on the DMU50."""
+    f = shutil.copy(ex / TRACKER, tmp_path / "tr.csv")
+    refused(capsys, id_argv(f, tmp_path, layout="DMU50"), id_outs(tmp_path), "tr.csv",
+            ("position", "X"), ("travel", "layout", "DMU50"))
+
+
+@xfail("NOT refused: exit 0, id_errors/X.csv, id.json, id.png written ('11 positions x 3 points x 4 round(s), method lsq, condition 1.41, residual RMS 2.7 um'): an exactly constant z column (the three points flattened into one plane) is not noticed")
+def test_tracker_z_column_lost(ex, tmp_path, capsys):
+    """A 2-D export: every z reads 0."""
+    f = mutate(ex / TRACKER, tmp_path / "tr_z0.csv", lambda d: d.assign(z=0.0))
+    refused(capsys, id_argv(f, tmp_path), id_outs(tmp_path), f.name, ("z",),
+            ("constant", "zero", "0"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -592,6 +622,14 @@ def test_positioning_a_reading_duplicated(ex, tmp_path, capsys):
                lambda d: pd.concat([d, d.iloc[[5]]], ignore_index=True))
     refused(capsys, pos_argv(f, tmp_path), pos_outs(tmp_path), f.name,
             ("cycle", "direction", "target"), ("twice", "duplicate", "once", "more than"))
+
+
+@xfail("NOT refused: exit 0, pos.json, pos_tables/, pos.html written: a certificate 'A 0.00 (U 0.46) E 0.00 ... R 0.00 (U 0.00)' from a run whose every deviation is exactly 0")
+def test_positioning_deviation_column_all_zero(ex, tmp_path, capsys):
+    """The interferometer recorded nothing: every deviation 0 (no repeatability is exactly 0)."""
+    f = mutate(ex / RUN, tmp_path / "run_zero.csv", lambda d: d.assign(deviation_um=0.0))
+    refused(capsys, pos_argv(f, tmp_path), pos_outs(tmp_path), f.name, ("deviation_um",),
+            ("constant", "zero", "all 0"))
 
 
 def test_positioning_date_in_the_future(ex, tmp_path, capsys):
