@@ -938,6 +938,81 @@ def test_history_add_dated_in_the_future(reference, tmp_path, capsys):
                      reference], [db], "--date", (), ("future", "after today", "today"))
 
 
+def test_check_with_rotary_axes_in_radians(ex, reference, tmp_path, capsys):
+    """The interim check's sphere file exported in radians: the geometry check must hold in
+    check as in calibrate."""
+    f = mutate(ex / SPHERE, tmp_path / "chk_rad.csv", scale(("B", "C"), RAD))
+    out = tmp_path / "check.json"
+    refused(capsys, ["check", "DMU50", "--reference", reference, f, "--json", out], [out],
+            f.name, ("B", "C"), ("radian",))
+
+
+def test_check_with_a_file_of_another_machine(ex, reference, tmp_path, capsys):
+    f = shutil.copy(ex / BALLBAR, tmp_path / "chk_bb.csv")
+    out = tmp_path / "check.json"
+    refused(capsys, ["check", "DMU50", "--reference", reference, f, "--json", out], [out],
+            "chk_bb.csv", ("X", "Y", "Z", "pivot"), ("travel", "layout", "DMU50", "MB1"))
+
+
+def test_loop_with_a_sphere_file_in_radians(ex, tmp_path, capsys):
+    f = mutate(ex / SPHERE, tmp_path / "lp_rad.csv", scale(("B", "C"), RAD))
+    refused(capsys, lp_argv(f, tmp_path, layout="DMU50"), lp_outs(tmp_path), f.name, ("B", "C"),
+            ("radian",))
+
+
+@xfail("NOT refused: exit 0, comp.nc written; 'tool: offset (0, 0, 85) mm in the tool frame "
+       "(--tool)' -- a positive tool offset (tip inside the spindle, against the documented 0 0 "
+       "-L) is used without a word")
+def test_compensate_tool_offset_with_the_wrong_sign(ex, tmp_path, capsys):
+    """--tool 0 0 85 for an 85 mm tool: the documented offset is 0 0 -L (the tip below the
+    spindle nose); +85 puts the tip inside the spindle."""
+    out = tmp_path / "comp.nc"
+    refused(capsys, ["compensate", "DMU50", "--errors", ex / "dmu50" / "errors",
+                     ex / "dmu50" / "hemisphere.nc", "--out", out, "--tool", "0", "0", "85"],
+            [out], "--tool", (), ("sign", "-85", "0 0 -L", "negative"))
+
+
+@xfail("NOT refused: exit 0, pos.json, pos_tables/, pos.html written; 'A 444.01 (U 76.90) E "
+       "443.21 M 440.67' um -- a 48 K expansion correction from a material temperature of 68 "
+       "(degF) read as degC")
+def test_positioning_material_temperature_in_fahrenheit(ex, tmp_path, capsys):
+    f = shutil.copy(ex / RUN, tmp_path / "run.csv")
+    refused(capsys, pos_argv(f, tmp_path, "--cte-ppm-per-K", "11.5", "--material-temp-C", "68"),
+            pos_outs(tmp_path), "--material-temp-C", (), ("fahrenheit", "°F", "degF", "implausible"))
+
+
+@xfail("NOT refused: exit 0, outputs written; cte 11.5e-6 ppm/K used as given (a correction of "
+       "~0), 'A 9.41 (U 4.94)' -- a coefficient far below any material's is not questioned")
+def test_positioning_expansion_coefficient_in_per_kelvin(ex, tmp_path, capsys):
+    """11.5e-6 (1/K) typed where ppm/K is asked: a correction a million times too small."""
+    f = shutil.copy(ex / RUN, tmp_path / "run.csv")
+    refused(capsys, pos_argv(f, tmp_path, "--cte-ppm-per-K", "11.5e-6", "--material-temp-C",
+                             "23"), pos_outs(tmp_path), "--cte-ppm-per-K", (),
+            ("ppm", "1/K", "unit"))
+
+
+@xfail("NOT refused: exit 0, u.json written; a 400 mm distance reported as '426.769144 mm, 95 % "
+       "[-1257.6, 2328.7] mm, bias +4600000.221 um, U 1920904.188 um' from --part-cte 11.5 "
+       "(ppm/K typed for 1/K)")
+def test_uncertainty_part_expansion_in_ppm(ex, tmp_path, capsys):
+    """--part-cte 11.5 1 (ppm/K typed where 1/K is asked): a part growing 1150 % per kelvin."""
+    out = tmp_path / "u.json"
+    refused(capsys, ["uncertainty", "MB1", "--task", ex / "task_distance.csv", "--evaluate",
+                     "distance", "--errors", ex / "errors_MB1", "--samples", "200", "--quiet",
+                     "--part-cte", "11.5", "1", "--part-dt", "1", "0.2", "--json", out], [out],
+            "--part-cte", (), ("ppm", "1/K", "unit", "1e-6"))
+
+
+@xfail("NOT refused: exit 0, id_errors/X.csv, id.json, id.png written ('residual RMS 3.18 um'); "
+       "a tracker at (1.5, -2, 0.3) mm, among the measured points, accepted for the uncertainty "
+       "model")
+def test_identify_tracker_position_in_metres(ex, tmp_path, capsys):
+    """--tracker 1.5 -2 0.3 (m): the tracker 2 mm from the measured points, inside the axis."""
+    f = shutil.copy(ex / TRACKER, tmp_path / "tr.csv")
+    refused(capsys, id_argv(f, tmp_path) + ["--tracker", "1.5", "-2", "0.3"], id_outs(tmp_path),
+            "--tracker", (), ("m", "unit", "metre", "close"))
+
+
 # ---------------------------------------------------------------------------------------------
 # false alarms: correct files must pass
 
