@@ -108,10 +108,12 @@ def refused(capsys, argv, outputs, name, columns=(), causes=()):
     assert not written, report
     line = lines[0]
     assert _mentions(line, name), f"does not name {name!r}: {line}"
+    # a list of the causes ruled out names none of them as the likely one
+    judged = re.sub(r"no usual mistake \([^)]*\) explains it", "", line)
     if columns:
-        assert any(_mentions(line, c) for c in columns), f"names none of {columns}: {line}"
+        assert any(_mentions(judged, c) for c in columns), f"names none of {columns}: {line}"
     if causes:
-        assert any(_mentions(line, c) for c in causes), f"names none of the causes {causes}: {line}"
+        assert any(_mentions(judged, c) for c in causes), f"names none of the causes {causes}: {line}"
     return line
 
 
@@ -182,7 +184,7 @@ def test_sphere_one_placement_centre_off_by_an_inch(ex, tmp_path, capsys):
         return d
     f = mutate(ex / SPHERE, tmp_path / "sph_p2.csv", fn)
     refused(capsys, cal_argv("DMU50", [f], tmp_path), outs_cal(tmp_path), f.name,
-            ("sphere_x", "sphere"), ("placement", "inch", "centre", "center"))
+            ("sphere_x", "sphere"), ("inch", "25.4"))
 
 
 @xfail("refused (exit 2, nothing written) but the line names no column (dx_um/dy_um/dz_um) and "
@@ -194,6 +196,10 @@ def test_sphere_deviations_in_nm(ex, tmp_path, capsys):
             ("dx_um", "dy_um", "dz_um"), ("nm", "unit"))
 
 
+@xfail("refused (exit 2, nothing written) but names no column (Xp/Zp) and no cause: 'sph_xp.csv: placement 2 row 54: the commanded tool point strays 232 mm from the "
+       "placement's sphere centre: the file and layout DMU50 disagree beyond 1 mm; no usual "
+       "mistake (...) explains it' -- a tool offset in the wrong column is not among the tried "
+       "causes")
 def test_sphere_tool_offset_in_the_wrong_column(ex, tmp_path, capsys):
     """The 120 mm tool length typed into Xp instead of Zp."""
     def fn(d):
@@ -201,7 +207,7 @@ def test_sphere_tool_offset_in_the_wrong_column(ex, tmp_path, capsys):
         return d
     f = mutate(ex / SPHERE, tmp_path / "sph_xp.csv", fn)
     refused(capsys, cal_argv("DMU50", [f], tmp_path), outs_cal(tmp_path), f.name,
-            ("Xp", "Zp", "tool"), ("swap", "offset", "tool"))
+            ("Xp", "Zp"), ("swap", "wrong column", "Xp", "Zp"))
 
 
 def test_sphere_file_given_to_a_cmm_layout(ex, tmp_path, capsys):
@@ -1004,10 +1010,10 @@ def test_uncertainty_part_expansion_in_ppm(ex, tmp_path, capsys):
 
 
 @xfail("NOT refused: exit 0, id_errors/X.csv, id.json, id.png written ('residual RMS 3.18 um'); "
-       "a tracker at (1.5, -2, 0.3) mm, among the measured points, accepted for the uncertainty "
-       "model")
+       "a tracker at (1.5, -2, 0.3) mm, 144 mm from the nearest measured point (closer than any "
+       "tracker's minimum range), accepted for the uncertainty model")
 def test_identify_tracker_position_in_metres(ex, tmp_path, capsys):
-    """--tracker 1.5 -2 0.3 (m): the tracker 2 mm from the measured points, inside the axis."""
+    """--tracker 1.5 -2 0.3 (m typed for mm): the tracker 144 mm from the nearest point."""
     f = shutil.copy(ex / TRACKER, tmp_path / "tr.csv")
     refused(capsys, id_argv(f, tmp_path) + ["--tracker", "1.5", "-2", "0.3"], id_outs(tmp_path),
             "--tracker", (), ("m", "unit", "metre", "close"))
