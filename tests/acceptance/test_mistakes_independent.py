@@ -23,6 +23,8 @@ from __future__ import annotations
 import json
 import re
 import shutil
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -1039,6 +1041,37 @@ def test_iso10360_mpe_constant_in_mm(ex, tmp_path, capsys):
     out = [tmp_path / "e0.json", tmp_path / "e0.html"]
     refused(capsys, ["iso10360", "MB1", "--errors", ex / "errors_MB1", "--mpe", "E0=0.002+L/300",
                      "--json", out[0], "--html", out[1]], out, "--mpe", (), ("mm", "unit", "um"))
+
+
+def _race(db, jobs):
+    """Start ``volerr history add`` for every (machine, result) of ``jobs`` at once; their
+    (exit code, stdout + stderr)."""
+    procs = [subprocess.Popen([sys.executable, "-m", "volerr", "history", "add", "--db", str(db),
+                               "--machine", m, str(r)], stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True) for m, r in jobs]
+    return [(p.wait(timeout=120), p.stdout.read()) for p in procs]
+
+
+def _entries(capsys, db, machine, tmp_path):
+    out = tmp_path / f"show_{machine}.json"
+    code, _, err, _ = run(capsys, ["history", "show", "--db", db, "--machine", machine,
+                                   "--json", out])
+    assert code == 0, err
+    return json.loads(out.read_text())["entries"]
+
+
+@pytest.mark.parametrize("round_", [0, 1])
+def test_history_race_same_result_on_two_machines_loses_nothing(reference, tmp_path, capsys,
+                                                                round_):
+    """The issue's case: the same result added to A and B of a NEW database at once.  One
+    result is one machine at one time: exactly one may say added, and that entry must be in
+    the database afterwards (the file must exist)."""
+    db = tmp_path / f"race{round_}.sqlite"
+    said = _race(db, [("A", reference), ("B", reference)])
+    added = [m for (code, text), m in zip(said, "AB") if code == 0 and "added" in text]
+    assert len(added) == 1, said
+    assert db.exists(), f"database gone after {said}"
+    assert len(_entries(capsys, db, added[0], tmp_path)) == 1, said
 
 
 # ---------------------------------------------------------------------------------------------
