@@ -831,8 +831,8 @@ def test_compensate_negative_tool_length(ex, tmp_path, capsys):
             ("sign", "negative", "positive", ">= 0"))
 
 
-def test_compensate_datum_in_inches_outside_travel(ex, tmp_path, capsys):
-    """A datum of 300 mm typed as 11.81 in -> fine; typed in um (300000) is outside travel."""
+def test_compensate_datum_in_um_outside_travel(ex, tmp_path, capsys):
+    """A datum of 30, 20, 20 mm typed in um (30000, 20000, 20000): outside the travel."""
     e = ex / "dmu50" / "errors"
     out = tmp_path / "comp.nc"
     refused(capsys, ["compensate", "DMU50", "--errors", e, ex / "dmu50" / "hemisphere.nc",
