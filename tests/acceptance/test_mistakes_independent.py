@@ -891,9 +891,6 @@ def test_map_rotary_position_outside_travel(ex, tmp_path, capsys):
 # freedom against the declared reading uncertainty, issue 43 item 3) or the trace itself tells
 
 
-@xfail("NOT refused: exit 0, cal.json and cal_errors/ written; RMS 9.572 um (held-out 9.281) "
-       "against 0.509 um for the example as shipped, i.e. about 19x the reading noise -- the "
-       "chi^2 residual gate (being built on another branch) is meant to stop this")
 def test_sphere_dy_and_dz_columns_swapped(ex, tmp_path, capsys):
     f = mutate(ex / SPHERE, tmp_path / "sph_dyz.csv",
                lambda d: d.rename(columns={"dy_um": "dz_um", "dz_um": "dy_um"}))
