@@ -1,5 +1,5 @@
 """Directed drift channels as rows of the layout's model, fitted jointly
-(:mod:`volerr.loop.drift_rows`), and the Python API on drift runs.
+(:mod:`volerr.loop.drift.rows`), and the Python API on drift runs.
 
 The simulator here is its own: a machine whose tool point moves along X by 0.8 um/K of a lag
 (tau 1500 s) of sensor ``T_a`` and along Z by -1.1 um/K of the same, while the spindle tilts
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from helpers import drift_sim as D
-from volerr.loop import drift_rows as R
+from volerr.loop.drift import rows as R
 
 DT = 30.0
 HOURS = 8.0
