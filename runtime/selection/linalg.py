@@ -27,7 +27,12 @@ def solve_normal(G: np.ndarray, b: np.ndarray, tol: float) -> np.ndarray:
 def solve_scaled(G: np.ndarray, h: np.ndarray, rcond: float = 1e-12) -> np.ndarray:
     """The least-squares coefficients from the normal equations ``G b = h`` solved with the
     columns scaled to unit norm (pseudo-inverse, ``rcond``); a column all zero (a run without
-    readings) gets 0.  Coefficients in the units of the unscaled columns."""
+    readings) gets 0.  Coefficients in the units of the unscaled columns.
+
+    numpy's Hermitian pseudo-inverse, not :func:`pinv_sym`: the two agree to the last bits
+    only, and the drift loop's static regression (nearly collinear temperatures) moves by
+    2e-12 relative between them (FL_THERMAL, measured): kept as the drift figures were
+    measured."""
     d = np.sqrt(np.diag(G))
     on = d > 0
     b = np.zeros(len(h))
