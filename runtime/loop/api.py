@@ -6,7 +6,7 @@ import os
 from dataclasses import dataclass
 
 from ..errors import require
-from ..selection.rules import SIG_K
+from ..selection.rules import SIG_K, significant  # noqa: F401  (SIG_K: former name here)
 from . import candidates
 from .drift.report import K_PRINT
 from .run import Report, run_loop
@@ -53,7 +53,7 @@ def effect_terms(e: dict) -> str:
         text = f"{k} = {v:.4g} {e['units'][k]}"
         if u is not None:
             text += f" +- {K_PRINT * u:.2g} (k = {K_PRINT:g})"
-        (weak if u is not None and abs(v) < SIG_K * u else shown).append(text)
+        (shown if significant(v, u) else weak).append(text)
     out = ", ".join(shown) or "no significant term"
     if weak:
         out += f"; not significant, not part of the effect: {', '.join(weak)}"

@@ -441,49 +441,30 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     def full(design):
         return dense(design) if ctx_s is ctx else _full_base(design, train, w_rows, y)
 
-    A_all = A0
-    cv_old = _cv_sq(A_all, y, folds, train, w_rows)
-    accepted, rejected, first, last = [], set(), None, []
-    while True:
-        base = full(A_all)
-        scored = screen(candidates, ctx_s, dense(A_all) if ctx_s is not ctx else base,
+    st = {"A": A0, "cv": _cv_sq(A0, y, folds, train, w_rows), "first": None, "last": []}
+    rejected: set = set()
+
+    def propose(accepted):        # screen on the current residual, then the leaders in turn
+        base = full(st["A"])
+        scored = screen(candidates, ctx_s, dense(st["A"]) if ctx_s is not ctx else base,
                         rejected | {a.cand.name for a in accepted})
         if ctx_s is not ctx:
             scored = rescore(scored, ctx, base, candidates, 2 * N_SOURCES)
-        last = scored
-        if first is None:
-            first = scored
+        st["last"] = scored
+        if st["first"] is None:
+            st["first"] = scored
         if len(accepted) >= MAX_EFFECTS:
-            break
-        hit = None
+            return None
         from .lags import prefer_plain
-        scored = _lag_leaders_refined(scored, A_all, ctx, train, w_rows, y, _order(candidates))
+        scored = _lag_leaders_refined(scored, st["A"], ctx, train, w_rows, y, _order(candidates))
         prefer_plain(scored, TOP_FIT)
-        for x in scored[:TOP_FIT]:
-            if x.dbic > -BIC_GAIN:
-                break
-            x = _lag_refined(x, A_all, ctx, train, w_rows, y)
-            cols, _ = ctx.columns(x.cand.terms, full=True)
-            A_try = A_all.plus([cols])
-            cv_new = _cv_sq(A_try, y, folds, train, w_rows)
-            t = paired_t(cv_old - cv_new)
-            if t < CV_T:
-                rejected.add(x.cand.name)
-                continue
-            alts = [o.cand.name for o in scored[:2 * N_SOURCES] if o.cand.name != x.cand.name
-                    and o.gain >= 0.98 * x.gain]
-            hit = Accepted(x.cand, x.params, cols, {
-                "delta_bic": round(x.dbic, 2),
-                "rss_reduction_fraction": round(x.gain / base.rss, 5),
-                "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
-                "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
-                "cv_paired_t": round(t, 2), "step": len(accepted) + 1,
-                "indistinguishable_from": alts[:5]})
-            A_all, cv_old = A_try, cv_new
-            break
-        if hit is None:
-            break
-        accepted.append(hit)
+        return _first_earning(scored, st, base, ctx, (train, w_rows, y, folds), rejected,
+                              len(accepted) + 1)
+
+    # one screening more after the last effect (as before): it fixes profiles the final
+    # screening reuses
+    accepted = stepwise.forward(propose, lambda hit, chosen: True, MAX_EFFECTS + 1)
+    A_all, first, last = st["A"], st["first"], st["last"]
     if accepted:
         accepted = _backward(A0, accepted, train, w_rows, y)
         accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, train, w_rows, y)
@@ -501,6 +482,36 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             last = screen(candidates, ctx, base, names)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
+
+
+def _first_earning(scored, st, base, ctx, fit_data, rejected: set, step: int):
+    """The first of the ``TOP_FIT`` leaders that earns its place (the rule of
+    :mod:`volerr.selection.rules`: dBIC <= -``BIC_GAIN`` and the paired t of the held-out
+    improvement >= ``CV_T``), as an :class:`Accepted` (``st``'s design and cross-validated
+    residual updated), or None; a leader refused by the t is not tried again."""
+    train, w_rows, y, folds = fit_data
+    for x in scored[:TOP_FIT]:
+        if x.dbic > -BIC_GAIN:          # (not bic_accepts, NaN included as before)
+            return None
+        x = _lag_refined(x, st["A"], ctx, train, w_rows, y)
+        cols, _ = ctx.columns(x.cand.terms, full=True)
+        A_try = st["A"].plus([cols])
+        cv_old, cv_new = st["cv"], _cv_sq(A_try, y, folds, train, w_rows)
+        t = paired_t(cv_old - cv_new)
+        if t < CV_T:
+            rejected.add(x.cand.name)
+            continue
+        alts = [o.cand.name for o in scored[:2 * N_SOURCES] if o.cand.name != x.cand.name
+                and o.gain >= 0.98 * x.gain]
+        st["A"], st["cv"] = A_try, cv_new
+        return Accepted(x.cand, x.params, cols, {
+            "delta_bic": round(x.dbic, 2),
+            "rss_reduction_fraction": round(x.gain / base.rss, 5),
+            "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
+            "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
+            "cv_paired_t": round(t, 2), "step": step,
+            "indistinguishable_from": alts[:5]})
+    return None
 
 
 def _lag_leaders_refined(scored: list, A_all, ctx, train, w_rows, y, order: dict) -> list:
