@@ -129,7 +129,7 @@ def drift(n: int) -> None:
     import tempfile
     from pathlib import Path
 
-    from volerr.loop.drift_report import loop_drift
+    from volerr.loop.drift.run import loop_drift
     from volerr.machine.lags import lag
 
     rng = np.random.default_rng(5)

@@ -43,14 +43,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..loop.fitting import CV_T
-from ..loop.lags import BIC_TIE, CV_SAME
-from ..loop.select import BIC_GAIN
+from ..selection import stepwise
+from ..selection.rules import BIC_GAIN, BIC_TIE, CV_SAME, CV_T, TIE_SCORE_REL
 
 #: false-alarm probability the threshold holds at least (a clean machine called "changed")
 ALPHA = 0.05
-#: relative agreement of two chi2 reductions that counts as a tie
-TIE = 1e-9
+#: relative agreement of two chi2 reductions that counts as a tie (the rule of
+#: :mod:`volerr.selection.rules`)
+TIE = TIE_SCORE_REL
 #: correlation of two parameters' columns above which this check cannot tell them apart
 INDISTINCT = 0.98
 #: chi2 difference within which two indistinguishable candidates are a statistical tie
@@ -88,24 +88,32 @@ def select(system, candidates=None, series=()) -> Selection:
     cands = list(range(system.p)) if candidates is None else list(candidates)
     c = threshold(system.n_readings, max(len(cands), 1))
     corr = _correlation(system)
-    S, fit, steps = [], system.solve([]), []
-    while len(S) < MAX_CHANGED:
+    steps, state = [], {"fit": system.solve([])}
+
+    def propose(chosen):
+        S = [t[0] for t in chosen]
         trial = [(j, system.solve(S + [j])) for j in cands if j not in S]
         if not trial:
-            break
+            return None
         best = min(f.chi2 for _, f in trial)
+        fit = state["fit"]
         j, f = next((j, f) for j, f in trial if f.chi2 <= best + TIE * max(fit.chi2, 1.0))
         tied = [(j2 in series, j2, f2) for j2, f2 in trial
                 if f2.chi2 <= best + SAME_CHI2 and abs(corr[j, j2]) > INDISTINCT]
         _, j, f = min(tied + [(j in series, j, f)], key=lambda t: (t[0], t[1]))
-        gain = fit.chi2 - f.chi2
+        return j, f
+
+    def accept(term, chosen):
+        S, (j, f) = [t[0] for t in chosen], term
+        gain = state["fit"].chi2 - f.chi2
         t = cv_t(system, S, S + [j]) if gain > c else float("nan")
         ok = gain > c and t > cv_limit(len(np.unique(system.point)))
         steps.append({"parameter": j, "dchi2": gain, "cv_t": t, "accepted": bool(ok)})
-        if not ok:
-            break
-        S, fit = S + [j], f
-    S, fit = _backward(system, S, fit, c)
+        return ok
+
+    chosen = stepwise.forward(propose, accept, MAX_CHANGED,
+                              take=lambda term: state.update(fit=term[1]))
+    S, fit = _backward(system, [j for j, _ in chosen], state["fit"], c)
     return Selection(S, fit, c, steps, alternatives(system, S, fit, cands))
 
 
@@ -119,13 +127,20 @@ def cv_limit(n_points: int) -> float:
 def _backward(system, S, fit, c):
     """Drop, one at a time, the parameter whose removal raises ``chi2`` least while that
     rise stays below the threshold."""
-    while S:
-        trial = [(j, system.solve([k for k in S if k != j])) for j in S]
-        j, f = min(trial, key=lambda t: t[1].chi2)
-        if f.chi2 - fit.chi2 > c:
-            break
-        S, fit = [k for k in S if k != j], f
-    return S, fit
+    state = {"fit": fit}
+
+    def without(S, i):
+        f = system.solve([k for k in S if k != S[i]])
+        return f.chi2, f
+
+    def drop(res, S):
+        if res[1].chi2 - state["fit"].chi2 > c:
+            return False
+        state["fit"] = res[1]
+        return True
+
+    S, _ = stepwise.backward(S, without, drop)
+    return S, state["fit"]
 
 
 def alternatives(system, S, fit, candidates) -> dict:

@@ -8,16 +8,15 @@ before and after on held-out points.  See :mod:`volerr.loop.run`.
 
 Drift runs (``drift:FILE`` or a file detected as one; ``volerr formats loop-lags``): the loop
 on a position held while the machine heats and cools, ``--holdout-time`` / ``--holdout-files``
-and ``--predictions-out``; see :mod:`volerr.loop.drift`.
+and ``--predictions-out``; see :mod:`volerr.loop.drift`.  The command checks its outputs,
+calls :func:`volerr.loop` (the one entry for both kinds) and writes its result.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import require
 from ..fileio import Outputs
-from ..loop.api import console_lines
 from ._common import (add_accept_residual, add_errors_out, add_force, add_html,
                       add_identification_arguments, add_json, identification_from_args,
                       write_certificates)
@@ -74,87 +73,50 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..loop.api import is_drift
-
-    if is_drift(args.data):
-        return run_drift(args)
-    require(not (args.holdout_files or args.predictions_out),
-            "loop: --holdout-files and --predictions-out are for drift runs (drift:FILE)")
-    from ..loop import candidates
-    from ..loop.run import run_loop
-
-    from ._common import layout_inputs
-    from ..machine.model import load
-
+    """Check the outputs, call :func:`volerr.loop` (measured deviations or drift runs alike:
+    it refuses the options that do not apply, one line), write the result, print its
+    summary."""
+    from .. import loop as api_loop
     from ..instruments import split_spec
+    from ..machine.model import load
+    from ._common import layout_inputs
 
-    inputs = [split_spec(d)[1] for d in args.data] + layout_inputs(args.layout)
+    inputs = [split_spec(d)[1] for d in list(args.data) + list(args.holdout_files or [])] \
+        + layout_inputs(args.layout)
     model = load(args.layout)
     aug = (f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py")
     # as the user named it (no resolve): the report names the files where they end up
     out_dir = Path(args.out_dir) if args.out_dir else None
     OUT_DIR = "--out-dir"
     outs = Outputs(inputs, force=args.force).file("--json", args.json).file("--html", args.html) \
-        .file("--pdf", args.pdf).folder(OUT_DIR, out_dir, files=aug) \
+        .file("--pdf", args.pdf) \
+        .file("--predictions-out", args.predictions_out).folder(OUT_DIR, out_dir, files=aug) \
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     ident = identification_from_args(args, inputs)
-    families = candidates.FAMILIES
-    if args.families:
-        families = tuple(f.strip() for f in args.families.split(",") if f.strip())
-        bad = [f for f in families if f not in candidates.FAMILIES]
-        require(not bad, f"unknown family {bad[0] if bad else ''!r}; families are "
-                f"{' '.join(candidates.FAMILIES)}")
     with outs:
-        staged = outs.path(OUT_DIR)
-        data = args.data[0] if len(args.data) == 1 else args.data
-        report = run_loop(args.layout, data, seed=args.seed, folds=args.folds,
-                          test_fraction=args.test_fraction, degree=args.degree,
-                          out_dir=staged, families=families, inputs=inputs,
-                          holdout_time=args.holdout_time)
-        from ..fit_quality import gate
+        report = api_loop(args.layout, list(args.data), out_dir=outs.path(OUT_DIR),
+                          seed=args.seed, folds=args.folds, test_fraction=args.test_fraction,
+                          degree=args.degree, families=args.families,
+                          holdout_time=args.holdout_time,
+                          holdout_files=list(args.holdout_files or []),
+                          differences=args.differences, inputs=inputs)
+        if getattr(report, "quality", None) is not None:
+            from ..fit_quality import gate
 
-        report.quality = gate(report.data, report.quality, args.accept_residual,
-                              f"loop {' '.join(inputs[:len(args.data)])}")
+            report.quality = gate(report.data, report.quality, args.accept_residual,
+                                  f"loop {' '.join(inputs[:len(args.data)])}")
         for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
             if report.data.get(key):
                 report.data[key] = str(out_dir / Path(report.data[key]).name)
-        if args.json:
-            report.write_json(outs.path("--json"), inputs=inputs)
-        if args.html:
-            report.write_html(outs.path("--html"), inputs=inputs)
-        if args.errors_out:
-            report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
-        write_certificates(outs, report, ident, inputs)
-    for line in console_lines(report):
-        print(line)
-    return 0
-
-
-def run_drift(args) -> int:
-    """The loop on drift runs (:func:`volerr.loop.drift_report.loop_drift`)."""
-    from ..instruments import split_spec
-    from ..loop.drift_report import loop_drift
-    from ._common import layout_inputs
-
-    paths = [split_spec(d)[1] for d in args.data]
-    held = [split_spec(d)[1] for d in (args.holdout_files or [])]
-    require(not (args.out_dir or args.errors_out), "loop: --out-dir and --errors-out are not "
-            "written for drift runs (their effects are per channel, not in the layout)")
-    inputs = paths + held + layout_inputs(args.layout)
-    outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .file("--html", args.html).file("--predictions-out", args.predictions_out) \
-        .file("--pdf", args.pdf).check()
-    ident = identification_from_args(args, inputs)
-    with outs:
-        report = loop_drift(args.layout, paths, window=args.holdout_time,
-                            files=held, differences=args.differences)
-        if args.json:
-            report.write_json(outs.path("--json"), inputs=inputs)
-        if args.html:
-            report.write_html(outs.path("--html"), inputs=inputs)
         if args.predictions_out:
             report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
+        if args.errors_out:
+            report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+        if args.json:
+            report.write_json(outs.path("--json"), inputs=inputs)
+        if args.html:
+            report.write_html(outs.path("--html"), inputs=inputs)
         write_certificates(outs, report, ident, inputs)
     print(report.summary())
     return 0

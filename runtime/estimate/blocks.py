@@ -10,10 +10,11 @@ square roots of the robust point weights (one per point).
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
+from ..selection.linalg import pinv_sym
+from ..selection.rules import delta_bic
 from .design import SV_TOL, declared_design, series_basis, twist_sensitivity
 
 #: points per block (a block of rows is 3 * BLOCK x p floats)
@@ -132,11 +133,8 @@ def unit_scale(colsq, n_rows: int) -> np.ndarray:
     return s
 
 
-def eig_inverse(G, tol: float):
-    """Pseudo-inverse of a symmetric PSD matrix by eigh: eigenvalues below tol*max cut."""
-    w, V = np.linalg.eigh(G)
-    ok = w > tol * max(float(w[-1]), 1e-300)
-    return (V[:, ok] / w[ok]) @ V[:, ok].T
+#: the one symmetric pseudo-inverse (:func:`volerr.selection.linalg.pinv_sym`), by its former name
+eig_inverse = pinv_sym
 
 
 def predict(design, points, coef) -> np.ndarray:
@@ -267,5 +265,5 @@ class BlockBase:
         return self.score_many([group])[0]
 
     def dbic(self, gain: float, m_eff: int) -> float:
-        new = max(self.rss - gain, 1e-300)
-        return self.n * math.log(new / self.rss) + m_eff * math.log(self.n)
+        """BIC change of a group that lowers the RSS by ``gain`` with ``m_eff`` parameters."""
+        return delta_bic(self.n, self.rss - gain, self.rss, m_eff)

@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import require
 from ..instruments.observations import Observations
 from ..machine.model import Model
+from ..selection.linalg import solve_normal as _solve_normal
 
 SETUP = ("dx", "dy", "dz", "ex", "ey", "ez")
 #: relative singular value below which a direction counts as undetermined
@@ -268,11 +269,9 @@ def priority_order(labels) -> list:
 
 # ---- linear algebra -----------------------------------------------------------------
 def solve_normal(G: np.ndarray, b: np.ndarray, tol: float = SV_TOL ** 2) -> np.ndarray:
-    """Minimum-norm solution of G x = b (G symmetric PSD): eigenvalues below tol*max cut."""
-    w, V = np.linalg.eigh(G)
-    wmax = max(float(w[-1]), 1e-300)
-    ok = w > tol * wmax
-    return V[:, ok] @ ((V[:, ok].T @ b) / w[ok])
+    """Minimum-norm solution of G x = b (G symmetric PSD): eigenvalues below tol*max cut
+    (:func:`volerr.selection.linalg.solve_normal`)."""
+    return _solve_normal(G, b, tol)
 
 
 def rows_of(points: np.ndarray) -> np.ndarray:

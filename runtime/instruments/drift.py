@@ -328,7 +328,7 @@ def _text_inputs(c: Columns, skip) -> list:
     return notes
 
 
-def _test_position(run: DriftRun, model) -> dict:
+def test_position(run: DriftRun, model) -> dict:
     """Every axis of ``model`` at the run's position (absent axes: middle of the travel,
     rotary axes 0 when inside it), inside the travel."""
     where = run.name
@@ -352,7 +352,7 @@ def run_observations(run: DriftRun, model) -> Observations:
     labels = list(run.channels)
     n, k = run.n, len(labels)
     total = n * k
-    pos = _test_position(run, model)
+    pos = test_position(run, model)
     probe = np.zeros((total, 3))
     proj = np.zeros((total, 3, 3))
     dev = np.zeros((total, 3))

@@ -1,18 +1,21 @@
 """Closing the loop: measured deviations in, declared model fitted, residual traced to candidate
 effects "parameter P of the chain varies with covariate C", the layout augmented, before/after
-reported on held-out points.  Modules: ``fit`` (design and gauge), ``candidates`` (P x C x basis
-generated from the chain), ``select`` (screening, selection, backward check, merge), ``run``
-(the named steps, robust weights, augmentation), ``blocks`` (least squares with the columns
-generated per block of points), ``report`` (HTML), ``simulate`` (a virtual machine with
-undeclared effects).
+reported on held-out points.  Modules: ``api`` (``volerr.loop(...)``, the one entry, drift
+files too), ``run`` (the named steps, robust weights, augmentation), ``candidates`` (P x C x
+basis generated from the chain), ``select`` (screening, selection, backward check, merge),
+``fitting`` (cross-validated residuals and bases over blocks of points,
+:mod:`volerr.estimate.blocks`), ``lags`` (time constants, alternatives), ``symbols``,
+``thermal``, ``checks``, ``report`` (HTML), ``simulate`` (a virtual machine with undeclared
+effects); the sub-package ``drift`` (the loop on drift runs, a room of its own).  The
+selection rules and stepwise core: :mod:`volerr.selection`.
 """
 
 from .run import Report, read_deviations, run_loop
 
 
 def loop_drift(layout, paths, window=None, files=(), differences=False, progress=None):
-    """The loop on drift runs: :func:`volerr.loop.drift_report.loop_drift`."""
-    from .drift_report import loop_drift as _loop_drift
+    """The loop on drift runs: :func:`volerr.loop.drift.run.loop_drift`."""
+    from .drift.run import loop_drift as _loop_drift
 
     return _loop_drift(layout, paths, window=window, files=files, differences=differences,
                        progress=progress)

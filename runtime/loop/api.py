@@ -6,8 +6,9 @@ import os
 from dataclasses import dataclass
 
 from ..errors import require
+from ..selection.rules import SIG_K, significant  # noqa: F401  (SIG_K: former name here)
 from . import candidates
-from .drift_report import K_PRINT
+from .drift.report import K_PRINT
 from .run import Report, run_loop
 
 
@@ -39,8 +40,10 @@ class Loop(Report):
                                else None, e["units"][k], 1.0))
         return out
 
-
-SIG_K = 2.0      # a term below this many standard uncertainties is not part of the effect
+    def write_predictions(self, path, inputs=()):
+        """Not written for measured deviations: the predictions CSV is the drift loop's."""
+        require(False, "loop: --predictions-out (write_predictions) is for drift runs "
+                       "(drift:FILE)")
 
 
 def effect_terms(e: dict) -> str:
@@ -53,7 +56,7 @@ def effect_terms(e: dict) -> str:
         text = f"{k} = {v:.4g} {e['units'][k]}"
         if u is not None:
             text += f" +- {K_PRINT * u:.2g} (k = {K_PRINT:g})"
-        (weak if u is not None and abs(v) < SIG_K * u else shown).append(text)
+        (shown if significant(v, u) else weak).append(text)
     out = ", ".join(shown) or "no significant term"
     if weak:
         out += f"; not significant, not part of the effect: {', '.join(weak)}"
@@ -118,7 +121,7 @@ def is_drift(specs) -> bool:
 def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None,
          test_fraction: float = 0.25, degree: int | None = None, families=None,
          progress=None, holdout_time: str | None = None, holdout_files=(),
-         differences: bool = False):
+         differences: bool = False, inputs=()):
     """Close the loop on measured deviations (``volerr loop``): fit the declared model, trace
     the residual to candidate effects "parameter P varies with covariate C", augment the
     layout, report the error before and after on held-out points.
@@ -155,6 +158,8 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
         Drift runs: every run of these files held out (read beside ``files``).
     differences : bool
         Drift runs: try differences of two sensors as well.
+    inputs : list, optional
+        Files the outputs (``out_dir``) must not overwrite.
 
     Returns
     -------
@@ -165,13 +170,15 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
         For drift runs (``drift:FILE`` or files detected as drift; 'volerr formats
         loop-lags'): ``data`` / ``["channels"]`` / ``effects`` the JSON of ``volerr loop
         --json``, ``summary()`` the console text, ``write_json``, ``write_html``,
-        ``write_predictions`` (:class:`volerr.loop.drift_report.DriftReport`).
+        ``write_predictions``, ``table()``, ``figures()``
+        (:class:`volerr.loop.drift.report.DriftReport`).
     """
     specs = list(files) if isinstance(files, (list, tuple)) else [files]
     if specs and all(isinstance(f, (str, os.PathLike)) for f in specs) and is_drift(specs):
         return _drift(layout, specs, out_dir, holdout_time, holdout_files, differences,
                       progress)
-    require(not holdout_files, "loop: holdout_files is for drift runs (drift:FILE)")
+    require(not holdout_files, "loop: holdout_files (--holdout-files) is for drift runs "
+            "(drift:FILE)")
     chosen = candidates.FAMILIES
     if families:
         parts = families.split(",") if isinstance(families, str) else list(families)
@@ -183,17 +190,17 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
         files = files[0] if len(files) == 1 else list(files)
     r = run_loop(layout, files, seed=seed, folds=folds, test_fraction=test_fraction,
                  degree=degree, out_dir=out_dir, families=chosen, progress=progress,
-                 holdout_time=holdout_time)
+                 holdout_time=holdout_time, inputs=inputs)
     return Loop(r.data, r.plot_data, r.augmented_text, r.generated, r.quality)
 
 
 def _drift(layout, specs, out_dir, holdout_time, holdout_files, differences, progress):
-    """The loop on drift runs (:func:`volerr.loop.drift_report.loop_drift`)."""
+    """The loop on drift runs (:func:`volerr.loop.drift.run.loop_drift`)."""
     from ..instruments import split_spec
-    from .drift_report import loop_drift
+    from .drift.run import loop_drift
 
-    require(out_dir is None, "loop: out_dir is not written for drift runs (their effects are "
-            "per channel, not in the layout)")
+    require(out_dir is None, "loop: out_dir (--out-dir) is not written for drift runs (their "
+            "effects are per channel, not in the layout)")
     held = [split_spec(str(d))[1] for d in (holdout_files or [])]
     return loop_drift(layout, [split_spec(str(d))[1] for d in specs], window=holdout_time,
                       files=held, differences=differences,

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..estimate.blocks import BlockBase, cv_sq as _blocks_cv_sq
+from ..selection.rules import CV_T, TIE_BIC_ABS as TIE_ABS, TIE_BIC_REL as TIE_REL, tied
 
-CV_T = 3.0           # minimum paired t of the held-out improvement
-TIE_REL = 1e-7       # BIC changes equal within TIE_REL |dBIC| + TIE_ABS are one fit (a tie)
-TIE_ABS = 1e-9
+__all__ = ["CV_T", "TIE_ABS", "TIE_REL", "cv_sq", "dense_group", "full_base", "rank", "stack",
+           "tied"]
 
 
 def cv_sq(design, y, folds, train, w_rows) -> np.ndarray:
@@ -33,18 +33,9 @@ def dense_group(cols):
     return lambda idx: cols[idx]
 
 
-def tied(d0: float, d1: float) -> bool:
-    """Whether two BIC changes are one fit: equal within ``TIE_REL |d0| + TIE_ABS``.  Columns
-    that span the same space on these data (a tool that grows and a Z error of the axis
-    holding it, seen at one tool length) give the same residual up to the last bits of the
-    arithmetic, which differ between BLAS kernels; the tolerance is far above those bits and
-    far below any difference the data can show."""
-    return abs(d1 - d0) <= TIE_REL * abs(d0) + TIE_ABS
-
-
 def rank(scored: list, order: dict, dbic=lambda x: x.dbic, name=lambda x: x.cand.name) -> None:
     """Sort scored candidates (in place) by BIC change, best first; candidates of one fit
-    (:func:`tied` to the first of their run) in the order of ``order`` (candidate name ->
+    (:func:`volerr.selection.rules.tied` to the first of their run) in the order of ``order`` (candidate name ->
     position in :func:`volerr.loop.candidates.build`'s list, whose order the docstring of
     :mod:`volerr.loop.symbols` states): which of two explanations the data cannot tell apart
     is named is the stated rule's choice, never rounding's."""

@@ -35,15 +35,14 @@ import numpy as np
 
 from . import fitting
 from .candidates import extra_parameters as _extra
+from ..selection.profile import profile_argmin, tau_std
+from ..selection.rules import BIC_TIE, CV_SAME, LAG_EARN, paired_t
 
-LAG_EARN = 10.0         # BIC a lag must gain over the same sensor without one
-BIC_TIE = 10.0          # BIC difference below which two explanations are not told apart
 PROFILE_STEPS = np.linspace(-0.3, 0.3, 13)
 PROFILE_SCALES = (1.0, 0.1)   # the coarse pass, then one 10 times narrower around its vertex
 MAX_ALTERNATIVES = 3
 NEAR = 0.9              # rivals explaining this share of the effect's RSS reduction are refined
 BIC_SWAP = 1.0          # an alternative better by more than this is named instead
-CV_SAME = 0.01          # cross-validated RMS within 1 %: not told apart in practice
 
 
 def prefer_plain(scored: list, top: int) -> None:
@@ -88,31 +87,20 @@ def profile_tau(cand, ctx, base, tau0: float) -> tuple[float, float | None]:
             return round(math.exp(x0), 1), None
         x0, q, rss_min, rank = fit
     dof = max(base.n - len(base.scale) - rank - 1, 1)
-    s2 = rss_min / dof
-    std_x = math.sqrt(2 * s2 / (2 * q))
     tau = math.exp(x0)
-    return round(tau, 1), tau * std_x
+    return round(tau, 1), tau_std(tau, q, rss_min, dof)
 
 
 def _parabola(cand, ctx, base, x0: float, steps):
-    """The RSS profile at ``x0 + steps`` (x = ln tau; re-centred while its minimum is at an
-    edge), a parabola through the best seven values: (vertex x, curvature coefficient q,
-    least RSS, rank of that column group), or None where the profile is not convex."""
-    for _ in range(4):
-        xs = x0 + steps
+    """The RSS profile at ``x0 + steps`` (x = ln tau; :func:`volerr.selection.profile.profile_argmin`):
+    (vertex x, curvature coefficient q, least RSS, rank of that column group), or None where
+    the profile is not convex."""
+    def rss_at(xs):
         groups = [ctx.group(cand.fixed(math.exp(x)).terms) for x in xs]
         scores = base.score_many(groups)
-        rss = np.array([base.rss - g for g, _ in scores])
-        k = int(np.argmin(rss))
-        if 0 < k < len(xs) - 1:
-            break
-        x0 = xs[k]
-    lo, hi = max(k - 3, 0), min(k + 4, len(xs))
-    q, b, _ = np.polyfit(xs[lo:hi] - xs[k], rss[lo:hi], 2)
-    if not q > 0:
-        return None
-    x_best = xs[k] + float(np.clip(-b / (2 * q), xs[lo] - xs[k], xs[hi - 1] - xs[k]))
-    return x_best, float(q), float(rss[k]), scores[k][1]
+        return np.array([base.rss - g for g, _ in scores]), [r for _, r in scores]
+
+    return profile_argmin(rss_at, x0, steps)
 
 
 def _explanation(cand) -> tuple:
@@ -144,8 +132,7 @@ def alternatives(accepted: list, pool: list, A0, ctx, train, w_rows, y, folds) -
         for d_x, c in close[:2 * MAX_ALTERNATIVES]:
             cols, _ = ctx.columns(c.terms, full=True)
             cv_x = fitting.cv_sq(A_o.plus([cols]), y, folds, train, w_rows)
-            d = cv_x - cv_a
-            t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
+            t = paired_t(cv_x - cv_a)
             ratio = math.sqrt(cv_x.mean() / max(cv_a.mean(), 1e-300))
             if abs(t) < fitting.CV_T or abs(ratio - 1.0) < CV_SAME:
                 found.append({"cand": c, "cols": cols, "delta_bic": round(d_x - d_a, 2),

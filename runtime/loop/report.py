@@ -269,9 +269,7 @@ def figure_interactions(fg, sources):
 
 def render_html(report) -> str:
     """The complete HTML text of a :class:`volerr.loop.run.Report`."""
-    import jinja2
-
-    from importlib import resources
+    from .drift.figure import render_template
 
     fg = report.plot_data
     figures = {"residuals": fig_residuals(fg), "maps": fig_maps(fg),
@@ -280,11 +278,8 @@ def render_html(report) -> str:
     effects = [{"e": e, "png": fig_effect(fg, e),
                 "params": [(p, v, e["std"][p], e["units"][p]) for p, v in e["parameters"].items()]}
                for e in report.data["effects"]]
-    text = (resources.files("volerr.loop") / "templates" / "report.html.j2").read_text(
-        encoding="utf-8")
-    env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
     paths = {k: (Path(v).name if v else v) for k, v in (
         ("augmented_layout", report.data.get("augmented_layout")),
         ("generated_module", report.data.get("generated_module")))}
-    return env.from_string(text).render(r=report.data, figures=figures, effects=effects,
-                                        paths=paths)
+    return render_template("report.html.j2", r=report.data, figures=figures, effects=effects,
+                           paths=paths)

@@ -599,7 +599,7 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
     ``out_dir``: where the augmented layout and its generated module are written (nothing is
     written when None; the texts are in the report object either way).  ``holdout_time``
     ``"A:B"`` (units s, min, h): hold out the points with A <= t < B of the time column
-    (:func:`volerr.loop.drift_split.parse_window`) instead of the default stretches."""
+    (:func:`volerr.loop.drift.split.parse_window`) instead of the default stretches."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
@@ -610,9 +610,9 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
 def _split(dat, seed, test_fraction, folds, holdout_time=None) -> Split:
     """The held-out points: ``holdout_time`` ``"A:B"`` (the points with A <= t < B), else
     with a time column whole stretches of time
-    (:func:`volerr.loop.drift_split.stretch_split`), else drawn at random (``seed``)."""
+    (:func:`volerr.loop.drift.split.stretch_split`), else drawn at random (``seed``)."""
     from ..machine.lags import TIME_COLUMNS
-    from .drift_split import parse_window, stretch_split
+    from .drift.split import parse_window, stretch_split
 
     spl = split_points(dat.n, seed, test_fraction, folds)
     time = next((c for c in TIME_COLUMNS if c in dat.covariates), None)

@@ -26,8 +26,10 @@ from .fitting import full_base as _full_base, rank, stack as _stack
 from ..estimate.blocks import BlockBase, blocks
 from ..estimate.design import TWIST, rows_of
 from ..machine.expressions import evaluate, lag_calls
+from ..selection import stepwise
+from ..selection.linalg import pinv_sym as _pinv_sym
+from ..selection.rules import BIC_GAIN, delta_bic, paired_t
 
-BIC_GAIN = 10.0      # minimum BIC improvement (natural-log units) to accept an effect
 MAX_EFFECTS = 8
 TOP_FIT = 3          # candidates fitted fully per forward step
 SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
@@ -36,13 +38,6 @@ LAG_CACHE = 48       # lagged series (all points) kept while screening
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
-
-
-def _pinv_sym(G, tol=1e-12):
-    """Pseudo-inverse of a symmetric PSD matrix by eigh (small matrices only)."""
-    w, V = np.linalg.eigh(G)
-    ok = w > tol * max(float(w[-1]), 1e-300)
-    return (V[:, ok] / w[ok]) @ V[:, ok].T
 
 
 class Base:
@@ -85,8 +80,8 @@ class Base:
         return np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
 
     def dbic(self, gain: float, m_eff: int) -> float:
-        new = max(self.rss - gain, 1e-300)
-        return self.n * math.log(new / self.rss) + m_eff * math.log(self.n)
+        """BIC change of columns that lower the RSS by ``gain`` with ``m_eff`` parameters."""
+        return delta_bic(self.n, self.rss - gain, self.rss, m_eff)
 
 
 @dataclass
@@ -446,50 +441,30 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
     def full(design):
         return dense(design) if ctx_s is ctx else _full_base(design, train, w_rows, y)
 
-    A_all = A0
-    cv_old = _cv_sq(A_all, y, folds, train, w_rows)
-    accepted, rejected, first, last = [], set(), None, []
-    while True:
-        base = full(A_all)
-        scored = screen(candidates, ctx_s, dense(A_all) if ctx_s is not ctx else base,
+    st = {"A": A0, "cv": _cv_sq(A0, y, folds, train, w_rows), "first": None, "last": []}
+    rejected: set = set()
+
+    def propose(accepted):        # screen on the current residual, then the leaders in turn
+        base = full(st["A"])
+        scored = screen(candidates, ctx_s, dense(st["A"]) if ctx_s is not ctx else base,
                         rejected | {a.cand.name for a in accepted})
         if ctx_s is not ctx:
             scored = rescore(scored, ctx, base, candidates, 2 * N_SOURCES)
-        last = scored
-        if first is None:
-            first = scored
+        st["last"] = scored
+        if st["first"] is None:
+            st["first"] = scored
         if len(accepted) >= MAX_EFFECTS:
-            break
-        hit = None
+            return None
         from .lags import prefer_plain
-        scored = _lag_leaders_refined(scored, A_all, ctx, train, w_rows, y, _order(candidates))
+        scored = _lag_leaders_refined(scored, st["A"], ctx, train, w_rows, y, _order(candidates))
         prefer_plain(scored, TOP_FIT)
-        for x in scored[:TOP_FIT]:
-            if x.dbic > -BIC_GAIN:
-                break
-            x = _lag_refined(x, A_all, ctx, train, w_rows, y)
-            cols, _ = ctx.columns(x.cand.terms, full=True)
-            A_try = A_all.plus([cols])
-            cv_new = _cv_sq(A_try, y, folds, train, w_rows)
-            d = cv_old - cv_new
-            t = float(d.mean() / (d.std(ddof=1) / math.sqrt(len(d)) + 1e-300))
-            if t < CV_T:
-                rejected.add(x.cand.name)
-                continue
-            alts = [o.cand.name for o in scored[:2 * N_SOURCES] if o.cand.name != x.cand.name
-                    and o.gain >= 0.98 * x.gain]
-            hit = Accepted(x.cand, x.params, cols, {
-                "delta_bic": round(x.dbic, 2),
-                "rss_reduction_fraction": round(x.gain / base.rss, 5),
-                "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
-                "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
-                "cv_paired_t": round(t, 2), "step": len(accepted) + 1,
-                "indistinguishable_from": alts[:5]})
-            A_all, cv_old = A_try, cv_new
-            break
-        if hit is None:
-            break
-        accepted.append(hit)
+        return _first_earning(scored, st, base, ctx, (train, w_rows, y, folds), rejected,
+                              len(accepted) + 1)
+
+    # one screening more after the last effect (as before): it fixes profiles the final
+    # screening reuses
+    accepted = stepwise.forward(propose, lambda hit, chosen: True, MAX_EFFECTS + 1)
+    A_all, first, last = st["A"], st["first"], st["last"]
     if accepted:
         accepted = _backward(A0, accepted, train, w_rows, y)
         accepted = _merge(A0, accepted, first[:2 * N_SOURCES], ctx, train, w_rows, y)
@@ -507,6 +482,36 @@ def select(candidates, ctx: Context, A0, y, folds, w_rows, screen_points: int) -
             last = screen(candidates, ctx, base, names)
     _same_cause(accepted)
     return Selection(accepted, A_all, first or [], last, len(candidates))
+
+
+def _first_earning(scored, st, base, ctx, fit_data, rejected: set, step: int):
+    """The first of the ``TOP_FIT`` leaders that earns its place (the rule of
+    :mod:`volerr.selection.rules`: dBIC <= -``BIC_GAIN`` and the paired t of the held-out
+    improvement >= ``CV_T``), as an :class:`Accepted` (``st``'s design and cross-validated
+    residual updated), or None; a leader refused by the t is not tried again."""
+    train, w_rows, y, folds = fit_data
+    for x in scored[:TOP_FIT]:
+        if x.dbic > -BIC_GAIN:          # (not bic_accepts, NaN included as before)
+            return None
+        x = _lag_refined(x, st["A"], ctx, train, w_rows, y)
+        cols, _ = ctx.columns(x.cand.terms, full=True)
+        A_try = st["A"].plus([cols])
+        cv_old, cv_new = st["cv"], _cv_sq(A_try, y, folds, train, w_rows)
+        t = paired_t(cv_old - cv_new)
+        if t < CV_T:
+            rejected.add(x.cand.name)
+            continue
+        alts = [o.cand.name for o in scored[:2 * N_SOURCES] if o.cand.name != x.cand.name
+                and o.gain >= 0.98 * x.gain]
+        st["A"], st["cv"] = A_try, cv_new
+        return Accepted(x.cand, x.params, cols, {
+            "delta_bic": round(x.dbic, 2),
+            "rss_reduction_fraction": round(x.gain / base.rss, 5),
+            "cv_rms_before_um": round(1e3 * math.sqrt(cv_old.mean()), 4),
+            "cv_rms_after_um": round(1e3 * math.sqrt(cv_new.mean()), 4),
+            "cv_paired_t": round(t, 2), "step": step,
+            "indistinguishable_from": alts[:5]})
+    return None
 
 
 def _lag_leaders_refined(scored: list, A_all, ctx, train, w_rows, y, order: dict) -> list:
@@ -556,20 +561,17 @@ def _lag_refined(x: Scored, A_all, ctx, train, w_rows, y) -> Scored:
 def _backward(A0, selected, train, w_rows, y) -> list:
     """Drop an effect that, given all the others, no longer gains dBIC < -BIC_GAIN (a later
     effect made it redundant); each kept effect gets ``delta_bic_given_others``."""
-    def dbic_without(sel, i):
+    def without(sel, i):          # cost of dropping effect i: minus its dBIC given the others
         base = _full_base(_stack(A0, sel[:i] + sel[i + 1:]), train, w_rows, y)
         gain, rank = base.score(_dense_group(sel[i].cols))
-        return base.dbic(gain, rank + cands.extra_parameters(sel[i].cand))
+        return -base.dbic(gain, rank + cands.extra_parameters(sel[i].cand)), None
 
-    sel = list(selected)
-    while sel:
-        scores = [dbic_without(sel, i) for i in range(len(sel))]
-        worst = int(np.argmax(scores))
-        if scores[worst] <= -BIC_GAIN or len(sel) == 1:
-            for s_, d in zip(sel, scores):
-                s_.evidence["delta_bic_given_others"] = round(d, 2)
-            break
-        sel.pop(worst)
+    def drop(res, sel):
+        return not (-res[0] <= -BIC_GAIN or len(sel) == 1)
+
+    sel, last = stepwise.backward(selected, without, drop)
+    for s_, (cost, _) in zip(sel, last or []):
+        s_.evidence["delta_bic_given_others"] = round(-cost, 2)
     for k, s_ in enumerate(sel):
         s_.evidence["step"] = k + 1
     return sel
@@ -579,39 +581,40 @@ def _merge(A0, accepted, pool, ctx: Context, train, w_rows, y) -> list:
     """Parsimony across overlapping candidates: two accepted effects are replaced by ONE
     candidate of the first screening when it explains the data at least as well by BIC (e.g.
     a yaw of Y, taken first as squareness and then as a yaw of X).  Repeated while it helps."""
-    sel = list(accepted)
-    changed = True
-    while changed and len(sel) >= 2:
-        changed = False
-        best = (0.0, None)
-        for i in range(len(sel)):
-            for j in range(i + 1, len(sel)):
-                others = [s_ for k, s_ in enumerate(sel) if k not in (i, j)]
-                base = _full_base(_stack(A0, others), train, w_rows, y)
-                pair = np.concatenate([sel[i].cols, sel[j].cols], axis=2)
-                xs = [x for x in pool
-                      if x.cand.name not in (sel[i].cand.name, sel[j].cand.name)]
-                scores = base.score_many([_dense_group(pair)] +
-                                         [ctx.group(x.cand.terms) for x in xs])
-                g_ij, r_ij = scores[0]
-                m_ij = r_ij + sum(cands.extra_parameters(s_.cand) for s_ in (sel[i], sel[j]))
-                for x, (g_c, r_c) in zip(xs, scores[1:]):
-                    m_c = r_c + cands.extra_parameters(x.cand)
-                    d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
-                    if r_c and d < best[0]:
-                        best = (d, (i, j, x))
-        if best[1] is not None:
-            i, j, x = best[1]
-            cols, _ = ctx.columns(x.cand.terms, full=True)
-            ev = dict(sel[i].evidence)
-            ev["replaces"] = [sel[i].cand.name, sel[j].cand.name]
-            ev["delta_bic_vs_replaced"] = round(best[0], 2)
-            merged = Accepted(x.cand, x.params, cols, ev)
-            sel = [s_ for k, s_ in enumerate(sel) if k not in (i, j)] + [merged]
-            changed = True
+    sel = stepwise.merge(accepted, lambda s: _merged(A0, s, pool, ctx, train, w_rows, y))
     for k, s_ in enumerate(sel):
         s_.evidence["step"] = k + 1
     return sel
+
+
+def _merged(A0, sel, pool, ctx: Context, train, w_rows, y):
+    """``sel`` with the best pair replaced by one candidate of ``pool``, or None."""
+    best = (0.0, None)
+    for i in range(len(sel)):
+        for j in range(i + 1, len(sel)):
+            others = [s_ for k, s_ in enumerate(sel) if k not in (i, j)]
+            base = _full_base(_stack(A0, others), train, w_rows, y)
+            pair = np.concatenate([sel[i].cols, sel[j].cols], axis=2)
+            xs = [x for x in pool
+                  if x.cand.name not in (sel[i].cand.name, sel[j].cand.name)]
+            scores = base.score_many([_dense_group(pair)] +
+                                     [ctx.group(x.cand.terms) for x in xs])
+            g_ij, r_ij = scores[0]
+            m_ij = r_ij + sum(cands.extra_parameters(s_.cand) for s_ in (sel[i], sel[j]))
+            for x, (g_c, r_c) in zip(xs, scores[1:]):
+                m_c = r_c + cands.extra_parameters(x.cand)
+                d = base.dbic(g_c, m_c) - base.dbic(g_ij, m_ij)
+                if r_c and d < best[0]:
+                    best = (d, (i, j, x))
+    if best[1] is None:
+        return None
+    i, j, x = best[1]
+    cols, _ = ctx.columns(x.cand.terms, full=True)
+    ev = dict(sel[i].evidence)
+    ev["replaces"] = [sel[i].cand.name, sel[j].cand.name]
+    ev["delta_bic_vs_replaced"] = round(best[0], 2)
+    merged = Accepted(x.cand, x.params, cols, ev)
+    return [s_ for k, s_ in enumerate(sel) if k not in (i, j)] + [merged]
 
 
 def _same_cause(accepted) -> None:

@@ -54,8 +54,8 @@ def test_a_term_dropped_as_not_significant_is_listed(tmp_path):
     ``not_significant`` (before: the list was reset at every refit and always empty).  The
     run: a drift that follows one sensor, a second sensor that wanders on its own (given to
     the test as a term; its coefficient is within 2 u of zero, checked here)."""
-    from volerr.loop import drift as core
-    from volerr.loop import drift_basis as basis
+    from volerr.loop.drift import basis
+    from volerr.loop.drift import fit as core
 
     rng = np.random.default_rng(11)
     t = np.arange(0.0, 16 * 3600.0, 30.0)
@@ -71,8 +71,9 @@ def test_a_term_dropped_as_not_significant_is_listed(tmp_path):
              {"source": "T_b", "p": None, "tau_s": 0.0, "minus": None}]
     fold, rule = basis.folds(s)
     R = np.ones((len(t), 1))
-    kept, fit = sig(s, specs, R, y, fold, rule)
-    full = core._jackknife(s, specs, R, y, fold)
+    ch = core.Channel(s, y, R, fold, rule)
+    kept, fit = sig(ch, specs)
+    full = core._jackknife(ch, specs)
     assert abs(full["coef"][1]) < 1.5 * full["coef_std"][1]      # clearly not significant
     assert abs(full["coef"][0]) > 10 * full["coef_std"][0]
     assert [k["source"] for k in kept] == ["T_a"]

@@ -9,10 +9,10 @@ import pytest
 
 from volerr.errors import InputError
 from helpers import drift_sim as D
-from volerr.loop import drift as core
-from volerr.loop import drift_basis as B
-from volerr.loop.drift_cv import Engine
-from volerr.loop.drift_split import parse_window, stretch_split
+from volerr.loop.drift import basis as B
+from volerr.loop.drift import fit as core
+from volerr.loop.drift.engine import Engine
+from volerr.loop.drift.split import parse_window, stretch_split
 
 
 def _first_order(u, tau, dt):
@@ -96,8 +96,7 @@ def test_planted_heat_response_found_with_its_time_constant():
     assert abs(heat[0]["tau_s"] / 1800.0 - 1) < 0.15
     assert all(t["source"] == "heat" for t in res["terms"])
     f = res["fit"]
-    R = np.ones((len(s.t_s), 1))
-    after = core.predict(s, R, f["design"], np.concatenate([f["zeros"], f["coef"]]), res["y"])
+    after = core.predict(s, f["design"], np.concatenate([f["zeros"], f["coef"]]), res["y"])
     assert np.mean(np.abs((res["y"] - after)[s.test])) < 0.1
 
 
@@ -114,13 +113,12 @@ def test_a_held_out_run_is_predicted_from_its_own_zero():
     assert res["fold_rule"] == "stretches"      # two training runs: stretches of each
     r = res["channels"]["x"]
     f = r["fit"]
-    R = (s.run[:, None] == np.arange(3)).astype(float)
-    after = core.predict(s, R, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
+    after = core.predict(s, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
     first = np.flatnonzero(s.run == 2)[0]
     assert after[first] == r["y"][first]
     y2 = r["y"].copy()
     y2[s.run == 2] += 5.0                       # another zero of the held-out run
-    after2 = core.predict(s, R, f["design"], np.concatenate([f["zeros"], f["coef"]]), y2)
+    after2 = core.predict(s, f["design"], np.concatenate([f["zeros"], f["coef"]]), y2)
     np.testing.assert_allclose(after2[s.run == 2] - after[s.run == 2], 5.0)
 
 

@@ -1,5 +1,5 @@
 """Directed drift channels as rows of the layout's model, fitted jointly
-(:mod:`volerr.loop.drift_rows`), and the Python API on drift runs.
+(:mod:`volerr.loop.drift.rows`), and the Python API on drift runs.
 
 The simulator here is its own: a machine whose tool point moves along X by 0.8 um/K of a lag
 (tau 1500 s) of sensor ``T_a`` and along Z by -1.1 um/K of the same, while the spindle tilts
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from helpers import drift_sim as D
-from volerr.loop import drift_rows as R
+from volerr.loop.drift import rows as R
 
 DT = 30.0
 HOURS = 8.0
@@ -190,3 +190,54 @@ def test_api_equals_cli(campaign):
     res.write_json(folder / "api.json")
     res.write_html(folder / "api.html")
     assert "<img" in (folder / "api.html").read_text()
+
+
+def test_drift_result_contract(campaign):
+    """The drift loop's result keeps the result contract (issue 42): a short repr (before: a
+    23,401-character dump of its data), a table of every reported coefficient and time
+    constant with its standard uncertainty, one figure per channel, the page from the
+    loop's template and style."""
+    import matplotlib.figure
+
+    import volerr
+
+    folder, _, doc, out = campaign
+    res = volerr.loop("DMU50", [f"drift:{folder / f'r{r}.csv'}" for r in range(3)])
+    assert "\n" not in repr(res) and len(repr(res)) < 160
+    assert repr(res).startswith("<volerr DriftReport: ") and out.split("\n")[0][:60] in repr(res)
+    rows = {r.name: r for r in res._rows()}
+    terms = [(f"{e['name']}_{j}", t) for e in doc["effects"] for j, t in enumerate(e["terms"])]
+    assert terms, "the campaign's loop found no effect: the table test would test nothing"
+    for name, t in terms:
+        assert (rows[name].value, rows[name].std, rows[name].unit) == (t["value"], t["std"],
+                                                                       t["unit"])
+        if t["lag_s"]:
+            assert (rows[f"{name}:tau"].value, rows[f"{name}:tau"].unit) == \
+                (t["lag_s"]["value"], "s")
+    for label, c in doc["channels"].items():
+        assert rows[f"{label}:mae_after"].value == c["mae_after_um"]
+    figs = res.figures()
+    assert sorted(figs) == sorted(f"channel {k}" for k in doc["channels"])
+    assert all(isinstance(f, matplotlib.figure.Figure) for f in figs.values())
+    res.write_html(folder / "contract.html")
+    page = (folder / "contract.html").read_text()
+    assert "border-collapse" in page and page.count("<img") == len(doc["channels"])
+    assert res.to_dict() == json.loads((folder / "j.json").read_text()) | {"runs": res["runs"]}
+
+
+def test_cli_refuses_outputs_the_kind_does_not_have(campaign, tmp_path):
+    """One line, exit 2, nothing written: ``--errors-out`` on drift runs, ``--predictions-out``
+    on measured deviations (the refusals stated once, by ``volerr.loop`` and its results)."""
+    folder = campaign[0]
+    p = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", "drift:r0.csv",
+                        "drift:r1.csv", "drift:r2.csv", "--json", str(tmp_path / "a.json"),
+                        "--errors-out", str(tmp_path / "err")], cwd=folder,
+                       capture_output=True, text=True)
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
+    assert "--errors-out" in p.stderr and "drift" in p.stderr
+    assert not (tmp_path / "a.json").exists() and not (tmp_path / "err").exists()
+    p = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", "drift:r0.csv",
+                        "--out-dir", str(tmp_path / "aug")], cwd=folder,
+                       capture_output=True, text=True)
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
+    assert "--out-dir" in p.stderr and not (tmp_path / "aug").exists()

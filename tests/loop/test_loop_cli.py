@@ -142,3 +142,18 @@ def test_layout_effect_table_errors(tmp_path):
     for why, table in bad.items():
         with pytest.raises(InputError):
             parse_layout(text + "\n" + table, f"{why}.toml")
+
+
+def test_cli_loop_refuses_drift_options_on_deviations(tmp_path, campaign):
+    """``--predictions-out`` and ``--holdout-files`` are the drift loop's: on measured
+    deviations one line, exit 2, nothing written (the refusals are ``volerr.loop``'s and its
+    result's, not the command's)."""
+    um = _write(tmp_path / "um.csv", campaign.columns())
+    r = _cli("loop", "MB1", um, "--json", tmp_path / "r.json", "--degree", "2",
+             "--predictions-out", tmp_path / "p.csv")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "--predictions-out" in r.stderr and "drift" in r.stderr
+    assert not (tmp_path / "r.json").exists() and not (tmp_path / "p.csv").exists()
+    r = _cli("loop", "MB1", um, "--json", tmp_path / "r.json", "--holdout-files", um)
+    assert r.returncode == 2 and "--holdout-files" in r.stderr
+    assert not (tmp_path / "r.json").exists()

@@ -1,22 +1,22 @@
 """The HTML page of the loop on drift runs: per channel a time-series figure (measured, the
 declared model's prediction "before", the augmented model's "after", the static regression,
 the residual; below it the spindle programme and the sensors the effects chose), held-out
-readings shaded; the tables of :class:`volerr.loop.drift_report.DriftReport`."""
+readings shaded; the tables of :class:`volerr.loop.drift.report.DriftReport`.  The page is
+``templates/drift.html.j2`` of :mod:`volerr.loop`, in the style of the loop's other page
+(``templates/style.html.j2``, :func:`render_template`)."""
 
 from __future__ import annotations
 
-from html import escape
-
 import numpy as np
 
-from ..plotstyle import embedded_img, figure, png, styled
-from . import drift_basis as basis
+from ...plotstyle import embedded_img, figure, png, styled
+from ...selection.rules import SIG_K
+from . import basis
 
 MAX_DRAWN = 4000      # readings drawn per line (every n-th: the figure stays light)
 
 
-@styled
-def fig_channel(report, label: str) -> str:
+def _draw(report, label: str):
     s = report.series
     p = report.pred[label]
     y = s.channels[label]
@@ -49,7 +49,18 @@ def fig_channel(report, label: str) -> str:
     ax[2].set_xlabel("time / h (runs one after the other)")
     for a in ax:
         _shade(a, t_h, s.test)
-    return embedded_img(png(fig), f"channel {label} against time")
+    return fig
+
+
+@styled
+def channel_figure(report, label: str):
+    """The time-series figure of channel ``label`` (a matplotlib Figure)."""
+    return _draw(report, label)
+
+
+@styled
+def _channel_img(report, label: str) -> str:
+    return embedded_img(png(_draw(report, label)), f"channel {label} against time")
 
 
 def _run_offsets(s) -> np.ndarray:
@@ -68,21 +79,25 @@ def _shade(ax, t_h, test) -> None:
         ax.axvspan(t_h[a], t_h[b - 1], color="0.9", zorder=0)
 
 
+def render_template(name: str, **context) -> str:
+    """The loop's template ``name`` (``volerr/loop/templates``) rendered with ``context``
+    (autoescaped, undefined names refused)."""
+    from importlib import resources
+
+    import jinja2
+
+    folder = resources.files("volerr.loop") / "templates"
+    env = jinja2.Environment(
+        loader=jinja2.FunctionLoader(lambda n: (folder / n).read_text(encoding="utf-8")),
+        autoescape=True, undefined=jinja2.StrictUndefined)
+    return env.get_template(name).render(**context)
+
+
 def render_html(report) -> str:
-    d = report.data
-    rows = "".join(
-        f"<tr><td>{escape(k)}</td><td>{c['n_test']}</td><td>{c['mae_before_um']:.3f}</td>"
-        f"<td>{c['mae_static_um']:.3f}</td><td>{c['mae_after_um']:.3f}</td>"
-        f"<td>{c['rms_before_um']:.3f}</td><td>{c['rms_after_um']:.3f}</td>"
-        f"<td>{c['max_abs_before_um']:.3f}</td><td>{c['max_abs_after_um']:.3f}</td></tr>"
-        for k, c in d["channels"].items())
-    eff = "".join(f"<li>{escape(line.strip())}</li>" for line in report.summary_lines()[1:])
-    figs = "".join(f"<h2>Channel {escape(k)}</h2>{fig_channel(report, k)}" for k in d["channels"])
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>volerr loop: drift "
-            f"runs</title></head><body><h1>Loop on drift runs: {escape(d['layout'])}</h1>"
-            f"<p>{escape(report.summary_lines()[0])}</p>"
-            f"<table border='1'><tr><th>channel</th><th>held out</th><th>MAE before</th>"
-            f"<th>MAE static</th><th>MAE after</th><th>RMS before</th><th>RMS after</th>"
-            f"<th>max before</th><th>max after</th></tr>{rows}</table>"
-            f"<p>um; held-out readings only; uncertainties with k = 2.</p><ul>{eff}</ul>"
-            f"{figs}</body></html>")
+    """The complete HTML text of a :class:`volerr.loop.drift.report.DriftReport`."""
+    lines = report.summary_lines()
+    figs = {k: _channel_img(report, k) for k in report.data["channels"]}
+    return render_template("drift.html.j2", r=report.data, headline=lines[0].strip()
+                           if not report.data.get("extrapolation") else lines[1].strip(),
+                           extrapolation=lines[0].strip(), figures=figs, k=report.K_PRINT,
+                           sig_k=f"{SIG_K:g}")

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import require
-from .drift_basis import DriftSeries
+from ...errors import require
+from .series import DriftSeries
 
 DEFAULT_TEST = 0.25          # share of a single run's time held out at its end
 _UNITS = {"s": 1.0, "min": 60.0, "h": 3600.0}

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import drift_basis as basis
+from . import basis
 
 #: the tilt read by two sensors along an axis: (about which axis, sign of ds/dz)
 TILT = {"X": ("Y", 1.0), "Y": ("X", -1.0)}

@@ -1,5 +1,5 @@
 """Forward selection of the terms of one drift channel, judged by blocked cross-validation
-(:mod:`volerr.loop.drift_cv`) on the training part only.
+(:mod:`volerr.loop.drift.engine`) on the training part only.
 
 Steps (:func:`select_terms`):
 
@@ -9,15 +9,17 @@ Steps (:func:`select_terms`):
    the same lag; the heat input keeps the exponent of its first term (one heat input);
 3. the candidate with the least cross-validated SSE is taken when it lowers the
    cross-validated mean square by at least ``CV_GAIN`` (relative) *and* gains at least
-   ``select.BIC_GAIN`` in BIC on all training readings (the rule of the 3-D loop; a
+   ``BIC_GAIN`` in BIC on all training readings (the rule of the 3-D loop; a
    difference costs one parameter more, for the choice of its second sensor); ties (equal
    to ``TIE_REL``) go to the candidate first in the library's order (sensors in file order,
    shorter lags first, the heat input last), a stated rule rather than rounding;
 4. stop when no candidate passes or ``MAX_TERMS`` terms are in the model.
 
-The candidates within ``ALT_REL`` of the chosen one's cross-validated RMS (in its place)
+The candidates within ``CV_SAME`` of the chosen one's cross-validated RMS (in its place)
 are its *alternatives*: explanations these data cannot tell apart (the sensor selection rule
-of :mod:`volerr.loop.lags`, judged by cross-validation).
+of :mod:`volerr.loop.lags`, judged by cross-validation).  ``CV_GAIN``, ``BIC_GAIN``,
+``CV_SAME`` and the tie tolerance ``TIE_REL`` (``TIE_SCORE_REL``) are the rules of
+:mod:`volerr.selection.rules`.
 """
 
 from __future__ import annotations
@@ -27,14 +29,13 @@ import math
 
 import numpy as np
 
-from .drift_cv import Engine
-from .select import BIC_GAIN
+from ...selection import stepwise
+from ...selection.rules import CV_GAIN, CV_SAME, bic_accepts, cv_gain, delta_bic
+from ...selection.rules import TIE_SCORE_REL as TIE_REL
+from .engine import Engine
 
-CV_GAIN = 0.01        # relative drop of the cross-validated mean square a term must bring
 DIFF_GAIN = 0.10      # a difference of two sensors must beat the best single sensor by this
 MAX_TERMS = 6         # terms per channel (the effects reported)
-TIE_REL = 1e-9        # relative difference of two scores below which they are tied
-ALT_REL = 0.01        # cross-validated RMS within 1 %: not told apart (lags.CV_SAME)
 N_ALT = 3
 
 
@@ -67,38 +68,43 @@ def select_terms(eng: Engine, cols, n_runs: int, cands=None, start=(), max_terms
     mz = n_runs + len(cols)
     if cands is None:
         cands = candidates(cols)
-    W = np.eye(mz)[:, :n_runs]
-    chosen, taken, chosen_p = [], set(), None
+    st = {"W": np.eye(mz)[:, :n_runs], "taken": set(), "p": None}
     for term in start:
         a, b = term["pair"]
-        W = np.column_stack([W, _combo(mz, (a + n_runs, b + n_runs if b >= 0 else -1))])
-        taken.add((a, b))
-        chosen_p = cols[a].p if cols[a].p is not None else chosen_p
-    cur = eng.cv_sse(W) / eng.n
-    rss0 = eng.train_rss_many(W, np.zeros((0, 2), int))[1]
+        st["W"] = np.column_stack([st["W"], _combo(mz, (a + n_runs, b + n_runs if b >= 0 else -1))])
+        st["taken"].add((a, b))
+        st["p"] = cols[a].p if cols[a].p is not None else st["p"]
+    st["cur"] = eng.cv_sse(st["W"]) / eng.n
+    st["rss0"] = eng.train_rss_many(st["W"], np.zeros((0, 2), int))[1]
     zc = cands + np.where(cands >= 0, n_runs, 0)
-    while len(chosen) + len(start) < max_terms:
-        ok = _allowed(cands, cols, chosen_p, taken)
-        sse, _ = eng.cv_many(W, zc[ok])
+
+    def propose(chosen):
+        ok = _allowed(cands, cols, st["p"], st["taken"])
+        sse, _ = eng.cv_many(st["W"], zc[ok])
         mse = sse / eng.n
         if not np.isfinite(mse).any():
-            break
+            return None
         k = _first_best(mse, cands[ok])
-        rss, _ = eng.train_rss_many(W, zc[ok][k:k + 1])
+        rss, _ = eng.train_rss_many(st["W"], zc[ok][k:k + 1])
         extra = 1 + (cands[ok][k, 1] >= 0)
-        dbic = eng.n * math.log(max(rss[0], 1e-300) / max(rss0, 1e-300)) + extra * math.log(eng.n)
-        if not (mse[k] <= cur * (1 - CV_GAIN) and dbic <= -BIC_GAIN):
-            break
-        pair = tuple(int(x) for x in cands[ok][k])
-        alts = _alternatives(mse, k, cands[ok])
-        chosen.append({"pair": pair, "cv_mse": float(mse[k]), "cv_mse_before": float(cur),
-                       "delta_bic": float(dbic), "alternatives": alts})
-        taken.add(pair)
+        dbic = delta_bic(eng.n, rss[0], st["rss0"], extra)
+        return {"pair": tuple(int(x) for x in cands[ok][k]), "cv_mse": float(mse[k]),
+                "cv_mse_before": float(st["cur"]), "delta_bic": float(dbic),
+                "alternatives": _alternatives(mse, k, cands[ok]),
+                "_z": zc[ok][k], "_rss": float(rss[0])}
+
+    def take(term):
+        pair = term["pair"]
+        st["taken"].add(pair)
         if cols[pair[0]].p is not None:
-            chosen_p = cols[pair[0]].p
-        W = np.column_stack([W, _combo(mz, zc[ok][k])])
-        cur, rss0 = float(mse[k]), float(rss[0])
-    return chosen
+            st["p"] = cols[pair[0]].p
+        st["W"] = np.column_stack([st["W"], _combo(mz, term.pop("_z"))])
+        st["cur"], st["rss0"] = term["cv_mse"], term.pop("_rss")
+
+    def accept(term, chosen):
+        return cv_gain(term["cv_mse"], st["cur"]) and bic_accepts(term["delta_bic"])
+
+    return stepwise.forward(propose, accept, max_terms - len(start), take)
 
 
 def _first_best(mse, cands) -> int:
@@ -118,7 +124,7 @@ def _first_best(mse, cands) -> int:
 
 def _alternatives(mse, k, cands) -> list:
     rms = np.sqrt(mse)
-    near = np.flatnonzero(np.isfinite(rms) & (rms <= rms[k] * (1 + ALT_REL)))
+    near = np.flatnonzero(np.isfinite(rms) & (rms <= rms[k] * (1 + CV_SAME)))
     near = [int(i) for i in near[np.argsort(rms[near], kind="stable")] if i != k][:N_ALT]
     return [(int(cands[i, 0]), int(cands[i, 1]), float(rms[i])) for i in near]
 

@@ -1,6 +1,11 @@
-"""The report of the loop on drift runs (:func:`loop_drift`): JSON (INTERFACE.md "Thermal
-drift tests ... and the loop on measured heat"), the console, the predictions CSV and the
-HTML page with one time-series figure per channel.
+"""The loop on drift runs, start to end: drift files in, a :class:`DriftReport` out.
+
+:func:`loop_drift` reads the files into one :class:`~volerr.loop.drift.series.DriftSeries`
+(:mod:`~volerr.loop.drift.series`), holds out readings (:mod:`~volerr.loop.drift.split`) and
+calls :func:`analyse` on that one data type: the directed channels become rows of the
+layout's model (:mod:`~volerr.loop.drift.rows`), every channel (or quantity) is fitted
+(:mod:`~volerr.loop.drift.fit`), and the JSON is assembled here (its fields: INTERFACE.md,
+"Thermal drift tests ... and the loop on measured heat").
 
 Effects: the terms of one channel with the same covariate (the heat input, a sensor, a
 difference of two sensors) form one effect ("two time constants where one is not enough");
@@ -12,167 +17,53 @@ jackknife) in ``parameters``/``std``; uncertainties are printed with k = 2.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import require
-from ..fileio import json_text
-from . import drift as core
-from . import drift_basis as basis
-from . import drift_rows as rows_mod
-from .drift_split import extrapolation, extrapolation_line, held_out
-
-K_PRINT = 2.0      # coverage factor of the printed uncertainties (the loop's console, 3-D too)
-
-
-
-def load_series(paths) -> basis.DriftSeries:
-    """Drift files (paths) -> one :class:`~volerr.loop.drift_basis.DriftSeries` (every run
-    its own zero and its own lag start); runs must log the same channels and inputs."""
-    return _series(_runs(paths))
-
-
-def _runs(paths) -> list:
-    from ..instruments.drift import read_runs
-
-    runs = [r for p in paths for r in read_runs(p)]
-    first = runs[0]
-    for r in runs[1:]:
-        require(set(r.channels) == set(first.channels) and set(r.inputs) == set(first.inputs),
-                f"{r.name}: its channels and logged inputs differ from {first.name}'s; the "
-                f"runs of one loop log the same ones")
-    return runs
-
-
-def _series(runs) -> basis.DriftSeries:
-    first = runs[0]
-    cat = np.concatenate
-    return basis.DriftSeries(
-        cat([r.t_s for r in runs]), cat([np.full(r.n, i) for i, r in enumerate(runs)]),
-        [(r.file, r.run) for r in runs],
-        {k: cat([r.inputs[k] for r in runs]) for k in first.inputs},
-        {k: cat([r.channels[k] for r in runs]) for k in first.channels},
-        dict(first.directions), dict(first.heights))
-
-
-@dataclass
-class DriftReport:
-    """Result of :func:`loop_drift`: ``data`` the JSON, ``rows`` the predictions, ``series``
-    and ``pred`` what the figures need."""
-
-    data: dict
-    series: basis.DriftSeries
-    pred: dict = field(default_factory=dict)
-
-    def __getitem__(self, key):
-        return self.data[key]
-
-    @property
-    def effects(self) -> list:
-        return self.data["effects"]
-
-    def write_json(self, path, inputs=()) -> Path:
-        from ..fileio import write_text
-
-        return write_text(path, json_text(self.data), inputs=list(inputs))
-
-    def write_predictions(self, path, inputs=()) -> Path:
-        """CSV ``file,run,t_s,channel,measured_um,before_um,after_um,split`` (every reading)."""
-        from ..fileio import write_text
-
-        s = self.series
-        lines = ["file,run,t_s,channel,measured_um,before_um,after_um,split"]
-        for label, p in self.pred.items():
-            y = s.channels[label]
-            for i in range(len(s.t_s)):
-                f, r = s.runs[s.run[i]]
-                lines.append(f"{f},{r},{s.t_s[i]:.10g},{label},{y[i]:.10g},{p['before'][i]:.10g},"
-                             f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'}")
-        return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
-
-    def write_html(self, path, inputs=()) -> Path:
-        from ..fileio import write_text
-        from .drift_figure import render_html
-
-        return write_text(path, render_html(self), inputs=list(inputs))
-
-    def summary(self) -> str:
-        """The whole console text of ``volerr loop`` on drift runs."""
-        return "\n".join(self.summary_lines())
-
-    def to_dict(self) -> dict:
-        return self.data
-
-    def summary_lines(self) -> list:
-        d = self.data
-        out = [f"{d['layout']}: drift runs {', '.join(d['runs'])}; {d['split']}; "
-               f"{d['n_train']} training, {d['n_test']} held-out readings; choices by blocked "
-               f"cross-validation over {d['n_folds']} {d['fold_rule']}"]
-        if d.get("extrapolation"):
-            out.insert(0, "  " + extrapolation_line(d["extrapolation"]))
-        for label, c in d["channels"].items():
-            out.append(f"  channel {label}: held-out MAE {c['mae_before_um']:.3f} -> "
-                       f"{c['mae_after_um']:.3f} um (static regression on all temperatures "
-                       f"{c['mae_static_um']:.3f}), RMS {c['rms_before_um']:.3f} -> "
-                       f"{c['rms_after_um']:.3f}, max {c['max_abs_before_um']:.3f} -> "
-                       f"{c['max_abs_after_um']:.3f} um")
-        for sym, q in d.get("quantities", {}).items():
-            rows = ", ".join(f"{c} {w:+.4g}" for c, w in q["rows"].items())
-            own = ", ".join(q["layout_parameters"]) or "none"
-            out.append(f"  {sym} ({q['unit']}): {q['description']}, rows {rows}; the layout's "
-                       f"parameters it is at this position: {own}")
-        for e in d["effects"]:
-            what = e["channel"] if not e.get("quantity") else \
-                f"{e['quantity']} (channels {', '.join(e['channels'])})"
-            out.append(f"  {e['kind']} {e['name']}: {what} varies with {e['basis']}")
-            for t in e["terms"]:
-                out.append("    " + _term_line(t))
-        for n in d["not_significant"]:
-            out.append(f"  not significant (|value| < {core.SIG_K:g} u), left out: {n}")
-        return out
-
-
-def _term_line(t: dict) -> str:
-    k = K_PRINT
-    c = f"{t['value']:.4g} +- {k * t['std']:.2g} {t['unit']} (k = {k:g})"
-    lag = t.get("lag_s")
-    if lag:
-        u = f" +- {k * lag['std']:.0f}" if lag.get("std") is not None else " (u not determined)"
-        c += f", tau = {lag['value']:.0f}{u} s (k = {k:g})"
-    if t.get("alternatives"):
-        c += "; these data cannot tell it from " + ", ".join(
-            a["covariate"] + (f" through {a['lag_s']:.0f} s" if a.get("lag_s") else "")
-            for a in t["alternatives"])
-    return f"{t['basis']}: {c}"
+from . import basis
+from . import fit as core
+from . import rows as rows_mod
+from .report import DriftReport
+from .series import DriftSeries, read_runs, stack_runs
+from .split import extrapolation, held_out
 
 
 def loop_drift(layout: str, paths, window=None, files=(), differences: bool = False,
                progress=None) -> DriftReport:
     """The loop on drift files ``paths`` and the held-out ``files`` (read beside them, every
-    run of theirs held out; see :mod:`volerr.loop.drift`).  Channels with a direction are
-    rows of the layout's model (:mod:`volerr.loop.drift_rows`): the quantities of the chain
-    they read are modelled, each channel predicted by its row of them."""
-    from ..machine.model import load
+    run of theirs held out; ``window`` ``"A:B"`` holds out the readings with A <= t < B; see
+    :mod:`volerr.loop.drift.fit`)."""
+    from ...instruments.drift import test_position
+    from ...machine.model import load
 
     model = load(layout)
     named = {Path(p).resolve() for p in paths}
-    runs = _runs(list(paths) + [f for f in files if Path(f).resolve() not in named])
-    s = _series(runs)
+    runs = read_runs(list(paths) + [f for f in files if Path(f).resolve() not in named])
+    s = stack_runs(runs)
     s.test, said = held_out(s, window, files)
-    rows = _rows(s, runs[0], model)
+    directed = rows_mod.rows_of(s.directions, s.heights) is not None
+    position = test_position(runs[0], model) if directed else {}
+    return analyse(model, s, position, said, differences, progress)
+
+
+def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool = False,
+            progress=None) -> DriftReport:
+    """The loop on the series ``s`` (its ``test`` mask set; ``split`` says how) of a machine
+    ``model`` held at ``position`` (the first run's axis values): channels with a direction
+    are rows of the layout's model, the quantities of the chain they read are modelled,
+    each channel predicted by its row of them."""
+    rows = _rows(s, position, model)
     m, resid = (s, {}) if rows is None else rows_mod.modelled_series(s, rows)
     res = core.run_drift(m, differences=differences, progress=progress)
     data = {"layout": model.name, "kind": "drift",
-            "runs": [f if not r else f"{f}[{r}]" for f, r in s.runs], "split": said,
+            "runs": [f if not r else f"{f}[{r}]" for f, r in s.runs], "split": split,
             "n_points": int(len(s.t_s) * len(s.channels)), "n_train": int(s.train.sum()),
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
             "not_significant": [], "static_regression": {}, "unidentifiable": [],
             "extrapolation": extrapolation(s)}
-    R = (s.run[:, None] == np.arange(len(s.runs))[None, :]).astype(float)
-    qpred = {label: _prediction(m, R, r) for label, r in res["channels"].items()}
+    qpred = {label: _prediction(m, r) for label, r in res["channels"].items()}
     pred = {k: qpred[k] for k in s.channels if k not in resid}
     if rows is not None:
         pred.update(rows_mod.map_back(s, rows, qpred, resid))
@@ -197,21 +88,19 @@ def loop_drift(layout: str, paths, window=None, files=(), differences: bool = Fa
     return DriftReport(data, s, pred)
 
 
-def _rows(s, run, model):
-    """The rows of the directed channels, named in the layout at the first run's position
+def _rows(s, position, model):
+    """The rows of the directed channels, named in the layout at the test ``position``
     (None: no channel has a direction)."""
-    from ..instruments.drift import _test_position
-
     rows = rows_mod.rows_of(s.directions, s.heights)
     if rows is not None:
-        rows_mod.name_in_layout(rows, model, _test_position(run, model),
+        rows_mod.name_in_layout(rows, model, position,
                                 taken=[k for k in s.channels if k not in rows.channels])
     return rows
 
 
-def _prediction(m, R, r) -> dict:
+def _prediction(m, r) -> dict:
     f = r["fit"]
-    after = core.predict(m, R, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
+    after = core.predict(m, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
     return {"before": r["before"], "after": after, "static": r["static"], "terms": r["terms"]}
 
 

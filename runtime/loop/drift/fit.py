@@ -3,21 +3,22 @@ cools, the displacement channels traced to the heat put in and to the sensors th
 
 Steps (:func:`run_drift`):
 
-1. split (:mod:`volerr.loop.drift_split`): the held-out readings (``--holdout-time``,
+1. split (:mod:`volerr.loop.drift.split`): the held-out readings (``--holdout-time``,
    ``--holdout-files`` or, without them, the last ``DEFAULT_TEST`` of every run's time:
    whole contiguous stretches); nothing below sees them;
 2. the declared model: at one position the geometric model predicts a constant per channel
    and run, the run's *zero* (its first displacement reading): the "before" prediction;
-3. per channel, the basis (:mod:`volerr.loop.drift_basis`: sensors, the heat input
+3. per channel, the basis (:mod:`volerr.loop.drift.basis`: sensors, the heat input
    ``lag((S/S_ref)^p, tau)``) and its blocked folds; the terms chosen by cross-validation
-   (:mod:`volerr.loop.drift_select`) in two stages: first the heat input (its exponent, up
+   (:mod:`volerr.loop.drift.select`) in two stages: first the heat input (its exponent, up
    to ``HEAT_TERMS`` terms: plain and one or two time constants), then the sensors;
 4. every time constant refined between its grid neighbours by the cross-validated error
    (``REFINE`` values of ln tau), the model fitted on all training readings (a free zero per
    training run), the standard uncertainties of coefficients and time constants by the
    blocked jackknife over the folds (``u^2 = (K-1)/K sum (theta_k - mean)^2``: honest where
    the readings are autocorrelated, as a drift log is; the least-squares formula is not);
-5. a term whose coefficient is not significant (``|value| < SIG_K u``) is dropped (the
+5. a term whose coefficient is not significant (``|value| < SIG_K u``,
+   :mod:`volerr.selection.rules`) is dropped (the
    least significant first, refitted each time): no effect is presented with a term the
    data do not support;
 6. the prediction of every reading: a training run with its fitted zero, a held-out run with
@@ -31,27 +32,62 @@ Units: displacements um, temperatures degC (changes in K), time s, speed rpm.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from . import drift_basis as basis
-from . import drift_select as sel
-from .drift_cv import Engine
+from ...selection import stepwise
+from ...selection.linalg import solve_scaled as _solve_normal
+from ...selection.profile import profile_vertex
+from ...selection.rules import CV_GAIN, SIG_K, TIE_SCORE_REL
+from . import basis
+from . import select as sel
+from .engine import Engine
+
+__all__ = ["HEAT_TERMS", "REFINE", "RECENTRE", "SIG_K", "Channel", "column", "predict",
+           "run_drift"]
 
 HEAT_TERMS = 3        # plain heat input and up to two time constants
 REFINE = np.linspace(-1.0, 1.0, 9)   # ln-tau steps (in grid steps) tried around a grid value
 RECENTRE = 3         # searches of a fold's time constant re-centred at an edge
-SIG_K = 2.0           # coverage factor of the significance test of a term
+
+
+@dataclass
+class Channel:
+    """What the steps of one channel share: the series ``s`` (its ``test`` mask set), the
+    channel's readings ``y`` (N,) um, the run indicators ``R`` (N, n_runs), the blocked
+    ``fold`` of every training reading (-1 held out) and its ``rule`` (``"runs"`` or
+    ``"stretches"``)."""
+
+    s: basis.DriftSeries
+    y: np.ndarray
+    R: np.ndarray
+    fold: np.ndarray
+    rule: str
+
+    @property
+    def n_runs(self) -> int:
+        return self.R.shape[1]
+
+    def cv(self, D) -> float:
+        """Cross-validated mean square (um^2) of the model with the columns ``D``."""
+        eng = Engine(D, self.y, self.fold, self.rule == "runs", self.s.run, self.n_runs)
+        return eng.cv_sse(np.eye(D.shape[1])) / eng.n
+
+    def design(self, specs, taus=None) -> np.ndarray:
+        """The run indicators and the columns of the terms ``specs`` (their lags ``taus``)."""
+        cols = [column(self.s, sp, None if taus is None else taus[i])
+                for i, sp in enumerate(specs)]
+        return np.column_stack([self.R] + cols) if cols else self.R
 
 
 def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) -> dict:
     """The loop on the drift runs ``s`` (its ``test`` mask set): per channel the chosen
-    terms, predictions and figures (see :mod:`volerr.loop.drift_report` for the JSON)."""
+    terms, predictions and figures (see :mod:`volerr.loop.drift.report` for the JSON)."""
     s.memo.clear()            # columns depend on the split (S_ref): computed afresh
     cols, X = basis.library(s)
     fold, rule = basis.folds(s)
-    n_runs = len(s.runs)
-    R = (s.run[:, None] == np.arange(n_runs)[None, :]).astype(float)
+    R = s.indicators()
     Z = np.column_stack([R, X])
     cands = _candidates(s, cols, differences)
     out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {}}
@@ -59,9 +95,8 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
     for label, y in s.channels.items():
         if progress:
             progress(label)
-        out["channels"][label] = _channel(s, cols, X, Z, R, y, fold, rule, cands, cache)
+        out["channels"][label] = _channel(Channel(s, y, R, fold, rule), cols, Z, cands, cache)
     return out
-
 
 def _candidates(s, cols, differences: bool) -> tuple:
     """(heat candidates, sensor candidates) as (nc, 2) pairs: a sensor's lag is searched up
@@ -79,37 +114,34 @@ def _candidates(s, cols, differences: bool) -> tuple:
     return c[heat], c[~heat]
 
 
-def _channel(s, cols, X, Z, R, y, fold, rule, cands, cache) -> dict:
-    n_runs = R.shape[1]
-    eng = Engine(Z, y, fold, rule == "runs", s.run, n_runs, cache)
+def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
+    eng = Engine(Z, ch.y, ch.fold, ch.rule == "runs", ch.s.run, ch.n_runs, cache)
     heat_c, sensor_c = cands
     terms = []
     if len(heat_c):
-        terms = sel.select_terms(eng, cols, n_runs, cands=heat_c, max_terms=HEAT_TERMS)
+        terms = sel.select_terms(eng, cols, ch.n_runs, cands=heat_c, max_terms=HEAT_TERMS)
     if len(sensor_c):
-        terms = terms + sel.select_terms(eng, cols, n_runs, cands=sensor_c, start=terms)
-    specs = _backward(s, [_spec(cols, t) for t in terms], R, y, fold, rule)
-    specs = _refine_all(s, specs, R, y, fold, rule)
-    specs, fit = _significant(s, specs, R, y, fold, rule)
-    return {"terms": specs, "fit": fit, "y": y,
-            "static": _static(s, R, y), "before": y[s.firsts()][s.run]}
+        terms = terms + sel.select_terms(eng, cols, ch.n_runs, cands=sensor_c, start=terms)
+    specs = _backward(ch, [_spec(cols, t) for t in terms])
+    specs = _refine_all(ch, specs)
+    specs, fit = _significant(ch, specs)
+    return {"terms": specs, "fit": fit, "y": ch.y,
+            "static": _static(ch), "before": ch.y[ch.s.firsts()][ch.s.run]}
 
 
-def _backward(s, specs, R, y, fold, rule) -> list:
+def _backward(ch: Channel, specs) -> list:
     """Drop a term that, given all the others, no longer lowers the cross-validated mean
-    square by ``drift_select.CV_GAIN`` (a later term made it redundant: the heat input
-    taken first where a sensor tells the same story better), the least useful first."""
-    while len(specs) > 1:
-        cols = [column(s, sp) for sp in specs]
-        full = _cv(np.column_stack([R] + cols), y, fold, rule, s.run, R.shape[1])
-        without = [_cv(np.column_stack([R] + cols[:i] + cols[i + 1:]), y, fold, rule, s.run,
-                       R.shape[1]) for i in range(len(specs))]
-        i = int(np.argmin(without))
-        if without[i] * (1 - sel.CV_GAIN) < full:
-            specs = specs[:i] + specs[i + 1:]
-            continue
-        return specs
-    return specs
+    square by ``CV_GAIN`` (a later term made it redundant: the heat input taken first where
+    a sensor tells the same story better), the least useful first."""
+    def without(items, i):
+        cols = [column(ch.s, sp) for sp in items]
+        return ch.cv(np.column_stack([ch.R] + cols[:i] + cols[i + 1:])), None
+
+    def drop(res, items):
+        full = ch.cv(np.column_stack([ch.R] + [column(ch.s, sp) for sp in items]))
+        return res[0] * (1 - CV_GAIN) < full
+
+    return stepwise.backward(specs, without, drop, keep=1)[0]
 
 
 def _spec(cols, term) -> dict:
@@ -160,40 +192,34 @@ def column(s, sp, tau=None) -> np.ndarray:
     return s.memo[key]
 
 
-def _design(s, specs, R, taus=None) -> np.ndarray:
-    cols = [column(s, sp, None if taus is None else taus[i]) for i, sp in enumerate(specs)]
-    return np.column_stack([R] + cols) if cols else R
-
-
-def _cv(D, y, fold, rule, run, n_runs) -> float:
-    eng = Engine(D, y, fold, rule == "runs", run, n_runs)
-    return eng.cv_sse(np.eye(D.shape[1])) / eng.n
-
-
-def _refine_all(s, specs, R, y, fold, rule) -> list:
+def _refine_all(ch: Channel, specs) -> list:
     """Every term's time constant refined in turn, the others as they stand."""
     specs = list(specs)
     for i in range(len(specs)):
-        others = [column(s, o) for j, o in enumerate(specs) if j != i]
-        specs[i] = _refine(s, specs[i], R, y, fold, rule, others)
+        others = [column(ch.s, o) for j, o in enumerate(specs) if j != i]
+        specs[i] = _refine(ch, specs[i], others)
     return specs
 
 
-def _refine(s, sp, R, y, fold, rule, others=()) -> dict:
+def _refine(ch: Channel, sp, others=()) -> dict:
     """The term's time constant refined by the cross-validated error of the model with it
     beside the run zeros and the other terms (columns ``others``; grid step r: ln tau
-    +- ``REFINE`` r)."""
+    +- ``REFINE`` r); ties (``TIE_SCORE_REL``) go to the first value tried."""
     if not sp["tau_s"] > 0:
         return sp
-    r = math.log(basis.tau_grid(s)[1] / basis.tau_grid(s)[0])
+    r = _grid_step_of(ch.s)
     best = None
     for d in REFINE:
         tau = sp["tau_s"] * math.exp(d * r)
-        D = np.column_stack([R, *others, column(s, sp, tau)])
-        e = _cv(D, y, fold, rule, s.run, R.shape[1])
-        if best is None or e < best[0] * (1 - sel.TIE_REL):
+        e = ch.cv(np.column_stack([ch.R, *others, column(ch.s, sp, tau)]))
+        if best is None or e < best[0] * (1 - TIE_SCORE_REL):
             best = (e, tau)
     return {**sp, "tau_s": float(best[1])}
+
+
+def _grid_step_of(s) -> float:
+    """ln of the ratio of two neighbouring time constants of the grid."""
+    return math.log(basis.tau_grid(s)[1] / basis.tau_grid(s)[0])
 
 
 def _fit(D, y, mask) -> np.ndarray:
@@ -203,23 +229,11 @@ def _fit(D, y, mask) -> np.ndarray:
     return _solve_normal(Dm.T @ Dm, Dm.T @ y[mask])
 
 
-def _solve_normal(G, h) -> np.ndarray:
-    """The least-squares coefficients from the normal equations ``G b = h``, solved with the
-    columns scaled to unit norm (pseudo-inverse, rcond 1e-12); a column all zero gets 0."""
-    d = np.sqrt(np.diag(G))
-    on = d > 0
-    b = np.zeros(len(h))
-    Gs = G[np.ix_(on, on)] / np.outer(d[on], d[on])
-    b[on] = np.linalg.pinv(Gs, rcond=1e-12, hermitian=True) @ (h[on] / d[on])
-    b[on] /= d[on]
-    return b
-
-
-def _significant(s, specs, R, y, fold, rule) -> tuple[list, dict]:
+def _significant(ch: Channel, specs) -> tuple[list, dict]:
     """Fit, jackknife, and drop non-significant terms one at a time (module step 5)."""
     dropped = []
     while True:
-        fit = _jackknife(s, specs, R, y, fold)
+        fit = _jackknife(ch, specs)
         fit["dropped"] = dropped
         t = [abs(c) / u if u > 0 else math.inf for c, u in zip(fit["coef"], fit["coef_std"])]
         weak = [i for i, v in enumerate(t) if v < SIG_K]
@@ -230,21 +244,20 @@ def _significant(s, specs, R, y, fold, rule) -> tuple[list, dict]:
         specs = specs[:drop] + specs[drop + 1:]
 
 
-def _jackknife(s, specs, R, y, fold) -> dict:
+def _jackknife(ch: Channel, specs) -> dict:
     """Coefficients (unscaled units) fitted on all training readings, their blocked
     jackknife standard uncertainties, and the time constants' (re-estimated per fold)."""
-    tr = s.train
-    n_runs = R.shape[1]
-    D = _design(s, specs, R)
-    b = _fit(D, y, tr)
-    K = int(fold.max()) + 1
-    bk, tk, edge = [], [], []
-    masks = [tr & (fold != k) for k in range(K)]
-    got = [_tau_on(s, sp, i, specs, R, y, masks) for i, sp in enumerate(specs)]
+    tr, n_runs = ch.s.train, ch.n_runs
+    D = ch.design(specs)
+    b = _fit(D, ch.y, tr)
+    K = int(ch.fold.max()) + 1
+    bk, tk = [], []
+    masks = [tr & (ch.fold != k) for k in range(K)]
+    got = [_tau_on(ch, sp, i, specs, masks) for i, sp in enumerate(specs)]
     edge = [any(g[1] for g in gi) for gi in got]
     for k, m in enumerate(masks):
         taus = [gi[k][0] for gi in got]
-        bk.append(_fit(_design(s, specs, R, taus), y, m)[n_runs:])
+        bk.append(_fit(ch.design(specs, taus), ch.y, m)[n_runs:])
         tk.append(taus)
     bk, tk = np.array(bk).reshape(K, len(specs)), np.array(tk).reshape(K, len(specs))
     f = (K - 1) / K
@@ -257,31 +270,24 @@ def _jackknife(s, specs, R, y, fold) -> dict:
             "tau_std": tau_std, "design": D}
 
 
-def _tau_on(s, sp, i, specs, R, y, masks) -> list:
+def _tau_on(ch: Channel, sp, i, specs, masks) -> list:
     """Per mask of ``masks``: (the term's time constant re-estimated on those readings,
     whether it lies at the edge of the range searched): least RSS over ln tau within +- one
-    grid step, the others fixed (a parabola through 7 values; the RSS of every trial from
-    one set of cross-products per mask)."""
+    grid step, the others fixed (:func:`volerr.selection.profile.profile_vertex`: a parabola
+    through 7 values; the RSS of every trial from one set of cross-products per mask)."""
     if not sp["tau_s"] > 0:
         return [(0.0, False)] * len(masks)
-    r = math.log(basis.tau_grid(s)[1] / basis.tau_grid(s)[0])
-    xs = np.linspace(-r, r, 7)
-    base = np.column_stack([R] + [column(s, o) for j, o in enumerate(specs) if j != i])
+    s, y = ch.s, ch.y
+    base = np.column_stack([ch.R] + [column(s, o) for j, o in enumerate(specs) if j != i])
     out = []
     for m in masks:
-        x0, res = 0.0, None
-        for _ in range(RECENTRE):
+        def rss_at(x0, xs):
             trial = np.column_stack([column(s, sp, sp["tau_s"] * math.exp(x0 + x)) for x in xs])
-            rss = _trial_rss(base[m], trial[m], y[m])
-            q, lin, _ = np.polyfit(xs, rss, 2)
-            x = float(np.clip(-lin / (2 * q), -r, r)) if q > 0 else float(xs[int(np.argmin(rss))])
-            if abs(x) < r * (1 - 1e-9):
-                res = (sp["tau_s"] * math.exp(x0 + x), False)
-                break
-            x0 += x             # the least RSS at the edge: search again around it
-        out.append(res or (sp["tau_s"] * math.exp(x0), True))
-    return out
+            return _trial_rss(base[m], trial[m], y[m])
 
+        x, edge = profile_vertex(rss_at, _grid_step_of(s), 7, RECENTRE)
+        out.append((sp["tau_s"] * math.exp(x), edge))
+    return out
 
 def _trial_rss(B, T, y) -> list:
     """RSS of the least-squares fit of ``y`` on the columns ``B`` plus each column of ``T``
@@ -298,21 +304,22 @@ def _trial_rss(B, T, y) -> list:
     return out
 
 
-def _static(s, R, y) -> np.ndarray:
+def _static(ch: Channel) -> np.ndarray:
     """The static multiple linear regression on all temperatures (their change since the
     run's start; a zero per training run, a held-out run from its first reading), fitted
     on the training readings: its prediction of every reading (N,)."""
+    s = ch.s
     temps = [k for k in basis.sensors(s) if k.startswith("T")]
     cols = [basis.series(s, k, 0.0) for k in temps]
-    D = np.column_stack([R] + cols)
-    b = _fit(D, y, s.train)
-    return predict(s, R, D, b, y)
+    D = np.column_stack([ch.R] + cols)
+    b = _fit(D, ch.y, s.train)
+    return predict(s, D, b, ch.y)
 
 
-def predict(s, R, D, b, y) -> np.ndarray:
+def predict(s, D, b, y) -> np.ndarray:
     """``D b`` where a run has training readings; a run without: its first reading plus the
     terms (the basis is zero at every run's first reading)."""
-    n_runs = R.shape[1]
+    n_runs = len(s.runs)
     zeros = b[:n_runs].copy()
     seen = np.array([np.any(s.train & (s.run == r)) for r in range(n_runs)])
     zeros[~seen] = y[s.firsts()][~seen]

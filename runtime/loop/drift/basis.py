@@ -1,5 +1,5 @@
 """The basis of the loop on drift runs: what a displacement channel may vary with, and the
-blocked folds it is judged on (:mod:`volerr.loop.drift` runs the selection).
+blocked folds it is judged on (:mod:`volerr.loop.drift.fit` runs the selection).
 
 A drift run holds one machine position while the machine heats and cools: the declared
 geometric model predicts a constant per channel (the run's zero).  What varies is heat; the
@@ -17,7 +17,7 @@ is causal, the held-out part is predicted from its own inputs):
   ``lag(q, tau)`` is the standard first-order thermal response to a heat source switched on
   and off;
 * differences of two sensors (a gradient) are combinations of these columns
-  (:mod:`volerr.loop.drift` forms them from the cross-products).
+  (:mod:`volerr.loop.drift.select` forms them from the cross-products).
 
 Time constants: a geometric grid of ``N_TAU`` values from ``TAU_MIN_STEPS`` reading intervals
 (at least 60 s) to half the training duration; the selected one is refined between its grid
@@ -37,7 +37,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import require
+from ...errors import require
+from .series import DriftSeries
+
+__all__ = ["Column", "DriftSeries", "folds", "heat", "library", "series", "sensors",
+           "tau_grid"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
 N_TAU = 14                # time constants on the grid
@@ -46,34 +50,6 @@ K_FOLDS = 6               # contiguous stretches per run when the folds are not 
 RUN_FOLDS_MIN = 3         # training runs from which every fold is one whole run
 SENSOR_TAU_SPAN = 0.125  # a sensor's lag is searched up to this share of the training span
 SPEED = "S_rpm"           # the logged input the heat input is derived from
-
-
-@dataclass
-class DriftSeries:
-    """Drift runs stacked in time order within each run.
-
-    ``t_s`` (N,) seconds; ``run`` (N,) run index into ``runs`` [(file, label)];
-    ``inputs`` {name: (N,)} logged inputs (degC, rpm, ...); ``channels`` {label: (N,)} um;
-    ``directions`` {label: "X".."-Z" or "?"}; ``heights`` {label: mm or None};
-    ``test`` (N,) bool: held out."""
-
-    t_s: np.ndarray
-    run: np.ndarray
-    runs: list
-    inputs: dict
-    channels: dict
-    directions: dict = field(default_factory=dict)
-    heights: dict = field(default_factory=dict)
-    test: np.ndarray | None = None
-    memo: dict = field(default_factory=dict, repr=False, compare=False)
-
-    @property
-    def train(self) -> np.ndarray:
-        return ~self.test
-
-    def firsts(self) -> np.ndarray:
-        """Index (n_runs,) of every run's first reading."""
-        return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
 
 
 @dataclass
@@ -121,7 +97,7 @@ def heat(s: DriftSeries, p: float) -> np.ndarray:
 def series(s: DriftSeries, source: str, tau_s: float, p: float | None = None) -> np.ndarray:
     """The unscaled column: the change since each run's first reading of a sensor, or the
     heat input, through a lag ``tau_s`` (0: none), restarted in every run."""
-    from ..machine.lags import lag
+    from ...machine.lags import lag
 
     u = heat(s, p) if source == "heat" else np.asarray(s.inputs[source], float)
     y = lag(u, tau_s, s.t_s, s.run) if tau_s > 0 else u

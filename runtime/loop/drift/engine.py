@@ -1,8 +1,8 @@
 """Blocked cross-validation of linear drift models from cross-products, for many candidate
-columns at once (:mod:`volerr.loop.drift` selects with it).
+columns at once (:mod:`volerr.loop.drift.select` selects with it).
 
 A model of one channel is ``y = Z W b`` (``Z`` the run indicators and the basis columns of
-:func:`volerr.loop.drift_basis.library`, ``W`` the combinations chosen so far: a run's zero,
+:func:`volerr.loop.drift.basis.library`, ``W`` the combinations chosen so far: a run's zero,
 a column, a difference of two columns).  For a fold k the fit on the other folds and its
 squared error on fold k follow from the cross-products ``Z'Z``, ``Z'y``, ``y'y`` of fold k
 and of all training readings: no pass over the readings per candidate.  Adding a candidate

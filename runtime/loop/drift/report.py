@@ -1,0 +1,147 @@
+"""The result of the loop on drift runs (:class:`DriftReport`, built by
+:func:`volerr.loop.drift.run.loop_drift`): JSON (INTERFACE.md "Thermal drift tests ... and
+the loop on measured heat"), the console, the predictions CSV, the table of reported values
+and the HTML page with one time-series figure per channel (:mod:`volerr.loop.drift.figure`).
+
+Effects: the terms of one channel with the same covariate (the heat input, a sensor, a
+difference of two sensors) form one effect ("two time constants where one is not enough");
+each names its ``channels``, ``covariates``, ``basis``, ``lag_s`` ``{value, std}`` (its first
+term's; every term in ``terms``) and its coefficients with standard uncertainties (blocked
+jackknife) in ``parameters``/``std``; uncertainties are printed with k = 2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+
+from ...results import ResultMixin, Row
+from ...selection.rules import SIG_K
+from . import basis
+from .series import DriftSeries
+from .split import extrapolation_line
+
+K_PRINT = 2.0      # coverage factor of the printed uncertainties (the loop's console, 3-D too)
+
+
+@dataclass(repr=False)
+class DriftReport(ResultMixin):
+    """Result of the loop on drift runs (``volerr.loop(layout, ["drift:FILE"])``): ``data``
+    the JSON of ``volerr loop --json`` (:meth:`to_dict`), ``summary()`` its console text,
+    :meth:`table` every reported coefficient and time constant with its standard
+    uncertainty (k = 1) and the per-channel held-out figures (um), :meth:`figures` one
+    time-series figure per channel, ``write_json`` / ``write_html`` /
+    :meth:`write_predictions`.  ``series`` (:class:`~volerr.loop.drift.series.DriftSeries`)
+    and ``pred`` (per channel the predictions before, after and of the static regression,
+    um) are what the figures and the predictions CSV need."""
+
+    data: dict
+    series: DriftSeries
+    pred: dict = field(default_factory=dict)
+    #: coverage factor of the printed uncertainties
+    K_PRINT = K_PRINT
+
+    def __getitem__(self, key):
+        return self.data[key]
+
+    @property
+    def effects(self) -> list:
+        return self.data["effects"]
+
+    def write_predictions(self, path, inputs=()) -> Path:
+        """CSV ``file,run,t_s,channel,measured_um,before_um,after_um,split`` (every reading)."""
+        from ...fileio import write_text
+
+        s = self.series
+        lines = ["file,run,t_s,channel,measured_um,before_um,after_um,split"]
+        for label, p in self.pred.items():
+            y = s.channels[label]
+            for i in range(len(s.t_s)):
+                f, r = s.runs[s.run[i]]
+                lines.append(f"{f},{r},{s.t_s[i]:.10g},{label},{y[i]:.10g},{p['before'][i]:.10g},"
+                             f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'}")
+        return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
+
+    def write_html(self, path, inputs=()) -> Path:
+        """The page (the loop's template and style, :func:`volerr.loop.drift.figure.render_html`)."""
+        from ...fileio import write_text
+        from .figure import render_html
+
+        return write_text(path, render_html(self), inputs=list(inputs))
+
+    def write_error_tables(self, directory, inputs=()):
+        """Not written for drift runs: their effects are per channel, not in the layout."""
+        from ...errors import require
+
+        require(False, "loop: --errors-out (write_error_tables) is not written for drift runs "
+                       "(their effects are per channel, not in the layout)")
+
+    def figures(self) -> dict:
+        """``{"channel LABEL": matplotlib Figure}``: measured, before, after and the static
+        regression against time, the residuals, the inputs the effects chose."""
+        from .figure import channel_figure
+
+        return {f"channel {k}": channel_figure(self, k) for k in self.data["channels"]}
+
+    def summary(self) -> str:
+        """The whole console text of ``volerr loop`` on drift runs."""
+        return "\n".join(self.summary_lines())
+
+    def _rows(self) -> list:
+        out = []
+        for e in self.data["effects"]:
+            for j, t in enumerate(e["terms"]):
+                name = f"{e['name']}_{j}"
+                out.append(Row(name, t["value"], t["std"], t["unit"], 1.0))
+                if t.get("lag_s"):
+                    out.append(Row(f"{name}:tau", t["lag_s"]["value"], t["lag_s"]["std"], "s",
+                                   1.0))
+        for label, c in self.data["channels"].items():
+            for key in ("mae_before_um", "mae_after_um", "mae_static_um"):
+                out.append(Row(f"{label}:{key[:-3]}", c[key], None, "um", 1.0))
+        return out
+
+    def summary_lines(self) -> list:
+        d = self.data
+        out = [f"{d['layout']}: drift runs {', '.join(d['runs'])}; {d['split']}; "
+               f"{d['n_train']} training, {d['n_test']} held-out readings; choices by blocked "
+               f"cross-validation over {d['n_folds']} {d['fold_rule']}"]
+        if d.get("extrapolation"):
+            out.insert(0, "  " + extrapolation_line(d["extrapolation"]))
+        for label, c in d["channels"].items():
+            out.append(f"  channel {label}: held-out MAE {c['mae_before_um']:.3f} -> "
+                       f"{c['mae_after_um']:.3f} um (static regression on all temperatures "
+                       f"{c['mae_static_um']:.3f}), RMS {c['rms_before_um']:.3f} -> "
+                       f"{c['rms_after_um']:.3f}, max {c['max_abs_before_um']:.3f} -> "
+                       f"{c['max_abs_after_um']:.3f} um")
+        for sym, q in d.get("quantities", {}).items():
+            rows = ", ".join(f"{c} {w:+.4g}" for c, w in q["rows"].items())
+            own = ", ".join(q["layout_parameters"]) or "none"
+            out.append(f"  {sym} ({q['unit']}): {q['description']}, rows {rows}; the layout's "
+                       f"parameters it is at this position: {own}")
+        for e in d["effects"]:
+            what = e["channel"] if not e.get("quantity") else \
+                f"{e['quantity']} (channels {', '.join(e['channels'])})"
+            out.append(f"  {e['kind']} {e['name']}: {what} varies with {e['basis']}")
+            for t in e["terms"]:
+                out.append("    " + _term_line(t))
+        for n in d["not_significant"]:
+            out.append(f"  not significant (|value| < {SIG_K:g} u), left out: {n}")
+        return out
+
+
+def _term_line(t: dict) -> str:
+    k = K_PRINT
+    c = f"{t['value']:.4g} +- {k * t['std']:.2g} {t['unit']} (k = {k:g})"
+    lag = t.get("lag_s")
+    if lag:
+        u = f" +- {k * lag['std']:.0f}" if lag.get("std") is not None else " (u not determined)"
+        c += f", tau = {lag['value']:.0f}{u} s (k = {k:g})"
+    if t.get("alternatives"):
+        c += "; these data cannot tell it from " + ", ".join(
+            a["covariate"] + (f" through {a['lag_s']:.0f} s" if a.get("lag_s") else "")
+            for a in t["alternatives"])
+    return f"{t['basis']}: {c}"
+
+
