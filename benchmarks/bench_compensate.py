@@ -50,8 +50,12 @@ from volerr.cli import main
 from volerr.fiveaxis import program
 program.WHOLE_CHUNK = sys.argv[4] == "1"
 t0 = time.perf_counter(); c0 = time.process_time()
+# the tool length only for the TCPM shapes: on axis-position programs --tool-length moves the
+# evaluated point to the tool tip (a different, not a slower, compensation than a base before it)
+head = open(sys.argv[1], encoding="latin-1").read(300)
+tool = ["--tool-length", "120"] if ("G43.5" in head or "TRAORI" in head) else []
 rc = main(["compensate", "DMU50", sys.argv[1], "--errors", sys.argv[2], "--out", sys.argv[3],
-           "--tool-length", "120"])
+           *tool])
 print(time.perf_counter() - t0, time.process_time() - c0,
       resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
 """
