@@ -10,16 +10,10 @@ volerr.uncertainty.iso10360.
 from __future__ import annotations
 
 
-import numpy as np
-
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
                       add_vector, error_functions_from_args, finite_option,
                       identification_from_args, inputs_of)
 from ..fileio import Outputs, json_text, write_text
-from ..machine.model import load
-from ..uncertainty import iso10360
-from ..units import num
-from ..cmm.volmap import volume
 
 
 def register(sub) -> None:
@@ -56,7 +50,10 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _test_uncertainty(args) -> iso10360.TestUncertainty:
+def _test_uncertainty(args):
+    """:class:`volerr.uncertainty.iso10360.TestUncertainty` of the artefact options."""
+    from ..uncertainty import iso10360
+
     a, k = iso10360.parse_calibration(args.artefact_u)
     finite_option(args.artefact_cte_ppm_per_K, "--artefact-cte-ppm-per-K", -100.0, 100.0)
     finite_option(args.artefact_cte_u_ppm_per_K, "--artefact-cte-u-ppm-per-K", 0.0, 100.0)
@@ -68,6 +65,13 @@ def _test_uncertainty(args) -> iso10360.TestUncertainty:
 
 
 def run(args) -> int:
+    import numpy as np
+
+    from ..cmm.volmap import volume  # the capability: when the command runs
+    from ..machine.model import load
+    from ..uncertainty import iso10360
+    from ..units import num
+
     model = load(args.layout)
     funcs = error_functions_from_args(args, model)
     inputs = inputs_of(args)

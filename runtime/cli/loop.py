@@ -17,7 +17,6 @@ from pathlib import Path
 
 from ..errors import require
 from ..fileio import Outputs
-from ..loop.api import console_lines
 from ._common import add_errors_out, add_force, add_html, add_json
 
 
@@ -70,7 +69,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..loop.api import is_drift
+    from ..loop.api import console_lines, is_drift
 
     if is_drift(args.data):
         return run_drift(args)

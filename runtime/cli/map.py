@@ -10,10 +10,8 @@ from __future__ import annotations
 
 from ._common import (add_accept_implausible, add_common, error_functions_from_args,
                       inputs_of, parse_at)
-from ..cmm import volmap
 from ..errors import require
 from ..fileio import Outputs, json_text, write_text
-from ..machine.model import load
 
 
 def register(sub) -> None:
@@ -41,6 +39,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     import math
+
+    from ..cmm import volmap  # the capability: when the command runs
+    from ..machine.model import load
 
     require(args.magnify is None or (math.isfinite(args.magnify) and args.magnify > 0),
             f"--magnify must be a positive finite number, got {args.magnify}")
