@@ -55,3 +55,42 @@ def test_model_and_load_still_named_by_the_package():
 
     assert Model is model.Model and load is model.load
     assert "Model" in dir(volerr)
+
+
+ONE_COMMAND = """
+import contextlib, io, sys
+import volerr.cli as cli
+with contextlib.redirect_stdout(io.StringIO()):
+    code = cli.main(["history", "add", "--help"])
+print(code, " ".join(sorted(m for m in sys.modules if m.startswith("volerr.cli."))))
+"""
+
+
+def test_a_command_builds_only_its_own_parser():
+    proc = subprocess.run([sys.executable, "-c", ONE_COMMAND], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    code, *modules = proc.stdout.split()
+    assert code == "0"
+    assert set(modules) <= {"volerr.cli._common", "volerr.cli._memory", "volerr.cli.history"}
+    assert "volerr.cli.history" in modules
+
+
+def _commands(parser) -> dict:
+    import argparse
+
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices
+
+
+def test_the_parser_of_one_command_is_the_one_of_the_whole_parser():
+    from volerr.cli import build_parser
+
+    whole = _commands(build_parser())
+    assert len(whole) >= 20
+    for name, parser in whole.items():
+        alone = _commands(build_parser(name))
+        assert list(alone) == [name]
+        assert alone[name].format_help() == parser.format_help(), name
+    # not a command as typed (the module's name, an unknown word): every command
+    assert len(_commands(build_parser("probe_cal"))) == len(whole)
+    assert len(_commands(build_parser("mapp"))) == len(whole)
