@@ -26,7 +26,6 @@ import importlib
 
 from .errors import InputError
 from .machine.layout import layout_names as layouts
-from .machine.model import Model, load  # noqa: F401
 
 __version__ = "0.1.0"
 
@@ -48,7 +47,10 @@ __all__ = ["InputError", "Model", "layouts", "load", *_PACKAGES, *_MODULES, *_FU
 
 
 def __getattr__(name):
-    # lazy: the capability is imported when first named (numpy, scipy, matplotlib ...)
+    # lazy: the capability is imported when first named (numpy, scipy, matplotlib ...); so are
+    # Model and load (numpy): ``python -m volerr CMD --help`` imports no numpy
+    if name in ("Model", "load"):
+        return getattr(importlib.import_module(f"{__name__}.machine.model"), name)
     if name in _PACKAGES or name in _MODULES:
         return importlib.import_module(f"{__name__}.{name}")
     if name in _FUNCTIONS:

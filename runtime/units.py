@@ -13,8 +13,6 @@ from __future__ import annotations
 import math
 import re
 
-import numpy as np
-
 from .errors import InputError
 
 #: micrometres per millimetre
@@ -79,6 +77,8 @@ def format_number(value: float, digits: int = 12) -> str:
 def format_rows(data, digits: int = 12, block: int = 20000) -> str:
     """CSV rows (``\n``-terminated) of the (n, k) numbers ``data``, each cell as
     :func:`format_number`; one %-format per block of rows instead of a call per number."""
+    import numpy as np  # here, not at import: every --help imports this module
+
     data = np.asarray(data, dtype=float) + 0.0      # + 0.0: -0 becomes 0
     row = ",".join([f"%.{digits}g"] * data.shape[1]) + "\n"
     return "".join((row * len(b)) % tuple(b.ravel().tolist())

@@ -170,7 +170,11 @@ def _mark_leaves(parser) -> None:
                 _mark_leaves(child)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``volerr`` parser with every command's sub-parser; ``command`` (a command's name as
+    typed, e.g. ``probe-cal``): only that command's, the other command modules not imported
+    (:func:`main` does this when its first argument names a command: the parse, the help and
+    every message of that command are the same, the start-up cheaper)."""
     from .. import __version__
 
     parser = _Parser(
@@ -180,7 +184,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="print the version of volerr and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for name in COMMANDS:
+    module_name = (command or "").replace("-", "_")
+    only = command is not None and "_" not in command and module_name in COMMANDS
+    for name in (module_name,) if only else COMMANDS:
         try:
             module = importlib.import_module(f"volerr.cli.{name}")
         except ModuleNotFoundError as exc:
@@ -196,7 +202,8 @@ def main(argv=None) -> int:
     from ._memory import keep_freed_blocks
 
     keep_freed_blocks()
-    parser = build_parser()
+    first = (sys.argv[1:] if argv is None else list(argv))[:1]
+    parser = build_parser(str(first[0]) if first else None)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse prints its own one-line usage error

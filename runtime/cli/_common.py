@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..cmm import volmap
+from ..choices import INTERPOLATION as METHODS
 from ..errors import InputError, require
-from ..tables.functions import METHODS, ErrorFunctions
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
@@ -24,9 +23,11 @@ def add_error_arguments(parser, required: bool = True) -> None:
                         help="evaluate beyond the measured range of a table (default: refuse)")
 
 
-def error_functions_from_args(args, model) -> ErrorFunctions:
-    """:class:`ErrorFunctions` from the arguments added by :func:`add_error_arguments` (and
-    :func:`add_accept_implausible`, when the command has it)."""
+def error_functions_from_args(args, model):
+    """:class:`volerr.tables.functions.ErrorFunctions` from the arguments added by
+    :func:`add_error_arguments` (and :func:`add_accept_implausible`, when the command has it)."""
+    from ..tables.functions import ErrorFunctions  # when the command runs, not at --help
+
     return ErrorFunctions.from_dir(args.errors, model, method=args.method, degree=args.degree,
                                    extrapolate=args.extrapolate,
                                    accept_implausible=getattr(args, "accept_implausible", False))
@@ -69,6 +70,8 @@ def parse_at(items) -> dict:
 def inputs_of(args, model=None) -> list:
     """Files that must never be overwritten: the error tables and a layout file (shipped
     layouts are package files, protected by :class:`volerr.fileio.Outputs` anyway)."""
+    from ..cmm import volmap
+
     files = volmap.error_dir_inputs(args.errors)
     files.extend(layout_inputs(args.layout))
     return files

@@ -11,7 +11,7 @@ DEVIATION_ONLY = (("probe", None), ("rounds", 1), ("effect", []), ("magnitude_um
 
 def add_arguments(p) -> None:
     """The options of the instrument files (an argument group of ``simulate``)."""
-    from ..instruments.simulated_files import INSTRUMENTS
+    from ..choices import SIMULATED_INSTRUMENTS as INSTRUMENTS
 
     g = p.add_argument_group(
         "instrument files (--instrument sphere | ballbar): the layout's model with planted "
@@ -23,7 +23,7 @@ def add_arguments(p) -> None:
                         "formats sphere') or ballbar (three ISO 230-4 circles XY, YZ, ZX about "
                         "the middle of the travel, both directions, 180 readings each, one "
                         "file with a placement column; 'volerr formats ballbar')")
-    from ..instruments.simulated_files import DEFAULT_PLANTED
+    from ..choices import SIMULATED_PLANTED as DEFAULT_PLANTED
 
     shown = {k: ", ".join(f"{n}={v:g}" for n, v in d.items())
              for k, d in DEFAULT_PLANTED.items()}

@@ -15,8 +15,6 @@ printed equations of their layouts (no derivation involved).
 from __future__ import annotations
 
 
-from ..audit import run as audit_run
-from ..audit import summary_line
 from ..errors import require
 from ..fileio import json_text, write_text
 
@@ -39,6 +37,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..audit import run as audit_run  # the capability: when the command runs
+    from ..audit import summary_line
     from ._common import layout_inputs, progress
     from ..fileio import Outputs
 

@@ -24,7 +24,8 @@ Argument parsing and one call: :func:`volerr.controller_export` /
 
 from __future__ import annotations
 
-from ..fiveaxis.controller_api import AXIS_FORMATS, TEMP_FORMATS
+from ..choices import CONTROLLER_AXIS_FORMATS as AXIS_FORMATS
+from ..choices import CONTROLLER_TEMP_FORMATS as TEMP_FORMATS
 
 
 def register(sub) -> None:

@@ -9,12 +9,11 @@ Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
 from __future__ import annotations
 
 
-from ..cmm import api, diagonals
 from ._common import (add_accept_implausible, add_common, error_functions_from_args,
                       inputs_of, parse_at)
 from ..errors import require
 from ..fileio import Outputs
-from ..machine.model import load
+from ..choices import DIAGONAL_KINDS
 
 
 def register(sub) -> None:
@@ -22,7 +21,7 @@ def register(sub) -> None:
                                          "lines of the working volume (length deviations)",
                        description=__doc__.split("\n\n")[1].replace("``", ""))
     add_common(p)
-    p.add_argument("--lines", nargs="+", choices=diagonals.KINDS, default=list(diagonals.KINDS),
+    p.add_argument("--lines", nargs="+", choices=DIAGONAL_KINDS, default=list(DIAGONAL_KINDS),
                    help="which lines: space diagonals, face diagonals, axis-parallel "
                         "lines")
     p.add_argument("--profile-points", type=int, default=21, metavar="N",
@@ -34,6 +33,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..cmm import api, diagonals  # the capability: when the command runs
+    from ..machine.model import load
+
     require(2 <= args.profile_points <= 10000, "--profile-points must be between 2 and 10000")
     model = load(args.layout)
     funcs = error_functions_from_args(args, model)

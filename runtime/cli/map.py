@@ -11,10 +11,8 @@ from __future__ import annotations
 from ._common import (add_accept_implausible, add_common, add_identification_arguments,
                       error_functions_from_args, identification_from_args, inputs_of, parse_at,
                       write_certificates)
-from ..cmm import volmap
 from ..errors import require
 from ..fileio import Outputs, json_text, write_text
-from ..machine.model import load
 
 
 def register(sub) -> None:
@@ -42,6 +40,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..cmm import volmap
+    from ..machine.model import load
+
     import math
 
     require(args.magnify is None or (math.isfinite(args.magnify) and args.magnify > 0),

@@ -18,9 +18,7 @@ from ._common import (add_error_arguments, add_html, add_identification_argument
                       add_plot, identification_from_args, write_certificates)
 from ..errors import require
 from ..fileio import Outputs, write_bytes
-from ..machine.model import load
-from ..uncertainty import ensemble, tasks
-from ..uncertainty.report import BIAS_MODES
+from ..choices import BIAS_MODES
 
 
 def register(sub) -> None:
@@ -101,6 +99,8 @@ def register(sub) -> None:
 
 #: captions of the report's figures
 def _temperature(args):
+    from ..uncertainty import ensemble
+
     vals = {k: getattr(args, k) for k in ("part_cte", "part_dt", "scale_cte", "scale_dt")}
     if all(v is None for v in vals.values()):
         return None
@@ -138,6 +138,8 @@ def _check_options(args) -> None:
 
 
 def run(args) -> int:
+    from ..machine.model import load  # the capability: when the command runs
+    from ..uncertainty import tasks
     from ..uncertainty.api import uncertainty
     from ._common import inputs_of, layout_inputs
 

@@ -45,7 +45,7 @@ from ..units import UM_PER_MM
 from ..errors import require
 from .volmap import fixed_positions, linear_axes
 
-KINDS = ("space", "face", "axis")
+from ..choices import DIAGONAL_KINDS as KINDS  # noqa: E402  (stated once, light)
 
 
 @dataclass

@@ -18,6 +18,8 @@ in um (max and rms of the length of the 3-D volumetric error).
 
 from __future__ import annotations
 
+from ..choices import CONTROLLER_AXIS_FORMATS, CONTROLLER_TEMP_FORMATS
+
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,9 +28,9 @@ from ..results import ResultMixin, Row
 from ..tables.controller_tables import worse_than_none
 
 #: the axis compensation formats (tables of one error against one axis)
-AXIS_FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc", "linuxcnc")
+AXIS_FORMATS = CONTROLLER_AXIS_FORMATS
 #: the temperature compensation formats (fitted to an augmented layout's thermal effects)
-TEMP_FORMATS = ("sinumerik-temp", "isg-temp")
+TEMP_FORMATS = CONTROLLER_TEMP_FORMATS
 #: the volumetric compensation formats (every parameter of the error directory)
 VOLUMETRIC_FORMATS = ("isg", "etalon")
 

@@ -29,15 +29,10 @@ import numpy as np
 
 from ..errors import InputError, require
 
-#: planted errors when none are given, in the units ``calibrate`` reports (um, urad, um/mm)
-DEFAULT_PLANTED = {
-    "sphere": {"EX0B": 12.0, "EY0B": -8.0, "EA0B": 35.0, "EB0B": -20.0, "EX0C": 15.0,
-               "EY0C": -10.0, "EA0C": 25.0, "EB0C": -40.0, "EY0A": 9.0, "EZ0A": -7.0,
-               "EB0A": 22.0, "EC0A": -18.0},
-    "ballbar": {"EC0Y": 20.0, "EB0Z": -12.0, "EA0Z": 8.0, "EXX@slope": 0.015,
-                "EYY@slope": -0.005, "EZZ@slope": 0.010},
-}
-INSTRUMENTS = ("deviations", "sphere", "ballbar")
+# the planted errors when none are given (um, urad, um/mm) and the instruments: stated
+# in volerr.choices, which --help reads without importing numpy
+from ..choices import SIMULATED_INSTRUMENTS as INSTRUMENTS  # noqa: E402  (stated once, light)
+from ..choices import SIMULATED_PLANTED as DEFAULT_PLANTED  # noqa: E402
 #: the tool offset of simulated sphere files, mm: a 120 mm probe hanging below the reference
 #: point (tool frame, +z towards the spindle: docs/conventions.md)
 PROBE = (0.0, 0.0, -120.0)

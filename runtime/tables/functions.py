@@ -115,7 +115,7 @@ def make_function(x, y, method: str = "linear", degree: int | None = None):
     raise InputError(f"unknown interpolation method {method!r} (linear, cubic, poly)")
 
 
-METHODS = ("linear", "cubic", "poly")
+from ..choices import INTERPOLATION as METHODS  # noqa: E402  (stated once, light)
 
 
 class ErrorFunctions:

@@ -23,7 +23,7 @@ from pathlib import Path
 from ..plotstyle import embedded_img
 from ..units import MM_PER_UM, UM_PER_MM, num  # noqa: F401  (num re-exported)
 
-BIAS_MODES = ("corrected", "uncorrected")
+from ..choices import BIAS_MODES  # noqa: E402,F401  (stated once, light)
 
 
 def machine_text(spec=None, errors=None, table_std: str = "", repeatability: bool = False) -> str:

@@ -23,8 +23,8 @@ from volerr.audit.numeric import _evaluate, _paper_values, spot_check
 from helpers import reference_chain
 from helpers.audit_rule import KIND, expected
 
-#: the module's verdicts are computed once, in one worker
-pytestmark = pytest.mark.xdist_group("audit_pahk")
+#: the module's verdicts come from the full audit (conftest.provider_verdicts), in its group
+pytestmark = pytest.mark.xdist_group("full_audit")
 
 audit_pahk = pytest.importorskip("volerr.derive.audit.pahk")
 
@@ -33,8 +33,8 @@ DATA = tomllib.loads((resources.files("volerr.derive.audit") / "data" / "printed
 
 
 @pytest.fixture(scope="module")
-def verdicts():
-    return audit_pahk.audit(DATA, None)
+def verdicts(provider_verdicts):
+    return provider_verdicts(audit_pahk, DATA, None)
 
 
 def find(verdicts, eq, comp=""):

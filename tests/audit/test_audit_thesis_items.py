@@ -20,8 +20,8 @@ from volerr.derive.audit import ch2 as audit_ch2, htm as audit_htm, listings as 
 from volerr.derive.audit import metrology as audit_metrology, results as audit_results
 from volerr.derive.audit import scripts as audit_scripts, squareness as audit_squareness
 
-# the module fixtures once, on one xdist worker (not once per worker)
-pytestmark = pytest.mark.xdist_group("audit_thesis_items")
+#: the providers' verdicts come from the full audit (conftest.provider_verdicts), in its group
+pytestmark = pytest.mark.xdist_group("full_audit")
 
 
 def data(name):
@@ -56,8 +56,8 @@ def rounds_to(printed: str, value: float) -> bool:
 
 # ------------------------------------------------------------ paper, thesis ch. 3, project
 @pytest.fixture(scope="module")
-def htm():
-    return audit_htm.audit(data("printed_htm.toml"))
+def htm(provider_verdicts):
+    return provider_verdicts(audit_htm, data("printed_htm.toml"))
 
 
 def _printed_matrix(item, b=0.0, c=0.0, d=154.996):
@@ -260,8 +260,8 @@ def test_project_report_relations(htm):
 
 # --------------------------------------------------------------------------------- ch. 2
 @pytest.fixture(scope="module")
-def ch2():
-    return audit_ch2.audit(data("printed_ch2.toml"))
+def ch2(provider_verdicts):
+    return provider_verdicts(audit_ch2, data("printed_ch2.toml"))
 
 
 def test_rodrigues_example_recomputed(ch2):
@@ -310,8 +310,8 @@ def test_statistics_2_45_to_2_49_and_script(ch2):
 
 
 # -------------------------------------------------------------------------- instruments
-def test_tracker_coordinates_and_multilateration():
-    vs = audit_metrology.audit(data("printed_metrology.toml"))
+def test_tracker_coordinates_and_multilateration(provider_verdicts):
+    vs = provider_verdicts(audit_metrology, data("printed_metrology.toml"))
     r, az, el = 2.0, 0.7, 0.3
     tracker = r * np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az),
                             math.sin(el)])
@@ -344,8 +344,8 @@ def _angle(error, slope, sign):
     return -abs(slope) if neg else abs(slope)
 
 
-def test_listing_3_2_and_3_4_against_eq_2_39_and_3_18():
-    vs = audit_squareness.audit(data("printed_squareness.toml"))
+def test_listing_3_2_and_3_4_against_eq_2_39_and_3_18(provider_verdicts):
+    vs = provider_verdicts(audit_squareness, data("printed_squareness.toml"))
     k = {"XY": 2e-5, "YX": 5e-6, "XZ": -8e-6, "ZX": 1.5e-5, "YZ": 3e-6, "ZY": -1.1e-5}
     results = {}
     for sy, sz in itertools.product((1, -1), (1, -1)):

@@ -9,8 +9,8 @@ import pytest
 
 from volerr.derive.audit import dmu50 as audit_dmu50
 
-#: the module's verdicts are computed once, in one worker
-pytestmark = pytest.mark.xdist_group("audit_fiveaxis")
+#: the module's verdicts come from the full audit (conftest.provider_verdicts), in its group
+pytestmark = pytest.mark.xdist_group("full_audit")
 
 
 @pytest.fixture(scope="module")
@@ -20,8 +20,8 @@ def printed():
 
 
 @pytest.fixture(scope="module")
-def verdicts(printed):
-    return {v.equation: v for v in audit_dmu50.audit(printed, None)}
+def verdicts(printed, provider_verdicts):
+    return {v.equation: v for v in provider_verdicts(audit_dmu50, printed, None)}
 
 
 def test_forward_and_inverse_formulas_are_identical(verdicts):

@@ -11,8 +11,8 @@ import pytest
 from volerr.derive import three_point
 from volerr.derive.audit import tracker as audit_tracker
 
-#: the module's verdicts are computed once, in one worker
-pytestmark = pytest.mark.xdist_group("audit_tracker")
+#: the module's verdicts come from the full audit (conftest.provider_verdicts), in its group
+pytestmark = pytest.mark.xdist_group("full_audit")
 
 
 def _printed():
@@ -21,8 +21,9 @@ def _printed():
 
 
 @pytest.fixture(scope="module")
-def verdicts():
-    return {(v.equation, v.component): v for v in audit_tracker.audit(_printed())}
+def verdicts(provider_verdicts):
+    return {(v.equation, v.component): v
+            for v in provider_verdicts(audit_tracker, _printed())}
 
 
 @pytest.mark.parametrize("sel", sorted(three_point.SELECTIONS))

@@ -10,16 +10,17 @@ import pytest
 
 from volerr.probe import calibration as probe
 
-# the module fixtures once, on one xdist worker (not once per worker)
-pytestmark = pytest.mark.xdist_group("audit_probe")
+#: the module's verdicts come from the full audit (conftest.provider_verdicts), in its group
+pytestmark = pytest.mark.xdist_group("full_audit")
 
 
 @pytest.fixture(scope="module")
-def verdicts():
+def verdicts(provider_verdicts):
     from volerr.derive.audit import probe as audit_probe
 
     text = (resources.files("volerr.derive.audit") / "data" / audit_probe.DATA_FILE).read_text()
-    return {(v.equation, v.component): v for v in audit_probe.audit(tomllib.loads(text))}
+    return {(v.equation, v.component): v
+            for v in provider_verdicts(audit_probe, tomllib.loads(text))}
 
 
 def test_verdicts(verdicts):

@@ -3,11 +3,17 @@ load reads the entry without sympy; another layout text gets another entry; a co
 ignored and rewritten."""
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from volerr.machine import layout as layout_mod
+
+#: the first load (a derivation, ~3 s of CPU in its own process) once, on one xdist worker
+pytestmark = pytest.mark.xdist_group("layout_cache")
 
 LOAD = ("import sys, numpy as np, volerr; m = volerr.load(sys.argv[1]); "
         "e = m.volumetric_error([[100.0, 200.0, 300.0]], {'EXX': 1e-3, 'EYY': 2e-3}); "
@@ -31,10 +37,26 @@ def _load(path, cache):
     return used_sympy == "True", value.strip()
 
 
-def test_second_load_reads_the_cache_without_sympy(tmp_path):
+@pytest.fixture(scope="module")
+def first_load(tmp_path_factory):
+    """(cache folder, (used sympy, value)) of the first load of the layout of :func:`_layout`
+    into an empty cache; each test loads from its own copy of the folder (the key is the
+    layout text's sha256, not its path)."""
+    root = tmp_path_factory.mktemp("first_load")
+    cache = root / "cache"
+    return cache, _load(_layout(root), cache)
+
+
+def _cache_copy(first_load, tmp_path) -> Path:
     cache = tmp_path / "cache"
+    shutil.copytree(first_load[0], cache)
+    return cache
+
+
+def test_second_load_reads_the_cache_without_sympy(tmp_path, first_load):
+    cache = _cache_copy(first_load, tmp_path)
     path = _layout(tmp_path)
-    first = _load(path, cache)
+    first = first_load[1]
     assert first[0], "the first load derives (sympy)"
     entries = list(cache.glob("*.py"))
     assert len(entries) == 1 and entries[0].name.startswith("mycmm-")
@@ -44,10 +66,10 @@ def test_second_load_reads_the_cache_without_sympy(tmp_path):
     assert eval(first[1]) == [1e-3, 2e-3, 0.0]
 
 
-def test_changed_layout_text_gets_a_new_entry(tmp_path):
-    cache = tmp_path / "cache"
+def test_changed_layout_text_gets_a_new_entry(tmp_path, first_load):
+    cache = _cache_copy(first_load, tmp_path)   # the first load of this layout text
     path = _layout(tmp_path)
-    _load(path, cache)
+    assert len(list(cache.glob("*.py"))) == 1
     path.write_text(path.read_text() + "\n# a comment changes the text, hence the key\n")
     used, _ = _load(path, cache)
     assert used
@@ -58,10 +80,10 @@ def _flip(text: str, i: int) -> str:
     return text[:i] + ("1" if text[i] != "1" else "2") + text[i + 1:]
 
 
-def test_corrupt_entry_is_rebuilt(tmp_path):
-    cache = tmp_path / "cache"
+def test_corrupt_entry_is_rebuilt(tmp_path, first_load):
+    cache = _cache_copy(first_load, tmp_path)   # the first load of this layout text
     path = _layout(tmp_path)
-    _, value = _load(path, cache)
+    value = first_load[1][1]
     (entry,) = cache.glob("*.py")
     good = entry.read_text()
     for bad in (good[: len(good) // 2], "not python at all (\n", _flip(good, len(good) // 3)):
