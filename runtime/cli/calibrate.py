@@ -62,13 +62,8 @@ def run(args) -> int:
     from ..machine.model import load
     from ._common import layout_inputs
 
-    from .. import fit_quality as fq
-
     require(2 <= args.map_grid <= 60, "--map-grid must be between 2 and 60")
-    require(args.reference or not args.max_change, "--max-change needs --reference CAL.json")
-    limits = fq.parse_max_change(args.max_change) if args.max_change else None
     model = load(args.layout)
-    old = fq.read_reference_parameters(args.reference, model.name) if args.reference else None
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
@@ -76,13 +71,11 @@ def run(args) -> int:
         .folder("--errors-out", args.errors_out,
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     with outs:
-        result = calibrate(args.layout, args.files, parameters=args.parameters,
+        result = calibrate(model, args.files, parameters=args.parameters,
                            degree=args.degree, seed=args.seed,
-                           test_fraction=args.test_fraction)
-        where = f"calibrate {' '.join(split_spec(f)[1] for f in args.files)}"
-        result.quality = fq.gate(result.data, result.quality, args.accept_residual, where)
-        if old is not None:
-            fq.against_reference(result.data, old, limits, args.accept_change, where)
+                           test_fraction=args.test_fraction,
+                           accept_residual=args.accept_residual, reference=args.reference,
+                           max_change=args.max_change, accept_change=args.accept_change)
         if args.json:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:

@@ -13,6 +13,7 @@ and ``--predictions-out``; see :mod:`volerr.loop.drift`.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..errors import require
@@ -107,14 +108,11 @@ def run(args) -> int:
         report = run_loop(args.layout, data, seed=args.seed, folds=args.folds,
                           test_fraction=args.test_fraction, degree=args.degree,
                           out_dir=staged, families=families, inputs=inputs,
-                          holdout_time=args.holdout_time)
-        from ..fit_quality import gate
-
-        report.quality = gate(report.data, report.quality, args.accept_residual,
-                              f"loop {' '.join(inputs[:len(args.data)])}")
-        for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
-            if report.data.get(key):
-                report.data[key] = str(out_dir / Path(report.data[key]).name)
+                          holdout_time=args.holdout_time, accept_residual=args.accept_residual,
+                          where=f"loop {' '.join(inputs[:len(args.data)])}")
+        report = replace(report, data={    # the final paths, not staging (a new result)
+            k: str(out_dir / Path(v).name) if k in ("augmented_layout", "generated_module")
+            and v else v for k, v in report.data.items()})
         if args.json:
             report.write_json(outs.path("--json"), inputs=inputs)
         if args.html:
