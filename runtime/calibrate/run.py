@@ -198,9 +198,13 @@ class Calibration(ResultMixin):
                 tables[a] = ErrorTable(a, np.linspace(*self.ranges[a], n_grid), {})
             tables[a].reversal = np.full(len(tables[a].positions), float(coef[j]))
 
-    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False,
+                           accept_implausible: bool = False, shown=None) -> Path:
         """The error directory (``X.csv`` ... ``constants.csv``); refused for a fit far above
-        the readings' uncertainty unless ``accept_residual`` (:mod:`volerr.fit_quality`)."""
+        the readings' uncertainty unless ``accept_residual`` (:mod:`volerr.fit_quality`), and
+        for values beyond what a machine of the layout's travel can have unless
+        ``accept_implausible`` (:mod:`volerr.tables.plausible`; a refusal names ``shown``,
+        default ``directory``)."""
         from ..fit_quality import forced_note, require_writable
         from ..tables.table import write_error_dir
 
@@ -213,7 +217,8 @@ class Calibration(ResultMixin):
                 comments.setdefault(where, []).insert(0, note)
         tables, constants, cstd = self.error_tables()
         return write_error_dir(directory, tables, constants or None, cstd or None,
-                               inputs=list(inputs), comments=comments)
+                               inputs=list(inputs), comments=comments, machine=self.model,
+                               accept_implausible=accept_implausible, shown=shown)
 
     def table_comments(self) -> dict:
         """``{axis or "constants": [line ...]}``: what the error directory holds under a name

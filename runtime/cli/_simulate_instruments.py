@@ -37,6 +37,9 @@ def add_arguments(p) -> None:
     g.add_argument("--errors", metavar="DIR",
                    help="sphere / ballbar: plant the errors of an error directory instead "
                         "(tables and constants, 'volerr formats tables')")
+    from ._common import add_accept_implausible
+
+    add_accept_implausible(g)
     g.add_argument("--steps", type=int, default=None,
                    help="sphere: positions of each rotary axis over its travel (at most 320 "
                         "deg), every combination (default 9)")
@@ -82,7 +85,8 @@ def run(args) -> int:
     if args.errors:
         from ..tables.functions import ErrorFunctions
 
-        planted, funcs = None, ErrorFunctions.from_dir(args.errors, model)
+        planted, funcs = None, ErrorFunctions.from_dir(
+            args.errors, model, accept_implausible=args.accept_implausible)
     else:
         planted = (sim.parse_planted(args.plant, model) if args.plant is not None
                    else sim.default_planted(model, args.instrument))

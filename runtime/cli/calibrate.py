@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from ..errors import require
 from ..fileio import Outputs
-from ._common import add_accept_residual, add_errors_out, add_force, add_html, add_json, \
-    add_max_change
+from ._common import add_accept_implausible, add_accept_residual, add_errors_out, add_force, \
+    add_html, add_json, add_max_change
 
 
 def register(sub) -> None:
@@ -40,6 +40,7 @@ def register(sub) -> None:
                    help="points per linear axis of --map-out")
     add_force(p)
     add_accept_residual(p)
+    add_accept_implausible(p)
     add_max_change(p, reference=True)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters fitted, the others held at zero: comma list of names "
@@ -81,7 +82,9 @@ def run(args) -> int:
         if args.html:
             result.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
-            result.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+            result.write_error_tables(outs.path("--errors-out"), inputs=inputs,
+                                      accept_implausible=args.accept_implausible,
+                                      shown=args.errors_out)
         if args.map_out:
             from ..calibrate.mapping import write_csv
 

@@ -19,7 +19,8 @@ from pathlib import Path
 from ..errors import require
 from ..fileio import Outputs
 from ..loop.api import console_lines
-from ._common import add_accept_residual, add_errors_out, add_force, add_html, add_json
+from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
+                      add_html, add_json)
 
 
 def register(sub) -> None:
@@ -59,6 +60,7 @@ def register(sub) -> None:
     add_errors_out(p, "the fitted error functions (effects removed)")
     add_force(p)
     add_accept_residual(p)
+    add_accept_implausible(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
                                              "leave-one-point-out, exact via the hat matrix)")
@@ -118,7 +120,9 @@ def run(args) -> int:
         if args.html:
             report.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
-            report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+            report.write_error_tables(outs.path("--errors-out"), inputs=inputs,
+                                      accept_implausible=args.accept_implausible,
+                                      shown=args.errors_out)
     for line in console_lines(report):
         print(line)
     return 0

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..errors import require
 from ..units import URAD_PER_RAD
-from ._common import add_errors_out, add_force, add_json
+from ._common import add_accept_implausible, add_errors_out, add_force, add_json
 
 
 def register(sub) -> None:
@@ -24,6 +24,7 @@ def register(sub) -> None:
     add_errors_out(p, "the squareness with the slope-free tables (must differ from DIR)",
                    "--out", required=True)
     add_force(p)
+    add_accept_implausible(p)
     p.add_argument("--tables-are", choices=("carrier", "component"), default="carrier",
                    help="carrier: motions of the component carrying the points, as written by "
                         "'volerr identify' (default); component: ISO component errors (tool "
@@ -45,7 +46,8 @@ def run(args) -> int:
     require(src.is_dir(), f"{src} is a file: give the error directory (X.csv, Y.csv ...)")
     require(not (out.exists() and out.resolve() == src.resolve()),
             "--errors-out must differ from the input directory (inputs are never overwritten)")
-    tables, (consts, cstd, _) = read_error_dir(src, axes=layout.axis_names)
+    tables, (consts, cstd, _) = read_error_dir(src, axes=layout.axis_names, machine=layout,
+                                               accept_implausible=args.accept_implausible)
     require(tables, f"{src}: no error tables")
     values, std, corrected, slopes = squareness(tables, layout, args.tables_are)
     require(values, f"{src}: no pair of straightness tables for a squareness (EC0Y needs EYX "
@@ -63,7 +65,8 @@ def run(args) -> int:
         staged = outs.path("--errors-out")
         for name, text in texts.items():
             write_text(staged / name, text, inputs=inputs)
-        write_constants(staged / "constants.csv", merged, inputs=inputs, std=merged_std)
+        write_constants(staged / "constants.csv", merged, inputs=inputs, std=merged_std,
+                        machine=layout, accept_implausible=args.accept_implausible)
         if args.json:
             doc = {"squareness_urad": {k: v * URAD_PER_RAD for k, v in values.items()},
                    "u_urad": {k: v * URAD_PER_RAD for k, v in std.items()},

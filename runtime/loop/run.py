@@ -158,10 +158,13 @@ class Report(ResultMixin):
                 constants[p] = float(coef[index[(p, None)]])
         return tables, constants
 
-    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False,
+                           accept_implausible: bool = False, shown=None) -> Path:
         """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``);
         refused for a fit far above the readings' uncertainty unless ``accept_residual``
-        (:mod:`volerr.fit_quality`)."""
+        (:mod:`volerr.fit_quality`), and for values beyond what a machine of the layout's
+        travel can have unless ``accept_implausible`` (:mod:`volerr.tables.plausible`; a
+        refusal names ``shown``, default ``directory``)."""
         from ..fit_quality import forced_note, require_writable
         from ..tables.table import write_error_dir
 
@@ -171,7 +174,8 @@ class Report(ResultMixin):
                                            accept_residual and self.quality else None)
         comments = {w: [note] for w in ["constants", *tables]} if note else None
         return write_error_dir(directory, tables, constants or None, inputs=list(inputs),
-                               comments=comments)
+                               comments=comments, machine=self.plot_data.model,
+                               accept_implausible=accept_implausible, shown=shown)
 
     def summary(self) -> str:
         d = self.data
