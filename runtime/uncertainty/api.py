@@ -110,8 +110,7 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
                 max_samples: int = 1_000_000, seed: int = 0, chunks: int = 1,
                 scheduler: str = "none", scheduler_address: str | None = None,
                 workers: int = 2, contributions: int = 2000, backend: str = "numpy",
-                bias: str = "corrected", progress: bool = False,
-                accept_implausible: bool = False) -> Uncertainty:
+                bias: str = "corrected", progress=False, accept_implausible=False) -> Uncertainty:
     """Task-specific measurement uncertainty by Monte Carlo (``volerr uncertainty``; a
     virtual CMM, ISO/TS 15530-4, JCGM 101).
 
@@ -125,9 +124,7 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
         The evaluation (``distance``, ``sphere``, ... :data:`volerr.uncertainty.EVALUATIONS`).
     errors : path, optional
         Error directory with ``_std`` / ``_u95`` columns (the machine's identified errors);
-        ``method``, ``degree``, ``extrapolate``: how its tables are interpolated;
-        ``accept_implausible`` (``--accept-implausible``): values beyond what a machine of
-        the layout's travel can have used instead of refused (:mod:`volerr.tables.plausible`).
+        ``method``/``degree``/``extrapolate``/``accept_implausible``: as the ``--`` options.
     spec : str, optional
         ``"E0=A+L/K"`` (um, L in mm): machines that pass this ISO 10360-2 specification.
     noise_um : float
@@ -163,10 +160,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
                                            f"(one of {', '.join(tasks.EVALUATIONS)})")
     model = load(layout)
     tk = tasks.read_task(task, model.axes)
-    funcs = (ErrorFunctions.from_dir(errors, model, method=method, degree=degree,
-                                     extrapolate=extrapolate,
-                                     accept_implausible=accept_implausible)
-             if errors else None)
+    funcs = (ErrorFunctions.from_dir(errors, model, method, degree, extrapolate,
+                                     accept_implausible) if errors else None)
     parsed = ensemble.parse_spec(spec) if spec else None
     require(funcs is not None or parsed is not None or noise_um > 0 or probe_map is not None
             or temperature is not None,
