@@ -378,10 +378,11 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
         ``--accept-residual``: a fit far above the readings' declared uncertainty
         (:mod:`volerr.fit_quality`) is returned marked forced (``fit["verdict"] == "forced"``,
         ``data["forced"]`` the sentence every output carries) instead of refused.
-    reference : str, path or dict, optional
-        ``--reference``: a calibrate / check JSON of the same layout (or its ``parameters``,
-        ``{NAME: {"value", "unit"}}``); the result's ``reference_change`` lists every common
-        parameter's change (report units).
+    reference : str, path, dict or Calibration, optional
+        ``--reference``: a calibrate / check JSON of the same layout (the file, its document,
+        its ``parameters`` ``{NAME: {"value", "unit"}}``, or an earlier :class:`Calibration`);
+        the result's ``reference_change`` lists every common parameter's change (report
+        units).
     max_change : str or dict, optional
         ``--max-change`` (needs ``reference``): ``"EX0C=20 um,EA0B=50 urad"`` or ``"20 um"``
         (units required; :func:`volerr.fit_quality.parse_max_change`); a parameter moved
@@ -408,8 +409,7 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
     require(reference is not None or not max_change, "--max-change needs --reference CAL.json")
     limits = fq.parse_max_change(max_change) if isinstance(max_change, str) else max_change
     model = layout if isinstance(layout, Model) else load(layout)
-    old = None if reference is None else dict(reference) if isinstance(reference, dict) \
-        else fq.read_reference_parameters(reference, model.name)
+    old = None if reference is None else _reference_parameters(reference, model.name)
     report, fields = fit_campaign(model, files, parameters=parameters, degree=degree,
                                   max_degree=max_degree, seed=seed,
                                   test_fraction=test_fraction, extra_terms=extra_terms,
@@ -419,6 +419,24 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
     if old is not None:
         fq.against_reference(report, old, limits, accept_change, where)
     return Calibration(report, *fields[:-1], quality)
+
+
+def _reference_parameters(reference, layout: str) -> dict:
+    """``{NAME: {"value", "unit"}}`` of a reference: a calibrate / check JSON file, a
+    :class:`Calibration`, its JSON document or its ``parameters``."""
+    from ..fit_quality import read_reference_parameters
+
+    if isinstance(reference, Calibration):
+        reference = reference.data
+    if isinstance(reference, dict):
+        require(reference.get("layout", layout) == layout, f"reference: a calibration of "
+                f"layout {reference.get('layout')}, not of {layout}")
+        params = reference.get("parameters", reference)
+        require(isinstance(params, dict) and all(
+            isinstance(v, dict) and "value" in v for v in params.values()),
+            "reference: no parameters with values (give a calibrate or check JSON)")
+        return dict(params)
+    return read_reference_parameters(reference, layout)
 
 
 def campaign_names(files) -> str:

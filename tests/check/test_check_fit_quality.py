@@ -259,3 +259,18 @@ def test_the_api_check_validates_its_date(world, tmp_path, date, needle):
     with pytest.raises(InputError) as e:
         volerr.check(LAYOUT, [str(check_empty)], reference=str(cal), date=date)
     assert needle in str(e.value) and "\n" not in str(e.value)
+
+
+def test_calibrate_takes_an_earlier_result_as_its_reference(world, tmp_path):
+    """reference= an earlier Calibration (or its document) is the same as its JSON file."""
+    import volerr
+
+    d, cal, _, check_empty = world
+    path = _filled(check_empty, tmp_path / "again.csv", PLANTED, 93)
+    ref = json.loads(cal.read_text())
+    a = volerr.calibrate(LAYOUT, [str(path)], reference=str(cal), plan=False, progress=False)
+    b = volerr.calibrate(LAYOUT, [str(path)], reference=ref, plan=False, progress=False)
+    c = volerr.calibrate(LAYOUT, [str(path)], reference=b, plan=False, progress=False)
+    assert a.data["reference_change"] == b.data["reference_change"]
+    assert set(c.data["reference_change"]) == set(b.data["parameters"])
+    assert all(abs(v["change"]) < 1e-9 for v in c.data["reference_change"].values())
