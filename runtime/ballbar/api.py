@@ -5,7 +5,8 @@ from __future__ import annotations
 from .evaluate import Evaluation, check_layout_for, evaluate
 
 
-def ballbar_evaluate(files, layout=None, *, diagnose: bool = True) -> Evaluation:
+def ballbar_evaluate(files, layout=None, *, diagnose: bool = True,
+                     accept_residual: bool = False) -> Evaluation:
     """ISO 230-4 evaluation of ballbar traces and their diagnosis in ISO 230-1 parameters.
 
     Parameters
@@ -18,6 +19,10 @@ def ballbar_evaluate(files, layout=None, *, diagnose: bool = True) -> Evaluation
         A trace with rotary-axis columns needs its layout.
     diagnose : bool
         Also fit the layout's squareness / location / scale parameters to the traces.
+    accept_residual : bool
+        ``--accept-residual``: a diagnosis whose fit is far above the readings' declared
+        uncertainty (:mod:`volerr.fit_quality`) is given, marked forced; by default it is
+        withheld (``diagnosis`` empty, ``diagnosis_note`` says why; G, H, F always given).
 
     Returns
     -------
@@ -28,4 +33,5 @@ def ballbar_evaluate(files, layout=None, *, diagnose: bool = True) -> Evaluation
     files = [files] if isinstance(files, (str, bytes)) or hasattr(files, "__fspath__") \
         else list(files)
     check_layout_for(files, layout)
-    return evaluate(files, layout, diagnose)
+    return evaluate(files, layout, diagnose, accept_residual,
+                    f"ballbar evaluate {' '.join(map(str, files))} (the diagnosis)")

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..calibrate import calibrate
+from ..calibrate.run import fit_campaign
 from ..errors import require
 from ..machine.iso_names import along_component
 
@@ -74,8 +74,8 @@ def diagnose_fit(model, obs, planes: list, swept: list = ()) -> tuple:
         params += [p for p in model.parameters if model.parameter_axis.get(p) is None
                    and p[-1] == r and p[2] == "0"]
     require(params, "nothing to diagnose in these traces")
-    cal = calibrate(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
-                    extra_terms=extra, plan=False, progress=False)
+    cal = fit_campaign(model, obs, parameters=",".join(dict.fromkeys(params)), degree=2,
+                       extra_terms=extra, plan=False, progress=False)
     entries = _entries(cal, report, swept, extra)
     for e in entries:   # the estimator's budget where the entry is one of its parameters
         b = (cal.data.get("budgets") or {}).get(e["parameter"])

@@ -47,24 +47,6 @@ class Evaluation(ResultMixin):
             out.append("  diagnosis " + self.quality.line())
         return "\n".join(out)
 
-    def judge(self, accept: bool, where: str) -> None:
-        """The residual rule (:mod:`volerr.fit_quality`) on the diagnosis fit.  The ISO 230-4
-        values (G, H, F) do not depend on any model and are always given; a diagnosis whose
-        fit is far above the readings' declared uncertainty is withheld (``diagnosis`` empty,
-        ``diagnosis_note`` says why, ``fit`` verdict ``refused``) unless ``accept``
-        (``--accept-residual``: given, marked forced in every output)."""
-        from ..errors import InputError
-        from ..fit_quality import gate
-
-        try:
-            self.quality = gate(self.data, self.quality, accept, where)
-        except InputError as e:
-            self.data["diagnosis"] = []
-            self.data["diagnosis_note"] = (f"withheld: {str(e).split(': ', 1)[1]}"
-                                           .replace("nothing written", "diagnosis withheld")
-                                           .replace("writes it", "gives it"))
-            self.data["fit"] = self.quality.to_dict()
-
     def _rows(self) -> list:
         from ..results import Row
 
@@ -89,9 +71,32 @@ class Evaluation(ResultMixin):
         return write_text(path, json_text(self.data), inputs=list(inputs))
 
 
-def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
+def judge(data: dict, quality, accept: bool, where: str):
+    """The residual rule (:mod:`volerr.fit_quality`) on the diagnosis fit, applied to the
+    JSON ``data`` before the result is built; returns the verdict (forced when accepted).
+    The ISO 230-4 values (G, H, F) do not depend on any model and are always given; a
+    diagnosis whose fit is far above the readings' declared uncertainty is withheld
+    (``diagnosis`` empty, ``diagnosis_note`` says why, ``fit`` verdict ``refused``) unless
+    ``accept`` (``--accept-residual``: given, marked forced in every output)."""
+    from ..errors import InputError
+    from ..fit_quality import gate
+
+    try:
+        return gate(data, quality, accept, where)
+    except InputError as e:
+        data["diagnosis"] = []
+        data["diagnosis_note"] = (f"withheld: {str(e).split(': ', 1)[1]}"
+                                  .replace("nothing written", "diagnosis withheld")
+                                  .replace("writes it", "gives it"))
+        data["fit"] = quality.to_dict()
+        return quality
+
+
+def evaluate(files, layout=None, diagnose: bool = True, accept_residual: bool = False,
+             where: str = "ballbar evaluate") -> Evaluation:
     """Evaluate ballbar ``files`` (paths); ``layout`` None: :data:`DEFAULT_LAYOUT` for
-    X, Y, Z traces (the travel of the generic layout is not enforced)."""
+    X, Y, Z traces (the travel of the generic layout is not enforced).  The diagnosis is
+    judged by its residual (:func:`judge`; ``where`` names the run in its note)."""
     model = load(layout or DEFAULT_LAYOUT)
     instruments.refuse_duplicates(files)
     parts, trs = [], []
@@ -113,6 +118,7 @@ def evaluate(files, layout=None, diagnose: bool = True) -> Evaluation:
         data["budgets"] = {e["parameter"]: e.pop("budget") for e in data["diagnosis"]
                            if "budget" in e}
         data["fit"] = quality.to_dict()
+        quality = judge(data, quality, accept_residual, where)
         return Evaluation(data, trs, results, quality)
     return Evaluation(data, trs, results)
 

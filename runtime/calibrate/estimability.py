@@ -64,6 +64,9 @@ def distances(G: np.ndarray) -> np.ndarray:
     out = np.zeros(p)
     for j in np.flatnonzero(nonzero):
         o = np.r_[0:j, j + 1:p]
+        if not len(o):          # a lone column: nothing to be in the span of (distance 1)
+            out[j] = 1.0
+            continue
         Co = C[np.ix_(o, o)]
         w, V = np.linalg.eigh(Co)
         keep = w > 1e-13 * max(float(w[-1]), 1e-300)

@@ -198,18 +198,27 @@ class Calibration(ResultMixin):
                 tables[a] = ErrorTable(a, np.linspace(*self.ranges[a], n_grid), {})
             tables[a].reversal = np.full(len(tables[a].positions), float(coef[j]))
 
-    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False,
+                           accept_implausible: bool = False, shown=None) -> Path:
         """The error directory (``X.csv`` ... ``constants.csv``); refused for a fit far above
-        the readings' uncertainty unless ``accept_residual`` (:mod:`volerr.fit_quality`)."""
-        from ..fit_quality import gate, require_writable
+        the readings' uncertainty unless ``accept_residual`` (:mod:`volerr.fit_quality`), and
+        for values beyond what a machine of the layout's travel can have unless
+        ``accept_implausible`` (:mod:`volerr.tables.plausible`; a refusal names ``shown``,
+        default ``directory``)."""
+        from ..fit_quality import forced_note, require_writable
         from ..tables.table import write_error_dir
 
         require_writable(self.quality, accept_residual, f"error tables {directory}")
-        if accept_residual:
-            self.quality = gate(self.data, self.quality, True, "error tables")
+        comments = self.table_comments()
+        note = None if self.data.get("forced") or not accept_residual \
+            or self.quality is None else forced_note(self.quality.marked())
+        if note:            # a refused fit written on the caller's word (not changed here)
+            for where in ["constants", *self.model.axes]:
+                comments.setdefault(where, []).insert(0, note)
         tables, constants, cstd = self.error_tables()
         return write_error_dir(directory, tables, constants or None, cstd or None,
-                               inputs=list(inputs), comments=self.table_comments())
+                               inputs=list(inputs), comments=comments, machine=self.model,
+                               accept_implausible=accept_implausible, shown=shown)
 
     def table_comments(self) -> dict:
         """``{axis or "constants": [line ...]}``: what the error directory holds under a name
@@ -334,7 +343,8 @@ def reading_weights(obs) -> tuple[np.ndarray, float]:
 
 def calibrate(layout, files, *, parameters: str | None = None, degree: int | None = None,
               max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
-              extra_terms=(), plan: bool = True, progress=None) -> Calibration:
+              extra_terms=(), plan: bool = True, progress=None, accept_residual: bool = False,
+              reference=None, max_change=None, accept_change: bool = False) -> Calibration:
     """Identify ``layout``'s parameters from measurement files of any instruments, mixed in
     one campaign, by weighted least squares (``volerr calibrate``; ``volerr.calibrate(...)``).
 
@@ -364,6 +374,19 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
         Suggest the plan extensions that would determine what the campaign does not.
     progress : bool, optional
         Progress bar on stderr (None: when stderr is a terminal).
+    accept_residual : bool
+        ``--accept-residual``: a fit far above the readings' declared uncertainty
+        (:mod:`volerr.fit_quality`) is returned marked forced (``fit["verdict"] == "forced"``,
+        ``data["forced"]`` the sentence every output carries) instead of refused.
+    reference : str, path, dict or Calibration, optional
+        ``--reference``: a calibrate / check JSON of the same layout (the file, its document,
+        its ``parameters`` ``{NAME: {"value", "unit"}}``, or an earlier :class:`Calibration`);
+        the result's ``reference_change`` lists every common parameter's change (report
+        units).
+    max_change : str or dict, optional
+        ``--max-change`` (needs ``reference``): ``"EX0C=20 um,EA0B=50 urad"`` or ``"20 um"``
+        (units required; :func:`volerr.fit_quality.parse_max_change`); a parameter moved
+        further than its limit is refused unless ``accept_change`` (``--accept-change``).
 
     Returns
     -------
@@ -377,13 +400,67 @@ def calibrate(layout, files, *, parameters: str | None = None, degree: int | Non
     Raises
     ------
     volerr.InputError
-        Bad input, with the command's one-line message.
+        Bad input, with the command's one-line message; a fit far above its declared
+        uncertainty (unless ``accept_residual``), a change beyond ``max_change`` (unless
+        ``accept_change``).
     """
+    from .. import fit_quality as fq
+
+    require(reference is not None or not max_change, "--max-change needs --reference CAL.json")
+    limits = fq.parse_max_change(max_change) if isinstance(max_change, str) else max_change
+    model = layout if isinstance(layout, Model) else load(layout)
+    old = None if reference is None else _reference_parameters(reference, model.name)
+    report, fields = fit_campaign(model, files, parameters=parameters, degree=degree,
+                                  max_degree=max_degree, seed=seed,
+                                  test_fraction=test_fraction, extra_terms=extra_terms,
+                                  plan=plan, progress=progress, built=False)
+    where = f"calibrate {campaign_names(files)}"
+    quality = fq.gate(report, fields[-1], accept_residual, where)
+    if old is not None:
+        fq.against_reference(report, old, limits, accept_change, where)
+    return Calibration(report, *fields[:-1], quality)
+
+
+def _reference_parameters(reference, layout: str) -> dict:
+    """``{NAME: {"value", "unit"}}`` of a reference: a calibrate / check JSON file, a
+    :class:`Calibration`, its JSON document or its ``parameters``."""
+    from ..fit_quality import read_reference_parameters
+
+    if isinstance(reference, Calibration):
+        reference = reference.data
+    if isinstance(reference, dict):
+        require(reference.get("layout", layout) == layout, f"reference: a calibration of "
+                f"layout {reference.get('layout')}, not of {layout}")
+        params = reference.get("parameters", reference)
+        require(isinstance(params, dict) and all(
+            isinstance(v, dict) and "value" in v for v in params.values()),
+            "reference: no parameters with values (give a calibrate or check JSON)")
+        return dict(params)
+    return read_reference_parameters(reference, layout)
+
+
+def campaign_names(files) -> str:
+    """The campaign's files as the command names them (``KIND:`` dropped), for messages."""
+    if isinstance(files, instruments.Observations):
+        return " ".join(f.name for f in files.files)
+    from ..results import file_list
+
+    return " ".join(instruments.split_spec(str(f))[1] for f in file_list(files))
+
+
+def fit_campaign(layout, files, *, parameters: str | None = None, degree: int | None = None,
+                 max_degree: int = 8, seed: int = 0, test_fraction: float = 0.25,
+                 extra_terms=(), plan: bool = True, progress=None, built: bool = True):
+    """:func:`calibrate` without the residual rule's gate and the reference: the fit as it
+    is, judged (``quality``) but neither refused nor forced -- for a capability that
+    decides itself what a refused fit means (``ballbar evaluate`` withholds its diagnosis).
+    ``built``: the :class:`Calibration`; False: ``(report, fields)`` to build it from."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
-        return _run(layout, files, parameters, degree, max_degree, seed, test_fraction,
-                    list(extra_terms), plan, progress)
+        report, fields = _run(layout, files, parameters, degree, max_degree, seed,
+                              test_fraction, list(extra_terms), plan, progress)
+    return Calibration(report, *fields) if built else (report, fields)
 
 
 def _progress(total: int, enabled):
@@ -469,7 +546,7 @@ def _run(layout, files, parameters, degree, max_degree, seed, test_fraction, ext
     from .budget import budgets
     report["budgets"] = budgets(draft, fit, u_ref)
     report["seconds"] = round(time.perf_counter() - t0, 2)
-    return Calibration(report, *fields)
+    return report, fields
 
 
 def fit_quality(sol, u_ref: float) -> FitQuality:

@@ -192,18 +192,21 @@ class CheckResult(ResultMixin):
             out["max_change"] = self.consent
         return out
 
-    def gate(self, accept_residual: bool, limits: dict | None, accept_change: bool,
-             where: str) -> None:
-        """Before anything is written: the residual rule (refused far above the readings'
-        uncertainty unless ``accept_residual``) and, with ``limits``
+    def gated(self, accept_residual: bool, limits: dict | None, accept_change: bool,
+              where: str) -> "CheckResult":
+        """The residual rule (refused far above the readings' uncertainty unless
+        ``accept_residual``) and, with ``limits``
         (:func:`volerr.fit_quality.parse_max_change`), the parameters moved beyond them
         against the reference (refused unless ``accept_change``); a ``"map"`` limit (um)
-        bounds the largest volumetric change.  One-line InputError."""
+        bounds the largest volumetric change.  One-line InputError; else a new result with
+        the verdict (forced when accepted) and the consent block (this one is not changed)."""
+        from dataclasses import replace
+
         from .. import fit_quality as fq
 
-        self.quality = fq.require_fit(self.quality, accept_residual, where)
+        quality = fq.require_fit(self.quality, accept_residual, where)
         if not limits:
-            return
+            return replace(self, quality=quality)
         limits = dict(limits)
         beyond = []
         if "map" in limits:
@@ -217,7 +220,8 @@ class CheckResult(ResultMixin):
         old = {n: {"value": e["reference"], "unit": e["unit"]} for n, e in params.items()}
         beyond += fq.changes_beyond(old, params, limits)
         fq.require_consent(beyond, accept_change, where)
-        self.consent = fq.consent_block(beyond, limits, accept_change)
+        return replace(self, quality=quality,
+                       consent=fq.consent_block(beyond, limits, accept_change))
 
     def summary(self) -> str:
         """What ``volerr check`` prints."""

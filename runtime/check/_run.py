@@ -34,7 +34,8 @@ P_UNEXPLAINED = 1e-3
 
 
 def check(layout, files, *, reference, tolerance: str | None = None,
-          date: str | None = None) -> CheckResult:
+          date: str | None = None, accept_residual: bool = False, max_change=None,
+          accept_change: bool = False) -> CheckResult:
     """What changed since the reference calibration (``volerr check LAYOUT --reference REF
     FILE...``; module docstring).
 
@@ -52,7 +53,16 @@ def check(layout, files, *, reference, tolerance: str | None = None,
         ``"NAME=VALUE [UNIT],...,map=VALUE"`` (``--tolerance``; ISO 14253-1 decisions,
         :mod:`volerr.check._tolerance`; ``map`` in um of the volumetric change).
     date : str, optional
-        ``YYYY-MM-DD``, carried into the result (``--date``).
+        ``YYYY-MM-DD``, not after today (UTC), carried into the result (``--date``;
+        :func:`volerr.units.parse_date`: a malformed or future date is an InputError).
+    accept_residual : bool
+        ``--accept-residual``: a fit far above the readings' declared uncertainty
+        (:mod:`volerr.fit_quality`) is returned marked forced instead of refused.
+    max_change : str or dict, optional
+        ``--max-change``: ``"EX0C=20 um,map=30 um"`` (units required;
+        :func:`volerr.fit_quality.parse_max_change`; ``map`` bounds the largest volumetric
+        change, um); a parameter moved further than its limit against the reference is
+        refused unless ``accept_change`` (``--accept-change``).
 
     Returns
     -------
@@ -64,6 +74,11 @@ def check(layout, files, *, reference, tolerance: str | None = None,
 
     from ..results import file_list
 
+    from ..fit_quality import parse_max_change
+    from ..units import parse_date
+
+    date = None if date is None else parse_date(date)
+    limits = parse_max_change(max_change) if isinstance(max_change, str) else max_change
     model = layout if isinstance(layout, Model) else load(layout)
     ref = _reference.load(reference, model)
     files = file_list(files)
@@ -88,14 +103,15 @@ def check(layout, files, *, reference, tolerance: str | None = None,
                                     "u of each reading as declared in its file, else its "
                                     "instrument's default, times the reference's Birge ratio "
                                     "when above 1"))
-    if tol is None:
-        return res
-    from dataclasses import replace
+    if tol is not None:
+        from dataclasses import replace
 
-    from ._tolerance import decide
+        from ._tolerance import decide
 
-    # a new result with the decisions (the one without them is not changed)
-    return replace(res, tolerance=decide(tol, res))
+        # a new result with the decisions (the one without them is not changed)
+        res = replace(res, tolerance=decide(tol, res))
+    where = f"check {' '.join(instruments.split_spec(str(f))[1] for f in files)}"
+    return res.gated(accept_residual, limits, accept_change, where)
 
 
 def _misfit(system, sel, ref) -> dict:

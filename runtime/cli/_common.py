@@ -9,7 +9,8 @@ from ..errors import InputError, require
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
-    """Add ``--errors DIR --method --degree --extrapolate`` to an argparse parser."""
+    """Add ``--errors DIR --method --degree --extrapolate --accept-implausible`` to an argparse
+    parser."""
     parser.add_argument("--errors", metavar="DIR", required=required,
                         help="error directory: X.csv, Y.csv, ... (one table per axis) and "
                              "optionally constants.csv")
@@ -21,6 +22,7 @@ def add_error_arguments(parser, required: bool = True) -> None:
                              "leave-one-out cross-validation)")
     parser.add_argument("--extrapolate", action="store_true",
                         help="evaluate beyond the measured range of a table (default: refuse)")
+    add_accept_implausible(parser)
 
 
 def error_functions_from_args(args, model):
@@ -35,7 +37,10 @@ def error_functions_from_args(args, model):
 
 def add_accept_implausible(parser) -> None:
     """``--accept-implausible``: error values beyond what a machine of the layout's travel can
-    have (:mod:`volerr.tables.plausible`) are used instead of refused."""
+    have (:mod:`volerr.tables.plausible`) are used instead of refused.  Added once (a command
+    whose error arguments carry it already is left as it is)."""
+    if "--accept-implausible" in parser._option_string_actions:
+        return
     parser.add_argument("--accept-implausible", action="store_true",
                         help="for a machine that really is that bad: use error values beyond "
                              "what a machine of this travel can have (default: refused, "

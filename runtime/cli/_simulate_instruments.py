@@ -37,6 +37,9 @@ def add_arguments(p) -> None:
     g.add_argument("--errors", metavar="DIR",
                    help="sphere / ballbar: plant the errors of an error directory instead "
                         "(tables and constants, 'volerr formats tables')")
+    from ._common import add_accept_implausible
+
+    add_accept_implausible(g)
     g.add_argument("--steps", type=int, default=None,
                    help="sphere: positions of each rotary axis over its travel (at most 320 "
                         "deg), every combination (default 9)")
@@ -71,7 +74,9 @@ def run(args) -> int:
     outs = Outputs(inputs).file("--out", args.out).check()
     text, line = instrument_file(args.layout, args.instrument, plant=args.plant,
                                  errors=args.errors, steps=args.steps, radius=args.radius,
-                                 noise_um=args.noise_um, seed=args.seed)
+                                 noise_um=args.noise_um, seed=args.seed,
+                                 accept_implausible=args.accept_implausible)
+
     with outs:
         write_text(outs.path("--out"), text, inputs=inputs)
     print(f"{line} -> {args.out}")

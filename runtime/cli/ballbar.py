@@ -114,8 +114,7 @@ def run_evaluate(args) -> int:
     outs = Outputs(inputs, force=args.force).file("--json", args.json).plot("--plot", args.plot) \
         .file("--html", args.html).file("--pdf", args.pdf).check()
     ident = identification_from_args(args, inputs)
-    ev = ballbar_evaluate(args.files, args.layout)
-    ev.judge(args.accept_residual, f"ballbar evaluate {' '.join(args.files)} (the diagnosis)")
+    ev = ballbar_evaluate(args.files, args.layout, accept_residual=args.accept_residual)
     with outs:
         if args.json:
             ev.write_json(outs.path("--json"), inputs=inputs)

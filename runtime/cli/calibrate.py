@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from ..errors import require
 from ..fileio import Outputs
-from ._common import (add_accept_residual, add_errors_out, add_force, add_html,
-                      add_identification_arguments, add_json, add_max_change,
+from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
+                      add_html, add_identification_arguments, add_json, add_max_change,
                       identification_from_args, write_certificates)
 
 
@@ -42,6 +42,7 @@ def register(sub) -> None:
                    help="points per linear axis of --map-out")
     add_force(p)
     add_accept_residual(p)
+    add_accept_implausible(p)
     add_max_change(p, reference=True)
     p.add_argument("--parameters", metavar="SPEC",
                    help="parameters fitted, the others held at zero: comma list of names "
@@ -64,13 +65,8 @@ def run(args) -> int:
     from ..machine.model import load
     from ._common import layout_inputs
 
-    from .. import fit_quality as fq
-
     require(2 <= args.map_grid <= 60, "--map-grid must be between 2 and 60")
-    require(args.reference or not args.max_change, "--max-change needs --reference CAL.json")
-    limits = fq.parse_max_change(args.max_change) if args.max_change else None
     model = load(args.layout)
-    old = fq.read_reference_parameters(args.reference, model.name) if args.reference else None
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
@@ -79,19 +75,19 @@ def run(args) -> int:
                 files=[f"{a}.csv" for a in model.axes] + ["constants.csv"]).check()
     ident = identification_from_args(args, inputs)
     with outs:
-        result = calibrate(args.layout, args.files, parameters=args.parameters,
+        result = calibrate(model, args.files, parameters=args.parameters,
                            degree=args.degree, seed=args.seed,
-                           test_fraction=args.test_fraction)
-        where = f"calibrate {' '.join(split_spec(f)[1] for f in args.files)}"
-        result.quality = fq.gate(result.data, result.quality, args.accept_residual, where)
-        if old is not None:
-            fq.against_reference(result.data, old, limits, args.accept_change, where)
+                           test_fraction=args.test_fraction,
+                           accept_residual=args.accept_residual, reference=args.reference,
+                           max_change=args.max_change, accept_change=args.accept_change)
         if args.json:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:
             result.write_html(outs.path("--html"), inputs=inputs)
         if args.errors_out:
-            result.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+            result.write_error_tables(outs.path("--errors-out"), inputs=inputs,
+                                      accept_implausible=args.accept_implausible,
+                                      shown=args.errors_out)
         if args.map_out:
             from ..calibrate.mapping import write_csv
 

@@ -133,22 +133,14 @@ def _check(args, inputs) -> int:
     from ..instruments import split_spec
 
     layout, files = args.words[0], args.words[1:]
-    if args.date is not None:           # YYYY-MM-DD, not in the future
-        from ..units import parse_date
-
-        args.date = parse_date(args.date)
     inputs = inputs + [Path(args.reference)] + [Path(split_spec(f)[1]) for f in files]
-    from ..fit_quality import parse_max_change
-
-    limits = parse_max_change(args.max_change) if args.max_change else None
     outs = Outputs(inputs, force=args.force).file("--json", args.json) \
         .file("--html", args.html).file("--pdf", args.pdf).check()
     ident = identification_from_args(args, [Path(split_spec(f)[1]) for f in files] + inputs)
     with outs:
         result = check(layout, files, reference=args.reference, tolerance=args.tolerance,
-                       date=args.date)
-        result.gate(args.accept_residual, limits, args.accept_change,
-                    f"check {' '.join(split_spec(f)[1] for f in files)}")
+                       date=args.date, accept_residual=args.accept_residual,
+                       max_change=args.max_change, accept_change=args.accept_change)
         if args.json:
             result.write_json(outs.path("--json"), inputs=inputs)
         if args.html:

@@ -124,7 +124,8 @@ def run(args) -> int:
                 check_travel=not args.ignore_travel, arc_tol_um=args.arc_tolerance_um,
                 dialect=args.dialect, out=outs.path("--out"),
                 report=outs.path("--report") if args.report else None, inputs=inputs,
-                out_name=args.out, keep_errors=bool(args.plot), progress=tick)
+                out_name=args.out, keep_errors=bool(args.plot), progress=tick,
+                accept_implausible=args.accept_implausible)
         if args.json:
             res.write_json(outs.path("--json"), inputs)
         if args.plot:

@@ -87,6 +87,9 @@ def register(sub) -> None:
     e.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
                    help="position of a rotary axis for what the export leaves, "
                         "repeatable (default 0 deg)")
+    from ._common import add_accept_implausible
+
+    add_accept_implausible(e)
     e.set_defaults(func=run)
     i = s.add_parser("import", help="controller file -> error directory")
     i.add_argument("layout", help="layout name or file")
@@ -94,10 +97,11 @@ def register(sub) -> None:
                                 "to it; linuxcnc: the ini naming the COMP_FILEs)")
     i.add_argument("--format", choices=("auto", "isg", "etalon") + AXIS_FORMATS,
                    default="auto", help="the file's format (auto: isg or etalon)")
-    from ._common import add_errors_out, add_force
+    from ._common import add_accept_implausible, add_errors_out, add_force
 
     add_errors_out(i, "the imported tables", "--out", required=True)
     add_force(i)
+    add_accept_implausible(i)
     i.add_argument("--negate", action="store_true",
                    help="isg / etalon: the file holds compensation values: reverse their sign")
     i.set_defaults(func=run)
@@ -112,9 +116,11 @@ def run(args) -> int:
             args.layout, args.errors, format=args.format, out=args.out, json=args.json,
             plot=args.plot, loop_json=args.loop_json, temperatures=args.temperatures,
             sensors=args.sensors, comp_file_type=args.comp_file_type, negate=args.negate,
-            force=args.force, points=args.points, grid=args.grid, at=parse_at(args.at))
+            force=args.force, points=args.points, grid=args.grid, at=parse_at(args.at),
+            accept_implausible=args.accept_implausible)
     else:
         result = controller_import(args.layout, args.file, out=args.errors_out,
-                                   format=args.format, negate=args.negate, force=args.force)
+                                   format=args.format, negate=args.negate, force=args.force,
+                                   accept_implausible=args.accept_implausible)
     print(result.summary())
     return 0

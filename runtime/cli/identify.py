@@ -114,16 +114,12 @@ def run(args) -> int:
         origin=("layout" if args.origin == ["layout"] else
                 _vec(args.origin, "--origin") if args.origin else None),
         sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k, signs=args.signs,
-        accept_implausible=args.accept_implausible)
-    from ..fit_quality import gate
-
-    res.quality = gate(res.data, res.quality, args.accept_residual,
-                       f"identify {' '.join(args.files)}", key="fit_quality")
+        accept_implausible=args.accept_implausible, accept_residual=args.accept_residual)
     result, table = res.identification, res.errors
     text = table_to_csv(table)
     if res.data.get("forced"):
         text = f"# {res.data['forced']}\n" + text
-    summary = res.data
+    summary = dict(res.data)        # --fit adds its entry to the JSON, not to the result
     fits = None
     if args.fit:
         from ..tables.errorfit import fit_table

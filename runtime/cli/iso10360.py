@@ -66,7 +66,7 @@ def run(args) -> int:
         artefact_u=args.artefact_u, artefact_cte_ppm_per_K=args.artefact_cte_ppm_per_K,
         artefact_cte_u_ppm_per_K=args.artefact_cte_u_ppm_per_K,
         temperature_C=args.temperature_C, temperature_u_K=args.temperature_u_K,
-        identification=ident)
+        identification=ident, accept_implausible=args.accept_implausible)
     print(res.summary())
     with outs:
         if args.json:

@@ -14,12 +14,13 @@ calls :func:`volerr.loop` (the one entry for both kinds) and writes its result.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..fileio import Outputs
-from ._common import (add_accept_residual, add_errors_out, add_force, add_html,
-                      add_identification_arguments, add_json, identification_from_args,
-                      write_certificates)
+from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
+                      add_html, add_identification_arguments, add_json,
+                      identification_from_args, write_certificates)
 
 
 def register(sub) -> None:
@@ -60,6 +61,7 @@ def register(sub) -> None:
     add_errors_out(p, "the fitted error functions (effects removed)")
     add_force(p)
     add_accept_residual(p)
+    add_accept_implausible(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help="k-fold cross-validation with this k (default: "
                                              "leave-one-point-out, exact via the hat matrix)")
@@ -100,19 +102,18 @@ def run(args) -> int:
                           degree=args.degree, families=args.families,
                           holdout_time=args.holdout_time,
                           holdout_files=list(args.holdout_files or []),
-                          differences=args.differences, inputs=inputs)
-        if getattr(report, "quality", None) is not None:
-            from ..fit_quality import gate
-
-            report.quality = gate(report.data, report.quality, args.accept_residual,
-                                  f"loop {' '.join(inputs[:len(args.data)])}")
-        for key in ("augmented_layout", "generated_module"):  # the final paths, not staging
-            if report.data.get(key):
-                report.data[key] = str(out_dir / Path(report.data[key]).name)
+                          differences=args.differences, inputs=inputs,
+                          accept_residual=args.accept_residual)
+        moved = {k: str(out_dir / Path(v).name) for k, v in report.data.items()
+                 if k in ("augmented_layout", "generated_module") and v}
+        if moved:       # the final paths, not staging (a new result)
+            report = replace(report, data={**report.data, **moved})
         if args.predictions_out:
             report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
         if args.errors_out:
-            report.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+            report.write_error_tables(outs.path("--errors-out"), inputs=inputs,
+                                      accept_implausible=args.accept_implausible,
+                                      shown=args.errors_out)
         if args.json:
             report.write_json(outs.path("--json"), inputs=inputs)
         if args.html:

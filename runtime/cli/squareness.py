@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import require
-from ._common import add_errors_out, add_force, add_json
+from ._common import add_accept_implausible, add_errors_out, add_force, add_json
 
 
 def register(sub) -> None:
@@ -23,6 +23,7 @@ def register(sub) -> None:
     add_errors_out(p, "the squareness with the slope-free tables (must differ from DIR)",
                    "--out", required=True)
     add_force(p)
+    add_accept_implausible(p)
     p.add_argument("--tables-are", choices=("carrier", "component"), default="carrier",
                    help="carrier: motions of the component carrying the points, as written by "
                         "'volerr identify' (default); component: ISO component errors (tool "
@@ -39,7 +40,8 @@ def run(args) -> int:
     src, out = Path(args.directory), Path(args.errors_out)
     require(not (out.exists() and out.resolve() == src.resolve()),
             "--errors-out must differ from the input directory (inputs are never overwritten)")
-    res = squareness(args.layout, src, tables_are=args.tables_are)
+    res = squareness(args.layout, src, tables_are=args.tables_are,
+                     accept_implausible=args.accept_implausible)
     inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
     outs = Outputs(inputs, force=args.force) \
         .folder("--errors-out", out, files=[*res.texts, "constants.csv"]) \

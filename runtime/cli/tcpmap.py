@@ -53,7 +53,7 @@ def run(args) -> int:
         res = tcpmap(args.layout, args.errors, tuple(args.point), tool=tuple(args.tool),
                      steps=args.steps, approach=args.approach, method=args.method,
                      degree=args.degree, extrapolate=args.extrapolate, plot_name=args.plot,
-                     progress=tick)
+                     progress=tick, accept_implausible=args.accept_implausible)
     with outs:
         res.write_plot(outs.path("--plot"))
         if args.csv:

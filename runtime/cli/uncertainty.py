@@ -168,7 +168,7 @@ def run(args) -> int:
         seed=args.seed, chunks=args.chunks, scheduler=args.scheduler,
         scheduler_address=args.scheduler_address, workers=args.workers,
         contributions=args.contributions, backend=args.backend, bias=args.bias,
-        progress=not args.quiet)
+        progress=not args.quiet, accept_implausible=args.accept_implausible)
     if not args.quiet:
         print(res.summary())
     with outs:

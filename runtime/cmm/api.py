@@ -194,6 +194,8 @@ class Squareness(ResultMixin):
     texts: dict
     constants: dict
     constants_std: dict
+    layout: object = None               # the layout the tables are of (their size limits)
+    accept_implausible: bool = False    # --accept-implausible: the limits waived
 
     def summary(self) -> str:
         """What ``volerr squareness`` prints (without the line naming the written folder)."""
@@ -214,7 +216,8 @@ class Squareness(ResultMixin):
         for name, text in self.texts.items():
             write_text(folder / name, text, inputs=list(inputs))
         write_constants(folder / "constants.csv", self.constants, inputs=list(inputs),
-                        std=self.constants_std)
+                        std=self.constants_std, machine=self.layout,
+                        accept_implausible=self.accept_implausible)
 
     def _rows(self) -> list:
         from ..results import Row
@@ -223,7 +226,8 @@ class Squareness(ResultMixin):
                 for k, v in self.data["squareness_urad"].items()]
 
 
-def squareness(layout, directory, *, tables_are: str = "carrier") -> Squareness:
+def squareness(layout, directory, *, tables_are: str = "carrier",
+               accept_implausible: bool = False) -> Squareness:
     """Squareness of the linear axes from the reference straight lines of the straightness
     tables of ``directory`` (``volerr squareness``).
 
@@ -237,6 +241,9 @@ def squareness(layout, directory, *, tables_are: str = "carrier") -> Squareness:
     tables_are : {"carrier", "component"}
         carrier: motions of the component carrying the points (as ``volerr identify``
         writes them); component: ISO component errors (tool relative to workpiece).
+    accept_implausible : bool
+        Accept tables beyond what a machine of the layout's travel can have
+        (:mod:`volerr.tables.plausible`); by default refused with the likely unit.
 
     Returns
     -------
@@ -256,7 +263,8 @@ def squareness(layout, directory, *, tables_are: str = "carrier") -> Squareness:
     src = Path(directory)
     require(src.exists(), f"error directory {src} does not exist")
     require(src.is_dir(), f"{src} is a file: give the error directory (X.csv, Y.csv ...)")
-    tables, (consts, cstd, _) = read_error_dir(src, axes=lay.axis_names)
+    tables, (consts, cstd, _) = read_error_dir(src, axes=lay.axis_names, machine=lay,
+                                               accept_implausible=accept_implausible)
     require(tables, f"{src}: no error tables")
     values, std, corrected, slopes = fit(tables, lay, tables_are)
     require(values, f"{src}: no pair of straightness tables for a squareness (EC0Y needs EYX "
@@ -270,4 +278,4 @@ def squareness(layout, directory, *, tables_are: str = "carrier") -> Squareness:
            "slopes_urad": {k: v * URAD_PER_RAD for k, v in slopes.items()},
            "tables_are": tables_are}
     texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
-    return Squareness(doc, values, std, texts, merged, merged_std)
+    return Squareness(doc, values, std, texts, merged, merged_std, lay, accept_implausible)

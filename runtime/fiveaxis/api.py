@@ -120,7 +120,7 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
                extrapolate: bool = False, initial=None, check_travel: bool = True,
                arc_tol_um: float = 1.0, dialect: str = "auto", out=None, report=None,
                inputs=(), out_name=None, keep_errors: bool = False,
-               progress=None) -> Compensation:
+               progress=None, accept_implausible: bool = False) -> Compensation:
     """Rewrite an NC program with compensated coordinates (``volerr compensate``).
 
     Parameters
@@ -163,6 +163,10 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
         With ``out``: keep the per-block errors for :meth:`Compensation.program_errors`.
     progress : callable, optional
         ``progress(n_lines)`` after every chunk.
+    accept_implausible : bool
+        ``--accept-implausible``: use error values beyond what a machine of the layout's
+        travel can have (:mod:`volerr.tables.plausible`); by default they are refused naming
+        the file, the column and the likely unit.
 
     Returns
     -------
@@ -178,7 +182,8 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
                   tool_table=tool_table, orientation=orientation, strategy=strategy,
                   types=types, tol_um=tol_um, decimals=decimals, method=method, degree=degree,
                   extrapolate=extrapolate, initial=initial, check_travel=check_travel,
-                  arc_tol_um=arc_tol_um, dialect=dialect)
+                  arc_tol_um=arc_tol_um, dialect=dialect,
+                  accept_implausible=accept_implausible)
     axes = (tuple(job.model.axes), tuple(job.model.rotary_axes))
     if out is None:
         sink = _Collect(job.model)
@@ -257,7 +262,7 @@ class ToolTipMap(ResultMixin):
 
 def tcpmap(layout, errors, point, *, tool=(0.0, 0.0, 0.0), steps: int = 73, approach=None,
            method: str = "linear", degree=None, extrapolate: bool = False, plot_name=None,
-           progress=None) -> ToolTipMap:
+           progress=None, accept_implausible: bool = False) -> ToolTipMap:
     """Tool-tip error of a five-axis machine over the range of its two rotary axes for one
     workpiece point (``volerr tcpmap``).
 
@@ -283,6 +288,9 @@ def tcpmap(layout, errors, point, *, tool=(0.0, 0.0, 0.0), steps: int = 73, appr
         The name of the written plot the summary line gives ("; wrote NAME").
     progress : callable, optional
         ``progress(n_points)`` block by block.
+    accept_implausible : bool
+        ``--accept-implausible``: use error values beyond what a machine of the layout's
+        travel can have (:mod:`volerr.tables.plausible`); by default refused.
 
     Returns
     -------
@@ -305,7 +313,8 @@ def tcpmap(layout, errors, point, *, tool=(0.0, 0.0, 0.0), steps: int = 73, appr
     require(not Path(errors).is_file(), f"{errors} is a file, not an error "
                                         f"directory (the folder holding X.csv ...)")
     require(Path(errors).is_dir(), f"error directory not found: {errors}")
-    funcs, notes = error_functions(errors, model, method, degree, extrapolate)
+    funcs, notes = error_functions(errors, model, method, degree, extrapolate,
+                                   accept_implausible)
     if approach != "sweep" and not isinstance(approach, dict):
         approach = parse_approach(approach, model, funcs)
     tmap = tcp_map(model, funcs, point, tool, steps, steps, approach=approach,

@@ -149,13 +149,16 @@ def close_periodic(tables_: dict, model) -> tuple[dict, list[str]]:
 
 
 def error_functions(directory, model, method: str = "linear", degree=None,
-                    extrapolate: bool = False):
+                    extrapolate: bool = False, accept_implausible: bool = False):
     """:class:`volerr.tables.functions.ErrorFunctions` of an error directory, endless rotary axes closed
-    over the full turn (:func:`close_periodic`).  Returns (functions, notes)."""
+    over the full turn (:func:`close_periodic`).  Returns (functions, notes).  Values beyond
+    what a machine of ``model``'s travel can have are refused unless ``accept_implausible``
+    (:mod:`volerr.tables.plausible`)."""
     from ..tables.functions import ErrorFunctions
     from ..tables.table import read_error_dir
 
-    tabs, (consts, cstd, cu95) = read_error_dir(directory, model.axes)
+    tabs, (consts, cstd, cu95) = read_error_dir(directory, model.axes, machine=model,
+                                                accept_implausible=accept_implausible)
     tabs, notes = close_periodic(tabs, model)
     cstd = {**{k: v / 2.0 for k, v in cu95.items()}, **cstd}
     return ErrorFunctions(tabs, consts, model, method, degree, extrapolate, constants_std=cstd,

@@ -117,7 +117,8 @@ class ControllerImport(ResultMixin):
 def controller_export(layout, errors=None, *, format: str, out=None, json=None, plot=None,
                       loop_json=None, temperatures=None, sensors=None, comp_file_type=None,
                       negate: bool = False, force: bool = False, points=None,
-                      grid: int = 9, at=None) -> ControllerExport:
+                      grid: int = 9, at=None,
+                      accept_implausible: bool = False) -> ControllerExport:
     """An error directory as a controller's compensation, with what it leaves of the
     volumetric error (``volerr controller export``).
 
@@ -155,6 +156,10 @@ def controller_export(layout, errors=None, *, format: str, out=None, json=None, 
         Grid points per linear axis of what the export leaves (2 .. 60).
     at : dict, optional
         Rotary axis -> position (deg) for what the export leaves (default 0).
+    accept_implausible : bool
+        ``--accept-implausible``: error values beyond what a machine of the layout's travel
+        can have (:mod:`volerr.tables.plausible`) used instead of refused (by default
+        refused naming the file, the column and the likely unit).
 
     Returns
     -------
@@ -171,7 +176,8 @@ def controller_export(layout, errors=None, *, format: str, out=None, json=None, 
 
     model = load(layout)
     o = _Options(layout, errors, format, out, json, plot, loop_json, temperatures, sensors,
-                 comp_file_type, negate, force, points, grid, dict(at or {}))
+                 comp_file_type, negate, force, points, grid, dict(at or {}),
+                 accept_implausible)
     if format in TEMP_FORMATS:
         return _export_temperature(o, model)
     for flag in ("loop_json", "temperatures", "sensors"):
@@ -207,6 +213,7 @@ class _Options:
     points: object
     grid: int
     at: dict
+    accept_implausible: bool = False
 
 
 def _layout_inputs(layout) -> list:
@@ -243,7 +250,8 @@ def _export_volumetric(o: _Options, model) -> ControllerExport:
     for flag in ("plot", "points", "comp_file_type"):
         require(getattr(o, flag) is None, f"--{flag.replace('_', '-')} is for the axis "
                                           f"compensation formats ({' '.join(AXIS_FORMATS)})")
-    tables, (consts, _, _) = read_error_dir(o.errors, model.axes)
+    tables, (consts, _, _) = read_error_dir(o.errors, model.axes, machine=model,
+                                            accept_implausible=o.accept_implausible)
     ct.check_against_model(model, tables, consts, o.errors)
     require(tables or consts, f"{o.errors}: no error tables or constants to export")
     if o.negate:
@@ -251,7 +259,8 @@ def _export_volumetric(o: _Options, model) -> ControllerExport:
     writer = ct.write_isg if o.format == "isg" else ct.write_etalon
     inputs = list(Path(o.errors).glob("*.csv")) + _layout_inputs(o.layout)
     outs = Outputs(inputs).file("--out", o.out).file("--json", o.json).check()
-    res = volumetric_left(model, ErrorFunctions.from_dir(o.errors, model), o.grid, o.at)
+    res = volumetric_left(model, ErrorFunctions.from_dir(
+        o.errors, model, accept_implausible=o.accept_implausible), o.grid, o.at)
     s = res.summary()
     worse = _refuse_worse(s, o.force, f"{model.name}: a volumetric compensation with these "
                                       "parameters leaves more than none")
@@ -283,7 +292,7 @@ def _export_axis_tables(o: _Options, model) -> ControllerExport:
                           "sign conventions, volerr formats controller)")
     require(o.comp_file_type is None or o.format == "linuxcnc",
             "--comp-file-type is for --format linuxcnc")
-    funcs = ErrorFunctions.from_dir(o.errors, model)
+    funcs = ErrorFunctions.from_dir(o.errors, model, accept_implausible=o.accept_implausible)
     tables = ctl.build(funcs, o.format, o.points)
     inputs = list(Path(o.errors).glob("*.csv")) + _layout_inputs(o.layout)
     outs = Outputs(inputs, force=o.force)
@@ -400,7 +409,8 @@ def _temperature_lines(model, o: _Options, res, s, worse, where) -> list:
 
 
 def controller_import(layout, file, *, out=None, format: str = "auto", negate: bool = False,
-                      force: bool = False) -> ControllerImport:
+                      force: bool = False,
+                      accept_implausible: bool = False) -> ControllerImport:
     """A controller's compensation file read back into error tables (``volerr controller
     import``).
 
@@ -421,6 +431,10 @@ def controller_import(layout, file, *, out=None, format: str = "auto", negate: b
         isg / etalon: the file holds compensation values; reverse their sign.
     force : bool
         Let the import replace files in ``out``.
+    accept_implausible : bool
+        ``--accept-implausible``: error values beyond what a machine of the layout's travel
+        can have (:mod:`volerr.tables.plausible`) used instead of refused (by default
+        refused naming the file, the column and the likely unit).
 
     Returns
     -------
@@ -452,7 +466,9 @@ def controller_import(layout, file, *, out=None, format: str = "auto", negate: b
     with outs:
         if out is not None:
             write_error_dir(outs.path("--errors-out"), tables,
-                            None if axis else (consts or None), inputs=inputs)
+                            None if axis else (consts or None), inputs=inputs,
+                            machine=model, accept_implausible=accept_implausible,
+                            shown=out)
     n = sum(len(t.values) for t in tables.values())
     line = (f"{model.name}: read {n} component errors ({len(tables)} axes) from {file} "
             f"({format}); wrote {_dest(out, '/')}" if axis else

@@ -176,7 +176,7 @@ def prepare(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
             tool_length=None, tool_table=None, orientation=False, strategy="full",
             types=None, tol_um=0.1, decimals=4, method="linear", degree=None,
             extrapolate=False, initial=None, check_travel=True, arc_tol_um=1.0,
-            dialect="auto") -> Job:
+            dialect="auto", accept_implausible=False) -> Job:
     """Every input of a compensation validated once -> :class:`Job` (the arguments are those
     of :func:`volerr.fiveaxis.api.compensate`)."""
     from ..machine.model import load
@@ -187,7 +187,8 @@ def prepare(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
     require(not Path(errors).is_file(), f"{errors} is a file, not an error "
                                         f"directory (the folder holding X.csv ...)")
     require(Path(errors).is_dir(), f"error directory not found: {errors}")
-    funcs, notes = error_functions(errors, model, method, degree, extrapolate)
+    funcs, notes = error_functions(errors, model, method, degree, extrapolate,
+                                   accept_implausible)
     opener, name, path = _program_source(program)
     table, table_path = _tool_table(tool_table)
     types = _types(types)

@@ -48,7 +48,8 @@ class Identified(ResultMixin):
 def identify(layout, axis: str, files, *, format: str = "csv", positions: str | None = None,
              points: str | None = None, method: str = "lsq", tracker=None, direction=None,
              origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
-             signs: str = "component", accept_implausible: bool = False) -> Identified:
+             signs: str = "component", accept_implausible: bool = False,
+             accept_residual: bool = False) -> Identified:
     """Three-point (or more) laser-tracker identification of the six error motions of an axis
     (``volerr identify``; the thesis' eq. 30 for linear axes, eq. 3.4 for rotary axes).
 
@@ -70,6 +71,11 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     accept_implausible : bool
         Accept identified errors beyond what a machine of the layout's travel can have
         (:mod:`volerr.tables.plausible`); by default they are refused with the likely cause.
+    accept_residual : bool
+        ``--accept-residual``: a fit far above the points' uncertainty
+        (:mod:`volerr.fit_quality`) is returned marked forced (``data["fit_quality"]``
+        verdict ``"forced"``, ``data["forced"]`` the sentence the written table carries)
+        instead of refused (InputError).
 
     Returns
     -------
@@ -91,9 +97,13 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     if signs == "model":
         table = to_model_signs(table, lay, reference=result.rounds[0].positions[0])
     check_identified(table, lay, files, accept_implausible)
+    from ..fit_quality import gate
+
     quality = result.fit_quality()
     data = result.report()
     data["fit_quality"] = quality.to_dict()
+    quality = gate(data, quality, accept_residual, f"identify {' '.join(map(str, files))}",
+                   key="fit_quality")
     return Identified(data, table, result, axis.strip().upper(), quality)
 
 

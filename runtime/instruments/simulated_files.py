@@ -186,7 +186,8 @@ def csv_text(cols: dict) -> str:
 
 def instrument_file(layout, instrument: str, *, plant: str | None = None, errors=None,
                     steps: int | None = None, radius: float | None = None,
-                    noise_um: float = 0.3, seed: int = 0) -> tuple[str, str]:
+                    noise_um: float = 0.3, seed: int = 0,
+                    accept_implausible: bool = False) -> tuple[str, str]:
     """``volerr simulate --instrument sphere|ballbar``: the file's text and the line the
     command prints (without its ``-> FILE`` tail).
 
@@ -208,7 +209,8 @@ def instrument_file(layout, instrument: str, *, plant: str | None = None, errors
         require(Path(errors).is_dir(), f"error directory not found: {errors}")
         from ..tables.functions import ErrorFunctions
 
-        planted, funcs = None, ErrorFunctions.from_dir(errors, model)
+        planted, funcs = None, ErrorFunctions.from_dir(errors, model,
+                                                       accept_implausible=accept_implausible)
     else:
         planted = (parse_planted(plant, model) if plant is not None
                    else default_planted(model, instrument))

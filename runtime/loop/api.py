@@ -121,7 +121,7 @@ def is_drift(specs) -> bool:
 def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None,
          test_fraction: float = 0.25, degree: int | None = None, families=None,
          progress=None, holdout_time: str | None = None, holdout_files=(),
-         differences: bool = False, inputs=()):
+         differences: bool = False, inputs=(), accept_residual: bool = False):
     """Close the loop on measured deviations (``volerr loop``): fit the declared model, trace
     the residual to candidate effects "parameter P varies with covariate C", augment the
     layout, report the error before and after on held-out points.
@@ -160,6 +160,9 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
         Drift runs: try differences of two sensors as well.
     inputs : list, optional
         Files the outputs (``out_dir``) must not overwrite.
+    accept_residual : bool
+        ``--accept-residual``: a fit far above the readings' declared uncertainty
+        (:mod:`volerr.fit_quality`) is returned marked forced instead of refused (InputError).
 
     Returns
     -------
@@ -179,6 +182,8 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
                       progress)
     require(not holdout_files, "loop: holdout_files (--holdout-files) is for drift runs "
             "(drift:FILE)")
+    from ..instruments import split_spec
+
     chosen = candidates.FAMILIES
     if families:
         parts = families.split(",") if isinstance(families, str) else list(families)
@@ -190,7 +195,9 @@ def loop(layout, files, *, out_dir=None, seed: int = 0, folds: int | None = None
         files = files[0] if len(files) == 1 else list(files)
     r = run_loop(layout, files, seed=seed, folds=folds, test_fraction=test_fraction,
                  degree=degree, out_dir=out_dir, families=chosen, progress=progress,
-                 holdout_time=holdout_time, inputs=inputs)
+                 holdout_time=holdout_time, inputs=inputs, accept_residual=accept_residual,
+                 where=" ".join(["loop"] + [split_spec(str(f))[1] for f in specs
+                                            if isinstance(f, (str, os.PathLike))]))
     return Loop(r.data, r.plot_data, r.augmented_text, r.generated, r.quality)
 
 

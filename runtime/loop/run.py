@@ -158,21 +158,24 @@ class Report(ResultMixin):
                 constants[p] = float(coef[index[(p, None)]])
         return tables, constants
 
-    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False) -> Path:
+    def write_error_tables(self, directory, inputs=(), accept_residual: bool = False,
+                           accept_implausible: bool = False, shown=None) -> Path:
         """Write :meth:`error_tables` as an error directory (``X.csv`` ... ``constants.csv``);
         refused for a fit far above the readings' uncertainty unless ``accept_residual``
-        (:mod:`volerr.fit_quality`)."""
-        from ..fit_quality import gate, require_writable
+        (:mod:`volerr.fit_quality`), and for values beyond what a machine of the layout's
+        travel can have unless ``accept_implausible`` (:mod:`volerr.tables.plausible`; a
+        refusal names ``shown``, default ``directory``)."""
+        from ..fit_quality import forced_note, require_writable
         from ..tables.table import write_error_dir
 
         require_writable(self.quality, accept_residual, f"error tables {directory}")
-        if accept_residual:
-            self.quality = gate(self.data, self.quality, True, "error tables")
         tables, constants = self.error_tables()
-        note = self.data.get("forced")
+        note = self.data.get("forced") or (forced_note(self.quality.marked()) if
+                                           accept_residual and self.quality else None)
         comments = {w: [note] for w in ["constants", *tables]} if note else None
         return write_error_dir(directory, tables, constants or None, inputs=list(inputs),
-                               comments=comments)
+                               comments=comments, machine=self.plot_data.model,
+                               accept_implausible=accept_implausible, shown=shown)
 
     def summary(self) -> str:
         d = self.data
@@ -592,19 +595,23 @@ def run_loop(layout, data, *, seed: int = 0, folds: int | None = None,
              test_fraction: float = 0.25,
              degree: int | None = None, max_degree: int = 10, out_dir=None,
              progress=None, families=cands.FAMILIES, inputs=(),
-             holdout_time: str | None = None) -> Report:
+             holdout_time: str | None = None, accept_residual: bool = False,
+             where: str = "loop") -> Report:
     """Run the loop on ``data`` (CSV path, :class:`volerr.loop.simulate.Campaign` or
     :class:`volerr.estimate.design.Data`) for ``layout`` (name or layout file). Returns a :class:`Report`.
 
     ``out_dir``: where the augmented layout and its generated module are written (nothing is
     written when None; the texts are in the report object either way).  ``holdout_time``
     ``"A:B"`` (units s, min, h): hold out the points with A <= t < B of the time column
-    (:func:`volerr.loop.drift.split.parse_window`) instead of the default stretches."""
+    (:func:`volerr.loop.drift.split.parse_window`) instead of the default stretches.
+    A fit far above the readings' declared uncertainty is refused (InputError naming
+    ``where``, nothing written) unless ``accept_residual`` (then marked forced;
+    :mod:`volerr.fit_quality`)."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
         return _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir,
-                    progress, families, inputs, holdout_time)
+                    progress, families, inputs, holdout_time, (accept_residual, where))
 
 
 def _split(dat, seed, test_fraction, folds, holdout_time=None) -> Split:
@@ -637,7 +644,7 @@ def _split(dat, seed, test_fraction, folds, holdout_time=None) -> Split:
 
 
 def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, progress,
-         families, inputs, holdout_time=None) -> Report:
+         families, inputs, holdout_time=None, gate=(False, "loop")) -> Report:
     t_start = time.perf_counter()
     model, dat = _load(layout, data)
     checks.one_position(dat)
@@ -662,6 +669,9 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     out = outcome_step(decl, aug, spl, robust, y, effect_columns(selection, aug))
     effects = effects_step(selection, aug, out, dat.n)
     alternatives_step(effects, selection, decl, spl, robust, y)
+    from ..fit_quality import forced_note, require_fit
+
+    quality = require_fit(fit_quality(dat, out), *gate)     # refused: nothing written
     bar.update()
     paths = _write_augmented(out_dir, aug, selection, inputs, data)
     bar.update()
@@ -675,9 +685,10 @@ def _run(layout, data, seed, folds, test_fraction, degree, max_degree, out_dir, 
     report["residual_sources_after"] = src_after
     report["residual_note"] = residual_note(dat, out, src_after, robust)
     report["instruments"] = instrument_residuals(dat, spl, out)
-    quality = fit_quality(dat, out)
     report["fit"] = quality.to_dict()
     report["seconds"] = round(time.perf_counter() - t_start, 2)
+    if forced_note(quality):
+        report["forced"] = forced_note(quality)
     figs = Figures(model, dat, ranges, degree, out.res_before, out.res_after, spl.test,
                    out.r_before, out.r_after, selection.accepted, out.contrib, out.c_all,
                    aug.labels, out.c_before, decl.labels, out.cov_diag, robust.weights)

@@ -545,18 +545,20 @@ def read_error_dir(directory, axes=None, *, machine=None,
 
 def write_error_dir(directory, tables: dict, constants: dict | None = None,
                     constants_std: dict | None = None, inputs=(), comments=None, *,
-                    machine=None, accept_implausible: bool = False) -> Path:
+                    machine=None, accept_implausible: bool = False, shown=None) -> Path:
     """Write ``<AXIS>.csv`` for each table and ``constants.csv`` (when given) into ``directory``;
     ``comments``: {axis or "constants": [line ...]} written as ``#`` lines above the header
     (what a value written under a name stands for).  Values beyond what ``machine`` (Model or
     Layout; default: the tables' span) can have are refused before anything is written,
-    unless ``accept_implausible`` (:func:`check_magnitudes`)."""
+    unless ``accept_implausible`` (:func:`check_magnitudes`; a refusal names the folder
+    ``shown``, default ``directory``: the folder the user named when ``directory`` is a
+    staging folder)."""
     d = Path(directory)
     comments = comments or {}
     for ax, t in tables.items():
         require(ax == t.axis, f"table for {t.axis} stored under {ax}")
     check_magnitudes({ax: _unread(t) for ax, t in tables.items()}, constants, constants_std,
-                     machine=machine, where=str(d), cause=WRITE_CAUSE,
+                     machine=machine, where=str(shown or d), cause=WRITE_CAUSE,
                      accept_implausible=accept_implausible)
     for ax, t in tables.items():
         write_error_table(d / f"{ax}.csv", t, inputs=inputs, comments=comments.get(ax, ()),

@@ -110,7 +110,7 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
                 max_samples: int = 1_000_000, seed: int = 0, chunks: int = 1,
                 scheduler: str = "none", scheduler_address: str | None = None,
                 workers: int = 2, contributions: int = 2000, backend: str = "numpy",
-                bias: str = "corrected", progress: bool = False) -> Uncertainty:
+                bias: str = "corrected", progress=False, accept_implausible=False) -> Uncertainty:
     """Task-specific measurement uncertainty by Monte Carlo (``volerr uncertainty``; a
     virtual CMM, ISO/TS 15530-4, JCGM 101).
 
@@ -124,7 +124,7 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
         The evaluation (``distance``, ``sphere``, ... :data:`volerr.uncertainty.EVALUATIONS`).
     errors : path, optional
         Error directory with ``_std`` / ``_u95`` columns (the machine's identified errors);
-        ``method``, ``degree``, ``extrapolate``: how its tables are interpolated.
+        ``method``/``degree``/``extrapolate``/``accept_implausible``: as the ``--`` options.
     spec : str, optional
         ``"E0=A+L/K"`` (um, L in mm): machines that pass this ISO 10360-2 specification.
     noise_um : float
@@ -160,8 +160,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
                                            f"(one of {', '.join(tasks.EVALUATIONS)})")
     model = load(layout)
     tk = tasks.read_task(task, model.axes)
-    funcs = (ErrorFunctions.from_dir(errors, model, method=method, degree=degree,
-                                     extrapolate=extrapolate) if errors else None)
+    funcs = (ErrorFunctions.from_dir(errors, model, method, degree, extrapolate,
+                                     accept_implausible) if errors else None)
     parsed = ensemble.parse_spec(spec) if spec else None
     require(funcs is not None or parsed is not None or noise_um > 0 or probe_map is not None
             or temperature is not None,
@@ -249,7 +249,8 @@ def iso10360(layout, errors, *, probe=(0.0, 0.0, 0.0), volume: str = "travel",
              artefact_u: str = "0.1+L/2000", artefact_cte_ppm_per_K: float = 11.5,
              artefact_cte_u_ppm_per_K: float = 1.0, temperature_C: float = 20.0,
              temperature_u_K: float = 0.2, method: str = "linear", degree: int | None = None,
-             extrapolate: bool = False, identification=None) -> Iso10360:
+             extrapolate: bool = False, identification=None,
+             accept_implausible: bool = False) -> Iso10360:
     """The simulated ISO 10360-2 length measuring test (``volerr iso10360``): 7 positions (4
     space diagonals, lines along X, Y, Z through the centre), 5 lengths, 3 repetitions.
 
@@ -275,6 +276,9 @@ def iso10360(layout, errors, *, probe=(0.0, 0.0, 0.0), volume: str = "travel",
         Artefact temperature during the test (degC) and its standard uncertainty (K).
     method, degree, extrapolate
         How the tables are interpolated (as ``--method``, ``--degree``, ``--extrapolate``).
+    accept_implausible : bool
+        ``--accept-implausible``: table values beyond what a machine of the layout's travel
+        can have used instead of refused (:mod:`volerr.tables.plausible`).
     identification : volerr.certificate.Identification, optional
         Machine, instrument, operator, date of the certificate (the artefact's temperature
         and expansion coefficient are added to its conditions).
@@ -294,7 +298,8 @@ def iso10360(layout, errors, *, probe=(0.0, 0.0, 0.0), volume: str = "travel",
 
     model = layout if isinstance(layout, Model) else load(layout)
     funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
-        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+        errors, model, method=method, degree=degree, extrapolate=extrapolate,
+        accept_implausible=accept_implausible)
     spec = iso.parse_spec(mpe, "--mpe") if mpe is not None else None
     tu = iso.artefact_uncertainty(artefact_u, artefact_cte_ppm_per_K, artefact_cte_u_ppm_per_K,
                               temperature_C, temperature_u_K)

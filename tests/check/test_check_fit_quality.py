@@ -204,3 +204,73 @@ def test_check_change_beyond_the_limit_needs_consent(world, tmp_path, capsys):
     assert main(argv + ["--max-change", "EX0C=1 um", "--accept-change", "--force"]) == 0
     doc = json.loads(out.read_text())
     assert doc["max_change"]["accepted"] and doc["max_change"]["beyond"][0]["parameter"] == "EX0C"
+
+
+def test_the_api_gates_check_and_calibrate_like_the_commands(world, tmp_path):
+    """The residual rule and the consent rule are inside volerr.check / volerr.calibrate:
+    refused (InputError, one line) or returned already marked (no mutation afterwards)."""
+    import volerr
+    from volerr.errors import InputError
+
+    d, cal, _, check_empty = world
+    good = _filled(check_empty, tmp_path / "chk.csv", PLANTED, 71)
+    bad = _scaled(good, tmp_path / "chk_x3.csv", 3.0)
+    with pytest.raises(InputError) as e:
+        volerr.check(LAYOUT, [str(bad)], reference=str(cal))
+    assert "chi2/dof" in str(e.value) and "\n" not in str(e.value)
+    res = volerr.check(LAYOUT, [str(bad)], reference=str(cal), accept_residual=True)
+    assert res.to_dict()["fit"]["verdict"] == "forced" and "FORCED" in res.to_dict()["forced"]
+    jump = _filled(check_empty, tmp_path / "jump.csv",
+                   {**PLANTED, "EX0C": PLANTED["EX0C"] + 4.0}, 81)
+    with pytest.raises(InputError) as e:
+        volerr.check(LAYOUT, [str(jump)], reference=str(cal), max_change="EX0C=1 um")
+    assert "EX0C" in str(e.value) and "--accept-change" in str(e.value)
+    res = volerr.check(LAYOUT, [str(jump)], reference=str(cal), max_change="EX0C=1 um",
+                       accept_change=True)
+    assert res.to_dict()["max_change"]["accepted"]
+    # calibrate against the reference: the same rule, the reference read by the API
+    path = _filled(check_empty, tmp_path / "recal.csv",
+                   {**PLANTED, "EX0C": PLANTED["EX0C"] + 6.0}, 91)
+    with pytest.raises(InputError) as e:
+        volerr.calibrate(LAYOUT, [str(path)], reference=str(cal), max_change="EX0C=1 um",
+                         plan=False, progress=False)
+    assert "EX0C" in str(e.value)
+    got = volerr.calibrate(LAYOUT, [str(path)], reference=str(cal), max_change="EX0C=1 um",
+                           accept_change=True, plan=False, progress=False)
+    change = got.data["reference_change"]["EX0C"]["change"]
+    assert abs(change - 6.0) < 2.0, change          # the planted 6 um jump
+    assert got.data["max_change"]["beyond"][0]["parameter"] == "EX0C"
+    with pytest.raises(InputError) as e:
+        volerr.calibrate(LAYOUT, [str(path)], max_change="EX0C=1 um", plan=False,
+                         progress=False)
+    assert "--reference" in str(e.value)
+
+
+@pytest.mark.parametrize("date, needle", [("2099-01-01", "future"),
+                                          ("2025-13-01", "YYYY-MM-DD"),
+                                          ("01.02.2025", "YYYY-MM-DD")])
+def test_the_api_check_validates_its_date(world, tmp_path, date, needle):
+    """volerr.check(date=...) as check --date: a future or malformed date is refused with
+    one line before anything is computed."""
+    import volerr
+    from volerr.errors import InputError
+
+    d, cal, _, check_empty = world
+    with pytest.raises(InputError) as e:
+        volerr.check(LAYOUT, [str(check_empty)], reference=str(cal), date=date)
+    assert needle in str(e.value) and "\n" not in str(e.value)
+
+
+def test_calibrate_takes_an_earlier_result_as_its_reference(world, tmp_path):
+    """reference= an earlier Calibration (or its document) is the same as its JSON file."""
+    import volerr
+
+    d, cal, _, check_empty = world
+    path = _filled(check_empty, tmp_path / "again.csv", PLANTED, 93)
+    ref = json.loads(cal.read_text())
+    a = volerr.calibrate(LAYOUT, [str(path)], reference=str(cal), plan=False, progress=False)
+    b = volerr.calibrate(LAYOUT, [str(path)], reference=ref, plan=False, progress=False)
+    c = volerr.calibrate(LAYOUT, [str(path)], reference=b, plan=False, progress=False)
+    assert a.data["reference_change"] == b.data["reference_change"]
+    assert set(c.data["reference_change"]) == set(b.data["parameters"])
+    assert all(abs(v["change"]) < 1e-9 for v in c.data["reference_change"].values())

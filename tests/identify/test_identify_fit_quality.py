@@ -15,6 +15,7 @@ table reader skips.
 import json
 
 import numpy as np
+import pytest
 from helpers.tracker_sim import simulate, smooth_errors, to_csv
 
 from volerr.cli import main
@@ -66,3 +67,19 @@ def test_a_slipped_reflector_is_refused(tmp_path, capsys):
     assert out.read_text().startswith("# FORCED")
     assert json.loads(js.read_text())["fit_quality"]["verdict"] == "forced"
     assert read_error_table(out).axis == "X"
+
+
+def test_the_api_refuses_or_returns_it_marked(tmp_path):
+    """volerr.identify applies the residual rule itself: InputError, or with
+    accept_residual=True a result already marked forced (its summary says so)."""
+    import volerr
+    from volerr.errors import InputError
+
+    f = tmp_path / "slip.csv"
+    f.write_text(_csv(slip_mm=0.5))
+    with pytest.raises(InputError) as e:
+        volerr.identify("MB1", "X", str(f), accept_implausible=True)
+    assert "chi2/dof" in str(e.value) and str(f) in str(e.value)
+    res = volerr.identify("MB1", "X", str(f), accept_implausible=True, accept_residual=True)
+    assert res.data["fit_quality"]["verdict"] == "forced" and "FORCED" in res.data["forced"]
+    assert "FORCED" in res.summary()

@@ -99,16 +99,47 @@ def test_evaluate_withholds_the_diagnosis(traces, tmp_path):
     assert abs(ec["value"] - 3 * -22.0) < 5 * ec["std"] + 3.0, ec
 
 
-def test_the_api_writes_no_table_of_a_refused_fit(traces, tmp_path):
+def test_the_api_refuses_a_fit_far_above_unless_accepted(traces, tmp_path):
+    """The gate is inside the API: volerr.calibrate refuses (one line, chi2/dof named) and,
+    with accept_residual=True, returns a result already marked forced (built once)."""
     import volerr
     from volerr.errors import InputError
 
     _, _, x3 = traces
-    cal = volerr.calibrate("MB1", [x3], plan=False, progress=False)
+    with pytest.raises(InputError) as e:
+        volerr.calibrate("MB1", [x3], plan=False, progress=False)
+    assert "chi2/dof" in str(e.value) and "\n" not in str(e.value)
+    cal = volerr.calibrate("MB1", [x3], plan=False, progress=False, accept_residual=True)
+    assert cal.fit["verdict"] == "forced" and cal.fit["chi2_per_dof"] > 4.0
+    assert "FORCED" in cal.data["forced"] and "FORCED" in cal.summary()
+    cal.write_error_tables(tmp_path / "errs")
+    assert "FORCED" in (tmp_path / "errs" / "X.csv").read_text().splitlines()[0]
+
+
+def test_the_api_writes_no_table_of_a_refused_fit(traces, tmp_path):
+    """A refused fit reached without the gate (fit_campaign, as ballbar evaluate's diagnosis
+    uses it) is not written by write_error_tables unless accept_residual; writing it does
+    not change the result."""
+    from volerr.calibrate.run import fit_campaign
+    from volerr.errors import InputError
+
+    _, _, x3 = traces
+    cal = fit_campaign("MB1", [x3], plan=False, progress=False)
     assert cal.fit["verdict"] == "refused" and cal.fit["chi2_per_dof"] > 4.0
     with pytest.raises(InputError):
         cal.write_error_tables(tmp_path / "errs")
     assert not (tmp_path / "errs").exists()
     cal.write_error_tables(tmp_path / "errs", accept_residual=True)
     assert "FORCED" in (tmp_path / "errs" / "X.csv").read_text().splitlines()[0]
-    assert cal.fit["verdict"] == "forced"
+    assert cal.fit["verdict"] == "refused" and "forced" not in cal.data
+
+
+def test_ballbar_evaluate_api_withholds_or_forces(traces):
+    import volerr
+
+    _, _, x3 = traces
+    ev = volerr.ballbar_evaluate(x3, "MB1")
+    assert ev.data["fit"]["verdict"] == "refused" and ev.data["diagnosis"] == []
+    assert "withheld" in ev.data["diagnosis_note"]
+    ev = volerr.ballbar_evaluate(x3, "MB1", accept_residual=True)
+    assert ev.data["fit"]["verdict"] == "forced" and ev.data["diagnosis"]

@@ -71,3 +71,20 @@ def test_deviations_times_3_are_refused(files, tmp_path, capsys):
     assert "FORCED" in page.read_text()
     for table in errs.iterdir():
         assert "FORCED" in table.read_text().splitlines()[0], table.name
+
+
+def test_the_api_refuses_or_returns_it_marked(files, tmp_path):
+    """volerr.loop applies the residual rule itself, before anything is written (out_dir
+    stays empty); with accept_residual=True the result comes back marked forced."""
+    import volerr
+    from volerr.errors import InputError
+
+    _, x3 = files
+    out = tmp_path / "aug"
+    with pytest.raises(InputError) as e:
+        volerr.loop("MB1", x3, out_dir=out, families="step", progress=False)
+    assert "chi2/dof" in str(e.value) and "dev_x3.csv" in str(e.value)
+    assert not out.exists() or not any(out.iterdir())
+    rep = volerr.loop("MB1", x3, families="step", progress=False, accept_residual=True)
+    assert rep.fit["verdict"] == "forced" and "FORCED" in rep.data["forced"]
+    assert "FORCED" in rep.summary()

@@ -70,7 +70,7 @@ class DriftReport(ResultMixin):
 
         return write_text(path, render_html(self), inputs=list(inputs))
 
-    def write_error_tables(self, directory, inputs=()):
+    def write_error_tables(self, directory, inputs=(), **_):
         """Not written for drift runs: their effects are per channel, not in the layout."""
         from ...errors import require
 
