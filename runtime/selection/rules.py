@@ -91,3 +91,30 @@ def tied(d0: float, d1: float) -> bool:
 def significant(value: float, u: float | None) -> bool:
     """Whether a coefficient is significant: ``|value| >= SIG_K u`` (no uncertainty: yes)."""
     return u is None or not abs(value) < SIG_K * u
+
+
+#: one-sided 95 % quantiles of Student's t, df = 1 .. 30 (beyond: the normal 1.645)
+T95_ONE_SIDED = (6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812,
+                 1.796, 1.782, 1.771, 1.761, 1.753, 1.746, 1.740, 1.734, 1.729, 1.725,
+                 1.721, 1.717, 1.714, 1.711, 1.708, 1.706, 1.703, 1.701, 1.699, 1.697)
+
+
+def t95(df: int) -> float:
+    """One-sided 95 % quantile of Student's t with ``df`` degrees of freedom (table)."""
+    return T95_ONE_SIDED[df - 1] if df <= len(T95_ONE_SIDED) else 1.645
+
+
+def significantly_below(err_new, err_old) -> bool:
+    """Whether the per-fold cross-validated mean squares ``err_new`` are significantly below
+    ``err_old`` (the same K folds): the paired t over the folds of ``ln(err_old / err_new)``
+    (:func:`paired_t`) at least the one-sided 95 % Student quantile with K - 1 degrees of
+    freedom (:func:`t95`), the mean log ratio positive.  The log ratio, not the difference:
+    the folds' mean squares differ by orders of magnitude (a stretch where the spindle
+    switches, a cool-down), a difference is the largest fold's alone; the log ratio is each
+    fold's relative gain, and the test asks that the gain be consistent over the folds.
+    The rule by which a more complex model family (the drift loop's lag model) replaces a
+    simpler one (a static regression, a constant)."""
+    new = np.maximum(np.asarray(err_new, float), 1e-300)
+    old = np.maximum(np.asarray(err_old, float), 1e-300)
+    d = np.log(old / new)
+    return len(d) >= 2 and d.mean() > 0 and paired_t(d) >= t95(len(d) - 1)

@@ -1,0 +1,125 @@
+"""The baselines as candidates of the drift loop's selection, and the prediction interval of
+the model chosen (:func:`volerr.loop.drift.fit.run_drift` calls :func:`choose` per channel).
+
+Three families compete per channel, scored by the SAME blocked cross-validation (the folds of
+:func:`volerr.loop.drift.basis.folds`; a fold of whole runs predicted from the run's first
+reading, a fold of stretches from the run's zero fitted on the other stretches):
+
+* ``constant``: a zero per run (the training mean of each run; a held-out run its first
+  reading): the declared model;
+* ``static``: the static multiple linear regression on all temperatures (their change since
+  the run's start) plus a zero per run, ridge-free least squares on the training readings;
+* ``lag``: the terms the selection chose (heat input and sensors through lags).
+
+The rule (:func:`volerr.selection.rules.significantly_below`): the lag model is the
+channel's model only when its per-fold cross-validated mean squares are significantly below
+each baseline's: the paired t over the K folds of ``ln(baseline's / lag model's)`` at least
+the one-sided 95 % Student quantile with K - 1 degrees of freedom.  Otherwise the better
+baseline (the lower cross-validated mean square; a tie to the constant) is the channel's
+model and the report says so.
+
+Prediction interval (``LEVEL`` = 95 %): the half-width is the ``LEVEL`` quantile of the
+absolute blocked-CV residuals of the chosen family over the training readings (symmetric,
+um).  Why a quantile and not ``t sigma``: drift residuals are autocorrelated, skewed and
+heavier at the switches of the spindle programme; the empirical quantile of residuals of
+stretches the fit never saw carries that (and the error of the choice of terms, made on all
+folds) without assuming normality.  Its coverage of the held-out readings is reported
+beside it (``coverage_test``): an interval is only as good as its held-out coverage.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...selection.linalg import solve_scaled
+from ...selection.rules import TIE_SCORE_REL, paired_t, significantly_below, t95
+
+FAMILIES = ("constant", "static", "lag")
+LEVEL = 0.95
+NAMES = {"constant": "a constant (each run's zero)",
+         "static": "the static regression on all temperatures",
+         "lag": "the lag model"}
+
+
+def cv_residuals(ch, D) -> np.ndarray:
+    """Blocked-CV residual (N,) um of the model with the design ``D`` (run indicators first)
+    at every training reading (NaN elsewhere): fold k predicted by the fit on the other
+    training folds (a fold of whole runs from the run's first reading plus the terms)."""
+    y, fold, n_runs = ch.y, ch.fold, ch.n_runs
+    r = np.full(len(y), np.nan)
+    first = y[ch.s.firsts()]
+    for k in range(int(fold.max()) + 1):
+        m = fold == k
+        fit = (fold >= 0) & ~m
+        Dm = D[fit]
+        b = solve_scaled(Dm.T @ Dm, Dm.T @ y[fit])
+        if ch.rule == "runs":
+            pred = first[ch.s.run[m]] + D[m, n_runs:] @ b[n_runs:]
+        else:
+            pred = D[m] @ b
+        r[m] = y[m] - pred
+    return r
+
+
+def fold_mse(fold, r) -> np.ndarray:
+    """Per fold the mean square (um^2) of the CV residuals ``r``."""
+    return np.array([float(np.mean(r[fold == k] ** 2)) for k in range(int(fold.max()) + 1)])
+
+
+def choose(ch, designs: dict, has_terms: bool) -> dict:
+    """The family of the channel by the module's rule: ``designs`` family -> design matrix;
+    ``has_terms`` False: the lag model has no term (it is the constant).  Returns
+    {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
+    "lag_vs_static"}, "rule", "cv_resid" (N,) of the chosen family}."""
+    resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
+    mse = {f: fold_mse(ch.fold, r) for f, r in resid.items()}
+    tr = ch.fold >= 0
+    cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
+    t = {f"{a}_vs_{b}": _log_t(mse[a], mse[b])
+         for a, b in (("static", "constant"), ("lag", "constant"), ("lag", "static"))}
+    # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
+    fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
+    if has_terms and all(significantly_below(mse["lag"], mse[b]) for b in ("constant", "static")):
+        fam = "lag"
+    K = len(mse["lag"])
+    return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
+            "cv_resid": resid[fam],
+            "fold_ms_um2": {f: [float(v) for v in m] for f, m in mse.items()},
+            "rule": f"lag model only if, against each baseline, the paired t over the {K} "
+                    f"blocked folds of ln(baseline's / lag model's CV mean square) >= "
+                    f"{t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the baseline of "
+                    f"lower CV mean square"}
+
+
+def _log_t(new, old) -> float:
+    """Paired t over the folds of ``ln(old / new)`` (positive: ``new`` lower)."""
+    return paired_t(np.log(np.maximum(old, 1e-300) / np.maximum(new, 1e-300)))
+
+
+def interval(cv_resid, y, pred, train, test) -> dict:
+    """The ``LEVEL`` prediction interval: half-width (um) the ``LEVEL`` quantile of |CV
+    residual| over the training readings, its share of held-out readings covered."""
+    r = np.abs(cv_resid[train])
+    r = r[np.isfinite(r)]
+    hw = float(np.quantile(r, LEVEL)) if len(r) else float("nan")
+    e = np.abs((y - pred)[test])
+    return {"level": LEVEL, "half_width_um": hw,
+            "coverage_test": float(np.mean(e <= hw)) if len(e) else None,
+            "method": "quantile of |blocked-CV residuals| of the chosen model"}
+
+
+def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) -> str:
+    """One sentence: which model the channel reports, and why."""
+    figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, static regression {cv_rms['static']:.3f}, "
+            f"constant {cv_rms['constant']:.3f} um")
+    if family == "lag":
+        return f"the lag model beats both baselines significantly ({figs})"
+    if not has_terms:
+        return f"no lag term earns a place: the model is {NAMES[family]} ({figs})"
+    lost = [b for b in ("static", "constant") if not t[f"lag_vs_{b}"] >= t_crit]
+    what = " and the ".join("static regression" if b == "static" else "constant" for b in lost)
+    worst = min(t[f"lag_vs_{b}"] for b in lost)
+    return (f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f}; {figs}):"
+            f" the model is {NAMES[family]}")
