@@ -14,7 +14,9 @@ reading, a fold of stretches from the run's zero fitted on the other stretches):
 The rule (:func:`volerr.selection.rules.significantly_below`): the lag model is the
 channel's model only when its per-fold cross-validated mean squares are significantly below
 each baseline's: the paired t over the K folds of ``ln(baseline's / lag model's)`` at least
-the one-sided 95 % Student quantile with K - 1 degrees of freedom.  Otherwise the better
+the one-sided 95 % Student quantile with K - 1 degrees of freedom.  (A lag model whose terms
+are all plain temperatures is a sub-model of the static regression: there the static
+regression is the more complex and must be significantly below the lag model instead.)  Otherwise the better
 baseline (the lower cross-validated mean square; a tie to the constant) is the channel's
 model and the report says so.
 
@@ -68,9 +70,11 @@ def fold_mse(fold, r) -> np.ndarray:
     return np.array([float(np.mean(r[fold == k] ** 2)) for k in range(int(fold.max()) + 1)])
 
 
-def choose(ch, designs: dict, has_terms: bool) -> dict:
+def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
     """The family of the channel by the module's rule: ``designs`` family -> design matrix;
-    ``has_terms`` False: the lag model has no term (it is the constant).  Returns
+    ``has_terms`` False: the lag model has no term (it is the constant); ``nested``: its
+    terms are plain temperatures (no lag, no heat input): a sub-model of the static
+    regression, which then must be significantly below it to be preferred.  Returns
     {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
     "lag_vs_static"}, "rule", "cv_resid" (N,) of the chosen family}."""
     resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
@@ -81,7 +85,11 @@ def choose(ch, designs: dict, has_terms: bool) -> dict:
          for a, b in (("static", "constant"), ("lag", "constant"), ("lag", "static"))}
     # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
     fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
-    if has_terms and all(significantly_below(mse["lag"], mse[b]) for b in ("constant", "static")):
+    # a lag model of plain temperatures only is a sub-model of the static regression: there
+    # the static regression is the more complex one and must beat it significantly
+    beats_static = (not significantly_below(mse["static"], mse["lag"]) if nested else
+                    significantly_below(mse["lag"], mse["static"]))
+    if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static:
         fam = "lag"
     K = len(mse["lag"])
     return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),

@@ -133,7 +133,7 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
            "constant": predict(ch.s, ch.R, _fit(ch.R, ch.y, tr), ch.y),
            "before": ch.y[ch.s.firsts()][ch.s.run]}
     out["choice"] = family.choose(ch, {"constant": ch.R, "static": Ds, "lag": fit["design"]},
-                                  bool(specs))
+                                  bool(specs), _nested_in_static(specs))
     return out
 
 
@@ -310,6 +310,14 @@ def _trial_rss(B, T, y) -> list:
         b = _solve_normal(g, h)
         out.append(max(yy - 2 * b @ h + b @ g @ b, 0.0))
     return out
+
+
+def _nested_in_static(specs) -> bool:
+    """Whether every term is a plain temperature (or a difference of two): the model is then
+    a sub-model of the static regression (:func:`_static_design`)."""
+    def temp(k):
+        return k is None or (k != "heat" and k.startswith("T"))
+    return all(sp["tau_s"] == 0 and temp(sp["source"]) and temp(sp["minus"]) for sp in specs)
 
 
 def _static_design(ch: Channel) -> np.ndarray:
