@@ -105,16 +105,13 @@ def t95(df: int) -> float:
 
 
 def significantly_below(err_new, err_old) -> bool:
-    """Whether the per-fold cross-validated mean squares ``err_new`` are significantly below
-    ``err_old`` (the same K folds): the paired t over the folds of ``ln(err_old / err_new)``
-    (:func:`paired_t`) at least the one-sided 95 % Student quantile with K - 1 degrees of
-    freedom (:func:`t95`), the mean log ratio positive.  The log ratio, not the difference:
-    the folds' mean squares differ by orders of magnitude (a stretch where the spindle
-    switches, a cool-down), a difference is the largest fold's alone; the log ratio is each
-    fold's relative gain, and the test asks that the gain be consistent over the folds.
-    The rule by which a more complex model family (the drift loop's lag model) replaces a
-    simpler one (a static regression, a constant)."""
-    new = np.maximum(np.asarray(err_new, float), 1e-300)
-    old = np.maximum(np.asarray(err_old, float), 1e-300)
-    d = np.log(old / new)
+    """Whether the cross-validated mean squares ``err_new`` of n equal blocks of held-out
+    readings are significantly below ``err_old`` (the same blocks): the paired t over the
+    blocks of ``err_old - err_new`` (:func:`paired_t`) at least the one-sided 95 % Student
+    quantile with n - 1 degrees of freedom (:func:`t95`), the mean difference positive.  The
+    mean of those differences is the difference of the pooled cross-validated mean squares
+    (the score the selection minimises); the test asks that it stand out of its
+    block-to-block scatter.  The rule by which a more complex model family (the drift loop's
+    lag model) replaces a simpler one (a static regression, a constant)."""
+    d = np.asarray(err_old, float) - np.asarray(err_new, float)
     return len(d) >= 2 and d.mean() > 0 and paired_t(d) >= t95(len(d) - 1)

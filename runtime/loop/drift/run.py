@@ -131,7 +131,6 @@ def _choice(choice, has_terms) -> dict:
     return {"family": choice["family"],
             "cv_rms_um": {k: round(v, 6) for k, v in choice["cv_rms_um"].items()},
             "paired_t": {k: round(v, 3) for k, v in choice["t"].items()},
-            "cv_fold_ms_um2": choice["fold_ms_um2"],
             "selection_rule": choice["rule"],
             "t_critical": round(choice["t_crit"], 3),
             "verdict": family.verdict(choice["family"], choice["cv_rms_um"], choice["t"],
