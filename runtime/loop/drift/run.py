@@ -157,7 +157,7 @@ def _family(s, label, p, r) -> dict:
         out["lag_model"]["cv_rms_um"] = out["cv_rms_um"]["lag"]
     else:
         out["family"] = p["family"]
-    out["interval"] = family.interval(p["cv_resid"], y, p["after"], s.train, te)
+    out["interval"] = family.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te)
     return out
 
 
