@@ -66,11 +66,12 @@ def cv_residuals(ch, D) -> np.ndarray:
     y, fold, n_runs = ch.y, ch.fold, ch.n_runs
     r = np.full(len(y), np.nan)
     first = y[ch.s.firsts()]
-    for k in range(int(fold.max()) + 1):
+    K = int(fold.max()) + 1
+    parts = [(D[fold == k].T @ D[fold == k], D[fold == k].T @ y[fold == k]) for k in range(K)]
+    G, h = sum(p[0] for p in parts), sum(p[1] for p in parts)
+    for k in range(K):
         m = fold == k
-        fit = (fold >= 0) & ~m
-        Dm = D[fit]
-        b = solve_scaled(Dm.T @ Dm, Dm.T @ y[fit])
+        b = solve_scaled(G - parts[k][0], h - parts[k][1])   # the fit on the other folds
         if ch.rule == "runs":
             pred = first[ch.s.run[m]] + D[m, n_runs:] @ b[n_runs:]
         else:
