@@ -62,7 +62,8 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "n_points": int(len(s.t_s) * len(s.channels)), "n_train": int(s.train.sum()),
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
-            "not_significant": [], "not_reported": [], "static_regression": {}, "unidentifiable": [],
+            "not_significant": [], "not_reported": [], "static_regression": {},
+            "unidentifiable": [],
             "extrapolation": extrapolation(s)}
     qpred = {label: _prediction(m, r) for label, r in res["channels"].items()}
     pred = {k: qpred[k] for k in s.channels if k not in resid}
@@ -141,15 +142,14 @@ def _family(s, label, p, r) -> dict:
     """A channel's baselines' held-out figures, the lag model's, its family (a channel of
     rows: the most complex of its quantities') and its prediction interval."""
     y, te = s.channels[label], s.test
-    out = {"baselines": {}, "lag_model": {}}
-    for name, where in (("static", "baselines"), ("constant", "baselines"), ("lag", "lag_model")):
+    figs = {}
+    for name in ("static", "constant", "lag"):
         e = (y - p[name])[te]
-        fig = {"mae_um": float(np.mean(np.abs(e))), "rms_um": float(np.sqrt(np.mean(e ** 2))),
-               "max_abs_um": float(np.max(np.abs(e)))}
-        if where == "baselines":
-            out["baselines"][name] = fig
-        else:
-            out["lag_model"] = fig
+        figs[name] = {"mae_um": float(np.mean(np.abs(e))),
+                      "rms_um": float(np.sqrt(np.mean(e ** 2))),
+                      "max_abs_um": float(np.max(np.abs(e)))}
+    out = {"baselines": {"static": figs["static"], "constant": figs["constant"]},
+           "lag_model": figs["lag"]}
     if r is not None:
         out.update(_choice(r["choice"], bool(r["terms"])))
         for name in ("static", "constant"):
