@@ -91,3 +91,27 @@ def tied(d0: float, d1: float) -> bool:
 def significant(value: float, u: float | None) -> bool:
     """Whether a coefficient is significant: ``|value| >= SIG_K u`` (no uncertainty: yes)."""
     return u is None or not abs(value) < SIG_K * u
+
+
+#: one-sided 95 % quantiles of Student's t, df = 1 .. 30 (beyond: the normal 1.645)
+T95_ONE_SIDED = (6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812,
+                 1.796, 1.782, 1.771, 1.761, 1.753, 1.746, 1.740, 1.734, 1.729, 1.725,
+                 1.721, 1.717, 1.714, 1.711, 1.708, 1.706, 1.703, 1.701, 1.699, 1.697)
+
+
+def t95(df: int) -> float:
+    """One-sided 95 % quantile of Student's t with ``df`` degrees of freedom (table)."""
+    return T95_ONE_SIDED[df - 1] if df <= len(T95_ONE_SIDED) else 1.645
+
+
+def significantly_below(err_new, err_old) -> bool:
+    """Whether the cross-validated mean squares ``err_new`` of n equal blocks of held-out
+    readings are significantly below ``err_old`` (the same blocks): the paired t over the
+    blocks of ``err_old - err_new`` (:func:`paired_t`) at least the one-sided 95 % Student
+    quantile with n - 1 degrees of freedom (:func:`t95`), the mean difference positive.  The
+    mean of those differences is the difference of the pooled cross-validated mean squares
+    (the score the selection minimises); the test asks that it stand out of its
+    block-to-block scatter.  The rule by which a more complex model family (the drift loop's
+    lag model) replaces a simpler one (a static regression, a constant)."""
+    d = np.asarray(err_old, float) - np.asarray(err_new, float)
+    return len(d) >= 2 and d.mean() > 0 and paired_t(d) >= t95(len(d) - 1)

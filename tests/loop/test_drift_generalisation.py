@@ -12,6 +12,8 @@ window so a window's tests share its run):
 =========  ==================  =====================================================
 window     A:B (s)             what the training part has not seen
 =========  ==================  =====================================================
+0-20 %     0 : 33345           the run's start: the 1250 rpm run and its cool-down
+                               (training after it only: every lag starts at rest)
 20-40 %    33345 : 66690       the 2500 rpm cool-down and the 3750 rpm run (most of it)
 40-60 %    66690 : 100035      the 3750 rpm cool-down and the 5000 rpm run (the fastest;
                                only its last 20 min, 100035 .. 101268 s, are in training)
@@ -30,6 +32,13 @@ Criteria a metrologist would accept (per channel, on the held-out readings):
   regression on the same temperatures has learnt the training part, not the machine;
 * on the 60-80 % window (the publication's), trained here on everything else, every channel
   stays below the best published MAE (seq2seq with attention).
+
+Issue 44: the model each channel reports (the lag model, or the better baseline where the
+lag model's blocked-CV error is not significantly below both baselines') is not worse than
+the better of the static regression and a constant (the training readings' mean), both
+computed here: ``mae_loop <= STATIC_FACTOR * min(static, constant) + STATIC_SLACK_UM``; the
+JSON's baselines are those computed here, and its prediction interval's held-out coverage is
+the share of held-out readings of the predictions file within its half-width.
 
 The loop's own ``mae_static_um`` must also agree with the regression computed here (it is
 the same model by INTERFACE.md's description), so that its console's comparison can be
@@ -57,7 +66,7 @@ STATIC_SLACK_UM = 0.2
 STATIC_AGREE_REL = 0.01
 
 #: window name -> (A, B) seconds (B None: open end), as ``--holdout-time`` reads it
-WINDOWS = {"20-40": (33345.0, 66690.0), "40-60": (66690.0, 100035.0),
+WINDOWS = {"0-20": (0.0, 33345.0), "20-40": (33345.0, 66690.0), "40-60": (66690.0, 100035.0),
            "60-80": (100035.0, 133380.0), "80-100": (133380.0, None)}
 
 #: measured on a shared 2-core machine (load ~4), one loop run each: 20-40 % 27 s,
@@ -152,9 +161,13 @@ def _param(name):
 #: channel-windows where the loop is known to lose to the static regression (issue 35 left
 #: open on them; measured on the lead's branch: ch5 40-60 % 4.44 vs 2.91 um, ch5 60-80 %
 #: 7.58 vs 2.32 um: a heat input at p = 0.5 with two lags, its sensor terms dropped as not
-#: significant one by one; ch2 80-100 % 3.41 vs 3.04 um).  Strict where the gap is wide (a
-#: fix makes the test fail until this list is updated), not where it is within 1 %.
-KNOWN_GAPS = {("40-60", "ch5"): True, ("60-80", "ch5"): True, ("80-100", "ch2"): False}
+#: significant one by one; ch2 80-100 % 3.41 vs 3.04 um).  Issue 44 (the baselines as
+#: candidates of the same blocked CV) reports the static regression on ch5 60-80 % (2.32 um);
+#: on the two left the blocked CV itself prefers the lag model significantly (its pooled CV
+#: mean square far below both baselines'), so no choice among the three families fixes them
+#: (measured: ch5 40-60 % 4.45 vs 2.91 um, ch2 80-100 % 3.41 vs a constant's 2.32 um).
+#: Strict: a fix makes the test fail until this list is updated.
+KNOWN_GAPS = {("40-60", "ch5"): True, ("80-100", "ch2"): True}
 
 
 def _pair(name, channel):
@@ -188,13 +201,53 @@ def test_the_reported_static_regression_is_the_one_computed_here(loop_runs, tabl
             static, rel=STATIC_AGREE_REL), (name, ch)
 
 
-@pytest.mark.parametrize("channel", [
-    pytest.param(c, marks=[pytest.mark.xfail(reason="issue 35: ch5 7.58 um, see KNOWN_GAPS",
-                                             strict=True)] if c == "ch5" else [])
-    for c in CHANNELS])
+@pytest.mark.parametrize("channel", CHANNELS)
 @pytest.mark.xdist_group("fl_window_60-80")
 def test_published_window_trained_on_the_rest_beats_the_published_best(loop_runs, table,
                                                                       channel):
     _, rows = loop_runs("60-80")
     mae = loop_mae(table, rows, channel, "60-80")
     assert mae < PUBLISHED_MAE_UM[channel], (channel, mae, PUBLISHED_MAE_UM[channel])
+
+
+def constant_mae(table: dict, channel: str, name: str) -> float:
+    """MAE on the window of a constant: the mean of the readings outside it."""
+    test = _mask(table["t_s"], name)
+    y = table[f"d_{channel}_um"]
+    return float(np.mean(np.abs(y[test] - y[~test].mean())))
+
+
+@pytest.mark.parametrize("name,channel", [_pair(n, c) for n in WINDOWS for c in CHANNELS])
+def test_never_worse_than_the_better_baseline(loop_runs, table, name, channel):
+    doc, rows = loop_runs(name)
+    c = doc["channels"][channel]
+    static = static_regression_mae(table, channel, name)
+    const = constant_mae(table, channel, name)
+    assert c["baselines"]["static"]["mae_um"] == pytest.approx(static, rel=STATIC_AGREE_REL)
+    assert c["baselines"]["constant"]["mae_um"] == pytest.approx(const, rel=1e-6)
+    mine = loop_mae(table, rows, channel, name)
+    assert c["family"] in ("lag", "static", "constant")
+    if c["family"] != "lag":      # the baseline IS the channel's model, and no effect of it
+        assert mine == pytest.approx(c["baselines"][c["family"]]["mae_um"], rel=1e-6)
+        assert not [e for e in doc["effects"] if e["channels"] == [channel]]
+        assert "no lag model beats" in c["verdict"]
+    best = min(static, const)
+    assert mine <= STATIC_FACTOR * best + STATIC_SLACK_UM, (
+        f"window {name} %, {channel} ({c['family']}): MAE {mine:.3f} um > {STATIC_FACTOR} x "
+        f"min(static {static:.3f}, constant {const:.3f}) + {STATIC_SLACK_UM} um")
+
+
+@pytest.mark.parametrize("name", [_param(n) for n in WINDOWS])
+def test_interval_coverage_is_that_of_the_predictions(loop_runs, table, name):
+    """The reported held-out coverage of the 95 % interval is the share of the window's
+    readings (the data file's values) within the half-width of the predictions file's."""
+    doc, rows = loop_runs(name)
+    for ch in CHANNELS:
+        iv = doc["channels"][ch]["interval"]
+        assert iv["level"] == 0.95 and iv["half_width_um"] > 0
+        test = [r for r in rows if r["channel"] == ch and r["split"] == "test"]
+        t = np.array([float(r["t_s"]) for r in test])
+        e = np.interp(t, table["t_s"], table[f"d_{ch}_um"]) - np.array(
+            [float(r["after_um"]) for r in test])
+        assert iv["coverage_test"] == pytest.approx(
+            float(np.mean(np.abs(e) <= iv["half_width_um"])), abs=1e-9), (name, ch)

@@ -27,7 +27,19 @@ def _draw(report, label: str):
     ax[0].plot(t_h[i], y[i], lw=0.8, label="measured")
     ax[0].plot(t_h[i], p["before"][i], lw=0.8, label="before (declared: the run's zero)")
     ax[0].plot(t_h[i], p["static"][i], lw=0.8, label="static regression, all T")
-    ax[0].plot(t_h[i], p["after"][i], lw=0.8, label="after (augmented)")
+    c = report.data["channels"].get(label, {})
+    fam = c.get("family", "lag")
+    ax[0].plot(t_h[i], p["after"][i], lw=0.8, label=f"after (model: {fam})")
+    iv = c.get("interval")
+    if iv and np.isfinite(iv["half_width_um"]):
+        hw = iv["half_width_um"]
+        cov = "" if iv["coverage_test"] is None else \
+            f", held-out coverage {100 * iv['coverage_test']:.0f} %"
+        ax[0].fill_between(t_h[i], p["after"][i] - hw, p["after"][i] + hw, color="C3",
+                           alpha=0.15, lw=0,
+                           label=f"{100 * iv['level']:.0f} % prediction interval{cov}")
+    if c.get("verdict"):
+        ax[0].set_title(c["verdict"], fontsize="small")
     ax[0].set_ylabel(f"{label} / um")
     ax[0].legend(fontsize="small", ncol=2)
     ax[1].plot(t_h[i], (y - p["after"])[i], lw=0.6, label="residual after")

@@ -41,6 +41,7 @@ from ...selection.linalg import solve_scaled as _solve_normal
 from ...selection.profile import profile_vertex
 from ...selection.rules import CV_GAIN, SIG_K, TIE_SCORE_REL
 from . import basis
+from . import family
 from . import select as sel
 from .engine import Engine
 
@@ -125,8 +126,15 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     specs = _backward(ch, [_spec(cols, t) for t in terms])
     specs = _refine_all(ch, specs)
     specs, fit = _significant(ch, specs)
-    return {"terms": specs, "fit": fit, "y": ch.y,
-            "static": _static(ch), "before": ch.y[ch.s.firsts()][ch.s.run]}
+    Ds = _static_design(ch)
+    tr = ch.s.train
+    out = {"terms": specs, "fit": fit, "y": ch.y,
+           "static": predict(ch.s, Ds, _fit(Ds, ch.y, tr), ch.y),
+           "constant": predict(ch.s, ch.R, _fit(ch.R, ch.y, tr), ch.y),
+           "before": ch.y[ch.s.firsts()][ch.s.run]}
+    out["choice"] = family.choose(ch, {"constant": ch.R, "static": Ds, "lag": fit["design"]},
+                                  bool(specs), _nested_in_static(specs))
+    return out
 
 
 def _backward(ch: Channel, specs) -> list:
@@ -304,16 +312,21 @@ def _trial_rss(B, T, y) -> list:
     return out
 
 
-def _static(ch: Channel) -> np.ndarray:
-    """The static multiple linear regression on all temperatures (their change since the
-    run's start; a zero per training run, a held-out run from its first reading), fitted
-    on the training readings: its prediction of every reading (N,)."""
+def _nested_in_static(specs) -> bool:
+    """Whether every term is a plain temperature (or a difference of two): the model is then
+    a sub-model of the static regression (:func:`_static_design`)."""
+    def temp(k):
+        return k is None or (k != "heat" and k.startswith("T"))
+    return all(sp["tau_s"] == 0 and temp(sp["source"]) and temp(sp["minus"]) for sp in specs)
+
+
+def _static_design(ch: Channel) -> np.ndarray:
+    """The design of the static multiple linear regression on all temperatures (their change
+    since the run's start) and a zero per run; fitted on the training readings (a held-out
+    run predicted from its first reading, :func:`predict`) it is the shop's usual model."""
     s = ch.s
     temps = [k for k in basis.sensors(s) if k.startswith("T")]
-    cols = [basis.series(s, k, 0.0) for k in temps]
-    D = np.column_stack([ch.R] + cols)
-    b = _fit(D, ch.y, s.train)
-    return predict(s, D, b, ch.y)
+    return np.column_stack([ch.R] + [basis.series(s, k, 0.0) for k in temps])
 
 
 def predict(s, D, b, y) -> np.ndarray:

@@ -115,6 +115,7 @@ class DriftReport(ResultMixin):
                        f"{c['mae_static_um']:.3f}), RMS {c['rms_before_um']:.3f} -> "
                        f"{c['rms_after_um']:.3f}, max {c['max_abs_before_um']:.3f} -> "
                        f"{c['max_abs_after_um']:.3f} um")
+            out += _family_lines(c)
         for sym, q in d.get("quantities", {}).items():
             rows = ", ".join(f"{c} {w:+.4g}" for c, w in q["rows"].items())
             own = ", ".join(q["layout_parameters"]) or "none"
@@ -126,9 +127,31 @@ class DriftReport(ResultMixin):
             out.append(f"  {e['kind']} {e['name']}: {what} varies with {e['basis']}")
             for t in e["terms"]:
                 out.append("    " + _term_line(t))
+        for n in d.get("not_reported", []):
+            out.append(f"  lag term not reported (its channel's model is a baseline): {n}")
         for n in d["not_significant"]:
             out.append(f"  not significant (|value| < {SIG_K:g} u), left out: {n}")
         return out
+
+
+def _family_lines(c: dict) -> list:
+    """A channel's model family, its baselines' held-out figures, why, its interval."""
+    if "family" not in c:
+        return []
+    b = c.get("baselines", {})
+    line = (f"    model: {c['family']}; held-out MAE of the baselines: static regression "
+            f"{b['static']['mae_um']:.3f}, constant {b['constant']['mae_um']:.3f} um; lag model "
+            f"{c['lag_model']['mae_um']:.3f} um")
+    out = [line]
+    if c.get("verdict"):
+        out.append(f"    {c['verdict']}")
+    iv = c.get("interval")
+    if iv:
+        cov = "n/a" if iv["coverage_test"] is None else f"{100 * iv['coverage_test']:.1f} %"
+        out.append(f"    {100 * iv['level']:.0f} % prediction interval +- "
+                   f"{iv['half_width_um']:.3f} um (from the blocked-CV residuals); held-out "
+                   f"readings inside it: {cov}")
+    return out
 
 
 def _term_line(t: dict) -> str:

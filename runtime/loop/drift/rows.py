@@ -175,6 +175,10 @@ def run_constant(s: basis.DriftSeries, e: np.ndarray) -> np.ndarray:
     return out
 
 
+#: the model families, simplest first (a channel of rows: the most complex of its quantities')
+FAMILY_ORDER = ("constant", "static", "lag")
+
+
 def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict:
     """Every directed channel's predictions from the quantities' (``qpred`` symbol ->
     {"after", "static", "terms"}): its row of them plus its residual's run constant; the
@@ -184,13 +188,17 @@ def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict
         c = run_constant(s, resid[k])
         y = s.channels[k]
         p = {"before": y[s.firsts()][s.run], "terms": [], "quantities": []}
-        for name in ("after", "static"):
-            p[name] = c + sum(rows.A[i, j] * qpred[q.symbol][name]
-                              for j, q in enumerate(rows.quantities) if rows.A[i, j] != 0)
-        for j, q in enumerate(rows.quantities):
-            if rows.A[i, j] != 0:
-                p["terms"] += qpred[q.symbol]["terms"]
-                p["quantities"].append(q.symbol)
+        on = [(j, q) for j, q in enumerate(rows.quantities) if rows.A[i, j] != 0]
+        for name in ("after", "static", "constant", "lag"):
+            p[name] = c + sum(rows.A[i, j] * qpred[q.symbol][name] for j, q in on)
+        # the channel's CV residual: its row of the quantities' plus its own row residual
+        p["cv_resid"] = resid[k] - c + sum(rows.A[i, j] * qpred[q.symbol]["cv_resid"]
+                                           for j, q in on)
+        fams = [qpred[q.symbol]["family"] for _, q in on]
+        p["family"] = max(fams, key=FAMILY_ORDER.index) if fams else "constant"
+        for j, q in on:
+            p["terms"] += qpred[q.symbol]["terms"]
+            p["quantities"].append(q.symbol)
         out[k] = p
     return out
 

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from . import basis
+from . import family
 from . import fit as core
 from . import rows as rows_mod
 from .report import DriftReport
@@ -61,7 +62,8 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "n_points": int(len(s.t_s) * len(s.channels)), "n_train": int(s.train.sum()),
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
-            "not_significant": [], "static_regression": {}, "unidentifiable": [],
+            "not_significant": [], "not_reported": [], "static_regression": {},
+            "unidentifiable": [],
             "extrapolation": extrapolation(s)}
     qpred = {label: _prediction(m, r) for label, r in res["channels"].items()}
     pred = {k: qpred[k] for k in s.channels if k not in resid}
@@ -72,12 +74,18 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
     for label, p in pred.items():
         c = data["channels"][label] = _metrics(s, s.channels[label], p["before"], p["after"],
                                                p["static"])
+        c.update(_family(s, label, p, res["channels"].get(label)))
         c["direction"] = s.directions.get(label, "?")
         if label in resid:
             c["row"] = rows.row(label)
             c["row_residual_rms_um"] = rows_mod.residual_rms(s, resid[label])
     quantity = {q.symbol: q for q in (rows.quantities if rows is not None else ())}
     for label, r in res["channels"].items():
+        if label in quantity:
+            data["quantities"][label].update(_choice(r["choice"], bool(r["terms"])))
+        if r["choice"]["family"] != "lag":
+            data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]]
+            continue
         data["effects"] += _effects(label, r, m, quantity.get(label))
         data["not_significant"] += [f"{label}: {_basis(sp)}" for sp in r["fit"].get("dropped", [])]
     tr = list(data["channels"].values())
@@ -99,9 +107,16 @@ def _rows(s, position, model):
 
 
 def _prediction(m, r) -> dict:
-    f = r["fit"]
-    after = core.predict(m, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
-    return {"before": r["before"], "after": after, "static": r["static"], "terms": r["terms"]}
+    """The predictions (N,) um of one label: "lag" the lag model's, "after" the chosen
+    family's (:mod:`volerr.loop.drift.family`), "static", "constant", "before"; "cv_resid"
+    the chosen family's blocked-CV residuals; "terms" the lag terms where the lag model is
+    the one reported (else none)."""
+    f, c = r["fit"], r["choice"]
+    lag = core.predict(m, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
+    fam = c["family"]
+    return {"before": r["before"], "lag": lag, "after": lag if fam == "lag" else r[fam],
+            "static": r["static"], "constant": r["constant"], "cv_resid": c["cv_resid"],
+            "family": fam, "terms": r["terms"] if fam == "lag" else []}
 
 
 def _quantity(q, rows) -> dict:
@@ -110,6 +125,40 @@ def _quantity(q, rows) -> dict:
             "rows": {k: float(rows.A[rows.channels.index(k), rows.quantities.index(q)])
                      for k in q.channels},
             "layout_parameters": dict(q.layout_parameters)}
+
+
+def _choice(choice, has_terms) -> dict:
+    """The family chosen for a label and why (:mod:`volerr.loop.drift.family`)."""
+    return {"family": choice["family"],
+            "cv_rms_um": {k: round(v, 6) for k, v in choice["cv_rms_um"].items()},
+            "paired_t": {k: round(v, 3) for k, v in choice["t"].items()},
+            "selection_rule": choice["rule"],
+            "t_critical": round(choice["t_crit"], 3),
+            "verdict": family.verdict(choice["family"], choice["cv_rms_um"], choice["t"],
+                                      has_terms, choice["t_crit"])}
+
+
+def _family(s, label, p, r) -> dict:
+    """A channel's baselines' held-out figures, the lag model's, its family (a channel of
+    rows: the most complex of its quantities') and its prediction interval."""
+    y, te = s.channels[label], s.test
+    figs = {}
+    for name in ("static", "constant", "lag"):
+        e = (y - p[name])[te]
+        figs[name] = {"mae_um": float(np.mean(np.abs(e))),
+                      "rms_um": float(np.sqrt(np.mean(e ** 2))),
+                      "max_abs_um": float(np.max(np.abs(e)))}
+    out = {"baselines": {"static": figs["static"], "constant": figs["constant"]},
+           "lag_model": figs["lag"]}
+    if r is not None:
+        out.update(_choice(r["choice"], bool(r["terms"])))
+        for name in ("static", "constant"):
+            out["baselines"][name]["cv_rms_um"] = out["cv_rms_um"][name]
+        out["lag_model"]["cv_rms_um"] = out["cv_rms_um"]["lag"]
+    else:
+        out["family"] = p["family"]
+    out["interval"] = family.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te)
+    return out
 
 
 def _pool(chs, key) -> float:

@@ -1,0 +1,154 @@
+"""The baselines as candidates of the drift loop's selection, and the prediction interval of
+the model chosen (:func:`volerr.loop.drift.fit.run_drift` calls :func:`choose` per channel).
+
+Three families compete per channel, scored by the SAME blocked cross-validation (the folds of
+:func:`volerr.loop.drift.basis.folds`; a fold of whole runs predicted from the run's first
+reading, a fold of stretches from the run's zero fitted on the other stretches):
+
+* ``constant``: a zero per run (the training mean of each run; a held-out run its first
+  reading): the declared model;
+* ``static``: the static multiple linear regression on all temperatures (their change since
+  the run's start) plus a zero per run, ridge-free least squares on the training readings;
+* ``lag``: the terms the selection chose (heat input and sensors through lags).
+
+The rule (:func:`volerr.selection.rules.significantly_below`): every fold's CV residuals are
+cut into ``SUB_BLOCKS`` consecutive blocks (nearly equal: on FL_THERMAL 35-50 min of readings)
+and the lag model is the channel's model only when, against each baseline, the paired t over
+those blocks of ``baseline's - lag model's`` mean square is at least the one-sided 95 %
+Student quantile (n - 1 degrees of freedom).  The mean of those differences is the
+difference of the pooled CV mean squares, the score the selection minimises; the t asks that
+it stand out of its block-to-block scatter.  Blocks within folds, not the folds alone: six
+folds leave 5 degrees of freedom, and on FL_THERMAL's publication split (training on the
+first 60 %) no channel's gain was significant at the folds' level although the lag model's
+pooled CV mean square was half the static regression's and its held-out MAE 2-6x lower.
+Blocks of residuals 15 s apart are autocorrelated: the t of short blocks is optimistic,
+which is why they are kept at tens of minutes.  Otherwise the better baseline (the lower
+cross-validated mean square; a tie to the constant) is the channel's model and the report
+says so.  (A lag model whose terms are all plain temperatures is a sub-model of the static
+regression: there the static regression is the more complex and must be significantly
+below the lag model instead.)
+
+Prediction interval (``LEVEL`` = 95 %): per blocked CV fold the ``LEVEL`` quantile of the
+absolute CV residuals of the chosen family, and the half-width the largest of them
+(symmetric, um).  Why: the held-out part is one stretch the fit never saw, like one fold;
+folds differ tenfold in their error (a stretch where the spindle switches, a cool-down), so
+the pooled quantile of all CV residuals averages easy and hard stretches and covers too
+little of a hard one (on FL_THERMAL's 30 channel-windows it covered 68 % of the held-out
+readings on average, the largest fold's quantile 79 %).  A quantile and not ``t sigma``:
+drift residuals are autocorrelated and skewed.  The CV residuals are those of the terms
+chosen on all folds (the choice is not repeated per fold), so they are optimistic; the
+coverage of the held-out readings is reported beside the interval (``coverage_test``): an
+interval is only as good as its held-out coverage.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...selection.linalg import solve_scaled
+from ...selection.rules import TIE_SCORE_REL, paired_t, significantly_below, t95
+
+FAMILIES = ("constant", "static", "lag")
+#: consecutive blocks each fold's CV residuals are cut into for the paired test
+SUB_BLOCKS = 8
+LEVEL = 0.95
+NAMES = {"constant": "a constant (each run's zero)",
+         "static": "the static regression on all temperatures",
+         "lag": "the lag model"}
+
+
+def cv_residuals(ch, D) -> np.ndarray:
+    """Blocked-CV residual (N,) um of the model with the design ``D`` (run indicators first)
+    at every training reading (NaN elsewhere): fold k predicted by the fit on the other
+    training folds (a fold of whole runs from the run's first reading plus the terms)."""
+    y, fold, n_runs = ch.y, ch.fold, ch.n_runs
+    r = np.full(len(y), np.nan)
+    first = y[ch.s.firsts()]
+    K = int(fold.max()) + 1
+    parts = [(D[fold == k].T @ D[fold == k], D[fold == k].T @ y[fold == k]) for k in range(K)]
+    G, h = sum(p[0] for p in parts), sum(p[1] for p in parts)
+    for k in range(K):
+        m = fold == k
+        b = solve_scaled(G - parts[k][0], h - parts[k][1])   # the fit on the other folds
+        if ch.rule == "runs":
+            pred = first[ch.s.run[m]] + D[m, n_runs:] @ b[n_runs:]
+        else:
+            pred = D[m] @ b
+        r[m] = y[m] - pred
+    return r
+
+
+def block_mse(fold, r, sub: int = SUB_BLOCKS) -> np.ndarray:
+    """The mean squares (um^2) of the CV residuals ``r`` over ``sub`` consecutive blocks of
+    every fold (nearly equal blocks, in fold then time order)."""
+    out = []
+    for k in range(int(fold.max()) + 1):
+        for part in np.array_split(np.flatnonzero(fold == k), sub):
+            if len(part):
+                out.append(float(np.mean(r[part] ** 2)))
+    return np.array(out)
+
+
+def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
+    """The family of the channel by the module's rule: ``designs`` family -> design matrix;
+    ``has_terms`` False: the lag model has no term (it is the constant); ``nested``: its
+    terms are plain temperatures (no lag, no heat input): a sub-model of the static
+    regression, which then must be significantly below it to be preferred.  Returns
+    {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
+    "lag_vs_static"}, "rule", "cv_resid" (N,) of the chosen family}."""
+    resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
+    mse = {f: block_mse(ch.fold, r) for f, r in resid.items()}
+    tr = ch.fold >= 0
+    cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
+    t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a])
+         for a, b in (("static", "constant"), ("lag", "constant"), ("lag", "static"))}
+    # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
+    fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
+    # a lag model of plain temperatures only is a sub-model of the static regression: there
+    # the static regression is the more complex one and must beat it significantly
+    beats_static = (not significantly_below(mse["static"], mse["lag"]) if nested else
+                    significantly_below(mse["lag"], mse["static"]))
+    if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static:
+        fam = "lag"
+    K = len(mse["lag"])
+    return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
+            "cv_resid": resid[fam],
+            "rule": f"lag model only if, against each baseline, the paired t over {K} blocks "
+                    f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
+                    f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
+                    f"baseline of lower CV mean square"}
+
+
+def interval(cv_resid, y, pred, fold, test) -> dict:
+    """The ``LEVEL`` prediction interval (module docstring): half-width (um) the largest over
+    the folds (``fold`` (N,), -1 held out) of the fold's ``LEVEL`` quantile of |CV
+    residual|; its share of held-out readings covered."""
+    qs = []
+    for k in range(int(fold.max()) + 1):
+        r = np.abs(cv_resid[fold == k])
+        r = r[np.isfinite(r)]
+        if len(r):
+            qs.append(float(np.quantile(r, LEVEL)))
+    hw = max(qs) if qs else float("nan")
+    e = np.abs((y - pred)[test])
+    return {"level": LEVEL, "half_width_um": hw,
+            "coverage_test": float(np.mean(e <= hw)) if len(e) else None,
+            "method": "the largest over the blocked CV folds of the fold's 95 % quantile of "
+                      "|CV residual| of the chosen model"}
+
+
+def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) -> str:
+    """One sentence: which model the channel reports, and why."""
+    figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, static regression {cv_rms['static']:.3f}, "
+            f"constant {cv_rms['constant']:.3f} um")
+    if family == "lag":
+        return f"the lag model beats both baselines significantly ({figs})"
+    if not has_terms:
+        return f"no lag term earns a place: the model is {NAMES[family]} ({figs})"
+    lost = [b for b in ("static", "constant") if not t[f"lag_vs_{b}"] >= t_crit] or ["static"]
+    what = " and the ".join("static regression" if b == "static" else "constant" for b in lost)
+    worst = min(t[f"lag_vs_{b}"] for b in lost)
+    return (f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f}; {figs}):"
+            f" the model is {NAMES[family]}")
