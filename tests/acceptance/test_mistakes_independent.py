@@ -937,8 +937,6 @@ def test_check_dated_in_the_future(ex, reference, tmp_path, capsys):
             ("future", "after today", "today"))
 
 
-@xfail("NOT refused: exit 0, check.json written, 'tolerance: pass' against a 22 mm limit on a "
-       "location error (um typed as mm)")
 def test_check_tolerance_typed_in_mm_for_um(
         ex, reference, tmp_path, capsys):
     """--tolerance EX0C=22 mm (a typo of um) is a 22 mm tolerance: no machine parameter of a
@@ -952,9 +950,6 @@ def test_check_tolerance_typed_in_mm_for_um(
             ("um", "implausible", "unit", "large"))
 
 
-@xfail("NOT refused: exit 0, check.json written, 'tolerance: pass' with a bare EX0B=22 "
-       "(check --help documents a bare value as the parameter's unit, while history show "
-       "refuses the same text: 'the value needs its unit'; issue 43 item 5 asks for the unit)")
 def test_check_tolerance_without_unit(ex, reference, tmp_path, capsys):
     """Issue 43 item 5: every option value with a unit needs it (as history show refuses
     EX0C=22)."""
