@@ -294,3 +294,17 @@ def check_tolerance_um(value_um: float, where: str, unit: str = "um") -> float:
             else "a wrong unit?")
     raise InputError(f"{where}: {value_um:g} um is below any machine's tolerance "
                      f"({TOLERANCE_FLOOR_UM:g} um): {hint}")
+
+
+def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
+    """A tool offset in the tool frame (mm, from the point the axis positions refer to, the
+    spindle gauge point, to the tool tip: ``0 0 -L`` for a tool L long, docs/conventions.md)
+    returned when :func:`check_offset_mm` accepts it and its z is not positive; a positive z
+    puts the tip inside the spindle: refused as the likely sign (one line naming ``where``)."""
+    v = check_offset_mm(vector, where, limit_mm, "offset")
+    if v[2] > 0:
+        raise InputError(f"{where} {' '.join(f'{x:g}' for x in v)}: a tool offset with z = "
+                         f"+{v[2]:g} mm puts the tip inside the spindle; the offset of a tool "
+                         f"L long is 0 0 -L: likely the sign (write {v[0]:g} {v[1]:g} "
+                         f"{-v[2]:g}, or --tool-length {v[2]:g})")
+    return v

@@ -84,6 +84,10 @@ class Options:
                 "the thesis strategy does not compensate the orientation")
         tool = np.asarray(self.tool, dtype=float)
         require(tool.shape == (3,) and np.all(np.isfinite(tool)), "tool offset must be 3 numbers")
+        from ..tables.plausible import DEFAULT_SIZE_MM, machine_size
+        from ..units import check_tool_offset
+
+        check_tool_offset(tool, "--tool", machine_size(model) or DEFAULT_SIZE_MM)
         tool = _tool_of_length(tool, self.tool_length)
         for a in self.initial or {}:
             require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")

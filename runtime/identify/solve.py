@@ -638,6 +638,27 @@ def _flag_outliers(rnd, resid, W, sigma, n, k):
     return out
 
 
+#: no laser tracker measures closer than this, mm (their ranges start at 0.5 .. 1 m; the
+#: interferometer's figures of :data:`IFM_MPE` hold from there)
+TRACKER_MIN_RANGE_MM = 200.0
+
+
+def _check_tracker_range(tracker: np.ndarray, rounds) -> None:
+    """Refuse a tracker position closer than :data:`TRACKER_MIN_RANGE_MM` to a measured point
+    (one line naming ``--tracker``): a position typed in m (1.5 -2 0.3 for 1500 -2000 300)."""
+    pts = np.concatenate([r.points.reshape(-1, 3) for r in rounds])
+    near = float(np.min(np.linalg.norm(pts - tracker, axis=1)))
+    if near >= TRACKER_MIN_RANGE_MM:
+        return
+    t = " ".join(f"{v:g}" for v in tracker)
+    far = float(np.min(np.linalg.norm(pts - tracker * MM_PER_M, axis=1)))
+    hint = (f"likely given in m: write {' '.join(f'{v * MM_PER_M:g}' for v in tracker)} (mm)"
+            if far >= TRACKER_MIN_RANGE_MM else "a wrong unit or a wrong position?")
+    raise InputError(f"--tracker {t}: the tracker stands {near:.0f} mm from the nearest measured "
+                     f"point, closer than any laser tracker measures "
+                     f"({TRACKER_MIN_RANGE_MM:g} mm); {hint}")
+
+
 def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, direction=None,
              origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
              cross_check: bool = True) -> Identification:
@@ -698,6 +719,7 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         tracker = np.asarray(tracker, dtype=float)
         require(tracker.shape == (3,) and np.all(np.isfinite(tracker)),
                 "tracker position must be three finite numbers (mm)")
+        _check_tracker_range(tracker, rounds)
     # the same point order in every round
     labels = rounds[0].labels
     aligned = []
