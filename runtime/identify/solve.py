@@ -638,6 +638,24 @@ def _flag_outliers(rnd, resid, W, sigma, n, k):
     return out
 
 
+def _check_travel(rounds, layout, axis: str) -> None:
+    """Refuse commanded positions outside the travel of ``axis`` of ``layout`` (one line
+    naming the file and the column position: a file of another machine, a wrong layout)."""
+    ax = layout.axes.get(axis)
+    if ax is None or not rounds:
+        return
+    lo, hi = (float(v) for v in ax.travel)
+    pos = np.concatenate([np.asarray(r.positions, dtype=float) for r in rounds])
+    pad = 1e-6 * max(1.0, hi - lo)
+    bad = pos[(pos < lo - pad) | (pos > hi + pad)]
+    if bad.size:
+        unit = "deg" if ax.kind == "rotary" else "mm"
+        raise InputError(f"{rounds[0].name.rsplit(':', 1)[0]}: column position: {axis} = "
+                         f"{float(bad[np.argmax(np.abs(bad))]):g} {unit} lies outside the travel "
+                         f"of {layout.name}'s {axis} ({lo:g} .. {hi:g} {unit}): a file of another "
+                         f"machine, or the wrong layout?")
+
+
 #: no laser tracker measures closer than this, mm (their ranges start at 0.5 .. 1 m; the
 #: interferometer's figures of :data:`IFM_MPE` hold from there)
 TRACKER_MIN_RANGE_MM = 200.0
@@ -702,6 +720,7 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         layout = read_layout(layout)
     require(method in ("lsq", "closed"), f"unknown method {method!r} (lsq, closed)")
     kind, d, o = _axis_geometry(layout, axis, direction, origin)
+    _check_travel(rounds, layout, axis)
     others = {n: (a.kind, tuple(np.asarray(a.direction, float) / np.linalg.norm(a.direction)))
               for n, a in layout.axes.items() if n != axis}
     rounds = list(rounds)
