@@ -9,7 +9,7 @@ import re
 
 import numpy as np
 
-from ..errors import require
+from ..errors import InputError, require
 
 AXIS_NAMES = "XYZUVWABC"
 
@@ -185,7 +185,7 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
              what: str = "an error map") -> np.ndarray:
     """Readings (n, len(names)) mm from columns ``<name>_um`` or ``<name>_mm``,
     plausibility-checked."""
-    out = np.zeros((n, len(names)))
+    out, heads = np.zeros((n, len(names))), []
     for i, d in enumerate(names):
         require(find.name(d) is None, f"{where}: deviation column {d} has no unit suffix "
                 f"(use {d}_um or {d}_mm)")
@@ -196,9 +196,15 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
                     f"supported (use {d}_um or {d}_mm)")
         require(c_um or c_mm, f"{where}: missing deviation column {d}_um (or {d}_mm)")
         out[:, i] = find.cols[c_um] * 1e-3 if c_um else find.cols[c_mm]
+        heads.append(c_um or c_mm)
     big = float(np.max(np.abs(out))) if out.size else 0.0
-    require(big < limit_mm, f"{where}: deviations up to {big:g} mm are implausible for "
-            f"{what}: wrong unit (um given as mm?) or nominal instead of deviation values")
+    if big >= limit_mm:
+        col = heads[int(np.argmax(np.max(np.abs(out), axis=0)))]
+        cause = ("likely nm under the _um header (give um), or nominal instead of deviation "
+                 "values" if col.lower().endswith("_um") and big * 1e-3 < limit_mm else
+                 "wrong unit (um given as mm?) or nominal instead of deviation values")
+        raise InputError(f"{where}: column {col}: deviations up to {big:g} mm are implausible "
+                         f"for {what}: {cause}")
     return out
 
 

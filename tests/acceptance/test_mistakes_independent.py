@@ -189,9 +189,6 @@ def test_sphere_one_placement_centre_off_by_an_inch(ex, tmp_path, capsys):
             ("sphere_x", "sphere"), ("inch", "25.4"))
 
 
-@xfail("refused (exit 2, nothing written) but the line names no column (dx_um/dy_um/dz_um) and "
-       "its cause is backwards: 'deviations up to 33.8365 mm are implausible for a sphere "
-       "reading: wrong unit (um given as mm?)' -- the readings are nm under an _um header")
 def test_sphere_deviations_in_nm(ex, tmp_path, capsys):
     f = mutate(ex / SPHERE, tmp_path / "sph_nm.csv", scale(("dx_um", "dy_um", "dz_um"), 1000.0))
     refused(capsys, cal_argv("DMU50", [f], tmp_path), outs_cal(tmp_path), f.name,
@@ -333,9 +330,6 @@ def test_ballbar_length_in_inches(ex, tmp_path, capsys):
     refused(capsys, bb_argv(f, tmp_path), bb_outs(tmp_path), f.name, ("length_mm",), ("inch",))
 
 
-@xfail("refused (exit 2, nothing written) but names no column (dr_um) and the cause is "
-       "backwards: 'deviations up to 14.3731 mm are implausible for a ballbar reading: wrong "
-       "unit (um given as mm?)'")
 def test_ballbar_readings_in_nm(ex, tmp_path, capsys):
     f = mutate(ex / BALLBAR, tmp_path / "bb_nm.csv", scale(("dr_um",), 1000.0))
     refused(capsys, bb_argv(f, tmp_path), bb_outs(tmp_path), f.name, ("dr_um",), ("nm", "unit"))
@@ -354,9 +348,6 @@ def test_ballbar_x_and_y_columns_swapped(ex, tmp_path, capsys):
             ("swap", "pivot", "length"))
 
 
-@xfail("refused (exit 2, nothing written) but names no column (dr_um) and the cause is "
-       "backwards: 'ballbar_YZ.csv: deviations up to 13.3271 mm are implausible for a ballbar "
-       "reading: wrong unit (um given as mm?)'")
 def test_ballbar_set_calibrated_with_one_trace_in_nm(ex, tmp_path, capsys):
     d = copy_dir(ex / "ballbar", tmp_path / "bb")
     mutate(ex / "ballbar" / "ballbar_YZ.csv", d / "ballbar_YZ.csv", scale(("dr_um",), 1000.0))
@@ -541,9 +532,6 @@ def lp_argv(f, t, layout="MB1"):
     return ["loop", layout, f, "--json", o[0], "--errors-out", o[1]]
 
 
-@xfail("refused (exit 2, nothing written) but names no column and the cause is backwards: "
-       "'dev_nm.csv: deviations up to 60.407 mm are implausible for an error map: wrong unit (um"
-       " given as mm?)'")
 def test_deviations_in_nm(ex, tmp_path, capsys):
     f = mutate(ex / DEV, tmp_path / "dev_nm.csv", scale(("dx_um", "dy_um", "dz_um"), 1000.0))
     refused(capsys, lp_argv(f, tmp_path), lp_outs(tmp_path), f.name, ("dx_um", "dy_um", "dz_um"),
