@@ -200,8 +200,8 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
     big = float(np.max(np.abs(out))) if out.size else 0.0
     if big >= limit_mm:
         col = heads[int(np.argmax(np.max(np.abs(out), axis=0)))]
-        cause = ("likely nm under the _um header (give um), or nominal instead of deviation "
-                 "values" if col.lower().endswith("_um") and big * 1e-3 < limit_mm else
+        cause = ("wrong unit: likely nm under the _um header (give um), or nominal instead of "
+                 "deviation values" if col.lower().endswith("_um") and big * 1e-3 < limit_mm else
                  "wrong unit (um given as mm?) or nominal instead of deviation values")
         raise InputError(f"{where}: column {col}: deviations up to {big:g} mm are implausible "
                          f"for {what}: {cause}")
