@@ -179,9 +179,12 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
             bad = (ql[:, i] < lo - 1e-9) | (ql[:, i] > hi + 1e-9)
             if bad.any():
                 k = int(np.argmax(bad))
-                raise InputError(f"line {numbers[k]}: {a} = {q_nom[k, i]:g} is outside "
-                                 f"the measured range {lo:g} .. {hi:g} of error table {a} "
-                                 "(--extrapolate to evaluate beyond it)")
+                from ..tables.table import range_cause
+
+                why = range_cause(a, lo, hi, float(ql[k, i]), getattr(em.funcs, "source", ""))
+                raise InputError(f"{why}line {numbers[k]}: {a} = {q_nom[k, i]:g} is outside "
+                                 f"the measured range {lo:g} .. {hi:g} of error table {a}"
+                                 + ("" if why else " (--extrapolate to evaluate beyond it)"))
 
 
 # ---------------------------------------------------------------------------------------

@@ -742,9 +742,6 @@ def test_compensate_tables_headed_mm_over_um(ex, tmp_path, capsys):
             "Z.csv", ("EXZ_mm", "EYZ_mm", "EZZ_mm", "_mm"), ("um", "µm", "unit"))
 
 
-@xfail("refused (exit 2, nothing written) but names no file and no cause: 'line 6: B = 21.2747 "
-       "is outside the measured range 0 .. 3.14159 of error table B (--extrapolate to evaluate "
-       "beyond it)' -- a table range of 0..pi is radians, and --extrapolate is the wrong advice")
 def test_compensate_rotary_table_angles_in_radians(ex, tmp_path, capsys):
     """B.csv tabulated at radians (0, 0.157, ...) under a B column of degrees."""
     e = copy_dir(ex / "dmu50" / "errors", tmp_path / "err")
