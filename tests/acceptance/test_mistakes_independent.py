@@ -359,9 +359,6 @@ def test_ballplate_nominal_positions_in_inches(ex, tmp_path, capsys):
             ("u_mm", "v_mm", "w_mm"), ("inch", "unit"))
 
 
-@xfail("refused (exit 2, nothing written) but the line names no column and the wrong cause: "
-       "'bp_xy.csv: row 22: the measured point puts Y at 610.132, outside the travel of layout "
-       "MB1: layout mismatch' -- swapped x_mm/y_mm columns are not suggested")
 def test_ballplate_x_and_y_swapped(ex, tmp_path, capsys):
     f = mutate(ex / PLATE, tmp_path / "bp_xy.csv",
                lambda d: d.rename(columns={"x_mm": "y_mm", "y_mm": "x_mm"}))
