@@ -462,10 +462,6 @@ def test_probecal_sphere_radius_in_um(ex, tmp_path, capsys):
             "--sphere-radius", (), ("um", "µm", "unit", "mm"))
 
 
-@xfail("refused (exit 2, nothing written) but the line names no file and blames the option: "
-       "'fitted radius of the ball centres 1.02374 mm minus the sphere radius 25.006 mm gives a "
-       "stylus-ball radius -23.98 mm <= 0: check --sphere-radius ...; likely the radius in um "
-       "(0.025006 mm would fit)?' -- the points are in inches, the radius is right")
 def test_probecal_points_in_inches(ex, tmp_path, capsys):
     f = mutate(ex / PROBE, tmp_path / "ps_in.csv", scale(("x", "y", "z"), 1.0 / INCH))
     refused(capsys, pc_argv(f, tmp_path, "--sphere-radius", "25.006"), pc_outs(tmp_path),
