@@ -840,8 +840,6 @@ def test_deviations_dx_and_dy_columns_swapped(ex, tmp_path, capsys):
             ("swap", "residual", "chi"))
 
 
-@xfail("NOT refused: exit 0, bb.json, bb.png, bb.html written; the traces are labelled cw/ccw "
-       "from the inverted column although the X, Y sequence runs the other way")
 def test_ballbar_direction_column_inverted(ex, tmp_path, capsys):
     """direction +1/-1 exchanged: the positions run counter-clockwise where the column says
     clockwise (the sense of the trace is in the X, Y sequence itself)."""
