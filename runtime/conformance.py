@@ -70,7 +70,7 @@ def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
         v, unit = parse_quantity(value, f"{option} {allowed[key]}={value.strip()}",
                                  default_unit="um", kinds=("length",), positive=False)
         v = convert(v, unit, "um")
-        check_tolerance_um(v, f"{option} {allowed[key]}={value.strip()}", unit)
+        check_tolerance_um(v, f"{option} {allowed[key]}={value.strip()}", unit, allowed[key])
         require(math.isfinite(v) and 0 < v <= 1e6,
                 f"{option}: {allowed[key]} = {value.strip()} must be a positive number of um "
                 f"(at most 1e6)")

@@ -284,13 +284,15 @@ def check_offset_mm(vector, where: str, limit_mm: float, what: str = "offset") -
 TOLERANCE_FLOOR_UM = 0.1
 
 
-def check_tolerance_um(value_um: float, where: str, unit: str = "um") -> float:
+def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "") -> float:
     """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM`; else one-line
     :class:`InputError` naming ``where``: below any machine's tolerance, likely given in mm
-    (``unit``: as the user wrote it; bare numbers are um)."""
+    (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for the
+    suggested spelling ``A=0.012 mm``)."""
     if value_um >= TOLERANCE_FLOOR_UM or value_um <= 0:
         return value_um
-    hint = (f"likely meant in mm: write {value_um:g} mm" if unit == "um"
+    hint = (f"likely meant in mm: write {name + '=' if name else ''}{value_um:g} mm"
+            if unit == "um"
             else "a wrong unit?")
     raise InputError(f"{where}: {value_um:g} um is below any machine's tolerance "
                      f"({TOLERANCE_FLOOR_UM:g} um): {hint}")
