@@ -65,11 +65,12 @@ def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
         require(key in allowed, f"{option}: unknown quantity {key!r}; one of "
                                 f"{' '.join(names)}")
         require(allowed[key] not in out, f"{option}: {allowed[key]} given twice")
-        from .units import convert, parse_quantity   # a bare number: um, as documented
+        from .units import check_tolerance_um, convert, parse_quantity   # bare: um
 
         v, unit = parse_quantity(value, f"{option} {allowed[key]}={value.strip()}",
                                  default_unit="um", kinds=("length",), positive=False)
         v = convert(v, unit, "um")
+        check_tolerance_um(v, f"{option} {allowed[key]}={value.strip()}", unit, allowed[key])
         require(math.isfinite(v) and 0 < v <= 1e6,
                 f"{option}: {allowed[key]} = {value.strip()} must be a positive number of um "
                 f"(at most 1e6)")

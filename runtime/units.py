@@ -211,3 +211,102 @@ def parse_date(text, where: str = "--date", future: bool = False) -> str:
         raise InputError(f"{where} {t} is in the future (today is {now} UTC); a result is "
                          f"dated when it was measured")
     return d.isoformat()
+
+
+# -- plausibility of option values typed in the wrong unit ----------------------------------
+#: a temperature read in degC (a room, a structure, a motor, a part) lies in this range; a
+#: value beyond it is not degC (degF: 68 degF = 20 degC)
+TEMPERATURE_RANGE_C = (-10.0, 80.0)
+#: the material temperature of a measured scale or part (ISO 230-2, ISO 1): degC
+MATERIAL_TEMPERATURE_RANGE_C = (-10.0, 50.0)
+#: no material's expansion coefficient reaches this, ppm/K (Zerodur class 0: 0.02 ppm/K)
+CTE_FLOOR_PPM_PER_K = 1e-3
+#: no solid's expansion coefficient reaches this, ppm/K (polymers: about 200 ppm/K)
+CTE_CEILING_PPM_PER_K = 1e3
+
+
+def check_temperature_C(value: float, where: str,
+                        low_high: tuple = TEMPERATURE_RANGE_C) -> float:
+    """``value`` (degC) returned when finite and in ``low_high``; else one-line
+    :class:`InputError` naming ``where``, with ``"degF?"`` when the value read as degF
+    (``(F - 32) x 5/9``) falls in the range (68 -> 20 degC)."""
+    lo, hi = low_high
+    if not math.isfinite(value):
+        raise InputError(f"{where}: {value} is not a finite temperature")
+    if lo <= value <= hi:
+        return float(value)
+    as_c = (value - 32.0) * 5.0 / 9.0
+    hint = (f"likely in degF (Fahrenheit: {value:g} degF = {as_c:.1f} degC); give degC"
+            if lo <= as_c <= hi else "not a temperature in degC (in K? a wrong column?)")
+    raise InputError(f"{where} = {value:g} is outside {lo:g} .. {hi:g} degC: {hint}")
+
+
+def check_cte(value: float, where: str, unit: str = "ppm/K") -> float:
+    """An expansion coefficient in ``unit`` (``"ppm/K"`` or ``"1/K"``) returned when finite and
+    0 or of a material's size (|alpha| between 1e-3 and 1e3 ppm/K); else one-line
+    :class:`InputError` naming ``where`` and the likely unit (11.5e-6 typed for ppm/K is
+    1/K; 11.5 typed for 1/K is ppm/K).  Sign: any (a negative coefficient exists)."""
+    if not math.isfinite(value):
+        raise InputError(f"{where}: {value} is not a finite number")
+    ppm = abs(value) * (1e6 if unit == "1/K" else 1.0)
+    if value == 0 or CTE_FLOOR_PPM_PER_K <= ppm <= CTE_CEILING_PPM_PER_K:
+        return float(value)
+    if unit == "1/K":
+        raise InputError(f"{where} = {value:g} 1/K is {ppm:g} ppm/K, beyond any material: "
+                         f"likely given in ppm/K; give 1/K ({value:g} ppm/K = "
+                         f"{value * 1e-6:g} 1/K)")
+    hint = (f"likely given in 1/K; give ppm/K ({value:g} 1/K = {value * 1e6:g} ppm/K)"
+            if ppm < CTE_FLOOR_PPM_PER_K else "no material expands this much (a wrong unit?)")
+    raise InputError(f"{where} = {value:g} ppm/K is beyond any material's expansion "
+                     f"coefficient ({CTE_FLOOR_PPM_PER_K:g} .. {CTE_CEILING_PPM_PER_K:g} "
+                     f"ppm/K): {hint}")
+
+
+def check_offset_mm(vector, where: str, limit_mm: float, what: str = "offset") -> tuple:
+    """An offset vector (mm) returned as a tuple of floats when finite and no longer than
+    ``limit_mm`` (the machine's size: a stylus or a tool cannot be longer than the machine);
+    else one-line :class:`InputError` naming ``where`` and the likely unit (um typed for
+    mm, when the length / 1000 fits)."""
+    v = tuple(float(x) for x in vector)
+    if not all(math.isfinite(x) for x in v):
+        raise InputError(f"{where}: the {what} must be finite numbers (mm)")
+    n = math.sqrt(sum(x * x for x in v))
+    if n <= limit_mm:
+        return v
+    hint = ("likely given in um; give mm" if n * MM_PER_UM <= limit_mm
+            else "a wrong unit?")
+    raise InputError(f"{where} {' '.join(f'{x:g}' for x in v)}: an {what} {n:g} mm long, "
+                     f"longer than the machine ({limit_mm:g} mm): {hint}")
+
+
+#: no tolerance or MPE of a machine tool or CMM is below this, um (the best CMMs: MPE
+#: 0.3 um + L/1000; an ISO 230-2 tolerance is a micrometre or more)
+TOLERANCE_FLOOR_UM = 0.1
+
+
+def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "") -> float:
+    """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM`; else one-line
+    :class:`InputError` naming ``where``: below any machine's tolerance, likely given in mm
+    (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for the
+    suggested spelling ``A=0.012 mm``)."""
+    if value_um >= TOLERANCE_FLOOR_UM or value_um <= 0:
+        return value_um
+    hint = (f"likely meant in mm: write {name + '=' if name else ''}{value_um:g} mm"
+            if unit == "um"
+            else "a wrong unit?")
+    raise InputError(f"{where}: {value_um:g} um is below any machine's tolerance "
+                     f"({TOLERANCE_FLOOR_UM:g} um): {hint}")
+
+
+def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
+    """A tool offset in the tool frame (mm, from the point the axis positions refer to, the
+    spindle gauge point, to the tool tip: ``0 0 -L`` for a tool L long, docs/conventions.md)
+    returned when :func:`check_offset_mm` accepts it and its z is not positive; a positive z
+    puts the tip inside the spindle: refused as the likely sign (one line naming ``where``)."""
+    v = check_offset_mm(vector, where, limit_mm, "offset")
+    if v[2] > 0:
+        raise InputError(f"{where} {' '.join(f'{x:g}' for x in v)}: a tool offset with z = "
+                         f"+{v[2]:g} mm puts the tip inside the spindle; the offset of a tool "
+                         f"L long is 0 0 -L: likely the sign (write {v[0]:g} {v[1]:g} "
+                         f"{-v[2]:g}, or --tool-length {v[2]:g})")
+    return v

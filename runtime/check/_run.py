@@ -87,7 +87,7 @@ def check(layout, files, *, reference, tolerance: str | None = None,
     if tolerance is not None:
         from ._tolerance import parse
 
-        tol = parse(tolerance, ref)
+        tol = parse(tolerance, ref, model)
     with threadpool_limits(limits=1, user_api="blas"):
         parts = instruments.read_parts(files, model)
         obs = instruments.stack(parts)

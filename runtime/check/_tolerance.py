@@ -3,8 +3,8 @@ decision rule, as the certificates (:mod:`volerr.conformance`): each quantity ag
 limit with the expanded uncertainty ``U = 2 u`` (k = 2) from the covariance after the check.
 
 Grammar: ``NAME=VALUE [UNIT],...`` with ``NAME`` a parameter of the reference (its ``|value|``
-against ``VALUE`` in the parameter's unit; a unit given must be of its kind and is converted,
-:func:`volerr.units.parse_quantity`) or ``map`` (the largest
+against ``VALUE UNIT``: the unit is required and must be of its kind, it is converted,
+:func:`volerr.units.parse_quantity`; a limit beyond :mod:`volerr.tables.plausible` is refused) or ``map`` (the largest
 length of the volumetric error over the working volume, um).  Example:
 ``"EX0C=20 um,EA0B=40 urad,map=30 um"``.
 """
@@ -14,13 +14,21 @@ from __future__ import annotations
 import math
 
 from .. import conformance
-from ..errors import require
+from ..errors import InputError, require
 from ..units import convert, parse_quantity
 from . import _volume
 
 
-def parse(text: str, ref) -> dict:
-    """``{NAME: limit}`` (the parameter's unit; ``map``: um); one-line InputError."""
+def parse(text: str, ref, model=None) -> dict:
+    """``{NAME: limit}`` (the parameter's unit; ``map``: um); one-line InputError.
+
+    Every VALUE needs its unit (issue 43: ``EX0C=22`` is refused, as ``history show`` does).
+    A limit beyond what any machine of ``model``'s size can have
+    (:mod:`volerr.tables.plausible`: ``EX0C=22 mm``, um typed as mm) is refused naming the
+    likely unit."""
+    from ..tables import plausible
+
+    limits = plausible.limits_for(model)
     units = dict(zip(ref.names, ref.units))
     out = {}
     parts = [p.strip() for p in str(text).replace("|", ",").split(",") if p.strip()]
@@ -35,15 +43,39 @@ def parse(text: str, ref) -> dict:
                                               f"parameter of the reference "
                                               f"({', '.join(ref.names[:8])} ...)")
         unit = "um" if key == "map" else units[key]
-        # a bare number is in the parameter's unit (documented); a unit given is converted
-        v, given = parse_quantity(rest, f"--tolerance {part}", default_unit=unit,
-                                  positive=False)
+        # every value with its unit (issue 43 item 5); a unit given is converted
+        v, given = parse_quantity(rest, f"--tolerance {part}", positive=False,
+                                  any_unit=given_unit_any(unit))
         v = convert(v, given, unit, f"--tolerance {name}")
+        _plausible(v, unit, given, part, limits)
         require(math.isfinite(v) and v > 0, f"--tolerance: {name} = {rest.strip()!r} must be "
                                             f"a positive number")
         require(key not in out, f"--tolerance: {name} given twice")
         out[key] = v
     return out
+
+
+def given_unit_any(unit: str) -> bool:
+    """A parameter unit outside :data:`volerr.units.QUANTITY_UNITS` (a slope, ``um/mm``) is
+    given as written."""
+    from ..units import QUANTITY_UNITS
+
+    return unit not in QUANTITY_UNITS
+
+
+def _plausible(v: float, unit: str, given: str, part: str, limits) -> None:
+    """Refuse a limit beyond the magnitude rule (:mod:`volerr.tables.plausible`)."""
+    from ..units import QUANTITY_UNITS
+
+    kind = QUANTITY_UNITS.get(unit, (None,))[0]
+    if kind is None:
+        return
+    internal = convert(v, unit, "mm" if kind == "length" else "rad")
+    if internal > limits.of(kind):
+        small = "um" if kind == "length" else "urad"
+        raise InputError(f"--tolerance {part}: {kind} limit {v:g} {unit} is beyond what any "
+                         f"machine of this size can have ({limits.rule(kind)}); likely meant "
+                         f"in {small}, not {given}")
 
 
 def decide(limits: dict, result) -> dict:

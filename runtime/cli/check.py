@@ -60,10 +60,10 @@ def register(sub) -> None:
                         "(default 5)")
     p.add_argument("--out", metavar="DIR", help="check plan: folder of the check's files")
     p.add_argument("--tolerance", metavar="T",
-                   help="check: \"NAME=VALUE [UNIT],...,map=VALUE um\": each parameter's "
+                   help="check: \"NAME=VALUE UNIT,...,map=VALUE um\": each parameter's "
                         "|value| and the largest volumetric error after the check against "
-                        "its limit (ISO 14253-1, U = 2 u); a bare VALUE is in the "
-                        "parameter's unit, a unit given is converted")
+                        "its limit (ISO 14253-1, U = 2 u); every VALUE needs its unit "
+                        "(converted to the parameter's)")
     p.add_argument("--date", metavar="YYYY-MM-DD", help="check: the date of the check, not "
                                                         "after today (carried into the JSON)")
     add_json(p, "the check plan or the check's result")

@@ -100,6 +100,7 @@ def register(sub) -> None:
 #: captions of the report's figures
 def _temperature(args):
     from ..uncertainty import ensemble
+    from ..units import check_cte
 
     vals = {k: getattr(args, k) for k in ("part_cte", "part_dt", "scale_cte", "scale_dt")}
     if all(v is None for v in vals.values()):
@@ -109,6 +110,8 @@ def _temperature(args):
         v = v or (0.0, 0.0)
         require(all(abs(x) < 1e3 for x in v) and v[1] >= 0,
                 f"--{k.replace('_', '-')}: value and a non-negative u")
+        if k.endswith("cte"):   # in 1/K: 11.5 (ppm/K typed) refused, naming the unit
+            check_cte(v[0], f"--{k.replace('_', '-')}", "1/K")
         kw[k], kw[f"u_{k}"] = float(v[0]), float(v[1])
     return ensemble.Temperature(**kw, compensated=args.temperature_compensated)
 

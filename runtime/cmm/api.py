@@ -90,6 +90,10 @@ def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
     from . import volmap
 
     model = layout if isinstance(layout, Model) else load(layout)
+    from ..tables.plausible import DEFAULT_SIZE_MM, machine_size
+    from ..units import check_offset_mm
+
+    probe = check_offset_mm(probe, "--probe", machine_size(model) or DEFAULT_SIZE_MM, "offset")
     funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
         errors, model, method=method, degree=degree, extrapolate=extrapolate)
     grid = [grid] if isinstance(grid, int) else grid

@@ -84,6 +84,10 @@ class Options:
                 "the thesis strategy does not compensate the orientation")
         tool = np.asarray(self.tool, dtype=float)
         require(tool.shape == (3,) and np.all(np.isfinite(tool)), "tool offset must be 3 numbers")
+        from ..tables.plausible import DEFAULT_SIZE_MM, machine_size
+        from ..units import check_tool_offset
+
+        check_tool_offset(tool, "--tool", machine_size(model) or DEFAULT_SIZE_MM)
         tool = _tool_of_length(tool, self.tool_length)
         for a in self.initial or {}:
             require(a in model.axes, f"{model.name}: unknown axis {a!r} in the initial position")
@@ -175,9 +179,12 @@ def check_positions(blocks: Blocks, em, opts: Options) -> None:
             bad = (ql[:, i] < lo - 1e-9) | (ql[:, i] > hi + 1e-9)
             if bad.any():
                 k = int(np.argmax(bad))
-                raise InputError(f"line {numbers[k]}: {a} = {q_nom[k, i]:g} is outside "
-                                 f"the measured range {lo:g} .. {hi:g} of error table {a} "
-                                 "(--extrapolate to evaluate beyond it)")
+                from ..tables.table import range_cause
+
+                why = range_cause(a, lo, hi, float(ql[k, i]), getattr(em.funcs, "source", ""))
+                raise InputError(f"{why}line {numbers[k]}: {a} = {q_nom[k, i]:g} is outside "
+                                 f"the measured range {lo:g} .. {hi:g} of error table {a}"
+                                 + ("" if why else " (--extrapolate to evaluate beyond it)"))
 
 
 # ---------------------------------------------------------------------------------------

@@ -93,6 +93,9 @@ def likely_cause(kind, pts, steps, d, o, senses, others) -> str:
     for name, (k2, d2) in others.items():
         if k2 == kind and fits(dd=np.asarray(d2, dtype=float)):
             found.append(f"a file of axis {name} (the points move as {name} does)")
+    if kind == "linear":
+        found += [f"the position column in {u}, not mm" for u, f in _UNITS
+                  if fits(st=steps * f)]
     if kind == "rotary" and fits(st=np.degrees(steps)):
         found.append("positions in rad, not deg")
     if found:

@@ -638,6 +638,45 @@ def _flag_outliers(rnd, resid, W, sigma, n, k):
     return out
 
 
+def _check_travel(rounds, layout, axis: str) -> None:
+    """Refuse commanded positions outside the travel of ``axis`` of ``layout`` (one line
+    naming the file and the column position: a file of another machine, a wrong layout)."""
+    ax = layout.axes.get(axis)
+    if ax is None or not rounds:
+        return
+    lo, hi = (float(v) for v in ax.travel)
+    pos = np.concatenate([np.asarray(r.positions, dtype=float) for r in rounds])
+    pad = 1e-6 * max(1.0, hi - lo)
+    bad = pos[(pos < lo - pad) | (pos > hi + pad)]
+    if bad.size:
+        unit = "deg" if ax.kind == "rotary" else "mm"
+        raise InputError(f"{rounds[0].name.rsplit(':', 1)[0]}: column position: {axis} = "
+                         f"{float(bad[np.argmax(np.abs(bad))]):g} {unit} lies outside the travel "
+                         f"of {layout.name}'s {axis} ({lo:g} .. {hi:g} {unit}): a file of another "
+                         f"machine, or the wrong layout?")
+
+
+#: no laser tracker measures closer than this, mm (their ranges start at 0.5 .. 1 m; the
+#: interferometer's figures of :data:`IFM_MPE` hold from there)
+TRACKER_MIN_RANGE_MM = 200.0
+
+
+def _check_tracker_range(tracker: np.ndarray, rounds) -> None:
+    """Refuse a tracker position closer than :data:`TRACKER_MIN_RANGE_MM` to a measured point
+    (one line naming ``--tracker``): a position typed in m (1.5 -2 0.3 for 1500 -2000 300)."""
+    pts = np.concatenate([r.points.reshape(-1, 3) for r in rounds])
+    near = float(np.min(np.linalg.norm(pts - tracker, axis=1)))
+    if near >= TRACKER_MIN_RANGE_MM:
+        return
+    t = " ".join(f"{v:g}" for v in tracker)
+    far = float(np.min(np.linalg.norm(pts - tracker * MM_PER_M, axis=1)))
+    hint = (f"likely given in m: write {' '.join(f'{v * MM_PER_M:g}' for v in tracker)} (mm)"
+            if far >= TRACKER_MIN_RANGE_MM else "a wrong unit or a wrong position?")
+    raise InputError(f"--tracker {t}: the tracker stands {near:.0f} mm from the nearest measured "
+                     f"point, closer than any laser tracker measures "
+                     f"({TRACKER_MIN_RANGE_MM:g} mm); {hint}")
+
+
 def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, direction=None,
              origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
              cross_check: bool = True) -> Identification:
@@ -681,6 +720,7 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         layout = read_layout(layout)
     require(method in ("lsq", "closed"), f"unknown method {method!r} (lsq, closed)")
     kind, d, o = _axis_geometry(layout, axis, direction, origin)
+    _check_travel(rounds, layout, axis)
     others = {n: (a.kind, tuple(np.asarray(a.direction, float) / np.linalg.norm(a.direction)))
               for n, a in layout.axes.items() if n != axis}
     rounds = list(rounds)
@@ -698,6 +738,7 @@ def identify(rounds, layout, axis: str, *, method: str = "lsq", tracker=None, di
         tracker = np.asarray(tracker, dtype=float)
         require(tracker.shape == (3,) and np.all(np.isfinite(tracker)),
                 "tracker position must be three finite numbers (mm)")
+        _check_tracker_range(tracker, rounds)
     # the same point order in every round
     labels = rounds[0].labels
     aligned = []

@@ -301,6 +301,19 @@ def check_rounds(rounds: list[Round]) -> None:
             raise InputError(f"rounds {first.name} and {r.name} have different positions "
                              f"(e.g. {extra[0]:g} in one only); every round must visit the "
                              f"same commanded positions")
+    _constant_coordinate(rounds)
+
+
+def _constant_coordinate(rounds: list[Round]) -> None:
+    """Refuse a coordinate column (x, y or z) that reads exactly 0 for every point of every
+    round: no tracker reads points exactly in a coordinate plane through a whole axis' travel
+    (a 2-D export, a zero-filled column).  One line naming the file and the column."""
+    pts = np.concatenate([r.points.reshape(-1, 3) for r in rounds])
+    for j, c in enumerate("xyz"):
+        if pts.shape[0] > 1 and not np.any(pts[:, j]):
+            raise InputError(f"{rounds[0].name.rsplit(':', 1)[0]}: column {c} is constant "
+                             f"(every value 0 mm): a 2-D export or a zero-filled "
+                             f"column? a tracker reads three coordinates of every point")
 
 
 def example_path(axis: str):

@@ -184,6 +184,30 @@ def _raw_rows(path) -> tuple[list, list]:
     return comments, rows
 
 
+#: the largest thermal drift of a displacement channel over a test, mm: spindle and structure
+#: drifts are micrometres to a few hundred micrometres; 1 mm or more is um under a (mm) header
+MAX_DRIFT_RANGE_MM = 1.0
+
+
+def _check_mm_drift(cells, head: str, where: str) -> None:
+    """Refuse a channel headed mm whose range over the test is :data:`MAX_DRIFT_RANGE_MM` or
+    more (one line naming the file and the column: likely um under a (mm) header)."""
+    vals = []
+    for c in cells:
+        try:
+            vals.append(float(c))
+        except ValueError:
+            continue    # the reader names a cell that is not a number
+    vals = [v for v in vals if v == v and abs(v) != float("inf")]
+    if len(vals) < 2:
+        return
+    span = max(vals) - min(vals)
+    require(span < MAX_DRIFT_RANGE_MM,
+            f"{where}: column {head} drifts by {span:g} mm over the test, beyond any thermal "
+            f"drift ({MAX_DRIFT_RANGE_MM:g} mm): likely readings in um under a (mm) header; "
+            f"head it (um)")
+
+
 def _scaled(cell: str, factor: float) -> str:
     """A cell multiplied by ``factor`` (the cell as it was when ``factor`` is 1 or it is not a
     number: the reader names it)."""
@@ -246,6 +270,9 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
             names[j] = n[:-3] + "_um"
         else:
             factors.append(1.0)
+    for j, f in enumerate(factors):
+        if f == 1000.0:
+            _check_mm_drift([r[j] for r in rows[1:] if j < len(r)], rows[0][j], where)
     twice = sorted({n for n in names if names.count(n) > 1})
     require(not twice, f"{where}: two columns become the same drift column "
                        f"({', '.join(twice)}); name one with --map")

@@ -9,7 +9,7 @@ import re
 
 import numpy as np
 
-from ..errors import require
+from ..errors import InputError, require
 
 AXIS_NAMES = "XYZUVWABC"
 
@@ -185,7 +185,7 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
              what: str = "an error map") -> np.ndarray:
     """Readings (n, len(names)) mm from columns ``<name>_um`` or ``<name>_mm``,
     plausibility-checked."""
-    out = np.zeros((n, len(names)))
+    out, heads = np.zeros((n, len(names))), []
     for i, d in enumerate(names):
         require(find.name(d) is None, f"{where}: deviation column {d} has no unit suffix "
                 f"(use {d}_um or {d}_mm)")
@@ -196,9 +196,15 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
                     f"supported (use {d}_um or {d}_mm)")
         require(c_um or c_mm, f"{where}: missing deviation column {d}_um (or {d}_mm)")
         out[:, i] = find.cols[c_um] * 1e-3 if c_um else find.cols[c_mm]
+        heads.append(c_um or c_mm)
     big = float(np.max(np.abs(out))) if out.size else 0.0
-    require(big < limit_mm, f"{where}: deviations up to {big:g} mm are implausible for "
-            f"{what}: wrong unit (um given as mm?) or nominal instead of deviation values")
+    if big >= limit_mm:
+        col = heads[int(np.argmax(np.max(np.abs(out), axis=0)))]
+        cause = ("wrong unit: likely nm under the _um header (give um), or nominal instead of "
+                 "deviation values" if col.lower().endswith("_um") and big * 1e-3 < limit_mm else
+                 "wrong unit (um given as mm?) or nominal instead of deviation values")
+        raise InputError(f"{where}: column {col}: deviations up to {big:g} mm are implausible "
+                         f"for {what}: {cause}")
     return out
 
 
@@ -249,10 +255,59 @@ def labels(find: Finder, name: str, raw: dict, n: int) -> np.ndarray | None:
     return np.asarray([f"{x:g}" for x in v], dtype=object)
 
 
+#: temperature columns of a room, the air, the structure or the material: degC in this range
+#: (a workshop's or a structure's temperature is never above 50 degC); other ``T_*`` columns
+#: (spindle, motor, coolant) in :data:`volerr.units.TEMPERATURE_RANGE_C`
+_AMBIENT_RX = re.compile(r"^T(_C)?$|room|air|amb|env|hall|material|part|scale|struct|bed|base",
+                         re.IGNORECASE)
+AMBIENT_RANGE_C = (-10.0, 50.0)
+#: the longest time axis of one file, s (30 days): a drift test or a calibration campaign lasts
+#: hours to days; a longer ``t_s`` is milliseconds read as seconds
+LONGEST_TIME_S = 30 * 86400.0
+
+
+def is_temperature(name: str) -> bool:
+    """A temperature column (degC): ``T``, ``T_C``, ``T_<label>``, ``<label>_T_C``."""
+    return re.fullmatch(r"T(_\w+)?|\w+_T_C", name) is not None
+
+
+def check_temperature(values, name: str, where: str) -> None:
+    """Refuse a temperature column (``name``, degC) outside the range of its kind (room /
+    structure / material: -10 .. 50 degC, else -10 .. 80 degC): one line naming the file and
+    the column, ``degF`` when the values read as Fahrenheit fit (68 -> 20 degC)."""
+    from ..units import TEMPERATURE_RANGE_C, check_temperature_C
+
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return
+    rng = AMBIENT_RANGE_C if _AMBIENT_RX.search(name) else TEMPERATURE_RANGE_C
+    worst = float(v.max()) if v.max() - rng[1] >= rng[0] - v.min() else float(v.min())
+    check_temperature_C(worst, f"{where}: column {name}", rng)
+
+
+def check_time(t, name: str, where: str) -> None:
+    """Refuse a time column (s) spanning more than :data:`LONGEST_TIME_S` (one line naming
+    the file and the column: likely milliseconds read as seconds)."""
+    t = np.asarray(t, dtype=float)
+    t = t[np.isfinite(t)]
+    span = float(t.max() - t.min()) if t.size else 0.0
+    require(span <= LONGEST_TIME_S,
+            f"{where}: column {name} spans {span:g} s ({span / 86400:.0f} days) in one file, "
+            f"longer than a drift test or a calibration lasts: likely in ms, not s "
+            f"({span / 1000:g} s = {span / 3.6e6:.3g} h); give seconds")
+
+
 def covariates(find: Finder, model, where: str, skip=()) -> dict:
-    """Every numeric column not used by the reader (temperatures, times, directions ...)."""
+    """Every numeric column not used by the reader (temperatures, times, directions ...);
+    temperatures (:func:`check_temperature`) and ``t_s`` (:func:`check_time`) checked."""
     skip = {s.lower() for s in skip}
     covs = {c: v for c, v in find.cols.items() if c not in find.used and c.lower() not in skip}
+    for c, v in covs.items():
+        if is_temperature(c):
+            check_temperature(v, c, where)
+        elif c == "t_s":
+            check_time(v, c, where)
     missing = [c for c in model.covariates if c not in covs]
     require(not missing, f"{where}: layout {model.name} needs covariate column "
             f"{missing[0] if missing else ''}")

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import require
+from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
@@ -104,13 +104,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     u = f.uncertainty_named(find, "probe_u", n, DEFAULT_U_UM, where)
     u_std = _calibration_uncertainty(find, n, where)
     pos = model.linear_positions(measured, rotary, probe)
-    for a in lin_axes:
-        lo, hi = model.travel[a]
-        margin = 0.05 * (hi - lo)
-        bad = np.flatnonzero((pos[a] < lo - margin) | (pos[a] > hi + margin))
-        require(len(bad) == 0, f"{where}: row {bad[0] + 2 if len(bad) else 0}: the measured "
-                f"point puts {a} at {pos[a][bad[0]] if len(bad) else 0:g}, outside the travel "
-                f"of layout {model.name}: layout mismatch")
+    _inside_travel(model, pos, lin_axes, where)
     t = model.nominal_position(pos, probe)
     names, gidx = np.unique(placement.astype(str), return_inverse=True)
     gidx = gidx.ravel()
@@ -139,6 +133,30 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     return Observations(pos, probe, -lin[:, :, 0], covs, warnings, proj=lin[:, :, 1:4],
                         rows=rows, setup=setup, files=(FileInfo(where, KIND, "um", 3),),
                         sigma=u, info=info)
+
+
+def _inside_travel(model, pos: dict, lin_axes, where) -> None:
+    """Refuse a measured point whose axis positions lie outside the travel, naming the likely
+    cause (:func:`volerr.instruments.geometry_check.travel_cause`: swapped x_mm / y_mm ...,
+    another machine), else "layout mismatch"."""
+    import re
+
+    from .geometry_check import travel_cause
+
+    for a in lin_axes:
+        lo, hi = model.travel[a]
+        margin = 0.05 * (hi - lo)
+        bad = np.flatnonzero((pos[a] < lo - margin) | (pos[a] > hi + margin))
+        if not len(bad):
+            continue
+        cause = travel_cause(model, pos)
+        m = re.fullmatch(r"columns ([XYZ]) and ([XYZ]) swapped", cause or "")
+        if m:
+            cause = (f"columns {m.group(1).lower()}_mm and {m.group(2).lower()}_mm swapped "
+                     f"(exchanged, every point lies inside the travel)")
+        raise InputError(f"{where}: row {bad[0] + 2}: the measured point puts {a} at "
+                         f"{pos[a][bad[0]]:g}, outside the travel of layout {model.name}: "
+                         + (f"likely {cause}" if cause else "layout mismatch"))
 
 
 def check_geometry(model, placement, point, measured, where) -> None:

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import require
+from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
@@ -185,6 +185,8 @@ def split_traces(rel, pivot, length, placement, direction, direction_given, swep
                                   swept)
     if not direction_given:
         direction = _trace_senses(rel, trace, swept)
+    else:
+        _check_senses(rel, trace, swept, direction, placement, where)
     for k in np.unique(trace):
         idx = np.flatnonzero(trace == k)
         if not swept[idx].any():
@@ -305,6 +307,34 @@ def _trace_senses(rel, trace, swept) -> np.ndarray:
             continue
         out[idx] = -1.0 if np.sum(_steps(rel[idx], _trace_plane(rel[idx]))) < 0 else 1.0
     return out
+
+
+#: a trace's readings run in one sense when at least this share of its steps turn that way
+#: (rows in the order they were measured; a shuffled or sorted file is not judged)
+SENSE_SHARE = 0.9
+
+
+def _check_senses(rel, trace, swept, direction, placement, where: str) -> None:
+    """Refuse a ``direction`` column that contradicts the sense in which the trace's positions
+    run (one line naming the file and the column): every step of a circle trace turns one
+    way (:data:`SENSE_SHARE` of them), and that way is not the column's +1 (ccw) / -1 (cw)."""
+    for k in np.unique(trace):
+        idx = np.flatnonzero(trace == k)
+        if swept[idx].any() or len(idx) < MIN_TRACE_READINGS:
+            continue
+        steps = _steps(rel[idx], _trace_plane(rel[idx]))[1:]
+        steps = steps[np.abs(steps) > 1e-9]
+        if not len(steps) or np.max(np.abs(steps)) > np.radians(45.0):
+            continue        # not a sequence of neighbouring readings: not judged
+        share = float(np.mean(steps > 0))
+        sense = 1.0 if share >= SENSE_SHARE else -1.0 if share <= 1 - SENSE_SHARE else 0.0
+        if sense and sense != direction[idx[0]]:
+            said = "+1 (ccw)" if direction[idx[0]] > 0 else "-1 (cw)"
+            runs = "counter-clockwise" if sense > 0 else "clockwise"
+            raise InputError(f"{where}: column direction: trace "
+                             f"{_label(placement, rel, idx)} says {said} but its positions "
+                             f"run {runs}: the direction column inverted (cw/ccw swapped), or "
+                             f"the rows not in the order they were measured")
 
 
 def check_trace(rel, where: str, label: str, direction) -> None:

@@ -150,7 +150,9 @@ def check_geometry(model, pos, probe, station, d, column, start, where) -> None:
         pos, probe, {"the distances": d}, {"the distances": column},
         gc.distances_misfit(names, locate, FIT_TOLERANCE_MM)),
         extra=[("distances in m (x 1000 makes the file consistent)", column,
-                {"the distances": d * 1000.0})])
+                {"the distances": d * 1000.0}),
+               ("distances in um, not mm (/ 1000 makes the file consistent)", column,
+                {"the distances": d * 1e-3})])
 
 
 def _uncertainty(find, dist, where) -> np.ndarray:

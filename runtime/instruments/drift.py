@@ -291,6 +291,10 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None) -
                                          if re.fullmatch(r"[XYZUVWABC](_mm|_deg)?", h)}
     inputs = [h for h in c.numbers if h not in skip]
     _column_defects(c, inputs)
+    f.check_time(t, tcol, where)
+    for h in inputs:
+        if f.is_temperature(h):
+            f.check_temperature(c.numbers[h], h, where)
     notes = _text_inputs(c, skip)
     out = []
     for r, label in enumerate(labels):

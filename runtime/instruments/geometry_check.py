@@ -12,7 +12,9 @@ and keeping the one that makes the file consistent:
 
 * rotary axes in radians (their columns times 180/pi),
 * axis positions and tool offset in inches (times 25.4), or the target's columns in inches,
-* the tool offset with the wrong sign (``Xp, Yp, Zp`` negated),
+* the tool offset with the wrong sign (``Xp, Yp, Zp`` negated), in the wrong column (two of
+  them exchanged), in m or um (x 1000, / 1000),
+* a rotary axis counting the other way (its column negated),
 * two axis columns swapped (``X`` <-> ``Y`` ...),
 * the file of another machine (every shipped layout with the same axes),
 * an instrument's own alternatives (a bar length that is a diameter, distances in m ...).
@@ -24,7 +26,8 @@ pointing from the tool point towards the spindle; a tool of length L hanging bel
 reference point is ``(0, 0, -L)``.  ``docs/conventions.md`` ("Tool and probe offsets") draws it.
 
 A miss no alternative explains is still refused, naming the file, the columns and saying that
-none of the usual mistakes explains it.  Nothing is written: the readers run before outputs.
+none of the usual mistakes explains it -- or, when a rotary axis column holds one value in
+every row, naming that column (the export lost the axis).  Nothing is written: the readers run before outputs.
 """
 
 from __future__ import annotations
@@ -86,6 +89,11 @@ def _alternatives(model, g: Geometry, extra=()):
                f"consistent; the offset is the vector from the reference point to the tool "
                f"point in the tool frame, +z towards the spindle)", names, model, g.pos,
                flipped, g.targets)
+    yield from _offset_alternatives(model, g, off)
+    for a in rot:
+        yield (f"rotary axis {a} counting the other way (sense reversed: with {a} negated the "
+               f"file is consistent; the controller's sign of {a} differs from the layout's)",
+               a, model, {**g.pos, a: -g.pos[a]}, g.probe, g.targets)
     for name, cols in g.target_columns.items():
         yield (f"{name} in inches (x 25.4 makes the file consistent)", cols, model, g.pos,
                g.probe, {**g.targets, name: g.targets[name] * INCH_MM})
@@ -106,6 +114,35 @@ def _alternatives(model, g: Geometry, extra=()):
     for cause, cols, targets in extra:
         yield cause, cols, model, g.pos, g.probe, {**g.targets, **targets}
     yield from _other_layouts(model, g)
+
+
+def _offset_alternatives(model, g: Geometry, off):
+    """The tool offset typed into the wrong column (two of Xp Yp Zp exchanged) or in m / um
+    (x 1000, / 1000): only for a file with a non-zero offset ``off`` (its columns)."""
+    if not off:
+        return
+    for i, j in ((0, 2), (1, 2), (0, 1)):
+        if i in off or j in off:
+            p = g.probe.copy()
+            p[:, [i, j]] = p[:, [j, i]]
+            names = f"{'XYZ'[i]}p, {'XYZ'[j]}p"
+            yield (f"the tool offset in the wrong column ({names} swapped makes the file "
+                   f"consistent)", names, model, g.pos, p, g.targets)
+    names = ", ".join("XYZ"[j] + "p" for j in off)
+    for unit, factor in (("m", 1000.0), ("um", 1e-3)):
+        yield (f"the tool offset in {unit}, not mm (x {factor:g} makes the file consistent)",
+               names, model, g.pos, g.probe * factor, g.targets)
+
+
+def _stuck_rotary(model, g: Geometry) -> str | None:
+    """A rotary axis column holding one value in every row of a file that needs it moving
+    (the export lost the axis): the clause for the refusal, or None."""
+    for a in model.rotary_axes:
+        v = np.asarray(g.pos.get(a, ()), dtype=float)
+        if v.size > 1 and float(np.ptp(v)) == 0.0:
+            return (f"column {a}: constant ({v[0]:g} deg in every row): the rotary axis is "
+                    f"stuck in the export (a lost column?)")
+    return None
 
 
 def _other_layouts(model, g: Geometry):
@@ -157,6 +194,9 @@ def require_consistent(where: str, model, g: Geometry, extra=()) -> None:
     found = diagnose(model, g, extra)
     tail = (f"{miss.text}: the file and layout {model.name} disagree beyond "
             f"{miss.tolerance:g} mm")
+    stuck = _stuck_rotary(model, g) if found is None else None
+    if stuck is not None:
+        raise InputError(f"{where}: {stuck}; {tail}")
     if found is None:
         raise InputError(f"{where}: {tail}; no usual mistake (radians, inches, the tool "
                          f"offset's sign, swapped axis columns, another layout) explains it")

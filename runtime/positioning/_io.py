@@ -353,7 +353,10 @@ def read_run(path, axis: str = "X") -> PositioningRun:
         run = _read_long(path, axis.upper(), header, body, low)
     else:
         run = _read_wide(path, axis.upper(), header, body, low)
-    check_plausible_deviations(run)
+    cols = [h.strip() for h in header
+            if _DEVIATION_RX.match(h.strip()) or wide_column(h) is not None]
+    check_plausible_deviations(run, cols[0] if len(cols) == 1 else
+                               (f"{cols[0]} .. {cols[-1]}" if cols else None))
     return run
 
 
@@ -362,19 +365,34 @@ def read_run(path, axis: str = "X") -> PositioningRun:
 MAX_DEVIATION_MM = 1.0
 
 
-def check_plausible_deviations(run: PositioningRun) -> None:
+def check_plausible_deviations(run: PositioningRun, column: str | None = None) -> None:
     """Refuse deviations a positioning run cannot hold: |x_ij| of :data:`MAX_DEVIATION_MM` or
     more, or more than half the smallest target spacing (the machine would then stand nearer
-    the next target than its own).  Such values are micrometres read under a ``_mm`` header
-    (9.4 um read as 9.4 mm) or a target column in the wrong unit (one line)."""
-    worst = float(np.max(np.abs(run.deviation)))
+    the next target than its own), or every deviation exactly equal (a constant column: no
+    axis repeats to the nanometre; the instrument recorded nothing).  Such values are a unit
+    mistake (nm under a ``_um`` header, um under a ``_mm`` header) or a target column in the
+    wrong unit.  ``column``: the reading column(s) as headed, for the line (one line)."""
+    col = f"column {column}" if column else "the deviation column"
+    d = run.deviation
+    if d.size and float(np.ptp(d)) == 0.0:
+        raise InputError(f"{run.source}: every deviation in {col} is {1e3 * float(d.flat[0]):g} "
+                         f"um, a constant column: no axis repeats exactly (the instrument "
+                         f"recorded nothing? a zero-filled export?)")
+    worst = float(np.max(np.abs(d)))
     spacing = float(np.min(np.diff(run.targets)))
     limit = min(MAX_DEVIATION_MM, 0.5 * spacing)
     if worst >= limit:
-        i = np.unravel_index(int(np.argmax(np.abs(run.deviation))), run.deviation.shape)
+        i = np.unravel_index(int(np.argmax(np.abs(d))), d.shape)
         why = (f"{MAX_DEVIATION_MM:g} mm or more" if limit == MAX_DEVIATION_MM else
                f"more than half the smallest target spacing ({spacing:g} mm)")
+        headed_mm = bool(column) and re.search(r"mm\b|\(mm\)|_mm", column.lower()) is not None
+        if headed_mm:
+            cause = "values in um under a _mm header? the target column in the wrong unit?"
+        elif worst * 1e-3 < limit:
+            cause = (f"values in nm under a um header? ({1e3 * worst:g} nm = {worst:g} um); "
+                     f"give um")
+        else:
+            cause = "a wrong unit? the target column in the wrong unit?"
         raise InputError(
-            f"{run.source}: deviation {1e3 * worst:g} um at target {run.targets[i[0]]:g} mm "
-            f"is {why}: not a positioning deviation (values in um under a _mm header? the "
-            f"target column in the wrong unit?)")
+            f"{run.source}: {col}: deviation {1e3 * worst:g} um at target "
+            f"{run.targets[i[0]]:g} mm is {why}: not a positioning deviation ({cause})")

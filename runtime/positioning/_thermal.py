@@ -65,7 +65,9 @@ def correct_to_20C(run: PositioningRun, cte_ppm_per_K: float, temperature_C: flo
     temperature column (giving both is refused).  Returns (corrected run, what was done)."""
     import math
 
-    require(math.isfinite(cte_ppm_per_K), "--cte-ppm-per-K must be a finite number")
+    from ..units import MATERIAL_TEMPERATURE_RANGE_C, check_cte, check_temperature_C
+
+    check_cte(cte_ppm_per_K, "--cte-ppm-per-K")
     require(math.isfinite(reference_mm), "--cte-reference-mm must be a finite number")
     w = run.source or "positioning run"
     if run.temperature is not None:
@@ -76,8 +78,7 @@ def correct_to_20C(run: PositioningRun, cte_ppm_per_K: float, temperature_C: flo
         require(temperature_C is not None,
                 f"{w}: --cte-ppm-per-K needs the material temperature: a T_C column or "
                 f"--material-temp-C")
-        require(math.isfinite(temperature_C) and -50.0 < temperature_C < 100.0,
-                f"--material-temp-C must be a temperature in degC, got {temperature_C}")
+        check_temperature_C(temperature_C, "--material-temp-C", MATERIAL_TEMPERATURE_RANGE_C)
         T, source = np.full(run.deviation.shape, float(temperature_C)), "option"
     P = run.targets[:, None, None]
     corr = -cte_ppm_per_K * 1e-6 * (T - REFERENCE_C) * (P - reference_mm)   # mm

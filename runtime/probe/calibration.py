@@ -578,8 +578,34 @@ def _calibrate_once(p, used, sphere_radius, phi_deg, theta_deg, tilt_deg, roll_d
         noise=noise, u_center=u_par[:3], u_r_eff=float(u_par[3]), notes=notes)
 
 
+def _check_point_unit(data: SphereData, sphere_radius: float, ball_radius=None) -> None:
+    """Refuse ball centres in inches: their fitted sphere does not fit the declared radius
+    (:func:`check_stylus`) but the points x 25.4 do -- one line naming the file and the
+    columns x, y, z (the radius is then right, the points are not)."""
+    if len(data.points) < MIN_POINTS:
+        return
+    try:
+        r = fit_sphere(data.points).radius
+    except (InputError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return
+
+    def fits(fit_radius):
+        r_eff = fit_radius - sphere_radius
+        if ball_radius is not None:
+            return abs(r_eff - ball_radius) <= TIP_TOLERANCE_MM
+        return MIN_BALL_RADIUS_MM <= r_eff <= MAX_BALL_RADIUS_MM
+
+    if not fits(r) and fits(r * 25.4):
+        raise InputError(f"{data.source or 'probe file'}: columns x, y, z: the ball centres "
+                         f"lie on a {r:.6g} mm sphere, less than --sphere-radius "
+                         f"{sphere_radius:g} mm; x 25.4 they fit it: likely the points in "
+                         f"inches, not mm (give mm)")
+
+
 def calibrate_data(data: SphereData, sphere_radius: float, **kw) -> ProbeCalibration:
-    """:func:`calibrate` on :class:`SphereData` (nominal directions taken when present)."""
+    """:func:`calibrate` on :class:`SphereData` (nominal directions taken when present);
+    points in inches refused first (:func:`_check_point_unit`)."""
+    _check_point_unit(data, sphere_radius, kw.get("ball_radius"))
     return calibrate(data.points, sphere_radius, data.phi_deg, data.theta_deg, **kw)
 
 

@@ -277,7 +277,10 @@ class ErrorFunctions:
                 if bad.any():
                     u = axis_unit(ax)
                     x = v[bad][np.argmax(np.abs(v[bad] - 0.5 * (lo + hi)))]
-                    raise InputError(f"{ax} = {x:g} {u} is outside the measured range "
+                    from .table import range_cause
+
+                    raise InputError(f"{range_cause(ax, lo, hi, float(x), self.source)}"
+                                     f"{ax} = {x:g} {u} is outside the measured range "
                                      f"{lo:g} .. {hi:g} {u} of table {ax} (no extrapolation "
                                      f"unless asked for)")
         return cols, n

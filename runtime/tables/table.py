@@ -117,6 +117,23 @@ def axis_unit(axis: str) -> str:
     return "deg" if axis in ROTARY_LETTERS else "mm"
 
 
+def range_cause(axis: str, lo: float, hi: float, x: float, source: str = "") -> str:
+    """Why a position ``x`` lies outside the measured range ``lo .. hi`` of table ``axis``,
+    when a unit explains it: a rotary table whose positions all lie within +-2 pi and
+    whose range read as radians (x 180/pi) covers ``x`` was tabulated in radians.  Returns
+    ``"<source>/<axis>.csv: column <axis>: ... likely radians, not degrees; "`` or ``""``."""
+    import math
+
+    if axis not in ROTARY_LETTERS or not (-2 * math.pi - 1e-9 <= lo < hi <= 2 * math.pi + 1e-9):
+        return ""
+    dlo, dhi = math.degrees(lo), math.degrees(hi)
+    if not dlo - 1e-6 <= x <= dhi + 1e-6:
+        return ""
+    name = f"{source.rstrip('/')}/{axis}.csv" if source else f"{axis}.csv"
+    return (f"{name}: column {axis}: the table's positions {lo:g} .. {hi:g} are likely "
+            f"radians, not degrees (x 180/pi: {dlo:g} .. {dhi:g} deg); ")
+
+
 def _to_internal(values, unit: str):
     return np.asarray(values, dtype=float) / _DIVISOR[unit]
 

@@ -57,7 +57,7 @@ def parse_spec(text: str, option: str = "--spec") -> Spec:
     """``"E0=A+L/K"`` (A um, K dimensionless), optionally ``",PFTU=P"`` (um).  ``option``:
     the command-line option the text came from, named in the messages.  A and P may carry
     a length unit (``"E0=1.5 um+L/333"``, ``"E0=0.0015mm+L/333"``; bare: um)."""
-    from ..units import convert, parse_quantity
+    from ..units import check_tolerance_um, convert, parse_quantity
 
     t = str(text).replace(" ", "")
     m = re.fullmatch(r"(?:MPE_?)?E0?=" + _LEN + r"\+L/" + _NUM + r"(?:[,;](?:MPE_?)?PFTU=" + _LEN
@@ -72,6 +72,8 @@ def parse_spec(text: str, option: str = "--spec") -> Spec:
 
     a, k = um(m.group(1)), float(m.group(2))
     require(a > 0 and k > 0, f"{option} {text!r}: A and K must be positive")
+    check_tolerance_um(a, f"{option} {text!r}: the constant A",
+                       "mm" if "mm" in m.group(1).lower() else "um")
     p = um(m.group(3)) if m.group(3) else None
     require(p is None or p > 0, f"{option} {text!r}: PFTU must be positive")
     return Spec(a, k, p)

@@ -244,10 +244,13 @@ def test_check_tolerance_converts_to_the_parameters_unit():
     from volerr.check._tolerance import parse
 
     ref = SimpleNamespace(names=["EX0C", "EA0C", "EXX@slope"], units=["um", "urad", "um/m^2"])
-    got = parse("EX0C=0.03 mm, EA0C=2 arcsec, EXX@slope=4, map=0.05 mm", ref)
+    got = parse("EX0C=0.03 mm, EA0C=2 arcsec, EXX@slope=4 um/m^2, map=0.05 mm", ref)
     assert got == pytest.approx({"EX0C": 30.0, "EA0C": 2 * ARCSEC_URAD, "EXX@slope": 4.0,
                                  "map": 50.0}, rel=1e-12)
-    assert parse("EX0C=30", ref) == {"EX0C": 30.0}      # bare: the parameter's unit
+    # issue 43 item 5: every value needs its unit (as history show): a bare one is refused
+    for bare in ("EX0C=30", "EXX@slope=4", "map=30"):
+        with pytest.raises(InputError, match="needs its unit"):
+            parse(bare, ref)
     for text, word in (("EX0C=3 urad", "not a unit of um"), ("EA0C=1 mm", "not a unit of urad"),
                        ("map=3 urad", "not a unit of um"), ("EX0C=1e999 um", "finite")):
         with pytest.raises(InputError, match=word):

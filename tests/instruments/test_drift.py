@@ -146,7 +146,9 @@ def test_unknown_direction(tmp_path, dmu):
 
 
 def test_logger_file_read_and_converted(tmp_path, dmu, capsys):
-    rows = _good_rows()
+    # ch3 logged in mm: a drift of micrometres (0.001 mm), as a real mm channel reads (issue
+    # 43: a (mm) channel drifting by millimetres is refused as um under a (mm) header)
+    rows = [r[:3] + (f"{float(r[3]) / 1000:.7f}",) + r[4:] for r in _good_rows()]
     raw_rows = [(f"{float(r[0]) / 60:g}",) + r[1:] + ("ok",) for r in rows]
     raw = _write(tmp_path / "logger.csv", "Time(min),ch1(um),ch2(µm),ch3(mm),t1(°C),"
                  "spindle(RPM),comment", raw_rows)
