@@ -34,3 +34,8 @@ SIMULATED_PLANTED = {
 #: controller table formats (``volerr controller``): per-axis tables, temperature compensation
 CONTROLLER_AXIS_FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc", "linuxcnc")
 CONTROLLER_TEMP_FORMATS = ("sinumerik-temp", "isg-temp")
+
+#: the sections of ``volerr demo`` (``--only``), in the order of its report
+DEMO_SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "ballplate",
+                 "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty", "plan",
+                 "check")

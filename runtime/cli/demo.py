@@ -5,7 +5,17 @@ Argument parsing only: the run is :func:`volerr.demo` (:mod:`volerr.demo`, its s
 
 from __future__ import annotations
 
-from ..demo.text import ABOUT, CAPTIONS, SECTIONS  # noqa: F401  (the demo's texts, by name)
+from ..choices import DEMO_SECTIONS as SECTIONS
+
+
+def __getattr__(name):
+    # the demo's texts by name (ABOUT, CAPTIONS), imported only when asked: --help imports
+    # no capability
+    if name in ("ABOUT", "CAPTIONS"):
+        from ..demo import text
+
+        return getattr(text, name)
+    raise AttributeError(name)
 
 
 def register(sub) -> None:

@@ -1,8 +1,7 @@
 """The demo's texts and fixed settings: its sections, one sentence per section, the figure
 captions, the example tolerances, the audited layouts and the planned campaigns."""
 
-SECTIONS = ("cmm_a", "cmm_b", "audit", "probe", "identify", "ballbar", "rotary", "ballplate",
-            "multilateration", "fiveaxis", "loop", "iso230_2", "uncertainty", "plan", "check")
+from ..choices import DEMO_SECTIONS as SECTIONS  # the --only word list
 
 #: one sentence per section of index.html: what it shows and how to read it
 ABOUT = {

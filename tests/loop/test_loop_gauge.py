@@ -61,7 +61,9 @@ def test_axis_that_does_not_move_is_named_as_the_reason():
     model = volerr.load("MB1")
     camp = simulate("MB1", n_points=300, seed=3, probes=demo_probes(model), noise_um=0.3)
     camp.positions["X"] = np.full(camp.n_points, 450.0)
-    rep = run_loop("MB1", camp, seed=3, progress=False, families=())
+    # X is overwritten after the readings were simulated with it moving: the residual rule
+    # refuses that fit (issue 43); accepted here to read the identifiability report
+    rep = run_loop("MB1", camp, seed=3, progress=False, families=(), accept_residual=True)
     groups = {g["parameters"][0]: g for g in rep["unidentifiable"]}
     assert {"EXX", "EYX", "EZX"} <= set(groups)
     for p in ("EXX", "EYX", "EZX"):

@@ -204,7 +204,7 @@ def test_bad_input_one_line(tmp_path, capsys):
     nan = _write(tmp_path / "n.csv", "X,Y,Z\n100,100,100\nnan,100,100\n")
     assert "NaN" in _cli_error(capsys, base + ["--task", nan, "--evaluate", "distance"])
     err = _cli_error(capsys, ["uncertainty", "MB1", "--task", good, "--evaluate", "distance",
-                              "--spec", "E0=0.01+L/1e9", "--noise-um", "5", "--samples", "300",
+                              "--spec", "E0=0.2+L/1e9", "--noise-um", "5", "--samples", "300",
                               "--json", out, "--quiet"])
     assert "no sampled machine satisfies" in err
     assert "--spec" in _cli_error(capsys, base + ["--task", good, "--evaluate", "distance",
