@@ -27,7 +27,7 @@ class Compensation(ResultMixin):
     ``notes`` the notes and warnings the command prints on stderr; ``text`` the compensated
     program (None when it was streamed into a file, ``out``); ``blocks`` the per-block
     reports (:class:`volerr.fiveaxis.program.LineReport`; empty when streamed);
-    ``corrections`` axis -> (max |correction|, rms correction), mm / deg.  Sign: a
+    ``corrections`` axis -> (max ``|correction|``, rms correction), mm / deg.  Sign: a
     correction is the written minus the programmed position, about minus the predicted error
     (actual minus nominal tool tip) turned into axis motion."""
 
@@ -205,7 +205,7 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
 class ToolTipMap(ResultMixin):
     """Result of :func:`tcpmap`: ``map`` the :class:`volerr.fiveaxis.tcpmap.TcpMap` (grid,
     axis positions, tool-tip error in mm, workpiece frame, actual minus nominal), ``data``
-    its summary (:meth:`to_dict`: tool-tip error |e| max / min / rms over the valid grid
+    its summary (:meth:`to_dict`: tool-tip error ``|e|`` max / min / rms over the valid grid
     points, um), ``lines`` / ``notes`` what ``volerr tcpmap`` prints on stdout / stderr."""
 
     map: object

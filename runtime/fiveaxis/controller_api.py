@@ -76,7 +76,7 @@ class ControllerExport(ResultMixin):
                 for stat in ("max", "rms")]
 
     def figures(self) -> dict:
-        """``{"left"}``: |e| before and after the axis tables' correction on three levels of
+        """``{"left"}``: ``|e|`` before and after the axis tables' correction on three levels of
         the last linear axis (axis formats only; none for the others)."""
         if not self.tables or self.left is None:
             return {}
