@@ -42,16 +42,6 @@ def check_machine(machine: str) -> str:
     return machine
 
 
-def today() -> str:
-    """Today's date, UTC (:func:`volerr.units.today_utc`)."""
-    return today_utc()
-
-
-def check_date(text: str, where: str = "--date") -> str:
-    """``text`` as YYYY-MM-DD, not after today (UTC): :func:`volerr.units.parse_date`."""
-    return parse_date(text, where)
-
-
 def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 10.0) -> list:
     """Add the result files to ``machine``'s history in ``db`` (module docstring); returns
     ``[(Entry, "added" | "already stored")]``.  Every entry reported ``"added"`` is committed.
@@ -65,7 +55,7 @@ def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 1
     check_machine(machine)
     files = list(files)
     require(files, "give at least one RESULT.json")
-    date = check_date(date) if date is not None else None
+    date = parse_date(date) if date is not None else None
     _read_entries(files, date)              # every file checked before the database is touched
 
     def work(store):
@@ -98,7 +88,7 @@ def _read_entries(files: list, date: str | None) -> list:
     entries = []
     for f in files:
         e = results.read(f)
-        e.date = date or (check_date(e.date, f"{f}: its date") if e.date else today())
+        e.date = date or (parse_date(e.date, f"{f}: its date") if e.date else today_utc())
         entries.append((f, e))
     entries.sort(key=lambda fe: (fe[1].date, fe[1].kind != CALIBRATION))
     return entries
