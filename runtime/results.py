@@ -138,6 +138,19 @@ class ResultMixin:
         return write_text(path, html_page(type(self).__name__, self.summary(), self._rows()),
                           inputs=list(inputs))
 
+    def write_plot(self, path, inputs=()):
+        """Write the result's main figure as the command's ``--plot`` PNG; returns its path
+        (a result with a plot overrides :meth:`png`)."""
+        from .fileio import write_bytes
+
+        return write_bytes(path, self.png(), inputs=list(inputs))
+
+    def png(self) -> bytes:
+        """The command's ``--plot`` figure as PNG bytes (a result without one: refused)."""
+        from .errors import InputError
+
+        raise InputError(f"{type(self).__name__} has no plot")
+
     def _headline(self) -> str:
         """The line :func:`repr` shows: the first line of :meth:`summary`."""
         text = self.summary().splitlines()

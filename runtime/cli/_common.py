@@ -349,6 +349,47 @@ class _Document:
         return rows_of(self.data.get("parameters"))
 
 
+def planned_outputs(args, inputs, **more):
+    """:class:`volerr.fileio.Outputs` of a command's run, declared and checked: the report
+    options the command has (``--json``, ``--html``, ``--pdf`` files, ``--plot`` PNG) and
+    ``more`` (``"--out": path`` a file, ``"--errors-out": (path, names)`` a folder with the
+    names of its files, ``None`` names: not known before the run)."""
+    from ..fileio import Outputs
+
+    outs = Outputs(inputs, force=getattr(args, "force", False))
+    for role in ("json", "html", "pdf"):
+        outs.file("--" + role, getattr(args, role, None))
+    outs.plot("--plot", getattr(args, "plot", None))
+    for role, target in more.items():
+        if isinstance(target, tuple):
+            outs.folder(role, target[0], files=target[1])
+        else:
+            outs.file(role, target)
+    return outs.check()
+
+
+def write_outputs(args, outs, result, ident, inputs, title: str | None = None) -> None:
+    """Inside ``with outs:``, after the command's own outputs: the outputs of the result
+    contract the command was given (``--json`` :meth:`write_json`, ``--html``
+    :meth:`write_html`, ``--plot`` :meth:`write_plot`), then the identification stamped
+    into them and the ``--pdf`` certificate (:func:`write_certificates`)."""
+    if getattr(args, "json", None):
+        result.write_json(outs.path("--json"), inputs=inputs)
+    if getattr(args, "html", None):
+        result.write_html(outs.path("--html"), inputs=inputs)
+    if getattr(args, "plot", None):
+        result.write_plot(outs.path("--plot"), inputs=inputs)
+    write_certificates(outs, result, ident, inputs, title=title)
+
+
+def help_text(command: str) -> str:
+    """The epilog of ``volerr COMMAND --help`` (input formats, outputs, methods): the text
+    file ``volerr/data/help/COMMAND.txt`` (documentation, kept beside formats.md)."""
+    from importlib.resources import files
+
+    return (files("volerr") / "data" / "help" / f"{command}.txt").read_text(encoding="utf-8")
+
+
 def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
     """A number option checked to be finite and within [low, high] (None passes)."""
     import math

@@ -44,6 +44,22 @@ class Iso230_2(ResultMixin):
         per_run = self.data["runs"] if "runs" in self.data else [self.data]
         return plot_runs(self.evaluations, verdicts_per_run=[r.get("verdicts") for r in per_run])
 
+    def write_error_tables(self, folder, inputs=()) -> list:
+        """``FOLDER/<axis>.csv`` per run (mean bidirectional deviation, its standard
+        uncertainty, the single-reading repeatability and the reversal; 'volerr formats
+        tables'), readable by ``volerr map --errors FOLDER``; returns the paths."""
+        from pathlib import Path
+
+        from . import error_table_csv
+        from ..fileio import write_text
+
+        axes = [ev.run.axis for ev in self.evaluations]
+        dup = sorted({a for a in axes if axes.count(a) > 1})
+        require(not dup, f"--errors-out writes one table per axis: {len(axes)} runs of axis "
+                         f"{dup[0] if dup else ''}; evaluate them one at a time")
+        return [write_text(Path(folder) / f"{ev.run.axis}.csv", error_table_csv(ev),
+                           inputs=list(inputs)) for ev in self.evaluations]
+
     def write_html(self, path, inputs=()):
         """The certificate page (``--html``)."""
         import datetime
@@ -58,12 +74,20 @@ class Iso230_2(ResultMixin):
                           inputs=list(inputs))
 
 
+def run_axes(axis: str, n: int) -> list:
+    """The axis of each of ``n`` runs from ``"X"`` (all) or ``"X,Y,..."`` (one per run)."""
+    axes = [a.strip().upper() for a in axis.split(",")]
+    require(len(axes) in (1, n), f"--axis: give one axis or one per RUN file ({n}), got "
+                                 f"{len(axes)}")
+    return axes * n if len(axes) == 1 else axes
+
+
 def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
              instrument_ppm: float = 0.5, alignment_mm: float = 0.1,
              temperature_u_K: float = 0.2, cte_u_ppm_per_K: float = 1.0,
              eve_um: float | None = None, cte_ppm_per_K: float | None = None,
              material_temp_C: float | None = None, cte_reference_mm: float = 0.0,
-             identification=None) -> Iso230_2:
+             identification=None, errors_out: bool = False) -> Iso230_2:
     """ISO 230-2 evaluation of positioning runs (``volerr iso230-2``).
 
     Parameters
@@ -82,6 +106,9 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
     identification : dict, optional
         What identifies the instrument and the machine in the report (as the command's
         identification options give it).
+    errors_out : bool
+        The error tables will be written (:meth:`Iso230_2.write_error_tables`): refused at
+        once when two runs have the same axis.
 
     Returns
     -------
@@ -97,17 +124,23 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
             "the same RUN file is given twice")
     require(material_temp_C is None or cte_ppm_per_K is not None,
             "--material-temp-C is used only with --cte-ppm-per-K")
-    axes = [a.strip().upper() for a in axis.split(",")]
-    require(len(axes) in (1, len(inputs)), f"--axis: give one axis or one per RUN file "
-                                           f"({len(inputs)}), got {len(axes)}")
-    axes = axes * len(inputs) if len(axes) == 1 else axes
+    axes = run_axes(axis, len(inputs))
+    dup = sorted({a for a in axes if axes.count(a) > 1})
+    require(not errors_out or not dup, f"--errors-out writes one table per axis: "
+                                       f"{len(inputs)} runs of axis {dup[0] if dup else ''}; "
+                                       f"evaluate them one at a time")
     tol = (conformance.parse_tolerances(tolerance, ("A", "E", "M", "R", "B"))
            if tolerance is not None else None)
     rs = evaluate_files(inputs, axes, cte_ppm_per_K, material_temp_C, cte_reference_mm)
     report = rs.report(inputs=BudgetInputs(instrument_ppm, alignment_mm, temperature_u_K,
                                            cte_u_ppm_per_K, eve_um), tolerance=tol,
                        identification=identification)
-    return Iso230_2(report, rs.evaluations, identification=identification)
+    from . import summary_lines
+
+    per_run = report["runs"] if "runs" in report else [report]
+    notes = summary_lines(report)[1] + [f"{r['file']}: {n}" for r in per_run
+                                        for n in r["uncertainty_budget"]["notes"]]
+    return Iso230_2(report, rs.evaluations, notes, identification=identification)
 
 
 @dataclass(repr=False)
