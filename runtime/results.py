@@ -118,6 +118,10 @@ class ResultMixin:
 
         return write_pdf(path, self, identification, inputs=list(inputs), title=title)
 
+    def summary(self) -> str:
+        """The text the command prints on stdout (by default its ``lines``)."""
+        return "\n".join(self.lines)
+
     def _rows(self) -> list:
         return rows_of(self._document().get("parameters"))
 

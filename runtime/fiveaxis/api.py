@@ -55,10 +55,6 @@ class Compensation(ResultMixin):
                                        "keep_errors=True: no per-block errors kept")
         return ProgramErrors.from_reports(self.blocks)
 
-    def summary(self) -> str:
-        """The text ``volerr compensate`` prints on stdout."""
-        return "\n".join(self.lines)
-
     def figures(self) -> dict:
         """``{"program_errors": Figure}``: the predicted tool-tip and tool-axis errors per
         block before and after (what ``--plot`` draws); none when the program was streamed
@@ -212,10 +208,6 @@ class ToolTipMap(ResultMixin):
     data: dict
     lines: tuple
     notes: tuple
-
-    def summary(self) -> str:
-        """The text ``volerr tcpmap`` prints on stdout."""
-        return "\n".join(self.lines)
 
     def _rows(self) -> list:
         s = self.data

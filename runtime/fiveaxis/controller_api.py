@@ -64,10 +64,6 @@ class ControllerExport(ResultMixin):
     left: object = None
     tables: list = field(default_factory=list)
 
-    def summary(self) -> str:
-        """What ``volerr controller export`` prints."""
-        return "\n".join(self.lines)
-
     def _rows(self) -> list:
         # what is left against no compensation: exact figures of the grid, no uncertainty
         d = self.data
@@ -97,10 +93,6 @@ class ControllerImport(ResultMixin):
     tables: dict
     constants: dict
     lines: list
-
-    def summary(self) -> str:
-        """What ``volerr controller import`` prints."""
-        return "\n".join(self.lines)
 
     def _rows(self) -> list:
         out = [Row(n, v * (1e6 if n[1] in "ABC" else 1e3), None,

@@ -107,6 +107,31 @@ def text_columns(text: dict, needed, where: str, labels=()) -> list:
     return warnings
 
 
+def open_columns(cols: dict, text: dict, model, where: str, needed=(), labels=()):
+    """The first step of every instrument reader: columns holding NaN or infinity set aside
+    (:func:`drop_nonfinite`), then the columns the reader needs -- the layout's axes (bare,
+    ``_mm``, ``_deg``), the instrument's ``needed`` and the layout's covariates -- refused
+    when not numeric, other text columns warned about (:func:`text_columns`; ``labels``: the
+    instrument's own text columns).  Returns ``(find, warnings)``: a :class:`Finder` over the
+    numeric columns (``find.cols``) and the warnings."""
+    cols, text = drop_nonfinite(cols, text, where)
+    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")} | set(needed)
+              | set(model.covariates))
+    return Finder(cols, where), text_columns(text, needed, where, labels)
+
+
+def read_file(path, model, columns_to_observations, unique_rows: bool = True, **options):
+    """Read an instrument's CSV into :class:`Observations` with the instrument's
+    ``columns_to_observations(numbers, text, labels, model, name, **options)``; a row given
+    twice refused first (``unique_rows``).  InputError, one line, on a defect."""
+    from ._csv import read_columns
+
+    c = read_columns(path)
+    if unique_rows:
+        refuse_duplicate_rows(c, c.name)
+    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name, **options)
+
+
 class Finder:
     """Finds a column under one of its unit spellings (names case-insensitive); remembers the
     columns used."""

@@ -32,7 +32,6 @@ from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
-from ._csv import read_columns
 from .observations import FileInfo, Observations, Setup
 
 KIND = "artifact"
@@ -59,8 +58,7 @@ def detect(names) -> bool:
 
 def read(path, model: Model) -> Observations:
     """Read an artifact CSV into :class:`Observations` (InputError, one line, on a defect)."""
-    c = read_columns(path)
-    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
+    return f.read_file(path, model, columns_to_observations, unique_rows=False)
 
 
 def _labels(find, raw, name, n, where, required=True):
@@ -71,12 +69,10 @@ def _labels(find, raw, name, n, where, required=True):
 
 def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                             where: str) -> Observations:
-    cols, text = f.drop_nonfinite(cols, text, where)
-    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
-              | {"u_mm", "v_mm", "w_mm", "x_mm", "y_mm", "z_mm", "Xp", "Yp", "Zp",
-                 "u_std_um", "probe_u_um"} | set(model.covariates))
-    warnings = f.text_columns(text, needed, where, labels=("placement", "ball", "feature"))
-    find = f.Finder(cols, where)
+    needed = {"u_mm", "v_mm", "w_mm", "x_mm", "y_mm", "z_mm", "Xp", "Yp", "Zp", "u_std_um",
+              "probe_u_um"}
+    find, warnings = f.open_columns(cols, text, model, where, needed,
+                                    labels=("placement", "ball", "feature"))
     require(find.name("u_um") is None, f"{where}: column u_um is ambiguous in an artifact file "
             f"(u_mm is a calibrated coordinate): give the probing uncertainty as probe_u_um "
             f"and the calibration's as u_std_um")
@@ -97,7 +93,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
         h = find(a, ("", "_deg"), f"axis {a}")
         require(h is not None, f"{where}: missing axis column {a} (layout {model.name} has "
                 f"rotary axis {a}: its position during the measurement)")
-        rotary[a] = cols[h]
+        rotary[a] = find.cols[h]
     placement = _labels(find, raw, "placement", n, where)
     ball = _labels(find, raw, "ball", n, where)
     feature = _features(find, raw, n, where)

@@ -41,7 +41,6 @@ from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
-from ._csv import read_columns
 from .observations import FileInfo, Observations, Setup
 
 KIND = "ballbar"
@@ -67,18 +66,15 @@ def read(path, model: Model, check_travel: bool = True) -> Observations:
     """Read a ballbar CSV into :class:`Observations` (InputError, one line, on a defect);
     ``check_travel`` False: positions outside the layout's travel accepted (a generic layout
     standing in for the machine)."""
-    c = read_columns(path)
-    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name, check_travel)
+    return f.read_file(path, model, columns_to_observations, unique_rows=False,
+                       check_travel=check_travel)
 
 
 def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                             where: str, check_travel: bool = True) -> Observations:
-    cols, text = f.drop_nonfinite(cols, text, where)
-    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
-              | {"pivot_x", "pivot_y", "pivot_z", "length_mm", "dr_um", "dr_mm", "Xp", "Yp",
-                 "Zp", "direction", "u_um", "length_u_um"} | set(model.covariates))
-    warnings = f.text_columns(text, needed, where, labels=("placement",))
-    find = f.Finder(cols, where)
+    needed = {"pivot_x", "pivot_y", "pivot_z", "length_mm", "dr_um", "dr_mm", "Xp", "Yp", "Zp",
+              "direction", "u_um", "length_u_um"}
+    find, warnings = f.open_columns(cols, text, model, where, needed, labels=("placement",))
     pos = f.positions(find, model, where, min_points=4, needs="a ballbar trace",
                       check_travel=check_travel)
     n = len(next(iter(pos.values())))

@@ -26,7 +26,6 @@ from ..errors import require
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
-from ._csv import read_columns
 from .observations import FileInfo, Observations, Setup
 
 KIND = "distances"
@@ -66,19 +65,13 @@ def require_stations(parts) -> None:
 
 def read(path, model: Model) -> Observations:
     """Read a distances CSV into :class:`Observations` (InputError, one line, on a defect)."""
-    c = read_columns(path)
-    f.refuse_duplicate_rows(c, c.name)
-    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
+    return f.read_file(path, model, columns_to_observations)
 
 
 def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                             where: str) -> Observations:
-    cols, text = f.drop_nonfinite(cols, text, where)
-    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
-              | {"d_mm", "dd_mm", "Xp", "Yp", "Zp", "u_um", "station_x", "station_y",
-                 "station_z"} | set(model.covariates))
-    warnings = f.text_columns(text, needed, where, labels=("station",))
-    find = f.Finder(cols, where)
+    needed = {"d_mm", "dd_mm", "Xp", "Yp", "Zp", "u_um", "station_x", "station_y", "station_z"}
+    find, warnings = f.open_columns(cols, text, model, where, needed, labels=("station",))
     pos = f.positions(find, model, where, min_points=8, needs="multilateration")
     n = len(next(iter(pos.values())))
     probe = f.probe(find, n, where)
@@ -88,7 +81,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     h_abs, h_rel = find("d", ("_mm",), "d_mm"), find("dd", ("_mm",), "dd_mm")
     require(bool(h_abs) != bool(h_rel), f"{where}: give one reading column: d_mm (absolute "
                                         f"distance) or dd_mm (change since the first reading)")
-    d = cols[h_abs or h_rel]
+    d = find.cols[h_abs or h_rel]
     relative = h_rel is not None
     start = None
     if any(find.name(c) for c in ("station_x", "station_y", "station_z")):

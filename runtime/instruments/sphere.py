@@ -28,7 +28,6 @@ from ..errors import require
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
-from ._csv import read_columns
 from .observations import FileInfo, Observations, Setup
 
 KIND = "sphere"
@@ -47,20 +46,15 @@ def detect(names) -> bool:
 
 def read(path, model: Model) -> Observations:
     """Read a sphere / R-test CSV into :class:`Observations` (InputError, one line)."""
-    c = read_columns(path)
-    f.refuse_duplicate_rows(c, c.name)
-    return columns_to_observations(c.numbers, c.text, c.labels, model, c.name)
+    return f.read_file(path, model, columns_to_observations)
 
 
 def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                             where: str) -> Observations:
-    cols, text = f.drop_nonfinite(cols, text, where)
-    needed = ({a + u for a in model.axes for u in ("", "_mm", "_deg")}
-              | {"sphere_x", "sphere_y", "sphere_z", "Xp", "Yp", "Zp", "u_um", "tool_u_um"}
-              | {f"{d}_{u}" for d in ("dx", "dy", "dz") for u in ("um", "mm")}
-              | set(model.covariates))
-    warnings = f.text_columns(text, needed, where, labels=("placement", "frame"))
-    find = f.Finder(cols, where)
+    needed = ({"sphere_x", "sphere_y", "sphere_z", "Xp", "Yp", "Zp", "u_um", "tool_u_um"}
+              | {f"{d}_{u}" for d in ("dx", "dy", "dz") for u in ("um", "mm")})
+    find, warnings = f.open_columns(cols, text, model, where, needed,
+                                    labels=("placement", "frame"))
     pos = f.positions(find, model, where, min_points=3, needs="a sphere file")
     n = len(next(iter(pos.values())))
     probe = f.probe(find, n, where)
