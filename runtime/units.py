@@ -310,3 +310,10 @@ def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
                          f"L long is 0 0 -L: likely the sign (write {v[0]:g} {v[1]:g} "
                          f"{-v[2]:g}, or --tool-length {v[2]:g})")
     return v
+
+
+#: the spindle's tilt read by two displacement sensors of one direction at two heights z:
+#: direction -> (the axis it turns about, the sign of the tilt per ds/dz), right hand --
+#: sensors along X read the tilt about +Y (+ds/dz), along Y the tilt about +X (-ds/dz);
+#: used by the ISO 230-3 evaluation and the drift loop's rows alike
+SENSOR_TILT = {"X": ("Y", 1.0), "Y": ("X", -1.0)}

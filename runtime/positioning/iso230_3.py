@@ -46,6 +46,7 @@ import numpy as np
 
 from ..certificate import html_table
 from ..plotstyle import TEST_REPORT_CSS, embedded_img, figure, label, png, styled
+from ..units import SENSOR_TILT as _TILT
 
 STANDARD = "ISO 230-3:2020"
 #: a stage ends where the stage value leaves its first value by more than this fraction of the
@@ -54,8 +55,6 @@ STAGE_TOLERANCE = 0.02
 #: unit vectors' axis and sign of the channel directions
 _AXIS = {"X": ("X", 1.0), "-X": ("X", -1.0), "Y": ("Y", 1.0), "-Y": ("Y", -1.0),
          "Z": ("Z", 1.0), "-Z": ("Z", -1.0)}
-#: the tilt of a pair of sensors along an axis: (about which axis, sign of ds/dz)
-_TILT = {"X": ("Y", 1.0), "Y": ("X", -1.0)}
 
 
 @dataclass

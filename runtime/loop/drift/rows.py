@@ -44,10 +44,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...units import SENSOR_TILT as TILT
 from . import basis
 
-#: the tilt read by two sensors along an axis: (about which axis, sign of ds/dz)
-TILT = {"X": ("Y", 1.0), "Y": ("X", -1.0)}
 ROTATION = {"X": "A", "Y": "B"}   # ISO 230-1 letters of the rotations about X, Y
 UM_PER_URAD_MM = 1e-3          # a tilt of 1 urad moves a point 1 mm up the mandrel by 1e-3 um
 LEVER_MM = 100.0               # the height at which the layout's sensitivity is read for tilts
