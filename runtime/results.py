@@ -207,3 +207,17 @@ def callable_package(name: str, function) -> None:
     module = sys.modules[name]
     module.__api__ = function
     module.__class__ = CallableModule
+
+
+def former_module(package: str, module: str):
+    """The module ``__getattr__`` of a package that was once the flat module ``package``:
+    the names of its submodule ``module`` stay importable from the package
+    (``__getattr__ = former_module(__name__, "solve")``)."""
+    def __getattr__(name):
+        import importlib
+
+        try:
+            return getattr(importlib.import_module(f"{package}.{module}"), name)
+        except AttributeError:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}") from None
+    return __getattr__

@@ -4,17 +4,13 @@ conversion to the model's sign convention, and the identification plots.
 """
 
 from .solve import Identification, identify, identify_round, to_model_signs
+from ..results import former_module
 
 __all__ = ["Identification", "identify", "identify_round", "to_model_signs"]
 
 
-def __getattr__(name):
-    # names of the former flat module volerr.identify, still importable from here
-    from . import solve as _m
-    try:
-        return getattr(_m, name)
-    except AttributeError:
-        raise AttributeError(f"module 'volerr.identify' has no attribute {name!r}") from None
+# names of the former flat module volerr.identify, still importable from here
+__getattr__ = former_module(__name__, "solve")
 
 
 from . import api as _api  # noqa: E402

@@ -11,6 +11,7 @@ selection rules and stepwise core: :mod:`volerr.selection`.
 """
 
 from .run import Report, read_deviations, run_loop
+from ..results import former_module
 
 
 def loop_drift(layout, paths, window=None, files=(), differences=False, progress=None):
@@ -24,13 +25,8 @@ def loop_drift(layout, paths, window=None, files=(), differences=False, progress
 __all__ = ["Report", "loop_drift", "read_deviations", "run_loop"]
 
 
-def __getattr__(name):
-    # names of the former flat module volerr.loop, still importable from here
-    from . import run as _m
-    try:
-        return getattr(_m, name)
-    except AttributeError:
-        raise AttributeError(f"module 'volerr.loop' has no attribute {name!r}") from None
+# names of the former flat module volerr.loop, still importable from here
+__getattr__ = former_module(__name__, "run")
 
 
 from . import api as _api  # noqa: E402

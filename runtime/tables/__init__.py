@@ -8,14 +8,10 @@ from .table import (ErrorTable, read_constants, read_error_dir, read_error_table
                                  table_to_csv, write_constants, write_error_dir,
                                  write_error_table)
 from .functions import ErrorFunctions
+from ..results import former_module
 
 __all__ = ["ErrorFunctions", "ErrorTable", "read_constants", "read_error_dir", "read_error_table", "table_to_csv", "write_constants", "write_error_dir", "write_error_table"]
 
 
-def __getattr__(name):
-    # names of the former flat module volerr.tables, still importable from here
-    from . import table as _m
-    try:
-        return getattr(_m, name)
-    except AttributeError:
-        raise AttributeError(f"module 'volerr.tables' has no attribute {name!r}") from None
+# names of the former flat module volerr.tables, still importable from here
+__getattr__ = former_module(__name__, "table")
