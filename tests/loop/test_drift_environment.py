@@ -104,6 +104,9 @@ def test_the_folds_hold_out_whole_environments(campaign):
     assert rep["n_folds"] == 3            # constant, daily, door train; hvac-off held out
     assert rep["runs"][-1].startswith(HELD_OUT) and rep["n_test"] == len(
         campaign[0][HELD_OUT]["t_s"])
+    assert rep["environments"] == {f"{name}.csv": env for name, _, env, _ in RUNS}
+    assert rep["fold_environments"] == ["constant", "daily", "door"]
+    assert "over 3 environments (constant, daily, door)" in rep.summary()
 
 
 def test_a_room_never_seen_is_predicted_within_its_floor(campaign):
