@@ -138,3 +138,24 @@ def test_an_environment_that_changes_within_a_run_is_refused(tmp_path):
         loop_drift("DMU50", [tmp_path / "bad.csv"])
     msg = str(err.value)
     assert "bad.csv" in msg and "environment" in msg and "\n" not in msg
+
+
+def test_one_file_of_labelled_runs_is_the_same_campaign(campaign, tmp_path):
+    """The same runs in ONE file with ``run`` and ``environment`` columns (the held-out run
+    last: without --holdout-* the last run is held out) give the same folds and the same
+    held-out predictions as one file per run."""
+    runs, rep = campaign
+    cols = ["t_s", "S_rpm", "d_x_um", "T_room", "T_bearing", "T_casting", "T_cabinet"]
+    lines = ["# channel d_x: X", ",".join(["run"] + cols + ["environment"])]
+    for name, _, env, _ in RUNS:
+        r = runs[name]
+        lines += [f"{name}," + ",".join(f"{r[c][i]:.6f}" for c in cols) + f",{env}"
+                  for i in range(len(r["t_s"]))]
+    (tmp_path / "all.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    one = loop_drift("DMU50", [tmp_path / "all.csv"])
+    assert one["fold_rule"] == "environments" and one["n_folds"] == 3
+    assert one["fold_environments"] == ["constant", "daily", "door"]
+    assert one["environments"]["all.csv[h1]"] == "hvac-off"
+    a = one.pred["x"]["after"][one.series.test]
+    b = rep.pred["x"]["after"][rep.series.test]
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-6)
