@@ -7,7 +7,9 @@ displacement channels ``d_<label>_um``; every other numeric column a logged inpu
 ``T_<label>`` degC, spindle speed ``S_rpm``, feed, power ...); optional position columns
 ``X, Y, Z[, B, C]`` (constant in a run: the test position; axes not given stand at the middle of
 their travel, rotary axes at 0), optional ``run`` (a label: a file is one run unless it says
-otherwise; lags start afresh in every run).  Header lines ``# channel d_<label>: DIR [at
+otherwise; lags start afresh in every run), optional ``environment`` (a label per run, one
+value within a run: the room behaviour or programme the run was logged in, e.g.
+``constant``, ``varying``; the drift loop's folds then hold out whole environments).  Header lines ``# channel d_<label>: DIR [at
 z=<mm>]`` give a channel's direction, ``DIR`` one of ``X Y Z -X -Y -Z`` (machine axes of the
 workpiece frame) or ``?`` (not known, the default), and the sensor's height ``z`` on the
 mandrel.  A logger's file as saved (``Time(min)``, ``ch1(um)``, ``t1(°C)``) is read by the
@@ -81,6 +83,8 @@ class DriftRun:
     rows: np.ndarray | None = None
     #: columns left out (text columns such as a date), one line each
     notes: list = field(default_factory=list)
+    #: the run's ``environment`` label ("" when the file has no such column)
+    environment: str = ""
 
     @property
     def n(self) -> int:
@@ -287,7 +291,7 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None) -
     heads = channel_lines(path)
     names = _channels(c, heads)
     labels, run_of = _runs(c, n)
-    skip = set(names) | {tcol, "run"} | {h for h in c.numbers
+    skip = set(names) | {tcol, "run", ENVIRONMENT} | {h for h in c.numbers
                                          if re.fullmatch(r"[XYZUVWABC](_mm|_deg)?", h)}
     inputs = [h for h in c.numbers if h not in skip]
     _column_defects(c, inputs)
@@ -314,8 +318,30 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None) -
             {k: heads.get(k, ("?", None))[0] for k in chans},
             {k: heads.get(k, ("?", None))[1] for k in chans},
             {h: c.numbers[h][idx] for h in inputs}, _position(c, idx, where, shown), idx,
-            notes))
+            notes, _environment(c, idx, where, shown)))
     return out
+
+
+#: the optional column naming the environment (room behaviour, programme) of each run
+ENVIRONMENT = "environment"
+
+
+def _environment(c: Columns, idx: np.ndarray, where: str, run: str) -> str:
+    """The run's ``environment`` label ("" without the column); one line refuses a blank
+    cell or a label that changes within the run."""
+    if ENVIRONMENT not in c.numbers and ENVIRONMENT not in c.labels:
+        return ""
+    raw = (c.labels[ENVIRONMENT] if ENVIRONMENT in c.labels
+           else [f"{x:g}" for x in c.numbers[ENVIRONMENT]])
+    cells = [str(raw[i]).strip() for i in idx]
+    blank = next((i for i, s in zip(idx, cells) if not s), None)
+    require(blank is None, f"{where}: column {ENVIRONMENT} row {(blank or 0) + 2} is empty "
+                           f"(one label per run: e.g. constant, varying)")
+    found = list(dict.fromkeys(cells))
+    require(len(found) == 1, f"{where}: column {ENVIRONMENT} changes within "
+            f"{'run ' + run if run else 'the run'} ({found[0]}, {found[-1]}); one environment "
+            f"per run (a run column splits the file into runs)")
+    return found[0]
 
 
 def _text_inputs(c: Columns, skip) -> list:

@@ -24,8 +24,15 @@ Time constants: a geometric grid of ``N_TAU`` values from ``TAU_MIN_STEPS`` read
 neighbours.  Columns are scaled to unit RMS over the training part (conditioning; the
 reported coefficients are in the units of the unscaled column).
 
-Folds (the split rule of ``volerr formats loop-lags``): with at least ``RUN_FOLDS_MIN``
-training runs every fold is one whole run (predicted from its own zero, its first reading);
+Folds (the split rule of ``volerr formats loop-lags``): where the files name the runs'
+``environment`` (a room held constant or varying, another programme) and the training runs
+span at least ``RUN_FOLDS_MIN`` environments, every fold is one whole environment (all its
+runs, each predicted from its own zero, its first reading): the cross-validation then
+measures how a model carries over to a room behaviour it was not fitted on, not how it
+interpolates within one (two environments are two folds, each fitted on half the runs: too
+coarse to select with; measured on tests/loop/test_drift_environment.py's machine with two
+training environments, 1.7-2.0 x the floor against 1.1-1.3 x by whole runs); otherwise,
+with at least ``RUN_FOLDS_MIN`` training runs every fold is one whole run;
 otherwise ``K_FOLDS`` folds, fold k being the k-th of ``K_FOLDS`` contiguous stretches of
 every run's training readings (each run keeps a zero fitted on its other stretches).  Folds
 are whole stretches, never readings drawn at random: readings 15 s apart are almost equal.
@@ -40,7 +47,7 @@ import numpy as np
 from ...errors import require
 from .series import DriftSeries
 
-__all__ = ["Column", "DriftSeries", "folds", "heat", "library", "series", "sensors",
+__all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "library", "series", "sensors",
            "tau_grid"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
@@ -125,10 +132,16 @@ def library(s: DriftSeries) -> tuple[list, np.ndarray]:
 
 def folds(s: DriftSeries) -> tuple[np.ndarray, str]:
     """Fold index (N,) of every training reading (-1: held out) and the rule used
-    (``"runs"`` or ``"stretches"``), by the rule of the module docstring."""
+    (``"environments"``, ``"runs"`` or ``"stretches"``), by the rule of the module
+    docstring."""
     tr = s.train
     f = np.full(len(s.t_s), -1)
     train_runs = [r for r in range(len(s.runs)) if np.any(tr & (s.run == r))]
+    envs = list(dict.fromkeys(s.environments[r] for r in train_runs)) if s.environments else []
+    if len(envs) >= RUN_FOLDS_MIN:
+        for r in train_runs:
+            f[tr & (s.run == r)] = envs.index(s.environments[r])
+        return f, "environments"
     if len(train_runs) >= RUN_FOLDS_MIN:
         for k, r in enumerate(train_runs):
             f[tr & (s.run == r)] = k
@@ -139,3 +152,8 @@ def folds(s: DriftSeries) -> tuple[np.ndarray, str]:
     require(len(set(f[tr])) >= 2, "loop: too few training readings for a cross-validation "
             "(at least two stretches of time are needed)")
     return f, "stretches"
+
+
+def whole_runs(rule: str) -> bool:
+    """Whether the folds of ``rule`` are whole runs (each predicted from its first reading)."""
+    return rule in ("runs", "environments")

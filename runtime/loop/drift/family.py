@@ -49,6 +49,7 @@ import numpy as np
 
 from ...selection.linalg import solve_scaled
 from ...selection.rules import TIE_SCORE_REL, paired_t, significantly_below, t95
+from . import basis
 
 FAMILIES = ("constant", "static", "lag")
 #: consecutive blocks each fold's CV residuals are cut into for the paired test
@@ -72,7 +73,7 @@ def cv_residuals(ch, D) -> np.ndarray:
     for k in range(K):
         m = fold == k
         b = solve_scaled(G - parts[k][0], h - parts[k][1])   # the fit on the other folds
-        if ch.rule == "runs":
+        if basis.whole_runs(ch.rule):
             pred = first[ch.s.run[m]] + D[m, n_runs:] @ b[n_runs:]
         else:
             pred = D[m] @ b

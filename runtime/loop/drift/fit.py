@@ -57,8 +57,8 @@ RECENTRE = 3         # searches of a fold's time constant re-centred at an edge
 class Channel:
     """What the steps of one channel share: the series ``s`` (its ``test`` mask set), the
     channel's readings ``y`` (N,) um, the run indicators ``R`` (N, n_runs), the blocked
-    ``fold`` of every training reading (-1 held out) and its ``rule`` (``"runs"`` or
-    ``"stretches"``)."""
+    ``fold`` of every training reading (-1 held out) and its ``rule`` (``"environments"``,
+    ``"runs"`` or ``"stretches"``)."""
 
     s: basis.DriftSeries
     y: np.ndarray
@@ -72,7 +72,8 @@ class Channel:
 
     def cv(self, D) -> float:
         """Cross-validated mean square (um^2) of the model with the columns ``D``."""
-        eng = Engine(D, self.y, self.fold, self.rule == "runs", self.s.run, self.n_runs)
+        eng = Engine(D, self.y, self.fold, basis.whole_runs(self.rule), self.s.run,
+                     self.n_runs)
         return eng.cv_sse(np.eye(D.shape[1])) / eng.n
 
     def design(self, specs, taus=None) -> np.ndarray:
@@ -116,7 +117,7 @@ def _candidates(s, cols, differences: bool) -> tuple:
 
 
 def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
-    eng = Engine(Z, ch.y, ch.fold, ch.rule == "runs", ch.s.run, ch.n_runs, cache)
+    eng = Engine(Z, ch.y, ch.fold, basis.whole_runs(ch.rule), ch.s.run, ch.n_runs, cache)
     heat_c, sensor_c = cands
     terms = []
     if len(heat_c):

@@ -106,7 +106,9 @@ class DriftReport(ResultMixin):
         d = self.data
         out = [f"{d['layout']}: drift runs {', '.join(d['runs'])}; {d['split']}; "
                f"{d['n_train']} training, {d['n_test']} held-out readings; choices by blocked "
-               f"cross-validation over {d['n_folds']} {d['fold_rule']}"]
+               f"cross-validation over {d['n_folds']} {d['fold_rule']}"
+               + (f" ({', '.join(d['fold_environments'])})" if d.get("fold_environments")
+                  else "")]
         if d.get("extrapolation"):
             out.insert(0, "  " + extrapolation_line(d["extrapolation"]))
         for label, c in d["channels"].items():

@@ -157,7 +157,7 @@ def modelled_series(s: basis.DriftSeries, rows: Rows) -> tuple[basis.DriftSeries
     keep = [k for k in s.channels if k not in rows.channels]
     out = basis.DriftSeries(s.t_s, s.run, s.runs, s.inputs, chans,
                             {k: s.directions.get(k, "?") for k in keep},
-                            {k: s.heights.get(k) for k in keep}, s.test)
+                            {k: s.heights.get(k) for k in keep}, s.test, s.environments)
     return out, {k: E[:, i] for i, k in enumerate(rows.channels)}
 
 

@@ -65,6 +65,12 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "not_significant": [], "not_reported": [], "static_regression": {},
             "unidentifiable": [],
             "extrapolation": extrapolation(s)}
+    if s.environments:        # each run's environment (the folds' groups, basis.folds)
+        data["environments"] = {(f if not r else f"{f}[{r}]"): e
+                                for (f, r), e in zip(s.runs, s.environments)}
+        if res["fold_rule"] == "environments":
+            data["fold_environments"] = list(dict.fromkeys(
+                e for r, e in enumerate(s.environments) if np.any(s.train & (s.run == r))))
     qpred = {label: _prediction(m, r) for label, r in res["channels"].items()}
     pred = {k: qpred[k] for k in s.channels if k not in resid}
     if rows is not None:

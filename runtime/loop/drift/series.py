@@ -21,7 +21,8 @@ class DriftSeries:
     ``t_s`` (N,) seconds; ``run`` (N,) run index into ``runs`` [(file, label)];
     ``inputs`` {name: (N,)} logged inputs (degC, rpm, ...); ``channels`` {label: (N,)} um;
     ``directions`` {label: "X".."-Z" or "?"}; ``heights`` {label: mm or None};
-    ``test`` (N,) bool: held out."""
+    ``test`` (N,) bool: held out; ``environments`` one label per run (the files'
+    ``environment`` column; empty: none given)."""
 
     t_s: np.ndarray
     run: np.ndarray
@@ -31,6 +32,7 @@ class DriftSeries:
     directions: dict = field(default_factory=dict)
     heights: dict = field(default_factory=dict)
     test: np.ndarray | None = None
+    environments: list = field(default_factory=list)
     memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -80,4 +82,5 @@ def stack_runs(runs) -> DriftSeries:
         [(r.file, r.run) for r in runs],
         {k: cat([r.inputs[k] for r in runs]) for k in first.inputs},
         {k: cat([r.channels[k] for r in runs]) for k in first.channels},
-        dict(first.directions), dict(first.heights))
+        dict(first.directions), dict(first.heights),
+        environments=[r.environment for r in runs] if any(r.environment for r in runs) else [])
