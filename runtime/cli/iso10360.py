@@ -1,23 +1,15 @@
-"""``volerr iso10360 LAYOUT --errors DIR``: simulated ISO 10360-2 length measuring test.
-
-7 positions (4 space diagonals, lines along X, Y, Z through the centre), 5 lengths, 3
-repetitions, bidirectional; prints E0 per position and length (um) and, with --mpe, the
-verdict against the MPE line per ISO 14253-1 with the test uncertainty U; --plot draws the
-certificate picture, --html writes the certificate.  Definitions and the sign convention:
-volerr.uncertainty.iso10360.
-"""
+"""``volerr iso10360 LAYOUT --errors DIR``: the simulated ISO 10360-2 length measuring test (see
+``volerr iso10360 --help``; the Python API :func:`volerr.iso10360`)."""
 
 from __future__ import annotations
 
-
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, identification_from_args, inputs_of, write_certificates)
-from ..fileio import Outputs, write_bytes
+                      add_vector, command_parser, identification_from_args, inputs_of,
+                      planned_outputs, write_document_outputs)
 
 
 def register(sub) -> None:
-    p = sub.add_parser("iso10360", help="simulated ISO 10360-2 length measuring test (E0)",
-                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    p = command_parser(sub, "iso10360", "simulated ISO 10360-2 length measuring test (E0)")
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)
     add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
@@ -50,35 +42,22 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    import math
+
     from ..uncertainty.api import iso10360
 
     inputs = inputs_of(args)
-    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
-        .file("--html", args.html).file("--pdf", args.pdf).check()
-    ident = identification_from_args(args, inputs, {
-        "artefact temperature": f"{args.temperature_C:g} \u00b0C (u = {args.temperature_u_K:g} K)",
-        "artefact expansion coefficient": f"{args.artefact_cte_ppm_per_K:g} ppm/K (u = "
-                                          f"{args.artefact_cte_u_ppm_per_K:g} ppm/K)"})
+    outs = planned_outputs(args, inputs)
     res = iso10360(
         args.layout, args.errors, method=args.method, degree=args.degree,
-        extrapolate=args.extrapolate, probe=args.probe,
-        volume=args.volume, mpe=args.mpe, noise_um=args.noise_um, seed=args.seed,
-        artefact_u=args.artefact_u, artefact_cte_ppm_per_K=args.artefact_cte_ppm_per_K,
+        extrapolate=args.extrapolate, probe=args.probe, volume=args.volume, mpe=args.mpe,
+        noise_um=args.noise_um, seed=args.seed, artefact_u=args.artefact_u,
+        artefact_cte_ppm_per_K=args.artefact_cte_ppm_per_K,
         artefact_cte_u_ppm_per_K=args.artefact_cte_u_ppm_per_K,
         temperature_C=args.temperature_C, temperature_u_K=args.temperature_u_K,
-        identification=ident, accept_implausible=args.accept_implausible)
+        identification=identification_from_args(args, inputs),
+        accept_implausible=args.accept_implausible)
     print(res.summary())
     with outs:
-        if args.json:
-            res.write_json(outs.path("--json"), inputs)
-        if args.plot:
-            write_bytes(outs.path("--plot"), res.png(), inputs)
-        if args.html:
-            res.write_html(outs.path("--html"), inputs)
-        d = res.to_dict()
-        title = f"{d['layout']}: simulated ISO 10360-2" + \
-            (f", {d['verdict']}" if args.mpe is not None else "")
-        write_certificates(outs, d, ident, inputs, title)
-    import math
-
+        write_document_outputs(args, outs, res, res.identification, inputs, res.title)
     return 0 if math.isfinite(res.data["max_abs_E_um"]) else 1

@@ -1,31 +1,15 @@
-"""``volerr iso230-2``: ISO 230-2 evaluation of laser-interferometer positioning runs.
-
-    volerr iso230-2 RUN.csv [RUN2.csv ...] [--axis X] [--json F] [--plot P] [--html F]
-                    [--errors-out DIR] [--tolerance "A=..,E=..,M=..,R=..,B=.."]
-                    [--machine T --instrument T --operator T --date D]
-                    [--cte-ppm-per-K A [--material-temp-C T] [--cte-reference-mm P]]
-
-Parses arguments and calls :mod:`volerr.positioning`; formats are described there and in
-``--help``.
-"""
+"""``volerr iso230-2 RUN.csv [RUN2.csv ...]``: ISO 230-2 evaluation of laser-interferometer
+positioning runs (see ``volerr iso230-2 --help``; the Python API :func:`volerr.iso230_2`)."""
 
 from __future__ import annotations
 
 from ._common import (add_errors_out, add_force, add_html, add_identification, add_json,
-                      add_plot, finite_option, help_text, identification_from_args,
+                      add_plot, command_parser, finite_option, identification_from_args,
                       planned_outputs, write_outputs)
 
-
-
 def register(sub) -> None:
-    p = sub.add_parser(
-        "iso230-2", help="ISO 230-2 evaluation of laser-interferometer positioning runs",
-        description="Evaluate positioning runs of one linear axis (targets x cycles x both "
-                    "directions) by ISO 230-2:2014: mean unidirectional and bidirectional "
-                    "deviations, reversal B, repeatability R, systematic error E, M and "
-                    "accuracy A; the standard's plot, an HTML certificate and an error table "
-                    "with reversal for --errors DIR.",
-        epilog=help_text("iso230-2"))
+    p = command_parser(sub, "iso230-2",
+                       "ISO 230-2 evaluation of laser-interferometer positioning runs")
     p.add_argument("runs", nargs="+", metavar="RUN.csv", help="positioning run(s), long or "
                                                                "wide format (below)")
     p.add_argument("--axis", default="X",

@@ -153,6 +153,8 @@ class Iso230_3(ResultMixin):
     data: dict
     evaluations: list
     identification: object = None
+    #: the run labels of the file (``"1"`` for a file of one run), as the plots are named
+    runs: tuple = ()
 
     def summary(self) -> str:
         """What ``volerr iso230-3`` prints: a line per channel and tilt, per run."""
@@ -188,6 +190,19 @@ class Iso230_3(ResultMixin):
 
         return [plot(ev) for ev in self.evaluations]
 
+    def plot_paths(self, path) -> list:
+        """Where the ``--plot`` PNGs of :meth:`pngs` go: ``[path]`` for a file of one run,
+        else ``STEM_<run>.png`` beside ``path`` per run (``[]`` when ``path`` is None)."""
+        from pathlib import Path
+
+        if path is None:
+            return []
+        p = Path(path)
+        if len(self.evaluations) == 1:
+            return [p]
+        require(p.suffix.lower() == ".png", f"plot file must end in .png, got {path}")
+        return [p.with_name(f"{p.stem}_{r}{p.suffix}") for r in self.runs]
+
     def write_html(self, path, inputs=()):
         """The test report (``--html``): identification, drift per channel and stage, plot."""
         import datetime
@@ -209,5 +224,7 @@ def evaluate_drift_runs(runs, stage_column: str | None = None,
     (:func:`volerr.instruments.drift.read_runs`); :func:`volerr.iso230_3` reads the file."""
     from . import iso230_3
 
+    runs = list(runs)
     evals = [iso230_3.evaluate(r, stage_column) for r in runs]
-    return Iso230_3(iso230_3.report_dict(evals), evals, identification)
+    return Iso230_3(iso230_3.report_dict(evals), evals, identification,
+                    tuple(r.run for r in runs))

@@ -47,6 +47,12 @@ class Uncertainty(ResultMixin):
     def title(self) -> str:
         return f"{self.data['layout']} {self.data['evaluation']} ({len(self.values)} samples)"
 
+    def png(self) -> bytes:
+        """The ``--plot`` figure as PNG: the histogram of :meth:`figures`."""
+        from .plots import histogram_png
+
+        return histogram_png(self.values, self.names, self.summary_stats, self.title)
+
     def write_html(self, path, inputs=()):
         """The report page (histogram, convergence, the sources and contributions)."""
         from ..fileio import write_text
@@ -87,6 +93,40 @@ def check_options(noise_um, correlation_mm, spec_acceptance, samples, digits, ma
     require(max_samples <= 10 ** 9, "--max-samples must be at most 1e9")
 
 
+def temperature_model(part_cte=None, part_dt=None, scale_cte=None, scale_dt=None,
+                      compensated: bool = False):
+    """The task's temperatures as :class:`volerr.uncertainty.ensemble.Temperature`, from
+    ``(value, u)`` pairs (the command's ``--part-cte`` ... options); ``None`` when none is
+    given.
+
+    Parameters
+    ----------
+    part_cte, scale_cte : (float, float), optional
+        Expansion coefficient of the part / the scale and its standard uncertainty, 1/K
+        (11.5e-6, not 11.5: a coefficient in ppm/K is refused, naming the unit).
+    part_dt, scale_dt : (float, float), optional
+        Temperature of the part / the scale minus 20 degC and its standard uncertainty, K.
+    compensated : bool
+        The CMM corrects the nominal expansion; only the uncertainties remain.
+    """
+    from ..units import check_cte
+    from .ensemble import Temperature
+
+    vals = {"part_cte": part_cte, "part_dt": part_dt, "scale_cte": scale_cte,
+            "scale_dt": scale_dt}
+    if all(v is None for v in vals.values()):
+        return None
+    kw = {}
+    for k, v in vals.items():
+        v = v or (0.0, 0.0)
+        require(all(abs(x) < 1e3 for x in v) and v[1] >= 0,
+                f"--{k.replace('_', '-')}: value and a non-negative u")
+        if k.endswith("cte"):   # in 1/K: 11.5 (ppm/K typed) refused, naming the unit
+            check_cte(v[0], f"--{k.replace('_', '-')}", "1/K")
+        kw[k], kw[f"u_{k}"] = float(v[0]), float(v[1])
+    return Temperature(**kw, compensated=compensated)
+
+
 def _backend(name: str) -> str:
     """The backend to use; a missing numba is one warning line on stderr, then numpy."""
     import sys
@@ -110,7 +150,9 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
                 max_samples: int = 1_000_000, seed: int = 0, chunks: int = 1,
                 scheduler: str = "none", scheduler_address: str | None = None,
                 workers: int = 2, contributions: int = 2000, backend: str = "numpy",
-                bias: str = "corrected", progress=False, accept_implausible=False) -> Uncertainty:
+                bias: str = "corrected", progress=False, accept_implausible=False,
+                part_cte=None, part_dt=None, scale_cte=None, scale_dt=None,
+                temperature_compensated: bool = False) -> Uncertainty:
     """Task-specific measurement uncertainty by Monte Carlo (``volerr uncertainty``; a
     virtual CMM, ISO/TS 15530-4, JCGM 101).
 
@@ -142,6 +184,9 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
     bias : {"corrected", "uncorrected"}
         Report the result corrected for the bias of the known errors, or the reading with an
         interval that contains the bias.
+    part_cte, part_dt, scale_cte, scale_dt, temperature_compensated
+        The temperatures as ``(value, u)`` pairs (1/K, K; :func:`temperature_model`), when
+        ``temperature`` is not given.
 
     Returns
     -------
@@ -156,6 +201,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
 
     check_options(noise_um, correlation_mm, spec_acceptance, samples, digits, max_samples,
                   seed, chunks, workers, contributions)
+    temperature = temperature or temperature_model(part_cte, part_dt, scale_cte, scale_dt,
+                                                   temperature_compensated)
     require(evaluate in tasks.EVALUATIONS, f"unknown evaluation {evaluate!r} "
                                            f"(one of {', '.join(tasks.EVALUATIONS)})")
     model = load(layout)
@@ -225,13 +272,17 @@ class Iso10360(ResultMixin):
                                "um", 1.0))
         return out
 
+    @property
+    def title(self) -> str:
+        """The title of the plot and the certificate (the verdict with an MPE)."""
+        return f"{self.data['layout']}: simulated ISO 10360-2" + (
+            f", {self.data['verdict']}" if self.data.get("mpe") else "")
+
     def png(self) -> bytes:
         """The certificate picture: E0 against L with the MPE and the undecided zone."""
         from . import iso10360 as iso
 
-        spec = self.data.get("mpe")
-        return iso.plot_png(self.result, f"{self.data['layout']}: simulated ISO 10360-2"
-                            + (f", {self.data['verdict']}" if spec else ""))
+        return iso.plot_png(self.result, self.title)
 
     def write_html(self, path, inputs=()):
         """The certificate page (``--html``)."""
