@@ -418,12 +418,24 @@ def command_parser(sub, name: str, help: str, text: str | None = None, **kwargs)
     return sub.add_parser(name, help=help, **kwargs)
 
 
+def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> None:
+    """Inside ``with outs:``: the outputs ``roles`` the command was given, each by the
+    result's ``write_ROLE`` (``--json`` :meth:`write_json`, ``--csv`` ``write_csv`` ...)."""
+    for role in roles:
+        if getattr(args, role, None):
+            getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
+
+
 def write_document_outputs(args, outs, result, ident, inputs, title: str | None = None,
                            roles=("json", "html", "plot")) -> None:
     """As :func:`write_outputs` (inside ``with outs:``), with the ``--pdf`` certificate made
     of the result's JSON document alone (its ``"parameters"`` as rows, no figures), as
-    ``iso10360`` and ``iso230-3`` write it; ``roles``: the outputs written here."""
-    for role in roles:
-        if getattr(args, role, None):
-            getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
+    ``iso10360`` and ``iso230-3`` write it; ``roles``: :func:`write_files`."""
+    write_files(args, outs, result, inputs, roles)
     write_certificates(outs, result.to_dict(), ident, inputs, title=title)
+
+
+def options_of(args, names: str, **more) -> dict:
+    """The options ``names`` (their argparse dests, space separated) as keywords of the
+    command's API function, which names them alike; ``more`` added over them."""
+    return {**{name: getattr(args, name) for name in names.split()}, **more}

@@ -1,6 +1,5 @@
-"""``volerr drift convert RAW.csv --out drift.csv``: a thermal logger's file as saved -> a
-``drift`` file (see ``volerr drift convert --help``; the Python API
-:func:`volerr.instruments.drift_test.drift_convert`)."""
+"""``volerr drift convert``: a thermal logger's file -> a drift file (``--help``; the Python
+API :func:`volerr.instruments.drift_test.drift_convert`)."""
 
 from __future__ import annotations
 

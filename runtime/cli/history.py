@@ -1,5 +1,5 @@
-"""``volerr history add|show --db DB --machine ID ...``: a machine's calibrations and checks
-over time (see ``volerr history --help``; the Python API :mod:`volerr.history`)."""
+"""``volerr history add|show``: a machine's calibrations and checks over time (``--help``;
+the Python API :mod:`volerr.history`)."""
 
 from __future__ import annotations
 
@@ -7,30 +7,24 @@ from ._common import (add_html, add_identification_arguments, add_json, command_
                       identification_from_args, planned_outputs, write_outputs)
 
 
-def _common(p) -> None:
-    p.add_argument("--db", required=True, metavar="DB",
-                   help="the history: a file (SQLite) or a postgresql:// URL")
-    p.add_argument("--machine", required=True, metavar="ID", help="the machine's id")
-    p.add_argument("--wait", type=float, default=10.0, metavar="S",
-                   help="seconds to wait for another writer's lock")
-
-
 def register(sub) -> None:
     p = command_parser(sub, "history", "a machine's calibrations and checks over time: "
                                        "events, trends, forecast")
-    s = p.add_subparsers(dest="action", metavar="ACTION")
-    s.required = True
+    s = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     a = command_parser(s, "add", "store results (calibrate / check JSON) of a machine",
                        "history", description=None)
-    _common(a)
-    a.add_argument("--date", metavar="YYYY-MM-DD",
-                   help="the date of the results, not after today (default: the date a "
-                        "result states, else today, UTC)")
-    a.add_argument("results", nargs="+", metavar="RESULT.json", help="result files")
-    a.set_defaults(func=run_add)
     sh = command_parser(s, "show", "events, trends, forecast of a machine's history", "history",
                         description=None)
-    _common(sh)
+    for q in (a, sh):
+        q.add_argument("--db", required=True, metavar="DB",
+                       help="the history: a file (SQLite) or a postgresql:// URL")
+        q.add_argument("--machine", required=True, metavar="ID", help="the machine's id")
+        q.add_argument("--wait", type=float, default=10.0, metavar="S",
+                       help="seconds to wait for another writer's lock")
+    a.add_argument("--date", metavar="YYYY-MM-DD", help="the date of the results, not after "
+                   "today (default: the date a result states, else today, UTC)")
+    a.add_argument("results", nargs="+", metavar="RESULT.json", help="result files")
+    a.set_defaults(func=run_add)
     sh.add_argument("--tolerance", metavar="'NAME=V UNIT,map=V um'",
                     help="tolerances |value| <= V of parameters (or of the volumetric error, "
                          "map=), each with its unit (22 um, 5 urad, 0.02 mm, 3 arcsec): the "
@@ -42,24 +36,23 @@ def register(sub) -> None:
 
 
 def run_add(args) -> int:
-    from .. import history
-    from ..history.run import added_lines
+    from ..history.run import add, added_lines
 
-    done = history.add(args.db, args.machine, args.results, args.date, args.wait)
+    done = add(args.db, args.machine, args.results, args.date, args.wait)
     if done:
         print(added_lines(done, args.machine))
     return 0
 
 
 def run_show(args) -> int:
-    from .. import history
+    from ..history.run import show
 
     inputs = [] if "://" in args.db else [args.db]
     outs = planned_outputs(args, inputs)
     ident = identification_from_args(args, inputs)
     ident.machine = ident.machine or (None if ident.machine_details else args.machine)
     with outs:
-        h = history.show(args.db, args.machine, args.tolerance, args.wait)
+        h = show(args.db, args.machine, args.tolerance, args.wait)
         write_outputs(args, outs, h, ident, inputs)
     print(h.summary())
     return 0

@@ -1,10 +1,10 @@
-"""``volerr iso230-3 FILE``: ISO 230-3 evaluation of a thermal drift test (see ``volerr
-iso230-3 --help``; the Python API :func:`volerr.iso230_3`)."""
+"""``volerr iso230-3``: ISO 230-3 evaluation of a thermal drift test (``--help``; the Python
+API :func:`volerr.iso230_3`)."""
 
 from __future__ import annotations
 
 from ._common import (add_force, add_html, add_identification, add_json, add_plot,
-                      command_parser, identification_from_args, write_certificates)
+                      command_parser, identification_from_args, write_document_outputs)
 
 
 def register(sub) -> None:
@@ -36,12 +36,8 @@ def run(args) -> int:
     else:
         outs.group("--plot", plots)
     with outs.check():
-        if args.json:
-            res.write_json(outs.path("--json"), inputs=inputs)
         for k, png in enumerate(res.pngs() if plots else []):
             write_bytes(outs.path(outs.group_role("--plot", plots, k)), png, inputs=inputs)
-        if args.html:
-            res.write_html(outs.path("--html"), inputs=inputs)
-        write_certificates(outs, res.to_dict(), ident, inputs)
+        write_document_outputs(args, outs, res, ident, inputs, roles=("json", "html"))
     print(res.summary())
     return 0

@@ -1,6 +1,5 @@
-"""``volerr probe-cal DATA.csv --sphere-radius R --out MAP.csv`` (probe lobing calibration on a
-master sphere, Pahk sec. 3.2, eq. 13) and ``volerr probe-cal --plan PLAN.csv ...`` (a probing
-plan): see ``volerr probe-cal --help``; the Python API :func:`volerr.probe_cal`."""
+"""``volerr probe-cal``: probe calibration on a master sphere, or a probing plan (``--help``;
+the Python API :func:`volerr.probe_cal`, :func:`volerr.probe.api.probe_plan`)."""
 
 from __future__ import annotations
 
@@ -8,53 +7,47 @@ import sys
 
 from ..errors import require
 from ._common import (add_force, add_identification_arguments, add_vector, command_parser,
-                      identification_from_args, planned_outputs, write_outputs)
+                      identification_from_args, options_of, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
     p = command_parser(sub, "probe-cal",
                        "probe lobing calibration on a master sphere (Pahk eq. 13)")
-    p.add_argument("data", nargs="?", metavar="DATA.csv",
-                   help="CSV x,y,z (ball centres, mm) [,phi_deg,theta_deg (probe frame)]")
-    p.add_argument("--sphere-radius", type=float, required=True, metavar="R",
-                   help="master-sphere radius, mm (calibrated value)")
-    p.add_argument("--out", metavar="MAP.csv",
-                   help="output map: phi_deg,theta_deg,probe_um (+ map_um, residual_um, "
-                        "r_m_mm, outlier)")
-    p.add_argument("--json", metavar="F", help="summary: r_eff_mm, center_mm, probe_error_um")
-    p.add_argument("--tilt-deg", type=float, default=0.0, metavar="A",
-                   help="probe-head tilt A, deg (default 0: vertical probe)")
-    p.add_argument("--roll-deg", type=float, default=0.0, metavar="B",
-                   help="probe-head roll B, deg (default 0)")
-    p.add_argument("--degree", type=int, metavar="L",
-                   help="spherical-harmonic degree of the smooth map (default: by "
-                        "cross-validation)")
-    p.add_argument("--outlier-k", type=float, default=5.0, metavar="K",
-                   help="flag points whose leave-one-out map residual exceeds K x 1.4826 MAD "
-                        "(default 5)")
-    p.add_argument("--exclude-outliers", action="store_true",
-                   help="refit without the flagged points (they stay in MAP.csv, flagged)")
-    p.add_argument("--plot", metavar="F.png",
-                   help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map "
-                        "(Fig. 3b)")
-    p.add_argument("--plots", metavar="DIR",
-                   help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png (Fig. 3b) into "
-                        "DIR (created when missing, its parent must exist)")
+    a = p.add_argument
+    a("data", nargs="?", metavar="DATA.csv",
+      help="CSV x,y,z (ball centres, mm) [,phi_deg,theta_deg (probe frame)]")
+    a("--sphere-radius", type=float, required=True, metavar="R",
+      help="master-sphere radius, mm (calibrated value)")
+    a("--out", metavar="MAP.csv",
+      help="output map: phi_deg,theta_deg,probe_um (+ map_um, residual_um, r_m_mm, outlier)")
+    a("--json", metavar="F", help="summary: r_eff_mm, center_mm, probe_error_um")
+    a("--tilt-deg", type=float, default=0.0, metavar="A",
+      help="probe-head tilt A, deg (default 0: vertical probe)")
+    a("--roll-deg", type=float, default=0.0, metavar="B", help="probe-head roll B, deg")
+    a("--degree", type=int, metavar="L",
+      help="spherical-harmonic degree of the smooth map (default: by cross-validation)")
+    a("--outlier-k", type=float, default=5.0, metavar="K",
+      help="flag points whose leave-one-out map residual exceeds K x 1.4826 MAD")
+    a("--exclude-outliers", action="store_true",
+      help="refit without the flagged points (they stay in MAP.csv, flagged)")
+    a("--plot", metavar="F.png",
+      help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map (Fig. 3b)")
+    a("--plots", metavar="DIR", help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png "
+                                     "(Fig. 3b) into DIR (created when missing, its parent "
+                                     "must exist)")
     add_force(p)
     g = p.add_argument_group("plan generation (--plan)")
-    g.add_argument("--plan", metavar="PLAN.csv",
-                   help="write a probing plan (nominal ball centres x,y,z,phi_deg,theta_deg) "
-                        "instead of calibrating")
-    p.add_argument("--ball-radius", type=float, metavar="r",
-                   help="stylus-ball radius, mm (nominal): needed with --plan; when "
-                        "calibrating, the effective radius the data give must match it within "
-                        "the pretravel (0.1 mm), else --sphere-radius is refused")
-    add_vector(g, "--center", default=(0.0, 0.0, 0.0),
-               help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
+    g.add_argument("--plan", metavar="PLAN.csv", help="write a probing plan (nominal ball "
+                   "centres x,y,z,phi_deg,theta_deg) instead of calibrating")
+    a("--ball-radius", type=float, metavar="r",
+      help="stylus-ball radius, mm (nominal): needed with --plan; when calibrating, the "
+           "effective radius the data give must match it within the pretravel (0.1 mm), else "
+           "--sphere-radius is refused")
+    add_vector(g, "--center", default=(0.0, 0.0, 0.0), help="sphere centre X Y Z, mm (X Y Z or "
+                                                           "X,Y,Z)")
     g.add_argument("--step-deg", type=float, default=18.0,
-                   help="Pahk plan: latitude and azimuth step, deg (default 18)")
-    g.add_argument("--circles", type=int, default=5,
-                   help="Pahk plan: number of latitude circles (default 5)")
+                   help="Pahk plan: latitude and azimuth step, deg")
+    g.add_argument("--circles", type=int, default=5, help="Pahk plan: latitude circles")
     g.add_argument("--phis", metavar="P1,P2,...",
                    help="custom plan: circle latitudes phi, deg (with --per-circle)")
     g.add_argument("--per-circle", type=int, metavar="N", help="custom plan: points per circle")
@@ -69,10 +62,9 @@ def _run_plan(args) -> int:
 
     require(args.data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
     with Outputs().file("--plan", args.plan) as outs:
-        res = probe_plan(args.sphere_radius, args.ball_radius, center=args.center,
-                         tilt_deg=args.tilt_deg, roll_deg=args.roll_deg,
-                         step_deg=args.step_deg, circles=args.circles, phis=args.phis,
-                         per_circle=args.per_circle, pole=not args.no_pole)
+        res = probe_plan(**options_of(args, "sphere_radius ball_radius center tilt_deg "
+                                            "roll_deg step_deg circles phis per_circle",
+                                      pole=not args.no_pole))
         res.write_csv(outs.path("--plan"))
     print(f"{res.summary()} -> {args.plan}")
     return 0
@@ -90,9 +82,8 @@ def run(args) -> int:
         args.plots, ("probe_map_3d.png", "probe_map_2d.png"))})
     ident = identification_from_args(args, inputs)
     with outs:
-        res = probe_cal(args.data, args.sphere_radius, tilt_deg=args.tilt_deg,
-                        roll_deg=args.roll_deg, degree=args.degree, outlier_k=args.outlier_k,
-                        exclude_outliers=args.exclude_outliers, ball_radius=args.ball_radius)
+        res = probe_cal(**options_of(args, "data sphere_radius tilt_deg roll_deg degree "
+                                           "outlier_k exclude_outliers ball_radius"))
         res.write_map(outs.path("--out"), inputs=inputs)
         if args.plots:
             res.write_plots(outs.path("--plots"))

@@ -1,6 +1,5 @@
-"""``volerr squareness LAYOUT DIR --errors-out DIR2``: squareness from the reference lines of
-straightness tables (see ``volerr squareness --help``; the Python API
-:func:`volerr.cmm.api.squareness`)."""
+"""``volerr squareness``: squareness from the reference lines of straightness tables
+(``--help``; the Python API :func:`volerr.cmm.api.squareness`)."""
 
 from __future__ import annotations
 
@@ -8,7 +7,7 @@ from pathlib import Path
 
 from ..errors import require
 from ._common import (add_accept_implausible, add_errors_out, add_force, add_json,
-                      command_parser, layout_inputs, planned_outputs)
+                      command_parser, layout_inputs, planned_outputs, write_files)
 
 
 def register(sub) -> None:
@@ -39,8 +38,7 @@ def run(args) -> int:
     with planned_outputs(args, inputs, **{"--errors-out": (out, [*res.texts,
                                                                  "constants.csv"])}) as outs:
         res.write_dir(outs.path("--errors-out"), inputs)
-        if args.json:
-            res.write_json(outs.path("--json"), inputs)
+        write_files(args, outs, res, inputs, ("json",))
     print(res.summary())
     print(f"-> {out}")
     return 0

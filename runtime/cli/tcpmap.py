@@ -1,11 +1,10 @@
-"""``volerr tcpmap LAYOUT --errors DIR --point X Y Z --plot F.png``: tool-tip error over the
-range of the two rotary axes of a five-axis machine (see ``volerr tcpmap --help``; the Python
-API :func:`volerr.tcpmap`)."""
+"""``volerr tcpmap``: five-axis tool-tip error over the range of the rotary axes
+(``--help``; the Python API :func:`volerr.tcpmap`)."""
 
 from __future__ import annotations
 
 from ._common import (add_error_arguments, add_plot, add_vector, command_parser, layout_inputs,
-                      planned_outputs)
+                      options_of, planned_outputs, write_files)
 
 
 def register(sub) -> None:
@@ -19,12 +18,8 @@ def register(sub) -> None:
     p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
     add_plot(p, "the map", "--out", required=True)
     p.add_argument("--csv", metavar="F.csv", help="write the grid (CSV)")
-    p.add_argument("--approach", default=None, metavar="DIRS",
-                   help="approach direction of linear axes whose tables carry a reversal "
-                        "column RV_<axis>_um: X+,Y- per axis, + / - for all, or sweep (the "
-                        "grid run row by row with the first rotary axis rising, each axis "
-                        "approaching in the direction it moves; not given: the bidirectional "
-                        "mean)")
+    p.add_argument("--approach", metavar="DIRS", help="approach direction of the linear axes "
+                   "with a reversal column RV_<axis>_um: X+,Y-, + / -, or sweep (below)")
     p.set_defaults(func=run)
 
 
@@ -32,21 +27,17 @@ def run(args) -> int:
     import sys
     from pathlib import Path
 
-    from ..fileio import write_text
     from ..fiveaxis.api import tcpmap
     from ._common import progress_bar
 
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
     outs = planned_outputs(args, inputs, **{"--csv": args.csv})
     with progress_bar(None, "tcpmap", total=args.steps * args.steps, unit="points") as tick:
-        res = tcpmap(args.layout, args.errors, tuple(args.point), tool=tuple(args.tool),
-                     steps=args.steps, approach=args.approach, method=args.method,
-                     degree=args.degree, extrapolate=args.extrapolate, plot_name=args.plot,
-                     progress=tick, accept_implausible=args.accept_implausible)
+        res = tcpmap(**options_of(args, "layout errors point tool steps approach method degree "
+                                        "extrapolate accept_implausible",
+                                  plot_name=args.plot, progress=tick))
     with outs:
-        res.write_plot(outs.path("--plot"))
-        if args.csv:
-            write_text(outs.path("--csv"), res.csv_text(), inputs)
+        write_files(args, outs, res, inputs, ("plot", "csv"))
     print(res.summary())
     for note in res.notes:    # after success: bad input gets exactly one line on stderr
         print(note, file=sys.stderr)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from ..errors import require
@@ -74,6 +75,18 @@ class Iso230_2(ResultMixin):
                           inputs=list(inputs))
 
 
+def correction_conditions(cte_ppm_per_K: float | None = None,
+                          material_temp_C: float | None = None) -> dict:
+    """The correction to 20 degC as test conditions of the report (``--cte-ppm-per-K``
+    in ppm/K, ``--material-temp-C`` in degC; those not given are left out)."""
+    out = {}
+    if cte_ppm_per_K is not None:
+        out["expansion coefficient"] = f"{cte_ppm_per_K:g} ppm/K (corrected to 20 \u00b0C)"
+    if material_temp_C is not None:
+        out["material temperature"] = f"{material_temp_C:g} \u00b0C"
+    return out
+
+
 def run_axes(axis: str, n: int) -> list:
     """The axis of each of ``n`` runs from ``"X"`` (all) or ``"X,Y,..."`` (one per run)."""
     axes = [a.strip().upper() for a in axis.split(",")]
@@ -119,6 +132,12 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
     from . import BudgetInputs, evaluate_files
     from pathlib import Path
 
+    for opt, v in (("instrument-ppm", instrument_ppm), ("alignment-mm", alignment_mm),
+                   ("temperature-u-K", temperature_u_K), ("cte-u-ppm-per-K", cte_u_ppm_per_K),
+                   ("eve-um", eve_um)):
+        if v is not None:
+            require(math.isfinite(v) and 0.0 <= v <= 1e3,
+                    f"--{opt} must be a number between 0 and 1000, got {v:g}")
     inputs = [runs] if isinstance(runs, str) or hasattr(runs, "__fspath__") else list(runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs),
             "the same RUN file is given twice")

@@ -127,6 +127,19 @@ def temperature_model(part_cte=None, part_dt=None, scale_cte=None, scale_dt=None
     return Temperature(**kw, compensated=compensated)
 
 
+def _sample(prob, samples, adaptive: bool, digits: int, max_samples: int, runner) -> tuple:
+    """``(values, info, adaptive_info)``: the Monte Carlo samples of ``prob`` drawn by
+    ``runner`` (``samples``, default 10 000, or the adaptive procedure of JCGM 101 7.9;
+    ``adaptive_info`` None without it)."""
+    from . import montecarlo as mc
+
+    with runner:
+        if adaptive:
+            return mc.run_adaptive(prob, runner, digits, max_samples=max_samples)
+        values, info = mc.run(prob, 10_000 if samples is None else samples, runner)
+    return values, info, None
+
+
 def _backend(name: str) -> str:
     """The backend to use; a missing numba is one warning line on stderr, then numpy."""
     import sys
@@ -150,9 +163,7 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
                 max_samples: int = 1_000_000, seed: int = 0, chunks: int = 1,
                 scheduler: str = "none", scheduler_address: str | None = None,
                 workers: int = 2, contributions: int = 2000, backend: str = "numpy",
-                bias: str = "corrected", progress=False, accept_implausible=False,
-                part_cte=None, part_dt=None, scale_cte=None, scale_dt=None,
-                temperature_compensated: bool = False) -> Uncertainty:
+                bias: str = "corrected", progress=False, accept_implausible=False) -> Uncertainty:
     """Task-specific measurement uncertainty by Monte Carlo (``volerr uncertainty``; a
     virtual CMM, ISO/TS 15530-4, JCGM 101).
 
@@ -172,7 +183,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
     noise_um : float
         Probing noise per point, standard deviation (um).
     table_std, repeatability, correlation_mm, spec_acceptance, temperature, probe_map
-        As the command's options; ``temperature`` a :class:`volerr.uncertainty.Temperature`,
+        As the command's options; ``temperature`` a :class:`volerr.uncertainty.Temperature`
+        or the keywords of :func:`temperature_model` (``{"part_cte": (value, u), ...}``),
         ``probe_map`` a probe map read by :func:`volerr.probe.read_probe_map`.
     samples : int, optional
         Monte Carlo samples (default 10 000); ``adaptive``, ``digits``, ``max_samples``: the
@@ -184,9 +196,6 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
     bias : {"corrected", "uncorrected"}
         Report the result corrected for the bias of the known errors, or the reading with an
         interval that contains the bias.
-    part_cte, part_dt, scale_cte, scale_dt, temperature_compensated
-        The temperatures as ``(value, u)`` pairs (1/K, K; :func:`temperature_model`), when
-        ``temperature`` is not given.
 
     Returns
     -------
@@ -201,8 +210,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
 
     check_options(noise_um, correlation_mm, spec_acceptance, samples, digits, max_samples,
                   seed, chunks, workers, contributions)
-    temperature = temperature or temperature_model(part_cte, part_dt, scale_cte, scale_dt,
-                                                   temperature_compensated)
+    if isinstance(temperature, dict):
+        temperature = temperature_model(**temperature)
     require(evaluate in tasks.EVALUATIONS, f"unknown evaluation {evaluate!r} "
                                            f"(one of {', '.join(tasks.EVALUATIONS)})")
     model = load(layout)
@@ -221,13 +230,9 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
     require(prob.sources, "nothing is random: the tables have no _std / _u95 columns (their _s "
                           "columns need --repeatability) and no noise, spec or temperature "
                           "uncertainty is given")
-    adaptive_info = None
-    with mc.Runner(scheduler, chunks, workers, scheduler_address, progress=progress) as runner:
-        if adaptive:
-            values, info, adaptive_info = mc.run_adaptive(prob, runner, digits,
-                                                          max_samples=max_samples)
-        else:
-            values, info = mc.run(prob, 10_000 if samples is None else samples, runner)
+    values, info, adaptive_info = _sample(prob, samples, adaptive, digits, max_samples,
+                                          mc.Runner(scheduler, chunks, workers,
+                                                    scheduler_address, progress=progress))
     stats = mc.summarize(prob, values)
     doc = report.result_document(
         prob, values, stats, info, layout=model.name, task=str(task), evaluation=evaluate,
