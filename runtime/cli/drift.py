@@ -7,21 +7,19 @@ from ._common import command_parser
 
 
 def register(sub) -> None:
-    p = sub.add_parser("drift", help="thermal drift files (ISO 230-3): convert a logger's file",
-                       description="Thermal drift files: 'convert' turns a logger's file as "
-                                   "saved (Time(min), ch1(um), t1(°C), spindle(RPM) ...) into "
-                                   "the drift format (volerr formats drift).")
+    p = command_parser(sub, "drift", "thermal drift files (ISO 230-3): convert a logger's file")
     steps = p.add_subparsers(dest="step", metavar="STEP", required=True)
     c = command_parser(steps, "convert", "a logger's CSV -> a drift file", "drift-convert")
-    c.add_argument("raw", metavar="RAW.csv", help="the logger's file (CSV, UTF-8)")
-    c.add_argument("--out", required=True, metavar="F", help="the drift file to write")
-    c.add_argument("--map", metavar="'RAW=NAME,...'",
-                   help="column names: RAW header cell = drift name (over the default rules)")
-    c.add_argument("--time-unit", choices=("s", "min", "h"),
-                   help="the unit of a time column whose header gives none")
-    c.add_argument("--channel", action="append", metavar="'LABEL=DIR [at z=MM]'",
-                   help="a channel's direction and height (repeatable)")
-    c.add_argument("--force", action="store_true", help="replace an existing --out file")
+    a = c.add_argument
+    a("raw", metavar="RAW.csv", help="the logger's file (CSV, UTF-8)")
+    a("--out", required=True, metavar="F", help="the drift file to write")
+    a("--map", metavar="'RAW=NAME,...'",
+      help="column names: RAW header cell = drift name (over the default rules)")
+    a("--time-unit", choices=("s", "min", "h"), help="the unit of a time column whose header "
+                                                    "gives none")
+    a("--channel", action="append", metavar="'LABEL=DIR [at z=MM]'",
+      help="a channel's direction and height (repeatable)")
+    a("--force", action="store_true", help="replace an existing --out file")
     c.set_defaults(func=run)
 
 

@@ -11,17 +11,17 @@ from ._common import (add_errors_out, add_force, add_html, add_identification, a
 def register(sub) -> None:
     p = command_parser(sub, "iso230-2",
                        "ISO 230-2 evaluation of laser-interferometer positioning runs")
-    p.add_argument("runs", nargs="+", metavar="RUN.csv",
-                   help="positioning run(s), long or wide format (below)")
-    p.add_argument("--axis", default="X", help="axis letter of the runs (X Y Z U V W; default "
-                                               "X), or a comma list with one per RUN file")
+    a = p.add_argument
+    a("runs", nargs="+", metavar="RUN.csv", help="positioning run(s), long or wide format (below)")
+    a("--axis", default="X", help="axis letter of the runs (X Y Z U V W; default X), or a comma "
+                                  "list with one letter per RUN file")
     add_json(p, "the results")
     add_plot(p, "the ISO 230-2 plot")
     add_html(p, "the certificate (identification, results with U, verdicts, plot, budget)")
     add_errors_out(p, "DIR/<axis>.csv (columns below)", "--table-out")
     add_force(p)
-    p.add_argument("--tolerance", metavar="'A=..,E=..'", help="tolerances in um (or with a "
-                   "length unit: A=0.012 mm) of any of A E M R B: verdicts (below)")
+    a("--tolerance", metavar="'A=..,E=..'", help="tolerances in um (or with a length unit: "
+      "A=0.012 mm) of any of A E M R B: verdicts (below)")
     u = p.add_argument_group("measurement uncertainty (ISO/TR 230-9)").add_argument
     u("--instrument-ppm", type=float, default=0.5, metavar="P", help="accuracy of the "
       "interferometer with its environmental compensation, ppm of the length (a maximum "

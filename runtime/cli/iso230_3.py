@@ -13,9 +13,8 @@ def register(sub) -> None:
     add_json(p, "the results")
     add_plot(p, "drift, tilts, speed and temperatures against time")
     add_html(p, "the test report (identification, drift per channel and stage, the plot)")
-    p.add_argument("--stage-column", metavar="NAME",
-                   help="the logged column whose changes make the stages (default: stage, "
-                        "else S_rpm)")
+    p.add_argument("--stage-column", metavar="NAME", help="the logged column whose changes "
+                   "make the stages (default: stage, else S_rpm)")
     add_force(p)
     add_identification(p, "the displacement sensors")
     p.set_defaults(func=run)

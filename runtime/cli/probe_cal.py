@@ -11,8 +11,8 @@ from ._common import (add_force, add_identification_arguments, add_vector, comma
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "probe-cal",
-                       "probe lobing calibration on a master sphere (Pahk eq. 13)")
+    p = command_parser(sub, "probe-cal", "probe lobing calibration on a master sphere (Pahk "
+                                         "eq. 13)")
     a = p.add_argument
     a("data", nargs="?", metavar="DATA.csv",
       help="CSV x,y,z (ball centres, mm) [,phi_deg,theta_deg (probe frame)]")
@@ -33,25 +33,23 @@ def register(sub) -> None:
     a("--plot", metavar="F.png",
       help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map (Fig. 3b)")
     a("--plots", metavar="DIR", help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png "
-                                     "(Fig. 3b) into DIR (created when missing, its parent "
-                                     "must exist)")
+      "(Fig. 3b) into DIR (created when missing, its parent must exist)")
     add_force(p)
-    g = p.add_argument_group("plan generation (--plan)")
-    g.add_argument("--plan", metavar="PLAN.csv", help="write a probing plan (nominal ball "
-                   "centres x,y,z,phi_deg,theta_deg) instead of calibrating")
-    a("--ball-radius", type=float, metavar="r",
-      help="stylus-ball radius, mm (nominal): needed with --plan; when calibrating, the "
-           "effective radius the data give must match it within the pretravel (0.1 mm), else "
-           "--sphere-radius is refused")
-    add_vector(g, "--center", default=(0.0, 0.0, 0.0), help="sphere centre X Y Z, mm (X Y Z or "
-                                                           "X,Y,Z)")
-    g.add_argument("--step-deg", type=float, default=18.0,
-                   help="Pahk plan: latitude and azimuth step, deg")
-    g.add_argument("--circles", type=int, default=5, help="Pahk plan: latitude circles")
-    g.add_argument("--phis", metavar="P1,P2,...",
-                   help="custom plan: circle latitudes phi, deg (with --per-circle)")
-    g.add_argument("--per-circle", type=int, metavar="N", help="custom plan: points per circle")
-    g.add_argument("--no-pole", action="store_true", help="leave out the pole point")
+    plan = p.add_argument_group("plan generation (--plan)")
+    g = plan.add_argument
+    g("--plan", metavar="PLAN.csv", help="write a probing plan (nominal ball centres "
+      "x,y,z,phi_deg,theta_deg) instead of calibrating")
+    a("--ball-radius", type=float, metavar="r", help="stylus-ball radius, mm (nominal): needed "
+      "with --plan; when calibrating, the effective radius the data give must match it within "
+      "the pretravel (0.1 mm), else --sphere-radius is refused")
+    add_vector(plan, "--center", default=(0.0, 0.0, 0.0),
+               help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
+    g("--step-deg", type=float, default=18.0, help="Pahk plan: latitude and azimuth step, deg")
+    g("--circles", type=int, default=5, help="Pahk plan: latitude circles")
+    g("--phis", metavar="P1,P2,...", help="custom plan: circle latitudes phi, deg (with "
+                                          "--per-circle)")
+    g("--per-circle", type=int, metavar="N", help="custom plan: points per circle")
+    g("--no-pole", action="store_true", help="leave out the pole point")
     add_identification_arguments(p, "the reference sphere (its calibration)")
     p.set_defaults(func=run)
 
@@ -90,6 +88,5 @@ def run(args) -> int:
         write_outputs(args, outs, res, ident, inputs)
     for note in res.calibration.notes:
         print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
-    print(res.summary())
-    print(f"map: {args.out}")
+    print(f"{res.summary()}\nmap: {args.out}")
     return 0

@@ -17,8 +17,8 @@ def register(sub) -> None:
     a("--task", required=True, metavar="CSV", help="probing points X,Y,Z[,i,j,k][,Xp,Yp,Zp] mm")
     a("--evaluate", required=True, metavar="E", help="distance, circle, sphere or plane")
     add_error_arguments(p, required=False)
-    a("--table-std", choices=("systematic", "repeatability"), default="systematic",
-      help="how the tables' _std columns are drawn (below)")
+    a("--table-std", choices=("systematic", "repeatability"), default="systematic", help="how the "
+      "tables' _std columns are drawn (below)")
     a("--repeatability", action="store_true", help="also draw the tables' _s columns (below)")
     a("--bias", choices=BIAS_MODES, default="corrected",
       help="the result corrected for the bias of the known errors, or not (below)")
@@ -30,8 +30,7 @@ def register(sub) -> None:
       help="fraction of prior candidates passing the test (sets the prior scale)")
     a("--noise-um", type=float, default=0.0, metavar="S",
       help="probing noise, standard deviation per point, um")
-    a("--probe-map", metavar="MAP.csv", help="probe error map of probe-cal (needs i,j,k in the "
-                                             "task)")
+    a("--probe-map", metavar="MAP.csv", help="probe-cal's error map (needs i,j,k in the task)")
     for name, what in (("part-cte", "part expansion coefficient and its u, 1/K"),
                        ("part-dt", "part temperature - 20 C and its u, K"),
                        ("scale-cte", "scale expansion coefficient and its u, 1/K"),
@@ -46,12 +45,10 @@ def register(sub) -> None:
     a("--digits", type=int, default=2, help="significant digits of u for --adaptive")
     a("--max-samples", type=int, default=1_000_000, metavar="N",
       help="--adaptive: stop after this many samples even when not converged")
-    a("--seed", type=int, default=0, metavar="K", help="seed of the draws (same seed, same "
-                                                      "numbers)")
+    a("--seed", type=int, default=0, metavar="K", help="seed of the random draws (reproducible)")
     a("--chunks", type=int, default=1, metavar="M",
       help="split the samples into M chunks (results identical for any M)")
-    a("--scheduler", choices=("none", "dask"), default="none", help="where the chunks run "
-                                                                   "(below)")
+    a("--scheduler", choices=("none", "dask"), default="none", help="where the chunks run (below)")
     a("--scheduler-address", metavar="ADDR", help="an existing dask scheduler")
     a("--workers", type=int, default=2, help="LocalCluster workers")
     a("--contributions", type=int, default=2000, metavar="N",
@@ -69,24 +66,21 @@ def register(sub) -> None:
 def run(args) -> int:
     from pathlib import Path
 
+    from ..probe import read_probe_map
     from ..uncertainty.api import uncertainty
 
-    inputs = [Path(args.task)] + ([Path(args.probe_map)] if args.probe_map else [])
+    inputs = [Path(f) for f in (args.task, args.probe_map) if f]
     inputs += (inputs_of(args) if args.errors else []) + layout_inputs(args.layout)
     outs = planned_outputs(args, inputs)
     ident = identification_from_args(args, inputs)
-    pmap = None
-    if args.probe_map:
-        from ..probe import read_probe_map
-        pmap = read_probe_map(args.probe_map)
-    temperature = options_of(args, "part_cte part_dt scale_cte scale_dt",
-                             compensated=args.temperature_compensated)
     res = uncertainty(**options_of(
         args, "layout task evaluate errors method degree extrapolate spec noise_um table_std "
               "repeatability correlation_mm spec_acceptance samples adaptive digits "
               "max_samples seed chunks scheduler scheduler_address workers contributions "
-              "backend bias accept_implausible", probe_map=pmap, progress=not args.quiet,
-        temperature=temperature))
+              "backend bias accept_implausible", progress=not args.quiet,
+        probe_map=read_probe_map(args.probe_map) if args.probe_map else None,
+        temperature=options_of(args, "part_cte part_dt scale_cte scale_dt",
+                               compensated=args.temperature_compensated)))
     if not args.quiet:
         print(res.summary())
     with outs:
