@@ -35,8 +35,8 @@ def run(args) -> int:
     res = squareness(args.layout, src, tables_are=args.tables_are,
                      accept_implausible=args.accept_implausible)
     inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
-    with planned_outputs(args, inputs, **{"--errors-out": (out, [*res.texts,
-                                                                 "constants.csv"])}) as outs:
+    files = [*res.texts, "constants.csv"]
+    with planned_outputs(args, inputs, **{"--errors-out": (out, files)}) as outs:
         res.write_dir(outs.path("--errors-out"), inputs)
         write_files(args, outs, res, inputs, ("json",))
     print(res.summary())
