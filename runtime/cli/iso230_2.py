@@ -66,4 +66,3 @@ def run(args) -> int:
     for n in res.notes:
         print(f"volerr iso230-2: note: {n}", file=sys.stderr)
     return 0
-
