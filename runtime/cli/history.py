@@ -1,5 +1,4 @@
-"""``volerr history add|show``: a machine's calibrations and checks over time (``--help``;
-the Python API :mod:`volerr.history`)."""
+"""``volerr history add|show``: a machine's results over time (:mod:`volerr.history`)."""
 
 from __future__ import annotations
 

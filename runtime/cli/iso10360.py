@@ -1,5 +1,4 @@
-"""``volerr iso10360``: the simulated ISO 10360-2 length measuring test (``--help``; the
-Python API :func:`volerr.iso10360`)."""
+"""``volerr iso10360``: the simulated ISO 10360-2 length test (:func:`volerr.iso10360`)."""
 
 from __future__ import annotations
 

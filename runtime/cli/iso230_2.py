@@ -1,5 +1,4 @@
-"""``volerr iso230-2``: ISO 230-2 evaluation of positioning runs (``--help``; the Python API
-:func:`volerr.iso230_2`)."""
+"""``volerr iso230-2``: ISO 230-2 evaluation of positioning runs (:func:`volerr.iso230_2`)."""
 
 from __future__ import annotations
 

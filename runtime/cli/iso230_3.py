@@ -1,5 +1,4 @@
-"""``volerr iso230-3``: ISO 230-3 evaluation of a thermal drift test (``--help``; the Python
-API :func:`volerr.iso230_3`)."""
+"""``volerr iso230-3``: ISO 230-3 evaluation of a thermal drift test (:func:`volerr.iso230_3`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""``volerr tcpmap``: five-axis tool-tip error over the range of the rotary axes
-(``--help``; the Python API :func:`volerr.tcpmap`)."""
+"""``volerr tcpmap``: five-axis tool-tip error over the rotary range (:func:`volerr.tcpmap`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""``volerr uncertainty``: task-specific uncertainty by Monte Carlo (``--help``; the Python
-API :func:`volerr.uncertainty`)."""
+"""``volerr uncertainty``: task uncertainty by Monte Carlo (:func:`volerr.uncertainty`)."""
 
 from __future__ import annotations
 
