@@ -398,3 +398,44 @@ def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
         require(math.isfinite(value) and low <= value <= high,
                 f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
     return value
+
+
+# ---------------------------------------------------------------------------------------------
+# cli-a: the helpers of iso230-2, iso230-3, iso10360, uncertainty, probe-cal, drift, history,
+# squareness and tcpmap (issue 42 item 4)
+def command_parser(sub, name: str, help: str, text: str | None = None, **kwargs):
+    """``sub.add_parser(name, help=help, **kwargs)`` with its long texts from
+    ``volerr/data/help/``: the description ``TEXT.description.txt`` and the epilog
+    ``TEXT.txt`` where those files are (``text``: ``name`` unless given)."""
+    from importlib.resources import files
+
+    folder = files("volerr") / "data" / "help"
+    text = text or name
+    if "description" not in kwargs and (folder / f"{text}.description.txt").is_file():
+        kwargs["description"] = help_text(f"{text}.description").rstrip("\n")
+    if "epilog" not in kwargs and (folder / f"{text}.txt").is_file():
+        kwargs["epilog"] = help_text(text)
+    return sub.add_parser(name, help=help, **kwargs)
+
+
+def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> None:
+    """Inside ``with outs:``: the outputs ``roles`` the command was given, each by the
+    result's ``write_ROLE`` (``--json`` :meth:`write_json`, ``--csv`` ``write_csv`` ...)."""
+    for role in roles:
+        if getattr(args, role, None):
+            getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
+
+
+def write_document_outputs(args, outs, result, ident, inputs, title: str | None = None,
+                           roles=("json", "html", "plot")) -> None:
+    """As :func:`write_outputs` (inside ``with outs:``), with the ``--pdf`` certificate made
+    of the result's JSON document alone (its ``"parameters"`` as rows, no figures), as
+    ``iso10360`` and ``iso230-3`` write it; ``roles``: :func:`write_files`."""
+    write_files(args, outs, result, inputs, roles)
+    write_certificates(outs, result.to_dict(), ident, inputs, title=title)
+
+
+def options_of(args, names: str, **more) -> dict:
+    """The options ``names`` (their argparse dests, space separated) as keywords of the
+    command's API function, which names them alike; ``more`` added over them."""
+    return {**{name: getattr(args, name) for name in names.split()}, **more}

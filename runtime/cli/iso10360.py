@@ -1,47 +1,38 @@
-"""``volerr iso10360 LAYOUT --errors DIR``: simulated ISO 10360-2 length measuring test.
-
-7 positions (4 space diagonals, lines along X, Y, Z through the centre), 5 lengths, 3
-repetitions, bidirectional; prints E0 per position and length (um) and, with --mpe, the
-verdict against the MPE line per ISO 14253-1 with the test uncertainty U; --plot draws the
-certificate picture, --html writes the certificate.  Definitions and the sign convention:
-volerr.uncertainty.iso10360.
-"""
+"""``volerr iso10360``: the simulated ISO 10360-2 length test (:func:`volerr.iso10360`)."""
 
 from __future__ import annotations
 
-
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, identification_from_args, inputs_of, write_certificates)
-from ..fileio import Outputs, write_bytes
+                      add_vector, command_parser, identification_from_args, inputs_of,
+                      options_of, planned_outputs, write_document_outputs)
 
 
 def register(sub) -> None:
-    p = sub.add_parser("iso10360", help="simulated ISO 10360-2 length measuring test (E0)",
-                       description=__doc__.split("\n\n")[1].replace("``", ""))
-    p.add_argument("layout", help="layout name (volerr layouts) or layout file")
+    p = command_parser(sub, "iso10360", "simulated ISO 10360-2 length measuring test (E0)")
+    a = p.add_argument
+    a("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)
     add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
                help="probe offset XP YP ZP, mm (X Y Z or X,Y,Z; E0 is tested with 0 0 0)")
-    p.add_argument("--volume", choices=("travel", "measured"), default="travel",
-                   help="box of the test: the layout's travel or the part of it the error "
-                        "tables cover")
-    p.add_argument("--mpe", metavar="'E0=A+L/K'",
-                   help="MPE line to judge against (A um, or with a length unit: E0=1.5 um+L/333; "
-                        "L mm): verdict per ISO 14253-1")
-    p.add_argument("--noise-um", type=float, default=0.0, metavar="S",
-                   help="probing noise per point, standard deviation, um")
-    p.add_argument("--seed", type=int, default=0, metavar="K", help="seed of the probing noise")
+    a("--volume", choices=("travel", "measured"), default="travel", help="box of the test: the "
+      "layout's travel or the part of it the error tables cover")
+    a("--mpe", metavar="'E0=A+L/K'", help="MPE line to judge against (A um, or with a length "
+      "unit: E0=1.5 um+L/333; L mm): verdict per ISO 14253-1")
+    a("--noise-um", type=float, default=0.0, metavar="S",
+      help="probing noise per point, standard deviation, um")
+    a("--seed", type=int, default=0, metavar="K", help="seed of the probing noise")
     g = p.add_argument_group("test uncertainty U(L), k = 2 (ISO 10360-2 / ISO 14253-5)")
-    g.add_argument("--artefact-u", default="0.1+L/2000", metavar="'A+L/K'",
-                   help="expanded calibration uncertainty of the reference lengths, um (L mm)")
-    g.add_argument("--artefact-cte-ppm-per-K", type=float, default=11.5, metavar="A",
-                   help="expansion coefficient of the artefact, ppm/K")
-    g.add_argument("--artefact-cte-u-ppm-per-K", type=float, default=1.0, metavar="U",
-                   help="standard uncertainty of that coefficient, ppm/K")
-    g.add_argument("--temperature-C", type=float, default=20.0, metavar="T",
-                   help="artefact temperature during the test, degC")
-    g.add_argument("--temperature-u-K", type=float, default=0.2, metavar="U",
-                   help="standard uncertainty of the artefact temperature, K")
+    g = g.add_argument
+    g("--artefact-u", default="0.1+L/2000", metavar="'A+L/K'",
+      help="expanded calibration uncertainty of the reference lengths, um (L mm)")
+    g("--artefact-cte-ppm-per-K", type=float, default=11.5, metavar="A",
+      help="expansion coefficient of the artefact, ppm/K")
+    g("--artefact-cte-u-ppm-per-K", type=float, default=1.0, metavar="U",
+      help="standard uncertainty of that coefficient, ppm/K")
+    g("--temperature-C", type=float, default=20.0, metavar="T",
+      help="artefact temperature during the test, degC")
+    g("--temperature-u-K", type=float, default=0.2, metavar="U",
+      help="standard uncertainty of the artefact temperature, K")
     add_json(p, "E0 values, U, verdicts")
     add_plot(p, "E0 against L with the MPE, the undecided zone and the marked values")
     add_html(p, "the certificate (identification, verdict, plot, every E0)")
@@ -50,35 +41,18 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    import math
+
     from ..uncertainty.api import iso10360
 
     inputs = inputs_of(args)
-    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot) \
-        .file("--html", args.html).file("--pdf", args.pdf).check()
-    ident = identification_from_args(args, inputs, {
-        "artefact temperature": f"{args.temperature_C:g} \u00b0C (u = {args.temperature_u_K:g} K)",
-        "artefact expansion coefficient": f"{args.artefact_cte_ppm_per_K:g} ppm/K (u = "
-                                          f"{args.artefact_cte_u_ppm_per_K:g} ppm/K)"})
-    res = iso10360(
-        args.layout, args.errors, method=args.method, degree=args.degree,
-        extrapolate=args.extrapolate, probe=args.probe,
-        volume=args.volume, mpe=args.mpe, noise_um=args.noise_um, seed=args.seed,
-        artefact_u=args.artefact_u, artefact_cte_ppm_per_K=args.artefact_cte_ppm_per_K,
-        artefact_cte_u_ppm_per_K=args.artefact_cte_u_ppm_per_K,
-        temperature_C=args.temperature_C, temperature_u_K=args.temperature_u_K,
-        identification=ident, accept_implausible=args.accept_implausible)
+    outs = planned_outputs(args, inputs)
+    res = iso10360(**options_of(
+        args, "layout errors method degree extrapolate probe volume mpe noise_um seed "
+              "artefact_u artefact_cte_ppm_per_K artefact_cte_u_ppm_per_K temperature_C "
+              "temperature_u_K accept_implausible",
+        identification=identification_from_args(args, inputs)))
     print(res.summary())
     with outs:
-        if args.json:
-            res.write_json(outs.path("--json"), inputs)
-        if args.plot:
-            write_bytes(outs.path("--plot"), res.png(), inputs)
-        if args.html:
-            res.write_html(outs.path("--html"), inputs)
-        d = res.to_dict()
-        title = f"{d['layout']}: simulated ISO 10360-2" + \
-            (f", {d['verdict']}" if args.mpe is not None else "")
-        write_certificates(outs, d, ident, inputs, title)
-    import math
-
+        write_document_outputs(args, outs, res, res.identification, inputs, res.title)
     return 0 if math.isfinite(res.data["max_abs_E_um"]) else 1

@@ -1,23 +1,17 @@
-"""``volerr squareness LAYOUT DIR --errors-out DIR2``: squareness from straightness reference lines.
-
-Reads the error tables of DIR (``X.csv``, ``Y.csv``, ``Z.csv`` ..., e.g. written by ``volerr
-identify``), fits the least-squares reference straight line of every straightness, writes the
-squareness errors ``EC0Y EB0Z EA0Z`` (those whose two straightness tables exist) to
-``DIR2/constants.csv`` (with the other constants of DIR) and the tables with the slopes removed
-to DIR2.  Sign convention: ``volerr.cmm.squareness``.
-"""
+"""``volerr squareness``: squareness from the reference lines of straightness tables
+(``--help``; the Python API :func:`volerr.cmm.api.squareness`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..errors import require
-from ._common import add_accept_implausible, add_errors_out, add_force, add_json
+from ._common import (add_accept_implausible, add_errors_out, add_force, add_json,
+                      command_parser, layout_inputs, planned_outputs, write_files)
 
 
 def register(sub) -> None:
-    p = sub.add_parser("squareness", help="squareness of linear axes from straightness tables",
-                       description=__doc__.split("\n\n")[1])
+    p = command_parser(sub, "squareness", "squareness of linear axes from straightness tables")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("directory", help="error directory with the straightness tables")
     add_errors_out(p, "the squareness with the slope-free tables (must differ from DIR)",
@@ -33,9 +27,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ._common import layout_inputs
     from ..cmm.api import squareness
-    from ..fileio import Outputs
 
     src, out = Path(args.directory), Path(args.errors_out)
     require(not (out.exists() and out.resolve() == src.resolve()),
@@ -43,13 +35,10 @@ def run(args) -> int:
     res = squareness(args.layout, src, tables_are=args.tables_are,
                      accept_implausible=args.accept_implausible)
     inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
-    outs = Outputs(inputs, force=args.force) \
-        .folder("--errors-out", out, files=[*res.texts, "constants.csv"]) \
-        .file("--json", args.json).check()
-    with outs:
+    files = [*res.texts, "constants.csv"]
+    with planned_outputs(args, inputs, **{"--errors-out": (out, files)}) as outs:
         res.write_dir(outs.path("--errors-out"), inputs)
-        if args.json:
-            res.write_json(outs.path("--json"), inputs)
+        write_files(args, outs, res, inputs, ("json",))
     print(res.summary())
     print(f"-> {out}")
     return 0

@@ -240,11 +240,19 @@ class ToolTipMap(ResultMixin):
 
         return {"map": unsaved(draw_tcp_error_map, self.map)}
 
-    def write_plot(self, path) -> Path:
-        """The map as PNG (:func:`volerr.fiveaxis.plots.plot_tcp_error_map`)."""
+    def write_plot(self, path, inputs=()) -> Path:
+        """The map as PNG (:func:`volerr.fiveaxis.plots.plot_tcp_error_map`); ``inputs``:
+        files it must not replace."""
+        from ..fileio import check_plot
         from .plots import plot_tcp_error_map
 
-        return plot_tcp_error_map(self.map, path)
+        return plot_tcp_error_map(self.map, check_plot(path, list(inputs)))
+
+    def write_csv(self, path, inputs=()) -> Path:
+        """Write :meth:`csv_text` (``--csv``); returns its path."""
+        from ..fileio import write_text
+
+        return write_text(path, self.csv_text(), inputs=list(inputs))
 
     def __repr__(self) -> str:
         s = self.data

@@ -42,6 +42,20 @@ def check_machine(machine: str) -> str:
     return machine
 
 
+def check_wait(wait_s: float) -> float:
+    """``wait_s`` (seconds to wait for another writer's lock) when within 0 to 3600 s, else
+    :class:`InputError`."""
+    require(0 <= wait_s <= 3600, f"--wait {wait_s:g}: 0 to 3600 s")
+    return wait_s
+
+
+def added_lines(done: list, machine: str) -> str:
+    """What ``volerr history add`` prints: a line per result of :func:`add`'s ``done``
+    (its file, kind, layout and date, and whether it was added or stored already)."""
+    return "\n".join(f"{entry.source}: {entry.kind} of {entry.layout} on {entry.date} for "
+                     f"machine {machine}: {what}" for entry, what in done)
+
+
 def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 10.0) -> list:
     """Add the result files to ``machine``'s history in ``db`` (module docstring); returns
     ``[(Entry, "added" | "already stored")]``.  Every entry reported ``"added"`` is committed.
@@ -52,6 +66,7 @@ def add(db: str, machine: str, files, date: str | None = None, wait_s: float = 1
     are read again and added to what is stored."""
     from .store import Conflict, Store, add_to_new_file
 
+    check_wait(wait_s)
     check_machine(machine)
     files = list(files)
     require(files, "give at least one RESULT.json")
@@ -150,6 +165,7 @@ def show(db: str, machine: str, tolerance: str | None = None, wait_s: float = 10
     from .report import History
     from .store import Store
 
+    check_wait(wait_s)
     check_machine(machine)
     tol = parse_tolerances(tolerance)
     store = Store(db, wait_s=wait_s, create=False)

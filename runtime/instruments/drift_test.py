@@ -5,6 +5,8 @@ a thermal drift test.  Here, in the instruments' room, because it reads the drif
 
 from __future__ import annotations
 
+from ..results import ResultMixin
+
 
 def iso230_3(file, *, stage_column: str | None = None, identification=None):
     """ISO 230-3:2020 evaluation of a thermal drift test (environmental temperature
@@ -32,3 +34,67 @@ def iso230_3(file, *, stage_column: str | None = None, identification=None):
     from .drift import read_runs
 
     return evaluate_drift_runs(read_runs(file), stage_column, identification)
+
+
+def drift_convert(raw, *, mapping=None, time_unit: str | None = None, channels=None):
+    """A thermal logger's file as saved -> a ``drift`` file (``volerr drift convert``).
+
+    Parameters
+    ----------
+    raw : str or path
+        The logger's CSV (UTF-8): ``Time(min)``, ``ch1(um)``, ``t1(°C)``, ``spindle(RPM)`` ...
+        (the header rules of :mod:`volerr.instruments._drift_logger`).
+    mapping : str or dict, optional
+        Column names over the rules: ``"RAW=NAME,..."`` (``--map``) or ``{RAW: NAME}``.
+    time_unit : {"s", "min", "h"}, optional
+        The unit of a time column whose header gives none.
+    channels : list of str or dict, optional
+        A channel's direction and height: ``["ch1=X at z=120", ...]`` (``--channel``) or
+        ``{label: "X at z=120"}`` (direction X Y Z -X -Y -Z ?, height on the mandrel, mm).
+
+    Returns
+    -------
+    DriftConversion
+        ``text`` the drift file (time in s, displacements in um), read back already: a file
+        that converts is a file ``volerr iso230-3`` and ``volerr loop`` read.
+    """
+    from . import _drift_logger as logger
+    from .drift import convert
+
+    if not isinstance(mapping, dict):
+        mapping = logger.parse_map(mapping)
+    if not isinstance(channels, dict):
+        channels = logger.parse_channels(channels)
+    text, runs = convert(raw, mapping, time_unit, channels)
+    return DriftConversion(text, runs)
+
+
+class DriftConversion(ResultMixin):
+    """Result of :func:`drift_convert`: ``text`` the drift file, ``runs`` its
+    :class:`volerr.instruments.drift.DriftRun` (time in s, displacements in um)."""
+
+    def __init__(self, text: str, runs: list):
+        self.text, self.runs = text, list(runs)
+
+    def data(self) -> dict:
+        """Per run: readings, time span (s), channels with their directions, other inputs."""
+        return {"runs": [{"run": r.run, "n_readings": r.n,
+                          "span_s": float(r.t_s[-1] - r.t_s[0]),
+                          "channels": {k: r.directions[k] for k in r.channels},
+                          "inputs": list(r.inputs)} for r in self.runs]}
+
+    def summary(self, out: str = "drift file") -> str:
+        """What ``volerr drift convert`` prints, ``out`` the name of the file written."""
+        lines = []
+        for r in self.runs:
+            head = out if len(self.runs) == 1 else f"{out}[{r.run}]"
+            lines.append(f"{head}: {r.n} readings over {r.t_s[-1] - r.t_s[0]:g} s; channels "
+                         f"{', '.join(f'{k} ({r.directions[k]})' for k in r.channels)}; inputs "
+                         f"{', '.join(r.inputs) or 'none'}")
+        return "\n".join(lines)
+
+    def write(self, path, inputs=()):
+        """Write the drift file (``--out``); returns its path."""
+        from ..fileio import write_text
+
+        return write_text(path, self.text, inputs=list(inputs))

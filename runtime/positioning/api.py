@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from ..errors import require
@@ -74,6 +75,18 @@ class Iso230_2(ResultMixin):
                           inputs=list(inputs))
 
 
+def correction_conditions(cte_ppm_per_K: float | None = None,
+                          material_temp_C: float | None = None) -> dict:
+    """The correction to 20 degC as test conditions of the report (``--cte-ppm-per-K``
+    in ppm/K, ``--material-temp-C`` in degC; those not given are left out)."""
+    out = {}
+    if cte_ppm_per_K is not None:
+        out["expansion coefficient"] = f"{cte_ppm_per_K:g} ppm/K (corrected to 20 \u00b0C)"
+    if material_temp_C is not None:
+        out["material temperature"] = f"{material_temp_C:g} \u00b0C"
+    return out
+
+
 def run_axes(axis: str, n: int) -> list:
     """The axis of each of ``n`` runs from ``"X"`` (all) or ``"X,Y,..."`` (one per run)."""
     axes = [a.strip().upper() for a in axis.split(",")]
@@ -119,6 +132,12 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
     from . import BudgetInputs, evaluate_files
     from pathlib import Path
 
+    for opt, v in (("instrument-ppm", instrument_ppm), ("alignment-mm", alignment_mm),
+                   ("temperature-u-K", temperature_u_K), ("cte-u-ppm-per-K", cte_u_ppm_per_K),
+                   ("eve-um", eve_um)):
+        if v is not None:
+            require(math.isfinite(v) and 0.0 <= v <= 1e3,
+                    f"--{opt} must be a number between 0 and 1000, got {v:g}")
     inputs = [runs] if isinstance(runs, str) or hasattr(runs, "__fspath__") else list(runs)
     require(len({Path(f).resolve() for f in inputs}) == len(inputs),
             "the same RUN file is given twice")
@@ -153,6 +172,8 @@ class Iso230_3(ResultMixin):
     data: dict
     evaluations: list
     identification: object = None
+    #: the run labels of the file (``"1"`` for a file of one run), as the plots are named
+    runs: tuple = ()
 
     def summary(self) -> str:
         """What ``volerr iso230-3`` prints: a line per channel and tilt, per run."""
@@ -188,6 +209,19 @@ class Iso230_3(ResultMixin):
 
         return [plot(ev) for ev in self.evaluations]
 
+    def plot_paths(self, path) -> list:
+        """Where the ``--plot`` PNGs of :meth:`pngs` go: ``[path]`` for a file of one run,
+        else ``STEM_<run>.png`` beside ``path`` per run (``[]`` when ``path`` is None)."""
+        from pathlib import Path
+
+        if path is None:
+            return []
+        p = Path(path)
+        if len(self.evaluations) == 1:
+            return [p]
+        require(p.suffix.lower() == ".png", f"plot file must end in .png, got {path}")
+        return [p.with_name(f"{p.stem}_{r}{p.suffix}") for r in self.runs]
+
     def write_html(self, path, inputs=()):
         """The test report (``--html``): identification, drift per channel and stage, plot."""
         import datetime
@@ -209,5 +243,7 @@ def evaluate_drift_runs(runs, stage_column: str | None = None,
     (:func:`volerr.instruments.drift.read_runs`); :func:`volerr.iso230_3` reads the file."""
     from . import iso230_3
 
+    runs = list(runs)
     evals = [iso230_3.evaluate(r, stage_column) for r in runs]
-    return Iso230_3(iso230_3.report_dict(evals), evals, identification)
+    return Iso230_3(iso230_3.report_dict(evals), evals, identification,
+                    tuple(r.run for r in runs))

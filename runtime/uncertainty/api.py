@@ -47,6 +47,12 @@ class Uncertainty(ResultMixin):
     def title(self) -> str:
         return f"{self.data['layout']} {self.data['evaluation']} ({len(self.values)} samples)"
 
+    def png(self) -> bytes:
+        """The ``--plot`` figure as PNG: the histogram of :meth:`figures`."""
+        from .plots import histogram_png
+
+        return histogram_png(self.values, self.names, self.summary_stats, self.title)
+
     def write_html(self, path, inputs=()):
         """The report page (histogram, convergence, the sources and contributions)."""
         from ..fileio import write_text
@@ -85,6 +91,53 @@ def check_options(noise_um, correlation_mm, spec_acceptance, samples, digits, ma
     require(workers >= 1, "--workers must be >= 1")
     require(0 <= contributions <= 10 ** 6, "--contributions must be between 0 and 1e6")
     require(max_samples <= 10 ** 9, "--max-samples must be at most 1e9")
+
+
+def temperature_model(part_cte=None, part_dt=None, scale_cte=None, scale_dt=None,
+                      compensated: bool = False):
+    """The task's temperatures as :class:`volerr.uncertainty.ensemble.Temperature`, from
+    ``(value, u)`` pairs (the command's ``--part-cte`` ... options); ``None`` when none is
+    given.
+
+    Parameters
+    ----------
+    part_cte, scale_cte : (float, float), optional
+        Expansion coefficient of the part / the scale and its standard uncertainty, 1/K
+        (11.5e-6, not 11.5: a coefficient in ppm/K is refused, naming the unit).
+    part_dt, scale_dt : (float, float), optional
+        Temperature of the part / the scale minus 20 degC and its standard uncertainty, K.
+    compensated : bool
+        The CMM corrects the nominal expansion; only the uncertainties remain.
+    """
+    from ..units import check_cte
+    from .ensemble import Temperature
+
+    vals = {"part_cte": part_cte, "part_dt": part_dt, "scale_cte": scale_cte,
+            "scale_dt": scale_dt}
+    if all(v is None for v in vals.values()):
+        return None
+    kw = {}
+    for k, v in vals.items():
+        v = v or (0.0, 0.0)
+        require(all(abs(x) < 1e3 for x in v) and v[1] >= 0,
+                f"--{k.replace('_', '-')}: value and a non-negative u")
+        if k.endswith("cte"):   # in 1/K: 11.5 (ppm/K typed) refused, naming the unit
+            check_cte(v[0], f"--{k.replace('_', '-')}", "1/K")
+        kw[k], kw[f"u_{k}"] = float(v[0]), float(v[1])
+    return Temperature(**kw, compensated=compensated)
+
+
+def _sample(prob, samples, adaptive: bool, digits: int, max_samples: int, runner) -> tuple:
+    """``(values, info, adaptive_info)``: the Monte Carlo samples of ``prob`` drawn by
+    ``runner`` (``samples``, default 10 000, or the adaptive procedure of JCGM 101 7.9;
+    ``adaptive_info`` None without it)."""
+    from . import montecarlo as mc
+
+    with runner:
+        if adaptive:
+            return mc.run_adaptive(prob, runner, digits, max_samples=max_samples)
+        values, info = mc.run(prob, 10_000 if samples is None else samples, runner)
+    return values, info, None
 
 
 def _backend(name: str) -> str:
@@ -130,7 +183,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
     noise_um : float
         Probing noise per point, standard deviation (um).
     table_std, repeatability, correlation_mm, spec_acceptance, temperature, probe_map
-        As the command's options; ``temperature`` a :class:`volerr.uncertainty.Temperature`,
+        As the command's options; ``temperature`` a :class:`volerr.uncertainty.Temperature`
+        or the keywords of :func:`temperature_model` (``{"part_cte": (value, u), ...}``),
         ``probe_map`` a probe map read by :func:`volerr.probe.read_probe_map`.
     samples : int, optional
         Monte Carlo samples (default 10 000); ``adaptive``, ``digits``, ``max_samples``: the
@@ -156,6 +210,8 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
 
     check_options(noise_um, correlation_mm, spec_acceptance, samples, digits, max_samples,
                   seed, chunks, workers, contributions)
+    if isinstance(temperature, dict):
+        temperature = temperature_model(**temperature)
     require(evaluate in tasks.EVALUATIONS, f"unknown evaluation {evaluate!r} "
                                            f"(one of {', '.join(tasks.EVALUATIONS)})")
     model = load(layout)
@@ -174,13 +230,9 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
     require(prob.sources, "nothing is random: the tables have no _std / _u95 columns (their _s "
                           "columns need --repeatability) and no noise, spec or temperature "
                           "uncertainty is given")
-    adaptive_info = None
-    with mc.Runner(scheduler, chunks, workers, scheduler_address, progress=progress) as runner:
-        if adaptive:
-            values, info, adaptive_info = mc.run_adaptive(prob, runner, digits,
-                                                          max_samples=max_samples)
-        else:
-            values, info = mc.run(prob, 10_000 if samples is None else samples, runner)
+    values, info, adaptive_info = _sample(prob, samples, adaptive, digits, max_samples,
+                                          mc.Runner(scheduler, chunks, workers,
+                                                    scheduler_address, progress=progress))
     stats = mc.summarize(prob, values)
     doc = report.result_document(
         prob, values, stats, info, layout=model.name, task=str(task), evaluation=evaluate,
@@ -225,13 +277,17 @@ class Iso10360(ResultMixin):
                                "um", 1.0))
         return out
 
+    @property
+    def title(self) -> str:
+        """The title of the plot and the certificate (the verdict with an MPE)."""
+        return f"{self.data['layout']}: simulated ISO 10360-2" + (
+            f", {self.data['verdict']}" if self.data.get("mpe") else "")
+
     def png(self) -> bytes:
         """The certificate picture: E0 against L with the MPE and the undecided zone."""
         from . import iso10360 as iso
 
-        spec = self.data.get("mpe")
-        return iso.plot_png(self.result, f"{self.data['layout']}: simulated ISO 10360-2"
-                            + (f", {self.data['verdict']}" if spec else ""))
+        return iso.plot_png(self.result, self.title)
 
     def write_html(self, path, inputs=()):
         """The certificate page (``--html``)."""
