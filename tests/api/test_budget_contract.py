@@ -1,0 +1,57 @@
+"""Issue 45 item 3, done-when: every reported uncertainty has a budget whose combined u
+equals the stated u to 1e-6 relative.
+
+Walks every result kind of :mod:`test_result_contract` (its ``CASES``, built by the API on
+the shipped examples, its ``ex`` fixture): for each row of ``table()`` with a standard
+uncertainty u > 0 (a u of 0 is a datum, fixed by definition: no budget), the budget of that
+row (:func:`volerr.report.budget.of_row` over :func:`volerr.report.content.budgets_of` of the
+JSON document) exists, and
+
+* its combined u, recomputed here as the root sum of squares of |c_i| u(x_i) of its sources
+  (not the budget's own ``u`` field), equals the row's u to 1e-6 relative;
+* its ``u`` field and ``U = k u`` agree with that;
+* every contribution is |c_i| u(x_i) of its source.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from api.test_result_contract import CASES, ex  # noqa: F401  (the fixture, reused)
+from volerr.report.budget import of_row
+from volerr.report.content import budgets_of
+
+pytestmark = pytest.mark.xdist_group("api_examples")
+
+
+def _combined(b: dict) -> float:
+    total = 0.0
+    for s in b["sources"]:
+        c = abs(float(s["sensitivity"])) * float(s["u"])
+        assert math.isclose(c, s["contribution"], rel_tol=1e-12, abs_tol=1e-300), s
+        total += c * c
+    return math.sqrt(total)
+
+
+@pytest.mark.parametrize("kind", list(CASES))
+def test_every_reported_uncertainty_has_its_budget(kind, ex, monkeypatch):  # noqa: F811
+    monkeypatch.chdir(ex)
+    r = CASES[kind][1]()
+    budgets = budgets_of(r.to_dict())
+    missing, wrong = [], []
+    for row in r._rows():
+        if row.std is None or not row.std > 0:
+            continue
+        b = of_row(budgets, row.name)
+        if b is None:
+            missing.append(row.name)
+            continue
+        u = _combined(b)
+        if not math.isclose(u, row.std, rel_tol=1e-6):
+            wrong.append((row.name, row.std, u))
+        assert math.isclose(b["u"], u, rel_tol=1e-9) and \
+            math.isclose(b["U"], b["k"] * u, rel_tol=1e-9), b
+    assert not missing, f"{kind}: no budget for {len(missing)} rows: {missing[:5]}"
+    assert not wrong, f"{kind}: combined u != stated u: {wrong[:5]}"
