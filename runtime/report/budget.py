@@ -53,6 +53,17 @@ def of_row(budgets, name: str):
                 None)
 
 
+def restated(b: dict, u_stated: float) -> dict:
+    """The budget ``b`` for a u the report states rounded (``u_stated``, within 1e-3 relative
+    of ``b["u"]``): every source's u(x_i) and contribution scaled by u_stated / u, so that
+    the combined u is the stated one; ``b`` as it is when they differ by more."""
+    f = float(u_stated) / b["u"] if b["u"] > 0 else 1.0
+    if abs(f - 1.0) > 1e-3:
+        return b
+    srcs = [dict(s, u=s["u"] * f, contribution=s["contribution"] * f) for s in b["sources"]]
+    return {**b, "sources": srcs, "u": b["u"] * f, "U": b["U"] * f}
+
+
 def combined(b: dict) -> float:
     """The combined standard uncertainty of a budget recomputed from its contributions."""
     return math.sqrt(sum(s["contribution"] ** 2 for s in b["sources"]))
