@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from api.test_result_contract import CASES, ex  # noqa: F401  (the fixture, reused)
@@ -60,3 +61,33 @@ def test_every_reported_uncertainty_has_its_budget(kind, ex, monkeypatch):  # no
             math.isclose(b["U"], b["k"] * b["u"], rel_tol=1e-9), b
     assert not missing, f"{kind}: no budget for {len(missing)} rows: {missing[:5]}"
     assert not wrong, f"{kind}: combined u != stated u: {wrong[:5]}"
+
+
+def _series(y, s, step_days=7.0):
+    from volerr.history import analysis as an
+
+    t = 20000.0 + step_days * np.arange(len(y))
+    return an.Series("P", "um", [an.date_of(x) for x in t], t, np.asarray(y, float),
+                     np.asarray(s, float))
+
+
+def test_history_steps_and_trends_have_their_budgets():
+    """The example history has one entry per parameter (no step, no trend): a planted step
+    and a drifting series here.  The slope of a line through equally uncertain entries
+    (chi2/dof <= 1: not widened) has u = u_entry / sqrt(sum (t - mean t)^2) (textbook WLS),
+    the budget's combined u; a step's budget combines to the std the rule states."""
+    from volerr.history import analysis as an
+
+    rng = np.random.default_rng(7)
+    y = np.r_[np.zeros(8), np.full(8, 20.0)] + rng.normal(0, 0.3, 16)
+    steps = [c for c in an.changes(_series(y, np.full(16, 0.5))) if c["kind"] == an.STEP]
+    assert steps
+    for c in steps:
+        assert math.isclose(_combined(c["budget"]), c["std"], rel_tol=1e-6)
+    t = 7.0 * np.arange(10)
+    s = _series(0.01 * t + rng.normal(0, 0.05, 10), np.full(10, 0.5))   # scatter < u
+    tr = an.trend(s)
+    assert not tr.scaled
+    expected = 0.5 / math.sqrt(np.sum((t - t.mean()) ** 2))
+    assert math.isclose(_combined(tr.budget), expected, rel_tol=1e-9)
+    assert math.isclose(_combined(tr.budget), math.sqrt(tr.cov[1, 1]), rel_tol=1e-6)
