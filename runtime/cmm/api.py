@@ -180,7 +180,7 @@ def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
                                 profile_points)
     doc = {"layout": model.name, "probe_mm": [float(v) for v in probe],
            "errors": (funcs.source or "") if errors is funcs else str(errors), "method": method,
-           "lines": [r.as_dict() for r in results]}
+           "lines": [r.as_dict() for r in results], "budgets": dg.budgets(results)}
     return Diagonals(doc, results)
 
 
