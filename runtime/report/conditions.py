@@ -126,8 +126,8 @@ def of(doc: dict, stated: dict | None = None) -> dict:
 
 def measured(doc: dict) -> list:
     """The standard's own results beside the result rows, as (heading, table rows): the
-    ISO 230-4 G, H and F of every ballbar trace (µm; their uncertainty is not evaluated:
-    said in a note row), nothing for the other tests (their rows carry U)."""
+    ISO 230-4 G, H and F of every ballbar trace (µm; their U in the result rows, their
+    budgets from :func:`volerr.ballbar.iso230_4.budgets`), nothing for the other tests."""
     from .fmt import number
 
     tr = [t for t in doc.get("traces") or [] if isinstance(t, dict) and "G_um" in t]
@@ -140,5 +140,5 @@ def measured(doc: dict) -> list:
               number(t.get("F_min_um")), number(t.get("F_max_um"))] for t in tr]
     return [("ISO 230-4 results per trace", "table", rows),
             (None, "text", "G: circular deviation, H: circular hysteresis, F: radial "
-                           "deviation (ISO 230-4). Their measurement uncertainty is not "
-                           "evaluated here (no ISO 230-9 budget of the ballbar test yet).")]
+                           "deviation (ISO 230-4). Their u, k and U are in the results, "
+                           "their uncertainty budgets below.")]

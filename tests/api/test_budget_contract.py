@@ -91,3 +91,29 @@ def test_history_steps_and_trends_have_their_budgets():
     expected = 0.5 / math.sqrt(np.sum((t - t.mean()) ** 2))
     assert math.isclose(_combined(tr.budget), expected, rel_tol=1e-9)
     assert math.isclose(_combined(tr.budget), math.sqrt(tr.cov[1, 1]), rel_tol=1e-6)
+
+
+def test_ballbar_g_f_h_budgets_on_an_oval_trace():
+    """An oval path dr = A cos(2 theta), every reading u = 0.5 um: the largest radius at
+    theta = 0, the smallest at 90 deg, so their radial directions differ by sqrt(2); the
+    least-squares centre's u per coordinate is u sqrt(2 / n).  Expected (GUM, by hand):
+    u(G) = sqrt(2 u^2 + 2 (u sqrt(2 / n))^2), u(F_max) = u(F_min) = u; H of a clockwise
+    trace read at the same angles: the interpolation is exact there, u(H) = sqrt(2) u."""
+    from volerr.ballbar import iso230_4 as iso
+
+    n, u, A = 72, 0.5, 4e-3
+    th = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    dr = A * np.cos(2 * th)
+
+    def trace(direction, extra):
+        return iso.Trace("t.csv", "p", direction, "XY", 150.0, th, dr + extra,
+                         np.arange(n), np.zeros(3), np.full(n, u * 1e-3))
+
+    trs = [trace(1, 0.0), trace(-1, 1e-3 * (th > np.pi))]
+    res = iso.evaluate_all(trs)
+    b = iso.budgets(trs, res)
+    assert math.isclose(_combined(b["G t.csv p ccw"]),
+                        math.sqrt(2 * u ** 2 + 2 * (u * math.sqrt(2 / n)) ** 2), rel_tol=1e-9)
+    assert math.isclose(_combined(b["F_max t.csv p ccw"]), u, rel_tol=1e-12)
+    assert math.isclose(_combined(b["H t.csv p"]), math.sqrt(2) * u, rel_tol=1e-9)
+    assert res[0]["u_H_um"] == res[1]["u_H_um"] == b["H t.csv p"]["u"]
