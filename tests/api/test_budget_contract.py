@@ -117,3 +117,26 @@ def test_ballbar_g_f_h_budgets_on_an_oval_trace():
     assert math.isclose(_combined(b["F_max t.csv p ccw"]), u, rel_tol=1e-12)
     assert math.isclose(_combined(b["H t.csv p"]), math.sqrt(2) * u, rel_tol=1e-9)
     assert res[0]["u_H_um"] == res[1]["u_H_um"] == b["H t.csv p"]["u"]
+
+
+def test_iso230_3_budget_of_a_drift_range_from_planted_noise():
+    """A channel with a slow linear drift plus white noise sigma, recorded to 0.001 um:
+    the budget's noise source is within 10 % of sigma (second differences remove the
+    drift; 4000 readings: the estimate's relative u is about 1 %), its resolution 0.001 um,
+    and u(range) = sqrt(2 (sigma_hat^2 + r^2 / 12))."""
+    from types import SimpleNamespace
+
+    from volerr.positioning import iso230_3
+
+    rng = np.random.default_rng(11)
+    t = 30.0 * np.arange(4000)
+    sigma = 0.2
+    x = np.round(1e-4 * t + rng.normal(0, sigma, t.size), 3)
+    run = SimpleNamespace(name="r", t_s=t, channels={"a": x}, directions={"a": "X"},
+                          heights={"a": None}, inputs={})
+    ev = iso230_3.evaluate(run)
+    noise, res = ev.reading_u()["a"]
+    assert abs(noise / sigma - 1) < 0.1 and res == pytest.approx(1e-3)
+    b = ev.budgets()["a:range"]
+    assert math.isclose(_combined(b), math.sqrt(2 * (noise ** 2 + res ** 2 / 12)),
+                        rel_tol=1e-12)
