@@ -149,7 +149,7 @@ class DriftEvaluation:
             n, r = ru[k]
             return [source(f"{k}: noise of the readings (Type A, second differences)", n,
                            "um", c),
-                    source(f"{k}: resolution {r:g} um as recorded (rectangular)",
+                    source(f"{k}: resolution {r:g} \u00b5m as recorded (rectangular)",
                            r / np.sqrt(12.0), "um", c)]
 
         series = [(k, sources(k, np.sqrt(2.0)), "um") for k in self.drift]
