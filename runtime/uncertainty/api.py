@@ -190,7 +190,6 @@ def uncertainty(layout, task, evaluate: str, *, errors=None, method: str = "line
         noise_um=noise_um, adaptive=adaptive_info, digits=digits,
         contributions=mc.contributions(prob, contributions) if contributions else None,
         bias=bias, table_uncertainty=ens.table_columns, task_points=tk.n_points)
-    doc["budgets"] = report.budgets(doc)
     return Uncertainty(doc, values, tuple(prob.names), stats)
 
 

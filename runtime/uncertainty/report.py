@@ -87,7 +87,8 @@ def result_document(problem, values, summary: dict, info: dict, *, layout: str, 
     dict
         Keys ``layout task evaluation quantities samples seed block_size chunks scheduler
         machine noise_um sources bias table_uncertainty`` and, when present,
-        ``spec_acceptance adaptive contributions``; each quantity also carries
+        ``spec_acceptance adaptive contributions``, then ``budgets`` (:func:`budgets`); each
+        quantity also carries
         ``corrected_estimate_mm`` and the stated result (:func:`statement`).
     """
     quantities = {}
@@ -110,6 +111,7 @@ def result_document(problem, values, summary: dict, info: dict, *, layout: str, 
                            "tolerance_um": [d * UM_PER_MM for d in adaptive.delta_mm]}
     if contributions is not None:
         doc["contributions"] = contributions
+    doc["budgets"] = budgets(doc)
     return doc
 
 
