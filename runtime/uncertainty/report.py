@@ -88,8 +88,8 @@ def result_document(problem, values, summary: dict, info: dict, *, layout: str, 
         Keys ``layout task evaluation quantities samples seed block_size chunks scheduler
         machine noise_um sources bias table_uncertainty`` and, when present,
         ``spec_acceptance adaptive contributions``, then ``budgets`` (:func:`budgets`); each
-        quantity also carries
-        ``corrected_estimate_mm`` and the stated result (:func:`statement`).
+        quantity also carries ``corrected_estimate_mm`` and the stated result
+        (:func:`statement`).
     """
     quantities = {}
     for name, q in summary.items():

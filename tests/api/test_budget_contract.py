@@ -140,3 +140,26 @@ def test_iso230_3_budget_of_a_drift_range_from_planted_noise():
     b = ev.budgets()["a:range"]
     assert math.isclose(_combined(b), math.sqrt(2 * (noise ** 2 + res ** 2 / 12)),
                         rel_tol=1e-12)
+
+
+def test_monte_carlo_budget_of_two_independent_groups(ex, monkeypatch):
+    """The machine (spec) and the probing noise are independent groups: their one-at-a-time
+    Monte Carlo variances add up to the joint run's (the budget's common sensitivity within
+    5 % of 1); the noise group alone on the distance of two probed points is the noise of a
+    difference of two points along the line, sqrt(2) sigma (within 10 %: 2000 samples);
+    the combined u is the stated one; the MC standard error of u, u / sqrt(2 (M - 1)), is
+    stated in a note."""
+    import volerr
+
+    monkeypatch.chdir(ex)
+    sigma = 0.3
+    r = volerr.uncertainty("MH2", "task_distance.csv", "distance", spec="E0=2+L/300",
+                           noise_um=sigma, samples=2000, contributions=2000)
+    d = r.to_dict()
+    b = d["budgets"]["distance"]
+    u = d["quantities"]["distance"]["standard_uncertainty_um"]
+    assert math.isclose(_combined(b), u, rel_tol=1e-9)
+    assert len(b["sources"]) == 2 and abs(b["sources"][0]["sensitivity"] - 1) < 0.05
+    noise = next(s for s in b["sources"] if s["source"].startswith("probing noise"))
+    assert abs(noise["u"] / (math.sqrt(2) * sigma) - 1) < 0.1
+    assert f"{u / math.sqrt(2 * 1999):.3g} \u00b5m (2000 samples)" in b["notes"][0]
