@@ -12,6 +12,8 @@ when this manual was built, and the first page of its PDF is shown (rendered wit
 without their figures, which come last, so that the manual builds quickly: the first page
 is the same as the one the command writes.
 """
+import os
+
 import matplotlib.pyplot as plt
 import pypdfium2 as pdfium
 
@@ -20,7 +22,7 @@ from _common import examples
 from volerr import certificate
 from volerr.report.stamp import write_pdf
 
-examples()
+folder = examples()
 with open(certificate.IDENTIFICATION_FILE, "w") as f:
     f.write('''operator = "A. Person"
 customer = "ACME Precision Ltd"
@@ -89,6 +91,7 @@ KINDS = [
 # --------------------------------------------------------
 # The identification is the same file for all (a real lab keeps one beside each data
 # set); the report id differs because it hashes the inputs and the method.
+os.chdir(folder)            # each block of this page runs from the tutorials' folder
 for kind, command, files, call in KINDS:
     ident = certificate.build({}, certificate.IDENTIFICATION_FILE, files,
                               method={"command": command, "version": volerr.__version__})
