@@ -163,3 +163,29 @@ def test_monte_carlo_budget_of_two_independent_groups(ex, monkeypatch):
     noise = next(s for s in b["sources"] if s["source"].startswith("probing noise"))
     assert abs(noise["u"] / (math.sqrt(2) * sigma) - 1) < 0.1
     assert f"{u / math.sqrt(2 * 1999):.3g} \u00b5m (2000 samples)" in b["notes"][0]
+
+
+def test_squareness_rows_have_budgets_from_their_two_legs(tmp_path):
+    """``volerr squareness`` (not among the contract's kinds): straightness tables with noise
+    on a straight line; each squareness's u is the root sum of squares of its two legs'
+    slope standard errors, sigma / sqrt(sum (s - mean s)^2) each (textbook), in urad."""
+    from volerr.cmm.api import squareness
+    from volerr.tables.table import ErrorTable, write_error_dir
+
+    rng = np.random.default_rng(5)
+    s = np.linspace(0, 400, 9)
+    sig = 1e-3                                               # mm
+    tables = {ax: ErrorTable(ax, s, {f"E{c}{ax}": 2e-5 * s + rng.normal(0, sig, s.size)
+                                     for c in "XYZ" if c != ax}) for ax in "XYZ"}
+    write_error_dir(tmp_path / "d", tables, {})
+    r = squareness("MB1", tmp_path / "d")
+    budgets = budgets_of(r.to_dict())
+    rows = [row for row in r._rows() if row.std]
+    assert rows
+    sxx = float(np.sum((s - s.mean()) ** 2))
+    for row in rows:
+        b = of_row(budgets, row.name)
+        assert math.isclose(_combined(b), row.std, rel_tol=1e-9)
+        assert len(b["sources"]) == 2
+        for src in b["sources"]:          # each leg's slope u from its own residuals
+            assert 0.3 < src["u"] / (sig / math.sqrt(sxx) * 1e6) < 2.0
