@@ -163,9 +163,9 @@ def budgets(trs: list, results: list) -> dict:
     * F_max, F_min: one reading each (the largest / smallest dr), sensitivity 1;
     * G = max d - min d about the least-squares centre: the two readings, sensitivity 1
       each, and the centre (u per coordinate sqrt(2 / n) times the readings' RMS u, the
-      least-squares circle's), sensitivity |n_max - n_min| (the difference of the two
+      least-squares circle's), sensitivity ``|n_max - n_min|`` (the difference of the two
       readings' radial directions: a centre error moves both radii);
-    * H = max |dr_ccw - dr_cw(theta)|: the counter-clockwise reading and the clockwise
+    * H = ``max |dr_ccw - dr_cw(theta)|``: the counter-clockwise reading and the clockwise
       path linearly interpolated at its angle (its two readings' u with the interpolation
       weights), sensitivity 1 each.
 

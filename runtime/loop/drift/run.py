@@ -233,7 +233,7 @@ def _budget(row: str, t: dict, f: dict, i: int) -> dict:
     """The GUM budgets (:mod:`volerr.report.budget`) of term ``i``'s coefficient (row
     ``row``) and time constant (``row:tau``): their blocked jackknife standard uncertainty,
     u^2 = (K - 1) / K sum_k (b_k - mean b)^2 over the K folds (:mod:`volerr.loop.drift.fit`),
-    as one source per fold left out, u(x_k) = |b_k - mean b|, sensitivity sqrt((K - 1) / K)
+    as one source per fold left out, u(x_k) = ``|b_k - mean b|``, sensitivity sqrt((K - 1) / K)
     (taken as the stated u over the root sum of squares of the deviations: the stated u is
     rounded)."""
     from ...report.budget import budget, source
