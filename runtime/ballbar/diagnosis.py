@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..calibrate.budget import combination_budget
 from ..calibrate.run import fit_campaign
 from ..errors import require
 from ..machine.iso_names import along_component
@@ -81,6 +82,13 @@ def diagnose_fit(model, obs, planes: list, swept: list = ()) -> tuple:
         b = (cal.data.get("budgets") or {}).get(e["parameter"])
         if b is not None and abs(b["u"] - e["std"]) <= 1e-9 * max(e["std"], 1e-300):
             e["budget"] = b
+        elif "weights" in e:     # a combination: its budget from the same per-file terms
+            b = combination_budget(cal, e["weights"], e["parameter"], e["factor"], e["unit"])
+            if b is not None:
+                e["budget"] = b
+    for e in entries:
+        e.pop("weights", None)
+        e.pop("factor", None)
     return entries, why_not(cal, swept, entries), cal.quality
 
 
@@ -115,9 +123,12 @@ def why_not(cal, swept: list, entries: list) -> str | None:
 
 
 
-def _entry(name, value_std, factor, unit) -> dict:
+def _entry(name, value_std, factor, unit, weights=None) -> dict:
+    """The JSON entry; ``weights`` (of a combination) and ``factor`` kept for its budget
+    until :func:`diagnose_fit` drops them."""
     v, s = value_std
-    return {"parameter": name, "value": v * factor, "unit": unit, "std": s * abs(factor)}
+    return {"parameter": name, "value": v * factor, "unit": unit, "std": s * abs(factor),
+            **({"weights": weights, "factor": factor} if weights else {})}
 
 
 def _entries(cal, report, swept, extra) -> list:
@@ -125,33 +136,39 @@ def _entries(cal, report, swept, extra) -> list:
     ranges = cal.ranges
     for plane, a, b, sq, ea, eb, sab, sba in report:
         if sq in cal.model.parameters:
-            r = cal.combination({(sq, None): 1.0})
+            w = {(sq, None): 1.0}
+            r = cal.combination(w)
             if r:
-                out.append(_entry(sq, r, 1e6, "urad"))
+                out.append(_entry(sq, r, 1e6, "urad", w))
         slopes = {}
         for ax, comp in ((a, ea), (b, eb)):
             lo, hi = ranges[ax]
             slopes[comp] = 2.0 / (hi - lo)
-            r = cal.combination({(comp, 1): slopes[comp]})
+            w = {(comp, 1): slopes[comp]}
+            r = cal.combination(w)
             if r:
-                out.append(_entry(f"{comp}@slope", r, 1e3, "um/mm"))
+                out.append(_entry(f"{comp}@slope", r, 1e3, "um/mm", w))
         if not any(e["parameter"] in (f"{ea}@slope", f"{eb}@slope") for e in out):
-            r = cal.combination({(ea, 1): slopes[ea], (eb, 1): -slopes[eb]})
+            w = {(ea, 1): slopes[ea], (eb, 1): -slopes[eb]}
+            r = cal.combination(w)
             if r:
-                out.append(_entry(f"{ea}@slope-{eb}@slope", r, 1e3, "um/mm"))
+                out.append(_entry(f"{ea}@slope-{eb}@slope", r, 1e3, "um/mm", w))
         for comp in (sab, sba):
-            r = cal.combination({(comp, 2): 1.0})
+            w = {(comp, 2): 1.0}
+            r = cal.combination(w)
             if r:
-                out.append(_entry(f"{comp}@P2", r, 1e3, "um"))
+                out.append(_entry(f"{comp}@P2", r, 1e3, "um", w))
     for name, *_ in extra:
-        r = cal.combination({(name, "extra"): 1.0})
+        w = {(name, "extra"): 1.0}
+        r = cal.combination(w)
         if r and not any(e["parameter"] == name for e in out):
-            out.append(_entry(name, r, 1e3, "um"))
+            out.append(_entry(name, r, 1e3, "um", w))
     for r_axis in swept:
         for p in cal.model.parameters:
             if cal.model.parameter_axis.get(p) is None and p[-1] == r_axis and p[2] == "0":
-                r = cal.combination({(p, None): 1.0})
+                w = {(p, None): 1.0}
+                r = cal.combination(w)
                 if r:
                     f, u = (1e6, "urad") if p[1] in "ABC" else (1e3, "um")
-                    out.append(_entry(p, r, f, u))
+                    out.append(_entry(p, r, f, u, w))
     return out

@@ -50,8 +50,14 @@ class Evaluation(ResultMixin):
     def _rows(self) -> list:
         from ..results import Row
 
-        return [Row(d["parameter"], d["value"], d["std"], d["unit"], 1.0)
-                for d in self.data["diagnosis"]]
+        out = []
+        for r in self.data["traces"]:      # ISO 230-4: G, F per trace; H once per placement
+            for q in ("G", "F_max", "F_min") + (("H",) if r.get("direction") == "ccw" else ()):
+                if f"{q}_um" in r:
+                    out.append(Row(iso230_4.row_name(q, r), r[f"{q}_um"], r.get(f"u_{q}_um"),
+                                   "um", 1.0))
+        return out + [Row(d["parameter"], d["value"], d["std"], d["unit"], 1.0)
+                      for d in self.data["diagnosis"]]
 
     def figures(self) -> dict:
         """``{"polar": Figure}``: the traces' polar plot."""
@@ -106,7 +112,8 @@ def evaluate(files, layout=None, diagnose: bool = True, accept_residual: bool = 
         parts.append(obs)
         trs += iso230_4.traces(obs, model)
     results = iso230_4.evaluate_all(trs)
-    data = {"layout": model.name, "traces": results, "diagnosis": []}
+    gum = iso230_4.budgets(trs, results)
+    data = {"layout": model.name, "traces": results, "diagnosis": [], "budgets": gum}
     if diagnose:
         stacked = instruments.stack(parts)
         planes = list(dict.fromkeys(t.plane for t in trs))
@@ -115,8 +122,8 @@ def evaluate(files, layout=None, diagnose: bool = True, accept_residual: bool = 
             model, stacked, [] if swept else planes, swept)
         if note:
             data["diagnosis_note"] = note
-        data["budgets"] = {e["parameter"]: e.pop("budget") for e in data["diagnosis"]
-                           if "budget" in e}
+        data["budgets"] = {**gum, **{e["parameter"]: e.pop("budget")
+                                     for e in data["diagnosis"] if "budget" in e}}
         data["fit"] = quality.to_dict()
         quality = judge(data, quality, accept_residual, where)
         return Evaluation(data, trs, results, quality)

@@ -58,6 +58,7 @@ class Trace:
     dr: np.ndarray
     rows: np.ndarray
     pivot: np.ndarray
+    u: np.ndarray | None = None     # standard uncertainty of each reading, mm (the file's)
 
 
 def traces(obs, model) -> list:
@@ -87,7 +88,8 @@ def traces(obs, model) -> list:
         require(len(idx) >= 8, f"{where}: trace {pl} ({'ccw' if d > 0 else 'cw'}) has "
                                f"{len(idx)} readings; ISO 230-4 needs a full circle")
         out.append(Trace(where, str(pl), int(d), plane, float(length[idx[0]]),
-                         theta, obs.info["dr"][idx], idx, pivot[idx[0]]))
+                         theta, obs.info["dr"][idx], idx, pivot[idx[0]],
+                         None if obs.sigma is None else np.asarray(obs.sigma)[idx]))
     return out
 
 
@@ -142,4 +144,87 @@ def evaluate_all(trs: list) -> list:
             if u.direction < 0 and u.file == t.file and u.placement == t.placement:
                 h = hysteresis(t, u)
                 out[i]["H_um"] = out[j]["H_um"] = h
+    return out
+
+
+def row_name(quantity: str, r: dict) -> str:
+    """The result row of ``quantity`` (G, F_max, F_min; H of a placement) of the evaluated
+    trace ``r``: ``G ballbar_XY.csv 1 ccw``, ``H ballbar_XY.csv 1``."""
+    tail = "" if quantity == "H" else f" {r['direction']}"
+    return f"{quantity} {r['file']} {r['placement']}{tail}"
+
+
+def budgets(trs: list, results: list) -> dict:
+    """The GUM budgets (:mod:`volerr.report.budget`, um) of G, F_max, F_min of every trace
+    and H of every placement run both ways, from the readings' stated standard
+    uncertainties (the file's ``u_um``, else the ballbar's default: bar and calibrator);
+    each result gets its ``u_G_um`` ... (k = 1).
+
+    * F_max, F_min: one reading each (the largest / smallest dr), sensitivity 1;
+    * G = max d - min d about the least-squares centre: the two readings, sensitivity 1
+      each, and the centre (u per coordinate sqrt(2 / n) times the readings' RMS u, the
+      least-squares circle's), sensitivity ``|n_max - n_min|`` (the difference of the two
+      readings' radial directions: a centre error moves both radii);
+    * H = ``max |dr_ccw - dr_cw(theta)|``: the counter-clockwise reading and the clockwise
+      path linearly interpolated at its angle (its two readings' u with the interpolation
+      weights), sensitivity 1 each.
+
+    A steady length offset of the bar (its calibration, a constant temperature) shifts
+    every reading alike: it cancels in G and H and is in the readings' u for F."""
+    from ..report.budget import budget, source
+
+    out = {}
+    for tr, r in zip(trs, results):
+        if tr.u is None:
+            continue
+        u = tr.u * 1e3
+        rad = tr.radius_mm + tr.dr
+        x, y = rad * np.cos(tr.theta), rad * np.sin(tr.theta)
+        a, b, _ = least_squares_circle(x, y)
+        d = np.hypot(x - a, y - b)
+        i, j = int(np.argmax(d)), int(np.argmin(d))
+        n_i = np.array([x[i] - a, y[i] - b]) / d[i]
+        n_j = np.array([x[j] - a, y[j] - b]) / d[j]
+        u_c = float(np.sqrt(np.mean(u ** 2)) * np.sqrt(2.0 / len(u)))
+        g = [source("reading at the largest radius (its stated u)", u[i], "um"),
+             source("reading at the smallest radius (its stated u)", u[j], "um"),
+             source("least-squares centre (u per coordinate)", u_c, "um",
+                    float(np.linalg.norm(n_i - n_j)))]
+        k, m = int(np.argmax(tr.dr)), int(np.argmin(tr.dr))
+        for q, srcs in (("G", g),
+                        ("F_max", [source("reading of the largest dr (its stated u)", u[k],
+                                          "um")]),
+                        ("F_min", [source("reading of the smallest dr (its stated u)",
+                                          u[m], "um")])):
+            name = row_name(q, r)
+            out[name] = budget(name, "um", srcs, 2.0)
+            r[f"u_{q}_um"] = out[name]["u"]
+    out.update(_hysteresis_budgets(trs, results))
+    return out
+
+
+def _hysteresis_budgets(trs: list, results: list) -> dict:
+    """The budget of H of every placement run both ways (:func:`budgets`)."""
+    from ..report.budget import budget, source
+
+    out = {}
+    for t, rt in zip(trs, results):
+        if t.direction < 0 or "H_um" not in rt or t.u is None:
+            continue
+        for c, rc in zip(trs, results):
+            if c.direction > 0 or c.file != t.file or c.placement != t.placement \
+                    or c.u is None:
+                continue
+            order = np.argsort(c.theta)
+            th, dr = c.theta[order], c.dr[order]
+            other = np.interp(t.theta, th, dr, period=2 * np.pi)
+            i = int(np.argmax(np.abs(t.dr - other)))
+            w = np.array([np.interp(t.theta[i], th, e, period=2 * np.pi)
+                          for e in np.eye(len(th))])
+            u_cw = float(np.sqrt(np.sum((w * c.u[order] * 1e3) ** 2)))
+            name = row_name("H", rt)
+            out[name] = budget(name, "um", [
+                source("counter-clockwise reading (its stated u)", t.u[i] * 1e3, "um"),
+                source("clockwise path interpolated at that angle", u_cw, "um")], 2.0)
+            rt["u_H_um"] = rc["u_H_um"] = out[name]["u"]
     return out

@@ -41,8 +41,10 @@ def budgets(cal, fit, u_ref: float) -> dict:
     kept = out.kept
     sc = fit.scale[kept]
     S = np.outer(sc, sc)
-    per_file = [np.einsum("ij,jk,ik->i", out.Gi, Gf[np.ix_(kept, kept)] / S, out.Gi)
-                / sc ** 2 * u_ref ** 2 for Gf in fit.G_files]
+    # the full terms (natural units) kept for the budgets of combinations
+    out.budget_terms = [out.Gi @ (Gf[np.ix_(kept, kept)] / S) @ out.Gi / S * u_ref ** 2
+                        for Gf in fit.G_files]
+    per_file = [np.diag(m) for m in out.budget_terms]
     a_priori = np.diag(out.Gi) / sc ** 2 * u_ref ** 2
     widen = max(out.s0, 1.0) ** 2 - 1.0
     files = [e["file"] for e in cal.data["instruments"]]
@@ -62,3 +64,25 @@ def budgets(cal, fit, u_ref: float) -> dict:
         srcs.append(source(model_name, math.sqrt(widen * a_priori[pos]) * factor, p["unit"]))
         result[name_of(cal.labels[j])] = budget(name_of(cal.labels[j]), p["unit"], srcs, 2.0)
     return result
+
+
+def combination_budget(cal, weights: dict, name: str, factor: float, unit: str):
+    """The budget of ``factor`` times the combination ``weights`` of :meth:`Calibration.
+    combination` (its std in ``unit``), from the per-file terms :func:`budgets` kept: c^T
+    C_f c per file and the model residual's widening; None when the combination is not
+    determined or the terms were not computed."""
+    out = cal.solution
+    terms_f = getattr(out, "budget_terms", None)
+    c = cal.combination_vector(weights)
+    if c is None or terms_f is None:
+        return None
+    ck = c[out.kept]
+    per_file = [float(ck @ m @ ck) for m in terms_f]
+    a_priori = sum(per_file)          # C0 = sum_f C_f (module docstring)
+    widen = max(out.s0, 1.0) ** 2 - 1.0
+    srcs = [source(f"readings of {e['file']} (stated u, set-up)",
+                   math.sqrt(max(v, 0.0)) * abs(factor), unit)
+            for e, v in zip(cal.data["instruments"], per_file)]
+    srcs.append(source(f"model residual (a-posteriori factor s0 = {out.s0:.3g})",
+                       math.sqrt(widen * max(a_priori, 0.0)) * abs(factor), unit))
+    return budget(name, unit, srcs, 2.0)

@@ -111,6 +111,15 @@ class Calibration(ResultMixin):
         ``cal.combination({"EY0B": 1, "EY0C": 1})``: the sum of two location errors that only
         a combination of set-ups determines.
         """
+        c = self.combination_vector(weights)
+        if c is None:
+            return None
+        ck = c[self.solution.kept]
+        return float(c @ self.coef), float(np.sqrt(max(ck @ self.solution.cov @ ck, 0.0)))
+
+    def combination_vector(self, weights: dict) -> np.ndarray | None:
+        """The weights of :meth:`combination` over the design columns (:attr:`labels`), or
+        None when the campaign does not determine that combination."""
         sol = self.solution
         names = self._label_names()
         c = np.zeros(len(self.labels))
@@ -123,8 +132,7 @@ class Calibration(ResultMixin):
         d = np.where(sol.norms > 0, sol.norms, 1.0)
         if np.linalg.norm(sol.null.T @ (c / d)) > 1e-6 * np.linalg.norm(c / d):
             return None
-        ck = c[sol.kept]
-        return float(c @ self.coef), float(np.sqrt(max(ck @ sol.cov @ ck, 0.0)))
+        return c
 
     def _label_names(self) -> dict:
         """report name -> design column (parameters only)."""
@@ -815,6 +823,7 @@ class Solution:
     rss_files: dict = field(default_factory=dict)   # file -> weighted residual SS (mm^2)
     Gi: np.ndarray | None = None                     # inverse of the unit-scaled kept Gram
     mixes: dict = field(default_factory=dict)        # kept column -> {left-out column: B}
+    budget_terms: list | None = None   # per file its covariance term (budget.budgets)
 
 
 def _solve(design, labels, obs, spl, fit: Normal, sw, u_ref: float, prefer=None) -> Solution:

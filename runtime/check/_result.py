@@ -129,6 +129,32 @@ class CheckResult(ResultMixin):
                         "std": float(np.sqrt(max(cov[j, j], 0.0)))})
         return out
 
+    def budgets(self) -> dict:
+        """The GUM budget (:mod:`volerr.report.budget`) of every parameter after the check:
+        its covariance is N^-1 of the fit's normal matrix N = N_readings + N_reference (the
+        check's weighted readings with their set-ups, and the reference calibration's
+        information), so it splits exactly into N^-1 N_readings N^-1 (the readings' stated
+        u propagated) plus N^-1 N_reference N^-1 (the reference's covariance propagated);
+        both sources in the parameter's unit, sensitivity 1."""
+        from ..report.budget import budget, source
+
+        ref, fit, sysm = self.reference, self.selection.fit, self.system
+        G, _, _ = sysm.normal()
+        n_ref = sysm.matrix(np.zeros_like(G), fit.changed)
+        n_all = sysm.matrix(G, fit.changed)
+        d = slice(fit.ns, fit.ns + fit.p)
+        terms = [np.einsum("ij,jk,ik->i", fit.Ni, m, fit.Ni)[d] for m in (n_all - n_ref, n_ref)]
+        files = ", ".join(_file_name(f.get("file", "") if isinstance(f, dict) else f)
+                          for f in self.files) or "the check's files"
+        out = {}
+        for j, (n, u) in enumerate(zip(ref.names, ref.units)):
+            out[n] = budget(n, u, [
+                source(f"readings of {files} (their stated u, set-ups)",
+                       np.sqrt(max(terms[0][j], 0.0)), u),
+                source(f"reference {_file_name(ref.path)} (its covariance)",
+                       np.sqrt(max(terms[1][j], 0.0)), u)], 2.0)
+        return out
+
     def after(self) -> tuple[np.ndarray, np.ndarray]:
         """(values, covariance) of the reference's parameters after the check, report units."""
         d, C = self.selection.fit.delta()
@@ -175,7 +201,7 @@ class CheckResult(ResultMixin):
                        "note": "every linear axis in 5 steps over its travel, every rotary "
                                "axis in 5 steps (at most one turn); length of the change of "
                                "the volumetric error, um"},
-            "method": METHOD})
+            "method": METHOD, "budgets": self.budgets()})
         if self.tolerance is not None:
             out["tolerance"] = self.tolerance
         return self._fit_entries(out)

@@ -80,6 +80,17 @@ class System:
         change, on all data rows or all but the fold ``leave_out``."""
         G, b, rr = self.normal(leave_out)
         ns, p, k = self.ns, self.p, len(changed)
+        N = self.matrix(G, changed)
+        bb = np.concatenate([b, np.zeros(k)])
+        Ni = _inverse(N)
+        z = Ni @ bb
+        return Fit(list(changed), z, Ni, max(rr - float(bb @ z), 0.0), ns, p)
+
+    def matrix(self, G: np.ndarray, changed) -> np.ndarray:
+        """The normal matrix of the fit with ``changed`` free: the data's ``G`` (set-ups and
+        parameters) plus the reference's information ``Sinv`` on the parameters before the
+        change (``G`` = 0: the reference's part alone, :meth:`CheckResult.budgets`)."""
+        ns, p, k = self.ns, self.p, len(changed)
         E = np.zeros((p, k))
         E[list(changed), np.arange(k)] = 1.0
         N = np.zeros((ns + p + k, ns + p + k))
@@ -89,10 +100,7 @@ class System:
         N[d, ns + p:] = -self.Sinv @ E
         N[ns + p:, d] = -E.T @ self.Sinv
         N[ns + p:, ns + p:] = E.T @ self.Sinv @ E
-        bb = np.concatenate([b, np.zeros(k)])
-        Ni = _inverse(N)
-        z = Ni @ bb
-        return Fit(list(changed), z, Ni, max(rr - float(bb @ z), 0.0), ns, p)
+        return N
 
     def data_information(self) -> np.ndarray:
         """(p, p) the check's information on the parameters alone, set-ups eliminated (the

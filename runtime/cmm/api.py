@@ -180,7 +180,7 @@ def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
                                 profile_points)
     doc = {"layout": model.name, "probe_mm": [float(v) for v in probe],
            "errors": (funcs.source or "") if errors is funcs else str(errors), "method": method,
-           "lines": [r.as_dict() for r in results]}
+           "lines": [r.as_dict() for r in results], "budgets": dg.budgets(results)}
     return Diagonals(doc, results)
 
 
@@ -261,7 +261,7 @@ def squareness(layout, directory, *, tables_are: str = "carrier",
     from ..machine.layout import read_layout
     from ..tables.table import read_error_dir, table_to_csv
     from ..units import URAD_PER_RAD
-    from .squareness import squareness as fit
+    from .squareness import budgets as leg_budgets, squareness as fit
 
     lay = read_layout(layout)
     src = Path(directory)
@@ -280,6 +280,6 @@ def squareness(layout, directory, *, tables_are: str = "carrier",
     doc = {"squareness_urad": {k: v * URAD_PER_RAD for k, v in values.items()},
            "u_urad": {k: v * URAD_PER_RAD for k, v in std.items()},
            "slopes_urad": {k: v * URAD_PER_RAD for k, v in slopes.items()},
-           "tables_are": tables_are}
+           "tables_are": tables_are, "budgets": leg_budgets(tables, values)}
     texts = {f"{ax}.csv": table_to_csv(t) for ax, t in corrected.items()}
     return Squareness(doc, values, std, texts, merged, merged_std, lay, accept_implausible)

@@ -68,6 +68,8 @@ class LineResult:
     profile_s_mm: np.ndarray = field(default_factory=lambda: np.zeros(0))
     profile_um: np.ndarray = field(default_factory=lambda: np.zeros(0))
     profile_random_um: np.ndarray | None = None
+    #: parameter -> (variance term of u(dL), mm^2; its larger u at the ends, mm or rad)
+    random_terms: dict | None = None
 
     def as_dict(self, with_profile: bool = True) -> dict:
         d = {"name": self.line.name, "kind": self.line.kind,
@@ -135,8 +137,12 @@ def _positions(model, pts: np.ndarray, lin, fixed: dict) -> dict:
     return {a: pos[a] for a in model.axes}
 
 
-def length_random(model, funcs, pos1: dict, pos2: dict, u: np.ndarray, probe) -> np.ndarray:
-    """Standard uncertainty (mm) of u.(d(P2) - d(P1)) for paired points (module docstring)."""
+def length_random(model, funcs, pos1: dict, pos2: dict, u: np.ndarray, probe,
+                  parts: dict | None = None) -> np.ndarray:
+    """Standard uncertainty (mm) of u.(d(P2) - d(P1)) for paired points (module docstring).
+    ``parts``, when given, receives per error parameter (variance term mm^2, its standard
+    uncertainty, the larger of its values at P1 and P2): the sources of the sum of variances
+    (:func:`budgets`)."""
     n = len(next(iter(pos2.values())))
     s1 = model.sensitivity(pos1, probe)          # (n, 3, n_par)
     s2 = model.sensitivity(pos2, probe)
@@ -152,8 +158,11 @@ def length_random(model, funcs, pos1: dict, pos2: dict, u: np.ndarray, probe) ->
         g2 = np.broadcast_to(sig2[p], (n,))
         ax = paxis.get(p)
         same = np.ones(n, bool) if ax is None else np.isclose(pos1[ax], pos2[ax], rtol=0, atol=1e-9)
-        var += np.where(same, (a2[:, j] * g2 - a1[:, j] * g1) ** 2,
+        term = np.where(same, (a2[:, j] * g2 - a1[:, j] * g1) ** 2,
                         (a2[:, j] * g2) ** 2 + (a1[:, j] * g1) ** 2)
+        var += term
+        if parts is not None:
+            parts[p] = (term, np.maximum(np.abs(g1), np.abs(g2)))
     return np.sqrt(var)
 
 
@@ -179,7 +188,9 @@ def evaluate_lines(model, funcs, lines, probe=(0.0, 0.0, 0.0), at=None,
         pos0 = _positions(model, p0, lin, fixed)
         dirs = np.repeat(nom[:, -1, :] - nom[:, 0, :], len(t), axis=0)
         dirs = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)
-        rand = length_random(model, funcs, pos0, pos, dirs, probe).reshape(len(lines), len(t))
+        parts = {}
+        rand = length_random(model, funcs, pos0, pos, dirs, probe, parts).reshape(
+            len(lines), len(t))
         rand[:, 0] = 0.0  # zero length: the same point
     out = []
     for i, ln in enumerate(lines):
@@ -193,7 +204,41 @@ def evaluate_lines(model, funcs, lines, probe=(0.0, 0.0, 0.0), at=None,
                               float((np.linalg.norm(actual) - length) * UM_PER_MM),
                               None if rand is None else float(rand[i, -1] * UM_PER_MM),
                               t * length, prof * UM_PER_MM,
-                              None if rand is None else rand[i] * UM_PER_MM))
+                              None if rand is None else rand[i] * UM_PER_MM,
+                              None if rand is None else
+                              {p: (float(v.reshape(len(lines), len(t))[i, -1]),
+                                   float(np.broadcast_to(g, v.shape).reshape(
+                                       len(lines), len(t))[i, -1]))
+                               for p, (v, g) in parts.items()}))
+    return out
+
+
+def budgets(results) -> dict:
+    """The GUM budget (:mod:`volerr.report.budget`, um) of every line's random part u(dL),
+    keyed by its row ``dL(name)``: one source per error parameter with a standard
+    uncertainty in the tables (mm or rad, the larger at the line's two ends, as um or urad),
+    its sensitivity
+    the term's square root over it -- the terms :func:`length_random` sums (a parameter of
+    the same axis position at both ends enters once, as the difference of its two
+    effects)."""
+    from ..machine.iso_names import is_angle
+    from ..report.budget import budget, source
+
+    out = {}
+    for r in results:
+        if r.random_um is None or not r.random_terms:
+            continue
+        srcs = []
+        for p, (var, g) in r.random_terms.items():
+            try:
+                f, unit = (1e6, "urad") if is_angle(p) else (1e3, "um")
+            except Exception:          # a parameter of no ISO name: as a length
+                f, unit = 1e3, "um"
+            c = np.sqrt(max(var, 0.0)) * UM_PER_MM
+            if c > 0:
+                srcs.append(source(p, g * f, unit, c / (g * f) if g else 0.0))
+        row = f"dL({r.line.name})"
+        out[row] = budget(row, "um", srcs, 2.0)
     return out
 
 

@@ -117,3 +117,23 @@ def _reference_position(t: ErrorTable) -> float:
     else the first position."""
     zero = np.all(np.stack([np.abs(v) for v in t.values.values()]) == 0, axis=0)
     return float(t.positions[int(np.argmax(zero))]) if zero.any() else float(t.positions[0])
+
+
+def budgets(tables: dict, values: dict) -> dict:
+    """The GUM budget (:mod:`volerr.report.budget`, urad) of every squareness in
+    ``values`` (:func:`squareness`): its two legs' reference-line slopes, each with the
+    standard error of its least-squares slope (:func:`reference_line`), sensitivity 1 (a
+    sign does not change a contribution)."""
+    from ..report.budget import budget, source
+    from ..units import URAD_PER_RAD
+
+    out = {}
+    for sq in values:
+        srcs = []
+        for name, ax, _ in PAIRS[sq]:
+            t = tables[ax]
+            _, _, u = reference_line(t.positions, t.values[name])
+            srcs.append(source(f"slope of the reference line of {name} (its least-squares "
+                               f"standard error)", u * URAD_PER_RAD, "urad"))
+        out[sq] = budget(sq, "urad", srcs, 2.0)
+    return out

@@ -154,6 +154,28 @@ def _wls(X: np.ndarray, y: np.ndarray, s: np.ndarray):
     return coef, rinv @ rinv.T, chi2
 
 
+def wls_budget(X: np.ndarray, s: Series, rows: slice, j: int, phi: float,
+               f: float = 1.0) -> dict:
+    """The GUM budget (:mod:`volerr.report.budget`, quantity named by the caller) of
+    coefficient ``j`` (times ``f``) of the WLS fit of the entries ``rows`` of ``s`` on the
+    columns ``X``: coef = C A^T (y / u) with A = X / u, C = (A^T A)^-1, so each entry i is a
+    source, its stated u_i with the sensitivity f (C A^T)_ji / u_i; the scatter beyond the
+    stated u (``phi`` = chi2 / dof above 1 widens the covariance by phi) one more source,
+    f sqrt((phi - 1) C_jj).  The combined u is f sqrt(max(phi, 1) C_jj), the std stated."""
+    from ..report.budget import budget, source
+
+    u, dates = s.s[rows], s.dates[rows]
+    A = X / u[:, None]
+    C = np.linalg.inv(A.T @ A)
+    gain = (C @ A.T)[j] / u
+    srcs = [source(f"entry of {d} (its stated u)", ui, s.unit, f * g)
+            for d, ui, g in zip(dates, u, gain)]
+    srcs.append(source(f"scatter beyond the stated u (chi2/dof = {phi:.3g}"
+                       + (")" if phi > 1 else " <= 1: not widened)"),
+                       abs(f) * math.sqrt(max(phi - 1.0, 0.0) * C[j, j]), s.unit))
+    return budget("", s.unit, srcs, 2.0)
+
+
 def _chi2_isf(p: float, dof: int) -> float:
     from scipy.stats import chi2
 
@@ -234,7 +256,8 @@ def changes(s: Series) -> list:
         out.append({"kind": kind, "index": at, "date": s.dates[at],
                     "previous_date": s.dates[at - 1] if at > 0 else None,
                     "change": float(coef[nb + i]) * f,
-                    "std": float(math.sqrt(cov[nb + i, nb + i] * phi)) * f})
+                    "std": float(math.sqrt(cov[nb + i, nb + i] * phi)) * f,
+                    "budget": wls_budget(X, s, slice(None), nb + i, phi, f)})
     return sorted(out, key=lambda e: (e["index"], e["kind"]))
 
 
@@ -255,6 +278,7 @@ class Trend:
     since: str
     scaled: bool
     dof: int
+    budget: dict | None = None      # of the slope b (:func:`wls_budget`)
 
     def at(self, t: float) -> tuple[float, float]:
         """(value, standard uncertainty) of the line at day ``t``."""
@@ -276,7 +300,7 @@ def trend(s: Series, start: int = 0) -> Trend | None:
     scaled = phi > 1.0
     cov = cov * max(1.0, phi)
     return Trend(float(coef[0]), float(coef[1]), cov, t0, len(t), s.dates[start], scaled,
-                 dof)
+                 dof, wls_budget(X, s, slice(start, None), 1, phi))
 
 
 # -- 4. forecast ----------------------------------------------------------------------------

@@ -76,7 +76,7 @@ class History(ResultMixin):
                 "entries": [_entry_dict(e) for e in entries], "events": events,
                 "slope_changes": slopes,
                 "trends": trends, "forecast": forecast, "control": control,
-                "method": METHOD}
+                "method": METHOD, "budgets": _budgets(series, fits)}
         return cls(data, series, {n: f for n, f in fits.items()})
 
     def __getitem__(self, key):
@@ -282,3 +282,25 @@ collapse}}td,th{{border:1px solid #bbb;padding:2px 6px}}</style></head><body>
 <h2>Parameters</h2>{figs}
 </body></html>
 """
+
+
+def _budgets(series: dict, fits: dict) -> dict:
+    """The budget of every uncertainty the rows state (:meth:`History._rows`): each step and
+    trend slope from its WLS fit (:func:`volerr.history.analysis.wls_budget`), and each
+    parameter's latest entry, whose u is the stored one of its report (one source)."""
+    from ..report.budget import budget, source
+
+    out = {}
+    for name, s in series.items():
+        steps, tr = fits[name]
+        for e in steps:
+            row = f"{name} step {e['date']}"
+            out[row] = {**e["budget"], "quantity": row}
+        if tr is not None and tr.budget is not None:
+            row = f"{name} slope since {tr.since}"
+            out[row] = {**tr.budget, "quantity": row, "unit": f"{s.unit}/d"}
+        row = f"{name} latest {s.dates[-1]}"
+        out[row] = budget(row, s.unit, [source(
+            f"the entry of {s.dates[-1]} as stored (u of its report; its budget there)",
+            float(s.s[-1]), s.unit)], 2.0)
+    return out

@@ -101,6 +101,9 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
 
     quality = result.fit_quality()
     data = result.report()
+    from .solve import error_table_budgets
+
+    data["budgets"] = error_table_budgets(table, len(result.rounds))
     data["fit_quality"] = quality.to_dict()
     quality = gate(data, quality, accept_residual, f"identify {' '.join(map(str, files))}",
                    key="fit_quality")

@@ -272,6 +272,25 @@ def error_table_rows(t) -> list:
     return out
 
 
+def error_table_budgets(t, n_rounds: int) -> dict:
+    """The GUM budget (:mod:`volerr.report.budget`) of every row of
+    :func:`error_table_rows` with a standard uncertainty: the Type A u of a mean of
+    ``n_rounds`` rounds is the experimental standard deviation s of one round (the table's
+    ``s``) with the sensitivity 1 / sqrt(n_rounds)."""
+    from ..report.budget import budget, source
+
+    out = {}
+    for name, s in (t.s or {}).items():
+        f, unit = (1e6, "urad") if name[1] in "ABC" else (1e3, "um")
+        for i, q in enumerate(t.positions):
+            row = f"{name}({q:g})"
+            out[row] = budget(row, unit, [source(
+                f"scatter of {n_rounds} rounds (Type A: s of one round; the tracker's own "
+                f"u is in the _u95 column)", f * float(s[i]), unit,
+                1.0 / math.sqrt(n_rounds))], 2.0, rows=[row])
+    return out
+
+
 def _mean_or_none(values):
     """Mean of the finite values (None when there is none: JSON null, never NaN)."""
     v = [float(x) for x in values if x is not None and math.isfinite(x)]

@@ -444,6 +444,25 @@ def effects_step(selection, aug: Augmented, out: Outcome, n: int) -> list:
     return effects
 
 
+def effect_budgets(effects: list, sigma2: float) -> dict:
+    """The GUM budget (:mod:`volerr.report.budget`) of every effect parameter's std: the
+    a-posteriori scatter of the weighted residuals, sigma = sqrt(sigma2) (um; the fit's
+    ``noise_estimate_um``), times the parameter's sensitivity to it, sqrt((A^T W A)^-1_jj)
+    in its unit per um (taken as the stated std / sigma, so that the rounded std the report
+    states is the combined u); keyed ``effect:parameter`` as the result rows."""
+    from ..report.budget import budget, source
+
+    sigma = 1e3 * math.sqrt(max(sigma2, 0.0))
+    out = {}
+    for e in effects:
+        for pn, std in e["std"].items():
+            name, unit = f"{e['name']}:{pn}", e["units"][pn]
+            out[name] = budget(name, unit, [source(
+                "scatter of the residuals after the fit (a posteriori, sigma)", sigma, "um",
+                std / sigma if sigma > 0 else 0.0)], 2.0)
+    return out
+
+
 def _lag_entry(info: dict) -> dict:
     """``lag_s`` of an effect through a lag (:mod:`volerr.loop.lags`), else nothing."""
     if info.get("lag_s") is None:
@@ -778,6 +797,7 @@ def _report_dict(model, dat, spl, degree, degree_scores, decl, robust, selection
         "max_before_um": round(1e3 * float(nb.max()), 4),
         "max_after_um": round(1e3 * float(na.max()), 4),
         "effects": effects,
+        "budgets": effect_budgets(effects, out.sigma2),
         "unidentifiable": decl.unidentifiable,
         "residual_sources": [],
         "residual_sources_after": [],

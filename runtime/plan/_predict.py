@@ -17,12 +17,14 @@ cross-validation only when a whole component error (``EXX``, not ``EXX@slope``) 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
 from .. import instruments
 from ..calibrate import run as calibration
 from ..calibrate import terms
+from ..calibrate.budget import budgets
 from ..calibrate.defaults import default_parameters
 from ..estimate import blocks
 from ..estimate.design import data_ranges, declared_design, gauge_mask, parameter_labels
@@ -43,6 +45,7 @@ class Prediction:
     combinations: list = field(default_factory=list)
     map_u_um: dict = field(default_factory=dict)
     gauge: list = field(default_factory=list)
+    budgets: dict = field(default_factory=dict)  # calibrate's budgets, the variance factor 1
 
     @property
     def determined(self) -> set:
@@ -95,6 +98,8 @@ def predict(model, parts: list, spec: str | None, tool=(0.0, 0.0, 0.0)) -> Predi
     pred = Prediction(params, list(report["unidentifiable"]), why,
                       list(report.get("combinations", [])))
     pred.gauge = list(report.get("gauge_fixed", []))
+    pred.budgets = budgets(SimpleNamespace(solution=out, data=report, model=model,
+                                           ranges=ranges, labels=labels), fit, u_ref)
     pred.map_u_um = map_uncertainty(model, labels, out.kept, out.cov, degree, ranges, tool)
     return pred
 

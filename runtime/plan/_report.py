@@ -76,6 +76,15 @@ def _params(pred, alone=None) -> dict:
     return out
 
 
+def _budgets(pred) -> dict:
+    """The budget of every predicted std (:func:`volerr.calibrate.budget.budgets` on the
+    plan's files, the variance factor at 1), restated for the rounded std of the JSON."""
+    from ..report.budget import restated
+
+    return {n: restated(b, round(pred.parameters[n]["predicted_std"], 6))
+            for n, b in pred.budgets.items() if n in pred.parameters}
+
+
 def data(plan) -> dict:
     """The JSON report of a plan."""
     pred, base = plan.prediction, plan.baseline["prediction"]
@@ -99,6 +108,7 @@ def data(plan) -> dict:
                         plan.instruments],
         "requested": list(plan.chosen),
         "parameters": _params(pred, plan.alone),
+        "budgets": _budgets(pred),
         "unidentifiable": list(pred.unidentifiable),
         "why_unidentifiable": dict(pred.why),
         "only_combined": [n for n in pred.parameters

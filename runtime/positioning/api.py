@@ -181,17 +181,20 @@ class Iso230_3(ResultMixin):
 
     def _rows(self) -> list:
         """Per run, channel and tilt: the drift range (um; urad for a tilt), the largest
-        and the smallest drift (readings, no uncertainty stated: ``std`` None)."""
+        and the smallest drift, with the standard uncertainty of their budgets
+        (:meth:`volerr.positioning.iso230_3.DriftEvaluation.budgets`)."""
         from ..results import Row
 
         out = []
         for ev in self.evaluations:
             pre = f"{ev.name}:" if len(self.evaluations) > 1 else ""
+            gum = ev.budgets(pre)
             series = [(k, e, "um") for k, e in ev.channel_extremes().items()]
             series += [(tl.name, e, "urad") for tl, e in zip(ev.tilts,
                                                             ev.tilt_extremes().values())]
             for k, e, unit in series:
-                out += [Row(f"{pre}{k}:{what}", float(v), None, unit, 1.0)
+                out += [Row(f"{pre}{k}:{what}", float(v), gum[f"{pre}{k}:{what}"]["u"], unit,
+                            1.0)
                         for what, v in (("range", e.range), ("max", e.max), ("min", e.min))]
         return out
 

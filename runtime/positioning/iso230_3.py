@@ -120,6 +120,48 @@ class DriftEvaluation:
     def channel_extremes(self) -> dict:
         return {k: Extremes.of(self.t_s, v) for k, v in self.drift.items()}
 
+    def reading_u(self) -> dict:
+        """label -> (noise, resolution) of a channel's readings, um: the noise (Type A) from
+        the second differences of the series, s^2 = sum (x_i+1 - 2 x_i + x_i-1)^2 /
+        (6 (N - 2)) (a drift that is locally linear over two intervals cancels), and the
+        resolution as the readings are recorded (the last decimal that varies)."""
+        out = {}
+        for k, v in self.drift.items():
+            d2 = np.diff(v, 2)
+            noise = float(np.sqrt(np.sum(d2 ** 2) / (6 * len(d2)))) if len(d2) else 0.0
+            out[k] = (noise, _resolution(v))
+        return out
+
+    def budgets(self, prefix: str = "") -> dict:
+        """The GUM budget (:mod:`volerr.report.budget`) of every drift range, max and min
+        (rows ``prefix + label:range`` ...) and every tilt's: each is a difference of two
+        readings of a channel (a range: the largest and smallest; max and min: against the
+        first reading), so each reading source enters with sensitivity sqrt(2) -- the noise
+        and the resolution (rectangular, r / sqrt(12)); a tilt (s2 - s1) / lever adds both
+        channels with sensitivity sqrt(2) / lever (urad per um: 1000 / lever_mm)."""
+        from ..report.budget import budget, source
+
+        ru = self.reading_u()
+        out = {}
+
+        def sources(k, c):
+            n, r = ru[k]
+            return [source(f"{k}: noise of the readings (Type A, second differences)", n,
+                           "um", c),
+                    source(f"{k}: resolution {r:g} \u00b5m as recorded (rectangular)",
+                           r / np.sqrt(12.0), "um", c)]
+
+        series = [(k, sources(k, np.sqrt(2.0)), "um") for k in self.drift]
+        series += [(tl.name, sources(tl.channels[0], np.sqrt(2.0) * 1e3 / tl.lever_mm)
+                    + sources(tl.channels[1], np.sqrt(2.0) * 1e3 / tl.lever_mm), "urad")
+                   for tl in self.tilts]
+        for k, srcs, unit in series:
+            for what in ("range", "max", "min"):
+                row = f"{prefix}{k}:{what}"
+                out[row] = budget(row, unit, srcs, 2.0, notes=[NOT_IN_BUDGET] if what ==
+                                  "range" else ())
+        return out
+
     def tilt_extremes(self) -> dict:
         return {tl.name: Extremes.of(self.t_s, tl.series) for tl in self.tilts}
 
@@ -138,7 +180,8 @@ class DriftEvaluation:
                 "duration_s": float(self.t_s[-1] - self.t_s[0]), "channels": chans,
                 "tilts": tilts, "stage_column": self.stage_column,
                 "stages": [self._stage_dict(s) for s in self.stages],
-                "temperatures": temps, "notes": list(self.notes)}
+                "temperatures": temps, "notes": list(self.notes),
+                "budgets": self.budgets()}
 
     def _stage_dict(self, s: Stage) -> dict:
         sl = slice(s.start, s.stop)
@@ -173,6 +216,22 @@ class DriftEvaluation:
     def __repr__(self) -> str:
         return (f"DriftEvaluation({self.name!r}: {len(self.drift)} channels, {len(self.tilts)} "
                 f"tilts, {len(self.stages)} stages)")
+
+
+#: what the budgets of the drift leave out (not given to volerr)
+NOT_IN_BUDGET = ("Not included (not given to volerr): the sensors' calibration (scale) and "
+                 "the thermal expansion of the sensor fixture and the test mandrel.")
+
+
+def _resolution(v: np.ndarray) -> float:
+    """The resolution the readings ``v`` (um) are recorded with: 10^-k for the smallest k
+    (0 .. 6) at which every value is a whole multiple (to 1e-6 of a step and the float's
+    rounding), else 1e-6."""
+    for k in range(7):
+        x = np.asarray(v) * 10.0 ** k
+        if np.all(np.abs(x - np.round(x)) <= 1e-6 + 1e-9 * np.abs(x)):
+            return 10.0 ** -k
+    return 1e-6
 
 
 def _extremes_dict(e: Extremes, unit: str) -> dict:
@@ -254,6 +313,9 @@ def evaluate(run, stage_column: str | None = None) -> DriftEvaluation:
 def report_dict(evaluations: list) -> dict:
     """One run: its :meth:`DriftEvaluation.to_dict`; several: ``{"runs": [...]}``."""
     docs = [ev.to_dict() for ev in evaluations]
+    if len(docs) > 1:       # the rows are named with the run there (Iso230_3._rows)
+        for d, ev in zip(docs, evaluations):
+            d["budgets"] = ev.budgets(f"{ev.name}:")
     return docs[0] if len(docs) == 1 else {"standard": STANDARD, "runs": docs}
 
 

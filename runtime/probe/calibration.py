@@ -371,6 +371,21 @@ class ProbeCalibration:
         return {"max": float(v.max()), "min": float(v.min()),
                 "rms": float(math.sqrt(np.mean(v ** 2)))}
 
+    def budget(self) -> dict:
+        """The GUM budget of R_eff (um, :mod:`volerr.report.budget`): the scatter of the
+        probed points about the sphere fit (Type A, ``noise``, um) with the sensitivity
+        sqrt((J^T J)^-1_rr) of the fitted radius to it (the fit's covariance per unit
+        residual variance), the u the report states.  The master sphere's radius
+        uncertainty u(R_s) is not given to volerr and is not in it (a note)."""
+        from ..report.budget import budget, source
+
+        n, u = self.noise * UM_PER_MM, self.u_r_eff * UM_PER_MM
+        return budget("r_eff", "um", [source(
+            "scatter of the points about the probe map (Type A)", n, "um",
+            u / n if n > 0 else 0.0)], 2.0, notes=[
+            "The master sphere's radius uncertainty u(R_s) is not included: add it in "
+            "quadrature (sensitivity 1)."])
+
     def summary(self) -> dict:
         """The ``--json`` report (INTERFACE.md keys first, then details)."""
         out = {
@@ -410,6 +425,7 @@ class ProbeCalibration:
                 "u_r_eff_um": float(self.u_r_eff * UM_PER_MM),
             },
             "sphere_fit_condition": float(self.condition),
+            "budgets": {"r_eff": self.budget()},
         }
         if self.direction_mismatch_deg is not None:
             out["direction_mismatch_deg"] = {

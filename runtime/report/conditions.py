@@ -29,6 +29,9 @@ FIELDS = {
         "artefact temperature", "compensation"),
     "sphere / R-test set-up": (
         "sphere radius", "readings", "positions", "probe / stylus", "compensation"),
+    "ball / hole plate set-up": (
+        "plate", "placements", "features", "readings", "plate calibration",
+        "plate temperature", "compensation"),
 }
 
 
@@ -90,14 +93,48 @@ def _iso10360(doc: dict) -> dict:
 
 
 def _sphere(doc: dict) -> dict:
+    if "r_eff_mm" not in doc:          # a calibration from sphere / R-test files
+        files = _files_of(doc, "sphere")
+        return {"readings": sum(i.get("n_readings", 0) for i in files),
+                "positions": _placements(doc, files)}
     return {"sphere radius": doc.get("sphere_radius_mm"), "readings": doc.get("n_points")}
+
+
+def _plate(doc: dict) -> dict:
+    files = _files_of(doc, "artifact")
+    return {"plate": ", ".join(i.get("file", "") for i in files),
+            "placements": _placements(doc, files),
+            "features": f"{sum(i.get('n', 0) for i in files)} probed in all",
+            "readings": sum(i.get("n_readings", 0) for i in files)}
+
+
+def _files_of(doc: dict, kind: str) -> list:
+    """The ``instruments`` entries of a calibration of the instrument ``kind``."""
+    return [i for i in doc.get("instruments") or [] if isinstance(i, dict)
+            and i.get("kind") == kind]
+
+
+def _placements(doc: dict, files: list) -> str:
+    """``4 (XYhigh, XYlow, XZ, YZ)``: the files' placements (their set-up keys ``F#P``)."""
+    names = [k.split("#", 1)[1] for k in doc.get("setup") or {} if "#" in k
+             and k.split("#", 1)[0] in {i.get("file") for i in files}]
+    return f"{len(names)} ({', '.join(names)})" if names else "1"
 
 
 _TESTS = (("ballbar", "ISO 230-4 (circular test, ballbar)", _ballbar, "traces"),
           ("iso230-2", "ISO 230-2 (positioning, linear axis)", _iso230_2, "targets_mm"),
           ("iso230-3", "ISO 230-3 (thermal effects)", _iso230_3, "stages"),
-          ("iso10360", "ISO 10360-2 (CMM length measurement)", _iso10360, "E_um"),
-          ("probe-cal", "sphere / R-test set-up", _sphere, "r_eff_mm"))
+          ("iso10360", "ISO 10360-2 (CMM length measurement)", _iso10360, "max_abs_E_um"),
+          ("probe-cal", "sphere / R-test set-up", _sphere, "r_eff_mm"),
+          ("probe-cal", "sphere / R-test set-up", _sphere, "instrument:sphere"),
+          ("probe-cal", "ball / hole plate set-up", _plate, "instrument:artifact"))
+
+
+def _has(doc: dict, key: str) -> bool:
+    """``key`` in the document, or ``instrument:KIND``: a calibration with a file of KIND."""
+    if key.startswith("instrument:"):
+        return bool(_files_of(doc, key.split(":", 1)[1]))
+    return key in doc
 
 
 def of(doc: dict, stated: dict | None = None) -> dict:
@@ -109,7 +146,7 @@ def of(doc: dict, stated: dict | None = None) -> dict:
     for word, standard, fill, key in _TESTS:
         runs = doc.get("runs") if isinstance(doc.get("runs"), list) else None
         probe = runs[0] if runs and isinstance(runs[0], dict) else doc
-        if word in command or key in probe:
+        if word in command or _has(probe, key):
             found = {k: v for k, v in fill(probe).items() if v not in (None, "")}
             cal = [i for i in (doc.get("identification") or {}).get("instruments") or []
                    if i.get("certificate")]
@@ -126,8 +163,8 @@ def of(doc: dict, stated: dict | None = None) -> dict:
 
 def measured(doc: dict) -> list:
     """The standard's own results beside the result rows, as (heading, table rows): the
-    ISO 230-4 G, H and F of every ballbar trace (µm; their uncertainty is not evaluated:
-    said in a note row), nothing for the other tests (their rows carry U)."""
+    ISO 230-4 G, H and F of every ballbar trace (µm; their U in the result rows, their
+    budgets from :func:`volerr.ballbar.iso230_4.budgets`), nothing for the other tests."""
     from .fmt import number
 
     tr = [t for t in doc.get("traces") or [] if isinstance(t, dict) and "G_um" in t]
@@ -140,5 +177,5 @@ def measured(doc: dict) -> list:
               number(t.get("F_min_um")), number(t.get("F_max_um"))] for t in tr]
     return [("ISO 230-4 results per trace", "table", rows),
             (None, "text", "G: circular deviation, H: circular hysteresis, F: radial "
-                           "deviation (ISO 230-4). Their measurement uncertainty is not "
-                           "evaluated here (no ISO 230-9 budget of the ballbar test yet).")]
+                           "deviation (ISO 230-4). Their u, k and U are in the results, "
+                           "their uncertainty budgets below.")]

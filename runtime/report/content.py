@@ -130,6 +130,7 @@ def sections(doc: dict, rows, figures: dict, ident=None) -> list:
     out += _verdicts(doc) + _tolerance_items(doc)
     for b in budgets_of(doc):
         out.append((f"Uncertainty budget: {b['quantity']}", "table", budget_rows(b)))
+        out += [(None, "text", n) for n in b.get("notes") or ()]
     notes = [n for n in doc.get("notes") or [] if isinstance(n, str)]
     if notes:
         out.append(("Notes", "text", "\n".join(f"\u2013 {n}" for n in notes)))

@@ -81,7 +81,8 @@ def budgets_html(budgets: list) -> str:
                                         f"<td>{e(c)}</td>" for i, c in enumerate(r))
                        + "</tr>" for r in rows[1:])
         out.append(f"<h3>Uncertainty budget: {e(b['quantity'])}</h3>"
-                   f"<table class='budget'><tr>{head}</tr>{body}</table>")
+                   f"<table class='budget'><tr>{head}</tr>{body}</table>"
+                   + "".join(f"<p>{e(n)}</p>" for n in b.get("notes") or ()))
     return "".join(out)
 
 

@@ -56,15 +56,19 @@ def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
         write_pdf(pdf_path, result, ident, inputs=inputs, title=title)
 
 
-def write_pdf(path, result, ident=None, inputs=(), title: str | None = None) -> Path:
-    """The PDF certificate of ``result`` (a result object or its JSON document)."""
+def write_pdf(path, result, ident=None, inputs=(), title: str | None = None,
+              figures: bool = True) -> Path:
+    """The PDF certificate of ``result`` (a result object or its JSON document);
+    ``figures=False``: without the figures (they come last: the pages before are the same;
+    the manual's gallery of certificates, built quickly)."""
     from . import content, pdf
 
     doc = document_of(result)
     ident = content.identification_of(doc, ident)
     doc["identification"] = ident.as_dict()
     title = title or _title(result, doc)
-    secs = content.sections(doc, rows_of_result(result), figures_of(result), ident)
+    secs = content.sections(doc, rows_of_result(result),
+                            figures_of(result) if figures else {}, ident)
     return pdf.write(path, secs, ident.report_id or "not stated", title, inputs=inputs)
 
 

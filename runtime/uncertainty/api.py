@@ -266,13 +266,14 @@ class Iso10360(ResultMixin):
         """One row per position and length: E0 (um, the mean of the repetitions) with the
         standard uncertainty of the test, U(L) / k (k = 2, ISO 14253-5)."""
         from ..results import Row
+        from .iso10360 import row_name
 
         res, U = self.result, self.data.get("uncertainty_um") or {}
         u = U.get("E0")
         out = []
         for i, name in enumerate(res.names):
             for j, L in enumerate(res.lengths[i]):
-                out.append(Row(f"E0({name.strip()}, L={L:.1f})",
+                out.append(Row(row_name(name, L),
                                float(np.mean(res.E_um[i, j])), None if u is None else u / 2.0,
                                "um", 1.0))
         return out

@@ -105,6 +105,12 @@ def linear_box(model, box=None) -> dict:
     return {a: tuple(map(float, box[a])) for a in ("X", "Y", "Z")}
 
 
+def row_name(position: str, length_mm: float) -> str:
+    """The name of the result row of E0 at ``position`` and ``length_mm``:
+    ``E0(diagonal +X+Y+Z, L=114.0)``."""
+    return f"E0({position.strip()}, L={float(length_mm):.1f})"
+
+
 def axis_positions(model, targets, probe) -> dict:
     """Axis positions (module units) that put the nominal probe tip at ``targets`` (N, 3) mm,
     for the linear axes (nominal position affine in them); rotary axes at 0."""
@@ -347,7 +353,11 @@ class TestResult:
         out["max_abs_E_um"] = float(np.max(np.abs(self.E_um)))
         out["uncertainty_um"] = {"E0": float(U.max())}
         out["test_uncertainty"] = self.uncertainty.as_dict()
-        out["budgets"] = {"E0": self.uncertainty.budget(float(self.lengths.flat[U.argmax()]))}
+        b = self.uncertainty.budget(float(self.lengths.flat[U.argmax()]))
+        b["rows"] = [row_name(n, L) for i, n in enumerate(self.names) for L in self.lengths[i]]
+        b["notes"] = ["Every E0 row states this u: the test uncertainty at the longest length, "
+                      "the largest of the test (a conservative u for the shorter lengths)."]
+        out["budgets"] = {"E0": b}
         if self.spec is not None:
             mpe = self.spec.mpe_um(self.lengths)[..., None]
             ratio = np.abs(self.E_um) / mpe

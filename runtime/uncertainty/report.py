@@ -18,6 +18,7 @@ nominal value of the task) and a standard uncertainty u; U = 2 u.  Two ways to s
 from __future__ import annotations
 
 import html
+import math
 from pathlib import Path
 
 from ..plotstyle import embedded_img
@@ -86,8 +87,9 @@ def result_document(problem, values, summary: dict, info: dict, *, layout: str, 
     dict
         Keys ``layout task evaluation quantities samples seed block_size chunks scheduler
         machine noise_um sources bias table_uncertainty`` and, when present,
-        ``spec_acceptance adaptive contributions``; each quantity also carries
-        ``corrected_estimate_mm`` and the stated result (:func:`statement`).
+        ``spec_acceptance adaptive contributions``, then ``budgets`` (:func:`budgets`); each
+        quantity also carries ``corrected_estimate_mm`` and the stated result
+        (:func:`statement`).
     """
     quantities = {}
     for name, q in summary.items():
@@ -109,7 +111,43 @@ def result_document(problem, values, summary: dict, info: dict, *, layout: str, 
                            "tolerance_um": [d * UM_PER_MM for d in adaptive.delta_mm]}
     if contributions is not None:
         doc["contributions"] = contributions
+    doc["budgets"] = budgets(doc)
     return doc
+
+
+def budgets(doc: dict) -> dict:
+    """Per quantity the budget (:mod:`volerr.report.budget`, um) of the Monte Carlo standard
+    uncertainty u: each group of sources (``doc["contributions"]``: the Monte Carlo run with
+    only that group random, the others off) with its u_i as u(x_i) and one sensitivity
+    c = u / sqrt(sum u_i^2) for all (the joint run against the root sum of squares of the
+    one-at-a-time runs: 1 when the groups add in quadrature; it carries their interactions,
+    the spec's acceptance of machines and the sampling), so that the combined u is the u the
+    run states.  Without contributions (``--contributions 0``) one source, the joint run.
+    The Monte Carlo's own standard error of u, u / sqrt(2 (M - 1)) for M samples (normal
+    approximation, JCGM 101 7.9), is a note: it is the uncertainty of u, not a source."""
+    from ..report.budget import budget, source
+
+    m = int(doc["samples"])
+    out = {}
+    for name, q in doc["quantities"].items():
+        u = float(q["standard_uncertainty_um"])
+        one = [(c["source"], float(c["standard_uncertainty_um"][name]))
+               for c in doc.get("contributions") or [] if name in c["standard_uncertainty_um"]]
+        rss = math.sqrt(sum(v * v for _, v in one))
+        notes = [f"Monte Carlo standard error of u: {u / math.sqrt(2 * max(m - 1, 1)):.3g} "
+                 f"\u00b5m ({m} samples)."]
+        if one and rss > 0:
+            c = u / rss
+            srcs = [source(f"{s} (Monte Carlo, only this group random)", v, "um", c)
+                    for s, v in one]
+            notes.append(f"c = u / \u221a(\u03a3 u(x_i)\u00b2) = {c:.4g}: the joint run over "
+                         f"the one-at-a-time runs (interactions, acceptance, sampling; 1 "
+                         f"when the groups add in quadrature).")
+        else:
+            srcs = [source("every source together (joint Monte Carlo; no one-at-a-time "
+                           "runs: --contributions 0)", u, "um")]
+        out[name] = budget(name, "um", srcs, 2.0, notes=notes)
+    return out
 
 
 def summary_lines(doc: dict) -> list[str]:

@@ -250,9 +250,9 @@ def test_write_pdf_of_an_api_result_has_vector_figures_and_page_numbers(tmp_path
     # the polar plot is drawn as paths, not embedded as a raster image
     assert not any(page.images for page in reader.pages)
     assert "EC0Y" in text[0] and "\u00b5rad" in text[0]
-    # the diagnosis' budgets: the estimator's, where an entry is one of its parameters
+    # the budgets of the rows: ISO 230-4 G, F, H and the diagnosis (the estimator's)
     budgets = ev.to_dict()["budgets"]
-    std = {e["parameter"]: e["std"] for e in ev.to_dict()["diagnosis"]}
+    std = {r.name: r.std for r in ev._rows()}
     assert "EC0Y" in budgets
     for name, b in budgets.items():
         assert b["u"] == pytest.approx(std[name], rel=1e-6)

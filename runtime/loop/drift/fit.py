@@ -276,7 +276,8 @@ def _jackknife(ch: Channel, specs) -> dict:
     tau_std = [None if (e or not sp["tau_s"] > 0) else float(u)
                for e, sp, u in zip(edge, specs, tau_std)]
     return {"zeros": b[:n_runs], "coef": b[n_runs:], "coef_std": coef_std,
-            "tau_std": tau_std, "design": D}
+            "tau_std": tau_std, "design": D, "coef_dev": bk - bk.mean(0),
+            "tau_dev": tk - tk.mean(0)}
 
 
 def _tau_on(ch: Channel, sp, i, specs, masks) -> list:

@@ -62,6 +62,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "n_points": int(len(s.t_s) * len(s.channels)), "n_train": int(s.train.sum()),
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
+            "budgets": {},
             "not_significant": [], "not_reported": [], "static_regression": {},
             "unidentifiable": [],
             "extrapolation": extrapolation(s)}
@@ -92,7 +93,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
         if r["choice"]["family"] != "lag":
             data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]]
             continue
-        data["effects"] += _effects(label, r, m, quantity.get(label))
+        data["effects"] += _effects(label, r, m, quantity.get(label), data["budgets"])
         data["not_significant"] += [f"{label}: {_basis(sp)}" for sp in r["fit"].get("dropped", [])]
     tr = list(data["channels"].values())
     data["rms_before_um"] = _pool(tr, "rms_before_um")
@@ -188,9 +189,10 @@ def _basis(sp) -> str:
     return f"lag({what}, {sp['tau_s']:.0f} s)" if sp["tau_s"] > 0 else what
 
 
-def _effects(label, r, s, q=None) -> list:
+def _effects(label, r, s, q=None, budgets=None) -> list:
     """The channel's (or the quantity ``q``'s) terms grouped by covariate (module
-    docstring)."""
+    docstring); the budget of every term's std (and its time constant's) into ``budgets``
+    (:func:`_budget`)."""
     f = r["fit"]
     groups: dict = {}
     for i, sp in enumerate(r["terms"]):
@@ -213,6 +215,9 @@ def _effects(label, r, s, q=None) -> list:
                  "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"]}
             terms.append(t)
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
+        for j, (i, t) in enumerate(zip(idx, terms)):
+            if budgets is not None:
+                budgets.update(_budget(f"{name}_{j}", t, f, i))
         e = {"kind": "thermal", "name": name, "channel": label,
              "channels": list(q.channels) if q is not None else [label],
              "quantity": q.symbol if q is not None else None,
@@ -227,6 +232,30 @@ def _effects(label, r, s, q=None) -> list:
             e["heat_exponent"] = sp0["p"]
             e["S_ref_rpm"] = S_ref
         out.append(e)
+    return out
+
+
+def _budget(row: str, t: dict, f: dict, i: int) -> dict:
+    """The GUM budgets (:mod:`volerr.report.budget`) of term ``i``'s coefficient (row
+    ``row``) and time constant (``row:tau``): their blocked jackknife standard uncertainty,
+    u^2 = (K - 1) / K sum_k (b_k - mean b)^2 over the K folds (:mod:`volerr.loop.drift.fit`),
+    as one source per fold left out, u(x_k) = ``|b_k - mean b|``, sensitivity sqrt((K - 1) / K)
+    (taken as the stated u over the root sum of squares of the deviations: the stated u is
+    rounded)."""
+    from ...report.budget import budget, source
+
+    out = {}
+    for key, dev, std, unit in (
+            (row, f.get("coef_dev"), t["std"], t["unit"]),
+            (f"{row}:tau", f.get("tau_dev"), (t.get("lag_s") or {}).get("std"), "s")):
+        if dev is None or std is None:
+            continue
+        d = np.abs(np.asarray(dev)[:, i])
+        rss = float(np.sqrt(np.sum(d ** 2)))
+        K = len(d)
+        out[key] = budget(key, unit, [
+            source(f"fold {k + 1} of {K} left out (jackknife replicate)", float(v), unit,
+                   std / rss if rss > 0 else 0.0) for k, v in enumerate(d)], 2.0)
     return out
 
 
