@@ -310,3 +310,29 @@ def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
                          f"L long is 0 0 -L: likely the sign (write {v[0]:g} {v[1]:g} "
                          f"{-v[2]:g}, or --tool-length {v[2]:g})")
     return v
+
+
+#: the largest coordinate accepted on the command line (mm)
+MAX_COORD_MM = 1e6
+
+
+def parse_vector(tokens, what: str, n: int = 3) -> tuple:
+    """``["1", "2", "3"]``, ``["1,2,3"]`` or ``["1, 2", "3"]`` -> (1.0, 2.0, 3.0): both vector
+    syntaxes, finite numbers of at most :data:`MAX_COORD_MM`; ``what`` (the option) names
+    the value in the one-line :class:`InputError` of a bad one."""
+    if isinstance(tokens, str):
+        tokens = [tokens]
+    parts = [c for t in tokens for c in str(t).replace(",", " ").split()]
+    try:
+        v = tuple(float(c) for c in parts)
+    except ValueError:
+        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got "
+                         f"{' '.join(map(str, tokens))!r}") from None
+    if len(v) != n:
+        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got {len(v)}")
+    if not all(math.isfinite(c) and abs(c) <= MAX_COORD_MM for c in v):
+        raise InputError(f"{what}: numbers must be finite and at most {MAX_COORD_MM:g} mm, "
+                         f"got {' '.join(map(str, tokens))}")
+    return v
