@@ -226,18 +226,8 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
     own = set(getattr(args, "_ident_own", ())) | {"date"}
     given = {k: getattr(args, k, None) for k in ("machine", "instrument", "operator", "date",
                                                  "customer") if k in own}
-    paths = {str(f) for f in files}
-    skip = _NOT_METHOD | own          # outputs, and the identification's own fields
-    def is_input(v) -> bool:          # an input file (also as KIND:FILE): hashed, not an option
-        return str(v) in paths or str(v).split(":", 1)[-1] in paths
-
-    options = {k: (str(v) if isinstance(v, Path) else v) for k, v in sorted(vars(args).items())
-               if not k.startswith("_") and k not in skip and v not in (None, False, [])
-               and not is_input(v) and not callable(v)}
-    options = {k: v for k, v in options.items()
-               if not (isinstance(v, list) and all(is_input(x) for x in v))}
     method = {"command": getattr(args, "_ident_prog", "volerr"), "version": __version__,
-              "options": options}
+              "options": certificate.method_options(vars(args), files, _NOT_METHOD | own)}
     file = certificate.find_identification_file(getattr(args, "identification", None),
                                                 list(files))
     return certificate.build(given, file, list(files), method, conditions)
