@@ -336,3 +336,18 @@ def parse_vector(tokens, what: str, n: int = 3) -> tuple:
         raise InputError(f"{what}: numbers must be finite and at most {MAX_COORD_MM:g} mm, "
                          f"got {' '.join(map(str, tokens))}")
     return v
+
+
+def parse_at(items, option: str = "--at") -> dict:
+    """``["B=30", "C=-90"]`` (``AXIS=VALUE``, repeatable option) -> ``{"B": 30.0, "C": -90.0}``
+    (rotary axes in deg, linear in mm); a malformed item: one-line :class:`InputError`."""
+    out = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not (sep == "=" and name):
+            raise InputError(f"{option} expects AXIS=VALUE, got {item!r}")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise InputError(f"{option} {item!r}: {value!r} is not a number") from None
+    return out

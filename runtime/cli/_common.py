@@ -7,7 +7,7 @@ from pathlib import Path
 from ..choices import INTERPOLATION as METHODS
 from ..errors import InputError, require
 from ..progress import bar, progress, progress_bar  # noqa: F401  (one rule: volerr.progress)
-from ..units import MAX_COORD_MM, parse_vector  # noqa: F401  (the parsing with the units)
+from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the parsing: units)
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
@@ -60,18 +60,6 @@ def add_common(p) -> None:
     p.add_argument("--volume", choices=("travel", "measured"), default="travel",
                    help="box of the linear axes: the layout's travel (default) or the part of "
                         "it the error tables cover (no extrapolation either way)")
-
-
-def parse_at(items) -> dict:
-    out = {}
-    for item in items or []:
-        name, sep, value = item.partition("=")
-        require(sep == "=" and name, f"--at expects AXIS=VALUE, got {item!r}")
-        try:
-            out[name.strip()] = float(value)
-        except ValueError:
-            raise InputError(f"--at {item!r}: {value!r} is not a number") from None
-    return out
 
 
 def inputs_of(args, model=None) -> list:
@@ -252,11 +240,9 @@ def planned_outputs(args, inputs, *, first: dict | None = None, **more):
 
     outs = Outputs(inputs, force=getattr(args, "force", False))
     first = first or {}
-    _declare(outs, first)
-    _declare(outs, {f"--{role}": getattr(args, role, None) for role in ("json", "html", "pdf",
-                                                                      "plot")
-                    if f"--{role}" not in first and f"--{role}" not in more})
-    _declare(outs, more)
+    report = {r: getattr(args, r[2:], None) for r in ("--json", "--html", "--pdf", "--plot")}
+    for targets in (first, {r: p for r, p in report.items() if r not in {**first, **more}}, more):
+        _declare(outs, targets)
     return outs.check()
 
 

@@ -23,7 +23,8 @@ def register(sub) -> None:
                                                 "dz_um (+ rx_um ry_um rz_um)")
     p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")
     p.add_argument("--plot-random", metavar="PNG",
-                   help="random component plot (default <plot>_random.png when the tables have std)")
+                   help="random component plot (default <plot>_random.png when the tables "
+                        "have std)")
     p.add_argument("--magnify", type=float, default=None, metavar="K",
                    help="error magnification in the plots (default: automatic)")
     p.add_argument("--json", metavar="F", help="summary as JSON")

@@ -123,8 +123,9 @@ def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
     Returns
     -------
     ErrorMap
-        ``to_dict()`` is ``--json``: max ``|dx|``, ``|dy|``, ``|dz|``, max and RMS ``|d|`` (um; actual minus
-        nominal probe tip), and the random part's maximum (k = 1).
+        ``to_dict()`` is ``--json``: max ``|dx|``, ``|dy|``, ``|dz|``, max and RMS ``|d|``
+        (um; actual minus nominal probe tip), and the random part's maximum (k = 1); after
+        :meth:`ErrorMap.write_plot` also the plots' magnifications.
     """
     import math
 
