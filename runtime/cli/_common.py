@@ -222,11 +222,15 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
 
 
 def write_certificates(outs, result, ident, inputs=(), title: str | None = None) -> None:
-    """Inside ``with outs:`` after the command's own outputs: :func:`volerr.report.stamp.finish`
-    (the identification stamped into ``--json`` / ``--html``, the ``--pdf`` certificate)."""
+    """Inside ``with outs:`` after the command's own outputs: the identification stamped into
+    the written ``--json`` and ``--html`` and the ``--pdf`` certificate of ``result`` (a
+    result object or its JSON document; :func:`volerr.report.stamp.finish`)."""
     from ..report import stamp
+    from ..results import Document
 
-    stamp.finish(outs, result, ident, inputs=inputs, title=title)
+    if isinstance(result, dict) or not hasattr(result, "_rows"):   # its "parameters" as rows
+        result = Document(result)
+    stamp.finish(outs, result, ident, inputs=list(inputs), title=title)
 
 
 def planned_outputs(args, inputs, *, first: dict | None = None, **more):

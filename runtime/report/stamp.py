@@ -17,14 +17,8 @@ def document_of(result) -> dict:
 
 
 def rows_of_result(result) -> list:
-    """The reported rows of a result (its ``_rows()``); of a plain JSON document (``map``,
-    ``compensate``, ``iso10360`` ...) or a result without rows (``check``): the rows of its
-    ``"parameters"`` (``{name: {"value", "std", "unit"}}``)."""
-    if hasattr(result, "_rows"):
-        return list(result._rows())
-    from ..results import rows_of
-
-    return rows_of(document_of(result).get("parameters"))
+    """The reported rows of a result (its ``_rows()``; none for a plain document)."""
+    return list(result._rows()) if hasattr(result, "_rows") else []
 
 
 def figures_of(result) -> dict:
@@ -37,9 +31,7 @@ def figures_of(result) -> dict:
 
 def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
     """Stamp ``--json`` (when written and the user stated an identification, or the document
-    carries one of its own) and ``--html`` (when written); write ``--pdf`` (when given) of
-    ``result`` (a result object or its JSON document)."""
-    inputs = list(inputs)
+    carries one of its own) and ``--html`` (when written); write ``--pdf`` (when given)."""
     from ..fileio import json_text, write_text
     from .page import stamp_html
 
