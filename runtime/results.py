@@ -204,20 +204,3 @@ def callable_package(name: str, function) -> None:
     module.__api__ = function
     module.__class__ = CallableModule
 
-
-class Document(ResultMixin):
-    """A command's bare JSON document (``map``, ``compensate``, ``iso10360`` ...) or a result
-    without rows (``check``) as a result for its certificate (:mod:`volerr.report.stamp`):
-    ``to_dict()`` the document itself, the rows of its ``"parameters"`` and the result's
-    figures."""
-
-    def __init__(self, result):
-        self.result = result
-        self.data = result if isinstance(result, dict) else result.to_dict()
-
-    def to_dict(self) -> dict:
-        return self.data
-
-    def figures(self) -> dict:
-        return {} if isinstance(self.result, dict) or not hasattr(self.result, "figures") \
-            else self.result.figures()

@@ -226,7 +226,7 @@ def write_certificates(outs, result, ident, inputs=(), title: str | None = None)
     the written ``--json`` and ``--html`` and the ``--pdf`` certificate of ``result`` (a
     result object or its JSON document; :func:`volerr.report.stamp.finish`)."""
     from ..report import stamp
-    from ..results import Document
+    from ..report.document import Document
 
     if isinstance(result, dict) or not hasattr(result, "_rows"):   # its "parameters" as rows
         result = Document(result)
