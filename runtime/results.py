@@ -203,4 +203,3 @@ def callable_package(name: str, function) -> None:
     module = sys.modules[name]
     module.__api__ = function
     module.__class__ = CallableModule
-
