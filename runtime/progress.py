@@ -71,7 +71,7 @@ class progress_bar:
         self.bar = None
 
     def __enter__(self):
-        if not sys.stderr.isatty():
+        if not on_terminal():
             return lambda n: None
         try:
             from tqdm import tqdm
