@@ -234,12 +234,10 @@ def write_certificates(outs, result, ident, inputs=(), title: str | None = None)
 
 
 def planned_outputs(args, inputs, *, first: dict | None = None, **more):
-    """:class:`volerr.fileio.Outputs` of a command's run, declared and checked: ``first``,
-    the report options the command has (``--json``, ``--html``, ``--pdf`` files, ``--plot``
-    PNG) and ``more`` (``"--out": path`` a file, ``"--errors-out": (path, names)`` a folder
-    with the names of its files, ``None`` names: not known before the run).  The order of
-    declaring is the order of the refusals (``first``: a command's own outputs named first,
-    as before)."""
+    """:class:`volerr.fileio.Outputs` of a command's run, declared in this order (the order
+    of the refusals) and checked: ``first``, the report options the command has (``--json``,
+    ``--html``, ``--pdf``, ``--plot``) and ``more``; ``{"--out": path}`` a file (``--plot...``
+    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet)."""
     from ..fileio import Outputs
 
     outs = Outputs(inputs, force=getattr(args, "force", False))
@@ -251,7 +249,6 @@ def planned_outputs(args, inputs, *, first: dict | None = None, **more):
 
 
 def _declare(outs, targets: dict) -> None:
-    """Declare ``{role: path or (folder, names)}`` (a ``--plot...`` role a PNG)."""
     for role, target in targets.items():
         if isinstance(target, tuple):
             outs.folder(role, target[0], files=target[1])

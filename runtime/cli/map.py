@@ -57,9 +57,6 @@ def run(args) -> int:
         if rnd_plot:    # before write_outputs: the --json holds the magnifications
             res.write_random_plot(outs.path("--plot-random"), inputs)
         write_outputs(args, outs, res, ident, inputs)
-    print(res.summary())
-    for label, path in (("map", args.out), ("plot", args.plot), ("random plot", rnd_plot),
-                        ("summary", args.json)):
-        if path:
-            print(f"  {label}: {path}")
+    print(res.summary({"map": args.out, "plot": args.plot, "random plot": rnd_plot,
+                       "summary": args.json}))
     return 0

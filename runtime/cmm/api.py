@@ -49,8 +49,9 @@ class ErrorMap(ResultMixin):
                                                           inputs)
         return path
 
-    def summary(self) -> str:
-        """What ``volerr map`` prints (without the lines naming the written files)."""
+    def summary(self, written: dict | None = None) -> str:
+        """What ``volerr map`` prints; ``written``: ``{label: path}`` of the files written
+        (``map``, ``plot``, ``random plot``, ``summary``), one line each at the end."""
         s, vmap = self.data, self.map
         m = s["max_abs_um"]
         out = [f"{s['layout']}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
@@ -61,6 +62,7 @@ class ErrorMap(ResultMixin):
             r = s["random_max_um"]
             out.append(f"  random (1 sigma, k = 1) max rx {r['x']:.2f} um, ry {r['y']:.2f} um, "
                        f"rz {r['z']:.2f} um")
+        out += [f"  {label}: {path}" for label, path in (written or {}).items() if path]
         return "\n".join(out)
 
     def write_csv(self, path, inputs=()):
