@@ -260,6 +260,24 @@ def report_id(files=(), options: dict | None = None) -> str:
     return "VE-" + h.hexdigest()[:12].upper()
 
 
+def method_options(values: dict, files=(), skip=()) -> dict:
+    """The options of a run that state its method (the report's ``method.options``): of
+    ``values`` (option -> value, as a command's arguments), those given (not None, False or
+    ``[]``), not private (``_...``), not in ``skip`` (outputs, the identification's own
+    fields), not callable and not an input file of ``files`` (hashed into the report id
+    instead; also as ``KIND:FILE``, or a list of them); paths as text."""
+    paths = {str(f) for f in files}
+
+    def is_input(v) -> bool:
+        return str(v) in paths or str(v).split(":", 1)[-1] in paths
+
+    options = {k: (str(v) if isinstance(v, Path) else v) for k, v in sorted(values.items())
+               if not k.startswith("_") and k not in skip and v not in (None, False, [])
+               and not is_input(v) and not callable(v)}
+    return {k: v for k, v in options.items()
+            if not (isinstance(v, list) and all(is_input(x) for x in v))}
+
+
 def build(given: dict, file=None, files=(), method: dict | None = None,
           conditions: dict | None = None) -> Identification:
     """One :class:`Identification` from the file's fields (:func:`read_identification_file`)

@@ -317,3 +317,44 @@ def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
 #: sensors along X read the tilt about +Y (+ds/dz), along Y the tilt about +X (-ds/dz);
 #: used by the ISO 230-3 evaluation and the drift loop's rows alike
 SENSOR_TILT = {"X": ("Y", 1.0), "Y": ("X", -1.0)}
+
+
+#: the largest coordinate accepted on the command line (mm)
+MAX_COORD_MM = 1e6
+
+
+def parse_vector(tokens, what: str, n: int = 3) -> tuple:
+    """``["1", "2", "3"]``, ``["1,2,3"]`` or ``["1, 2", "3"]`` -> (1.0, 2.0, 3.0): both vector
+    syntaxes, finite numbers of at most :data:`MAX_COORD_MM`; ``what`` (the option) names
+    the value in the one-line :class:`InputError` of a bad one."""
+    if isinstance(tokens, str):
+        tokens = [tokens]
+    parts = [c for t in tokens for c in str(t).replace(",", " ").split()]
+    try:
+        v = tuple(float(c) for c in parts)
+    except ValueError:
+        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got "
+                         f"{' '.join(map(str, tokens))!r}") from None
+    if len(v) != n:
+        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
+                         f"X,Y,Z), got {len(v)}")
+    if not all(math.isfinite(c) and abs(c) <= MAX_COORD_MM for c in v):
+        raise InputError(f"{what}: numbers must be finite and at most {MAX_COORD_MM:g} mm, "
+                         f"got {' '.join(map(str, tokens))}")
+    return v
+
+
+def parse_at(items, option: str = "--at") -> dict:
+    """``["B=30", "C=-90"]`` (``AXIS=VALUE``, repeatable option) -> ``{"B": 30.0, "C": -90.0}``
+    (rotary axes in deg, linear in mm); a malformed item: one-line :class:`InputError`."""
+    out = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not (sep == "=" and name):
+            raise InputError(f"{option} expects AXIS=VALUE, got {item!r}")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise InputError(f"{option} {item!r}: {value!r} is not a number") from None
+    return out

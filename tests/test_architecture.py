@@ -209,6 +209,41 @@ def test_every_file_has_a_room():
     assert not lost, f"files in no room of docs/architecture.md: {lost}"
 
 
+def folder_gaps(patterns, folders) -> tuple[list, list]:
+    """(package folders no pattern names, patterns naming a folder or file that is not
+    there).  A folder is named by ``dir/`` or ``dir/*.py``; ``folders`` end in ``/``."""
+    named = {pat if pat.endswith("/") else pat.rsplit("/", 1)[0] + "/"
+             for pat in patterns if pat.endswith("/") or pat.endswith("/*.py")}
+    files = [pat for pat in patterns if not pat.endswith("/") and "*" not in pat]
+    missing = sorted(set(folders) - named)
+    stale = sorted(named - set(folders)) + sorted(f for f in files if not (ROOT / f).is_file())
+    return missing, stale
+
+
+def package_folders() -> set[str]:
+    """Every folder of runtime/, derive/ and generated/ that holds Python files."""
+    return {p.rsplit("/", 1)[0] + "/" for p in modules().values()}
+
+
+def test_the_room_list_names_every_package_folder_and_no_other():
+    """issue 42 item 6: the table of docs/architecture.md is the tree as it is -- every folder
+    with Python files is a room's ``dir/`` or ``dir/*.py``, and every folder or file the
+    table names exists."""
+    patterns = [pat for _, pats, _ in rooms() for pat in pats]
+    missing, stale = folder_gaps(patterns, package_folders())
+    assert not missing, f"package folders docs/architecture.md does not name: {missing}"
+    assert not stale, f"docs/architecture.md names what is not there: {stale}"
+
+
+def test_folder_gaps_finds_a_missing_and_a_stale_room():
+    folders = {"runtime/", "runtime/cli/", "runtime/new/"}
+    patterns = ["runtime/*.py", "runtime/cli/", "runtime/gone/", "runtime/cli/nothere.py"]
+    missing, stale = folder_gaps(patterns, folders)
+    assert missing == ["runtime/new/"]
+    assert stale == ["runtime/gone/", "runtime/cli/nothere.py"]
+    assert folder_gaps(["runtime/*.py", "runtime/cli/", "runtime/new/"], folders) == ([], [])
+
+
 def test_imports_go_only_the_allowed_ways():
     allowed = {room: may for room, _, may in rooms()}
     wrong = []

@@ -1,8 +1,5 @@
-"""The ``volerr`` command line.
-
-Each command lives in its own module under ``volerr.cli`` with ``register(subparsers)``
-that adds its parser and sets ``func``.  Bad input raises :class:`volerr.errors.InputError`,
-which becomes one line on stderr and exit code 2.
+"""The ``volerr`` command line: one module per command (``register(subparsers)`` adds its
+parser and sets ``func``); :class:`volerr.errors.InputError` becomes one line on stderr, exit 2.
 """
 
 from __future__ import annotations
@@ -10,6 +7,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import importlib
+import math
 import re
 import sys
 
@@ -33,8 +31,6 @@ class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
 
     @staticmethod
     def _plain(text: str) -> str:
-        import re
-
         text = re.sub(r":(?:mod|func|class|meth|attr|data):`~?([^`]+)`", r"\1", text)
         return text.replace("``", "")
 
@@ -52,12 +48,8 @@ class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
         if (default is None or default is False or default is argparse.SUPPRESS
                 or not action.option_strings or default == [] or "%(default)" in text):
             return text
-        if isinstance(default, (list, tuple)):
-            shown = " ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in default)
-        elif isinstance(default, float):
-            shown = f"{default:g}"
-        else:
-            shown = str(default)
+        shown = " ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in (
+            default if isinstance(default, (list, tuple)) else [default]))
         if "default" in text.lower() and shown in text:
             return text  # the help states it already
         return f"{text} (default: {shown.replace('%', '%%')})"
@@ -83,13 +75,11 @@ class _Parser(argparse.ArgumentParser):
             known = set(self._option_string_actions)
             for token in _ARGV:
                 name = token.split("=", 1)[0]
-                if name.startswith("--") and name not in known and not any(
-                        k.startswith(name) for k in known):
-                    close = difflib.get_close_matches(name, _visible_options(self), n=1,
-                                                      cutoff=0.6)
-                    if close:
-                        message = f"unrecognized option {token} (did you mean {close[0]}?)"
-                        break
+                close = _closest(self, name) if name.startswith("--") and not any(
+                    k.startswith(name) for k in known) else ""
+                if close:
+                    message = f"unrecognized option {token}{close}"
+                    break
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
     def parse_args(self, args=None, namespace=None):
@@ -97,16 +87,13 @@ class _Parser(argparse.ArgumentParser):
         with the closest option of that command ("did you mean --json?")."""
         _ARGV[:] = [str(a) for a in (sys.argv[1:] if args is None else args)]
         ns, extras = self.parse_known_args(args, namespace)
-        _refuse_empty(getattr(ns, "_parser", None) or self, _ARGV)
-        _refuse_nonfinite(getattr(ns, "_parser", None) or self, ns)
+        leaf = getattr(ns, "_parser", None) or self
+        _refuse_empty(leaf, _ARGV)
+        _refuse_nonfinite(leaf, ns)
+        bad = next((e for e in extras if e.startswith("-")), None)
+        if bad:
+            leaf.error(f"unrecognized option {bad}{_closest(leaf, bad.split('=', 1)[0])}")
         if extras:
-            leaf = getattr(ns, "_parser", None) or self
-            bad = next((e for e in extras if e.startswith("-")), extras[0])
-            if bad.startswith("-"):
-                close = difflib.get_close_matches(bad.split("=", 1)[0],
-                                                  _visible_options(leaf), n=1, cutoff=0.6)
-                hint = f" (did you mean {close[0]}?)" if close else ""
-                leaf.error(f"unrecognized option {bad}{hint}")
             leaf.error(f"unrecognized arguments: {' '.join(extras)}")
         return ns
 
@@ -118,8 +105,6 @@ def _refuse_nonfinite(parser, ns) -> None:
     """Every number option is finite (``nan``, ``inf`` parse as floats but are never a
     tolerance, radius or limit), and a ``--seed`` is an integer 0 .. 2^32 - 1 (numpy's
     seeds)."""
-    import math
-
     for action in parser._actions:
         if action.type not in (float, int) or not action.option_strings:
             continue
@@ -145,9 +130,12 @@ def _refuse_empty(parser, argv) -> None:
                          "empty argument ('')")
 
 
-def _visible_options(parser) -> list:
-    return [s for a in parser._actions if a.help is not argparse.SUPPRESS
-            for s in a.option_strings]
+def _closest(parser, name: str) -> str:
+    """`` (did you mean --json?)``: the visible option of ``parser`` closest to ``name``."""
+    options = [s for a in parser._actions if a.help is not argparse.SUPPRESS
+               for s in a.option_strings]
+    close = difflib.get_close_matches(name, options, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]}?)" if close else ""
 
 
 def _did_you_mean(message: str) -> str:
@@ -177,9 +165,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     every message of that command are the same, the start-up cheaper)."""
     from .. import __version__
 
-    parser = _Parser(
-        prog="volerr",
-        description="Derived, audited volumetric error models of CMMs and five-axis machines.")
+    parser = _Parser(prog="volerr", description="Derived, audited volumetric error models of "
+                                                "CMMs and five-axis machines.")
     parser.add_argument("--version", action="version", version=f"volerr {__version__}",
                         help="print the version of volerr and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -187,13 +174,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     module_name = (command or "").replace("-", "_")
     only = command is not None and "_" not in command and module_name in COMMANDS
     for name in (module_name,) if only else COMMANDS:
-        try:
-            module = importlib.import_module(f"volerr.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"volerr.cli.{name}":
-                continue  # command not built yet
-            raise
-        module.register(sub)
+        importlib.import_module(f"volerr.cli.{name}").register(sub)
     _mark_leaves(parser)
     return parser
 

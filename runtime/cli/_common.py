@@ -6,6 +6,8 @@ from pathlib import Path
 
 from ..choices import INTERPOLATION as METHODS
 from ..errors import InputError, require
+from ..progress import bar, progress, progress_bar  # noqa: F401  (one rule: volerr.progress)
+from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the parsing: units)
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
@@ -60,18 +62,6 @@ def add_common(p) -> None:
                         "it the error tables cover (no extrapolation either way)")
 
 
-def parse_at(items) -> dict:
-    out = {}
-    for item in items or []:
-        name, sep, value = item.partition("=")
-        require(sep == "=" and name, f"--at expects AXIS=VALUE, got {item!r}")
-        try:
-            out[name.strip()] = float(value)
-        except ValueError:
-            raise InputError(f"--at {item!r}: {value!r} is not a number") from None
-    return out
-
-
 def inputs_of(args, model=None) -> list:
     """Files that must never be overwritten: the error tables and a layout file (shipped
     layouts are package files, protected by :class:`volerr.fileio.Outputs` anyway)."""
@@ -86,81 +76,6 @@ def layout_inputs(layout) -> list:
     """``[path]`` when LAYOUT names an existing file, else ``[]`` (a shipped name)."""
     p = Path(str(layout))
     return [p] if p.is_file() else []
-
-
-from ..progress import bar, progress  # noqa: E402,F401  (one rule: volerr.progress)
-
-
-class progress_bar:
-    """``with progress_bar(path, what) as tick:`` -- a ``tqdm`` bar over the lines of the
-    file ``path`` (total estimated from its size and first lines) on stderr when stderr is a
-    terminal; ``tick(n)`` advances it by ``n`` lines.  Off a terminal ``tick`` does nothing
-    (no bar in logs and pipes)."""
-
-    def __init__(self, path, what: str, total=None, unit: str = "lines"):
-        self.path, self.what, self.total, self.unit = path, what, total, unit
-        self.bar = None
-
-    def __enter__(self):
-        import sys
-
-        if not sys.stderr.isatty():
-            return lambda n: None
-        try:
-            from tqdm import tqdm
-        except ImportError:  # pragma: no cover
-            return lambda n: None
-        total = self.total
-        if total is None and self.path is not None:
-            total = _estimated_lines(self.path)
-        self.bar = tqdm(total=total, file=sys.stderr, leave=False, unit=self.unit,
-                        unit_scale=True, desc=self.what)
-        return self.bar.update
-
-    def __exit__(self, *exc):
-        if self.bar is not None:
-            self.bar.close()
-        return False
-
-
-def _estimated_lines(path) -> int | None:
-    """Lines of a text file, estimated from its size and the length of its first lines."""
-    try:
-        size = Path(path).stat().st_size
-        with open(path, "rb") as fh:
-            head = fh.read(65536)
-    except OSError:
-        return None
-    n = head.count(b"\n") or head.count(b"\r")
-    if not n:
-        return None
-    return int(round(size / (len(head) / n)))
-
-
-#: the largest coordinate accepted on the command line (mm)
-MAX_COORD_MM = 1e6
-
-
-def parse_vector(tokens, what: str, n: int = 3) -> tuple:
-    """``["1", "2", "3"]``, ``["1,2,3"]`` or ``["1, 2", "3"]`` -> (1.0, 2.0, 3.0): both vector
-    syntaxes, finite numbers of at most :data:`MAX_COORD_MM`."""
-    import math
-
-    if isinstance(tokens, str):
-        tokens = [tokens]
-    parts = [c for t in tokens for c in str(t).replace(",", " ").split()]
-    try:
-        v = tuple(float(c) for c in parts)
-    except ValueError:
-        raise InputError(f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
-                         f"X,Y,Z), got "
-                         f"{' '.join(map(str, tokens))!r}") from None
-    require(len(v) == n, f"{what}: expected {'three' if n == 3 else n} numbers (X Y Z or "
-                         f"X,Y,Z), got {len(v)}")
-    require(all(math.isfinite(c) and abs(c) <= MAX_COORD_MM for c in v),
-            f"{what}: numbers must be finite and at most {MAX_COORD_MM:g} mm, got "
-            f"{' '.join(map(str, tokens))}")
-    return v
 
 
 def add_vector(parser, flag: str, help: str, default=None, required: bool = False,
@@ -299,18 +214,8 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
     own = set(getattr(args, "_ident_own", ())) | {"date"}
     given = {k: getattr(args, k, None) for k in ("machine", "instrument", "operator", "date",
                                                  "customer") if k in own}
-    paths = {str(f) for f in files}
-    skip = _NOT_METHOD | own          # outputs, and the identification's own fields
-    def is_input(v) -> bool:          # an input file (also as KIND:FILE): hashed, not an option
-        return str(v) in paths or str(v).split(":", 1)[-1] in paths
-
-    options = {k: (str(v) if isinstance(v, Path) else v) for k, v in sorted(vars(args).items())
-               if not k.startswith("_") and k not in skip and v not in (None, False, [])
-               and not is_input(v) and not callable(v)}
-    options = {k: v for k, v in options.items()
-               if not (isinstance(v, list) and all(is_input(x) for x in v))}
     method = {"command": getattr(args, "_ident_prog", "volerr"), "version": __version__,
-              "options": options}
+              "options": certificate.method_options(vars(args), files, _NOT_METHOD | own)}
     file = certificate.find_identification_file(getattr(args, "identification", None),
                                                 list(files))
     return certificate.build(given, file, list(files), method, conditions)
@@ -318,67 +223,52 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
 
 def write_certificates(outs, result, ident, inputs=(), title: str | None = None) -> None:
     """Inside ``with outs:`` after the command's own outputs: the identification stamped into
-    the written ``--json`` and ``--html`` (when the command did not carry it itself) and the
-    ``--pdf`` certificate of ``result`` (a result object or its JSON document)."""
+    the written ``--json`` and ``--html`` and the ``--pdf`` certificate of ``result`` (a
+    result object or its JSON document; :func:`volerr.report.stamp.finish`)."""
     from ..report import stamp
+    from ..report.document import Document
 
     if isinstance(result, dict) or not hasattr(result, "_rows"):   # its "parameters" as rows
-        result = _Document(result)
+        result = Document(result)
     stamp.finish(outs, result, ident, inputs=list(inputs), title=title)
 
 
-class _Document:
-    """A command's JSON document (``map``, ``compensate``, ``iso10360`` ...) or a result
-    without rows (``check``) as a result for its certificate: ``to_dict()``, the rows of its
-    ``"parameters"`` and the result's figures."""
-
-    def __init__(self, result):
-        self.result = result
-        self.data = result if isinstance(result, dict) else result.to_dict()
-
-    def to_dict(self) -> dict:
-        return self.data
-
-    def figures(self) -> dict:
-        return {} if isinstance(self.result, dict) or not hasattr(self.result, "figures") \
-            else self.result.figures()
-
-    def _rows(self) -> list:
-        from ..results import rows_of
-
-        return rows_of(self.data.get("parameters"))
-
-
-def planned_outputs(args, inputs, **more):
-    """:class:`volerr.fileio.Outputs` of a command's run, declared and checked: the report
-    options the command has (``--json``, ``--html``, ``--pdf`` files, ``--plot`` PNG) and
-    ``more`` (``"--out": path`` a file, ``"--errors-out": (path, names)`` a folder with the
-    names of its files, ``None`` names: not known before the run)."""
+def planned_outputs(args, inputs, *, first: dict | None = None, **more):
+    """:class:`volerr.fileio.Outputs` of a command's run, declared in this order (the order
+    of the refusals) and checked: ``first``, the report options the command has (``--json``,
+    ``--html``, ``--pdf``, ``--plot``) and ``more``; ``{"--out": path}`` a file (``--plot...``
+    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet)."""
     from ..fileio import Outputs
 
     outs = Outputs(inputs, force=getattr(args, "force", False))
-    for role in ("json", "html", "pdf"):
-        outs.file("--" + role, getattr(args, role, None))
-    outs.plot("--plot", getattr(args, "plot", None))
-    for role, target in more.items():
+    first = first or {}
+    report = {r: getattr(args, r[2:], None) for r in ("--json", "--html", "--pdf", "--plot")}
+    for targets in (first, {r: p for r, p in report.items() if r not in {**first, **more}}, more):
+        _declare(outs, targets)
+    return outs.check()
+
+
+def _declare(outs, targets: dict) -> None:
+    for role, target in targets.items():
         if isinstance(target, tuple):
             outs.folder(role, target[0], files=target[1])
+        elif role.startswith("--plot"):
+            outs.plot(role, target)
         else:
             outs.file(role, target)
-    return outs.check()
 
 
 def write_outputs(args, outs, result, ident, inputs, title: str | None = None) -> None:
     """Inside ``with outs:``, after the command's own outputs: the outputs of the result
-    contract the command was given (``--json`` :meth:`write_json`, ``--html``
-    :meth:`write_html`, ``--plot`` :meth:`write_plot`), then the identification stamped
+    contract the command was given (``--plot`` :meth:`write_plot`, ``--json``
+    :meth:`write_json`, ``--html`` :meth:`write_html`), then the identification stamped
     into them and the ``--pdf`` certificate (:func:`write_certificates`)."""
+    if getattr(args, "plot", None):   # first: a plot may record its scale in the JSON
+        result.write_plot(outs.path("--plot"), inputs=inputs)
     if getattr(args, "json", None):
         result.write_json(outs.path("--json"), inputs=inputs)
     if getattr(args, "html", None):
         result.write_html(outs.path("--html"), inputs=inputs)
-    if getattr(args, "plot", None):
-        result.write_plot(outs.path("--plot"), inputs=inputs)
     write_certificates(outs, result, ident, inputs, title=title)
 
 

@@ -14,9 +14,7 @@ printed equations of their layouts (no derivation involved).
 
 from __future__ import annotations
 
-
-from ..errors import require
-from ..fileio import json_text, write_text
+from ._common import layout_inputs, planned_outputs
 
 
 def register(sub) -> None:
@@ -38,34 +36,17 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..audit import run as audit_run  # the capability: when the command runs
-    from ..audit import summary_line
-    from ._common import layout_inputs, progress
-    from ..fileio import Outputs
+    from ..audit.api import audit
+    from ..progress import progress
 
-    require(args.points >= 1, "--points must be at least 1")
     inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]
-    inputs += audit_run.data_paths()
-    outs = Outputs(inputs).file("--json", args.json).file("--html", args.html).check()
-    args.layouts = audit_run.resolve_layouts(args.layouts)
-    mods, verdicts = audit_run.collect(args.layouts, progress=progress)
-    entries = [v.as_dict() for v in verdicts]
-    files = {}
-    if args.json:
-        files["--json"] = json_text(entries, indent=1, ensure_ascii=False)
-    if args.html:
-        from ..audit import render_html
-
-        files["--html"] = render_html(entries)
+    outs = planned_outputs(args, inputs + audit_run.data_paths())
+    res = audit(args.layouts, detail=args.detail, numeric=args.numeric, points=args.points,
+                progress=progress)
     with outs:
-        for role, text in files.items():
-            write_text(outs.path(role), text, inputs=audit_run.data_paths(mods))
-    rows = audit_run.detail_rows(verdicts) if args.detail else audit_run.group(verdicts)
-    print(audit_run.table(rows))
-    print("\n" + audit_run.totals_line(verdicts))
-    print(summary_line(entries) + "."
-          + (f" Evidence: {', '.join(p for p in (args.json, args.html) if p)}" if files
-             else " Evidence: --json F, --html F"))
-    if args.numeric:
-        print()
-        print(audit_run.numeric_table(args.layouts or None, args.points))
+        if args.json:
+            res.write_json(outs.path("--json"))
+        if args.html:
+            res.write_html(outs.path("--html"))
+    print(res.summary(evidence=[args.json, args.html]))
     return 0

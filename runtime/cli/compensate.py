@@ -1,40 +1,19 @@
-"""``volerr compensate LAYOUT --errors DIR PROGRAM --out F``: compensated NC program.
-
-Reads an NC program (ISO G-code or Heidenhain plain language; axis positions, arcs G2/G3,
-TCPM), predicts the tool-tip error of every motion block from the layout's model and the error
-tables (by each block's approach direction where they carry a reversal), and writes a copy
-whose positions make the actual tool tip land on the nominal one (see
-:mod:`volerr.fiveaxis.compensate` for the method, :mod:`volerr.nc.gcode`,
-:mod:`volerr.nc.arcs`, :mod:`volerr.nc.tcpm` and :mod:`volerr.nc.heidenhain`
-for what is supported; ``volerr formats gcode``).  Only position numbers change; the input is
-never overwritten.
-
-Outputs: ``--out`` (the program, same bytes except the compensated numbers), ``--report``
-(CSV, one row per motion block: ``line,status``, the programmed and written axis positions
-``<axis>_nominal_mm|deg``, ``<axis>_out_mm|deg``, the predicted tool-tip error before and after
-``dx_before_um, dy_before_um, dz_before_um, e_before_um, dx_after_um, ..., e_after_um``, the
-tool-axis error ``orientation_before_urad, orientation_after_urad``, ``iterations`` and the
-standard uncertainty of the remaining error ``ux_after_um, uy_after_um, uz_after_um`` from the
-tables' std columns, empty without them),
-``--json`` (summary) and ``--plot`` (PNG: error along the program before and after).
-With ``--datum`` the report's errors are relative to the work datum and three more columns
-``dx_datum_um, dy_datum_um, dz_datum_um`` give the error at the datum (the same on every row:
-what the work offset absorbed).
-"""
+"""``volerr compensate LAYOUT PROGRAM --errors DIR --out F``: compensated NC program; see
+``volerr compensate --help`` and :func:`volerr.compensate`."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import (add_error_arguments, add_identification_arguments, add_vector,
-                      identification_from_args, layout_inputs, progress_bar, write_certificates)
-from ..fileio import Outputs
+from ._common import (add_error_arguments, add_identification_arguments, add_vector, help_text,
+                      identification_from_args, layout_inputs, planned_outputs, progress_bar,
+                      write_certificates)
 
 
 def register(sub) -> None:
 
     p = sub.add_parser("compensate", help="rewrite an NC program with compensated coordinates",
-                       description=__doc__.split("\n\n")[1])
+                       description=help_text("compensate-description"))
     p.add_argument("layout", help="layout name (see 'volerr layouts') or layout file")
     p.add_argument("program", help="G-code program in machine axis coordinates")
     p.add_argument("--out", required=True, help="compensated program (never the input)")
@@ -109,8 +88,7 @@ def run(args) -> int:
 
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
               *([args.tool_table] if args.tool_table else [])]
-    outs = Outputs(inputs).file("--out", args.out).file("--report", args.report) \
-        .file("--json", args.json).plot("--plot", args.plot).file("--pdf", args.pdf).check()
+    outs = planned_outputs(args, inputs, first={"--out": args.out, "--report": args.report})
     ident = identification_from_args(args, inputs)
     with outs:  # all or nothing: staged outputs are put in place at the end
         with progress_bar(Path(args.program), "compensate") as tick:
@@ -129,13 +107,9 @@ def run(args) -> int:
         if args.json:
             res.write_json(outs.path("--json"), inputs)
         if args.plot:
-            from ..fiveaxis.plots import plot_program_errors
-
-            plot_program_errors(res.program_errors(), outs.path("--plot"),
-                                title=f"{res.layout}: {args.program}")
-        write_certificates(outs, res.to_dict(), ident, inputs)
+            res.write_plot(outs.path("--plot"), title=f"{res.layout}: {args.program}")
+        write_certificates(outs, res.to_dict(), ident, inputs)   # the summary's certificate
     print(res.summary())
-    # notes only after success: bad input gets exactly one line on stderr
-    for note in res.notes:
+    for note in res.notes:   # only after success: bad input gets one line on stderr
         print(note, file=sys.stderr)
     return 0

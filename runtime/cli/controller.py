@@ -3,22 +3,7 @@
 SINUMERIK (LEC, CEC), Heidenhain (``.CMA`` / ``.COM``) and Fanuc (pitch error compensation)
 (:mod:`volerr.tables.controller_tables`).
 
-``volerr controller export LAYOUT --errors DIR --format FORMAT --out F [--json F] [--plot P]``
-    writes the tables and constants of an error directory; for the axis compensation formats
-    it compares what compensating with the tables leaves (the model's volumetric error over
-    the working volume after their correction, max and rms) with the uncompensated error, on
-    the console and in ``--json``, and refuses (exit 2) tables that leave more than none
-    unless ``--force``; ``--plot`` maps both.  ``--format linuxcnc``: ``--out`` is a folder
-    (one ``COMP_FILE`` per joint and the ini lines).
-``volerr controller export LAYOUT_aug.toml --format sinumerik-temp|isg-temp --loop-json F
---temperatures LOG.csv --out DIR``
-    the temperature compensation a controller runs (per axis offset and gradient, linear in
-    the temperatures it reads) fitted to an augmented layout's thermal effects on a logged
-    series, with what it leaves against the full model (:mod:`volerr.tables.thermal_comp`).
-``volerr controller import LAYOUT FILE --out DIR [--format ...]``
-    reads such a file back into an error directory (``X.csv`` ... ``constants.csv``).
-
-Argument parsing and one call: :func:`volerr.controller_export` /
+See ``volerr controller export --help``, :func:`volerr.controller_export` /
 :func:`volerr.controller_import` (:mod:`volerr.fiveaxis.controller_api`).
 """
 
@@ -26,6 +11,7 @@ from __future__ import annotations
 
 from ..choices import CONTROLLER_AXIS_FORMATS as AXIS_FORMATS
 from ..choices import CONTROLLER_TEMP_FORMATS as TEMP_FORMATS
+from ._common import add_accept_implausible, add_errors_out, add_force, parse_at
 
 
 def register(sub) -> None:
@@ -87,8 +73,6 @@ def register(sub) -> None:
     e.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
                    help="position of a rotary axis for what the export leaves, "
                         "repeatable (default 0 deg)")
-    from ._common import add_accept_implausible
-
     add_accept_implausible(e)
     e.set_defaults(func=run)
     i = s.add_parser("import", help="controller file -> error directory")
@@ -97,8 +81,6 @@ def register(sub) -> None:
                                 "to it; linuxcnc: the ini naming the COMP_FILEs)")
     i.add_argument("--format", choices=("auto", "isg", "etalon") + AXIS_FORMATS,
                    default="auto", help="the file's format (auto: isg or etalon)")
-    from ._common import add_accept_implausible, add_errors_out, add_force
-
     add_errors_out(i, "the imported tables", "--out", required=True)
     add_force(i)
     add_accept_implausible(i)
@@ -109,7 +91,6 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..fiveaxis.controller_api import controller_export, controller_import
-    from ._common import parse_at
 
     if args.action == "export":
         result = controller_export(

@@ -1,26 +1,14 @@
 """``volerr demo [--out DIR]``: the whole pipeline on built-in data; writes a report.
 
-Argument parsing only: the run is :func:`volerr.demo` (:mod:`volerr.demo`, its sections and
-``index.html``)."""
+Argument parsing only: the run is :func:`volerr.demo` (:mod:`volerr.demo`)."""
 
 from __future__ import annotations
 
 from ..choices import DEMO_SECTIONS as SECTIONS
-
-
-def __getattr__(name):
-    # the demo's texts by name (ABOUT, CAPTIONS), imported only when asked: --help imports
-    # no capability
-    if name in ("ABOUT", "CAPTIONS"):
-        from ..demo import text
-
-        return getattr(text, name)
-    raise AttributeError(name)
+from ._common import add_force
 
 
 def register(sub) -> None:
-    from ._common import add_force
-
     p = sub.add_parser("demo", help="the whole pipeline on built-in data; writes a report",
                        description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="volerr-demo", help="output folder (default volerr-demo)")

@@ -9,11 +9,6 @@ it writes the committed ``generated/`` folder (that is ``./generated/`` there), 
 
 from pathlib import Path
 
-from ..errors import require
-from ..fileio import Outputs, is_package_file, write_text
-from ..machine import derivation
-from ..machine.layout import read_layout
-
 
 def register(sub) -> None:
     p = sub.add_parser("derive", help="derive and generate one layout (or --all)",
@@ -30,38 +25,16 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    require(args.layout or args.all, "name a layout (see 'volerr layouts') or use --all")
-    require(not (args.in_package and args.out), "give either --out DIR or --in-package")
-    out = derivation.package_generated_dir() if args.in_package else \
-        Path(args.out if args.out else "generated")
-    # the committed generated/ folder may be rewritten only as a whole, by --all
-    in_package = is_package_file(out)
-    if in_package:
-        require(out.resolve() == derivation.package_generated_dir().resolve(),
-                f"--out {out}: refusing to write into the installed volerr package")
-        require(args.all and not args.layout,
-                f"{out} is the installed package's generated/ folder: only 'volerr derive "
-                f"--all' rewrites it; give --out DIR for a layout")
-    require(not args.in_package or args.all, "--in-package regenerates everything: add --all")
-    layouts = [read_layout(name) for name in args.layout]
-    names = [derivation.module_filename(lay) for lay in layouts]
-    if args.all:
-        from ..machine.layout import layout_names
-        names += [derivation.module_filename(read_layout(n)) for n in layout_names()]
-    dup = sorted({n for n in names if names.count(n) > 1})
-    require(not dup, f"two layouts generate the same module {dup[0] if dup else ''}: give them "
-                     f"different names or derive them one at a time")
+    from ..fileio import Outputs, write_text
+    from ..machine import derivation
+    from ..progress import progress
+
+    out, in_package, layouts = derivation.derive_request(
+        args.layout, all_layouts=args.all, out=args.out, in_package=args.in_package)
     inputs = [p for p in (Path(n) for n in args.layout) if p.is_file()]
     # rewriting generated modules is what derive is for: its files may be replaced
     outs = Outputs(inputs, allow_package=in_package).folder("--out", out, replace=True).check()
-    texts = {}
-    from ._common import progress
-
-    for layout in progress(layouts, desc="derive", unit="layout"):
-        texts[derivation.module_filename(layout)] = derivation.generate_source(layout)
-    if args.all:
-        texts.update(derivation.all_sources(
-            lambda names: progress(names, desc="derive --all", unit="layout")))
+    texts = derivation.derived_sources(layouts, args.all, progress)
     with outs:
         for filename, text in texts.items():
             write_text(outs.path("--out") / filename, text, inputs=inputs)

@@ -8,11 +8,7 @@ Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
 
 from __future__ import annotations
 
-
-from ._common import (add_accept_implausible, add_common, error_functions_from_args,
-                      inputs_of, parse_at)
-from ..errors import require
-from ..fileio import Outputs
+from ._common import add_accept_implausible, add_common, inputs_of, parse_at, planned_outputs
 from ..choices import DIAGONAL_KINDS
 
 
@@ -33,26 +29,21 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..cmm import api, diagonals  # the capability: when the command runs
-    from ..machine.model import load
+    from ..cmm import api  # the capability: when the command runs
 
-    require(2 <= args.profile_points <= 10000, "--profile-points must be between 2 and 10000")
-    model = load(args.layout)
-    funcs = error_functions_from_args(args, model)
-    inputs = inputs_of(args)
-    outs = Outputs(inputs).file("--json", args.json).plot("--plot", args.plot).check()
-    res = api.diagonals(model, funcs, lines=args.lines, probe=tuple(args.probe),
+    res = api.diagonals(args.layout, args.errors, lines=args.lines, probe=tuple(args.probe),
                         at=parse_at(args.at), volume=args.volume,
-                        profile_points=args.profile_points, method=args.method)
+                        profile_points=args.profile_points, method=args.method,
+                        degree=args.degree, extrapolate=args.extrapolate,
+                        accept_implausible=args.accept_implausible)
+    outs = planned_outputs(args, inputs_of(args))
     print(res.summary())
     with outs:
-        if args.json:
-            res.write_json(outs.path("--json"), inputs)
         if args.plot:
-            diagonals.plot_lines(res.lines, outs.path("--plot"),
-                                 f"{model.name}: length deviations ({args.errors})", inputs)
-    if args.json:
-        print(f"json: {args.json}")
-    if args.plot:
-        print(f"plot: {args.plot}")
+            res.write_plot(outs.path("--plot"), inputs_of(args))
+        if args.json:
+            res.write_json(outs.path("--json"), inputs_of(args))
+    for label, path in (("json", args.json), ("plot", args.plot)):
+        if path:
+            print(f"{label}: {path}")
     return 0

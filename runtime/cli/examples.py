@@ -1,22 +1,14 @@
-"""``volerr examples --out DIR``: example input files for every command.
-
-Parses arguments and calls :func:`volerr.example_files.write_examples`; the folder goes through
-the common output checks (created when its parent exists; an existing file is never replaced
-without --force)."""
+"""``volerr examples --out DIR``: example input files for every command
+(:func:`volerr.example_files.write_examples`); see ``volerr examples --help``."""
 
 from __future__ import annotations
 
+from ._common import add_force, help_text
+
 
 def register(sub) -> None:
-    from ._common import add_force
-
     p = sub.add_parser("examples", help="write example input files for every command",
-                       description="Write example input files into DIR: the files shipped "
-                                   "in the package (laser-tracker runs, a sphere probing "
-                                   "cycle, a ballbar circle) and the built-in campaigns of "
-                                   "'volerr demo' (error tables, a five-axis program, "
-                                   "instrument files, a positioning run, an uncertainty "
-                                   "task), with DIR/README.txt naming a command for each.")
+                       description=help_text("examples-description"))
     p.add_argument("--out", required=True, metavar="DIR",
                    help="folder to write (created when missing, its parent must exist)")
     add_force(p)

@@ -14,9 +14,5 @@ def register(sub) -> None:
 
 def run(args) -> int:
     for name in layout_names():
-        if args.long:
-            print(describe(read_layout(name)))
-            print()
-        else:
-            print(name)
+        print(f"{describe(read_layout(name))}\n" if args.long else name)
     return 0

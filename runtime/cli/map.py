@@ -7,12 +7,9 @@ deviations in the tables also ``<plot>_random.png`` or ``--plot-random``) and pr
 
 from __future__ import annotations
 
-
 from ._common import (add_accept_implausible, add_common, add_identification_arguments,
-                      error_functions_from_args, identification_from_args, inputs_of, parse_at,
-                      write_certificates)
-from ..errors import require
-from ..fileio import Outputs, json_text, write_text
+                      identification_from_args, inputs_of, parse_at, planned_outputs,
+                      write_outputs)
 
 
 def register(sub) -> None:
@@ -26,7 +23,8 @@ def register(sub) -> None:
                                                 "dz_um (+ rx_um ry_um rz_um)")
     p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")
     p.add_argument("--plot-random", metavar="PNG",
-                   help="random component plot (default <plot>_random.png when the tables have std)")
+                   help="random component plot (default <plot>_random.png when the tables "
+                        "have std)")
     p.add_argument("--magnify", type=float, default=None, metavar="K",
                    help="error magnification in the plots (default: automatic)")
     p.add_argument("--json", metavar="F", help="summary as JSON")
@@ -40,43 +38,25 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..cmm import volmap
-    from ..machine.model import load
-
-    import math
-
-    require(args.magnify is None or (math.isfinite(args.magnify) and args.magnify > 0),
-            f"--magnify must be a positive finite number, got {args.magnify}")
-    model = load(args.layout)
-    funcs = error_functions_from_args(args, model)
-    inputs = inputs_of(args, model)
-    rnd_plot = args.plot_random
-    if rnd_plot is None and args.plot and funcs.has_random:
-        rnd_plot = volmap.random_plot_path(args.plot)
-    outs = Outputs(inputs).file("--out", args.out).plot("--plot", args.plot) \
-        .plot("--plot-random", rnd_plot).file("--json", args.json).file("--pdf", args.pdf).check()
-    ident = identification_from_args(args, inputs)
     from ..cmm.api import error_map
-    from ..tables.functions import parse_approach
+    from ..cmm.volmap import random_plot_path
 
-    approach = parse_approach(args.approach, model, funcs)
-    res = error_map(model, funcs, grid=args.grid, probe=tuple(args.probe), at=parse_at(args.at),
-                    volume=args.volume, approach=approach)
-    vmap, s = res.map, res.data
+    res = error_map(args.layout, args.errors, grid=args.grid, probe=tuple(args.probe),
+                    at=parse_at(args.at), volume=args.volume, approach=args.approach,
+                    method=args.method, degree=args.degree, extrapolate=args.extrapolate,
+                    accept_implausible=args.accept_implausible, magnify=args.magnify)
+    rnd_plot = args.plot_random or (random_plot_path(args.plot) if args.plot and
+                                    res.has_random else None)
+    inputs = inputs_of(args)
+    outs = planned_outputs(args, inputs, first={"--out": args.out, "--plot": args.plot,
+                                                "--plot-random": rnd_plot})
+    ident = identification_from_args(args, inputs)
     with outs:
         if args.out:
-            volmap.write_map_csv(outs.path("--out"), vmap, inputs)
-        if args.plot:
-            s["magnification"] = volmap.plot_map(vmap, outs.path("--plot"), args.magnify, inputs)
-        if rnd_plot:
-            s["random_magnification"] = volmap.plot_random(vmap, outs.path("--plot-random"),
-                                                           args.magnify, inputs)
-        if args.json:
-            write_text(outs.path("--json"), json_text(s), inputs)
-        write_certificates(outs, res, ident, inputs)
-    print(res.summary())
-    for label, path in (("map", args.out), ("plot", args.plot), ("random plot", rnd_plot),
-                        ("summary", args.json)):
-        if path:
-            print(f"  {label}: {path}")
+            res.write_csv(outs.path("--out"), inputs)
+        if rnd_plot:    # before write_outputs: the --json holds the magnifications
+            res.write_random_plot(outs.path("--plot-random"), inputs)
+        write_outputs(args, outs, res, ident, inputs)
+    print(res.summary({"map": args.out, "plot": args.plot, "random plot": rnd_plot,
+                       "summary": args.json}))
     return 0

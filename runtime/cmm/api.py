@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..results import ResultMixin
 
@@ -15,9 +15,43 @@ class ErrorMap(ResultMixin):
 
     data: dict
     map: object
+    magnify: float | None = None    # the plots' error magnification (None: automatic)
+    #: the magnifications of the written plots (``magnification``, ``random_magnification``)
+    scales: dict = field(default_factory=dict)
 
-    def summary(self) -> str:
-        """What ``volerr map`` prints (without the lines naming the written files)."""
+    def _document(self) -> dict:
+        """``data`` and, after the plots are written, their magnifications."""
+        return {**self.data, **{k: self.scales[k] for k in ("magnification",
+                                                            "random_magnification")
+                                if k in self.scales}}
+
+    @property
+    def has_random(self) -> bool:
+        """The tables carry standard deviations: the map has a random component."""
+        return self.map.random is not None
+
+    def write_plot(self, path, inputs=()):
+        """``--plot``: nominal vs actual grid, magnified (Pahk Fig. 5 / 7(a),
+        :func:`volerr.cmm.volmap.plot_map`); the magnification used is recorded in
+        :meth:`to_dict` (``"magnification"``).  Returns the path."""
+        from .volmap import plot_map
+
+        self.scales["magnification"] = plot_map(self.map, path, self.magnify, inputs)
+        return path
+
+    def write_random_plot(self, path, inputs=()):
+        """``--plot-random``: the random component (k = 1) as bars at every node (Pahk Fig.
+        7(b), :func:`volerr.cmm.volmap.plot_random`); its magnification is recorded in
+        :meth:`to_dict` (``"random_magnification"``).  Returns the path."""
+        from .volmap import plot_random
+
+        self.scales["random_magnification"] = plot_random(self.map, path, self.magnify,
+                                                          inputs)
+        return path
+
+    def summary(self, written: dict | None = None) -> str:
+        """What ``volerr map`` prints; ``written``: ``{label: path}`` of the files written
+        (``map``, ``plot``, ``random plot``, ``summary``), one line each at the end."""
         s, vmap = self.data, self.map
         m = s["max_abs_um"]
         out = [f"{s['layout']}: volumetric error on a {'x'.join(map(str, vmap.shape))} grid, "
@@ -28,6 +62,7 @@ class ErrorMap(ResultMixin):
             r = s["random_max_um"]
             out.append(f"  random (1 sigma, k = 1) max rx {r['x']:.2f} um, ry {r['y']:.2f} um, "
                        f"rz {r['z']:.2f} um")
+        out += [f"  {label}: {path}" for label, path in (written or {}).items() if path]
         return "\n".join(out)
 
     def write_csv(self, path, inputs=()):
@@ -56,7 +91,8 @@ class ErrorMap(ResultMixin):
 
 def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
               volume: str = "travel", approach=None, method: str = "linear",
-              degree: int | None = None, extrapolate: bool = False) -> ErrorMap:
+              degree: int | None = None, extrapolate: bool = False,
+              accept_implausible: bool = False, magnify: float | None = None) -> ErrorMap:
     """The volumetric error over the working volume (``volerr map``).
 
     Parameters
@@ -74,35 +110,51 @@ def error_map(layout, errors, *, grid=None, probe=(0.0, 0.0, 0.0), at=None,
         Positions of the rotary axes during the test, deg (default 0).
     volume : {"travel", "measured"}
         The layout's travel, or the part of it the tables cover.
-    approach : dict, optional
-        ``{axis: +1 or -1}``: evaluate the tables' reversal for that approach direction.
+    approach : dict or str, optional
+        ``{axis: +1 or -1}`` or the option's text (``"X+,Y-"``, ``"+"``, ``"-"``): evaluate
+        the tables' reversal for that approach direction.
     method, degree, extrapolate
         How the tables are interpolated (as ``--method``, ``--degree``, ``--extrapolate``).
+    accept_implausible : bool
+        Use table values beyond what a machine of the layout's travel can have
+        (:mod:`volerr.tables.plausible`; by default refused naming the likely unit).
+    magnify : float, optional
+        Error magnification of the plots (:meth:`ErrorMap.write_plot`; > 0; default
+        automatic).
 
     Returns
     -------
     ErrorMap
-        ``to_dict()`` is ``--json``: max ``|dx|``, ``|dy|``, ``|dz|``, max and RMS ``|d|`` (um; actual minus
-        nominal probe tip), and the random part's maximum (k = 1).
+        ``to_dict()`` is ``--json``: max ``|dx|``, ``|dy|``, ``|dz|``, max and RMS ``|d|``
+        (um; actual minus nominal probe tip), and the random part's maximum (k = 1); after
+        :meth:`ErrorMap.write_plot` also the plots' magnifications.
     """
+    import math
+
+    from ..errors import require
     from ..machine.model import Model, load
-    from ..tables.functions import ErrorFunctions
+    from ..tables.functions import ErrorFunctions, parse_approach
     from . import volmap
 
+    require(magnify is None or (math.isfinite(magnify) and magnify > 0),
+            f"--magnify must be a positive finite number, got {magnify}")
     model = layout if isinstance(layout, Model) else load(layout)
     from ..tables.plausible import DEFAULT_SIZE_MM, machine_size
     from ..units import check_offset_mm
 
-    probe = check_offset_mm(probe, "--probe", machine_size(model) or DEFAULT_SIZE_MM, "offset")
     funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
-        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+        errors, model, method=method, degree=degree, extrapolate=extrapolate,
+        accept_implausible=accept_implausible)
+    probe = check_offset_mm(probe, "--probe", machine_size(model) or DEFAULT_SIZE_MM, "offset")
+    if not isinstance(approach, dict):
+        approach = parse_approach(approach, model, funcs)
     grid = [grid] if isinstance(grid, int) else grid
     vmap = volmap.volumetric_map(model, funcs, grid, tuple(probe), dict(at or {}),
                                  box=volmap.volume(model, funcs, volume), approach=approach)
     s = vmap.summary()
     if approach:
         s["approach"] = {a: ("+" if v > 0 else "-") for a, v in approach.items()}
-    return ErrorMap(s, vmap)
+    return ErrorMap(s, vmap, magnify)
 
 
 @dataclass(repr=False)
@@ -123,6 +175,15 @@ class Diagonals(ResultMixin):
         return (f"{self.data['layout']}: length deviation dL = actual - nominal distance of "
                 f"the probe tip (first order), probe {probe} mm\n{format_table(self.lines)}")
 
+    def write_plot(self, path, inputs=()):
+        """``--plot``: the space-diagonal profiles and every line's deviation
+        (:func:`volerr.cmm.diagonals.plot_lines`); returns the path."""
+        from .diagonals import plot_lines
+
+        title = f"{self.data['layout']}: length deviations ({self.data['errors']})"
+        plot_lines(self.lines, path, title, inputs)
+        return path
+
     def _rows(self) -> list:
         """One row per line: its length deviation dL (um, positive: the line measures long)
         with the standard uncertainty (k = 1) of its random part where the tables carry
@@ -136,7 +197,8 @@ class Diagonals(ResultMixin):
 
 def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
               volume: str = "travel", profile_points: int = 21, method: str = "linear",
-              degree: int | None = None, extrapolate: bool = False) -> Diagonals:
+              degree: int | None = None, extrapolate: bool = False,
+              accept_implausible: bool = False) -> Diagonals:
     """Length deviations of the space diagonals (Pahk sec. 4), face diagonals and
     axis-parallel lines of the working volume (``volerr diagonals``).
 
@@ -158,6 +220,9 @@ def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
         Points along each line for its profile (2 .. 10000).
     method, degree, extrapolate
         How the tables are interpolated.
+    accept_implausible : bool
+        Use table values beyond what a machine of the layout's travel can have
+        (:mod:`volerr.tables.plausible`; by default refused naming the likely unit).
 
     Returns
     -------
@@ -173,7 +238,8 @@ def diagonals(layout, errors, *, lines=None, probe=(0.0, 0.0, 0.0), at=None,
     require(2 <= profile_points <= 10000, "--profile-points must be between 2 and 10000")
     model = layout if isinstance(layout, Model) else load(layout)
     funcs = errors if isinstance(errors, ErrorFunctions) else ErrorFunctions.from_dir(
-        errors, model, method=method, degree=degree, extrapolate=extrapolate)
+        errors, model, method=method, degree=degree, extrapolate=extrapolate,
+        accept_implausible=accept_implausible)
     found = dg.box_lines(box(model, funcs, volume), linear_axes(model),
                          tuple(lines or dg.KINDS))
     results = dg.evaluate_lines(model, funcs, found, tuple(probe), dict(at or {}),

@@ -66,6 +66,15 @@ class Compensation(ResultMixin):
         return {"program_errors": unsaved(draw_program_errors, self.program_errors(),
                                           f"{self.data['layout']}: program")}
 
+    def write_plot(self, path, inputs=(), title: str | None = None) -> Path:
+        """The ``--plot`` PNG: the predicted tool-tip error (um) and tool-axis error (urad)
+        per block, before and after (:func:`volerr.fiveaxis.plots.plot_program_errors`);
+        ``title`` default ``"LAYOUT: program"``."""
+        from .plots import plot_program_errors
+
+        return plot_program_errors(self.program_errors(), path,
+                                   title=title or f"{self.data['layout']}: program")
+
     def write_program(self, path, inputs=()) -> Path:
         """Write the compensated program, the bytes ``volerr compensate --out`` writes
         (latin-1, line endings as read); never over an input."""

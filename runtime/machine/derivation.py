@@ -163,3 +163,49 @@ def package_generated_dir() -> Path:
     import volerr.generated
 
     return Path(volerr.generated.__file__).parent
+
+
+def derive_request(layouts=(), *, all_layouts: bool = False, out=None,
+                   in_package: bool = False) -> tuple:
+    """A ``volerr derive`` request checked: ``(folder, in_package, layouts)``.  ``layouts``:
+    names or layout files; ``all_layouts``: every shipped layout and every layout-independent
+    module; ``out``: the folder (default ``./generated``); ``in_package``: the installed
+    package's ``generated/`` (developers, with ``all_layouts`` only).  The committed
+    ``generated/`` folder is rewritten only as a whole; two layouts that would write the same
+    module are refused (one line each)."""
+    from ..errors import require
+    from ..fileio import is_package_file
+    from .layout import layout_names, read_layout
+
+    require(layouts or all_layouts, "name a layout (see 'volerr layouts') or use --all")
+    require(not (in_package and out), "give either --out DIR or --in-package")
+    folder = package_generated_dir() if in_package else Path(out if out else "generated")
+    writes_package = is_package_file(folder)
+    if writes_package:
+        require(folder.resolve() == package_generated_dir().resolve(),
+                f"--out {folder}: refusing to write into the installed volerr package")
+        require(all_layouts and not layouts,
+                f"{folder} is the installed package's generated/ folder: only 'volerr derive "
+                f"--all' rewrites it; give --out DIR for a layout")
+    require(not in_package or all_layouts, "--in-package regenerates everything: add --all")
+    found = [read_layout(name) for name in layouts]
+    names = [module_filename(lay) for lay in found]
+    if all_layouts:
+        names += [module_filename(read_layout(n)) for n in layout_names()]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    require(not dup, f"two layouts generate the same module {dup[0] if dup else ''}: give them "
+                     f"different names or derive them one at a time")
+    return folder, writes_package, found
+
+
+def derived_sources(layouts, all_layouts: bool = False, progress=None) -> dict:
+    """File name -> generated text of each layout of ``layouts`` (and with ``all_layouts``
+    of every file of ``generated/``); imports sympy.  ``progress``: an optional wrapper of
+    an iterable (``progress(items, desc=..., unit=...)``, :func:`volerr.progress.progress`)."""
+    def wrap(items, desc):
+        return progress(items, desc=desc, unit="layout") if progress else items
+
+    texts = {module_filename(lay): generate_source(lay) for lay in wrap(layouts, "derive")}
+    if all_layouts:
+        texts.update(all_sources(lambda names: wrap(names, "derive --all")))
+    return texts
