@@ -70,6 +70,13 @@ class Evaluation(ResultMixin):
 
         return write_text(path, json_text(self.data), inputs=list(inputs))
 
+    def write_plot(self, path, inputs=()):
+        """The ``--plot`` PNG: the traces' polar plot (:meth:`figures`)."""
+        from .plots import polar_plot
+
+        polar_plot(self.traces, self.results, path, inputs=inputs)
+        return path
+
 
 def judge(data: dict, quality, accept: bool, where: str):
     """The residual rule (:mod:`volerr.fit_quality`) on the diagnosis fit, applied to the

@@ -398,3 +398,29 @@ def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
         require(math.isfinite(value) and low <= value <= high,
                 f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
     return value
+
+
+# ---------------------------------------------------------------------------------------------
+# cli-b: a command's parser whose prose lives in volerr/data/help, and shared output names
+def command_parser(sub, name: str, help: str, text: str | None = None, **kw):
+    """``sub.add_parser(name)`` with its description from the text file
+    ``volerr/data/help/TEXT.description.txt`` (``TEXT`` default ``name``; a sub-command's
+    ``ballbar-evaluate``), printed as it is by ``--help`` (one paragraph a line)."""
+    about = help_text(f"{text or name}.description").rstrip("\n")
+    return sub.add_parser(name, help=help, description=about, **kw)
+
+
+def error_dir_names(layout) -> list:
+    """The files of the error directory a fit of ``layout`` writes: ``<axis>.csv`` of every
+    axis and ``constants.csv`` (declared before the run)."""
+    from ..machine.model import load
+
+    return [f"{a}.csv" for a in load(layout).axes] + ["constants.csv"]
+
+
+def option_help(name: str) -> dict:
+    """``{option: help}`` of a command's long option helps, from the text file
+    ``volerr/data/help/NAME.options.txt``: blocks separated by a blank line, the option (or
+    positional argument) on the first line, its help on the next (re-wrapped by --help)."""
+    blocks = help_text(f"{name}.options").strip("\n").split("\n\n")
+    return {b.split("\n", 1)[0]: " ".join(b.split("\n")[1:]) for b in blocks}
