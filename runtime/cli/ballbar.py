@@ -19,19 +19,15 @@ def register(sub) -> None:
     H_sim = option_help("ballbar-simulate")
     sim.add_argument("layout", help="layout name or layout file")
     add_error_arguments(sim)
-    sim.add_argument("--plane", choices=("XY", "YZ", "ZX"), required=True,
-                     help="plane of the circle in the workpiece frame")
+    sim.add_argument("--plane", choices=("XY", "YZ", "ZX"), required=True, help=H_sim["--plane"])
     sim.add_argument("--radius", type=float, required=True, help="bar length, mm")
     add_vector(sim, "--centre", required=True, help=H_sim["--centre"])
-    add_vector(sim, "--tool", default=(0.0, 0.0, 0.0),
-               help="offset of the tool-side ball centre from the tool point, mm")
-    sim.add_argument("--rotary", default=None, metavar="A=DEG,...",
-                     help="rotary axes: AXIS=DEG fixed, AXIS=START:STOP swept (comma list)")
+    add_vector(sim, "--tool", default=(0.0, 0.0, 0.0), help=H_sim["--tool"])
+    sim.add_argument("--rotary", default=None, metavar="A=DEG,...", help=H_sim["--rotary"])
     sim.add_argument("--points", type=int, default=360, help="readings per direction")
-    sim.add_argument("--noise-um", type=float, default=0.0,
-                     help="standard deviation of Gaussian noise added to each reading, um")
+    sim.add_argument("--noise-um", type=float, default=0.0, help=H_sim["--noise-um"])
     sim.add_argument("--direction", choices=("both", "ccw", "cw"), default="both",
-                     help="counter-clockwise, clockwise or both (CCW first)")
+                     help=H_sim["--direction"])
     sim.add_argument("--seed", type=int, default=0, help="seed of the noise")
     sim.add_argument("--out", required=True, metavar="TRACE.csv", help="the trace to write")
     add_force(sim)

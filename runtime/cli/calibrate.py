@@ -20,8 +20,7 @@ def register(sub) -> None:
     add_identification_arguments(p, "the instruments")
     add_errors_out(p, "the identified model (for map, compensate, uncertainty)")
     p.add_argument("--map-out", metavar="MAP.csv", help=H["--map-out"])
-    p.add_argument("--map-grid", type=int, default=9, metavar="N",
-                   help="points per linear axis of --map-out")
+    p.add_argument("--map-grid", type=int, default=9, metavar="N", help=H["--map-grid"])
     add_force(p)
     add_accept_residual(p)
     add_accept_implausible(p)
@@ -29,8 +28,7 @@ def register(sub) -> None:
     p.add_argument("--parameters", metavar="SPEC", help=H["--parameters"])
     p.add_argument("--degree", type=int, help=H["--degree"])
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split")
-    p.add_argument("--test-fraction", type=float, default=0.25,
-                   help="fraction of the points held out for the held-out residual")
+    p.add_argument("--test-fraction", type=float, default=0.25, help=H["--test-fraction"])
     p.set_defaults(func=run)
 
 
@@ -39,7 +37,7 @@ def run(args) -> int:
     from ..calibrate.run import calibrate
     from ..instruments import split_spec
 
-    grid = grid_counts(args.map_grid)
+    grid_counts(args.map_grid)      # refused before anything else
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
     outs = planned_outputs(args, inputs, **{"--map-out": args.map_out, "--errors-out": (
@@ -55,7 +53,7 @@ def run(args) -> int:
                                       accept_implausible=args.accept_implausible,
                                       shown=args.errors_out)
         if args.map_out:
-            result.write_map(outs.path("--map-out"), grid, inputs=inputs)
+            result.write_map(outs.path("--map-out"), args.map_grid, inputs=inputs)
         write_outputs(args, outs, result, ident, inputs)
     print(result.summary())
     return 0

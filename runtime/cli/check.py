@@ -22,15 +22,12 @@ def register(sub) -> None:
     H = option_help("check")
     p = command_parser(sub, "check", "between calibrations: plan an interim check, or say what "
                                      "changed since the reference", usage=USAGE)
-    p.add_argument("words", nargs="+", metavar="LAYOUT FILE",
-                   help="'plan LAYOUT', or LAYOUT and the check's filled files")
+    p.add_argument("words", nargs="+", metavar="LAYOUT FILE", help=H["words"])
     p.add_argument("--reference", required=True, nargs="+", metavar=("CAL.json", "FILE"),
                    help=H["--reference"])
-    p.add_argument("--instrument", action="append", metavar="SPEC",
-                   help="check plan: an instrument, as 'volerr plan --instrument' (repeat)")
+    p.add_argument("--instrument", action="append", metavar="SPEC", help=H["--instrument"])
     p.add_argument("--minutes", type=float, metavar="M", help=H["--minutes"])
-    p.add_argument("--readings", type=int, metavar="N",
-                   help="check plan: at most N readings (rows of the files)")
+    p.add_argument("--readings", type=int, metavar="N", help=H["--readings"])
     p.add_argument("--detect-um", type=float, metavar="D", help=H["--detect-um"])
     p.add_argument("--out", metavar="DIR", help="check plan: folder of the check's files")
     p.add_argument("--tolerance", metavar="T", help=H["--tolerance"])

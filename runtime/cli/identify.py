@@ -20,13 +20,8 @@ def register(sub) -> None:
     p.add_argument("files", nargs="+", metavar="FILE", help="tracker data file(s)")
     p.add_argument("--axis", required=True, help="the measured axis (X, Y, Z, B, C ...)")
     out = p.add_mutually_exclusive_group(required=True)
-    out.add_argument("--errors-out", metavar="DIR",
-                     help="write the error table as DIR/<axis>.csv of an error directory (for "
-                          "'volerr squareness', 'map', 'uncertainty'); DIR is created when "
-                          "missing, its parent must exist")
-    out.add_argument("--out", metavar="F.csv",
-                     help="write the error table to this file instead (name it after the axis "
-                          "inside an error directory: DIR/X.csv ...)")
+    out.add_argument("--errors-out", metavar="DIR", help=H["--errors-out"])
+    out.add_argument("--out", metavar="F.csv", help=H["--out"])
     p.add_argument("--format", choices=("csv", "thesis"), default="csv", help=H["--format"])
     p.add_argument("--positions", help=H["--positions"])
     p.add_argument("--labels", dest="points", help=H["--labels"])
@@ -35,12 +30,9 @@ def register(sub) -> None:
     add_vector(p, "--tracker", help=H["--tracker"])
     add_vector(p, "--direction", help=H["--direction"])
     p.add_argument("--origin", nargs="+", metavar="X", help=H["--origin"])
-    p.add_argument("--sense", choices=("auto", "+", "-"), default="auto",
-                   help="sense of the nominal motion of the points; auto: from the data")
-    p.add_argument("--max-cond", type=float, default=1e4,
-                   help="refuse point geometry with a larger condition number")
-    p.add_argument("--outlier-k", type=float, default=5.0,
-                   help="flag points whose residual exceeds k times the noise (default 5)")
+    p.add_argument("--sense", choices=("auto", "+", "-"), default="auto", help=H["--sense"])
+    p.add_argument("--max-cond", type=float, default=1e4, help=H["--max-cond"])
+    p.add_argument("--outlier-k", type=float, default=5.0, help=H["--outlier-k"])
     p.add_argument("--fit", choices=("poly", "smooth", "linear", "cubic"), help=H["--fit"])
     p.add_argument("--residuals", help="write per-position, per-point residuals (CSV, um)")
     p.add_argument("--signs", choices=("component", "model"), default="component",

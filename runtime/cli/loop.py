@@ -20,8 +20,7 @@ def register(sub) -> None:
     add_identification_arguments(p, "the instruments")
     p.add_argument("--out-dir", metavar="DIR", help=H["--out-dir"])
     p.add_argument("--holdout-time", metavar="A:B", help=H["--holdout-time"])
-    p.add_argument("--holdout-files", nargs="+", metavar="FILE",
-                   help="drift runs: hold out every run of these files")
+    p.add_argument("--holdout-files", nargs="+", metavar="FILE", help=H["--holdout-files"])
     p.add_argument("--predictions-out", metavar="P.csv", help=H["--predictions-out"])
     p.add_argument("--differences", action="store_true", help=H["--differences"])
     add_errors_out(p, "the fitted error functions (effects removed)")
@@ -30,8 +29,7 @@ def register(sub) -> None:
     add_accept_implausible(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help=H["--folds"])
-    p.add_argument("--test-fraction", type=float, default=0.25,
-                   help="fraction of points held out for before/after (default 0.25)")
+    p.add_argument("--test-fraction", type=float, default=0.25, help=H["--test-fraction"])
     p.add_argument("--degree", type=int, help=H["--degree"])
     p.add_argument("--families", help=H["--families"])
     p.set_defaults(func=run)

@@ -15,8 +15,7 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("--instrument", action="append", required=True, metavar="SPEC",
                    help=H["--instrument"])
-    p.add_argument("--readings", type=int, required=True, metavar="N",
-                   help="readings in all (rows of the plan files)")
+    p.add_argument("--readings", type=int, required=True, metavar="N", help=H["--readings"])
     p.add_argument("--out", required=True, metavar="DIR", help=H["--out"])
     add_json(p, "the plan: predicted standard uncertainties, files, baseline")
     add_html(p, "the set-up sheet (default: DIR/plan.html)")

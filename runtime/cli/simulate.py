@@ -22,19 +22,16 @@ def register(sub) -> None:
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("--out", required=True, help="measured-deviation CSV to write")
     p.add_argument("--points", type=int, default=600, help="number of points (default 600)")
-    p.add_argument("--seed", type=int, default=0,
-                   help="seed of the machine's error functions, points and noise")
+    p.add_argument("--seed", type=int, default=0, help=H["--seed"])
     add_vector(p, "--probe", append=True, help=H["--probe"])
     p.add_argument("--rounds", type=int, default=1, help="measurement rounds (set-ups)")
     p.add_argument("--effect", action="append", default=[], metavar="KIND[:K=V,...]",
-                   help="an undeclared effect (repeatable)")
+                   help=H["--effect"])
     p.add_argument("--noise-um", type=float, default=0.3, help="instrument noise, um (1 sigma)")
-    p.add_argument("--magnitude-um", type=float, default=5.0,
-                   help="size of the random error functions, um")
+    p.add_argument("--magnitude-um", type=float, default=5.0, help=H["--magnitude-um"])
     p.add_argument("--sensors", metavar="N|NAMES", help=H["--sensors"])
     p.add_argument("--duty", metavar="SPEC", help=H["--duty"])
-    p.add_argument("--hours", type=float, default=8.0,
-                   help="duration of the campaign, h (the points in time order; default 8)")
+    p.add_argument("--hours", type=float, default=8.0, help=H["--hours"])
     from ..choices import SIMULATED_INSTRUMENTS as INSTRUMENTS
 
     g = p.add_argument_group(
