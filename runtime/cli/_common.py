@@ -402,12 +402,12 @@ def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
 
 # ---------------------------------------------------------------------------------------------
 # cli-b: a command's parser whose prose lives in volerr/data/help, and shared output names
-def command_parser(sub, name: str, help: str, text: str | None = None, **kw):
-    """``sub.add_parser(name)`` with its description from the text file
-    ``volerr/data/help/TEXT.description.txt`` (``TEXT`` default ``name``; a sub-command's
-    ``ballbar-evaluate``), printed as it is by ``--help`` (one paragraph a line)."""
-    about = help_text(f"{text or name}.description").rstrip("\n")
-    return sub.add_parser(name, help=help, description=about, **kw)
+def command_parser(sub, name: str, text: str | None = None, **kw):
+    """``sub.add_parser(name)`` with its texts from ``volerr/data/help/TEXT.description.txt``
+    (``TEXT`` default ``name``; a sub-command's ``ballbar-evaluate``): the first line its help
+    in the list of commands, the next its description, printed as it is by ``--help``."""
+    short, about = help_text(f"{text or name}.description").rstrip("\n").split("\n", 1)
+    return sub.add_parser(name, help=short, description=about, **kw)
 
 
 def error_dir_names(layout) -> list:
@@ -416,6 +416,14 @@ def error_dir_names(layout) -> list:
     from ..machine.model import load
 
     return [f"{a}.csv" for a in load(layout).axes] + ["constants.csv"]
+
+
+def write_errors_out(args, outs, result, inputs) -> None:
+    """Inside ``with outs:``: ``--errors-out DIR`` (when given) from ``result``'s
+    ``write_error_tables`` (``--accept-implausible``; a refusal names DIR as given)."""
+    if args.errors_out:
+        result.write_error_tables(outs.path("--errors-out"), inputs=inputs, shown=args.errors_out,
+                                  accept_implausible=args.accept_implausible)
 
 
 def option_help(name: str) -> dict:

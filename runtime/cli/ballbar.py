@@ -1,5 +1,5 @@
-"""``volerr ballbar simulate|evaluate``: ballbar traces of a layout's model, and the ISO 230-4
-evaluation of measured traces with a diagnosis; see ``volerr ballbar --help``."""
+"""``volerr ballbar simulate|evaluate``: ballbar traces of a model, ISO 230-4 evaluation; see
+``volerr ballbar --help``."""
 
 from __future__ import annotations
 
@@ -10,12 +10,10 @@ from ._common import (add_accept_residual, add_error_arguments, add_force, add_h
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "ballbar", "ballbar traces: simulate (ISO 230-4 / 10791-6) and "
-                                       "evaluate (G, H, polar plot, diagnosis)")
+    p = command_parser(sub, "ballbar")
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
-    sim = command_parser(s, "simulate", "a ballbar trace of the layout's model (CSV)",
-                         text="ballbar-simulate")
+    sim = command_parser(s, "simulate", text="ballbar-simulate")
     H_sim = option_help("ballbar-simulate")
     sim.add_argument("layout", help="layout name or layout file")
     add_error_arguments(sim)
@@ -32,8 +30,7 @@ def register(sub) -> None:
     sim.add_argument("--out", required=True, metavar="TRACE.csv", help="the trace to write")
     add_force(sim)
     sim.set_defaults(func=run_simulate)
-    ev = command_parser(s, "evaluate", "ISO 230-4 G, H, F of traces and a diagnosis",
-                        text="ballbar-evaluate")
+    ev = command_parser(s, "evaluate", text="ballbar-evaluate")
     H_ev = option_help("ballbar-evaluate")
     ev.add_argument("files", nargs="+", metavar="TRACE.csv", help="ballbar files")
     ev.add_argument("--layout", help=H_ev["--layout"])

@@ -1,18 +1,17 @@
-"""``volerr calibrate LAYOUT FILE... --json F``: identify a layout's parameters from the files
-of any instruments, mixed in one campaign; see ``volerr calibrate --help``."""
+"""``volerr calibrate LAYOUT FILE...``: a layout's parameters from any instruments' files; see
+``volerr calibrate --help``."""
 
 from __future__ import annotations
 
 from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
                       add_html, add_identification_arguments, add_json, add_max_change,
                       command_parser, error_dir_names, identification_from_args, layout_inputs,
-                      option_help, planned_outputs, write_outputs)
+                      option_help, planned_outputs, write_errors_out, write_outputs)
 
 
 def register(sub) -> None:
     H = option_help("calibrate")
-    p = command_parser(sub, "calibrate", "identify the layout's parameters from instrument "
-                                         "files (any mix)")
+    p = command_parser(sub, "calibrate")
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help=H["files"])
     add_json(p, "the report (parameters, identifiability, set-ups, residuals per file)")
@@ -48,10 +47,7 @@ def run(args) -> int:
                            degree=args.degree, seed=args.seed, test_fraction=args.test_fraction,
                            accept_residual=args.accept_residual, reference=args.reference,
                            max_change=args.max_change, accept_change=args.accept_change)
-        if args.errors_out:
-            result.write_error_tables(outs.path("--errors-out"), inputs=inputs,
-                                      accept_implausible=args.accept_implausible,
-                                      shown=args.errors_out)
+        write_errors_out(args, outs, result, inputs)
         if args.map_out:
             result.write_map(outs.path("--map-out"), args.map_grid, inputs=inputs)
         write_outputs(args, outs, result, ident, inputs)

@@ -1,5 +1,5 @@
-"""``volerr check plan LAYOUT ...`` / ``volerr check LAYOUT --reference CAL.json FILE...``: the
-interim check between two calibrations; see ``volerr check --help``."""
+"""``volerr check [plan] LAYOUT --reference CAL.json ...``: the interim check; see ``volerr check
+--help``."""
 
 from __future__ import annotations
 
@@ -20,8 +20,7 @@ CHECK_ONLY = ("tolerance", "date", "max_change")
 
 def register(sub) -> None:
     H = option_help("check")
-    p = command_parser(sub, "check", "between calibrations: plan an interim check, or say what "
-                                     "changed since the reference", usage=USAGE)
+    p = command_parser(sub, "check", usage=USAGE)
     p.add_argument("words", nargs="+", metavar="LAYOUT FILE", help=H["words"])
     p.add_argument("--reference", required=True, nargs="+", metavar=("CAL.json", "FILE"),
                    help=H["--reference"])

@@ -1,5 +1,5 @@
-"""``volerr identify LAYOUT --axis A FILE... --out F``: three-point laser-tracker identification
-of an axis' six error motions; see ``volerr identify --help``."""
+"""``volerr identify LAYOUT --axis A FILE... --out F``: laser-tracker identification of an axis;
+see ``volerr identify --help``."""
 
 from __future__ import annotations
 
@@ -14,8 +14,7 @@ from ._common import (add_accept_implausible, add_accept_residual, add_force,
 
 def register(sub) -> None:
     H = option_help("identify")
-    p = command_parser(sub, "identify", "three-point laser-tracker identification of an "
-                                        "axis' error motions")
+    p = command_parser(sub, "identify")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="tracker data file(s)")
     p.add_argument("--axis", required=True, help="the measured axis (X, Y, Z, B, C ...)")
@@ -59,14 +58,12 @@ def run(args) -> int:
     outs = planned_outputs(args, inputs, **{"--out": args.out, "--errors-out": (
         args.errors_out, [f"{axis}.csv"]), "--residuals": args.residuals})
     ident = identification_from_args(args, inputs)
-    origin = "layout" if args.origin == ["layout"] else args.origin
-    vec = {k: v if v in (None, "layout") else list(parse_vector(v, "--" + k)) for k, v in
-           (("tracker", args.tracker), ("direction", args.direction), ("origin", origin))}
+    origin = args.origin[0] if args.origin == ["layout"] else args.origin and list(
+        parse_vector(args.origin, "--origin"))
     with outs:
         res = identify(args.layout, args.axis, args.files, format=args.format,
                        positions=args.positions, points=args.points, method=args.method,
-                       tracker=vec["tracker"], direction=vec["direction"],
-                       origin=vec["origin"],
+                       tracker=args.tracker, direction=args.direction, origin=origin,
                        sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k,
                        signs=args.signs, accept_implausible=args.accept_implausible,
                        accept_residual=args.accept_residual, fit=args.fit)

@@ -1,18 +1,17 @@
-"""``volerr loop LAYOUT FILE... --json F [--html F]``: close the loop on measured deviations
-or drift runs (:func:`volerr.loop`, the one entry for both); see ``volerr loop --help``."""
+"""``volerr loop LAYOUT FILE...``: close the loop on measured deviations or drift runs; see
+``volerr loop --help``."""
 
 from __future__ import annotations
 
 from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
                       add_html, add_identification_arguments, add_json, command_parser,
                       identification_from_args, layout_inputs, option_help, planned_outputs,
-                      write_outputs)
+                      write_errors_out, write_outputs)
 
 
 def register(sub) -> None:
     H = option_help("loop")
-    p = command_parser(sub, "loop", "fit measured deviations, find missing effects, augment "
-                                    "the model")
+    p = command_parser(sub, "loop")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", nargs="+", metavar="FILE", help=H["data"])
     add_json(p, "the report")
@@ -36,9 +35,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    """Check the outputs, call :func:`volerr.loop` (measured deviations or drift runs alike:
-    it refuses the options that do not apply, one line), write the result, print its
-    summary."""
     from .. import loop as api_loop
     from ..instruments import split_spec
     from ..machine.model import load
@@ -63,10 +59,7 @@ def run(args) -> int:
             report = report.written_in(args.out_dir)
         if args.predictions_out:
             report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
-        if args.errors_out:
-            report.write_error_tables(outs.path("--errors-out"), inputs=inputs,
-                                      accept_implausible=args.accept_implausible,
-                                      shown=args.errors_out)
+        write_errors_out(args, outs, report, inputs)
         write_outputs(args, outs, report, ident, inputs)
     print(report.summary())
     return 0

@@ -1,5 +1,5 @@
-"""``volerr plan LAYOUT --instrument SPEC ... --readings N --out DIR``: design a measurement
-campaign before the machine time is spent; see ``volerr plan --help``."""
+"""``volerr plan LAYOUT --instrument SPEC --readings N --out DIR``: design a measurement campaign;
+see ``volerr plan --help``."""
 
 from __future__ import annotations
 
@@ -10,8 +10,7 @@ from ._common import (add_force, add_html, add_identification_arguments, add_jso
 
 def register(sub) -> None:
     H = option_help("plan")
-    p = command_parser(sub, "plan", "design a measurement campaign (optimal set-ups, files, "
-                                    "NC programs)")
+    p = command_parser(sub, "plan")
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("--instrument", action="append", required=True, metavar="SPEC",
                    help=H["--instrument"])
