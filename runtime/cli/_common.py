@@ -402,12 +402,18 @@ def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
 
 # ---------------------------------------------------------------------------------------------
 # cli-b: a command's parser whose prose lives in volerr/data/help, and shared output names
-def command_parser(sub, name: str, text: str | None = None, **kw):
-    """``sub.add_parser(name)`` with its texts from ``volerr/data/help/TEXT.description.txt``
-    (``TEXT`` default ``name``; a sub-command's ``ballbar-evaluate``): the first line its help
-    in the list of commands, the next its description, printed as it is by ``--help``."""
+def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
+    """``(parser, helps)``: ``sub.add_parser(name)`` with its texts from
+    ``volerr/data/help/TEXT.description.txt`` (``TEXT`` default ``name``; a sub-command's
+    ``ballbar-evaluate``): the first line its help in the list of commands, the next its
+    description, printed as it is by ``--help``; ``helps`` its options' long helps
+    (:func:`option_help`, empty without a ``TEXT.options.txt``)."""
+    from importlib.resources import files
+
     short, about = help_text(f"{text or name}.description").rstrip("\n").split("\n", 1)
-    return sub.add_parser(name, help=short, description=about, **kw)
+    known = (files("volerr") / "data" / "help" / f"{text or name}.options.txt").is_file()
+    return (sub.add_parser(name, help=short, description=about, **kw),
+            option_help(text or name) if known else {})
 
 
 def error_dir_names(layout) -> list:
@@ -432,3 +438,21 @@ def option_help(name: str) -> dict:
     positional argument) on the first line, its help on the next (re-wrapped by --help)."""
     blocks = help_text(f"{name}.options").strip("\n").split("\n\n")
     return {b.split("\n", 1)[0]: " ".join(b.split("\n")[1:]) for b in blocks}
+
+
+def add_report_options(parser, json: str, html: str, instrument: str | None = None) -> None:
+    """The report options of a command, in this order: ``--json`` (writing ``json``),
+    ``--html`` (``html``) and the identification (``instrument``: what ``--instrument``
+    names; :func:`add_identification_arguments`)."""
+    add_json(parser, json)
+    add_html(parser, html)
+    add_identification_arguments(parser, *([instrument] if instrument else []))
+
+
+def add_fit_switches(parser, implausible: bool = True) -> None:
+    """``--force``, ``--accept-residual`` and (``implausible``) ``--accept-implausible``, in
+    this order: the switches of a command that writes a fit."""
+    add_force(parser)
+    add_accept_residual(parser)
+    if implausible:
+        add_accept_implausible(parser)

@@ -6,15 +6,14 @@ from __future__ import annotations
 from ._common import (add_accept_residual, add_error_arguments, add_force, add_html,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
                       error_functions_from_args, identification_from_args, layout_inputs,
-                      option_help, planned_outputs, write_outputs)
+                      planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "ballbar")
+    p, _ = command_parser(sub, "ballbar")
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
-    sim = command_parser(s, "simulate", text="ballbar-simulate")
-    H_sim = option_help("ballbar-simulate")
+    sim, H_sim = command_parser(s, "simulate", text="ballbar-simulate")
     sim.add_argument("layout", help="layout name or layout file")
     add_error_arguments(sim)
     sim.add_argument("--plane", choices=("XY", "YZ", "ZX"), required=True, help=H_sim["--plane"])
@@ -30,8 +29,7 @@ def register(sub) -> None:
     sim.add_argument("--out", required=True, metavar="TRACE.csv", help="the trace to write")
     add_force(sim)
     sim.set_defaults(func=run_simulate)
-    ev = command_parser(s, "evaluate", text="ballbar-evaluate")
-    H_ev = option_help("ballbar-evaluate")
+    ev, H_ev = command_parser(s, "evaluate", text="ballbar-evaluate")
     ev.add_argument("files", nargs="+", metavar="TRACE.csv", help="ballbar files")
     ev.add_argument("--layout", help=H_ev["--layout"])
     add_json(ev, "the evaluation (G, H, F per trace; diagnosis)")

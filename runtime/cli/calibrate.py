@@ -3,26 +3,21 @@
 
 from __future__ import annotations
 
-from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
-                      add_html, add_identification_arguments, add_json, add_max_change,
+from ._common import (add_errors_out, add_fit_switches, add_max_change, add_report_options,
                       command_parser, error_dir_names, identification_from_args, layout_inputs,
-                      option_help, planned_outputs, write_errors_out, write_outputs)
+                      planned_outputs, write_errors_out, write_outputs)
 
 
 def register(sub) -> None:
-    H = option_help("calibrate")
-    p = command_parser(sub, "calibrate")
+    p, H = command_parser(sub, "calibrate")
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help=H["files"])
-    add_json(p, "the report (parameters, identifiability, set-ups, residuals per file)")
-    add_html(p, "the report with figures")
-    add_identification_arguments(p, "the instruments")
+    add_report_options(p, "the report (parameters, identifiability, set-ups, residuals per file)",
+                       "the report with figures", "the instruments")
     add_errors_out(p, "the identified model (for map, compensate, uncertainty)")
     p.add_argument("--map-out", metavar="MAP.csv", help=H["--map-out"])
     p.add_argument("--map-grid", type=int, default=9, metavar="N", help=H["--map-grid"])
-    add_force(p)
-    add_accept_residual(p)
-    add_accept_implausible(p)
+    add_fit_switches(p)
     add_max_change(p, reference=True)
     p.add_argument("--parameters", metavar="SPEC", help=H["--parameters"])
     p.add_argument("--degree", type=int, help=H["--degree"])

@@ -4,23 +4,18 @@
 from __future__ import annotations
 
 from ..errors import require
-from ._common import (add_accept_residual, add_force, add_html, add_identification_arguments,
-                      add_json, add_max_change, command_parser, identification_from_args,
-                      layout_inputs, option_help, planned_outputs, write_certificates,
-                      write_outputs)
+from ._common import (add_fit_switches, add_max_change, add_report_options, command_parser,
+                      help_text, identification_from_args, layout_inputs, planned_outputs,
+                      write_certificates, write_outputs)
 
-USAGE = ("volerr check plan LAYOUT --reference CAL.json --instrument SPEC [--minutes M] "
-         "[--readings N] [--detect-um D] --out DIR [--json F] [--html H]\n"
-         "       volerr check LAYOUT --reference CAL.json FILE... [--tolerance T] "
-         "[--date YYYY-MM-DD] [--json F] [--html H]")
+USAGE = help_text("check.usage").rstrip("\n")
 #: options of one form only
 PLAN_ONLY = ("instrument", "minutes", "readings", "detect_um", "out")
 CHECK_ONLY = ("tolerance", "date", "max_change")
 
 
 def register(sub) -> None:
-    H = option_help("check")
-    p = command_parser(sub, "check", usage=USAGE)
+    p, H = command_parser(sub, "check", usage=USAGE)
     p.add_argument("words", nargs="+", metavar="LAYOUT FILE", help=H["words"])
     p.add_argument("--reference", required=True, nargs="+", metavar=("CAL.json", "FILE"),
                    help=H["--reference"])
@@ -31,11 +26,9 @@ def register(sub) -> None:
     p.add_argument("--out", metavar="DIR", help="check plan: folder of the check's files")
     p.add_argument("--tolerance", metavar="T", help=H["--tolerance"])
     p.add_argument("--date", metavar="YYYY-MM-DD", help=H["--date"])
-    add_json(p, "the check plan or the check's result")
-    add_html(p, "the set-up sheet (check plan) or the check's page")
-    add_identification_arguments(p)
-    add_force(p)
-    add_accept_residual(p)
+    add_report_options(p, "the check plan or the check's result",
+                       "the set-up sheet (check plan) or the check's page")
+    add_fit_switches(p, implausible=False)
     add_max_change(p, reference=False)
     p.set_defaults(func=run)
 

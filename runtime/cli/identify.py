@@ -8,13 +8,11 @@ from pathlib import Path
 
 from ._common import (add_accept_implausible, add_accept_residual, add_force,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
-                      identification_from_args, layout_inputs, option_help, planned_outputs,
-                      write_outputs)
+                      identification_from_args, layout_inputs, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    H = option_help("identify")
-    p = command_parser(sub, "identify")
+    p, H = command_parser(sub, "identify")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("files", nargs="+", metavar="FILE", help="tracker data file(s)")
     p.add_argument("--axis", required=True, help="the measured axis (X, Y, Z, B, C ...)")

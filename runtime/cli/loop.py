@@ -3,29 +3,23 @@
 
 from __future__ import annotations
 
-from ._common import (add_accept_implausible, add_accept_residual, add_errors_out, add_force,
-                      add_html, add_identification_arguments, add_json, command_parser,
-                      identification_from_args, layout_inputs, option_help, planned_outputs,
-                      write_errors_out, write_outputs)
+from ._common import (add_errors_out, add_fit_switches, add_report_options, command_parser,
+                      identification_from_args, layout_inputs, planned_outputs, write_errors_out,
+                      write_outputs)
 
 
 def register(sub) -> None:
-    H = option_help("loop")
-    p = command_parser(sub, "loop")
+    p, H = command_parser(sub, "loop")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("data", nargs="+", metavar="FILE", help=H["data"])
-    add_json(p, "the report")
-    add_html(p, "the report with figures")
-    add_identification_arguments(p, "the instruments")
+    add_report_options(p, "the report", "the report with figures", "the instruments")
     p.add_argument("--out-dir", metavar="DIR", help=H["--out-dir"])
     p.add_argument("--holdout-time", metavar="A:B", help=H["--holdout-time"])
     p.add_argument("--holdout-files", nargs="+", metavar="FILE", help=H["--holdout-files"])
     p.add_argument("--predictions-out", metavar="P.csv", help=H["--predictions-out"])
     p.add_argument("--differences", action="store_true", help=H["--differences"])
     add_errors_out(p, "the fitted error functions (effects removed)")
-    add_force(p)
-    add_accept_residual(p)
-    add_accept_implausible(p)
+    add_fit_switches(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the held-out split and folds")
     p.add_argument("--folds", type=int, help=H["--folds"])
     p.add_argument("--test-fraction", type=float, default=0.25, help=H["--test-fraction"])
@@ -48,13 +42,12 @@ def run(args) -> int:
         "--errors-out": (args.errors_out, [f"{a}.csv" for a in model.axes] + ["constants.csv"])})
     ident = identification_from_args(args, inputs)
     with outs:
-        report = api_loop(args.layout, list(args.data), out_dir=outs.path("--out-dir"),
-                          seed=args.seed, folds=args.folds, test_fraction=args.test_fraction,
-                          degree=args.degree, families=args.families,
-                          holdout_time=args.holdout_time,
-                          holdout_files=list(args.holdout_files or []),
-                          differences=args.differences, inputs=inputs,
-                          accept_residual=args.accept_residual)
+        report = api_loop(
+            args.layout, list(args.data), out_dir=outs.path("--out-dir"), seed=args.seed,
+            folds=args.folds, test_fraction=args.test_fraction, degree=args.degree,
+            families=args.families, holdout_time=args.holdout_time,
+            holdout_files=list(args.holdout_files or []), differences=args.differences,
+            inputs=inputs, accept_residual=args.accept_residual)
         if args.out_dir:    # the final paths, not staging (a new result)
             report = report.written_in(args.out_dir)
         if args.predictions_out:

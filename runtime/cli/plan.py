@@ -3,22 +3,19 @@ see ``volerr plan --help``."""
 
 from __future__ import annotations
 
-from ._common import (add_force, add_html, add_identification_arguments, add_json, command_parser,
-                      identification_from_args, layout_inputs, option_help, planned_outputs,
-                      write_certificates)
+from ._common import (add_force, add_report_options, command_parser, identification_from_args,
+                      layout_inputs, planned_outputs, write_certificates)
 
 
 def register(sub) -> None:
-    H = option_help("plan")
-    p = command_parser(sub, "plan")
+    p, H = command_parser(sub, "plan")
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     p.add_argument("--instrument", action="append", required=True, metavar="SPEC",
                    help=H["--instrument"])
     p.add_argument("--readings", type=int, required=True, metavar="N", help=H["--readings"])
     p.add_argument("--out", required=True, metavar="DIR", help=H["--out"])
-    add_json(p, "the plan: predicted standard uncertainties, files, baseline")
-    add_html(p, "the set-up sheet (default: DIR/plan.html)")
-    add_identification_arguments(p)
+    add_report_options(p, "the plan: predicted standard uncertainties, files, baseline",
+                       "the set-up sheet (default: DIR/plan.html)")
     p.add_argument("--parameters", metavar="SPEC", help=H["--parameters"])
     p.add_argument("--minutes", type=float, metavar="M", help=H["--minutes"])
     p.add_argument("--criterion", choices=("I", "D"), default="I", help=H["--criterion"])

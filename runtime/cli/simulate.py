@@ -5,12 +5,11 @@ from __future__ import annotations
 
 from ..choices import SIMULATED_INSTRUMENTS as INSTRUMENTS, SIMULATED_PLANTED as PLANTED
 from ._common import (add_accept_implausible, add_vector, command_parser, layout_inputs,
-                      option_help, planned_outputs)
+                      planned_outputs)
 
 
 def register(sub) -> None:
-    H = option_help("simulate")
-    p = command_parser(sub, "simulate")
+    p, H = command_parser(sub, "simulate")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("--out", required=True, help="measured-deviation CSV to write")
     p.add_argument("--points", type=int, default=600, help="number of points (default 600)")
