@@ -70,12 +70,11 @@ class Evaluation(ResultMixin):
 
         return write_text(path, json_text(self.data), inputs=list(inputs))
 
-    def write_plot(self, path, inputs=()):
+    def png(self) -> bytes:
         """The ``--plot`` PNG: the traces' polar plot (:meth:`figures`)."""
-        from .plots import polar_plot
+        from .plots import polar_png
 
-        polar_plot(self.traces, self.results, path, inputs=inputs)
-        return path
+        return polar_png(self.traces, self.results)
 
 
 def judge(data: dict, quality, accept: bool, where: str):

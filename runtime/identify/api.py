@@ -57,12 +57,12 @@ class Identified(ResultMixin):
 
         return write_text(path, residual_csv(self.identification), inputs=list(inputs))
 
-    def write_plot(self, path, inputs=()):
-        """Write the ``--plot`` PNG: the six error motions and the ``fit`` curves."""
-        from .plots import plot_identification
+    def png(self) -> bytes:
+        """The ``--plot`` PNG: the six error motions and the ``fit`` curves."""
+        from ..plotstyle import png
+        from .plots import identification_figure
 
-        plot_identification(self.identification, path, self.fits)
-        return path
+        return png(identification_figure(self.identification, self.fits))
 
     def _rows(self) -> list:
         from .solve import error_table_rows

@@ -587,6 +587,7 @@ class SimulatedTrace:
         self.columns, self.layout, self.plane, self.radius = columns, layout, plane, radius
 
     def summary(self, written: str = "(not written)") -> str:
+        """The line ``volerr ballbar simulate`` prints, the file named ``written``."""
         dr = self.columns["dr_um"]
         return (f"{self.layout}: ballbar trace {self.plane}, radius {self.radius:g} mm, "
                 f"{len(dr)} readings -> {written} (dr {dr.min():.3f} .. {dr.max():.3f} um)")
@@ -600,9 +601,44 @@ def simulated_trace(model: Model, functions, plane: str, radius: float, centre,
                     tool=(0.0, 0.0, 0.0), rotary=None, points: int = 360,
                     noise_um: float = 0.0, direction: str = "both",
                     seed: int = 0) -> SimulatedTrace:
-    """:func:`simulate` of ``volerr ballbar simulate``, its options checked first (one line):
-    ``noise_um`` (um) not negative, ``radius`` (mm) in (0, 1e5], ``points`` per direction in
-    8 .. 10^6; ``rotary`` a dict or its ``--rotary`` text (:func:`parse_rotary`)."""
+    """A ballbar trace of ``model`` with the error ``functions`` (``volerr ballbar simulate``):
+    :func:`simulate`, its options checked first.
+
+    Parameters
+    ----------
+    model : Model
+        The machine (its first-order observation model).
+    functions : volerr.tables.functions.ErrorFunctions
+        The error functions (mm / rad) the readings see.
+    plane : {"XY", "YZ", "ZX"}
+        Plane of the circle in the workpiece frame.
+    radius : float
+        Bar length, mm, in (0, 1e5].
+    centre, tool : 3-vectors
+        Pivot ball centre (workpiece frame) and tool-side ball offset from the tool point, mm.
+    rotary : dict or str, optional
+        Rotary axes held (deg) or swept (START, STOP), or its ``--rotary`` text
+        (:func:`parse_rotary`); None: none.
+    points : int
+        Readings per direction, 8 .. 10^6.
+    noise_um : float
+        Standard deviation of the Gaussian noise of a reading, um, not negative.
+    direction : {"both", "ccw", "cw"}
+        Counter-clockwise, clockwise or both (CCW first).
+    seed : int
+        Seed of the noise.
+
+    Returns
+    -------
+    SimulatedTrace
+        ``columns`` (``dr_um`` in um: bar longer than nominal positive), ``write_csv``,
+        ``summary()`` the line the command prints.
+
+    Raises
+    ------
+    volerr.InputError
+        An option out of range, with the command's one-line message.
+    """
     require(noise_um >= 0, "--noise-um must not be negative")
     require(0 < radius <= 1e5, f"--radius must be a positive length of at most 1e5 mm, "
                                f"got {radius:g}")
