@@ -26,8 +26,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..plan import plan
-    from ..plan.api import check_folder, check_options
+    from ..plan.api import check_folder, check_options, plan
 
     check_options(args.readings, args.minutes, args.parameters, args.dialect)
     inputs = layout_inputs(args.layout)
@@ -35,8 +34,8 @@ def run(args) -> int:
     outs = planned_outputs(args, inputs, **{"--out": (args.out, None)})
     ident = identification_from_args(args, inputs)
     with outs:
-        result = plan(args.layout, args.instrument, args.readings, args.parameters,
-                      args.minutes, args.criterion, args.seed)
+        result = plan(args.layout, args.instrument, args.readings, parameters=args.parameters,
+                      minutes=args.minutes, criterion=args.criterion, seed=args.seed)
         result.write(outs.path("--out"), outs.path("--json"), outs.path("--html"), inputs,
                      args.dialect)
         write_certificates(outs, result, ident, inputs)
