@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from ._common import (add_accept_residual, add_error_arguments, add_force, add_html,
+from ._common import (add_error_arguments, add_fit_switches, add_force, add_html,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
                       error_functions_from_args, identification_from_args, layout_inputs,
                       planned_outputs, write_outputs)
@@ -36,8 +36,7 @@ def register(sub) -> None:
     add_plot(ev, "the polar plot")
     add_html(ev, "the report page (polar plot, ISO 230-4 table, diagnosis)")
     add_identification_arguments(ev, "the ballbar (its calibration length and certificate)")
-    add_force(ev)
-    add_accept_residual(ev)
+    add_fit_switches(ev, implausible=False)
     ev.set_defaults(func=run_evaluate)
 
 

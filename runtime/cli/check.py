@@ -50,12 +50,12 @@ def run(args) -> int:
 def _plan(args) -> int:
     from ..check import plan_check
     from ..check._plan import DEFAULT_DETECT_UM, check_plan_options
-    from ..plan.api import check_folder
+    from ..plan.api import check_plan_folder
 
     check_plan_options(args.instrument, args.readings, args.minutes, args.detect_um)
     require(args.out, "check plan: give --out DIR")
     inputs = layout_inputs(args.words[1]) + [args.reference]
-    check_folder(args.out, args.force, "check", (".csv", ".nc", ".html"))
+    check_plan_folder(args.out, args.force, "check", (".csv", ".nc", ".html"))
     outs = planned_outputs(args, inputs, **{"--out": (args.out, None)})
     ident = identification_from_args(args, inputs[-1:] + inputs[:-1])
     with outs:

@@ -26,11 +26,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..plan.api import check_folder, check_options, plan
+    from ..plan.api import check_plan_folder, check_options, plan
 
     check_options(args.readings, args.minutes, args.parameters, args.dialect)
     inputs = layout_inputs(args.layout)
-    check_folder(args.out, args.force)
+    check_plan_folder(args.out, args.force)
     outs = planned_outputs(args, inputs, **{"--out": (args.out, None)})
     ident = identification_from_args(args, inputs)
     with outs:

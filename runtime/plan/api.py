@@ -67,7 +67,7 @@ def check_options(readings: int, minutes: float | None = None, parameters: str |
             "--parameters: empty; give names, axes or groups")
 
 
-def check_folder(folder, force: bool = False, what: str = "plan",
+def check_plan_folder(folder, force: bool = False, what: str = "plan",
                  suffixes=PLAN_SUFFIXES) -> None:
     """Refuse ``folder`` (``--out DIR`` of ``volerr plan`` / ``check plan``) when it is a
     file, or, without ``force``, when it holds a file a plan writes (``suffixes``) already:

@@ -67,20 +67,20 @@ def test_plan_refuses_as_the_command(kwargs, message):
 
 
 def test_plan_folder_check(tmp_path):
-    from volerr.plan.api import check_folder, check_options
+    from volerr.plan.api import check_plan_folder, check_options
 
     with pytest.raises(InputError, match="--dialect bogus: not a dialect; give one of iso"):
         check_options(10, dialect="bogus")
-    check_folder(tmp_path / "new")                       # a folder still to be made
+    check_plan_folder(tmp_path / "new")                       # a folder still to be made
     (tmp_path / "b.nc").write_text("")
     (tmp_path / "a.csv").write_text("")
     with pytest.raises(InputError) as e:
-        check_folder(tmp_path)
+        check_plan_folder(tmp_path)
     assert str(e.value) == (f"--out {tmp_path}: holds a.csv already; give --force to replace "
                             f"plan files there, or another folder")
-    check_folder(tmp_path, force=True)
+    check_plan_folder(tmp_path, force=True)
     with pytest.raises(InputError, match="a file, not a folder"):
-        check_folder(tmp_path / "a.csv")
+        check_plan_folder(tmp_path / "a.csv")
 
 
 @pytest.mark.parametrize("kwargs, message", [
