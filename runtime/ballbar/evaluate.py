@@ -76,6 +76,12 @@ class Evaluation(ResultMixin):
 
         return write_text(path, json_text(self.data), inputs=list(inputs))
 
+    def png(self) -> bytes:
+        """The ``--plot`` PNG: the traces' polar plot (:meth:`figures`)."""
+        from .plots import polar_png
+
+        return polar_png(self.traces, self.results)
+
 
 def judge(data: dict, quality, accept: bool, where: str):
     """The residual rule (:mod:`volerr.fit_quality`) on the diagnosis fit, applied to the

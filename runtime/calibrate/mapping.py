@@ -87,6 +87,14 @@ def predict(cal, positions: dict, probe) -> tuple[np.ndarray, np.ndarray, np.nda
     return e, np.sqrt(np.maximum(var, 0.0)), A, cols
 
 
+def grid_counts(n: int) -> tuple:
+    """``(n, n, n)``: the points per linear axis of a map (``--map-grid``), 2 .. 60."""
+    from ..errors import require
+
+    require(2 <= n <= 60, "--map-grid must be between 2 and 60")
+    return (n,) * 3
+
+
 def grid_positions(cal, counts=(GRID, GRID, GRID), at=None) -> tuple[dict, tuple, dict]:
     """Positions of a grid over the measured range of the linear axes (C order, last axis
     fastest), rotary axes at ``at`` {axis: deg} or their default (module docstring).  Returns

@@ -272,7 +272,19 @@ class Calibration(ResultMixin):
         lines = [self.headline(), *self.console_lines()]
         if self.quality is not None:
             lines.insert(1, "  " + self.quality.line())
+        beyond = self.data.get("max_change", {}).get("beyond")
+        if beyond:          # written on the caller's word (accept_change)
+            lines.append("  changes beyond --max-change, accepted (--accept-change): " + ", ".join(
+                f"{c['parameter']} {c['old']:.4g} -> {c['new']:.4g} {c['unit']}" for c in beyond))
         return "\n".join(lines)
+
+    def write_map(self, path, grid: int = 9, inputs=()) -> Path:
+        """The ``--map-out`` CSV: the identified volumetric error map over the measured range
+        with its standard uncertainty (k = 1), ``grid`` points per linear axis (2 .. 60)
+        (:func:`volerr.calibrate.mapping.write_csv`: positions mm / deg, errors um)."""
+        from .mapping import grid_counts, write_csv
+
+        return write_csv(path, self, grid_counts(grid), inputs=list(inputs))
 
     def console_lines(self) -> list:
         """The lines ``volerr calibrate`` prints below :meth:`headline`."""

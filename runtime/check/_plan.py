@@ -119,6 +119,18 @@ def _fmt(v) -> str:
     return "-" if v is None else f"{v:.3g}"
 
 
+def check_plan_options(specs, readings: int | None = None, minutes: float | None = None,
+                       detect_um: float | None = None) -> None:
+    """Refuse options of :func:`plan_check` (``volerr check plan``) out of range, one line:
+    no instrument, ``readings`` outside 1 .. 100000, ``minutes`` or ``detect_um`` (um) not
+    positive."""
+    require(specs, "check plan: give at least one --instrument")
+    require(readings is None or 1 <= readings <= 10 ** 5,
+            "--readings must be between 1 and 100000")
+    require(minutes is None or minutes > 0, "--minutes must be positive")
+    require(detect_um is None or detect_um > 0, "--detect-um must be positive")
+
+
 def plan_check(layout, reference, specs, *, minutes: float | None = None,
                readings: int | None = None, detect_um: float = DEFAULT_DETECT_UM,
                seed: int = 0) -> CheckPlan:
@@ -126,9 +138,9 @@ def plan_check(layout, reference, specs, *, minutes: float | None = None,
     or check JSON) with the instruments ``specs``."""
     from threadpoolctl import threadpool_limits
 
+    check_plan_options(specs, readings, minutes, detect_um)
     model = layout if isinstance(layout, Model) else load(layout)
     ref = _reference.load(reference, model)
-    require(detect_um > 0, "--detect-um must be positive")
     insts = [_spec.parse(s) for s in specs]
     require(insts, "give at least one --instrument")
     with threadpool_limits(limits=1, user_api="blas"):

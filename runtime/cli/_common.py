@@ -291,23 +291,67 @@ def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
 
 
 # ---------------------------------------------------------------------------------------------
-# cli-a: the helpers of iso230-2, iso230-3, iso10360, uncertainty, probe-cal, drift, history,
-# squareness and tcpmap (issue 42 item 4)
-def command_parser(sub, name: str, help: str, text: str | None = None, **kwargs):
-    """``sub.add_parser(name, help=help, **kwargs)`` with its long texts from
-    ``volerr/data/help/``: the description ``TEXT.description.txt`` and the epilog
-    ``TEXT.txt`` where those files are (``text``: ``name`` unless given)."""
+def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
+    """``(parser, helps)``: ``sub.add_parser(name)`` with its texts from
+    ``volerr/data/help/`` (``TEXT`` default ``name``; a sub-command's ``ballbar-evaluate``):
+    ``TEXT.description.txt`` its help in the list of commands (first line) and its
+    description (the lines after it, printed as they are by ``--help``; none: no
+    description), ``TEXT.txt`` (where it is) its epilog; ``helps`` its options' long helps
+    (:func:`option_help`, empty without a ``TEXT.options.txt``)."""
     from importlib.resources import files
 
-    folder = files("volerr") / "data" / "help"
-    text = text or name
-    if "description" not in kwargs and (folder / f"{text}.description.txt").is_file():
-        kwargs["description"] = help_text(f"{text}.description").rstrip("\n")
-    if "epilog" not in kwargs and (folder / f"{text}.txt").is_file():
-        kwargs["epilog"] = help_text(text)
-    return sub.add_parser(name, help=help, **kwargs)
+    folder, text = files("volerr") / "data" / "help", text or name
+    short, _, about = help_text(f"{text}.description").rstrip("\n").partition("\n")
+    kw.setdefault("description", about or None)
+    if (folder / f"{text}.txt").is_file():
+        kw.setdefault("epilog", help_text(text))
+    known = (folder / f"{text}.options.txt").is_file()
+    return sub.add_parser(name, help=short, **kw), option_help(text) if known else {}
 
 
+def error_dir_names(layout) -> list:
+    """The files of the error directory a fit of ``layout`` writes: ``<axis>.csv`` of every
+    axis and ``constants.csv`` (declared before the run)."""
+    from ..machine.model import load
+
+    return [f"{a}.csv" for a in load(layout).axes] + ["constants.csv"]
+
+
+def write_errors_out(args, outs, result, inputs) -> None:
+    """Inside ``with outs:``: ``--errors-out DIR`` (when given) from ``result``'s
+    ``write_error_tables`` (``--accept-implausible``; a refusal names DIR as given)."""
+    if args.errors_out:
+        result.write_error_tables(outs.path("--errors-out"), inputs=inputs, shown=args.errors_out,
+                                  accept_implausible=args.accept_implausible)
+
+
+def option_help(name: str) -> dict:
+    """``{option: help}`` of a command's long option helps, from the text file
+    ``volerr/data/help/NAME.options.txt``: blocks separated by a blank line, the option (or
+    positional argument) on the first line, its help on the next (re-wrapped by --help)."""
+    blocks = help_text(f"{name}.options").strip("\n").split("\n\n")
+    return {b.split("\n", 1)[0]: " ".join(b.split("\n")[1:]) for b in blocks}
+
+
+def add_report_options(parser, json: str, html: str, instrument: str | None = None) -> None:
+    """The report options of a command, in this order: ``--json`` (writing ``json``),
+    ``--html`` (``html``) and the identification (``instrument``: what ``--instrument``
+    names; :func:`add_identification_arguments`)."""
+    add_json(parser, json)
+    add_html(parser, html)
+    add_identification_arguments(parser, *([instrument] if instrument else []))
+
+
+def add_fit_switches(parser, implausible: bool = True) -> None:
+    """``--force``, ``--accept-residual`` and (``implausible``) ``--accept-implausible``, in
+    this order: the switches of a command that writes a fit."""
+    add_force(parser)
+    add_accept_residual(parser)
+    if implausible:
+        add_accept_implausible(parser)
+
+
+# the outputs of a result, the options of an API call
 def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> None:
     """Inside ``with outs:``: the outputs ``roles`` the command was given, each by the
     result's ``write_ROLE`` (``--json`` :meth:`write_json`, ``--csv`` ``write_csv`` ...)."""

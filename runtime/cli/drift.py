@@ -7,9 +7,9 @@ from ._common import command_parser
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "drift", "thermal drift files (ISO 230-3): convert a logger's file")
+    p, _ = command_parser(sub, "drift")
     steps = p.add_subparsers(dest="step", metavar="STEP", required=True)
-    c = command_parser(steps, "convert", "a logger's CSV -> a drift file", "drift-convert")
+    c, _ = command_parser(steps, "convert", "drift-convert")
     a = c.add_argument
     a("raw", metavar="RAW.csv", help="the logger's file (CSV, UTF-8)")
     a("--out", required=True, metavar="F", help="the drift file to write")

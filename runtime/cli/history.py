@@ -3,17 +3,14 @@
 from __future__ import annotations
 
 from ._common import (add_html, add_identification_arguments, add_json, command_parser,
-                      identification_from_args, planned_outputs, write_outputs)
+                      help_text, identification_from_args, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "history", "a machine's calibrations and checks over time: "
-                                       "events, trends, forecast")
+    p, _ = command_parser(sub, "history")
     s = p.add_subparsers(dest="action", metavar="ACTION", required=True)
-    a = command_parser(s, "add", "store results (calibrate / check JSON) of a machine",
-                       "history", description=None)
-    sh = command_parser(s, "show", "events, trends, forecast of a machine's history", "history",
-                        description=None)
+    a, _ = command_parser(s, "add", "history-add", epilog=help_text("history"))
+    sh, _ = command_parser(s, "show", "history-show", epilog=help_text("history"))
     for q in (a, sh):
         q.add_argument("--db", required=True, metavar="DB",
                        help="the history: a file (SQLite) or a postgresql:// URL")

@@ -8,7 +8,7 @@ from ._common import (add_error_arguments, add_html, add_identification, add_jso
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "iso10360", "simulated ISO 10360-2 length measuring test (E0)")
+    p, _ = command_parser(sub, "iso10360")
     a = p.add_argument
     a("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)

@@ -8,8 +8,7 @@ from ._common import (add_errors_out, add_force, add_html, add_identification, a
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "iso230-2",
-                       "ISO 230-2 evaluation of laser-interferometer positioning runs")
+    p, _ = command_parser(sub, "iso230-2")
     a = p.add_argument
     a("runs", nargs="+", metavar="RUN.csv", help="positioning run(s), long or wide format (below)")
     a("--axis", default="X", help="axis letter of the runs (X Y Z U V W; default X), or a comma "

@@ -7,7 +7,7 @@ from ._common import (add_force, add_html, add_identification, add_json, add_plo
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "iso230-3", "ISO 230-3 evaluation of a thermal drift test")
+    p, _ = command_parser(sub, "iso230-3")
     p.add_argument("file", metavar="FILE", help="the drift file (volerr formats drift)")
     add_json(p, "the results")
     add_plot(p, "drift, tilts, speed and temperatures against time")

@@ -11,8 +11,7 @@ from ._common import (add_force, add_identification_arguments, add_vector, comma
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "probe-cal", "probe lobing calibration on a master sphere (Pahk "
-                                         "eq. 13)")
+    p, _ = command_parser(sub, "probe-cal")
     a = p.add_argument
     a("data", nargs="?", metavar="DATA.csv",
       help="CSV x,y,z (ball centres, mm) [,phi_deg,theta_deg (probe frame)]")

@@ -11,7 +11,7 @@ from ._common import (add_accept_implausible, add_errors_out, add_force, add_jso
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "squareness", "squareness of linear axes from straightness tables")
+    p, _ = command_parser(sub, "squareness")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("directory", help="error directory with the straightness tables")
     add_errors_out(p, "the squareness with the slope-free tables (must differ from DIR)",

@@ -7,7 +7,7 @@ from ._common import (add_error_arguments, add_plot, add_vector, command_parser,
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "tcpmap", "five-axis tool-tip error over the rotary range (PNG)")
+    p, _ = command_parser(sub, "tcpmap")
     p.add_argument("layout", help="five-axis layout name or file")
     add_error_arguments(p)
     add_vector(p, "--point", required=True,

@@ -9,8 +9,7 @@ from ._common import (add_error_arguments, add_html, add_identification_argument
 
 
 def register(sub) -> None:
-    p = command_parser(sub, "uncertainty",
-                       "task-specific uncertainty by Monte Carlo (virtual CMM)")
+    p, _ = command_parser(sub, "uncertainty")
     a = p.add_argument
     a("layout", help="layout name (volerr layouts) or layout file")
     a("--task", required=True, metavar="CSV", help="probing points X,Y,Z[,i,j,k][,Xp,Yp,Zp] mm")

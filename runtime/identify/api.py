@@ -18,19 +18,51 @@ class Identified(ResultMixin):
     identification: object
     axis: str
     quality: object = None      # the residual rule (volerr.fit_quality), JSON "fit_quality"
+    fits: dict | None = None    # ``fit``: name -> the fitted error function (tables.errorfit)
 
-    def summary(self) -> str:
-        """What ``volerr identify`` prints (without the line naming the written table)."""
+    def summary(self, written: str = "(not written)") -> str:
+        """What ``volerr identify`` prints, the written table named ``written``."""
         from ..identify.report import summary_lines
 
-        lines = summary_lines(self.axis, self.data, "(not written)")
+        lines = summary_lines(self.axis, self.data, written)
         return "\n".join(lines + (["  " + self.quality.line()] if self.quality else []))
 
+    @property
+    def notes(self) -> list:
+        """The warnings ``volerr identify`` prints on stderr: one per flagged point (round,
+        position, point, residual in um)."""
+        from ..identify.report import outlier_warnings
+
+        return outlier_warnings(self.data)
+
     def error_table_csv(self) -> str:
-        """The error table as ``volerr identify --out`` writes it (``_um``, ``_urad``)."""
+        """The error table as ``volerr identify --out`` writes it (``_um``, ``_urad``; a
+        forced fit's sentence first, as a ``#`` line)."""
         from ..tables.table import table_to_csv
 
-        return table_to_csv(self.errors)
+        forced = self.data.get("forced")
+        return (f"# {forced}\n" if forced else "") + table_to_csv(self.errors)
+
+    def write_table(self, path, inputs=()):
+        """Write :meth:`error_table_csv` (``--out F`` or ``--errors-out DIR``'s
+        ``<axis>.csv``); returns its path."""
+        from ..fileio import write_text
+
+        return write_text(path, self.error_table_csv(), inputs=list(inputs))
+
+    def write_residuals(self, path, inputs=()):
+        """Write the per-position, per-point residuals (``--residuals``: CSV, um)."""
+        from ..fileio import write_text
+        from .report import residual_csv
+
+        return write_text(path, residual_csv(self.identification), inputs=list(inputs))
+
+    def png(self) -> bytes:
+        """The ``--plot`` PNG: the six error motions and the ``fit`` curves."""
+        from ..plotstyle import png
+        from .plots import identification_figure
+
+        return png(identification_figure(self.identification, self.fits))
 
     def _rows(self) -> list:
         from .solve import error_table_rows
@@ -42,14 +74,14 @@ class Identified(ResultMixin):
         every round (um, urad; the thesis' Fig. 4.x style, as ``--plot`` draws them)."""
         from .plots import identification_figure
 
-        return {"motions": identification_figure(self.identification)}
+        return {"motions": identification_figure(self.identification, self.fits)}
 
 
 def identify(layout, axis: str, files, *, format: str = "csv", positions: str | None = None,
              points: str | None = None, method: str = "lsq", tracker=None, direction=None,
              origin=None, sense="auto", max_cond: float = 1e4, outlier_k: float = 5.0,
              signs: str = "component", accept_implausible: bool = False,
-             accept_residual: bool = False) -> Identified:
+             accept_residual: bool = False, fit: str | None = None) -> Identified:
     """Three-point (or more) laser-tracker identification of the six error motions of an axis
     (``volerr identify``; the thesis' eq. 30 for linear axes, eq. 3.4 for rotary axes).
 
@@ -76,6 +108,11 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
         (:mod:`volerr.fit_quality`) is returned marked forced (``data["fit_quality"]``
         verdict ``"forced"``, ``data["forced"]`` the sentence the written table carries)
         instead of refused (InputError).
+    fit : {"poly", "smooth", "linear", "cubic"}, optional
+        ``--fit``: fit error functions to the identified table (poly: degree by
+        cross-validation; smooth: smoothing spline by GCV; weighted by the rounds' ``std``
+        where there is one); their residuals (um, urad) in ``data["fit"]``, the curves on
+        the plot.
 
     Returns
     -------
@@ -107,7 +144,13 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     data["fit_quality"] = quality.to_dict()
     quality = gate(data, quality, accept_residual, f"identify {' '.join(map(str, files))}",
                    key="fit_quality")
-    return Identified(data, table, result, axis.strip().upper(), quality)
+    fits = None
+    if fit:
+        from ..tables.errorfit import fit_table
+
+        fits = fit_table(table, fit, weighted=table.std != {})
+        data["fit"] = [f.report() for f in fits.values()]
+    return Identified(data, table, result, axis.strip().upper(), quality, fits)
 
 
 #: what identified errors beyond the size limits likely come from

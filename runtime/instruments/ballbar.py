@@ -555,3 +555,93 @@ def write_csv(path, cols: dict, inputs=()):
     for i in range(n):
         lines.append(",".join(num(cols[k][i], f) for f, k in zip(fmt, names)))
     return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
+
+
+def parse_rotary(text: str) -> dict:
+    """``"B=0,C=0:360"`` (``--rotary``) -> ``{"B": 0.0, "C": (0.0, 360.0)}``: a rotary axis
+    held at DEG, or swept from START to STOP (deg)."""
+    out = {}
+    for item in [t.strip() for t in text.split(",") if t.strip()]:
+        name, sep, value = item.partition("=")
+        require(sep == "=" and name.strip(), f"--rotary expects AXIS=DEG or AXIS=START:STOP, "
+                                             f"got {item!r}")
+        try:
+            parts = [float(v) for v in value.split(":")]
+        except ValueError:
+            raise InputError(f"--rotary {item!r}: not a number") from None
+        require(len(parts) in (1, 2), f"--rotary {item!r}: AXIS=DEG or AXIS=START:STOP")
+        out[name.strip().upper()] = parts[0] if len(parts) == 1 else tuple(parts)
+    return out
+
+
+class SimulatedTrace:
+    """A simulated ballbar file (:func:`simulated_trace`): ``columns`` as :func:`write_csv`
+    writes them (``dr_um`` in um, positions mm / deg); :meth:`summary` what ``volerr ballbar
+    simulate`` prints."""
+
+    def __init__(self, columns: dict, layout: str, plane: str, radius: float):
+        self.columns, self.layout, self.plane, self.radius = columns, layout, plane, radius
+
+    def summary(self, written: str = "(not written)") -> str:
+        """The line ``volerr ballbar simulate`` prints, the file named ``written``."""
+        dr = self.columns["dr_um"]
+        return (f"{self.layout}: ballbar trace {self.plane}, radius {self.radius:g} mm, "
+                f"{len(dr)} readings -> {written} (dr {dr.min():.3f} .. {dr.max():.3f} um)")
+
+    def write_csv(self, path, inputs=()):
+        """The ballbar file ('volerr formats ballbar')."""
+        return write_csv(path, self.columns, inputs=inputs)
+
+
+def simulated_trace(model: Model, functions, plane: str, radius: float, centre,
+                    tool=(0.0, 0.0, 0.0), rotary=None, points: int = 360,
+                    noise_um: float = 0.0, direction: str = "both",
+                    seed: int = 0) -> SimulatedTrace:
+    """A ballbar trace of ``model`` with the error ``functions`` (``volerr ballbar simulate``):
+    :func:`simulate`, its options checked first.
+
+    Parameters
+    ----------
+    model : Model
+        The machine (its first-order observation model).
+    functions : volerr.tables.functions.ErrorFunctions
+        The error functions (mm / rad) the readings see.
+    plane : {"XY", "YZ", "ZX"}
+        Plane of the circle in the workpiece frame.
+    radius : float
+        Bar length, mm, in (0, 1e5].
+    centre, tool : 3-vectors
+        Pivot ball centre (workpiece frame) and tool-side ball offset from the tool point, mm.
+    rotary : dict or str, optional
+        Rotary axes held (deg) or swept (START, STOP), or its ``--rotary`` text
+        (:func:`parse_rotary`); None: none.
+    points : int
+        Readings per direction, 8 .. 10^6.
+    noise_um : float
+        Standard deviation of the Gaussian noise of a reading, um, not negative.
+    direction : {"both", "ccw", "cw"}
+        Counter-clockwise, clockwise or both (CCW first).
+    seed : int
+        Seed of the noise.
+
+    Returns
+    -------
+    SimulatedTrace
+        ``columns`` (``dr_um`` in um: bar longer than nominal positive), ``write_csv``,
+        ``summary()`` the line the command prints.
+
+    Raises
+    ------
+    volerr.InputError
+        An option out of range, with the command's one-line message.
+    """
+    require(noise_um >= 0, "--noise-um must not be negative")
+    require(0 < radius <= 1e5, f"--radius must be a positive length of at most 1e5 mm, "
+                               f"got {radius:g}")
+    require(8 <= points <= 10 ** 6, f"--points must be between 8 and 10^6 readings per "
+                                    f"direction, got {points}")
+    if rotary is None or isinstance(rotary, str):
+        rotary = parse_rotary(rotary or "")
+    cols = simulate(model, functions, plane, radius, centre, tool, rotary, points, noise_um,
+                    direction, seed)
+    return SimulatedTrace(cols, model.name, plane, radius)

@@ -184,6 +184,25 @@ def csv_text(cols: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: options of ``volerr simulate`` that only the deviations campaign uses: (name, default)
+DEVIATION_ONLY = (("probe", None), ("rounds", 1), ("effect", []), ("magnitude_um", 5.0))
+#: options of the instrument files: (name, the instruments that use it)
+INSTRUMENT_ONLY = (("plant", ("sphere", "ballbar")), ("errors", ("sphere", "ballbar")),
+                   ("steps", ("sphere",)), ("radius", ("ballbar",)))
+
+
+def refuse_unused(instrument: str, options: dict) -> None:
+    """Refuse, one line, an option of ``volerr simulate`` (``options``: name -> value, as
+    the command's attributes; None or the default: not given) that the file of
+    ``instrument`` (deviations, sphere, ballbar) does not use: never silently ignored."""
+    for name, default in () if instrument == "deviations" else DEVIATION_ONLY:
+        require(options.get(name) in (default, None),
+                f"--{name.replace('_', '-')} is for --instrument deviations")
+    for name, users in INSTRUMENT_ONLY:
+        require(options.get(name) is None or instrument in users,
+                f"--{name} is for --instrument {' / '.join(users)}")
+
+
 def instrument_file(layout, instrument: str, *, plant: str | None = None, errors=None,
                     steps: int | None = None, radius: float | None = None,
                     noise_um: float = 0.3, seed: int = 0,

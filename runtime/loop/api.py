@@ -40,6 +40,16 @@ class Loop(Report):
                                else None, e["units"][k], 1.0))
         return out
 
+    def written_in(self, folder) -> "Loop":
+        """A new result whose ``augmented_layout`` and ``generated_module`` name the files in
+        ``folder`` (where the command moves them from its staging folder); this one unchanged."""
+        from dataclasses import replace
+        from pathlib import Path
+
+        moved = {k: str(Path(folder) / Path(v).name) for k, v in self.data.items()
+                 if k in ("augmented_layout", "generated_module") and v}
+        return replace(self, data={**self.data, **moved}) if moved else self
+
     def write_predictions(self, path, inputs=()):
         """Not written for measured deviations: the predictions CSV is the drift loop's."""
         require(False, "loop: --predictions-out (write_predictions) is for drift runs "

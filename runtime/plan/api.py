@@ -5,6 +5,9 @@ from __future__ import annotations
 from ..errors import require
 from ._run import Plan, plan as _plan
 
+#: the files a plan (or a check plan) writes into its folder, by suffix
+PLAN_SUFFIXES = (".csv", ".nc", ".html", ".h", ".mpf")
+
 
 def plan(layout, instruments, readings: int, *, parameters: str | None = None,
          minutes: float | None = None, criterion: str = "I", seed: int = 0) -> Plan:
@@ -44,9 +47,36 @@ def plan(layout, instruments, readings: int, *, parameters: str | None = None,
     volerr.InputError
         Bad input, with the command's one-line message.
     """
-    require(1 <= readings <= 10 ** 7, "--readings must be between 1 and 10000000")
-    require(minutes is None or minutes > 0, "--minutes must be positive")
-    require(parameters is None or parameters.strip(),
-            "--parameters: empty; give names, axes or groups")
+    check_options(readings, minutes, parameters)
     specs = [instruments] if isinstance(instruments, str) else list(instruments)
     return _plan(layout, specs, readings, parameters, minutes, criterion, seed)
+
+
+def check_options(readings: int, minutes: float | None = None, parameters: str | None = None,
+                  dialect: str = "iso") -> None:
+    """Refuse options of :func:`plan` out of range, one line (``volerr plan`` checks them
+    before its outputs): ``readings`` outside 1 .. 10^7, ``minutes`` not positive, an empty
+    ``parameters``, an unknown NC ``dialect`` (:data:`volerr.plan._dialect.NAMES`)."""
+    from ._dialect import NAMES
+
+    require(1 <= readings <= 10 ** 7, "--readings must be between 1 and 10000000")
+    require(minutes is None or minutes > 0, "--minutes must be positive")
+    require(dialect in NAMES, f"--dialect {dialect}: not a dialect; give one of "
+                              f"{', '.join(NAMES)}")
+    require(parameters is None or parameters.strip(),
+            "--parameters: empty; give names, axes or groups")
+
+
+def check_plan_folder(folder, force: bool = False, what: str = "plan",
+                 suffixes=PLAN_SUFFIXES) -> None:
+    """Refuse ``folder`` (``--out DIR`` of ``volerr plan`` / ``check plan``) when it is a
+    file, or, without ``force``, when it holds a file a plan writes (``suffixes``) already:
+    the first such file named, one line."""
+    from pathlib import Path
+
+    out = Path(folder)
+    require(not out.exists() or out.is_dir(), f"--out {out}: a file, not a folder")
+    if out.is_dir() and not force:
+        taken = sorted(p.name for p in out.iterdir() if p.suffix in suffixes)
+        require(not taken, f"--out {out}: holds {taken[0] if taken else ''} already; give "
+                           f"--force to replace {what} files there, or another folder")
