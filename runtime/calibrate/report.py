@@ -14,6 +14,7 @@ import numpy as np
 
 from ..plotstyle import embedded_img, figure, label, png, styled, unit
 from ..fit_quality import fit_html
+from ..report.page import document
 from ..units import num
 
 
@@ -224,12 +225,7 @@ def render_html(cal) -> str:
                                  "identified parameters with expanded uncertainty bars"))
     if cal.residuals:
         figs.append(embedded_img(png(residual_figure(cal)), "residuals per file"))
-    return f"""<!DOCTYPE html><html><head><meta charset="utf-8">
-<title>Calibration of {html.escape(d['layout'])}</title>
-<style>body{{font-family:sans-serif;max-width:1200px;margin:1em auto}}table{{border-collapse:
-collapse;margin:0.5em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;
-vertical-align:top;overflow-wrap:anywhere}}</style></head><body>
-<h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
+    return document(f"Calibration of {d['layout']}", f"""<h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
 {fit_html(d)}<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
 variance factor {num(d['variance_factor'], '.3g')} (1 when the residuals match the stated
 reading uncertainties).  Standard uncertainties u (k = 1); the figure's bars ± 2 u (k = 2).</p>
@@ -252,6 +248,4 @@ own set-up unknowns are removed.  Fixed by convention (not parameters):
 {_lab_sections(d)}
 <h2>Set-up estimates</h2>
 <table><tr><th>set-up</th><th>unknown</th><th>value</th><th>u</th><th>unit</th>
-<th>determined</th></tr>{setup}</table>
-</body></html>
-"""
+<th>determined</th></tr>{setup}</table>""")

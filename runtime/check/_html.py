@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import html
 
+from ..report.page import document
+
 
 def _figure(d: dict) -> str:
     """An ``<img>`` (embedded PNG): change / std of every changed parameter, and the
@@ -62,11 +64,7 @@ def check_html(d: dict) -> str:
                   f"</tr>" for i in t["items"]) + f"</table><p>{e(t['rule'])}</p>"
     files = "".join(f"<li>{e(f['file'])} ({e(f['kind'])}, {f['n_readings']} readings, "
                     f"SHA-256 {e(f['sha256'][:16])}...)</li>" for f in d["files"])
-    return f"""<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>volerr check: {e(d['layout'])}</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
-td,th{{padding:2px 8px;text-align:right}}</style></head><body>
-<h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
+    return document(f"volerr check: {d['layout']}", f"""<h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
 {fit_html(d)}<p>Against the reference {e(str(d['reference']['file']))}{' on ' + e(d['date']) if d.get('date') else ''}.
 Volumetric change over the working volume: max {v['max']:.3g} µm, RMS {v['rms']:.3g} µm.
 Residual: Birge ratio {d['misfit']['birge_ratio']:.3g} on {d['misfit']['dof']} degrees of
@@ -74,5 +72,4 @@ freedom{' -- a change none of the reference parameters explains' if d['misfit'][
 <h2>Changed</h2>{table}
 {_figure(d)}
 {'<h2>Cannot be told apart by this check</h2><ul>' + apart + '</ul>' if apart else ''}
-{tol}<h2>Files</h2><ul>{files}</ul><p>{e(d['method'])}</p></body></html>
-"""
+{tol}<h2>Files</h2><ul>{files}</ul><p>{e(d['method'])}</p>""")

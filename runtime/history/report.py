@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..report.page import document
 from ..results import ResultMixin, Row, as_table
 from . import analysis as an
 
@@ -266,11 +267,7 @@ def render_html(h: History) -> str:
                     f"{esc(str(f['interval'][1]))}</td></tr>" for n, f in d["forecast"].items())
     figs = "".join(f"<h3>{esc(n)}</h3>" + embedded_img(png(parameter_figure(h, n)), n)
                    for n in h.series)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>History of {esc(d['machine'])}</title>
-<style>body{{font-family:sans-serif;max-width:1040px;margin:auto}}table{{border-collapse:
-collapse}}td,th{{border:1px solid #bbb;padding:2px 6px}}</style></head><body>
-<h1>History of machine {esc(d['machine'])} ({esc(d['layout'])})</h1>
+    return document(f"History of {d['machine']}", f"""<h1>History of machine {esc(d['machine'])} ({esc(d['layout'])})</h1>
 <p>{len(d['entries'])} entries from {esc(d['entries'][0]['date'])} to
 {esc(d['entries'][-1]['date'])}. {esc(d['method'])}.</p>
 <h2>Events</h2><table><tr><th>date</th><th>parameter</th><th>change</th><th>std (k = 1)</th>
@@ -279,6 +276,4 @@ collapse}}td,th{{border:1px solid #bbb;padding:2px 6px}}</style></head><body>
 <th>unit</th><th>since</th><th>entries</th></tr>{trows}</table>
 <h2>Forecast</h2><table><tr><th>quantity</th><th>tolerance</th><th>leaves it on</th>
 <th>95 % interval</th></tr>{frows}</table>
-<h2>Parameters</h2>{figs}
-</body></html>
-"""
+<h2>Parameters</h2>{figs}""")

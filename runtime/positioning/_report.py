@@ -33,7 +33,8 @@ from ..units import MM_PER_M, UM_PER_MM
 
 from .. import conformance
 from ..certificate import html_table, verdict_html
-from ..plotstyle import TEST_REPORT_CSS, embedded_img, figure, label, png, styled
+from ..report.page import document
+from ..plotstyle import embedded_img, figure, label, png, styled
 from ..units import num
 from ._evaluate import Evaluation
 from ._uncertainty import BudgetInputs, QUANTITIES, budget, decisive_targets, verdicts
@@ -318,13 +319,7 @@ def report_html(report: dict, png: bytes, inputs, generated: str = "", identific
                  f"{e(conformance.RULE)}.</p>" if toleranced else
                  "<p class='verdict'>No tolerance given (<code>--tolerance</code>): no "
                  "verdict.</p>")
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<title>ISO 230-2 positioning test</title>
-<style>
-{TEST_REPORT_CSS}
-</style></head><body>
-<h1>Positioning accuracy and repeatability &mdash; ISO 230-2</h1>
+    return document("ISO 230-2 positioning test", f"""<h1>Positioning accuracy and repeatability &mdash; ISO 230-2</h1>
 <p>Evaluation of laser-interferometer positioning runs by direct measurement of a single axis
 according to {e(STANDARD)}. Deviations are actual minus target position, in &micro;m.
 {e(generated)}</p>
@@ -348,9 +343,7 @@ decide a quantity that fails (red) or is undecided (amber).</p>
 <p class="s">Instrument, alignment and temperature act on A, E and M (ranges over the travel);
 R and B are differences at one target, where they cancel. U = 2 u<sub>c</sub>.</p>
 {tables}
-{'<h2>Notes</h2><ul>' + ''.join(f'<li>{e(n)}</li>' for n in notes) + '</ul>' if notes else ''}
-</body></html>
-"""
+{'<h2>Notes</h2><ul>' + ''.join(f'<li>{e(n)}</li>' for n in notes) + '</ul>' if notes else ''}""")
 
 
 def error_table(ev: Evaluation) -> ErrorTable:

@@ -1,4 +1,7 @@
-"""One page style for every report (HTML): tables whose headers never break a word (they wrap
+"""One page style for every report (HTML): every page is built by :func:`document` (the
+shared head with :data:`STYLE`, the page's own few rules after it, units in words), so the
+calibrate, ballbar, plan, loop (3-D and drift), check, history, ISO 230-2 / 230-3,
+uncertainty, ISO 10360-2, audit pages and the demo's index look alike; tables whose headers never break a word (they wrap
 between words only: ``word-break: keep-all``, no hyphens; ``white-space: nowrap`` on every
 header was tried and made the uncertainty page's result table wider than a 1100 px window,
 clipped), units in
@@ -11,35 +14,127 @@ from __future__ import annotations
 import html
 import re
 
-#: the shared style, added once to a page's <head> (class ``volerr-certificate``)
-CSS = """
-<style>
+#: the one stylesheet of every page (screen and print): words left, numbers right (``th.l``,
+#: ``td.l`` for text), no word broken in a table cell (``word-break: keep-all``, no hyphens,
+#: ``overflow-wrap: normal``: a cell wraps between words only), figures never wider than the
+#: window, a print stylesheet (A4, "page x of y" at the foot of every printed page;
+#: :func:`print_ids` adds the report id at the head and foot); ``volerr-certificate`` marks a
+#: page that carries it
+STYLE = """
 /* volerr-certificate: the shared page style */
-body { font-family: Helvetica, Arial, "DejaVu Sans", sans-serif; }
+body { font-family: Helvetica, Arial, "DejaVu Sans", sans-serif; max-width: 1200px;
+  margin: 1.5em auto; padding: 0 1em; color: #1a1a1a; line-height: 1.4; }
+h1 { font-size: 1.5em; border-bottom: 2px solid #333; padding-bottom: .3em; }
+h2 { font-size: 1.25em; margin-top: 1.5em; } h3 { font-size: 1.05em; }
+table { border-collapse: collapse; margin: .5em 0 1em 0; font-size: .92em; }
+th, td { border: 1px solid #bbb; padding: .2em .6em; text-align: right; vertical-align: top; }
+th { background: #eef1f5; }
+th.l, td.l { text-align: left; }
 table th { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
 table td { word-break: keep-all; hyphens: none; overflow-wrap: normal; }
+img { max-width: 100%; height: auto; }
+figure { margin: 1em 0; } figcaption { color: #444; font-size: .95em; }
+pre { background: #f6f6f6; padding: .6em; white-space: pre-wrap; font-size: .85em; }
+.s { color: #555; font-size: .85em; } .verdict, .headline { font-size: 1.15em; }
 table.ident { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
-table.ident th, table.ident td { text-align: left; padding: 2px 10px 2px 0;
-  vertical-align: top; border-bottom: 1px solid #ddd; }
+table.ident th, table.ident td { text-align: left; padding: 2px 10px 2px 4px;
+  vertical-align: top; border: none; border-bottom: 1px solid #ddd; background: none; }
 table.ident td { white-space: normal; }
 table.budget { border-collapse: collapse; margin: 0.3em 0 0.8em 0; }
-table.budget th, table.budget td { padding: 2px 8px; border-bottom: 1px solid #ddd;
+table.budget th, table.budget td { padding: 2px 8px; border: none; border-bottom: 1px solid #ddd;
   text-align: right; } table.budget td.l { text-align: left; }
 p.warn { color: #b26a00; font-weight: bold; }
-div.report-id { font: 12px sans-serif; color: #555; text-align: right; }
+div.report-id { font-size: 12px; color: #555; text-align: right; }
 @page { size: A4; margin: 16mm 14mm 18mm 14mm;
-  @bottom-right { content: "REPORT_ID  page " counter(page) " of " counter(pages);
-    font: 8pt sans-serif; color: #555; }
-  @top-right { content: "REPORT_ID"; font: 8pt sans-serif; color: #555; } }
-@media print { body { max-width: none; margin: 0; font-size: 10pt; }
+  @bottom-right { content: "page " counter(page) " of " counter(pages);
+    font: 8pt sans-serif; color: #555; } }
+@media print { body { max-width: none; margin: 0; padding: 0; font-size: 10pt; }
   div.report-id { display: none; }
   table.budget, table.ident { page-break-inside: avoid; }
-  h3 { page-break-after: avoid; }
   img { max-width: 100%; page-break-inside: avoid; }
   table { page-break-inside: auto; } tr { page-break-inside: avoid; }
-  h2 { page-break-after: avoid; } }
-</style>
+  h1, h2, h3 { page-break-after: avoid; } }
 """
+#: the shared style as it was named before the one stylesheet (kept for its importers)
+CSS = "<style>" + STYLE + "</style>\n"
+
+
+def print_ids(report_id: str | None) -> str:
+    """The ``<style>`` that prints ``report_id`` at the head and beside "page x of y" at the
+    foot of every printed page (empty without an id)."""
+    if not report_id:
+        return ""
+    rid = re.sub(r"[^A-Za-z0-9 ._:/-]", "", str(report_id))   # a CSS string, no escapes
+    return ("<style>@page { @top-right { content: \"report " + rid + "\"; font: 8pt "
+            "sans-serif; color: #555; } @bottom-right { content: \"report " + rid +
+            "   page \" counter(page) \" of \" counter(pages); font: 8pt sans-serif; "
+            "color: #555; } }</style>\n")
+
+
+def document(title: str, body: str, css: str = "", report_id: str | None = None) -> str:
+    """A whole page: the shared head (:data:`STYLE`, then the page's own rules ``css``, then
+    :func:`print_ids`), the ``title``, and ``body`` (HTML, its units written as µm and µrad:
+    :func:`units_in_words`)."""
+    extra = f"/* the page's own rules */\n{css}\n" if css else ""
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+            f"<title>{html.escape(title)}</title>\n<style>{STYLE}{extra}</style>\n"
+            f"{print_ids(report_id)}</head>\n<body>\n{aligned(units_in_words(body))}\n"
+            "</body></html>\n")
+
+
+def finish(text: str) -> str:
+    """A whole page made elsewhere (a template) finished as :func:`document` finishes its
+    body: units in words and tables aligned, in the ``<body>`` only."""
+    if "<body" not in text:
+        return aligned(units_in_words(text))
+    head, body = text.split("<body", 1)
+    return head + "<body" + aligned(units_in_words(body))
+
+
+#: a cell that reads as a number (or numbers: "4.29, -12.03", "3.08 → 0.52", "23 %", "–")
+_NUMERIC = re.compile(r"^[\s+\-\u2212\u2013\u00b10-9.,eE%\u2192()/*]*$")
+_TABLE = re.compile(r"<table\b.*?</table>", re.S | re.I)
+_ROW = re.compile(r"<tr\b[^>]*>(.*?)</tr>", re.S | re.I)
+_CELL = re.compile(r"<(t[dh])(\s[^>]*)?>(.*?)</\1>", re.S | re.I)
+
+
+def aligned(body: str) -> str:
+    """Every table of ``body`` with words left and numbers right: a column whose data cells
+    all read as numbers stays right-aligned (the style's default), any other column gets
+    ``class="l"`` on its plain cells (header included); a cell with a class or a ``colspan``
+    keeps its own."""
+    return _TABLE.sub(lambda m: _align_table(m.group(0)), body)
+
+
+def _align_table(table: str) -> str:
+    rows = [[(c.group(1).lower(), c.group(2) or "", c.group(3)) for c in _CELL.finditer(r)]
+            for r in _ROW.findall(table)]
+    text_cols = set()
+    for cells in rows:
+        if any("colspan" in a for _, a, _ in cells):
+            continue
+        for i, (tag, _, inner) in enumerate(cells):
+            words = html.unescape(re.sub(r"<[^>]*>", "", inner)).strip()
+            if tag == "td" and words and not _NUMERIC.match(words):
+                text_cols.add(i)
+
+    def row(m):
+        cells = list(_CELL.finditer(m.group(1)))
+        if any("colspan" in (c.group(2) or "") for c in cells):
+            return m.group(0)
+        out, at = [], 0
+        for i, c in enumerate(cells):
+            plain = not (c.group(2) or "").strip()
+            out.append(m.group(1)[at:c.start()])
+            out.append(f"<{c.group(1)} class=\"l\">{c.group(3)}</{c.group(1)}>"
+                       if plain and i in text_cols else c.group(0))
+            at = c.end()
+        out.append(m.group(1)[at:])
+        return m.group(0).replace(m.group(1), "".join(out), 1)
+
+    return _ROW.sub(row, table) if text_cols else table
+
 
 #: the ASCII spellings of units that every page shows as µm and µrad
 _UNITS = [(re.compile(r"(?<![A-Za-z_\-.])um(?=[ )/,.;:<\]]|$)"), "\u00b5m"),
@@ -92,10 +187,9 @@ def stamp_html(text: str, ident, conditions: dict | None = None, budgets=()) -> 
     from ..certificate import html_table
 
     rid = html.escape(ident.report_id or "")
-    css = CSS.replace("REPORT_ID", f"report {rid}" if rid else "")
-    if "volerr-certificate" not in text:
-        text = (text.replace("</head>", css + "</head>", 1) if "</head>" in text
-                else css + text)
+    css = ("" if "volerr-certificate" in text else CSS) + print_ids(ident.report_id)
+    text = (text.replace("</head>", css + "</head>", 1) if "</head>" in text
+            else css + text)
     block = f"<div class='report-id'>report {rid}</div>" if rid else ""
     own = re.search(r"<table class=.ident.>.*?</table>(<p class='warn'>.*?</p>)*", text, re.S)
     if own is None:

@@ -93,16 +93,24 @@ def _shade(ax, t_h, test) -> None:
 
 def render_template(name: str, **context) -> str:
     """The loop's template ``name`` (``volerr/loop/templates``) rendered with ``context``
-    (autoescaped, undefined names refused)."""
+    (autoescaped, undefined names refused), in the one page style of every report
+    (:mod:`volerr.report.page`: ``page_style`` in the head, JSON keys in words through the
+    filter ``words``, units as µm and µrad, words left and numbers right in every table)."""
     from importlib import resources
 
     import jinja2
+
+    from ...report.fmt import unit, words
+    from ...report.page import STYLE, finish
 
     folder = resources.files("volerr.loop") / "templates"
     env = jinja2.Environment(
         loader=jinja2.FunctionLoader(lambda n: (folder / n).read_text(encoding="utf-8")),
         autoescape=True, undefined=jinja2.StrictUndefined)
-    return env.get_template(name).render(**context)
+    env.globals["page_style"] = STYLE
+    env.filters["words"] = words
+    env.filters["unit"] = unit
+    return finish(env.get_template(name).render(**context))
 
 
 def render_html(report) -> str:
