@@ -22,6 +22,8 @@ from ..units import num
 def parameter_figure(params: dict, truth: dict | None = None):
     """Identified values with +-2 u bars (k = 2), one panel per unit; ``truth``: planted
     values drawn beside them (simulated campaigns)."""
+    from matplotlib.ticker import MaxNLocator
+
     units = list(dict.fromkeys(v["unit"] for v in params.values()))
     rows = max(sum(v["unit"] == u for v in params.values()) for u in units)
     fig, axes = figure(1, len(units), width=4.6 * len(units) + 0.4,
@@ -40,6 +42,8 @@ def parameter_figure(params: dict, truth: dict | None = None):
         ax.set_yticklabels(names)
         ax.invert_yaxis()
         ax.set_xlabel(label("value", u))
+        # three panels share the page's 10 in: six ticks of "-0.010" overlapped (seen)
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=4 if len(units) > 2 else 6))
         ax.grid(axis="x", alpha=0.3)
         ax.legend(loc="best")
     return fig

@@ -101,23 +101,25 @@ _CELL = re.compile(r"<(t[dh])(\s[^>]*)?>(.*?)</\1>", re.S | re.I)
 
 def aligned(body: str) -> str:
     """Every table of ``body`` with words left and numbers right: a column whose data cells
-    all read as numbers stays right-aligned (the style's default), any other column gets
-    ``class="l"`` on its plain cells (header included); a cell with a class or a ``colspan``
-    keeps its own."""
+    all read as numbers (one at least) stays right-aligned (the style's default), any other
+    column (words, or empty) gets ``class="l"`` on its plain cells (header included); a cell
+    with a class or a ``colspan`` keeps its own."""
     return _TABLE.sub(lambda m: _align_table(m.group(0)), body)
 
 
 def _align_table(table: str) -> str:
     rows = [[(c.group(1).lower(), c.group(2) or "", c.group(3)) for c in _CELL.finditer(r)]
             for r in _ROW.findall(table)]
-    text_cols = set()
+    text_cols, numbers = set(), set()
     for cells in rows:
         if any("colspan" in a for _, a, _ in cells):
             continue
         for i, (tag, _, inner) in enumerate(cells):
             words = html.unescape(re.sub(r"<[^>]*>", "", inner)).strip()
-            if tag == "td" and words and not _NUMERIC.match(words):
-                text_cols.add(i)
+            if tag == "td" and words:
+                (numbers if _NUMERIC.match(words) else text_cols).add(i)
+    width = max((len(c) for c in rows), default=0)
+    text_cols |= set(range(width)) - numbers
 
     def row(m):
         cells = list(_CELL.finditer(m.group(1)))

@@ -143,11 +143,25 @@ def _layout(pdf, rows: list, header: bool) -> tuple:
     return size, widths, height
 
 
-def table(pdf, rows: list, header: bool = True, align: str = "LEFT", heading: str = "") -> None:
+def _aligns(rows: list, header: bool) -> tuple:
+    """Per column: "RIGHT" when every data cell reads as a number (as on the HTML pages,
+    :func:`volerr.report.page.aligned`), else "LEFT"."""
+    from .page import _NUMERIC
+
+    n = max(len(r) for r in rows)
+    data = rows[1:] if header else rows
+    return tuple("RIGHT" if any(len(r) > i and r[i].strip() for r in data) and all(
+        len(r) <= i or _NUMERIC.match(r[i]) for r in data) else "LEFT" for i in range(n))
+
+
+def table(pdf, rows: list, header: bool = True, align: str | None = None,
+          heading: str = "") -> None:
     """``rows`` (first the header when ``header``) as a table that breaks no word, under
-    ``heading``; a table of at most :data:`KEEP_TOGETHER_MM` starts on a new page rather
+    ``heading``; words left and numbers right (``align`` one alignment for every column
+    instead); a table of at most :data:`KEEP_TOGETHER_MM` starts on a new page rather
     than break (a longer one breaks, its header repeated)."""
     rows = [[str(c) for c in r] for r in rows]
+    align = align or _aligns(rows, header)
     size, widths, height = _layout(pdf, rows, header)
     if pdf.get_y() + min(height, KEEP_TOGETHER_MM) + (9 if heading else 0) > PAGE_BOTTOM_MM:
         pdf.add_page()
