@@ -49,7 +49,7 @@ def check_html(d: dict) -> str:
         f"<td>{e(', '.join(c.get('indistinguishable_from', [])))}</td>"
         f"<td>{e(_alternatives(c))}</td></tr>"
         for c in d["changed"])
-    table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>std (k = 1)"
+    table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>u (k = 1)"
              f"</th><th>unit</th><th>indistinguishable from</th>"
              f"<th>or (not told apart by this check)</th></tr>{rows}</table>"
              if rows else "<p>No parameter changed.</p>")

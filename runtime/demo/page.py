@@ -50,9 +50,9 @@ def index_html(out: Path, results: list) -> None:
            "margin-top:2em}img{border:1px solid #eee}.file{color:#777;font-size:.9em}"
            ".result{background:#f5f7fa;padding:.6em .9em;border-left:4px solid #4a7}"
            ".files a{margin-right:.8em}")
-    html = document("volerr demo", "<h1>volerr demo</h1><p>Every step below ran a real <code>volerr</code> command "
-            "on built-in data; units µm and µrad unless stated.  Click a figure for full "
-            "size; the files next to this page hold every number.  Report pages: "
-            f"{page_list}.</p>"
-            f"<ol>{''.join(toc)}</ol>{''.join(parts)}", css=css)
+    html = document("volerr demo", "<h1>volerr demo</h1><p>Every step below ran a real "
+                    "<code>volerr</code> command on built-in data; units µm and µrad unless "
+                    "stated.  Click a figure for full size; the files next to this page hold "
+                    f"every number.  Report pages: {page_list}.</p>"
+                    f"<ol>{''.join(toc)}</ol>{''.join(parts)}", css=css)
     write_text(out / "index.html", html)

@@ -270,9 +270,9 @@ def render_html(h: History) -> str:
     return document(f"History of {d['machine']}", f"""<h1>History of machine {esc(d['machine'])} ({esc(d['layout'])})</h1>
 <p>{len(d['entries'])} entries from {esc(d['entries'][0]['date'])} to
 {esc(d['entries'][-1]['date'])}. {esc(d['method'])}.</p>
-<h2>Events</h2><table><tr><th>date</th><th>parameter</th><th>change</th><th>std (k = 1)</th>
+<h2>Events</h2><table><tr><th>date</th><th>parameter</th><th>change</th><th>u (k = 1)</th>
 <th>unit</th></tr>{rows}</table>
-<h2>Trends</h2><table><tr><th>parameter</th><th>slope per 30 days</th><th>std (k = 1)</th>
+<h2>Trends</h2><table><tr><th>parameter</th><th>slope per 30 days</th><th>u (k = 1)</th>
 <th>unit</th><th>since</th><th>entries</th></tr>{trows}</table>
 <h2>Forecast</h2><table><tr><th>quantity</th><th>tolerance</th><th>leaves it on</th>
 <th>95 % interval</th></tr>{frows}</table>

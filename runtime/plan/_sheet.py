@@ -132,8 +132,8 @@ FILES</code> (no options).</p>
 <h2>Set-ups, in order</h2><table><tr><th class=l>file</th><th class=l>NC program</th>
 <th class=l>set-up</th><th class=l>what goes where</th><th>readings</th></tr>{''.join(rows)}
 </table>{img}
-<h2>Predicted result</h2><table><tr><th class=l>parameter</th><th>predicted std</th>
-<th class=l>unit</th><th class=l>determined alone by</th><th>baseline std</th></tr>{params}
+<h2>Predicted result</h2><table><tr><th class=l>parameter</th>
+<th>predicted u (k = 1)</th><th class=l>unit</th><th class=l>determined alone by</th><th>u of the conventional plan</th></tr>{params}
 </table><p>Map of the volumetric error over the working volume: predicted standard uncertainty
 RMS {m['rms']:.3g} µm, max {m['max']:.3g} µm (k = 1); {_baseline_text(d, b)}.</p>
 {'<h2>Not determined by this plan</h2><ul>' + why + '</ul>' if why else ''}""")

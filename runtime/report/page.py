@@ -1,12 +1,13 @@
 """One page style for every report (HTML): every page is built by :func:`document` (the
-shared head with :data:`STYLE`, the page's own few rules after it, units in words), so the
-calibrate, ballbar, plan, loop (3-D and drift), check, history, ISO 230-2 / 230-3,
-uncertainty, ISO 10360-2, audit pages and the demo's index look alike; tables whose headers never break a word (they wrap
-between words only: ``word-break: keep-all``, no hyphens; ``white-space: nowrap`` on every
-header was tried and made the uncertainty page's result table wider than a 1100 px window,
-clipped), units in
-µm and µrad, a print stylesheet (A4, the report id and "page x of y" on every printed page),
-and the identification block put on a command's page that does not carry it itself
+shared head with :data:`STYLE`, the page's own few rules after it, units in words, tables
+aligned), so the calibrate, ballbar, plan, loop (3-D and drift), check, history, ISO 230-2 /
+230-3, uncertainty, ISO 10360-2, audit pages and the demo's index look alike: tables whose
+cells never break a word (they wrap between words only: ``word-break: keep-all``, no
+hyphens; ``white-space: nowrap`` on every header was tried and made the uncertainty page's
+result table wider than a 1100 px window, clipped), words left and numbers right
+(:func:`aligned`), units in µm and µrad (:func:`units_in_words`), a print stylesheet (A4,
+the report id and "page x of y" on every printed page: :func:`print_ids`), and the
+identification block put on a command's page that does not carry it itself
 (:func:`stamp_html`)."""
 
 from __future__ import annotations
