@@ -105,7 +105,17 @@ def aligned(body: str) -> str:
     all read as numbers (one at least) stays right-aligned (the style's default), any other
     column (words, or empty) gets ``class="l"`` on its plain cells (header included); a cell
     with a class or a ``colspan`` keeps its own."""
-    return _TABLE.sub(lambda m: _align_table(m.group(0)), body)
+    return _TABLE.sub(lambda m: _align_table(_HEADER.sub(_keep_k, m.group(0))), body)
+
+
+#: a table header, and a coverage factor in it ("k = 2"), kept on one line ("U (k" over
+#: "= 2)" was seen in the uncertainty page's headers at 800 px)
+_HEADER = re.compile(r"(<th\b[^>]*>)(.*?)(</th>)", re.S | re.I)
+_K = re.compile(r"\bk = (\d)")
+
+
+def _keep_k(m) -> str:
+    return m.group(1) + _K.sub("k&nbsp;=&nbsp;\\1", m.group(2)) + m.group(3)
 
 
 def _align_table(table: str) -> str:

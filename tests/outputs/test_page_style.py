@@ -150,3 +150,8 @@ def test_every_pdf_page_is_numbered_with_the_report_id_and_no_word_is_split():
         assert f"page {i} of {n}" in text and "VE-0123456789ab" in text
         for w in LONG_WORDS:
             assert w in text, (i, w)
+
+
+def test_a_coverage_factor_in_a_header_stays_on_one_line():
+    out = page.aligned("<table><tr><th>U (k = 2) / um</th></tr><tr><td>1.5</td></tr></table>")
+    assert "U (k&nbsp;=&nbsp;2) / um" in out
