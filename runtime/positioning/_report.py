@@ -156,7 +156,8 @@ def plot_runs(evaluations, path=None, verdicts_per_run=None) -> bytes:
                      f"{num(f['E_um'], '.2f')}, M {num(f['M_um'], '.2f')}, R "
                      f"{num(f['R_um'], '.2f')}, B {num(f['B_um'], '.2f')} (mean "
                      f"{num(f['B_avg_um'], '+.2f')}) \u00b5m")
-        ax.legend(loc="upper left", ncol=1)
+        # below the panel: inside it hid the forward band at 200-300 mm (seen on the page)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=9)
     data = png(fig)
     if path is not None:
         from ..fileio import write_bytes
