@@ -22,7 +22,8 @@ from ._summary import CATEGORIES, category_counts
 _COLOURS = {"identical": "#2e7d32", "printing_error": "#c62828", "extraction": "#6a1b9a",
             "convention": "#1565c0", "simplification": "#00838f", "undecidable": "#ef6c00"}
 _MAX_MATH = 3000          # characters: longer expressions are shown as text
-_ONE_LINE = 90            # characters: longer sums are rendered term by term (they wrap)
+_ONE_LINE = 40            # characters: longer sums are rendered term by term (they wrap;
+#                           at 90 an 80-character sum overflowed its 20 % column, seen)
 _PLAIN = re.compile(r"^[\w\s\(\)\*\+\-/\.\^,]+$")
 
 
