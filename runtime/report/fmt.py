@@ -39,6 +39,7 @@ LABELS = {
     "indistinguishable_from": "indistinguishable on the screening subset from",
     "same_cause_as": "same cause (parameter and covariate) as",
     "replaces": "replaces",
+    "tau": "time constant",
     "contribution_rms_um": "contribution of the effect, RMS / \u00b5m",
     "contribution_max_um": "contribution of the effect, largest / \u00b5m",
 }

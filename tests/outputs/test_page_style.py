@@ -155,3 +155,12 @@ def test_every_pdf_page_is_numbered_with_the_report_id_and_no_word_is_split():
 def test_a_coverage_factor_in_a_header_stays_on_one_line():
     out = page.aligned("<table><tr><th>U (k = 2) / um</th></tr><tr><td>1.5</td></tr></table>")
     assert "U (k&nbsp;=&nbsp;2) / um" in out
+
+
+def test_certificate_rows_name_json_keys_in_words_and_keep_parameter_names():
+    from volerr.report.content import row_name
+
+    assert row_name("x1:mae_before") == "x1: MAE before"
+    assert row_name("KH_EXZ_S_rpm_0:tau") == "KH_EXZ_S_rpm_0: time constant"
+    for kept in ("EXX@slope", "KT_EXZ_T_spindle_0", "X:A", "EY0B + EY0C"):
+        assert row_name(kept) == kept

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...plotstyle import embedded_img, figure, png, styled
+from ...plotstyle import label as axis_label
 from ...selection.rules import SIG_K
 from . import basis
 
@@ -40,18 +41,19 @@ def _draw(report, label: str):
                            label=f"{100 * iv['level']:.0f} % prediction interval{cov}")
     if c.get("verdict"):
         ax[0].set_title(c["verdict"], fontsize="small")
-    ax[0].set_ylabel(f"{label} / um")
-    ax[0].legend(fontsize="small", ncol=2)
+    ax[0].set_ylabel(axis_label(label, "um"))
+    # beside the panels: inside, the legend lay over the measured curve (seen on the page)
+    ax[0].legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax[1].plot(t_h[i], (y - p["after"])[i], lw=0.6, label="residual after")
     ax[1].plot(t_h[i], (y - p["static"])[i], lw=0.6, alpha=0.6, label="residual static")
-    ax[1].set_ylabel("residual / um")
-    ax[1].legend(fontsize="small")
+    ax[1].set_ylabel(axis_label("residual", "um"))
+    ax[1].legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     chosen = sorted({t["source"] for t in p["terms"] if t["source"] != "heat"}
                     | {t["minus"] for t in p["terms"] if t.get("minus")})
     for k in chosen:
         v = s.inputs[k]
         ax[2].plot(t_h[i], v[i], lw=0.7, label=k)
-    ax[2].set_ylabel("temperature / degC")
+    ax[2].set_ylabel(axis_label("temperature", "degC"))
     if basis.SPEED in s.inputs:
         tw = ax[2].twinx()
         tw.plot(t_h[i], s.inputs[basis.SPEED][i], color="0.5", lw=0.7, label="S_rpm")
