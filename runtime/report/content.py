@@ -52,12 +52,14 @@ def result_rows(rows) -> list:
 def row_name(name: str) -> str:
     """A result row's name as printed: a JSON key after the last colon in words
     (``"x1:mae_before"`` -> ``"x1: MAE before"``, ``"KT_EZZ:tau"`` -> ``"KT_EZZ: time
-    constant"``); a parameter's own name (``EXX@slope``, ``KT_EXZ_T_spindle_0``) kept."""
+    constant"``, ``"max_abs_dx"`` -> ``"largest |dx|"``); a parameter's own name
+    (``EXX@slope``, ``KT_EXZ_T_spindle_0``, ``tool_dz``... in upper case or after no colon
+    without an underscore) kept."""
     from .fmt import words
 
     head, sep, key = str(name).rpartition(":")
-    if sep and re.fullmatch(r"[a-z][a-z0-9_]*", key):
-        return f"{head}: {words(key)}"
+    if re.fullmatch(r"[a-z][a-z0-9]*_[a-z0-9_]*", key) or (sep and re.fullmatch(r"[a-z]\w*", key)):
+        return f"{head}{sep} {words(key)}".strip()
     return str(name)
 
 

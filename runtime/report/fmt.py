@@ -40,12 +40,17 @@ LABELS = {
     "same_cause_as": "same cause (parameter and covariate) as",
     "replaces": "replaces",
     "tau": "time constant",
+    "max_length": "largest length of the volumetric error",
+    "rms_length": "RMS length of the volumetric error",
+    "r_eff": "effective stylus radius r_eff",
+    **{f"max_abs_d{a}": f"largest |d{a}|" for a in "xyz"},
+    **{f"random_max_{a}": f"random component, largest in {a} (k = 1)" for a in "xyz"},
     "contribution_rms_um": "contribution of the effect, RMS / \u00b5m",
     "contribution_max_um": "contribution of the effect, largest / \u00b5m",
 }
 
 #: abbreviations of key words spelt out, and the units a key may end in
-_WORDS = {"cv": "cross-validated", "rms": "RMS", "bic": "BIC", "std": "standard uncertainty",
+_WORDS = {"cv": "cross-validated", "rms": "RMS", "abs": "absolute", "bic": "BIC", "std": "standard uncertainty",
           "mae": "MAE", "n": "number of", "max": "largest", "min": "smallest"}
 _UNIT_WORDS = {"um": "\u00b5m", "urad": "\u00b5rad", "mm": "mm", "s": "s", "deg": "\u00b0",
                "h": "h", "K": "K", "C": "\u00b0C", "ppm": "ppm"}

@@ -162,5 +162,7 @@ def test_certificate_rows_name_json_keys_in_words_and_keep_parameter_names():
 
     assert row_name("x1:mae_before") == "x1: MAE before"
     assert row_name("KH_EXZ_S_rpm_0:tau") == "KH_EXZ_S_rpm_0: time constant"
+    assert row_name("max_abs_dx") == "largest |dx|"            # volerr map's rows
+    assert "_" not in row_name("rms_length") and "_" not in row_name("random_max_z")
     for kept in ("EXX@slope", "KT_EXZ_T_spindle_0", "X:A", "EY0B + EY0C"):
         assert row_name(kept) == kept
