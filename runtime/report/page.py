@@ -43,7 +43,7 @@ table.ident th, table.ident td { text-align: left; padding: 2px 10px 2px 4px;
 table.ident td { white-space: normal; }
 table.budget { border-collapse: collapse; margin: 0.3em 0 0.8em 0; }
 table.budget th, table.budget td { padding: 2px 8px; border: none; border-bottom: 1px solid #ddd;
-  text-align: right; } table.budget td.l { text-align: left; }
+  text-align: right; } table.budget td.l, table.budget th.l { text-align: left; }
 p.warn { color: #b26a00; font-weight: bold; }
 div.report-id { font-size: 12px; color: #555; text-align: right; }
 @page { size: A4; margin: 16mm 14mm 18mm 14mm;
@@ -54,7 +54,8 @@ div.report-id { font-size: 12px; color: #555; text-align: right; }
   table.budget, table.ident { page-break-inside: avoid; }
   img { max-width: 100%; page-break-inside: avoid; }
   table { page-break-inside: auto; } tr { page-break-inside: avoid; }
-  h1, h2, h3 { page-break-after: avoid; } }
+  tr:first-child, tr:nth-child(2) { break-after: avoid; }
+  h1, h2, h3 { page-break-after: avoid; break-after: avoid; } }
 """
 #: the shared style as it was named before the one stylesheet (kept for its importers)
 CSS = "<style>" + STYLE + "</style>\n"
@@ -184,7 +185,8 @@ def budgets_html(budgets: list) -> str:
     out = []
     for b in budgets:
         rows = budget_rows(b)
-        head = "".join(f"<th>{e(c)}</th>" for c in rows[0])
+        head = "".join(f"<th class='l'>{e(c)}</th>" if i == 0 else f"<th>{e(c)}</th>"
+                       for i, c in enumerate(rows[0]))
         body = "".join("<tr>" + "".join(f"<td class='l'>{e(c)}</td>" if i == 0 else
                                         f"<td>{e(c)}</td>" for i, c in enumerate(r))
                        + "</tr>" for r in rows[1:])
