@@ -157,15 +157,23 @@ _UNITS = [(re.compile(r"(?<![A-Za-z_\-.])um(?=[ )/,.;:<\]]|$)"), "\u00b5m"),
 
 def units_in_words(text: str) -> str:
     """``um`` -> ``µm``, ``urad`` -> ``µrad`` in visible text (never inside a tag or a name
-    such as ``A_um``)."""
+    such as ``A_um``, nor what a user types: ``<code>`` and a command line with its
+    options, ``volerr check ... --tolerance EX0C=30 um``, stay as written)."""
     parts = re.split(r"(<[^>]*>)", text)
-    out = []
+    out, code = [], 0
     for i, part in enumerate(parts):
-        if i % 2 == 0 and part:
+        if i % 2:
+            tag = re.match(r"<(/?)code\b", part, re.I)
+            code += (-1 if tag.group(1) else 1) if tag else 0
+        elif part and code <= 0 and not _COMMAND.search(part):
             for pattern, unit in _UNITS:
                 part = pattern.sub(unit, part)
         out.append(part)
     return "".join(out)
+
+
+#: a command line in a page's text (the identification's method): its options as typed
+_COMMAND = re.compile(r"\bvolerr [a-z0-9-]+ .*--[a-z]")
 
 
 def conditions_table(cond: dict) -> str:

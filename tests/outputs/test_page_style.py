@@ -166,3 +166,14 @@ def test_certificate_rows_name_json_keys_in_words_and_keep_parameter_names():
     assert "_" not in row_name("rms_length") and "_" not in row_name("random_max_z")
     for kept in ("EXX@slope", "KT_EXZ_T_spindle_0", "X:A", "EY0B + EY0C"):
         assert row_name(kept) == kept
+
+
+def test_what_a_user_types_keeps_its_units_as_typed():
+    """A command line (the identification's method) and <code> are not rewritten: a user
+    copying "--tolerance EX0C=30 um" must get what volerr reads."""
+    text = page.document("t", "<table><tr><td>volerr check (volerr 0.1.0) --tolerance "
+                              "EX0C=30 um DMU50</td></tr></table><p>give <code>--detect-um "
+                              "5 um</code>; changed by 5 um</p>")
+    seen = _visible(text)
+    assert "--tolerance EX0C=30 um DMU50" in seen and "--detect-um 5 um" in seen
+    assert "changed by 5 \u00b5m" in seen
