@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import re
 
-from .fmt import number, unit  # noqa: F401  (the page's numbers and units)
+from .fmt import number, unit, value_for  # noqa: F401  (the page's numbers and units)
 
 #: the coverage factor of the expanded uncertainties on a certificate (about 95 % for a
 #: normal distribution, ISO/TR 230-9 and the GUM's usual choice)
@@ -44,8 +44,8 @@ def result_rows(rows) -> list:
     for r in rows:
         k = K_CERTIFICATE
         U = None if r.std is None else k * float(r.std)
-        out.append([row_name(r.name), number(r.value), number(r.std, 3), f"{k:g}",
-                    number(U, 3), unit(r.unit)])
+        out.append([row_name(r.name), value_for(r.value, r.std), number(r.std, 3),
+                    f"{k:g}", number(U, 3), unit(r.unit)])
     return out
 
 

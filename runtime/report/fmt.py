@@ -24,6 +24,25 @@ def number(v, digits: int = 4) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
+def value_for(v, u, digits: int = 4) -> str:
+    """A value beside its standard uncertainty ``u`` (same unit): :func:`number`, with more
+    decimals where those would hide what ``u`` resolves (down to u's second significant
+    digit): 399.999965 mm with u = 0.0013 mm reads "400.0000", not "400" (seen on the
+    uncertainty certificate)."""
+    import math
+
+    text = number(v, digits)
+    try:
+        x, s = float(v), float(u)
+    except (TypeError, ValueError):
+        return text
+    if "e" in text or not (math.isfinite(x) and math.isfinite(s) and s > 0):
+        return text
+    need = max(0, 1 - math.floor(math.log10(s)))
+    have = len(text.partition(".")[2])
+    return f"{x:.{need}f}" if need > have else text
+
+
 #: the labels of the JSON keys a page shows by name (the loop's evidence ...): words, the
 #: unit after a slash; a key not listed is spelt out by :func:`words`
 LABELS = {

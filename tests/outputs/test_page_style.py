@@ -177,3 +177,16 @@ def test_what_a_user_types_keeps_its_units_as_typed():
     seen = _visible(text)
     assert "--tolerance EX0C=30 um DMU50" in seen and "--detect-um 5 um" in seen
     assert "changed by 5 \u00b5m" in seen
+
+
+def test_a_certificate_value_shows_what_its_uncertainty_resolves():
+    """399.999965 mm with u = 0.00133 mm: 4 significant digits ("400") would hide the
+    -0.035 um the Monte Carlo found; the value is printed to u's second significant digit
+    (0.0001 mm), and never with fewer digits than before."""
+    from volerr.report.content import result_rows
+    from volerr.results import Row
+
+    rows = result_rows([Row("distance", 399.999965, 0.00133, "mm"),
+                        Row("A", 9.4123, 0.58, "um"), Row("r", 5.0, None, "mm")])
+    assert rows[1][1] == "400.0000" and rows[2][1] == "9.412" and rows[3][1] == "5"
+    assert rows[2][5] == "\u00b5m"
