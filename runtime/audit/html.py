@@ -165,12 +165,13 @@ def render_html(entries: list[dict], title: str = "volerr audit") -> str:
                          "<th>derived</th><th>evidence and readings</th></tr>"
                          + "".join(_row(e) for e in rows) + "</table>")
     # the shared page style (volerr.report.page), then the audit's own: fixed columns; an
-    # expression (MathML, code) may wrap anywhere, never a word of the text
+    # expression (MathML, code) may wrap anywhere; a word of the text only when it is wider
+    # than its whole fixed column (break-word; else it would run over the next column)
     style = ("body{max-width:1360px}"
              "table{width:100%;table-layout:fixed}"
              "col.c1{width:9%}col.c2{width:10%}col.c3{width:20%}col.c4{width:20%}"
              "col.c5{width:41%}"
-             "td,th{padding:4px;font-size:90%}"
+             "td,th{padding:4px;font-size:90%}td{overflow-wrap:break-word}"
              "math{max-width:100%;overflow-wrap:anywhere}"
              "math[display=block]{overflow-wrap:anywhere}"
              ".mwrap{white-space:normal;line-height:1.9}.mwrap math{display:inline}"
