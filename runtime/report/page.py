@@ -44,7 +44,7 @@ table.ident td { white-space: normal; }
 table.budget { border-collapse: collapse; margin: 0.3em 0 0.8em 0; }
 table.budget th, table.budget td { padding: 2px 8px; border: none; border-bottom: 1px solid #ddd;
   text-align: right; } table.budget td.l, table.budget th.l { text-align: left; }
-p.warn { color: #b26a00; font-weight: bold; }
+p.warn { color: #b26a00; font-weight: bold; } span.nw { white-space: nowrap; }
 div.report-id { font-size: 12px; color: #555; text-align: right; }
 @page { size: A4; margin: 16mm 14mm 18mm 14mm;
   @bottom-right { content: "page " counter(page) " of " counter(pages);
@@ -109,14 +109,20 @@ def aligned(body: str) -> str:
     return _TABLE.sub(lambda m: _align_table(_HEADER.sub(_keep_k, m.group(0))), body)
 
 
-#: a table header, and a coverage factor in it ("k = 2"), kept on one line ("U (k" over
-#: "= 2)" was seen in the uncertainty page's headers at 800 px)
+#: a table header, and in it what stays on one line: a coverage factor ("U (k" over "= 2)"
+#: was seen in the uncertainty page's headers at 800 px) and a hyphenated word ("set-" over
+#: "up" in the plan sheet's)
 _HEADER = re.compile(r"(<th\b[^>]*>)(.*?)(</th>)", re.S | re.I)
 _K = re.compile(r"\bk = (\d)")
+_HYPHENATED = re.compile(r"\b\w+(?:-\w+)+\b")
 
 
 def _keep_k(m) -> str:
-    return m.group(1) + _K.sub("k&nbsp;=&nbsp;\\1", m.group(2)) + m.group(3)
+    parts = re.split(r"(<[^>]*>)", m.group(2))
+    for i in range(0, len(parts), 2):
+        parts[i] = _HYPHENATED.sub(lambda w: f'<span class="nw">{w.group(0)}</span>',
+                                   _K.sub("k&nbsp;=&nbsp;\\1", parts[i]))
+    return m.group(1) + "".join(parts) + m.group(3)
 
 
 def _align_table(table: str) -> str:

@@ -152,9 +152,12 @@ def test_every_pdf_page_is_numbered_with_the_report_id_and_no_word_is_split():
             assert w in text, (i, w)
 
 
-def test_a_coverage_factor_in_a_header_stays_on_one_line():
-    out = page.aligned("<table><tr><th>U (k = 2) / um</th></tr><tr><td>1.5</td></tr></table>")
+def test_a_coverage_factor_and_a_hyphenated_word_in_a_header_stay_on_one_line():
+    out = page.aligned("<table><tr><th>U (k = 2) / um</th><th>set-up</th></tr>"
+                       "<tr><td>1.5</td><td>S3</td></tr></table>")
     assert "U (k&nbsp;=&nbsp;2) / um" in out
+    assert '<span class="nw">set-up</span>' in out and "span.nw { white-space: nowrap; }" \
+        in page.STYLE
 
 
 def test_certificate_rows_name_json_keys_in_words_and_keep_parameter_names():
