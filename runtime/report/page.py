@@ -106,7 +106,23 @@ def aligned(body: str) -> str:
     all read as numbers (one at least) stays right-aligned (the style's default), any other
     column (words, or empty) gets ``class="l"`` on its plain cells (header included); a cell
     with a class or a ``colspan`` keeps its own."""
-    return _TABLE.sub(lambda m: _align_table(_HEADER.sub(_keep_k, m.group(0))), body)
+    return _TABLE.sub(lambda m: _align_table(_DATA.sub(_joints, _HEADER.sub(
+        _keep_k, m.group(0)))), body)
+
+
+#: a data cell, and a long name in it (``setup:sphere_DMU50.csv#2.centre_dz``): it may wrap
+#: after its ":" and "#" joints, never inside a word (at 800 px such names made the
+#: calibrate page's table wider than the window)
+_DATA = re.compile(r"(<td\b[^>]*>)(.*?)(</td>)", re.S | re.I)
+_LONG_NAME = re.compile(r"[^\s<>]{24,}")
+_JOINT = re.compile(r"(?<!&)([:#])(?=\w)")   # not the "#" of an entity (&#8593;)
+
+
+def _joints(m) -> str:
+    parts = re.split(r"(<[^>]*>)", m.group(2))
+    for i in range(0, len(parts), 2):
+        parts[i] = _LONG_NAME.sub(lambda w: _JOINT.sub(r"\1<wbr>", w.group(0)), parts[i])
+    return m.group(1) + "".join(parts) + m.group(3)
 
 
 #: a table header, and in it what stays on one line: a coverage factor ("U (k" over "= 2)"

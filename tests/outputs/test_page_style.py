@@ -193,3 +193,11 @@ def test_a_certificate_value_shows_what_its_uncertainty_resolves():
                         Row("A", 9.4123, 0.58, "um"), Row("r", 5.0, None, "mm")])
     assert rows[1][1] == "400.0000" and rows[2][1] == "9.412" and rows[3][1] == "5"
     assert rows[2][5] == "\u00b5m"
+
+
+def test_a_long_name_in_a_cell_may_wrap_at_its_joints_only():
+    out = page.aligned("<table><tr><td>EY0C, setup:sphere_example_DMU50.csv#2.centre_dz, "
+                       "a:b &#8593;</td></tr></table>")
+    assert "setup:<wbr>sphere_example_DMU50.csv#<wbr>2.centre_dz," in out
+    assert "a:b &#8593;" in out                     # short names and entities untouched
+    assert re.sub(r"<wbr>", "", out).count("sphere_example_DMU50.csv#2.centre_dz") == 1
