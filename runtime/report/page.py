@@ -55,6 +55,7 @@ div.report-id { font-size: 12px; color: #555; text-align: right; }
   img { max-width: 100%; page-break-inside: avoid; }
   table { page-break-inside: auto; } tr { page-break-inside: avoid; }
   tr:first-child, tr:nth-child(2) { break-after: avoid; }
+  tr:last-child { break-before: avoid; }
   h1, h2, h3 { page-break-after: avoid; break-after: avoid; } }
 """
 #: the shared style as it was named before the one stylesheet (kept for its importers)
@@ -115,13 +116,17 @@ def aligned(body: str) -> str:
 #: calibrate page's table wider than the window)
 _DATA = re.compile(r"(<td\b[^>]*>)(.*?)(</td>)", re.S | re.I)
 _LONG_NAME = re.compile(r"[^\s<>]{24,}")
+#: a number with an exponent, kept on one line ("6.16e-" over "15" was seen, printed)
+_EXPONENT = re.compile(r"(?<![\w.])[-+\u2212]?\d+(?:\.\d+)?e[-+]\d+\b")
 _JOINT = re.compile(r"(?<!&)([:#])(?=\w)")   # not the "#" of an entity (&#8593;)
 
 
 def _joints(m) -> str:
     parts = re.split(r"(<[^>]*>)", m.group(2))
     for i in range(0, len(parts), 2):
-        parts[i] = _LONG_NAME.sub(lambda w: _JOINT.sub(r"\1<wbr>", w.group(0)), parts[i])
+        parts[i] = _EXPONENT.sub(lambda w: f'<span class="nw">{w.group(0)}</span>',
+                                 _LONG_NAME.sub(lambda w: _JOINT.sub(r"\1<wbr>", w.group(0)),
+                                                parts[i]))
     return m.group(1) + "".join(parts) + m.group(3)
 
 
@@ -222,7 +227,7 @@ def budgets_html(budgets: list) -> str:
                        + "</tr>" for r in rows[1:])
         out.append(f"<h3>Uncertainty budget: {e(b['quantity'])}</h3>"
                    f"<table class='budget'><tr>{head}</tr>{body}</table>")
-    return "".join(out)
+    return aligned("".join(out))
 
 
 def stamp_html(text: str, ident, conditions: dict | None = None, budgets=()) -> str:

@@ -201,3 +201,12 @@ def test_a_long_name_in_a_cell_may_wrap_at_its_joints_only():
     assert "setup:<wbr>sphere_example_DMU50.csv#<wbr>2.centre_dz," in out
     assert "a:b &#8593;" in out                     # short names and entities untouched
     assert re.sub(r"<wbr>", "", out).count("sphere_example_DMU50.csv#2.centre_dz") == 1
+
+
+def test_a_number_with_an_exponent_is_kept_on_one_line():
+    out = page.aligned("<table><tr><th>u</th></tr><tr><td>6.16e-15</td></tr></table>")
+    assert '<span class="nw">6.16e-15</span>' in out
+    budget = {"quantity": "EC0Y", "unit": "urad", "u": 0.5, "k": 2.0, "U": 1.0,
+              "sources": [{"source": "readings", "u": 6.16e-15, "unit": "urad",
+                           "sensitivity": 1.0, "contribution": 6.16e-15}]}
+    assert '<span class="nw">6.16e-15</span>' in page.budgets_html([budget])
