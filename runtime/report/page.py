@@ -116,8 +116,9 @@ def aligned(body: str) -> str:
 #: calibrate page's table wider than the window)
 _DATA = re.compile(r"(<td\b[^>]*>)(.*?)(</td>)", re.S | re.I)
 _LONG_NAME = re.compile(r"[^\s<>]{24,}")
-#: a number with an exponent, kept on one line ("6.16e-" over "15" was seen, printed)
-_EXPONENT = re.compile(r"(?<![\w.])[-+\u2212]?\d+(?:\.\d+)?e[-+]\d+\b")
+#: kept on one line: a number with an exponent ("6.16e-" over "15" was seen, printed) and
+#: a command's option ("--" over "artefact-u" in the method line of the ISO 10360-2 page)
+_EXPONENT = re.compile(r"(?<![\w.])[-+\u2212]?\d+(?:\.\d+)?e[-+]\d+\b|(?<!\S)--\w[\w-]*")
 _JOINT = re.compile(r"(?<!&)([:#])(?=\w)")   # not the "#" of an entity (&#8593;)
 
 
@@ -185,8 +186,9 @@ _UNITS = [(re.compile(r"(?<![A-Za-z_\-.])um(?=[ )/,.;:<\]]|$)"), "\u00b5m"),
 def units_in_words(text: str) -> str:
     """``um`` -> ``µm``, ``urad`` -> ``µrad`` in visible text (never inside a tag or a name
     such as ``A_um``, nor what a user types: ``<code>`` and a command line with its
-    options, ``volerr check ... --tolerance EX0C=30 um``, stay as written)."""
-    parts = re.split(r"(<[^>]*>)", text)
+    options, ``volerr check ... --tolerance EX0C=30 um``, stay as written).  A ``<span>``
+    (:func:`aligned` keeps an option on one line with one) does not split the text."""
+    parts = re.split(r"(<(?!/?span[ >])[^>]*>)", text)
     out, code = [], 0
     for i, part in enumerate(parts):
         if i % 2:
@@ -251,7 +253,7 @@ def stamp_html(text: str, ident, conditions: dict | None = None, budgets=()) -> 
             text = text[:own.end()] + conditions_table(conditions) + text[own.end():]
     m = re.search(r"</h1>", text) or re.search(r"<body[^>]*>", text)
     at = m.end() if m else 0
-    text = text[:at] + block + text[at:]
+    text = text[:at] + aligned(block) + text[at:]
     if budgets and "Uncertainty budget:" not in text:
         tail = ("<h2>Uncertainty budgets (GUM, ISO/TR 230-9)</h2><p>u(x_i): standard "
                 "uncertainty of the source in its unit; c_i: sensitivity; contribution "

@@ -27,7 +27,7 @@ def _visible(text: str) -> str:
     """The text of a page's body as a reader sees it (no tags, no style, entities decoded)."""
     body = text.split("<body", 1)[1]
     body = re.sub(r"<style>.*?</style>|<[^>]*>", " ", body, flags=re.S)
-    return htmllib.unescape(body)
+    return re.sub(r"[ \t\n]+", " ", htmllib.unescape(body))
 
 
 def test_document_writes_units_in_words_but_leaves_names_and_tags():
@@ -210,3 +210,21 @@ def test_a_number_with_an_exponent_is_kept_on_one_line():
               "sources": [{"source": "readings", "u": 6.16e-15, "unit": "urad",
                            "sensitivity": 1.0, "contribution": 6.16e-15}]}
     assert '<span class="nw">6.16e-15</span>' in page.budgets_html([budget])
+
+
+def test_an_option_of_a_command_line_is_kept_on_one_line():
+    out = page.aligned("<table><tr><th>method</th><td>volerr iso10360 --artefact-cte-ppm-per-K"
+                       " 11.5</td></tr></table>")
+    assert '<span class="nw">--artefact-cte-ppm-per-K</span> 11.5' in out
+
+
+def test_a_stamped_identification_keeps_the_command_line_as_typed():
+    """stamp_html aligns the identification block (options kept on one line by a <span>)
+    before it writes units in words: the method line must still read as typed."""
+    from volerr.certificate import Identification
+
+    ident = Identification(report_id="VE-0123456789ab", method={
+        "command": "volerr check", "version": "0.1.0", "options": {"tolerance": "EX0C=30 um"}})
+    text = page.stamp_html(page.document("t", "<h1>t</h1><p>moved 3 um</p>"), ident)
+    seen = _visible(text)
+    assert "EX0C=30 um" in seen and "moved 3 \u00b5m" in seen
