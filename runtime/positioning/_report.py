@@ -146,8 +146,11 @@ def plot_runs(evaluations, path=None, verdicts_per_run=None) -> bytes:
             ax.plot(t[i], y, "o", ms=14, mfc="none", mec=_MARK[worst], mew=2.2)
             text = "; ".join(f"{', '.join(q for q, w in qv if w == v)}: {v}"
                              for v in ("fail", "undecided") if any(w == v for _, w in qv))
+            # on a white ground: the labels lay over the bands and lines (seen on the page)
             ax.annotate(text, (t[i], y), xytext=(9, 7), textcoords="offset points",
-                        color=_MARK[worst], fontweight="bold")
+                        color=_MARK[worst], fontweight="bold", zorder=5,
+                        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                              "alpha": 0.85})
         f = ev.figures_um()
         ax.set_xlabel(label(f"target position {ev.run.axis}", "mm"))
         ax.set_ylabel(label("positional deviation", "um"))
