@@ -25,7 +25,8 @@ def render(ev) -> str:
                    f"<td>{num(d['std'], '.2g')}</td><td>{html.escape(d['unit'])}</td></tr>"
                    for d in ev.data["diagnosis"]) or (
         f"<tr><td colspan=4>none: {html.escape(ev.data.get('diagnosis_note', ''))}</td></tr>")
-    return document("Ballbar evaluation", f"""<h1>Ballbar evaluation (ISO 230-4), layout {html.escape(ev.data['layout'])}</h1>
+    return document("Ballbar evaluation", f"""\
+<h1>Ballbar evaluation (ISO 230-4), layout {html.escape(ev.data['layout'])}</h1>
 {fit_html(ev.data)}{img}
 <p>Radial deviation of each trace about its least-squares circle (the grey ring), magnified;
 angles from the plane's first axis towards its second (a rotary sweep: the reading against the

@@ -229,7 +229,8 @@ def render_html(cal) -> str:
                                  "identified parameters with expanded uncertainty bars"))
     if cal.residuals:
         figs.append(embedded_img(png(residual_figure(cal)), "residuals per file"))
-    return document(f"Calibration of {d['layout']}", f"""<h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
+    return document(f"Calibration of {d['layout']}", f"""\
+<h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
 {fit_html(d)}<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
 variance factor {num(d['variance_factor'], '.3g')} (1 when the residuals match the stated
 reading uncertainties).  Standard uncertainties u (k = 1); the figure's bars ± 2 u (k = 2).</p>

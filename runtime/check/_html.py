@@ -64,7 +64,8 @@ def check_html(d: dict) -> str:
                   f"</tr>" for i in t["items"]) + f"</table><p>{e(t['rule'])}</p>"
     files = "".join(f"<li>{e(f['file'])} ({e(f['kind'])}, {f['n_readings']} readings, "
                     f"SHA-256 {e(f['sha256'][:16])}...)</li>" for f in d["files"])
-    return document(f"volerr check: {d['layout']}", f"""<h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
+    return document(f"volerr check: {d['layout']}", f"""\
+<h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
 {fit_html(d)}<p>Against the reference {e(str(d['reference']['file']))}{' on ' + e(d['date']) if d.get('date') else ''}.
 Volumetric change over the working volume: max {v['max']:.3g} µm, RMS {v['rms']:.3g} µm.
 Residual: Birge ratio {d['misfit']['birge_ratio']:.3g} on {d['misfit']['dof']} degrees of

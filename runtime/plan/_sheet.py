@@ -124,7 +124,8 @@ def html(plan) -> str:
                   for n in d["unidentifiable"])
     m, b = d["map_u_um"], d["baseline"]["map_u_um"]
     img = plotstyle.embedded_img(figure(plan), "where each set-up goes")
-    return document(f"volerr plan {d['layout']}", f"""<h1>Measurement plan: {escape(d['layout'])}</h1>
+    return document(f"volerr plan {d['layout']}", f"""\
+<h1>Measurement plan: {escape(d['layout'])}</h1>
 <p>{d['readings']} readings, about {d['minutes']:g} min (time model: volerr formats plan).
 Criterion: {escape(d['criterion'])}. Run each NC program with its set-up mounted; fill the
 reading columns of each file and give the files to <code>volerr calibrate {escape(d['layout'])}

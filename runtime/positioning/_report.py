@@ -323,7 +323,8 @@ def report_html(report: dict, png: bytes, inputs, generated: str = "", identific
                  f"{e(conformance.RULE)}.</p>" if toleranced else
                  "<p class='verdict'>No tolerance given (<code>--tolerance</code>): no "
                  "verdict.</p>")
-    return document("ISO 230-2 positioning test", f"""<h1>Positioning accuracy and repeatability &mdash; ISO 230-2</h1>
+    return document("ISO 230-2 positioning test", f"""\
+<h1>Positioning accuracy and repeatability &mdash; ISO 230-2</h1>
 <p>Evaluation of laser-interferometer positioning runs by direct measurement of a single axis
 according to {e(STANDARD)}. Deviations are actual minus target position, in &micro;m.
 {e(generated)}</p>

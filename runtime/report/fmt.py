@@ -69,7 +69,8 @@ LABELS = {
 }
 
 #: abbreviations of key words spelt out, and the units a key may end in
-_WORDS = {"cv": "cross-validated", "rms": "RMS", "abs": "absolute", "bic": "BIC", "std": "standard uncertainty",
+_WORDS = {"cv": "cross-validated", "rms": "RMS", "abs": "absolute", "bic": "BIC",
+          "std": "standard uncertainty",
           "mae": "MAE", "n": "number of", "max": "largest", "min": "smallest"}
 _UNIT_WORDS = {"um": "\u00b5m", "urad": "\u00b5rad", "mm": "mm", "s": "s", "deg": "\u00b0",
                "h": "h", "K": "K", "C": "\u00b0C", "ppm": "ppm"}

@@ -41,7 +41,8 @@ def report_html(doc: dict, png: bytes | None, identification: Identification | N
     else:
         verdict = "<p class='verdict'>No MPE given (<code>--mpe</code>): no verdict.</p>"
     img = embedded_img(png, "ISO 10360-2 length errors") if png else ""
-    return document(f"ISO 10360-2 length test: {doc['layout']}", f"""<h1>Length measuring test &mdash; ISO 10360-2 (simulated on the model of {e(doc['layout'])})</h1>
+    return document(f"ISO 10360-2 length test: {doc['layout']}", f"""\
+<h1>Length measuring test &mdash; ISO 10360-2 (simulated on the model of {e(doc['layout'])})</h1>
 <p>E0 = indicated minus calibrated length, bidirectional, 7 positions &times; 5 lengths &times;
 {reps} repetitions, computed from the error tables <code>{e(str(doc['errors']))}</code> with the
 probe offset {' '.join(f'{v:g}' for v in doc['probe_mm'])} mm. {e(generated)}</p>

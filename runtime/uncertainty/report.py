@@ -189,7 +189,8 @@ def html_report(doc: dict, pngs=(), captions=()) -> str:
     result_head = ("corrected result y \u2212 b / mm" if corrected else "result (uncorrected) / mm")
     figs = "".join(f"<figure>{embedded_img(p, c or 'figure')}<figcaption>{e(c)}</figcaption>"
                    f"</figure>" for p, c in zip(pngs, list(captions) + [""] * len(pngs)))
-    return document(f"volerr uncertainty: {doc['layout']}", f"""<h1>Task-specific uncertainty (Monte Carlo, JCGM 101)</h1>
+    return document(f"volerr uncertainty: {doc['layout']}", f"""\
+<h1>Task-specific uncertainty (Monte Carlo, JCGM 101)</h1>
 <table>{head}</table>
 <h2>Result</h2>
 <table><tr><th class='l'>quantity</th><th>nominal / mm</th><th>Monte Carlo reading y / mm</th>
