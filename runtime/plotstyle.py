@@ -138,16 +138,3 @@ def embedded_img(png_bytes: bytes, alt: str) -> str:
     """:func:`img_tag` of an embedded PNG."""
     return img_tag(data_uri(png_bytes), alt, png_bytes)
 
-
-#: the style sheet of the one-page test reports (ISO 230-2 positioning, ISO 10360-2 length
-#: test): tables with the identification of the test, verdict, plots
-TEST_REPORT_CSS = """\
-body { font-family: sans-serif; max-width: 1100px; margin: 1.5em auto; color: #111; }
-h1 { font-size: 1.4em; border-bottom: 2px solid #333; padding-bottom: .3em; }
-table { border-collapse: collapse; margin: .5em 0 1em 0; font-size: .9em; }
-th, td { border: 1px solid #999; padding: .2em .6em; text-align: right; }
-th.l, td.l { text-align: left; }
-th.l { background: #f2f2f2; }
-.s { color: #555; font-size: .85em; }
-.verdict { font-size: 1.15em; }
-img { max-width: 100%; height: auto; border: 1px solid #ccc; }"""

@@ -81,11 +81,16 @@ def html_page(title: str, summary: str, rows: list) -> str:
     def cell(v):
         return "" if v is None else escape(f"{v:.6g}" if isinstance(v, float) else str(v))
 
-    body = "".join(f"<tr>{''.join(f'<td>{cell(v)}</td>' for v in r)}</tr>\n" for r in rows)
-    head = "".join(f"<th>{h}</th>" for h in Row._fields)
-    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{escape(title)}"
-            f"</title></head>\n<body><h1>{escape(title)}</h1>\n<pre>{escape(summary)}</pre>\n"
-            f"<table>\n<tr>{head}</tr>\n{body}</table>\n</body></html>\n")
+    from .report.fmt import unit
+    from .report.page import document
+
+    body = "".join(f"<tr><td>{cell(r.name)}</td><td>{cell(r.value)}</td><td>{cell(r.std)}"
+                   f"</td><td>{cell(unit(r.unit))}</td><td>{cell(r.k)}</td></tr>\n"
+                   for r in (Row(*r) for r in rows))
+    head = "".join(f"<th>{h}</th>" for h in ("quantity", "value", "standard uncertainty u",
+                                              "unit", "k of u"))
+    return document(title, f"<h1>{escape(title)}</h1>\n<pre>{escape(summary)}</pre>\n"
+                           f"<table>\n<tr>{head}</tr>\n{body}</table>\n")
 
 
 class ResultMixin:

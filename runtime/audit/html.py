@@ -22,7 +22,8 @@ from ._summary import CATEGORIES, category_counts
 _COLOURS = {"identical": "#2e7d32", "printing_error": "#c62828", "extraction": "#6a1b9a",
             "convention": "#1565c0", "simplification": "#00838f", "undecidable": "#ef6c00"}
 _MAX_MATH = 3000          # characters: longer expressions are shown as text
-_ONE_LINE = 90            # characters: longer sums are rendered term by term (they wrap)
+_ONE_LINE = 40            # characters: longer sums are rendered term by term (they wrap;
+#                           at 90 an 80-character sum overflowed its 20 % column, seen)
 _PLAIN = re.compile(r"^[\w\s\(\)\*\+\-/\.\^,]+$")
 
 
@@ -163,19 +164,21 @@ def render_html(entries: list[dict], title: str = "volerr audit") -> str:
                          "<tr><th>equation</th><th>category</th><th>printed</th>"
                          "<th>derived</th><th>evidence and readings</th></tr>"
                          + "".join(_row(e) for e in rows) + "</table>")
-    style = ("body{font-family:sans-serif;margin:1em auto;max-width:1360px;padding:0 10px}"
-             "table{border-collapse:collapse;margin:1em 0;width:100%;table-layout:fixed}"
+    # the shared page style (volerr.report.page), then the audit's own: fixed columns; an
+    # expression (MathML, code) may wrap anywhere; a word of the text only when it is wider
+    # than its whole fixed column (break-word; else it would run over the next column)
+    style = ("body{max-width:1360px}"
+             "table{width:100%;table-layout:fixed}"
              "col.c1{width:9%}col.c2{width:10%}col.c3{width:20%}col.c4{width:20%}"
              "col.c5{width:41%}"
-             "td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%;"
-             "overflow-wrap:anywhere;word-break:break-word}"
-             "math{max-width:100%}math[display=block]{overflow-wrap:anywhere}"
+             "td,th{padding:4px;font-size:90%}td{overflow-wrap:break-word}"
+             "math{max-width:100%;overflow-wrap:anywhere}"
+             "math[display=block]{overflow-wrap:anywhere}"
              ".mwrap{white-space:normal;line-height:1.9}.mwrap math{display:inline}"
              "pre{white-space:pre-wrap;overflow-wrap:anywhere;word-break:break-all;margin:0}"
              "ul.tried{margin:0 0 0 1.2em;padding:0;font-size:92%}ul.cats{list-style:none;"
              "padding:0}ul.cats li{display:inline;margin-right:1.5em}"
              ".cat{color:#fff;border-radius:3px;padding:1px 5px;font-size:85%}")
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            "<meta name=\"viewport\" content=\"width=device-width\">"
-            f"<title>{html.escape(title)}</title><style>{style}</style></head><body>"
-            + "\n".join(parts) + "</body></html>\n")
+    from ..report.page import document
+
+    return document(title, "\n".join(parts), css=style)

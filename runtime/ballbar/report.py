@@ -6,6 +6,7 @@ import html
 
 from ..plotstyle import embedded_img
 from ..fit_quality import fit_html
+from ..report.page import document
 from ..units import num
 
 
@@ -24,9 +25,7 @@ def render(ev) -> str:
                    f"<td>{num(d['std'], '.2g')}</td><td>{html.escape(d['unit'])}</td></tr>"
                    for d in ev.data["diagnosis"]) or (
         f"<tr><td colspan=4>none: {html.escape(ev.data.get('diagnosis_note', ''))}</td></tr>")
-    return f"""<!DOCTYPE html><html><head><meta charset="utf-8"><title>Ballbar evaluation</title>
-<style>body{{font-family:sans-serif;max-width:1100px;margin:1em auto}}table{{border-collapse:
-collapse}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}</style></head><body>
+    return document("Ballbar evaluation", f"""\
 <h1>Ballbar evaluation (ISO 230-4), layout {html.escape(ev.data['layout'])}</h1>
 {fit_html(ev.data)}{img}
 <p>Radial deviation of each trace about its least-squares circle (the grey ring), magnified;
@@ -41,9 +40,7 @@ deviation about the pivot.</p>
 <h2>Diagnosis (ISO 230-1 parameters, standard uncertainty k = 1)</h2>
 <table><tr><th>parameter</th><th>value</th><th>u</th><th>unit</th></tr>{diag}</table>
 <p>Fitted with the layout's observation model of the ballbar: only what the traces determine
-is listed (with the bar length unknown, only the scale mismatch of the two axes).</p>
-</body></html>
-"""
+is listed (with the bar length unknown, only the scale mismatch of the two axes).</p>""")
 
 
 def _num(v) -> str:

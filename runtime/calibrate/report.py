@@ -14,6 +14,7 @@ import numpy as np
 
 from ..plotstyle import embedded_img, figure, label, png, styled, unit
 from ..fit_quality import fit_html
+from ..report.page import document
 from ..units import num
 
 
@@ -21,6 +22,8 @@ from ..units import num
 def parameter_figure(params: dict, truth: dict | None = None):
     """Identified values with +-2 u bars (k = 2), one panel per unit; ``truth``: planted
     values drawn beside them (simulated campaigns)."""
+    from matplotlib.ticker import MaxNLocator
+
     units = list(dict.fromkeys(v["unit"] for v in params.values()))
     rows = max(sum(v["unit"] == u for v in params.values()) for u in units)
     fig, axes = figure(1, len(units), width=4.6 * len(units) + 0.4,
@@ -39,6 +42,8 @@ def parameter_figure(params: dict, truth: dict | None = None):
         ax.set_yticklabels(names)
         ax.invert_yaxis()
         ax.set_xlabel(label("value", u))
+        # three panels share the page's 10 in: six ticks of "-0.010" overlapped (seen)
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=4 if len(units) > 2 else 6))
         ax.grid(axis="x", alpha=0.3)
         ax.legend(loc="best")
     return fig
@@ -224,11 +229,7 @@ def render_html(cal) -> str:
                                  "identified parameters with expanded uncertainty bars"))
     if cal.residuals:
         figs.append(embedded_img(png(residual_figure(cal)), "residuals per file"))
-    return f"""<!DOCTYPE html><html><head><meta charset="utf-8">
-<title>Calibration of {html.escape(d['layout'])}</title>
-<style>body{{font-family:sans-serif;max-width:1200px;margin:1em auto}}table{{border-collapse:
-collapse;margin:0.5em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;
-vertical-align:top;overflow-wrap:anywhere}}</style></head><body>
+    return document(f"Calibration of {d['layout']}", f"""\
 <h1>Calibration of {html.escape(d['layout'])} from {len(d['instruments'])} file(s)</h1>
 {fit_html(d)}<p>{html.escape(d['method'])}.  Degree of the component series: {d['degree']}; a-posteriori
 variance factor {num(d['variance_factor'], '.3g')} (1 when the residuals match the stated
@@ -252,6 +253,4 @@ own set-up unknowns are removed.  Fixed by convention (not parameters):
 {_lab_sections(d)}
 <h2>Set-up estimates</h2>
 <table><tr><th>set-up</th><th>unknown</th><th>value</th><th>u</th><th>unit</th>
-<th>determined</th></tr>{setup}</table>
-</body></html>
-"""
+<th>determined</th></tr>{setup}</table>""")

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import html
 
+from ..report.page import document
+
 
 def _figure(d: dict) -> str:
     """An ``<img>`` (embedded PNG): change / std of every changed parameter, and the
@@ -47,7 +49,7 @@ def check_html(d: dict) -> str:
         f"<td>{e(', '.join(c.get('indistinguishable_from', [])))}</td>"
         f"<td>{e(_alternatives(c))}</td></tr>"
         for c in d["changed"])
-    table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>std (k = 1)"
+    table = (f"<table><tr><th>parameter</th><th>reference</th><th>change</th><th>u (k = 1)"
              f"</th><th>unit</th><th>indistinguishable from</th>"
              f"<th>or (not told apart by this check)</th></tr>{rows}</table>"
              if rows else "<p>No parameter changed.</p>")
@@ -62,10 +64,7 @@ def check_html(d: dict) -> str:
                   f"</tr>" for i in t["items"]) + f"</table><p>{e(t['rule'])}</p>"
     files = "".join(f"<li>{e(f['file'])} ({e(f['kind'])}, {f['n_readings']} readings, "
                     f"SHA-256 {e(f['sha256'][:16])}...)</li>" for f in d["files"])
-    return f"""<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>volerr check: {e(d['layout'])}</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
-td,th{{padding:2px 8px;text-align:right}}</style></head><body>
+    return document(f"volerr check: {d['layout']}", f"""\
 <h1>Check of {e(d['layout'])}: {e(d['verdict'])}</h1>
 {fit_html(d)}<p>Against the reference {e(str(d['reference']['file']))}{' on ' + e(d['date']) if d.get('date') else ''}.
 Volumetric change over the working volume: max {v['max']:.3g} µm, RMS {v['rms']:.3g} µm.
@@ -74,5 +73,4 @@ freedom{' -- a change none of the reference parameters explains' if d['misfit'][
 <h2>Changed</h2>{table}
 {_figure(d)}
 {'<h2>Cannot be told apart by this check</h2><ul>' + apart + '</ul>' if apart else ''}
-{tol}<h2>Files</h2><ul>{files}</ul><p>{e(d['method'])}</p></body></html>
-"""
+{tol}<h2>Files</h2><ul>{files}</ul><p>{e(d['method'])}</p>""")

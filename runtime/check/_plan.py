@@ -88,8 +88,11 @@ class CheckPlan:
         from ..fileio import json_text, write_text
         from ..plan import _sheet
 
+        from ..report.page import finish
+
         self.plan.write(folder, None, html_path, inputs)
         page = _sheet.html(self.plan).replace("</body>", self.power_html() + "</body>", 1)
+        page = finish(page)   # the power table aligned as the sheet's
         write_text(html_path or f"{folder}/plan.html", page, inputs=list(inputs))
         if json_path:
             write_text(json_path, json_text(self.to_dict()), inputs=list(inputs))
@@ -111,7 +114,7 @@ class CheckPlan:
                 f"{_power.POWER:.0%} probability (false alarms below 5 %).</p><table><tr>"
                 f"<th>parameter</th><th>change moving the map by {self.detect_um:g} µm</th>"
                 f"<th>power</th>"
-                f"<th>detected with 95 %</th><th>std of a change</th><th>unit</th></tr>{rows}"
+                f"<th>detected with 95 %</th><th>u of a change (k = 1)</th><th>unit</th></tr>{rows}"
                 f"</table>")
 
 

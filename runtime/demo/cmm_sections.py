@@ -34,9 +34,12 @@ def cmm(w, layout: str, label: str) -> dict:
     w.later(f"diagonals_{layout}.png", lambda p: dg.plot_lines(
         res.lines, p, f"{model.name}: length deviations ({errors})"))
     space = [ln for ln in res.to_dict()["lines"] if ln.get("kind") == "space"]
-    text = ", ".join(f"{ln['deviation_um']:+.1f}" for ln in space)
+    # each diagonal named by its corners (x y z; 0 the start of travel, 1 its end): the bare
+    # list "-10.9, +34.5, -8.1, +11.4 um" did not say which diagonal was which
+    text = ", ".join(f"{ln['name']} {ln['deviation_um']:+.1f}" for ln in space)
     rand = [ln.get("random_um") for ln in space if ln.get("random_um") is not None]
     text += (" um (random " + ", ".join(f"{r:.1f}" for r in rand) + " um)") if rand else " um"
+    text += "; diagonal from corner to corner, x y z: 0 the start of travel, 1 its end"
     return {"title": f"{label} ({layout}): space diagonals", "value": text,
             "files": files + [f"diagonals_{layout}.json", f"diagonals_{layout}.png"]}
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..fileio import write_text
+from ..report.page import document
 from .text import ABOUT, CAPTIONS
 
 
@@ -44,20 +45,14 @@ def index_html(out: Path, results: list) -> None:
             f'<span class="file">[{r.get("seconds", 0)} s]</span></p>'
             + report_links + "".join(figs) + f'<p class="files">Files: {files}</p></section>')
     page_list = ", ".join(f'<a href="{escape(f)}">{escape(f)}</a>' for f in pages)
-    html = ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-            "<title>volerr demo</title><style>"
-            "body{font-family:system-ui,sans-serif;font-size:17px;line-height:1.5;"
-            "max-width:1200px;margin:2em auto;padding:0 1em;color:#222}"
-            "h1{font-size:1.9em}h2{font-size:1.35em;border-bottom:2px solid #ddd;"
-            "padding-bottom:.2em;margin-top:2em}"
-            "figure{margin:1.2em 0}img{max-width:100%;height:auto;border:1px solid #eee}"
-            "figcaption{font-size:.95em;color:#444}.file{color:#777;font-size:.9em}"
-            ".result{background:#f5f7fa;padding:.6em .9em;border-left:4px solid #4a7}"
-            ".files a{margin-right:.8em}</style></head><body>"
-            "<h1>volerr demo</h1><p>Every step below ran a real <code>volerr</code> command "
-            "on built-in data; units µm and µrad unless stated.  Click a figure for full "
-            "size; the files next to this page hold every number.  Report pages: "
-            f"{page_list}.</p>"
-            f"<ol>{''.join(toc)}</ol>{''.join(parts)}</body></html>\n")
+    # the shared page style (volerr.report.page), then the index's own few rules
+    css = ("body{line-height:1.5}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;"
+           "margin-top:2em}img{border:1px solid #eee}.file{color:#777;font-size:.9em}"
+           ".result{background:#f5f7fa;padding:.6em .9em;border-left:4px solid #4a7}"
+           ".files a{margin-right:.8em}")
+    html = document("volerr demo", "<h1>volerr demo</h1><p>Every step below ran a real "
+                    "<code>volerr</code> command on built-in data; units µm and µrad unless "
+                    "stated.  Click a figure for full size; the files next to this page hold "
+                    f"every number.  Report pages: {page_list}.</p>"
+                    f"<ol>{''.join(toc)}</ol>{''.join(parts)}", css=css)
     write_text(out / "index.html", html)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..report.page import document
 from ..results import ResultMixin, Row, as_table
 from . import analysis as an
 
@@ -237,13 +238,14 @@ def parameter_figure(h: History, name: str):
                 ax.axvline(_dates([an.day(f["date"])])[0], color="k", lw=1.0, ls="--",
                            label=f"leaves the tolerance {f['date']}")
         ax.set_ylabel(label(name, s.unit))
-        ax.legend(loc="best", fontsize=9)
+        # beside the panels: "best" still lay over the error bars (seen on the page)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9)
         ax2.plot(x, [p["z"] for p in c["ewma"]], "o-", ms=3, label="EWMA z")
         ax2.plot(x, [p["ucl"] for p in c["ewma"]], "--", color="C3", lw=0.9,
                  label="EWMA limits (ISO 7870-6)")
         ax2.plot(x, [p["lcl"] for p in c["ewma"]], "--", color="C3", lw=0.9)
         ax2.set_ylabel(label("EWMA", s.unit))
-        ax2.legend(loc="best", fontsize=9)
+        ax2.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9)
         return fig
 
     return draw()
@@ -263,25 +265,21 @@ def render_html(h: History) -> str:
                     for n, t in d["trends"].items())
     frows = "".join(f"<tr><td>{esc(n)}</td><td>{f['tolerance']:g} {esc(f['unit'])}</td>"
                     f"<td>{esc(str(f['date']))}</td><td>{esc(str(f['interval'][0]))} to "
-                    f"{esc(str(f['interval'][1]))}</td></tr>" for n, f in d["forecast"].items())
+                    f"{esc(str(f['interval'][1]))}</td></tr>" for n, f in d["forecast"].items()) \
+        or "<tr><td colspan=4>none: no tolerance given (--tolerance)</td></tr>"
     figs = "".join(f"<h3>{esc(n)}</h3>" + embedded_img(png(parameter_figure(h, n)), n)
                    for n in h.series)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>History of {esc(d['machine'])}</title>
-<style>body{{font-family:sans-serif;max-width:1040px;margin:auto}}table{{border-collapse:
-collapse}}td,th{{border:1px solid #bbb;padding:2px 6px}}</style></head><body>
-<h1>History of machine {esc(d['machine'])} ({esc(d['layout'])})</h1>
+    return document(f"History of {d['machine']}", f"""<h1>History of machine \
+{esc(d['machine'])} ({esc(d['layout'])})</h1>
 <p>{len(d['entries'])} entries from {esc(d['entries'][0]['date'])} to
 {esc(d['entries'][-1]['date'])}. {esc(d['method'])}.</p>
-<h2>Events</h2><table><tr><th>date</th><th>parameter</th><th>change</th><th>std (k = 1)</th>
+<h2>Events</h2><table><tr><th>date</th><th>parameter</th><th>change</th><th>u (k = 1)</th>
 <th>unit</th></tr>{rows}</table>
-<h2>Trends</h2><table><tr><th>parameter</th><th>slope per 30 days</th><th>std (k = 1)</th>
+<h2>Trends</h2><table><tr><th>parameter</th><th>slope per 30 days</th><th>u (k = 1)</th>
 <th>unit</th><th>since</th><th>entries</th></tr>{trows}</table>
 <h2>Forecast</h2><table><tr><th>quantity</th><th>tolerance</th><th>leaves it on</th>
 <th>95 % interval</th></tr>{frows}</table>
-<h2>Parameters</h2>{figs}
-</body></html>
-"""
+<h2>Parameters</h2>{figs}""")
 
 
 def _budgets(series: dict, fits: dict) -> dict:

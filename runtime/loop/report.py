@@ -219,7 +219,9 @@ def figure_functions(report):
                         lw=0.8)
             ax.set_xlabel(label(a, "deg" if a in report.plot_data.model.rotary_axes else "mm"))
             ax.set_ylabel(label("error", unit))
-            ax.legend(fontsize=9, ncol=2)
+            # above the panel: inside, it lay over the curves (seen on the page and the PDF)
+            ax.legend(fontsize=9, ncol=3, loc="lower center", bbox_to_anchor=(0.5, 1.0),
+                      frameon=False, borderaxespad=0.2)
     fig.suptitle("solid: augmented model (band \u00b12 standard deviations, k = 2), dashed: "
                  "declared model")
     return fig

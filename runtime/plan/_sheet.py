@@ -9,6 +9,7 @@ from html import escape
 import numpy as np
 
 from .. import plotstyle
+from ..report.page import document
 from . import _candidates, _report
 
 VIEWS = (("X", "Y", 0, 1), ("X", "Z", 0, 2), ("Y", "Z", 1, 2))
@@ -123,9 +124,8 @@ def html(plan) -> str:
                   for n in d["unidentifiable"])
     m, b = d["map_u_um"], d["baseline"]["map_u_um"]
     img = plotstyle.embedded_img(figure(plan), "where each set-up goes")
-    return f"""<!DOCTYPE html><html><head><meta charset="utf-8">
-<title>volerr plan {escape(d['layout'])}</title><style>{plotstyle.TEST_REPORT_CSS}</style>
-</head><body><h1>Measurement plan: {escape(d['layout'])}</h1>
+    return document(f"volerr plan {d['layout']}", f"""\
+<h1>Measurement plan: {escape(d['layout'])}</h1>
 <p>{d['readings']} readings, about {d['minutes']:g} min (time model: volerr formats plan).
 Criterion: {escape(d['criterion'])}. Run each NC program with its set-up mounted; fill the
 reading columns of each file and give the files to <code>volerr calibrate {escape(d['layout'])}
@@ -133,13 +133,11 @@ FILES</code> (no options).</p>
 <h2>Set-ups, in order</h2><table><tr><th class=l>file</th><th class=l>NC program</th>
 <th class=l>set-up</th><th class=l>what goes where</th><th>readings</th></tr>{''.join(rows)}
 </table>{img}
-<h2>Predicted result</h2><table><tr><th class=l>parameter</th><th>predicted std</th>
-<th class=l>unit</th><th class=l>determined alone by</th><th>baseline std</th></tr>{params}
+<h2>Predicted result</h2><table><tr><th class=l>parameter</th>
+<th>predicted u (k = 1)</th><th class=l>unit</th><th class=l>determined alone by</th><th>u of the conventional plan</th></tr>{params}
 </table><p>Map of the volumetric error over the working volume: predicted standard uncertainty
 RMS {m['rms']:.3g} µm, max {m['max']:.3g} µm (k = 1); {_baseline_text(d, b)}.</p>
-{'<h2>Not determined by this plan</h2><ul>' + why + '</ul>' if why else ''}
-</body></html>
-"""
+{'<h2>Not determined by this plan</h2><ul>' + why + '</ul>' if why else ''}""")
 
 
 def _baseline_text(d, b) -> str:

@@ -33,7 +33,8 @@ from ..units import MM_PER_M, UM_PER_MM
 
 from .. import conformance
 from ..certificate import html_table, verdict_html
-from ..plotstyle import TEST_REPORT_CSS, embedded_img, figure, label, png, styled
+from ..report.page import document
+from ..plotstyle import embedded_img, figure, label, png, styled
 from ..units import num
 from ._evaluate import Evaluation
 from ._uncertainty import BudgetInputs, QUANTITIES, budget, decisive_targets, verdicts
@@ -145,8 +146,11 @@ def plot_runs(evaluations, path=None, verdicts_per_run=None) -> bytes:
             ax.plot(t[i], y, "o", ms=14, mfc="none", mec=_MARK[worst], mew=2.2)
             text = "; ".join(f"{', '.join(q for q, w in qv if w == v)}: {v}"
                              for v in ("fail", "undecided") if any(w == v for _, w in qv))
+            # on a white ground: the labels lay over the bands and lines (seen on the page)
             ax.annotate(text, (t[i], y), xytext=(9, 7), textcoords="offset points",
-                        color=_MARK[worst], fontweight="bold")
+                        color=_MARK[worst], fontweight="bold", zorder=5,
+                        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                              "alpha": 0.85})
         f = ev.figures_um()
         ax.set_xlabel(label(f"target position {ev.run.axis}", "mm"))
         ax.set_ylabel(label("positional deviation", "um"))
@@ -155,7 +159,8 @@ def plot_runs(evaluations, path=None, verdicts_per_run=None) -> bytes:
                      f"{num(f['E_um'], '.2f')}, M {num(f['M_um'], '.2f')}, R "
                      f"{num(f['R_um'], '.2f')}, B {num(f['B_um'], '.2f')} (mean "
                      f"{num(f['B_avg_um'], '+.2f')}) \u00b5m")
-        ax.legend(loc="upper left", ncol=1)
+        # below the panel: inside it hid the forward band at 200-300 mm (seen on the page)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=9)
     data = png(fig)
     if path is not None:
         from ..fileio import write_bytes
@@ -318,12 +323,7 @@ def report_html(report: dict, png: bytes, inputs, generated: str = "", identific
                  f"{e(conformance.RULE)}.</p>" if toleranced else
                  "<p class='verdict'>No tolerance given (<code>--tolerance</code>): no "
                  "verdict.</p>")
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<title>ISO 230-2 positioning test</title>
-<style>
-{TEST_REPORT_CSS}
-</style></head><body>
+    return document("ISO 230-2 positioning test", f"""\
 <h1>Positioning accuracy and repeatability &mdash; ISO 230-2</h1>
 <p>Evaluation of laser-interferometer positioning runs by direct measurement of a single axis
 according to {e(STANDARD)}. Deviations are actual minus target position, in &micro;m.
@@ -348,9 +348,7 @@ decide a quantity that fails (red) or is undecided (amber).</p>
 <p class="s">Instrument, alignment and temperature act on A, E and M (ranges over the travel);
 R and B are differences at one target, where they cancel. U = 2 u<sub>c</sub>.</p>
 {tables}
-{'<h2>Notes</h2><ul>' + ''.join(f'<li>{e(n)}</li>' for n in notes) + '</ul>' if notes else ''}
-</body></html>
-"""
+{'<h2>Notes</h2><ul>' + ''.join(f'<li>{e(n)}</li>' for n in notes) + '</ul>' if notes else ''}""")
 
 
 def error_table(ev: Evaluation) -> ErrorTable:

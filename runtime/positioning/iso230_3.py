@@ -45,7 +45,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..certificate import html_table
-from ..plotstyle import TEST_REPORT_CSS, embedded_img, figure, label, png, styled
+from ..plotstyle import embedded_img, figure, label, png, styled
+from ..report.page import document
 from ..units import SENSOR_TILT as _TILT
 
 STANDARD = "ISO 230-3:2020"
@@ -428,19 +429,11 @@ def report_html(evaluations: list, pngs: list, generated: str = "",
             "<th>t(max) / h</th><th>t(min) / h</th></tr>")
     for ev, img in zip(evaluations, pngs):
         parts.append(_run_html(ev, img, head))
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<title>ISO 230-3 thermal drift test</title>
-<style>
-{TEST_REPORT_CSS}
-</style></head><body>
-<h1>Thermal effects &mdash; ISO 230-3</h1>
+    return document("ISO 230-3 thermal drift test", f"""<h1>Thermal effects &mdash; ISO 230-3</h1>
 <p>Evaluation of a thermal drift test according to {e(STANDARD)}: the displacement of the tool
 side relative to the workpiece side at one position, as the sensors read it, from the first
 reading, in &micro;m; tilts in &micro;rad (right hand, tool side relative to workpiece side).
 {e(generated)}</p>
 <h2>Identification</h2>
 {html_table(ident)}
-{''.join(parts)}
-</body></html>
-"""
+{''.join(parts)}""")

@@ -16,7 +16,9 @@ Units: the rows' units as µm and µrad (never "um")."""
 
 from __future__ import annotations
 
-from .fmt import number, unit  # noqa: F401  (the page's numbers and units)
+import re
+
+from .fmt import number, unit, value_for  # noqa: F401  (the page's numbers and units)
 
 #: the coverage factor of the expanded uncertainties on a certificate (about 95 % for a
 #: normal distribution, ISO/TR 230-9 and the GUM's usual choice)
@@ -42,9 +44,23 @@ def result_rows(rows) -> list:
     for r in rows:
         k = K_CERTIFICATE
         U = None if r.std is None else k * float(r.std)
-        out.append([r.name, number(r.value), number(r.std, 3), f"{k:g}", number(U, 3),
-                    unit(r.unit)])
+        out.append([row_name(r.name), value_for(r.value, r.std), number(r.std, 3),
+                    f"{k:g}", number(U, 3), unit(r.unit)])
     return out
+
+
+def row_name(name: str) -> str:
+    """A result row's name as printed: a JSON key after the last colon in words
+    (``"x1:mae_before"`` -> ``"x1: MAE before"``, ``"KT_EZZ:tau"`` -> ``"KT_EZZ: time
+    constant"``, ``"max_abs_dx"`` -> ``"largest |dx|"``); a parameter's own name
+    (``EXX@slope``, ``KT_EXZ_T_spindle_0``, ``tool_dz``... in upper case or after no colon
+    without an underscore) kept."""
+    from .fmt import words
+
+    head, sep, key = str(name).rpartition(":")
+    if re.fullmatch(r"[a-z][a-z0-9]*_[a-z0-9_]*", key) or (sep and re.fullmatch(r"[a-z]\w*", key)):
+        return f"{head}{sep} {words(key)}".strip()
+    return str(name)
 
 
 def budget_rows(b: dict) -> list:

@@ -31,6 +31,9 @@ CELL_PAD_MM = 1.0
 #: the tallest a figure is set, mm (two figures and a table share a page), and where the
 #: text stops above the footer, mm from the top of the A4 page
 FIGURE_MAX_MM, PAGE_BOTTOM_MM = 115.0, 279.0
+#: a tall figure (height over width above TALL) may fill a page up to FULL_PAGE_MM high: at
+#: FIGURE_MAX_MM the loop's 14-row residual figure was 40 mm wide, its text about 1.5 pt
+TALL, FULL_PAGE_MM = 1.0, 240.0
 #: a figure of more SVG elements (markers, paths) than this is set as a PNG of RASTER_DPI
 #: instead: fpdf2 imports about 500 elements a second (3000 markers: 6 s measured), so a
 #: scatter of tens of thousands of readings would take minutes as vectors
@@ -143,11 +146,25 @@ def _layout(pdf, rows: list, header: bool) -> tuple:
     return size, widths, height
 
 
-def table(pdf, rows: list, header: bool = True, align: str = "LEFT", heading: str = "") -> None:
+def _aligns(rows: list, header: bool) -> tuple:
+    """Per column: "RIGHT" when every data cell reads as a number (as on the HTML pages,
+    :func:`volerr.report.page.aligned`), else "LEFT"."""
+    from .page import _NUMERIC
+
+    n = max(len(r) for r in rows)
+    data = rows[1:] if header else rows
+    return tuple("RIGHT" if any(len(r) > i and r[i].strip() for r in data) and all(
+        len(r) <= i or _NUMERIC.match(r[i]) for r in data) else "LEFT" for i in range(n))
+
+
+def table(pdf, rows: list, header: bool = True, align: str | None = None,
+          heading: str = "") -> None:
     """``rows`` (first the header when ``header``) as a table that breaks no word, under
-    ``heading``; a table of at most :data:`KEEP_TOGETHER_MM` starts on a new page rather
+    ``heading``; words left and numbers right (``align`` one alignment for every column
+    instead); a table of at most :data:`KEEP_TOGETHER_MM` starts on a new page rather
     than break (a longer one breaks, its header repeated)."""
     rows = [[str(c) for c in r] for r in rows]
+    align = align or _aligns(rows, header)
     size, widths, height = _layout(pdf, rows, header)
     if pdf.get_y() + min(height, KEEP_TOGETHER_MM) + (9 if heading else 0) > PAGE_BOTTOM_MM:
         pdf.add_page()
@@ -194,7 +211,8 @@ def figure(pdf, fig, heading: str = "") -> None:
         fig.savefig(buf, format="png", dpi=RASTER_DPI, bbox_inches="tight")
         buf.seek(0)
     w_in, h_in = fig.get_size_inches()
-    width = min(TEXT_WIDTH_MM, FIGURE_MAX_MM * w_in / h_in)
+    tallest = FULL_PAGE_MM if h_in / w_in > TALL else FIGURE_MAX_MM
+    width = min(TEXT_WIDTH_MM, tallest * w_in / h_in)
     height = width * h_in / w_in
     if pdf.get_y() + height + 12 > PAGE_BOTTOM_MM:
         pdf.add_page()

@@ -9,7 +9,8 @@ import html
 
 from ..certificate import Identification, html_table, verdict_html
 from ..conformance import RULE
-from ..plotstyle import TEST_REPORT_CSS, embedded_img
+from ..report.page import document
+from ..plotstyle import embedded_img
 from ..units import num
 
 
@@ -40,11 +41,7 @@ def report_html(doc: dict, png: bytes | None, identification: Identification | N
     else:
         verdict = "<p class='verdict'>No MPE given (<code>--mpe</code>): no verdict.</p>"
     img = embedded_img(png, "ISO 10360-2 length errors") if png else ""
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>ISO 10360-2 length test: {e(doc['layout'])}</title>
-<style>
-{TEST_REPORT_CSS}
-</style></head><body>
+    return document(f"ISO 10360-2 length test: {doc['layout']}", f"""\
 <h1>Length measuring test &mdash; ISO 10360-2 (simulated on the model of {e(doc['layout'])})</h1>
 <p>E0 = indicated minus calibrated length, bidirectional, 7 positions &times; 5 lengths &times;
 {reps} repetitions, computed from the error tables <code>{e(str(doc['errors']))}</code> with the
@@ -60,6 +57,4 @@ probe offset {' '.join(f'{v:g}' for v in doc['probe_mm'])} mm. {e(generated)}</p
 (red) or are undecided (amber).</p>
 <h2>Length errors</h2>
 <table><tr><th class='l'>position</th><th>L / mm</th>{''.join(f'<th>E0 #{k + 1} / &micro;m</th>' for k in range(reps))}<th>U (k = 2) / &micro;m</th></tr>
-{''.join(rows)}</table>
-</body></html>
-"""
+{''.join(rows)}</table>""")

@@ -22,6 +22,7 @@ import math
 from pathlib import Path
 
 from ..plotstyle import embedded_img
+from ..report.page import document
 from ..units import MM_PER_UM, UM_PER_MM, num  # noqa: F401  (num re-exported)
 
 from ..choices import BIAS_MODES  # noqa: E402,F401  (stated once, light)
@@ -226,13 +227,7 @@ def html_report(doc: dict, pngs=(), captions=()) -> str:
     result_head = ("corrected result y \u2212 b / mm" if corrected else "result (uncorrected) / mm")
     figs = "".join(f"<figure>{embedded_img(p, c or 'figure')}<figcaption>{e(c)}</figcaption>"
                    f"</figure>" for p, c in zip(pngs, list(captions) + [""] * len(pngs)))
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>volerr uncertainty: {e(doc['layout'])}</title>
-<style>body{{font-family:sans-serif;max-width:1100px;margin:1.5em auto;color:#111}}
-td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}table{{border-collapse:collapse;margin:.5em 0 1em 0}}
-th.l,td.l{{text-align:left}}th.l{{background:#f2f2f2}}img{{max-width:100%;height:auto}}
-figcaption{{color:#444}}</style>
-</head><body>
+    return document(f"volerr uncertainty: {doc['layout']}", f"""\
 <h1>Task-specific uncertainty (Monte Carlo, JCGM 101)</h1>
 <table>{head}</table>
 <h2>Result</h2>
@@ -244,6 +239,4 @@ figcaption{{color:#444}}</style>
 <p>{'The result is corrected for the known bias (GUM 3.2.4): y &minus; b with U; the interval is the probabilistically symmetric 95 % interval of the Monte Carlo, shifted by &minus;b.' if corrected else 'The result is the reading itself; its interval is the 95 % Monte Carlo interval widened on the side of the bias so that it contains it (U&minus; and U+ differ).'}</p>
 <h2>Contributions (one source at a time)</h2>
 <table><tr><th class='l'>source</th>{names}</tr>{''.join(contrib)}</table>
-{figs}
-</body></html>
-"""
+{figs}""")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...plotstyle import embedded_img, figure, png, styled
+from ...plotstyle import label as axis_label
 from ...selection.rules import SIG_K
 from . import basis
 
@@ -40,18 +41,19 @@ def _draw(report, label: str):
                            label=f"{100 * iv['level']:.0f} % prediction interval{cov}")
     if c.get("verdict"):
         ax[0].set_title(c["verdict"], fontsize="small")
-    ax[0].set_ylabel(f"{label} / um")
-    ax[0].legend(fontsize="small", ncol=2)
+    ax[0].set_ylabel(axis_label(label, "um"))
+    # beside the panels: inside, the legend lay over the measured curve (seen on the page)
+    ax[0].legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax[1].plot(t_h[i], (y - p["after"])[i], lw=0.6, label="residual after")
     ax[1].plot(t_h[i], (y - p["static"])[i], lw=0.6, alpha=0.6, label="residual static")
-    ax[1].set_ylabel("residual / um")
-    ax[1].legend(fontsize="small")
+    ax[1].set_ylabel(axis_label("residual", "um"))
+    ax[1].legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     chosen = sorted({t["source"] for t in p["terms"] if t["source"] != "heat"}
                     | {t["minus"] for t in p["terms"] if t.get("minus")})
     for k in chosen:
         v = s.inputs[k]
         ax[2].plot(t_h[i], v[i], lw=0.7, label=k)
-    ax[2].set_ylabel("temperature / degC")
+    ax[2].set_ylabel(axis_label("temperature", "degC"))
     if basis.SPEED in s.inputs:
         tw = ax[2].twinx()
         tw.plot(t_h[i], s.inputs[basis.SPEED][i], color="0.5", lw=0.7, label="S_rpm")
@@ -93,16 +95,24 @@ def _shade(ax, t_h, test) -> None:
 
 def render_template(name: str, **context) -> str:
     """The loop's template ``name`` (``volerr/loop/templates``) rendered with ``context``
-    (autoescaped, undefined names refused)."""
+    (autoescaped, undefined names refused), in the one page style of every report
+    (:mod:`volerr.report.page`: ``page_style`` in the head, JSON keys in words through the
+    filter ``words``, units as µm and µrad, words left and numbers right in every table)."""
     from importlib import resources
 
     import jinja2
+
+    from ...report.fmt import unit, words
+    from ...report.page import STYLE, finish
 
     folder = resources.files("volerr.loop") / "templates"
     env = jinja2.Environment(
         loader=jinja2.FunctionLoader(lambda n: (folder / n).read_text(encoding="utf-8")),
         autoescape=True, undefined=jinja2.StrictUndefined)
-    return env.get_template(name).render(**context)
+    env.globals["page_style"] = STYLE
+    env.filters["words"] = words
+    env.filters["unit"] = unit
+    return finish(env.get_template(name).render(**context))
 
 
 def render_html(report) -> str:
