@@ -14,18 +14,14 @@ printed equations of their layouts (no derivation involved).
 
 from __future__ import annotations
 
-from ._common import layout_inputs, planned_outputs
+from ._common import command_parser, layout_inputs, planned_outputs
 
 
 def register(sub) -> None:
-    p = sub.add_parser("audit", help="derived equations against the printed ones (errata)")
-    p.add_argument("layouts", nargs="*", metavar="LAYOUT",
-                   help="restrict to these layouts, by name or layout file (default: every "
-                        "audited equation)")
+    p, H = command_parser(sub, "audit")
+    p.add_argument("layouts", nargs="*", metavar="LAYOUT", help=H["layouts"])
     p.add_argument("--json", metavar="F", help="write the verdicts with evidence as JSON")
-    p.add_argument("--html", metavar="F",
-                   help="write one HTML page: a section per source document, rendered math, "
-                        "category and evidence of every verdict (no network needed to view)")
+    p.add_argument("--html", metavar="F", help=H["--html"])
     p.add_argument("--detail", action="store_true",
                    help="one row per component (dX, RY2, the rule of dx(X) ...)")
     p.add_argument("--numeric", action="store_true",

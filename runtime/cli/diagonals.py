@@ -1,25 +1,19 @@
-"""``volerr diagonals LAYOUT --errors DIR``: length deviations of the space diagonals (Pahk
-sec. 4), face diagonals and axis-parallel lines of the working volume.
-
-Prints a table in um (with standard deviations in the tables also the random component u(dL),
-k = 1), optionally writes ``--json`` (with the profiles along each line) and ``--plot``.
-Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
-"""
+"""``volerr diagonals LAYOUT --errors DIR``: length deviations of the space diagonals, face
+diagonals and axis-parallel lines; see ``volerr diagonals --help`` and
+:mod:`volerr.cmm.diagonals` (definitions, the propagation assumption)."""
 
 from __future__ import annotations
 
-from ._common import add_accept_implausible, add_common, inputs_of, parse_at, planned_outputs
+from ._common import (add_accept_implausible, add_common, command_parser, inputs_of, parse_at,
+                      planned_outputs)
 from ..choices import DIAGONAL_KINDS
 
 
 def register(sub) -> None:
-    p = sub.add_parser("diagonals", help="space diagonals, face diagonals and axis-parallel "
-                                         "lines of the working volume (length deviations)",
-                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    p, H = command_parser(sub, "diagonals")
     add_common(p)
     p.add_argument("--lines", nargs="+", choices=DIAGONAL_KINDS, default=list(DIAGONAL_KINDS),
-                   help="which lines: space diagonals, face diagonals, axis-parallel "
-                        "lines")
+                   help=H["--lines"])
     p.add_argument("--profile-points", type=int, default=21, metavar="N",
                    help="points along each line for the profile (default 21)")
     p.add_argument("--json", metavar="F", help="results with profiles as JSON")
