@@ -17,17 +17,13 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, help="compensated program (never the input)")
     add_error_arguments(p)
     p.add_argument("--strategy", choices=("full", "thesis"), default="full", help=H["--strategy"])
-    p.add_argument("--orientation", action="store_true",
-                   help="also correct the tool orientation with the rotary axes (FOR)")
+    p.add_argument("--orientation", action="store_true", help=H["--orientation"])
     p.add_argument("--types", default=None, help=H["--types"])
     add_vector(p, "--tool", default=(0.0, 0.0, 0.0), help=H["--tool"])
-    p.add_argument("--tol-um", type=float, default=0.1,
-                   help="stop iterating when the correction changes by less than this (um)")
-    p.add_argument("--decimals", type=int, default=4,
-                   help="decimals of the written numbers (at least those of the input)")
+    p.add_argument("--tol-um", type=float, default=0.1, help=H["--tol-um"])
+    p.add_argument("--decimals", type=int, default=4, help=H["--decimals"])
     p.add_argument("--initial", default=None, help=H["--initial"])
-    p.add_argument("--ignore-travel", action="store_true",
-                   help="accept positions outside the layout's travel")
+    p.add_argument("--ignore-travel", action="store_true", help=H["--ignore-travel"])
     p.add_argument("--arc-tolerance-um", type=float, default=1.0, metavar="T",
                    help=H["--arc-tolerance-um"])
     p.add_argument("--tool-length", type=float, default=None, metavar="MM",

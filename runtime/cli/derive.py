@@ -9,10 +9,8 @@ from ._common import command_parser
 def register(sub) -> None:
     p, H = command_parser(sub, "derive")
     p.add_argument("layout", nargs="*", help="layout name or layout file")
-    p.add_argument("--all", action="store_true",
-                   help="every shipped layout and every layout-independent module")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="output folder (default: ./generated of the working directory)")
+    p.add_argument("--all", action="store_true", help=H["--all"])
+    p.add_argument("--out", metavar="DIR", default=None, help=H["--out"])
     p.add_argument("--in-package", action="store_true", help=H["--in-package"])
     p.set_defaults(func=run)
 

@@ -7,9 +7,8 @@ from ._common import add_force, command_parser
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "examples")
-    p.add_argument("--out", required=True, metavar="DIR",
-                   help="folder to write (created when missing, its parent must exist)")
+    p, H = command_parser(sub, "examples")
+    p.add_argument("--out", required=True, metavar="DIR", help=H["--out"])
     add_force(p)
     p.set_defaults(func=run)
 

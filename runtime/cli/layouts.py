@@ -5,9 +5,8 @@ from ._common import command_parser
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "layouts")
-    p.add_argument("--long", action="store_true",
-                   help="with axes, travel, rotary axis points, parameters and description")
+    p, H = command_parser(sub, "layouts")
+    p.add_argument("--long", action="store_true", help=H["--long"])
     p.set_defaults(func=run)
 
 

@@ -15,8 +15,7 @@ def register(sub) -> None:
     p.add_argument("--out", metavar="CSV", help=H["--out"])
     p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")
     p.add_argument("--plot-random", metavar="PNG", help=H["--plot-random"])
-    p.add_argument("--magnify", type=float, default=None, metavar="K",
-                   help="error magnification in the plots (default: automatic)")
+    p.add_argument("--magnify", type=float, default=None, metavar="K", help=H["--magnify"])
     p.add_argument("--json", metavar="F", help="summary as JSON")
     p.add_argument("--approach", default=None, metavar="DIRS", help=H["--approach"])
     add_accept_implausible(p)
