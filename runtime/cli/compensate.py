@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from ._common import (add_error_arguments, add_identification_arguments, add_vector,
@@ -40,8 +41,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-
     from ..fiveaxis.api import compensate
 
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),

@@ -5,7 +5,7 @@ diagonals and axis-parallel lines; see ``volerr diagonals --help`` and
 from __future__ import annotations
 
 from ._common import (add_accept_implausible, add_common, command_parser, inputs_of, parse_at,
-                      planned_outputs)
+                      planned_outputs, write_files)
 from ..choices import DIAGONAL_KINDS
 
 
@@ -33,10 +33,7 @@ def run(args) -> int:
     outs = planned_outputs(args, inputs_of(args))
     print(res.summary())
     with outs:
-        if args.plot:
-            res.write_plot(outs.path("--plot"), inputs_of(args))
-        if args.json:
-            res.write_json(outs.path("--json"), inputs_of(args))
+        write_files(args, outs, res, inputs_of(args), roles=("plot", "json"))
     for label, path in (("json", args.json), ("plot", args.plot)):
         if path:
             print(f"{label}: {path}")
