@@ -1,21 +1,16 @@
-"""``volerr demo [--out DIR]``: the whole pipeline on built-in data; writes a report.
-
-Argument parsing only: the run is :func:`volerr.demo` (:mod:`volerr.demo`)."""
+"""``volerr demo [--out DIR]``: argument parsing only, the run is :func:`volerr.demo`."""
 
 from __future__ import annotations
 
 from ..choices import DEMO_SECTIONS as SECTIONS
-from ._common import add_force
+from ._common import add_force, command_parser
 
 
 def register(sub) -> None:
-    p = sub.add_parser("demo", help="the whole pipeline on built-in data; writes a report",
-                       description=__doc__.split("\n\n")[0])
+    p, H = command_parser(sub, "demo")
     p.add_argument("--out", default="volerr-demo", help="output folder (default volerr-demo)")
     p.add_argument("--only", nargs="+", choices=SECTIONS, help="run only these sections")
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="worker processes for the sections (default: one per core, at most "
-                        "2; 1: all in one process); the files do not depend on it")
+    p.add_argument("--jobs", type=int, default=None, metavar="N", help=H["--jobs"])
     add_force(p)
     p.set_defaults(func=run)
 

@@ -1,26 +1,17 @@
-"""``volerr derive LAYOUT [--out DIR]``: derive a layout and generate its numpy module.
-
-Writes ``<name>.py`` into ``--out`` (default: ``./generated/`` of the working directory), never
-into the installed package.  ``volerr derive --all`` regenerates every file of ``generated/``
-(one module per shipped layout plus the layout-independent modules); run from a source checkout
-it writes the committed ``generated/`` folder (that is ``./generated/`` there), elsewhere give
-``--out DIR`` or, as a developer, ``--in-package`` to regenerate the installed package's folder.
-"""
+"""``volerr derive LAYOUT [--out DIR]``: derive a layout and generate its numpy module; see
+``volerr derive --help``."""
 
 from pathlib import Path
 
+from ._common import command_parser
+
 
 def register(sub) -> None:
-    p = sub.add_parser("derive", help="derive and generate one layout (or --all)",
-                       description=__doc__.split("\n\n")[1])
+    p, H = command_parser(sub, "derive")
     p.add_argument("layout", nargs="*", help="layout name or layout file")
-    p.add_argument("--all", action="store_true",
-                   help="every shipped layout and every layout-independent module")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="output folder (default: ./generated of the working directory)")
-    p.add_argument("--in-package", action="store_true",
-                   help="developers: with --all, regenerate the installed package's generated/ "
-                        "folder")
+    p.add_argument("--all", action="store_true", help=H["--all"])
+    p.add_argument("--out", metavar="DIR", default=None, help=H["--out"])
+    p.add_argument("--in-package", action="store_true", help=H["--in-package"])
     p.set_defaults(func=run)
 
 

@@ -1,25 +1,19 @@
-"""``volerr diagonals LAYOUT --errors DIR``: length deviations of the space diagonals (Pahk
-sec. 4), face diagonals and axis-parallel lines of the working volume.
-
-Prints a table in um (with standard deviations in the tables also the random component u(dL),
-k = 1), optionally writes ``--json`` (with the profiles along each line) and ``--plot``.
-Definitions and the propagation assumption: :mod:`volerr.cmm.diagonals`.
-"""
+"""``volerr diagonals LAYOUT --errors DIR``: length deviations of the space diagonals, face
+diagonals and axis-parallel lines; see ``volerr diagonals --help`` and
+:mod:`volerr.cmm.diagonals` (definitions, the propagation assumption)."""
 
 from __future__ import annotations
 
-from ._common import add_accept_implausible, add_common, inputs_of, parse_at, planned_outputs
+from ._common import (add_accept_implausible, add_common, command_parser, inputs_of, parse_at,
+                      planned_outputs, write_files)
 from ..choices import DIAGONAL_KINDS
 
 
 def register(sub) -> None:
-    p = sub.add_parser("diagonals", help="space diagonals, face diagonals and axis-parallel "
-                                         "lines of the working volume (length deviations)",
-                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    p, H = command_parser(sub, "diagonals")
     add_common(p)
     p.add_argument("--lines", nargs="+", choices=DIAGONAL_KINDS, default=list(DIAGONAL_KINDS),
-                   help="which lines: space diagonals, face diagonals, axis-parallel "
-                        "lines")
+                   help=H["--lines"])
     p.add_argument("--profile-points", type=int, default=21, metavar="N",
                    help="points along each line for the profile (default 21)")
     p.add_argument("--json", metavar="F", help="results with profiles as JSON")
@@ -39,10 +33,7 @@ def run(args) -> int:
     outs = planned_outputs(args, inputs_of(args))
     print(res.summary())
     with outs:
-        if args.plot:
-            res.write_plot(outs.path("--plot"), inputs_of(args))
-        if args.json:
-            res.write_json(outs.path("--json"), inputs_of(args))
+        write_files(args, outs, res, inputs_of(args), roles=("plot", "json"))
     for label, path in (("json", args.json), ("plot", args.plot)):
         if path:
             print(f"{label}: {path}")

@@ -3,14 +3,12 @@
 
 from __future__ import annotations
 
-from ._common import add_force, help_text
+from ._common import add_force, command_parser
 
 
 def register(sub) -> None:
-    p = sub.add_parser("examples", help="write example input files for every command",
-                       description=help_text("examples-description"))
-    p.add_argument("--out", required=True, metavar="DIR",
-                   help="folder to write (created when missing, its parent must exist)")
+    p, H = command_parser(sub, "examples")
+    p.add_argument("--out", required=True, metavar="DIR", help=H["--out"])
     add_force(p)
     p.set_defaults(func=run)
 

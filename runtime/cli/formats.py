@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from ._common import command_parser
+
 
 def __getattr__(name):
     # text() and sections() by their former place, imported only when asked (--help imports
@@ -15,15 +17,8 @@ def __getattr__(name):
 
 
 def register(sub) -> None:
-    p = sub.add_parser("formats", help="the file formats (error tables, tracker CSV, layout "
-                                       "TOML, G-code ...)",
-                       description="Print the file formats volerr reads and writes: all "
-                                   "section names, or one section.")
-    p.add_argument("name", nargs="?", metavar="NAME",
-                   help="section: tables, tracker, probe-sphere, deviations, ballbar, sphere, "
-                        "artifact, interferometer, distances, drift, iso230-3, calibrate-json, "
-                        "check, loop-json, history, layout, gcode, tools, controller, "
-                        "axis-tables, uncertainty, iso230-2, outputs, audit, or 'all'")
+    p, H = command_parser(sub, "formats")
+    p.add_argument("name", nargs="?", metavar="NAME", help=H["name"])
     p.set_defaults(func=run)
 
 

@@ -1,14 +1,12 @@
-"""``volerr layouts [--long]``: list the shipped layouts (with --long: axes, travel, rotary axis
-points, parameters and the description)."""
+"""``volerr layouts [--long]``: list the shipped layouts; see ``volerr layouts --help``."""
 
 from ..machine.layout import describe, layout_names, read_layout
+from ._common import command_parser
 
 
 def register(sub) -> None:
-    p = sub.add_parser("layouts", help="list the shipped machine layouts",
-                       description=__doc__.split(":", 1)[1].strip())
-    p.add_argument("--long", action="store_true",
-                   help="with axes, travel, rotary axis points, parameters and description")
+    p, H = command_parser(sub, "layouts")
+    p.add_argument("--long", action="store_true", help=H["--long"])
     p.set_defaults(func=run)
 
 

@@ -1,37 +1,23 @@
-"""``volerr map LAYOUT --errors DIR``: volumetric error map over the working volume.
-
-Writes the map as CSV (``--out``), plots it like Pahk Fig. 5 / 7 (``--plot``; with standard
-deviations in the tables also ``<plot>_random.png`` or ``--plot-random``) and prints a summary
-(um).  See :mod:`volerr.cmm.volmap` for the grid, the columns and the plots.
-"""
+"""``volerr map LAYOUT --errors DIR``: volumetric error map over the working volume; see
+``volerr map --help`` and :mod:`volerr.cmm.volmap` (the grid, the columns and the plots)."""
 
 from __future__ import annotations
 
 from ._common import (add_accept_implausible, add_common, add_identification_arguments,
-                      identification_from_args, inputs_of, parse_at, planned_outputs,
-                      write_outputs)
+                      command_parser, identification_from_args, inputs_of, parse_at,
+                      planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    p = sub.add_parser("map", help="volumetric error map over the working volume (CSV, plots)",
-                       description=__doc__.split("\n\n")[1].replace("``", ""))
+    p, H = command_parser(sub, "map")
     add_common(p)
-    p.add_argument("--grid", nargs="+", type=int, default=None, metavar="N",
-                   help="grid points per axis: N, or nx ny nz (default 5; 2..200 per axis, at "
-                        "most 10^6 points in all: N <= 100)")
-    p.add_argument("--out", metavar="CSV", help="map CSV: axis positions, Xp Yp Zp, dx_um dy_um "
-                                                "dz_um (+ rx_um ry_um rz_um)")
+    p.add_argument("--grid", nargs="+", type=int, default=None, metavar="N", help=H["--grid"])
+    p.add_argument("--out", metavar="CSV", help=H["--out"])
     p.add_argument("--plot", metavar="PNG", help="nominal vs actual grid, magnified")
-    p.add_argument("--plot-random", metavar="PNG",
-                   help="random component plot (default <plot>_random.png when the tables "
-                        "have std)")
-    p.add_argument("--magnify", type=float, default=None, metavar="K",
-                   help="error magnification in the plots (default: automatic)")
+    p.add_argument("--plot-random", metavar="PNG", help=H["--plot-random"])
+    p.add_argument("--magnify", type=float, default=None, metavar="K", help=H["--magnify"])
     p.add_argument("--json", metavar="F", help="summary as JSON")
-    p.add_argument("--approach", default=None, metavar="DIRS",
-                   help="approach direction of axes whose tables carry a reversal column "
-                        "RV_<axis>_um (ISO 230-2 B_i): X+,Y- per axis, or + / - for all "
-                        "(default: the bidirectional mean, the tabulated value)")
+    p.add_argument("--approach", default=None, metavar="DIRS", help=H["--approach"])
     add_accept_implausible(p)
     add_identification_arguments(p)
     p.set_defaults(func=run)
