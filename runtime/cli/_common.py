@@ -13,17 +13,11 @@ from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the par
 def add_error_arguments(parser, required: bool = True) -> None:
     """Add ``--errors DIR --method --degree --extrapolate --accept-implausible`` to an argparse
     parser."""
-    parser.add_argument("--errors", metavar="DIR", required=required,
-                        help="error directory: X.csv, Y.csv, ... (one table per axis) and "
-                             "optionally constants.csv")
-    parser.add_argument("--method", choices=METHODS, default="linear",
-                        help="error functions from the tables: linear or cubic interpolation, "
-                             "or least-squares polynomial (default linear)")
-    parser.add_argument("--degree", type=int, default=None,
-                        help="polynomial degree for --method poly (default: chosen by "
-                             "leave-one-out cross-validation)")
-    parser.add_argument("--extrapolate", action="store_true",
-                        help="evaluate beyond the measured range of a table (default: refuse)")
+    a = parser.add_argument
+    a("--errors", metavar="DIR", required=required, help=_C("--errors"))
+    a("--method", choices=METHODS, default="linear", help=_C("--method"))
+    a("--degree", type=int, default=None, help=_C("--degree"))
+    a("--extrapolate", action="store_true", help=_C("--extrapolate"))
     add_accept_implausible(parser)
 
 
@@ -44,9 +38,7 @@ def add_accept_implausible(parser) -> None:
     if "--accept-implausible" in parser._option_string_actions:
         return
     parser.add_argument("--accept-implausible", action="store_true",
-                        help="for a machine that really is that bad: use error values beyond "
-                             "what a machine of this travel can have (default: refused, "
-                             "naming the likely unit mistake)")
+                        help=_C("--accept-implausible"))
 
 
 def add_common(p) -> None:
@@ -55,11 +47,9 @@ def add_common(p) -> None:
     add_error_arguments(p)
     add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
                help="probe / tool offset XP YP ZP, mm (X Y Z or X,Y,Z)")
-    p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
-                   help="position of a rotary axis during the test, repeatable (default 0 deg)")
+    p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG", help=_C("--at"))
     p.add_argument("--volume", choices=("travel", "measured"), default="travel",
-                   help="box of the linear axes: the layout's travel (default) or the part of "
-                        "it the error tables cover (no extrapolation either way)")
+                   help=_C("--volume"))
 
 
 def inputs_of(args, model=None) -> list:
@@ -126,53 +116,34 @@ def add_errors_out(parser, what: str, *aliases: str, required: bool = False) -> 
     """``--errors-out DIR`` for every error directory a command writes (``map --errors DIR``
     reads it); ``aliases``: the command's former spelling, still accepted."""
     parser.add_argument("--errors-out", *aliases, dest="errors_out", metavar="DIR",
-                        required=required,
-                        help=f"write {what} as an error directory (X.csv ... constants.csv; "
-                             f"'volerr formats tables'); created when missing, its parent "
-                             f"must exist")
+                        required=required, help=_C("--errors-out").format(what))
 
 
 def add_force(parser) -> None:
     """``--force``: a folder output may replace files that were there before the run."""
-    parser.add_argument("--force", action="store_true",
-                        help="let an output folder replace files that exist there already "
-                             "(without it such a file is named and nothing is written)")
+    parser.add_argument("--force", action="store_true", help=_C("--force"))
 
 
 def add_accept_residual(parser) -> None:
     """``--accept-residual``: write a fit whose residual is far above the readings' declared
     uncertainty (:mod:`volerr.fit_quality`), every output marked as forced."""
-    parser.add_argument("--accept-residual", action="store_true",
-                        help="write the results even when the fit's residual is far above "
-                             "the readings' declared uncertainty (chi2/dof > 4 at p < 1e-6; "
-                             "without it: exit 2, nothing written); every output then says "
-                             "it was forced")
+    parser.add_argument("--accept-residual", action="store_true", help=_C("--accept-residual"))
 
 
 def add_max_change(parser, reference: bool) -> None:
     """``--max-change`` and ``--accept-change`` (the KinematicsOpt maxModification rule,
     :mod:`volerr.fit_quality`); ``reference``: also ``--reference CAL.json`` (calibrate)."""
     if reference:
-        parser.add_argument("--reference", metavar="CAL.json",
-                            help="an earlier calibrate or check --json: its parameters are "
-                                 "compared with the new ones (--max-change)")
-    parser.add_argument("--max-change", metavar="LIMITS",
-                        help="largest change of a parameter against the reference written "
-                             "without consent: \"EX0C=20 um,EA0B=50 urad\" or one bound per "
-                             "unit (\"20 um,50 urad\"); units required")
-    parser.add_argument("--accept-change", action="store_true",
-                        help="write the results although a parameter moved more than "
-                             "--max-change")
+        parser.add_argument("--reference", metavar="CAL.json", help=_C("--reference"))
+    parser.add_argument("--max-change", metavar="LIMITS", help=_C("--max-change"))
+    parser.add_argument("--accept-change", action="store_true", help=_C("--accept-change"))
 
 
 #: options whose values are outputs or switches of writing, not of the method (report id)
 _NOT_METHOD = {"json", "html", "pdf", "plot", "errors_out", "map_out", "out", "force", "func",
                "command", "action", "identification", "date"}
-_IDENT_OPTIONS = {"--machine": ("machine", "the machine tested: id, make, model, serial number"),
-                  "--operator": ("operator", "who made the measurement"),
-                  "--date": ("date", "date of the measurement YYYY-MM-DD (not in the future; "
-                                     "not given: the file's, else today)"),
-                  "--customer": ("customer", "the customer the report is for")}
+#: the identification's fields, in the order of their options
+_IDENT_FIELDS = ("machine", "operator", "date", "customer", "instrument")
 
 
 def add_identification_arguments(parser, instrument: str = "the measuring instrument") -> None:
@@ -180,24 +151,17 @@ def add_identification_arguments(parser, instrument: str = "the measuring instru
     identification of a report (:mod:`volerr.certificate`) and its PDF certificate.  An option
     the command already has with its own meaning (``check --instrument SPEC``, ``history
     --machine ID``) keeps it; that field then comes from the identification file."""
-    g = parser.add_argument_group("report identification (on the page, in the JSON and the "
-                                  "PDF; options replace the fields of the identification file)")
+    g = parser.add_argument_group(_C("identification"))
     have = parser._option_string_actions
-    g.add_argument("--identification", metavar="F.toml",
-                   help="identification file (TOML: machine, instruments, operator, customer, "
-                        "date, environment); without it volerr-identification.toml beside the "
-                        "first data file is read when it is there")
+    g.add_argument("--identification", metavar="F.toml", help=_C("--identification"))
     own = []
-    for flag, (dest, text) in {**_IDENT_OPTIONS, "--instrument": (
-            "instrument", f"{instrument}: make, model, serial number, calibration")}.items():
-        if flag not in have:
-            g.add_argument(flag, dest=dest, metavar="YYYY-MM-DD" if dest == "date" else "TEXT",
-                           help=text)
+    for dest in _IDENT_FIELDS:
+        if f"--{dest}" not in have:
+            g.add_argument(f"--{dest}", dest=dest, help=_C(f"--{dest}").format(instrument),
+                           metavar="YYYY-MM-DD" if dest == "date" else "TEXT")
             own.append(dest)
     if "--pdf" not in have:
-        g.add_argument("--pdf", metavar="F.pdf",
-                       help="write the PDF certificate (A4, identification, conditions, "
-                            "results with U and k, budget, figures)")
+        g.add_argument("--pdf", metavar="F.pdf", help=_C("--pdf"))
     parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog)
 
 
@@ -331,6 +295,16 @@ def option_help(name: str) -> dict:
     positional argument) on the first line, its help on the next (re-wrapped by --help)."""
     blocks = help_text(f"{name}.options").strip("\n").split("\n\n")
     return {b.split("\n", 1)[0]: " ".join(b.split("\n")[1:]) for b in blocks}
+
+
+def _C(option: str) -> str:
+    """The help of a shared option (its text in ``volerr/data/help/common.options.txt``)."""
+    global _COMMON
+    _COMMON = _COMMON or option_help("common")
+    return _COMMON[option]
+
+
+_COMMON: dict = {}
 
 
 def add_report_options(parser, json: str, html: str, instrument: str | None = None) -> None:
