@@ -7,13 +7,12 @@ from ._common import (add_force, add_html, add_identification, add_json, add_plo
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "iso230-3")
+    p, H = command_parser(sub, "iso230-3")
     p.add_argument("file", metavar="FILE", help="the drift file (volerr formats drift)")
     add_json(p, "the results")
     add_plot(p, "drift, tilts, speed and temperatures against time")
     add_html(p, "the test report (identification, drift per channel and stage, the plot)")
-    p.add_argument("--stage-column", metavar="NAME", help="the logged column whose changes "
-                   "make the stages (default: stage, else S_rpm)")
+    p.add_argument("--stage-column", metavar="NAME", help=H["--stage-column"])
     add_force(p)
     add_identification(p, "the displacement sensors")
     p.set_defaults(func=run)
