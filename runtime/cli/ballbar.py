@@ -1,5 +1,4 @@
-"""``volerr ballbar simulate|evaluate``: ballbar traces of a model, ISO 230-4 evaluation; see
-``volerr ballbar --help``."""
+"""``volerr ballbar simulate|evaluate``: ballbar traces, ISO 230-4 (``ballbar.api``)."""
 
 from __future__ import annotations
 

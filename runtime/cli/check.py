@@ -1,5 +1,4 @@
-"""``volerr check [plan] LAYOUT --reference CAL.json ...``: the interim check; see ``volerr check
---help``."""
+"""``volerr check [plan] LAYOUT --reference CAL.json ...``: the interim check."""
 
 from __future__ import annotations
 

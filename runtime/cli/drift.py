@@ -1,5 +1,4 @@
-"""``volerr drift convert``: a thermal logger's file -> a drift file (``--help``; the Python
-API :func:`volerr.instruments.drift_test.drift_convert`)."""
+"""``volerr drift convert``: a logger's file -> a drift file (``drift_test.drift_convert``)."""
 
 from __future__ import annotations
 

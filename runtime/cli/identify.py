@@ -1,5 +1,4 @@
-"""``volerr identify LAYOUT --axis A FILE... --out F``: laser-tracker identification of an axis;
-see ``volerr identify --help``."""
+"""``volerr identify``: laser-tracker identification of an axis (:func:`volerr.identify`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""``volerr probe-cal``: probe calibration on a master sphere, or a probing plan (``--help``;
-the Python API :func:`volerr.probe_cal`, :func:`volerr.probe.api.probe_plan`)."""
+"""``volerr probe-cal``: probe calibration or a probing plan (:func:`volerr.probe_cal`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""``volerr simulate LAYOUT --out F``: a virtual machine's deviations or instrument file; see
-``volerr simulate --help``."""
+"""``volerr simulate LAYOUT --out F``: a virtual machine's deviations or instrument file."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""``volerr squareness``: squareness from the reference lines of straightness tables
-(``--help``; the Python API :func:`volerr.cmm.api.squareness`)."""
+"""``volerr squareness``: squareness of straightness tables (:func:`volerr.cmm.api.squareness`)."""
 
 from __future__ import annotations
 
