@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ._common import (add_html, add_identification_arguments, add_json, command_parser,
-                      help_text, identification_from_args, planned_outputs, write_outputs)
+from ._common import (add_html, add_identification_arguments, add_json, command_parser, help_text,
+                      identification_from_args, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, command_parser, identification_from_args, inputs_of,
-                      options_of, planned_outputs, write_document_outputs)
+                      add_vector, command_parser, identification_from_args, inputs_of, options_of,
+                      planned_outputs, write_document_outputs)
 
 
 def register(sub) -> None:

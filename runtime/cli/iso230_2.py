@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ._common import (add_errors_out, add_force, add_html, add_identification, add_json,
-                      add_plot, command_parser, identification_from_args, options_of,
-                      planned_outputs, write_outputs)
+from ._common import (add_errors_out, add_force, add_html, add_identification, add_json, add_plot,
+                      command_parser, identification_from_args, options_of, planned_outputs,
+                      write_outputs)
 
 
 def register(sub) -> None:

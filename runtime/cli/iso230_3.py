@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ._common import (add_force, add_html, add_identification, add_json, add_plot,
-                      command_parser, identification_from_args, write_document_outputs)
+from ._common import (add_force, add_html, add_identification, add_json, add_plot, command_parser,
+                      identification_from_args, write_document_outputs)
 
 
 def register(sub) -> None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import require
-from ._common import (add_accept_implausible, add_errors_out, add_force, add_json,
-                      command_parser, layout_inputs, planned_outputs, write_files)
+from ._common import (add_accept_implausible, add_errors_out, add_force, add_json, command_parser,
+                      layout_inputs, planned_outputs, write_files)
 
 
 def register(sub) -> None:

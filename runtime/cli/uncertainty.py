@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from ..choices import BIAS_MODES
 from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
-                      add_plot, command_parser, identification_from_args, inputs_of,
-                      layout_inputs, options_of, planned_outputs, write_outputs)
+                      add_plot, command_parser, identification_from_args, inputs_of, layout_inputs,
+                      options_of, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
