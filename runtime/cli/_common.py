@@ -5,14 +5,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..choices import INTERPOLATION as METHODS
-from ..errors import InputError, require
+from ..errors import InputError
 from ..progress import bar, progress, progress_bar  # noqa: F401  (one rule: volerr.progress)
 from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the parsing: units)
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
-    """Add ``--errors DIR --method --degree --extrapolate --accept-implausible`` to an argparse
-    parser."""
+    """``--errors DIR --method --degree --extrapolate --accept-implausible``."""
     a = parser.add_argument
     a("--errors", metavar="DIR", required=required, help=_C("--errors"))
     a("--method", choices=METHODS, default="linear", help=_C("--method"))
@@ -53,8 +52,7 @@ def add_common(p) -> None:
 
 
 def inputs_of(args, model=None) -> list:
-    """Files that must never be overwritten: the error tables and a layout file (shipped
-    layouts are package files, protected by :class:`volerr.fileio.Outputs` anyway)."""
+    """The inputs never overwritten: the error tables and a layout file (not a shipped one)."""
     from ..cmm import volmap
 
     files = volmap.error_dir_inputs(args.errors)
@@ -70,8 +68,7 @@ def layout_inputs(layout) -> list:
 
 def add_vector(parser, flag: str, help: str, default=None, required: bool = False,
                append: bool = False, metavar: str = "X Y Z") -> None:
-    """A 3-vector option that accepts both ``X Y Z`` and ``X,Y,Z`` (checked at parse time:
-    exit 2 and one line for a bad value)."""
+    """A 3-vector option, ``X Y Z`` or ``X,Y,Z`` (a bad value: exit 2 and one line)."""
     import argparse
 
     class _Vector(argparse.Action):
@@ -113,8 +110,7 @@ def add_html(parser, what: str = "a one-page report with the figures") -> None:
 
 
 def add_errors_out(parser, what: str, *aliases: str, required: bool = False) -> None:
-    """``--errors-out DIR`` for every error directory a command writes (``map --errors DIR``
-    reads it); ``aliases``: the command's former spelling, still accepted."""
+    """``--errors-out DIR``, an error directory written (``aliases``: former spellings)."""
     parser.add_argument("--errors-out", *aliases, dest="errors_out", metavar="DIR",
                         required=required, help=_C("--errors-out").format(what))
 
@@ -125,8 +121,7 @@ def add_force(parser) -> None:
 
 
 def add_accept_residual(parser) -> None:
-    """``--accept-residual``: write a fit whose residual is far above the readings' declared
-    uncertainty (:mod:`volerr.fit_quality`), every output marked as forced."""
+    """``--accept-residual``: write a fit of too large a residual (:mod:`volerr.fit_quality`)."""
     parser.add_argument("--accept-residual", action="store_true", help=_C("--accept-residual"))
 
 
@@ -237,21 +232,10 @@ def write_outputs(args, outs, result, ident, inputs, title: str | None = None) -
 
 
 def help_text(command: str) -> str:
-    """The epilog of ``volerr COMMAND --help`` (input formats, outputs, methods): the text
-    file ``volerr/data/help/COMMAND.txt`` (documentation, kept beside formats.md)."""
+    """The text file ``volerr/data/help/COMMAND.txt`` (e.g. the epilog of ``--help``)."""
     from importlib.resources import files
 
     return (files("volerr") / "data" / "help" / f"{command}.txt").read_text(encoding="utf-8")
-
-
-def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
-    """A number option checked to be finite and within [low, high] (None passes)."""
-    import math
-
-    if value is not None:
-        require(math.isfinite(value) and low <= value <= high,
-                f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
-    return value
 
 
 # ---------------------------------------------------------------------------------------------
@@ -274,8 +258,7 @@ def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
 
 
 def error_dir_names(layout) -> list:
-    """The files of the error directory a fit of ``layout`` writes: ``<axis>.csv`` of every
-    axis and ``constants.csv`` (declared before the run)."""
+    """The files of a fit's error directory: ``<axis>.csv`` of ``layout``'s axes, constants."""
     from ..machine.model import load
 
     return [f"{a}.csv" for a in load(layout).axes] + ["constants.csv"]
@@ -317,8 +300,7 @@ def add_report_options(parser, json: str, html: str, instrument: str | None = No
 
 
 def add_fit_switches(parser, implausible: bool = True) -> None:
-    """``--force``, ``--accept-residual`` and (``implausible``) ``--accept-implausible``, in
-    this order: the switches of a command that writes a fit."""
+    """``--force``, ``--accept-residual``, (``implausible``) ``--accept-implausible``."""
     add_force(parser)
     add_accept_residual(parser)
     if implausible:
@@ -344,6 +326,5 @@ def write_document_outputs(args, outs, result, ident, inputs, title: str | None 
 
 
 def options_of(args, names: str, **more) -> dict:
-    """The options ``names`` (their argparse dests, space separated) as keywords of the
-    command's API function, which names them alike; ``more`` added over them."""
+    """The options ``names`` (dests, space separated) as the API's keywords, and ``more``."""
     return {**{name: getattr(args, name) for name in names.split()}, **more}
