@@ -31,13 +31,10 @@ def error_functions_from_args(args, model):
 
 
 def add_accept_implausible(parser) -> None:
-    """``--accept-implausible``: error values beyond what a machine of the layout's travel can
-    have (:mod:`volerr.tables.plausible`) are used instead of refused.  Added once (a command
-    whose error arguments carry it already is left as it is)."""
-    if "--accept-implausible" in parser._option_string_actions:
-        return
-    parser.add_argument("--accept-implausible", action="store_true",
-                        help=_C("--accept-implausible"))
+    """``--accept-implausible`` (:mod:`volerr.tables.plausible`), once (not twice)."""
+    if "--accept-implausible" not in parser._option_string_actions:
+        parser.add_argument("--accept-implausible", action="store_true", help=_C(
+            "--accept-implausible"))
 
 
 def add_common(p) -> None:
@@ -126,8 +123,8 @@ def add_accept_residual(parser) -> None:
 
 
 def add_max_change(parser, reference: bool) -> None:
-    """``--max-change`` and ``--accept-change`` (the KinematicsOpt maxModification rule,
-    :mod:`volerr.fit_quality`); ``reference``: also ``--reference CAL.json`` (calibrate)."""
+    """(``reference``: ``--reference CAL.json``) ``--max-change``, ``--accept-change``
+    (the KinematicsOpt maxModification rule, :mod:`volerr.fit_quality`)."""
     if reference:
         parser.add_argument("--reference", metavar="CAL.json", help=_C("--reference"))
     parser.add_argument("--max-change", metavar="LIMITS", help=_C("--max-change"))
@@ -142,10 +139,8 @@ _IDENT_FIELDS = ("machine", "operator", "date", "customer", "instrument")
 
 
 def add_identification_arguments(parser, instrument: str = "the measuring instrument") -> None:
-    """``--identification F --machine --instrument --operator --date --customer --pdf F``: the
-    identification of a report (:mod:`volerr.certificate`) and its PDF certificate.  An option
-    the command already has with its own meaning (``check --instrument SPEC``, ``history
-    --machine ID``) keeps it; that field then comes from the identification file."""
+    """``--identification F``, its fields' options (:mod:`volerr.certificate`), ``--pdf F``;
+    an option the command has with its own meaning keeps it (the field: from the file)."""
     g = parser.add_argument_group(_C("identification"))
     have = parser._option_string_actions
     g.add_argument("--identification", metavar="F.toml", help=_C("--identification"))
@@ -164,10 +159,8 @@ add_identification = add_identification_arguments   # its former name
 
 
 def identification_from_args(args, files=(), conditions: dict | None = None):
-    """:class:`volerr.certificate.Identification` of the options of
-    :func:`add_identification_arguments` and the identification file (``--identification``,
-    else volerr-identification.toml beside the first of ``files``); checked (dates), with
-    its report id (``files``' bytes and the options) and method (command, version, options)."""
+    """:class:`volerr.certificate.Identification` of the options and the identification file
+    (else volerr-identification.toml beside ``files[0]``), with its report id and method."""
     from .. import __version__, certificate
 
     own = set(getattr(args, "_ident_own", ())) | {"date"}
@@ -181,9 +174,8 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
 
 
 def write_certificates(outs, result, ident, inputs=(), title: str | None = None) -> None:
-    """Inside ``with outs:`` after the command's own outputs: the identification stamped into
-    the written ``--json`` and ``--html`` and the ``--pdf`` certificate of ``result`` (a
-    result object or its JSON document; :func:`volerr.report.stamp.finish`)."""
+    """Inside ``with outs:``: :func:`volerr.report.stamp.finish` of ``result`` (a result or its
+    JSON document): the identification stamped into ``--json``, ``--html``; ``--pdf``."""
     from ..report import stamp
     from ..report.document import Document
 
@@ -218,16 +210,9 @@ def _declare(outs, targets: dict) -> None:
 
 
 def write_outputs(args, outs, result, ident, inputs, title: str | None = None) -> None:
-    """Inside ``with outs:``, after the command's own outputs: the outputs of the result
-    contract the command was given (``--plot`` :meth:`write_plot`, ``--json``
-    :meth:`write_json`, ``--html`` :meth:`write_html`), then the identification stamped
-    into them and the ``--pdf`` certificate (:func:`write_certificates`)."""
-    if getattr(args, "plot", None):   # first: a plot may record its scale in the JSON
-        result.write_plot(outs.path("--plot"), inputs=inputs)
-    if getattr(args, "json", None):
-        result.write_json(outs.path("--json"), inputs=inputs)
-    if getattr(args, "html", None):
-        result.write_html(outs.path("--html"), inputs=inputs)
+    """Inside ``with outs:``: ``--plot``, ``--json``, ``--html`` (:func:`write_files`; the
+    plot first: it may record its scale in the JSON), then :func:`write_certificates`."""
+    write_files(args, outs, result, inputs, ("plot", "json", "html"))
     write_certificates(outs, result, ident, inputs, title=title)
 
 
@@ -240,12 +225,9 @@ def help_text(command: str) -> str:
 
 # ---------------------------------------------------------------------------------------------
 def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
-    """``(parser, helps)``: ``sub.add_parser(name)`` with its texts from
-    ``volerr/data/help/`` (``TEXT`` default ``name``; a sub-command's ``ballbar-evaluate``):
-    ``TEXT.description.txt`` its help in the list of commands (first line) and its
-    description (the lines after it, printed as they are by ``--help``; none: no
-    description), ``TEXT.txt`` (where it is) its epilog; ``helps`` its options' long helps
-    (:func:`option_help`, empty without a ``TEXT.options.txt``)."""
+    """``(parser, helps)``: ``sub.add_parser(name)``, its texts from ``volerr/data/help/TEXT``
+    (default ``name``): ``.description.txt`` (line 1: its help in the command list; the rest:
+    its description), ``.txt`` its epilog, ``.options.txt`` the ``helps`` (:func:`option_help`)."""
     from importlib.resources import files
 
     folder, text = files("volerr") / "data" / "help", text or name
@@ -265,17 +247,15 @@ def error_dir_names(layout) -> list:
 
 
 def write_errors_out(args, outs, result, inputs) -> None:
-    """Inside ``with outs:``: ``--errors-out DIR`` (when given) from ``result``'s
-    ``write_error_tables`` (``--accept-implausible``; a refusal names DIR as given)."""
+    """Inside ``with outs:``: ``--errors-out DIR`` (when given), ``result.write_error_tables``."""
     if args.errors_out:
         result.write_error_tables(outs.path("--errors-out"), inputs=inputs, shown=args.errors_out,
                                   accept_implausible=args.accept_implausible)
 
 
 def option_help(name: str) -> dict:
-    """``{option: help}`` of a command's long option helps, from the text file
-    ``volerr/data/help/NAME.options.txt``: blocks separated by a blank line, the option (or
-    positional argument) on the first line, its help on the next (re-wrapped by --help)."""
+    """``{option: help}`` of ``volerr/data/help/NAME.options.txt``: blocks separated by a blank
+    line, the option (or argument) on the first line, its help on the next."""
     blocks = help_text(f"{name}.options").strip("\n").split("\n\n")
     return {b.split("\n", 1)[0]: " ".join(b.split("\n")[1:]) for b in blocks}
 
@@ -291,9 +271,7 @@ _COMMON: dict = {}
 
 
 def add_report_options(parser, json: str, html: str, instrument: str | None = None) -> None:
-    """The report options of a command, in this order: ``--json`` (writing ``json``),
-    ``--html`` (``html``) and the identification (``instrument``: what ``--instrument``
-    names; :func:`add_identification_arguments`)."""
+    """``--json`` (of ``json``), ``--html`` (``html``), :func:`add_identification_arguments`."""
     add_json(parser, json)
     add_html(parser, html)
     add_identification_arguments(parser, *([instrument] if instrument else []))
@@ -309,8 +287,7 @@ def add_fit_switches(parser, implausible: bool = True) -> None:
 
 # the outputs of a result, the options of an API call
 def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> None:
-    """Inside ``with outs:``: the outputs ``roles`` the command was given, each by the
-    result's ``write_ROLE`` (``--json`` :meth:`write_json`, ``--csv`` ``write_csv`` ...)."""
+    """Inside ``with outs:``: each output of ``roles`` given, by the result's ``write_ROLE``."""
     for role in roles:
         if getattr(args, role, None):
             getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
@@ -318,9 +295,8 @@ def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> N
 
 def write_document_outputs(args, outs, result, ident, inputs, title: str | None = None,
                            roles=("json", "html", "plot")) -> None:
-    """As :func:`write_outputs` (inside ``with outs:``), with the ``--pdf`` certificate made
-    of the result's JSON document alone (its ``"parameters"`` as rows, no figures), as
-    ``iso10360`` and ``iso230-3`` write it; ``roles``: :func:`write_files`."""
+    """:func:`write_outputs` with the ``--pdf`` of the result's JSON document alone (its
+    ``"parameters"`` as rows, no figures: ``iso10360``, ``iso230-3``)."""
     write_files(args, outs, result, inputs, roles)
     write_certificates(outs, result.to_dict(), ident, inputs, title=title)
 
