@@ -155,9 +155,6 @@ def add_identification_arguments(parser, instrument: str = "the measuring instru
     parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog)
 
 
-add_identification = add_identification_arguments   # its former name
-
-
 def identification_from_args(args, files=(), conditions: dict | None = None):
     """:class:`volerr.certificate.Identification` of the options and the identification file
     (else volerr-identification.toml beside ``files[0]``), with its report id and method."""

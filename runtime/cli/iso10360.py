@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, command_parser, identification_from_args, inputs_of, options_of,
-                      planned_outputs, write_document_outputs)
+from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
+                      add_plot, add_vector, command_parser, identification_from_args, inputs_of,
+                      options_of, planned_outputs, write_document_outputs)
 
 
 def register(sub) -> None:
@@ -29,7 +29,7 @@ def register(sub) -> None:
     add_json(p, "E0 values, U, verdicts")
     add_plot(p, H["--plot"])
     add_html(p, "the certificate (identification, verdict, plot, every E0)")
-    add_identification(p, "the artefact (step gauge, gauge blocks)")
+    add_identification_arguments(p, "the artefact (step gauge, gauge blocks)")
     p.set_defaults(func=run)
 
 

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ._common import (add_errors_out, add_force, add_html, add_identification, add_json, add_plot,
-                      command_parser, identification_from_args, options_of, planned_outputs,
-                      write_outputs)
+from ._common import (add_errors_out, add_force, add_html, add_identification_arguments, add_json,
+                      add_plot, command_parser, identification_from_args, options_of,
+                      planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
@@ -24,7 +24,7 @@ def register(sub) -> None:
     u("--temperature-u-K", type=float, default=0.2, metavar="U", help=H["--temperature-u-K"])
     u("--cte-u-ppm-per-K", type=float, default=1.0, metavar="U", help=H["--cte-u-ppm-per-K"])
     u("--eve-um", type=float, metavar="V", help=H["--eve-um"])
-    add_identification(p, "the laser interferometer")
+    add_identification_arguments(p, "the laser interferometer")
     g = p.add_argument_group("correction to 20 degC").add_argument
     g("--cte-ppm-per-K", type=float, metavar="A", help=H["--cte-ppm-per-K"])
     g("--material-temp-C", type=float, metavar="T", help=H["--material-temp-C"])

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ._common import (add_force, add_html, add_identification, add_json, add_plot, command_parser,
-                      identification_from_args, write_document_outputs)
+from ._common import (add_force, add_html, add_identification_arguments, add_json, add_plot,
+                      command_parser, identification_from_args, write_document_outputs)
 
 
 def register(sub) -> None:
@@ -14,7 +14,7 @@ def register(sub) -> None:
     add_html(p, "the test report (identification, drift per channel and stage, the plot)")
     p.add_argument("--stage-column", metavar="NAME", help=H["--stage-column"])
     add_force(p)
-    add_identification(p, "the displacement sensors")
+    add_identification_arguments(p, "the displacement sensors")
     p.set_defaults(func=run)
 
 
