@@ -10,8 +10,7 @@ from ._common import (add_error_arguments, add_fit_switches, add_force, add_html
 
 def register(sub) -> None:
     p, _ = command_parser(sub, "ballbar")
-    s = p.add_subparsers(dest="action", metavar="ACTION")
-    s.required = True
+    s = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     sim, H_sim = command_parser(s, "simulate", text="ballbar-simulate")
     sim.add_argument("layout", help="layout name or layout file")
     add_error_arguments(sim)
