@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 from ..choices import INTERPOLATION as METHODS
@@ -77,14 +78,11 @@ def add_vector(parser, flag: str, help: str, default=None, required: bool = Fals
             except InputError as exc:
                 p.error(str(exc))
             if append:
-                items = list(getattr(namespace, self.dest) or [])
-                items.append(v)
-                v = items
+                v = [*(getattr(namespace, self.dest) or []), v]
             setattr(namespace, self.dest, v)
 
-    act = parser.add_argument(flag, nargs="+", action=_Vector, default=default,
-                              required=required, metavar=metavar, help=help)
-    act.vector = True
+    parser.add_argument(flag, nargs="+", action=_Vector, default=default, required=required,
+                        metavar=metavar, help=help)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -250,6 +248,7 @@ def write_errors_out(args, outs, result, inputs) -> None:
                                   accept_implausible=args.accept_implausible)
 
 
+@lru_cache(maxsize=None)
 def option_help(name: str) -> dict:
     """``{option: help}`` of ``volerr/data/help/NAME.options.txt``: blocks separated by a blank
     line, the option (or argument) on the first line, its help on the next."""
@@ -259,12 +258,7 @@ def option_help(name: str) -> dict:
 
 def _C(option: str) -> str:
     """The help of a shared option (its text in ``volerr/data/help/common.options.txt``)."""
-    global _COMMON
-    _COMMON = _COMMON or option_help("common")
-    return _COMMON[option]
-
-
-_COMMON: dict = {}
+    return option_help("common")[option]
 
 
 def add_report_options(parser, json: str, html: str, instrument: str | None = None) -> None:
