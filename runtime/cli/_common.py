@@ -183,7 +183,8 @@ def planned_outputs(args, inputs, *, first: dict | None = None, **more):
     """:class:`volerr.fileio.Outputs` of a command's run, declared in this order (the order
     of the refusals) and checked: ``first``, the report options the command has (``--json``,
     ``--html``, ``--pdf``, ``--plot``) and ``more``; ``{"--out": path}`` a file (``--plot...``
-    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet)."""
+    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet),
+    ``{"--plot": [paths]}`` a group (:meth:`volerr.fileio.Outputs.group`)."""
     from ..fileio import Outputs
 
     outs = Outputs(inputs, force=getattr(args, "force", False))
@@ -198,6 +199,8 @@ def _declare(outs, targets: dict) -> None:
     for role, target in targets.items():
         if isinstance(target, tuple):
             outs.folder(role, target[0], files=target[1])
+        elif isinstance(target, list):     # one option, several files
+            outs.group(role, target)
         elif role.startswith("--plot"):
             outs.plot(role, target)
         else:
