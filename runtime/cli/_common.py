@@ -21,16 +21,6 @@ def add_error_arguments(parser, required: bool = True) -> None:
     add_accept_implausible(parser)
 
 
-def error_functions_from_args(args, model):
-    """:class:`volerr.tables.functions.ErrorFunctions` from the arguments added by
-    :func:`add_error_arguments` (and :func:`add_accept_implausible`, when the command has it)."""
-    from ..tables.functions import ErrorFunctions  # when the command runs, not at --help
-
-    return ErrorFunctions.from_dir(args.errors, model, method=args.method, degree=args.degree,
-                                   extrapolate=args.extrapolate,
-                                   accept_implausible=getattr(args, "accept_implausible", False))
-
-
 def add_accept_implausible(parser) -> None:
     """``--accept-implausible`` (:mod:`volerr.tables.plausible`), once (not twice)."""
     if "--accept-implausible" not in parser._option_string_actions:
