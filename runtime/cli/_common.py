@@ -32,8 +32,7 @@ def add_common(p) -> None:
     """Arguments shared with ``volerr diagonals``."""
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)
-    add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
-               help="probe / tool offset XP YP ZP, mm (X Y Z or X,Y,Z)")
+    add_vector(p, "--probe", default=(0.0, 0.0, 0.0), help=_C("--probe"))
     p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG", help=_C("--at"))
     p.add_argument("--volume", choices=("travel", "measured"), default="travel",
                    help=_C("--volume"))
@@ -43,9 +42,7 @@ def inputs_of(args, model=None) -> list:
     """The inputs never overwritten: the error tables and a layout file (not a shipped one)."""
     from ..cmm import volmap
 
-    files = volmap.error_dir_inputs(args.errors)
-    files.extend(layout_inputs(args.layout))
-    return files
+    return volmap.error_dir_inputs(args.errors) + layout_inputs(args.layout)
 
 
 def layout_inputs(layout) -> list:
