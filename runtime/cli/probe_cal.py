@@ -28,8 +28,7 @@ def register(sub) -> None:
     g = plan.add_argument
     g("--plan", metavar="PLAN.csv", help=H["--plan"])
     a("--ball-radius", type=float, metavar="r", help=H["--ball-radius"])
-    add_vector(plan, "--center", default=(0.0, 0.0, 0.0),
-               help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
+    add_vector(plan, "--center", default=(0.0, 0.0, 0.0), help=H["--center"])
     g("--step-deg", type=float, default=18.0, help="Pahk plan: latitude and azimuth step, deg")
     g("--circles", type=int, default=5, help="Pahk plan: latitude circles")
     g("--phis", metavar="P1,P2,...", help=H["--phis"])
