@@ -2,74 +2,47 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 from ..choices import INTERPOLATION as METHODS
-from ..errors import InputError, require
+from ..errors import InputError
 from ..progress import bar, progress, progress_bar  # noqa: F401  (one rule: volerr.progress)
 from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the parsing: units)
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
-    """Add ``--errors DIR --method --degree --extrapolate --accept-implausible`` to an argparse
-    parser."""
-    parser.add_argument("--errors", metavar="DIR", required=required,
-                        help="error directory: X.csv, Y.csv, ... (one table per axis) and "
-                             "optionally constants.csv")
-    parser.add_argument("--method", choices=METHODS, default="linear",
-                        help="error functions from the tables: linear or cubic interpolation, "
-                             "or least-squares polynomial (default linear)")
-    parser.add_argument("--degree", type=int, default=None,
-                        help="polynomial degree for --method poly (default: chosen by "
-                             "leave-one-out cross-validation)")
-    parser.add_argument("--extrapolate", action="store_true",
-                        help="evaluate beyond the measured range of a table (default: refuse)")
+    """``--errors DIR --method --degree --extrapolate --accept-implausible``."""
+    a = parser.add_argument
+    a("--errors", metavar="DIR", required=required, help=_C("--errors"))
+    a("--method", choices=METHODS, default="linear", help=_C("--method"))
+    a("--degree", type=int, default=None, help=_C("--degree"))
+    a("--extrapolate", action="store_true", help=_C("--extrapolate"))
     add_accept_implausible(parser)
 
 
-def error_functions_from_args(args, model):
-    """:class:`volerr.tables.functions.ErrorFunctions` from the arguments added by
-    :func:`add_error_arguments` (and :func:`add_accept_implausible`, when the command has it)."""
-    from ..tables.functions import ErrorFunctions  # when the command runs, not at --help
-
-    return ErrorFunctions.from_dir(args.errors, model, method=args.method, degree=args.degree,
-                                   extrapolate=args.extrapolate,
-                                   accept_implausible=getattr(args, "accept_implausible", False))
-
-
 def add_accept_implausible(parser) -> None:
-    """``--accept-implausible``: error values beyond what a machine of the layout's travel can
-    have (:mod:`volerr.tables.plausible`) are used instead of refused.  Added once (a command
-    whose error arguments carry it already is left as it is)."""
-    if "--accept-implausible" in parser._option_string_actions:
-        return
-    parser.add_argument("--accept-implausible", action="store_true",
-                        help="for a machine that really is that bad: use error values beyond "
-                             "what a machine of this travel can have (default: refused, "
-                             "naming the likely unit mistake)")
+    """``--accept-implausible`` (:mod:`volerr.tables.plausible`), once (not twice)."""
+    if "--accept-implausible" not in parser._option_string_actions:
+        parser.add_argument("--accept-implausible", action="store_true", help=_C(
+            "--accept-implausible"))
 
 
 def add_common(p) -> None:
     """Arguments shared with ``volerr diagonals``."""
     p.add_argument("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)
-    add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
-               help="probe / tool offset XP YP ZP, mm (X Y Z or X,Y,Z)")
-    p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG",
-                   help="position of a rotary axis during the test, repeatable (default 0 deg)")
+    add_vector(p, "--probe", default=(0.0, 0.0, 0.0), help=_C("--probe"))
+    p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG", help=_C("--at"))
     p.add_argument("--volume", choices=("travel", "measured"), default="travel",
-                   help="box of the linear axes: the layout's travel (default) or the part of "
-                        "it the error tables cover (no extrapolation either way)")
+                   help=_C("--volume"))
 
 
 def inputs_of(args, model=None) -> list:
-    """Files that must never be overwritten: the error tables and a layout file (shipped
-    layouts are package files, protected by :class:`volerr.fileio.Outputs` anyway)."""
+    """The inputs never overwritten: the error tables and a layout file (not a shipped one)."""
     from ..cmm import volmap
 
-    files = volmap.error_dir_inputs(args.errors)
-    files.extend(layout_inputs(args.layout))
-    return files
+    return volmap.error_dir_inputs(args.errors) + layout_inputs(args.layout)
 
 
 def layout_inputs(layout) -> list:
@@ -80,8 +53,7 @@ def layout_inputs(layout) -> list:
 
 def add_vector(parser, flag: str, help: str, default=None, required: bool = False,
                append: bool = False, metavar: str = "X Y Z") -> None:
-    """A 3-vector option that accepts both ``X Y Z`` and ``X,Y,Z`` (checked at parse time:
-    exit 2 and one line for a bad value)."""
+    """A 3-vector option, ``X Y Z`` or ``X,Y,Z`` (a bad value: exit 2 and one line)."""
     import argparse
 
     class _Vector(argparse.Action):
@@ -93,14 +65,11 @@ def add_vector(parser, flag: str, help: str, default=None, required: bool = Fals
             except InputError as exc:
                 p.error(str(exc))
             if append:
-                items = list(getattr(namespace, self.dest) or [])
-                items.append(v)
-                v = items
+                v = [*(getattr(namespace, self.dest) or []), v]
             setattr(namespace, self.dest, v)
 
-    act = parser.add_argument(flag, nargs="+", action=_Vector, default=default,
-                              required=required, metavar=metavar, help=help)
-    act.vector = True
+    parser.add_argument(flag, nargs="+", action=_Vector, default=default, required=required,
+                        metavar=metavar, help=help)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -123,92 +92,57 @@ def add_html(parser, what: str = "a one-page report with the figures") -> None:
 
 
 def add_errors_out(parser, what: str, *aliases: str, required: bool = False) -> None:
-    """``--errors-out DIR`` for every error directory a command writes (``map --errors DIR``
-    reads it); ``aliases``: the command's former spelling, still accepted."""
+    """``--errors-out DIR``, an error directory written (``aliases``: former spellings)."""
     parser.add_argument("--errors-out", *aliases, dest="errors_out", metavar="DIR",
-                        required=required,
-                        help=f"write {what} as an error directory (X.csv ... constants.csv; "
-                             f"'volerr formats tables'); created when missing, its parent "
-                             f"must exist")
+                        required=required, help=_C("--errors-out").format(what))
 
 
 def add_force(parser) -> None:
     """``--force``: a folder output may replace files that were there before the run."""
-    parser.add_argument("--force", action="store_true",
-                        help="let an output folder replace files that exist there already "
-                             "(without it such a file is named and nothing is written)")
+    parser.add_argument("--force", action="store_true", help=_C("--force"))
 
 
 def add_accept_residual(parser) -> None:
-    """``--accept-residual``: write a fit whose residual is far above the readings' declared
-    uncertainty (:mod:`volerr.fit_quality`), every output marked as forced."""
-    parser.add_argument("--accept-residual", action="store_true",
-                        help="write the results even when the fit's residual is far above "
-                             "the readings' declared uncertainty (chi2/dof > 4 at p < 1e-6; "
-                             "without it: exit 2, nothing written); every output then says "
-                             "it was forced")
+    """``--accept-residual``: write a fit of too large a residual (:mod:`volerr.fit_quality`)."""
+    parser.add_argument("--accept-residual", action="store_true", help=_C("--accept-residual"))
 
 
 def add_max_change(parser, reference: bool) -> None:
-    """``--max-change`` and ``--accept-change`` (the KinematicsOpt maxModification rule,
-    :mod:`volerr.fit_quality`); ``reference``: also ``--reference CAL.json`` (calibrate)."""
+    """(``reference``: ``--reference CAL.json``) ``--max-change``, ``--accept-change``
+    (the KinematicsOpt maxModification rule, :mod:`volerr.fit_quality`)."""
     if reference:
-        parser.add_argument("--reference", metavar="CAL.json",
-                            help="an earlier calibrate or check --json: its parameters are "
-                                 "compared with the new ones (--max-change)")
-    parser.add_argument("--max-change", metavar="LIMITS",
-                        help="largest change of a parameter against the reference written "
-                             "without consent: \"EX0C=20 um,EA0B=50 urad\" or one bound per "
-                             "unit (\"20 um,50 urad\"); units required")
-    parser.add_argument("--accept-change", action="store_true",
-                        help="write the results although a parameter moved more than "
-                             "--max-change")
+        parser.add_argument("--reference", metavar="CAL.json", help=_C("--reference"))
+    parser.add_argument("--max-change", metavar="LIMITS", help=_C("--max-change"))
+    parser.add_argument("--accept-change", action="store_true", help=_C("--accept-change"))
 
 
 #: options whose values are outputs or switches of writing, not of the method (report id)
 _NOT_METHOD = {"json", "html", "pdf", "plot", "errors_out", "map_out", "out", "force", "func",
                "command", "action", "identification", "date"}
-_IDENT_OPTIONS = {"--machine": ("machine", "the machine tested: id, make, model, serial number"),
-                  "--operator": ("operator", "who made the measurement"),
-                  "--date": ("date", "date of the measurement YYYY-MM-DD (not in the future; "
-                                     "not given: the file's, else today)"),
-                  "--customer": ("customer", "the customer the report is for")}
+#: the identification's fields, in the order of their options
+_IDENT_FIELDS = ("machine", "operator", "date", "customer", "instrument")
 
 
 def add_identification_arguments(parser, instrument: str = "the measuring instrument") -> None:
-    """``--identification F --machine --instrument --operator --date --customer --pdf F``: the
-    identification of a report (:mod:`volerr.certificate`) and its PDF certificate.  An option
-    the command already has with its own meaning (``check --instrument SPEC``, ``history
-    --machine ID``) keeps it; that field then comes from the identification file."""
-    g = parser.add_argument_group("report identification (on the page, in the JSON and the "
-                                  "PDF; options replace the fields of the identification file)")
+    """``--identification F``, its fields' options (:mod:`volerr.certificate`), ``--pdf F``;
+    an option the command has with its own meaning keeps it (the field: from the file)."""
+    g = parser.add_argument_group(_C("identification"))
     have = parser._option_string_actions
-    g.add_argument("--identification", metavar="F.toml",
-                   help="identification file (TOML: machine, instruments, operator, customer, "
-                        "date, environment); without it volerr-identification.toml beside the "
-                        "first data file is read when it is there")
+    g.add_argument("--identification", metavar="F.toml", help=_C("--identification"))
     own = []
-    for flag, (dest, text) in {**_IDENT_OPTIONS, "--instrument": (
-            "instrument", f"{instrument}: make, model, serial number, calibration")}.items():
-        if flag not in have:
-            g.add_argument(flag, dest=dest, metavar="YYYY-MM-DD" if dest == "date" else "TEXT",
-                           help=text)
+    for dest in _IDENT_FIELDS:
+        if f"--{dest}" not in have:
+            g.add_argument(f"--{dest}", dest=dest, help=_C(f"--{dest}").format(instrument),
+                           metavar="YYYY-MM-DD" if dest == "date" else "TEXT")
             own.append(dest)
     if "--pdf" not in have:
-        g.add_argument("--pdf", metavar="F.pdf",
-                       help="write the PDF certificate (A4, identification, conditions, "
-                            "results with U and k, budget, figures)")
+        g.add_argument("--pdf", metavar="F.pdf", help=_C("--pdf"))
     parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog)
 
 
-add_identification = add_identification_arguments   # its former name
-
-
 def identification_from_args(args, files=(), conditions: dict | None = None):
-    """:class:`volerr.certificate.Identification` of the options of
-    :func:`add_identification_arguments` and the identification file (``--identification``,
-    else volerr-identification.toml beside the first of ``files``); checked (dates), with
-    its report id (``files``' bytes and the options) and method (command, version, options)."""
+    """:class:`volerr.certificate.Identification` of the options and the identification file
+    (else volerr-identification.toml beside ``files[0]``), with its report id and method."""
     from .. import __version__, certificate
 
     own = set(getattr(args, "_ident_own", ())) | {"date"}
@@ -222,9 +156,8 @@ def identification_from_args(args, files=(), conditions: dict | None = None):
 
 
 def write_certificates(outs, result, ident, inputs=(), title: str | None = None) -> None:
-    """Inside ``with outs:`` after the command's own outputs: the identification stamped into
-    the written ``--json`` and ``--html`` and the ``--pdf`` certificate of ``result`` (a
-    result object or its JSON document; :func:`volerr.report.stamp.finish`)."""
+    """Inside ``with outs:``: :func:`volerr.report.stamp.finish` of ``result`` (a result or its
+    JSON document): the identification stamped into ``--json``, ``--html``; ``--pdf``."""
     from ..report import stamp
     from ..report.document import Document
 
@@ -237,7 +170,8 @@ def planned_outputs(args, inputs, *, first: dict | None = None, **more):
     """:class:`volerr.fileio.Outputs` of a command's run, declared in this order (the order
     of the refusals) and checked: ``first``, the report options the command has (``--json``,
     ``--html``, ``--pdf``, ``--plot``) and ``more``; ``{"--out": path}`` a file (``--plot...``
-    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet)."""
+    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet),
+    ``{"--plot": [paths]}`` a group (:meth:`volerr.fileio.Outputs.group`)."""
     from ..fileio import Outputs
 
     outs = Outputs(inputs, force=getattr(args, "force", False))
@@ -252,6 +186,8 @@ def _declare(outs, targets: dict) -> None:
     for role, target in targets.items():
         if isinstance(target, tuple):
             outs.folder(role, target[0], files=target[1])
+        elif isinstance(target, list):     # one option, several files
+            outs.group(role, target)
         elif role.startswith("--plot"):
             outs.plot(role, target)
         else:
@@ -259,45 +195,24 @@ def _declare(outs, targets: dict) -> None:
 
 
 def write_outputs(args, outs, result, ident, inputs, title: str | None = None) -> None:
-    """Inside ``with outs:``, after the command's own outputs: the outputs of the result
-    contract the command was given (``--plot`` :meth:`write_plot`, ``--json``
-    :meth:`write_json`, ``--html`` :meth:`write_html`), then the identification stamped
-    into them and the ``--pdf`` certificate (:func:`write_certificates`)."""
-    if getattr(args, "plot", None):   # first: a plot may record its scale in the JSON
-        result.write_plot(outs.path("--plot"), inputs=inputs)
-    if getattr(args, "json", None):
-        result.write_json(outs.path("--json"), inputs=inputs)
-    if getattr(args, "html", None):
-        result.write_html(outs.path("--html"), inputs=inputs)
+    """Inside ``with outs:``: ``--plot``, ``--json``, ``--html`` (:func:`write_files`; the
+    plot first: it may record its scale in the JSON), then :func:`write_certificates`."""
+    write_files(args, outs, result, inputs, ("plot", "json", "html"))
     write_certificates(outs, result, ident, inputs, title=title)
 
 
 def help_text(command: str) -> str:
-    """The epilog of ``volerr COMMAND --help`` (input formats, outputs, methods): the text
-    file ``volerr/data/help/COMMAND.txt`` (documentation, kept beside formats.md)."""
+    """The text file ``volerr/data/help/COMMAND.txt`` (e.g. the epilog of ``--help``)."""
     from importlib.resources import files
 
     return (files("volerr") / "data" / "help" / f"{command}.txt").read_text(encoding="utf-8")
 
 
-def finite_option(value, option: str, low: float = 0.0, high: float = 1e6):
-    """A number option checked to be finite and within [low, high] (None passes)."""
-    import math
-
-    if value is not None:
-        require(math.isfinite(value) and low <= value <= high,
-                f"{option} must be a number between {low:g} and {high:g}, got {value:g}")
-    return value
-
-
 # ---------------------------------------------------------------------------------------------
 def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
-    """``(parser, helps)``: ``sub.add_parser(name)`` with its texts from
-    ``volerr/data/help/`` (``TEXT`` default ``name``; a sub-command's ``ballbar-evaluate``):
-    ``TEXT.description.txt`` its help in the list of commands (first line) and its
-    description (the lines after it, printed as they are by ``--help``; none: no
-    description), ``TEXT.txt`` (where it is) its epilog; ``helps`` its options' long helps
-    (:func:`option_help`, empty without a ``TEXT.options.txt``)."""
+    """``(parser, helps)``: ``sub.add_parser(name)``, its texts from ``volerr/data/help/TEXT``
+    (default ``name``): ``.description.txt`` (line 1: its help in the command list; the rest:
+    its description), ``.txt`` its epilog, ``.options.txt`` the ``helps`` (:func:`option_help`)."""
     from importlib.resources import files
 
     folder, text = files("volerr") / "data" / "help", text or name
@@ -310,41 +225,41 @@ def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
 
 
 def error_dir_names(layout) -> list:
-    """The files of the error directory a fit of ``layout`` writes: ``<axis>.csv`` of every
-    axis and ``constants.csv`` (declared before the run)."""
+    """The files of a fit's error directory: ``<axis>.csv`` of ``layout``'s axes, constants."""
     from ..machine.model import load
 
     return [f"{a}.csv" for a in load(layout).axes] + ["constants.csv"]
 
 
 def write_errors_out(args, outs, result, inputs) -> None:
-    """Inside ``with outs:``: ``--errors-out DIR`` (when given) from ``result``'s
-    ``write_error_tables`` (``--accept-implausible``; a refusal names DIR as given)."""
+    """Inside ``with outs:``: ``--errors-out DIR`` (when given), ``result.write_error_tables``."""
     if args.errors_out:
         result.write_error_tables(outs.path("--errors-out"), inputs=inputs, shown=args.errors_out,
                                   accept_implausible=args.accept_implausible)
 
 
+@lru_cache(maxsize=None)
 def option_help(name: str) -> dict:
-    """``{option: help}`` of a command's long option helps, from the text file
-    ``volerr/data/help/NAME.options.txt``: blocks separated by a blank line, the option (or
-    positional argument) on the first line, its help on the next (re-wrapped by --help)."""
+    """``{option: help}`` of ``volerr/data/help/NAME.options.txt``: blocks separated by a blank
+    line, the option (or argument) on the first line, its help on the next."""
     blocks = help_text(f"{name}.options").strip("\n").split("\n\n")
     return {b.split("\n", 1)[0]: " ".join(b.split("\n")[1:]) for b in blocks}
 
 
+def _C(option: str) -> str:
+    """The help of a shared option (its text in ``volerr/data/help/common.options.txt``)."""
+    return option_help("common")[option]
+
+
 def add_report_options(parser, json: str, html: str, instrument: str | None = None) -> None:
-    """The report options of a command, in this order: ``--json`` (writing ``json``),
-    ``--html`` (``html``) and the identification (``instrument``: what ``--instrument``
-    names; :func:`add_identification_arguments`)."""
+    """``--json`` (of ``json``), ``--html`` (``html``), :func:`add_identification_arguments`."""
     add_json(parser, json)
     add_html(parser, html)
     add_identification_arguments(parser, *([instrument] if instrument else []))
 
 
 def add_fit_switches(parser, implausible: bool = True) -> None:
-    """``--force``, ``--accept-residual`` and (``implausible``) ``--accept-implausible``, in
-    this order: the switches of a command that writes a fit."""
+    """``--force``, ``--accept-residual``, (``implausible``) ``--accept-implausible``."""
     add_force(parser)
     add_accept_residual(parser)
     if implausible:
@@ -353,8 +268,7 @@ def add_fit_switches(parser, implausible: bool = True) -> None:
 
 # the outputs of a result, the options of an API call
 def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> None:
-    """Inside ``with outs:``: the outputs ``roles`` the command was given, each by the
-    result's ``write_ROLE`` (``--json`` :meth:`write_json`, ``--csv`` ``write_csv`` ...)."""
+    """Inside ``with outs:``: each output of ``roles`` given, by the result's ``write_ROLE``."""
     for role in roles:
         if getattr(args, role, None):
             getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
@@ -362,14 +276,12 @@ def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> N
 
 def write_document_outputs(args, outs, result, ident, inputs, title: str | None = None,
                            roles=("json", "html", "plot")) -> None:
-    """As :func:`write_outputs` (inside ``with outs:``), with the ``--pdf`` certificate made
-    of the result's JSON document alone (its ``"parameters"`` as rows, no figures), as
-    ``iso10360`` and ``iso230-3`` write it; ``roles``: :func:`write_files`."""
+    """:func:`write_outputs` with the ``--pdf`` of the result's JSON document alone (its
+    ``"parameters"`` as rows, no figures: ``iso10360``, ``iso230-3``)."""
     write_files(args, outs, result, inputs, roles)
     write_certificates(outs, result.to_dict(), ident, inputs, title=title)
 
 
 def options_of(args, names: str, **more) -> dict:
-    """The options ``names`` (their argparse dests, space separated) as keywords of the
-    command's API function, which names them alike; ``more`` added over them."""
+    """The options ``names`` (dests, space separated) as the API's keywords, and ``more``."""
     return {**{name: getattr(args, name) for name in names.split()}, **more}

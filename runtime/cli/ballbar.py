@@ -1,18 +1,16 @@
-"""``volerr ballbar simulate|evaluate``: ballbar traces of a model, ISO 230-4 evaluation; see
-``volerr ballbar --help``."""
+"""``volerr ballbar simulate|evaluate``: ballbar traces, ISO 230-4 (``ballbar.api``)."""
 
 from __future__ import annotations
 
 from ._common import (add_error_arguments, add_fit_switches, add_force, add_html,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
-                      error_functions_from_args, identification_from_args, layout_inputs,
-                      planned_outputs, write_outputs)
+                      identification_from_args, layout_inputs, options_of, planned_outputs,
+                      write_outputs)
 
 
 def register(sub) -> None:
     p, _ = command_parser(sub, "ballbar")
-    s = p.add_subparsers(dest="action", metavar="ACTION")
-    s.required = True
+    s = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     sim, H_sim = command_parser(s, "simulate", text="ballbar-simulate")
     sim.add_argument("layout", help="layout name or layout file")
     add_error_arguments(sim)
@@ -49,9 +47,9 @@ def run_simulate(args) -> int:
     inputs = error_dir_inputs(args.errors) + layout_inputs(args.layout)
     outs = planned_outputs(args, inputs, **{"--out": args.out})
     with outs:
-        trace = simulated_trace(model, error_functions_from_args(args, model), args.plane,
-                                args.radius, args.centre, args.tool, args.rotary, args.points,
-                                args.noise_um, args.direction, args.seed)
+        trace = simulated_trace(model, args.errors, args.plane, args.radius, args.centre,
+                                **options_of(args, "tool rotary points noise_um direction seed "
+                                                   "method degree extrapolate accept_implausible"))
         trace.write_csv(outs.path("--out"), inputs=inputs)
     print(trace.summary(args.out))
     return 0

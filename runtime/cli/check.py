@@ -1,5 +1,4 @@
-"""``volerr check [plan] LAYOUT --reference CAL.json ...``: the interim check; see ``volerr check
---help``."""
+"""``volerr check [plan] LAYOUT --reference CAL.json ...``: the interim check."""
 
 from __future__ import annotations
 
@@ -26,8 +25,7 @@ def register(sub) -> None:
     p.add_argument("--out", metavar="DIR", help="check plan: folder of the check's files")
     p.add_argument("--tolerance", metavar="T", help=H["--tolerance"])
     p.add_argument("--date", metavar="YYYY-MM-DD", help=H["--date"])
-    add_report_options(p, "the check plan or the check's result",
-                       "the set-up sheet (check plan) or the check's page")
+    add_report_options(p, H["--json"], H["--html"])
     add_fit_switches(p, implausible=False)
     add_max_change(p, reference=False)
     p.set_defaults(func=run)

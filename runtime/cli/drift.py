@@ -1,5 +1,4 @@
-"""``volerr drift convert``: a thermal logger's file -> a drift file (``--help``; the Python
-API :func:`volerr.instruments.drift_test.drift_convert`)."""
+"""``volerr drift convert``: a logger's file -> a drift file (``drift_test.drift_convert``)."""
 
 from __future__ import annotations
 
@@ -9,16 +8,13 @@ from ._common import command_parser
 def register(sub) -> None:
     p, _ = command_parser(sub, "drift")
     steps = p.add_subparsers(dest="step", metavar="STEP", required=True)
-    c, _ = command_parser(steps, "convert", "drift-convert")
+    c, H = command_parser(steps, "convert", "drift-convert")
     a = c.add_argument
     a("raw", metavar="RAW.csv", help="the logger's file (CSV, UTF-8)")
     a("--out", required=True, metavar="F", help="the drift file to write")
-    a("--map", metavar="'RAW=NAME,...'",
-      help="column names: RAW header cell = drift name (over the default rules)")
-    a("--time-unit", choices=("s", "min", "h"), help="the unit of a time column whose header "
-                                                    "gives none")
-    a("--channel", action="append", metavar="'LABEL=DIR [at z=MM]'",
-      help="a channel's direction and height (repeatable)")
+    a("--map", metavar="'RAW=NAME,...'", help=H["--map"])
+    a("--time-unit", choices=("s", "min", "h"), help=H["--time-unit"])
+    a("--channel", action="append", metavar="'LABEL=DIR [at z=MM]'", help=H["--channel"])
     a("--force", action="store_true", help="replace an existing --out file")
     c.set_defaults(func=run)
 

@@ -2,30 +2,24 @@
 
 from __future__ import annotations
 
-from ._common import (add_html, add_identification_arguments, add_json, command_parser,
-                      help_text, identification_from_args, planned_outputs, write_outputs)
+from ._common import (add_html, add_identification_arguments, add_json, command_parser, help_text,
+                      identification_from_args, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "history")
+    p, H = command_parser(sub, "history")
     s = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     a, _ = command_parser(s, "add", "history-add", epilog=help_text("history"))
     sh, _ = command_parser(s, "show", "history-show", epilog=help_text("history"))
     for q in (a, sh):
-        q.add_argument("--db", required=True, metavar="DB",
-                       help="the history: a file (SQLite) or a postgresql:// URL")
+        q.add_argument("--db", required=True, metavar="DB", help=H["--db"])
         q.add_argument("--machine", required=True, metavar="ID", help="the machine's id")
-        q.add_argument("--wait", type=float, default=10.0, metavar="S",
-                       help="seconds to wait for another writer's lock")
-    a.add_argument("--date", metavar="YYYY-MM-DD", help="the date of the results, not after "
-                   "today (default: the date a result states, else today, UTC)")
+        q.add_argument("--wait", type=float, default=10.0, metavar="S", help=H["--wait"])
+    a.add_argument("--date", metavar="YYYY-MM-DD", help=H["--date"])
     a.add_argument("results", nargs="+", metavar="RESULT.json", help="result files")
     a.set_defaults(func=run_add)
-    sh.add_argument("--tolerance", metavar="'NAME=V UNIT,map=V um'",
-                    help="tolerances |value| <= V of parameters (or of the volumetric error, "
-                         "map=), each with its unit (22 um, 5 urad, 0.02 mm, 3 arcsec): the "
-                         "date each is left, with a 95 %% interval")
-    add_json(sh, "the history (entries, events, trends, forecast, control charts)")
+    sh.add_argument("--tolerance", metavar="'NAME=V UNIT,map=V um'", help=H["--tolerance"])
+    add_json(sh, H["--json"])
     add_html(sh, "the history page (one chart per parameter)")
     add_identification_arguments(sh)
     sh.set_defaults(func=run_show)

@@ -1,5 +1,4 @@
-"""``volerr identify LAYOUT --axis A FILE... --out F``: laser-tracker identification of an axis;
-see ``volerr identify --help``."""
+"""``volerr identify``: laser-tracker identification of an axis (:func:`volerr.identify`)."""
 
 from __future__ import annotations
 
@@ -8,7 +7,8 @@ from pathlib import Path
 
 from ._common import (add_accept_implausible, add_accept_residual, add_force,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
-                      identification_from_args, layout_inputs, planned_outputs, write_outputs)
+                      identification_from_args, layout_inputs, options_of, planned_outputs,
+                      write_outputs)
 
 
 def register(sub) -> None:
@@ -59,12 +59,9 @@ def run(args) -> int:
     origin = args.origin[0] if args.origin == ["layout"] else args.origin and list(
         parse_vector(args.origin, "--origin"))
     with outs:
-        res = identify(args.layout, args.axis, args.files, format=args.format,
-                       positions=args.positions, points=args.points, method=args.method,
-                       tracker=args.tracker, direction=args.direction, origin=origin,
-                       sense=args.sense, max_cond=args.max_cond, outlier_k=args.outlier_k,
-                       signs=args.signs, accept_implausible=args.accept_implausible,
-                       accept_residual=args.accept_residual, fit=args.fit)
+        res = identify(args.layout, args.axis, args.files, origin=origin, **options_of(
+            args, "format positions points method tracker direction sense max_cond outlier_k "
+                  "signs accept_implausible accept_residual fit"))
         res.write_table(outs.path("--out") or outs.path("--errors-out") / f"{axis}.csv",
                         inputs=inputs)
         if args.residuals:

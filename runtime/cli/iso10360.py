@@ -2,41 +2,34 @@
 
 from __future__ import annotations
 
-from ._common import (add_error_arguments, add_html, add_identification, add_json, add_plot,
-                      add_vector, command_parser, identification_from_args, inputs_of,
+from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
+                      add_plot, add_vector, command_parser, identification_from_args, inputs_of,
                       options_of, planned_outputs, write_document_outputs)
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "iso10360")
+    p, H = command_parser(sub, "iso10360")
     a = p.add_argument
     a("layout", help="layout name (volerr layouts) or layout file")
     add_error_arguments(p)
-    add_vector(p, "--probe", default=(0.0, 0.0, 0.0),
-               help="probe offset XP YP ZP, mm (X Y Z or X,Y,Z; E0 is tested with 0 0 0)")
-    a("--volume", choices=("travel", "measured"), default="travel", help="box of the test: the "
-      "layout's travel or the part of it the error tables cover")
-    a("--mpe", metavar="'E0=A+L/K'", help="MPE line to judge against (A um, or with a length "
-      "unit: E0=1.5 um+L/333; L mm): verdict per ISO 14253-1")
-    a("--noise-um", type=float, default=0.0, metavar="S",
-      help="probing noise per point, standard deviation, um")
+    add_vector(p, "--probe", default=(0.0, 0.0, 0.0), help=H["--probe"])
+    a("--volume", choices=("travel", "measured"), default="travel", help=H["--volume"])
+    a("--mpe", metavar="'E0=A+L/K'", help=H["--mpe"])
+    a("--noise-um", type=float, default=0.0, metavar="S", help=H["--noise-um"])
     a("--seed", type=int, default=0, metavar="K", help="seed of the probing noise")
     g = p.add_argument_group("test uncertainty U(L), k = 2 (ISO 10360-2 / ISO 14253-5)")
     g = g.add_argument
-    g("--artefact-u", default="0.1+L/2000", metavar="'A+L/K'",
-      help="expanded calibration uncertainty of the reference lengths, um (L mm)")
+    g("--artefact-u", default="0.1+L/2000", metavar="'A+L/K'", help=H["--artefact-u"])
     g("--artefact-cte-ppm-per-K", type=float, default=11.5, metavar="A",
-      help="expansion coefficient of the artefact, ppm/K")
+      help=H["--artefact-cte-ppm-per-K"])
     g("--artefact-cte-u-ppm-per-K", type=float, default=1.0, metavar="U",
-      help="standard uncertainty of that coefficient, ppm/K")
-    g("--temperature-C", type=float, default=20.0, metavar="T",
-      help="artefact temperature during the test, degC")
-    g("--temperature-u-K", type=float, default=0.2, metavar="U",
-      help="standard uncertainty of the artefact temperature, K")
+      help=H["--artefact-cte-u-ppm-per-K"])
+    g("--temperature-C", type=float, default=20.0, metavar="T", help=H["--temperature-C"])
+    g("--temperature-u-K", type=float, default=0.2, metavar="U", help=H["--temperature-u-K"])
     add_json(p, "E0 values, U, verdicts")
-    add_plot(p, "E0 against L with the MPE, the undecided zone and the marked values")
+    add_plot(p, H["--plot"])
     add_html(p, "the certificate (identification, verdict, plot, every E0)")
-    add_identification(p, "the artefact (step gauge, gauge blocks)")
+    add_identification_arguments(p, "the artefact (step gauge, gauge blocks)")
     p.set_defaults(func=run)
 
 

@@ -2,44 +2,33 @@
 
 from __future__ import annotations
 
-from ._common import (add_errors_out, add_force, add_html, add_identification, add_json,
+from ._common import (add_errors_out, add_force, add_html, add_identification_arguments, add_json,
                       add_plot, command_parser, identification_from_args, options_of,
                       planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "iso230-2")
+    p, H = command_parser(sub, "iso230-2")
     a = p.add_argument
     a("runs", nargs="+", metavar="RUN.csv", help="positioning run(s), long or wide format (below)")
-    a("--axis", default="X", help="axis letter of the runs (X Y Z U V W; default X), or a comma "
-                                  "list with one letter per RUN file")
+    a("--axis", default="X", help=H["--axis"])
     add_json(p, "the results")
     add_plot(p, "the ISO 230-2 plot")
     add_html(p, "the certificate (identification, results with U, verdicts, plot, budget)")
     add_errors_out(p, "DIR/<axis>.csv (columns below)", "--table-out")
     add_force(p)
-    a("--tolerance", metavar="'A=..,E=..'", help="tolerances in um (or with a length unit: "
-      "A=0.012 mm) of any of A E M R B: verdicts (below)")
+    a("--tolerance", metavar="'A=..,E=..'", help=H["--tolerance"])
     u = p.add_argument_group("measurement uncertainty (ISO/TR 230-9)").add_argument
-    u("--instrument-ppm", type=float, default=0.5, metavar="P", help="accuracy of the "
-      "interferometer with its environmental compensation, ppm of the length (a maximum "
-      "error, rectangular)")
-    u("--alignment-mm", type=float, default=0.1, metavar="D", help="lateral offset of the beam "
-      "over the travel after alignment, mm (cosine error D^2 / 2L)")
-    u("--temperature-u-K", type=float, default=0.2, metavar="U",
-      help="standard uncertainty of the material temperature, K")
-    u("--cte-u-ppm-per-K", type=float, default=1.0, metavar="U",
-      help="standard uncertainty of the expansion coefficient, ppm/K")
-    u("--eve-um", type=float, metavar="V", help="environmental variation error of a drift "
-      "test, um (not given: not included, noted)")
-    add_identification(p, "the laser interferometer")
+    u("--instrument-ppm", type=float, default=0.5, metavar="P", help=H["--instrument-ppm"])
+    u("--alignment-mm", type=float, default=0.1, metavar="D", help=H["--alignment-mm"])
+    u("--temperature-u-K", type=float, default=0.2, metavar="U", help=H["--temperature-u-K"])
+    u("--cte-u-ppm-per-K", type=float, default=1.0, metavar="U", help=H["--cte-u-ppm-per-K"])
+    u("--eve-um", type=float, metavar="V", help=H["--eve-um"])
+    add_identification_arguments(p, "the laser interferometer")
     g = p.add_argument_group("correction to 20 degC").add_argument
-    g("--cte-ppm-per-K", type=float, metavar="A", help="coefficient of expansion of the scale "
-      "/ material, ppm/K (um/m/K); needs a T_C column or --material-temp-C")
-    g("--material-temp-C", type=float, metavar="T", help="material temperature for the whole "
-      "run, degC (when the file has no T_C column)")
-    g("--cte-reference-mm", type=float, default=0.0, metavar="P", help="position where the "
-      "expansion is zero (scale fixed point or where the interferometer was zeroed), mm")
+    g("--cte-ppm-per-K", type=float, metavar="A", help=H["--cte-ppm-per-K"])
+    g("--material-temp-C", type=float, metavar="T", help=H["--material-temp-C"])
+    g("--cte-reference-mm", type=float, default=0.0, metavar="P", help=H["--cte-reference-mm"])
     p.set_defaults(func=run)
 
 

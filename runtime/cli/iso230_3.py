@@ -2,38 +2,33 @@
 
 from __future__ import annotations
 
-from ._common import (add_force, add_html, add_identification, add_json, add_plot,
-                      command_parser, identification_from_args, write_document_outputs)
+from ._common import (add_force, add_html, add_identification_arguments, add_json, add_plot,
+                      command_parser, identification_from_args, planned_outputs,
+                      write_document_outputs)
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "iso230-3")
+    p, H = command_parser(sub, "iso230-3")
     p.add_argument("file", metavar="FILE", help="the drift file (volerr formats drift)")
     add_json(p, "the results")
     add_plot(p, "drift, tilts, speed and temperatures against time")
     add_html(p, "the test report (identification, drift per channel and stage, the plot)")
-    p.add_argument("--stage-column", metavar="NAME", help="the logged column whose changes "
-                   "make the stages (default: stage, else S_rpm)")
+    p.add_argument("--stage-column", metavar="NAME", help=H["--stage-column"])
     add_force(p)
-    add_identification(p, "the displacement sensors")
+    add_identification_arguments(p, "the displacement sensors")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..fileio import Outputs, write_bytes
+    from ..fileio import write_bytes
     from ..instruments.drift_test import iso230_3
 
     inputs = [args.file]
     ident = identification_from_args(args, inputs)     # --date checked before reading
     res = iso230_3(args.file, stage_column=args.stage_column, identification=ident)
     plots = res.plot_paths(args.plot)      # one PNG per run of the file
-    outs = Outputs(inputs, force=args.force).file("--json", args.json) \
-        .file("--html", args.html).file("--pdf", args.pdf)
-    if len(plots) == 1:
-        outs.plot("--plot", plots[0])
-    else:
-        outs.group("--plot", plots)
-    with outs.check():
+    outs = planned_outputs(args, inputs, **{"--plot": plots[0] if len(plots) == 1 else plots})
+    with outs:
         for k, png in enumerate(res.pngs() if plots else []):
             write_bytes(outs.path(outs.group_role("--plot", plots, k)), png, inputs=inputs)
         write_document_outputs(args, outs, res, ident, inputs, roles=("json", "html"))

@@ -1,5 +1,4 @@
-"""``volerr probe-cal``: probe calibration on a master sphere, or a probing plan (``--help``;
-the Python API :func:`volerr.probe_cal`, :func:`volerr.probe.api.probe_plan`)."""
+"""``volerr probe-cal``: probe calibration or a probing plan (:func:`volerr.probe_cal`)."""
 
 from __future__ import annotations
 
@@ -11,42 +10,28 @@ from ._common import (add_force, add_identification_arguments, add_vector, comma
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "probe-cal")
+    p, H = command_parser(sub, "probe-cal")
     a = p.add_argument
-    a("data", nargs="?", metavar="DATA.csv",
-      help="CSV x,y,z (ball centres, mm) [,phi_deg,theta_deg (probe frame)]")
-    a("--sphere-radius", type=float, required=True, metavar="R",
-      help="master-sphere radius, mm (calibrated value)")
-    a("--out", metavar="MAP.csv",
-      help="output map: phi_deg,theta_deg,probe_um (+ map_um, residual_um, r_m_mm, outlier)")
+    a("data", nargs="?", metavar="DATA.csv", help=H["data"])
+    a("--sphere-radius", type=float, required=True, metavar="R", help=H["--sphere-radius"])
+    a("--out", metavar="MAP.csv", help=H["--out"])
     a("--json", metavar="F", help="summary: r_eff_mm, center_mm, probe_error_um")
-    a("--tilt-deg", type=float, default=0.0, metavar="A",
-      help="probe-head tilt A, deg (default 0: vertical probe)")
+    a("--tilt-deg", type=float, default=0.0, metavar="A", help=H["--tilt-deg"])
     a("--roll-deg", type=float, default=0.0, metavar="B", help="probe-head roll B, deg")
-    a("--degree", type=int, metavar="L",
-      help="spherical-harmonic degree of the smooth map (default: by cross-validation)")
-    a("--outlier-k", type=float, default=5.0, metavar="K",
-      help="flag points whose leave-one-out map residual exceeds K x 1.4826 MAD")
-    a("--exclude-outliers", action="store_true",
-      help="refit without the flagged points (they stay in MAP.csv, flagged)")
-    a("--plot", metavar="F.png",
-      help="one PNG with the 3-D lobing map (Fig. 3a) and the (phi, theta) map (Fig. 3b)")
-    a("--plots", metavar="DIR", help="write probe_map_3d.png (Fig. 3a) and probe_map_2d.png "
-      "(Fig. 3b) into DIR (created when missing, its parent must exist)")
+    a("--degree", type=int, metavar="L", help=H["--degree"])
+    a("--outlier-k", type=float, default=5.0, metavar="K", help=H["--outlier-k"])
+    a("--exclude-outliers", action="store_true", help=H["--exclude-outliers"])
+    a("--plot", metavar="F.png", help=H["--plot"])
+    a("--plots", metavar="DIR", help=H["--plots"])
     add_force(p)
     plan = p.add_argument_group("plan generation (--plan)")
     g = plan.add_argument
-    g("--plan", metavar="PLAN.csv", help="write a probing plan (nominal ball centres "
-      "x,y,z,phi_deg,theta_deg) instead of calibrating")
-    a("--ball-radius", type=float, metavar="r", help="stylus-ball radius, mm (nominal): needed "
-      "with --plan; when calibrating, the effective radius the data give must match it within "
-      "the pretravel (0.1 mm), else --sphere-radius is refused")
-    add_vector(plan, "--center", default=(0.0, 0.0, 0.0),
-               help="sphere centre X Y Z, mm (X Y Z or X,Y,Z)")
+    g("--plan", metavar="PLAN.csv", help=H["--plan"])
+    a("--ball-radius", type=float, metavar="r", help=H["--ball-radius"])
+    add_vector(plan, "--center", default=(0.0, 0.0, 0.0), help=H["--center"])
     g("--step-deg", type=float, default=18.0, help="Pahk plan: latitude and azimuth step, deg")
     g("--circles", type=int, default=5, help="Pahk plan: latitude circles")
-    g("--phis", metavar="P1,P2,...", help="custom plan: circle latitudes phi, deg (with "
-                                          "--per-circle)")
+    g("--phis", metavar="P1,P2,...", help=H["--phis"])
     g("--per-circle", type=int, metavar="N", help="custom plan: points per circle")
     g("--no-pole", action="store_true", help="leave out the pole point")
     add_identification_arguments(p, "the reference sphere (its calibration)")

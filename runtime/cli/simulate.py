@@ -1,11 +1,10 @@
-"""``volerr simulate LAYOUT --out F``: a virtual machine's deviations or instrument file; see
-``volerr simulate --help``."""
+"""``volerr simulate LAYOUT --out F``: a virtual machine's deviations or instrument file."""
 
 from __future__ import annotations
 
 from ..choices import SIMULATED_INSTRUMENTS as INSTRUMENTS, SIMULATED_PLANTED as PLANTED
 from ._common import (add_accept_implausible, add_vector, command_parser, layout_inputs,
-                      planned_outputs)
+                      options_of, planned_outputs)
 
 
 def register(sub) -> None:
@@ -45,18 +44,13 @@ def run(args) -> int:
     outs = planned_outputs(args, inputs, **{"--out": args.out})
     with outs:
         if args.instrument == "deviations":
-            camp, name = simulate_options(
-                args.layout, points=args.points, seed=args.seed, probes=args.probe,
-                rounds=args.rounds, effects=args.effect, noise_um=args.noise_um,
-                magnitude_um=args.magnitude_um, hours=args.hours, sensors=args.sensors,
-                duty=args.duty)
+            camp, name = simulate_options(args.layout, probes=args.probe, effects=args.effect, **(
+                options_of(args, "points seed rounds noise_um magnitude_um hours sensors duty")))
             camp.write_csv(outs.path("--out"), inputs=inputs)
             line = f"{camp.n_points} points of {name}"
         else:
-            text, line = instrument_file(
-                args.layout, args.instrument, plant=args.plant, errors=args.errors,
-                steps=args.steps, radius=args.radius, noise_um=args.noise_um, seed=args.seed,
-                accept_implausible=args.accept_implausible)
+            text, line = instrument_file(args.layout, args.instrument, **options_of(
+                args, "plant errors steps radius noise_um seed accept_implausible"))
             write_text(outs.path("--out"), text, inputs=inputs)
     print(f"{line} -> {args.out}")
     return 0

@@ -1,27 +1,23 @@
-"""``volerr squareness``: squareness from the reference lines of straightness tables
-(``--help``; the Python API :func:`volerr.cmm.api.squareness`)."""
+"""``volerr squareness``: squareness of straightness tables (:func:`volerr.cmm.api.squareness`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..errors import require
-from ._common import (add_accept_implausible, add_errors_out, add_force, add_json,
-                      command_parser, layout_inputs, planned_outputs, write_files)
+from ._common import (add_accept_implausible, add_errors_out, add_force, add_json, command_parser,
+                      layout_inputs, planned_outputs, write_files)
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "squareness")
+    p, H = command_parser(sub, "squareness")
     p.add_argument("layout", help="layout name or layout file")
     p.add_argument("directory", help="error directory with the straightness tables")
-    add_errors_out(p, "the squareness with the slope-free tables (must differ from DIR)",
-                   "--out", required=True)
+    add_errors_out(p, H["--errors-out"], "--out", required=True)
     add_force(p)
     add_accept_implausible(p)
     p.add_argument("--tables-are", choices=("carrier", "component"), default="carrier",
-                   help="carrier: motions of the component carrying the points, as written by "
-                        "'volerr identify' (default); component: ISO component errors (tool "
-                        "relative to workpiece)")
+                   help=H["--tables-are"])
     add_json(p, "the squareness and the slopes (urad)")
     p.set_defaults(func=run)
 

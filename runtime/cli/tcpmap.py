@@ -7,18 +7,15 @@ from ._common import (add_error_arguments, add_plot, add_vector, command_parser,
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "tcpmap")
+    p, H = command_parser(sub, "tcpmap")
     p.add_argument("layout", help="five-axis layout name or file")
     add_error_arguments(p)
-    add_vector(p, "--point", required=True,
-               help="workpiece point X Y Z, mm, workpiece frame (X Y Z or X,Y,Z)")
-    add_vector(p, "--tool", default=(0.0, 0.0, 0.0),
-               help="tool-tip offset XT YT ZT in the tool frame, mm (X Y Z or X,Y,Z)")
+    add_vector(p, "--point", required=True, help=H["--point"])
+    add_vector(p, "--tool", default=(0.0, 0.0, 0.0), help=H["--tool"])
     p.add_argument("--steps", type=int, default=73, help="grid steps per rotary axis")
     add_plot(p, "the map", "--out", required=True)
     p.add_argument("--csv", metavar="F.csv", help="write the grid (CSV)")
-    p.add_argument("--approach", metavar="DIRS", help="approach direction of the linear axes "
-                   "with a reversal column RV_<axis>_um: X+,Y-, + / -, or sweep (below)")
+    p.add_argument("--approach", metavar="DIRS", help=H["--approach"])
     p.set_defaults(func=run)
 
 

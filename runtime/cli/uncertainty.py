@@ -4,59 +4,45 @@ from __future__ import annotations
 
 from ..choices import BIAS_MODES
 from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
-                      add_plot, command_parser, identification_from_args, inputs_of,
-                      layout_inputs, options_of, planned_outputs, write_outputs)
+                      add_plot, command_parser, identification_from_args, inputs_of, layout_inputs,
+                      options_of, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
-    p, _ = command_parser(sub, "uncertainty")
+    p, H = command_parser(sub, "uncertainty")
     a = p.add_argument
     a("layout", help="layout name (volerr layouts) or layout file")
     a("--task", required=True, metavar="CSV", help="probing points X,Y,Z[,i,j,k][,Xp,Yp,Zp] mm")
     a("--evaluate", required=True, metavar="E", help="distance, circle, sphere or plane")
     add_error_arguments(p, required=False)
-    a("--table-std", choices=("systematic", "repeatability"), default="systematic", help="how the "
-      "tables' _std columns are drawn (below)")
+    a("--table-std", choices=("systematic", "repeatability"), default="systematic",
+      help=H["--table-std"])
     a("--repeatability", action="store_true", help="also draw the tables' _s columns (below)")
-    a("--bias", choices=BIAS_MODES, default="corrected",
-      help="the result corrected for the bias of the known errors, or not (below)")
-    a("--correlation-mm", type=float, default=0.0, metavar="L",
-      help="correlation length of the node perturbations along an axis (0: independent nodes)")
-    a("--spec", metavar="'E0=A+L/K'", help="ISO 10360-2 specification (A um, L mm, K), "
-                                           "optionally ',PFTU=P' um: constrained Monte Carlo")
-    a("--spec-acceptance", type=float, default=0.5, metavar="F",
-      help="fraction of prior candidates passing the test (sets the prior scale)")
-    a("--noise-um", type=float, default=0.0, metavar="S",
-      help="probing noise, standard deviation per point, um")
+    a("--bias", choices=BIAS_MODES, default="corrected", help=H["--bias"])
+    a("--correlation-mm", type=float, default=0.0, metavar="L", help=H["--correlation-mm"])
+    a("--spec", metavar="'E0=A+L/K'", help=H["--spec"])
+    a("--spec-acceptance", type=float, default=0.5, metavar="F", help=H["--spec-acceptance"])
+    a("--noise-um", type=float, default=0.0, metavar="S", help=H["--noise-um"])
     a("--probe-map", metavar="MAP.csv", help="probe-cal's error map (needs i,j,k in the task)")
-    for name, what in (("part-cte", "part expansion coefficient and its u, 1/K"),
-                       ("part-dt", "part temperature - 20 C and its u, K"),
-                       ("scale-cte", "scale expansion coefficient and its u, 1/K"),
-                       ("scale-dt", "scale temperature - 20 C and its u, K")):
-        a(f"--{name}", nargs=2, type=float, metavar=("VALUE", "U"), help=what)
-    a("--temperature-compensated", action="store_true",
-      help="the CMM corrects the nominal expansion; only the uncertainties remain")
+    for name in ("part-cte", "part-dt", "scale-cte", "scale-dt"):
+        a(f"--{name}", nargs=2, type=float, metavar=("VALUE", "U"), help=H[f"--{name}"])
+    a("--temperature-compensated", action="store_true", help=H["--temperature-compensated"])
     g = p.add_mutually_exclusive_group()
     g.add_argument("--samples", type=int, metavar="N", help="Monte Carlo samples (default 10000)")
-    g.add_argument("--adaptive", action="store_true",
-                   help="adaptive Monte Carlo, JCGM 101 7.9 (--digits significant digits)")
+    g.add_argument("--adaptive", action="store_true", help=H["--adaptive"])
     a("--digits", type=int, default=2, help="significant digits of u for --adaptive")
-    a("--max-samples", type=int, default=1_000_000, metavar="N",
-      help="--adaptive: stop after this many samples even when not converged")
+    a("--max-samples", type=int, default=1_000_000, metavar="N", help=H["--max-samples"])
     a("--seed", type=int, default=0, metavar="K", help="seed of the random draws (reproducible)")
-    a("--chunks", type=int, default=1, metavar="M",
-      help="split the samples into M chunks (results identical for any M)")
+    a("--chunks", type=int, default=1, metavar="M", help=H["--chunks"])
     a("--scheduler", choices=("none", "dask"), default="none", help="where the chunks run (below)")
     a("--scheduler-address", metavar="ADDR", help="an existing dask scheduler")
     a("--workers", type=int, default=2, help="LocalCluster workers")
-    a("--contributions", type=int, default=2000, metavar="N",
-      help="samples per source for the one-at-a-time ranking (0: skip)")
+    a("--contributions", type=int, default=2000, metavar="N", help=H["--contributions"])
     add_json(p, "the results")
-    add_html(p, "the report (result, contributions, histogram and convergence plots)")
+    add_html(p, H["--html"])
     add_plot(p, "the histogram with the coverage interval")
     add_identification_arguments(p)
-    a("--backend", choices=("numpy", "numba"), default="numpy",
-      help="evaluation of the samples: numpy or the fused numba kernel (below; same values)")
+    a("--backend", choices=("numpy", "numba"), default="numpy", help=H["--backend"])
     a("--quiet", action="store_true", help="print nothing (no progress, no result lines)")
     p.set_defaults(func=run)
 

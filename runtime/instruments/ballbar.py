@@ -595,8 +595,9 @@ class SimulatedTrace:
 
 def simulated_trace(model: Model, functions, plane: str, radius: float, centre,
                     tool=(0.0, 0.0, 0.0), rotary=None, points: int = 360,
-                    noise_um: float = 0.0, direction: str = "both",
-                    seed: int = 0) -> SimulatedTrace:
+                    noise_um: float = 0.0, direction: str = "both", seed: int = 0, *,
+                    method: str = "linear", degree: int | None = None, extrapolate: bool = False,
+                    accept_implausible: bool = False) -> SimulatedTrace:
     """A ballbar trace of ``model`` with the error ``functions`` (``volerr ballbar simulate``):
     :func:`simulate`, its options checked first.
 
@@ -604,8 +605,10 @@ def simulated_trace(model: Model, functions, plane: str, radius: float, centre,
     ----------
     model : Model
         The machine (its first-order observation model).
-    functions : volerr.tables.functions.ErrorFunctions
-        The error functions (mm / rad) the readings see.
+    functions : volerr.tables.functions.ErrorFunctions, str or path
+        The error functions (mm / rad) the readings see, or an error directory, read with
+        ``method``, ``degree``, ``extrapolate`` and ``accept_implausible`` (the ``--errors``
+        options; :meth:`volerr.tables.functions.ErrorFunctions.from_dir`).
     plane : {"XY", "YZ", "ZX"}
         Plane of the circle in the workpiece frame.
     radius : float
@@ -635,6 +638,11 @@ def simulated_trace(model: Model, functions, plane: str, radius: float, centre,
     volerr.InputError
         An option out of range, with the command's one-line message.
     """
+    if isinstance(functions, (str, bytes)) or hasattr(functions, "__fspath__"):
+        from ..tables.functions import ErrorFunctions
+
+        functions = ErrorFunctions.from_dir(functions, model, method, degree, extrapolate,
+                                            accept_implausible=accept_implausible)
     require(noise_um >= 0, "--noise-um must not be negative")
     require(0 < radius <= 1e5, f"--radius must be a positive length of at most 1e5 mm, "
                                f"got {radius:g}")

@@ -71,3 +71,25 @@ def test_simulated_readings_equal_first_order_of_exact_chain(tmp_path, layout):
     assert np.abs(first).max() > 1.0            # the errors do show
     # agreement to the resolution of the file (readings written to 1e-5 um)
     assert np.abs(col("dr_um") - first).max() < 1e-5, np.abs(col("dr_um") - first).max()
+
+
+def test_python_api_reads_an_error_directory_with_the_command_options(tmp_path):
+    # volerr.instruments.ballbar.simulated_trace(model, DIR, ...): the directory read as the
+    # command's --errors options read it, the same readings as from the functions built first
+    from volerr import InputError
+    from volerr.instruments.ballbar import simulated_trace
+    from volerr.machine.model import load
+    from volerr.tables.functions import ErrorFunctions
+
+    model = load("MB1")
+    _write_errors(tmp_path / "errors", S.Machine("MB1"), CASES["MB1"][1])
+    funcs = ErrorFunctions.from_dir(tmp_path / "errors", model, "cubic")
+    kw = dict(tool=(0.0, 0.0, -50.0), points=24, noise_um=0.0)
+    want = simulated_trace(model, funcs, "XY", 100.0, (450.0, 290.0, 200.0), **kw)
+    got = simulated_trace(model, str(tmp_path / "errors"), "XY", 100.0, (450.0, 290.0, 200.0),
+                          method="cubic", **kw)
+    assert np.abs(want.columns["dr_um"]).max() > 1.0
+    assert np.array_equal(got.columns["dr_um"], want.columns["dr_um"])
+    with pytest.raises(InputError, match="needs method 'poly'"):   # degree is passed on
+        simulated_trace(model, tmp_path / "errors", "XY", 100.0, (450.0, 290.0, 200.0),
+                        degree=2, **kw)
