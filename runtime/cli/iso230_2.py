@@ -15,7 +15,7 @@ def register(sub) -> None:
     add_json(p, "the results")
     add_plot(p, "the ISO 230-2 plot")
     add_html(p, "the certificate (identification, results with U, verdicts, plot, budget)")
-    add_errors_out(p, "DIR/<axis>.csv (columns below)", "--table-out")
+    add_errors_out(p, H["--errors-out"], "--table-out")
     add_force(p)
     a("--tolerance", metavar="'A=..,E=..'", help=H["--tolerance"])
     u = p.add_argument_group("measurement uncertainty (ISO/TR 230-9)").add_argument
