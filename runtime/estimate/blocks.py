@@ -210,6 +210,28 @@ def solve_sym(G, b, tol: float = SV_TOL ** 2):
     return solve_normal(G, b, tol)
 
 
+#: columns of candidate groups multiplied by a block's design columns in one product
+STACK_COLUMNS = 64
+
+
+def _stacked(groups, idx, w):
+    """The groups' weighted columns at the points ``idx`` (row weights ``w``), stacked:
+    [(group numbers, (M, 3n) rows, offsets of the groups' rows (len + 1))], each stack at
+    most ``STACK_COLUMNS`` rows (a wider group alone)."""
+    out, ks, parts, cuts = [], [], [], [0]
+    for k, g in enumerate(groups):
+        Bt = group_block(g(idx))
+        if parts and cuts[-1] + len(Bt) > STACK_COLUMNS:
+            out.append((ks, np.concatenate(parts) * w, cuts))
+            ks, parts, cuts = [], [], [0]
+        ks.append(k)
+        parts.append(Bt)
+        cuts.append(cuts[-1] + len(Bt))
+    if parts:
+        out.append((ks, np.concatenate(parts) * w, cuts))
+    return out
+
+
 class BlockBase:
     """The current design on the weighted training rows, column-scaled, with its Gram
     pseudo-inverse and residual: :class:`volerr.loop.select.Base` without the rows.
@@ -235,17 +257,25 @@ class BlockBase:
 
     def score_many(self, groups) -> list:
         """[(RSS reduction, effective rank)] of adding each column group; a group is a function
-        ``idx -> (n, 3, m)`` columns at the points ``idx``."""
+        ``idx -> (n, 3, m)`` columns at the points ``idx``.
+
+        Per block the groups' columns are stacked (at most ``STACK_COLUMNS`` at a time) and
+        multiplied by the block's design columns in one matrix product: the (p, 3n) block
+        is read once per stack, not once per group (a product with a few columns is bound by
+        that read)."""
         acc = [None] * len(groups)
         for s, idx in blocks(self.points):
             w = wrows(self.sw[s])
             At = self.design.block(idx)
             At *= w / self.scale[:, None]
             r = self.r[3 * s.start:3 * s.start + 3 * len(idx)]
-            for k, g in enumerate(groups):
-                Bt = group_block(g(idx)) * w
-                parts = (At @ Bt.T, Bt @ Bt.T, Bt @ r)
-                acc[k] = parts if acc[k] is None else tuple(x + y for x, y in zip(acc[k], parts))
+            for ks, Ball, cuts in _stacked(groups, idx, w):
+                AB, Br = At @ Ball.T, Ball @ r
+                for k, a, b in zip(ks, cuts[:-1], cuts[1:]):
+                    Bt = Ball[a:b]
+                    parts = (AB[:, a:b], Bt @ Bt.T, Br[a:b])
+                    acc[k] = parts if acc[k] is None else tuple(
+                        x + y for x, y in zip(acc[k], parts))
         return [self._score(*a) for a in acc]
 
     def _score(self, AB, BB, Br) -> tuple[float, int]:
