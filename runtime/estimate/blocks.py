@@ -10,7 +10,6 @@ square roots of the robust point weights (one per point).
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from ..selection.linalg import pinv_sym
@@ -111,19 +110,46 @@ def to_point_major(r, n: int) -> np.ndarray:
     return np.ascontiguousarray(r.reshape(3, n).T).ravel()
 
 
-def normal(design, points, sw, y):
+def normal(design, points, sw, y, kept: "Kept | None" = None):
     """Weighted normal equations on ``points``: (G, b, colsq) with G = A^T W A, b = A^T W y
     and colsq the weighted column sums of squares (= diag G).  ``sw`` (len(points),) square
-    roots of the point weights; ``y`` all rows (3N,)."""
+    roots of the point weights; ``y`` all rows (3N,).  ``kept``: an empty :class:`Kept` of
+    ``design`` at ``points`` that keeps the blocks generated here (unweighted), for further
+    passes over the same points without generating them again."""
     G = np.zeros((design.p, design.p))
     b = np.zeros(design.p)
     for s, idx in blocks(points):
         w = wrows(sw[s])
-        At = design.block(idx)
-        At *= w
+        if kept is None:
+            At = design.block(idx)
+            At *= w
+        else:
+            kept.append(design.block(idx))
+            At = kept[-1] * w
         G += At @ At.T
         b += At @ (yrows(y, idx) * w)
     return G, b, np.diag(G).copy()
+
+
+#: bytes of generated blocks a sequence of passes over the same points may keep (the passes
+#: of :class:`BlockBase` and of the loop's robust weights): above it (10^6 points) every pass
+#: generates its blocks again
+KEEP_BYTES = 256 * 2 ** 20
+
+
+class Kept(list):
+    """The blocks of a design at some points (:meth:`Design.block`, unweighted, in the order
+    of :func:`blocks`), filled by :func:`normal` and read by index by the passes after it."""
+
+    @staticmethod
+    def fits(design, points) -> bool:
+        """Whether the blocks of ``design`` at ``points`` fit in ``KEEP_BYTES``."""
+        return 8 * design.p * 3 * len(points) <= KEEP_BYTES
+
+    @classmethod
+    def of(cls, design, points) -> "Kept | None":
+        """An empty ``Kept`` where the blocks fit (:meth:`fits`), else None."""
+        return cls() if cls.fits(design, points) else None
 
 
 def unit_scale(colsq, n_rows: int) -> np.ndarray:
@@ -137,12 +163,13 @@ def unit_scale(colsq, n_rows: int) -> np.ndarray:
 eig_inverse = pinv_sym
 
 
-def predict(design, points, coef) -> np.ndarray:
-    """Rows A c at ``points`` (point-major, 3 per point)."""
+def predict(design, points, coef, kept: Kept | None = None) -> np.ndarray:
+    """Rows A c at ``points`` (point-major, 3 per point); ``kept``: the blocks at ``points``
+    (:func:`normal`'s), else generated."""
     out = np.empty(3 * len(points))
-    for s, idx in blocks(points):
-        out[3 * s.start:3 * s.start + 3 * len(idx)] = to_point_major(
-            coef @ design.block(idx), len(idx))
+    for k, (s, idx) in enumerate(blocks(points)):
+        At = design.block(idx) if kept is None else kept[k]
+        out[3 * s.start:3 * s.start + 3 * len(idx)] = to_point_major(coef @ At, len(idx))
     return out
 
 
@@ -237,11 +264,16 @@ class BlockBase:
     pseudo-inverse and residual: :class:`volerr.loop.select.Base` without the rows.
 
     ``score_many`` gives the RSS reduction of adding column groups, from the blockwise
-    cross-products A_c^T r, A_c^T A_c and A_c^T A (one pass for all groups)."""
+    cross-products A_c^T r, A_c^T A_c and A_c^T A (one pass for all groups).
+
+    Where they fit in ``KEEP_BYTES`` (:meth:`Kept.fits`), the design's blocks are generated once
+    and kept, weighted and scaled, for every ``score_many`` (a lag's profile scores 13
+    values of its time constant a pass, several passes on one base)."""
 
     def __init__(self, design, points, sw, y):
         self.design, self.points, self.sw = design, np.asarray(points), np.asarray(sw)
-        G, b, colsq = normal(design, self.points, self.sw, y)
+        kept = Kept.of(design, self.points)
+        G, b, colsq = normal(design, self.points, self.sw, y, kept)
         n_rows = 3 * len(self.points)
         #: readings (rows that carry one: a ballbar point has one), the n of the BIC
         self.n = int(design.data.readings_per_point()[self.points].sum())
@@ -249,10 +281,13 @@ class BlockBase:
         self.Gi = eig_inverse(G / np.outer(self.scale, self.scale), 1e-12)
         c = self.Gi @ (b / self.scale) / self.scale
         self.r = np.empty(n_rows)         # weighted residual rows, component-major per block
-        for s, idx in blocks(self.points):
+        for k, (s, idx) in enumerate(blocks(self.points)):
             w = wrows(self.sw[s])
-            self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (
-                (yrows(y, idx) - c @ design.block(idx)) * w)
+            At = design.block(idx) if kept is None else kept[k]
+            self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (yrows(y, idx) - c @ At) * w
+            if kept is not None:
+                At *= w / self.scale[:, None]       # as score_many weighs and scales it
+        self._kept = kept
         self.rss = float(self.r @ self.r)
 
     def score_many(self, groups) -> list:
@@ -264,10 +299,13 @@ class BlockBase:
         is read once per stack, not once per group (a product with a few columns is bound by
         that read)."""
         acc = [None] * len(groups)
-        for s, idx in blocks(self.points):
+        for kb, (s, idx) in enumerate(blocks(self.points)):
             w = wrows(self.sw[s])
-            At = self.design.block(idx)
-            At *= w / self.scale[:, None]
+            if self._kept is not None:
+                At = self._kept[kb]
+            else:
+                At = self.design.block(idx)
+                At *= w / self.scale[:, None]
             r = self.r[3 * s.start:3 * s.start + 3 * len(idx)]
             for ks, Ball, cuts in _stacked(groups, idx, w):
                 AB, Br = At @ Ball.T, Ball @ r

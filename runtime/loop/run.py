@@ -231,13 +231,15 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     ``design``: :class:`volerr.estimate.blocks.Design`; ``points``: the points fitted (their rows
     of ``y``).  The normal equations of all points at their instrument weight are accumulated
     once; each iteration subtracts those of the down-weighted points (few) and predicts
-    blockwise."""
+    blockwise, from the blocks of that first pass where they fit in
+    :data:`volerr.estimate.blocks.KEEP_BYTES` (else generated again)."""
     data = design.data
     base = data.point_weights()[points]
     dims = data.readings_per_point()[points]
     w = np.ones(len(points))
     rows = rows_of(points)
-    G1, b1, colsq = blocks.normal(design, points, np.sqrt(base), y)
+    kept = blocks.Kept.of(design, points)        # the blocks, for every pass
+    G1, b1, colsq = blocks.normal(design, points, np.sqrt(base), y, kept)
     scale = blocks.unit_scale(colsq, len(rows))
     sigma = 0.0
     for _ in range(iterations):
@@ -254,7 +256,7 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
                 G -= At @ At.T
                 b -= At @ (blocks.yrows(y, idx) * d)
         c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
-        r = point_norm(y[rows] - blocks.predict(design, points, c)) * np.sqrt(base)
+        r = point_norm(y[rows] - blocks.predict(design, points, c, kept)) * np.sqrt(base)
         sigma = max(float(np.median((r / CHI_MEDIAN[dims])[w > 0])), 1e-12)
         z = r / sigma
         w_new = np.where(z <= ROBUST_K, 1.0,
