@@ -248,10 +248,7 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
             G, b, _ = blocks.normal(design, points, np.sqrt(base * w), y)
         else:       # G1 minus the down-weighted points' share (1 - w) A_i^T A_i
             G, b = G1.copy(), b1.copy()
-            for _, part in blocks.blocks(low):
-                idx = points[part]
-                d = blocks.wrows(np.sqrt(base[part] * (1.0 - w[part])))
-                At = design.block(idx)
+            for At, idx, d in _low_blocks(design, kept, points, low, base * (1.0 - w)):
                 At *= d
                 G -= At @ At.T
                 b -= At @ (blocks.yrows(y, idx) * d)
@@ -268,6 +265,21 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     weights[points] = w * base
     flagged = points[z > OUTLIER_Z]
     return Robust(weights, sigma, flagged)
+
+
+def _low_blocks(design, kept, points, low, v):
+    """(columns (p, 3m), points (m,), row weights sqrt(v) (3m,)) of the points ``low`` (positions
+    in ``points``), block by block: taken from the blocks ``kept`` at ``points`` where given
+    (the columns of a point are the same in any block), else generated."""
+    if kept is None:
+        for _, part in blocks.blocks(low):
+            yield design.block(points[part]), points[part], blocks.wrows(np.sqrt(v[part]))
+        return
+    for k, (s, idx) in enumerate(blocks.blocks(points)):
+        m = low[(low >= s.start) & (low < s.start + len(idx))] - s.start
+        if len(m):
+            cols = np.concatenate([m, m + len(idx), m + 2 * len(idx)])   # component-major
+            yield kept[k][:, cols], idx[m], blocks.wrows(np.sqrt(v[s][m]))
 
 
 def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, families,
