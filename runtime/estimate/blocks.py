@@ -179,15 +179,16 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     hat matrix), else k-fold (``folds``: fold label per point).  Equals
     :meth:`volerr.estimate.design.Problem.loo_residuals` / ``cv_residuals`` on the weighted rows."""
     n_rows = 3 * len(points)
+    kept = Kept.of(design, points)          # the blocks of the first pass, for the second
     if folds is None:
-        G, b, colsq = normal(design, points, sw, y)
+        G, b, colsq = normal(design, points, sw, y, kept)
         sc = unit_scale(colsq, n_rows)
         Gi = eig_inverse(G / np.outer(sc, sc), SV_TOL ** 2)
         c = Gi @ (b / sc)
         out = np.empty(len(points))
-        for s, idx in blocks(points):
+        for kb, (s, idx) in enumerate(blocks(points)):
             w = wrows(sw[s])
-            At = design.block(idx)
+            At = design.block(idx) if kept is None else kept[kb]
             At *= w / sc[:, None]
             n = len(idx)
             r = (yrows(y, idx) * w - c @ At).reshape(3, n).T          # (n, 3)
@@ -206,7 +207,11 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     for s, idx in blocks(points):
         w = wrows(sw[s])
         At = design.block(idx)
-        At *= w
+        if kept is not None:
+            kept.append(At)
+            At = At * w
+        else:
+            At *= w
         yw = yrows(y, idx) * w
         f = np.tile(folds[s], 3)
         for k, lab in enumerate(labels):
@@ -219,10 +224,10 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     coef = np.array([solve_sym((G - Gf[k]) / S, (b - bf[k]) / sc) / sc
                      for k in range(len(labels))])
     out = np.empty(len(points))
-    for s, idx in blocks(points):
+    for kb, (s, idx) in enumerate(blocks(points)):
         w = wrows(sw[s])
         n = len(idx)
-        At = design.block(idx).reshape(p, 3, n)
+        At = (design.block(idx) if kept is None else kept[kb]).reshape(p, 3, n)
         k = np.searchsorted(labels, folds[s])
         pred = np.einsum("pin,np->ni", At, coef[k])
         yw = (yrows(y, idx) * w).reshape(3, n).T
