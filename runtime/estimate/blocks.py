@@ -1,6 +1,10 @@
 """Least squares on the loop's designs without the (3N, p) matrix: columns generated per block of
 points, weighted normal equations (A^T W A, A^T W y) and cross-products accumulated blockwise,
-held-out residuals per block.  Memory: p x p matrices, p-vectors and one block of rows.
+held-out residuals per block.  Memory: p x p matrices, p-vectors and one block of rows; where a
+sequence of passes reads the same points (a :class:`BlockBase`, :func:`cv_sq`, the loop's robust
+weights) the blocks of its first pass are kept for the others when they fit in ``KEEP_BYTES``
+(:class:`Kept`: 10^5 points of a 78-column design, 187 MB; at 10^6 points every pass generates
+them again).
 
 A :class:`Design` is the declared model's kept columns (generated from the model's sensitivity
 per block, :func:`volerr.estimate.design.declared_design`) followed by dense extra columns (accepted
