@@ -12,6 +12,7 @@ inside the loop (threadpoolctl).  Each size runs in a child process: CPU time of
 (``RUSAGE_CHILDREN``), with the RSS before the loop (simulated campaign in memory).
 
     python benchmarks/bench_loop.py [n_points ...]      (default: 10000 100000)
+    python benchmarks/bench_loop.py --json DIR [n ...]  also write each size's JSON to DIR
     python benchmarks/bench_loop.py --threads N         default BLAS threads vs one thread
     python benchmarks/bench_loop.py --lags [N]          N points (default 10^5), 10 sensors
 
@@ -45,7 +46,7 @@ from volerr.loop.simulate import demo_probes, simulate
 KEEP = ("T_C", "t_s", "dir_X", "setup")
 
 
-def one(n: int) -> None:
+def one(n: int, json_dir: str | None = None) -> None:
     model = volerr.load("MB1")
     camp = simulate("MB1", n_points=n, seed=7, probes=demo_probes(model), rounds=2,
                     effects=[{"kind": "thermal", "axis": "Y", "ppm_per_K": 6.0}])
@@ -71,6 +72,8 @@ def one(n: int) -> None:
     print(f"loop (screening + selection + augment + before/after): CPU {cpu:.2f} s, wall "
           f"{total:.2f} s; {ratio}; peak RSS before the loop {pre:.0f} MB")
     print("  " + rep.summary())
+    if json_dir:    # the loop's JSON, to compare two trees (benchmarks/json_close.py)
+        print(f"  JSON: {rep.write_json(f'{json_dir}/loop_{n}.json')}")
 
 
 def lags(n: int) -> None:
@@ -95,11 +98,12 @@ def lags(n: int) -> None:
     print("  " + rep.summary())
 
 
-def child(n: int) -> None:
+def child(n: int, json_dir: str | None = None) -> None:
     """Run :func:`one` in a child process and report its peak RSS."""
     import subprocess
 
-    subprocess.run([sys.executable, __file__, "--child", str(n)], check=True)
+    subprocess.run([sys.executable, __file__, "--child", str(n)]
+                   + (["--json", json_dir] if json_dir else []), check=True)
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     print(f"  peak RSS of the child process: {peak:.0f} MB")
 
@@ -173,7 +177,10 @@ if __name__ == "__main__":
         lags(int(sys.argv[2]) if len(sys.argv) > 2 else 100000)
         sys.exit()
     if sys.argv[1:2] == ["--child"]:
-        one(int(sys.argv[2]))
+        one(int(sys.argv[2]), sys.argv[4] if sys.argv[3:4] == ["--json"] else None)
         sys.exit()
-    for arg in (sys.argv[1:] or ["10000", "100000"]):
-        child(int(arg))
+    args, out = sys.argv[1:], None
+    if args[:1] == ["--json"]:
+        out, args = args[1], args[2:]
+    for arg in (args or ["10000", "100000"]):
+        child(int(arg), out)

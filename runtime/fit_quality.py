@@ -86,9 +86,11 @@ class FitQuality:
     @property
     def p_value(self) -> float:
         """``P(chi2_dof >= chi2)``: small when the residual is above the declared u."""
-        from scipy.stats import chi2
+        # scipy.stats.chi2.sf is this function (chdtrc(df, x), 1 for x <= 0); scipy.special
+        # imports in a quarter of the CPU time of scipy.stats (0.2 against 0.8 s)
+        from scipy.special import chdtrc
 
-        return float(chi2.sf(self.chi2, max(self.dof, 1)))
+        return float(chdtrc(max(self.dof, 1), max(self.chi2, 0.0)))
 
     @property
     def far_above(self) -> bool:

@@ -1,6 +1,10 @@
 """Least squares on the loop's designs without the (3N, p) matrix: columns generated per block of
 points, weighted normal equations (A^T W A, A^T W y) and cross-products accumulated blockwise,
-held-out residuals per block.  Memory: p x p matrices, p-vectors and one block of rows.
+held-out residuals per block.  Memory: p x p matrices, p-vectors and one block of rows; where a
+sequence of passes reads the same points (a :class:`BlockBase`, :func:`cv_sq`, the loop's robust
+weights) the blocks of its first pass are kept for the others when they fit in ``KEEP_BYTES``
+(:class:`Kept`: 10^5 points of a 78-column design, 187 MB; at 10^6 points every pass generates
+them again).
 
 A :class:`Design` is the declared model's kept columns (generated from the model's sensitivity
 per block, :func:`volerr.estimate.design.declared_design`) followed by dense extra columns (accepted
@@ -9,7 +13,6 @@ square roots of the robust point weights (one per point).
 """
 
 from __future__ import annotations
-
 
 import numpy as np
 
@@ -111,19 +114,46 @@ def to_point_major(r, n: int) -> np.ndarray:
     return np.ascontiguousarray(r.reshape(3, n).T).ravel()
 
 
-def normal(design, points, sw, y):
+def normal(design, points, sw, y, kept: "Kept | None" = None):
     """Weighted normal equations on ``points``: (G, b, colsq) with G = A^T W A, b = A^T W y
     and colsq the weighted column sums of squares (= diag G).  ``sw`` (len(points),) square
-    roots of the point weights; ``y`` all rows (3N,)."""
+    roots of the point weights; ``y`` all rows (3N,).  ``kept``: an empty :class:`Kept` of
+    ``design`` at ``points`` that keeps the blocks generated here (unweighted), for further
+    passes over the same points without generating them again."""
     G = np.zeros((design.p, design.p))
     b = np.zeros(design.p)
     for s, idx in blocks(points):
         w = wrows(sw[s])
-        At = design.block(idx)
-        At *= w
+        if kept is None:
+            At = design.block(idx)
+            At *= w
+        else:
+            kept.append(design.block(idx))
+            At = kept[-1] * w
         G += At @ At.T
         b += At @ (yrows(y, idx) * w)
     return G, b, np.diag(G).copy()
+
+
+#: bytes of generated blocks a sequence of passes over the same points may keep (the passes
+#: of :class:`BlockBase` and of the loop's robust weights): above it (10^6 points) every pass
+#: generates its blocks again
+KEEP_BYTES = 256 * 2 ** 20
+
+
+class Kept(list):
+    """The blocks of a design at some points (:meth:`Design.block`, unweighted, in the order
+    of :func:`blocks`), filled by :func:`normal` and read by index by the passes after it."""
+
+    @staticmethod
+    def fits(design, points) -> bool:
+        """Whether the blocks of ``design`` at ``points`` fit in ``KEEP_BYTES``."""
+        return 8 * design.p * 3 * len(points) <= KEEP_BYTES
+
+    @classmethod
+    def of(cls, design, points) -> "Kept | None":
+        """An empty ``Kept`` where the blocks fit (:meth:`fits`), else None."""
+        return cls() if cls.fits(design, points) else None
 
 
 def unit_scale(colsq, n_rows: int) -> np.ndarray:
@@ -137,12 +167,13 @@ def unit_scale(colsq, n_rows: int) -> np.ndarray:
 eig_inverse = pinv_sym
 
 
-def predict(design, points, coef) -> np.ndarray:
-    """Rows A c at ``points`` (point-major, 3 per point)."""
+def predict(design, points, coef, kept: Kept | None = None) -> np.ndarray:
+    """Rows A c at ``points`` (point-major, 3 per point); ``kept``: the blocks at ``points``
+    (:func:`normal`'s), else generated."""
     out = np.empty(3 * len(points))
-    for s, idx in blocks(points):
-        out[3 * s.start:3 * s.start + 3 * len(idx)] = to_point_major(
-            coef @ design.block(idx), len(idx))
+    for k, (s, idx) in enumerate(blocks(points)):
+        At = design.block(idx) if kept is None else kept[k]
+        out[3 * s.start:3 * s.start + 3 * len(idx)] = to_point_major(coef @ At, len(idx))
     return out
 
 
@@ -152,15 +183,16 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     hat matrix), else k-fold (``folds``: fold label per point).  Equals
     :meth:`volerr.estimate.design.Problem.loo_residuals` / ``cv_residuals`` on the weighted rows."""
     n_rows = 3 * len(points)
+    kept = Kept.of(design, points)          # the blocks of the first pass, for the second
     if folds is None:
-        G, b, colsq = normal(design, points, sw, y)
+        G, b, colsq = normal(design, points, sw, y, kept)
         sc = unit_scale(colsq, n_rows)
         Gi = eig_inverse(G / np.outer(sc, sc), SV_TOL ** 2)
         c = Gi @ (b / sc)
         out = np.empty(len(points))
-        for s, idx in blocks(points):
+        for kb, (s, idx) in enumerate(blocks(points)):
             w = wrows(sw[s])
-            At = design.block(idx)
+            At = design.block(idx) if kept is None else kept[kb]
             At *= w / sc[:, None]
             n = len(idx)
             r = (yrows(y, idx) * w - c @ At).reshape(3, n).T          # (n, 3)
@@ -179,7 +211,11 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     for s, idx in blocks(points):
         w = wrows(sw[s])
         At = design.block(idx)
-        At *= w
+        if kept is not None:
+            kept.append(At)
+            At = At * w
+        else:
+            At *= w
         yw = yrows(y, idx) * w
         f = np.tile(folds[s], 3)
         for k, lab in enumerate(labels):
@@ -192,10 +228,10 @@ def cv_sq(design, y, folds, points, sw) -> np.ndarray:
     coef = np.array([solve_sym((G - Gf[k]) / S, (b - bf[k]) / sc) / sc
                      for k in range(len(labels))])
     out = np.empty(len(points))
-    for s, idx in blocks(points):
+    for kb, (s, idx) in enumerate(blocks(points)):
         w = wrows(sw[s])
         n = len(idx)
-        At = design.block(idx).reshape(p, 3, n)
+        At = (design.block(idx) if kept is None else kept[kb]).reshape(p, 3, n)
         k = np.searchsorted(labels, folds[s])
         pred = np.einsum("pin,np->ni", At, coef[k])
         yw = (yrows(y, idx) * w).reshape(3, n).T
@@ -210,16 +246,43 @@ def solve_sym(G, b, tol: float = SV_TOL ** 2):
     return solve_normal(G, b, tol)
 
 
+#: columns of candidate groups multiplied by a block's design columns in one product
+STACK_COLUMNS = 64
+
+
+def _stacked(groups, idx, w):
+    """The groups' weighted columns at the points ``idx`` (row weights ``w``), stacked:
+    [(group numbers, (M, 3n) rows, offsets of the groups' rows (len + 1))], each stack at
+    most ``STACK_COLUMNS`` rows (a wider group alone)."""
+    out, ks, parts, cuts = [], [], [], [0]
+    for k, g in enumerate(groups):
+        Bt = group_block(g(idx))
+        if parts and cuts[-1] + len(Bt) > STACK_COLUMNS:
+            out.append((ks, np.concatenate(parts) * w, cuts))
+            ks, parts, cuts = [], [], [0]
+        ks.append(k)
+        parts.append(Bt)
+        cuts.append(cuts[-1] + len(Bt))
+    if parts:
+        out.append((ks, np.concatenate(parts) * w, cuts))
+    return out
+
+
 class BlockBase:
     """The current design on the weighted training rows, column-scaled, with its Gram
     pseudo-inverse and residual: :class:`volerr.loop.select.Base` without the rows.
 
     ``score_many`` gives the RSS reduction of adding column groups, from the blockwise
-    cross-products A_c^T r, A_c^T A_c and A_c^T A (one pass for all groups)."""
+    cross-products A_c^T r, A_c^T A_c and A_c^T A (one pass for all groups).
+
+    Where they fit in ``KEEP_BYTES`` (:meth:`Kept.fits`), the design's blocks are generated once
+    and kept, weighted and scaled, for every ``score_many`` (a lag's profile scores 13
+    values of its time constant a pass, several passes on one base)."""
 
     def __init__(self, design, points, sw, y):
         self.design, self.points, self.sw = design, np.asarray(points), np.asarray(sw)
-        G, b, colsq = normal(design, self.points, self.sw, y)
+        kept = Kept.of(design, self.points)
+        G, b, colsq = normal(design, self.points, self.sw, y, kept)
         n_rows = 3 * len(self.points)
         #: readings (rows that carry one: a ballbar point has one), the n of the BIC
         self.n = int(design.data.readings_per_point()[self.points].sum())
@@ -227,25 +290,39 @@ class BlockBase:
         self.Gi = eig_inverse(G / np.outer(self.scale, self.scale), 1e-12)
         c = self.Gi @ (b / self.scale) / self.scale
         self.r = np.empty(n_rows)         # weighted residual rows, component-major per block
-        for s, idx in blocks(self.points):
+        for k, (s, idx) in enumerate(blocks(self.points)):
             w = wrows(self.sw[s])
-            self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (
-                (yrows(y, idx) - c @ design.block(idx)) * w)
+            At = design.block(idx) if kept is None else kept[k]
+            self.r[3 * s.start:3 * s.start + 3 * len(idx)] = (yrows(y, idx) - c @ At) * w
+            if kept is not None:
+                At *= w / self.scale[:, None]       # as score_many weighs and scales it
+        self._kept = kept
         self.rss = float(self.r @ self.r)
 
     def score_many(self, groups) -> list:
         """[(RSS reduction, effective rank)] of adding each column group; a group is a function
-        ``idx -> (n, 3, m)`` columns at the points ``idx``."""
+        ``idx -> (n, 3, m)`` columns at the points ``idx``.
+
+        Per block the groups' columns are stacked (at most ``STACK_COLUMNS`` at a time) and
+        multiplied by the block's design columns in one matrix product: the (p, 3n) block
+        is read once per stack, not once per group (a product with a few columns is bound by
+        that read)."""
         acc = [None] * len(groups)
-        for s, idx in blocks(self.points):
+        for kb, (s, idx) in enumerate(blocks(self.points)):
             w = wrows(self.sw[s])
-            At = self.design.block(idx)
-            At *= w / self.scale[:, None]
+            if self._kept is not None:
+                At = self._kept[kb]
+            else:
+                At = self.design.block(idx)
+                At *= w / self.scale[:, None]
             r = self.r[3 * s.start:3 * s.start + 3 * len(idx)]
-            for k, g in enumerate(groups):
-                Bt = group_block(g(idx)) * w
-                parts = (At @ Bt.T, Bt @ Bt.T, Bt @ r)
-                acc[k] = parts if acc[k] is None else tuple(x + y for x, y in zip(acc[k], parts))
+            for ks, Ball, cuts in _stacked(groups, idx, w):
+                AB, Br = At @ Ball.T, Ball @ r
+                for k, a, b in zip(ks, cuts[:-1], cuts[1:]):
+                    Bt = Ball[a:b]
+                    parts = (AB[:, a:b], Bt @ Bt.T, Br[a:b])
+                    acc[k] = parts if acc[k] is None else tuple(
+                        x + y for x, y in zip(acc[k], parts))
         return [self._score(*a) for a in acc]
 
     def _score(self, AB, BB, Br) -> tuple[float, int]:

@@ -231,13 +231,15 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     ``design``: :class:`volerr.estimate.blocks.Design`; ``points``: the points fitted (their rows
     of ``y``).  The normal equations of all points at their instrument weight are accumulated
     once; each iteration subtracts those of the down-weighted points (few) and predicts
-    blockwise."""
+    blockwise, from the blocks of that first pass where they fit in
+    :data:`volerr.estimate.blocks.KEEP_BYTES` (else generated again)."""
     data = design.data
     base = data.point_weights()[points]
     dims = data.readings_per_point()[points]
     w = np.ones(len(points))
     rows = rows_of(points)
-    G1, b1, colsq = blocks.normal(design, points, np.sqrt(base), y)
+    kept = blocks.Kept.of(design, points)        # the blocks, for every pass
+    G1, b1, colsq = blocks.normal(design, points, np.sqrt(base), y, kept)
     scale = blocks.unit_scale(colsq, len(rows))
     sigma = 0.0
     for _ in range(iterations):
@@ -246,15 +248,12 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
             G, b, _ = blocks.normal(design, points, np.sqrt(base * w), y)
         else:       # G1 minus the down-weighted points' share (1 - w) A_i^T A_i
             G, b = G1.copy(), b1.copy()
-            for _, part in blocks.blocks(low):
-                idx = points[part]
-                d = blocks.wrows(np.sqrt(base[part] * (1.0 - w[part])))
-                At = design.block(idx)
+            for At, idx, d in _low_blocks(design, kept, points, low, base * (1.0 - w)):
                 At *= d
                 G -= At @ At.T
                 b -= At @ (blocks.yrows(y, idx) * d)
         c = solve_normal(G / np.outer(scale, scale), b / scale) / scale
-        r = point_norm(y[rows] - blocks.predict(design, points, c)) * np.sqrt(base)
+        r = point_norm(y[rows] - blocks.predict(design, points, c, kept)) * np.sqrt(base)
         sigma = max(float(np.median((r / CHI_MEDIAN[dims])[w > 0])), 1e-12)
         z = r / sigma
         w_new = np.where(z <= ROBUST_K, 1.0,
@@ -266,6 +265,21 @@ def robust_weights(design, y, points, n: int, iterations: int = 8) -> Robust:
     weights[points] = w * base
     flagged = points[z > OUTLIER_Z]
     return Robust(weights, sigma, flagged)
+
+
+def _low_blocks(design, kept, points, low, v):
+    """(columns (p, 3m), points (m,), row weights sqrt(v) (3m,)) of the points ``low`` (positions
+    in ``points``), block by block: taken from the blocks ``kept`` at ``points`` where given
+    (the columns of a point are the same in any block), else generated."""
+    if kept is None:
+        for _, part in blocks.blocks(low):
+            yield design.block(points[part]), points[part], blocks.wrows(np.sqrt(v[part]))
+        return
+    for k, (s, idx) in enumerate(blocks.blocks(points)):
+        m = low[(low >= s.start) & (low < s.start + len(idx))] - s.start
+        if len(m):
+            cols = np.concatenate([m, m + len(idx), m + 2 * len(idx)])   # component-major
+            yield kept[k][:, cols], idx[m], blocks.wrows(np.sqrt(v[s][m]))
 
 
 def selection_step(model, dat, decl: Declared, spl: Split, ranges, degree, families,

@@ -16,6 +16,7 @@ not drive the choice.  Units: mm rows; BIC in natural-log units.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -224,14 +225,23 @@ class Context:
         params = list(dict.fromkeys(t[0] for t in terms))
         arrays = self.sensitivities(idx)
         out = np.zeros((len(idx), 3, len(params)))
-        vals = {k: v[idx] for k, v in self.values(True).items()}
+        vals = self._values_at(idx)
         for pn, target, basis in terms:
             lagged = {k: self.lag_series(k, *rest)[idx] for k, *rest in lag_calls(basis)} \
                 if "lag(" in basis else {}
-            b = np.broadcast_to(evaluate(basis, {**vals, **lagged} if lagged else vals),
-                                (len(idx),))
+            b = np.broadcast_to(evaluate(basis, _Taken(vals.base, idx, vals.taken, lagged)
+                                         if lagged else vals), (len(idx),))
             out[:, :, params.index(pn)] += self._column(target, *arrays) * b[:, None]
         return out
+
+    def _values_at(self, idx) -> "_Taken":
+        """:meth:`values` of all points taken at ``idx`` as they are asked for (kept for the
+        last ``idx``: the candidate groups of one block share them)."""
+        last = self.cache.get("_vals_block")
+        if last is None or not np.array_equal(last.idx, idx):
+            last = _Taken(self.values(True), np.array(idx))
+            self.cache["_vals_block"] = last
+        return last
 
     def group(self, terms):
         """The columns of ``terms`` as a function of the points (for :class:`BlockBase`)."""
@@ -258,6 +268,33 @@ class Context:
                 return rows
             self.cache[key] = rows
         return self.cache[key]
+
+
+class _Taken(Mapping):
+    """The arrays of ``base`` (all points) at the points ``idx``, each taken when first asked
+    for (a basis needs two or three of the dozens of variables), then ``extra`` (arrays
+    already at ``idx``) over them; ``taken``: the cache of taken arrays (shared)."""
+
+    def __init__(self, base: dict, idx, taken: dict | None = None, extra: dict | None = None):
+        self.base, self.idx = base, idx
+        self.taken = {} if taken is None else taken
+        self.extra = extra or {}
+
+    def __getitem__(self, key):
+        if key in self.extra:
+            return self.extra[key]
+        if key not in self.taken:
+            self.taken[key] = np.asarray(self.base[key])[self.idx]
+        return self.taken[key]
+
+    def __contains__(self, key) -> bool:
+        return key in self.extra or key in self.base
+
+    def __iter__(self):
+        return iter({**dict.fromkeys(self.base), **dict.fromkeys(self.extra)})
+
+    def __len__(self) -> int:
+        return len(set(self.base) | set(self.extra))
 
 
 @dataclass
