@@ -31,9 +31,16 @@ def _blocks(text: str) -> dict:
 
 
 def _help_of(parser, key):
+    """The help of option ``key`` of ``parser``, else of its sub-commands' (a text file of
+    ``history`` serves ``history add`` and ``history show``)."""
     for action in parser._actions:
         if key in action.option_strings or (not action.option_strings and action.dest == key):
             return action.help
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in action.choices.values():
+                if (shown := _help_of(child, key)) is not None:
+                    return shown
     return None
 
 
