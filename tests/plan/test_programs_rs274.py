@@ -32,6 +32,9 @@ from helpers import rs274_path as R
 from volerr.cli import main
 from volerr.machine.layout import read_layout
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("plan_rs274")
+
 needs_rs274 = pytest.mark.skipif(R.rs274() is None, reason=R.SKIP_REASON)
 
 #: plan cases: small readings counts (the suite's time), every kind of issue 36
