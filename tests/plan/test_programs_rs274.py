@@ -32,9 +32,6 @@ from helpers import rs274_path as R
 from volerr.cli import main
 from volerr.machine.layout import read_layout
 
-# the module fixtures once, on one xdist worker (not once per worker)
-pytestmark = pytest.mark.xdist_group("plan_rs274")
-
 needs_rs274 = pytest.mark.skipif(R.rs274() is None, reason=R.SKIP_REASON)
 
 #: plan cases: small readings counts (the suite's time), every kind of issue 36
@@ -54,7 +51,10 @@ CASES = {
                         "--parameters", "squareness,EXX@slope,EYY@slope,EZZ@slope"],
 }
 DIALECTS = ("linuxcnc", "iso")
-PLANS = [pytest.param(c, d, id=f"{c}-{d}") for c in CASES for d in DIALECTS]
+#: the two tests of a plan on one xdist worker: the plan made and its programs read by rs274
+#: once (the module's ``planned`` and ``_READ`` caches live in each worker), the plans spread
+PLANS = [pytest.param(c, d, id=f"{c}-{d}", marks=pytest.mark.xdist_group(f"rs274_{c}-{d}"))
+         for c in CASES for d in DIALECTS]
 
 
 # ---------------------------------------------------------------------------------------------
