@@ -79,18 +79,60 @@ def figure(nrows: int = 1, ncols: int = 1, *, width: float = PAGE_WIDTH_IN,
     return plt.subplots(nrows, ncols, figsize=(min(width, PAGE_WIDTH_IN), height), **kwargs)
 
 
+#: zlib level of every PNG: 1 (fastest) encodes a figure about 4x faster than PIL's default
+#: 6, for files about a third larger; the pixels are the same (PNG is lossless)
+PNG_COMPRESS_LEVEL = 1
+
+
 def png(fig) -> bytes:
-    """PNG bytes of ``fig`` at :data:`DPI`, its full size (no cropping), then closed."""
+    """PNG bytes of ``fig`` at :data:`DPI`, its full size (no cropping), then closed.
+
+    The figure is drawn once: matplotlib's ``savefig`` of a figure with a layout engine
+    (``constrained``) draws it twice, once with the drawing switched off to run the layout and
+    once to paint; here the layout runs first (:func:`_layout_once`) and the figure is then
+    painted with the engine set aside, the same pixels at about two thirds of the cost.
+    Zlib level :data:`PNG_COMPRESS_LEVEL`."""
     plt = pyplot()
     w = fig.get_figwidth()
     if w > PAGE_WIDTH_IN + 1e-9:  # wider figures would be shrunk on the page
         fig.set_size_inches(PAGE_WIDTH_IN, fig.get_figheight() * PAGE_WIDTH_IN / w)
     buf = io.BytesIO()
     try:
-        fig.savefig(buf, format="png", dpi=DPI)
+        engine = _layout_once(fig)
+        try:
+            fig.savefig(buf, format="png", dpi=DPI,
+                        pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
+        finally:
+            if engine is not None:
+                fig.set_layout_engine(engine)
     finally:
         plt.close(fig)
     return buf.getvalue()
+
+
+def _layout_once(fig):
+    """Run ``fig``'s layout engine now, as ``savefig`` would in its first (unpainted) draw, and
+    set the engine aside so that ``savefig`` paints once; return the engine (to be put back),
+    or None where the figure is left as it is (no engine, no axes, not an Agg canvas, another
+    resolution than :data:`DPI`, or rcParams that would replace a missing engine)."""
+    import matplotlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    engine = fig.get_layout_engine()
+    rc = matplotlib.rcParams
+    if (engine is None or not fig.axes or not isinstance(fig.canvas, FigureCanvasAgg)
+            or fig.dpi != DPI or rc["figure.autolayout"] or rc["figure.constrained_layout.use"]
+            or rc["savefig.bbox"] == "tight"):
+        return None
+    for ax in fig.axes:   # what Figure.draw does before its layout (_get_draw_artists)
+        locator = ax.get_axes_locator()
+        ax.apply_aspect(locator(ax, fig.canvas.get_renderer()) if locator else None)
+    try:
+        engine.execute(fig)
+    except ValueError:    # as Figure.draw: the layout is then left as it was
+        pass
+    fig.set_layout_engine(None)   # with the rcParams above: no engine at all
+    return engine
 
 
 def save(fig, path, inputs=()) -> bytes:

@@ -92,11 +92,27 @@ def _split(v: sp.Matrix) -> _Dual:
     return _Dual(nom, (v - nom).applyfunc(sp.expand))
 
 
+def _split_vectors(L: dict) -> dict:
+    """``{"Lx": _split(...), ...}`` of the L vectors, each split once per process (the readings
+    of a chain exchange the same few vectors); the values are never changed in place."""
+    try:
+        key = tuple(tuple(L[k]) for k in "xyz")
+        hash(key)
+    except TypeError:             # entries that cannot be a key: split them as they are
+        return {k: _split(v) for k, v in _vectors(L).items()}
+    return _split_key(key)
+
+
+@lru_cache(maxsize=None)
+def _split_key(key: tuple) -> dict:
+    return {k: _split(v) for k, v in _vectors(dict(zip("xyz", key))).items()}
+
+
 def chain_error(lhs: str, rhs: str, L: dict) -> list:
     """First-order (dX, dY, dZ) implied by a printed chain ``lhs = rhs``: with f = lhs - rhs
     affine in A, nominal A0 solves f0(A0) = 0 and A1 = -J0^-1 f1(A0)."""
     names = {"T" + k: _Dual(sp.eye(3), _T(k.upper()) - sp.eye(3)) for k in "xyz"}
-    names.update({k: _split(v) for k, v in _vectors(L).items()})
+    names.update(_split_vectors(L))
     names["P"] = _Dual(sp.Matrix(PROBE), sp.zeros(3, 1))
     names["A"] = _Dual(sp.Matrix(A_SYMS), sp.zeros(3, 1))
     f = _evaluate(lhs, names) - _evaluate(rhs, names)

@@ -267,10 +267,16 @@ def _paper_map(name: str, work, flips: tuple) -> tuple:
 
 
 def derived_error(name: str, reading: Reading = Reading()) -> list:
-    """(dX, dY, dZ) of a layout under a reading, in paper symbols."""
+    """(dX, dY, dZ) of a layout under a reading, in paper symbols (a new list; the expansion
+    computed once per layout and reading: the audit asks for half of them twice)."""
+    return list(_derived_error(name, reading))
+
+
+@lru_cache(maxsize=None)
+def _derived_error(name: str, reading: Reading) -> tuple:
     _, err = iso_error(name, reading.pivot, reading.tool, reading.work)
     m = paper_map(layout(name), reading.work, reading.flips)
-    return [sp.expand(e.xreplace(m)) for e in err]
+    return tuple(sp.expand(e.xreplace(m)) for e in err)
 
 
 def readings(name: str, geoms: tuple) -> list[Reading]:

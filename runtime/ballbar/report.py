@@ -10,10 +10,14 @@ from ..report.page import document
 from ..units import num
 
 
-def render(ev) -> str:
+def render(ev, polar: bytes | None = None) -> str:
+    """The page of a ballbar evaluation ``ev``; ``polar``: the polar plot's PNG bytes when
+    already drawn (:func:`volerr.ballbar.plots.polar_png`), else drawn here."""
     from .plots import polar_png
 
-    img = embedded_img(polar_png(ev.traces, ev.results), "ballbar polar plot")
+    if polar is None:
+        polar = polar_png(ev.traces, ev.results)
+    img = embedded_img(polar, "ballbar polar plot")
     rows = "".join(
         f"<tr><td>{html.escape(r['file'])}</td><td>{html.escape(r['placement'])}</td>"
         f"<td>{r['plane']}</td><td>{num(r['radius_mm'], 'g')}</td><td>{r['direction']}</td>"
@@ -47,7 +51,8 @@ def _num(v) -> str:
     return "-" if v is None else num(v, ".3f")
 
 
-def write_html(path, ev, inputs=()):
+def write_html(path, ev, inputs=(), polar: bytes | None = None):
+    """Write :func:`render` of ``ev`` to ``path`` (``polar``: the plot's PNG when drawn)."""
     from ..fileio import write_text
 
-    return write_text(path, render(ev), inputs=list(inputs))
+    return write_text(path, render(ev, polar), inputs=list(inputs))

@@ -28,15 +28,16 @@ def _calibrated(w, stem: str, result, html: bool = True) -> dict:
 def ballbar(w) -> dict:
     """ISO 230-4 circles of MB1 in three planes: G, H and the diagnosis."""
     from ..ballbar.api import ballbar_evaluate
-    from ..ballbar.plots import polar_plot
+    from ..ballbar.plots import polar_png
     from ..ballbar.report import write_html
     from ..calibrate.examples import write_ballbar_example
 
     ex = write_ballbar_example(w.out / "ballbar")
     ev = ballbar_evaluate(ex["files"])
     w.later("ballbar.json", ev.write_json)
-    w.later("ballbar_polar.png", lambda p: polar_plot(ev.traces, ev.results, p))
-    w.later("ballbar.html", lambda p: write_html(p, ev))
+    polar = w.once(lambda: polar_png(ev.traces, ev.results))   # the file and the page
+    w.later("ballbar_polar.png", lambda p: _write_bytes(p, polar()))
+    w.later("ballbar.html", lambda p: write_html(p, ev, polar=polar()))
     rep = ev.to_dict()
     g = ", ".join(f"{t['plane']} {num(t['G_um'], '.2f')}" for t in rep["traces"]
                   if t["direction"] == "ccw")

@@ -139,7 +139,8 @@ def identify(w) -> dict:
 def uncertainty(w) -> dict:
     """Task-specific uncertainty of a 400 mm distance on MH2 (``volerr uncertainty``)."""
     from ..cmm.examples import write_example_errors
-    from ..fileio import write_text
+    from ..fileio import write_bytes, write_text
+    from ..plotstyle import png
     from ..uncertainty.api import uncertainty as task_uncertainty
 
     errors = w.out / "errors_MH2_u"
@@ -148,8 +149,9 @@ def uncertainty(w) -> dict:
     res = task_uncertainty("MH2", w.out / "task_distance.csv", "distance", errors=errors,
                            repeatability=True, noise_um=0.5, samples=2000, seed=1)
     w.later("uncertainty.json", res.write_json)
-    w.figure("uncertainty.png", res.figures()["histogram"])
-    w.later("uncertainty.html", res.write_html)
+    hist = w.once(lambda: png(res.figures()["histogram"]))      # the file and the page
+    w.later("uncertainty.png", lambda p: write_bytes(p, hist()))
+    w.later("uncertainty.html", lambda p: res.write_html(p, histogram=hist()))
     q = res.to_dict()["quantities"]["distance"]
     lo, hi = q["result_interval_mm"]
     return {"title": "task-specific uncertainty of a 400 mm distance on MH2 (Monte Carlo, "

@@ -96,7 +96,7 @@ def iso230_2(w) -> dict:
     w.text("iso230_2.json", json_text(res.data))
     png = res.png()
     w.later("iso230_2.png", lambda p: _write_bytes(p, png))
-    w.later("iso230_2.html", lambda p: res.write_html(p, inputs=[run]))
+    w.later("iso230_2.html", lambda p: res.write_html(p, inputs=[run], png=png))
     U = r["uncertainty_um"]
     return {"title": "ISO 230-2 evaluation of a simulated positioning run of X",
             "value": ", ".join(f"{q} {num(r[q + '_um'], '.2f')} \u00b1 {num(U[q], '.2f')}"

@@ -106,6 +106,7 @@ def _in_parallel(todo: list, progress, jobs: int) -> list:
 
     pyplot()          # imported once here, before the fork, not once in every worker
     load("MB1")
+    _import_shared(todo)
     order = sorted(todo, key=lambda n: BY_COST.index(n) if n in BY_COST else -1)
     ctx = multiprocessing.get_context("fork")
     with ProcessPoolExecutor(jobs, mp_context=ctx) as pool:
@@ -115,6 +116,23 @@ def _in_parallel(todo: list, progress, jobs: int) -> list:
             progress.update()
         done = {name: f.result() for f, name in futures.items()}
     return [done[name] for name in todo]
+
+
+#: the sections that calibrate (``volerr.calibrate``, the fit's chi-square test of
+#: scipy.stats; ``plan`` and ``check`` the plans too)
+CALIBRATING = ("rotary", "ballplate", "multilateration", "plan", "check")
+
+
+def _import_shared(todo: list) -> None:
+    """Import, before the fork, what sections in both workers import (the calibration, the
+    plans, the fit's chi-square test): once in the parent, about 1 s of CPU, instead of once
+    per worker; nothing when fewer than two sections of ``todo`` calibrate."""
+    if sum(name in CALIBRATING for name in todo) < 2:
+        return
+    import scipy.stats  # noqa: F401  (volerr.fit_quality's p-values)
+
+    from ..calibrate import run  # noqa: F401
+    from ..plan import api  # noqa: F401
 
 
 def _jobs(jobs, todo: list) -> int:

@@ -33,6 +33,18 @@ class Work:
         """Write ``name`` (relative to :attr:`out`) at the end: ``write(path)``."""
         self._later.append((name, write))
 
+    @staticmethod
+    def once(make):
+        """``make()`` computed at the first call of the function returned, then kept: a
+        figure's PNG drawn once at the end for its file and for the page that embeds it."""
+        kept = []
+
+        def get():
+            if not kept:
+                kept.append(make())
+            return kept[0]
+        return get
+
     def text(self, name: str, text: str) -> None:
         """The text file ``name`` (UTF-8), written at the end."""
         from ..fileio import write_text

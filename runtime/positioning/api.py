@@ -61,8 +61,9 @@ class Iso230_2(ResultMixin):
         return [write_text(Path(folder) / f"{ev.run.axis}.csv", error_table_csv(ev),
                            inputs=list(inputs)) for ev in self.evaluations]
 
-    def write_html(self, path, inputs=()):
-        """The certificate page (``--html``)."""
+    def write_html(self, path, inputs=(), png: bytes | None = None):
+        """The certificate page (``--html``); ``png``: the plot (:meth:`png`) when already
+        drawn, else drawn here."""
         import datetime
         from importlib.metadata import version
 
@@ -70,7 +71,8 @@ class Iso230_2(ResultMixin):
         from ..fileio import write_text
 
         made = f"Evaluated with volerr {version('volerr')} on {datetime.date.today().isoformat()}."
-        return write_text(path, report_html(self.data, self.png(), list(inputs), made,
+        return write_text(path, report_html(self.data, self.png() if png is None else png,
+                                            list(inputs), made,
                                             identification=self.identification),
                           inputs=list(inputs))
 

@@ -53,13 +53,16 @@ class Uncertainty(ResultMixin):
 
         return histogram_png(self.values, self.names, self.summary_stats, self.title)
 
-    def write_html(self, path, inputs=()):
-        """The report page (histogram, convergence, the sources and contributions)."""
+    def write_html(self, path, inputs=(), histogram: bytes | None = None):
+        """The report page (histogram, convergence, the sources and contributions);
+        ``histogram``: the histogram's PNG when already drawn, else drawn here."""
         from ..fileio import write_text
         from . import plots, report
 
-        figs = [plots.histogram_png(self.values, self.names, self.summary_stats, self.title),
-                plots.convergence_png(self.values, self.names, self.title)]
+        if histogram is None:
+            histogram = plots.histogram_png(self.values, self.names, self.summary_stats,
+                                            self.title)
+        figs = [histogram, plots.convergence_png(self.values, self.names, self.title)]
         return write_text(path, report.html_report(self.data, figs, CAPTIONS),
                           inputs=list(inputs))
 

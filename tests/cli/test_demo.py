@@ -95,6 +95,7 @@ def test_demo(tmp_path_factory):
     _every_section_and_honest_figures(out)
     _every_figure_has_text_of_at_least_9_px_where_it_is_shown(out, records)
     _one_unit_notation_on_every_axis_and_table_header(out, records)
+    _every_figure_drawn_once(out)
 
 
 def _every_section_and_honest_figures(out):
@@ -192,6 +193,29 @@ def _every_figure_has_text_of_at_least_9_px_where_it_is_shown(out, records):
     assert n >= 20
     # every PNG file of the demo is shown on the index
     assert {p.name for p in out.glob("*.png")} <= shown
+
+
+def _idat(data: bytes) -> bytes:
+    """The image data of a PNG (its IDAT chunks joined; the tEXt tag left out)."""
+    out, i = [], 8
+    while i < len(data):
+        n, kind = struct.unpack(">I4s", data[i:i + 8])
+        if kind == b"IDAT":
+            out.append(data[i + 8:i + 8 + n])
+        i += 12 + n
+    return b"".join(out)
+
+
+def _every_figure_drawn_once(out):
+    """Issue 42 item 7: an image shown twice (the PNG file on the index and the page that
+    embeds it: ballbar, ISO 230-2, uncertainty) comes from one drawing -- one savefig, one
+    tag -- not from the same figure drawn again."""
+    tags: dict = {}
+    for page, src, data, _ in _displayed(out):
+        tags.setdefault(_idat(data), set()).add(_png_chunks(data)["volerr-test"])
+    assert sum(len(t) > 1 for t in tags.values()) == 0, [
+        sorted(t) for t in tags.values() if len(t) > 1]
+    assert sum(len(t) for t in tags.values()) == len(tags) > 20
 
 
 def _one_unit_notation_on_every_axis_and_table_header(out, records):

@@ -20,6 +20,9 @@ import pytest
 from helpers import drift_sim as D
 from volerr.loop.drift import rows as R
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("drift_rows")
+
 DT = 30.0
 HOURS = 8.0
 NOISE = 0.05

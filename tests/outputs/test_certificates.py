@@ -14,6 +14,9 @@ import pytest
 
 from volerr.cli import main
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("outputs_certificates")
+
 pypdf = pytest.importorskip("pypdf")
 
 A4_PT = (595.28, 841.89)

@@ -11,6 +11,9 @@ import pytest
 
 from volerr.cli import main
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("outputs_reports")
+
 VOID = {"meta", "img", "br", "hr", "link", "input", "source", "wbr"}
 
 

@@ -32,6 +32,9 @@ import pytest
 from volerr.machine.model import load
 from volerr.plan import _candidates, _files, _nc, _spec
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("plan_nc")
+
 #: (layout, kind spec, set-ups taken: every n-th candidate, readings per set-up)
 CASES = {
     "MB1-ballbar": ("MB1", "ballbar:lengths=100,250", 40, 24),

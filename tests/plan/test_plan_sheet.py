@@ -8,6 +8,9 @@ import pytest
 from volerr import plotstyle
 from volerr.plan import _sheet, plan
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("plan_sheet")
+
 
 @pytest.fixture(scope="module")
 def fig():

@@ -51,7 +51,10 @@ CASES = {
                         "--parameters", "squareness,EXX@slope,EYY@slope,EZZ@slope"],
 }
 DIALECTS = ("linuxcnc", "iso")
-PLANS = [pytest.param(c, d, id=f"{c}-{d}") for c in CASES for d in DIALECTS]
+#: the two tests of a plan on one xdist worker: the plan made and its programs read by rs274
+#: once (the module's ``planned`` and ``_READ`` caches live in each worker), the plans spread
+PLANS = [pytest.param(c, d, id=f"{c}-{d}", marks=pytest.mark.xdist_group(f"rs274_{c}-{d}"))
+         for c in CASES for d in DIALECTS]
 
 
 # ---------------------------------------------------------------------------------------------

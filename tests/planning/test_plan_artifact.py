@@ -22,6 +22,9 @@ from volerr.calibrate.run import calibrate
 from volerr.cli import main
 from volerr.machine.layout import read_layout
 
+# the module fixtures once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("planning_artifact")
+
 PLAN = ["MB1", "--instrument", "artifact:balls=3x3:pitch=150:places=6", "--readings", "54",
         "--parameters", "squareness,EXX@slope,EYY@slope,EZZ@slope"]
 PLANTED = {"EA0Z": 12.0, "EB0Z": -8.0, "EC0Y": 15.0, "EXX@slope": 0.010, "EYY@slope": -0.008,
