@@ -274,13 +274,6 @@ def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> N
             getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
 
 
-def write_document_outputs(args, outs, result, ident, inputs, title: str | None = None,
-                           roles=("json", "html", "plot")) -> None:
-    """:func:`write_outputs` with the ``--pdf`` of the result's JSON document alone (its
-    ``"parameters"`` as rows, no figures: ``iso10360``, ``iso230-3``)."""
-    write_files(args, outs, result, inputs, roles)
-    write_certificates(outs, result.to_dict(), ident, inputs, title=title)
-
 
 def options_of(args, names: str, **more) -> dict:
     """The options ``names`` (dests, space separated) as the API's keywords, and ``more``."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
                       add_plot, add_vector, command_parser, identification_from_args, inputs_of,
-                      options_of, planned_outputs, write_document_outputs)
+                      options_of, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
@@ -47,5 +47,5 @@ def run(args) -> int:
         identification=identification_from_args(args, inputs)))
     print(res.summary())
     with outs:
-        write_document_outputs(args, outs, res, res.identification, inputs, res.title)
+        write_outputs(args, outs, res, res.identification, inputs, res.title)
     return 0 if math.isfinite(res.data["max_abs_E_um"]) else 1

@@ -68,11 +68,26 @@ def budget_rows(b: dict) -> list:
     q = unit(b["unit"])
     out = [["source", "u(x_i)", "unit of x_i", "sensitivity c_i", f"contribution / {q}"]]
     for s in b["sources"]:
-        out.append([s["source"], number(s["u"], 3), unit(s["unit"]),
-                    number(s["sensitivity"], 3), number(s["contribution"], 3)])
+        out.append([s["source"], number(_noise_free(s["u"], b, s["unit"]), 3), unit(s["unit"]),
+                    number(s["sensitivity"], 3),
+                    number(_noise_free(s["contribution"], b, b["unit"]), 3)])
     out.append(["combined standard uncertainty u", "", "", "", number(b["u"], 4)])
     out.append([f"expanded uncertainty U (k = {b['k']:g})", "", "", "", number(b["U"], 4)])
     return out
+
+
+#: below this fraction of the combined u a value of a budget is rounding noise of the
+#: arithmetic (a source that the quantity does not depend on), printed as 0
+NOISE = 1e-9
+
+
+def _noise_free(value, b: dict, value_unit: str):
+    """``value`` (in ``value_unit``), or 0 when it is in the budget's unit and below
+    :data:`NOISE` times its combined u (printed 6.16e-15 µrad where the source adds
+    nothing); the JSON keeps the computed value."""
+    if value is None or value_unit != b["unit"] or not b.get("u"):
+        return value
+    return 0.0 if abs(float(value)) < NOISE * abs(float(b["u"])) else value
 
 
 def budgets_of(doc: dict) -> list:
