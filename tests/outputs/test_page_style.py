@@ -206,8 +206,10 @@ def test_a_long_name_in_a_cell_may_wrap_at_its_joints_only():
 def test_a_number_with_an_exponent_is_kept_on_one_line():
     out = page.aligned("<table><tr><th>u</th></tr><tr><td>6.16e-15</td></tr></table>")
     assert '<span class="nw">6.16e-15</span>' in out
+    # a source in its own unit (a budget's own-unit rounding noise prints as 0:
+    # tests/outputs/test_budget_noise.py)
     budget = {"quantity": "EC0Y", "unit": "urad", "u": 0.5, "k": 2.0, "U": 1.0,
-              "sources": [{"source": "readings", "u": 6.16e-15, "unit": "urad",
+              "sources": [{"source": "readings", "u": 6.16e-15, "unit": "um",
                            "sensitivity": 1.0, "contribution": 6.16e-15}]}
     assert '<span class="nw">6.16e-15</span>' in page.budgets_html([budget])
 
