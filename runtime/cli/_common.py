@@ -38,7 +38,7 @@ def add_common(p) -> None:
                    help=_C("--volume"))
 
 
-def inputs_of(args, model=None) -> list:
+def inputs_of(args) -> list:
     """The inputs never overwritten: the error tables and a layout file (not a shipped one)."""
     from ..cmm import volmap
 
@@ -224,11 +224,9 @@ def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
     return sub.add_parser(name, help=short, **kw), option_help(text) if known else {}
 
 
-def error_dir_names(layout) -> list:
-    """The files of a fit's error directory: ``<axis>.csv`` of ``layout``'s axes, constants."""
-    from ..machine.model import load
-
-    return [f"{a}.csv" for a in load(layout).axes] + ["constants.csv"]
+def error_dir_names(model) -> list:
+    """The files of a fit's error directory: ``<axis>.csv`` of the model's axes, constants."""
+    return [f"{a}.csv" for a in model.axes] + ["constants.csv"]
 
 
 def write_errors_out(args, outs, result, inputs) -> None:
@@ -272,7 +270,6 @@ def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> N
     for role in roles:
         if getattr(args, role, None):
             getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
-
 
 
 def options_of(args, names: str, **more) -> dict:

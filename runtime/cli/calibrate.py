@@ -30,12 +30,13 @@ def run(args) -> int:
     from ..calibrate.mapping import grid_counts
     from ..calibrate.run import calibrate
     from ..instruments import split_spec
+    from ..machine.model import load
 
     grid_counts(args.map_grid)      # refused before anything else
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
     outs = planned_outputs(args, inputs, **{"--map-out": args.map_out, "--errors-out": (
-        args.errors_out, error_dir_names(args.layout))})
+        args.errors_out, error_dir_names(load(args.layout)))})
     ident = identification_from_args(args, inputs)
     with outs:
         result = calibrate(args.layout, args.files, parameters=args.parameters,

@@ -30,10 +30,11 @@ def run(args) -> int:
                         profile_points=args.profile_points, method=args.method,
                         degree=args.degree, extrapolate=args.extrapolate,
                         accept_implausible=args.accept_implausible)
-    outs = planned_outputs(args, inputs_of(args))
+    inputs = inputs_of(args)
+    outs = planned_outputs(args, inputs)
     print(res.summary())
     with outs:
-        write_files(args, outs, res, inputs_of(args), roles=("plot", "json"))
+        write_files(args, outs, res, inputs, roles=("plot", "json"))
     for label, path in (("json", args.json), ("plot", args.plot)):
         if path:
             print(f"{label}: {path}")

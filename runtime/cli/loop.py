@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 from ._common import (add_errors_out, add_fit_switches, add_report_options, command_parser,
-                      identification_from_args, layout_inputs, planned_outputs, write_errors_out,
-                      write_outputs)
+                      error_dir_names, identification_from_args, layout_inputs, planned_outputs,
+                      write_errors_out, write_outputs)
 
 
 def register(sub) -> None:
@@ -39,7 +39,7 @@ def run(args) -> int:
     outs = planned_outputs(args, inputs, **{
         "--predictions-out": args.predictions_out,
         "--out-dir": (args.out_dir, [f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py"]),
-        "--errors-out": (args.errors_out, [f"{a}.csv" for a in model.axes] + ["constants.csv"])})
+        "--errors-out": (args.errors_out, error_dir_names(model))})
     ident = identification_from_args(args, inputs)
     with outs:
         report = api_loop(

@@ -54,10 +54,7 @@ class Iso230_2(ResultMixin):
         from . import error_table_csv
         from ..fileio import write_text
 
-        axes = [ev.run.axis for ev in self.evaluations]
-        dup = sorted({a for a in axes if axes.count(a) > 1})
-        require(not dup, f"--errors-out writes one table per axis: {len(axes)} runs of axis "
-                         f"{dup[0] if dup else ''}; evaluate them one at a time")
+        refuse_one_axis_twice([ev.run.axis for ev in self.evaluations])
         return [write_text(Path(folder) / f"{ev.run.axis}.csv", error_table_csv(ev),
                            inputs=list(inputs)) for ev in self.evaluations]
 
@@ -87,6 +84,13 @@ def correction_conditions(cte_ppm_per_K: float | None = None,
     if material_temp_C is not None:
         out["material temperature"] = f"{material_temp_C:g} \u00b0C"
     return out
+
+
+def refuse_one_axis_twice(axes: list) -> None:
+    """The error tables are one file per axis: two runs of one axis are refused (one line)."""
+    dup = sorted({a for a in axes if axes.count(a) > 1})
+    require(not dup, f"--errors-out writes one table per axis: {len(axes)} runs of axis "
+                     f"{dup[0] if dup else ''}; evaluate them one at a time")
 
 
 def run_axes(axis: str, n: int) -> list:
@@ -146,10 +150,8 @@ def iso230_2(runs, axis: str = "X", *, tolerance: str | None = None,
     require(material_temp_C is None or cte_ppm_per_K is not None,
             "--material-temp-C is used only with --cte-ppm-per-K")
     axes = run_axes(axis, len(inputs))
-    dup = sorted({a for a in axes if axes.count(a) > 1})
-    require(not errors_out or not dup, f"--errors-out writes one table per axis: "
-                                       f"{len(inputs)} runs of axis {dup[0] if dup else ''}; "
-                                       f"evaluate them one at a time")
+    if errors_out:
+        refuse_one_axis_twice(axes)
     tol = (conformance.parse_tolerances(tolerance, ("A", "E", "M", "R", "B"))
            if tolerance is not None else None)
     rs = evaluate_files(inputs, axes, cte_ppm_per_K, material_temp_C, cte_reference_mm)
