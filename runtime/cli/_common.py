@@ -194,10 +194,12 @@ def _declare(outs, targets: dict) -> None:
             outs.file(role, target)
 
 
-def write_outputs(args, outs, result, ident, inputs, title: str | None = None) -> None:
+def write_outputs(args, outs, result, ident, inputs, title: str | None = None,
+                  roles=("plot", "json", "html")) -> None:
     """Inside ``with outs:``: ``--plot``, ``--json``, ``--html`` (:func:`write_files`; the
-    plot first: it may record its scale in the JSON), then :func:`write_certificates`."""
-    write_files(args, outs, result, inputs, ("plot", "json", "html"))
+    plot first: it may record its scale in the JSON; ``roles``: those the result writes),
+    then :func:`write_certificates`."""
+    write_files(args, outs, result, inputs, roles)
     write_certificates(outs, result, ident, inputs, title=title)
 
 

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from ._common import (add_force, add_html, add_identification_arguments, add_json, add_plot,
-                      command_parser, identification_from_args, planned_outputs,
-                      write_certificates, write_files)
+                      command_parser, identification_from_args, planned_outputs, write_outputs)
 
 
 def register(sub) -> None:
@@ -31,7 +30,6 @@ def run(args) -> int:
     with outs:
         for k, png in enumerate(res.pngs() if plots else []):
             write_bytes(outs.path(outs.group_role("--plot", plots, k)), png, inputs=inputs)
-        write_files(args, outs, res, inputs, ("json", "html"))
-        write_certificates(outs, res, ident, inputs)   # the PDF with the result's rows
+        write_outputs(args, outs, res, ident, inputs, roles=("json", "html"))
     print(res.summary())
     return 0
