@@ -31,6 +31,7 @@ class Engine:
         ``Z`` with itself do not depend on the channel: computed once)."""
         cache = {} if cache is None else cache
         self.n_runs = n_runs
+        self._cache, self._by_runs = cache, by_runs
         self.K = int(fold.max()) + 1
         self.n = int((fold >= 0).sum())
         first = np.zeros(n_runs)
@@ -56,6 +57,7 @@ class Engine:
                 self.fold_test.append((TG, Zt.T @ yt, float(yt @ yt), int(m.sum())))
             else:
                 self.fold_test.append(fit + (int(m.sum()),))
+        self._data = (Z, y, fold, run, first)
         self.G = sum(f[0] for f in self.fold_fit)
         self.h = sum(f[1] for f in self.fold_fit)
         self.yy = sum(f[2] for f in self.fold_fit)
@@ -85,6 +87,33 @@ class Engine:
             tot += sse
             base += sse0
         return tot, base
+
+    def cv_blocks(self, W, cands, sub: int) -> tuple[np.ndarray, np.ndarray]:
+        """Cross-validated mean squares over ``sub`` consecutive blocks of every fold (the
+        blocks of :func:`volerr.loop.drift.family.block_mse`, in fold then time order): (nc,
+        B) of ``W`` plus each candidate (+inf where dependent) and (B,) of ``W`` alone.  Each
+        block is predicted by the fit on the other folds, as in :meth:`cv_many`; the blocks'
+        test cross-products of ``Z`` are computed once per basis (``cache``)."""
+        Z, y, fold, run, first = self._data
+        a, b = cands[:, 0], cands[:, 1]
+        out, base = [], []
+        for k, (Gk, hk, _) in enumerate(self.fold_fit):
+            Gt, ht = self.G - Gk, self.h - hk
+            Wf = W[:, self._active(W, Gt)]
+            for j, part in enumerate(np.array_split(np.flatnonzero(fold == k), sub)):
+                if not len(part):
+                    continue
+                if ("block", k, j, sub) not in self._cache:
+                    Zb = Z[part].copy()
+                    if self._by_runs:              # anchored at the run's first reading
+                        Zb[:, :self.n_runs] = 0.0
+                    self._cache[("block", k, j, sub)] = (Zb, Zb.T @ Zb)
+                Zb, TG = self._cache[("block", k, j, sub)]
+                yb = y[part] - first[run[part]] if self._by_runs else y[part]
+                sse, sse0 = _bordered(Gt, ht, TG, Zb.T @ yb, float(yb @ yb), Wf, a, b)
+                out.append(sse / len(part))
+                base.append(sse0 / len(part))
+        return np.array(out).T.reshape(len(cands), len(base)), np.array(base)
 
     def train_rss_many(self, W, cands) -> tuple[np.ndarray, float]:
         """(training RSS (nc,) with each candidate, RSS of ``W``), fitted on all training."""

@@ -162,7 +162,8 @@ def _spec(cols, term) -> dict:
           "cv_rms_before_um": math.sqrt(term["cv_mse_before"]),
           "delta_bic": term["delta_bic"],
           "alternatives": [_alt(cols, x) for x in term["alternatives"]
-                           if not _same_term(cols, x, ca, b)]}
+                           if not _same_term(cols, x, ca, b)],
+          "tau_equivalent_s": sel.tau_equivalent(cols, term)}
     return sp
 
 
@@ -182,11 +183,12 @@ def _grid_step(cols) -> float:
 
 
 def _alt(cols, x) -> dict:
-    a, b, rms = x
+    a, b, rms, t = x
     c = cols[a]
     src = basis.SPEED if c.source == "heat" else c.source
     return {"covariate": src if b < 0 else f"{src} - {cols[b].source}",
-            "p": c.p, "lag_s": c.tau_s or None, "cv_rms_um": round(rms, 4)}
+            "p": c.p, "lag_s": c.tau_s or None, "cv_rms_um": round(rms, 4),
+            "paired_t": round(t, 3)}
 
 
 def column(s, sp, tau=None) -> np.ndarray:

@@ -212,7 +212,8 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
                  "unit": unit if heat else f"{unit}/K",
                  "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if f["tau_std"][i] is None
                             else round(f["tau_std"][i], 1)} if sp["tau_s"] > 0 else None),
-                 "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"]}
+                 "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
+                 "tau_equivalent_s": sp.get("tau_equivalent_s")}
             terms.append(t)
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
         for j, (i, t) in enumerate(zip(idx, terms)):

@@ -30,13 +30,14 @@ import math
 import numpy as np
 
 from ...selection import stepwise
-from ...selection.rules import CV_GAIN, CV_SAME, bic_accepts, cv_gain, delta_bic
+from ...selection.rules import CV_GAIN, bic_accepts, cv_gain, delta_bic, paired_t
+from ...selection.rules import significantly_below
 from ...selection.rules import TIE_SCORE_REL as TIE_REL
 from .engine import Engine
+from .family import SUB_BLOCKS
 
 DIFF_GAIN = 0.10      # a difference of two sensors must beat the best single sensor by this
 MAX_TERMS = 6         # terms per channel (the effects reported)
-N_ALT = 3
 
 
 def candidates(cols) -> np.ndarray:
@@ -90,7 +91,7 @@ def select_terms(eng: Engine, cols, n_runs: int, cands=None, start=(), max_terms
         dbic = delta_bic(eng.n, rss[0], st["rss0"], extra)
         return {"pair": tuple(int(x) for x in cands[ok][k]), "cv_mse": float(mse[k]),
                 "cv_mse_before": float(st["cur"]), "delta_bic": float(dbic),
-                "alternatives": _alternatives(mse, k, cands[ok]),
+                "alternatives": _alternatives(eng, st["W"], zc[ok], mse, k, cands[ok]),
                 "_z": zc[ok][k], "_rss": float(rss[0])}
 
     def take(term):
@@ -122,11 +123,38 @@ def _first_best(mse, cands) -> int:
     return min(best, key=lambda i: (mse[i], i)) if len(best) == 2 else best[0]
 
 
-def _alternatives(mse, k, cands) -> list:
-    rms = np.sqrt(mse)
-    near = np.flatnonzero(np.isfinite(rms) & (rms <= rms[k] * (1 + CV_SAME)))
-    near = [int(i) for i in near[np.argsort(rms[near], kind="stable")] if i != k][:N_ALT]
-    return [(int(cands[i, 0]), int(cands[i, 1]), float(rms[i])) for i in near]
+def _alternatives(eng, W, zc, mse, k, cands) -> list:
+    """The candidates the blocked CV cannot tell from the chosen one ``k`` in its place: the
+    chosen one is not significantly below them (:func:`volerr.selection.rules.
+    significantly_below`: the paired t over the ``SUB_BLOCKS`` blocks of every fold of
+    their CV mean squares, the rule by which :mod:`volerr.loop.drift.family` judges the
+    families), every one of them, the lowest CV RMS first: [(a, b, cv_rms, paired t)]."""
+    fine = np.flatnonzero(np.isfinite(mse))
+    fine = fine[fine != k]
+    if not len(fine):
+        return []
+    blocks, _ = eng.cv_blocks(W, zc[np.r_[k, fine]], SUB_BLOCKS)
+    out = []
+    for i, bm in zip(fine, blocks[1:]):
+        if np.all(np.isfinite(bm)) and not significantly_below(blocks[0], bm):
+            out.append((int(cands[i, 0]), int(cands[i, 1]), float(np.sqrt(mse[i])),
+                        paired_t(bm - blocks[0])))
+    return sorted(out, key=lambda x: (x[2], x[0], x[1]))
+
+
+def tau_equivalent(cols, term) -> list | None:
+    """[lo, hi] s: the time constants of the chosen term's own source (the same sensor or
+    difference, the heat input at the same exponent) among it and its CV-equivalent
+    alternatives (:func:`_alternatives`): the lags these data cannot tell apart; None for a
+    term without a lag (or whose equivalents include the plain source)."""
+    a, b = term["pair"]
+    own = (cols[a].source, cols[a].p, b >= 0 and cols[b].source)
+    taus = [cols[a].tau_s] + [cols[x[0]].tau_s for x in term["alternatives"]
+                              if (cols[x[0]].source, cols[x[0]].p,
+                                  x[1] >= 0 and cols[x[1]].source) == own]
+    if not min(taus) > 0:
+        return None
+    return [float(min(taus)), float(max(taus))]
 
 
 def _combo(mz, pair) -> np.ndarray:
