@@ -31,7 +31,7 @@ class Engine:
         ``Z`` with itself do not depend on the channel: computed once)."""
         cache = {} if cache is None else cache
         self.n_runs = n_runs
-        self._cache, self._by_runs = cache, by_runs
+        self._cache, self._by_runs, self._rhs = cache, by_runs, {}
         self.K = int(fold.max()) + 1
         self.n = int((fold >= 0).sum())
         first = np.zeros(n_runs)
@@ -94,7 +94,7 @@ class Engine:
         B) of ``W`` plus each candidate (+inf where dependent) and (B,) of ``W`` alone.  Each
         block is predicted by the fit on the other folds, as in :meth:`cv_many`; the blocks'
         test cross-products of ``Z`` are computed once per basis (``cache``)."""
-        Z, y, fold, run, first = self._data
+        fold = self._data[2]
         a, b = cands[:, 0], cands[:, 1]
         out, base = [], []
         for k, (Gk, hk, _) in enumerate(self.fold_fit):
@@ -103,17 +103,28 @@ class Engine:
             for j, part in enumerate(np.array_split(np.flatnonzero(fold == k), sub)):
                 if not len(part):
                     continue
-                if ("block", k, j, sub) not in self._cache:
-                    Zb = Z[part].copy()
-                    if self._by_runs:              # anchored at the run's first reading
-                        Zb[:, :self.n_runs] = 0.0
-                    self._cache[("block", k, j, sub)] = (Zb, Zb.T @ Zb)
-                Zb, TG = self._cache[("block", k, j, sub)]
-                yb = y[part] - first[run[part]] if self._by_runs else y[part]
-                sse, sse0 = _bordered(Gt, ht, TG, Zb.T @ yb, float(yb @ yb), Wf, a, b)
+                TG, Th, Tyy = self._block(k, j, sub, part)
+                sse, sse0 = _bordered(Gt, ht, TG, Th, Tyy, Wf, a, b)
                 out.append(sse / len(part))
                 base.append(sse0 / len(part))
         return np.array(out).T.reshape(len(cands), len(base)), np.array(base)
+
+    def _block(self, k: int, j: int, sub: int, part) -> tuple:
+        """The test cross-products (Z'Z, Z'y, y'y) of block j of fold k (readings ``part``;
+        a fold of whole runs anchored at each run's first reading): Z'Z once per basis, the
+        rest once per channel."""
+        key = ("block", k, j, sub)
+        if key not in self._rhs:
+            Z, y, _, run, first = self._data
+            Zb = Z[part]
+            yb = y[part]
+            if self._by_runs:                  # predicted from the run's first reading
+                Zb[:, :self.n_runs] = 0.0
+                yb = yb - first[run[part]]
+            if key not in self._cache:
+                self._cache[key] = Zb.T @ Zb
+            self._rhs[key] = (Zb.T @ yb, float(yb @ yb))
+        return (self._cache[key],) + self._rhs[key]
 
     def train_rss_many(self, W, cands) -> tuple[np.ndarray, float]:
         """(training RSS (nc,) with each candidate, RSS of ``W``), fitted on all training."""

@@ -91,10 +91,11 @@ def select_terms(eng: Engine, cols, n_runs: int, cands=None, start=(), max_terms
         dbic = delta_bic(eng.n, rss[0], st["rss0"], extra)
         return {"pair": tuple(int(x) for x in cands[ok][k]), "cv_mse": float(mse[k]),
                 "cv_mse_before": float(st["cur"]), "delta_bic": float(dbic),
-                "alternatives": _alternatives(eng, st["W"], zc[ok], mse, k, cands[ok]),
-                "_z": zc[ok][k], "_rss": float(rss[0])}
+                "_z": zc[ok][k], "_rss": float(rss[0]), "_scored": (zc[ok], mse, k, cands[ok])}
 
     def take(term):
+        # its alternatives in its place (the model before it): only for the terms taken
+        term["alternatives"] = _alternatives(eng, st["W"], *term.pop("_scored"))
         pair = term["pair"]
         st["taken"].add(pair)
         if cols[pair[0]].p is not None:
