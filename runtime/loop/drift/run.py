@@ -213,7 +213,7 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
                  "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if f["tau_std"][i] is None
                             else round(f["tau_std"][i], 1)} if sp["tau_s"] > 0 else None),
                  "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
-                 "tau_equivalent_s": sp.get("tau_equivalent_s")}
+                 "tau_equivalent_s": _tau_span(sp)}
             terms.append(t)
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
         for j, (i, t) in enumerate(zip(idx, terms)):
@@ -234,6 +234,15 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
             e["S_ref_rpm"] = S_ref
         out.append(e)
     return out
+
+
+def _tau_span(sp) -> list | None:
+    """[lo, hi] s: the time constants of the term's own source its group holds
+    (:func:`volerr.loop.drift.select.tau_equivalent`, on the grid) and its refined one."""
+    span = sp.get("tau_equivalent_s")
+    if not span or not sp["tau_s"] > 0:
+        return None
+    return [round(min(span[0], sp["tau_s"]), 1), round(max(span[1], sp["tau_s"]), 1)]
 
 
 def _budget(row: str, t: dict, f: dict, i: int) -> dict:

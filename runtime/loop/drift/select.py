@@ -15,10 +15,15 @@ Steps (:func:`select_terms`):
    shorter lags first, the heat input last), a stated rule rather than rounding;
 4. stop when no candidate passes or ``MAX_TERMS`` terms are in the model.
 
-The candidates within ``CV_SAME`` of the chosen one's cross-validated RMS (in its place)
-are its *alternatives*: explanations these data cannot tell apart (the sensor selection rule
-of :mod:`volerr.loop.lags`, judged by cross-validation).  ``CV_GAIN``, ``BIC_GAIN``,
-``CV_SAME`` and the tie tolerance ``TIE_REL`` (``TIE_SCORE_REL``) are the rules of
+The candidates the cross-validation cannot tell from the chosen one in its place are its
+*alternatives*, every one of them (issue 44): those within ``CV_SAME`` of its
+cross-validated RMS (the sensor selection rule of :mod:`volerr.loop.lags`), and those the
+chosen one is not significantly below by the paired t over the blocks of every fold (the
+rule by which :mod:`volerr.loop.drift.family` judges the families).  A term is then a
+*group* of equivalent sources (near-collinear sensors, their lags, the heat input at other
+time constants), not the diagnosis of one sensor; :func:`tau_equivalent` the span of its
+own source's time constants in the group.  ``CV_GAIN``, ``BIC_GAIN``, ``CV_SAME`` and the
+tie tolerance ``TIE_REL`` (``TIE_SCORE_REL``) are the rules of
 :mod:`volerr.selection.rules`.
 """
 
@@ -30,7 +35,7 @@ import math
 import numpy as np
 
 from ...selection import stepwise
-from ...selection.rules import CV_GAIN, bic_accepts, cv_gain, delta_bic, paired_t
+from ...selection.rules import CV_GAIN, CV_SAME, bic_accepts, cv_gain, delta_bic, paired_t
 from ...selection.rules import significantly_below
 from ...selection.rules import TIE_SCORE_REL as TIE_REL
 from .engine import Engine
@@ -125,20 +130,27 @@ def _first_best(mse, cands) -> int:
 
 
 def _alternatives(eng, W, zc, mse, k, cands) -> list:
-    """The candidates the blocked CV cannot tell from the chosen one ``k`` in its place: the
-    chosen one is not significantly below them (:func:`volerr.selection.rules.
-    significantly_below`: the paired t over the ``SUB_BLOCKS`` blocks of every fold of
-    their CV mean squares, the rule by which :mod:`volerr.loop.drift.family` judges the
-    families), every one of them, the lowest CV RMS first: [(a, b, cv_rms, paired t)]."""
+    """The candidates these data cannot tell from the chosen one ``k`` in its place, every
+    one of them, the lowest CV RMS first: [(a, b, cv_rms, paired t)].  Two ways of not
+    telling apart: the cross-validated RMS within ``CV_SAME`` (a difference too small to
+    matter), or the chosen one not significantly below the candidate
+    (:func:`volerr.selection.rules.significantly_below`: the paired t over the
+    ``SUB_BLOCKS`` blocks of every fold of their CV mean squares, the rule
+    :mod:`volerr.loop.drift.family` judges the families by: a difference that does not
+    stand out of its block-to-block scatter).  The paired t is positive where the
+    candidate is the worse."""
     fine = np.flatnonzero(np.isfinite(mse))
     fine = fine[fine != k]
     if not len(fine):
         return []
     blocks, _ = eng.cv_blocks(W, zc[np.r_[k, fine]], SUB_BLOCKS)
+    rms = np.sqrt(mse)
     out = []
     for i, bm in zip(fine, blocks[1:]):
-        if np.all(np.isfinite(bm)) and not significantly_below(blocks[0], bm):
-            out.append((int(cands[i, 0]), int(cands[i, 1]), float(np.sqrt(mse[i])),
+        if not np.all(np.isfinite(bm)):
+            continue
+        if rms[i] <= rms[k] * (1 + CV_SAME) or not significantly_below(blocks[0], bm):
+            out.append((int(cands[i, 0]), int(cands[i, 1]), float(rms[i]),
                         paired_t(bm - blocks[0])))
     return sorted(out, key=lambda x: (x[2], x[0], x[1]))
 
