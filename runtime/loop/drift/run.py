@@ -240,7 +240,7 @@ def _tau_span(sp) -> list | None:
     """[lo, hi] s: the time constants of the term's own source its group holds
     (:func:`volerr.loop.drift.select.tau_equivalent`, on the grid) and its refined one."""
     span = sp.get("tau_equivalent_s")
-    if not span or not sp["tau_s"] > 0:
+    if span is None or not sp["tau_s"] > 0:
         return None
     return [round(min(span[0], sp["tau_s"]), 1), round(max(span[1], sp["tau_s"]), 1)]
 

@@ -158,14 +158,14 @@ def _alternatives(eng, W, zc, mse, k, cands) -> list:
 def tau_equivalent(cols, term) -> list | None:
     """[lo, hi] s: the time constants of the chosen term's own source (the same sensor or
     difference, the heat input at the same exponent) among it and its CV-equivalent
-    alternatives (:func:`_alternatives`): the lags these data cannot tell apart; None for a
-    term without a lag (or whose equivalents include the plain source)."""
+    alternatives (:func:`_alternatives`): the lags these data cannot tell apart (lo 0: the
+    plain source too); None for a term without a lag."""
     a, b = term["pair"]
     own = (cols[a].source, cols[a].p, b >= 0 and cols[b].source)
     taus = [cols[a].tau_s] + [cols[x[0]].tau_s for x in term["alternatives"]
                               if (cols[x[0]].source, cols[x[0]].p,
                                   x[1] >= 0 and cols[x[1]].source) == own]
-    if not min(taus) > 0:
+    if not cols[a].tau_s > 0:
         return None
     return [float(min(taus)), float(max(taus))]
 
