@@ -164,9 +164,28 @@ def _term_line(t: dict) -> str:
         u = f" +- {k * lag['std']:.0f}" if lag.get("std") is not None else " (u not determined)"
         c += f", tau = {lag['value']:.0f}{u} s (k = {k:g})"
     if t.get("alternatives"):
-        c += "; these data cannot tell it from " + ", ".join(
-            a["covariate"] + (f" through {a['lag_s']:.0f} s" if a.get("lag_s") else "")
-            for a in t["alternatives"])
+        c += "; these data cannot tell it from " + _alternatives_text(t["alternatives"])
     return f"{t['basis']}: {c}"
+
+
+#: sources named on the console per term (all of them in the JSON)
+ALT_PRINT = 5
+
+
+def _alternatives_text(alts: list) -> str:
+    """The alternatives by source, in the JSON's order (lowest CV RMS first): a source with
+    the span of its lags (``plain`` for no lag), at most ``ALT_PRINT`` sources."""
+    by: dict = {}
+    for a in alts:
+        by.setdefault(a["covariate"], []).append(a.get("lag_s") or 0.0)
+    parts = []
+    for src, lags in list(by.items())[:ALT_PRINT]:
+        on = sorted(x for x in lags if x > 0)
+        what = [] if not on else [f"{on[0]:.0f} s" if on[0] == on[-1] else
+                                  f"{on[0]:.0f}..{on[-1]:.0f} s"]
+        what += ["plain"] if len(on) < len(lags) else []
+        parts.append(f"{src} ({', '.join(what)})")
+    more = len(by) - ALT_PRINT
+    return ", ".join(parts) + (f" and {more} other sources (JSON)" if more > 0 else "")
 
 
