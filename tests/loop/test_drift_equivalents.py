@@ -22,21 +22,13 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from helpers.drift_sim import lag
 from volerr.loop.drift import basis, family
 from volerr.loop.drift import fit as core
 from volerr.loop.drift.engine import Engine
 from volerr.loop.drift.series import DriftSeries
 
 DT = 60.0
-
-
-def _first_order(u, tau, dt):
-    """Implicit-Euler first-order lag of ``u`` (at rest at the start): the tests' own."""
-    y = np.zeros_like(u)
-    a = dt / (tau + dt)
-    for i in range(1, len(u)):
-        y[i] = y[i - 1] + a * (u[i] - y[i - 1])
-    return y
 
 
 def _series(n_runs: int = 1, seed: int = 11) -> DriftSeries:
@@ -50,14 +42,14 @@ def _series(n_runs: int = 1, seed: int = 11) -> DriftSeries:
     t = np.concatenate([t1] * n_runs)
     run = np.repeat(np.arange(n_runs), len(t1))
     on = ((t1 // 5400.0) % 2 == 1).astype(float) * (1 + (t1 // 10800.0) % 3)
-    T = np.concatenate([20.0 + 6.0 * _first_order(on / 3, 1500.0, DT)] * n_runs)
+    T = np.concatenate([20.0 + 6.0 * lag(on / 3, 1500.0, DT)] * n_runs)
     Ta = T + rng.normal(0, 0.005, len(t))       # two sensors reading the same temperature
     Tb = T + rng.normal(0, 0.005, len(t))
     Tc = 20.0 + np.cumsum(rng.normal(0, 0.02, len(t)))
     y = np.zeros(len(t))
     for r in range(n_runs):
         m = run == r
-        y[m] = 2.5 * _first_order(T[m] - T[m][0], 2400.0, DT)
+        y[m] = 2.5 * lag(T[m] - T[m][0], 2400.0, DT)
     y = y + rng.normal(0, 0.3, len(t))
     s = DriftSeries(t_s=t, run=run, runs=[("sim.csv", str(r)) for r in range(n_runs)],
                     inputs={"T_a": Ta, "T_b": Tb, "T_c": Tc}, channels={"x": y},
