@@ -87,14 +87,18 @@ def runs(tmp_path_factory):
     return get
 
 
-def _half_step(doc) -> float:
-    """Half the grid's ln step: an alternative's lag on the grid stands for the lags within
-    it (the grid runs from the shortest lag to half the training span, ``N_TAU`` values)."""
-    lags = sorted({a["lag_s"] for e in doc["effects"] for t in e["terms"]
-                   for a in t["alternatives"] if a["lag_s"]})
-    if len(lags) < 2:
-        return 0.0
-    return 0.5 * min(math.log(b / a) for a, b in zip(lags, lags[1:]) if b / a > 1.0001)
+def _half_step(step: int, name: str) -> float:
+    """Half the ln step of the grid of time constants an alternative's lag lies on: the
+    grid runs from 4 reading intervals (at least 60 s) to half the training span, ``N_TAU``
+    values, geometric (``volerr formats loop-lags``); computed here from the file's times."""
+    win, cut = WINDOWS[name]
+    t = np.arange(0.0, 166710.0 + 1.0, 15.0 * step)
+    if cut is not None:
+        t = t[t < cut]
+    a, b = (float(x[:-1]) if x else np.inf for x in win.split(":"))
+    train = t[(t < a) | (t >= b)]
+    lo, hi = max(60.0, 4 * 15.0 * step), max(np.ptp(train) / 2, 4 * max(60.0, 60.0 * step))
+    return 0.5 * math.log(hi / lo) / (N_TAU - 1)
 
 
 def _group(t: dict, covariate: str, h: float) -> dict:
@@ -121,8 +125,7 @@ def _group(t: dict, covariate: str, h: float) -> dict:
             for k, (lo, hi) in g.items()}
 
 
-def _terms(doc, ch) -> list:
-    h = _half_step(doc)
+def _terms(doc, ch, h) -> list:
     return [(t["basis"], _group(t, e["covariate"], h)) for e in doc["effects"]
             if e["channels"] == [ch] for t in e["terms"]]
 
@@ -145,7 +148,7 @@ def test_60_s_names_the_diagnosis_of_15_s_or_its_equivalents(runs, name, ch):
     a, b = runs(1, name), runs(4, name)
     fa, fb = a["channels"][ch]["family"], b["channels"][ch]["family"]
     assert fa == fb, f"{name} {ch}: family {fa} at 15 s, {fb} at 60 s"
-    ta, tb = _terms(a, ch), _terms(b, ch)
+    ta, tb = _terms(a, ch, _half_step(1, name)), _terms(b, ch, _half_step(4, name))
     lost = [x for x, g in ta if not _agrees(g, tb)] + [x for x, g in tb if not _agrees(g, ta)]
     assert not lost, f"{name} {ch}: terms without a counterpart in the other sampling: {lost}"
 
