@@ -69,7 +69,7 @@ def _allowed(cands, cols, chosen_p, taken) -> np.ndarray:
 
 
 def select_terms(eng: Engine, cols, n_runs: int, cands=None, start=(), max_terms=MAX_TERMS) -> list:
-    """The chosen terms [{"pair": (a, b), "cv_mse", "alternatives": [(a, b, cv_rms)]}] in
+    """The chosen terms [{"pair": (a, b), "cv_mse", "alternatives": [(a, b, cv_rms, paired_t)]}] in
     the order taken (indices into ``cols``; Z's column of basis column j is n_runs + j)."""
     mz = n_runs + len(cols)
     if cands is None:
