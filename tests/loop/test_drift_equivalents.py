@@ -35,8 +35,9 @@ DT = 60.0
 def _series(n_runs: int = 1, seed: int = 11) -> DriftSeries:
     """A channel following a 40 min lag of a bearing temperature read by two sensors
     ``T_a`` and ``T_b`` (each with 0.005 K noise of its own; the channel 0.3 um); ``T_c`` a
-    wandering sensor that carries nothing of the drift.  No speed is logged (no heat input): the first term is
-    chosen beside the run zeros alone, where its alternatives are scored."""
+    wandering sensor that carries nothing of the drift.  No speed is logged (no heat
+    input): the first term is chosen beside the run zeros alone, where its alternatives are
+    scored."""
     rng = np.random.default_rng(seed)
     hours = 20.0 / n_runs
     t1 = np.arange(0.0, hours * 3600.0, DT)
