@@ -100,11 +100,12 @@ class Engine:
         for k, (Gk, hk, _) in enumerate(self.fold_fit):
             Gt, ht = self.G - Gk, self.h - hk
             Wf = W[:, self._active(W, Gt)]
+            fit = _bordered_fit(Gt, ht, Wf, a, b)         # one fit per fold, its blocks tested
             for j, part in enumerate(np.array_split(np.flatnonzero(fold == k), sub)):
                 if not len(part):
                     continue
                 TG, Th, Tyy = self._block(k, j, sub, part)
-                sse, sse0 = _bordered(Gt, ht, TG, Th, Tyy, Wf, a, b)
+                sse, sse0 = _bordered_test(fit, TG, Th, Tyy, Wf, a, b)
                 out.append(sse / len(part))
                 base.append(sse0 / len(part))
         return np.array(out).T.reshape(len(cands), len(base)), np.array(base)
@@ -152,15 +153,18 @@ def _quad(G, a, b):
 def _bordered(Gt, ht, TG, Th, Tyy, W, a, b):
     """SSE on the test cross-products (TG, Th, Tyy) of the fit on (Gt, ht) with the columns
     ``W`` plus each candidate, and of ``W`` alone."""
+    return _bordered_test(_bordered_fit(Gt, ht, W, a, b), TG, Th, Tyy, W, a, b)
+
+
+def _bordered_fit(Gt, ht, W, a, b) -> tuple:
+    """The fits on (Gt, ht): of ``W`` alone (b0) and of ``W`` plus each candidate (B, beta;
+    ``ok`` False where the candidate is dependent)."""
     M = W.T @ Gt @ W
     hS = W.T @ ht
     Minv = np.linalg.pinv(M, rcond=1e-12, hermitian=True) if M.size else M
     b0 = Minv @ hS
-    TGW = TG @ W
-    GkSS, hkS = W.T @ TGW, W.T @ Th
-    sse0 = Tyy - 2 * b0 @ hkS + b0 @ GkSS @ b0
     if len(a) == 0:
-        return np.zeros(0), float(sse0)
+        return b0, None, None, None
     U = _pair(Gt @ W, a, b).T                 # (s, nc)  W' Gt c
     v = _quad(Gt, a, b)
     hc = _pair(ht[:, None], a, b)[:, 0]
@@ -169,6 +173,18 @@ def _bordered(Gt, ht, TG, Th, Tyy, W, a, b):
     ok = schur > SINGULAR * np.maximum(v, 1e-300)
     beta = np.where(ok, (hc - U.T @ b0) / np.where(ok, schur, 1.0), 0.0)
     B = b0[:, None] - Zm * beta
+    return b0, B, beta, ok
+
+
+def _bordered_test(fit, TG, Th, Tyy, W, a, b):
+    """SSE on the test cross-products (TG, Th, Tyy) of the fits ``fit``
+    (:func:`_bordered_fit`): (per candidate, +inf where dependent; of ``W`` alone)."""
+    b0, B, beta, ok = fit
+    TGW = TG @ W
+    GkSS, hkS = W.T @ TGW, W.T @ Th
+    sse0 = Tyy - 2 * b0 @ hkS + b0 @ GkSS @ b0
+    if len(a) == 0:
+        return np.zeros(0), float(sse0)
     GkSc = _pair(TGW, a, b).T
     Gkcc = _quad(TG, a, b)
     hkc = _pair(Th[:, None], a, b)[:, 0]
