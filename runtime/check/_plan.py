@@ -82,6 +82,16 @@ class CheckPlan:
                 if v["power"] is not None and v["size"] is not None and v["size_95"] is not None]
         return "\n".join([head] + rows)
 
+    def write_outputs(self, outs, options: dict, ident, inputs=(), title=None, roles=()):
+        """``volerr check plan``'s outputs inside ``with outs:``: :meth:`write` into
+        ``--out`` (and ``--json``, ``--html``), then the identification
+        (:func:`volerr.report.stamp.finish`)."""
+        from ..report.document import Document
+        from ..report.stamp import finish
+
+        self.write(outs.path("--out"), outs.path("--json"), outs.path("--html"), inputs)
+        finish(outs, Document(self), ident, list(inputs))
+
     def write(self, folder, json_path=None, html_path=None, inputs=()) -> None:
         """The plan's files, NC programs and set-up sheet (:meth:`volerr.plan.Plan.write`),
         the sheet with the check's power table added, and the JSON."""

@@ -49,6 +49,21 @@ class ErrorMap(ResultMixin):
                                                           inputs)
         return path
 
+    def random_plot_path(self, plot_random=None, plot=None):
+        """Where ``volerr map`` draws the random component: ``plot_random``, else beside
+        ``plot`` (``NAME_random.png``) when the map has one, else ``None``."""
+        from .volmap import random_plot_path
+
+        return plot_random or (random_plot_path(plot) if plot and self.has_random else None)
+
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr map``'s ``--out`` CSV and the random plot (before the JSON: it records
+        the magnification)."""
+        if options.get("out"):
+            self.write_csv(outs.path("--out"), inputs)
+        if outs.path("--plot-random"):
+            self.write_random_plot(outs.path("--plot-random"), inputs)
+
     def summary(self, written: dict | None = None) -> str:
         """What ``volerr map`` prints; ``written``: ``{label: path}`` of the files written
         (``map``, ``plot``, ``random plot``, ``summary``), one line each at the end."""

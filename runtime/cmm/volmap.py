@@ -375,6 +375,14 @@ def error_dir_inputs(directory) -> list:
     return [f for f in d.iterdir() if f.is_file()]
 
 
+def map_inputs(layout, errors) -> list:
+    """The inputs of a run on an error model, never overwritten: the files of the error
+    directory ``errors`` and the layout file (not a shipped layout's name)."""
+    from ..machine.layout import layout_inputs
+
+    return error_dir_inputs(errors) + layout_inputs(layout)
+
+
 def check_distinct(*paths) -> None:
     seen = {}
     for label, p in paths:

@@ -52,6 +52,12 @@ class ProbeCal(ResultMixin):
 
         return plot_probe_calibration(self.calibration, check_plot(path, list(inputs)))
 
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr probe-cal``'s ``--out MAP.csv`` and ``--plots DIR``."""
+        self.write_map(outs.path("--out"), inputs=inputs)
+        if options.get("plots"):
+            self.write_plots(outs.path("--plots"))
+
     def write_plots(self, folder) -> list:
         """``FOLDER/probe_map_3d.png`` (Fig. 3a) and ``FOLDER/probe_map_2d.png`` (Fig. 3b)
         (``--plots DIR``); returns their paths."""
