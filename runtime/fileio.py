@@ -691,3 +691,10 @@ def planned_outputs(options: dict, inputs, *, first: dict | None = None, **more)
             else:
                 outs.file(role, target)
     return outs.check()
+
+
+def layout_inputs(layout) -> list:
+    """``[path]`` when ``layout`` names an existing layout file (an input of a run, never
+    overwritten), else ``[]`` (a shipped layout's name)."""
+    p = Path(str(layout))
+    return [p] if p.is_file() else []

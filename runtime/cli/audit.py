@@ -22,7 +22,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from ..audit import run as audit_run  # the capability: when the command runs
     from ..audit.api import audit
-    from ..machine.layout import layout_inputs
+    from ..fileio import layout_inputs
     from ..progress import progress
 
     inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]

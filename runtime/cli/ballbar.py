@@ -54,12 +54,10 @@ def run_simulate(args) -> int:
     return 0
 
 
-def run_evaluate(args) -> int:
+def run_evaluate(args):
     from ..ballbar.api import ballbar_evaluate
-    from ..machine.layout import layout_inputs
+    from ..fileio import layout_inputs
     from ..results import run_command
 
-    ev = run_command(vars(args), list(args.files) + layout_inputs(args.layout), lambda *_: (
+    return run_command(vars(args), list(args.files) + layout_inputs(args.layout), lambda *_: (
         ballbar_evaluate(args.files, args.layout, accept_residual=args.accept_residual)))
-    print(ev.summary())
-    return 0

@@ -25,11 +25,11 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..calibrate.mapping import grid_counts
     from ..calibrate.run import calibrate
+    from ..fileio import layout_inputs
     from ..instruments import split_spec
-    from ..machine.layout import layout_inputs
     from ..machine.model import load
     from ..results import run_command
     from ..tables.table import error_dir_names
@@ -39,8 +39,6 @@ def run(args) -> int:
         + ([args.reference] if args.reference else [])
     outputs = {"--map-out": args.map_out,
                "--errors-out": (args.errors_out, error_dir_names(load(args.layout).axes))}
-    result = run_command(vars(args), inputs, lambda *_: calibrate(args.layout, args.files, **(
+    return run_command(vars(args), inputs, lambda *_: calibrate(args.layout, args.files, **(
         options_of(args, "parameters degree seed test_fraction accept_residual reference "
                          "max_change accept_change"))), **outputs)
-    print(result.summary())
-    return 0

@@ -27,17 +27,17 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..check._run import command_form
 
     plan, args.words, args.reference = command_form(args.words, args.reference, vars(args))
     return _plan(args) if plan else _check(args)
 
 
-def _plan(args) -> int:
+def _plan(args):
     from ..check import plan_check
     from ..check._plan import DEFAULT_DETECT_UM, check_plan_options
-    from ..machine.layout import layout_inputs
+    from ..fileio import layout_inputs
     from ..plan.api import check_plan_folder
     from ..results import run_command
 
@@ -45,24 +45,20 @@ def _plan(args) -> int:
     require(args.out, "check plan: give --out DIR")
     inputs = layout_inputs(args.words[1]) + [args.reference]
     check_plan_folder(args.out, args.force, "check", (".csv", ".nc", ".html"))
-    result = run_command(vars(args), inputs, lambda *_: plan_check(
+    return run_command(vars(args), inputs, lambda *_: plan_check(
         args.words[1], args.reference, args.instrument, **options_of(
             args, "minutes readings", detect_um=args.detect_um or DEFAULT_DETECT_UM)),
         ident_files=inputs[-1:] + inputs[:-1], **{"--out": (args.out, None)})
-    print(result.summary())
-    return 0
 
 
-def _check(args) -> int:
+def _check(args):
     from ..check import check
+    from ..fileio import layout_inputs
     from ..instruments import split_spec
-    from ..machine.layout import layout_inputs
     from ..results import run_command
 
     files = [split_spec(f)[1] for f in args.words[1:]]
     inputs = layout_inputs(args.words[0]) + [args.reference] + files
-    result = run_command(vars(args), inputs, lambda *_: check(args.words[0], args.words[1:], **(
+    return run_command(vars(args), inputs, lambda *_: check(args.words[0], args.words[1:], **(
         options_of(args, "reference tolerance date accept_residual max_change accept_change"))),
         ident_files=files + inputs)
-    print(result.summary())
-    return 0

@@ -40,8 +40,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..fileio import layout_inputs
     from ..fiveaxis.api import compensate
-    from ..machine.layout import layout_inputs
     from ..results import run_command
 
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),

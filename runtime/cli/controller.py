@@ -45,15 +45,12 @@ def register(sub) -> None:
     i.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..fiveaxis.controller_api import controller_export, controller_import
 
     if args.action == "export":
-        result = controller_export(args.layout, args.errors, at=parse_at(args.at), **options_of(
+        return controller_export(args.layout, args.errors, at=parse_at(args.at), **options_of(
             args, "format out json plot loop_json temperatures sensors comp_file_type negate "
                   "force points grid accept_implausible"))
-    else:
-        result = controller_import(args.layout, args.file, out=args.errors_out, **options_of(
-            args, "format negate force accept_implausible"))
-    print(result.summary())
-    return 0
+    return controller_import(args.layout, args.file, out=args.errors_out, **options_of(
+        args, "format negate force accept_implausible"))

@@ -33,13 +33,11 @@ def run_add(args) -> int:
     return 0
 
 
-def run_show(args) -> int:
+def run_show(args):
     from ..history.run import show
     from ..results import run_command
 
     def call(_, ident):     # the report's machine: --machine, unless the file states one
         ident.machine = ident.machine or (None if ident.machine_details else args.machine)
         return show(args.db, args.machine, args.tolerance, args.wait)
-    h = run_command(vars(args), [] if "://" in args.db else [args.db], call)
-    print(h.summary())
-    return 0
+    return run_command(vars(args), [] if "://" in args.db else [args.db], call)

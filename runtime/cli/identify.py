@@ -45,9 +45,9 @@ def register(sub) -> None:
 def run(args) -> int:
     import sys
 
+    from ..fileio import layout_inputs
     from ..identify.api import identify
     from ..identify.inputs import refuse_repeated_files
-    from ..machine.layout import layout_inputs
     from ..results import run_command
 
     inputs = list(args.files) + layout_inputs(args.layout)

@@ -18,7 +18,7 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..certificate import from_options
     from ..fileio import planned_outputs
     from ..instruments.drift_test import iso230_3
@@ -30,5 +30,4 @@ def run(args) -> int:
     with planned_outputs(vars(args), inputs, **{"--plot": plots[0] if len(plots) == 1
                                                 else plots}) as outs:
         res.write_outputs(outs, vars(args), ident, inputs, roles=("json", "html"))
-    print(res.summary())
-    return 0
+    return res

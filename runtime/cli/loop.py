@@ -27,10 +27,10 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from .. import loop as api_loop
+    from ..fileio import layout_inputs
     from ..instruments import split_spec
-    from ..machine.layout import layout_inputs
     from ..machine.model import load
     from ..results import run_command
     from ..tables.table import error_dir_names
@@ -50,9 +50,7 @@ def run(args) -> int:
             report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
         report.write_errors_out(outs, vars(args), inputs)
         return report
-    report = run_command(vars(args), inputs, call, **{
+    return run_command(vars(args), inputs, call, **{
         "--predictions-out": args.predictions_out,
         "--out-dir": (args.out_dir, [f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py"]),
         "--errors-out": (args.errors_out, error_dir_names(model.axes))})
-    print(report.summary())
-    return 0

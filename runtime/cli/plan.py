@@ -24,15 +24,13 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
-    from ..machine.layout import layout_inputs
+def run(args):
+    from ..fileio import layout_inputs
     from ..plan.api import check_plan_folder, check_options, plan
     from ..results import run_command
 
     check_options(args.readings, args.minutes, args.parameters, args.dialect)
     check_plan_folder(args.out, args.force)
-    result = run_command(vars(args), layout_inputs(args.layout), lambda *_: plan(
+    return run_command(vars(args), layout_inputs(args.layout), lambda *_: plan(
         args.layout, args.instrument, args.readings, **options_of(
             args, "parameters minutes criterion seed")), **{"--out": (args.out, None)})
-    print(result.summary())
-    return 0

@@ -35,9 +35,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..fileio import planned_outputs, write_text
+    from ..fileio import layout_inputs
     from ..instruments.simulated_files import refuse_unused
     from ..loop.simulate import simulated_file
-    from ..machine.layout import layout_inputs
 
     refuse_unused(args.instrument, vars(args))
     inputs = layout_inputs(args.layout) + ([args.errors] if args.errors else [])

@@ -25,7 +25,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..cmm.api import squareness
-    from ..machine.layout import layout_inputs
+    from ..fileio import layout_inputs
 
     src, out = Path(args.directory), Path(args.errors_out)
     require(not (out.exists() and out.resolve() == src.resolve()),

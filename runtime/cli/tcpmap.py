@@ -24,8 +24,8 @@ def run(args) -> int:
     import sys
     from pathlib import Path
 
+    from ..fileio import layout_inputs
     from ..fiveaxis.api import tcpmap
-    from ..machine.layout import layout_inputs
 
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
     outs = planned_outputs(vars(args), inputs, **{"--csv": args.csv})

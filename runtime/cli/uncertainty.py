@@ -50,7 +50,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from ..cmm.volmap import map_inputs
-    from ..machine.layout import layout_inputs
+    from ..fileio import layout_inputs
     from ..probe import read_probe_map
     from ..results import run_command
     from ..uncertainty.api import uncertainty

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import require
-from ..machine.layout import layout_inputs
+from ..fileio import layout_inputs
 from ..results import ResultMixin, Row
 from ..tables.controller_tables import worse_than_none
 

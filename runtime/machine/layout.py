@@ -442,13 +442,6 @@ def shipped_layout_dir():
     return resources.files("volerr") / "layouts"
 
 
-def layout_inputs(layout) -> list:
-    """``[path]`` when ``layout`` names an existing layout file (an input of a run, never
-    overwritten), else ``[]`` (a shipped layout's name)."""
-    p = Path(str(layout))
-    return [p] if p.is_file() else []
-
-
 def layout_names() -> list[str]:
     """Names of the shipped layouts, sorted."""
     return sorted(p.name[:-5] for p in shipped_layout_dir().iterdir() if p.name.endswith(".toml"))
