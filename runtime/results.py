@@ -185,7 +185,12 @@ class ResultMixin:
 
     def _write_own(self, outs, options: dict, inputs: list) -> None:
         """The outputs of the command that only this kind of result writes (error tables,
-        maps ...), before the report's; none by default."""
+        maps ...), before the report's; by default a fit's ``--predictions-out`` (by
+        ``write_predictions``) and ``--errors-out`` (:meth:`write_errors_out`), when
+        ``options`` gives them."""
+        if options.get("predictions_out"):
+            self.write_predictions(outs.path("--predictions-out"), inputs=inputs)
+        self.write_errors_out(outs, options, inputs)
 
     def png(self) -> bytes:
         """The command's ``--plot`` figure as PNG bytes (a result without one: refused)."""

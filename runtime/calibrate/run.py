@@ -209,7 +209,7 @@ class Calibration(ResultMixin):
     def _write_own(self, outs, options: dict, inputs: list) -> None:
         """``volerr calibrate``'s ``--errors-out DIR`` (:meth:`write_error_tables`) and
         ``--map-out MAP.csv`` (:meth:`write_map`, ``map_grid`` nodes per axis)."""
-        self.write_errors_out(outs, options, inputs)
+        super()._write_own(outs, options, inputs)
         if options.get("map_out"):
             self.write_map(outs.path("--map-out"), options.get("map_grid", 9), inputs=inputs)
 

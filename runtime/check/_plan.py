@@ -133,15 +133,22 @@ def _fmt(v) -> str:
 
 
 def check_plan_options(specs, readings: int | None = None, minutes: float | None = None,
-                       detect_um: float | None = None) -> None:
+                       detect_um: float | None = None, out=False, force: bool = False) -> None:
     """Refuse options of :func:`plan_check` (``volerr check plan``) out of range, one line:
     no instrument, ``readings`` outside 1 .. 100000, ``minutes`` or ``detect_um`` (um) not
-    positive."""
+    positive; then (unless ``out`` is False) no folder ``out`` (``--out DIR``), or one that
+    holds the check's files already without ``force``
+    (:func:`volerr.plan.api.check_plan_folder`)."""
     require(specs, "check plan: give at least one --instrument")
     require(readings is None or 1 <= readings <= 10 ** 5,
             "--readings must be between 1 and 100000")
     require(minutes is None or minutes > 0, "--minutes must be positive")
     require(detect_um is None or detect_um > 0, "--detect-um must be positive")
+    if out is not False:
+        from ..plan.api import check_plan_folder
+
+        require(out, "check plan: give --out DIR")
+        check_plan_folder(out, force, "check", (".csv", ".nc", ".html"))
 
 
 def plan_check(layout, reference, specs, *, minutes: float | None = None,

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from functools import lru_cache
-from pathlib import Path
 
+from .. import __version__
 from ..choices import INTERPOLATION as METHODS
 from ..errors import InputError
-from ..progress import bar, progress, progress_bar  # noqa: F401  (one rule: volerr.progress)
-from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the parsing: units)
+from ..progress import progress_bar  # noqa: F401  (one rule: volerr.progress)
+from ..units import parse_at, parse_vector  # noqa: F401  (the parsing: units)
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
@@ -121,8 +121,6 @@ def add_identification_arguments(parser, instrument: str = "the measuring instru
             own.append(dest)
     if "--pdf" not in have:
         g.add_argument("--pdf", metavar="F.pdf", help=_C("--pdf"))
-    from .. import __version__
-
     parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog,
                         _ident_version=__version__)
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from ..errors import require
 from ._common import (add_fit_switches, add_max_change, add_report_options, command_parser,
                       help_text, options_of)
 
@@ -38,13 +37,11 @@ def _plan(args):
     from ..check import plan_check
     from ..check._plan import DEFAULT_DETECT_UM, check_plan_options
     from ..fileio import layout_inputs
-    from ..plan.api import check_plan_folder
     from ..results import run_command
 
-    check_plan_options(args.instrument, args.readings, args.minutes, args.detect_um)
-    require(args.out, "check plan: give --out DIR")
+    check_plan_options(args.instrument, args.readings, args.minutes, args.detect_um, args.out,
+                       args.force)
     inputs = layout_inputs(args.words[1]) + [args.reference]
-    check_plan_folder(args.out, args.force, "check", (".csv", ".nc", ".html"))
     return run_command(vars(args), inputs, lambda *_: plan_check(
         args.words[1], args.reference, args.instrument, **options_of(
             args, "minutes readings", detect_um=args.detect_um or DEFAULT_DETECT_UM)),

@@ -30,11 +30,7 @@ def run(args) -> int:
                         **options_of(args, "lines volume profile_points method degree "
                                            "extrapolate accept_implausible"))
     inputs = map_inputs(args.layout, args.errors)
-    outs = planned_outputs(vars(args), inputs)
-    print(res.summary())
-    with outs:
+    with planned_outputs(vars(args), inputs) as outs:
         res.write_files(outs, vars(args), inputs, roles=("plot", "json"))
-    for label, path in (("json", args.json), ("plot", args.plot)):
-        if path:
-            print(f"{label}: {path}")
+    print(res.summary({"json": args.json, "plot": args.plot}))
     return 0

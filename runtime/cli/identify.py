@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ._common import (add_accept_implausible, add_accept_residual, add_force,
@@ -43,8 +44,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-
     from ..fileio import layout_inputs
     from ..identify.api import identify
     from ..identify.inputs import refuse_repeated_files

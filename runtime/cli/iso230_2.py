@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 from ._common import (add_errors_out, add_force, add_html, add_identification_arguments, add_json,
                       add_plot, command_parser, options_of)
 
@@ -32,8 +34,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-
     from ..positioning.api import correction_conditions, iso230_2, run_axes
     from ..results import run_command
 

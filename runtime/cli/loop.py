@@ -43,13 +43,8 @@ def run(args):
         report = api_loop(args.layout, list(args.data), **options_of(
             args, "seed folds test_fraction degree families holdout_time differences "
                   "accept_residual", out_dir=outs.path("--out-dir"), holdout_files=holdout,
-            inputs=inputs))
-        if args.out_dir:    # the final paths, not staging (a new result)
-            report = report.written_in(args.out_dir)
-        if args.predictions_out:
-            report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
-        report.write_errors_out(outs, vars(args), inputs)
-        return report
+            inputs=inputs))     # with --out-dir: the final paths, not staging (a new result)
+        return report.written_in(args.out_dir) if args.out_dir else report
     return run_command(vars(args), inputs, call, **{
         "--predictions-out": args.predictions_out,
         "--out-dir": (args.out_dir, [f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py"]),

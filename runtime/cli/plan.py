@@ -26,11 +26,11 @@ def register(sub) -> None:
 
 def run(args):
     from ..fileio import layout_inputs
-    from ..plan.api import check_plan_folder, check_options, plan
+    from ..plan.api import check_options, plan
     from ..results import run_command
 
-    check_options(args.readings, args.minutes, args.parameters, args.dialect)
-    check_plan_folder(args.out, args.force)
+    check_options(args.readings, args.minutes, args.parameters, args.dialect, args.out,
+                  args.force)
     return run_command(vars(args), layout_inputs(args.layout), lambda *_: plan(
         args.layout, args.instrument, args.readings, **options_of(
             args, "parameters minutes criterion seed")), **{"--out": (args.out, None)})

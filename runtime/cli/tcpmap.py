@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 from ..fileio import planned_outputs
 from ._common import (add_error_arguments, add_plot, add_vector, command_parser, options_of,
                       progress_bar)
@@ -21,9 +24,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-    from pathlib import Path
-
     from ..fileio import layout_inputs
     from ..fiveaxis.api import tcpmap
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from ..choices import BIAS_MODES
 from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
                       add_plot, command_parser, options_of)
@@ -46,9 +48,7 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
-    from pathlib import Path
-
+def run(args):
     from ..cmm.volmap import map_inputs
     from ..fileio import layout_inputs
     from ..probe import read_probe_map
@@ -66,6 +66,4 @@ def run(args) -> int:
         probe_map=read_probe_map(args.probe_map) if args.probe_map else None,
         temperature=options_of(args, "part_cte part_dt scale_cte scale_dt",
                                compensated=args.temperature_compensated))))
-    if not args.quiet:
-        print(res.summary())
-    return 0
+    return 0 if args.quiet else res

@@ -182,13 +182,17 @@ class Diagonals(ResultMixin):
     data: dict
     lines: list
 
-    def summary(self) -> str:
-        """What ``volerr diagonals`` prints (without the lines naming the written files)."""
+    def summary(self, written: dict | None = None) -> str:
+        """What ``volerr diagonals`` prints; ``written``: ``{label: path}`` of the files
+        written (``json``, ``plot``), one line each at the end."""
         from .diagonals import format_table
 
         probe = " ".join(f"{v:g}" for v in self.data["probe_mm"])
-        return (f"{self.data['layout']}: length deviation dL = actual - nominal distance of "
-                f"the probe tip (first order), probe {probe} mm\n{format_table(self.lines)}")
+        return "\n".join([f"{self.data['layout']}: length deviation dL = actual - nominal "
+                          f"distance of the probe tip (first order), probe {probe} mm",
+                          format_table(self.lines)]
+                         + [f"{label}: {path}" for label, path in (written or {}).items()
+                            if path])
 
     def write_plot(self, path, inputs=()):
         """``--plot``: the space-diagonal profiles and every line's deviation
