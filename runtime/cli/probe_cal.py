@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sys
 
-from ..errors import require
 from ._common import (add_force, add_identification_arguments, add_vector, command_parser,
                       options_of)
 
@@ -42,7 +41,6 @@ def _run_plan(args) -> int:
     from ..fileio import Outputs
     from ..probe.api import probe_plan
 
-    require(args.data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
     with Outputs().file("--plan", args.plan) as outs:
         res = probe_plan(**options_of(args, "sphere_radius ball_radius center tilt_deg "
                                             "roll_deg step_deg circles phis per_circle",
@@ -53,13 +51,12 @@ def _run_plan(args) -> int:
 
 
 def run(args) -> int:
-    if args.plan:
-        return _run_plan(args)
-    from ..probe.api import probe_cal
+    from ..probe.api import command_form, probe_cal
     from ..results import run_command
 
-    require(args.data, "name the probing data DATA.csv (or use --plan to write a plan)")
-    require(args.out, "--out MAP.csv is required")
+    command_form(args.data, args.plan, args.out)
+    if args.plan:
+        return _run_plan(args)
     res = run_command(vars(args), [args.data], lambda *_: probe_cal(**options_of(
         args, "data sphere_radius tilt_deg roll_deg degree outlier_k exclude_outliers "
               "ball_radius")), **{"--out": args.out, "--plots": (

@@ -69,6 +69,16 @@ class ProbeCal(ResultMixin):
                 plot_probe_map_2d(self.calibration, Path(folder) / "probe_map_2d.png")]
 
 
+def command_form(data=None, plan=None, out=None) -> None:
+    """Refuse, one line, a ``volerr probe-cal`` that is neither a calibration (``data`` read,
+    the map written to ``out``) nor a plan (written to ``plan``), or both."""
+    if plan:
+        require(data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
+    else:
+        require(data, "name the probing data DATA.csv (or use --plan to write a plan)")
+        require(out, "--out MAP.csv is required")
+
+
 def probe_cal(data, sphere_radius: float, *, tilt_deg: float = 0.0, roll_deg: float = 0.0,
               degree: int | None = None, outlier_k: float = 5.0,
               exclude_outliers: bool = False, ball_radius: float | None = None) -> ProbeCal:
