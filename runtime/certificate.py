@@ -299,6 +299,32 @@ def build(given: dict, file=None, files=(), method: dict | None = None,
     return ident
 
 
+#: a run's options that name outputs or switches of writing, not its method (the report id)
+NOT_METHOD = frozenset({"json", "html", "pdf", "plot", "errors_out", "map_out", "out", "force",
+                        "func", "command", "action", "identification", "date"})
+#: the fields an option may state (``--machine`` ...), in the order of the options
+FIELD_OPTIONS = ("machine", "instrument", "operator", "date", "customer")
+
+
+def from_options(options: dict, files=(), conditions: dict | None = None) -> Identification:
+    """The :class:`Identification` of a run from its options as a plain dict (a command's
+    arguments): the fields ``machine instrument operator customer`` where ``_ident_own``
+    names them (a command whose option of that name means something else: the field comes
+    from the file), ``date`` (YYYY-MM-DD), the file ``identification`` (else
+    :data:`IDENTIFICATION_FILE` beside ``files[0]``); the method: ``_ident_prog`` (the
+    command), ``_ident_version`` (volerr's version) and the options that state the method
+    (:func:`method_options`).
+    ``files``: the run's inputs (the report id hashes them); ``conditions``: labelled test
+    conditions (e.g. the correction to 20 degC)."""
+    own = set(options.get("_ident_own", ())) | {"date"}
+    given = {k: options.get(k) for k in FIELD_OPTIONS if k in own}
+    method = {"command": options.get("_ident_prog", "volerr"),
+              "version": options.get("_ident_version", ""),
+              "options": method_options(options, files, NOT_METHOD | own)}
+    file = find_identification_file(options.get("identification"), list(files))
+    return build(given, file, list(files), method, conditions)
+
+
 def html_table(ident: Identification) -> str:
     """The identification block of a report page (HTML table, then its warnings)."""
     e = html.escape

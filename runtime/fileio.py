@@ -668,3 +668,33 @@ class Outputs:
                     return f"{role} {final}"
             return str(name)
         return " ".join(f"{r} {p}" for r, p in self.declared) or "the outputs"
+
+
+def planned_outputs(options: dict, inputs, *, first: dict | None = None, **more) -> Outputs:
+    """:class:`Outputs` of a command's run, declared in this order (the order of the refusals)
+    and checked: ``first``, the report outputs ``options`` (a plain dict of the run's options)
+    gives (``json``, ``html``, ``pdf``, ``plot``: roles ``--json`` ...) and ``more``;
+    ``{"--out": path}`` a file (``--plot...`` a PNG), ``{"--errors-out": (path, names)}`` a
+    folder (``None`` names: not known yet), ``{"--plot": [paths]}`` a group
+    (:meth:`Outputs.group`).  ``options["force"]``: :class:`Outputs`' ``force``."""
+    outs = Outputs(inputs, force=options.get("force", False))
+    first = first or {}
+    report = {r: options.get(r[2:]) for r in ("--json", "--html", "--pdf", "--plot")}
+    for targets in (first, {r: p for r, p in report.items() if r not in {**first, **more}}, more):
+        for role, target in targets.items():
+            if isinstance(target, tuple):
+                outs.folder(role, target[0], files=target[1])
+            elif isinstance(target, list):     # one option, several files
+                outs.group(role, target)
+            elif role.startswith("--plot"):
+                outs.plot(role, target)
+            else:
+                outs.file(role, target)
+    return outs.check()
+
+
+def layout_inputs(layout) -> list:
+    """``[path]`` when ``layout`` names an existing layout file (an input of a run, never
+    overwritten), else ``[]`` (a shipped layout's name)."""
+    p = Path(str(layout))
+    return [p] if p.is_file() else []

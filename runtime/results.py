@@ -154,6 +154,44 @@ class ResultMixin:
 
         return write_bytes(path, self.png(), inputs=list(inputs))
 
+    def write_outputs(self, outs, options: dict, ident, inputs=(), title: str | None = None,
+                      roles=("plot", "json", "html")) -> None:
+        """A command's outputs, inside ``with outs:`` (:class:`volerr.fileio.Outputs`, declared
+        by :func:`volerr.fileio.planned_outputs`): the result's own (:meth:`_write_own`),
+        then each of ``roles`` that ``options`` (the run's options, a plain dict) gives, by
+        ``write_ROLE`` (the plot first: it may record its scale in the JSON), then the
+        identification ``ident`` stamped into ``--json`` and ``--html`` and ``--pdf``
+        written (:func:`volerr.report.stamp.finish`; ``title``: the PDF's)."""
+        from .report import stamp
+
+        self._write_own(outs, options, list(inputs))
+        self.write_files(outs, options, inputs, roles)
+        stamp.finish(outs, self, ident, inputs=list(inputs), title=title)
+
+    def write_files(self, outs, options: dict, inputs=(), roles=("json", "html", "plot")):
+        """Inside ``with outs:``: each output of ``roles`` that ``options`` gives, by the
+        result's ``write_ROLE`` (no identification)."""
+        for role in roles:
+            if options.get(role):
+                getattr(self, f"write_{role}")(outs.path("--" + role), inputs=inputs)
+
+    def write_errors_out(self, outs, options: dict, inputs=()) -> None:
+        """Inside ``with outs:``: a fit's ``--errors-out DIR`` when ``options`` gives it, by
+        the result's ``write_error_tables`` (``accept_implausible`` from ``options``)."""
+        if options.get("errors_out"):
+            self.write_error_tables(outs.path("--errors-out"), inputs=list(inputs),
+                                    shown=options["errors_out"],
+                                    accept_implausible=options.get("accept_implausible", False))
+
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """The outputs of the command that only this kind of result writes (error tables,
+        maps ...), before the report's; by default a fit's ``--predictions-out`` (by
+        ``write_predictions``) and ``--errors-out`` (:meth:`write_errors_out`), when
+        ``options`` gives them."""
+        if options.get("predictions_out"):
+            self.write_predictions(outs.path("--predictions-out"), inputs=inputs)
+        self.write_errors_out(outs, options, inputs)
+
     def png(self) -> bytes:
         """The command's ``--plot`` figure as PNG bytes (a result without one: refused)."""
         from .errors import InputError
@@ -179,6 +217,27 @@ class ResultMixin:
         if len(first) > 110:
             first = first[:107] + "..."
         return f"<volerr {type(self).__name__}: {first}>"
+
+
+def run_command(options: dict, inputs, call, *, first: dict | None = None, ident_files=None,
+                conditions: dict | None = None, title: str | None = None,
+                roles=("plot", "json", "html"), **outputs):
+    """A command's run, all or nothing, its refusals in this order: its outputs declared and
+    checked (:func:`volerr.fileio.planned_outputs` of ``options``, the run's options as a
+    plain dict: ``first``, the report outputs, ``outputs``), its identification
+    (:func:`volerr.certificate.from_options` of ``ident_files``, default ``inputs``, and
+    ``conditions``), then inside ``with outs:`` ``call(outs, identification)`` (the API
+    call; ``outs.path(ROLE)``: where an output it streams goes) and the result's outputs
+    (:meth:`ResultMixin.write_outputs`, ``title``, ``roles``); returns the result."""
+    from .certificate import from_options
+    from .fileio import planned_outputs
+
+    outs = planned_outputs(options, inputs, first=first, **outputs)
+    ident = from_options(options, inputs if ident_files is None else ident_files, conditions)
+    with outs:
+        result = call(outs, ident)
+        result.write_outputs(outs, options, ident, inputs, title, roles)
+    return result
 
 
 def file_list(files) -> list:

@@ -206,6 +206,13 @@ class Calibration(ResultMixin):
                 tables[a] = ErrorTable(a, np.linspace(*self.ranges[a], n_grid), {})
             tables[a].reversal = np.full(len(tables[a].positions), float(coef[j]))
 
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr calibrate``'s ``--errors-out DIR`` (:meth:`write_error_tables`) and
+        ``--map-out MAP.csv`` (:meth:`write_map`, ``map_grid`` nodes per axis)."""
+        super()._write_own(outs, options, inputs)
+        if options.get("map_out"):
+            self.write_map(outs.path("--map-out"), options.get("map_grid", 9), inputs=inputs)
+
     def write_error_tables(self, directory, inputs=(), accept_residual: bool = False,
                            accept_implausible: bool = False, shown=None) -> Path:
         """The error directory (``X.csv`` ... ``constants.csv``); refused for a fit far above

@@ -82,6 +82,16 @@ class CheckPlan:
                 if v["power"] is not None and v["size"] is not None and v["size_95"] is not None]
         return "\n".join([head] + rows)
 
+    def write_outputs(self, outs, options: dict, ident, inputs=(), title=None, roles=()):
+        """``volerr check plan``'s outputs inside ``with outs:``: :meth:`write` into
+        ``--out`` (and ``--json``, ``--html``), then the identification
+        (:func:`volerr.report.stamp.finish`)."""
+        from ..report.document import Document
+        from ..report.stamp import finish
+
+        self.write(outs.path("--out"), outs.path("--json"), outs.path("--html"), inputs)
+        finish(outs, Document(self), ident, list(inputs))
+
     def write(self, folder, json_path=None, html_path=None, inputs=()) -> None:
         """The plan's files, NC programs and set-up sheet (:meth:`volerr.plan.Plan.write`),
         the sheet with the check's power table added, and the JSON."""
@@ -123,15 +133,22 @@ def _fmt(v) -> str:
 
 
 def check_plan_options(specs, readings: int | None = None, minutes: float | None = None,
-                       detect_um: float | None = None) -> None:
+                       detect_um: float | None = None, out=False, force: bool = False) -> None:
     """Refuse options of :func:`plan_check` (``volerr check plan``) out of range, one line:
     no instrument, ``readings`` outside 1 .. 100000, ``minutes`` or ``detect_um`` (um) not
-    positive."""
+    positive; then (unless ``out`` is False) no folder ``out`` (``--out DIR``), or one that
+    holds the check's files already without ``force``
+    (:func:`volerr.plan.api.check_plan_folder`)."""
     require(specs, "check plan: give at least one --instrument")
     require(readings is None or 1 <= readings <= 10 ** 5,
             "--readings must be between 1 and 100000")
     require(minutes is None or minutes > 0, "--minutes must be positive")
     require(detect_um is None or detect_um > 0, "--detect-um must be positive")
+    if out is not False:
+        from ..plan.api import check_plan_folder
+
+        require(out, "check plan: give --out DIR")
+        check_plan_folder(out, force, "check", (".csv", ".nc", ".html"))
 
 
 def plan_check(layout, reference, specs, *, minutes: float | None = None,

@@ -29,6 +29,10 @@ from ..machine.model import Model, load
 from . import _reference, _select, _system, _volume
 from ._result import CheckResult
 
+#: options of one form of ``volerr check`` only (``check plan``; ``check LAYOUT FILE...``)
+PLAN_ONLY = ("instrument", "minutes", "readings", "detect_um", "out")
+CHECK_ONLY = ("tolerance", "date", "max_change")
+
 #: p-value of the residual chi2 below which the readings hold a change nothing explains
 P_UNEXPLAINED = 1e-3
 
@@ -142,3 +146,23 @@ def _file_entry(spec, part) -> dict:
     kind = part.files[0].kind if part.files else "deviations"
     return {"file": path.name, "kind": kind, "sha256": digest,
             "n_readings": int(part.n_readings)}
+
+
+def command_form(words, reference, options: dict) -> tuple:
+    """The form of ``volerr check WORDS --reference CAL.json [FILE...]``: ``(plan, words,
+    reference)``, ``plan`` when the first word is ``plan`` (then one LAYOUT follows), else
+    LAYOUT and the check's files (those after ``CAL.json`` join them); an option of the other
+    form (``options``: the run's options as a plain dict) refused, naming it."""
+    from importlib.resources import files
+
+    words, reference = list(words) + list(reference[1:]), reference[0]
+    plan = words[0] == "plan"
+    usage = (files("volerr") / "data" / "help" / "check.usage.txt").read_text(encoding="utf-8")
+    require(not plan or len(words) == 2, "check plan: give one LAYOUT (usage: "
+            + usage.split("\n")[0].strip() + ")")
+    require(plan or len(words) >= 2, "give LAYOUT and the check's files (or 'check plan "
+                                     "LAYOUT ...' to plan one)")
+    form = "volerr check LAYOUT FILE..." if plan else "volerr check plan"
+    for name in CHECK_ONLY if plan else PLAN_ONLY:
+        require(options.get(name) is None, f"--{name.replace('_', '-')} belongs to '{form}'")
+    return plan, words, reference

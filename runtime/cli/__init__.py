@@ -1,5 +1,6 @@
 """The ``volerr`` command line: one module per command (``register(subparsers)`` adds its
-parser and sets ``func``); :class:`volerr.errors.InputError` becomes one line on stderr, exit 2.
+parser and sets ``func``; ``func(args)`` returns the exit code, or the API's result, whose
+``summary()`` is printed); :class:`volerr.errors.InputError` becomes one line on stderr, exit 2.
 """
 
 from __future__ import annotations
@@ -191,6 +192,9 @@ def main(argv=None) -> int:
         return int(exc.code or 0)
     try:
         result = args.func(args)
+        if hasattr(result, "summary"):   # a command's result (the API's): print its summary
+            print(result.summary())
+            result = 0
     except InputError as exc:
         print(f"volerr {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from functools import lru_cache
-from pathlib import Path
 
+from .. import __version__
 from ..choices import INTERPOLATION as METHODS
 from ..errors import InputError
-from ..progress import bar, progress, progress_bar  # noqa: F401  (one rule: volerr.progress)
-from ..units import MAX_COORD_MM, parse_at, parse_vector  # noqa: F401  (the parsing: units)
+from ..progress import progress_bar  # noqa: F401  (one rule: volerr.progress)
+from ..units import parse_at, parse_vector  # noqa: F401  (the parsing: units)
 
 
 def add_error_arguments(parser, required: bool = True) -> None:
@@ -36,19 +36,6 @@ def add_common(p) -> None:
     p.add_argument("--at", action="append", default=[], metavar="AXIS=DEG", help=_C("--at"))
     p.add_argument("--volume", choices=("travel", "measured"), default="travel",
                    help=_C("--volume"))
-
-
-def inputs_of(args) -> list:
-    """The inputs never overwritten: the error tables and a layout file (not a shipped one)."""
-    from ..cmm import volmap
-
-    return volmap.error_dir_inputs(args.errors) + layout_inputs(args.layout)
-
-
-def layout_inputs(layout) -> list:
-    """``[path]`` when LAYOUT names an existing file, else ``[]`` (a shipped name)."""
-    p = Path(str(layout))
-    return [p] if p.is_file() else []
 
 
 def add_vector(parser, flag: str, help: str, default=None, required: bool = False,
@@ -116,9 +103,6 @@ def add_max_change(parser, reference: bool) -> None:
     parser.add_argument("--accept-change", action="store_true", help=_C("--accept-change"))
 
 
-#: options whose values are outputs or switches of writing, not of the method (report id)
-_NOT_METHOD = {"json", "html", "pdf", "plot", "errors_out", "map_out", "out", "force", "func",
-               "command", "action", "identification", "date"}
 #: the identification's fields, in the order of their options
 _IDENT_FIELDS = ("machine", "operator", "date", "customer", "instrument")
 
@@ -137,70 +121,8 @@ def add_identification_arguments(parser, instrument: str = "the measuring instru
             own.append(dest)
     if "--pdf" not in have:
         g.add_argument("--pdf", metavar="F.pdf", help=_C("--pdf"))
-    parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog)
-
-
-def identification_from_args(args, files=(), conditions: dict | None = None):
-    """:class:`volerr.certificate.Identification` of the options and the identification file
-    (else volerr-identification.toml beside ``files[0]``), with its report id and method."""
-    from .. import __version__, certificate
-
-    own = set(getattr(args, "_ident_own", ())) | {"date"}
-    given = {k: getattr(args, k, None) for k in ("machine", "instrument", "operator", "date",
-                                                 "customer") if k in own}
-    method = {"command": getattr(args, "_ident_prog", "volerr"), "version": __version__,
-              "options": certificate.method_options(vars(args), files, _NOT_METHOD | own)}
-    file = certificate.find_identification_file(getattr(args, "identification", None),
-                                                list(files))
-    return certificate.build(given, file, list(files), method, conditions)
-
-
-def write_certificates(outs, result, ident, inputs=(), title: str | None = None) -> None:
-    """Inside ``with outs:``: :func:`volerr.report.stamp.finish` of ``result`` (a result or its
-    JSON document): the identification stamped into ``--json``, ``--html``; ``--pdf``."""
-    from ..report import stamp
-    from ..report.document import Document
-
-    if isinstance(result, dict) or not hasattr(result, "_rows"):   # its "parameters" as rows
-        result = Document(result)
-    stamp.finish(outs, result, ident, inputs=list(inputs), title=title)
-
-
-def planned_outputs(args, inputs, *, first: dict | None = None, **more):
-    """:class:`volerr.fileio.Outputs` of a command's run, declared in this order (the order
-    of the refusals) and checked: ``first``, the report options the command has (``--json``,
-    ``--html``, ``--pdf``, ``--plot``) and ``more``; ``{"--out": path}`` a file (``--plot...``
-    a PNG), ``{"--errors-out": (path, names)}`` a folder (``None`` names: not known yet),
-    ``{"--plot": [paths]}`` a group (:meth:`volerr.fileio.Outputs.group`)."""
-    from ..fileio import Outputs
-
-    outs = Outputs(inputs, force=getattr(args, "force", False))
-    first = first or {}
-    report = {r: getattr(args, r[2:], None) for r in ("--json", "--html", "--pdf", "--plot")}
-    for targets in (first, {r: p for r, p in report.items() if r not in {**first, **more}}, more):
-        _declare(outs, targets)
-    return outs.check()
-
-
-def _declare(outs, targets: dict) -> None:
-    for role, target in targets.items():
-        if isinstance(target, tuple):
-            outs.folder(role, target[0], files=target[1])
-        elif isinstance(target, list):     # one option, several files
-            outs.group(role, target)
-        elif role.startswith("--plot"):
-            outs.plot(role, target)
-        else:
-            outs.file(role, target)
-
-
-def write_outputs(args, outs, result, ident, inputs, title: str | None = None,
-                  roles=("plot", "json", "html")) -> None:
-    """Inside ``with outs:``: ``--plot``, ``--json``, ``--html`` (:func:`write_files`; the
-    plot first: it may record its scale in the JSON; ``roles``: those the result writes),
-    then :func:`write_certificates`."""
-    write_files(args, outs, result, inputs, roles)
-    write_certificates(outs, result, ident, inputs, title=title)
+    parser.set_defaults(_ident_own=tuple(own), _ident_prog=parser.prog,
+                        _ident_version=__version__)
 
 
 def help_text(command: str) -> str:
@@ -224,18 +146,6 @@ def command_parser(sub, name: str, text: str | None = None, **kw) -> tuple:
         kw.setdefault("epilog", help_text(text))
     known = (folder / f"{text}.options.txt").is_file()
     return sub.add_parser(name, help=short, **kw), option_help(text) if known else {}
-
-
-def error_dir_names(model) -> list:
-    """The files of a fit's error directory: ``<axis>.csv`` of the model's axes, constants."""
-    return [f"{a}.csv" for a in model.axes] + ["constants.csv"]
-
-
-def write_errors_out(args, outs, result, inputs) -> None:
-    """Inside ``with outs:``: ``--errors-out DIR`` (when given), ``result.write_error_tables``."""
-    if args.errors_out:
-        result.write_error_tables(outs.path("--errors-out"), inputs=inputs, shown=args.errors_out,
-                                  accept_implausible=args.accept_implausible)
 
 
 @lru_cache(maxsize=None)
@@ -264,14 +174,6 @@ def add_fit_switches(parser, implausible: bool = True) -> None:
     add_accept_residual(parser)
     if implausible:
         add_accept_implausible(parser)
-
-
-# the outputs of a result, the options of an API call
-def write_files(args, outs, result, inputs, roles=("json", "html", "plot")) -> None:
-    """Inside ``with outs:``: each output of ``roles`` given, by the result's ``write_ROLE``."""
-    for role in roles:
-        if getattr(args, role, None):
-            getattr(result, f"write_{role}")(outs.path("--" + role), inputs=inputs)
 
 
 def options_of(args, names: str, **more) -> dict:

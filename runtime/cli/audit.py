@@ -4,7 +4,8 @@ Finding errata is the purpose: exit 0 when errata are found, 2 for bad input (un
 
 from __future__ import annotations
 
-from ._common import command_parser, layout_inputs, planned_outputs
+from ..fileio import planned_outputs
+from ._common import command_parser
 
 
 def register(sub) -> None:
@@ -21,16 +22,14 @@ def register(sub) -> None:
 def run(args) -> int:
     from ..audit import run as audit_run  # the capability: when the command runs
     from ..audit.api import audit
+    from ..fileio import layout_inputs
     from ..progress import progress
 
     inputs = [q for item in args.layouts or [] for q in layout_inputs(item)]
-    outs = planned_outputs(args, inputs + audit_run.data_paths())
+    outs = planned_outputs(vars(args), inputs + audit_run.data_paths())
     res = audit(args.layouts, detail=args.detail, numeric=args.numeric, points=args.points,
                 progress=progress)
     with outs:
-        if args.json:
-            res.write_json(outs.path("--json"))
-        if args.html:
-            res.write_html(outs.path("--html"))
+        res.write_files(outs, vars(args), roles=("json", "html"))
     print(res.summary(evidence=[args.json, args.html]))
     return 0

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from ._common import (add_error_arguments, add_fit_switches, add_force, add_html,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
-                      identification_from_args, layout_inputs, options_of, planned_outputs,
-                      write_outputs)
+                      options_of)
 
 
 def register(sub) -> None:
@@ -39,14 +38,14 @@ def register(sub) -> None:
 
 
 def run_simulate(args) -> int:
-    from ..cmm.volmap import error_dir_inputs
+    from ..cmm.volmap import map_inputs
+    from ..fileio import planned_outputs
     from ..instruments.ballbar import simulated_trace
     from ..machine.model import load
 
     model = load(args.layout)
-    inputs = error_dir_inputs(args.errors) + layout_inputs(args.layout)
-    outs = planned_outputs(args, inputs, **{"--out": args.out})
-    with outs:
+    inputs = map_inputs(args.layout, args.errors)
+    with planned_outputs(vars(args), inputs, **{"--out": args.out}) as outs:
         trace = simulated_trace(model, args.errors, args.plane, args.radius, args.centre,
                                 **options_of(args, "tool rotary points noise_um direction seed "
                                                    "method degree extrapolate accept_implausible"))
@@ -55,14 +54,10 @@ def run_simulate(args) -> int:
     return 0
 
 
-def run_evaluate(args) -> int:
+def run_evaluate(args):
     from ..ballbar.api import ballbar_evaluate
+    from ..fileio import layout_inputs
+    from ..results import run_command
 
-    inputs = list(args.files) + layout_inputs(args.layout)
-    outs = planned_outputs(args, inputs)
-    ident = identification_from_args(args, inputs)
-    with outs:
-        ev = ballbar_evaluate(args.files, args.layout, accept_residual=args.accept_residual)
-        write_outputs(args, outs, ev, ident, inputs)
-    print(ev.summary())
-    return 0
+    return run_command(vars(args), list(args.files) + layout_inputs(args.layout), lambda *_: (
+        ballbar_evaluate(args.files, args.layout, accept_residual=args.accept_residual)))

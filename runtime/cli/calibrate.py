@@ -4,8 +4,7 @@
 from __future__ import annotations
 
 from ._common import (add_errors_out, add_fit_switches, add_max_change, add_report_options,
-                      command_parser, error_dir_names, identification_from_args, layout_inputs,
-                      planned_outputs, write_errors_out, write_outputs)
+                      command_parser, options_of)
 
 
 def register(sub) -> None:
@@ -26,26 +25,20 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..calibrate.mapping import grid_counts
     from ..calibrate.run import calibrate
+    from ..fileio import layout_inputs
     from ..instruments import split_spec
     from ..machine.model import load
+    from ..results import run_command
+    from ..tables.table import error_dir_names
 
     grid_counts(args.map_grid)      # refused before anything else
     inputs = [split_spec(f)[1] for f in args.files] + layout_inputs(args.layout) \
         + ([args.reference] if args.reference else [])
-    outs = planned_outputs(args, inputs, **{"--map-out": args.map_out, "--errors-out": (
-        args.errors_out, error_dir_names(load(args.layout)))})
-    ident = identification_from_args(args, inputs)
-    with outs:
-        result = calibrate(args.layout, args.files, parameters=args.parameters,
-                           degree=args.degree, seed=args.seed, test_fraction=args.test_fraction,
-                           accept_residual=args.accept_residual, reference=args.reference,
-                           max_change=args.max_change, accept_change=args.accept_change)
-        write_errors_out(args, outs, result, inputs)
-        if args.map_out:
-            result.write_map(outs.path("--map-out"), args.map_grid, inputs=inputs)
-        write_outputs(args, outs, result, ident, inputs)
-    print(result.summary())
-    return 0
+    outputs = {"--map-out": args.map_out,
+               "--errors-out": (args.errors_out, error_dir_names(load(args.layout).axes))}
+    return run_command(vars(args), inputs, lambda *_: calibrate(args.layout, args.files, **(
+        options_of(args, "parameters degree seed test_fraction accept_residual reference "
+                         "max_change accept_change"))), **outputs)

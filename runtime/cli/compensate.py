@@ -7,8 +7,7 @@ import sys
 from pathlib import Path
 
 from ._common import (add_error_arguments, add_identification_arguments, add_vector,
-                      command_parser, identification_from_args, layout_inputs, planned_outputs,
-                      progress_bar, write_certificates)
+                      command_parser, options_of, progress_bar)
 
 
 def register(sub) -> None:
@@ -41,31 +40,23 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..fileio import layout_inputs
     from ..fiveaxis.api import compensate
+    from ..results import run_command
 
     inputs = [args.program, *Path(args.errors).glob("*.csv"), *layout_inputs(args.layout),
               *([args.tool_table] if args.tool_table else [])]
-    outs = planned_outputs(args, inputs, first={"--out": args.out, "--report": args.report})
-    ident = identification_from_args(args, inputs)
-    with outs:  # all or nothing: staged outputs are put in place at the end
+
+    def call(outs, _):
         with progress_bar(Path(args.program), "compensate") as tick:
-            res = compensate(
-                args.layout, Path(args.program), args.errors, datum=args.datum,
-                tool=tuple(args.tool), tool_length=args.tool_length,
-                tool_table=args.tool_table, orientation=args.orientation,
-                strategy=args.strategy, types=args.types, tol_um=args.tol_um,
-                decimals=args.decimals, method=args.method, degree=args.degree,
-                extrapolate=args.extrapolate, initial=args.initial or "",
+            return compensate(args.layout, Path(args.program), args.errors, **options_of(
+                args, "datum tool_length tool_table orientation strategy types tol_um decimals "
+                      "method degree extrapolate dialect accept_implausible",
+                tool=tuple(args.tool), initial=args.initial or "",
                 check_travel=not args.ignore_travel, arc_tol_um=args.arc_tolerance_um,
-                dialect=args.dialect, out=outs.path("--out"),
-                report=outs.path("--report") if args.report else None, inputs=inputs,
-                out_name=args.out, keep_errors=bool(args.plot), progress=tick,
-                accept_implausible=args.accept_implausible)
-        if args.json:
-            res.write_json(outs.path("--json"), inputs)
-        if args.plot:
-            res.write_plot(outs.path("--plot"), title=f"{res.layout}: {args.program}")
-        write_certificates(outs, res.to_dict(), ident, inputs)   # the summary's certificate
+                out=outs.path("--out"), report=outs.path("--report") if args.report else None,
+                inputs=inputs, out_name=args.out, keep_errors=bool(args.plot), progress=tick))
+    res = run_command(vars(args), inputs, call, first={"--out": args.out, "--report": args.report})
     print(res.summary())
     for note in res.notes:   # only after success: bad input gets one line on stderr
         print(note, file=sys.stderr)

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from ..choices import CONTROLLER_AXIS_FORMATS as AXIS_FORMATS
 from ..choices import CONTROLLER_TEMP_FORMATS as TEMP_FORMATS
-from ._common import add_accept_implausible, add_errors_out, add_force, command_parser, parse_at
+from ._common import (add_accept_implausible, add_errors_out, add_force, command_parser,
+                      options_of, parse_at)
 
 
 def register(sub) -> None:
@@ -44,19 +45,12 @@ def register(sub) -> None:
     i.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..fiveaxis.controller_api import controller_export, controller_import
 
     if args.action == "export":
-        result = controller_export(
-            args.layout, args.errors, format=args.format, out=args.out, json=args.json,
-            plot=args.plot, loop_json=args.loop_json, temperatures=args.temperatures,
-            sensors=args.sensors, comp_file_type=args.comp_file_type, negate=args.negate,
-            force=args.force, points=args.points, grid=args.grid, at=parse_at(args.at),
-            accept_implausible=args.accept_implausible)
-    else:
-        result = controller_import(args.layout, args.file, out=args.errors_out,
-                                   format=args.format, negate=args.negate, force=args.force,
-                                   accept_implausible=args.accept_implausible)
-    print(result.summary())
-    return 0
+        return controller_export(args.layout, args.errors, at=parse_at(args.at), **options_of(
+            args, "format out json plot loop_json temperatures sensors comp_file_type negate "
+                  "force points grid accept_implausible"))
+    return controller_import(args.layout, args.file, out=args.errors_out, **options_of(
+        args, "format negate force accept_implausible"))

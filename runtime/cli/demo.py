@@ -15,8 +15,7 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from ..demo import demo
 
-    print(demo(args.out, only=args.only, force=args.force, jobs=args.jobs).summary())
-    return 0
+    return demo(args.out, only=args.only, force=args.force, jobs=args.jobs)

@@ -4,8 +4,8 @@ diagonals and axis-parallel lines; see ``volerr diagonals --help`` and
 
 from __future__ import annotations
 
-from ._common import (add_accept_implausible, add_common, command_parser, inputs_of, parse_at,
-                      planned_outputs, write_files)
+from ..fileio import planned_outputs
+from ._common import add_accept_implausible, add_common, command_parser, options_of, parse_at
 from ..choices import DIAGONAL_KINDS
 
 
@@ -24,18 +24,13 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..cmm import api  # the capability: when the command runs
+    from ..cmm.volmap import map_inputs
 
-    res = api.diagonals(args.layout, args.errors, lines=args.lines, probe=tuple(args.probe),
-                        at=parse_at(args.at), volume=args.volume,
-                        profile_points=args.profile_points, method=args.method,
-                        degree=args.degree, extrapolate=args.extrapolate,
-                        accept_implausible=args.accept_implausible)
-    inputs = inputs_of(args)
-    outs = planned_outputs(args, inputs)
-    print(res.summary())
-    with outs:
-        write_files(args, outs, res, inputs, roles=("plot", "json"))
-    for label, path in (("json", args.json), ("plot", args.plot)):
-        if path:
-            print(f"{label}: {path}")
+    res = api.diagonals(args.layout, args.errors, probe=tuple(args.probe), at=parse_at(args.at),
+                        **options_of(args, "lines volume profile_points method degree "
+                                           "extrapolate accept_implausible"))
+    inputs = map_inputs(args.layout, args.errors)
+    with planned_outputs(vars(args), inputs) as outs:
+        res.write_files(outs, vars(args), inputs, roles=("plot", "json"))
+    print(res.summary({"json": args.json, "plot": args.plot}))
     return 0

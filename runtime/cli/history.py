@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import (add_html, add_identification_arguments, add_json, command_parser, help_text,
-                      identification_from_args, planned_outputs, write_outputs)
+from ._common import add_html, add_identification_arguments, add_json, command_parser, help_text
 
 
 def register(sub) -> None:
@@ -34,15 +33,11 @@ def run_add(args) -> int:
     return 0
 
 
-def run_show(args) -> int:
+def run_show(args):
     from ..history.run import show
+    from ..results import run_command
 
-    inputs = [] if "://" in args.db else [args.db]
-    outs = planned_outputs(args, inputs)
-    ident = identification_from_args(args, inputs)
-    ident.machine = ident.machine or (None if ident.machine_details else args.machine)
-    with outs:
-        h = show(args.db, args.machine, args.tolerance, args.wait)
-        write_outputs(args, outs, h, ident, inputs)
-    print(h.summary())
-    return 0
+    def call(_, ident):     # the report's machine: --machine, unless the file states one
+        ident.machine = ident.machine or (None if ident.machine_details else args.machine)
+        return show(args.db, args.machine, args.tolerance, args.wait)
+    return run_command(vars(args), [] if "://" in args.db else [args.db], call)

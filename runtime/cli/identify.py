@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ._common import (add_accept_implausible, add_accept_residual, add_force,
                       add_identification_arguments, add_json, add_plot, add_vector, command_parser,
-                      identification_from_args, layout_inputs, options_of, planned_outputs,
-                      write_outputs)
+                      options_of)
 
 
 def register(sub) -> None:
@@ -44,30 +44,21 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-
+    from ..fileio import layout_inputs
     from ..identify.api import identify
     from ..identify.inputs import refuse_repeated_files
-    from ._common import parse_vector
+    from ..results import run_command
 
     inputs = list(args.files) + layout_inputs(args.layout)
     refuse_repeated_files(args.files)
-    axis = args.axis.strip().upper()
-    outs = planned_outputs(args, inputs, **{"--out": args.out, "--errors-out": (
-        args.errors_out, [f"{axis}.csv"]), "--residuals": args.residuals})
-    ident = identification_from_args(args, inputs)
-    origin = args.origin[0] if args.origin == ["layout"] else args.origin and list(
-        parse_vector(args.origin, "--origin"))
-    with outs:
-        res = identify(args.layout, args.axis, args.files, origin=origin, **options_of(
-            args, "format positions points method tracker direction sense max_cond outlier_k "
-                  "signs accept_implausible accept_residual fit"))
-        res.write_table(outs.path("--out") or outs.path("--errors-out") / f"{axis}.csv",
-                        inputs=inputs)
-        if args.residuals:
-            res.write_residuals(outs.path("--residuals"), inputs=inputs)
-        write_outputs(args, outs, res, ident, inputs)
-    print(res.summary(args.out or str(Path(args.errors_out) / f"{axis}.csv")))
+    table = f"{args.axis.strip().upper()}.csv"
+    res = run_command(vars(args), inputs, lambda *_: identify(
+        args.layout, args.axis, args.files, **options_of(
+            args, "format positions points method tracker direction origin sense max_cond "
+                  "outlier_k signs accept_implausible accept_residual fit")), **{
+        "--out": args.out, "--errors-out": (args.errors_out, [table]),
+        "--residuals": args.residuals})
+    print(res.summary(args.out or str(Path(args.errors_out) / table)))
     for line in res.notes:
         print(line, file=sys.stderr)
     return 0

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
-                      add_plot, add_vector, command_parser, identification_from_args, inputs_of,
-                      options_of, planned_outputs, write_outputs)
+                      add_plot, add_vector, command_parser, options_of)
 
 
 def register(sub) -> None:
@@ -36,16 +35,14 @@ def register(sub) -> None:
 def run(args) -> int:
     import math
 
+    from ..cmm.volmap import map_inputs
+    from ..results import run_command
     from ..uncertainty.api import iso10360
 
-    inputs = inputs_of(args)
-    outs = planned_outputs(args, inputs)
-    res = iso10360(**options_of(
-        args, "layout errors method degree extrapolate probe volume mpe noise_um seed "
-              "artefact_u artefact_cte_ppm_per_K artefact_cte_u_ppm_per_K temperature_C "
-              "temperature_u_K accept_implausible",
-        identification=identification_from_args(args, inputs)))
+    res = run_command(vars(args), map_inputs(args.layout, args.errors), lambda _, ident: iso10360(
+        **options_of(args, "layout errors method degree extrapolate probe volume mpe noise_um "
+                           "seed artefact_u artefact_cte_ppm_per_K artefact_cte_u_ppm_per_K "
+                           "temperature_C temperature_u_K accept_implausible",
+                     identification=ident)))
     print(res.summary())
-    with outs:
-        write_outputs(args, outs, res, res.identification, inputs, res.title)
     return 0 if math.isfinite(res.data["max_abs_E_um"]) else 1

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import sys
+
 from ._common import (add_errors_out, add_force, add_html, add_identification_arguments, add_json,
-                      add_plot, command_parser, identification_from_args, options_of,
-                      planned_outputs, write_outputs)
+                      add_plot, command_parser, options_of)
 
 
 def register(sub) -> None:
@@ -33,22 +34,16 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-
     from ..positioning.api import correction_conditions, iso230_2, run_axes
+    from ..results import run_command
 
     names = sorted({f"{a}.csv" for a in run_axes(args.axis, len(args.runs))})
-    outs = planned_outputs(args, args.runs, **{"--errors-out": (args.errors_out, names)})
-    ident = identification_from_args(args, args.runs, correction_conditions(
-        args.cte_ppm_per_K, args.material_temp_C))
-    with outs:
-        res = iso230_2(**options_of(
-            args, "runs axis tolerance instrument_ppm alignment_mm temperature_u_K "
-                  "cte_u_ppm_per_K eve_um cte_ppm_per_K material_temp_C cte_reference_mm",
-            identification=ident, errors_out=bool(args.errors_out)))
-        if args.errors_out:
-            res.write_error_tables(outs.path("--errors-out"), inputs=args.runs)
-        write_outputs(args, outs, res, ident, args.runs)
+    res = run_command(vars(args), args.runs, lambda _, ident: iso230_2(**options_of(
+        args, "runs axis tolerance instrument_ppm alignment_mm temperature_u_K "
+              "cte_u_ppm_per_K eve_um cte_ppm_per_K material_temp_C cte_reference_mm",
+        identification=ident, errors_out=bool(args.errors_out))),
+        conditions=correction_conditions(args.cte_ppm_per_K, args.material_temp_C),
+        **{"--errors-out": (args.errors_out, names)})
     print(res.summary())
     for n in res.notes:
         print(f"volerr iso230-2: note: {n}", file=sys.stderr)

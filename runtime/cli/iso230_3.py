@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ._common import (add_force, add_html, add_identification_arguments, add_json, add_plot,
-                      command_parser, identification_from_args, planned_outputs, write_outputs)
+                      command_parser)
 
 
 def register(sub) -> None:
@@ -18,18 +18,16 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
-    from ..fileio import write_bytes
+def run(args):
+    from ..certificate import from_options
+    from ..fileio import planned_outputs
     from ..instruments.drift_test import iso230_3
 
     inputs = [args.file]
-    ident = identification_from_args(args, inputs)     # --date checked before reading
+    ident = from_options(vars(args), inputs)     # --date checked before reading
     res = iso230_3(args.file, stage_column=args.stage_column, identification=ident)
     plots = res.plot_paths(args.plot)      # one PNG per run of the file
-    outs = planned_outputs(args, inputs, **{"--plot": plots[0] if len(plots) == 1 else plots})
-    with outs:
-        for k, png in enumerate(res.pngs() if plots else []):
-            write_bytes(outs.path(outs.group_role("--plot", plots, k)), png, inputs=inputs)
-        write_outputs(args, outs, res, ident, inputs, roles=("json", "html"))
-    print(res.summary())
-    return 0
+    with planned_outputs(vars(args), inputs, **{"--plot": plots[0] if len(plots) == 1
+                                                else plots}) as outs:
+        res.write_outputs(outs, vars(args), ident, inputs, roles=("json", "html"))
+    return res

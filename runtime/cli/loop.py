@@ -4,8 +4,7 @@
 from __future__ import annotations
 
 from ._common import (add_errors_out, add_fit_switches, add_report_options, command_parser,
-                      error_dir_names, identification_from_args, layout_inputs, planned_outputs,
-                      write_errors_out, write_outputs)
+                      options_of)
 
 
 def register(sub) -> None:
@@ -28,31 +27,25 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args):
     from .. import loop as api_loop
+    from ..fileio import layout_inputs
     from ..instruments import split_spec
     from ..machine.model import load
+    from ..results import run_command
+    from ..tables.table import error_dir_names
 
-    inputs = [split_spec(d)[1] for d in list(args.data) + list(args.holdout_files or [])] \
-        + layout_inputs(args.layout)
+    holdout = list(args.holdout_files or [])
+    inputs = [split_spec(d)[1] for d in list(args.data) + holdout] + layout_inputs(args.layout)
     model = load(args.layout)
-    outs = planned_outputs(args, inputs, **{
+
+    def call(outs, _):
+        report = api_loop(args.layout, list(args.data), **options_of(
+            args, "seed folds test_fraction degree families holdout_time differences "
+                  "accept_residual", out_dir=outs.path("--out-dir"), holdout_files=holdout,
+            inputs=inputs))     # with --out-dir: the final paths, not staging (a new result)
+        return report.written_in(args.out_dir) if args.out_dir else report
+    return run_command(vars(args), inputs, call, **{
         "--predictions-out": args.predictions_out,
         "--out-dir": (args.out_dir, [f"{model.name}_aug.toml", f"{model.name.lower()}_aug.py"]),
-        "--errors-out": (args.errors_out, error_dir_names(model))})
-    ident = identification_from_args(args, inputs)
-    with outs:
-        report = api_loop(
-            args.layout, list(args.data), out_dir=outs.path("--out-dir"), seed=args.seed,
-            folds=args.folds, test_fraction=args.test_fraction, degree=args.degree,
-            families=args.families, holdout_time=args.holdout_time,
-            holdout_files=list(args.holdout_files or []), differences=args.differences,
-            inputs=inputs, accept_residual=args.accept_residual)
-        if args.out_dir:    # the final paths, not staging (a new result)
-            report = report.written_in(args.out_dir)
-        if args.predictions_out:
-            report.write_predictions(outs.path("--predictions-out"), inputs=inputs)
-        write_errors_out(args, outs, report, inputs)
-        write_outputs(args, outs, report, ident, inputs)
-    print(report.summary())
-    return 0
+        "--errors-out": (args.errors_out, error_dir_names(model.axes))})

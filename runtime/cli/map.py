@@ -4,8 +4,7 @@
 from __future__ import annotations
 
 from ._common import (add_accept_implausible, add_common, add_identification_arguments,
-                      command_parser, identification_from_args, inputs_of, parse_at,
-                      planned_outputs, write_outputs)
+                      command_parser, options_of, parse_at)
 
 
 def register(sub) -> None:
@@ -25,24 +24,15 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..cmm.api import error_map
-    from ..cmm.volmap import random_plot_path
+    from ..cmm.volmap import map_inputs
+    from ..results import run_command
 
-    res = error_map(args.layout, args.errors, grid=args.grid, probe=tuple(args.probe),
-                    at=parse_at(args.at), volume=args.volume, approach=args.approach,
-                    method=args.method, degree=args.degree, extrapolate=args.extrapolate,
-                    accept_implausible=args.accept_implausible, magnify=args.magnify)
-    rnd_plot = args.plot_random or (random_plot_path(args.plot) if args.plot and
-                                    res.has_random else None)
-    inputs = inputs_of(args)
-    outs = planned_outputs(args, inputs, first={"--out": args.out, "--plot": args.plot,
-                                                "--plot-random": rnd_plot})
-    ident = identification_from_args(args, inputs)
-    with outs:
-        if args.out:
-            res.write_csv(outs.path("--out"), inputs)
-        if rnd_plot:    # before write_outputs: the --json holds the magnifications
-            res.write_random_plot(outs.path("--plot-random"), inputs)
-        write_outputs(args, outs, res, ident, inputs)
+    res = error_map(args.layout, args.errors, probe=tuple(args.probe), at=parse_at(args.at),
+                    **options_of(args, "grid volume approach method degree extrapolate "
+                                       "accept_implausible magnify"))
+    rnd_plot = res.random_plot_path(args.plot_random, args.plot)
+    run_command(vars(args), map_inputs(args.layout, args.errors), lambda *_: res, first={
+        "--out": args.out, "--plot": args.plot, "--plot-random": rnd_plot})
     print(res.summary({"map": args.out, "plot": args.plot, "random plot": rnd_plot,
                        "summary": args.json}))
     return 0

@@ -3,8 +3,7 @@ see ``volerr plan --help``."""
 
 from __future__ import annotations
 
-from ._common import (add_force, add_report_options, command_parser, identification_from_args,
-                      layout_inputs, planned_outputs, write_certificates)
+from ._common import add_force, add_report_options, command_parser, options_of
 
 
 def register(sub) -> None:
@@ -25,19 +24,13 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
-    from ..plan.api import check_plan_folder, check_options, plan
+def run(args):
+    from ..fileio import layout_inputs
+    from ..plan.api import check_options, plan
+    from ..results import run_command
 
-    check_options(args.readings, args.minutes, args.parameters, args.dialect)
-    inputs = layout_inputs(args.layout)
-    check_plan_folder(args.out, args.force)
-    outs = planned_outputs(args, inputs, **{"--out": (args.out, None)})
-    ident = identification_from_args(args, inputs)
-    with outs:
-        result = plan(args.layout, args.instrument, args.readings, parameters=args.parameters,
-                      minutes=args.minutes, criterion=args.criterion, seed=args.seed)
-        result.write(outs.path("--out"), outs.path("--json"), outs.path("--html"), inputs,
-                     args.dialect)
-        write_certificates(outs, result, ident, inputs)
-    print(result.summary())
-    return 0
+    check_options(args.readings, args.minutes, args.parameters, args.dialect, args.out,
+                  args.force)
+    return run_command(vars(args), layout_inputs(args.layout), lambda *_: plan(
+        args.layout, args.instrument, args.readings, **options_of(
+            args, "parameters minutes criterion seed")), **{"--out": (args.out, None)})

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import sys
 
-from ..errors import require
 from ._common import (add_force, add_identification_arguments, add_vector, command_parser,
-                      identification_from_args, options_of, planned_outputs, write_outputs)
+                      options_of)
 
 
 def register(sub) -> None:
@@ -42,7 +41,6 @@ def _run_plan(args) -> int:
     from ..fileio import Outputs
     from ..probe.api import probe_plan
 
-    require(args.data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
     with Outputs().file("--plan", args.plan) as outs:
         res = probe_plan(**options_of(args, "sphere_radius ball_radius center tilt_deg "
                                             "roll_deg step_deg circles phis per_circle",
@@ -53,23 +51,16 @@ def _run_plan(args) -> int:
 
 
 def run(args) -> int:
+    from ..probe.api import command_form, probe_cal
+    from ..results import run_command
+
+    command_form(args.data, args.plan, args.out)
     if args.plan:
         return _run_plan(args)
-    from ..probe.api import probe_cal
-
-    require(args.data, "name the probing data DATA.csv (or use --plan to write a plan)")
-    require(args.out, "--out MAP.csv is required")
-    inputs = [args.data]
-    outs = planned_outputs(args, inputs, **{"--out": args.out, "--plots": (
+    res = run_command(vars(args), [args.data], lambda *_: probe_cal(**options_of(
+        args, "data sphere_radius tilt_deg roll_deg degree outlier_k exclude_outliers "
+              "ball_radius")), **{"--out": args.out, "--plots": (
         args.plots, ("probe_map_3d.png", "probe_map_2d.png"))})
-    ident = identification_from_args(args, inputs)
-    with outs:
-        res = probe_cal(**options_of(args, "data sphere_radius tilt_deg roll_deg degree "
-                                           "outlier_k exclude_outliers ball_radius"))
-        res.write_map(outs.path("--out"), inputs=inputs)
-        if args.plots:
-            res.write_plots(outs.path("--plots"))
-        write_outputs(args, outs, res, ident, inputs)
     for note in res.calibration.notes:
         print(f"volerr probe-cal: warning: {note}", file=sys.stderr)
     print(f"{res.summary()}\nmap: {args.out}")

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from ..choices import SIMULATED_INSTRUMENTS as INSTRUMENTS, SIMULATED_PLANTED as PLANTED
-from ._common import (add_accept_implausible, add_vector, command_parser, layout_inputs,
-                      options_of, planned_outputs)
+from ._common import add_accept_implausible, add_vector, command_parser, options_of
 
 
 def register(sub) -> None:
@@ -35,22 +34,17 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..fileio import write_text
-    from ..instruments.simulated_files import instrument_file, refuse_unused
-    from ..loop.simulate import simulate_options
+    from ..fileio import planned_outputs, write_text
+    from ..fileio import layout_inputs
+    from ..instruments.simulated_files import refuse_unused
+    from ..loop.simulate import simulated_file
 
     refuse_unused(args.instrument, vars(args))
     inputs = layout_inputs(args.layout) + ([args.errors] if args.errors else [])
-    outs = planned_outputs(args, inputs, **{"--out": args.out})
-    with outs:
-        if args.instrument == "deviations":
-            camp, name = simulate_options(args.layout, probes=args.probe, effects=args.effect, **(
-                options_of(args, "points seed rounds noise_um magnitude_um hours sensors duty")))
-            camp.write_csv(outs.path("--out"), inputs=inputs)
-            line = f"{camp.n_points} points of {name}"
-        else:
-            text, line = instrument_file(args.layout, args.instrument, **options_of(
-                args, "plant errors steps radius noise_um seed accept_implausible"))
-            write_text(outs.path("--out"), text, inputs=inputs)
+    with planned_outputs(vars(args), inputs, **{"--out": args.out}) as outs:
+        text, line = simulated_file(args.layout, args.instrument, **options_of(
+            args, "probe effect points seed rounds noise_um magnitude_um hours sensors duty "
+                  "plant errors steps radius accept_implausible"))
+        write_text(outs.path("--out"), text, inputs=inputs)
     print(f"{line} -> {args.out}")
     return 0

@@ -5,8 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import require
+from ..fileio import planned_outputs
 from ._common import (add_accept_implausible, add_errors_out, add_force, add_json, command_parser,
-                      layout_inputs, planned_outputs, write_files)
+                      options_of)
 
 
 def register(sub) -> None:
@@ -24,17 +25,16 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..cmm.api import squareness
+    from ..fileio import layout_inputs
 
     src, out = Path(args.directory), Path(args.errors_out)
     require(not (out.exists() and out.resolve() == src.resolve()),
             "--errors-out must differ from the input directory (inputs are never overwritten)")
-    res = squareness(args.layout, src, tables_are=args.tables_are,
-                     accept_implausible=args.accept_implausible)
+    res = squareness(args.layout, src, **options_of(args, "tables_are accept_implausible"))
     inputs = [p for p in src.iterdir() if p.is_file()] + layout_inputs(args.layout)
     files = [*res.texts, "constants.csv"]
-    with planned_outputs(args, inputs, **{"--errors-out": (out, files)}) as outs:
+    with planned_outputs(vars(args), inputs, **{"--errors-out": (out, files)}) as outs:
         res.write_dir(outs.path("--errors-out"), inputs)
-        write_files(args, outs, res, inputs, ("json",))
-    print(res.summary())
-    print(f"-> {out}")
+        res.write_files(outs, vars(args), inputs, ("json",))
+    print(f"{res.summary()}\n-> {out}")
     return 0

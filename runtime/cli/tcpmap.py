@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
-from ._common import (add_error_arguments, add_plot, add_vector, command_parser, layout_inputs,
-                      options_of, planned_outputs, write_files)
+import sys
+from pathlib import Path
+
+from ..fileio import planned_outputs
+from ._common import (add_error_arguments, add_plot, add_vector, command_parser, options_of,
+                      progress_bar)
 
 
 def register(sub) -> None:
@@ -20,20 +24,17 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-    from pathlib import Path
-
+    from ..fileio import layout_inputs
     from ..fiveaxis.api import tcpmap
-    from ._common import progress_bar
 
     inputs = [*Path(args.errors).glob("*.csv"), *layout_inputs(args.layout)]
-    outs = planned_outputs(args, inputs, **{"--csv": args.csv})
+    outs = planned_outputs(vars(args), inputs, **{"--csv": args.csv})
     with progress_bar(None, "tcpmap", total=args.steps * args.steps, unit="points") as tick:
         res = tcpmap(**options_of(args, "layout errors point tool steps approach method degree "
                                         "extrapolate accept_implausible",
                                   plot_name=args.plot, progress=tick))
     with outs:
-        write_files(args, outs, res, inputs, ("plot", "csv"))
+        res.write_files(outs, vars(args), inputs, ("plot", "csv"))
     print(res.summary())
     for note in res.notes:    # after success: bad input gets exactly one line on stderr
         print(note, file=sys.stderr)

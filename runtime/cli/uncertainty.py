@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from ..choices import BIAS_MODES
 from ._common import (add_error_arguments, add_html, add_identification_arguments, add_json,
-                      add_plot, command_parser, identification_from_args, inputs_of, layout_inputs,
-                      options_of, planned_outputs, write_outputs)
+                      add_plot, command_parser, options_of)
 
 
 def register(sub) -> None:
@@ -47,26 +48,22 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
-    from pathlib import Path
-
+def run(args):
+    from ..cmm.volmap import map_inputs
+    from ..fileio import layout_inputs
     from ..probe import read_probe_map
+    from ..results import run_command
     from ..uncertainty.api import uncertainty
 
     inputs = [Path(f) for f in (args.task, args.probe_map) if f]
-    inputs += (inputs_of(args) if args.errors else []) + layout_inputs(args.layout)
-    outs = planned_outputs(args, inputs)
-    ident = identification_from_args(args, inputs)
-    res = uncertainty(**options_of(
+    inputs += (map_inputs(args.layout, args.errors) if args.errors else []) \
+        + layout_inputs(args.layout)
+    res = run_command(vars(args), inputs, lambda *_: uncertainty(**options_of(
         args, "layout task evaluate errors method degree extrapolate spec noise_um table_std "
               "repeatability correlation_mm spec_acceptance samples adaptive digits "
               "max_samples seed chunks scheduler scheduler_address workers contributions "
               "backend bias accept_implausible", progress=not args.quiet,
         probe_map=read_probe_map(args.probe_map) if args.probe_map else None,
         temperature=options_of(args, "part_cte part_dt scale_cte scale_dt",
-                               compensated=args.temperature_compensated)))
-    if not args.quiet:
-        print(res.summary())
-    with outs:
-        write_outputs(args, outs, res, ident, inputs)
-    return 0
+                               compensated=args.temperature_compensated))))
+    return 0 if args.quiet else res

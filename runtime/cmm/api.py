@@ -49,6 +49,21 @@ class ErrorMap(ResultMixin):
                                                           inputs)
         return path
 
+    def random_plot_path(self, plot_random=None, plot=None):
+        """Where ``volerr map`` draws the random component: ``plot_random``, else beside
+        ``plot`` (``NAME_random.png``) when the map has one, else ``None``."""
+        from .volmap import random_plot_path
+
+        return plot_random or (random_plot_path(plot) if plot and self.has_random else None)
+
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr map``'s ``--out`` CSV and the random plot (before the JSON: it records
+        the magnification)."""
+        if options.get("out"):
+            self.write_csv(outs.path("--out"), inputs)
+        if outs.path("--plot-random"):
+            self.write_random_plot(outs.path("--plot-random"), inputs)
+
     def summary(self, written: dict | None = None) -> str:
         """What ``volerr map`` prints; ``written``: ``{label: path}`` of the files written
         (``map``, ``plot``, ``random plot``, ``summary``), one line each at the end."""
@@ -167,13 +182,17 @@ class Diagonals(ResultMixin):
     data: dict
     lines: list
 
-    def summary(self) -> str:
-        """What ``volerr diagonals`` prints (without the lines naming the written files)."""
+    def summary(self, written: dict | None = None) -> str:
+        """What ``volerr diagonals`` prints; ``written``: ``{label: path}`` of the files
+        written (``json``, ``plot``), one line each at the end."""
         from .diagonals import format_table
 
         probe = " ".join(f"{v:g}" for v in self.data["probe_mm"])
-        return (f"{self.data['layout']}: length deviation dL = actual - nominal distance of "
-                f"the probe tip (first order), probe {probe} mm\n{format_table(self.lines)}")
+        return "\n".join([f"{self.data['layout']}: length deviation dL = actual - nominal "
+                          f"distance of the probe tip (first order), probe {probe} mm",
+                          format_table(self.lines)]
+                         + [f"{label}: {path}" for label, path in (written or {}).items()
+                            if path])
 
     def write_plot(self, path, inputs=()):
         """``--plot``: the space-diagonal profiles and every line's deviation

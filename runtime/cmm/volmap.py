@@ -27,7 +27,7 @@ import numpy as np
 from ..units import UM_PER_MM
 from ..errors import InputError, require
 from . import csvformat
-from ..fileio import AtomicFile, check_plot
+from ..fileio import AtomicFile, check_plot, layout_inputs
 from ..plotstyle import styled
 
 
@@ -373,6 +373,12 @@ def error_dir_inputs(directory) -> list:
     if not d.is_dir():
         return []
     return [f for f in d.iterdir() if f.is_file()]
+
+
+def map_inputs(layout, errors) -> list:
+    """The inputs of a run on an error model, never overwritten: the files of the error
+    directory ``errors`` and the layout file (not a shipped layout's name)."""
+    return error_dir_inputs(errors) + layout_inputs(layout)
 
 
 def check_distinct(*paths) -> None:

@@ -75,6 +75,19 @@ class Compensation(ResultMixin):
         return plot_program_errors(self.program_errors(), path,
                                    title=title or f"{self.data['layout']}: program")
 
+    def write_outputs(self, outs, options: dict, ident, inputs=(), title=None, roles=()) -> None:
+        """``volerr compensate``'s ``--json``, ``--plot`` (titled ``LAYOUT: PROGRAM``) and the
+        certificate of the summary (:func:`volerr.report.stamp.finish` of :meth:`to_dict`),
+        inside ``with outs:`` (the program and ``--report`` are streamed by the call)."""
+        from ..report.document import Document
+        from ..report.stamp import finish
+
+        if options.get("json"):
+            self.write_json(outs.path("--json"), inputs)
+        if options.get("plot"):
+            self.write_plot(outs.path("--plot"), title=f"{self.layout}: {options['program']}")
+        finish(outs, Document(self.to_dict()), ident, list(inputs))
+
     def write_program(self, path, inputs=()) -> Path:
         """Write the compensated program, the bytes ``volerr compensate --out`` writes
         (latin-1, line endings as read); never over an input."""

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import require
+from ..fileio import layout_inputs
 from ..results import ResultMixin, Row
 from ..tables.controller_tables import worse_than_none
 
@@ -208,11 +209,6 @@ class _Options:
     accept_implausible: bool = False
 
 
-def _layout_inputs(layout) -> list:
-    p = Path(str(layout))
-    return [p] if p.is_file() else []
-
-
 def _dest(out, tail: str = "") -> str:
     """Where the console text says the output went: ``out`` (a folder with ``tail`` "/"), or
     "(not written)" when the API call wrote nothing."""
@@ -249,7 +245,7 @@ def _export_volumetric(o: _Options, model) -> ControllerExport:
     if o.negate:
         tables, consts = ct.negated(tables, consts)
     writer = ct.write_isg if o.format == "isg" else ct.write_etalon
-    inputs = list(Path(o.errors).glob("*.csv")) + _layout_inputs(o.layout)
+    inputs = list(Path(o.errors).glob("*.csv")) + layout_inputs(o.layout)
     outs = Outputs(inputs).file("--out", o.out).file("--json", o.json).check()
     res = volumetric_left(model, ErrorFunctions.from_dir(
         o.errors, model, accept_implausible=o.accept_implausible), o.grid, o.at)
@@ -286,7 +282,7 @@ def _export_axis_tables(o: _Options, model) -> ControllerExport:
             "--comp-file-type is for --format linuxcnc")
     funcs = ErrorFunctions.from_dir(o.errors, model, accept_implausible=o.accept_implausible)
     tables = ctl.build(funcs, o.format, o.points)
-    inputs = list(Path(o.errors).glob("*.csv")) + _layout_inputs(o.layout)
+    inputs = list(Path(o.errors).glob("*.csv")) + layout_inputs(o.layout)
     outs = Outputs(inputs, force=o.force)
     files = ctl.write(model, tables, o.format, Path(o.out if o.out is not None else
                                                     f"{model.name}_{o.format}"),
@@ -356,7 +352,7 @@ def _export_temperature(o: _Options, model) -> ControllerExport:
     require(o.temperatures is not None, f"--temperatures LOG.csv is needed for "
                                         f"{o.format}")
     name = "temp_comp.spf" if o.format == "sinumerik-temp" else "temp_comp.lis"
-    inputs = [o.loop_json, o.temperatures] + _layout_inputs(o.layout)
+    inputs = [o.loop_json, o.temperatures] + layout_inputs(o.layout)
     outs = Outputs(inputs, force=o.force)
     if o.out is not None:
         outs.folder("--out", o.out, files=[name])
@@ -443,7 +439,7 @@ def controller_import(layout, file, *, out=None, format: str = "auto", negate: b
     axis = format in AXIS_FORMATS
     if axis:
         require(not negate, "--negate is for isg / etalon")
-    inputs = [file] + _layout_inputs(layout)
+    inputs = [file] + layout_inputs(layout)
     outs = Outputs(inputs, force=force)
     if out is not None:
         outs.folder("--errors-out", out,

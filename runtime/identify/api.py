@@ -50,6 +50,14 @@ class Identified(ResultMixin):
 
         return write_text(path, self.error_table_csv(), inputs=list(inputs))
 
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr identify``'s table (``--out F``, else ``--errors-out DIR``'s
+        ``<axis>.csv``) and ``--residuals``."""
+        self.write_table(outs.path("--out") or outs.path("--errors-out") / f"{self.axis}.csv",
+                         inputs=inputs)
+        if options.get("residuals"):
+            self.write_residuals(outs.path("--residuals"), inputs=inputs)
+
     def write_residuals(self, path, inputs=()):
         """Write the per-position, per-point residuals (``--residuals``: CSV, um)."""
         from ..fileio import write_text
@@ -96,7 +104,8 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
         (position in mm or deg); the first position of each round is the reference.
     format, positions, points, method, tracker, direction, origin, sense, max_cond, outlier_k
         As the command's options of the same names (``volerr identify --help``);
-        ``tracker`` / ``direction`` / ``origin``: 3-vectors (mm; direction unitless).
+        ``tracker`` / ``direction`` / ``origin``: 3-vectors (mm; direction unitless; as
+        numbers or their text, ``"1,2,3"``), ``origin`` also ``"layout"``.
     signs : {"component", "model"}
         component: the error motions of the moving component that carries the points (as
         the thesis); model: volerr's tool-relative convention, ready for map / compensate.
@@ -123,6 +132,7 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
     from ..identify.solve import identify as solve, to_model_signs
     from ..machine.layout import read_layout
 
+    origin = _origin(origin)
     files = [files] if isinstance(files, str) or hasattr(files, "__fspath__") else list(files)
     refuse_repeated_files(files)
     lay = read_layout(layout)
@@ -151,6 +161,19 @@ def identify(layout, axis: str, files, *, format: str = "csv", positions: str | 
         fits = fit_table(table, fit, weighted=table.std != {})
         data["fit"] = [f.report() for f in fits.values()]
     return Identified(data, table, result, axis.strip().upper(), quality, fits)
+
+
+def _origin(origin):
+    """``origin`` as the solve takes it: ``None``, ``"layout"`` (also ``["layout"]``, the
+    command's ``--origin layout``) or a list of three numbers (mm; parsed and checked as
+    every 3-vector option, :func:`volerr.units.parse_vector`)."""
+    from ..units import parse_vector
+
+    if origin is None or isinstance(origin, str) and origin == "layout":
+        return origin
+    if not isinstance(origin, str) and list(origin) == ["layout"]:
+        return "layout"
+    return list(parse_vector(origin, "--origin"))
 
 
 #: what identified errors beyond the size limits likely come from

@@ -89,17 +89,21 @@ class Campaign:
         cols.update(self.covariates)
         return cols
 
-    def write_csv(self, path, inputs=()) -> Path:
-        """Write the measured-deviation CSV (INTERFACE.md) atomically; returns the path."""
-        from ..fileio import write_text
-
+    def csv_text(self) -> str:
+        """The measured-deviation CSV (INTERFACE.md)."""
         cols = self.columns()
         names = list(cols)
         lines = [",".join(names)]
         arr = np.column_stack([np.asarray(cols[n], dtype=float) for n in names])
         for row in arr:
             lines.append(",".join(_fmt(v) for v in row))
-        return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
+        return "\n".join(lines) + "\n"
+
+    def write_csv(self, path, inputs=()) -> Path:
+        """Write :meth:`csv_text` atomically; returns the path."""
+        from ..fileio import write_text
+
+        return write_text(path, self.csv_text(), inputs=list(inputs))
 
 
 def _fmt(v: float) -> str:
@@ -385,3 +389,28 @@ def simulate_options(layout, *, points: int = 600, seed: int = 0, probes=None,
     return simulate(layout, n_points=points, seed=seed, probes=probes, rounds=rounds,
                     effects=found, noise_um=noise_um, magnitude_um=magnitude_um,
                     duration_h=hours, sensors=sensors, duty=duty), model.name
+
+
+def simulated_file(layout, instrument: str = "deviations", *, probe=None, effect=(),
+                   points: int = 600, seed: int = 0, rounds: int = 1, noise_um: float = 0.3,
+                   magnitude_um: float = 5.0, hours: float = 8.0, sensors=None, duty=None,
+                   plant: str | None = None, errors=None, steps: int | None = None,
+                   radius: float | None = None, accept_implausible: bool = False) -> tuple:
+    """``volerr simulate``: ``(text, line)``, the file's text and the line the command prints
+    (without its ``-> FILE`` tail).  ``instrument`` deviations: the measured deviations of
+    :func:`simulate_options` (``probe``: the probe offsets, mm; ``effect``: the ``--effect``
+    texts; ``points`` ... ``duty``); else the file of that instrument
+    (:func:`volerr.instruments.simulated_files.instrument_file`: ``plant`` ... ``radius``,
+    ``noise_um``, ``seed``, ``accept_implausible``).  Options a file does not use:
+    :func:`volerr.instruments.simulated_files.refuse_unused`."""
+    if instrument != "deviations":
+        from ..instruments.simulated_files import instrument_file
+
+        return instrument_file(layout, instrument, plant=plant, errors=errors, steps=steps,
+                               radius=radius, noise_um=noise_um, seed=seed,
+                               accept_implausible=accept_implausible)
+    camp, name = simulate_options(layout, points=points, seed=seed, probes=probe,
+                                  rounds=rounds, effects=effect, noise_um=noise_um,
+                                  magnitude_um=magnitude_um, hours=hours, sensors=sensors,
+                                  duty=duty)
+    return camp.csv_text(), f"{camp.n_points} points of {name}"

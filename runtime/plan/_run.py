@@ -79,6 +79,16 @@ class Plan(ResultMixin):
     map_grid: dict = field(default_factory=dict)
     dialect: str = "iso"
 
+    def write_outputs(self, outs, options: dict, ident, inputs=(), title=None, roles=()):
+        """``volerr plan``'s outputs inside ``with outs:``: :meth:`write` into ``--out`` (and
+        ``--json``, ``--html``; the options' ``dialect``), then the identification
+        (:func:`volerr.report.stamp.finish`)."""
+        from ..report.stamp import finish
+
+        self.write(outs.path("--out"), outs.path("--json"), outs.path("--html"), inputs,
+                   options.get("dialect"))
+        finish(outs, self, ident, list(inputs))
+
     def write(self, folder, json_path=None, html_path=None, inputs=(), dialect=None) -> None:
         """The files, NC programs (in ``dialect``, default :attr:`dialect`: one of
         :data:`volerr.plan._dialect.NAMES`), ``plan.html`` (or ``html_path``) and the JSON."""

@@ -53,10 +53,11 @@ def plan(layout, instruments, readings: int, *, parameters: str | None = None,
 
 
 def check_options(readings: int, minutes: float | None = None, parameters: str | None = None,
-                  dialect: str = "iso") -> None:
+                  dialect: str = "iso", out=None, force: bool = False) -> None:
     """Refuse options of :func:`plan` out of range, one line (``volerr plan`` checks them
     before its outputs): ``readings`` outside 1 .. 10^7, ``minutes`` not positive, an empty
-    ``parameters``, an unknown NC ``dialect`` (:data:`volerr.plan._dialect.NAMES`)."""
+    ``parameters``, an unknown NC ``dialect`` (:data:`volerr.plan._dialect.NAMES`); then the
+    folder ``out`` (``--out DIR``, when given: :func:`check_plan_folder`, ``force``)."""
     from ._dialect import NAMES
 
     require(1 <= readings <= 10 ** 7, "--readings must be between 1 and 10000000")
@@ -65,6 +66,8 @@ def check_options(readings: int, minutes: float | None = None, parameters: str |
                               f"{', '.join(NAMES)}")
     require(parameters is None or parameters.strip(),
             "--parameters: empty; give names, axes or groups")
+    if out is not None:
+        check_plan_folder(out, force)
 
 
 def check_plan_folder(folder, force: bool = False, what: str = "plan",

@@ -45,6 +45,11 @@ class Iso230_2(ResultMixin):
         per_run = self.data["runs"] if "runs" in self.data else [self.data]
         return plot_runs(self.evaluations, verdicts_per_run=[r.get("verdicts") for r in per_run])
 
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr iso230-2``'s ``--errors-out DIR`` (:meth:`write_error_tables`)."""
+        if options.get("errors_out"):
+            self.write_error_tables(outs.path("--errors-out"), inputs=inputs)
+
     def write_error_tables(self, folder, inputs=()) -> list:
         """``FOLDER/<axis>.csv`` per run (mean bidirectional deviation, its standard
         uncertainty, the single-reading repeatability and the reversal; 'volerr formats
@@ -228,6 +233,15 @@ class Iso230_3(ResultMixin):
             return [p]
         require(p.suffix.lower() == ".png", f"plot file must end in .png, got {path}")
         return [p.with_name(f"{p.stem}_{r}{p.suffix}") for r in self.runs]
+
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr iso230-3``'s ``--plot``: :meth:`pngs` at :meth:`plot_paths` (declared as
+        one file for a file of one run, else as a group)."""
+        from ..fileio import write_bytes
+
+        plots = self.plot_paths(options.get("plot"))
+        for k, png in enumerate(self.pngs() if plots else []):
+            write_bytes(outs.path(outs.group_role("--plot", plots, k)), png, inputs=inputs)
 
     def write_html(self, path, inputs=()):
         """The test report (``--html``): identification, drift per channel and stage, plot."""

@@ -52,6 +52,12 @@ class ProbeCal(ResultMixin):
 
         return plot_probe_calibration(self.calibration, check_plot(path, list(inputs)))
 
+    def _write_own(self, outs, options: dict, inputs: list) -> None:
+        """``volerr probe-cal``'s ``--out MAP.csv`` and ``--plots DIR``."""
+        self.write_map(outs.path("--out"), inputs=inputs)
+        if options.get("plots"):
+            self.write_plots(outs.path("--plots"))
+
     def write_plots(self, folder) -> list:
         """``FOLDER/probe_map_3d.png`` (Fig. 3a) and ``FOLDER/probe_map_2d.png`` (Fig. 3b)
         (``--plots DIR``); returns their paths."""
@@ -61,6 +67,16 @@ class ProbeCal(ResultMixin):
 
         return [plot_probe_map_3d(self.calibration, Path(folder) / "probe_map_3d.png"),
                 plot_probe_map_2d(self.calibration, Path(folder) / "probe_map_2d.png")]
+
+
+def command_form(data=None, plan=None, out=None) -> None:
+    """Refuse, one line, a ``volerr probe-cal`` that is neither a calibration (``data`` read,
+    the map written to ``out``) nor a plan (written to ``plan``), or both."""
+    if plan:
+        require(data is None, "give either DATA.csv (calibrate) or --plan (write a plan)")
+    else:
+        require(data, "name the probing data DATA.csv (or use --plan to write a plan)")
+        require(out, "--out MAP.csv is required")
 
 
 def probe_cal(data, sphere_radius: float, *, tilt_deg: float = 0.0, roll_deg: float = 0.0,

@@ -1,6 +1,6 @@
-"""A command's report outputs finished with its identification (called by
-``volerr.cli._common.write_certificates`` inside ``with outs:``, after the command's own
-writes, so everything stays all or nothing): the written ``--json`` gets
+"""A command's report outputs finished with its identification (:func:`finish`, called by
+:meth:`volerr.results.ResultMixin.write_outputs` inside ``with outs:``, after the command's
+own writes, so everything stays all or nothing): the written ``--json`` gets
 ``"identification"``, the written ``--html`` the shared style, the report id and the
 identification block (:func:`volerr.report.page.stamp_html`), and ``--pdf`` the certificate
 (:mod:`volerr.report.pdf`)."""
@@ -30,8 +30,11 @@ def figures_of(result) -> dict:
 
 
 def finish(outs, result, ident, inputs=(), title: str | None = None) -> None:
-    """Stamp ``--json`` (when written and the user stated an identification, or the document
-    carries one of its own) and ``--html`` (when written); write ``--pdf`` (when given)."""
+    """Inside ``with outs:`` (:class:`volerr.fileio.Outputs`): stamp ``--json`` (when written
+    and the user stated an identification, or the document carries one of its own) and
+    ``--html`` (when written) with ``ident`` (:class:`volerr.certificate.Identification`);
+    write ``--pdf`` (when given).  ``result``: a result object (a bare JSON document, or a
+    result without rows: as :class:`volerr.report.document.Document`)."""
     from ..fileio import json_text, write_text
     from .page import stamp_html
 

@@ -560,6 +560,12 @@ def read_error_dir(directory, axes=None, *, machine=None,
     return tables, tuple(consts)
 
 
+def error_dir_names(axes) -> list:
+    """The files of an error directory a fit writes (:func:`write_error_dir`): ``<axis>.csv``
+    of each of ``axes``, ``constants.csv``."""
+    return [f"{a}.csv" for a in axes] + ["constants.csv"]
+
+
 def write_error_dir(directory, tables: dict, constants: dict | None = None,
                     constants_std: dict | None = None, inputs=(), comments=None, *,
                     machine=None, accept_implausible: bool = False, shown=None) -> Path:

@@ -287,6 +287,13 @@ class Iso10360(ResultMixin):
         return f"{self.data['layout']}: simulated ISO 10360-2" + (
             f", {self.data['verdict']}" if self.data.get("mpe") else "")
 
+    def write_outputs(self, outs, options: dict, ident=None, inputs=(), title=None,
+                      roles=("plot", "json", "html")) -> None:
+        """:meth:`volerr.results.ResultMixin.write_outputs` with the test's identification
+        (``ident`` and the artefact's conditions, :attr:`identification`) and :attr:`title`."""
+        super().write_outputs(outs, options, self.identification or ident, inputs,
+                              title or self.title, roles)
+
     def png(self) -> bytes:
         """The certificate picture: E0 against L with the MPE and the undecided zone."""
         from . import iso10360 as iso
