@@ -57,7 +57,10 @@ SUB_BLOCKS = 8
 LEVEL = 0.95
 NAMES = {"constant": "a constant (each run's zero)",
          "static": "the static regression on all temperatures",
-         "lag": "the lag model"}
+         "lag": "the lag model",
+         "regularised": "the regularised fit over the lag bank"}
+RIVAL = {"static": "static regression", "constant": "constant",
+         "regularised": "regularised fit over the lag bank"}
 
 
 def cv_residuals(ch, D) -> np.ndarray:
@@ -92,34 +95,57 @@ def block_mse(fold, r, sub: int = SUB_BLOCKS) -> np.ndarray:
     return np.array(out)
 
 
-def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
+def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
+           regularised=None) -> dict:
     """The family of the channel by the module's rule: ``designs`` family -> design matrix;
     ``has_terms`` False: the lag model has no term (it is the constant); ``nested``: its
     terms are plain temperatures (no lag, no heat input): a sub-model of the static
-    regression, which then must be significantly below it to be preferred.  Returns
+    regression, which then must be significantly below it to be preferred;
+    ``regularised``: the blocked-CV residuals (N,) of the regularised fit over the lag bank
+    (:mod:`volerr.loop.drift.shrink`), a fourth candidate (None: three).  Returns
     {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
-    "lag_vs_static"}, "rule", "cv_resid" (N,) of the chosen family}."""
+    "lag_vs_static"; with the fourth "regularised_vs_constant", "regularised_vs_static",
+    "lag_vs_regularised"}, "rule", "cv_resid" (N,) of the chosen family}."""
     resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
+    if regularised is not None:
+        resid["regularised"] = regularised
     mse = {f: block_mse(ch.fold, r) for f, r in resid.items()}
     tr = ch.fold >= 0
     cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
-    t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a])
-         for a, b in (("static", "constant"), ("lag", "constant"), ("lag", "static"))}
+    pairs = [("static", "constant"), ("lag", "constant"), ("lag", "static")]
+    if regularised is not None:
+        pairs += [("regularised", "constant"), ("regularised", "static"),
+                  ("lag", "regularised")]
+    t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a]) for a, b in pairs}
     # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
     fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
+    if regularised is not None and all(significantly_below(mse["regularised"], mse[b])
+                                       for b in ("static", "constant")):
+        fam = "regularised"
     # a lag model of plain temperatures only is a sub-model of the static regression: there
     # the static regression is the more complex one and must beat it significantly
     beats_static = (not significantly_below(mse["static"], mse["lag"]) if nested else
                     significantly_below(mse["lag"], mse["static"]))
-    if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static:
+    beats_reg = regularised is None or significantly_below(mse["lag"], mse["regularised"])
+    if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static \
+            and beats_reg:
         fam = "lag"
     K = len(mse["lag"])
     return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
-            "cv_resid": resid[fam],
-            "rule": f"lag model only if, against each baseline, the paired t over {K} blocks "
-                    f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
-                    f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
-                    f"baseline of lower CV mean square"}
+            "cv_resid": resid[fam], "rule": _rule_text(K, regularised is not None)}
+
+
+def _rule_text(K: int, regularised: bool) -> str:
+    if not regularised:
+        return (f"lag model only if, against each baseline, the paired t over {K} blocks "
+                f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
+                f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
+                f"baseline of lower CV mean square")
+    return (f"lag model only if, against each baseline and the regularised fit over the lag "
+            f"bank, the paired t over {K} blocks ({SUB_BLOCKS} per blocked CV fold) of (the "
+            f"other's - the lag model's CV mean square) >= {t95(K - 1):.3f} (one-sided 95 %, "
+            f"{K - 1} df); else the regularised fit if so against each baseline; else the "
+            f"baseline of lower CV mean square")
 
 
 def interval(cv_resid, y, pred, fold, test) -> dict:
@@ -142,14 +168,23 @@ def interval(cv_resid, y, pred, fold, test) -> dict:
 
 def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) -> str:
     """One sentence: which model the channel reports, and why."""
-    figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, static regression {cv_rms['static']:.3f}, "
-            f"constant {cv_rms['constant']:.3f} um")
+    reg = "regularised" in cv_rms
+    figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, "
+            + (f"regularised fit {cv_rms['regularised']:.3f}, " if reg else "")
+            + f"static regression {cv_rms['static']:.3f}, constant {cv_rms['constant']:.3f} um")
     if family == "lag":
-        return f"the lag model beats both baselines significantly ({figs})"
-    if not has_terms:
-        return f"no lag term earns a place: the model is {NAMES[family]} ({figs})"
-    lost = [b for b in ("static", "constant") if not t[f"lag_vs_{b}"] >= t_crit] or ["static"]
-    what = " and the ".join("static regression" if b == "static" else "constant" for b in lost)
+        return (f"the lag model beats both baselines{' and the regularised fit' if reg else ''}"
+                f" significantly ({figs})")
+    rivals = ("static", "constant") + (("regularised",) if reg else ())
+    lost = [b for b in rivals if not t[f"lag_vs_{b}"] >= t_crit] or ["static"]
     worst = min(t[f"lag_vs_{b}"] for b in lost)
+    what = " and the ".join(RIVAL[b] for b in lost)
+    why = (f"no lag term earns a place" if not has_terms else
+           f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f})")
+    if family == "regularised":
+        return (f"{why}; {NAMES['regularised']} beats both baselines significantly ({figs}): "
+                f"the model is {NAMES['regularised']} (it names no effect)")
+    if not has_terms:
+        return f"{why}: the model is {NAMES[family]} ({figs})"
     return (f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f}; {figs}):"
             f" the model is {NAMES[family]}")

@@ -143,7 +143,9 @@ def _family_lines(c: dict) -> list:
     b = c.get("baselines", {})
     line = (f"    model: {c['family']}; held-out MAE of the baselines: static regression "
             f"{b['static']['mae_um']:.3f}, constant {b['constant']['mae_um']:.3f} um; lag model "
-            f"{c['lag_model']['mae_um']:.3f} um")
+            f"{c['lag_model']['mae_um']:.3f} um"
+            + (f", regularised fit over the lag bank {c['regularised']['mae_um']:.3f} um"
+               if "regularised" in c else ""))
     out = [line]
     if c.get("verdict"):
         out.append(f"    {c['verdict']}")
