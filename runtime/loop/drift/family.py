@@ -119,19 +119,20 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
     t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a]) for a, b in pairs}
     # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
     fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
-    if regularised is not None and all(significantly_below(mse["regularised"], mse[b])
-                                       for b in ("static", "constant")):
+    reg_ok = regularised is not None and all(significantly_below(mse["regularised"], mse[b])
+                                             for b in ("static", "constant"))
+    if reg_ok:
         fam = "regularised"
     # a lag model of plain temperatures only is a sub-model of the static regression: there
     # the static regression is the more complex one and must beat it significantly
     beats_static = (not significantly_below(mse["static"], mse["lag"]) if nested else
                     significantly_below(mse["lag"], mse["static"]))
-    beats_reg = regularised is None or significantly_below(mse["lag"], mse["regularised"])
-    if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static \
-            and beats_reg:
+    named = has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static
+    if named and (not reg_ok or significantly_below(mse["lag"], mse["regularised"])):
         fam = "lag"
     K = len(mse["lag"])
-    return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
+    return {"family": fam, "named": named and fam in ("lag", "regularised"),
+            "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
             "cv_resid": resid[fam], "rule": _rule_text(K, regularised is not None)}
 
 
@@ -141,11 +142,12 @@ def _rule_text(K: int, regularised: bool) -> str:
                 f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
                 f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
                 f"baseline of lower CV mean square")
-    return (f"lag model only if, against each baseline and the regularised fit over the lag "
-            f"bank, the paired t over {K} blocks ({SUB_BLOCKS} per blocked CV fold) of (the "
-            f"other's - the lag model's CV mean square) >= {t95(K - 1):.3f} (one-sided 95 %, "
-            f"{K - 1} df); else the regularised fit if so against each baseline; else the "
-            f"baseline of lower CV mean square")
+    return (f"the regularised fit over the lag bank if, against each baseline, the paired t "
+            f"over {K} blocks ({SUB_BLOCKS} per blocked CV fold) of (baseline's - its CV mean "
+            f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df), unless the lag model "
+            f"is so below it; the lag model if so below each baseline (its terms named "
+            f"wherever it is, the prediction the regularised fit's unless the lag model beats "
+            f"it too); else the baseline of lower CV mean square")
 
 
 def interval(cv_resid, y, pred, fold, test) -> dict:
@@ -181,6 +183,11 @@ def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) 
     what = " and the ".join(RIVAL[b] for b in lost)
     why = (f"no lag term earns a place" if not has_terms else
            f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f})")
+    if family == "regularised" and lost == ["regularised"]:
+        return (f"the lag model beats both baselines significantly but not the regularised "
+                f"fit over the lag bank (paired t {worst:.2f} < {t_crit:.2f}; {figs}): the "
+                f"model is {NAMES['regularised']}; the lag model's terms are named as the "
+                f"diagnosis")
     if family == "regularised":
         return (f"{why}; {NAMES['regularised']} beats both baselines significantly ({figs}): "
                 f"the model is {NAMES['regularised']} (it names no effect)")

@@ -130,7 +130,7 @@ class DriftReport(ResultMixin):
             for t in e["terms"]:
                 out.append("    " + _term_line(t))
         for n in d.get("not_reported", []):
-            out.append(f"  lag term not reported (its channel's model is a baseline): {n}")
+            out.append(f"  lag term not reported (the lag model does not beat both baselines): {n}")
         for n in d["not_significant"]:
             out.append(f"  not significant (|value| < {SIG_K:g} u), left out: {n}")
         return out

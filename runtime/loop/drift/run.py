@@ -90,7 +90,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
     for label, r in res["channels"].items():
         if label in quantity:
             data["quantities"][label].update(_choice(r["choice"], bool(r["terms"])))
-        if r["choice"]["family"] != "lag":
+        if not r["choice"]["named"]:
             data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]]
             continue
         data["effects"] += _effects(label, r, m, quantity.get(label), data["budgets"])
@@ -124,7 +124,7 @@ def _prediction(m, r) -> dict:
     return {"before": r["before"], "lag": lag, "after": lag if fam == "lag" else r[fam],
             "static": r["static"], "constant": r["constant"], "regularised": r["regularised"],
             "cv_resid": c["cv_resid"], "family": fam,
-            "terms": r["terms"] if fam == "lag" else []}
+            "terms": r["terms"] if c["named"] else []}
 
 
 def _quantity(q, rows) -> dict:
@@ -137,7 +137,7 @@ def _quantity(q, rows) -> dict:
 
 def _choice(choice, has_terms) -> dict:
     """The family chosen for a label and why (:mod:`volerr.loop.drift.family`)."""
-    return {"family": choice["family"],
+    return {"family": choice["family"], "lag_terms_named": bool(choice["named"]),
             "cv_rms_um": {k: round(v, 6) for k, v in choice["cv_rms_um"].items()},
             "paired_t": {k: round(v, 3) for k, v in choice["t"].items()},
             "selection_rule": choice["rule"],
