@@ -113,7 +113,7 @@ def test_the_regularised_fit_is_the_penalised_least_squares(n_runs, rule):
     s = _series(n_runs)
     cols, X, fold, got_rule = _bank(s)
     assert got_rule == rule
-    res = shrink.fit(s, s.channels["x"], X, cols, fold, rule, {})
+    res = shrink.fit(s, s.channels["x"], X, list(range(X.shape[1])), cols, fold, rule, {})
     tr = s.train
     # the lambda: the grid's least CV mean square, recomputed here for every grid value
     mse = [np.mean(_independent(s, cols, X, fold, rule, lr)[0][tr] ** 2)

@@ -146,7 +146,7 @@ def _regularised(ch: Channel, cols, Z, cands, cache) -> dict:
     """The regularised fit over the columns the selection may take (every single column of
     ``cands``; :mod:`volerr.loop.drift.shrink`)."""
     keep = sorted({int(a) for c in cands for a, b in c if b < 0})
-    return shrink.fit(ch.s, ch.y, Z[:, ch.n_runs:][:, keep], [cols[j] for j in keep],
+    return shrink.fit(ch.s, ch.y, Z, [ch.n_runs + j for j in keep], [cols[j] for j in keep],
                       ch.fold, ch.rule, cache)
 
 

@@ -29,10 +29,10 @@ CV residuals are nearly those of a model fitted without the fold, the sparse mod
 optimistic.  The fit names no effect (hundreds of shrunk coefficients): where it is the
 channel's model the report says so and lists no term.
 
-Computation: per fold the columns (scaled by ``1/sqrt(w)``) are centred per run over the
-fitting readings (the free zeros, Frisch-Waugh) and the Gram matrix decomposed once
-(``eigh``); every lambda is then a diagonal solve.  The decompositions do not depend on the
-channel and are shared (``cache``).
+Computation: the columns scaled by ``1/sqrt(w)``; per fold their Gram matrix and per-run
+sums (one pass over the readings); a fit's Gram matrix is the sum over its folds, centred
+per run (the free zeros, Frisch-Waugh), decomposed once (``eigh``); every lambda is then a
+diagonal solve.  None of it depends on the channel: it is shared (``cache``).
 """
 
 from __future__ import annotations
@@ -60,68 +60,80 @@ def fold_time(s, fold) -> float:
     return max(span, 1.0) / (int(fold.max()) + 1)
 
 
-def _decompose(Zs, run, n_runs, fit):
-    """Per-run means (n_runs, p) of ``Zs`` over the readings ``fit``, their counts, and the
-    eigen-decomposition (e, V) of the centred Gram matrix."""
-    mu, cnt = np.zeros((n_runs, Zs.shape[1])), np.zeros(n_runs)
-    for r in range(n_runs):
-        m = fit & (run == r)
-        cnt[r] = m.sum()
-        if cnt[r]:
-            mu[r] = Zs[m].mean(axis=0)
-    Zc = Zs[fit] - mu[run[fit]]
-    e, V = np.linalg.eigh(Zc.T @ Zc)
+def _blocks(Zs, run, n_runs, fold) -> list:
+    """Per fold k: (Gram matrix, per-run sums (n_runs, p), per-run counts) of ``Zs`` over the
+    fold's readings: every fit's cross-products are sums of these (one pass over the data)."""
+    out = []
+    for k in range(int(fold.max()) + 1):
+        m = fold == k
+        Zk, rk = Zs[m], run[m]
+        sums = np.array([Zk[rk == r].sum(axis=0) for r in range(n_runs)])
+        out.append((Zk.T @ Zk, sums, np.bincount(rk, minlength=n_runs).astype(float)))
+    return out
+
+
+def _decompose(blocks, leave):
+    """Per-run means (n_runs, p) over the folds but ``leave`` (-1: none), their counts, and
+    the eigen-decomposition (e, V) of the Gram matrix centred per run (the free zeros)."""
+    parts = [b for k, b in enumerate(blocks) if k != leave]
+    G = sum(b[0] for b in parts)
+    sums, cnt = sum(b[1] for b in parts), sum(b[2] for b in parts)
+    mu = sums / np.maximum(cnt, 1.0)[:, None]
+    e, V = np.linalg.eigh(G - (sums.T * (1.0 / np.maximum(cnt, 1.0))) @ sums)
     return mu, cnt, np.clip(e, 0.0, None), V
 
 
-def _path(parts, Zs, y, run, fit, rows, anchored, first, lams):
-    """Predictions (len(rows), L) of the readings ``rows`` by the fits on ``fit`` for every
-    lambda of ``lams`` (absolute); ``anchored``: from each run's first reading, else from
-    the run's zero fitted on ``fit`` (a run without fitting readings: its first reading)."""
+def _path(parts, zy, ysum, Zs, run, rows, anchored, first, lams):
+    """Predictions (len(rows), L) of the readings ``rows`` for every lambda of ``lams``
+    (absolute) by the fit whose cross-products are ``parts`` (:func:`_decompose`), ``zy``
+    (``Zs' y`` over its readings, (p,)) and ``ysum`` (per-run sums of ``y`` there);
+    ``anchored``: from each run's first reading, else from the run's fitted zero (a run
+    without fitting readings: its first reading)."""
     mu, cnt, e, V = parts
-    ybar = np.array([y[fit & (run == r)].mean() if c else 0.0 for r, c in enumerate(cnt)])
-    g = V.T @ (Zs[fit].T @ y[fit] - mu.T @ (cnt * ybar))
+    ybar = ysum / np.maximum(cnt, 1.0)
+    g = V.T @ (zy - mu.T @ ysum)
     B = V @ (g[:, None] / (e[:, None] + lams[None, :]))          # (p, L) coefficients
     rr = run[rows]
     if anchored:
-        return first[rr][:, None] + Zs[rows] @ B, B
+        return first[rr][:, None] + Zs[rows] @ B
     zero = ybar[:, None] - mu @ B
     zero[cnt == 0] = first[cnt == 0][:, None]
-    return zero[rr] + Zs[rows] @ B, B
+    return zero[rr] + Zs[rows] @ B
 
 
-def fit(s, y, X, cols, fold, rule: str, cache: dict) -> dict:
-    """The regularised fit of one channel ``y`` (N,) um on the bank ``X`` (N, p) (unit-RMS
-    columns ``cols``), judged on the blocked ``fold`` (rule ``rule``).  Returns {"pred" (N,)
-    every reading by the fit on all training readings, "cv_resid" (N,) NaN off training,
-    "lambda_rel", "edf" (effective number of coefficients, ``sum e/(e + lambda)``),
+def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict) -> dict:
+    """The regularised fit of one channel ``y`` (N,) um on the bank ``Z[:, keep]`` (N, p)
+    (unit-RMS columns ``cols``), judged on the blocked ``fold`` (rule ``rule``).  Returns
+    {"pred" (N,) every reading by the fit on all training readings, "cv_resid" (N,) NaN off
+    training, "lambda_rel", "edf" (effective number of coefficients, ``sum e/(e + lambda)``),
     "n_columns", "penalty"}."""
     n_runs, run, tr = len(s.runs), s.run, s.train
+    K = int(fold.max()) + 1
     if "shrink_Z" not in cache:
-        cache["shrink_Z"] = X / np.sqrt(weights(cols, fold_time(s, fold)))
-    Zs = cache["shrink_Z"]
+        cache["shrink_Z"] = Zs = Z[:, keep] / np.sqrt(weights(cols, fold_time(s, fold)))
+        cache["shrink_blocks"] = _blocks(Zs, run, n_runs, fold)
+        cache["shrink_eig"] = [_decompose(cache["shrink_blocks"], k) for k in range(-1, K)]
+    Zs, eig = cache["shrink_Z"], cache["shrink_eig"]
+    zy = [Zs[fold == k].T @ y[fold == k] for k in range(K)]
+    ys = [np.bincount(run[fold == k], y[fold == k], n_runs) for k in range(K)]
     lams = LAMBDAS * float(tr.sum())
     first = y[s.firsts()]
-    anchored = basis.whole_runs(rule)
     resid = np.full((len(y), len(lams)), np.nan)
-    for k in range(int(fold.max()) + 1):
-        rows, fit_ = fold == k, tr & (fold != k) & (fold >= 0)
-        if ("shrink", k) not in cache:
-            cache[("shrink", k)] = _decompose(Zs, run, n_runs, fit_)
-        pred, _ = _path(cache[("shrink", k)], Zs, y, run, fit_, rows, anchored, first, lams)
+    for k in range(K):
+        rows = fold == k
+        others = [j for j in range(K) if j != k]
+        pred = _path(eig[k + 1], sum(zy[j] for j in others), sum(ys[j] for j in others), Zs,
+                     run, rows, basis.whole_runs(rule), first, lams)
         resid[rows] = y[rows][:, None] - pred
     mse = np.mean(resid[tr] ** 2, axis=0)
     i = len(lams) - 1                       # from the most shrunk: a tie keeps the larger
     for j in range(len(lams) - 2, -1, -1):
         if mse[j] < mse[i] * (1 - TIE_SCORE_REL):
             i = j
-    if "shrink_all" not in cache:
-        cache["shrink_all"] = _decompose(Zs, run, n_runs, tr)
-    parts = cache["shrink_all"]
-    everything = np.ones(len(y), bool)
-    pred, _ = _path(parts, Zs, y, run, tr, everything, False, first, lams[i:i + 1])
-    e = parts[2]
+    pred = _path(eig[0], sum(zy), sum(ys), Zs, run, np.ones(len(y), bool), False, first,
+                 lams[i:i + 1])
+    e = eig[0][2]
     return {"pred": pred[:, 0], "cv_resid": resid[:, i], "lambda_rel": float(LAMBDAS[i]),
-            "edf": float(np.sum(e / (e + lams[i]))), "n_columns": int(X.shape[1]),
+            "edf": float(np.sum(e / (e + lams[i]))), "n_columns": len(keep),
             "penalty": "ridge, weights (1 + tau/T)^2, T = a fold's share of the training "
                        "time; lambda of least blocked-CV mean square"}
