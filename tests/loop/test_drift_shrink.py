@@ -165,3 +165,18 @@ def test_the_rule_with_the_regularised_fit():
     assert noise["family"] == "regularised" and not noise["named"]
     v = family.verdict("regularised", noise["cv_rms_um"], noise["t"], True, noise["t_crit"])
     assert "names no effect" in v
+
+
+def test_the_folds_cross_products_of_the_whole_design_give_the_same_fit():
+    """The loop passes the drift engine's ``Z_k' Z_k`` of every fold (run indicators and the
+    whole library); the fit from them equals the one from the columns themselves."""
+    s = _series(1)
+    cols, X, fold, rule = _bank(s)
+    Z = np.column_stack([s.indicators(), X])
+    keep = list(range(1, Z.shape[1]))
+    grams = [Z[fold == k].T @ Z[fold == k] for k in range(int(fold.max()) + 1)]
+    a = shrink.fit(s, s.channels["x"], Z, keep, cols, fold, rule, {})
+    b = shrink.fit(s, s.channels["x"], Z, keep, cols, fold, rule, {}, grams)
+    assert a["lambda_rel"] == b["lambda_rel"]
+    np.testing.assert_allclose(a["pred"], b["pred"], atol=1e-8)
+    np.testing.assert_allclose(a["cv_resid"], b["cv_resid"], atol=1e-8)

@@ -146,8 +146,10 @@ def _regularised(ch: Channel, cols, Z, cands, cache) -> dict:
     """The regularised fit over the columns the selection may take (every single column of
     ``cands``; :mod:`volerr.loop.drift.shrink`)."""
     keep = sorted({int(a) for c in cands for a, b in c if b < 0})
+    grams = [cache[("fit", k)] for k in range(int(ch.fold.max()) + 1)] \
+        if ("fit", 0) in cache else None         # the engine's cross-products of the folds
     return shrink.fit(ch.s, ch.y, Z, [ch.n_runs + j for j in keep], [cols[j] for j in keep],
-                      ch.fold, ch.rule, cache)
+                      ch.fold, ch.rule, cache, grams)
 
 
 def _backward(ch: Channel, specs) -> list:

@@ -30,9 +30,11 @@ optimistic.  The fit names no effect (hundreds of shrunk coefficients): where it
 channel's model the report says so and lists no term.
 
 Computation: the columns scaled by ``1/sqrt(w)``; per fold their Gram matrix and per-run
-sums (one pass over the readings); a fit's Gram matrix is the sum over its folds, centred
-per run (the free zeros, Frisch-Waugh), decomposed once (``eigh``); every lambda is then a
-diagonal solve.  None of it depends on the channel: it is shared (``cache``).
+sums (taken from the drift engine's cross-products of the folds: no pass over the readings);
+a fit's Gram matrix is the sum over its folds, centred per run (the free zeros,
+Frisch-Waugh), decomposed once (``eigh``); every lambda is then a diagonal solve, and a
+fold's squared error for every lambda follows from its cross-products.  None of it depends
+on the channel: it is shared (``cache``).
 """
 
 from __future__ import annotations
@@ -60,11 +62,19 @@ def fold_time(s, fold) -> float:
     return max(span, 1.0) / (int(fold.max()) + 1)
 
 
-def _blocks(Zs, run, n_runs, fold) -> list:
+def _blocks(Zs, run, n_runs, fold, grams=None, keep=None, scale=None) -> list:
     """Per fold k: (Gram matrix, per-run sums (n_runs, p), per-run counts) of ``Zs`` over the
-    fold's readings: every fit's cross-products are sums of these (one pass over the data)."""
+    fold's readings: every fit's cross-products are sums of these.  ``grams``: the folds'
+    cross-products ``Z_k' Z_k`` of the whole design ``Z`` (run indicators first; the drift
+    engine's, :class:`volerr.loop.drift.engine.Engine`), from which these follow by the
+    columns ``keep`` and their ``scale`` without a pass over the readings."""
     out = []
     for k in range(int(fold.max()) + 1):
+        if grams is not None:
+            g = grams[k]
+            out.append((g[np.ix_(keep, keep)] * np.outer(scale, scale),
+                        g[:n_runs][:, keep] * scale, np.diag(g)[:n_runs].copy()))
+            continue
         m = fold == k
         Zk, rk = Zs[m], run[m]
         sums = np.array([Zk[rk == r].sum(axis=0) for r in range(n_runs)])
@@ -83,57 +93,74 @@ def _decompose(blocks, leave):
     return mu, cnt, np.clip(e, 0.0, None), V
 
 
-def _path(parts, zy, ysum, Zs, run, rows, anchored, first, lams):
-    """Predictions (len(rows), L) of the readings ``rows`` for every lambda of ``lams``
-    (absolute) by the fit whose cross-products are ``parts`` (:func:`_decompose`), ``zy``
-    (``Zs' y`` over its readings, (p,)) and ``ysum`` (per-run sums of ``y`` there);
-    ``anchored``: from each run's first reading, else from the run's fitted zero (a run
-    without fitting readings: its first reading)."""
-    mu, cnt, e, V = parts
-    ybar = ysum / np.maximum(cnt, 1.0)
-    g = V.T @ (zy - mu.T @ ysum)
-    B = V @ (g[:, None] / (e[:, None] + lams[None, :]))          # (p, L) coefficients
-    rr = run[rows]
-    if anchored:
-        return first[rr][:, None] + Zs[rows] @ B
-    zero = ybar[:, None] - mu @ B
-    zero[cnt == 0] = first[cnt == 0][:, None]
-    return zero[rr] + Zs[rows] @ B
+def _centres(parts, block, anchored):
+    """The held-out fold's Gram matrix of ``Zs - m[run]`` (m the fit's run means, or 0 where
+    the fold is predicted from each run's first reading) and ``m``."""
+    mu, cnt = parts[0], parts[1]
+    G, S, n = block
+    m = np.zeros_like(mu) if anchored else np.where(cnt[:, None] > 0, mu, 0.0)
+    return G - S.T @ m - m.T @ S + (m.T * n) @ m, m
 
 
-def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict) -> dict:
-    """The regularised fit of one channel ``y`` (N,) um on the bank ``Z[:, keep]`` (N, p)
-    (unit-RMS columns ``cols``), judged on the blocked ``fold`` (rule ``rule``).  Returns
-    {"pred" (N,) every reading by the fit on all training readings, "cv_resid" (N,) NaN off
-    training, "lambda_rel", "edf" (effective number of coefficients, ``sum e/(e + lambda)``),
-    "n_columns", "penalty"}."""
+def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict, grams=None) -> dict:
+    """The regularised fit of one channel ``y`` (N,) um on the bank ``Z[:, keep]`` (unit-RMS
+    columns ``cols``), judged on the blocked ``fold`` (rule ``rule``); ``grams`` the folds'
+    ``Z_k' Z_k`` if known (:func:`_blocks`).  Returns {"pred" (N,) every reading by the fit
+    on all training readings, "cv_resid" (N,) NaN off training, "lambda_rel", "edf"
+    (effective number of coefficients, ``sum e/(e + lambda)``), "n_columns", "penalty"}."""
     n_runs, run, tr = len(s.runs), s.run, s.train
-    K = int(fold.max()) + 1
+    K, anchored = int(fold.max()) + 1, basis.whole_runs(rule)
     if "shrink_Z" not in cache:
-        cache["shrink_Z"] = Zs = Z[:, keep] / np.sqrt(weights(cols, fold_time(s, fold)))
-        cache["shrink_blocks"] = _blocks(Zs, run, n_runs, fold)
-        cache["shrink_eig"] = [_decompose(cache["shrink_blocks"], k) for k in range(-1, K)]
+        scale = 1.0 / np.sqrt(weights(cols, fold_time(s, fold)))
+        cache["shrink_Z"] = Zs = Z[:, keep] * scale
+        blocks = _blocks(Zs, run, n_runs, fold, grams, keep, scale)
+        cache["shrink_eig"] = eig = [_decompose(blocks, k) for k in range(-1, K)]
+        cache["shrink_test"] = [(blocks[k],) + _centres(eig[k + 1], blocks[k], anchored)
+                                for k in range(K)]
     Zs, eig = cache["shrink_Z"], cache["shrink_eig"]
-    zy = [Zs[fold == k].T @ y[fold == k] for k in range(K)]
-    ys = [np.bincount(run[fold == k], y[fold == k], n_runs) for k in range(K)]
+    idx = [np.flatnonzero(fold == k) for k in range(K)]
+    zy = [Zs[i].T @ y[i] for i in idx]
+    ys = [np.bincount(run[i], y[i], n_runs) for i in idx]
     lams = LAMBDAS * float(tr.sum())
     first = y[s.firsts()]
-    resid = np.full((len(y), len(lams)), np.nan)
-    for k in range(K):
-        rows = fold == k
-        others = [j for j in range(K) if j != k]
-        pred = _path(eig[k + 1], sum(zy[j] for j in others), sum(ys[j] for j in others), Zs,
-                     run, rows, basis.whole_runs(rule), first, lams)
-        resid[rows] = y[rows][:, None] - pred
-    mse = np.mean(resid[tr] ** 2, axis=0)
+    sse = np.zeros(len(lams))
+    for k in range(K):           # the fold's SSE for every lambda from cross-products
+        mu, cnt, e, V = eig[k + 1]
+        (_, S, n), Gt, m = cache["shrink_test"][k]
+        ysum = sum(ys[j] for j in range(K) if j != k)
+        B = V @ ((V.T @ (sum(zy[j] for j in range(K) if j != k) - mu.T @ ysum))[:, None]
+                 / (e[:, None] + lams[None, :]))
+        c = first if anchored else np.where(cnt > 0, ysum / np.maximum(cnt, 1.0), first)
+        h = zy[k] - S.T @ c - m.T @ ys[k] + m.T @ (n * c)
+        yy = float(y[idx[k]] @ y[idx[k]]) - 2 * c @ ys[k] + n @ c ** 2
+        sse += yy - 2 * B.T @ h + np.einsum("il,il->l", B, Gt @ B)
     i = len(lams) - 1                       # from the most shrunk: a tie keeps the larger
     for j in range(len(lams) - 2, -1, -1):
-        if mse[j] < mse[i] * (1 - TIE_SCORE_REL):
+        if sse[j] < sse[i] * (1 - TIE_SCORE_REL):
             i = j
-    pred = _path(eig[0], sum(zy), sum(ys), Zs, run, np.ones(len(y), bool), False, first,
-                 lams[i:i + 1])
+    resid = np.full(len(y), np.nan)
+    for k in range(K):
+        pred = _predict(eig[k + 1], sum(zy[j] for j in range(K) if j != k),
+                        sum(ys[j] for j in range(K) if j != k), Zs, run, idx[k], anchored,
+                        first, lams[i])
+        resid[idx[k]] = y[idx[k]] - pred
+    pred = _predict(eig[0], sum(zy), sum(ys), Zs, run, slice(None), False, first, lams[i])
     e = eig[0][2]
-    return {"pred": pred[:, 0], "cv_resid": resid[:, i], "lambda_rel": float(LAMBDAS[i]),
+    return {"pred": pred, "cv_resid": resid, "lambda_rel": float(LAMBDAS[i]),
             "edf": float(np.sum(e / (e + lams[i]))), "n_columns": len(keep),
             "penalty": "ridge, weights (1 + tau/T)^2, T = a fold's share of the training "
                        "time; lambda of least blocked-CV mean square"}
+
+
+def _predict(parts, zy, ysum, Zs, run, rows, anchored, first, lam):
+    """Predictions of the readings ``rows`` by the fit whose cross-products are ``parts``
+    (:func:`_decompose`), ``zy`` (``Zs' y`` over its readings) and ``ysum`` (per-run sums of
+    ``y`` there) at ``lam``; ``anchored``: from each run's first reading, else from the run's
+    fitted zero (a run without fitting readings: its first reading)."""
+    mu, cnt, e, V = parts
+    b = V @ ((V.T @ (zy - mu.T @ ysum)) / (e + lam))
+    rr = run[rows]
+    if anchored:
+        return first[rr] + Zs[rows] @ b
+    zero = np.where(cnt > 0, ysum / np.maximum(cnt, 1.0) - mu @ b, first)
+    return zero[rr] + Zs[rows] @ b
