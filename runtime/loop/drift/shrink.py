@@ -110,16 +110,16 @@ def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict, grams=None) -> dict:
     (effective number of coefficients, ``sum e/(e + lambda)``), "n_columns", "penalty"}."""
     n_runs, run, tr = len(s.runs), s.run, s.train
     K, anchored = int(fold.max()) + 1, basis.whole_runs(rule)
-    if "shrink_Z" not in cache:
-        scale = 1.0 / np.sqrt(weights(cols, fold_time(s, fold)))
-        cache["shrink_Z"] = Zs = Z[:, keep] * scale
-        blocks = _blocks(Zs, run, n_runs, fold, grams, keep, scale)
+    if "shrink_eig" not in cache:
+        cache["shrink_scale"] = scale = 1.0 / np.sqrt(weights(cols, fold_time(s, fold)))
+        blocks = _blocks(None if grams is not None else Z[:, keep] * scale, run, n_runs,
+                         fold, grams, keep, scale)
         cache["shrink_eig"] = eig = [_decompose(blocks, k) for k in range(-1, K)]
         cache["shrink_test"] = [(blocks[k],) + _centres(eig[k + 1], blocks[k], anchored)
                                 for k in range(K)]
-    Zs, eig = cache["shrink_Z"], cache["shrink_eig"]
+    scale, eig = cache["shrink_scale"], cache["shrink_eig"]
     idx = [np.flatnonzero(fold == k) for k in range(K)]
-    zy = [Zs[i].T @ y[i] for i in idx]
+    zy = [(_rows(Z, i).T @ y[i])[keep] * scale for i in idx]       # Zs' y over each fold
     ys = [np.bincount(run[i], y[i], n_runs) for i in idx]
     lams = LAMBDAS * float(tr.sum())
     first = y[s.firsts()]
@@ -138,13 +138,15 @@ def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict, grams=None) -> dict:
     for j in range(len(lams) - 2, -1, -1):
         if sse[j] < sse[i] * (1 - TIE_SCORE_REL):
             i = j
+    bank = (Z, keep, scale)
     resid = np.full(len(y), np.nan)
     for k in range(K):
         pred = _predict(eig[k + 1], sum(zy[j] for j in range(K) if j != k),
-                        sum(ys[j] for j in range(K) if j != k), Zs, run, idx[k], anchored,
-                        first, lams[i])
+                        sum(ys[j] for j in range(K) if j != k), bank, run, anchored, first,
+                        lams[i], idx[k])
         resid[idx[k]] = y[idx[k]] - pred
-    pred = _predict(eig[0], sum(zy), sum(ys), Zs, run, slice(None), False, first, lams[i])
+    pred = _predict(eig[0], sum(zy), sum(ys), bank, run, False, first, lams[i],
+                    np.arange(len(y)))
     e = eig[0][2]
     return {"pred": pred, "cv_resid": resid, "lambda_rel": float(LAMBDAS[i]),
             "edf": float(np.sum(e / (e + lams[i]))), "n_columns": len(keep),
@@ -152,15 +154,25 @@ def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict, grams=None) -> dict:
                        "time; lambda of least blocked-CV mean square"}
 
 
-def _predict(parts, zy, ysum, Zs, run, rows, anchored, first, lam):
-    """Predictions of the readings ``rows`` by the fit whose cross-products are ``parts``
-    (:func:`_decompose`), ``zy`` (``Zs' y`` over its readings) and ``ysum`` (per-run sums of
-    ``y`` there) at ``lam``; ``anchored``: from each run's first reading, else from the run's
-    fitted zero (a run without fitting readings: its first reading)."""
+def _rows(Z, i):
+    """``Z[i]`` for sorted row indices ``i``: a view where they are contiguous (a fold of
+    stretches in one run), no copy of the design."""
+    return Z[i[0]:i[-1] + 1] if len(i) and i[-1] - i[0] + 1 == len(i) else Z[i]
+
+
+def _predict(parts, zy, ysum, bank, run, anchored, first, lam, rows):
+    """Predictions of the readings ``rows`` (sorted indices) by the fit whose cross-products
+    are ``parts`` (:func:`_decompose`), ``zy`` (``Zs' y`` over its readings) and ``ysum``
+    (per-run sums of ``y`` there) at ``lam``; ``bank`` (Z, keep, scale): ``Zs = Z[:, keep]
+    scale``; ``anchored``: from each run's first reading, else from the run's fitted zero (a
+    run without fitting readings: its first reading)."""
     mu, cnt, e, V = parts
+    Z, keep, scale = bank
     b = V @ ((V.T @ (zy - mu.T @ ysum)) / (e + lam))
-    rr = run[rows]
+    full = np.zeros(Z.shape[1])
+    full[keep] = b * scale
+    terms = _rows(Z, rows) @ full
     if anchored:
-        return first[rr] + Zs[rows] @ b
+        return first[run[rows]] + terms
     zero = np.where(cnt > 0, ysum / np.maximum(cnt, 1.0) - mu @ b, first)
-    return zero[rr] + Zs[rows] @ b
+    return zero[run[rows]] + terms
