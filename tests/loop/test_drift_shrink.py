@@ -6,8 +6,8 @@
   rows ``sqrt(lambda w_j)`` (the run zeros unpenalised), with the weights
   ``(1 + tau/T)^2`` and ``T`` (training time over the folds) computed here; its lambda is the
   grid's least CV mean square recomputed here; its prediction is the refit on all training
-  readings; for folds of stretches (one run) and of whole runs (four runs, the last held out, each predicted
-  from its first reading);
+  readings; for folds of stretches (one run) and of whole runs (four runs, the last held
+  out, each predicted from its first reading);
 * the rule of :func:`volerr.loop.drift.family.choose` with the fourth candidate: a
   regularised fit significantly below everything is the model (the lag model's terms still
   named when the lag model beats both baselines), one far worse leaves the lag model, one
@@ -155,7 +155,8 @@ def test_the_rule_with_the_regularised_fit():
     half = _choice("lag", lambda r: 0.5 * r["lag"])    # far below everything
     assert half["family"] == "regularised" and half["named"]
     assert half["t"]["lag_vs_regularised"] < half["t_crit"]
-    v = family.verdict("regularised", half["cv_rms_um"], half["t"], True, half["t_crit"])
+    v = family.verdict("regularised", half["cv_rms_um"], half["t"], True, half["t_crit"],
+                       named=True)
     assert "not the regularised fit" in v and "named" in v
     worse = _choice("lag", lambda r: 3.0 * r["lag"])   # far above the lag model
     assert worse["family"] == "lag" and worse["named"]
@@ -163,7 +164,8 @@ def test_the_rule_with_the_regularised_fit():
     assert same["family"] == "lag"
     noise = _choice("noise", lambda r: 0.5 * r["constant"])
     assert noise["family"] == "regularised" and not noise["named"]
-    v = family.verdict("regularised", noise["cv_rms_um"], noise["t"], True, noise["t_crit"])
+    v = family.verdict("regularised", noise["cv_rms_um"], noise["t"], True, noise["t_crit"],
+                       named=False)
     assert "names no effect" in v
 
 

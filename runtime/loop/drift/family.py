@@ -11,6 +11,13 @@ reading, a fold of stretches from the run's zero fitted on the other stretches):
   the run's start) plus a zero per run, ridge-free least squares on the training readings;
 * ``lag``: the terms the selection chose (heat input and sensors through lags).
 
+A fourth candidate, ``regularised`` (:mod:`volerr.loop.drift.shrink`): every column the
+lag selection may take at once, shrunk by ridge with weights growing with the lag; it is the
+channel's model where its CV error is significantly below both baselines' (the rule below),
+unless the lag model's is significantly below its own as well; the lag model's terms are
+named wherever the lag model beats both baselines (``named``), even where the regularised
+fit predicts (it names no effect itself).
+
 The rule (:func:`volerr.selection.rules.significantly_below`): every fold's CV residuals are
 cut into ``SUB_BLOCKS`` consecutive blocks (nearly equal: on FL_THERMAL 35-50 min of readings)
 and the lag model is the channel's model only when, against each baseline, the paired t over
@@ -168,8 +175,10 @@ def interval(cv_resid, y, pred, fold, test) -> dict:
                       "|CV residual| of the chosen model"}
 
 
-def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) -> str:
-    """One sentence: which model the channel reports, and why."""
+def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float,
+            named: bool = False) -> str:
+    """One sentence: which model the channel reports, and why (``named``: the lag model's
+    terms are named, :func:`choose`)."""
     reg = "regularised" in cv_rms
     figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, "
             + (f"regularised fit {cv_rms['regularised']:.3f}, " if reg else "")
@@ -183,9 +192,10 @@ def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) 
     what = " and the ".join(RIVAL[b] for b in lost)
     why = (f"no lag term earns a place" if not has_terms else
            f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f})")
-    if family == "regularised" and lost == ["regularised"]:
+    if family == "regularised" and named:
+        tr = t["lag_vs_regularised"]
         return (f"the lag model beats both baselines significantly but not the regularised "
-                f"fit over the lag bank (paired t {worst:.2f} < {t_crit:.2f}; {figs}): the "
+                f"fit over the lag bank (paired t {tr:.2f} < {t_crit:.2f}; {figs}): the "
                 f"model is {NAMES['regularised']}; the lag model's terms are named as the "
                 f"diagnosis")
     if family == "regularised":

@@ -24,7 +24,9 @@ Steps (:func:`run_drift`):
 6. the prediction of every reading: a training run with its fitted zero, a held-out run with
    its own zero (its first reading) and its own inputs; beside it the shop's usual model, a
    static multiple linear regression on all temperatures (their change since the run's
-   start), fitted on the same training readings.
+   start), fitted on the same training readings, and the regularised fit over every column
+   the selection may take (:mod:`volerr.loop.drift.shrink`); the channel's model is chosen
+   among them and the constant by :func:`volerr.loop.drift.family.choose`.
 
 Units: displacements um, temperatures degC (changes in K), time s, speed rpm.
 """

@@ -143,7 +143,7 @@ def _choice(choice, has_terms) -> dict:
             "selection_rule": choice["rule"],
             "t_critical": round(choice["t_crit"], 3),
             "verdict": family.verdict(choice["family"], choice["cv_rms_um"], choice["t"],
-                                      has_terms, choice["t_crit"])}
+                                      has_terms, choice["t_crit"], choice["named"])}
 
 
 def _family(s, label, p, r) -> dict:
