@@ -167,7 +167,10 @@ def _param(name):
 #: mean square far below both baselines'), so no choice among the three families fixes them
 #: (measured: ch5 40-60 % 4.45 vs 2.91 um, ch2 80-100 % 3.41 vs a constant's 2.32 um).
 #: Strict: a fix makes the test fail until this list is updated.
-KNOWN_GAPS = {("40-60", "ch5"): True, ("80-100", "ch2"): True}
+#: Issue 44 item 1 (a fourth candidate, the regularised fit over the lag bank): 80-100 % ch2
+#: 1.81 um (the regularised fit); 40-60 % ch5 stays (the lag model is significantly below the
+#: regularised fit there too: 4.44 um).
+KNOWN_GAPS = {("40-60", "ch5"): True}
 
 
 def _pair(name, channel):
@@ -226,11 +229,15 @@ def test_never_worse_than_the_better_baseline(loop_runs, table, name, channel):
     assert c["baselines"]["static"]["mae_um"] == pytest.approx(static, rel=STATIC_AGREE_REL)
     assert c["baselines"]["constant"]["mae_um"] == pytest.approx(const, rel=1e-6)
     mine = loop_mae(table, rows, channel, name)
-    assert c["family"] in ("lag", "static", "constant")
-    if c["family"] != "lag":      # the baseline IS the channel's model, and no effect of it
+    assert c["family"] in ("lag", "regularised", "static", "constant")
+    if c["family"] in ("static", "constant"):  # the baseline IS the model, and no effect of it
         assert mine == pytest.approx(c["baselines"][c["family"]]["mae_um"], rel=1e-6)
         assert not [e for e in doc["effects"] if e["channels"] == [channel]]
         assert "no lag model beats" in c["verdict"]
+    if c["family"] == "regularised":     # its figures are the channel's; effects only if named
+        assert mine == pytest.approx(c["regularised"]["mae_um"], rel=1e-6)
+        named = [e for e in doc["effects"] if e["channels"] == [channel]]
+        assert bool(named) == c["lag_terms_named"]
     best = min(static, const)
     assert mine <= STATIC_FACTOR * best + STATIC_SLACK_UM, (
         f"window {name} %, {channel} ({c['family']}): MAE {mine:.3f} um > {STATIC_FACTOR} x "

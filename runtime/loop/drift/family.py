@@ -11,6 +11,13 @@ reading, a fold of stretches from the run's zero fitted on the other stretches):
   the run's start) plus a zero per run, ridge-free least squares on the training readings;
 * ``lag``: the terms the selection chose (heat input and sensors through lags).
 
+A fourth candidate, ``regularised`` (:mod:`volerr.loop.drift.shrink`): every column the
+lag selection may take at once, shrunk by ridge with weights growing with the lag; it is the
+channel's model where its CV error is significantly below both baselines' (the rule below),
+unless the lag model's is significantly below its own as well; the lag model's terms are
+named wherever the lag model beats both baselines (``named``), even where the regularised
+fit predicts (it names no effect itself).
+
 The rule (:func:`volerr.selection.rules.significantly_below`): every fold's CV residuals are
 cut into ``SUB_BLOCKS`` consecutive blocks (nearly equal: on FL_THERMAL 35-50 min of readings)
 and the lag model is the channel's model only when, against each baseline, the paired t over
@@ -57,7 +64,10 @@ SUB_BLOCKS = 8
 LEVEL = 0.95
 NAMES = {"constant": "a constant (each run's zero)",
          "static": "the static regression on all temperatures",
-         "lag": "the lag model"}
+         "lag": "the lag model",
+         "regularised": "the regularised fit over the lag bank"}
+RIVAL = {"static": "static regression", "constant": "constant",
+         "regularised": "regularised fit over the lag bank"}
 
 
 def cv_residuals(ch, D) -> np.ndarray:
@@ -92,34 +102,59 @@ def block_mse(fold, r, sub: int = SUB_BLOCKS) -> np.ndarray:
     return np.array(out)
 
 
-def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
+def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
+           regularised=None) -> dict:
     """The family of the channel by the module's rule: ``designs`` family -> design matrix;
     ``has_terms`` False: the lag model has no term (it is the constant); ``nested``: its
     terms are plain temperatures (no lag, no heat input): a sub-model of the static
-    regression, which then must be significantly below it to be preferred.  Returns
+    regression, which then must be significantly below it to be preferred;
+    ``regularised``: the blocked-CV residuals (N,) of the regularised fit over the lag bank
+    (:mod:`volerr.loop.drift.shrink`), a fourth candidate (None: three).  Returns
     {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
-    "lag_vs_static"}, "rule", "cv_resid" (N,) of the chosen family}."""
+    "lag_vs_static"; with the fourth "regularised_vs_constant", "regularised_vs_static",
+    "lag_vs_regularised"}, "rule", "cv_resid" (N,) of the chosen family}."""
     resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
+    if regularised is not None:
+        resid["regularised"] = regularised
     mse = {f: block_mse(ch.fold, r) for f, r in resid.items()}
     tr = ch.fold >= 0
     cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
-    t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a])
-         for a, b in (("static", "constant"), ("lag", "constant"), ("lag", "static"))}
+    pairs = [("static", "constant"), ("lag", "constant"), ("lag", "static")]
+    if regularised is not None:
+        pairs += [("regularised", "constant"), ("regularised", "static"),
+                  ("lag", "regularised")]
+    t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a]) for a, b in pairs}
     # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
     fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
+    reg_ok = regularised is not None and all(significantly_below(mse["regularised"], mse[b])
+                                             for b in ("static", "constant"))
+    if reg_ok:
+        fam = "regularised"
     # a lag model of plain temperatures only is a sub-model of the static regression: there
     # the static regression is the more complex one and must beat it significantly
     beats_static = (not significantly_below(mse["static"], mse["lag"]) if nested else
                     significantly_below(mse["lag"], mse["static"]))
-    if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static:
+    named = has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static
+    if named and (not reg_ok or significantly_below(mse["lag"], mse["regularised"])):
         fam = "lag"
     K = len(mse["lag"])
-    return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
-            "cv_resid": resid[fam],
-            "rule": f"lag model only if, against each baseline, the paired t over {K} blocks "
-                    f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
-                    f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
-                    f"baseline of lower CV mean square"}
+    return {"family": fam, "named": named and fam in ("lag", "regularised"),
+            "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
+            "cv_resid": resid[fam], "rule": _rule_text(K, regularised is not None)}
+
+
+def _rule_text(K: int, regularised: bool) -> str:
+    if not regularised:
+        return (f"lag model only if, against each baseline, the paired t over {K} blocks "
+                f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
+                f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
+                f"baseline of lower CV mean square")
+    return (f"the regularised fit over the lag bank if, against each baseline, the paired t "
+            f"over {K} blocks ({SUB_BLOCKS} per blocked CV fold) of (baseline's - its CV mean "
+            f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df), unless the lag model "
+            f"is so below it; the lag model if so below each baseline (its terms named "
+            f"wherever it is, the prediction the regularised fit's unless the lag model beats "
+            f"it too); else the baseline of lower CV mean square")
 
 
 def interval(cv_resid, y, pred, fold, test) -> dict:
@@ -140,16 +175,33 @@ def interval(cv_resid, y, pred, fold, test) -> dict:
                       "|CV residual| of the chosen model"}
 
 
-def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float) -> str:
-    """One sentence: which model the channel reports, and why."""
-    figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, static regression {cv_rms['static']:.3f}, "
-            f"constant {cv_rms['constant']:.3f} um")
+def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float,
+            named: bool = False) -> str:
+    """One sentence: which model the channel reports, and why (``named``: the lag model's
+    terms are named, :func:`choose`)."""
+    reg = "regularised" in cv_rms
+    figs = (f"CV RMS lag model {cv_rms['lag']:.3f}, "
+            + (f"regularised fit {cv_rms['regularised']:.3f}, " if reg else "")
+            + f"static regression {cv_rms['static']:.3f}, constant {cv_rms['constant']:.3f} um")
     if family == "lag":
-        return f"the lag model beats both baselines significantly ({figs})"
-    if not has_terms:
-        return f"no lag term earns a place: the model is {NAMES[family]} ({figs})"
-    lost = [b for b in ("static", "constant") if not t[f"lag_vs_{b}"] >= t_crit] or ["static"]
-    what = " and the ".join("static regression" if b == "static" else "constant" for b in lost)
+        return (f"the lag model beats both baselines{' and the regularised fit' if reg else ''}"
+                f" significantly ({figs})")
+    rivals = ("static", "constant") + (("regularised",) if reg else ())
+    lost = [b for b in rivals if not t[f"lag_vs_{b}"] >= t_crit] or ["static"]
     worst = min(t[f"lag_vs_{b}"] for b in lost)
+    what = " and the ".join(RIVAL[b] for b in lost)
+    why = (f"no lag term earns a place" if not has_terms else
+           f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f})")
+    if family == "regularised" and named:
+        tr = t["lag_vs_regularised"]
+        return (f"the lag model beats both baselines significantly but not the regularised "
+                f"fit over the lag bank (paired t {tr:.2f} < {t_crit:.2f}; {figs}): the "
+                f"model is {NAMES['regularised']}; the lag model's terms are named as the "
+                f"diagnosis")
+    if family == "regularised":
+        return (f"{why}; {NAMES['regularised']} beats both baselines significantly ({figs}): "
+                f"the model is {NAMES['regularised']} (it names no effect)")
+    if not has_terms:
+        return f"{why}: the model is {NAMES[family]} ({figs})"
     return (f"no lag model beats the {what} here (paired t {worst:.2f} < {t_crit:.2f}; {figs}):"
             f" the model is {NAMES[family]}")

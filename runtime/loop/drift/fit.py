@@ -24,7 +24,9 @@ Steps (:func:`run_drift`):
 6. the prediction of every reading: a training run with its fitted zero, a held-out run with
    its own zero (its first reading) and its own inputs; beside it the shop's usual model, a
    static multiple linear regression on all temperatures (their change since the run's
-   start), fitted on the same training readings.
+   start), fitted on the same training readings, and the regularised fit over every column
+   the selection may take (:mod:`volerr.loop.drift.shrink`); the channel's model is chosen
+   among them and the constant by :func:`volerr.loop.drift.family.choose`.
 
 Units: displacements um, temperatures degC (changes in K), time s, speed rpm.
 """
@@ -43,6 +45,7 @@ from ...selection.rules import CV_GAIN, SIG_K, TIE_SCORE_REL
 from . import basis
 from . import family
 from . import select as sel
+from . import shrink
 from .engine import Engine
 
 __all__ = ["HEAT_TERMS", "REFINE", "RECENTRE", "SIG_K", "Channel", "column", "predict",
@@ -129,13 +132,26 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     specs, fit = _significant(ch, specs)
     Ds = _static_design(ch)
     tr = ch.s.train
+    reg = _regularised(ch, cols, Z, cands, cache)
     out = {"terms": specs, "fit": fit, "y": ch.y,
            "static": predict(ch.s, Ds, _fit(Ds, ch.y, tr), ch.y),
            "constant": predict(ch.s, ch.R, _fit(ch.R, ch.y, tr), ch.y),
+           "regularised": reg["pred"], "shrink": reg,
            "before": ch.y[ch.s.firsts()][ch.s.run]}
     out["choice"] = family.choose(ch, {"constant": ch.R, "static": Ds, "lag": fit["design"]},
-                                  bool(specs), _nested_in_static(specs))
+                                  bool(specs), _nested_in_static(specs),
+                                  regularised=reg["cv_resid"])
     return out
+
+
+def _regularised(ch: Channel, cols, Z, cands, cache) -> dict:
+    """The regularised fit over the columns the selection may take (every single column of
+    ``cands``; :mod:`volerr.loop.drift.shrink`)."""
+    keep = sorted({int(a) for c in cands for a, b in c if b < 0})
+    grams = [cache[("fit", k)] for k in range(int(ch.fold.max()) + 1)] \
+        if ("fit", 0) in cache else None         # the engine's cross-products of the folds
+    return shrink.fit(ch.s, ch.y, Z, [ch.n_runs + j for j in keep], [cols[j] for j in keep],
+                      ch.fold, ch.rule, cache, grams)
 
 
 def _backward(ch: Channel, specs) -> list:

@@ -130,7 +130,7 @@ class DriftReport(ResultMixin):
             for t in e["terms"]:
                 out.append("    " + _term_line(t))
         for n in d.get("not_reported", []):
-            out.append(f"  lag term not reported (its channel's model is a baseline): {n}")
+            out.append(f"  lag term not reported (the lag model does not beat both baselines): {n}")
         for n in d["not_significant"]:
             out.append(f"  not significant (|value| < {SIG_K:g} u), left out: {n}")
         return out
@@ -143,7 +143,9 @@ def _family_lines(c: dict) -> list:
     b = c.get("baselines", {})
     line = (f"    model: {c['family']}; held-out MAE of the baselines: static regression "
             f"{b['static']['mae_um']:.3f}, constant {b['constant']['mae_um']:.3f} um; lag model "
-            f"{c['lag_model']['mae_um']:.3f} um")
+            f"{c['lag_model']['mae_um']:.3f} um"
+            + (f", regularised fit over the lag bank {c['regularised']['mae_um']:.3f} um"
+               if "regularised" in c else ""))
     out = [line]
     if c.get("verdict"):
         out.append(f"    {c['verdict']}")

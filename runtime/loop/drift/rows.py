@@ -175,7 +175,7 @@ def run_constant(s: basis.DriftSeries, e: np.ndarray) -> np.ndarray:
 
 
 #: the model families, simplest first (a channel of rows: the most complex of its quantities')
-FAMILY_ORDER = ("constant", "static", "lag")
+FAMILY_ORDER = ("constant", "static", "regularised", "lag")
 
 
 def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict:
@@ -188,7 +188,7 @@ def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict
         y = s.channels[k]
         p = {"before": y[s.firsts()][s.run], "terms": [], "quantities": []}
         on = [(j, q) for j, q in enumerate(rows.quantities) if rows.A[i, j] != 0]
-        for name in ("after", "static", "constant", "lag"):
+        for name in ("after", "static", "constant", "regularised", "lag"):
             p[name] = c + sum(rows.A[i, j] * qpred[q.symbol][name] for j, q in on)
         # the channel's CV residual: its row of the quantities' plus its own row residual
         p["cv_resid"] = resid[k] - c + sum(rows.A[i, j] * qpred[q.symbol]["cv_resid"]

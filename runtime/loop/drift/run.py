@@ -90,7 +90,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
     for label, r in res["channels"].items():
         if label in quantity:
             data["quantities"][label].update(_choice(r["choice"], bool(r["terms"])))
-        if r["choice"]["family"] != "lag":
+        if not r["choice"]["named"]:
             data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]]
             continue
         data["effects"] += _effects(label, r, m, quantity.get(label), data["budgets"])
@@ -122,8 +122,9 @@ def _prediction(m, r) -> dict:
     lag = core.predict(m, f["design"], np.concatenate([f["zeros"], f["coef"]]), r["y"])
     fam = c["family"]
     return {"before": r["before"], "lag": lag, "after": lag if fam == "lag" else r[fam],
-            "static": r["static"], "constant": r["constant"], "cv_resid": c["cv_resid"],
-            "family": fam, "terms": r["terms"] if fam == "lag" else []}
+            "static": r["static"], "constant": r["constant"], "regularised": r["regularised"],
+            "cv_resid": c["cv_resid"], "family": fam,
+            "terms": r["terms"] if c["named"] else []}
 
 
 def _quantity(q, rows) -> dict:
@@ -136,13 +137,13 @@ def _quantity(q, rows) -> dict:
 
 def _choice(choice, has_terms) -> dict:
     """The family chosen for a label and why (:mod:`volerr.loop.drift.family`)."""
-    return {"family": choice["family"],
+    return {"family": choice["family"], "lag_terms_named": bool(choice["named"]),
             "cv_rms_um": {k: round(v, 6) for k, v in choice["cv_rms_um"].items()},
             "paired_t": {k: round(v, 3) for k, v in choice["t"].items()},
             "selection_rule": choice["rule"],
             "t_critical": round(choice["t_crit"], 3),
             "verdict": family.verdict(choice["family"], choice["cv_rms_um"], choice["t"],
-                                      has_terms, choice["t_crit"])}
+                                      has_terms, choice["t_crit"], choice["named"])}
 
 
 def _family(s, label, p, r) -> dict:
@@ -150,18 +151,23 @@ def _family(s, label, p, r) -> dict:
     rows: the most complex of its quantities') and its prediction interval."""
     y, te = s.channels[label], s.test
     figs = {}
-    for name in ("static", "constant", "lag"):
+    for name in ("static", "constant", "lag", "regularised"):
         e = (y - p[name])[te]
         figs[name] = {"mae_um": float(np.mean(np.abs(e))),
                       "rms_um": float(np.sqrt(np.mean(e ** 2))),
                       "max_abs_um": float(np.max(np.abs(e)))}
     out = {"baselines": {"static": figs["static"], "constant": figs["constant"]},
-           "lag_model": figs["lag"]}
+           "lag_model": figs["lag"], "regularised": figs["regularised"]}
     if r is not None:
         out.update(_choice(r["choice"], bool(r["terms"])))
         for name in ("static", "constant"):
             out["baselines"][name]["cv_rms_um"] = out["cv_rms_um"][name]
         out["lag_model"]["cv_rms_um"] = out["cv_rms_um"]["lag"]
+        sh = r["shrink"]
+        out["regularised"].update({"cv_rms_um": out["cv_rms_um"]["regularised"],
+                                   "lambda_rel": sh["lambda_rel"],
+                                   "edf": round(sh["edf"], 3), "n_columns": sh["n_columns"],
+                                   "penalty": sh["penalty"]})
     else:
         out["family"] = p["family"]
     out["interval"] = family.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te)
