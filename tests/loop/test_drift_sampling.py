@@ -19,8 +19,8 @@ sampling (240 s) is not resolved at 60 s: there it stands for the plain source a
 Two terms agree when their groups share a source whose time-constant ranges overlap.  A
 channel-window agrees when both samplings report the same family and every reported term
 of each agrees with a term of the other.  Where they do not (measured when this test was
-written: 13 of 30, 14 with the regularised family), the channel-window is listed in ``DIFFERENT`` (strict: a fix makes the
-test fail until the list is updated).
+written: 13 of 30; 14 with the regularised family), the channel-window is listed in
+``DIFFERENT`` (strict: a fix makes the test fail until the list is updated).
 """
 
 from __future__ import annotations
