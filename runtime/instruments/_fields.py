@@ -337,3 +337,170 @@ def covariates(find: Finder, model, where: str, skip=()) -> dict:
     require(not missing, f"{where}: layout {model.name} needs covariate column "
             f"{missing[0] if missing else ''}")
     return covs
+
+
+# --- faulty sensors: a reading frozen, an offset step (the logger's own noise as the scale) ---
+#
+# The scale of a sensor is its own reading-to-reading scatter, estimated robustly from the
+# second differences d2_i = v_{i+1} - 2 v_i + v_{i-1} (a smooth drift contributes almost
+# nothing to them): for white noise of std sigma, std(d2) = sqrt(6) sigma and the std of a
+# first difference about the local trend is sqrt(2) sigma = std(d2) / sqrt(3); std(d2) is
+# taken as 1.4826 median ``|d2|`` (the MAD of a zero-median variable, consistent for normal
+# noise; Rousseeuw & Croux 1993, JASA 88 1273; the difference-based noise estimate of
+# von Neumann's mean square successive difference, Ann. Math. Stat. 12 (1941) 367).  A
+# logger that loses its sensor holds the last value (a frozen stretch); a re-plugged or
+# re-seated sensor jumps (an offset step): the two faults of a data logger's quality checks
+# (e.g. WMO-No. 8 (2018) Vol. V 1.3.3 "step test" and "persistence test").
+
+#: a frozen stretch: at least this many equal readings in a row ...
+FROZEN_MIN_READINGS = 10
+#: ... and less likely than this under the sensor's own rate of equal consecutive readings
+#: elsewhere in the run (n p^L, p that rate, L the equal steps of the stretch)
+FROZEN_CHANCE = 1e-6
+#: an offset step: a reading-to-reading change beyond STEP_K robust stds of the sensor's own
+#: changes about its local trend (the median change over STEP_WINDOW readings each side) ...
+STEP_K = 12.0
+STEP_WINDOW = 10
+#: ... while no other logged input changes by more than SHARED_K of its own std at that
+#: reading or its neighbours (then the change is an event of the machine, not of the sensor)
+SHARED_K = 4.0
+
+
+def _longest_equal(v: np.ndarray) -> tuple[int, int]:
+    """(start, number of equal steps) of the longest stretch of equal consecutive readings."""
+    same = np.concatenate([[False], np.diff(v) == 0, [False]])
+    edges = np.flatnonzero(np.diff(same.astype(int)))
+    if not len(edges):
+        return 0, 0
+    starts, ends = edges[::2], edges[1::2]
+    k = int(np.argmax(ends - starts))
+    return int(starts[k]), int(ends[k] - starts[k])
+
+
+def change_scores(v) -> tuple[np.ndarray, float]:
+    """(z, s): every reading-to-reading change of ``v`` about its local trend in units of the
+    sensor's robust scale ``s`` (block comment above; z[i] the change from reading i to i+1;
+    ``s`` = 0 (a sensor without noise, e.g. a commanded speed): any change scores inf)."""
+    v = np.asarray(v, float)
+    d1 = np.diff(v)
+    if len(d1) < 3:
+        return np.zeros(len(d1)), 0.0
+    w = min(STEP_WINDOW, (len(d1) - 1) // 2)
+    pad = np.pad(d1, w, mode="edge")
+    trend = np.median(np.lib.stride_tricks.sliding_window_view(pad, 2 * w + 1), axis=1)
+    start, steps = _longest_equal(v)
+    keep = np.ones(len(v), bool)
+    keep[start:start + steps + 1] = steps == 0
+    d2 = np.diff(v[keep], 2) if keep.sum() > 2 else np.diff(v, 2)
+    s = 1.4826 * float(np.median(np.abs(d2))) / np.sqrt(3.0)
+    e = d1 - trend
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.where(e == 0, 0.0, np.abs(e) / s) if s > 0 else np.where(e == 0, 0.0, np.inf)
+    return z, s
+
+
+def frozen_stretch(v) -> tuple[int, int] | None:
+    """(first, last) reading index of a frozen stretch of ``v`` (the rule of
+    :data:`FROZEN_MIN_READINGS` and :data:`FROZEN_CHANCE`; the sensor must change elsewhere),
+    or None."""
+    v = np.asarray(v, float)
+    start, steps = _longest_equal(v)
+    if steps + 1 < FROZEN_MIN_READINGS:
+        return None
+    d1 = np.diff(v)
+    other = np.ones(len(d1), bool)
+    other[start:start + steps] = False
+    if not other.any() or not np.any(d1[other] != 0):
+        return None                     # never changes: the constant-sensor check's case
+    p = float(np.mean(d1[other] == 0))
+    return (start, start + steps) if len(d1) * p ** steps < FROZEN_CHANCE else None
+
+
+def sensor_faults(t, columns: dict, others: dict) -> list:
+    """The faults of the series ``columns`` {name: (N,)} of one run logged at ``t`` (N,) s:
+    [{"input", "fault": "frozen", "from_s", "to_s", "readings"}] and
+    [{"input", "fault": "step", "at_s", "step", "noise"}] (``step`` the jump in the column's
+    unit, ``noise`` the sensor's robust std of a reading-to-reading change), one per column
+    at most, frozen first.  ``others`` {name: (N,)} every logged input: a step shared with
+    another input (:data:`SHARED_K`) is no fault."""
+    t = np.asarray(t, float)
+    scores = {k: change_scores(v)[0] for k, v in others.items()}
+    out = []
+    for name, v in columns.items():
+        v = np.asarray(v, float)
+        fz = frozen_stretch(v)
+        if fz is not None:
+            out.append({"input": name, "fault": "frozen", "from_s": float(t[fz[0]]),
+                        "to_s": float(t[fz[1]]), "readings": int(fz[1] - fz[0] + 1)})
+            continue
+        step = _step(v, name, scores)
+        if step is not None:
+            i, s = step
+            out.append({"input": name, "fault": "step", "at_s": float(t[i + 1]),
+                        "step": float(v[i + 1] - v[i]), "noise": float(s)})
+    return out
+
+
+def _step(v: np.ndarray, name: str, scores: dict) -> tuple[int, float] | None:
+    """(i, s): the largest lasting change i -> i+1 of ``v`` beyond :data:`STEP_K` its scale
+    ``s`` that no other input shares (:data:`SHARED_K`), or None (lasting: :func:`_lasting`)."""
+    z, s = change_scores(v)
+    d1 = np.diff(v)
+    if not s > 0:               # no scatter (a coarse resolution): the resolution is the scale
+        nz = np.abs(d1[d1 != 0])
+        if not len(nz):
+            return None
+        s = float(nz.min())
+        z = np.abs(d1 - np.median(d1)) / s
+    for i in np.argsort(-z, kind="stable"):
+        if not z[i] > STEP_K:
+            return None
+        if not _lasting(v, int(i), s):
+            continue
+        lo, hi = max(i - 1, 0), i + 2
+        if any(np.any(zo[lo:hi] > SHARED_K) for k, zo in scores.items() if k != name):
+            continue
+        return int(i), s
+    return None
+
+
+def _lasting(v: np.ndarray, i: int, s: float) -> bool:
+    """The change i -> i+1 moves the level: the median of the :data:`STEP_WINDOW` readings
+    after it minus the median of those up to it (less the local trend over that span) has
+    the change's sign, at least half its size, and is beyond :data:`STEP_K` ``s`` itself (a
+    spike, a burst of noise or a change taken back soon after is no offset step)."""
+    w = STEP_WINDOW
+    if i + 1 - w < 0 or i + 1 + w > len(v):
+        w = min(i + 1, len(v) - i - 1)
+    if w < 2:
+        return False
+    d1 = np.diff(v)
+    near = np.concatenate([d1[max(i - w, 0):i], d1[i + 1:i + 1 + w]])
+    level = float(np.median(v[i + 1:i + 1 + w]) - np.median(v[i + 1 - w:i + 1])
+                  - w * np.median(near))
+    step = float(d1[i])
+    return (level * step > 0 and abs(level) >= 0.5 * abs(step) and abs(level) > STEP_K * s
+            and not _relaxes(v, i, step) and _quiet(v, i, s))
+
+
+def _relaxes(v: np.ndarray, i: int, step: float) -> bool:
+    """After the change the reading relaxes back (a door opened, a draught: the air is
+    replaced and warms again): over the next ``2 STEP_WINDOW`` readings it recovers more than
+    a quarter of the change against the trend before it."""
+    w = STEP_WINDOW
+    if i + 1 + 2 * w > len(v) or i - w < 0:
+        return False
+    d1 = np.diff(v)
+    back = (np.median(v[i + 1 + w:i + 1 + 2 * w]) - np.median(v[i + 1:i + 1 + w])
+            - w * np.median(d1[i - w:i]))
+    return back * step < 0 and abs(back) > 0.25 * abs(step)
+
+
+def _quiet(v: np.ndarray, i: int, s: float) -> bool:
+    """The sensor reads with its usual scatter round the change (a robust scale of its second
+    differences within ``STEP_WINDOW`` readings each side, the change's own left out, at most
+    3 ``s``): a change inside a burst of noise is no clean offset step."""
+    w = STEP_WINDOW
+    d2 = np.diff(v, 2)              # d2[j] centred on reading j + 1; the step touches i, i+1
+    near = np.r_[d2[max(i - w, 0):max(i - 1, 0)], d2[i + 1:i + 1 + w]]
+    return len(near) < 4 or 1.4826 * np.median(np.abs(near)) / np.sqrt(3.0) <= 3.0 * s
