@@ -361,8 +361,9 @@ FROZEN_CHANCE = 1e-6
 #: changes about its local trend (the median change over STEP_WINDOW readings each side) ...
 STEP_K = 12.0
 STEP_WINDOW = 10
-#: ... while no other logged input changes by more than SHARED_K of its own std at that
-#: reading or its neighbours (then the change is an event of the machine, not of the sensor)
+#: ... while no other logged input changes by more than SHARED_K of its own std (and half
+#: the step's own score) at that reading (then the change is an event of
+#: the machine, not of the sensor)
 SHARED_K = 4.0
 
 
@@ -457,8 +458,8 @@ def _step(v: np.ndarray, name: str, scores: dict) -> tuple[int, float] | None:
             return None
         if not _lasting(v, int(i), s):
             continue
-        lo, hi = max(i - 1, 0), i + 2
-        if any(np.any(zo[lo:hi] > SHARED_K) for k, zo in scores.items() if k != name):
+        shared = max(SHARED_K, 0.5 * float(z[i]))
+        if any(zo[i] > shared for k, zo in scores.items() if k != name):
             continue
         return int(i), s
     return None
@@ -485,15 +486,13 @@ def _lasting(v: np.ndarray, i: int, s: float) -> bool:
 
 def _relaxes(v: np.ndarray, i: int, step: float) -> bool:
     """After the change the reading relaxes back (a door opened, a draught: the air is
-    replaced and warms again): over the next ``2 STEP_WINDOW`` readings it recovers more than
-    a quarter of the change against the trend before it."""
-    w = STEP_WINDOW
-    if i + 1 + 2 * w > len(v) or i - w < 0:
+    replaced and warms again): over the ``2 STEP_WINDOW`` readings after the change its
+    least-squares slope runs against the change and undoes more than a quarter of it."""
+    after = v[i + 1:i + 1 + 2 * STEP_WINDOW]
+    if len(after) < 4:
         return False
-    d1 = np.diff(v)
-    back = (np.median(v[i + 1 + w:i + 1 + 2 * w]) - np.median(v[i + 1:i + 1 + w])
-            - w * np.median(d1[i - w:i]))
-    return back * step < 0 and abs(back) > 0.25 * abs(step)
+    slope = np.polyfit(np.arange(len(after)), after, 1)[0]
+    return slope * step < 0 and abs(slope) * len(after) > 0.25 * abs(step)
 
 
 def _quiet(v: np.ndarray, i: int, s: float) -> bool:
