@@ -358,6 +358,36 @@ def _text_inputs(c: Columns, skip) -> list:
     return notes
 
 
+def faults(run: DriftRun) -> list:
+    """The faulty sensors of a run (:func:`volerr.instruments._fields.sensor_faults`: a
+    temperature frozen or stepped against its own reading-to-reading scatter; a channel
+    frozen), each {"input", "fault", ..., "file", "run"}; a channel's fault is marked
+    ``"channel": True``.  A step of a channel is not judged: a machine's displacement jumps
+    when a spindle starts or stops (FL_THERMAL's channels do, unlogged in their speed)."""
+    temps = {h: v for h, v in run.inputs.items() if f.is_temperature(h)}
+    out = f.sensor_faults(run.t_s, temps, run.inputs)
+    for label, v in run.channels.items():
+        span = f.frozen_stretch(v)
+        if span is not None:
+            out.append({"input": f"d_{label}_um", "fault": "frozen", "channel": True,
+                        "from_s": float(run.t_s[span[0]]), "to_s": float(run.t_s[span[1]]),
+                        "readings": int(span[1] - span[0] + 1)})
+    for e in out:
+        e.update(file=run.file, run=run.run)
+    return out
+
+
+def fault_text(e: dict) -> str:
+    """One fault of :func:`faults` in words (times in s of the run's file)."""
+    where = e["file"] if not e.get("run") else f"{e['file']}[{e['run']}]"
+    if e["fault"] == "frozen":
+        return (f"{e['input']} frozen in {where} from t = {e['from_s']:.0f} s to "
+                f"{e['to_s']:.0f} s ({e['readings']} equal readings)")
+    return (f"{e['input']} steps by {e['step']:+.3g} at t = {e['at_s']:.0f} s in {where} "
+            f"({abs(e['step']) / e['noise']:.0f}x its reading-to-reading scatter "
+            f"{e['noise']:.2g})")
+
+
 def test_position(run: DriftRun, model) -> dict:
     """Every axis of ``model`` at the run's position (absent axes: middle of the travel,
     rotary axes 0 when inside it), inside the travel."""

@@ -117,9 +117,14 @@ def render_template(name: str, **context) -> str:
 
 def render_html(report) -> str:
     """The complete HTML text of a :class:`volerr.loop.drift.report.DriftReport`."""
+    from .series import left_out_line
+    from .split import extrapolation_line
+
+    d = report.data
     lines = report.summary_lines()
-    figs = {k: _channel_img(report, k) for k in report.data["channels"]}
-    return render_template("drift.html.j2", r=report.data, headline=lines[0].strip()
-                           if not report.data.get("extrapolation") else lines[1].strip(),
-                           extrapolation=lines[0].strip(), figures=figs, k=report.K_PRINT,
-                           sig_k=f"{SIG_K:g}")
+    figs = {k: _channel_img(report, k) for k in d["channels"]}
+    return render_template("drift.html.j2", r=d,
+                           headline=next(x for x in lines if not x.startswith(" ")).strip(),
+                           extrapolation=extrapolation_line(d.get("extrapolation") or []),
+                           left_out=left_out_line(d.get("inputs_left_out") or []),
+                           figures=figs, k=report.K_PRINT, sig_k=f"{SIG_K:g}")

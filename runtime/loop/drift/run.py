@@ -40,8 +40,8 @@ def loop_drift(layout: str, paths, window=None, files=(), differences: bool = Fa
 
     model = load(layout)
     named = {Path(p).resolve() for p in paths}
-    runs = read_runs(list(paths) + [f for f in files if Path(f).resolve() not in named])
-    s = stack_runs(runs)
+    runs, left = read_runs(list(paths) + [f for f in files if Path(f).resolve() not in named])
+    s = stack_runs(runs, left)
     s.test, said = held_out(s, window, files)
     directed = rows_mod.rows_of(s.directions, s.heights) is not None
     position = test_position(runs[0], model) if directed else {}
@@ -63,9 +63,8 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
             "budgets": {},
-            "not_significant": [], "not_reported": [], "static_regression": {},
-            "unidentifiable": [],
-            "extrapolation": extrapolation(s)}
+            "not_significant": [], "not_reported": [], "unidentifiable": [],
+            "extrapolation": extrapolation(s), "inputs_left_out": list(s.left_out)}
     if s.environments:        # each run's environment (the folds' groups, basis.folds)
         data["environments"] = {(f if not r else f"{f}[{r}]"): e
                                 for (f, r), e in zip(s.runs, s.environments)}

@@ -22,7 +22,8 @@ class DriftSeries:
     ``inputs`` {name: (N,)} logged inputs (degC, rpm, ...); ``channels`` {label: (N,)} um;
     ``directions`` {label: "X".."-Z" or "?"}; ``heights`` {label: mm or None};
     ``test`` (N,) bool: held out; ``environments`` one label per run (the files'
-    ``environment`` column; empty: none given)."""
+    ``environment`` column; empty: none given); ``left_out`` the inputs left out of every
+    run (:func:`read_runs`)."""
 
     t_s: np.ndarray
     run: np.ndarray
@@ -33,6 +34,8 @@ class DriftSeries:
     heights: dict = field(default_factory=dict)
     test: np.ndarray | None = None
     environments: list = field(default_factory=list)
+    #: inputs left out of every run (missing from a file or faulty; series.read_runs)
+    left_out: list = field(default_factory=list)
     memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -55,26 +58,68 @@ class DriftSeries:
 
 def load_series(paths) -> DriftSeries:
     """Drift files (paths) -> one :class:`DriftSeries` (every run its own zero and its own lag
-    start); runs must log the same channels and inputs."""
-    return stack_runs(read_runs(paths))
+    start); runs must log the same channels; inputs not logged in every run, or faulty in
+    one, are left out (:func:`read_runs`)."""
+    return stack_runs(*read_runs(paths))
 
 
-def read_runs(paths) -> list:
-    """The runs (:class:`volerr.instruments.drift.DriftRun`) of the drift files ``paths``;
-    every run must log the same channels and inputs as the first (one line names the run)."""
-    from ...instruments.drift import read_runs as _read
+def read_runs(paths) -> tuple[list, list]:
+    """(runs, left_out): the runs (:class:`volerr.instruments.drift.DriftRun`) of the drift
+    files ``paths``, every run with the logged inputs every run has and none faulty, and the
+    inputs left out [{"input", "reason": "missing" | "faulty", "files": [the runs that lack
+    it], "faults": [the faults, :func:`volerr.instruments.drift.faults`]}], in order of first
+    appearance.  Every run must log the same channels as the first (one line names the run;
+    a channel is the measurand), and a faulty channel refuses its file."""
+    from ...instruments.drift import fault_text, faults, read_runs as _read
 
     runs = [r for p in paths for r in _read(p)]
     first = runs[0]
     for r in runs[1:]:
-        require(set(r.channels) == set(first.channels) and set(r.inputs) == set(first.inputs),
-                f"{r.name}: its channels and logged inputs differ from {first.name}'s; the "
-                f"runs of one loop log the same ones")
-    return runs
+        require(set(r.channels) == set(first.channels),
+                f"{r.name}: its channels ({', '.join(r.channels)}) differ from {first.name}'s "
+                f"({', '.join(first.channels)}); the runs of one loop log the same channels")
+    found = [e for r in runs for e in faults(r)]
+    bad = next((e for e in found if e.get("channel")), None)
+    require(bad is None, f"{bad and bad['file']}: channel {bad and fault_text(bad)}: a channel "
+                         f"is the measurand and cannot be left out; cut the run or check "
+                         f"the sensor")
+    names = list(dict.fromkeys(k for r in runs for k in r.inputs))
+    left = []
+    for k in names:
+        lack = [r.name for r in runs if k not in r.inputs]
+        bad_k = [e for e in found if e["input"] == k]
+        if lack or bad_k:
+            left.append({"input": k, "reason": "missing" if lack else "faulty",
+                         "files": lack, "faults": bad_k})
+    gone = {e["input"] for e in left}
+    require(any(k not in gone for k in names),
+            f"{first.name}: no logged input is left for the model (every one is missing from "
+            f"a file or faulty: {', '.join(sorted(gone))})")
+    for r in runs:
+        r.inputs = {k: v for k, v in r.inputs.items() if k not in gone}
+    return runs, left
 
 
-def stack_runs(runs) -> DriftSeries:
-    """The runs one after the other as one :class:`DriftSeries` (no reading held out yet)."""
+def left_out_line(left: list) -> str:
+    """One console line naming the inputs :func:`read_runs` left out (empty: '')."""
+    if not left:
+        return ""
+    from ...instruments.drift import fault_text
+
+    parts = []
+    for e in left:
+        if e["reason"] == "missing":
+            parts.append(f"{e['input']} (missing from {', '.join(e['files'])})")
+        else:
+            parts.append("; ".join(fault_text(x) for x in e["faults"]))
+    return ("note: left out of the model in every run: " + "; ".join(parts)
+            + " (a model needs the inputs of every run; a faulty sensor would be fitted as "
+              "physics)")
+
+
+def stack_runs(runs, left_out=()) -> DriftSeries:
+    """The runs one after the other as one :class:`DriftSeries` (no reading held out yet;
+    ``left_out`` the inputs :func:`read_runs` left out)."""
     first = runs[0]
     cat = np.concatenate
     return DriftSeries(
@@ -83,4 +128,5 @@ def stack_runs(runs) -> DriftSeries:
         {k: cat([r.inputs[k] for r in runs]) for k in first.inputs},
         {k: cat([r.channels[k] for r in runs]) for k in first.channels},
         dict(first.directions), dict(first.heights),
-        environments=[r.environment for r in runs] if any(r.environment for r in runs) else [])
+        environments=[r.environment for r in runs] if any(r.environment for r in runs) else [],
+        left_out=list(left_out))

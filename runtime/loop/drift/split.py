@@ -115,11 +115,22 @@ EXTRAPOLATION_MARGIN = 0.05
 def extrapolation(s: DriftSeries) -> list:
     """The logged inputs whose held-out readings leave the range the training readings span
     (by more than ``EXTRAPOLATION_MARGIN`` of it): there a fitted drift model extrapolates
-    (a speed never run, a temperature never reached), its prediction is not supported by the
-    data.  [{"input", "train_min", "train_max", "test_min", "test_max"}], in file order."""
+    (a speed never run, a warming never reached), its prediction is not supported by the
+    data.  Judged on what the model uses: a temperature (any input but the speed) as its
+    change since its run's first reading (every run its own zero, :meth:`DriftSeries.firsts`;
+    runs that start at different room temperatures are no extrapolation), the speed
+    (``S_rpm``, the heat input ``(S/S_ref)^p``) as logged.  [{"input", "train_min",
+    "train_max", "test_min", "test_max", "basis": "change" | "value"}] (the input's unit),
+    in file order."""
+    from .basis import SPEED
+
     out = []
+    firsts = s.firsts()
     for name, v in s.inputs.items():
         v = np.asarray(v, float)
+        change = name != SPEED
+        if change:
+            v = v - v[firsts][s.run]
         tr, te = v[s.train], v[s.test]
         if not (len(tr) and len(te)):
             continue
@@ -127,7 +138,8 @@ def extrapolation(s: DriftSeries) -> list:
         pad = EXTRAPOLATION_MARGIN * max(hi - lo, 1e-12)
         if te.min() < lo - pad or te.max() > hi + pad:
             out.append({"input": name, "train_min": lo, "train_max": hi,
-                        "test_min": float(te.min()), "test_max": float(te.max())})
+                        "test_min": float(te.min()), "test_max": float(te.max()),
+                        "basis": "change" if change else "value"})
     return out
 
 
@@ -135,7 +147,8 @@ def extrapolation_line(items: list) -> str:
     """One console line naming the inputs :func:`extrapolation` found (empty: '')."""
     if not items:
         return ""
-    parts = [f"{e['input']} {e['test_min']:.4g}..{e['test_max']:.4g} (training "
+    parts = [f"{e['input']}{' change' if e.get('basis') == 'change' else ''} "
+             f"{e['test_min']:.4g}..{e['test_max']:.4g} (training "
              f"{e['train_min']:.4g}..{e['train_max']:.4g})" for e in items]
     return ("warning: the held-out readings leave the training range of " + ", ".join(parts)
             + ": there the model extrapolates, its held-out figures judge an extrapolation")
