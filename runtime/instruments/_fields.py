@@ -456,13 +456,21 @@ def _step(v: np.ndarray, name: str, scores: dict) -> tuple[int, float] | None:
     for i in np.argsort(-z, kind="stable"):
         if not z[i] > STEP_K:
             return None
-        if not _lasting(v, int(i), s):
+        if not _lasting(v, int(i), s) or not _isolated(z, int(i)):
             continue
         shared = max(SHARED_K, 0.5 * float(z[i]))
         if any(zo[i] > shared for k, zo in scores.items() if k != name):
             continue
         return int(i), s
     return None
+
+
+def _isolated(z: np.ndarray, i: int) -> bool:
+    """The change i -> i+1 stands alone: over the 3 changes before it and the 3 after it the
+    median score is within :data:`SHARED_K` (a sensor answering heat keeps moving for several
+    readings -- a kink of its trend, not a jump; a re-plugged sensor jumps once)."""
+    around = [z[max(i - 3, 0):i], z[i + 1:i + 4]]
+    return all(not len(a) or float(np.median(a)) < SHARED_K for a in around)
 
 
 def _lasting(v: np.ndarray, i: int, s: float) -> bool:
