@@ -111,6 +111,8 @@ def test_fl_thermal_and_the_simulators_raise_no_fault(tmp_path):
         (tmp_path / name).mkdir()
         drift_sim.campaign(planted, tmp_path / name)
         files += sorted((tmp_path / name).glob("run*.csv"))
+    files.append(tmp_path / "long.csv")
+    drift_sim.long_run(drift_sim.CASES["fast"], tmp_path)
     files += M.write_campaign(tmp_path, M.campaign())
     runs = [r for f in files for r in drift.read_runs(f)]
     assert len(runs) >= 10
