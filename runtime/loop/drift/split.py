@@ -108,8 +108,20 @@ def stretch_split(t, groups, fraction: float) -> np.ndarray:
     return test
 
 
-#: a held-out input beyond the training range by more than this share of that range
+#: a held-out input beyond the training range by more than this share of that range ...
 EXTRAPOLATION_MARGIN = 0.05
+#: ... and by more than this many times its reading-to-reading scatter (a run's zero is one
+#: reading: every change of the run carries that reading's noise)
+EXTRAPOLATION_NOISE = 3.0
+
+
+def _scatter(v: np.ndarray, run: np.ndarray) -> float:
+    """The median over the runs of an input's robust reading-to-reading scatter
+    (:func:`volerr.instruments._fields.change_scores`; 0 for a commanded speed)."""
+    from ...instruments._fields import change_scores
+
+    found = [change_scores(v[run == r])[1] for r in np.unique(run) if np.sum(run == r) > 3]
+    return float(np.median(found)) if found else 0.0
 
 
 def extrapolation(s: DriftSeries) -> list:
@@ -119,7 +131,9 @@ def extrapolation(s: DriftSeries) -> list:
     data.  Judged on what the model uses: a temperature (any input but the speed) as its
     change since its run's first reading (every run its own zero, :meth:`DriftSeries.firsts`;
     runs that start at different room temperatures are no extrapolation), the speed
-    (``S_rpm``, the heat input ``(S/S_ref)^p``) as logged.  [{"input", "train_min",
+    (``S_rpm``, the heat input ``(S/S_ref)^p``) as logged.  Beyond the range by more than
+    ``EXTRAPOLATION_MARGIN`` of it and ``EXTRAPOLATION_NOISE`` times the input's scatter
+    (:func:`_scatter`).  [{"input", "train_min",
     "train_max", "test_min", "test_max", "basis": "change" | "value"}] (the input's unit),
     in file order."""
     from .basis import SPEED
@@ -135,7 +149,8 @@ def extrapolation(s: DriftSeries) -> list:
         if not (len(tr) and len(te)):
             continue
         lo, hi = float(tr.min()), float(tr.max())
-        pad = EXTRAPOLATION_MARGIN * max(hi - lo, 1e-12)
+        pad = max(EXTRAPOLATION_MARGIN * max(hi - lo, 1e-12),
+                  EXTRAPOLATION_NOISE * _scatter(v[s.train], s.run[s.train]))
         if te.min() < lo - pad or te.max() > hi + pad:
             out.append({"input": name, "train_min": lo, "train_max": hi,
                         "test_min": float(te.min()), "test_max": float(te.max()),
