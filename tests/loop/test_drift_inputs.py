@@ -132,6 +132,19 @@ def test_an_input_missing_from_one_file_is_left_out_and_named(tmp_path, capsys):
     assert all("T_room" not in e["covariates"] for e in doc["effects"])
 
 
+def test_the_page_names_the_input_left_out(tmp_path):
+    import volerr
+
+    files = [_write(tmp_path / f"day{i}.csv", _run(70 + i), drop=("T_room",) if i == 0 else ())
+             for i in range(3)]
+    r = volerr.loop("DMU50", [f"drift:{f}" for f in files])
+    page = tmp_path / "p.html"
+    r.write_html(page)
+    text = page.read_text()
+    assert "left out of the model" in text and "missing from day0.csv" in text
+    assert r.summary().splitlines()[0].strip().startswith("note: left out")
+
+
 def test_a_channel_missing_from_one_file_is_refused(tmp_path, capsys):
     files = [_write(tmp_path / f"day{i}.csv", _run(20 + i)) for i in range(2)]
     r = _run(22)
