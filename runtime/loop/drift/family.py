@@ -54,6 +54,8 @@ from . import basis
 FAMILIES = ("constant", "static", "lag")
 #: consecutive blocks each fold's CV residuals are cut into for the paired test
 SUB_BLOCKS = 8
+#: training runs from which, with folds of whole runs, the paired test's unit is the run
+RUN_UNITS_MIN = 6
 LEVEL = 0.95
 NAMES = {"constant": "a constant (each run's zero)",
          "static": "the static regression on all temperatures",
@@ -66,7 +68,7 @@ def cv_residuals(ch, D) -> np.ndarray:
     training folds (a fold of whole runs from the run's first reading plus the terms)."""
     y, fold, n_runs = ch.y, ch.fold, ch.n_runs
     r = np.full(len(y), np.nan)
-    first = y[ch.s.firsts()]
+    first = ch.s.zero(y)[ch.s.firsts()]
     K = int(fold.max()) + 1
     parts = [(D[fold == k].T @ D[fold == k], D[fold == k].T @ y[fold == k]) for k in range(K)]
     G, h = sum(p[0] for p in parts), sum(p[1] for p in parts)
@@ -92,6 +94,23 @@ def block_mse(fold, r, sub: int = SUB_BLOCKS) -> np.ndarray:
     return np.array(out)
 
 
+def by_runs(ch) -> bool:
+    """Whether the paired test's unit is the run (module docstring): folds of whole runs and
+    at least ``RUN_UNITS_MIN`` training runs."""
+    runs = np.unique(ch.s.run[ch.fold >= 0])
+    return basis.whole_runs(ch.rule) and len(runs) >= RUN_UNITS_MIN
+
+
+def unit_mse(ch, r) -> np.ndarray:
+    """The mean squares (um^2) of the CV residuals ``r`` per unit of the paired test: per
+    training run (:func:`by_runs`), else per block (:func:`block_mse`)."""
+    if not by_runs(ch):
+        return block_mse(ch.fold, r)
+    tr = ch.fold >= 0
+    return np.array([float(np.mean(r[tr & (ch.s.run == k)] ** 2))
+                     for k in np.unique(ch.s.run[tr])])
+
+
 def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
     """The family of the channel by the module's rule: ``designs`` family -> design matrix;
     ``has_terms`` False: the lag model has no term (it is the constant); ``nested``: its
@@ -100,7 +119,7 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
     {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
     "lag_vs_static"}, "rule", "cv_resid" (N,) of the chosen family}."""
     resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
-    mse = {f: block_mse(ch.fold, r) for f, r in resid.items()}
+    mse = {f: unit_mse(ch, r) for f, r in resid.items()}
     tr = ch.fold >= 0
     cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
     t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a])
@@ -114,12 +133,14 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
     if has_terms and significantly_below(mse["lag"], mse["constant"]) and beats_static:
         fam = "lag"
     K = len(mse["lag"])
+    units = ("training runs (one CV mean square per run: the run is the unit of "
+             "independence)" if by_runs(ch) else
+             f"blocks ({SUB_BLOCKS} per blocked CV fold)")
     return {"family": fam, "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
-            "cv_resid": resid[fam],
-            "rule": f"lag model only if, against each baseline, the paired t over {K} blocks "
-                    f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
-                    f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
-                    f"baseline of lower CV mean square"}
+            "cv_resid": resid[fam], "paired_units": "runs" if by_runs(ch) else "blocks",
+            "rule": f"lag model only if, against each baseline, the paired t over {K} {units}"
+                    f" of (baseline's - lag model's CV mean square) >= {t95(K - 1):.3f} "
+                    f"(one-sided 95 %, {K - 1} df); else the baseline of lower CV mean square"}
 
 
 def interval(cv_resid, y, pred, fold, test) -> dict:

@@ -73,7 +73,7 @@ class Channel:
     def cv(self, D) -> float:
         """Cross-validated mean square (um^2) of the model with the columns ``D``."""
         eng = Engine(D, self.y, self.fold, basis.whole_runs(self.rule), self.s.run,
-                     self.n_runs)
+                     self.n_runs, zero=self.s.zero(self.y))
         return eng.cv_sse(np.eye(D.shape[1])) / eng.n
 
     def design(self, specs, taus=None) -> np.ndarray:
@@ -91,7 +91,7 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
     fold, rule = basis.folds(s)
     R = s.indicators()
     Z = np.column_stack([R, X])
-    cands = _candidates(s, cols, differences)
+    cands = _candidates(s, cols, differences, basis.whole_runs(rule))
     out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {}}
     cache: dict = {}
     for label, y in s.channels.items():
@@ -100,15 +100,18 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
         out["channels"][label] = _channel(Channel(s, y, R, fold, rule), cols, Z, cands, cache)
     return out
 
-def _candidates(s, cols, differences: bool) -> tuple:
+def _candidates(s, cols, differences: bool, whole_runs: bool = False) -> tuple:
     """(heat candidates, sensor candidates) as (nc, 2) pairs: a sensor's lag is searched up
     to ``SENSOR_TAU_SPAN`` of the training span (a longer lag of a slowly moving sensor is a
-    trend, not an effect: it cannot be told from one within the data)."""
+    trend, not an effect: within one run's stretches it cannot be told from one); with folds
+    of ``whole_runs`` every lag of the grid (each fold a run predicted from its own start and
+    inputs: a trend that is no effect does not carry over to it, and the room reaches the
+    structure through hours)."""
     span = float(max(np.ptp(s.t_s[s.train & (s.run == r)]) if np.any(s.train & (s.run == r))
                      else 0.0 for r in range(len(s.runs))))
+    cap = np.inf if whole_runs else basis.SENSOR_TAU_SPAN * span
     c = sel.candidates(cols)
-    keep = np.array([cols[a].p is not None or cols[a].tau_s <= basis.SENSOR_TAU_SPAN * span
-                     for a, _ in c], bool)
+    keep = np.array([cols[a].p is not None or cols[a].tau_s <= cap for a, _ in c], bool)
     if not differences:
         keep &= c[:, 1] < 0
     c = c[keep]
@@ -117,7 +120,8 @@ def _candidates(s, cols, differences: bool) -> tuple:
 
 
 def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
-    eng = Engine(Z, ch.y, ch.fold, basis.whole_runs(ch.rule), ch.s.run, ch.n_runs, cache)
+    eng = Engine(Z, ch.y, ch.fold, basis.whole_runs(ch.rule), ch.s.run, ch.n_runs, cache,
+                 ch.s.zero(ch.y))
     heat_c, sensor_c = cands
     terms = []
     if len(heat_c):
@@ -132,7 +136,7 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     out = {"terms": specs, "fit": fit, "y": ch.y,
            "static": predict(ch.s, Ds, _fit(Ds, ch.y, tr), ch.y),
            "constant": predict(ch.s, ch.R, _fit(ch.R, ch.y, tr), ch.y),
-           "before": ch.y[ch.s.firsts()][ch.s.run]}
+           "before": ch.s.zero(ch.y)}
     out["choice"] = family.choose(ch, {"constant": ch.R, "static": Ds, "lag": fit["design"]},
                                   bool(specs), _nested_in_static(specs))
     return out
@@ -337,5 +341,5 @@ def predict(s, D, b, y) -> np.ndarray:
     n_runs = len(s.runs)
     zeros = b[:n_runs].copy()
     seen = np.array([np.any(s.train & (s.run == r)) for r in range(n_runs)])
-    zeros[~seen] = y[s.firsts()][~seen]
+    zeros[~seen] = s.zero(y)[s.firsts()][~seen]
     return zeros[s.run] + D[:, n_runs:] @ b[n_runs:]

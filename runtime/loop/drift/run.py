@@ -65,7 +65,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "budgets": {},
             "not_significant": [], "not_reported": [], "static_regression": {},
             "unidentifiable": [],
-            "extrapolation": extrapolation(s)}
+            "extrapolation": extrapolation(s), "kept_out": basis.kept_out(s)}
     if s.environments:        # each run's environment (the folds' groups, basis.folds)
         data["environments"] = {(f if not r else f"{f}[{r}]"): e
                                 for (f, r), e in zip(s.runs, s.environments)}

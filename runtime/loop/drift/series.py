@@ -13,6 +13,10 @@ import numpy as np
 
 from ...errors import require
 
+#: a run's zero, where a series holds several runs: the mean of its readings within this many
+#: seconds of its first (one run: its first reading)
+ZERO_S = 300.0
+
 
 @dataclass
 class DriftSeries:
@@ -50,6 +54,25 @@ class DriftSeries:
     def firsts(self) -> np.ndarray:
         """Index (n_runs,) of every run's first reading."""
         return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
+
+    def zero(self, v) -> np.ndarray:
+        """The zero of ``v`` (N,) in its run, at every reading (N,): the value a run is
+        predicted from where its zero is not fitted (a held-out run, a fold of whole runs),
+        the same for the readings and every model column (each column is its change since
+        it).  One run: its first reading.  Several: the mean of the run's readings within
+        ``ZERO_S`` of its first (at least the first): a zero read from one reading carries that
+        reading's noise into every prediction of the run (through every sensor's coefficient:
+        of near-collinear sensors, magnified); the mean of the first minutes is the same zero
+        for a linear model (readings and columns alike are changes since it), with the noise
+        of several readings averaged."""
+        v = np.asarray(v, float)
+        if "_zero" not in self.memo:
+            window = ZERO_S if len(self.runs) > 1 else 0.0
+            runs = (np.flatnonzero(self.run == r) for r in range(len(self.runs)))
+            self.memo["_zero"] = [i[:max(1, int(np.sum(self.t_s[i] - self.t_s[i[0]] < window)))]
+                                  for i in runs]
+        z = np.array([v[i].mean() if len(i) > 1 else v[i[0]] for i in self.memo["_zero"]])
+        return z[self.run]
 
 
 
