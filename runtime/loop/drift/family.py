@@ -124,8 +124,11 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False) -> dict:
     cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
     t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a])
          for a, b in (("static", "constant"), ("lag", "constant"), ("lag", "static"))}
-    # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
+    # the better baseline: the lower CV mean square (a tie to the constant, the simpler); run
+    # by run, the static regression must be significantly below the constant (many runs)
     fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
+    if by_runs(ch) and not significantly_below(mse["static"], mse["constant"]):
+        fam = "constant"
     # a lag model of plain temperatures only is a sub-model of the static regression: there
     # the static regression is the more complex one and must beat it significantly
     beats_static = (not significantly_below(mse["static"], mse["lag"]) if nested else
