@@ -131,3 +131,25 @@ def test_a_lag_effect_of_two_days_does_not_transfer(loose_clamp):
     # noise's (MAE sqrt(2/pi) sigma, the zero's own noise of five readings beside it)
     sigma = L.D_NOISE_UM * np.sqrt(1 + 1 / 5)
     assert c["mae_after_um"] <= 1.15 * np.sqrt(2 / np.pi) * sigma, c
+
+
+def test_a_runs_zero_is_the_mean_of_its_first_five_minutes():
+    """Several runs: each run's zero is the mean of its readings less than 300 s after its
+    first (at 60 s: five readings), for a channel and every column alike; one run: its
+    first reading."""
+    from volerr.loop.drift import basis
+    from volerr.loop.drift.series import DriftSeries
+
+    t = np.concatenate([np.arange(0.0, 3600.0, 60.0), np.arange(0.0, 1800.0, 30.0)])
+    run = np.repeat([0, 1], [60, 60])
+    v = np.random.default_rng(5).normal(size=len(t))
+    s = DriftSeries(t, run, [("a.csv", ""), ("b.csv", "")], {"T_a": v}, {"x": v},
+                    test=np.zeros(len(t), bool))
+    z = s.zero(v)
+    assert z[0] == pytest.approx(np.mean(v[:5])) and z[59] == z[0]
+    assert z[60] == pytest.approx(np.mean(v[60:70]))          # 30 s: ten readings
+    col = basis.series(s, "T_a", 0.0)
+    assert np.mean(col[:5]) == pytest.approx(0.0, abs=1e-12)
+    one = DriftSeries(t[:60], run[:60], [("a.csv", "")], {"T_a": v[:60]}, {"x": v[:60]},
+                      test=np.zeros(60, bool))
+    assert np.all(one.zero(v[:60]) == v[0])
