@@ -48,7 +48,7 @@ from ...errors import require
 from .series import DriftSeries
 
 __all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "kept_out", "library",
-           "modelled", "series", "sensors", "tau_grid"]
+           "modelled", "reference", "series", "sensors", "tau_grid"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
 N_TAU = 14                # time constants on the grid
@@ -60,6 +60,8 @@ SPEED = "S_rpm"           # the logged input the heat input is derived from
 #: a sensor whose changes in the held-out runs span more than this many times its changes in
 #: the training runs is kept out of the lag model (its coefficient was never determined there)
 KEEP_OUT_RATIO = 4.0
+#: words in a logged input's name that make it a sensor of the room air (the environment)
+ROOM_WORDS = ("room", "ambient")
 
 
 @dataclass
@@ -71,10 +73,12 @@ class Column:
     tau_s: float
     p: float | None = None
     scale: float = 1.0
+    minus: str | None = None     # the room sensor a sensor's rise is taken over (reference)
 
     @property
     def label(self) -> str:
         what = self.source if self.p is None else f"(S/S_ref)^{self.p:g}"
+        what = f"{what} - {self.minus}" if self.minus else what
         return f"lag({what}, {self.tau_s:.0f} s)" if self.tau_s > 0 else what
 
 
@@ -97,6 +101,31 @@ def sensors(s: DriftSeries) -> list:
     return [k for k, v in s.inputs.items() if k != SPEED and np.ptp(v[tr]) > 0]
 
 
+def reference(s: DriftSeries) -> str | None:
+    """The room sensor every other sensor's rise is taken over: with folds of whole runs, the
+    first logged sensor whose name holds one of ``ROOM_WORDS`` (None: no such sensor, or
+    folds of stretches).  Why: a sensor on the machine reads the room plus what the machine's
+    heat adds; trained where the room is held, its coefficient is the heat's, and applied
+    to its reading in a varying room it would carry the room's change into the drift at the
+    heat's rate.  Taken as its rise over the room (``T - T_room``, through the same lag) the
+    heat's part enters alone, and the room enters as an input of its own, plain and through
+    its own lags (room air reaches the structure through hours)."""
+    if not whole_runs(folds(s)[1]):
+        return None
+    return next((k for k in sensors(s) if any(w in k.lower() for w in ROOM_WORDS)), None)
+
+
+def _is_room(k: str) -> bool:
+    return any(w in k.lower() for w in ROOM_WORDS)
+
+
+def entered(s: DriftSeries, k: str, ref: str | None) -> np.ndarray:
+    """The sensor ``k`` as the model takes it: its reading, or its rise over the room
+    sensor ``ref`` (:func:`reference`; a room sensor itself is taken plain)."""
+    v = np.asarray(s.inputs[k], float)
+    return v - np.asarray(s.inputs[ref], float) if ref and not _is_room(k) else v
+
+
 def kept_out(s: DriftSeries) -> list:
     """The sensors kept out of the lag model: where whole runs are held out, every sensor whose
     change since the run's zero spans (peak to peak) more than ``KEEP_OUT_RATIO`` times as much
@@ -112,18 +141,20 @@ def kept_out(s: DriftSeries) -> list:
     if not whole.any():
         return []
     out = []
+    ref = reference(s)
     for k in sensors(s):
-        v = np.asarray(s.inputs[k], float)
+        v = entered(s, k, ref)
         d = v - s.zero(v)
         a, b = float(np.ptp(d[s.train])), float(np.ptp(d[whole]))
         if b > KEEP_OUT_RATIO * a:
-            out.append({"input": k, "train_change": a, "test_change": b})
+            out.append({"input": k if not (ref and not _is_room(k)) else f"{k} - {ref}",
+                        "sensor": k, "train_change": a, "test_change": b})
     return out
 
 
 def modelled(s: DriftSeries) -> list:
     """The sensors the lag model may use: :func:`sensors` but those :func:`kept_out`."""
-    out = {e["input"] for e in kept_out(s)}
+    out = {e["sensor"] for e in kept_out(s)}
     return [k for k in sensors(s) if k not in out]
 
 
@@ -147,15 +178,19 @@ def series(s: DriftSeries, source: str, tau_s: float, p: float | None = None) ->
 def library(s: DriftSeries) -> tuple[list, np.ndarray]:
     """Every basis column (list of :class:`Column`) and their values (N, m), scaled."""
     taus = tau_grid(s)
+    ref = reference(s)
     cols = []
     for name in modelled(s):
-        cols += [Column(name, 0.0)] + [Column(name, float(t)) for t in taus]
+        m = ref if ref and not _is_room(name) else None
+        cols += [Column(name, 0.0, minus=m)] + [Column(name, float(t), minus=m) for t in taus]
     if SPEED in s.inputs and np.ptp(s.inputs[SPEED][s.train]) > 0:
         for p in P_GRID:
             cols += [Column("heat", 0.0, p)] + [Column("heat", float(t), p) for t in taus]
     X = np.empty((len(s.t_s), len(cols)))
     for j, c in enumerate(cols):
         X[:, j] = series(s, c.source, c.tau_s, c.p)
+        if c.minus:
+            X[:, j] -= series(s, c.minus, c.tau_s)
     sc = np.sqrt(np.mean(X[s.train] ** 2, axis=0))
     sc = np.where(sc > 0, sc, 1.0)
     for c, v in zip(cols, sc):

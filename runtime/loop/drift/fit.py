@@ -161,7 +161,7 @@ def _spec(cols, term) -> dict:
     a, b = term["pair"]
     ca = cols[a]
     sp = {"source": ca.source, "p": ca.p, "tau_s": ca.tau_s,
-          "minus": None if b < 0 else cols[b].source,
+          "minus": ca.minus if b < 0 else cols[b].source,
           "cv_rms_um": math.sqrt(term["cv_mse"]),
           "cv_rms_before_um": math.sqrt(term["cv_mse_before"]),
           "delta_bic": term["delta_bic"],
@@ -174,8 +174,8 @@ def _same_term(cols, x, ca, b) -> bool:
     """An alternative that is the chosen term at a neighbouring grid lag (the refinement
     searches there) is no other explanation."""
     c = cols[x[0]]
-    same = (c.source, c.p, x[1] < 0 or cols[x[1]].source) == \
-        (ca.source, ca.p, b < 0 or cols[b].source)
+    same = (c.source, c.p, c.minus if x[1] < 0 else cols[x[1]].source) == \
+        (ca.source, ca.p, ca.minus if b < 0 else cols[b].source)
     return same and (c.tau_s > 0) == (ca.tau_s > 0) and (
         c.tau_s == 0 or abs(math.log(c.tau_s / ca.tau_s)) < 1.5 * _grid_step(cols))
 
@@ -189,7 +189,8 @@ def _alt(cols, x) -> dict:
     a, b, rms = x
     c = cols[a]
     src = basis.SPEED if c.source == "heat" else c.source
-    return {"covariate": src if b < 0 else f"{src} - {cols[b].source}",
+    minus = c.minus if b < 0 else cols[b].source
+    return {"covariate": f"{src} - {minus}" if minus else src,
             "p": c.p, "lag_s": c.tau_s or None, "cv_rms_um": round(rms, 4)}
 
 
