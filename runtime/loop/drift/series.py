@@ -59,18 +59,26 @@ class DriftSeries:
         """The zero of ``v`` (N,) in its run, at every reading (N,): the value a run is
         predicted from where its zero is not fitted (a held-out run, a fold of whole runs),
         the same for the readings and every model column (each column is its change since
-        it).  One run: its first reading.  Several: the mean of the run's readings within
-        ``ZERO_S`` of its first (at least the first): a zero read from one reading carries that
-        reading's noise into every prediction of the run (through every sensor's coefficient:
-        of near-collinear sensors, magnified); the mean of the first minutes is the same zero
-        for a linear model (readings and columns alike are changes since it), with the noise
-        of several readings averaged."""
+        it).  One run: its first reading.  Several: the mean of the run's first readings
+        while the machine is still as at its first: within ``ZERO_S`` of it and before the
+        spindle speed (``S_rpm``) first changes (at least the first reading).  A zero read
+        from one reading carries that reading's noise into every prediction of the run
+        (through every sensor's coefficient: of near-collinear sensors, magnified); over
+        readings where nothing has started to move the mean is the same zero (readings and
+        columns alike are changes since it) with the noise averaged, while readings after
+        the spindle starts move for reasons a model need not capture exactly."""
         v = np.asarray(v, float)
         if "_zero" not in self.memo:
             window = ZERO_S if len(self.runs) > 1 else 0.0
-            runs = (np.flatnonzero(self.run == r) for r in range(len(self.runs)))
-            self.memo["_zero"] = [i[:max(1, int(np.sum(self.t_s[i] - self.t_s[i[0]] < window)))]
-                                  for i in runs]
+            S = self.inputs.get("S_rpm")
+            heads = []
+            for r in range(len(self.runs)):
+                i = np.flatnonzero(self.run == r)
+                still = self.t_s[i] - self.t_s[i[0]] < window
+                if S is not None:              # ... and the spindle as at the first reading
+                    still &= np.asarray(S, float)[i] == float(S[i[0]])
+                heads.append(i[:max(1, int(np.argmin(still)) if not still.all() else len(i))])
+            self.memo["_zero"] = heads
         z = np.array([v[i].mean() if len(i) > 1 else v[i[0]] for i in self.memo["_zero"]])
         return z[self.run]
 
