@@ -28,6 +28,13 @@ says so.  (A lag model whose terms are all plain temperatures is a sub-model of 
 regression: there the static regression is the more complex and must be significantly
 below the lag model instead.)
 
+Many runs (folds of whole runs and at least ``RUN_UNITS_MIN`` training runs): the unit of
+the paired test is the run, one CV mean square per training run (n - 1 degrees of freedom),
+not ``SUB_BLOCKS`` blocks of every fold: a run's level error is one error, and its blocks are
+not independent of each other.  The static regression, judged the same way, is then the
+better baseline only when significantly below the constant run by run (many near-collinear
+temperatures fit within runs and need not carry across them).
+
 Prediction interval (``LEVEL`` = 95 %): per blocked CV fold the ``LEVEL`` quantile of the
 absolute CV residuals of the chosen family, and the half-width the largest of them
 (symmetric, um).  Why: the held-out part is one stretch the fit never saw, like one fold;
