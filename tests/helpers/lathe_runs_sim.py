@@ -35,10 +35,9 @@ The machine
 The floor (:func:`floor_prediction`): the TRUE network (the nodes as lags of the logged speed
 and room air, every lag started at rest: the nodes' start offsets are not known from the logs)
 refitted by least squares on the training runs (a zero per run), a held-out run predicted from
-its zero (the mean of its first five minutes) plus the fitted terms: what a model that knows
-the physics can do from these logs.  The static regression (:func:`static_prediction`): every
-temperature's change since the run's zero, fitted the same way (the shop's model: its zero
-the first reading).
+its first reading plus the fitted terms: what a model that knows the physics can do from these
+logs.  The static regression (:func:`static_prediction`): every temperature's change since the
+run's first reading, fitted the same way (the shop's model).
 """
 
 from __future__ import annotations
@@ -164,28 +163,23 @@ def _static_columns(run: dict) -> np.ndarray:
     return np.column_stack([run[k] - run[k][0] for k in SENSORS if np.ptp(run[k]) > 0])
 
 
-def _refit_predict(train: list, test: dict, columns, ch: str, zero_s: float) -> np.ndarray:
+def _refit_predict(train: list, test: dict, columns, ch: str) -> np.ndarray:
     """Least squares on the training runs (a zero per run); the held-out run predicted from
-    its zero plus the fitted terms: the zero its reading at its start (``zero_s`` 0) or the
-    mean of its readings within ``zero_s`` of its start, every column then its change since
-    that same mean (a linear model's prediction is the same; the noise of the zero less)."""
+    its first reading plus the fitted terms (the columns are zero at its start)."""
     blocks = [columns(r) for r in train]
     n = [len(b) for b in blocks]
     Z = (np.repeat(np.arange(len(train)), n)[:, None] == np.arange(len(train))).astype(float)
     X = np.column_stack([Z, np.vstack(blocks)])
     y = np.concatenate([r[f"d_{ch}_um"] for r in train])
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-    head = test["t_s"] - test["t_s"][0] < max(zero_s, 1e-9)
-    Xt = columns(test)
-    Xt = Xt - Xt[head].mean(axis=0)
-    return test[f"d_{ch}_um"][head].mean() + Xt @ coef[len(train):]
+    return test[f"d_{ch}_um"][0] + columns(test) @ coef[len(train):]
 
 
-def floor_prediction(train: list, test: dict, ch: str, zero_s: float = 300.0) -> np.ndarray:
-    """The true network refitted (the floor; its zero the mean of the first 5 min)."""
-    return _refit_predict(train, test, _true_columns, ch, zero_s)
+def floor_prediction(train: list, test: dict, ch: str) -> np.ndarray:
+    """The true network refitted (the floor)."""
+    return _refit_predict(train, test, _true_columns, ch)
 
 
-def static_prediction(train: list, test: dict, ch: str, zero_s: float = 0.0) -> np.ndarray:
-    """The static regression on every temperature (the shop's: its zero the first reading)."""
-    return _refit_predict(train, test, _static_columns, ch, zero_s)
+def static_prediction(train: list, test: dict, ch: str) -> np.ndarray:
+    """The static regression on every temperature (the shop's model)."""
+    return _refit_predict(train, test, _static_columns, ch)

@@ -7,12 +7,10 @@ X and Z, an arbitrary zero per run, rooms ``constant``, ``daily``, ``door``):
   and by date (the first ten days train, the last five are judged), the loop's held-out MAE
   per axis is within ``FLOOR_FACTOR`` x the floor (the true network refitted on the same
   training runs) and never above the static regression on all temperatures fitted on the
-  same runs (whether that regression takes a run's zero from its first reading, the shop's
-  way, or from its first five minutes, the loop's);
+  same runs;
 * trained in constant rooms, the room sensors (which the judged runs vary several times
   more) are kept out of the model and named (``kept_out``); every other sensor enters as its
-  rise over ``T_room`` (recomputed here from the simulated readings), the run's zero the
-  mean of its first five minutes;
+  rise over ``T_room`` (recomputed here from the simulated readings);
 * with at least six training runs in folds of whole runs, the paired test's unit is the
   run (one CV mean square per run, ``n - 1`` degrees of freedom);
 * a lag effect present on two training days only (a loose clamp: the X channel followed the
@@ -77,8 +75,7 @@ def test_within_the_floor_and_never_worse_than_the_static_regression(campaign, s
         np.testing.assert_allclose(y, s.channels[ch][s.test], rtol=0, atol=1e-5)   # as written
         loop = _mae(y, after)
         floor = _mae(y, np.concatenate([L.floor_prediction(train, r, ch) for r in test]))
-        static = min(_mae(y, np.concatenate([L.static_prediction(train, r, ch, zero_s=z)
-                                             for r in test])) for z in (0.0, 300.0))
+        static = _mae(y, np.concatenate([L.static_prediction(train, r, ch) for r in test]))
         assert loop <= FLOOR_FACTOR * floor, (name, ch, loop, floor)
         assert loop <= static * 1.001, (name, ch, loop, static)
         assert rep["channels"][ch]["mae_after_um"] == pytest.approx(loop)
@@ -135,33 +132,11 @@ def test_a_lag_effect_of_two_days_does_not_transfer(loose_clamp):
     assert c["mae_after_um"] <= 1.15 * np.sqrt(2 / np.pi) * sigma, c
 
 
-def test_a_runs_zero_is_the_mean_of_its_first_five_minutes():
-    """Several runs: each run's zero is the mean of its readings less than 300 s after its
-    first (at 60 s: five readings), for a channel and every column alike; one run: its
-    first reading."""
-    from volerr.loop.drift import basis
-    from volerr.loop.drift.series import DriftSeries
-
-    t = np.concatenate([np.arange(0.0, 3600.0, 60.0), np.arange(0.0, 1800.0, 30.0)])
-    run = np.repeat([0, 1], [60, 60])
-    v = np.random.default_rng(5).normal(size=len(t))
-    s = DriftSeries(t, run, [("a.csv", ""), ("b.csv", "")], {"T_a": v}, {"x": v},
-                    test=np.zeros(len(t), bool))
-    z = s.zero(v)
-    assert z[0] == pytest.approx(np.mean(v[:5])) and z[59] == z[0]
-    assert z[60] == pytest.approx(np.mean(v[60:70]))          # 30 s: ten readings
-    col = basis.series(s, "T_a", 0.0)
-    assert np.mean(col[:5]) == pytest.approx(0.0, abs=1e-12)
-    one = DriftSeries(t[:60], run[:60], [("a.csv", "")], {"T_a": v[:60]}, {"x": v[:60]},
-                      test=np.zeros(60, bool))
-    assert np.all(one.zero(v[:60]) == v[0])
-
-
 def test_machine_sensors_enter_as_their_rise_over_the_room(campaign, split):
     """With folds of whole runs every sensor but the room's enters as its rise over
     ``T_room`` (the first sensor naming the room): the plain column of ``T_bearing`` is
-    ``T_bearing - T_room`` less its mean over the run's first readings before the spindle
-    starts (here the first 5 min: the programmes start at 6 min); the room sensors plain."""
+    ``T_bearing - T_room`` less its value at the run's first reading; the room sensors
+    plain."""
     from volerr.loop.drift import basis
 
     name, held, rep = split
@@ -175,5 +150,5 @@ def test_machine_sensors_enter_as_their_rise_over_the_room(campaign, split):
     want = []
     for n, _, r in campaign:                 # the runs in the order of the files given
         rise = r["T_bearing"] - r["T_room"]
-        want.append(rise - rise[r["t_s"] < 300.0].mean())
+        want.append(rise - rise[0])
     np.testing.assert_allclose(got, np.concatenate(want), atol=2e-5)

@@ -48,7 +48,7 @@ from ...errors import require
 from .series import DriftSeries
 
 __all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "kept_out", "library",
-           "modelled", "reference", "series", "sensors", "tau_grid"]
+           "many_runs", "modelled", "reference", "series", "sensors", "tau_grid"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
 N_TAU = 14                # time constants on the grid
@@ -60,6 +60,8 @@ SPEED = "S_rpm"           # the logged input the heat input is derived from
 #: a sensor whose changes in the held-out runs span more than this many times its changes in
 #: the training runs is kept out of the lag model (its coefficient was never determined there)
 KEEP_OUT_RATIO = 4.0
+#: training runs (in folds of whole runs) from which the run is the unit: "many runs"
+MANY_RUNS = 6
 #: words in a logged input's name that make it a sensor of the room air (the environment)
 ROOM_WORDS = ("room", "ambient")
 
@@ -101,16 +103,25 @@ def sensors(s: DriftSeries) -> list:
     return [k for k, v in s.inputs.items() if k != SPEED and np.ptp(v[tr]) > 0]
 
 
+def many_runs(s: DriftSeries) -> bool:
+    """Whether the training part is "many runs": folds of whole runs (:func:`folds`) and at
+    least ``MANY_RUNS`` training runs.  Then the run is the unit: what a rule trusts to be
+    judged on runs the fit never saw (a lag of hours, a room of its own) is judged on
+    several of them (on three, a trend of one day passed for an effect)."""
+    f, rule = folds(s)
+    return whole_runs(rule) and len(np.unique(s.run[f >= 0])) >= MANY_RUNS
+
+
 def reference(s: DriftSeries) -> str | None:
-    """The room sensor every other sensor's rise is taken over: with folds of whole runs, the
-    first logged sensor whose name holds one of ``ROOM_WORDS`` (None: no such sensor, or
-    folds of stretches).  Why: a sensor on the machine reads the room plus what the machine's
+    """The room sensor every other sensor's rise is taken over: with many runs
+    (:func:`many_runs`), the first logged sensor whose name holds one of ``ROOM_WORDS``
+    (None: no such sensor, or not many runs).  Why: a sensor on the machine reads the room plus what the machine's
     heat adds; trained where the room is held, its coefficient is the heat's, and applied
     to its reading in a varying room it would carry the room's change into the drift at the
     heat's rate.  Taken as its rise over the room (``T - T_room``, through the same lag) the
     heat's part enters alone, and the room enters as an input of its own, plain and through
     its own lags (room air reaches the structure through hours)."""
-    if not whole_runs(folds(s)[1]):
+    if not many_runs(s):
         return None
     return next((k for k in sensors(s) if any(w in k.lower() for w in ROOM_WORDS)), None)
 

@@ -28,7 +28,8 @@ says so.  (A lag model whose terms are all plain temperatures is a sub-model of 
 regression: there the static regression is the more complex and must be significantly
 below the lag model instead.)
 
-Many runs (folds of whole runs and at least ``RUN_UNITS_MIN`` training runs): the unit of
+Many runs (:func:`volerr.loop.drift.basis.many_runs`: folds of whole runs and at least
+``basis.MANY_RUNS`` training runs): the unit of
 the paired test is the run, one CV mean square per training run (n - 1 degrees of freedom),
 not ``SUB_BLOCKS`` blocks of every fold: a run's level error is one error, and its blocks are
 not independent of each other.  The static regression, judged the same way, is then the
@@ -61,8 +62,6 @@ from . import basis
 FAMILIES = ("constant", "static", "lag")
 #: consecutive blocks each fold's CV residuals are cut into for the paired test
 SUB_BLOCKS = 8
-#: training runs from which, with folds of whole runs, the paired test's unit is the run
-RUN_UNITS_MIN = 6
 LEVEL = 0.95
 NAMES = {"constant": "a constant (each run's zero)",
          "static": "the static regression on all temperatures",
@@ -103,9 +102,9 @@ def block_mse(fold, r, sub: int = SUB_BLOCKS) -> np.ndarray:
 
 def by_runs(ch) -> bool:
     """Whether the paired test's unit is the run (module docstring): folds of whole runs and
-    at least ``RUN_UNITS_MIN`` training runs."""
+    at least ``basis.MANY_RUNS`` training runs (:func:`volerr.loop.drift.basis.many_runs`)."""
     runs = np.unique(ch.s.run[ch.fold >= 0])
-    return basis.whole_runs(ch.rule) and len(runs) >= RUN_UNITS_MIN
+    return basis.whole_runs(ch.rule) and len(runs) >= basis.MANY_RUNS
 
 
 def unit_mse(ch, r) -> np.ndarray:

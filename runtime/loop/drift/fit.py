@@ -91,7 +91,7 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
     fold, rule = basis.folds(s)
     R = s.indicators()
     Z = np.column_stack([R, X])
-    cands = _candidates(s, cols, differences, basis.whole_runs(rule))
+    cands = _candidates(s, cols, differences, basis.many_runs(s))
     out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {}}
     cache: dict = {}
     for label, y in s.channels.items():
@@ -100,16 +100,16 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
         out["channels"][label] = _channel(Channel(s, y, R, fold, rule), cols, Z, cands, cache)
     return out
 
-def _candidates(s, cols, differences: bool, whole_runs: bool = False) -> tuple:
+def _candidates(s, cols, differences: bool, many: bool = False) -> tuple:
     """(heat candidates, sensor candidates) as (nc, 2) pairs: a sensor's lag is searched up
     to ``SENSOR_TAU_SPAN`` of the training span (a longer lag of a slowly moving sensor is a
-    trend, not an effect: within one run's stretches it cannot be told from one); with folds
-    of ``whole_runs`` every lag of the grid (each fold a run predicted from its own start and
-    inputs: a trend that is no effect does not carry over to it, and the room reaches the
-    structure through hours)."""
+    trend, not an effect: within one run's stretches it cannot be told from one); with
+    ``many`` runs (:func:`volerr.loop.drift.basis.many_runs`) every lag of the grid (each fold
+    a run predicted from its own start and inputs: a trend that is no effect does not carry
+    over to several of them, and the room reaches the structure through hours)."""
     span = float(max(np.ptp(s.t_s[s.train & (s.run == r)]) if np.any(s.train & (s.run == r))
                      else 0.0 for r in range(len(s.runs))))
-    cap = np.inf if whole_runs else basis.SENSOR_TAU_SPAN * span
+    cap = np.inf if many else basis.SENSOR_TAU_SPAN * span
     c = sel.candidates(cols)
     keep = np.array([cols[a].p is not None or cols[a].tau_s <= cap for a, _ in c], bool)
     if not differences:

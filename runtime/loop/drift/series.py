@@ -13,10 +13,6 @@ import numpy as np
 
 from ...errors import require
 
-#: a run's zero, where a series holds several runs: the mean of its readings within this many
-#: seconds of its first (one run: its first reading)
-ZERO_S = 300.0
-
 
 @dataclass
 class DriftSeries:
@@ -56,31 +52,12 @@ class DriftSeries:
         return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
 
     def zero(self, v) -> np.ndarray:
-        """The zero of ``v`` (N,) in its run, at every reading (N,): the value a run is
-        predicted from where its zero is not fitted (a held-out run, a fold of whole runs),
-        the same for the readings and every model column (each column is its change since
-        it).  One run: its first reading.  Several: the mean of the run's first readings
-        while the machine is still as at its first: within ``ZERO_S`` of it and before the
-        spindle speed (``S_rpm``) first changes (at least the first reading).  A zero read
-        from one reading carries that reading's noise into every prediction of the run
-        (through every sensor's coefficient: of near-collinear sensors, magnified); over
-        readings where nothing has started to move the mean is the same zero (readings and
-        columns alike are changes since it) with the noise averaged, while readings after
-        the spindle starts move for reasons a model need not capture exactly."""
-        v = np.asarray(v, float)
-        if "_zero" not in self.memo:
-            window = ZERO_S if len(self.runs) > 1 else 0.0
-            S = self.inputs.get("S_rpm")
-            heads = []
-            for r in range(len(self.runs)):
-                i = np.flatnonzero(self.run == r)
-                still = self.t_s[i] - self.t_s[i[0]] < window
-                if S is not None:              # ... and the spindle as at the first reading
-                    still &= np.asarray(S, float)[i] == float(S[i[0]])
-                heads.append(i[:max(1, int(np.argmin(still)) if not still.all() else len(i))])
-            self.memo["_zero"] = heads
-        z = np.array([v[i].mean() if len(i) > 1 else v[i[0]] for i in self.memo["_zero"]])
-        return z[self.run]
+        """The zero of ``v`` (N,) in its run, at every reading (N,): its first reading, the
+        value a run is predicted from where its zero is not fitted (a held-out run, a fold of
+        whole runs), the same for the readings and every model column (each column is its
+        change since it), in every family.  (The mean of the first readings before the
+        spindle starts was measured and not adopted: docs/drift_loop.md.)"""
+        return np.asarray(v, float)[self.firsts()][self.run]
 
 
 
