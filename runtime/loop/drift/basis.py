@@ -47,8 +47,8 @@ import numpy as np
 from ...errors import require
 from .series import DriftSeries
 
-__all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "library", "series", "sensors",
-           "tau_grid"]
+__all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "kept_out", "library",
+           "many_runs", "modelled", "reference", "series", "sensors", "tau_grid"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
 N_TAU = 14                # time constants on the grid
@@ -57,6 +57,13 @@ K_FOLDS = 6               # contiguous stretches per run when the folds are not 
 RUN_FOLDS_MIN = 3         # training runs from which every fold is one whole run
 SENSOR_TAU_SPAN = 0.125  # a sensor's lag is searched up to this share of the training span
 SPEED = "S_rpm"           # the logged input the heat input is derived from
+#: a sensor whose changes in the held-out runs span more than this many times its changes in
+#: the training runs is kept out of the lag model (its coefficient was never determined there)
+KEEP_OUT_RATIO = 4.0
+#: training runs (in folds of whole runs) from which the run is the unit: "many runs"
+MANY_RUNS = 6
+#: words in a logged input's name that make it a sensor of the room air (the environment)
+ROOM_WORDS = ("room", "ambient")
 
 
 @dataclass
@@ -68,10 +75,12 @@ class Column:
     tau_s: float
     p: float | None = None
     scale: float = 1.0
+    minus: str | None = None     # the room sensor a sensor's rise is taken over (reference)
 
     @property
     def label(self) -> str:
         what = self.source if self.p is None else f"(S/S_ref)^{self.p:g}"
+        what = f"{what} - {self.minus}" if self.minus else what
         return f"lag({what}, {self.tau_s:.0f} s)" if self.tau_s > 0 else what
 
 
@@ -94,6 +103,72 @@ def sensors(s: DriftSeries) -> list:
     return [k for k, v in s.inputs.items() if k != SPEED and np.ptp(v[tr]) > 0]
 
 
+def many_runs(s: DriftSeries) -> bool:
+    """Whether the training part is "many runs": folds of whole runs (:func:`folds`) and at
+    least ``MANY_RUNS`` training runs.  Then the run is the unit: what a rule trusts to be
+    judged on runs the fit never saw (a lag of hours, a room of its own) is judged on
+    several of them (on three, a trend of one day passed for an effect)."""
+    f, rule = folds(s)
+    return whole_runs(rule) and len(np.unique(s.run[f >= 0])) >= MANY_RUNS
+
+
+def reference(s: DriftSeries) -> str | None:
+    """The room sensor every other sensor's rise is taken over: with many runs
+    (:func:`many_runs`), the first logged sensor whose name holds one of ``ROOM_WORDS``
+    (None: no such sensor, or not many runs).  Why: a sensor on the machine reads the room plus what the machine's
+    heat adds; trained where the room is held, its coefficient is the heat's, and applied
+    to its reading in a varying room it would carry the room's change into the drift at the
+    heat's rate.  Taken as its rise over the room (``T - T_room``, through the same lag) the
+    heat's part enters alone, and the room enters as an input of its own, plain and through
+    its own lags (room air reaches the structure through hours)."""
+    if not many_runs(s):
+        return None
+    return next((k for k in sensors(s) if any(w in k.lower() for w in ROOM_WORDS)), None)
+
+
+def _is_room(k: str) -> bool:
+    return any(w in k.lower() for w in ROOM_WORDS)
+
+
+def entered(s: DriftSeries, k: str, ref: str | None) -> np.ndarray:
+    """The sensor ``k`` as the model takes it: its reading, or its rise over the room
+    sensor ``ref`` (:func:`reference`; a room sensor itself is taken plain)."""
+    v = np.asarray(s.inputs[k], float)
+    return v - np.asarray(s.inputs[ref], float) if ref and not _is_room(k) else v
+
+
+def kept_out(s: DriftSeries) -> list:
+    """The sensors kept out of the lag model: where whole runs are held out, every sensor whose
+    change since the run's zero spans (peak to peak) more than ``KEEP_OUT_RATIO`` times as much
+    in the held-out runs as in the training runs (a room held constant in training, varying in
+    the runs judged).  Its coefficient would rest on changes a fraction of those it is applied
+    to, often on its noise, or carry an effect of the heat it happened to follow in training:
+    a coefficient these data never determined, extrapolated.  The model leaves it out and the
+    report names it; what the held-out runs do through it is then unmodelled, as the physics
+    of the training runs allows.  [{"input", "train_change", "test_change"}] in file order
+    (units of the input)."""
+    seen = np.array([np.any(s.train & (s.run == r)) for r in range(len(s.runs))])
+    whole = s.test & ~seen[s.run]
+    if not whole.any():
+        return []
+    out = []
+    ref = reference(s)
+    for k in sensors(s):
+        v = entered(s, k, ref)
+        d = v - s.zero(v)
+        a, b = float(np.ptp(d[s.train])), float(np.ptp(d[whole]))
+        if b > KEEP_OUT_RATIO * a:
+            out.append({"input": k if not (ref and not _is_room(k)) else f"{k} - {ref}",
+                        "sensor": k, "train_change": a, "test_change": b})
+    return out
+
+
+def modelled(s: DriftSeries) -> list:
+    """The sensors the lag model may use: :func:`sensors` but those :func:`kept_out`."""
+    out = {e["sensor"] for e in kept_out(s)}
+    return [k for k in sensors(s) if k not in out]
+
+
 def heat(s: DriftSeries, p: float) -> np.ndarray:
     """``(S / S_ref) ** p`` (N,), ``S_ref`` the largest |speed| of the training part."""
     S = np.abs(np.asarray(s.inputs[SPEED], float))
@@ -108,21 +183,25 @@ def series(s: DriftSeries, source: str, tau_s: float, p: float | None = None) ->
 
     u = heat(s, p) if source == "heat" else np.asarray(s.inputs[source], float)
     y = lag(u, tau_s, s.t_s, s.run) if tau_s > 0 else u
-    return y - y[s.firsts()][s.run]
+    return y - s.zero(y)
 
 
 def library(s: DriftSeries) -> tuple[list, np.ndarray]:
     """Every basis column (list of :class:`Column`) and their values (N, m), scaled."""
     taus = tau_grid(s)
+    ref = reference(s)
     cols = []
-    for name in sensors(s):
-        cols += [Column(name, 0.0)] + [Column(name, float(t)) for t in taus]
+    for name in modelled(s):
+        m = ref if ref and not _is_room(name) else None
+        cols += [Column(name, 0.0, minus=m)] + [Column(name, float(t), minus=m) for t in taus]
     if SPEED in s.inputs and np.ptp(s.inputs[SPEED][s.train]) > 0:
         for p in P_GRID:
             cols += [Column("heat", 0.0, p)] + [Column("heat", float(t), p) for t in taus]
     X = np.empty((len(s.t_s), len(cols)))
     for j, c in enumerate(cols):
         X[:, j] = series(s, c.source, c.tau_s, c.p)
+        if c.minus:
+            X[:, j] -= series(s, c.minus, c.tau_s)
     sc = np.sqrt(np.mean(X[s.train] ** 2, axis=0))
     sc = np.where(sc > 0, sc, 1.0)
     for c, v in zip(cols, sc):

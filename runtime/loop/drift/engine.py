@@ -26,9 +26,11 @@ class Engine:
     ``Z`` (N, mz): run indicators then basis columns; ``y`` (N,); ``fold`` (N,) fold index of
     each training reading (-1 held out); ``by_runs``: folds are whole runs (anchored test)."""
 
-    def __init__(self, Z, y, fold, by_runs: bool, run, n_runs: int, cache=None):
+    def __init__(self, Z, y, fold, by_runs: bool, run, n_runs: int, cache=None, zero=None):
         """``cache``: a dict shared by the channels of one basis (the cross-products of
-        ``Z`` with itself do not depend on the channel: computed once)."""
+        ``Z`` with itself do not depend on the channel: computed once); ``zero`` (N,) each
+        reading's run zero of ``y`` (:meth:`~volerr.loop.drift.series.DriftSeries.zero`;
+        None: the run's first reading)."""
         cache = {} if cache is None else cache
         self.n_runs = n_runs
         self._cache, self._by_runs, self._rhs = cache, by_runs, {}
@@ -37,7 +39,7 @@ class Engine:
         first = np.zeros(n_runs)
         for r in range(n_runs):
             idx = np.flatnonzero(run == r)
-            first[r] = y[idx[0]] if len(idx) else 0.0
+            first[r] = (y if zero is None else zero)[idx[0]] if len(idx) else 0.0
         self.fold_fit, self.fold_test = [], []
         for k in range(self.K):
             m = fold == k

@@ -35,6 +35,14 @@ says so.  (A lag model whose terms are all plain temperatures is a sub-model of 
 regression: there the static regression is the more complex and must be significantly
 below the lag model instead.)
 
+Many runs (:func:`volerr.loop.drift.basis.many_runs`: folds of whole runs and at least
+``basis.MANY_RUNS`` training runs): the unit of
+the paired test is the run, one CV mean square per training run (n - 1 degrees of freedom),
+not ``SUB_BLOCKS`` blocks of every fold: a run's level error is one error, and its blocks are
+not independent of each other.  The static regression, judged the same way, is then the
+better baseline only when significantly below the constant run by run (many near-collinear
+temperatures fit within runs and need not carry across them).
+
 Prediction interval (``LEVEL`` = 95 %): per blocked CV fold the ``LEVEL`` quantile of the
 absolute CV residuals of the chosen family, and the half-width the largest of them
 (symmetric, um).  Why: the held-out part is one stretch the fit never saw, like one fold;
@@ -76,7 +84,7 @@ def cv_residuals(ch, D) -> np.ndarray:
     training folds (a fold of whole runs from the run's first reading plus the terms)."""
     y, fold, n_runs = ch.y, ch.fold, ch.n_runs
     r = np.full(len(y), np.nan)
-    first = y[ch.s.firsts()]
+    first = ch.s.zero(y)[ch.s.firsts()]
     K = int(fold.max()) + 1
     parts = [(D[fold == k].T @ D[fold == k], D[fold == k].T @ y[fold == k]) for k in range(K)]
     G, h = sum(p[0] for p in parts), sum(p[1] for p in parts)
@@ -102,6 +110,23 @@ def block_mse(fold, r, sub: int = SUB_BLOCKS) -> np.ndarray:
     return np.array(out)
 
 
+def by_runs(ch) -> bool:
+    """Whether the paired test's unit is the run (module docstring): folds of whole runs and
+    at least ``basis.MANY_RUNS`` training runs (:func:`volerr.loop.drift.basis.many_runs`)."""
+    runs = np.unique(ch.s.run[ch.fold >= 0])
+    return basis.whole_runs(ch.rule) and len(runs) >= basis.MANY_RUNS
+
+
+def unit_mse(ch, r) -> np.ndarray:
+    """The mean squares (um^2) of the CV residuals ``r`` per unit of the paired test: per
+    training run (:func:`by_runs`), else per block (:func:`block_mse`)."""
+    if not by_runs(ch):
+        return block_mse(ch.fold, r)
+    tr = ch.fold >= 0
+    return np.array([float(np.mean(r[tr & (ch.s.run == k)] ** 2))
+                     for k in np.unique(ch.s.run[tr])])
+
+
 def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
            regularised=None) -> dict:
     """The family of the channel by the module's rule: ``designs`` family -> design matrix;
@@ -116,7 +141,7 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
     resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
     if regularised is not None:
         resid["regularised"] = regularised
-    mse = {f: block_mse(ch.fold, r) for f, r in resid.items()}
+    mse = {f: unit_mse(ch, r) for f, r in resid.items()}
     tr = ch.fold >= 0
     cv_rms = {f: math.sqrt(float(np.mean(r[tr] ** 2))) for f, r in resid.items()}
     pairs = [("static", "constant"), ("lag", "constant"), ("lag", "static")]
@@ -124,8 +149,11 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
         pairs += [("regularised", "constant"), ("regularised", "static"),
                   ("lag", "regularised")]
     t = {f"{a}_vs_{b}": paired_t(mse[b] - mse[a]) for a, b in pairs}
-    # the better baseline: the lower CV mean square (a tie to the constant, the simpler)
+    # the better baseline: the lower CV mean square (a tie to the constant, the simpler); run
+    # by run, the static regression must be significantly below the constant (many runs)
     fam = "static" if cv_rms["static"] < cv_rms["constant"] * (1 - TIE_SCORE_REL) else "constant"
+    if by_runs(ch) and not significantly_below(mse["static"], mse["constant"]):
+        fam = "constant"
     reg_ok = regularised is not None and all(significantly_below(mse["regularised"], mse[b])
                                              for b in ("static", "constant"))
     if reg_ok:
@@ -138,23 +166,26 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
     if named and (not reg_ok or significantly_below(mse["lag"], mse["regularised"])):
         fam = "lag"
     K = len(mse["lag"])
+    units = ("training runs (one CV mean square per run: the run is the unit of "
+             "independence)" if by_runs(ch) else
+             f"blocks ({SUB_BLOCKS} per blocked CV fold)")
     return {"family": fam, "named": named and fam in ("lag", "regularised"),
             "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
-            "cv_resid": resid[fam], "rule": _rule_text(K, regularised is not None)}
+            "cv_resid": resid[fam], "paired_units": "runs" if by_runs(ch) else "blocks",
+            "rule": _rule_text(K, regularised is not None, units)}
 
 
-def _rule_text(K: int, regularised: bool) -> str:
+def _rule_text(K: int, regularised: bool, units: str) -> str:
     if not regularised:
-        return (f"lag model only if, against each baseline, the paired t over {K} blocks "
-                f"({SUB_BLOCKS} per blocked CV fold) of (baseline's - lag model's CV mean "
-                f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df); else the "
-                f"baseline of lower CV mean square")
+        return (f"lag model only if, against each baseline, the paired t over {K} {units} "
+                f"of (baseline's - lag model's CV mean square) >= {t95(K - 1):.3f} "
+                f"(one-sided 95 %, {K - 1} df); else the baseline of lower CV mean square")
     return (f"the regularised fit over the lag bank if, against each baseline, the paired t "
-            f"over {K} blocks ({SUB_BLOCKS} per blocked CV fold) of (baseline's - its CV mean "
-            f"square) >= {t95(K - 1):.3f} (one-sided 95 %, {K - 1} df), unless the lag model "
-            f"is so below it; the lag model if so below each baseline (its terms named "
-            f"wherever it is, the prediction the regularised fit's unless the lag model beats "
-            f"it too); else the baseline of lower CV mean square")
+            f"over {K} {units} of (baseline's - its CV mean square) >= {t95(K - 1):.3f} "
+            f"(one-sided 95 %, {K - 1} df), unless the lag model is so below it; the lag "
+            f"model if so below each baseline (its terms named wherever it is, the prediction "
+            f"the regularised fit's unless the lag model beats it too); else the baseline of "
+            f"lower CV mean square")
 
 
 def interval(cv_resid, y, pred, fold, test) -> dict:

@@ -76,7 +76,7 @@ class Channel:
     def cv(self, D) -> float:
         """Cross-validated mean square (um^2) of the model with the columns ``D``."""
         eng = Engine(D, self.y, self.fold, basis.whole_runs(self.rule), self.s.run,
-                     self.n_runs)
+                     self.n_runs, zero=self.s.zero(self.y))
         return eng.cv_sse(np.eye(D.shape[1])) / eng.n
 
     def design(self, specs, taus=None) -> np.ndarray:
@@ -94,7 +94,7 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
     fold, rule = basis.folds(s)
     R = s.indicators()
     Z = np.column_stack([R, X])
-    cands = _candidates(s, cols, differences)
+    cands = _candidates(s, cols, differences, basis.many_runs(s))
     out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {}}
     cache: dict = {}
     for label, y in s.channels.items():
@@ -103,15 +103,18 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
         out["channels"][label] = _channel(Channel(s, y, R, fold, rule), cols, Z, cands, cache)
     return out
 
-def _candidates(s, cols, differences: bool) -> tuple:
+def _candidates(s, cols, differences: bool, many: bool = False) -> tuple:
     """(heat candidates, sensor candidates) as (nc, 2) pairs: a sensor's lag is searched up
     to ``SENSOR_TAU_SPAN`` of the training span (a longer lag of a slowly moving sensor is a
-    trend, not an effect: it cannot be told from one within the data)."""
+    trend, not an effect: within one run's stretches it cannot be told from one); with
+    ``many`` runs (:func:`volerr.loop.drift.basis.many_runs`) every lag of the grid (each fold
+    a run predicted from its own start and inputs: a trend that is no effect does not carry
+    over to several of them, and the room reaches the structure through hours)."""
     span = float(max(np.ptp(s.t_s[s.train & (s.run == r)]) if np.any(s.train & (s.run == r))
                      else 0.0 for r in range(len(s.runs))))
+    cap = np.inf if many else basis.SENSOR_TAU_SPAN * span
     c = sel.candidates(cols)
-    keep = np.array([cols[a].p is not None or cols[a].tau_s <= basis.SENSOR_TAU_SPAN * span
-                     for a, _ in c], bool)
+    keep = np.array([cols[a].p is not None or cols[a].tau_s <= cap for a, _ in c], bool)
     if not differences:
         keep &= c[:, 1] < 0
     c = c[keep]
@@ -120,7 +123,8 @@ def _candidates(s, cols, differences: bool) -> tuple:
 
 
 def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
-    eng = Engine(Z, ch.y, ch.fold, basis.whole_runs(ch.rule), ch.s.run, ch.n_runs, cache)
+    eng = Engine(Z, ch.y, ch.fold, basis.whole_runs(ch.rule), ch.s.run, ch.n_runs, cache,
+                 ch.s.zero(ch.y))
     heat_c, sensor_c = cands
     terms = []
     if len(heat_c):
@@ -137,7 +141,7 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
            "static": predict(ch.s, Ds, _fit(Ds, ch.y, tr), ch.y),
            "constant": predict(ch.s, ch.R, _fit(ch.R, ch.y, tr), ch.y),
            "regularised": reg["pred"], "shrink": reg,
-           "before": ch.y[ch.s.firsts()][ch.s.run]}
+           "before": ch.s.zero(ch.y)}
     out["choice"] = family.choose(ch, {"constant": ch.R, "static": Ds, "lag": fit["design"]},
                                   bool(specs), _nested_in_static(specs),
                                   regularised=reg["cv_resid"])
@@ -173,7 +177,7 @@ def _spec(cols, term) -> dict:
     a, b = term["pair"]
     ca = cols[a]
     sp = {"source": ca.source, "p": ca.p, "tau_s": ca.tau_s,
-          "minus": None if b < 0 else cols[b].source,
+          "minus": ca.minus if b < 0 else cols[b].source,
           "cv_rms_um": math.sqrt(term["cv_mse"]),
           "cv_rms_before_um": math.sqrt(term["cv_mse_before"]),
           "delta_bic": term["delta_bic"],
@@ -187,8 +191,8 @@ def _same_term(cols, x, ca, b) -> bool:
     """An alternative that is the chosen term at a neighbouring grid lag (the refinement
     searches there) is no other explanation."""
     c = cols[x[0]]
-    same = (c.source, c.p, x[1] < 0 or cols[x[1]].source) == \
-        (ca.source, ca.p, b < 0 or cols[b].source)
+    same = (c.source, c.p, c.minus if x[1] < 0 else cols[x[1]].source) == \
+        (ca.source, ca.p, ca.minus if b < 0 else cols[b].source)
     return same and (c.tau_s > 0) == (ca.tau_s > 0) and (
         c.tau_s == 0 or abs(math.log(c.tau_s / ca.tau_s)) < 1.5 * _grid_step(cols))
 
@@ -202,7 +206,8 @@ def _alt(cols, x) -> dict:
     a, b, rms, t = x
     c = cols[a]
     src = basis.SPEED if c.source == "heat" else c.source
-    return {"covariate": src if b < 0 else f"{src} - {cols[b].source}",
+    minus = c.minus if b < 0 else cols[b].source
+    return {"covariate": f"{src} - {minus}" if minus else src,
             "p": c.p, "lag_s": c.tau_s or None, "cv_rms_um": round(rms, 4),
             "paired_t": round(t, 3)}
 
@@ -355,5 +360,5 @@ def predict(s, D, b, y) -> np.ndarray:
     n_runs = len(s.runs)
     zeros = b[:n_runs].copy()
     seen = np.array([np.any(s.train & (s.run == r)) for r in range(n_runs)])
-    zeros[~seen] = y[s.firsts()][~seen]
+    zeros[~seen] = s.zero(y)[s.firsts()][~seen]
     return zeros[s.run] + D[:, n_runs:] @ b[n_runs:]

@@ -20,7 +20,7 @@ from ...results import ResultMixin, Row
 from ...selection.rules import SIG_K
 from . import basis
 from .series import DriftSeries, left_out_line
-from .split import extrapolation_line
+from .split import extrapolation_line, kept_out_line
 
 K_PRINT = 2.0      # coverage factor of the printed uncertainties (the loop's console, 3-D too)
 
@@ -111,6 +111,8 @@ class DriftReport(ResultMixin):
                   else "")]
         if d.get("extrapolation"):
             out.insert(0, "  " + extrapolation_line(d["extrapolation"]))
+        if d.get("kept_out"):
+            out.insert(0, "  " + kept_out_line(d["kept_out"]))
         if d.get("inputs_left_out"):
             out.insert(0, "  " + left_out_line(d["inputs_left_out"]))
         for label, c in d["channels"].items():

@@ -163,14 +163,14 @@ def modelled_series(s: basis.DriftSeries, rows: Rows) -> tuple[basis.DriftSeries
 
 def run_constant(s: basis.DriftSeries, e: np.ndarray) -> np.ndarray:
     """The residual's constant per run, at every reading (N,): its mean over the run's
-    training readings; a run without training readings, its value at the run's first
-    reading (as a held-out run's zero is its first reading)."""
+    training readings; a run without training readings, its zero (as a held-out run's zero
+    is, :meth:`~volerr.loop.drift.series.DriftSeries.zero`)."""
     out = np.empty(len(e))
-    firsts = s.firsts()
+    firsts, zero = s.firsts(), s.zero(e)
     for r in range(len(s.runs)):
         m = s.run == r
         tr = m & s.train
-        out[m] = e[tr].mean() if tr.any() else e[firsts[r]]
+        out[m] = e[tr].mean() if tr.any() else zero[firsts[r]]
     return out
 
 
@@ -186,7 +186,7 @@ def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict
     for i, k in enumerate(rows.channels):
         c = run_constant(s, resid[k])
         y = s.channels[k]
-        p = {"before": y[s.firsts()][s.run], "terms": [], "quantities": []}
+        p = {"before": s.zero(y), "terms": [], "quantities": []}
         on = [(j, q) for j, q in enumerate(rows.quantities) if rows.A[i, j] != 0]
         for name in ("after", "static", "constant", "regularised", "lag"):
             p[name] = c + sum(rows.A[i, j] * qpred[q.symbol][name] for j, q in on)

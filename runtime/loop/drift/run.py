@@ -64,7 +64,8 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
             "budgets": {},
             "not_significant": [], "not_reported": [], "unidentifiable": [],
-            "extrapolation": extrapolation(s), "inputs_left_out": list(s.left_out)}
+            "extrapolation": extrapolation(s), "inputs_left_out": list(s.left_out),
+            "kept_out": basis.kept_out(s)}
     if s.environments:        # each run's environment (the folds' groups, basis.folds)
         data["environments"] = {(f if not r else f"{f}[{r}]"): e
                                 for (f, r), e in zip(s.runs, s.environments)}

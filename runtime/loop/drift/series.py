@@ -54,6 +54,14 @@ class DriftSeries:
         """Index (n_runs,) of every run's first reading."""
         return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
 
+    def zero(self, v) -> np.ndarray:
+        """The zero of ``v`` (N,) in its run, at every reading (N,): its first reading, the
+        value a run is predicted from where its zero is not fitted (a held-out run, a fold of
+        whole runs), the same for the readings and every model column (each column is its
+        change since it), in every family.  (The mean of the first readings before the
+        spindle starts was measured and not adopted: docs/drift_loop.md.)"""
+        return np.asarray(v, float)[self.firsts()][self.run]
+
 
 
 def load_series(paths) -> DriftSeries:

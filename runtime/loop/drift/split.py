@@ -167,3 +167,15 @@ def extrapolation_line(items: list) -> str:
              f"{e['train_min']:.4g}..{e['train_max']:.4g})" for e in items]
     return ("warning: the held-out readings leave the training range of " + ", ".join(parts)
             + ": there the model extrapolates, its held-out figures judge an extrapolation")
+
+
+def kept_out_line(items: list) -> str:
+    """One console line naming the sensors :func:`volerr.loop.drift.basis.kept_out` found
+    (empty: '')."""
+    if not items:
+        return ""
+    parts = [f"{e['input']} {e['test_change']:.3g} (training {e['train_change']:.3g})"
+             for e in items]
+    return ("warning: kept out of the lag model, their held-out runs change far more than the "
+            "training runs (peak to peak since each run's zero): " + ", ".join(parts)
+            + "; their coefficients were never determined, what they do there is unmodelled")
