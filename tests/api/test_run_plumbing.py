@@ -8,22 +8,7 @@ import pytest
 
 import volerr
 from volerr.cli import main
-from volerr.errors import InputError
-
-
-def _command_error(argv, capsys) -> str:
-    assert main([str(a) for a in argv]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    prefix = f"volerr {argv[0]}: error: "
-    assert err[0].startswith(prefix), err[0]
-    return err[0][len(prefix):]
-
-
-def _api_error(call) -> str:
-    with pytest.raises(InputError) as exc:
-        call()
-    return str(exc.value)
+from helpers.refusals import api_error, command_error
 
 
 # --- the identification of a run from its options as a plain dict ----------------------------
@@ -57,9 +42,9 @@ def test_identification_from_the_options_dict(tmp_path):
 def test_identification_date_refused_alike(capsys, tmp_path):
     from volerr.certificate import from_options
 
-    said = _command_error(["iso230-2", tmp_path / "run.csv", "--date", "2026-13-40"], capsys)
+    said = command_error(["iso230-2", tmp_path / "run.csv", "--date", "2026-13-40"], capsys)
     assert "--date" in said
-    assert _api_error(lambda: from_options({"date": "2026-13-40"})) == said
+    assert api_error(lambda: from_options({"date": "2026-13-40"})) == said
 
 
 # --- outputs declared from the options, in the order of the refusals ---------------------------
@@ -68,9 +53,9 @@ def test_planned_outputs_refuses_in_declaration_order(tmp_path):
 
     missing = tmp_path / "no-such-folder"
     options = {"json": str(missing / "r.json"), "html": None, "force": False}
-    said = _api_error(lambda: planned_outputs(options, [], first={"--out": str(missing / "o")}))
+    said = api_error(lambda: planned_outputs(options, [], first={"--out": str(missing / "o")}))
     assert said.startswith("--out"), said             # first: before the report outputs
-    said = _api_error(lambda: planned_outputs(options, [], **{"--out": str(missing / "o")}))
+    said = api_error(lambda: planned_outputs(options, [], **{"--out": str(missing / "o")}))
     assert said.startswith("--json"), said            # more: after them
 
 
@@ -79,7 +64,7 @@ def test_planned_outputs_never_over_an_input(tmp_path):
 
     data = tmp_path / "data.csv"
     data.write_text("x\n1\n")
-    said = _api_error(lambda: planned_outputs({"json": str(data)}, [data]))
+    said = api_error(lambda: planned_outputs({"json": str(data)}, [data]))
     assert "--json" in said and "input" in said
     assert data.read_text() == "x\n1\n"
 
@@ -94,15 +79,15 @@ def test_check_form_split_and_refused_alike(capsys, tmp_path):
     assert command_form(["plan", "DMU50"], ["ref.json"], {"tolerance": None}) == (
         True, ["plan", "DMU50"], "ref.json")
     ref = tmp_path / "ref.json"
-    said = _command_error(["check", "plan", "DMU50", "--reference", ref, "--tolerance", "1"],
+    said = command_error(["check", "plan", "DMU50", "--reference", ref, "--tolerance", "1"],
                           capsys)
     assert said == "--tolerance belongs to 'volerr check LAYOUT FILE...'"
-    assert _api_error(lambda: command_form(["plan", "DMU50"], [str(ref)],
+    assert api_error(lambda: command_form(["plan", "DMU50"], [str(ref)],
                                            {"tolerance": "1"})) == said
-    said = _command_error(["check", "DMU50", "a.csv", "--reference", ref, "--minutes", "5"],
+    said = command_error(["check", "DMU50", "a.csv", "--reference", ref, "--minutes", "5"],
                           capsys)
     assert said == "--minutes belongs to 'volerr check plan'"
-    said = _command_error(["check", "plan", "DMU50", "MB1", "--reference", ref], capsys)
+    said = command_error(["check", "plan", "DMU50", "MB1", "--reference", ref], capsys)
     assert said.startswith("check plan: give one LAYOUT (usage: volerr check plan LAYOUT")
 
 
@@ -112,20 +97,20 @@ def test_plan_folder_refused_alike(capsys, tmp_path):
 
     taken = tmp_path / "plan-here"
     taken.write_text("a file, not a folder\n")
-    said = _command_error(["plan", "MB1", "--instrument", "sphere", "--readings", "100",
+    said = command_error(["plan", "MB1", "--instrument", "sphere", "--readings", "100",
                            "--out", taken], capsys)
     assert said == f"--out {taken}: a file, not a folder"
-    assert _api_error(lambda: check_options(100, out=taken)) == said
+    assert api_error(lambda: check_options(100, out=taken)) == said
     check_options(100)          # no folder given: nothing to check
 
 
 def test_check_plan_without_out_refused_alike(capsys, tmp_path):
     from volerr.check._plan import check_plan_options
 
-    said = _command_error(["check", "plan", "DMU50", "--reference", tmp_path / "ref.json",
+    said = command_error(["check", "plan", "DMU50", "--reference", tmp_path / "ref.json",
                            "--instrument", "sphere"], capsys)
     assert said == "check plan: give --out DIR"
-    assert _api_error(lambda: check_plan_options(["sphere"], out=None)) == said
+    assert api_error(lambda: check_plan_options(["sphere"], out=None)) == said
     check_plan_options(["sphere"])     # the API's own call: no folder to check
 
 
@@ -135,10 +120,10 @@ def test_identify_origin_refused_alike(origin, capsys, tmp_path):
     from volerr.identify.api import identify
 
     data = tmp_path / "tracker.csv"          # never read: the origin is refused first
-    said = _command_error(["identify", "MB1", data, "--axis", "X", "--out",
+    said = command_error(["identify", "MB1", data, "--axis", "X", "--out",
                            tmp_path / "X.csv", "--origin", *origin], capsys)
     assert said.startswith("--origin: ")
-    assert _api_error(lambda: identify("MB1", "X", data, origin=origin)) == said
+    assert api_error(lambda: identify("MB1", "X", data, origin=origin)) == said
     assert not (tmp_path / "X.csv").exists()
 
 
