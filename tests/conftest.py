@@ -25,8 +25,8 @@ matplotlib.use("Agg")  # no display on CI; every plot goes to a file
 # assertion rewriting) from source again.  The pytest processes now write them once into the
 # checkout's __pycache__ folders (.gitignore); every later process reads them (the processes
 # the tests start keep the environment: they read, never write).  Nothing a test checks lists
-# those folders.  Measured from a checkout without them (-p no:xdist, 4 pairs, load 5-7):
-# tests/fiveaxis/test_compensate.py + tests/cli/test_cli_core.py 19.5 -> 15.2 s CPU.
+# those folders.  Measured from a checkout without them (-p no:xdist, 2 pairs, load 6-7):
+# tests/fiveaxis/test_compensate.py + tests/cli/test_cli_core.py 20.7 -> 15.9 s CPU.
 sys.dont_write_bytecode = False
 
 settings.register_profile("deterministic", derandomize=True, database=None,
