@@ -16,6 +16,7 @@ not drive the choice.  Units: mm rows; BIC in natural-log units.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -39,6 +40,8 @@ LAG_CACHE = 48       # lagged series (all points) kept while screening
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
+#: the time constant of a lag in a basis text (the one number a lag profile varies)
+_LAG_ARG = re.compile(r"lag\(\s*(\w+)\s*,\s*[^,)]+")
 
 
 class Base:
@@ -260,14 +263,30 @@ class Context:
             n = len(self.pts)
             cols = np.zeros((n, 3, len(values)))
             for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
-                basis = np.column_stack([np.broadcast_to(
-                    evaluate(m[i][2], self.basis_values(m[i][2])), (n,)) for m in made])
+                texts = [m[i][2] for m in made]
+                basis = self._lag_profile_basis(texts) if c.search.what == "lag_s" else None
+                if basis is None:
+                    basis = np.column_stack([np.broadcast_to(
+                        evaluate(t, self.basis_values(t)), (n,)) for t in texts])
                 cols += self.target_column(target)[:, :, None] * basis[:, None, :]
             rows = (cols * self.sw[:, None, None]).reshape(-1, len(values))
             if c.search.what == "lag_s":    # hundreds of lag candidates: not kept
                 return rows
             self.cache[key] = rows
         return self.cache[key]
+
+    def _lag_profile_basis(self, texts) -> np.ndarray | None:
+        """(n, G) basis of the texts of one lag term at G time constants, evaluated once with
+        the G lagged series stacked (G, n) in place of the first text's lag: the texts differ
+        only in the time constant of their one lag, so every element is the same arithmetic on
+        the same numbers as evaluating each text alone; None when they are not of that shape."""
+        calls = [lag_calls(t) for t in texts]
+        if any(len(cl) != 1 for cl in calls) or \
+                len({_LAG_ARG.sub(r"lag(\1, TAU", t) for t in texts}) != 1:
+            return None
+        stacked = np.stack([self.lag_at_points(*cl[0]) for cl in calls])
+        vals = {**self.values(), calls[0][0][0]: stacked}
+        return np.broadcast_to(evaluate(texts[0], vals), stacked.shape).T
 
 
 class _Taken(Mapping):

@@ -31,14 +31,27 @@ def generate_source(layout: Layout) -> str:
     return generate_module(layout)
 
 
+#: reduced module texts derived in this process: the layout's repr (every field) -> text
+_FIT_SOURCES: dict = {}
+#: how many :data:`_FIT_SOURCES` keeps (the most recently derived)
+FIT_SOURCES_KEPT = 16
+
+
 def fit_source(layout: Layout) -> str:
     """A reduced module text of ``layout`` for fitting (imports sympy): the constants of
     :func:`generate_source` and only ``sensitivity`` and ``setup_sensitivity``.  Used by
     ``volerr loop`` for its augmented model during the run; the full text is derived only
-    when it is written or asked for."""
-    from volerr.derive.generate import generate_fit_module
+    when it is written or asked for.  The derivation is deterministic, so a text derived
+    in this process for an equal layout (every field) is reused: a loop run again on the
+    same data augments the layout the same way."""
+    key = repr(layout)
+    if key not in _FIT_SOURCES:
+        from volerr.derive.generate import generate_fit_module
 
-    return generate_fit_module(layout)
+        while len(_FIT_SOURCES) >= FIT_SOURCES_KEPT:
+            _FIT_SOURCES.pop(next(iter(_FIT_SOURCES)))
+        _FIT_SOURCES[key] = generate_fit_module(layout)
+    return _FIT_SOURCES[key]
 
 
 def module_filename(layout: Layout) -> str:

@@ -42,11 +42,12 @@ def parse(text: str) -> ast.Expression:
         tree = ast.parse(str(text), mode="eval")
     except SyntaxError:
         raise InputError(f"basis expression {text!r} is not a valid expression") from None
-    require_small = len(str(text)) <= MAX_CHARS and sum(1 for _ in ast.walk(tree)) <= MAX_NODES
+    nodes = list(ast.walk(tree))        # walked once: counted here, checked below
+    require_small = len(str(text)) <= MAX_CHARS and len(nodes) <= MAX_NODES
     if not require_small:
         raise InputError(f"basis expression {str(text)[:40]!r}...: longer than {MAX_CHARS} "
                          f"characters or {MAX_NODES} terms")
-    for node in ast.walk(tree):
+    for node in nodes:
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
             e = node.right
             if isinstance(e, ast.UnaryOp) and isinstance(e.op, (ast.USub, ast.UAdd)):

@@ -40,7 +40,8 @@ import pytest
 
 from helpers import drift_sim as D
 
-pytestmark = pytest.mark.slow
+# the module fixture's loop runs once, on one xdist worker (a case's two tests share it)
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("drift_acceptance")]
 
 FLOOR_FACTOR = 1.15
 TAU_TOLERANCE = 0.25

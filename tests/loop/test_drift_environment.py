@@ -32,6 +32,9 @@ from helpers import spindle_machine_sim as M
 from volerr.errors import InputError
 from volerr.loop.drift.run import loop_drift
 
+# the module fixture's loop runs once, on one xdist worker (not once per worker)
+pytestmark = pytest.mark.xdist_group("drift_environment")
+
 FLOOR_FACTOR = 1.5
 SAMPLE_S = 60.0
 SEED = 2044
