@@ -86,6 +86,7 @@ def read_runs(paths) -> tuple[list, list]:
         require(set(r.channels) == set(first.channels),
                 f"{r.name}: its channels ({', '.join(r.channels)}) differ from {first.name}'s "
                 f"({', '.join(first.channels)}); the runs of one loop log the same channels")
+    _refuse_twice(runs)
     found = [e for r in runs for e in faults(r)]
     bad = next((e for e in found if e.get("channel")), None)
     require(bad is None, f"{bad and bad['file']}: channel {bad and fault_text(bad)}: a channel "
@@ -106,6 +107,25 @@ def read_runs(paths) -> tuple[list, list]:
     for r in runs:
         r.inputs = {k: v for k, v in r.inputs.items() if k not in gone}
     return runs, left
+
+
+def _refuse_twice(runs) -> None:
+    """One line when two runs hold the same readings (the same file given twice, or a copy
+    under another name, e.g. once as data and once held out): a run counted twice is
+    predicted from its own copy in the cross-validation of whole runs, and a held-out copy
+    is judged on the readings the model was fitted on (its held-out figure is not held out)."""
+    import hashlib
+
+    seen: dict = {}
+    for r in runs:
+        h = hashlib.sha256(np.ascontiguousarray(r.t_s, float).tobytes())
+        for k in sorted(r.channels):
+            h.update(k.encode() + np.ascontiguousarray(r.channels[k], float).tobytes())
+        key = h.hexdigest()
+        other = seen.setdefault(key, r)
+        require(other is r, f"{r.name}: the same readings as {other.name} (one run given twice, "
+                            f"or copied under another name): a run counted twice is judged on "
+                            f"its own copy; give each run once")
 
 
 def left_out_line(left: list) -> str:
