@@ -110,17 +110,18 @@ def read_runs(paths) -> tuple[list, list]:
 
 
 def _refuse_twice(runs) -> None:
-    """One line when two runs hold the same readings (the same file given twice, or a copy
-    under another name, e.g. once as data and once held out): a run counted twice is
-    predicted from its own copy in the cross-validation of whole runs, and a held-out copy
-    is judged on the readings the model was fitted on (its held-out figure is not held out)."""
+    """One line when two runs hold the same readings, times, channels and inputs alike (the
+    same file given twice, or a copy under another name, e.g. once as data and once held
+    out): a run counted twice is predicted from its own copy in the cross-validation of
+    whole runs, and a held-out copy is judged on the readings the model was fitted on (its
+    held-out figure is not held out)."""
     import hashlib
 
     seen: dict = {}
     for r in runs:
         h = hashlib.sha256(np.ascontiguousarray(r.t_s, float).tobytes())
-        for k in sorted(r.channels):
-            h.update(k.encode() + np.ascontiguousarray(r.channels[k], float).tobytes())
+        for k, v in sorted({**r.channels, **r.inputs}.items()):
+            h.update(k.encode() + np.ascontiguousarray(v, float).tobytes())
         key = h.hexdigest()
         other = seen.setdefault(key, r)
         require(other is r, f"{r.name}: the same readings as {other.name} (one run given twice, "
