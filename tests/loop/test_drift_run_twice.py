@@ -1,5 +1,6 @@
 """A run given twice (the same file twice, or a copy under another name held out) would be
-judged on its own readings: refused with one line naming both, nothing written."""
+judged on its own readings: refused with one line naming both, nothing written.  A run whose
+channel is in mm under its ``_um`` header (1000x small against the other runs) likewise."""
 
 from __future__ import annotations
 
@@ -57,3 +58,20 @@ def test_distinct_runs_pass(tmp_path):
     r = _loop(tmp_path, *files, "--holdout-files", tmp_path / "day2.csv")
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "out.json").exists()
+
+
+def test_a_run_in_mm_under_the_um_header_is_refused(tmp_path):
+    """One day's channel written in mm (values 1000x small) among days in um: one line naming
+    that file and the likely mistake; nothing written."""
+    for i in range(4):
+        _run_file(tmp_path / f"day{i}.csv", i)
+    lines = (tmp_path / "day2.csv").read_text().splitlines()
+    head, rows = lines[:2], [r.split(",") for r in lines[2:]]
+    rows = [[a, f"{float(b) / 1000:.7f}", c, e] for a, b, c, e in rows]
+    (tmp_path / "day2.csv").write_text("\n".join(head + [",".join(r) for r in rows]) + "\n")
+    files = [f"drift:{tmp_path / f'day{i}.csv'}" for i in range(4)]
+    r = _loop(tmp_path, *files, "--holdout-files", tmp_path / "day3.csv")
+    assert r.returncode == 2, r.stdout
+    err = r.stderr.strip().splitlines()
+    assert len(err) == 1 and "day2.csv" in err[0] and "mm" in err[0], err
+    assert not (tmp_path / "out.json").exists()

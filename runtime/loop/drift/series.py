@@ -87,6 +87,7 @@ def read_runs(paths) -> tuple[list, list]:
                 f"{r.name}: its channels ({', '.join(r.channels)}) differ from {first.name}'s "
                 f"({', '.join(first.channels)}); the runs of one loop log the same channels")
     _refuse_twice(runs)
+    _refuse_unit_slip(runs)
     found = [e for r in runs for e in faults(r)]
     bad = next((e for e in found if e.get("channel")), None)
     require(bad is None, f"{bad and bad['file']}: channel {bad and fault_text(bad)}: a channel "
@@ -127,6 +128,28 @@ def _refuse_twice(runs) -> None:
         require(other is r, f"{r.name}: the same readings as {other.name} (one run given twice, "
                             f"or copied under another name): a run counted twice is judged on "
                             f"its own copy; give each run once")
+
+
+#: a run whose channel ranges less than this share of the other runs' median range: a unit
+#: slip (mm written under a ``_um`` header is 1000x small); real runs differ by far less,
+#: since a channel's range holds at least its reading noise
+UNIT_SLIP = 1 / 200
+
+
+def _refuse_unit_slip(runs) -> None:
+    """One line when, in a campaign of three runs or more, one run's channel spans less than
+    ``UNIT_SLIP`` of the median span (peak to peak, um) of the runs: the likely mistake is a
+    channel in mm under its ``_um`` header (nm under it is refused by the drift reader)."""
+    if len(runs) < 3:
+        return
+    for k in runs[0].channels:
+        span = np.array([float(np.ptp(r.channels[k])) for r in runs])
+        med = float(np.median(span))
+        for r, v in zip(runs, span):
+            require(not (med > 0 and v < UNIT_SLIP * med),
+                    f"{r.name}: channel d_{k}_um spans {v:.3g} um where the runs' median span "
+                    f"is {med:.3g} um ({med / max(v, 1e-300):.0f}x more): mm under the _um "
+                    f"header? give the channel in um")
 
 
 def left_out_line(left: list) -> str:
