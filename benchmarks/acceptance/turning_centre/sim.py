@@ -146,6 +146,30 @@ def network_matrices():
 
 
 # ---------------------------------------------------------------- spindle programmes
+#: the programmes of cuts and pauses: (cut length s (lo, hi), speed / S_ref (one value, or
+#: a tuple chosen per cut), x duty, z duty, pause s (lo, hi)).  duty: production, 15-25 min
+#: cuts, 5-10 min loading; light: finishing at a low speed, long pauses; highspeed: above
+#: S_ref, only in --hard's held-out days
+CUTS = {
+    "duty": ((900, 1500), (0.7, 0.75, 0.8), 0.6, 0.8, (300, 600)),
+    "light": ((1800, 3000), 0.35, 0.3, 0.4, (900, 1800)),
+    "highspeed": ((1200, 2400), 1.25, 0.4, 0.9, (300, 900)),
+}
+
+
+def _cuts(segs, rng, work, t, on_s, speed, x_duty, z_duty, off_s):
+    """Append cuts and pauses (:data:`CUTS`) to ``segs`` until ``work`` s; return the time."""
+    while t < work:
+        on = min(rng.uniform(*on_s), work - t)
+        s = rng.choice(list(speed)) if isinstance(speed, tuple) else speed
+        segs.append((on, s * S_REF, 1, x_duty, z_duty))
+        t += on
+        off = min(rng.uniform(*off_s), max(work - t, 1.0))
+        segs.append((off, 0.0, 0, 0.0, 0.0))
+        t += off
+    return t
+
+
 def programme_segments(name, hours, rng):
     """Return a list of (duration_s, S_rpm, cutting 0/1, x_duty, z_duty) filling `hours`.
 
@@ -169,30 +193,8 @@ def programme_segments(name, hours, rng):
             d = min(1200.0, work - t)
             segs.append((d, 0.6 * S_REF, 1, 0.5, 0.7))
             t += d
-    elif name == "duty":                # production: 15-25 min cuts, 5-10 min loading
-        while t < work:
-            on = min(rng.uniform(900, 1500), work - t)
-            segs.append((on, rng.choice([0.7, 0.75, 0.8]) * S_REF, 1, 0.6, 0.8))
-            t += on
-            off = min(rng.uniform(300, 600), max(work - t, 1.0))
-            segs.append((off, 0.0, 0, 0.0, 0.0))
-            t += off
-    elif name == "light":               # finishing at a low speed, long pauses
-        while t < work:
-            on = min(rng.uniform(1800, 3000), work - t)
-            segs.append((on, 0.35 * S_REF, 1, 0.3, 0.4))
-            t += on
-            off = min(rng.uniform(900, 1800), max(work - t, 1.0))
-            segs.append((off, 0.0, 0, 0.0, 0.0))
-            t += off
-    elif name == "highspeed":           # only in --hard's held-out days: above S_ref
-        while t < work:
-            on = min(rng.uniform(1200, 2400), work - t)
-            segs.append((on, 1.25 * S_REF, 1, 0.4, 0.9))
-            t += on
-            off = min(rng.uniform(300, 900), max(work - t, 1.0))
-            segs.append((off, 0.0, 0, 0.0, 0.0))
-            t += off
+    elif name in CUTS:
+        t = _cuts(segs, rng, work, t, *CUTS[name])
     else:
         raise ValueError(name)
     segs.append((max(total - sum(s[0] for s in segs), 60.0), 0.0, 0, 0.0, 0.0))
