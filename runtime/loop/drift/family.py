@@ -84,7 +84,7 @@ def cv_residuals(ch, D) -> np.ndarray:
     training folds (a fold of whole runs from the run's first reading plus the terms)."""
     y, fold, n_runs = ch.y, ch.fold, ch.n_runs
     r = np.full(len(y), np.nan)
-    first = ch.s.zero(y)[ch.s.firsts()]
+    first = ch.s.run_zeros(y)
     K = int(fold.max()) + 1
     parts = [(D[fold == k].T @ D[fold == k], D[fold == k].T @ y[fold == k]) for k in range(K)]
     G, h = sum(p[0] for p in parts), sum(p[1] for p in parts)

@@ -360,5 +360,5 @@ def predict(s, D, b, y) -> np.ndarray:
     n_runs = len(s.runs)
     zeros = b[:n_runs].copy()
     seen = np.array([np.any(s.train & (s.run == r)) for r in range(n_runs)])
-    zeros[~seen] = s.zero(y)[s.firsts()][~seen]
+    zeros[~seen] = s.run_zeros(y)[~seen]
     return zeros[s.run] + D[:, n_runs:] @ b[n_runs:]

@@ -166,11 +166,11 @@ def run_constant(s: basis.DriftSeries, e: np.ndarray) -> np.ndarray:
     training readings; a run without training readings, its zero (as a held-out run's zero
     is, :meth:`~volerr.loop.drift.series.DriftSeries.zero`)."""
     out = np.empty(len(e))
-    firsts, zero = s.firsts(), s.zero(e)
+    zero = s.run_zeros(e)
     for r in range(len(s.runs)):
         m = s.run == r
         tr = m & s.train
-        out[m] = e[tr].mean() if tr.any() else zero[firsts[r]]
+        out[m] = e[tr].mean() if tr.any() else zero[r]
     return out
 
 

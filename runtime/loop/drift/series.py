@@ -54,13 +54,17 @@ class DriftSeries:
         """Index (n_runs,) of every run's first reading."""
         return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
 
+    def run_zeros(self, v) -> np.ndarray:
+        """The zero (n_runs,) of ``v`` (N,) in every run: its first reading, the value a run
+        is predicted from where its zero is not fitted (a held-out run, a fold of whole
+        runs), the same for the readings and every model column (each column is its change
+        since it), in every family.  (The mean of the first readings before the spindle
+        starts was measured and not adopted: docs/drift_loop.md.)"""
+        return np.asarray(v, float)[self.firsts()]
+
     def zero(self, v) -> np.ndarray:
-        """The zero of ``v`` (N,) in its run, at every reading (N,): its first reading, the
-        value a run is predicted from where its zero is not fitted (a held-out run, a fold of
-        whole runs), the same for the readings and every model column (each column is its
-        change since it), in every family.  (The mean of the first readings before the
-        spindle starts was measured and not adopted: docs/drift_loop.md.)"""
-        return np.asarray(v, float)[self.firsts()][self.run]
+        """:meth:`run_zeros` of ``v`` at every reading (N,)."""
+        return self.run_zeros(v)[self.run]
 
 
 

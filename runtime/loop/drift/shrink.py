@@ -122,7 +122,7 @@ def fit(s, y, Z, keep, cols, fold, rule: str, cache: dict, grams=None) -> dict:
     zy = [(_rows(Z, i).T @ y[i])[keep] * scale for i in idx]       # Zs' y over each fold
     ys = [np.bincount(run[i], y[i], n_runs) for i in idx]
     lams = LAMBDAS * float(tr.sum())
-    first = y[s.firsts()]
+    first = s.run_zeros(y)
     sse = np.zeros(len(lams))
     for k in range(K):           # the fold's SSE for every lambda from cross-products
         mu, cnt, e, V = eig[k + 1]

@@ -129,7 +129,7 @@ def extrapolation(s: DriftSeries) -> list:
     (by more than ``EXTRAPOLATION_MARGIN`` of it): there a fitted drift model extrapolates
     (a speed never run, a warming never reached), its prediction is not supported by the
     data.  Judged on what the model uses: a temperature (any input but the speed) as its
-    change since its run's first reading (every run its own zero, :meth:`DriftSeries.firsts`;
+    change since its run's first reading (every run its own zero, :meth:`DriftSeries.zero`;
     runs that start at different room temperatures are no extrapolation), the speed
     (``S_rpm``, the heat input ``(S/S_ref)^p``) as logged.  Beyond the range by more than
     ``EXTRAPOLATION_MARGIN`` of it and ``EXTRAPOLATION_NOISE`` times the input's scatter
@@ -139,12 +139,11 @@ def extrapolation(s: DriftSeries) -> list:
     from .basis import SPEED
 
     out = []
-    firsts = s.firsts()
     for name, v in s.inputs.items():
         v = np.asarray(v, float)
         change = name != SPEED
         if change:
-            v = v - v[firsts][s.run]
+            v = v - s.zero(v)
         tr, te = v[s.train], v[s.test]
         if not (len(tr) and len(te)):
             continue
