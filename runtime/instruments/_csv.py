@@ -88,7 +88,9 @@ def read_columns(path) -> Columns:
     rows = _rows(path)
     require(len(rows) >= 2, f"{p.name}: no data rows")
     header = [h.strip() for h in rows[0]]
-    require(len(set(header)) == len(header), f"{p.name}: duplicate column names")
+    twice = next((h for j, h in enumerate(header) if h in header[:j]), None)
+    require(twice is None, f"{p.name}: duplicate column names ({twice!r} appears "
+                           f"{header.count(twice)} times; every column once)")
     body = rows[1:]
     for i, r in enumerate(body):
         require(len(r) == len(header), f"{p.name}: row {i + 2} has {len(r)} fields, "

@@ -419,16 +419,22 @@ def frozen_stretch(v) -> tuple[int, int] | None:
 
 def sensor_faults(t, columns: dict, others: dict) -> list:
     """The faults of the series ``columns`` {name: (N,)} of one run logged at ``t`` (N,) s:
+    [{"input", "fault": "constant", "value", "from_s", "to_s", "readings"}] (one value over
+    the whole run: a sensor disconnected or stuck, or a room steadier than its resolution),
     [{"input", "fault": "frozen", "from_s", "to_s", "readings"}] and
     [{"input", "fault": "step", "at_s", "step", "noise"}] (``step`` the jump in the column's
     unit, ``noise`` the sensor's robust std of a reading-to-reading change), one per column
-    at most, frozen first.  ``others`` {name: (N,)} every logged input: a step shared with
+    at most, constant first, then frozen.  ``others`` {name: (N,)} every logged input: a step shared with
     another input (:data:`SHARED_K`) is no fault."""
     t = np.asarray(t, float)
     scores = {k: change_scores(v)[0] for k, v in others.items()}
     out = []
     for name, v in columns.items():
         v = np.asarray(v, float)
+        if len(v) and not np.ptp(v) > 0:
+            out.append({"input": name, "fault": "constant", "value": float(v[0]),
+                        "from_s": float(t[0]), "to_s": float(t[-1]), "readings": len(v)})
+            continue
         fz = frozen_stretch(v)
         if fz is not None:
             out.append({"input": name, "fault": "frozen", "from_s": float(t[fz[0]]),

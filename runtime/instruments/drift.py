@@ -85,6 +85,12 @@ class DriftRun:
     notes: list = field(default_factory=list)
     #: the run's ``environment`` label ("" when the file has no such column)
     environment: str = ""
+    #: the timestamp subtracted from the file's time column, s (its first reading, where
+    #: that holds timestamps: ``_time``; 0 otherwise)
+    time_origin_s: float = 0.0
+    #: the run's label in the file's ``run`` column, also where the file holds one run
+    #: ("" when the file has no such column; ``run`` is "" for a file of one run)
+    label: str = ""
 
     @property
     def n(self) -> int:
@@ -201,14 +207,27 @@ def _column_defects(c: Columns, needed) -> None:
         f.require_finite(c.numbers[h], h, where)
 
 
-def _time(c: Columns) -> tuple[str, np.ndarray]:
+#: a time column whose first reading lies beyond this (s, about 3 years) holds timestamps
+#: (epoch seconds: 1.7e9 in 2024), not a time since the start of a test
+TIMESTAMP_S = 1e8
+
+
+def _time(c: Columns) -> tuple[str, np.ndarray, float]:
+    """(the time column, its readings in s, the origin subtracted): timestamps
+    (:data:`TIMESTAMP_S`) are read as seconds since the file's first reading, as clock
+    times are (the origin, in the column's seconds, is returned; else 0)."""
     where = c.name
     present = [h for h in TIME_COLUMNS if h in c.numbers or h in c.text]
     require(len(present) == 1, f"{where}: " + (
         f"several time columns ({', '.join(present)})" if present else
         "no time column (t_s, t_min or t_h; see volerr formats drift)"))
+    h, origin = present[0], 0.0
+    v = np.asarray(c.numbers.get(h, []), dtype=float) * logger.SECONDS[h]
+    if len(v) and np.all(np.isfinite(v)) and v[0] > TIMESTAMP_S:
+        origin = float(v[0])
+        c.numbers[h] = (v - origin) / logger.SECONDS[h]
     _column_defects(c, present)
-    return present[0], c.numbers[present[0]] * logger.SECONDS[present[0]]
+    return h, c.numbers[h] * logger.SECONDS[h], origin
 
 
 def _runs(c: Columns, n: int) -> tuple[list, np.ndarray]:
@@ -281,13 +300,16 @@ def _position(c: Columns, idx: np.ndarray, where: str, run: str) -> dict:
     return out
 
 
-def read_runs(path, mapping: dict | None = None, time_unit: str | None = None) -> list:
+def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
+              keep_constant: bool = False) -> list:
     """Read a drift file into its :class:`DriftRun` (one per run label, in order of
-    appearance); InputError (one line) on every defect of the module docstring's list."""
+    appearance); InputError (one line) on every defect of the module docstring's list.
+    ``keep_constant``: a ``T_*`` input constant over a run is kept (the drift loop leaves it
+    out and names it, :func:`faults`), not refused."""
     path = Path(path)
     c = _mapped_columns(path, mapping, time_unit)
     where, n = c.name, c.n
-    tcol, t = _time(c)
+    tcol, t, origin = _time(c)
     heads = channel_lines(path)
     names = _channels(c, heads)
     labels, run_of = _runs(c, n)
@@ -311,14 +333,14 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None) -
         for h in names:
             _constant_sensor(c.numbers[h][idx], h, where, shown)
         for h in inputs:
-            if h.startswith("T_"):
+            if h.startswith("T_") and not keep_constant:
                 _constant_sensor(c.numbers[h][idx], h, where, shown)
         out.append(DriftRun(
             where, shown or ("" if len(labels) == 1 else label), t[idx], chans,
             {k: heads.get(k, ("?", None))[0] for k in chans},
             {k: heads.get(k, ("?", None))[1] for k in chans},
             {h: c.numbers[h][idx] for h in inputs}, _position(c, idx, where, shown), idx,
-            notes, _environment(c, idx, where, shown)))
+            notes, _environment(c, idx, where, shown), origin, label))
     return out
 
 
@@ -380,6 +402,9 @@ def faults(run: DriftRun) -> list:
 def fault_text(e: dict) -> str:
     """One fault of :func:`faults` in words (times in s of the run's file)."""
     where = e["file"] if not e.get("run") else f"{e['file']}[{e['run']}]"
+    if e["fault"] == "constant":
+        return (f"{e['input']} constant in {where} (= {e['value']:g} in all {e['readings']} "
+                f"readings: disconnected, stuck, or steadier than its resolution)")
     if e["fault"] == "frozen":
         return (f"{e['input']} frozen in {where} from t = {e['from_s']:.0f} s to "
                 f"{e['to_s']:.0f} s ({e['readings']} equal readings)")

@@ -50,7 +50,8 @@ class DriftReport(ResultMixin):
         return self.data["effects"]
 
     def write_predictions(self, path, inputs=()) -> Path:
-        """CSV ``file,run,t_s,channel,measured_um,before_um,after_um,split`` (every reading)."""
+        """CSV ``file,run,t_s,channel,measured_um,before_um,after_um,split`` (every reading;
+        ``run`` the run's label in its file, else the file name: :meth:`DriftSeries.row_label`)."""
         from ...fileio import write_text
 
         s = self.series
@@ -58,7 +59,7 @@ class DriftReport(ResultMixin):
         for label, p in self.pred.items():
             y = s.channels[label]
             for i in range(len(s.t_s)):
-                f, r = s.runs[s.run[i]]
+                f, r = s.runs[s.run[i]][0], s.row_label(s.run[i])
                 lines.append(f"{f},{r},{s.t_s[i]:.10g},{label},{y[i]:.10g},{p['before'][i]:.10g},"
                              f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'}")
         return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
@@ -115,6 +116,10 @@ class DriftReport(ResultMixin):
             out.insert(0, "  " + kept_out_line(d["kept_out"]))
         if d.get("inputs_left_out"):
             out.insert(0, "  " + left_out_line(d["inputs_left_out"]))
+        if d.get("time_origins_s"):
+            out.insert(0, "  note: the time column of " + ", ".join(
+                f"{f} holds timestamps (first {v:.10g} s)" for f, v in d["time_origins_s"].items())
+                + ": read as seconds since the file's first reading (--holdout-time too)")
         for label, c in d["channels"].items():
             out.append(f"  channel {label}: held-out MAE {c['mae_before_um']:.3f} -> "
                        f"{c['mae_after_um']:.3f} um (static regression on all temperatures "

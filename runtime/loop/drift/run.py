@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import require
 from . import basis
 from . import family
 from . import fit as core
@@ -40,12 +41,18 @@ def loop_drift(layout: str, paths, window=None, files=(), differences: bool = Fa
 
     model = load(layout)
     named = {Path(p).resolve() for p in paths}
+    for f in files:
+        require(Path(f).is_file(), f"--holdout-files: data file not found: {f}")
     runs, left = read_runs(list(paths) + [f for f in files if Path(f).resolve() not in named])
     s = stack_runs(runs, left)
     s.test, said = held_out(s, window, files)
     directed = rows_mod.rows_of(s.directions, s.heights) is not None
     position = test_position(runs[0], model) if directed else {}
-    return analyse(model, s, position, said, differences, progress)
+    rep = analyse(model, s, position, said, differences, progress)
+    origins = {r.file: r.time_origin_s for r in runs if r.time_origin_s}
+    if origins:           # timestamps in the time column (instruments.drift._time)
+        rep.data["time_origins_s"] = origins
+    return rep
 
 
 def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool = False,

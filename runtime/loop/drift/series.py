@@ -36,6 +36,8 @@ class DriftSeries:
     environments: list = field(default_factory=list)
     #: inputs left out of every run (missing from a file or faulty; series.read_runs)
     left_out: list = field(default_factory=list)
+    #: every run's label for the rows of the predictions CSV (:meth:`row_label`)
+    labels: list = field(default_factory=list)
     memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -49,6 +51,12 @@ class DriftSeries:
             self.memo["_R"] = (self.run[:, None] == np.arange(len(self.runs))[None, :]
                                ).astype(float)
         return self.memo["_R"]
+
+    def row_label(self, r: int) -> str:
+        """Run ``r`` as the predictions CSV's ``run`` column names it: its label in its
+        file's ``run`` column (also where the file holds one run), else its file name."""
+        return (self.labels[r] if r < len(self.labels) else "") or self.runs[r][1] \
+            or self.runs[r][0]
 
     def firsts(self) -> np.ndarray:
         """Index (n_runs,) of every run's first reading."""
@@ -84,7 +92,7 @@ def read_runs(paths) -> tuple[list, list]:
     a channel is the measurand), and a faulty channel refuses its file."""
     from ...instruments.drift import fault_text, faults, read_runs as _read
 
-    runs = [r for p in paths for r in _read(p)]
+    runs = [r for p in paths for r in _read(p, keep_constant=True)]
     first = runs[0]
     for r in runs[1:]:
         require(set(r.channels) == set(first.channels),
@@ -92,6 +100,7 @@ def read_runs(paths) -> tuple[list, list]:
                 f"({', '.join(first.channels)}); the runs of one loop log the same channels")
     _refuse_twice(runs)
     _refuse_unit_slip(runs)
+    _refuse_time_slip(runs)
     found = [e for r in runs for e in faults(r)]
     bad = next((e for e in found if e.get("channel")), None)
     require(bad is None, f"{bad and bad['file']}: channel {bad and fault_text(bad)}: a channel "
@@ -106,12 +115,35 @@ def read_runs(paths) -> tuple[list, list]:
             left.append({"input": k, "reason": "missing" if lack else "faulty",
                          "files": lack, "faults": bad_k})
     gone = {e["input"] for e in left}
-    require(any(k not in gone for k in names),
-            f"{first.name}: no logged input is left for the model (every one is missing from "
-            f"a file or faulty: {', '.join(sorted(gone))})")
+    require(any(k not in gone for k in names), _none_left(runs, left))
     for r in runs:
         r.inputs = {k: v for k, v in r.inputs.items() if k not in gone}
     return runs, left
+
+
+def _none_left(runs, left: list) -> str:
+    """The line refusing a campaign whose every logged input is missing from a run or faulty
+    in one: it names the run that lacks (or has faulty) the most of them, first in file
+    order among equals, what it lacks, what is faulty in it (the faults' words) and what
+    the other runs lost."""
+    def where(x):
+        return x["file"] if not x.get("run") else f"{x['file']}[{x['run']}]"
+
+    count = {r.name: 0 for r in runs}
+    for e in left:
+        for name in set(e["files"]) | {where(x) for x in e["faults"]}:
+            count[name] += 1
+    worst = max(count, key=lambda k: count[k])
+    lacks = [e["input"] for e in left if worst in e["files"]]
+    faulty = {x["input"]: x["fault"] for e in left for x in e["faults"] if where(x) == worst
+              and e["input"] not in lacks}
+    rest = [e["input"] for e in left if e["input"] not in lacks and e["input"] not in faulty]
+    parts = [f"it lacks {', '.join(lacks)}" if lacks else "",
+             "faulty in it: " + ", ".join(f"{k} ({v})" for k, v in faulty.items())
+             if faulty else "",
+             f"missing from or faulty in other runs: {', '.join(rest)}" if rest else ""]
+    return (f"{worst}: no logged input is left for the model ({'; '.join(p for p in parts if p)}"
+            f"); a model needs the inputs of every run")
 
 
 def _refuse_twice(runs) -> None:
@@ -156,18 +188,77 @@ def _refuse_unit_slip(runs) -> None:
                     f"header? give the channel in um")
 
 
+#: a run whose reading interval and duration are both this many times below the campaign's
+#: medians, while its drift and temperatures change at least ``SLIP_CHANGE`` of theirs: its
+#: time column is in minutes (60x) or hours (3600x) under ``t_s``; real campaigns mix
+#: intervals (15-60 s) and durations (1 h days beside 8 h ones) by far less than 30x both
+TIME_SLIP = 30.0
+SLIP_CHANGE = 1 / 3
+#: the fastest a run's median temperature sensor is taken to change over the whole run,
+#: K/min: a machine's structure (most of its sensors) warms with time constants of tens of
+#: minutes to hours (FL_THERMAL 0.001, the turning-centre days at most 0.016 K/min); a run
+#: faster than this is a time column in minutes or hours (judged with 3 sensors or more)
+FASTEST_K_PER_MIN = 0.1
+
+
+def _temperature_change(r) -> tuple[float, int]:
+    """(the median over the run's ``T_*`` sensors of their peak-to-peak change, K; how many)."""
+    temps = [float(np.ptp(v)) for k, v in r.inputs.items() if k.startswith("T_")]
+    return (float(np.median(temps)) if temps else 0.0), len(temps)
+
+
+def _refuse_time_slip(runs) -> None:
+    """One line when a run's time column reads minutes or hours as seconds: its temperatures
+    change faster than a machine warms (:data:`FASTEST_K_PER_MIN`, every run), or, in a
+    campaign of three runs or more, its reading interval and duration are both
+    :data:`TIME_SLIP` times below the runs' medians while its drift and temperatures change
+    as much (:data:`SLIP_CHANGE`)."""
+    dt = np.array([float(np.median(np.diff(r.t_s))) for r in runs])
+    span = np.array([float(r.t_s[-1] - r.t_s[0]) for r in runs])
+    heat = np.array([_temperature_change(r)[0] for r in runs])
+    drift = np.array([float(np.median([np.ptp(v) for v in r.channels.values()])) for r in runs])
+    for i, r in enumerate(runs):
+        change, n = _temperature_change(r)
+        rate = change / max(span[i], 1e-300) * 60.0
+        require(not (n >= 3 and rate > FASTEST_K_PER_MIN),
+                f"{r.name}: its temperatures change {change:.3g} K (median sensor) in {span[i]:g} "
+                f"s of its time column, {rate:.2g} K/min: faster than a machine warms (at most "
+                f"{FASTEST_K_PER_MIN:g} K/min): time in minutes or hours under t_s? give "
+                f"seconds (or name the column t_min / t_h)")
+        if len(runs) < 3:
+            continue
+        mdt, mspan = float(np.median(dt)), float(np.median(span))
+        slip = (dt[i] * TIME_SLIP < mdt and span[i] * TIME_SLIP < mspan
+                and drift[i] >= SLIP_CHANGE * np.median(drift)
+                and heat[i] >= SLIP_CHANGE * np.median(heat))
+        require(not slip, f"{r.name}: its time column spans {span[i]:g} s at {dt[i]:g} s "
+                          f"steps where the runs' median is {mspan:g} s at {mdt:g} s steps "
+                          f"({mspan / span[i]:.0f}x longer), while its drift and temperatures "
+                          f"change as much: time in minutes or hours under t_s? give seconds "
+                          f"(or name the column t_min / t_h)")
+
+
 def left_out_line(left: list) -> str:
     """One console line naming the inputs :func:`read_runs` left out (empty: '')."""
     if not left:
         return ""
     from ...instruments.drift import fault_text
 
-    parts = []
+    parts, const = [], {}
     for e in left:
         if e["reason"] == "missing":
             parts.append(f"{e['input']} (missing from {', '.join(e['files'])})")
-        else:
-            parts.append("; ".join(fault_text(x) for x in e["faults"]))
+            continue
+        for x in e["faults"]:
+            if x["fault"] == "constant":      # one phrase for the sensors constant in a run
+                where = x["file"] if not x.get("run") else f"{x['file']}[{x['run']}]"
+                const.setdefault((where, x["readings"]), []).append(x)
+        if any(x["fault"] != "constant" for x in e["faults"]):
+            parts.append("; ".join(fault_text(x) for x in e["faults"] if x["fault"] != "constant"))
+    for (where, n), xs in const.items():
+        parts.append(", ".join(f"{x['input']} (= {x['value']:g})" for x in xs)
+                     + f" constant in {where} (all {n} readings: disconnected, stuck, or "
+                       f"steadier than the sensor's resolution)")
     return ("note: left out of the model in every run: " + "; ".join(parts)
             + " (a model needs the inputs of every run; a faulty sensor would be fitted as "
               "physics)")
@@ -185,4 +276,4 @@ def stack_runs(runs, left_out=()) -> DriftSeries:
         {k: cat([r.channels[k] for r in runs]) for k in first.channels},
         dict(first.directions), dict(first.heights),
         environments=[r.environment for r in runs] if any(r.environment for r in runs) else [],
-        left_out=list(left_out))
+        left_out=list(left_out), labels=[r.label for r in runs])

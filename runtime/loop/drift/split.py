@@ -67,9 +67,25 @@ def held_out(s: DriftSeries, window=None, files=()) -> tuple[np.ndarray, str]:
     if window is None and not files:
         test, text = default_split(s)
         said.append(text)
-    require(test.any(), "loop: nothing is held out (the window or files select no reading)")
-    require((~test).sum() >= 20, "loop: fewer than 20 training readings are left")
+    _enough(s, test, window, files)
     return test, "; ".join(said)
+
+
+def _enough(s: DriftSeries, test: np.ndarray, window, files) -> None:
+    """One line naming the option when the split holds out nothing (with the runs' time
+    range) or leaves fewer than 20 training readings (with what it held out)."""
+    given = [f"--holdout-time {window}" if window is not None else "",
+             "--holdout-files" if files else ""]
+    opts = " and ".join(g for g in given if g) or "the default split"
+    lo, hi = float(s.t_s.min()), float(s.t_s.max())
+    require(test.any(), f"loop: nothing is held out: {opts} selects no reading (the runs' "
+                        f"times span {lo:g} .. {hi:g} s = {lo / 3600:.4g} .. {hi / 3600:.4g} h, "
+                        f"each in its file's time)")
+    n = int((~test).sum())
+    whole = sum(bool(np.all(test[s.run == r])) for r in range(len(s.runs)))
+    require(n >= 20, f"loop: fewer than 20 training readings are left ({n} of {len(test)}): "
+                     f"{opts} held out {int(test.sum())} readings ({whole} of {len(s.runs)} "
+                     f"runs whole); hold out less, or give more runs")
 
 
 def default_split(s: DriftSeries) -> tuple[np.ndarray, str]:
