@@ -86,7 +86,14 @@ class Column:
 
 def tau_grid(s: DriftSeries) -> np.ndarray:
     """The time constants (s) searched: ``N_TAU`` from the shortest lag to half the training
-    duration (geometric)."""
+    duration (geometric); kept in ``memo`` for the split it was computed on."""
+    key = ("_tau_grid", s.test.tobytes())
+    if key not in s.memo:
+        s.memo[key] = _tau_grid(s)
+    return s.memo[key]
+
+
+def _tau_grid(s: DriftSeries) -> np.ndarray:
     tr = s.train
     dt = float(np.median(np.diff(s.t_s)[np.diff(s.run) == 0])) if len(s.t_s) > 1 else 1.0
     lo = max(60.0, TAU_MIN_STEPS * dt)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 SINGULAR = 1e-9         # a candidate whose Schur complement is below this share of c'c: dependent
+SOLVES = 4              # models whose folds' pseudo-inverses are kept (Engine._fit)
 
 
 class Engine:
@@ -66,9 +67,9 @@ class Engine:
 
     # ---- the model so far, and one candidate more --------------------------------------
     def _active(self, W, G):
-        """Columns of ``W`` that the fit on ``G`` determines (a run without training
-        readings in it has no zero there)."""
-        return np.einsum("ij,ij->j", W, G @ W) > 0
+        """Columns of ``W`` (a :class:`Sel`) that the fit on ``G`` determines (a run without
+        training readings in it has no zero there)."""
+        return np.einsum("ij,ij->j", W.W, W.right(G)) > 0
 
     def cv_sse(self, W) -> float:
         """Cross-validated sum of squared errors of the model ``W`` (mz, s)."""
@@ -80,15 +81,31 @@ class Engine:
         dependent candidates get +inf."""
         a, b = cands[:, 0], cands[:, 1]
         tot = np.zeros(len(cands))
-        base = 0.0
-        for (Gk, hk, _), (TG, Th, Tyy, _) in zip(self.fold_fit, self.fold_test):
+        base, key, W = 0.0, W.tobytes(), Sel(W)
+        for k, ((Gk, hk, _), (TG, Th, Tyy, _)) in enumerate(zip(self.fold_fit, self.fold_test)):
             Gt, ht = self.G - Gk, self.h - hk
-            on = self._active(W, Gt)
-            Wf = W[:, on]
-            sse, sse0 = _bordered(Gt, ht, TG, Th, Tyy, Wf, a, b)
+            Wf = W.take(self._active(W, Gt))
+            sse, sse0 = _bordered_test(self._fit(key, k, Gt, ht, Wf, a, b), TG, Th, Tyy, Wf,
+                                       a, b)
             tot += sse
             base += sse0
         return tot, base
+
+    def _fit(self, key, k, Gt, ht, W, a, b) -> tuple:
+        """:func:`_bordered_fit` on fold ``k``'s training cross-products; the
+        pseudo-inverse of ``W' Gt W`` (the same numbers every time: it depends on the basis,
+        the fold and the model, not on the channel) kept for the last ``SOLVES`` models
+        (``key`` the whole model's bytes: a step's candidates, then its alternatives, then
+        the next stage and the other channels start from one model)."""
+        kept = self._cache.setdefault("solves", {})
+        if key not in kept:
+            if len(kept) >= SOLVES:
+                del kept[next(iter(kept))]
+            kept[key] = {}
+        if k not in kept[key]:
+            kept[key][k] = _pinv(W.right(W.left(Gt)))
+        Minv = kept[key][k]
+        return _bordered_fit(Gt, ht, W, a, b, (Minv, Minv @ W.left(ht)))
 
     def cv_blocks(self, W, cands, sub: int) -> tuple[np.ndarray, np.ndarray]:
         """Cross-validated mean squares over ``sub`` consecutive blocks of every fold (the
@@ -98,11 +115,11 @@ class Engine:
         test cross-products of ``Z`` are computed once per basis (``cache``)."""
         fold = self._data[2]
         a, b = cands[:, 0], cands[:, 1]
-        out, base = [], []
+        out, base, key, W = [], [], W.tobytes(), Sel(W)
         for k, (Gk, hk, _) in enumerate(self.fold_fit):
             Gt, ht = self.G - Gk, self.h - hk
-            Wf = W[:, self._active(W, Gt)]
-            fit = _bordered_fit(Gt, ht, Wf, a, b)         # one fit per fold, its blocks tested
+            Wf = W.take(self._active(W, Gt))
+            fit = self._fit(key, k, Gt, ht, Wf, a, b)     # one fit per fold, its blocks tested
             for j, part in enumerate(np.array_split(np.flatnonzero(fold == k), sub)):
                 if not len(part):
                     continue
@@ -132,8 +149,9 @@ class Engine:
     def train_rss_many(self, W, cands) -> tuple[np.ndarray, float]:
         """(training RSS (nc,) with each candidate, RSS of ``W``), fitted on all training."""
         a, b = cands[:, 0], cands[:, 1]
-        on = self._active(W, self.G)
-        return _bordered(self.G, self.h, self.G, self.h, self.yy, W[:, on], a, b)
+        W = Sel(W)
+        return _bordered(self.G, self.h, self.G, self.h, self.yy,
+                         W.take(self._active(W, self.G)), a, b)
 
 
 def _pair(Mat, a, b):
@@ -152,22 +170,76 @@ def _quad(G, a, b):
     return v
 
 
+class Sel:
+    """A model's columns ``W`` (mz, s) and, where every column is one column of ``Z`` or a
+    difference of two (a run's zero, a term: the models of :mod:`volerr.loop.drift.select`),
+    their index pairs: then ``M @ W`` and ``W.T @ M`` are columns (rows) of ``M`` picked and
+    subtracted, the same numbers as the products (each entry sums one or two nonzero terms,
+    the rest exact zeros: one rounding either way; ``+ 0.0`` makes a zero +0 as the sum's)
+    without the ``mz^2 s`` multiplications.  ``pa`` None: any other ``W`` (the products)."""
+
+    def __init__(self, W):
+        self.W, self.pa, self.pb = W, None, None
+        nz = W != 0
+        count = nz.sum(0)
+        plus, minus = W == 1.0, W == -1.0
+        if W.size and np.all(plus.sum(0) == 1) and np.all(count == plus.sum(0) + minus.sum(0)) \
+                and np.all(minus.sum(0) <= 1):
+            self.pa = plus.argmax(0)
+            self.pb = np.where(minus.any(0), minus.argmax(0), -1)
+
+    def take(self, on) -> "Sel":
+        """The columns ``on`` (bool) of the model."""
+        out = Sel.__new__(Sel)
+        out.W = self.W[:, on]
+        out.pa, out.pb = (None, None) if self.pa is None else (self.pa[on], self.pb[on])
+        return out
+
+    def right(self, M):
+        """``M @ W``."""
+        if self.pa is None:
+            return M @ self.W
+        out = M[..., self.pa]
+        m = self.pb >= 0
+        if m.any():
+            out[..., m] -= M[..., self.pb[m]]
+        return out + 0.0
+
+    def left(self, M):
+        """``W.T @ M`` (``M`` a matrix or a vector)."""
+        if self.pa is None:
+            return self.W.T @ M
+        out = M[self.pa]
+        m = self.pb >= 0
+        if m.any():
+            out[m] -= M[self.pb[m]]
+        return out + 0.0
+
+
 def _bordered(Gt, ht, TG, Th, Tyy, W, a, b):
     """SSE on the test cross-products (TG, Th, Tyy) of the fit on (Gt, ht) with the columns
-    ``W`` plus each candidate, and of ``W`` alone."""
+    ``W`` (a :class:`Sel`) plus each candidate, and of ``W`` alone."""
     return _bordered_test(_bordered_fit(Gt, ht, W, a, b), TG, Th, Tyy, W, a, b)
 
 
-def _bordered_fit(Gt, ht, W, a, b) -> tuple:
-    """The fits on (Gt, ht): of ``W`` alone (b0) and of ``W`` plus each candidate (B, beta;
-    ``ok`` False where the candidate is dependent)."""
-    M = W.T @ Gt @ W
-    hS = W.T @ ht
-    Minv = np.linalg.pinv(M, rcond=1e-12, hermitian=True) if M.size else M
-    b0 = Minv @ hS
+def _pinv(M):
+    return np.linalg.pinv(M, rcond=1e-12, hermitian=True) if M.size else M
+
+
+def _solve(Gt, ht, W) -> tuple:
+    """(the pseudo-inverse of ``W' Gt W``, the fit b0 of ``W`` alone on (Gt, ht))."""
+    Minv = _pinv(W.right(W.left(Gt)))
+    return Minv, Minv @ W.left(ht)
+
+
+def _bordered_fit(Gt, ht, W, a, b, solved=None) -> tuple:
+    """The fits on (Gt, ht): of ``W`` (a :class:`Sel`) alone (b0) and of ``W`` plus each
+    candidate (B, beta; ``ok`` False where the candidate is dependent); ``solved``
+    :func:`_solve`'s answer where known."""
+    Minv, b0 = _solve(Gt, ht, W) if solved is None else solved
     if len(a) == 0:
         return b0, None, None, None
-    U = _pair(Gt @ W, a, b).T                 # (s, nc)  W' Gt c
+    U = _pair(W.right(Gt), a, b).T            # (s, nc)  W' Gt c
     v = _quad(Gt, a, b)
     hc = _pair(ht[:, None], a, b)[:, 0]
     Zm = Minv @ U
@@ -182,8 +254,8 @@ def _bordered_test(fit, TG, Th, Tyy, W, a, b):
     """SSE on the test cross-products (TG, Th, Tyy) of the fits ``fit``
     (:func:`_bordered_fit`): (per candidate, +inf where dependent; of ``W`` alone)."""
     b0, B, beta, ok = fit
-    TGW = TG @ W
-    GkSS, hkS = W.T @ TGW, W.T @ Th
+    TGW = W.right(TG)
+    GkSS, hkS = W.left(TGW), W.left(Th)
     sse0 = Tyy - 2 * b0 @ hkS + b0 @ GkSS @ b0
     if len(a) == 0:
         return np.zeros(0), float(sse0)

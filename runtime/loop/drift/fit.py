@@ -312,13 +312,15 @@ def _tau_on(ch: Channel, sp, i, specs, masks) -> list:
         return [(0.0, False)] * len(masks)
     s, y = ch.s, ch.y
     base = np.column_stack([ch.R] + [column(s, o) for j, o in enumerate(specs) if j != i])
-    out = []
+    out, step = [], _grid_step_of(s)
     for m in masks:
+        bm, ym = base[m], y[m]
+
         def rss_at(x0, xs):
             trial = np.column_stack([column(s, sp, sp["tau_s"] * math.exp(x0 + x)) for x in xs])
-            return _trial_rss(base[m], trial[m], y[m])
+            return _trial_rss(bm, trial[m], ym)
 
-        x, edge = profile_vertex(rss_at, _grid_step_of(s), 7, RECENTRE)
+        x, edge = profile_vertex(rss_at, step, 7, RECENTRE)
         out.append((sp["tau_s"] * math.exp(x), edge))
     return out
 

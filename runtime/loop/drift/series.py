@@ -59,8 +59,11 @@ class DriftSeries:
             or self.runs[r][0]
 
     def firsts(self) -> np.ndarray:
-        """Index (n_runs,) of every run's first reading."""
-        return np.array([int(np.flatnonzero(self.run == r)[0]) for r in range(len(self.runs))])
+        """Index (n_runs,) of every run's first reading (kept in ``memo``)."""
+        if "_firsts" not in self.memo:
+            self.memo["_firsts"] = np.array([int(np.flatnonzero(self.run == r)[0])
+                                             for r in range(len(self.runs))])
+        return self.memo["_firsts"]
 
     def run_zeros(self, v) -> np.ndarray:
         """The zero (n_runs,) of ``v`` (N,) in every run: its first reading, the value a run
