@@ -198,10 +198,12 @@ def _refuse_unit_slip(runs) -> None:
 TIME_SLIP = 30.0
 SLIP_CHANGE = 1 / 3
 #: the fastest a run's median temperature sensor is taken to change over the whole run,
-#: K/min: a machine's structure (most of its sensors) warms with time constants of tens of
-#: minutes to hours (FL_THERMAL 0.001, the turning-centre days at most 0.016 K/min); a run
-#: faster than this is a time column in minutes or hours (judged with 3 sensors or more)
-FASTEST_K_PER_MIN = 0.1
+#: K/min (15 K/h): a machine's structure (most of its sensors) warms with time constants of
+#: tens of minutes to hours (FL_THERMAL 0.001, the turning-centre days, 1 h ones included,
+#: at most 0.016 K/min; a spindle housing at full speed a few tenths in its first minutes,
+#: less over a run); a run faster than this is a time column in minutes or hours under
+#: ``t_s`` (60x, 3600x: a 5 h run in minutes 0.37 K/min) (judged with 3 sensors or more)
+FASTEST_K_PER_MIN = 0.25
 
 
 def _temperature_change(r) -> tuple[float, int]:
