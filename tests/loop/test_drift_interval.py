@@ -161,3 +161,16 @@ def test_one_fold_or_a_zero_quantile():
     assert band.one_more_fold([2.0]) == 2.0
     assert band.one_more_fold([0.0, 3.0]) == 3.0
     assert np.isnan(band.one_more_fold([]))
+
+
+def test_thinned_readings_interpolated_within_each_run(monkeypatch):
+    monkeypatch.setattr(band, "EVALUATED", 10)
+    run = np.repeat([0, 1, 2], [17, 40, 23])
+    rows = np.flatnonzero(run != 1)                  # a fit's readings: runs 0 and 2
+    sub = band._thinned(rows, run)
+    assert len(sub) < len(rows)
+    for r in (0, 2):                                 # each run's first and last evaluated
+        pos = np.flatnonzero(run[rows] == r)
+        assert pos[0] in sub and pos[-1] in sub
+    h = 0.5 + 0.01 * rows + 3.0 * (run[rows] == 2)   # linear within a run, a jump between
+    np.testing.assert_allclose(band._filled(rows, sub, h[sub], run), h, rtol=1e-12)

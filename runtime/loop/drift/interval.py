@@ -105,25 +105,58 @@ def shrink_leverage(cache, Z, keep, run, fold, anchored, lam) -> np.ndarray:
     """(N,) leverage of every reading under the regularised fit at ``lam`` (absolute, in the
     scaled columns ``Z[:, keep] scale`` of :mod:`volerr.loop.drift.shrink`, whose
     decompositions per fold ``cache`` holds): ``h0 + sum_j (d' v_j)^2 / (e_j + lam)``; the
-    projections ``(d' v_j)^2`` are the same for every channel and kept in ``cache``."""
+    projections ``(d' v_j)^2`` are the same for every channel and kept in ``cache``.  At
+    most ``EVALUATED`` readings of a fit's are evaluated, evenly spaced in each run with its
+    first and last, the others interpolated linearly (the columns are lags of smooth inputs;
+    on FL_THERMAL every reading is evaluated)."""
     if "shrink_proj" not in cache:
         scale, eig = cache["shrink_scale"], cache["shrink_eig"]
         proj = []
-        K = int(fold.max()) + 1
-        for k in range(-1, K):
-            rows = fold == k if k >= 0 else fold < 0
+        for k in range(-1, int(fold.max()) + 1):
+            rows = np.flatnonzero(fold == k if k >= 0 else fold < 0)
+            sub = _thinned(rows, run)
             mu, cnt, _, V = eig[k + 1]
-            r = run[rows]
+            r = run[rows[sub]]
             free = (cnt[r] > 0) & (k < 0 or not anchored)
-            d = Z[rows][:, keep] * scale - np.where(free[:, None], mu[r], 0.0)
+            d = Z[rows[sub]][:, keep] * scale - np.where(free[:, None], mu[r], 0.0)
             h0 = np.where(free, 1.0 / np.maximum(cnt[r], 1.0), 1.0)
-            proj.append((rows, h0, (d @ V) ** 2))
+            proj.append((rows, sub, h0, (d @ V) ** 2))
         cache["shrink_proj"] = proj
     h = np.full(len(run), np.nan)
-    for k, (rows, h0, P) in enumerate(cache["shrink_proj"]):
+    for k, (rows, sub, h0, P) in enumerate(cache["shrink_proj"]):
         e = cache["shrink_eig"][k][2]
-        h[rows] = h0 + P @ (1.0 / (e + lam))
+        h[rows] = _filled(rows, sub, h0 + P @ (1.0 / (e + lam)), run)
     return h
+
+
+#: the most readings of one fit whose leverage is evaluated (the rest interpolated)
+EVALUATED = 2500
+
+
+def _thinned(rows, run) -> np.ndarray:
+    """Positions in ``rows`` (sorted reading indices) evaluated: every reading where they
+    are at most ``EVALUATED``, else evenly spaced ones of each run with its first and last."""
+    step = -(-len(rows) // EVALUATED)
+    if step <= 1:
+        return np.arange(len(rows))
+    out = []
+    for r in np.unique(run[rows]):
+        pos = np.flatnonzero(run[rows] == r)
+        out.append(np.unique(np.append(pos[::step], pos[-1])))
+    return np.concatenate(out)
+
+
+def _filled(rows, sub, hs, run) -> np.ndarray:
+    """The values ``hs`` at the positions ``sub`` of ``rows``, linearly interpolated (by
+    reading index, within each run) at every position."""
+    if len(sub) == len(rows):
+        return hs
+    out = np.empty(len(rows))
+    for r in np.unique(run[rows]):
+        pos = np.flatnonzero(run[rows] == r)
+        at = np.isin(sub, pos)
+        out[pos] = np.interp(rows[pos], rows[sub[at]], hs[at])
+    return out
 
 
 def cv_leverage(X, run, fold, train, anchored, penalty=None) -> np.ndarray:
