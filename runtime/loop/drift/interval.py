@@ -68,7 +68,7 @@ METHOD = ("locally weighted conformal from the blocked CV: half-width q sigma(x)
           "|CV residual| / sigma from the K folds'")
 
 
-def leverage(X, run, fit_mask, rows, anchored, gram_inv=None, penalty=None) -> np.ndarray:
+def leverage(X, run, fit_mask, rows, anchored, penalty=None) -> np.ndarray:
     """The leverage (module docstring) of the readings ``rows`` (bool (N,)) under the fit of
     the term columns ``X`` (N, p) (a free zero per run ``run``) on the readings
     ``fit_mask``; ``anchored``: every reading predicted from its run's first reading; else a
@@ -79,9 +79,8 @@ def leverage(X, run, fit_mask, rows, anchored, gram_inv=None, penalty=None) -> n
     sums = np.zeros((n_runs, X.shape[1]))
     np.add.at(sums, run[fit_mask], X[fit_mask])
     mu = sums / np.maximum(cnt, 1.0)[:, None]
-    if gram_inv is None:
-        Xc = X[fit_mask] - mu[run[fit_mask]]
-        gram_inv = _inverse(Xc.T @ Xc + (0.0 if penalty is None else penalty))
+    Xc = X[fit_mask] - mu[run[fit_mask]]
+    gram_inv = _inverse(Xc.T @ Xc + (0.0 if penalty is None else penalty))
     r = run[rows]
     free = (cnt[r] > 0) & (not anchored)
     d = X[rows] - np.where(free[:, None], mu[r], 0.0)

@@ -62,9 +62,9 @@ class DriftReport(ResultMixin):
             hw = p.get("half_width")
             for i in range(len(s.t_s)):
                 f, r = s.runs[s.run[i]]
+                band = "" if hw is None else format(hw[i], ".6g")
                 lines.append(f"{f},{r},{s.t_s[i]:.10g},{label},{y[i]:.10g},{p['before'][i]:.10g},"
-                             f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'},"
-                             f"{'' if hw is None else format(hw[i], '.6g')}")
+                             f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'},{band}")
         return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
 
     def write_html(self, path, inputs=()) -> Path:
