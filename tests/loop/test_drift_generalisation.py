@@ -117,6 +117,7 @@ def loop_runs(tmp_path_factory):
             cache[name] = (json.loads((folder / "w.json").read_text()), rows)
         return cache[name]
 
+    get.cache = cache             # the windows run so far in this process (pooled tests)
     return get
 
 
@@ -256,5 +257,37 @@ def test_interval_coverage_is_that_of_the_predictions(loop_runs, table, name):
         t = np.array([float(r["t_s"]) for r in test])
         e = np.interp(t, table["t_s"], table[f"d_{ch}_um"]) - np.array(
             [float(r["after_um"]) for r in test])
-        assert iv["coverage_test"] == pytest.approx(
-            float(np.mean(np.abs(e) <= iv["half_width_um"])), abs=1e-9), (name, ch)
+        hw = np.array([float(r["half_width_um"]) for r in test])
+        assert np.all(hw > 0) and iv["half_width_um"] == pytest.approx(np.median(hw), rel=1e-5)
+        assert iv["coverage_test"] == pytest.approx(float(np.mean(np.abs(e) <= hw)),
+                                                    abs=1e-9), (name, ch)
+
+
+#: issue 44 item 4: the share of ALL held-out readings of the channel-windows (pooled) inside
+#: their 95 % interval; per window 90-98 % is out of reach for any honest rule (one held-out
+#: stretch is one draw of its level, docs/drift_loop.md), the pooled share is the target.
+#: Measured: 95.3 % over these 25 channel-windows (95.9 % with the publication split's 5).
+POOLED_COVERAGE = (0.90, 0.98)
+
+
+def test_pooled_interval_coverage_of_all_windows(loop_runs, table):
+    """Pooled over every held-out reading of the five windows' 25 channel-windows, the share
+    inside the predictions file's per-reading half-width (the data file's values) is within
+    ``POOLED_COVERAGE``.  No loop run of its own: it reads the windows the tests above ran in
+    this process (run the file without xdist: ``-p no:xdist``), else it is skipped."""
+    if set(loop_runs.cache) != set(WINDOWS):
+        pytest.skip("the windows ran in other processes (xdist groups): run this file with "
+                    "-p no:xdist")
+    inside = total = 0
+    for name in WINDOWS:
+        _, rows = loop_runs(name)
+        for ch in CHANNELS:
+            test = [r for r in rows if r["channel"] == ch and r["split"] == "test"]
+            t = np.array([float(r["t_s"]) for r in test])
+            e = np.interp(t, table["t_s"], table[f"d_{ch}_um"]) - np.array(
+                [float(r["after_um"]) for r in test])
+            inside += int(np.sum(np.abs(e) <= np.array([float(r["half_width_um"])
+                                                        for r in test])))
+            total += len(test)
+    lo, hi = POOLED_COVERAGE
+    assert lo <= inside / total <= hi, (inside, total)

@@ -163,7 +163,7 @@ def test_cli_refusals_one_line_nothing_written(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "the last run (b.csv) held out" in r.stdout
     head = (tmp_path / "p.csv").read_text().splitlines()[0]
-    assert head == "file,run,t_s,channel,measured_um,before_um,after_um,split"
+    assert head == "file,run,t_s,channel,measured_um,before_um,after_um,split,half_width_um"
     assert "<img" in (tmp_path / "p.html").read_text()
 
 

@@ -43,17 +43,7 @@ not independent of each other.  The static regression, judged the same way, is t
 better baseline only when significantly below the constant run by run (many near-collinear
 temperatures fit within runs and need not carry across them).
 
-Prediction interval (``LEVEL`` = 95 %): per blocked CV fold the ``LEVEL`` quantile of the
-absolute CV residuals of the chosen family, and the half-width the largest of them
-(symmetric, um).  Why: the held-out part is one stretch the fit never saw, like one fold;
-folds differ tenfold in their error (a stretch where the spindle switches, a cool-down), so
-the pooled quantile of all CV residuals averages easy and hard stretches and covers too
-little of a hard one (on FL_THERMAL's 30 channel-windows it covered 68 % of the held-out
-readings on average, the largest fold's quantile 79 %).  A quantile and not ``t sigma``:
-drift residuals are autocorrelated and skewed.  The CV residuals are those of the terms
-chosen on all folds (the choice is not repeated per fold), so they are optimistic; the
-coverage of the held-out readings is reported beside the interval (``coverage_test``): an
-interval is only as good as its held-out coverage.
+The prediction interval of the model chosen: :mod:`volerr.loop.drift.interval`.
 """
 
 from __future__ import annotations
@@ -186,24 +176,6 @@ def _rule_text(K: int, regularised: bool, units: str) -> str:
             f"model if so below each baseline (its terms named wherever it is, the prediction "
             f"the regularised fit's unless the lag model beats it too); else the baseline of "
             f"lower CV mean square")
-
-
-def interval(cv_resid, y, pred, fold, test) -> dict:
-    """The ``LEVEL`` prediction interval (module docstring): half-width (um) the largest over
-    the folds (``fold`` (N,), -1 held out) of the fold's ``LEVEL`` quantile of |CV
-    residual|; its share of held-out readings covered."""
-    qs = []
-    for k in range(int(fold.max()) + 1):
-        r = np.abs(cv_resid[fold == k])
-        r = r[np.isfinite(r)]
-        if len(r):
-            qs.append(float(np.quantile(r, LEVEL)))
-    hw = max(qs) if qs else float("nan")
-    e = np.abs((y - pred)[test])
-    return {"level": LEVEL, "half_width_um": hw,
-            "coverage_test": float(np.mean(e <= hw)) if len(e) else None,
-            "method": "the largest over the blocked CV folds of the fold's 95 % quantile of "
-                      "|CV residual| of the chosen model"}
 
 
 def verdict(family: str, cv_rms: dict, t: dict, has_terms: bool, t_crit: float,

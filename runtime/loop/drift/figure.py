@@ -33,7 +33,8 @@ def _draw(report, label: str):
     ax[0].plot(t_h[i], p["after"][i], lw=0.8, label=f"after (model: {fam})")
     iv = c.get("interval")
     if iv and np.isfinite(iv["half_width_um"]):
-        hw = iv["half_width_um"]
+        hw = p.get("half_width")                    # per reading (interval.py)
+        hw = (np.full(len(y), iv["half_width_um"]) if hw is None else hw)[i]
         cov = "" if iv["coverage_test"] is None else \
             f", held-out coverage {100 * iv['coverage_test']:.0f} %"
         ax[0].fill_between(t_h[i], p["after"][i] - hw, p["after"][i] + hw, color="C3",

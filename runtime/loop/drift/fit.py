@@ -44,6 +44,7 @@ from ...selection.profile import profile_vertex
 from ...selection.rules import CV_GAIN, SIG_K, TIE_SCORE_REL
 from . import basis
 from . import family
+from . import interval as band
 from . import select as sel
 from . import shrink
 from .engine import Engine
@@ -142,10 +143,23 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
            "constant": predict(ch.s, ch.R, _fit(ch.R, ch.y, tr), ch.y),
            "regularised": reg["pred"], "shrink": reg,
            "before": ch.s.zero(ch.y)}
-    out["choice"] = family.choose(ch, {"constant": ch.R, "static": Ds, "lag": fit["design"]},
-                                  bool(specs), _nested_in_static(specs),
+    designs = {"constant": ch.R, "static": Ds, "lag": fit["design"]}
+    out["choice"] = family.choose(ch, designs, bool(specs), _nested_in_static(specs),
                                   regularised=reg["cv_resid"])
+    out["leverage"] = _leverage(ch, out["choice"]["family"], designs, reg, Z, cache)
     return out
+
+
+def _leverage(ch: Channel, fam: str, designs: dict, reg: dict, Z, cache) -> np.ndarray:
+    """(N,) leverage of every reading in the chosen family's fit that predicts it (its CV
+    fold's for a training reading), the scale of the prediction interval
+    (:mod:`volerr.loop.drift.interval`: the lag model's is the bank's it was chosen from)."""
+    anchored = basis.whole_runs(ch.rule)
+    if fam in ("regularised", "lag"):
+        lam = reg["lambda_rel"] * float(ch.s.train.sum())
+        return band.shrink_leverage(cache, Z, reg["keep"], ch.s.run, ch.fold, anchored, lam)
+    return band.cv_leverage(designs[fam][:, ch.n_runs:], ch.s.run, ch.fold, ch.s.train,
+                            anchored)
 
 
 def _regularised(ch: Channel, cols, Z, cands, cache) -> dict:
@@ -154,8 +168,10 @@ def _regularised(ch: Channel, cols, Z, cands, cache) -> dict:
     keep = sorted({int(a) for c in cands for a, b in c if b < 0})
     grams = [cache[("fit", k)] for k in range(int(ch.fold.max()) + 1)] \
         if ("fit", 0) in cache else None         # the engine's cross-products of the folds
-    return shrink.fit(ch.s, ch.y, Z, [ch.n_runs + j for j in keep], [cols[j] for j in keep],
-                      ch.fold, ch.rule, cache, grams)
+    out = shrink.fit(ch.s, ch.y, Z, [ch.n_runs + j for j in keep], [cols[j] for j in keep],
+                     ch.fold, ch.rule, cache, grams)
+    out["keep"] = [ch.n_runs + j for j in keep]
+    return out
 
 
 def _backward(ch: Channel, specs) -> list:

@@ -50,18 +50,22 @@ class DriftReport(ResultMixin):
         return self.data["effects"]
 
     def write_predictions(self, path, inputs=()) -> Path:
-        """CSV ``file,run,t_s,channel,measured_um,before_um,after_um,split`` (every reading;
-        ``run`` the run's label in its file, else the file name: :meth:`DriftSeries.row_label`)."""
+        """CSV ``file,run,t_s,channel,measured_um,before_um,after_um,split,half_width_um``
+        (every reading; ``run`` the run's label in its file, else the file name:
+        :meth:`DriftSeries.row_label`; ``half_width_um`` the 95 % prediction interval's at the
+        reading, :mod:`volerr.loop.drift.interval`)."""
         from ...fileio import write_text
 
         s = self.series
-        lines = ["file,run,t_s,channel,measured_um,before_um,after_um,split"]
+        lines = ["file,run,t_s,channel,measured_um,before_um,after_um,split,half_width_um"]
         for label, p in self.pred.items():
             y = s.channels[label]
+            hw = p.get("half_width")
             for i in range(len(s.t_s)):
                 f, r = s.runs[s.run[i]][0], s.row_label(s.run[i])
+                band = "" if hw is None else format(hw[i], ".6g")
                 lines.append(f"{f},{r},{s.t_s[i]:.10g},{label},{y[i]:.10g},{p['before'][i]:.10g},"
-                             f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'}")
+                             f"{p['after'][i]:.10g},{'test' if s.test[i] else 'train'},{band}")
         return write_text(path, "\n".join(lines) + "\n", inputs=list(inputs))
 
     def write_html(self, path, inputs=()) -> Path:
@@ -161,9 +165,11 @@ def _family_lines(c: dict) -> list:
     iv = c.get("interval")
     if iv:
         cov = "n/a" if iv["coverage_test"] is None else f"{100 * iv['coverage_test']:.1f} %"
+        lo, hi = iv.get("half_width_um_range") or (iv["half_width_um"],) * 2
         out.append(f"    {100 * iv['level']:.0f} % prediction interval +- "
-                   f"{iv['half_width_um']:.3f} um (from the blocked-CV residuals); held-out "
-                   f"readings inside it: {cov}")
+                   f"{iv['half_width_um']:.3f} um (median over the held-out readings; "
+                   f"{lo:.3f}..{hi:.3f} um, wider where the inputs extrapolate; from the "
+                   f"blocked-CV residuals); held-out readings inside it: {cov}")
     return out
 
 

@@ -193,6 +193,9 @@ def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict
         # the channel's CV residual: its row of the quantities' plus its own row residual
         p["cv_resid"] = resid[k] - c + sum(rows.A[i, j] * qpred[q.symbol]["cv_resid"]
                                            for j, q in on)
+        # the interval's scale: the largest leverage of its quantities' (interval.py)
+        p["leverage"] = np.max([qpred[q.symbol]["leverage"] for _, q in on], axis=0) \
+            if on else None
         fams = [qpred[q.symbol]["family"] for _, q in on]
         p["family"] = max(fams, key=FAMILY_ORDER.index) if fams else "constant"
         for j, q in on:

@@ -25,6 +25,7 @@ from ...errors import require
 from . import basis
 from . import family
 from . import fit as core
+from . import interval as band
 from . import rows as rows_mod
 from .report import DriftReport
 from .series import DriftSeries, read_runs, stack_runs
@@ -130,7 +131,7 @@ def _prediction(m, r) -> dict:
     fam = c["family"]
     return {"before": r["before"], "lag": lag, "after": lag if fam == "lag" else r[fam],
             "static": r["static"], "constant": r["constant"], "regularised": r["regularised"],
-            "cv_resid": c["cv_resid"], "family": fam,
+            "cv_resid": c["cv_resid"], "family": fam, "leverage": r["leverage"],
             "terms": r["terms"] if c["named"] else []}
 
 
@@ -177,7 +178,9 @@ def _family(s, label, p, r) -> dict:
                                    "penalty": sh["penalty"]})
     else:
         out["family"] = p["family"]
-    out["interval"] = family.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te)
+    iv = band.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te, p.get("leverage"))
+    p["half_width"] = iv.pop("per_reading")
+    out["interval"] = iv
     return out
 
 
