@@ -134,6 +134,8 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     specs = _backward(ch, [_spec(cols, t) for t in terms])
     specs = _refine_all(ch, specs)
     specs, fit = _significant(ch, specs)
+    for sp, w in zip(specs, family.without_each(ch, fit["design"])):
+        sp.update(w)          # is the model without it CV-equivalent? (issue 44)
     Ds = _static_design(ch)
     tr = ch.s.train
     reg = _regularised(ch, cols, Z, cands, cache)

@@ -142,6 +142,7 @@ def _choice(choice, has_terms) -> dict:
             "paired_t": {k: round(v, 3) for k, v in choice["t"].items()},
             "selection_rule": choice["rule"],
             "t_critical": round(choice["t_crit"], 3),
+            "families_equivalent": choice.get("equivalent", []),
             "verdict": family.verdict(choice["family"], choice["cv_rms_um"], choice["t"],
                                       has_terms, choice["t_crit"], choice["named"])}
 
@@ -219,7 +220,8 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
                  "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if f["tau_std"][i] is None
                             else round(f["tau_std"][i], 1)} if sp["tau_s"] > 0 else None),
                  "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
-                 "tau_equivalent_s": _tau_span(sp)}
+                 "tau_equivalent_s": _tau_span(sp), "cv_decided": sp.get("cv_decided"),
+                 "cv_without": sp.get("cv_without")}
             terms.append(t)
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
         for j, (i, t) in enumerate(zip(idx, terms)):
