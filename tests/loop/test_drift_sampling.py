@@ -16,11 +16,25 @@ source's time constants the cross-validation cannot tell apart (``tau_equivalent
 its CV-equivalent alternatives, each a source at a lag of the grid (standing for the lags
 within half a grid step of it).  A lag shorter than 4 reading intervals of the coarser
 sampling (240 s) is not resolved at 60 s: there it stands for the plain source as well.
-Two terms agree when their groups share a source whose time-constant ranges overlap.  A
-channel-window agrees when both samplings report the same family and every reported term
-of each agrees with a term of the other.  Where they do not (measured when this test was
-written: 13 of 30; 14 with the regularised family), the channel-window is listed in
-``DIFFERENT`` (strict: a fix makes the test fail until the list is updated).
+Two terms agree when their groups share a source whose time-constant ranges overlap.
+
+The rule (issue 44: "... or lists the CV-equivalent alternatives", alternatives "the CV
+cannot tell apart, named as such").  A channel-window agrees when
+
+* both samplings report the same family, or each lists the other's family among the
+  families its cross-validation cannot tell from its own (``families_equivalent``: neither
+  significantly below the other by the paired t the families are chosen by); and
+* every reported term of each sampling agrees with a reported term of the other, or with a
+  term the other could not tell from its absence (``not_decided``: the loop left it out
+  because the model without it is CV-equivalent; its absence is that sampling's
+  CV-equivalent alternative); a term marked ``cv_decided`` false in its own sampling agrees
+  as it is (the loop reports none such: it leaves them out).
+
+Measured: by the first rule (the same family, every reported term with a reported
+counterpart) 16 of 30 before issue 44's undecided terms and equivalent families, 17 of 30
+after (the loop now leaves undecided terms out); by this rule 18 of 30.  Where they do not
+agree, the channel-window is listed in ``DIFFERENT`` (strict: a fix makes the test fail
+until the list is updated).
 """
 
 from __future__ import annotations
@@ -45,16 +59,22 @@ WINDOWS = {"0-20": ("0s:33345s", None), "20-40": ("33345s:66690s", None),
 STEPS = (1, 4)                # every reading (15 s), every 4th (60 s)
 SHORTEST_60S = 4 * 60.0       # the shortest lag searched at 60 s (4 reading intervals)
 
-#: measured when this test was written (both samplings): the channel-windows whose
-#: diagnoses differ.  Two differ in family (0-20 % ch5: lag at 15 s, static at 60 s; 60-80 %
-#: ch5 the reverse); the others by a term one sampling finds and the other does not (a
-#: plain T_1 or T_4, a long lag of T_6, T_7, T_9, T_13 or T_15) or, on 40-60 % ch4 and the
-#: publication's ch3, by several terms.  With the regularised family (issue 44) one more:
-#: 20-40 % ch3, the lag model at 15 s, the regularised fit at 60 s.
-DIFFERENT = {("0-20", "ch1"), ("0-20", "ch3"), ("0-20", "ch4"), ("0-20", "ch5"),
-             ("20-40", "ch3"), ("20-40", "ch4"), ("40-60", "ch1"), ("40-60", "ch2"),
-             ("40-60", "ch3"), ("40-60", "ch4"), ("60-80", "ch5"), ("80-100", "ch2"), ("pub", "ch1"),
-             ("pub", "ch3")}
+#: measured (both samplings) with the rule of the module docstring: the channel-windows
+#: whose diagnoses differ.  Six differ in family, the lag model at 15 s and the regularised
+#: fit at 60 s, where the 15 s cross-validation finds the lag model significantly below
+#: the regularised fit (so lists no family as equivalent) and the 60 s one does not (0-20 %
+#: ch3, ch4, ch5; 20-40 % ch3; 40-60 % ch3, ch4: two of them list the lag model as
+#: CV-equivalent at 60 s, which the rule asks of both samplings); the others by terms one
+#: sampling reports and the other neither reports nor lists as not decided (20-40 % ch4 a 3.4 h lag of T_9; 40-60 %
+#: ch1 and the publication's ch1 a plain T_1, T_6; 60-80 % ch5 and the publication's ch3
+#: several), and the publication's ch2, where at 15 s the lag model without the term the
+#: CV cannot tell from its absence (a 3.8 h lag of T_16) no longer beats the static
+#: regression, so no lag term is named there, while 60 s names two.  Before issue 44's
+#: undecided terms and equivalent families: 14 (0-20 % ch1, 40-60 % ch2 and 80-100 % ch2
+#: differed by a term the CV could not tell from its absence; the publication's ch2 agreed).
+DIFFERENT = {("0-20", "ch3"), ("0-20", "ch4"), ("0-20", "ch5"), ("20-40", "ch3"),
+             ("20-40", "ch4"), ("40-60", "ch1"), ("40-60", "ch3"), ("40-60", "ch4"),
+             ("60-80", "ch5"), ("pub", "ch1"), ("pub", "ch2"), ("pub", "ch3")}
 
 
 def _data() -> Path:
@@ -128,7 +148,25 @@ def _group(t: dict, covariate: str, h: float) -> dict:
 
 def _terms(doc, ch, h) -> list:
     return [(t["basis"], _group(t, e["covariate"], h)) for e in doc["effects"]
-            if e["channels"] == [ch] for t in e["terms"]]
+            if e["channels"] == [ch] for t in e["terms"] if t["cv_decided"] is not False]
+
+
+def _not_decided(doc, ch, h) -> list:
+    """The channel's terms the cross-validation could not tell from their absence: marked
+    ``cv_decided`` false among the reported terms, or left out of the model for it
+    (``not_decided``)."""
+    marked = [(t["basis"], _group(t, e["covariate"], h)) for e in doc["effects"]
+              if e["channels"] == [ch] for t in e["terms"] if t["cv_decided"] is False]
+    return marked + [(t["basis"], _group(t, t["covariate"], h))
+                     for t in doc.get("not_decided", []) if t["channel"] == ch]
+
+
+def _families_agree(a: dict, b: dict) -> bool:
+    """The same family, or each sampling lists the other's family among those its
+    cross-validation cannot tell from its own (``families_equivalent``)."""
+    fa, fb = a["family"], b["family"]
+    return fa == fb or (fb in {f["family"] for f in a["families_equivalent"]}
+                        and fa in {f["family"] for f in b["families_equivalent"]})
 
 
 def _agrees(g: dict, others: list) -> bool:
@@ -147,11 +185,35 @@ def _pair(name, ch):
 @pytest.mark.parametrize("name,ch", [_pair(n, c) for n in WINDOWS for c in CHANNELS])
 def test_60_s_names_the_diagnosis_of_15_s_or_its_equivalents(runs, name, ch):
     a, b = runs(1, name), runs(4, name)
-    fa, fb = a["channels"][ch]["family"], b["channels"][ch]["family"]
-    assert fa == fb, f"{name} {ch}: family {fa} at 15 s, {fb} at 60 s"
-    ta, tb = _terms(a, ch, _half_step(1, name)), _terms(b, ch, _half_step(4, name))
-    lost = [x for x, g in ta if not _agrees(g, tb)] + [x for x, g in tb if not _agrees(g, ta)]
+    ca, cb = a["channels"][ch], b["channels"][ch]
+    assert _families_agree(ca, cb), f"{name} {ch}: family {ca['family']} at 15 s, " \
+        f"{cb['family']} at 60 s, neither listed as the other's CV-equivalent"
+    ha, hb = _half_step(1, name), _half_step(4, name)
+    ta, tb = _terms(a, ch, ha), _terms(b, ch, hb)
+    # a term of one sampling agrees with a term of the other, or with a term the other
+    # could not tell from its absence; a term not decided in its own sampling agrees
+    oa, ob = tb + _not_decided(b, ch, hb), ta + _not_decided(a, ch, ha)
+    lost = [x for x, g in ta if not _agrees(g, oa)] + [x for x, g in tb if not _agrees(g, ob)]
     assert not lost, f"{name} {ch}: terms without a counterpart in the other sampling: {lost}"
+
+
+@pytest.mark.parametrize("name", list(WINDOWS))
+def test_a_term_left_out_as_not_decided_is_listed_with_its_figures(runs, name):
+    """A term the cross-validation cannot tell from its absence is in no effect; it is
+    listed with its figures and a paired t below the critical value; every reported term
+    is decided, its paired t at least the critical value."""
+    for step in STEPS:
+        doc = runs(step, name)
+        reported = {(e["channel"], t["basis"]) for e in doc["effects"] for t in e["terms"]}
+        for t in doc["not_decided"]:
+            ch = doc["channels"][t["channel"]]
+            assert (t["channel"], t["basis"]) not in reported
+            assert t["cv_decided"] is False and math.isfinite(t["value"]) and t["std"] > 0
+            assert t["cv_without"]["paired_t"] < ch["t_critical"], (name, step, t)
+        for e in doc["effects"]:
+            for t in e["terms"]:
+                assert t["cv_decided"] is True
+                assert t["cv_without"]["paired_t"] >= doc["channels"][e["channel"]]["t_critical"]
 
 
 @pytest.mark.parametrize("name", list(WINDOWS))
