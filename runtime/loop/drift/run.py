@@ -91,7 +91,9 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
         if label in quantity:
             data["quantities"][label].update(_choice(r["choice"], bool(r["terms"])))
         if not r["choice"]["named"]:
-            data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]]
+            data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]] + [
+                f"{label}: {_basis(sp)} (not decided by these data: the lag model without it "
+                f"is CV-equivalent)" for sp in r["fit"].get("undecided", [])]
             continue
         data["effects"] += _effects(label, r, m, quantity.get(label), data["budgets"])
         data["not_significant"] += [f"{label}: {_basis(sp)}" for sp in r["fit"].get("dropped", [])]
