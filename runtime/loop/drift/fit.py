@@ -20,12 +20,10 @@ Steps (:func:`run_drift`):
 5. a term whose coefficient is not significant (``|value| < SIG_K u``,
    :mod:`volerr.selection.rules`) is dropped (the
    least significant first, refitted each time): no effect is presented with a term the
-   data do not support; then, by the same one at a time, a term the cross-validation cannot
-   tell from its absence (:func:`volerr.loop.drift.family.without_each`: the model with it
-   not significantly below the model without it, the rule the families are chosen by; the
-   lowest paired t first): the model without it is as good by every test the loop makes,
-   so it is the simpler model reported, and the term is listed as not decided by these
-   data (``not_decided``, with its figures) instead of being presented as an effect;
+   data do not support; every term kept is then scored against its absence
+   (:func:`volerr.loop.drift.family.without_each`) and one the cross-validation cannot tell
+   from it is named as not decided (``cv_decided`` false), not dropped: the model is judged
+   as a whole by the families' rule, and pairwise tests are not transitive;
 6. the prediction of every reading: a training run with its fitted zero, a held-out run with
    its own zero (its first reading) and its own inputs; beside it the shop's usual model, a
    static multiple linear regression on all temperatures (their change since the run's
@@ -139,6 +137,8 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     specs = _backward(ch, [_spec(cols, t) for t in terms])
     specs = _refine_all(ch, specs)
     specs, fit = _significant(ch, specs)
+    for sp, w in zip(specs, family.without_each(ch, fit["design"])):
+        sp.update(w)          # is the model without it CV-equivalent? (issue 44)
     Ds = _static_design(ch)
     tr = ch.s.train
     reg = _regularised(ch, cols, Z, cands, cache)
@@ -267,27 +267,15 @@ def _fit(D, y, mask) -> np.ndarray:
 
 
 def _significant(ch: Channel, specs) -> tuple[list, dict]:
-    """Fit, jackknife, and drop non-significant terms one at a time, then terms the CV
-    cannot tell from their absence (module step 5; ``fit["undecided"]`` those, each with its
-    figures in the fit it was dropped from: ``value``, ``std``, ``tau_std``)."""
-    dropped, undecided = [], []
+    """Fit, jackknife, and drop non-significant terms one at a time (module step 5)."""
+    dropped = []
     while True:
         fit = _jackknife(ch, specs)
-        fit["dropped"], fit["undecided"] = dropped, undecided
+        fit["dropped"] = dropped
         t = [abs(c) / u if u > 0 else math.inf for c, u in zip(fit["coef"], fit["coef_std"])]
         weak = [i for i, v in enumerate(t) if v < SIG_K]
         if not weak:
-            w = family.without_each(ch, fit["design"])
-            for sp, x in zip(specs, w):
-                sp.update(x)
-            weak = [i for i, x in enumerate(w) if not x["cv_decided"]]
-            if not weak:
-                return specs, fit
-            i = min(weak, key=lambda i: (w[i]["cv_without"]["paired_t"], i))
-            undecided.append({**specs[i], "value": float(fit["coef"][i]),
-                              "std": float(fit["coef_std"][i]), "tau_std": fit["tau_std"][i]})
-            specs = specs[:i] + specs[i + 1:]
-            continue
+            return specs, fit
         drop = min(weak, key=lambda i: (t[i], i))
         dropped.append(specs[drop])
         specs = specs[:drop] + specs[drop + 1:]

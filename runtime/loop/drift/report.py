@@ -137,10 +137,6 @@ class DriftReport(ResultMixin):
             out.append(f"  lag term not reported (the lag model does not beat both baselines): {n}")
         for n in d["not_significant"]:
             out.append(f"  not significant (|value| < {SIG_K:g} u), left out: {n}")
-        for t in d.get("not_decided", []):
-            out.append(f"  not decided by these data (the model without it is CV-equivalent, "
-                       f"paired t {t['cv_without']['paired_t']:.2f}), left out: "
-                       f"{t['quantity'] or t['channel']}: {_term_line(t)}")
         return out
 
 
@@ -179,6 +175,9 @@ def _term_line(t: dict) -> str:
         c += f", tau = {lag['value']:.0f}{u} s (k = {k:g})"
     if t.get("alternatives"):
         c += "; these data cannot tell it from " + _alternatives_text(t["alternatives"])
+    if t.get("cv_decided") is False:
+        c = (f"NOT DECIDED by these data (the model without it is CV-equivalent, paired t "
+             f"{t['cv_without']['paired_t']:.2f}): " + c)
     return f"{t['basis']}: {c}"
 
 

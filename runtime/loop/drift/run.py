@@ -63,7 +63,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "n_test": int(s.test.sum()), "fold_rule": res["fold_rule"],
             "n_folds": res["n_folds"], "channels": {}, "quantities": {}, "effects": [],
             "budgets": {},
-            "not_significant": [], "not_decided": [], "not_reported": [], "unidentifiable": [],
+            "not_significant": [], "not_reported": [], "unidentifiable": [],
             "extrapolation": extrapolation(s), "inputs_left_out": list(s.left_out),
             "kept_out": basis.kept_out(s)}
     if s.environments:        # each run's environment (the folds' groups, basis.folds)
@@ -91,13 +91,10 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
         if label in quantity:
             data["quantities"][label].update(_choice(r["choice"], bool(r["terms"])))
         if not r["choice"]["named"]:
-            data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]] + [
-                f"{label}: {_basis(sp)} (not decided by these data: the lag model without it "
-                f"is CV-equivalent)" for sp in r["fit"].get("undecided", [])]
+            data["not_reported"] += [f"{label}: {_basis(sp)}" for sp in r["terms"]]
             continue
         data["effects"] += _effects(label, r, m, quantity.get(label), data["budgets"])
         data["not_significant"] += [f"{label}: {_basis(sp)}" for sp in r["fit"].get("dropped", [])]
-        data["not_decided"] += _not_decided(label, r, quantity.get(label))
     tr = list(data["channels"].values())
     data["rms_before_um"] = _pool(tr, "rms_before_um")
     data["rms_after_um"] = _pool(tr, "rms_after_um")
@@ -243,7 +240,9 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
 def _term(sp, value: float, std: float, tau_std, unit: str) -> dict:
     """A term's JSON: its basis, coefficient and standard uncertainty (``unit``: the
     quantity's; per K for a temperature), time constant, its alternatives in its place and
-    whether the CV tells the model from its absence (``cv_decided``, ``cv_without``)."""
+    whether the CV tells the model from its absence (``cv_decided``, ``cv_without``:
+    :func:`volerr.loop.drift.family.without_each`; a term not decided stays in the model and
+    is named as such)."""
     return {"basis": _basis(sp), "value": value, "std": std,
             "unit": unit if sp["source"] == "heat" else f"{unit}/K",
             "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if tau_std is None
@@ -251,22 +250,6 @@ def _term(sp, value: float, std: float, tau_std, unit: str) -> dict:
             "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
             "tau_equivalent_s": _tau_span(sp), "cv_decided": sp.get("cv_decided"),
             "cv_without": sp.get("cv_without")}
-
-
-def _not_decided(label, r, q=None) -> list:
-    """The terms the CV could not tell from their absence, left out of the channel's (or the
-    quantity ``q``'s) model (:func:`volerr.loop.drift.fit._significant`): each a term's JSON
-    (:func:`_term`, its figures in the fit it was dropped from) with its ``channel``,
-    ``quantity``, ``covariate`` and ``covariates`` (as an effect names them)."""
-    unit = q.unit if q is not None else "um"
-    out = []
-    for sp in r["fit"].get("undecided", []):
-        covs = [basis.SPEED] if sp["source"] == "heat" else \
-            [c for c in (sp["source"], sp["minus"]) if c]
-        out.append({"channel": label, "quantity": q.symbol if q is not None else None,
-                    "covariate": covs[0], "covariates": covs,
-                    **_term(sp, sp["value"], sp["std"], sp["tau_std"], unit)})
-    return out
 
 
 def _tau_span(sp) -> list | None:
