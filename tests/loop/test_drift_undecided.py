@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from helpers.drift_sim import lag
 from volerr.loop.drift import basis, family
 from volerr.loop.drift import fit as core
 from volerr.loop.drift.series import DriftSeries
@@ -28,22 +29,14 @@ TAU = 3000.0
 SUB = 8                      # blocks per fold (family.SUB_BLOCKS, stated by the docs)
 
 
-def _lag(u, tau):
-    y = np.zeros_like(u)
-    a = DT / (tau + DT)
-    for i in range(1, len(u)):
-        y[i] = y[i - 1] + a * (u[i] - y[i - 1])
-    return y
-
-
 def _channel():
     rng = np.random.default_rng(44)
     t = np.arange(0.0, 24 * 3600.0, DT)
     S = 2000.0 * ((t // 7200.0) % 2 == 1) * (1 + (t // 14400.0) % 3)
-    heat = _lag(S / S.max(), TAU)
+    heat = lag(S / S.max(), TAU, DT)
     y = 12.0 * heat + rng.normal(0, 0.3, len(t))
     s = DriftSeries(t_s=t, run=np.zeros(len(t), int), runs=[("sim.csv", "")],
-                    inputs={"S_rpm": S, "T_a": 20 + 5 * _lag(S / S.max(), 600.0)},
+                    inputs={"S_rpm": S, "T_a": 20 + 5 * lag(S / S.max(), 600.0, DT)},
                     channels={"x": y}, directions={"x": "?"}, heights={"x": None})
     s.test = t >= 0.8 * t[-1]
     fold, rule = basis.folds(s)
