@@ -16,11 +16,24 @@ source's time constants the cross-validation cannot tell apart (``tau_equivalent
 its CV-equivalent alternatives, each a source at a lag of the grid (standing for the lags
 within half a grid step of it).  A lag shorter than 4 reading intervals of the coarser
 sampling (240 s) is not resolved at 60 s: there it stands for the plain source as well.
-Two terms agree when their groups share a source whose time-constant ranges overlap.  A
-channel-window agrees when both samplings report the same family and every reported term
-of each agrees with a term of the other.  Where they do not (measured when this test was
-written: 13 of 30; 14 with the regularised family), the channel-window is listed in
-``DIFFERENT`` (strict: a fix makes the test fail until the list is updated).
+Two terms agree when their groups share a source whose time-constant ranges overlap.
+
+The rule (issue 44: "... or lists the CV-equivalent alternatives", alternatives "the CV
+cannot tell apart, named as such").  A channel-window agrees when
+
+* both samplings report the same family, or each lists the other's family among the
+  families its cross-validation cannot tell from its own (``families_equivalent``: neither
+  significantly below the other by the paired t the families are chosen by); and
+* every reported term of each sampling the cross-validation decides (``cv_decided``: the
+  model with it significantly below the model without it) agrees with a reported term of
+  the other, decided or not; a term not decided in its own sampling agrees as it is (the
+  model without it is that sampling's CV-equivalent alternative, named as such).
+
+Measured: by the first rule (the same family, every reported term with a reported
+counterpart) 16 of 30; by this rule 19 of 30 (0-20 % ch1, 40-60 % ch2 and 80-100 % ch2 now
+agree: each differed by one term the cross-validation cannot tell from its absence).
+Where they do not agree, the channel-window is listed in ``DIFFERENT`` (strict: a fix
+makes the test fail until the list is updated).
 """
 
 from __future__ import annotations
@@ -45,16 +58,20 @@ WINDOWS = {"0-20": ("0s:33345s", None), "20-40": ("33345s:66690s", None),
 STEPS = (1, 4)                # every reading (15 s), every 4th (60 s)
 SHORTEST_60S = 4 * 60.0       # the shortest lag searched at 60 s (4 reading intervals)
 
-#: measured when this test was written (both samplings): the channel-windows whose
-#: diagnoses differ.  Two differ in family (0-20 % ch5: lag at 15 s, static at 60 s; 60-80 %
-#: ch5 the reverse); the others by a term one sampling finds and the other does not (a
-#: plain T_1 or T_4, a long lag of T_6, T_7, T_9, T_13 or T_15) or, on 40-60 % ch4 and the
-#: publication's ch3, by several terms.  With the regularised family (issue 44) one more:
-#: 20-40 % ch3, the lag model at 15 s, the regularised fit at 60 s.
-DIFFERENT = {("0-20", "ch1"), ("0-20", "ch3"), ("0-20", "ch4"), ("0-20", "ch5"),
-             ("20-40", "ch3"), ("20-40", "ch4"), ("40-60", "ch1"), ("40-60", "ch2"),
-             ("40-60", "ch3"), ("40-60", "ch4"), ("60-80", "ch5"), ("80-100", "ch2"), ("pub", "ch1"),
-             ("pub", "ch3")}
+#: measured (both samplings) with the rule of the module docstring: the channel-windows
+#: whose diagnoses differ.  Six differ in family, the lag model at 15 s and the regularised
+#: fit at 60 s, where the 15 s cross-validation finds the lag model significantly below
+#: the regularised fit (so lists no family as equivalent) and the 60 s one does not (0-20 %
+#: ch3, ch4, ch5; 20-40 % ch3; 40-60 % ch3, ch4: two of them list the lag model as
+#: CV-equivalent at 60 s, which the rule asks of both samplings); the others by terms one
+#: sampling reports as decided and the other does not report (20-40 % ch4 a 3.4 h lag of
+#: T_9; 40-60 % ch1 and the publication's ch1 a plain T_1, T_6; 60-80 % ch5 and the
+#: publication's ch3 several).  Before issue 44's undecided terms and equivalent families:
+#: 14 (also 0-20 % ch1, 40-60 % ch2 and 80-100 % ch2, where one sampling's term is one the
+#: cross-validation cannot tell from its absence).
+DIFFERENT = {("0-20", "ch3"), ("0-20", "ch4"), ("0-20", "ch5"), ("20-40", "ch3"),
+             ("20-40", "ch4"), ("40-60", "ch1"), ("40-60", "ch3"), ("40-60", "ch4"),
+             ("60-80", "ch5"), ("pub", "ch1"), ("pub", "ch3")}
 
 
 def _data() -> Path:
@@ -128,7 +145,23 @@ def _group(t: dict, covariate: str, h: float) -> dict:
 
 def _terms(doc, ch, h) -> list:
     return [(t["basis"], _group(t, e["covariate"], h)) for e in doc["effects"]
-            if e["channels"] == [ch] for t in e["terms"]]
+            if e["channels"] == [ch] for t in e["terms"] if t["cv_decided"] is not False]
+
+
+def _not_decided(doc, ch, h) -> list:
+    """The channel's reported terms the cross-validation could not tell from their absence
+    (``cv_decided`` false: the model without the term is that sampling's CV-equivalent
+    alternative)."""
+    return [(t["basis"], _group(t, e["covariate"], h)) for e in doc["effects"]
+            if e["channels"] == [ch] for t in e["terms"] if t["cv_decided"] is False]
+
+
+def _families_agree(a: dict, b: dict) -> bool:
+    """The same family, or each sampling lists the other's family among those its
+    cross-validation cannot tell from its own (``families_equivalent``)."""
+    fa, fb = a["family"], b["family"]
+    return fa == fb or (fb in {f["family"] for f in a["families_equivalent"]}
+                        and fa in {f["family"] for f in b["families_equivalent"]})
 
 
 def _agrees(g: dict, others: list) -> bool:
@@ -147,11 +180,31 @@ def _pair(name, ch):
 @pytest.mark.parametrize("name,ch", [_pair(n, c) for n in WINDOWS for c in CHANNELS])
 def test_60_s_names_the_diagnosis_of_15_s_or_its_equivalents(runs, name, ch):
     a, b = runs(1, name), runs(4, name)
-    fa, fb = a["channels"][ch]["family"], b["channels"][ch]["family"]
-    assert fa == fb, f"{name} {ch}: family {fa} at 15 s, {fb} at 60 s"
-    ta, tb = _terms(a, ch, _half_step(1, name)), _terms(b, ch, _half_step(4, name))
-    lost = [x for x, g in ta if not _agrees(g, tb)] + [x for x, g in tb if not _agrees(g, ta)]
+    ca, cb = a["channels"][ch], b["channels"][ch]
+    assert _families_agree(ca, cb), f"{name} {ch}: family {ca['family']} at 15 s, " \
+        f"{cb['family']} at 60 s, neither listed as the other's CV-equivalent"
+    ha, hb = _half_step(1, name), _half_step(4, name)
+    ta, tb = _terms(a, ch, ha), _terms(b, ch, hb)
+    # a term of one sampling agrees with a term of the other, or with a term the other
+    # could not tell from its absence; a term not decided in its own sampling agrees
+    oa, ob = tb + _not_decided(b, ch, hb), ta + _not_decided(a, ch, ha)
+    lost = [x for x, g in ta if not _agrees(g, oa)] + [x for x, g in tb if not _agrees(g, ob)]
     assert not lost, f"{name} {ch}: terms without a counterpart in the other sampling: {lost}"
+
+
+@pytest.mark.parametrize("name", list(WINDOWS))
+def test_a_term_the_cv_cannot_tell_from_its_absence_is_named_so(runs, name):
+    """Every reported term says whether the cross-validation tells the model from the model
+    without it: decided where its paired t reaches the channel's critical value, not
+    decided (and so named) below it; the model without it has a finite CV RMS."""
+    for step in STEPS:
+        doc = runs(step, name)
+        for e in doc["effects"]:
+            crit = doc["channels"][e["channel"]]["t_critical"]
+            for t in e["terms"]:
+                w = t["cv_without"]
+                assert math.isfinite(w["cv_rms_um"]) and w["cv_rms_um"] > 0
+                assert t["cv_decided"] is (w["paired_t"] >= crit), (name, step, t["basis"], w)
 
 
 @pytest.mark.parametrize("name", list(WINDOWS))

@@ -117,6 +117,41 @@ def unit_mse(ch, r) -> np.ndarray:
                      for k in np.unique(ch.s.run[tr])])
 
 
+def without_each(ch, D) -> list:
+    """Per term of the lag model with the design ``D`` (run indicators first, then one column
+    per term): whether these data decide it, by the rule the families are judged by
+    (:func:`volerr.selection.rules.significantly_below` over the units of
+    :func:`unit_mse`): the model with it must be significantly below the model without it
+    (the same terms otherwise, their time constants as they stand).  Where it is not, the
+    model without it is an alternative the cross-validation cannot tell apart.  Returns
+    [{"cv_decided": bool, "cv_without": {"cv_rms_um", "paired_t"}}] (the paired t of the
+    units' (without - with) mean squares, positive where the term helps; um)."""
+    tr = ch.fold >= 0
+    full = unit_mse(ch, cv_residuals(ch, D))
+    out = []
+    for j in range(ch.n_runs, D.shape[1]):
+        r = cv_residuals(ch, np.delete(D, j, axis=1))
+        mse = unit_mse(ch, r)
+        out.append({"cv_decided": bool(significantly_below(full, mse)),
+                    "cv_without": {"cv_rms_um": round(math.sqrt(float(np.mean(r[tr] ** 2))), 6),
+                                   "paired_t": round(paired_t(mse - full), 3)}})
+    return out
+
+
+def equivalent_families(mse: dict, cv_rms: dict, fam: str, has_terms: bool) -> list:
+    """The families the cross-validation cannot tell from the reported ``fam``: neither's
+    unit mean squares (``mse`` family -> (n,)) significantly below the other's (the rule of
+    :func:`choose`), the lowest CV RMS first: [{"family", "cv_rms_um", "paired_t"}] (the
+    paired t of (family's - reported's) mean squares: positive where the family is the
+    worse).  The lag model without terms is the constant and is not listed."""
+    out = [{"family": f, "cv_rms_um": round(cv_rms[f], 6),
+            "paired_t": round(paired_t(mse[f] - mse[fam]), 3)}
+           for f in mse if f != fam and (f != "lag" or has_terms)
+           and not significantly_below(mse[fam], mse[f])
+           and not significantly_below(mse[f], mse[fam])]
+    return sorted(out, key=lambda x: (x["cv_rms_um"], x["family"]))
+
+
 def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
            regularised=None) -> dict:
     """The family of the channel by the module's rule: ``designs`` family -> design matrix;
@@ -127,7 +162,8 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
     (:mod:`volerr.loop.drift.shrink`), a fourth candidate (None: three).  Returns
     {"family", "cv_rms_um" {family: um}, "t" {"static_vs_constant", "lag_vs_constant",
     "lag_vs_static"; with the fourth "regularised_vs_constant", "regularised_vs_static",
-    "lag_vs_regularised"}, "rule", "cv_resid" (N,) of the chosen family}."""
+    "lag_vs_regularised"}, "rule", "cv_resid" (N,) of the chosen family, "equivalent" the
+    families the cross-validation cannot tell from it (:func:`equivalent_families`)}."""
     resid = {f: cv_residuals(ch, designs[f]) for f in FAMILIES if f in designs}
     if regularised is not None:
         resid["regularised"] = regularised
@@ -162,6 +198,7 @@ def choose(ch, designs: dict, has_terms: bool, nested: bool = False,
     return {"family": fam, "named": named and fam in ("lag", "regularised"),
             "cv_rms_um": cv_rms, "t": t, "t_crit": t95(K - 1),
             "cv_resid": resid[fam], "paired_units": "runs" if by_runs(ch) else "blocks",
+            "equivalent": equivalent_families(mse, cv_rms, fam, has_terms),
             "rule": _rule_text(K, regularised is not None, units)}
 
 

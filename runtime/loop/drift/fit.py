@@ -20,7 +20,10 @@ Steps (:func:`run_drift`):
 5. a term whose coefficient is not significant (``|value| < SIG_K u``,
    :mod:`volerr.selection.rules`) is dropped (the
    least significant first, refitted each time): no effect is presented with a term the
-   data do not support;
+   data do not support; every term kept is then scored against its absence
+   (:func:`volerr.loop.drift.family.without_each`) and one the cross-validation cannot tell
+   from it is named as not decided (``cv_decided`` false), not dropped: the model is judged
+   as a whole by the families' rule, and pairwise tests are not transitive;
 6. the prediction of every reading: a training run with its fitted zero, a held-out run with
    its own zero (its first reading) and its own inputs; beside it the shop's usual model, a
    static multiple linear regression on all temperatures (their change since the run's
@@ -135,6 +138,8 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     specs = _backward(ch, [_spec(cols, t) for t in terms])
     specs = _refine_all(ch, specs)
     specs, fit = _significant(ch, specs)
+    for sp, w in zip(specs, family.without_each(ch, fit["design"])):
+        sp.update(w)          # is the model without it CV-equivalent? (issue 44)
     Ds = _static_design(ch)
     tr = ch.s.train
     reg = _regularised(ch, cols, Z, cands, cache)

@@ -162,6 +162,10 @@ def _family_lines(c: dict) -> list:
     out = [line]
     if c.get("verdict"):
         out.append(f"    {c['verdict']}")
+    if c.get("families_equivalent"):
+        out.append("    the cross-validation cannot tell it from: " + ", ".join(
+            f"{f['family']} (CV RMS {f['cv_rms_um']:.3f} um, paired t {f['paired_t']:.2f})"
+            for f in c["families_equivalent"]))
     iv = c.get("interval")
     if iv:
         cov = "n/a" if iv["coverage_test"] is None else f"{100 * iv['coverage_test']:.1f} %"
@@ -182,6 +186,9 @@ def _term_line(t: dict) -> str:
         c += f", tau = {lag['value']:.0f}{u} s (k = {k:g})"
     if t.get("alternatives"):
         c += "; these data cannot tell it from " + _alternatives_text(t["alternatives"])
+    if t.get("cv_decided") is False:
+        c = (f"NOT DECIDED by these data (the model without it is CV-equivalent, paired t "
+             f"{t['cv_without']['paired_t']:.2f}): " + c)
     return f"{t['basis']}: {c}"
 
 

@@ -150,6 +150,7 @@ def _choice(choice, has_terms) -> dict:
             "paired_t": {k: round(v, 3) for k, v in choice["t"].items()},
             "selection_rule": choice["rule"],
             "t_critical": round(choice["t_crit"], 3),
+            "families_equivalent": choice.get("equivalent", []),
             "verdict": family.verdict(choice["family"], choice["cv_rms_um"], choice["t"],
                                       has_terms, choice["t_crit"], choice["named"])}
 
@@ -223,14 +224,8 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
         covs = [basis.SPEED] if heat else [c for c in key if c]
         terms = []
         for i in idx:
-            sp = r["terms"][i]
-            t = {"basis": _basis(sp), "value": float(f["coef"][i]), "std": float(f["coef_std"][i]),
-                 "unit": unit if heat else f"{unit}/K",
-                 "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if f["tau_std"][i] is None
-                            else round(f["tau_std"][i], 1)} if sp["tau_s"] > 0 else None),
-                 "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
-                 "tau_equivalent_s": _tau_span(sp)}
-            terms.append(t)
+            terms.append(_term(r["terms"][i], float(f["coef"][i]), float(f["coef_std"][i]),
+                               f["tau_std"][i], unit))
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
         for j, (i, t) in enumerate(zip(idx, terms)):
             if budgets is not None:
@@ -250,6 +245,21 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
             e["S_ref_rpm"] = S_ref
         out.append(e)
     return out
+
+
+def _term(sp, value: float, std: float, tau_std, unit: str) -> dict:
+    """A term's JSON: its basis, coefficient and standard uncertainty (``unit``: the
+    quantity's; per K for a temperature), time constant, its alternatives in its place and
+    whether the CV tells the model from its absence (``cv_decided``, ``cv_without``:
+    :func:`volerr.loop.drift.family.without_each`; a term not decided stays in the model and
+    is named as such)."""
+    return {"basis": _basis(sp), "value": value, "std": std,
+            "unit": unit if sp["source"] == "heat" else f"{unit}/K",
+            "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if tau_std is None
+                       else round(tau_std, 1)} if sp["tau_s"] > 0 else None),
+            "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
+            "tau_equivalent_s": _tau_span(sp), "cv_decided": sp.get("cv_decided"),
+            "cv_without": sp.get("cv_without")}
 
 
 def _tau_span(sp) -> list | None:
