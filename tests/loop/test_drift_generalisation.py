@@ -6,8 +6,8 @@ Data: runtime/data/fl_thermal_spindle.csv (the real 46.3 h spindle test, 11 115 
 15 s, t = 0 .. 166 710 s, 16 temperatures, 5 channels of unknown direction; README in
 /work/shared/data/thermal/).  Each window below is held out of the WHOLE file with
 ``volerr loop DMU50 drift:FILE --holdout-time A:B`` (training: every reading outside the
-window, before and after it), run once per window (module fixture, one xdist group per
-window so a window's tests share its run):
+window, before and after it), run once per window (tests/helpers/fl_runs.py, shared with
+test_drift_sampling.py; one xdist group per window so a window's tests share its run):
 
 =========  ==================  =====================================================
 window     A:B (s)             what the training part has not seen
@@ -48,15 +48,13 @@ trusted.
 from __future__ import annotations
 
 import csv
-import json
-import os
-import subprocess
-import sys
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from helpers import fl_runs
 
 CHANNELS = ("ch1", "ch2", "ch3", "ch4", "ch5")
 PUBLISHED_MAE_UM = {"ch1": 3.561, "ch2": 3.755, "ch3": 3.704, "ch4": 3.461, "ch5": 4.284}
@@ -97,25 +95,18 @@ def _window_arg(a, b) -> str:
 
 
 @pytest.fixture(scope="module")
-def loop_runs(tmp_path_factory):
-    """window -> (JSON, predictions rows): ``volerr loop`` run once per window."""
-    cache: dict = {}
+def loop_runs():
+    """window -> (JSON, predictions rows): ``volerr loop DMU50 drift:FILE --holdout-time A:B
+    --json --predictions-out`` on the shipped file, run once per process for every test
+    file that asks for it (tests/helpers/fl_runs.py: in-process, one BLAS thread; the same
+    bytes as a ``python -m volerr`` process writes)."""
 
     def get(name: str):
-        if name not in cache:
-            a, b = WINDOWS[name]
-            folder = tmp_path_factory.mktemp(f"fl_{name}")
-            env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                   "MKL_NUM_THREADS": "1"}
-            r = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50",
-                                f"drift:{_data()}", "--holdout-time", _window_arg(a, b),
-                                "--json", "w.json", "--predictions-out", "p.csv"],
-                               capture_output=True, text=True, cwd=folder, env=env)
-            assert r.returncode == 0, r.stderr
-            with open(folder / "p.csv", newline="") as fh:
-                rows = list(csv.DictReader(fh))
-            cache[name] = (json.loads((folder / "w.json").read_text()), rows)
-        return cache[name]
+        assert fl_runs.WINDOWS[name] == (_window_arg(*WINDOWS[name]), None)   # same run
+        run = fl_runs.loop_run(1, name)
+        assert run.returncode == 0, run.stderr
+        assert run.input == _data()
+        return run.doc, run.rows
 
     return get
 

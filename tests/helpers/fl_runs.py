@@ -1,0 +1,112 @@
+"""``volerr loop`` on the FL_THERMAL spindle test, run once per process for every test file
+that asks for the same run (issue 42 item 7: the suite's time).
+
+tests/loop/test_drift_sampling.py (every window at 15 s and 60 s),
+test_drift_generalisation.py (the five 20 % windows at 15 s) and test_drift_fl_thermal.py
+(the publication window at 15 s) ran the same loop on the same bytes with the same options,
+each in its own fixture (and the last two each in a ``python -m volerr`` process).  Here the
+command runs in-process (``volerr.cli.main``, what ``python -m volerr`` calls) with the
+BLAS limited to one thread (what those processes' ``OPENBLAS_NUM_THREADS=1`` did), its
+``--json`` and ``--predictions-out`` files read back, and the result kept
+(``functools.lru_cache``).  The tests of one window are in one xdist group
+(``fl_window_<name>``), so that their worker computes the window's runs once.
+
+Measured when this module was written (both ways, every window): the JSON and the
+predictions file of the in-process run are byte-identical to those of the process the tests
+started, and the JSON equals ``loop_drift(...).data`` (what test_drift_sampling.py read) but
+for the file names in ``runs``.
+"""
+
+from __future__ import annotations
+
+import atexit
+import contextlib
+import csv
+import io
+import json
+import shutil
+import tempfile
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+#: window -> (``--holdout-time``, the file cut before this time in s, or None): five 20 %
+#: windows held out of the whole file (training on both sides) and the publication split
+#: (the file before 133 380 s, 100 035 s on held out)
+WINDOWS = {"0-20": ("0s:33345s", None), "20-40": ("33345s:66690s", None),
+           "40-60": ("66690s:100035s", None), "60-80": ("100035s:133380s", None),
+           "80-100": ("133380s:", None), "pub": ("100035s:", 133380.0)}
+
+
+def data() -> Path:
+    """The shipped data file (15 s)."""
+    return Path(str(resources.files("volerr") / "data" / "fl_thermal_spindle.csv"))
+
+
+def file_text(step: int, cut) -> str:
+    """The data file with every ``step``-th reading, the readings at ``cut`` s and later left
+    out (``cut`` None: none); its header lines kept (step 1, no cut: the file itself)."""
+    lines = data().read_text().splitlines()
+    head = [ln for ln in lines if ln.startswith("#")]
+    body = [ln for ln in lines if not ln.startswith("#")]
+    rows = body[1:][::step]
+    if cut is not None:
+        rows = [r for r in rows if float(r.split(",", 1)[0]) < cut]
+    return "\n".join(head + [body[0]] + rows) + "\n"
+
+
+@dataclass(frozen=True)
+class Run:
+    """One ``volerr loop`` run: its exit code, console text, JSON (parsed), predictions
+    (``csv.DictReader`` rows), and the folder holding its input ``input`` and its outputs
+    ``w.json`` and ``p.csv`` (kept until the process ends)."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+    doc: dict
+    rows: list
+    folder: Path
+    input: Path
+
+
+_ROOT: list = []
+
+
+def _root() -> Path:
+    if not _ROOT:
+        _ROOT.append(Path(tempfile.mkdtemp(prefix="volerr-fl-runs-")))
+        atexit.register(shutil.rmtree, _ROOT[0], True)
+    return _ROOT[0]
+
+
+@lru_cache(maxsize=None)
+def loop_run(step: int, name: str) -> Run:
+    """``volerr loop DMU50 drift:FILE --holdout-time W --json w.json --predictions-out
+    p.csv`` on window ``name`` of :data:`WINDOWS`, FILE every ``step``-th reading (step 1 of
+    an uncut window: the shipped file itself), run once per process."""
+    from threadpoolctl import threadpool_limits
+
+    from volerr.cli import main
+
+    window, cut = WINDOWS[name]
+    folder = _root() / f"{name}_{step}"
+    folder.mkdir()
+    if step == 1 and cut is None:
+        path = data()
+    else:
+        path = folder / f"fl_{step}.csv"
+        path.write_text(file_text(step, cut))
+    out, err = io.StringIO(), io.StringIO()
+    with threadpool_limits(limits=1), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        code = main(["loop", "DMU50", f"drift:{path}", "--holdout-time", window,
+                     "--json", str(folder / "w.json"),
+                     "--predictions-out", str(folder / "p.csv")])
+    doc, rows = {}, []
+    if code == 0:
+        doc = json.loads((folder / "w.json").read_text())
+        with open(folder / "p.csv", newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    return Run(code, out.getvalue(), err.getvalue(), doc, rows, folder, path)
