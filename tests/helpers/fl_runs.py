@@ -5,8 +5,8 @@ tests/loop/test_drift_sampling.py (every window at 15 s and 60 s),
 test_drift_generalisation.py (the five 20 % windows at 15 s) and test_drift_fl_thermal.py
 (the publication window at 15 s) ran the same loop on the same bytes with the same options,
 each in its own fixture (and the last two each in a ``python -m volerr`` process).  Here the
-command runs in-process (``volerr.cli.main``, what ``python -m volerr`` calls) with the
-BLAS limited to one thread (what those processes' ``OPENBLAS_NUM_THREADS=1`` did), its
+command runs in-process (tests/helpers/cli_run.py: ``volerr.cli.main``, what ``python -m
+volerr`` calls, with one BLAS thread, what those processes' ``OPENBLAS_NUM_THREADS=1`` did), its
 ``--json`` and ``--predictions-out`` files read back, and the result kept
 (``functools.lru_cache``).  The tests of one window are in one xdist group
 (``fl_window_<name>``), so that their worker computes the window's runs once.
@@ -20,9 +20,7 @@ for the file names in ``runs``.
 from __future__ import annotations
 
 import atexit
-import contextlib
 import csv
-import io
 import json
 import shutil
 import tempfile
@@ -86,9 +84,7 @@ def loop_run(step: int, name: str) -> Run:
     """``volerr loop DMU50 drift:FILE --holdout-time W --json w.json --predictions-out
     p.csv`` on window ``name`` of :data:`WINDOWS`, FILE every ``step``-th reading (step 1 of
     an uncut window: the shipped file itself), run once per process."""
-    from threadpoolctl import threadpool_limits
-
-    from volerr.cli import main
+    from helpers import cli_run
 
     window, cut = WINDOWS[name]
     folder = _root() / f"{name}_{step}"
@@ -98,15 +94,11 @@ def loop_run(step: int, name: str) -> Run:
     else:
         path = folder / f"fl_{step}.csv"
         path.write_text(file_text(step, cut))
-    out, err = io.StringIO(), io.StringIO()
-    with threadpool_limits(limits=1), contextlib.redirect_stdout(out), \
-            contextlib.redirect_stderr(err):
-        code = main(["loop", "DMU50", f"drift:{path}", "--holdout-time", window,
-                     "--json", str(folder / "w.json"),
-                     "--predictions-out", str(folder / "p.csv")])
+    r = cli_run.run(["loop", "DMU50", f"drift:{path}", "--holdout-time", window,
+                     "--json", "w.json", "--predictions-out", "p.csv"], folder)
     doc, rows = {}, []
-    if code == 0:
+    if r.returncode == 0:
         doc = json.loads((folder / "w.json").read_text())
         with open(folder / "p.csv", newline="") as fh:
             rows = list(csv.DictReader(fh))
-    return Run(code, out.getvalue(), err.getvalue(), doc, rows, folder, path)
+    return Run(r.returncode, r.stdout, r.stderr, doc, rows, folder, path)

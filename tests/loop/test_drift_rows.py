@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from helpers import drift_sim as D
+from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.loop.drift import rows as R
 
 # the module fixtures once, on one xdist worker (not once per worker)
