@@ -9,7 +9,8 @@ hundred rows, at most about a hundred columns) their waiting costs far more CPU 
 arithmetic.  Measured on this machine (load 12-18), ``numpy.linalg.lstsq`` of a 453 x 94
 matrix: 97 ms CPU with the default threads, 3.5 ms with one.  What the tests compute with one
 thread is what ``python -m volerr`` computes with ``OPENBLAS_NUM_THREADS=1``; the figures
-may differ from the threaded run's in the last digits only (summation order).
+may differ from the threaded run's in the last digits (summation order; the FL_THERMAL
+loop's JSON: the same families and terms, floats within 1e-10 relative).
 """
 
 from __future__ import annotations
