@@ -30,14 +30,12 @@ from __future__ import annotations
 
 import csv
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from helpers import cli_run
 from helpers import drift_sim as D
 
 # the module fixture's loop runs once, on one xdist worker (a case's two tests share it)
@@ -61,11 +59,8 @@ def _loop(folder: Path, files=RUNS) -> tuple:
     """Run the command of the module docstring in ``folder``: (process, JSON or None)."""
     if _SKIP:
         pytest.skip(_SKIP[0])
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-           "MKL_NUM_THREADS": "1"}
-    args = [sys.executable, "-m", "volerr", "loop", "DMU50", *files, "--json", "loop.json",
-            "--predictions-out", "pred.csv"]
-    r = subprocess.run(args, capture_output=True, text=True, cwd=folder, env=env)
+    r = cli_run.run(["loop", "DMU50", *files, "--json", "loop.json",     # in-process
+                     "--predictions-out", "pred.csv"], folder)
     if r.returncode != 0 and any(m in r.stderr for m in NOT_YET):
         _SKIP.append("volerr loop does not take drift runs yet: "
                      + (r.stderr.strip().splitlines() or [""])[-1])

@@ -10,17 +10,17 @@ predictions file and the data file itself (not taken from the report)."""
 from __future__ import annotations
 
 import csv
-import json
-import os
-import subprocess
-import sys
+import shutil
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("drift_fl_thermal")]  # fixture once
+from helpers import fl_runs
+
+# the run is test_drift_sampling.py's publication window at 15 s: one xdist group, one run
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group(fl_runs.GROUP)]
 
 PUBLISHED_MAE_UM = {"ch1": 3.561, "ch2": 3.755, "ch3": 3.704, "ch4": 3.461, "ch5": 4.284}
 END_S = 133380.0
@@ -43,13 +43,15 @@ def run(tmp_path_factory):
     body = [ln for ln in lines if not ln.startswith("#")]
     keep = [body[0]] + [ln for ln in body[1:] if float(ln.split(",")[0]) < END_S]
     (folder / "fl80.csv").write_text("\n".join(head + keep) + "\n")
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-    r = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", "drift:fl80.csv",
-                        "--holdout-time", "100035s:", "--json", "fl.json",
-                        "--predictions-out", "p.csv"],
-                       capture_output=True, text=True, cwd=folder, env=env)
+    # ``volerr loop DMU50 drift:fl80.csv --holdout-time 100035s: --json --predictions-out``,
+    # run once per process for every test file that asks for it (tests/helpers/fl_runs.py:
+    # in-process, one BLAS thread): the same file bytes and window
+    assert fl_runs.WINDOWS["pub"] == ("100035s:", END_S)
+    r = fl_runs.loop_run(1, "pub")
     assert r.returncode == 0, r.stderr
-    return folder, r, json.loads((folder / "fl.json").read_text())
+    assert r.input.read_bytes() == (folder / "fl80.csv").read_bytes()
+    shutil.copyfile(r.folder / "p.csv", folder / "p.csv")
+    return folder, r, r.doc
 
 
 def test_beats_the_published_models_on_the_held_out_window(run):

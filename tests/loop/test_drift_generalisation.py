@@ -6,8 +6,8 @@ Data: runtime/data/fl_thermal_spindle.csv (the real 46.3 h spindle test, 11 115 
 15 s, t = 0 .. 166 710 s, 16 temperatures, 5 channels of unknown direction; README in
 /work/shared/data/thermal/).  Each window below is held out of the WHOLE file with
 ``volerr loop DMU50 drift:FILE --holdout-time A:B`` (training: every reading outside the
-window, before and after it), run once per window (module fixture, one xdist group per
-window so a window's tests share its run):
+window, before and after it), run once per window (tests/helpers/fl_runs.py, shared with
+test_drift_sampling.py; one xdist group for every window so the tests share the runs):
 
 =========  ==================  =====================================================
 window     A:B (s)             what the training part has not seen
@@ -48,15 +48,13 @@ trusted.
 from __future__ import annotations
 
 import csv
-import json
-import os
-import subprocess
-import sys
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from helpers import fl_runs
 
 CHANNELS = ("ch1", "ch2", "ch3", "ch4", "ch5")
 PUBLISHED_MAE_UM = {"ch1": 3.561, "ch2": 3.755, "ch3": 3.704, "ch4": 3.461, "ch5": 4.284}
@@ -97,27 +95,19 @@ def _window_arg(a, b) -> str:
 
 
 @pytest.fixture(scope="module")
-def loop_runs(tmp_path_factory):
-    """window -> (JSON, predictions rows): ``volerr loop`` run once per window."""
-    cache: dict = {}
+def loop_runs():
+    """window -> (JSON, predictions rows): ``volerr loop DMU50 drift:FILE --holdout-time A:B
+    --json --predictions-out`` on the shipped file, run once per process for every test
+    file that asks for it (tests/helpers/fl_runs.py: in-process, one BLAS thread; the same
+    bytes as a ``python -m volerr`` process writes)."""
 
     def get(name: str):
-        if name not in cache:
-            a, b = WINDOWS[name]
-            folder = tmp_path_factory.mktemp(f"fl_{name}")
-            env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                   "MKL_NUM_THREADS": "1"}
-            r = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50",
-                                f"drift:{_data()}", "--holdout-time", _window_arg(a, b),
-                                "--json", "w.json", "--predictions-out", "p.csv"],
-                               capture_output=True, text=True, cwd=folder, env=env)
-            assert r.returncode == 0, r.stderr
-            with open(folder / "p.csv", newline="") as fh:
-                rows = list(csv.DictReader(fh))
-            cache[name] = (json.loads((folder / "w.json").read_text()), rows)
-        return cache[name]
+        assert fl_runs.WINDOWS[name] == (_window_arg(*WINDOWS[name]), None)   # same run
+        run = fl_runs.loop_run(1, name)
+        assert run.returncode == 0, run.stderr
+        assert run.input == _data()
+        return run.doc, run.rows
 
-    get.cache = cache             # the windows run so far in this process (pooled tests)
     return get
 
 
@@ -153,7 +143,7 @@ def loop_mae(table: dict, rows: list, channel: str, name: str) -> float:
 def _param(name):
     """A window as a parameter: its tests in one xdist group (they share its loop run); the
     windows whose run takes longest (measured, see SLOW_WINDOWS) marked slow as well."""
-    marks = [pytest.mark.xdist_group(f"fl_window_{name}")]
+    marks = [pytest.mark.xdist_group(fl_runs.GROUP)]
     if name in SLOW_WINDOWS:
         marks.append(pytest.mark.slow)
     return pytest.param(name, id=name, marks=marks)
@@ -206,7 +196,7 @@ def test_the_reported_static_regression_is_the_one_computed_here(loop_runs, tabl
 
 
 @pytest.mark.parametrize("channel", CHANNELS)
-@pytest.mark.xdist_group("fl_window_60-80")
+@pytest.mark.xdist_group(fl_runs.GROUP)
 def test_published_window_trained_on_the_rest_beats_the_published_best(loop_runs, table,
                                                                       channel):
     _, rows = loop_runs("60-80")
@@ -270,14 +260,12 @@ def test_interval_coverage_is_that_of_the_predictions(loop_runs, table, name):
 POOLED_COVERAGE = (0.90, 0.98)
 
 
+@pytest.mark.xdist_group(fl_runs.GROUP)
 def test_pooled_interval_coverage_of_all_windows(loop_runs, table):
     """Pooled over every held-out reading of the five windows' 25 channel-windows, the share
     inside the predictions file's per-reading half-width (the data file's values) is within
     ``POOLED_COVERAGE``.  No loop run of its own: it reads the windows the tests above ran in
-    this process (run the file without xdist: ``-p no:xdist``), else it is skipped."""
-    if set(loop_runs.cache) != set(WINDOWS):
-        pytest.skip("the windows ran in other processes (xdist groups): run this file with "
-                    "-p no:xdist")
+    this process (every FL window's tests are in one xdist group, tests/helpers/fl_runs.py)."""
     inside = total = 0
     for name in WINDOWS:
         _, rows = loop_runs(name)

@@ -5,10 +5,12 @@ uncertainty) as at 15 s, or lists the CV-equivalent alternatives; no reported te
 interval includes zero".)
 
 Data: runtime/data/fl_thermal_spindle.csv (15 s) and every 4th reading of it (60 s, written
-here); the six windows of tests/loop/test_drift_generalisation.py: five 20 % windows held
-out of the whole file (training on both sides) and the publication split (the file before
-133 380 s, 100 035 s on held out).  The loop runs once per window and sampling (module
-fixture, one xdist group; the 60 s runs are 4x smaller).
+by tests/helpers/fl_runs.py); the six windows of tests/loop/test_drift_generalisation.py:
+five 20 % windows held out of the whole file (training on both sides) and the publication
+split (the file before 133 380 s, 100 035 s on held out).  ``volerr loop`` runs once per
+window and sampling (tests/helpers/fl_runs.py, in-process, shared with
+test_drift_generalisation.py and test_drift_fl_thermal.py; one xdist group for every
+window, ``fl_runs.GROUP``; the 60 s runs are 4x smaller).
 
 A reported term is a *group*: its source through its time constant (tau +- 2 u, where u is
 its blocked-jackknife standard uncertainty; u not determined: any tau), the span of its own
@@ -39,22 +41,16 @@ makes the test fail until the list is updated).
 from __future__ import annotations
 
 import math
-from importlib import resources
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from helpers.fl_runs import GROUP, WINDOWS, loop_run
 from volerr.loop.drift.basis import N_TAU
-from volerr.loop.drift.run import loop_drift
 
-pytestmark = [pytest.mark.xdist_group("fl_sampling"), pytest.mark.slow]
+pytestmark = [pytest.mark.slow]
 
 CHANNELS = ("ch1", "ch2", "ch3", "ch4", "ch5")
-#: window -> (--holdout-time, the file cut before this time or None)
-WINDOWS = {"0-20": ("0s:33345s", None), "20-40": ("33345s:66690s", None),
-           "40-60": ("66690s:100035s", None), "60-80": ("100035s:133380s", None),
-           "80-100": ("133380s:", None), "pub": ("100035s:", 133380.0)}
 STEPS = (1, 4)                # every reading (15 s), every 4th (60 s)
 SHORTEST_60S = 4 * 60.0       # the shortest lag searched at 60 s (4 reading intervals)
 
@@ -74,35 +70,23 @@ DIFFERENT = {("0-20", "ch3"), ("0-20", "ch4"), ("0-20", "ch5"), ("20-40", "ch3")
              ("60-80", "ch5"), ("pub", "ch1"), ("pub", "ch3")}
 
 
-def _data() -> Path:
-    return Path(str(resources.files("volerr") / "data" / "fl_thermal_spindle.csv"))
-
-
-def _write(folder: Path, step: int, cut) -> Path:
-    lines = _data().read_text().splitlines()
-    head = [ln for ln in lines if ln.startswith("#")]
-    body = [ln for ln in lines if not ln.startswith("#")]
-    rows = body[1:][::step]
-    if cut is not None:
-        rows = [r for r in rows if float(r.split(",", 1)[0]) < cut]
-    path = folder / f"fl_{step}.csv"
-    path.write_text("\n".join(head + [body[0]] + rows) + "\n")
-    return path
-
-
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """(step, window) -> the loop's JSON, run once each."""
-    cache: dict = {}
+def runs():
+    """(step, window) -> the loop's JSON (``volerr loop --json``, the same as
+    ``loop_drift(...).data``), run once per process for every test file that asks for it
+    (tests/helpers/fl_runs.py; the tests of window W in xdist group ``fl_runs.GROUP``)."""
 
     def get(step: int, name: str) -> dict:
-        if (step, name) not in cache:
-            win, cut = WINDOWS[name]
-            path = _write(tmp_path_factory.mktemp(f"fl_{name}_{step}"), step, cut)
-            cache[(step, name)] = loop_drift("DMU50", [str(path)], window=win).data
-        return cache[(step, name)]
+        run = loop_run(step, name)
+        assert run.returncode == 0, run.stderr
+        return run.doc
 
     return get
+
+
+def _window(name):
+    """A window as a parameter, in the xdist group of its runs (tests/helpers/fl_runs.py)."""
+    return pytest.param(name, id=name, marks=pytest.mark.xdist_group(GROUP))
 
 
 def _half_step(step: int, name: str) -> float:
@@ -170,7 +154,7 @@ def _agrees(g: dict, others: list) -> bool:
 
 
 def _pair(name, ch):
-    marks = []
+    marks = [pytest.mark.xdist_group(GROUP)]
     if (name, ch) in DIFFERENT:
         marks.append(pytest.mark.xfail(reason="issue 44: the samplings' diagnoses differ "
                                               "(measured, see DIFFERENT)", strict=True))
@@ -192,7 +176,7 @@ def test_60_s_names_the_diagnosis_of_15_s_or_its_equivalents(runs, name, ch):
     assert not lost, f"{name} {ch}: terms without a counterpart in the other sampling: {lost}"
 
 
-@pytest.mark.parametrize("name", list(WINDOWS))
+@pytest.mark.parametrize("name", [_window(n) for n in WINDOWS])
 def test_a_term_the_cv_cannot_tell_from_its_absence_is_named_so(runs, name):
     """Every reported term says whether the cross-validation tells the model from the model
     without it: decided where its paired t reaches the channel's critical value, not
@@ -207,7 +191,7 @@ def test_a_term_the_cv_cannot_tell_from_its_absence_is_named_so(runs, name):
                 assert t["cv_decided"] is (w["paired_t"] >= crit), (name, step, t["basis"], w)
 
 
-@pytest.mark.parametrize("name", list(WINDOWS))
+@pytest.mark.parametrize("name", [_window(n) for n in WINDOWS])
 @pytest.mark.parametrize("step", STEPS)
 def test_no_reported_term_includes_zero_at_k_2(runs, step, name):
     doc = runs(step, name)
@@ -216,7 +200,7 @@ def test_no_reported_term_includes_zero_at_k_2(runs, step, name):
             assert abs(t["value"]) >= 2 * t["std"], (name, step, t["basis"], t["value"], t["std"])
 
 
-@pytest.mark.parametrize("name", list(WINDOWS))
+@pytest.mark.parametrize("name", [_window(n) for n in WINDOWS])
 def test_every_term_names_its_group(runs, name):
     """Every reported term's alternatives carry their CV RMS and paired t, lowest CV RMS
     first; a lag's span of equivalent time constants holds the lag itself."""

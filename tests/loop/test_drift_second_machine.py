@@ -26,13 +26,11 @@ from __future__ import annotations
 
 import csv
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from helpers import cli_run
 from helpers import spindle_machine_sim as M
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("drift_second_machine")]
@@ -46,13 +44,9 @@ A_SLOW_SAME = 4.0
 
 
 def _loop(folder) -> dict:
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-           "MKL_NUM_THREADS": "1"}
     files = [f"drift:{n}.csv" for n in M.PROGRAMMES]
-    r = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", *files,
-                        "--holdout-files", f"{M.HELD_OUT}.csv", "--json", "loop.json",
-                        "--predictions-out", "pred.csv"],
-                       capture_output=True, text=True, cwd=folder, env=env)
+    r = cli_run.run(["loop", "DMU50", *files, "--holdout-files", f"{M.HELD_OUT}.csv",
+                     "--json", "loop.json", "--predictions-out", "pred.csv"], folder)
     assert r.returncode == 0, r.stderr
     with open(folder / "pred.csv", newline="") as fh:
         rows = [row for row in csv.DictReader(fh) if row["split"] == "test"]
