@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import in_process
+from helpers import in_process, plan_designs
 from helpers import instrument_sim as S
 from helpers import plan_exec as P
 
@@ -434,18 +434,22 @@ def test_bad_input_one_line_nothing_written(plan_exists, tmp_path, what):
 
 def test_output_folder_with_files_needs_force(plan_exists, tmp_path):
     """A second plan into a folder holding the first one's files: refused without --force
-    (one line, nothing changed, no JSON), done with it."""
+    (one line, nothing changed, no JSON), done with it.  The three runs ask for one design,
+    made once (``helpers.plan_designs``): what is checked is the command's output folder."""
     out = tmp_path / "out"
     args = ["plan", "MB1", "--instrument", "ballbar:lengths=100,150", "--readings", "100",
             "--out", out]
-    r = run(*args, "--json", tmp_path / "first.json")
+    with plan_designs.designed_once():
+        r = run(*args, "--json", tmp_path / "first.json")
     assert r.returncode == 0, r.stderr[-2000:]
     (out / "notes.txt").write_text("mine\n")
     before = {q.name: q.read_bytes() for q in out.rglob("*") if q.is_file()}
-    r = run(*args, "--json", tmp_path / "second.json")
+    with plan_designs.designed_once():
+        r = run(*args, "--json", tmp_path / "second.json")
     _refused(r, "force", "exist")
     after = {q.name: q.read_bytes() for q in out.rglob("*") if q.is_file()}
     assert after == before and not (tmp_path / "second.json").exists()
-    r = run(*args, "--json", tmp_path / "third.json", "--force")
+    with plan_designs.designed_once():
+        r = run(*args, "--json", tmp_path / "third.json", "--force")
     assert r.returncode == 0 and (tmp_path / "third.json").is_file(), r.stderr[-2000:]
     assert (out / "notes.txt").read_text() == "mine\n"

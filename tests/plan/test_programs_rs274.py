@@ -28,6 +28,7 @@ import pytest
 
 import volerr
 from helpers import reference_chain
+from helpers import plan_designs
 from helpers import rs274_path as R
 from volerr.cli import main
 from volerr.machine.layout import read_layout
@@ -52,11 +53,12 @@ CASES = {
 }
 DIALECTS = ("linuxcnc", "iso")
 #: the tests of a plan case on one xdist worker, both dialects: the plan designed once (the
-#: design does not depend on the dialect, only the programs written from it do: ``planned``)
-#: and each program read by rs274 once (the module's ``_PLANS``, ``planned`` and ``_READ``
-#: caches live in each worker); the cases spread over the workers
-PLANS = [pytest.param(c, d, id=f"{c}-{d}", marks=pytest.mark.xdist_group(f"rs274_{c}"))
-         for c in CASES for d in DIALECTS]
+#: design does not depend on the dialect, only the programs written from it do:
+#: ``helpers.plan_designs``) and each program read by rs274 once (the module's ``planned`` and
+#: ``_READ`` caches live in each worker); the cases spread over the workers.  DMU50-ballbar is
+#: tests/planning/test_plan.py's SWEEPS plan (the same design): in that module's group
+PLANS = [pytest.param(c, d, id=f"{c}-{d}", marks=pytest.mark.xdist_group(
+    "planning_plans" if c == "DMU50-ballbar" else f"rs274_{c}")) for c in CASES for d in DIALECTS]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -218,29 +220,8 @@ def test_forward_kinematics_agree_with_the_reference_chain():
 # ---------------------------------------------------------------------------------------------
 # every program of the plans
 
-#: the designs of the module's ``volerr plan`` runs: repr of the API call's arguments -> Plan
-_PLANS: dict = {}
-
-
-def _plan_once(plan):
-    """``volerr.plan.api.plan`` designing each request once: the command with ``--dialect
-    linuxcnc`` and with ``--dialect iso`` asks for the same design (layout, instruments,
-    readings, parameters, seed: the dialect is not among them; it is applied when the result
-    writes its programs, ``Plan.write``), so the second run takes the first's design and
-    writes its own files through the command's own outputs (issue 42 item 7: the design is
-    most of a run's time)."""
-    def once(*args, **kwargs):
-        key = repr((args, sorted(kwargs.items())))
-        if key not in _PLANS:
-            _PLANS[key] = plan(*args, **kwargs)
-        return _PLANS[key]
-    return once
-
-
 @pytest.fixture(scope="module")
 def planned(tmp_path_factory):
-    import volerr.plan.api
-
     cache = {}
 
     def run(case, dialect):
@@ -248,8 +229,7 @@ def planned(tmp_path_factory):
             tmp = tmp_path_factory.mktemp(f"{case}-{dialect}")
             argv = ["plan", *CASES[case], "--dialect", dialect, "--out", str(tmp / "plan"),
                     "--json", str(tmp / "plan.json")]
-            with pytest.MonkeyPatch.context() as mp:
-                mp.setattr(volerr.plan.api, "plan", _plan_once(volerr.plan.api.plan))
+            with plan_designs.designed_once():     # the two dialects: one design
                 try:
                     rc = main(argv)
                 except SystemExit as exc:        # argparse refusing an option
