@@ -18,7 +18,8 @@ import pytest
 
 import volerr
 from volerr.audit.numeric import _evaluate, _paper_values, spot_check
-from helpers import in_process, reference_chain
+from helpers import reference_chain
+from helpers.in_process import volerr as volerr_command
 from helpers.audit_rule import KIND, expected
 
 #: the module's verdicts come from the full audit (conftest.provider_verdicts), in its group
@@ -321,9 +322,9 @@ def test_spot_check_reports_rounding_level_and_real_differences():
 # ------------------------------------------------------------------------------- CLI
 def run(*args):
     """``volerr audit ARGS`` as ``python -m volerr`` runs it (exit code, stdout, stderr), in this
-    process (``helpers.in_process``: ``main``'s exit code and lines; a warning a process
+    process (``helpers.in_process.volerr``: ``main``'s exit code and lines; a warning a process
     would print counts as a line of stderr), without an interpreter importing sympy again."""
-    return in_process.volerr("audit", *args)
+    return volerr_command("audit", *args)
 
 
 def assert_clean_failure(proc, fragment=""):

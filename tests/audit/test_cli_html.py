@@ -9,7 +9,7 @@ from collections import Counter
 from importlib import resources
 
 import pytest
-from helpers import in_process
+from helpers.in_process import volerr as volerr_command
 
 
 CATS = ("identical", "printing_error", "extraction", "convention", "simplification",
@@ -18,9 +18,9 @@ CATS = ("identical", "printing_error", "extraction", "convention", "simplificati
 
 def run(*args):
     """``volerr audit ARGS`` as ``python -m volerr`` runs it (exit code, stdout, stderr), in this
-    process (``helpers.in_process``: ``main``'s exit code and lines; a warning a process
+    process (``helpers.in_process.volerr``: ``main``'s exit code and lines; a warning a process
     would print counts as a line of stderr), without an interpreter importing sympy again."""
-    return in_process.volerr("audit", *args)
+    return volerr_command("audit", *args)
 
 
 def test_html_equal_to_json_refused_before_computing(tmp_path):
