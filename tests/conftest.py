@@ -14,8 +14,23 @@ local run must reproduce CI's verdict.  To search for new failing examples on pu
 import os
 import sys
 
-import matplotlib
-from hypothesis import settings
+# One BLAS thread in every test process (issue 42 item 7: the suite's time).  Two xdist workers
+# already fill this 2-core machine, and OpenBLAS would start a thread per core in each: on the
+# tests' small systems (tens to a few hundred columns) the extra threads only wait, at a cost
+# (``lstsq`` of 453 x 94: 97 ms CPU with the default threads under load, 3.5 ms with one;
+# tests/loop/test_drift_shrink.py 62 -> 3.5 s CPU; tests/planning/test_plan.py 21.4 -> 14.6 s).
+# Set before numpy is imported here (matplotlib imports it), so the workers xdist starts and
+# every ``python -m volerr`` a test starts inherit it; threadpoolctl holds a numpy imported
+# earlier (by a plugin) to the same.  The runtime already runs its loops, calibrations and
+# checks on one BLAS thread (threadpool_limits in volerr.loop.run, calibrate.run, check).
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_name] = "1"
+
+import matplotlib  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+from hypothesis import settings  # noqa: E402
+
+threadpool_limits(limits=1)
 
 matplotlib.use("Agg")  # no display on CI; every plot goes to a file
 

@@ -136,6 +136,15 @@ def _closed(selection: str) -> dict:
     return closed_form(selection)
 
 
+@lru_cache(maxsize=None)
+def _factored(expr: sp.Expr) -> sp.Expr:
+    """``sp.factor(expr)``, computed once per expression: a closed form's derived solution is
+    factored for its evidence and again for its verdict, and a denominator's is the closed
+    form's of the same selection (factor is a pure function of the expression; the verdicts'
+    text is unchanged)."""
+    return sp.factor(expr)
+
+
 #: the extraction's demonstrated repetitions and losses within one image (quoted by verdicts)
 EXTRACTION_REPEATS = (
     "appendix B sec. 2.4 lists the three rotational errors as '(E_AX, E_BX, E_BX) E_CX'; "
@@ -508,7 +517,7 @@ def audit_system(eq: dict, others: dict | None = None) -> list[Verdict]:
         if labels != want:
             problems.append(f"rows {labels} are not the Zhang & Hu selection {want}")
         det = _closed(sel)["N"]
-        sel_note = (f" The selected 6 x 6 system has determinant N = {fmt(sp.factor(det))} "
+        sel_note = (f" The selected 6 x 6 system has determinant N = {fmt(_factored(det))} "
                     f"(rotated coordinates for a rotary axis): it is singular whenever N = 0, "
                     f"even for non-collinear points (e.g. all points at one height z).")
     raw = _raw_matrix(eq)
@@ -949,7 +958,7 @@ def _n_verdict(eq: dict, axis: str) -> tuple[Verdict | None, dict]:
         if eq.get("rotated"):
             det = _hat(det)
         ok = _equal(N, det) or _equal(N, -det)
-        ev = f"derived determinant of the selected system: {fmt(sp.factor(det))}"
+        ev = f"derived determinant of the selected system: {fmt(_factored(det))}"
         erratum = ""
         if not ok:
             fixed = _product_readings(eq["define"]["N"], axis, det)
@@ -962,7 +971,7 @@ def _n_verdict(eq: dict, axis: str) -> tuple[Verdict | None, dict]:
                 erratum = "N differs from the determinant"
             ev += f"; printed N = {eq['define']['N']}"
         n_verdict = _verdict(eq, "N", ok, erratum, ev + (UNDECIDABLE_N if erratum.startswith(
-            "N printed as one product") else ""), eq["define"]["N"], sp.factor(det),
+            "N printed as one product") else ""), eq["define"]["N"], _factored(det),
             category="undecidable" if erratum.startswith("N printed as one product")
             else "printing_error")
         if erratum.startswith("N printed as one product"):
@@ -993,7 +1002,7 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                 + (" in rotated coordinates" if eq.get("rotated") else "")
                                 + (" in raw coordinates (d = measured - nominal)"
                                    if eq.get("variables") == "raw" else "") + "." + note,
-                                eq["expr"][motion], sp.factor(derived)))
+                                eq["expr"][motion], _factored(derived)))
             if note:
                 out[-1].evidence = "With the reading below: " + out[-1].evidence
                 out[-1].printed = raw_line(eq, motion) or out[-1].printed
@@ -1013,7 +1022,7 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
                                           "the factor read as multiplying z: exact"]
                 out[-1].readings_used = [f"glyph:eq. {eq['id']} {name} subscript scope"]
             continue
-        errs, ev = [], (f"derived {fmt(sp.factor(derived))}; the printed form{where} is not "
+        errs, ev = [], (f"derived {fmt(_factored(derived))}; the printed form{where} is not "
                         f"identical.")
         category = "printing_error"
         fixed_define = {**define, **define_fix}
@@ -1036,7 +1045,7 @@ def audit_closed_form(eq: dict) -> list[Verdict]:
             else:
                 errs.append("closed form differs (no single-symbol reading reproduces it)")
         v = _verdict(eq, name, False, " ".join(errs), ev + note, eq["expr"][motion],
-                     sp.factor(derived), category=category)
+                     _factored(derived), category=category)
         if category == "undecidable":
             v.readings_tried = ["the printed solution with the printed N: differs",
                                 "N read with its minus sign restored: exact"]
@@ -1065,7 +1074,7 @@ def audit_denominator(eq: dict) -> list[Verdict]:
         if motion not in eq["expr"]:
             continue
         pr = parse(eq["expr"][motion], axis)
-        de = sp.denom(sp.factor(_closed(eq["selection"])[motion]))
+        de = sp.denom(_factored(_closed(eq["selection"])[motion]))
         ratio = sp.cancel(pr / de)
         ok = ratio.is_number and ratio != 0
         out.append(_verdict(eq, motion + axis, bool(ok),

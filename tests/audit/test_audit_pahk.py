@@ -9,8 +9,6 @@ import copy
 import json
 import re
 from collections import defaultdict
-import subprocess
-import sys
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -21,6 +19,7 @@ import pytest
 import volerr
 from volerr.audit.numeric import _evaluate, _paper_values, spot_check
 from helpers import reference_chain
+from helpers.in_process import volerr as volerr_command
 from helpers.audit_rule import KIND, expected
 
 #: the module's verdicts come from the full audit (conftest.provider_verdicts), in its group
@@ -322,8 +321,10 @@ def test_spot_check_reports_rounding_level_and_real_differences():
 
 # ------------------------------------------------------------------------------- CLI
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "volerr", "audit", *args],
-                          capture_output=True, text=True)
+    """``volerr audit ARGS`` as ``python -m volerr`` runs it (exit code, stdout, stderr), in this
+    process (``helpers.in_process.volerr``: ``main``'s exit code and lines; a warning a process
+    would print counts as a line of stderr), without an interpreter importing sympy again."""
+    return volerr_command("audit", *args)
 
 
 def assert_clean_failure(proc, fragment=""):

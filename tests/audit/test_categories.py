@@ -282,7 +282,7 @@ def _mh2_chain(Lz):
     return [_first_order(A[i] - (X, Y, Z)[i] - P[i]) for i in range(3)]
 
 
-def test_extraction_eq6_uses_the_repaired_lz_of_eq3():
+def test_extraction_eq6_uses_the_repaired_lz_of_eq3(mb1):
     """Eq. 6 borrows the vectors of eq. 3, whose printed Lz x-component 'dx(Z) - Z' lost the
     factor beta1: taken literally the chain has a zeroth-order term -Z (no error model can),
     repaired it gives the printed eq. 7 (written here from the data file) -> extraction."""
@@ -307,7 +307,7 @@ def test_extraction_eq6_uses_the_repaired_lz_of_eq3():
     assert v.verdict == "identical" and v.category == "identical"
     assert "beta1" in v.evidence and "vector" in v.evidence
     # the damaged vector of eq. 3 is judged on its own (MB1's eq. 1 prints it): a lost glyph
-    lz = find(audit_pahk.audit(data("printed_pahk.toml"), ["MB1"]), "3", "Lz")
+    lz = find(mb1, "3", "Lz")          # the module's MB1 audit (the same call)
     assert lz.category == "undecidable" and "beta1" in lz.erratum
 
 
@@ -357,9 +357,15 @@ def test_numbers_probe_units_and_rms(numbers):
 
 
 # --------------------------------------------------------------------------- code listings
-def test_listing_negative_positions_wrap_around():
+@pytest.fixture(scope="module")
+def listings():
+    """The listings' verdicts, audited once for the two tests below (the same call)."""
+    return audit_listings.audit(data("printed_listings.toml"))
+
+
+def test_listing_negative_positions_wrap_around(listings):
     """Own transcription: model array for 0, -1, ..., -400 mm, read at round(pos)."""
-    vs = audit_listings.audit(data("printed_listings.toml"))
+    vs = listings
     axis = np.linspace(0.0, -400.0, 11)
     u = axis / 400.0
     err = 20.0 * u + 40.0 * u ** 2 + 12.0 * u ** 3
@@ -378,9 +384,9 @@ def test_listing_negative_positions_wrap_around():
     assert worst > 1.0
 
 
-def test_listing_constant_term_dropped():
+def test_listing_constant_term_dropped(listings):
     """For degree > 1 the listing's loop never adds polyfit's last coefficient."""
-    vs = audit_listings.audit(data("printed_listings.toml"))
+    vs = listings
     v = find(vs, "Listing 3.1 + 3.4", "constant term")
     assert v.category == "printing_error"
     x = np.linspace(0, 500, 11)

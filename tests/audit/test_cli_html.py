@@ -5,12 +5,11 @@ from __future__ import annotations
 
 import json
 import re
-import subprocess
-import sys
 from collections import Counter
 from importlib import resources
 
 import pytest
+from helpers.in_process import volerr as volerr_command
 
 
 CATS = ("identical", "printing_error", "extraction", "convention", "simplification",
@@ -18,8 +17,10 @@ CATS = ("identical", "printing_error", "extraction", "convention", "simplificati
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "volerr", "audit", *args],
-                          capture_output=True, text=True, timeout=600)
+    """``volerr audit ARGS`` as ``python -m volerr`` runs it (exit code, stdout, stderr), in this
+    process (``helpers.in_process.volerr``: ``main``'s exit code and lines; a warning a process
+    would print counts as a line of stderr), without an interpreter importing sympy again."""
+    return volerr_command("audit", *args)
 
 
 def test_html_equal_to_json_refused_before_computing(tmp_path):

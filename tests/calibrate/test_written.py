@@ -10,11 +10,10 @@ determined and wrote EY0B = -18.10 um (their sum) without a word."""
 
 import contextlib
 import io
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers import in_process
 
 from volerr.calibrate import calibrate, terms
 from volerr.calibrate.examples import write_ballbar_example
@@ -119,8 +118,7 @@ def test_dmu50_shipped_example_cli(tmp_path):
     from importlib.resources import files
 
     src = files("volerr") / "data" / "sphere_example_DMU50.csv"
-    r = subprocess.run([sys.executable, "-m", "volerr", "calibrate", "DMU50", str(src),
-                        "--errors-out", tmp_path / "d"], capture_output=True, text=True)
+    r = in_process.volerr("calibrate", "DMU50", src, "--errors-out", tmp_path / "d")
     assert r.returncode == 0, r.stderr
     assert "determined only in combination: EY0B + EY0C" in r.stdout, r.stdout
     assert "written as 0" in r.stdout and "EY0C" in r.stdout

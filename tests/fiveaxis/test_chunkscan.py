@@ -283,12 +283,19 @@ def vector_program(m, seed: int, n: int, siemens: bool) -> str:
 def test_tool_vector_programs_whole_chunk_equal_line_by_line(setup, siemens, monkeypatch):
     """TCPM tool-vector programs go through the whole-chunk path (runs of plain lines with
     the vector words) and give the bytes and reports of the line-by-line path, for any chunk
-    size; their rotary axes are set by the vectors (no axis taken at 0 deg)."""
+    size; their rotary axes are set by the vectors (no axis taken at 0 deg).
+
+    2500 blocks (issue 42 item 7: 5000 before, twice the time): chunks of 997 lines still
+    end twice inside the program, and the program's occasional blocks still come many times
+    each (counted on these two programs: 25 and 26 switches out of TCPM and back, 70-80
+    blocks with the vector held, 200-220 vertical vectors, 29 rotary-angle blocks in
+    TRAORI)."""
     from volerr.nc import interpret as nc_interpret
 
     m, funcs = setup
     funcs = ErrorFunctions(funcs.tables, funcs.constants, m, extrapolate=True)
-    text = vector_program(m, 4 + siemens, 5000, siemens)
+    n = 2500
+    text = vector_program(m, 4 + siemens, n, siemens)
     kw = {"tool_length": 100.0, "check_travel": False}
     texts = set()
     for k in (None, 997):
@@ -296,7 +303,7 @@ def test_tool_vector_programs_whole_chunk_equal_line_by_line(setup, siemens, mon
         ref = compensate_program(m, funcs, text, chunk_lines=k, **kw)
         monkeypatch.setattr(program, "WHOLE_CHUNK", True)
         s = ref.summary()
-        assert s["tcpm_blocks"] > 4500 and ref.text != text and ref.assumed_zero == ()
+        assert s["tcpm_blocks"] > 0.9 * n and ref.text != text and ref.assumed_zero == ()
         got = compensate_program(m, funcs, text, chunk_lines=k, **kw)
         assert got.text == ref.text, k
         assert [(r.line, r.status, r.output) for r in got.reports] == \

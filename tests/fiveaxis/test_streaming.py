@@ -2,11 +2,10 @@
 modal state (G91, unknown axes after G28, the last written value an added word refers to)
 crosses a chunk boundary; the command streams the same bytes to its file."""
 
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers import in_process
 from helpers.error_dirs import write_errors
 
 import volerr
@@ -92,7 +91,6 @@ def test_cli_streams_the_same_bytes(setup, tmp_path):
     text = "\r\n".join(lines) + "\r\n"
     prog.write_bytes(text.encode("latin-1"))
     out = tmp_path / "o.nc"
-    r = subprocess.run([sys.executable, "-m", "volerr", "compensate", "DMU50", str(prog),
-                        "--errors", str(d), "--out", str(out)], capture_output=True, text=True)
+    r = in_process.volerr("compensate", "DMU50", prog, "--errors", d, "--out", out)
     assert r.returncode == 0, r.stderr
     assert out.read_bytes() == compensate_program(m, funcs, text).text.encode("latin-1")

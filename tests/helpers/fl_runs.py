@@ -5,7 +5,7 @@ tests/loop/test_drift_sampling.py (every window at 15 s and 60 s),
 test_drift_generalisation.py (the five 20 % windows at 15 s) and test_drift_fl_thermal.py
 (the publication window at 15 s) ran the same loop on the same bytes with the same options,
 each in its own fixture (and the last two each in a ``python -m volerr`` process).  Here the
-command runs in-process (tests/helpers/cli_run.py: ``volerr.cli.main``, what ``python -m
+command runs in-process (tests/helpers/in_process.py: ``volerr.cli.main``, what ``python -m
 volerr`` calls, with one BLAS thread as those processes had), its ``--json`` and
 ``--predictions-out`` files read back, and the result kept (``functools.lru_cache``; the
 tests share the objects and must not change them).  Every test of these files is in one
@@ -90,7 +90,7 @@ def loop_run(step: int, name: str) -> Run:
     """``volerr loop DMU50 drift:FILE --holdout-time W --json w.json --predictions-out
     p.csv`` on window ``name`` of :data:`WINDOWS`, FILE every ``step``-th reading (step 1 of
     an uncut window: the shipped file itself), run once per process."""
-    from helpers import cli_run
+    from helpers.in_process import volerr as volerr_cmd
 
     window, cut = WINDOWS[name]
     folder = _root() / f"{name}_{step}"
@@ -100,8 +100,8 @@ def loop_run(step: int, name: str) -> Run:
     else:
         path = folder / f"fl_{step}.csv"
         path.write_text(file_text(step, cut))
-    r = cli_run.run(["loop", "DMU50", f"drift:{path}", "--holdout-time", window,
-                     "--json", "w.json", "--predictions-out", "p.csv"], folder)
+    r = volerr_cmd(*["loop", "DMU50", f"drift:{path}", "--holdout-time", window,
+                     "--json", "w.json", "--predictions-out", "p.csv"], cwd=folder)
     doc, rows = {}, []
     if r.returncode == 0:
         doc = json.loads((folder / "w.json").read_text())

@@ -1,11 +1,10 @@
 """Three-point identification: exact rigid-body simulation -> identify -> known error motions."""
 
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers import in_process
 from helpers.tracker_sim import simulate, smooth_errors, to_csv
 
 from volerr.errors import InputError  # noqa: E402
@@ -242,9 +241,8 @@ def test_rounds_table_written_with_std(tmp_path):
     f = tmp_path / "in.csv"
     f.write_text(to_csv(rounds, pos, LABELS))
     out = tmp_path / "X.csv"
-    cp = subprocess.run([sys.executable, "-m", "volerr", "identify", "MB1", "--axis", "X",
-                         str(f), "--out", str(out), "--tracker=-2000,1000,500"],
-                        capture_output=True, text=True)
+    cp = in_process.volerr("identify", "MB1", "--axis", "X", f, "--out", out,
+                           "--tracker=-2000,1000,500")      # as python -m volerr, in-process
     assert cp.returncode == 0, cp.stderr
     t = read_error_table(out)
     assert t.axis == "X" and set(t.std) == set(t.values) and set(t.u95) == set(t.values)

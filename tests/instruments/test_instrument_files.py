@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from helpers import instrument_sim as S
+from helpers.in_process import volerr as volerr_command
 from helpers.tracker_sim import simulate as tracker_simulate
 from helpers.tracker_sim import smooth_errors, to_csv
-from instruments._common import Campaign, check_one_line_error, cli, in_process, random_setup
+from instruments._common import Campaign, check_one_line_error, in_process, random_setup
 
 # module-scoped simulated data: keep the module on one xdist worker
 pytestmark = pytest.mark.xdist_group("test_instrument_files")
@@ -71,7 +72,7 @@ def test_bad_file_exit_2_one_line(tmp_path, good, case, command):
     path = S.write_csv(tmp_path / "bad.csv", cols)
     before = open(path).read()
     out = tmp_path / "out.json"
-    r = cli(command, layout, prefix + path, "--json", out)
+    r = volerr_command(command, layout, prefix + path, "--json", out)   # python -m volerr
     check_one_line_error(r, *keywords)
     assert not out.exists()
     assert open(path).read() == before
@@ -81,7 +82,7 @@ def test_ballbar_evaluate_refuses_inconsistent_length(tmp_path, good):
     cols = _variant(good["ballbar"], change=_longer)
     path = S.write_csv(tmp_path / "bad.csv", cols)
     out = tmp_path / "ev.json"
-    r = cli("ballbar", "evaluate", path, "--json", out)
+    r = volerr_command("ballbar", "evaluate", path, "--json", out)
     check_one_line_error(r, "length", "radius")
     assert not out.exists()
 

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import cli_run
+from helpers.in_process import volerr as volerr_cmd
 from helpers import drift_sim as D
 
 # the module fixture's loop runs once, on one xdist worker (a case's two tests share it)
@@ -59,8 +59,8 @@ def _loop(folder: Path, files=RUNS) -> tuple:
     """Run the command of the module docstring in ``folder``: (process, JSON or None)."""
     if _SKIP:
         pytest.skip(_SKIP[0])
-    r = cli_run.run(["loop", "DMU50", *files, "--json", "loop.json",     # in-process
-                     "--predictions-out", "pred.csv"], folder)
+    r = volerr_cmd(*["loop", "DMU50", *files, "--json", "loop.json",     # in-process
+                     "--predictions-out", "pred.csv"], cwd=folder)
     if r.returncode != 0 and any(m in r.stderr for m in NOT_YET):
         _SKIP.append("volerr loop does not take drift runs yet: "
                      + (r.stderr.strip().splitlines() or [""])[-1])

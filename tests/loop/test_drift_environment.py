@@ -29,7 +29,6 @@ import numpy as np
 import pytest
 
 from helpers import spindle_machine_sim as M
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.errors import InputError
 from volerr.loop.drift.run import loop_drift
 

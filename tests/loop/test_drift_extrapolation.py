@@ -9,7 +9,6 @@ import json
 
 import numpy as np
 
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.cli import main
 
 

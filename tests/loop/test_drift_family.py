@@ -20,7 +20,6 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.loop.drift import basis, family
 from volerr.loop.drift import interval as band
 from volerr.loop.drift import fit as core

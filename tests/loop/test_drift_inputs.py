@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.cli import main
 from volerr.instruments import _fields as F
 

@@ -9,7 +9,6 @@ import pytest
 
 from volerr.errors import InputError
 from helpers import drift_sim as D
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.loop.drift import basis as B
 from volerr.loop.drift import fit as core
 from volerr.loop.drift.engine import Engine

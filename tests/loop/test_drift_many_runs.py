@@ -27,7 +27,6 @@ import numpy as np
 import pytest
 
 from helpers import lathe_runs_sim as L
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.loop.drift.run import loop_drift
 from volerr.selection.rules import t95
 

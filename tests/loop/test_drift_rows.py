@@ -17,9 +17,8 @@ import sys
 import numpy as np
 import pytest
 
-from helpers import cli_run
+from helpers.in_process import volerr as volerr_cmd
 from helpers import drift_sim as D
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.loop.drift import rows as R
 
 # the module fixtures once, on one xdist worker (not once per worker)
@@ -77,8 +76,8 @@ def campaign(tmp_path_factory):
     for r, run in enumerate(runs):
         _write(folder / f"r{r}.csv", run, HEADS)
     specs = [f"drift:r{r}.csv" for r in range(3)]
-    p = cli_run.run(["loop", "DMU50", *specs, "--json", "j.json", "--predictions-out",
-                     "p.csv"], folder)         # in-process, one BLAS thread as the API here
+    p = volerr_cmd(*["loop", "DMU50", *specs, "--json", "j.json", "--predictions-out",
+                     "p.csv"], cwd=folder)         # in-process, one BLAS thread as the API here
     assert p.returncode == 0, p.stderr
     return folder, runs, json.loads((folder / "j.json").read_text()), p.stdout
 
@@ -155,8 +154,8 @@ def test_disagreeing_channels_fitted_with_their_residual(tmp_path):
     heads = {"x1": "X at z=50", "x2": "-X at z=50", "z": "Z"}
     for r, run in enumerate(runs):
         _write(tmp_path / f"r{r}.csv", run, heads)
-    p = cli_run.run(["loop", "TC_XZ", "drift:r0.csv", "drift:r1.csv", "--json", "j.json"],
-                    tmp_path)
+    p = volerr_cmd(*["loop", "TC_XZ", "drift:r0.csv", "drift:r1.csv", "--json", "j.json"],
+               cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     doc = json.loads((tmp_path / "j.json").read_text())
     assert set(doc["quantities"]) == {"EXX", "EZX"}      # TC_XZ: X carries the turret

@@ -30,7 +30,7 @@ import json
 import numpy as np
 import pytest
 
-from helpers import cli_run
+from helpers.in_process import volerr as volerr_cmd
 from helpers import spindle_machine_sim as M
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("drift_second_machine")]
@@ -45,8 +45,8 @@ A_SLOW_SAME = 4.0
 
 def _loop(folder) -> dict:
     files = [f"drift:{n}.csv" for n in M.PROGRAMMES]
-    r = cli_run.run(["loop", "DMU50", *files, "--holdout-files", f"{M.HELD_OUT}.csv",
-                     "--json", "loop.json", "--predictions-out", "pred.csv"], folder)
+    r = volerr_cmd(*["loop", "DMU50", *files, "--holdout-files", f"{M.HELD_OUT}.csv",
+                     "--json", "loop.json", "--predictions-out", "pred.csv"], cwd=folder)
     assert r.returncode == 0, r.stderr
     with open(folder / "pred.csv", newline="") as fh:
         rows = [row for row in csv.DictReader(fh) if row["split"] == "test"]

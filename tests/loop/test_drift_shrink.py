@@ -19,7 +19,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from volerr.loop.drift import basis, family, shrink
 from volerr.loop.drift import fit as core
 from volerr.loop.drift.series import DriftSeries

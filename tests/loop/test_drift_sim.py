@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from helpers import drift_sim as D
-from helpers.blas import one_blas_thread  # noqa: F401 (autouse: small matrices)
 from helpers.drift_sim import CASES, SPECS, campaign
 
 

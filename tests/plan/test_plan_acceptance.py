@@ -31,19 +31,14 @@ over the working volume); the ``max`` is reported in the assertion messages.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from helpers import in_process, plan_designs
 from helpers import instrument_sim as S
 from helpers import plan_exec as P
 
@@ -85,27 +80,12 @@ ALL = [_case(c) for c in CASES]
 MIXED = [_case(c) for c in CASES if len(CASES[c][1]) > 1]
 
 
-def cli(*args):
-    """``python -m volerr ARGS`` with one BLAS thread (the machine's cores are shared)."""
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-           "MKL_NUM_THREADS": "1"}
-    return subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
-                          capture_output=True, text=True, env=env)
-
-
 def run(*args):
     """``volerr ARGS`` through ``volerr.cli.main`` in this process with one BLAS thread: the
-    command's parser, files and exit code as :func:`cli` gives them, without starting an
-    interpreter (the exit-2 paths stay with :func:`cli`)."""
-    from threadpoolctl import threadpool_limits
-
-    from volerr.cli import main
-
-    out, err = io.StringIO(), io.StringIO()
-    with threadpool_limits(limits=1), contextlib.redirect_stdout(out), \
-            contextlib.redirect_stderr(err):
-        code = main([str(a) for a in args])
-    return SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
+    command's parser, files, exit code and stderr as ``python -m volerr`` gives them, without
+    starting an interpreter (``helpers.in_process``: a stray warning still counts as a line of
+    stderr; the exit-2 paths too, their one line is ``main``'s)."""
+    return in_process.volerr(*args)
 
 
 def determined(entry) -> bool:
@@ -376,7 +356,7 @@ def test_time_budget_is_kept(runs, case, tmp_path):
     args = ["plan", p.layout, *sum((["--instrument", s] for s in p.specs), []),
             "--readings", p.readings, "--minutes", budget, "--out", out, "--json", js,
             "--seed", 1]
-    r = cli(*args)
+    r = run(*args)
     if _setups(p.files) == 1:
         _refused(r, "minutes")
         return
@@ -420,7 +400,7 @@ def test_mixed_campaign_determines_what_no_instrument_does_alone(runs, case):
 # ---- bad input -------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def plan_exists():
-    r = cli("plan", "--help")
+    r = run("plan", "--help")
     assert r.returncode == 0, r.stderr[-2000:]
     return r.stdout
 
@@ -446,7 +426,7 @@ def test_bad_input_one_line_nothing_written(plan_exists, tmp_path, what):
     if "--readings" not in extra:
         extra = extra + ["--readings", "100"]
     out, js, html = tmp_path / "out", tmp_path / "p.json", tmp_path / "p.html"
-    r = cli("plan", "MB1", *extra, "--out", out, "--json", js, "--html", html)
+    r = run("plan", "MB1", *extra, "--out", out, "--json", js, "--html", html)
     _refused(r, *words)
     assert not out.exists() and not js.exists() and not html.exists(), sorted(
         q.name for q in tmp_path.iterdir())
@@ -454,18 +434,22 @@ def test_bad_input_one_line_nothing_written(plan_exists, tmp_path, what):
 
 def test_output_folder_with_files_needs_force(plan_exists, tmp_path):
     """A second plan into a folder holding the first one's files: refused without --force
-    (one line, nothing changed, no JSON), done with it."""
+    (one line, nothing changed, no JSON), done with it.  The three runs ask for one design,
+    made once (``helpers.plan_designs``): what is checked is the command's output folder."""
     out = tmp_path / "out"
     args = ["plan", "MB1", "--instrument", "ballbar:lengths=100,150", "--readings", "100",
             "--out", out]
-    r = run(*args, "--json", tmp_path / "first.json")
+    with plan_designs.designed_once():
+        r = run(*args, "--json", tmp_path / "first.json")
     assert r.returncode == 0, r.stderr[-2000:]
     (out / "notes.txt").write_text("mine\n")
     before = {q.name: q.read_bytes() for q in out.rglob("*") if q.is_file()}
-    r = cli(*args, "--json", tmp_path / "second.json")
+    with plan_designs.designed_once():
+        r = run(*args, "--json", tmp_path / "second.json")
     _refused(r, "force", "exist")
     after = {q.name: q.read_bytes() for q in out.rglob("*") if q.is_file()}
     assert after == before and not (tmp_path / "second.json").exists()
-    r = run(*args, "--json", tmp_path / "third.json", "--force")
+    with plan_designs.designed_once():
+        r = run(*args, "--json", tmp_path / "third.json", "--force")
     assert r.returncode == 0 and (tmp_path / "third.json").is_file(), r.stderr[-2000:]
     assert (out / "notes.txt").read_text() == "mine\n"

@@ -24,10 +24,10 @@ import math
 import re
 import shutil
 import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers import in_process
 
 from volerr.machine.model import load
 from volerr.plan import _candidates, _files, _nc, _spec
@@ -414,9 +414,8 @@ def test_dialect_option_writes_that_dialect(tmp_path):
 
 @pytest.mark.parametrize("bad", ["ISO"])
 def test_bad_dialect_one_line_exit_2_nothing_written(tmp_path, bad):
-    run = subprocess.run([sys.executable, "-m", "volerr", "plan", "MB1", "--instrument", "ballbar",
-                          "--readings", "100", "--dialect", bad, "--out", str(tmp_path / "p")],
-                         capture_output=True, text=True)
+    run = in_process.volerr("plan", "MB1", "--instrument", "ballbar", "--readings", "100",
+                            "--dialect", bad, "--out", tmp_path / "p")
     assert run.returncode == 2
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and "--dialect" in lines[0], run.stderr

@@ -28,6 +28,7 @@ import pytest
 
 import volerr
 from helpers import reference_chain
+from helpers import plan_designs
 from helpers import rs274_path as R
 from volerr.cli import main
 from volerr.machine.layout import read_layout
@@ -51,10 +52,13 @@ CASES = {
                         "--parameters", "squareness,EXX@slope,EYY@slope,EZZ@slope"],
 }
 DIALECTS = ("linuxcnc", "iso")
-#: the two tests of a plan on one xdist worker: the plan made and its programs read by rs274
-#: once (the module's ``planned`` and ``_READ`` caches live in each worker), the plans spread
-PLANS = [pytest.param(c, d, id=f"{c}-{d}", marks=pytest.mark.xdist_group(f"rs274_{c}-{d}"))
-         for c in CASES for d in DIALECTS]
+#: the tests of a plan case on one xdist worker, both dialects: the plan designed once (the
+#: design does not depend on the dialect, only the programs written from it do:
+#: ``helpers.plan_designs``) and each program read by rs274 once (the module's ``planned`` and
+#: ``_READ`` caches live in each worker); the cases spread over the workers.  DMU50-ballbar is
+#: tests/planning/test_plan.py's SWEEPS plan (the same design): in that module's group
+PLANS = [pytest.param(c, d, id=f"{c}-{d}", marks=pytest.mark.xdist_group(
+    "planning_plans" if c == "DMU50-ballbar" else f"rs274_{c}")) for c in CASES for d in DIALECTS]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -225,10 +229,11 @@ def planned(tmp_path_factory):
             tmp = tmp_path_factory.mktemp(f"{case}-{dialect}")
             argv = ["plan", *CASES[case], "--dialect", dialect, "--out", str(tmp / "plan"),
                     "--json", str(tmp / "plan.json")]
-            try:
-                rc = main(argv)
-            except SystemExit as exc:        # argparse refusing an option
-                rc = exc.code
+            with plan_designs.designed_once():     # the two dialects: one design
+                try:
+                    rc = main(argv)
+                except SystemExit as exc:        # argparse refusing an option
+                    rc = exc.code
             cache[(case, dialect)] = (rc, tmp)
         rc, tmp = cache[(case, dialect)]
         if rc != 0:

@@ -12,7 +12,7 @@ import shutil
 import numpy as np
 import pytest
 
-from helpers import plan_fill
+from helpers import plan_designs, plan_fill
 from volerr.calibrate.run import calibrate
 from volerr.cli import main
 from volerr.machine.layout import read_layout
@@ -32,8 +32,12 @@ PLANTED = {"MB1": {"EC0Y": 25.0, "EB0Z": -15.0, "EA0Z": 10.0},
 
 
 def _plan(tmp, argv):
+    """``volerr plan ARGV`` into ``tmp``; the design shared with the other modules of the group
+    that ask for the same one (``helpers.plan_designs``: SWEEPS is test_programs_rs274's
+    DMU50-ballbar)."""
     out, js = tmp / "plan", tmp / "plan.json"
-    assert main(["plan", *argv, "--out", str(out), "--json", str(js)]) == 0
+    with plan_designs.designed_once():
+        assert main(["plan", *argv, "--out", str(out), "--json", str(js)]) == 0
     return out, json.loads(js.read_text())
 
 

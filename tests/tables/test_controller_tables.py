@@ -6,13 +6,12 @@ helpers.fiveaxis_chain.tool2work at the positions the controller commands after 
 interpolation of the tables."""
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from helpers import in_process
 from helpers.error_dirs import write_errors
 from helpers.fiveaxis_chain import tool2work
 
@@ -155,10 +154,9 @@ def test_cli_export_json_plot_and_import(setup, tmp_path):
     m, funcs, d = setup
     out = tmp_path / "ctl" / "comp.cma"
     out.parent.mkdir()            # an output's folder must exist (a typo is never created)
-    r = subprocess.run([sys.executable, "-m", "volerr", "controller", "export", "DMU50",
-                        "--errors", str(d), "--format", "heidenhain", "--out", str(out),
-                        "--json", str(tmp_path / "s.json"), "--plot", str(tmp_path / "m.png"),
-                        "--grid", "4", "--points", "30"], capture_output=True, text=True)
+    r = in_process.volerr("controller", "export", "DMU50", "--errors", d, "--format",
+                          "heidenhain", "--out", out, "--json", tmp_path / "s.json", "--plot",
+                          tmp_path / "m.png", "--grid", "4", "--points", "30")
     assert r.returncode == 0, r.stderr
     s = json.loads((tmp_path / "s.json").read_text())
     assert s["format"] == "heidenhain" and set(s["left_um"]) == {"max", "rms"}
@@ -166,9 +164,8 @@ def test_cli_export_json_plot_and_import(setup, tmp_path):
         f"comp_{a}.com" for a in m.axes}
     assert all(t["points"] <= 30 for t in s["tables"])
     assert (tmp_path / "m.png").stat().st_size > 10000
-    r = subprocess.run([sys.executable, "-m", "volerr", "controller", "import", "DMU50",
-                        str(out), "--format", "heidenhain", "--out", str(tmp_path / "back")],
-                       capture_output=True, text=True)
+    r = in_process.volerr("controller", "import", "DMU50", out, "--format", "heidenhain",
+                          "--out", tmp_path / "back")
     assert r.returncode == 0, r.stderr
     back = ErrorFunctions.from_dir(tmp_path / "back", m)
     x = back.tables["X"].positions
@@ -178,10 +175,8 @@ def test_cli_export_json_plot_and_import(setup, tmp_path):
     inside[:, 0] = np.clip(x, *funcs.ranges()["X"])     # the last point a hair beyond
     assert np.abs(back(q)["EYX"] - funcs(inside)["EYX"]).max() <= 0.5e-4 + 1e-12
     # beyond the format's limit: exit 2, one line, nothing written
-    r = subprocess.run([sys.executable, "-m", "volerr", "controller", "export", "DMU50",
-                        "--errors", str(d), "--format", "fanuc", "--out",
-                        str(tmp_path / "f.txt"), "--points", "500"],
-                       capture_output=True, text=True)
+    r = in_process.volerr("controller", "export", "DMU50", "--errors", d, "--format", "fanuc",
+                          "--out", tmp_path / "f.txt", "--points", "500")
     assert r.returncode == 2 and "2 .. 128 for fanuc" in r.stderr and \
         len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert not (tmp_path / "f.txt").exists()

@@ -36,7 +36,17 @@ def loop_drift(layout: str, paths, window=None, files=(), differences: bool = Fa
                progress=None) -> DriftReport:
     """The loop on drift files ``paths`` and the held-out ``files`` (read beside them, every
     run of theirs held out; ``window`` ``"A:B"`` holds out the readings with A <= t < B; see
-    :mod:`volerr.loop.drift.fit`)."""
+    :mod:`volerr.loop.drift.fit`).  BLAS runs on one thread meanwhile, as in the 3-D loop
+    (:func:`volerr.loop.run.loop`): the systems are a few hundred rows by at most a few
+    hundred columns, where more threads only wait (``lstsq`` of 453 x 94: 97 ms CPU with the
+    default threads on this 2-core machine under load, 3.5 ms with one)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _loop_drift(layout, paths, window, files, differences, progress)
+
+
+def _loop_drift(layout, paths, window, files, differences, progress) -> DriftReport:
     from ...instruments.drift import test_position
     from ...machine.model import load
 
