@@ -25,7 +25,7 @@ import numpy as np
 from . import candidates as cands
 from .fitting import CV_T, cv_sq as _cv_sq, dense_group as _dense_group
 from .fitting import full_base as _full_base, rank, stack as _stack
-from ..estimate.blocks import BlockBase, blocks
+from ..estimate.blocks import BlockBase, blocks, rss_gain
 from ..estimate.design import TWIST, rows_of
 from ..machine.expressions import evaluate, lag_calls
 from ..machine.lags import lag_key
@@ -97,7 +97,7 @@ class Base:
             b = a + B.shape[1]
             Bs = Ball[:, a:b]
             M = Bs.T @ Bs - C[:, a:b].T @ GiC[:, a:b]
-            out.append(_gain(M, g_all[a:b], 1e-9 * len(Bs)))
+            out.append(rss_gain(M, g_all[a:b], 1e-9 * len(Bs)))
             a = b
         return out
 
@@ -116,21 +116,6 @@ class Base:
         """BIC change of columns that lower the RSS by ``gain`` with ``m_eff`` parameters."""
         return delta_bic(self.n, self.rss - gain, self.rss, m_eff)
 
-
-def _gain(M, g, floor: float) -> tuple[float, int]:
-    """(RSS reduction, effective rank) of columns (unit RMS) whose Gram matrix off the base's
-    span is ``M`` (m, m) and whose products with the residual are ``g`` (m,): the directions
-    of ``M`` with an eigenvalue above ``floor`` (not inside the base span) count.  One column:
-    the 1 x 1 eigen-decomposition is the number itself (what LAPACK returns)."""
-    if len(g) == 1:
-        w = float(M[0, 0])
-        return (float(g[0] * g[0] / w), 1) if w > floor else (0.0, 0)
-    w, V = np.linalg.eigh((M + M.T) / 2)
-    ok = w > floor
-    if not ok.any():
-        return 0.0, 0
-    h = V[:, ok].T @ g
-    return float(np.sum(h * h / w[ok])), int(ok.sum())
 
 
 @dataclass
