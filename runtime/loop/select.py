@@ -117,7 +117,6 @@ class Base:
         return delta_bic(self.n, self.rss - gain, self.rss, m_eff)
 
 
-
 @dataclass
 class Context:
     """What the columns of a candidate need: model, data, sensitivities (of the parameters, of
