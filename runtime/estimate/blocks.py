@@ -268,6 +268,23 @@ def _stacked(groups, idx, w):
     return out
 
 
+def rss_gain(M, g, floor: float) -> tuple[float, int]:
+    """(RSS reduction, effective rank) of adding columns (scaled to unit RMS) whose Gram
+    matrix off the current design's span is ``M`` (m, m) and whose products with the
+    residual are ``g`` (m,): the eigen-directions of ``M`` above ``floor`` count (the others
+    lie inside the span).  One column: its 1 x 1 eigen-decomposition is the number itself
+    (what LAPACK returns, bit for bit), taken without the call."""
+    if len(g) == 1:
+        w = float(M[0, 0])
+        return (float(g[0] * g[0] / w), 1) if w > floor else (0.0, 0)
+    w, V = np.linalg.eigh((M + M.T) / 2)
+    ok = w > floor
+    if not ok.any():
+        return 0.0, 0
+    h = V[:, ok].T @ g
+    return float(np.sum(h * h / w[ok])), int(ok.sum())
+
+
 class BlockBase:
     """The current design on the weighted training rows, column-scaled, with its Gram
     pseudo-inverse and residual: :class:`volerr.loop.select.Base` without the rows.
@@ -331,12 +348,7 @@ class BlockBase:
         sc[sc == 0] = 1.0
         C = AB / sc
         M = BB / np.outer(sc, sc) - C.T @ self.Gi @ C
-        w, V = np.linalg.eigh((M + M.T) / 2)
-        ok = w > 1e-9 * len(self.r)
-        if not ok.any():
-            return 0.0, 0
-        g = V[:, ok].T @ (Br / sc)
-        return float(np.sum(g * g / w[ok])), int(ok.sum())
+        return rss_gain(M, Br / sc, 1e-9 * len(self.r))
 
     def score(self, group) -> tuple[float, int]:
         return self.score_many([group])[0]

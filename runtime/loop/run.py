@@ -312,7 +312,7 @@ class Augmented:
 
     def source(self) -> str:
         if self._source is None:
-            self._source = "" if self.layout is None else derivation.generate_source(self.layout)
+            self._source = "" if self.layout is None else derivation.derive_source(self.layout)
         return self._source
 
 

@@ -25,9 +25,10 @@ import numpy as np
 from . import candidates as cands
 from .fitting import CV_T, cv_sq as _cv_sq, dense_group as _dense_group
 from .fitting import full_base as _full_base, rank, stack as _stack
-from ..estimate.blocks import BlockBase, blocks
+from ..estimate.blocks import BlockBase, blocks, rss_gain
 from ..estimate.design import TWIST, rows_of
 from ..machine.expressions import evaluate, lag_calls
+from ..machine.lags import lag_key
 from ..selection import stepwise
 from ..selection.linalg import pinv_sym as _pinv_sym
 from ..selection.rules import BIC_GAIN, delta_bic, paired_t
@@ -37,11 +38,13 @@ TOP_FIT = 3          # candidates fitted fully per forward step
 SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescored on all)
 N_SOURCES = 10       # residual sources reported
 LAG_CACHE = 48       # lagged series (all points) kept while screening
+STACK_COLUMNS = 64   # candidate columns scored in one matrix product (Base.score_many)
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
 #: the time constant of a lag in a basis text (the one number a lag profile varies)
 _LAG_ARG = re.compile(r"lag\(\s*(\w+)\s*,\s*[^,)]+")
+_LAG_TAU = re.compile(r"lag\(\s*(\w+)\s*,\s*([^,)]+)")
 
 
 class Base:
@@ -60,17 +63,43 @@ class Base:
 
     def score(self, B) -> tuple[float, int]:
         """(RSS reduction, effective rank) of adding the columns B (rows, m)."""
-        sc = np.sqrt(np.mean(B ** 2, axis=0))
+        return self.score_many([B])[0]
+
+    def score_many(self, groups) -> list:
+        """[(RSS reduction, effective rank)] of adding each column group of ``groups`` (rows,
+        m) alone.  The groups are stacked (at most ``STACK_COLUMNS`` columns at a time) and
+        multiplied by the base's columns in one matrix product: the (rows, p) design is read
+        once per stack, not once per group (a product with one or two columns is bound by
+        that read).  Each group's numbers are its own (scaled to unit RMS, its Gram block,
+        its eigen-decomposition); only the order of summation in the products differs from
+        scoring it alone (rounding, 1e-15 relative)."""
+        out, i = [], 0
+        while i < len(groups):
+            stack, width = [groups[i]], groups[i].shape[1]
+            i += 1
+            while i < len(groups) and width + groups[i].shape[1] <= STACK_COLUMNS:
+                width += groups[i].shape[1]
+                stack.append(groups[i])
+                i += 1
+            out += self._score_stack(stack)
+        return out
+
+    def _score_stack(self, stack) -> list:
+        Ball = np.concatenate(stack, axis=1)
+        sc = np.sqrt(np.mean(Ball ** 2, axis=0))
         sc[sc == 0] = 1.0
-        Bs = B / sc
-        C = self.A.T @ Bs
-        M = Bs.T @ Bs - C.T @ self.Gi @ C
-        w, V = np.linalg.eigh((M + M.T) / 2)
-        ok = w > 1e-9 * len(Bs)          # columns (unit RMS) not inside the base span
-        if not ok.any():
-            return 0.0, 0
-        g = V[:, ok].T @ (Bs.T @ self.r)
-        return float(np.sum(g * g / w[ok])), int(ok.sum())
+        Ball = Ball / sc
+        C = self.A.T @ Ball
+        GiC = self.Gi @ C
+        g_all = Ball.T @ self.r
+        out, a = [], 0
+        for B in stack:
+            b = a + B.shape[1]
+            Bs = Ball[:, a:b]
+            M = Bs.T @ Bs - C[:, a:b].T @ GiC[:, a:b]
+            out.append(rss_gain(M, g_all[a:b], 1e-9 * len(Bs)))
+            a = b
+        return out
 
     def score_single(self, B) -> np.ndarray:
         """RSS reduction of each single column of B (rows, G) added alone (profiles)."""
@@ -280,13 +309,30 @@ class Context:
         the G lagged series stacked (G, n) in place of the first text's lag: the texts differ
         only in the time constant of their one lag, so every element is the same arithmetic on
         the same numbers as evaluating each text alone; None when they are not of that shape."""
-        calls = [lag_calls(t) for t in texts]
-        if any(len(cl) != 1 for cl in calls) or \
-                len({_LAG_ARG.sub(r"lag(\1, TAU", t) for t in texts}) != 1:
+        calls = _lag_calls_alike(texts)
+        if calls is None:
             return None
         stacked = np.stack([self.lag_at_points(*cl[0]) for cl in calls])
         vals = {**self.values(), calls[0][0][0]: stacked}
         return np.broadcast_to(evaluate(texts[0], vals), stacked.shape).T
+
+
+def _lag_calls_alike(texts) -> list | None:
+    """:func:`lag_calls` of each of ``texts`` when they are one text with one lag that differ
+    only in its time constant (else None): the first text parsed and checked, the others'
+    time constants read from their lag's argument (``float`` of the same characters the
+    parser reads), without parsing hundreds of texts that differ in one number."""
+    first = lag_calls(texts[0])
+    if len(first) != 1 or len({_LAG_ARG.sub(r"lag(\1, TAU", t) for t in texts}) != 1:
+        return None
+    (key, col, tau, time), = first
+    out = []
+    for t in texts:
+        tau_t = float(_LAG_TAU.search(t).group(2))
+        if not tau_t > 0:             # refused by the parser: let it say so
+            return None
+        out.append(((lag_key(col, tau_t, time), col, tau_t, time),))
+    return out
 
 
 class _Taken(Mapping):
@@ -389,9 +435,17 @@ def _scored(c, ctx: Context, base: Base) -> "Scored":
 
 
 def _scored_many(cs, ctx: Context, base) -> list:
-    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`."""
+    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`,
+    stacks of ``STACK_COLUMNS`` candidates (their rows made a stack at a time) for a
+    :class:`Base`."""
     if not isinstance(base, BlockBase):
-        return [_scored(c, ctx, base) for c in cs]
+        out = []
+        for i in range(0, len(cs), STACK_COLUMNS):
+            made = [ctx.columns(c.terms) for c in cs[i:i + STACK_COLUMNS]]
+            res = base.score_many([ctx.rows(cols) for cols, _ in made])
+            out += [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c, params)
+                    for c, (_, params), (g, r) in zip(cs[i:i + STACK_COLUMNS], made, res)]
+        return out
     res = base.score_many([ctx.group(c.terms) for c in cs])
     return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
                    c.parameters) for c, (g, r) in zip(cs, res)]
@@ -399,7 +453,7 @@ def _scored_many(cs, ctx: Context, base) -> list:
 
 def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
     """Score every candidate against the residual of ``base``; sorted by BIC change."""
-    out = []
+    cs = []
     fixed = ctx.cache.setdefault("fixed", {})
     for c in candidates:
         if c.name in skip:
@@ -408,9 +462,8 @@ def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
             # profiled once; later screenings reuse the value and re-profile the leaders
             c = fixed[c.name] if c.name in fixed else _profile(c, ctx, base)
             fixed[c.name] = c
-        sc = _scored(c, ctx, base)
-        if sc.rank:
-            out.append(sc)
+        cs.append(c)
+    out = [sc for sc in _scored_many(cs, ctx, base) if sc.rank]
     out.sort(key=lambda x: x.dbic)
     for i, sc in enumerate(out[:2 * TOP_FIT]):
         if sc.cand.search is not None:

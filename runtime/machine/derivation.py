@@ -93,6 +93,24 @@ def derive_module(layout: Layout, cache: bool = True) -> types.ModuleType:
     return module_from_source(source, layout.name)
 
 
+def derive_source(layout: Layout) -> str:
+    """:func:`generate_source` of ``layout`` through the cache of :func:`derive_module`: the
+    entry's text when it was derived from the same layout text and file name (the module
+    names its layout file), else derived and stored, so that loading the file later (``volerr
+    loop``'s augmented layout refitted) reads it without sympy.  An entry keeps the text
+    without its final newline; the generator's texts end with exactly one (every module of
+    ``generated/``), which is given back."""
+    path = cache_path(layout)
+    body = _read_entry(path)
+    if body is not None and f"LAYOUT_SHA256 = {layout.sha256!r}" in body \
+            and f" from {layout.path}.\n" in body:
+        return body + "\n"
+    source = generate_source(layout)
+    if source.endswith("\n") and not source.endswith("\n\n"):
+        _write_entry(path, source)
+    return source
+
+
 _ENTRY_TAG = "# volerr-cache sha256 "
 
 

@@ -72,6 +72,37 @@ def test_stacked_scores_are_the_rss_drops_of_refits(problem, monkeypatch):
         assert gain == pytest.approx(gain1, rel=1e-12)
 
 
+def test_dense_stacked_scores_are_the_rss_drops_of_refits(problem, monkeypatch):
+    """The dense screening base (``select.Base``, a few thousand training points) scores
+    candidate groups in stacks of ``STACK_COLUMNS`` columns (one product with the design per
+    stack): each group's score is the RSS drop of refitting with its columns (dense lstsq
+    written here), stacks of at most 4 columns give what each group alone gives (to
+    round-off: only the order of summation differs), one column (no 1 x 1 eigh) included, and
+    a group inside the design's span (a design column, scaled) adds nothing (rank 0)."""
+    from volerr.loop import select
+
+    _, dense, y = problem
+    rng = np.random.default_rng(6)
+    wr = np.repeat(rng.uniform(0.3, 1.0, len(y) // 3), 3)
+    Aw, yw = dense * wr[:, None], y * wr
+    rss0 = _rss(Aw, yw)
+    groups = [g.reshape(-1, g.shape[-1]) * wr[:, None] for g in _groups(len(y) // 3)]
+    inside = Aw[:, 2:3] * 3.0
+    monkeypatch.setattr(select, "STACK_COLUMNS", 4)
+    base = select.Base(Aw, yw)
+    assert base.rss == pytest.approx(rss0, rel=1e-9)
+    stacked = base.score_many(groups + [inside])
+    monkeypatch.setattr(select, "STACK_COLUMNS", 1)     # every group alone
+    alone = base.score_many(groups + [inside])
+    assert len({g.shape[1] for g in groups}) == 5 and stacked[-1] == alone[-1] == (0.0, 0)
+    for B, (gain, rank), (gain1, rank1) in zip(groups, stacked, alone):
+        want = rss0 - _rss(np.concatenate([Aw, B], axis=1), yw)
+        assert rank == rank1 == B.shape[1]
+        assert np.isclose(gain, want, rtol=1e-6)
+        assert gain == pytest.approx(gain1, rel=1e-12)
+        assert base.score(B) == (gain1, rank1)
+
+
 def test_kept_blocks_give_the_generated_ones(problem, monkeypatch):
     """BlockBase, cv_sq (leave-one-out and k-fold) with the blocks kept between passes equal
     the same with every pass generating them (KEEP_BYTES 0), to round-off."""

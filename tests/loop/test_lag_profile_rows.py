@@ -60,3 +60,25 @@ def test_other_shapes_fall_back_to_one_evaluation_per_text():
     assert Context._lag_profile_basis(
         pts, ["X*(lag(T_a, 600.0) - 20)", "(lag(T_a, 612.5) - 20)"]) is None
     assert Context._lag_profile_basis(pts, ["X*(T_a - 20)", "X*(T_a - 20)"]) is None
+
+
+def test_time_constants_read_from_the_texts_are_the_parsers():
+    """The profile reads the time constant of texts of one shape from their lag's argument
+    (``_lag_calls_alike``, no parse per text): each text's (key, column, tau, time column)
+    equals what the parser gives (``lag_calls``), integers, exponents, spaces and another
+    time column included; a time constant the parser refuses (not > 0) gives None, so that
+    the texts are evaluated one by one and the parser says what is wrong."""
+    import pytest
+
+    from volerr.errors import InputError
+    from volerr.loop.select import _lag_calls_alike
+    from volerr.machine.expressions import lag_calls
+
+    for form in ("X*(lag(T_a, {}) - 20)", "(lag( T_a ,{} , t_min) - 20)*Y"):
+        texts = [form.format(t) for t in ("600", "612.5", "1e3", " 3600.1 ", "2400.0")]
+        assert _lag_calls_alike(texts) == [lag_calls(t) for t in texts]
+    zero = ["X*lag(T_a, 600.0)", "X*lag(T_a, 0.0)"]
+    assert _lag_calls_alike(zero) is None
+    with pytest.raises(InputError):
+        lag_calls(zero[1])
+    assert _lag_calls_alike(["lag(T_a, 60) - lag(T_b, 60)"] * 2) is None

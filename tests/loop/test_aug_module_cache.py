@@ -1,0 +1,53 @@
+"""The augmented layout's generated module through the derivation cache (issue 42 item 7):
+``volerr loop --out-dir`` writes the module of its augmented layout with
+``derivation.derive_source``, which stores it in the cache of ``derive_module``, so that the
+refit of that layout file on another day (``volerr loop D/MB1_aug.toml dayB.csv``) loads it
+without sympy, and a run that augments the same way writes it without deriving again.  The
+text must be the derivation's byte for byte, and an entry derived for the same layout text
+under another file name (the module names its layout file) is not taken for it."""
+
+from volerr.machine import derivation
+from volerr.machine.layout import layout_text, parse_layout
+
+
+def _layout(origin):
+    text, _ = layout_text("MB1")
+    return parse_layout(text.replace('name = "MB1"', 'name = "MB1C"', 1), origin)
+
+
+def test_derived_once_then_read_back_byte_for_byte(tmp_path, monkeypatch):
+    monkeypatch.setenv("VOLERR_CACHE_DIR", str(tmp_path / "cache"))
+    lay = _layout("MB1C.toml")
+    calls = []
+    generate = derivation.generate_source
+
+    def counted(layout):
+        calls.append(layout.path)
+        return generate(layout)
+
+    monkeypatch.setattr(derivation, "generate_source", counted)
+    first = derivation.derive_source(lay)
+    assert calls == ["MB1C.toml"] and first.endswith("}\n") and " from MB1C.toml.\n" in first
+    assert derivation.derive_source(lay) == first            # read back: no second derivation
+    assert calls == ["MB1C.toml"]
+    # the file loaded later (the refit of the augmented layout) reads the same entry
+    mod = derivation.derive_module(_layout("MB1C.toml"))
+    assert calls == ["MB1C.toml"] and mod.LAYOUT_SHA256 == lay.sha256
+    # the same text under another file name: its module names that file, derived anew
+    monkeypatch.setattr(derivation, "generate_source", lambda layout: "derived anew\n")
+    assert derivation.derive_source(_layout("other.toml")) == "derived anew\n"
+
+
+def test_a_corrupt_entry_is_derived_again(tmp_path, monkeypatch):
+    monkeypatch.setenv("VOLERR_CACHE_DIR", str(tmp_path / "cache"))
+    lay = _layout("MB1C.toml")
+    text = "# a module\nLAYOUT_SHA256 = %r\n# from MB1C.toml.\nX = 1\n" % lay.sha256
+    monkeypatch.setattr(derivation, "generate_source", lambda layout: text)
+    assert derivation.derive_source(lay) == text
+    path = derivation.cache_path(lay)
+    path.write_text(path.read_text().replace("X = 1", "X = 2"))     # its own hash no more
+    again = text.replace("X = 1", "X = 3")
+    monkeypatch.setattr(derivation, "generate_source", lambda layout: again)
+    assert derivation.derive_source(lay) == again
+    monkeypatch.setattr(derivation, "generate_source", lambda layout: "not asked\n")
+    assert derivation.derive_source(lay) == again             # the rewritten entry
