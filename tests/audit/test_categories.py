@@ -1,8 +1,10 @@
 """Verdict categories: each category has an equation that must land in it, checked against a
 derivation written HERE (sympy / numpy), not through the audit's own code path.
 
-Fast tests call one provider on its own data; the full per-category counts (which move when a
-verdict moves) are in the slow test at the end.
+Fast tests call one provider on its own data -- or, where the call is the one the full audit
+makes (a provider's whole data file, every layout), take the verdicts that call returned inside
+the full audit (conftest.provider_verdicts; those tests are in its ``full_audit`` xdist group);
+the full per-category counts (which move when a verdict moves) are in the slow test at the end.
 """
 
 from __future__ import annotations
@@ -163,9 +165,10 @@ def test_convention_a2_table_origin_pivot():
         assert v.dropped_um == pytest.approx(575 * 10e-6 * 1e3)
 
 
-def test_convention_eq16_atan_read_as_atan2():
+@pytest.mark.xdist_group("full_audit")
+def test_convention_eq16_atan_read_as_atan2(provider_verdicts):
     rng = np.random.default_rng(5)
-    vs = audit_probe.audit(data("printed_probe.toml"))
+    vs = provider_verdicts(audit_probe, data("printed_probe.toml"))
     v = find(vs, "16", "theta")
     assert v.category == "convention"
     for _ in range(50):
@@ -187,10 +190,11 @@ def _rotary_items():
     return out
 
 
-def test_printing_error_rotary_axis_model_sec_2_5():
+@pytest.mark.xdist_group("full_audit")
+def test_printing_error_rotary_axis_model_sec_2_5(provider_verdicts):
     """(T_ES - I) Rz(C) p computed here with numpy: the printed Delta_y has E_CC with the wrong
     sign, the printed error matrix -E_XC where -E_AC belongs, T_CC has -cos C."""
-    vs = audit_rotary.audit(data("printed_rotary.toml"))
+    vs = provider_verdicts(audit_rotary, data("printed_rotary.toml"))
     rng = np.random.default_rng(3)
     vals = dict(zip(("EXC", "EYC", "EZC", "EAC", "EBC", "ECC"), rng.normal(0, 1e-3, 6)))
     c = 0.7
@@ -313,10 +317,11 @@ def test_extraction_eq6_uses_the_repaired_lz_of_eq3(mb1):
 
 # --------------------------------------------------------------------------- numbers
 @pytest.fixture(scope="module")
-def numbers():
-    return audit_numbers.audit(data("printed_numbers.toml"))
+def numbers(provider_verdicts):
+    return provider_verdicts(audit_numbers, data("printed_numbers.toml"))
 
 
+@pytest.mark.xdist_group("full_audit")
 def test_numbers_reduction_49_identical_78_undecidable(numbers):
     assert 100 * (1 - 10.45 / 20.55) <= 49.5 and 100 * (1 - 10.35 / 20.65) >= 48.5
     v = find(numbers, "sec. 4.2.1 / paper sec. 5: E_XX reduction", "percent")
@@ -327,6 +332,7 @@ def test_numbers_reduction_49_identical_78_undecidable(numbers):
     assert v.category == "undecidable" and "8.98 um" in v.evidence
 
 
+@pytest.mark.xdist_group("full_audit")
 def test_numbers_same_peak_quoted_differently(numbers):
     v = find(numbers, "sec. 4.1 / 4.1.2 / 4.2.2: peak of E_YY", "sec. 4.1.2: 48")
     assert "40.8"[:1] + "40.8"[3:] == "48"          # '40.8' with '0.' lost
@@ -336,6 +342,7 @@ def test_numbers_same_peak_quoted_differently(numbers):
     assert v.category == "identical"
 
 
+@pytest.mark.xdist_group("full_audit")
 def test_numbers_symbol_list_squareness_planes(numbers):
     """eq. 4: beta1 multiplies Z in dX (X-Z plane), beta2 multiplies Z in dY (Y-Z plane)."""
     eq4 = next(e for e in data("printed_pahk.toml")["equation"] if e["id"] == "4")
@@ -347,6 +354,7 @@ def test_numbers_symbol_list_squareness_planes(numbers):
                 "sec. 2 text after eq. 3").category == "identical"
 
 
+@pytest.mark.xdist_group("full_audit")
 def test_numbers_probe_units_and_rms(numbers):
     v = find(numbers, "sec. 3.2: probe error units", "unit")
     assert v.category == "undecidable" and "one glyph" in v.evidence
@@ -358,11 +366,12 @@ def test_numbers_probe_units_and_rms(numbers):
 
 # --------------------------------------------------------------------------- code listings
 @pytest.fixture(scope="module")
-def listings():
+def listings(provider_verdicts):
     """The listings' verdicts, audited once for the two tests below (the same call)."""
-    return audit_listings.audit(data("printed_listings.toml"))
+    return provider_verdicts(audit_listings, data("printed_listings.toml"))
 
 
+@pytest.mark.xdist_group("full_audit")
 def test_listing_negative_positions_wrap_around(listings):
     """Own transcription: model array for 0, -1, ..., -400 mm, read at round(pos)."""
     vs = listings
@@ -384,6 +393,7 @@ def test_listing_negative_positions_wrap_around(listings):
     assert worst > 1.0
 
 
+@pytest.mark.xdist_group("full_audit")
 def test_listing_constant_term_dropped(listings):
     """For degree > 1 the listing's loop never adds polyfit's last coefficient."""
     vs = listings
