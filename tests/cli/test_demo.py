@@ -11,12 +11,12 @@ import html as htmllib
 import json
 import re
 import struct
-import subprocess
-import sys
 import zlib
 from pathlib import Path
 
 import pytest
+
+from helpers.in_process import volerr as volerr_command
 
 #: text must be at least this high on the page, px
 MIN_PX = 9.0
@@ -238,8 +238,7 @@ def _one_unit_notation_on_every_axis_and_table_header(out, records):
 def test_demo_refuses_to_write_over_a_file(tmp_path):
     target = tmp_path / "file"
     target.write_text("keep")
-    proc = subprocess.run([sys.executable, "-m", "volerr", "demo", "--out", str(target),
-                           "--only", "cmm_a"], capture_output=True, text=True)
+    proc = volerr_command("demo", "--out", target, "--only", "cmm_a")   # main, in-process
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
     assert target.read_text() == "keep"
