@@ -126,6 +126,9 @@ def design(machine: Machine, blocks, terms) -> S.Design:
         m = b.n * 3
         J = np.zeros((m, len(cols)))
         mine = set(b.setup_names())
+        # the unperturbed readings: the same for every column (a zero value or set-up is
+        # skipped exactly like a missing one), computed once per block
+        f0 = readings(machine, b, terms, {})
         for j, c in enumerate(cols):
             if j >= len(params) and c not in mine:
                 continue
@@ -135,7 +138,7 @@ def design(machine: Machine, blocks, terms) -> S.Design:
                     return readings(machine, b, terms, {c: h})
                 return readings(machine, b, terms, {}, {c: h})
 
-            big = np.max(np.abs(f(1.0) - f(0.0)))
+            big = np.max(np.abs(f(1.0) - f0))
             h = 1.0 / big if big > 0 else 1.0
             J[:, j] = ((f(h) - f(-h)) / (2 * h)).ravel()
         parts.append(J)
