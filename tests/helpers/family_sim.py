@@ -75,9 +75,11 @@ class Machine(S.Machine):
             self._points, self._frames = saved_points, saved_frames
 
 
-def readings(machine: Machine, block: S.Block, terms, values, setup=None) -> np.ndarray:
+def readings(machine: Machine, block: S.Block, terms, values, setup=None,
+             nominal=None) -> np.ndarray:
     """Exact readings (um) of a ``deviations`` or ``sphere`` block: (N, 3).  ``terms``: the
-    instrument simulator's error terms and :class:`Growth` terms."""
+    instrument simulator's error terms and :class:`Growth` terms; ``nominal``: the block's
+    nominal tool points (mm) when the caller already has them (:func:`design`)."""
     setup = setup or {}
     n = block.n
     err = S.errors_at(block, [t for t in terms if isinstance(t, S.Term)], values)
@@ -102,7 +104,9 @@ def readings(machine: Machine, block: S.Block, terms, values, setup=None) -> np.
         d = np.array([setup.get(f"{block.name}:{k}", 0.0) for k in S.DEVIATION_SETUP[:3]])
         e = np.array([setup.get(f"{block.name}:{k}", 0.0) for k in S.DEVIATION_SETUP[3:]])
         meas = Rotation.from_rotvec(1e-6 * e).apply(t_act) + 1e-3 * d
-        return 1e3 * (meas - machine.tool_point(block.pos, None, block.probe))
+        if nominal is None:
+            nominal = machine.tool_point(block.pos, None, block.probe)
+        return 1e3 * (meas - nominal)
     if block.kind == "sphere":
         dc = np.zeros((n, 3))
         for p in np.unique(block.placement):
@@ -126,16 +130,20 @@ def design(machine: Machine, blocks, terms) -> S.Design:
         m = b.n * 3
         J = np.zeros((m, len(cols)))
         mine = set(b.setup_names())
+        # the unperturbed readings: the same for every column (a zero value or set-up is
+        # skipped exactly like a missing one), computed once per block
+        nom = machine.tool_point(b.pos, None, b.probe) if b.kind == "deviations" else None
+        f0 = readings(machine, b, terms, {}, None, nom)
         for j, c in enumerate(cols):
             if j >= len(params) and c not in mine:
                 continue
 
             def f(h, c=c, j=j):
                 if j < len(params):
-                    return readings(machine, b, terms, {c: h})
-                return readings(machine, b, terms, {}, {c: h})
+                    return readings(machine, b, terms, {c: h}, None, nom)
+                return readings(machine, b, terms, {}, {c: h}, nom)
 
-            big = np.max(np.abs(f(1.0) - f(0.0)))
+            big = np.max(np.abs(f(1.0) - f0))
             h = 1.0 / big if big > 0 else 1.0
             J[:, j] = ((f(h) - f(-h)) / (2 * h)).ravel()
         parts.append(J)

@@ -7,6 +7,8 @@ check the derived first-order model by finite differences.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -22,8 +24,17 @@ def trans(v) -> np.ndarray:
 
 
 def rot(rotvec) -> np.ndarray:
+    v = np.asarray(rotvec, dtype=float)
+    return _rot(v.tobytes(), v.shape).copy()
+
+
+@functools.lru_cache(maxsize=256)
+def _rot(key: bytes, shape: tuple) -> np.ndarray:
+    """:func:`rot` of the rotation vector whose float64 bytes are ``key`` (the frames' and the
+    zero error rotations repeat at every point: computed once; keyed by the bytes, so -0.0 and
+    0.0 stay apart and every matrix is bitwise the one computed from its own vector)."""
     m = np.eye(4)
-    m[:3, :3] = Rotation.from_rotvec(np.asarray(rotvec, dtype=float)).as_matrix()
+    m[:3, :3] = Rotation.from_rotvec(np.frombuffer(key, float).reshape(shape).copy()).as_matrix()
     return m
 
 
