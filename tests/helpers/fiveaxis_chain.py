@@ -10,7 +10,11 @@ D = 154.996
 
 
 def rot(axis, angle):
-    """Right-hand rotation HTM (Rodrigues), angle in rad."""
+    """Right-hand rotation HTM (Rodrigues), angle in rad.  A zero angle (every absent error)
+    is the identity, which Rodrigues gives exactly (0 * K and (1 - cos 0) * K K are zeros):
+    returned without the arithmetic, the same bits, ~20 of a chain's ~23 rotations."""
+    if np.ndim(angle) == 0 and angle == 0:
+        return np.eye(4)
     k = np.asarray(axis, float) / np.linalg.norm(axis)
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     m = np.eye(4)
