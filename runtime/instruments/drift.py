@@ -399,9 +399,15 @@ def faults(run: DriftRun) -> list:
     return out
 
 
+def fault_where(e: dict) -> str:
+    """Where a fault of :func:`faults` is: its file, and ``[run]`` for a run of a file of
+    several."""
+    return e["file"] if not e.get("run") else f"{e['file']}[{e['run']}]"
+
+
 def fault_text(e: dict) -> str:
     """One fault of :func:`faults` in words (times in s of the run's file)."""
-    where = e["file"] if not e.get("run") else f"{e['file']}[{e['run']}]"
+    where = fault_where(e)
     if e["fault"] == "constant":
         return (f"{e['input']} constant in {where} (= {e['value']:g} in all {e['readings']} "
                 f"readings: disconnected, stuck, or steadier than its resolution)")

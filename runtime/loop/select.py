@@ -42,8 +42,8 @@ STACK_COLUMNS = 64   # candidate columns scored in one matrix product (Base.scor
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
-#: the time constant of a lag in a basis text (the one number a lag profile varies)
-_LAG_ARG = re.compile(r"lag\(\s*(\w+)\s*,\s*[^,)]+")
+#: the time constant of a lag in a basis text (the one number a lag profile varies): the
+#: lagged column (group 1) and the time constant's characters (group 2)
 _LAG_TAU = re.compile(r"lag\(\s*(\w+)\s*,\s*([^,)]+)")
 
 
@@ -323,7 +323,7 @@ def _lag_calls_alike(texts) -> list | None:
     time constants read from their lag's argument (``float`` of the same characters the
     parser reads), without parsing hundreds of texts that differ in one number."""
     first = lag_calls(texts[0])
-    if len(first) != 1 or len({_LAG_ARG.sub(r"lag(\1, TAU", t) for t in texts}) != 1:
+    if len(first) != 1 or len({_LAG_TAU.sub(r"lag(\1, TAU", t) for t in texts}) != 1:
         return None
     (key, col, tau, time), = first
     out = []

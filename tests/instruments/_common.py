@@ -6,10 +6,7 @@ the layout is only parsed (``read_layout``) by the simulator."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -25,28 +22,20 @@ FLOOR_FACTOR = 1.15
 
 
 def cli(*args, cwd=None):
-    """``python -m volerr ARGS`` (one BLAS thread: the machine's cores are shared)."""
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-           "MKL_NUM_THREADS": "1"}
+    """``python -m volerr ARGS`` (one BLAS thread, as every process the tests start:
+    tests/conftest.py)."""
     return subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd, env=env)
+                          capture_output=True, text=True, cwd=cwd)
 
 
 def in_process(*args):
-    """``volerr ARGS`` through ``volerr.cli.main`` in this process with one BLAS thread, console
-    captured: (returncode, stdout, stderr) as :func:`cli` gives them, without starting an
-    interpreter (the commands expected to succeed; exit-2 paths use :func:`cli`)."""
-    from types import SimpleNamespace
+    """``volerr ARGS`` through ``volerr.cli.main`` in this process, console captured:
+    (returncode, stdout, stderr) as :func:`cli` gives them, without starting an interpreter
+    (the commands expected to succeed; exit-2 paths use :func:`cli`):
+    :func:`helpers.in_process.volerr`."""
+    from helpers.in_process import volerr
 
-    from threadpoolctl import threadpool_limits
-
-    from volerr.cli import main
-
-    out, err = io.StringIO(), io.StringIO()
-    with threadpool_limits(limits=1), contextlib.redirect_stdout(out), \
-            contextlib.redirect_stderr(err):
-        code = main([str(a) for a in args])
-    return SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
+    return volerr(*args)
 
 
 def run_json(args, json_path: Path):

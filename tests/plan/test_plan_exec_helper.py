@@ -12,8 +12,6 @@ so that a failure of test_plan_acceptance.py points at the planner, not at the t
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 
 import numpy as np
@@ -155,19 +153,13 @@ def test_filled_hand_made_plan_calibrates_to_the_truth(campaign):
     paths, setup = P.execute(m, files, truth, root / "filled", rng, plan)
     assert all(p.is_file() for p in paths) and len(setup) > 10
     out = root / "cal.json"
-    # the command through volerr.cli.main in this process (one BLAS thread): its parser, JSON
-    # and exit code, without a second interpreter importing numpy, scipy ... again
-    from threadpoolctl import threadpool_limits
+    # the command through volerr.cli.main in this process: its parser, JSON and exit code,
+    # without a second interpreter importing numpy, scipy ... again
+    from helpers.in_process import volerr
 
-    from volerr.cli import main
-
-    err = io.StringIO()
-    with threadpool_limits(limits=1), contextlib.redirect_stdout(io.StringIO()), \
-            contextlib.redirect_stderr(err):
-        code = main(["calibrate", "DMU50", *map(str, paths),
-                     "--parameters", "EXX,EYY,EZZ,squareness,location", "--degree", "1",
-                     "--json", str(out)])
-    assert code == 0, err.getvalue()[-3000:]
+    r = volerr("calibrate", "DMU50", *paths, "--parameters", "EXX,EYY,EZZ,squareness,location",
+               "--degree", "1", "--json", out)
+    assert r.returncode == 0, r.stderr[-3000:]
     doc = json.loads(out.read_text())
     assert set(names) <= set(doc["parameters"]), doc["unidentifiable"]
     bad = [(k, e["value"], truth.get(k, 0.0), e["std"]) for k, e in doc["parameters"].items()

@@ -104,8 +104,7 @@ class Engine:
             kept[key] = {}
         if k not in kept[key]:
             kept[key][k] = _pinv(W.right(W.left(Gt)))
-        Minv = kept[key][k]
-        return _bordered_fit(Gt, ht, W, a, b, (Minv, Minv @ W.left(ht)))
+        return _bordered_fit(Gt, ht, W, a, b, kept[key][k])
 
     def cv_blocks(self, W, cands, sub: int) -> tuple[np.ndarray, np.ndarray]:
         """Cross-validated mean squares over ``sub`` consecutive blocks of every fold (the
@@ -226,17 +225,13 @@ def _pinv(M):
     return np.linalg.pinv(M, rcond=1e-12, hermitian=True) if M.size else M
 
 
-def _solve(Gt, ht, W) -> tuple:
-    """(the pseudo-inverse of ``W' Gt W``, the fit b0 of ``W`` alone on (Gt, ht))."""
-    Minv = _pinv(W.right(W.left(Gt)))
-    return Minv, Minv @ W.left(ht)
-
-
-def _bordered_fit(Gt, ht, W, a, b, solved=None) -> tuple:
+def _bordered_fit(Gt, ht, W, a, b, Minv=None) -> tuple:
     """The fits on (Gt, ht): of ``W`` (a :class:`Sel`) alone (b0) and of ``W`` plus each
-    candidate (B, beta; ``ok`` False where the candidate is dependent); ``solved``
-    :func:`_solve`'s answer where known."""
-    Minv, b0 = _solve(Gt, ht, W) if solved is None else solved
+    candidate (B, beta; ``ok`` False where the candidate is dependent); ``Minv`` the
+    pseudo-inverse of ``W' Gt W`` where known."""
+    if Minv is None:
+        Minv = _pinv(W.right(W.left(Gt)))
+    b0 = Minv @ W.left(ht)
     if len(a) == 0:
         return b0, None, None, None
     U = _pair(W.right(Gt), a, b).T            # (s, nc)  W' Gt c

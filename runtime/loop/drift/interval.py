@@ -81,11 +81,18 @@ def leverage(X, run, fit_mask, rows, anchored, penalty=None) -> np.ndarray:
     mu = sums / np.maximum(cnt, 1.0)[:, None]
     Xc = X[fit_mask] - mu[run[fit_mask]]
     gram_inv = _inverse(Xc.T @ Xc + (0.0 if penalty is None else penalty))
-    r = run[rows]
-    free = (cnt[r] > 0) & (not anchored)
-    d = X[rows] - np.where(free[:, None], mu[r], 0.0)
-    h0 = np.where(free, 1.0 / np.maximum(cnt[r], 1.0), 1.0)
+    d, h0 = _from_zero(X[rows], run[rows], mu, cnt, not anchored)
     return h0 + np.einsum("ij,jk,ik->i", d, gram_inv, d)
+
+
+def _from_zero(x, r, mu, cnt, fitted: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(the readings' columns ``x`` less their run's zero, the zero's share ``h0``): where
+    the zero is fitted (``fitted`` and the run ``r`` has fitting readings) the run's mean
+    ``mu`` of its ``cnt`` fitting readings and ``1 / cnt``; else 0 (the basis is zero at the
+    run's first reading) and 1."""
+    free = (cnt[r] > 0) & fitted
+    return (x - np.where(free[:, None], mu[r], 0.0),
+            np.where(free, 1.0 / np.maximum(cnt[r], 1.0), 1.0))
 
 
 def _inverse(G) -> np.ndarray:
@@ -115,10 +122,8 @@ def shrink_leverage(cache, Z, keep, run, fold, anchored, lam) -> np.ndarray:
             rows = np.flatnonzero(fold == k if k >= 0 else fold < 0)
             sub = _thinned(rows, run)
             mu, cnt, _, V = eig[k + 1]
-            r = run[rows[sub]]
-            free = (cnt[r] > 0) & (k < 0 or not anchored)
-            d = Z[rows[sub]][:, keep] * scale - np.where(free[:, None], mu[r], 0.0)
-            h0 = np.where(free, 1.0 / np.maximum(cnt[r], 1.0), 1.0)
+            d, h0 = _from_zero(Z[rows[sub]][:, keep] * scale, run[rows[sub]], mu, cnt,
+                               k < 0 or not anchored)
             proj.append((rows, sub, h0, (d @ V) ** 2))
         cache["shrink_proj"] = proj
     h = np.full(len(run), np.nan)

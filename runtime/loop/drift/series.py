@@ -129,8 +129,7 @@ def _none_left(runs, left: list) -> str:
     in one: it names the run that lacks (or has faulty) the most of them, first in file
     order among equals, what it lacks, what is faulty in it (the faults' words) and what
     the other runs lost."""
-    def where(x):
-        return x["file"] if not x.get("run") else f"{x['file']}[{x['run']}]"
+    from ...instruments.drift import fault_where as where
 
     count = {r.name: 0 for r in runs}
     for e in left:
@@ -220,10 +219,12 @@ def _refuse_time_slip(runs) -> None:
     as much (:data:`SLIP_CHANGE`)."""
     dt = np.array([float(np.median(np.diff(r.t_s))) for r in runs])
     span = np.array([float(r.t_s[-1] - r.t_s[0]) for r in runs])
-    heat = np.array([_temperature_change(r)[0] for r in runs])
+    changes = [_temperature_change(r) for r in runs]
+    heat = np.array([c for c, _ in changes])
     drift = np.array([float(np.median([np.ptp(v) for v in r.channels.values()])) for r in runs])
+    mdt, mspan = float(np.median(dt)), float(np.median(span))
     for i, r in enumerate(runs):
-        change, n = _temperature_change(r)
+        change, n = changes[i]
         rate = change / max(span[i], 1e-300) * 60.0
         require(not (n >= 3 and rate > FASTEST_K_PER_MIN),
                 f"{r.name}: its temperatures change {change:.3g} K (median sensor) in {span[i]:g} "
@@ -232,7 +233,6 @@ def _refuse_time_slip(runs) -> None:
                 f"seconds (or name the column t_min / t_h)")
         if len(runs) < 3:
             continue
-        mdt, mspan = float(np.median(dt)), float(np.median(span))
         slip = (dt[i] * TIME_SLIP < mdt and span[i] * TIME_SLIP < mspan
                 and drift[i] >= SLIP_CHANGE * np.median(drift)
                 and heat[i] >= SLIP_CHANGE * np.median(heat))
@@ -247,7 +247,7 @@ def left_out_line(left: list) -> str:
     """One console line naming the inputs :func:`read_runs` left out (empty: '')."""
     if not left:
         return ""
-    from ...instruments.drift import fault_text
+    from ...instruments.drift import fault_text, fault_where
 
     parts, const = [], {}
     for e in left:
@@ -256,8 +256,7 @@ def left_out_line(left: list) -> str:
             continue
         for x in e["faults"]:
             if x["fault"] == "constant":      # one phrase for the sensors constant in a run
-                where = x["file"] if not x.get("run") else f"{x['file']}[{x['run']}]"
-                const.setdefault((where, x["readings"]), []).append(x)
+                const.setdefault((fault_where(x), x["readings"]), []).append(x)
         if any(x["fault"] != "constant" for x in e["faults"]):
             parts.append("; ".join(fault_text(x) for x in e["faults"] if x["fault"] != "constant"))
     for (where, n), xs in const.items():
