@@ -86,3 +86,22 @@ def test_effects_name_sensors_and_time_constants_with_uncertainties(run):
     lags = [t["lag_s"] for e in doc["effects"] for t in e["terms"] if t["lag_s"]]
     assert lags and sum(lag["std"] is not None for lag in lags) >= len(lags) // 2
     assert "(k = 2)" in out.stdout
+
+
+def test_the_named_effects_hold_on_the_held_out_window(run):
+    """The diagnosis judged by the readings it never saw (issue 44;
+    :func:`volerr.loop.drift.family.held_out_verdict`): on the publication window every
+    channel whose model is the lag model is confirmed (and, measured, every channel naming
+    effects: its lag model's held-out MAE 1.24 / 3.12 / 2.94 / 1.54 / 3.24 um, each within
+    1.05 x the better baseline's + 0.2 um)."""
+    _, out, doc = run
+    lag = [ch for ch, c in doc["channels"].items() if c["family"] == "lag"]
+    assert lag                                            # ch1 at least
+    for ch in lag:
+        h = doc["channels"][ch]["held_out"]
+        c = doc["channels"][ch]
+        assert h["confirmed"] and h["lag_model_mae_um"] == c["lag_model"]["mae_um"]
+        assert h["baseline_mae_um"] == min(c["baselines"][b]["mae_um"]
+                                           for b in ("static", "constant"))
+        assert all(e["held_out"]["confirmed"] for e in doc["effects"] if e["channel"] == ch)
+    assert "not confirmed" not in out.stdout

@@ -198,6 +198,19 @@ def effects_summary(js):
     return lines
 
 
+def held_out_text(ch):
+    """The loop JSON's verdict on a channel's named effects (its "held_out": whether the lag
+    model they come from holds on the held-out readings; absent: no effect named)."""
+    if "held_out" not in ch:
+        return "none named"
+    h = ch["held_out"]
+    if h is None:
+        return "not judged"
+    word = "confirmed" if h["confirmed"] else "NOT confirmed"
+    return (f"{word} (lag {h['lag_model_mae_um']:.2f} vs {h['bound_um']:.2f} = 1.05 x "
+            f"{h['baseline']} {h['baseline_mae_um']:.2f} + 0.2)")
+
+
 def table(seed, split, ntrain, ntest, own, loop, fmt_md=True):
     rows = []
     head = f"seed {seed}, split {split}: {ntrain} training runs, {ntest} held-out runs"
@@ -221,6 +234,8 @@ def table(seed, split, ntrain, ntest, own, loop, fmt_md=True):
                                  f"{(js[ax].get('lag_model') or {}).get('mae_um', float('nan')):.2f} / "
                                  f"{(js[ax].get('interval') or {}).get('coverage_test', float('nan')):.2f}"
                                  for ax in AXES) + " |")
+        rows.append("| loop JSON named effects on the held-out readings | "
+                    + " | ".join(held_out_text(js[ax]) for ax in AXES) + " |")
         verdict = []
         for ax in AXES:
             ref = min(own["static"][ax], own["published"][ax])
@@ -258,7 +273,8 @@ def record(seed, split, a, train, test, own, loop):
     rec["mae_um"]["loop"] = {ax: loop["mae"][ax] for ax in AXES}
     rec["loop"] = {ax: {"family": (ch.get(ax) or {}).get("family"),
                         "coverage_95": ((ch.get(ax) or {}).get("interval") or {}).get("coverage_test"),
-                        "lag_model_mae_um": ((ch.get(ax) or {}).get("lag_model") or {}).get("mae_um")}
+                        "lag_model_mae_um": ((ch.get(ax) or {}).get("lag_model") or {}).get("mae_um"),
+                        "held_out": (ch.get(ax) or {}).get("held_out", "none named")}
                    for ax in AXES}
     rec["loop"].update({"wall_s": loop["wall_s"], "fold_rule": loop["json"].get("fold_rule"),
                         "refused_first": loop.get("refused_first"),

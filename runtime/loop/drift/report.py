@@ -19,6 +19,7 @@ from pathlib import Path
 from ...results import ResultMixin, Row
 from ...selection.rules import SIG_K
 from . import basis
+from .family import HELD_OUT_ABS_UM, HELD_OUT_REL, RIVAL
 from .series import DriftSeries, left_out_line
 from .split import extrapolation_line, kept_out_line
 
@@ -136,10 +137,19 @@ class DriftReport(ResultMixin):
             own = ", ".join(q["layout_parameters"]) or "none"
             out.append(f"  {sym} ({q['unit']}): {q['description']}, rows {rows}; the layout's "
                        f"parameters it is at this position: {own}")
+        if any("held_out" in e and e["held_out"] is None for e in d["effects"]):
+            out.append("  the effects are not judged on held-out readings: none are held out")
+        said: dict = {}       # label -> its first effect not confirmed (the line said once)
         for e in d["effects"]:
             what = e["channel"] if not e.get("quantity") else \
                 f"{e['quantity']} (channels {', '.join(e['channels'])})"
             out.append(f"  {e['kind']} {e['name']}: {what} varies with {e['basis']}")
+            if e.get("held_out") and not e["held_out"]["confirmed"]:
+                out.append("    " + (_not_confirmed_line(e["held_out"], bool(e.get("quantity")))
+                                     if e["channel"] not in said else
+                                     f"not confirmed on the held-out readings (as "
+                                     f"{said[e['channel']]} above: the same lag model)"))
+                said.setdefault(e["channel"], e["name"])
             for t in e["terms"]:
                 out.append("    " + _term_line(t))
         for n in d.get("not_reported", []):
@@ -175,6 +185,17 @@ def _family_lines(c: dict) -> list:
                    f"{lo:.3f}..{hi:.3f} um, wider where the inputs extrapolate; from the "
                    f"blocked-CV residuals); held-out readings inside it: {cov}")
     return out
+
+
+def _not_confirmed_line(h: dict, quantity: bool) -> str:
+    """The console line of an effect whose lag model does not hold on the held-out readings
+    (:func:`volerr.loop.drift.family.held_out_verdict`; ``quantity``: judged on the channel
+    ``h["channel"]`` of least margin)."""
+    on = f" on channel {h['channel']}" if quantity else ""
+    return (f"not confirmed on the held-out readings: the lag model's held-out MAE{on} "
+            f"{h['lag_model_mae_um']:.2f} um > {h['bound_um']:.2f} um = {HELD_OUT_REL:g} x the "
+            f"{RIVAL[h['baseline']]}'s {h['baseline_mae_um']:.2f} um + {HELD_OUT_ABS_UM:g} um: "
+            f"these terms describe the training readings, not a transfer")
 
 
 def _term_line(t: dict) -> str:

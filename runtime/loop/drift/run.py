@@ -118,7 +118,30 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
     data["rms_after_um"] = _pool(tr, "rms_after_um")
     data["max_before_um"] = max(c["max_abs_before_um"] for c in tr)
     data["max_after_um"] = max(c["max_abs_after_um"] for c in tr)
+    _judge_held_out(data, pred)
     return DriftReport(data, s, pred)
+
+
+def _judge_held_out(data: dict, pred: dict) -> None:
+    """The held-out verdict (:func:`volerr.loop.drift.family.held_out_verdict`: does the lag
+    model, the model the named effects come from, hold on the held-out readings?) of every
+    channel whose lag terms are named (its own or its quantities'), and of every effect: its
+    channel's, or for a quantity read by several channels the one of least margin
+    (``bound_um - lag_model_mae_um``; ``"channel"`` names it), so an effect is confirmed
+    where every channel it is judged on is.  None (JSON null) where nothing is held out.
+    Changes no choice and no figure."""
+    data["held_out_rule"] = family.HELD_OUT_RULE
+    chs = data["channels"]
+    for label, c in chs.items():
+        if pred[label]["terms"]:
+            c["held_out"] = family.held_out_verdict(c)
+    for e in data["effects"]:
+        judged = [(k, chs[k]["held_out"]) for k in e["channels"] if "held_out" in chs.get(k, {})]
+        if not judged or any(v is None for _, v in judged):
+            e["held_out"] = None
+            continue
+        k, v = min(judged, key=lambda kv: kv[1]["bound_um"] - kv[1]["lag_model_mae_um"])
+        e["held_out"] = {"channel": k, **v}
 
 
 def _rows(s, position, model):
