@@ -105,3 +105,7 @@ def test_the_named_effects_hold_on_the_held_out_window(run):
                                            for b in ("static", "constant"))
         assert all(e["held_out"]["confirmed"] for e in doc["effects"] if e["channel"] == ch)
     assert "not confirmed" not in out.stdout
+    # and the model every channel reports, whichever family, holds by the same bar
+    for ch, c in doc["channels"].items():
+        assert c["held_out_reported"]["within"], (ch, c["held_out_reported"])
+    assert "NOT HELD" not in out.stdout

@@ -172,6 +172,13 @@ def _family_lines(c: dict) -> list:
     out = [line]
     if c.get("verdict"):
         out.append(f"    {c['verdict']}")
+    h = c.get("held_out_reported")
+    if h and not h["within"]:
+        out.append(f"    NOT HELD on the held-out readings: the reported model's held-out MAE "
+                   f"{h['mae_um']:.2f} um > {h['bound_um']:.2f} um = {HELD_OUT_REL:g} x the "
+                   f"{RIVAL[h['baseline']]}'s {h['baseline_mae_um']:.2f} um + "
+                   f"{HELD_OUT_ABS_UM:g} um: the choice the training readings made did not "
+                   f"carry over here")
     if c.get("families_equivalent"):
         out.append("    the cross-validation cannot tell it from: " + ", ".join(
             f"{f['family']} (CV RMS {f['cv_rms_um']:.3f} um, paired t {f['paired_t']:.2f})"

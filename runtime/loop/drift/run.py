@@ -133,6 +133,8 @@ def _judge_held_out(data: dict, pred: dict) -> None:
     data["held_out_rule"] = family.HELD_OUT_RULE
     chs = data["channels"]
     for label, c in chs.items():
+        if "family" in c:
+            c["held_out_reported"] = family.reported_held_out(c)
         if pred[label]["terms"]:
             c["held_out"] = family.held_out_verdict(c)
     for e in data["effects"]:
