@@ -42,6 +42,12 @@ STACK_COLUMNS = 64   # candidate columns scored in one matrix product (Base.scor
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
+#: searched basis parameters whose profile is scored on the design reduced against the
+#: candidate's one target (:meth:`Base.score_term`): time constants, whose gains on the grid
+#: differ by far more than that scoring's rounding (measured: 1e-8 of the best apart or more,
+#: rounding 1e-14); not a step's location, whose neighbouring values between two measured
+#: positions can gain the same to 1e-12 (there the exact rows decide, as they always did)
+REDUCED_SEARCH = ("lag_s", "tau_h")
 #: the time constant of a lag in a basis text (the one number a lag profile varies): the
 #: lagged column (group 1) and the time constant's characters (group 2)
 _LAG_TAU = re.compile(r"lag\(\s*(\w+)\s*,\s*([^,)]+)")
@@ -110,6 +116,27 @@ class Base:
         m = np.einsum("ij,ij->j", Bs, Bs) - np.einsum("ij,ij->j", C, self.Gi @ C)
         g = Bs.T @ self.r
         ok = m > 1e-9 * len(Bs)
+        return np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
+
+    def score_term(self, s, basis) -> np.ndarray:
+        """:meth:`score_single` of the columns of one term, ``s`` (n, 3) weighted target
+        column (the rows of a point: ``s[i] basis[i, j]``) times each basis column ``basis``
+        (n, G), without the (3n, G) rows: the design is reduced against ``s`` once, ``A_s[i]
+        = sum_k A[3i+k] s[i, k]`` (n, p), and every product is then over n points instead
+        of 3n rows (``A^T B = A_s^T basis``, ``B^T B = w^T basis^2`` with ``w = sum_k s^2``,
+        ``B^T r = r_s^T basis``).  The same numbers up to the order of summation (rounding,
+        raised by the difference in the Gram block to 1e-9 relative, measured): a profile
+        takes only the best value of its grid from them."""
+        n = len(s)
+        A_s = np.einsum("ikp,ik->ip", self.A.reshape(n, 3, -1), s)
+        r_s = np.einsum("ik,ik->i", self.r.reshape(n, 3), s)
+        bb = np.einsum("ik,ik->i", s, s) @ (basis * basis)      # B^T B, unscaled
+        sc = np.sqrt(bb / (3 * n))
+        sc[sc == 0] = 1.0
+        C = A_s.T @ basis
+        m = (bb - np.einsum("ij,ij->j", C, self.Gi @ C)) / (sc * sc)
+        g = (r_s @ basis) / sc
+        ok = m > 1e-9 * 3 * n
         return np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
 
     def dbic(self, gain: float, m_eff: int) -> float:
@@ -286,23 +313,46 @@ class Context:
     def profile_rows(self, c, values) -> np.ndarray:
         """Weighted rows (3n, G) of a one-parameter searched candidate at ``values`` (its
         terms summed: a proportional warm-up of the probe offset has three)."""
+        n = len(self.pts)
+        cols = np.zeros((n, 3, len(values)))
+        for target, basis in self.profile_terms(c, values):
+            cols += self.target_column(target)[:, :, None] * basis[:, None, :]
+        return (cols * self.sw[:, None, None]).reshape(-1, len(values))
+
+    def profile_terms(self, c, values) -> list:
+        """[(target, basis (n, G))] of a one-parameter searched candidate at ``values``, one
+        per term: its columns are the sum of the target columns times the bases.  A lag
+        term's basis is kept by its texts (the last ``LAG_CACHE``): the candidates of one
+        sensor on every target share the texts of one basis form; other searched bases are
+        kept per candidate (a few)."""
         key = ("profile", c.name, tuple(values))
-        if key not in self.cache or c.search.what == "lag_s":
-            made = [c.search.make(v)[0] for v in values]
-            n = len(self.pts)
-            cols = np.zeros((n, 3, len(values)))
-            for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
-                texts = [m[i][2] for m in made]
-                basis = self._lag_profile_basis(texts) if c.search.what == "lag_s" else None
-                if basis is None:
-                    basis = np.column_stack([np.broadcast_to(
-                        evaluate(t, self.basis_values(t)), (n,)) for t in texts])
-                cols += self.target_column(target)[:, :, None] * basis[:, None, :]
-            rows = (cols * self.sw[:, None, None]).reshape(-1, len(values))
-            if c.search.what == "lag_s":    # hundreds of lag candidates: not kept
-                return rows
-            self.cache[key] = rows
-        return self.cache[key]
+        if key in self.cache:
+            return self.cache[key]
+        made = [c.search.make(v)[0] for v in values]
+        n = len(self.pts)
+        out = []
+        for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
+            texts = [m[i][2] for m in made]
+            basis = self._lag_basis_kept(texts) if c.search.what == "lag_s" else None
+            if basis is None:
+                basis = np.column_stack([np.broadcast_to(
+                    evaluate(t, self.basis_values(t)), (n,)) for t in texts])
+            out.append((target, basis))
+        if c.search.what != "lag_s":        # hundreds of lag candidates: not kept
+            self.cache[key] = out
+        return out
+
+    def _lag_basis_kept(self, texts) -> np.ndarray | None:
+        """:meth:`_lag_profile_basis` of ``texts``, kept (the last ``LAG_CACHE`` sets)."""
+        store = self.cache.setdefault("lag_bases", {})
+        key = tuple(texts)
+        if key in store:
+            store[key] = store.pop(key)           # most recently used last
+            return store[key]
+        while len(store) >= LAG_CACHE:
+            store.pop(next(iter(store)))
+        store[key] = self._lag_profile_basis(texts)
+        return store[key]
 
     def _lag_profile_basis(self, texts) -> np.ndarray | None:
         """(n, G) basis of the texts of one lag term at G time constants, evaluated once with
@@ -380,7 +430,12 @@ def _profile(c: cands.Candidate, ctx: Context, base: Base) -> cands.Candidate:
     grid = list(c.search.grid)
 
     def best_of(values):
-        g = base.score_single(ctx.profile_rows(c, values))
+        terms = ctx.profile_terms(c, values)
+        if c.search.what in REDUCED_SEARCH and len({t for t, _ in terms}) == 1:
+            basis = terms[0][1] if len(terms) == 1 else sum(b for _, b in terms)
+            g = base.score_term(ctx.target_column(terms[0][0]) * ctx.sw[:, None], basis)
+        else:
+            g = base.score_single(ctx.profile_rows(c, values))
         return values[int(np.argmax(g))]
 
     v0 = best_of(grid)
