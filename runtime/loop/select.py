@@ -121,23 +121,38 @@ class Base:
     def score_term(self, s, basis) -> np.ndarray:
         """:meth:`score_single` of the columns of one term, ``s`` (n, 3) weighted target
         column (the rows of a point: ``s[i] basis[i, j]``) times each basis column ``basis``
-        (n, G), without the (3n, G) rows: the design is reduced against ``s`` once, ``A_s[i]
-        = sum_k A[3i+k] s[i, k]`` (n, p), and every product is then over n points instead
-        of 3n rows (``A^T B = A_s^T basis``, ``B^T B = w^T basis^2`` with ``w = sum_k s^2``,
-        ``B^T r = r_s^T basis``).  The same numbers up to the order of summation (rounding,
-        raised by the difference in the Gram block to 1e-9 relative, measured): a profile
-        takes only the best value of its grid from them."""
+        (n, G): :meth:`term_gains`' RSS reductions."""
+        return self.term_gains(s, basis)[0]
+
+    def term_gains(self, s, basis, cuts=None) -> tuple[np.ndarray, np.ndarray]:
+        """(RSS reduction, effective rank) of each column ``s[i] basis[i, j]`` (rows of point
+        i) added alone, or of each group of columns ``cuts[k]:cuts[k + 1]`` (offsets, len +
+        1) added together, without the (3n, G) rows: the design is reduced against ``s``
+        once, ``A_s[i] = sum_k A[3i+k] s[i, k]`` (n, p), and every product is then over n
+        points instead of 3n rows (``A^T B = A_s^T basis``, ``B^T B = basis^T diag(w) basis``
+        with ``w = sum_k s^2``, ``B^T r = r_s^T basis``).  The same numbers as
+        :meth:`score_many` of those rows up to the order of summation (rounding, raised by
+        the difference in the Gram block to 1e-9 relative, measured)."""
         n = len(s)
         A_s = np.einsum("ikp,ik->ip", self.A.reshape(n, 3, -1), s)
         r_s = np.einsum("ik,ik->i", self.r.reshape(n, 3), s)
-        bb = np.einsum("ik,ik->i", s, s) @ (basis * basis)      # B^T B, unscaled
+        w = np.einsum("ik,ik->i", s, s)
+        bb = w @ (basis * basis)                                # diag of B^T B, unscaled
         sc = np.sqrt(bb / (3 * n))
         sc[sc == 0] = 1.0
         C = A_s.T @ basis
-        m = (bb - np.einsum("ij,ij->j", C, self.Gi @ C)) / (sc * sc)
+        GiC = self.Gi @ C
+        m = (bb - np.einsum("ij,ij->j", C, GiC)) / (sc * sc)
         g = (r_s @ basis) / sc
-        ok = m > 1e-9 * 3 * n
-        return np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
+        floor = 1e-9 * 3 * n
+        ok = m > floor
+        gain = np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
+        if cuts is None:
+            return gain, ok.astype(int)
+        out = [(gain[a], int(ok[a])) if b - a == 1 else rss_gain(
+            ((basis[:, a:b] * w[:, None]).T @ basis[:, a:b] - C[:, a:b].T @ GiC[:, a:b])
+            / np.outer(sc[a:b], sc[a:b]), g[a:b], floor) for a, b in zip(cuts[:-1], cuts[1:])]
+        return np.array([x[0] for x in out], float), np.array([x[1] for x in out], int)
 
     def dbic(self, gain: float, m_eff: int) -> float:
         """BIC change of columns that lower the RSS by ``gain`` with ``m_eff`` parameters."""
@@ -278,6 +293,18 @@ class Context:
         if not full and len(self.pts) * len(params) <= 20000 * 3:
             self.cache[key] = (out, params)
         return out, params
+
+    def term_basis(self, terms) -> np.ndarray:
+        """(n,) the summed bases of ``terms`` at the context's points, each text evaluated
+        once (kept: the candidates of one covariate on every target share its texts)."""
+        store = self.cache.setdefault("term_bases", {})
+        n = len(self.pts)
+        out = None
+        for _, _, text in terms:
+            if text not in store:
+                store[text] = np.broadcast_to(evaluate(text, self.basis_values(text)), (n,))
+            out = store[text] if out is None else out + store[text]
+        return out
 
     def columns_at(self, terms, idx) -> np.ndarray:
         """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
@@ -490,20 +517,43 @@ def _scored(c, ctx: Context, base: Base) -> "Scored":
 
 
 def _scored_many(cs, ctx: Context, base) -> list:
-    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`,
-    stacks of ``STACK_COLUMNS`` candidates (their rows made a stack at a time) for a
-    :class:`Base`."""
-    if not isinstance(base, BlockBase):
-        out = []
-        for i in range(0, len(cs), STACK_COLUMNS):
-            made = [ctx.columns(c.terms) for c in cs[i:i + STACK_COLUMNS]]
-            res = base.score_many([ctx.rows(cols) for cols, _ in made])
-            out += [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c, params)
-                    for c, (_, params), (g, r) in zip(cs[i:i + STACK_COLUMNS], made, res)]
-        return out
-    res = base.score_many([ctx.group(c.terms) for c in cs])
-    return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
-                   c.parameters) for c, (g, r) in zip(cs, res)]
+    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`;
+    for a :class:`Base` the candidates on one target (nearly all) together per target, on
+    the design reduced against it (:meth:`Base.term_gains`: a screening's
+    thousands of columns without their rows), the others in stacks of ``STACK_COLUMNS``
+    (their rows made a stack at a time)."""
+    if isinstance(base, BlockBase):
+        res = base.score_many([ctx.group(c.terms) for c in cs])
+        return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
+                       c.parameters) for c, (g, r) in zip(cs, res)]
+    out, by_target, rest = [None] * len(cs), {}, []
+    for i, c in enumerate(cs):
+        t = _one_target(c)
+        (rest if t is None else by_target.setdefault(t, [])).append(i)
+    for t, idx in by_target.items():
+        bases = [[ctx.term_basis([x for x in cs[i].terms if x[0] == p])
+                  for p in cs[i].parameters] for i in idx]
+        cuts = np.cumsum([0] + [len(b) for b in bases])
+        g, ok = base.term_gains(ctx.target_column(t) * ctx.sw[:, None],
+                                np.column_stack([b for bs in bases for b in bs]), cuts)
+        for i, gain, r in zip(idx, g.tolist(), ok.tolist()):
+            gain = gain if r else 0.0
+            out[i] = Scored(base.dbic(gain, r + cands.extra_parameters(cs[i])), gain, r,
+                            cs[i], cs[i].parameters)
+    for k in range(0, len(rest), STACK_COLUMNS):
+        part = [cs[i] for i in rest[k:k + STACK_COLUMNS]]
+        made = [ctx.columns(c.terms) for c in part]
+        res = base.score_many([ctx.rows(cols) for cols, _ in made])
+        for i, c, (_, params), (g, r) in zip(rest[k:k + STACK_COLUMNS], part, made, res):
+            out[i] = Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c, params)
+    return out
+
+
+def _one_target(c) -> str | None:
+    """The target of a candidate whose terms all act on one target (its parameters' columns
+    are that target's sensitivity times their bases), else None."""
+    targets = {t for _, t, _ in c.terms}
+    return next(iter(targets)) if len(targets) == 1 else None
 
 
 def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
