@@ -4,7 +4,10 @@ Screen: every candidate (P x C x basis, :mod:`volerr.loop.candidates`) is scored
 current residual by the exact RSS reduction of adding its columns to the current design (a
 score test through the Gram matrix: no refit), converted to a BIC change; searched basis
 parameters (warm-up tau, step location, period) are profiled on their grid, refined, and cost
-one extra parameter.  Select: the best three by BIC are fitted fully; the first with dBIC <
+one extra parameter.  A candidate's columns are one target's sensitivity (n, 3) times its
+bases (n,): the candidates on one target are scored together on the design reduced against
+that sensitivity once (:meth:`Base.term_gains`: products over the n points, not the 3n rows).
+Select: the best three by BIC are fitted fully; the first with dBIC <
 -``BIC_GAIN`` and a significantly smaller cross-validated residual (paired t > ``CV_T`` on the
 per-point squared errors) is accepted; repeat.  After acceptance every effect is re-tested
 given the others (backward check) and dropped when it no longer earns its place.
