@@ -4,7 +4,10 @@ Screen: every candidate (P x C x basis, :mod:`volerr.loop.candidates`) is scored
 current residual by the exact RSS reduction of adding its columns to the current design (a
 score test through the Gram matrix: no refit), converted to a BIC change; searched basis
 parameters (warm-up tau, step location, period) are profiled on their grid, refined, and cost
-one extra parameter.  Select: the best three by BIC are fitted fully; the first with dBIC <
+one extra parameter.  A candidate's columns are one target's sensitivity (n, 3) times its
+bases (n,): the candidates on one target are scored together on the design reduced against
+that sensitivity once (:meth:`Base.term_gains`: products over the n points, not the 3n rows).
+Select: the best three by BIC are fitted fully; the first with dBIC <
 -``BIC_GAIN`` and a significantly smaller cross-validated residual (paired t > ``CV_T`` on the
 per-point squared errors) is accepted; repeat.  After acceptance every effect is re-tested
 given the others (backward check) and dropped when it no longer earns its place.
@@ -42,6 +45,12 @@ STACK_COLUMNS = 64   # candidate columns scored in one matrix product (Base.scor
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
+#: searched basis parameters whose profile is scored on the design reduced against the
+#: candidate's one target (:meth:`Base.score_term`): time constants, whose gains on the grid
+#: differ by far more than that scoring's rounding (measured: 1e-8 of the best apart or more,
+#: rounding 1e-14); not a step's location, whose neighbouring values between two measured
+#: positions can gain the same to 1e-12 (there the exact rows decide, as they always did)
+REDUCED_SEARCH = ("lag_s", "tau_h")
 #: the time constant of a lag in a basis text (the one number a lag profile varies): the
 #: lagged column (group 1) and the time constant's characters (group 2)
 _LAG_TAU = re.compile(r"lag\(\s*(\w+)\s*,\s*([^,)]+)")
@@ -111,6 +120,42 @@ class Base:
         g = Bs.T @ self.r
         ok = m > 1e-9 * len(Bs)
         return np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
+
+    def score_term(self, s, basis) -> np.ndarray:
+        """:meth:`score_single` of the columns of one term, ``s`` (n, 3) weighted target
+        column (the rows of a point: ``s[i] basis[i, j]``) times each basis column ``basis``
+        (n, G): :meth:`term_gains`' RSS reductions."""
+        return self.term_gains(s, basis)[0]
+
+    def term_gains(self, s, basis, cuts=None) -> tuple[np.ndarray, np.ndarray]:
+        """(RSS reduction, effective rank) of each column ``s[i] basis[i, j]`` (rows of point
+        i) added alone, or of each group of columns ``cuts[k]:cuts[k + 1]`` (offsets, len +
+        1) added together, without the (3n, G) rows: the design is reduced against ``s``
+        once, ``A_s[i] = sum_k A[3i+k] s[i, k]`` (n, p), and every product is then over n
+        points instead of 3n rows (``A^T B = A_s^T basis``, ``B^T B = basis^T diag(w) basis``
+        with ``w = sum_k s^2``, ``B^T r = r_s^T basis``).  The same numbers as
+        :meth:`score_many` of those rows up to the order of summation (rounding, raised by
+        the difference in the Gram block to 1e-9 relative, measured)."""
+        n = len(s)
+        A_s = np.einsum("ikp,ik->ip", self.A.reshape(n, 3, -1), s)
+        r_s = np.einsum("ik,ik->i", self.r.reshape(n, 3), s)
+        w = np.einsum("ik,ik->i", s, s)
+        bb = w @ (basis * basis)                                # diag of B^T B, unscaled
+        sc = np.sqrt(bb / (3 * n))
+        sc[sc == 0] = 1.0
+        C = A_s.T @ basis
+        GiC = self.Gi @ C
+        m = (bb - np.einsum("ij,ij->j", C, GiC)) / (sc * sc)
+        g = (r_s @ basis) / sc
+        floor = 1e-9 * 3 * n
+        ok = m > floor
+        gain = np.where(ok, g * g / np.where(ok, m, 1.0), 0.0)
+        if cuts is None:
+            return gain, ok.astype(int)
+        out = [(gain[a], int(ok[a])) if b - a == 1 else rss_gain(
+            ((basis[:, a:b] * w[:, None]).T @ basis[:, a:b] - C[:, a:b].T @ GiC[:, a:b])
+            / np.outer(sc[a:b], sc[a:b]), g[a:b], floor) for a, b in zip(cuts[:-1], cuts[1:])]
+        return np.array([x[0] for x in out], float), np.array([x[1] for x in out], int)
 
     def dbic(self, gain: float, m_eff: int) -> float:
         """BIC change of columns that lower the RSS by ``gain`` with ``m_eff`` parameters."""
@@ -252,6 +297,18 @@ class Context:
             self.cache[key] = (out, params)
         return out, params
 
+    def term_basis(self, terms) -> np.ndarray:
+        """(n,) the summed bases of ``terms`` at the context's points, each text evaluated
+        once (kept: the candidates of one covariate on every target share its texts)."""
+        store = self.cache.setdefault("term_bases", {})
+        n = len(self.pts)
+        out = None
+        for _, _, text in terms:
+            if text not in store:
+                store[text] = np.broadcast_to(evaluate(text, self.basis_values(text)), (n,))
+            out = store[text] if out is None else out + store[text]
+        return out
+
     def columns_at(self, terms, idx) -> np.ndarray:
         """(n, 3, m) columns of ``terms`` at the data points ``idx`` (one block)."""
         params = list(dict.fromkeys(t[0] for t in terms))
@@ -286,23 +343,46 @@ class Context:
     def profile_rows(self, c, values) -> np.ndarray:
         """Weighted rows (3n, G) of a one-parameter searched candidate at ``values`` (its
         terms summed: a proportional warm-up of the probe offset has three)."""
+        n = len(self.pts)
+        cols = np.zeros((n, 3, len(values)))
+        for target, basis in self.profile_terms(c, values):
+            cols += self.target_column(target)[:, :, None] * basis[:, None, :]
+        return (cols * self.sw[:, None, None]).reshape(-1, len(values))
+
+    def profile_terms(self, c, values) -> list:
+        """[(target, basis (n, G))] of a one-parameter searched candidate at ``values``, one
+        per term: its columns are the sum of the target columns times the bases.  A lag
+        term's basis is kept by its texts (the last ``LAG_CACHE``): the candidates of one
+        sensor on every target share the texts of one basis form; other searched bases are
+        kept per candidate (a few)."""
         key = ("profile", c.name, tuple(values))
-        if key not in self.cache or c.search.what == "lag_s":
-            made = [c.search.make(v)[0] for v in values]
-            n = len(self.pts)
-            cols = np.zeros((n, 3, len(values)))
-            for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
-                texts = [m[i][2] for m in made]
-                basis = self._lag_profile_basis(texts) if c.search.what == "lag_s" else None
-                if basis is None:
-                    basis = np.column_stack([np.broadcast_to(
-                        evaluate(t, self.basis_values(t)), (n,)) for t in texts])
-                cols += self.target_column(target)[:, :, None] * basis[:, None, :]
-            rows = (cols * self.sw[:, None, None]).reshape(-1, len(values))
-            if c.search.what == "lag_s":    # hundreds of lag candidates: not kept
-                return rows
-            self.cache[key] = rows
-        return self.cache[key]
+        if key in self.cache:
+            return self.cache[key]
+        made = [c.search.make(v)[0] for v in values]
+        n = len(self.pts)
+        out = []
+        for i, (_, target, _) in enumerate(made[0]):    # one parameter, its terms
+            texts = [m[i][2] for m in made]
+            basis = self._lag_basis_kept(texts) if c.search.what == "lag_s" else None
+            if basis is None:
+                basis = np.column_stack([np.broadcast_to(
+                    evaluate(t, self.basis_values(t)), (n,)) for t in texts])
+            out.append((target, basis))
+        if c.search.what != "lag_s":        # hundreds of lag candidates: not kept
+            self.cache[key] = out
+        return out
+
+    def _lag_basis_kept(self, texts) -> np.ndarray | None:
+        """:meth:`_lag_profile_basis` of ``texts``, kept (the last ``LAG_CACHE`` sets)."""
+        store = self.cache.setdefault("lag_bases", {})
+        key = tuple(texts)
+        if key in store:
+            store[key] = store.pop(key)           # most recently used last
+            return store[key]
+        while len(store) >= LAG_CACHE:
+            store.pop(next(iter(store)))
+        store[key] = self._lag_profile_basis(texts)
+        return store[key]
 
     def _lag_profile_basis(self, texts) -> np.ndarray | None:
         """(n, G) basis of the texts of one lag term at G time constants, evaluated once with
@@ -380,7 +460,12 @@ def _profile(c: cands.Candidate, ctx: Context, base: Base) -> cands.Candidate:
     grid = list(c.search.grid)
 
     def best_of(values):
-        g = base.score_single(ctx.profile_rows(c, values))
+        terms = ctx.profile_terms(c, values)
+        if c.search.what in REDUCED_SEARCH and len({t for t, _ in terms}) == 1:
+            basis = terms[0][1] if len(terms) == 1 else sum(b for _, b in terms)
+            g = base.score_term(ctx.target_column(terms[0][0]) * ctx.sw[:, None], basis)
+        else:
+            g = base.score_single(ctx.profile_rows(c, values))
         return values[int(np.argmax(g))]
 
     v0 = best_of(grid)
@@ -435,20 +520,43 @@ def _scored(c, ctx: Context, base: Base) -> "Scored":
 
 
 def _scored_many(cs, ctx: Context, base) -> list:
-    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`,
-    stacks of ``STACK_COLUMNS`` candidates (their rows made a stack at a time) for a
-    :class:`Base`."""
-    if not isinstance(base, BlockBase):
-        out = []
-        for i in range(0, len(cs), STACK_COLUMNS):
-            made = [ctx.columns(c.terms) for c in cs[i:i + STACK_COLUMNS]]
-            res = base.score_many([ctx.rows(cols) for cols, _ in made])
-            out += [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c, params)
-                    for c, (_, params), (g, r) in zip(cs[i:i + STACK_COLUMNS], made, res)]
-        return out
-    res = base.score_many([ctx.group(c.terms) for c in cs])
-    return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
-                   c.parameters) for c, (g, r) in zip(cs, res)]
+    """:func:`_scored` of several candidates; one pass over the rows for a :class:`BlockBase`;
+    for a :class:`Base` the candidates on one target (nearly all) together per target, on
+    the design reduced against it (:meth:`Base.term_gains`: a screening's
+    thousands of columns without their rows), the others in stacks of ``STACK_COLUMNS``
+    (their rows made a stack at a time)."""
+    if isinstance(base, BlockBase):
+        res = base.score_many([ctx.group(c.terms) for c in cs])
+        return [Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c,
+                       c.parameters) for c, (g, r) in zip(cs, res)]
+    out, by_target, rest = [None] * len(cs), {}, []
+    for i, c in enumerate(cs):
+        t = _one_target(c)
+        (rest if t is None else by_target.setdefault(t, [])).append(i)
+    for t, idx in by_target.items():
+        bases = [[ctx.term_basis([x for x in cs[i].terms if x[0] == p])
+                  for p in cs[i].parameters] for i in idx]
+        cuts = np.cumsum([0] + [len(b) for b in bases])
+        g, ok = base.term_gains(ctx.target_column(t) * ctx.sw[:, None],
+                                np.column_stack([b for bs in bases for b in bs]), cuts)
+        for i, gain, r in zip(idx, g.tolist(), ok.tolist()):
+            gain = gain if r else 0.0
+            out[i] = Scored(base.dbic(gain, r + cands.extra_parameters(cs[i])), gain, r,
+                            cs[i], cs[i].parameters)
+    for k in range(0, len(rest), STACK_COLUMNS):
+        part = [cs[i] for i in rest[k:k + STACK_COLUMNS]]
+        made = [ctx.columns(c.terms) for c in part]
+        res = base.score_many([ctx.rows(cols) for cols, _ in made])
+        for i, c, (_, params), (g, r) in zip(rest[k:k + STACK_COLUMNS], part, made, res):
+            out[i] = Scored(base.dbic(g, r + cands.extra_parameters(c)), g, r, c, params)
+    return out
+
+
+def _one_target(c) -> str | None:
+    """The target of a candidate whose terms all act on one target (its parameters' columns
+    are that target's sensitivity times their bases), else None."""
+    targets = {t for _, t, _ in c.terms}
+    return next(iter(targets)) if len(targets) == 1 else None
 
 
 def screen(candidates, ctx: Context, base: Base, skip=()) -> list:
