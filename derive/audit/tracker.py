@@ -141,8 +141,93 @@ def _factored(expr: sp.Expr) -> sp.Expr:
     """``sp.factor(expr)``, computed once per expression: a closed form's derived solution is
     factored for its evidence and again for its verdict, and a denominator's is the closed
     form's of the same selection (factor is a pure function of the expression; the verdicts'
-    text is unchanged)."""
-    return sp.factor(expr)
+    text is unchanged).
+
+    The factorization is sympy's, term for term (:func:`_factor_linear`): the same
+    irreducible factors, each with a positive leading coefficient, the same coefficient and
+    the same expression built from them."""
+    return _factor_linear(expr)
+
+
+#: the lever arms (mm): the symbols a closed form's numerator is not linear in
+_LEVERS = frozenset(S(f"{c}{pre}_{lab}") for lab in LABELS for c in COORDS for pre in ("", "h"))
+
+
+def _factor_linear(expr: sp.Expr) -> sp.Expr:
+    """``sp.factor(expr)`` for a quotient of polynomials whose numerator is of degree at most
+    one in the symbols other than the lever arms (a Cramer's-rule solution is linear in the
+    right-hand side: the deviations, or the measured positions and offsets they stand for).
+
+    Such a polynomial is its content (the gcd of its coefficients as polynomials in the lever
+    arms, factored by sympy) times a primitive part of degree one in the other symbols, which
+    is irreducible (a factorization would give one factor of degree zero in them, a common
+    divisor of the coefficients).  Sympy proves the same irreducibility with Wang's algorithm
+    at many times the cost; the factors are normalized as sympy's (primitive, positive leading
+    coefficient in the generators' order) and multiplied as in ``sympy.factor``.  The factors
+    of a product are those of its polynomial factors (sympy's ``together`` first is not needed:
+    irreducible factors so normalized are unique).  Anything else (a non-integer power, a
+    non-polynomial factor, rational coefficients, degree two) is left to ``sp.factor``."""
+    from sympy.core.exprtools import _keep_coeff
+
+    coeff, factors = sp.S.One, {}
+    for arg in sp.Mul.make_args(expr):   # factors of a product: those of its factors
+        if arg.is_Rational:
+            coeff *= arg
+            continue
+        base, exp = arg.as_base_exp() if arg.is_Pow else (arg, sp.S.One)
+        poly = sp.Poly(base) if exp.is_Integer and not base.is_Number else None
+        listed = _factor_list_linear(poly) if poly is not None and all(
+            g.is_Symbol for g in poly.gens) else None
+        if listed is None:
+            return sp.factor(expr)
+        c, fs = listed
+        coeff *= c ** exp
+        for f, k in fs:
+            factors[f] = factors.get(f, 0) + k * exp
+    return _keep_coeff(coeff, sp.Mul(*[f.as_expr() ** k for f, k in factors.items()]))
+
+
+def _factor_list_linear(p: sp.Poly):
+    """``p.factor_list()`` (coefficient, [(Poly, multiplicity)]) when ``p`` is over ZZ and
+    of degree at most one in its non-lever-arm generators, else None (see
+    :func:`_factor_linear`).  A polynomial of lever arms alone (a denominator) is sympy's."""
+    if p.domain != sp.ZZ:
+        return None
+    lin = [i for i, g in enumerate(p.gens) if g not in _LEVERS]
+    if not lin:
+        return _lever_factor_list(p)
+    parts: dict = {}
+    for monom, c in p.terms():
+        if sum(monom[i] for i in lin) > 1:
+            return None
+        key = tuple(monom[i] for i in lin)
+        rest = tuple(0 if i in lin else e for i, e in enumerate(monom))
+        parts.setdefault(key, {})[rest] = c
+    R = sp.ring(p.gens, sp.ZZ)[0]       # sparse: gcds far cheaper than the dense Poly's
+    content = None
+    for terms in sorted(parts.values(), key=len):
+        q = R.from_dict(terms)
+        content = q if content is None else content.gcd(q)
+        if content.is_ground:
+            break
+    if content.is_ground:                # the usual case: the primitive part is p itself
+        c0, fs, rest = sp.S.One, [], p
+    else:
+        content = sp.Poly.from_dict(dict(content.items()), *p.gens, domain=sp.ZZ)
+        (c0, fs), rest = content.factor_list(), p.exquo(content)
+    c1, prim = rest.primitive()
+    if prim.LC() < 0:
+        c1, prim = -c1, -prim
+    if not prim.is_ground:
+        fs = fs + [(prim, 1)]
+    return c0 * c1, fs
+
+
+@lru_cache(maxsize=None)
+def _lever_factor_list(p: sp.Poly):
+    """``p.factor_list()``, once per polynomial: the six motions of a selection share their
+    denominator."""
+    return p.factor_list()
 
 
 #: the extraction's demonstrated repetitions and losses within one image (quoted by verdicts)

@@ -201,3 +201,26 @@ def test_lost_minus_of_n_cites_the_x_axis_formula_and_d1(verdicts):
         assert "the same formula for the X axis (x_x symbols)" in v.evidence
         assert "the same determinant" not in v.evidence
         assert "appendix D.1" in v.evidence and "Neither separates" in v.evidence
+
+
+def test_linear_factorization_is_sympys_factor():
+    """The closed forms' factorization (content times an irreducible part linear in the
+    deviations) is ``sp.factor``'s expression itself, structure and all, and falls back to
+    ``sp.factor`` outside its case."""
+    import sympy as sp
+
+    S = audit_tracker.S
+    xP, xQ, xK, yP, yK, zQ = (S(n) for n in ("x_P", "x_Q", "x_K", "y_P", "y_K", "z_Q"))
+    dxP, dyK, xo, xmP = (S(n) for n in ("d_xP", "d_yK", "x_o", "xm_P"))
+    det = three_point.closed_form("z")
+    cases = [
+        (xP - xQ) * (dxP * yK - dyK * zQ) / (xK * yP - xP * yK),       # a lever-arm content
+        -2 * (xQ - xP) ** 2 * (dxP * xK + dyK * zQ + 3 * xo) / (yK - yP) ** 2,
+        (dxP * (xmP - xP - xo) + yK) / (xK - xQ),                       # degree two: sympy's
+        (xQ * yK - xK) * dxP - zQ * yP * (xmP - xP - xo) - 4 * zQ * xo,
+        sp.expand(6 * (xP - xQ) ** 2 * yK * (dxP * yK - dyK * zQ + xo)) / (xK - xQ),
+        det["EB"], audit_tracker._hat(det["EB"]), det["N"],
+    ]
+    for e in cases:
+        want, got = sp.factor(e), audit_tracker._factor_linear(e)
+        assert sp.srepr(got) == sp.srepr(want) and str(got) == str(want), e
