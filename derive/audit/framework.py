@@ -39,6 +39,7 @@ term-by-term comparison of two polynomials (:func:`term_diff`, :func:`describe_d
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from functools import lru_cache
 
 import sympy as sp
 
@@ -365,6 +366,20 @@ def n_diff(derived, printed) -> int:
 def n_issues(expected, printed) -> int:
     """Number of distinct defects (an exchanged symbol counts once, not as two terms)."""
     return sum(len(v) for v in term_diff(expected, printed).values())
+
+
+@lru_cache(maxsize=None)
+def simplified(expr):
+    """``sp.simplify(expr)``, once per expression and process (the matrices of the audits
+    compare the same entries again and again; simplify is a pure function of the
+    expression, which is immutable)."""
+    return sp.simplify(expr)
+
+
+def is_zero(expr) -> bool:
+    """``sp.simplify(expr) == 0``: an expression built as 0 needs no simplification (the usual
+    case: two equal entries), anything else is :func:`simplified`."""
+    return expr == 0 or simplified(expr) == 0
 
 
 def fmt(expr) -> str:

@@ -68,8 +68,11 @@ def _locals(axis: str) -> dict:
     return loc
 
 
+@lru_cache(maxsize=None)
 def parse(text: str, axis: str) -> sp.Expr:
-    """A printed expression in the data file's notation -> sympy (ValueError if garbled)."""
+    """A printed expression in the data file's notation -> sympy (ValueError if garbled);
+    each text parsed once per process (the checks and readings parse the same entries
+    again; the expression is immutable)."""
     loc = _locals(axis)
     try:
         expr = sp.parse_expr(text, local_dict=loc)
