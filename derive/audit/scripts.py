@@ -19,19 +19,13 @@ legible.  The authority:
 
 from __future__ import annotations
 
-import functools
 import itertools
 
 import numpy as np
 import sympy as sp
 
 from .framework import Verdict, category_of, fmt
-from ..three_point import closed_form as _closed_form
-
-
-@functools.lru_cache(maxsize=None)
-def closed_form(selection: str) -> dict:
-    return _closed_form(selection)
+from ..three_point import closed_form_once as closed_form
 
 DATA_FILE = "printed_scripts.toml"
 LAYOUTS = ("DMU50",)

@@ -35,7 +35,7 @@ from functools import lru_cache
 import sympy as sp
 
 from .framework import RECURRENCE_UNSHOWN, Verdict, describe_diff, fmt
-from ..three_point import (COORDS, MOTIONS, SELECTIONS, closed_form, point_displacement,
+from ..three_point import (COORDS, MOTIONS, SELECTIONS, closed_form_once, point_displacement,
                           point_symbols, rotated_lever_arm, system)
 
 SOURCE = "Ellingsdalen 2021"
@@ -121,11 +121,14 @@ def _equal(a, b, n: int = 8) -> bool:
     (Schwartz-Zippel: for the low-degree polynomials here a false "identical" has probability
     far below 1e-20); points where a denominator vanishes are skipped."""
     d = a - b
+    exact = _exact_evaluator(d)
     hits = 0
     for point in _samples(d.free_symbols, 3 * n):
-        v = d.xreplace(point)
-        if v.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
-            continue
+        v = exact(point) if exact is not None else None
+        if v is None:                     # not a rational function, or a zero denominator
+            v = d.xreplace(point)
+            if v.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+                continue
         if v != 0:
             return False
         hits += 1
@@ -134,9 +137,50 @@ def _equal(a, b, n: int = 8) -> bool:
     return False
 
 
-@lru_cache(maxsize=None)
+class _NotRational(Exception):
+    pass
+
+
+def _exact_evaluator(expr):
+    """``point -> value`` of a rational function with rational coefficients, evaluated exactly
+    in Python fractions (the same value as ``expr.xreplace(point)``, which rebuilds the whole
+    expression in sympy at each point), None at a point where a denominator vanishes (sympy
+    is asked there); None instead of a function for anything else (floats, functions, I).
+    ``point``: {symbol: sympy Rational}."""
+    from fractions import Fraction
+
+    consts: list = []
+    syms: list = []
+
+    def src(e) -> str:
+        if e.is_Symbol:
+            if e not in syms:
+                syms.append(e)
+            return f"p[{syms.index(e)}]"
+        if e.is_Rational:
+            consts.append(Fraction(int(e.p), int(e.q)))
+            return f"c[{len(consts) - 1}]"
+        if e.is_Add or e.is_Mul:
+            return "(" + (" + " if e.is_Add else " * ").join(src(a) for a in e.args) + ")"
+        if e.is_Pow and e.exp.is_Integer:
+            return f"({src(e.base)} ** {int(e.exp)})"
+        raise _NotRational
+
+    try:
+        fn = eval(f"lambda p, c: {src(expr)}")  # noqa: S307 - built above from the tree
+    except (_NotRational, SyntaxError, RecursionError, MemoryError):
+        return None
+
+    def value(point):
+        try:
+            return fn([Fraction(int(point[s].p), int(point[s].q)) for s in syms], consts)
+        except ZeroDivisionError:
+            return None
+    return value
+
+
 def _closed(selection: str) -> dict:
-    return closed_form(selection)
+    return closed_form_once(selection)
 
 
 @lru_cache(maxsize=None)
