@@ -224,3 +224,19 @@ def test_linear_factorization_is_sympys_factor():
     for e in cases:
         want, got = sp.factor(e), audit_tracker._factor_linear(e)
         assert sp.srepr(got) == sp.srepr(want) and str(got) == str(want), e
+
+
+def test_exact_point_evaluation_is_sympys():
+    """The random-point identity's evaluation in fractions gives sympy's exact value; a zero
+    denominator and a non-rational expression are left to sympy (None)."""
+    import sympy as sp
+
+    x, y, C = audit_tracker.S("x_P"), audit_tracker.S("y_P"), audit_tracker.C
+    e = (3 * x ** 2 - y / 7) / (x - 2 * y) + sp.Rational(5, 3) * x * y ** -2
+    value = audit_tracker._exact_evaluator(e)
+    for px, py in ((sp.Rational(-91, 13), sp.Rational(44, 101)), (sp.Integer(3), sp.Integer(5))):
+        got = value({x: px, y: py})
+        assert sp.Rational(got.numerator, got.denominator) == e.xreplace({x: px, y: py})
+    assert value({x: sp.Integer(2), y: sp.Integer(1)}) is None     # x - 2 y = 0
+    assert audit_tracker._exact_evaluator(sp.cos(C) * x) is None
+    assert audit_tracker._exact_evaluator(sp.Float(0.5) * x) is None
