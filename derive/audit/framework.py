@@ -383,7 +383,16 @@ def is_zero(expr) -> bool:
 
 
 def fmt(expr) -> str:
-    """A compact string of an expression (symbols print as the paper writes them)."""
+    """A compact string of an expression (symbols print as the paper writes them); an
+    expression is printed once per process (the evidence quotes the same ones again)."""
+    if isinstance(expr, sp.Basic):
+        return _fmt_basic(expr)
+    return sp.sstr(expr, order="lex")
+
+
+@lru_cache(maxsize=None)
+def _fmt_basic(expr) -> str:
+    # only sympy objects: equal ones (structurally) print alike, unlike 1 and 1.0
     return sp.sstr(expr, order="lex")
 
 

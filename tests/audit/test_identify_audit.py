@@ -240,3 +240,14 @@ def test_exact_point_evaluation_is_sympys():
     assert value({x: sp.Integer(2), y: sp.Integer(1)}) is None     # x - 2 y = 0
     assert audit_tracker._exact_evaluator(sp.cos(C) * x) is None
     assert audit_tracker._exact_evaluator(sp.Float(0.5) * x) is None
+
+
+def test_hat_is_the_simultaneous_substitution():
+    """``_hat`` (a renaming by ``xreplace``) gives what ``subs(..., simultaneous=True)`` gives."""
+    import sympy as sp
+
+    S = audit_tracker.S
+    m = {S(f"{c}_{lab}"): S(f"{c}h_{lab}") for lab in "PQK" for c in "xy"}
+    for e in (audit_tracker._closed("x")["EB"], audit_tracker._closed("x")["N"],
+              S("x_P") ** 2 * S("y_Q") / (S("x_P") - 3 * S("y_K")) + sp.cos(S("x_Q"))):
+        assert sp.srepr(audit_tracker._hat(e)) == sp.srepr(e.subs(m, simultaneous=True))
