@@ -161,6 +161,14 @@ def closed_form(selection: str) -> dict:
     return out
 
 
+@functools.lru_cache(maxsize=None)
+def closed_form_once(selection: str) -> dict:
+    """:func:`closed_form` derived once per process and shared by its readers (the audits of
+    the thesis' equations and of its scripts solve the same selections); the dict is shared:
+    read it, never change it."""
+    return closed_form(selection)
+
+
 def _args(selection: str) -> list[str]:
     pts = [str(s) for lab in ("P", "Q", "K") for s in point_symbols(lab)]
     ds = [str(delta_symbols(lab)[COORDS.index(c)]) for lab, c in SELECTIONS[selection]]

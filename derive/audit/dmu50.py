@@ -34,7 +34,7 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from .framework import RECURRENCE_UNSHOWN, TYPICAL, Verdict, fmt
+from .framework import RECURRENCE_UNSHOWN, TYPICAL, Verdict, fmt, is_zero, simplified
 from ..inverse import BRANCH, TIP, TOOL_AXIS, linear_inverse, rotary_inverse
 from ..kinematics import Chain, position_symbol, rotation, translation
 from ..volumetric import nominal_point, nominal_tool_axis, volumetric_error
@@ -51,7 +51,9 @@ _LOCALS = {"X": X, "Y": Y, "Z": Z, "B": B, "C": C, "d": D, "a": A_SYM,
            **{str(s): s for s in TIP + TOOL_AXIS}}
 
 
+@functools.lru_cache(maxsize=None)
 def _parse(text: str):
+    """A printed entry -> sympy, once per text (the matrices repeat their entries)."""
     return sp.sympify(text, locals=_LOCALS)
 
 
@@ -255,12 +257,11 @@ def _rows_note(rows, derived: sp.Matrix) -> tuple[int, list[str]]:
     (number of rows, ['row [...] lost', 'the row [...] twice', 'its row 1 with 5 entries']).
     A printed row stands for a derived row when its first entries equal it, up to the signs
     (a sign defect is no row defect); exact matches are paired first."""
-    parsed = [[sp.simplify(_parse(c)) for c in r] for r in rows]
-    drows = [[sp.simplify(derived[i, j]) for j in range(derived.cols)]
+    parsed = [[simplified(_parse(c)) for c in r] for r in rows]
+    drows = [[simplified(derived[i, j]) for j in range(derived.cols)]
              for i in range(derived.rows)]
     free, left = list(range(len(drows))), list(range(len(parsed)))
-    for test in (lambda u, v: sp.simplify(u - v) == 0,
-                 lambda u, v: sp.simplify(u ** 2 - v ** 2) == 0):
+    for test in (lambda u, v: is_zero(u - v), lambda u, v: is_zero(u ** 2 - v ** 2)):
         for k in list(left):
             hit = next((i for i in free if len(parsed[k]) >= len(drows[i])
                         and all(test(u, v) for u, v in zip(parsed[k], drows[i]))), None)
@@ -356,20 +357,20 @@ DERIVED_ORDER = ["T_w^5", "T_5^4", "T_4^3", "T_3^2", "T_2^1", "T_1^0", "T_0^t"]
 # ------------------------------------------------------------------------------ comparisons
 def _matrix_diff(printed_rows, derived: sp.Matrix) -> tuple[bool, str, str]:
     """(same, erratum, evidence) of a printed matrix (list of rows) against ``derived``."""
-    rows = [[sp.simplify(_parse(c)) for c in r] for r in printed_rows]
-    drows = [[sp.simplify(derived[i, j]) for j in range(derived.cols)] for i in range(derived.rows)]
+    rows = [[simplified(_parse(c)) for c in r] for r in printed_rows]
+    drows = [[simplified(derived[i, j]) for j in range(derived.cols)] for i in range(derived.rows)]
 
     def eq(r1, r2):
-        return len(r1) == len(r2) and all(sp.simplify(a - b) == 0 for a, b in zip(r1, r2))
+        return len(r1) == len(r2) and all(is_zero(a - b) for a, b in zip(r1, r2))
 
     if len(rows) == len(drows) and all(len(r) == len(d) for r, d in zip(rows, drows)):
         bad = [(i, j) for i in range(len(rows)) for j in range(len(rows[i]))
-               if sp.simplify(rows[i][j] - drows[i][j]) != 0]
+               if not is_zero(rows[i][j] - drows[i][j])]
         if not bad:
             return True, "", "all 16 entries agree with the derived factor"
         desc = "; ".join(f"entry ({i + 1},{j + 1}): printed {fmt(rows[i][j])}, derived "
                          f"{fmt(drows[i][j])}" for i, j in bad)
-        kind = "sign error" if all(sp.simplify(rows[i][j] + drows[i][j]) == 0 for i, j in bad) \
+        kind = "sign error" if all(is_zero(rows[i][j] + drows[i][j]) for i, j in bad) \
             else "wrong entries"
         m = sp.Matrix(rows)
         extra = ""

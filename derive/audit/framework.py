@@ -39,6 +39,7 @@ term-by-term comparison of two polynomials (:func:`term_diff`, :func:`describe_d
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from functools import lru_cache
 
 import sympy as sp
 
@@ -367,8 +368,31 @@ def n_issues(expected, printed) -> int:
     return sum(len(v) for v in term_diff(expected, printed).values())
 
 
+@lru_cache(maxsize=None)
+def simplified(expr):
+    """``sp.simplify(expr)``, once per expression and process (the matrices of the audits
+    compare the same entries again and again; simplify is a pure function of the
+    expression, which is immutable)."""
+    return sp.simplify(expr)
+
+
+def is_zero(expr) -> bool:
+    """``sp.simplify(expr) == 0``: an expression built as 0 needs no simplification (the usual
+    case: two equal entries), anything else is :func:`simplified`."""
+    return expr == 0 or simplified(expr) == 0
+
+
 def fmt(expr) -> str:
-    """A compact string of an expression (symbols print as the paper writes them)."""
+    """A compact string of an expression (symbols print as the paper writes them); an
+    expression is printed once per process (the evidence quotes the same ones again)."""
+    if isinstance(expr, sp.Basic):
+        return _fmt_basic(expr)
+    return sp.sstr(expr, order="lex")
+
+
+@lru_cache(maxsize=None)
+def _fmt_basic(expr) -> str:
+    # only sympy objects: equal ones (structurally) print alike, unlike 1 and 1.0
     return sp.sstr(expr, order="lex")
 
 

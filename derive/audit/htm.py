@@ -32,7 +32,7 @@ import sympy as sp
 
 from volerr.machine.layout import read_layout
 
-from .framework import Verdict, category_of, fmt, worst_case_um
+from .framework import Verdict, category_of, fmt, is_zero, worst_case_um
 from .dmu50 import (T22_UNDECIDED, T23_CROSS_COPY, derived_factors, derived_forward,
                           forward_note, forward_tried, t23_forward)
 from ..kinematics import Chain, position_symbol, rotation, stage_factors, translation
@@ -61,7 +61,9 @@ SQUARENESS = {"EC0XY": ("EC0Y", "E_C(0X)Y", "eq. 3.11 n_X = [cos E, sin E, 0]: X
                         "leans toward +Y")}
 
 
+@functools.lru_cache(maxsize=None)
 def _parse(text: str):
+    """A printed entry -> sympy, once per text (the matrices repeat their entries)."""
     return sp.sympify(text, locals=_LOC)
 
 
@@ -82,7 +84,7 @@ def _v(item, comp, category, erratum, evidence, printed, derived, tried=(), used
 def _entries(p: sp.Matrix, d: sp.Matrix) -> list[str]:
     return [f"({i + 1},{j + 1}) printed {fmt(p[i, j])}, derived {fmt(d[i, j])}"
             for i in range(d.rows) for j in range(d.cols)
-            if sp.simplify(p[i, j] - d[i, j]) != 0]
+            if not is_zero(p[i, j] - d[i, j])]
 
 
 @functools.lru_cache(maxsize=1)
@@ -408,7 +410,7 @@ def audit_rotary(item: dict) -> Verdict:
     htm = _small(e, t) * rz
     no_error = {s_: 0 for s_ in (*e, *t)}
     missing = [(i + 1, j + 1) for i in range(3) for j in range(3)
-               if sp.simplify(printed[i, j].subs(no_error) - rz[i, j]) != 0]
+               if not is_zero(printed[i, j].subs(no_error) - rz[i, j])]
     n_htm = len(_entries(printed, htm))
     return _v(item, "", "printing_error", f"{len(bad)} entries differ from (T_EB - I) Rz(B)",
               "derived (T_EB - I) Rz(B), first order (the squareness neglected as stated): "

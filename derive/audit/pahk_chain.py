@@ -22,7 +22,7 @@ import sympy as sp
 
 from .framework import (TYPICAL, Verdict, best_combination, category_of, classify,
                     describe_diff, fmt, is_identical, n_diff, typical_text, worst_case_um)
-from .pahk_model import (COMPONENTS, POS, derived_error, error_symbols, layout,
+from .pahk_model import (COMPONENTS, POS, derived_error, error_symbols, is_paper, layout,
                                parse, printed_component, readings)
 from .pahk_rules import CONVENTION_TABLE, _bounds
 from ..kinematics import PROBE
@@ -30,8 +30,12 @@ from ..kinematics import PROBE
 SOURCE = "Pahk 1995"
 
 
+#: the error symbols of the small-angle rotations Tx, Ty, Tz (:func:`_T`)
+_T_SYMS = {k: tuple(sp.Symbol(f"E{c}({k.upper()})", real=True) for c in "xyz") for k in "xyz"}
+
+
 def _T(axis: str) -> sp.Matrix:
-    ex, ey, ez = (sp.Symbol(f"E{c}({axis})", real=True) for c in "xyz")
+    ex, ey, ez = _T_SYMS[axis.lower()]
     return sp.Matrix([[1, -ez, ey], [ez, 1, -ex], [-ey, ex, 1]])
 
 
@@ -110,7 +114,31 @@ def _split_key(key: tuple) -> dict:
 
 def chain_error(lhs: str, rhs: str, L: dict) -> list:
     """First-order (dX, dY, dZ) implied by a printed chain ``lhs = rhs``: with f = lhs - rhs
-    affine in A, nominal A0 solves f0(A0) = 0 and A1 = -J0^-1 f1(A0)."""
+    affine in A, nominal A0 solves f0(A0) = 0 and A1 = -J0^-1 f1(A0).  Each chain is
+    evaluated once per process (the readings of the layouts repeat chains: 115 calls, 61
+    chains); a chain that cannot be evaluated raises each time."""
+    try:
+        key = (lhs, rhs, tuple(tuple(L[k]) for k in "xyz"))
+        hash(key)
+    except TypeError:             # entries that cannot be a key: evaluated as they are
+        return _chain_error(lhs, rhs, L)
+    return list(_chain_error_key(key))
+
+
+@lru_cache(maxsize=None)
+def _chain_error_key(key: tuple) -> tuple:
+    lhs, rhs, vectors = key
+    return tuple(_chain_error(lhs, rhs, dict(zip("xyz", vectors))))
+
+
+def _chain_error(lhs: str, rhs: str, L: dict) -> list:
+    """:func:`chain_error` computed in a polynomial ring (:func:`_chain_error_ring`), else
+    (or to raise its error) with sympy matrices of expressions."""
+    fast = _chain_error_ring(lhs, rhs, L)
+    return fast if fast is not None else _chain_error_sympy(lhs, rhs, L)
+
+
+def _chain_error_sympy(lhs: str, rhs: str, L: dict) -> list:
     names = {"T" + k: _Dual(sp.eye(3), _T(k.upper()) - sp.eye(3)) for k in "xyz"}
     names.update(_split_vectors(L))
     names["P"] = _Dual(sp.Matrix(PROBE), sp.zeros(3, 1))
@@ -125,6 +153,103 @@ def chain_error(lhs: str, rhs: str, L: dict) -> list:
     if any(sp.expand(a0[i] - nominal[i]) != 0 for i in range(3)):
         raise ValueError(f"chain {lhs} = {rhs}: nominal point is not (X + Xp, Y + Yp, Z + Zp)")
     return [sp.expand(a1[i]) for i in range(3)]
+
+
+class _RDual(_Dual):
+    """:class:`_Dual` of 3 x 3 or 3 x 1 matrices (lists of rows) of polynomial-ring elements;
+    a shape mismatch raises :class:`_NotRing` (sympy then raises its own error)."""
+
+    def __add__(self, o):
+        return _RDual(_madd(self.nom, o.nom, 1), _madd(self.eps, o.eps, 1))
+
+    def __sub__(self, o):
+        return _RDual(_madd(self.nom, o.nom, -1), _madd(self.eps, o.eps, -1))
+
+    def __neg__(self):
+        return _RDual([[-x for x in r] for r in self.nom], [[-x for x in r] for r in self.eps])
+
+    def __mul__(self, o):
+        return _RDual(_mmul(self.nom, o.nom),
+                      _madd(_mmul(self.nom, o.eps), _mmul(self.eps, o.nom), 1))
+
+
+class _NotRing(Exception):
+    pass
+
+
+def _madd(a, b, sign):
+    if len(a) != len(b) or len(a[0]) != len(b[0]):
+        raise _NotRing
+    return [[x + y if sign > 0 else x - y for x, y in zip(r, s)] for r, s in zip(a, b)]
+
+
+def _mmul(a, b):
+    if len(a[0]) != len(b):
+        raise _NotRing
+    return [[sum((a[i][k] * b[k][j] for k in range(len(b))), a[0][0].ring.zero)
+             for j in range(len(b[0]))] for i in range(len(a))]
+
+
+def _chain_error_ring(lhs: str, rhs: str, L: dict) -> list | None:
+    """The first-order error of :func:`chain_error` with every matrix entry an element of
+    one polynomial ring over QQ (sympy's sparse polynomials: the same exact arithmetic as
+    expanded expressions, without rebuilding expressions at each product); the expanded
+    result is the same expression.  None where that does not apply (a vector that is no
+    polynomial, a nominal Jacobian that is not constant, any error: sympy decides)."""
+    try:
+        vecs = _vectors(L)
+        gens = set(A_SYMS) | set(PROBE) | set(POS.values()) | set().union(*_T_SYMS.values())
+        for m in vecs.values():
+            gens |= m.free_symbols
+        R, g = _ring(tuple(sorted(gens, key=str)))
+        one, zero = R.one, R.zero
+        eye = [[one if i == j else zero for j in range(3)] for i in range(3)]
+        names = {}
+        for k in "xyz":
+            ex, ey, ez = (g[s] for s in _T_SYMS[k])
+            names["T" + k] = _RDual(eye, [[zero, -ez, ey], [ez, zero, -ex], [-ey, ex, zero]])
+        for k, v in vecs.items():
+            names[k] = _ring_split(R, tuple(v))
+        col = lambda v: [[g[s]] for s in v]               # noqa: E731
+        names["P"] = _RDual(col(PROBE), [[zero]] * 3)
+        names["A"] = _RDual(col(A_SYMS), [[zero]] * 3)
+        f = _evaluate(lhs, names) - _evaluate(rhs, names)
+        J0 = [f.nom[i][0].diff(g[a]) for i in range(3) for a in A_SYMS]
+        if not all(x.is_ground for x in J0):
+            return None
+        J0i = sp.Matrix(3, 3, [R.domain.to_sympy(x.LC) for x in J0]).inv()
+        J0i = [[R.ground_new(R.domain.from_sympy(J0i[i, k])) for k in range(3)]
+               for i in range(3)]
+        c0 = [f.nom[i][0].compose([(g[a], zero) for a in A_SYMS]) for i in range(3)]
+        a0 = [-sum((J0i[i][k] * c0[k] for k in range(3)), zero) for i in range(3)]
+        nominal = [g[POS[k]] + g[PROBE[i]] for i, k in enumerate("XYZ")]
+        off = any(a0[i] != nominal[i] for i in range(3))
+        if not off:
+            e1 = [f.eps[i][0].compose([(g[a], x) for a, x in zip(A_SYMS, a0)])
+                  for i in range(3)]
+            a1 = [-sum((J0i[i][k] * e1[k] for k in range(3)), zero) for i in range(3)]
+            return [sp.expand(x.as_expr()) for x in a1]
+    except Exception:  # noqa: BLE001 - sympy's path raises the error the caller expects
+        return None
+    # the same exact a0 as sympy's: its check fails the same way, with the same message
+    raise ValueError(f"chain {lhs} = {rhs}: nominal point is not (X + Xp, Y + Yp, Z + Zp)")
+
+
+@lru_cache(maxsize=None)
+def _ring(gens: tuple):
+    """(ring over QQ, {symbol: generator}) of a chain's symbols."""
+    R, *g = sp.ring(gens, sp.QQ)
+    return R, dict(zip(gens, g))
+
+
+@lru_cache(maxsize=None)
+def _ring_split(R, vector: tuple) -> _RDual:
+    """A vector as :func:`_split` splits it, in the ring ``R`` (nominal part: the terms free
+    of error symbols); never changed in place."""
+    errs = [i for i, s in enumerate(R.symbols) if is_paper(s)]
+    full = [[R(e)] for e in vector]
+    nom = [[R({m: c for m, c in x.terms() if not any(m[i] for i in errs)})] for (x,) in full]
+    return _RDual(nom, _madd(full, nom, -1))
 
 
 def _relabel(text: str, tmap: dict, lmap: dict) -> str:

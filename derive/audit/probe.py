@@ -25,7 +25,7 @@ import numpy as np
 import sympy as sp
 
 from .. import probe as d
-from .framework import Verdict, fmt
+from .framework import Verdict, fmt, is_zero
 
 DATA_FILE = "printed_probe.toml"
 SOURCE = "Pahk 1995"
@@ -55,8 +55,9 @@ def _v(eq, same, erratum, evidence, printed, derived, component="",
 
 
 def _zero(m) -> bool:
-    return sp.simplify(m) == sp.zeros(*m.shape) if hasattr(m, "shape") else \
-        sp.simplify(m) == 0
+    """``simplify(m) == 0`` (a matrix: entry by entry, as sympy simplifies one), each entry
+    built as 0 taken as it is (:func:`framework.is_zero`)."""
+    return all(is_zero(x) for x in m) if hasattr(m, "shape") else is_zero(m)
 
 
 def _by_id(printed: dict) -> dict:

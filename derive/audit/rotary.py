@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .framework import RECURRENCE_UNSHOWN, Verdict, fmt
+from .framework import RECURRENCE_UNSHOWN, Verdict, fmt, is_zero
 
 DATA_FILE = "printed_rotary.toml"
 LAYOUTS = ("DMU50",)
@@ -72,7 +72,7 @@ def _entries(printed: sp.Matrix, derived: sp.Matrix) -> list[str]:
     return [f"entry ({i + 1},{j + 1}): printed {fmt(printed[i, j])}, derived "
             f"{fmt(derived[i, j])}"
             for i in range(derived.rows) for j in range(derived.cols)
-            if sp.simplify(printed[i, j] - derived[i, j]) != 0]
+            if not is_zero(printed[i, j] - derived[i, j])]
 
 
 # ------------------------------------------------------------------------------ linear axis

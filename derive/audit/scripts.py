@@ -19,19 +19,13 @@ legible.  The authority:
 
 from __future__ import annotations
 
-import functools
 import itertools
 
 import numpy as np
 import sympy as sp
 
 from .framework import Verdict, category_of, fmt
-from ..three_point import closed_form as _closed_form
-
-
-@functools.lru_cache(maxsize=None)
-def closed_form(selection: str) -> dict:
-    return _closed_form(selection)
+from ..three_point import closed_form_once as closed_form
 
 DATA_FILE = "printed_scripts.toml"
 LAYOUTS = ("DMU50",)
@@ -152,6 +146,23 @@ def _unit_factor_verdict(c1: dict, name: str, factor: str, unit: str) -> Verdict
     return out[0]
 
 
+def _cofactor(sol, d, N):
+    """``expand(cancel(diff(sol, d) * N))``: the cofactor of the deviation ``d`` in a closed
+    form ``sol`` = numerator / denominator over the determinant ``N``.  Where the denominator
+    divides N times the numerator's derivative (Cramer's rule: always), the quotient is
+    computed exactly in a polynomial ring and is the same expanded expression; else sympy's."""
+    num, den = sol.as_numer_denom()
+    gens = tuple(sorted(num.free_symbols | den.free_symbols | N.free_symbols | {d}, key=str))
+    try:
+        R, *_ = sp.ring(gens, sp.QQ)
+        q, r = divmod(R(num).diff(R(d)) * R(N), R(den))
+    except Exception:  # noqa: BLE001 - not polynomials: sympy decides
+        r = None
+    if r is None or r != 0:
+        return sp.expand(sp.cancel(sp.diff(sol, d) * N))
+    return sp.expand(q.as_expr())
+
+
 def audit_c1(c1: dict) -> list[Verdict]:
     loc = _c1_locals("x")
     cf = closed_form("x")
@@ -164,7 +175,7 @@ def audit_c1(c1: dict) -> list[Verdict]:
     out = []
     for name, motion in MOTIONS.items():
         sol = cf[motion]
-        cof = {d: sp.expand(sp.cancel(sp.diff(sol, d) * N)) * n_sign for d in devs}
+        cof = {d: _cofactor(sol, d, N) * n_sign for d in devs}
         terms = [t for t in c1.get("term", []) if t["formula"] == name]
         damaged = [d["what"] for d in c1.get("damaged", []) if d["formula"] == name]
         checked, bad = _c1_terms(terms, cof, devs, by_dev, loc)

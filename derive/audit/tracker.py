@@ -35,7 +35,7 @@ from functools import lru_cache
 import sympy as sp
 
 from .framework import RECURRENCE_UNSHOWN, Verdict, describe_diff, fmt
-from ..three_point import (COORDS, MOTIONS, SELECTIONS, closed_form, point_displacement,
+from ..three_point import (COORDS, MOTIONS, SELECTIONS, closed_form_once, point_displacement,
                           point_symbols, rotated_lever_arm, system)
 
 SOURCE = "Ellingsdalen 2021"
@@ -68,8 +68,11 @@ def _locals(axis: str) -> dict:
     return loc
 
 
+@lru_cache(maxsize=None)
 def parse(text: str, axis: str) -> sp.Expr:
-    """A printed expression in the data file's notation -> sympy (ValueError if garbled)."""
+    """A printed expression in the data file's notation -> sympy (ValueError if garbled);
+    each text parsed once per process (the checks and readings parse the same entries
+    again; the expression is immutable)."""
     loc = _locals(axis)
     try:
         expr = sp.parse_expr(text, local_dict=loc)
@@ -82,9 +85,10 @@ def parse(text: str, axis: str) -> sp.Expr:
 
 
 def _hat(expr):
-    """Lever-arm symbols x_P, y_P -> the rotated ones xh_P, yh_P (z unchanged)."""
-    return expr.subs({S(f"{c}_{lab}"): S(f"{c}h_{lab}") for lab in LABELS for c in "xy"},
-                     simultaneous=True)
+    """Lever-arm symbols x_P, y_P -> the rotated ones xh_P, yh_P (z unchanged): a renaming of
+    symbols, so ``xreplace`` (what ``subs(..., simultaneous=True)`` ends in, without its
+    detour through dummy products; the same expressions, checked on every closed form)."""
+    return expr.xreplace({S(f"{c}_{lab}"): S(f"{c}h_{lab}") for lab in LABELS for c in "xy"})
 
 
 def _motion_map(axis: str) -> dict:
@@ -118,11 +122,14 @@ def _equal(a, b, n: int = 8) -> bool:
     (Schwartz-Zippel: for the low-degree polynomials here a false "identical" has probability
     far below 1e-20); points where a denominator vanishes are skipped."""
     d = a - b
+    exact = _exact_evaluator(d)
     hits = 0
     for point in _samples(d.free_symbols, 3 * n):
-        v = d.xreplace(point)
-        if v.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
-            continue
+        v = exact(point) if exact is not None else None
+        if v is None:                     # not a rational function, or a zero denominator
+            v = d.xreplace(point)
+            if v.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+                continue
         if v != 0:
             return False
         hits += 1
@@ -131,9 +138,50 @@ def _equal(a, b, n: int = 8) -> bool:
     return False
 
 
-@lru_cache(maxsize=None)
+class _NotRational(Exception):
+    pass
+
+
+def _exact_evaluator(expr):
+    """``point -> value`` of a rational function with rational coefficients, evaluated exactly
+    in Python fractions (the same value as ``expr.xreplace(point)``, which rebuilds the whole
+    expression in sympy at each point), None at a point where a denominator vanishes (sympy
+    is asked there); None instead of a function for anything else (floats, functions, I).
+    ``point``: {symbol: sympy Rational}."""
+    from fractions import Fraction
+
+    consts: list = []
+    syms: list = []
+
+    def src(e) -> str:
+        if e.is_Symbol:
+            if e not in syms:
+                syms.append(e)
+            return f"p[{syms.index(e)}]"
+        if e.is_Rational:
+            consts.append(Fraction(int(e.p), int(e.q)))
+            return f"c[{len(consts) - 1}]"
+        if e.is_Add or e.is_Mul:
+            return "(" + (" + " if e.is_Add else " * ").join(src(a) for a in e.args) + ")"
+        if e.is_Pow and e.exp.is_Integer:
+            return f"({src(e.base)} ** {int(e.exp)})"
+        raise _NotRational
+
+    try:
+        fn = eval(f"lambda p, c: {src(expr)}")  # noqa: S307 - built above from the tree
+    except (_NotRational, SyntaxError, RecursionError, MemoryError):
+        return None
+
+    def value(point):
+        try:
+            return fn([Fraction(int(point[s].p), int(point[s].q)) for s in syms], consts)
+        except ZeroDivisionError:
+            return None
+    return value
+
+
 def _closed(selection: str) -> dict:
-    return closed_form(selection)
+    return closed_form_once(selection)
 
 
 @lru_cache(maxsize=None)
@@ -141,8 +189,93 @@ def _factored(expr: sp.Expr) -> sp.Expr:
     """``sp.factor(expr)``, computed once per expression: a closed form's derived solution is
     factored for its evidence and again for its verdict, and a denominator's is the closed
     form's of the same selection (factor is a pure function of the expression; the verdicts'
-    text is unchanged)."""
-    return sp.factor(expr)
+    text is unchanged).
+
+    The factorization is sympy's, term for term (:func:`_factor_linear`): the same
+    irreducible factors, each with a positive leading coefficient, the same coefficient and
+    the same expression built from them."""
+    return _factor_linear(expr)
+
+
+#: the lever arms (mm): the symbols a closed form's numerator is not linear in
+_LEVERS = frozenset(S(f"{c}{pre}_{lab}") for lab in LABELS for c in COORDS for pre in ("", "h"))
+
+
+def _factor_linear(expr: sp.Expr) -> sp.Expr:
+    """``sp.factor(expr)`` for a quotient of polynomials whose numerator is of degree at most
+    one in the symbols other than the lever arms (a Cramer's-rule solution is linear in the
+    right-hand side: the deviations, or the measured positions and offsets they stand for).
+
+    Such a polynomial is its content (the gcd of its coefficients as polynomials in the lever
+    arms, factored by sympy) times a primitive part of degree one in the other symbols, which
+    is irreducible (a factorization would give one factor of degree zero in them, a common
+    divisor of the coefficients).  Sympy proves the same irreducibility with Wang's algorithm
+    at many times the cost; the factors are normalized as sympy's (primitive, positive leading
+    coefficient in the generators' order) and multiplied as in ``sympy.factor``.  The factors
+    of a product are those of its polynomial factors (sympy's ``together`` first is not needed:
+    irreducible factors so normalized are unique).  Anything else (a non-integer power, a
+    non-polynomial factor, rational coefficients, degree two) is left to ``sp.factor``."""
+    from sympy.core.exprtools import _keep_coeff
+
+    coeff, factors = sp.S.One, {}
+    for arg in sp.Mul.make_args(expr):   # factors of a product: those of its factors
+        if arg.is_Rational:
+            coeff *= arg
+            continue
+        base, exp = arg.as_base_exp() if arg.is_Pow else (arg, sp.S.One)
+        poly = sp.Poly(base) if exp.is_Integer and not base.is_Number else None
+        listed = _factor_list_linear(poly) if poly is not None and all(
+            g.is_Symbol for g in poly.gens) else None
+        if listed is None:
+            return sp.factor(expr)
+        c, fs = listed
+        coeff *= c ** exp
+        for f, k in fs:
+            factors[f] = factors.get(f, 0) + k * exp
+    return _keep_coeff(coeff, sp.Mul(*[f.as_expr() ** k for f, k in factors.items()]))
+
+
+def _factor_list_linear(p: sp.Poly):
+    """``p.factor_list()`` (coefficient, [(Poly, multiplicity)]) when ``p`` is over ZZ and
+    of degree at most one in its non-lever-arm generators, else None (see
+    :func:`_factor_linear`).  A polynomial of lever arms alone (a denominator) is sympy's."""
+    if p.domain != sp.ZZ:
+        return None
+    lin = [i for i, g in enumerate(p.gens) if g not in _LEVERS]
+    if not lin:
+        return _lever_factor_list(p)
+    parts: dict = {}
+    for monom, c in p.terms():
+        if sum(monom[i] for i in lin) > 1:
+            return None
+        key = tuple(monom[i] for i in lin)
+        rest = tuple(0 if i in lin else e for i, e in enumerate(monom))
+        parts.setdefault(key, {})[rest] = c
+    R = sp.ring(p.gens, sp.ZZ)[0]       # sparse: gcds far cheaper than the dense Poly's
+    content = None
+    for terms in sorted(parts.values(), key=len):
+        q = R.from_dict(terms)
+        content = q if content is None else content.gcd(q)
+        if content.is_ground:
+            break
+    if content.is_ground:                # the usual case: the primitive part is p itself
+        c0, fs, rest = sp.S.One, [], p
+    else:
+        content = sp.Poly.from_dict(dict(content.items()), *p.gens, domain=sp.ZZ)
+        (c0, fs), rest = content.factor_list(), p.exquo(content)
+    c1, prim = rest.primitive()
+    if prim.LC() < 0:
+        c1, prim = -c1, -prim
+    if not prim.is_ground:
+        fs = fs + [(prim, 1)]
+    return c0 * c1, fs
+
+
+@lru_cache(maxsize=None)
+def _lever_factor_list(p: sp.Poly):
+    """``p.factor_list()``, once per polynomial: the six motions of a selection share their
+    denominator."""
+    return p.factor_list()
 
 
 #: the extraction's demonstrated repetitions and losses within one image (quoted by verdicts)

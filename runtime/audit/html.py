@@ -14,6 +14,7 @@ preformatted text.  All links are relative (``#anchors``).  sympy is imported in
 
 from __future__ import annotations
 
+import functools
 import html
 import re
 
@@ -31,8 +32,10 @@ def _anchor(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "-", text).strip("-").lower() or "x"
 
 
+@functools.lru_cache(maxsize=4096)
 def math_html(text: str) -> str:
-    """Presentation MathML of an expression string, or escaped preformatted text."""
+    """Presentation MathML of an expression string, or escaped preformatted text (once per
+    text: verdicts repeat their printed and derived forms)."""
     if not text:
         return ""
     if len(text) <= _MAX_MATH and _PLAIN.match(text):

@@ -731,3 +731,29 @@ def test_a6_dy_x_is_the_lone_outlier_of_its_rule(verdicts):
     assert (f"All {len(others)} other layouts print 'dy(X) = {next(iter(others.values()))}'"
             in v.evidence and "lone outlier" in v.evidence)
     assert [w for w in verdicts if "lone outlier" in w.evidence] == [v]
+
+
+def test_chain_in_the_polynomial_ring_is_the_sympy_chain():
+    """The chains' first-order error computed in a polynomial ring is the sympy-matrix result,
+    expression for expression; a relabelled chain whose nominal point is wrong raises the
+    same error; what the ring cannot take (a damaged vector) is left to sympy."""
+    import sympy as sp
+
+    from volerr.derive.audit import pahk_chain
+
+    by_id = {e["id"]: e for e in DATA["equation"]}
+    seen = {"result": 0, "raised": 0}
+    for eq in [e for e in DATA["equation"] if e["id"] in ("1", "A1")]:
+        L, _, _ = pahk_chain.chain_vectors(eq, by_id)
+        for _, lhs, rhs, LL, _ in pahk_chain.chain_readings(eq, L)[::5]:
+            outcome = []
+            for f in (pahk_chain._chain_error_ring, pahk_chain._chain_error_sympy):
+                try:
+                    outcome.append([sp.srepr(x) for x in f(lhs, rhs, LL)])
+                except ValueError as exc:
+                    outcome.append(str(exc))
+            assert outcome[0] == outcome[1], (lhs, rhs)
+            seen["raised" if isinstance(outcome[0], str) else "result"] += 1
+    assert seen["result"] and seen["raised"]
+    bad = {"x": ["X +", "0", "0"], "y": ["0", "Y", "0"], "z": ["0", "0", "Z"]}
+    assert pahk_chain._chain_error_ring("A", "Lx + Ly + Lz", bad) is None

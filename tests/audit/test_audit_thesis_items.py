@@ -614,3 +614,18 @@ def test_rodrigues_inputs_and_figure_3_11_table_cells(ch2):
     assert all(len(r) == 3 for r in comp)
     assert find(vs, "Figure 3.11", "homogeneous column").category == "undecidable"
     assert find(vs, "sec. 4.2.1: E_YX 6.6 -> 1.3 um", "values").category == "undecidable"
+
+
+def test_cofactor_by_exact_division_is_sympys():
+    """The cofactors of appendix C.1's check (a quotient in a polynomial ring) are
+    ``expand(cancel(diff(sol, d) * N))`` expression for expression; a denominator that does not
+    divide is left to sympy."""
+    cf = audit_scripts.closed_form("x")
+    N = sp.expand(cf["N"])
+    devs = list(audit_scripts._deviations())
+    for motion, d in (("EX", devs[0]), ("EB", devs[3]), ("EC", devs[5])):
+        want = sp.expand(sp.cancel(sp.diff(cf[motion], d) * N))
+        assert sp.srepr(audit_scripts._cofactor(cf[motion], d, N)) == sp.srepr(want)
+    x, y = sp.symbols("x y")
+    assert audit_scripts._cofactor(x ** 2 / (x + y), x, y) == sp.expand(
+        sp.cancel(sp.diff(x ** 2 / (x + y), x) * y))

@@ -201,3 +201,53 @@ def test_lost_minus_of_n_cites_the_x_axis_formula_and_d1(verdicts):
         assert "the same formula for the X axis (x_x symbols)" in v.evidence
         assert "the same determinant" not in v.evidence
         assert "appendix D.1" in v.evidence and "Neither separates" in v.evidence
+
+
+def test_linear_factorization_is_sympys_factor():
+    """The closed forms' factorization (content times an irreducible part linear in the
+    deviations) is ``sp.factor``'s expression itself, structure and all, and falls back to
+    ``sp.factor`` outside its case."""
+    import sympy as sp
+
+    S = audit_tracker.S
+    xP, xQ, xK, yP, yK, zQ = (S(n) for n in ("x_P", "x_Q", "x_K", "y_P", "y_K", "z_Q"))
+    dxP, dyK, xo, xmP = (S(n) for n in ("d_xP", "d_yK", "x_o", "xm_P"))
+    det = audit_tracker._closed("z")       # the audit's own (cached) closed forms
+    cases = [
+        (xP - xQ) * (dxP * yK - dyK * zQ) / (xK * yP - xP * yK),       # a lever-arm content
+        -2 * (xQ - xP) ** 2 * (dxP * xK + dyK * zQ + 3 * xo) / (yK - yP) ** 2,
+        (dxP * (xmP - xP - xo) + yK) / (xK - xQ),                       # degree two: sympy's
+        (xQ * yK - xK) * dxP - zQ * yP * (xmP - xP - xo) - 4 * zQ * xo,
+        sp.expand(6 * (xP - xQ) ** 2 * yK * (dxP * yK - dyK * zQ + xo)) / (xK - xQ),
+        det["EB"], audit_tracker._hat(det["EB"]), det["N"],
+    ]
+    for e in cases:
+        want, got = sp.factor(e), audit_tracker._factor_linear(e)
+        assert sp.srepr(got) == sp.srepr(want) and str(got) == str(want), e
+
+
+def test_exact_point_evaluation_is_sympys():
+    """The random-point identity's evaluation in fractions gives sympy's exact value; a zero
+    denominator and a non-rational expression are left to sympy (None)."""
+    import sympy as sp
+
+    x, y, C = audit_tracker.S("x_P"), audit_tracker.S("y_P"), audit_tracker.C
+    e = (3 * x ** 2 - y / 7) / (x - 2 * y) + sp.Rational(5, 3) * x * y ** -2
+    value = audit_tracker._exact_evaluator(e)
+    for px, py in ((sp.Rational(-91, 13), sp.Rational(44, 101)), (sp.Integer(3), sp.Integer(5))):
+        got = value({x: px, y: py})
+        assert sp.Rational(got.numerator, got.denominator) == e.xreplace({x: px, y: py})
+    assert value({x: sp.Integer(2), y: sp.Integer(1)}) is None     # x - 2 y = 0
+    assert audit_tracker._exact_evaluator(sp.cos(C) * x) is None
+    assert audit_tracker._exact_evaluator(sp.Float(0.5) * x) is None
+
+
+def test_hat_is_the_simultaneous_substitution():
+    """``_hat`` (a renaming by ``xreplace``) gives what ``subs(..., simultaneous=True)`` gives."""
+    import sympy as sp
+
+    S = audit_tracker.S
+    m = {S(f"{c}_{lab}"): S(f"{c}h_{lab}") for lab in "PQK" for c in "xy"}
+    for e in (audit_tracker._closed("x")["EB"], audit_tracker._closed("x")["N"],
+              S("x_P") ** 2 * S("y_Q") / (S("x_P") - 3 * S("y_K")) + sp.cos(S("x_Q"))):
+        assert sp.srepr(audit_tracker._hat(e)) == sp.srepr(e.subs(m, simultaneous=True))
