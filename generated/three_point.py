@@ -5,8 +5,8 @@ Do not edit: regenerate instead.
 
 Provenance
 ----------
-input sha256       8f48ae22c9d9174ceb46ef2e1c0d222d9e7831da6fdabb688f89a798a1d4d8ef
-derivation sha256  8d24f58aee76e7932aeabd80e15848146a211282d09f0dca97d2aebf9d49470a
+input sha256       741913e98b5adb8e3adb7ac9cff98149f15bc2cd5aa5114bb9d38ef05436e761
+derivation sha256  499443e219b43e2c25f9b46dd82dd1dc78445acea54debb0a806421bf1fee9a0
 sympy              1.14.0
 derivation sources (hashed in this order):
     derive/htm.py, derive/kinematics.py, derive/three_point.py, derive/codegen.py,
