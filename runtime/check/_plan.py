@@ -94,18 +94,21 @@ class CheckPlan:
 
     def write(self, folder, json_path=None, html_path=None, inputs=()) -> None:
         """The plan's files, NC programs and set-up sheet (:meth:`volerr.plan.Plan.write`),
-        the sheet with the check's power table added, and the JSON."""
+        the sheet with the check's power table added (drawn once: the plan writes this page
+        instead of its own), and the JSON."""
         from ..fileio import json_text, write_text
-        from ..plan import _sheet
 
-        from ..report.page import finish
-
-        self.plan.write(folder, None, html_path, inputs)
-        page = _sheet.html(self.plan).replace("</body>", self.power_html() + "</body>", 1)
-        page = finish(page)   # the power table aligned as the sheet's
-        write_text(html_path or f"{folder}/plan.html", page, inputs=list(inputs))
+        self.plan.write(folder, None, html_path, inputs, sheet=self._sheet)
         if json_path:
             write_text(json_path, json_text(self.to_dict()), inputs=list(inputs))
+
+    def _sheet(self, plan) -> str:
+        """The plan's set-up sheet with the power table of the check."""
+        from ..plan import _sheet
+        from ..report.page import finish
+
+        page = _sheet.html(plan).replace("</body>", self.power_html() + "</body>", 1)
+        return finish(page)   # the power table aligned as the sheet's
 
     def power_html(self) -> str:
         """The power table of the check (an HTML section)."""

@@ -259,9 +259,13 @@ def _face_lines(shape):
 
 
 def _axes3d(fig, pos=111):
+    """A 3-D panel with its axis labels and no autoscaling: the caller sets the limits
+    (:func:`_equal_box`), so the hundreds of lines drawn on it do not each rescale it (an
+    ``autoscale_view`` of three axes at every ``plot``, then overwritten)."""
     from ..plotstyle import label
 
     ax = fig.add_subplot(pos, projection="3d")
+    ax.set_autoscale_on(False)
     ax.set_xlabel(label("x", "mm"))
     ax.set_ylabel(label("y", "mm"))
     ax.set_zlabel(label("z", "mm"))

@@ -89,9 +89,12 @@ class Plan(ResultMixin):
                    options.get("dialect"))
         finish(outs, self, ident, list(inputs))
 
-    def write(self, folder, json_path=None, html_path=None, inputs=(), dialect=None) -> None:
+    def write(self, folder, json_path=None, html_path=None, inputs=(), dialect=None,
+              sheet=None) -> None:
         """The files, NC programs (in ``dialect``, default :attr:`dialect`: one of
-        :data:`volerr.plan._dialect.NAMES`), ``plan.html`` (or ``html_path``) and the JSON."""
+        :data:`volerr.plan._dialect.NAMES`), ``plan.html`` (or ``html_path``) and the JSON.
+        ``sheet``: the function that writes the page's text from the plan (default the set-up
+        sheet, :func:`volerr.plan._sheet.html`; a check plan adds its power table to it)."""
         from ..fileio import json_text, write_text
         from . import _nc, _report, _sheet
         from ._files import csv_text
@@ -104,7 +107,8 @@ class Plan(ResultMixin):
             write_text(f"{folder}/{nc}", _nc.program(self.model, pf, header, self.dialect,
                                                      _nc.program_name(nc)),
                        inputs=list(inputs))
-        write_text(html_path or f"{folder}/plan.html", _sheet.html(self), inputs=list(inputs))
+        write_text(html_path or f"{folder}/plan.html", (sheet or _sheet.html)(self),
+                   inputs=list(inputs))
         if json_path:
             write_text(json_path, json_text(_report.data(self)), inputs=list(inputs))
 
