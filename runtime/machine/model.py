@@ -87,6 +87,10 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
     is evaluated (the inputs' validation, done while the block is read anyway).  ``trig``:
     argument -> (its sine, its cosine) (n,), computed once for several functions
     (:meth:`Model.prepared`), which the fused kernel reads instead of computing them."""
+    if n == 1 and check_rows is None:   # one point: its kernel on the values (the same bits)
+        out = _point(fn, kwargs, n_out, trig or {})
+        if out is not None:
+            return _one_block(lambda: None, out, finite, None)
     scalars = {k for k, v in kwargs.items() if _ndim(v) == 0}
     zeros = frozenset(k for k in scalars if kwargs[k] == 0)
     trig = trig or {}
@@ -98,12 +102,6 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
                                for f, v in zip(("sin", "cos"), sc)}}
         scratch = np.empty((n_scratch, min(BLOCK, n)))
     out = np.empty((n, n_out))
-    if n == 1 and kernel is not None:   # one point: its kernel on the values (the same bits)
-        values = _point_values(kwargs)
-        point = None if values is None else fused.point_kernel(
-            fn, zeros, frozenset(scalars) - zeros, frozenset(trig))
-        if point is not None:
-            return _one_block(lambda: point(out, **values), out, finite, check_rows)
     if 0 < n <= BLOCK:      # one block: the arguments whole (what slicing them would give)
         if kernel is not None:
             return _one_block(lambda: kernel(out, scratch, **kwargs), out, finite, check_rows)
@@ -153,19 +151,43 @@ def _one_block(evaluate, out: np.ndarray, finite, check_rows) -> np.ndarray:
     return out
 
 
-def _point_values(kwargs: dict) -> dict | None:
-    """The arguments of one point as :func:`volerr.machine.fused.point_kernel` takes them:
-    float64 arrays of one value as that value (a float), scalars as they are; None when an
-    argument is of another kind (a dict of lags, another dtype)."""
-    out = {}
+def _point(fn, kwargs: dict, n_out: int, trig: dict) -> np.ndarray | None:
+    """``fn`` at one point as :func:`_blocked` evaluates it, (1, n_out), by its
+    :func:`volerr.machine.fused.point_kernel` (the numpy kernel's bits) for the arguments'
+    pattern of scalars and zeros; None when there is none or an argument is of another kind
+    (a dict of lags, another dtype): the numpy kernel then.  One pass over the arguments: the
+    scalars, the zeros among them and every value as a float."""
+    if fused.n_outputs(fn) != n_out:
+        return None
+    values, scalars, zeros = {}, [], []
     for k, v in kwargs.items():
-        if type(v) is np.ndarray:
+        t = type(v)
+        if t is np.ndarray:
             if v.dtype is not _FLOAT or v.size != 1:
                 return None
+            if v.ndim == 0:
+                scalars.append(k)
+                if v == 0:
+                    zeros.append(k)
             v = v.item()
-        elif type(v) not in (float, int, np.float64):
+        elif t is float or t is int or t is np.float64:
+            scalars.append(k)
+            if v == 0:
+                zeros.append(k)
+        else:
             return None
-        out[k] = v
+        values[k] = v
+    for a, sc in trig.items():
+        for f, v in zip(("sin", "cos"), sc):
+            if type(v) is not np.ndarray or v.dtype is not _FLOAT or v.size != 1:
+                return None
+            values[fused.trig_name(f, a)] = v.item()
+    zeros = frozenset(zeros)
+    kernel = fused.point_kernel(fn, zeros, frozenset(scalars) - zeros, frozenset(trig))
+    if kernel is None:
+        return None
+    out = np.empty((1, n_out))
+    kernel(out, **values)
     return out
 
 
