@@ -17,6 +17,11 @@ written here), into
   given as inputs, computed once for several functions at the same positions
   (:meth:`volerr.machine.model.Model.prepared`): the values are bitwise those of the
   generated function;
+* a **point kernel** for one point (:func:`point_kernel`; a compensation chunk of one line):
+  the same three-address code with the additions, subtractions, multiplications and
+  negations written as Python float arithmetic on the values and the other functions (sin,
+  cos, sqrt ...) still the ufuncs on one-element arrays -- the same bits without the ~1 us
+  ufunc call of every operation;
 * a **numba kernel** (optional, ``pip install 'volerr[fast]'``): one compiled per-point loop
   over 2-D broadcast inputs writing an (S, P, n_out) array, the whole expression fused in
   registers.  Compilation costs 1-4 s per function the first time, so it is opt-in
