@@ -225,6 +225,8 @@ class ErrorModel:
     def _clip_edges(self, q: np.ndarray) -> np.ndarray:
         if self.funcs is None or self.funcs.extrapolate:
             return q
+        if self._inside_ranges(q):
+            return q                # (the usual case: no position beyond the tables)
         q = q.copy()
         for a, (lo, hi) in self.ranges.items():
             i = self.model.axes.index(a)
@@ -235,6 +237,19 @@ class ErrorModel:
             near = ((v < lo) & (v >= lo - m)) | ((v > hi) & (v <= hi + m))
             q[:, i] = np.where(near, np.clip(v, lo, hi), v)
         return q
+
+    def _inside_ranges(self, q: np.ndarray) -> bool:
+        """Whether every position of ``q`` (N, n_axes) lies inside its table's range (the
+        bounds as columns, built once)."""
+        b = self.__dict__.get("_bounds")
+        if b is None or b[0] is not self.ranges:
+            axes = self.model.axes
+            b = self.__dict__["_bounds"] = (
+                self.ranges, [axes.index(a) for a in self.ranges],
+                np.array([lo for lo, _ in self.ranges.values()]),
+                np.array([hi for _, hi in self.ranges.values()]))
+        sub = q[:, b[1]]
+        return bool((sub >= b[2]).all() and (sub <= b[3]).all())
 
     def errors(self, q: np.ndarray, subset=None, direction=None) -> dict:
         """Error functions at ``q`` (the last three evaluations are remembered: the position and
@@ -263,7 +278,8 @@ class ErrorModel:
     def _evaluate_tables(self, q: np.ndarray, direction) -> dict:
         """The error functions at ``q`` (see :meth:`errors`), not remembered."""
         ql = self._clip_edges(self.lookup(q))
-        e = self.funcs(ql)
+        tables = getattr(self.funcs, "table_values", None)
+        e = tables(ql)[0] if tables is not None else self.funcs(ql)
         # constants as scalars: the generated code then takes their sin/cos once
         e.update({k: float(v) for k, v in self.funcs.constants.items()})
         if direction is not None:
@@ -330,6 +346,8 @@ def _same(a, b) -> bool:
     """Both None, or arrays of one shape with equal values."""
     if a is None or b is None:
         return a is b
+    if type(a) is np.ndarray and type(b) is np.ndarray:    # (np.array_equal without its checks)
+        return a.shape == b.shape and bool((a == b).all())
     return np.shape(a) == np.shape(b) and np.array_equal(a, b)
 
 

@@ -17,6 +17,11 @@ written here), into
   given as inputs, computed once for several functions at the same positions
   (:meth:`volerr.machine.model.Model.prepared`): the values are bitwise those of the
   generated function;
+* a **point kernel** for one point (:func:`point_kernel`; a compensation chunk of one line):
+  the same three-address code with the additions, subtractions, multiplications and
+  negations written as Python float arithmetic on the values and the other functions (sin,
+  cos, sqrt ...) still the ufuncs on one-element arrays -- the same bits without the ~1 us
+  ufunc call of every operation;
 * a **numba kernel** (optional, ``pip install 'volerr[fast]'``): one compiled per-point loop
   over 2-D broadcast inputs writing an (S, P, n_out) array, the whole expression fused in
   registers.  Compilation costs 1-4 s per function the first time, so it is opt-in
@@ -284,6 +289,10 @@ def _copy(node):
 # ---- numpy block kernel ---------------------------------------------------------------------
 _UFUNC = {ast.Add: "add", ast.Sub: "subtract", ast.Mult: "multiply", ast.Div: "true_divide",
           ast.Pow: "power"}
+#: ufuncs a one-point kernel writes as Python float arithmetic: one IEEE double operation each,
+#: as the ufunc's loop does it (no division: Python raises where numpy gives inf)
+_POINT_OPS = {"add": "{0} + {1}", "subtract": "{0} - {1}", "multiply": "{0} * {1}",
+              "square": "{0} * {0}", "negative": "-{0}"}
 
 
 class _Emitter:
@@ -291,8 +300,10 @@ class _Emitter:
     with ``out=`` a row of the scratch array ``_s`` (or the output column), so a block
     allocates nothing; operations on scalars only stay scalar expressions."""
 
-    def __init__(self, arrays: set):
+    def __init__(self, arrays: set, point: bool = False):
         self.arrays = set(arrays)       # names bound to arrays
+        #: the one-point form (:func:`point_kernel`); False when an operation has none
+        self.point = self.point_ok = point
         self.lines: list[str] = []
         self.free: list[int] = []
         self.n_buf = 0
@@ -334,21 +345,38 @@ class _Emitter:
         if target is None:
             buf = self.buffer()
             target = f"_b{buf}"
-        # out as the last positional argument: cheaper to parse than the keyword
-        self.lines.append(f"numpy.{ufunc}({', '.join(texts)}, {target})")
+        if self.point:
+            self.lines.append(f"{target} = {self._point_op(ufunc, operands, texts)}")
+        else:   # out as the last positional argument: cheaper to parse than the keyword
+            self.lines.append(f"numpy.{ufunc}({', '.join(texts)}, {target})")
         return target, buf
+
+    def _point_op(self, ufunc: str, operands, texts) -> str:
+        """The operation of one point on the values (floats) of the array operands: Python
+        arithmetic (:data:`_POINT_OPS`), or the ufunc called on one-element arrays made of
+        them, as the numpy kernel calls it on (1,) arrays (scalar operands stay scalars)."""
+        if ufunc in _POINT_OPS:
+            return _POINT_OPS[ufunc].format(*texts)
+        if ufunc not in _CALLS:
+            self.point_ok = False
+            return "None"
+        args = [f"_one({t})" if self.is_array(o) else t for o, t in zip(operands, texts)]
+        return f"numpy.{ufunc}({', '.join(args)}).item()"
 
 
 def numpy_source(parsed: Parsed, zeros=frozenset(), scalars=frozenset(),
-                 trig=frozenset()) -> tuple[str, int]:
+                 trig=frozenset(), point: bool = False) -> tuple[str | None, int]:
     """Source of the numpy block kernel ``kernel(_out, _s, <args>)`` and its number of scratch
     rows: ``_out`` (m, n_out) the block of the result, ``_s`` (n_scratch, m) scratch space;
     ``zeros`` arguments known to be scalar 0 (folded away), ``scalars`` other scalar arguments
     (all others are (m,) or (1,) arrays); ``trig`` array arguments whose sine and cosine are
-    given as the further arguments ``_sin_<a>``, ``_cos_<a>`` (in sorted order of ``a``)."""
+    given as the further arguments ``_sin_<a>``, ``_cos_<a>`` (in sorted order of ``a``).
+
+    ``point``: the one-point kernel ``kernel(_out, <args>)`` instead (:func:`point_kernel`;
+    no scratch; the source None when an operation has no one-point form)."""
     temps, outputs = _fold(parsed, frozenset(zeros), frozenset(trig))
     given = [trig_name(f, a) for a in sorted(trig) for f in ("sin", "cos")]
-    em = _Emitter(set(parsed.args) - set(zeros) - set(scalars) | set(given))
+    em = _Emitter(set(parsed.args) - set(zeros) - set(scalars) | set(given), point)
     last_use = {}
     for i, (_, value) in enumerate(temps + [(None, v) for v in outputs]):
         for node in ast.walk(value):
@@ -375,6 +403,10 @@ def numpy_source(parsed: Parsed, zeros=frozenset(), scalars=frozenset(),
         else:
             em.lines.append(f"{col} = {ast.unparse(value)}")
         _release(em, last_use, len(temps) + k)
+    if point:
+        head = [f"def kernel(_out, {', '.join(parsed.args + tuple(given))}):"]
+        return ("\n".join(head + ["    " + ln for ln in em.lines]) + "\n"
+                if em.point_ok else None), 0
     head = [f"def kernel(_out, _s, {', '.join(parsed.args + tuple(given))}):"]
     if em.n_buf:
         head.append(f"    {''.join(f'_b{j}, ' for j in range(em.n_buf))}= _s")
@@ -400,6 +432,28 @@ def numpy_kernel(fn, zeros=frozenset(), scalars=frozenset(), trig=frozenset()):
     ns = {"numpy": np}
     exec(compile(src, f"<fused {parsed.name}>", "exec"), ns)
     return ns["kernel"], n_scratch
+
+
+@functools.lru_cache(maxsize=256)
+def point_kernel(fn, zeros=frozenset(), scalars=frozenset(), trig=frozenset()):
+    """The kernel of :func:`numpy_kernel` for one point: ``kernel(_out, **inputs)`` with
+    ``_out`` (1, n_out) and every (1,) array input given as its value (a float).  The same
+    operations on the same operands in the same order, so the same bits: additions,
+    subtractions, multiplications and negations are single IEEE double operations in Python
+    as in the ufunc loops, and the other elementwise functions (sin, cos, sqrt ...) are the
+    ufuncs called on one-element arrays as in the numpy kernel.  What it saves is the ufunc
+    call of every operation (about 1 us each, some 750 for a five-axis ``exact_error``),
+    the per-chunk cost of a program compensated one line at a time.  None when ``fn`` is not
+    in straight-line form or divides (Python raises on a zero where numpy gives inf)."""
+    parsed = parse(fn)
+    if parsed is None:
+        return None
+    src, _ = numpy_source(parsed, zeros, scalars, trig, point=True)
+    if src is None:
+        return None
+    ns = {"numpy": np, "_one": lambda v: np.array((v,))}
+    exec(compile(src, f"<point {parsed.name}>", "exec"), ns)
+    return ns["kernel"]
 
 
 def n_outputs(fn) -> int | None:

@@ -45,6 +45,12 @@ def _floats(value, what: str) -> np.ndarray:
         raise InputError(f"{what} must be numbers, got {value!r:.60}") from None
 
 
+#: a missing error parameter's value (read only, shared)
+_ZERO = np.asarray(0.0)
+_ZERO.flags.writeable = False
+_FLOAT = _ZERO.dtype
+
+
 def _case_insensitive(given: dict, names) -> dict:
     """Keys that match one of ``names`` only up to case (``x``, ``exx``) get its spelling."""
     upper = {}
@@ -81,7 +87,11 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
     is evaluated (the inputs' validation, done while the block is read anyway).  ``trig``:
     argument -> (its sine, its cosine) (n,), computed once for several functions
     (:meth:`Model.prepared`), which the fused kernel reads instead of computing them."""
-    scalars = {k for k, v in kwargs.items() if np.ndim(v) == 0}
+    if n == 1 and check_rows is None:   # one point: its kernel on the values (the same bits)
+        out = _point(fn, kwargs, n_out, trig or {})
+        if out is not None:
+            return _one_block(lambda: None, out, finite, None)
+    scalars = {k for k, v in kwargs.items() if _ndim(v) == 0}
     zeros = frozenset(k for k in scalars if kwargs[k] == 0)
     trig = trig or {}
     kernel = (fused.numpy_kernel(fn, zeros, frozenset(scalars) - zeros, frozenset(trig))
@@ -92,6 +102,14 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
                                for f, v in zip(("sin", "cos"), sc)}}
         scratch = np.empty((n_scratch, min(BLOCK, n)))
     out = np.empty((n, n_out))
+    if 0 < n <= BLOCK:      # one block: the arguments whole (what slicing them would give)
+        if kernel is not None:
+            return _one_block(lambda: kernel(out, scratch, **kwargs), out, finite, check_rows)
+
+        def columns():
+            for i, c in enumerate(fn(**kwargs)):
+                out[:, i] = c
+        return _one_block(columns, out, finite, check_rows)
     ok = True
     sliced = [k for k, v in kwargs.items() if _per_point(v, n)]
     # a dict argument (the ``lags`` of a generated function): its (n,) arrays sliced as well
@@ -117,6 +135,67 @@ def _blocked(fn, kwargs: dict, n: int, n_out: int = 3, finite: list | None = Non
     if finite is not None:
         finite.append(ok or bool(np.isfinite(out).all()))  # ok False: sum overflow or NaN
     return out
+
+
+def _one_block(evaluate, out: np.ndarray, finite, check_rows) -> np.ndarray:
+    """:func:`_blocked` of at most ``BLOCK`` points: the same steps on the whole arguments,
+    without the per-argument slicing (per-chunk overhead of short evaluations);
+    ``evaluate()`` fills ``out``."""
+    if check_rows is not None:
+        check_rows[1](check_rows[0])
+    evaluate()
+    if finite is not None:
+        with np.errstate(over="ignore"):  # NaN/inf anywhere -> sum not finite
+            ok = bool(np.isfinite(out.sum()))
+        finite.append(ok or bool(np.isfinite(out).all()))  # ok False: sum overflow or NaN
+    return out
+
+
+def _point(fn, kwargs: dict, n_out: int, trig: dict) -> np.ndarray | None:
+    """``fn`` at one point as :func:`_blocked` evaluates it, (1, n_out), by its
+    :func:`volerr.machine.fused.point_kernel` (the numpy kernel's bits) for the arguments'
+    pattern of scalars and zeros; None when there is none or an argument is of another kind
+    (a dict of lags, another dtype): the numpy kernel then.  One pass over the arguments: the
+    scalars, the zeros among them and every value as a float."""
+    if fused.n_outputs(fn) != n_out:
+        return None
+    values, scalars, zeros = {}, [], []
+    for k, v in kwargs.items():
+        t = type(v)
+        if t is np.ndarray:
+            if v.dtype is not _FLOAT or v.size != 1:
+                return None
+            if v.ndim == 0:
+                scalars.append(k)
+                if v == 0:
+                    zeros.append(k)
+            v = v.item()
+        elif t is float or t is int or t is np.float64:
+            scalars.append(k)
+            if v == 0:
+                zeros.append(k)
+        else:
+            return None
+        values[k] = v
+    for a, sc in trig.items():
+        for f, v in zip(("sin", "cos"), sc):
+            if type(v) is not np.ndarray or v.dtype is not _FLOAT or v.size != 1:
+                return None
+            values[fused.trig_name(f, a)] = v.item()
+    zeros = frozenset(zeros)
+    kernel = fused.point_kernel(fn, zeros, frozenset(scalars) - zeros, frozenset(trig))
+    if kernel is None:
+        return None
+    out = np.empty((1, n_out))
+    kernel(out, **values)
+    return out
+
+
+def _ndim(v) -> int:
+    """``np.ndim(v)``, without its array conversion for a float or an array."""
+    if type(v) is float:
+        return 0
+    return v.ndim if isinstance(v, np.ndarray) else np.ndim(v)
 
 
 def _per_point(v, n: int) -> bool:
@@ -250,14 +329,18 @@ class Model:
             arr = _floats(positions, "positions")
             if arr.ndim == 1:
                 arr = arr[None, :]
-            require(arr.ndim == 2 and arr.shape[1] == len(self.axes),
-                    f"{self.name}: positions must have {len(self.axes)} columns "
-                    f"({' '.join(self.axes)}), got shape {arr.shape}")
-            cols = {a: arr[:, i] for i, a in enumerate(self.axes)}  # strided views, no copy
+            axes = self.axes
+            if not (arr.ndim == 2 and arr.shape[1] == len(axes)):
+                raise InputError(f"{self.name}: positions must have {len(axes)} columns "
+                                 f"({' '.join(axes)}), got shape {arr.shape}")
             if defer and arr.flags.c_contiguous and len(arr) > 1:
                 deferred = arr
             else:
                 self._check_rows(arr)
+            # columns: strided views, no copy (all of one length: nothing to broadcast)
+            rot = self.rotary_axes
+            return ({a: np.deg2rad(arr[:, i]) if a in rot else arr[:, i]
+                     for i, a in enumerate(axes)}, len(arr), deferred)
         for a, v in cols.items():
             if isinstance(positions, Mapping) and not np.isfinite(v).all():
                 raise InputError(f"{self.name}: position {a} has NaN or infinite values")
@@ -300,8 +383,9 @@ class Model:
 
     def _probe(self, probe, n: int) -> dict:
         p = _floats(probe, "probe offset")
-        require(p.shape in ((3,), (n, 3)), f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
-        require(np.all(np.isfinite(p)), "probe offset has NaN values")
+        if p.shape not in ((3,), (n, 3)):
+            raise InputError(f"probe offset must be (3,) or ({n}, 3), got {p.shape}")
+        require(np.isfinite(p).all(), "probe offset has NaN values")
         if p.shape == (3,):  # one offset for all points: scalars broadcast in the generated code
             return {"Xp": float(p[0]), "Yp": float(p[1]), "Zp": float(p[2])}
         return {"Xp": p[:, 0], "Yp": p[:, 1], "Zp": p[:, 2]}
@@ -328,14 +412,21 @@ class Model:
     def _errors(self, errors, n: int) -> dict:
         require(errors is None or isinstance(errors, Mapping),
                 f"errors must be a dict {{name: value}}, got {type(errors).__name__}")
-        errors = _case_insensitive(dict(errors or {}), self.parameters)
-        unknown = set(errors) - set(self.parameters)
+        names = self.parameters
+        errors = dict(errors or {})
+        if not errors.keys() <= set(names):     # (names spelt as the model does: kept as given)
+            errors = _case_insensitive(errors, names)
+        unknown = set(errors) - set(names)
         if unknown:
             raise InputError(f"{self.name}: unknown error parameter {sorted(unknown, key=str)[0]!r}")
         out = {}
-        for p in self.parameters:
-            v = _floats(errors.get(p, 0.0), f"error {p}")
-            require(v.shape in ((), (n,), (1,)), f"error {p} must be a scalar or ({n},) array")
+        shapes = ((), (n,), (1,))
+        for p in names:
+            v = errors.get(p, _ZERO)
+            if type(v) is not np.ndarray or v.dtype is not _FLOAT:    # (else _floats(v) is v)
+                v = _floats(v, f"error {p}")
+            if v.shape not in shapes:
+                raise InputError(f"error {p} must be a scalar or ({n},) array")
             out[p] = v
         return out
 

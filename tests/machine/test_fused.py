@@ -267,3 +267,42 @@ def test_monte_carlo_numba_backend_same_values(numba_cache):
     scale = np.abs(v["numpy"]).max()
     np.testing.assert_allclose(v["numba"], v["numpy"], rtol=1e-12, atol=1e-12 * scale)
     assert not math.isnan(v["numba"].sum())
+
+
+@pytest.mark.parametrize("model", [DMU50, MB1, volerr.load("TT_AC")], ids=lambda m: m.name)
+def test_point_kernel_gives_the_numpy_kernel_bits(model):
+    """One point (a compensation chunk of one line): the point kernel (Python float
+    arithmetic, the other ufuncs on one-element arrays) writes the bits of the numpy kernel
+    on (1,) arrays, for random zero / scalar / array patterns, with and without the rotary
+    axes' sines and cosines given; Model methods on one point take it."""
+    rng = np.random.default_rng(7)
+    names = ("volumetric_error", "exact_error", "orientation_error", "nominal_position",
+             "tool_axis")
+    for fname in names:
+        fn = getattr(model.module, fname)
+        args = fused.parse(fn).args
+        for trial in range(30):
+            kw = {}
+            for a in args:
+                r = rng.random()
+                kw[a] = (0.0 if r < 0.25 else float(rng.normal() * 10.0 ** rng.integers(-9, 3))
+                         if r < 0.4 else np.array([rng.normal() * 10.0 ** rng.integers(-9, 3)]))
+            rot = [a for a in model.rotary_axes if a in args]
+            for a in rot:
+                kw[a] = np.array([rng.uniform(-7, 7)])
+            trig = {a: (np.sin(kw[a]), np.cos(kw[a])) for a in rot} if trial % 2 else {}
+            scalars = {k for k, v in kw.items() if np.ndim(v) == 0}
+            zeros = frozenset(k for k in scalars if kw[k] == 0)
+            full = {**kw, **{fused.trig_name(f, a): v for a, sc in trig.items()
+                             for f, v in zip(("sin", "cos"), sc)}}
+            kernel, n_s = fused.numpy_kernel(fn, zeros, frozenset(scalars) - zeros,
+                                             frozenset(trig))
+            want = np.empty((1, fused.n_outputs(fn)))
+            kernel(want, np.empty((n_s, 1)), **full)
+            point = fused.point_kernel(fn, zeros, frozenset(scalars) - zeros, frozenset(trig))
+            got = np.empty_like(want)
+            point(got, **{k: (v.item() if isinstance(v, np.ndarray) else v)
+                          for k, v in full.items()})
+            assert got.tobytes() == want.tobytes(), (fname, trial)
+            via = model_mod._blocked(fn, kw, 1, want.shape[1], trig=trig)
+            assert via.tobytes() == want.tobytes(), (fname, trial)

@@ -295,3 +295,29 @@ def test_table_csv_cells_are_format_number_of_the_values(data):
     for i, line in enumerate(lines[1:]):
         want = [pos[i], vals["EXX"][i] * 1e3, vals["EBX"][i] * 1e6, abs(vals["EXX"][i]) * 1e3]
         assert line.split(",") == [format_number(v) for v in want]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.data())
+def test_stacked_linear_functions_give_each_axis_group_bits(data):
+    """A few positions (a compensation chunk of one line): the linear functions of all axes
+    evaluated at once (_LinearStack) give the bits of each axis' _LinearGroup, inside the
+    nodes, on them, beyond them (the end rule, clamped or extended) and for unevenly spaced
+    nodes."""
+    from volerr.tables.functions import _LinearGroup, _LinearStack
+
+    rng = np.random.default_rng(data.draw(st.integers(0, 2 ** 32 - 1)))
+    groups = []
+    for _ in range(data.draw(st.integers(1, 5))):
+        m = int(rng.integers(2, 30))
+        lo = rng.uniform(-500, 0)
+        hi = lo + rng.uniform(1, 900)
+        x = np.linspace(lo, hi, m) if rng.random() < 0.8 else np.sort(rng.uniform(lo, hi, m))
+        ys = [rng.normal(size=m) * 1e-3 for _ in range(int(rng.integers(1, 8)))]
+        groups.append(_LinearGroup(x, ys, clamp=bool(rng.integers(2))))
+    n = data.draw(st.integers(0, 12))
+    Q = np.array([np.where(rng.random(n) < 0.3, g.x[rng.integers(0, len(g.x), n)],
+                           rng.uniform(g.x[0] - 5, g.x[-1] + 5, n)) for g in groups])
+    got = _LinearStack(groups)(Q.reshape(len(groups), n))
+    for g, q, v in zip(groups, Q.reshape(len(groups), n), got):
+        assert v.tobytes() == g(q).tobytes()
