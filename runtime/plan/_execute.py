@@ -51,7 +51,7 @@ def execute(path, model, errors: dict, rng, setup_um: float = 20.0,
         s = _offsets(cols, labels["station"], "station_", rng, setup_um)
         dist = np.linalg.norm(t + e - s, axis=1)
         sig = (0.3 + 0.3e-3 * dist) if u is None else u
-        dead = {k: dead_mm + rng.normal(0, 0.05) for k in set(labels["station"])}
+        dead = {k: dead_mm + rng.normal(0, 0.05) for k in sorted(set(labels["station"]))}
         values = {"d_mm": dist + np.array([dead[k] for k in labels["station"]])
                   + 1e-3 * sig * rng.normal(0, 1, n)}
     with open(path, "w", encoding="utf-8") as fh:
@@ -62,7 +62,7 @@ def _ballbar(cols, labels, t, e, rng, setup_um, u) -> dict:
     pivot = np.column_stack([cols[k] for k in ("pivot_x", "pivot_y", "pivot_z")])
     v = (t - pivot) / np.linalg.norm(t - pivot, axis=1)[:, None]
     dp = _offsets(cols, labels["placement"], None, rng, setup_um)
-    dl = {k: rng.normal(0, setup_um * 1e-3) for k in set(labels["placement"])}
+    dl = {k: rng.normal(0, setup_um * 1e-3) for k in sorted(set(labels["placement"]))}
     dr = np.sum(v * (e - dp), axis=1) + np.array([dl[k] for k in labels["placement"]])
     noise = rng.normal(0, 1, len(dr)) * (DEFAULT_U_UM["ballbar"] if u is None else u)
     return {"dr_um": 1e3 * dr + noise}
