@@ -374,6 +374,24 @@ def _position(c: Columns, idx: np.ndarray, where: str, run: str) -> dict:
     return out
 
 
+#: the largest drift file read, bytes (100 MB: a week at one reading a second with ten
+#: columns is about 50 MB; reading holds some 25 bytes of memory per byte of the file, the
+#: loop more, so a week at 0.01 s -- 3 GB -- would exhaust the memory, not be refused)
+MAX_FILE_BYTES = 100 * 2 ** 20
+
+
+def refuse_huge(path) -> None:
+    """One line for a drift file larger than :data:`MAX_FILE_BYTES`, before it is read
+    (nothing for a missing file: the reader names it)."""
+    p = Path(path)
+    size = p.stat().st_size if p.is_file() else 0
+    require(size <= MAX_FILE_BYTES,
+            f"{p.name}: {size / 2 ** 20:.0f} MB is more than a drift file holds "
+            f"({MAX_FILE_BYTES / 2 ** 20:.0f} MB: a week at one reading a second is about 50 "
+            f"MB); readings every 0.01 s? a thermal drift changes over minutes: resample to "
+            f"1 s or coarser")
+
+
 def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
               keep_constant: bool = False) -> list:
     """Read a drift file into its :class:`DriftRun` (one per run label, in order of
@@ -381,6 +399,7 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
     ``keep_constant``: a ``T_*`` input constant over a run is kept (the drift loop leaves it
     out and names it, :func:`faults`), not refused."""
     path = Path(path)
+    refuse_huge(path)
     c = _mapped_columns(path, mapping, time_unit)
     where, n = c.name, c.n
     tcol, t, origin = _time(c)
@@ -570,6 +589,7 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
 
     require(time_unit in (None, "s", "min", "h"), f"--time-unit: {time_unit!r} is not one of "
                                                   f"s, min, h")
+    refuse_huge(path)
     text = logger.convert(path, mapping, time_unit, channels)
     with tempfile.TemporaryDirectory() as tmp:
         probe = Path(tmp) / Path(path).name

@@ -288,6 +288,26 @@ CASES = {
 }
 
 
+@pytest.mark.parametrize("command", ["loop", "iso230-3", "convert"])
+def test_a_file_too_large_to_read_is_refused_before_reading(tmp_path, monkeypatch, command):
+    """Readings every 0.01 s for a week (3 GB) would exhaust the memory: refused by size
+    before reading (the limit lowered here to 64 kB for a 0.25 MB file: 0.01 s for 80 s)."""
+    from volerr.instruments import drift
+
+    monkeypatch.setattr(drift, "MAX_FILE_BYTES", 2 ** 16)
+    t = np.arange(0.0, 80.0, 0.01)
+    f = _write(tmp_path / "week.csv", {"t_s": t, "d_X_um": 1e-3 * t, "T_spindle": 20 + 1e-3 * t,
+                                       "T_room": 20 + 1e-4 * t})
+    assert f.stat().st_size > 2 ** 17
+    (tmp_path / "out.json").write_text(KEEP)
+    run = {"loop": lambda: _loop(tmp_path, f), "iso230-3": lambda: _iso(tmp_path, f),
+           "convert": lambda: _convert(tmp_path, f)}[command]
+    r = run()
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "week.csv" in r.stderr and "every 0.01 s?" in r.stderr, r.stderr
+    assert (tmp_path / "out.json").read_text() == KEEP and not (tmp_path / "p.csv").exists()
+
+
 @pytest.mark.parametrize("case", list(CASES))
 def test_hostile_drift_input(tmp_path, case):
     run, words = CASES[case]
