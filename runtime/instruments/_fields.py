@@ -311,6 +311,23 @@ def check_temperature(values, name: str, where: str) -> None:
     check_temperature_C(worst, f"{where}: column {name}", rng)
 
 
+def check_temperatures_together(temps: dict, where: str) -> None:
+    """Refuse a file whose temperature columns ``temps`` (name -> degC, two or more) all read
+    above the room range (:data:`AMBIENT_RANGE_C`) in every reading: no sensor at a room's
+    or structure's temperature (each column alone may be a hot spindle's,
+    :func:`check_temperature`); one line naming the coldest, ``degF`` when it reads as
+    Fahrenheit (68 degF = 20 degC)."""
+    from ..units import check_temperature_C
+
+    lows = {h: float(np.min(v)) for h, v in temps.items() if np.size(v)}
+    if len(lows) < 2 or min(lows.values()) <= AMBIENT_RANGE_C[1]:
+        return
+    cold = min(lows, key=lambda h: lows[h])
+    check_temperature_C(lows[cold], f"{where}: every temperature column reads above "
+                        f"{AMBIENT_RANGE_C[1]:g} degC in every row (none a room's); the "
+                        f"coldest, column {cold}", AMBIENT_RANGE_C)
+
+
 def check_time(t, name: str, where: str) -> None:
     """Refuse a time column (s) spanning more than :data:`LONGEST_TIME_S` (one line naming
     the file and the column: likely milliseconds read as seconds)."""

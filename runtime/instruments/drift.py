@@ -53,6 +53,12 @@ TIME_COLUMNS = ("t_s", "t_min", "t_h")
 #: the largest drift reading accepted, um (10 mm: beyond the range of the displacement
 #: sensors of a thermal test -- capacitive and inductive probes read a few mm at most)
 MAX_CHANNEL_UM = 10000.0
+#: the least span of a channel over a file, um (10 nm): the noise of the displacement sensors
+#: of a thermal test (capacitive: a few nm, inductive: tens of nm) and a machine's drift over
+#: a test (a micrometre or more) give more; a drift of micrometres in mm under ``_um`` less
+MIN_CHANNEL_SPAN_UM = 0.01
+#: a channel column in a unit the reader does not convert (``d_<label>_nm``, ``_in`` ...)
+_OTHER_UNIT = re.compile(r"d_\w+_(nm|m|cm|in|inch|mil|thou|mu|micron)", re.IGNORECASE)
 POSITION_AXES = "XYZUVWABC"
 #: a channel header line: ``# channel d_ch1: X at z=120`` (``d_`` and ``_um`` optional)
 _CHANNEL_LINE = re.compile(r"^#\s*channel\s+(\S+?)\s*:\s*(.*?)\s*$", re.IGNORECASE)
@@ -258,6 +264,10 @@ def _channels(c: Columns, heads: dict) -> list:
     """The channel columns, in file order; header lines of absent channels and a file without
     a channel refused."""
     where = c.name
+    for h in read_order(c):
+        m = _OTHER_UNIT.fullmatch(h)
+        require(m is None, f"{where}: column {h}: a displacement channel's unit is um or mm, "
+                           f"not {m and m.group(1)!r}; convert it to um (d_<label>_um)")
     names = [h for h in list(c.numbers) + list(c.text) if re.fullmatch(r"d_\w+_um", h)]
     order = {h: i for i, h in enumerate(read_order(c))}
     names.sort(key=lambda h: order.get(h, 0))
@@ -275,6 +285,70 @@ def _channels(c: Columns, heads: dict) -> list:
                 f"sensor reads ({MAX_CHANNEL_UM / 1000:g} mm): likely nm headed um, or a wrong "
                 f"unit")
     return names
+
+
+def _channel_span(v: np.ndarray, h: str, where: str, run: str) -> None:
+    """A channel's span over a run (um) that no thermal drift has: 1 mm or more (nm under
+    ``_um``; :data:`volerr.instruments._drift_logger.MAX_DRIFT_RANGE_MM`, the rule of a
+    ``(mm)`` header in ``drift convert``) or less than :data:`MIN_CHANNEL_SPAN_UM` (mm under
+    ``_um``); one line.  A constant channel is :func:`_constant_sensor`'s."""
+    span, inside = float(np.ptp(v)), f" in run {run}" if run else " over the run"
+    require(span < 1000.0 * logger.MAX_DRIFT_RANGE_MM,
+            f"{where}: column {h} drifts by {span:g} um{inside}, beyond any thermal drift "
+            f"({logger.MAX_DRIFT_RANGE_MM:g} mm): likely readings in nm under the _um header; "
+            f"give um")
+    require(not 0 < span < MIN_CHANNEL_SPAN_UM,
+            f"{where}: column {h} spans {span:.3g} um{inside}, below what a displacement "
+            f"sensor's noise and a machine's drift give ({MIN_CHANNEL_SPAN_UM:g} um): likely "
+            f"readings in mm under the _um header; give um")
+
+
+#: a channel whose every reading lies in this range (um) reads like a room's temperatures
+#: (degC) ...
+ROOM_LIKE = (10.0, 40.0)
+#: ... and a temperature whose first reading is within this of 0 (degC) like a zeroed channel
+ZERO_LIKE_C = 0.5
+
+
+def _refuse_swapped(c: Columns, names, temps: dict, where: str) -> None:
+    """One line when a temperature column starts at a channel's zero (:data:`ZERO_LIKE_C`)
+    while a channel reads a room's temperatures (:data:`ROOM_LIKE`): the temperature and
+    drift columns swapped in the header (no machine sensor reads 0 degC in a drift test)."""
+    cold = next((h for h, v in temps.items() if abs(v[0]) <= ZERO_LIKE_C), None)
+    room = next((h for h in names if ROOM_LIKE[0] <= np.min(c.numbers[h])
+                 and np.max(c.numbers[h]) <= ROOM_LIKE[1]), None)
+    if cold is None or room is None:
+        return
+    v = c.numbers[room]
+    raise InputError(f"{where}: column {cold} starts at {temps[cold][0]:g} degC like a zeroed "
+                     f"channel, and {room} reads {np.min(v):.4g} .. {np.max(v):.4g} um like a "
+                     f"room's temperatures: temperature and drift columns swapped? check the "
+                     f"header")
+
+
+#: an input whose correlation with a channel is this close to 1 (in size) is the channel
+#: again: logged inputs and readings never agree so (their noises are independent), while a
+#: copy rescaled (nm, mm) and printed to 6 digits or more agrees to 1e-10; judged on this
+#: many readings or more (two readings always correlate 1, three may by chance)
+COPY_CORRELATION = 1 - 1e-9
+COPY_MIN_READINGS = 10
+
+
+def _refuse_channel_copy(c: Columns, names, inputs, where: str) -> None:
+    """One line when a logged input is a channel again (up to scale and offset: the channel
+    exported twice, or in another unit under another name): a model would fit the measurand
+    with itself."""
+    if c.n < COPY_MIN_READINGS:
+        return
+    for h in inputs:
+        x = c.numbers[h] - np.mean(c.numbers[h])
+        for ch in names:
+            y = c.numbers[ch] - np.mean(c.numbers[ch])
+            den = float(np.sqrt(np.dot(x, x) * np.dot(y, y)))
+            require(not (den > 0 and abs(float(np.dot(x, y))) >= COPY_CORRELATION * den),
+                    f"{where}: column {h} is channel {ch} again (correlation 1: a copy up to "
+                    f"scale and offset): the channel exported twice? an input must be logged "
+                    f"beside the channel, not be it")
 
 
 def read_order(c: Columns) -> list:
@@ -300,6 +374,24 @@ def _position(c: Columns, idx: np.ndarray, where: str, run: str) -> dict:
     return out
 
 
+#: the largest drift file read, bytes (100 MB: a week at one reading a second with ten
+#: columns is about 50 MB; reading holds some 25 bytes of memory per byte of the file, the
+#: loop more, so a week at 0.01 s -- 3 GB -- would exhaust the memory, not be refused)
+MAX_FILE_BYTES = 100 * 2 ** 20
+
+
+def refuse_huge(path) -> None:
+    """One line for a drift file larger than :data:`MAX_FILE_BYTES`, before it is read
+    (nothing for a missing file: the reader names it)."""
+    p = Path(path)
+    size = p.stat().st_size if p.is_file() else 0
+    require(size <= MAX_FILE_BYTES,
+            f"{p.name}: {size / 2 ** 20:.0f} MB is more than a drift file holds "
+            f"({MAX_FILE_BYTES / 2 ** 20:.0f} MB: a week at one reading a second is about 50 "
+            f"MB); readings every 0.01 s? a thermal drift changes over minutes: resample to "
+            f"1 s or coarser")
+
+
 def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
               keep_constant: bool = False) -> list:
     """Read a drift file into its :class:`DriftRun` (one per run label, in order of
@@ -307,6 +399,7 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
     ``keep_constant``: a ``T_*`` input constant over a run is kept (the drift loop leaves it
     out and names it, :func:`faults`), not refused."""
     path = Path(path)
+    refuse_huge(path)
     c = _mapped_columns(path, mapping, time_unit)
     where, n = c.name, c.n
     tcol, t, origin = _time(c)
@@ -318,9 +411,12 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
     inputs = [h for h in c.numbers if h not in skip]
     _column_defects(c, inputs)
     f.check_time(t, tcol, where)
-    for h in inputs:
-        if f.is_temperature(h):
-            f.check_temperature(c.numbers[h], h, where)
+    temps = {h: c.numbers[h] for h in inputs if f.is_temperature(h)}
+    for h, v in temps.items():
+        f.check_temperature(v, h, where)
+    f.check_temperatures_together(temps, where)
+    _refuse_swapped(c, names, temps, where)
+    _refuse_channel_copy(c, names, inputs, where)
     notes = _text_inputs(c, skip)
     out = []
     for r, label in enumerate(labels):
@@ -332,6 +428,7 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
         chans = {h[2:-3]: c.numbers[h][idx] for h in names}
         for h in names:
             _constant_sensor(c.numbers[h][idx], h, where, shown)
+            _channel_span(c.numbers[h][idx], h, where, shown)
         for h in inputs:
             if h.startswith("T_") and not keep_constant:
                 _constant_sensor(c.numbers[h][idx], h, where, shown)
@@ -492,6 +589,7 @@ def convert(path, mapping: dict | None = None, time_unit: str | None = None,
 
     require(time_unit in (None, "s", "min", "h"), f"--time-unit: {time_unit!r} is not one of "
                                                   f"s, min, h")
+    refuse_huge(path)
     text = logger.convert(path, mapping, time_unit, channels)
     with tempfile.TemporaryDirectory() as tmp:
         probe = Path(tmp) / Path(path).name

@@ -203,29 +203,42 @@ SLIP_CHANGE = 1 / 3
 #: less over a run); a run faster than this is a time column in minutes or hours under
 #: ``t_s`` (60x, 3600x: a 5 h run in minutes 0.37 K/min) (judged with 3 sensors or more)
 FASTEST_K_PER_MIN = 0.25
+#: the same with one or two sensors (a spindle housing's alone may change a few tenths K/min
+#: over a short run): the slower of them changing faster than this, K/min, is a time column
+#: in hours under ``t_s`` (3600x: 1 K in a 3 h run read as 3 s is 20 K/min)
+FASTEST_FEW_K_PER_MIN = 2.0
 
 
-def _temperature_change(r) -> tuple[float, int]:
-    """(the median over the run's ``T_*`` sensors of their peak-to-peak change, K; how many)."""
+def _temperature_change(r) -> tuple[float, int, float]:
+    """(the median over the run's ``T_*`` sensors of their peak-to-peak change, K; how many;
+    the least of them, K)."""
     temps = [float(np.ptp(v)) for k, v in r.inputs.items() if k.startswith("T_")]
-    return (float(np.median(temps)) if temps else 0.0), len(temps)
+    return (float(np.median(temps)) if temps else 0.0), len(temps), min(temps, default=0.0)
 
 
 def _refuse_time_slip(runs) -> None:
     """One line when a run's time column reads minutes or hours as seconds: its temperatures
-    change faster than a machine warms (:data:`FASTEST_K_PER_MIN`, every run), or, in a
+    change faster than a machine warms (:data:`FASTEST_K_PER_MIN`, every run; the slower of
+    one or two sensors :data:`FASTEST_FEW_K_PER_MIN`), or, in a
     campaign of three runs or more, its reading interval and duration are both
     :data:`TIME_SLIP` times below the runs' medians while its drift and temperatures change
     as much (:data:`SLIP_CHANGE`)."""
     dt = np.array([float(np.median(np.diff(r.t_s))) for r in runs])
     span = np.array([float(r.t_s[-1] - r.t_s[0]) for r in runs])
     changes = [_temperature_change(r) for r in runs]
-    heat = np.array([c for c, _ in changes])
+    heat = np.array([c[0] for c in changes])
     drift = np.array([float(np.median([np.ptp(v) for v in r.channels.values()])) for r in runs])
     mdt, mspan = float(np.median(dt)), float(np.median(span))
     for i, r in enumerate(runs):
-        change, n = changes[i]
+        change, n, least = changes[i]
         rate = change / max(span[i], 1e-300) * 60.0
+        slow = least / max(span[i], 1e-300) * 60.0
+        require(not (0 < n < 3 and slow > FASTEST_FEW_K_PER_MIN),
+                f"{r.name}: its {'slower ' if n > 1 else ''}temperature changes {least:.3g} K "
+                f"in {span[i]:g} s of its time column, {slow:.2g} K/min: faster than a machine "
+                f"warms (at most {FASTEST_FEW_K_PER_MIN:g} K/min with {n} "
+                f"sensor{'s' if n > 1 else ''}): time in hours under t_s? give seconds (or name "
+                f"the column t_h)")
         require(not (n >= 3 and rate > FASTEST_K_PER_MIN),
                 f"{r.name}: its temperatures change {change:.3g} K (median sensor) in {span[i]:g} "
                 f"s of its time column, {rate:.2g} K/min: faster than a machine warms (at most "
