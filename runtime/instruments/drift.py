@@ -334,18 +334,27 @@ COPY_CORRELATION = 1 - 1e-9
 COPY_MIN_READINGS = 10
 
 
-def _refuse_channel_copy(c: Columns, names, inputs, where: str) -> None:
+def _collinear(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether ``a`` and ``b`` agree up to scale and offset (correlation ``COPY_CORRELATION``
+    or closer to 1 in size; never for a constant)."""
+    x, y = a - np.mean(a), b - np.mean(b)
+    den = float(np.sqrt(np.dot(x, x) * np.dot(y, y)))
+    return den > 0 and abs(float(np.dot(x, y))) >= COPY_CORRELATION * den
+
+
+def _refuse_channel_copy(c: Columns, names, inputs, where: str, t=None) -> None:
     """One line when a logged input is a channel again (up to scale and offset: the channel
     exported twice, or in another unit under another name): a model would fit the measurand
-    with itself."""
+    with itself.  A channel that is itself a straight line in time ``t`` (s; a noise-free
+    ramp, as a simulated or a hand-written test file has it) is not judged: any other ramp,
+    a temperature rising steadily, agrees with it as closely without being a copy."""
     if c.n < COPY_MIN_READINGS:
         return
-    for h in inputs:
-        x = c.numbers[h] - np.mean(c.numbers[h])
-        for ch in names:
-            y = c.numbers[ch] - np.mean(c.numbers[ch])
-            den = float(np.sqrt(np.dot(x, x) * np.dot(y, y)))
-            require(not (den > 0 and abs(float(np.dot(x, y))) >= COPY_CORRELATION * den),
+    for ch in names:
+        if t is not None and _collinear(c.numbers[ch], t):
+            continue
+        for h in inputs:
+            require(not _collinear(c.numbers[h], c.numbers[ch]),
                     f"{where}: column {h} is channel {ch} again (correlation 1: a copy up to "
                     f"scale and offset): the channel exported twice? an input must be logged "
                     f"beside the channel, not be it")
@@ -416,7 +425,7 @@ def read_runs(path, mapping: dict | None = None, time_unit: str | None = None,
         f.check_temperature(v, h, where)
     f.check_temperatures_together(temps, where)
     _refuse_swapped(c, names, temps, where)
-    _refuse_channel_copy(c, names, inputs, where)
+    _refuse_channel_copy(c, names, inputs, where, t)
     notes = _text_inputs(c, skip)
     out = []
     for r, label in enumerate(labels):

@@ -325,3 +325,20 @@ def test_hostile_drift_input(tmp_path, case):
         assert w in lines[0], (w, lines[0])
     assert (tmp_path / "out.json").read_text() == KEEP
     assert not (tmp_path / "p.csv").exists()
+
+
+def test_a_noise_free_ramp_is_no_copy_and_fits_exactly(tmp_path):
+    """A simulated or hand-written run with no noise: the channel and a temperature both
+    straight lines in time agree to correlation 1 without one being the other (not refused
+    as a copy), and the loop fits the exact slope (the least-score tie rule holds for a
+    score at the rounding floor, which may fall below 0) instead of failing."""
+    t = np.arange(0.0, 200 * 15.0, 15.0)
+    i = t / 15.0
+    f = _write(tmp_path / "ramp.csv", {"t_s": t, "d_X_um": 0.1 * i, "T_head": 20 + 0.01 * i,
+                                       "T_bed": 21 + 0.003 * i * ((i % 7) - 3)})
+    r = _loop(tmp_path, f)
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    import json
+    doc = json.loads((tmp_path / "out.json").read_text())
+    (term,) = [t for e in doc["effects"] for t in e["terms"]]
+    assert term["basis"] == "T_head" and term["value"] == pytest.approx(10.0, rel=1e-9)
