@@ -273,12 +273,19 @@ def reported_held_out(c: dict) -> dict | None:
     "bound_um", "within"}."""
     if not c.get("n_test") or "family" not in c:
         return None
-    b = c["baselines"]
-    base = "static" if b["static"]["mae_um"] <= b["constant"]["mae_um"] else "constant"
-    ref, mae = b[base]["mae_um"], c["mae_after_um"]
-    bound = HELD_OUT_REL * ref + HELD_OUT_ABS_UM
+    base, ref, bound = _held_out_bar(c)
+    mae = c["mae_after_um"]
     return {"family": c["family"], "mae_um": mae, "baseline_mae_um": ref, "baseline": base,
             "bound_um": bound, "within": bool(mae <= bound)}
+
+
+def _held_out_bar(c: dict) -> tuple:
+    """(the better baseline on the held-out readings, its held-out MAE, the bar ``HELD_OUT_REL``
+    x that + ``HELD_OUT_ABS_UM``), um; a tie to the static regression."""
+    b = c["baselines"]
+    base = "static" if b["static"]["mae_um"] <= b["constant"]["mae_um"] else "constant"
+    ref = b[base]["mae_um"]
+    return base, ref, HELD_OUT_REL * ref + HELD_OUT_ABS_UM
 
 
 def held_out_verdict(c: dict) -> dict | None:
@@ -289,9 +296,7 @@ def held_out_verdict(c: dict) -> dict | None:
     {"lag_model_mae_um", "baseline_mae_um", "baseline", "bound_um", "confirmed"}."""
     if not c.get("n_test"):
         return None
-    b = c["baselines"]
-    base = "static" if b["static"]["mae_um"] <= b["constant"]["mae_um"] else "constant"
-    ref, lag = b[base]["mae_um"], c["lag_model"]["mae_um"]
-    bound = HELD_OUT_REL * ref + HELD_OUT_ABS_UM
+    base, ref, bound = _held_out_bar(c)
+    lag = c["lag_model"]["mae_um"]
     return {"lag_model_mae_um": lag, "baseline_mae_um": ref, "baseline": base,
             "bound_um": bound, "confirmed": bool(lag <= bound)}
