@@ -237,3 +237,14 @@ def dominant_covariate(run_list: list, effects: list) -> str | None:
         if rms > best:
             best, name = rms, " - ".join(e["covariates"])
     return name
+
+
+def write_run(path, run: dict, env: str, cols, direction: str = "X") -> None:
+    """One simulated run ``run`` {column: (N,)} as a drift file: the channel line (``d_x``
+    along ``direction``, "?" for none), the columns ``cols`` to 6 decimals and the run's
+    ``environment`` label on every row."""
+    cols = list(cols)
+    lines = [f"# channel d_x: {direction}", ",".join(cols + ["environment"])]
+    lines += [",".join(f"{run[c][i]:.6f}" for c in cols) + f",{env}"
+              for i in range(len(run["t_s"]))]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -81,11 +81,8 @@ def _run(programme: str, env: str, hour: float, rng) -> dict:
 
 
 def _write(path, run: dict, env: str) -> None:
-    cols = ["t_s", "S_rpm", "d_x_um", "T_room", "T_bearing", "T_casting", "T_cabinet"]
-    lines = ["# channel d_x: X", ",".join(cols + ["environment"])]
-    lines += [",".join(f"{run[c][i]:.6f}" for c in cols) + f",{env}"
-              for i in range(len(run["t_s"]))]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    M.write_run(path, run, env, ["t_s", "S_rpm", "d_x_um", "T_room", "T_bearing", "T_casting",
+                                 "T_cabinet"])
 
 
 @pytest.fixture(scope="module")

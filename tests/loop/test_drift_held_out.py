@@ -72,10 +72,7 @@ def _run(programme: str, env: str, hour: float, rng) -> dict:
 
 
 def _write(path, run: dict, env: str) -> None:
-    lines = ["# channel d_x: ?", ",".join(COLS + ("environment",))]
-    lines += [",".join(f"{run[c][i]:.6f}" for c in COLS) + f",{env}"
-              for i in range(len(run["t_s"]))]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    M.write_run(path, run, env, COLS, direction="?")
 
 
 @pytest.fixture(scope="module")
