@@ -15,7 +15,10 @@ def register(sub) -> None:
     a("--map", metavar="'RAW=NAME,...'", help=H["--map"])
     a("--time-unit", choices=("s", "min", "h"), help=H["--time-unit"])
     a("--channel", action="append", metavar="'LABEL=DIR [at z=MM]'", help=H["--channel"])
-    a("--force", action="store_true", help="replace an existing --out file")
+    a("--force", action="store_true",
+      help="accepted for uniformity with the other commands; a file named by --out is "
+           "replaced either way (only output folders need --force), and never when the "
+           "input is refused")
     c.set_defaults(func=run)
 
 
