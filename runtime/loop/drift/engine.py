@@ -78,7 +78,8 @@ class Engine:
     def cv_many(self, W, cands) -> tuple[np.ndarray, float]:
         """(cross-validated SSE (nc,) of ``W`` plus each candidate, SSE of ``W`` alone).
         ``cands`` (nc, 2) index pairs (a, b) into Z's columns, b = -1 for a single column;
-        dependent candidates get +inf."""
+        dependent candidates get +inf.  From cross-products, an exact fit (a noise-free run)
+        lands at the rounding floor, which may fall below 0: returned as 0."""
         a, b = cands[:, 0], cands[:, 1]
         tot = np.zeros(len(cands))
         base, key, W = 0.0, W.tobytes(), Sel(W)
@@ -89,7 +90,7 @@ class Engine:
                                        a, b)
             tot += sse
             base += sse0
-        return tot, base
+        return np.maximum(tot, 0.0), max(base, 0.0)
 
     def _fit(self, key, k, Gt, ht, W, a, b) -> tuple:
         """:func:`_bordered_fit` on fold ``k``'s training cross-products; the

@@ -87,8 +87,7 @@ def select_terms(eng: Engine, cols, n_runs: int, cands=None, start=(), max_terms
     def propose(chosen):
         ok = _allowed(cands, cols, st["p"], st["taken"])
         sse, _ = eng.cv_many(st["W"], zc[ok])
-        # an exact fit (a noise-free run) scores at the rounding floor, which may fall below 0
-        mse = np.maximum(sse / eng.n, 0.0)
+        mse = sse / eng.n
         if not np.isfinite(mse).any():
             return None
         k = _first_best(mse, cands[ok])
@@ -124,10 +123,8 @@ def _first_best(mse, cands) -> int:
     for part in (single, ~single):
         part = part & np.isfinite(mse)
         if part.any():
-            # a score at the rounding floor of an exact fit (a noise-free ramp) may be < 0
             m = float(np.min(mse[part]))
-            bound = m * (1 + TIE_REL) if m >= 0 else m * (1 - TIE_REL)
-            best.append(int(np.flatnonzero(part & (mse <= bound + 1e-300))[0]))
+            best.append(int(np.flatnonzero(part & (mse <= m * (1 + TIE_REL) + 1e-300))[0]))
     if len(best) == 2 and not mse[best[1]] < mse[best[0]] * (1 - DIFF_GAIN):
         return best[0]
     return min(best, key=lambda i: (mse[i], i)) if len(best) == 2 else best[0]
