@@ -175,9 +175,7 @@ def _family_lines(c: dict) -> list:
     h = c.get("held_out_reported")
     if h and not h["within"]:
         out.append(f"    NOT HELD on the held-out readings: the reported model's held-out MAE "
-                   f"{h['mae_um']:.2f} um > {h['bound_um']:.2f} um = {HELD_OUT_REL:g} x the "
-                   f"{RIVAL[h['baseline']]}'s {h['baseline_mae_um']:.2f} um + "
-                   f"{HELD_OUT_ABS_UM:g} um: the choice the training readings made did not "
+                   f"{_over_bar(h['mae_um'], h)}: the choice the training readings made did not "
                    f"carry over here")
     if c.get("families_equivalent"):
         out.append("    the cross-validation cannot tell it from: " + ", ".join(
@@ -200,9 +198,16 @@ def _not_confirmed_line(h: dict, quantity: bool) -> str:
     ``h["channel"]`` of least margin)."""
     on = f" on channel {h['channel']}" if quantity else ""
     return (f"not confirmed on the held-out readings: the lag model's held-out MAE{on} "
-            f"{h['lag_model_mae_um']:.2f} um > {h['bound_um']:.2f} um = {HELD_OUT_REL:g} x the "
-            f"{RIVAL[h['baseline']]}'s {h['baseline_mae_um']:.2f} um + {HELD_OUT_ABS_UM:g} um: "
-            f"these terms describe the training readings, not a transfer")
+            f"{_over_bar(h['lag_model_mae_um'], h)}: these terms describe the training "
+            f"readings, not a transfer")
+
+
+def _over_bar(mae: float, h: dict) -> str:
+    """'MAE um > bound um = 1.05 x the baseline's B um + 0.2 um': a held-out MAE (um) above
+    the bar of the verdict ``h`` (:func:`volerr.loop.drift.family.held_out_verdict`,
+    :func:`~volerr.loop.drift.family.reported_held_out`)."""
+    return (f"{mae:.2f} um > {h['bound_um']:.2f} um = {HELD_OUT_REL:g} x the "
+            f"{RIVAL[h['baseline']]}'s {h['baseline_mae_um']:.2f} um + {HELD_OUT_ABS_UM:g} um")
 
 
 def _term_line(t: dict) -> str:
