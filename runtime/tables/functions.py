@@ -62,10 +62,7 @@ class _LinearGroup:
         x, last = self.x, len(self.x) - 2
         if self.inv_step is None:
             return np.clip(np.searchsorted(x, q, side="right") - 1, 0, last)
-        j = np.clip((q - x[0]) * self.inv_step, 0, last).astype(np.intp)
-        j -= (x.take(j) > q) & (j > 0)          # rounding may put q one segment off
-        j += (x.take(j + 1) <= q) & (j < last)
-        return j
+        return _bracket_even(x, q, x[0], self.inv_step, last)
 
     def __call__(self, q) -> np.ndarray:
         x, y, slope = self.x, self.y, self.slope
@@ -81,6 +78,27 @@ class _LinearGroup:
             out[:, first] = y[:, :1] if self.clamp else \
                 y[:, :1] + (q[first] - x[0]) * (y[:, 1:2] - y[:, :1]) / (x[1] - x[0])
         return out
+
+
+def _range_tolerance(lo: float, hi: float) -> float:
+    """How far beyond a table's measured range ``lo`` .. ``hi`` (mm / deg) a position still
+    counts as inside (rounding of positions written to a few decimals)."""
+    return 1e-9 * max(1.0, hi - lo)
+
+
+def _bracket_even(x, q, first, inv_step, last, off=None):
+    """Segment index j per position on evenly spaced nodes ``x``: x[j] <= q < x[j+1],
+    clipped to the end segments (the same j as a binary search).  ``first``, ``inv_step``,
+    ``last`` (the last segment's index) scalars for one axis, or columns (n_axes, 1) with
+    ``off`` each axis' first index into the concatenated ``x`` (:class:`_LinearStack`)."""
+    j = np.minimum(np.maximum((q - first) * inv_step, 0), last).astype(np.intp)
+    lo = 0
+    if off is not None:
+        j += off
+        lo, last = off, off + last
+    j -= (x.take(j) > q) & (j > lo)          # rounding may put q one segment off
+    j += (x.take(j + 1) <= q) & (j < last)
+    return j
 
 
 #: up to this many positions the linear functions of all axes are evaluated at once
@@ -124,11 +142,7 @@ class _LinearStack:
     def __call__(self, Q: np.ndarray) -> list:
         if not self.even:
             return [g(q) for g, q in zip(self.groups, Q)]
-        # _LinearGroup.bracket, every axis at once
-        j = np.minimum(np.maximum((Q - self.first) * self.inv_step, 0), self.last).astype(np.intp)
-        j += self.off
-        j -= (self.x.take(j) > Q) & (j > self.off)
-        j += (self.x.take(j + 1) <= Q) & (j < self.off + self.last)
+        j = _bracket_even(self.x, Q, self.first, self.inv_step, self.last, self.off)
         d = (Q - self.x.take(j))[self.row_group]
         j -= self.off
         jr = j[self.row_group]
@@ -331,7 +345,7 @@ class ErrorFunctions:
         if not self.extrapolate:
             for ax, (lo, hi) in self.ranges().items():
                 v = cols[ax]
-                tol = 1e-9 * max(1.0, hi - lo)
+                tol = _range_tolerance(lo, hi)
                 if not len(v) or (v.min() >= lo - tol and v.max() <= hi + tol):
                     continue        # (finite values, all inside: the usual case)
                 bad = (v < lo - tol) | (v > hi + tol)
@@ -356,7 +370,7 @@ class ErrorFunctions:
         key = tuple((ax, t.positions[0], t.positions[-1]) for ax, t in self.tables.items())
         if cache.get("key") != key:
             ranges = self.ranges()
-            tol = {ax: 1e-9 * max(1.0, hi - lo) for ax, (lo, hi) in ranges.items()}
+            tol = {ax: _range_tolerance(lo, hi) for ax, (lo, hi) in ranges.items()}
             cache.update(key=key, idx=[self.model.axes.index(ax) for ax in ranges],
                          lo=np.array([lo - tol[ax] for ax, (lo, _) in ranges.items()]),
                          hi=np.array([hi + tol[ax] for ax, (_, hi) in ranges.items()]))
