@@ -46,7 +46,7 @@ import numpy as np
 import pytest
 
 from helpers.fl_runs import GROUP, WINDOWS, loop_run
-from volerr.loop.drift.basis import N_TAU
+from volerr.loop.drift.basis import N_TAU, TAU_MIN_STEPS
 
 pytestmark = [pytest.mark.slow]
 
@@ -215,3 +215,17 @@ def test_every_term_names_its_group(runs, name):
                     assert lo <= t["lag_s"]["value"] <= hi, (name, step, t["basis"])
                 else:
                     assert t["tau_equivalent_s"] is None
+
+
+@pytest.mark.parametrize("name", [_window(n) for n in WINDOWS])
+def test_every_named_lag_is_within_the_searched_grid(runs, name):
+    """A named lag is no shorter than the grid's shortest, ``TAU_MIN_STEPS`` reading
+    intervals and at least 60 s (docs/drift_loop.md, basis.py): a lag of fewer readings is
+    not resolved by them.  Before the refinement was clipped to the grid, 0-20 % named
+    ``lag(T_4, 35 s)`` at 15 s (ch1, ch2) and ``lag(T_8, 193-215 s)`` at 60 s (ch3, ch4)."""
+    for step in STEPS:
+        lo = max(60.0, TAU_MIN_STEPS * 15.0 * step)
+        for e in runs(step, name)["effects"]:
+            for t in e["terms"]:
+                if t["lag_s"]:
+                    assert t["lag_s"]["value"] >= lo - 0.05, (name, step, t["basis"])

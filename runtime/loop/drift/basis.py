@@ -21,7 +21,7 @@ is causal, the held-out part is predicted from its own inputs):
 
 Time constants: a geometric grid of ``N_TAU`` values from ``TAU_MIN_STEPS`` reading intervals
 (at least 60 s) to half the training duration; the selected one is refined between its grid
-neighbours.  Columns are scaled to unit RMS over the training part (conditioning; the
+neighbours, within the grid's range.  Columns are scaled to unit RMS over the training part (conditioning; the
 reported coefficients are in the units of the unscaled column).
 
 Folds (the split rule of ``volerr formats loop-lags``): where the files name the runs'

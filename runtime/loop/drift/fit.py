@@ -257,13 +257,17 @@ def _refine_all(ch: Channel, specs) -> list:
 def _refine(ch: Channel, sp, others=()) -> dict:
     """The term's time constant refined by the cross-validated error of the model with it
     beside the run zeros and the other terms (columns ``others``; grid step r: ln tau
-    +- ``REFINE`` r); ties (``TIE_SCORE_REL``) go to the first value tried."""
+    +- ``REFINE`` r, clipped to the grid's range); ties (``TIE_SCORE_REL``) go to the first
+    value tried."""
     if not sp["tau_s"] > 0:
         return sp
     r = _grid_step_of(ch.s)
+    grid = basis.tau_grid(ch.s)
     best = None
     for d in REFINE:
-        tau = sp["tau_s"] * math.exp(d * r)
+        # within the grid's range: a lag shorter than its shortest (TAU_MIN_STEPS readings)
+        # is not resolved by the readings, one longer than its longest not by the runs
+        tau = min(max(sp["tau_s"] * math.exp(d * r), float(grid[0])), float(grid[-1]))
         e = ch.cv(np.column_stack([ch.R, *others, column(ch.s, sp, tau)]))
         if best is None or e < best[0] * (1 - TIE_SCORE_REL):
             best = (e, tau)
