@@ -48,7 +48,8 @@ from ...errors import require
 from .series import DriftSeries
 
 __all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "kept_out", "library",
-           "many_runs", "modelled", "reference", "series", "sensors", "tau_grid"]
+           "many_runs", "modelled", "reference", "room", "room_undecided", "series", "sensors",
+           "tau_grid"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
 N_TAU = 14                # time constants on the grid
@@ -64,6 +65,15 @@ KEEP_OUT_RATIO = 4.0
 MANY_RUNS = 6
 #: words in a logged input's name that make it a sensor of the room air (the environment)
 ROOM_WORDS = ("room", "ambient")
+#: the training runs hold the room for a sensor where the room's change spans at most this
+#: share of the sensor's own change (:func:`room_undecided`)
+ROOM_HELD_SHARE = 0.2
+#: ... and the held-out runs' room changes by more than this many times the training's
+ROOM_VARY_RATIO = 3.0
+ROOM_RULE = (f"the held-out runs' room changes (peak to peak since each run's zero) more "
+             f"than {ROOM_VARY_RATIO:g} x the training runs', and the sensors named change "
+             f"in training at least {1 / ROOM_HELD_SHARE:g} x the room: their absolute "
+             f"change and their rise over the room are one column there")
 
 
 @dataclass
@@ -128,12 +138,24 @@ def reference(s: DriftSeries) -> str | None:
     heat's rate.  Taken as its rise over the room (``T - T_room``, through the same lag) the
     heat's part enters alone, and the room enters as an input of its own, plain and through
     its own lags (room air reaches the structure through hours)."""
-    if not many_runs(s):
-        return None
-    return next((k for k in sensors(s) if any(w in k.lower() for w in ROOM_WORDS)), None)
+    return room(s) if many_runs(s) else None
 
 
-def _is_room(k: str) -> bool:
+def room(s: DriftSeries) -> str | None:
+    """The room sensor: the first logged sensor whose name holds one of ``ROOM_WORDS``
+    (None: none), whether or not the other sensors are taken as rises over it."""
+    return next((k for k in sensors(s) if is_room(k)), None)
+
+
+def alternative_reference(s: DriftSeries) -> str | None:
+    """The other reading of the sensors (:func:`room_undecided`): plain where the model takes
+    them as rises over the room (:func:`reference`), else their rise over the room sensor
+    (:func:`room`)."""
+    return None if reference(s) else room(s)
+
+
+def is_room(k: str) -> bool:
+    """Whether the input named ``k`` is a sensor of the room air (``ROOM_WORDS``)."""
     return any(w in k.lower() for w in ROOM_WORDS)
 
 
@@ -141,7 +163,7 @@ def entered(s: DriftSeries, k: str, ref: str | None) -> np.ndarray:
     """The sensor ``k`` as the model takes it: its reading, or its rise over the room
     sensor ``ref`` (:func:`reference`; a room sensor itself is taken plain)."""
     v = np.asarray(s.inputs[k], float)
-    return v - np.asarray(s.inputs[ref], float) if ref and not _is_room(k) else v
+    return v - np.asarray(s.inputs[ref], float) if ref and not is_room(k) else v
 
 
 def kept_out(s: DriftSeries) -> list:
@@ -165,9 +187,59 @@ def kept_out(s: DriftSeries) -> list:
         d = v - s.zero(v)
         a, b = float(np.ptp(d[s.train])), float(np.ptp(d[whole]))
         if b > KEEP_OUT_RATIO * a:
-            out.append({"input": k if not (ref and not _is_room(k)) else f"{k} - {ref}",
+            out.append({"input": k if not (ref and not is_room(k)) else f"{k} - {ref}",
                         "sensor": k, "train_change": a, "test_change": b})
     return out
+
+
+def _change_ptp(s: DriftSeries, k: str, mask) -> float:
+    """Peak to peak (units of the input) of the input ``k``'s change since its run's zero
+    over the readings ``mask`` (pooled over their runs)."""
+    v = np.asarray(s.inputs[k], float)
+    d = (v - s.zero(v))[mask]
+    return float(np.ptp(d)) if len(d) else 0.0
+
+
+def room_undecided(s: DriftSeries) -> dict | None:
+    """What a training in a held room cannot decide: whether a sensor acts by its absolute
+    change (a temperature of the structure: its change carries over) or by its rise over
+    the room (a proxy of the machine's heat: its rise carries over).  The two readings of a
+    sensor differ by the room's change alone; where the training runs hold the room they
+    are nearly one column, and the model's reading (:func:`reference`: rises with many
+    runs, else plain) is an assumption these data do not test; where the held-out runs'
+    room moves, the two predict differently.
+
+    The rule (changes since each run's zero, peak to peak over all readings of a part,
+    pooled over its runs, K): a room sensor (:func:`room`) and whole held-out runs; the
+    held-out runs' room change more than ``ROOM_VARY_RATIO`` x the training runs' (several
+    times: the two readings then differ there by more than anything the blocked CV saw);
+    and the sensors named are the modelled ones (:func:`modelled`; not the room's own)
+    whose own training change is at least 1 / ``ROOM_HELD_SHARE`` x the room's (the two
+    readings differ in training by at most a fifth of the sensor's change: with a room
+    independent of the heat they correlate above 0.98, which no blocked CV separates from
+    the heat's lags).  None where it does not fire (no such sensor).  Returns {"room",
+    "train_room_ptp_K", "held_out_room_ptp_K", "reading" (the model's: "rise over the
+    room" or "absolute"), "alternative" (the other), "sensors": [{"sensor",
+    "train_change_K", "room_share"}] in file order}."""
+    k_room = room(s)
+    seen = np.array([np.any(s.train & (s.run == r)) for r in range(len(s.runs))])
+    whole = s.test & ~seen[s.run]
+    if k_room is None or not whole.any():
+        return None
+    a, b = _change_ptp(s, k_room, s.train), _change_ptp(s, k_room, whole)
+    if not b > ROOM_VARY_RATIO * a:
+        return None
+    named = []
+    for k in modelled(s):
+        own = _change_ptp(s, k, s.train)
+        if not is_room(k) and a <= ROOM_HELD_SHARE * own:
+            named.append({"sensor": k, "train_change_K": own, "room_share": a / own})
+    if not named:
+        return None
+    rise = reference(s) is not None
+    return {"room": k_room, "train_room_ptp_K": a, "held_out_room_ptp_K": b,
+            "reading": "rise over the room" if rise else "absolute",
+            "alternative": "absolute" if rise else "rise over the room", "sensors": named}
 
 
 def modelled(s: DriftSeries) -> list:
@@ -193,13 +265,15 @@ def series(s: DriftSeries, source: str, tau_s: float, p: float | None = None) ->
     return y - s.zero(y)
 
 
-def library(s: DriftSeries) -> tuple[list, np.ndarray]:
-    """Every basis column (list of :class:`Column`) and their values (N, m), scaled."""
+def library(s: DriftSeries, alternative: bool = False) -> tuple[list, np.ndarray]:
+    """Every basis column (list of :class:`Column`) and their values (N, m), scaled;
+    ``alternative``: the sensors in their other reading (:func:`alternative_reference`), the
+    same columns otherwise (same sensors, lags and order)."""
     taus = tau_grid(s)
-    ref = reference(s)
+    ref = alternative_reference(s) if alternative else reference(s)
     cols = []
     for name in modelled(s):
-        m = ref if ref and not _is_room(name) else None
+        m = ref if ref and not is_room(name) else None
         cols += [Column(name, 0.0, minus=m)] + [Column(name, float(t), minus=m) for t in taus]
     if SPEED in s.inputs and np.ptp(s.inputs[SPEED][s.train]) > 0:
         for p in P_GRID:

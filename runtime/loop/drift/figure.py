@@ -119,7 +119,7 @@ def render_template(name: str, **context) -> str:
 def render_html(report) -> str:
     """The complete HTML text of a :class:`volerr.loop.drift.report.DriftReport`."""
     from .series import left_out_line
-    from .split import extrapolation_line
+    from .split import extrapolation_line, room_undecided_line
 
     d = report.data
     lines = report.summary_lines()
@@ -128,4 +128,5 @@ def render_html(report) -> str:
                            headline=next(x for x in lines if not x.startswith(" ")).strip(),
                            extrapolation=extrapolation_line(d.get("extrapolation") or []),
                            left_out=left_out_line(d.get("inputs_left_out") or []),
+                           room_undecided=room_undecided_line(d.get("room_undecided")),
                            figures=figs, k=report.K_PRINT, sig_k=f"{SIG_K:g}")

@@ -99,13 +99,76 @@ def run_drift(s: basis.DriftSeries, differences: bool = False, progress=None) ->
     R = s.indicators()
     Z = np.column_stack([R, X])
     cands = _candidates(s, cols, differences, basis.many_runs(s))
-    out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {}}
+    out = {"fold_rule": rule, "n_folds": int(fold.max()) + 1, "channels": {},
+           "room_undecided": basis.room_undecided(s)}
     cache: dict = {}
+    alt = _Alternative(s, differences) if out["room_undecided"] else None
     for label, y in s.channels.items():
         if progress:
             progress(label)
-        out["channels"][label] = _channel(Channel(s, y, R, fold, rule), cols, Z, cands, cache)
+        ch = Channel(s, y, R, fold, rule)
+        out["channels"][label] = r = _channel(ch, cols, Z, cands, cache)
+        if alt is not None:
+            r["alternative"] = alt.predict(ch, r)
     return out
+
+
+class _Alternative:
+    """The chosen family fitted on the sensors' other reading (plain instead of their rise
+    over the room, or the reverse: :func:`volerr.loop.drift.basis.alternative_reference`),
+    on the same training readings, where the training cannot decide between the two
+    (:func:`volerr.loop.drift.basis.room_undecided`); its prediction widens the interval
+    (:func:`volerr.loop.drift.interval.widen_for_room`).  Per family: the constant has no
+    sensor (no alternative); the static regression takes every temperature as its rise
+    over the room, except where the room is itself one of its columns (then the two
+    readings span the same columns: the same prediction, none computed); the lag model
+    keeps its terms and time constants, each sensor term in its other reading (a
+    difference of two sensors, the room's own terms and the heat input as they are), its
+    coefficients refitted by least squares; the regularised fit is refitted on the bank in
+    the other reading, its lambda chosen by the same blocked CV (shared by the channels:
+    ``cache``)."""
+
+    def __init__(self, s, differences: bool):
+        self.s, self.differences, self.cache = s, differences, {}
+        self.ref, self.other = basis.reference(s), basis.alternative_reference(s)
+        self.bank = None
+
+    def predict(self, ch: Channel, r: dict) -> np.ndarray | None:
+        """(N,) um: the alternative's prediction of every reading (None: the same as the
+        chosen family's)."""
+        fam, s, tr = r["choice"]["family"], ch.s, ch.s.train
+        if fam == "static":
+            room = basis.room(s)
+            temps = [k for k in basis.sensors(s) if k.startswith("T")]
+            if room in temps:
+                return None
+            D = np.column_stack([ch.R] + [basis.series(s, k, 0.0) - basis.series(s, room, 0.0)
+                                          for k in temps])
+            return predict(s, D, _fit(D, ch.y, tr), ch.y)
+        if fam == "lag":
+            D = ch.design([self._other(sp) for sp in r["terms"]])
+            return predict(s, D, _fit(D, ch.y, tr), ch.y)
+        if fam == "regularised":
+            if self.bank is None:
+                cols, X = basis.library(s, alternative=True)
+                cands = _candidates(s, cols, self.differences, basis.many_runs(s))
+                self.bank = (cols, np.column_stack([ch.R, X]),
+                             sorted({int(a) for c in cands for a, b in c if b < 0}))
+            cols, Z, keep = self.bank
+            return shrink.fit(s, ch.y, Z, [ch.n_runs + j for j in keep],
+                              [cols[j] for j in keep], ch.fold, ch.rule, self.cache)["pred"]
+        return None
+
+    def _other(self, sp: dict) -> dict:
+        """The term ``sp`` in the sensors' other reading (the class docstring)."""
+        if sp["source"] == "heat" or basis.is_room(sp["source"]):
+            return sp
+        if self.ref and sp["minus"] == self.ref:
+            return {**sp, "minus": None}
+        if not self.ref and sp["minus"] is None:
+            return {**sp, "minus": self.other}
+        return sp
+
 
 def _candidates(s, cols, differences: bool, many: bool = False) -> tuple:
     """(heat candidates, sensor candidates) as (nc, 2) pairs: a sensor's lag is searched up

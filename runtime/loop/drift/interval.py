@@ -43,6 +43,12 @@ squares covariance ``(X'X)^-1`` understates the coefficients' by about that fact
 effective number of readings ``n (1 - rho) / (1 + rho)``); without it the leverage of
 thousands of readings stays near 0 even where the inputs extrapolate.
 
+Where the training runs hold the room and the held-out runs' room moves
+(:func:`volerr.loop.drift.basis.room_undecided`), the folds cannot show what the sensors'
+reading (absolute change or rise over the room) does there: every held-out reading's
+half-width is widened by ``abs(prediction - alternative)``, the alternative being the chosen
+family fitted on the sensors' other reading (:func:`widen_for_room`).
+
 Calibration and prediction use the same definition of ``sigma``; the folds are still not
 the held-out part (a held-out stretch is one draw of a level, and the lag model's terms were
 chosen on all folds): the held-out coverage is reported beside the interval
@@ -227,3 +233,36 @@ def interval(cv_resid, y, pred, fold, test, lev=None) -> dict:
             "q": q, "rho": round(rho, 6),
             "coverage_test": float(np.mean(e <= hw[test])) if len(e) else None,
             "method": METHOD, "per_reading": hw}
+
+
+def widen_for_room(iv: dict, y, pred, alternative, test, reading: str) -> None:
+    """Widen the interval ``iv`` (:func:`interval`, in place) where the training runs hold
+    the room (:func:`volerr.loop.drift.basis.room_undecided`): each held-out reading's
+    half-width grows by ``abs(pred - alternative)`` (um), the difference of the chosen
+    prediction ``pred`` and the chosen family's fit in the sensors' other reading
+    ``alternative`` (``reading``: which; None: the same prediction, no widening).  Why
+    added, not combined in quadrature: the two readings are two models these data cannot
+    tell apart, not two random errors; the band must hold the alternative's too
+    (``abs(y - alternative) <= hw`` gives ``abs(y - pred) <= hw + abs(d)``).  A confident
+    wrong answer is worse than a wide one.  The prediction stays the chosen model's.  Adds
+    ``iv["room_undecided"]`` {"alternative", "same_model" (no alternative: the family's two
+    readings are one model), "difference_um" [median, max] over the held-out readings,
+    "half_width_um_unwidened", "coverage_test_unwidened"}."""
+    d = np.zeros(len(y)) if alternative is None else np.abs(np.asarray(pred) - alternative)
+    d = np.where(test, d, 0.0)
+    hw = iv["per_reading"] + d
+    e = np.abs((y - pred)[test])
+    at = hw[test]
+    iv["room_undecided"] = {
+        "alternative": reading, "same_model": alternative is None,
+        "difference_um": [float(np.median(d[test])),
+                                                  float(np.max(d[test]))],
+        "half_width_um_unwidened": iv["half_width_um"],
+        "coverage_test_unwidened": iv["coverage_test"]}
+    iv.update({"half_width_um": float(np.median(at)),
+               "half_width_um_range": [float(np.min(at)), float(np.max(at))],
+               "coverage_test": float(np.mean(e <= at)), "per_reading": hw})
+    if alternative is not None:
+        iv["method"] = (METHOD + "; each held-out reading's half-width widened by abs(the "
+                        "prediction - the same family in the sensors' other reading of the "
+                        "room) (the training holds the room)")

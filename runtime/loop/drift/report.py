@@ -21,7 +21,7 @@ from ...selection.rules import SIG_K
 from . import basis
 from .family import HELD_OUT_ABS_UM, HELD_OUT_REL, RIVAL
 from .series import DriftSeries, left_out_line
-from .split import extrapolation_line, kept_out_line
+from .split import extrapolation_line, kept_out_line, room_undecided_line
 
 K_PRINT = 2.0      # coverage factor of the printed uncertainties (the loop's console, 3-D too)
 
@@ -117,6 +117,8 @@ class DriftReport(ResultMixin):
                   else "")]
         if d.get("extrapolation"):
             out.insert(0, "  " + extrapolation_line(d["extrapolation"]))
+        if d.get("room_undecided"):
+            out.insert(0, "  " + room_undecided_line(d["room_undecided"]))
         if d.get("kept_out"):
             out.insert(0, "  " + kept_out_line(d["kept_out"]))
         if d.get("inputs_left_out"):
@@ -189,6 +191,18 @@ def _family_lines(c: dict) -> list:
                    f"{iv['half_width_um']:.3f} um (median over the held-out readings; "
                    f"{lo:.3f}..{hi:.3f} um, wider where the inputs extrapolate; from the "
                    f"blocked-CV residuals); held-out readings inside it: {cov}")
+        room = iv.get("room_undecided")
+        if room and room["same_model"]:
+            out.append("      not widened for the room: in this model the sensors' two readings "
+                       "are one model (the room is a column of its own, or no sensor enters)")
+        elif room:
+            cov0 = room["coverage_test_unwidened"]
+            out.append(f"      widened on the held-out readings by the difference to the "
+                       f"{room['alternative']} reading of the sensors (median "
+                       f"{room['difference_um'][0]:.3f}, max {room['difference_um'][1]:.3f} um;"
+                       f" the training holds the room): without it +- "
+                       f"{room['half_width_um_unwidened']:.3f} um, inside it "
+                       + ("n/a" if cov0 is None else f"{100 * cov0:.1f} %"))
     return out
 
 

@@ -196,6 +196,10 @@ def map_back(s: basis.DriftSeries, rows: Rows, qpred: dict, resid: dict) -> dict
         # the interval's scale: the largest leverage of its quantities' (interval.py)
         p["leverage"] = np.max([qpred[q.symbol]["leverage"] for _, q in on], axis=0) \
             if on else None
+        alts = [qpred[q.symbol].get("alternative") for _, q in on]
+        if any(a is not None for a in alts):    # the room's other reading (fit._Alternative)
+            p["alternative"] = c + sum(rows.A[i, j] * (qpred[q.symbol]["after"] if a is None
+                                                       else a) for (j, q), a in zip(on, alts))
         fams = [qpred[q.symbol]["family"] for _, q in on]
         p["family"] = max(fams, key=FAMILY_ORDER.index) if fams else "constant"
         for j, q in on:

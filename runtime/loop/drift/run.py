@@ -84,6 +84,8 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
             "not_significant": [], "not_reported": [], "unidentifiable": [],
             "extrapolation": extrapolation(s), "inputs_left_out": list(s.left_out),
             "kept_out": basis.kept_out(s)}
+    if res["room_undecided"]:  # what a training in a held room cannot decide (basis.py)
+        data["room_undecided"] = {**res["room_undecided"], "rule": basis.ROOM_RULE}
     if s.environments:        # each run's environment (the folds' groups, basis.folds)
         data["environments"] = {(f if not r else f"{f}[{r}]"): e
                                 for (f, r), e in zip(s.runs, s.environments)}
@@ -99,7 +101,7 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
     for label, p in pred.items():
         c = data["channels"][label] = _metrics(s, s.channels[label], p["before"], p["after"],
                                                p["static"])
-        c.update(_family(s, label, p, res["channels"].get(label)))
+        c.update(_family(s, label, p, res["channels"].get(label), res["room_undecided"]))
         c["direction"] = s.directions.get(label, "?")
         if label in resid:
             c["row"] = rows.row(label)
@@ -167,7 +169,7 @@ def _prediction(m, r) -> dict:
     return {"before": r["before"], "lag": lag, "after": lag if fam == "lag" else r[fam],
             "static": r["static"], "constant": r["constant"], "regularised": r["regularised"],
             "cv_resid": c["cv_resid"], "family": fam, "leverage": r["leverage"],
-            "terms": r["terms"] if c["named"] else []}
+            "terms": r["terms"] if c["named"] else [], "alternative": r.get("alternative")}
 
 
 def _quantity(q, rows) -> dict:
@@ -190,9 +192,11 @@ def _choice(choice, has_terms) -> dict:
                                       has_terms, choice["t_crit"], choice["named"])}
 
 
-def _family(s, label, p, r) -> dict:
+def _family(s, label, p, r, room=None) -> dict:
     """A channel's baselines' held-out figures, the lag model's, its family (a channel of
-    rows: the most complex of its quantities') and its prediction interval."""
+    rows: the most complex of its quantities') and its prediction interval (``room``: what
+    the training cannot decide, :func:`volerr.loop.drift.basis.room_undecided`; None:
+    nothing)."""
     y, te = s.channels[label], s.test
     figs = {}
     for name in ("static", "constant", "lag", "regularised"):
@@ -215,6 +219,8 @@ def _family(s, label, p, r) -> dict:
     else:
         out["family"] = p["family"]
     iv = band.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te, p.get("leverage"))
+    if room is not None:      # widened by the room's other reading (interval.py)
+        band.widen_for_room(iv, y, p["after"], p.get("alternative"), te, room["alternative"])
     p["half_width"] = iv.pop("per_reading")
     out["interval"] = iv
     return out

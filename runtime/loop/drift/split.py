@@ -194,3 +194,19 @@ def kept_out_line(items: list) -> str:
     return ("warning: kept out of the lag model, their held-out runs change far more than the "
             "training runs (peak to peak since each run's zero): " + ", ".join(parts)
             + "; their coefficients were never determined, what they do there is unmodelled")
+
+
+def room_undecided_line(item: dict | None) -> str:
+    """One console line saying what :func:`volerr.loop.drift.basis.room_undecided` found
+    (None: '')."""
+    if not item:
+        return ""
+    names = ", ".join(e["sensor"] for e in item["sensors"])
+    verb, its = ("acts", "its") if len(item["sensors"]) == 1 else ("act", "their")
+    return (f"warning: the training runs hold the room ({item['room']} changes "
+            f"{item['train_room_ptp_K']:.3g} K peak to peak, the held-out runs' "
+            f"{item['held_out_room_ptp_K']:.3g} K), so whether {names} {verb} by {its} absolute "
+            f"change (a structure temperature) or by {its} rise over the room (a heat proxy) "
+            f"is not decided by these data (the model takes the {item['reading']}); the two "
+            f"readings differ in the held-out room, the prediction interval holds both; a "
+            f"training run in a varying room decides it")
