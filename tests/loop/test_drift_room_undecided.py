@@ -114,7 +114,14 @@ def test_the_widened_interval_covers_the_held_out_room(held_room):
     unwidened = band.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te,
                               p["leverage"])["per_reading"]
     d = np.abs(p["after"] - p["alternative"])
-    np.testing.assert_allclose(p["half_width"][te], unwidened[te] + d[te], rtol=1e-12)
+    # and the kept-out inputs' widening after it (interval.widen_for_kept_out)
+    kept = np.zeros(len(y))
+    ref = basis.reference(s)
+    for e, w in zip(held_room["kept_out"], iv["kept_out_widening"]["inputs"]):
+        v = basis.entered(s, e["sensor"], ref)
+        kept += (abs(w["coef_um_per_unit"]) + 2 * w["u"]) * np.abs(v - s.zero(v))
+    np.testing.assert_allclose(p["half_width"][te], unwidened[te] + d[te] + kept[te],
+                               rtol=1e-12)
     np.testing.assert_array_equal(p["half_width"][~te], unwidened[~te])
     assert r["difference_um"] == [pytest.approx(np.median(d[te])), pytest.approx(d[te].max())]
     # coverage at the stated level where before it was not (59.0 % -> 99.9 %)

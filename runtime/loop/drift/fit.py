@@ -391,6 +391,22 @@ def _jackknife(ch: Channel, specs) -> dict:
             "tau_dev": tk - tk.mean(0)}
 
 
+def kept_out_coef(s, resid, x, fold) -> tuple[float, float]:
+    """What the training readings say of a kept-out input's coefficient
+    (:func:`volerr.loop.drift.basis.kept_out`): ``resid`` (N,) um the chosen family's
+    residuals, ``x`` (N,) the input's change since its run's zero (units of the input),
+    regressed on a free zero per training run and ``x`` over the training readings.  Returns
+    (b um per unit, u its blocked jackknife standard uncertainty over the folds ``fold``:
+    each fit without one fold, ``sqrt((K - 1) / K sum (b_k - mean b_k)^2)``, as
+    :func:`_jackknife`)."""
+    tr = s.train
+    D = np.column_stack([s.indicators(), x])
+    b = float(_fit(D, resid, tr)[-1])
+    K = int(fold.max()) + 1
+    bk = np.array([_fit(D, resid, tr & (fold != k))[-1] for k in range(K)])
+    return b, float(np.sqrt((K - 1) / K * ((bk - bk.mean()) ** 2).sum()))
+
+
 def _tau_on(ch: Channel, sp, i, specs, masks) -> list:
     """Per mask of ``masks``: (the term's time constant re-estimated on those readings,
     whether it lies at the edge of the range searched): least RSS over ln tau within +- one

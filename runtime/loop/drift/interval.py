@@ -266,3 +266,44 @@ def widen_for_room(iv: dict, y, pred, alternative, test, reading: str) -> None:
         iv["method"] = (METHOD + "; each held-out reading's half-width widened by abs(the "
                         "prediction - the same family in the sensors' other reading of the "
                         "room) (the training holds the room)")
+
+
+def widen_for_kept_out(iv: dict, y, pred, test, terms: list) -> None:
+    """Widen the interval ``iv`` (:func:`interval`, in place, after :func:`widen_for_room`)
+    for the inputs kept out of the model (:func:`volerr.loop.drift.basis.kept_out`): their
+    coefficients were never determined, what they do on the held-out readings is unmodelled.
+    ``terms``: per input {"input", "coef_um_per_unit" b, "u" (its blocked jackknife standard
+    uncertainty; b fitted to the chosen family's training residuals), "change" (N,) the
+    input's change since its run's zero}.  Each held-out reading's half-width grows by
+    ``sum (abs(b) + 2 u) abs(change)`` (um): the effect the training readings leave
+    possible (b within two u), added as :func:`widen_for_room` adds (a bound on an effect
+    not modelled, not a random error).  The prediction stays the chosen model's.  Adds
+    ``iv["kept_out_widening"]`` {"inputs": [{"input", "coef_um_per_unit", "u",
+    "held_out_change_max" (max abs(change) over the held-out readings)}], "difference_um"
+    [median, max] over the held-out readings, "half_width_um_unwidened",
+    "coverage_test_unwidened"}."""
+    d = np.zeros(len(y))
+    items = []
+    for e in terms:
+        x = np.abs(np.asarray(e["change"], float))
+        d = d + (abs(e["coef_um_per_unit"]) + 2.0 * e["u"]) * x
+        items.append({"input": e["input"], "coef_um_per_unit": e["coef_um_per_unit"],
+                      "u": e["u"],
+                      "held_out_change_max": float(np.max(x[test])) if np.any(test) else 0.0})
+    d = np.where(test, d, 0.0)
+    hw = iv["per_reading"] + d
+    if not np.any(test):
+        return
+    e = np.abs((y - pred)[test])
+    at = hw[test]
+    iv["kept_out_widening"] = {
+        "inputs": items, "difference_um": [float(np.median(d[test])), float(np.max(d[test]))],
+        "half_width_um_unwidened": iv["half_width_um"],
+        "coverage_test_unwidened": iv["coverage_test"]}
+    iv.update({"half_width_um": float(np.median(at)),
+               "half_width_um_range": [float(np.min(at)), float(np.max(at))],
+               "coverage_test": float(np.mean(e <= at)), "per_reading": hw})
+    iv["method"] = iv["method"] + (
+        "; each held-out reading's half-width widened by the sum over the inputs kept out "
+        "of (abs(b) + 2 u) abs(the input's change since its run's zero), b and u its "
+        "coefficient on the training residuals and its blocked jackknife uncertainty")

@@ -203,6 +203,16 @@ def _family_lines(c: dict) -> list:
                        f" the training holds the room): without it +- "
                        f"{room['half_width_um_unwidened']:.3f} um, inside it "
                        + ("n/a" if cov0 is None else f"{100 * cov0:.1f} %"))
+        kept = iv.get("kept_out_widening")
+        if kept:
+            cov0 = kept["coverage_test_unwidened"]
+            names = ", ".join(f"{k['input']} ({k['coef_um_per_unit']:.3g} +- "
+                              f"{2 * k['u']:.3g} um/unit, k = 2)" for k in kept["inputs"])
+            out.append(f"      widened on the held-out readings for the inputs kept out, "
+                       f"by their coefficients on the training residuals: {names} (median "
+                       f"{kept['difference_um'][0]:.3f}, max {kept['difference_um'][1]:.3f} "
+                       f"um): without it +- {kept['half_width_um_unwidened']:.3f} um, inside "
+                       f"it " + ("n/a" if cov0 is None else f"{100 * cov0:.1f} %"))
     return out
 
 

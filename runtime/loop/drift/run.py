@@ -101,7 +101,8 @@ def analyse(model, s: DriftSeries, position: dict, split: str, differences: bool
     for label, p in pred.items():
         c = data["channels"][label] = _metrics(s, s.channels[label], p["before"], p["after"],
                                                p["static"])
-        c.update(_family(s, label, p, res["channels"].get(label), res["room_undecided"]))
+        c.update(_family(s, label, p, res["channels"].get(label), res["room_undecided"],
+                         data["kept_out"]))
         c["direction"] = s.directions.get(label, "?")
         if label in resid:
             c["row"] = rows.row(label)
@@ -192,11 +193,11 @@ def _choice(choice, has_terms) -> dict:
                                       has_terms, choice["t_crit"], choice["named"])}
 
 
-def _family(s, label, p, r, room=None) -> dict:
+def _family(s, label, p, r, room=None, kept=()) -> dict:
     """A channel's baselines' held-out figures, the lag model's, its family (a channel of
     rows: the most complex of its quantities') and its prediction interval (``room``: what
     the training cannot decide, :func:`volerr.loop.drift.basis.room_undecided`; None:
-    nothing)."""
+    nothing; ``kept``: the inputs kept out, :func:`volerr.loop.drift.basis.kept_out`)."""
     y, te = s.channels[label], s.test
     figs = {}
     for name in ("static", "constant", "lag", "regularised"):
@@ -221,8 +222,25 @@ def _family(s, label, p, r, room=None) -> dict:
     iv = band.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te, p.get("leverage"))
     if room is not None:      # widened by the room's other reading (interval.py)
         band.widen_for_room(iv, y, p["after"], p.get("alternative"), te, room["alternative"])
+    if kept:                  # widened by what a kept-out input may do (interval.py)
+        band.widen_for_kept_out(iv, y, p["after"], te, _kept_out_terms(s, y - p["after"], kept))
     p["half_width"] = iv.pop("per_reading")
     out["interval"] = iv
+    return out
+
+
+def _kept_out_terms(s, resid, kept) -> list:
+    """Per kept-out input (``kept``, :func:`volerr.loop.drift.basis.kept_out`): {"input",
+    "coef_um_per_unit", "u", "change" (N,) its change since its run's zero as kept_out
+    measures it}, the coefficient and its u fitted to the chosen family's residuals
+    ``resid`` on the training readings (:func:`volerr.loop.drift.fit.kept_out_coef`)."""
+    ref, fold = basis.reference(s), basis.folds(s)[0]
+    out = []
+    for e in kept:
+        v = basis.entered(s, e["sensor"], ref)
+        x = v - s.zero(v)
+        b, u = core.kept_out_coef(s, resid, x, fold)
+        out.append({"input": e["input"], "coef_um_per_unit": b, "u": u, "change": x})
     return out
 
 
