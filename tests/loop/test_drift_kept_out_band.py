@@ -7,7 +7,11 @@ through two hours, ``d = 8 lag(q, 1500 s) - 3 um/K (lag(T_room, 2 h) - start) + 
 ``T_room`` changes more than ``KEEP_OUT_RATIO`` times as much held out as in training: it is
 kept out of the model, and the room's own effect is what the model never fitted.  Measured
 (seed 3): the band held 33.7 % of the held-out readings (room widening included; its
-difference is 0 here), widened by ``b`` = -2.06 +- 0.46 um/K (true -3 through 30 min) 97.5 %.
+difference is 0 here), widened by ``b`` = -2.06 +- 0.46 um/K (true -3 through 30 min): 97.5 %
+with ``(abs(b) + 2 u) abs(change)`` added as the rule was first written, 85.9 % with the
+rule adopted (``abs(b change)`` added, ``2 u change`` in quadrature with the band:
+docs/drift_loop.md, "What a kept-out input may do").  Asked: at least 80 % and at least
+40 points above the band without the widening.
 
 The first version of this machine (the room through 2 h, the held room 0.05 K over 1 h,
 written before the rule's figures) did not pass: 33.7 % -> 45.0 % (room) -> 65.5 %, ``b`` =
@@ -19,7 +23,7 @@ in general.
 
 Checked to fail without the change: with ``widen_for_kept_out`` a no-op (the code before)
 the coverage test fails (the band holds the figure of ``coverage_test_unwidened``, below
-0.9) and the key is missing; with the coefficient fitted on all readings instead of each
+0.5) and the key is missing; with the coefficient fitted on all readings instead of each
 fold's the jackknife comparison fails; with the widening applied where nothing is kept out
 the no-kept-out test fails (checked for all three).  Three loop runs, about 2 s of CPU.
 """
@@ -32,6 +36,8 @@ import numpy as np
 import pytest
 
 from helpers import spindle_machine_sim as M
+from volerr.loop.drift import basis
+from volerr.loop.drift import interval as band
 from volerr.loop.drift import run as run_mod
 from volerr.loop.drift.run import loop_drift
 
@@ -84,8 +90,8 @@ def test_the_band_holds_the_kept_out_room(kept):
     assert [e["input"] for e in kept["kept_out"]] == ["T_room"]
     iv = kept["channels"]["x"]["interval"]
     w = iv["kept_out_widening"]
-    assert w["coverage_test_unwidened"] < 0.9, w          # the band before did not hold it
-    assert iv["coverage_test"] >= 0.9, iv
+    assert w["coverage_test_unwidened"] < 0.5, w          # the band before did not hold it
+    assert iv["coverage_test"] >= max(0.8, w["coverage_test_unwidened"] + 0.4), iv
     assert [k["input"] for k in w["inputs"]] == ["T_room"]
     s = kept.series
     x = s.inputs["T_room"] - s.zero(s.inputs["T_room"])
@@ -114,7 +120,15 @@ def test_the_coefficient_and_u_match_lstsq_per_fold(kept):
     got = w["inputs"][0]
     assert got["coef_um_per_unit"] == pytest.approx(b, rel=1e-6, abs=1e-9)
     assert got["u"] == pytest.approx(u, rel=1e-6)
-    d = (abs(b) + 2 * u) * np.abs(x[s.test])
+    # the band: the bias abs(b x) added, 2 u x in quadrature with the band before it
+    p, te = kept.pred["x"], s.test
+    h0 = band.interval(p["cv_resid"], y, p["after"], basis.folds(s)[0], te,
+                       p["leverage"])["per_reading"][te]
+    if p.get("alternative") is not None:        # the room's other reading (widen_for_room)
+        h0 = h0 + np.abs(p["after"] - p["alternative"])[te]
+    want = abs(b) * np.abs(x[te]) + np.sqrt(h0 ** 2 + (2 * u * x[te]) ** 2)
+    np.testing.assert_allclose(p["half_width"][te], want, rtol=1e-6)
+    d = want - h0
     assert w["difference_um"] == pytest.approx([np.median(d), np.max(d)], rel=1e-6)
 
 

@@ -115,12 +115,16 @@ def test_the_widened_interval_covers_the_held_out_room(held_room):
                               p["leverage"])["per_reading"]
     d = np.abs(p["after"] - p["alternative"])
     # and the kept-out inputs' widening after it (interval.widen_for_kept_out)
-    kept = np.zeros(len(y))
+    # (the bias abs(b x) added, 2 u x in quadrature with the room-widened band)
+    bias, var = np.zeros(len(y)), np.zeros(len(y))
     ref = basis.reference(s)
     for e, w in zip(held_room["kept_out"], iv["kept_out_widening"]["inputs"]):
         v = basis.entered(s, e["sensor"], ref)
-        kept += (abs(w["coef_um_per_unit"]) + 2 * w["u"]) * np.abs(v - s.zero(v))
-    np.testing.assert_allclose(p["half_width"][te], unwidened[te] + d[te] + kept[te],
+        x = np.abs(v - s.zero(v))
+        bias += abs(w["coef_um_per_unit"]) * x
+        var += (2 * w["u"] * x) ** 2
+    np.testing.assert_allclose(p["half_width"][te],
+                               bias[te] + np.sqrt((unwidened[te] + d[te]) ** 2 + var[te]),
                                rtol=1e-12)
     np.testing.assert_array_equal(p["half_width"][~te], unwidened[~te])
     assert r["difference_um"] == [pytest.approx(np.median(d[te])), pytest.approx(d[te].max())]

@@ -274,24 +274,30 @@ def widen_for_kept_out(iv: dict, y, pred, test, terms: list) -> None:
     coefficients were never determined, what they do on the held-out readings is unmodelled.
     ``terms``: per input {"input", "coef_um_per_unit" b, "u" (its blocked jackknife standard
     uncertainty; b fitted to the chosen family's training residuals), "change" (N,) the
-    input's change since its run's zero}.  Each held-out reading's half-width grows by
-    ``sum (abs(b) + 2 u) abs(change)`` (um): the effect the training readings leave
-    possible (b within two u), added as :func:`widen_for_room` adds (a bound on an effect
-    not modelled, not a random error).  The prediction stays the chosen model's.  Adds
+    input's change since its run's zero}.  The input's effect at a held-out reading is
+    about ``N(b change, (u change)^2)``, not in the prediction: ``b change`` is an
+    uncorrected bias, added to the half-width as it stands, and ``2 u abs(change)`` an
+    uncertainty independent of the band's, combined with it in quadrature (the half-width
+    ``hw`` becomes ``sum abs(b change) + sqrt(hw^2 + sum (2 u change)^2)``, um; the
+    expanded uncertainty plus the magnitude of the uncorrected bias: Phillips, Eberhardt &
+    Parry 1997, J. Res. NIST 102, 577-585; quadrature for independent contributions:
+    JCGM 100:2008, 5.1.2).  The prediction stays the chosen model's.  Adds
     ``iv["kept_out_widening"]`` {"inputs": [{"input", "coef_um_per_unit", "u",
     "held_out_change_max" (max abs(change) over the held-out readings)}], "difference_um"
     [median, max] over the held-out readings, "half_width_um_unwidened",
     "coverage_test_unwidened"}."""
-    d = np.zeros(len(y))
+    bias, var = np.zeros(len(y)), np.zeros(len(y))
     items = []
     for e in terms:
         x = np.abs(np.asarray(e["change"], float))
-        d = d + (abs(e["coef_um_per_unit"]) + 2.0 * e["u"]) * x
+        bias = bias + abs(e["coef_um_per_unit"]) * x
+        var = var + (2.0 * e["u"] * x) ** 2
         items.append({"input": e["input"], "coef_um_per_unit": e["coef_um_per_unit"],
                       "u": e["u"],
                       "held_out_change_max": float(np.max(x[test])) if np.any(test) else 0.0})
-    d = np.where(test, d, 0.0)
-    hw = iv["per_reading"] + d
+    h0 = iv["per_reading"]
+    hw = np.where(test, bias + np.sqrt(h0 ** 2 + var), h0)
+    d = hw - h0
     if not np.any(test):
         return
     e = np.abs((y - pred)[test])
@@ -304,6 +310,6 @@ def widen_for_kept_out(iv: dict, y, pred, test, terms: list) -> None:
                "half_width_um_range": [float(np.min(at)), float(np.max(at))],
                "coverage_test": float(np.mean(e <= at)), "per_reading": hw})
     iv["method"] = iv["method"] + (
-        "; each held-out reading's half-width widened by the sum over the inputs kept out "
-        "of (abs(b) + 2 u) abs(the input's change since its run's zero), b and u its "
+        "; for the inputs kept out, each held-out reading's half-width hw -> sum abs(b x) + "
+        "sqrt(hw^2 + sum (2 u x)^2), x the input's change since its run's zero, b and u its "
         "coefficient on the training residuals and its blocked jackknife uncertainty")
