@@ -250,18 +250,8 @@ def widen_for_room(iv: dict, y, pred, alternative, test, reading: str) -> None:
     "half_width_um_unwidened", "coverage_test_unwidened"}."""
     d = np.zeros(len(y)) if alternative is None else np.abs(np.asarray(pred) - alternative)
     d = np.where(test, d, 0.0)
-    hw = iv["per_reading"] + d
-    e = np.abs((y - pred)[test])
-    at = hw[test]
-    iv["room_undecided"] = {
-        "alternative": reading, "same_model": alternative is None,
-        "difference_um": [float(np.median(d[test])),
-                                                  float(np.max(d[test]))],
-        "half_width_um_unwidened": iv["half_width_um"],
-        "coverage_test_unwidened": iv["coverage_test"]}
-    iv.update({"half_width_um": float(np.median(at)),
-               "half_width_um_range": [float(np.min(at)), float(np.max(at))],
-               "coverage_test": float(np.mean(e <= at)), "per_reading": hw})
+    _widened(iv, "room_undecided", {"alternative": reading, "same_model": alternative is None},
+             iv["per_reading"] + d, d, y, pred, test)
     if alternative is not None:
         iv["method"] = (METHOD + "; each held-out reading's half-width widened by abs(the "
                         "prediction - the same family in the sensors' other reading of the "
@@ -295,21 +285,28 @@ def widen_for_kept_out(iv: dict, y, pred, test, terms: list) -> None:
         items.append({"input": e["input"], "coef_um_per_unit": e["coef_um_per_unit"],
                       "u": e["u"],
                       "held_out_change_max": float(np.max(x[test])) if np.any(test) else 0.0})
-    h0 = iv["per_reading"]
-    hw = np.where(test, bias + np.sqrt(h0 ** 2 + var), h0)
-    d = hw - h0
     if not np.any(test):
         return
-    e = np.abs((y - pred)[test])
-    at = hw[test]
-    iv["kept_out_widening"] = {
-        "inputs": items, "difference_um": [float(np.median(d[test])), float(np.max(d[test]))],
-        "half_width_um_unwidened": iv["half_width_um"],
-        "coverage_test_unwidened": iv["coverage_test"]}
-    iv.update({"half_width_um": float(np.median(at)),
-               "half_width_um_range": [float(np.min(at)), float(np.max(at))],
-               "coverage_test": float(np.mean(e <= at)), "per_reading": hw})
+    h0 = iv["per_reading"]
+    hw = np.where(test, bias + np.sqrt(h0 ** 2 + var), h0)
+    _widened(iv, "kept_out_widening", {"inputs": items}, hw, hw - h0, y, pred, test)
     iv["method"] = iv["method"] + (
         "; for the inputs kept out, each held-out reading's half-width hw -> sum abs(b x) + "
         "sqrt(hw^2 + sum (2 u x)^2), x the input's change since its run's zero, b and u its "
         "coefficient on the training residuals and its blocked jackknife uncertainty")
+
+
+def _widened(iv: dict, key: str, record: dict, hw, d, y, pred, test) -> None:
+    """The interval ``iv`` with the half-widths ``hw`` (N,) um (wider by ``d`` (N,) um on the
+    held-out readings ``test``, as they were elsewhere), in place: ``iv[key]`` = ``record``
+    plus "difference_um" [median, max] of ``d`` over the held-out readings and the figures
+    before it ("half_width_um_unwidened", "coverage_test_unwidened"); the median, range and
+    held-out coverage of ``hw`` (``abs(y - pred) <= hw``)."""
+    d = d[test]
+    at, e = hw[test], np.abs((y - pred)[test])
+    iv[key] = {**record, "difference_um": [float(np.median(d)), float(np.max(d))],
+               "half_width_um_unwidened": iv["half_width_um"],
+               "coverage_test_unwidened": iv["coverage_test"]}
+    iv.update({"half_width_um": float(np.median(at)),
+               "half_width_um_range": [float(np.min(at)), float(np.max(at))],
+               "coverage_test": float(np.mean(e <= at)), "per_reading": hw})
