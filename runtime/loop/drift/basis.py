@@ -49,7 +49,7 @@ from .series import DriftSeries
 
 __all__ = ["Column", "DriftSeries", "folds", "whole_runs", "heat", "kept_out", "library",
            "many_runs", "modelled", "reference", "room", "room_undecided", "series", "sensors",
-           "tau_grid"]
+           "tau_grid", "trained_runs", "unseen"]
 
 P_GRID = (0.5, 1.0, 1.5, 2.0, 2.5)   # exponents of the spindle speed tried for the heat input
 N_TAU = 14                # time constants on the grid
@@ -176,26 +176,35 @@ def kept_out(s: DriftSeries) -> list:
     report names it; what the held-out runs do through it is then unmodelled, as the physics
     of the training runs allows.  [{"input", "train_change", "test_change"}] in file order
     (units of the input)."""
-    seen = np.array([np.any(s.train & (s.run == r)) for r in range(len(s.runs))])
-    whole = s.test & ~seen[s.run]
+    whole = unseen(s)
     if not whole.any():
         return []
     out = []
     ref = reference(s)
     for k in sensors(s):
         v = entered(s, k, ref)
-        d = v - s.zero(v)
-        a, b = float(np.ptp(d[s.train])), float(np.ptp(d[whole]))
+        a, b = _change_ptp(s, v, s.train), _change_ptp(s, v, whole)
         if b > KEEP_OUT_RATIO * a:
             out.append({"input": k if not (ref and not is_room(k)) else f"{k} - {ref}",
                         "sensor": k, "train_change": a, "test_change": b})
     return out
 
 
-def _change_ptp(s: DriftSeries, k: str, mask) -> float:
-    """Peak to peak (units of the input) of the input ``k``'s change since its run's zero
-    over the readings ``mask`` (pooled over their runs)."""
-    v = np.asarray(s.inputs[k], float)
+def trained_runs(s: DriftSeries) -> np.ndarray:
+    """Per run (bool): whether it has a training reading (a run without one is predicted
+    from its first reading)."""
+    return np.array([np.any(s.train & (s.run == r)) for r in range(len(s.runs))])
+
+
+def unseen(s: DriftSeries) -> np.ndarray:
+    """The held-out readings of the runs without a training reading (whole held-out runs)."""
+    return s.test & ~trained_runs(s)[s.run]
+
+
+def _change_ptp(s: DriftSeries, v, mask) -> float:
+    """Peak to peak (units of the input) of the input values ``v``'s change since its run's
+    zero over the readings ``mask`` (pooled over their runs)."""
+    v = np.asarray(v, float)
     d = (v - s.zero(v))[mask]
     return float(np.ptp(d)) if len(d) else 0.0
 
@@ -222,16 +231,16 @@ def room_undecided(s: DriftSeries) -> dict | None:
     room" or "absolute"), "alternative" (the other), "sensors": [{"sensor",
     "train_change_K", "room_share"}] in file order}."""
     k_room = room(s)
-    seen = np.array([np.any(s.train & (s.run == r)) for r in range(len(s.runs))])
-    whole = s.test & ~seen[s.run]
+    whole = unseen(s)
     if k_room is None or not whole.any():
         return None
-    a, b = _change_ptp(s, k_room, s.train), _change_ptp(s, k_room, whole)
+    v_room = s.inputs[k_room]
+    a, b = _change_ptp(s, v_room, s.train), _change_ptp(s, v_room, whole)
     if not b > ROOM_VARY_RATIO * a:
         return None
     named = []
     for k in modelled(s):
-        own = _change_ptp(s, k, s.train)
+        own = _change_ptp(s, s.inputs[k], s.train)
         if not is_room(k) and a <= ROOM_HELD_SHARE * own:
             named.append({"sensor": k, "train_change_K": own, "room_share": a / own})
     if not named:

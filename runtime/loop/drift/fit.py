@@ -465,6 +465,6 @@ def predict(s, D, b, y) -> np.ndarray:
     terms (the basis is zero at every run's first reading)."""
     n_runs = len(s.runs)
     zeros = b[:n_runs].copy()
-    seen = np.array([np.any(s.train & (s.run == r)) for r in range(n_runs)])
+    seen = basis.trained_runs(s)
     zeros[~seen] = s.run_zeros(y)[~seen]
     return zeros[s.run] + D[:, n_runs:] @ b[n_runs:]
