@@ -139,7 +139,7 @@ class _Alternative:
         fam, s, tr = r["choice"]["family"], ch.s, ch.s.train
         if fam == "static":
             room = basis.room(s)
-            temps = [k for k in basis.sensors(s) if k.startswith("T")]
+            temps = _temperatures(s)
             if room in temps:
                 return None
             D = np.column_stack([ch.R] + [basis.series(s, k, 0.0) - basis.series(s, room, 0.0)
@@ -456,8 +456,13 @@ def _static_design(ch: Channel) -> np.ndarray:
     since the run's start) and a zero per run; fitted on the training readings (a held-out
     run predicted from its first reading, :func:`predict`) it is the shop's usual model."""
     s = ch.s
-    temps = [k for k in basis.sensors(s) if k.startswith("T")]
+    temps = _temperatures(s)
     return np.column_stack([ch.R] + [basis.series(s, k, 0.0) for k in temps])
+
+
+def _temperatures(s) -> list:
+    """The logged temperatures (the sensors named ``T...``): the static regression's inputs."""
+    return [k for k in basis.sensors(s) if k.startswith("T")]
 
 
 def predict(s, D, b, y) -> np.ndarray:
