@@ -652,7 +652,7 @@ def _split(dat, seed, test_fraction, folds, holdout_time=None) -> Split:
     with a time column whole stretches of time
     (:func:`volerr.loop.drift.split.stretch_split`), else drawn at random (``seed``)."""
     from ..machine.lags import TIME_COLUMNS
-    from .drift.split import parse_window, stretch_split
+    from .drift.split import not_from_end, parse_window, stretch_split
 
     spl = split_points(dat.n, seed, test_fraction, folds)
     time = next((c for c in TIME_COLUMNS if c in dat.covariates), None)
@@ -663,6 +663,7 @@ def _split(dat, seed, test_fraction, folds, holdout_time=None) -> Split:
     if holdout_time is not None:
         a, b = parse_window(holdout_time)
         t = np.asarray(dat.covariates[time], float) * TIME_COLUMNS[time]
+        not_from_end(t, holdout_time, a, b)
         test = (t >= a) & (t < b)
         require(test.any() and (~test).sum() >= 20, f"--holdout-time {holdout_time}: holds "
                 f"out {int(test.sum())} of {dat.n} points (some, and all but 20 at most)")

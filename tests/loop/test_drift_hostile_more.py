@@ -167,6 +167,12 @@ def _holdout_reversed(d):
     return _loop(d, _write(d / "a.csv", _cols()), extra=("--holdout-time", "2h:1h"))
 
 
+def _holdout_from_end(d):
+    """``-1h:2h`` (with ``=``, past argparse) read by the rule ``A <= t < B`` holds out the
+    first 2 h; the likely meaning, a time counted from the end, is another stretch."""
+    return _loop(d, _write(d / "a.csv", _cols()), extra=("--holdout-time=-1h:2h",))
+
+
 def _huge_line(d):
     """One 5 MB line (a binary dump or a file without line ends)."""
     p = d / "big.csv"
@@ -271,6 +277,8 @@ CASES = {
     "a channel's header line twice": (_header_line_twice, ["two.csv", "two header lines"]),
     "header only, iso230-3": (_header_only_iso, ["head.csv", "no data rows"]),
     "--holdout-time reversed": (_holdout_reversed, ["--holdout-time '2h:1h'", "A >= B"]),
+    "--holdout-time from the end": (_holdout_from_end, ["'-1h:2h'", "-3600 s is before every "
+                                                        "reading", "from the end", "7140s:"]),
     "a 5 MB line": (_huge_line, ["big.csv", "not a readable CSV"]),
     "environment label on every row": (_environment_every_row, ["env.csv", "environment",
                                                                 "changes within"]),

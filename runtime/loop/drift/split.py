@@ -52,6 +52,7 @@ def held_out(s: DriftSeries, window=None, files=()) -> tuple[np.ndarray, str]:
     said = []
     if window is not None:
         a, b = parse_window(window)
+        not_from_end(s.t_s, window, a, b)
         test |= (s.t_s >= a) & (s.t_s < b)
         said.append(f"readings with {window} held out")
     if files:
@@ -69,6 +70,20 @@ def held_out(s: DriftSeries, window=None, files=()) -> tuple[np.ndarray, str]:
         said.append(text)
     _enough(s, test, window, files)
     return test, "; ".join(said)
+
+
+def not_from_end(t, window, a: float, b: float) -> None:
+    """One line where a bound of ``--holdout-time`` (``a``, ``b`` s) is negative and no
+    reading's time ``t`` (s) is: the likely mistake is a time counted back from the end
+    (``-1h:`` for the last hour), which the rule (``A <= t < B``, ``t`` the file's time)
+    would read as a time before the run's start and silently hold out another stretch."""
+    lo, hi = float(np.min(t)), float(np.max(t))
+    neg = [v for v in (a, b) if np.isfinite(v) and v < 0]
+    require(not neg or lo < 0,
+            f"--holdout-time {window!r}: {neg[0] if neg else 0:g} s is before every reading "
+            f"(the runs' times span {lo:g} .. {hi:g} s, each in its file's time); a time counted "
+            f"from the end is not read as such: give it from the start (e.g. "
+            f"{max(hi - 3600.0, lo):g}s: for the last hour)")
 
 
 def _enough(s: DriftSeries, test: np.ndarray, window, files) -> None:
