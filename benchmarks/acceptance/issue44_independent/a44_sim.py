@@ -16,7 +16,8 @@ import sys
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+# the repository: this folder is benchmarks/acceptance/issue44_independent
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 VOLERR_CMD = [sys.executable, "-m", "volerr"]   # the CLI of the interpreter running this
 OUT = os.environ.get("ACCEPT44_OUT", os.path.join(HERE, "out"))
 
