@@ -14,7 +14,8 @@ import a44_scen5 as scen5       # noqa: E402
 import a44_sim as sim44          # noqa: E402
 
 PLANTED = (1020.0, 9720.0)
-VARIANTS = ("J", "P", "Pprof", "Pnaive", "P+J")
+ALL = ("J", "P", "Pprof", "Pnaive", "P+J", "Pblock", "Pblockprof")
+VARIANTS = ALL
 
 
 def rng(t, v):
@@ -65,7 +66,7 @@ def fl_widths(fl):
     no_span = [t for t in named if t["J"]["u"] is None and t["J"]["lo"] == t["J"]["hi"]]
     print("today: lag_s.std null %d (of which without a tau_equivalent span either: %d)"
           % (len(no_u), len(no_span)))
-    for v in ("P", "Pprof", "Pnaive"):
+    for v in [v for v in VARIANTS if v not in ("J", "P+J")]:
         both = sum(1 for t in named if t[v]["lo"] is None and t[v]["hi"] is None)
         lo_open = sum(1 for t in named if t[v]["lo"] is None and t[v]["hi"] is not None)
         hi_open = sum(1 for t in named if t[v]["hi"] is None and t[v]["lo"] is not None)
@@ -74,7 +75,7 @@ def fl_widths(fl):
     today = [_clip(rng(t, "J"), t["grid"]) for t in named if not (t in no_span)]
     print("median width today (s, clipped to the grid, %d ranges): %.0f"
           % (len(today), statistics.median(today)))
-    for v in ("P", "Pprof", "Pnaive", "P+J"):
+    for v in [v for v in VARIANTS if v != "J"]:
         w = [_clip(rng(t, v), t["grid"]) for t in named]
         print("median width %s (s, %d ranges): %.0f  (%.2f x today)"
               % (v, len(w), statistics.median(w), statistics.median(w) / statistics.median(today)))
@@ -166,8 +167,11 @@ def fl_terms(path, ch):
 
 def main():
     simdir, fldir = sys.argv[1], sys.argv[2]
+    global VARIANTS
     sim = json.load(open(os.path.join(simdir, "records_sim.json")))
     fl = json.load(open(os.path.join(fldir, "records_fl.json")))
+    t0 = [t for f in sim for r in f["records"] for t in r["terms"]][0]
+    VARIANTS = tuple(v for v in ALL if v == "P+J" or v in t0)
     coverage(sim)
     fl_widths(fl)
     decimation(sim, fl, simdir, fldir)

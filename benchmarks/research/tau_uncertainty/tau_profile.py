@@ -34,6 +34,7 @@ from volerr.cli import main as cli_main          # noqa: E402
 from volerr.loop.drift import basis              # noqa: E402
 from volerr.loop.drift import fit as fitmod      # noqa: E402
 from volerr.loop.drift import run as runmod      # noqa: E402
+from volerr.loop.drift.family import SUB_BLOCKS  # noqa: E402
 
 SUB = 4            # profile points per grid step
 PROFILE_OTHERS = os.environ.get("TAU_PROF", "0") == "1"   # variant P-prof
@@ -81,10 +82,17 @@ def profile(ch, specs, fit, i):
     rho = _rho(ch, fit)
     out = {"grid": [float(grid[0]), float(grid[-1])], "rho": rho, "n": n, "p": p}
     prof = np.array(profiled(ch, specs, i, x, xs)) if PROFILE_OTHERS else None
-    for name, r, curve in (("P", rho, rss), ("Pnaive", 0.0, rss), ("Pprof", rho, prof)):
+    n_blocks = float(SUB_BLOCKS * (int(ch.fold.max()) + 1))
+    out["curve"] = {"x": x.tolist(), "rss": rss.tolist(),
+                    "prof": None if prof is None else prof.tolist(), "n_blocks": n_blocks}
+    for name, r, curve in (("P", rho, rss), ("Pnaive", 0.0, rss), ("Pprof", rho, prof),
+                           ("Pblock", None, rss), ("Pblockprof", None, prof)):
         if curve is None:
             continue
-        neff = n * (1 - r) / (1 + r) if r > 0 else float(n)
+        if r is None:            # addendum 2: the paired test's blocks as independent units
+            neff = n_blocks
+        else:
+            neff = n * (1 - r) / (1 + r) if r > 0 else float(n)
         nu = max(neff - p, 1.0)
         thr = curve.min() * (1 + stats.f.ppf(0.95, 1, nu) / nu)
         lo, hi = _interval(x, curve, thr)
@@ -163,8 +171,9 @@ def run(path, js, hold):
 def sim_fits(out):
     import a44_scen1 as scen1
     res = []
-    for variant, seeds in (("hard", (1, 2, 3)), ("easy", (1, 2, 3)),
-                           ("speedonly", range(1, 9))):
+    plan = (("hard", (1, 2, 3)), ("easy", (1, 2, 3)), ("speedonly", range(1, 9)))
+    only = os.environ.get("TAU_VARIANTS")
+    for variant, seeds in [v for v in plan if not only or v[0] in only.split(",")]:
         scen1.VARIANT = variant
         pre = {"easy": "s1", "hard": "s1h", "speedonly": "s1s"}[variant]
         for seed in seeds:
@@ -181,6 +190,7 @@ def sim_fits(out):
                     res.append({"tag": tag, "variant": variant, "seed": seed, "dt": dt,
                                 "window": wname, "records": recs})
                     print(tag, flush=True)
+                    _dump(out, "sim", res)
     return res
 
 
@@ -200,15 +210,20 @@ def fl_fits(out):
             recs = run(f, os.path.join(out, tag + ".json"), hold)
             res.append({"tag": tag, "dt": dt, "window": name, "records": recs})
             print(tag, flush=True)
+            _dump(out, "fl", res)
     return res
+
+
+def _dump(out, what, res):
+    """The records so far (written after every fit)."""
+    with open(os.path.join(out, "records_%s.json" % what), "w") as f:
+        json.dump(res, f, indent=1)
 
 
 def main():
     what, out = sys.argv[1], sys.argv[2]
     os.makedirs(out, exist_ok=True)
-    res = sim_fits(out) if what == "sim" else fl_fits(out)
-    with open(os.path.join(out, "records_%s.json" % what), "w") as f:
-        json.dump(res, f, indent=1)
+    _dump(out, what, sim_fits(out) if what == "sim" else fl_fits(out))
 
 
 if __name__ == "__main__":
