@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 from ..fileio import sniff_delimiter
 
 
@@ -41,7 +41,7 @@ def _rows(path, header_only: bool = False) -> list:
     """The rows of a CSV file that are neither blank nor ``#`` comments (only the first with
     ``header_only``); InputError (one line) for a missing or unreadable file."""
     p = Path(path)
-    require(p.is_file(), f"data file not found: {path}")
+    require_file(p, f"data file not found: {path}")
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
             delim = sniff_delimiter(fh.read(65536))
