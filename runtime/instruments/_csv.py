@@ -17,6 +17,12 @@ from ..errors import InputError, require, require_file
 from ..fileio import sniff_delimiter
 
 
+#: what the line of a column with a header and no value in any row says (the files of
+#: ``volerr plan`` and ``volerr check plan`` before they are filled)
+EMPTY_COLUMN = ("is empty in every row: no readings (a file of 'volerr plan' or 'volerr check "
+                "plan' not filled in yet?)")
+
+
 @dataclass
 class Columns:
     """The columns of one file: ``numbers`` name -> float array, ``text`` name -> None (a
@@ -106,6 +112,10 @@ def read_columns(path) -> Columns:
             except ValueError:
                 bad = bad if bad is not None else i
                 vals.append(math.nan)
+        if body and not any(raw):      # a header over nothing: readings not filled in
+            text[h] = f"{p.name}: column {h} {EMPTY_COLUMN}"
+            labels[h] = raw
+            continue
         if bad is not None and all(_not_number(s) for s in raw):
             comma = next((s for s in raw if re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", s)),
                          None)
