@@ -1,6 +1,6 @@
 """Benchmark: whole commands a user waits for, this tree against a baseline commit.
 
-* ``volerr map MH2 --grid 100 --out map.csv``: 10^6 points with the random component, errors
+* ``volerr map MH2 --errors DIR --grid 100 --out map.csv``: 10^6 points with the random component, errors
   from ``volerr.cmm.examples.write_example_errors``;
 * ``volerr identify MB1 track.csv --axis X --out X.csv``: a tracker CSV of 10^5 positions x 3
   points (3 x 10^5 rows).

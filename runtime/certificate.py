@@ -50,7 +50,7 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import InputError, require
+from .errors import InputError, require, require_file
 
 NOT_STATED = "not stated"
 #: the identification file read automatically from the folder of the first data file
@@ -238,7 +238,8 @@ def find_identification_file(explicit, files) -> Path | None:
     """The identification file: ``explicit`` (``--identification``), else
     :data:`IDENTIFICATION_FILE` beside the first data file of ``files`` when it is there."""
     if explicit:
-        require(Path(explicit).is_file(), f"--identification {explicit}: no such file")
+        require_file(explicit, f"--identification {explicit}: no such file",
+                     f"--identification {explicit}")
         return Path(explicit)
     for f in files:
         if Path(str(f)).is_file():

@@ -15,3 +15,14 @@ def require(condition: bool, message: str) -> None:
     """Raise :class:`InputError` with ``message`` unless ``condition`` holds."""
     if not condition:
         raise InputError(message)
+
+
+def require_file(path, missing: str, label: str = "") -> None:
+    """Raise :class:`InputError` unless ``path`` is a file: ``missing`` when nothing is
+    there, '<label>: is a folder, not a file' when a folder is (``label``: the path unless
+    given), rather than calling an existing folder missing."""
+    from pathlib import Path
+
+    if Path(path).is_dir():
+        raise InputError(f"{label or path}: is a folder, not a file")
+    require(Path(path).is_file(), missing)

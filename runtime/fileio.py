@@ -18,7 +18,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from .errors import InputError, require
+from .errors import InputError, require, require_file
 
 
 def check_output(path, inputs=()) -> Path:
@@ -146,7 +146,7 @@ def read_csv_rows(path, missing: str = "", empty: str = "") -> list:
     whose first cell starts with '#' are skipped.  ``missing``/``empty``: the error lines for
     a file that does not exist / has no rows."""
     path = Path(path)
-    require(path.is_file(), missing or f"{path}: no such file")
+    require_file(path, missing or f"{path}: no such file")
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:

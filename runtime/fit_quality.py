@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .errors import InputError, require
+from .errors import InputError, require, require_file
 from .units import parse_number
 
 #: p-value below which (together with :data:`RATIO_REFUSE`) a fit is refused
@@ -310,7 +310,7 @@ def read_result_json(path, layout: str | None = None, option: str = "--reference
     from pathlib import Path
 
     p = Path(path)
-    require(p.is_file(), f"{option} {path}: no such file")
+    require_file(p, f"{option} {path}: no such file", f"{option} {path}")
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, ValueError):

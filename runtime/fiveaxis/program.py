@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 from ..nc import gcode, tcpm
 from ..nc.interpret import CHUNK_LINES, Blocks, interpret, prescan
 from ..nc.writer import Writer
@@ -813,8 +813,7 @@ def open_program(path):
     from pathlib import Path
 
     p = Path(path)
-    if not p.is_file():
-        raise InputError(f"program not found: {path}")
+    require_file(p, f"program not found: {path}")
     return lambda: open(p, encoding="latin-1", newline="")
 
 

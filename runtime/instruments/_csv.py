@@ -13,8 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 from ..fileio import sniff_delimiter
+
+
+#: what the line of a column with a header and no value in any row says (the files of
+#: ``volerr plan`` and ``volerr check plan`` before they are filled)
+EMPTY_COLUMN = ("is empty in every row: no readings (a file of 'volerr plan' or 'volerr check "
+                "plan' not filled in yet?)")
 
 
 @dataclass
@@ -41,7 +47,7 @@ def _rows(path, header_only: bool = False) -> list:
     """The rows of a CSV file that are neither blank nor ``#`` comments (only the first with
     ``header_only``); InputError (one line) for a missing or unreadable file."""
     p = Path(path)
-    require(p.is_file(), f"data file not found: {path}")
+    require_file(p, f"data file not found: {path}")
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
             delim = sniff_delimiter(fh.read(65536))
@@ -106,6 +112,10 @@ def read_columns(path) -> Columns:
             except ValueError:
                 bad = bad if bad is not None else i
                 vals.append(math.nan)
+        if body and not any(raw):      # a header over nothing: readings not filled in
+            text[h] = f"{p.name}: column {h} {EMPTY_COLUMN}"
+            labels[h] = raw
+            continue
         if bad is not None and all(_not_number(s) for s in raw):
             comma = next((s for s in raw if re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", s)),
                          None)

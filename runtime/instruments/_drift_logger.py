@@ -36,7 +36,7 @@ import re
 
 from datetime import datetime
 
-from ..errors import require
+from ..errors import require, require_file
 
 #: names of a time column (lower case), in the loggers' languages
 TIME_WORDS = ("time", "t", "zeit", "時間", "时间", "temps", "tiempo", "tempo")
@@ -165,7 +165,7 @@ def _raw_rows(path) -> tuple[list, list]:
     from ..fileio import sniff_delimiter
 
     p = Path(path)
-    require(p.is_file(), f"data file not found: {path}")
+    require_file(p, f"data file not found: {path}")
     try:
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:

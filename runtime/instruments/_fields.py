@@ -54,7 +54,11 @@ def refuse_duplicate_rows(columns, where: str) -> None:
     """Refuse a file in which a row repeats an earlier one in every cell (a file or a block
     pasted twice: real readings never agree to the last digit in every column, and a copied
     reading would count twice in the fit).  ``columns``: a
-    :class:`volerr.instruments._csv.Columns` (numbers and label columns)."""
+    :class:`volerr.instruments._csv.Columns` (numbers and label columns).  Where a column is
+    empty in every row (a plan's file not filled in), that column is named instead: its
+    missing readings are why the rows repeat."""
+    from ._csv import EMPTY_COLUMN
+
     cells = [np.asarray(v, dtype=float) for v in columns.numbers.values()]
     for v in columns.labels.values():       # labels as codes in order of appearance
         codes: dict = {}
@@ -72,9 +76,11 @@ def refuse_duplicate_rows(columns, where: str) -> None:
     same = np.flatnonzero(key[order][1:] == key[order][:-1])
     for k in same:
         i, j = sorted((int(order[k]), int(order[k + 1])))
-        require(not np.array_equal(rows[i], rows[j]),
-                f"{where}: row {j + 2} repeats row {i + 2} in every column (a file or a block "
-                f"pasted twice?)")
+        if np.array_equal(rows[i], rows[j]):
+            empty = [m for m in columns.text.values() if m and m.endswith(EMPTY_COLUMN)]
+            raise InputError(empty[0] if empty else
+                             f"{where}: row {j + 2} repeats row {i + 2} in every column (a "
+                             f"file or a block pasted twice?)")
 
 
 def check_groups(labels, what: str, where: str, minimum: int, why: str) -> None:
@@ -94,6 +100,8 @@ def check_groups(labels, what: str, where: str, minimum: int, why: str) -> None:
 def text_columns(text: dict, needed, where: str, labels=()) -> list:
     """Refuse a needed column that is not numeric; one warning for each other such column
     (``labels``: text columns the instrument reads itself, e.g. ``placement``)."""
+    from ._csv import EMPTY_COLUMN
+
     needed = {h.lower() for h in needed}
     labels = {h.lower() for h in labels}
     warnings = []
@@ -102,6 +110,8 @@ def text_columns(text: dict, needed, where: str, labels=()) -> list:
             continue
         require(h.lower() not in needed, msg or f"{where}: column {h} is not numeric")
         warnings.append(f"column {h} is not numeric: left out of the candidates" if msg is None
+                        else f"column {h} is empty in every row: left out of the candidates"
+                        if msg.endswith(EMPTY_COLUMN)
                         else f"column {h} has a value that is not a finite number: left out "
                              f"of the candidates")
     return warnings

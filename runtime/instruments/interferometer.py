@@ -43,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
@@ -73,7 +73,7 @@ def metadata(path) -> dict:
     of :data:`META_KEYS` (names case-insensitive; other comment lines ignored)."""
     out = {}
     p = Path(path)
-    require(p.is_file(), f"data file not found: {path}")
+    require_file(p, f"data file not found: {path}")
     try:
         lines = p.read_text(encoding="utf-8-sig").splitlines()
     except UnicodeDecodeError:

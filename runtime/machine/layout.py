@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 
 LINEAR_COMPONENTS = ("EX", "EY", "EZ", "EA", "EB", "EC")
 #: squareness name -> (rotation axis index, carrier axis, reference axis)
@@ -458,7 +458,7 @@ def layout_text(name_or_path) -> tuple[str, str]:
     s = str(name_or_path)
     if s.endswith(".toml") or "/" in s or "\\" in s:
         p = Path(s)
-        require(p.is_file(), f"layout file not found: {s}")
+        require_file(p, f"layout file not found: {s}")
         try:
             return p.read_text(encoding="utf-8-sig"), p.name
         except UnicodeDecodeError:

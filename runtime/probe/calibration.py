@@ -51,7 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from ..units import MM_PER_UM, UM_PER_MM, parse_number
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 from ..fileio import sniff_delimiter
 from .fits import (MAX_CONDITION, MAX_DEGREE, MIN_POINTS, OUTLIER_K,  # noqa: F401
                                PLANE_RATIO, RIDGE, SCALE_FLOOR_MM, SHFit, SphereFit,
@@ -151,7 +151,7 @@ def _float(text: str, where: str) -> float:
 def _csv_rows(path: Path) -> list:
     """The non-blank rows of a CSV file (cells as written), InputError (one line) for a file
     that is missing, not text, malformed or empty."""
-    require(path.is_file(), f"{path}: no such file")
+    require_file(path, f"{path}: no such file")
     try:
         text = path.read_text(encoding="utf-8-sig")
         rows = [r for r in csv.reader(io.StringIO(text), delimiter=sniff_delimiter(text))
@@ -651,7 +651,7 @@ def probe_map_from_json(source, tilt_deg: float | None = None, roll_deg: float |
 
     if not isinstance(source, dict):
         path = Path(source)
-        require(path.is_file(), f"{path}: no such file")
+        require_file(path, f"{path}: no such file")
         try:
             source = json.loads(path.read_text(encoding="utf-8"))
         except ValueError as exc:

@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require
+from ..errors import InputError, require, require_file
 from ..fileio import check_header, check_magnitude
 from ..machine import iso_names
 from .table import ErrorTable, axis_unit
@@ -332,7 +332,7 @@ def check_against_model(model, tables: dict, constants: dict, where: str) -> Non
 
 def read_controller_file(path, model, fmt: str = "auto") -> tuple[dict, dict]:
     p = Path(path)
-    require(p.is_file(), f"controller file not found: {path}")
+    require_file(p, f"controller file not found: {path}")
     try:
         text = p.read_text(encoding="utf-8")
     except UnicodeDecodeError:

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import require
+from ..errors import require, require_file
 from . import comp_tables as ct
 
 FORMATS = ("sinumerik-lec", "sinumerik-cec", "heidenhain", "fanuc", "linuxcnc")
@@ -82,7 +82,7 @@ def read(model, path, fmt: str) -> list:
     p = Path(path)
     if fmt == "linuxcnc":
         return linuxcnc.read_tables(p, model)
-    require(p.is_file(), f"controller file not found: {path}")
+    require_file(p, f"controller file not found: {path}")
     if fmt == "heidenhain":
         return heidenhain_tables.read(p, model.axes)
     text = p.read_text(encoding="latin-1")
