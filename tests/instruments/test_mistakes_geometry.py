@@ -109,6 +109,9 @@ CASES = {
                          ["column Zp", "tool offset in inches"]),
     "distances_zp_inches": ("calibrate", "DMU50", ML, scale("Zp", by=1 / INCH), None,
                             ["column Zp", "tool offset in inches"]),
+    # every distance change negated (the reading's sign convention inverted)
+    "distances_sign_flipped": ("calibrate", "DMU50", ML, scale("dd_mm", by=-1.0), None,
+                               ["column dd_mm", "distances with the wrong sign"]),
     "sphere_centre_in_inches": ("calibrate", "DMU50", SPH,
                                 scale("sphere_x", "sphere_y", "sphere_z", by=1 / INCH), None,
                                 ["sphere_x", "inches"]),
