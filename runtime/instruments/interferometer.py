@@ -200,6 +200,8 @@ def _readings(path, axis, mode, where):
     f.require_finite(c.numbers[hits[0]], hits[0], where)
     f.require_finite(targets, _target_column(c, names, where)[1], where)
     dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
+    if mode == "positioning":     # straightness optics read millimetres of misalignment
+        _refuse_implausible(targets, dev, hits[0], where)
     hd = next(h for h in names if h.lower() in _DIRECTION)
     direction = _directions(c, hd, where)
     hc = next((h for h in names if h.lower() in ("cycle", "run")), None)
@@ -215,6 +217,24 @@ def _readings(path, axis, mode, where):
     if hc is not None:
         _refuse_repeated_readings(targets, direction, cycle, where)
     return targets, dev, direction, cycle, temp, np.arange(n)
+
+
+def _refuse_implausible(targets, dev_mm, column, where) -> None:
+    """Refuse a positioning reading (long format) of 1 mm or more
+    (:data:`volerr.positioning._io.MAX_DEVIATION_MM`, the limit ``volerr iso230-2`` holds the
+    same files to): a machine axis' deviations are micrometres to tens of micrometres; such a
+    value is nm under a ``_um`` header, or um under a ``_mm`` header (one line)."""
+    from ..positioning._io import MAX_DEVIATION_MM
+
+    a = np.abs(np.asarray(dev_mm, dtype=float))
+    if not a.size or float(a.max()) < MAX_DEVIATION_MM:
+        return
+    i = int(np.argmax(a))
+    cause = ("values in um under a _mm header?" if column.lower().endswith("_mm") else
+             f"values in nm under a um header? ({1e3 * a[i]:g} nm = {a[i]:g} um); give um")
+    raise InputError(f"{where}: column {column}: reading {1e3 * a[i]:g} um at target "
+                     f"{targets[i]:g} mm (row {i + 2}) is {MAX_DEVIATION_MM:g} mm or more: not "
+                     f"a deviation of a machine axis ({cause})")
 
 
 def _refuse_repeated_readings(targets, direction, cycle, where) -> None:

@@ -4,7 +4,7 @@ refused (one line naming the file, the column and the likely unit; nothing writt
 otherwise move every deviation by cte x (T - 20) x P -- 48 K on 900 mm of steel is ~500 um.
 A long-format run read by ``volerr calibrate`` (section ``interferometer``) that reads one
 target, cycle and direction twice (a block pasted twice) is refused as ``volerr iso230-2``
-refuses it."""
+refuses it, and so is a positioning reading of 1 mm or more (nm under the um header)."""
 
 from __future__ import annotations
 
@@ -95,4 +95,15 @@ def test_interferometer_reading_given_twice_refused(tmp_path, capsys):
     rc = main(["calibrate", "MB1", str(f), "--json", str(out)])
     line = refused_one_line(capsys, rc, "lx.csv", "pasted twice")
     assert "cycle 1" in line and "target 0 mm" in line
+    assert not out.exists()
+
+
+def test_interferometer_reading_in_nm_refused_naming_the_unit(tmp_path, capsys):
+    """A positioning reading of 1 mm or more (nm under the um header) is refused by the
+    unit check ``volerr iso230-2`` holds the same file to, not only by the fit's residual."""
+    rows = [r[:3] + [f"{float(r[3]) * 1000:.1f}"] for r in run_rows()]
+    f = write(tmp_path / "lx.csv", rows, header=["# axis: X", "# u_um: 1"])
+    out = tmp_path / "cal.json"
+    rc = main(["calibrate", "MB1", str(f), "--json", str(out)])
+    refused_one_line(capsys, rc, "lx.csv", "column deviation_um", "nm under a um header")
     assert not out.exists()
