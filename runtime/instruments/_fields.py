@@ -83,6 +83,32 @@ def refuse_duplicate_rows(columns, where: str) -> None:
                              f"file or a block pasted twice?)")
 
 
+def refuse_repeated_block(numbers: dict, labels: dict, minimum: int, where: str) -> None:
+    """Refuse a file in which ``minimum`` or more consecutive rows repeat, row for row and in
+    every cell (``numbers`` name -> values, ``labels`` name -> text cells), consecutive rows
+    met earlier in the file: a file or a trace pasted twice, whose readings would count twice.
+    A single row equal to an earlier one is kept (a ballbar's overrun at a quantised reading
+    can repeat one); a whole block of them is never a new measurement."""
+    cells = [np.asarray(v, dtype=float) + 0.0 for v in numbers.values()]   # -0.0 == 0.0
+    for v in labels.values():
+        codes: dict = {}
+        cells.append(np.array([codes.setdefault(str(x), len(codes)) for x in v], dtype=float))
+    if not cells or len(cells[0]) < 2 * minimum:
+        return
+    rows = np.ascontiguousarray(np.column_stack(cells))
+    first: dict = {}
+    run, start, prev = 0, 0, -1
+    for i, r in enumerate(rows):
+        j = first.setdefault(r.tobytes(), i)
+        run = run + 1 if j < i and run and j == prev + 1 else (1 if j < i else 0)
+        if run == 1:
+            start = i
+        prev = j
+        require(run < minimum, f"{where}: rows {start + 2} .. {i + 2} repeat rows "
+                               f"{j - run + 3} .. {j + 2} in every column (a file or a trace "
+                               f"pasted twice: its readings would count twice)")
+
+
 def check_groups(labels, what: str, where: str, minimum: int, why: str) -> None:
     """Refuse an empty label and a group (placement, station) of fewer than ``minimum`` rows
     (a label mistyped on one row makes a group of its own that carries nothing)."""

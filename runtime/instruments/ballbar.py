@@ -74,6 +74,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
                             where: str, check_travel: bool = True) -> Observations:
     needed = {"pivot_x", "pivot_y", "pivot_z", "length_mm", "dr_um", "dr_mm", "Xp", "Yp", "Zp",
               "direction", "u_um", "length_u_um"}
+    f.refuse_repeated_block(cols, raw, MIN_TRACE_READINGS, where)
     find, warnings = f.open_columns(cols, text, model, where, needed, labels=("placement",))
     pos = f.positions(find, model, where, min_points=4, needs="a ballbar trace",
                       check_travel=check_travel)

@@ -129,7 +129,7 @@ def check_geometry(model, pos, probe, station, d, column, start, where) -> None:
     :data:`FIT_TOLERANCE_MM` RMS (:func:`volerr.instruments.geometry_check.distances_misfit`;
     with ``station_x ...`` given the station's own refit below still applies); a miss is
     refused naming the likely cause (radians, inches, the offset's sign, swapped columns,
-    another layout, distances in m)."""
+    another layout, distances in m or um, the distances' sign)."""
     from . import geometry_check as gc
 
     names = np.asarray(station).astype(str)
@@ -145,7 +145,10 @@ def check_geometry(model, pos, probe, station, d, column, start, where) -> None:
         extra=[("distances in m (x 1000 makes the file consistent)", column,
                 {"the distances": d * 1000.0}),
                ("distances in um, not mm (/ 1000 makes the file consistent)", column,
-                {"the distances": d * 1e-3})])
+                {"the distances": d * 1e-3}),
+               ("distances with the wrong sign (negated, the file is consistent: a length "
+                "change is the later reading minus the first, positive away from the station)",
+                column, {"the distances": -d})])
 
 
 def _uncertainty(find, dist, where) -> np.ndarray:

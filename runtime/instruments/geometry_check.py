@@ -13,7 +13,7 @@ and keeping the one that makes the file consistent:
 * rotary axes in radians (their columns times 180/pi),
 * axis positions and tool offset in inches (times 25.4), or the target's columns in inches,
 * the tool offset with the wrong sign (``Xp, Yp, Zp`` negated), in the wrong column (two of
-  them exchanged), in m or um (x 1000, / 1000),
+  them exchanged), in m, um or inches (x 1000, / 1000, x 25.4),
 * a rotary axis counting the other way (its column negated),
 * two axis columns swapped (``X`` <-> ``Y`` ...),
 * the file of another machine (every shipped layout with the same axes),
@@ -117,8 +117,9 @@ def _alternatives(model, g: Geometry, extra=()):
 
 
 def _offset_alternatives(model, g: Geometry, off):
-    """The tool offset typed into the wrong column (two of Xp Yp Zp exchanged) or in m / um
-    (x 1000, / 1000): only for a file with a non-zero offset ``off`` (its columns)."""
+    """The tool offset typed into the wrong column (two of Xp Yp Zp exchanged) or in m / um /
+    inches (x 1000, / 1000, x 25.4): only for a file with a non-zero offset ``off`` (its
+    columns)."""
     if not off:
         return
     for i, j in ((0, 2), (1, 2), (0, 1)):
@@ -129,7 +130,7 @@ def _offset_alternatives(model, g: Geometry, off):
             yield (f"the tool offset in the wrong column ({names} swapped makes the file "
                    f"consistent)", names, model, g.pos, p, g.targets)
     names = ", ".join("XYZ"[j] + "p" for j in off)
-    for unit, factor in (("m", 1000.0), ("um", 1e-3)):
+    for unit, factor in (("m", 1000.0), ("um", 1e-3), ("inches", INCH_MM)):
         yield (f"the tool offset in {unit}, not mm (x {factor:g} makes the file consistent)",
                names, model, g.pos, g.probe * factor, g.targets)
 

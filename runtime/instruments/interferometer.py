@@ -200,14 +200,55 @@ def _readings(path, axis, mode, where):
     f.require_finite(c.numbers[hits[0]], hits[0], where)
     f.require_finite(targets, _target_column(c, names, where)[1], where)
     dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
+    if mode == "positioning":     # straightness optics read millimetres of misalignment
+        _refuse_implausible(targets, dev, hits[0], where)
     hd = next(h for h in names if h.lower() in _DIRECTION)
     direction = _directions(c, hd, where)
     hc = next((h for h in names if h.lower() in ("cycle", "run")), None)
     cycle = (np.full(n, "1", dtype=object) if hc is None else
              np.asarray(c.labels.get(hc) or [f"{v:g}" for v in c.numbers[hc]], dtype=object))
-    temp = next((c.numbers[h] for h in c.numbers
-                 if h.lower() in ("t_c", "material_t_c", "t_material_c")), None)
+    hT = next((h for h in c.numbers if h.lower() in ("t_c", "material_t_c", "t_material_c")),
+              None)
+    temp = None if hT is None else c.numbers[hT]
+    if temp is not None:
+        from ..positioning._io import check_material_temperature
+
+        check_material_temperature(temp, f"{where}: column {hT}")
+    if hc is not None:
+        _refuse_repeated_readings(targets, direction, cycle, where)
     return targets, dev, direction, cycle, temp, np.arange(n)
+
+
+def _refuse_implausible(targets, dev_mm, column, where) -> None:
+    """Refuse a positioning reading (long format) of 1 mm or more
+    (:data:`volerr.positioning._io.MAX_DEVIATION_MM`, the limit ``volerr iso230-2`` holds the
+    same files to): a machine axis' deviations are micrometres to tens of micrometres; such a
+    value is nm under a ``_um`` header, or um under a ``_mm`` header (one line)."""
+    from ..positioning._io import MAX_DEVIATION_MM
+
+    a = np.abs(np.asarray(dev_mm, dtype=float))
+    if not a.size or float(a.max()) < MAX_DEVIATION_MM:
+        return
+    i = int(np.argmax(a))
+    cause = ("values in um under a _mm header?" if column.lower().endswith("_mm") else
+             f"values in nm under a um header? ({1e3 * a[i]:g} nm = {a[i]:g} um); give um")
+    raise InputError(f"{where}: column {column}: reading {1e3 * a[i]:g} um at target "
+                     f"{targets[i]:g} mm (row {i + 2}) is {MAX_DEVIATION_MM:g} mm or more: not "
+                     f"a deviation of a machine axis ({cause})")
+
+
+def _refuse_repeated_readings(targets, direction, cycle, where) -> None:
+    """Refuse a long-format run with a cycle column in which one target, direction and cycle
+    is read twice (a row or a block pasted twice; ``volerr iso230-2`` refuses it as a
+    duplicate reading): a copied reading would count twice in the fit."""
+    seen: dict = {}
+    for i, key in enumerate(zip(np.round(np.asarray(targets, float) * 1e6).astype(np.int64),
+                                direction, (str(c) for c in cycle))):
+        require(key not in seen, f"{where}: row {i + 2} repeats the reading of row "
+                                 f"{seen.get(key, 0) + 2} (target {targets[i]:g} mm, cycle "
+                                 f"{key[2]}, direction {key[1]:+g}): a row or a block pasted "
+                                 f"twice?")
+        seen[key] = i
 
 
 def _target_column(c, names, where):

@@ -340,6 +340,23 @@ def _read_wide(path, axis, header, body, low) -> PositioningRun:
                      ignored)
 
 
+def check_material_temperature(values, where: str) -> None:
+    """Refuse a material temperature column (degC, ISO 1: the scale's or part's temperature)
+    with a value outside :data:`volerr.units.MATERIAL_TEMPERATURE_RANGE_C` (-10 .. 50 degC):
+    one line naming ``where`` (file and column) and the likely unit (68 degF = 20 degC; 293 is
+    K).  The correction to 20 degC would otherwise move every deviation by
+    cte x (T - 20) x P: 48 K too warm on 800 mm of steel is 445 um."""
+    from ..units import MATERIAL_TEMPERATURE_RANGE_C, check_temperature_C
+
+    v = np.asarray(values, dtype=float).ravel()
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return
+    lo, hi = MATERIAL_TEMPERATURE_RANGE_C
+    worst = float(v.max()) if v.max() - hi >= lo - v.min() else float(v.min())
+    check_temperature_C(worst, where, MATERIAL_TEMPERATURE_RANGE_C)
+
+
 def read_run(path, axis: str = "X") -> PositioningRun:
     """Read a positioning run (long or wide format, module docstring) -> :class:`PositioningRun`.
 
@@ -353,6 +370,8 @@ def read_run(path, axis: str = "X") -> PositioningRun:
         run = _read_long(path, axis.upper(), header, body, low)
     else:
         run = _read_wide(path, axis.upper(), header, body, low)
+    if run.temperature is not None:
+        check_material_temperature(run.temperature, f"{path}: column {header[_find(low, _TEMP)]}")
     cols = [h.strip() for h in header
             if _DEVIATION_RX.match(h.strip()) or wide_column(h) is not None]
     check_plausible_deviations(run, cols[0] if len(cols) == 1 else

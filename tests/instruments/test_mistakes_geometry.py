@@ -104,6 +104,14 @@ CASES = {
                                  ["column", "B, C", "radians"]),
     "sphere_zp_wrong_sign": ("calibrate", "DMU50", SPH, scale("Zp", by=-1.0), None,
                              ["Zp", "wrong sign"]),
+    # the tool offset alone in inches (the axis positions in mm): named, not "no usual mistake"
+    "sphere_zp_inches": ("calibrate", "DMU50", SPH, scale("Zp", by=1 / INCH), None,
+                         ["column Zp", "tool offset in inches"]),
+    "distances_zp_inches": ("calibrate", "DMU50", ML, scale("Zp", by=1 / INCH), None,
+                            ["column Zp", "tool offset in inches"]),
+    # every distance change negated (the reading's sign convention inverted)
+    "distances_sign_flipped": ("calibrate", "DMU50", ML, scale("dd_mm", by=-1.0), None,
+                               ["column dd_mm", "distances with the wrong sign"]),
     "sphere_centre_in_inches": ("calibrate", "DMU50", SPH,
                                 scale("sphere_x", "sphere_y", "sphere_z", by=1 / INCH), None,
                                 ["sphere_x", "inches"]),
