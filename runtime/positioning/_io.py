@@ -219,6 +219,10 @@ def _assemble(path, axis, entries, temps, fmt, conditions, ignored) -> Positioni
     require(len(cycles) >= 2, f"{path}: needs at least 2 cycles per direction, got "
                               f"{len(cycles)}")
     require(len(tkeys) >= 2, f"{path}: needs at least 2 target positions, got {len(tkeys)}")
+    require(len(tkeys) < len(entries) or len(entries) < 4,
+            f"{path}: every reading has a target position of its own ({len(entries)} readings, "
+            f"{len(tkeys)} targets): not the target list of a run, whose every target is read "
+            f"in both directions in every cycle -- the target and deviation columns swapped?")
     targets = {}
     for (tk, _, _), (_, t, _) in entries.items():
         targets.setdefault(tk, t)
