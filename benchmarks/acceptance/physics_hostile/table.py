@@ -27,7 +27,7 @@ NOTES = {
     71: "can be right",
     72: "left: 5 probe points given twice are fitted twice",
     79: "left: deviations <= 0.009 um accepted (A 0.0094 um); no lower bound",
-    81: "WEAK: names a one-direction target, not the swap of target and deviation",
+    81: "FIXED (ece2b0d); before WEAK: named a one-direction target, not the swap",
     82: "can be right (a 31.5 mm run)",
     83: "harness wrote -1.0 / 1.0: refused as not +1/-1 (cycle 1.0 is accepted); case 119 is the "
         "clean swap",
