@@ -98,3 +98,13 @@ def test_a_good_file_still_passes(tmp_path, capsys):
     code, err, out = _run(tmp_path, capsys, _rounds())
     assert code == 0, err
     assert out.exists()
+
+
+def test_one_stray_reading_named(tmp_path, capsys):
+    """One coordinate mistyped by 5 m (every other reading follows the axis): the line names
+    that reading -- its point and its position from the round's first -- instead of the
+    general advice."""
+    R = [r.copy() for r in _rounds()]
+    R[0][3, 1, 0] += 5000.0                 # round 1, position 300 mm, the second point
+    _refused(tmp_path, capsys, R, "one reading alone", "point 2 in file order at +300 mm",
+             "stray measurement")
