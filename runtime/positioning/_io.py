@@ -64,10 +64,10 @@ LINEAR_AXES = "XYZUVW"
 _CYCLE = ("cycle", "run")
 _DIRECTION = ("direction", "dir")
 _TEMP = ("t_c", "material_t_c", "t_material_c")
-_DIR_WORDS = {**{w: +1 for w in ("+1", "1", "+", "fwd", "forward", "up", "pos", "plus",
-                                 "\u2191")},
-              **{w: -1 for w in ("-1", "-", "bwd", "backward", "back", "down", "neg", "minus",
-                                 "rev", "reverse", "\u2193")}}
+_DIR_WORDS = {**{w: +1 for w in ("+1", "1", "+1.0", "1.0", "+", "fwd", "forward", "up", "pos",
+                                 "plus", "\u2191")},
+              **{w: -1 for w in ("-1", "-1.0", "-", "bwd", "backward", "back", "down", "neg",
+                                 "minus", "rev", "reverse", "\u2193")}}
 _F = r"fwd|forward|fw|f|up|pos|plus|\+|\u2191"
 _B = r"bwd|backward|bw|back|b|down|neg|minus|reverse|rev|-|\u2193"
 _UNIT = r"(?:[ _]?[(\[]?(?P<u>um|\u00b5m|\u03bcm|mm)[)\]]?)?"
