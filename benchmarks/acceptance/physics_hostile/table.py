@@ -10,8 +10,8 @@ NOTES = {
     5: "left: accepted, EXX EBX ECX come out negated; with --sense auto a point motion along -x "
        "is taken as a tracker facing the other way, and a mirrored frame cannot be told from the "
        "points alone (undetectable)",
-    7: "WEAK: names the travel, not a sign flip",
-    8: "WEAK: names the round, not the row of the stray point",
+    7: "FIXED (79e005b); before WEAK: named the travel and another machine, not the sign",
+    8: "FIXED (b25c7d6); before WEAK: general advice (check --axis, units, point order)",
     21: "left: every reading <= 0.034 um is accepted; no lower bound on a reading's size",
     22: "WEAK: residual refusal, lists every cause, names no column",
     23: "WEAK: residual refusal, lists every cause, names no column",
@@ -21,7 +21,9 @@ NOTES = {
     36: "can be right (a perfect machine); G 0.005 um",
     37: "can be right",
     41: "FIXED (69eb993); before: 4 traces, std of EC0Y 0.50 -> 0.35 urad",
-    52: "WEAK: refused, but names a copied placement, not nominal/actual swapped",
+    52: "FIXED (279a962): pre-classed possible, but a ball label's calibrated coordinates "
+        "cannot move between placements; before: refused naming a copied placement (wrong "
+        "cause)",
     61: "FIXED (01b8922); before: 'no usual mistake explains it'",
     70: "can be right (a mirrored set of sphere points is a sphere)",
     71: "can be right",
@@ -29,8 +31,8 @@ NOTES = {
     79: "left: deviations <= 0.009 um accepted (A 0.0094 um); no lower bound",
     81: "FIXED (ece2b0d); before WEAK: named a one-direction target, not the swap",
     82: "can be right (a 31.5 mm run)",
-    83: "harness wrote -1.0 / 1.0: refused as not +1/-1 (cycle 1.0 is accepted); case 119 is the "
-        "clean swap",
+    83: "FIXED (d64ee63): the harness writes -1.0 / 1.0, refused before as not +1/-1 (cycle "
+        "1.0 was accepted); now read: can be right (case 119 the same with +1/-1)",
     89: "FIXED (194aeed); before: rc 0, A 447.7 um (correction -445 um)",
     90: "FIXED (194aeed); before: rc 0, A 2518.6 um",
     92: "can be right: iso230-2 ignores a time column",
