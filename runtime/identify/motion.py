@@ -100,5 +100,30 @@ def likely_cause(kind, pts, steps, d, o, senses, others) -> str:
         found.append("positions in rad, not deg")
     if found:
         return "likely " + ", or ".join(found) + "?"
+    stray = _one_stray_reading(kind, pts, steps, d, o, senses)
+    if stray:
+        return stray
     return ("check --axis, the axis direction, the units (mm, deg)"
             f"{', the origin on the axis' if kind == 'rotary' else ''} and the point order")
+
+
+def _one_stray_reading(kind, pts, steps, d, o, senses) -> str | None:
+    """The clause naming the one reading (point at a position) that alone leaves the nominal
+    motion by more than its limit, when there is exactly one: a mistyped coordinate or a stray
+    measurement (every other reading of the round follows the axis); else None."""
+    lim = limit_mm(kind, pts, steps, d, o)
+    best = None
+    for s in senses:
+        nom, _ = nominal(kind, pts[0], steps, d, o, s)
+        dev = np.linalg.norm(pts - nom, axis=-1)                     # (K, n)
+        off = np.argwhere(dev > lim)
+        if best is None or len(off) < len(best[0]):
+            best = (off, dev)
+    off, dev = best
+    if len(off) != 1 or off[0][0] == 0:
+        return None
+    k, j = (int(v) for v in off[0])
+    unit = "mm" if kind == "linear" else "deg"
+    return (f"one reading alone is {dev[k, j]:.3g} mm off the motion (point {j + 1} in file "
+            f"order at {steps[k]:+g} {unit} from the round's first position): likely a mistyped "
+            f"coordinate or a stray measurement of that point")

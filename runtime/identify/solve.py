@@ -659,7 +659,8 @@ def _flag_outliers(rnd, resid, W, sigma, n, k):
 
 def _check_travel(rounds, layout, axis: str) -> None:
     """Refuse commanded positions outside the travel of ``axis`` of ``layout`` (one line
-    naming the file and the column position: a file of another machine, a wrong layout)."""
+    naming the file and the column position: a file of another machine, a wrong layout, or
+    positions negated when every negated one lies inside the travel)."""
     ax = layout.axes.get(axis)
     if ax is None or not rounds:
         return
@@ -669,10 +670,13 @@ def _check_travel(rounds, layout, axis: str) -> None:
     bad = pos[(pos < lo - pad) | (pos > hi + pad)]
     if bad.size:
         unit = "deg" if ax.kind == "rotary" else "mm"
+        negated = bool(np.all((-pos >= lo - pad) & (-pos <= hi + pad)))
+        cause = ("likely the positions with the wrong sign (negated, every one lies inside the "
+                 "travel: a controller counting the other way?), or a file of another machine"
+                 if negated else "a file of another machine, or the wrong layout?")
         raise InputError(f"{rounds[0].name.rsplit(':', 1)[0]}: column position: {axis} = "
                          f"{float(bad[np.argmax(np.abs(bad))]):g} {unit} lies outside the travel "
-                         f"of {layout.name}'s {axis} ({lo:g} .. {hi:g} {unit}): a file of another "
-                         f"machine, or the wrong layout?")
+                         f"of {layout.name}'s {axis} ({lo:g} .. {hi:g} {unit}): {cause}")
 
 
 #: no laser tracker measures closer than this, mm (their ranges start at 0.5 .. 1 m; the

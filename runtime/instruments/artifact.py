@@ -249,6 +249,7 @@ def refuse_repeats(where, placement, ball, point, measured) -> None:
         require(np.max(np.abs(first[1] - point[i])) <= SAME_POINT_MM,
                 f"{where}: placement {key[0]}: ball {key[1]} has different calibrated "
                 f"coordinates in rows {first[0] + 2} and {i + 2} (two balls with one label?)")
+    _refuse_moving_labels(where, placement, ball, point)
     groups: dict = {}
     for name in dict.fromkeys(placement.tolist()):
         m = placement == name
@@ -257,6 +258,26 @@ def refuse_repeats(where, placement, ball, point, measured) -> None:
                                    f"{groups.get(key)} row for row (the same balls measured at "
                                    f"the same points): a placement copied under a new label")
         groups[key] = name
+
+
+def _refuse_moving_labels(where, placement, ball, point) -> None:
+    """Refuse a ball label whose calibrated coordinates differ by more than
+    :data:`FIT_TOLERANCE_MM` between placements (one line): a label names the same ball of
+    the one artifact in every placement, its coordinates those of the calibration
+    certificate -- calibrated coordinates that move with the placement are measured ones (the
+    calibrated and measured columns swapped), or labels of different balls."""
+    first: dict = {}
+    for i, (name, label) in enumerate(zip(placement, ball)):
+        j = first.setdefault(label, i)
+        if placement[j] == name:
+            continue
+        gap = float(np.max(np.abs(point[i] - point[j])))
+        require(gap <= FIT_TOLERANCE_MM,
+                f"{where}: ball {label} has calibrated coordinates {gap:.4g} mm apart in "
+                f"placements {placement[j]} (row {j + 2}) and {name} (row {i + 2}); a ball's "
+                f"calibrated coordinates are the same in every placement: likely the "
+                f"calibrated (u_mm, v_mm, w_mm) and measured (x_mm, y_mm, z_mm) columns "
+                f"swapped, or one label for different balls")
 
 
 def _ordered(keys) -> tuple:

@@ -64,10 +64,10 @@ LINEAR_AXES = "XYZUVW"
 _CYCLE = ("cycle", "run")
 _DIRECTION = ("direction", "dir")
 _TEMP = ("t_c", "material_t_c", "t_material_c")
-_DIR_WORDS = {**{w: +1 for w in ("+1", "1", "+", "fwd", "forward", "up", "pos", "plus",
-                                 "\u2191")},
-              **{w: -1 for w in ("-1", "-", "bwd", "backward", "back", "down", "neg", "minus",
-                                 "rev", "reverse", "\u2193")}}
+_DIR_WORDS = {**{w: +1 for w in ("+1", "1", "+1.0", "1.0", "+", "fwd", "forward", "up", "pos",
+                                 "plus", "\u2191")},
+              **{w: -1 for w in ("-1", "-1.0", "-", "bwd", "backward", "back", "down", "neg",
+                                 "minus", "rev", "reverse", "\u2193")}}
 _F = r"fwd|forward|fw|f|up|pos|plus|\+|\u2191"
 _B = r"bwd|backward|bw|back|b|down|neg|minus|reverse|rev|-|\u2193"
 _UNIT = r"(?:[ _]?[(\[]?(?P<u>um|\u00b5m|\u03bcm|mm)[)\]]?)?"
@@ -219,6 +219,10 @@ def _assemble(path, axis, entries, temps, fmt, conditions, ignored) -> Positioni
     require(len(cycles) >= 2, f"{path}: needs at least 2 cycles per direction, got "
                               f"{len(cycles)}")
     require(len(tkeys) >= 2, f"{path}: needs at least 2 target positions, got {len(tkeys)}")
+    require(len(tkeys) < len(entries) or len(entries) < 4,
+            f"{path}: every reading has a target position of its own ({len(entries)} readings, "
+            f"{len(tkeys)} targets): not the target list of a run, whose every target is read "
+            f"in both directions in every cycle -- the target and deviation columns swapped?")
     targets = {}
     for (tk, _, _), (_, t, _) in entries.items():
         targets.setdefault(tk, t)

@@ -98,3 +98,27 @@ def test_a_good_file_still_passes(tmp_path, capsys):
     code, err, out = _run(tmp_path, capsys, _rounds())
     assert code == 0, err
     assert out.exists()
+
+
+def test_one_stray_reading_named(tmp_path, capsys):
+    """One coordinate mistyped by 5 m (every other reading follows the axis): the line names
+    that reading -- its point and its position from the round's first -- instead of the
+    general advice."""
+    R = [r.copy() for r in _rounds()]
+    R[0][3, 1, 0] += 5000.0                 # round 1, position 300 mm, the second point
+    _refused(tmp_path, capsys, R, "one reading alone", "point 2 in file order at +300 mm",
+             "stray measurement")
+
+
+def test_positions_with_the_wrong_sign_named(tmp_path, capsys):
+    """Positions written negated (0 .. -500 on MB1's X, travel 0 .. 900): outside the travel,
+    and every one inside it negated -- the line names the sign."""
+    _refused(tmp_path, capsys, _rounds(), "column position", "positions with the wrong sign",
+             pos=-POS)
+
+
+def test_positions_of_another_machine_not_called_a_sign(tmp_path, capsys):
+    """Positions beyond the travel either way (1000 .. 1500 mm) are not called a sign."""
+    code, err, out = _run(tmp_path, capsys, _rounds(), pos=POS + 1000.0)
+    assert code == 2 and "another machine" in err and "wrong sign" not in err, err
+    assert not out.exists()

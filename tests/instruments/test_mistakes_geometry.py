@@ -112,6 +112,13 @@ CASES = {
     # every distance change negated (the reading's sign convention inverted)
     "distances_sign_flipped": ("calibrate", "DMU50", ML, scale("dd_mm", by=-1.0), None,
                                ["column dd_mm", "distances with the wrong sign"]),
+    # calibrated and measured coordinates exchanged: the "calibrated" ones move with the
+    # placement (was refused as a placement copied under a new label, the wrong cause)
+    "artifact_calibrated_measured_swapped": ("calibrate", "MB1", BP,
+                                             both(swap("u_mm", "x_mm"), swap("v_mm", "y_mm"),
+                                                  swap("w_mm", "z_mm")), None,
+                                             ["ball B01", "measured (x_mm, y_mm, z_mm) columns "
+                                              "swapped"]),
     "sphere_centre_in_inches": ("calibrate", "DMU50", SPH,
                                 scale("sphere_x", "sphere_y", "sphere_z", by=1 / INCH), None,
                                 ["sphere_x", "inches"]),
