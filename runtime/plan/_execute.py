@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import csv
 import io
+from pathlib import Path
 
 import numpy as np
 
@@ -29,7 +30,7 @@ DEFAULT_U_UM = {"ballbar": 0.5, "sphere": 1.0}
 def execute(path, model, errors: dict, rng, setup_um: float = 20.0,
             tool_dz_um: float = 0.5, dead_mm: float = 0.2) -> None:
     """Fill the plan file ``path`` in place (module docstring); ``errors`` {name: mm / rad}."""
-    text = open(path, encoding="utf-8").read()
+    text = Path(path).read_text(encoding="utf-8")
     c = read_columns(path)
     cols, labels = c.numbers, c.labels
     pos = {a: cols[a] for a in model.axes}

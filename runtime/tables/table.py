@@ -555,9 +555,26 @@ def read_error_dir(directory, axes=None, *, machine=None,
             continue
         raise InputError(f"{f}: unknown file in error directory (expected "
                          f"{', '.join(a + '.csv' for a in (axes or ['X', 'Y', 'Z']))} or constants.csv)")
+    _refuse_a_folder_of_other_things(d, tables)
     check_magnitudes(tables, *consts, machine=machine, constants_origin=origin,
                      accept_implausible=accept_implausible)
     return tables, tuple(consts)
+
+
+def _refuse_a_folder_of_other_things(d: Path, tables: dict) -> None:
+    """An empty folder is a machine without errors (a missing table means zero errors); a
+    folder that holds other things (sub-folders, programs, plots) but no table and no
+    ``constants.csv`` is refused: it is the wrong folder (``--errors dmu50`` for
+    ``dmu50/errors``), and read as zero errors it would give a confident wrong answer."""
+    if tables or any(f.suffix.lower() == ".csv" for f in d.iterdir()):
+        return                          # tables, or a constants.csv (other CSVs are refused)
+    others = sorted(f.name + ("/" if f.is_dir() else "") for f in d.iterdir()
+                    if not f.name.startswith("."))
+    sub = next((o for o in others if o.endswith("/")), None)
+    require(not others, f"{d}: no error table (X.csv ...) and no constants.csv in this folder, "
+            f"only {', '.join(others[:3])}{' ...' if len(others) > 3 else ''}"
+            + (f": is the error directory {d / sub.rstrip('/')}?" if sub else
+               ": not an error directory"))
 
 
 def error_dir_names(axes) -> list:
