@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       6ed720420a66bda53faa0aff37c360150d15409390162774f959284006fa7a68
-derivation sha256  b6065aacbb46aa27d42e17c0af85d8924cbb2af58fc251cac2ff2e6ad746a1a4
+derivation sha256  7df9bce3c5fb17bb936ca59c570fc0fcda886ece6b547789051c05b67a58cbc5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,

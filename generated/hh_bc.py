@@ -6,7 +6,7 @@ Do not edit: regenerate instead.
 Provenance
 ----------
 input sha256       9e0b9225cac4964404bf2e854a5173268922f8f2cc7f38758d6dc04d440f1726
-derivation sha256  b6065aacbb46aa27d42e17c0af85d8924cbb2af58fc251cac2ff2e6ad746a1a4
+derivation sha256  7df9bce3c5fb17bb936ca59c570fc0fcda886ece6b547789051c05b67a58cbc5
 sympy              1.14.0
 derivation sources (hashed in this order):
     runtime/machine/layout.py, derive/htm.py, derive/effects.py, derive/kinematics.py,
