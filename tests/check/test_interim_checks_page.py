@@ -62,3 +62,11 @@ def test_history_event_trend_forecast(weekly):
             f"{ev['unit']} on the week-12 date") in page
     assert f"trend ({tr['slope_per_day']:.3g} +- {tr['std']:.1g} um/day" in page
     assert f"forecast ({fc['date']}, interval {lo[5:]} .. {hi[5:]};" in page
+
+
+def test_formats_check_plan_json_example(weekly):
+    """formats.md's check plan JSON example carries the demo plan's EX0C (it showed 0.83 /
+    0.15)."""
+    ex0c = weekly[0]["plan"]["detectable"]["EX0C"]
+    page = re.sub(r"\s+", " ", (PAGE.parent / "formats.md").read_text(encoding="utf-8"))
+    assert (f'"size_95": {ex0c["size_95"]:.2f}, "std": {ex0c["std"]:.2f}}}') in page
