@@ -174,7 +174,8 @@ def _values(s, sp, tau) -> np.ndarray:
 def _trial_columns(s, sp, xs, rows) -> np.ndarray:
     """The term's columns at the lags exp(``xs``) s on the readings ``rows``
     (len(rows), len(xs)); kept in ``s.memo`` for the split (the runs' channels share them)."""
-    key = ("_tau_trials", sp["source"], sp["minus"], sp["p"], s.test.tobytes(), len(xs))
+    key = ("_tau_trials", sp["source"], sp["minus"], sp["p"], s.test.tobytes(), len(xs),
+           rows.tobytes())
     if key not in s.memo:
         u = basis.heat(s, sp["p"]) if sp["source"] == "heat" \
             else np.asarray(s.inputs[sp["source"]], float)
