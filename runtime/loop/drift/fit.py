@@ -50,6 +50,7 @@ from . import family
 from . import interval as band
 from . import select as sel
 from . import shrink
+from . import tau_range
 from .engine import Engine
 
 __all__ = ["HEAT_TERMS", "REFINE", "RECENTRE", "SIG_K", "Channel", "column", "predict",
@@ -201,6 +202,7 @@ def _channel(ch: Channel, cols, Z, cands, cache) -> dict:
     specs = _backward(ch, [_spec(cols, t) for t in terms])
     specs = _refine_all(ch, specs)
     specs, fit = _significant(ch, specs)
+    fit["tau_range"] = tau_range.ranges(ch, specs, fit)    # profile ranges, s (issue 44)
     for sp, w in zip(specs, family.without_each(ch, fit["design"])):
         sp.update(w)          # is the model without it CV-equivalent? (issue 44)
     Ds = _static_design(ch)

@@ -5,8 +5,9 @@ and the HTML page with one time-series figure per channel (:mod:`volerr.loop.dri
 
 Effects: the terms of one channel with the same covariate (the heat input, a sensor, a
 difference of two sensors) form one effect ("two time constants where one is not enough");
-each names its ``channels``, ``covariates``, ``basis``, ``lag_s`` ``{value, std}`` (its first
-term's; every term in ``terms``) and its coefficients with standard uncertainties (blocked
+each names its ``channels``, ``covariates``, ``basis``, ``lag_s`` ``{value, std,
+range_k2}`` (its first term's; every term in ``terms``; ``range_k2``:
+:mod:`volerr.loop.drift.tau_range`) and its coefficients with standard uncertainties (blocked
 jackknife) in ``parameters``/``std``; uncertainties are printed with k = 2.
 """
 
@@ -240,13 +241,29 @@ def _term_line(t: dict) -> str:
     lag = t.get("lag_s")
     if lag:
         u = f" +- {k * lag['std']:.0f}" if lag.get("std") is not None else " (u not determined)"
-        c += f", tau = {lag['value']:.0f}{u} s (k = {k:g})"
+        c += f", tau = {lag['value']:.0f}{u} s (k = {k:g}){_range_text(lag)}"
     if t.get("alternatives"):
         c += "; these data cannot tell it from " + _alternatives_text(t["alternatives"])
     if t.get("cv_decided") is False:
         c = (f"NOT DECIDED by these data (the model without it is CV-equivalent, paired t "
              f"{t['cv_without']['paired_t']:.2f}): " + c)
     return f"{t['basis']}: {c}"
+
+
+def _range_text(lag: dict) -> str:
+    """', range LO .. HI s' of a time constant's profile range (``lag_s.range_k2``,
+    :mod:`volerr.loop.drift.tau_range`; an open end: 'above LO s', 'below HI s', both: 'not
+    determined by these runs'); '' without one."""
+    if "range_k2" not in lag:
+        return ""
+    lo, hi = lag["range_k2"]
+    if lo is None and hi is None:
+        return ", range not determined by these runs"
+    if hi is None:
+        return f", range above {lo:.0f} s"
+    if lo is None:
+        return f", range below {hi:.0f} s"
+    return f", range {lo:.0f} .. {hi:.0f} s"
 
 
 #: sources named on the console per term (all of them in the JSON)

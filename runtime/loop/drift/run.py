@@ -9,8 +9,9 @@ layout's model (:mod:`~volerr.loop.drift.rows`), every channel (or quantity) is 
 
 Effects: the terms of one channel with the same covariate (the heat input, a sensor, a
 difference of two sensors) form one effect ("two time constants where one is not enough");
-each names its ``channels``, ``covariates``, ``basis``, ``lag_s`` ``{value, std}`` (its first
-term's; every term in ``terms``) and its coefficients with standard uncertainties (blocked
+each names its ``channels``, ``covariates``, ``basis``, ``lag_s`` ``{value, std,
+range_k2}`` (its first term's; every term in ``terms``; ``range_k2``:
+:mod:`volerr.loop.drift.tau_range`) and its coefficients with standard uncertainties (blocked
 jackknife) in ``parameters``/``std``; uncertainties are printed with k = 2.
 """
 
@@ -284,7 +285,8 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
         terms = []
         for i in idx:
             terms.append(_term(r["terms"][i], float(f["coef"][i]), float(f["coef_std"][i]),
-                               f["tau_std"][i], unit))
+                               f["tau_std"][i], unit,
+                               f["tau_range"][i] if f.get("tau_range") else None))
         name = f"{'KH' if heat else 'KT'}_{label}_{'_'.join(covs)}".replace(" ", "")
         for j, (i, t) in enumerate(zip(idx, terms)):
             if budgets is not None:
@@ -306,16 +308,23 @@ def _effects(label, r, s, q=None, budgets=None) -> list:
     return out
 
 
-def _term(sp, value: float, std: float, tau_std, unit: str) -> dict:
+def _term(sp, value: float, std: float, tau_std, unit: str, tau_range=None) -> dict:
     """A term's JSON: its basis, coefficient and standard uncertainty (``unit``: the
-    quantity's; per K for a temperature), time constant, its alternatives in its place and
-    whether the CV tells the model from its absence (``cv_decided``, ``cv_without``:
-    :func:`volerr.loop.drift.family.without_each`; a term not decided stays in the model and
-    is named as such)."""
+    quantity's; per K for a temperature), time constant (``lag_s``: value, the jackknife's
+    ``std`` and the profile range ``range_k2`` [lo, hi] s, None an open end:
+    :mod:`volerr.loop.drift.tau_range`; ``tau_range`` None: no range computed), its
+    alternatives in its place and whether the CV tells the model from its absence
+    (``cv_decided``, ``cv_without``: :func:`volerr.loop.drift.family.without_each`; a term
+    not decided stays in the model and is named as such)."""
+    lag = None
+    if sp["tau_s"] > 0:
+        lag = {"value": round(sp["tau_s"], 1),
+               "std": None if tau_std is None else round(tau_std, 1)}
+        if tau_range is not None:
+            lag["range_k2"] = [None if v is None else round(v, 1) for v in tau_range]
     return {"basis": _basis(sp), "value": value, "std": std,
             "unit": unit if sp["source"] == "heat" else f"{unit}/K",
-            "lag_s": ({"value": round(sp["tau_s"], 1), "std": None if tau_std is None
-                       else round(tau_std, 1)} if sp["tau_s"] > 0 else None),
+            "lag_s": lag,
             "alternatives": sp["alternatives"], "cv_rms_um": sp["cv_rms_um"],
             "tau_equivalent_s": _tau_span(sp), "cv_decided": sp.get("cv_decided"),
             "cv_without": sp.get("cv_without")}

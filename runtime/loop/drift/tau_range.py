@@ -1,0 +1,275 @@
+"""The range of a fitted time constant: the profile-likelihood interval (issue 44), stated
+beside the blocked jackknife's standard uncertainty (``lag_s.range_k2`` of the JSON).
+
+For each term i with tau > 0 of the final lag model, trial values x over ln tau: the grid's
+range at ``SUB`` points per grid step (``linspace(ln grid[0], ln grid[-1], SUB (n - 1) + 1)``)
+united with ln of the term's tau.  At each x the RSS (um^2) over the training readings of the
+lag model with term i at exp(x) s, the run zeros and every other coefficient refitted, and
+every other lagged term's time constant re-optimised by one coordinate pass in the terms'
+order over the same ``SUB`` grid (each taking the least RSS): the profile of Bates & Watts
+(1988, *Nonlinear Regression Analysis and Its Applications*, Wiley, 6.1) with the other
+parameters profiled out (Venzon & Moolgavkar 1988, *Appl. Statist.* 37, 87-94).  The range
+is ``{x : RSS(x) <= RSS_min (1 + F(0.95; 1, nu) / nu)}``, its hull, ends interpolated
+linearly in ln tau, an end at the grid's edge open (None); nu = max(n_eff - p, 1) with n_eff
+= ``family.SUB_BLOCKS`` x the folds, the blocks the loop's paired test takes as independent
+units (a drift model's misfit is smooth over hours: the readings are not), p = the design's
+columns not all zero on the training readings + the lagged terms.  Measured in
+``benchmarks/research/tau_uncertainty`` (variant P-block-prof: the planted time constants
+inside in 39 of 48 and 39 of 48 pairs on fresh seeds, the jackknife's tau +- 2 u 21 and 25).
+
+Cost: the cross-products (Gram) of [run zeros, the unlagged terms' columns, every lagged
+term's column at its tau and at every trial tau, y] once per channel; every RSS from their
+sub-blocks (batched over the trial values).  Above ``THIN_ABOVE`` training readings the Gram
+is taken on every k-th training reading of each run (k = ceil(n / ``THIN_ABOVE``)): the
+threshold is a ratio of RSS, nearly unchanged by thinning columns smooth over many readings.
+
+Units: time constants s, readings um.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import basis
+from .family import SUB_BLOCKS
+
+__all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "lag_many", "ranges"]
+
+SUB = 4               # trial values of ln tau per grid step
+CONFIDENCE = 0.95     # the F quantile of the threshold (two-sided 95 %: "k = 2")
+THIN_ABOVE = 20000    # training readings above which the Gram is taken on thinned readings
+RCOND = 1e-12         # as :func:`volerr.selection.linalg.solve_scaled`
+
+
+def ranges(ch, specs, fit) -> list:
+    """Per term of ``specs`` (the final fit ``fit`` of :func:`volerr.loop.drift.fit._jackknife`
+    on the channel ``ch``): [lo, hi] s of its time constant (an end None: open, the grid's
+    edge), or None for a term without a lag."""
+    lagged = [i for i, sp in enumerate(specs) if sp["tau_s"] > 0]
+    if not lagged:
+        return [None] * len(specs)
+    s, tr = ch.s, ch.s.train
+    grid = basis.tau_grid(s)
+    lg = np.log(grid)
+    xs = np.linspace(lg[0], lg[-1], SUB * (len(grid) - 1) + 1)
+    rows = _rows(s)
+    cols = [ch.R[rows]] + [_values(s, sp, sp["tau_s"])[rows][:, None] for sp in specs]
+    trial, seen = {}, {}
+    at = ch.R.shape[1] + len(specs)
+    for i in lagged:
+        key = (specs[i]["source"], specs[i]["minus"], specs[i]["p"])
+        if key not in seen:     # terms of one source (the heat input's) share their trials
+            cols.append(_trial_columns(s, specs[i], xs, rows))
+            seen[key] = np.arange(at, at + len(xs))
+            at += len(xs)
+        trial[i] = seen[key]
+    A = np.column_stack(cols + [ch.y[rows]])
+    G = A.T @ A
+    n_runs = ch.R.shape[1]
+    cur = {i: n_runs + i for i in range(len(specs))}
+    D = fit["design"][tr]
+    p = int(np.sum(np.any(D != 0, axis=0))) + len(lagged)
+    nu = max(float(SUB_BLOCKS * (int(ch.fold.max()) + 1)) - p, 1.0)
+    rise = 1.0 + _f_ppf(CONFIDENCE, nu) / nu
+    out = [None] * len(specs)
+    for i in lagged:
+        x, pos = _trials(xs, math.log(specs[i]["tau_s"]), trial[i], cur[i])
+        rss = _profile(G, n_runs, cur, trial, lagged, i, pos)
+        out[i] = _interval(x, rss, rss.min() * rise)
+    return out
+
+
+def _trials(xs, x0, trial, here) -> tuple:
+    """The trial values of ln tau (``xs`` united with ``x0``, clipped to ``xs``' range) and
+    their columns in the Gram (``trial`` for ``xs``, ``here`` for ``x0``)."""
+    x = np.unique(np.r_[xs, x0])
+    x = x[(x >= xs[0] - 1e-12) & (x <= xs[-1] + 1e-12)]
+    pos = np.array([here if v == x0 else trial[int(np.searchsorted(xs, v))] for v in x])
+    return x, pos
+
+
+def _profile(G, n_runs, cur, trial, lagged, i, pos) -> np.ndarray:
+    """RSS (um^2) at each trial column ``pos`` of term ``i``: the other lagged terms'
+    columns chosen by one coordinate pass in their order, each the least RSS of its trials
+    ``trial[j]`` with the others at their current columns (the fitted taus at the start)."""
+    X = len(pos)
+    now = np.array([[cur[k] for k in sorted(cur)] for _ in range(X)])   # (X, terms)
+    now[:, i] = pos
+    best = None
+    for j in [k for k in lagged if k != i]:
+        T = trial[j]
+        idx = np.concatenate([np.broadcast_to(np.arange(n_runs), (X, len(T), n_runs)),
+                              np.broadcast_to(np.delete(now, j, axis=1)[:, None, :],
+                                              (X, len(T), now.shape[1] - 1)),
+                              np.broadcast_to(T[None, :, None], (X, len(T), 1))], axis=2)
+        r = _rss(G, idx)                                     # (X, T)
+        k = np.argmin(r, axis=1)
+        now[:, j] = T[k]
+        best = r[np.arange(X), k]
+    if best is None:
+        idx = np.concatenate([np.broadcast_to(np.arange(n_runs), (X, n_runs)), now], axis=1)
+        best = _rss(G, idx)
+    return best
+
+
+def _rss(G, idx) -> np.ndarray:
+    """RSS of y (the Gram's last column) on the columns ``idx`` (..., m) of the Gram ``G``,
+    solved as :func:`volerr.selection.linalg.solve_scaled` solves (columns scaled to unit
+    norm, Hermitian pseudo-inverse; a column all zero gets 0)."""
+    g = G[idx[..., :, None], idx[..., None, :]]
+    h = G[idx, -1]
+    d = np.sqrt(np.diagonal(g, axis1=-2, axis2=-1))
+    d = np.where(d > 0, d, 1.0)
+    gs = g / (d[..., :, None] * d[..., None, :])
+    b = (np.linalg.pinv(gs, rcond=RCOND, hermitian=True) @ (h / d)[..., None])[..., 0] / d
+    yy = G[-1, -1]
+    quad = np.einsum("...i,...ij,...j->...", b, g, b)
+    return np.maximum(yy - 2 * np.einsum("...i,...i->...", b, h) + quad, 0.0)
+
+
+def _interval(x, rss, thr) -> list:
+    """Hull of ``{x : rss <= thr}`` (ln tau), ends interpolated linearly; [lo, hi] s, None
+    for an end at the first or last trial value (open)."""
+    inside = np.flatnonzero(rss <= thr)
+    a, b = int(inside[0]), int(inside[-1])
+
+    def cross(k, m):          # k inside, m outside
+        return x[k] + (thr - rss[k]) / (rss[m] - rss[k]) * (x[m] - x[k])
+    lo = None if a == 0 else math.exp(cross(a, a - 1))
+    hi = None if b == len(x) - 1 else math.exp(cross(b, b + 1))
+    return [lo, hi]
+
+
+def _stride(s) -> int:
+    """k of :func:`_rows`: 1, or ceil(n / ``THIN_ABOVE``) above ``THIN_ABOVE`` training
+    readings."""
+    n = int(s.train.sum())
+    return 1 if n <= THIN_ABOVE else math.ceil(n / THIN_ABOVE)
+
+
+def _rows(s) -> np.ndarray:
+    """The training readings (indices) the Gram is taken on: all, or above ``THIN_ABOVE``
+    every k-th of each run's (k = :func:`_stride`)."""
+    idx = np.flatnonzero(s.train)
+    k = _stride(s)
+    if k == 1:
+        return idx
+    return np.concatenate([idx[s.run[idx] == r][::k] for r in range(len(s.runs))])
+
+
+def _values(s, sp, tau) -> np.ndarray:
+    """A term's column (N,) at the lag ``tau`` s (as :func:`volerr.loop.drift.fit.column`,
+    from its memo when there, not stored: the trial columns are used once)."""
+    key = (sp["source"], sp["minus"], sp["p"], float(tau))
+    if key in s.memo:
+        return s.memo[key]
+    v = basis.series(s, sp["source"], float(tau), sp["p"])
+    if sp["minus"]:
+        v = v - basis.series(s, sp["minus"], float(tau))
+    return v
+
+
+def _trial_columns(s, sp, xs, rows) -> np.ndarray:
+    """The term's columns at the lags exp(``xs``) s on the readings ``rows``
+    (len(rows), len(xs)); kept in ``s.memo`` for the split (the runs' channels share them)."""
+    key = ("_tau_trials", sp["source"], sp["minus"], sp["p"], s.test.tobytes(), len(xs),
+           rows.tobytes())
+    if key not in s.memo:
+        u = basis.heat(s, sp["p"]) if sp["source"] == "heat" \
+            else np.asarray(s.inputs[sp["source"]], float)
+        if sp["minus"]:
+            u = u - np.asarray(s.inputs[sp["minus"]], float)
+        taus = np.exp(xs)
+        got = lag_many(u - s.zero(u), taus, s.t_s, s.run, rows, _stride(s))
+        if got is None:       # readings not evenly spaced: one lag at a time
+            got = np.column_stack([_values(s, sp, float(v))[rows] for v in taus])
+        s.memo[key] = got
+    return s.memo[key]
+
+
+def lag_many(u, taus, t, run, rows, step=1):
+    """The first-order lag (as :func:`volerr.machine.lags.lag`, restarted in every run, the
+    same first-order-hold recursion ``y_k = a y_(k-1) + (1 - a) u_(k-1) + c (u_k - u_(k-1))``,
+    ``a = exp(-dt / tau)``, ``c = 1 - (1 - a) tau / dt``) of ``u`` (N,), zero at every run's
+    first reading, at the lags ``taus`` (T,) s at once, at the readings ``rows`` (about every
+``step``-th of a run: the cost scales with N / ``step``); None unless
+    every run's readings are contiguous, in time order and evenly spaced (then ``a`` and
+    ``c`` are constants per lag and the recursion is a cumulative sum in segments)."""
+    out = np.empty((len(rows), len(taus)))
+    for r in np.unique(run):
+        idx = np.flatnonzero(run == r)
+        dt = np.diff(t[idx])
+        if len(idx) > 1 and (idx[-1] - idx[0] + 1 != len(idx) or not dt[0] > 0
+                             or np.ptp(dt) > 1e-9 * dt[0]):
+            return None
+        want = np.flatnonzero(run[rows] == r)
+        if len(idx) < 2:
+            out[want] = 0.0
+            continue
+        y = _lag_even(u[idx], float(np.mean(dt)) / taus, rows[want] - idx[0], step)
+        out[want] = y
+    return out
+
+
+def _lag_even(u, x, at, step) -> np.ndarray:
+    """The lag recursion of ``u`` (M,) (``u[0]`` = 0) with steps ``x`` = dt / tau (T,), at
+    the readings ``at`` (M',): carried from target to target (``at`` and every ``step``-th
+    reading), each block's inputs summed by one matrix product, the carry a cumulative sum
+    in segments over which the weights stay below exp(300)."""
+    oma = -np.expm1(-x)
+    small = x < 1e-6
+    c = np.where(small, x / 2 - x * x / 6, 1.0 - oma / np.where(small, 1.0, x))
+    tg = np.arange(0, len(u), step)
+    if len(at) and not (np.all(at % step == 0) and at[-1] < len(u)):
+        tg = np.union1d(tg, at)
+    ell = np.diff(tg)                                        # block lengths (readings)
+    K = int(ell.max()) if len(ell) else 1
+    back = np.arange(K - 1, -1, -1)                          # steps before the block's end
+    J = tg[1:, None] - back[None, :]
+    ok = back[None, :] < ell[:, None]
+    J = np.where(ok, J, 1)
+    dec = np.exp(-back[:, None] * x[None, :])                # (K, T)
+    P = np.where(ok, u[J - 1], 0.0) @ (oma * dec) + np.where(ok, u[J] - u[J - 1], 0.0) @ (c * dec)
+    L = np.concatenate([[0.0], np.cumsum(ell, dtype=float)])   # readings from the start
+    y = np.zeros((len(tg), len(x)))
+    seg = max(1, int(300.0 / (float(x.max()) * K)))
+    for a in range(1, len(tg), seg):
+        b = min(a + seg, len(tg))
+        m = (L[a:b] - L[a - 1])[:, None] * x[None, :]
+        y[a:b] = np.exp(-m) * (y[a - 1] + np.cumsum(P[a - 1:b - 1] * np.exp(m), axis=0))
+    return y[np.searchsorted(tg, at)]
+
+
+def _f_ppf(q: float, nu: float) -> float:
+    """F(q; 1, nu): the q quantile of Fisher's F with 1 and ``nu`` (a whole number) degrees
+    of freedom, the square of Student's t two-sided: P(abs(T) <= t) = q, from the closed form
+    of Abramowitz & Stegun (1964, *Handbook of Mathematical Functions*, 26.7.3-4) solved by
+    bisection (no scipy at run time)."""
+    n = int(round(nu))
+    lo, hi = 0.0, 1e4
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if _t_two_sided(mid, n) < q:
+            lo = mid
+        else:
+            hi = mid
+    return (0.5 * (lo + hi)) ** 2
+
+
+def _t_two_sided(t: float, n: int) -> float:
+    """P(abs(T) <= t) for Student's T with ``n`` >= 1 degrees of freedom (A & S 26.7.3-4)."""
+    th = math.atan(t / math.sqrt(n))
+    sn, cs = math.sin(th), math.cos(th)
+    if n % 2:
+        term, acc = cs, (cs if n > 1 else 0.0)
+        for k in range(3, n - 1, 2):           # cos th (1 + 2/3 cos^2 + 2 4/(3 5) cos^4 ...)
+            term *= (k - 1) / k * cs * cs
+            acc += term
+        return 2.0 / math.pi * (th + sn * acc)
+    term, acc = 1.0, 1.0
+    for k in range(2, n - 1, 2):               # 1 + 1/2 cos^2 + 1 3/(2 4) cos^4 ...
+        term *= (k - 1) / k * cs * cs
+        acc += term
+    return sn * acc
