@@ -115,3 +115,20 @@ def test_f_quantile():
     table 26.9: 161.45, 18.513, 4.9646, 4.0847 at nu = 1, 2, 10, 40)."""
     for nu, want in ((1, 161.45), (2, 18.513), (10, 4.9646), (40, 4.0847)):
         assert tau_range._f_ppf(0.95, nu) == pytest.approx(want, rel=2e-4)
+
+
+@pytest.mark.parametrize("rng,value,words", [
+    ([900.0, 1100.0], 1000.0, ", range 900 .. 1100 s"),
+    ([900.0, 1100.0], 11501.0, "(not this fit's tau"),
+    ([None, 1100.0], 1000.0, ", range below 1100 s"),
+    ([900.0, None], 800.0, "(not this fit's tau"),
+    ([None, None], 5.0, ", range not determined by these runs")])
+def test_the_console_says_when_the_range_does_not_hold_the_reported_tau(rng, value, words):
+    """The range lies where the least RSS is with the other time constants free, the
+    reported tau is the cross-validation's choice: where the range does not hold it the line
+    says so instead of printing a range beside a value outside it without a word."""
+    from volerr.loop.drift.report import _range_text
+
+    text = _range_text({"value": value, "std": None, "range_k2": rng})
+    assert words in text, text
+    assert ("not this fit's tau" in text) == (words == "(not this fit's tau"), text

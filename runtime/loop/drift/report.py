@@ -260,10 +260,16 @@ def _range_text(lag: dict) -> str:
     if lo is None and hi is None:
         return ", range not determined by these runs"
     if hi is None:
-        return f", range above {lo:.0f} s"
-    if lo is None:
-        return f", range below {hi:.0f} s"
-    return f", range {lo:.0f} .. {hi:.0f} s"
+        text = f", range above {lo:.0f} s"
+    elif lo is None:
+        text = f", range below {hi:.0f} s"
+    else:
+        text = f", range {lo:.0f} .. {hi:.0f} s"
+    if (lo or 0.0) <= lag["value"] <= (hi if hi is not None else float("inf")):
+        return text
+    # the range is where the least RSS lies with every other time constant free: two terms
+    # of one source may trade their time constants, the reported one is the CV's choice
+    return text + " (not this fit's tau: the profile's least RSS lies elsewhere)"
 
 
 #: sources named on the console per term (all of them in the JSON)
