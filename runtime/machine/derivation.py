@@ -124,12 +124,15 @@ def cache_dir() -> Path:
 
 
 _FINGERPRINT = None
+#: files of ``volerr.machine`` among the derivation sources of a layout's module
+RUNTIME_SOURCES = ("layout.py", "lags.py")
 
 
 def generator_fingerprint() -> str:
     """sha256 of the generator's source files (``volerr.derive``: *.py and templates, not the
-    audit of printed equations in ``audit/``, which shapes no generated code) and the sympy
-    version, without importing either."""
+    audit of printed equations in ``audit/``, which shapes no generated code), the runtime's
+    derivation sources (``RUNTIME_SOURCES``) and the sympy version, without importing
+    either."""
     global _FINGERPRINT
     if _FINGERPRINT is None:
         import importlib.util
@@ -143,6 +146,12 @@ def generator_fingerprint() -> str:
                             and p.suffix not in (".pyc",) and "__pycache__" not in p.parts
                             and p.relative_to(root).parts[0] != "audit"):
                 h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+        # the runtime's derivation sources (derive.generate.LAYOUT_SOURCES, derive.lags.SOURCES):
+        # a layout module's provenance hashes them, so an entry derived before they changed
+        # must not be served after
+        machine = Path(importlib.util.find_spec("volerr.machine").submodule_search_locations[0])
+        for name in RUNTIME_SOURCES:
+            h.update(name.encode() + b"\0" + (machine / name).read_bytes() + b"\0")
         try:
             h.update(metadata.version("sympy").encode())
         except metadata.PackageNotFoundError:  # pragma: no cover

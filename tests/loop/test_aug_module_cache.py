@@ -51,3 +51,25 @@ def test_a_corrupt_entry_is_derived_again(tmp_path, monkeypatch):
     assert derivation.derive_source(lay) == again
     monkeypatch.setattr(derivation, "generate_source", lambda layout: "not asked\n")
     assert derivation.derive_source(lay) == again             # the rewritten entry
+
+
+def test_the_cache_key_holds_every_runtime_derivation_source():
+    """A layout module's provenance hashes runtime files (derive.generate.LAYOUT_SOURCES,
+    derive.lags.SOURCES); the cache key must hold each of them, or an entry derived before
+    one changed is served after it with the other derivation's sha256 (found when an older
+    checkout's test read a newer checkout's entry)."""
+    from volerr.derive import generate, lags
+    from volerr.machine import derivation
+
+    runtime = {s.split("/", 2)[-1] for s in generate.LAYOUT_SOURCES + lags.SOURCES
+               if s.startswith("runtime/machine/")}
+    assert runtime and runtime <= set(derivation.RUNTIME_SOURCES), runtime
+
+
+def test_a_changed_runtime_source_changes_the_cache_key(monkeypatch, tmp_path):
+    from volerr.machine import derivation
+
+    before = derivation.generator_fingerprint()
+    monkeypatch.setattr(derivation, "_FINGERPRINT", None)
+    monkeypatch.setattr(derivation, "RUNTIME_SOURCES", ("lags.py",))
+    assert derivation.generator_fingerprint() != before
