@@ -14,6 +14,7 @@ usage: python stab_runs.py [WINDOW ...]   (default: the six windows; both sampli
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import sys
@@ -33,6 +34,10 @@ from volerr.loop.drift import select as sel  # noqa: E402
 from volerr.loop.drift.engine import Engine  # noqa: E402
 
 STEPS = (1, 4)
+#: "lofo" (RULE.md: leave one blocked fold out, K subsamples) or "cpairs" (a sensitivity
+#: measured after RULE.md's figures: every split of the K folds into two complementary
+#: halves, Shah & Samworth 2013; K = 6: 10 pairs, 20 subsamples of 3 folds)
+SCHEME = os.environ.get("STAB_SCHEME", "lofo")
 
 
 def source_key(cols, a: int) -> str:
@@ -48,6 +53,24 @@ def subsample_folds(fold: np.ndarray, k: int) -> np.ndarray:
     f[fold == k] = -1
     f[fold > k] -= 1
     return f
+
+
+def half_folds(fold: np.ndarray, half) -> np.ndarray:
+    """Only the folds ``half`` training, renumbered 0.. in order; the others -1."""
+    f = np.full_like(fold, -1)
+    for i, k in enumerate(sorted(half)):
+        f[fold == k] = i
+    return f
+
+
+def subsample_list(fold: np.ndarray) -> list:
+    """The subsamples' fold arrays of ``SCHEME``."""
+    K = int(fold.max()) + 1
+    if SCHEME == "lofo":
+        return [subsample_folds(fold, k) for k in range(K)]
+    halves = [h for h in itertools.combinations(range(K), K // 2) if 0 in h]
+    return [half_folds(fold, x) for h in halves
+            for x in (h, tuple(k for k in range(K) if k not in h))]
 
 
 def select_on(ch, cols, Z, cands, fold, cache) -> list:
@@ -82,15 +105,15 @@ def run_window(name: str, step: int) -> dict:
     assert run.returncode == 0, run.stderr
     out = {"window": name, "step": step, "cpu_loop_s": cpu_loop, "doc": run.doc,
            "channels": {}}
-    K = int(seen[0][0].fold.max()) + 1
+    K = len(subsample_list(seen[0][0].fold))
     caches = [{} for _ in range(K)]
     t0 = time.process_time()
     with threadpool_limits(limits=1, user_api="blas"):
         for ch, cols, Z, cands in seen:
             label = next(k for k, v in ch.s.channels.items() if v is ch.y)
             subs = []
-            for k in range(K):
-                terms = select_on(ch, cols, Z, cands, subsample_folds(ch.fold, k), caches[k])
+            for k, f in enumerate(subsample_list(ch.fold)):
+                terms = select_on(ch, cols, Z, cands, f, caches[k])
                 subs.append([source_key(cols, t["pair"][0]) for t in terms])
             out["channels"][label] = {"K": K, "fold_rule": ch.rule, "subsamples": subs}
     out["cpu_subsamples_s"] = time.process_time() - t0
@@ -102,7 +125,7 @@ def main(names):
     for name in names:
         for step in STEPS:
             res = run_window(name, step)
-            with open(os.path.join(OUT, f"{name}_{step}.json"), "w") as fh:
+            with open(os.path.join(OUT, f"{name}_{step}{'' if SCHEME == 'lofo' else '_' + SCHEME}.json"), "w") as fh:
                 json.dump(res, fh, indent=1, default=float)
             print(f"{name} step {step}: loop {res['cpu_loop_s']:.1f} s CPU, "
                   f"{len(res['channels'])} channels x K subsamples "
