@@ -24,6 +24,7 @@ sys.path.insert(0, os.path.join(ROOT, "benchmarks", "acceptance", "issue44_indep
 OUT = os.path.join(HERE, "out")
 
 import a44_scen5 as scen5  # noqa: E402
+from stab_runs import out_name  # noqa: E402
 
 
 def _load_test_module():
@@ -37,7 +38,8 @@ def _load_test_module():
 rule = _load_test_module()
 WINDOWS = ("0-20", "20-40", "40-60", "60-80", "80-100", "pub")
 CHANNELS = rule.CHANNELS
-PI_THR = float(os.environ.get("STAB_PI_THR", "0.7"))   # RULE.md: 0.7; other values: sensitivity only
+#: RULE.md: 0.7; other values: sensitivity only
+PI_THR = float(os.environ.get("STAB_PI_THR", "0.7"))
 SCHEME = os.environ.get("STAB_SCHEME", "lofo")     # stab_runs.py's subsamples
 SUFFIX = os.environ.get("STAB_SUFFIX", "")   # out/compare<SUFFIX>.json
 
@@ -144,7 +146,7 @@ def main():
     counts = {"reported": {1: 0, 4: 0}, "named": {1: 0, 4: 0}, "zero_in_k2": 0,
               "stable_unheld": {1: 0, 4: 0}}
     for name in WINDOWS:
-        res = {st: json.load(open(os.path.join(OUT, f"{name}_{st}{'' if SCHEME == 'lofo' else '_' + SCHEME}.json"))) for st in (1, 4)}
+        res = {st: json.load(open(out_name(name, st, SCHEME))) for st in (1, 4)}
         flags = {st: named_flags(res[st]) for st in (1, 4)}
         docs = {(st, nm): restricted(res[st], flags[st], nm) for st in (1, 4)
                 for nm in (False, True)}

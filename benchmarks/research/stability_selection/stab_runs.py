@@ -40,6 +40,11 @@ STEPS = (1, 4)
 SCHEME = os.environ.get("STAB_SCHEME", "lofo")
 
 
+def out_name(name: str, step: int, scheme: str = SCHEME) -> str:
+    """out/<window>_<step>[_<scheme>].json: the file of one window and sampling."""
+    return os.path.join(OUT, f"{name}_{step}{'' if scheme == 'lofo' else '_' + scheme}.json")
+
+
 def source_key(cols, a: int) -> str:
     """A basis column's source (RULE.md): the heat input at any exponent and lag is one
     source, ``basis.SPEED``; a sensor its name."""
@@ -125,7 +130,7 @@ def main(names):
     for name in names:
         for step in STEPS:
             res = run_window(name, step)
-            with open(os.path.join(OUT, f"{name}_{step}{'' if SCHEME == 'lofo' else '_' + SCHEME}.json"), "w") as fh:
+            with open(out_name(name, step), "w") as fh:
                 json.dump(res, fh, indent=1, default=float)
             print(f"{name} step {step}: loop {res['cpu_loop_s']:.1f} s CPU, "
                   f"{len(res['channels'])} channels x K subsamples "
