@@ -128,6 +128,32 @@ def check_header(cells, where: str) -> None:
     require(not dup, f"{where}: column {dup[0] if dup else ''!r} appears twice in the header")
 
 
+#: targets (mm) within this are one target of a positioning run (1 nm)
+TARGET_KEY_MM = 1e-6
+
+
+def refuse_repeated_readings(targets_mm, direction, cycle, where: str, lines=None) -> None:
+    """Refuse a positioning run (one reading a row: ``volerr iso230-2``'s long format, the
+    ``interferometer`` instrument) in which one target, direction and cycle is read twice
+    (a row or a block pasted twice: a copied reading would count twice).  ``targets_mm``
+    (n,) mm, equal within :data:`TARGET_KEY_MM`; ``direction`` (n,) +1 forward (approach in
+    the positive direction) or -1 backward; ``cycle`` (n,) labels; ``lines``: each reading's
+    line in the file (the message says ``where:LINE``), else the data row counted with the
+    header as row 1 (``row N``).  The second reading is named, with the first."""
+    seen: dict = {}
+    for i, key in enumerate(zip((round(float(t) / TARGET_KEY_MM) for t in targets_mm),
+                                (1 if float(d) > 0 else -1 for d in direction),
+                                (str(c) for c in cycle))):
+        if key in seen:
+            j = seen[key]
+            at, first = ((f"{where}:{lines[i]}", f"line {lines[j]}") if lines is not None
+                         else (f"{where}: row {i + 2}", f"row {j + 2}"))
+            raise InputError(f"{at}: duplicate reading: target {float(targets_mm[i]):g} mm, "
+                             f"cycle {key[2]}, {'forward' if key[1] > 0 else 'backward'} "
+                             f"already given on {first} (a row or a block pasted twice?)")
+        seen[key] = i
+
+
 def sniff_delimiter(text: str) -> str:
     """The column separator of a CSV text: ``,`` unless the first line that is neither blank
     nor a ``#`` comment has no comma but a semicolon (``;``, spreadsheet exports with a
