@@ -32,10 +32,11 @@ import math
 
 import numpy as np
 
+from ...machine.lags import lag
 from . import basis
 from .family import SUB_BLOCKS
 
-__all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "lag_many", "ranges"]
+__all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "ranges"]
 
 SUB = 4               # trial values of ln tau per grid step
 CONFIDENCE = 0.95     # the F quantile of the threshold (two-sided 95 %: "k = 2")
@@ -181,65 +182,9 @@ def _trial_columns(s, sp, xs, rows) -> np.ndarray:
             else np.asarray(s.inputs[sp["source"]], float)
         if sp["minus"]:
             u = u - np.asarray(s.inputs[sp["minus"]], float)
-        taus = np.exp(xs)
-        got = lag_many(u - s.zero(u), taus, s.t_s, s.run, rows, _stride(s))
-        if got is None:       # readings not evenly spaced: one lag at a time
-            got = np.column_stack([_values(s, sp, float(v))[rows] for v in taus])
-        s.memo[key] = got
+        s.memo[key] = lag(u - s.zero(u), np.exp(xs), s.t_s, s.run, rows=rows,
+                          step=_stride(s))
     return s.memo[key]
-
-
-def lag_many(u, taus, t, run, rows, step=1):
-    """The first-order lag (as :func:`volerr.machine.lags.lag`, restarted in every run, the
-    same first-order-hold recursion ``y_k = a y_(k-1) + (1 - a) u_(k-1) + c (u_k - u_(k-1))``,
-    ``a = exp(-dt / tau)``, ``c = 1 - (1 - a) tau / dt``) of ``u`` (N,), zero at every run's
-    first reading, at the lags ``taus`` (T,) s at once, at the readings ``rows`` (about every
-``step``-th of a run: the cost scales with N / ``step``); None unless
-    every run's readings are contiguous, in time order and evenly spaced (then ``a`` and
-    ``c`` are constants per lag and the recursion is a cumulative sum in segments)."""
-    out = np.empty((len(rows), len(taus)))
-    for r in np.unique(run):
-        idx = np.flatnonzero(run == r)
-        dt = np.diff(t[idx])
-        if len(idx) > 1 and (idx[-1] - idx[0] + 1 != len(idx) or not dt[0] > 0
-                             or np.ptp(dt) > 1e-9 * dt[0]):
-            return None
-        want = np.flatnonzero(run[rows] == r)
-        if len(idx) < 2:
-            out[want] = 0.0
-            continue
-        y = _lag_even(u[idx], float(np.mean(dt)) / taus, rows[want] - idx[0], step)
-        out[want] = y
-    return out
-
-
-def _lag_even(u, x, at, step) -> np.ndarray:
-    """The lag recursion of ``u`` (M,) (``u[0]`` = 0) with steps ``x`` = dt / tau (T,), at
-    the readings ``at`` (M',): carried from target to target (``at`` and every ``step``-th
-    reading), each block's inputs summed by one matrix product, the carry a cumulative sum
-    in segments over which the weights stay below exp(300)."""
-    oma = -np.expm1(-x)
-    small = x < 1e-6
-    c = np.where(small, x / 2 - x * x / 6, 1.0 - oma / np.where(small, 1.0, x))
-    tg = np.arange(0, len(u), step)
-    if len(at) and not (np.all(at % step == 0) and at[-1] < len(u)):
-        tg = np.union1d(tg, at)
-    ell = np.diff(tg)                                        # block lengths (readings)
-    K = int(ell.max()) if len(ell) else 1
-    back = np.arange(K - 1, -1, -1)                          # steps before the block's end
-    J = tg[1:, None] - back[None, :]
-    ok = back[None, :] < ell[:, None]
-    J = np.where(ok, J, 1)
-    dec = np.exp(-back[:, None] * x[None, :])                # (K, T)
-    P = np.where(ok, u[J - 1], 0.0) @ (oma * dec) + np.where(ok, u[J] - u[J - 1], 0.0) @ (c * dec)
-    L = np.concatenate([[0.0], np.cumsum(ell, dtype=float)])   # readings from the start
-    y = np.zeros((len(tg), len(x)))
-    seg = max(1, int(300.0 / (float(x.max()) * K)))
-    for a in range(1, len(tg), seg):
-        b = min(a + seg, len(tg))
-        m = (L[a:b] - L[a - 1])[:, None] * x[None, :]
-        y[a:b] = np.exp(-m) * (y[a - 1] + np.cumsum(P[a - 1:b - 1] * np.exp(m), axis=0))
-    return y[np.searchsorted(tg, at)]
 
 
 def _f_ppf(q: float, nu: float) -> float:
