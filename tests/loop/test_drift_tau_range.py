@@ -112,13 +112,6 @@ def test_lag_of_several_taus_is_the_lag_of_each_tau(step, uneven):
         np.testing.assert_allclose(got[:, j], want, rtol=0, atol=1e-9 * np.abs(want).max())
 
 
-def test_f_quantile():
-    """F(0.95; 1, nu) from the closed form: tabulated values (Abramowitz & Stegun 1964,
-    table 26.9: 161.45, 18.513, 4.9646, 4.0847 at nu = 1, 2, 10, 40)."""
-    for nu, want in ((1, 161.45), (2, 18.513), (10, 4.9646), (40, 4.0847)):
-        assert tau_range._f_ppf(0.95, nu) == pytest.approx(want, rel=2e-4)
-
-
 @pytest.mark.parametrize("rng,value,words", [
     ([900.0, 1100.0], 1000.0, ", range 900 .. 1100 s"),
     ([900.0, 1100.0], 11501.0, "(not this fit's tau"),

@@ -33,6 +33,7 @@ import math
 import numpy as np
 
 from ...machine.lags import lag
+from ...selection.rules import f_quantile
 from . import basis
 from .family import SUB_BLOCKS
 
@@ -73,7 +74,7 @@ def ranges(ch, specs, fit) -> list:
     D = fit["design"][tr]
     p = int(np.sum(np.any(D != 0, axis=0))) + len(lagged)
     nu = max(float(SUB_BLOCKS * (int(ch.fold.max()) + 1)) - p, 1.0)
-    rise = 1.0 + _f_ppf(CONFIDENCE, nu) / nu
+    rise = 1.0 + f_quantile(CONFIDENCE, nu) / nu
     out = [None] * len(specs)
     for i in lagged:
         x, pos = _trials(xs, math.log(specs[i]["tau_s"]), trial[i], cur[i])
@@ -185,36 +186,3 @@ def _trial_columns(s, sp, xs, rows) -> np.ndarray:
         s.memo[key] = lag(u - s.zero(u), np.exp(xs), s.t_s, s.run, rows=rows,
                           step=_stride(s))
     return s.memo[key]
-
-
-def _f_ppf(q: float, nu: float) -> float:
-    """F(q; 1, nu): the q quantile of Fisher's F with 1 and ``nu`` (a whole number) degrees
-    of freedom, the square of Student's t two-sided: P(abs(T) <= t) = q, from the closed form
-    of Abramowitz & Stegun (1964, *Handbook of Mathematical Functions*, 26.7.3-4) solved by
-    bisection (no scipy at run time)."""
-    n = int(round(nu))
-    lo, hi = 0.0, 1e4
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if _t_two_sided(mid, n) < q:
-            lo = mid
-        else:
-            hi = mid
-    return (0.5 * (lo + hi)) ** 2
-
-
-def _t_two_sided(t: float, n: int) -> float:
-    """P(abs(T) <= t) for Student's T with ``n`` >= 1 degrees of freedom (A & S 26.7.3-4)."""
-    th = math.atan(t / math.sqrt(n))
-    sn, cs = math.sin(th), math.cos(th)
-    if n % 2:
-        term, acc = cs, (cs if n > 1 else 0.0)
-        for k in range(3, n - 1, 2):           # cos th (1 + 2/3 cos^2 + 2 4/(3 5) cos^4 ...)
-            term *= (k - 1) / k * cs * cs
-            acc += term
-        return 2.0 / math.pi * (th + sn * acc)
-    term, acc = 1.0, 1.0
-    for k in range(2, n - 1, 2):               # 1 + 1/2 cos^2 + 1 3/(2 4) cos^4 ...
-        term *= (k - 1) / k * cs * cs
-        acc += term
-    return sn * acc
