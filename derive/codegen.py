@@ -19,10 +19,12 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from .linewrap import wrap_statement, wrap_text
+from .seal import GENERATED_TAG, seal
 
 _DERIVE = Path(__file__).resolve().parent
 #: sources that shape every generated module: this printer, the wrapper and the template
-PRINTER_SOURCES = ("derive/codegen.py", "derive/linewrap.py", "derive/templates/model.py.j2")
+PRINTER_SOURCES = ("derive/codegen.py", "derive/linewrap.py", "derive/seal.py",
+                   "derive/templates/model.py.j2")
 #: units paragraph of a layout's error-model module
 MODEL_UNITS = ("Linear positions and probe offsets mm, rotary positions rad (the runtime "
                "converts from deg), translational errors mm, angular errors rad. Errors are "
@@ -224,7 +226,9 @@ def render_module(header: dict, constants: dict, functions: list[Function],
     added) and optionally ``units`` (the module's Units paragraph, default: error-model units).
     ``constants``: name -> Python literal.  The header records the sympy version and the
     sha256 over the derivation sources next to the input's sha256.  ``helpers``: source lines
-    of module-level helper functions (printed after the constants)."""
+    of module-level helper functions (printed after the constants).  The last line is the
+    sha256 of the text above it (:func:`volerr.derive.seal.seal`): ``volerr derive``
+    replaces a file only while it is as written (else ``--force``)."""
     sources = tuple(header.get("sources", ())) + PRINTER_SOURCES
     header = {**header, "sympy_version": sp.__version__,
               "sources_sha256": sources_sha256(sources),
@@ -236,5 +240,6 @@ def render_module(header: dict, constants: dict, functions: list[Function],
         keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True,
         undefined=jinja2.StrictUndefined)
     template = env.get_template("model.py.j2")
-    return template.render(header=header, constants=consts, helpers=list(helpers),
+    text = template.render(header=header, constants=consts, helpers=list(helpers),
                            functions=[_prepare(f) for f in functions])
+    return seal(text, GENERATED_TAG)    # the last line: what volerr derive may replace

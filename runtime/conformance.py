@@ -18,7 +18,6 @@ fail -> fail, else any undecided -> undecided, else pass).  Values and U in one 
 from __future__ import annotations
 
 import math
-import re
 
 from .errors import InputError, require
 
@@ -52,28 +51,26 @@ def overall(verdicts) -> str | None:
 
 
 def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
-    """``"A=10,E=8,R=4"`` -> ``{"A": 10.0, "E": 8.0, "R": 4.0}`` (um); names from ``names``
-    (any case), each at most once, values positive finite numbers, in um when bare, else
-    with a length unit (``"A=0.012 mm"``, :func:`volerr.units.parse_quantity`)."""
+    """``"A=10,E=8 um,R=0.004 mm"`` -> ``{"A": 10.0, "E": 8.0, "R": 4.0}`` (um): the pairs
+    as every ``--tolerance`` is read (:func:`volerr.units.parse_assignments`: split at ``,``
+    ``;`` ``|``, ``NAME=VALUE UNIT``, ``5um`` or ``5 um``), names from ``names`` (any case,
+    an optional ``_um`` suffix), each at most once, values positive finite lengths; a bare
+    number is um (every quantity here is a length reported in um)."""
+    from .units import check_tolerance_um, convert, parse_assignments
+
     allowed = {n.upper(): n for n in names}
+    example = ",".join(f"{n}=10 um" for n in list(names)[:3])
     out = {}
-    for part in filter(None, (p.strip() for p in re.split(r"[,;]", str(text)))):
-        key, eq, value = part.partition("=")
-        key = key.strip().upper().removesuffix("_UM")
-        require(eq == "=" and key, f"{option} {text!r}: write NAME=VALUE pairs in um, e.g. "
-                                   f"\"{','.join(f'{n}=10' for n in list(names)[:3])}\"")
+    for name, (v, unit) in parse_assignments(text, option, example, default_unit="um",
+                                             kinds=("length",), positive=False):
+        key = name.upper().removesuffix("_UM")
         require(key in allowed, f"{option}: unknown quantity {key!r}; one of "
                                 f"{' '.join(names)}")
         require(allowed[key] not in out, f"{option}: {allowed[key]} given twice")
-        from .units import check_tolerance_um, convert, parse_quantity   # bare: um
-
-        v, unit = parse_quantity(value, f"{option} {allowed[key]}={value.strip()}",
-                                 default_unit="um", kinds=("length",), positive=False)
+        given = f"{option} {allowed[key]}={v:g}" + ("" if unit == "um" else f" {unit}")
         v = convert(v, unit, "um")
-        check_tolerance_um(v, f"{option} {allowed[key]}={value.strip()}", unit, allowed[key])
+        check_tolerance_um(v, given, unit, allowed[key])
         require(math.isfinite(v) and 0 < v <= 1e6,
-                f"{option}: {allowed[key]} = {value.strip()} must be a positive number of um "
-                f"(at most 1e6)")
+                f"{given}: a tolerance must be a positive number of um (at most 1e6)")
         out[allowed[key]] = v
-    require(out, f"{option}: no tolerance given")
     return out

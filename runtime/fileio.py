@@ -128,6 +128,32 @@ def check_header(cells, where: str) -> None:
     require(not dup, f"{where}: column {dup[0] if dup else ''!r} appears twice in the header")
 
 
+#: targets (mm) within this are one target of a positioning run (1 nm)
+TARGET_KEY_MM = 1e-6
+
+
+def refuse_repeated_readings(targets_mm, direction, cycle, where: str, lines=None) -> None:
+    """Refuse a positioning run (one reading a row: ``volerr iso230-2``'s long format, the
+    ``interferometer`` instrument) in which one target, direction and cycle is read twice
+    (a row or a block pasted twice: a copied reading would count twice).  ``targets_mm``
+    (n,) mm, equal within :data:`TARGET_KEY_MM`; ``direction`` (n,) +1 forward (approach in
+    the positive direction) or -1 backward; ``cycle`` (n,) labels; ``lines``: each reading's
+    line in the file (the message says ``where:LINE``), else the data row counted with the
+    header as row 1 (``row N``).  The second reading is named, with the first."""
+    seen: dict = {}
+    for i, key in enumerate(zip((round(float(t) / TARGET_KEY_MM) for t in targets_mm),
+                                (1 if float(d) > 0 else -1 for d in direction),
+                                (str(c) for c in cycle))):
+        if key in seen:
+            j = seen[key]
+            at, first = ((f"{where}:{lines[i]}", f"line {lines[j]}") if lines is not None
+                         else (f"{where}: row {i + 2}", f"row {j + 2}"))
+            raise InputError(f"{at}: duplicate reading: target {float(targets_mm[i]):g} mm, "
+                             f"cycle {key[2]}, {'forward' if key[1] > 0 else 'backward'} "
+                             f"already given on {first} (a row or a block pasted twice?)")
+        seen[key] = i
+
+
 def sniff_delimiter(text: str) -> str:
     """The column separator of a CSV text: ``,`` unless the first line that is neither blank
     nor a ``#`` comment has no comma but a semicolon (``;``, spreadsheet exports with a
@@ -357,7 +383,7 @@ class Outputs:
         self.inputs = files
         self.allow_package = allow_package
         self.force = force
-        self._replace: set = set()      # folder roles whose files may be replaced
+        self._replace: dict = {}        # folder role -> True or its rule (folder())
         self._items: list = []          # (role, path, kind, files)
         self._stage: dict = {}          # role -> staged path
         self._roots: dict = {}          # target folder -> staging folder
@@ -400,26 +426,30 @@ class Outputs:
         """Declare a PNG plot (must end in ``.png``)."""
         return self.file(role, path, plot=True)
 
-    def folder(self, role: str, path, files=None, *, replace: bool = False) -> "Outputs":
+    def folder(self, role: str, path, files=None, *, replace=False) -> "Outputs":
         """Declare an output folder and, when known, the names of the files it will get
         (relative paths); unknown names are checked at commit, before anything moves.
-        ``replace``: files of this folder may be replaced without ``force`` (only for a
-        folder whose files are by definition rewritten, such as ``volerr derive``'s)."""
+        ``replace``: files of this folder may be replaced without ``force``: True (every
+        file) or a rule ``replace(path) -> None`` (may be replaced) ``| str`` (why not: the
+        refusal says ``<path> <why>; give --force ...``), e.g. ``volerr derive``'s, which
+        replaces a generated module only while it is as volerr wrote it."""
         if path is not None:
             require(not self._checked, "internal: output declared after check()")
             self._items.append((role, Path(path), "folder",
                                 None if files is None else tuple(files)))
             if replace:
-                self._replace.add(role)
+                self._replace[role] = replace
         return self
 
     def _refuse_existing(self, role, folder: Path, f: Path) -> None:
-        """A folder output must not replace a file that was there before the run."""
-        if self.force or role in self._replace:
+        """A folder output must not replace a file that was there before the run (unless
+        ``force``, or its folder's ``replace`` rule allows it)."""
+        rule = self._replace.get(role)
+        if self.force or rule is True or not (f.exists() or f.is_symlink()):
             return
-        require(not (f.exists() or f.is_symlink()),
-                f"{role} {folder}: {f} exists already (not written by this run); give "
-                f"--force to replace it, or another folder")
+        why = rule(f) if callable(rule) else "exists already (not written by this run)"
+        require(why is None, f"{role} {folder}: {f} {why}; give --force to replace it, or "
+                             f"another folder")
 
     @property
     def declared(self) -> list:

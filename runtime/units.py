@@ -161,24 +161,29 @@ def convert(value: float, unit: str, to: str, where: str = "") -> float:
     return float(value) * a[1] / b[1]
 
 
-def parse_assignments(text, option: str, **quantity) -> list:
+def parse_assignments(text, option: str, example: str = "EX0C=20 um, EA0C=5 urad",
+                      **quantity) -> list:
     """``"EX0C=20 um, EA0C=5 urad"`` -> ``[(name, (value, unit)), ...]`` in the order given:
     pairs split at ``,`` ``;`` ``|``, each ``NAME=VALUE UNIT`` read by :func:`parse_quantity`
-    (``quantity``: its keywords).  Names as written (stripped); a name given twice, an empty
-    list or a pair without ``=`` is refused, naming ``option`` and the pair."""
+    (``quantity``: its keywords; the unit may follow the number directly, ``5um``).  A bare
+    number takes ``default_unit`` where the option states one (``volerr iso230-2
+    --tolerance``: every quantity a length in um), else it is refused (``volerr history show
+    --tolerance``, ``volerr check --tolerance``: parameters in different units).  Names as
+    written (stripped); a name given twice, an empty list or a pair without ``=`` is refused,
+    naming ``option`` and the pair (``example``: the option's own, for that message)."""
     out, seen = [], set()
     for part in filter(None, (p.strip() for p in re.split(r"[,;|]", str(text or "")))):
         name, eq, rest = part.partition("=")
         name = name.strip()
         if not (eq and name):
-            raise InputError(f"{option} {part!r}: NAME=VALUE UNIT expected (e.g. EX0C=20 um, "
-                             f"EA0C=5 urad)")
+            raise InputError(f"{option} {part!r}: NAME=VALUE UNIT expected (e.g. {example})")
         if name in seen:
             raise InputError(f"{option}: {name} given twice")
         seen.add(name)
         out.append((name, parse_quantity(rest, f"{option} {part}", **quantity)))
     if not out:
-        raise InputError(f"{option}: no value given (NAME=VALUE UNIT, e.g. EX0C=20 um)")
+        raise InputError(f"{option}: no value given (NAME=VALUE UNIT, e.g. "
+                         f"{example.split(',')[0]})")
     return out
 
 

@@ -146,8 +146,9 @@ def _reference(entry, stored: list, path):
 
 def parse_tolerances(text: str | None) -> dict:
     """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``: every value with
-    its unit (:func:`volerr.units.parse_assignments`; a bare number is refused, the history
-    holds parameters in different units); ``map`` (the volumetric error) a length, in um."""
+    its unit (:func:`volerr.units.parse_assignments`, the reading of every ``--tolerance``;
+    a bare number is refused, the history holds parameters in different units); ``map``
+    (the volumetric error) a length, in um."""
     if not text:
         return {}
     out = {}

@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require, require_file
+from ..fileio import refuse_repeated_readings
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
@@ -215,7 +216,7 @@ def _readings(path, axis, mode, where):
 
         check_material_temperature(temp, f"{where}: column {hT}")
     if hc is not None:
-        _refuse_repeated_readings(targets, direction, cycle, where)
+        refuse_repeated_readings(targets, direction, cycle, where)
     return targets, dev, direction, cycle, temp, np.arange(n)
 
 
@@ -235,20 +236,6 @@ def _refuse_implausible(targets, dev_mm, column, where) -> None:
     raise InputError(f"{where}: column {column}: reading {1e3 * a[i]:g} um at target "
                      f"{targets[i]:g} mm (row {i + 2}) is {MAX_DEVIATION_MM:g} mm or more: not "
                      f"a deviation of a machine axis ({cause})")
-
-
-def _refuse_repeated_readings(targets, direction, cycle, where) -> None:
-    """Refuse a long-format run with a cycle column in which one target, direction and cycle
-    is read twice (a row or a block pasted twice; ``volerr iso230-2`` refuses it as a
-    duplicate reading): a copied reading would count twice in the fit."""
-    seen: dict = {}
-    for i, key in enumerate(zip(np.round(np.asarray(targets, float) * 1e6).astype(np.int64),
-                                direction, (str(c) for c in cycle))):
-        require(key not in seen, f"{where}: row {i + 2} repeats the reading of row "
-                                 f"{seen.get(key, 0) + 2} (target {targets[i]:g} mm, cycle "
-                                 f"{key[2]}, direction {key[1]:+g}): a row or a block pasted "
-                                 f"twice?")
-        seen[key] = i
 
 
 def _target_column(c, names, where):

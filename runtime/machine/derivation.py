@@ -111,7 +111,7 @@ def derive_source(layout: Layout) -> str:
     return source
 
 
-_ENTRY_TAG = "# volerr-cache sha256 "
+_ENTRY_TAG = "# volerr-cache sha256 "     # an entry's seal (volerr.derive.seal)
 
 
 def cache_dir() -> Path:
@@ -173,17 +173,15 @@ def _read_entry(path: Path) -> str | None:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         return None
-    body, _, tag = text.rstrip("\n").rpartition("\n")
-    if not tag.startswith(_ENTRY_TAG):
-        return None
-    if hashlib.sha256(body.encode("utf-8")).hexdigest() != tag[len(_ENTRY_TAG):]:
-        return None
-    return body
+    from volerr.derive.seal import unseal
+
+    return unseal(text, _ENTRY_TAG)
 
 
 def _write_entry(path: Path, source: str) -> None:
-    body = source.rstrip("\n")
-    text = f"{body}\n{_ENTRY_TAG}{hashlib.sha256(body.encode('utf-8')).hexdigest()}\n"
+    from volerr.derive.seal import seal
+
+    text = seal(source, _ENTRY_TAG)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -236,6 +234,40 @@ def derive_request(layouts=(), *, all_layouts: bool = False, out=None,
     require(not dup, f"two layouts generate the same module {dup[0] if dup else ''}: give them "
                      f"different names or derive them one at a time")
     return folder, writes_package, found
+
+
+def target_names(layouts, all_layouts: bool = False) -> list:
+    """The file names :func:`derived_sources` gives (known before deriving)."""
+    names = [module_filename(lay) for lay in layouts]
+    if all_layouts:
+        from volerr.derive.generate import EXTRA_MODULES, module_name
+
+        from .layout import layout_names
+
+        names += [f"{module_name(n)}.py" for n in layout_names()] + list(EXTRA_MODULES)
+    return list(dict.fromkeys(names))
+
+
+def not_replaceable(path) -> str | None:
+    """Why ``volerr derive`` must not replace the existing file ``path`` without ``--force``
+    (the end of a one-line refusal), or None: a file is replaced while it is as volerr
+    derive wrote it -- its last line the sha256 of the text above it (:mod:`volerr.derive.seal`),
+    however stale its content; an edited file, or one without that line (written by hand, or
+    by a volerr from before the line), differs from anything volerr derive writes."""
+    from volerr.derive.seal import GENERATED_TAG, unseal
+
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return "is not a text file volerr derive wrote"
+    if unseal(text, GENERATED_TAG) is not None:
+        return None
+    last = text.rstrip("\n").rpartition("\n")[2]
+    if last.startswith(GENERATED_TAG):
+        return ("was edited after volerr derive wrote it (its text no longer matches the "
+                "sha256 of its last line)")
+    return (f"was not written by this volerr derive (no '{GENERATED_TAG.strip()}' last "
+            f"line: written by hand, or by an older volerr)")
 
 
 def derived_sources(layouts, all_layouts: bool = False, progress=None) -> dict:

@@ -18,6 +18,12 @@ sensor's first reading).  Data of several files are filtered file by file.
 Units: ``tau`` and ``t`` in the same unit (seconds for ``lag(C, tau_s)`` over ``t_s``).  The
 recurrence is summed in closed form with cumulative sums (no Python loop over the samples),
 restarted every ``_SEGMENT`` time constants so that no exponential overflows.
+
+Several time constants at once (``lag(u, taus, ...)``, the trial time constants of a profile,
+:mod:`volerr.loop.drift.tau_range`): where every group is evenly sampled, contiguous and in
+time order, ``a`` and ``c`` are constants per time constant and the recurrence of all of
+them is carried from target to target (every ``step``-th point and the points asked for),
+each block's inputs summed by one matrix product; elsewhere one time constant at a time.
 """
 
 from __future__ import annotations
@@ -31,11 +37,18 @@ TIME_COLUMNS = {"t_s": 1.0, "time_s": 1.0, "t_min": 60.0, "time_min": 60.0, "t_h
                 "time_h": 3600.0}
 
 
-def lag(u, tau_s: float, t, groups=None, order=None) -> np.ndarray:
+def lag(u, tau_s, t, groups=None, order=None, rows=None, step: int = 1) -> np.ndarray:
     """``u`` (N,) filtered through a first-order lag of time constant ``tau_s`` over the
     times ``t`` (N,), same unit as ``tau_s``; ``groups`` (N,) ints: filter each group (file)
     on its own; ``order``: :func:`time_order` of ``(t, groups)`` when already known.  A scalar
-    ``u`` is returned unchanged.  Returns (N,) floats."""
+    ``u`` is returned unchanged.  Returns (N,) floats.
+
+    ``tau_s`` (T,) time constants at once (module docstring): returns (N, T), column j the
+    lag at ``tau_s[j]``, or only the points ``rows`` (indices), (len(rows), T); ``step``:
+    ``rows`` are about every ``step``-th point of a group (evenly sampled groups then cost
+    N / ``step`` per time constant)."""
+    if np.ndim(tau_s):
+        return _lag_taus(u, np.asarray(tau_s, dtype=float), t, groups, order, rows, step)
     u = np.asarray(u, dtype=float)
     if u.ndim == 0:
         return u
@@ -48,6 +61,70 @@ def lag(u, tau_s: float, t, groups=None, order=None) -> np.ndarray:
     out = np.empty(flat.size)
     out[order] = y
     return out.reshape(u.shape)
+
+
+def _lag_taus(u, taus, t, groups, order, rows, step) -> np.ndarray:
+    """:func:`lag` of ``u`` (N,) at the time constants ``taus`` (T,), at ``rows``:
+    (len(rows), T)."""
+    u = np.asarray(u, dtype=float).ravel()
+    t = np.broadcast_to(np.asarray(t, dtype=float), u.shape)
+    rows = np.arange(u.size) if rows is None else np.asarray(rows)
+    run = np.zeros(u.size, int) if groups is None else np.asarray(groups).ravel()
+    got = _lag_even_groups(u, taus, t, run, rows, step)
+    if got is None:               # a group not evenly sampled: one time constant at a time
+        order = time_order(t, groups) if order is None else order
+        got = np.column_stack([lag(u, float(tau), t, groups, order)[rows] for tau in taus])
+    return got
+
+
+def _lag_even_groups(u, taus, t, run, rows, step):
+    """(len(rows), T) lags of ``u`` at ``taus`` group by group (``run``), each group from
+    equilibrium at its first point; None unless every group's points are contiguous, in
+    time order and evenly spaced."""
+    out = np.empty((len(rows), len(taus)))
+    for r in np.unique(run):
+        idx = np.flatnonzero(run == r)
+        dt = np.diff(t[idx])
+        if len(idx) > 1 and (idx[-1] - idx[0] + 1 != len(idx) or not dt[0] > 0
+                             or np.ptp(dt) > 1e-9 * dt[0]):
+            return None
+        want = np.flatnonzero(run[rows] == r)
+        u0 = u[idx[0]]
+        if len(idx) < 2:
+            out[want] = u0
+            continue
+        out[want] = _lag_even(u[idx] - u0, float(np.mean(dt)) / taus, rows[want] - idx[0],
+                              step) + u0
+    return out
+
+
+def _lag_even(u, x, at, step) -> np.ndarray:
+    """The lag recursion of ``u`` (M,) (``u[0]`` = 0) with steps ``x`` = dt / tau (T,), at
+    the readings ``at`` (M',): carried from target to target (``at`` and every ``step``-th
+    reading), each block's inputs summed by one matrix product, the carry a cumulative sum
+    in segments over which the weights stay below exp(300)."""
+    oma = -np.expm1(-x)
+    small = x < 1e-6
+    c = np.where(small, x / 2 - x * x / 6, 1.0 - oma / np.where(small, 1.0, x))
+    tg = np.arange(0, len(u), step)
+    if len(at) and not (np.all(at % step == 0) and at[-1] < len(u)):
+        tg = np.union1d(tg, at)
+    ell = np.diff(tg)                                        # block lengths (readings)
+    K = int(ell.max()) if len(ell) else 1
+    back = np.arange(K - 1, -1, -1)                          # steps before the block's end
+    J = tg[1:, None] - back[None, :]
+    ok = back[None, :] < ell[:, None]
+    J = np.where(ok, J, 1)
+    dec = np.exp(-back[:, None] * x[None, :])                # (K, T)
+    P = np.where(ok, u[J - 1], 0.0) @ (oma * dec) + np.where(ok, u[J] - u[J - 1], 0.0) @ (c * dec)
+    L = np.concatenate([[0.0], np.cumsum(ell, dtype=float)])   # readings from the start
+    y = np.zeros((len(tg), len(x)))
+    seg = max(1, int(_SEGMENT / (float(x.max()) * K)))
+    for a in range(1, len(tg), seg):
+        b = min(a + seg, len(tg))
+        m = (L[a:b] - L[a - 1])[:, None] * x[None, :]
+        y[a:b] = np.exp(-m) * (y[a - 1] + np.cumsum(P[a - 1:b - 1] * np.exp(m), axis=0))
+    return y[np.searchsorted(tg, at)]
 
 
 def time_order(t, groups=None) -> np.ndarray:

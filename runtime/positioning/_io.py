@@ -54,7 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require
-from ..fileio import read_csv_rows
+from ..fileio import TARGET_KEY_MM, read_csv_rows, refuse_repeated_readings
 from ..units import MM_PER_UM, parse_number
 
 FWD, BWD = 0, 1
@@ -78,7 +78,6 @@ _DEVIATION_RX = re.compile(rf"^deviation{_UNIT}$", re.IGNORECASE)
 _RUN = r"(?:run|cycle|cyc|c|r)?"
 _WIDE = (re.compile(rf"^(?P<d>{_F}|{_B})[ _.-]?{_RUN}[ _.-]?(?P<k>\d+){_UNIT}$", re.IGNORECASE),
          re.compile(rf"^{_RUN}[ _.-]?(?P<k>\d+)[ _.-]?(?P<d>{_F}|{_B}){_UNIT}$", re.IGNORECASE))
-_TARGET_KEY_MM = 1e-6  # targets equal to 1 nm are the same target
 
 
 @dataclass
@@ -265,7 +264,7 @@ def _read_long(path, axis, header, body, low) -> PositioningRun:
     used = {jt, jc, jd, jv, jT}
     cond = [j for j in range(len(header)) if j not in used and low[j].endswith("_c")]
     ignored = [header[j] for j in range(len(header)) if j not in used and j not in cond]
-    entries, temps = {}, {}
+    rows = []               # (target mm, FWD | BWD, cycle, deviation mm, line, T or None)
     for ln, cells in body:
         t = _number(path, ln, header[jt], cells[jt]) * tscale
         dtext = cells[jd].lower()
@@ -275,13 +274,16 @@ def _read_long(path, axis, header, body, low) -> PositioningRun:
         require(cells[jc] != "", f"{path}:{ln}: empty value in column {header[jc]}")
         c = _cycle_label(path, ln, header[jc], cells[jc])
         v = _number(path, ln, header[jv], cells[jv]) * scale
-        key = (round(t / _TARGET_KEY_MM), d, c)
-        if key in entries:
-            raise InputError(f"{path}:{ln}: duplicate reading: target {t:g} mm, cycle {c}, "
-                             f"{DIRECTION_NAMES[d]} already given on line {entries[key][2]}")
+        rows.append((t, d, c, v, ln,
+                     None if jT is None else _number(path, ln, header[jT], cells[jT])))
+    refuse_repeated_readings([r[0] for r in rows], [1 if r[1] == FWD else -1 for r in rows],
+                             [r[2] for r in rows], str(path), lines=[r[4] for r in rows])
+    entries, temps = {}, {}
+    for t, d, c, v, ln, T in rows:
+        key = (round(t / TARGET_KEY_MM), d, c)
         entries[key] = (v, t, ln)
-        if jT is not None:
-            temps[key] = _number(path, ln, header[jT], cells[jT])
+        if T is not None:
+            temps[key] = T
     return _assemble(path, axis, entries, temps, "long", _conditions(path, header, body, cond),
                      ignored)
 
@@ -328,7 +330,7 @@ def _read_wide(path, axis, header, body, low) -> PositioningRun:
     entries, temps, rows_of = {}, {}, {}
     for ln, cells in body:
         t = _number(path, ln, header[jt], cells[jt]) * tscale
-        tk = round(t / _TARGET_KEY_MM)
+        tk = round(t / TARGET_KEY_MM)
         if tk in rows_of:
             raise InputError(f"{path}:{ln}: duplicate target {t:g} mm (already on line "
                              f"{rows_of[tk]})")

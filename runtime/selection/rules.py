@@ -24,7 +24,11 @@ apply them; their scorers stay their own).
   ``LAG_EARN`` BIC over the same covariate without one (the plain covariate is the limit
   tau -> 0).
 
-Reference: Schwarz (1978) for the BIC.
+* **Quantiles**: Student's t one-sided 95 % (:func:`t95`, a table) and Fisher's F(q; 1, nu)
+  (:func:`f_quantile`, the square of the two-sided t from its closed form
+  :func:`t_two_sided`; the threshold of a profile range, :mod:`volerr.loop.drift.tau_range`).
+
+Reference: Schwarz (1978) for the BIC; Abramowitz & Stegun (1964) 26.7.3-4 for t.
 """
 
 from __future__ import annotations
@@ -102,6 +106,39 @@ T95_ONE_SIDED = (6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 
 def t95(df: int) -> float:
     """One-sided 95 % quantile of Student's t with ``df`` degrees of freedom (table)."""
     return T95_ONE_SIDED[df - 1] if df <= len(T95_ONE_SIDED) else 1.645
+
+
+def f_quantile(q: float, nu: float) -> float:
+    """F(q; 1, nu): the q quantile of Fisher's F with 1 and ``nu`` (a whole number) degrees
+    of freedom, the square of Student's t two-sided: P(abs(T) <= t) = q, from the closed form
+    of Abramowitz & Stegun (1964, *Handbook of Mathematical Functions*, 26.7.3-4) solved by
+    bisection (no scipy at run time)."""
+    n = int(round(nu))
+    lo, hi = 0.0, 1e4
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if t_two_sided(mid, n) < q:
+            lo = mid
+        else:
+            hi = mid
+    return (0.5 * (lo + hi)) ** 2
+
+
+def t_two_sided(t: float, n: int) -> float:
+    """P(abs(T) <= t) for Student's T with ``n`` >= 1 degrees of freedom (A & S 26.7.3-4)."""
+    th = math.atan(t / math.sqrt(n))
+    sn, cs = math.sin(th), math.cos(th)
+    if n % 2:
+        term, acc = cs, (cs if n > 1 else 0.0)
+        for k in range(3, n - 1, 2):           # cos th (1 + 2/3 cos^2 + 2 4/(3 5) cos^4 ...)
+            term *= (k - 1) / k * cs * cs
+            acc += term
+        return 2.0 / math.pi * (th + sn * acc)
+    term, acc = 1.0, 1.0
+    for k in range(2, n - 1, 2):               # 1 + 1/2 cos^2 + 1 3/(2 4) cos^4 ...
+        term *= (k - 1) / k * cs * cs
+        acc += term
+    return sn * acc
 
 
 def significantly_below(err_new, err_old) -> bool:

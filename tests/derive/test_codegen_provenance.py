@@ -67,7 +67,7 @@ def test_header_records_sympy_version_and_source_hash(module, sources):
     text = (GENERATED / module).read_text(encoding="utf-8")
     assert _header_field(text, "sympy") == sp.__version__
     h = hashlib.sha256()
-    for name in sources + ["derive/codegen.py", "derive/linewrap.py",
+    for name in sources + ["derive/codegen.py", "derive/linewrap.py", "derive/seal.py",
                            "derive/templates/model.py.j2"]:
         h.update(name.encode() + b"\0" + (REPO / name).read_bytes() + b"\0")
     assert _header_field(text, "derivation sha256") == h.hexdigest()

@@ -6,6 +6,7 @@ without sympy, and a run that augments the same way writes it without deriving a
 text must be the derivation's byte for byte, and an entry derived for the same layout text
 under another file name (the module names its layout file) is not taken for it."""
 
+from volerr.derive.seal import unseal
 from volerr.machine import derivation
 from volerr.machine.layout import layout_text, parse_layout
 
@@ -27,7 +28,8 @@ def test_derived_once_then_read_back_byte_for_byte(tmp_path, monkeypatch):
 
     monkeypatch.setattr(derivation, "generate_source", counted)
     first = derivation.derive_source(lay)
-    assert calls == ["MB1C.toml"] and first.endswith("}\n") and " from MB1C.toml.\n" in first
+    whole = unseal(first)                                    # the module, sealed
+    assert calls == ["MB1C.toml"] and whole.endswith("}") and " from MB1C.toml.\n" in first
     assert derivation.derive_source(lay) == first            # read back: no second derivation
     assert calls == ["MB1C.toml"]
     # the file loaded later (the refit of the augmented layout) reads the same entry

@@ -91,30 +91,25 @@ def test_range_is_an_addition_only(tmp_path, monkeypatch):
         json.dumps(without, sort_keys=True, default=str)
 
 
-@pytest.mark.parametrize("step", [1, 3])
-def test_lag_many_is_the_lag_of_each_tau(step):
-    """The batched lag equals :func:`volerr.machine.lags.lag` one tau at a time (two runs, a
-    held-out stretch in the first)."""
+@pytest.mark.parametrize("step,uneven", [(1, False), (3, False), (3, True)])
+def test_lag_of_several_taus_is_the_lag_of_each_tau(step, uneven):
+    """:func:`volerr.machine.lags.lag` at several time constants at once (the profile's
+    trial columns) equals it one tau at a time (two runs, a held-out stretch in the first;
+    evenly sampled: the batched path, not: one tau at a time)."""
     rng = np.random.default_rng(3)
     t = np.r_[10.0 * np.arange(900), 10.0 * np.arange(600)]
+    if uneven:
+        t[900:] = np.cumsum(rng.uniform(5.0, 15.0, 600))
     run = np.r_[np.zeros(900, int), np.ones(600, int)]
     u = np.cumsum(rng.standard_normal(len(t)))
-    first = np.r_[np.full(900, u[0]), np.full(600, u[900])]
     idx = np.flatnonzero(~((t > 3000) & (t < 5000) & (run == 0)))
     rows = np.concatenate([idx[run[idx] == r][::step] for r in (0, 1)])
     taus = np.geomspace(40.0, 40000.0, 17)
-    got = tau_range.lag_many(u - first, taus, t, run, rows, step)
+    got = lag(u, taus, t, run, rows=rows, step=step)
+    assert got.shape == (len(rows), len(taus))
     for j, tau in enumerate(taus):
-        y = lag(u, tau, t, run)
-        want = (y - np.r_[np.full(900, y[0]), np.full(600, y[900])])[rows]
+        want = lag(u, tau, t, run)[rows]
         np.testing.assert_allclose(got[:, j], want, rtol=0, atol=1e-9 * np.abs(want).max())
-
-
-def test_f_quantile():
-    """F(0.95; 1, nu) from the closed form: tabulated values (Abramowitz & Stegun 1964,
-    table 26.9: 161.45, 18.513, 4.9646, 4.0847 at nu = 1, 2, 10, 40)."""
-    for nu, want in ((1, 161.45), (2, 18.513), (10, 4.9646), (40, 4.0847)):
-        assert tau_range._f_ppf(0.95, nu) == pytest.approx(want, rel=2e-4)
 
 
 @pytest.mark.parametrize("rng,value,words", [

@@ -32,10 +32,12 @@ import math
 
 import numpy as np
 
+from ...machine.lags import lag
+from ...selection.rules import f_quantile
 from . import basis
 from .family import SUB_BLOCKS
 
-__all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "lag_many", "ranges"]
+__all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "ranges"]
 
 SUB = 4               # trial values of ln tau per grid step
 CONFIDENCE = 0.95     # the F quantile of the threshold (two-sided 95 %: "k = 2")
@@ -72,7 +74,7 @@ def ranges(ch, specs, fit) -> list:
     D = fit["design"][tr]
     p = int(np.sum(np.any(D != 0, axis=0))) + len(lagged)
     nu = max(float(SUB_BLOCKS * (int(ch.fold.max()) + 1)) - p, 1.0)
-    rise = 1.0 + _f_ppf(CONFIDENCE, nu) / nu
+    rise = 1.0 + f_quantile(CONFIDENCE, nu) / nu
     out = [None] * len(specs)
     for i in lagged:
         x, pos = _trials(xs, math.log(specs[i]["tau_s"]), trial[i], cur[i])
@@ -181,95 +183,6 @@ def _trial_columns(s, sp, xs, rows) -> np.ndarray:
             else np.asarray(s.inputs[sp["source"]], float)
         if sp["minus"]:
             u = u - np.asarray(s.inputs[sp["minus"]], float)
-        taus = np.exp(xs)
-        got = lag_many(u - s.zero(u), taus, s.t_s, s.run, rows, _stride(s))
-        if got is None:       # readings not evenly spaced: one lag at a time
-            got = np.column_stack([_values(s, sp, float(v))[rows] for v in taus])
-        s.memo[key] = got
+        s.memo[key] = lag(u - s.zero(u), np.exp(xs), s.t_s, s.run, rows=rows,
+                          step=_stride(s))
     return s.memo[key]
-
-
-def lag_many(u, taus, t, run, rows, step=1):
-    """The first-order lag (as :func:`volerr.machine.lags.lag`, restarted in every run, the
-    same first-order-hold recursion ``y_k = a y_(k-1) + (1 - a) u_(k-1) + c (u_k - u_(k-1))``,
-    ``a = exp(-dt / tau)``, ``c = 1 - (1 - a) tau / dt``) of ``u`` (N,), zero at every run's
-    first reading, at the lags ``taus`` (T,) s at once, at the readings ``rows`` (about every
-``step``-th of a run: the cost scales with N / ``step``); None unless
-    every run's readings are contiguous, in time order and evenly spaced (then ``a`` and
-    ``c`` are constants per lag and the recursion is a cumulative sum in segments)."""
-    out = np.empty((len(rows), len(taus)))
-    for r in np.unique(run):
-        idx = np.flatnonzero(run == r)
-        dt = np.diff(t[idx])
-        if len(idx) > 1 and (idx[-1] - idx[0] + 1 != len(idx) or not dt[0] > 0
-                             or np.ptp(dt) > 1e-9 * dt[0]):
-            return None
-        want = np.flatnonzero(run[rows] == r)
-        if len(idx) < 2:
-            out[want] = 0.0
-            continue
-        y = _lag_even(u[idx], float(np.mean(dt)) / taus, rows[want] - idx[0], step)
-        out[want] = y
-    return out
-
-
-def _lag_even(u, x, at, step) -> np.ndarray:
-    """The lag recursion of ``u`` (M,) (``u[0]`` = 0) with steps ``x`` = dt / tau (T,), at
-    the readings ``at`` (M',): carried from target to target (``at`` and every ``step``-th
-    reading), each block's inputs summed by one matrix product, the carry a cumulative sum
-    in segments over which the weights stay below exp(300)."""
-    oma = -np.expm1(-x)
-    small = x < 1e-6
-    c = np.where(small, x / 2 - x * x / 6, 1.0 - oma / np.where(small, 1.0, x))
-    tg = np.arange(0, len(u), step)
-    if len(at) and not (np.all(at % step == 0) and at[-1] < len(u)):
-        tg = np.union1d(tg, at)
-    ell = np.diff(tg)                                        # block lengths (readings)
-    K = int(ell.max()) if len(ell) else 1
-    back = np.arange(K - 1, -1, -1)                          # steps before the block's end
-    J = tg[1:, None] - back[None, :]
-    ok = back[None, :] < ell[:, None]
-    J = np.where(ok, J, 1)
-    dec = np.exp(-back[:, None] * x[None, :])                # (K, T)
-    P = np.where(ok, u[J - 1], 0.0) @ (oma * dec) + np.where(ok, u[J] - u[J - 1], 0.0) @ (c * dec)
-    L = np.concatenate([[0.0], np.cumsum(ell, dtype=float)])   # readings from the start
-    y = np.zeros((len(tg), len(x)))
-    seg = max(1, int(300.0 / (float(x.max()) * K)))
-    for a in range(1, len(tg), seg):
-        b = min(a + seg, len(tg))
-        m = (L[a:b] - L[a - 1])[:, None] * x[None, :]
-        y[a:b] = np.exp(-m) * (y[a - 1] + np.cumsum(P[a - 1:b - 1] * np.exp(m), axis=0))
-    return y[np.searchsorted(tg, at)]
-
-
-def _f_ppf(q: float, nu: float) -> float:
-    """F(q; 1, nu): the q quantile of Fisher's F with 1 and ``nu`` (a whole number) degrees
-    of freedom, the square of Student's t two-sided: P(abs(T) <= t) = q, from the closed form
-    of Abramowitz & Stegun (1964, *Handbook of Mathematical Functions*, 26.7.3-4) solved by
-    bisection (no scipy at run time)."""
-    n = int(round(nu))
-    lo, hi = 0.0, 1e4
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if _t_two_sided(mid, n) < q:
-            lo = mid
-        else:
-            hi = mid
-    return (0.5 * (lo + hi)) ** 2
-
-
-def _t_two_sided(t: float, n: int) -> float:
-    """P(abs(T) <= t) for Student's T with ``n`` >= 1 degrees of freedom (A & S 26.7.3-4)."""
-    th = math.atan(t / math.sqrt(n))
-    sn, cs = math.sin(th), math.cos(th)
-    if n % 2:
-        term, acc = cs, (cs if n > 1 else 0.0)
-        for k in range(3, n - 1, 2):           # cos th (1 + 2/3 cos^2 + 2 4/(3 5) cos^4 ...)
-            term *= (k - 1) / k * cs * cs
-            acc += term
-        return 2.0 / math.pi * (th + sn * acc)
-    term, acc = 1.0, 1.0
-    for k in range(2, n - 1, 2):               # 1 + 1/2 cos^2 + 1 3/(2 4) cos^4 ...
-        term *= (k - 1) / k * cs * cs
-        acc += term
-    return sn * acc
