@@ -303,6 +303,53 @@ def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str 
                      f"({TOLERANCE_FLOOR_UM:g} um): {hint}")
 
 
+#: the smallest spread (largest minus smallest value) the readings of one error column of a
+#: real machine show, um.  A very good machine's positioning error over a short axis still
+#: spans about 0.1 um (its repeatability alone: ISO 230-2 R of the best axes 0.2-0.5 um), an
+#: R-test over a rotary sweep or a ballbar circle micrometres; the instruments resolve
+#: 0.001-0.01 um (laser interferometer, probe), so no real column spans less than half that
+#: 0.1 um.  Readings in mm written under an ``_um`` header span a thousandth of the real
+#: spread: every machine whose real spread is below 50 um is caught (one-sided evidence: a
+#: column in mm of a worse machine passes).
+MIN_READING_SPREAD_UM = 0.05
+#: a spread at or below this, um, is no reading at all (1 pm, a thousandth of the finest
+#: instrument's resolution): a constant or zero-filled column, or the round-off of a
+#: simulated perfect machine (1e-9 um), left to the readers' own checks
+NO_SPREAD_UM = 1e-6
+
+
+#: the smallest spread of the readings of a cycle over a rotary axis' travel (R-test, touch
+#: probe on a sphere) or of a ballbar circle, um: they read the axes' location and squareness
+#: errors times a radius of 100 mm or more and the set-up's offsets (the sphere off its
+#: nominal centre, the circle's centre), micrometres on the best five-axis machines
+#: (ISO 230-4 G of the best circles 1-2 um); a tenth of a micrometre spread is no such cycle
+MIN_CYCLE_SPREAD_UM = 0.5
+
+
+def check_reading_spread_um(columns: dict, where: str,
+                            minimum_um: float = MIN_READING_SPREAD_UM) -> None:
+    """Refuse readings that look like mm written under ``_um`` (x1000): ``columns``
+    ``{header: values}`` of one file's error readings headed ``_um`` (values as written, um);
+    one-line :class:`InputError` naming ``where`` and the column when the largest spread
+    ``max - min`` of the columns is above :data:`NO_SPREAD_UM` and below ``minimum_um``
+    (:data:`MIN_READING_SPREAD_UM`; :data:`MIN_CYCLE_SPREAD_UM` for the readings of a
+    rotary cycle or a ballbar circle)."""
+    import numpy as np
+
+    vals = {h: np.asarray(v, dtype=float) for h, v in columns.items()}
+    vals = {h: v[np.isfinite(v)] for h, v in vals.items()}
+    vals = {h: v for h, v in vals.items() if v.size}
+    spread = {h: float(np.ptp(v)) for h, v in vals.items()}
+    col = max(spread, key=spread.get, default=None)      # the widest column (first on ties)
+    if col is None or not NO_SPREAD_UM < spread[col] < minimum_um:
+        return
+    big = float(np.max(np.abs(vals[col])))
+    raise InputError(f"{where}: column {col}: the readings span {spread[col]:.3g} um (largest "
+                     f"{big:.3g} um), less than any machine and instrument show "
+                     f"({minimum_um:g} um): looks like mm written under _um "
+                     f"(x1000); give um, or head the column _mm")
+
+
 def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
     """A tool offset in the tool frame (mm, from the point the axis positions refer to, the
     spindle gauge point, to the tool tip: ``0 0 -L`` for a tool L long, docs/conventions.md)

@@ -150,8 +150,8 @@ METHOD = ("control charts against the first calibration: Shewhart individuals +-
           "(ISO 7870-2), EWMA lambda 0.2, L 3 (ISO 7870-6), sigma from the stated "
           "uncertainties; events: steps in the level by weighted least squares with one slope, "
           "added while the likelihood ratio exceeds chi2(1) at 1 - 0.01/m (Bonferroni over the "
-          "m positions); trends: weighted least-squares line after the last event (slope per "
-          "day); forecast: the date the trend reaches the tolerance, 95 % interval from the "
+          "m positions); trends: generalised least-squares line after the last event (slope per "
+          "day; the checks on one reference share its error); forecast: the date the trend reaches the tolerance, 95 % interval from the "
           "line's confidence band (Fieller)")
 
 

@@ -17,6 +17,9 @@ What an entry keeps of its result (:class:`Entry`):
   the uncertainty of "no change") is stored the same way (status ``unchanged``); a
   combination the check lists with status ``unchanged`` likewise; one listed by name only
   without a number carries none (value and std ``None``) and is left out of every statistic;
+* a check's values also keep ``common``: the part of their ``std`` the reference's
+  covariance gives (the check's budget source ``reference ... (its covariance)``), which
+  every check on that reference shares (:func:`volerr.history.analysis.entry_covariance`);
 * ``covariance``: ``{"names": [...], "matrix": [[...]]}`` when the result carries one (in the
   report units of the names), else ``None``;
 * ``files``: the instrument files the result names, each with the SHA-256 of the file found
@@ -30,7 +33,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import InputError, require
@@ -49,6 +52,7 @@ class Value:
     unit: str
     status: str
     change: float | None = None     # a check's stated change (None for a calibration)
+    common: float | None = None     # the part of ``std`` its reference shares (a check's)
 
 
 @dataclass
@@ -204,6 +208,7 @@ def _check(doc: dict, path, sha: str, text: str) -> Entry:
             require(std >= 0, f"{where}: std must be >= 0, got {std}")
             values[name] = Value(None, std, str(item.get("unit", "")), status,
                                  _number(item["change"], f"{where} change"))
+    values = with_reference_parts(values, doc)
     layout = doc.get("layout")
     require(layout is None or (isinstance(layout, str) and layout),
             f"{path}: 'layout' must be a layout name")
@@ -212,6 +217,35 @@ def _check(doc: dict, path, sha: str, text: str) -> Entry:
                                               else None)
     return Entry(CHECK, layout or "", values, sha, Path(path).name, text, verdict=verdict,
                  reference_sha256=ref_sha)
+
+
+#: the largest share of a check's variance its reference may hold in the history's trend
+#: (the rest is the check's own readings; 1 would leave two checks of one reference with a
+#: singular covariance)
+MAX_COMMON_SHARE = 0.99
+
+
+def with_reference_parts(values: dict, doc: dict) -> dict:
+    """``values`` of the check JSON ``doc`` (also as the store keeps them) with their
+    :attr:`Value.common` (:func:`_with_common`)."""
+    budgets = doc.get("budgets") if isinstance(doc, dict) else None
+    return {n: _with_common(v, budgets, n) for n, v in values.items()}
+
+
+def _with_common(v: Value, budgets, name: str) -> Value:
+    """``v`` with ``common``: the standard uncertainty its check states for the reference's
+    covariance propagated (the budget's source ``reference ... (its covariance)``,
+    :meth:`volerr.check._result.CheckResult.budgets`), at most ``sqrt(MAX_COMMON_SHARE)``
+    of ``std``; None without a number or a budget (an older check JSON).  Every check on
+    one reference carries the same reference error: :func:`volerr.history.analysis.trend`
+    correlates this part among them."""
+    rec = budgets.get(name) if isinstance(budgets, dict) else None
+    srcs = rec.get("sources") if isinstance(rec, dict) else None
+    u = next((x.get("u") for x in srcs or [] if isinstance(x, dict)
+              and str(x.get("source", "")).startswith("reference")), None)
+    if v.std is None or not isinstance(u, (int, float)) or not math.isfinite(u) or u <= 0:
+        return v
+    return replace(v, common=min(float(u), math.sqrt(MAX_COMMON_SHARE) * v.std))
 
 
 def _measured(doc: dict, path) -> dict:
@@ -256,7 +290,8 @@ def apply_reference(entry: Entry, reference: Entry, path) -> None:
         if v.change is None:
             out[name] = Value(None, None, ref.unit, v.status)
         else:
-            out[name] = Value(ref.value + v.change, v.std, ref.unit, v.status, v.change)
+            out[name] = Value(ref.value + v.change, v.std, ref.unit, v.status, v.change,
+                              v.common)
     entry.values = out
 
 

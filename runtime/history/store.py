@@ -50,7 +50,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import InputError, require
-from .results import Entry, Value
+from .results import CHECK, Entry, Value, with_reference_parts
 
 SCHEMA_VERSION = 1
 #: an arbitrary constant key of the PostgreSQL advisory lock that serialises writers
@@ -360,6 +360,8 @@ def _publish(tmp: Path, path: Path) -> bool:
 
 
 def _entry(r, values: dict) -> Entry:
+    if r["kind"] == CHECK:      # the reference's part of each std, from the stored document
+        values = with_reference_parts(values, json.loads(r["document"]))
     return Entry(r["kind"], r["layout"], values, r["sha256"], r["source"], r["document"],
                  date=r["date"], verdict=r["verdict"],
                  covariance=json.loads(r["covariance"]) if r["covariance"] else None,

@@ -10,6 +10,7 @@ import re
 import numpy as np
 
 from ..errors import InputError, require
+from ..units import MIN_READING_SPREAD_UM, check_reading_spread_um
 
 AXIS_NAMES = "XYZUVWABC"
 
@@ -243,9 +244,12 @@ def vector(find: Finder, names, what: str, where: str, units=("", "_mm")) -> np.
 
 
 def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
-             what: str = "an error map") -> np.ndarray:
+             what: str = "an error map", min_spread_um: float = MIN_READING_SPREAD_UM
+             ) -> np.ndarray:
     """Readings (n, len(names)) mm from columns ``<name>_um`` or ``<name>_mm``,
-    plausibility-checked."""
+    plausibility-checked: none of ``limit_mm`` or more (nm under ``_um``, um under ``_mm``),
+    and the ``_um`` columns not all spanning less than ``min_spread_um`` (mm under
+    ``_um``: :func:`volerr.units.check_reading_spread_um`)."""
     out, heads = np.zeros((n, len(names))), []
     for i, d in enumerate(names):
         require(find.name(d) is None, f"{where}: deviation column {d} has no unit suffix "
@@ -266,6 +270,8 @@ def readings(find: Finder, names, n: int, where: str, limit_mm: float = 5.0,
                  "wrong unit (um given as mm?) or nominal instead of deviation values")
         raise InputError(f"{where}: column {col}: deviations up to {big:g} mm are implausible "
                          f"for {what}: {cause}")
+    check_reading_spread_um({h: find.cols[h] for h in heads if h.lower().endswith("_um")},
+                            where, min_spread_um)
     return out
 
 

@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import InputError, require
 from ..generated import instruments as generated
 from ..machine.model import Model
+from ..units import MIN_CYCLE_SPREAD_UM
 from . import _fields as f
 from .observations import FileInfo, Observations, Setup
 
@@ -86,7 +87,8 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     require(float(np.min(length)) >= MIN_LENGTH_MM, f"{where}: column length_mm: "
             f"{float(np.min(length)):g} mm is shorter than any ballbar ({MIN_LENGTH_MM:g} mm "
             f"and longer): likely every length in inches (x 25.4), or cm")
-    dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading")[:, 0]
+    dr = f.readings(find, ("dr",), n, where, limit_mm=1.0, what="a ballbar reading",
+                    min_spread_um=MIN_CYCLE_SPREAD_UM)[:, 0]
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
     # a bar calibrated with its calibrator: its length offset known to within length_u_um
     length_u = f.known_uncertainty(find, "length_u", where)

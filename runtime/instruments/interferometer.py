@@ -45,6 +45,7 @@ import numpy as np
 
 from ..errors import InputError, require, require_file
 from ..fileio import refuse_repeated_readings
+from ..units import check_reading_spread_um
 from ..generated import instruments as generated
 from ..machine.model import Model
 from . import _fields as f
@@ -203,6 +204,8 @@ def _readings(path, axis, mode, where):
     dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
     if mode == "positioning":     # straightness optics read millimetres of misalignment
         _refuse_implausible(targets, dev, hits[0], where)
+    if unit[hits[0].lower().replace(' ', '_')] == 1e-3:       # read in um: not mm under it
+        check_reading_spread_um({hits[0]: c.numbers[hits[0]]}, where)
     hd = next(h for h in names if h.lower() in _DIRECTION)
     direction = _directions(c, hd, where)
     hc = next((h for h in names if h.lower() in ("cycle", "run")), None)

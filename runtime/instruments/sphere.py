@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import require
 from ..generated import instruments as generated
 from ..machine.model import Model
+from ..units import MIN_CYCLE_SPREAD_UM
 from . import _fields as f
 from .observations import FileInfo, Observations, Setup
 
@@ -61,7 +62,7 @@ def columns_to_observations(cols: dict, text: dict, raw: dict, model: Model,
     centre = f.vector(find, ("sphere_x", "sphere_y", "sphere_z"), "nominal sphere centre",
                       where)
     reading = f.readings(find, ("dx", "dy", "dz"), n, where, limit_mm=5.0,
-                         what="a sphere reading")
+                         what="a sphere reading", min_spread_um=MIN_CYCLE_SPREAD_UM)
     u = f.uncertainty(find, n, DEFAULT_U_UM, where)
     placement = f.labels(find, "placement", raw, n)
     require(placement is not None, f"{where}: no placement column: give each reading the "

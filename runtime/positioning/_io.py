@@ -55,7 +55,7 @@ import numpy as np
 
 from ..errors import InputError, require
 from ..fileio import TARGET_KEY_MM, read_csv_rows, refuse_repeated_readings
-from ..units import MM_PER_UM, parse_number
+from ..units import MM_PER_UM, UM_PER_MM, check_reading_spread_um, parse_number
 
 FWD, BWD = 0, 1
 DIRECTION_NAMES = ("forward", "backward")
@@ -396,7 +396,10 @@ def check_plausible_deviations(run: PositioningRun, column: str | None = None) -
     the next target than its own), or every deviation exactly equal (a constant column: no
     axis repeats to the nanometre; the instrument recorded nothing).  Such values are a unit
     mistake (nm under a ``_um`` header, um under a ``_mm`` header) or a target column in the
-    wrong unit.  ``column``: the reading column(s) as headed, for the line (one line)."""
+    wrong unit.  Deviations read in um (a column not headed mm) that all span less than
+    :data:`volerr.units.MIN_READING_SPREAD_UM` (0.05 um; the best axes span 0.1 um or more)
+    are mm written under ``_um`` (:func:`volerr.units.check_reading_spread_um`).
+    ``column``: the reading column(s) as headed, for the line (one line)."""
     col = f"column {column}" if column else "the deviation column"
     d = run.deviation
     if d.size and float(np.ptp(d)) == 0.0:
@@ -421,3 +424,5 @@ def check_plausible_deviations(run: PositioningRun, column: str | None = None) -
         raise InputError(
             f"{run.source}: {col}: deviation {1e3 * worst:g} um at target "
             f"{run.targets[i[0]]:g} mm is {why}: not a positioning deviation ({cause})")
+    if not (column and re.search(r"mm\b|\(mm\)|_mm", column.lower())):
+        check_reading_spread_um({column or "deviation": UM_PER_MM * d}, str(run.source))

@@ -62,6 +62,28 @@ def test_history_event_trend_forecast(weekly):
             f"{ev['unit']} on the week-12 date") in page
     assert f"trend ({tr['slope_per_day']:.3g} +- {tr['std']:.1g} um/day" in page
     assert f"forecast ({fc['date']}, interval {lo[5:]} .. {hi[5:]};" in page
+    assert f"the last check, {tr['value_at_last']:.2f} +- {tr['value_at_last_std']:.2g} um" in page
+
+
+def test_forecast_against_the_planted_crossing(weekly):
+    """The page states where the planted crossing lies against the forecast's 95 % interval
+    (the demo's pivot reaches 22 um at week 28): outside it by 3 days, the reference's draw
+    (docs/interim_checks.md); the interval holds at least the reference's part of the line's
+    value at the last check (0.067 um of EX0C: 0.065 um before the shared part was
+    correlated)."""
+    import datetime
+
+    from volerr.check import demo
+
+    h = weekly[1]
+    lo, hi = h["forecast"]["EX0C"]["interval"]
+    weeks = (22.0 - demo.TRUTH["EX0C"] * 1e3) / demo.DRIFT_UM_PER_WEEK
+    planted = demo.date_of(round(weeks))
+    assert planted == "2026-12-14" and "truth 12-14" in _page()
+    days = (datetime.date.fromisoformat(planted) - datetime.date.fromisoformat(hi)).days
+    assert lo < planted and days > 0                 # after the interval's end
+    assert f"outside the interval by {days} days" in _page()
+    assert h["trends"]["EX0C"]["value_at_last_std"] >= 0.067
 
 
 def test_formats_check_plan_json_example(weekly):
