@@ -84,7 +84,9 @@ def _channel(ch, cols, Z, cands, cache):
     out = _orig_channel(ch, cols, Z, cands, cache)
     t1 = time.process_time()
     before = out["choice"]
-    rec = {"label": next((l for l, v in ch.s.channels.items() if v is ch.y), "?"),
+    argv = __import__("sys").argv
+    rec = {"json": argv[argv.index("--json") + 1] if "--json" in argv else "",
+           "label": next((l for l, v in ch.s.channels.items() if v is ch.y), "?"),
            "family_before": before["family"], "named_before": bool(before["named"]),
            "cv_rms_before": {f: round(v, 4) for f, v in before["cv_rms_um"].items()},
            "cpu_channel_s": round(t1 - t0, 2), "nested": False}
