@@ -118,6 +118,43 @@ def sample_arc(start, end, arc, n=16):
     return pts
 
 
+def arc_distance_mm(points: np.ndarray, start, end, arc) -> np.ndarray:
+    """Distance (mm) of points (n, 3: X Y Z) from an rs274 ARC_FEED (start, end dicts):
+    each point is referred to the arc's parameter at its own angle about the centre (radius
+    and the normal axis linear in the angle, as the controller interpolates); points whose
+    angle lies outside the sweep are measured to the nearer end point."""
+    plane, centre, rot = arc
+    f, s, nrm = ARC_AXES[plane]
+    ix = {a: k for k, a in enumerate(("X", "Y", "Z"))}
+    a0 = math.atan2(start[s] - centre[s], start[f] - centre[f])
+    r0 = math.hypot(start[f] - centre[f], start[s] - centre[s])
+    r1 = math.hypot(end[f] - centre[f], end[s] - centre[s])
+    sweep = sample_sweep(start, end, arc)
+    u = points[:, ix[f]] - centre[f]
+    v = points[:, ix[s]] - centre[s]
+    rel = np.mod((np.arctan2(v, u) - a0) * np.sign(sweep), 2 * math.pi)
+    t = rel / abs(sweep)
+    inside = t <= 1.0
+    t = np.clip(t, 0.0, 1.0)
+    r = r0 + t * (r1 - r0)
+    n_nom = start[nrm] + t * (end[nrm] - start[nrm])
+    d_in = np.hypot(np.hypot(u, v) - r, points[:, ix[nrm]] - n_nom)
+    ends = np.array([[start[a] for a in ("X", "Y", "Z")], [end[a] for a in ("X", "Y", "Z")]])
+    d_end = np.min(np.linalg.norm(points[:, None, :] - ends[None], axis=2), axis=1)
+    return np.where(inside, np.minimum(d_in, d_end), d_end)
+
+
+def sample_sweep(start, end, arc) -> float:
+    """Signed sweep (rad) of an rs274 ARC_FEED (positive: counter-clockwise)."""
+    plane, centre, rot = arc
+    f, s, _ = ARC_AXES[plane]
+    a0 = math.atan2(start[s] - centre[s], start[f] - centre[f])
+    a1 = math.atan2(end[s] - centre[s], end[f] - centre[f])
+    if rot > 0:
+        return ((a1 - a0) % (2 * math.pi) or 2 * math.pi) + 2 * math.pi * (rot - 1)
+    return -((a0 - a1) % (2 * math.pi) or 2 * math.pi) - 2 * math.pi * (-rot - 1)
+
+
 def sample_line(start, end, n=8):
     return [{k: start[k] + t * (end[k] - start[k]) for k in CANON} for t in np.linspace(0, 1, n + 1)]
 
@@ -158,24 +195,32 @@ def match_rows(rows, moves, key, axes, tol):
 
 
 class Model:
-    """q + e(q) of the layout with the case's error folder (tool offset 0)."""
+    """The predicted actual tool tip of volerr's own error model (ErrorModel of
+    volerr.fiveaxis.compensate, the one compensate solves with; tool offset 0), expressed as
+    the axis position whose nominal tip it is, so that it compares with the program's path."""
 
     def __init__(self, layout, errors):
         import volerr
-        from volerr.tables import ErrorFunctions
+        from volerr.fiveaxis.compensate import ErrorModel, error_functions
         self.m = volerr.load(layout)
-        self.funcs = ErrorFunctions.from_dir(str(errors), self.m)
+        funcs, _ = error_functions(str(errors), self.m)
+        self.em = ErrorModel(self.m, funcs)
 
     def actual(self, pts: list[dict]) -> np.ndarray:
+        """(n, 3) X Y Z: q + R^-1 e(q), R the derivative of the nominal tip by X Y Z (the
+        rotary axes held, the nominal tip is affine in X Y Z)."""
         axes = self.m.axes
         q = np.array([[p[a] for a in axes] for p in pts], dtype=float)
-        for k, a in enumerate(axes):     # a full-turn rotary table: its table is 0 .. 360 deg
-            lo, hi = self.m.travel[a]
-            if a in self.m.rotary_axes and hi - lo > 360:
-                q[:, k] = np.mod(q[:, k], 360.0)
-        e = self.m.volumetric_error(q, self.funcs(q), probe=(0.0, 0.0, 0.0))
-        tip = np.array([[p[a] for a in ("X", "Y", "Z")] for p in pts])
-        return tip + e
+        lin = [axes.index(a) for a in ("X", "Y", "Z")]
+        p0 = self.em.nominal_position(q)
+        cols = []
+        for k in lin:
+            dq = q.copy()
+            dq[:, k] += 1.0
+            cols.append(self.em.nominal_position(dq) - p0)
+        r = np.stack(cols, axis=2)              # (n, 3 tip, 3 axes)
+        e = self.em.position_error(q)
+        return q[:, lin] + np.linalg.solve(r, e[:, :, None])[:, :, 0]
 
 
 def arc_deviation_um(model, in_moves, out_moves, rows, in_idx, out_idx) -> float:
@@ -189,13 +234,10 @@ def arc_deviation_um(model, in_moves, out_moves, rows, in_idx, out_idx) -> float
         prev_out = o
         if arc is None:
             continue
-        nominal = np.array([[p[a] for a in ("X", "Y", "Z")] for p in
-                            sample_arc(s_in, e_in, arc, n=4000)])
         pts = []
         for (_, s, e, a) in segs:
             pts += sample_arc(s, e, a) if a is not None else sample_line(s, e)
-        act = model.actual(pts)
-        d = np.min(np.linalg.norm(act[:, None, :] - nominal[None, :, :], axis=2), axis=1)
+        d = arc_distance_mm(model.actual(pts), s_in, e_in, arc)
         worst = max(worst, float(d.max()) * 1e3)
     return worst
 
