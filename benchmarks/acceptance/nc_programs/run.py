@@ -47,7 +47,13 @@ EXPECT = {
     "siemens_G70_inch_FB2.mpf": "refuse",
     "tilted_plane_G682_DMU50.nc": "refuse",
     "lathe_diameter_G7_TC_XZ.nc": "refuse",
+    # added after the first run (RESULTS.md): the mill case inside FB2's travel, and the TCPM
+    # case with the tool length the shortest form refuses to guess
+    "fanuc_mill_intravel_FB2.nc": "compensate",
+    "fiveaxis_tcpm_len_TT_AC.nc": "compensate",
 }
+#: options beyond the shortest form (post-hoc cases only)
+EXTRA = {"fiveaxis_tcpm_len_TT_AC.nc": ["--tool-length", "100"]}
 CANON = ("X", "Y", "Z", "A", "B", "C")
 _MOVE = re.compile(r"^\s*\d+\s+N\S*\s+(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\((.*)\)")
 _PLANE = re.compile(r"SELECT_PLANE\(CANON_PLANE_(XY|XZ|YZ)\)")
@@ -256,7 +262,8 @@ def judge(case: str, work: Path) -> dict:
     out, rep, js = d / ("out" + Path(case).suffix), d / "report.csv", d / "summary.json"
     p = subprocess.run([*VOLERR, "compensate", layout, "--errors", str(errors),
                         str(CASES / case), "--out", str(out), "--report", str(rep),
-                        "--json", str(js)], capture_output=True, text=True, timeout=300)
+                        "--json", str(js), *EXTRA.get(case, [])], capture_output=True,
+                       text=True, timeout=300)
     err_lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
     res = {"case": case, "layout": layout, "expect": EXPECT[case], "rc": p.returncode,
            "stderr": err_lines[0] if err_lines else ""}
@@ -282,15 +289,16 @@ def judge_output(case, layout, errors, d, out, rep, res) -> dict:
     rc_in, err_in, mv_in = rs274(CASES / case, d / "rs274_in.txt")
     rc_out, err_out, mv_out = rs274(out, d / "rs274_out.txt")
     notes = []
-    ok = rc_out == 0 and not err_out
-    if not ok:
-        notes.append(f"(a) rs274 refuses the output: {err_out}")
+    ok = True
     if rc_in != 0 or err_in:
         notes.append(f"rs274 cannot read input ({err_in}); judged on 3-4 from report only")
         after = max((r["e_after"] or 0.0) for r in rows) if rows else 0.0
         res.update(passed=ok and after <= ARC_T_UM + ROUND_UM,
                    detail="; ".join(notes + [f"max e_after {after:.3f} um"]))
         return res
+    if rc_out != 0 or err_out:
+        ok = False
+        notes.append(f"(a) rs274 refuses the output: {err_out}")
     in_idx, miss = match_rows(rows, mv_in, "nominal", axes, NOMINAL_TOL_MM)
     if miss is not None:
         ok = False
