@@ -30,7 +30,8 @@ Interpretation (modal state, one block per line)
   write that changes what axis words mean (:data:`REFUSED_G`, :data:`REFUSED_M`: ``G7``
   diameter mode, ``G16`` polar, ``G51.1`` mirror, ``G65 G66`` macro calls, ``G68.2`` tilted
   plane, ``G70 G700`` SINUMERIK inch, ``G90.1`` absolute arc centres, ``G12 G13 G75``
-  cycles, ``M97 M198`` subprogram calls).
+  cycles, ``M97 M198`` subprogram calls), and an arc under ``G93`` inverse-time feed
+  (linearised, the block's ``F`` -- its time -- would apply to every segment).
 * TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
   ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
   angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
@@ -352,6 +353,8 @@ class Interpreter:
         #: modal motion: 0, 1 (straight), 2, 3 (arcs); plane 17, 18, 19
         self.motion = 0
         self.plane = 17
+        #: G93 inverse-time feed in force (G94 / G95 end it)
+        self.inverse_time = False
         #: "axes", or "tcpm" with ``orientation`` "angles" / "vector" / "any" (TRAORI)
         self.frame = "axes"
         self.orientation = None
@@ -451,6 +454,10 @@ class Interpreter:
         if axis_words and 4 not in gs:      # dwell: X / P are times
             kind = "reference" if (28 in gs or 30 in gs) else \
                 "arc" if self.motion in (2, 3) else "motion"
+        if kind == "arc" and self.inverse_time:
+            raise InputError(f"{where}: an arc (G{self.motion}) under G93 inverse-time feed is "
+                             "not supported (linearised, the block's F -- its time -- would "
+                             "apply to every segment)")
         arc = self._arc(axis_words, centre, radius, where) if kind == "arc" else None
         if tcpm and self.orientation == "any" and kind == "motion":
             # TRAORI: rotary words give angles, A3 B3 C3 a vector; a block with neither
@@ -504,6 +511,8 @@ class Interpreter:
                 self.motion = int(g)
             elif g in (17, 18, 19):
                 self.plane = int(g)
+            elif g in (93, 94, 95):
+                self.inverse_time = g == 93
 
     def _tcpm_switch(self, gs, ms, keywords, where: str) -> tuple:
         """TCPM on / off by the line's G, M and keywords (the tool numbers of this line

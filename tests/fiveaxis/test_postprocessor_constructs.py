@@ -55,3 +55,13 @@ def test_reference_return_without_axis_words_makes_every_axis_unknown(tmp_path):
     assert status[2].startswith("not compensated: position of axis Y"), status
     assert status[3] == "compensated"
     assert res.text.splitlines()[3] == "G1 X110."
+
+
+def test_arc_under_inverse_time_feed_is_refused():
+    """Under G93 the F of a block is its time (1/min): an arc linearised into N lines would
+    take N times as long, and rs274 refuses its G1 lines without F ("F word missing with
+    inverse time g1 move"); straight moves under G93 and arcs after G94 stay."""
+    with pytest.raises(volerr.errors.InputError, match="line 3: an arc .*G93 inverse-time"):
+        gcode.blocks(gcode.parse("G0 X0 Y0 Z0\nG93\nG2 X40. Y40. I40. J0. F2.\n"), AXES)
+    ok = "G0 X0 Y0 Z0\nG93\nG1 X10. F2.\nG94\nG2 X50. Y40. I40. J0. F500.\n"
+    assert len(gcode.blocks(gcode.parse(ok), AXES)) == 3
