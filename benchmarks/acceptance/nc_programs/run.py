@@ -51,6 +51,7 @@ EXPECT = {
     # case with the tool length the shortest form refuses to guess
     "fanuc_mill_intravel_FB2.nc": "compensate",
     "fiveaxis_tcpm_len_TT_AC.nc": "compensate",
+    "inverse_time_arc_FB2.nc": "refuse",
 }
 #: options beyond the shortest form (post-hoc cases only)
 EXTRA = {"fiveaxis_tcpm_len_TT_AC.nc": ["--tool-length", "100"]}
