@@ -184,6 +184,10 @@ def prepare(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
     from .program import Options
 
     model = load(layout)
+    linear = [a for a in model.axes if a not in model.rotary_axes]
+    require(sorted(linear) == ["X", "Y", "Z"],
+            f"{model.name}: compensate needs the linear axes X, Y and Z (this layout has "
+            f"{' '.join(linear)}: its tool tip has an error component no axis word corrects)")
     require(not Path(errors).is_file(), f"{errors} is a file, not an error "
                                         f"directory (the folder holding X.csv ...)")
     require(Path(errors).is_dir(), f"error directory not found: {errors}")

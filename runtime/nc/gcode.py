@@ -26,7 +26,12 @@ Interpretation (modal state, one block per line)
   function is a *motion block*.  Canned cycles ``G73 G74 G76 G81``-``G89``, ``G92 G52 G10``
   (offset changes), ``G68 G51`` (rotation, scaling), ``G41 G42`` (cutter radius
   compensation), ``G20`` (inch), ``/`` (block delete) and ``M98`` (subprogram call) are
-  refused: a compensated copy could not be guaranteed.
+  refused: a compensated copy could not be guaranteed; so are what other controllers' posts
+  write that changes what axis words mean (:data:`REFUSED_G`, :data:`REFUSED_M`: ``G7``
+  diameter mode, ``G16`` polar, ``G51.1`` mirror, ``G65 G66`` macro calls, ``G68.2`` tilted
+  plane, ``G70 G700`` SINUMERIK inch, ``G90.1`` absolute arc centres, ``G12 G13 G75``
+  cycles, ``M97 M198`` subprogram calls), and an arc under ``G93`` inverse-time feed
+  (linearised, the block's ``F`` -- its time -- would apply to every segment).
 * TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
   ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
   angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
@@ -38,7 +43,8 @@ Interpretation (modal state, one block per line)
 * ``G53`` moves and work offsets (``G54`` ...) are kept as written: the program's numbers are
   taken to be the axis positions the error tables refer to.
 * ``G28``/``G30`` (reference return) and ``G4`` (dwell, its ``X``/``P`` is time) are passed
-  through untouched; after ``G28``/``G30`` the axes they name are at an unknown position until
+  through untouched; after ``G28``/``G30`` the axes they name (without axis words: every
+  axis, as LinuxCNC and Haas go to the reference with all) are at an unknown position until
   programmed again.
 * Axis words are the model's axes (e.g. ``X Y Z B C``); a letter that is an axis of another
   machine (``A`` ``U`` ... on a DMU 50) is refused.  ``T H D`` words are remembered (tool
@@ -86,14 +92,28 @@ REFUSED_G = {
     12.1: "G12.1 polar interpolation", 7.1: "G7.1 cylindrical interpolation",
 }
 REFUSED_G.update({g: f"G{g} canned cycle" for g in range(81, 90)})
-REFUSED_M = {98: "M98 subprogram call"}
+#: what other controllers' post-processors write that changes what the axis words mean (a
+#: compensated copy would be silently wrong): lathe diameter mode, polar coordinates, mirror
+#: image, macro calls with axis arguments, tilted working planes, absolute arc centres, inch
+#: (SINUMERIK G70 / G700; G70 is a finishing cycle on Fanuc and LinuxCNC lathes), the Fanuc
+#: lathe grooving cycle and Haas circle-milling cycles
+REFUSED_G.update({
+    7: "G7 lathe diameter mode", 16: "G16 polar coordinates", 51.1: "G51.1 mirror image",
+    65: "G65 macro call", 66: "G66 modal macro call",
+    **{g: f"G{g} tilted working plane" for g in (68.1, 68.2, 68.3, 68.4)},
+    70: "G70 inch units (SINUMERIK) / finishing cycle (lathe)", 700: "G700 inch units",
+    90.1: "G90.1 absolute arc centres", 75: "G75 grooving cycle",
+    12: "G12 circle milling cycle", 13: "G13 circle milling cycle",
+})
+REFUSED_M = {98: "M98 subprogram call", 97: "M97 local subprogram call",
+             198: "M198 subprogram call"}
 #: the components of a tool vector (``I J K`` of G43.5, ``A3 B3 C3`` of TRAORI)
 VECTOR = ("I", "J", "K")
 #: Siemens extended address of a tool-vector component: ``A3=0.5``
 _SIEMENS_VECTOR = re.compile(r"([ABCabc])3[ \t]*=[ \t]*([+-]?(?:\d+\.?\d*|\.\d+))")
 _KEYWORD = re.compile(r"(TRAORI|TRAFOOF)(?:[ \t]*\([ \t]*\d*[ \t]*\))?", re.IGNORECASE)
 #: M functions the interpreter acts on (a line with one of them is interpreted line by line)
-SPECIAL_M = frozenset({98, 128, 129})
+SPECIAL_M = frozenset({128, 129, *REFUSED_M})
 
 
 @dataclass
@@ -333,6 +353,8 @@ class Interpreter:
         #: modal motion: 0, 1 (straight), 2, 3 (arcs); plane 17, 18, 19
         self.motion = 0
         self.plane = 17
+        #: G93 inverse-time feed in force (G94 / G95 end it)
+        self.inverse_time = False
         #: "axes", or "tcpm" with ``orientation`` "angles" / "vector" / "any" (TRAORI)
         self.frame = "axes"
         self.orientation = None
@@ -409,6 +431,9 @@ class Interpreter:
             gs.append(1.0)
         self._set_modes(gs)
         forget = self._tcpm_switch(gs, ms, keywords, where)
+        if (28 in gs or 30 in gs) and not axis_words:
+            # without axis words every axis goes to the reference (LinuxCNC, Haas)
+            forget = (*forget, *self.axes)
         self._check_axes(axis_words, where)
         if vector and self.vector_words is None:
             # a line of address words only (parts) cannot hold a Siemens A3=: I J K
@@ -429,6 +454,10 @@ class Interpreter:
         if axis_words and 4 not in gs:      # dwell: X / P are times
             kind = "reference" if (28 in gs or 30 in gs) else \
                 "arc" if self.motion in (2, 3) else "motion"
+        if kind == "arc" and self.inverse_time:
+            raise InputError(f"{where}: an arc (G{self.motion}) under G93 inverse-time feed is "
+                             "not supported (linearised, the block's F -- its time -- would "
+                             "apply to every segment)")
         arc = self._arc(axis_words, centre, radius, where) if kind == "arc" else None
         if tcpm and self.orientation == "any" and kind == "motion":
             # TRAORI: rotary words give angles, A3 B3 C3 a vector; a block with neither
@@ -482,6 +511,8 @@ class Interpreter:
                 self.motion = int(g)
             elif g in (17, 18, 19):
                 self.plane = int(g)
+            elif g in (93, 94, 95):
+                self.inverse_time = g == 93
 
     def _tcpm_switch(self, gs, ms, keywords, where: str) -> tuple:
         """TCPM on / off by the line's G, M and keywords (the tool numbers of this line
