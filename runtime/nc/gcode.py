@@ -30,8 +30,9 @@ Interpretation (modal state, one block per line)
   write that changes what axis words mean (:data:`REFUSED_G`, :data:`REFUSED_M`: ``G7``
   diameter mode, ``G16`` polar, ``G51.1`` mirror, ``G65 G66`` macro calls, ``G68.2`` tilted
   plane, ``G70 G700`` SINUMERIK inch, ``G90.1`` absolute arc centres, ``G12 G13 G75``
-  cycles, ``M97 M198`` subprogram calls), and an arc under ``G93`` inverse-time feed
-  (linearised, the block's ``F`` -- its time -- would apply to every segment).
+  cycles, ``M97 M198`` subprogram calls), an arc under ``G93`` inverse-time feed
+  (linearised, the block's ``F`` -- its time -- would apply to every segment), and
+  LinuxCNC's spline moves ``G5 G5.1 G5.2`` (:data:`SPLINE_G`) on a line that moves.
 * TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
   ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
   angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
@@ -105,6 +106,9 @@ REFUSED_G.update({
     90.1: "G90.1 absolute arc centres", 75: "G75 grooving cycle",
     12: "G12 circle milling cycle", 13: "G13 circle milling cycle",
 })
+#: LinuxCNC's spline motions (cubic, quadratic B-spline, NURBS): refused where the line moves
+#: (axis or I J words); Fanuc writes G05 / G05.1 with P or Q alone as machining modes
+SPLINE_G = frozenset({5.0, 5.1, 5.2, 5.3})
 REFUSED_M = {98: "M98 subprogram call", 97: "M97 local subprogram call",
              198: "M198 subprogram call"}
 #: the components of a tool vector (``I J K`` of G43.5, ``A3 B3 C3`` of TRAORI)
@@ -427,6 +431,13 @@ class Interpreter:
             return None
         where = f"line {line.number}"
         gs, ms, axis_words, centre, vector, radius = self._read_words(items, where)
+        spline = [g for g in gs if g in SPLINE_G]
+        if spline and (axis_words or centre):
+            # LinuxCNC's G5 / G5.1 / G5.2 move along a curve its words define: compensating
+            # the end point only would leave the path between uncorrected (Fanuc's G05 P10000
+            # and G05.1 Q1 are modes without axis words and pass)
+            raise InputError(f"{where}: G{spline[0]:g} spline move is not supported (only its "
+                             "end point could be compensated, not the curve between)")
         if "L" in keywords:                 # Heidenhain straight move
             gs.append(1.0)
         self._set_modes(gs)

@@ -28,6 +28,9 @@ AXES = ("X", "Y", "Z", "B", "C")
     ("G75 X20. Z-5. P1. Q1.\n", "G75 grooving"),
     ("G1 X1.\nM97 P100\n", "M97 local subprogram"),
     ("G1 X1.\nM198 P100\n", "M198 subprogram"),
+    ("G1 X0. Y0.\nG5 I0. J3. P0. Q-3. X1. Y1.\n", "G5 spline"),
+    ("G1 X0. Y0.\nG5.1 X4. I2. J2.\n", "G5.1 spline"),
+    ("G1 X0. Y0.\nG5.2 X0. Y1. P1. L3\n", "G5.2 spline"),
 ])
 def test_constructs_that_change_axis_words_are_refused(text, msg):
     with pytest.raises(volerr.errors.InputError, match=msg):
@@ -65,3 +68,11 @@ def test_arc_under_inverse_time_feed_is_refused():
         gcode.blocks(gcode.parse("G0 X0 Y0 Z0\nG93\nG2 X40. Y40. I40. J0. F2.\n"), AXES)
     ok = "G0 X0 Y0 Z0\nG93\nG1 X10. F2.\nG94\nG2 X50. Y40. I40. J0. F500.\n"
     assert len(gcode.blocks(gcode.parse(ok), AXES)) == 3
+
+
+def test_fanuc_machining_modes_g05_pass():
+    """Fanuc's ``G05.1 Q1`` (AI contour control) and ``G05 P10000`` (high-speed machining)
+    carry no axis words: modes, not moves; the moves after them are read as written."""
+    steps = gcode.blocks(gcode.parse("G05.1 Q1\nG05 P10000\nG1 X10. Y5. F500.\n"), AXES)
+    assert [(b.programmed, b.target["X"], b.target["Y"]) for b in steps] == \
+        [(("X", "Y"), 10.0, 5.0)]
