@@ -5,10 +5,10 @@ limit with the expanded uncertainty ``U = 2 u`` (k = 2) from the covariance afte
 Grammar: ``NAME=VALUE UNIT`` pairs separated by ``,`` ``;`` or ``|`` (the reading of every
 ``--tolerance``, :func:`volerr.units.parse_assignments`; ``22 um`` or ``22um``), ``NAME`` as
 written or in any case when that names one (:func:`volerr.units.match_name`): a parameter of
-the reference (its ``|value|``
-against ``VALUE UNIT``: the unit is required and must be of its kind, it is converted,
-:func:`volerr.units.parse_quantity`; a limit beyond :mod:`volerr.tables.plausible` is refused) or ``map`` (the largest
-length of the volumetric error over the working volume, um).  Example:
+the reference (its ``|value|`` against ``VALUE UNIT``: the unit is required and must be of
+its kind, it is converted, :func:`volerr.units.parse_quantity`; a limit beyond
+:mod:`volerr.tables.plausible` is refused) or ``map`` (the largest length of the volumetric
+error over the working volume, um).  Example:
 ``"EX0C=20 um,EA0B=40 urad,map=30 um"``.
 """
 
