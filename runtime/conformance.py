@@ -53,24 +53,26 @@ def overall(verdicts) -> str | None:
 def parse_tolerances(text: str, names, option: str = "--tolerance") -> dict:
     """``"A=10,E=8 um,R=0.004 mm"`` -> ``{"A": 10.0, "E": 8.0, "R": 4.0}`` (um): the pairs
     as every ``--tolerance`` is read (:func:`volerr.units.parse_assignments`: split at ``,``
-    ``;`` ``|``, ``NAME=VALUE UNIT``, ``5um`` or ``5 um``), names from ``names`` (any case,
-    an optional ``_um`` suffix), each at most once, values positive finite lengths; a bare
+    ``;`` ``|``, ``NAME=VALUE UNIT``, ``5um`` or ``5 um``), names from ``names`` (as written, or
+    in any case when that names one, :func:`volerr.units.match_name`; an optional ``_um``
+    suffix), each at most once, values positive finite lengths; a bare
     number is um (every quantity here is a length reported in um)."""
-    from .units import check_tolerance_um, convert, parse_assignments
+    from .units import check_tolerance_um, convert, match_name, parse_assignments
 
-    allowed = {n.upper(): n for n in names}
+    names = list(names)
     example = ",".join(f"{n}=10 um" for n in list(names)[:3])
     out = {}
     for name, (v, unit) in parse_assignments(text, option, example, default_unit="um",
                                              kinds=("length",), positive=False):
-        key = name.upper().removesuffix("_UM")
-        require(key in allowed, f"{option}: unknown quantity {key!r}; one of "
-                                f"{' '.join(names)}")
-        require(allowed[key] not in out, f"{option}: {allowed[key]} given twice")
-        given = f"{option} {allowed[key]}={v:g}" + ("" if unit == "um" else f" {unit}")
+        bare = name[:-3] if name.upper().endswith("_UM") else name
+        key = match_name(bare, names, option)
+        require(key is not None, f"{option}: unknown quantity {bare.upper()!r}; one of "
+                                 f"{' '.join(names)}")
+        require(key not in out, f"{option}: {key} given twice")
+        given = f"{option} {key}={v:g}" + ("" if unit == "um" else f" {unit}")
         v = convert(v, unit, "um")
-        check_tolerance_um(v, given, unit, allowed[key])
+        check_tolerance_um(v, given, unit, key)
         require(math.isfinite(v) and 0 < v <= 1e6,
                 f"{given}: a tolerance must be a positive number of um (at most 1e6)")
-        out[allowed[key]] = v
+        out[key] = v
     return out

@@ -162,7 +162,7 @@ def convert(value: float, unit: str, to: str, where: str = "") -> float:
 
 
 def parse_assignments(text, option: str, example: str = "EX0C=20 um, EA0C=5 urad",
-                      **quantity) -> list:
+                      keywords_for=None, **quantity) -> list:
     """``"EX0C=20 um, EA0C=5 urad"`` -> ``[(name, (value, unit)), ...]`` in the order given:
     pairs split at ``,`` ``;`` ``|``, each ``NAME=VALUE UNIT`` read by :func:`parse_quantity`
     (``quantity``: its keywords; the unit may follow the number directly, ``5um``).  A bare
@@ -170,7 +170,10 @@ def parse_assignments(text, option: str, example: str = "EX0C=20 um, EA0C=5 urad
     --tolerance``: every quantity a length in um), else it is refused (``volerr history show
     --tolerance``, ``volerr check --tolerance``: parameters in different units).  Names as
     written (stripped); a name given twice, an empty list or a pair without ``=`` is refused,
-    naming ``option`` and the pair (``example``: the option's own, for that message)."""
+    naming ``option`` and the pair (``example``: the option's own, for that message).
+    ``keywords_for``: ``name -> dict`` of further :func:`parse_quantity` keywords for that
+    name's value (``volerr check``: a slope parameter takes its own unit); it may refuse an
+    unknown name before its value is read."""
     out, seen = [], set()
     for part in filter(None, (p.strip() for p in re.split(r"[,;|]", str(text or "")))):
         name, eq, rest = part.partition("=")
@@ -180,11 +183,28 @@ def parse_assignments(text, option: str, example: str = "EX0C=20 um, EA0C=5 urad
         if name in seen:
             raise InputError(f"{option}: {name} given twice")
         seen.add(name)
-        out.append((name, parse_quantity(rest, f"{option} {part}", **quantity)))
+        extra = keywords_for(name) if keywords_for is not None else {}
+        out.append((name, parse_quantity(rest, f"{option} {part}", **{**quantity, **extra})))
     if not out:
         raise InputError(f"{option}: no value given (NAME=VALUE UNIT, e.g. "
                          f"{example.split(',')[0]})")
     return out
+
+
+def match_name(name: str, known, option: str) -> str | None:
+    """The one of ``known`` that ``name`` (of a ``NAME=VALUE`` pair of ``option``) names, or
+    None: written exactly, else the only one equal to it ignoring case (``ex0c`` is ``EX0C``,
+    ``map`` is ``MAP``, ``a`` is ``A``).  Two known names equal ignoring case and neither
+    written exactly are refused in one line naming both: a name is never assigned by a guess.
+    The rule of every ``--tolerance`` of volerr (``iso230-2``, ``check``, ``history show``)."""
+    known = list(known)
+    if name in known:
+        return name
+    hits = [k for k in known if k.casefold() == name.casefold()]
+    if len(hits) > 1:
+        raise InputError(f"{option}: {name!r} is any of {', '.join(hits)} ignoring case; "
+                         f"write the name exactly")
+    return hits[0] if hits else None
 
 
 # -- dates -----------------------------------------------------------------------------------

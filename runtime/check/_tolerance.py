@@ -2,10 +2,13 @@
 decision rule, as the certificates (:mod:`volerr.conformance`): each quantity against its
 limit with the expanded uncertainty ``U = 2 u`` (k = 2) from the covariance after the check.
 
-Grammar: ``NAME=VALUE [UNIT],...`` with ``NAME`` a parameter of the reference (its ``|value|``
-against ``VALUE UNIT``: the unit is required and must be of its kind, it is converted,
-:func:`volerr.units.parse_quantity`; a limit beyond :mod:`volerr.tables.plausible` is refused) or ``map`` (the largest
-length of the volumetric error over the working volume, um).  Example:
+Grammar: ``NAME=VALUE UNIT`` pairs separated by ``,`` ``;`` or ``|`` (the reading of every
+``--tolerance``, :func:`volerr.units.parse_assignments`; ``22 um`` or ``22um``), ``NAME`` as
+written or in any case when that names one (:func:`volerr.units.match_name`): a parameter of
+the reference (its ``|value|`` against ``VALUE UNIT``: the unit is required and must be of
+its kind, it is converted, :func:`volerr.units.parse_quantity`; a limit beyond
+:mod:`volerr.tables.plausible` is refused) or ``map`` (the largest length of the volumetric
+error over the working volume, um).  Example:
 ``"EX0C=20 um,EA0B=40 urad,map=30 um"``.
 """
 
@@ -15,44 +18,51 @@ import math
 
 from .. import conformance
 from ..errors import InputError, require
-from ..units import convert, parse_quantity
+from ..units import convert
 from . import _volume
 
 
 def parse(text: str, ref, model=None) -> dict:
     """``{NAME: limit}`` (the parameter's unit; ``map``: um); one-line InputError.
 
+    The pairs as every ``--tolerance`` is read (:func:`volerr.units.parse_assignments`: split
+    at ``,`` ``;`` ``|``, ``22 um`` or ``22um``); a name as written or in any case when that
+    names one (:func:`volerr.units.match_name`: ``ex0c`` is ``EX0C``, ``MAP`` is ``map``).
     Every VALUE needs its unit (issue 43: ``EX0C=22`` is refused, as ``history show`` does).
     A limit beyond what any machine of ``model``'s size can have
     (:mod:`volerr.tables.plausible`: ``EX0C=22 mm``, um typed as mm) is refused naming the
     likely unit."""
     from ..tables import plausible
+    from ..units import parse_assignments
 
     limits = plausible.limits_for(model)
-    units = dict(zip(ref.names, ref.units))
+    units = {**dict(zip(ref.names, ref.units)), "map": "um"}
     out = {}
-    parts = [p.strip() for p in str(text).replace("|", ",").split(",") if p.strip()]
-    require(parts, "--tolerance: no tolerance given")
-    for part in parts:
-        name, eq, rest = part.partition("=")
-        name = name.strip()
-        require(eq and name and rest.strip(),
-                f"--tolerance {text!r}: write NAME=VALUE [UNIT] pairs, e.g. \"map=30 um\"")
-        key = "map" if name.lower() == "map" else name
-        require(key == "map" or key in units, f"--tolerance: {name!r} is neither 'map' nor a "
-                                              f"parameter of the reference "
-                                              f"({', '.join(ref.names[:8])} ...)")
-        unit = "um" if key == "map" else units[key]
-        # every value with its unit (issue 43 item 5); a unit given is converted
-        v, given = parse_quantity(rest, f"--tolerance {part}", positive=False,
-                                  any_unit=given_unit_any(unit))
-        v = convert(v, given, unit, f"--tolerance {name}")
-        _plausible(v, unit, given, part, limits)
-        require(math.isfinite(v) and v > 0, f"--tolerance: {name} = {rest.strip()!r} must be "
-                                            f"a positive number")
+    pairs = parse_assignments(
+        text, "--tolerance", "EX0C=20 um,EA0B=40 urad,map=30 um",
+        keywords_for=lambda name: {"any_unit": given_unit_any(units[_key(name, ref)])},
+        positive=False)
+    for name, (v, given) in pairs:
+        key = _key(name, ref)
+        part = f"{name}={v:g}" + (f" {given}" if given else "")
+        v = convert(v, given, units[key], f"--tolerance {name}")
+        _plausible(v, units[key], given, part, limits)
+        require(math.isfinite(v) and v > 0, f"--tolerance: {name} = {part.partition('=')[2]!r} "
+                                            f"must be a positive number")
         require(key not in out, f"--tolerance: {name} given twice")
         out[key] = v
     return out
+
+
+def _key(name: str, ref) -> str:
+    """``map`` or the reference's parameter ``name`` names (:func:`volerr.units.match_name`);
+    else one line naming the first known ones."""
+    from ..units import match_name
+
+    key = match_name(name, ["map", *ref.names], "--tolerance")
+    require(key is not None, f"--tolerance: {name!r} is neither 'map' nor a parameter of the "
+                             f"reference ({', '.join(ref.names[:8])} ...)")
+    return key
 
 
 def given_unit_any(unit: str) -> bool:

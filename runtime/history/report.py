@@ -38,6 +38,7 @@ class History(ResultMixin):
     @classmethod
     def build(cls, machine: str, entries: list, tolerances: dict) -> "History":
         from ..errors import require
+        from ..units import match_name
 
         series = an.series_of(entries)
         events, slopes, trends, control, forecast = [], [], {}, {}, {}
@@ -63,8 +64,10 @@ class History(ResultMixin):
             if name == "map":
                 forecast["map"] = _map_forecast(entries, series, fits, value)
                 continue
-            require(name in series, f"--tolerance {name}: not a parameter of this history "
-                                    f"({', '.join(list(series)[:10])})")
+            typed, name = name, match_name(name, list(series), "--tolerance")
+            require(name is not None, f"--tolerance {typed}: not a parameter of this history "
+                                      f"({', '.join(list(series)[:10])})")
+            require(name not in forecast, f"--tolerance: {typed} given twice")
             tol = _convert(value, unit, series[name].unit, name)
             tr = fits[name][1]
             f = (an.forecast(tr, tol) if tr is not None else

@@ -27,7 +27,8 @@ import re
 from pathlib import Path
 
 from ..errors import InputError, require
-from ..units import QUANTITY_UNITS, convert, parse_assignments, parse_date, today_utc
+from ..units import (QUANTITY_UNITS, convert, match_name, parse_assignments, parse_date,
+                     today_utc)
 from . import results
 from .results import CALIBRATION, CHECK
 
@@ -148,12 +149,16 @@ def parse_tolerances(text: str | None) -> dict:
     """``"EX0C=20 um,EA0C=50 urad,map=30 um"`` -> ``{name: (value, unit)}``: every value with
     its unit (:func:`volerr.units.parse_assignments`, the reading of every ``--tolerance``;
     a bare number is refused, the history holds parameters in different units); ``map``
-    (the volumetric error) a length, in um."""
+    (the volumetric error, any case: ``MAP``) a length, in um.  A parameter's name is matched
+    to the history's in :meth:`volerr.history.report.History.build` (as written, or in any
+    case when that names one: :func:`volerr.units.match_name`)."""
     if not text:
         return {}
     out = {}
     for name, (value, unit) in parse_assignments(text, "--tolerance", any_unit=True):
-        if name == "map":
+        if match_name(name, ["map"], "--tolerance") == "map":
+            require("map" not in out, f"--tolerance: {name} given twice")
+            name = "map"
             require(QUANTITY_UNITS.get(unit, ("",))[0] == "length",
                     "--tolerance map=VALUE um (the volumetric error, a length)")
             value, unit = convert(value, unit, "um"), "um"
