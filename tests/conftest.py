@@ -88,3 +88,34 @@ def pytest_runtest_protocol(item, nextitem):
     if nextitem is not None and getattr(nextitem, "module", None) is not getattr(
             item, "module", None):
         _settle()
+
+
+# Module fixtures computed once per run, not once per worker (the suite's time, session 8).
+# Under ``--dist loadgroup`` the tests of a module without an ``xdist_group`` mark are dealt to
+# both workers, and each worker that receives one of them computes the module's module-scoped
+# fixtures again (tests/check/test_interim_checks_page.py's weekly demo: 5.3 s of set-up on one
+# worker, 5.6 s on the other).  A test that uses a module- or package-scoped fixture of the
+# tests (not one of pytest's own) and has no group is put in its module's group, so that one
+# worker computes those fixtures once; a group set in the test file is kept.  Session-scoped
+# fixtures are left to their files' own groups (tests/audit/conftest.py).  Runs before
+# xdist's own hook, which appends the group to the node id.
+_SHARED_SCOPES = ("module", "package")
+
+
+def _uses_a_module_fixture(item) -> bool:
+    """Whether ``item`` uses a module- or package-scoped fixture defined under tests/."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return False
+    for defs in info.name2fixturedefs.values():
+        for fixturedef in defs:
+            if fixturedef.scope in _SHARED_SCOPES and fixturedef.baseid:
+                return True
+    return False
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None and _uses_a_module_fixture(item):
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+
+from helpers import in_process
 
 HOURS = 4.0
 
@@ -49,9 +49,11 @@ def _campaign(tmp_path, n=4, **kw):
 
 
 def _loop(tmp_path, *args):
-    return subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", *map(str, args),
-                           "--json", tmp_path / "out.json", "--predictions-out",
-                           tmp_path / "p.csv"], capture_output=True, text=True, cwd=tmp_path)
+    """``volerr ARGS`` in this process (``helpers.in_process``: ``main``'s exit code and
+    lines; a warning a process would print is appended to stderr), without starting an
+    interpreter; the entry point's own process is tests/cli/test_cli_core.py's."""
+    return in_process.volerr("loop", "DMU50", *args, "--json", tmp_path / "out.json",
+                             "--predictions-out", tmp_path / "p.csv", cwd=tmp_path)
 
 
 def _refused(r, tmp_path, *words):

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -168,8 +166,7 @@ def test_bad_headers_refused(tmp_path):
     run = _run(0, np.random.default_rng(1))
     for heads in ({"x1": "W at z=20"}, {"x1": "X at z=abc"}, {"q9": "X"}):
         _write(tmp_path / "bad.csv", run, heads)
-        p = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", "drift:bad.csv",
-                            "--json", "j.json"], cwd=tmp_path, capture_output=True, text=True)
+        p = volerr_cmd("loop", "DMU50", "drift:bad.csv", "--json", "j.json", cwd=tmp_path)
         assert p.returncode == 2, (heads, p.stderr)
         assert len(p.stderr.strip().splitlines()) == 1 and "Traceback" not in p.stderr
         assert not (tmp_path / "j.json").exists()
@@ -231,15 +228,11 @@ def test_cli_refuses_outputs_the_kind_does_not_have(campaign, tmp_path):
     """One line, exit 2, nothing written: ``--errors-out`` on drift runs, ``--predictions-out``
     on measured deviations (the refusals stated once, by ``volerr.loop`` and its results)."""
     folder = campaign[0]
-    p = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", "drift:r0.csv",
-                        "drift:r1.csv", "drift:r2.csv", "--json", str(tmp_path / "a.json"),
-                        "--errors-out", str(tmp_path / "err")], cwd=folder,
-                       capture_output=True, text=True)
+    p = volerr_cmd("loop", "DMU50", "drift:r0.csv", "drift:r1.csv", "drift:r2.csv",
+                   "--json", tmp_path / "a.json", "--errors-out", tmp_path / "err", cwd=folder)
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
     assert "--errors-out" in p.stderr and "drift" in p.stderr
     assert not (tmp_path / "a.json").exists() and not (tmp_path / "err").exists()
-    p = subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", "drift:r0.csv",
-                        "--out-dir", str(tmp_path / "aug")], cwd=folder,
-                       capture_output=True, text=True)
+    p = volerr_cmd("loop", "DMU50", "drift:r0.csv", "--out-dir", tmp_path / "aug", cwd=folder)
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
     assert "--out-dir" in p.stderr and not (tmp_path / "aug").exists()

@@ -5,10 +5,10 @@ channel is in mm under its ``_um`` header (1000x small against the other runs) l
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 
 import numpy as np
+
+from helpers import in_process
 
 
 def _run_file(path, seed: int) -> None:
@@ -24,9 +24,11 @@ def _run_file(path, seed: int) -> None:
 
 
 def _loop(tmp_path, *args):
-    return subprocess.run([sys.executable, "-m", "volerr", "loop", "DMU50", *map(str, args),
-                           "--json", tmp_path / "out.json"],
-                          capture_output=True, text=True, cwd=tmp_path)
+    """``volerr ARGS`` in this process (``helpers.in_process``: ``main``'s exit code and
+    lines; a warning a process would print is appended to stderr), without starting an
+    interpreter; the entry point's own process is tests/cli/test_cli_core.py's."""
+    return in_process.volerr("loop", "DMU50", *args, "--json", tmp_path / "out.json",
+                             cwd=tmp_path)
 
 
 def test_a_copy_held_out_is_refused_naming_both(tmp_path):

@@ -3,8 +3,6 @@ traceback, inputs untouched, nothing written)."""
 
 import hashlib
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -13,10 +11,14 @@ import volerr
 from volerr.cli import main
 from volerr.loop.simulate import demo_probes, simulate
 
+from helpers import in_process
+
 
 def _cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd)
+    """``volerr ARGS`` in this process (``helpers.in_process``: ``main``'s exit code and
+    lines; a warning a process would print is appended to stderr), without starting an
+    interpreter; the entry point's own process is tests/cli/test_cli_core.py's."""
+    return in_process.volerr(*args, cwd=cwd)
 
 
 @pytest.fixture(scope="module")

@@ -3,18 +3,18 @@ would be "found" on nothing), and readings that determine none of the declared m
 parameters (sphere probing with the rotary axes standing still): exit 2, one line naming what
 is missing, nothing written.  Data from the independent exact simulator."""
 
-import subprocess
-import sys
-
 import numpy as np
 
 from helpers import family_sim as F
+from helpers import in_process
 from helpers import instrument_sim as S
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "volerr", *map(str, args)],
-                          capture_output=True, text=True)
+    """``volerr ARGS`` in this process (``helpers.in_process``: ``main``'s exit code and
+    lines; a warning a process would print is appended to stderr), without starting an
+    interpreter; the entry point's own process is tests/cli/test_cli_core.py's."""
+    return in_process.volerr(*args)
 
 
 def _one_line(r, *words):

@@ -1,8 +1,5 @@
 """The virtual machine: exact chain, plans, CSV output, effects, bad input."""
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
@@ -10,6 +7,8 @@ import volerr
 from volerr.errors import InputError
 from volerr.loop.run import read_deviations
 from volerr.loop.simulate import simulate
+
+from helpers import in_process
 
 
 def _rz(t):
@@ -94,8 +93,10 @@ def test_bad_effects(effect):
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "volerr", *args], capture_output=True,
-                          text=True)
+    """``volerr ARGS`` in this process (``helpers.in_process``: ``main``'s exit code and
+    lines; a warning a process would print is appended to stderr), without starting an
+    interpreter; the entry point's own process is tests/cli/test_cli_core.py's."""
+    return in_process.volerr(*args)
 
 
 def test_cli_simulate(tmp_path):
