@@ -42,6 +42,9 @@ SCREEN_POINTS = 3000  # training points a screening uses at most (leaders rescor
 N_SOURCES = 10       # residual sources reported
 LAG_CACHE = 48       # lagged series (all points) kept while screening
 STACK_COLUMNS = 64   # candidate columns scored in one matrix product (Base.score_many)
+#: targets whose reduced design (Base.reduced: n x p floats each) a Base keeps: the
+#: candidates of one target come together, a few targets interleave in a lag profile
+REDUCED_CACHE = 8
 #: caches of lagged series a context shares with its sub-contexts (and a second selection
 #: on the same data: :func:`volerr.loop.run.selection_step`)
 SHARED_LAG_CACHES = ("lags", "lag_orders", "lag_pts")
@@ -69,6 +72,7 @@ class Base:
         self.rss = float(self.r @ self.r)
         #: readings (rows that carry one), the n of the BIC
         self.n = len(y) if n_readings is None else int(n_readings)
+        self._reduced = {}      # Base.reduced: s bytes -> (A_s, r_s, w)
 
     def score(self, B) -> tuple[float, int]:
         """(RSS reduction, effective rank) of adding the columns B (rows, m)."""
@@ -137,9 +141,7 @@ class Base:
         :meth:`score_many` of those rows up to the order of summation (rounding, raised by
         the difference in the Gram block to 1e-9 relative, measured)."""
         n = len(s)
-        A_s = np.einsum("ikp,ik->ip", self.A.reshape(n, 3, -1), s)
-        r_s = np.einsum("ik,ik->i", self.r.reshape(n, 3), s)
-        w = np.einsum("ik,ik->i", s, s)
+        A_s, r_s, w = self.reduced(s)
         bb = w @ (basis * basis)                                # diag of B^T B, unscaled
         sc = np.sqrt(bb / (3 * n))
         sc[sc == 0] = 1.0
@@ -156,6 +158,25 @@ class Base:
             ((basis[:, a:b] * w[:, None]).T @ basis[:, a:b] - C[:, a:b].T @ GiC[:, a:b])
             / np.outer(sc[a:b], sc[a:b]), g[a:b], floor) for a, b in zip(cuts[:-1], cuts[1:])]
         return np.array([x[0] for x in out], float), np.array([x[1] for x in out], int)
+
+    def reduced(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The design and residual reduced against ``s`` (n, 3) for :meth:`term_gains`:
+        ``A_s`` (n, p), ``r_s`` (n,) and ``w = sum_k s^2`` (n,).  Kept for the last
+        ``REDUCED_CACHE`` values of ``s`` (by its bytes): a screening asks for a few dozen
+        targets thousands of times (2371 calls, 141 distinct ``s`` on the lag acceptance
+        campaigns), and a kept value is the same computation's result, bit for bit."""
+        key = (s.shape, s.strides, s.dtype.str, np.ascontiguousarray(s).tobytes())
+        store = self._reduced
+        if key in store:
+            store[key] = store.pop(key)           # most recently used last
+            return store[key]
+        while len(store) >= REDUCED_CACHE:
+            store.pop(next(iter(store)))
+        n = len(s)
+        store[key] = (np.einsum("ikp,ik->ip", self.A.reshape(n, 3, -1), s),
+                      np.einsum("ik,ik->i", self.r.reshape(n, 3), s),
+                      np.einsum("ik,ik->i", s, s))
+        return store[key]
 
     def dbic(self, gain: float, m_eff: int) -> float:
         """BIC change of columns that lower the RSS by ``gain`` with ``m_eff`` parameters."""
