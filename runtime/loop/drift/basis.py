@@ -296,7 +296,8 @@ def library(s: DriftSeries, alternative: bool = False) -> tuple[list, np.ndarray
     sc = np.where(sc > 0, sc, 1.0)
     for c, v in zip(cols, sc):
         c.scale = float(v)
-    return cols, X / sc
+    X /= sc                    # in place: the same quotients, no second (N, m) array
+    return cols, X
 
 
 def folds(s: DriftSeries) -> tuple[np.ndarray, str]:
