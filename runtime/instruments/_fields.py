@@ -445,7 +445,9 @@ def change_scores(v) -> tuple[np.ndarray, float]:
     d1 = np.diff(v)
     if len(d1) < 3:
         return np.zeros(len(d1)), 0.0
-    trend = _running_median(d1, min(STEP_WINDOW, (len(d1) - 1) // 2))
+    w = min(STEP_WINDOW, (len(d1) - 1) // 2)
+    pad = np.pad(d1, w, mode="edge")
+    trend = np.median(np.lib.stride_tricks.sliding_window_view(pad, 2 * w + 1), axis=1)
     start, steps = _longest_equal(v)
     keep = np.ones(len(v), bool)
     keep[start:start + steps + 1] = steps == 0
@@ -455,19 +457,6 @@ def change_scores(v) -> tuple[np.ndarray, float]:
     with np.errstate(divide="ignore", invalid="ignore"):
         z = np.where(e == 0, 0.0, np.abs(e) / s) if s > 0 else np.where(e == 0, 0.0, np.inf)
     return z, s
-
-
-def _running_median(d, w: int) -> np.ndarray:
-    """Median (len(d),) of ``d`` over ``w`` readings each side, the ends padded with the end
-    values.  The window is odd: its median is one of its readings whatever the algorithm,
-    so scipy's running median (O(w) a reading, not numpy's sort of every window) gives the
-    same numbers; with a nan in ``d``, numpy's rule (a nan window's median is nan)."""
-    if np.isnan(d).any():
-        pad = np.pad(d, w, mode="edge")
-        return np.median(np.lib.stride_tricks.sliding_window_view(pad, 2 * w + 1), axis=1)
-    from scipy.ndimage import median_filter
-
-    return median_filter(d, size=2 * w + 1, mode="nearest")
 
 
 def frozen_stretch(v) -> tuple[int, int] | None:
