@@ -52,7 +52,8 @@ def _rows(path, header_only: bool = False) -> list:
         with open(p, newline="", encoding="utf-8-sig") as fh:
             delim = sniff_delimiter(fh.read(65536))
             fh.seek(0)
-            rows = (r for r in csv.reader(fh, delimiter=delim) if any(c.strip() for c in r)
+            # "".join(r).strip(): some cell holds more than white space (one call a row)
+            rows = (r for r in csv.reader(fh, delimiter=delim) if "".join(r).strip()
                     and not r[0].lstrip().startswith("#"))
             return [next(rows, [])] if header_only else list(rows)
     except (UnicodeDecodeError, csv.Error) as exc:
@@ -104,14 +105,7 @@ def read_columns(path) -> Columns:
     cols, text, labels = {}, {}, {}
     for j, h in enumerate(header):
         raw = [r[j].strip() for r in body]
-        vals = []
-        bad = None
-        for i, s in enumerate(raw):
-            try:
-                vals.append(float(s))
-            except ValueError:
-                bad = bad if bad is not None else i
-                vals.append(math.nan)
+        vals, bad = _floats(raw)
         if body and not any(raw):      # a header over nothing: readings not filled in
             text[h] = f"{p.name}: column {h} {EMPTY_COLUMN}"
             labels[h] = raw
@@ -130,6 +124,23 @@ def read_columns(path) -> Columns:
             continue
         cols[h] = np.asarray(vals)
     return Columns(cols, text, labels, p.name)
+
+
+def _floats(raw: list) -> tuple[list, int | None]:
+    """(values, bad): ``float`` of every text of ``raw`` (nan where it is not a number) and
+    the index of the first that is not (None: all are); one comprehension when all are."""
+    try:
+        return [float(s) for s in raw], None
+    except ValueError:
+        pass
+    vals, bad = [], None
+    for i, s in enumerate(raw):
+        try:
+            vals.append(float(s))
+        except ValueError:
+            bad = bad if bad is not None else i
+            vals.append(math.nan)
+    return vals, bad
 
 
 def _not_number(s: str) -> bool:

@@ -486,9 +486,12 @@ def sensor_faults(t, columns: dict, others: dict) -> list:
     at most, constant first, then frozen.  ``others`` {name: (N,)} every logged input: a step shared with
     another input (:data:`SHARED_K`) is no fault."""
     t = np.asarray(t, float)
-    scores = {k: change_scores(v)[0] for k, v in others.items()}
+    found = {k: change_scores(v) for k, v in others.items()}
+    scores = {k: zs[0] for k, zs in found.items()}
     out = []
     for name, v in columns.items():
+        # the column's own (z, s), when ``others`` holds that very array: computed once
+        own = found[name] if others.get(name) is v else None
         v = np.asarray(v, float)
         if len(v) and not np.ptp(v) > 0:
             out.append({"input": name, "fault": "constant", "value": float(v[0]),
@@ -499,7 +502,7 @@ def sensor_faults(t, columns: dict, others: dict) -> list:
             out.append({"input": name, "fault": "frozen", "from_s": float(t[fz[0]]),
                         "to_s": float(t[fz[1]]), "readings": int(fz[1] - fz[0] + 1)})
             continue
-        step = _step(v, name, scores)
+        step = _step(v, name, scores, own)
         if step is not None:
             i, s = step
             out.append({"input": name, "fault": "step", "at_s": float(t[i + 1]),
@@ -507,10 +510,11 @@ def sensor_faults(t, columns: dict, others: dict) -> list:
     return out
 
 
-def _step(v: np.ndarray, name: str, scores: dict) -> tuple[int, float] | None:
+def _step(v: np.ndarray, name: str, scores: dict, own=None) -> tuple[int, float] | None:
     """(i, s): the largest lasting change i -> i+1 of ``v`` beyond :data:`STEP_K` its scale
-    ``s`` that no other input shares (:data:`SHARED_K`), or None (lasting: :func:`_lasting`)."""
-    z, s = change_scores(v)
+    ``s`` that no other input shares (:data:`SHARED_K`), or None (lasting: :func:`_lasting`);
+    ``own``: :func:`change_scores` of ``v`` when already computed (not changed here)."""
+    z, s = change_scores(v) if own is None else own
     d1 = np.diff(v)
     if not s > 0:               # no scatter (a coarse resolution): the resolution is the scale
         nz = np.abs(d1[d1 != 0])

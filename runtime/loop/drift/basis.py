@@ -270,7 +270,7 @@ def series(s: DriftSeries, source: str, tau_s: float, p: float | None = None) ->
     from ...machine.lags import lag
 
     u = heat(s, p) if source == "heat" else np.asarray(s.inputs[source], float)
-    y = lag(u, tau_s, s.t_s, s.run) if tau_s > 0 else u
+    y = lag(u, tau_s, s.t_s, s.run, order=s.order()) if tau_s > 0 else u
     return y - s.zero(y)
 
 
@@ -296,7 +296,8 @@ def library(s: DriftSeries, alternative: bool = False) -> tuple[list, np.ndarray
     sc = np.where(sc > 0, sc, 1.0)
     for c, v in zip(cols, sc):
         c.scale = float(v)
-    return cols, X / sc
+    X /= sc                    # in place: the same quotients, no second (N, m) array
+    return cols, X
 
 
 def folds(s: DriftSeries) -> tuple[np.ndarray, str]:

@@ -65,6 +65,16 @@ class DriftSeries:
                                              for r in range(len(self.runs))])
         return self.memo["_firsts"]
 
+    def order(self) -> np.ndarray:
+        """Indices (N,) that sort the readings by (run, time)
+        (:func:`volerr.machine.lags.time_order`; kept in ``memo``): what every lag of the
+        series sorts by."""
+        if "_order" not in self.memo:
+            from ...machine.lags import time_order
+
+            self.memo["_order"] = time_order(self.t_s, self.run)
+        return self.memo["_order"]
+
     def run_zeros(self, v) -> np.ndarray:
         """The zero (n_runs,) of ``v`` (N,) in every run: its first reading, the value a run
         is predicted from where its zero is not fitted (a held-out run, a fold of whole
