@@ -101,4 +101,6 @@ def main():
 
 
 if __name__ == "__main__":
+    if {"-h", "--help"} & set(sys.argv[1:]):     # the usage is the docstring
+        sys.exit(print(__doc__))
     main()

@@ -59,4 +59,6 @@ def main(n=100_000):
 
 
 if __name__ == "__main__":
+    if {"-h", "--help"} & set(sys.argv[1:]):     # the usage is the docstring
+        sys.exit(print(__doc__))
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 100_000)

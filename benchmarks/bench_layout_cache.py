@@ -46,4 +46,6 @@ def main(name: str = "DMU50") -> None:
 
 
 if __name__ == "__main__":
+    if {"-h", "--help"} & set(sys.argv[1:]):     # the usage is the docstring
+        sys.exit(print(__doc__))
     main(*sys.argv[1:2])

@@ -167,6 +167,8 @@ def drift(n: int) -> None:
 
 
 if __name__ == "__main__":
+    if {"-h", "--help"} & set(sys.argv[1:]):     # the usage is the docstring
+        sys.exit(print(__doc__))
     if sys.argv[1:2] == ["--drift"]:
         drift(int(sys.argv[2]) if len(sys.argv) > 2 else 100000)
         sys.exit()
