@@ -18,7 +18,7 @@ import math
 
 from .. import conformance
 from ..errors import InputError, require
-from ..units import convert
+from ..units import convert, match_name, parse_assignments
 from . import _volume
 
 
@@ -33,7 +33,6 @@ def parse(text: str, ref, model=None) -> dict:
     (:mod:`volerr.tables.plausible`: ``EX0C=22 mm``, um typed as mm) is refused naming the
     likely unit."""
     from ..tables import plausible
-    from ..units import parse_assignments
 
     limits = plausible.limits_for(model)
     units = {**dict(zip(ref.names, ref.units)), "map": "um"}
@@ -57,8 +56,6 @@ def parse(text: str, ref, model=None) -> dict:
 def _key(name: str, ref) -> str:
     """``map`` or the reference's parameter ``name`` names (:func:`volerr.units.match_name`);
     else one line naming the first known ones."""
-    from ..units import match_name
-
     key = match_name(name, ["map", *ref.names], "--tolerance")
     require(key is not None, f"--tolerance: {name!r} is neither 'map' nor a parameter of the "
                              f"reference ({', '.join(ref.names[:8])} ...)")

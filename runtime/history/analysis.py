@@ -338,7 +338,7 @@ class Trend:
 def trend(s: Series, start: int = 0) -> Trend | None:
     """The line of ``s`` from entry ``start`` on (step 3; generalised least squares over
     :func:`entry_covariance`); None with too few entries or a single date."""
-    t, y, u = s.t[start:], s.y[start:], s.s[start:]
+    t, y = s.t[start:], s.y[start:]
     if len(t) < MIN_TREND_POINTS or np.ptp(t) <= 0:
         return None
     t0 = float(t[-1])

@@ -201,10 +201,11 @@ def _readings(path, axis, mode, where):
             f"{next(iter(unit))})")
     f.require_finite(c.numbers[hits[0]], hits[0], where)
     f.require_finite(targets, _target_column(c, names, where)[1], where)
-    dev = c.numbers[hits[0]] * unit[hits[0].lower().replace(' ', '_')]
+    factor = unit[hits[0].lower().replace(' ', '_')]      # mm per unit of the column
+    dev = c.numbers[hits[0]] * factor
     if mode == "positioning":     # straightness optics read millimetres of misalignment
         _refuse_implausible(targets, dev, hits[0], where)
-    if unit[hits[0].lower().replace(' ', '_')] == 1e-3:       # read in um: not mm under it
+    if factor == 1e-3:                                    # read in um: not mm under it
         check_reading_spread_um({hits[0]: c.numbers[hits[0]]}, where)
     hd = next(h for h in names if h.lower() in _DIRECTION)
     direction = _directions(c, hd, where)

@@ -55,7 +55,8 @@ import numpy as np
 
 from ..errors import InputError, require
 from ..fileio import TARGET_KEY_MM, read_csv_rows, refuse_repeated_readings
-from ..units import MM_PER_UM, UM_PER_MM, check_reading_spread_um, parse_number
+from ..units import (MATERIAL_TEMPERATURE_RANGE_C, MM_PER_UM, UM_PER_MM,
+                     check_reading_spread_um, check_temperature_C, parse_number)
 
 FWD, BWD = 0, 1
 DIRECTION_NAMES = ("forward", "backward")
@@ -352,8 +353,6 @@ def check_material_temperature(values, where: str) -> None:
     one line naming ``where`` (file and column) and the likely unit (68 degF = 20 degC; 293 is
     K).  The correction to 20 degC would otherwise move every deviation by
     cte x (T - 20) x P: 48 K too warm on 800 mm of steel is 445 um."""
-    from ..units import MATERIAL_TEMPERATURE_RANGE_C, check_temperature_C
-
     v = np.asarray(values, dtype=float).ravel()
     v = v[np.isfinite(v)]
     if not v.size:
@@ -401,6 +400,7 @@ def check_plausible_deviations(run: PositioningRun, column: str | None = None) -
     are mm written under ``_um`` (:func:`volerr.units.check_reading_spread_um`).
     ``column``: the reading column(s) as headed, for the line (one line)."""
     col = f"column {column}" if column else "the deviation column"
+    headed_mm = bool(column) and re.search(r"mm\b|\(mm\)|_mm", column.lower()) is not None
     d = run.deviation
     if d.size and float(np.ptp(d)) == 0.0:
         raise InputError(f"{run.source}: every deviation in {col} is {1e3 * float(d.flat[0]):g} "
@@ -413,7 +413,6 @@ def check_plausible_deviations(run: PositioningRun, column: str | None = None) -
         i = np.unravel_index(int(np.argmax(np.abs(d))), d.shape)
         why = (f"{MAX_DEVIATION_MM:g} mm or more" if limit == MAX_DEVIATION_MM else
                f"more than half the smallest target spacing ({spacing:g} mm)")
-        headed_mm = bool(column) and re.search(r"mm\b|\(mm\)|_mm", column.lower()) is not None
         if headed_mm:
             cause = "values in um under a _mm header? the target column in the wrong unit?"
         elif worst * 1e-3 < limit:
@@ -424,5 +423,5 @@ def check_plausible_deviations(run: PositioningRun, column: str | None = None) -
         raise InputError(
             f"{run.source}: {col}: deviation {1e3 * worst:g} um at target "
             f"{run.targets[i[0]]:g} mm is {why}: not a positioning deviation ({cause})")
-    if not (column and re.search(r"mm\b|\(mm\)|_mm", column.lower())):
+    if not headed_mm:
         check_reading_spread_um({column or "deviation": UM_PER_MM * d}, str(run.source))
