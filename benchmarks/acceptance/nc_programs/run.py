@@ -249,6 +249,30 @@ def arc_deviation_um(model, in_moves, out_moves, rows, in_idx, out_idx) -> float
     return worst
 
 
+def line_deviation_um(model, in_moves, out_moves, rows, in_idx, out_idx) -> float:
+    """Largest distance (um) of the predicted actual tip along every output straight move
+    (8 samples) from the nominal input straight move of the same block (reported, not
+    judged: volerr corrects the end points of a straight move)."""
+    worst = 0.0
+    prev_out = -1
+    for r, i, o in zip(rows, in_idx, out_idx):
+        kind, s_in, e_in, arc = in_moves[i]
+        segs = out_moves[prev_out + 1:o + 1]
+        prev_out = o
+        if arc is not None or not segs:
+            continue
+        _, s, e, _ = segs[-1]
+        pts = model.actual(sample_line(s, e))
+        a = np.array([s_in[k] for k in ("X", "Y", "Z")])
+        b = np.array([e_in[k] for k in ("X", "Y", "Z")])
+        d = b - a
+        n2 = float(d @ d)
+        t = np.clip((pts - a) @ d / n2, 0.0, 1.0) if n2 > 0 else np.zeros(len(pts))
+        dist = np.linalg.norm(pts - (a + t[:, None] * d), axis=1)
+        worst = max(worst, float(dist.max()) * 1e3)
+    return worst
+
+
 def judge(case: str, work: Path) -> dict:
     layout = layout_of(case)
     errors = work / f"errors_{layout}"
@@ -317,6 +341,7 @@ def judge_output(case, layout, errors, d, out, rep, res) -> dict:
     arc_um = float("nan")
     if miss is None and miss_o is None:
         arc_um = arc_deviation_um(model, mv_in, mv_out, rows, in_idx, out_idx)
+        res["line_path_um"] = line_deviation_um(model, mv_in, mv_out, rows, in_idx, out_idx)
         if arc_um > ARC_T_UM + ROUND_UM:
             ok = False
             notes.append(f"arc path deviation {arc_um:.3f} um")
