@@ -32,7 +32,9 @@ Interpretation (modal state, one block per line)
   plane, ``G70 G700`` SINUMERIK inch, ``G90.1`` absolute arc centres, ``G12 G13 G75``
   cycles, ``M97 M198`` subprogram calls), an arc under ``G93`` inverse-time feed
   (linearised, the block's ``F`` -- its time -- would apply to every segment), and
-  LinuxCNC's spline moves ``G5 G5.1 G5.2`` (:data:`SPLINE_G`) on a line that moves.
+  LinuxCNC's spline moves ``G5 G5.1 G5.2`` (:data:`SPLINE_G`) on a line that moves, and
+  probing moves (``G38.2``-``G38.5``, ``G31``, SINUMERIK ``MEAS=`` / ``MEAW=``: they end
+  where the probe touches, unknown to the program).
 * TCPM (tool centre point management): ``G43.4`` (rotary angles) / ``G43.5`` (tool vector
   ``I J K``) until ``G49``; ``M128`` until ``M129``; ``TRAORI`` until ``TRAFOOF`` (rotary
   angles, or the vector ``A3 B3 C3``).  In TCPM the linear words are the tool tip in the
@@ -106,6 +108,21 @@ REFUSED_G.update({
     90.1: "G90.1 absolute arc centres", 75: "G75 grooving cycle",
     12: "G12 circle milling cycle", 13: "G13 circle milling cycle",
 })
+#: probing (measuring) moves: the move ends where the probe touches, which the program does not
+#: know, so every position after it (an incremental move, a modal probe line: LinuxCNC's G38.x
+#: is in modal group 1) would rest on a guess, and the position the controller records at the
+#: trigger is the raw axis position, which compensating the target does not correct.  LinuxCNC
+#: G38.2-G38.5 (linuxcnc.org/docs/html/gcode/g-code.html#gcode:g38), Fanuc / Haas G31 skip
+#: and G31.1-G31.4 multi-step skip; Siemens MEAS= / MEAW= are refused by the tokenizer
+#: (:data:`PROBING_KEYWORD`)
+REFUSED_G.update({
+    **{g: f"G{g} probe move (ends where the probe touches: the position after it is unknown)"
+       for g in (38.2, 38.3, 38.4, 38.5)},
+    **{g: f"G{g:g} skip (probe) move (ends where the probe touches: the position after it is "
+          "unknown)" for g in (31, 31.1, 31.2, 31.3, 31.4)},
+})
+#: Siemens measuring moves (``MEAS=1 G1 X..``, ``MEAW=1``): refused as G31 / G38.x are
+PROBING_KEYWORD = re.compile(r"(MEAS|MEAW)[ \t]*=", re.IGNORECASE)
 #: LinuxCNC's spline motions (cubic, quadratic B-spline, NURBS): refused where the line moves
 #: (axis or I J words); Fanuc writes G05 / G05.1 with P or Q alone as machining modes
 SPLINE_G = frozenset({5.0, 5.1, 5.2, 5.3})
@@ -251,6 +268,10 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
             i = m.end()
         else:
             m = _WORD.match(body, i)
+            if not m and PROBING_KEYWORD.match(body, i):
+                raise InputError(f"line {number}: SINUMERIK {body[i:i + 4].upper()} probe "
+                                 "move is not supported (ends where the probe touches: the "
+                                 "position after it is unknown)")
             if not m:
                 raise InputError(f"line {number}: cannot interpret {body[i:i + 12]!r} (only "
                                  "address words, comments and blanks are supported)")
