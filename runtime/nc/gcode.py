@@ -25,8 +25,8 @@ Interpretation (modal state, one block per line)
   see :mod:`volerr.nc.arcs`), modal.  A block with axis words and no other non-modal
   function is a *motion block*.  Canned cycles ``G73 G74 G76 G81``-``G89``, ``G92 G52 G10``
   (offset changes), ``G68 G51`` (rotation, scaling), ``G41 G42`` (cutter radius
-  compensation), ``G20`` (inch), ``/`` (block delete) and ``M98`` (subprogram call) are
-  refused: a compensated copy could not be guaranteed; so are what other controllers' posts
+  compensation, also ``G41.1 G42.1`` ... ``G41.6 G42.6``), ``G20`` (inch), ``/`` (block
+  delete) and ``M98`` (subprogram call) are refused: a compensated copy could not be guaranteed; so are what other controllers' posts
   write that changes what axis words mean (:data:`REFUSED_G`, :data:`REFUSED_M`: ``G7``
   diameter mode, ``G16`` polar, ``G51.1`` mirror, ``G65 G66`` macro calls, ``G68.2`` tilted
   plane, ``G70 G700`` SINUMERIK inch, ``G90.1`` absolute arc centres, ``G12 G13 G75``
@@ -108,6 +108,12 @@ REFUSED_G.update({
     90.1: "G90.1 absolute arc centres", 75: "G75 grooving cycle",
     12: "G12 circle milling cycle", 13: "G13 circle milling cycle",
 })
+#: cutter radius compensation in every form posts write: LinuxCNC's dynamic G41.1 / G42.1
+#: (the diameter in the D word, linuxcnc.org/docs/html/gcode/g-code.html#gcode:g41.1-g42.1),
+#: Fanuc's G41.2-G41.6 / G42.2-G42.6 (3-D and five-axis tool radius compensation): the
+#: controller moves the tool off the written positions by its radius
+REFUSED_G.update({g: f"G{g} cutter radius compensation"
+                  for side in (41, 42) for g in (side + k / 10 for k in range(1, 7))})
 #: probing (measuring) moves: the move ends where the probe touches, which the program does not
 #: know, so every position after it (an incremental move, a modal probe line: LinuxCNC's G38.x
 #: is in modal group 1) would rest on a guess, and the position the controller records at the
