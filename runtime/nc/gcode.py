@@ -43,8 +43,12 @@ Interpretation (modal state, one block per line)
   At a switch into or out of TCPM the linear positions become unknown until programmed.
 * ``G90``/``G91``: both handled; in ``G91`` an axis word is the increment from the position
   the controller holds.
-* ``G53`` moves and work offsets (``G54`` ...) are kept as written: the program's numbers are
-  taken to be the axis positions the error tables refer to.
+* ``G53`` moves and work offsets (``G54``-``G59``, ``G59.1``-``G59.3``, Fanuc ``G54.1 P`` /
+  ``G54 P``) are kept as written: the program's numbers are taken to be the machine axis
+  positions the error tables refer to (every work offset zero, as in LinuxCNC with its default
+  parameters), so a ``G53`` word and a work-offset word mean the same position.  What makes a
+  word mean another position than written is refused (``G10 G52 G92 G92.3``); ``G92.1`` /
+  ``G92.2`` (cancel / suspend G92 offsets) pass.
 * ``G28``/``G30`` (reference return) and ``G4`` (dwell, its ``X``/``P`` is time) are passed
   through untouched; after ``G28``/``G30`` the axes they name (without axis words: every
   axis, as LinuxCNC and Haas go to the reference with all) are at an unknown position until
@@ -108,6 +112,11 @@ REFUSED_G.update({
     90.1: "G90.1 absolute arc centres", 75: "G75 grooving cycle",
     12: "G12 circle milling cycle", 13: "G13 circle milling cycle",
 })
+#: G92.3 restores the G92 offsets saved in parameters 5211-5216 before the program ran
+#: (linuxcnc.org/docs/html/gcode/g-code.html#gcode:g92.3): unknown to the program, and the
+#: words after it would mean other machine positions (G92.1 / G92.2 cancel / suspend G92
+#: offsets: every offset stays zero, as the program's numbers are taken, and they pass)
+REFUSED_G[92.3] = "G92.3 restore of saved G92 offsets"
 #: cutter radius compensation in every form posts write: LinuxCNC's dynamic G41.1 / G42.1
 #: (the diameter in the D word, linuxcnc.org/docs/html/gcode/g-code.html#gcode:g41.1-g42.1),
 #: Fanuc's G41.2-G41.6 / G42.2-G42.6 (3-D and five-axis tool radius compensation): the
