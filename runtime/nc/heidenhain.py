@@ -23,7 +23,10 @@ What is read (TNC conversational format, one block per line, block number first)
 * Refused with the line number (a compensated copy could not be guaranteed): circles
   ``CC C CR CT``, ``RND CHF``, ``APPR DEP``, ``LN`` (3-D correction), radius compensation
   ``RL RR``, cycles ``CYCL``, labels and calls ``LBL CALL``, parameters ``FN Q``, ``PLANE``
-  other than ``PLANE RESET STAY``, ``M140``, and anything else.
+  other than ``PLANE RESET STAY``, ``M140``, ``M92`` (the block's coordinates are relative
+  to a position the machine builder defines), and anything else.  ``M91`` (coordinates
+  relative to the machine datum) passes: the program's numbers are taken as machine axis
+  positions anyway (the work-offset rule of :mod:`volerr.nc.gcode`).
 
 Writing: only the numbers of the axis words change; a word the block needs is added after
 its last axis word (or after ``L``), with an explicit sign, as the TNC writes them.
@@ -164,6 +167,9 @@ def _block_words(body: str, i: int, end: int, word0: str, tokens: list, where: s
                                  "is not supported (the path would be offset by the "
                                  "controller)")
             tokens.append(Token("other", mm.group(0), j))
+        elif kind == "m" and float(mm.group(2)) == 92:
+            raise InputError(f"{where}: M92 (coordinates relative to a position the machine "
+                             "builder defines, not the machine datum) is not supported")
         elif kind == "f" and not mm.group(2):
             tokens.append(Token("other", mm.group(0), j))
         else:
