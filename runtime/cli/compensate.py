@@ -31,6 +31,8 @@ def register(sub) -> None:
     p.add_argument("--tool-table", default=None, metavar="CSV", help=H["--tool-table"])
     p.add_argument("--dialect", choices=("auto", "iso", "heidenhain"), default="auto",
                    help=H["--dialect"])
+    p.add_argument("--decimal-less", choices=("auto", "mm"), default="auto",
+                   help=H["--decimal-less"])
     p.add_argument("--datum", default="none", metavar="X,Y,Z[,B,C]", help=H["--datum"])
     p.add_argument("--report", help="per-block CSV report")
     p.add_argument("--json", help="summary as JSON")
@@ -51,7 +53,7 @@ def run(args) -> int:
         with progress_bar(Path(args.program), "compensate") as tick:
             return compensate(args.layout, Path(args.program), args.errors, **options_of(
                 args, "datum tool_length tool_table orientation strategy types tol_um decimals "
-                      "method degree extrapolate dialect accept_implausible",
+                      "method degree extrapolate dialect accept_implausible decimal_less",
                 tool=tuple(args.tool), initial=args.initial or "",
                 check_travel=not args.ignore_travel, arc_tol_um=args.arc_tolerance_um,
                 out=outs.path("--out"), report=outs.path("--report") if args.report else None,

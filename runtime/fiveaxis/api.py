@@ -138,7 +138,8 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
                extrapolate: bool = False, initial=None, check_travel: bool = True,
                arc_tol_um: float = 1.0, dialect: str = "auto", out=None, report=None,
                inputs=(), out_name=None, keep_errors: bool = False,
-               progress=None, accept_implausible: bool = False) -> Compensation:
+               progress=None, accept_implausible: bool = False,
+               decimal_less: str = "auto") -> Compensation:
     """Rewrite an NC program with compensated coordinates (``volerr compensate``).
 
     Parameters
@@ -185,6 +186,11 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
         ``--accept-implausible``: use error values beyond what a machine of the layout's
         travel can have (:mod:`volerr.tables.plausible`); by default they are refused naming
         the file, the column and the likely unit.
+    decimal_less : {"auto", "mm"}
+        ``--decimal-less``: how an axis or arc number without a decimal point (``X300``) is
+        read.  "auto": refused in a Fanuc-style program (a program-number line ``O1234``:
+        300 mm or 0.300 mm by the controller's parameter 3401#0 DPI), mm elsewhere; "mm":
+        read as mm.
 
     Returns
     -------
@@ -201,7 +207,7 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
                   types=types, tol_um=tol_um, decimals=decimals, method=method, degree=degree,
                   extrapolate=extrapolate, initial=initial, check_travel=check_travel,
                   arc_tol_um=arc_tol_um, dialect=dialect,
-                  accept_implausible=accept_implausible)
+                  accept_implausible=accept_implausible, decimal_less=decimal_less)
     axes = (tuple(job.model.axes), tuple(job.model.rotary_axes))
     if out is None:
         sink = _Collect(job.model)

@@ -176,7 +176,7 @@ def prepare(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
             tool_length=None, tool_table=None, orientation=False, strategy="full",
             types=None, tol_um=0.1, decimals=4, method="linear", degree=None,
             extrapolate=False, initial=None, check_travel=True, arc_tol_um=1.0,
-            dialect="auto", accept_implausible=False) -> Job:
+            dialect="auto", accept_implausible=False, decimal_less="auto") -> Job:
     """Every input of a compensation validated once -> :class:`Job` (the arguments are those
     of :func:`volerr.fiveaxis.api.compensate`)."""
     from ..machine.model import load
@@ -200,7 +200,7 @@ def prepare(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
         tool_length = _number(tool_length, "--tool-length")
     opts = Options(tuple(tool), orientation, strategy, tol_um, decimals, _initial(initial),
                    check_travel, 50, types, arc_tol_um, tool_length, table, dialect,
-                   None).validated(model)
+                   None, decimal_less).validated(model)
     d = parse_datum(datum, model)
     text, doc = datum_lines(model, funcs, opts.tool, d)
     import dataclasses

@@ -68,6 +68,8 @@ class Options:
     #: the work datum: axis positions (layout order) where the work offset was set, or None
     #: (:meth:`volerr.fiveaxis.compensate.ErrorModel.relative_to`)
     datum: tuple | None = None
+    #: numbers without a decimal point: "auto" or "mm" (:data:`volerr.nc.dialect.DECIMAL_LESS`)
+    decimal_less: str = "auto"
 
     def validated(self, model) -> "Options":
         """The options checked (:class:`InputError` naming the option), ``tool`` the offset
@@ -102,6 +104,9 @@ class Options:
         from ..nc.dialect import DIALECTS
         require(self.dialect in DIALECTS, f"unknown dialect {self.dialect!r} "
                                           f"({' '.join(DIALECTS)})")
+        from ..nc.dialect import DECIMAL_LESS
+        require(self.decimal_less in DECIMAL_LESS, f"--decimal-less: {self.decimal_less!r} is "
+                                                   f"not one of {' '.join(DECIMAL_LESS)}")
         return Options(tuple(float(v) for v in tool), bool(self.orientation), self.strategy,
                        float(self.tol_um), int(self.decimals), dict(self.initial or {}),
                        bool(self.check_travel), int(self.max_iter),
@@ -109,7 +114,8 @@ class Options:
                        float(self.arc_tol_um),
                        None if self.tool_length is None else float(self.tool_length),
                        None if self.tool_table is None else dict(self.tool_table),
-                       self.dialect, None if self.datum is None else tuple(self.datum))
+                       self.dialect, None if self.datum is None else tuple(self.datum),
+                       self.decimal_less)
 
 
 def _tool_of_length(tool: np.ndarray, length) -> np.ndarray:
@@ -587,7 +593,8 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
     from .reversal import Directions
 
     opts = opts.validated(model)
-    pre = prescan(open_source, model.rotary_axes, chunk_lines, opts.dialect)
+    pre = prescan(open_source, model.rotary_axes, chunk_lines, opts.dialect,
+                  opts.decimal_less)
     never = tuple(a for a in pre.absent_rotary if a not in opts.initial)
     em = ErrorModel(model, funcs, opts.tool, parameters_for_types(model, opts.types))
     if opts.datum is not None:
@@ -890,7 +897,7 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
                        max_iter: int = 50, types=None, chunk_lines: int | None = None,
                        arc_tol_um: float = 1.0, tool_length: float | None = None,
                        tool_table: dict | None = None, dialect: str = "auto",
-                       datum=None) -> Result:
+                       datum=None, decimal_less: str = "auto") -> Result:
     """Compensate a G-code program (text decoded as latin-1) -> :class:`Result`.
 
     ``types``: ISO/TR 16907 compensation types to apply (e.g. ``("L-VOL",)`` for a controller
@@ -904,13 +911,14 @@ def compensate_program(model, funcs, text: str, tool=(0.0, 0.0, 0.0), orientatio
     order, mm / deg) where the work offset was set (by probing the part), or None: the
     corrections are then relative to the error at the datum, which the work offset absorbs
     (:meth:`volerr.fiveaxis.compensate.ErrorModel.relative_to`; ``volerr compensate
-    --datum``)."""
+    --datum``).  ``decimal_less``: "auto" (a Fanuc-style program's axis or arc number without
+    a decimal point is refused) or "mm" (``volerr compensate --decimal-less``)."""
     import io
 
     opts = Options(tool, orientation, strategy, tol_um, decimals, dict(initial or {}),
                    check_travel, max_iter, None if types is None else tuple(types),
                    arc_tol_um, tool_length, tool_table, dialect,
-                   None if datum is None else tuple(float(v) for v in datum))
+                   None if datum is None else tuple(float(v) for v in datum), decimal_less)
     sink = _Collect(model)
     s, never = run(lambda: io.StringIO(text, newline=""), model, funcs, opts, sink,
                    chunk_lines or CHUNK_LINES)

@@ -50,6 +50,42 @@ def detect(lines, first: int = 1) -> str:
     return "iso"
 
 
+#: how an axis or arc word's number without a decimal point is read: "auto" (refused in a
+#: Fanuc-style program, :func:`fanuc_style`; mm elsewhere) or "mm"
+DECIMAL_LESS = ("auto", "mm")
+#: a program-number line (``O1234``, ``O0042 (NAME)``): Fanuc, Haas, Mitsubishi, Okuma EIA
+_PROGRAM_NUMBER = re.compile(r"[ \t]*[Oo]\d+[ \t]*(\(.*)?$")
+#: an axis or arc word whose number is not zero and has no decimal point (comments removed)
+_DECIMAL_LESS = re.compile(r"(?<![A-Za-z])([XYZABCUVWIJKRxyzabcuvwijkr])[ \t]*([+-]?0*[1-9]\d*)"
+                           r"(?![\d.])")
+_COMMENT = re.compile(r"\([^)\r\n]*\)|;[^\r\n]*")
+
+
+def fanuc_style(lines) -> bool:
+    """True when one of the first lines is a program number (``O1234``), as Fanuc and the
+    controllers that read its programs (Haas, Mitsubishi) write it."""
+    return any(_PROGRAM_NUMBER.match(seg.rstrip("\r\n")) for seg in lines[:LOOK])
+
+
+def refuse_decimal_less(lines, first: int = 1) -> None:
+    """Raise :class:`InputError` naming the first axis or arc word (``X Y Z A B C U V W I J K
+    R``) whose number is not zero and has no decimal point (``X300``).  A Fanuc reads it as
+    300 mm or as 300 least input increments (0.300 mm) by parameter 3401#0 DPI (FANUC Series
+    0i / 30i "Decimal point programming"; Mitsubishi M700V programming manual 5.3 "Decimal
+    Point Input", parameter #1078 Decpt2: X1 = X0.001 in type I), which the program does not
+    say; the compensated copy writes a decimal point, a factor 1000 where it meant the
+    increment.  ``--decimal-less mm`` states the reading."""
+    text = _COMMENT.sub("", "".join(lines))
+    m = _DECIMAL_LESS.search(text)
+    if m is None:
+        return
+    number = first + text.count("\n", 0, m.start()) if "\n" in text else first
+    word = f"{m.group(1).upper()}{m.group(2)}"
+    raise InputError(f"line {number}: {word} has no decimal point in a Fanuc-style program "
+                     f"(O number): {word}. mm or {word} x 0.001 mm by the controller's "
+                     "parameter 3401#0 DPI; write the decimal point, or give --decimal-less mm")
+
+
 def parser(name: str):
     """The line parser of a dialect for :func:`volerr.nc.interpret.interpret`: None for
     ISO, :class:`volerr.nc.heidenhain.Dialect` for Heidenhain."""

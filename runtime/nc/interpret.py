@@ -50,15 +50,19 @@ class Prescan:
 
 
 def prescan(open_source, rotary_axes, chunk_lines: int = CHUNK_LINES,
-            dialect: str = "auto") -> Prescan:
+            dialect: str = "auto", decimal_less: str = "auto") -> Prescan:
     """Read the program once, cheaply (no interpretation), for :class:`Prescan`;
-    ``open_source()`` a fresh iterator over its lines, ``rotary_axes`` the machine's."""
+    ``open_source()`` a fresh iterator over its lines, ``rotary_axes`` the machine's.
+    ``decimal_less`` "auto": a Fanuc-style ISO program (:func:`volerr.nc.dialect.fanuc_style`)
+    with an axis or arc number without a decimal point is refused
+    (:func:`volerr.nc.dialect.refuse_decimal_less`; read to its end); "mm": read as mm."""
     from . import dialect as dialects
 
     rot = list(rotary_axes)
     pats = {a: re.compile(rf"[{a}{a.lower()}][ \t]*[+-]?\.?\d") for a in rot}
     seen = set()
     spaced = None
+    check_points = None
     fh = open_source()
     try:
         first = 1
@@ -68,11 +72,17 @@ def prescan(open_source, rotary_axes, chunk_lines: int = CHUNK_LINES,
                 dialect = dialects.detect(buf, first)
             if dialect == "heidenhain":
                 spaced = True
+            if check_points is None:
+                check_points = (decimal_less == "auto" and dialect != "heidenhain"
+                                and dialects.fanuc_style(buf))
+            if check_points:
+                dialects.refuse_decimal_less(buf, first)
             if spaced is None:
                 spaced = _first_spacing(buf, first)
             seen |= _letters(buf, pats, seen)
             first += len(buf)
-            if len(buf) < chunk_lines or (len(seen) == len(rot) and spaced is not None):
+            if len(buf) < chunk_lines or (len(seen) == len(rot) and spaced is not None
+                                          and not check_points):
                 break           # the end, or nothing left to learn from the rest
     finally:
         if hasattr(fh, "close"):

@@ -13,6 +13,7 @@ from volerr.nc import gcode
 from volerr.fiveaxis.program import compensate_program
 from volerr.tables.functions import ErrorFunctions
 
+#: an O number with decimal-less numbers: the reading (mm) stated, ``decimal_less="mm"``
 PROGRAM = """%
 O0001 (STREAM)
 G90 G1 X10 Y20 Z100 B10 C5 F500
@@ -44,11 +45,13 @@ def setup(tmp_path_factory):
 @pytest.mark.parametrize("orientation", [False, True])
 def test_chunked_output_equals_unchunked(setup, orientation):
     m, funcs, _ = setup
-    whole = compensate_program(m, funcs, PROGRAM, orientation=orientation)
+    whole = compensate_program(m, funcs, PROGRAM, orientation=orientation,
+                               decimal_less="mm")
     assert whole.text != PROGRAM                                # something was compensated
     assert any(r.status.startswith("not compensated") for r in whole.reports)  # after G28
     for k in (1, 2, 3, 5, 7):
-        part = compensate_program(m, funcs, PROGRAM, orientation=orientation, chunk_lines=k)
+        part = compensate_program(m, funcs, PROGRAM, orientation=orientation, chunk_lines=k,
+                                  decimal_less="mm")
         assert part.text == whole.text, k
         assert [(r.line, r.status, r.output) for r in part.reports] == \
             [(r.line, r.status, r.output) for r in whole.reports]
@@ -59,7 +62,7 @@ def test_written_program_replays_to_the_compensated_positions(setup):
     """Independent of the writer: interpret the OUTPUT program and compare its positions with
     the reported ones (G91 increments were re-derived from the written values)."""
     m, funcs, _ = setup
-    res = compensate_program(m, funcs, PROGRAM, chunk_lines=3)
+    res = compensate_program(m, funcs, PROGRAM, chunk_lines=3, decimal_less="mm")
     out_blocks = gcode.blocks(gcode.parse(res.text), m.axes)
     done = {r.line: r for r in res.reports if r.status == "compensated"}
     for b in out_blocks:
