@@ -57,7 +57,7 @@ DECIMAL_LESS = ("auto", "mm")
 _PROGRAM_NUMBER = re.compile(r"[ \t]*[Oo]\d+[ \t]*(\(.*)?$")
 #: an axis or arc word whose number is not zero and has no decimal point (comments removed)
 _DECIMAL_LESS = re.compile(r"(?<![A-Za-z])([XYZABCUVWIJKRxyzabcuvwijkr])[ \t]*([+-]?0*[1-9]\d*)"
-                           r"(?![\d.])")
+                           r"(?![\d.,])")
 _COMMENT = re.compile(r"\([^)\r\n]*\)|;[^\r\n]*")
 
 

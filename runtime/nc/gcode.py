@@ -287,6 +287,10 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
                 raise InputError(f"line {number}: SINUMERIK {body[i:i + 4].upper()} probe "
                                  "move is not supported (ends where the probe touches: the "
                                  "position after it is unknown)")
+            if not m and c == "," and tokens and tokens[-1].kind == "word" and \
+                    body[i + 1:i + 2].isdigit():
+                raise InputError(f"line {number}: {tokens[-1].text.strip()}{body[i:i + 2]}...: "
+                                 "a comma is no decimal point in G-code (write a point)")
             if not m:
                 raise InputError(f"line {number}: cannot interpret {body[i:i + 12]!r} (only "
                                  "address words, comments and blanks are supported)")
