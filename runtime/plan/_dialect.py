@@ -119,7 +119,11 @@ class Iso:
 
     # -- words ----------------------------------------------------------------------------
     def words(self, to: dict) -> str:
-        return " ".join(f"{a}{number(to[a])}" for a in self.axes if a in to)
+        return " ".join(f"{a}{self.position(to[a])}" for a in self.axes if a in to)
+
+    def position(self, value: float) -> str:
+        """An axis position or arc-centre offset (mm / deg) as a word's number."""
+        return number(value)
 
     def comment(self, text: str) -> list:
         clean = str(text).replace("(", "[").replace(")", "]")
@@ -130,7 +134,7 @@ class Iso:
 
     def start(self, z_top: float) -> list:
         return ["G21 G90 G94 G17 G40 G49 G80",
-                f"G53 G0 Z{number(z_top)}",
+                f"G53 G0 Z{self.position(z_top)}",
                 "G54 G61",
                 *self.comment("metric, absolute, feed per minute; first the retract along Z "
                               "alone in machine coordinates to the top of the Z travel; "
@@ -148,8 +152,8 @@ class Iso:
     def arc(self, op: Op, start: dict) -> list:
         a, i, b, j = CENTRE_WORDS[op.normal]
         code = "G3" if op.ccw else "G2"
-        off = " ".join(sorted([f"{i}{number(op.centre[a] - start[a])}",
-                               f"{j}{number(op.centre[b] - start[b])}"]))    # I J K
+        off = " ".join(sorted([f"{i}{self.position(op.centre[a] - start[a])}",
+                               f"{j}{self.position(op.centre[b] - start[b])}"]))    # I J K
         return [f"{PLANE_CODE[op.normal]} {code} {self.words(op.to)} {off} F{number(op.feed)}"]
 
     def probe(self, op: Op) -> list:
@@ -202,6 +206,13 @@ class Fanuc(Iso):
     def begin(self, name: str) -> list:
         return ["%", "O1000"]
 
+    def position(self, value: float) -> str:
+        """Always with a decimal point (``Z400.``): without one a Fanuc reads 400 least input
+        increments (0.400 mm) when parameter 3401#0 DPI is 0 (FANUC 0i / 30i "decimal point
+        programming"; ``volerr compensate`` refuses such words in an O-number program)."""
+        text = number(value)
+        return text if "." in text else text + "."
+
     def dwell(self, op: Op) -> list:
         return [f"G4 P{int(round(op.seconds * 1000))}"]
 
@@ -224,7 +235,7 @@ class Sinumerik(Iso):
 
     def start(self, z_top: float) -> list:
         return ["G71 G90 G94 G17 G40 G60",
-                f"G53 G0 Z{number(z_top)}",
+                f"G53 G0 Z{self.position(z_top)}",
                 "G54 D0",
                 *self.comment("metric, absolute, feed per minute; first the retract along Z "
                               "alone in machine coordinates; work offset G54 with zero "
