@@ -169,7 +169,7 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
         TCPM tool lengths by tool number (CSV ``tool,length_mm`` or ``{number: mm}``), looked
         up at the H, else T, else D word; refused for a program without TCPM.
     orientation, strategy, types, tol_um, decimals, method, degree, extrapolate, initial,
-    check_travel, arc_tol_um, dialect
+    check_travel, arc_tol_um, dialect, decimal_less
         As the command's options (``volerr compensate --help``); ``types`` a sequence or the
         option's text ``'L-VOL,R-VOL'``, ``initial`` a dict or ``'B=0,C=0'``.
     out, report : path, optional
@@ -186,11 +186,6 @@ def compensate(layout, program, errors, *, datum=None, tool=(0.0, 0.0, 0.0),
         ``--accept-implausible``: use error values beyond what a machine of the layout's
         travel can have (:mod:`volerr.tables.plausible`); by default they are refused naming
         the file, the column and the likely unit.
-    decimal_less : {"auto", "mm"}
-        ``--decimal-less``: how an axis or arc number without a decimal point (``X300``) is
-        read.  "auto": refused in a Fanuc-style program (a program-number line ``O1234``:
-        300 mm or 0.300 mm by the controller's parameter 3401#0 DPI), mm elsewhere; "mm":
-        read as mm.
 
     Returns
     -------
