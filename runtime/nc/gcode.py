@@ -138,6 +138,17 @@ REFUSED_G.update({
 })
 #: Siemens measuring moves (``MEAS=1 G1 X..``, ``MEAW=1``): refused as G31 / G38.x are
 PROBING_KEYWORD = re.compile(r"(MEAS|MEAW)[ \t]*=", re.IGNORECASE)
+#: SINUMERIK frame instructions (programmable work offset, rotation, scale, mirror: the words
+#: after them mean other machine positions) and SUPA (suppresses every offset: the words are
+#: machine positions); refused naming the instruction, with the work-offset rule
+SIEMENS_FRAMES = {"TRANS": "frame (programmable work offset)",
+                  "ATRANS": "frame (additive work offset)", "ROT": "frame (rotation)",
+                  "AROT": "frame (additive rotation)", "SCALE": "frame (scaling)",
+                  "ASCALE": "frame (additive scaling)", "MIRROR": "frame (mirror)",
+                  "AMIRROR": "frame (additive mirror)",
+                  "SUPA": "machine coordinates with every offset suppressed"}
+_SIEMENS_FRAME = re.compile(r"(A?TRANS|A?ROT|A?SCALE|A?MIRROR|SUPA)(?![A-Za-z0-9_])",
+                            re.IGNORECASE)
 #: LinuxCNC's spline motions (cubic, quadratic B-spline, NURBS): refused where the line moves
 #: (axis or I J words); Fanuc writes G05 / G05.1 with P or Q alone as machining modes
 SPLINE_G = frozenset({5.0, 5.1, 5.2, 5.3})
@@ -291,6 +302,12 @@ def tokenize(body: str, number: int = 0) -> list[Token]:
                     body[i + 1:i + 2].isdigit():
                 raise InputError(f"line {number}: {tokens[-1].text.strip()}{body[i:i + 2]}...: "
                                  "a comma is no decimal point in G-code (write a point)")
+            frame = None if m else _SIEMENS_FRAME.match(body, i)
+            if frame:
+                name = frame.group(1).upper()
+                raise InputError(f"line {number}: SINUMERIK {name} {SIEMENS_FRAMES[name]} is "
+                                 "not supported (the program's numbers are taken as machine "
+                                 "positions with zero offsets)")
             if not m:
                 raise InputError(f"line {number}: cannot interpret {body[i:i + 12]!r} (only "
                                  "address words, comments and blanks are supported)")
