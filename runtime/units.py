@@ -338,6 +338,16 @@ MIN_READING_SPREAD_UM = 0.05
 NO_SPREAD_UM = 1e-6
 
 
+#: the smallest spread of one angular error column of a real machine, urad (an error table's
+#: ``EAX_urad`` ... over an axis' travel).  The pitch, yaw and roll of the best linear axes
+#: and the wobble of the best rotary axes over their travel span 0.5 urad and more (ISO 230-2
+#: angular runs of precision CMMs: 0.5-2 urad); angular optics resolve 0.01-0.05 urad, so no
+#: real column spans less than a tenth of that 0.5 urad.  Angles in mrad (or rad) written under
+#: ``_urad`` span a thousandth (a millionth) of the real spread: every machine whose real
+#: spread is below 50 urad is caught.
+MIN_ANGLE_SPREAD_URAD = 0.05
+
+
 #: the smallest spread of the readings of a cycle over a rotary axis' travel (R-test, touch
 #: probe on a sphere) or of a ballbar circle, um: they read the axes' location and squareness
 #: errors times a radius of 100 mm or more and the set-up's offsets (the sphere off its
@@ -347,13 +357,15 @@ MIN_CYCLE_SPREAD_UM = 0.5
 
 
 def check_reading_spread_um(columns: dict, where: str,
-                            minimum_um: float = MIN_READING_SPREAD_UM) -> None:
+                            minimum_um: float = MIN_READING_SPREAD_UM, unit: str = "um") -> None:
     """Refuse readings that look like mm written under ``_um`` (x1000): ``columns``
     ``{header: values}`` of one file's error readings headed ``_um`` (values as written, um);
     one-line :class:`InputError` naming ``where`` and the column when the largest spread
     ``max - min`` of the columns is above :data:`NO_SPREAD_UM` and below ``minimum_um``
     (:data:`MIN_READING_SPREAD_UM`; :data:`MIN_CYCLE_SPREAD_UM` for the readings of a
-    rotary cycle or a ballbar circle)."""
+    rotary cycle or a ballbar circle).  ``unit="urad"``: angular columns headed ``_urad``
+    (values in urad, ``minimum_um`` then a spread in urad, :data:`MIN_ANGLE_SPREAD_URAD`):
+    the refusal names mrad or rad written under ``_urad``."""
     import numpy as np
 
     vals = {h: np.asarray(v, dtype=float) for h, v in columns.items()}
@@ -364,10 +376,12 @@ def check_reading_spread_um(columns: dict, where: str,
     if col is None or not NO_SPREAD_UM < spread[col] < minimum_um:
         return
     big = float(np.max(np.abs(vals[col])))
-    raise InputError(f"{where}: column {col}: the readings span {spread[col]:.3g} um (largest "
-                     f"{big:.3g} um), less than any machine and instrument show "
-                     f"({minimum_um:g} um): looks like mm written under _um "
-                     f"(x1000); give um, or head the column _mm")
+    likely = ("mm written under _um (x1000); give um, or head the column _mm" if unit == "um"
+              else "mrad or rad written under _urad (x1000 or x1e6); give urad, or head the "
+                   "column _rad")
+    raise InputError(f"{where}: column {col}: the readings span {spread[col]:.3g} {unit} "
+                     f"(largest {big:.3g} {unit}), less than any machine and instrument show "
+                     f"({minimum_um:g} {unit}): looks like {likely}")
 
 
 def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:
