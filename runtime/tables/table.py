@@ -413,6 +413,8 @@ def check_magnitudes(tables: dict, constants=None, constants_std=None, constants
             col, unit = cols.get(("RV", ""), (f"RV_{ax}_um", None))
             plausible.check(t.reversal, "length", limits, src, f"column {col}", unit, cause)
         _check_spread(t, src)
+        if machine is not None and getattr(t, "_source", ""):
+            plausible.check_positions(ax, t.positions, machine, src)
     origin = constants_origin or {}
     csrc = str(Path(where) / "constants.csv") if where else "constants"
     for label, dct in (("", constants), ("std", constants_std), ("u95", constants_u95)):
