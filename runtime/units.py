@@ -307,13 +307,28 @@ def check_offset_mm(vector, where: str, limit_mm: float, what: str = "offset") -
 #: no tolerance or MPE of a machine tool or CMM is below this, um (the best CMMs: MPE
 #: 0.3 um + L/1000; an ISO 230-2 tolerance is a micrometre or more)
 TOLERANCE_FLOOR_UM = 0.1
+#: no tolerance or MPE of a machine tool or CMM is above this, um (1 mm): the positioning
+#: tolerances of the longest axes in the machine-tool standards (ISO 10791-2, ISO 3070-2:
+#: A of axes of several metres) are a few tenths of a millimetre, a CMM's MPE constant a few
+#: micrometres; a tolerance of millimetres is a value in um typed with ``mm`` (``A=12 mm``)
+#: or one in nm typed as um (``E=25000``)
+TOLERANCE_CEILING_UM = 1000.0
 
 
 def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "") -> float:
-    """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM`; else one-line
-    :class:`InputError` naming ``where``: below any machine's tolerance, likely given in mm
-    (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for the
-    suggested spelling ``A=0.012 mm``)."""
+    """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM` and at most
+    :data:`TOLERANCE_CEILING_UM`; else one-line :class:`InputError` naming ``where``: below
+    any machine's tolerance, likely given in mm; above it, likely given in um with ``mm`` or
+    in nm (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for
+    the suggested spelling ``A=0.012 mm``).  Zero and negative values are returned for the
+    caller's own one line."""
+    label = name + "=" if name else ""
+    if value_um > TOLERANCE_CEILING_UM:
+        hint = (f"likely meant in um: write {label}{value_um / UM_PER_MM:g} um" if unit == "mm"
+                else f"likely given in nm: write {label}{value_um * 1e-3:g} um"
+                if unit in ("um", "nm") else "a wrong unit?")
+        raise InputError(f"{where}: {value_um:g} um is above any machine's tolerance "
+                         f"({TOLERANCE_CEILING_UM:g} um): {hint}")
     if value_um >= TOLERANCE_FLOOR_UM or value_um <= 0:
         return value_um
     hint = (f"likely meant in mm: write {name + '=' if name else ''}{value_um:g} mm"
