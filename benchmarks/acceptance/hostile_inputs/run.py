@@ -3,7 +3,7 @@
 Usage::
 
     .venv/bin/python benchmarks/acceptance/hostile_inputs/run.py [WORKDIR] [--only ID,ID]
-        [--md RESULTS_TABLE.md]
+        [--batch 1|2|1,2] [--md RESULTS_TABLE.md]
 
 Every case is a shipped example (``volerr examples --out WORKDIR/ex``) with one mistake made
 by a function below; the command runs in a subprocess (the ``volerr`` beside this Python, a
@@ -406,6 +406,76 @@ def instrument_cases(w: Path, ex: Path) -> list:
     return cases
 
 
+def batch2_cases(w: Path, ex: Path) -> list:
+    """The amendment of RULE.md: spreadsheet exports of tables and drift files, files not of
+    their kind, a reversal column in nm."""
+    cases = []
+
+    def out_in(cid, name):
+        p = w / cid / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return str(p)
+
+    def map_case(cid, mistake, make, expect, words, same_as=None):
+        d = copy_dir(ex / "errors_MB1", w / cid / "errors")
+        make(Path(d) / "X.csv")
+        out = out_in(cid, "map.csv")
+        cases.append(Case(cid, "b2 exports", mistake,
+                          ["map", "MB1", "--errors", d, "--out", out, "--grid", "3"],
+                          expect, words, (out,), sentinel=None if expect == "accept" else out,
+                          same_as=same_as))
+    map_case("b2_tab_plain", "errors_MB1 unchanged", lambda p: None, "accept", ())
+    map_case("b2_tab_bom_crlf", "X.csv with BOM and CRLF",
+             lambda p: write(p, *read(p), newline="\r\n", bom=True), "accept", (),
+             same_as="b2_tab_plain")
+    map_case("b2_tab_semicolon_comma", "X.csv with semicolons and decimal commas",
+             lambda p: (lambda c, h, r: write(p, c, h, [[x.replace(".", ",") for x in row]
+                                                       for row in r], sep=";"))(*read(p)),
+             "either", ("decimal comma", "comma"), same_as="b2_tab_plain")
+    map_case("b2_tab_rv_nm", "an RV_X_um reversal column in nm (x 1000)",
+             lambda p: mapped(p, p, lambda h, r: (h + ["RV_X_um"],
+                                                  [x + [fmt(2000.0 + 10 * i)]
+                                                   for i, x in enumerate(r)])),
+             "refuse", ("nm",))
+
+    src = ex / "drift_spindle.csv"
+
+    def drift_case(cid, mistake, make, expect, words, same_as=None):
+        f = Path(out_in(cid, "drift.csv"))
+        make(f)
+        out = out_in(cid, "drift.json")
+        cases.append(Case(cid, "b2 exports", mistake, ["iso230-3", str(f), "--json", out],
+                          expect, words, (out,), sentinel=None if expect == "accept" else out,
+                          same_as=same_as))
+    drift_case("b2_drift_plain", "drift_spindle.csv unchanged", lambda f: shutil.copy(src, f),
+               "accept", ())
+    drift_case("b2_drift_bom_crlf", "BOM and CRLF",
+               lambda f: write(f, *read(src), newline="\r\n", bom=True), "accept", (),
+               same_as="b2_drift_plain")
+    drift_case("b2_drift_semicolon_comma", "semicolons and decimal commas",
+               lambda f: (lambda c, h, r: write(f, c, h, [[x.replace(".", ",") for x in row]
+                                                         for row in r], sep=";"))(*read(src)),
+               "either", ("decimal comma", "comma"), same_as="b2_drift_plain")
+
+    for cid, mistake, argv, words in [
+            ("b2_sphere_as_ballbar", "a sphere file given as ballbar:",
+             ["calibrate", "DMU50", "ballbar:" + str(ex / "sphere_example_DMU50.csv")],
+             ("ballbar", "column", "dr_um", "sphere")),
+            ("b2_run_as_deviations", "a positioning run given as deviations:",
+             ["calibrate", "MB1", "deviations:" + str(ex / "iso230_2_run_X.csv")],
+             ("deviations", "column", "interferometer")),
+            ("b2_tracker_to_calibrate", "a tracker file given to calibrate",
+             ["calibrate", "MB1", str(ex / "tracker_example_X.csv")],
+             ("tracker", "identify", "column", "kind")),
+            ("b2_ballbar_to_iso230_2", "a ballbar trace given to iso230-2",
+             ["iso230-2", str(ex / "ballbar_example_XY.csv")],
+             ("column", "target", "ballbar"))]:
+        out = out_in(cid, "r.json")
+        cases.append(Case(cid, "b2 kinds", mistake, argv + ["--json", out], "refuse", words,
+                          (out,), sentinel=out))
+    return cases
+
+
 # -- running and judging ---------------------------------------------------------------------
 def _json_values(path):
     """A JSON result without what differs between equal runs (file names, dates, versions)."""
@@ -473,8 +543,11 @@ def judge(c: Case, code, err, lines, done) -> list:
             d.append(f"2: {len(lines)} lines on stderr")
         if c.expect == "accept":
             d.append("4: a plausible input refused")
+        # the words are looked for in the line without its paths and file names (a file
+        # named tracker_example_X.csv does not name the mistake "tracker")
+        said = re.sub(r"\S*(?:/|\.csv|\.json|\.png)\S*", "", lines[-1] if lines else "")
         if c.expect in ("refuse", "either") and c.words and not any(
-                w.lower() in (lines[-1].lower() if lines else "") for w in c.words):
+                w.lower() in said.lower() for w in c.words):
             if c.expect == "refuse":
                 d.append("5: the line names none of " + "/".join(c.words))
         if _written(c):
@@ -486,6 +559,9 @@ def judge(c: Case, code, err, lines, done) -> list:
         if same and c.outputs and str(c.outputs[0]).endswith(".json"):
             if _json_values(c.outputs[0]) != _json_values(same.outputs[0]):
                 d.append(f"4: result differs from {c.same_as}")
+        elif same and c.outputs and str(c.outputs[0]).endswith(".csv"):
+            if Path(c.outputs[0]).read_bytes() != Path(same.outputs[0]).read_bytes():
+                d.append(f"4: output differs from {c.same_as}'s (bytes)")
         for o in c.outputs:
             if not Path(o).exists() or (o == c.sentinel and Path(o).read_bytes() == SENTINEL):
                 d.append(f"4: output {Path(o).name} not written")
@@ -507,7 +583,11 @@ def markdown(results) -> str:
 
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    only = md = None
+    only = md = batch = None
+    if "--batch" in argv:
+        i = argv.index("--batch")
+        batch = argv[i + 1]
+        del argv[i:i + 2]
     if "--only" in argv:
         i = argv.index("--only")
         only = set(argv[i + 1].split(","))
@@ -525,8 +605,10 @@ def main(argv=None) -> int:
     if not ex.is_dir():
         subprocess.run([VOLERR, "examples", "--out", str(ex)], check=True,
                        capture_output=True)
-    cases = (table_cases(w, ex) + drift_cases(w, ex) + option_cases(w, ex)
-             + positioning_cases(w, ex) + instrument_cases(w, ex))
+    batches = {"1": lambda: (table_cases(w, ex) + drift_cases(w, ex) + option_cases(w, ex)
+                             + positioning_cases(w, ex) + instrument_cases(w, ex)),
+               "2": lambda: batch2_cases(w, ex)}
+    cases = [c for b in (batch.split(",") if batch else ("1", "2")) for c in batches[b]()]
     done, results = {}, []
     for c in cases:
         if only and c.id not in only and not (c.id == "run_plain"):
