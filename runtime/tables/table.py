@@ -428,9 +428,9 @@ def _check_spread(table: ErrorTable, src: str) -> None:
     """The lower bound of a table read from a file: its error columns headed ``_um`` (and,
     apart, those headed ``_urad``) must span, the widest of them, at least what any machine
     and instrument show (:func:`volerr.units.check_reading_spread_um`,
-    :data:`~volerr.units.MIN_READING_SPREAD_UM` 0.05 um, :data:`~volerr.units.
-    MIN_ANGLE_SPREAD_URAD` 0.05 urad): a table in mm under ``_um`` (mrad or rad under
-    ``_urad``) spans a thousandth of the real error or less.  Columns without spread (zeros,
+    :data:`~volerr.units.MIN_READING_SPREAD_UM` 0.05 um,
+    :data:`~volerr.units.MIN_ANGLE_SPREAD_URAD` 0.05 urad): a table in mm under ``_um``
+    (mrad or rad under ``_urad``) spans a thousandth of the real error or less.  Columns without spread (zeros,
     a constant) say nothing and pass; uncertainty and reversal columns are not judged (a
     constant backlash or uncertainty is real).  Tables not read from a file (computed, to be
     written) are not judged: a simulated perfect machine identifies to round-off."""
