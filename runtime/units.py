@@ -315,15 +315,17 @@ TOLERANCE_FLOOR_UM = 0.1
 TOLERANCE_CEILING_UM = 1000.0
 
 
-def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "") -> float:
+def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "",
+                       ceiling: bool = True) -> float:
     """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM` and at most
     :data:`TOLERANCE_CEILING_UM`; else one-line :class:`InputError` naming ``where``: below
     any machine's tolerance, likely given in mm; above it, likely given in um with ``mm`` or
     in nm (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for
     the suggested spelling ``A=0.012 mm``).  Zero and negative values are returned for the
-    caller's own one line."""
+    caller's own one line.  ``ceiling=False``: the floor only (a limit on a parameter of a
+    layout, bounded by the machine's size instead: :mod:`volerr.tables.plausible`)."""
     label = name + "=" if name else ""
-    if value_um > TOLERANCE_CEILING_UM:
+    if ceiling and value_um > TOLERANCE_CEILING_UM:
         hint = (f"likely meant in um: write {label}{value_um / UM_PER_MM:g} um" if unit == "mm"
                 else f"likely given in nm: write {label}{value_um * 1e-3:g} um"
                 if unit in ("um", "nm") else "a wrong unit?")
