@@ -307,13 +307,30 @@ def check_offset_mm(vector, where: str, limit_mm: float, what: str = "offset") -
 #: no tolerance or MPE of a machine tool or CMM is below this, um (the best CMMs: MPE
 #: 0.3 um + L/1000; an ISO 230-2 tolerance is a micrometre or more)
 TOLERANCE_FLOOR_UM = 0.1
+#: no tolerance or MPE of a machine tool or CMM is above this, um (1 mm): the positioning
+#: tolerances of the longest axes in the machine-tool standards (ISO 10791-2, ISO 3070-2:
+#: A of axes of several metres) are a few tenths of a millimetre, a CMM's MPE constant a few
+#: micrometres; a tolerance of millimetres is a value in um typed with ``mm`` (``A=12 mm``)
+#: or one in nm typed as um (``E=25000``)
+TOLERANCE_CEILING_UM = 1000.0
 
 
-def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "") -> float:
-    """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM`; else one-line
-    :class:`InputError` naming ``where``: below any machine's tolerance, likely given in mm
-    (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for the
-    suggested spelling ``A=0.012 mm``)."""
+def check_tolerance_um(value_um: float, where: str, unit: str = "um", name: str = "",
+                       ceiling: bool = True) -> float:
+    """A tolerance (um) returned when at least :data:`TOLERANCE_FLOOR_UM` and at most
+    :data:`TOLERANCE_CEILING_UM`; else one-line :class:`InputError` naming ``where``: below
+    any machine's tolerance, likely given in mm; above it, likely given in um with ``mm`` or
+    in nm (``unit``: as the user wrote it; bare numbers are um; ``name``: the quantity, for
+    the suggested spelling ``A=0.012 mm``).  Zero and negative values are returned for the
+    caller's own one line.  ``ceiling=False``: the floor only (a limit on a parameter of a
+    layout, bounded by the machine's size instead: :mod:`volerr.tables.plausible`)."""
+    label = name + "=" if name else ""
+    if ceiling and value_um > TOLERANCE_CEILING_UM:
+        hint = (f"likely meant in um: write {label}{value_um / UM_PER_MM:g} um" if unit == "mm"
+                else f"likely given in nm: write {label}{value_um * 1e-3:g} um"
+                if unit in ("um", "nm") else "a wrong unit?")
+        raise InputError(f"{where}: {value_um:g} um is above any machine's tolerance "
+                         f"({TOLERANCE_CEILING_UM:g} um): {hint}")
     if value_um >= TOLERANCE_FLOOR_UM or value_um <= 0:
         return value_um
     hint = (f"likely meant in mm: write {name + '=' if name else ''}{value_um:g} mm"
@@ -338,6 +355,16 @@ MIN_READING_SPREAD_UM = 0.05
 NO_SPREAD_UM = 1e-6
 
 
+#: the smallest spread of one angular error column of a real machine, urad (an error table's
+#: ``EAX_urad`` ... over an axis' travel).  The pitch, yaw and roll of the best linear axes
+#: and the wobble of the best rotary axes over their travel span 0.5 urad and more (ISO 230-2
+#: angular runs of precision CMMs: 0.5-2 urad); angular optics resolve 0.01-0.05 urad, so no
+#: real column spans less than a tenth of that 0.5 urad.  Angles in mrad (or rad) written under
+#: ``_urad`` span a thousandth (a millionth) of the real spread: every machine whose real
+#: spread is below 50 urad is caught.
+MIN_ANGLE_SPREAD_URAD = 0.05
+
+
 #: the smallest spread of the readings of a cycle over a rotary axis' travel (R-test, touch
 #: probe on a sphere) or of a ballbar circle, um: they read the axes' location and squareness
 #: errors times a radius of 100 mm or more and the set-up's offsets (the sphere off its
@@ -347,13 +374,15 @@ MIN_CYCLE_SPREAD_UM = 0.5
 
 
 def check_reading_spread_um(columns: dict, where: str,
-                            minimum_um: float = MIN_READING_SPREAD_UM) -> None:
+                            minimum_um: float = MIN_READING_SPREAD_UM, unit: str = "um") -> None:
     """Refuse readings that look like mm written under ``_um`` (x1000): ``columns``
     ``{header: values}`` of one file's error readings headed ``_um`` (values as written, um);
     one-line :class:`InputError` naming ``where`` and the column when the largest spread
     ``max - min`` of the columns is above :data:`NO_SPREAD_UM` and below ``minimum_um``
     (:data:`MIN_READING_SPREAD_UM`; :data:`MIN_CYCLE_SPREAD_UM` for the readings of a
-    rotary cycle or a ballbar circle)."""
+    rotary cycle or a ballbar circle).  ``unit="urad"``: angular columns headed ``_urad``
+    (values in urad, ``minimum_um`` then a spread in urad, :data:`MIN_ANGLE_SPREAD_URAD`):
+    the refusal names mrad or rad written under ``_urad``."""
     import numpy as np
 
     vals = {h: np.asarray(v, dtype=float) for h, v in columns.items()}
@@ -364,10 +393,12 @@ def check_reading_spread_um(columns: dict, where: str,
     if col is None or not NO_SPREAD_UM < spread[col] < minimum_um:
         return
     big = float(np.max(np.abs(vals[col])))
-    raise InputError(f"{where}: column {col}: the readings span {spread[col]:.3g} um (largest "
-                     f"{big:.3g} um), less than any machine and instrument show "
-                     f"({minimum_um:g} um): looks like mm written under _um "
-                     f"(x1000); give um, or head the column _mm")
+    likely = ("mm written under _um (x1000); give um, or head the column _mm" if unit == "um"
+              else "mrad or rad written under _urad (x1000 or x1e6); give urad, or head the "
+                   "column _rad")
+    raise InputError(f"{where}: column {col}: the readings span {spread[col]:.3g} {unit} "
+                     f"(largest {big:.3g} {unit}), less than any machine and instrument show "
+                     f"({minimum_um:g} {unit}): looks like {likely}")
 
 
 def check_tool_offset(vector, where: str, limit_mm: float) -> tuple:

@@ -7,7 +7,8 @@ Grammar: ``NAME=VALUE UNIT`` pairs separated by ``,`` ``;`` or ``|`` (the readin
 written or in any case when that names one (:func:`volerr.units.match_name`): a parameter of
 the reference (its ``|value|`` against ``VALUE UNIT``: the unit is required and must be of
 its kind, it is converted, :func:`volerr.units.parse_quantity`; a limit beyond
-:mod:`volerr.tables.plausible` is refused) or ``map`` (the largest length of the volumetric
+:mod:`volerr.tables.plausible` is refused, and a length limit below any machine's tolerance,
+:func:`volerr.units.check_tolerance_um`) or ``map`` (the largest length of the volumetric
 error over the working volume, um).  Example:
 ``"EX0C=20 um,EA0B=40 urad,map=30 um"``.
 """
@@ -18,7 +19,8 @@ import math
 
 from .. import conformance
 from ..errors import InputError, require
-from ..units import convert, match_name, parse_assignments
+from ..units import (QUANTITY_UNITS, check_tolerance_um, convert, match_name,
+                     parse_assignments)
 from . import _volume
 
 
@@ -46,6 +48,9 @@ def parse(text: str, ref, model=None) -> dict:
         part = f"{name}={v:g}" + (f" {given}" if given else "")
         v = convert(v, given, units[key], f"--tolerance {name}")
         _plausible(v, units[key], given, part, limits)
+        if QUANTITY_UNITS.get(units[key], (None,))[0] == "length":
+            check_tolerance_um(convert(v, units[key], "um"), f"--tolerance {part}", given,
+                               name, ceiling=False)
         require(math.isfinite(v) and v > 0, f"--tolerance: {name} = {part.partition('=')[2]!r} "
                                             f"must be a positive number")
         require(key not in out, f"--tolerance: {name} given twice")
@@ -65,15 +70,11 @@ def _key(name: str, ref) -> str:
 def given_unit_any(unit: str) -> bool:
     """A parameter unit outside :data:`volerr.units.QUANTITY_UNITS` (a slope, ``um/mm``) is
     given as written."""
-    from ..units import QUANTITY_UNITS
-
     return unit not in QUANTITY_UNITS
 
 
 def _plausible(v: float, unit: str, given: str, part: str, limits) -> None:
     """Refuse a limit beyond the magnitude rule (:mod:`volerr.tables.plausible`)."""
-    from ..units import QUANTITY_UNITS
-
     kind = QUANTITY_UNITS.get(unit, (None,))[0]
     if kind is None:
         return

@@ -27,8 +27,8 @@ import re
 from pathlib import Path
 
 from ..errors import InputError, require
-from ..units import (QUANTITY_UNITS, convert, match_name, parse_assignments, parse_date,
-                     today_utc)
+from ..units import (QUANTITY_UNITS, check_tolerance_um, convert, match_name,
+                     parse_assignments, parse_date, today_utc)
 from . import results
 from .results import CALIBRATION, CHECK
 
@@ -162,6 +162,9 @@ def parse_tolerances(text: str | None) -> dict:
             require(QUANTITY_UNITS.get(unit, ("",))[0] == "length",
                     "--tolerance map=VALUE um (the volumetric error, a length)")
             value, unit = convert(value, unit, "um"), "um"
+        if QUANTITY_UNITS.get(unit, ("",))[0] == "length":     # below any machine's: in mm?
+            check_tolerance_um(convert(value, unit, "um"), f"--tolerance {name}={value:g} "
+                               f"{unit}", unit, name, ceiling=False)
         out[name] = (value, unit)
     return out
 

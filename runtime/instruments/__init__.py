@@ -46,11 +46,22 @@ def split_spec(spec: str) -> tuple[str | None, str]:
     return None, text
 
 
+#: the columns of laser-tracker three-point data (docs/formats.md "tracker"), the input of
+#: ``volerr identify``, not of an instrument here: its ``position`` column would make it read
+#: as an interferometer run asking for an ``# axis`` line, the wrong mistake named
+TRACKER_COLUMNS = frozenset({"round", "point", "position", "x", "y", "z"})
+
+
 def detect(path) -> str:
-    """The instrument kind of a file, from its header (InputError when it cannot tell)."""
+    """The instrument kind of a file, from its header (InputError when it cannot tell; a
+    laser-tracker file, :data:`TRACKER_COLUMNS`, is refused naming ``volerr identify``)."""
     from ._csv import read_header
 
     names = read_header(path)       # the columns alone: the instrument reads the file once
+    require(not TRACKER_COLUMNS <= {n.strip().lower() for n in names},
+            f"{Path(path).name}: laser-tracker three-point data (round, point, position, x, y, "
+            f"z), not an instrument file of calibrate or loop: identify it with 'volerr "
+            f"identify LAYOUT --axis A {Path(path).name}'")
     hits = [k for k, m in kinds().items() if k != FALLBACK and hasattr(m, "detect")
             and m.detect(names)]
     require(len(hits) <= 1, f"{Path(path).name}: columns of several instruments "

@@ -164,11 +164,32 @@ def _csv_rows(path: Path) -> list:
     return rows
 
 
+#: the reading columns of volerr's other measurement files (docs/formats.md): a file that
+#: carries one is that instrument's file, not master-sphere probing data, whatever x, y, z
+#: it also has (a deviations or sphere file's X, Y, Z are axis positions, not ball centres)
+OTHER_KINDS = {"dx_um": "deviations or sphere (R-test)", "dy_um": "deviations or sphere (R-test)",
+               "dz_um": "deviations or sphere (R-test)", "dr_um": "ballbar",
+               "d_mm": "distances", "dd_mm": "distances", "deviation_um": "interferometer",
+               "x_mm,u_mm": "artifact"}
+
+
+def _refuse_other_kind(path, header) -> None:
+    """One line when ``header`` (lower case) holds the reading columns of another file kind
+    (:data:`OTHER_KINDS`): the wrong file given to ``probe-cal``."""
+    hit = [c for c in OTHER_KINDS if all(k in header for k in c.split(","))]
+    if hit:
+        raise InputError(f"{path}: column {hit[0].split(',')[-1]} is a reading of the "
+                         f"{OTHER_KINDS[hit[0]]} format, not master-sphere probing data (x,y,z "
+                         f"ball centres, mm): the wrong file for probe-cal?")
+
+
 def read_sphere_csv(path) -> SphereData:
-    """Read ``x,y,z[,phi_deg,theta_deg]`` (mm, deg); other columns are ignored."""
+    """Read ``x,y,z[,phi_deg,theta_deg]`` (mm, deg); other columns are ignored, except the
+    reading columns of another instrument's file (:data:`OTHER_KINDS`: refused)."""
     path = Path(path)
     rows = _csv_rows(path)
     header = [h.strip().lower() for h in rows[0]]
+    _refuse_other_kind(path, header)
     alias = {"x_mm": "x", "y_mm": "y", "z_mm": "z"}
     header = [alias.get(h, h) for h in header]
     dup = [c for c in ("x", "y", "z", "phi_deg", "theta_deg") if header.count(c) > 1]

@@ -26,7 +26,18 @@ layout: the largest measured span of the linear-axis tables read, else 1000 mm).
   L = 1000 mm, 0.45 mrad for L = 5000 mm).  1 mrad (206 arcsec, 1 mm per metre) is beyond
   any machine axis in use whatever its size.
 
-Sign: the limits bound the magnitude ``|value|``; both signs are alike.
+Sign: the limits bound the magnitude ``abs(value)``; both signs are alike.
+
+**Positions** of a table read from a file, against the axis' travel in the layout
+(:func:`check_positions`): an error table is measured over the travel of its axis (ISO 230-2
+measures over the axis' travel, a rotary axis over its range or a full turn).  A table that
+covers less than :data:`POSITION_COVERAGE_MIN` (a tenth) of the travel while its positions read
+in the other usual unit (radians x 180/pi for a rotary axis, inches x 25.4 for a linear one)
+lie inside the travel and cover at least :data:`POSITION_COVERAGE_UNIT` (half) of it was
+written in that unit: refused naming it (``C`` 0 .. 6.28 of a C axis of -360 .. 360 deg is 0 ..
+360 deg in radians; ``X`` 0 .. 35.4 of a 900 mm axis is 0 .. 900 mm in inches).  The travel of
+an endless rotary axis counts as one turn.  A real partial table whose span happens to be a
+radian or an inch measure of the travel is the exception ``--accept-implausible`` is for.
 """
 
 from __future__ import annotations
@@ -51,6 +62,16 @@ ANGLE_CAP_URAD = 1000.0
 DEFAULT_SIZE_MM = 1000.0
 #: the option that accepts values beyond the limits (named in every refusal)
 OPTION = "--accept-implausible"
+
+#: a table covering less than this fraction of its axis' travel is judged by
+#: :func:`check_positions` (a tenth: the measuring travel of ISO 230-2 is the axis' travel)
+POSITION_COVERAGE_MIN = 0.1
+#: ... and refused when its positions read in the other unit cover at least this fraction
+POSITION_COVERAGE_UNIT = 0.5
+#: the other usual unit of an axis' positions: kind -> (unit, factor to the file's unit, file
+#: unit)
+POSITION_UNITS = {"rotary": ("radians", 180.0 / math.pi, "deg"),
+                  "linear": ("inches", 25.4, "mm")}
 
 #: units a value may really have been written in: name -> (kind, mm or rad per unit); in the
 #: order they are suggested
@@ -171,3 +192,30 @@ def check(values, kind: str, limits: Limits, where: str, what: str,
     if v.size and float(np.abs(v).max()) > limits.of(kind):
         peak = float(v[np.argmax(np.abs(v))])   # signed: as the file or table has it
         raise refusal(where, what, peak, kind, limits, declared, cause, single=v.size == 1)
+
+
+def check_positions(axis: str, positions, machine, where: str) -> None:
+    """Refuse table positions (``axis``'s, mm or deg, increasing) written in radians or inches
+    (module docstring: :data:`POSITION_COVERAGE_MIN`, :data:`POSITION_COVERAGE_UNIT`) against
+    the travel of ``axis`` in ``machine`` (Model or Layout); one-line :class:`InputError`
+    naming ``where``, the column and the likely unit.  An axis the layout lacks: nothing."""
+    layout = getattr(machine, "layout", machine)
+    ax = getattr(layout, "axes", {}).get(axis)
+    if ax is None or ax.kind not in POSITION_UNITS or len(positions) < 2:
+        return
+    t0, t1 = float(ax.travel[0]), float(ax.travel[1])
+    travel = min(t1 - t0, 360.0) if ax.kind == "rotary" else t1 - t0
+    lo, hi = float(positions[0]), float(positions[-1])
+    if not (travel > 0 and 0 < hi - lo < POSITION_COVERAGE_MIN * travel):
+        return
+    unit, factor, given = POSITION_UNITS[ax.kind]
+    lo2, hi2 = lo * factor, hi * factor
+    slack = 0.05 * travel                 # a table may reach a little past the nominal travel
+    if not (t0 - slack <= lo2 and hi2 <= t1 + slack
+            and hi2 - lo2 >= POSITION_COVERAGE_UNIT * travel):
+        return
+    raise InputError(f"{where}: column {axis}: positions {lo:g} .. {hi:g} {given} cover "
+                     f"{(hi - lo) / travel:.1%} of the {t0:g} .. {t1:g} {given} travel of "
+                     f"{layout.name}; read as {unit} (x {factor:.4g}: {lo2:.4g} .. {hi2:.4g} "
+                     f"{given}) they cover it: likely {unit}, not {given}; give {given} "
+                     f"({OPTION} for a table that really covers this little)")

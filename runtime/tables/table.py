@@ -67,7 +67,8 @@ from pathlib import Path
 import numpy as np
 
 from ..machine import iso_names
-from ..units import (MM_PER_UM, RAD_PER_URAD, UM_PER_MM, URAD_PER_RAD, format_number,
+from ..units import (MIN_ANGLE_SPREAD_URAD, MIN_READING_SPREAD_UM, MM_PER_UM, RAD_PER_URAD,
+                     UM_PER_MM, URAD_PER_RAD, check_reading_spread_um, format_number,
                      format_rows, parse_number)
 from ..errors import InputError, require
 from ..fileio import check_magnitude, read_csv_rows, write_text
@@ -411,6 +412,9 @@ def check_magnitudes(tables: dict, constants=None, constants_std=None, constants
         if t.reversal is not None:
             col, unit = cols.get(("RV", ""), (f"RV_{ax}_um", None))
             plausible.check(t.reversal, "length", limits, src, f"column {col}", unit, cause)
+        _check_spread(t, src)
+        if machine is not None and getattr(t, "_source", ""):
+            plausible.check_positions(ax, t.positions, machine, src)
     origin = constants_origin or {}
     csrc = str(Path(where) / "constants.csv") if where else "constants"
     for label, dct in (("", constants), ("std", constants_std), ("u95", constants_u95)):
@@ -418,6 +422,26 @@ def check_magnitudes(tables: dict, constants=None, constants_std=None, constants
             src, unit = origin.get(name, (csrc, None))
             plausible.check([v], parameter_kind(name), limits, src,
                             f"{name} {label}".strip(), unit, cause)
+
+
+def _check_spread(table: ErrorTable, src: str) -> None:
+    """The lower bound of a table read from a file: its error columns headed ``_um`` (and,
+    apart, those headed ``_urad``) must span, the widest of them, at least what any machine
+    and instrument show (:func:`volerr.units.check_reading_spread_um`,
+    :data:`~volerr.units.MIN_READING_SPREAD_UM` 0.05 um,
+    :data:`~volerr.units.MIN_ANGLE_SPREAD_URAD` 0.05 urad): a table in mm under ``_um``
+    (mrad or rad under ``_urad``) spans a thousandth of the real error or less.  Columns without spread (zeros,
+    a constant) say nothing and pass; uncertainty and reversal columns are not judged (a
+    constant backlash or uncertainty is real).  Tables not read from a file (computed, to be
+    written) are not judged: a simulated perfect machine identifies to round-off."""
+    cols = getattr(table, "_columns", None)
+    if not cols:
+        return
+    for unit, scale, minimum in (("um", UM_PER_MM, MIN_READING_SPREAD_UM),
+                                 ("urad", URAD_PER_RAD, MIN_ANGLE_SPREAD_URAD)):
+        heads = {col: table.values[name] * scale for (name, kind), (col, u) in cols.items()
+                 if kind == "" and u == unit and name in table.values}
+        check_reading_spread_um(heads, src, minimum, unit)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -62,6 +62,8 @@ def parse_spec(text: str, option: str = "--spec") -> Spec:
     t = str(text).replace(" ", "")
     m = re.fullmatch(r"(?:MPE_?)?E0?=" + _LEN + r"\+L/" + _NUM + r"(?:[,;](?:MPE_?)?PFTU=" + _LEN
                      + r")?", t, re.IGNORECASE)
+    require(m is not None or not re.search(r"[=+/]-", t),
+            f"{option} {text!r}: A, K and PFTU must be positive (a minus sign)")
     require(m is not None, f"{option} {text!r}: expected \"E0=A+L/K\" (A in um, L in mm, K "
                            f"dimensionless), optionally \",PFTU=P\" (um)")
 
