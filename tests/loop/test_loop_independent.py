@@ -101,9 +101,11 @@ def test_redundant_effect_dropped_by_backward_check(tmp_path):
 
 def test_semicolon_and_tab_separated_read_decimal_comma_refused(tmp_path):
     """Spreadsheet exports: ';' or tab separators are read like commas; a decimal comma is
-    refused with one clear line (it used to read as a text column, then 'missing axis X')."""
-    import subprocess
-    import sys
+    refused with one clear line (it used to read as a text column, then 'missing axis X');
+    the refusal through ``volerr.cli.main`` in this process (``helpers.in_process``: its exit
+    code and lines, a warning appended to stderr; the entry point's own process is
+    tests/cli/test_cli_core.py's)."""
+    from helpers import in_process
 
     cols = sim.campaign("MB1", 200, 5, [])
     text = open(sim.write_csv(str(tmp_path / "c.csv"), cols)).read()
@@ -116,8 +118,7 @@ def test_semicolon_and_tab_separated_read_decimal_comma_refused(tmp_path):
     p = tmp_path / "dc.csv"
     p.write_text(text.replace(",", ";").replace(".", ","))
     before = p.read_bytes()
-    r = subprocess.run([sys.executable, "-m", "volerr", "loop", "MB1", str(p), "--json",
-                        str(tmp_path / "o.json")], capture_output=True, text=True)
+    r = in_process.volerr("loop", "MB1", p, "--json", tmp_path / "o.json")
     assert r.returncode == 2 and "decimal comma" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
     assert p.read_bytes() == before and not (tmp_path / "o.json").exists()

@@ -16,8 +16,13 @@ from volerr.loop.simulate import demo_probes, simulate
 THERMAL = {"kind": "thermal", "axis": "X", "ppm_per_K": 11.5}
 
 
+# At 100 000 points only: the 30 000-point runs (same seed, effect and checks) were the
+# weaker copy.  False outliers grow with n (0.5 expected at 30 000, 1.5 at 100 000 against
+# the bar of 10), so a threshold or scale set too low shows 3.3 times more at 100 000; the
+# robust sigma's sampling error (median of the 3-D length: 0.56 / sqrt(n) relative) is 0.3 %
+# at 30 000 and 0.2 % at 100 000, both far inside the 5 % checked.
 @pytest.mark.slow
-@pytest.mark.parametrize("n", [30_000, 100_000])
+@pytest.mark.parametrize("n", [100_000])
 @pytest.mark.parametrize("effect", [True, False])
 def test_outliers_on_clean_data_are_a_handful(n, effect):
     camp = simulate("MB1", n_points=n, seed=5, probes=demo_probes(volerr.load("MB1")),
