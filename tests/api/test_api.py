@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 import volerr
+from helpers import plan_designs
 from volerr.cli import main
 from volerr.example_files import shipped_path
 
@@ -92,8 +93,13 @@ def test_combination_by_names_equals_the_reported_combination():
 
 @pytest.mark.slow
 def test_plan_equals_the_command(tmp_path, capsys):
-    doc, printed = _cli_json(tmp_path, ["plan", "MB1", "--instrument", "ballbar", "--readings",
-                                        "200", "--out", str(tmp_path / "p")], capsys)
+    """The command's design is kept for tests/cli/test_readme_commands.py's shortest plan
+    (the same request, one xdist group: ``helpers.plan_designs``); the API call below designs
+    its own."""
+    with plan_designs.designed_once():
+        doc, printed = _cli_json(tmp_path, ["plan", "MB1", "--instrument", "ballbar",
+                                            "--readings", "200", "--out", str(tmp_path / "p")],
+                                 capsys)
     p = volerr.plan("MB1", "ballbar", readings=200)
     d = p.to_dict()
     assert d["parameters"] == doc["parameters"]

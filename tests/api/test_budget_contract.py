@@ -2,7 +2,8 @@
 equals the stated u to 1e-6 relative.
 
 Walks every result kind of :mod:`test_result_contract` (its ``CASES``, built by the API on
-the shipped examples, its ``ex`` fixture): for each row of ``table()`` with a standard
+the shipped examples, tests/api/conftest.py's ``ex``; the results themselves, made once
+per process: ``api_result``): for each row of ``table()`` with a standard
 uncertainty u > 0 (a u of 0 is a datum, fixed by definition: no budget), the budget of that
 row (:func:`volerr.report.budget.of_row` over :func:`volerr.report.content.budgets_of` of the
 JSON document) exists, and
@@ -20,7 +21,7 @@ import math
 import numpy as np
 import pytest
 
-from api.test_result_contract import CASES, ex  # noqa: F401  (the fixture, reused)
+from api.test_result_contract import CASES, api_result
 from volerr.report.budget import of_row
 from volerr.report.content import budgets_of
 
@@ -42,9 +43,8 @@ def _combined(b: dict) -> float:
 
 
 @pytest.mark.parametrize("kind", list(CASES))
-def test_every_reported_uncertainty_has_its_budget(kind, ex, monkeypatch):  # noqa: F811
-    monkeypatch.chdir(ex)
-    r = CASES[kind][1]()
+def test_every_reported_uncertainty_has_its_budget(kind, ex):
+    r = api_result(kind, ex)          # the result the result contract checks (one per process)
     budgets = budgets_of(r.to_dict())
     missing, wrong = [], []
     for row in r._rows():

@@ -35,17 +35,10 @@ SPHERE = "sphere:u_um=0.5"
 
 
 @pytest.fixture(scope="module")
-def world(tmp_path_factory):
-    """(folder, reference JSON path, check plan JSON, the empty check file)."""
-    d = tmp_path_factory.mktemp("check")
-    assert main(["plan", LAYOUT, "--instrument", SPHERE, "--readings", "80",
-                 "--out", str(d / "ref")]) == 0
-    plan_fill.fill(d / "ref" / "sphere.csv", LAYOUT, PLANTED, np.random.default_rng(11))
-    assert main(["calibrate", LAYOUT, str(d / "ref" / "sphere.csv"),
-                 "--json", str(d / "cal.json")]) == 0
-    assert main(["check", "plan", LAYOUT, "--reference", str(d / "cal.json"),
-                 "--instrument", SPHERE, "--minutes", "20", "--out", str(d / "plan"),
-                 "--json", str(d / "plan.json")]) == 0
+def world(sphere_campaign):
+    """(folder, reference JSON path, check plan JSON, the empty check file): the campaign of
+    tests/check/conftest.py (shared with test_check_fit_quality.py)."""
+    d = sphere_campaign
     return d, d / "cal.json", json.loads((d / "plan.json").read_text()), d / "plan" / "sphere.csv"
 
 

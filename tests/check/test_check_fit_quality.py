@@ -30,7 +30,8 @@ import pytest
 from helpers import plan_fill
 from volerr.cli import main
 
-pytestmark = pytest.mark.xdist_group("check_fit_quality")
+# the campaign of tests/check/conftest.py once, with test_check.py, on one xdist worker
+pytestmark = pytest.mark.xdist_group("check_world")
 
 LAYOUT = "DMU50"
 PLANTED = {"EX0B": 12.0, "EY0B": -8.0, "EA0B": 35.0, "EB0B": -20.0, "EX0C": 15.0,
@@ -39,20 +40,11 @@ SPHERE = "sphere:u_um=0.5"
 
 
 @pytest.fixture(scope="module")
-def world(tmp_path_factory):
+def world(sphere_campaign):
     """(folder, reference calibration JSON, the plan's empty sphere file, the check plan's
-    empty sphere file)."""
-    d = tmp_path_factory.mktemp("fitq")
-    assert main(["plan", LAYOUT, "--instrument", SPHERE, "--readings", "80",
-                 "--out", str(d / "ref")]) == 0
-    empty = d / "ref_empty.csv"
-    shutil.copy(d / "ref" / "sphere.csv", empty)
-    plan_fill.fill(d / "ref" / "sphere.csv", LAYOUT, PLANTED, np.random.default_rng(11))
-    assert main(["calibrate", LAYOUT, str(d / "ref" / "sphere.csv"),
-                 "--json", str(d / "cal.json")]) == 0
-    assert main(["check", "plan", LAYOUT, "--reference", str(d / "cal.json"),
-                 "--instrument", SPHERE, "--minutes", "20", "--out", str(d / "plan")]) == 0
-    return d, d / "cal.json", empty, d / "plan" / "sphere.csv"
+    empty sphere file): the campaign of tests/check/conftest.py (shared with test_check.py)."""
+    d = sphere_campaign
+    return d, d / "cal.json", d / "ref_empty.csv", d / "plan" / "sphere.csv"
 
 
 def _filled(src, dst, planted, seed):

@@ -5,15 +5,18 @@ fails the test.  The table moved from README.md into the manual's ``docs/command
 
 from __future__ import annotations
 
+import contextlib
 import re
 from pathlib import Path
 
 import pytest
 
+from helpers import plan_designs
 from volerr.cli import main
 
-# the module fixtures once, on one xdist worker (not once per worker)
-pytestmark = pytest.mark.xdist_group("readme_examples")
+# the module fixtures once, on one xdist worker (not once per worker); the group of
+# tests/api/test_api.py, whose command plans the shortest plan's design (helpers.plan_designs)
+pytestmark = pytest.mark.xdist_group("api_examples")
 
 #: the command table lives in the manual's page of every command (the README links it)
 README = Path(__file__).resolve().parents[2] / "docs" / "commands.md"
@@ -100,7 +103,9 @@ def test_shortest_form_runs(examples, command, monkeypatch, capsys):
     monkeypatch.chdir(examples)
     if command == "controller import" and not (examples / "dmu50.isg.csv").exists():
         assert main(["controller", "export", *SHORTEST["controller export"]]) == 0
-    code = main([*command.split(), *SHORTEST[command]])
+    # the plan: the design test_api's command made for the same request in this process
+    with plan_designs.designed_once() if command == "plan" else contextlib.nullcontext():
+        code = main([*command.split(), *SHORTEST[command]])
     captured = capsys.readouterr()
     assert code == 0, captured.err
     assert "Traceback" not in captured.err + captured.out

@@ -158,12 +158,14 @@ def _value(rng, a):
     return rng.uniform(*_range(a))
 
 
-def random_program(seed: int) -> str:
+def random_program(seed: int, n_lines: int = 120) -> str:
+    """A program of ``n_lines`` random lines (plus its head and tail); a shorter program's
+    random lines begin the longer one of the same seed."""
     rng = np.random.default_rng(seed)
     out = ["%", "G90 G1 X0 Y0 Z100 F500" if seed % 2 else "G90 G1 X0 Y0 Z100 B10 C5"]
     incr = False
     cur = {"X": 0.0, "Y": 0.0, "Z": 100.0, "B": 10.0, "C": 5.0}
-    for i in range(120):
+    for i in range(n_lines):
         r = rng.uniform()
         if r < 0.04:
             out.append("G91" if not incr else "G90")
@@ -210,8 +212,16 @@ def random_program(seed: int) -> str:
 @pytest.mark.parametrize("seed", range(10))
 @pytest.mark.parametrize("orientation", [False, True])
 def test_whole_chunk_path_writes_the_line_by_line_bytes(setup, seed, orientation, monkeypatch):
+    """The plain programs (seeds 0-7) have 60 random lines, the TCPM programs 120 (the
+    suite's time, session 9: 120 plain lines before).  A chunk of one line costs a solve per
+    line (most of this test's time); at 60 lines the eight plain programs still hold 11
+    switches to G91 and 11 back, 7 G28 blocks, 19 comment-only lines and 48 T / H words (18,
+    18, 12, 30, 96 at 120 lines), chunks of 7 and 25 lines still end 8 and 2 times inside
+    every program, and each deliberate break of the whole-chunk path tried
+    (benchmarks/suite_time/session9_nonloop.md) fails here as it did at 120 lines.  The TCPM
+    programs keep 120 lines: at 60, seed 8 has 10 TCPM blocks."""
     m, funcs = setup
-    text = random_program(seed)
+    text = random_program(seed, 120 if seed >= 8 else 60)
     init = {"B": 10.0, "C": 5.0} if seed % 2 else {}
     kw = {}
     if seed >= 8:       # TCPM: the axis positions may leave the travel and the tables
@@ -223,7 +233,7 @@ def test_whole_chunk_path_writes_the_line_by_line_bytes(setup, seed, orientation
     assert ref.text != text
     if seed >= 8:
         assert ref.summary()["tcpm_blocks"] > 50
-    for k in (None, 1, 7, 50) if seed < 8 else (None, 13):
+    for k in (None, 1, 7, 25) if seed < 8 else (None, 13):
         got = compensate_program(m, funcs, text, orientation=orientation, initial=init,
                                  chunk_lines=k, **kw)
         assert got.text == ref.text, k

@@ -319,7 +319,8 @@ def _controller_rule(m, vectors, previous):
         for branch in (1.0, -1.0):
             r = [float(np.rad2deg(v)) for v in m.module.inverse_rotary(*k, branch)]
             q = np.r_[0.0, 0.0, 0.0, r]
-            turns = [np.linalg.norm((_axis(m, q + 1e-7 * np.eye(5)[3 + j]) - _axis(m, q))
+            at_q = _axis(m, q)
+            turns = [np.linalg.norm((_axis(m, q + 1e-7 * np.eye(5)[3 + j]) - at_q)
                                     / np.deg2rad(1e-7)) for j in range(2)]
             sols.append([x if t > 1e-6 else None for x, t in zip(r, turns)])
         best = None

@@ -107,8 +107,9 @@ class Plan:
         self.option = REQUEST.get(name)
         if self.option:
             args += ["--parameters", self.option]
-        self.proc = run(*args, "--readings", n, "--out", self.dir, "--json", self.json,
-                        "--seed", 1)
+        with plan_designs.designed_once():   # kept for test_output_folder_with_files_needs_force
+            self.proc = run(*args, "--readings", n, "--out", self.dir, "--json", self.json,
+                            "--seed", 1)
         assert self.proc.returncode == 0, self.proc.stderr[-3000:]
         self.doc = json.loads(self.json.read_text())
         self.machine = S.Machine(layout)
@@ -432,13 +433,15 @@ def test_bad_input_one_line_nothing_written(plan_exists, tmp_path, what):
         q.name for q in tmp_path.iterdir())
 
 
+@pytest.mark.xdist_group("plan_MB1-ballbar")
 def test_output_folder_with_files_needs_force(plan_exists, tmp_path):
     """A second plan into a folder holding the first one's files: refused without --force
     (one line, nothing changed, no JSON), done with it.  The three runs ask for one design,
-    made once (``helpers.plan_designs``): what is checked is the command's output folder."""
+    made once (``helpers.plan_designs``): what is checked is the command's output folder.
+    The request is the MB1-ballbar case's, in its xdist group: its design, made there."""
     out = tmp_path / "out"
-    args = ["plan", "MB1", "--instrument", "ballbar:lengths=100,150", "--readings", "100",
-            "--out", out]
+    layout, specs, n, _, _ = CASES["MB1-ballbar"]
+    args = ["plan", layout, "--instrument", *specs, "--readings", n, "--seed", 1, "--out", out]
     with plan_designs.designed_once():
         r = run(*args, "--json", tmp_path / "first.json")
     assert r.returncode == 0, r.stderr[-2000:]

@@ -394,22 +394,8 @@ def _short_arcs(canonical: str) -> bool:
 
 
 # ---- the command line ----------------------------------------------------------------------
-def test_dialect_option_writes_that_dialect(tmp_path):
-    import json
-
-    from volerr.cli import main
-
-    out, js = tmp_path / "plan", tmp_path / "plan.json"
-    assert main(["plan", "MB1", "--instrument", "interferometer", "--readings",
-                 "1200", "--dialect", "heidenhain", "--out", str(out), "--json", str(js)]) == 0
-    doc = json.loads(js.read_text())
-    assert doc["nc_dialect"] == "heidenhain"
-    for f in doc["files"]:
-        assert f["nc"].endswith(".h")
-        text = (out / f["nc"]).read_text()
-        assert text.startswith("0 BEGIN PGM ") and "CYCL DEF 9.1 DWELL 3" in text
-        assert max(map(len, text.splitlines())) < 254
-    assert not list(out.glob("*.nc"))
+# test_dialect_option_writes_that_dialect: in tests/planning/test_plan_interferometer.py (the
+# same plan in another dialect: one design for both)
 
 
 @pytest.mark.parametrize("bad", ["ISO"])

@@ -10,8 +10,14 @@ from pathlib import Path
 
 import pytest
 
+from helpers import plan_designs
 from volerr.cli import main
 from volerr.example_files import shipped_path
+
+# the module fixture once, on one xdist worker; the group of tests/api/test_api.py and
+# tests/cli/test_readme_commands.py, whose commands plan the same MB1 ballbar plan (one design
+# per process: helpers.plan_designs)
+pytestmark = pytest.mark.xdist_group("api_examples")
 
 
 @pytest.fixture(scope="module")
@@ -21,8 +27,9 @@ def planned(tmp_path_factory):
                  "--json", str(d / "cal.json")]) == 0
     assert main(["check", "plan", "DMU50", "--reference", str(d / "cal.json"), "--instrument",
                  "sphere:u_um=0.5", "--out", str(d / "chk")]) == 0
-    assert main(["plan", "MB1", "--instrument", "ballbar", "--readings", "200", "--out",
-                 str(d / "plan")]) == 0
+    with plan_designs.designed_once():
+        assert main(["plan", "MB1", "--instrument", "ballbar", "--readings", "200", "--out",
+                     str(d / "plan")]) == 0
     return d
 
 

@@ -16,7 +16,7 @@ import pytest
 
 from helpers import instrument_sim as S
 from helpers import metrology_sim as M
-from helpers import plan_fill
+from helpers import plan_designs, plan_fill
 from volerr.calibrate.run import calibrate
 from volerr.cli import main
 from volerr.machine.layout import read_layout
@@ -34,7 +34,8 @@ PLANTED = {"EXX@slope": 0.010, "EYY@slope": -0.008, "EZZ@slope": 0.005, "EYX@P2"
 def plan(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("interferometer")
     out, js = tmp / "plan", tmp / "plan.json"
-    assert main(["plan", *PLAN, "--out", str(out), "--json", str(js)]) == 0
+    with plan_designs.designed_once():    # the design shared with the Heidenhain plan below
+        assert main(["plan", *PLAN, "--out", str(out), "--json", str(js)]) == 0
     return out, json.loads(js.read_text())
 
 
@@ -170,3 +171,22 @@ def test_nc_program_passes_through_the_rows_with_a_dwell(plan):
                 assert lines[i + 1].startswith("G4 P")
                 k += 1
         assert k == len(rows), f["file"]
+
+
+def test_dialect_option_writes_that_dialect(plan, tmp_path):
+    """``--dialect heidenhain``: the module's plan (its design made once: ``plan`` asks for it
+    first, ``helpers.plan_designs``; the dialect is applied when the command writes the plan)
+    written as Heidenhain programs.  Moved here from tests/plan/test_plan_nc.py (the suite's
+    time, session 9), where it designed the same plan again."""
+    out, js = tmp_path / "plan", tmp_path / "plan.json"
+    with plan_designs.designed_once():
+        assert main(["plan", *PLAN, "--dialect", "heidenhain", "--out", str(out), "--json",
+                     str(js)]) == 0
+    doc = json.loads(js.read_text())
+    assert doc["nc_dialect"] == "heidenhain"
+    for f in doc["files"]:
+        assert f["nc"].endswith(".h")
+        text = (out / f["nc"]).read_text()
+        assert text.startswith("0 BEGIN PGM ") and "CYCL DEF 9.1 DWELL 3" in text
+        assert max(map(len, text.splitlines())) < 254
+    assert not list(out.glob("*.nc"))
