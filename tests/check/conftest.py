@@ -9,10 +9,7 @@ import shutil
 import numpy as np
 import pytest
 
-LAYOUT = "DMU50"
-PLANTED = {"EX0B": 12.0, "EY0B": -8.0, "EA0B": 35.0, "EB0B": -20.0, "EX0C": 15.0,
-           "EY0C": -10.0, "EA0C": 25.0, "EB0C": -40.0}
-SPHERE = "sphere:u_um=0.5"
+from helpers.check_world import LAYOUT, PLANTED, SPHERE  # noqa: F401 (shared campaign)
 
 
 @pytest.fixture(scope="session")

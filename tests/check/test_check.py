@@ -28,10 +28,7 @@ from volerr.cli import main
 # the module fixtures once, on one xdist worker (not once per worker)
 pytestmark = pytest.mark.xdist_group("check_world")
 
-LAYOUT = "DMU50"
-PLANTED = {"EX0B": 12.0, "EY0B": -8.0, "EA0B": 35.0, "EB0B": -20.0, "EX0C": 15.0,
-           "EY0C": -10.0, "EA0C": 25.0, "EB0C": -40.0}
-SPHERE = "sphere:u_um=0.5"
+from helpers.check_world import LAYOUT, PLANTED, SPHERE  # noqa: F401 (shared campaign)
 
 
 @pytest.fixture(scope="module")
