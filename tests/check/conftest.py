@@ -9,7 +9,7 @@ import shutil
 import numpy as np
 import pytest
 
-from helpers.check_world import LAYOUT, PLANTED, SPHERE  # noqa: F401 (shared campaign)
+from helpers.check_world import LAYOUT, PLANTED, SPHERE
 
 
 @pytest.fixture(scope="session")

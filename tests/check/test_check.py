@@ -28,7 +28,7 @@ from volerr.cli import main
 # the module fixtures once, on one xdist worker (not once per worker)
 pytestmark = pytest.mark.xdist_group("check_world")
 
-from helpers.check_world import LAYOUT, PLANTED, SPHERE  # noqa: F401 (shared campaign)
+from helpers.check_world import LAYOUT, PLANTED, SPHERE
 
 
 @pytest.fixture(scope="module")

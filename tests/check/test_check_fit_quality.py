@@ -33,7 +33,7 @@ from volerr.cli import main
 # the campaign of tests/check/conftest.py once, with test_check.py, on one xdist worker
 pytestmark = pytest.mark.xdist_group("check_world")
 
-from helpers.check_world import LAYOUT, PLANTED, SPHERE  # noqa: F401 (shared campaign)
+from helpers.check_world import LAYOUT, PLANTED
 
 
 @pytest.fixture(scope="module")
