@@ -261,3 +261,27 @@ def _bordered_test(fit, TG, Th, Tyy, W, a, b):
     sse = (Tyy - 2 * (B.T @ hkS + beta * hkc) + np.einsum("ij,ij->j", B, GkSS @ B)
            + 2 * beta * np.einsum("ij,ij->j", B, GkSc) + beta ** 2 * Gkcc)
     return np.where(ok, sse, np.inf), float(sse0)
+
+
+def rss_stack(G, h, yy: float, fixed, cands) -> np.ndarray:
+    """RSS (X, nc) of the least-squares fits on one set of cross-products ``G`` = Z'Z, ``h``
+    = Z'y, ``yy`` = y'y with Z's columns ``fixed[x]`` (``fixed`` (X, s) indices: a stack of
+    models, one a row) plus each single column ``cands[c]`` in turn: the bordered system of
+    :func:`_bordered_fit` batched over the models (one pseudo-inverse of ``G[f, f]`` per
+    model, rcond 1e-12; the candidate's gain ``(h_c - u' b0)^2 / schur`` taken from the
+    model's RSS).  A candidate dependent on the model (Schur complement below ``SINGULAR``
+    of c'c) adds nothing: the model's RSS, as a pseudo-inverse of the whole system gives it.
+    An exact fit lands at the rounding floor: returned as 0."""
+    g = G[fixed[:, :, None], fixed[:, None, :]]                     # (X, s, s)
+    hf = h[fixed]                                                   # (X, s)
+    Minv = np.linalg.pinv(g, rcond=1e-12, hermitian=True)
+    b0 = (Minv @ hf[..., None])[..., 0]
+    rss0 = yy - 2 * np.einsum("xi,xi->x", b0, hf) + np.einsum("xi,xij,xj->x", b0, g, b0)
+    U = G[fixed[:, :, None], cands[None, None, :]]                  # (X, s, nc)
+    v = G[cands, cands]
+    Zm = Minv @ U
+    schur = v - np.einsum("xic,xic->xc", U, Zm)
+    r = h[cands] - np.einsum("xic,xi->xc", U, b0)
+    ok = schur > SINGULAR * np.maximum(v, 1e-300)
+    gain = np.where(ok, r ** 2 / np.where(ok, schur, 1.0), 0.0)
+    return np.maximum(rss0[:, None] - gain, 0.0)

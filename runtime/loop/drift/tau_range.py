@@ -19,7 +19,12 @@ inside in 39 of 48 and 39 of 48 pairs on fresh seeds, the jackknife's tau +- 2 u
 
 Cost: the cross-products (Gram) of [run zeros, the unlagged terms' columns, every lagged
 term's column at its tau and at every trial tau, y] once per channel; every RSS from their
-sub-blocks (batched over the trial values).  Above ``THIN_ABOVE`` training readings the Gram
+sub-blocks, the columns scaled to unit norm: per coordinate pass and trial value of term i,
+one pseudo-inverse of the model without the other term's trial column, every trial column
+then added by the bordered system (:func:`volerr.loop.drift.engine.rss_stack`; the same
+RSS as a pseudo-inverse of every trial's whole system, to about 1e-11 relative on the
+FL_THERMAL windows, every choice and printed range the same: benchmarks/speed_drift,
+session 9).  Above ``THIN_ABOVE`` training readings the Gram
 is taken on every k-th training reading of each run (k = ceil(n / ``THIN_ABOVE``)): the
 threshold is a ratio of RSS, nearly unchanged by thinning columns smooth over many readings.
 
@@ -35,6 +40,7 @@ import numpy as np
 from ...machine.lags import lag
 from ...selection.rules import f_quantile
 from . import basis
+from .engine import rss_stack
 from .family import SUB_BLOCKS
 
 __all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "ranges"]
@@ -42,7 +48,6 @@ __all__ = ["CONFIDENCE", "SUB", "THIN_ABOVE", "ranges"]
 SUB = 4               # trial values of ln tau per grid step
 CONFIDENCE = 0.95     # the F quantile of the threshold (two-sided 95 %: "k = 2")
 THIN_ABOVE = 20000    # training readings above which the Gram is taken on thinned readings
-RCOND = 1e-12         # as :func:`volerr.selection.linalg.solve_scaled`
 
 
 def ranges(ch, specs, fit) -> list:
@@ -68,7 +73,7 @@ def ranges(ch, specs, fit) -> list:
             at += len(xs)
         trial[i] = seen[key]
     A = np.column_stack(cols + [ch.y[rows]])
-    G = A.T @ A
+    scaled = _scaled(A.T @ A)
     n_runs = ch.R.shape[1]
     cur = {i: n_runs + i for i in range(len(specs))}
     D = fit["design"][tr]
@@ -78,7 +83,7 @@ def ranges(ch, specs, fit) -> list:
     out = [None] * len(specs)
     for i in lagged:
         x, pos = _trials(xs, math.log(specs[i]["tau_s"]), trial[i], cur[i])
-        rss = _profile(G, n_runs, cur, trial, lagged, i, pos)
+        rss = _profile(scaled, n_runs, cur, trial, lagged, i, pos)
         out[i] = _interval(x, rss, rss.min() * rise)
     return out
 
@@ -92,43 +97,42 @@ def _trials(xs, x0, trial, here) -> tuple:
     return x, pos
 
 
-def _profile(G, n_runs, cur, trial, lagged, i, pos) -> np.ndarray:
+def _profile(scaled, n_runs, cur, trial, lagged, i, pos) -> np.ndarray:
     """RSS (um^2) at each trial column ``pos`` of term ``i``: the other lagged terms'
     columns chosen by one coordinate pass in their order, each the least RSS of its trials
-    ``trial[j]`` with the others at their current columns (the fitted taus at the start)."""
+    ``trial[j]`` with the others at their current columns (the fitted taus at the start);
+    ``scaled`` the Gram of :func:`_scaled`."""
     X = len(pos)
     now = np.array([[cur[k] for k in sorted(cur)] for _ in range(X)])   # (X, terms)
     now[:, i] = pos
+    runs = np.broadcast_to(np.arange(n_runs), (X, n_runs))
     best = None
     for j in [k for k in lagged if k != i]:
         T = trial[j]
-        idx = np.concatenate([np.broadcast_to(np.arange(n_runs), (X, len(T), n_runs)),
-                              np.broadcast_to(np.delete(now, j, axis=1)[:, None, :],
-                                              (X, len(T), now.shape[1] - 1)),
-                              np.broadcast_to(T[None, :, None], (X, len(T), 1))], axis=2)
-        r = _rss(G, idx)                                     # (X, T)
+        r = _rss(scaled, np.concatenate([runs, np.delete(now, j, axis=1)], axis=1), T)
         k = np.argmin(r, axis=1)
         now[:, j] = T[k]
         best = r[np.arange(X), k]
-    if best is None:
-        idx = np.concatenate([np.broadcast_to(np.arange(n_runs), (X, n_runs)), now], axis=1)
-        best = _rss(G, idx)
+    if best is None:          # no other lagged term: the other columns the same at every x
+        best = _rss(scaled, np.r_[np.arange(n_runs), np.delete(now[0], i)][None, :], pos)[0]
     return best
 
 
-def _rss(G, idx) -> np.ndarray:
-    """RSS of y (the Gram's last column) on the columns ``idx`` (..., m) of the Gram ``G``,
-    solved as :func:`volerr.selection.linalg.solve_scaled` solves (columns scaled to unit
-    norm, Hermitian pseudo-inverse; a column all zero gets 0)."""
-    g = G[idx[..., :, None], idx[..., None, :]]
-    h = G[idx, -1]
-    d = np.sqrt(np.diagonal(g, axis1=-2, axis2=-1))
+def _scaled(G) -> tuple:
+    """The Gram's columns scaled to unit norm (a column all zero kept: its scale 1), as
+    :func:`volerr.selection.linalg.solve_scaled` scales: (Z'Z, Z'y, y'y) of the scaled
+    columns (the RSS is that of the unscaled ones)."""
+    d = np.sqrt(np.diag(G)[:-1])
     d = np.where(d > 0, d, 1.0)
-    gs = g / (d[..., :, None] * d[..., None, :])
-    b = (np.linalg.pinv(gs, rcond=RCOND, hermitian=True) @ (h / d)[..., None])[..., 0] / d
-    yy = G[-1, -1]
-    quad = np.einsum("...i,...ij,...j->...", b, g, b)
-    return np.maximum(yy - 2 * np.einsum("...i,...i->...", b, h) + quad, 0.0)
+    return G[:-1, :-1] / np.outer(d, d), G[:-1, -1] / d, float(G[-1, -1])
+
+
+def _rss(scaled, fixed, T) -> np.ndarray:
+    """RSS (len(fixed), len(T)) of y on the columns ``fixed[x]`` of the Gram plus each trial
+    column ``T[t]`` in turn, on the scaled columns (:func:`_scaled`): the bordered system of
+    :func:`volerr.loop.drift.engine.rss_stack`, one pseudo-inverse per row of ``fixed``."""
+    Gs, hs, yy = scaled
+    return rss_stack(Gs, hs, yy, fixed, np.asarray(T))
 
 
 def _interval(x, rss, thr) -> list:
