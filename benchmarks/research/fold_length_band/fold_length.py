@@ -52,22 +52,42 @@ def long_folds(ch) -> tuple:
     return f, K
 
 
+MODE = os.environ.get("FOLD_LENGTH", "")
+
+
 def long_scores(ch, out, cols, Z) -> tuple:
-    """(cv_resid, sigma, fold) of the chosen family on the long folds (module docstring)."""
+    """(cv_resid, sigma, fold, K, diagnostics) of the chosen family on the long folds (module
+    docstring); ``FOLD_LENGTH=2`` (RULE.md addendum 1): the regularised fit's lambda and the
+    autocorrelation factor ``c`` kept at today's (the six folds'), those of the held-out
+    readings' ``sigma``."""
     fold, K = long_folds(ch)
+    lams = shrink.LAMBDAS
+    if MODE == "2":
+        shrink.LAMBDAS = np.array([out["shrink"]["lambda_rel"]])
     chl = dataclasses.replace(ch, fold=fold)
     fam = out["choice"]["family"]
     designs = {"constant": ch.R, "static": fit._static_design(ch), "lag": out["fit"]["design"]}
     cache = {}
     keep = out["shrink"]["keep"]
-    reg = shrink.fit(ch.s, ch.y, Z, keep, [cols[j - ch.n_runs] for j in keep], fold,
-                     ch.rule, cache)
+    try:
+        reg = shrink.fit(ch.s, ch.y, Z, keep, [cols[j - ch.n_runs] for j in keep], fold,
+                         ch.rule, cache)
+    finally:
+        shrink.LAMBDAS = lams
     reg["keep"] = keep
     r = reg["cv_resid"] if fam == "regularised" else family.cv_residuals(chl, designs[fam])
     lev = fit._leverage(chl, fam, designs, reg, Z, cache)
-    rho = band.autocorrelation(r, fold)
+    rho_long = band.autocorrelation(r, fold)
+    rho_today = band.autocorrelation(out["choice"]["cv_resid"], ch.fold)
+    rho = rho_today if MODE == "2" else rho_long
     sigma = np.sqrt(1.0 + (1.0 + rho) / (1.0 - rho) * np.nan_to_num(lev, nan=0.0))
-    return r, sigma, fold, K
+    tr = fold >= 0
+    diag = {"lambda_today": out["shrink"]["lambda_rel"], "lambda_long": reg["lambda_rel"],
+            "rho_today": rho_today, "rho_long": rho_long,
+            "cv_rms_long": float(np.sqrt(np.nanmean(r[tr] ** 2))),
+            "cv_rms_today": float(np.sqrt(np.nanmean(out["choice"]["cv_resid"][ch.fold >= 0] ** 2))),
+            "median_sigma_long": float(np.nanmedian(sigma[tr]))}
+    return r, sigma, fold, K, diag
 
 
 _c2_channel = nested_band._channel
@@ -77,8 +97,8 @@ def _channel(ch, cols, Z, cands, cache):
     """Candidate 2's channel (the nested choice), then ``q`` on the long folds."""
     out = _c2_channel(ch, cols, Z, cands, cache)
     label = next((l for l, v in ch.s.channels.items() if v is ch.y), "?")
-    r, sigma, fold, K = long_scores(ch, out, cols, Z)
-    _q_long[label] = (nested_band.expected_q(r, sigma, fold), K)
+    r, sigma, fold, K, diag = long_scores(ch, out, cols, Z)
+    _q_long[label] = (nested_band.expected_q(r, sigma, fold), K, diag)
     return out
 
 
@@ -91,7 +111,7 @@ def interval(cv_resid, y, pred, fold, test, lev=None) -> dict:
     label = nested_band._state["label"]
     if label not in _q_long:
         return iv
-    q_long, K = _q_long[label]
+    q_long, K, diag = _q_long[label]
     q_c2 = iv["q"]
     hw = np.asarray(iv["per_reading"]) * (q_long / q_c2)
     e = np.abs((y - pred)[test])
@@ -104,7 +124,9 @@ def interval(cv_resid, y, pred, fold, test, lev=None) -> dict:
                                 "K_long": K, "q_c2": q_c2, "q_long": q_long,
                                 "n_test": int(len(e)),
                                 "inside_c2": int(np.sum(e <= iv["per_reading"][test])),
-                                "inside_long": int(np.sum(e <= hw[test]))}) + "\n")
+                                "inside_long": int(np.sum(e <= hw[test])),
+                                "median_sigma_test": float(np.median(iv["per_reading"][test]) / q_c2),
+                                **diag}) + "\n")
     at = hw[test] if np.any(test) else hw
     iv.update({"half_width_um": float(np.median(at)),
                "half_width_um_range": [float(np.min(at)), float(np.max(at))], "q": q_long,
