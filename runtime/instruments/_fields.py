@@ -5,7 +5,6 @@ the column and, where it helps, the row."""
 
 from __future__ import annotations
 
-import hashlib
 import re
 
 import numpy as np
@@ -438,29 +437,11 @@ def _longest_equal(v: np.ndarray) -> tuple[int, int]:
     return int(starts[k]), int(ends[k] - starts[k])
 
 
-#: results of :func:`change_scores` kept, by the digest of the readings' bytes (a drift
-#: file's inputs are scored by its faults, then again by the split's extrapolation check)
-SCORES_KEPT = 64
-_scores: dict = {}
-
-
 def change_scores(v) -> tuple[np.ndarray, float]:
     """(z, s): every reading-to-reading change of ``v`` about its local trend in units of the
     sensor's robust scale ``s`` (block comment above; z[i] the change from reading i to i+1;
-    ``s`` = 0 (a sensor without noise, e.g. a commanded speed): any change scores inf).
-    The same readings (the same bytes) give the kept result (``z`` a fresh copy)."""
-    v = np.ascontiguousarray(v, float)
-    key = (len(v), hashlib.blake2b(v, digest_size=32).digest())
-    if key not in _scores:
-        if len(_scores) >= SCORES_KEPT:
-            del _scores[next(iter(_scores))]
-        _scores[key] = _change_scores(v)
-    z, s = _scores[key]
-    return z.copy(), s
-
-
-def _change_scores(v: np.ndarray) -> tuple[np.ndarray, float]:
-    """:func:`change_scores` computed."""
+    ``s`` = 0 (a sensor without noise, e.g. a commanded speed): any change scores inf)."""
+    v = np.asarray(v, float)
     d1 = np.diff(v)
     if len(d1) < 3:
         return np.zeros(len(d1)), 0.0
