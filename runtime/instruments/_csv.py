@@ -99,19 +99,12 @@ def read_columns(path) -> Columns:
     require(twice is None, f"{p.name}: duplicate column names ({twice!r} appears "
                            f"{header.count(twice)} times; every column once)")
     body = rows[1:]
-    widths = list(map(len, body))
-    if widths.count(len(header)) != len(body):
-        i = next(i for i, w in enumerate(widths) if w != len(header))
-        require(False, f"{p.name}: row {i + 2} has {widths[i]} fields, the header "
-                f"{len(header)}")
+    for i, r in enumerate(body):
+        require(len(r) == len(header), f"{p.name}: row {i + 2} has {len(r)} fields, "
+                f"the header {len(header)}")
     cols, text, labels = {}, {}, {}
-    for h, cells in zip(header, zip(*body)):
-        try:        # every cell a number: float() strips white space as str.strip() does
-            cols[h] = np.asarray(list(map(float, cells)))
-            continue
-        except ValueError:
-            pass
-        raw = [s.strip() for s in cells]
+    for j, h in enumerate(header):
+        raw = [r[j].strip() for r in body]
         vals, bad = _floats(raw)
         if body and not any(raw):      # a header over nothing: readings not filled in
             text[h] = f"{p.name}: column {h} {EMPTY_COLUMN}"
