@@ -447,7 +447,12 @@ def change_scores(v) -> tuple[np.ndarray, float]:
         return np.zeros(len(d1)), 0.0
     w = min(STEP_WINDOW, (len(d1) - 1) // 2)
     pad = np.pad(d1, w, mode="edge")
-    trend = np.median(np.lib.stride_tricks.sliding_window_view(pad, 2 * w + 1), axis=1)
+    win = np.lib.stride_tricks.sliding_window_view(pad, 2 * w + 1)
+    # the median of an odd window is its middle element: one partition at w (np.median also
+    # partitions at the end to find a NaN, and takes a mean of the one element); with a NaN
+    # np.median (NaN there).  A zero's sign may differ between the two: e == 0 below sees none
+    trend = (np.partition(win, w, axis=1)[:, w] if not np.isnan(d1).any()
+             else np.median(win, axis=1))
     start, steps = _longest_equal(v)
     keep = np.ones(len(v), bool)
     keep[start:start + steps + 1] = steps == 0

@@ -43,23 +43,23 @@ class Engine:
             first[r] = (y if zero is None else zero)[idx[0]] if len(idx) else 0.0
         self.fold_fit, self.fold_test = [], []
         for k in range(self.K):
-            m = fold == k
+            m = _rows_of(fold == k, Z, y)
+            Zk = Z[m]
             if ("fit", k) not in cache:
-                Zk = Z[m]
                 cache[("fit", k)] = Zk.T @ Zk
                 if by_runs:
                     Zt = Zk.copy()
                     Zt[:, :n_runs] = 0.0
                     cache[("test", k)] = (Zt, Zt.T @ Zt)
             Gk, yk = cache[("fit", k)], y[m]
-            fit = (Gk, Z[m].T @ yk, float(yk @ yk))
+            fit = (Gk, Zk.T @ yk, float(yk @ yk))
             self.fold_fit.append(fit)
             if by_runs:
                 Zt, TG = cache[("test", k)]
                 yt = yk - first[run[m]]
-                self.fold_test.append((TG, Zt.T @ yt, float(yt @ yt), int(m.sum())))
+                self.fold_test.append((TG, Zt.T @ yt, float(yt @ yt), len(yk)))
             else:
-                self.fold_test.append(fit + (int(m.sum()),))
+                self.fold_test.append(fit + (len(yk),))
         self._data = (Z, y, fold, run, first)
         self.G = sum(f[0] for f in self.fold_fit)
         self.h = sum(f[1] for f in self.fold_fit)
@@ -152,6 +152,18 @@ class Engine:
         W = Sel(W)
         return _bordered(self.G, self.h, self.G, self.h, self.yy,
                          W.take(self._active(W, self.G)), a, b)
+
+
+def _rows_of(mask, *arrays):
+    """The readings of ``mask`` (N,) as an index into the rows of ``arrays``: a slice (a view,
+    no copy) where they are one contiguous block and every array is C-contiguous, else their
+    indices.  A contiguous block of a C-contiguous array has the layout of its gathered copy,
+    so the products of either have the same bits."""
+    idx = np.flatnonzero(mask)
+    if (len(idx) and idx[-1] - idx[0] + 1 == len(idx)
+            and all(a.flags.c_contiguous for a in arrays)):
+        return slice(int(idx[0]), int(idx[-1]) + 1)
+    return idx
 
 
 def _pair(Mat, a, b):
