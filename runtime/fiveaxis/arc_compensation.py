@@ -108,13 +108,7 @@ def _path_deviation(em, q_mid: np.ndarray, paths, owner, lin, direction=None) ->
     """Distance (mm) of the predicted actual tool tip at the axis positions ``q_mid`` from
     the nominal arc of their owner: the actual tip mapped back into axis space through the
     nominal kinematics (affine in the linear axes for fixed rotary positions)."""
-    m = em.model
-    actual = m.nominal_position(q_mid, em.tool) + em.position_error(q_mid, None, direction)
-    # axis positions whose nominal tip is the actual tip: one Newton step is exact (affine)
-    jac = linear_jacobian(m, q_mid, em.tool)
-    q_back = q_mid.copy()
-    q_back[:, lin] += np.linalg.solve(jac, (actual - m.nominal_position(q_mid, em.tool))
-                                      [:, :, None])[:, :, 0]
+    q_back = actual_in_axes(em, q_mid, lin, direction)
     out = np.empty(len(q_mid))
     pos = 0
     nf = len(CHECK_AT)
@@ -123,3 +117,17 @@ def _path_deviation(em, q_mid: np.ndarray, paths, owner, lin, direction=None) ->
         out[pos:pos + m_rows] = paths[i].distance(q_back[pos:pos + m_rows])
         pos += m_rows
     return out
+
+
+def actual_in_axes(em, q: np.ndarray, lin, direction=None) -> np.ndarray:
+    """The predicted actual tool tip at the axis positions ``q`` (k, n_axes), expressed as
+    the axis positions (mm / deg) whose nominal tip it is: the rotary axes held, the linear
+    axes (indices ``lin``) moved by ``M^-1 e(q)``, ``M`` the derivative of the nominal tip by
+    the linear axes (one Newton step is exact: the nominal chain is affine in them)."""
+    m = em.model
+    actual = m.nominal_position(q, em.tool) + em.position_error(q, None, direction)
+    jac = linear_jacobian(m, q, em.tool)
+    q_back = q.copy()
+    q_back[:, lin] += np.linalg.solve(jac, (actual - m.nominal_position(q, em.tool))
+                                      [:, :, None])[:, :, 0]
+    return q_back

@@ -292,6 +292,14 @@ def console_lines(data: dict, job: Job, wrote=None) -> list:
                      f"{arcs['max_path_deviation_um']:.3g} um); {arcs['kept']} kept as arcs")
     elif arcs["kept"]:
         lines.append(f"arcs: {arcs['kept']} kept as arcs (end point and centre corrected)")
+    ln = s["lines"]
+    if ln["sampled"]:
+        lines.append(f"G1 moves: predicted path within {ln['max_path_deviation_um']:.3g} um of "
+                     f"the nominal line (max at line {ln['line']}; {ln['sampled']} moves "
+                     "sampled between their corrected ends; G0 rapids not: not cut)")
+    if ln["tcpm_not_sampled"]:
+        lines.append(f"G1 moves under TCPM not sampled ({ln['tcpm_not_sampled']}): the "
+                     "controller interpolates the tool tip")
     if s["max_u_after_um"] > 0:
         lines.append(f"standard uncertainty of the remaining error (tables' _std and _s, "
                      f"k = 1): max {s['max_u_after_um']:.3f} um")

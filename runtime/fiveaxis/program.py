@@ -35,6 +35,7 @@ from ..nc import gcode, tcpm
 from ..nc.interpret import CHUNK_LINES, Blocks, interpret, prescan
 from ..nc.writer import Writer
 from . import tcpm_kinematics
+from .line_path import LinePaths
 from .compensate import (STRATEGIES, ErrorModel, parameters_for_types, resolve_linear, solve,
                          solve_thesis)
 from ..machine.kinematics import inverse, is_five_axis, linear_axes
@@ -484,6 +485,9 @@ class Chunk:
     strategy: str
     w_out: np.ndarray = None
     arcs: dict = field(default_factory=dict)
+    #: row -> predicted path deviation (um) of its G1 move (:mod:`volerr.fiveaxis.line_path`;
+    #: key -1: the TCPM G1 moves not sampled)
+    lines: dict = field(default_factory=dict)
 
     def status(self, r: int) -> str:
         if self.strategy == "thesis":
@@ -512,6 +516,9 @@ class Summary:
         self.max_iter = 0
         self.arcs_kept = self.arcs_linearised = self.segments = self.tcpm = 0
         self.max_arc_dev = 0.0
+        #: G1 moves sampled, the largest path deviation (um) and its line, TCPM G1 moves
+        self.lines_sampled = self.lines_tcpm = 0
+        self.max_line_dev, self.max_line_at = 0.0, None
         #: written minus programmed position per axis: max |.| and sum of squares (mm / deg)
         self.corr_max = self.corr_sq = None
 
@@ -530,6 +537,7 @@ class Summary:
                 self.arcs_linearised += 1
                 self.segments += len(res.points)
             self.max_arc_dev = max(self.max_arc_dev, res.deviation_um)
+        self.add_lines(chunk)
         if b.frame is not None:
             self.tcpm += int(np.count_nonzero(b.frame))
         if n:
@@ -549,6 +557,17 @@ class Summary:
                 self.corr_max, self.corr_sq = np.zeros(d.shape[1]), np.zeros(d.shape[1])
             self.corr_max = np.maximum(self.corr_max, np.abs(d).max(axis=0))
             self.corr_sq += np.einsum("ij,ij->j", d, d)
+
+    def add_lines(self, chunk: Chunk) -> None:
+        """The G1 path deviations of a chunk (the first largest kept: ties to the earlier
+        line)."""
+        for r, dev in chunk.lines.items():
+            if r < 0:
+                self.lines_tcpm += dev
+                continue
+            self.lines_sampled += 1
+            if dev > self.max_line_dev or self.max_line_at is None:
+                self.max_line_dev, self.max_line_at = dev, int(chunk.blocks.numbers[r])
 
     def corrections(self, axes) -> dict:
         """Axis -> (max |correction|, rms correction) over the compensated blocks, mm / deg
@@ -575,6 +594,9 @@ class Summary:
             "arcs": {"kept": self.arcs_kept, "linearised": self.arcs_linearised,
                      "segments": self.segments,
                      "max_path_deviation_um": float(self.max_arc_dev)},
+            "lines": {"sampled": self.lines_sampled, "tcpm_not_sampled": self.lines_tcpm,
+                      "max_path_deviation_um": float(self.max_line_dev),
+                      "line": self.max_line_at},
         }
 
 
@@ -610,6 +632,7 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
             funcs.has_reversal else None
         known = set(initial)
         summary = Summary()
+        line_paths = LinePaths()
         sink.start()
         fh = open_source()
         try:
@@ -617,7 +640,7 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
             while True:
                 buf = list(itertools.islice(fh, chunk_lines))
                 chunk = _run_chunk(buf, first, interp, writer, em, opts, known, pre.dialect,
-                                   directions)
+                                   line_paths, directions)
                 summary.add(chunk)
                 sink.add(chunk)
                 if progress is not None:
@@ -636,7 +659,7 @@ def run(open_source, model, funcs, opts: Options, sink, chunk_lines: int = CHUNK
         never = tuple(a for a in model.rotary_axes if a in never or a in late)
 
 
-def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None,
+def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None, line_paths=None,
                directions=None) -> Chunk:
     model = em.model
     b = interpret(segs, first, interp, model, opts.decimals, dialect, WHOLE_CHUNK)
@@ -655,7 +678,8 @@ def _run_chunk(segs, first, interp, writer, em, opts, known, dialect=None,
     if interp.vector_words is not None:
         writer.vector_words = interp.vector_words
     text = writer.chunk(b, w_out, arc_res)
-    return Chunk(b, sol, q_out, pred, text, opts.strategy, w_out, arc_res)
+    lines = line_paths.chunk(em, b, q_out) if line_paths is not None else {}
+    return Chunk(b, sol, q_out, pred, text, opts.strategy, w_out, arc_res, lines)
 
 
 def _settle(em, b: Blocks, sol: Solution, w_out, q_out, opts, directions):

@@ -158,6 +158,8 @@ class Blocks:
     dir_before: np.ndarray | None = None
     #: the approach directions of the program as read (its own moves), for "before"
     dir_program: np.ndarray | None = None
+    #: (n,) per row: a straight feed move (G1; not G0, not an arc)
+    feed: np.ndarray | None = None
 
     def dir(self, rows):
         """The directions of ``rows`` (None without reversal)."""
@@ -193,6 +195,8 @@ class Sheet:
         self.nd = np.full((n, len(self.letters)), decimals, dtype=np.int64)
         self.nd[:, self.nax:] = max(decimals, VECTOR_DECIMALS)
         self.motion = np.zeros(n, dtype=bool)
+        #: per line: a straight move under G1 (feed; G0 rapids and arcs are not)
+        self.feed = np.zeros(n, dtype=bool)
         self.frame = np.zeros(n, dtype=np.int8)
         self.length = np.full(n, np.nan)
         self.paths, self.slow, self.runs = {}, {}, []
@@ -270,6 +274,7 @@ def interpret_run(sheet: Sheet, sc, i: int, j: int, interp: gcode.Interpreter,
     startv = np.array([np.nan if pos[a] is None else pos[a] for a in letters])
     sheet.w[i:j, :cols] = np.where(last >= 0, v[np.maximum(last, 0), np.arange(cols)], startv)
     sheet.motion[i:j] = has.any(axis=1)
+    _feed_of_run(sheet, sc, ws, i, j, interp)
     if interp.frame == "tcpm":          # TCPM: the tip, and the angles or the vector
         mrows = i + np.flatnonzero(has.any(axis=1))
         sheet.frame[mrows] = tcpm.VECTOR if vector else tcpm.ANGLES
@@ -282,6 +287,21 @@ def interpret_run(sheet: Sheet, sc, i: int, j: int, interp: gcode.Interpreter,
         val = sheet.w[j - 1, c]
         pos[a] = None if val != val else float(val)
     sheet.runs.append((i, j, cols))
+
+
+def _feed_of_run(sheet: Sheet, sc, ws: slice, i: int, j: int, interp) -> None:
+    """The modal G0 / G1 of every line of a run (its last G word so far, else the mode in
+    force before the run) -> ``sheet.feed``; the mode after the run left in ``interp``."""
+    g = np.flatnonzero(sc.axis[ws] == chunkscan.G_WORD)
+    mode = np.full(j - i, interp.motion, dtype=np.int64)
+    if len(g):
+        at = np.full(j - i, -1, dtype=np.int64)
+        at[sc.line[ws][g] - i] = sc.value[ws][g].astype(np.int64)
+        last = np.where(at >= 0, np.arange(j - i), -1)
+        np.maximum.accumulate(last, out=last)
+        mode = np.where(last >= 0, at[np.maximum(last, 0)], mode)
+        interp.motion = int(mode[-1])
+    sheet.feed[i:j] = sheet.motion[i:j] & (mode == 1)
 
 
 def interpret_line(sheet: Sheet, segs, first: int, i: int, interp: gcode.Interpreter,
@@ -304,6 +324,7 @@ def interpret_line(sheet: Sheet, segs, first: int, i: int, interp: gcode.Interpr
         return
     nax, w = sheet.nax, sheet.w
     sheet.motion[i] = True
+    sheet.feed[i] = step.kind == "motion" and interp.motion == 1
     w[i] = [np.nan if pos[a] is None else pos[a] for a in sheet.letters]
     if step.frame == "tcpm":
         vec = step.orientation == "vector"
@@ -359,7 +380,8 @@ def _blocks(sheet: Sheet, segs, first: int, sc, interp, rotary_axes) -> Blocks:
     return Blocks(list(segs), first, sc, sheet.runs, sheet.slow, row, first + rows,
                   w[rows, :nax].copy(), sheet.nd[rows], order, pending, known_rotary, motion,
                   w[rows], frame[rows], sheet.length[rows],
-                  {int(row[i]): p for i, p in sheet.paths.items() if row[i] >= 0})
+                  {int(row[i]): p for i, p in sheet.paths.items() if row[i] >= 0},
+                  feed=sheet.feed[rows])
 
 
 def _refuse_zero_vectors(w, rows, nax: int, first: int) -> None:
