@@ -9,6 +9,8 @@ controller's conversational language): the program is refused naming that line.
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import re
 
 from ..errors import InputError
@@ -79,7 +81,10 @@ def refuse_decimal_less(lines, first: int = 1) -> None:
     m = _DECIMAL_LESS.search(text)
     if m is None:
         return
-    number = first + text.count("\n", 0, m.start()) if "\n" in text else first
+    # the match's line by the lines' lengths without comments (a comment ends on its line), so
+    # any line ending counts: LF, CR LF or CR
+    ends = itertools.accumulate(len(_COMMENT.sub("", seg)) for seg in lines)
+    number = first + bisect.bisect_right(list(ends), m.start())
     word = f"{m.group(1).upper()}{m.group(2)}"
     raise InputError(f"line {number}: {word} has no decimal point in a Fanuc-style program "
                      f"(O number): {word}. mm or {word} x 0.001 mm by the controller's "

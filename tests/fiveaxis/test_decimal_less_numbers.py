@@ -45,3 +45,11 @@ def test_what_is_not_ambiguous_passes(text):
 def test_refusal_line_number_counts_from_the_chunk_start():
     with pytest.raises(volerr.errors.InputError, match=r"line 12: Y-2 has no decimal point"):
         dialect.refuse_decimal_less(["G0 X1.\n", "(c)\n", "G1 Y-2\n"], first=10)
+
+
+@pytest.mark.parametrize("ending", ["\n", "\r\n", "\r"])
+def test_refusal_line_number_for_every_line_ending(ending, fb2):
+    # a program with CR endings (old controllers' editors) named line 1 before
+    text = FANUC.replace("\n", ending)
+    with pytest.raises(volerr.errors.InputError, match=r"line 5: X350 has no decimal point"):
+        compensate_program(*fb2, text)
